@@ -1,0 +1,1 @@
+"""I-POMDP infomax model of eye movement: the numpy model core (no rclpy)."""

@@ -1,0 +1,53 @@
+"""The ``ipomdp-gaze`` command line: one subcommand per job.
+
+Each subcommand lives in its own module under ``ipomdp_gaze.commands`` with ``add_parser(sub)``
+(registering its arguments and a ``run(args) -> int``). A bad argument or input file exits
+non-zero with one clear line on stderr, never a traceback.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+# Modules under ipomdp_gaze.commands, in the order --help lists them.
+COMMANDS = ('evaluate', 'search', 'demo')
+
+
+class CliError(Exception):
+    """A user-facing error: printed as one line, exit status 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):
+        self.exit(2, f'{self.prog}: error: {message}\n')
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The top-level parser with every subcommand registered."""
+    parser = _Parser(
+        prog='ipomdp-gaze',
+        description='I-POMDP infomax gaze control (Butko & Movellan, ICDL 2008): '
+                    'evaluate, train and run policies that choose where to look next.')
+    sub = parser.add_subparsers(dest='command', metavar='COMMAND', parser_class=_Parser)
+    sub.required = True
+    for name in COMMANDS:
+        importlib.import_module(f'ipomdp_gaze.commands.{name}').add_parser(sub)
+    return parser
+
+
+def main(argv=None) -> int:
+    """Entry point of the console script."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.run(args) or 0)
+    except (CliError, ValueError, OSError) as exc:
+        print(f'ipomdp-gaze {args.command}: error: {exc}', file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130
+
+
+if __name__ == '__main__':
+    sys.exit(main())

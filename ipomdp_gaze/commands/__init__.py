@@ -1,0 +1,1 @@
+"""Subcommands of ``ipomdp-gaze``; shared argument helpers live in :mod:`.common`."""

@@ -1,0 +1,90 @@
+"""Argument helpers shared by the subcommands: grid, FPOC and policy selection."""
+from __future__ import annotations
+
+import argparse
+import math
+
+import yaml
+
+from ipomdp_gaze.fpoc import MODELS, make_fpoc, parameter_names
+from ipomdp_gaze.grid import Grid, parse_grid
+
+
+def grid_arg(text: str) -> tuple[int, int]:
+    """argparse type for ``ROWSxCOLS``."""
+    try:
+        return parse_grid(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def positive_int(text: str) -> int:
+    """argparse type for an integer >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'expected a positive integer, got {text!r}') from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f'expected a positive integer, got {text!r}')
+    return value
+
+
+def nonneg_int(text: str) -> int:
+    """argparse type for an integer >= 0 (seeds)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'expected an integer >= 0, got {text!r}') from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f'expected an integer >= 0, got {text!r}')
+    return value
+
+
+def positive_float(text: str) -> float:
+    """argparse type for a finite number > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'expected a positive number, got {text!r}') from None
+    if not math.isfinite(value) or value <= 0:
+        raise argparse.ArgumentTypeError(f'expected a positive number, got {text!r}')
+    return value
+
+
+def fpoc_param(text: str) -> tuple[str, object]:
+    """argparse type for ``name=value``; the value is parsed as YAML (numbers, lists, words)."""
+    name, sep, value = text.partition('=')
+    if not sep or not name.strip():
+        raise argparse.ArgumentTypeError(f'expected name=value, got {text!r}')
+    try:
+        parsed = yaml.safe_load(value)
+    except yaml.YAMLError:
+        raise argparse.ArgumentTypeError(f'cannot parse the value of {text!r}') from None
+    return name.strip(), parsed
+
+
+def add_task_args(parser: argparse.ArgumentParser, grid: str = '7x7', spacing: float = 0.42,
+                  fpoc: str = 'human') -> None:
+    """``--grid``, ``--spacing-deg``, ``--fpoc`` and repeated ``--fpoc-param name=value``."""
+    parser.add_argument('--grid', type=grid_arg, default=parse_grid(grid),
+                        help=f'visual array ROWSxCOLS (default {grid})')
+    parser.add_argument('--spacing-deg', type=positive_float, default=spacing,
+                        help=f'degrees between neighbouring cells (default {spacing})')
+    parser.add_argument('--fpoc', choices=tuple(MODELS), default=fpoc,
+                        help=f'FPOC model (default {fpoc})')
+    parser.add_argument('--fpoc-param', type=fpoc_param, action='append', default=[],
+                        metavar='NAME=VALUE',
+                        help='FPOC parameter by its DESIGN.md name, e.g. foveal_dprime=2.5 '
+                             '(repeatable)')
+
+
+def task_from_args(args) -> tuple[Grid, object]:
+    """Build ``(grid, fpoc)`` from :func:`add_task_args` arguments (ValueError names the problem)."""
+    grid = Grid(args.grid[0], args.grid[1], args.spacing_deg)
+    params = dict(args.fpoc_param)
+    names = parameter_names(args.fpoc)
+    for name in params:
+        if name not in names:
+            raise ValueError(f"unknown FPOC parameter {name!r} for {args.fpoc!r}; valid: "
+                             f"{', '.join(names)}")
+    return grid, make_fpoc(args.fpoc, **params)

@@ -1,0 +1,1 @@
+"""Fixation policies: baselines, learned families, training and shipped kernels."""

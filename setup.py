@@ -1,0 +1,43 @@
+"""Install ipomdp_gaze: an ament_python ROS 2 package that is also a plain pip package."""
+from glob import glob
+
+from setuptools import setup
+
+PACKAGE = 'ipomdp_gaze'
+
+setup(
+    name=PACKAGE,
+    version='0.1.0',
+    packages=[PACKAGE, f'{PACKAGE}.nodes', 'policies', 'msg_adapters'],
+    package_data={'policies': ['kernels/*.yaml']},
+    data_files=[
+        ('share/ament_index/resource_index/packages', [f'resource/{PACKAGE}']),
+        (f'share/{PACKAGE}', ['package.xml']),
+        (f'share/{PACKAGE}/config', glob('config/*.yaml')),
+        (f'share/{PACKAGE}/launch', glob('launch/*.launch.py')),
+        (f'share/{PACKAGE}/kernels', glob('policies/kernels/*.yaml')),
+    ],
+    python_requires='>=3.10',
+    install_requires=[
+        'numpy>=1.24',
+        'scipy>=1.10',
+        'matplotlib>=3.7',
+        'tqdm>=4.60',
+        'PyYAML>=6.0',
+        'gymnasium>=1.0',
+    ],
+    extras_require={
+        'ros': ['ros-jazzy-rclpy[fastrtps]', 'ros-jazzy-common-interfaces'],
+        'test': ['pytest>=7', 'hypothesis>=6'],
+    },
+    zip_safe=True,
+    maintainer='ipomdp_gaze developers',
+    maintainer_email='ipomdp-gaze@example.org',
+    description='I-POMDP infomax gaze control (Butko & Movellan 2008) for ROS 2 pan/tilt heads',
+    license='Apache-2.0',
+    entry_points={
+        'console_scripts': [
+            'ipomdp-gaze = ipomdp_gaze.cli:main',
+        ],
+    },
+)
