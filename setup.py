@@ -38,6 +38,8 @@ setup(
     entry_points={
         'console_scripts': [
             'ipomdp-gaze = ipomdp_gaze.cli:main',
+            'controller = ipomdp_gaze.nodes.controller:main',
+            'camera = ipomdp_gaze.nodes.camera:main',
         ],
     },
 )

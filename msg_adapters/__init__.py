@@ -1,1 +1,19 @@
-"""Conversions between numpy arrays and ROS messages."""
+"""Conversions between numpy arrays and ROS 2 messages: the only place that touches message fields.
+
+Submodules
+----------
+grid_arrays
+    Grid-shaped ``Float32MultiArray`` (belief, evidence) and the ``Int32MultiArray`` ground truth.
+joints
+    Cell <-> pan/tilt angles (REP 103 signs, offsets, limits) and the head commands
+    (``JointState``, ``Float64MultiArray``, ``JointTrajectory``).
+images
+    The colour-mapped belief heatmap (``rgb8``) and ``32FC1`` evidence images.
+diagnostics
+    ``/diagnostics`` status and the ``found`` event.
+stamps
+    ``builtin_interfaces/Time`` <-> seconds.
+
+The model core and the policies never import this package; the nodes import nothing else to
+read or fill a message.
+"""

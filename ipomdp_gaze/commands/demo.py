@@ -1,15 +1,53 @@
-"""``ipomdp-gaze demo``: the main job of ``make demo``."""
+"""``ipomdp-gaze demo`` (what ``make demo`` runs): the ROS 2 nodes find a hidden target.
+
+Starts ``gaze_controller`` and ``simulated_camera`` as two processes with the shipped YAML files,
+prints each fixation until the ``found`` event, says where the target is and whether that is
+right, and shuts both nodes down (see :mod:`ipomdp_gaze.nodes.demo`). The offline, ROS-free
+search is ``ipomdp-gaze search``.
+"""
 from __future__ import annotations
+
+from .common import nonneg_int, positive_float
 
 
 def add_parser(sub):
-    p = sub.add_parser('demo', help='run the demo search (what `make demo` runs)',
-                       description='An offline search with the default human FPOC and ELM.')
-    p.add_argument('--seed', type=int, default=0)
+    p = sub.add_parser(
+        'demo', help='run the ROS 2 demo: controller and simulated camera as two processes',
+        description='Start the gaze_controller and simulated_camera nodes as separate processes '
+                    'with config/controller.yaml and config/camera.yaml on a private ROS domain, '
+                    'print every fixation until the target is found, and shut both down.')
+    p.add_argument('--fpoc', choices=('camera', 'human'), default='camera',
+                   help='FPOC of both nodes (human: 0.42 deg/cell and ELM; default camera)')
+    p.add_argument('--policy', default=None,
+                   help="the controller's policy.name (default: the YAML file's; elm for human)")
+    p.add_argument('--seed', type=nonneg_int, default=0,
+                   help='seed of both nodes (the camera draws target and noise from it)')
+    p.add_argument('--target', default=None, metavar='ROW,COL',
+                   help='where the camera hides the target (default: random)')
+    p.add_argument('--timeout', type=positive_float, default=120.0,
+                   help='give up after this many seconds (default 120)')
+    p.add_argument('--domain-id', type=int, default=None,
+                   help='ROS domain id, 0..101 (default: derived from the process id)')
+    p.add_argument('--verbose', action='store_true', help="print the nodes' own output")
     p.set_defaults(run=run)
 
 
+def parse_target(text):
+    """``'ROW,COL'`` -> ``(row, col)``; None stays None."""
+    if text is None:
+        return None
+    try:
+        row, col = (int(x) for x in text.split(','))
+    except ValueError:
+        raise ValueError(f'--target must be ROW,COL, got {text!r}') from None
+    return row, col
+
+
 def run(args) -> int:
-    from ipomdp_gaze.cli import main
-    return main(['search', '--grid', '7x7', '--fpoc', 'human', '--policy', 'elm',
-                 '--seed', str(args.seed)])
+    from ipomdp_gaze.nodes.demo import demo_setup, run_demo
+
+    def out(line):
+        print(line, flush=True)
+
+    setup = demo_setup(args.fpoc, args.policy, args.seed, parse_target(args.target))
+    return run_demo(setup, args.timeout, args.domain_id, args.verbose, out)

@@ -1,0 +1,21 @@
+"""``ipomdp-gaze camera``: run the ``simulated_camera`` node (what ``ros2 run`` starts)."""
+from __future__ import annotations
+
+import argparse
+
+
+def add_parser(sub):
+    p = sub.add_parser(
+        'camera', help='run the simulated_camera ROS 2 node',
+        description='Run the simulated_camera node, exactly as `ros2 run ipomdp_gaze camera` '
+                    'does; everything after --ros-args goes to ROS (-p name:=value, '
+                    '--params-file FILE, -r from:=to, --log-level ...).')
+    p.add_argument('--ros-args', dest='ros_args', nargs=argparse.REMAINDER, default=None,
+                   metavar='ARG', help='ROS arguments')
+    p.set_defaults(run=run)
+
+
+def run(args) -> int:
+    from ipomdp_gaze.nodes.camera import main
+    ros = [] if args.ros_args is None else ['--ros-args', *args.ros_args]
+    return main(['ipomdp-gaze-camera', *ros])

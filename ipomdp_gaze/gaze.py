@@ -1,0 +1,301 @@
+"""The gaze controller's brain, without ROS: belief, frame acceptance, policy and found event.
+
+:class:`GazeController` is what the ``gaze_controller`` node wraps. It holds the belief over the
+target's cell and the current fixation, and decides what to do with every frame of evidence:
+
+- a frame that cannot be used (wrong length, +/-inf; the node adds layout errors through
+  :meth:`GazeController.reject`) is *rejected* and the belief is unchanged;
+- while disabled, or before ``settle_time_s`` has passed since the current target was sent
+  (a frame taken mid-saccade), a valid frame is *skipped*;
+- otherwise it is *applied*: one frame per fixation (the model assumes independent noise per
+  observation), NaN cells count as unobserved, and the policy chooses the next fixation at once.
+
+Every frame is counted: ``received = applied + rejected + skipped``. The first fixation after a
+reset is the start cell (the centre by default, DESIGN.md section 4); the policy picks the rest.
+Times are plain seconds on whatever clock the caller uses (the node's ROS clock).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from policies.baselines import STRATEGIES, make_baseline
+from policies.conv import ConvPolicy, check_action
+
+from .belief import (EvidenceError, check_evidence, entropy, map_cell, normalize_log,
+                     uniform_log_belief)
+from .fpoc import FPOC, dprime_matrix
+from .grid import Grid
+
+POLICY_NAMES = ('learned', 'map', 'elm', 'random', 'center', 'spiral', 'greedy')
+
+
+class PolicyUnavailable(ValueError):
+    """A policy that cannot be built here: a policy file or module that does not exist."""
+
+
+@dataclass(frozen=True)
+class Found:
+    """The found event: the most likely cell first reached the confidence level."""
+
+    cell: int
+    probability: float
+    fixations: int
+
+
+@dataclass(frozen=True)
+class FrameResult:
+    """What happened to one frame of evidence.
+
+    ``status`` is ``'applied'``, ``'skipped'`` or ``'rejected'``; ``reason`` says why a frame was
+    not applied; ``fixation`` is the new target after an applied frame; ``found`` is set on the
+    frame that first made the most likely cell reach the confidence level.
+    """
+
+    status: str
+    reason: str = ''
+    fixation: int | None = None
+    found: Found | None = None
+
+    @property
+    def applied(self) -> bool:
+        """Whether the frame updated the belief."""
+        return self.status == 'applied'
+
+
+def check_kernel(values, grid: Grid) -> np.ndarray:
+    """A row-major kernel (``(2*rows-1) * (2*cols-1)`` finite numbers) as a 2-D array.
+
+    Raises
+    ------
+    ValueError
+        Naming the expected length or the non-finite entry.
+    """
+    shape = grid.kernel_shape
+    a = np.asarray(values, dtype=float).ravel()
+    if a.size != shape[0] * shape[1]:
+        raise ValueError(f'policy.kernel must have {shape[0] * shape[1]} values '
+                         f'({shape[0]}x{shape[1]} row-major for a {grid.rows}x{grid.cols} grid), '
+                         f'got {a.size}')
+    bad = np.flatnonzero(~np.isfinite(a))
+    if bad.size:
+        raise ValueError(f'policy.kernel must be finite, entry {int(bad[0])} is {a[bad[0]]}')
+    return a.reshape(shape)
+
+
+def build_policy(name: str, grid: Grid, fpoc: FPOC, kernel=None, file: str = '',
+                 action: str = 'argmax', warn=None):
+    """Build the policy called ``name`` (one of :data:`POLICY_NAMES`).
+
+    ``learned`` uses ``kernel`` (a row-major convolutional kernel) when it is non-empty, else the
+    policy ``file`` (a policy YAML path or a shipped kernel name); ``action`` (``argmax`` or
+    ``sample``) applies to it. A file trained on another FPOC is accepted and ``warn(message)``
+    is called; one for another grid is refused.
+
+    Raises
+    ------
+    PolicyUnavailable
+        If the policy file does not exist or policy files are not supported by this install.
+    ValueError
+        For an unknown name, a bad kernel or a policy file that does not fit the grid.
+    """
+    check_action(action)
+    if name in STRATEGIES:
+        try:
+            return make_baseline(name, grid, fpoc)
+        except ImportError as exc:
+            raise PolicyUnavailable(f'policy {name!r} is not available in this install '
+                                    f'({exc})') from None
+    if name != 'learned':
+        raise ValueError(f"unknown policy {name!r}; valid policies: {', '.join(POLICY_NAMES)}")
+    if kernel is not None and len(kernel):
+        return ConvPolicy(grid, check_kernel(kernel, grid), action=action)
+    if not file:
+        raise ValueError("policy 'learned' needs policy.kernel or policy.file")
+    try:
+        from policies.policy_file import load_policy
+    except ImportError as exc:
+        raise PolicyUnavailable(f'policy files are not supported by this install ({exc})') \
+            from None
+    try:
+        return load_policy(file, grid=grid, fpoc=fpoc, action=action, warn=warn)
+    except FileNotFoundError as exc:
+        raise PolicyUnavailable(f'policy file {file!r} not found ({exc})') from None
+
+
+class GazeController:
+    """Belief, fixation and frame acceptance of one search (see the module docstring).
+
+    Parameters
+    ----------
+    grid, fpoc
+        The task; the FPOC is the controller's model of its camera and detector.
+    policy
+        Anything with ``select(belief (1, N), t, rng)``.
+    start_cell
+        First fixation after a reset (default: the centre cell).
+    settle_time_s
+        Frames stamped earlier than this after the target was sent are skipped.
+    confidence
+        The found event fires when the most likely cell's probability first reaches this.
+    seed
+        Seed of the generator handed to the policy (``random``, ``sample``).
+    """
+
+    def __init__(self, grid: Grid, fpoc: FPOC, policy, start_cell: int | None = None,
+                 settle_time_s: float = 0.0, confidence: float = 0.95, seed: int = 0):
+        self.grid = grid
+        self.set_fpoc(fpoc)
+        self.policy = policy
+        self.set_start_cell(grid.center_index if start_cell is None else start_cell)
+        self.set_settle_time(settle_time_s)
+        self.set_confidence(confidence)
+        self.reseed(seed)
+        self.enabled = True
+        self.received = self.applied = self.rejected = self.skipped = 0
+        self.last_rejection = ''
+        self._log_belief = uniform_log_belief(grid.n_cells)
+        self._belief = np.exp(self._log_belief)
+        self.fixation = self.start_cell
+        self.fixations = 0
+        self.target_time_s = 0.0
+        self.found: Found | None = None
+
+    # -- configuration -------------------------------------------------------------------
+    def set_fpoc(self, fpoc: FPOC) -> None:
+        """Use another FPOC for the following updates (the belief is kept)."""
+        self.fpoc = fpoc
+        self._dprime_by_fixation = np.ascontiguousarray(dprime_matrix(self.grid, fpoc).T)
+
+    def set_policy(self, policy) -> None:
+        """Use another policy from the next choice on."""
+        self.policy = policy
+
+    def set_start_cell(self, cell: int) -> None:
+        """The first fixation after the next reset."""
+        self.grid.cell(cell)
+        self.start_cell = int(cell)
+
+    def set_settle_time(self, settle_time_s: float) -> None:
+        """Seconds after sending a target before a frame may be used."""
+        if not np.isfinite(settle_time_s) or settle_time_s < 0:
+            raise ValueError(f'settle_time_s must be finite and >= 0, got {settle_time_s!r}')
+        self.settle_time_s = float(settle_time_s)
+
+    def set_confidence(self, confidence: float) -> None:
+        """Probability of the most likely cell at which the found event fires."""
+        if not 0 < confidence < 1:
+            raise ValueError(f'confidence must be between 0 and 1 (exclusive), got {confidence!r}')
+        self.confidence = float(confidence)
+
+    def reseed(self, seed: int) -> None:
+        """Restart the policy's random stream."""
+        self.rng = np.random.default_rng(seed)
+
+    # -- state -----------------------------------------------------------------------------
+    @property
+    def belief(self) -> np.ndarray:
+        """Probabilities ``B_i`` (N,), a copy."""
+        return self._belief.copy()
+
+    @property
+    def map_cell(self) -> int:
+        """The most likely cell (ties to the lowest index)."""
+        return int(map_cell(self._belief))
+
+    @property
+    def map_probability(self) -> float:
+        """Probability of the most likely cell."""
+        return float(self._belief[self.map_cell])
+
+    @property
+    def entropy_nats(self) -> float:
+        """Entropy of the belief in nats."""
+        return float(entropy(self._belief))
+
+    def counters(self) -> dict:
+        """Frames received, applied, rejected and skipped (received = the other three)."""
+        return {'received': self.received, 'applied': self.applied,
+                'rejected': self.rejected, 'skipped': self.skipped}
+
+    # -- events ----------------------------------------------------------------------------
+    def reset(self, now_s: float) -> int:
+        """Uniform belief, fixation back to the start cell; returns it (sent at ``now_s``)."""
+        self._log_belief = uniform_log_belief(self.grid.n_cells)
+        self._belief = np.exp(self._log_belief)
+        self.fixation = self.start_cell
+        self.fixations = 0
+        self.found = None
+        self.target_time_s = float(now_s)
+        return self.fixation
+
+    def retarget(self, now_s: float) -> int:
+        """The current target is (re)sent at ``now_s``: frames must settle from then on."""
+        self.target_time_s = float(now_s)
+        return self.fixation
+
+    def set_enabled(self, enabled: bool, now_s: float) -> bool:
+        """Enable or disable; returns whether that changed anything.
+
+        Disabled, frames are skipped (no belief update, no new target). Enabling again re-sends
+        the current target at ``now_s``.
+        """
+        enabled = bool(enabled)
+        if enabled == self.enabled:
+            return False
+        self.enabled = enabled
+        if enabled:
+            self.retarget(now_s)
+        return True
+
+    def reject(self, reason: str) -> FrameResult:
+        """Count a frame that could not even be read (for example a bad message layout)."""
+        self.received += 1
+        self.rejected += 1
+        self.last_rejection = str(reason)
+        return FrameResult('rejected', str(reason))
+
+    def offer(self, evidence, stamp_s: float, now_s: float | None = None) -> FrameResult:
+        """Use, skip or reject one frame of evidence taken at ``stamp_s``.
+
+        Parameters
+        ----------
+        evidence : array (N,)
+            One standardised detector response per cell; NaN = not observed.
+        stamp_s : float
+            When the frame was taken (its header stamp, or its arrival time).
+        now_s : float, optional
+            Current time, when the next target is sent (default ``stamp_s``).
+        """
+        try:
+            obs = check_evidence(evidence, self.grid.n_cells)
+        except EvidenceError as exc:
+            return self.reject(str(exc))
+        self.received += 1
+        if not self.enabled:
+            self.skipped += 1
+            return FrameResult('skipped', 'disabled')
+        if stamp_s < self.target_time_s + self.settle_time_s:
+            self.skipped += 1
+            return FrameResult('skipped', 'taken before the fixation settled')
+        d = self._dprime_by_fixation[self.fixation]
+        term = d * (obs - 0.5 * d)
+        self._log_belief += np.where(np.isnan(term), 0.0, term)
+        normalize_log(self._log_belief)
+        np.exp(self._log_belief, out=self._belief)
+        self.applied += 1
+        self.fixations += 1
+        found = None
+        if self.found is None and self.map_probability >= self.confidence:
+            found = self.found = Found(self.map_cell, self.map_probability, self.fixations)
+        self.fixation = self.choose()
+        self.target_time_s = float(stamp_s if now_s is None else now_s)
+        return FrameResult('applied', fixation=self.fixation, found=found)
+
+    def choose(self) -> int:
+        """The policy's choice for the next fixation given the current belief."""
+        choice = self.policy.select(self._belief[None, :], self.fixations, self.rng)
+        cell = int(np.asarray(choice).ravel()[0])
+        self.grid.cell(cell)
+        return cell

@@ -1,0 +1,243 @@
+"""The ``simulated_camera`` node: a pan/tilt camera and detector for bench testing.
+
+It stands in for the hardware. It subscribes ``pan_tilt`` (``sensor_msgs/JointState``), snaps
+the command to the nearest cell and moves there in ``saccade_time_s`` (until it arrives, the head
+is still at the old cell; a repeated command for the cell it is moving to is ignored, one for the
+cell it is at takes ``saccade_time_s`` to settle again). With ``rate_hz = 0`` it publishes one
+evidence frame when it arrives; with ``rate_hz > 0`` it publishes frames at that rate like a video
+camera, including while it moves. Each frame follows the observation model with the
+camera's own FPOC: ``o_j ~ N(d, 1)`` at the target, ``N(0, 1)`` elsewhere, and NaN where the
+FPOC gives ``d' = 0`` (outside the field of view, not observed).
+
+Publishes ``evidence`` (``Float32MultiArray``, best effort) or, with ``publish_image``, the
+stamped ``evidence_image`` (``32FC1``); ``joint_states`` (its pose, stamped like the frame taken
+there); and ``ground_truth`` (``std_msgs/Int32MultiArray`` ``[row, col]``, transient local).
+``~/reset`` (``std_srvs/Trigger``) draws a new target (``target_row``/``target_col``, or a random
+cell when they are -1).
+"""
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+
+import numpy as np
+import rclpy
+from rcl_interfaces.msg import SetParametersResult
+from rclpy.exceptions import ParameterException
+from rclpy.executors import ExternalShutdownException
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import Image, JointState
+from std_msgs.msg import Float32MultiArray, Int32MultiArray
+from std_srvs.srv import Trigger
+
+from ipomdp_gaze.fpoc import dprime_matrix
+from msg_adapters import grid_arrays, images, joints
+
+from .params import (INT_MAX, T, Param, cell_from, current_values, declare, fpoc_from,
+                     fpoc_params, grid_from, grid_params, head_from, joint_params)
+
+NODE_NAME = 'simulated_camera'
+FRAME_QOS = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
+STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                       durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
+def camera_params() -> list[Param]:
+    """Every parameter of the simulated camera, in declaration order."""
+    return grid_params() + fpoc_params() + joint_params(limits=False) + [
+        Param('target_row', -1, T.INTEGER, 'row of the target (-1: random at each reset)',
+              int_range=(-1, 254)),
+        Param('target_col', -1, T.INTEGER, 'column of the target (-1: random at each reset)',
+              int_range=(-1, 254)),
+        Param('seed', 0, T.INTEGER, 'seed of the targets and the observation noise',
+              int_range=(0, INT_MAX)),
+        Param('saccade_time_s', 0.15, T.DOUBLE, 'time to move to a new cell',
+              float_range=(0.0, 60.0)),
+        Param('rate_hz', 0.0, T.DOUBLE,
+              'frames per second like a video camera (0: one frame per arrival)',
+              float_range=(0.0, 1000.0)),
+        Param('publish_image', False, T.BOOL,
+              'publish stamped 32FC1 evidence_image frames instead of evidence'),
+    ]
+
+
+@dataclass
+class CameraConfig:
+    """What the camera derives from its parameters."""
+
+    values: dict
+    grid: object
+    dprime: np.ndarray
+    head: joints.PanTiltMap
+    target: int | None
+
+
+class SimulatedCameraNode(Node):
+    """A simulated pan/tilt head with a detector (see the module docstring)."""
+
+    def __init__(self, **kwargs):
+        super().__init__(NODE_NAME, **kwargs)
+        self._params = camera_params()
+        self._by_name = {p.name: p for p in self._params}
+        self._ready = False
+        self._pending = None
+        self.add_on_set_parameters_callback(self._on_set)
+        self.add_post_set_parameters_callback(self._post_set)
+        declare(self, self._params)
+        self._config = self._build(current_values(self, self._params))
+        v = self._config.values
+        self.rng = np.random.default_rng(v['seed'])
+        self.pose = self.goal = self._config.grid.center_index
+        self.moving = False
+        self.target = 0
+        self._evidence_pub = self.create_publisher(Float32MultiArray, 'evidence', FRAME_QOS)
+        self._image_pub = self.create_publisher(Image, 'evidence_image', FRAME_QOS)
+        self._joint_pub = self.create_publisher(JointState, 'joint_states', 10)
+        self._truth_pub = self.create_publisher(Int32MultiArray, 'ground_truth', STATE_QOS)
+        self.create_subscription(JointState, 'pan_tilt', self._on_command, STATE_QOS)
+        self.create_service(Trigger, '~/reset', self._on_reset)
+        self._saccade_timer = self._frame_timer = None
+        self._make_timers(v)
+        self._ready = True
+        self._new_target()
+        self._publish_pose(self.get_clock().now().to_msg())
+
+    # -- parameters ----------------------------------------------------------------------
+    def _build(self, values: dict) -> CameraConfig:
+        grid = grid_from(values)
+        fpoc = fpoc_from(values)
+        head = head_from(values, grid)
+        target = cell_from(values, grid, 'target_row', 'target_col')
+        return CameraConfig(dict(values), grid, dprime_matrix(grid, fpoc), head, target)
+
+    def _on_set(self, params) -> SetParametersResult:
+        for p in params:
+            spec = self._by_name.get(p.name)
+            reason = spec.check(p.value) if spec is not None else None
+            if reason:
+                return SetParametersResult(successful=False, reason=reason)
+        if not self._ready:
+            return SetParametersResult(successful=True)
+        values = current_values(self, self._params)
+        values.update({p.name: p.value for p in params})
+        try:
+            self._pending = self._build(values)
+        except ValueError as exc:
+            self._pending = None
+            return SetParametersResult(successful=False, reason=str(exc))
+        return SetParametersResult(successful=True)
+
+    def _post_set(self, params) -> None:
+        if not self._ready or self._pending is None:
+            return
+        old, self._config, self._pending = self._config, self._pending, None
+        v, ov = self._config.values, old.values
+        if v['seed'] != ov['seed']:
+            self.rng = np.random.default_rng(v['seed'])
+        if (v['saccade_time_s'], v['rate_hz']) != (ov['saccade_time_s'], ov['rate_hz']):
+            self._make_timers(v)
+        changed = ', '.join(f'{p.name}={p.value!r}' for p in params)
+        self.get_logger().info(f'parameters set: {changed}')
+
+    def _make_timers(self, values: dict) -> None:
+        for timer in (self._saccade_timer, self._frame_timer):
+            if timer is not None:
+                self.destroy_timer(timer)
+        self._saccade_timer = self._frame_timer = None
+        if self.moving:
+            self._arrive()
+        if values['saccade_time_s'] > 0:
+            self._saccade_timer = self.create_timer(values['saccade_time_s'], self._on_arrival)
+            self._saccade_timer.cancel()
+        if values['rate_hz'] > 0:
+            self._frame_timer = self.create_timer(1.0 / values['rate_hz'], self._publish_frame)
+
+    # -- head ------------------------------------------------------------------------------
+    def _on_command(self, msg: JointState) -> None:
+        try:
+            pan, tilt = joints.angles_from_joint_state(msg, self._config.head)
+            cell = self._config.head.nearest_cell(pan, tilt)
+        except ValueError as exc:
+            self.get_logger().warning(f'ignored a pan_tilt command: {exc}',
+                                      throttle_duration_sec=5.0)
+            return
+        if cell == self.goal and self.moving:
+            return
+        self.goal, self.moving = cell, True
+        if self._saccade_timer is None:
+            self._arrive()
+        else:
+            self._saccade_timer.reset()
+
+    def _on_arrival(self) -> None:
+        self._saccade_timer.cancel()
+        if self.moving:
+            self._arrive()
+
+    def _arrive(self) -> None:
+        self.pose, self.moving = self.goal, False
+        if self._config.values['rate_hz'] == 0:
+            self._publish_frame()
+        else:
+            self._publish_pose(self.get_clock().now().to_msg())
+
+    # -- outputs -------------------------------------------------------------------------
+    def _publish_frame(self) -> None:
+        cfg = self._config
+        d = cfg.dprime[:, self.pose]
+        obs = self.rng.standard_normal(cfg.grid.n_cells)
+        obs[self.target] += d[self.target]
+        obs[d == 0] = np.nan
+        stamp = self.get_clock().now().to_msg()
+        if cfg.values['publish_image']:
+            self._image_pub.publish(images.evidence_image(obs, cfg.grid, stamp))
+        else:
+            self._evidence_pub.publish(grid_arrays.to_multiarray(obs, cfg.grid))
+        self._publish_pose(stamp)
+
+    def _publish_pose(self, stamp) -> None:
+        self._joint_pub.publish(joints.joint_state(self._config.head, self.pose, stamp))
+
+    def _new_target(self) -> int:
+        cfg = self._config
+        self.target = int(self.rng.integers(cfg.grid.n_cells)) if cfg.target is None \
+            else cfg.target
+        self._truth_pub.publish(grid_arrays.ground_truth(cfg.grid, self.target))
+        return self.target
+
+    def _on_reset(self, request, response):
+        row, col = self._config.grid.cell(self._new_target())
+        response.success = True
+        response.message = f'new target at ({row}, {col})'
+        self.get_logger().info(response.message)
+        return response
+
+
+def main(args=None) -> int:
+    """Run the ``simulated_camera`` node until shutdown (Ctrl-C or SIGTERM)."""
+    rclpy.init(args=args)
+    node = None
+    status = 0
+    try:
+        node = SimulatedCameraNode()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except _rclpy.RCLError:
+        # SIGTERM/SIGINT shut the context down while the executor was building its wait set.
+        if rclpy.ok():
+            raise
+    except (ValueError, ParameterException) as exc:
+        print(f'{NODE_NAME}: error: {exc}', file=sys.stderr)
+        status = 1
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return status
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,481 @@
+"""The ``gaze_controller`` node: I-POMDP gaze control of a pan/tilt head.
+
+A thin wrapper: :class:`ipomdp_gaze.gaze.GazeController` holds the belief and decides, and
+:mod:`msg_adapters` reads and fills every message. Relative topic names, so namespaces and
+remapping work:
+
+- subscribes ``evidence`` (``std_msgs/Float32MultiArray``, one standardised detector response
+  per cell, NaN = not observed; arrival time counts) and ``evidence_image``
+  (``sensor_msgs/Image`` 32FC1, rows x cols; its header stamp counts, or its arrival when unset),
+  both best effort;
+- publishes ``pan_tilt`` (``sensor_msgs/JointState``, transient local, depth 1, re-sent every
+  ``retry_period_s`` until a usable frame arrives), ``belief`` (``Float32MultiArray``) and
+  ``belief_image`` (``rgb8``) after every update and reset, ``found``
+  (``diagnostic_msgs/DiagnosticStatus``, once per search) and ``/diagnostics``; optionally
+  ``Float64MultiArray`` and ``JointTrajectory`` head commands on the topics their parameters name;
+- services ``~/reset`` (``std_srvs/Trigger``) and ``~/enable`` (``std_srvs/SetBool``).
+
+Run with ``ros2 run ipomdp_gaze controller`` (or ``ipomdp-gaze controller``) and the usual
+``--ros-args``.
+"""
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+
+import rclpy
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from rcl_interfaces.msg import SetParametersResult
+from rclpy.exceptions import NameValidationException, ParameterException
+from rclpy.executors import ExternalShutdownException
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.validate_topic_name import validate_topic_name
+from sensor_msgs.msg import Image, JointState
+from std_msgs.msg import Float32MultiArray, Float64MultiArray
+from std_srvs.srv import SetBool, Trigger
+from trajectory_msgs.msg import JointTrajectory
+
+from ipomdp_gaze.belief import EvidenceError
+from ipomdp_gaze.gaze import (POLICY_NAMES, GazeController, PolicyUnavailable, build_policy,
+                              check_kernel)
+from msg_adapters import diagnostics, grid_arrays, images, joints, stamps
+from policies.baselines import STRATEGIES
+from policies.conv import ACTIONS
+
+from .params import (INT_MAX, T, Param, cell_from, current_values, declare, fpoc_from,
+                     fpoc_params, grid_from, grid_params, head_from, joint_params)
+
+NODE_NAME = 'gaze_controller'
+EVIDENCE_QOS = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
+STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                       durability=DurabilityPolicy.TRANSIENT_LOCAL)
+WARN_THROTTLE_S = 5.0
+
+
+def controller_params() -> list[Param]:
+    """Every parameter of the controller, in declaration order (the grid first)."""
+    return grid_params() + fpoc_params() + [
+        Param('start_row', -1, T.INTEGER, 'row of the first fixation after a reset (-1: centre)',
+              int_range=(-1, 254)),
+        Param('start_col', -1, T.INTEGER,
+              'column of the first fixation after a reset (-1: centre)', int_range=(-1, 254)),
+        Param('seed', 0, T.INTEGER, 'seed of the random and sample policies',
+              int_range=(0, INT_MAX)),
+        Param('settle_time_s', 0.1, T.DOUBLE,
+              'frames taken earlier than this after a target was sent are skipped',
+              float_range=(0.0, 60.0)),
+        Param('retry_period_s', 1.0, T.DOUBLE,
+              're-send the current target this often until a usable frame arrives (0: never)',
+              float_range=(0.0, 3600.0)),
+        Param('confidence', 0.95, T.DOUBLE,
+              'the found event fires when the most likely cell first reaches this probability',
+              float_range=(0.0, 1.0)),
+        Param('policy.name', 'elm', T.STRING, 'fixation policy', choices=POLICY_NAMES),
+        Param('policy.file', '', T.STRING,
+              'policy YAML path or shipped kernel name; setting it selects learned'),
+        Param('policy.kernel', None, T.DOUBLE_ARRAY,
+              'convolutional kernel, (2*rows-1) x (2*cols-1) row-major; setting it selects '
+              'learned'),
+        Param('policy.action', 'argmax', T.STRING, 'action rule of a learned policy',
+              choices=ACTIONS),
+        Param('policy.fallback', '', T.STRING,
+              'baseline used at start-up when policy.file does not exist ("": fail)',
+              choices=('',) + STRATEGIES),
+    ] + joint_params(limits=True) + [
+        Param('forward_command_topic', '', T.STRING,
+              'also send [pan, tilt] as Float64MultiArray here ("": off)'),
+        Param('trajectory_topic', '', T.STRING, 'also send a JointTrajectory here ("": off)'),
+        Param('trajectory_duration_s', 0.5, T.DOUBLE,
+              'time_from_start of the JointTrajectory point', float_range=(0.0, 60.0)),
+        Param('belief_image_scale_px', 32, T.INTEGER, 'pixels per cell in belief_image',
+              int_range=(1, 256)),
+        Param('diagnostics_period_s', 1.0, T.DOUBLE, 'period of /diagnostics',
+              float_range=(0.01, 3600.0)),
+    ]
+
+
+POLICY_KEYS = ('policy.name', 'policy.file', 'policy.kernel', 'policy.action')
+
+
+@dataclass
+class Config:
+    """Everything the node derives from its parameters."""
+
+    values: dict
+    grid: object
+    fpoc: object
+    policy: object
+    head: joints.PanTiltMap
+    start_cell: int
+    warning: str = ''
+
+
+class GazeControllerNode(Node):
+    """ROS 2 wrapper of :class:`ipomdp_gaze.gaze.GazeController`."""
+
+    def __init__(self, **kwargs):
+        super().__init__(NODE_NAME, **kwargs)
+        self._params = controller_params()
+        self._by_name = {p.name: p for p in self._params}
+        self._ready = False
+        self._pending: Config | None = None
+        self.add_pre_set_parameters_callback(self._pre_set)
+        self.add_on_set_parameters_callback(self._on_set)
+        self.add_post_set_parameters_callback(self._post_set)
+        declare(self, self._params)
+        self._config = self._startup_config()
+        cfg = self._config
+        v = cfg.values
+        self.core = GazeController(cfg.grid, cfg.fpoc, cfg.policy, cfg.start_cell,
+                                   v['settle_time_s'], v['confidence'], v['seed'])
+
+        self._pan_tilt_pub = self.create_publisher(JointState, 'pan_tilt', STATE_QOS)
+        self._belief_pub = self.create_publisher(Float32MultiArray, 'belief', 10)
+        self._image_pub = self.create_publisher(Image, 'belief_image', 2)
+        self._found_pub = self.create_publisher(DiagnosticStatus, 'found', 10)
+        self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
+        self._forward_pub = self._trajectory_pub = None
+        self._make_command_publishers(v)
+        self.create_subscription(Float32MultiArray, 'evidence', self._on_evidence, EVIDENCE_QOS)
+        self.create_subscription(Image, 'evidence_image', self._on_evidence_image, EVIDENCE_QOS)
+        self.create_service(Trigger, '~/reset', self._on_reset)
+        self.create_service(SetBool, '~/enable', self._on_enable)
+        self._retry_timer = self._diag_timer = None
+        self._make_timers(v)
+        self._resends = 0
+        self._diag_rejected_before = 0
+        self._diag_last = (self._now_s(), 0)
+        self._pan_tilt_msg = None
+        self._ready = True
+        self.core.reset(self._now_s())
+        self._publish_belief()
+        self._send_target()
+        self.get_logger().info(
+            f'{cfg.grid.rows}x{cfg.grid.cols} grid at {cfg.grid.spacing_deg} deg/cell, FPOC '
+            f'{cfg.fpoc.to_dict()}, policy {self._policy_label(v)}; first fixation '
+            f'{cfg.grid.cell(self.core.fixation)}')
+
+    # -- parameters ----------------------------------------------------------------------
+    def _build(self, values: dict, changed=None, previous: Config | None = None) -> Config:
+        """Derive a :class:`Config` from parameter values (ValueError names the problem)."""
+        grid = grid_from(values)
+        fpoc = fpoc_from(values)
+        head = head_from(values, grid)
+        start = cell_from(values, grid, 'start_row', 'start_col')
+        if not 0.0 < values['confidence'] < 1.0:
+            raise ValueError(f"confidence must be between 0 and 1 (exclusive), got "
+                             f"{values['confidence']}")
+        if values['policy.kernel']:
+            check_kernel(values['policy.kernel'], grid)
+        for name in ('forward_command_topic', 'trajectory_topic'):
+            if values[name]:
+                try:
+                    validate_topic_name(values[name])
+                except NameValidationException as exc:
+                    raise ValueError(f'{name}: {exc}') from None
+        warnings = []
+        policy_changed = changed is None or any(k in changed for k in POLICY_KEYS) or any(
+            k.startswith('fpoc.') for k in changed)
+        if previous is not None and not policy_changed:
+            policy = previous.policy
+        else:
+            policy = build_policy(values['policy.name'], grid, fpoc, values['policy.kernel'],
+                                  values['policy.file'], values['policy.action'],
+                                  warn=warnings.append)
+        return Config(dict(values), grid, fpoc, policy, head,
+                      grid.center_index if start is None else start, '; '.join(warnings))
+
+    def _startup_config(self) -> Config:
+        values = current_values(self, self._params)
+        try:
+            cfg = self._build(values)
+        except PolicyUnavailable as exc:
+            fallback = values['policy.fallback']
+            if not fallback:
+                raise
+            self.get_logger().warning(f'{exc}; using policy.fallback {fallback!r}')
+            self.set_parameters([Parameter('policy.name', T.STRING, fallback)])
+            values['policy.name'] = fallback
+            cfg = self._build(values)
+        if cfg.warning:
+            self.get_logger().warning(cfg.warning)
+        return cfg
+
+    def _pre_set(self, params: list[Parameter]) -> list[Parameter]:
+        """Make a kernel or a policy file select the learned policy, in the same atomic set.
+
+        Setting a file also clears the kernel, which would otherwise take precedence.
+        """
+        names = {p.name for p in params}
+        extra = []
+        for p in params:
+            if p.name == 'policy.kernel' and p.type_ == T.DOUBLE_ARRAY and len(p.value):
+                extra.append(Parameter('policy.name', T.STRING, 'learned'))
+            if p.name == 'policy.file' and p.type_ == T.STRING and p.value:
+                extra.append(Parameter('policy.name', T.STRING, 'learned'))
+                if 'policy.kernel' not in names:
+                    extra.append(Parameter('policy.kernel', T.DOUBLE_ARRAY, []))
+        seen = set(names)
+        for p in extra:
+            if p.name not in seen:
+                seen.add(p.name)
+                params = params + [p]
+        return params
+
+    def _on_set(self, params: list[Parameter]) -> SetParametersResult:
+        for p in params:
+            spec = self._by_name.get(p.name)
+            reason = spec.check(p.value) if spec is not None else None
+            if reason:
+                return SetParametersResult(successful=False, reason=reason)
+        if not self._ready:
+            return self._check_declared(params)
+        values = current_values(self, self._params)
+        values.update({p.name: p.value for p in params})
+        try:
+            self._pending = self._build(values, {p.name for p in params}, self._config)
+        except ValueError as exc:
+            self._pending = None
+            return SetParametersResult(successful=False, reason=str(exc))
+        reason = f'accepted with a warning: {self._pending.warning}' \
+            if self._pending.warning else ''
+        return SetParametersResult(successful=True, reason=reason)
+
+    def _check_declared(self, params: list[Parameter]) -> SetParametersResult:
+        """While declaring: check what the already declared grid allows (overrides included)."""
+        try:
+            for p in params:
+                if p.name == 'policy.kernel' and p.value:
+                    check_kernel(p.value, grid_from(current_values(self, grid_params())))
+        except ValueError as exc:
+            return SetParametersResult(successful=False, reason=str(exc))
+        return SetParametersResult(successful=True)
+
+    def _post_set(self, params: list[Parameter]) -> None:
+        if not self._ready or self._pending is None:
+            return
+        old, cfg = self._config, self._pending
+        self._config, self._pending = cfg, None
+        if cfg.warning:
+            self.get_logger().warning(cfg.warning)
+        v, ov = cfg.values, old.values
+        core = self.core
+        core.set_fpoc(cfg.fpoc)
+        core.set_policy(cfg.policy)
+        core.set_start_cell(cfg.start_cell)
+        core.set_settle_time(v['settle_time_s'])
+        core.set_confidence(v['confidence'])
+        if v['seed'] != ov['seed']:
+            core.reseed(v['seed'])
+        if (v['forward_command_topic'], v['trajectory_topic']) != \
+                (ov['forward_command_topic'], ov['trajectory_topic']):
+            self._make_command_publishers(v)
+        if (v['retry_period_s'], v['diagnostics_period_s']) != \
+                (ov['retry_period_s'], ov['diagnostics_period_s']):
+            self._make_timers(v)
+        if cfg.head != old.head and core.enabled:
+            core.retarget(self._now_s())
+            self._send_target()
+        changed = ', '.join(f'{p.name}={p.value!r}' for p in params)
+        self.get_logger().info(f'parameters set: {changed}; policy {self._policy_label(v)}')
+
+    @staticmethod
+    def _policy_label(values: dict) -> str:
+        name = values['policy.name']
+        if name != 'learned':
+            return name
+        if values['policy.kernel']:
+            return f"learned (policy.kernel, {values['policy.action']})"
+        return f"learned ({values['policy.file']}, {values['policy.action']})"
+
+    def _make_command_publishers(self, values: dict) -> None:
+        for pub in (self._forward_pub, self._trajectory_pub):
+            if pub is not None:
+                self.destroy_publisher(pub)
+        self._forward_pub = self._trajectory_pub = None
+        if values['forward_command_topic']:
+            self._forward_pub = self.create_publisher(
+                Float64MultiArray, values['forward_command_topic'], 10)
+        if values['trajectory_topic']:
+            self._trajectory_pub = self.create_publisher(
+                JointTrajectory, values['trajectory_topic'], 10)
+
+    def _make_timers(self, values: dict) -> None:
+        for timer in (self._retry_timer, self._diag_timer):
+            if timer is not None:
+                self.destroy_timer(timer)
+        self._retry_timer = None
+        if values['retry_period_s'] > 0:
+            self._retry_timer = self.create_timer(values['retry_period_s'], self._on_retry)
+        self._diag_timer = self.create_timer(values['diagnostics_period_s'],
+                                             self._publish_diagnostics)
+
+    # -- time ----------------------------------------------------------------------------
+    def _now(self):
+        return self.get_clock().now()
+
+    def _now_s(self) -> float:
+        return self._now().nanoseconds * 1e-9
+
+    # -- outputs -------------------------------------------------------------------------
+    def _send_target(self) -> None:
+        """Publish the current fixation as the head's target."""
+        head, cell = self._config.head, self.core.fixation
+        self._pan_tilt_msg = joints.joint_state(head, cell, self._now().to_msg())
+        self._publish_target()
+
+    def _publish_target(self) -> None:
+        head, cell = self._config.head, self.core.fixation
+        self._pan_tilt_pub.publish(self._pan_tilt_msg)
+        if self._forward_pub is not None:
+            self._forward_pub.publish(joints.forward_command(head, cell))
+        if self._trajectory_pub is not None:
+            self._trajectory_pub.publish(joints.joint_trajectory(
+                head, cell, self._config.values['trajectory_duration_s']))
+        if self._retry_timer is not None:
+            self._retry_timer.reset()
+
+    def _on_retry(self) -> None:
+        if self.core.enabled and self._pan_tilt_msg is not None:
+            self._resends += 1
+            self._publish_target()
+
+    def _publish_belief(self) -> None:
+        grid, belief = self._config.grid, self.core.belief
+        self._belief_pub.publish(grid_arrays.to_multiarray(belief, grid))
+        if self._image_pub.get_subscription_count():
+            self._image_pub.publish(images.belief_image(
+                belief, grid, self.core.fixation, self._config.values['belief_image_scale_px'],
+                self._now().to_msg()))
+
+    def _publish_found(self, found) -> None:
+        grid = self._config.grid
+        row, col = grid.cell(found.cell)
+        pan, tilt = self._config.head.angles(found.cell)
+        self._found_pub.publish(diagnostics.found_status(
+            f'{self.get_fully_qualified_name()}: found', row, col, found.cell, pan, tilt,
+            found.probability, found.fixations))
+        self.get_logger().info(
+            f'found: target most likely at ({row}, {col}), pan {pan:+.4f} rad, tilt '
+            f'{tilt:+.4f} rad, probability {found.probability:.4f} after {found.fixations} '
+            f'fixations')
+
+    def _publish_diagnostics(self) -> None:
+        core, grid = self.core, self._config.grid
+        now = self._now_s()
+        last_t, last_received = self._diag_last
+        rate = (core.received - last_received) / max(now - last_t, 1e-9)
+        self._diag_last = (now, core.received)
+        counters = core.counters()
+        map_row, map_col = grid.cell(core.map_cell)
+        fix_row, fix_col = grid.cell(core.fixation)
+        level, message = 'ok', 'searching'
+        if not core.enabled:
+            message = 'disabled'
+        elif core.found is not None:
+            message = 'target found'
+        elif core.received == last_received:
+            level, message = 'warn', 'no evidence received'
+        if core.rejected and core.last_rejection and level == 'ok' and \
+                self._diag_rejected_before != core.rejected:
+            level, message = 'warn', f'evidence rejected: {core.last_rejection}'
+        self._diag_rejected_before = core.rejected
+        values = {
+            'policy': self._policy_label(self._config.values), 'enabled': core.enabled,
+            'evidence_rate_hz': rate, 'frames_received': counters['received'],
+            'frames_applied': counters['applied'], 'frames_rejected': counters['rejected'],
+            'frames_skipped': counters['skipped'], 'fixations': core.fixations,
+            'fixation_row': fix_row, 'fixation_col': fix_col, 'entropy_nats': core.entropy_nats,
+            'most_likely_row': map_row, 'most_likely_col': map_col,
+            'most_likely_probability': core.map_probability, 'found': core.found is not None,
+            'pan_tilt_resends': self._resends, 'last_rejection': core.last_rejection}
+        self._diag_pub.publish(diagnostics.diagnostic_array(
+            [diagnostics.status(f'{self.get_fully_qualified_name()}: search', level, message,
+                                values)], self._now().to_msg()))
+
+    # -- inputs --------------------------------------------------------------------------
+    def _on_evidence(self, msg: Float32MultiArray) -> None:
+        now = self._now_s()
+        try:
+            values = grid_arrays.from_multiarray(msg, self._config.grid)
+        except EvidenceError as exc:
+            self._handle(self.core.reject(str(exc)))
+            return
+        self._handle(self.core.offer(values, now))
+
+    def _on_evidence_image(self, msg: Image) -> None:
+        now = self._now_s()
+        try:
+            values = images.evidence_from_image(msg, self._config.grid)
+        except EvidenceError as exc:
+            self._handle(self.core.reject(str(exc)))
+            return
+        stamp = now if stamps.is_zero(msg.header.stamp) else stamps.to_seconds(msg.header.stamp)
+        self._handle(self.core.offer(values, stamp, now))
+
+    def _handle(self, result) -> None:
+        if result.status == 'rejected':
+            self.get_logger().warning(
+                f'rejected an evidence frame ({self.core.rejected} so far): {result.reason}',
+                throttle_duration_sec=WARN_THROTTLE_S)
+            return
+        if not result.applied:
+            return
+        self._publish_belief()
+        if result.found is not None:
+            self._publish_found(result.found)
+        self._send_target()
+
+    def _on_reset(self, request, response):
+        cell = self.core.reset(self._now_s())
+        self._publish_belief()
+        row, col = self._config.grid.cell(cell)
+        response.success = True
+        if self.core.enabled:
+            self._send_target()
+            response.message = f'belief reset; looking at ({row}, {col})'
+        else:
+            response.message = f'belief reset; disabled, ({row}, {col}) is sent when enabled'
+        self.get_logger().info(response.message)
+        return response
+
+    def _on_enable(self, request, response):
+        changed = self.core.set_enabled(request.data, self._now_s())
+        state = 'enabled' if self.core.enabled else 'disabled'
+        if changed and self.core.enabled:
+            self._send_target()
+        response.success = True
+        response.message = state if changed else f'already {state}'
+        self.get_logger().info(f'gaze control {response.message}')
+        return response
+
+
+def main(args=None) -> int:
+    """Run the ``gaze_controller`` node until shutdown (Ctrl-C or SIGTERM)."""
+    rclpy.init(args=args)
+    node = None
+    status = 0
+    try:
+        node = GazeControllerNode()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except _rclpy.RCLError:
+        # SIGTERM/SIGINT shut the context down while the executor was building its wait set.
+        if rclpy.ok():
+            raise
+    except (ValueError, ParameterException) as exc:
+        print(f'{NODE_NAME}: error: {exc}', file=sys.stderr)
+        status = 1
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return status
+
+
+if __name__ == '__main__':
+    sys.exit(main())

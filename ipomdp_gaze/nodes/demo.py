@@ -1,0 +1,225 @@
+"""The ROS 2 demo: both nodes as separate processes, watched from this process.
+
+:func:`run_demo` starts ``gaze_controller`` and then ``simulated_camera`` (once the controller's
+first target has arrived here, so no update is missed), prints every fixation until the ``found``
+event, checks the answer against the camera's ``ground_truth`` and stops both with SIGTERM. It
+runs on its own ROS domain with discovery limited to this host, so it never drives a real head.
+"""
+from __future__ import annotations
+
+import math
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import rclpy
+import yaml
+from diagnostic_msgs.msg import DiagnosticStatus
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float32MultiArray, Int32MultiArray
+
+from ipomdp_gaze.belief import entropy
+from msg_adapters import diagnostics, grid_arrays, joints
+
+from .config import config_file
+from .params import grid_from, head_from
+from .processes import NodeProcess, domain_id_for, ros_environment
+
+LATCHED = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE,
+                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
+FPOC_OVERRIDES = {
+    'camera': {},
+    # The human FPOC is calibrated at 0.42 degrees per cell (DESIGN.md section 2).
+    'human': {'fpoc.model': 'human', 'grid.spacing_deg': 0.42},
+}
+
+
+def flatten(tree: dict, prefix: str = '') -> dict:
+    """Nested YAML parameters -> dotted names (``{'grid': {'rows': 11}}`` -> ``grid.rows``)."""
+    out = {}
+    for key, value in tree.items():
+        name = f'{prefix}{key}'
+        if isinstance(value, dict):
+            out.update(flatten(value, name + '.'))
+        else:
+            out[name] = value
+    return out
+
+
+def yaml_parameters(path, node_name: str) -> dict:
+    """The ``ros__parameters`` of ``node_name`` in a parameter file, with dotted names."""
+    tree = yaml.safe_load(Path(path).read_text())
+    try:
+        return flatten(tree[node_name]['ros__parameters'])
+    except (KeyError, TypeError):
+        raise ValueError(f'{path} has no {node_name}: ros__parameters block') from None
+
+
+def _ros_value(value) -> str:
+    if isinstance(value, bool):
+        return 'true' if value else 'false'
+    return str(value)
+
+
+@dataclass
+class DemoSetup:
+    """Arguments of both nodes and the controller's grid and head, as the YAML files say."""
+
+    controller_args: list
+    camera_args: list
+    grid: object
+    head: joints.PanTiltMap
+    overrides: dict = field(default_factory=dict)
+
+
+def demo_setup(fpoc: str = 'camera', policy: str | None = None, seed: int = 0,
+               target: tuple | None = None) -> DemoSetup:
+    """Build the node arguments from the shipped YAML files and the demo's options."""
+    if fpoc not in FPOC_OVERRIDES:
+        raise ValueError(f"fpoc must be one of {', '.join(FPOC_OVERRIDES)}, got {fpoc!r}")
+    controller_yaml, camera_yaml = config_file('controller.yaml'), config_file('camera.yaml')
+    shared = dict(FPOC_OVERRIDES[fpoc], seed=seed)
+    controller = dict(shared)
+    policy = policy or ('elm' if fpoc == 'human' else None)
+    if policy:
+        controller['policy.name'] = policy
+    camera = dict(shared)
+    if target is not None:
+        camera.update({'target_row': int(target[0]), 'target_col': int(target[1])})
+    values = yaml_parameters(controller_yaml, 'gaze_controller')
+    values.update(controller)
+    grid = grid_from(values)
+
+    def ros_args(path, overrides):
+        args = ['--params-file', str(path)]
+        for name, value in overrides.items():
+            args += ['-p', f'{name}:={_ros_value(value)}']
+        return args
+
+    return DemoSetup(ros_args(controller_yaml, controller), ros_args(camera_yaml, camera), grid,
+                     head_from(values, grid), controller)
+
+
+class Watcher:
+    """A node in the demo process that records what the controller and camera publish."""
+
+    def __init__(self, context):
+        self.node = Node('gaze_demo', context=context)
+        self.targets, self.beliefs, self.found, self.truth = [], [], [], []
+        self._stamps = set()
+        self.node.create_subscription(Float32MultiArray, 'belief', self._on_belief, 50)
+        self.node.create_subscription(JointState, 'pan_tilt', self._on_target, LATCHED)
+        self.node.create_subscription(DiagnosticStatus, 'found', self.found.append, 10)
+        self.node.create_subscription(Int32MultiArray, 'ground_truth', self.truth.append,
+                                      LATCHED)
+
+    def _on_belief(self, msg):
+        # A uniform belief is a reset, not the result of a fixation.
+        if np.ptp(np.asarray(msg.data)) > 0:
+            self.beliefs.append(msg)
+
+    def _on_target(self, msg):
+        key = (msg.header.stamp.sec, msg.header.stamp.nanosec)
+        if key not in self._stamps:     # a retry re-sends the same message
+            self._stamps.add(key)
+            self.targets.append(msg)
+
+
+class _Session:
+    def __init__(self, executor, deadline, processes):
+        self.executor, self.deadline, self.processes = executor, deadline, processes
+
+    def spin_until(self, condition) -> bool:
+        while not condition():
+            if time.monotonic() > self.deadline:
+                return False
+            for proc in self.processes:
+                if proc.proc is not None and not proc.running:
+                    raise RuntimeError(f'the {proc.node} node exited with status '
+                                       f'{proc.proc.returncode}:\n{proc.output()[-3000:]}')
+            self.executor.spin_once(timeout_sec=0.05)
+        return True
+
+
+def run_demo(setup: DemoSetup, timeout_s: float = 120.0, domain_id: int | None = None,
+             verbose: bool = False, out=print) -> int:
+    """Run the demo; 0 when the target was found and both nodes stopped cleanly."""
+    domain = domain_id_for() if domain_id is None else domain_id
+    with tempfile.TemporaryDirectory(prefix='ipomdp-gaze-demo-') as tmp:
+        env = ros_environment(domain, Path(tmp) / 'ros_log')
+        controller = NodeProcess('controller', setup.controller_args, env,
+                                 Path(tmp) / 'controller.log')
+        camera = NodeProcess('camera', setup.camera_args, env, Path(tmp) / 'camera.log')
+        context = rclpy.Context()
+        rclpy.init(context=context, domain_id=domain, args=[])
+        executor = SingleThreadedExecutor(context=context)
+        watcher = Watcher(context)
+        executor.add_node(watcher.node)
+        session = _Session(executor, time.monotonic() + timeout_s, [controller, camera])
+        g = setup.grid
+        out(f'ipomdp-gaze demo: {g.rows}x{g.cols} grid at {g.spacing_deg} deg/cell, ROS domain '
+            f'{domain}; starting gaze_controller, then simulated_camera')
+        status = 1
+        try:
+            controller.start()
+            if not session.spin_until(lambda: watcher.targets):
+                raise RuntimeError('the controller sent no target in time')
+            camera.start()
+            status = _follow(setup, watcher, session, timeout_s, out)
+        except RuntimeError as exc:
+            out(f'ipomdp-gaze demo: error: {exc}')
+        finally:
+            codes = {p.node: p.stop() for p in (camera, controller)}
+            executor.shutdown(timeout_sec=1.0)
+            watcher.node.destroy_node()
+            rclpy.try_shutdown(context=context)
+        if verbose or status:
+            for p in (controller, camera):
+                out(f'--- {p.node} output ---\n{p.output().rstrip()}')
+        clean = all(code == 0 for code in codes.values())
+        out(f"stopped both nodes ({', '.join(f'{k} exit status {v}' for k, v in codes.items())})"
+            + ('' if clean else ': NOT a clean shutdown'))
+        return status if clean else 1
+
+
+def _follow(setup: DemoSetup, watcher: Watcher, session: _Session, timeout_s: float, out) -> int:
+    """Print fixations until the found event; return 0 once the answer was checked."""
+    grid, head = setup.grid, setup.head
+    printed = 0
+
+    def show_new():
+        nonlocal printed
+        while printed < min(len(watcher.beliefs), len(watcher.targets)):
+            belief = grid_arrays.from_multiarray(watcher.beliefs[printed], grid)
+            pan, tilt = joints.angles_from_joint_state(watcher.targets[printed], head)
+            looked = grid.cell(head.nearest_cell(pan, tilt))
+            guess = int(np.argmax(belief))
+            out(f'fixation {printed + 1:3d}: looked at {looked}  pan {math.degrees(pan):+6.2f} '
+                f'deg  tilt {math.degrees(tilt):+6.2f} deg  ->  most likely {grid.cell(guess)} '
+                f'p={belief[guess]:.3f}  entropy {float(entropy(belief)):.2f} nats')
+            printed += 1
+
+    def finished():
+        show_new()
+        return bool(watcher.found) and \
+            printed >= diagnostics.parse_found(watcher.found[0])['fixations']
+
+    if not session.spin_until(finished):
+        out(f'ipomdp-gaze demo: the target was not found within {timeout_s:g} s')
+        return 1
+    found = diagnostics.parse_found(watcher.found[0])
+    out(f"found: the target is most likely at ({found['row']}, {found['col']}), pan "
+        f"{math.degrees(found['pan_rad']):+.2f} deg, tilt {math.degrees(found['tilt_rad']):+.2f} "
+        f"deg, probability {found['probability']:.3f}, after {found['fixations']} fixations")
+    if not session.spin_until(lambda: watcher.truth):
+        out('ipomdp-gaze demo: the simulated camera did not report where the target is')
+        return 1
+    truth = grid_arrays.cell_from_ground_truth(watcher.truth[-1], grid)
+    verdict = 'right' if truth == found['cell'] else 'wrong'
+    out(f'the simulated camera hid the target at {grid.cell(truth)}: that is {verdict}')
+    return 0

@@ -1,0 +1,200 @@
+"""Parameter declarations shared by the nodes: explicit types, descriptors, ranges and choices.
+
+Both nodes describe the task with the same names (``grid.*``, ``fpoc.<name>`` with the names of
+DESIGN.md section 2, the pan/tilt joint mapping), so one YAML block can be shared. Every
+parameter is declared with a ``ParameterDescriptor`` and an explicit type; the grid is read-only
+after start. ``fpoc.dprime`` is dynamically typed because it is a number for the ``camera`` FPOC
+and a list for the ``table`` FPOC.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+from rclpy.parameter import Parameter
+
+from ipomdp_gaze.fpoc import MODELS, CameraFPOC, make_fpoc, parameter_names
+from ipomdp_gaze.grid import Grid
+from msg_adapters.joints import PanTiltMap
+
+T = Parameter.Type
+INT_MAX = 2 ** 31 - 1
+
+
+@dataclass(frozen=True)
+class Param:
+    """One declared parameter: name, default, type, description and constraints.
+
+    ``default=None`` declares the type only and then sets an empty array (array parameters).
+    ``choices`` restricts strings; ``float_range``/``int_range`` are enforced by rclpy itself.
+    """
+
+    name: str
+    default: object
+    type: Parameter.Type
+    description: str
+    read_only: bool = False
+    dynamic: bool = False
+    float_range: tuple | None = None
+    int_range: tuple | None = None
+    choices: tuple | None = None
+
+    def descriptor(self) -> ParameterDescriptor:
+        """The ``ParameterDescriptor`` to declare with."""
+        d = ParameterDescriptor(description=self.description, read_only=self.read_only)
+        if self.dynamic:
+            d.dynamic_typing = True
+        else:
+            d.type = self.type.value
+        if self.float_range is not None:
+            d.floating_point_range = [FloatingPointRange(
+                from_value=float(self.float_range[0]), to_value=float(self.float_range[1]),
+                step=0.0)]
+        if self.int_range is not None:
+            low, high, step = (tuple(self.int_range) + (1,))[:3]
+            d.integer_range = [IntegerRange(from_value=low, to_value=high, step=step)]
+        if self.choices is not None:
+            d.additional_constraints = 'one of: ' + ', '.join(repr(c) for c in self.choices)
+        return d
+
+    def check(self, value) -> str | None:
+        """The reason ``value`` is invalid, or None (ranges and types are rclpy's job)."""
+        if self.choices is not None and value not in self.choices:
+            return (f"{self.name} must be one of {', '.join(repr(c) for c in self.choices)}, "
+                    f'got {value!r}')
+        if self.dynamic and self.name == 'fpoc.dprime':
+            items = value if isinstance(value, (list, tuple)) else [value]
+            if not items or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                    for v in items):
+                return f'fpoc.dprime must be a number or a list of numbers, got {value!r}'
+        return None
+
+
+def grid_params() -> list[Param]:
+    """``grid.rows``, ``grid.cols``, ``grid.spacing_deg`` (read-only)."""
+    return [
+        Param('grid.rows', 11, T.INTEGER, 'rows of the visual array (read-only)', read_only=True,
+              int_range=(1, 255)),
+        Param('grid.cols', 11, T.INTEGER, 'columns of the visual array (read-only)',
+              read_only=True, int_range=(1, 255)),
+        Param('grid.spacing_deg', 5.0, T.DOUBLE,
+              'pan/tilt degrees between neighbouring cells (read-only)', read_only=True,
+              float_range=(1e-6, 90.0)),
+    ]
+
+
+def fpoc_params() -> list[Param]:
+    """``fpoc.model`` and the union of every model's parameters (DESIGN.md section 2).
+
+    The defaults describe a camera whose field of view covers 5x5 cells of a 5-degree grid.
+    """
+    return [
+        Param('fpoc.model', 'camera', T.STRING, 'FPOC model', choices=tuple(MODELS)),
+        Param('fpoc.dprime', 4.0, T.DOUBLE, "d' inside the field of view (camera: a number), "
+              "or d' at each fpoc.ecc_deg (table: a list)", dynamic=True),
+        Param('fpoc.shape', 'rectangle', T.STRING, 'camera field of view shape',
+              choices=CameraFPOC.SHAPES),
+        Param('fpoc.half_width_deg', 10.0, T.DOUBLE, 'camera: half-width of the field of view',
+              float_range=(0.0, 180.0)),
+        Param('fpoc.half_height_deg', 10.0, T.DOUBLE,
+              'camera: half-height of the field of view', float_range=(0.0, 180.0)),
+        Param('fpoc.radius_deg', 10.0, T.DOUBLE, 'camera (circle): radius of the field of view',
+              float_range=(0.0, 180.0)),
+        Param('fpoc.noise_contrast', 0.20, T.DOUBLE, 'human: noise contrast n',
+              float_range=(0.0, 10.0)),
+        Param('fpoc.foveal_dprime', 2.0, T.DOUBLE, "human, exponential: d' at the fovea",
+              float_range=(1e-6, 12.0)),
+        Param('fpoc.scale_deg', 1.5, T.DOUBLE, 'exponential: fall-off scale in degrees',
+              float_range=(1e-6, 180.0)),
+        Param('fpoc.ecc_deg', [0.0, 10.0], T.DOUBLE_ARRAY,
+              'table: eccentricities in degrees (increasing)'),
+    ]
+
+
+def joint_params(limits: bool) -> list[Param]:
+    """Joint names, REP 103 signs, offsets and (for the controller) joint limits."""
+    params = [
+        Param('pan_joint', 'pan_joint', T.STRING, 'name of the pan joint'),
+        Param('tilt_joint', 'tilt_joint', T.STRING, 'name of the tilt joint'),
+        Param('pan_sign', 1, T.INTEGER, '1 if positive pan turns left (REP 103), else -1',
+              int_range=(-1, 1, 2)),
+        Param('tilt_sign', 1, T.INTEGER, '1 if positive tilt looks down (REP 103), else -1',
+              int_range=(-1, 1, 2)),
+        Param('pan_offset_rad', 0.0, T.DOUBLE, 'pan of the centre column in radians',
+              float_range=(-2 * math.pi, 2 * math.pi)),
+        Param('tilt_offset_rad', 0.0, T.DOUBLE, 'tilt of the centre row in radians',
+              float_range=(-2 * math.pi, 2 * math.pi)),
+    ]
+    if limits:
+        params += [
+            Param('pan_min_rad', -math.pi, T.DOUBLE, 'lower pan limit; every cell must fit'),
+            Param('pan_max_rad', math.pi, T.DOUBLE, 'upper pan limit; every cell must fit'),
+            Param('tilt_min_rad', -math.pi / 2, T.DOUBLE, 'lower tilt limit; every cell must fit'),
+            Param('tilt_max_rad', math.pi / 2, T.DOUBLE, 'upper tilt limit; every cell must fit'),
+        ]
+    return params
+
+
+def declare(node, params: list[Param]) -> None:
+    """Declare every parameter (YAML and ``-p`` overrides go through the node's callbacks)."""
+    for p in params:
+        if p.default is None:
+            node.declare_parameter(p.name, p.type, p.descriptor())
+            if node.get_parameter_or(p.name).type_ == T.NOT_SET:
+                node.set_parameters([Parameter(p.name, p.type, [])])
+        else:
+            node.declare_parameter(p.name, p.default, p.descriptor())
+
+
+def current_values(node, params: list[Param]) -> dict:
+    """``{name: value}`` of the declared parameters."""
+    return {p.name: node.get_parameter(p.name).value for p in params}
+
+
+def grid_from(values: dict) -> Grid:
+    """The grid described by ``grid.*``."""
+    return Grid(values['grid.rows'], values['grid.cols'], values['grid.spacing_deg'])
+
+
+def fpoc_from(values: dict):
+    """The FPOC described by ``fpoc.model`` and its ``fpoc.<name>`` parameters."""
+    model = values['fpoc.model']
+    kwargs = {}
+    for name in parameter_names(model):
+        value = values[f'fpoc.{name}']
+        kwargs[name] = list(value) if isinstance(value, (list, tuple)) else value
+    if model == 'table' and not isinstance(kwargs['dprime'], list):
+        raise ValueError('the table FPOC needs fpoc.dprime as a list matching fpoc.ecc_deg')
+    return make_fpoc(model, **kwargs)
+
+
+def head_from(values: dict, grid: Grid) -> PanTiltMap:
+    """The pan/tilt mapping; joint limits are used when they were declared."""
+    limits = {}
+    if 'pan_min_rad' in values:
+        limits = {'pan_limits_rad': (values['pan_min_rad'], values['pan_max_rad']),
+                  'tilt_limits_rad': (values['tilt_min_rad'], values['tilt_max_rad'])}
+    return PanTiltMap(grid, values['pan_joint'], values['tilt_joint'], values['pan_sign'],
+                      values['tilt_sign'], values['pan_offset_rad'], values['tilt_offset_rad'],
+                      **limits)
+
+
+def cell_from(values: dict, grid: Grid, row_name: str, col_name: str):
+    """The cell named by two ``-1``-able row/col parameters, or None when both are -1.
+
+    Raises
+    ------
+    ValueError
+        If only one is -1 or the cell is outside the grid.
+    """
+    row, col = values[row_name], values[col_name]
+    if row == -1 and col == -1:
+        return None
+    if row == -1 or col == -1:
+        raise ValueError(f'{row_name} and {col_name} must both be -1 or both name a cell, '
+                         f'got {row} and {col}')
+    if not (0 <= row < grid.rows and 0 <= col < grid.cols):
+        raise ValueError(f'({row_name}, {col_name}) = ({row}, {col}) is outside the '
+                         f'{grid.rows}x{grid.cols} grid')
+    return grid.index(row, col)

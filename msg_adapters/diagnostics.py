@@ -1,0 +1,69 @@
+"""``diagnostic_msgs``: the controller's ``/diagnostics`` status and its ``found`` event.
+
+The ``found`` event is a ``diagnostic_msgs/DiagnosticStatus`` (level OK, a readable message)
+whose ``values`` carry the result as key/value strings: ``row``, ``col``, ``cell``, ``pan_rad``,
+``tilt_rad``, ``probability`` and ``fixations``. It reads well in ``ros2 topic echo`` and needs
+no custom interface package; :func:`parse_found` turns it back into numbers.
+"""
+from __future__ import annotations
+
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from std_msgs.msg import Header
+
+LEVELS = {'ok': DiagnosticStatus.OK, 'warn': DiagnosticStatus.WARN,
+          'error': DiagnosticStatus.ERROR, 'stale': DiagnosticStatus.STALE}
+FOUND_KEYS = ('row', 'col', 'cell', 'pan_rad', 'tilt_rad', 'probability', 'fixations')
+
+
+def _text(value) -> str:
+    if isinstance(value, bool):
+        return 'true' if value else 'false'
+    if isinstance(value, float):
+        return f'{value:.6g}'
+    return str(value)
+
+
+def status(name: str, level: str, message: str, values: dict,
+           hardware_id: str = '') -> DiagnosticStatus:
+    """A ``DiagnosticStatus``; ``level`` is ``ok``, ``warn``, ``error`` or ``stale``."""
+    return DiagnosticStatus(level=LEVELS[level], name=name, message=message,
+                            hardware_id=hardware_id,
+                            values=[KeyValue(key=k, value=_text(v)) for k, v in values.items()])
+
+
+def diagnostic_array(statuses, stamp) -> DiagnosticArray:
+    """A stamped ``DiagnosticArray`` for ``/diagnostics``."""
+    return DiagnosticArray(header=Header(stamp=stamp), status=list(statuses))
+
+
+def values_of(msg: DiagnosticStatus) -> dict:
+    """The key/value pairs of a status as a dict of strings."""
+    return {kv.key: kv.value for kv in msg.values}
+
+
+def found_status(name: str, row: int, col: int, cell: int, pan_rad: float, tilt_rad: float,
+                 probability: float, fixations: int) -> DiagnosticStatus:
+    """The ``found`` event."""
+    message = (f'target found at row {row}, col {col} (pan {pan_rad:+.4f} rad, tilt '
+               f'{tilt_rad:+.4f} rad) with probability {probability:.4f} after {fixations} '
+               f'fixations')
+    return status(name, 'ok', message, {
+        'row': row, 'col': col, 'cell': cell, 'pan_rad': float(pan_rad),
+        'tilt_rad': float(tilt_rad), 'probability': float(probability), 'fixations': fixations})
+
+
+def parse_found(msg: DiagnosticStatus) -> dict:
+    """The numbers of a ``found`` event (row, col, cell and fixations as int, the rest float).
+
+    Raises
+    ------
+    ValueError
+        If a key is missing or not a number.
+    """
+    kv = values_of(msg)
+    missing = [k for k in FOUND_KEYS if k not in kv]
+    if missing:
+        raise ValueError(f'found event lacks {missing}')
+    out = {k: int(kv[k]) for k in ('row', 'col', 'cell', 'fixations')}
+    out.update({k: float(kv[k]) for k in ('pan_rad', 'tilt_rad', 'probability')})
+    return out

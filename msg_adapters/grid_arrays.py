@@ -1,0 +1,122 @@
+"""Grid-shaped arrays <-> ``std_msgs`` multi-arrays (DESIGN.md section 5).
+
+The layout of a ``rows x cols`` grid is ``dim[0] = {label: 'rows', size: rows, stride: rows*cols}``,
+``dim[1] = {label: 'cols', size: cols, stride: cols}``, ``data_offset = 0``, data row-major.
+Incoming arrays with an empty layout are read as row-major of the node's grid when their length
+fits; a layout that disagrees with the grid makes the frame invalid (:class:`LayoutError`).
+"""
+from __future__ import annotations
+
+import array
+
+import numpy as np
+from std_msgs.msg import (Float32MultiArray, Int32MultiArray, MultiArrayDimension,
+                          MultiArrayLayout)
+
+from ipomdp_gaze.belief import EvidenceError
+from ipomdp_gaze.grid import Grid
+
+
+class LayoutError(EvidenceError):
+    """A message layout that does not describe the node's grid."""
+
+
+def grid_layout(grid: Grid) -> MultiArrayLayout:
+    """The two-dimension row-major layout of ``grid``."""
+    return MultiArrayLayout(
+        dim=[MultiArrayDimension(label='rows', size=grid.rows, stride=grid.n_cells),
+             MultiArrayDimension(label='cols', size=grid.cols, stride=grid.cols)],
+        data_offset=0)
+
+
+def to_multiarray(values, grid: Grid) -> Float32MultiArray:
+    """A ``Float32MultiArray`` holding ``values`` (N,) or (rows, cols) with the grid layout.
+
+    Raises
+    ------
+    ValueError
+        If ``values`` does not have one entry per cell.
+    """
+    a = np.ascontiguousarray(values, dtype=np.float32)
+    if a.size != grid.n_cells or a.shape not in ((grid.n_cells,), grid.shape):
+        raise ValueError(f'expected {grid.n_cells} values (shape ({grid.n_cells},) or '
+                         f'{grid.shape}), got shape {a.shape}')
+    msg = Float32MultiArray(layout=grid_layout(grid))
+    msg.data = array.array('f', a.tobytes())
+    return msg
+
+
+def check_layout(layout: MultiArrayLayout, grid: Grid) -> None:
+    """Raise :class:`LayoutError` unless ``layout`` is empty or describes ``grid`` row-major.
+
+    Accepted: no dimensions; one dimension of size N; or two of sizes (rows, cols). A stride of 0
+    counts as unset; any other stride must be the row-major one. ``data_offset`` must be 0.
+    """
+    if layout.data_offset != 0:
+        raise LayoutError(f'layout.data_offset is {layout.data_offset}, expected 0')
+    dims = list(layout.dim)
+    if not dims:
+        return
+    if len(dims) == 1:
+        expected = [(grid.n_cells, grid.n_cells)]
+    elif len(dims) == 2:
+        expected = [(grid.rows, grid.n_cells), (grid.cols, grid.cols)]
+    else:
+        raise LayoutError(f'layout has {len(dims)} dimensions, expected 2 '
+                          f'({grid.rows} rows x {grid.cols} cols)')
+    sizes = 'x'.join(str(d.size) for d in dims)
+    want = 'x'.join(str(size) for size, _ in expected)
+    for dim, (size, stride) in zip(dims, expected):
+        if dim.size != size:
+            raise LayoutError(f'layout is {sizes}, the grid is {want} '
+                              f'({grid.rows} rows x {grid.cols} cols)')
+        if dim.stride not in (0, stride):
+            raise LayoutError(f"layout dimension '{dim.label}' has stride {dim.stride}, "
+                              f'expected {stride} (row-major {grid.rows}x{grid.cols})')
+
+
+def from_multiarray(msg, grid: Grid) -> np.ndarray:
+    """The values of a grid-shaped ``Float32MultiArray`` as float64, shape (N,).
+
+    The layout is checked (:func:`check_layout`) and the length must be N; the values themselves
+    (NaN, inf) are left for :func:`ipomdp_gaze.belief.check_evidence`.
+
+    Raises
+    ------
+    LayoutError
+        If the layout disagrees with the grid.
+    EvidenceError
+        If the data does not have one value per cell.
+    """
+    check_layout(msg.layout, grid)
+    values = np.asarray(msg.data, dtype=np.float32)
+    if values.size != grid.n_cells:
+        raise EvidenceError(f'evidence has {values.size} values, expected {grid.n_cells} '
+                            f'({grid.rows}x{grid.cols} grid)')
+    return values.astype(np.float64)
+
+
+def ground_truth(grid: Grid, cell: int) -> Int32MultiArray:
+    """The simulated camera's ground truth: ``data = [row, col]``."""
+    row, col = grid.cell(cell)
+    msg = Int32MultiArray(layout=MultiArrayLayout(
+        dim=[MultiArrayDimension(label='row_col', size=2, stride=2)], data_offset=0))
+    msg.data = [int(row), int(col)]
+    return msg
+
+
+def cell_from_ground_truth(msg, grid: Grid) -> int:
+    """The cell index of a ground-truth ``[row, col]`` message.
+
+    Raises
+    ------
+    ValueError
+        If the message is not two integers inside the grid.
+    """
+    data = list(msg.data)
+    if len(data) != 2:
+        raise ValueError(f'ground truth must be [row, col], got {data}')
+    row, col = data
+    if not (0 <= row < grid.rows and 0 <= col < grid.cols):
+        raise ValueError(f'ground truth ({row}, {col}) is outside the {grid.rows}x{grid.cols} grid')
+    return grid.index(row, col)

@@ -1,0 +1,115 @@
+"""Images: the belief heatmap (``rgb8``) and per-cell evidence as ``32FC1``.
+
+Float images look black in rqt_image_view unless its dynamic range is switched on, so the belief
+is published as a colour-mapped ``rgb8`` picture (DESIGN.md section 5): each cell becomes a
+``scale_px x scale_px`` block coloured by ``B_i / max(B)`` on a viridis-like map (dark purple = 0,
+yellow = the most likely cell), and the current fixation gets a red outline.
+"""
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+from sensor_msgs.msg import Image
+from std_msgs.msg import Header
+
+from ipomdp_gaze.belief import EvidenceError
+from ipomdp_gaze.grid import Grid
+
+from .grid_arrays import LayoutError
+
+# Viridis sampled at 0, 1/4, 1/2, 3/4, 1 (matplotlib's values), interpolated linearly.
+_ANCHORS = np.array([[68, 1, 84], [59, 82, 139], [33, 145, 140], [94, 201, 98],
+                     [253, 231, 37]], dtype=float)
+MARK_RGB = (255, 0, 0)
+_LITTLE = sys.byteorder == 'little'
+
+
+def _uint8(data) -> np.ndarray:
+    """The bytes of an image's ``data`` field (bytes, array('B') or a list) as uint8."""
+    try:
+        return np.frombuffer(data, dtype=np.uint8)
+    except TypeError:
+        return np.asarray(data, dtype=np.uint8)
+
+
+def colour_map(values: np.ndarray) -> np.ndarray:
+    """Map values in [0, 1] to ``uint8`` RGB (shape ``values.shape + (3,)``)."""
+    v = np.clip(np.nan_to_num(np.asarray(values, dtype=float)), 0.0, 1.0)
+    x = np.linspace(0.0, 1.0, len(_ANCHORS))
+    rgb = np.stack([np.interp(v, x, _ANCHORS[:, ch]) for ch in range(3)], axis=-1)
+    return np.round(rgb).astype(np.uint8)
+
+
+def belief_picture(belief, grid: Grid, fixation: int | None, scale_px: int) -> np.ndarray:
+    """The heatmap as a ``(rows*scale_px, cols*scale_px, 3)`` uint8 array."""
+    if scale_px < 1:
+        raise ValueError(f'scale_px must be >= 1, got {scale_px}')
+    b = np.asarray(belief, dtype=float).reshape(grid.shape)
+    peak = b.max()
+    rgb = colour_map(b / peak if peak > 0 else b)
+    img = np.repeat(np.repeat(rgb, scale_px, axis=0), scale_px, axis=1)
+    if fixation is not None:
+        row, col = grid.cell(fixation)
+        width = max(1, scale_px // 8)
+        r0, c0 = row * scale_px, col * scale_px
+        block = img[r0:r0 + scale_px, c0:c0 + scale_px]
+        block[:width] = MARK_RGB
+        block[-width:] = MARK_RGB
+        block[:, :width] = MARK_RGB
+        block[:, -width:] = MARK_RGB
+    return img
+
+
+def belief_image(belief, grid: Grid, fixation: int | None, scale_px: int, stamp,
+                 frame_id: str = '') -> Image:
+    """A stamped ``rgb8`` ``sensor_msgs/Image`` of the belief heatmap."""
+    img = belief_picture(belief, grid, fixation, scale_px)
+    height, width = img.shape[:2]
+    return Image(header=Header(stamp=stamp, frame_id=frame_id), height=height, width=width,
+                 encoding='rgb8', is_bigendian=0, step=3 * width, data=img.tobytes())
+
+
+def rgb8_array(msg: Image) -> np.ndarray:
+    """The pixels of an ``rgb8`` image as ``(height, width, 3)`` uint8 (row padding dropped)."""
+    if msg.encoding != 'rgb8':
+        raise ValueError(f"expected an rgb8 image, got encoding {msg.encoding!r}")
+    buf = _uint8(msg.data)
+    if msg.step < 3 * msg.width or buf.size != msg.step * msg.height:
+        raise ValueError(f'image data has {buf.size} bytes, expected step {msg.step} x height '
+                         f'{msg.height} with step >= {3 * msg.width}')
+    return buf.reshape(msg.height, msg.step)[:, :3 * msg.width].reshape(msg.height, msg.width, 3)
+
+
+def evidence_image(values, grid: Grid, stamp, frame_id: str = '') -> Image:
+    """Per-cell evidence as a stamped ``32FC1`` image (height = rows, width = cols)."""
+    a = np.ascontiguousarray(values, dtype=np.float32)
+    if a.size != grid.n_cells:
+        raise ValueError(f'expected {grid.n_cells} values, got {a.size}')
+    return Image(header=Header(stamp=stamp, frame_id=frame_id), height=grid.rows,
+                 width=grid.cols, encoding='32FC1', is_bigendian=int(not _LITTLE),
+                 step=4 * grid.cols, data=a.tobytes())
+
+
+def evidence_from_image(msg: Image, grid: Grid) -> np.ndarray:
+    """The values of a ``32FC1`` evidence image as float64, shape (N,), row-major.
+
+    Raises
+    ------
+    LayoutError
+        If the encoding is not ``32FC1`` or the size is not ``rows x cols``.
+    EvidenceError
+        If the data does not match the declared step and height.
+    """
+    if msg.encoding.upper() != '32FC1':
+        raise LayoutError(f"evidence image encoding is {msg.encoding!r}, expected '32FC1'")
+    if (msg.height, msg.width) != grid.shape:
+        raise LayoutError(f'evidence image is {msg.height}x{msg.width} (height x width), '
+                          f'the grid is {grid.rows}x{grid.cols}')
+    buf = _uint8(msg.data)
+    if msg.step < 4 * msg.width or buf.size != msg.step * msg.height:
+        raise EvidenceError(f'evidence image has {buf.size} bytes, expected step {msg.step} x '
+                            f'height {msg.height} with step >= {4 * msg.width}')
+    rows = buf.reshape(msg.height, msg.step)[:, :4 * msg.width]
+    dtype = np.dtype('>f4' if msg.is_bigendian else '<f4')
+    return np.ascontiguousarray(rows).view(dtype).reshape(-1).astype(np.float64)
