@@ -1,6 +1,7 @@
 """Grid-shaped arrays <-> ``std_msgs`` multi-arrays (DESIGN.md section 5).
 
-The layout of a ``rows x cols`` grid is ``dim[0] = {label: 'rows', size: rows, stride: rows*cols}``,
+The layout of a ``rows x cols`` grid is
+``dim[0] = {label: 'rows', size: rows, stride: rows*cols}``,
 ``dim[1] = {label: 'cols', size: cols, stride: cols}``, ``data_offset = 0``, data row-major.
 Incoming arrays with an empty layout are read as row-major of the node's grid when their length
 fits; a layout that disagrees with the grid makes the frame invalid (:class:`LayoutError`).
@@ -118,5 +119,6 @@ def cell_from_ground_truth(msg, grid: Grid) -> int:
         raise ValueError(f'ground truth must be [row, col], got {data}')
     row, col = data
     if not (0 <= row < grid.rows and 0 <= col < grid.cols):
-        raise ValueError(f'ground truth ({row}, {col}) is outside the {grid.rows}x{grid.cols} grid')
+        raise ValueError(f'ground truth ({row}, {col}) is outside the '
+                         f'{grid.rows}x{grid.cols} grid')
     return grid.index(row, col)

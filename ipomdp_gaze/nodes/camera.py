@@ -35,7 +35,7 @@ from std_srvs.srv import Trigger
 from ipomdp_gaze.fpoc import dprime_matrix
 from msg_adapters import grid_arrays, images, joints
 
-from .params import (INT_MAX, T, Param, cell_from, current_values, declare, fpoc_from,
+from .params import (INT_MAX, T, Param, row_col_from, current_values, declare, fpoc_from,
                      fpoc_params, grid_from, grid_params, head_from, joint_params)
 
 NODE_NAME = 'simulated_camera'
@@ -47,10 +47,10 @@ STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
 def camera_params() -> list[Param]:
     """Every parameter of the simulated camera, in declaration order."""
     return grid_params() + fpoc_params() + joint_params(limits=False) + [
-        Param('target_row', -1, T.INTEGER, 'row of the target (-1: random at each reset)',
+        Param('target_row', -1, T.INTEGER, 'row of the target (-1: a random row at each reset)',
               int_range=(-1, 254)),
-        Param('target_col', -1, T.INTEGER, 'column of the target (-1: random at each reset)',
-              int_range=(-1, 254)),
+        Param('target_col', -1, T.INTEGER,
+              'column of the target (-1: a random column at each reset)', int_range=(-1, 254)),
         Param('seed', 0, T.INTEGER, 'seed of the targets and the observation noise',
               int_range=(0, INT_MAX)),
         Param('saccade_time_s', 0.15, T.DOUBLE, 'time to move to a new cell',
@@ -71,7 +71,7 @@ class CameraConfig:
     grid: object
     dprime: np.ndarray
     head: joints.PanTiltMap
-    target: int | None
+    target: tuple
 
 
 class SimulatedCameraNode(Node):
@@ -109,7 +109,7 @@ class SimulatedCameraNode(Node):
         grid = grid_from(values)
         fpoc = fpoc_from(values)
         head = head_from(values, grid)
-        target = cell_from(values, grid, 'target_row', 'target_col')
+        target = row_col_from(values, grid, 'target_row', 'target_col')
         return CameraConfig(dict(values), grid, dprime_matrix(grid, fpoc), head, target)
 
     def _on_set(self, params) -> SetParametersResult:
@@ -202,8 +202,10 @@ class SimulatedCameraNode(Node):
 
     def _new_target(self) -> int:
         cfg = self._config
-        self.target = int(self.rng.integers(cfg.grid.n_cells)) if cfg.target is None \
-            else cfg.target
+        row, col = cfg.target
+        row = int(self.rng.integers(cfg.grid.rows)) if row is None else row
+        col = int(self.rng.integers(cfg.grid.cols)) if col is None else col
+        self.target = cfg.grid.index(row, col)
         self._truth_pub.publish(grid_arrays.ground_truth(cfg.grid, self.target))
         return self.target
 

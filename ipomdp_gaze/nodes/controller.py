@@ -45,7 +45,7 @@ from msg_adapters import diagnostics, grid_arrays, images, joints, stamps
 from policies.baselines import STRATEGIES
 from policies.conv import ACTIONS
 
-from .params import (INT_MAX, T, Param, cell_from, current_values, declare, fpoc_from,
+from .params import (INT_MAX, T, Param, row_col_from, current_values, declare, fpoc_from,
                      fpoc_params, grid_from, grid_params, head_from, joint_params)
 
 NODE_NAME = 'gaze_controller'
@@ -58,10 +58,12 @@ WARN_THROTTLE_S = 5.0
 def controller_params() -> list[Param]:
     """Every parameter of the controller, in declaration order (the grid first)."""
     return grid_params() + fpoc_params() + [
-        Param('start_row', -1, T.INTEGER, 'row of the first fixation after a reset (-1: centre)',
+        Param('start_row', -1, T.INTEGER,
+              'row of the first fixation after a reset (-1: the centre row)',
               int_range=(-1, 254)),
         Param('start_col', -1, T.INTEGER,
-              'column of the first fixation after a reset (-1: centre)', int_range=(-1, 254)),
+              'column of the first fixation after a reset (-1: the centre column)',
+              int_range=(-1, 254)),
         Param('seed', 0, T.INTEGER, 'seed of the random and sample policies',
               int_range=(0, INT_MAX)),
         Param('settle_time_s', 0.1, T.DOUBLE,
@@ -164,7 +166,9 @@ class GazeControllerNode(Node):
         grid = grid_from(values)
         fpoc = fpoc_from(values)
         head = head_from(values, grid)
-        start = cell_from(values, grid, 'start_row', 'start_col')
+        row, col = row_col_from(values, grid, 'start_row', 'start_col')
+        centre_row, centre_col = grid.cell(grid.center_index)
+        start = grid.index(centre_row if row is None else row, centre_col if col is None else col)
         if not 0.0 < values['confidence'] < 1.0:
             raise ValueError(f"confidence must be between 0 and 1 (exclusive), got "
                              f"{values['confidence']}")
@@ -185,8 +189,7 @@ class GazeControllerNode(Node):
             policy = build_policy(values['policy.name'], grid, fpoc, values['policy.kernel'],
                                   values['policy.file'], values['policy.action'],
                                   warn=warnings.append)
-        return Config(dict(values), grid, fpoc, policy, head,
-                      grid.center_index if start is None else start, '; '.join(warnings))
+        return Config(dict(values), grid, fpoc, policy, head, start, '; '.join(warnings))
 
     def _startup_config(self) -> Config:
         values = current_values(self, self._params)

@@ -180,21 +180,21 @@ def head_from(values: dict, grid: Grid) -> PanTiltMap:
                       **limits)
 
 
-def cell_from(values: dict, grid: Grid, row_name: str, col_name: str):
-    """The cell named by two ``-1``-able row/col parameters, or None when both are -1.
+def row_col_from(values: dict, grid: Grid, row_name: str, col_name: str) -> tuple:
+    """``(row, col)`` from two parameters where -1 means "not fixed" (returned as None).
+
+    Each coordinate stands on its own, so ``ros2 param set`` can change one at a time.
 
     Raises
     ------
     ValueError
-        If only one is -1 or the cell is outside the grid.
+        If a coordinate is outside the grid.
     """
-    row, col = values[row_name], values[col_name]
-    if row == -1 and col == -1:
-        return None
-    if row == -1 or col == -1:
-        raise ValueError(f'{row_name} and {col_name} must both be -1 or both name a cell, '
-                         f'got {row} and {col}')
-    if not (0 <= row < grid.rows and 0 <= col < grid.cols):
-        raise ValueError(f'({row_name}, {col_name}) = ({row}, {col}) is outside the '
-                         f'{grid.rows}x{grid.cols} grid')
-    return grid.index(row, col)
+    out = []
+    for name, size in ((row_name, grid.rows), (col_name, grid.cols)):
+        value = values[name]
+        if value != -1 and not 0 <= value < size:
+            raise ValueError(f'{name} must be -1 or in 0..{size - 1} for a '
+                             f'{grid.rows}x{grid.cols} grid, got {value}')
+        out.append(None if value == -1 else int(value))
+    return tuple(out)

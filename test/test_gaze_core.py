@@ -1,0 +1,250 @@
+"""The gaze controller core without ROS: frames, belief, policy choice, found, counters."""
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from ipomdp_gaze.belief import update_log_belief, uniform_log_belief
+from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
+from ipomdp_gaze.gaze import (POLICY_NAMES, GazeController, PolicyUnavailable, build_policy,
+                              check_kernel)
+from ipomdp_gaze.grid import Grid
+from policies.baselines import spiral_order
+from policies.conv import ConvPolicy
+
+GRID = Grid(11, 11, 5.0)
+CAMERA = make_fpoc('camera', half_width_deg=10.0, half_height_deg=10.0)
+
+
+def controller(policy='elm', settle_time_s=0.5, **kwargs):
+    policy = build_policy(policy, GRID, CAMERA) if isinstance(policy, str) else policy
+    core = GazeController(GRID, CAMERA, policy, settle_time_s=settle_time_s, **kwargs)
+    core.reset(0.0)
+    return core
+
+
+def expected_update(belief, frame, fixation, fpoc=CAMERA):
+    d = dprime_matrix(GRID, fpoc)[:, fixation]
+    return np.exp(update_log_belief(np.log(belief), np.asarray(frame, dtype=float), d))
+
+
+def test_starts_uniform_at_the_centre_with_zero_counters():
+    core = controller()
+    assert core.fixation == GRID.center_index == 60
+    np.testing.assert_allclose(core.belief, 1 / 121)
+    assert core.counters() == {'received': 0, 'applied': 0, 'rejected': 0, 'skipped': 0}
+    assert core.entropy_nats == pytest.approx(np.log(121))
+
+
+def test_frame_before_settling_is_skipped_and_changes_nothing():
+    core = controller(settle_time_s=0.5)
+    before = core.belief
+    result = core.offer(np.random.default_rng(0).standard_normal(121), stamp_s=0.49)
+    assert (result.status, result.fixation) == ('skipped', None)
+    np.testing.assert_array_equal(core.belief, before)
+    assert core.fixation == 60
+    assert core.counters() == {'received': 1, 'applied': 0, 'rejected': 0, 'skipped': 1}
+
+
+def test_settled_frame_updates_the_belief_and_the_policy_picks_the_next_fixation():
+    core = controller(settle_time_s=0.5)
+    frame = np.random.default_rng(1).standard_normal(121)
+    result = core.offer(frame, stamp_s=0.5, now_s=0.7)
+    want = expected_update(np.full(121, 1 / 121), frame, 60)
+    np.testing.assert_allclose(core.belief, want, rtol=1e-12)
+    elm = build_policy('elm', GRID, CAMERA)
+    assert result.applied and result.fixation == core.fixation
+    assert core.fixation == int(elm.select(want[None], 1, None)[0])
+    assert core.target_time_s == 0.7 and core.fixations == 1
+
+
+def test_one_frame_per_fixation():
+    core = controller(settle_time_s=0.5)
+    rng = np.random.default_rng(2)
+    assert core.offer(rng.standard_normal(121), 1.0).applied
+    # A second frame of the same moment belongs to the new fixation, which has not settled.
+    result = core.offer(rng.standard_normal(121), 1.0)
+    assert result.status == 'skipped'
+    assert core.offer(rng.standard_normal(121), 1.5).applied
+    assert core.counters() == {'received': 3, 'applied': 2, 'rejected': 0, 'skipped': 1}
+
+
+def test_nan_cells_are_unobserved():
+    core = controller(settle_time_s=0.0)
+    frame = np.random.default_rng(3).standard_normal(121)
+    frame[[0, 60, 61, 120]] = np.nan
+    core.offer(frame, 1.0)
+    zeroed = np.where(np.isnan(frame), 0.0, frame)
+    d = dprime_matrix(GRID, CAMERA)[:, 60]
+    log_b = uniform_log_belief(121) + np.where(np.isnan(frame), 0.0, d * (zeroed - d / 2))
+    want = np.exp(log_b - np.logaddexp.reduce(log_b))
+    np.testing.assert_allclose(core.belief, want, rtol=1e-12)
+
+
+@pytest.mark.parametrize('frame, words', [
+    (np.zeros(120), '120 values'),
+    (np.r_[np.zeros(120), np.inf], 'inf'),
+    (np.r_[-np.inf, np.zeros(120)], 'inf'),
+    (np.zeros((11, 11)), 'shape'),
+])
+def test_invalid_frames_are_rejected_and_change_nothing(frame, words):
+    core = controller(settle_time_s=0.0)
+    before, fixation = core.belief, core.fixation
+    result = core.offer(frame, 5.0)
+    assert result.status == 'rejected' and words in result.reason
+    np.testing.assert_array_equal(core.belief, before)
+    assert core.fixation == fixation and core.last_rejection == result.reason
+    assert core.counters() == {'received': 1, 'applied': 0, 'rejected': 1, 'skipped': 0}
+
+
+def test_reject_counts_frames_the_node_could_not_read():
+    core = controller()
+    result = core.reject('layout is 7x7, the grid is 11x11')
+    assert result.status == 'rejected' and core.rejected == core.received == 1
+
+
+def test_disabled_skips_frames_and_enabling_resends_the_target():
+    core = controller(settle_time_s=0.5)
+    assert core.set_enabled(False, 1.0)
+    assert not core.set_enabled(False, 1.1)
+    result = core.offer(np.zeros(121), 10.0)
+    assert (result.status, result.reason) == ('skipped', 'disabled')
+    np.testing.assert_allclose(core.belief, 1 / 121)
+    assert core.set_enabled(True, 20.0)
+    assert core.target_time_s == 20.0
+    assert core.offer(np.zeros(121), 20.4).status == 'skipped'
+    assert core.offer(np.zeros(121), 20.5).applied
+
+
+def test_found_fires_once_per_search_and_reset_starts_over():
+    core = controller(settle_time_s=0.0, confidence=0.95)
+    target = 17
+    frame = np.zeros(121)
+    frame[target] = 40.0            # an unmistakable detection inside the field of view
+    core.fixation = target
+    result = core.offer(frame, 1.0)
+    assert result.found is not None
+    assert (result.found.cell, result.found.fixations) == (target, 1)
+    assert result.found.probability >= 0.95
+    core.fixation = target
+    assert core.offer(frame, 2.0).found is None
+    assert core.reset(3.0) == GRID.center_index
+    np.testing.assert_allclose(core.belief, 1 / 121)
+    assert core.found is None and core.fixations == 0
+    core.fixation = target
+    assert core.offer(frame, 4.0).found is not None
+
+
+def test_policy_time_index_counts_fixations_since_reset():
+    core = controller('spiral', settle_time_s=0.0)
+    order = spiral_order(GRID)
+    seen = [core.fixation]
+    for t in range(1, 6):
+        seen.append(core.offer(np.zeros(121), float(t)).fixation)
+    assert seen == list(order[:6])
+    core.reset(10.0)
+    assert core.offer(np.zeros(121), 11.0).fixation == order[1]
+
+
+def test_start_cell_and_validation():
+    core = controller(start_cell=GRID.index(0, 10))
+    assert core.reset(0.0) == 10
+    with pytest.raises(ValueError, match='outside'):
+        core.set_start_cell(121)
+    with pytest.raises(ValueError, match='settle_time_s'):
+        core.set_settle_time(-1.0)
+    with pytest.raises(ValueError, match='confidence'):
+        core.set_confidence(1.0)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.tuples(st.sampled_from(['good', 'nan', 'short', 'inf', 'reject', 'off', 'on']),
+                          st.floats(0.0, 1.0)), max_size=30))
+def test_counters_add_up(events):
+    core = controller(settle_time_s=0.3)
+    rng = np.random.default_rng(0)
+    now = 0.0
+    for kind, dt in events:
+        now += dt
+        frame = rng.standard_normal(121)
+        if kind == 'nan':
+            frame[rng.random(121) < 0.5] = np.nan
+        elif kind == 'short':
+            frame = frame[:100]
+        elif kind == 'inf':
+            frame[3] = np.inf
+        if kind == 'reject':
+            core.reject('bad layout')
+        elif kind in ('off', 'on'):
+            core.set_enabled(kind == 'on', now)
+        else:
+            core.offer(frame, now)
+        c = core.counters()
+        assert c['received'] == c['applied'] + c['rejected'] + c['skipped']
+        assert c['applied'] == core.fixations
+        np.testing.assert_allclose(core.belief.sum(), 1.0, rtol=1e-12)
+
+
+@pytest.mark.parametrize('seed', range(6))
+def test_search_with_the_camera_observation_model_finds_the_target(seed):
+    """The core alone finds the target: the MAP cell at 0.999 is the target."""
+    rng = np.random.default_rng([seed, 42])
+    target = int(rng.integers(121))
+    d = dprime_matrix(GRID, CAMERA)
+    core = controller(settle_time_s=0.0)
+    for t in range(200):
+        frame = rng.standard_normal(121)
+        frame[target] += d[target, core.fixation]
+        frame[d[:, core.fixation] == 0] = np.nan
+        core.offer(frame, float(t))
+        if core.map_probability >= 0.999:
+            break
+    assert core.map_probability >= 0.999
+    assert core.map_cell == target
+    assert core.found is not None and core.found.fixations <= core.fixations
+
+
+def test_build_policy_names():
+    for name in POLICY_NAMES:
+        if name in ('learned', 'greedy'):
+            continue
+        assert hasattr(build_policy(name, GRID, CAMERA), 'select')
+    with pytest.raises(ValueError, match='valid policies: learned, map'):
+        build_policy('foo', GRID, CAMERA)
+    with pytest.raises(ValueError, match='action'):
+        build_policy('elm', GRID, CAMERA, action='softmax')
+    with pytest.raises(ValueError, match='policy.kernel or policy.file'):
+        build_policy('learned', GRID, CAMERA)
+
+
+def test_learned_kernel_is_used_as_given():
+    kernel = np.random.default_rng(4).standard_normal(GRID.kernel_shape)
+    policy = build_policy('learned', GRID, CAMERA, kernel=kernel.ravel().tolist())
+    assert isinstance(policy, ConvPolicy)
+    np.testing.assert_array_equal(policy.kernel, kernel)
+    belief = np.random.default_rng(5).dirichlet(np.ones(121))
+    assert policy.select(belief[None], 1, None)[0] == ConvPolicy(GRID, kernel).select(
+        belief[None], 1, None)[0]
+
+
+def test_check_kernel_reasons():
+    with pytest.raises(ValueError, match='441 values .*21x21.*got 440'):
+        check_kernel(np.zeros(440), GRID)
+    bad = np.zeros(441)
+    bad[7] = np.nan
+    with pytest.raises(ValueError, match='entry 7 is nan'):
+        check_kernel(bad, GRID)
+    assert check_kernel(np.zeros(441), GRID).shape == (21, 21)
+
+
+def test_missing_policy_file_support_or_file_is_unavailable(monkeypatch, tmp_path):
+    monkeypatch.setitem(sys.modules, 'policies.policy_file', None)
+    with pytest.raises(PolicyUnavailable, match='not supported'):
+        build_policy('learned', GRID, CAMERA, file='camera-11x11-infomax')
+    monkeypatch.setitem(sys.modules, 'policies.greedy', None)
+    with pytest.raises(PolicyUnavailable, match='greedy'):
+        build_policy('greedy', GRID, CAMERA)

@@ -1,0 +1,262 @@
+"""msg_adapters: every conversion between numpy and ROS messages (no DDS, no node)."""
+from __future__ import annotations
+
+import array
+import math
+
+import numpy as np
+import pytest
+
+pytest.importorskip('std_msgs.msg', reason='ROS message packages are not installed')
+
+from builtin_interfaces.msg import Time  # noqa: E402
+from sensor_msgs.msg import Image, JointState  # noqa: E402
+from std_msgs.msg import (Float32MultiArray, Int32MultiArray, MultiArrayDimension,  # noqa: E402
+                          MultiArrayLayout)
+
+from ipomdp_gaze.belief import EvidenceError  # noqa: E402
+from ipomdp_gaze.grid import Grid  # noqa: E402
+from msg_adapters import diagnostics, grid_arrays, images, joints, stamps  # noqa: E402
+from msg_adapters.grid_arrays import LayoutError  # noqa: E402
+
+GRID = Grid(11, 11, 5.0)
+DEG = math.pi / 180
+
+
+def layout(*dims, offset=0):
+    return MultiArrayLayout(dim=[MultiArrayDimension(label=label, size=size, stride=stride)
+                                 for label, size, stride in dims], data_offset=offset)
+
+
+def test_multiarray_layout_and_round_trip():
+    values = np.random.default_rng(0).standard_normal(121)
+    msg = grid_arrays.to_multiarray(values, GRID)
+    dims = [(d.label, d.size, d.stride) for d in msg.layout.dim]
+    assert dims == [('rows', 11, 121), ('cols', 11, 11)]
+    assert msg.layout.data_offset == 0
+    assert isinstance(msg.data, array.array) and msg.data.typecode == 'f'
+    back = grid_arrays.from_multiarray(msg, GRID)
+    np.testing.assert_array_equal(back, values.astype(np.float32))
+    assert back.dtype == np.float64
+    grid2d = grid_arrays.from_multiarray(grid_arrays.to_multiarray(values.reshape(11, 11), GRID),
+                                         GRID)
+    np.testing.assert_array_equal(grid2d, back)
+
+
+def test_row_major_means_row_times_cols_plus_col():
+    values = np.zeros((11, 11))
+    values[2, 9] = 1.0
+    msg = grid_arrays.to_multiarray(values, GRID)
+    assert int(np.argmax(np.asarray(msg.data))) == 2 * 11 + 9
+
+
+def test_to_multiarray_refuses_the_wrong_size():
+    with pytest.raises(ValueError, match='121 values'):
+        grid_arrays.to_multiarray(np.zeros(120), GRID)
+
+
+@pytest.mark.parametrize('lay', [
+    MultiArrayLayout(),
+    layout(('cells', 121, 121)),
+    layout(('rows', 11, 121), ('cols', 11, 11)),
+    layout(('height', 11, 0), ('width', 11, 0)),
+])
+def test_accepted_layouts(lay):
+    msg = Float32MultiArray(layout=lay, data=list(np.arange(121.0)))
+    np.testing.assert_array_equal(grid_arrays.from_multiarray(msg, GRID), np.arange(121.0))
+
+
+@pytest.mark.parametrize('lay, words', [
+    (layout(('rows', 7, 49), ('cols', 7, 7)), 'layout is 7x7, the grid is 11x11'),
+    (layout(('rows', 11, 121), ('cols', 11, 12)), 'stride 12, expected 11'),
+    (layout(('rows', 11, 121), ('cols', 11, 11), offset=3), 'data_offset is 3'),
+    (layout(('a', 11, 0), ('b', 11, 0), ('c', 1, 0)), '3 dimensions'),
+    (layout(('cells', 120, 120)), 'layout is 120, the grid is 121'),
+])
+def test_layouts_that_disagree_with_the_grid(lay, words):
+    msg = Float32MultiArray(layout=lay, data=[0.0] * 121)
+    with pytest.raises(LayoutError, match=words):
+        grid_arrays.from_multiarray(msg, GRID)
+
+
+def test_empty_layout_with_the_wrong_length():
+    with pytest.raises(EvidenceError, match='120 values, expected 121'):
+        grid_arrays.from_multiarray(Float32MultiArray(data=[0.0] * 120), GRID)
+
+
+def test_layout_error_is_an_evidence_error():
+    assert issubclass(LayoutError, EvidenceError)
+
+
+def test_ground_truth_round_trip_and_checks():
+    msg = grid_arrays.ground_truth(GRID, GRID.index(3, 8))
+    assert isinstance(msg, Int32MultiArray) and list(msg.data) == [3, 8]
+    assert grid_arrays.cell_from_ground_truth(msg, GRID) == 41
+    with pytest.raises(ValueError, match='outside'):
+        grid_arrays.cell_from_ground_truth(Int32MultiArray(data=[11, 0]), GRID)
+    with pytest.raises(ValueError, match=r'\[row, col\]'):
+        grid_arrays.cell_from_ground_truth(Int32MultiArray(data=[1]), GRID)
+
+
+# -- pan/tilt -----------------------------------------------------------------------------------
+@pytest.mark.parametrize('row, col, pan_deg, tilt_deg', [
+    (5, 5, 0.0, 0.0),
+    (0, 0, 25.0, -25.0),       # top left: turn left (+pan), look up (-tilt)
+    (10, 10, -25.0, 25.0),     # bottom right: turn right, look down
+    (5, 6, -5.0, 0.0),
+    (4, 5, 0.0, -5.0),
+])
+def test_rep103_angles_of_known_cells(row, col, pan_deg, tilt_deg):
+    head = joints.PanTiltMap(GRID)
+    pan, tilt = head.angles(GRID.index(row, col))
+    assert pan == pytest.approx(pan_deg * DEG, abs=1e-12)
+    assert tilt == pytest.approx(tilt_deg * DEG, abs=1e-12)
+
+
+def test_signs_and_offsets():
+    head = joints.PanTiltMap(GRID, pan_sign=-1, tilt_sign=-1, pan_offset_rad=0.1,
+                             tilt_offset_rad=-0.2)
+    pan, tilt = head.angles(GRID.index(0, 0))
+    assert pan == pytest.approx(-25 * DEG + 0.1)
+    assert tilt == pytest.approx(25 * DEG - 0.2)
+
+
+@pytest.mark.parametrize('kwargs', [{}, {'pan_sign': -1}, {'tilt_sign': -1, 'pan_offset_rad': 0.3},
+                                    {'tilt_offset_rad': -0.05}])
+def test_nearest_cell_inverts_angles(kwargs):
+    head = joints.PanTiltMap(GRID, **kwargs)
+    cells = np.arange(GRID.n_cells)
+    pan, tilt = head.angles(cells)
+    jitter = 0.4 * head.spacing_rad
+    back = [head.nearest_cell(p + jitter, t - jitter) for p, t in zip(pan, tilt)]
+    assert back == list(cells)
+
+
+def test_nearest_cell_clips_to_the_grid():
+    head = joints.PanTiltMap(GRID)
+    assert head.nearest_cell(3.0, -3.0) == GRID.index(0, 0)
+    with pytest.raises(ValueError, match='finite'):
+        head.nearest_cell(float('nan'), 0.0)
+
+
+def test_limits_must_contain_every_cell():
+    with pytest.raises(ValueError, match=r'cell \(\d+, 0\) needs pan 0.4363 rad.*limits'):
+        joints.PanTiltMap(GRID, pan_limits_rad=(-1.0, 0.4))
+    with pytest.raises(ValueError, match='min < max'):
+        joints.PanTiltMap(GRID, tilt_limits_rad=(1.0, -1.0))
+    with pytest.raises(ValueError, match='must differ'):
+        joints.PanTiltMap(GRID, pan_joint='head', tilt_joint='head')
+    with pytest.raises(ValueError, match='pan_sign'):
+        joints.PanTiltMap(GRID, pan_sign=2)
+
+
+def test_joint_state_messages():
+    head = joints.PanTiltMap(GRID, pan_joint='head_pan', tilt_joint='head_tilt')
+    msg = joints.joint_state(head, GRID.index(0, 10), Time(sec=5, nanosec=7))
+    assert list(msg.name) == ['head_pan', 'head_tilt']
+    np.testing.assert_allclose(msg.position, [-25 * DEG, -25 * DEG])
+    assert (msg.header.stamp.sec, msg.header.stamp.nanosec) == (5, 7)
+    reordered = JointState(name=['other', 'head_tilt', 'head_pan'], position=[9.0, 0.1, 0.2])
+    assert joints.angles_from_joint_state(reordered, head) == (0.2, 0.1)
+    with pytest.raises(ValueError, match="not 'head_pan'"):
+        joints.angles_from_joint_state(JointState(name=['pan'], position=[0.0]), head)
+    with pytest.raises(ValueError, match='no finite position'):
+        joints.angles_from_joint_state(
+            JointState(name=['head_pan', 'head_tilt'], position=[0.0]), head)
+
+
+def test_ros2_control_commands():
+    head = joints.PanTiltMap(GRID)
+    cell = GRID.index(1, 2)
+    fwd = joints.forward_command(head, cell)
+    np.testing.assert_allclose(fwd.data, head.angles(cell))
+    traj = joints.joint_trajectory(head, cell, 0.75)
+    assert list(traj.joint_names) == ['pan_joint', 'tilt_joint']
+    assert len(traj.points) == 1
+    np.testing.assert_allclose(traj.points[0].positions, head.angles(cell))
+    assert (traj.points[0].time_from_start.sec, traj.points[0].time_from_start.nanosec) == \
+        (0, 750_000_000)
+    assert (traj.header.stamp.sec, traj.header.stamp.nanosec) == (0, 0)
+
+
+# -- images -------------------------------------------------------------------------------------
+def test_belief_image_size_encoding_and_marks():
+    belief = np.full(121, 0.1 / 120)
+    peak, fixation = GRID.index(2, 3), GRID.index(8, 8)
+    belief[peak] = 0.9
+    msg = images.belief_image(belief, GRID, fixation, 16, Time(sec=1))
+    assert (msg.height, msg.width, msg.encoding, msg.step) == (176, 176, 'rgb8', 528)
+    img = images.rgb8_array(msg)
+    assert tuple(img[2 * 16 + 8, 3 * 16 + 8]) == (253, 231, 37)      # the peak: yellow
+    assert tuple(img[0, 0]) == (68, 1, 84)                           # near zero: dark purple
+    assert tuple(img[8 * 16, 8 * 16 + 8]) == images.MARK_RGB         # outline of the fixation
+    assert tuple(img[8 * 16 + 8, 8 * 16 + 8]) != images.MARK_RGB     # its inside is the belief
+
+
+def test_colour_map_is_monotone_in_brightness():
+    rgb = images.colour_map(np.linspace(0, 1, 50)).astype(float)
+    luminance = rgb @ [0.2126, 0.7152, 0.0722]
+    assert np.all(np.diff(luminance) > 0)
+
+
+@pytest.mark.parametrize('big_endian', [False, True])
+def test_evidence_image_round_trip(big_endian):
+    values = np.random.default_rng(1).standard_normal(121)
+    values[5] = np.nan
+    msg = images.evidence_image(values, GRID, Time(sec=3))
+    assert (msg.height, msg.width, msg.encoding, msg.step) == (11, 11, '32FC1', 44)
+    if big_endian:
+        raw = values.astype('>f4').tobytes()
+        msg = Image(height=11, width=11, encoding='32FC1', is_bigendian=1, step=44, data=raw)
+    back = images.evidence_from_image(msg, GRID)
+    np.testing.assert_array_equal(back, values.astype(np.float32))
+
+
+def test_evidence_image_with_row_padding():
+    values = np.arange(121, dtype=np.float32).reshape(11, 11)
+    padded = np.zeros((11, 12), dtype='<f4')
+    padded[:, :11] = values
+    msg = Image(height=11, width=11, encoding='32FC1', step=48, data=padded.tobytes())
+    np.testing.assert_array_equal(images.evidence_from_image(msg, GRID), values.ravel())
+
+
+@pytest.mark.parametrize('kwargs, err, words', [
+    ({'encoding': 'mono8'}, LayoutError, "encoding is 'mono8'"),
+    ({'height': 7, 'width': 7, 'step': 28}, LayoutError, '7x7'),
+    ({'step': 40}, EvidenceError, 'step'),
+])
+def test_bad_evidence_images(kwargs, err, words):
+    fields = dict(height=11, width=11, encoding='32FC1', step=44,
+                  data=np.zeros(121, '<f4').tobytes())
+    fields.update(kwargs)
+    with pytest.raises(err, match=words):
+        images.evidence_from_image(Image(**fields), GRID)
+
+
+# -- diagnostics and stamps ---------------------------------------------------------------------
+def test_found_event_round_trip():
+    msg = diagnostics.found_status('/gaze_controller: found', 3, 7, 40, 0.1, -0.2, 0.9734, 6)
+    assert 'row 3, col 7' in msg.message
+    assert diagnostics.parse_found(msg) == {
+        'row': 3, 'col': 7, 'cell': 40, 'fixations': 6, 'pan_rad': 0.1, 'tilt_rad': -0.2,
+        'probability': 0.9734}
+    msg.values = msg.values[:2]
+    with pytest.raises(ValueError, match='lacks'):
+        diagnostics.parse_found(msg)
+
+
+def test_status_levels_and_values():
+    status = diagnostics.status('x', 'warn', 'no evidence received', {'enabled': True, 'r': 0.5})
+    assert status.level == diagnostics.LEVELS['warn']
+    assert diagnostics.values_of(status) == {'enabled': 'true', 'r': '0.5'}
+    array_msg = diagnostics.diagnostic_array([status], Time(sec=2))
+    assert array_msg.header.stamp.sec == 2 and len(array_msg.status) == 1
+
+
+def test_stamps():
+    t = stamps.from_seconds(12.25)
+    assert (t.sec, t.nanosec) == (12, 250_000_000)
+    assert stamps.to_seconds(t) == 12.25
+    assert stamps.is_zero(Time()) and not stamps.is_zero(t)
+    with pytest.raises(ValueError):
+        stamps.from_seconds(-1.0)

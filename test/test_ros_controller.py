@@ -1,0 +1,308 @@
+"""The controller process alone, with this test playing the camera and the operator.
+
+Covers: the kernel parameter set from another process through SetParameters (what ``ros2 param
+set`` does), invalid parameter values rejected with their reason, malformed evidence rejected
+and counted while the node keeps serving, NaN cells, ``reset``, ``enable`` and pan/tilt signs.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from conftest import HAVE_RCLPY, config_path, wait_for
+
+pytestmark = [pytest.mark.ros,
+              pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
+
+NODE = 'gaze_controller'
+SPACING_RAD = math.radians(5.0)
+
+
+class Camera:
+    """This test as the camera: sends frames, sees the controller's beliefs and targets."""
+
+    def __init__(self, probe, launch):
+        from diagnostic_msgs.msg import DiagnosticArray
+        from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+        from sensor_msgs.msg import Image, JointState
+        from std_msgs.msg import Float32MultiArray
+
+        from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
+        from ipomdp_gaze.grid import Grid
+        self.grid = Grid(11, 11, 5.0)
+        self.d = dprime_matrix(self.grid, make_fpoc('camera', half_width_deg=10.0,
+                                                    half_height_deg=10.0))
+        latched = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE,
+                             durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        self.probe = probe
+        self.beliefs = probe.record(Float32MultiArray, 'belief', 100)
+        self.targets = probe.record(JointState, 'pan_tilt', latched, distinct_stamps=True)
+        self.diagnostics = probe.record(DiagnosticArray, '/diagnostics', 50)
+        self.evidence = probe.publisher(Float32MultiArray, 'evidence', 10)
+        self.evidence_image = probe.publisher(Image, 'evidence_image', 10)
+        self.proc = launch('controller', [
+            '--params-file', config_path('controller.yaml'), '-p', 'settle_time_s:=0.0',
+            '-p', 'diagnostics_period_s:=0.2', '-p', 'policy.name:=elm'])
+        assert wait_for(lambda: self.targets, 30), self.proc.output()
+        assert wait_for(lambda: self.evidence.get_subscription_count() > 0 and
+                        self.evidence_image.get_subscription_count() > 0, 30)
+        # The start-up belief went out before this probe was discovered: reset for a fresh one.
+        _fresh_search(probe, self)
+
+    # -- what the controller said ----------------------------------------------------------
+    def belief(self, i=-1) -> np.ndarray:
+        from msg_adapters import grid_arrays
+        return grid_arrays.from_multiarray(self.beliefs[i][1], self.grid)
+
+    def fixation(self, i=-1) -> int:
+        from msg_adapters import joints
+        head = joints.PanTiltMap(self.grid)
+        return head.nearest_cell(*joints.angles_from_joint_state(self.targets[i][1], head))
+
+    def counters(self) -> dict:
+        from msg_adapters import diagnostics
+        for _, msg in reversed(self.diagnostics):
+            for status in msg.status:
+                if status.name.endswith(f'{NODE}: search'):
+                    return diagnostics.values_of(status)
+        return {}
+
+    def wait_counters(self, **want) -> dict:
+        n = len(self.diagnostics)
+        ok = wait_for(lambda: len(self.diagnostics) > n + 1 and all(
+            self.counters().get(k) == str(v) for k, v in want.items()), 20)
+        assert ok, f'diagnostics {self.counters()} never showed {want}'
+        return self.counters()
+
+    # -- sending -----------------------------------------------------------------------------
+    def send(self, values, layout=None):
+        from std_msgs.msg import Float32MultiArray
+
+        from msg_adapters import grid_arrays
+        if layout is None:
+            msg = grid_arrays.to_multiarray(values, self.grid)
+        else:
+            msg = Float32MultiArray(layout=layout, data=list(np.asarray(values, np.float32)))
+        self.evidence.publish(msg)
+
+    def step(self, frame) -> tuple:
+        """Send one valid frame; wait for the belief and the next target; return both."""
+        nb, nt = len(self.beliefs), len(self.targets)
+        self.send(frame)
+        assert wait_for(lambda: len(self.beliefs) > nb and len(self.targets) > nt, 20)
+        return self.belief(), self.fixation()
+
+    def expected(self, belief, frame, fixation) -> np.ndarray:
+        """The posterior computed offline (float64 from the float32 frame)."""
+        d = self.d[:, fixation]
+        o = np.asarray(frame, np.float32).astype(np.float64)
+        term = np.where(np.isnan(o), 0.0, d * (np.nan_to_num(o) - d / 2))
+        log_b = np.log(np.maximum(belief, 1e-300)) + term
+        return np.exp(log_b - np.logaddexp.reduce(log_b))
+
+
+@pytest.fixture(scope='module')
+def cam(probe, launch):
+    return Camera(probe, launch)
+
+
+def _enable(probe, flag):
+    from std_srvs.srv import SetBool
+    return probe.call(SetBool, f'/{NODE}/enable', SetBool.Request(data=flag))
+
+
+def _reset(probe):
+    from std_srvs.srv import Trigger
+    return probe.call(Trigger, f'/{NODE}/reset', Trigger.Request())
+
+
+def _set(probe, **values):
+    names = {k.replace('__', '.'): v for k, v in values.items()}
+    return probe.set_parameters(NODE, names)
+
+
+def _fresh_search(probe, cam):
+    """Reset and wait for the uniform belief and the start target."""
+    nb, nt = len(cam.beliefs), len(cam.targets)
+    assert _reset(probe).success
+    assert wait_for(lambda: len(cam.beliefs) > nb and len(cam.targets) > nt, 20)
+    np.testing.assert_allclose(cam.belief(), 1 / 121, rtol=1e-6)
+
+
+def _frames(seed, n):
+    return np.random.default_rng(seed).standard_normal((n, 121)).astype(np.float32)
+
+
+def _conv_choice(kernel, belief):
+    """The kernel's next fixation offline, and the margin over the runner-up."""
+    from policies.conv import ConvPolicy
+    from ipomdp_gaze.grid import Grid
+    policy = ConvPolicy(Grid(11, 11, 5.0), np.asarray(kernel).reshape(21, 21))
+    scores = policy.scores(belief[None])[0]
+    top2 = np.sort(scores)[-2:]
+    return int(policy.select(belief[None], 1, None)[0]), top2[1] - top2[0]
+
+
+def test_kernel_set_remotely_drives_the_next_fixation(probe, cam):
+    kernel = np.random.default_rng(7).standard_normal(441)      # asymmetric on purpose
+    assert 'disabled' in _enable(probe, False).message
+    results = _set(probe, policy__kernel=kernel.tolist())
+    assert results[0].successful, results[0].reason
+    params = probe.get_parameters(NODE, ['policy.name', 'policy.kernel'])
+    assert params['policy.name'] == 'learned'
+    np.testing.assert_array_equal(params['policy.kernel'], kernel)
+    nb = len(cam.beliefs)
+    assert _reset(probe).success
+    assert wait_for(lambda: len(cam.beliefs) > nb)
+    nt = len(cam.targets)
+    assert _enable(probe, True).message == 'enabled'
+    assert wait_for(lambda: len(cam.targets) > nt)
+    assert cam.fixation() == 60                                  # the start cell
+    belief = np.full(121, 1 / 121)
+    for frame in _frames(1, 3):
+        fixation = cam.fixation()
+        got_belief, got_next = cam.step(frame)
+        belief = cam.expected(belief, frame, fixation)
+        np.testing.assert_allclose(got_belief, belief, rtol=1e-4, atol=1e-7)
+        want_next, margin = _conv_choice(kernel, belief)
+        assert margin > 1e-4
+        assert got_next == want_next
+        belief = got_belief.astype(np.float64)
+
+
+@pytest.mark.parametrize('bad, words', [
+    (np.zeros(440).tolist(), 'policy.kernel must have 441 values'),
+    ([float('nan')] + [0.0] * 440, 'must be finite'),
+    ([1] * 441, 'Wrong parameter type'),
+])
+def test_bad_kernel_is_rejected_and_the_old_one_stays(probe, cam, bad, words):
+    old = np.random.default_rng(8).standard_normal(441)
+    assert _set(probe, policy__kernel=old.tolist())[0].successful
+    result = _set(probe, policy__kernel=bad)[0]
+    assert not result.successful and words in result.reason, result.reason
+    np.testing.assert_array_equal(probe.get_parameters(NODE, ['policy.kernel'])['policy.kernel'],
+                                  old)
+    # The node still fixates by the old kernel.
+    belief, fixation = cam.belief().astype(np.float64), cam.fixation()
+    frame = _frames(99, 1)[0]
+    got_belief, got_next = cam.step(frame)
+    np.testing.assert_allclose(got_belief, cam.expected(belief, frame, fixation),
+                               rtol=1e-4, atol=1e-7)
+    assert got_next == _conv_choice(old, got_belief.astype(np.float64))[0]
+
+
+@pytest.mark.parametrize('values, words', [
+    ({'policy.name': 'foo'}, "policy.name must be one of 'learned', 'map'"),
+    ({'grid.rows': 7}, 'read-only'),
+    ({'settle_time_s': -1.0}, 'settle_time_s'),
+    ({'start_row': 11}, 'start_row must be -1 or in 0..10'),
+    ({'pan_max_rad': 0.1}, 'outside the pan limits'),
+    ({'confidence': 1.0}, 'confidence must be between 0 and 1'),
+    ({'fpoc.model': 'sonar'}, 'fpoc.model must be one of'),
+    ({'fpoc.dprime': -2.0}, 'dprime must be finite and > 0'),
+    ({'policy.action': 'softmax'}, 'policy.action must be one of'),
+    ({'trajectory_topic': 'bad topic'}, 'trajectory_topic'),
+])
+def test_invalid_parameters_are_rejected_with_a_reason(probe, cam, values, words):
+    before = probe.get_parameters(NODE, list(values))
+    result = probe.set_parameters(NODE, values)[0]
+    assert not result.successful
+    assert words in result.reason, result.reason
+    assert probe.get_parameters(NODE, list(values)) == before
+
+
+def test_malformed_evidence_is_rejected_counted_and_throttled(probe, cam):
+    from sensor_msgs.msg import Image
+    from std_msgs.msg import MultiArrayDimension, MultiArrayLayout
+
+    before = cam.counters()
+    belief, fixation, nb, nt = cam.belief(), cam.fixation(), len(cam.beliefs), len(cam.targets)
+    seven = MultiArrayLayout(dim=[MultiArrayDimension(label='rows', size=7, stride=49),
+                                  MultiArrayDimension(label='cols', size=7, stride=7)])
+    good = _frames(5, 1)[0]
+    cam.send(good[:120], layout=MultiArrayLayout())                  # wrong length
+    cam.send(np.where(np.arange(121) == 3, np.inf, good))             # +inf
+    cam.send(np.where(np.arange(121) == 4, -np.inf, good))            # -inf
+    cam.send(good[:49], layout=seven)                                 # a 7x7 layout
+    cam.send(good, layout=MultiArrayLayout(dim=seven.dim, data_offset=0))  # layout vs length
+    cam.evidence_image.publish(Image(height=11, width=11, encoding='mono8', step=11,
+                                     data=bytes(121)))
+    rejected = int(before['frames_rejected']) + 6
+    after = cam.wait_counters(frames_rejected=rejected)
+    assert int(after['frames_applied']) == int(before['frames_applied'])
+    assert int(after['frames_received']) == int(after['frames_applied']) + rejected + int(
+        after['frames_skipped'])
+    assert len(cam.beliefs) == nb and len(cam.targets) == nt          # belief unchanged
+    warnings = [line for line in cam.proc.output().splitlines()
+                if 'rejected an evidence frame' in line]
+    assert 1 <= len(warnings) < 6, warnings                          # throttled
+    # The node keeps serving: a good frame is applied to the unchanged belief.
+    got_belief, _ = cam.step(good)
+    np.testing.assert_allclose(got_belief, cam.expected(belief, good, fixation),
+                               rtol=1e-4, atol=1e-7)
+
+
+def test_nan_cells_are_unobserved(probe, cam):
+    belief, fixation = cam.belief().astype(np.float64), cam.fixation()
+    frame = _frames(6, 1)[0]
+    frame[::3] = np.nan
+    got_belief, _ = cam.step(frame)
+    np.testing.assert_allclose(got_belief, cam.expected(belief, frame, fixation),
+                               rtol=1e-4, atol=1e-7)
+
+
+def test_stamped_evidence_image_is_used(probe, cam):
+    from msg_adapters import images
+    belief, fixation = cam.belief().astype(np.float64), cam.fixation()
+    frame = _frames(8, 1)[0]
+    nb = len(cam.beliefs)
+    stamp = cam.probe.node.get_clock().now().to_msg()
+    cam.evidence_image.publish(images.evidence_image(frame, cam.grid, stamp))
+    assert wait_for(lambda: len(cam.beliefs) > nb, 20)
+    np.testing.assert_allclose(cam.belief(), cam.expected(belief, frame, fixation),
+                               rtol=1e-4, atol=1e-7)
+
+
+def test_disable_skips_frames_enable_resends_reset_restarts(probe, cam):
+    before = cam.counters()
+    fixation, nb, nt = cam.fixation(), len(cam.beliefs), len(cam.targets)
+    assert _enable(probe, False).message == 'disabled'
+    assert _enable(probe, False).message == 'already disabled'
+    cam.send(_frames(9, 1)[0])
+    cam.wait_counters(frames_skipped=int(before['frames_skipped']) + 1, enabled='false')
+    assert len(cam.beliefs) == nb and len(cam.targets) == nt
+    old_stamp = cam.targets[-1][1].header.stamp
+    assert _enable(probe, True).message == 'enabled'
+    assert wait_for(lambda: len(cam.targets) > nt)
+    assert cam.fixation() == fixation and cam.targets[-1][1].header.stamp != old_stamp
+    cam.step(_frames(10, 1)[0])
+    _fresh_search(probe, cam)
+    assert cam.fixation() == 60
+    assert _reset(probe).message == 'belief reset; looking at (5, 5)'
+
+
+@pytest.mark.parametrize('params, cell, pan_deg, tilt_deg', [
+    ({'start_row': 0, 'start_col': 0}, (0, 0), 25.0, -25.0),
+    ({'start_row': 10, 'start_col': 3}, (10, 3), 10.0, 25.0),
+    ({'start_row': 10, 'start_col': 3, 'pan_sign': -1}, (10, 3), -10.0, 25.0),
+    ({'start_row': 2, 'start_col': 8, 'tilt_sign': -1, 'pan_offset_rad': 0.5},
+     (2, 8), -15.0 + math.degrees(0.5), 15.0),
+])
+def test_pan_tilt_of_known_cells_and_signs(probe, cam, params, cell, pan_deg, tilt_deg):
+    defaults = {'start_row': -1, 'start_col': -1, 'pan_sign': 1, 'tilt_sign': 1,
+                'pan_offset_rad': 0.0}
+    try:
+        results = probe.set_parameters(NODE, params)
+        assert all(r.successful for r in results), [r.reason for r in results]
+        want = (math.radians(pan_deg), math.radians(tilt_deg))
+        assert _reset(probe).message == f'belief reset; looking at {cell}'
+        # A sign or offset change re-sends the current target first; the reset's comes last.
+        wait_for(lambda: np.allclose(cam.targets[-1][1].position, want, atol=1e-9), 20)
+        msg = cam.targets[-1][1]
+        assert list(msg.name) == ['pan_joint', 'tilt_joint']
+        assert msg.position[0] == pytest.approx(want[0], abs=1e-9)
+        assert msg.position[1] == pytest.approx(want[1], abs=1e-9)
+    finally:
+        probe.set_parameters(NODE, defaults)
