@@ -1,16 +1,18 @@
-"""Simulation throughput: 20,000 episodes x 49 fixations of the 7x7 task per baseline.
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Simulation throughput: 20,000 episodes x 49 fixations of the 7x7 task per baseline.
 
 Run: ``.venv/bin/python bench/bench_simulate.py``. Prints wall seconds and episode-fixations per
 second, beside a naive per-episode Python loop on a subsample (the reference ratio).
 """
 import time
 
-import numpy as np
-
 from ipomdp_gaze.belief import map_cell, uniform_log_belief, update_log_belief
 from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.simulate import simulate
+import numpy as np
 from policies.baselines import make_baseline
 
 

@@ -1,4 +1,7 @@
-"""Gymnasium environment ``ipomdp_gaze/VisualSearch-v0``: the I-POMDP visual-search task.
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Gymnasium environment ``ipomdp_gaze/VisualSearch-v0``: the I-POMDP visual-search task.
 
 Each step fixates one cell (``Discrete(N)`` action), draws one observation per cell from the
 observation model (DESIGN.md section 1) and updates the belief. The observation is a ``Dict`` with
@@ -11,11 +14,11 @@ target is in ``info['target']`` for oracle baselines.
 from __future__ import annotations
 
 import gymnasium
-import numpy as np
 from gymnasium import spaces
+import numpy as np
 
 from .belief import entropy, infomax_reward, map_cell, normalize_log, uniform_log_belief
-from .fpoc import FPOC, dprime_matrix, make_fpoc
+from .fpoc import dprime_matrix, FPOC, make_fpoc
 from .grid import Grid
 from .render import belief_heatmap, belief_text
 
@@ -43,7 +46,7 @@ class VisualSearchEnv(gymnasium.Env):
         if not 0.0 < confidence <= 1.0:
             raise ValueError(f'confidence must be in (0, 1], got {confidence!r}')
         if render_mode is not None and render_mode not in self.metadata['render_modes']:
-            raise ValueError(f"unknown render_mode {render_mode!r}; valid: rgb_array, ansi")
+            raise ValueError(f'unknown render_mode {render_mode!r}; valid: rgb_array, ansi')
         n = self.grid.n_cells
         self.reward_name, self.observe, self.confidence = reward, observe, float(confidence)
         self.max_steps = n if max_steps is None else int(max_steps)
@@ -66,7 +69,7 @@ class VisualSearchEnv(gymnasium.Env):
 
     @property
     def belief(self) -> np.ndarray:
-        """Current belief, shape (N,)."""
+        """Return the current belief, shape (N,)."""
         return np.exp(self._log_b)
 
     def _obs(self):
@@ -93,7 +96,8 @@ class VisualSearchEnv(gymnasium.Env):
     def step(self, action):
         k = int(action)
         if not self.action_space.contains(k):
-            raise ValueError(f'action must be a cell index in [0, {self.grid.n_cells}), got {action!r}')
+            raise ValueError(
+                f'action must be a cell index in [0, {self.grid.n_cells}), got {action!r}')
         d_k = self._d[:, k]
         obs = self.np_random.standard_normal(self.grid.n_cells)
         obs[self._target] += d_k[self._target]

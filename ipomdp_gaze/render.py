@@ -1,4 +1,7 @@
-"""Pictures of a belief: a colour-mapped heatmap (uint8 RGB) and a text grid, with no ROS.
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Pictures of a belief: a colour-mapped heatmap (uint8 RGB) and a text grid, with no ROS.
 
 Used by the Gymnasium environment's ``render`` and by the controller's ``belief_image`` adapter.
 """
@@ -23,7 +26,8 @@ def colormap(values: np.ndarray) -> np.ndarray:
 
 def belief_heatmap(belief: np.ndarray, rows: int, cols: int, fixation: int | None = None,
                    scale: int = 16) -> np.ndarray:
-    """A ``(rows*scale, cols*scale, 3)`` uint8 heatmap of the belief, normalised to its maximum.
+    """
+    Draw a ``(rows*scale, cols*scale, 3)`` uint8 heatmap of the belief, normalised to its maximum.
 
     The fixated cell, if given, is outlined in cyan so the scan is visible in rqt_image_view.
     """

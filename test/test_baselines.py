@@ -1,11 +1,12 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """Baselines by strategy string and the convolutional policy's scores."""
-import numpy as np
-import pytest
-
 from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
 from ipomdp_gaze.grid import Grid
-from policies.baselines import STRATEGIES, make_baseline, spiral_order
+import numpy as np
+from policies.baselines import make_baseline, spiral_order, STRATEGIES
 from policies.conv import ConvPolicy, kernel_from_radial, radial_bins
+import pytest
 
 GRID = Grid(5, 6, 0.42)
 HUMAN = make_fpoc('human')

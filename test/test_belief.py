@@ -1,11 +1,12 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """The log-domain belief update against a brute-force Bayes posterior, and its edge cases."""
+from ipomdp_gaze.belief import (argmax_ties_low, check_evidence, entropy, EvidenceError,
+                                fixate_target_reward, infomax_reward, map_cell, uniform_log_belief,
+                                update_log_belief)
 import numpy as np
 import pytest
 from scipy.stats import norm
-
-from ipomdp_gaze.belief import (EvidenceError, argmax_ties_low, check_evidence, entropy,
-                                fixate_target_reward, infomax_reward, map_cell,
-                                uniform_log_belief, update_log_belief)
 
 
 def brute_force_posterior(prior, observations, dprimes):

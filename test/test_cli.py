@@ -1,11 +1,12 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """The ``ipomdp-gaze`` command line: help, JSON output and one-line errors."""
 import json
 import subprocess
 import sys
 
-import pytest
-
 from ipomdp_gaze.cli import main
+import pytest
 
 
 def run_cli(*args):

@@ -1,9 +1,9 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """Fixations to 90% correct and its bootstrap interval."""
+from ipomdp_gaze.evaluation import fixations_to_90_ci, fixations_to_level, paired_difference_ci
 import numpy as np
 import pytest
-
-from ipomdp_gaze.evaluation import (fixations_to_90_ci, fixations_to_level,
-                                    paired_difference_ci)
 
 
 def test_linear_interpolation_between_fixations():

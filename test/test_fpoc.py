@@ -1,10 +1,11 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """FPOC values against DESIGN.md section 2 and their parameter checks."""
-import numpy as np
-import pytest
-
-from ipomdp_gaze.fpoc import (CameraFPOC, HumanFPOC, dprime_matrix, dprime_table, fpoc_from_dict,
+from ipomdp_gaze.fpoc import (CameraFPOC, dprime_matrix, dprime_table, fpoc_from_dict, HumanFPOC,
                               make_fpoc)
 from ipomdp_gaze.grid import Grid
+import numpy as np
+import pytest
 
 
 def test_human_default_matches_design_table():

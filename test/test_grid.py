@@ -1,8 +1,9 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """Grid geometry: row-major indices, offsets and the offset table."""
+from ipomdp_gaze.grid import Grid, parse_grid
 import numpy as np
 import pytest
-
-from ipomdp_gaze.grid import Grid, parse_grid
 
 
 def test_index_cell_round_trip():

@@ -1,13 +1,14 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """The Gymnasium environment: API conformance and the model it wraps."""
 import gymnasium
-import numpy as np
-import pytest
 from gymnasium.utils.env_checker import check_env
-
-import ipomdp_gaze.gym  # noqa: F401  (registers the environment)
 from ipomdp_gaze.belief import uniform_log_belief, update_log_belief
 from ipomdp_gaze.fpoc import dprime_matrix
+import ipomdp_gaze.gym  # noqa: F401  (registers the environment)
 from ipomdp_gaze.gym import ENV_ID, VisualSearchEnv
+import numpy as np
+import pytest
 
 
 @pytest.mark.filterwarnings('ignore:.*Box observation space m.* value is:UserWarning')

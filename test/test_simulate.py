@@ -1,13 +1,14 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """Batched simulator: common random numbers, agreement with step-by-step updates, calibration."""
-import numpy as np
-import pytest
-
 from ipomdp_gaze.belief import map_cell, uniform_log_belief, update_log_belief
 from ipomdp_gaze.evaluation import fixations_to_90_ci
 from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.simulate import draw_targets, noise_stream, simulate
+import numpy as np
 from policies.baselines import make_baseline
+import pytest
 
 GRID = Grid(7, 7, 0.42)
 HUMAN = make_fpoc('human')
@@ -46,7 +47,8 @@ def test_targets_are_uniform():
 
 @pytest.mark.parametrize('name, reference', [('random', 11.33), ('map', 9.1)])
 def test_calibrated_baselines_reach_design_values(name, reference):
-    """DESIGN.md: random about 11.3 and MAP about 9.1 fixations to 90% on 7x7 (human default).
+    """
+    DESIGN.md: random about 11.3 and MAP about 9.1 fixations to 90% on 7x7 (human default).
 
     The tolerance is four bootstrap standard errors of this run plus 0.05 for the rounding of the
     reference, so a correct model fails this with probability well below 1e-3.
