@@ -1,4 +1,7 @@
-"""Full logistic policy: ``p(k | B) ∝ exp(score_k)`` with ``score_k = sum_j theta[k, j] B_j``.
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Full logistic policy: ``p(k | B) ∝ exp(score_k)`` with ``score_k = sum_j theta[k, j] B_j``.
 
 One free weight per (fixation, cell) pair: N x N weights (2,401 at 7x7, 14,641 at 11x11), paper
 Sec. III. The convolutional family of :mod:`policies.conv` is the special case
@@ -6,10 +9,9 @@ Sec. III. The convolutional family of :mod:`policies.conv` is the special case
 """
 from __future__ import annotations
 
-import numpy as np
-
 from ipomdp_gaze.belief import argmax_ties_low
 from ipomdp_gaze.grid import Grid
+import numpy as np
 
 from .conv import check_action
 

@@ -1,4 +1,7 @@
-"""Policy files: a learned policy with the task it was trained for, as YAML.
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Policy files: a learned policy with the task it was trained for, as YAML.
 
 Format ``ipomdp_gaze/policy-v1`` (issue 3)::
 
@@ -21,17 +24,16 @@ with a file (:class:`PolicyFileError`). A source is a path or the name of a ship
 """
 from __future__ import annotations
 
-import math
-import warnings
 from dataclasses import dataclass, field
+import math
 from pathlib import Path
 from typing import Callable
-
-import numpy as np
-import yaml
+import warnings
 
 from ipomdp_gaze.fpoc import FPOC, fpoc_from_dict
 from ipomdp_gaze.grid import Grid
+import numpy as np
+import yaml
 
 from .conv import ACTIONS, ConvPolicy, radial_bins
 from .logistic import LogisticPolicy
@@ -57,7 +59,8 @@ class PolicyFileWarning(UserWarning):
 
 @dataclass
 class PolicySpec:
-    """Everything a policy file holds, validated.
+    """
+    Everything a policy file holds, validated.
 
     ``kernel`` is set for the ``conv`` family, ``theta`` for ``logistic``; ``training`` and
     ``evaluation`` are the free-form records of how the policy was made and how well it did.
@@ -76,7 +79,7 @@ class PolicySpec:
 
     @property
     def weights(self) -> np.ndarray:
-        """The family's array: the kernel (conv) or theta (logistic)."""
+        """Return the family's array: the kernel (conv) or theta (logistic)."""
         return self.kernel if self.family == 'conv' else self.theta
 
     def radial(self) -> dict | None:
@@ -92,7 +95,7 @@ class PolicySpec:
                 'weight': [float(w) for w in weight]}
 
     def make_policy(self, action: str | None = None):
-        """The policy object (:class:`ConvPolicy` or :class:`LogisticPolicy`)."""
+        """Build the policy object (:class:`ConvPolicy` or :class:`LogisticPolicy`)."""
         action = self.action if action is None else action
         if self.family == 'conv':
             policy = ConvPolicy(self.grid, self.kernel, action=action)
@@ -103,7 +106,7 @@ class PolicySpec:
         return policy
 
     def to_dict(self) -> dict:
-        """The YAML document as plain Python types (what :func:`save_policy` writes)."""
+        """Return the YAML document as plain Python types (what :func:`save_policy` writes)."""
         doc = {'format': FORMAT, 'grid': self.grid.to_dict(), 'fpoc': _plain(self.fpoc.to_dict()),
                'reward': self.reward, 'family': self.family, 'action': self.action}
         if self.family == 'conv':
@@ -137,12 +140,14 @@ def shipped_kernels() -> list[str]:
 
 
 def resolve_source(source) -> Path:
-    """The file a source names: an existing path, or a shipped kernel name (with or without .yaml).
+    """
+    Resolve the file a source names: an existing path, or a shipped kernel name (with or without .yaml).
 
     Raises
     ------
     PolicyFileError
         If it is neither, listing the shipped names.
+
     """
     path = Path(source)
     if path.is_file():
@@ -254,12 +259,14 @@ def _record(doc: dict, key: str) -> dict:
 
 
 def spec_from_dict(doc, path: Path | None = None) -> PolicySpec:
-    """Validate a parsed policy document and build its :class:`PolicySpec`.
+    """
+    Validate a parsed policy document and build its :class:`PolicySpec`.
 
     Raises
     ------
     PolicyFileError
         Naming the first problem found.
+
     """
     if not isinstance(doc, dict):
         raise PolicyFileError(f'a policy file must be a YAML mapping, got '
@@ -302,13 +309,15 @@ def spec_from_dict(doc, path: Path | None = None) -> PolicySpec:
 
 
 def load_policy_spec(source) -> PolicySpec:
-    """Read and validate a policy file given by path or shipped kernel name.
+    """
+    Read and validate a policy file given by path or shipped kernel name.
 
     Raises
     ------
     PolicyFileError
         If the file is missing, is not YAML, or breaks the schema; the message names the file
         and the problem.
+
     """
     path = resolve_source(source)
     try:
@@ -333,7 +342,8 @@ def _warn(message: str) -> None:
 
 def check_task(spec: PolicySpec, grid: Grid | None = None, fpoc: FPOC | None = None,
                warn: Callable[[str], None] | None = None) -> None:
-    """Check a policy against the task it is used on.
+    """
+    Check a policy against the task it is used on.
 
     A different number of rows or columns is an error (the policy cannot act on that grid); a
     different spacing or FPOC is allowed (the policy is used off its training task) and reported
@@ -355,7 +365,8 @@ def check_task(spec: PolicySpec, grid: Grid | None = None, fpoc: FPOC | None = N
 
 def load_policy(source, grid: Grid | None = None, fpoc: FPOC | None = None,
                 action: str | None = None, warn: Callable[[str], None] | None = None):
-    """Load a policy file (path or shipped name) as a policy object with ``select``.
+    """
+    Load a policy file (path or shipped name) as a policy object with ``select``.
 
     Parameters
     ----------
@@ -367,6 +378,7 @@ def load_policy(source, grid: Grid | None = None, fpoc: FPOC | None = None,
         Overrides the file's action rule.
     warn : callable, optional
         Receives a message when the policy is used off its training task.
+
     """
     spec = load_policy_spec(source)
     check_task(spec, grid, fpoc, warn)
