@@ -141,7 +141,7 @@ def shipped_kernels() -> list[str]:
 
 def resolve_source(source) -> Path:
     """
-    Resolve the file a source names: an existing path, or a shipped kernel name (with or without .yaml).
+    Resolve a source: an existing path, or a shipped kernel name (with or without .yaml).
 
     Raises
     ------
