@@ -67,3 +67,12 @@ def test_learned_order_of_baselines():
         res = simulate(GRID, HUMAN, make_baseline(name, GRID, HUMAN), 3000, 20, seed=5)
         f90[name] = fixations_to_90_ci(res.correct, 49, np.random.default_rng(0), 1)[0]
     assert f90['elm'] < f90['map'] - 0.6 and f90['map'] < f90['random'] - 1.0, f90
+
+
+def test_fewer_episodes_see_a_prefix_of_the_same_draws():
+    """Common random numbers hold across batch sizes: 300 episodes are the first 300 of 1000."""
+    policy = make_baseline('elm', GRID, HUMAN)
+    small = simulate(GRID, HUMAN, policy, 300, 8, seed=9)
+    large = simulate(GRID, HUMAN, policy, 1000, 8, seed=9)
+    np.testing.assert_array_equal(small.correct, large.correct[:300])
+    np.testing.assert_array_equal(small.fixations, large.fixations[:300])
