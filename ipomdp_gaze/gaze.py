@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """The gaze controller's brain, without ROS: belief, frame acceptance, policy and found event.
 
 :class:`GazeController` is what the ``gaze_controller`` node wraps. It holds the belief over the

@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """``diagnostic_msgs``: the controller's ``/diagnostics`` status and its ``found`` event.
 
 The ``found`` event is a ``diagnostic_msgs/DiagnosticStatus`` (level OK, a readable message)

@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """Grid-shaped arrays <-> ``std_msgs`` multi-arrays (DESIGN.md section 5).
 
 The layout of a ``rows x cols`` grid is

@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """Images: the belief heatmap (``rgb8``) and per-cell evidence as ``32FC1``.
 
 Float images look black in rqt_image_view unless its dynamic range is switched on, so the belief

@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """Grid cells <-> pan/tilt joint angles, and the head command messages.
 
 REP 103 (x forward, y left, z up): positive pan turns left, positive tilt looks down. With row 0

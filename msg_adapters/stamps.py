@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """``builtin_interfaces/Time`` <-> seconds."""
 from __future__ import annotations
 

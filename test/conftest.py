@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """Shared fixtures; the ROS ones run real nodes over real DDS, isolated per test run.
 
 Every run gets its own ``ROS_DOMAIN_ID`` (derived from the pytest process id, 0..101), discovery

@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """The gaze controller core without ROS: frames, belief, policy choice, found, counters."""
 from __future__ import annotations
 

@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """msg_adapters: every conversion between numpy and ROS messages (no DDS, no node)."""
 from __future__ import annotations
 

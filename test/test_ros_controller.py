@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """The controller process alone, with this test playing the camera and the operator.
 
 Covers: the kernel parameter set from another process through SetParameters (what ``ros2 param

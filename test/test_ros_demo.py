@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """``ipomdp-gaze demo`` end to end: two node processes, a found target, a clean exit."""
 from __future__ import annotations
 

@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """The launch test with the simulated camera: both nodes as processes with the shipped YAML files.
 
 A probe node watches ``belief``, ``pan_tilt``, ``belief_image``, ``found`` and ``ground_truth``.

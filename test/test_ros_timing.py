@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """Re-sent ``pan_tilt`` for a camera that starts late; ``settle_time_s`` with a video camera.
 
 The controller starts alone and keeps re-sending its target; the camera starts late and the

@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """``ipomdp-gaze camera``: run the ``simulated_camera`` node (what ``ros2 run`` starts)."""
 from __future__ import annotations
 

@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """``ipomdp-gaze demo`` (what ``make demo`` runs): the ROS 2 nodes find a hidden target.
 
 Starts ``gaze_controller`` and ``simulated_camera`` as two processes with the shipped YAML files,

@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """The ``simulated_camera`` node: a pan/tilt camera and detector for bench testing.
 
 It stands in for the hardware. It subscribes ``pan_tilt`` (``sensor_msgs/JointState``), snaps

@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """Where the package's shared files (config YAML, launch files) are found.
 
 A colcon or pip install puts them under ``<prefix>/share/ipomdp_gaze``; an editable install has no

@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """The ``gaze_controller`` node: I-POMDP gaze control of a pan/tilt head.
 
 A thin wrapper: :class:`ipomdp_gaze.gaze.GazeController` holds the belief and decides, and

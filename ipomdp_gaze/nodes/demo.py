@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """The ROS 2 demo: both nodes as separate processes, watched from this process.
 
 :func:`run_demo` starts ``gaze_controller`` and then ``simulated_camera`` (once the controller's

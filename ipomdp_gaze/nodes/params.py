@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """Parameter declarations shared by the nodes: explicit types, descriptors, ranges and choices.
 
 Both nodes describe the task with the same names (``grid.*``, ``fpoc.<name>`` with the names of

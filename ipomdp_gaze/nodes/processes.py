@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """Start and stop nodes as separate processes (no ``ros2 launch`` here): the demo and tests.
 
 Each node runs as ``python -m ipomdp_gaze.nodes.<name> --ros-args ...`` with its output in a log
