@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""The gaze controller's brain, without ROS: belief, frame acceptance, policy and found event.
+"""
+The gaze controller's brain, without ROS: belief, frame acceptance, policy and found event.
 
 :class:`GazeController` is what the ``gaze_controller`` node wraps. It holds the belief over the
 target's cell and the current fixation, and decides what to do with every frame of evidence:
@@ -21,13 +22,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from policies.baselines import make_baseline, STRATEGIES
+from policies.conv import check_action, ConvPolicy
 
-from policies.baselines import STRATEGIES, make_baseline
-from policies.conv import ConvPolicy, check_action
-
-from .belief import (EvidenceError, check_evidence, entropy, map_cell, normalize_log,
+from .belief import (check_evidence, entropy, EvidenceError, map_cell, normalize_log,
                      uniform_log_belief)
-from .fpoc import FPOC, dprime_matrix
+from .fpoc import dprime_matrix, FPOC
 from .grid import Grid
 
 POLICY_NAMES = ('learned', 'map', 'elm', 'random', 'center', 'spiral', 'greedy')
@@ -48,7 +48,8 @@ class Found:
 
 @dataclass(frozen=True)
 class FrameResult:
-    """What happened to one frame of evidence.
+    """
+    What happened to one frame of evidence.
 
     ``status`` is ``'applied'``, ``'skipped'`` or ``'rejected'``; ``reason`` says why a frame was
     not applied; ``fixation`` is the new target after an applied frame; ``found`` is set on the
@@ -67,12 +68,14 @@ class FrameResult:
 
 
 def check_kernel(values, grid: Grid) -> np.ndarray:
-    """A row-major kernel (``(2*rows-1) * (2*cols-1)`` finite numbers) as a 2-D array.
+    """
+    Check a row-major kernel (``(2*rows-1) * (2*cols-1)`` finite numbers); return it 2-D.
 
     Raises
     ------
     ValueError
         Naming the expected length or the non-finite entry.
+
     """
     shape = grid.kernel_shape
     a = np.asarray(values, dtype=float).ravel()
@@ -88,7 +91,8 @@ def check_kernel(values, grid: Grid) -> np.ndarray:
 
 def build_policy(name: str, grid: Grid, fpoc: FPOC, kernel=None, file: str = '',
                  action: str = 'argmax', warn=None):
-    """Build the policy called ``name`` (one of :data:`POLICY_NAMES`).
+    """
+    Build the policy called ``name`` (one of :data:`POLICY_NAMES`).
 
     ``learned`` uses ``kernel`` (a row-major convolutional kernel) when it is non-empty, else the
     policy ``file`` (a policy YAML path or a shipped kernel name); ``action`` (``argmax`` or
@@ -98,9 +102,12 @@ def build_policy(name: str, grid: Grid, fpoc: FPOC, kernel=None, file: str = '',
     Raises
     ------
     PolicyUnavailable
-        If the policy file does not exist or policy files are not supported by this install.
+        If the policy file does not exist (neither a path nor a shipped kernel name) or policy
+        files are not supported by this install.
     ValueError
-        For an unknown name, a bad kernel or a policy file that does not fit the grid.
+        For an unknown name, a bad kernel or a policy file that is invalid or does not fit the
+        grid (``policies.policy_file.PolicyFileError`` is a ValueError).
+
     """
     check_action(action)
     if name in STRATEGIES:
@@ -116,18 +123,20 @@ def build_policy(name: str, grid: Grid, fpoc: FPOC, kernel=None, file: str = '',
     if not file:
         raise ValueError("policy 'learned' needs policy.kernel or policy.file")
     try:
-        from policies.policy_file import load_policy
+        from policies.policy_file import load_policy, PolicyFileError, resolve_source
     except ImportError as exc:
         raise PolicyUnavailable(f'policy files are not supported by this install ({exc})') \
             from None
     try:
-        return load_policy(file, grid=grid, fpoc=fpoc, action=action, warn=warn)
-    except FileNotFoundError as exc:
-        raise PolicyUnavailable(f'policy file {file!r} not found ({exc})') from None
+        resolve_source(file)
+    except PolicyFileError as exc:
+        raise PolicyUnavailable(str(exc)) from None
+    return load_policy(file, grid=grid, fpoc=fpoc, action=action, warn=warn)
 
 
 class GazeController:
-    """Belief, fixation and frame acceptance of one search (see the module docstring).
+    """
+    Belief, fixation and frame acceptance of one search (see the module docstring).
 
     Parameters
     ----------
@@ -143,6 +152,7 @@ class GazeController:
         The found event fires when the most likely cell's probability first reaches this.
     seed
         Seed of the generator handed to the policy (``random``, ``sample``).
+
     """
 
     def __init__(self, grid: Grid, fpoc: FPOC, policy, start_cell: int | None = None,
@@ -175,7 +185,7 @@ class GazeController:
         self.policy = policy
 
     def set_start_cell(self, cell: int) -> None:
-        """The first fixation after the next reset."""
+        """Set the first fixation after the next reset."""
         self.grid.cell(cell)
         self.start_cell = int(cell)
 
@@ -203,7 +213,7 @@ class GazeController:
 
     @property
     def map_cell(self) -> int:
-        """The most likely cell (ties to the lowest index)."""
+        """Return the most likely cell (ties to the lowest index)."""
         return int(map_cell(self._belief))
 
     @property
@@ -233,12 +243,13 @@ class GazeController:
         return self.fixation
 
     def retarget(self, now_s: float) -> int:
-        """The current target is (re)sent at ``now_s``: frames must settle from then on."""
+        """Record that the current target is (re)sent at ``now_s``; frames settle from then on."""
         self.target_time_s = float(now_s)
         return self.fixation
 
     def set_enabled(self, enabled: bool, now_s: float) -> bool:
-        """Enable or disable; returns whether that changed anything.
+        """
+        Enable or disable; returns whether that changed anything.
 
         Disabled, frames are skipped (no belief update, no new target). Enabling again re-sends
         the current target at ``now_s``.
@@ -259,7 +270,8 @@ class GazeController:
         return FrameResult('rejected', str(reason))
 
     def offer(self, evidence, stamp_s: float, now_s: float | None = None) -> FrameResult:
-        """Use, skip or reject one frame of evidence taken at ``stamp_s``.
+        """
+        Use, skip or reject one frame of evidence taken at ``stamp_s``.
 
         Parameters
         ----------
@@ -269,6 +281,7 @@ class GazeController:
             When the frame was taken (its header stamp, or its arrival time).
         now_s : float, optional
             Current time, when the next target is sent (default ``stamp_s``).
+
         """
         try:
             obs = check_evidence(evidence, self.grid.n_cells)
@@ -296,7 +309,7 @@ class GazeController:
         return FrameResult('applied', fixation=self.fixation, found=found)
 
     def choose(self) -> int:
-        """The policy's choice for the next fixation given the current belief."""
+        """Ask the policy for the next fixation given the current belief."""
         choice = self.policy.select(self._belief[None, :], self.fixations, self.rng)
         cell = int(np.asarray(choice).ravel()[0])
         self.grid.cell(cell)

@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""Conversions between numpy arrays and ROS 2 messages: the only place that touches message fields.
+"""
+Conversions between numpy arrays and ROS 2 messages: the only place that touches message fields.
 
 Submodules
 ----------

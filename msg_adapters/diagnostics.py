@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""``diagnostic_msgs``: the controller's ``/diagnostics`` status and its ``found`` event.
+"""
+``diagnostic_msgs``: the controller's ``/diagnostics`` status and its ``found`` event.
 
 The ``found`` event is a ``diagnostic_msgs/DiagnosticStatus`` (level OK, a readable message)
 whose ``values`` carry the result as key/value strings: ``row``, ``col``, ``cell``, ``pan_rad``,
@@ -27,25 +28,25 @@ def _text(value) -> str:
 
 def status(name: str, level: str, message: str, values: dict,
            hardware_id: str = '') -> DiagnosticStatus:
-    """A ``DiagnosticStatus``; ``level`` is ``ok``, ``warn``, ``error`` or ``stale``."""
+    """Build a ``DiagnosticStatus``; ``level`` is ``ok``, ``warn``, ``error`` or ``stale``."""
     return DiagnosticStatus(level=LEVELS[level], name=name, message=message,
                             hardware_id=hardware_id,
                             values=[KeyValue(key=k, value=_text(v)) for k, v in values.items()])
 
 
 def diagnostic_array(statuses, stamp) -> DiagnosticArray:
-    """A stamped ``DiagnosticArray`` for ``/diagnostics``."""
+    """Build a stamped ``DiagnosticArray`` for ``/diagnostics``."""
     return DiagnosticArray(header=Header(stamp=stamp), status=list(statuses))
 
 
 def values_of(msg: DiagnosticStatus) -> dict:
-    """The key/value pairs of a status as a dict of strings."""
+    """Return the key/value pairs of a status as a dict of strings."""
     return {kv.key: kv.value for kv in msg.values}
 
 
 def found_status(name: str, row: int, col: int, cell: int, pan_rad: float, tilt_rad: float,
                  probability: float, fixations: int) -> DiagnosticStatus:
-    """The ``found`` event."""
+    """Build the ``found`` event."""
     message = (f'target found at row {row}, col {col} (pan {pan_rad:+.4f} rad, tilt '
                f'{tilt_rad:+.4f} rad) with probability {probability:.4f} after {fixations} '
                f'fixations')
@@ -55,12 +56,14 @@ def found_status(name: str, row: int, col: int, cell: int, pan_rad: float, tilt_
 
 
 def parse_found(msg: DiagnosticStatus) -> dict:
-    """The numbers of a ``found`` event (row, col, cell and fixations as int, the rest float).
+    """
+    Read a ``found`` event (row, col, cell and fixations as int, the rest as float).
 
     Raises
     ------
     ValueError
         If a key is missing or not a number.
+
     """
     kv = values_of(msg)
     missing = [k for k in FOUND_KEYS if k not in kv]

@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""Grid-shaped arrays <-> ``std_msgs`` multi-arrays (DESIGN.md section 5).
+"""
+Grid-shaped arrays <-> ``std_msgs`` multi-arrays (DESIGN.md section 5).
 
 The layout of a ``rows x cols`` grid is
 ``dim[0] = {label: 'rows', size: rows, stride: rows*cols}``,
@@ -12,12 +13,10 @@ from __future__ import annotations
 
 import array
 
-import numpy as np
-from std_msgs.msg import (Float32MultiArray, Int32MultiArray, MultiArrayDimension,
-                          MultiArrayLayout)
-
 from ipomdp_gaze.belief import EvidenceError
 from ipomdp_gaze.grid import Grid
+import numpy as np
+from std_msgs.msg import Float32MultiArray, Int32MultiArray, MultiArrayDimension, MultiArrayLayout
 
 
 class LayoutError(EvidenceError):
@@ -25,7 +24,7 @@ class LayoutError(EvidenceError):
 
 
 def grid_layout(grid: Grid) -> MultiArrayLayout:
-    """The two-dimension row-major layout of ``grid``."""
+    """Build the two-dimension row-major layout of ``grid``."""
     return MultiArrayLayout(
         dim=[MultiArrayDimension(label='rows', size=grid.rows, stride=grid.n_cells),
              MultiArrayDimension(label='cols', size=grid.cols, stride=grid.cols)],
@@ -33,12 +32,14 @@ def grid_layout(grid: Grid) -> MultiArrayLayout:
 
 
 def to_multiarray(values, grid: Grid) -> Float32MultiArray:
-    """A ``Float32MultiArray`` holding ``values`` (N,) or (rows, cols) with the grid layout.
+    """
+    Pack ``values`` (N,) or (rows, cols) in a ``Float32MultiArray`` with the grid layout.
 
     Raises
     ------
     ValueError
         If ``values`` does not have one entry per cell.
+
     """
     a = np.ascontiguousarray(values, dtype=np.float32)
     if a.size != grid.n_cells or a.shape not in ((grid.n_cells,), grid.shape):
@@ -50,7 +51,8 @@ def to_multiarray(values, grid: Grid) -> Float32MultiArray:
 
 
 def check_layout(layout: MultiArrayLayout, grid: Grid) -> None:
-    """Raise :class:`LayoutError` unless ``layout`` is empty or describes ``grid`` row-major.
+    """
+    Raise :class:`LayoutError` unless ``layout`` is empty or describes ``grid`` row-major.
 
     Accepted: no dimensions; one dimension of size N; or two of sizes (rows, cols). A stride of 0
     counts as unset; any other stride must be the row-major one. ``data_offset`` must be 0.
@@ -79,7 +81,8 @@ def check_layout(layout: MultiArrayLayout, grid: Grid) -> None:
 
 
 def from_multiarray(msg, grid: Grid) -> np.ndarray:
-    """The values of a grid-shaped ``Float32MultiArray`` as float64, shape (N,).
+    """
+    Read a grid-shaped ``Float32MultiArray`` as float64 values, shape (N,).
 
     The layout is checked (:func:`check_layout`) and the length must be N; the values themselves
     (NaN, inf) are left for :func:`ipomdp_gaze.belief.check_evidence`.
@@ -90,6 +93,7 @@ def from_multiarray(msg, grid: Grid) -> np.ndarray:
         If the layout disagrees with the grid.
     EvidenceError
         If the data does not have one value per cell.
+
     """
     check_layout(msg.layout, grid)
     values = np.asarray(msg.data, dtype=np.float32)
@@ -100,7 +104,7 @@ def from_multiarray(msg, grid: Grid) -> np.ndarray:
 
 
 def ground_truth(grid: Grid, cell: int) -> Int32MultiArray:
-    """The simulated camera's ground truth: ``data = [row, col]``."""
+    """Build the simulated camera's ground truth: ``data = [row, col]``."""
     row, col = grid.cell(cell)
     msg = Int32MultiArray(layout=MultiArrayLayout(
         dim=[MultiArrayDimension(label='row_col', size=2, stride=2)], data_offset=0))
@@ -109,12 +113,14 @@ def ground_truth(grid: Grid, cell: int) -> Int32MultiArray:
 
 
 def cell_from_ground_truth(msg, grid: Grid) -> int:
-    """The cell index of a ground-truth ``[row, col]`` message.
+    """
+    Return the cell index of a ground-truth ``[row, col]`` message.
 
     Raises
     ------
     ValueError
         If the message is not two integers inside the grid.
+
     """
     data = list(msg.data)
     if len(data) != 2:

@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""Images: the belief heatmap (``rgb8``) and per-cell evidence as ``32FC1``.
+"""
+Images: the belief heatmap (``rgb8``) and per-cell evidence as ``32FC1``.
 
 Float images look black in rqt_image_view unless its dynamic range is switched on, so the belief
 is published as a colour-mapped ``rgb8`` picture (DESIGN.md section 5): each cell becomes a
@@ -11,12 +12,11 @@ from __future__ import annotations
 
 import sys
 
+from ipomdp_gaze.belief import EvidenceError
+from ipomdp_gaze.grid import Grid
 import numpy as np
 from sensor_msgs.msg import Image
 from std_msgs.msg import Header
-
-from ipomdp_gaze.belief import EvidenceError
-from ipomdp_gaze.grid import Grid
 
 from .grid_arrays import LayoutError
 
@@ -28,7 +28,7 @@ _LITTLE = sys.byteorder == 'little'
 
 
 def _uint8(data) -> np.ndarray:
-    """The bytes of an image's ``data`` field (bytes, array('B') or a list) as uint8."""
+    """View the bytes of an image's ``data`` field (bytes, array('B') or a list) as uint8."""
     try:
         return np.frombuffer(data, dtype=np.uint8)
     except TypeError:
@@ -43,14 +43,19 @@ def colour_map(values: np.ndarray) -> np.ndarray:
     return np.round(rgb).astype(np.uint8)
 
 
+_LUT = colour_map(np.linspace(0.0, 1.0, 256))
+
+
 def belief_picture(belief, grid: Grid, fixation: int | None, scale_px: int) -> np.ndarray:
-    """The heatmap as a ``(rows*scale_px, cols*scale_px, 3)`` uint8 array."""
+    """Draw the heatmap as a ``(rows*scale_px, cols*scale_px, 3)`` uint8 array."""
     if scale_px < 1:
         raise ValueError(f'scale_px must be >= 1, got {scale_px}')
     b = np.asarray(belief, dtype=float).reshape(grid.shape)
     peak = b.max()
-    rgb = colour_map(b / peak if peak > 0 else b)
-    img = np.repeat(np.repeat(rgb, scale_px, axis=0), scale_px, axis=1)
+    level = np.clip(np.nan_to_num(b / peak if peak > 0 else b), 0.0, 1.0)
+    rgb = _LUT[np.round(level * (len(_LUT) - 1)).astype(np.intp)]
+    # Columns first, then whole rows: both repeats copy contiguous memory (fast).
+    img = np.repeat(np.repeat(rgb, scale_px, axis=1), scale_px, axis=0)
     if fixation is not None:
         row, col = grid.cell(fixation)
         width = max(1, scale_px // 8)
@@ -65,7 +70,7 @@ def belief_picture(belief, grid: Grid, fixation: int | None, scale_px: int) -> n
 
 def belief_image(belief, grid: Grid, fixation: int | None, scale_px: int, stamp,
                  frame_id: str = '') -> Image:
-    """A stamped ``rgb8`` ``sensor_msgs/Image`` of the belief heatmap."""
+    """Build a stamped ``rgb8`` ``sensor_msgs/Image`` of the belief heatmap."""
     img = belief_picture(belief, grid, fixation, scale_px)
     height, width = img.shape[:2]
     return Image(header=Header(stamp=stamp, frame_id=frame_id), height=height, width=width,
@@ -73,9 +78,9 @@ def belief_image(belief, grid: Grid, fixation: int | None, scale_px: int, stamp,
 
 
 def rgb8_array(msg: Image) -> np.ndarray:
-    """The pixels of an ``rgb8`` image as ``(height, width, 3)`` uint8 (row padding dropped)."""
+    """Read an ``rgb8`` image as ``(height, width, 3)`` uint8 pixels (row padding dropped)."""
     if msg.encoding != 'rgb8':
-        raise ValueError(f"expected an rgb8 image, got encoding {msg.encoding!r}")
+        raise ValueError(f'expected an rgb8 image, got encoding {msg.encoding!r}')
     buf = _uint8(msg.data)
     if msg.step < 3 * msg.width or buf.size != msg.step * msg.height:
         raise ValueError(f'image data has {buf.size} bytes, expected step {msg.step} x height '
@@ -94,7 +99,8 @@ def evidence_image(values, grid: Grid, stamp, frame_id: str = '') -> Image:
 
 
 def evidence_from_image(msg: Image, grid: Grid) -> np.ndarray:
-    """The values of a ``32FC1`` evidence image as float64, shape (N,), row-major.
+    """
+    Read a ``32FC1`` evidence image as float64 values, shape (N,), row-major.
 
     Raises
     ------
@@ -102,6 +108,7 @@ def evidence_from_image(msg: Image, grid: Grid) -> np.ndarray:
         If the encoding is not ``32FC1`` or the size is not ``rows x cols``.
     EvidenceError
         If the data does not match the declared step and height.
+
     """
     if msg.encoding.upper() != '32FC1':
         raise LayoutError(f"evidence image encoding is {msg.encoding!r}, expected '32FC1'")

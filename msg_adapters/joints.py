@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""Grid cells <-> pan/tilt joint angles, and the head command messages.
+"""
+Grid cells <-> pan/tilt joint angles, and the head command messages.
 
 REP 103 (x forward, y left, z up): positive pan turns left, positive tilt looks down. With row 0
 at the top and column 0 at the left (DESIGN.md section 5)::
@@ -14,16 +15,15 @@ fit the head is refused instead of being clamped silently.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+import math
 
-import numpy as np
 from builtin_interfaces.msg import Duration
+from ipomdp_gaze.grid import Grid
+import numpy as np
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, Header
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
-
-from ipomdp_gaze.grid import Grid
 
 from .stamps import from_seconds
 
@@ -86,7 +86,7 @@ class PanTiltMap:
         return float(pan), float(tilt)
 
     def nearest_cell(self, pan_rad: float, tilt_rad: float) -> int:
-        """The cell whose pan/tilt is nearest (snapped and clipped to the grid)."""
+        """Return the cell whose pan/tilt is nearest (snapped and clipped to the grid)."""
         col = (self.grid.cols - 1) / 2 - (pan_rad - self.pan_offset_rad) / (
             self.pan_sign * self.spacing_rad)
         row = (self.grid.rows - 1) / 2 + (tilt_rad - self.tilt_offset_rad) / (
@@ -99,19 +99,21 @@ class PanTiltMap:
 
 
 def joint_state(head: PanTiltMap, cell: int, stamp) -> JointState:
-    """A stamped ``JointState`` with the pan and tilt positions of ``cell``."""
+    """Build a stamped ``JointState`` with the pan and tilt positions of ``cell``."""
     pan, tilt = head.angles(cell)
     return JointState(header=Header(stamp=stamp), name=[head.pan_joint, head.tilt_joint],
                       position=[pan, tilt])
 
 
 def angles_from_joint_state(msg: JointState, head: PanTiltMap) -> tuple[float, float]:
-    """``(pan_rad, tilt_rad)`` from a ``JointState`` that names both joints.
+    """
+    ``(pan_rad, tilt_rad)`` from a ``JointState`` that names both joints.
 
     Raises
     ------
     ValueError
         If a joint is missing, has no position, or the position is not finite.
+
     """
     names = list(msg.name)
     positions = list(msg.position)
@@ -134,7 +136,8 @@ def forward_command(head: PanTiltMap, cell: int) -> Float64MultiArray:
 
 
 def joint_trajectory(head: PanTiltMap, cell: int, duration_s: float) -> JointTrajectory:
-    """A one-point ``JointTrajectory`` reaching ``cell`` after ``duration_s``.
+    """
+    Build a one-point ``JointTrajectory`` reaching ``cell`` after ``duration_s``.
 
     The header stamp is left at zero, which a joint_trajectory_controller reads as "start now".
     """

@@ -21,7 +21,7 @@ def is_zero(stamp: Time) -> bool:
 
 
 def from_seconds(seconds: float) -> Time:
-    """A ``builtin_interfaces/Time`` for a time in seconds (>= 0)."""
+    """Convert a time in seconds (>= 0) to a ``builtin_interfaces/Time``."""
     if not math.isfinite(seconds) or seconds < 0:
         raise ValueError(f'a stamp must be a finite time >= 0 s, got {seconds!r}')
     total_ns = int(round(seconds * NS_PER_S))

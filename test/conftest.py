@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""Shared fixtures; the ROS ones run real nodes over real DDS, isolated per test run.
+"""
+Shared fixtures; the ROS ones run real nodes over real DDS, isolated per test run.
 
 Every run gets its own ``ROS_DOMAIN_ID`` (derived from the pytest process id, 0..101), discovery
 limited to this host and node log files in a temporary directory. Nodes under test run as
@@ -12,13 +13,16 @@ from __future__ import annotations
 
 import importlib.util
 import os
+from pathlib import Path
 import threading
 import time
-from pathlib import Path
 
 import pytest
 
 HAVE_RCLPY = importlib.util.find_spec('rclpy') is not None
+HAVE_ROS_MSGS = importlib.util.find_spec('std_msgs') is not None
+# The message adapters need the ROS message packages (the `ros` extra); skip them without it.
+collect_ignore = [] if HAVE_ROS_MSGS else ['test_msg_adapters.py']
 REPO = Path(__file__).resolve().parents[1]
 
 
@@ -86,7 +90,8 @@ class Probe:
         self.rclpy.shutdown(context=self.context)
 
     def record(self, msg_type, topic: str, qos=10, distinct_stamps: bool = False) -> list:
-        """Subscribe and return the list the messages are appended to (as ``(t, msg)``).
+        """
+        Subscribe and return the list the messages are appended to (as ``(t, msg)``).
 
         With ``distinct_stamps``, a message with the header stamp of one already recorded (the
         controller's re-sent ``pan_tilt``) is dropped.
@@ -105,7 +110,7 @@ class Probe:
         return received
 
     def publisher(self, msg_type, topic: str, qos=10):
-        """A publisher on ``topic``."""
+        """Create a publisher on ``topic``."""
         return self.node.create_publisher(msg_type, topic, qos)
 
     def call(self, srv_type, name: str, request, timeout_s: float = 20.0):
@@ -120,7 +125,7 @@ class Probe:
             self.node.destroy_client(client)
 
     def set_parameters(self, node_name: str, values: dict, timeout_s: float = 20.0) -> list:
-        """SetParameters on another node (what ``ros2 param set`` does); the results."""
+        """Call SetParameters on another node (what ``ros2 param set`` does); the results."""
         from rcl_interfaces.srv import SetParameters
         from rclpy.parameter import Parameter
         params = []
@@ -134,7 +139,7 @@ class Probe:
         return list(response.results)
 
     def get_parameters(self, node_name: str, names, timeout_s: float = 20.0) -> dict:
-        """GetParameters on another node: ``{name: python value}``."""
+        """Call GetParameters on another node: ``{name: python value}``."""
         from rcl_interfaces.srv import GetParameters
         from rclpy.parameter import parameter_value_to_python
         response = self.call(GetParameters, f'/{node_name}/get_parameters',
@@ -144,7 +149,7 @@ class Probe:
 
 @pytest.fixture(scope='module')
 def probe(ros_env):
-    """A :class:`Probe` on this run's domain, shared by the tests of one module."""
+    """Provide a :class:`Probe` on this run's domain, shared by the tests of one module."""
     p = Probe(int(ros_env['ROS_DOMAIN_ID']))
     yield p
     p.close()
@@ -152,7 +157,8 @@ def probe(ros_env):
 
 @pytest.fixture(scope='module')
 def launch(ros_env, tmp_path_factory):
-    """Start nodes as separate processes: ``launch('controller', ros_args) -> NodeProcess``.
+    """
+    Start nodes as separate processes (each call returns its ``NodeProcess``).
 
     At teardown every process gets SIGTERM and must exit with status 0 (a clean shutdown).
     """
@@ -172,6 +178,6 @@ def launch(ros_env, tmp_path_factory):
 
 
 def config_path(name: str) -> str:
-    """A shipped config file, as the nodes find it."""
+    """Find a shipped config file as the nodes do."""
     from ipomdp_gaze.nodes.config import config_file
     return str(config_file(name))

@@ -5,18 +5,17 @@ from __future__ import annotations
 
 import sys
 
-import numpy as np
-import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-
-from ipomdp_gaze.belief import update_log_belief, uniform_log_belief
+from ipomdp_gaze.belief import uniform_log_belief, update_log_belief
 from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
-from ipomdp_gaze.gaze import (POLICY_NAMES, GazeController, PolicyUnavailable, build_policy,
-                              check_kernel)
+from ipomdp_gaze.gaze import (build_policy, check_kernel, GazeController, POLICY_NAMES,
+                              PolicyUnavailable)
 from ipomdp_gaze.grid import Grid
+import numpy as np
 from policies.baselines import spiral_order
 from policies.conv import ConvPolicy
+import pytest
 
 GRID = Grid(11, 11, 5.0)
 CAMERA = make_fpoc('camera', half_width_deg=10.0, half_height_deg=10.0)
@@ -250,3 +249,34 @@ def test_missing_policy_file_support_or_file_is_unavailable(monkeypatch, tmp_pat
     monkeypatch.setitem(sys.modules, 'policies.greedy', None)
     with pytest.raises(PolicyUnavailable, match='greedy'):
         build_policy('greedy', GRID, CAMERA)
+
+
+def _policy_file(tmp_path, grid=GRID, fpoc=CAMERA, seed=9):
+    from policies.policy_file import PolicySpec, save_policy
+    kernel = np.random.default_rng(seed).standard_normal(grid.kernel_shape)
+    spec = PolicySpec(grid=grid, fpoc=fpoc, reward='infomax', family='conv', kernel=kernel)
+    return save_policy(tmp_path / f'k{seed}.yaml', spec), kernel
+
+
+def test_policy_file_is_loaded_and_checked_against_the_task(tmp_path):
+    path, kernel = _policy_file(tmp_path)
+    warnings = []
+    policy = build_policy('learned', GRID, CAMERA, file=str(path), warn=warnings.append)
+    np.testing.assert_array_equal(policy.kernel, kernel)
+    assert warnings == []
+    human = make_fpoc('human')
+    build_policy('learned', GRID, human, file=str(path), warn=warnings.append)
+    assert len(warnings) == 1 and 'FPOC' in warnings[0]
+    small, _ = _policy_file(tmp_path, Grid(7, 7, 5.0), seed=10)
+    with pytest.raises(ValueError, match='7x7 grid but the task grid is 11x11') as err:
+        build_policy('learned', GRID, CAMERA, file=str(small))
+    assert not isinstance(err.value, PolicyUnavailable)
+    with pytest.raises(PolicyUnavailable, match='not found'):
+        build_policy('learned', GRID, CAMERA, file=str(tmp_path / 'missing.yaml'))
+
+
+def test_kernel_takes_precedence_over_the_file(tmp_path):
+    path, _ = _policy_file(tmp_path)
+    kernel = np.ones(GRID.kernel_shape)
+    policy = build_policy('learned', GRID, CAMERA, kernel=kernel.ravel(), file=str(path))
+    np.testing.assert_array_equal(policy.kernel, kernel)

@@ -6,20 +6,15 @@ from __future__ import annotations
 import array
 import math
 
+from builtin_interfaces.msg import Time
+from ipomdp_gaze.belief import EvidenceError
+from ipomdp_gaze.grid import Grid
+from msg_adapters import diagnostics, grid_arrays, images, joints, stamps
+from msg_adapters.grid_arrays import LayoutError
 import numpy as np
 import pytest
-
-pytest.importorskip('std_msgs.msg', reason='ROS message packages are not installed')
-
-from builtin_interfaces.msg import Time  # noqa: E402
-from sensor_msgs.msg import Image, JointState  # noqa: E402
-from std_msgs.msg import (Float32MultiArray, Int32MultiArray, MultiArrayDimension,  # noqa: E402
-                          MultiArrayLayout)
-
-from ipomdp_gaze.belief import EvidenceError  # noqa: E402
-from ipomdp_gaze.grid import Grid  # noqa: E402
-from msg_adapters import diagnostics, grid_arrays, images, joints, stamps  # noqa: E402
-from msg_adapters.grid_arrays import LayoutError  # noqa: E402
+from sensor_msgs.msg import Image, JointState
+from std_msgs.msg import Float32MultiArray, Int32MultiArray, MultiArrayDimension, MultiArrayLayout
 
 GRID = Grid(11, 11, 5.0)
 DEG = math.pi / 180
@@ -228,8 +223,8 @@ def test_evidence_image_with_row_padding():
     ({'step': 40}, EvidenceError, 'step'),
 ])
 def test_bad_evidence_images(kwargs, err, words):
-    fields = dict(height=11, width=11, encoding='32FC1', step=44,
-                  data=np.zeros(121, '<f4').tobytes())
+    fields = {'height': 11, 'width': 11, 'encoding': '32FC1', 'step': 44,
+              'data': np.zeros(121, '<f4').tobytes()}
     fields.update(kwargs)
     with pytest.raises(err, match=words):
         images.evidence_from_image(Image(**fields), GRID)

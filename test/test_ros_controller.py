@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""The controller process alone, with this test playing the camera and the operator.
+"""
+The controller process alone, with this test playing the camera and the operator.
 
 Covers: the kernel parameter set from another process through SetParameters (what ``ros2 param
 set`` does), invalid parameter values rejected with their reason, malformed evidence rejected
@@ -10,10 +11,9 @@ from __future__ import annotations
 
 import math
 
+from conftest import config_path, HAVE_RCLPY, wait_for
 import numpy as np
 import pytest
-
-from conftest import HAVE_RCLPY, config_path, wait_for
 
 pytestmark = [pytest.mark.ros,
               pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
@@ -27,12 +27,11 @@ class Camera:
 
     def __init__(self, probe, launch):
         from diagnostic_msgs.msg import DiagnosticArray
+        from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
+        from ipomdp_gaze.grid import Grid
         from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
         from sensor_msgs.msg import Image, JointState
         from std_msgs.msg import Float32MultiArray
-
-        from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
-        from ipomdp_gaze.grid import Grid
         self.grid = Grid(11, 11, 5.0)
         self.d = dprime_matrix(self.grid, make_fpoc('camera', half_width_deg=10.0,
                                                     half_height_deg=10.0))
@@ -80,9 +79,8 @@ class Camera:
 
     # -- sending -----------------------------------------------------------------------------
     def send(self, values, layout=None):
-        from std_msgs.msg import Float32MultiArray
-
         from msg_adapters import grid_arrays
+        from std_msgs.msg import Float32MultiArray
         if layout is None:
             msg = grid_arrays.to_multiarray(values, self.grid)
         else:
@@ -97,7 +95,7 @@ class Camera:
         return self.belief(), self.fixation()
 
     def expected(self, belief, frame, fixation) -> np.ndarray:
-        """The posterior computed offline (float64 from the float32 frame)."""
+        """Compute the posterior offline (float64 from the float32 frame)."""
         d = self.d[:, fixation]
         o = np.asarray(frame, np.float32).astype(np.float64)
         term = np.where(np.isnan(o), 0.0, d * (np.nan_to_num(o) - d / 2))
@@ -138,9 +136,9 @@ def _frames(seed, n):
 
 
 def _conv_choice(kernel, belief):
-    """The kernel's next fixation offline, and the margin over the runner-up."""
-    from policies.conv import ConvPolicy
+    """Evaluate the kernel's next fixation offline, and its margin over the runner-up."""
     from ipomdp_gaze.grid import Grid
+    from policies.conv import ConvPolicy
     policy = ConvPolicy(Grid(11, 11, 5.0), np.asarray(kernel).reshape(21, 21))
     scores = policy.scores(belief[None])[0]
     top2 = np.sort(scores)[-2:]
@@ -308,3 +306,73 @@ def test_pan_tilt_of_known_cells_and_signs(probe, cam, params, cell, pan_deg, ti
         assert msg.position[1] == pytest.approx(want[1], abs=1e-9)
     finally:
         probe.set_parameters(NODE, defaults)
+
+
+@pytest.fixture(scope='module')
+def policy_files(tmp_path_factory):
+    from ipomdp_gaze.fpoc import make_fpoc
+    from ipomdp_gaze.grid import Grid
+    from policies.policy_file import PolicySpec, save_policy
+    folder = tmp_path_factory.mktemp('policies')
+    camera = make_fpoc('camera', half_width_deg=10.0, half_height_deg=10.0)
+    files = {}
+    for name, grid, fpoc in (('match', Grid(11, 11, 5.0), camera),
+                             ('human', Grid(11, 11, 5.0), make_fpoc('human')),
+                             ('small', Grid(7, 7, 5.0), camera)):
+        kernel = np.random.default_rng(len(files) + 20).standard_normal(grid.kernel_shape)
+        spec = PolicySpec(grid=grid, fpoc=fpoc, reward='infomax', family='conv', kernel=kernel)
+        files[name] = (str(save_policy(folder / f'{name}.yaml', spec)), kernel)
+    return files
+
+
+def test_policy_file_set_remotely(probe, cam, policy_files):
+    path, kernel = policy_files['match']
+    result = _set(probe, policy__file=path)[0]
+    assert result.successful and result.reason == ''
+    params = probe.get_parameters(NODE, ['policy.name', 'policy.kernel'])
+    assert params['policy.name'] == 'learned' and list(params['policy.kernel']) == []
+    belief, fixation = cam.belief().astype(np.float64), cam.fixation()
+    frame = _frames(30, 1)[0]
+    got_belief, got_next = cam.step(frame)
+    np.testing.assert_allclose(got_belief, cam.expected(belief, frame, fixation),
+                               rtol=1e-4, atol=1e-7)
+    assert got_next == _conv_choice(kernel, got_belief.astype(np.float64))[0]
+    # Trained on another FPOC: accepted, with a warning in the node's log.
+    assert _set(probe, policy__file=policy_files['human'][0])[0].successful
+    assert wait_for(lambda: 'policy was trained for FPOC' in cam.proc.output(), 10)
+    # Another grid, or no such file: refused, nothing changes.
+    for source, words in ((policy_files['small'][0], 'policy is for a 7x7 grid'),
+                          ('/no/such/file.yaml', 'not found')):
+        result = _set(probe, policy__file=source)[0]
+        assert not result.successful and words in result.reason, result.reason
+        assert probe.get_parameters(NODE, ['policy.file'])['policy.file'] == \
+            policy_files['human'][0]
+
+
+def test_ros2_control_outputs_follow_their_topic_parameters(probe, cam):
+    from std_msgs.msg import Float64MultiArray
+    from trajectory_msgs.msg import JointTrajectory
+    forward = probe.record(Float64MultiArray, 'head/commands', 10)
+    trajectory = probe.record(JointTrajectory, 'head/joint_trajectory', 10)
+    results = _set(probe, forward_command_topic='head/commands',
+                   trajectory_topic='head/joint_trajectory', trajectory_duration_s=0.25)
+    assert all(r.successful for r in results)
+    # A publisher created at run time needs discovery before its messages arrive.
+    assert wait_for(lambda: probe.node.count_publishers('head/commands') > 0 and
+                    probe.node.count_publishers('head/joint_trajectory') > 0, 20)
+    for _ in range(10):
+        cam.step(_frames(40 + len(forward), 1)[0])
+        if forward and trajectory:
+            break
+    assert forward and trajectory
+    target = cam.targets[-1][1]
+    np.testing.assert_allclose(forward[-1][1].data, target.position)
+    point = trajectory[-1][1].points[0]
+    assert list(trajectory[-1][1].joint_names) == ['pan_joint', 'tilt_joint']
+    np.testing.assert_allclose(point.positions, target.position)
+    assert (point.time_from_start.sec, point.time_from_start.nanosec) == (0, 250_000_000)
+    assert all(r.successful for r in _set(probe, forward_command_topic='', trajectory_topic=''))
+    assert wait_for(lambda: probe.node.count_publishers('head/commands') == 0, 20)
+    n = len(forward)
+    cam.step(_frames(50, 1)[0])
+    assert len(forward) == n

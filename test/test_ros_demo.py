@@ -3,14 +3,13 @@
 """``ipomdp-gaze demo`` end to end: two node processes, a found target, a clean exit."""
 from __future__ import annotations
 
+from pathlib import Path
 import re
 import subprocess
 import sys
-from pathlib import Path
-
-import pytest
 
 from conftest import HAVE_RCLPY, REPO
+import pytest
 
 pytestmark = [pytest.mark.ros,
               pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]

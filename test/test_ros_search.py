@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""The launch test with the simulated camera: both nodes as processes with the shipped YAML files.
+"""
+The launch test with the simulated camera: both nodes as processes with the shipped YAML files.
 
 A probe node watches ``belief``, ``pan_tilt``, ``belief_image``, ``found`` and ``ground_truth``.
 For several seeds and targets the most likely cell is the target once its probability passes
@@ -10,10 +11,9 @@ from __future__ import annotations
 
 import math
 
+from conftest import config_path, HAVE_RCLPY, wait_for
 import numpy as np
 import pytest
-
-from conftest import HAVE_RCLPY, config_path, wait_for
 
 pytestmark = [pytest.mark.ros,
               pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
@@ -63,8 +63,8 @@ def _enable(probe, flag):
 
 def _search(probe, rec, seed, target, start):
     """Run one search from a reset; return (beliefs, targets, truth, found) of this search."""
-    from msg_adapters import grid_arrays
     from ipomdp_gaze.grid import Grid
+    from msg_adapters import grid_arrays
     grid = Grid(11, 11, 5.0)
     _enable(probe, False)
     camera_params = {'seed': seed, 'target_row': -1, 'target_col': -1}
@@ -111,8 +111,8 @@ def test_most_likely_cell_is_the_target_at_0999(searches):
 
 
 def test_found_event(searches):
-    from msg_adapters import diagnostics, joints
     from ipomdp_gaze.grid import Grid
+    from msg_adapters import diagnostics, joints
     head = joints.PanTiltMap(Grid(11, 11, 5.0))
     for _, (beliefs, _, _, found_msg) in searches:
         found = diagnostics.parse_found(found_msg)
@@ -157,3 +157,13 @@ def test_belief_image_size_encoding_and_fixation_mark(rig, searches):
     marked = np.all(img == images.MARK_RGB, axis=2)
     rows, cols = np.nonzero(marked)
     assert rows.size and rows.max() - rows.min() == 31 and cols.max() - cols.min() == 31
+
+
+def test_shipped_kernel_or_the_elm_fallback(rig, probe):
+    from policies.policy_file import shipped_kernels
+    params = probe.get_parameters(CONTROLLER, ['policy.name', 'policy.file', 'policy.fallback'])
+    assert params['policy.file'] == 'camera-11x11-infomax'
+    if 'camera-11x11-infomax' in shipped_kernels():
+        assert params['policy.name'] == 'learned'
+    else:
+        assert params['policy.name'] == params['policy.fallback'] == 'elm'

@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""Re-sent ``pan_tilt`` for a camera that starts late; ``settle_time_s`` with a video camera.
+"""
+Re-sent ``pan_tilt`` for a camera that starts late; ``settle_time_s`` with a video camera.
 
 The controller starts alone and keeps re-sending its target; the camera starts late and the
 search completes. Then the camera becomes a 20 Hz video camera with a 0.3 s saccade and stamped
@@ -11,10 +12,9 @@ frame taken mid-saccade is used, and the search still completes.
 """
 from __future__ import annotations
 
+from conftest import config_path, HAVE_RCLPY, wait_for
 import numpy as np
 import pytest
-
-from conftest import HAVE_RCLPY, config_path, wait_for
 
 pytestmark = [pytest.mark.ros,
               pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
@@ -102,11 +102,10 @@ def test_camera_that_starts_late_picks_up_the_target(rig, launch):
 
 
 def test_no_frame_taken_mid_saccade_is_used_and_the_search_completes(rig, probe):
-    from std_srvs.srv import SetBool, Trigger
-
     from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
     from ipomdp_gaze.grid import Grid
     from msg_adapters import grid_arrays, images, joints
+    from std_srvs.srv import SetBool, Trigger
     grid = Grid(11, 11, 5.0)
     head = joints.PanTiltMap(grid)
     d = dprime_matrix(grid, make_fpoc('camera', half_width_deg=10.0, half_height_deg=10.0))

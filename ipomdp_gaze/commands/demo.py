@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""``ipomdp-gaze demo`` (what ``make demo`` runs): the ROS 2 nodes find a hidden target.
+"""
+``ipomdp-gaze demo`` (what ``make demo`` runs): the ROS 2 nodes find a hidden target.
 
 Starts ``gaze_controller`` and ``simulated_camera`` as two processes with the shipped YAML files,
 prints each fixation until the ``found`` event, says where the target is and whether that is

@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""The ``simulated_camera`` node: a pan/tilt camera and detector for bench testing.
+"""
+The ``simulated_camera`` node: a pan/tilt camera and detector for bench testing.
 
 It stands in for the hardware. It subscribes ``pan_tilt`` (``sensor_msgs/JointState``), snaps
 the command to the nearest cell and moves there in ``saccade_time_s`` (until it arrives, the head
@@ -19,12 +20,14 @@ cell when they are -1).
 """
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
+import sys
 
+from ipomdp_gaze.fpoc import dprime_matrix
+from msg_adapters import grid_arrays, images, joints
 import numpy as np
-import rclpy
 from rcl_interfaces.msg import SetParametersResult
+import rclpy
 from rclpy.exceptions import ParameterException
 from rclpy.executors import ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
@@ -34,11 +37,8 @@ from sensor_msgs.msg import Image, JointState
 from std_msgs.msg import Float32MultiArray, Int32MultiArray
 from std_srvs.srv import Trigger
 
-from ipomdp_gaze.fpoc import dprime_matrix
-from msg_adapters import grid_arrays, images, joints
-
-from .params import (INT_MAX, T, Param, row_col_from, current_values, declare, fpoc_from,
-                     fpoc_params, grid_from, grid_params, head_from, joint_params)
+from .params import (current_values, declare, fpoc_from, fpoc_params, grid_from, grid_params,
+                     head_from, INT_MAX, joint_params, Param, row_col_from, T)
 
 NODE_NAME = 'simulated_camera'
 FRAME_QOS = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)

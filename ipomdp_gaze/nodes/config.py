@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""Where the package's shared files (config YAML, launch files) are found.
+"""
+Where the package's shared files (config YAML, launch files) are found.
 
 A colcon or pip install puts them under ``<prefix>/share/ipomdp_gaze``; an editable install has no
 ``share/`` tree, so the source tree is the fallback (DESIGN.md section 5).
@@ -8,8 +9,8 @@ A colcon or pip install puts them under ``<prefix>/share/ipomdp_gaze``; an edita
 from __future__ import annotations
 
 import os
-import sys
 from pathlib import Path
+import sys
 
 PACKAGE = 'ipomdp_gaze'
 SOURCE_ROOT = Path(__file__).resolve().parents[2]
@@ -23,12 +24,14 @@ def share_dirs() -> list[Path]:
 
 
 def config_file(name: str) -> Path:
-    """Path of ``config/<name>`` (for example ``controller.yaml``).
+    """
+    Path of ``config/<name>`` (for example ``controller.yaml``).
 
     Raises
     ------
     FileNotFoundError
         Listing the places searched.
+
     """
     searched = [d / 'config' / name for d in share_dirs()]
     for path in searched:

@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""The ``gaze_controller`` node: I-POMDP gaze control of a pan/tilt head.
+"""
+The ``gaze_controller`` node: I-POMDP gaze control of a pan/tilt head.
 
 A thin wrapper: :class:`ipomdp_gaze.gaze.GazeController` holds the belief and decides, and
 :mod:`msg_adapters` reads and fills every message. Relative topic names, so namespaces and
@@ -22,12 +23,18 @@ Run with ``ros2 run ipomdp_gaze controller`` (or ``ipomdp-gaze controller``) and
 """
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
+import sys
 
-import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from ipomdp_gaze.belief import EvidenceError
+from ipomdp_gaze.gaze import (build_policy, check_kernel, GazeController, POLICY_NAMES,
+                              PolicyUnavailable)
+from msg_adapters import diagnostics, grid_arrays, images, joints, stamps
+from policies.baselines import STRATEGIES
+from policies.conv import ACTIONS
 from rcl_interfaces.msg import SetParametersResult
+import rclpy
 from rclpy.exceptions import NameValidationException, ParameterException
 from rclpy.executors import ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
@@ -40,15 +47,8 @@ from std_msgs.msg import Float32MultiArray, Float64MultiArray
 from std_srvs.srv import SetBool, Trigger
 from trajectory_msgs.msg import JointTrajectory
 
-from ipomdp_gaze.belief import EvidenceError
-from ipomdp_gaze.gaze import (POLICY_NAMES, GazeController, PolicyUnavailable, build_policy,
-                              check_kernel)
-from msg_adapters import diagnostics, grid_arrays, images, joints, stamps
-from policies.baselines import STRATEGIES
-from policies.conv import ACTIONS
-
-from .params import (INT_MAX, T, Param, row_col_from, current_values, declare, fpoc_from,
-                     fpoc_params, grid_from, grid_params, head_from, joint_params)
+from .params import (current_values, declare, fpoc_from, fpoc_params, grid_from, grid_params,
+                     head_from, INT_MAX, joint_params, Param, row_col_from, T)
 
 NODE_NAME = 'gaze_controller'
 EVIDENCE_QOS = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
@@ -171,9 +171,9 @@ class GazeControllerNode(Node):
         row, col = row_col_from(values, grid, 'start_row', 'start_col')
         centre_row, centre_col = grid.cell(grid.center_index)
         start = grid.index(centre_row if row is None else row, centre_col if col is None else col)
-        if not 0.0 < values['confidence'] < 1.0:
-            raise ValueError(f"confidence must be between 0 and 1 (exclusive), got "
-                             f"{values['confidence']}")
+        confidence = values['confidence']
+        if not 0.0 < confidence < 1.0:
+            raise ValueError(f'confidence must be between 0 and 1 (exclusive), got {confidence}')
         if values['policy.kernel']:
             check_kernel(values['policy.kernel'], grid)
         for name in ('forward_command_topic', 'trajectory_topic'):
@@ -210,7 +210,8 @@ class GazeControllerNode(Node):
         return cfg
 
     def _pre_set(self, params: list[Parameter]) -> list[Parameter]:
-        """Make a kernel or a policy file select the learned policy, in the same atomic set.
+        """
+        Make a kernel or a policy file select the learned policy, in the same atomic set.
 
         Setting a file also clears the kernel, which would otherwise take precedence.
         """
@@ -245,9 +246,8 @@ class GazeControllerNode(Node):
         except ValueError as exc:
             self._pending = None
             return SetParametersResult(successful=False, reason=str(exc))
-        reason = f'accepted with a warning: {self._pending.warning}' \
-            if self._pending.warning else ''
-        return SetParametersResult(successful=True, reason=reason)
+        # rclpy drops the reason of a successful set, so a warning goes to the log (post-set).
+        return SetParametersResult(successful=True)
 
     def _check_declared(self, params: list[Parameter]) -> SetParametersResult:
         """While declaring: check what the already declared grid allows (overrides included)."""

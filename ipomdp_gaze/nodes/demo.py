@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""The ROS 2 demo: both nodes as separate processes, watched from this process.
+"""
+The ROS 2 demo: both nodes as separate processes, watched from this process.
 
 :func:`run_demo` starts ``gaze_controller`` and then ``simulated_camera`` (once the controller's
 first target has arrived here, so no update is missed), prints every fixation until the ``found``
@@ -9,28 +10,27 @@ runs on its own ROS domain with discovery limited to this host, so it never driv
 """
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 import math
+from pathlib import Path
 import tempfile
 import time
-from dataclasses import dataclass, field
-from pathlib import Path
 
+from diagnostic_msgs.msg import DiagnosticStatus
+from ipomdp_gaze.belief import entropy
+from msg_adapters import diagnostics, grid_arrays, joints
 import numpy as np
 import rclpy
-import yaml
-from diagnostic_msgs.msg import DiagnosticStatus
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float32MultiArray, Int32MultiArray
-
-from ipomdp_gaze.belief import entropy
-from msg_adapters import diagnostics, grid_arrays, joints
+import yaml
 
 from .config import config_file
 from .params import grid_from, head_from
-from .processes import NodeProcess, domain_id_for, ros_environment
+from .processes import domain_id_for, NodeProcess, ros_environment
 
 LATCHED = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
@@ -54,7 +54,7 @@ def flatten(tree: dict, prefix: str = '') -> dict:
 
 
 def yaml_parameters(path, node_name: str) -> dict:
-    """The ``ros__parameters`` of ``node_name`` in a parameter file, with dotted names."""
+    """Read the ``ros__parameters`` of ``node_name`` from a parameter file, dotted names."""
     tree = yaml.safe_load(Path(path).read_text())
     try:
         return flatten(tree[node_name]['ros__parameters'])
@@ -133,6 +133,8 @@ class Watcher:
 
 
 class _Session:
+    """Spin the watcher until a condition holds, failing fast when a node process dies."""
+
     def __init__(self, executor, deadline, processes):
         self.executor, self.deadline, self.processes = executor, deadline, processes
 

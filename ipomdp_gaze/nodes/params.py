@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""Parameter declarations shared by the nodes: explicit types, descriptors, ranges and choices.
+"""
+Parameter declarations shared by the nodes: explicit types, descriptors, ranges and choices.
 
 Both nodes describe the task with the same names (``grid.*``, ``fpoc.<name>`` with the names of
 DESIGN.md section 2, the pan/tilt joint mapping), so one YAML block can be shared. Every
@@ -10,15 +11,14 @@ and a list for the ``table`` FPOC.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+import math
 
-from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
-from rclpy.parameter import Parameter
-
-from ipomdp_gaze.fpoc import MODELS, CameraFPOC, make_fpoc, parameter_names
+from ipomdp_gaze.fpoc import CameraFPOC, make_fpoc, MODELS, parameter_names
 from ipomdp_gaze.grid import Grid
 from msg_adapters.joints import PanTiltMap
+from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+from rclpy.parameter import Parameter
 
 T = Parameter.Type
 INT_MAX = 2 ** 31 - 1
@@ -26,15 +26,17 @@ INT_MAX = 2 ** 31 - 1
 
 @dataclass(frozen=True)
 class Param:
-    """One declared parameter: name, default, type, description and constraints.
+    """
+    One declared parameter: name, default, type, description and constraints.
 
-    ``default=None`` declares the type only and then sets an empty array (array parameters).
+    ``ptype`` is the parameter type; ``default=None`` declares the type only and then sets an
+    empty array (array parameters).
     ``choices`` restricts strings; ``float_range``/``int_range`` are enforced by rclpy itself.
     """
 
     name: str
     default: object
-    type: Parameter.Type
+    ptype: Parameter.Type
     description: str
     read_only: bool = False
     dynamic: bool = False
@@ -43,12 +45,12 @@ class Param:
     choices: tuple | None = None
 
     def descriptor(self) -> ParameterDescriptor:
-        """The ``ParameterDescriptor`` to declare with."""
+        """Build the ``ParameterDescriptor`` to declare with."""
         d = ParameterDescriptor(description=self.description, read_only=self.read_only)
         if self.dynamic:
             d.dynamic_typing = True
         else:
-            d.type = self.type.value
+            d.type = self.ptype.value
         if self.float_range is not None:
             d.floating_point_range = [FloatingPointRange(
                 from_value=float(self.float_range[0]), to_value=float(self.float_range[1]),
@@ -61,7 +63,7 @@ class Param:
         return d
 
     def check(self, value) -> str | None:
-        """The reason ``value`` is invalid, or None (ranges and types are rclpy's job)."""
+        """Return why ``value`` is invalid, or None (ranges and types are rclpy's job)."""
         if self.choices is not None and value not in self.choices:
             return (f"{self.name} must be one of {', '.join(repr(c) for c in self.choices)}, "
                     f'got {value!r}')
@@ -87,7 +89,8 @@ def grid_params() -> list[Param]:
 
 
 def fpoc_params() -> list[Param]:
-    """``fpoc.model`` and the union of every model's parameters (DESIGN.md section 2).
+    """
+    ``fpoc.model`` and the union of every model's parameters (DESIGN.md section 2).
 
     The defaults describe a camera whose field of view covers 5x5 cells of a 5-degree grid.
     """
@@ -142,9 +145,9 @@ def declare(node, params: list[Param]) -> None:
     """Declare every parameter (YAML and ``-p`` overrides go through the node's callbacks)."""
     for p in params:
         if p.default is None:
-            node.declare_parameter(p.name, p.type, p.descriptor())
+            node.declare_parameter(p.name, p.ptype, p.descriptor())
             if node.get_parameter_or(p.name).type_ == T.NOT_SET:
-                node.set_parameters([Parameter(p.name, p.type, [])])
+                node.set_parameters([Parameter(p.name, p.ptype, [])])
         else:
             node.declare_parameter(p.name, p.default, p.descriptor())
 
@@ -155,12 +158,12 @@ def current_values(node, params: list[Param]) -> dict:
 
 
 def grid_from(values: dict) -> Grid:
-    """The grid described by ``grid.*``."""
+    """Build the grid described by ``grid.*``."""
     return Grid(values['grid.rows'], values['grid.cols'], values['grid.spacing_deg'])
 
 
 def fpoc_from(values: dict):
-    """The FPOC described by ``fpoc.model`` and its ``fpoc.<name>`` parameters."""
+    """Build the FPOC described by ``fpoc.model`` and its ``fpoc.<name>`` parameters."""
     model = values['fpoc.model']
     kwargs = {}
     for name in parameter_names(model):
@@ -172,7 +175,7 @@ def fpoc_from(values: dict):
 
 
 def head_from(values: dict, grid: Grid) -> PanTiltMap:
-    """The pan/tilt mapping; joint limits are used when they were declared."""
+    """Build the pan/tilt mapping; joint limits are used when they were declared."""
     limits = {}
     if 'pan_min_rad' in values:
         limits = {'pan_limits_rad': (values['pan_min_rad'], values['pan_max_rad']),
@@ -183,7 +186,8 @@ def head_from(values: dict, grid: Grid) -> PanTiltMap:
 
 
 def row_col_from(values: dict, grid: Grid, row_name: str, col_name: str) -> tuple:
-    """``(row, col)`` from two parameters where -1 means "not fixed" (returned as None).
+    """
+    ``(row, col)`` from two parameters where -1 means "not fixed" (returned as None).
 
     Each coordinate stands on its own, so ``ros2 param set`` can change one at a time.
 
@@ -191,6 +195,7 @@ def row_col_from(values: dict, grid: Grid, row_name: str, col_name: str) -> tupl
     ------
     ValueError
         If a coordinate is outside the grid.
+
     """
     out = []
     for name, size in ((row_name, grid.rows), (col_name, grid.cols)):

@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""Start and stop nodes as separate processes (no ``ros2 launch`` here): the demo and tests.
+"""
+Start and stop nodes as separate processes (no ``ros2 launch`` here): the demo and tests.
 
 Each node runs as ``python -m ipomdp_gaze.nodes.<name> --ros-args ...`` with its output in a log
 file. :func:`ros_environment` isolates a run: its own ``ROS_DOMAIN_ID``, discovery limited to this
@@ -9,21 +10,21 @@ host, and node log files in a directory of its own.
 from __future__ import annotations
 
 import os
+from pathlib import Path
 import signal
 import subprocess
 import sys
-from pathlib import Path
 
 MAX_DOMAIN_ID = 101
 
 
 def domain_id_for(pid: int | None = None) -> int:
-    """A ROS domain id in 0..101 derived from a process id (default: this process)."""
+    """Derive a ROS domain id in 0..101 from a process id (default: this process)."""
     return (os.getpid() if pid is None else int(pid)) % (MAX_DOMAIN_ID + 1)
 
 
 def ros_environment(domain_id: int, log_dir, base: dict | None = None) -> dict:
-    """A copy of ``base`` (default ``os.environ``) set up for an isolated run."""
+    """Copy ``base`` (default ``os.environ``) and set it up for an isolated run."""
     if not 0 <= int(domain_id) <= MAX_DOMAIN_ID:
         raise ValueError(f'domain id must be in 0..{MAX_DOMAIN_ID}, got {domain_id}')
     env = dict(os.environ if base is None else base)
@@ -77,7 +78,7 @@ class NodeProcess:
         return self.proc.returncode
 
     def output(self) -> str:
-        """What the process printed so far."""
+        """Return what the process printed so far."""
         if self.log_path is None or not self.log_path.exists():
             return ''
         return self.log_path.read_text(errors='replace')

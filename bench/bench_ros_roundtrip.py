@@ -1,0 +1,137 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Round trip through the gaze_controller process: evidence frame in, belief and next target out.
+
+Run: ``.venv/bin/python bench/bench_ros_roundtrip.py [policy ...]`` (default ``elm map``). For each
+policy it starts the controller (shipped YAML, ``settle_time_s`` 0, no retries) on a private
+domain; this process plays the camera: on every new ``pan_tilt`` it publishes one 11x11 evidence
+frame and times until the next ``pan_tilt`` (and the ``belief``) arrive. 20 warm-up and 200 timed
+round trips per policy; prints median and 90th percentile in ms. It also times the controller's
+work for one frame in-process (message in, update, choice, messages out) without DDS.
+"""
+from pathlib import Path
+import sys
+import tempfile
+import threading
+import time
+
+from builtin_interfaces.msg import Time
+from ipomdp_gaze.fpoc import make_fpoc
+from ipomdp_gaze.gaze import build_policy, GazeController
+from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.nodes.config import config_file
+from ipomdp_gaze.nodes.processes import domain_id_for, NodeProcess, ros_environment
+from msg_adapters import grid_arrays, images, joints
+import numpy as np
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float32MultiArray
+
+GRID = Grid(11, 11, 5.0)
+WARMUP, TIMED = 20, 200
+
+
+def in_process(policy_name, repeats=2000):
+    """Median microseconds of the controller's per-frame work without DDS."""
+    fpoc = make_fpoc('camera', half_width_deg=10.0, half_height_deg=10.0)
+    core = GazeController(GRID, fpoc, build_policy(policy_name, GRID, fpoc), settle_time_s=0.0)
+    head = joints.PanTiltMap(GRID)
+    rng = np.random.default_rng(0)
+    frames = [grid_arrays.to_multiarray(rng.standard_normal(121), GRID) for _ in range(50)]
+    times = []
+    for i in range(repeats):
+        if i % 20 == 0:
+            core.reset(float(i))
+        t0 = time.perf_counter()
+        result = core.offer(grid_arrays.from_multiarray(frames[i % 50], GRID), float(i))
+        grid_arrays.to_multiarray(core.belief, GRID)
+        joints.joint_state(head, result.fixation, Time())
+        t1 = time.perf_counter()
+        images.belief_image(core.belief, GRID, core.fixation, 32, Time())
+        t2 = time.perf_counter()
+        times.append((t1 - t0, t2 - t1))
+    t = np.median(np.array(times), axis=0) * 1e6
+    return t[0], t[1]
+
+
+def round_trips(policy_name, domain):
+    """Median and p90 milliseconds of frame -> next pan_tilt, and frame -> belief."""
+    with tempfile.TemporaryDirectory() as tmp:
+        env = ros_environment(domain, Path(tmp) / 'log')
+        proc = NodeProcess('controller', [
+            '--params-file', str(config_file('controller.yaml')), '-p', 'settle_time_s:=0.0',
+            '-p', 'retry_period_s:=0.0', '-p', f'policy.name:={policy_name}'], env,
+            Path(tmp) / 'controller.log').start()
+        context = rclpy.Context()
+        rclpy.init(context=context, domain_id=domain, args=[])
+        node = Node('bench_camera', context=context)
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(node)
+        latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                             durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        pub = node.create_publisher(Float32MultiArray, 'evidence', 10)
+        rng = np.random.default_rng(1)
+        state = {'sent': None, 'target': [], 'belief': [], 'stamps': set()}
+        done = threading.Event()
+
+        def send():
+            if len(state['target']) >= WARMUP + TIMED:
+                done.set()
+                return
+            msg = grid_arrays.to_multiarray(rng.standard_normal(121), GRID)
+            state['sent'] = time.perf_counter()
+            pub.publish(msg)
+
+        def on_target(msg):
+            key = (msg.header.stamp.sec, msg.header.stamp.nanosec)
+            if key in state['stamps']:
+                return
+            state['stamps'].add(key)
+            if state['sent'] is not None:
+                state['target'].append(time.perf_counter() - state['sent'])
+            if pub.get_subscription_count():
+                send()
+
+        def on_belief(msg):
+            if state['sent'] is not None:
+                state['belief'].append(time.perf_counter() - state['sent'])
+
+        node.create_subscription(JointState, 'pan_tilt', on_target, latched)
+        node.create_subscription(Float32MultiArray, 'belief', on_belief, 10)
+        deadline = time.monotonic() + 120
+        try:
+            while not done.is_set() and time.monotonic() < deadline:
+                executor.spin_once(timeout_sec=0.05)
+                if state['sent'] is None and pub.get_subscription_count() and state['stamps']:
+                    send()
+        finally:
+            executor.shutdown(timeout_sec=1)
+            node.destroy_node()
+            rclpy.try_shutdown(context=context)
+            proc.stop()
+        target = np.array(state['target'][WARMUP:]) * 1e3
+        belief = np.array(state['belief'][WARMUP:]) * 1e3
+        if target.size < TIMED:
+            raise RuntimeError(f'only {target.size} round trips timed:\n{proc.output()}')
+        return (np.median(target), np.percentile(target, 90), np.median(belief),
+                np.percentile(belief, 90))
+
+
+def main():
+    policies = sys.argv[1:] or ['elm', 'map']
+    domain = domain_id_for()
+    for name in policies:
+        work, image = in_process(name)
+        t50, t90, b50, b90 = round_trips(name, domain)
+        print(f'{name:8s} frame -> next pan_tilt: median {t50:.2f} ms, p90 {t90:.2f} ms; '
+              f'frame -> belief: median {b50:.2f} ms, p90 {b90:.2f} ms '
+              f'({TIMED} round trips); in-process work per frame {work:.0f} us '
+              f'+ belief_image {image:.0f} us')
+
+
+if __name__ == '__main__':
+    main()

@@ -1,0 +1,107 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The ROS side as shipped: YAML files, launch file, entry points and start-up validation.
+
+The YAML files must name only declared parameters with the declared types (rclpy refuses ``0``
+for a double at start-up), agree with each other on the task, and the launch file must start
+the executables and node names that exist.
+"""
+import ast
+import subprocess
+import sys
+
+from conftest import HAVE_RCLPY, REPO
+import pytest
+import yaml
+
+needs_rclpy = pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')
+
+
+def _yaml(name):
+    return yaml.safe_load((REPO / 'config' / name).read_text())
+
+
+def _flat(tree, prefix=''):
+    out = {}
+    for key, value in tree.items():
+        if isinstance(value, dict):
+            out.update(_flat(value, f'{prefix}{key}.'))
+        else:
+            out[f'{prefix}{key}'] = value
+    return out
+
+
+@needs_rclpy
+@pytest.mark.parametrize('file, node, params', [
+    ('controller.yaml', 'gaze_controller', 'controller_params'),
+    ('camera.yaml', 'simulated_camera', 'camera_params'),
+])
+def test_yaml_names_declared_parameters_with_their_types(file, node, params):
+    import importlib
+
+    from rclpy.parameter import Parameter
+    module = importlib.import_module(f"ipomdp_gaze.nodes.{params.split('_')[0]}")
+    declared = {p.name: p for p in getattr(module, params)()}
+    doc = _yaml(file)
+    assert list(doc) == [node]
+    values = _flat(doc[node]['ros__parameters'])
+    unknown = sorted(set(values) - set(declared))
+    assert not unknown, f'{file}: undeclared parameters {unknown}'
+    for name, value in values.items():
+        spec = declared[name]
+        if spec.dynamic:
+            continue
+        want = {Parameter.Type.DOUBLE: float, Parameter.Type.INTEGER: int,
+                Parameter.Type.STRING: str, Parameter.Type.BOOL: bool}.get(spec.ptype)
+        if want is not None:
+            assert type(value) is want, f'{file}: {name} = {value!r} is not a {want.__name__}'
+        if spec.choices is not None:
+            assert value in spec.choices, f'{file}: {name} = {value!r}'
+
+
+def test_the_two_yaml_files_describe_the_same_task():
+    controller = _flat(_yaml('controller.yaml')['gaze_controller']['ros__parameters'])
+    camera = _flat(_yaml('camera.yaml')['simulated_camera']['ros__parameters'])
+    task = [k for k in controller if k.startswith(('grid.', 'fpoc.')) or k.endswith(
+        ('_joint', '_sign', '_offset_rad'))]
+    assert {k: controller[k] for k in task} == {k: camera.get(k) for k in task}
+    assert (controller['grid.rows'], controller['grid.cols'], controller['grid.spacing_deg']) == \
+        (11, 11, 5.0)
+    assert controller['fpoc.model'] == 'camera'
+    assert controller['fpoc.half_width_deg'] == controller['fpoc.half_height_deg'] == 10.0
+    assert controller['policy.file'] == 'camera-11x11-infomax'
+    assert controller['policy.fallback'] == 'elm'
+
+
+def test_launch_file_starts_existing_executables_with_existing_config():
+    tree = ast.parse((REPO / 'launch' / 'gaze_demo.launch.py').read_text())
+    calls = [n for n in ast.walk(tree) if isinstance(n, ast.Call)
+             and getattr(n.func, 'id', '') == 'Node']
+    started = {(kw['executable'], kw['name']) for kw in (
+        {k.arg: k.value.value for k in c.keywords if isinstance(k.value, ast.Constant)}
+        for c in calls)}
+    assert started == {('controller', 'gaze_controller'), ('camera', 'simulated_camera')}
+    strings = {n.value for n in ast.walk(tree) if isinstance(n, ast.Constant)
+               and isinstance(n.value, str)}
+    assert {'controller.yaml', 'camera.yaml', 'ipomdp_gaze', 'config'} <= strings
+    setup = (REPO / 'setup.py').read_text()
+    assert "'controller = ipomdp_gaze.nodes.controller:main'" in setup
+    assert "'camera = ipomdp_gaze.nodes.camera:main'" in setup
+
+
+@pytest.mark.ros
+@needs_rclpy
+@pytest.mark.parametrize('command, ros_args, words', [
+    ('controller', ['-p', 'policy.kernel:=[1.0, 2.0]'], 'policy.kernel must have 441 values'),
+    ('controller', ['-p', 'policy.name:=learned', '-p', 'policy.file:=/no/such/policy.yaml'],
+     "policy file '/no/such/policy.yaml' not found"),
+    ('controller', ['-p', 'settle_time_s:=1'], 'settle_time_s'),
+    ('camera', ['-p', 'fpoc.model:=sonar'], "fpoc.model must be one of 'human'"),
+])
+def test_start_up_validation_through_the_cli(ros_env, command, ros_args, words):
+    run = subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', command, '--ros-args',
+                          *ros_args], env=ros_env, capture_output=True, text=True, timeout=60)
+    assert run.returncode == 1, run.stdout + run.stderr
+    assert words in run.stderr, run.stderr
+    assert 'Traceback' not in run.stderr
