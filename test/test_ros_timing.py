@@ -89,10 +89,15 @@ def _search_done(rig, start_index):
     return any(np.max(np.asarray(m.data)) >= 0.999 for _, m in rig['belief'][start_index:])
 
 
-def test_camera_that_starts_late_picks_up_the_target(rig, launch):
+@pytest.fixture(scope='module')
+def camera(rig, launch):
+    """Start the simulated camera late: after the controller has been waiting for it."""
+    return launch('camera', ['--params-file', config_path('camera.yaml'), '-p', 'seed:=3'])
+
+
+def test_camera_that_starts_late_picks_up_the_target(rig, camera):
     from ipomdp_gaze.grid import Grid
     from msg_adapters import grid_arrays
-    camera = launch('camera', ['--params-file', config_path('camera.yaml'), '-p', 'seed:=3'])
     assert wait_for(lambda: _search_done(rig, 0), 60), camera.output()
     assert wait_for(lambda: rig['truth'])
     grid = Grid(11, 11, 5.0)
@@ -101,7 +106,7 @@ def test_camera_that_starts_late_picks_up_the_target(rig, launch):
     assert int(np.argmax(np.asarray(done.data))) == truth
 
 
-def test_no_frame_taken_mid_saccade_is_used_and_the_search_completes(rig, probe):
+def test_no_frame_taken_mid_saccade_is_used_and_the_search_completes(rig, camera, probe):
     from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
     from ipomdp_gaze.grid import Grid
     from msg_adapters import grid_arrays, images, joints

@@ -38,7 +38,7 @@ from std_msgs.msg import Float32MultiArray, Int32MultiArray
 from std_srvs.srv import Trigger
 
 from .params import (current_values, declare, fpoc_from, fpoc_params, grid_from, grid_params,
-                     head_from, INT_MAX, joint_params, Param, row_col_from, T)
+                     head_from, INT_MAX, joint_params, Param, row_col_from, short_repr, T)
 
 NODE_NAME = 'simulated_camera'
 FRAME_QOS = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
@@ -140,7 +140,7 @@ class SimulatedCameraNode(Node):
             self.rng = np.random.default_rng(v['seed'])
         if (v['saccade_time_s'], v['rate_hz']) != (ov['saccade_time_s'], ov['rate_hz']):
             self._make_timers(v)
-        changed = ', '.join(f'{p.name}={p.value!r}' for p in params)
+        changed = ', '.join(f'{p.name}={short_repr(p.value)}' for p in params)
         self.get_logger().info(f'parameters set: {changed}')
 
     def _make_timers(self, values: dict) -> None:

@@ -48,7 +48,7 @@ from std_srvs.srv import SetBool, Trigger
 from trajectory_msgs.msg import JointTrajectory
 
 from .params import (current_values, declare, fpoc_from, fpoc_params, grid_from, grid_params,
-                     head_from, INT_MAX, joint_params, Param, row_col_from, T)
+                     head_from, INT_MAX, joint_params, Param, row_col_from, short_repr, T)
 
 NODE_NAME = 'gaze_controller'
 EVIDENCE_QOS = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
@@ -284,7 +284,7 @@ class GazeControllerNode(Node):
         if cfg.head != old.head and core.enabled:
             core.retarget(self._now_s())
             self._send_target()
-        changed = ', '.join(f'{p.name}={p.value!r}' for p in params)
+        changed = ', '.join(f'{p.name}={short_repr(p.value)}' for p in params)
         self.get_logger().info(f'parameters set: {changed}; policy {self._policy_label(v)}')
 
     @staticmethod

@@ -145,7 +145,7 @@ class _Session:
             for proc in self.processes:
                 if proc.proc is not None and not proc.running:
                     raise RuntimeError(f'the {proc.node} node exited with status '
-                                       f'{proc.proc.returncode}:\n{proc.output()[-3000:]}')
+                                       f'{proc.proc.returncode} (its output is below)')
             self.executor.spin_once(timeout_sec=0.05)
         return True
 
@@ -178,6 +178,7 @@ def run_demo(setup: DemoSetup, timeout_s: float = 120.0, domain_id: int | None =
         except RuntimeError as exc:
             out(f'ipomdp-gaze demo: error: {exc}')
         finally:
+            alive = {p.node: p.running for p in (camera, controller)}
             codes = {p.node: p.stop() for p in (camera, controller)}
             executor.shutdown(timeout_sec=1.0)
             watcher.node.destroy_node()
@@ -185,9 +186,11 @@ def run_demo(setup: DemoSetup, timeout_s: float = 120.0, domain_id: int | None =
         if verbose or status:
             for p in (controller, camera):
                 out(f'--- {p.node} output ---\n{p.output().rstrip()}')
-        clean = all(code == 0 for code in codes.values())
-        out(f"stopped both nodes ({', '.join(f'{k} exit status {v}' for k, v in codes.items())})"
-            + ('' if clean else ': NOT a clean shutdown'))
+        clean = all(codes[k] == 0 for k, running in alive.items() if running)
+        states = ', '.join(f'{k} exit status {v}' + ('' if alive[k] or v is None else
+                                                     ' (had already exited)')
+                           for k, v in codes.items())
+        out(f'stopped both nodes ({states})' + ('' if clean else ': NOT a clean shutdown'))
         return status if clean else 1
 
 

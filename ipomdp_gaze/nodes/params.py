@@ -157,6 +157,16 @@ def current_values(node, params: list[Param]) -> dict:
     return {p.name: node.get_parameter(p.name).value for p in params}
 
 
+def short_repr(value, limit: int = 6) -> str:
+    """Repr a parameter value for the log, with long arrays shortened to their length."""
+    if isinstance(value, (list, tuple)) or hasattr(value, 'typecode'):
+        items = list(value)
+        if len(items) > limit:
+            return f'[{len(items)} values: {items[0]!r}, {items[1]!r}, ...]'
+        return repr(items)
+    return repr(value)
+
+
 def grid_from(values: dict) -> Grid:
     """Build the grid described by ``grid.*``."""
     return Grid(values['grid.rows'], values['grid.cols'], values['grid.spacing_deg'])
