@@ -73,8 +73,11 @@ def belief_image(belief, grid: Grid, fixation: int | None, scale_px: int, stamp,
     """Build a stamped ``rgb8`` ``sensor_msgs/Image`` of the belief heatmap."""
     img = belief_picture(belief, grid, fixation, scale_px)
     height, width = img.shape[:2]
-    return Image(header=Header(stamp=stamp, frame_id=frame_id), height=height, width=width,
-                 encoding='rgb8', is_bigendian=0, step=3 * width, data=img.tobytes())
+    msg = Image(header=Header(stamp=stamp, frame_id=frame_id), height=height, width=width,
+                encoding='rgb8', is_bigendian=0, step=3 * width)
+    # Assigned after construction: Image(data=...) converts the bytes twice (~50x slower).
+    msg.data = img.tobytes()
+    return msg
 
 
 def rgb8_array(msg: Image) -> np.ndarray:
@@ -93,9 +96,11 @@ def evidence_image(values, grid: Grid, stamp, frame_id: str = '') -> Image:
     a = np.ascontiguousarray(values, dtype=np.float32)
     if a.size != grid.n_cells:
         raise ValueError(f'expected {grid.n_cells} values, got {a.size}')
-    return Image(header=Header(stamp=stamp, frame_id=frame_id), height=grid.rows,
-                 width=grid.cols, encoding='32FC1', is_bigendian=int(not _LITTLE),
-                 step=4 * grid.cols, data=a.tobytes())
+    msg = Image(header=Header(stamp=stamp, frame_id=frame_id), height=grid.rows,
+                width=grid.cols, encoding='32FC1', is_bigendian=int(not _LITTLE),
+                step=4 * grid.cols)
+    msg.data = a.tobytes()
+    return msg
 
 
 def evidence_from_image(msg: Image, grid: Grid) -> np.ndarray:
