@@ -42,7 +42,7 @@ REFERENCE_CALLS = {'exp + correlate2d': {7: 400, 11: 400, 21: 100, 64: 6, 128: 2
                    'exp + correlate (fft)': dict.fromkeys(SIZES, 40) | {256: 10, 512: 4},
                    'allocating library path': {7: 1000, 11: 1000, 21: 400, 64: 40},
                    'per-cell Python loop': {7: 20, 11: 6}}
-BREAK_EVEN_SIDES = (8, 12, 16, 20, 22, 24, 26, 28, 30, 32, 36, 40, 48)
+BREAK_EVEN_SIDES = (8, 12, 16, 20, 22, 24, 26, 28, 30, 32, 36, 40, 44, 48)
 TRUNCATIONS = (0.0, 1e-16, 1e-12, 1e-9, 1e-6)
 TARGETS_US = {11: 50.0, 256: 5000.0}
 
@@ -61,7 +61,7 @@ class ControllerLoop:
         self.frame = np.empty(grid.n_cells, dtype=np.float32)
         self.calls = 0
         self.fixations = []
-        self.update_ns, self.decide_ns = [], []
+        self.update_ns, self.decide_ns, self.cpu_ns = [], [], []
         self.k = grid.center_index
         self.target = 0
 
@@ -79,17 +79,20 @@ class ControllerLoop:
 
     def run(self, calls, keep=None):
         """Time ``calls`` frames; ``keep`` (list) collects a copy of every 5th belief."""
-        clock = time.perf_counter_ns
+        clock, cpu = time.perf_counter_ns, time.thread_time_ns
         tracker, policy, frame = self.tracker, self.policy, self.frame
         for _ in range(calls):
             self._prepare()
+            c0 = cpu()
             t0 = clock()
             tracker.update(frame, self.k)
             t1 = clock()
             self.k = policy.decide(tracker.belief)
             t2 = clock()
+            c1 = cpu()
             self.update_ns.append(t1 - t0)
             self.decide_ns.append(t2 - t1)
+            self.cpu_ns.append(c1 - c0)
             self.fixations.append(self.k)
             if keep is not None and self.calls % 5 == 0:
                 keep.append(tracker.belief.copy())
@@ -105,7 +108,7 @@ class ReferenceLoop:
         self.kernel = self.table ** 2
         rng = np.random.default_rng(seed)
         self.noise = rng.standard_normal((16, grid.n_cells))
-        self.calls, self.ns = 0, []
+        self.calls, self.ns, self.cpu_ns = 0, [], []
         self.k = grid.center_index
         if kind == 'allocating library path':
             self.d_matrix = kernel_matrix(grid, self.table).T.copy()        # d[j, k]
@@ -162,15 +165,17 @@ class ReferenceLoop:
 
     def run(self, calls):
         """Time ``calls`` frames."""
-        clock = time.perf_counter_ns
+        clock, cpu = time.perf_counter_ns, time.thread_time_ns
         for _ in range(calls):
             if self.calls % EPISODE == 0:
                 self.reset()
                 self.k = self.grid.center_index
             obs = self.noise[self.calls % 16]
+            c0 = cpu()
             t0 = clock()
             self.k = self.step(obs)
             self.ns.append(clock() - t0)
+            self.cpu_ns.append(cpu() - c0)
             self.calls += 1
 
 
@@ -208,6 +213,19 @@ def peak_memory(grid, fpoc, method):
         tracemalloc.stop()
 
 
+def frame_allocation(loop, frames=20):
+    """Peak bytes traced by tracemalloc while the loop's tracker and policy handle frames."""
+    tracker, policy, frame, k = loop.tracker, loop.policy, loop.frame.copy(), loop.k
+    tracemalloc.start()
+    try:
+        for _ in range(frames):
+            tracker.update(frame, k)
+            k = policy.decide(tracker.belief)
+        return tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+
+
 def latency(ctx, fpoc):
     """Item 1: per-size medians and p99 of ours and of the references."""
     rows = []
@@ -224,7 +242,8 @@ def latency(ctx, fpoc):
         ctx.log(f'latency {side}x{side}: {calls} calls x {methods}, references {list(refs)}')
         for loop in loops.values():
             loop.run(min(5, calls))                     # warm-up (FFT plans, caches)
-            loop.update_ns.clear(), loop.decide_ns.clear(), loop.fixations.clear()
+            loop.update_ns.clear(), loop.decide_ns.clear(), loop.cpu_ns.clear()
+            loop.fixations.clear()
             loop.calls = 0
             loop.policy.rescored = 0
         for r in range(ROUNDS):
@@ -240,12 +259,15 @@ def latency(ctx, fpoc):
             row[m] = _median_p99(total)
             row[m + ' update'] = _median_p99(loop.update_ns)
             row[m + ' decide'] = _median_p99(loop.decide_ns)
+            row[m + ' cpu'] = _median_p99(loop.cpu_ns)
+            row[m + ' allocation'] = frame_allocation(loop)
             row[m + ' shape'] = getattr(loop.policy, 'fft_shape', None)
             row[m + ' rescored'] = loop.policy.rescored
         if len(loops) == 2:
             row['same decisions'] = loops['direct'].fixations == loops['fft'].fixations
         for kind, (ref, _) in refs.items():
             row[kind] = _median_p99(ref.ns) if ref.ns else None
+            row[kind + ' cpu'] = _median_p99(ref.cpu_ns) if ref.ns else None
         for m in methods:
             row[m + ' memory'] = peak_memory(grid, fpoc, m)
         rows.append(row)
@@ -253,7 +275,7 @@ def latency(ctx, fpoc):
 
 
 def break_even(ctx, fpoc):
-    """Direct vs FFT decision time over grid sides, single belief and a batch of 256."""
+    """Direct vs FFT decision CPU time over grid sides, single belief and a batch of 256."""
     out = []
     rng = np.random.default_rng(5)
     for side in BREAK_EVEN_SIDES:
@@ -266,7 +288,7 @@ def break_even(ctx, fpoc):
         batch = {m: [] for m in policies}
         for p in policies.values():
             p.decide(beliefs[0]), p.select(beliefs[:8], 0, None)
-        clock = time.perf_counter_ns
+        clock = time.thread_time_ns
         for r in range(reps):
             b = beliefs[r % 256]
             for m, p in policies.items():
@@ -377,10 +399,13 @@ def plot(ctx, rows, scan):
         label = key if key in ('direct', 'fft') else f'reference: {key}'
         ax.errorbar(n, med, yerr=[np.zeros_like(med), p99 - med], fmt=style, color=color,
                     capsize=3, label=label)
+    auto = [(r['n'], r[r['auto'] + ' cpu'][0]) for r in rows]
+    ax.plot([a[0] for a in auto], [a[1] for a in auto], 'k.:', label='ours (auto), CPU time')
     for side, target in TARGETS_US.items():
         ax.plot(side * side, target, marker='*', color='k', markersize=14, linestyle='none')
     ax.plot([], [], marker='*', color='k', linestyle='none', label='target (issue 5)')
-    ax.set(xscale='log', yscale='log', xlabel='cells N', ylabel='µs per frame (median; bar: p99)',
+    ax.set(xscale='log', yscale='log', xlabel='cells N',
+           ylabel='µs per frame (wall median; bar: p99)',
            title='Belief update + decision (ELM kernel, human FPOC)')
     ax.grid(True, which='both', alpha=0.3)
     ax.legend(fontsize=8)
@@ -406,7 +431,9 @@ def plot(ctx, rows, scan):
     ax.plot(n, [r['batch fft'] / 256 for r in scan], 's--', label='FFT, per belief of 256')
     ax.axvline(conv.DIRECT_MAX_CELLS, color='k', linestyle=':',
                label=f'DIRECT_MAX_CELLS = {conv.DIRECT_MAX_CELLS}')
-    ax.set(xscale='log', yscale='log', xlabel='cells N', ylabel='µs per decision (median)',
+    ax.axvline(conv.DIRECT_MAX_CELLS_BATCH, color='k', linestyle='--',
+               label=f'DIRECT_MAX_CELLS_BATCH = {conv.DIRECT_MAX_CELLS_BATCH}')
+    ax.set(xscale='log', yscale='log', xlabel='cells N', ylabel='µs CPU per decision (median)',
            title='Direct vs FFT scores + tie-rule argmax')
     ax.grid(True, which='both', alpha=0.3)
     ax.legend(fontsize=8)
@@ -419,39 +446,52 @@ def report(rows, scan, trunc, greedy) -> str:
     """Markdown of the section."""
     text = [__doc__.split('\n\n')[1].replace('\n', ' '), '',
             '![latency and memory](figures/bench_latency.png)', '',
-            '### Our path: median / p99 per frame', '',
-            '| grid | cells | auto picks | direct | FFT | FFT size | update (auto) | '
-            'decide (auto) | same decisions | peak memory direct | peak memory FFT |',
+            '### Our path per frame: wall-clock median / p99 (CPU-time median)', '',
+            '| grid | cells | auto picks | direct | FFT | FFT size | update / decide (auto, '
+            'wall median) | same decisions | peak memory direct | peak memory FFT | '
+            'allocated per frame (auto) |',
             '|---|---|---|---|---|---|---|---|---|---|---|']
     for r in rows:
-        cell = {m: (f'{_fmt_us(r[m][0])} / {_fmt_us(r[m][1])}' if m in r else
+        cell = {m: (f'{_fmt_us(r[m][0])} / {_fmt_us(r[m][1])} ({_fmt_us(r[m + " cpu"][0])})'
+                    if m in r else
                     'refused (N x N matrix of ' + _fmt_bytes(8 * r['n'] ** 2) + ')')
                 for m in ('direct', 'fft')}
         a = r['auto']
+        cell[a] = f'**{cell[a]}**'
         same = {True: 'yes', False: '**no**'}.get(r.get('same decisions'), '-')
         shape = r.get('fft shape') or '-'
         text.append(f"| {r['side']}x{r['side']} | {r['n']} | {a} | {cell['direct']} | "
-                    f"{cell['fft']} | {shape[0]}x{shape[1]} | {_fmt_us(r[a + ' update'][0])} | "
+                    f"{cell['fft']} | {shape[0]}x{shape[1]} | {_fmt_us(r[a + ' update'][0])} / "
                     f"{_fmt_us(r[a + ' decide'][0])} | {same} | "
-                    f"{_fmt_bytes(r.get('direct memory'))} | {_fmt_bytes(r['fft memory'])} |")
+                    f"{_fmt_bytes(r.get('direct memory'))} | {_fmt_bytes(r['fft memory'])} | "
+                    f"{_fmt_bytes(r[a + ' allocation'])} |")
     text += ['', f"Calls per size: {', '.join(str(r['calls']) for r in rows)} "
              f'(in {ROUNDS} interleaved rounds, after 5 warm-up calls); the belief is reset every '
-             f'{EPISODE} frames. Targets: 11x11 under 50 µs, 256x256 under 5 ms (median).', '',
-             '### References measured in the same run (median per frame; ratio = reference / '
-             'ours with the automatic method)', '',
+             f'{EPISODE} frames. Targets: 11x11 under 50 µs, 256x256 under 5 ms (median). '
+             'Wall-clock time includes waiting for a core on the shared machine; CPU time '
+             '(`time.thread_time_ns`) is what the code itself costs. Peak memory: tracemalloc '
+             "while building the d' table, tracker and policy and handling 3 frames. Allocated "
+             'per frame: tracemalloc peak over 20 frames of a built controller: on the direct '
+             'path only Python scalars (the update and the decision write to preallocated '
+             'buffers: 12 numpy calls per update, 13 for float32 frames, 4 per decision); the '
+             'FFT path allocates its transforms (`scipy.fft` has no `out=`).', '',
+             '### References measured in the same run (CPU-time median per frame; ratio = '
+             'reference / ours with the automatic method)', '',
              '| grid | ' + ' | '.join(REFERENCE_CALLS) + ' |',
              '|---|' + '---|' * len(REFERENCE_CALLS)]
     for r in rows:
-        ours = r[r['auto']][0]
+        ours = r[r['auto'] + ' cpu'][0]
         cells = []
         for kind in REFERENCE_CALLS:
-            v = r.get(kind)
+            v = r.get(kind + ' cpu')
             cells.append(f'{_fmt_us(v[0])} ({v[0] / ours:,.0f}x)' if v else 'not run')
         text.append(f"| {r['side']}x{r['side']} | " + ' | '.join(cells) + ' |')
     text += ['', 'correlate2d is O(N^2) per frame (about 5 s at 256x256), so it is run up to '
              '128x128 only; the per-cell loop only at 7x7 and 11x11.', '',
              '### Break-even of direct and FFT scoring', '',
              '![break-even](figures/bench_breakeven.png)', '',
+             'CPU-time medians per decision (scores + tie-rule argmax), random beliefs '
+             '(Dirichlet 0.3), ELM kernel of the human FPOC.', '',
              '| grid | cells | FFT size | direct, one belief | FFT, one belief | '
              'direct, batch of 256 | FFT, batch of 256 |', '|---|---|---|---|---|---|---|']
     for r in scan:
@@ -461,10 +501,14 @@ def report(rows, scan, trunc, greedy) -> str:
     single = _crossing(scan, 'direct', 'fft')
     batch = _crossing(scan, 'batch direct', 'batch fft')
     text += ['', f'Measured break-even in this run: FFT is faster from {single}x{single} on '
-             f'for one belief and from {batch}x{batch} on for a batch of 256. '
-             f'`policies.conv.DIRECT_MAX_CELLS` = {conv.DIRECT_MAX_CELLS} '
-             f'(direct up to {math.isqrt(conv.DIRECT_MAX_CELLS)}x'
-             f'{math.isqrt(conv.DIRECT_MAX_CELLS)}), set from these measurements.', '',
+             f'for one belief and from {batch}x{batch} on for a batch of 256. The automatic '
+             f'switch in `policies/conv.py`: direct up to `DIRECT_MAX_CELLS` = '
+             f'{conv.DIRECT_MAX_CELLS} cells ({math.isqrt(conv.DIRECT_MAX_CELLS)}x'
+             f'{math.isqrt(conv.DIRECT_MAX_CELLS)}) for one belief and `DIRECT_MAX_CELLS_BATCH` '
+             f'= {conv.DIRECT_MAX_CELLS_BATCH} ({math.isqrt(conv.DIRECT_MAX_CELLS_BATCH)}x'
+             f'{math.isqrt(conv.DIRECT_MAX_CELLS_BATCH)}) for a batch; near the break-even the '
+             'two cost the same within the noise, and direct is preferred there (no '
+             'transform buffers, no re-scoring).', '',
              "### Kernel truncation on the benchmark's belief maps", '',
              'Beliefs: every 5th belief of two 25-fixation searches of the FFT controller loop. '
              '`truncate` drops kernel entries below that fraction of the largest from the FFT '

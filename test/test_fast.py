@@ -1,6 +1,9 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """FFT scoring, the allocation-free belief update and large grids without N x N arrays."""
+import importlib.util
+import os
+from pathlib import Path
 import tracemalloc
 
 from ipomdp_gaze.belief import (argmax_ties_low, BeliefTracker, dprime_column, dprime_window,
@@ -14,6 +17,7 @@ from policies.conv import ConvPolicy, kernel_matrix, support_box
 import pytest
 
 SHAPES = [(7, 7), (5, 9), (11, 11), (13, 6), (20, 31)]
+BENCH_RUN = Path(__file__).resolve().parents[1] / 'bench' / 'run.py'
 
 
 def _kernels(grid, rng):
@@ -306,3 +310,25 @@ def test_elm_at_512x512_agrees_with_a_windowed_direct_sum():
         scores += belief[j] * kernel[rj:rj + rows, cj:cj + cols][::-1, ::-1]
     assert k == int(argmax_ties_low(scores.ravel()))
     assert np.isclose(policy.exact_scores(belief, [k])[0], scores.flat[k], rtol=1e-12)
+
+
+# -- bench runner ---------------------------------------------------------------------------------
+
+def test_bench_report_sections_round_trip_for_partial_runs(tmp_path):
+    saved = dict(os.environ)                          # the runner pins BLAS threads on import
+    try:
+        spec = importlib.util.spec_from_file_location('bench_run', BENCH_RUN)
+        run = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(run)
+    finally:
+        os.environ.clear()
+        os.environ.update(saved)
+    text = run.compose({'b': 'B body\n', 'a': 'A body\n'}, {'a': 10.0, 'b': 30.0},
+                       {'a': 'Alpha', 'b': 'Beta'})
+    assert text.index('## Alpha') < text.index('## Beta')
+    for name in run.PENDING:                          # e.g. the ROS loop, until it lands
+        assert (f'bench_{name}.py' in text) == (name not in run.discover())
+    path = tmp_path / 'benchmarks.md'
+    path.write_text(text)
+    assert run.previous(path) == ({'a': 'A body\n', 'b': 'B body\n'},
+                                  {'a': 'Alpha', 'b': 'Beta'}, {'a': 10.0, 'b': 30.0})
