@@ -45,6 +45,17 @@ REFERENCE_CALLS = {'exp + correlate2d': {7: 400, 11: 400, 21: 100, 64: 6, 128: 2
 BREAK_EVEN_SIDES = (8, 12, 16, 20, 22, 24, 26, 28, 30, 32, 36, 40, 44, 48)
 TRUNCATIONS = (0.0, 1e-16, 1e-12, 1e-9, 1e-6)
 TARGETS_US = {11: 50.0, 256: 5000.0}
+INTRO = (
+    'Each call is what the gaze controller does per frame: `BeliefTracker.update(frame, '
+    "fixation)` then `ConvPolicy.decide(belief)`, with the ELM kernel (`K = d'^2`, human FPOC, "
+    'exactly 0 beyond 46 cells) and frames drawn from the observation model (float32, as read '
+    f'from a `Float32MultiArray` buffer); the belief is reset every {EPISODE} frames, so flat and '
+    'peaked beliefs both occur. Direct and FFT run interleaved in rounds on the same frames, and '
+    'their fixation sequences are compared. Beside them, naive references in the same process: '
+    'the probability-domain (exp) update with `scipy.signal.correlate2d` or '
+    '`scipy.signal.correlate(method="fft")` scores, the allocating library path of before issue '
+    "5 (`update_log_belief` with an N x N d' matrix, scores by an N x N product) and a per-cell "
+    'Python loop.')
 
 
 class ControllerLoop:
@@ -78,7 +89,7 @@ class ControllerLoop:
         self.frame[self.target] += self.table[rt - rk + g.rows - 1, ct - ck + g.cols - 1]
 
     def run(self, calls, keep=None):
-        """Time ``calls`` frames; ``keep`` (list) collects a copy of every 5th belief."""
+        """Time ``calls`` frames; ``keep`` (list) collects a copy of every belief."""
         clock, cpu = time.perf_counter_ns, time.thread_time_ns
         tracker, policy, frame = self.tracker, self.policy, self.frame
         for _ in range(calls):
@@ -94,7 +105,7 @@ class ControllerLoop:
             self.decide_ns.append(t2 - t1)
             self.cpu_ns.append(c1 - c0)
             self.fixations.append(self.k)
-            if keep is not None and self.calls % 5 == 0:
+            if keep is not None:
                 keep.append(tracker.belief.copy())
             self.calls += 1
 
@@ -335,9 +346,9 @@ def truncation(ctx):
             exact_scores = exact.scores(beliefs)
             for tol in TRUNCATIONS:
                 policy = ConvPolicy(grid, kernel, method='fft', truncate=tol)
-                t0 = time.perf_counter_ns()
+                t0 = time.thread_time_ns()
                 decisions = [policy.decide(b) for b in beliefs]
-                per_call = (time.perf_counter_ns() - t0) / len(beliefs) / 1e3
+                per_call = (time.thread_time_ns() - t0) / len(beliefs) / 1e3
                 raw = policy.scores(beliefs)
                 raw_decisions = argmax_ties_low(raw)
                 peak = np.abs(exact_scores.max(axis=1))
@@ -444,7 +455,7 @@ def plot(ctx, rows, scan):
 
 def report(rows, scan, trunc, greedy) -> str:
     """Markdown of the section."""
-    text = [__doc__.split('\n\n')[1].replace('\n', ' '), '',
+    text = [INTRO, '',
             '![latency and memory](figures/bench_latency.png)', '',
             '### Our path per frame: wall-clock median / p99 (CPU-time median)', '',
             '| grid | cells | auto picks | direct | FFT | FFT size | update / decide (auto, '
@@ -510,13 +521,16 @@ def report(rows, scan, trunc, greedy) -> str:
              'two cost the same within the noise, and direct is preferred there (no '
              'transform buffers, no re-scoring).', '',
              "### Kernel truncation on the benchmark's belief maps", '',
-             'Beliefs: every 5th belief of two 25-fixation searches of the FFT controller loop. '
+             'Beliefs: every belief (after each update) of two 25-fixation searches of the FFT '
+             'controller loop with that FPOC. '
              '`truncate` drops kernel entries below that fraction of the largest from the FFT '
-             '(0: only exact zeros, lossless). "raw" = tie-rule argmax of the truncated FFT '
+             '(0: only exact zeros, lossless; the default is `DEFAULT_TRUNCATE` = '
+             f'{conv.DEFAULT_TRUNCATE:g}, used in the tables above). "raw" = tie-rule argmax of '
+             'the truncated FFT '
              'scores alone; "decisions" = the policy (near-maximal cells re-scored exactly). '
              'Score error in units of the tie tolerance `1e-9 |peak|`.', '',
              '| FPOC | grid | truncate | FFT size | raw same | decisions same | '
-             'max score error / tie tol. | re-scored | µs per decision |',
+             'max score error / tie tol. | re-scored | CPU per decision |',
              '|---|---|---|---|---|---|---|---|---|']
     for r in trunc:
         text.append(f"| {r['model']} | {r['side']}x{r['side']} | {r['truncate']:g} | "

@@ -38,14 +38,18 @@ ACTIONS = ('argmax', 'sample')
 METHODS = ('auto', 'direct', 'fft')
 
 # Break-even between the N x N product and the FFT path, measured with bench/bench_latency.py
-# (docs/benchmarks.md): for one belief (the controller) direct was faster up to 26x26 and FFT from
-# 28x28 on; for a batch of 256 beliefs (simulation) direct stays faster up to about 40x40.
+# (docs/benchmarks.md): for one belief (the controller) the two cost the same at 24x24-28x28 (the
+# crossing moved within that range over three runs); for a batch of 256 beliefs (simulation)
+# direct stays faster up to 40x40-44x44 and FFT wins from 48x48.
 DIRECT_MAX_CELLS = 676
 DIRECT_MAX_CELLS_BATCH = 1600
 # The direct path refuses an N x N matrix larger than this (a 128x128 grid would need 2.1 GB).
 DIRECT_MAX_BYTES = 1 << 30
 # Safety factor of the FFT round-off bound (Higham's eta ~ 7u per radix stage, then x2).
 FFT_ERROR_FACTOR = 16.0
+# Default truncation: kernel entries below this fraction of the largest are left out of the FFT
+# (below float64 resolution next to the largest term; decisions never depend on it).
+DEFAULT_TRUNCATE = 1e-16
 # Near-maximal candidates re-scored exactly at most; more means a flat belief (a massive tie).
 RESCORE_MAX = 16
 # Cells re-scored per vectorised chunk (memory bound for the gathered windows).
@@ -170,9 +174,10 @@ class ConvPolicy:
         one belief and up to :data:`DIRECT_MAX_CELLS_BATCH` for a batch, ``fft`` above.
     truncate : float
         Entries with ``|K| <= truncate * max|K|`` are left out of the FFT (0 keeps every non-zero
-        entry). Argmax decisions do not depend on it: the error it adds is part of the bound
-        that selects the cells re-scored exactly, and a belief with more than
-        :data:`RESCORE_MAX` such cells is scored again without truncation; only the cost moves.
+        entry; the default is :data:`DEFAULT_TRUNCATE`, 1e-16). Argmax decisions do not depend
+        on it: the error it adds is part of the bound that selects the cells re-scored exactly,
+        and a belief with more than :data:`RESCORE_MAX` such cells is scored again without
+        truncation; only the cost moves.
 
     Notes
     -----
@@ -183,7 +188,7 @@ class ConvPolicy:
     name = 'learned'
 
     def __init__(self, grid: Grid, kernel, action: str = 'argmax', method: str = 'auto',
-                 truncate: float = 0.0):
+                 truncate: float = DEFAULT_TRUNCATE):
         kernel = np.asarray(kernel, dtype=float)
         if kernel.shape != grid.kernel_shape:
             raise ValueError(f'kernel must have shape {grid.kernel_shape} for a '

@@ -139,8 +139,13 @@ def test_support_box_and_fft_size_follow_the_kernel_reach():
     box_r, box_c = support_box(kernel)
     assert (box_r.start, box_r.stop) == (63 - 46, 63 + 47)
     assert (box_c.start, box_c.stop) == (63 - 46, 63 + 47)
-    p, q = ConvPolicy(grid, kernel, method='fft').fft_shape
+    p, q = ConvPolicy(grid, kernel, method='fft', truncate=0.0).fft_shape
     assert 64 + 46 <= p < 2 * 64 - 1 and 64 + 46 <= q < 2 * 64 - 1
+    # The default truncation (1e-16 of the largest entry) stops at 27 cells.
+    box_r, _ = support_box(kernel, conv.DEFAULT_TRUNCATE)
+    assert (box_r.start, box_r.stop) == (63 - 27, 63 + 28)
+    p, q = ConvPolicy(grid, kernel, method='fft').fft_shape
+    assert 64 + 27 <= p < 64 + 46 and 64 + 27 <= q < 64 + 46
     assert support_box(np.zeros((5, 7))) == (slice(2, 3), slice(3, 4))
 
 
