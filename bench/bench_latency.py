@@ -61,7 +61,7 @@ INTRO = (
 class ControllerLoop:
     """The controller's per-frame work, driven by frames from the observation model."""
 
-    def __init__(self, grid, fpoc, method, seed=0, frames=16, truncate=0.0):
+    def __init__(self, grid, fpoc, method, seed=0, frames=16, truncate=conv.DEFAULT_TRUNCATE):
         self.grid = grid
         self.table = dprime_table(grid, fpoc)
         self.tracker = BeliefTracker(grid, self.table)
@@ -341,7 +341,7 @@ def truncation(ctx):
             ControllerLoop(grid, fpoc, 'fft', seed=11).run(2 * EPISODE, keep=beliefs)
             beliefs = np.array(beliefs)
             kernel = dprime_table(grid, fpoc) ** 2
-            exact = ConvPolicy(grid, kernel, method='fft')
+            exact = ConvPolicy(grid, kernel, method='fft', truncate=0.0)
             reference = [exact.decide(b) for b in beliefs]
             exact_scores = exact.scores(beliefs)
             for tol in TRUNCATIONS:
