@@ -1,0 +1,181 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Run the benchmarks (``make bench``) and write ``docs/benchmarks.md`` with its figures.
+
+Every ``bench/bench_*.py`` is one section of the report, found by name, so a new benchmark
+(for example ``bench_ros_loop.py``) only has to be dropped into ``bench/``. A module takes part in
+one of two ways:
+
+- it defines ``bench(ctx) -> str``: markdown of its section, without the title. ``ctx`` is a
+  :class:`Context` (``ctx.quick``, ``ctx.figure(name)`` for a path under ``docs/figures/``,
+  ``ctx.log(text)``). Optional module attributes: ``TITLE`` (the section heading) and ``ORDER``
+  (position; lower first, default 50);
+- otherwise it is run as a script (``python bench/bench_x.py``) and its output is quoted.
+
+Sections are delimited by ``<!-- bench:NAME order=N -->`` markers, so ``--only NAME`` re-runs one
+benchmark and keeps the others' last results in the file. Timings are not tests: nothing in
+``make test`` depends on them.
+
+Usage: ``.venv/bin/python bench/run.py [--only latency,simulate] [--quick] [--out FILE]``.
+"""
+import argparse
+import datetime
+import importlib.util
+import os
+from pathlib import Path
+import platform
+import re
+import subprocess
+import sys
+import time
+
+# One BLAS thread, set before any benchmark imports numpy: on a small shared machine a
+# multi-threaded matrix-vector product waits for a busy core and becomes 10-100x slower; the
+# controller runs single-threaded as well.
+for _name in ('OPENBLAS_NUM_THREADS', 'OMP_NUM_THREADS', 'MKL_NUM_THREADS'):
+    os.environ.setdefault(_name, '1')
+
+BENCH_DIR = Path(__file__).resolve().parent
+ROOT = BENCH_DIR.parent
+DEFAULT_OUT = ROOT / 'docs' / 'benchmarks.md'
+FIGURES = ROOT / 'docs' / 'figures'
+SCRIPT_TIMEOUT_S = 3600
+MARK = re.compile(r'<!-- bench:(\w+) order=([-\d.]+) -->\n(.*?)<!-- /bench:\1 -->\n', re.S)
+
+
+class Context:
+    """What a benchmark's ``bench(ctx)`` gets: the run's options and where to put figures."""
+
+    def __init__(self, quick: bool, figures: Path):
+        self.quick = quick
+        self.figures = figures
+
+    def figure(self, name: str) -> Path:
+        """Path of a figure file ``docs/figures/<name>`` (the directory is created)."""
+        self.figures.mkdir(parents=True, exist_ok=True)
+        return self.figures / name
+
+    def log(self, text: str) -> None:
+        """Progress line on stderr (kept out of the report)."""
+        print(text, file=sys.stderr, flush=True)
+
+
+def discover() -> dict:
+    """Map benchmark name (``bench_NAME.py``) to its path."""
+    return {p.stem[len('bench_'):]: p for p in sorted(BENCH_DIR.glob('bench_*.py'))}
+
+
+def load(path: Path):
+    """Import a benchmark module from its path."""
+    if str(ROOT) not in sys.path:
+        sys.path.insert(0, str(ROOT))
+    spec = importlib.util.spec_from_file_location(f'bench_modules.{path.stem}', path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def run_one(name: str, path: Path, ctx: Context) -> tuple[float, str, str]:
+    """Run one benchmark; return ``(order, title, markdown body)``."""
+    module = load(path)
+    title = getattr(module, 'TITLE', name.replace('_', ' ').capitalize())
+    order = float(getattr(module, 'ORDER', 50))
+    t0 = time.perf_counter()
+    if hasattr(module, 'bench'):
+        body = module.bench(ctx).rstrip() + '\n'
+    else:
+        done = subprocess.run([sys.executable, str(path)], cwd=ROOT, capture_output=True,
+                              text=True, timeout=SCRIPT_TIMEOUT_S)
+        status = '' if done.returncode == 0 else f' (exit status {done.returncode})'
+        body = (f'Output of `python bench/{path.name}`{status}:\n\n```\n'
+                f'{(done.stdout + done.stderr).strip()}\n```\n')
+    wall = time.perf_counter() - t0
+    body += f'\n*Measured {machine()}; this section took {wall:.0f} s.*\n'
+    return order, title, body
+
+
+def machine() -> str:
+    """One line on the machine and software a section was measured on."""
+    import numpy
+    import scipy
+    load_avg = ', '.join(f'{x:.1f}' for x in os.getloadavg())
+    return (f'{datetime.datetime.now().isoformat(timespec="minutes")} on `{platform.node()}` '
+            f'({platform.machine()}, {os.cpu_count()} CPUs, load average {load_avg}), '
+            f'Python {platform.python_version()}, numpy {numpy.__version__}, '
+            f'scipy {scipy.__version__}, OPENBLAS_NUM_THREADS='
+            f'{os.environ.get("OPENBLAS_NUM_THREADS", "unset")}')
+
+
+# Benchmarks issue 5 asks for that other engineers add later: listed as pending until they exist.
+PENDING = {
+    'ros_loop': 'ROS loop: camera evidence -> controller -> pan_tilt -> camera as separate '
+                'processes, round trip and fixations per second (issue 5 item 2)',
+    'training': "training time to the learning issue's target (issue 5 item 3)",
+}
+
+HEADER = """# Benchmarks
+
+Written by `make bench` (`bench/run.py`): one section per `bench/bench_*.py`. The machine is
+small and shared (other engineers' jobs run at the same time), so absolute times move by 2x or
+more from run to run; every timing is therefore shown beside a reference measured in the same
+run, and the ratios are the numbers to compare. Benchmarks are not tests: nothing in `make test`
+depends on timing.
+
+"""
+
+
+def compose(sections: dict, order: dict, titles: dict) -> str:
+    """Assemble the report from sections ``{name: body}``."""
+    names = sorted(sections, key=lambda n: (order.get(n, 50.0), n))
+    text = HEADER
+    pending = [f'- `bench/bench_{n}.py`: {what}' for n, what in PENDING.items()
+               if n not in discover()]
+    if pending:
+        text += 'Not measured yet (each drops in as one file):\n\n' + '\n'.join(pending) + '\n\n'
+    for name in names:
+        text += (f'<!-- bench:{name} order={order.get(name, 50.0):g} -->\n## {titles[name]}\n\n'
+                 f'{sections[name]}<!-- /bench:{name} -->\n')
+    return text
+
+
+def previous(path: Path) -> tuple[dict, dict, dict]:
+    """Sections, titles and positions already in the report (kept by ``--only``)."""
+    if not path.exists():
+        return {}, {}, {}
+    sections, titles, order = {}, {}, {}
+    for match in MARK.finditer(path.read_text()):
+        name, position, block = match.group(1), match.group(2), match.group(3)
+        heading, _, body = block.partition('\n\n')
+        sections[name] = body
+        titles[name] = heading.removeprefix('## ').strip()
+        order[name] = float(position)
+    return sections, titles, order
+
+
+def main(argv=None) -> int:
+    """Run the selected benchmarks and write the report."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
+    parser.add_argument('--only', default='', help='comma-separated names (bench_NAME.py)')
+    parser.add_argument('--quick', action='store_true', help='few calls: a smoke run')
+    parser.add_argument('--out', type=Path, default=DEFAULT_OUT, help='report path')
+    args = parser.parse_args(argv)
+    found = discover()
+    names = [n for n in args.only.split(',') if n] or list(found)
+    unknown = [n for n in names if n not in found]
+    if unknown:
+        parser.error(f"unknown benchmark {unknown[0]!r}; available: {', '.join(found)}")
+    ctx = Context(args.quick, FIGURES)
+    sections, titles, order = previous(args.out) if args.only else ({}, {}, {})
+    for name in names:
+        ctx.log(f'== bench_{name}')
+        position, title, body = run_one(name, found[name], ctx)
+        sections[name], titles[name], order[name] = body, title, position
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(compose(sections, order, titles))
+    ctx.log(f'wrote {args.out}')
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
