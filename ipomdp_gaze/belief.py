@@ -19,6 +19,9 @@ import numpy as np
 TIE_RTOL = 1e-9
 
 
+OVERFLOW_REASON = 'evidence too large: d * (o - d/2) overflows float64'
+
+
 class EvidenceError(ValueError):
     """A frame of evidence that cannot be used (it is rejected, the belief is unchanged)."""
 
@@ -71,7 +74,10 @@ def log_likelihood(observation: np.ndarray, dprime: np.ndarray) -> np.ndarray:
         ``d_ik`` of each cell i for the current fixation k.
 
     """
-    term = dprime * (observation - 0.5 * dprime)
+    with np.errstate(over='ignore', invalid='ignore'):
+        term = dprime * (observation - 0.5 * dprime)
+    if np.any(np.isinf(term)):
+        raise EvidenceError(OVERFLOW_REASON)
     return np.where(np.isnan(term), 0.0, term)
 
 
@@ -289,6 +295,10 @@ class BeliefTracker:
         if missing:
             np.isnan(term, out=self._nan)
             np.copyto(term, 0.0, where=self._nan)
+        if not math.isfinite(np.add.reduce(term, axis=None)):
+            np.isinf(term, out=self._nan)
+            if self._nan.any():
+                raise EvidenceError(OVERFLOW_REASON)
         np.add(self._log_grid, term, out=self._log_grid)
         self._normalize()
 

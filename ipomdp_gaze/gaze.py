@@ -25,9 +25,8 @@ import numpy as np
 from policies.baselines import make_baseline, STRATEGIES
 from policies.conv import check_action, ConvPolicy
 
-from .belief import (check_evidence, entropy, EvidenceError, map_cell, normalize_log,
-                     uniform_log_belief)
-from .fpoc import dprime_matrix, FPOC
+from .belief import BeliefTracker, check_evidence, entropy, EvidenceError, map_cell
+from .fpoc import dprime_table, FPOC
 from .grid import Grid
 
 POLICY_NAMES = ('learned', 'map', 'elm', 'random', 'center', 'spiral', 'greedy')
@@ -158,6 +157,7 @@ class GazeController:
     def __init__(self, grid: Grid, fpoc: FPOC, policy, start_cell: int | None = None,
                  settle_time_s: float = 0.0, confidence: float = 0.95, seed: int = 0):
         self.grid = grid
+        self._tracker = None
         self.set_fpoc(fpoc)
         self.policy = policy
         self.set_start_cell(grid.center_index if start_cell is None else start_cell)
@@ -167,8 +167,6 @@ class GazeController:
         self.enabled = True
         self.received = self.applied = self.rejected = self.skipped = 0
         self.last_rejection = ''
-        self._log_belief = uniform_log_belief(grid.n_cells)
-        self._belief = np.exp(self._log_belief)
         self.fixation = self.start_cell
         self.fixations = 0
         self.target_time_s = 0.0
@@ -178,7 +176,12 @@ class GazeController:
     def set_fpoc(self, fpoc: FPOC) -> None:
         """Use another FPOC for the following updates (the belief is kept)."""
         self.fpoc = fpoc
-        self._dprime_by_fixation = np.ascontiguousarray(dprime_matrix(self.grid, fpoc).T)
+        previous = self._tracker
+        # d' from the (2R-1, 2C-1) offset table: no N x N matrix, so large grids fit in memory.
+        self._tracker = BeliefTracker(self.grid, dprime_table(self.grid, fpoc))
+        if previous is not None:
+            self._tracker.reset(previous.log_belief)
+        self._belief = self._tracker.belief
 
     def set_policy(self, policy) -> None:
         """Use another policy from the next choice on."""
@@ -234,8 +237,7 @@ class GazeController:
     # -- events ----------------------------------------------------------------------------
     def reset(self, now_s: float) -> int:
         """Uniform belief, fixation back to the start cell; returns it (sent at ``now_s``)."""
-        self._log_belief = uniform_log_belief(self.grid.n_cells)
-        self._belief = np.exp(self._log_belief)
+        self._tracker.reset()
         self.fixation = self.start_cell
         self.fixations = 0
         self.found = None
@@ -294,11 +296,7 @@ class GazeController:
         if stamp_s < self.target_time_s + self.settle_time_s:
             self.skipped += 1
             return FrameResult('skipped', 'taken before the fixation settled')
-        d = self._dprime_by_fixation[self.fixation]
-        term = d * (obs - 0.5 * d)
-        self._log_belief += np.where(np.isnan(term), 0.0, term)
-        normalize_log(self._log_belief)
-        np.exp(self._log_belief, out=self._belief)
+        self._tracker.update(obs, self.fixation)
         self.applied += 1
         self.fixations += 1
         found = None

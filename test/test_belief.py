@@ -120,3 +120,21 @@ def test_tie_rule_goes_to_lowest_index_within_relative_tolerance():
     assert argmax_ties_low(np.zeros(5)) == 0
     assert map_cell(np.exp(uniform_log_belief(49))) == 0
     np.testing.assert_array_equal(argmax_ties_low(np.array([[0, 1, 1], [2, 0, 2.0]])), [1, 0])
+
+
+def test_overflowing_evidence_is_rejected_and_the_belief_kept():
+    from ipomdp_gaze.belief import BeliefTracker
+    from ipomdp_gaze.fpoc import dprime_table, make_fpoc
+    from ipomdp_gaze.grid import Grid
+    obs = np.zeros(9)
+    obs[4] = 1.7e308
+    with pytest.raises(EvidenceError, match='overflows'):
+        update_log_belief(uniform_log_belief(9), obs, np.full(9, 2.0))
+    grid = Grid(3, 3)
+    tracker = BeliefTracker(grid, dprime_table(grid, make_fpoc('human')))
+    tracker.update(np.arange(9.0), 4)
+    before = tracker.belief.copy()
+    with pytest.warns(RuntimeWarning), pytest.raises(EvidenceError, match='overflows'):
+        tracker.update(obs, 4)
+    np.testing.assert_array_equal(tracker.belief, before)
+    assert np.all(np.isfinite(tracker.log_belief))
