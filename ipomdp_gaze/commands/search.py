@@ -3,6 +3,8 @@
 """``ipomdp-gaze search``: one offline search, printed fixation by fixation."""
 from __future__ import annotations
 
+from pathlib import Path
+
 from ipomdp_gaze.belief import entropy, map_cell, normalize_log, uniform_log_belief
 from ipomdp_gaze.fpoc import dprime_matrix
 from ipomdp_gaze.simulate import sample_observation
@@ -26,11 +28,13 @@ def add_parser(sub):
                    help='stop when the most likely cell reaches this probability')
     p.add_argument('--max-fixations', type=positive_int, default=None)
     p.add_argument('--seed', type=nonneg_int, default=0)
+    p.add_argument('--plot', type=Path, default=None, metavar='PNG',
+                   help='save the final belief with the scan path as a picture')
     p.set_defaults(run=run)
 
 
 def run_search(grid, fpoc, policy, target, confidence, max_fixations, seed, out=print):
-    """Search until the MAP probability reaches ``confidence``; return (guess, fixations)."""
+    """Search until the MAP probability reaches ``confidence``; return (guess, path, belief)."""
     rng = np.random.default_rng(seed)
     d = dprime_matrix(grid, fpoc)
     log_b = uniform_log_belief(grid.n_cells, 1)
@@ -39,8 +43,10 @@ def run_search(grid, fpoc, policy, target, confidence, max_fixations, seed, out=
     tr, tc = grid.cell(target)
     out(f'target hidden at cell {target} (row {tr}, col {tc}) of a {grid.rows}x{grid.cols} grid')
     guess = 0
+    path = []
     for t in range(max_fixations):
         k = int(policy.select(belief, t, rng)[0])
+        path.append(k)
         obs = sample_observation(d[target, k], targets, grid.n_cells, rng)
         log_b += d[:, k] * (obs - 0.5 * d[:, k])
         normalize_log(log_b)
@@ -57,7 +63,32 @@ def run_search(grid, fpoc, policy, target, confidence, max_fixations, seed, out=
     verdict = 'right' if guess == target else 'wrong'
     out(f'found: the target is most likely at ({grid.cell(guess)[0]},{grid.cell(guess)[1]}) '
         f'after {t + 1} fixations, which is {verdict}')
-    return guess, t + 1
+    return guess, path, belief[0]
+
+
+def plot_search(grid, belief, path, target, title, out_path):
+    """Save the belief as a heatmap with the numbered scan path and the target (a star)."""
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(5.2, 4.6))
+    log_belief = np.log10(np.maximum(belief, 1e-12)).reshape(grid.shape)
+    image = ax.imshow(log_belief, cmap='inferno', vmin=max(log_belief.min(), -8), vmax=0)
+    fig.colorbar(image, ax=ax, label='log10 belief')
+    rows, cols = grid.cell(np.asarray(path))
+    ax.plot(cols, rows, '-', color='cyan', lw=1.5, alpha=0.8)
+    for i, (r, c) in enumerate(zip(rows, cols)):
+        ax.text(c, r, str(i + 1), color='black', ha='center', va='center', fontsize=8,
+                bbox={'boxstyle': 'circle,pad=0.2', 'fc': 'cyan', 'ec': 'none'})
+    tr, tc = grid.cell(target)
+    ax.plot(tc, tr, marker='*', ms=16, mfc='none', mec='lime', mew=2)
+    ax.set_title(title, fontsize=10)
+    ax.set_xlabel('column')
+    ax.set_ylabel('row')
+    fig.tight_layout()
+    out_path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out_path, dpi=110)
+    plt.close(fig)
 
 
 def run(args) -> int:
@@ -74,5 +105,12 @@ def run(args) -> int:
     if target >= grid.n_cells:
         raise ValueError(f'--target {target} is outside the {grid.n_cells}-cell grid')
     max_fix = args.max_fixations or 4 * grid.n_cells
-    run_search(grid, fpoc, policy, target, args.confidence, max_fix, args.seed)
+    guess, path, belief = run_search(grid, fpoc, policy, target, args.confidence, max_fix,
+                                     args.seed)
+    if args.plot:
+        name = args.policy_file or args.policy
+        title = (f'{grid.rows}x{grid.cols}, {fpoc.model} FPOC, {name}: '
+                 f'{len(path)} fixations (star = target)')
+        plot_search(grid, belief, path, target, title, args.plot)
+        print(f'wrote {args.plot}')
     return 0

@@ -49,6 +49,7 @@ from trajectory_msgs.msg import JointTrajectory
 
 from .params import (current_values, declare, fpoc_from, fpoc_params, grid_from, grid_params,
                      head_from, INT_MAX, joint_params, Param, row_col_from, short_repr, T)
+from .spin import spin
 
 NODE_NAME = 'gaze_controller'
 EVIDENCE_QOS = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
@@ -465,7 +466,7 @@ def main(args=None) -> int:
     status = 0
     try:
         node = GazeControllerNode()
-        rclpy.spin(node)
+        spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except _rclpy.RCLError:
