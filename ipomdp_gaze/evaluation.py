@@ -1,4 +1,7 @@
-"""Honest evaluation: percent correct vs fixations, fixations to 90% correct, bootstrap intervals.
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Honest evaluation: percent correct vs fixations, fixations to 90% correct, bootstrap intervals.
 
 Fixations to 90% correct is the first t where percent correct reaches 0.90, interpolated linearly
 between t-1 and t (percent correct at t = 0 is the uniform guess, 1/N); ``None`` if never reached.
@@ -12,7 +15,8 @@ LEVEL = 0.90
 
 
 def fixations_to_level(percent_correct: np.ndarray, n_cells: int, level: float = LEVEL):
-    """First t (interpolated) at which ``percent_correct[t-1] >= level``; ``None`` if never.
+    """
+    First t (interpolated) at which ``percent_correct[t-1] >= level``; ``None`` if never.
 
     Works on a curve (T,) or a stack of curves (B, T), returning a float array with NaN for never.
     """
@@ -39,17 +43,26 @@ def bootstrap_counts(episodes: int, resamples: int, rng: np.random.Generator) ->
 
 def fixations_to_90_ci(correct: np.ndarray, n_cells: int, rng: np.random.Generator,
                        resamples: int = 1000, counts: np.ndarray | None = None):
-    """Point estimate and 95% percentile-bootstrap interval of fixations to 90% correct.
+    """
+    Point estimate and 95% percentile-bootstrap interval of fixations to 90% correct.
 
     Parameters
     ----------
     correct : bool array (episodes, T)
+        Whether each episode's MAP guess is right after t = 1..T fixations.
+    n_cells : int
+        N, for the chance level 1/N at t = 0.
+    rng : numpy.random.Generator
+        Source of the bootstrap resampling.
+    resamples : int
+        Number of bootstrap resamples.
     counts : array (resamples, episodes), optional
         Shared resampling weights, so paired comparisons resample the same episodes.
 
     Returns
     -------
     (estimate, (low, high)) with ``None`` where 90% is not reached.
+
     """
     episodes = correct.shape[0]
     point = fixations_to_level(correct.mean(axis=0), n_cells)
@@ -67,7 +80,7 @@ def fixations_to_90_ci(correct: np.ndarray, n_cells: int, rng: np.random.Generat
 
 def paired_difference_ci(correct_a: np.ndarray, correct_b: np.ndarray, n_cells: int,
                          rng: np.random.Generator, resamples: int = 1000):
-    """Difference ``a - b`` of fixations to 90% on the same episodes, with a paired 95% interval."""
+    """Difference ``a - b`` of fixations to 90% on the same episodes, with a paired 95% CI."""
     n = min(correct_a.shape[0], correct_b.shape[0])
     a, b = correct_a[:n], correct_b[:n]
     pa = fixations_to_level(a.mean(axis=0), n_cells)

@@ -1,5 +1,9 @@
-"""Foveal-peripheral operating characteristics (FPOCs): detectability d' of a target at offset
-``(dx, dy)`` degrees from the fixation point.
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Foveal-peripheral operating characteristics (FPOCs) of the observation model.
+
+An FPOC gives the detectability d' of a target at offset ``(dx, dy)`` degrees from fixation.
 
 Every FPOC is a small object built from the parameter names of DESIGN.md section 2 (the same
 names appear in policy files, the CLI's ``--fpoc-param`` and the nodes' ``fpoc.<name>``), and is
@@ -60,7 +64,8 @@ class FPOC:
 
 
 class HumanFPOC(FPOC):
-    """Najemnik & Geisler (2005) visibility map, radially averaged.
+    """
+    Najemnik & Geisler (2005) visibility map, radially averaged.
 
     ``c_T(e)^2 = 0.002130 exp(0.9790 e) + 0.6712 exp(0.4905 e) n^2``,
     ``s(e) = 2.8 e / (e + 0.8) + 2``, ``f(c, e) = 0.5 + 0.5 (1 - exp(-(c / c_T(e))^s(e)))``,
@@ -84,7 +89,7 @@ class HumanFPOC(FPOC):
         return 0.002130 * np.exp(0.9790 * ecc) + 0.6712 * np.exp(0.4905 * ecc) * n2
 
     def of_eccentricity(self, ecc_deg) -> np.ndarray:
-        """d' as a function of eccentricity in degrees."""
+        """Evaluate d' as a function of eccentricity in degrees."""
         ecc = np.asarray(ecc_deg, dtype=float)
         steep = 2.8 * ecc / (ecc + 0.8) + 2.0
         ratio_sq = self.contrast ** 2 / self._threshold_sq(ecc)
@@ -110,7 +115,7 @@ class ExponentialFPOC(FPOC):
         self.scale_deg = _positive('scale_deg', scale_deg)
 
     def of_eccentricity(self, ecc_deg):
-        """d' as a function of eccentricity in degrees."""
+        """Evaluate d' as a function of eccentricity in degrees."""
         return self.foveal_dprime * np.exp(-np.asarray(ecc_deg, dtype=float) / self.scale_deg)
 
     def __call__(self, dx, dy):
@@ -178,8 +183,9 @@ class TableFPOC(FPOC):
         self.ecc_deg, self.dprime = ecc, dp
 
     def of_eccentricity(self, ecc_deg):
-        """d' as a function of eccentricity in degrees."""
-        return np.maximum(np.interp(np.asarray(ecc_deg, dtype=float), self.ecc_deg, self.dprime), 0.0)
+        """Evaluate d' as a function of eccentricity in degrees."""
+        ecc = np.asarray(ecc_deg, dtype=float)
+        return np.maximum(np.interp(ecc, self.ecc_deg, self.dprime), 0.0)
 
     def __call__(self, dx, dy):
         return self.of_eccentricity(np.hypot(dx, dy))
@@ -194,7 +200,7 @@ MODELS: dict[str, Callable[..., FPOC]] = {
 
 
 def parameter_names(model: str) -> tuple[str, ...]:
-    """The parameter names accepted by an FPOC model."""
+    """Return the parameter names accepted by an FPOC model."""
     _check_model(model)
     return tuple(MODELS[model].defaults)
 
@@ -205,17 +211,19 @@ def _check_model(model):
 
 
 def make_fpoc(model: str = 'human', **params) -> FPOC:
-    """Build an FPOC by model name from DESIGN.md parameter names.
+    """
+    Build an FPOC by model name from DESIGN.md parameter names.
 
     Raises
     ------
     ValueError
         For an unknown model, an unknown parameter name or an invalid value, naming it.
+
     """
     _check_model(model)
     unknown = sorted(set(params) - set(MODELS[model].defaults))
     if unknown:
-        raise ValueError(f"unknown parameter {unknown[0]!r} for FPOC {model!r}; valid: "
+        raise ValueError(f'unknown parameter {unknown[0]!r} for FPOC {model!r}; valid: '
                          f"{', '.join(MODELS[model].defaults)}")
     return MODELS[model](**params)
 
@@ -229,13 +237,13 @@ def fpoc_from_dict(spec: dict) -> FPOC:
 
 
 def dprime_table(grid: Grid, fpoc: FPOC) -> np.ndarray:
-    """d' on the ``(2R-1) x (2C-1)`` offset table: entry ``[r_j-r_k+R-1, c_j-c_k+C-1]``."""
+    """Tabulate d' on the ``(2R-1) x (2C-1)`` offset table, entry ``[rj-rk+R-1, cj-ck+C-1]``."""
     dx, dy = grid.offset_table_deg()
     return np.asarray(fpoc(dx, dy), dtype=float)
 
 
 def dprime_matrix(grid: Grid, fpoc: FPOC) -> np.ndarray:
-    """The N x N matrix ``d[j, k]``: d' of target cell j when fixating cell k."""
+    """Return the N x N matrix ``d[j, k]``: d' of target cell j when fixating cell k."""
     table = dprime_table(grid, fpoc)
     ri, ci = grid.pair_offset_index()          # indexed [k, j]
     return np.ascontiguousarray(table[ri, ci].T)

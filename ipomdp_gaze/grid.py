@@ -1,4 +1,7 @@
-"""Grid geometry of the visual array: cell index <-> (row, col) <-> offsets in degrees.
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Grid geometry of the visual array: cell index <-> (row, col) <-> offsets in degrees.
 
 Cells are row-major, ``i = r * cols + c``; row 0 is the top and column 0 the left, as in an
 image. Offsets of cell ``j`` seen from fixation ``k`` are ``dy = spacing_deg * (r_j - r_k)`` and
@@ -6,8 +9,8 @@ image. Offsets of cell ``j`` seen from fixation ``k`` are ``dy = spacing_deg * (
 """
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
+import re
 
 import numpy as np
 
@@ -15,16 +18,18 @@ _GRID_RE = re.compile(r'^\s*(\d+)\s*[xX]\s*(\d+)\s*$')
 
 
 def parse_grid(text: str) -> tuple[int, int]:
-    """Parse ``'ROWSxCOLS'`` (for example ``'7x7'``) into ``(rows, cols)``.
+    """
+    Parse ``'ROWSxCOLS'`` (for example ``'7x7'``) into ``(rows, cols)``.
 
     Raises
     ------
     ValueError
         If the text is not two positive integers joined by ``x``.
+
     """
     match = _GRID_RE.match(str(text))
     if not match:
-        raise ValueError(f"grid must look like ROWSxCOLS, e.g. 7x7, got {text!r}")
+        raise ValueError(f'grid must look like ROWSxCOLS, e.g. 7x7, got {text!r}')
     rows, cols = int(match.group(1)), int(match.group(2))
     if rows < 1 or cols < 1:
         raise ValueError(f'grid must have at least one row and one column, got {text!r}')
@@ -47,7 +52,8 @@ class Grid:
             object.__setattr__(self, name, int(value))
         spacing = float(self.spacing_deg)
         if not np.isfinite(spacing) or spacing <= 0:
-            raise ValueError(f'spacing_deg must be a positive finite number, got {self.spacing_deg!r}')
+            raise ValueError(
+                f'spacing_deg must be a positive finite number, got {self.spacing_deg!r}')
         object.__setattr__(self, 'spacing_deg', spacing)
 
     @classmethod
@@ -58,7 +64,7 @@ class Grid:
 
     @property
     def n_cells(self) -> int:
-        """Number of cells N = rows * cols."""
+        """Return the number of cells N = rows * cols."""
         return self.rows * self.cols
 
     @property
@@ -97,13 +103,14 @@ class Grid:
         return idx // self.cols, idx % self.cols
 
     def offsets_deg(self, fixation: int) -> tuple[np.ndarray, np.ndarray]:
-        """Offsets ``(dx, dy)`` in degrees of every cell seen from cell ``fixation``, shape (N,)."""
+        """Offsets ``(dx, dy)`` in degrees of every cell seen from ``fixation``, shape (N,)."""
         rf, cf = self.cell(fixation)
         r, c = self.rows_cols()
         return self.spacing_deg * (c - cf), self.spacing_deg * (r - rf)
 
     def offset_table_deg(self) -> tuple[np.ndarray, np.ndarray]:
-        """Offsets ``(dx, dy)`` of shape ``(2*rows-1, 2*cols-1)``.
+        """
+        Offsets ``(dx, dy)`` of shape ``(2*rows-1, 2*cols-1)``.
 
         Entry ``[r_j - r_k + rows-1, c_j - c_k + cols-1]`` is the offset of cell j seen from k, so
         large grids never need an N x N array.
@@ -114,7 +121,8 @@ class Grid:
         return dx, dy
 
     def pair_offset_index(self) -> tuple[np.ndarray, np.ndarray]:
-        """Indices into an offset table for every (fixation k, cell j) pair, each (N, N).
+        """
+        Return indices into an offset table for every (fixation k, cell j) pair, each (N, N).
 
         ``table[ri[k, j], ci[k, j]]`` is the entry for cell j seen from fixation k.
         """

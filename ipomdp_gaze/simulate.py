@@ -1,4 +1,7 @@
-"""Batched simulation of the visual-search task: thousands of episodes at once.
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Batched simulation of the visual-search task: thousands of episodes at once.
 
 Any policy plugs in through one method, ``select(belief, t, rng) -> fixations``: ``belief`` is an
 (episodes, N) array of probabilities, ``t`` the 0-based fixation number and ``rng`` a
@@ -14,7 +17,7 @@ from typing import Protocol
 import numpy as np
 
 from .belief import map_cell, normalize_log, uniform_log_belief
-from .fpoc import FPOC, dprime_matrix
+from .fpoc import dprime_matrix, FPOC
 from .grid import Grid
 
 # Stream tags of the seed sequence: targets, noise per fixation, and the policy's own draws.
@@ -30,7 +33,8 @@ class Policy(Protocol):
 
 @dataclass
 class SearchResult:
-    """What a batch of simulated searches produced.
+    """
+    What a batch of simulated searches produced.
 
     ``correct[e, t-1]`` is whether episode e's MAP guess after t observations is its target;
     ``fixations[e, t-1]`` is the t-th fixation; ``map_prob[e, t-1]`` the MAP probability then.
@@ -55,12 +59,12 @@ def draw_targets(n_cells: int, episodes: int, seed: int) -> np.ndarray:
 
 
 def noise_stream(seed: int, t: int) -> np.random.Generator:
-    """Generator of the observation noise for fixation ``t`` (0-based)."""
+    """Return the generator of the observation noise for fixation ``t`` (0-based)."""
     return np.random.default_rng([seed, _NOISE, t])
 
 
 def policy_rng(seed: int) -> np.random.Generator:
-    """Generator handed to the policy's ``select``."""
+    """Return the generator handed to the policy's ``select``."""
     return np.random.default_rng([seed, _POLICY])
 
 
@@ -75,7 +79,8 @@ def sample_observation(dprime_at_target: np.ndarray, targets: np.ndarray, n_cell
 def simulate(grid: Grid, fpoc: FPOC, policy: Policy, episodes: int, horizon: int | None = None,
              seed: int = 0, targets: np.ndarray | None = None, dprime: np.ndarray | None = None,
              progress=None) -> SearchResult:
-    """Run ``episodes`` searches of ``horizon`` fixations (default N) from a uniform belief.
+    """
+    Run ``episodes`` searches of ``horizon`` fixations (default N) from a uniform belief.
 
     Parameters
     ----------
@@ -91,6 +96,7 @@ def simulate(grid: Grid, fpoc: FPOC, policy: Policy, episodes: int, horizon: int
         ``d[j, k]``; computed from ``fpoc`` when omitted.
     progress : callable, optional
         Called with the fixation number after each step.
+
     """
     n = grid.n_cells
     horizon = n if horizon is None else int(horizon)

@@ -1,16 +1,18 @@
-"""Baseline searchers chosen by a strategy string, after scikit-learn's ``DummyClassifier``.
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Baseline searchers chosen by a strategy string, after scikit-learn's ``DummyClassifier``.
 
 Every policy has ``select(belief, t, rng) -> fixations`` for a batch of beliefs (episodes, N).
-``make_baseline('elm', grid, fpoc)`` builds one; an unknown name raises a ``ValueError`` listing the
-valid ones. Randomness comes from the ``rng`` passed at each call.
+``make_baseline('elm', grid, fpoc)`` builds one; an unknown name raises a ``ValueError``
+listing the valid ones. Randomness comes from the ``rng`` passed at each call.
 """
 from __future__ import annotations
 
-import numpy as np
-
 from ipomdp_gaze.belief import argmax_ties_low
-from ipomdp_gaze.fpoc import FPOC, dprime_table
+from ipomdp_gaze.fpoc import dprime_table, FPOC
 from ipomdp_gaze.grid import Grid
+import numpy as np
 
 from .conv import ConvPolicy
 

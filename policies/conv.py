@@ -1,4 +1,7 @@
-"""Convolutional (shift-invariant) logistic policy: ``p(k | B) ∝ exp(score_k)``.
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Convolutional (shift-invariant) logistic policy: ``p(k | B) ∝ exp(score_k)``.
 
 ``score_k = sum_j B_j K[r_j - r_k + R-1, c_j - c_k + C-1]``: a cross-correlation of the belief with
 the kernel K of shape ``(2R-1, 2C-1)`` (DESIGN.md section 3). The radially weight-shared family
@@ -6,10 +9,9 @@ ties all entries with the same squared displacement ``dr^2 + dc^2``.
 """
 from __future__ import annotations
 
-import numpy as np
-
 from ipomdp_gaze.belief import argmax_ties_low
 from ipomdp_gaze.grid import Grid
+import numpy as np
 
 ACTIONS = ('argmax', 'sample')
 
@@ -29,7 +31,8 @@ def squared_distance_table(grid: Grid) -> np.ndarray:
 
 
 def radial_bins(grid: Grid) -> tuple[np.ndarray, np.ndarray]:
-    """Distinct squared distances (sorted) and the bin of each kernel entry.
+    """
+    Distinct squared distances (sorted) and the bin of each kernel entry.
 
     Returns ``(squared_distance, bin_index)`` with ``bin_index`` of the kernel's shape, so
     ``kernel = weight[bin_index]`` (27 weights at 7x7, 61 at 11x11).
@@ -50,7 +53,7 @@ def kernel_from_radial(grid: Grid, weight: np.ndarray) -> np.ndarray:
 
 
 def kernel_matrix(grid: Grid, kernel: np.ndarray) -> np.ndarray:
-    """The N x N matrix ``W[k, j] = K[r_j - r_k + R-1, c_j - c_k + C-1]`` (small grids only)."""
+    """Return ``W[k, j] = K[r_j - r_k + R-1, c_j - c_k + C-1]``, N x N (small grids only)."""
     ri, ci = grid.pair_offset_index()
     return np.ascontiguousarray(kernel[ri, ci])
 

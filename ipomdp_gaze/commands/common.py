@@ -1,17 +1,18 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """Argument helpers shared by the subcommands: grid, FPOC and policy selection."""
 from __future__ import annotations
 
 import argparse
 import math
 
-import yaml
-
-from ipomdp_gaze.fpoc import MODELS, make_fpoc, parameter_names
+from ipomdp_gaze.fpoc import make_fpoc, MODELS, parameter_names
 from ipomdp_gaze.grid import Grid, parse_grid
+import yaml
 
 
 def grid_arg(text: str) -> tuple[int, int]:
-    """argparse type for ``ROWSxCOLS``."""
+    """Parse ``ROWSxCOLS`` for argparse."""
     try:
         return parse_grid(text)
     except ValueError as exc:
@@ -19,7 +20,7 @@ def grid_arg(text: str) -> tuple[int, int]:
 
 
 def positive_int(text: str) -> int:
-    """argparse type for an integer >= 1."""
+    """Parse an integer >= 1 for argparse."""
     try:
         value = int(text)
     except ValueError:
@@ -30,7 +31,7 @@ def positive_int(text: str) -> int:
 
 
 def nonneg_int(text: str) -> int:
-    """argparse type for an integer >= 0 (seeds)."""
+    """Parse an integer >= 0 (seeds) for argparse."""
     try:
         value = int(text)
     except ValueError:
@@ -41,7 +42,7 @@ def nonneg_int(text: str) -> int:
 
 
 def positive_float(text: str) -> float:
-    """argparse type for a finite number > 0."""
+    """Parse a finite number > 0 for argparse."""
     try:
         value = float(text)
     except ValueError:
@@ -52,7 +53,7 @@ def positive_float(text: str) -> float:
 
 
 def fpoc_param(text: str) -> tuple[str, object]:
-    """argparse type for ``name=value``; the value is parsed as YAML (numbers, lists, words)."""
+    """Parse ``name=value`` for argparse; the value is read as YAML (numbers, lists, words)."""
     name, sep, value = text.partition('=')
     if not sep or not name.strip():
         raise argparse.ArgumentTypeError(f'expected name=value, got {text!r}')
@@ -79,12 +80,12 @@ def add_task_args(parser: argparse.ArgumentParser, grid: str = '7x7', spacing: f
 
 
 def task_from_args(args) -> tuple[Grid, object]:
-    """Build ``(grid, fpoc)`` from :func:`add_task_args` arguments (ValueError names the problem)."""
+    """Build ``(grid, fpoc)`` from :func:`add_task_args` arguments; errors name the problem."""
     grid = Grid(args.grid[0], args.grid[1], args.spacing_deg)
     params = dict(args.fpoc_param)
     names = parameter_names(args.fpoc)
     for name in params:
         if name not in names:
-            raise ValueError(f"unknown FPOC parameter {name!r} for {args.fpoc!r}; valid: "
+            raise ValueError(f'unknown FPOC parameter {name!r} for {args.fpoc!r}; valid: '
                              f"{', '.join(names)}")
     return grid, make_fpoc(args.fpoc, **params)

@@ -1,3 +1,5 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """``ipomdp-gaze demo``: the main job of ``make demo``."""
 from __future__ import annotations
 

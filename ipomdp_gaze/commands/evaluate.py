@@ -1,15 +1,16 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """``ipomdp-gaze evaluate``: fixations to 90% correct for baselines and policy files."""
 from __future__ import annotations
 
 import json
 from pathlib import Path
 
-import numpy as np
-
 from ipomdp_gaze.evaluation import fixations_to_90_ci
-from ipomdp_gaze.simulate import draw_targets, simulate
 from ipomdp_gaze.fpoc import dprime_matrix
-from policies.baselines import STRATEGIES, make_baseline
+from ipomdp_gaze.simulate import draw_targets, simulate
+import numpy as np
+from policies.baselines import make_baseline, STRATEGIES
 
 from .common import add_task_args, nonneg_int, positive_int, task_from_args
 
@@ -27,7 +28,7 @@ def add_parser(sub):
     p.add_argument('--episodes-greedy', type=positive_int, default=2000,
                    help='episodes for the slow ideal searcher (default 2000)')
     p.add_argument('--horizon', type=positive_int, default=None,
-                   help='fixations per episode (default N, the paper\'s T)')
+                   help="fixations per episode (default N, the paper's T)")
     p.add_argument('--seed', type=nonneg_int, default=0)
     p.add_argument('--bootstrap', type=positive_int, default=1000,
                    help='bootstrap resamples for the 95%% interval (default 1000)')
@@ -68,7 +69,7 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
 
 
 def format_table(result: dict) -> str:
-    """A plain-text table of fixations to 90% correct."""
+    """Format a plain-text table of fixations to 90% correct."""
     lines = [f"{'policy':<24} {'episodes':>8} {'fix->90%':>9} {'95% CI':>17} {'pc@1':>6} "
              f"{'pc@5':>6} {'pc@10':>6}"]
     for name, r in result['policies'].items():
@@ -85,7 +86,7 @@ def run(args) -> int:
     policies = load_policies(args, grid, fpoc)
     result = evaluate(grid, fpoc, policies, args.episodes, args.horizon, args.seed,
                       args.episodes_greedy, args.bootstrap)
-    print(f"{grid.rows}x{grid.cols} grid, {grid.spacing_deg} deg/cell, FPOC {fpoc.to_dict()}, "
+    print(f'{grid.rows}x{grid.cols} grid, {grid.spacing_deg} deg/cell, FPOC {fpoc.to_dict()}, '
           f"horizon {result['horizon']}, seed {args.seed}")
     print(format_table(result))
     if args.json:

@@ -1,12 +1,13 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
 """``ipomdp-gaze search``: one offline search, printed fixation by fixation."""
 from __future__ import annotations
 
-import numpy as np
-
-from ipomdp_gaze.belief import (entropy, map_cell, normalize_log, uniform_log_belief)
+from ipomdp_gaze.belief import entropy, map_cell, normalize_log, uniform_log_belief
 from ipomdp_gaze.fpoc import dprime_matrix
 from ipomdp_gaze.simulate import sample_observation
-from policies.baselines import STRATEGIES, make_baseline
+import numpy as np
+from policies.baselines import make_baseline, STRATEGIES
 
 from .common import add_task_args, nonneg_int, positive_int, task_from_args
 

@@ -1,0 +1,401 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+``ipomdp-gaze reproduce``: regenerate ``docs/reproduction.md`` and its figures.
+
+Everything comes from the shipped kernels and fixed seeds, so a rerun gives the same numbers;
+``--retrain`` retrains every shipped kernel first (long). Each figure and table is measured in
+the run that writes the report, with common random numbers across policies.
+"""
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+import time
+
+from ipomdp_gaze.evaluation import fixations_to_90_ci, paired_difference_ci
+from ipomdp_gaze.fpoc import dprime_matrix, dprime_table
+from ipomdp_gaze.simulate import draw_targets, simulate
+import numpy as np
+from policies.baselines import make_baseline
+from policies.conv import radial_bins
+
+from .common import nonneg_int, positive_int
+
+ROOT = Path(__file__).resolve().parents[2]
+KERNELS = ('human-7x7-infomax', 'human-11x11-infomax', 'human-11x11-fixate_target',
+           'exponential-11x11-infomax', 'camera-11x11-infomax')
+PAPER_7X7 = {'learned infomax': 7.86, 'greedy': 8.96, 'map': 9.25, 'random': 11.33}
+PAPER_11X11 = {'infomax-trained': 18.0, 'fixate-target-trained': 20.0}
+
+
+def add_parser(sub):
+    p = sub.add_parser('reproduce', help="regenerate docs/reproduction.md and the paper's figures",
+                       description='Reproduce Table I and Figs. 3-6 of Butko & Movellan (2008) '
+                                   'from the shipped kernels with fixed seeds.')
+    p.add_argument('--out', type=Path, default=ROOT / 'docs', help='output folder (default docs/)')
+    p.add_argument('--episodes', type=positive_int, default=20000)
+    p.add_argument('--episodes-greedy', type=positive_int, default=2000)
+    p.add_argument('--episodes-planner', type=positive_int, default=2000)
+    p.add_argument('--seed', type=nonneg_int, default=0)
+    p.add_argument('--bootstrap', type=positive_int, default=1000)
+    p.add_argument('--retrain', action='store_true', help='retrain every shipped kernel first')
+    p.set_defaults(run=run)
+
+
+def _load(name):
+    from policies.policy_file import load_policy_spec
+    return load_policy_spec(name)
+
+
+def _retrain(log):
+    from ipomdp_gaze.cli import main as cli_main
+    from policies.policy_file import resolve_source
+    for name in KERNELS:
+        spec = _load(name)
+        training = spec.training or {}
+        fpoc_args = []
+        for key, value in spec.fpoc.params().items():
+            fpoc_args += ['--fpoc-param', f'{key}={value}']
+        argv = ['train', '--grid', f'{spec.grid.rows}x{spec.grid.cols}',
+                '--spacing-deg', str(spec.grid.spacing_deg), '--fpoc', spec.fpoc.model,
+                *fpoc_args, '--reward', spec.reward, '--family', spec.family,
+                '--epochs', str(int(training.get('epochs', 300))),
+                '--seed', str(int(training.get('seed', 0))), '--out', str(resolve_source(name))]
+        if 'learning_rate' in training:
+            argv += ['--learning-rate', str(training['learning_rate'])]
+        log(f'retraining {name}: ipomdp-gaze {" ".join(argv)}')
+        if cli_main(argv) != 0:
+            raise RuntimeError(f'retraining {name} failed')
+
+
+class _Runner:
+    """Simulate policies on shared targets and noise; keep each one's correctness matrix."""
+
+    def __init__(self, grid, fpoc, episodes, seed, bootstrap):
+        self.grid, self.fpoc, self.seed = grid, fpoc, seed
+        self.episodes, self.bootstrap = episodes, bootstrap
+        self.d = dprime_matrix(grid, fpoc)
+        self.targets = draw_targets(grid.n_cells, episodes, seed)
+        self.correct, self.seconds = {}, {}
+
+    def run(self, name, policy, episodes=None):
+        n = self.episodes if episodes is None else min(episodes, self.episodes)
+        t0 = time.perf_counter()
+        result = simulate(self.grid, self.fpoc, policy, n, None, self.seed,
+                          targets=self.targets[:n], dprime=self.d)
+        self.seconds[name] = time.perf_counter() - t0
+        self.correct[name] = result.correct
+        return result
+
+    def summary(self, name):
+        correct = self.correct[name]
+        point, ci = fixations_to_90_ci(correct, self.grid.n_cells,
+                                       np.random.default_rng([self.seed, 7]), self.bootstrap)
+        return correct.shape[0], point, ci
+
+    def paired(self, a, b):
+        return paired_difference_ci(self.correct[a], self.correct[b], self.grid.n_cells,
+                                    np.random.default_rng([self.seed, 8]), self.bootstrap)
+
+
+def _fmt(point, ci):
+    if point is None:
+        return 'not reached'
+    return f'{point:.2f}' + (f' [{ci[0]:.2f}, {ci[1]:.2f}]' if ci else '')
+
+
+def _pyplot():
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def _radial_profile(spec):
+    values, bins = radial_bins(spec.grid)
+    kernel = spec.kernel
+    weight = np.array([kernel[bins == b].mean() for b in range(values.size)])
+    return np.sqrt(values), weight
+
+
+def preferred_offset_cells(kernel: np.ndarray) -> float:
+    """
+    Distance in cells from a single likely target to where the policy then looks.
+
+    With the belief on one cell j, ``score_k = K[r_j - r_k + R-1, c_j - c_k + C-1]``: the policy
+    looks at the offset of the kernel's largest entry (ties to the first, as argmax does).
+    """
+    rows, cols = kernel.shape
+    r, c = np.unravel_index(int(np.argmax(kernel)), kernel.shape)
+    return float(np.hypot(r - (rows - 1) // 2, c - (cols - 1) // 2))
+
+
+def _plot_kernels(plt, specs, titles, path, fpoc_panel=False):
+    n = len(specs)
+    rows = 3 if fpoc_panel else 2
+    fig, axes = plt.subplots(rows, n, figsize=(3.6 * n, 3.1 * rows), squeeze=False)
+    for i, (spec, title) in enumerate(zip(specs, titles)):
+        row = 0
+        if fpoc_panel:
+            ax = axes[0, i]
+            ecc_cells = np.linspace(0, spec.grid.rows - 1, 200)
+            ax.plot(ecc_cells, spec.fpoc(ecc_cells * spec.grid.spacing_deg, 0.0), color='k')
+            ax.set_title(f'FPOC: {spec.fpoc.model}')
+            ax.set_xlabel('eccentricity (cells)')
+            ax.set_ylabel("d'")
+            row = 1
+        dist, weight = _radial_profile(spec)
+        ax = axes[row, i]
+        ax.plot(dist, weight, 'o-', ms=3)
+        ax.axhline(0, color='0.6', lw=0.8)
+        ax.set_title(title)
+        ax.set_xlabel('distance from fixation (cells)')
+        ax.set_ylabel('kernel weight')
+        ax = axes[row + 1, i]
+        lim = np.max(np.abs(spec.kernel))
+        im = ax.imshow(spec.kernel, cmap='RdBu_r', vmin=-lim, vmax=lim,
+                       extent=[-(spec.grid.cols - 0.5), spec.grid.cols - 0.5,
+                               spec.grid.rows - 0.5, -(spec.grid.rows - 0.5)])
+        ax.set_xlabel('column offset (cells)')
+        ax.set_ylabel('row offset (cells)')
+        fig.colorbar(im, ax=ax, shrink=0.8)
+        if spec.fpoc.model == 'camera':
+            inside = dprime_table(spec.grid, spec.fpoc) > 0
+            ax.contour(np.arange(-(spec.grid.cols - 1), spec.grid.cols),
+                       np.arange(-(spec.grid.rows - 1), spec.grid.rows), inside.astype(float),
+                       levels=[0.5], colors='k', linewidths=1)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _read_curve(path):
+    with open(path, newline='') as fh:
+        rows = list(csv.DictReader(fh))
+    out = {}
+    for key in ('epoch', 'mean_return', 'fixations_to_90', 'wall_seconds'):
+        out[key] = np.array([float(r[key]) if r.get(key) not in (None, '') else np.nan
+                             for r in rows])
+    return out
+
+
+def run(args) -> int:
+    out, figures = args.out, args.out / 'figures'
+    figures.mkdir(parents=True, exist_ok=True)
+    started = time.perf_counter()
+
+    def log(message):
+        print(f'[{time.perf_counter() - started:6.0f} s] {message}', flush=True)
+
+    if args.retrain:
+        _retrain(log)
+    specs = {name: _load(name) for name in KERNELS}
+    plt = _pyplot()
+    lines = []
+
+    # Table I: 7x7, human FPOC.
+    h7 = specs['human-7x7-infomax']
+    grid7, fpoc7 = h7.grid, h7.fpoc
+    r7 = _Runner(grid7, fpoc7, args.episodes, args.seed, args.bootstrap)
+    policies7 = {'learned infomax': h7.make_policy('argmax'),
+                 'elm': make_baseline('elm', grid7, fpoc7),
+                 'map': make_baseline('map', grid7, fpoc7),
+                 'center': make_baseline('center', grid7, fpoc7),
+                 'random': make_baseline('random', grid7, fpoc7)}
+    for name, policy in policies7.items():
+        log(f'7x7 {name}')
+        r7.run(name, policy)
+    log('7x7 greedy (ideal searcher)')
+    r7.run('greedy', make_baseline('greedy', grid7, fpoc7), args.episodes_greedy)
+    from policies.planner import make_planner
+    log('7x7 planner')
+    planner = make_planner(grid7, fpoc7, base=h7.make_policy('argmax'))
+    result = r7.run('planner', planner, args.episodes_planner)
+    planner_ms = 1000 * r7.seconds['planner'] / result.fixations.size
+
+    # Figure 4a.
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    for name in ('planner', 'learned infomax', 'elm', 'greedy', 'map', 'center', 'random'):
+        pc = r7.correct[name].mean(axis=0)[:25]
+        ax.plot(np.arange(1, pc.size + 1), pc, marker='o', ms=3, label=name)
+    ax.axhline(0.9, color='0.5', ls='--', lw=0.8)
+    ax.set_xlabel('fixations')
+    ax.set_ylabel('percent correct (49-AFC)')
+    ax.set_title('7x7, human FPOC: percent correct vs fixations')
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(figures / 'fig4a_percent_correct.png', dpi=110)
+    plt.close(fig)
+
+    # 11x11: infomax-trained vs fixate-target-trained.
+    h11 = specs['human-11x11-infomax']
+    r11 = _Runner(h11.grid, h11.fpoc, args.episodes, args.seed, args.bootstrap)
+    ft11 = specs['human-11x11-fixate_target']
+    policies11 = {'infomax-trained': h11.make_policy('argmax'),
+                  'fixate-target-trained': ft11.make_policy('argmax'),
+                  'elm': make_baseline('elm', h11.grid, h11.fpoc),
+                  'map': make_baseline('map', h11.grid, h11.fpoc)}
+    for name, policy in policies11.items():
+        log(f'11x11 {name}')
+        r11.run(name, policy)
+
+    # Other FPOCs at 11x11 (the kernels of Fig. 6), each against ELM and MAP on its own task.
+    others = {}
+    for name in ('exponential-11x11-infomax', 'camera-11x11-infomax'):
+        spec = specs[name]
+        runner = _Runner(spec.grid, spec.fpoc, args.episodes, args.seed, args.bootstrap)
+        for label, policy in (('learned', spec.make_policy('argmax')),
+                              ('elm', make_baseline('elm', spec.grid, spec.fpoc)),
+                              ('map', make_baseline('map', spec.grid, spec.fpoc))):
+            log(f'{name} {label}')
+            runner.run(label, policy)
+        others[name] = runner
+
+    # Kernel figures.
+    _plot_kernels(plt, [h7], ['learned infomax kernel, 7x7 human'],
+                  figures / 'fig4b_kernel_human_7x7.png')
+    _plot_kernels(plt, [h11, specs['human-11x11-fixate_target']],
+                  ['infomax, 11x11 human', 'fixate target, 11x11 human'],
+                  figures / 'fig5a_kernels_11x11.png')
+    fig6 = [h11, specs['exponential-11x11-infomax'], specs['camera-11x11-infomax']]
+    _plot_kernels(plt, fig6, ['human', 'exponential', 'camera'],
+                  figures / 'fig6_kernels_by_fpoc.png', fpoc_panel=True)
+
+    # Figure 3: learning curves with and without weight sharing.
+    data = ROOT / 'docs' / 'data'
+    curves = {'weight sharing (conv, 27 weights)': data / 'curve-human-7x7-conv.csv',
+              'no weight sharing (logistic, 2401 weights)': data / 'curve-human-7x7-logistic.csv'}
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    for label, path in curves.items():
+        if not path.exists():
+            raise FileNotFoundError(f'learning curve {path} is missing (train with --family)')
+        c = _read_curve(path)
+        axes[0].plot(c['epoch'], c['mean_return'], label=label)
+        ok = ~np.isnan(c['fixations_to_90'])
+        axes[1].plot(c['epoch'][ok], c['fixations_to_90'][ok], 'o-', ms=3, label=label)
+    axes[0].set_xlabel('epoch (150 episodes each)')
+    axes[0].set_ylabel('mean return (infomax)')
+    axes[1].set_xlabel('epoch (150 episodes each)')
+    axes[1].set_ylabel('fixations to 90% correct')
+    axes[1].axhline(PAPER_7X7['learned infomax'], color='0.5', ls='--', lw=0.8)
+    for ax in axes:
+        ax.set_xscale('log')
+        ax.legend()
+    fig.suptitle('7x7, human FPOC: learning with and without weight sharing')
+    fig.tight_layout()
+    fig.savefig(figures / 'fig3_learning_curves.png', dpi=110)
+    plt.close(fig)
+
+    lines += _report(args, r7, r11, others, specs, planner_ms, curves)
+    (out / 'reproduction.md').write_text('\n'.join(lines) + '\n')
+    log(f'wrote {out / "reproduction.md"} and {figures}/')
+    return 0
+
+
+def _report(args, r7, r11, others, specs, planner_ms, curves):
+    seed = args.seed
+    lines = ['# Reproducing Butko & Movellan (2008), "I-POMDP: An Infomax Model of Eye Movement"',
+             '',
+             f'Regenerated by `make reproduce` (`ipomdp-gaze reproduce --seed {seed}`) from the '
+             'shipped kernels in `policies/kernels/`; `--retrain` retrains them first. Every '
+             'policy in a table sees the same targets and observation noise (common random '
+             'numbers); intervals are 95% percentile bootstraps over episodes '
+             f'({args.bootstrap} resamples). Fixations to 90% correct are interpolated linearly '
+             'between fixations; the first fixation is chosen by the policy from the uniform '
+             'prior (ties to the lowest cell index).',
+             '',
+             '## Table I: fixations to 90% correct, 7x7 (49-AFC), human FPOC',
+             '',
+             f'Human FPOC at the calibrated default (noise_contrast 0.20, foveal_dprime 2.0, '
+             f'0.42 deg/cell); argmax actions; {args.episodes} episodes (the ideal searcher '
+             f'{min(args.episodes_greedy, args.episodes)}, the planner '
+             f'{min(args.episodes_planner, args.episodes)}, each on the first episodes of the '
+             'same set).',
+             '',
+             '| policy | paper | ours [95% CI] | episodes |',
+             '|---|---|---|---|']
+    labels = {'learned infomax': 'learned infomax (conv kernel)', 'greedy':
+              'percent-correct greedy (ideal searcher)', 'map': 'fixate target (MAP)',
+              'random': 'fixate random', 'elm': 'ELM (N&G 2009)', 'center': 'fixate centre',
+              'planner': 'rollout planner (ours, beyond the paper)'}
+    for name in ('learned infomax', 'greedy', 'map', 'random', 'elm', 'center', 'planner'):
+        n, point, ci = r7.summary(name)
+        paper = PAPER_7X7.get(name)
+        lines.append(f"| {labels[name]} | {'' if paper is None else paper} | "
+                     f'{_fmt(point, ci)} | {n} |')
+    lines += ['', 'Paired differences (same episodes; negative = fewer fixations):', '']
+    for a, b in (('learned infomax', 'elm'), ('learned infomax', 'map'),
+                 ('planner', 'elm'), ('planner', 'greedy'), ('planner', 'learned infomax'),
+                 ('greedy', 'elm')):
+        diff, ci = r7.paired(a, b)
+        n = min(r7.correct[a].shape[0], r7.correct[b].shape[0])
+        lines.append(f'- {a} - {b}: {_fmt(diff, ci)} fixations ({n} paired episodes)')
+    lines += ['', f'Planner decision time: {planner_ms:.2f} ms per decision, measured as wall '
+              'time of the batched evaluation divided by its decisions (this machine, 2 cores).',
+              '', '![Fig. 4a](figures/fig4a_percent_correct.png)', '']
+
+    lines += ['## 11x11 (121-AFC), human FPOC: infomax-trained vs fixate-target-trained', '',
+              '| policy | paper | ours [95% CI] | episodes |', '|---|---|---|---|']
+    for name in ('infomax-trained', 'fixate-target-trained', 'elm', 'map'):
+        n, point, ci = r11.summary(name)
+        paper = PAPER_11X11.get(name)
+        lines.append(f"| {name} | {'' if paper is None else paper:} | {_fmt(point, ci)} | {n} |")
+    diff, ci = r11.paired('infomax-trained', 'fixate-target-trained')
+    lines += ['', f'Paired difference infomax-trained - fixate-target-trained: {_fmt(diff, ci)}.',
+              '']
+
+    lines += ['## Kernels of the other FPOCs (11x11)', '',
+              '| kernel | learned [95% CI] | ELM | MAP |', '|---|---|---|---|']
+    for name, runner in others.items():
+        cells = [_fmt(*runner.summary(label)[1:]) for label in ('learned', 'elm', 'map')]
+        spec = specs[name]
+        lines.append(f'| {name} ({spec.grid.spacing_deg} deg/cell, {spec.fpoc.to_dict()}) | '
+                     + ' | '.join(cells) + ' |')
+    lines += ['']
+
+    lines += ['## Where the learned kernels look (Figs. 4b, 5a, 6)', '',
+              'With the belief on a single cell, a convolutional policy looks at the offset of '
+              "its kernel's largest entry; the table gives that distance, the paper's claim, and "
+              'whether ours shows it.', '',
+              '| kernel | looks this far from a likely target | paper | holds? |',
+              '|---|---|---|---|']
+    claims = {'human-7x7-infomax': ('next to, not at', lambda d: 0 < d <= 2.5),
+              'human-11x11-infomax': ('next to, not at', lambda d: 0 < d <= 2.5),
+              'human-11x11-fixate_target': ('at it (when sure)', lambda d: d == 0),
+              'exponential-11x11-infomax': ('straight at it', lambda d: d == 0),
+              'camera-11x11-infomax': ('near the edge of the field of view', None)}
+    for name, (claim, check) in claims.items():
+        spec = specs[name]
+        dist = preferred_offset_cells(spec.kernel)
+        if check is None:
+            half = (dprime_table(spec.grid, spec.fpoc) > 0).sum(axis=1).max() // 2
+            holds = abs(dist - half) <= 1.0 and dist > 0
+            claim = f'{claim} (edge at {half} cells)'
+        else:
+            holds = check(dist)
+        lines.append(f"| {name} | {dist:.2f} cells | {claim} | {'yes' if holds else 'no'} |")
+    lines += ['', '![Fig. 4b](figures/fig4b_kernel_human_7x7.png)', '',
+              '![Fig. 5a](figures/fig5a_kernels_11x11.png)', '',
+              '![Fig. 6](figures/fig6_kernels_by_fpoc.png)', '']
+
+    lines += ['## Fig. 3: learning with and without weight sharing', '']
+    speed = []
+    for label, path in curves.items():
+        c = _read_curve(path)
+        ok = np.where(c['fixations_to_90'] <= PAPER_7X7['learned infomax'])[0]
+        if ok.size:
+            speed.append((label, c['epoch'][ok[0]], c['wall_seconds'][ok[0]]))
+            lines.append(f'- {label}: first reaches {PAPER_7X7["learned infomax"]} fixations to '
+                         f'90% at epoch {c["epoch"][ok[0]]:.0f} '
+                         f'({c["wall_seconds"][ok[0]]:.0f} s wall).')
+        else:
+            best = np.nanmin(c['fixations_to_90'])
+            lines.append(f'- {label}: does not reach {PAPER_7X7["learned infomax"]} within '
+                         f'{c["epoch"][-1]:.0f} epochs (best {best:.2f}, '
+                         f'{c["wall_seconds"][-1]:.0f} s wall).')
+    lines += ['', '![Fig. 3](figures/fig3_learning_curves.png)', '']
+    notes = ROOT / 'docs' / 'reproduction_notes.md'
+    if notes.exists():
+        lines += [notes.read_text().rstrip(), '']
+    return lines

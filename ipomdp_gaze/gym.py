@@ -1,0 +1,128 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Gymnasium environment ``ipomdp_gaze/VisualSearch-v0``: the I-POMDP visual-search task.
+
+Each step fixates one cell (``Discrete(N)`` action), draws one observation per cell from the
+observation model (DESIGN.md section 1) and updates the belief. The observation is a ``Dict`` with
+the belief grid (or, with ``observe='evidence'``, the raw evidence of the last frame) and the
+current fixation. The reward is the infomax reward ``sum_i B_i log B_i`` of the new belief
+(``reward='fixate_target'``: the belief at the fixated cell). An episode terminates when the most
+likely cell reaches ``confidence`` and is truncated after ``max_steps`` fixations. The hidden
+target is in ``info['target']`` for oracle baselines.
+"""
+from __future__ import annotations
+
+import gymnasium
+from gymnasium import spaces
+import numpy as np
+
+from .belief import entropy, infomax_reward, map_cell, normalize_log, uniform_log_belief
+from .fpoc import dprime_matrix, FPOC, make_fpoc
+from .grid import Grid
+from .render import belief_heatmap, belief_text
+
+ENV_ID = 'ipomdp_gaze/VisualSearch-v0'
+REWARDS = ('infomax', 'fixate_target')
+OBSERVE = ('belief', 'evidence')
+
+
+class VisualSearchEnv(gymnasium.Env):
+    """Find a hidden target on a ``rows x cols`` grid by choosing fixations."""
+
+    metadata = {'render_modes': ['rgb_array', 'ansi'], 'render_fps': 4}
+
+    def __init__(self, rows: int = 7, cols: int = 7, spacing_deg: float = 0.42,
+                 fpoc: str | FPOC = 'human', fpoc_params: dict | None = None,
+                 reward: str = 'infomax', observe: str = 'belief', confidence: float = 0.95,
+                 max_steps: int | None = None, start_cell: int | None = None,
+                 render_mode: str | None = None):
+        self.grid = Grid(rows, cols, spacing_deg)
+        self.fpoc = fpoc if isinstance(fpoc, FPOC) else make_fpoc(fpoc, **(fpoc_params or {}))
+        if reward not in REWARDS:
+            raise ValueError(f"unknown reward {reward!r}; valid rewards: {', '.join(REWARDS)}")
+        if observe not in OBSERVE:
+            raise ValueError(f"unknown observe {observe!r}; valid: {', '.join(OBSERVE)}")
+        if not 0.0 < confidence <= 1.0:
+            raise ValueError(f'confidence must be in (0, 1], got {confidence!r}')
+        if render_mode is not None and render_mode not in self.metadata['render_modes']:
+            raise ValueError(f'unknown render_mode {render_mode!r}; valid: rgb_array, ansi')
+        n = self.grid.n_cells
+        self.reward_name, self.observe, self.confidence = reward, observe, float(confidence)
+        self.max_steps = n if max_steps is None else int(max_steps)
+        self.start_cell = self.grid.center_index if start_cell is None else int(start_cell)
+        if not 0 <= self.start_cell < n:
+            raise ValueError(f'start_cell must be a cell index below {n}, got {start_cell!r}')
+        self.render_mode = render_mode
+        self._d = dprime_matrix(self.grid, self.fpoc)
+        self.action_space = spaces.Discrete(n)
+        if observe == 'belief':
+            grid_space = spaces.Box(0.0, 1.0, shape=self.grid.shape, dtype=np.float64)
+        else:
+            grid_space = spaces.Box(-np.inf, np.inf, shape=self.grid.shape, dtype=np.float64)
+        self.observation_space = spaces.Dict({observe: grid_space, 'fixation': spaces.Discrete(n)})
+        self._log_b = uniform_log_belief(n)
+        self._evidence = np.zeros(n)
+        self._fixation = self.start_cell
+        self._target = 0
+        self._steps = 0
+
+    @property
+    def belief(self) -> np.ndarray:
+        """Return the current belief, shape (N,)."""
+        return np.exp(self._log_b)
+
+    def _obs(self):
+        data = self.belief if self.observe == 'belief' else self._evidence
+        return {self.observe: data.reshape(self.grid.shape).copy(), 'fixation': self._fixation}
+
+    def _info(self):
+        b = self.belief
+        guess = int(map_cell(b))
+        return {'target': self._target, 'map_cell': guess, 'map_probability': float(b[guess]),
+                'entropy': float(entropy(b)), 'steps': self._steps}
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        n = self.grid.n_cells
+        target = (options or {}).get('target')
+        self._target = int(self.np_random.integers(n)) if target is None else int(target)
+        self._log_b = uniform_log_belief(n)
+        self._evidence = np.zeros(n)
+        self._fixation = self.start_cell
+        self._steps = 0
+        return self._obs(), self._info()
+
+    def step(self, action):
+        k = int(action)
+        if not self.action_space.contains(k):
+            raise ValueError(
+                f'action must be a cell index in [0, {self.grid.n_cells}), got {action!r}')
+        d_k = self._d[:, k]
+        obs = self.np_random.standard_normal(self.grid.n_cells)
+        obs[self._target] += d_k[self._target]
+        self._log_b += d_k * (obs - 0.5 * d_k)
+        normalize_log(self._log_b)
+        self._evidence, self._fixation = obs, k
+        self._steps += 1
+        b = self.belief
+        reward = float(infomax_reward(b)) if self.reward_name == 'infomax' else float(b[k])
+        terminated = bool(b.max() >= self.confidence)
+        truncated = bool(not terminated and self._steps >= self.max_steps)
+        return self._obs(), reward, terminated, truncated, self._info()
+
+    def render(self):
+        if self.render_mode == 'rgb_array':
+            return belief_heatmap(self.belief, *self.grid.shape, self._fixation)
+        if self.render_mode == 'ansi':
+            return belief_text(self.belief, *self.grid.shape, self._fixation)
+        return None
+
+
+def register_env() -> None:
+    """Register :data:`ENV_ID` with Gymnasium (idempotent)."""
+    if ENV_ID not in gymnasium.registry:
+        gymnasium.register(id=ENV_ID, entry_point='ipomdp_gaze.gym:VisualSearchEnv')
+
+
+register_env()

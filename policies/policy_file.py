@@ -1,0 +1,399 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Policy files: a learned policy with the task it was trained for, as YAML.
+
+Format ``ipomdp_gaze/policy-v1`` (issue 3)::
+
+    format: ipomdp_gaze/policy-v1
+    grid: {rows: 7, cols: 7, spacing_deg: 0.42}
+    fpoc: {model: human, noise_contrast: 0.2, foveal_dprime: 2.0}
+    reward: infomax                  # or fixate_target
+    family: conv                     # or logistic
+    action: argmax                   # or sample; argmax if absent
+    kernel: [[...], ...]             # conv: (2*rows-1) x (2*cols-1); authoritative
+    radial: {squared_distance: [...], weight: [...]}   # conv, optional: must agree with kernel
+    theta: [[...], ...]              # logistic: N x N, score_k = sum_j theta[k][j] * B_j
+    training: {epochs: .., episodes_per_epoch: 150, learning_rate: .., beta: .., seed: ..}
+    evaluation: {episodes: .., fixations_to_90: .., ci95: [.., ..]}
+
+Required: ``format``, ``grid``, ``fpoc``, ``reward``, ``family`` and the family's array
+(``kernel`` or ``theta``). Loading uses ``yaml.safe_load`` only and names exactly what is wrong
+with a file (:class:`PolicyFileError`). A source is a path or the name of a shipped kernel
+(``policies/kernels/<name>.yaml``, e.g. ``human-7x7-infomax``).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+import math
+from pathlib import Path
+from typing import Callable
+import warnings
+
+from ipomdp_gaze.fpoc import FPOC, fpoc_from_dict
+from ipomdp_gaze.grid import Grid
+import numpy as np
+import yaml
+
+from .conv import ACTIONS, ConvPolicy, radial_bins
+from .logistic import LogisticPolicy
+
+FORMAT = 'ipomdp_gaze/policy-v1'
+FAMILIES = ('conv', 'logistic')
+REWARDS = ('infomax', 'fixate_target')
+KERNEL_DIR = Path(__file__).resolve().parent / 'kernels'
+REQUIRED = ('format', 'grid', 'fpoc', 'reward', 'family')
+KEYS = REQUIRED + ('action', 'kernel', 'radial', 'theta', 'training', 'evaluation')
+ARRAY_KEY = {'conv': 'kernel', 'logistic': 'theta'}
+# Radial weights and the kernel agree when every entry is within this of its shared weight.
+RADIAL_RTOL = 1e-6
+
+
+class PolicyFileError(ValueError):
+    """A policy file (or policy specification) that cannot be used; the message says why."""
+
+
+class PolicyFileWarning(UserWarning):
+    """A policy file that loads but was made for a different task than the one it is used on."""
+
+
+@dataclass
+class PolicySpec:
+    """
+    Everything a policy file holds, validated.
+
+    ``kernel`` is set for the ``conv`` family, ``theta`` for ``logistic``; ``training`` and
+    ``evaluation`` are the free-form records of how the policy was made and how well it did.
+    """
+
+    grid: Grid
+    fpoc: FPOC
+    reward: str
+    family: str
+    action: str = 'argmax'
+    kernel: np.ndarray | None = None
+    theta: np.ndarray | None = None
+    training: dict = field(default_factory=dict)
+    evaluation: dict = field(default_factory=dict)
+    path: Path | None = None
+
+    @property
+    def weights(self) -> np.ndarray:
+        """Return the family's array: the kernel (conv) or theta (logistic)."""
+        return self.kernel if self.family == 'conv' else self.theta
+
+    def radial(self) -> dict | None:
+        """Shared weights ``{'squared_distance', 'weight'}`` of a radial kernel, else None."""
+        if self.family != 'conv' or np.shape(self.kernel) != self.grid.kernel_shape:
+            return None
+        values, bins = radial_bins(self.grid)
+        weight = np.zeros(values.size)
+        weight[bins.ravel()] = self.kernel.ravel()
+        if not np.array_equal(weight[bins], self.kernel):
+            return None
+        return {'squared_distance': [int(v) for v in values],
+                'weight': [float(w) for w in weight]}
+
+    def make_policy(self, action: str | None = None):
+        """Build the policy object (:class:`ConvPolicy` or :class:`LogisticPolicy`)."""
+        action = self.action if action is None else action
+        if self.family == 'conv':
+            policy = ConvPolicy(self.grid, self.kernel, action=action)
+        else:
+            policy = LogisticPolicy(self.grid, self.theta, action=action)
+        if self.path is not None:
+            policy.name = self.path.stem
+        return policy
+
+    def to_dict(self) -> dict:
+        """Return the YAML document as plain Python types (what :func:`save_policy` writes)."""
+        doc = {'format': FORMAT, 'grid': self.grid.to_dict(), 'fpoc': _plain(self.fpoc.to_dict()),
+               'reward': self.reward, 'family': self.family, 'action': self.action}
+        if self.family == 'conv':
+            doc['kernel'] = _plain(self.kernel)
+            radial = self.radial()
+            if radial is not None:
+                doc['radial'] = radial
+        else:
+            doc['theta'] = _plain(self.theta)
+        doc['training'] = _plain(dict(self.training))
+        doc['evaluation'] = _plain(dict(self.evaluation))
+        return doc
+
+
+def _plain(value):
+    """Convert numpy scalars and arrays (nested in dicts and lists) to plain Python types."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    return value
+
+
+def shipped_kernels() -> list[str]:
+    """Names of the kernels shipped with the package (``policies/kernels/*.yaml`` stems)."""
+    return sorted(p.stem for p in KERNEL_DIR.glob('*.yaml'))
+
+
+def resolve_source(source) -> Path:
+    """
+    Resolve a source: an existing path, or a shipped kernel name (with or without .yaml).
+
+    Raises
+    ------
+    PolicyFileError
+        If it is neither, listing the shipped names.
+
+    """
+    path = Path(source)
+    if path.is_file():
+        return path
+    name = path.name[:-5] if path.name.endswith('.yaml') else path.name
+    if str(source) in (name, name + '.yaml'):
+        shipped = KERNEL_DIR / f'{name}.yaml'
+        if shipped.is_file():
+            return shipped
+    names = ', '.join(shipped_kernels()) or 'none'
+    raise PolicyFileError(f'policy file {str(source)!r} not found and not a shipped kernel '
+                          f'name (shipped: {names})')
+
+
+def _array(doc: dict, key: str, shape: tuple[int, int], what: str) -> np.ndarray:
+    value = doc[key]
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise PolicyFileError(f'{key} must be a list of lists of numbers '
+                              f'(a {shape[0]} x {shape[1]} array)') from None
+    if array.ndim != 2:
+        raise PolicyFileError(f'{key} must be a 2-D list of lists, got {array.ndim} dimension(s)')
+    if array.shape != shape:
+        raise PolicyFileError(f'{key} has shape {array.shape} but {what} needs {shape}')
+    bad = np.argwhere(~np.isfinite(array))
+    if bad.size:
+        r, c = (int(x) for x in bad[0])
+        raise PolicyFileError(f'non-finite values in {key}: {bad.shape[0]} entries, the first '
+                              f'at [{r}][{c}] is {array[r, c]}')
+    return array
+
+
+def _grid(block) -> Grid:
+    if not isinstance(block, dict):
+        raise PolicyFileError('grid must be a mapping {rows, cols, spacing_deg}')
+    for key in ('rows', 'cols', 'spacing_deg'):
+        if key not in block:
+            raise PolicyFileError(f'missing key grid.{key}')
+    unknown = sorted(set(block) - {'rows', 'cols', 'spacing_deg'})
+    if unknown:
+        raise PolicyFileError(f'unknown key grid.{unknown[0]}; valid: rows, cols, spacing_deg')
+    for key in ('rows', 'cols'):
+        value = block[key]
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise PolicyFileError(f'grid.{key} must be a positive integer, got {value!r}')
+    spacing = block['spacing_deg']
+    if isinstance(spacing, bool) or not isinstance(spacing, (int, float)) \
+            or not math.isfinite(spacing) or spacing <= 0:
+        raise PolicyFileError(f'grid.spacing_deg must be a positive number, got {spacing!r}')
+    return Grid(block['rows'], block['cols'], float(spacing))
+
+
+def _choice(doc: dict, key: str, valid: tuple[str, ...]) -> str:
+    value = doc[key]
+    if value not in valid:
+        raise PolicyFileError(f"unknown {key} {value!r}; valid: {', '.join(valid)}")
+    return value
+
+
+def _check_radial(block, grid: Grid, kernel: np.ndarray) -> None:
+    if not isinstance(block, dict):
+        raise PolicyFileError('radial must be a mapping {squared_distance, weight}')
+    for key in ('squared_distance', 'weight'):
+        if key not in block:
+            raise PolicyFileError(f'missing key radial.{key}')
+    values, bins = radial_bins(grid)
+    try:
+        sq = np.asarray(block['squared_distance'], dtype=float)
+        weight = np.asarray(block['weight'], dtype=float)
+    except (TypeError, ValueError):
+        raise PolicyFileError('radial.squared_distance and radial.weight must be lists of '
+                              'numbers') from None
+    if sq.shape != values.shape or not np.array_equal(sq, values):
+        raise PolicyFileError(f'radial.squared_distance must list the {values.size} distinct '
+                              f'squared distances of a {grid.rows}x{grid.cols} grid '
+                              f'({", ".join(str(int(v)) for v in values[:4])}, ...)')
+    if weight.shape != values.shape:
+        raise PolicyFileError(f'radial.weight has {weight.size} values but '
+                              f'radial.squared_distance has {values.size}')
+    if not np.all(np.isfinite(weight)):
+        raise PolicyFileError('non-finite values in radial.weight')
+    expanded = weight[bins]
+    tol = RADIAL_RTOL * max(1.0, float(np.max(np.abs(kernel))))
+    off = np.argwhere(np.abs(expanded - kernel) > tol)
+    if off.size:
+        r, c = (int(x) for x in off[0])
+        raise PolicyFileError(
+            f'radial disagrees with kernel: squared_distance {int(values[bins[r, c]])} has '
+            f'weight {float(expanded[r, c])!r} but kernel[{r}][{c}] is {float(kernel[r, c])!r}')
+
+
+def _record(doc: dict, key: str) -> dict:
+    block = doc.get(key)
+    if block is None:
+        return {}
+    if not isinstance(block, dict):
+        raise PolicyFileError(f'{key} must be a mapping')
+    if key == 'evaluation':
+        f90 = block.get('fixations_to_90')
+        if f90 is not None and (isinstance(f90, bool) or not isinstance(f90, (int, float))):
+            raise PolicyFileError(f'evaluation.fixations_to_90 must be a number or null, '
+                                  f'got {f90!r}')
+        ci = block.get('ci95')
+        if ci is not None and not (isinstance(ci, list) and len(ci) == 2 and all(
+                isinstance(x, (int, float)) and not isinstance(x, bool) for x in ci)):
+            raise PolicyFileError(f'evaluation.ci95 must be [low, high] or null, got {ci!r}')
+    return dict(block)
+
+
+def spec_from_dict(doc, path: Path | None = None) -> PolicySpec:
+    """
+    Validate a parsed policy document and build its :class:`PolicySpec`.
+
+    Raises
+    ------
+    PolicyFileError
+        Naming the first problem found.
+
+    """
+    if not isinstance(doc, dict):
+        raise PolicyFileError(f'a policy file must be a YAML mapping, got '
+                              f'{type(doc).__name__}')
+    for key in REQUIRED:
+        if key not in doc:
+            raise PolicyFileError(f'missing key {key}')
+    unknown = sorted(str(k) for k in set(doc) - set(KEYS))
+    if unknown:
+        raise PolicyFileError(f"unknown key {unknown[0]}; valid: {', '.join(KEYS)}")
+    if doc['format'] != FORMAT:
+        raise PolicyFileError(f"wrong format string {doc['format']!r}; expected {FORMAT!r}")
+    grid = _grid(doc['grid'])
+    try:
+        fpoc = fpoc_from_dict(doc['fpoc'])
+    except ValueError as exc:
+        raise PolicyFileError(f'fpoc: {exc}') from None
+    reward = _choice(doc, 'reward', REWARDS)
+    family = _choice(doc, 'family', FAMILIES)
+    action = 'argmax' if doc.get('action') is None else _choice(doc, 'action', ACTIONS)
+    key = ARRAY_KEY[family]
+    other = ARRAY_KEY['logistic' if family == 'conv' else 'conv']
+    if key not in doc:
+        raise PolicyFileError(f'missing key {key} (required for family {family})')
+    if other in doc:
+        raise PolicyFileError(f'family {family} takes {key}, not {other}')
+    if family == 'logistic' and 'radial' in doc:
+        raise PolicyFileError('family logistic takes theta, not radial')
+    kernel = theta = None
+    if family == 'conv':
+        kernel = _array(doc, 'kernel', grid.kernel_shape, f'a {grid.rows}x{grid.cols} grid')
+        if 'radial' in doc:
+            _check_radial(doc['radial'], grid, kernel)
+    else:
+        n = grid.n_cells
+        theta = _array(doc, 'theta', (n, n), f'a {grid.rows}x{grid.cols} grid')
+    return PolicySpec(grid=grid, fpoc=fpoc, reward=reward, family=family, action=action,
+                      kernel=kernel, theta=theta, training=_record(doc, 'training'),
+                      evaluation=_record(doc, 'evaluation'), path=path)
+
+
+def load_policy_spec(source) -> PolicySpec:
+    """
+    Read and validate a policy file given by path or shipped kernel name.
+
+    Raises
+    ------
+    PolicyFileError
+        If the file is missing, is not YAML, or breaks the schema; the message names the file
+        and the problem.
+
+    """
+    path = resolve_source(source)
+    try:
+        text = path.read_text(encoding='utf-8')
+    except (OSError, UnicodeDecodeError) as exc:
+        raise PolicyFileError(f'{path}: cannot read: {exc}') from None
+    try:
+        doc = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, 'problem_mark', None)
+        where = f' at line {mark.line + 1}' if mark is not None else ''
+        raise PolicyFileError(f'{path}: not YAML{where}') from None
+    try:
+        return spec_from_dict(doc, path=path)
+    except PolicyFileError as exc:
+        raise PolicyFileError(f'{path}: {exc}') from None
+
+
+def _warn(message: str) -> None:
+    warnings.warn(message, PolicyFileWarning, stacklevel=3)
+
+
+def check_task(spec: PolicySpec, grid: Grid | None = None, fpoc: FPOC | None = None,
+               warn: Callable[[str], None] | None = None) -> None:
+    """
+    Check a policy against the task it is used on.
+
+    A different number of rows or columns is an error (the policy cannot act on that grid); a
+    different spacing or FPOC is allowed (the policy is used off its training task) and reported
+    through ``warn(message)`` (default: a :class:`PolicyFileWarning`).
+    """
+    warn = _warn if warn is None else warn
+    where = f'{spec.path}: ' if spec.path is not None else ''
+    if grid is not None:
+        if (grid.rows, grid.cols) != (spec.grid.rows, spec.grid.cols):
+            raise PolicyFileError(f'{where}policy is for a {spec.grid.rows}x{spec.grid.cols} '
+                                  f'grid but the task grid is {grid.rows}x{grid.cols}')
+        if not math.isclose(grid.spacing_deg, spec.grid.spacing_deg, rel_tol=1e-9):
+            warn(f'{where}policy was trained at spacing_deg {spec.grid.spacing_deg} but is used '
+                 f'at {grid.spacing_deg}')
+    if fpoc is not None and fpoc != spec.fpoc:
+        warn(f'{where}policy was trained for FPOC {spec.fpoc.to_dict()} but is used with '
+             f'{fpoc.to_dict()}')
+
+
+def load_policy(source, grid: Grid | None = None, fpoc: FPOC | None = None,
+                action: str | None = None, warn: Callable[[str], None] | None = None):
+    """
+    Load a policy file (path or shipped name) as a policy object with ``select``.
+
+    Parameters
+    ----------
+    source : str or Path
+        A policy file or a shipped kernel name such as ``'camera-11x11-infomax'``.
+    grid, fpoc : optional
+        The task it will be used on: see :func:`check_task`.
+    action : {'argmax', 'sample'}, optional
+        Overrides the file's action rule.
+    warn : callable, optional
+        Receives a message when the policy is used off its training task.
+
+    """
+    spec = load_policy_spec(source)
+    check_task(spec, grid, fpoc, warn)
+    if action is not None and action not in ACTIONS:
+        raise PolicyFileError(f"unknown action {action!r}; valid: {', '.join(ACTIONS)}")
+    return spec.make_policy(action)
+
+
+def save_policy(path, spec: PolicySpec) -> Path:
+    """Write ``spec`` as a policy file (validated first, so what is written always loads)."""
+    doc = spec.to_dict()
+    spec_from_dict(doc)
+    path = Path(path)
+    if path.parent != Path(''):
+        path.parent.mkdir(parents=True, exist_ok=True)
+    text = yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=100)
+    path.write_text(text, encoding='utf-8')
+    return path

@@ -1,0 +1,65 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""The ``ipomdp-gaze`` command line: help, JSON output and one-line errors."""
+import json
+import subprocess
+import sys
+
+from ipomdp_gaze.cli import main
+import pytest
+
+
+def run_cli(*args):
+    return subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', *args],
+                          capture_output=True, text=True, timeout=120)
+
+
+def test_help_lists_subcommands():
+    out = run_cli('--help')
+    assert out.returncode == 0
+    for name in ('evaluate', 'search', 'demo'):
+        assert name in out.stdout
+
+
+@pytest.mark.parametrize('args, message', [
+    (['evaluate', '--policy', 'saliency'], "invalid choice: 'saliency'"),
+    (['evaluate', '--grid', '7by7'], 'grid must look like ROWSxCOLS'),
+    (['evaluate', '--fpoc-param', 'bogus=1'], "unknown FPOC parameter 'bogus'"),
+    (['evaluate', '--fpoc-param', 'foveal_dprime=-2'], 'foveal_dprime must be finite and > 0'),
+    (['evaluate', '--fpoc-param', 'foveal_dprime'], 'expected name=value'),
+    (['evaluate', '--episodes', '0'], 'expected a positive integer'),
+    (['evaluate', '--spacing-deg', 'nan'], 'expected a positive number'),
+    (['evaluate', '--fpoc', 'laser'], "invalid choice: 'laser'"),
+    (['search', '--target', '99'], 'outside the 49-cell grid'),
+])
+def test_bad_arguments_exit_nonzero_with_one_line(args, message):
+    out = run_cli(*args)
+    assert out.returncode != 0
+    lines = out.stderr.strip().splitlines()
+    assert message in lines[-1]
+    assert 'Traceback' not in out.stderr
+    assert len([ln for ln in lines if 'error' in ln]) == 1
+
+
+def test_evaluate_writes_the_documented_json(tmp_path, capsys):
+    path = tmp_path / 'out.json'
+    rc = main(['evaluate', '--grid', '4x4', '--policy', 'map', '--policy', 'elm',
+               '--episodes', '300', '--seed', '3', '--json', str(path), '--bootstrap', '50'])
+    assert rc == 0
+    data = json.loads(path.read_text())
+    assert list(data) == ['grid', 'fpoc', 'episodes', 'horizon', 'seed', 'policies']
+    assert data['grid'] == {'rows': 4, 'cols': 4, 'spacing_deg': 0.42}
+    assert data['fpoc'] == {'model': 'human', 'noise_contrast': 0.2, 'foveal_dprime': 2.0}
+    assert data['horizon'] == 16 and data['episodes'] == 300 and data['seed'] == 3
+    for name in ('map', 'elm'):
+        r = data['policies'][name]
+        assert list(r) == ['episodes', 'fixations_to_90', 'ci95', 'percent_correct']
+        assert len(r['percent_correct']) == 16
+        assert r['ci95'][0] <= r['fixations_to_90'] <= r['ci95'][1]
+    assert 'elm' in capsys.readouterr().out
+
+
+def test_search_prints_each_fixation(capsys):
+    assert main(['search', '--grid', '5x5', '--target', '7', '--seed', '1']) == 0
+    out = capsys.readouterr().out
+    assert 'fixation   1: looked at' in out and 'found: the target is most likely at' in out

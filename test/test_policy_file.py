@@ -1,0 +1,326 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""Policy files: round trip, shipped names, and every error naming its problem."""
+from pathlib import Path
+
+from ipomdp_gaze.cli import main
+from ipomdp_gaze.fpoc import make_fpoc
+from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.simulate import simulate
+import numpy as np
+from policies import policy_file as pf
+from policies.conv import ConvPolicy, kernel_from_radial, radial_bins
+from policies.logistic import LogisticPolicy
+from policies.policy_file import (load_policy, load_policy_spec, PolicyFileError, PolicySpec,
+                                  save_policy, shipped_kernels)
+import pytest
+import yaml
+
+GRID = Grid(3, 4, 0.42)
+
+
+def conv_spec(grid=GRID, symmetric=True, seed=0):
+    """Make a conv spec with a random radial (or fully random) kernel."""
+    rng = np.random.default_rng(seed)
+    if symmetric:
+        kernel = kernel_from_radial(grid, rng.normal(size=radial_bins(grid)[0].size))
+    else:
+        kernel = rng.normal(size=grid.kernel_shape)
+    return PolicySpec(grid=grid, fpoc=make_fpoc('human'), reward='infomax', family='conv',
+                      kernel=kernel, training={'epochs': 3, 'seed': 1},
+                      evaluation={'episodes': 100, 'fixations_to_90': 5.5, 'ci95': [5.0, 6.0]})
+
+
+def logistic_spec(grid=GRID):
+    rng = np.random.default_rng(1)
+    return PolicySpec(grid=grid, fpoc=make_fpoc('camera', dprime=3.0), reward='fixate_target',
+                      family='logistic', action='sample',
+                      theta=rng.normal(size=(grid.n_cells, grid.n_cells)))
+
+
+def write_doc(tmp_path, doc, name='p.yaml'):
+    path = tmp_path / name
+    path.write_text(yaml.safe_dump(doc) if not isinstance(doc, str) else doc)
+    return path
+
+
+def good_doc():
+    return conv_spec().to_dict()
+
+
+@pytest.mark.parametrize('symmetric', [True, False])
+def test_conv_round_trip_is_exact(tmp_path, symmetric):
+    spec = conv_spec(symmetric=symmetric)
+    path = save_policy(tmp_path / 'sub' / 'k.yaml', spec)
+    back = load_policy_spec(path)
+    assert back.grid == spec.grid and back.fpoc == spec.fpoc
+    assert (back.reward, back.family, back.action) == ('infomax', 'conv', 'argmax')
+    np.testing.assert_array_equal(back.kernel, spec.kernel)
+    assert back.theta is None
+    assert back.training == {'epochs': 3, 'seed': 1}
+    assert back.evaluation['ci95'] == [5.0, 6.0]
+    assert back.path == path
+    doc = yaml.safe_load(path.read_text())
+    assert doc['format'] == 'ipomdp_gaze/policy-v1'
+    # The radial block is written exactly when the kernel is radially weight-shared.
+    assert ('radial' in doc) == symmetric
+    if symmetric:
+        assert len(doc['radial']['weight']) == radial_bins(GRID)[0].size
+
+
+def test_logistic_round_trip_is_exact(tmp_path):
+    spec = logistic_spec()
+    back = load_policy_spec(save_policy(tmp_path / 'l.yaml', spec))
+    np.testing.assert_array_equal(back.theta, spec.theta)
+    assert back.fpoc == make_fpoc('camera', dprime=3.0)
+    assert (back.reward, back.family, back.action) == ('fixate_target', 'logistic', 'sample')
+    policy = load_policy(tmp_path / 'l.yaml')
+    assert isinstance(policy, LogisticPolicy) and policy.action == 'sample'
+
+
+def test_radial_counts_match_the_paper():
+    assert radial_bins(Grid(7, 7))[0].size == 27
+    assert radial_bins(Grid(11, 11))[0].size == 61
+
+
+def test_loaded_conv_policy_acts_like_the_kernel(tmp_path):
+    grid = Grid(5, 5)
+    spec = conv_spec(grid, symmetric=False, seed=3)
+    path = save_policy(tmp_path / 'c.yaml', spec)
+    policy = load_policy(path, grid=grid, fpoc=make_fpoc('human'))
+    assert isinstance(policy, ConvPolicy) and policy.name == 'c'
+    fpoc = make_fpoc('human')
+    a = simulate(grid, fpoc, policy, 50, seed=4)
+    b = simulate(grid, fpoc, ConvPolicy(grid, spec.kernel), 50, seed=4)
+    np.testing.assert_array_equal(a.fixations, b.fixations)
+
+
+def test_action_override_and_default(tmp_path):
+    doc = good_doc()
+    del doc['action']
+    path = write_doc(tmp_path, doc)
+    assert load_policy(path).action == 'argmax'
+    assert load_policy(path, action='sample').action == 'sample'
+    with pytest.raises(PolicyFileError, match="unknown action 'best'"):
+        load_policy(path, action='best')
+
+
+def test_grid_mismatch_is_an_error(tmp_path):
+    path = save_policy(tmp_path / 'k.yaml', conv_spec())
+    with pytest.raises(PolicyFileError, match=r'3x4 grid but the task grid is 4x3'):
+        load_policy(path, grid=Grid(4, 3))
+
+
+def test_fpoc_or_spacing_mismatch_warns(tmp_path):
+    path = save_policy(tmp_path / 'k.yaml', conv_spec())
+    messages = []
+    load_policy(path, grid=Grid(3, 4, 0.42), fpoc=make_fpoc('human'), warn=messages.append)
+    assert messages == []
+    policy = load_policy(path, grid=Grid(3, 4, 0.5), fpoc=make_fpoc('exponential'),
+                         warn=messages.append)
+    assert isinstance(policy, ConvPolicy)
+    assert len(messages) == 2
+    assert 'spacing_deg 0.42' in messages[0] and 'exponential' in messages[1]
+    with pytest.warns(pf.PolicyFileWarning, match='FPOC'):
+        load_policy(path, fpoc=make_fpoc('exponential'))
+
+
+def _break(doc, change):
+    doc = dict(doc)
+    change(doc)
+    return doc
+
+
+def _set(key, value):
+    return lambda d: d.__setitem__(key, value)
+
+
+def _delete(key):
+    return lambda d: d.pop(key)
+
+
+def _nested(block, key, value):
+    def change(d):
+        d[block] = dict(d[block])
+        if value is _MISSING:
+            del d[block][key]
+        else:
+            d[block][key] = value
+    return change
+
+
+_MISSING = object()
+
+
+def _kernel_entry(value):
+    def change(d):
+        d['kernel'] = [list(r) for r in d['kernel']]
+        d['kernel'][1][2] = value
+    return change
+
+
+ERRORS = [
+    ('missing-format', _delete('format'), 'missing key format'),
+    ('missing-grid', _delete('grid'), 'missing key grid'),
+    ('missing-fpoc', _delete('fpoc'), 'missing key fpoc'),
+    ('missing-reward', _delete('reward'), 'missing key reward'),
+    ('missing-family', _delete('family'), 'missing key family'),
+    ('missing-kernel', _delete('kernel'), r'missing key kernel \(required for family conv\)'),
+    ('wrong-format', _set('format', 'ipomdp_gaze/policy-v2'),
+     r"wrong format string 'ipomdp_gaze/policy-v2'"),
+    ('unknown-key', _set('kernal', [[1.0]]), 'unknown key kernal'),
+    ('unknown-family', _set('family', 'mlp'), r"unknown family 'mlp'; valid: conv, logistic"),
+    ('unknown-reward', _set('reward', 'entropy'), r"unknown reward 'entropy'"),
+    ('unknown-action', _set('action', 'best'), r"unknown action 'best'; valid: argmax, sample"),
+    ('grid-not-mapping', _set('grid', '7x7'), 'grid must be a mapping'),
+    ('grid-missing-rows', _nested('grid', 'rows', _MISSING), 'missing key grid.rows'),
+    ('grid-missing-spacing', _nested('grid', 'spacing_deg', _MISSING),
+     'missing key grid.spacing_deg'),
+    ('grid-bad-rows', _nested('grid', 'rows', 0), 'grid.rows must be a positive integer'),
+    ('grid-bad-spacing', _nested('grid', 'spacing_deg', -1.0), 'grid.spacing_deg must be'),
+    ('fpoc-unknown-model', _nested('fpoc', 'model', 'eagle'), "fpoc: unknown FPOC model 'eagle'"),
+    ('fpoc-unknown-param', _nested('fpoc', 'scale_deg', 2.0),
+     "fpoc: unknown parameter 'scale_deg'"),
+    ('fpoc-no-model', _nested('fpoc', 'model', _MISSING), "fpoc: .*'model'"),
+    ('kernel-shape', _set('kernel', [[0.0] * 5] * 5),
+     r'kernel has shape \(5, 5\) but a 3x4 grid needs \(5, 7\)'),
+    ('kernel-1d', _set('kernel', [0.0] * 35), 'kernel must be a 2-D list of lists'),
+    ('kernel-ragged', _set('kernel', [[0.0] * 7] * 4 + [[0.0] * 6]),
+     'kernel must be a list of lists of numbers'),
+    ('kernel-text', _kernel_entry('big'), 'kernel must be a list of lists of numbers'),
+    ('kernel-nan', _kernel_entry(float('nan')), r'non-finite values in kernel: 1 entries, '
+     r'the first at \[1\]\[2\]'),
+    ('kernel-inf', _kernel_entry(float('inf')), r'non-finite values in kernel'),
+    ('theta-for-conv', _set('theta', [[0.0]]), 'family conv takes kernel, not theta'),
+    ('radial-disagrees', _kernel_entry(123.0),
+     r'radial disagrees with kernel: squared_distance \d+ has weight .* kernel\[1\]\[2\] is 123'),
+    ('radial-wrong-distances', _nested('radial', 'squared_distance', [0, 1, 2]),
+     r'radial.squared_distance must list the 9 distinct squared distances of a 3x4 grid'),
+    ('radial-missing-weight', _nested('radial', 'weight', _MISSING),
+     'missing key radial.weight'),
+    ('radial-short-weight', _nested('radial', 'weight', [0.0]),
+     'radial.weight has 1 values but radial.squared_distance has 9'),
+    ('training-not-mapping', _set('training', [1, 2]), 'training must be a mapping'),
+    ('evaluation-bad-ci', _nested('evaluation', 'ci95', [1.0]), r'evaluation.ci95 must be'),
+    ('evaluation-bad-f90', _nested('evaluation', 'fixations_to_90', 'fast'),
+     'evaluation.fixations_to_90 must be a number or null'),
+]
+
+
+@pytest.mark.parametrize('name,change,message', ERRORS, ids=[e[0] for e in ERRORS])
+def test_every_error_names_its_problem(tmp_path, name, change, message):
+    path = write_doc(tmp_path, _break(good_doc(), change))
+    with pytest.raises(PolicyFileError, match=message) as info:
+        load_policy_spec(path)
+    assert str(path) in str(info.value)
+
+
+def test_logistic_errors(tmp_path):
+    doc = logistic_spec().to_dict()
+    path = write_doc(tmp_path, _break(doc, _delete('theta')))
+    with pytest.raises(PolicyFileError, match=r'missing key theta \(required for family logistic'):
+        load_policy_spec(path)
+    path = write_doc(tmp_path, _break(doc, _set('theta', [[0.0] * 12] * 11)))
+    with pytest.raises(PolicyFileError, match=r'theta has shape \(11, 12\) but a 3x4 grid '
+                                              r'needs \(12, 12\)'):
+        load_policy_spec(path)
+    bad = [list(r) for r in doc['theta']]
+    bad[4][0] = float('nan')
+    path = write_doc(tmp_path, _break(doc, _set('theta', bad)))
+    with pytest.raises(PolicyFileError, match=r'non-finite values in theta: 1 entries, the '
+                                              r'first at \[4\]\[0\] is nan'):
+        load_policy_spec(path)
+    path = write_doc(tmp_path, _break(doc, _set('kernel', [[0.0]])))
+    with pytest.raises(PolicyFileError, match='family logistic takes theta, not kernel'):
+        load_policy_spec(path)
+
+
+@pytest.mark.parametrize('text,message', [
+    ('grid: [unclosed', r'not YAML at line 1'),
+    ('- 1\n- 2\n', 'a policy file must be a YAML mapping, got list'),
+    ('', 'a policy file must be a YAML mapping, got NoneType'),
+    ('!!python/object/apply:os.system ["echo hi"]\n', 'not YAML'),
+])
+def test_not_a_policy_document(tmp_path, text, message):
+    path = write_doc(tmp_path, text)
+    with pytest.raises(PolicyFileError, match=message):
+        load_policy_spec(path)
+
+
+def test_missing_file_lists_shipped_names(tmp_path):
+    with pytest.raises(PolicyFileError, match=r"'no-such-kernel' not found and not a shipped "
+                                              r'kernel name \(shipped: '):
+        load_policy_spec('no-such-kernel')
+    with pytest.raises(PolicyFileError, match='not found'):
+        load_policy_spec(tmp_path / 'absent.yaml')
+
+
+def test_shipped_names_resolve_with_and_without_suffix(tmp_path, monkeypatch):
+    monkeypatch.setattr(pf, 'KERNEL_DIR', tmp_path)
+    save_policy(tmp_path / 'human-3x4-infomax.yaml', conv_spec())
+    assert shipped_kernels() == ['human-3x4-infomax']
+    for name in ('human-3x4-infomax', 'human-3x4-infomax.yaml'):
+        assert load_policy_spec(name).path == tmp_path / 'human-3x4-infomax.yaml'
+    # A name with a directory part is a path, never looked up among the shipped kernels.
+    with pytest.raises(PolicyFileError, match='not found'):
+        load_policy_spec('elsewhere/human-3x4-infomax')
+
+
+@pytest.mark.parametrize('name', shipped_kernels())
+def test_every_shipped_kernel_loads(name):
+    spec = load_policy_spec(name)
+    assert spec.path.parent == pf.KERNEL_DIR
+    assert name == f'{spec.fpoc.model}-{spec.grid.rows}x{spec.grid.cols}-{spec.reward}'
+    assert spec.family == 'conv' and spec.radial() is not None
+    evaluation = spec.evaluation
+    assert evaluation['episodes'] == 20000 and evaluation['action'] == 'argmax'
+    assert evaluation['ci95'][0] <= evaluation['fixations_to_90'] <= evaluation['ci95'][1]
+    assert spec.training['episodes_per_epoch'] == 150
+
+
+def test_evaluate_cli_keys_results_by_stem(tmp_path, capsys):
+    grid = Grid(3, 3)
+    path = save_policy(tmp_path / 'mine.yaml', conv_spec(grid))
+    out = tmp_path / 'r.json'
+    assert main(['evaluate', '--grid', '3x3', '--policy-file', str(path), '--policy', 'map',
+                 '--episodes', '200', '--bootstrap', '50', '--json', str(out)]) == 0
+    import json
+    result = json.loads(out.read_text())
+    assert set(result['policies']) == {'map', 'mine'}
+    assert 'mine' in capsys.readouterr().out
+
+
+@pytest.mark.parametrize('content,message', [
+    ('format: nope\n', 'missing key grid'),
+    (None, 'not found'),
+])
+def test_evaluate_cli_bad_file_is_one_line(tmp_path, capsys, content, message):
+    path = tmp_path / 'bad.yaml'
+    if content is not None:
+        path.write_text(content)
+    assert main(['evaluate', '--grid', '3x3', '--policy-file', str(path),
+                 '--episodes', '10']) == 2
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1 and 'Traceback' not in err
+    assert err.startswith('ipomdp-gaze evaluate: error: ') and message in err
+
+
+def test_evaluate_cli_grid_mismatch_is_one_line(tmp_path, capsys):
+    path = save_policy(tmp_path / 'k.yaml', conv_spec())
+    assert main(['evaluate', '--grid', '7x7', '--policy-file', str(path),
+                 '--episodes', '10']) == 2
+    err = capsys.readouterr().err
+    assert 'policy is for a 3x4 grid but the task grid is 7x7' in err
+    assert err.count('\n') == 1
+
+
+def test_save_refuses_an_invalid_spec(tmp_path):
+    spec = conv_spec()
+    spec.kernel = spec.kernel[:-1]
+    with pytest.raises(PolicyFileError, match='kernel has shape'):
+        save_policy(tmp_path / 'x.yaml', spec)
+    assert not (tmp_path / 'x.yaml').exists()
+
+
+def test_kernel_dir_is_next_to_the_module():
+    assert pf.KERNEL_DIR == Path(pf.__file__).resolve().parent / 'kernels'

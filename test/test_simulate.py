@@ -1,0 +1,78 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""Batched simulator: common random numbers, agreement with step-by-step updates, calibration."""
+from ipomdp_gaze.belief import map_cell, uniform_log_belief, update_log_belief
+from ipomdp_gaze.evaluation import fixations_to_90_ci
+from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
+from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.simulate import draw_targets, noise_stream, simulate
+import numpy as np
+from policies.baselines import make_baseline
+import pytest
+
+GRID = Grid(7, 7, 0.42)
+HUMAN = make_fpoc('human')
+
+
+def test_simulator_matches_sequential_updates():
+    grid, fpoc = Grid(3, 4, 0.42), make_fpoc('human')
+    policy = make_baseline('elm', grid, fpoc)
+    res = simulate(grid, fpoc, policy, episodes=5, horizon=6, seed=11)
+    d = dprime_matrix(grid, fpoc)
+    for e in range(5):
+        log_b = uniform_log_belief(grid.n_cells)
+        for t in range(6):
+            k = int(policy.select(np.exp(log_b)[None], t, None)[0])
+            assert k == res.fixations[e, t]
+            obs = noise_stream(11, t).standard_normal((5, grid.n_cells))[e]
+            obs[res.targets[e]] += d[res.targets[e], k]
+            log_b = update_log_belief(log_b, obs, d[:, k])
+            assert (map_cell(np.exp(log_b)) == res.targets[e]) == res.correct[e, t]
+
+
+def test_common_random_numbers_across_policies():
+    a = simulate(GRID, HUMAN, make_baseline('center', GRID, HUMAN), 50, 5, seed=3)
+    b = simulate(GRID, HUMAN, make_baseline('center', GRID, HUMAN), 50, 5, seed=3)
+    c = simulate(GRID, HUMAN, make_baseline('map', GRID, HUMAN), 50, 5, seed=3)
+    np.testing.assert_array_equal(a.correct, b.correct)
+    np.testing.assert_array_equal(a.targets, c.targets)
+    np.testing.assert_array_equal(a.targets, draw_targets(49, 50, 3))
+
+
+def test_targets_are_uniform():
+    counts = np.bincount(draw_targets(49, 49_000, 0), minlength=49)
+    # Chi-square with 48 dof: 99.9% quantile is about 84.0.
+    assert np.sum((counts - 1000) ** 2 / 1000) < 84.0
+
+
+@pytest.mark.parametrize('name, reference', [('random', 11.33), ('map', 9.1)])
+def test_calibrated_baselines_reach_design_values(name, reference):
+    """
+    DESIGN.md: random about 11.3 and MAP about 9.1 fixations to 90% on 7x7 (human default).
+
+    The tolerance is four bootstrap standard errors of this run plus 0.05 for the rounding of the
+    reference, so a correct model fails this with probability well below 1e-3.
+    """
+    episodes = 6000
+    res = simulate(GRID, HUMAN, make_baseline(name, GRID, HUMAN), episodes, 20, seed=2024)
+    point, (low, high) = fixations_to_90_ci(res.correct, 49, np.random.default_rng(0), 400)
+    se = (high - low) / (2 * 1.96)
+    assert abs(point - reference) < 4 * se + 0.05, (point, se)
+
+
+def test_learned_order_of_baselines():
+    """ELM beats MAP, MAP beats random, on paired episodes (differences far beyond noise)."""
+    f90 = {}
+    for name in ('elm', 'map', 'random'):
+        res = simulate(GRID, HUMAN, make_baseline(name, GRID, HUMAN), 3000, 20, seed=5)
+        f90[name] = fixations_to_90_ci(res.correct, 49, np.random.default_rng(0), 1)[0]
+    assert f90['elm'] < f90['map'] - 0.6 and f90['map'] < f90['random'] - 1.0, f90
+
+
+def test_fewer_episodes_see_a_prefix_of_the_same_draws():
+    """Common random numbers hold across batch sizes: 300 episodes are the first 300 of 1000."""
+    policy = make_baseline('elm', GRID, HUMAN)
+    small = simulate(GRID, HUMAN, policy, 300, 8, seed=9)
+    large = simulate(GRID, HUMAN, policy, 1000, 8, seed=9)
+    np.testing.assert_array_equal(small.correct, large.correct[:300])
+    np.testing.assert_array_equal(small.fixations, large.fixations[:300])
