@@ -1,4 +1,7 @@
-"""Non-myopic planner: look-ahead rollouts from the current belief with a base policy.
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Non-myopic planner: look-ahead rollouts from the current belief with a base policy.
 
 At every decision the planner takes a shortlist of candidate fixations (the base policy's own
 choice first, then the next best cells by the base policy's score) and simulates ``rollouts``
@@ -31,11 +34,10 @@ can be the base, for example a learned convolutional kernel.
 """
 from __future__ import annotations
 
-import numpy as np
-
 from ipomdp_gaze.belief import argmax_ties_low
-from ipomdp_gaze.fpoc import FPOC, dprime_matrix
+from ipomdp_gaze.fpoc import dprime_matrix, FPOC
 from ipomdp_gaze.grid import Grid
+import numpy as np
 
 from .conv import kernel_matrix
 
@@ -62,7 +64,8 @@ def _finite(name: str, value, positive: bool = False) -> float:
 
 
 class TemperedELM:
-    """ELM on a tempered belief: ``argmax_k sum_i B_i^a d_ik^p`` (ties to the lowest index).
+    """
+    ELM on a tempered belief: ``argmax_k sum_i B_i^a d_ik^p`` (ties to the lowest index).
 
     ``belief_power`` a = 1 and ``dprime_power`` p = 2 is exactly ELM. ``a < 1`` flattens the
     belief, so cells that are unlikely but not yet ruled out keep drawing fixations: a cheap
@@ -97,8 +100,42 @@ class TemperedELM:
         return argmax_ties_low(self.scores(belief))
 
 
+class TemperedPolicy:
+    """
+    Any belief policy fed the tempered belief ``B^a / sum B^a`` (a learned kernel, say).
+
+    For a policy linear in the belief (a convolutional kernel) this is the same tempering as
+    :class:`TemperedELM`; whether it helps a given kernel is an empirical question.
+    """
+
+    def __init__(self, base, belief_power: float):
+        if not callable(getattr(base, 'select', None)):
+            raise ValueError('base policy must have a select(belief, t, rng) method')
+        self.base = base
+        self.belief_power = _finite('belief_power', belief_power, positive=True)
+        self.name = 'tempered_' + str(getattr(base, 'name', 'policy'))
+
+    def tempered(self, belief: np.ndarray) -> np.ndarray:
+        """``B^a`` renormalised over the last axis."""
+        b = np.power(np.asarray(belief), self.belief_power)
+        return b / b.sum(axis=-1, keepdims=True)
+
+    @property
+    def scores(self):
+        """Return the base policy's ``scores`` on the tempered belief, or None if it has none."""
+        scorer = getattr(self.base, 'scores', None)
+        if not callable(scorer):
+            return None
+        return lambda belief: scorer(self.tempered(belief))
+
+    def select(self, belief, t, rng):
+        """Return the base policy's choice for the tempered belief."""
+        return self.base.select(self.tempered(belief), t, rng)
+
+
 class RolloutPlanner:
-    """Pick each fixation by simulated look-ahead with a base policy (batched over episodes).
+    """
+    Pick each fixation by simulated look-ahead with a base policy (batched over episodes).
 
     Parameters
     ----------
@@ -108,6 +145,9 @@ class RolloutPlanner:
         The rollout policy, anything with ``select(belief, t, rng)``; :class:`TemperedELM` when
         omitted. If it has ``scores(belief)`` the shortlist is its best cells, otherwise the most
         likely cells.
+    belief_power : float, optional
+        Feed the base policy the tempered belief ``B^a`` (:class:`TemperedPolicy`); for a given
+        base only (the default base is already tempered).
     candidates : int
         Shortlist size, the base policy's choice included.
     rollouts : int
@@ -133,28 +173,35 @@ class RolloutPlanner:
         Simulated rows (episodes x candidates x rollouts) held at once; bounds memory only.
     dprime : array (N, N), optional
         ``d[j, k]``; computed from ``fpoc`` when omitted.
+
     """
 
     name = 'planner'
 
     def __init__(self, grid: Grid, fpoc: FPOC, base=None, candidates: int = 4,
                  rollouts: int = 64, rollout_budget: int | None = 2048, horizon: int = 2,
-                 until: int | None = 8,
-                 objective: str = 'correct', switch_z: float = 2.0, dtype: str = 'float32',
+                 until: int | None = 8, objective: str = 'correct', switch_z: float = 2.0,
+                 dtype: str = 'float32', belief_power: float | None = None,
                  chunk_rows: int = 1 << 17, dprime=None):
         n = grid.n_cells
         d = dprime_matrix(grid, fpoc) if dprime is None else np.asarray(dprime, dtype=float)
         if d.shape != (n, n):
             raise ValueError(f'dprime must have shape ({n}, {n}), got {d.shape}')
         if base is None:
+            if belief_power is not None:
+                raise ValueError('belief_power needs a base policy; the default base is '
+                                 'already TemperedELM')
             base = TemperedELM(grid, fpoc, dprime=d)
         if not callable(getattr(base, 'select', None)):
             raise ValueError('base policy must have a select(belief, t, rng) method')
+        inner = base
+        if belief_power is not None:
+            base = TemperedPolicy(base, belief_power)
         if objective not in OBJECTIVES:
-            raise ValueError(f"unknown objective {objective!r}; valid objectives: "
-                             f"{', '.join(OBJECTIVES)}")
+            valid = ', '.join(OBJECTIVES)
+            raise ValueError(f'unknown objective {objective!r}; valid objectives: {valid}')
         if str(dtype) not in DTYPES:
-            raise ValueError(f"dtype must be one of {', '.join(DTYPES)}, got {dtype!r}")
+            raise ValueError(f'dtype must be one of {DTYPES}, got {dtype!r}')
         self.grid = grid
         self.fpoc = fpoc
         self.base = base
@@ -173,8 +220,9 @@ class RolloutPlanner:
         self._half_d2_fix = (-0.5 * d_fix ** 2).astype(self.dtype)
         self._d2_fix = (d_fix ** 2).astype(self.dtype)
         self._base_weights = None
-        kernel = getattr(base, 'kernel', None)
-        if kernel is not None and getattr(base, 'action', None) == 'argmax':
+        self._base_power = None if belief_power is None else base.belief_power
+        kernel = getattr(inner, 'kernel', None)
+        if kernel is not None and getattr(inner, 'action', None) == 'argmax':
             self._base_weights = kernel_matrix(grid, np.asarray(kernel)).T.astype(self.dtype)
 
     def lookahead(self, t: int) -> int:
@@ -182,7 +230,7 @@ class RolloutPlanner:
         return self.horizon if self.until is None else max(self.horizon, self.until - t)
 
     def rollouts_at(self, t: int) -> int:
-        """Simulated futures per candidate at decision ``t``."""
+        """Return the number of simulated futures per candidate at decision ``t``."""
         if self.rollout_budget is None:
             return self.rollouts
         return max(self.rollouts, self.rollout_budget // self.lookahead(t))
@@ -212,7 +260,8 @@ class RolloutPlanner:
         return np.minimum(idx, belief.shape[1] - 1)
 
     def values(self, belief, t: int, rng: np.random.Generator):
-        """Shortlist (E, m), mean rollout score (E, m) and paired advantage z-scores (E, m).
+        """
+        Shortlist (E, m), mean rollout score (E, m) and paired advantage z-scores (E, m).
 
         The z-score of candidate c is the mean over rollouts of ``score_c - score_0`` (same
         target and noise for both) divided by its standard error; 0 for candidate 0.
@@ -241,13 +290,16 @@ class RolloutPlanner:
 
     def _base_choice(self, belief: np.ndarray, t: int, rng: np.random.Generator) -> np.ndarray:
         if self._base_weights is not None:
+            if self._base_power is not None:
+                belief = np.power(belief, self._base_power)
             return np.argmax(belief @ self._base_weights, axis=1)
         if isinstance(self.base, TemperedELM):
             return np.argmax(self.base.scores(belief), axis=1)
         return np.asarray(self.base.select(belief.astype(float), t, rng), dtype=np.int64)
 
     def rollout_scores(self, belief, cand, t, targets, noise, rng) -> np.ndarray:
-        """Score of every simulated future, shape (E, m, R).
+        """
+        Score of every simulated future, shape (E, m, R).
 
         Parameters
         ----------
@@ -264,6 +316,7 @@ class RolloutPlanner:
             the look-ahead length.
         rng : numpy.random.Generator
             Passed to a stochastic base policy.
+
         """
         episodes, m = cand.shape
         h, _, r, n = noise.shape

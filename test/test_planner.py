@@ -1,12 +1,14 @@
-"""Tests of the look-ahead planner (policies/planner.py): validity, determinism, rollouts, quality."""
-import numpy as np
-import pytest
-
-from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""Look-ahead planner (policies/planner.py): validity, determinism, rollouts, quality."""
+from ipomdp_gaze.fpoc import dprime_matrix, dprime_table, make_fpoc
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.simulate import noise_stream, simulate
-from policies.baselines import MapPolicy, elm_policy
-from policies.planner import RolloutPlanner, TemperedELM, make_planner
+import numpy as np
+from policies.baselines import elm_policy, MapPolicy
+from policies.conv import ConvPolicy
+from policies.planner import make_planner, RolloutPlanner, TemperedELM, TemperedPolicy
+import pytest
 
 GRID = Grid(7, 7)
 FPOC = make_fpoc('human')
@@ -22,7 +24,7 @@ def random_beliefs(episodes, seed, sharpness=3.0):
 
 
 def small_planner(**options):
-    opts = dict(candidates=3, rollouts=16, dprime=D)
+    opts = {'candidates': 3, 'rollouts': 16, 'rollout_budget': None, 'dprime': D}
     opts.update(options)
     return make_planner(GRID, FPOC, **opts)
 
@@ -62,13 +64,20 @@ def test_deterministic_given_the_rng_and_the_simulation_seed():
     np.testing.assert_array_equal(r1.fixations, r2.fixations)
 
 
-@pytest.mark.parametrize('base_name', ['elm', 'tempered', 'map'])
+def conv_kernel_policy(power=1.75):
+    """Build a convolutional policy with kernel ``d^power`` (stands in for a learned kernel)."""
+    return ConvPolicy(GRID, dprime_table(GRID, FPOC) ** power)
+
+
+@pytest.mark.parametrize('base_name', ['elm', 'tempered', 'map', 'tempered conv'])
 def test_rollouts_reproduce_simulate_on_the_same_targets_and_noise(base_name):
     """A rollout fed simulate's targets and noise ends in simulate's belief, step for step."""
     base = {'elm': elm_policy(GRID, FPOC), 'tempered': TemperedELM(GRID, FPOC, dprime=D),
-            'map': MapPolicy()}[base_name]
+            'map': MapPolicy(), 'tempered conv': conv_kernel_policy()}[base_name]
+    power = 0.7 if base_name == 'tempered conv' else None
     episodes, steps, seed = 10, 5, 4
-    result = simulate(GRID, FPOC, base, episodes, steps, seed=seed, dprime=D)
+    reference = base if power is None else TemperedPolicy(base, power)
+    result = simulate(GRID, FPOC, reference, episodes, steps, seed=seed, dprime=D)
     noise = np.stack([noise_stream(seed, s).standard_normal((episodes, N))
                       for s in range(steps)])[:, :, None, :]          # (H, E, R=1, N)
     uniform = np.full((episodes, N), 1.0 / N)
@@ -77,7 +86,8 @@ def test_rollouts_reproduce_simulate_on_the_same_targets_and_noise(base_name):
     for objective, expected in (('correct', result.map_prob[:, -1]),
                                 ('infomax', result.infomax.sum(axis=1))):
         planner = RolloutPlanner(GRID, FPOC, base=base, rollouts=1, horizon=steps, until=None,
-                                 objective=objective, dtype='float64', dprime=D)
+                                 objective=objective, dtype='float64', belief_power=power,
+                                 dprime=D)
         score = planner.rollout_scores(uniform, first, 0, targets, noise, None)
         np.testing.assert_allclose(score[:, 0, 0], expected, rtol=1e-9, atol=1e-9)
 
@@ -88,6 +98,19 @@ def test_tempered_elm_with_unit_powers_is_elm():
     same = TemperedELM(GRID, FPOC, belief_power=1.0, dprime_power=2.0)
     np.testing.assert_array_equal(same.select(beliefs, 0, None), elm.select(beliefs, 0, None))
     np.testing.assert_allclose(same.scores(beliefs), elm.scores(beliefs), rtol=1e-12)
+
+
+def test_tempering_a_conv_kernel_equals_tempered_elm():
+    beliefs = random_beliefs(300, seed=7)
+    wrapped = TemperedPolicy(conv_kernel_policy(1.75), 0.7)
+    direct = TemperedELM(GRID, FPOC, belief_power=0.7, dprime_power=1.75)
+    np.testing.assert_array_equal(wrapped.select(beliefs, 0, None),
+                                  direct.select(beliefs, 0, None))
+    assert TemperedPolicy(MapPolicy(), 0.5).scores is None
+    planner = make_planner(GRID, FPOC, base=conv_kernel_policy(1.75), belief_power=0.7,
+                           dprime=D)
+    np.testing.assert_array_equal(planner._base_choice(beliefs, 0, None),
+                                  direct.select(beliefs, 0, None))
 
 
 def test_make_planner_takes_a_base_policy_and_options():
@@ -109,6 +132,8 @@ def test_make_planner_takes_a_base_policy_and_options():
     ({'dtype': 'float16'}, 'dtype'),
     ({'base': object()}, 'base'),
     ({'dprime': np.ones((3, 3))}, 'dprime'),
+    ({'belief_power': 0.7}, 'belief_power'),
+    ({'base': MapPolicy(), 'belief_power': -1}, 'belief_power'),
 ])
 def test_bad_options_raise_errors_naming_the_problem(options, message):
     with pytest.raises(ValueError, match=message):
@@ -121,7 +146,8 @@ def test_bad_tempering_is_rejected():
 
 
 def paired_gap(policy_a, policy_b, episodes, seed, fixation=8):
-    """Mean and standard error of the per-episode paired difference of ``max B`` at a fixation.
+    """
+    Mean and standard error of the per-episode paired difference of ``max B`` at a fixation.
 
     ``max_i B_i`` after t fixations is the probability that the MAP guess is right given the
     history, so its mean is the percent correct at t; pairing (same targets and noise) removes
@@ -138,14 +164,15 @@ Z_TOL = 3.09
 
 
 def test_planner_is_not_worse_than_its_base_policy_beyond_sampling_error():
-    """Percent correct at fixation 8 (the 90% region): planner vs ELM, its base, paired.
+    """
+    Percent correct at fixation 8 (the 90% region): planner vs ELM, its base, paired.
 
     The tolerance is Z_TOL standard errors of the paired mean difference, estimated from the
     same run; ``switch_z=1`` makes the planner leave its base often enough to matter.
     """
     base = elm_policy(GRID, FPOC)
-    planner = make_planner(GRID, FPOC, base=base, candidates=3, rollouts=48, switch_z=1.0,
-                           dprime=D)
+    planner = make_planner(GRID, FPOC, base=base, candidates=3, rollouts=48,
+                           rollout_budget=None, switch_z=1.0, dprime=D)
     episodes = 150
     gap, se = paired_gap(planner, base, episodes, seed=21)
     switched = simulate(GRID, FPOC, planner, episodes, 8, seed=21, dprime=D).fixations
