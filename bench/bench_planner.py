@@ -80,6 +80,30 @@ def decision_times(planner, grid, d, episodes=20, fixations=10, seed=0):
     return 1000 * np.asarray(times), 1000 * np.asarray(cpu)
 
 
+def tempered_vs_elm(grid, fpoc, d, seeds, episodes, horizon, resamples):
+    """Tempered ELM - ELM on several fresh seeds: per seed and pooled (normal approximation)."""
+    rows = []
+    for seed in seeds:
+        a = simulate(grid, fpoc, TemperedELM(grid, fpoc, dprime=d), episodes, horizon, seed=seed,
+                     dprime=d)
+        b = simulate(grid, fpoc, make_baseline('elm', grid, fpoc), episodes, horizon, seed=seed,
+                     dprime=d)
+        entry = paired(a, b, grid.n_cells, seed, resamples)
+        rows.append(entry)
+        print(f"  seed {seed:>4}: indicator {fmt(entry['indicator'])}   "
+              f"expected {fmt(entry['expected'])}", flush=True)
+    pooled = {}
+    for key in ('indicator', 'expected'):
+        diffs = np.array([r[key]['difference'] for r in rows])
+        ses = np.array([(r[key]['ci95'][1] - r[key]['ci95'][0]) / 3.92 for r in rows])
+        mean, se = diffs.mean(), np.sqrt(np.sum(ses ** 2)) / len(rows)
+        pooled[key] = {'difference': float(mean), 'ci95': [mean - 1.96 * se, mean + 1.96 * se]}
+    print(f"  pooled ({len(seeds)} x {episodes}): indicator {fmt(pooled['indicator'])}   "
+          f"expected {fmt(pooled['expected'])}")
+    return {'seeds': list(seeds), 'episodes_per_seed': episodes, 'per_seed': rows,
+            'pooled': pooled}
+
+
 def fmt(block):
     value, ci = block.get('fixations_to_90', block.get('difference')), block['ci95']
     if value is None:
@@ -100,6 +124,11 @@ def main():
     parser.add_argument('--horizon', type=int, default=12, help='fixations per episode')
     parser.add_argument('--seed', type=int, default=0)
     parser.add_argument('--bootstrap', type=int, default=1000)
+    parser.add_argument('--tempered-seeds', type=int, default=0,
+                        help='also compare tempered ELM with ELM on this many fresh seeds '
+                             '(100, 101, ...) of --episodes-fast episodes each')
+    parser.add_argument('--skip-planner', action='store_true',
+                        help='only the fast policies (and --tempered-seeds)')
     parser.add_argument('--json', type=Path, default=None)
     args = parser.parse_args()
 
@@ -117,12 +146,15 @@ def main():
         policies['greedy'] = (make_baseline('greedy', grid, fpoc), args.episodes)
     except ImportError:
         print('percent-correct greedy (policies/greedy.py) not available: skipped')
-    if args.episodes_elm_planner:
+    if args.skip_planner:
+        policies.pop('greedy', None)
+    if args.episodes_elm_planner and not args.skip_planner:
         policies['planner_elm_base'] = (
             make_planner(grid, fpoc, base=make_baseline('elm', grid, fpoc), dprime=d),
             args.episodes_elm_planner)
     planner = make_planner(grid, fpoc, dprime=d)
-    policies['planner'] = (planner, args.episodes)
+    if not args.skip_planner:
+        policies['planner'] = (planner, args.episodes)
 
     results, report = {}, {'task': {'grid': grid.to_dict(), 'fpoc': fpoc.to_dict(),
                                     'horizon': args.horizon, 'seed': args.seed},
@@ -142,7 +174,8 @@ def main():
         print(f"{name:<18} {episodes:>8} {fmt(entry['indicator']):>27} "
               f"{fmt(entry['expected']):>27} {wall:8.1f}", flush=True)
 
-    pairs = [('planner', other) for other in results if other != 'planner']
+    pairs = [('planner', other) for other in results if 'planner' in results and
+             other != 'planner']
     pairs.append(('tempered_elm', 'elm'))
     if 'planner_elm_base' in results:
         pairs.append(('planner_elm_base', 'elm'))
@@ -156,6 +189,15 @@ def main():
         print(f"{a + ' - ' + b:<34} {common:>8} {fmt(entry['indicator']):>25} "
               f"{fmt(entry['expected']):>25}", flush=True)
 
+    if args.tempered_seeds:
+        print(f'\ntempered_elm - elm on {args.tempered_seeds} fresh seeds:')
+        report['tempered_seeds'] = tempered_vs_elm(
+            grid, fpoc, d, range(100, 100 + args.tempered_seeds), args.episodes_fast,
+            args.horizon, args.bootstrap)
+    if args.skip_planner:
+        if args.json:
+            args.json.write_text(json.dumps(report, indent=1))
+        return
     ms, cpu_ms = decision_times(planner, grid, d, seed=args.seed)
     rate = report['policies']['planner']['decisions_per_second']
     report['planner'] = {'options': {k: getattr(planner, k) for k in (
