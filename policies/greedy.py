@@ -29,14 +29,14 @@ into a lower limit ``L_k = max_j ln B_j``: below it ``G_k = 0`` and the integral
 Quadrature and its error
 ------------------------
 The integral runs over ``[lo, hi]`` with ``lo = max(L_k, max_j (mu_j - Z d_jk))`` and
-``hi = max_j (ln B_j + d_jk^2/2 + Z d_jk)``; with ``Z = 7.1`` each cut-off changes the score by
-at most ``Phi(-Z) = 6e-13``. Every cell j's features lie within ``Z d_jk + d_jk^2`` above ``lo``,
-so narrow (small-d) features sit near the lower end: Gauss-Legendre nodes in ``t`` mapped by
-``y = lo + (hi - lo) t^2`` concentrate there. 96 nodes give errors below 1e-10 on 7x7 human and
-exponential FPOCs (measured against adaptive quadrature in ``bench/bench_greedy.py``); 11x11's
-far-periphery d' (down to 0.002) needs more nodes, see the benchmark. The product ``G_k`` is
-summed as ``log_ndtr`` and ``1 - G_k`` taken as ``-expm1``, so the upper tail (weighted by
-``exp(y)``) keeps full precision.
+``hi = max_j (ln B_j + d_jk^2/2 + Z d_jk)``; with ``Z = 7.1`` the two cut-offs change the score by
+at most ``2 Phi(-Z) = 1.2e-12`` (below lo, ``G_k <= Phi(-Z)`` and ``exp(lo) <= 1``; above hi, cell
+j's tail contributes at most ``B_j Phi(-Z)``). Every cell j's features lie within
+``Z d_jk + d_jk^2`` above ``lo``, so narrow (small-d) features sit near the lower end:
+Gauss-Legendre nodes in ``t`` mapped by ``y = lo + (hi - lo) t^power`` concentrate there (see
+:func:`default_nodes` for the node counts and their measured errors). ``G_k`` is summed as
+``log1p(-q_j)`` of the upper tails ``q_j = 1 - F_j`` and ``1 - G_k`` taken as ``-expm1``, so the
+upper tail (weighted by ``exp(y)``) keeps full relative precision.
 
 Pruning and its bound
 ---------------------
@@ -64,15 +64,33 @@ from scipy.special import ndtr
 
 Z_TAIL = 7.1
 DEFAULT_TOL = 1e-10
-DEFAULT_NODES = 96
-NODE_POWER = 2
+# Quadrature (nodes, power): the first when every positive d' is at least SHARP_DPRIME, else the
+# second (the far periphery of 9x9 and larger human-FPOC grids has d' down to 0.002).
+NODES_SMOOTH = (112, 2)
+NODES_SHARP = (192, 3)
+SHARP_DPRIME = 0.05
 MAX_ELEMENTS = 1 << 21
 D_MAX = 25.0
 W_LIMIT = 8.3
 
 
+def default_nodes(dprime: np.ndarray) -> tuple[int, int]:
+    """
+    Quadrature ``(nodes, power)`` for a d' matrix.
+
+    Measured against 1024 nodes on beliefs from simulated searches (``bench/bench_greedy.py``):
+    112 nodes with power 2 stay below 1e-11 (7x7 human) and 3e-10 (7x7 exponential); 192 with
+    power 3 below 2e-9 at 11x11 human, where d' reaches 0.002.
+    """
+    d = np.asarray(dprime, dtype=float)
+    positive = d[d > 0]
+    if positive.size and positive.min() < SHARP_DPRIME:
+        return NODES_SHARP
+    return NODES_SMOOTH
+
+
 @functools.lru_cache(maxsize=16)
-def mapped_nodes(nodes: int = DEFAULT_NODES, power: int = NODE_POWER):
+def mapped_nodes(nodes: int, power: int):
     """
     Gauss-Legendre nodes on [0, 1] mapped by ``t -> t^power``: ``(positions, weights)``.
 
@@ -217,7 +235,7 @@ def _group_scores(log_b: np.ndarray, dk: np.ndarray, t_nodes: np.ndarray,
 
 
 def expected_percent_correct(belief, dprime: np.ndarray, tol: float = DEFAULT_TOL,
-                             nodes: int = DEFAULT_NODES, power: int = NODE_POWER,
+                             nodes: int | None = None, power: int | None = None,
                              return_bound: bool = False, max_elements: int = MAX_ELEMENTS):
     """
     Score ``sum_i B_i P(C | i, k)`` of every fixation k: the probability of a correct MAP guess.
@@ -230,8 +248,8 @@ def expected_percent_correct(belief, dprime: np.ndarray, tol: float = DEFAULT_TO
         ``d[j, k]``, from :func:`ipomdp_gaze.fpoc.dprime_matrix`.
     tol : float
         Bound on the pruning error of every score (0 keeps every cell with non-zero belief).
-    nodes, power : int
-        Gauss-Legendre nodes and the power of the node map (see the module docstring).
+    nodes, power : int, optional
+        Gauss-Legendre nodes and the power of the node map; :func:`default_nodes` when omitted.
     return_bound : bool
         Also return the per-row pruning bound and kept-set size.
     max_elements : int
@@ -249,7 +267,9 @@ def expected_percent_correct(belief, dprime: np.ndarray, tol: float = DEFAULT_TO
         raise ValueError(f'tol must be finite and >= 0, got {tol!r}')
     single = np.ndim(belief) == 1
     b = check_belief(belief, n)
-    t_nodes, w_nodes = mapped_nodes(nodes, power)
+    auto_nodes, auto_power = default_nodes(d)
+    t_nodes, w_nodes = mapped_nodes(auto_nodes if nodes is None else nodes,
+                                    auto_power if power is None else power)
     order, sizes, bound = prune(b, np.sqrt(2.0) * float(d.max(initial=0.0)), tol)
     scores = np.empty_like(b)
     for size in np.unique(sizes):
@@ -366,15 +386,18 @@ class PercentCorrectGreedy:
     name = 'greedy'
 
     def __init__(self, grid: Grid, fpoc: FPOC, tol: float = DEFAULT_TOL,
-                 nodes: int = DEFAULT_NODES, power: int = NODE_POWER,
+                 nodes: int | None = None, power: int | None = None,
                  max_elements: int = MAX_ELEMENTS):
         self.grid = grid
         self.fpoc = fpoc
         self.dprime = check_dprime(dprime_matrix(grid, fpoc))
         if not np.isfinite(tol) or tol < 0:
             raise ValueError(f'tol must be finite and >= 0, got {tol!r}')
-        mapped_nodes(nodes, power)
-        self.tol, self.nodes, self.power = float(tol), int(nodes), int(power)
+        auto_nodes, auto_power = default_nodes(self.dprime)
+        self.nodes = auto_nodes if nodes is None else nodes
+        self.power = auto_power if power is None else power
+        mapped_nodes(self.nodes, self.power)
+        self.tol = float(tol)
         self.max_elements = int(max_elements)
 
     def expected_percent_correct(self, belief, return_bound: bool = False):
