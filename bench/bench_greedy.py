@@ -8,7 +8,8 @@ Run: ``.venv/bin/python bench/bench_greedy.py [--quick] [--json OUT]``.
 Beliefs come from simulated searches (7x7: the greedy searcher's own; 11x11: ELM searches, as
 simulating the greedy searcher there is slow), one decision per call (a batch of one), timed
 with ``time.perf_counter``: median, p90, p99 over many decisions, by fixation number, and the
-uniform prior (the costliest, nothing can be pruned). Beside it, in the same run, the naive
+uniform prior (the costliest, nothing can be pruned); wall and process-CPU time (the steadier
+figure on a shared machine). Beside it, in the same run, the naive
 reference: Najemnik & Geisler's formula summed directly (``percent_correct_given_target``,
 O(N^3 Q)). Accuracy: the scores against 1024 quadrature nodes without pruning, and the pruning
 gap against its proven bound.
@@ -50,25 +51,26 @@ def search_beliefs(grid, fpoc, policy_name, episodes, horizon, seed):
     return np.stack(recorder.beliefs), result, wall
 
 
-def time_calls(function, arguments, repeats=1):
-    """Wall seconds of ``function(a)`` for each argument (best of ``repeats``)."""
-    out = np.empty(len(arguments))
+def time_calls(function, arguments):
+    """
+    Wall and process-CPU seconds of ``function(a)`` for each argument, as two arrays.
+
+    The CPU time is the steadier figure on a machine shared with other jobs.
+    """
+    wall, cpu = np.empty(len(arguments)), np.empty(len(arguments))
     for i, arg in enumerate(arguments):
-        best = np.inf
-        for _ in range(repeats):
-            t0 = time.perf_counter()
-            function(arg)
-            best = min(best, time.perf_counter() - t0)
-        out[i] = best
-    return out
+        w0, c0 = time.perf_counter(), time.process_time()
+        function(arg)
+        wall[i], cpu[i] = time.perf_counter() - w0, time.process_time() - c0
+    return wall, cpu
 
 
 def summary_ms(seconds):
-    """Median, p90, p99 and max in milliseconds."""
-    ms = 1e3 * np.asarray(seconds)
-    return {'median_ms': float(np.median(ms)), 'p90_ms': float(np.percentile(ms, 90)),
-            'p99_ms': float(np.percentile(ms, 99)), 'max_ms': float(ms.max()),
-            'calls': int(ms.size)}
+    """Median, p90, p99 and max wall milliseconds, and the median CPU milliseconds."""
+    wall, cpu = 1e3 * np.asarray(seconds[0]), 1e3 * np.asarray(seconds[1])
+    return {'median_ms': float(np.median(wall)), 'p90_ms': float(np.percentile(wall, 90)),
+            'p99_ms': float(np.percentile(wall, 99)), 'max_ms': float(wall.max()),
+            'cpu_median_ms': float(np.median(cpu)), 'calls': int(wall.size)}
 
 
 def decision_costs(policy, beliefs, samples, rng):
@@ -76,7 +78,7 @@ def decision_costs(policy, beliefs, samples, rng):
     horizon, episodes, _ = beliefs.shape
     t_idx = rng.integers(0, horizon, samples)
     e_idx = rng.integers(0, episodes, samples)
-    seconds = time_calls(lambda b: policy.select(b[None], 0, None), beliefs[t_idx, e_idx])
+    seconds, cpu = time_calls(lambda b: policy.select(b[None], 0, None), beliefs[t_idx, e_idx])
     kept = np.array([policy.expected_percent_correct(b, return_bound=True)[2]
                      for b in beliefs[t_idx, e_idx]])
     by_t = {}
@@ -84,10 +86,11 @@ def decision_costs(policy, beliefs, samples, rng):
         sel = (t_idx >= lo) & (t_idx < hi)
         if sel.any():
             by_t[f'{lo}-{hi - 1}'] = {'median_ms': float(1e3 * np.median(seconds[sel])),
+                                      'cpu_median_ms': float(1e3 * np.median(cpu[sel])),
                                       'mean_kept_cells': float(kept[sel].mean()),
                                       'calls': int(sel.sum())}
     uniform = np.full((1, beliefs.shape[2]), 1.0 / beliefs.shape[2])
-    return {'all': summary_ms(seconds), 'by_fixation_number': by_t,
+    return {'all': summary_ms((seconds, cpu)), 'by_fixation_number': by_t,
             'uniform_prior': summary_ms(time_calls(lambda b: policy.select(b, 0, None),
                                                    [uniform] * 15))}
 
@@ -115,11 +118,11 @@ def naive_reference(policy, belief, node_counts):
     d = policy.dprime
     out = {}
     for nodes in node_counts:
-        seconds = time_calls(lambda b: np.argmax(b @ percent_correct_given_target(b, d, nodes)),
-                             [belief])
-        out[f'direct_formula_{nodes}_nodes_ms'] = float(1e3 * seconds[0])
-    fast = time_calls(lambda b: policy.select(b[None], 0, None), [belief] * 5)
-    out['fast_ms'] = float(1e3 * np.median(fast))
+        _, cpu = time_calls(lambda b: np.argmax(b @ percent_correct_given_target(b, d, nodes)),
+                            [belief])
+        out[f'direct_formula_{nodes}_nodes_ms'] = float(1e3 * cpu[0])
+    _, cpu = time_calls(lambda b: policy.select(b[None], 0, None), [belief] * 5)
+    out['fast_ms'] = float(1e3 * np.median(cpu))
     out['ratio'] = out[f'direct_formula_{policy.nodes}_nodes_ms'] / out['fast_ms']
     return out
 
@@ -146,16 +149,18 @@ def print_grid(result):
           f"({result['episodes']} episodes x {result['horizon']}, simulated in "
           f"{result['simulate_wall_s']:.1f} s)")
     a = dec['all']
-    print(f"one decision: median {a['median_ms']:.2f} ms, p90 {a['p90_ms']:.2f}, "
-          f"p99 {a['p99_ms']:.2f}, max {a['max_ms']:.2f} ({a['calls']} calls)")
+    print(f"one decision (wall): median {a['median_ms']:.2f} ms, p90 {a['p90_ms']:.2f}, "
+          f"p99 {a['p99_ms']:.2f}, max {a['max_ms']:.2f}; CPU median {a['cpu_median_ms']:.2f} ms "
+          f"({a['calls']} calls)")
     for span, row in dec['by_fixation_number'].items():
-        print(f"  fixations {span:>6}: median {row['median_ms']:8.2f} ms, "
-              f"mean kept cells {row['mean_kept_cells']:5.1f} ({row['calls']} calls)")
+        print(f"  fixations {span:>6}: median {row['median_ms']:8.2f} ms wall, "
+              f"{row['cpu_median_ms']:8.2f} ms CPU, mean kept cells "
+              f"{row['mean_kept_cells']:5.1f} ({row['calls']} calls)")
     u = dec['uniform_prior']
-    print(f"uniform prior (nothing pruned): median {u['median_ms']:.2f} ms, "
-          f"max {u['max_ms']:.2f} ms")
+    print(f"uniform prior (nothing pruned): median {u['median_ms']:.2f} ms wall, "
+          f"{u['cpu_median_ms']:.2f} ms CPU")
     n = result['naive_reference']
-    print('naive reference on the uniform prior: ' + ', '.join(
+    print('naive reference on the uniform prior (CPU): ' + ', '.join(
         f'{k} {v:.1f}' for k, v in n.items() if k.endswith('_ms')) +
         f"; the fast path is {n['ratio']:.0f}x faster at equal node count")
     print(f"accuracy on {acc['beliefs']} beliefs ({acc['nodes']} nodes, power {acc['power']}): "
