@@ -113,10 +113,12 @@ def peaked_beliefs(n_cells, rows, seed):
     return out / out.sum(axis=1, keepdims=True)
 
 
-@pytest.mark.parametrize('tol', [1e-3, 1e-6])
-def test_pruned_scores_are_within_the_stated_bound(tol):
+@pytest.mark.parametrize('fpoc, tol', [
+    (HUMAN, 1e-3), (HUMAN, 1e-6), (make_fpoc('camera'), 1e-3), (CAMERA, 1e-3),
+], ids=['human-1e-3', 'human-1e-6', 'camera-5x5-fov-1e-3', 'camera-3x3-fov-1e-3'])
+def test_pruned_scores_are_within_the_stated_bound(fpoc, tol):
     grid = Grid(7, 7, 0.42)
-    d = dprime_matrix(grid, HUMAN)
+    d = dprime_matrix(grid, fpoc)
     beliefs = peaked_beliefs(grid.n_cells, 8, 7)
     full = expected_percent_correct(beliefs, d, tol=0.0)
     pruned, bound, kept = expected_percent_correct(beliefs, d, tol=tol, return_bound=True)
