@@ -1,0 +1,183 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+ROS loop: simulated camera -> evidence -> gaze_controller -> pan_tilt -> camera, two processes.
+
+Each camera frame and the pose it was taken at (``joint_states``) carry one stamp; the camera
+sends its next frame as soon as the next ``pan_tilt`` arrives (``saccade_time_s`` 0), so the gap
+between consecutive frame stamps is one full loop (camera -> controller -> camera over DDS). A
+third process (this one) only listens. At 256x256 the camera streams at 60 Hz instead, and the
+controller's own counters in ``/diagnostics`` say how many frames it applied, skipped (stale or
+superseded) or never saw (dropped by the keep-last queue), with its RSS from /proc.
+Run: ``.venv/bin/python bench/bench_ros_loop.py`` or ``make bench``.
+"""
+from pathlib import Path
+import sys
+import tempfile
+import time
+
+from diagnostic_msgs.msg import DiagnosticArray
+from ipomdp_gaze.nodes.processes import domain_id_for, NodeProcess, ros_environment
+import numpy as np
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.qos import qos_profile_sensor_data
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float32MultiArray
+
+TITLE = 'ROS loop: camera -> controller -> camera (separate processes)'
+ORDER = 30
+# (label, rows, spacing_deg, camera half field of view in degrees)
+LOOPS = (('11x11', 11, 5.0, 10.0), ('128x128', 128, 0.5, 2.0))
+STREAM = ('256x256 at 60 Hz', 256, 0.25, 1.0, 60.0)
+
+
+def _task_args(rows, spacing, half):
+    return ['-p', f'grid.rows:={rows}', '-p', f'grid.cols:={rows}',
+            '-p', f'grid.spacing_deg:={spacing}', '-p', 'fpoc.model:=camera',
+            '-p', f'fpoc.half_width_deg:={half}', '-p', f'fpoc.half_height_deg:={half}']
+
+
+def _rss_mib(pid):
+    with open(f'/proc/{pid}/status') as fh:
+        for line in fh:
+            if line.startswith('VmRSS:'):
+                return int(line.split()[1]) / 1024
+    return float('nan')
+
+
+class _Listener:
+    """This process's node: frame stamps from ``joint_states`` and the controller's counters."""
+
+    def __init__(self, domain, count_frames=False):
+        self.context = rclpy.Context()
+        rclpy.init(context=self.context, domain_id=domain, args=[])
+        self.node = Node('bench_listener', context=self.context)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        self.stamps, self.counters, self.frames = [], {}, 0
+        if count_frames:
+            self.node.create_subscription(Float32MultiArray, 'evidence', self._on_frame,
+                                          qos_profile_sensor_data)
+        self.node.create_subscription(JointState, 'joint_states', self._on_pose, 100)
+        self.node.create_subscription(DiagnosticArray, '/diagnostics', self._on_diag, 10)
+
+    def _on_pose(self, msg):
+        self.stamps.append(msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec)
+
+    def _on_frame(self, msg):
+        self.frames += 1
+
+    def _on_diag(self, msg):
+        for status in msg.status:
+            if status.name.endswith('search'):
+                self.counters = {kv.key: kv.value for kv in status.values}
+
+    def spin_for(self, seconds):
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            self.executor.spin_once(timeout_sec=0.05)
+
+    def close(self):
+        self.executor.shutdown(timeout_sec=1)
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)
+
+
+def _start(tmp, domain, rows, spacing, half, camera_args, controller_args=()):
+    env = ros_environment(domain, Path(tmp) / 'log')
+    task = _task_args(rows, spacing, half)
+    controller = NodeProcess('controller', [
+        *task, '-p', 'policy.name:=elm', '-p', 'settle_time_s:=0.0', '-p', 'retry_period_s:=0.5',
+        '-p', 'pan_min_rad:=-3.0', '-p', 'pan_max_rad:=3.0', '-p', 'tilt_min_rad:=-1.5',
+        '-p', 'tilt_max_rad:=1.5', *controller_args], env, Path(tmp) / 'controller.log').start()
+    camera = NodeProcess('camera', [*task, *camera_args], env, Path(tmp) / 'camera.log').start()
+    return controller, camera
+
+
+def loop(rows, spacing, half, seconds, domain):
+    """Loop periods (ms) and sustained fixations per second with a frame-per-command camera."""
+    with tempfile.TemporaryDirectory() as tmp:
+        controller, camera = _start(tmp, domain, rows, spacing, half,
+                                    ['-p', 'saccade_time_s:=0.0', '-p', 'rate_hz:=0.0'])
+        listener = _Listener(domain)
+        try:
+            deadline = time.monotonic() + 60
+            while len(listener.stamps) < 20 and time.monotonic() < deadline:
+                listener.spin_for(0.2)
+            if len(listener.stamps) < 20:
+                raise RuntimeError('the loop did not start:\n' + controller.output()[-2000:]
+                                   + camera.output()[-2000:])
+            first = len(listener.stamps)
+            listener.spin_for(seconds)
+            stamps = np.array(listener.stamps[first:])
+        finally:
+            listener.close()
+            controller.stop()
+            camera.stop()
+    periods = np.diff(stamps) * 1e3
+    return {'median_ms': float(np.median(periods)), 'p99_ms': float(np.percentile(periods, 99)),
+            'fixations_per_s': float(periods.size / (stamps[-1] - stamps[0])),
+            'loops': int(periods.size)}
+
+
+def stream(rows, spacing, half, rate_hz, seconds, domain):
+    """Stream camera frames: sent vs applied, skipped and lost; controller RSS (MiB)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        controller, camera = _start(tmp, domain, rows, spacing, half,
+                                    ['-p', 'saccade_time_s:=0.0', '-p', f'rate_hz:={rate_hz}'],
+                                    ['-p', 'diagnostics_period_s:=0.5'])
+        listener = _Listener(domain, count_frames=True)
+        try:
+            deadline = time.monotonic() + 90
+            while listener.counters.get('frames_applied', '0') in ('', '0') \
+                    and time.monotonic() < deadline:
+                listener.spin_for(0.5)
+            rss0 = _rss_mib(controller.proc.pid)
+            c0, n0 = dict(listener.counters), listener.frames
+            listener.spin_for(seconds)
+            listener.spin_for(1.2)                       # one more diagnostics period
+            c1, n1 = dict(listener.counters), listener.frames
+            rss1 = _rss_mib(controller.proc.pid)
+        finally:
+            listener.close()
+            controller.stop()
+            camera.stop()
+
+    def delta(key):
+        return int(float(c1.get(key, 'nan'))) - int(float(c0.get(key, 'nan')))
+    sent = n1 - n0
+    received, applied, skipped = (delta('frames_received'), delta('frames_applied'),
+                                  delta('frames_skipped'))
+    return {'sent': sent, 'received': received, 'applied': applied, 'skipped': skipped,
+            'rss0': rss0, 'rss1': rss1, 'seconds': seconds}
+
+
+def bench(ctx=None) -> str:
+    quick = bool(getattr(ctx, 'quick', False))
+    seconds = 4.0 if quick else 15.0
+    domain = domain_id_for()
+    lines = ['| grid | loops timed | loop median (ms) | loop p99 (ms) | fixations per second |',
+             '|---|---|---|---|---|']
+    for label, rows, spacing, half in LOOPS:
+        r = loop(rows, spacing, half, seconds, domain)
+        lines.append(f"| {label} | {r['loops']} | {r['median_ms']:.2f} | {r['p99_ms']:.2f} | "
+                     f"{r['fixations_per_s']:.0f} |")
+    label, rows, spacing, half, rate = STREAM
+    s = stream(rows, spacing, half, rate, seconds, domain)
+    lost = s['sent'] - s['received']
+    lines += ['', f"{label} (camera streaming, controller ELM by FFT), over {s['seconds']:.0f} s: "
+              f"this process saw {s['sent']} camera frames (best effort, so a lower bound of "
+              f"what was sent); the controller received {s['received']} "
+              f"(lost to the keep-last queue: {lost}), applied {s['applied']} and skipped "
+              f"{s['skipped']} (stale: taken before the latest target settled, or superseded); "
+              f"controller RSS {s['rss0']:.0f} MiB before, {s['rss1']:.0f} MiB after.",
+              '', "Each loop includes two DDS hops, the controller's update and decision and the "
+              "camera's frame generation; the camera stamps a frame when it sends it.", '']
+    return '\n'.join(lines)
+
+
+if __name__ == '__main__':
+    print(bench())
+    sys.exit(0)
