@@ -11,7 +11,7 @@ import importlib
 import sys
 
 # Modules under ipomdp_gaze.commands, in the order --help lists them.
-COMMANDS = ('evaluate', 'search', 'demo')
+COMMANDS = ('evaluate', 'search', 'demo', 'train')
 
 
 class CliError(Exception):

@@ -6,10 +6,9 @@ Sec. III. The convolutional family of :mod:`policies.conv` is the special case
 """
 from __future__ import annotations
 
-import numpy as np
-
 from ipomdp_gaze.belief import argmax_ties_low
 from ipomdp_gaze.grid import Grid
+import numpy as np
 
 from .conv import check_action
 

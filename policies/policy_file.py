@@ -21,17 +21,16 @@ with a file (:class:`PolicyFileError`). A source is a path or the name of a ship
 """
 from __future__ import annotations
 
-import math
-import warnings
 from dataclasses import dataclass, field
+import math
 from pathlib import Path
 from typing import Callable
-
-import numpy as np
-import yaml
+import warnings
 
 from ipomdp_gaze.fpoc import FPOC, fpoc_from_dict
 from ipomdp_gaze.grid import Grid
+import numpy as np
+import yaml
 
 from .conv import ACTIONS, ConvPolicy, radial_bins
 from .logistic import LogisticPolicy
@@ -92,7 +91,7 @@ class PolicySpec:
                 'weight': [float(w) for w in weight]}
 
     def make_policy(self, action: str | None = None):
-        """The policy object (:class:`ConvPolicy` or :class:`LogisticPolicy`)."""
+        """Build the policy object (:class:`ConvPolicy` or :class:`LogisticPolicy`)."""
         action = self.action if action is None else action
         if self.family == 'conv':
             policy = ConvPolicy(self.grid, self.kernel, action=action)
@@ -103,7 +102,7 @@ class PolicySpec:
         return policy
 
     def to_dict(self) -> dict:
-        """The YAML document as plain Python types (what :func:`save_policy` writes)."""
+        """Return the YAML document as plain Python types (what :func:`save_policy` writes)."""
         doc = {'format': FORMAT, 'grid': self.grid.to_dict(), 'fpoc': _plain(self.fpoc.to_dict()),
                'reward': self.reward, 'family': self.family, 'action': self.action}
         if self.family == 'conv':
@@ -137,7 +136,7 @@ def shipped_kernels() -> list[str]:
 
 
 def resolve_source(source) -> Path:
-    """The file a source names: an existing path, or a shipped kernel name (with or without .yaml).
+    """Find the file a source names: a path, or a shipped kernel name (with or without .yaml).
 
     Raises
     ------

@@ -1,25 +1,24 @@
 """Policy files: round trip, shipped names, and every error naming its problem."""
 from pathlib import Path
 
-import numpy as np
-import pytest
-import yaml
-
 from ipomdp_gaze.cli import main
 from ipomdp_gaze.fpoc import make_fpoc
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.simulate import simulate
+import numpy as np
 from policies import policy_file as pf
 from policies.conv import ConvPolicy, kernel_from_radial, radial_bins
 from policies.logistic import LogisticPolicy
-from policies.policy_file import (PolicyFileError, PolicySpec, load_policy, load_policy_spec,
+from policies.policy_file import (load_policy, load_policy_spec, PolicyFileError, PolicySpec,
                                   save_policy, shipped_kernels)
+import pytest
+import yaml
 
 GRID = Grid(3, 4, 0.42)
 
 
 def conv_spec(grid=GRID, symmetric=True, seed=0):
-    """A conv spec with a random radial (or fully random) kernel."""
+    """Build a conv spec with a random radial (or fully random) kernel."""
     rng = np.random.default_rng(seed)
     if symmetric:
         kernel = kernel_from_radial(grid, rng.normal(size=radial_bins(grid)[0].size))
