@@ -45,14 +45,17 @@ class TrainConfig:
     """Hyper-parameters of a training run (all recorded in the policy file's training block).
 
     ``reward_scale`` multiplies every reward before the gradient (the paper does not state its
-    scale); ``baseline`` subtracts a per-time-step reward baseline (the mean reward of the other
-    episodes of the epoch at the same step, which keeps the estimate unbiased).
+    scale); the step size of epoch i is ``learning_rate / (1 + i / anneal_epochs)`` (constant
+    when ``anneal_epochs`` is None; the paper's "gamma_t can anneal over time"); ``baseline``
+    subtracts a per-time-step reward baseline (the mean reward of the other episodes of the
+    epoch at the same step, which keeps the estimate unbiased).
     """
 
     reward: str = 'infomax'
     family: str = 'conv'
     learning_rate: float = 1.0
     reward_scale: float = 1.0
+    anneal_epochs: float | None = None
     beta: float = 0.75
     episodes_per_epoch: int = 150
     horizon: int | None = None
@@ -71,6 +74,10 @@ class TrainConfig:
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
                 raise ValueError(f'{name} must be a positive finite number, got {value!r}')
+        if self.anneal_epochs is not None and not (
+                isinstance(self.anneal_epochs, (int, float)) and self.anneal_epochs > 0):
+            raise ValueError(f'anneal_epochs must be a positive number or None, '
+                             f'got {self.anneal_epochs!r}')
         if not 0 <= self.beta < 1:
             raise ValueError(f'beta must be in [0, 1), got {self.beta!r}')
         for name in ('episodes_per_epoch', 'eval_every', 'eval_episodes'):
@@ -285,6 +292,13 @@ class Trainer:
         """Return the generator of epoch ``epoch`` (0-based)."""
         return np.random.default_rng([self.config.seed, epoch])
 
+    def learning_rate(self, epoch: int) -> float:
+        """Return the step size of epoch ``epoch`` (0-based)."""
+        cfg = self.config
+        if cfg.anneal_epochs is None:
+            return cfg.learning_rate
+        return cfg.learning_rate / (1.0 + epoch / cfg.anneal_epochs)
+
     def step(self) -> EpochResult:
         """Run one epoch and update the parameters."""
         cfg = self.config
@@ -292,7 +306,7 @@ class Trainer:
                                 cfg.episodes_per_epoch, self.horizon, self.epoch_rng(self.epoch))
         grad = self.family.project(theta_gradient(batch, cfg.beta, cfg.reward_scale,
                                                   cfg.baseline))
-        self.params += cfg.learning_rate * grad
+        self.params += self.learning_rate(self.epoch) * grad
         self.epoch += 1
         return EpochResult(grad, batch.reward.sum(axis=0))
 
@@ -353,7 +367,8 @@ class Trainer:
         """Return the policy file contents for the current parameters."""
         cfg = self.config
         training = {'epochs': self.epoch, 'episodes_per_epoch': cfg.episodes_per_epoch,
-                    'learning_rate': cfg.learning_rate, 'reward_scale': cfg.reward_scale,
+                    'learning_rate': cfg.learning_rate, 'anneal_epochs': cfg.anneal_epochs,
+                    'reward_scale': cfg.reward_scale,
                     'beta': cfg.beta, 'horizon': self.horizon, 'baseline': cfg.baseline,
                     'seed': cfg.seed, 'init': 'zeros', 'eval_every': cfg.eval_every,
                     'eval_episodes': cfg.eval_episodes, 'eval_seed': cfg.eval_seed,

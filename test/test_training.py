@@ -148,7 +148,7 @@ def test_short_training_beats_the_zero_kernel_at_argmax():
 def test_resume_continues_identically(tmp_path, family):
     grid = Grid(3, 4)
     config = TrainConfig(family=family, learning_rate=5.0, seed=9, eval_every=2,
-                         eval_episodes=50, baseline=True)
+                         eval_episodes=50, baseline=True, anneal_epochs=2.0)
     straight = Trainer(grid, FPOC, config)
     straight.run(6)
     first = Trainer(grid, FPOC, config)
@@ -160,6 +160,12 @@ def test_resume_continues_identically(tmp_path, family):
     np.testing.assert_array_equal(resumed.params, straight.params)
     assert [r['epoch'] for r in resumed.curve] == [4, 6]
     assert resumed.curve[-1]['mean_return'] == straight.curve[-1]['mean_return']
+
+
+def test_annealed_learning_rate():
+    trainer = Trainer(Grid(3, 3), FPOC, TrainConfig(learning_rate=6.0, anneal_epochs=2.0))
+    assert [trainer.learning_rate(i) for i in (0, 2, 4)] == [6.0, 3.0, 2.0]
+    assert Trainer(Grid(3, 3), FPOC, TrainConfig(learning_rate=6.0)).learning_rate(9) == 6.0
 
 
 def test_config_validation_names_the_problem():

@@ -14,7 +14,7 @@ from .common import add_task_args, nonneg_int, positive_float, positive_int, tas
 
 FAMILY_DEFAULT, REWARD_DEFAULT = 'conv', 'infomax'
 # The defaults of the learning rate and reward scale: chosen on the 7x7 human task (README).
-LEARNING_RATE = 20.0
+LEARNING_RATE = 5.0
 REWARD_SCALE = 1.0
 
 
@@ -38,6 +38,8 @@ def add_parser(sub):
                    help='continue training the policy in this file with its recorded settings')
     p.add_argument('--learning-rate', type=positive_float, default=None,
                    help=f'step size of theta += lr * mean g (default {LEARNING_RATE})')
+    p.add_argument('--anneal-epochs', type=positive_float, default=None, metavar='TAU',
+                   help='anneal the step size as lr / (1 + epoch / TAU) (default: constant)')
     p.add_argument('--reward-scale', type=positive_float, default=None,
                    help=f'factor applied to every reward (default {REWARD_SCALE})')
     p.add_argument('--beta', type=float, default=None, help='eligibility trace decay (0.75)')
@@ -103,7 +105,8 @@ def run(args) -> int:
         args.fpoc = args.fpoc if args.fpoc is not None else 'human'
     grid, fpoc = _task(args, spec)
     overrides = {
-        'learning_rate': args.learning_rate, 'reward_scale': args.reward_scale,
+        'learning_rate': args.learning_rate, 'anneal_epochs': args.anneal_epochs,
+        'reward_scale': args.reward_scale,
         'beta': args.beta, 'baseline': args.baseline, 'seed': args.seed,
         'episodes_per_epoch': args.episodes_per_epoch, 'eval_every': args.eval_every,
         'eval_episodes': args.eval_episodes}
