@@ -14,7 +14,7 @@ import importlib
 import sys
 
 # Modules under ipomdp_gaze.commands, in the order --help lists them.
-COMMANDS = ('evaluate', 'search', 'demo', 'reproduce', 'controller', 'camera')
+COMMANDS = ('evaluate', 'search', 'train', 'reproduce', 'demo', 'controller', 'camera')
 
 
 class CliError(Exception):

@@ -55,8 +55,8 @@ def test_install_tree_has_executables_index_marker_and_share_files(workspace):
 
 @pytest.mark.ros
 def test_ros2_run_starts_the_installed_controller(workspace, ros_env, probe, tmp_path):
-    from sensor_msgs.msg import JointState
     from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+    from sensor_msgs.msg import JointState
     latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                          durability=DurabilityPolicy.TRANSIENT_LOCAL)
     received = probe.record(JointState, '/colcon_check/pan_tilt', latched)

@@ -1,0 +1,159 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+``ipomdp-gaze train``: learn a policy by GPOMDP policy gradient and write its policy file.
+
+Writes ``PATH.yaml`` (the policy, its training record and, at the end, its evaluation on
+``--final-episodes`` episodes) and the learning curve ``PATH.csv`` beside it. Both are rewritten
+at every evaluation point, so an interrupted run resumes with ``--resume PATH.yaml``.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from ipomdp_gaze.grid import parse_grid
+
+from .common import add_task_args, nonneg_int, positive_float, positive_int, task_from_args
+
+FAMILY_DEFAULT, REWARD_DEFAULT = 'conv', 'infomax'
+# The defaults of the learning rate and reward scale: chosen on the 7x7 human task (README).
+LEARNING_RATE = 5.0
+REWARD_SCALE = 1.0
+
+
+def add_parser(sub):
+    p = sub.add_parser('train', help='learn a policy by policy gradient (GPOMDP)',
+                       description='Train a convolutional (radially weight-shared) or full '
+                                   'logistic policy from a zero kernel, or resume one; write the '
+                                   'policy file and a learning-curve CSV beside it.')
+    add_task_args(p)
+    p.set_defaults(grid=None, spacing_deg=None, fpoc=None)
+    p.add_argument('--reward', choices=('infomax', 'fixate_target'), default=None,
+                   help=f'reward (default {REWARD_DEFAULT})')
+    p.add_argument('--family', choices=('conv', 'logistic'), default=None,
+                   help=f'policy family (default {FAMILY_DEFAULT})')
+    p.add_argument('--epochs', type=nonneg_int, required=True,
+                   help='total epochs; with --resume, training continues up to this count')
+    p.add_argument('--seed', type=nonneg_int, default=None, help='training seed (default 0)')
+    p.add_argument('--out', type=Path, default=None, metavar='PATH.yaml',
+                   help='policy file to write (default: the --resume file)')
+    p.add_argument('--resume', type=Path, default=None, metavar='PATH.yaml',
+                   help='continue training the policy in this file with its recorded settings')
+    p.add_argument('--learning-rate', type=positive_float, default=None,
+                   help=f'step size of theta += lr * mean g (default {LEARNING_RATE})')
+    p.add_argument('--anneal-epochs', type=positive_float, default=None, metavar='TAU',
+                   help='anneal the step size as lr / (1 + epoch / TAU) (default: constant)')
+    p.add_argument('--reward-scale', type=positive_float, default=None,
+                   help=f'factor applied to every reward (default {REWARD_SCALE})')
+    p.add_argument('--beta', type=float, default=None, help='eligibility trace decay (0.75)')
+    p.add_argument('--baseline', dest='baseline', action='store_true', default=None,
+                   help='subtract a per-time-step reward baseline (the default)')
+    p.add_argument('--no-baseline', dest='baseline', action='store_false',
+                   help='plain GPOMDP without a baseline')
+    p.add_argument('--episodes-per-epoch', type=positive_int, default=None,
+                   help='episodes pooled per update (default 150, the paper)')
+    p.add_argument('--eval-every', type=positive_int, default=None, metavar='K',
+                   help='evaluate the argmax policy every K epochs (default 50)')
+    p.add_argument('--eval-episodes', type=positive_int, default=None,
+                   help='episodes of the fixed evaluation set used during training '
+                        '(default 2000)')
+    p.add_argument('--final-episodes', type=nonneg_int, default=20000,
+                   help='episodes of the final evaluation written to the file (default 20000; '
+                        '0 skips it)')
+    p.add_argument('--final-seed', type=nonneg_int, default=0,
+                   help='seed of the final evaluation (default 0, as ipomdp-gaze evaluate)')
+    p.add_argument('--quiet', action='store_true', help='no progress bar')
+    p.set_defaults(run=run)
+
+
+def _task(args, spec):
+    """Return the task of the command line or of the resumed file (explicit options must agree)."""
+    from ipomdp_gaze.fpoc import make_fpoc
+    from ipomdp_gaze.grid import Grid
+    from policies.policy_file import PolicyFileError
+    if spec is None:
+        return task_from_args(args)
+    given = {
+        'grid': args.grid is not None and tuple(args.grid) != spec.grid.shape,
+        'spacing-deg': args.spacing_deg is not None
+        and args.spacing_deg != spec.grid.spacing_deg,
+        'fpoc': args.fpoc is not None and args.fpoc != spec.fpoc.model,
+        'reward': args.reward is not None and args.reward != spec.reward,
+        'family': args.family is not None and args.family != spec.family,
+    }
+    clash = [name for name, differs in given.items() if differs]
+    if clash:
+        raise PolicyFileError(f'--{clash[0]} differs from the resumed file {args.resume} '
+                              '(drop it to continue the task of the file)')
+    if args.fpoc_param:
+        params = {**spec.fpoc.params(), **dict(args.fpoc_param)}
+        if make_fpoc(spec.fpoc.model, **params) != spec.fpoc:
+            raise PolicyFileError(f'--fpoc-param differs from the resumed file {args.resume}')
+    return Grid(spec.grid.rows, spec.grid.cols, spec.grid.spacing_deg), spec.fpoc
+
+
+def run(args) -> int:
+    from policies.policy_file import load_policy_spec, save_policy
+    from policies.training import (evaluation_block, read_curve, TrainConfig, Trainer,
+                                   trainer_from_spec, write_curve)
+    spec = load_policy_spec(args.resume) if args.resume is not None else None
+    out = args.out if args.out is not None else args.resume
+    if out is None:
+        raise ValueError('--out PATH.yaml is required (or --resume PATH.yaml)')
+    if out.suffix != '.yaml':
+        raise ValueError(f'--out must end in .yaml, got {out}')
+    if spec is None:
+        args.grid = args.grid if args.grid is not None else parse_grid('7x7')
+        args.spacing_deg = args.spacing_deg if args.spacing_deg is not None else 0.42
+        args.fpoc = args.fpoc if args.fpoc is not None else 'human'
+    grid, fpoc = _task(args, spec)
+    overrides = {
+        'learning_rate': args.learning_rate, 'anneal_epochs': args.anneal_epochs,
+        'reward_scale': args.reward_scale,
+        'beta': args.beta, 'baseline': args.baseline, 'seed': args.seed,
+        'episodes_per_epoch': args.episodes_per_epoch, 'eval_every': args.eval_every,
+        'eval_episodes': args.eval_episodes}
+    if spec is None:
+        defaults = {'reward': args.reward or REWARD_DEFAULT,
+                    'family': args.family or FAMILY_DEFAULT, 'learning_rate': LEARNING_RATE,
+                    'reward_scale': REWARD_SCALE, 'baseline': True}
+        defaults.update({k: v for k, v in overrides.items() if v is not None})
+        trainer = Trainer(grid, fpoc, TrainConfig(**defaults))
+    else:
+        trainer = trainer_from_spec(spec, **overrides)
+    curve_path = out.with_suffix('.csv')
+    rows = []
+    if spec is not None and args.resume.with_suffix('.csv').is_file():
+        rows = [r for r in read_curve(args.resume.with_suffix('.csv'))
+                if r['epoch'] <= trainer.epoch]
+    remaining = args.epochs - trainer.epoch
+    if remaining < 0:
+        raise ValueError(f'--epochs {args.epochs} is less than the {trainer.epoch} epochs '
+                         f'already trained in {args.resume}')
+
+    def checkpoint(row=None):
+        if row is not None:
+            rows.append(row)
+        save_policy(out, trainer.spec())
+        write_curve(curve_path, rows)
+
+    trainer.run(remaining, progress=not args.quiet, callback=checkpoint)
+    evaluation = {}
+    if args.final_episodes:
+        evaluation = evaluation_block(grid, fpoc, trainer.family.policy(trainer.params),
+                                      args.final_episodes, args.final_seed, trainer.horizon)
+    save_policy(out, trainer.spec(evaluation=evaluation))
+    write_curve(curve_path, rows)
+    cfg = trainer.config
+    print(f'trained {cfg.family} {cfg.reward} policy on {grid.rows}x{grid.cols} '
+          f'{fpoc.model}: {trainer.epoch} epochs, lr {cfg.learning_rate}, '
+          f'{trainer.wall_seconds:.1f} s of training')
+    if evaluation:
+        f90, ci = evaluation['fixations_to_90'], evaluation['ci95']
+        text = 'never' if f90 is None else f'{f90:.2f}'
+        if ci:
+            text += f' [{ci[0]:.2f}, {ci[1]:.2f}]'
+        print(f'fixations to 90% correct (argmax, {args.final_episodes} episodes, seed '
+              f'{args.final_seed}): {text}')
+    print(f'wrote {out} and {curve_path}')
+    return 0

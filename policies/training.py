@@ -1,0 +1,455 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+GPOMDP policy-gradient training of logistic and convolutional policies (DESIGN.md section 3).
+
+Per episode the eligibility trace is ``z_t = beta z_{t-1} + grad log pi(a_t | B_t)`` and the
+gradient estimate ``g = sum_t r_t z_t`` (Baxter & Bartlett 2001); every epoch runs
+``episodes_per_epoch`` episodes of horizon T (default N) and moves the weights by
+``learning_rate * mean over the episodes of g``. The reward of step t is computed on the belief
+after observation t.
+
+All episodes of an epoch are simulated as one batch. The trace is never stored: summing by parts,
+``g = sum_t r_t z_t = sum_s grad_s Q_s`` with ``Q_s = sum_{t >= s} beta^(t-s) r_t`` (the same
+number, exactly), and ``grad log pi(a | B)`` of a logistic policy is the outer product
+``(onehot(a) - p) B^T``, so the whole epoch's gradient is one matrix product
+``sum_{t,e} Q (onehot - p) B^T``. The convolutional family ties every ``theta[k, j]`` with the same
+squared displacement to one weight, so its gradient is the logistic gradient summed over each
+tie class (27 weights at 7x7, 61 at 11x11).
+
+Randomness: epoch ``i`` draws everything from ``numpy.random.default_rng([seed, i])``, so a run
+resumed from a saved policy after epoch i continues exactly as the uninterrupted run.
+"""
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass, field, replace
+import math
+from pathlib import Path
+import time
+from typing import Callable
+
+from ipomdp_gaze.belief import normalize_log, uniform_log_belief
+from ipomdp_gaze.evaluation import fixations_to_90_ci, fixations_to_level
+from ipomdp_gaze.fpoc import dprime_matrix, FPOC
+from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.simulate import simulate
+import numpy as np
+
+from .conv import ConvPolicy, kernel_from_radial, radial_bins
+from .logistic import LogisticPolicy, sample_rows, softmax
+from .policy_file import FAMILIES, PolicySpec, REWARDS
+
+CSV_FIELDS = ('epoch', 'episodes', 'mean_return', 'fixations_to_90', 'wall_seconds')
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """
+    Hyper-parameters of a training run (all recorded in the policy file's training block).
+
+    ``reward_scale`` multiplies every reward before the gradient (the paper does not state its
+    scale); the step size of epoch i is ``learning_rate / (1 + i / anneal_epochs)`` (constant
+    when ``anneal_epochs`` is None; the paper's "gamma_t can anneal over time"); ``baseline``
+    subtracts a per-time-step reward baseline (the mean reward of the other episodes of the
+    epoch at the same step, which keeps the estimate unbiased).
+    """
+
+    reward: str = 'infomax'
+    family: str = 'conv'
+    learning_rate: float = 1.0
+    reward_scale: float = 1.0
+    anneal_epochs: float | None = None
+    beta: float = 0.75
+    episodes_per_epoch: int = 150
+    horizon: int | None = None
+    baseline: bool = False
+    seed: int = 0
+    eval_every: int = 50
+    eval_episodes: int = 2000
+    eval_seed: int = 1000003
+
+    def __post_init__(self):
+        if self.reward not in REWARDS:
+            raise ValueError(f"unknown reward {self.reward!r}; valid: {', '.join(REWARDS)}")
+        if self.family not in FAMILIES:
+            raise ValueError(f"unknown family {self.family!r}; valid: {', '.join(FAMILIES)}")
+        for name in ('learning_rate', 'reward_scale'):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise ValueError(f'{name} must be a positive finite number, got {value!r}')
+        if self.anneal_epochs is not None and not (
+                isinstance(self.anneal_epochs, (int, float)) and self.anneal_epochs > 0):
+            raise ValueError(f'anneal_epochs must be a positive number or None, '
+                             f'got {self.anneal_epochs!r}')
+        if not 0 <= self.beta < 1:
+            raise ValueError(f'beta must be in [0, 1), got {self.beta!r}')
+        for name in ('episodes_per_epoch', 'eval_every', 'eval_episodes'):
+            if int(getattr(self, name)) < 1:
+                raise ValueError(f'{name} must be >= 1, got {getattr(self, name)!r}')
+        if self.episodes_per_epoch < 2 and self.baseline:
+            raise ValueError('a reward baseline needs at least 2 episodes per epoch')
+        if self.horizon is not None and int(self.horizon) < 1:
+            raise ValueError(f'horizon must be >= 1, got {self.horizon!r}')
+
+
+@dataclass
+class EpochResult:
+    """What one epoch produced: the mean gradient (over episodes) and the returns."""
+
+    gradient: np.ndarray
+    returns: np.ndarray
+
+
+@dataclass
+class Episodes:
+    """
+    A batch of sampled episodes: what the gradient needs, stacked over time steps.
+
+    ``belief[t, e]`` is B_t (before fixation t), ``delta[t, e] = onehot(a_t) - p(. | B_t)`` and
+    ``reward[t, e]`` the (unscaled) reward on the belief after observation t.
+    """
+
+    belief: np.ndarray
+    delta: np.ndarray
+    reward: np.ndarray
+    fixations: np.ndarray = field(default=None)
+
+
+class Family:
+    """Maps a family's parameter vector to the N x N matrix ``theta[k, j]`` and back."""
+
+    def __init__(self, grid: Grid, name: str):
+        self.grid = grid
+        self.name = name
+        if name == 'conv':
+            values, bins = radial_bins(grid)
+            ri, ci = grid.pair_offset_index()
+            self.squared_distance = values
+            self.pair_bins = np.ascontiguousarray(bins[ri, ci])      # [k, j]
+            self.size = values.size
+        else:
+            self.size = grid.n_cells ** 2
+
+    def theta(self, params: np.ndarray) -> np.ndarray:
+        """Expand a parameter vector into the N x N matrix ``theta[k, j]``."""
+        if self.name == 'conv':
+            return params[self.pair_bins]
+        n = self.grid.n_cells
+        return params.reshape(n, n)
+
+    def project(self, grad_theta: np.ndarray) -> np.ndarray:
+        """Gradient with respect to the parameters from the gradient with respect to theta."""
+        if self.name == 'conv':
+            return np.bincount(self.pair_bins.ravel(), weights=grad_theta.ravel(),
+                               minlength=self.size)
+        return grad_theta.ravel().copy()
+
+    def policy(self, params: np.ndarray, action: str = 'argmax'):
+        """Build the policy object with these parameters."""
+        if self.name == 'conv':
+            return ConvPolicy(self.grid, kernel_from_radial(self.grid, params), action=action)
+        return LogisticPolicy(self.grid, self.theta(params), action=action)
+
+    def params_from_spec(self, spec: PolicySpec) -> np.ndarray:
+        """Read the parameter vector stored in a policy file."""
+        if self.name == 'conv':
+            radial = spec.radial()
+            if radial is None:
+                raise ValueError('cannot resume a conv policy whose kernel is not radially '
+                                 'weight-shared')
+            return np.asarray(radial['weight'], dtype=float)
+        return np.asarray(spec.theta, dtype=float).ravel().copy()
+
+
+def sample_episodes(theta: np.ndarray, dprime_by_fix: np.ndarray, reward: str, episodes: int,
+                    horizon: int, rng: np.random.Generator) -> Episodes:
+    """
+    Run a batch of episodes with the softmax policy ``p(k | B) ∝ exp(theta[k] . B)``.
+
+    Parameters
+    ----------
+    theta : array (N, N)
+        ``theta[k, j]``.
+    dprime_by_fix : array (N, N)
+        ``d[k, j]``: d' of cell j when fixating k.
+    reward : {'infomax', 'fixate_target'}
+        The reward computed on the belief after each observation.
+    episodes, horizon : int
+        Batch size and fixations per episode.
+    rng : numpy.random.Generator
+        Source of the targets, the observation noise and the policy's samples.
+
+    """
+    n = theta.shape[0]
+    rows = np.arange(episodes)
+    theta_t = np.ascontiguousarray(theta.T)
+    targets = rng.integers(0, n, size=episodes)
+    log_b = uniform_log_belief(n, episodes)
+    belief = np.exp(log_b)
+    beliefs = np.empty((horizon, episodes, n))
+    delta = np.empty((horizon, episodes, n))
+    rewards = np.empty((horizon, episodes))
+    fixations = np.empty((horizon, episodes), dtype=np.int64)
+    for t in range(horizon):
+        beliefs[t] = belief
+        p = softmax(belief @ theta_t)
+        a = sample_rows(p, rng)
+        fixations[t] = a
+        np.negative(p, out=delta[t])
+        delta[t, rows, a] += 1.0
+        d_k = dprime_by_fix[a]
+        obs = rng.standard_normal((episodes, n))
+        obs[rows, targets] += d_k[rows, targets]
+        log_b += d_k * (obs - 0.5 * d_k)
+        normalize_log(log_b)
+        np.exp(log_b, out=belief)
+        if reward == 'infomax':
+            rewards[t] = np.sum(belief * log_b, axis=1)
+        else:
+            rewards[t] = belief[rows, a]
+    return Episodes(beliefs, delta, rewards, fixations)
+
+
+def discounted_from(rewards: np.ndarray, beta: float) -> np.ndarray:
+    """``Q_s = sum_{t >= s} beta^(t-s) r_t`` along axis 0 (time)."""
+    q = np.empty_like(rewards)
+    acc = np.zeros(rewards.shape[1:])
+    for t in range(rewards.shape[0] - 1, -1, -1):
+        acc = rewards[t] + beta * acc
+        q[t] = acc
+    return q
+
+
+def leave_one_out_mean(rewards: np.ndarray) -> np.ndarray:
+    """Per time step, the mean reward of the other episodes (axis 1) of the batch."""
+    e = rewards.shape[1]
+    return (rewards.sum(axis=1, keepdims=True) - rewards) / (e - 1)
+
+
+def theta_gradient(batch: Episodes, beta: float, reward_scale: float = 1.0,
+                   baseline: bool = False) -> np.ndarray:
+    """Mean over episodes of ``g = sum_t r_t z_t`` with respect to the N x N theta."""
+    r = reward_scale * batch.reward
+    if baseline:
+        r = r - leave_one_out_mean(r)
+    q = discounted_from(r, beta)
+    n = batch.belief.shape[-1]
+    weighted = (batch.delta * q[:, :, None]).reshape(-1, n)
+    return weighted.T @ batch.belief.reshape(-1, n) / batch.reward.shape[1]
+
+
+def trace_gradient_reference(batch: Episodes, beta: float, reward_scale: float = 1.0,
+                             baseline: bool = False) -> np.ndarray:
+    """Compute the same estimate literally with the eligibility trace (for tests; slow)."""
+    r = reward_scale * batch.reward
+    if baseline:
+        r = r - leave_one_out_mean(r)
+    horizon, episodes, n = batch.belief.shape
+    total = np.zeros((n, n))
+    for e in range(episodes):
+        z = np.zeros((n, n))
+        for t in range(horizon):
+            z = beta * z + np.outer(batch.delta[t, e], batch.belief[t, e])
+            total += r[t, e] * z
+    return total / episodes
+
+
+def log_policy_gradient(theta: np.ndarray, belief: np.ndarray, action: int) -> np.ndarray:
+    """``grad_theta log p(action | belief)`` of the logistic policy, shape (N, N)."""
+    p = softmax(belief @ theta.T)
+    onehot = np.zeros_like(p)
+    onehot[action] = 1.0
+    return np.outer(onehot - p, belief)
+
+
+class Trainer:
+    """
+    Trains one policy on one task; call :meth:`run` as often as needed (it resumes).
+
+    Parameters
+    ----------
+    grid, fpoc : the task.
+    config : TrainConfig
+    params : array, optional
+        Initial parameter vector (radial weights or flattened theta); zeros (a uniformly random
+        policy) when omitted: training from scratch.
+    epoch : int
+        Epochs already done (when resuming).
+
+    """
+
+    def __init__(self, grid: Grid, fpoc: FPOC, config: TrainConfig,
+                 params: np.ndarray | None = None, epoch: int = 0, wall_seconds: float = 0.0):
+        self.grid = grid
+        self.fpoc = fpoc
+        self.config = config
+        self.family = Family(grid, config.family)
+        if params is None:
+            params = np.zeros(self.family.size)
+        params = np.array(params, dtype=float).ravel()
+        if params.size != self.family.size:
+            raise ValueError(f'{config.family} parameters must have {self.family.size} values, '
+                             f'got {params.size}')
+        self.params = params
+        self.epoch = int(epoch)
+        self.wall_seconds = float(wall_seconds)
+        self.horizon = grid.n_cells if config.horizon is None else int(config.horizon)
+        self.dprime = dprime_matrix(grid, fpoc)
+        self.dprime_by_fix = np.ascontiguousarray(self.dprime.T)
+        self.curve: list[dict] = []
+
+    def epoch_rng(self, epoch: int) -> np.random.Generator:
+        """Return the generator of epoch ``epoch`` (0-based)."""
+        return np.random.default_rng([self.config.seed, epoch])
+
+    def learning_rate(self, epoch: int) -> float:
+        """Return the step size of epoch ``epoch`` (0-based)."""
+        cfg = self.config
+        if cfg.anneal_epochs is None:
+            return cfg.learning_rate
+        return cfg.learning_rate / (1.0 + epoch / cfg.anneal_epochs)
+
+    def step(self) -> EpochResult:
+        """Run one epoch and update the parameters."""
+        cfg = self.config
+        batch = sample_episodes(self.family.theta(self.params), self.dprime_by_fix, cfg.reward,
+                                cfg.episodes_per_epoch, self.horizon, self.epoch_rng(self.epoch))
+        grad = self.family.project(theta_gradient(batch, cfg.beta, cfg.reward_scale,
+                                                  cfg.baseline))
+        self.params += self.learning_rate(self.epoch) * grad
+        self.epoch += 1
+        return EpochResult(grad, batch.reward.sum(axis=0))
+
+    def evaluate(self, episodes: int | None = None, seed: int | None = None):
+        """Fixations to 90% correct of the argmax policy on a fixed evaluation set."""
+        cfg = self.config
+        result = simulate(self.grid, self.fpoc, self.family.policy(self.params, 'argmax'),
+                          cfg.eval_episodes if episodes is None else episodes, self.horizon,
+                          cfg.eval_seed if seed is None else seed, dprime=self.dprime)
+        return fixations_to_level(result.percent_correct, self.grid.n_cells)
+
+    def run(self, epochs: int, progress: bool = False,
+            callback: Callable[[dict], None] | None = None) -> list[dict]:
+        """
+        Train ``epochs`` more epochs; every ``eval_every`` epochs append a learning-curve row.
+
+        A row is ``{epoch, episodes, mean_return, fixations_to_90, wall_seconds}``: the mean
+        return (sum of the unscaled rewards of an episode, sampled policy) over the epochs since
+        the previous row, and fixations to 90% correct of the argmax policy on the fixed
+        evaluation set (None if never reached). ``callback(row)`` is called after each row.
+        Evaluation time is not counted in ``wall_seconds``. With ``progress`` a tqdm bar on
+        stderr shows the epoch and the mean return.
+        """
+        cfg = self.config
+        bar = None
+        if progress:
+            from tqdm import tqdm
+            bar = tqdm(total=epochs, unit='epoch', dynamic_ncols=True, disable=None)
+        returns = []
+        f90_text = '-'
+        start = time.perf_counter()
+        try:
+            for _ in range(epochs):
+                returns.append(float(self.step().returns.mean()))
+                last_return = returns[-1]
+                if self.epoch % cfg.eval_every == 0:
+                    self.wall_seconds += time.perf_counter() - start
+                    f90 = self.evaluate()
+                    row = {'epoch': self.epoch, 'episodes': self.epoch * cfg.episodes_per_epoch,
+                           'mean_return': float(np.mean(returns)), 'fixations_to_90': f90,
+                           'wall_seconds': round(self.wall_seconds, 3)}
+                    self.curve.append(row)
+                    returns = []
+                    f90_text = 'never' if f90 is None else f'{f90:.2f}'
+                    if callback is not None:
+                        callback(row)
+                    start = time.perf_counter()
+                if bar is not None:
+                    bar.set_description(f'epoch {self.epoch}')
+                    bar.set_postfix_str(f'return {last_return:.3f} fix->90% {f90_text}')
+                    bar.update(1)
+        finally:
+            self.wall_seconds += time.perf_counter() - start
+            if bar is not None:
+                bar.close()
+        return self.curve
+
+    def spec(self, action: str = 'argmax', evaluation: dict | None = None) -> PolicySpec:
+        """Return the policy file contents for the current parameters."""
+        cfg = self.config
+        training = {'epochs': self.epoch, 'episodes_per_epoch': cfg.episodes_per_epoch,
+                    'learning_rate': cfg.learning_rate, 'anneal_epochs': cfg.anneal_epochs,
+                    'reward_scale': cfg.reward_scale,
+                    'beta': cfg.beta, 'horizon': self.horizon, 'baseline': cfg.baseline,
+                    'seed': cfg.seed, 'init': 'zeros', 'eval_every': cfg.eval_every,
+                    'eval_episodes': cfg.eval_episodes, 'eval_seed': cfg.eval_seed,
+                    'wall_seconds': round(self.wall_seconds, 3)}
+        kernel = theta = None
+        if cfg.family == 'conv':
+            kernel = kernel_from_radial(self.grid, self.params)
+        else:
+            theta = self.family.theta(self.params).copy()
+        return PolicySpec(grid=self.grid, fpoc=self.fpoc, reward=cfg.reward, family=cfg.family,
+                          action=action, kernel=kernel, theta=theta, training=training,
+                          evaluation=dict(evaluation or {}))
+
+
+def config_from_spec(spec: PolicySpec, **overrides) -> TrainConfig:
+    """Read the training configuration of a policy file, with ``overrides`` applied."""
+    known = set(TrainConfig.__dataclass_fields__)
+    recorded = {k: v for k, v in spec.training.items() if k in known}
+    recorded.update(reward=spec.reward, family=spec.family)
+    if recorded.get('horizon') == spec.grid.n_cells:
+        recorded['horizon'] = None
+    config = TrainConfig(**recorded)
+    return replace(config, **{k: v for k, v in overrides.items() if v is not None})
+
+
+def trainer_from_spec(spec: PolicySpec, **overrides) -> Trainer:
+    """Build a trainer that resumes a saved policy (its weights, epoch count and settings)."""
+    config = config_from_spec(spec, **overrides)
+    family = Family(spec.grid, config.family)
+    return Trainer(spec.grid, spec.fpoc, config, params=family.params_from_spec(spec),
+                   epoch=int(spec.training.get('epochs', 0)),
+                   wall_seconds=float(spec.training.get('wall_seconds', 0.0)))
+
+
+def write_curve(path, rows: list[dict], append: bool = False) -> Path:
+    """Write (or append to) a learning-curve CSV with columns :data:`CSV_FIELDS`."""
+    path = Path(path)
+    exists = append and path.is_file()
+    with path.open('a' if exists else 'w', newline='') as fh:
+        writer = csv.DictWriter(fh, fieldnames=CSV_FIELDS)
+        if not exists:
+            writer.writeheader()
+        for row in rows:
+            writer.writerow({k: ('' if row.get(k) is None else row[k]) for k in CSV_FIELDS})
+    return path
+
+
+def read_curve(path) -> list[dict]:
+    """Read a learning-curve CSV back (numbers as floats, blank as None)."""
+    def value(key, text):
+        if text == '':
+            return None
+        return int(text) if key in ('epoch', 'episodes') else float(text)
+
+    with Path(path).open(newline='') as fh:
+        return [{k: value(k, v) for k, v in row.items()} for row in csv.DictReader(fh)]
+
+
+def evaluation_block(grid: Grid, fpoc: FPOC, policy, episodes: int = 20000, seed: int = 0,
+                     horizon: int | None = None, bootstrap: int = 1000) -> dict:
+    """
+    Fixations to 90% correct with a 95% bootstrap interval, as a policy file records it.
+
+    Uses the same targets, noise and bootstrap draws as ``ipomdp-gaze evaluate --seed SEED``, so
+    the numbers match that command's.
+    """
+    horizon = grid.n_cells if horizon is None else int(horizon)
+    result = simulate(grid, fpoc, policy, episodes, horizon, seed)
+    point, ci = fixations_to_90_ci(result.correct, grid.n_cells,
+                                   np.random.default_rng([seed, 99]), bootstrap)
+    return {'episodes': int(episodes), 'seed': int(seed), 'action': policy.action,
+            'horizon': horizon, 'fixations_to_90': point, 'ci95': list(ci) if ci else None}
