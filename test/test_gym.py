@@ -75,3 +75,22 @@ def test_bad_arguments_are_named():
         env = VisualSearchEnv()
         env.reset(seed=0)
         env.step(49)
+
+
+def test_example_drives_the_env_with_a_shipped_kernel_and_baselines(capsys):
+    """
+    The example's searches end at 95% confidence, so each guess is right with p >= 0.95.
+
+    Over 60 episodes, fewer than 80% right has probability below 1e-4 for a correct model.
+    """
+    import importlib.util
+    from pathlib import Path
+    path = Path(__file__).resolve().parents[1] / 'examples' / 'gym_search.py'
+    spec = importlib.util.spec_from_file_location('gym_search_example', path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    results = module.main(episodes=60, seed=1)
+    assert len(results) == 3
+    for mean_steps, right in results.values():
+        assert right >= 0.8 and 1 <= mean_steps < 49
+    assert 'shipped kernel' in capsys.readouterr().out
