@@ -430,10 +430,10 @@ class GazeControllerNode(Node):
             return
         if not result.applied:
             return
+        self._send_target()             # first: the head can start moving while we report
         self._publish_belief()
         if result.found is not None:
             self._publish_found(result.found)
-        self._send_target()
 
     def _on_reset(self, request, response):
         cell = self.core.reset(self._now_s())
