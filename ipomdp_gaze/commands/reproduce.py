@@ -271,8 +271,8 @@ def run(args) -> int:
 
     # Figure 3: learning curves with and without weight sharing.
     data = ROOT / 'docs' / 'data'
-    curves = {'weight sharing (conv, 27 weights)': data / 'curve-human-7x7-conv.csv',
-              'no weight sharing (logistic, 2401 weights)': data / 'curve-human-7x7-logistic.csv'}
+    curves = {'weight sharing (conv, 27 weights)': data / 'human-7x7-infomax.csv',
+              'no weight sharing (logistic, 2401 weights)': data / 'human-7x7-logistic.csv'}
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     for label, path in curves.items():
         if not path.exists():
