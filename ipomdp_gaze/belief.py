@@ -67,9 +67,25 @@ def log_likelihood(observation: np.ndarray, dprime: np.ndarray) -> np.ndarray:
     dprime : array (..., N)
         ``d_ik`` of each cell i for the current fixation k.
 
+    Raises
+    ------
+    EvidenceError
+        If an observed cell's term is not a finite number: an observation of +/-inf, or one so
+        large (about 1e308 / d') that the term overflows. Such a frame would turn the log belief
+        into inf - inf = NaN, so it is refused whole.
+
     """
-    term = dprime * (observation - 0.5 * dprime)
-    return np.where(np.isnan(term), 0.0, term)
+    with np.errstate(over='ignore', invalid='ignore'):
+        term = dprime * (observation - 0.5 * dprime)
+    term = np.where(np.isnan(observation), 0.0, term)
+    bad = ~np.isfinite(term)
+    if np.any(bad):
+        i = np.flatnonzero(bad)[0]
+        o, d = np.broadcast_to(observation, term.shape).flat[i], \
+            np.broadcast_to(dprime, term.shape).flat[i]
+        raise EvidenceError(f"evidence {o:.6g} at cell {i % term.shape[-1]} with d' = {d:.6g} "
+                            f'gives a log-likelihood of {term.flat[i]}; the frame is refused')
+    return term
 
 
 def update_log_belief(log_belief: np.ndarray, observation: np.ndarray,
@@ -88,13 +104,20 @@ def update_log_belief(log_belief: np.ndarray, observation: np.ndarray,
     out : array, optional
         Where to write the result (may be ``log_belief`` itself for an in-place update).
 
+    Raises
+    ------
+    EvidenceError
+        From :func:`log_likelihood`, before anything is written.
+
     """
+    term = log_likelihood(observation, dprime)
     if out is None:
         out = np.array(log_belief, dtype=float, copy=True)
     elif out is not log_belief:
         out[...] = log_belief
-    out += log_likelihood(observation, dprime)
-    return normalize_log(out)
+    with np.errstate(over='ignore'):          # a sum below -1.8e308 is -inf: probability 0
+        out += term
+        return normalize_log(out)
 
 
 def belief_from_log(log_belief: np.ndarray) -> np.ndarray:

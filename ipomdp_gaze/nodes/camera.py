@@ -23,7 +23,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 import sys
 
-from ipomdp_gaze.fpoc import dprime_matrix
+from ipomdp_gaze.fpoc import dprime_table
+from ipomdp_gaze.gaze import dprime_of_fixation
 from msg_adapters import grid_arrays, images, joints
 import numpy as np
 from rcl_interfaces.msg import SetParametersResult
@@ -39,6 +40,7 @@ from std_srvs.srv import Trigger
 
 from .params import (current_values, declare, fpoc_from, fpoc_params, grid_from, grid_params,
                      head_from, INT_MAX, joint_params, Param, row_col_from, short_repr, T)
+from .spin import spin
 
 NODE_NAME = 'simulated_camera'
 FRAME_QOS = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
@@ -112,7 +114,7 @@ class SimulatedCameraNode(Node):
         fpoc = fpoc_from(values)
         head = head_from(values, grid)
         target = row_col_from(values, grid, 'target_row', 'target_col')
-        return CameraConfig(dict(values), grid, dprime_matrix(grid, fpoc), head, target)
+        return CameraConfig(dict(values), grid, dprime_table(grid, fpoc), head, target)
 
     def _on_set(self, params) -> SetParametersResult:
         for p in params:
@@ -188,7 +190,7 @@ class SimulatedCameraNode(Node):
     # -- outputs -------------------------------------------------------------------------
     def _publish_frame(self) -> None:
         cfg = self._config
-        d = cfg.dprime[:, self.pose]
+        d = dprime_of_fixation(cfg.grid, cfg.dprime, self.pose)
         obs = self.rng.standard_normal(cfg.grid.n_cells)
         obs[self.target] += d[self.target]
         obs[d == 0] = np.nan
@@ -226,7 +228,7 @@ def main(args=None) -> int:
     status = 0
     try:
         node = SimulatedCameraNode()
-        rclpy.spin(node)
+        spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except _rclpy.RCLError:

@@ -1,0 +1,38 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Spin a node until SIGINT or SIGTERM, with a bounded wait so that the signal is never missed.
+
+rclpy's signal handler (a thread of its own) first triggers the executors' signal guard
+condition and then shuts the contexts down. An executor that wakes between the two sees its
+context still running, consumes the guard condition and waits again; with no timer of its own
+(an idle simulated camera) that wait has no timeout, so the process ignores the SIGTERM until it
+is killed (``exit status -9`` in the tests). A timer that does nothing bounds every wait to
+:data:`WAKE_PERIOD_S`, after which the executor sees the shut-down context and returns.
+"""
+from __future__ import annotations
+
+import rclpy
+
+WAKE_PERIOD_S = 0.25
+
+
+def _wake() -> None:
+    """Do nothing: the executor only needs to return from its wait."""
+
+
+def spin(node, wake_period_s: float = WAKE_PERIOD_S) -> None:
+    """
+    Spin ``node`` until its context shuts down, waking at least every ``wake_period_s``.
+
+    Raises
+    ------
+    rclpy.executors.ExternalShutdownException
+        When a signal shut the context down (as :func:`rclpy.spin` does).
+
+    """
+    timer = node.create_timer(wake_period_s, _wake)
+    try:
+        rclpy.spin(node)
+    finally:
+        node.destroy_timer(timer)
