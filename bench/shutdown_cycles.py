@@ -94,19 +94,25 @@ def main(argv=None) -> int:
             logs = {n: work / f'{n}-{cycle}.log' for n in ('controller', 'camera')}
             procs = {'controller': start('controller', controller_args, env, logs['controller']),
                      'camera': start('camera', camera_args, env, logs['camera'])}
-            deadline = time.monotonic() + 60
-            while len(beliefs) < args.frames and time.monotonic() < deadline:
-                executor.spin_once(timeout_sec=0.05)
-            row = {'cycle': cycle, 'beliefs': len(beliefs)}
-            for name in ('controller', 'camera'):
-                code, seconds = stop(procs[name], args.timeout_s)
-                times[name].append(seconds)
-                row[name] = {'code': code, 'exit_s': round(seconds, 3)}
-                if code != 0:
-                    hangs += 1
-                    kept = keep / f'hung-{name}-{cycle}.log'
-                    kept.write_bytes(logs[name].read_bytes())
-                    row[name]['log'] = str(kept)
+            try:
+                deadline = time.monotonic() + 60
+                while len(beliefs) < args.frames and time.monotonic() < deadline:
+                    executor.spin_once(timeout_sec=0.05)
+                row = {'cycle': cycle, 'beliefs': len(beliefs)}
+                for name in ('controller', 'camera'):
+                    code, seconds = stop(procs[name], args.timeout_s)
+                    times[name].append(seconds)
+                    row[name] = {'code': code, 'exit_s': round(seconds, 3)}
+                    if code != 0:
+                        hangs += 1
+                        kept = keep / f'hung-{name}-{cycle}.log'
+                        kept.write_bytes(logs[name].read_bytes())
+                        row[name]['log'] = str(kept)
+            finally:
+                for proc in procs.values():
+                    if proc.poll() is None:
+                        proc.kill()
+                        proc.wait(10)
             print(json.dumps(row), flush=True)
     finally:
         executor.shutdown(timeout_sec=1)

@@ -39,7 +39,8 @@ from std_msgs.msg import Float32MultiArray, Int32MultiArray
 from std_srvs.srv import Trigger
 
 from .params import (current_values, declare, fpoc_from, fpoc_params, grid_from, grid_params,
-                     head_from, INT_MAX, joint_params, Param, row_col_from, short_repr, T)
+                     head_from, INT_MAX, joint_params, MAX_CELLS_PER_SIDE, Param, row_col_from,
+                     short_repr, T)
 from .spin import spin
 
 NODE_NAME = 'simulated_camera'
@@ -52,9 +53,10 @@ def camera_params() -> list[Param]:
     """Every parameter of the simulated camera, in declaration order."""
     return grid_params() + fpoc_params() + joint_params(limits=False) + [
         Param('target_row', -1, T.INTEGER, 'row of the target (-1: a random row at each reset)',
-              int_range=(-1, 254)),
+              int_range=(-1, MAX_CELLS_PER_SIDE - 1)),
         Param('target_col', -1, T.INTEGER,
-              'column of the target (-1: a random column at each reset)', int_range=(-1, 254)),
+              'column of the target (-1: a random column at each reset)',
+              int_range=(-1, MAX_CELLS_PER_SIDE - 1)),
         Param('seed', 0, T.INTEGER, 'seed of the targets and the observation noise',
               int_range=(0, INT_MAX)),
         Param('saccade_time_s', 0.15, T.DOUBLE, 'time to move to a new cell',

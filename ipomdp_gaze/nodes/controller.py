@@ -49,7 +49,8 @@ from std_srvs.srv import SetBool, Trigger
 from trajectory_msgs.msg import JointTrajectory
 
 from .params import (current_values, declare, fpoc_from, fpoc_params, grid_from, grid_params,
-                     head_from, INT_MAX, joint_params, Param, row_col_from, short_repr, T)
+                     head_from, INT_MAX, joint_params, MAX_CELLS_PER_SIDE, Param, row_col_from,
+                     short_repr, T)
 from .spin import spin
 
 NODE_NAME = 'gaze_controller'
@@ -63,10 +64,10 @@ def controller_params() -> list[Param]:
     return grid_params() + fpoc_params() + [
         Param('start_row', -1, T.INTEGER,
               'row of the first fixation after a reset (-1: the centre row)',
-              int_range=(-1, 254)),
+              int_range=(-1, MAX_CELLS_PER_SIDE - 1)),
         Param('start_col', -1, T.INTEGER,
               'column of the first fixation after a reset (-1: the centre column)',
-              int_range=(-1, 254)),
+              int_range=(-1, MAX_CELLS_PER_SIDE - 1)),
         Param('seed', 0, T.INTEGER, 'seed of the random and sample policies',
               int_range=(0, INT_MAX)),
         Param('settle_time_s', 0.1, T.DOUBLE,
