@@ -20,6 +20,13 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(VPY) -m pytest -q test
 
+# The long robustness runs (minutes): 100,000 fuzzed frames, a minute of load at 1 kHz (11x11)
+# and 60 Hz (256x256), 50 start/SIGTERM cycles, and 1,000 examples per property test.
+soak: $(STAMP)
+	$(VPY) -m pytest -q -s -m soak test
+	PROPERTY_EXAMPLES=1000 $(VPY) -m pytest -q test/test_properties.py
+	$(VPY) bench/shutdown_cycles.py --cycles 50
+
 bench: $(STAMP)
 	$(VPY) bench/run.py
 

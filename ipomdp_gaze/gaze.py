@@ -25,7 +25,8 @@ import numpy as np
 from policies.baselines import make_baseline, STRATEGIES
 from policies.conv import check_action, ConvPolicy
 
-from .belief import BeliefTracker, check_evidence, entropy, EvidenceError, map_cell
+from .belief import (check_evidence, entropy, EvidenceError, log_likelihood, map_cell,
+                     normalize_log, uniform_log_belief)
 from .fpoc import dprime_table, FPOC
 from .grid import Grid
 
@@ -64,6 +65,19 @@ class FrameResult:
     def applied(self) -> bool:
         """Whether the frame updated the belief."""
         return self.status == 'applied'
+
+
+def dprime_of_fixation(grid: Grid, table: np.ndarray, fixation: int) -> np.ndarray:
+    """
+    Return ``d_jk`` of every cell j for fixation k, shape (N,), from the offset table.
+
+    ``table`` is :func:`ipomdp_gaze.fpoc.dprime_table` (``(2R-1, 2C-1)``); the cells seen from
+    k are the ``rows x cols`` window starting at ``(R-1-r_k, C-1-c_k)``, so no N x N matrix is
+    needed (a 256x256 grid would need 34 GB for one).
+    """
+    r, c = grid.cell(fixation)
+    rows, cols = grid.rows, grid.cols
+    return table[rows - 1 - r:2 * rows - 1 - r, cols - 1 - c:2 * cols - 1 - c].ravel()
 
 
 def check_kernel(values, grid: Grid) -> np.ndarray:
@@ -133,6 +147,35 @@ def build_policy(name: str, grid: Grid, fpoc: FPOC, kernel=None, file: str = '',
     return load_policy(file, grid=grid, fpoc=fpoc, action=action, warn=warn)
 
 
+class FrameSequence:
+    """
+    Frames lost on the way to the node, from the publisher's sequence numbers (1, 2, 3, ...).
+
+    A subscription that keeps only the newest frame drops the older ones when frames come
+    faster than the node takes them; the gaps in the numbers it sees count them. A number that
+    does not increase (a restarted publisher) starts counting again. Only meaningful while a
+    single publisher sends the frames.
+    """
+
+    def __init__(self):
+        self.last: int | None = None
+        self.lost = 0
+
+    def see(self, number) -> int:
+        """Record the sequence number of a frame taken; return how many were lost before it."""
+        if number is None or number <= 0:           # not supported by the middleware
+            return 0
+        number = int(number)
+        gap = number - self.last - 1 if self.last is not None and number > self.last else 0
+        self.last = number
+        self.lost += gap
+        return gap
+
+    def restart(self) -> None:
+        """Forget the last number (another publisher joined or left)."""
+        self.last = None
+
+
 class GazeController:
     """
     Belief, fixation and frame acceptance of one search (see the module docstring).
@@ -157,7 +200,6 @@ class GazeController:
     def __init__(self, grid: Grid, fpoc: FPOC, policy, start_cell: int | None = None,
                  settle_time_s: float = 0.0, confidence: float = 0.95, seed: int = 0):
         self.grid = grid
-        self._tracker = None
         self.set_fpoc(fpoc)
         self.policy = policy
         self.set_start_cell(grid.center_index if start_cell is None else start_cell)
@@ -167,21 +209,19 @@ class GazeController:
         self.enabled = True
         self.received = self.applied = self.rejected = self.skipped = 0
         self.last_rejection = ''
+        self._log_belief = uniform_log_belief(grid.n_cells)
+        self._belief = np.exp(self._log_belief)
         self.fixation = self.start_cell
         self.fixations = 0
         self.target_time_s = 0.0
+        self.usable_time_s = 0.0
         self.found: Found | None = None
 
     # -- configuration -------------------------------------------------------------------
     def set_fpoc(self, fpoc: FPOC) -> None:
         """Use another FPOC for the following updates (the belief is kept)."""
         self.fpoc = fpoc
-        previous = self._tracker
-        # d' from the (2R-1, 2C-1) offset table: no N x N matrix, so large grids fit in memory.
-        self._tracker = BeliefTracker(self.grid, dprime_table(self.grid, fpoc))
-        if previous is not None:
-            self._tracker.reset(previous.log_belief)
-        self._belief = self._tracker.belief
+        self._dprime_table = dprime_table(self.grid, fpoc)
 
     def set_policy(self, policy) -> None:
         """Use another policy from the next choice on."""
@@ -237,11 +277,12 @@ class GazeController:
     # -- events ----------------------------------------------------------------------------
     def reset(self, now_s: float) -> int:
         """Uniform belief, fixation back to the start cell; returns it (sent at ``now_s``)."""
-        self._tracker.reset()
+        self._log_belief = uniform_log_belief(self.grid.n_cells)
+        self._belief = np.exp(self._log_belief)
         self.fixation = self.start_cell
         self.fixations = 0
         self.found = None
-        self.target_time_s = float(now_s)
+        self.target_time_s = self.usable_time_s = float(now_s)
         return self.fixation
 
     def retarget(self, now_s: float) -> int:
@@ -262,7 +303,12 @@ class GazeController:
         self.enabled = enabled
         if enabled:
             self.retarget(now_s)
+            self.usable_time_s = float(now_s)
         return True
+
+    def seconds_without_evidence(self, now_s: float) -> float:
+        """Seconds since the last applied frame (or since the last reset or enable)."""
+        return max(0.0, float(now_s) - self.usable_time_s)
 
     def reject(self, reason: str) -> FrameResult:
         """Count a frame that could not even be read (for example a bad message layout)."""
@@ -296,14 +342,24 @@ class GazeController:
         if stamp_s < self.target_time_s + self.settle_time_s:
             self.skipped += 1
             return FrameResult('skipped', 'taken before the fixation settled')
-        self._tracker.update(obs, self.fixation)
+        try:
+            term = log_likelihood(obs, dprime_of_fixation(self.grid, self._dprime_table,
+                                                          self.fixation))
+        except EvidenceError as exc:
+            self.rejected += 1
+            self.last_rejection = str(exc)
+            return FrameResult('rejected', str(exc))
+        with np.errstate(over='ignore'):      # a sum below -1.8e308 is -inf: probability 0
+            self._log_belief += term
+            normalize_log(self._log_belief)
+        np.exp(self._log_belief, out=self._belief)
         self.applied += 1
         self.fixations += 1
         found = None
         if self.found is None and self.map_probability >= self.confidence:
             found = self.found = Found(self.map_cell, self.map_probability, self.fixations)
         self.fixation = self.choose()
-        self.target_time_s = float(stamp_s if now_s is None else now_s)
+        self.target_time_s = self.usable_time_s = float(stamp_s if now_s is None else now_s)
         return FrameResult('applied', fixation=self.fixation, found=found)
 
     def choose(self) -> int:

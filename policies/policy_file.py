@@ -162,8 +162,31 @@ def resolve_source(source) -> Path:
                           f'name (shipped: {names})')
 
 
+def _check_nesting(value, key: str, shape: tuple[int, int], what: str) -> None:
+    """
+    Refuse a list of lists that is too long or too deep before numpy walks it.
+
+    YAML aliases let a file of a few hundred bytes describe a billion numbers (a list of aliases
+    of a list of aliases ...); ``np.asarray`` would spend minutes and gigabytes on it. Only the
+    expected ``shape[0] x shape[1]`` entries are ever looked at here.
+    """
+    if not isinstance(value, list) or not any(isinstance(row, list) for row in value):
+        return
+    if len(value) > shape[0]:
+        raise PolicyFileError(f'{key} has {len(value)} rows but {what} needs {shape}')
+    for row in value:
+        if isinstance(row, list):
+            if len(row) > shape[1]:
+                raise PolicyFileError(f'{key} has a row of {len(row)} values but {what} needs '
+                                      f'{shape}')
+            if any(isinstance(x, (list, dict)) for x in row):
+                raise PolicyFileError(f'{key} must be a 2-D list of lists, got more than 2 '
+                                      f'dimensions')
+
+
 def _array(doc: dict, key: str, shape: tuple[int, int], what: str) -> np.ndarray:
     value = doc[key]
+    _check_nesting(value, key, shape, what)
     try:
         array = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -215,6 +238,11 @@ def _check_radial(block, grid: Grid, kernel: np.ndarray) -> None:
         if key not in block:
             raise PolicyFileError(f'missing key radial.{key}')
     values, bins = radial_bins(grid)
+    for key in ('squared_distance', 'weight'):
+        value = block[key]
+        if isinstance(value, list) and (len(value) > values.size or any(
+                isinstance(x, (list, dict)) for x in value)):
+            raise PolicyFileError(f'radial.{key} must be a list of {values.size} numbers')
     try:
         sq = np.asarray(block['squared_distance'], dtype=float)
         weight = np.asarray(block['weight'], dtype=float)
@@ -330,6 +358,8 @@ def load_policy_spec(source) -> PolicySpec:
         mark = getattr(exc, 'problem_mark', None)
         where = f' at line {mark.line + 1}' if mark is not None else ''
         raise PolicyFileError(f'{path}: not YAML{where}') from None
+    except RecursionError:
+        raise PolicyFileError(f'{path}: YAML nested too deeply to read') from None
     try:
         return spec_from_dict(doc, path=path)
     except PolicyFileError as exc:

@@ -17,7 +17,13 @@ from pathlib import Path
 import threading
 import time
 
+from hypothesis import settings
 import pytest
+
+# Property tests: the same examples on every CI run (CI=1), fresh ones on a developer's machine.
+settings.register_profile('ci', derandomize=True, deadline=None, print_blob=True)
+if os.environ.get('CI'):
+    settings.load_profile('ci')
 
 HAVE_RCLPY = importlib.util.find_spec('rclpy') is not None
 HAVE_ROS_MSGS = importlib.util.find_spec('std_msgs') is not None

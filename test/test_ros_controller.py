@@ -45,7 +45,9 @@ class Camera:
         self.evidence_image = probe.publisher(Image, 'evidence_image', 10)
         self.proc = launch('controller', [
             '--params-file', config_path('controller.yaml'), '-p', 'settle_time_s:=0.0',
-            '-p', 'diagnostics_period_s:=0.2', '-p', 'policy.name:=elm'])
+            '-p', 'diagnostics_period_s:=0.2', '-p', 'policy.name:=elm',
+            # Frames sent back to back must all arrive (the default keeps only the newest).
+            '-p', 'evidence_queue_depth:=10'])
         assert wait_for(lambda: self.targets, 30), self.proc.output()
         assert wait_for(lambda: self.evidence.get_subscription_count() > 0 and
                         self.evidence_image.get_subscription_count() > 0, 30)

@@ -23,8 +23,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 import sys
 
-from ipomdp_gaze.belief import dprime_column
 from ipomdp_gaze.fpoc import dprime_table
+from ipomdp_gaze.gaze import dprime_of_fixation
 from msg_adapters import grid_arrays, images, joints
 import numpy as np
 from rcl_interfaces.msg import SetParametersResult
@@ -39,7 +39,8 @@ from std_msgs.msg import Float32MultiArray, Int32MultiArray
 from std_srvs.srv import Trigger
 
 from .params import (current_values, declare, fpoc_from, fpoc_params, grid_from, grid_params,
-                     head_from, INT_MAX, joint_params, Param, row_col_from, short_repr, T)
+                     head_from, INT_MAX, joint_params, MAX_CELLS_PER_SIDE, Param, row_col_from,
+                     short_repr, T)
 from .spin import spin
 
 NODE_NAME = 'simulated_camera'
@@ -52,9 +53,10 @@ def camera_params() -> list[Param]:
     """Every parameter of the simulated camera, in declaration order."""
     return grid_params() + fpoc_params() + joint_params(limits=False) + [
         Param('target_row', -1, T.INTEGER, 'row of the target (-1: a random row at each reset)',
-              int_range=(-1, 254)),
+              int_range=(-1, MAX_CELLS_PER_SIDE - 1)),
         Param('target_col', -1, T.INTEGER,
-              'column of the target (-1: a random column at each reset)', int_range=(-1, 254)),
+              'column of the target (-1: a random column at each reset)',
+              int_range=(-1, MAX_CELLS_PER_SIDE - 1)),
         Param('seed', 0, T.INTEGER, 'seed of the targets and the observation noise',
               int_range=(0, INT_MAX)),
         Param('saccade_time_s', 0.15, T.DOUBLE, 'time to move to a new cell',
@@ -73,7 +75,7 @@ class CameraConfig:
 
     values: dict
     grid: object
-    dprime: np.ndarray          # d' on the (2R-1, 2C-1) offset table
+    dprime: np.ndarray
     head: joints.PanTiltMap
     target: tuple
 
@@ -190,7 +192,7 @@ class SimulatedCameraNode(Node):
     # -- outputs -------------------------------------------------------------------------
     def _publish_frame(self) -> None:
         cfg = self._config
-        d = dprime_column(cfg.grid, cfg.dprime, self.pose)
+        d = dprime_of_fixation(cfg.grid, cfg.dprime, self.pose)
         obs = self.rng.standard_normal(cfg.grid.n_cells)
         obs[self.target] += d[self.target]
         obs[d == 0] = np.nan

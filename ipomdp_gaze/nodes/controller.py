@@ -10,7 +10,8 @@ remapping work:
 - subscribes ``evidence`` (``std_msgs/Float32MultiArray``, one standardised detector response
   per cell, NaN = not observed; arrival time counts) and ``evidence_image``
   (``sensor_msgs/Image`` 32FC1, rows x cols; its header stamp counts, or its arrival when unset),
-  both best effort;
+  both best effort and keep-last ``evidence_queue_depth`` (1: the newest frame wins; frames
+  dropped on the way are counted from the publisher's sequence numbers);
 - publishes ``pan_tilt`` (``sensor_msgs/JointState``, transient local, depth 1, re-sent every
   ``retry_period_s`` until a usable frame arrives), ``belief`` (``Float32MultiArray``) and
   ``belief_image`` (``rgb8``) after every update and reset, ``found``
@@ -28,8 +29,8 @@ import sys
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from ipomdp_gaze.belief import EvidenceError
-from ipomdp_gaze.gaze import (build_policy, check_kernel, GazeController, POLICY_NAMES,
-                              PolicyUnavailable)
+from ipomdp_gaze.gaze import (build_policy, check_kernel, FrameSequence, GazeController,
+                              POLICY_NAMES, PolicyUnavailable)
 from msg_adapters import diagnostics, grid_arrays, images, joints, stamps
 from policies.baselines import STRATEGIES
 from policies.conv import ACTIONS
@@ -40,7 +41,7 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.validate_topic_name import validate_topic_name
 from sensor_msgs.msg import Image, JointState
 from std_msgs.msg import Float32MultiArray, Float64MultiArray
@@ -48,11 +49,11 @@ from std_srvs.srv import SetBool, Trigger
 from trajectory_msgs.msg import JointTrajectory
 
 from .params import (current_values, declare, fpoc_from, fpoc_params, grid_from, grid_params,
-                     head_from, INT_MAX, joint_params, Param, row_col_from, short_repr, T)
+                     head_from, INT_MAX, joint_params, MAX_CELLS_PER_SIDE, Param, row_col_from,
+                     short_repr, T)
 from .spin import spin
 
 NODE_NAME = 'gaze_controller'
-EVIDENCE_QOS = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
 STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                        durability=DurabilityPolicy.TRANSIENT_LOCAL)
 WARN_THROTTLE_S = 5.0
@@ -63,10 +64,10 @@ def controller_params() -> list[Param]:
     return grid_params() + fpoc_params() + [
         Param('start_row', -1, T.INTEGER,
               'row of the first fixation after a reset (-1: the centre row)',
-              int_range=(-1, 254)),
+              int_range=(-1, MAX_CELLS_PER_SIDE - 1)),
         Param('start_col', -1, T.INTEGER,
               'column of the first fixation after a reset (-1: the centre column)',
-              int_range=(-1, 254)),
+              int_range=(-1, MAX_CELLS_PER_SIDE - 1)),
         Param('seed', 0, T.INTEGER, 'seed of the random and sample policies',
               int_range=(0, INT_MAX)),
         Param('settle_time_s', 0.1, T.DOUBLE,
@@ -75,6 +76,12 @@ def controller_params() -> list[Param]:
         Param('retry_period_s', 1.0, T.DOUBLE,
               're-send the current target this often until a usable frame arrives (0: never)',
               float_range=(0.0, 3600.0)),
+        Param('stall_timeout_s', 5.0, T.DOUBLE,
+              'warn (diagnostics and log) when no frame was applied for this long (0: never)',
+              float_range=(0.0, 3600.0)),
+        Param('evidence_queue_depth', 1, T.INTEGER,
+              'frames kept for the node per evidence topic; 1: the newest frame wins '
+              '(read-only)', read_only=True, int_range=(1, 1000)),
         Param('confidence', 0.95, T.DOUBLE,
               'the found event fires when the most likely cell first reaches this probability',
               float_range=(0.0, 1.0)),
@@ -144,8 +151,16 @@ class GazeControllerNode(Node):
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self._forward_pub = self._trajectory_pub = None
         self._make_command_publishers(v)
-        self.create_subscription(Float32MultiArray, 'evidence', self._on_evidence, EVIDENCE_QOS)
-        self.create_subscription(Image, 'evidence_image', self._on_evidence_image, EVIDENCE_QOS)
+        evidence_qos = QoSProfile(history=HistoryPolicy.KEEP_LAST,
+                                  depth=v['evidence_queue_depth'],
+                                  reliability=ReliabilityPolicy.BEST_EFFORT)
+        self._sequences = {'evidence': FrameSequence(), 'evidence_image': FrameSequence()}
+        self._evidence_subs = {
+            'evidence': self.create_subscription(Float32MultiArray, 'evidence',
+                                                 self._on_evidence, evidence_qos),
+            'evidence_image': self.create_subscription(Image, 'evidence_image',
+                                                       self._on_evidence_image, evidence_qos)}
+        self._single_publisher = dict.fromkeys(self._sequences, True)
         self.create_service(Trigger, '~/reset', self._on_reset)
         self.create_service(SetBool, '~/enable', self._on_enable)
         self._retry_timer = self._diag_timer = None
@@ -378,9 +393,22 @@ class GazeControllerNode(Node):
         counters = core.counters()
         map_row, map_col = grid.cell(core.map_cell)
         fix_row, fix_col = grid.cell(core.fixation)
+        without_s = core.seconds_without_evidence(now)
+        stall_timeout_s = self._config.values['stall_timeout_s']
         level, message = 'ok', 'searching'
         if not core.enabled:
             message = 'disabled'
+        elif 0 < stall_timeout_s < without_s:
+            level, message = 'warn', f'no usable evidence for {without_s:.1f} s'
+            if core.received == last_received:
+                detail = 'no frames arrive'
+            else:
+                detail = f'{core.received - last_received} frames arrived, none usable'
+                if self._diag_rejected_before != core.rejected:
+                    detail += f'; last rejection: {core.last_rejection}'
+            self.get_logger().warning(f'{message} ({detail}); target re-sent '
+                                      f'{self._resends} times so far',
+                                      throttle_duration_sec=WARN_THROTTLE_S)
         elif core.found is not None:
             message = 'target found'
         elif core.received == last_received:
@@ -389,11 +417,14 @@ class GazeControllerNode(Node):
                 self._diag_rejected_before != core.rejected:
             level, message = 'warn', f'evidence rejected: {core.last_rejection}'
         self._diag_rejected_before = core.rejected
+        self._check_publishers()
         values = {
             'policy': self._policy_label(self._config.values), 'enabled': core.enabled,
             'evidence_rate_hz': rate, 'frames_received': counters['received'],
             'frames_applied': counters['applied'], 'frames_rejected': counters['rejected'],
-            'frames_skipped': counters['skipped'], 'fixations': core.fixations,
+            'frames_skipped': counters['skipped'],
+            'frames_dropped': sum(q.lost for q in self._sequences.values()),
+            'seconds_without_evidence': without_s, 'fixations': core.fixations,
             'fixation_row': fix_row, 'fixation_col': fix_col, 'entropy_nats': core.entropy_nats,
             'most_likely_row': map_row, 'most_likely_col': map_col,
             'most_likely_probability': core.map_probability, 'found': core.found is not None,
@@ -403,8 +434,21 @@ class GazeControllerNode(Node):
                                 values)], self._now().to_msg()))
 
     # -- inputs --------------------------------------------------------------------------
-    def _on_evidence(self, msg: Float32MultiArray) -> None:
+    def _check_publishers(self) -> None:
+        """Count dropped frames only while one publisher sends each evidence topic."""
+        for name, sub in self._evidence_subs.items():
+            single = self.count_publishers(sub.topic_name) <= 1
+            if single != self._single_publisher[name]:
+                self._sequences[name].restart()
+                self._single_publisher[name] = single
+
+    def _count_drops(self, topic: str, info) -> None:
+        if self._single_publisher[topic] and isinstance(info, dict):
+            self._sequences[topic].see(info.get('publication_sequence_number'))
+
+    def _on_evidence(self, msg: Float32MultiArray, info) -> None:
         now = self._now_s()
+        self._count_drops('evidence', info)
         try:
             values = grid_arrays.from_multiarray(msg, self._config.grid)
         except EvidenceError as exc:
@@ -412,8 +456,9 @@ class GazeControllerNode(Node):
             return
         self._handle(self.core.offer(values, now))
 
-    def _on_evidence_image(self, msg: Image) -> None:
+    def _on_evidence_image(self, msg: Image, info) -> None:
         now = self._now_s()
+        self._count_drops('evidence_image', info)
         try:
             values = images.evidence_from_image(msg, self._config.grid)
         except EvidenceError as exc:

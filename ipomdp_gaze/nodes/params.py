@@ -22,8 +22,8 @@ from rclpy.parameter import Parameter
 
 T = Parameter.Type
 INT_MAX = 2 ** 31 - 1
-# Largest grid side a node accepts: 2048 x 2048 cells is 32 MiB per float64 belief buffer.
-MAX_GRID_SIDE = 2048
+# Rows or columns of a grid: 256x256 (65,536 cells) is the largest grid tested under load.
+MAX_CELLS_PER_SIDE = 1024
 
 
 @dataclass(frozen=True)
@@ -81,9 +81,9 @@ def grid_params() -> list[Param]:
     """``grid.rows``, ``grid.cols``, ``grid.spacing_deg`` (read-only)."""
     return [
         Param('grid.rows', 11, T.INTEGER, 'rows of the visual array (read-only)', read_only=True,
-              int_range=(1, MAX_GRID_SIDE)),
+              int_range=(1, MAX_CELLS_PER_SIDE)),
         Param('grid.cols', 11, T.INTEGER, 'columns of the visual array (read-only)',
-              read_only=True, int_range=(1, MAX_GRID_SIDE)),
+              read_only=True, int_range=(1, MAX_CELLS_PER_SIDE)),
         Param('grid.spacing_deg', 5.0, T.DOUBLE,
               'pan/tilt degrees between neighbouring cells (read-only)', read_only=True,
               float_range=(1e-6, 90.0)),

@@ -1,25 +1,38 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-Spin a node until shutdown, robust to a lost wake-up of the SIGTERM/SIGINT handler.
+Spin a node until SIGINT or SIGTERM, with a bounded wait so that the signal is never missed.
 
-With the rclpy 7.1.6 wheels, ``rclpy.spin`` occasionally missed a shutdown signal and blocked in
-``rcl_wait`` forever (seen 1 in 25 SIGTERMs of the simulated camera under load: py-spy showed the
-main thread idle in ``WaitSet::wait`` after the signal). Waking every ``poll_s`` to re-check the
-context bounds the shutdown delay instead; it costs one empty wait per ``poll_s`` when idle.
+rclpy's signal handler (a thread of its own) first triggers the executors' signal guard
+condition and then shuts the contexts down. An executor that wakes between the two sees its
+context still running, consumes the guard condition and waits again; with no timer of its own
+(an idle simulated camera) that wait has no timeout, so the process ignores the SIGTERM until it
+is killed (``exit status -9`` in the tests). A timer that does nothing bounds every wait to
+:data:`WAKE_PERIOD_S`, after which the executor sees the shut-down context and returns.
 """
-from rclpy.executors import SingleThreadedExecutor
+from __future__ import annotations
 
-POLL_S = 0.1
+import rclpy
+
+WAKE_PERIOD_S = 0.25
 
 
-def spin(node, poll_s: float = POLL_S) -> None:
-    """Spin ``node`` on a SingleThreadedExecutor until its context is shut down."""
-    executor = SingleThreadedExecutor(context=node.context)
-    executor.add_node(node)
+def _wake() -> None:
+    """Do nothing: the executor only needs to return from its wait."""
+
+
+def spin(node, wake_period_s: float = WAKE_PERIOD_S) -> None:
+    """
+    Spin ``node`` until its context shuts down, waking at least every ``wake_period_s``.
+
+    Raises
+    ------
+    rclpy.executors.ExternalShutdownException
+        When a signal shut the context down (as :func:`rclpy.spin` does).
+
+    """
+    timer = node.create_timer(wake_period_s, _wake)
     try:
-        while node.context.ok():
-            executor.spin_once(timeout_sec=poll_s)
+        rclpy.spin(node)
     finally:
-        executor.remove_node(node)
-        executor.shutdown(timeout_sec=0)
+        node.destroy_timer(timer)

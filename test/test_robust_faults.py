@@ -1,0 +1,246 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Fault injection: nodes killed mid-search and restarted, evidence that stops, a signal race.
+
+- The camera is killed (SIGKILL) mid-search. The controller keeps its belief, reports the stall
+  in ``/diagnostics`` (WARN, ``no usable evidence for X s``) and its log, re-sends its target
+  and uses little CPU (``/proc/<pid>/stat`` over 5 s). A new camera gets the target, and its
+  first frame updates the kept belief (checked against Bayes' rule); the search completes on
+  the camera's target.
+- The controller is killed and a new one started: the camera keeps serving, and the new
+  controller's search completes.
+- rclpy's signal handler can wake the executor before it shuts the context down; the nodes'
+  spin loop must still return (the SIGTERM hang once seen as ``camera: exit status -9``).
+"""
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+import textwrap
+
+from conftest import HAVE_RCLPY, REPO, wait_for
+import numpy as np
+import pytest
+from robust_support import cpu_fraction, Diagnostics, Latest, Services
+
+pytestmark = [pytest.mark.ros,
+              pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
+
+TARGET = (2, 8)
+DPRIME = 2.5                       # a weak camera: a search takes several fixations
+STALL_S = 1.0
+CPU_WINDOW_S = 5.0
+TASK = ['-p', 'grid.rows:=11', '-p', 'grid.cols:=11', '-p', 'grid.spacing_deg:=5.0',
+        '-p', f'fpoc.dprime:={DPRIME}', '-p', 'fpoc.half_width_deg:=10.0',
+        '-p', 'fpoc.half_height_deg:=10.0']
+CONTROLLER_ARGS = TASK + ['-p', 'policy.name:=elm', '-p', 'retry_period_s:=0.3',
+                          '-p', f'stall_timeout_s:={STALL_S}', '-p', 'diagnostics_period_s:=0.2',
+                          '-p', 'confidence:=0.999']
+CAMERA_ARGS = TASK + ['-p', f'target_row:={TARGET[0]}', '-p', f'target_col:={TARGET[1]}',
+                      '-p', 'seed:=5']
+
+
+class Nodes:
+    """Node processes of this module; some are killed on purpose."""
+
+    def __init__(self, env, logs):
+        self.env, self.logs = env, logs
+        self.started, self.killed = [], []
+
+    def start(self, node: str, args):
+        """Start a node process."""
+        from ipomdp_gaze.nodes.processes import NodeProcess
+        log = self.logs / f'{node}-{len(self.started)}.log'
+        self.started.append(NodeProcess(node, args, self.env, log).start())
+        return self.started[-1]
+
+    def kill(self, proc) -> None:
+        """SIGKILL a node: no clean-up at all, as in a crash."""
+        proc.proc.kill()
+        proc.proc.wait(10)
+        self.killed.append(proc)
+
+    def last(self, node: str):
+        """Return the node process of this kind started last."""
+        return next(p for p in reversed(self.started) if p.node == node)
+
+
+@pytest.fixture(scope='module')
+def nodes(ros_env, tmp_path_factory):
+    """Start nodes; at teardown each one not killed gets SIGTERM and must exit with 0."""
+    nodes = Nodes(ros_env, tmp_path_factory.mktemp('fault_logs'))
+    yield nodes
+    codes = [(p, p.stop()) for p in nodes.started if p not in nodes.killed]
+    bad = [f'{p.node}: exit status {code}\n{p.output()[-3000:]}' for p, code in codes if code]
+    assert not bad, 'nodes did not shut down cleanly:\n' + '\n'.join(bad)
+
+
+class Watch:
+    """What the probe sees of the search: beliefs, targets, camera poses and frames, found."""
+
+    def __init__(self, probe):
+        from diagnostic_msgs.msg import DiagnosticStatus
+        from ipomdp_gaze.grid import Grid
+        from msg_adapters import joints
+        from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+        from sensor_msgs.msg import JointState
+        from std_msgs.msg import Float32MultiArray
+        latched = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE,
+                             durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        self.grid = Grid(11, 11, 5.0)
+        self.head = joints.PanTiltMap(self.grid)
+        self.beliefs = probe.record(Float32MultiArray, 'belief', 200)
+        self.targets = probe.record(JointState, 'pan_tilt', latched, distinct_stamps=True)
+        self.poses = probe.record(JointState, 'joint_states', 200)
+        best_effort = QoSProfile(depth=200, reliability=ReliabilityPolicy.BEST_EFFORT)
+        self.frames = probe.record(Float32MultiArray, 'evidence', best_effort)
+        self.found = Latest(probe, DiagnosticStatus, 'found', 10)
+        self.diag = Diagnostics(probe)
+
+    def cell(self, msg) -> int:
+        from msg_adapters import joints
+        return self.head.nearest_cell(*joints.angles_from_joint_state(msg, self.head))
+
+    def belief(self, i=-1) -> np.ndarray:
+        return np.asarray(self.beliefs[i][1].data, dtype=np.float64)
+
+    def finished(self, since: int) -> bool:
+        return any(max(m.data) >= 0.999 for _, m in self.beliefs[since:])
+
+
+@pytest.fixture(scope='module')
+def watch(probe):
+    return Watch(probe)
+
+
+def _posterior(belief, frame, fixation, grid) -> np.ndarray:
+    """Bayes' rule offline: the kept belief updated with one camera frame."""
+    from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
+    d = dprime_matrix(grid, make_fpoc('camera', dprime=DPRIME, half_width_deg=10.0,
+                                      half_height_deg=10.0))[:, fixation]
+    o = np.asarray(frame, np.float32).astype(np.float64)
+    term = np.where(np.isnan(o), 0.0, d * (np.nan_to_num(o) - d / 2))
+    log_b = np.log(np.maximum(belief, 1e-300)) + term
+    return np.exp(log_b - np.logaddexp.reduce(log_b))
+
+
+def _mid_search(probe, watch, services):
+    """Reset; wait for a search with a few applied frames that has not found the target."""
+    for _ in range(5):
+        n = len(watch.beliefs)
+        assert services.reset().success
+        assert wait_for(lambda: len(watch.beliefs) >= n + 4, 30), 'the search did not start'
+        if not watch.finished(n):
+            return
+    pytest.fail('every search finished within 3 fixations')
+
+
+def test_camera_killed_mid_search_then_restarted(nodes, probe, watch):
+    controller = nodes.start('controller', CONTROLLER_ARGS)
+    camera = nodes.start('camera', CAMERA_ARGS)
+    assert wait_for(lambda: watch.diag.count > 0, 30), controller.output()
+    services = Services(probe)
+    assert wait_for(lambda: watch.poses, 30), camera.output()
+    _mid_search(probe, watch, services)
+
+    nodes.kill(camera)
+    wait_for(lambda: False, 0.3)                 # frames in flight arrive or are lost
+    kept_beliefs = len(watch.beliefs)
+    kept = watch.belief()
+    before = watch.diag.wait_fresh()
+    resends = int(watch.diag.values['pan_tilt_resends'])
+    # Evidence has stopped: low CPU, then a warning in /diagnostics and in the log.
+    cpu = cpu_fraction(controller.proc.pid, CPU_WINDOW_S)
+    stalled = watch.diag.wait_fresh()
+    print(f'\ncontroller CPU with no evidence: {cpu:.1%} of a core over {CPU_WINDOW_S} s')
+    assert cpu < 0.2
+    assert stalled['applied'] == before['applied'] and len(watch.beliefs) == kept_beliefs
+    assert watch.diag.level == 1, watch.diag.message                 # WARN
+    assert watch.diag.message.startswith('no usable evidence for '), watch.diag.message
+    waited = float(watch.diag.message.split()[4])
+    assert waited >= CPU_WINDOW_S
+    assert int(watch.diag.values['pan_tilt_resends']) >= resends + 5
+    assert 'no usable evidence for' in controller.output()
+    assert controller.running
+
+    # A new camera. The test's probe must discover it before it sends anything worth checking,
+    # so the controller is disabled meanwhile (a frame taken then is skipped); enabling it
+    # re-sends the target, which reaches the new camera, and the camera's frame taken there
+    # updates the kept belief by Bayes' rule.
+    target = watch.cell(watch.targets[-1][1])
+    assert services.enable(False).success
+    graph = probe.node
+    publishers = graph.count_publishers('evidence'), graph.count_publishers('joint_states')
+    camera = nodes.start('camera', CAMERA_ARGS)
+    assert wait_for(lambda: graph.count_publishers('evidence') > publishers[0] and
+                    graph.count_publishers('joint_states') > publishers[1], 30), camera.output()
+    wait_for(lambda: False, 0.5)                 # let the probe's side of the match settle
+    n_frames, n_poses = len(watch.frames), len(watch.poses)
+    assert len(watch.beliefs) == kept_beliefs
+    assert services.enable(True).success
+    assert wait_for(lambda: any(watch.cell(m) == target for _, m in watch.poses[n_poses:]), 30), \
+        (target, [watch.cell(m) for _, m in watch.poses[n_poses:]], camera.output())
+    assert wait_for(lambda: len(watch.beliefs) > kept_beliefs, 30), controller.output()
+    first = watch.belief(kept_beliefs)
+    assert any(np.allclose(first, _posterior(kept, frame.data, target, watch.grid), rtol=1e-4,
+                           atol=1e-7) for _, frame in watch.frames[n_frames:]), \
+        'the first update after the restart is not the kept belief times a camera frame'
+    assert wait_for(lambda: watch.finished(kept_beliefs), 60), 'the search did not complete'
+    done = next(np.asarray(m.data) for _, m in watch.beliefs[kept_beliefs:]
+                if max(m.data) >= 0.999)
+    assert watch.grid.cell(int(np.argmax(done))) == TARGET
+    assert watch.diag.wait_fresh()['applied'] > before['applied']
+    assert watch.diag.message != '' and not watch.diag.message.startswith('no usable')
+
+
+def test_controller_killed_and_restarted_camera_keeps_serving(nodes, probe, watch):
+    from std_srvs.srv import Trigger
+    controller, camera = nodes.last('controller'), nodes.last('camera')
+    nodes.kill(controller)
+    reply = probe.call(Trigger, '/simulated_camera/reset', Trigger.Request())
+    assert reply.success and f'({TARGET[0]}, {TARGET[1]})' in reply.message
+    n = len(watch.beliefs)
+    controller = nodes.start('controller', CONTROLLER_ARGS)
+    assert wait_for(lambda: watch.finished(n), 60), controller.output()[-2000:]
+    done = next(np.asarray(m.data) for _, m in watch.beliefs[n:] if max(m.data) >= 0.999)
+    assert watch.grid.cell(int(np.argmax(done))) == TARGET
+    assert camera.running and controller.running
+
+
+RACE = textwrap.dedent("""
+    import sys, threading, time
+    import rclpy
+    from rclpy.executors import ExternalShutdownException
+    from rclpy.node import Node
+    from ipomdp_gaze.nodes.spin import spin
+
+    rclpy.init(args=[])
+    node = Node('idle_node')                      # no timer of its own, like an idle camera
+
+    def signal_like_rclpy():
+        time.sleep(1.0)
+        # rclpy's signal thread: first wake the executor, then shut the context down.
+        rclpy.get_global_executor()._sigint_gc.trigger()
+        time.sleep(0.3)
+        context = rclpy.get_default_context()
+        with context.handle:
+            context.handle.shutdown()
+
+    threading.Thread(target=signal_like_rclpy, daemon=True).start()
+    start = time.monotonic()
+    try:
+        spin(node)
+    except ExternalShutdownException:
+        pass
+    print(f'returned after {time.monotonic() - start:.2f} s', flush=True)
+""")
+
+
+def test_spin_returns_when_the_signal_wakes_the_executor_before_shutdown(ros_env):
+    proc = subprocess.run([sys.executable, '-c', RACE], env=ros_env, cwd=REPO, timeout=60,
+                          capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    seconds = float(proc.stdout.split()[-2])
+    assert math.isfinite(seconds) and seconds < 1.3 + 4 * 0.25 + 5.0

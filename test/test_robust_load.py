@@ -1,0 +1,113 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Load: a camera faster than the controller, at 1 kHz on 11x11 and at 60 Hz on 256x256.
+
+``bench/evidence_flood.py`` (its own process) publishes the frames; the controller keeps only the
+newest one (``evidence_queue_depth`` 1), so a frame it has not taken yet is replaced by the next
+one and counted as dropped from the publisher's sequence numbers. Every frame is accounted for:
+received + dropped = sent, received = applied + rejected + skipped. At 11x11 the steady
+1 kHz is followed by 5,000 frames at once, which must mostly be dropped rather than queued. The
+flood ends with one invalid frame; it is the newest, so it must be received (and rejected)
+however far behind the node was. The controller's RSS is sampled from ``/proc`` during the run
+and must not grow, and its CPU use is reported.
+
+At 256x256 the controller runs the MAP policy: on this branch ELM and learned kernels still
+build an N x N weight matrix (65,536^2 doubles, 34 GB).
+
+``make test`` runs each for about 5 s; ``make soak`` for a minute.
+"""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+from conftest import HAVE_RCLPY, REPO, wait_for
+import pytest
+from robust_support import Diagnostics, RssSampler
+
+pytestmark = [pytest.mark.ros,
+              pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
+
+FLOOD = REPO / 'bench' / 'evidence_flood.py'
+MB = 2 ** 20
+# (rows, spacing_deg, policy) of each grid.
+GRIDS = {11: (5.0, 'elm'), 256: (0.5, 'map')}
+
+
+def _flood(env, rows, rate_hz, seconds, burst):
+    cmd = [sys.executable, str(FLOOD), '--rows', str(rows), '--cols', str(rows), '--rate-hz',
+           str(rate_hz), '--seconds', str(seconds), '--burst', str(burst), '--marker']
+    return subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            text=True)
+
+
+def _run(launch, probe, ros_env, rows, rate_hz, seconds, burst):
+    spacing, policy = GRIDS[rows]
+    proc = launch('controller', [
+        '-p', f'grid.rows:={rows}', '-p', f'grid.cols:={rows}',
+        '-p', f'grid.spacing_deg:={spacing}', '-p', f'policy.name:={policy}',
+        '-p', 'diagnostics_period_s:=0.25'])
+    diag = Diagnostics(probe)
+    flood = _flood(ros_env, rows, rate_hz, seconds, burst)    # it waits for the controller
+    try:
+        assert wait_for(lambda: diag.count > 0, 60), proc.output()
+        rss = RssSampler(proc.proc.pid)
+        out, _ = flood.communicate(timeout=seconds + 120)
+        samples = rss.stop()
+        assert flood.returncode == 0, out
+        report = json.loads(out.strip().splitlines()[-1])
+        sent = report['sent']
+
+        def accounted():
+            c = diag.counters()
+            return c['received'] + c['dropped'] >= sent
+
+        assert wait_for(accounted, 20), (str(diag.counters()), report)
+        got = diag.wait_fresh()                  # a fresh controller: the counters start at 0
+        assert proc.running, proc.output()[-3000:]
+    finally:
+        if flood.poll() is None:
+            flood.kill()
+            flood.wait()
+        code = proc.stop()
+    assert code == 0, proc.output()[-3000:]
+    return report, got, samples
+
+
+def _check(report, got, samples, label, max_growth_mb):
+    sent = report['sent']
+    third = max(1, len(samples) // 3)
+    early = max(r for _, r, _ in samples[:third])
+    late = max(r for _, r, _ in samples[-third:])
+    peak = max(r for _, r, _ in samples)
+    (t0, _, c0), (t1, _, c1) = samples[third], samples[-third]
+    cpu = (c1 - c0) / (t1 - t0)                        # the middle third: steady flooding
+    rate, duration = report['rate_hz'], report['seconds']
+    print(f'\n{label}: sent {sent} frames at {rate} Hz for {duration} s; controller received '
+          f'{got["received"]}, dropped {got["dropped"]}, applied {got["applied"]}, rejected '
+          f'{got["rejected"]}, skipped {got["skipped"]}; CPU {cpu:.0%} of a core; '
+          f'RSS {early / MB:.1f} MB in the first third, {late / MB:.1f} MB in the last, peak '
+          f'{peak / MB:.1f} MB ({len(samples)} samples)')
+    assert got['received'] + got['dropped'] == sent
+    assert got['rejected'] == 1                        # the newest frame, the marker
+    assert got['received'] == got['applied'] + got['rejected'] + got['skipped']
+    assert got['applied'] >= 1 and got['skipped'] >= 1
+    assert late - early <= max_growth_mb * MB, (early, late)
+
+
+@pytest.mark.parametrize('rows, rate_hz, seconds, burst', [
+    pytest.param(11, 1000.0, 5.0, 5000, id='11x11-1kHz-5s'),
+    pytest.param(256, 60.0, 5.0, 0, id='256x256-60Hz-5s'),
+    pytest.param(11, 1000.0, 60.0, 5000, id='11x11-1kHz-60s', marks=pytest.mark.soak),
+    pytest.param(256, 60.0, 60.0, 0, id='256x256-60Hz-60s', marks=pytest.mark.soak),
+])
+def test_fast_camera_memory_and_queue_stay_bounded(launch, probe, ros_env, rows, rate_hz,
+                                                   seconds, burst):
+    report, got, samples = _run(launch, probe, ros_env, rows, rate_hz, seconds, burst)
+    _check(report, got, samples, f'{rows}x{rows} at {rate_hz:g} Hz'
+           + (f', then {burst} frames at once' if burst else ''), max_growth_mb=16)
+    if burst:
+        # Frames that came faster than the node took them were replaced, not queued.
+        assert got['dropped'] > 0 and got['received'] < report['sent']
