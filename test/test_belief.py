@@ -128,7 +128,7 @@ def test_overflowing_evidence_is_rejected_and_the_belief_kept():
     from ipomdp_gaze.grid import Grid
     obs = np.zeros(9)
     obs[4] = 1.7e308
-    with pytest.raises(EvidenceError, match='overflows'):
+    with pytest.raises(EvidenceError, match='refused'):
         update_log_belief(uniform_log_belief(9), obs, np.full(9, 2.0))
     grid = Grid(3, 3)
     tracker = BeliefTracker(grid, dprime_table(grid, make_fpoc('human')))
