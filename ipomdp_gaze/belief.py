@@ -17,6 +17,7 @@ import operator
 import numpy as np
 
 TIE_RTOL = 1e-9
+OVERFLOW_REASON = 'evidence too large: d * (o - d/2) overflows float64'
 
 
 OVERFLOW_REASON = 'evidence too large: d * (o - d/2) overflows float64'
@@ -89,8 +90,8 @@ def log_likelihood(observation: np.ndarray, dprime: np.ndarray) -> np.ndarray:
         i = np.flatnonzero(bad)[0]
         o, d = np.broadcast_to(observation, term.shape).flat[i], \
             np.broadcast_to(dprime, term.shape).flat[i]
-        raise EvidenceError(f"evidence {o:.6g} at cell {i % term.shape[-1]} with d' = {d:.6g} "
-                            f'gives a log-likelihood of {term.flat[i]}; the frame is refused')
+        raise EvidenceError(f'{OVERFLOW_REASON} at cell {i % term.shape[-1]} (o = {o:.6g}, '
+                            f"d' = {d:.6g}, term {term.flat[i]}); the frame is refused")
     return term
 
 

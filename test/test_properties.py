@@ -81,7 +81,7 @@ def test_update_refuses_with_a_reason_or_gives_a_normalised_belief(case):
         after = update_log_belief(log_b, check_evidence(obs, obs.size), d)
     except EvidenceError as exc:
         reason = str(exc)
-        assert 'inf' in reason or 'log-likelihood' in reason, reason
+        assert 'inf' in reason or 'overflows' in reason, reason
         np.testing.assert_array_equal(log_b, before)
         # Only a frame that would poison the belief is refused.
         with np.errstate(over='ignore', invalid='ignore'):
@@ -130,7 +130,7 @@ def test_overflowing_frames_are_refused_not_turned_into_nan():
     for obs, d in (([1e308, 0.0, 0.0], [4.0, 4.0, 4.0]),            # 4e308 > max double
                    ([-1e308] * 3, [4.0] * 3),                      # every cell -inf
                    ([0.0, 0.0, 0.0], [1e200, 1e200, 1e200])):      # d'^2 / 2 overflows
-        with pytest.raises(EvidenceError, match='log-likelihood of -?inf; the frame is refused'):
+        with pytest.raises(EvidenceError, match='overflows'):
             update_log_belief(log_b, np.array(obs), np.array(d))
     # Just below overflow it is evidence like any other: all mass on the one cell.
     after = update_log_belief(log_b, np.array([4e307, 0.0, 0.0]), np.full(3, 4.0))

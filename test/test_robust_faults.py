@@ -210,9 +210,9 @@ def test_controller_killed_and_restarted_camera_keeps_serving(nodes, probe, watc
 
 
 RACE = textwrap.dedent("""
-    import sys, threading, time
+    import gc, sys, threading, time
     import rclpy
-    from rclpy.executors import ExternalShutdownException
+    from rclpy.executors import Executor, ExternalShutdownException
     from rclpy.node import Node
     from ipomdp_gaze.nodes.spin import spin
 
@@ -221,8 +221,9 @@ RACE = textwrap.dedent("""
 
     def signal_like_rclpy():
         time.sleep(1.0)
-        # rclpy's signal thread: first wake the executor, then shut the context down.
-        rclpy.get_global_executor()._sigint_gc.trigger()
+        # rclpy's signal thread: first wake every executor, then shut the context down.
+        for executor in [x for x in gc.get_objects() if isinstance(x, Executor)]:
+            executor._sigint_gc.trigger()
         time.sleep(0.3)
         context = rclpy.get_default_context()
         with context.handle:

@@ -9,11 +9,11 @@ one and counted as dropped from the publisher's sequence numbers. Every frame is
 received + dropped = sent, received = applied + rejected + skipped. At 11x11 the steady
 1 kHz is followed by 5,000 frames at once, which must mostly be dropped rather than queued. The
 flood ends with one invalid frame; it is the newest, so it must be received (and rejected)
-however far behind the node was. The controller's RSS is sampled from ``/proc`` during the run
-and must not grow, and its CPU use is reported.
+however far behind the node was. A viewer subscribes to ``belief_image`` (at 256x256 and 32 px
+per cell the heatmap would be 201 MB; it is capped at 1024 px). The controller's RSS is sampled
+from ``/proc`` during the run and must not grow, and its CPU use is reported.
 
-At 256x256 the controller runs the MAP policy: on this branch ELM and learned kernels still
-build an N x N weight matrix (65,536^2 doubles, 34 GB).
+Both grids run ELM (at 256x256 an FFT convolution on the offset table: no N x N array).
 
 ``make test`` runs each for about 5 s; ``make soak`` for a minute.
 """
@@ -25,15 +25,16 @@ import sys
 
 from conftest import HAVE_RCLPY, REPO, wait_for
 import pytest
-from robust_support import Diagnostics, RssSampler
+from robust_support import Diagnostics, Latest, RssSampler
 
 pytestmark = [pytest.mark.ros,
               pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
 
 FLOOD = REPO / 'bench' / 'evidence_flood.py'
 MB = 2 ** 20
+MAX_RSS_MB = 400                    # 256x256 with a belief_image viewer once took 1.27 GB
 # (rows, spacing_deg, policy) of each grid.
-GRIDS = {11: (5.0, 'elm'), 256: (0.5, 'map')}
+GRIDS = {11: (5.0, 'elm'), 256: (0.5, 'elm')}
 
 
 def _flood(env, rows, rate_hz, seconds, burst):
@@ -49,7 +50,9 @@ def _run(launch, probe, ros_env, rows, rate_hz, seconds, burst):
         '-p', f'grid.rows:={rows}', '-p', f'grid.cols:={rows}',
         '-p', f'grid.spacing_deg:={spacing}', '-p', f'policy.name:={policy}',
         '-p', 'diagnostics_period_s:=0.25'])
+    from sensor_msgs.msg import Image
     diag = Diagnostics(probe)
+    viewer = Latest(probe, Image, 'belief_image', 2)          # someone watches the heatmap
     flood = _flood(ros_env, rows, rate_hz, seconds, burst)    # it waits for the controller
     try:
         assert wait_for(lambda: diag.count > 0, 60), proc.output()
@@ -67,6 +70,8 @@ def _run(launch, probe, ros_env, rows, rate_hz, seconds, burst):
         assert wait_for(accounted, 20), (str(diag.counters()), report)
         got = diag.wait_fresh()                  # a fresh controller: the counters start at 0
         assert proc.running, proc.output()[-3000:]
+        assert viewer.count > 0, 'no belief_image'
+        assert max(viewer.msg.height, viewer.msg.width) <= 1024
     finally:
         if flood.poll() is None:
             flood.kill()
@@ -95,6 +100,7 @@ def _check(report, got, samples, label, max_growth_mb):
     assert got['received'] == got['applied'] + got['rejected'] + got['skipped']
     assert got['applied'] >= 1 and got['skipped'] >= 1
     assert late - early <= max_growth_mb * MB, (early, late)
+    assert peak <= MAX_RSS_MB * MB, peak
 
 
 @pytest.mark.parametrize('rows, rate_hz, seconds, burst', [

@@ -57,6 +57,8 @@ NODE_NAME = 'gaze_controller'
 STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                        durability=DurabilityPolicy.TRANSIENT_LOCAL)
 WARN_THROTTLE_S = 5.0
+# belief_image is at most this many pixels on a side (256x256 cells at 32 px would be 201 MB).
+MAX_IMAGE_SIDE_PX = 1024
 
 
 def controller_params() -> list[Param]:
@@ -102,7 +104,9 @@ def controller_params() -> list[Param]:
         Param('trajectory_topic', '', T.STRING, 'also send a JointTrajectory here ("": off)'),
         Param('trajectory_duration_s', 0.5, T.DOUBLE,
               'time_from_start of the JointTrajectory point', float_range=(0.0, 60.0)),
-        Param('belief_image_scale_px', 32, T.INTEGER, 'pixels per cell in belief_image',
+        Param('belief_image_scale_px', 32, T.INTEGER,
+              'pixels per cell in belief_image (fewer when the image would exceed '
+              f'{MAX_IMAGE_SIDE_PX} px on a side)',
               int_range=(1, 256)),
         Param('diagnostics_period_s', 1.0, T.DOUBLE, 'period of /diagnostics',
               float_range=(0.01, 3600.0)),
@@ -369,8 +373,14 @@ class GazeControllerNode(Node):
         self._belief_pub.publish(grid_arrays.to_multiarray(belief, grid))
         if self._image_pub.get_subscription_count():
             self._image_pub.publish(images.belief_image(
-                belief, grid, self.core.fixation, self._config.values['belief_image_scale_px'],
+                belief, grid, self.core.fixation, self._image_scale_px(),
                 self._now().to_msg()))
+
+    def _image_scale_px(self) -> int:
+        """Pixels per cell of belief_image: as set, but the image fits MAX_IMAGE_SIDE_PX."""
+        grid = self._config.grid
+        fit = max(1, MAX_IMAGE_SIDE_PX // max(grid.rows, grid.cols))
+        return min(self._config.values['belief_image_scale_px'], fit)
 
     def _publish_found(self, found) -> None:
         grid = self._config.grid
