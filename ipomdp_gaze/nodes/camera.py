@@ -28,10 +28,6 @@ from ipomdp_gaze.gaze import dprime_of_fixation
 from msg_adapters import grid_arrays, images, joints
 import numpy as np
 from rcl_interfaces.msg import SetParametersResult
-import rclpy
-from rclpy.exceptions import ParameterException
-from rclpy.executors import ExternalShutdownException
-from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import Image, JointState
@@ -41,7 +37,7 @@ from std_srvs.srv import Trigger
 from .params import (current_values, declare, fpoc_from, fpoc_params, grid_from, grid_params,
                      head_from, INT_MAX, joint_params, MAX_CELLS_PER_SIDE, Param, row_col_from,
                      short_repr, T)
-from .spin import spin
+from .spin import run_node
 
 NODE_NAME = 'simulated_camera'
 FRAME_QOS = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
@@ -225,26 +221,7 @@ class SimulatedCameraNode(Node):
 
 def main(args=None) -> int:
     """Run the ``simulated_camera`` node until shutdown (Ctrl-C or SIGTERM)."""
-    rclpy.init(args=args)
-    node = None
-    status = 0
-    try:
-        node = SimulatedCameraNode()
-        spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except _rclpy.RCLError:
-        # SIGTERM/SIGINT shut the context down while the executor was building its wait set.
-        if rclpy.ok():
-            raise
-    except (ValueError, ParameterException) as exc:
-        print(f'{NODE_NAME}: error: {exc}', file=sys.stderr)
-        status = 1
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return status
+    return run_node(SimulatedCameraNode, NODE_NAME, args)
 
 
 if __name__ == '__main__':

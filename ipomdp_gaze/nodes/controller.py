@@ -35,10 +35,7 @@ from msg_adapters import diagnostics, grid_arrays, images, joints, stamps
 from policies.baselines import STRATEGIES
 from policies.conv import ACTIONS
 from rcl_interfaces.msg import SetParametersResult
-import rclpy
-from rclpy.exceptions import NameValidationException, ParameterException
-from rclpy.executors import ExternalShutdownException
-from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+from rclpy.exceptions import NameValidationException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
@@ -51,7 +48,7 @@ from trajectory_msgs.msg import JointTrajectory
 from .params import (current_values, declare, fpoc_from, fpoc_params, grid_from, grid_params,
                      head_from, INT_MAX, joint_params, MAX_CELLS_PER_SIDE, Param, row_col_from,
                      short_repr, T)
-from .spin import spin
+from .spin import run_node
 
 NODE_NAME = 'gaze_controller'
 STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
@@ -516,26 +513,7 @@ class GazeControllerNode(Node):
 
 def main(args=None) -> int:
     """Run the ``gaze_controller`` node until shutdown (Ctrl-C or SIGTERM)."""
-    rclpy.init(args=args)
-    node = None
-    status = 0
-    try:
-        node = GazeControllerNode()
-        spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except _rclpy.RCLError:
-        # SIGTERM/SIGINT shut the context down while the executor was building its wait set.
-        if rclpy.ok():
-            raise
-    except (ValueError, ParameterException) as exc:
-        print(f'{NODE_NAME}: error: {exc}', file=sys.stderr)
-        status = 1
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return status
+    return run_node(GazeControllerNode, NODE_NAME, args)
 
 
 if __name__ == '__main__':

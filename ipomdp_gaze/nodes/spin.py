@@ -12,6 +12,8 @@ is killed (``exit status -9`` in the tests). A timer that does nothing bounds ev
 """
 from __future__ import annotations
 
+import sys
+
 import rclpy
 
 WAKE_PERIOD_S = 0.25
@@ -36,3 +38,35 @@ def spin(node, wake_period_s: float = WAKE_PERIOD_S) -> None:
         rclpy.spin(node)
     finally:
         node.destroy_timer(timer)
+
+
+def run_node(make_node, node_name: str, args=None) -> int:
+    """
+    Run a node with the Jazzy idiom: init, spin until SIGINT/SIGTERM, destroy, try_shutdown.
+
+    An invalid start-up parameter (``ValueError`` or ``ParameterException`` from the node's
+    constructor) prints one line naming it and returns 1; a clean shutdown returns 0.
+    """
+    from rclpy.exceptions import ParameterException
+    from rclpy.executors import ExternalShutdownException
+    from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+    rclpy.init(args=args)
+    node = None
+    status = 0
+    try:
+        node = make_node()
+        spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except _rclpy.RCLError:
+        # SIGTERM/SIGINT shut the context down while the executor was building its wait set.
+        if rclpy.ok():
+            raise
+    except (ValueError, ParameterException) as exc:
+        print(f'{node_name}: error: {exc}', file=sys.stderr)
+        status = 1
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return status
