@@ -3,21 +3,22 @@
 """Install ipomdp_gaze: an ament_python ROS 2 package that is also a plain pip package."""
 from glob import glob
 
-from setuptools import setup
+from setuptools import find_packages, setup
 
 PACKAGE = 'ipomdp_gaze'
 
 setup(
     name=PACKAGE,
     version='0.1.0',
-    packages=[PACKAGE, f'{PACKAGE}.nodes', 'policies', 'msg_adapters'],
-    package_data={'policies': ['kernels/*.yaml']},
+    # One import namespace: policies/ and msg_adapters/ are reached through the committed
+    # symlinks ipomdp_gaze/policies and ipomdp_gaze/msg_adapters (docs/design.md section 8).
+    packages=find_packages(include=[PACKAGE, f'{PACKAGE}.*']),
+    package_data={f'{PACKAGE}.policies': ['kernels/*.yaml']},
     data_files=[
         ('share/ament_index/resource_index/packages', [f'resource/{PACKAGE}']),
         (f'share/{PACKAGE}', ['package.xml']),
         (f'share/{PACKAGE}/config', glob('config/*.yaml')),
         (f'share/{PACKAGE}/launch', glob('launch/*.launch.py')),
-        (f'share/{PACKAGE}/kernels', glob('policies/kernels/*.yaml')),
     ],
     python_requires='>=3.10',
     install_requires=[
@@ -36,7 +37,7 @@ setup(
                  'flake8-comprehensions', 'flake8-deprecated', 'flake8-docstrings',
                  'flake8-import-order', 'flake8-quotes', 'pydocstyle'],
     },
-    zip_safe=True,
+    zip_safe=False,
     maintainer='ipomdp_gaze developers',
     maintainer_email='ipomdp-gaze@example.org',
     description='I-POMDP infomax gaze control (Butko & Movellan 2008) for ROS 2 pan/tilt heads',

@@ -25,10 +25,10 @@ from ipomdp_gaze.belief import (argmax_ties_low, BeliefTracker, dprime_column, T
                                 uniform_log_belief, update_log_belief)
 from ipomdp_gaze.fpoc import dprime_table, make_fpoc
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.policies import conv
+from ipomdp_gaze.policies.baselines import elm_policy
+from ipomdp_gaze.policies.conv import ConvPolicy, kernel_matrix
 import numpy as np
-from policies import conv
-from policies.baselines import elm_policy
-from policies.conv import ConvPolicy, kernel_matrix
 import scipy.signal
 
 TITLE = 'Decision latency (belief update + policy choice), FFT break-even, memory'
@@ -366,7 +366,7 @@ def truncation(ctx):
 def greedy_cost(ctx):
     """Ideal searcher decision time at 7x7 and 11x11, when policies.greedy exists."""
     try:
-        from policies.greedy import PercentCorrectGreedy
+        from ipomdp_gaze.policies.greedy import PercentCorrectGreedy
     except ImportError:
         return None
     fpoc, out = make_fpoc('human'), []

@@ -25,14 +25,15 @@ import json
 from pathlib import Path
 import time
 
-from ipomdp_gaze.belief import normalize_log
+from ipomdp_gaze.belief import bayes_update
 from ipomdp_gaze.evaluation import fixations_to_90_ci, paired_difference_ci
 from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.observation import GaussianObservation
+from ipomdp_gaze.policies.baselines import make_baseline
+from ipomdp_gaze.policies.planner import make_planner, TemperedELM
 from ipomdp_gaze.simulate import draw_targets, simulate
 import numpy as np
-from policies.baselines import make_baseline
-from policies.planner import make_planner, TemperedELM
 
 
 def measure(result, n_cells, seed, resamples):
@@ -56,12 +57,11 @@ def paired(result_a, result_b, n_cells, seed, resamples):
     return out
 
 
-def decision_times(planner, grid, d, episodes=20, fixations=10, seed=0):
+def decision_times(planner, grid, model, episodes=20, fixations=10, seed=0):
     """Wall and CPU ms of single-belief decisions on beliefs along the base policy's searches."""
     rng = np.random.default_rng([seed, 7])
     n = grid.n_cells
     targets = rng.integers(0, n, episodes)
-    rows = np.arange(episodes)
     log_b = np.full((episodes, n), -np.log(n))
     times, cpu = [], []
     for t in range(fixations):
@@ -72,11 +72,8 @@ def decision_times(planner, grid, d, episodes=20, fixations=10, seed=0):
             times.append(time.perf_counter() - start)
             cpu.append(time.process_time() - start_cpu)
         k = planner.base.select(belief, t, rng)
-        d_k = d.T[k]
-        obs = rng.standard_normal((episodes, n))
-        obs[rows, targets] += d_k[rows, targets]
-        log_b += d_k * (obs - 0.5 * d_k)
-        normalize_log(log_b)
+        frames = model.sample(targets, k, rng)
+        bayes_update(log_b, model.log_likelihood_ratio(frames, k, validate=False), out=log_b)
     return 1000 * np.asarray(times), 1000 * np.asarray(cpu)
 
 
@@ -84,10 +81,8 @@ def tempered_vs_elm(grid, fpoc, d, seeds, episodes, horizon, resamples):
     """Tempered ELM - ELM on several fresh seeds: per seed and pooled (normal approximation)."""
     rows = []
     for seed in seeds:
-        a = simulate(grid, fpoc, TemperedELM(grid, fpoc, dprime=d), episodes, horizon, seed=seed,
-                     dprime=d)
-        b = simulate(grid, fpoc, make_baseline('elm', grid, fpoc), episodes, horizon, seed=seed,
-                     dprime=d)
+        a = simulate(grid, fpoc, TemperedELM(grid, fpoc, dprime=d), episodes, horizon, seed=seed)
+        b = simulate(grid, fpoc, make_baseline('elm', grid, fpoc), episodes, horizon, seed=seed)
         entry = paired(a, b, grid.n_cells, seed, resamples)
         rows.append(entry)
         print(f"  seed {seed:>4}: indicator {fmt(entry['indicator'])}   "
@@ -164,7 +159,7 @@ def main():
     for name, (policy, episodes) in policies.items():
         start = time.perf_counter()
         result = simulate(grid, fpoc, policy, episodes, args.horizon, seed=args.seed,
-                          targets=targets[:episodes], dprime=d)
+                          targets=targets[:episodes])
         wall = time.perf_counter() - start
         results[name] = result
         entry = measure(result, n, args.seed, args.bootstrap)
@@ -198,7 +193,7 @@ def main():
         if args.json:
             args.json.write_text(json.dumps(report, indent=1))
         return
-    ms, cpu_ms = decision_times(planner, grid, d, seed=args.seed)
+    ms, cpu_ms = decision_times(planner, grid, GaussianObservation(grid, fpoc), seed=args.seed)
     rate = report['policies']['planner']['decisions_per_second']
     report['planner'] = {'options': {k: getattr(planner, k) for k in (
         'candidates', 'rollouts', 'rollout_budget', 'horizon', 'until', 'objective',

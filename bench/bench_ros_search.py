@@ -21,7 +21,7 @@ from ipomdp_gaze.gaze import build_policy, GazeController
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.nodes.config import config_file
 from ipomdp_gaze.nodes.processes import domain_id_for, NodeProcess, ros_environment
-from msg_adapters import diagnostics, grid_arrays
+from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays
 import numpy as np
 import rclpy
 from rclpy.executors import SingleThreadedExecutor

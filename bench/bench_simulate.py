@@ -9,12 +9,13 @@ second, beside a naive per-episode Python loop on a subsample (the reference rat
 """
 import time
 
-from ipomdp_gaze.belief import map_cell, uniform_log_belief, update_log_belief
+from ipomdp_gaze.belief import bayes_update, map_cell, uniform_log_belief
 from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
+from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.simulate import simulate
 import numpy as np
-from policies.baselines import make_baseline
 
 
 def naive(grid, fpoc, episodes, seed=0):
@@ -28,7 +29,7 @@ def naive(grid, fpoc, episodes, seed=0):
             k = int(map_cell(np.exp(log_b)))
             obs = rng.standard_normal(grid.n_cells)
             obs[target] += d[target, k]
-            log_b = update_log_belief(log_b, obs, d[:, k])
+            log_b = bayes_update(log_b, llr(obs, d[:, k]))
 
 
 TITLE = 'Simulation throughput (batched simulator)'

@@ -34,10 +34,10 @@ from ipomdp_gaze.evaluation import (fixations_to_90_ci, fixations_to_level,  # n
                                     paired_difference_ci)
 from ipomdp_gaze.fpoc import make_fpoc  # noqa: E402
 from ipomdp_gaze.grid import Grid  # noqa: E402
+from ipomdp_gaze.policies.baselines import make_baseline  # noqa: E402
+from ipomdp_gaze.policies.training import TrainConfig, Trainer, write_curve  # noqa: E402
 from ipomdp_gaze.simulate import simulate  # noqa: E402
 import numpy as np  # noqa: E402
-from policies.baselines import make_baseline  # noqa: E402
-from policies.training import TrainConfig, Trainer, write_curve  # noqa: E402
 
 TARGET_FIXATIONS = 7.86
 TARGET_SECONDS = 120.0

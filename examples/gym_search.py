@@ -9,9 +9,9 @@ confidence threshold. Prints fixations per episode and how often the final guess
 """
 import gymnasium
 import ipomdp_gaze.gym  # noqa: F401  (registers ipomdp_gaze/VisualSearch-v0)
+from ipomdp_gaze.policies.baselines import make_baseline
+from ipomdp_gaze.policies.policy_file import load_policy_spec
 import numpy as np
-from policies.baselines import make_baseline
-from policies.policy_file import load_policy_spec
 
 
 def run(policy, env, episodes: int, seed: int) -> tuple[float, float]:

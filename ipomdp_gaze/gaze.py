@@ -14,7 +14,7 @@ target's cell and the current fixation, and decides what to do with every frame 
   observation), NaN cells count as unobserved, and the policy chooses the next fixation at once.
 
 Every frame is counted: ``received = applied + rejected + skipped``. The first fixation after a
-reset is the start cell (the centre by default, DESIGN.md section 4); the policy picks the rest.
+reset is the start cell (the centre by default, docs/design.md section 4); the policy picks the rest.
 Times are plain seconds on whatever clock the caller uses (the node's ROS clock).
 """
 from __future__ import annotations
@@ -22,19 +22,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from policies.baselines import make_baseline, STRATEGIES
-from policies.conv import check_action, ConvPolicy
 
-from .belief import (check_evidence, entropy, EvidenceError, log_likelihood, map_cell,
-                     normalize_log, uniform_log_belief)
-from .fpoc import dprime_table, FPOC
+from .belief import bayes_update, entropy, EvidenceError, map_cell, uniform_log_belief
 from .grid import Grid
-
-POLICY_NAMES = ('learned', 'map', 'elm', 'random', 'center', 'spiral', 'greedy')
-
-
-class PolicyUnavailable(ValueError):
-    """A policy that cannot be built here: a policy file or module that does not exist."""
+from .observation import as_observation, check_evidence
 
 
 @dataclass(frozen=True)
@@ -65,86 +56,6 @@ class FrameResult:
     def applied(self) -> bool:
         """Whether the frame updated the belief."""
         return self.status == 'applied'
-
-
-def dprime_of_fixation(grid: Grid, table: np.ndarray, fixation: int) -> np.ndarray:
-    """
-    Return ``d_jk`` of every cell j for fixation k, shape (N,), from the offset table.
-
-    ``table`` is :func:`ipomdp_gaze.fpoc.dprime_table` (``(2R-1, 2C-1)``); the cells seen from
-    k are the ``rows x cols`` window starting at ``(R-1-r_k, C-1-c_k)``, so no N x N matrix is
-    needed (a 256x256 grid would need 34 GB for one).
-    """
-    r, c = grid.cell(fixation)
-    rows, cols = grid.rows, grid.cols
-    return table[rows - 1 - r:2 * rows - 1 - r, cols - 1 - c:2 * cols - 1 - c].ravel()
-
-
-def check_kernel(values, grid: Grid) -> np.ndarray:
-    """
-    Check a row-major kernel (``(2*rows-1) * (2*cols-1)`` finite numbers); return it 2-D.
-
-    Raises
-    ------
-    ValueError
-        Naming the expected length or the non-finite entry.
-
-    """
-    shape = grid.kernel_shape
-    a = np.asarray(values, dtype=float).ravel()
-    if a.size != shape[0] * shape[1]:
-        raise ValueError(f'policy.kernel must have {shape[0] * shape[1]} values '
-                         f'({shape[0]}x{shape[1]} row-major for a {grid.rows}x{grid.cols} grid), '
-                         f'got {a.size}')
-    bad = np.flatnonzero(~np.isfinite(a))
-    if bad.size:
-        raise ValueError(f'policy.kernel must be finite, entry {int(bad[0])} is {a[bad[0]]}')
-    return a.reshape(shape)
-
-
-def build_policy(name: str, grid: Grid, fpoc: FPOC, kernel=None, file: str = '',
-                 action: str = 'argmax', warn=None):
-    """
-    Build the policy called ``name`` (one of :data:`POLICY_NAMES`).
-
-    ``learned`` uses ``kernel`` (a row-major convolutional kernel) when it is non-empty, else the
-    policy ``file`` (a policy YAML path or a shipped kernel name); ``action`` (``argmax`` or
-    ``sample``) applies to it. A file trained on another FPOC is accepted and ``warn(message)``
-    is called; one for another grid is refused.
-
-    Raises
-    ------
-    PolicyUnavailable
-        If the policy file does not exist (neither a path nor a shipped kernel name) or policy
-        files are not supported by this install.
-    ValueError
-        For an unknown name, a bad kernel or a policy file that is invalid or does not fit the
-        grid (``policies.policy_file.PolicyFileError`` is a ValueError).
-
-    """
-    check_action(action)
-    if name in STRATEGIES:
-        try:
-            return make_baseline(name, grid, fpoc)
-        except ImportError as exc:
-            raise PolicyUnavailable(f'policy {name!r} is not available in this install '
-                                    f'({exc})') from None
-    if name != 'learned':
-        raise ValueError(f"unknown policy {name!r}; valid policies: {', '.join(POLICY_NAMES)}")
-    if kernel is not None and len(kernel):
-        return ConvPolicy(grid, check_kernel(kernel, grid), action=action)
-    if not file:
-        raise ValueError("policy 'learned' needs policy.kernel or policy.file")
-    try:
-        from policies.policy_file import load_policy, PolicyFileError, resolve_source
-    except ImportError as exc:
-        raise PolicyUnavailable(f'policy files are not supported by this install ({exc})') \
-            from None
-    try:
-        resolve_source(file)
-    except PolicyFileError as exc:
-        raise PolicyUnavailable(str(exc)) from None
-    return load_policy(file, grid=grid, fpoc=fpoc, action=action, warn=warn)
 
 
 class FrameSequence:
@@ -182,8 +93,11 @@ class GazeController:
 
     Parameters
     ----------
-    grid, fpoc
-        The task; the FPOC is the controller's model of its camera and detector.
+    grid
+        The visual array.
+    observation
+        The controller's model of its camera and detector: an observation model
+        (:mod:`ipomdp_gaze.observation`) or an FPOC (the Gaussian model).
     policy
         Anything with ``select(belief (1, N), t, rng)``.
     start_cell
@@ -197,10 +111,10 @@ class GazeController:
 
     """
 
-    def __init__(self, grid: Grid, fpoc: FPOC, policy, start_cell: int | None = None,
+    def __init__(self, grid: Grid, observation, policy, start_cell: int | None = None,
                  settle_time_s: float = 0.0, confidence: float = 0.95, seed: int = 0):
         self.grid = grid
-        self.set_fpoc(fpoc)
+        self.set_observation(observation)
         self.policy = policy
         self.set_start_cell(grid.center_index if start_cell is None else start_cell)
         self.set_settle_time(settle_time_s)
@@ -218,10 +132,9 @@ class GazeController:
         self.found: Found | None = None
 
     # -- configuration -------------------------------------------------------------------
-    def set_fpoc(self, fpoc: FPOC) -> None:
-        """Use another FPOC for the following updates (the belief is kept)."""
-        self.fpoc = fpoc
-        self._dprime_table = dprime_table(self.grid, fpoc)
+    def set_observation(self, observation) -> None:
+        """Use another observation model (or FPOC) for the following updates; keep the belief."""
+        self.observation = as_observation(self.grid, observation)
 
     def set_policy(self, policy) -> None:
         """Use another policy from the next choice on."""
@@ -343,15 +256,12 @@ class GazeController:
             self.skipped += 1
             return FrameResult('skipped', 'taken before the fixation settled')
         try:
-            term = log_likelihood(obs, dprime_of_fixation(self.grid, self._dprime_table,
-                                                          self.fixation))
+            term = self.observation.log_likelihood_ratio(obs, self.fixation)
         except EvidenceError as exc:
             self.rejected += 1
             self.last_rejection = str(exc)
             return FrameResult('rejected', str(exc))
-        with np.errstate(over='ignore'):      # a sum below -1.8e308 is -inf: probability 0
-            self._log_belief += term
-            normalize_log(self._log_belief)
+        bayes_update(self._log_belief, term, out=self._log_belief)
         np.exp(self._log_belief, out=self._belief)
         self.applied += 1
         self.fixations += 1

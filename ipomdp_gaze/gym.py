@@ -4,9 +4,9 @@
 Gymnasium environment ``ipomdp_gaze/VisualSearch-v0``: the I-POMDP visual-search task.
 
 Each step fixates one cell (``Discrete(N)`` action), draws one observation per cell from the
-observation model (DESIGN.md section 1) and updates the belief. The observation is a ``Dict`` with
-the belief grid (or, with ``observe='evidence'``, the raw evidence of the last frame) and the
-current fixation. The reward is the infomax reward ``sum_i B_i log B_i`` of the new belief
+observation model (docs/design.md section 1) and updates the belief with the one Bayes step.
+The observation is a ``Dict`` with the belief grid (or, with ``observe='evidence'``, the raw
+evidence of the last frame) and the current fixation. The reward is the infomax reward ``sum_i B_i log B_i`` of the new belief
 (``reward='fixate_target'``: the belief at the fixated cell). An episode terminates when the most
 likely cell reaches ``confidence`` and is truncated after ``max_steps`` fixations. The hidden
 target is in ``info['target']`` for oracle baselines.
@@ -17,9 +17,10 @@ import gymnasium
 from gymnasium import spaces
 import numpy as np
 
-from .belief import entropy, infomax_reward, map_cell, normalize_log, uniform_log_belief
-from .fpoc import dprime_matrix, FPOC, make_fpoc
+from .belief import bayes_update, entropy, infomax_reward, map_cell, uniform_log_belief
+from .fpoc import FPOC, make_fpoc
 from .grid import Grid
+from .observation import GaussianObservation
 from .render import belief_heatmap, belief_text
 
 ENV_ID = 'ipomdp_gaze/VisualSearch-v0'
@@ -54,7 +55,7 @@ class VisualSearchEnv(gymnasium.Env):
         if not 0 <= self.start_cell < n:
             raise ValueError(f'start_cell must be a cell index below {n}, got {start_cell!r}')
         self.render_mode = render_mode
-        self._d = dprime_matrix(self.grid, self.fpoc)
+        self.model = GaussianObservation(self.grid, self.fpoc)
         self.action_space = spaces.Discrete(n)
         if observe == 'belief':
             grid_space = spaces.Box(0.0, 1.0, shape=self.grid.shape, dtype=np.float64)
@@ -98,11 +99,9 @@ class VisualSearchEnv(gymnasium.Env):
         if not self.action_space.contains(k):
             raise ValueError(
                 f'action must be a cell index in [0, {self.grid.n_cells}), got {action!r}')
-        d_k = self._d[:, k]
-        obs = self.np_random.standard_normal(self.grid.n_cells)
-        obs[self._target] += d_k[self._target]
-        self._log_b += d_k * (obs - 0.5 * d_k)
-        normalize_log(self._log_b)
+        obs = self.model.sample(self._target, k, self.np_random)
+        bayes_update(self._log_b, self.model.log_likelihood_ratio(obs, k, validate=False),
+                     out=self._log_b)
         self._evidence, self._fixation = obs, k
         self._steps += 1
         b = self.belief

@@ -16,9 +16,9 @@ from typing import Protocol
 
 import numpy as np
 
-from .belief import map_cell, normalize_log, uniform_log_belief
-from .fpoc import dprime_matrix, FPOC
+from .belief import bayes_update, map_cell, uniform_log_belief
 from .grid import Grid
+from .observation import as_observation
 
 # Stream tags of the seed sequence: targets, noise per fixation, and the policy's own draws.
 _TARGET, _NOISE, _POLICY = 0, 1, 2
@@ -68,32 +68,23 @@ def policy_rng(seed: int) -> np.random.Generator:
     return np.random.default_rng([seed, _POLICY])
 
 
-def sample_observation(dprime_at_target: np.ndarray, targets: np.ndarray, n_cells: int,
-                       rng: np.random.Generator) -> np.ndarray:
-    """One frame per episode: N(0, 1) everywhere, plus ``d_target,k`` at the target cell."""
-    obs = rng.standard_normal((targets.size, n_cells))
-    obs[np.arange(targets.size), targets] += dprime_at_target
-    return obs
-
-
-def simulate(grid: Grid, fpoc: FPOC, policy: Policy, episodes: int, horizon: int | None = None,
-             seed: int = 0, targets: np.ndarray | None = None, dprime: np.ndarray | None = None,
-             progress=None) -> SearchResult:
+def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | None = None,
+             seed: int = 0, targets: np.ndarray | None = None, progress=None) -> SearchResult:
     """
     Run ``episodes`` searches of ``horizon`` fixations (default N) from a uniform belief.
 
     Parameters
     ----------
-    grid, fpoc
-        The task.
+    grid
+        The visual array.
+    model
+        The observation model (:mod:`ipomdp_gaze.observation`), or an FPOC for the Gaussian one.
     policy
         Anything with ``select(belief, t, rng)``.
     episodes, horizon, seed
         Batch size, fixations per episode and the seed of all random streams.
     targets : array (episodes,), optional
         Target cells; drawn from the seed's target stream when omitted.
-    dprime : array (N, N), optional
-        ``d[j, k]``; computed from ``fpoc`` when omitted.
     progress : callable, optional
         Called with the fixation number after each step.
 
@@ -102,8 +93,7 @@ def simulate(grid: Grid, fpoc: FPOC, policy: Policy, episodes: int, horizon: int
     horizon = n if horizon is None else int(horizon)
     if horizon < 1 or episodes < 1:
         raise ValueError('episodes and horizon must be >= 1')
-    d = dprime_matrix(grid, fpoc) if dprime is None else dprime
-    d_by_fix = np.ascontiguousarray(d.T)   # [k, j]
+    model = as_observation(grid, model)
     targets = draw_targets(n, episodes, seed) if targets is None else np.asarray(targets)
     rows = np.arange(episodes)
     rng = policy_rng(seed)
@@ -116,11 +106,8 @@ def simulate(grid: Grid, fpoc: FPOC, policy: Policy, episodes: int, horizon: int
     for t in range(horizon):
         k = np.asarray(policy.select(belief, t, rng), dtype=np.int64)
         fixations[:, t] = k
-        d_k = d_by_fix[k]                                   # (E, N): d_jk for every j
-        noise = noise_stream(seed, t).standard_normal((episodes, n))
-        noise[rows, targets] += d_k[rows, targets]
-        log_b += d_k * (noise - 0.5 * d_k)
-        normalize_log(log_b)
+        frames = model.sample(targets, k, noise_stream(seed, t))
+        bayes_update(log_b, model.log_likelihood_ratio(frames, k, validate=False), out=log_b)
         np.exp(log_b, out=belief)
         guess = map_cell(belief)
         correct[:, t] = guess == targets

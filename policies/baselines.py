@@ -4,14 +4,15 @@
 Baseline searchers chosen by a strategy string, after scikit-learn's ``DummyClassifier``.
 
 Every policy has ``select(belief, t, rng) -> fixations`` for a batch of beliefs (episodes, N).
-``make_baseline('elm', grid, fpoc)`` builds one; an unknown name raises a ``ValueError``
-listing the valid ones. Randomness comes from the ``rng`` passed at each call.
+``make_baseline('elm', grid, model)`` builds one for an observation model (or an FPOC, for the
+Gaussian model); an unknown name raises a ``ValueError`` listing the valid ones. Randomness comes
+from the ``rng`` passed at each call.
 """
 from __future__ import annotations
 
 from ipomdp_gaze.belief import argmax_ties_low
-from ipomdp_gaze.fpoc import dprime_table, FPOC
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.observation import as_observation
 import numpy as np
 
 from .conv import ConvPolicy
@@ -89,15 +90,20 @@ class SpiralPolicy:
         return np.full(np.shape(belief)[0], self.order[t % self.order.size], dtype=np.int64)
 
 
-def elm_policy(grid: Grid, fpoc: FPOC) -> ConvPolicy:
-    """ELM (Najemnik & Geisler 2009): ``argmax_k sum_i B_i d_ik^2``, a conv policy with K = d^2."""
-    policy = ConvPolicy(grid, dprime_table(grid, fpoc) ** 2, action='argmax')
+def elm_policy(grid: Grid, model) -> ConvPolicy:
+    """
+    ELM (Najemnik & Geisler 2009): ``argmax_k sum_i B_i 2 KL_ik``, a conv policy.
+
+    ``2 KL`` per offset is the observation model's :meth:`elm_kernel` (``d^2`` for the Gaussian
+    model, so ``argmax_k sum_i B_i d_ik^2``).
+    """
+    policy = ConvPolicy(grid, as_observation(grid, model).elm_kernel(), action='argmax')
     policy.name = 'elm'
     return policy
 
 
-def make_baseline(strategy: str, grid: Grid, fpoc: FPOC):
-    """Build the baseline called ``strategy`` (one of :data:`STRATEGIES`)."""
+def make_baseline(strategy: str, grid: Grid, model):
+    """Build the baseline called ``strategy`` (one of :data:`STRATEGIES`) for ``model``."""
     if strategy == 'map':
         return MapPolicy()
     if strategy == 'random':
@@ -107,8 +113,8 @@ def make_baseline(strategy: str, grid: Grid, fpoc: FPOC):
     if strategy == 'spiral':
         return SpiralPolicy(grid)
     if strategy == 'elm':
-        return elm_policy(grid, fpoc)
+        return elm_policy(grid, model)
     if strategy == 'greedy':
         from .greedy import PercentCorrectGreedy
-        return PercentCorrectGreedy(grid, fpoc)
+        return PercentCorrectGreedy(grid, getattr(model, 'fpoc', model))
     raise ValueError(f"unknown policy {strategy!r}; valid policies: {', '.join(STRATEGIES)}")

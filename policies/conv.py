@@ -4,8 +4,8 @@
 Convolutional (shift-invariant) logistic policy: ``p(k | B) ∝ exp(score_k)``.
 
 ``score_k = sum_j B_j K[r_j - r_k + R-1, c_j - c_k + C-1]``: a cross-correlation of the belief with
-the kernel K of shape ``(2R-1, 2C-1)`` (DESIGN.md section 3). The radially weight-shared family
-ties all entries with the same squared displacement ``dr^2 + dc^2``.
+the kernel K of shape ``(2R-1, 2C-1)`` (docs/design.md section 3). The radially weight-shared
+family ties all entries with the same squared displacement ``dr^2 + dc^2``.
 
 Two ways to compute the scores, chosen automatically by grid size:
 
@@ -22,7 +22,7 @@ The switch is at :data:`DIRECT_MAX_CELLS` (one belief) and :data:`DIRECT_MAX_CEL
 batch), the measured break-evens (``docs/benchmarks.md``). Both paths make the same argmax
 decisions: FFT scores carry round-off (and any truncation) within a bound ``eps`` computed per
 belief, and every cell whose FFT score is within ``rtol |peak| + (2 + rtol) eps`` of the peak is
-re-scored exactly by the direct sum before the project's tie rule (DESIGN.md section 4) is
+re-scored exactly by the direct sum before the project's tie rule (docs/design.md section 4) is
 applied. When truncation leaves too many such cells, the scores are recomputed without it.
 """
 from __future__ import annotations
@@ -61,6 +61,35 @@ def check_action(action: str) -> str:
     if action not in ACTIONS:
         raise ValueError(f"unknown action {action!r}; valid actions: {', '.join(ACTIONS)}")
     return action
+
+
+def check_kernel(values, grid: Grid, what: str = 'kernel') -> np.ndarray:
+    """
+    Validate a kernel for ``grid`` and return it as a float64 ``(2R-1, 2C-1)`` array.
+
+    ``values`` is the 2-D kernel or its ``(2R-1) * (2C-1)`` entries row-major (a ROS parameter).
+    This is the only place a kernel is checked; ``what`` names it in the message.
+
+    Raises
+    ------
+    ValueError
+        Naming the expected size or the first non-finite entry.
+
+    """
+    shape = grid.kernel_shape
+    try:
+        a = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f'{what} must be numbers') from None
+    if a.size != shape[0] * shape[1] or (a.ndim > 1 and a.shape != shape):
+        raise ValueError(f'{what} must have {shape[0] * shape[1]} values ({shape[0]}x{shape[1]} '
+                         f'row-major for a {grid.rows}x{grid.cols} grid), got {a.size} in shape '
+                         f'{a.shape}')
+    a = a.reshape(shape)
+    bad = np.flatnonzero(~np.isfinite(a))
+    if bad.size:
+        raise ValueError(f'{what} must be finite, entry {int(bad[0])} is {a.flat[bad[0]]}')
+    return a
 
 
 def squared_distance_table(grid: Grid) -> np.ndarray:
@@ -164,9 +193,9 @@ class ConvPolicy:
     ----------
     grid : Grid
         The visual array.
-    kernel : array (2R-1, 2C-1)
+    kernel : array (2R-1, 2C-1), or its entries row-major
         ``K[dr + R-1, dc + C-1]`` is the weight of belief ``dr`` rows below and ``dc`` columns
-        right of the candidate fixation.
+        right of the candidate fixation; checked by :func:`check_kernel`.
     action : {'argmax', 'sample'}
         How :meth:`select` turns scores into a fixation.
     method : {'auto', 'direct', 'fft'}
@@ -188,13 +217,8 @@ class ConvPolicy:
     name = 'learned'
 
     def __init__(self, grid: Grid, kernel, action: str = 'argmax', method: str = 'auto',
-                 truncate: float = DEFAULT_TRUNCATE):
-        kernel = np.asarray(kernel, dtype=float)
-        if kernel.shape != grid.kernel_shape:
-            raise ValueError(f'kernel must have shape {grid.kernel_shape} for a '
-                             f'{grid.rows}x{grid.cols} grid, got {kernel.shape}')
-        if not np.all(np.isfinite(kernel)):
-            raise ValueError('kernel contains NaN or inf')
+                 truncate: float = DEFAULT_TRUNCATE, what: str = 'kernel'):
+        kernel = check_kernel(kernel, grid, what)
         if method not in METHODS:
             raise ValueError(f"unknown method {method!r}; valid methods: {', '.join(METHODS)}")
         truncate = float(truncate)
@@ -367,8 +391,7 @@ class ConvPolicy:
         Argmax fixation of one belief (N,) with the project tie rule: the controller's fast path.
 
         On the direct path it allocates nothing: the scores and the tie mask go to preallocated
-        buffers (``belief`` should be a contiguous float64 array, as :class:`BeliefTracker`
-        keeps it).
+        buffers (``belief`` should be a contiguous float64 array, as the controller keeps it).
         """
         if self.uses_direct():
             weights = self._weights_t if self._weights_t is not None else self._direct_weights()

@@ -20,11 +20,13 @@ Format ``ipomdp_gaze/policy-v1`` (issue 3)::
 Required: ``format``, ``grid``, ``fpoc``, ``reward``, ``family`` and the family's array
 (``kernel`` or ``theta``). Loading uses ``yaml.safe_load`` only and names exactly what is wrong
 with a file (:class:`PolicyFileError`). A source is a path or the name of a shipped kernel
-(``policies/kernels/<name>.yaml``, e.g. ``human-7x7-infomax``).
+(``ipomdp_gaze/policies/kernels/<name>.yaml``, e.g. ``human-7x7-infomax``), installed once as
+package data and found with :mod:`importlib.resources`.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from importlib import resources
 import math
 from pathlib import Path
 from typing import Callable
@@ -41,7 +43,8 @@ from .logistic import LogisticPolicy
 FORMAT = 'ipomdp_gaze/policy-v1'
 FAMILIES = ('conv', 'logistic')
 REWARDS = ('infomax', 'fixate_target')
-KERNEL_DIR = Path(__file__).resolve().parent / 'kernels'
+# Shipped kernels are package data of ipomdp_gaze.policies (a plain directory: never zipped).
+KERNEL_DIR = Path(str(resources.files(__package__).joinpath('kernels')))
 REQUIRED = ('format', 'grid', 'fpoc', 'reward', 'family')
 KEYS = REQUIRED + ('action', 'kernel', 'radial', 'theta', 'training', 'evaluation')
 ARRAY_KEY = {'conv': 'kernel', 'logistic': 'theta'}
@@ -135,7 +138,7 @@ def _plain(value):
 
 
 def shipped_kernels() -> list[str]:
-    """Names of the kernels shipped with the package (``policies/kernels/*.yaml`` stems)."""
+    """Names of the kernels shipped with the package (stems of ``kernels/*.yaml``)."""
     return sorted(p.stem for p in KERNEL_DIR.glob('*.yaml'))
 
 

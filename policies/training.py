@@ -1,7 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-GPOMDP policy-gradient training of logistic and convolutional policies (DESIGN.md section 3).
+GPOMDP policy-gradient training of logistic and convolutional policies (docs/design.md sec. 3).
 
 Per episode the eligibility trace is ``z_t = beta z_{t-1} + grad log pi(a_t | B_t)`` and the
 gradient estimate ``g = sum_t r_t z_t`` (Baxter & Bartlett 2001); every epoch runs
@@ -29,10 +29,11 @@ from pathlib import Path
 import time
 from typing import Callable
 
-from ipomdp_gaze.belief import normalize_log, uniform_log_belief
+from ipomdp_gaze.belief import bayes_update, uniform_log_belief
 from ipomdp_gaze.evaluation import fixations_to_90_ci, fixations_to_level
-from ipomdp_gaze.fpoc import dprime_matrix, FPOC
+from ipomdp_gaze.fpoc import FPOC
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.observation import as_observation
 from ipomdp_gaze.simulate import simulate
 import numpy as np
 
@@ -162,7 +163,7 @@ class Family:
         return np.asarray(spec.theta, dtype=float).ravel().copy()
 
 
-def sample_episodes(theta: np.ndarray, dprime_by_fix: np.ndarray, reward: str, episodes: int,
+def sample_episodes(theta: np.ndarray, model, reward: str, episodes: int,
                     horizon: int, rng: np.random.Generator) -> Episodes:
     """
     Run a batch of episodes with the softmax policy ``p(k | B) ∝ exp(theta[k] . B)``.
@@ -171,8 +172,8 @@ def sample_episodes(theta: np.ndarray, dprime_by_fix: np.ndarray, reward: str, e
     ----------
     theta : array (N, N)
         ``theta[k, j]``.
-    dprime_by_fix : array (N, N)
-        ``d[k, j]``: d' of cell j when fixating k.
+    model
+        The observation model the frames are drawn from (:mod:`ipomdp_gaze.observation`).
     reward : {'infomax', 'fixate_target'}
         The reward computed on the belief after each observation.
     episodes, horizon : int
@@ -198,11 +199,8 @@ def sample_episodes(theta: np.ndarray, dprime_by_fix: np.ndarray, reward: str, e
         fixations[t] = a
         np.negative(p, out=delta[t])
         delta[t, rows, a] += 1.0
-        d_k = dprime_by_fix[a]
-        obs = rng.standard_normal((episodes, n))
-        obs[rows, targets] += d_k[rows, targets]
-        log_b += d_k * (obs - 0.5 * d_k)
-        normalize_log(log_b)
+        frames = model.sample(targets, a, rng)
+        bayes_update(log_b, model.log_likelihood_ratio(frames, a, validate=False), out=log_b)
         np.exp(log_b, out=belief)
         if reward == 'infomax':
             rewards[t] = np.sum(belief * log_b, axis=1)
@@ -295,8 +293,7 @@ class Trainer:
         self.epoch = int(epoch)
         self.wall_seconds = float(wall_seconds)
         self.horizon = grid.n_cells if config.horizon is None else int(config.horizon)
-        self.dprime = dprime_matrix(grid, fpoc)
-        self.dprime_by_fix = np.ascontiguousarray(self.dprime.T)
+        self.model = as_observation(grid, fpoc)
         self.curve: list[dict] = []
 
     def epoch_rng(self, epoch: int) -> np.random.Generator:
@@ -313,7 +310,7 @@ class Trainer:
     def step(self) -> EpochResult:
         """Run one epoch and update the parameters."""
         cfg = self.config
-        batch = sample_episodes(self.family.theta(self.params), self.dprime_by_fix, cfg.reward,
+        batch = sample_episodes(self.family.theta(self.params), self.model, cfg.reward,
                                 cfg.episodes_per_epoch, self.horizon, self.epoch_rng(self.epoch))
         grad = self.family.project(theta_gradient(batch, cfg.beta, cfg.reward_scale,
                                                   cfg.baseline))
@@ -324,9 +321,9 @@ class Trainer:
     def evaluate(self, episodes: int | None = None, seed: int | None = None):
         """Fixations to 90% correct of the argmax policy on a fixed evaluation set."""
         cfg = self.config
-        result = simulate(self.grid, self.fpoc, self.family.policy(self.params, 'argmax'),
+        result = simulate(self.grid, self.model, self.family.policy(self.params, 'argmax'),
                           cfg.eval_episodes if episodes is None else episodes, self.horizon,
-                          cfg.eval_seed if seed is None else seed, dprime=self.dprime)
+                          cfg.eval_seed if seed is None else seed)
         return fixations_to_level(result.percent_correct, self.grid.n_cells)
 
     def run(self, epochs: int, progress: bool = False,

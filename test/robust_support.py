@@ -197,7 +197,7 @@ def bad_policy_files(folder, grid_rows: int = 11, grid_cols: int = 11, marker=No
     from ipomdp_gaze.fpoc import make_fpoc
     from ipomdp_gaze.grid import Grid
     import numpy as np
-    from policies.policy_file import PolicySpec, save_policy
+    from ipomdp_gaze.policies.policy_file import PolicySpec, save_policy
     import yaml
 
     folder = Path(folder)

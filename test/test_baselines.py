@@ -3,9 +3,9 @@
 """Baselines by strategy string and the convolutional policy's scores."""
 from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.policies.baselines import make_baseline, spiral_order, STRATEGIES
+from ipomdp_gaze.policies.conv import ConvPolicy, kernel_from_radial, radial_bins
 import numpy as np
-from policies.baselines import make_baseline, spiral_order, STRATEGIES
-from policies.conv import ConvPolicy, kernel_from_radial, radial_bins
 import pytest
 
 GRID = Grid(5, 6, 0.42)

@@ -1,9 +1,10 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """The log-domain belief update against a brute-force Bayes posterior, and its edge cases."""
-from ipomdp_gaze.belief import (argmax_ties_low, check_evidence, entropy, EvidenceError,
-                                fixate_target_reward, infomax_reward, map_cell, uniform_log_belief,
-                                update_log_belief)
+from ipomdp_gaze.belief import (argmax_ties_low, bayes_update, entropy, EvidenceError,
+                                fixate_target_reward, infomax_reward, map_cell, uniform_log_belief)
+from ipomdp_gaze.observation import check_evidence
+from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
 import numpy as np
 import pytest
 from scipy.stats import norm
@@ -34,7 +35,7 @@ def test_update_matches_brute_force_bayes(seed):
         obs[rng.random(n) < 0.15] = np.nan                   # some unobserved cells
         observations.append(obs)
         dprimes.append(d)
-        log_b = update_log_belief(log_b, obs, d)
+        log_b = bayes_update(log_b, llr(obs, d))
     expected = brute_force_posterior(prior, observations, dprimes)
     np.testing.assert_allclose(np.exp(log_b), expected, rtol=1e-9, atol=1e-12)
 
@@ -43,14 +44,14 @@ def test_batched_update_equals_single_updates():
     rng = np.random.default_rng(3)
     log_b = np.log(rng.dirichlet(np.ones(6), size=4))
     obs, d = rng.normal(size=(4, 6)), rng.uniform(0, 2, (4, 6))
-    batched = update_log_belief(log_b, obs, d)
+    batched = bayes_update(log_b, llr(obs, d))
     for e in range(4):
-        np.testing.assert_allclose(batched[e], update_log_belief(log_b[e], obs[e], d[e]))
+        np.testing.assert_allclose(batched[e], bayes_update(log_b[e], llr(obs[e], d[e])))
 
 
 def test_in_place_update_returns_same_array():
     log_b = uniform_log_belief(4)
-    out = update_log_belief(log_b, np.zeros(4), np.ones(4), out=log_b)
+    out = bayes_update(log_b, llr(np.zeros(4), np.ones(4)), out=log_b)
     assert out is log_b
     np.testing.assert_allclose(np.exp(log_b).sum(), 1.0)
 
@@ -61,7 +62,7 @@ def test_extreme_observations_stay_finite_and_normalised(value):
     obs = np.zeros(9)
     obs[4] = value
     for _ in range(50):
-        log_b = update_log_belief(log_b, obs, np.full(9, 2.0))
+        log_b = bayes_update(log_b, llr(obs, np.full(9, 2.0)))
     b = np.exp(log_b)
     assert np.all(np.isfinite(log_b))
     assert b.sum() == pytest.approx(1.0, abs=1e-12)
@@ -74,19 +75,19 @@ def test_extreme_observations_stay_finite_and_normalised(value):
 def test_zero_dprime_learns_nothing():
     rng = np.random.default_rng(0)
     log_b = np.log(rng.dirichlet(np.ones(7)))
-    after = update_log_belief(log_b, rng.normal(0, 100, 7), np.zeros(7))
+    after = bayes_update(log_b, llr(rng.normal(0, 100, 7), np.zeros(7)))
     np.testing.assert_allclose(after, log_b, atol=1e-12)
 
 
 def test_nan_cells_are_unobserved():
     log_b = uniform_log_belief(5)
     obs = np.array([np.nan, 3.0, np.nan, np.nan, np.nan])
-    after = update_log_belief(log_b, obs, np.full(5, 2.0))
+    after = bayes_update(log_b, llr(obs, np.full(5, 2.0)))
     b = np.exp(after)
     assert np.all(np.isfinite(after)) and b.sum() == pytest.approx(1.0)
     # Only cell 1 was observed: the other four keep equal belief.
     assert np.ptp(b[[0, 2, 3, 4]]) < 1e-15 and b[1] > b[0]
-    all_nan = update_log_belief(log_b, np.full(5, np.nan), np.full(5, 2.0))
+    all_nan = bayes_update(log_b, llr(np.full(5, np.nan), np.full(5, 2.0)))
     np.testing.assert_allclose(all_nan, log_b)
 
 
@@ -123,18 +124,20 @@ def test_tie_rule_goes_to_lowest_index_within_relative_tolerance():
 
 
 def test_overflowing_evidence_is_rejected_and_the_belief_kept():
-    from ipomdp_gaze.belief import BeliefTracker
-    from ipomdp_gaze.fpoc import dprime_table, make_fpoc
+    from ipomdp_gaze.fpoc import make_fpoc
+    from ipomdp_gaze.gaze import GazeController
     from ipomdp_gaze.grid import Grid
+    from ipomdp_gaze.policies.baselines import make_baseline
     obs = np.zeros(9)
     obs[4] = 1.7e308
     with pytest.raises(EvidenceError, match='refused'):
-        update_log_belief(uniform_log_belief(9), obs, np.full(9, 2.0))
-    grid = Grid(3, 3)
-    tracker = BeliefTracker(grid, dprime_table(grid, make_fpoc('human')))
-    tracker.update(np.arange(9.0), 4)
-    before = tracker.belief.copy()
-    with pytest.warns(RuntimeWarning), pytest.raises(EvidenceError, match='overflows'):
-        tracker.update(obs, 4)
-    np.testing.assert_array_equal(tracker.belief, before)
-    assert np.all(np.isfinite(tracker.log_belief))
+        bayes_update(uniform_log_belief(9), llr(obs, np.full(9, 2.0)))
+    grid, fpoc = Grid(3, 3), make_fpoc('human')
+    core = GazeController(grid, fpoc, make_baseline('map', grid, fpoc))
+    core.reset(0.0)
+    assert core.offer(np.arange(9.0), 1.0).applied
+    before = core.belief
+    result = core.offer(obs, 2.0)
+    assert result.status == 'rejected' and 'overflows' in result.reason
+    np.testing.assert_array_equal(core.belief, before)
+    assert np.all(np.isfinite(np.log(core.belief[core.belief > 0])))

@@ -83,7 +83,8 @@ def test_ros2_run_starts_the_installed_controller(workspace, ros_env, probe, tmp
 
 @pytest.mark.ros
 def test_sourced_workspace_imports_the_installed_copy(workspace):
-    code = 'import ipomdp_gaze, policies; print(ipomdp_gaze.__file__); print(policies.__file__)'
+    code = ('import ipomdp_gaze, ipomdp_gaze.policies as p; print(ipomdp_gaze.__file__); '
+            'print(p.__file__)')
     script = f'source install/setup.bash && "{sys.executable}" -c "{code}"'
     out = subprocess.run(['bash', '-c', script], cwd=workspace, capture_output=True, text=True,
                          timeout=60)

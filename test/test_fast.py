@@ -1,19 +1,21 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""FFT scoring, the allocation-free belief update and large grids without N x N arrays."""
+"""FFT scoring, the controller's per-frame path and large grids without N x N arrays."""
 import importlib.util
 import os
 from pathlib import Path
 import tracemalloc
 
-from ipomdp_gaze.belief import (argmax_ties_low, BeliefTracker, dprime_column, dprime_window,
-                                EvidenceError, TIE_RTOL, uniform_log_belief, update_log_belief)
+from ipomdp_gaze.belief import argmax_ties_low, bayes_update, TIE_RTOL, uniform_log_belief
 from ipomdp_gaze.fpoc import dprime_matrix, dprime_table, make_fpoc
+from ipomdp_gaze.gaze import GazeController
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
+from ipomdp_gaze.observation import GaussianObservation
+from ipomdp_gaze.policies import conv
+from ipomdp_gaze.policies.baselines import elm_policy
+from ipomdp_gaze.policies.conv import ConvPolicy, kernel_matrix, support_box
 import numpy as np
-from policies import conv
-from policies.baselines import elm_policy
-from policies.conv import ConvPolicy, kernel_matrix, support_box
 import pytest
 
 SHAPES = [(7, 7), (5, 9), (11, 11), (13, 6), (20, 31)]
@@ -191,87 +193,82 @@ def test_sampled_action_still_follows_the_softmax_on_the_fft_path():
     assert np.all(np.abs(freq - expected) < 4 * np.sqrt(expected * (1 - expected) / k.size))
 
 
-# -- belief tracker -------------------------------------------------------------------------------
+# -- the controller's per-frame path -------------------------------------------------------------
 
 @pytest.mark.parametrize('shape', [(7, 7), (4, 9)])
-def test_dprime_column_is_a_column_of_the_dprime_matrix(shape):
+def test_dprime_window_is_a_column_of_the_dprime_matrix(shape):
     grid = Grid(*shape)
     fpoc = make_fpoc('human')
-    table, d = dprime_table(grid, fpoc), dprime_matrix(grid, fpoc)
-    buffer = np.empty(grid.n_cells)
+    model, d = GaussianObservation(grid, fpoc), dprime_matrix(grid, fpoc)
     for k in range(grid.n_cells):
-        np.testing.assert_array_equal(dprime_column(grid, table, k), d[:, k])
-        np.testing.assert_array_equal(dprime_window(grid, table, k), d[:, k].reshape(shape))
-        assert dprime_column(grid, table, k, out=buffer) is buffer
-        np.testing.assert_array_equal(buffer, d[:, k])
+        np.testing.assert_array_equal(model.dprime(k), d[:, k])
+        np.testing.assert_array_equal(model.dprime_window(k), d[:, k].reshape(shape))
+    ks = np.arange(grid.n_cells)[::-1]
+    np.testing.assert_array_equal(model.dprime(ks), d[:, ks].T)
 
 
 @pytest.mark.parametrize('dtype', [np.float64, np.float32])
-def test_tracker_update_equals_update_log_belief(dtype):
+def test_controller_update_equals_the_bayes_step(dtype):
     grid = Grid(6, 8)
     fpoc = make_fpoc('human')
     d = dprime_matrix(grid, fpoc)
-    tracker = BeliefTracker(grid, dprime_table(grid, fpoc))
+    core = GazeController(grid, fpoc, elm_policy(grid, fpoc))
+    core.reset(0.0)
     rng = np.random.default_rng(6)
     log_b = uniform_log_belief(grid.n_cells)
     for t in range(40):
-        k = int(rng.integers(grid.n_cells))
+        k = core.fixation
         frame = rng.normal(size=grid.n_cells).astype(dtype)
         if t % 3 == 0:
             frame[rng.choice(grid.n_cells, 5, replace=False)] = np.nan
-        shaped = frame.reshape(grid.shape) if t % 2 else frame
-        tracker.update(shaped, k)
-        log_b = update_log_belief(log_b, frame.astype(float), d[:, k])
-        np.testing.assert_allclose(tracker.log_belief, log_b, rtol=1e-12, atol=1e-12)
-        np.testing.assert_allclose(tracker.belief, np.exp(log_b), rtol=1e-12, atol=1e-15)
-    assert tracker.map_cell() == int(argmax_ties_low(np.exp(log_b)))
+        assert core.offer(frame, float(t)).applied
+        log_b = bayes_update(log_b, llr(frame.astype(float), d[:, k]))
+        np.testing.assert_allclose(core.belief, np.exp(log_b), rtol=1e-12, atol=1e-15)
+    assert core.map_cell == int(argmax_ties_low(np.exp(log_b)))
 
 
-def test_tracker_rejects_bad_frames_and_keeps_the_belief():
+def test_controller_rejects_bad_frames_and_keeps_the_belief():
     grid = Grid(5, 5)
-    tracker = BeliefTracker(grid, dprime_table(grid, make_fpoc('human')))
-    tracker.update(np.full(25, 0.5), 12)
-    before = tracker.log_belief.copy()
+    fpoc = make_fpoc('human')
+    core = GazeController(grid, fpoc, elm_policy(grid, fpoc))
+    core.reset(0.0)
+    assert core.offer(np.full(25, 0.5), 1.0).applied
+    before = core.belief
     bad = np.zeros(25)
     bad[3] = -np.inf
-    with pytest.raises(EvidenceError, match='inf'):
-        tracker.update(bad, 0)
+    reasons = [core.offer(bad, 2.0).reason]
     bad[3], bad[4] = np.nan, np.inf
-    with pytest.raises(EvidenceError, match='inf'):
-        tracker.update(bad, 0)
-    with pytest.raises(EvidenceError, match='24 values'):
-        tracker.update(np.zeros(24), 0)
-    with pytest.raises(EvidenceError, match='expected 25'):
-        tracker.update(np.zeros((1, 25)), 0)
+    reasons.append(core.offer(bad, 2.0).reason)
+    reasons.append(core.offer(np.zeros(24), 2.0).reason)
+    reasons.append(core.offer(np.zeros((1, 25)), 2.0).reason)
+    assert ['inf' in reasons[0], 'inf' in reasons[1], '24 values' in reasons[2],
+            'expected 25' in reasons[3]] == [True] * 4
+    assert core.rejected == 4
+    np.testing.assert_array_equal(core.belief, before)
+    model = GaussianObservation(grid, fpoc)
     with pytest.raises(ValueError, match='outside a 5x5 grid'):
-        tracker.update(np.zeros(25), 25)
+        model.log_likelihood_ratio(np.zeros(25), 25)
     with pytest.raises(ValueError, match='integer cell index'):
-        tracker.update(np.zeros(25), 2.0)
-    np.testing.assert_array_equal(tracker.log_belief, before)
-    with pytest.raises(ValueError, match='dprime_table must have shape'):
-        BeliefTracker(grid, np.ones((5, 5)))
-    tracker.reset()
-    np.testing.assert_allclose(tracker.belief, 1 / 25)
+        model.log_likelihood_ratio(np.zeros(25), 2.0)
+    core.reset(3.0)
+    np.testing.assert_allclose(core.belief, 1 / 25)
 
 
-def test_tracker_update_and_direct_decide_allocate_no_arrays():
+def test_direct_decide_allocates_no_arrays():
     grid = Grid(32, 32)                              # 8 KiB per float64 array
     fpoc = make_fpoc('human')
-    tracker = BeliefTracker(grid, dprime_table(grid, fpoc))
     policy = ConvPolicy(grid, dprime_table(grid, fpoc) ** 2, method='direct')
-    rng = np.random.default_rng(7)
-    frames = rng.normal(size=(6, grid.n_cells)).astype(np.float32)
-    frames[2, :10] = np.nan
-    k = policy.decide(tracker.belief)                # builds W once
+    beliefs = np.random.default_rng(7).dirichlet(np.ones(grid.n_cells), size=6)
+    k = policy.decide(beliefs[0])                    # builds W once
     tracemalloc.start()
     try:
-        for frame in frames:
-            tracker.update(frame, k)
-            k = policy.decide(tracker.belief)
+        for belief in beliefs:
+            k = policy.decide(belief)
         peak = tracemalloc.get_traced_memory()[1]
     finally:
         tracemalloc.stop()
     assert peak < 4096                               # a few Python scalars, not one array
+    assert k == int(argmax_ties_low(beliefs[-1] @ kernel_matrix(grid, policy.kernel).T))
 
 
 def test_a_256x256_controller_never_builds_an_n_by_n_array():
@@ -279,14 +276,15 @@ def test_a_256x256_controller_never_builds_an_n_by_n_array():
     fpoc = make_fpoc('human')
     tracemalloc.start()
     try:
-        tracker = BeliefTracker(grid, dprime_table(grid, fpoc))
         policy = elm_policy(grid, fpoc)
+        core = GazeController(grid, fpoc, policy)
+        core.reset(0.0)
         rng = np.random.default_rng(8)
-        k = policy.decide(tracker.belief)
-        for _ in range(3):
-            tracker.update(rng.normal(size=grid.n_cells), k)
-            k = policy.decide(tracker.belief)
-        beliefs = np.vstack([tracker.belief, np.roll(tracker.belief, 1000)])
+        for t in range(3):
+            assert core.offer(rng.normal(size=grid.n_cells), float(t)).applied
+        k = policy.decide(core.belief)
+        assert core.fixation == k
+        beliefs = np.vstack([core.belief, np.roll(core.belief, 1000)])
         batch = policy.select(beliefs, 0, rng)
         peak = tracemalloc.get_traced_memory()[1]
     finally:

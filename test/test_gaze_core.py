@@ -3,18 +3,17 @@
 """The gaze controller core without ROS: frames, belief, policy choice, found, counters."""
 from __future__ import annotations
 
-import sys
-
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from ipomdp_gaze.belief import uniform_log_belief, update_log_belief
+from ipomdp_gaze.belief import bayes_update, uniform_log_belief
 from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
-from ipomdp_gaze.gaze import (build_policy, check_kernel, GazeController, POLICY_NAMES,
-                              PolicyUnavailable)
+from ipomdp_gaze.gaze import GazeController
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
+from ipomdp_gaze.policies.baselines import spiral_order
+from ipomdp_gaze.policies.conv import ConvPolicy
+from ipomdp_gaze.policies.registry import build_policy
 import numpy as np
-from policies.baselines import spiral_order
-from policies.conv import ConvPolicy
 import pytest
 
 GRID = Grid(11, 11, 5.0)
@@ -30,7 +29,7 @@ def controller(policy='elm', settle_time_s=0.5, **kwargs):
 
 def expected_update(belief, frame, fixation, fpoc=CAMERA):
     d = dprime_matrix(GRID, fpoc)[:, fixation]
-    return np.exp(update_log_belief(np.log(belief), np.asarray(frame, dtype=float), d))
+    return np.exp(bayes_update(np.log(belief), llr(np.asarray(frame, dtype=float), d)))
 
 
 def test_starts_uniform_at_the_centre_with_zero_counters():
@@ -207,76 +206,3 @@ def test_search_with_the_camera_observation_model_finds_the_target(seed):
     assert core.map_probability >= 0.999
     assert core.map_cell == target
     assert core.found is not None and core.found.fixations <= core.fixations
-
-
-def test_build_policy_names():
-    for name in POLICY_NAMES:
-        if name in ('learned', 'greedy'):
-            continue
-        assert hasattr(build_policy(name, GRID, CAMERA), 'select')
-    with pytest.raises(ValueError, match='valid policies: learned, map'):
-        build_policy('foo', GRID, CAMERA)
-    with pytest.raises(ValueError, match='action'):
-        build_policy('elm', GRID, CAMERA, action='softmax')
-    with pytest.raises(ValueError, match='policy.kernel or policy.file'):
-        build_policy('learned', GRID, CAMERA)
-
-
-def test_learned_kernel_is_used_as_given():
-    kernel = np.random.default_rng(4).standard_normal(GRID.kernel_shape)
-    policy = build_policy('learned', GRID, CAMERA, kernel=kernel.ravel().tolist())
-    assert isinstance(policy, ConvPolicy)
-    np.testing.assert_array_equal(policy.kernel, kernel)
-    belief = np.random.default_rng(5).dirichlet(np.ones(121))
-    assert policy.select(belief[None], 1, None)[0] == ConvPolicy(GRID, kernel).select(
-        belief[None], 1, None)[0]
-
-
-def test_check_kernel_reasons():
-    with pytest.raises(ValueError, match='441 values .*21x21.*got 440'):
-        check_kernel(np.zeros(440), GRID)
-    bad = np.zeros(441)
-    bad[7] = np.nan
-    with pytest.raises(ValueError, match='entry 7 is nan'):
-        check_kernel(bad, GRID)
-    assert check_kernel(np.zeros(441), GRID).shape == (21, 21)
-
-
-def test_missing_policy_file_support_or_file_is_unavailable(monkeypatch, tmp_path):
-    monkeypatch.setitem(sys.modules, 'policies.policy_file', None)
-    with pytest.raises(PolicyUnavailable, match='not supported'):
-        build_policy('learned', GRID, CAMERA, file='camera-11x11-infomax')
-    monkeypatch.setitem(sys.modules, 'policies.greedy', None)
-    with pytest.raises(PolicyUnavailable, match='greedy'):
-        build_policy('greedy', GRID, CAMERA)
-
-
-def _policy_file(tmp_path, grid=GRID, fpoc=CAMERA, seed=9):
-    from policies.policy_file import PolicySpec, save_policy
-    kernel = np.random.default_rng(seed).standard_normal(grid.kernel_shape)
-    spec = PolicySpec(grid=grid, fpoc=fpoc, reward='infomax', family='conv', kernel=kernel)
-    return save_policy(tmp_path / f'k{seed}.yaml', spec), kernel
-
-
-def test_policy_file_is_loaded_and_checked_against_the_task(tmp_path):
-    path, kernel = _policy_file(tmp_path)
-    warnings = []
-    policy = build_policy('learned', GRID, CAMERA, file=str(path), warn=warnings.append)
-    np.testing.assert_array_equal(policy.kernel, kernel)
-    assert warnings == []
-    human = make_fpoc('human')
-    build_policy('learned', GRID, human, file=str(path), warn=warnings.append)
-    assert len(warnings) == 1 and 'FPOC' in warnings[0]
-    small, _ = _policy_file(tmp_path, Grid(7, 7, 5.0), seed=10)
-    with pytest.raises(ValueError, match='7x7 grid but the task grid is 11x11') as err:
-        build_policy('learned', GRID, CAMERA, file=str(small))
-    assert not isinstance(err.value, PolicyUnavailable)
-    with pytest.raises(PolicyUnavailable, match='not found'):
-        build_policy('learned', GRID, CAMERA, file=str(tmp_path / 'missing.yaml'))
-
-
-def test_kernel_takes_precedence_over_the_file(tmp_path):
-    path, _ = _policy_file(tmp_path)
-    kernel = np.ones(GRID.kernel_shape)
-    policy = build_policy('learned', GRID, CAMERA, kernel=kernel.ravel(), file=str(path))
-    np.testing.assert_array_equal(policy.kernel, kernel)

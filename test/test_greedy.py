@@ -1,13 +1,14 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """The percent-correct greedy searcher (Najemnik & Geisler ideal searcher)."""
-from ipomdp_gaze.belief import map_cell, update_log_belief
+from ipomdp_gaze.belief import bayes_update, map_cell
 from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
+from ipomdp_gaze.policies.baselines import make_baseline
+from ipomdp_gaze.policies.greedy import (expected_percent_correct, percent_correct_given_target,
+                                         PercentCorrectGreedy)
 import numpy as np
-from policies.baselines import make_baseline
-from policies.greedy import (expected_percent_correct, percent_correct_given_target,
-                             PercentCorrectGreedy)
 import pytest
 
 GRID5 = Grid(5, 5, 0.42)
@@ -40,7 +41,7 @@ def monte_carlo_map_correct(belief, d, fixation, targets, samples, rng):
         obs = rng.standard_normal((samples, n))
         obs[:, target] += d[target, fixation]
         log_b = np.broadcast_to(np.log(belief), (samples, n))
-        posterior = update_log_belief(log_b, obs, np.broadcast_to(d[:, fixation], (samples, n)))
+        posterior = bayes_update(log_b, llr(obs, np.broadcast_to(d[:, fixation], (samples, n))))
         hits[row] = np.mean(map_cell(np.exp(posterior)) == target)
     return hits
 
@@ -99,7 +100,7 @@ def test_score_matches_monte_carlo_probability_correct(fpoc):
         obs = rng.standard_normal((samples, GRID5.n_cells))
         obs[np.arange(samples), targets] += d[targets, k]
         log_b = np.broadcast_to(np.log(belief), obs.shape)
-        posterior = update_log_belief(log_b, obs, np.broadcast_to(d[:, k], obs.shape))
+        posterior = bayes_update(log_b, llr(obs, np.broadcast_to(d[:, k], obs.shape)))
         estimate[row] = np.mean(map_cell(np.exp(posterior)) == targets)
     assert_binomial(estimate, score[list(fixations)], samples)
 

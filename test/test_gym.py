@@ -3,10 +3,11 @@
 """The Gymnasium environment: API conformance and the model it wraps."""
 import gymnasium
 from gymnasium.utils.env_checker import check_env
-from ipomdp_gaze.belief import uniform_log_belief, update_log_belief
+from ipomdp_gaze.belief import bayes_update, uniform_log_belief
 from ipomdp_gaze.fpoc import dprime_matrix
 import ipomdp_gaze.gym  # noqa: F401  (registers the environment)
 from ipomdp_gaze.gym import ENV_ID, VisualSearchEnv
+from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
 import numpy as np
 import pytest
 
@@ -27,7 +28,7 @@ def test_belief_follows_the_bayes_update_and_reward_is_negative_entropy():
     log_b = uniform_log_belief(16)
     for action in (0, 5, 15):
         obs, reward, *_ = env.step(action)
-        log_b = update_log_belief(log_b, obs['evidence'].ravel(), d[:, action])
+        log_b = bayes_update(log_b, llr(obs['evidence'].ravel(), d[:, action]))
         b = np.exp(log_b)
         np.testing.assert_allclose(env.belief, b, atol=1e-12)
         assert reward == pytest.approx(np.sum(b * np.log(b)))

@@ -9,8 +9,8 @@ import math
 from builtin_interfaces.msg import Time
 from ipomdp_gaze.belief import EvidenceError
 from ipomdp_gaze.grid import Grid
-from msg_adapters import diagnostics, grid_arrays, images, joints, stamps
-from msg_adapters.grid_arrays import LayoutError
+from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, stamps
+from ipomdp_gaze.msg_adapters.grid_arrays import LayoutError
 import numpy as np
 import pytest
 from sensor_msgs.msg import Image, JointState

@@ -3,11 +3,11 @@
 """Look-ahead planner (policies/planner.py): validity, determinism, rollouts, quality."""
 from ipomdp_gaze.fpoc import dprime_matrix, dprime_table, make_fpoc
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.policies.baselines import elm_policy, MapPolicy
+from ipomdp_gaze.policies.conv import ConvPolicy
+from ipomdp_gaze.policies.planner import make_planner, RolloutPlanner, TemperedELM, TemperedPolicy
 from ipomdp_gaze.simulate import noise_stream, simulate
 import numpy as np
-from policies.baselines import elm_policy, MapPolicy
-from policies.conv import ConvPolicy
-from policies.planner import make_planner, RolloutPlanner, TemperedELM, TemperedPolicy
 import pytest
 
 GRID = Grid(7, 7)
@@ -59,8 +59,8 @@ def test_deterministic_given_the_rng_and_the_simulation_seed():
     a = planner.select(beliefs, 2, np.random.default_rng(5))
     b = planner.select(beliefs, 2, np.random.default_rng(5))
     np.testing.assert_array_equal(a, b)
-    r1 = simulate(GRID, FPOC, planner, 6, 4, seed=9, dprime=D)
-    r2 = simulate(GRID, FPOC, planner, 6, 4, seed=9, dprime=D)
+    r1 = simulate(GRID, FPOC, planner, 6, 4, seed=9)
+    r2 = simulate(GRID, FPOC, planner, 6, 4, seed=9)
     np.testing.assert_array_equal(r1.fixations, r2.fixations)
 
 
@@ -72,12 +72,12 @@ def conv_kernel_policy(power=1.75):
 @pytest.mark.parametrize('base_name', ['elm', 'tempered', 'map', 'tempered conv'])
 def test_rollouts_reproduce_simulate_on_the_same_targets_and_noise(base_name):
     """A rollout fed simulate's targets and noise ends in simulate's belief, step for step."""
-    base = {'elm': elm_policy(GRID, FPOC), 'tempered': TemperedELM(GRID, FPOC, dprime=D),
+    base = {'elm': elm_policy(GRID, FPOC), 'tempered': TemperedELM(GRID, FPOC),
             'map': MapPolicy(), 'tempered conv': conv_kernel_policy()}[base_name]
     power = 0.7 if base_name == 'tempered conv' else None
     episodes, steps, seed = 10, 5, 4
     reference = base if power is None else TemperedPolicy(base, power)
-    result = simulate(GRID, FPOC, reference, episodes, steps, seed=seed, dprime=D)
+    result = simulate(GRID, FPOC, reference, episodes, steps, seed=seed)
     noise = np.stack([noise_stream(seed, s).standard_normal((episodes, N))
                       for s in range(steps)])[:, :, None, :]          # (H, E, R=1, N)
     uniform = np.full((episodes, N), 1.0 / N)
@@ -153,8 +153,8 @@ def paired_gap(policy_a, policy_b, episodes, seed, fixation=8):
     history, so its mean is the percent correct at t; pairing (same targets and noise) removes
     most of the between-episode variance.
     """
-    a = simulate(GRID, FPOC, policy_a, episodes, fixation, seed=seed, dprime=D)
-    b = simulate(GRID, FPOC, policy_b, episodes, fixation, seed=seed, dprime=D)
+    a = simulate(GRID, FPOC, policy_a, episodes, fixation, seed=seed)
+    b = simulate(GRID, FPOC, policy_b, episodes, fixation, seed=seed)
     diff = a.map_prob[:, -1] - b.map_prob[:, -1]
     return diff.mean(), diff.std(ddof=1) / np.sqrt(episodes)
 
@@ -172,11 +172,11 @@ def test_planner_is_not_worse_than_its_base_policy_beyond_sampling_error():
     """
     base = elm_policy(GRID, FPOC)
     planner = make_planner(GRID, FPOC, base=base, candidates=3, rollouts=48,
-                           rollout_budget=None, switch_z=1.0, dprime=D)
+                           rollout_budget=None, switch_z=1.0)
     episodes = 150
     gap, se = paired_gap(planner, base, episodes, seed=21)
-    switched = simulate(GRID, FPOC, planner, episodes, 8, seed=21, dprime=D).fixations
-    unchanged = simulate(GRID, FPOC, base, episodes, 8, seed=21, dprime=D).fixations
+    switched = simulate(GRID, FPOC, planner, episodes, 8, seed=21).fixations
+    unchanged = simulate(GRID, FPOC, base, episodes, 8, seed=21).fixations
     assert np.mean(np.any(switched != unchanged, axis=1)) > 0.2    # the check is not vacuous
     assert gap > -Z_TOL * se, (gap, se)
 

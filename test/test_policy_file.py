@@ -6,13 +6,13 @@ from pathlib import Path
 from ipomdp_gaze.cli import main
 from ipomdp_gaze.fpoc import make_fpoc
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.policies import policy_file as pf
+from ipomdp_gaze.policies.conv import ConvPolicy, kernel_from_radial, radial_bins
+from ipomdp_gaze.policies.logistic import LogisticPolicy
+from ipomdp_gaze.policies.policy_file import (load_policy, load_policy_spec, PolicyFileError,
+                                              PolicySpec, save_policy, shipped_kernels)
 from ipomdp_gaze.simulate import simulate
 import numpy as np
-from policies import policy_file as pf
-from policies.conv import ConvPolicy, kernel_from_radial, radial_bins
-from policies.logistic import LogisticPolicy
-from policies.policy_file import (load_policy, load_policy_spec, PolicyFileError, PolicySpec,
-                                  save_policy, shipped_kernels)
 import pytest
 import yaml
 
@@ -322,5 +322,6 @@ def test_save_refuses_an_invalid_spec(tmp_path):
     assert not (tmp_path / 'x.yaml').exists()
 
 
-def test_kernel_dir_is_next_to_the_module():
-    assert pf.KERNEL_DIR == Path(pf.__file__).resolve().parent / 'kernels'
+def test_kernel_dir_is_the_package_data_next_to_the_module():
+    assert pf.KERNEL_DIR.resolve() == (Path(pf.__file__).parent / 'kernels').resolve()
+    assert 'human-7x7-infomax' in pf.shipped_kernels()

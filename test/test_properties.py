@@ -16,14 +16,15 @@ import os
 
 from hypothesis import assume, given, HealthCheck, settings
 from hypothesis import strategies as st
-from ipomdp_gaze.belief import (check_evidence, EvidenceError, log_likelihood, uniform_log_belief,
-                                update_log_belief)
+from ipomdp_gaze.belief import bayes_update, EvidenceError, uniform_log_belief
 from ipomdp_gaze.fpoc import make_fpoc
-from ipomdp_gaze.gaze import build_policy, GazeController
+from ipomdp_gaze.gaze import GazeController
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.observation import check_evidence, gaussian_log_likelihood_ratio as llr
+from ipomdp_gaze.policies.baselines import make_baseline, STRATEGIES
+from ipomdp_gaze.policies.conv import ConvPolicy
+from ipomdp_gaze.policies.registry import build_policy
 import numpy as np
-from policies.baselines import make_baseline, STRATEGIES
-from policies.conv import ConvPolicy
 import pytest
 
 # More examples with PROPERTY_EXAMPLES (make soak uses 1000); CI derandomizes (conftest.py).
@@ -57,7 +58,7 @@ def log_beliefs(draw, n):
     zeros = np.array(draw(st.lists(st.booleans(), min_size=n, max_size=n)))
     zeros[draw(st.integers(0, n - 1))] = False                 # at least one possible cell
     logits[zeros] = -np.inf
-    log_b = update_log_belief(logits, np.full(n, np.nan), np.zeros(n))
+    log_b = bayes_update(logits, llr(np.full(n, np.nan), np.zeros(n)))
     assert_belief(log_b)
     return log_b
 
@@ -78,7 +79,7 @@ def test_update_refuses_with_a_reason_or_gives_a_normalised_belief(case):
     log_b, obs, d = case
     before = log_b.copy()
     try:
-        after = update_log_belief(log_b, check_evidence(obs, obs.size), d)
+        after = bayes_update(log_b, llr(check_evidence(obs, obs.size), d))
     except EvidenceError as exc:
         reason = str(exc)
         assert 'inf' in reason or 'overflows' in reason, reason
@@ -99,7 +100,7 @@ def test_in_place_update_is_all_or_nothing(case):
     log_b, obs, d = case
     before = log_b.copy()
     try:
-        update_log_belief(log_b, obs, d, out=log_b)
+        bayes_update(log_b, llr(obs, d), out=log_b)
     except EvidenceError:
         np.testing.assert_array_equal(log_b, before)
     else:
@@ -114,14 +115,14 @@ def test_nan_cells_are_unobserved(case, data):
     masked = np.where(hidden, np.nan, obs)
     other_d = np.where(hidden, data.draw(dprime_value), d)      # d' of unobserved cells is moot
     try:
-        want = update_log_belief(log_b, masked, d)
+        want = bayes_update(log_b, llr(masked, d))
     except EvidenceError:
         with pytest.raises(EvidenceError):
-            update_log_belief(log_b, masked, other_d)
+            bayes_update(log_b, llr(masked, other_d))
         return
-    np.testing.assert_array_equal(update_log_belief(log_b, masked, other_d), want)
-    np.testing.assert_allclose(log_likelihood(masked, d)[hidden], 0.0)
-    np.testing.assert_allclose(update_log_belief(log_b, np.full(obs.size, np.nan), d), log_b,
+    np.testing.assert_array_equal(bayes_update(log_b, llr(masked, other_d)), want)
+    np.testing.assert_allclose(llr(masked, d)[hidden], 0.0)
+    np.testing.assert_allclose(bayes_update(log_b, llr(np.full(obs.size, np.nan), d)), log_b,
                                rtol=1e-12, atol=1e-12)
 
 
@@ -131,9 +132,9 @@ def test_overflowing_frames_are_refused_not_turned_into_nan():
                    ([-1e308] * 3, [4.0] * 3),                      # every cell -inf
                    ([0.0, 0.0, 0.0], [1e200, 1e200, 1e200])):      # d'^2 / 2 overflows
         with pytest.raises(EvidenceError, match='overflows'):
-            update_log_belief(log_b, np.array(obs), np.array(d))
+            bayes_update(log_b, llr(np.array(obs), np.array(d)))
     # Just below overflow it is evidence like any other: all mass on the one cell.
-    after = update_log_belief(log_b, np.array([4e307, 0.0, 0.0]), np.full(3, 4.0))
+    after = bayes_update(log_b, llr(np.array([4e307, 0.0, 0.0]), np.full(3, 4.0)))
     np.testing.assert_array_equal(np.exp(after), [1.0, 0.0, 0.0])
 
 
@@ -153,7 +154,7 @@ def test_controller_core_survives_any_sequence(grid, dprime, half_width_deg, pol
     try:
         built = build_policy(policy, grid, fpoc)
     except ValueError as exc:                   # ELM of a d' whose square overflows
-        assert 'kernel contains NaN or inf' in str(exc)
+        assert 'kernel must be finite' in str(exc)
         return
     core = GazeController(grid, fpoc, built)
     core.reset(0.0)

@@ -83,7 +83,7 @@ class Watch:
     def __init__(self, probe):
         from diagnostic_msgs.msg import DiagnosticStatus
         from ipomdp_gaze.grid import Grid
-        from msg_adapters import joints
+        from ipomdp_gaze.msg_adapters import joints
         from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
         from sensor_msgs.msg import JointState
         from std_msgs.msg import Float32MultiArray
@@ -100,7 +100,7 @@ class Watch:
         self.diag = Diagnostics(probe)
 
     def cell(self, msg) -> int:
-        from msg_adapters import joints
+        from ipomdp_gaze.msg_adapters import joints
         return self.head.nearest_cell(*joints.angles_from_joint_state(msg, self.head))
 
     def belief(self, i=-1) -> np.ndarray:

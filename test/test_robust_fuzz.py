@@ -80,7 +80,7 @@ class Frames:
     def array(self, values, dims=None, offset=0, layout=True):
         import array
 
-        from msg_adapters import grid_arrays
+        from ipomdp_gaze.msg_adapters import grid_arrays
         from std_msgs.msg import Float32MultiArray, MultiArrayDimension, MultiArrayLayout
         msg = Float32MultiArray()
         if layout and dims is None:

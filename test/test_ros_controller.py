@@ -56,16 +56,16 @@ class Camera:
 
     # -- what the controller said ----------------------------------------------------------
     def belief(self, i=-1) -> np.ndarray:
-        from msg_adapters import grid_arrays
+        from ipomdp_gaze.msg_adapters import grid_arrays
         return grid_arrays.from_multiarray(self.beliefs[i][1], self.grid)
 
     def fixation(self, i=-1) -> int:
-        from msg_adapters import joints
+        from ipomdp_gaze.msg_adapters import joints
         head = joints.PanTiltMap(self.grid)
         return head.nearest_cell(*joints.angles_from_joint_state(self.targets[i][1], head))
 
     def counters(self) -> dict:
-        from msg_adapters import diagnostics
+        from ipomdp_gaze.msg_adapters import diagnostics
         for _, msg in reversed(self.diagnostics):
             for status in msg.status:
                 if status.name.endswith(f'{NODE}: search'):
@@ -81,7 +81,7 @@ class Camera:
 
     # -- sending -----------------------------------------------------------------------------
     def send(self, values, layout=None):
-        from msg_adapters import grid_arrays
+        from ipomdp_gaze.msg_adapters import grid_arrays
         from std_msgs.msg import Float32MultiArray
         if layout is None:
             msg = grid_arrays.to_multiarray(values, self.grid)
@@ -140,7 +140,7 @@ def _frames(seed, n):
 def _conv_choice(kernel, belief):
     """Evaluate the kernel's next fixation offline, and its margin over the runner-up."""
     from ipomdp_gaze.grid import Grid
-    from policies.conv import ConvPolicy
+    from ipomdp_gaze.policies.conv import ConvPolicy
     policy = ConvPolicy(Grid(11, 11, 5.0), np.asarray(kernel).reshape(21, 21))
     scores = policy.scores(belief[None])[0]
     top2 = np.sort(scores)[-2:]
@@ -256,7 +256,7 @@ def test_nan_cells_are_unobserved(probe, cam):
 
 
 def test_stamped_evidence_image_is_used(probe, cam):
-    from msg_adapters import images
+    from ipomdp_gaze.msg_adapters import images
     belief, fixation = cam.belief().astype(np.float64), cam.fixation()
     frame = _frames(8, 1)[0]
     nb = len(cam.beliefs)
@@ -314,7 +314,7 @@ def test_pan_tilt_of_known_cells_and_signs(probe, cam, params, cell, pan_deg, ti
 def policy_files(tmp_path_factory):
     from ipomdp_gaze.fpoc import make_fpoc
     from ipomdp_gaze.grid import Grid
-    from policies.policy_file import PolicySpec, save_policy
+    from ipomdp_gaze.policies.policy_file import PolicySpec, save_policy
     folder = tmp_path_factory.mktemp('policies')
     camera = make_fpoc('camera', half_width_deg=10.0, half_height_deg=10.0)
     files = {}

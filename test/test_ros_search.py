@@ -64,7 +64,7 @@ def _enable(probe, flag):
 def _search(probe, rec, seed, target, start):
     """Run one search from a reset; return (beliefs, targets, truth, found) of this search."""
     from ipomdp_gaze.grid import Grid
-    from msg_adapters import grid_arrays
+    from ipomdp_gaze.msg_adapters import grid_arrays
     grid = Grid(11, 11, 5.0)
     _enable(probe, False)
     camera_params = {'seed': seed, 'target_row': -1, 'target_col': -1}
@@ -112,7 +112,7 @@ def test_most_likely_cell_is_the_target_at_0999(searches):
 
 def test_found_event(searches):
     from ipomdp_gaze.grid import Grid
-    from msg_adapters import diagnostics, joints
+    from ipomdp_gaze.msg_adapters import diagnostics, joints
     head = joints.PanTiltMap(Grid(11, 11, 5.0))
     for _, (beliefs, _, _, found_msg) in searches:
         found = diagnostics.parse_found(found_msg)
@@ -149,7 +149,7 @@ def test_pan_tilt_angles_signs_and_start_cells(rig, searches):
 
 
 def test_belief_image_size_encoding_and_fixation_mark(rig, searches):
-    from msg_adapters import images
+    from ipomdp_gaze.msg_adapters import images
     assert rig['image'], 'no belief_image received'
     msg = rig['image'][-1][1]
     assert (msg.encoding, msg.height, msg.width, msg.step) == ('rgb8', 352, 352, 1056)
@@ -160,7 +160,7 @@ def test_belief_image_size_encoding_and_fixation_mark(rig, searches):
 
 
 def test_shipped_kernel_or_the_elm_fallback(rig, probe):
-    from policies.policy_file import shipped_kernels
+    from ipomdp_gaze.policies.policy_file import shipped_kernels
     params = probe.get_parameters(CONTROLLER, ['policy.name', 'policy.file', 'policy.fallback'])
     assert params['policy.file'] == 'camera-11x11-infomax'
     if 'camera-11x11-infomax' in shipped_kernels():

@@ -51,7 +51,7 @@ def rig(launch, probe):
 
 
 def _last_diagnostics(rec) -> dict:
-    from msg_adapters import diagnostics
+    from ipomdp_gaze.msg_adapters import diagnostics
     for _, msg in reversed(rec['diagnostics']):
         for status in msg.status:
             if status.name.endswith(f'{NODE}: search'):
@@ -97,7 +97,7 @@ def camera(rig, launch):
 
 def test_camera_that_starts_late_picks_up_the_target(rig, camera):
     from ipomdp_gaze.grid import Grid
-    from msg_adapters import grid_arrays
+    from ipomdp_gaze.msg_adapters import grid_arrays
     assert wait_for(lambda: _search_done(rig, 0), 60), camera.output()
     assert wait_for(lambda: rig['truth'])
     grid = Grid(11, 11, 5.0)
@@ -109,7 +109,7 @@ def test_camera_that_starts_late_picks_up_the_target(rig, camera):
 def test_no_frame_taken_mid_saccade_is_used_and_the_search_completes(rig, camera, probe):
     from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
     from ipomdp_gaze.grid import Grid
-    from msg_adapters import grid_arrays, images, joints
+    from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
     from std_srvs.srv import SetBool, Trigger
     grid = Grid(11, 11, 5.0)
     head = joints.PanTiltMap(grid)

@@ -1,13 +1,14 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """Batched simulator: common random numbers, agreement with step-by-step updates, calibration."""
-from ipomdp_gaze.belief import map_cell, uniform_log_belief, update_log_belief
+from ipomdp_gaze.belief import bayes_update, map_cell, uniform_log_belief
 from ipomdp_gaze.evaluation import fixations_to_90_ci
 from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
+from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.simulate import draw_targets, noise_stream, simulate
 import numpy as np
-from policies.baselines import make_baseline
 import pytest
 
 GRID = Grid(7, 7, 0.42)
@@ -26,7 +27,7 @@ def test_simulator_matches_sequential_updates():
             assert k == res.fixations[e, t]
             obs = noise_stream(11, t).standard_normal((5, grid.n_cells))[e]
             obs[res.targets[e]] += d[res.targets[e], k]
-            log_b = update_log_belief(log_b, obs, d[:, k])
+            log_b = bayes_update(log_b, llr(obs, d[:, k]))
             assert (map_cell(np.exp(log_b)) == res.targets[e]) == res.correct[e, t]
 
 

@@ -3,15 +3,17 @@
 """GPOMDP training: exact gradients, the eligibility trace, improvement, resume and the CLI."""
 from ipomdp_gaze.belief import entropy
 from ipomdp_gaze.cli import main
-from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
+from ipomdp_gaze.fpoc import make_fpoc
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.observation import GaussianObservation
+from ipomdp_gaze.policies.conv import ConvPolicy, kernel_from_radial, kernel_matrix, radial_bins
+from ipomdp_gaze.policies.logistic import LogisticPolicy
+from ipomdp_gaze.policies.policy_file import load_policy, load_policy_spec, save_policy
+from ipomdp_gaze.policies.training import (discounted_from, Family, leave_one_out_mean,
+                                           log_policy_gradient, read_curve, sample_episodes,
+                                           theta_gradient, trace_gradient_reference, TrainConfig,
+                                           Trainer, trainer_from_spec)
 import numpy as np
-from policies.conv import ConvPolicy, kernel_from_radial, kernel_matrix, radial_bins
-from policies.logistic import LogisticPolicy
-from policies.policy_file import load_policy, load_policy_spec, save_policy
-from policies.training import (discounted_from, Family, leave_one_out_mean, log_policy_gradient,
-                               read_curve, sample_episodes, theta_gradient,
-                               trace_gradient_reference, TrainConfig, Trainer, trainer_from_spec)
 import pytest
 
 FPOC = make_fpoc('human')
@@ -74,8 +76,8 @@ def _batch(grid, reward='infomax', episodes=7, seed=2, family='logistic'):
     fam = Family(grid, family)
     rng = np.random.default_rng(seed)
     params = rng.normal(scale=5.0, size=fam.size)
-    d = np.ascontiguousarray(dprime_matrix(grid, FPOC).T)
-    return fam, params, sample_episodes(fam.theta(params), d, reward, episodes, grid.n_cells,
+    model = GaussianObservation(grid, FPOC)
+    return fam, params, sample_episodes(fam.theta(params), model, reward, episodes, grid.n_cells,
                                         np.random.default_rng(seed + 1))
 
 
@@ -121,7 +123,7 @@ def test_short_training_improves_the_return(family):
                                               eval_every=1000))
 
     def mean_return(params):
-        batch = sample_episodes(trainer.family.theta(params), trainer.dprime_by_fix, 'infomax',
+        batch = sample_episodes(trainer.family.theta(params), trainer.model, 'infomax',
                                 4000, grid.n_cells, np.random.default_rng(11))
         total = batch.reward.sum(axis=0)
         return total.mean(), total.std() / np.sqrt(total.size)

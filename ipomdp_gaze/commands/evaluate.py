@@ -7,10 +7,10 @@ import json
 from pathlib import Path
 
 from ipomdp_gaze.evaluation import fixations_to_90_ci
-from ipomdp_gaze.fpoc import dprime_matrix
+from ipomdp_gaze.observation import GaussianObservation
+from ipomdp_gaze.policies.baselines import make_baseline, STRATEGIES
 from ipomdp_gaze.simulate import draw_targets, simulate
 import numpy as np
-from policies.baselines import make_baseline, STRATEGIES
 
 from .common import add_task_args, nonneg_int, positive_int, task_from_args
 
@@ -42,7 +42,7 @@ def load_policies(args, grid, fpoc) -> dict:
     for name in args.policy or ([] if args.policy_file else ['map']):
         policies[name] = make_baseline(name, grid, fpoc)
     for path in args.policy_file:
-        from policies.policy_file import load_policy
+        from ipomdp_gaze.policies.policy_file import load_policy
         policies[path.stem] = load_policy(path, grid=grid, fpoc=fpoc)
     return policies
 
@@ -51,13 +51,13 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
              episodes_greedy: int = 2000, bootstrap: int = 1000, progress=None) -> dict:
     """Run every policy on the same targets and noise; return the JSON-ready result."""
     horizon = grid.n_cells if horizon is None else horizon
-    d = dprime_matrix(grid, fpoc)
+    model = GaussianObservation(grid, fpoc)
     targets = draw_targets(grid.n_cells, episodes, seed)
     out = {'grid': grid.to_dict(), 'fpoc': fpoc.to_dict(), 'episodes': episodes,
            'horizon': horizon, 'seed': seed, 'policies': {}}
     for name, policy in policies.items():
         n = min(episodes, episodes_greedy) if getattr(policy, 'name', '') == 'greedy' else episodes
-        result = simulate(grid, fpoc, policy, n, horizon, seed, targets=targets[:n], dprime=d)
+        result = simulate(grid, model, policy, n, horizon, seed, targets=targets[:n])
         point, ci = fixations_to_90_ci(result.correct, grid.n_cells,
                                        np.random.default_rng([seed, 99]), bootstrap)
         out['policies'][name] = {

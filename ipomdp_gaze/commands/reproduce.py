@@ -14,12 +14,13 @@ from pathlib import Path
 import time
 
 from ipomdp_gaze.evaluation import fixations_to_90_ci, paired_difference_ci
-from ipomdp_gaze.fpoc import dprime_matrix, dprime_table
+from ipomdp_gaze.fpoc import dprime_table
+from ipomdp_gaze.observation import GaussianObservation
+from ipomdp_gaze.policies.baselines import make_baseline
+from ipomdp_gaze.policies.conv import radial_bins
+from ipomdp_gaze.policies.planner import make_planner, TemperedELM
 from ipomdp_gaze.simulate import draw_targets, simulate
 import numpy as np
-from policies.baselines import make_baseline
-from policies.conv import radial_bins
-from policies.planner import make_planner, TemperedELM
 
 from .common import nonneg_int, positive_int
 
@@ -47,13 +48,13 @@ def add_parser(sub):
 
 
 def _load(name):
-    from policies.policy_file import load_policy_spec
+    from ipomdp_gaze.policies.policy_file import load_policy_spec
     return load_policy_spec(name)
 
 
 def _retrain(log):
     from ipomdp_gaze.cli import main as cli_main
-    from policies.policy_file import resolve_source
+    from ipomdp_gaze.policies.policy_file import resolve_source
     for name in KERNELS:
         spec = _load(name)
         training = spec.training or {}
@@ -78,15 +79,15 @@ class _Runner:
     def __init__(self, grid, fpoc, episodes, seed, bootstrap):
         self.grid, self.fpoc, self.seed = grid, fpoc, seed
         self.episodes, self.bootstrap = episodes, bootstrap
-        self.d = dprime_matrix(grid, fpoc)
+        self.model = GaussianObservation(grid, fpoc)
         self.targets = draw_targets(grid.n_cells, episodes, seed)
         self.correct, self.seconds = {}, {}
 
     def run(self, name, policy, episodes=None, horizon=None):
         n = self.episodes if episodes is None else min(episodes, self.episodes)
         t0 = time.perf_counter()
-        result = simulate(self.grid, self.fpoc, policy, n, horizon, self.seed,
-                          targets=self.targets[:n], dprime=self.d)
+        result = simulate(self.grid, self.model, policy, n, horizon, self.seed,
+                          targets=self.targets[:n])
         self.seconds[name] = time.perf_counter() - t0
         self.correct[name] = result.correct
         return result

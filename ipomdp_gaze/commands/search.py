@@ -5,11 +5,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ipomdp_gaze.belief import entropy, map_cell, normalize_log, uniform_log_belief
-from ipomdp_gaze.fpoc import dprime_matrix
-from ipomdp_gaze.simulate import sample_observation
+from ipomdp_gaze.belief import bayes_update, entropy, map_cell, uniform_log_belief
+from ipomdp_gaze.observation import GaussianObservation
+from ipomdp_gaze.policies.baselines import make_baseline, STRATEGIES
 import numpy as np
-from policies.baselines import make_baseline, STRATEGIES
 
 from .common import add_task_args, nonneg_int, positive_int, task_from_args
 
@@ -33,10 +32,9 @@ def add_parser(sub):
     p.set_defaults(run=run)
 
 
-def run_search(grid, fpoc, policy, target, confidence, max_fixations, seed, out=print):
+def run_search(grid, model, policy, target, confidence, max_fixations, seed, out=print):
     """Search until the MAP probability reaches ``confidence``; return (guess, path, belief)."""
     rng = np.random.default_rng(seed)
-    d = dprime_matrix(grid, fpoc)
     log_b = uniform_log_belief(grid.n_cells, 1)
     belief = np.exp(log_b)
     targets = np.array([target])
@@ -47,9 +45,9 @@ def run_search(grid, fpoc, policy, target, confidence, max_fixations, seed, out=
     for t in range(max_fixations):
         k = int(policy.select(belief, t, rng)[0])
         path.append(k)
-        obs = sample_observation(d[target, k], targets, grid.n_cells, rng)
-        log_b += d[:, k] * (obs - 0.5 * d[:, k])
-        normalize_log(log_b)
+        fixations = np.array([k])
+        frames = model.sample(targets, fixations, rng)
+        bayes_update(log_b, model.log_likelihood_ratio(frames, fixations), out=log_b)
         np.exp(log_b, out=belief)
         guess = int(map_cell(belief)[0])
         kr, kc = grid.cell(k)
@@ -94,7 +92,7 @@ def plot_search(grid, belief, path, target, title, out_path):
 def run(args) -> int:
     grid, fpoc = task_from_args(args)
     if args.policy_file:
-        from policies.policy_file import load_policy
+        from ipomdp_gaze.policies.policy_file import load_policy
         policy = load_policy(args.policy_file, grid=grid, fpoc=fpoc)
     else:
         policy = make_baseline(args.policy, grid, fpoc)
@@ -105,8 +103,8 @@ def run(args) -> int:
     if target >= grid.n_cells:
         raise ValueError(f'--target {target} is outside the {grid.n_cells}-cell grid')
     max_fix = args.max_fixations or 4 * grid.n_cells
-    guess, path, belief = run_search(grid, fpoc, policy, target, args.confidence, max_fix,
-                                     args.seed)
+    guess, path, belief = run_search(grid, GaussianObservation(grid, fpoc), policy, target,
+                                     args.confidence, max_fix, args.seed)
     if args.plot:
         name = args.policy_file or args.policy
         title = (f'{grid.rows}x{grid.cols}, {fpoc.model} FPOC, {name}: '

@@ -70,7 +70,7 @@ def _task(args, spec):
     """Return the task of the command line or of the resumed file (explicit options must agree)."""
     from ipomdp_gaze.fpoc import make_fpoc
     from ipomdp_gaze.grid import Grid
-    from policies.policy_file import PolicyFileError
+    from ipomdp_gaze.policies.policy_file import PolicyFileError
     if spec is None:
         return task_from_args(args)
     given = {
@@ -93,9 +93,9 @@ def _task(args, spec):
 
 
 def run(args) -> int:
-    from policies.policy_file import load_policy_spec, save_policy
-    from policies.training import (evaluation_block, read_curve, TrainConfig, Trainer,
-                                   trainer_from_spec, write_curve)
+    from ipomdp_gaze.policies.policy_file import load_policy_spec, save_policy
+    from ipomdp_gaze.policies.training import (evaluation_block, read_curve, TrainConfig, Trainer,
+                                               trainer_from_spec, write_curve)
     spec = load_policy_spec(args.resume) if args.resume is not None else None
     out = args.out if args.out is not None else args.resume
     if out is None:

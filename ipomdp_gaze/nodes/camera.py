@@ -8,9 +8,9 @@ the command to the nearest cell and moves there in ``saccade_time_s`` (until it 
 is still at the old cell; a repeated command for the cell it is moving to is ignored, one for the
 cell it is at takes ``saccade_time_s`` to settle again). With ``rate_hz = 0`` it publishes one
 evidence frame when it arrives; with ``rate_hz > 0`` it publishes frames at that rate like a video
-camera, including while it moves. Each frame follows the observation model with the
-camera's own FPOC: ``o_j ~ N(d, 1)`` at the target, ``N(0, 1)`` elsewhere, and NaN where the
-FPOC gives ``d' = 0`` (outside the field of view, not observed).
+camera, including while it moves. Each frame is drawn from the Gaussian observation model with
+the camera's own FPOC (:meth:`ipomdp_gaze.observation.GaussianObservation.sample`), with NaN
+where the FPOC gives ``d' = 0`` (outside the field of view, not observed).
 
 Publishes ``evidence`` (``Float32MultiArray``, best effort) or, with ``publish_image``, the
 stamped ``evidence_image`` (``32FC1``); ``joint_states`` (its pose, stamped like the frame taken
@@ -23,9 +23,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 import sys
 
-from ipomdp_gaze.fpoc import dprime_table
-from ipomdp_gaze.gaze import dprime_of_fixation
-from msg_adapters import grid_arrays, images, joints
+from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
+from ipomdp_gaze.observation import GaussianObservation
 import numpy as np
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
@@ -71,7 +70,7 @@ class CameraConfig:
 
     values: dict
     grid: object
-    dprime: np.ndarray
+    observation: GaussianObservation
     head: joints.PanTiltMap
     target: tuple
 
@@ -112,7 +111,7 @@ class SimulatedCameraNode(Node):
         fpoc = fpoc_from(values)
         head = head_from(values, grid)
         target = row_col_from(values, grid, 'target_row', 'target_col')
-        return CameraConfig(dict(values), grid, dprime_table(grid, fpoc), head, target)
+        return CameraConfig(dict(values), grid, GaussianObservation(grid, fpoc), head, target)
 
     def _on_set(self, params) -> SetParametersResult:
         for p in params:
@@ -188,10 +187,8 @@ class SimulatedCameraNode(Node):
     # -- outputs -------------------------------------------------------------------------
     def _publish_frame(self) -> None:
         cfg = self._config
-        d = dprime_of_fixation(cfg.grid, cfg.dprime, self.pose)
-        obs = self.rng.standard_normal(cfg.grid.n_cells)
-        obs[self.target] += d[self.target]
-        obs[d == 0] = np.nan
+        obs = cfg.observation.sample(self.target, self.pose, self.rng)
+        obs[~cfg.observation.observed(self.pose)] = np.nan
         stamp = self.get_clock().now().to_msg()
         if cfg.values['publish_image']:
             self._image_pub.publish(images.evidence_image(obs, cfg.grid, stamp))

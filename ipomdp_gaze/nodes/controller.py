@@ -29,11 +29,12 @@ import sys
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from ipomdp_gaze.belief import EvidenceError
-from ipomdp_gaze.gaze import (build_policy, check_kernel, FrameSequence, GazeController,
-                              POLICY_NAMES, PolicyUnavailable)
-from msg_adapters import diagnostics, grid_arrays, images, joints, stamps
-from policies.baselines import STRATEGIES
-from policies.conv import ACTIONS
+from ipomdp_gaze.gaze import FrameSequence, GazeController
+from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, stamps
+from ipomdp_gaze.observation import GaussianObservation
+from ipomdp_gaze.policies.baselines import STRATEGIES
+from ipomdp_gaze.policies.conv import ACTIONS, check_kernel
+from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnavailable
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.exceptions import NameValidationException
 from rclpy.node import Node
@@ -191,8 +192,6 @@ class GazeControllerNode(Node):
         confidence = values['confidence']
         if not 0.0 < confidence < 1.0:
             raise ValueError(f'confidence must be between 0 and 1 (exclusive), got {confidence}')
-        if values['policy.kernel']:
-            check_kernel(values['policy.kernel'], grid)
         for name in ('forward_command_topic', 'trajectory_topic'):
             if values[name]:
                 try:
@@ -205,7 +204,8 @@ class GazeControllerNode(Node):
         if previous is not None and not policy_changed:
             policy = previous.policy
         else:
-            policy = build_policy(values['policy.name'], grid, fpoc, values['policy.kernel'],
+            policy = build_policy(values['policy.name'], grid, GaussianObservation(grid, fpoc),
+                                  values['policy.kernel'],
                                   values['policy.file'], values['policy.action'],
                                   warn=warnings.append)
         return Config(dict(values), grid, fpoc, policy, head, start, '; '.join(warnings))
@@ -271,7 +271,8 @@ class GazeControllerNode(Node):
         try:
             for p in params:
                 if p.name == 'policy.kernel' and p.value:
-                    check_kernel(p.value, grid_from(current_values(self, grid_params())))
+                    check_kernel(p.value, grid_from(current_values(self, grid_params())),
+                                 'policy.kernel')
         except ValueError as exc:
             return SetParametersResult(successful=False, reason=str(exc))
         return SetParametersResult(successful=True)
@@ -285,7 +286,7 @@ class GazeControllerNode(Node):
             self.get_logger().warning(cfg.warning)
         v, ov = cfg.values, old.values
         core = self.core
-        core.set_fpoc(cfg.fpoc)
+        core.set_observation(cfg.fpoc)
         core.set_policy(cfg.policy)
         core.set_start_cell(cfg.start_cell)
         core.set_settle_time(v['settle_time_s'])

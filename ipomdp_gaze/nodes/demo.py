@@ -18,7 +18,7 @@ import time
 
 from diagnostic_msgs.msg import DiagnosticStatus
 from ipomdp_gaze.belief import entropy
-from msg_adapters import diagnostics, grid_arrays, joints
+from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, joints
 import numpy as np
 import rclpy
 from rclpy.executors import SingleThreadedExecutor

@@ -16,7 +16,7 @@ import math
 
 from ipomdp_gaze.fpoc import CameraFPOC, make_fpoc, MODELS, parameter_names
 from ipomdp_gaze.grid import Grid
-from msg_adapters.joints import PanTiltMap
+from ipomdp_gaze.msg_adapters.joints import PanTiltMap
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.parameter import Parameter
 
