@@ -3,8 +3,9 @@
 """
 Decision latency of the controller path (belief update + policy choice) from 7x7 to 512x512.
 
-Each call is what the gaze controller does per frame: ``BeliefTracker.update(frame, fixation)``
-then ``ConvPolicy.decide(belief)``, with the ELM kernel (``K = d'^2``, human FPOC) and frames
+Each call is exactly what the gaze controller node does per frame: ``GazeController.offer(frame,
+stamp)`` (check the frame, the observation model's log-likelihood ratio, the one Bayes step, the
+found check and the policy's choice), with the ELM kernel (``K = d'^2``, human FPOC) and frames
 drawn from the observation model (float32, like a ``Float32MultiArray`` buffer); the belief is
 reset every :data:`EPISODE` calls, so flat and peaked beliefs both occur. The direct and FFT
 paths run interleaved in rounds on the same frames (their fixation sequences must agree), beside
@@ -21,10 +22,11 @@ import sys
 import time
 import tracemalloc
 
-from ipomdp_gaze.belief import (argmax_ties_low, BeliefTracker, dprime_column, TIE_RTOL,
-                                uniform_log_belief, update_log_belief)
+from ipomdp_gaze.belief import argmax_ties_low, bayes_update, TIE_RTOL, uniform_log_belief
 from ipomdp_gaze.fpoc import dprime_table, make_fpoc
+from ipomdp_gaze.gaze import GazeController
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.observation import gaussian_log_likelihood_ratio, GaussianObservation
 from ipomdp_gaze.policies import conv
 from ipomdp_gaze.policies.baselines import elm_policy
 from ipomdp_gaze.policies.conv import ConvPolicy, kernel_matrix
@@ -46,16 +48,32 @@ BREAK_EVEN_SIDES = (8, 12, 16, 20, 22, 24, 26, 28, 30, 32, 36, 40, 44, 48)
 TRUNCATIONS = (0.0, 1e-16, 1e-12, 1e-9, 1e-6)
 TARGETS_US = {11: 50.0, 256: 5000.0}
 INTRO = (
-    'Each call is what the gaze controller does per frame: `BeliefTracker.update(frame, '
-    "fixation)` then `ConvPolicy.decide(belief)`, with the ELM kernel (`K = d'^2`, human FPOC, "
+    'Each call is exactly what the gaze controller node does per frame: '
+    '`GazeController.offer(frame, stamp)` (frame check, log-likelihood ratio of the Gaussian '
+    'observation model, the one Bayes step, found check, policy choice), with the ELM kernel '
+    "(`K = d'^2`, human FPOC, "
     'exactly 0 beyond 46 cells) and frames drawn from the observation model (float32, as read '
     f'from a `Float32MultiArray` buffer); the belief is reset every {EPISODE} frames, so flat and '
     'peaked beliefs both occur. Direct and FFT run interleaved in rounds on the same frames, and '
     'their fixation sequences are compared. Beside them, naive references in the same process: '
     'the probability-domain (exp) update with `scipy.signal.correlate2d` or '
     '`scipy.signal.correlate(method="fft")` scores, the allocating library path of before issue '
-    "5 (`update_log_belief` with an N x N d' matrix, scores by an N x N product) and a per-cell "
+    "5 (the Bayes step with an N x N d' matrix, scores by an N x N product) and a per-cell "
     'Python loop.')
+
+
+class TimedPolicy:
+    """Forwards ``select`` to a policy and records its wall time: the decision inside ``offer``."""
+
+    def __init__(self, policy):
+        self.policy = policy
+        self.ns = []
+
+    def select(self, belief, t, rng):
+        t0 = time.perf_counter_ns()
+        choice = self.policy.select(belief, t, rng)
+        self.ns.append(time.perf_counter_ns() - t0)
+        return choice
 
 
 class ControllerLoop:
@@ -63,9 +81,11 @@ class ControllerLoop:
 
     def __init__(self, grid, fpoc, method, seed=0, frames=16, truncate=conv.DEFAULT_TRUNCATE):
         self.grid = grid
-        self.table = dprime_table(grid, fpoc)
-        self.tracker = BeliefTracker(grid, self.table)
-        self.policy = ConvPolicy(grid, self.table ** 2, method=method, truncate=truncate)
+        self.model = GaussianObservation(grid, fpoc)
+        self.table = self.model.table
+        self.policy = ConvPolicy(grid, self.model.elm_kernel(), method=method, truncate=truncate)
+        self.timed = TimedPolicy(self.policy)
+        self.core = GazeController(grid, self.model, self.timed)
         rng = np.random.default_rng(seed)
         self.noise = rng.standard_normal((frames, grid.n_cells)).astype(np.float32)
         self.targets = rng.integers(0, grid.n_cells, size=10_000)
@@ -73,40 +93,37 @@ class ControllerLoop:
         self.calls = 0
         self.fixations = []
         self.update_ns, self.decide_ns, self.cpu_ns = [], [], []
-        self.k = grid.center_index
         self.target = 0
 
     def _prepare(self):
         """Start an episode when due and fill the next frame (not timed)."""
         g = self.grid
         if self.calls % EPISODE == 0:
-            self.tracker.reset()
-            self.k = g.center_index
+            self.core.reset(0.0)
             self.target = int(self.targets[(self.calls // EPISODE) % self.targets.size])
         self.frame[:] = self.noise[self.calls % self.noise.shape[0]]
         rt, ct = divmod(self.target, g.cols)
-        rk, ck = divmod(self.k, g.cols)
+        rk, ck = divmod(self.core.fixation, g.cols)
         self.frame[self.target] += self.table[rt - rk + g.rows - 1, ct - ck + g.cols - 1]
 
     def run(self, calls, keep=None):
         """Time ``calls`` frames; ``keep`` (list) collects a copy of every belief."""
         clock, cpu = time.perf_counter_ns, time.thread_time_ns
-        tracker, policy, frame = self.tracker, self.policy, self.frame
+        core, frame, decided = self.core, self.frame, self.timed.ns
         for _ in range(calls):
             self._prepare()
             c0 = cpu()
             t0 = clock()
-            tracker.update(frame, self.k)
+            result = core.offer(frame, 1.0)
             t1 = clock()
-            self.k = policy.decide(tracker.belief)
-            t2 = clock()
             c1 = cpu()
-            self.update_ns.append(t1 - t0)
-            self.decide_ns.append(t2 - t1)
+            decide = decided.pop()
+            self.update_ns.append(t1 - t0 - decide)
+            self.decide_ns.append(decide)
             self.cpu_ns.append(c1 - c0)
-            self.fixations.append(self.k)
+            self.fixations.append(result.fixation)
             if keep is not None:
-                keep.append(tracker.belief.copy())
+                keep.append(core.belief)
             self.calls += 1
 
 
@@ -115,7 +132,8 @@ class ReferenceLoop:
 
     def __init__(self, grid, fpoc, kind, seed=0):
         self.grid, self.kind = grid, kind
-        self.table = dprime_table(grid, fpoc)
+        self.model = GaussianObservation(grid, fpoc)
+        self.table = self.model.table
         self.kernel = self.table ** 2
         rng = np.random.default_rng(seed)
         self.noise = rng.standard_normal((16, grid.n_cells))
@@ -137,11 +155,12 @@ class ReferenceLoop:
         """One frame: update and choose, the reference way."""
         g, k = self.grid, self.k
         if self.kind == 'allocating library path':
-            self.log_b = update_log_belief(self.log_b, obs, self.d_matrix[:, k])
+            self.log_b = bayes_update(self.log_b, gaussian_log_likelihood_ratio(
+                obs, self.d_matrix[:, k]))
             return int(argmax_ties_low(np.exp(self.log_b) @ self.weights_t))
         if self.kind == 'per-cell Python loop':
             return self._loop_step(obs)
-        d = dprime_column(g, self.table, k)
+        d = self.model.dprime(k)
         lik = np.exp(d * (obs - 0.5 * d))
         b = self.b * np.where(np.isnan(lik), 1.0, lik)
         self.b = b / b.sum()
@@ -214,7 +233,7 @@ def _fmt_bytes(b):
 
 
 def peak_memory(grid, fpoc, method):
-    """Peak traced bytes while building the d' table, tracker and policy and making 3 calls."""
+    """Peak traced bytes while building the observation model, controller and policy + 3 calls."""
     tracemalloc.start()
     try:
         loop = ControllerLoop(grid, fpoc, method, frames=1)
@@ -225,13 +244,13 @@ def peak_memory(grid, fpoc, method):
 
 
 def frame_allocation(loop, frames=20):
-    """Peak bytes traced by tracemalloc while the loop's tracker and policy handle frames."""
-    tracker, policy, frame, k = loop.tracker, loop.policy, loop.frame.copy(), loop.k
+    """Peak bytes traced by tracemalloc while the loop's controller handles frames."""
+    core, frame = loop.core, loop.frame.copy()
     tracemalloc.start()
     try:
         for _ in range(frames):
-            tracker.update(frame, k)
-            k = policy.decide(tracker.belief)
+            core.offer(frame, 1.0)
+            loop.timed.ns.clear()
         return tracemalloc.get_traced_memory()[1]
     finally:
         tracemalloc.stop()
@@ -427,7 +446,7 @@ def plot(ctx, rows, scan):
     n = np.array([r['n'] for r in rows], dtype=float)
     axm.plot(n, 8 * n * n / 2 ** 20, 'k:', label='one N x N float64 matrix')
     axm.set(xscale='log', yscale='log', xlabel='cells N', ylabel='MiB',
-            title='Peak memory (tracemalloc: table, tracker, policy, 3 calls)')
+            title='Peak memory (tracemalloc: model, controller, policy, 3 calls)')
     axm.grid(True, which='both', alpha=0.3)
     axm.legend(fontsize=8)
     fig.tight_layout()
@@ -481,11 +500,12 @@ def report(rows, scan, trunc, greedy) -> str:
              f'{EPISODE} frames. Targets: 11x11 under 50 µs, 256x256 under 5 ms (median). '
              'Wall-clock time includes waiting for a core on the shared machine; CPU time '
              '(`time.thread_time_ns`) is what the code itself costs. Peak memory: tracemalloc '
-             "while building the d' table, tracker and policy and handling 3 frames. Allocated "
-             'per frame: tracemalloc peak over 20 frames of a built controller: on the direct '
-             'path only Python scalars (the update and the decision write to preallocated '
-             'buffers: 12 numpy calls per update, 13 for float32 frames, 4 per decision); the '
-             'FFT path allocates its transforms (`scipy.fft` has no `out=`).', '',
+             'while building the observation model, controller and policy and handling 3 frames. '
+             'Allocated per frame: tracemalloc peak over 20 frames of a built controller '
+             '(`GazeController.offer`): the frame check, the log-likelihood ratio and the Bayes '
+             'step allocate a few temporaries of N floats each; the direct decision writes to '
+             'preallocated buffers, the FFT path allocates its transforms (`scipy.fft` has no '
+             '`out=`). "update" is `offer` minus the policy\'s choice inside it.', '',
              '### References measured in the same run (CPU-time median per frame; ratio = '
              'reference / ours with the automatic method)', '',
              '| grid | ' + ' | '.join(REFERENCE_CALLS) + ' |',

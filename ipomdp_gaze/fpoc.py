@@ -5,7 +5,7 @@ Foveal-peripheral operating characteristics (FPOCs) of the observation model.
 
 An FPOC gives the detectability d' of a target at offset ``(dx, dy)`` degrees from fixation.
 
-Every FPOC is a small object built from the parameter names of DESIGN.md section 2 (the same
+Every FPOC is a small object built from the parameter names of docs/design.md section 2 (the same
 names appear in policy files, the CLI's ``--fpoc-param`` and the nodes' ``fpoc.<name>``), and is
 evaluated on offset arrays. ``dprime_matrix`` gives the N x N matrix ``d[j, k]`` (target cell j,
 fixation k) for small grids; ``dprime_table`` gives the ``(2R-1) x (2C-1)`` offset table that
@@ -45,7 +45,7 @@ class FPOC:
         raise NotImplementedError
 
     def params(self) -> dict:
-        """Parameters by their DESIGN.md names (what a policy file's ``fpoc`` block holds)."""
+        """Parameters by their docs/design.md names (what a policy file's ``fpoc`` block holds)."""
         raise NotImplementedError
 
     def to_dict(self) -> dict:
@@ -212,7 +212,7 @@ def _check_model(model):
 
 def make_fpoc(model: str = 'human', **params) -> FPOC:
     """
-    Build an FPOC by model name from DESIGN.md parameter names.
+    Build an FPOC by model name from the parameter names of docs/design.md section 2.
 
     Raises
     ------

@@ -56,12 +56,6 @@ class Grid:
                 f'spacing_deg must be a positive finite number, got {self.spacing_deg!r}')
         object.__setattr__(self, 'spacing_deg', spacing)
 
-    @classmethod
-    def from_string(cls, text: str, spacing_deg: float = 0.42) -> 'Grid':
-        """Build a grid from ``'ROWSxCOLS'``."""
-        rows, cols = parse_grid(text)
-        return cls(rows, cols, spacing_deg)
-
     @property
     def n_cells(self) -> int:
         """Return the number of cells N = rows * cols."""

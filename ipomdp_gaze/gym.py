@@ -4,12 +4,12 @@
 Gymnasium environment ``ipomdp_gaze/VisualSearch-v0``: the I-POMDP visual-search task.
 
 Each step fixates one cell (``Discrete(N)`` action), draws one observation per cell from the
-observation model (docs/design.md section 1) and updates the belief with the one Bayes step.
-The observation is a ``Dict`` with the belief grid (or, with ``observe='evidence'``, the raw
-evidence of the last frame) and the current fixation. The reward is the infomax reward ``sum_i B_i log B_i`` of the new belief
-(``reward='fixate_target'``: the belief at the fixated cell). An episode terminates when the most
-likely cell reaches ``confidence`` and is truncated after ``max_steps`` fixations. The hidden
-target is in ``info['target']`` for oracle baselines.
+observation model (docs/design.md section 1) and updates the belief with the one Bayes step. The
+observation is a ``Dict`` with the belief grid (or, with ``observe='evidence'``, the raw evidence
+of the last frame) and the current fixation. The reward is the infomax reward ``sum_i B_i log B_i``
+of the new belief (``reward='fixate_target'``: the belief at the fixated cell). An episode
+terminates when the most likely cell reaches ``confidence`` and is truncated after ``max_steps``
+fixations. The hidden target is in ``info['target']`` for oracle baselines.
 """
 from __future__ import annotations
 
@@ -112,7 +112,7 @@ class VisualSearchEnv(gymnasium.Env):
 
     def render(self):
         if self.render_mode == 'rgb_array':
-            return belief_heatmap(self.belief, *self.grid.shape, self._fixation)
+            return belief_heatmap(self.belief, self.grid.shape, self._fixation)
         if self.render_mode == 'ansi':
             return belief_text(self.belief, *self.grid.shape, self._fixation)
         return None

@@ -109,8 +109,9 @@ class GaussianObservation:
     -----
     ``d_jk`` is read from the ``(2R-1, 2C-1)`` offset table
     (:func:`ipomdp_gaze.fpoc.dprime_table`): the cells seen from k are the ``rows x cols``
-    window starting at ``(R-1-r_k, C-1-c_k)``, so a single frame never needs an N x N matrix. Batches of fixations use the N x N matrix
-    ``d[k, j]``, built on first use for grids of up to :data:`MATRIX_MAX_CELLS` cells.
+    window starting at ``(R-1-r_k, C-1-c_k)``, so a single frame never needs an N x N matrix.
+    Batches of fixations use the N x N matrix ``d[k, j]``, built on first use for grids of up
+    to :data:`MATRIX_MAX_CELLS` cells.
 
     """
 

@@ -1,7 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-Grid-shaped arrays <-> ``std_msgs`` multi-arrays (DESIGN.md section 5).
+Grid-shaped arrays <-> ``std_msgs`` multi-arrays (docs/design.md section 5).
 
 The layout of a ``rows x cols`` grid is
 ``dim[0] = {label: 'rows', size: rows, stride: rows*cols}``,

@@ -4,9 +4,8 @@
 Images: the belief heatmap (``rgb8``) and per-cell evidence as ``32FC1``.
 
 Float images look black in rqt_image_view unless its dynamic range is switched on, so the belief
-is published as a colour-mapped ``rgb8`` picture (DESIGN.md section 5): each cell becomes a
-``scale_px x scale_px`` block coloured by ``B_i / max(B)`` on a viridis-like map (dark purple = 0,
-yellow = the most likely cell), and the current fixation gets a red outline.
+is published as the colour-mapped ``rgb8`` picture of :func:`ipomdp_gaze.render.belief_heatmap`
+(docs/design.md section 5).
 """
 from __future__ import annotations
 
@@ -14,16 +13,13 @@ import sys
 
 from ipomdp_gaze.belief import EvidenceError
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.render import belief_heatmap
 import numpy as np
 from sensor_msgs.msg import Image
 from std_msgs.msg import Header
 
 from .grid_arrays import LayoutError
 
-# Viridis sampled at 0, 1/4, 1/2, 3/4, 1 (matplotlib's values), interpolated linearly.
-_ANCHORS = np.array([[68, 1, 84], [59, 82, 139], [33, 145, 140], [94, 201, 98],
-                     [253, 231, 37]], dtype=float)
-MARK_RGB = (255, 0, 0)
 _LITTLE = sys.byteorder == 'little'
 
 
@@ -35,43 +31,10 @@ def _uint8(data) -> np.ndarray:
         return np.asarray(data, dtype=np.uint8)
 
 
-def colour_map(values: np.ndarray) -> np.ndarray:
-    """Map values in [0, 1] to ``uint8`` RGB (shape ``values.shape + (3,)``)."""
-    v = np.clip(np.nan_to_num(np.asarray(values, dtype=float)), 0.0, 1.0)
-    x = np.linspace(0.0, 1.0, len(_ANCHORS))
-    rgb = np.stack([np.interp(v, x, _ANCHORS[:, ch]) for ch in range(3)], axis=-1)
-    return np.round(rgb).astype(np.uint8)
-
-
-_LUT = colour_map(np.linspace(0.0, 1.0, 256))
-
-
-def belief_picture(belief, grid: Grid, fixation: int | None, scale_px: int) -> np.ndarray:
-    """Draw the heatmap as a ``(rows*scale_px, cols*scale_px, 3)`` uint8 array."""
-    if scale_px < 1:
-        raise ValueError(f'scale_px must be >= 1, got {scale_px}')
-    b = np.asarray(belief, dtype=float).reshape(grid.shape)
-    peak = b.max()
-    level = np.clip(np.nan_to_num(b / peak if peak > 0 else b), 0.0, 1.0)
-    rgb = _LUT[np.round(level * (len(_LUT) - 1)).astype(np.intp)]
-    # Columns first, then whole rows: both repeats copy contiguous memory (fast).
-    img = np.repeat(np.repeat(rgb, scale_px, axis=1), scale_px, axis=0)
-    if fixation is not None:
-        row, col = grid.cell(fixation)
-        width = max(1, scale_px // 8)
-        r0, c0 = row * scale_px, col * scale_px
-        block = img[r0:r0 + scale_px, c0:c0 + scale_px]
-        block[:width] = MARK_RGB
-        block[-width:] = MARK_RGB
-        block[:, :width] = MARK_RGB
-        block[:, -width:] = MARK_RGB
-    return img
-
-
 def belief_image(belief, grid: Grid, fixation: int | None, scale_px: int, stamp,
                  frame_id: str = '') -> Image:
     """Build a stamped ``rgb8`` ``sensor_msgs/Image`` of the belief heatmap."""
-    img = belief_picture(belief, grid, fixation, scale_px)
+    img = belief_heatmap(belief, grid.shape, fixation, scale_px)
     height, width = img.shape[:2]
     msg = Image(header=Header(stamp=stamp, frame_id=frame_id), height=height, width=width,
                 encoding='rgb8', is_bigendian=0, step=3 * width)

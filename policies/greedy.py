@@ -4,7 +4,7 @@
 Percent-correct greedy searcher: the ideal searcher of Najemnik & Geisler (2005).
 
 It fixates ``argmax_k sum_i B_i P(C | i, k)``, the cell that maximises the probability that the
-MAP guess after one more observation is right (DESIGN.md section 3), where
+MAP guess after one more observation is right (docs/design.md section 3), where
 
     P(C | i, k) = int phi(w) prod_{j != i} Phi([ln(B_i/B_j) + (d_ik^2 + d_jk^2)/2 + d_ik w]
                                                 / d_jk) dw
@@ -48,9 +48,9 @@ j beats every kept cell, and then it is at most ``sum_{j not in S} exp(Y_j) 1(Y_
 null expectation is ``sum_j B_j P(Y_j > Y_m | target j)``, and under target j,
 ``Y_j - Y_m ~ N(ln(B_j/B_m) + s_jm^2/2, s_jm^2)`` with ``s_jm^2 = d_jk^2 + d_mk^2 <= s^2``; the
 probability increases with ``s_jm`` because ``B_j <= B_m``. S is the smallest set whose bound is at
-most ``tol`` (default 1e-10, below the 1e-9 relative tie tolerance of DESIGN.md section 4), so the
-choice is ``tol``-optimal. When S is a single cell every fixation scores ``B_m`` exactly and the
-tie rule names cell 0: more information cannot change the MAP guess by more than ``tol``.
+most ``tol`` (default 1e-10, below the 1e-9 relative tie tolerance of docs/design.md section 4),
+so the choice is ``tol``-optimal. When S is a single cell every fixation scores ``B_m`` exactly and
+the tie rule names cell 0: more information cannot change the MAP guess by more than ``tol``.
 """
 from __future__ import annotations
 

@@ -11,7 +11,6 @@ from ipomdp_gaze.gaze import GazeController
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
 from ipomdp_gaze.policies.baselines import spiral_order
-from ipomdp_gaze.policies.conv import ConvPolicy
 from ipomdp_gaze.policies.registry import build_policy
 import numpy as np
 import pytest

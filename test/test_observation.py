@@ -42,7 +42,8 @@ def test_batched_ratio_equals_one_frame_at_a_time():
     frames = rng.normal(size=(7, GRID.n_cells))
     batch = MODEL.log_likelihood_ratio(frames, fixations)
     for e in range(7):
-        np.testing.assert_array_equal(batch[e], MODEL.log_likelihood_ratio(frames[e], fixations[e]))
+        one = MODEL.log_likelihood_ratio(frames[e], fixations[e])
+        np.testing.assert_array_equal(batch[e], one)
     np.testing.assert_array_equal(
         MODEL.log_likelihood_ratio(frames, fixations, validate=False), batch)
 

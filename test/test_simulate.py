@@ -49,7 +49,7 @@ def test_targets_are_uniform():
 @pytest.mark.parametrize('name, reference', [('random', 11.33), ('map', 9.1)])
 def test_calibrated_baselines_reach_design_values(name, reference):
     """
-    DESIGN.md: random about 11.3 and MAP about 9.1 fixations to 90% on 7x7 (human default).
+    docs/design.md: random about 11.3 and MAP about 9.1 fixations to 90% on 7x7 (human default).
 
     The tolerance is four bootstrap standard errors of this run plus 0.05 for the rounding of the
     reference, so a correct model fails this with probability well below 1e-3.

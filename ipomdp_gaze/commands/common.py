@@ -75,7 +75,7 @@ def add_task_args(parser: argparse.ArgumentParser, grid: str = '7x7', spacing: f
                         help=f'FPOC model (default {fpoc})')
     parser.add_argument('--fpoc-param', type=fpoc_param, action='append', default=[],
                         metavar='NAME=VALUE',
-                        help='FPOC parameter by its DESIGN.md name, e.g. foveal_dprime=2.5 '
+                        help='FPOC parameter by its docs/design.md name, e.g. foveal_dprime=2.5 '
                              '(repeatable)')
 
 
