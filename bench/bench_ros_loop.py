@@ -11,17 +11,12 @@ controller's own counters in ``/diagnostics`` say how many frames it applied, sk
 superseded) or never saw (dropped by the keep-last queue), with its RSS from /proc.
 Run: ``.venv/bin/python bench/bench_ros_loop.py`` or ``make bench``.
 """
-from pathlib import Path
 import sys
-import tempfile
 import time
 
-from diagnostic_msgs.msg import DiagnosticArray
-from ipomdp_gaze.nodes.processes import domain_id_for, NodeProcess, ros_environment
+from ipomdp_gaze.nodes.processes import domain_id_for, isolated_nodes
+from ipomdp_gaze.nodes.watch import Watch
 import numpy as np
-import rclpy
-from rclpy.executors import SingleThreadedExecutor
-from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float32MultiArray
@@ -47,75 +42,47 @@ def _rss_mib(pid):
     return float('nan')
 
 
-class _Listener:
+class _Listener(Watch):
     """This process's node: frame stamps from ``joint_states`` and the controller's counters."""
 
-    def __init__(self, domain, count_frames=False):
-        self.context = rclpy.Context()
-        rclpy.init(context=self.context, domain_id=domain, args=[])
-        self.node = Node('bench_listener', context=self.context)
-        self.executor = SingleThreadedExecutor(context=self.context)
-        self.executor.add_node(self.node)
-        self.stamps, self.counters, self.frames = [], {}, 0
-        if count_frames:
-            self.node.create_subscription(Float32MultiArray, 'evidence', self._on_frame,
-                                          qos_profile_sensor_data)
+    def __init__(self, domain, nodes, count_frames=False):
+        super().__init__(domain, 'bench_listener', nodes)
+        self.stamps = []
+        self.status = self.search_status()
+        self.frames = self.latest(Float32MultiArray, 'evidence', qos_profile_sensor_data) \
+            if count_frames else None
         self.node.create_subscription(JointState, 'joint_states', self._on_pose, 100)
-        self.node.create_subscription(DiagnosticArray, '/diagnostics', self._on_diag, 10)
 
     def _on_pose(self, msg):
         self.stamps.append(msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec)
 
-    def _on_frame(self, msg):
-        self.frames += 1
-
-    def _on_diag(self, msg):
-        for status in msg.status:
-            if status.name.endswith('search'):
-                self.counters = {kv.key: kv.value for kv in status.values}
-
-    def spin_for(self, seconds):
-        end = time.monotonic() + seconds
-        while time.monotonic() < end:
-            self.executor.spin_once(timeout_sec=0.05)
-
-    def close(self):
-        self.executor.shutdown(timeout_sec=1)
-        self.node.destroy_node()
-        rclpy.try_shutdown(context=self.context)
+    @property
+    def counters(self) -> dict:
+        return self.status.values
 
 
-def _start(tmp, domain, rows, spacing, half, camera_args, controller_args=()):
-    env = ros_environment(domain, Path(tmp) / 'log')
+def _start(nodes, rows, spacing, half, camera_args, controller_args=()):
     task = _task_args(rows, spacing, half)
-    controller = NodeProcess('controller', [
+    controller = nodes.start('controller', [
         *task, '-p', 'policy.name:=elm', '-p', 'settle_time_s:=0.0', '-p', 'retry_period_s:=0.5',
         '-p', 'pan_min_rad:=-3.0', '-p', 'pan_max_rad:=3.0', '-p', 'tilt_min_rad:=-1.5',
-        '-p', 'tilt_max_rad:=1.5', *controller_args], env, Path(tmp) / 'controller.log').start()
-    camera = NodeProcess('camera', [*task, *camera_args], env, Path(tmp) / 'camera.log').start()
+        '-p', 'tilt_max_rad:=1.5', *controller_args])
+    camera = nodes.start('camera', [*task, *camera_args])
     return controller, camera
 
 
 def loop(rows, spacing, half, seconds, domain):
     """Loop periods (ms) and sustained fixations per second with a frame-per-command camera."""
-    with tempfile.TemporaryDirectory() as tmp:
-        controller, camera = _start(tmp, domain, rows, spacing, half,
+    with isolated_nodes(domain) as nodes:
+        controller, camera = _start(nodes, rows, spacing, half,
                                     ['-p', 'saccade_time_s:=0.0', '-p', 'rate_hz:=0.0'])
-        listener = _Listener(domain)
-        try:
-            deadline = time.monotonic() + 60
-            while len(listener.stamps) < 20 and time.monotonic() < deadline:
-                listener.spin_for(0.2)
-            if len(listener.stamps) < 20:
+        with _Listener(domain, nodes) as listener:
+            if not listener.wait_until(lambda: len(listener.stamps) >= 20, 60, 0.2):
                 raise RuntimeError('the loop did not start:\n' + controller.output()[-2000:]
                                    + camera.output()[-2000:])
             first = len(listener.stamps)
-            listener.spin_for(seconds)
+            time.sleep(seconds)
             stamps = np.array(listener.stamps[first:])
-        finally:
-            listener.close()
-            controller.stop()
-            camera.stop()
     periods = np.diff(stamps) * 1e3
     return {'median_ms': float(np.median(periods)), 'p99_ms': float(np.percentile(periods, 99)),
             'fixations_per_s': float(periods.size / (stamps[-1] - stamps[0])),
@@ -124,26 +91,19 @@ def loop(rows, spacing, half, seconds, domain):
 
 def stream(rows, spacing, half, rate_hz, seconds, domain):
     """Stream camera frames: sent vs applied, skipped and lost; controller RSS (MiB)."""
-    with tempfile.TemporaryDirectory() as tmp:
-        controller, camera = _start(tmp, domain, rows, spacing, half,
+    with isolated_nodes(domain) as nodes:
+        controller, camera = _start(nodes, rows, spacing, half,
                                     ['-p', 'saccade_time_s:=0.0', '-p', f'rate_hz:={rate_hz}'],
                                     ['-p', 'diagnostics_period_s:=0.5'])
-        listener = _Listener(domain, count_frames=True)
-        try:
-            deadline = time.monotonic() + 90
-            while listener.counters.get('frames_applied', '0') in ('', '0') \
-                    and time.monotonic() < deadline:
-                listener.spin_for(0.5)
+        with _Listener(domain, nodes, count_frames=True) as listener:
+            listener.wait_until(lambda: listener.counters.get('frames_applied', '0')
+                                not in ('', '0'), 90, 0.5)
             rss0 = _rss_mib(controller.proc.pid)
-            c0, n0 = dict(listener.counters), listener.frames
-            listener.spin_for(seconds)
-            listener.spin_for(1.2)                       # one more diagnostics period
-            c1, n1 = dict(listener.counters), listener.frames
+            c0, n0 = dict(listener.counters), listener.frames.count
+            time.sleep(seconds)
+            time.sleep(1.2)                              # one more diagnostics period
+            c1, n1 = dict(listener.counters), listener.frames.count
             rss1 = _rss_mib(controller.proc.pid)
-        finally:
-            listener.close()
-            controller.stop()
-            camera.stop()
 
     def delta(key):
         return int(float(c1.get(key, 'nan'))) - int(float(c0.get(key, 'nan')))

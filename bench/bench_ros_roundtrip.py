@@ -10,24 +10,21 @@ frame and times until the next ``pan_tilt`` (and the ``belief``) arrive. 20 warm
 round trips per policy; prints median and 90th percentile in ms. It also times the controller's
 work for one frame in-process (message in, update, choice, messages out) without DDS.
 """
-from pathlib import Path
 import sys
-import tempfile
 import threading
 import time
 
 from builtin_interfaces.msg import Time
 from ipomdp_gaze.fpoc import make_fpoc
-from ipomdp_gaze.gaze import build_policy, GazeController
+from ipomdp_gaze.gaze import GazeController
 from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.nodes.config import config_file
-from ipomdp_gaze.nodes.processes import domain_id_for, NodeProcess, ros_environment
+from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
+from ipomdp_gaze.nodes.config import config_file
+from ipomdp_gaze.nodes.processes import domain_id_for, isolated_nodes
+from ipomdp_gaze.nodes.watch import LATCHED, Watch
+from ipomdp_gaze.policies.registry import build_policy
 import numpy as np
-import rclpy
-from rclpy.executors import SingleThreadedExecutor
-from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float32MultiArray
 
@@ -39,7 +36,7 @@ def in_process(policy_name, repeats=2000):
     """Median microseconds of the controller's per-frame work without DDS."""
     fpoc = make_fpoc('camera', half_width_deg=10.0, half_height_deg=10.0)
     core = GazeController(GRID, fpoc, build_policy(policy_name, GRID, fpoc), settle_time_s=0.0)
-    head = joints.PanTiltMap(GRID)
+    head = PanTiltMap(GRID)
     rng = np.random.default_rng(0)
     frames = [grid_arrays.to_multiarray(rng.standard_normal(121), GRID) for _ in range(50)]
     times = []
@@ -60,65 +57,53 @@ def in_process(policy_name, repeats=2000):
 
 def round_trips(policy_name, domain):
     """Median and p90 milliseconds of frame -> next pan_tilt, and frame -> belief."""
-    with tempfile.TemporaryDirectory() as tmp:
-        env = ros_environment(domain, Path(tmp) / 'log')
-        proc = NodeProcess('controller', [
+    with isolated_nodes(domain) as nodes:
+        proc = nodes.start('controller', [
             '--params-file', str(config_file('controller.yaml')), '-p', 'settle_time_s:=0.0',
-            '-p', 'retry_period_s:=0.0', '-p', f'policy.name:={policy_name}'], env,
-            Path(tmp) / 'controller.log').start()
-        context = rclpy.Context()
-        rclpy.init(context=context, domain_id=domain, args=[])
-        node = Node('bench_camera', context=context)
-        executor = SingleThreadedExecutor(context=context)
-        executor.add_node(node)
-        latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
-                             durability=DurabilityPolicy.TRANSIENT_LOCAL)
-        pub = node.create_publisher(Float32MultiArray, 'evidence', 10)
+            '-p', 'retry_period_s:=0.0', '-p', f'policy.name:={policy_name}'])
         rng = np.random.default_rng(1)
         state = {'sent': None, 'target': [], 'belief': [], 'stamps': set()}
         done = threading.Event()
+        with Watch(domain, 'bench_camera', nodes) as watch:
+            pub = watch.publisher(Float32MultiArray, 'evidence', 10)
 
-        def send():
-            if len(state['target']) >= WARMUP + TIMED:
-                done.set()
-                return
-            msg = grid_arrays.to_multiarray(rng.standard_normal(121), GRID)
-            state['sent'] = time.perf_counter()
-            pub.publish(msg)
+            def send():
+                if len(state['target']) >= WARMUP + TIMED:
+                    done.set()
+                    return
+                msg = grid_arrays.to_multiarray(rng.standard_normal(121), GRID)
+                state['sent'] = time.perf_counter()
+                pub.publish(msg)
 
-        def on_target(msg):
-            key = (msg.header.stamp.sec, msg.header.stamp.nanosec)
-            if key in state['stamps']:
-                return
-            state['stamps'].add(key)
-            if state['sent'] is not None:
-                state['target'].append(time.perf_counter() - state['sent'])
-            if pub.get_subscription_count():
-                send()
+            def on_target(msg):
+                key = (msg.header.stamp.sec, msg.header.stamp.nanosec)
+                if key in state['stamps']:
+                    return
+                state['stamps'].add(key)
+                if state['sent'] is not None:
+                    state['target'].append(time.perf_counter() - state['sent'])
+                if pub.get_subscription_count():
+                    send()
 
-        def on_belief(msg):
-            if state['sent'] is not None:
-                state['belief'].append(time.perf_counter() - state['sent'])
+            def on_belief(msg):
+                if state['sent'] is not None:
+                    state['belief'].append(time.perf_counter() - state['sent'])
 
-        node.create_subscription(JointState, 'pan_tilt', on_target, latched)
-        node.create_subscription(Float32MultiArray, 'belief', on_belief, 10)
-        deadline = time.monotonic() + 120
-        try:
-            while not done.is_set() and time.monotonic() < deadline:
-                executor.spin_once(timeout_sec=0.05)
+            def kick():
+                # The first target may arrive before the controller subscribes to our frames.
                 if state['sent'] is None and pub.get_subscription_count() and state['stamps']:
                     send()
-        finally:
-            executor.shutdown(timeout_sec=1)
-            node.destroy_node()
-            rclpy.try_shutdown(context=context)
-            proc.stop()
+
+            watch.node.create_subscription(JointState, 'pan_tilt', on_target, LATCHED)
+            watch.node.create_subscription(Float32MultiArray, 'belief', on_belief, 10)
+            watch.node.create_timer(0.05, kick)
+            watch.wait_until(done.is_set, 120)
         target = np.array(state['target'][WARMUP:]) * 1e3
         belief = np.array(state['belief'][WARMUP:]) * 1e3
         if target.size < TIMED:
             raise RuntimeError(f'only {target.size} round trips timed:\n{proc.output()}')
-        return (np.median(target), np.percentile(target, 90), np.median(belief),
-                np.percentile(belief, 90))
+    return (np.median(target), np.percentile(target, 90), np.median(belief),
+            np.percentile(belief, 90))
 
 
 def main():

@@ -39,6 +39,7 @@ def main(argv=None) -> int:
     parser.add_argument('--seed', type=int, default=0)
     args = parser.parse_args(argv)
 
+    from ipomdp_gaze.nodes.processes import wait_for
     import numpy as np
     import rclpy
     from rclpy.node import Node
@@ -62,10 +63,7 @@ def main(argv=None) -> int:
         values[rng.integers(n)] += 4.0
         msg.data = array.array('f', values.tobytes())
         frames.append(msg)
-    deadline = time.monotonic() + 60.0
-    while pub.get_subscription_count() < 1 and time.monotonic() < deadline:
-        time.sleep(0.05)
-    if pub.get_subscription_count() < 1:
+    if not wait_for(lambda: pub.get_subscription_count() >= 1, 60.0, 0.05):
         print(json.dumps({'error': 'no subscriber on evidence'}), flush=True)
         return 1
     time.sleep(0.5)                       # let the subscriber's side of the match settle too

@@ -19,8 +19,6 @@ import argparse
 import json
 import os
 from pathlib import Path
-import signal
-import subprocess
 import sys
 import tempfile
 import time
@@ -29,33 +27,7 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from ipomdp_gaze.nodes.config import config_file  # noqa: E402
-from ipomdp_gaze.nodes.processes import domain_id_for, ros_environment  # noqa: E402
-
-WRAPPER = ('import faulthandler, signal, sys; '
-           'faulthandler.register(signal.SIGUSR1, all_threads=True); '
-           'from ipomdp_gaze.nodes.{node} import main; sys.exit(main())')
-
-
-def start(node: str, ros_args, env: dict, log: Path) -> subprocess.Popen:
-    """Start a node with a faulthandler on SIGUSR1; output to ``log``."""
-    with open(log, 'wb') as out:
-        return subprocess.Popen(
-            [sys.executable, '-c', WRAPPER.format(node=node), '--ros-args', *ros_args],
-            env=env, stdout=out, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
-
-
-def stop(proc: subprocess.Popen, timeout_s: float) -> tuple:
-    """SIGTERM, wait; on a hang SIGUSR1 (stack dump) then SIGKILL. Returns (code, seconds)."""
-    t0 = time.monotonic()
-    proc.send_signal(signal.SIGTERM)
-    try:
-        proc.wait(timeout_s)
-    except subprocess.TimeoutExpired:
-        proc.send_signal(signal.SIGUSR1)
-        time.sleep(1.0)
-        proc.kill()
-        proc.wait(10)
-    return proc.returncode, time.monotonic() - t0
+from ipomdp_gaze.nodes.processes import domain_id_for, NodeGroup, ros_environment  # noqa: E402
 
 
 def main(argv=None) -> int:
@@ -68,9 +40,7 @@ def main(argv=None) -> int:
     parser.add_argument('--keep', default='', help='folder for the logs of hung nodes')
     args = parser.parse_args(argv)
 
-    import rclpy
-    from rclpy.executors import SingleThreadedExecutor
-    from rclpy.node import Node
+    from ipomdp_gaze.nodes.watch import Watch
     from std_msgs.msg import Float32MultiArray
 
     work = Path(tempfile.mkdtemp(prefix='shutdown_cycles_'))
@@ -78,46 +48,35 @@ def main(argv=None) -> int:
     env = ros_environment(domain, work / 'ros_log')
     os.environ.update({k: env[k] for k in ('ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_LOG_DIR')})
     keep = Path(args.keep) if args.keep else work
-    context = rclpy.Context()
-    rclpy.init(context=context, domain_id=domain, args=[])
-    probe = Node('shutdown_probe', context=context)
-    executor = SingleThreadedExecutor(context=context)
-    executor.add_node(probe)
-    beliefs = []
-    probe.create_subscription(Float32MultiArray, 'belief', lambda m: beliefs.append(1), 100)
     controller_args = ['--params-file', str(config_file('controller.yaml'))]
     camera_args = ['--params-file', str(config_file('camera.yaml'))]
     hangs, times = 0, {'controller': [], 'camera': []}
-    try:
+    nodes = NodeGroup(env, work, stack_dump=True)
+    with Watch(domain, 'shutdown_probe') as probe:
+        beliefs = probe.latest(Float32MultiArray, 'belief', 100)
         for cycle in range(args.cycles):
-            beliefs.clear()
-            logs = {n: work / f'{n}-{cycle}.log' for n in ('controller', 'camera')}
-            procs = {'controller': start('controller', controller_args, env, logs['controller']),
-                     'camera': start('camera', camera_args, env, logs['camera'])}
+            procs = {'controller': nodes.start('controller', controller_args),
+                     'camera': nodes.start('camera', camera_args)}
             try:
-                deadline = time.monotonic() + 60
-                while len(beliefs) < args.frames and time.monotonic() < deadline:
-                    executor.spin_once(timeout_sec=0.05)
-                row = {'cycle': cycle, 'beliefs': len(beliefs)}
-                for name in ('controller', 'camera'):
-                    code, seconds = stop(procs[name], args.timeout_s)
+                seen = beliefs.count
+                probe.wait_until(lambda: beliefs.count - seen >= args.frames, 60, 0.05)
+                row = {'cycle': cycle, 'beliefs': beliefs.count - seen}
+                for name, proc in procs.items():
+                    t0 = time.monotonic()
+                    code = proc.stop(args.timeout_s)
+                    seconds = time.monotonic() - t0
                     times[name].append(seconds)
                     row[name] = {'code': code, 'exit_s': round(seconds, 3)}
                     if code != 0:
                         hangs += 1
                         kept = keep / f'hung-{name}-{cycle}.log'
-                        kept.write_bytes(logs[name].read_bytes())
+                        kept.write_bytes(proc.log_path.read_bytes())
                         row[name]['log'] = str(kept)
             finally:
                 for proc in procs.values():
-                    if proc.poll() is None:
+                    if proc.running:
                         proc.kill()
-                        proc.wait(10)
             print(json.dumps(row), flush=True)
-    finally:
-        executor.shutdown(timeout_sec=1)
-        probe.destroy_node()
-        rclpy.shutdown(context=context)
     summary = {'cycles': args.cycles, 'bad_exits': hangs}
     for name, values in times.items():
         if values:

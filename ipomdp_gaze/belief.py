@@ -11,6 +11,8 @@ single belief (N,) or a batch (episodes, N).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 TIE_RTOL = 1e-9
@@ -28,6 +30,10 @@ def uniform_log_belief(n_cells: int, episodes: int | None = None) -> np.ndarray:
 
 def normalize_log(log_belief: np.ndarray) -> np.ndarray:
     """Renormalise in place so that ``sum exp(log_belief) = 1`` (log-sum-exp); returns it."""
+    if log_belief.ndim == 1:                    # one belief (the controller): scalar reductions
+        log_belief -= log_belief.max()
+        log_belief -= math.log(np.add.reduce(np.exp(log_belief)))
+        return log_belief
     peak = np.max(log_belief, axis=-1, keepdims=True)
     log_belief -= peak
     log_belief -= np.log(np.sum(np.exp(log_belief), axis=-1, keepdims=True))

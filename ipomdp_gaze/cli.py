@@ -3,9 +3,10 @@
 """
 The ``ipomdp-gaze`` command line: one subcommand per job.
 
-Each subcommand lives in its own module under ``ipomdp_gaze.commands`` with ``add_parser(sub)``
-(registering its arguments and a ``run(args) -> int``). A bad argument or input file exits
-non-zero with one clear line on stderr, never a traceback.
+Each module under ``ipomdp_gaze.commands`` has ``add_parser(sub)``, which registers its
+subcommands (one, or for :mod:`ipomdp_gaze.commands.nodes` one per node) with their arguments
+and a ``run(args) -> int``. A bad argument or input file exits non-zero with one clear line on
+stderr, never a traceback.
 """
 from __future__ import annotations
 
@@ -13,8 +14,9 @@ import argparse
 import importlib
 import sys
 
-# Modules under ipomdp_gaze.commands, in the order --help lists them.
-COMMANDS = ('evaluate', 'search', 'train', 'reproduce', 'demo', 'controller', 'camera')
+# Modules under ipomdp_gaze.commands, in the order --help lists their subcommands: evaluate,
+# search, train, reproduce, demo, then controller and camera (both from nodes).
+COMMANDS = ('evaluate', 'search', 'train', 'reproduce', 'demo', 'nodes')
 
 
 class CliError(Exception):

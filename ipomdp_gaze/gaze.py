@@ -14,8 +14,12 @@ target's cell and the current fixation, and decides what to do with every frame 
   observation), NaN cells count as unobserved, and the policy chooses the next fixation at once.
 
 Every frame is counted: ``received = applied + rejected + skipped``. The first fixation after a
-reset is the start cell (the centre by default, docs/design.md section 4); the policy picks the rest.
-Times are plain seconds on whatever clock the caller uses (the node's ROS clock).
+reset is the start cell (the centre by default, docs/design.md section 4); the policy picks the
+rest. Times are plain seconds on whatever clock the caller uses (the node's ROS clock).
+
+The settings are checked here, once: :func:`check_confidence`, :func:`check_settle_time` and
+:func:`start_cell` serve both the setters of :class:`GazeController` and the node, which checks
+a proposed parameter set before it takes it.
 """
 from __future__ import annotations
 
@@ -26,6 +30,54 @@ import numpy as np
 from .belief import bayes_update, entropy, EvidenceError, map_cell, uniform_log_belief
 from .grid import Grid
 from .observation import as_observation, check_evidence
+
+
+def check_confidence(confidence: float) -> float:
+    """
+    Return the confidence level of the found event as a float.
+
+    Raises
+    ------
+    ValueError
+        Unless ``0 < confidence < 1``.
+
+    """
+    if not 0 < confidence < 1:
+        raise ValueError(f'confidence must be between 0 and 1 (exclusive), got {confidence!r}')
+    return float(confidence)
+
+
+def check_settle_time(settle_time_s: float) -> float:
+    """
+    Return the settle time in seconds as a float.
+
+    Raises
+    ------
+    ValueError
+        Unless it is finite and >= 0.
+
+    """
+    if not np.isfinite(settle_time_s) or settle_time_s < 0:
+        raise ValueError(f'settle_time_s must be finite and >= 0, got {settle_time_s!r}')
+    return float(settle_time_s)
+
+
+def start_cell(grid: Grid, row: int | None = None, col: int | None = None) -> int:
+    """
+    Return the cell of the first fixation after a reset: ``(row, col)``, the centre where None.
+
+    Raises
+    ------
+    ValueError
+        If the cell is outside the grid.
+
+    """
+    centre_row, centre_col = grid.cell(grid.center_index)
+    row = centre_row if row is None else int(row)
+    col = centre_col if col is None else int(col)
+    if not (0 <= row < grid.rows and 0 <= col < grid.cols):
+        raise ValueError(f'start cell ({row}, {col}) is outside a {grid.rows}x{grid.cols} grid')
+    return grid.index(row, col)
 
 
 @dataclass(frozen=True)
@@ -147,15 +199,11 @@ class GazeController:
 
     def set_settle_time(self, settle_time_s: float) -> None:
         """Seconds after sending a target before a frame may be used."""
-        if not np.isfinite(settle_time_s) or settle_time_s < 0:
-            raise ValueError(f'settle_time_s must be finite and >= 0, got {settle_time_s!r}')
-        self.settle_time_s = float(settle_time_s)
+        self.settle_time_s = check_settle_time(settle_time_s)
 
     def set_confidence(self, confidence: float) -> None:
         """Probability of the most likely cell at which the found event fires."""
-        if not 0 < confidence < 1:
-            raise ValueError(f'confidence must be between 0 and 1 (exclusive), got {confidence!r}')
-        self.confidence = float(confidence)
+        self.confidence = check_confidence(confidence)
 
     def reseed(self, seed: int) -> None:
         """Restart the policy's random stream."""
@@ -266,7 +314,9 @@ class GazeController:
         self.applied += 1
         self.fixations += 1
         found = None
-        if self.found is None and self.map_probability >= self.confidence:
+        # max() first: map_probability (the tie rule's cell) is only needed when it can fire.
+        if self.found is None and self._belief.max() >= self.confidence \
+                and self.map_probability >= self.confidence:
             found = self.found = Found(self.map_cell, self.map_probability, self.fixations)
         self.fixation = self.choose()
         self.target_time_s = self.usable_time_s = float(stamp_s if now_s is None else now_s)

@@ -21,6 +21,7 @@ and ``N(0, 1)`` elsewhere, with ``d_jk`` from an FPOC. Its log-likelihood ratio 
 """
 from __future__ import annotations
 
+import math
 import operator
 
 import numpy as np
@@ -83,6 +84,8 @@ def gaussian_log_likelihood_ratio(observation: np.ndarray, dprime: np.ndarray,
         return dprime * (observation - 0.5 * dprime)
     with np.errstate(over='ignore', invalid='ignore'):
         term = dprime * (observation - 0.5 * dprime)
+        if math.isfinite(np.add.reduce(term, axis=None)):   # every cell observed and finite
+            return term
     term = np.where(np.isnan(observation), 0.0, term)
     bad = ~np.isfinite(term)
     if np.any(bad):

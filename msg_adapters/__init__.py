@@ -8,8 +8,8 @@ Submodules
 grid_arrays
     Grid-shaped ``Float32MultiArray`` (belief, evidence) and the ``Int32MultiArray`` ground truth.
 joints
-    Cell <-> pan/tilt angles (REP 103 signs, offsets, limits) and the head commands
-    (``JointState``, ``Float64MultiArray``, ``JointTrajectory``).
+    The head commands (``JointState``, ``Float64MultiArray``, ``JointTrajectory``) of the
+    angles that :class:`ipomdp_gaze.head.PanTiltMap` gives a cell.
 images
     The colour-mapped belief heatmap (``rgb8``) and ``32FC1`` evidence images.
 diagnostics

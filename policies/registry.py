@@ -3,9 +3,9 @@
 """
 Build a policy from a name, a kernel or a policy file: the one place that does it.
 
-The controller node, the ``evaluate`` command and the benches call :func:`build_policy`; a
-kernel is checked once (by :class:`ipomdp_gaze.policies.conv.ConvPolicy`), a policy file once
-(by :mod:`ipomdp_gaze.policies.policy_file`).
+The controller node, the ``evaluate`` and ``search`` commands and the benches call
+:func:`build_policy`; a kernel is checked once (by :class:`ipomdp_gaze.policies.conv.ConvPolicy`),
+a policy file once (by :mod:`ipomdp_gaze.policies.policy_file`).
 """
 from __future__ import annotations
 

@@ -1,20 +1,18 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-Helpers of the robustness tests: /proc readings, the controller's diagnostics, parameter calls.
+Helpers of the robustness tests: /proc readings and policy files that must be refused.
 
-``make soak`` runs the long versions (``pytest -m soak``); ``make test`` runs the short ones.
+The controller's diagnostics, services and parameters are reached through the ``probe`` fixture
+(:class:`ipomdp_gaze.nodes.watch.Watch`). ``make soak`` runs the long versions
+(``pytest -m soak``); ``make test`` runs the short ones.
 """
 from __future__ import annotations
 
-from collections import deque
 import os
 import threading
 import time
 
-from conftest import wait_for
-
-CONTROLLER = 'gaze_controller'
 CLOCK_TICKS = os.sysconf('SC_CLK_TCK')
 PAGE_BYTES = os.sysconf('SC_PAGE_SIZE')
 
@@ -65,124 +63,6 @@ class RssSampler:
         self._stop.set()
         self._thread.join(5)
         return self.samples
-
-
-class Diagnostics:
-    """The latest ``<node>: search`` status of the controller on ``/diagnostics`` (level: int)."""
-
-    def __init__(self, probe, node: str = CONTROLLER):
-        from diagnostic_msgs.msg import DiagnosticArray
-        self.suffix = f'{node}: search'
-        self.values: dict = {}
-        self.level = self.message = None
-        self.count = 0
-        self.history = deque(maxlen=200)
-        probe.node.create_subscription(DiagnosticArray, '/diagnostics', self._on_message, 50)
-
-    def _on_message(self, msg):
-        for status in msg.status:
-            if status.name.endswith(self.suffix):
-                self.values = {kv.key: kv.value for kv in status.values}
-                level = status.level
-                self.level = int.from_bytes(level, 'little') if isinstance(level, bytes) \
-                    else int(level)
-                self.message = status.message
-                self.history.append((self.level, self.message))
-                self.count += 1
-
-    def counter(self, name: str) -> int:
-        """Return the counter ``frames_<name>`` (-1 before the first status)."""
-        return int(self.values.get(f'frames_{name}', -1))
-
-    def counters(self) -> dict:
-        """Return the frame counters received, applied, rejected, skipped and dropped."""
-        return {k: self.counter(k) for k in ('received', 'applied', 'rejected', 'skipped',
-                                             'dropped')}
-
-    def wait_fresh(self, timeout_s: float = 20.0) -> dict:
-        """Wait for a status published after this call; return the counters."""
-        n = self.count
-        assert wait_for(lambda: self.count > n + 1, timeout_s), 'no /diagnostics from the node'
-        return self.counters()
-
-
-class Latest:
-    """Keep only the latest message of a topic and how many arrived (no unbounded list)."""
-
-    def __init__(self, probe, msg_type, topic: str, qos=10):
-        self.msg = None
-        self.count = 0
-        probe.node.create_subscription(msg_type, topic, self._on_message, qos)
-
-    def _on_message(self, msg):
-        self.msg = msg
-        self.count += 1
-
-
-class Parameters:
-    """Persistent SetParameters / GetParameters clients of one node (no discovery per call)."""
-
-    def __init__(self, probe, node: str = CONTROLLER, timeout_s: float = 30.0):
-        from rcl_interfaces.srv import GetParameters, SetParameters, SetParametersAtomically
-        self.timeout_s = timeout_s
-        self._set = probe.node.create_client(SetParameters, f'/{node}/set_parameters')
-        self._atomic = probe.node.create_client(SetParametersAtomically,
-                                                f'/{node}/set_parameters_atomically')
-        self._get = probe.node.create_client(GetParameters, f'/{node}/get_parameters')
-        for client in (self._set, self._atomic, self._get):
-            assert client.wait_for_service(timeout_sec=timeout_s), f'{node} has no services'
-
-    def _call(self, client, request):
-        future = client.call_async(request)
-        assert wait_for(future.done, self.timeout_s, 0.001), 'parameter service did not answer'
-        return future.result()
-
-    def set_each(self, params: list) -> list:
-        """Set ``rclpy.parameter.Parameter`` objects one by one (``ros2 param set``)."""
-        from rcl_interfaces.srv import SetParameters
-        request = SetParameters.Request(parameters=[p.to_parameter_msg() for p in params])
-        return list(self._call(self._set, request).results)
-
-    def set_atomically(self, params: list):
-        """Set ``rclpy.parameter.Parameter`` objects all or none; return the result."""
-        from rcl_interfaces.srv import SetParametersAtomically
-        request = SetParametersAtomically.Request(
-            parameters=[p.to_parameter_msg() for p in params])
-        return self._call(self._atomic, request).result
-
-    def get(self, names) -> dict:
-        """Return ``{name: python value}``."""
-        from rcl_interfaces.srv import GetParameters
-        from rclpy.parameter import parameter_value_to_python
-        response = self._call(self._get, GetParameters.Request(names=list(names)))
-        return {n: parameter_value_to_python(v) for n, v in zip(names, response.values)}
-
-
-class Services:
-    """Persistent ``~/reset`` and ``~/enable`` clients of the controller."""
-
-    def __init__(self, probe, node: str = CONTROLLER, timeout_s: float = 30.0):
-        from std_srvs.srv import SetBool, Trigger
-        self.timeout_s = timeout_s
-        self._reset = probe.node.create_client(Trigger, f'/{node}/reset')
-        self._enable = probe.node.create_client(SetBool, f'/{node}/enable')
-        for client in (self._reset, self._enable):
-            assert client.wait_for_service(timeout_sec=timeout_s), f'{node} has no services'
-
-    def _call(self, client, request):
-        future = client.call_async(request)
-        assert wait_for(future.done, self.timeout_s, 0.001), 'service did not answer'
-        return future.result()
-
-    def reset(self):
-        """Call ``~/reset``; return the response."""
-        from std_srvs.srv import Trigger
-        return self._call(self._reset, Trigger.Request())
-
-    def enable(self, flag: bool):
-        """Call ``~/enable``; return the response."""
-        from std_srvs.srv import SetBool
-        return self._call(self._enable, SetBool.Request(data=bool(flag)))
 
 
 def bad_policy_files(folder, grid_rows: int = 11, grid_cols: int = 11, marker=None) -> dict:

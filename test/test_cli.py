@@ -2,6 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The ``ipomdp-gaze`` command line: help, JSON output and one-line errors."""
 import json
+import re
 import subprocess
 import sys
 
@@ -19,6 +20,19 @@ def test_help_lists_subcommands():
     assert out.returncode == 0
     for name in ('evaluate', 'search', 'demo'):
         assert name in out.stdout
+    assert re.findall(r'^    (\w+)', out.stdout, re.M) == [
+        'evaluate', 'search', 'train', 'reproduce', 'demo', 'controller', 'camera']
+
+
+@pytest.mark.parametrize('command, node', [('controller', 'gaze_controller'),
+                                           ('camera', 'simulated_camera')])
+def test_node_subcommands_run_their_node(command, node, capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main([command, '--help'])
+    assert exit_info.value.code == 0
+    out = ' '.join(capsys.readouterr().out.split())
+    assert f'usage: ipomdp-gaze {command} [-h] [--ros-args ...]' in out
+    assert f'Run the {node} node, exactly as `ros2 run ipomdp_gaze {command}` does' in out
 
 
 @pytest.mark.parametrize('args, message', [

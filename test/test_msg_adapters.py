@@ -9,8 +9,10 @@ import math
 from builtin_interfaces.msg import Time
 from ipomdp_gaze.belief import EvidenceError
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, stamps
 from ipomdp_gaze.msg_adapters.grid_arrays import LayoutError
+from ipomdp_gaze.render import MARK_RGB
 import numpy as np
 import pytest
 from sensor_msgs.msg import Image, JointState
@@ -95,60 +97,9 @@ def test_ground_truth_round_trip_and_checks():
         grid_arrays.cell_from_ground_truth(Int32MultiArray(data=[1]), GRID)
 
 
-# -- pan/tilt -----------------------------------------------------------------------------------
-@pytest.mark.parametrize('row, col, pan_deg, tilt_deg', [
-    (5, 5, 0.0, 0.0),
-    (0, 0, 25.0, -25.0),       # top left: turn left (+pan), look up (-tilt)
-    (10, 10, -25.0, 25.0),     # bottom right: turn right, look down
-    (5, 6, -5.0, 0.0),
-    (4, 5, 0.0, -5.0),
-])
-def test_rep103_angles_of_known_cells(row, col, pan_deg, tilt_deg):
-    head = joints.PanTiltMap(GRID)
-    pan, tilt = head.angles(GRID.index(row, col))
-    assert pan == pytest.approx(pan_deg * DEG, abs=1e-12)
-    assert tilt == pytest.approx(tilt_deg * DEG, abs=1e-12)
-
-
-def test_signs_and_offsets():
-    head = joints.PanTiltMap(GRID, pan_sign=-1, tilt_sign=-1, pan_offset_rad=0.1,
-                             tilt_offset_rad=-0.2)
-    pan, tilt = head.angles(GRID.index(0, 0))
-    assert pan == pytest.approx(-25 * DEG + 0.1)
-    assert tilt == pytest.approx(25 * DEG - 0.2)
-
-
-@pytest.mark.parametrize('kwargs', [{}, {'pan_sign': -1}, {'tilt_sign': -1, 'pan_offset_rad': 0.3},
-                                    {'tilt_offset_rad': -0.05}])
-def test_nearest_cell_inverts_angles(kwargs):
-    head = joints.PanTiltMap(GRID, **kwargs)
-    cells = np.arange(GRID.n_cells)
-    pan, tilt = head.angles(cells)
-    jitter = 0.4 * head.spacing_rad
-    back = [head.nearest_cell(p + jitter, t - jitter) for p, t in zip(pan, tilt)]
-    assert back == list(cells)
-
-
-def test_nearest_cell_clips_to_the_grid():
-    head = joints.PanTiltMap(GRID)
-    assert head.nearest_cell(3.0, -3.0) == GRID.index(0, 0)
-    with pytest.raises(ValueError, match='finite'):
-        head.nearest_cell(float('nan'), 0.0)
-
-
-def test_limits_must_contain_every_cell():
-    with pytest.raises(ValueError, match=r'cell \(\d+, 0\) needs pan 0.4363 rad.*limits'):
-        joints.PanTiltMap(GRID, pan_limits_rad=(-1.0, 0.4))
-    with pytest.raises(ValueError, match='min < max'):
-        joints.PanTiltMap(GRID, tilt_limits_rad=(1.0, -1.0))
-    with pytest.raises(ValueError, match='must differ'):
-        joints.PanTiltMap(GRID, pan_joint='head', tilt_joint='head')
-    with pytest.raises(ValueError, match='pan_sign'):
-        joints.PanTiltMap(GRID, pan_sign=2)
-
-
+# -- pan/tilt messages --------------------------------------------------------------------------
 def test_joint_state_messages():
-    head = joints.PanTiltMap(GRID, pan_joint='head_pan', tilt_joint='head_tilt')
+    head = PanTiltMap(GRID, pan_joint='head_pan', tilt_joint='head_tilt')
     msg = joints.joint_state(head, GRID.index(0, 10), Time(sec=5, nanosec=7))
     assert list(msg.name) == ['head_pan', 'head_tilt']
     np.testing.assert_allclose(msg.position, [-25 * DEG, -25 * DEG])
@@ -163,7 +114,7 @@ def test_joint_state_messages():
 
 
 def test_ros2_control_commands():
-    head = joints.PanTiltMap(GRID)
+    head = PanTiltMap(GRID)
     cell = GRID.index(1, 2)
     fwd = joints.forward_command(head, cell)
     np.testing.assert_allclose(fwd.data, head.angles(cell))
@@ -186,14 +137,8 @@ def test_belief_image_size_encoding_and_marks():
     img = images.rgb8_array(msg)
     assert tuple(img[2 * 16 + 8, 3 * 16 + 8]) == (253, 231, 37)      # the peak: yellow
     assert tuple(img[0, 0]) == (68, 1, 84)                           # near zero: dark purple
-    assert tuple(img[8 * 16, 8 * 16 + 8]) == images.MARK_RGB         # outline of the fixation
-    assert tuple(img[8 * 16 + 8, 8 * 16 + 8]) != images.MARK_RGB     # its inside is the belief
-
-
-def test_colour_map_is_monotone_in_brightness():
-    rgb = images.colour_map(np.linspace(0, 1, 50)).astype(float)
-    luminance = rgb @ [0.2126, 0.7152, 0.0722]
-    assert np.all(np.diff(luminance) > 0)
+    assert tuple(img[8 * 16, 8 * 16 + 8]) == MARK_RGB         # outline of the fixation
+    assert tuple(img[8 * 16 + 8, 8 * 16 + 8]) != MARK_RGB     # its inside is the belief
 
 
 @pytest.mark.parametrize('big_endian', [False, True])

@@ -23,7 +23,7 @@ import textwrap
 from conftest import HAVE_RCLPY, REPO, wait_for
 import numpy as np
 import pytest
-from robust_support import cpu_fraction, Diagnostics, Latest, Services
+from robust_support import cpu_fraction
 
 pytestmark = [pytest.mark.ros,
               pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
@@ -42,72 +42,34 @@ CAMERA_ARGS = TASK + ['-p', f'target_row:={TARGET[0]}', '-p', f'target_col:={TAR
                       '-p', 'seed:=5']
 
 
-class Nodes:
-    """Node processes of this module; some are killed on purpose."""
-
-    def __init__(self, env, logs):
-        self.env, self.logs = env, logs
-        self.started, self.killed = [], []
-
-    def start(self, node: str, args):
-        """Start a node process."""
-        from ipomdp_gaze.nodes.processes import NodeProcess
-        log = self.logs / f'{node}-{len(self.started)}.log'
-        self.started.append(NodeProcess(node, args, self.env, log).start())
-        return self.started[-1]
-
-    def kill(self, proc) -> None:
-        """SIGKILL a node: no clean-up at all, as in a crash."""
-        proc.proc.kill()
-        proc.proc.wait(10)
-        self.killed.append(proc)
-
-    def last(self, node: str):
-        """Return the node process of this kind started last."""
-        return next(p for p in reversed(self.started) if p.node == node)
-
-
-@pytest.fixture(scope='module')
-def nodes(ros_env, tmp_path_factory):
-    """Start nodes; at teardown each one not killed gets SIGTERM and must exit with 0."""
-    nodes = Nodes(ros_env, tmp_path_factory.mktemp('fault_logs'))
-    yield nodes
-    codes = [(p, p.stop()) for p in nodes.started if p not in nodes.killed]
-    bad = [f'{p.node}: exit status {code}\n{p.output()[-3000:]}' for p, code in codes if code]
-    assert not bad, 'nodes did not shut down cleanly:\n' + '\n'.join(bad)
-
-
 class Watch:
-    """What the probe sees of the search: beliefs, targets, camera poses and frames, found."""
+    """What the probe sees of the search: beliefs, targets, camera poses and frames, status."""
 
     def __init__(self, probe):
-        from diagnostic_msgs.msg import DiagnosticStatus
         from ipomdp_gaze.grid import Grid
-        from ipomdp_gaze.msg_adapters import joints
-        from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+        from ipomdp_gaze.head import PanTiltMap
+        from ipomdp_gaze.nodes.watch import SearchRecord
+        from rclpy.qos import QoSProfile, ReliabilityPolicy
         from sensor_msgs.msg import JointState
         from std_msgs.msg import Float32MultiArray
-        latched = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE,
-                             durability=DurabilityPolicy.TRANSIENT_LOCAL)
         self.grid = Grid(11, 11, 5.0)
-        self.head = joints.PanTiltMap(self.grid)
-        self.beliefs = probe.record(Float32MultiArray, 'belief', 200)
-        self.targets = probe.record(JointState, 'pan_tilt', latched, distinct_stamps=True)
+        self.head = PanTiltMap(self.grid)
+        self.search = SearchRecord(probe)
+        self.beliefs, self.targets = self.search.beliefs, self.search.targets
         self.poses = probe.record(JointState, 'joint_states', 200)
         best_effort = QoSProfile(depth=200, reliability=ReliabilityPolicy.BEST_EFFORT)
         self.frames = probe.record(Float32MultiArray, 'evidence', best_effort)
-        self.found = Latest(probe, DiagnosticStatus, 'found', 10)
-        self.diag = Diagnostics(probe)
+        self.diag = probe.search_status()
 
     def cell(self, msg) -> int:
         from ipomdp_gaze.msg_adapters import joints
         return self.head.nearest_cell(*joints.angles_from_joint_state(msg, self.head))
 
     def belief(self, i=-1) -> np.ndarray:
-        return np.asarray(self.beliefs[i][1].data, dtype=np.float64)
+        return self.search.belief(i)
 
     def finished(self, since: int) -> bool:
-        return any(max(m.data) >= 0.999 for _, m in self.beliefs[since:])
+        return self.search.reached(0.999, since) is not None
 
 
 @pytest.fixture(scope='module')
@@ -126,11 +88,11 @@ def _posterior(belief, frame, fixation, grid) -> np.ndarray:
     return np.exp(log_b - np.logaddexp.reduce(log_b))
 
 
-def _mid_search(probe, watch, services):
+def _mid_search(probe, watch):
     """Reset; wait for a search with a few applied frames that has not found the target."""
     for _ in range(5):
         n = len(watch.beliefs)
-        assert services.reset().success
+        assert probe.reset().success
         assert wait_for(lambda: len(watch.beliefs) >= n + 4, 30), 'the search did not start'
         if not watch.finished(n):
             return
@@ -141,9 +103,8 @@ def test_camera_killed_mid_search_then_restarted(nodes, probe, watch):
     controller = nodes.start('controller', CONTROLLER_ARGS)
     camera = nodes.start('camera', CAMERA_ARGS)
     assert wait_for(lambda: watch.diag.count > 0, 30), controller.output()
-    services = Services(probe)
     assert wait_for(lambda: watch.poses, 30), camera.output()
-    _mid_search(probe, watch, services)
+    _mid_search(probe, watch)
 
     nodes.kill(camera)
     wait_for(lambda: False, 0.3)                 # frames in flight arrive or are lost
@@ -170,7 +131,7 @@ def test_camera_killed_mid_search_then_restarted(nodes, probe, watch):
     # re-sends the target, which reaches the new camera, and the camera's frame taken there
     # updates the kept belief by Bayes' rule.
     target = watch.cell(watch.targets[-1][1])
-    assert services.enable(False).success
+    assert probe.enable(False).success
     graph = probe.node
     publishers = graph.count_publishers('evidence'), graph.count_publishers('joint_states')
     camera = nodes.start('camera', CAMERA_ARGS)
@@ -179,7 +140,7 @@ def test_camera_killed_mid_search_then_restarted(nodes, probe, watch):
     wait_for(lambda: False, 0.5)                 # let the probe's side of the match settle
     n_frames, n_poses = len(watch.frames), len(watch.poses)
     assert len(watch.beliefs) == kept_beliefs
-    assert services.enable(True).success
+    assert probe.enable(True).success
     assert wait_for(lambda: any(watch.cell(m) == target for _, m in watch.poses[n_poses:]), 30), \
         (target, [watch.cell(m) for _, m in watch.poses[n_poses:]], camera.output())
     assert wait_for(lambda: len(watch.beliefs) > kept_beliefs, 30), controller.output()
@@ -196,10 +157,9 @@ def test_camera_killed_mid_search_then_restarted(nodes, probe, watch):
 
 
 def test_controller_killed_and_restarted_camera_keeps_serving(nodes, probe, watch):
-    from std_srvs.srv import Trigger
     controller, camera = nodes.last('controller'), nodes.last('camera')
     nodes.kill(controller)
-    reply = probe.call(Trigger, '/simulated_camera/reset', Trigger.Request())
+    reply = probe.reset('simulated_camera')
     assert reply.success and f'({TARGET[0]}, {TARGET[1]})' in reply.message
     n = len(watch.beliefs)
     controller = nodes.start('controller', CONTROLLER_ARGS)

@@ -26,11 +26,12 @@ import time
 from conftest import HAVE_RCLPY, wait_for
 import numpy as np
 import pytest
-from robust_support import bad_policy_files, Diagnostics, Latest, Parameters, Services
+from robust_support import bad_policy_files
 
 pytestmark = [pytest.mark.ros,
               pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
 
+CONTROLLER = 'gaze_controller'
 ROWS = COLS = 11
 N = ROWS * COLS
 QUEUE = 64
@@ -52,14 +53,13 @@ def fuzz(launch, probe, tmp_path_factory):
     from sensor_msgs.msg import Image
     rig = {
         'proc': proc,
-        'diag': Diagnostics(probe),
-        'belief': Latest(probe, Float32MultiArray, 'belief', 10),
+        'probe': probe,
+        'diag': probe.search_status(),
+        'belief': probe.latest(Float32MultiArray, 'belief', 10),
         'evidence': probe.publisher(Float32MultiArray, 'evidence', qos),
         'image': probe.publisher(Image, 'evidence_image', qos),
         'folder': tmp_path_factory.mktemp('fuzz_policies'),
     }
-    rig['params'] = Parameters(probe)
-    rig['services'] = Services(probe)
     assert wait_for(lambda: rig['evidence'].get_subscription_count() > 0 and
                     rig['image'].get_subscription_count() > 0, 30), proc.output()
     rig['diag'].wait_fresh()
@@ -262,16 +262,16 @@ class ParameterFuzz:
             ('retry', [p('retry_period_s', float(rng.choice([0.0, 0.5, 2.0])))], True, ''),
         ]
 
-    def send(self, params: Parameters, count: int) -> dict:
+    def send(self, probe, count: int) -> dict:
         """Send ``count`` random requests; check each answer; return counts per outcome."""
         tally = {'accepted': 0, 'refused': 0}
         for _ in range(count):
             options = self.requests()
             name, values, successful, words = options[self.rng.integers(len(options))]
             if len(values) == 1:
-                result = params.set_each(values)[0]
+                result = probe.set_parameters(CONTROLLER, values)[0]
             else:
-                result = params.set_atomically(values)
+                result = probe.set_parameters_atomically(CONTROLLER, values)
             assert result.successful == successful, (name, result.reason)
             if successful:
                 tally['accepted'] += 1
@@ -303,7 +303,7 @@ def _run_fuzz(rig, messages: int, param_requests: int, seed: int) -> dict:
     rng = np.random.default_rng(seed)
     frames = Frames(rng)
     kinds = frames.kind_names()
-    diag, services, params = rig['diag'], rig['services'], rig['params']
+    diag, probe = rig['diag'], rig['probe']
     files = bad_policy_files(rig['folder'], ROWS, COLS)
     pfuzz = ParameterFuzz(rng, files, str(rig['folder'] / 'good.yaml'))
     start = diag.wait_fresh()
@@ -317,11 +317,12 @@ def _run_fuzz(rig, messages: int, param_requests: int, seed: int) -> dict:
         disabled = b % 10 == 9
         hostile = b % 25 == 12                     # d' so large every observed term overflows
         if disabled:
-            assert services.enable(False).success
+            assert probe.enable(False).success
         if hostile:
             hostile_bursts += 1
-            policy = params.get(['policy.name'])['policy.name']
-            result = params.set_atomically(_fpoc(1e300, 'map'))   # ELM's d'^2 would overflow
+            policy = probe.get_parameters(CONTROLLER, ['policy.name'])['policy.name']
+            # ELM's d'^2 would overflow.
+            result = probe.set_parameters_atomically(CONTROLLER, _fpoc(1e300, 'map'))
             assert result.successful, result.reason
         for _ in range(n):
             kind = 'valid' if hostile else kinds[rng.integers(len(kinds))]
@@ -336,17 +337,17 @@ def _run_fuzz(rig, messages: int, param_requests: int, seed: int) -> dict:
         sent += n
         _wait_received(rig, start['received'] + sent)
         if disabled:
-            assert services.enable(True).success
+            assert probe.enable(True).success
         if hostile:
-            result = params.set_atomically(_fpoc(4.0, policy))
+            result = probe.set_parameters_atomically(CONTROLLER, _fpoc(4.0, policy))
             assert result.successful, result.reason
             pfuzz.expected.update({'fpoc.model': 'camera', 'fpoc.dprime': 4.0})
             assert 'overflows' in diag.values.get('last_rejection', ''), \
                 diag.values
         if b % 40 == 20:
-            assert services.reset().success
+            assert probe.reset().success
         share = param_requests * (b + 1) // bursts - param_requests * b // bursts
-        for outcome, k in pfuzz.send(params, share).items():
+        for outcome, k in pfuzz.send(probe, share).items():
             param_tally[outcome] += k
     seconds = time.monotonic() - t0
     end = diag.wait_fresh()
@@ -385,13 +386,14 @@ def test_fuzzed_controller_keeps_serving_and_counts_every_frame(fuzz, messages,
     # The valid parameter changes all took effect; nothing else changed.
     expected = report['expected_params']
     if expected:
-        current = fuzz['params'].get(list(expected))
+        current = fuzz['probe'].get_parameters(CONTROLLER, list(expected))
         for name, value in expected.items():
             if isinstance(value, list) and value:
                 np.testing.assert_array_equal(current[name], value, err_msg=name)
             else:
                 assert current[name] == value or (value == [] and len(current[name]) == 0), name
-    assert fuzz['params'].get(['grid.rows', 'grid.cols', 'evidence_queue_depth']) == {
+    assert fuzz['probe'].get_parameters(
+        CONTROLLER, ['grid.rows', 'grid.cols', 'evidence_queue_depth']) == {
         'grid.rows': ROWS, 'grid.cols': COLS, 'evidence_queue_depth': QUEUE}
     _assert_serving(fuzz)
     # Every rejection was counted with its reason; the log names the reason, throttled.
@@ -404,11 +406,11 @@ def test_fuzzed_controller_keeps_serving_and_counts_every_frame(fuzz, messages,
 
 def _assert_serving(rig):
     """Check the services answer and a fresh search starts uniform and updates normally."""
-    services, belief, diag = rig['services'], rig['belief'], rig['diag']
+    probe, belief, diag = rig['probe'], rig['belief'], rig['diag']
     frames = Frames(np.random.default_rng(0))
-    assert services.enable(True).success
+    assert probe.enable(True).success
     n = belief.count
-    assert services.reset().success
+    assert probe.reset().success
     assert wait_for(lambda: belief.count > n, 20)
     b = np.asarray(belief.msg.data, dtype=np.float64)
     np.testing.assert_allclose(b, 1 / N, rtol=1e-6)
@@ -429,14 +431,14 @@ def test_bad_policy_files_are_refused_parameters(fuzz, tmp_path):
     from rclpy.parameter import Parameter
     marker = tmp_path / 'unsafe-loader-was-used'
     files = bad_policy_files(tmp_path, ROWS, COLS, marker=marker)
-    params = fuzz['params']
-    before = params.get(['policy.name', 'policy.file', 'policy.kernel'])
+    probe = fuzz['probe']
+    before = probe.get_parameters(CONTROLLER, ['policy.name', 'policy.file', 'policy.kernel'])
     for name, (path, words) in files.items():
-        result = params.set_each([Parameter('policy.file', value=path)])[0]
+        result = probe.set_parameters(CONTROLLER, [Parameter('policy.file', value=path)])[0]
         assert not result.successful, name
         assert words in result.reason and '\n' not in result.reason, (name, result.reason)
     assert not marker.exists()
-    after = params.get(['policy.name', 'policy.file', 'policy.kernel'])
+    after = probe.get_parameters(CONTROLLER, ['policy.name', 'policy.file', 'policy.kernel'])
     assert after['policy.name'] == before['policy.name']
     assert after['policy.file'] == before['policy.file']
     assert list(after['policy.kernel']) == list(before['policy.kernel'])

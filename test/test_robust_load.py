@@ -25,7 +25,7 @@ import sys
 
 from conftest import HAVE_RCLPY, REPO, wait_for
 import pytest
-from robust_support import Diagnostics, Latest, RssSampler
+from robust_support import RssSampler
 
 pytestmark = [pytest.mark.ros,
               pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
@@ -51,8 +51,8 @@ def _run(launch, probe, ros_env, rows, rate_hz, seconds, burst):
         '-p', f'grid.spacing_deg:={spacing}', '-p', f'policy.name:={policy}',
         '-p', 'diagnostics_period_s:=0.25'])
     from sensor_msgs.msg import Image
-    diag = Diagnostics(probe)
-    viewer = Latest(probe, Image, 'belief_image', 2)          # someone watches the heatmap
+    diag = probe.search_status()
+    viewer = probe.latest(Image, 'belief_image', 2)           # someone watches the heatmap
     flood = _flood(ros_env, rows, rate_hz, seconds, burst)    # it waits for the controller
     try:
         assert wait_for(lambda: diag.count > 0, 60), proc.output()

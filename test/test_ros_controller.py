@@ -26,21 +26,20 @@ class Camera:
     """This test as the camera: sends frames, sees the controller's beliefs and targets."""
 
     def __init__(self, probe, launch):
-        from diagnostic_msgs.msg import DiagnosticArray
         from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
         from ipomdp_gaze.grid import Grid
-        from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-        from sensor_msgs.msg import Image, JointState
+        from ipomdp_gaze.head import PanTiltMap
+        from ipomdp_gaze.nodes.watch import SearchRecord
+        from sensor_msgs.msg import Image
         from std_msgs.msg import Float32MultiArray
         self.grid = Grid(11, 11, 5.0)
+        self.head = PanTiltMap(self.grid)
         self.d = dprime_matrix(self.grid, make_fpoc('camera', half_width_deg=10.0,
                                                     half_height_deg=10.0))
-        latched = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE,
-                             durability=DurabilityPolicy.TRANSIENT_LOCAL)
         self.probe = probe
-        self.beliefs = probe.record(Float32MultiArray, 'belief', 100)
-        self.targets = probe.record(JointState, 'pan_tilt', latched, distinct_stamps=True)
-        self.diagnostics = probe.record(DiagnosticArray, '/diagnostics', 50)
+        search = SearchRecord(probe, depth=100)
+        self.beliefs, self.targets = search.beliefs, search.targets
+        self.status = probe.search_status(NODE)
         self.evidence = probe.publisher(Float32MultiArray, 'evidence', 10)
         self.evidence_image = probe.publisher(Image, 'evidence_image', 10)
         self.proc = launch('controller', [
@@ -61,20 +60,15 @@ class Camera:
 
     def fixation(self, i=-1) -> int:
         from ipomdp_gaze.msg_adapters import joints
-        head = joints.PanTiltMap(self.grid)
-        return head.nearest_cell(*joints.angles_from_joint_state(self.targets[i][1], head))
+        return self.head.nearest_cell(*joints.angles_from_joint_state(self.targets[i][1],
+                                                                      self.head))
 
     def counters(self) -> dict:
-        from ipomdp_gaze.msg_adapters import diagnostics
-        for _, msg in reversed(self.diagnostics):
-            for status in msg.status:
-                if status.name.endswith(f'{NODE}: search'):
-                    return diagnostics.values_of(status)
-        return {}
+        return self.status.values
 
     def wait_counters(self, **want) -> dict:
-        n = len(self.diagnostics)
-        ok = wait_for(lambda: len(self.diagnostics) > n + 1 and all(
+        n = self.status.count
+        ok = wait_for(lambda: self.status.count > n + 1 and all(
             self.counters().get(k) == str(v) for k, v in want.items()), 20)
         assert ok, f'diagnostics {self.counters()} never showed {want}'
         return self.counters()
@@ -96,6 +90,19 @@ class Camera:
         assert wait_for(lambda: len(self.beliefs) > nb and len(self.targets) > nt, 20)
         return self.belief(), self.fixation()
 
+    def step_by_bayes(self, frame, belief=None, fixation=None) -> tuple:
+        """
+        Send one valid frame; check the new belief is Bayes' rule on the prior; return both.
+
+        The prior is ``belief`` at ``fixation``, by default the last belief and target received.
+        """
+        if belief is None:
+            belief, fixation = self.belief().astype(np.float64), self.fixation()
+        got_belief, got_next = self.step(frame)
+        np.testing.assert_allclose(got_belief, self.expected(belief, frame, fixation),
+                                   rtol=1e-4, atol=1e-7)
+        return got_belief, got_next
+
     def expected(self, belief, frame, fixation) -> np.ndarray:
         """Compute the posterior offline (float64 from the float32 frame)."""
         d = self.d[:, fixation]
@@ -111,13 +118,11 @@ def cam(probe, launch):
 
 
 def _enable(probe, flag):
-    from std_srvs.srv import SetBool
-    return probe.call(SetBool, f'/{NODE}/enable', SetBool.Request(data=flag))
+    return probe.enable(flag, NODE)
 
 
 def _reset(probe):
-    from std_srvs.srv import Trigger
-    return probe.call(Trigger, f'/{NODE}/reset', Trigger.Request())
+    return probe.reset(NODE)
 
 
 def _set(probe, **values):
@@ -187,11 +192,7 @@ def test_bad_kernel_is_rejected_and_the_old_one_stays(probe, cam, bad, words):
     np.testing.assert_array_equal(probe.get_parameters(NODE, ['policy.kernel'])['policy.kernel'],
                                   old)
     # The node still fixates by the old kernel.
-    belief, fixation = cam.belief().astype(np.float64), cam.fixation()
-    frame = _frames(99, 1)[0]
-    got_belief, got_next = cam.step(frame)
-    np.testing.assert_allclose(got_belief, cam.expected(belief, frame, fixation),
-                               rtol=1e-4, atol=1e-7)
+    got_belief, got_next = cam.step_by_bayes(_frames(99, 1)[0])
     assert got_next == _conv_choice(old, got_belief.astype(np.float64))[0]
 
 
@@ -219,7 +220,7 @@ def test_malformed_evidence_is_rejected_counted_and_throttled(probe, cam):
     from sensor_msgs.msg import Image
     from std_msgs.msg import MultiArrayDimension, MultiArrayLayout
 
-    before = cam.counters()
+    before = cam.wait_counters()            # fresh: /diagnostics comes once a second
     belief, fixation, nb, nt = cam.belief(), cam.fixation(), len(cam.beliefs), len(cam.targets)
     seven = MultiArrayLayout(dim=[MultiArrayDimension(label='rows', size=7, stride=49),
                                   MultiArrayDimension(label='cols', size=7, stride=7)])
@@ -241,18 +242,13 @@ def test_malformed_evidence_is_rejected_counted_and_throttled(probe, cam):
                 if 'rejected an evidence frame' in line]
     assert 1 <= len(warnings) < 6, warnings                          # throttled
     # The node keeps serving: a good frame is applied to the unchanged belief.
-    got_belief, _ = cam.step(good)
-    np.testing.assert_allclose(got_belief, cam.expected(belief, good, fixation),
-                               rtol=1e-4, atol=1e-7)
+    cam.step_by_bayes(good, belief, fixation)
 
 
 def test_nan_cells_are_unobserved(probe, cam):
-    belief, fixation = cam.belief().astype(np.float64), cam.fixation()
     frame = _frames(6, 1)[0]
     frame[::3] = np.nan
-    got_belief, _ = cam.step(frame)
-    np.testing.assert_allclose(got_belief, cam.expected(belief, frame, fixation),
-                               rtol=1e-4, atol=1e-7)
+    cam.step_by_bayes(frame)
 
 
 def test_stamped_evidence_image_is_used(probe, cam):
@@ -268,7 +264,7 @@ def test_stamped_evidence_image_is_used(probe, cam):
 
 
 def test_disable_skips_frames_enable_resends_reset_restarts(probe, cam):
-    before = cam.counters()
+    before = cam.wait_counters()            # fresh: /diagnostics comes once a second
     fixation, nb, nt = cam.fixation(), len(cam.beliefs), len(cam.targets)
     assert _enable(probe, False).message == 'disabled'
     assert _enable(probe, False).message == 'already disabled'
@@ -333,11 +329,7 @@ def test_policy_file_set_remotely(probe, cam, policy_files):
     assert result.successful and result.reason == ''
     params = probe.get_parameters(NODE, ['policy.name', 'policy.kernel'])
     assert params['policy.name'] == 'learned' and list(params['policy.kernel']) == []
-    belief, fixation = cam.belief().astype(np.float64), cam.fixation()
-    frame = _frames(30, 1)[0]
-    got_belief, got_next = cam.step(frame)
-    np.testing.assert_allclose(got_belief, cam.expected(belief, frame, fixation),
-                               rtol=1e-4, atol=1e-7)
+    got_belief, got_next = cam.step_by_bayes(_frames(30, 1)[0])
     assert got_next == _conv_choice(kernel, got_belief.astype(np.float64))[0]
     # Trained on another FPOC: accepted, with a warning in the node's log.
     assert _set(probe, policy__file=policy_files['human'][0])[0].successful

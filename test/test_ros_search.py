@@ -26,20 +26,12 @@ CASES = [(11, None, None), (12, (0, 10), (0, 0)), (13, (10, 1), None), (14, None
 
 @pytest.fixture(scope='module')
 def rig(launch, probe):
-    from diagnostic_msgs.msg import DiagnosticStatus
-    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-    from sensor_msgs.msg import Image, JointState
-    from std_msgs.msg import Float32MultiArray, Int32MultiArray
+    from ipomdp_gaze.nodes.watch import SearchRecord
+    from sensor_msgs.msg import Image
 
-    latched = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE,
-                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
-    rec = {
-        'belief': probe.record(Float32MultiArray, 'belief', 100),
-        'pan_tilt': probe.record(JointState, 'pan_tilt', latched, distinct_stamps=True),
-        'image': probe.record(Image, 'belief_image', 10),
-        'found': probe.record(DiagnosticStatus, 'found', 10),
-        'truth': probe.record(Int32MultiArray, 'ground_truth', latched),
-    }
+    search = SearchRecord(probe, depth=100)
+    rec = {'belief': search.beliefs, 'pan_tilt': search.targets, 'found': search.found,
+           'truth': search.truth, 'image': probe.record(Image, 'belief_image', 10)}
     controller = launch('controller', ['--params-file', config_path('controller.yaml')])
     camera = launch('camera', ['--params-file', config_path('camera.yaml')])
     assert wait_for(lambda: rec['pan_tilt'] and rec['truth'], 30), \
@@ -47,16 +39,14 @@ def rig(launch, probe):
     return rec
 
 
-def _call_trigger(probe, name):
-    from std_srvs.srv import Trigger
-    response = probe.call(Trigger, name, Trigger.Request())
+def _reset(probe, node):
+    response = probe.reset(node)
     assert response.success, response.message
     return response.message
 
 
 def _enable(probe, flag):
-    from std_srvs.srv import SetBool
-    response = probe.call(SetBool, f'/{CONTROLLER}/enable', SetBool.Request(data=flag))
+    response = probe.enable(flag, CONTROLLER)
     assert response.success
     return response.message
 
@@ -75,11 +65,11 @@ def _search(probe, rec, seed, target, start):
         {'start_row': start[0], 'start_col': start[1]}
     assert all(r.successful for r in probe.set_parameters(CONTROLLER, start_params))
     n_truth = len(rec['truth'])
-    _call_trigger(probe, f'/{CAMERA}/reset')
+    _reset(probe, CAMERA)
     assert wait_for(lambda: len(rec['truth']) > n_truth)
     truth = grid_arrays.cell_from_ground_truth(rec['truth'][-1][1], grid)
     n_belief, n_found, n_target = len(rec['belief']), len(rec['found']), len(rec['pan_tilt'])
-    _call_trigger(probe, f'/{CONTROLLER}/reset')
+    _reset(probe, CONTROLLER)
     # The reset publishes a uniform belief; everything after it belongs to this search.
     assert wait_for(lambda: any(np.ptp(np.asarray(m.data)) == 0
                                 for _, m in rec['belief'][n_belief:]))
@@ -112,8 +102,9 @@ def test_most_likely_cell_is_the_target_at_0999(searches):
 
 def test_found_event(searches):
     from ipomdp_gaze.grid import Grid
-    from ipomdp_gaze.msg_adapters import diagnostics, joints
-    head = joints.PanTiltMap(Grid(11, 11, 5.0))
+    from ipomdp_gaze.head import PanTiltMap
+    from ipomdp_gaze.msg_adapters import diagnostics
+    head = PanTiltMap(Grid(11, 11, 5.0))
     for _, (beliefs, _, _, found_msg) in searches:
         found = diagnostics.parse_found(found_msg)
         i = next(i for i, b in enumerate(beliefs) if b.max() >= 0.95)
@@ -150,11 +141,12 @@ def test_pan_tilt_angles_signs_and_start_cells(rig, searches):
 
 def test_belief_image_size_encoding_and_fixation_mark(rig, searches):
     from ipomdp_gaze.msg_adapters import images
+    from ipomdp_gaze.render import MARK_RGB
     assert rig['image'], 'no belief_image received'
     msg = rig['image'][-1][1]
     assert (msg.encoding, msg.height, msg.width, msg.step) == ('rgb8', 352, 352, 1056)
     img = images.rgb8_array(msg)
-    marked = np.all(img == images.MARK_RGB, axis=2)
+    marked = np.all(img == MARK_RGB, axis=2)
     rows, cols = np.nonzero(marked)
     assert rows.size and rows.max() - rows.min() == 31 and cols.max() - cols.min() == 31
 

@@ -25,38 +25,25 @@ SETTLE_S, SACCADE_S, RETRY_S = 0.5, 0.3, 0.3
 
 @pytest.fixture(scope='module')
 def rig(launch, probe):
-    from diagnostic_msgs.msg import DiagnosticArray
-    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+    from ipomdp_gaze.nodes.watch import SearchRecord
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import Image, JointState
-    from std_msgs.msg import Float32MultiArray, Int32MultiArray
 
-    latched = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE,
-                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    search = SearchRecord(probe)
     rec = {
-        'belief': probe.record(Float32MultiArray, 'belief', 200),
-        'targets': probe.record(JointState, 'pan_tilt', latched, distinct_stamps=True),
+        'search': search, 'belief': search.beliefs, 'targets': search.targets,
+        'truth': search.truth, 'status': probe.search_status(NODE),
         # A volatile subscriber (like many head drivers) only sees what is sent after it joined.
         'sent': probe.record(JointState, 'pan_tilt', 50),
         'frames': probe.record(Image, 'evidence_image',
                                QoSProfile(depth=200, reliability=ReliabilityPolicy.BEST_EFFORT)),
         'poses': probe.record(JointState, 'joint_states', 200),
-        'truth': probe.record(Int32MultiArray, 'ground_truth', latched),
-        'diagnostics': probe.record(DiagnosticArray, '/diagnostics', 50),
     }
     controller = launch('controller', [
         '--params-file', config_path('controller.yaml'), '-p', f'retry_period_s:={RETRY_S}',
         '-p', 'diagnostics_period_s:=0.2'])
     assert wait_for(lambda: rec['targets'], 30), controller.output()
     return rec
-
-
-def _last_diagnostics(rec) -> dict:
-    from ipomdp_gaze.msg_adapters import diagnostics
-    for _, msg in reversed(rec['diagnostics']):
-        for status in msg.status:
-            if status.name.endswith(f'{NODE}: search'):
-                return diagnostics.values_of(status)
-    return {}
 
 
 def _stamp(msg) -> tuple:
@@ -81,12 +68,12 @@ def test_target_is_resent_until_a_camera_answers(rig):
     assert wait_for(lambda: len(rig['sent']) >= 3, 20), 'the target was not re-sent'
     assert len({_stamp(m) for _, m in rig['sent']}) == 1       # the same target, again
     assert len(rig['targets']) == 1
-    assert wait_for(lambda: int(_last_diagnostics(rig).get('pan_tilt_resends', 0)) >= 2, 10)
-    assert _last_diagnostics(rig)['frames_received'] == '0'
+    assert wait_for(lambda: int(rig['status'].values.get('pan_tilt_resends', 0)) >= 2, 10)
+    assert rig['status'].values['frames_received'] == '0'
 
 
 def _search_done(rig, start_index):
-    return any(np.max(np.asarray(m.data)) >= 0.999 for _, m in rig['belief'][start_index:])
+    return rig['search'].reached(0.999, start_index) is not None
 
 
 @pytest.fixture(scope='module')
@@ -109,31 +96,31 @@ def test_camera_that_starts_late_picks_up_the_target(rig, camera):
 def test_no_frame_taken_mid_saccade_is_used_and_the_search_completes(rig, camera, probe):
     from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
     from ipomdp_gaze.grid import Grid
+    from ipomdp_gaze.head import PanTiltMap
     from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
-    from std_srvs.srv import SetBool, Trigger
     grid = Grid(11, 11, 5.0)
-    head = joints.PanTiltMap(grid)
+    head = PanTiltMap(grid)
     d = dprime_matrix(grid, make_fpoc('camera', half_width_deg=10.0, half_height_deg=10.0))
-    assert probe.call(SetBool, f'/{NODE}/enable', SetBool.Request(data=False)).success
+    assert probe.enable(False, NODE).success
     results = probe.set_parameters('simulated_camera', {
         'rate_hz': 20.0, 'saccade_time_s': SACCADE_S, 'publish_image': True, 'seed': 8})
     results += probe.set_parameters(NODE, {'settle_time_s': SETTLE_S})
     assert all(r.successful for r in results), [r.reason for r in results]
     n_truth = len(rig['truth'])
-    assert probe.call(Trigger, '/simulated_camera/reset', Trigger.Request()).success
+    assert probe.reset('simulated_camera').success
     assert wait_for(lambda: len(rig['truth']) > n_truth)
     n_belief = len(rig['belief'])
-    assert probe.call(Trigger, f'/{NODE}/reset', Trigger.Request()).success
+    assert probe.reset(NODE).success
     assert wait_for(lambda: len(rig['belief']) > n_belief)      # the uniform reset belief
     n_belief, n_targets = len(rig['belief']), len(rig['targets'])
-    assert probe.call(SetBool, f'/{NODE}/enable', SetBool.Request(data=True)).success
+    assert probe.enable(True, NODE).success
     assert wait_for(lambda: _search_done(rig, n_belief), 60)
 
     truth = grid_arrays.cell_from_ground_truth(rig['truth'][-1][1], grid)
     beliefs = [grid_arrays.from_multiarray(m, grid) for _, m in rig['belief'][n_belief:]]
     upto = next(i for i, b in enumerate(beliefs) if b.max() >= 0.999)
     assert int(np.argmax(beliefs[upto])) == truth
-    assert int(_last_diagnostics(rig)['frames_skipped']) > 0
+    assert int(rig['status'].values['frames_skipped']) > 0
 
     targets = [m for _, m in rig['targets'][n_targets:]]
     frames = {_stamp(m): images.evidence_from_image(m, grid) for _, m in rig['frames']}

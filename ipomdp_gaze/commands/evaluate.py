@@ -8,7 +8,8 @@ from pathlib import Path
 
 from ipomdp_gaze.evaluation import fixations_to_90_ci
 from ipomdp_gaze.observation import GaussianObservation
-from ipomdp_gaze.policies.baselines import make_baseline, STRATEGIES
+from ipomdp_gaze.policies.baselines import STRATEGIES
+from ipomdp_gaze.policies.registry import build_policy
 from ipomdp_gaze.simulate import draw_targets, simulate
 import numpy as np
 
@@ -40,10 +41,9 @@ def load_policies(args, grid, fpoc) -> dict:
     """Name -> policy for every ``--policy`` and ``--policy-file``."""
     policies = {}
     for name in args.policy or ([] if args.policy_file else ['map']):
-        policies[name] = make_baseline(name, grid, fpoc)
+        policies[name] = build_policy(name, grid, fpoc)
     for path in args.policy_file:
-        from ipomdp_gaze.policies.policy_file import load_policy
-        policies[path.stem] = load_policy(path, grid=grid, fpoc=fpoc)
+        policies[path.stem] = build_policy('learned', grid, fpoc, file=str(path))
     return policies
 
 

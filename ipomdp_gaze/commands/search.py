@@ -7,7 +7,8 @@ from pathlib import Path
 
 from ipomdp_gaze.belief import bayes_update, entropy, map_cell, uniform_log_belief
 from ipomdp_gaze.observation import GaussianObservation
-from ipomdp_gaze.policies.baselines import make_baseline, STRATEGIES
+from ipomdp_gaze.policies.baselines import STRATEGIES
+from ipomdp_gaze.policies.registry import build_policy
 import numpy as np
 
 from .common import add_task_args, nonneg_int, positive_int, task_from_args
@@ -92,10 +93,9 @@ def plot_search(grid, belief, path, target, title, out_path):
 def run(args) -> int:
     grid, fpoc = task_from_args(args)
     if args.policy_file:
-        from ipomdp_gaze.policies.policy_file import load_policy
-        policy = load_policy(args.policy_file, grid=grid, fpoc=fpoc)
+        policy = build_policy('learned', grid, fpoc, file=args.policy_file)
     else:
-        policy = make_baseline(args.policy, grid, fpoc)
+        policy = build_policy(args.policy, grid, fpoc)
     if not 0 < args.confidence < 1:
         raise ValueError(f'--confidence must be between 0 and 1, got {args.confidence}')
     rng = np.random.default_rng([args.seed, 1])

@@ -23,22 +23,22 @@ from __future__ import annotations
 from dataclasses import dataclass
 import sys
 
+from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
 from ipomdp_gaze.observation import GaussianObservation
 import numpy as np
-from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import Image, JointState
 from std_msgs.msg import Float32MultiArray, Int32MultiArray
 from std_srvs.srv import Trigger
 
-from .params import (current_values, declare, fpoc_from, fpoc_params, grid_from, grid_params,
-                     head_from, INT_MAX, joint_params, MAX_CELLS_PER_SIDE, Param, row_col_from,
-                     short_repr, T)
+from . import NODE_NAMES
+from .params import (cell_params, fpoc_from, fpoc_params, grid_from, grid_params, head_from,
+                     INT_MAX, joint_params, Param, ParameterTransaction, row_col_from, T)
 from .spin import run_node
 
-NODE_NAME = 'simulated_camera'
+NODE_NAME = NODE_NAMES['camera']
 FRAME_QOS = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
 STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                        durability=DurabilityPolicy.TRANSIENT_LOCAL)
@@ -46,12 +46,8 @@ STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
 
 def camera_params() -> list[Param]:
     """Every parameter of the simulated camera, in declaration order."""
-    return grid_params() + fpoc_params() + joint_params(limits=False) + [
-        Param('target_row', -1, T.INTEGER, 'row of the target (-1: a random row at each reset)',
-              int_range=(-1, MAX_CELLS_PER_SIDE - 1)),
-        Param('target_col', -1, T.INTEGER,
-              'column of the target (-1: a random column at each reset)',
-              int_range=(-1, MAX_CELLS_PER_SIDE - 1)),
+    return grid_params() + fpoc_params() + joint_params(limits=False) + cell_params(
+        'target', 'the target', 'a random {} at each reset') + [
         Param('seed', 0, T.INTEGER, 'seed of the targets and the observation noise',
               int_range=(0, INT_MAX)),
         Param('saccade_time_s', 0.15, T.DOUBLE, 'time to move to a new cell',
@@ -71,7 +67,7 @@ class CameraConfig:
     values: dict
     grid: object
     observation: GaussianObservation
-    head: joints.PanTiltMap
+    head: PanTiltMap
     target: tuple
 
 
@@ -80,14 +76,10 @@ class SimulatedCameraNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__(NODE_NAME, **kwargs)
-        self._params = camera_params()
-        self._by_name = {p.name: p for p in self._params}
-        self._ready = False
-        self._pending = None
-        self.add_on_set_parameters_callback(self._on_set)
-        self.add_post_set_parameters_callback(self._post_set)
-        declare(self, self._params)
-        self._config = self._build(current_values(self, self._params))
+        self._transaction = ParameterTransaction(self, camera_params(), self._build,
+                                                 self._apply_config)
+        self._transaction.declare()
+        self._transaction.start(self._build(self._transaction.values()))
         v = self._config.values
         self.rng = np.random.default_rng(v['seed'])
         self.pose = self.goal = self._config.grid.center_index
@@ -101,46 +93,30 @@ class SimulatedCameraNode(Node):
         self.create_service(Trigger, '~/reset', self._on_reset)
         self._saccade_timer = self._frame_timer = None
         self._make_timers(v)
-        self._ready = True
         self._new_target()
         self._publish_pose(self.get_clock().now().to_msg())
 
+    @property
+    def _config(self) -> CameraConfig:
+        """Return the configuration in force."""
+        return self._transaction.config
+
     # -- parameters ----------------------------------------------------------------------
-    def _build(self, values: dict) -> CameraConfig:
+    def _build(self, values: dict, changed=None, previous=None) -> CameraConfig:
+        """Derive a :class:`CameraConfig` from parameter values (ValueError names the problem)."""
         grid = grid_from(values)
         fpoc = fpoc_from(values)
         head = head_from(values, grid)
         target = row_col_from(values, grid, 'target_row', 'target_col')
         return CameraConfig(dict(values), grid, GaussianObservation(grid, fpoc), head, target)
 
-    def _on_set(self, params) -> SetParametersResult:
-        for p in params:
-            spec = self._by_name.get(p.name)
-            reason = spec.check(p.value) if spec is not None else None
-            if reason:
-                return SetParametersResult(successful=False, reason=reason)
-        if not self._ready:
-            return SetParametersResult(successful=True)
-        values = current_values(self, self._params)
-        values.update({p.name: p.value for p in params})
-        try:
-            self._pending = self._build(values)
-        except ValueError as exc:
-            self._pending = None
-            return SetParametersResult(successful=False, reason=str(exc))
-        return SetParametersResult(successful=True)
-
-    def _post_set(self, params) -> None:
-        if not self._ready or self._pending is None:
-            return
-        old, self._config, self._pending = self._config, self._pending, None
-        v, ov = self._config.values, old.values
+    def _apply_config(self, old: CameraConfig, cfg: CameraConfig) -> None:
+        """Follow a new configuration: a new seed restarts the noise, new times the timers."""
+        v, ov = cfg.values, old.values
         if v['seed'] != ov['seed']:
             self.rng = np.random.default_rng(v['seed'])
         if (v['saccade_time_s'], v['rate_hz']) != (ov['saccade_time_s'], ov['rate_hz']):
             self._make_timers(v)
-        changed = ', '.join(f'{p.name}={short_repr(p.value)}' for p in params)
-        self.get_logger().info(f'parameters set: {changed}')
 
     def _make_timers(self, values: dict) -> None:
         for timer in (self._saccade_timer, self._frame_timer):

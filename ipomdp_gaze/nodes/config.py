@@ -4,7 +4,7 @@
 Where the package's shared files (config YAML, launch files) are found.
 
 A colcon or pip install puts them under ``<prefix>/share/ipomdp_gaze``; an editable install has no
-``share/`` tree, so the source tree is the fallback (DESIGN.md section 5).
+``share/`` tree, so the source tree is the fallback (docs/design.md section 5).
 """
 from __future__ import annotations
 

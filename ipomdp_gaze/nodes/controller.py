@@ -29,13 +29,14 @@ import sys
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from ipomdp_gaze.belief import EvidenceError
-from ipomdp_gaze.gaze import FrameSequence, GazeController
+from ipomdp_gaze.gaze import check_confidence, FrameSequence, GazeController, start_cell
+from ipomdp_gaze.head import PanTiltMap
+from ipomdp_gaze.health import HealthMonitor, policy_label
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, stamps
 from ipomdp_gaze.observation import GaussianObservation
 from ipomdp_gaze.policies.baselines import STRATEGIES
 from ipomdp_gaze.policies.conv import ACTIONS, check_kernel
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnavailable
-from rcl_interfaces.msg import SetParametersResult
 from rclpy.exceptions import NameValidationException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -46,12 +47,13 @@ from std_msgs.msg import Float32MultiArray, Float64MultiArray
 from std_srvs.srv import SetBool, Trigger
 from trajectory_msgs.msg import JointTrajectory
 
-from .params import (current_values, declare, fpoc_from, fpoc_params, grid_from, grid_params,
-                     head_from, INT_MAX, joint_params, MAX_CELLS_PER_SIDE, Param, row_col_from,
-                     short_repr, T)
+from . import NODE_NAMES
+from .params import (cell_params, current_values, fpoc_from, fpoc_params, grid_from, grid_params,
+                     head_from, INT_MAX, joint_params, Param, ParameterTransaction, row_col_from,
+                     T)
 from .spin import run_node
 
-NODE_NAME = 'gaze_controller'
+NODE_NAME = NODE_NAMES['controller']
 STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                        durability=DurabilityPolicy.TRANSIENT_LOCAL)
 WARN_THROTTLE_S = 5.0
@@ -61,13 +63,8 @@ MAX_IMAGE_SIDE_PX = 1024
 
 def controller_params() -> list[Param]:
     """Every parameter of the controller, in declaration order (the grid first)."""
-    return grid_params() + fpoc_params() + [
-        Param('start_row', -1, T.INTEGER,
-              'row of the first fixation after a reset (-1: the centre row)',
-              int_range=(-1, MAX_CELLS_PER_SIDE - 1)),
-        Param('start_col', -1, T.INTEGER,
-              'column of the first fixation after a reset (-1: the centre column)',
-              int_range=(-1, MAX_CELLS_PER_SIDE - 1)),
+    return grid_params() + fpoc_params() + cell_params(
+        'start', 'the first fixation after a reset', 'the centre {}') + [
         Param('seed', 0, T.INTEGER, 'seed of the random and sample policies',
               int_range=(0, INT_MAX)),
         Param('settle_time_s', 0.1, T.DOUBLE,
@@ -122,9 +119,16 @@ class Config:
     grid: object
     fpoc: object
     policy: object
-    head: joints.PanTiltMap
+    head: PanTiltMap
     start_cell: int
     warning: str = ''
+
+    @property
+    def policy_label(self) -> str:
+        """Describe the policy for the log and ``/diagnostics``."""
+        v = self.values
+        return policy_label(v['policy.name'], v['policy.kernel'], v['policy.file'],
+                            v['policy.action'])
 
 
 class GazeControllerNode(Node):
@@ -132,15 +136,12 @@ class GazeControllerNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__(NODE_NAME, **kwargs)
-        self._params = controller_params()
-        self._by_name = {p.name: p for p in self._params}
-        self._ready = False
-        self._pending: Config | None = None
         self.add_pre_set_parameters_callback(self._pre_set)
-        self.add_on_set_parameters_callback(self._on_set)
-        self.add_post_set_parameters_callback(self._post_set)
-        declare(self, self._params)
-        self._config = self._startup_config()
+        self._transaction = ParameterTransaction(
+            self, controller_params(), self._build, self._apply_config,
+            self._check_while_declaring)
+        self._transaction.declare()
+        self._transaction.start(self._startup_config())
         cfg = self._config
         v = cfg.values
         self.core = GazeController(cfg.grid, cfg.fpoc, cfg.policy, cfg.start_cell,
@@ -168,17 +169,20 @@ class GazeControllerNode(Node):
         self._retry_timer = self._diag_timer = None
         self._make_timers(v)
         self._resends = 0
-        self._diag_rejected_before = 0
-        self._diag_last = (self._now_s(), 0)
+        self._health = HealthMonitor(self._now_s())
         self._pan_tilt_msg = None
-        self._ready = True
         self.core.reset(self._now_s())
         self._publish_belief()
         self._send_target()
         self.get_logger().info(
             f'{cfg.grid.rows}x{cfg.grid.cols} grid at {cfg.grid.spacing_deg} deg/cell, FPOC '
-            f'{cfg.fpoc.to_dict()}, policy {self._policy_label(v)}; first fixation '
+            f'{cfg.fpoc.to_dict()}, policy {cfg.policy_label}; first fixation '
             f'{cfg.grid.cell(self.core.fixation)}')
+
+    @property
+    def _config(self) -> Config:
+        """Return the configuration in force."""
+        return self._transaction.config
 
     # -- parameters ----------------------------------------------------------------------
     def _build(self, values: dict, changed=None, previous: Config | None = None) -> Config:
@@ -186,12 +190,8 @@ class GazeControllerNode(Node):
         grid = grid_from(values)
         fpoc = fpoc_from(values)
         head = head_from(values, grid)
-        row, col = row_col_from(values, grid, 'start_row', 'start_col')
-        centre_row, centre_col = grid.cell(grid.center_index)
-        start = grid.index(centre_row if row is None else row, centre_col if col is None else col)
-        confidence = values['confidence']
-        if not 0.0 < confidence < 1.0:
-            raise ValueError(f'confidence must be between 0 and 1 (exclusive), got {confidence}')
+        start = start_cell(grid, *row_col_from(values, grid, 'start_row', 'start_col'))
+        check_confidence(values['confidence'])
         for name in ('forward_command_topic', 'trajectory_topic'):
             if values[name]:
                 try:
@@ -211,7 +211,7 @@ class GazeControllerNode(Node):
         return Config(dict(values), grid, fpoc, policy, head, start, '; '.join(warnings))
 
     def _startup_config(self) -> Config:
-        values = current_values(self, self._params)
+        values = self._transaction.values()
         try:
             cfg = self._build(values)
         except PolicyUnavailable as exc:
@@ -248,40 +248,15 @@ class GazeControllerNode(Node):
                 params = params + [p]
         return params
 
-    def _on_set(self, params: list[Parameter]) -> SetParametersResult:
-        for p in params:
-            spec = self._by_name.get(p.name)
-            reason = spec.check(p.value) if spec is not None else None
-            if reason:
-                return SetParametersResult(successful=False, reason=reason)
-        if not self._ready:
-            return self._check_declared(params)
-        values = current_values(self, self._params)
-        values.update({p.name: p.value for p in params})
-        try:
-            self._pending = self._build(values, {p.name for p in params}, self._config)
-        except ValueError as exc:
-            self._pending = None
-            return SetParametersResult(successful=False, reason=str(exc))
-        # rclpy drops the reason of a successful set, so a warning goes to the log (post-set).
-        return SetParametersResult(successful=True)
-
-    def _check_declared(self, params: list[Parameter]) -> SetParametersResult:
+    def _check_while_declaring(self, params: list[Parameter]) -> None:
         """While declaring: check what the already declared grid allows (overrides included)."""
-        try:
-            for p in params:
-                if p.name == 'policy.kernel' and p.value:
-                    check_kernel(p.value, grid_from(current_values(self, grid_params())),
-                                 'policy.kernel')
-        except ValueError as exc:
-            return SetParametersResult(successful=False, reason=str(exc))
-        return SetParametersResult(successful=True)
+        for p in params:
+            if p.name == 'policy.kernel' and p.value:
+                check_kernel(p.value, grid_from(current_values(self, grid_params())),
+                             'policy.kernel')
 
-    def _post_set(self, params: list[Parameter]) -> None:
-        if not self._ready or self._pending is None:
-            return
-        old, cfg = self._config, self._pending
-        self._config, self._pending = cfg, None
+    def _apply_config(self, old: Config, cfg: Config) -> str:
+        """Make the controller follow a new configuration; return the policy for the log."""
         if cfg.warning:
             self.get_logger().warning(cfg.warning)
         v, ov = cfg.values, old.values
@@ -302,17 +277,7 @@ class GazeControllerNode(Node):
         if cfg.head != old.head and core.enabled:
             core.retarget(self._now_s())
             self._send_target()
-        changed = ', '.join(f'{p.name}={short_repr(p.value)}' for p in params)
-        self.get_logger().info(f'parameters set: {changed}; policy {self._policy_label(v)}')
-
-    @staticmethod
-    def _policy_label(values: dict) -> str:
-        name = values['policy.name']
-        if name != 'learned':
-            return name
-        if values['policy.kernel']:
-            return f"learned (policy.kernel, {values['policy.action']})"
-        return f"learned ({values['policy.file']}, {values['policy.action']})"
+        return f'policy {cfg.policy_label}'
 
     def _make_command_publishers(self, values: dict) -> None:
         for pub in (self._forward_pub, self._trajectory_pub):
@@ -393,53 +358,18 @@ class GazeControllerNode(Node):
             f'fixations')
 
     def _publish_diagnostics(self) -> None:
-        core, grid = self.core, self._config.grid
-        now = self._now_s()
-        last_t, last_received = self._diag_last
-        rate = (core.received - last_received) / max(now - last_t, 1e-9)
-        self._diag_last = (now, core.received)
-        counters = core.counters()
-        map_row, map_col = grid.cell(core.map_cell)
-        fix_row, fix_col = grid.cell(core.fixation)
-        without_s = core.seconds_without_evidence(now)
-        stall_timeout_s = self._config.values['stall_timeout_s']
-        level, message = 'ok', 'searching'
-        if not core.enabled:
-            message = 'disabled'
-        elif 0 < stall_timeout_s < without_s:
-            level, message = 'warn', f'no usable evidence for {without_s:.1f} s'
-            if core.received == last_received:
-                detail = 'no frames arrive'
-            else:
-                detail = f'{core.received - last_received} frames arrived, none usable'
-                if self._diag_rejected_before != core.rejected:
-                    detail += f'; last rejection: {core.last_rejection}'
-            self.get_logger().warning(f'{message} ({detail}); target re-sent '
+        self._check_publishers()
+        health = self._health.report(
+            self.core, self._now_s(), self._config.values['stall_timeout_s'],
+            self._config.policy_label, sum(q.lost for q in self._sequences.values()),
+            self._resends)
+        if health.stalled:
+            self.get_logger().warning(f'{health.message} ({health.detail}); target re-sent '
                                       f'{self._resends} times so far',
                                       throttle_duration_sec=WARN_THROTTLE_S)
-        elif core.found is not None:
-            message = 'target found'
-        elif core.received == last_received:
-            level, message = 'warn', 'no evidence received'
-        if core.rejected and core.last_rejection and level == 'ok' and \
-                self._diag_rejected_before != core.rejected:
-            level, message = 'warn', f'evidence rejected: {core.last_rejection}'
-        self._diag_rejected_before = core.rejected
-        self._check_publishers()
-        values = {
-            'policy': self._policy_label(self._config.values), 'enabled': core.enabled,
-            'evidence_rate_hz': rate, 'frames_received': counters['received'],
-            'frames_applied': counters['applied'], 'frames_rejected': counters['rejected'],
-            'frames_skipped': counters['skipped'],
-            'frames_dropped': sum(q.lost for q in self._sequences.values()),
-            'seconds_without_evidence': without_s, 'fixations': core.fixations,
-            'fixation_row': fix_row, 'fixation_col': fix_col, 'entropy_nats': core.entropy_nats,
-            'most_likely_row': map_row, 'most_likely_col': map_col,
-            'most_likely_probability': core.map_probability, 'found': core.found is not None,
-            'pan_tilt_resends': self._resends, 'last_rejection': core.last_rejection}
         self._diag_pub.publish(diagnostics.diagnostic_array(
-            [diagnostics.status(f'{self.get_fully_qualified_name()}: search', level, message,
-                                values)], self._now().to_msg()))
+            [diagnostics.status(f'{self.get_fully_qualified_name()}: search', health.level,
+                                health.message, health.values)], self._now().to_msg()))
 
     # -- inputs --------------------------------------------------------------------------
     def _check_publishers(self) -> None:
@@ -455,25 +385,22 @@ class GazeControllerNode(Node):
             self._sequences[topic].see(info.get('publication_sequence_number'))
 
     def _on_evidence(self, msg: Float32MultiArray, info) -> None:
-        now = self._now_s()
-        self._count_drops('evidence', info)
-        try:
-            values = grid_arrays.from_multiarray(msg, self._config.grid)
-        except EvidenceError as exc:
-            self._handle(self.core.reject(str(exc)))
-            return
-        self._handle(self.core.offer(values, now))
+        self._take('evidence', info, grid_arrays.from_multiarray, msg)
 
     def _on_evidence_image(self, msg: Image, info) -> None:
+        self._take('evidence_image', info, images.evidence_from_image, msg, msg.header.stamp)
+
+    def _take(self, topic: str, info, read, msg, stamp=None) -> None:
+        """Offer a frame to the core: taken at its stamp, or at its arrival when there is none."""
         now = self._now_s()
-        self._count_drops('evidence_image', info)
+        self._count_drops(topic, info)
         try:
-            values = images.evidence_from_image(msg, self._config.grid)
+            values = read(msg, self._config.grid)
         except EvidenceError as exc:
             self._handle(self.core.reject(str(exc)))
             return
-        stamp = now if stamps.is_zero(msg.header.stamp) else stamps.to_seconds(msg.header.stamp)
-        self._handle(self.core.offer(values, stamp, now))
+        taken = now if stamp is None or stamps.is_zero(stamp) else stamps.to_seconds(stamp)
+        self._handle(self.core.offer(values, taken, now))
 
     def _handle(self, result) -> None:
         if result.status == 'rejected':

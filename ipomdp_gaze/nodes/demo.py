@@ -13,30 +13,24 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 import math
 from pathlib import Path
-import tempfile
 import time
 
-from diagnostic_msgs.msg import DiagnosticStatus
 from ipomdp_gaze.belief import entropy
+from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, joints
 import numpy as np
-import rclpy
-from rclpy.executors import SingleThreadedExecutor
-from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from sensor_msgs.msg import JointState
-from std_msgs.msg import Float32MultiArray, Int32MultiArray
 import yaml
 
 from .config import config_file
 from .params import grid_from, head_from
-from .processes import domain_id_for, NodeProcess, ros_environment
+from .processes import domain_id_for, isolated_nodes
+from .watch import SearchRecord, Watch
 
-LATCHED = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE,
-                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
+# The watcher's wait for a condition (it polls; the records fill in the watch's spin thread).
+POLL_S = 0.05
 FPOC_OVERRIDES = {
     'camera': {},
-    # The human FPOC is calibrated at 0.42 degrees per cell (DESIGN.md section 2).
+    # The human FPOC is calibrated at 0.42 degrees per cell (docs/design.md section 2).
     'human': {'fpoc.model': 'human', 'grid.spacing_deg': 0.42},
 }
 
@@ -75,7 +69,7 @@ class DemoSetup:
     controller_args: list
     camera_args: list
     grid: object
-    head: joints.PanTiltMap
+    head: PanTiltMap
     overrides: dict = field(default_factory=dict)
 
 
@@ -107,82 +101,37 @@ def demo_setup(fpoc: str = 'camera', policy: str | None = None, seed: int = 0,
                      head_from(values, grid), controller)
 
 
-class Watcher:
-    """A node in the demo process that records what the controller and camera publish."""
-
-    def __init__(self, context):
-        self.node = Node('gaze_demo', context=context)
-        self.targets, self.beliefs, self.found, self.truth = [], [], [], []
-        self._stamps = set()
-        self.node.create_subscription(Float32MultiArray, 'belief', self._on_belief, 50)
-        self.node.create_subscription(JointState, 'pan_tilt', self._on_target, LATCHED)
-        self.node.create_subscription(DiagnosticStatus, 'found', self.found.append, 10)
-        self.node.create_subscription(Int32MultiArray, 'ground_truth', self.truth.append,
-                                      LATCHED)
-
-    def _on_belief(self, msg):
-        # A uniform belief is a reset, not the result of a fixation.
-        if np.ptp(np.asarray(msg.data)) > 0:
-            self.beliefs.append(msg)
-
-    def _on_target(self, msg):
-        key = (msg.header.stamp.sec, msg.header.stamp.nanosec)
-        if key not in self._stamps:     # a retry re-sends the same message
-            self._stamps.add(key)
-            self.targets.append(msg)
-
-
-class _Session:
-    """Spin the watcher until a condition holds, failing fast when a node process dies."""
-
-    def __init__(self, executor, deadline, processes):
-        self.executor, self.deadline, self.processes = executor, deadline, processes
-
-    def spin_until(self, condition) -> bool:
-        while not condition():
-            if time.monotonic() > self.deadline:
-                return False
-            for proc in self.processes:
-                if proc.proc is not None and not proc.running:
-                    raise RuntimeError(f'the {proc.node} node exited with status '
-                                       f'{proc.proc.returncode} (its output is below)')
-            self.executor.spin_once(timeout_sec=0.05)
-        return True
-
-
 def run_demo(setup: DemoSetup, timeout_s: float = 120.0, domain_id: int | None = None,
              verbose: bool = False, out=print) -> int:
     """Run the demo; 0 when the target was found and both nodes stopped cleanly."""
     domain = domain_id_for() if domain_id is None else domain_id
-    with tempfile.TemporaryDirectory(prefix='ipomdp-gaze-demo-') as tmp:
-        env = ros_environment(domain, Path(tmp) / 'ros_log')
-        controller = NodeProcess('controller', setup.controller_args, env,
-                                 Path(tmp) / 'controller.log')
-        camera = NodeProcess('camera', setup.camera_args, env, Path(tmp) / 'camera.log')
-        context = rclpy.Context()
-        rclpy.init(context=context, domain_id=domain, args=[])
-        executor = SingleThreadedExecutor(context=context)
-        watcher = Watcher(context)
-        executor.add_node(watcher.node)
-        session = _Session(executor, time.monotonic() + timeout_s, [controller, camera])
+    with isolated_nodes(domain, prefix='ipomdp-gaze-demo-') as nodes:
+        controller = nodes.add('controller', setup.controller_args)
+        camera = nodes.add('camera', setup.camera_args)
+        watch = Watch(domain, 'gaze_demo', nodes)
+        record = SearchRecord(watch, depth=50, updates_only=True)
+        deadline = time.monotonic() + timeout_s
+
+        def wait(condition) -> bool:
+            """Wait until the demo's deadline; NodeExited when a node process exits."""
+            return watch.wait_until(condition, max(0.0, deadline - time.monotonic()), POLL_S)
+
         g = setup.grid
         out(f'ipomdp-gaze demo: {g.rows}x{g.cols} grid at {g.spacing_deg} deg/cell, ROS domain '
             f'{domain}; starting gaze_controller, then simulated_camera')
         status = 1
         try:
             controller.start()
-            if not session.spin_until(lambda: watcher.targets):
+            if not wait(lambda: record.targets):
                 raise RuntimeError('the controller sent no target in time')
             camera.start()
-            status = _follow(setup, watcher, session, timeout_s, out)
+            status = _follow(setup, record, wait, timeout_s, out)
         except RuntimeError as exc:
             out(f'ipomdp-gaze demo: error: {exc}')
         finally:
             alive = {p.node: p.running for p in (camera, controller)}
-            codes = {p.node: p.stop() for p in (camera, controller)}
-            executor.shutdown(timeout_sec=1.0)
-            watcher.node.destroy_node()
-            rclpy.try_shutdown(context=context)
+            codes = {p.node: code for p, code in nodes.stop([camera, controller])}
+            watch.close()
         if verbose or status:
             for p in (controller, camera):
                 out(f'--- {p.node} output ---\n{p.output().rstrip()}')
@@ -194,16 +143,16 @@ def run_demo(setup: DemoSetup, timeout_s: float = 120.0, domain_id: int | None =
         return status if clean else 1
 
 
-def _follow(setup: DemoSetup, watcher: Watcher, session: _Session, timeout_s: float, out) -> int:
+def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out) -> int:
     """Print fixations until the found event; return 0 once the answer was checked."""
     grid, head = setup.grid, setup.head
     printed = 0
 
     def show_new():
         nonlocal printed
-        while printed < min(len(watcher.beliefs), len(watcher.targets)):
-            belief = grid_arrays.from_multiarray(watcher.beliefs[printed], grid)
-            pan, tilt = joints.angles_from_joint_state(watcher.targets[printed], head)
+        while printed < min(len(record.beliefs), len(record.targets)):
+            belief = grid_arrays.from_multiarray(record.beliefs[printed][1], grid)
+            pan, tilt = joints.angles_from_joint_state(record.targets[printed][1], head)
             looked = grid.cell(head.nearest_cell(pan, tilt))
             guess = int(np.argmax(belief))
             out(f'fixation {printed + 1:3d}: looked at {looked}  pan {math.degrees(pan):+6.2f} '
@@ -213,20 +162,20 @@ def _follow(setup: DemoSetup, watcher: Watcher, session: _Session, timeout_s: fl
 
     def finished():
         show_new()
-        return bool(watcher.found) and \
-            printed >= diagnostics.parse_found(watcher.found[0])['fixations']
+        return bool(record.found) and \
+            printed >= diagnostics.parse_found(record.found[0][1])['fixations']
 
-    if not session.spin_until(finished):
+    if not wait(finished):
         out(f'ipomdp-gaze demo: the target was not found within {timeout_s:g} s')
         return 1
-    found = diagnostics.parse_found(watcher.found[0])
+    found = diagnostics.parse_found(record.found[0][1])
     out(f"found: the target is most likely at ({found['row']}, {found['col']}), pan "
         f"{math.degrees(found['pan_rad']):+.2f} deg, tilt {math.degrees(found['tilt_rad']):+.2f} "
         f"deg, probability {found['probability']:.3f}, after {found['fixations']} fixations")
-    if not session.spin_until(lambda: watcher.truth):
+    if not wait(lambda: record.truth):
         out('ipomdp-gaze demo: the simulated camera did not report where the target is')
         return 1
-    truth = grid_arrays.cell_from_ground_truth(watcher.truth[-1], grid)
+    truth = grid_arrays.cell_from_ground_truth(record.truth[-1][1], grid)
     verdict = 'right' if truth == found['cell'] else 'wrong'
     out(f'the simulated camera hid the target at {grid.cell(truth)}: that is {verdict}')
     return 0

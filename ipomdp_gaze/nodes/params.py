@@ -1,13 +1,17 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-Parameter declarations shared by the nodes: explicit types, descriptors, ranges and choices.
+Parameters of the nodes: declarations with explicit types and descriptors, and changes at run time.
 
 Both nodes describe the task with the same names (``grid.*``, ``fpoc.<name>`` with the names of
-DESIGN.md section 2, the pan/tilt joint mapping), so one YAML block can be shared. Every
+docs/design.md section 2, the pan/tilt joint mapping), so one YAML block can be shared. Every
 parameter is declared with a ``ParameterDescriptor`` and an explicit type; the grid is read-only
 after start. ``fpoc.dprime`` is dynamically typed because it is a number for the ``camera`` FPOC
 and a list for the ``table`` FPOC.
+
+A change (``ros2 param set``, ``-p`` and YAML overrides included) goes through one
+:class:`ParameterTransaction` per node: it is checked whole and either taken whole or refused
+with the reason.
 """
 from __future__ import annotations
 
@@ -16,8 +20,9 @@ import math
 
 from ipomdp_gaze.fpoc import CameraFPOC, make_fpoc, MODELS, parameter_names
 from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.msg_adapters.joints import PanTiltMap
-from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+from ipomdp_gaze.head import PanTiltMap
+from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
+                                SetParametersResult)
 from rclpy.parameter import Parameter
 
 T = Parameter.Type
@@ -92,7 +97,7 @@ def grid_params() -> list[Param]:
 
 def fpoc_params() -> list[Param]:
     """
-    ``fpoc.model`` and the union of every model's parameters (DESIGN.md section 2).
+    ``fpoc.model`` and the union of every model's parameters (docs/design.md section 2).
 
     The defaults describe a camera whose field of view covers 5x5 cells of a 5-degree grid.
     """
@@ -141,6 +146,18 @@ def joint_params(limits: bool) -> list[Param]:
             Param('tilt_max_rad', math.pi / 2, T.DOUBLE, 'upper tilt limit; every cell must fit'),
         ]
     return params
+
+
+def cell_params(prefix: str, what: str, unset: str) -> list[Param]:
+    """
+    ``<prefix>_row`` and ``<prefix>_col``: a cell, each coordinate -1 when it is not fixed.
+
+    ``what`` names the cell (``'the target'``) and ``unset`` says what -1 means, with ``{}`` for
+    the word row or column (``'a random {} at each reset'``); :func:`row_col_from` reads them.
+    """
+    return [Param(f'{prefix}_{axis[:3]}', -1, T.INTEGER,
+                  f'{axis} of {what} (-1: {unset.format(axis)})',
+                  int_range=(-1, MAX_CELLS_PER_SIDE - 1)) for axis in ('row', 'column')]
 
 
 def declare(node, params: list[Param]) -> None:
@@ -217,3 +234,89 @@ def row_col_from(values: dict, grid: Grid, row_name: str, col_name: str) -> tupl
                              f'{grid.rows}x{grid.cols} grid, got {value}')
         out.append(None if value == -1 else int(value))
     return tuple(out)
+
+
+class ParameterTransaction:
+    """
+    Declare a node's parameters and take every change whole or not at all.
+
+    For each proposed set of parameters (one ``ros2 param set``, an atomic set, or a YAML or
+    ``-p`` override while declaring) the on-set callback checks each :class:`Param`, then builds
+    a candidate configuration from the current values and the proposed ones with
+    ``build(values, changed, previous)``; a ``ValueError`` refuses the whole set with its message
+    as the reason. The candidate is kept pending; once rclpy has stored the values, the post-set
+    callback makes it :attr:`config` and calls ``apply(old, new)``, then logs
+    ``parameters set: name=value, ...`` followed by what ``apply`` returned (if anything).
+
+    Parameters
+    ----------
+    node : rclpy.node.Node
+        The node; the callbacks are registered at once, so they see the overrides too.
+    params : list of Param
+        Every parameter of the node, in declaration order.
+    build : callable
+        ``build(values, changed, previous) -> config``: ``values`` maps every name to its value,
+        ``changed`` is the set of proposed names and ``previous`` the config in force (both None
+        for the first config).
+    apply : callable
+        ``apply(old, new) -> str or None``: make the node follow the new config; the returned
+        text is appended to the log line.
+    while_declaring : callable, optional
+        ``while_declaring(params)``, raising ``ValueError`` for an override that the parameters
+        declared so far already rule out (until :attr:`ready`, nothing is built).
+
+    """
+
+    def __init__(self, node, params: list[Param], build, apply, while_declaring=None):
+        self.node = node
+        self.params = params
+        self._by_name = {p.name: p for p in params}
+        self._build = build
+        self._apply = apply
+        self._while_declaring = while_declaring
+        self.ready = False
+        self.config = None
+        self._pending = None
+        node.add_on_set_parameters_callback(self._on_set)
+        node.add_post_set_parameters_callback(self._post_set)
+
+    def declare(self) -> None:
+        """Declare every parameter (YAML and ``-p`` overrides go through the callbacks)."""
+        declare(self.node, self.params)
+
+    def values(self) -> dict:
+        """``{name: value}`` of every parameter now."""
+        return current_values(self.node, self.params)
+
+    def start(self, config) -> None:
+        """Take ``config`` as the one in force and build every later change."""
+        self.config = config
+        self.ready = True
+
+    def _on_set(self, params: list[Parameter]) -> SetParametersResult:
+        for p in params:
+            spec = self._by_name.get(p.name)
+            reason = spec.check(p.value) if spec is not None else None
+            if reason:
+                return SetParametersResult(successful=False, reason=reason)
+        try:
+            if not self.ready:
+                if self._while_declaring is not None:
+                    self._while_declaring(params)
+                return SetParametersResult(successful=True)
+            values = self.values()
+            values.update({p.name: p.value for p in params})
+            self._pending = None
+            self._pending = self._build(values, {p.name for p in params}, self.config)
+        except ValueError as exc:
+            return SetParametersResult(successful=False, reason=str(exc))
+        # rclpy drops the reason of a successful set, so a warning goes to the log (post-set).
+        return SetParametersResult(successful=True)
+
+    def _post_set(self, params: list[Parameter]) -> None:
+        if not self.ready or self._pending is None:
+            return
+        old, self.config, self._pending = self.config, self._pending, None
+        extra = self._apply(old, self.config)
+        changed = ', '.join(f'{p.name}={short_repr(p.value)}' for p in params)
+        self.node.get_logger().info(f'parameters set: {changed}' + (f'; {extra}' if extra else ''))

@@ -1,21 +1,32 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-Start and stop nodes as separate processes (no ``ros2 launch`` here): the demo and tests.
+Start, watch and stop nodes as separate processes (no ``ros2 launch`` here): demo, tests, benches.
 
 Each node runs as ``python -m ipomdp_gaze.nodes.<name> --ros-args ...`` with its output in a log
 file. :func:`ros_environment` isolates a run: its own ``ROS_DOMAIN_ID``, discovery limited to this
-host, and node log files in a directory of its own.
+host, and node log files in a directory of its own. A :class:`NodeGroup` holds the processes of
+one run (:func:`isolated_nodes` makes one in a temporary folder); what they publish is watched
+from this process by :class:`ipomdp_gaze.nodes.watch.Watch`. This module does not import rclpy.
 """
 from __future__ import annotations
 
+from contextlib import contextmanager
 import os
 from pathlib import Path
 import signal
 import subprocess
 import sys
+import tempfile
+import time
+
+from . import NODE_NAMES
 
 MAX_DOMAIN_ID = 101
+# Run a node with a faulthandler: SIGUSR1 prints every thread's stack to its log.
+STACK_DUMP_MAIN = ('import faulthandler, signal, sys; '
+                   'faulthandler.register(signal.SIGUSR1, all_threads=True); '
+                   'from ipomdp_gaze.nodes.{node} import main; sys.exit(main())')
 
 
 def domain_id_for(pid: int | None = None) -> int:
@@ -35,15 +46,39 @@ def ros_environment(domain_id: int, log_dir, base: dict | None = None) -> dict:
     return env
 
 
-class NodeProcess:
-    """One node in its own process; its stdout and stderr go to ``log_path``."""
+def wait_for(condition, timeout_s: float = 20.0, interval_s: float = 0.02) -> bool:
+    """Poll ``condition()`` until it is true or ``timeout_s`` passes; return its last value."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        if condition():
+            return True
+        if time.monotonic() > deadline:
+            return bool(condition())
+        time.sleep(interval_s)
 
-    def __init__(self, node: str, ros_args=(), env: dict | None = None, log_path=None):
-        if node not in ('controller', 'camera'):
+
+class NodeExited(RuntimeError):
+    """A node process that should be running has exited."""
+
+
+class NodeProcess:
+    """
+    One node in its own process; its stdout and stderr go to ``log_path``.
+
+    With ``stack_dump``, the node runs with a faulthandler on SIGUSR1, and :meth:`stop` sends it
+    SIGUSR1 before SIGKILL, so a node that hangs on SIGTERM leaves every thread's stack in its log.
+    """
+
+    def __init__(self, node: str, ros_args=(), env: dict | None = None, log_path=None,
+                 stack_dump: bool = False):
+        if node not in NODE_NAMES:
             raise ValueError(f"node must be 'controller' or 'camera', got {node!r}")
         self.node = node
-        self.args = [sys.executable, '-m', f'ipomdp_gaze.nodes.{node}', '--ros-args',
-                     *map(str, ros_args)]
+        self.name = NODE_NAMES[node]
+        main = ['-c', STACK_DUMP_MAIN.format(node=node)] if stack_dump else \
+            ['-m', f'ipomdp_gaze.nodes.{node}']
+        self.args = [sys.executable, *main, '--ros-args', *map(str, ros_args)]
+        self.stack_dump = stack_dump
         self.env = env
         self.log_path = Path(log_path) if log_path else None
         self.proc: subprocess.Popen | None = None
@@ -73,12 +108,115 @@ class NodeProcess:
             try:
                 self.proc.wait(timeout_s)
             except subprocess.TimeoutExpired:
+                if self.stack_dump:
+                    self.proc.send_signal(signal.SIGUSR1)
+                    time.sleep(1.0)
                 self.proc.kill()
                 self.proc.wait(timeout_s)
         return self.proc.returncode
+
+    def kill(self) -> None:
+        """SIGKILL: no clean-up at all, as in a crash."""
+        if self.proc is not None:
+            self.proc.kill()
+            self.proc.wait(10)
 
     def output(self) -> str:
         """Return what the process printed so far."""
         if self.log_path is None or not self.log_path.exists():
             return ''
         return self.log_path.read_text(errors='replace')
+
+
+class NodeGroup:
+    """
+    The node processes of one run: one environment, their logs in one folder.
+
+    Parameters
+    ----------
+    env : dict
+        Environment of every node (:func:`ros_environment`).
+    log_dir : path
+        Folder of the log files, ``<node>-<n>.log`` (n counts the processes started).
+    stack_dump : bool
+        See :class:`NodeProcess`.
+
+    """
+
+    def __init__(self, env: dict, log_dir, stack_dump: bool = False):
+        self.env = env
+        self.log_dir = Path(log_dir)
+        self.stack_dump = stack_dump
+        self.processes: list[NodeProcess] = []
+        self.killed: list[NodeProcess] = []
+        self._count = 0
+
+    @property
+    def domain_id(self) -> int:
+        """Return the ROS domain of the nodes."""
+        return int(self.env['ROS_DOMAIN_ID'])
+
+    def add(self, node: str, ros_args=()) -> NodeProcess:
+        """Prepare a node process (``controller`` or ``camera``) of this run, not started yet."""
+        log = self.log_dir / f'{node}-{self._count}.log'
+        self._count += 1
+        proc = NodeProcess(node, ros_args, self.env, log, self.stack_dump)
+        self.processes.append(proc)
+        return proc
+
+    def start(self, node: str, ros_args=()) -> NodeProcess:
+        """Start a node process (``controller`` or ``camera``)."""
+        return self.add(node, ros_args).start()
+
+    def kill(self, proc: NodeProcess) -> None:
+        """SIGKILL a node on purpose; it is not expected to run any more."""
+        proc.kill()
+        self.killed.append(proc)
+
+    def last(self, node: str) -> NodeProcess:
+        """Return the process of this node started last."""
+        return next(p for p in reversed(self.processes) if p.node == node)
+
+    def check(self) -> None:
+        """
+        Raise :class:`NodeExited` if a node that was started and not killed has exited.
+
+        Raises
+        ------
+        NodeExited
+            Naming the node and its exit status (its output is in its log).
+
+        """
+        for proc in self.processes:
+            if proc.proc is not None and proc not in self.killed and not proc.running:
+                raise NodeExited(f'the {proc.node} node exited with status '
+                                 f'{proc.proc.returncode} (its output is below)')
+
+    def stop(self, procs=None, timeout_s: float = 10.0) -> list[tuple[NodeProcess, int | None]]:
+        """Stop ``procs`` in that order (default: every node not killed, in the order added)."""
+        if procs is None:
+            procs = [p for p in self.processes if p not in self.killed]
+        return [(p, p.stop(timeout_s)) for p in procs]
+
+    def close(self) -> list[str]:
+        """Stop every node not killed; describe each that did not exit with status 0."""
+        return [f'{p.node}: exit status {code}\n{p.output()[-3000:]}'
+                for p, code in self.stop() if code]
+
+
+@contextmanager
+def isolated_nodes(domain_id: int | None = None, prefix: str = 'ipomdp-gaze-',
+                   stack_dump: bool = False):
+    """
+    Yield a :class:`NodeGroup` on a domain of its own with its logs in a temporary folder.
+
+    The domain defaults to :func:`domain_id_for` this process. Every node still running at the
+    end is stopped (SIGTERM), and the folder is removed.
+    """
+    domain = domain_id_for() if domain_id is None else domain_id
+    with tempfile.TemporaryDirectory(prefix=prefix) as tmp:
+        group = NodeGroup(ros_environment(domain, Path(tmp) / 'ros_log'), tmp, stack_dump)
+        try:
+            yield group
+        finally:
+            group.stop()
