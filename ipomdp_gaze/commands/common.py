@@ -19,26 +19,25 @@ def grid_arg(text: str) -> tuple[int, int]:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
-def positive_int(text: str) -> int:
-    """Parse an integer >= 1 for argparse."""
+def _int_at_least(text: str, low: int, what: str) -> int:
+    """Parse an integer >= ``low`` for argparse; ``what`` names it in the error."""
     try:
         value = int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f'expected a positive integer, got {text!r}') from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f'expected a positive integer, got {text!r}')
+        value = low - 1
+    if value < low:
+        raise argparse.ArgumentTypeError(f'expected {what}, got {text!r}')
     return value
+
+
+def positive_int(text: str) -> int:
+    """Parse an integer >= 1 for argparse."""
+    return _int_at_least(text, 1, 'a positive integer')
 
 
 def nonneg_int(text: str) -> int:
     """Parse an integer >= 0 (seeds) for argparse."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'expected an integer >= 0, got {text!r}') from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f'expected an integer >= 0, got {text!r}')
-    return value
+    return _int_at_least(text, 0, 'an integer >= 0')
 
 
 def positive_float(text: str) -> float:
