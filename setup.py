@@ -13,7 +13,7 @@ setup(
     # One import namespace: policies/ and msg_adapters/ are reached through the committed
     # symlinks ipomdp_gaze/policies and ipomdp_gaze/msg_adapters (docs/design.md section 8).
     packages=find_packages(include=[PACKAGE, f'{PACKAGE}.*']),
-    package_data={f'{PACKAGE}.policies': ['kernels/*.yaml']},
+    package_data={f'{PACKAGE}.policies': ['kernels/*.yaml'], PACKAGE: ['models/*.yaml']},
     data_files=[
         ('share/ament_index/resource_index/packages', [f'resource/{PACKAGE}']),
         (f'share/{PACKAGE}', ['package.xml']),
@@ -28,6 +28,8 @@ setup(
         'tqdm>=4.60',
         'PyYAML>=6.0',
         'gymnasium>=1.0',
+        'opencv-python-headless>=4.5,<5',      # 5.x removed the Haar CascadeClassifier
+        'scikit-image>=0.21',                  # lfw_subset faces and photos for the scenes
     ],
     extras_require={
         'ros': ['ros-jazzy-rclpy[fastrtps]', 'ros-jazzy-common-interfaces'],

@@ -10,8 +10,14 @@ of the last frame) and the current fixation. The reward is the infomax reward ``
 of the new belief (``reward='fixate_target'``: the belief at the fixated cell). An episode
 terminates when the most likely cell reaches ``confidence`` and is truncated after ``max_steps``
 fixations. The hidden target is in ``info['target']`` for oracle baselines.
+
+By default the observation model is the Gaussian model of ``fpoc`` on a ``rows x cols`` grid
+(7x7); ``observation=`` takes any observation model instead, for example a count model or the
+path or shipped name of an ``ipomdp_gaze/observation-v1`` file, and its grid.
 """
 from __future__ import annotations
+
+from pathlib import Path
 
 import gymnasium
 from gymnasium import spaces
@@ -20,7 +26,7 @@ import numpy as np
 from .belief import bayes_update, entropy, infomax_reward, map_cell, uniform_log_belief
 from .fpoc import FPOC, make_fpoc
 from .grid import Grid
-from .observation import GaussianObservation
+from .observation import as_observation, GaussianObservation
 from .render import belief_heatmap, belief_text
 
 ENV_ID = 'ipomdp_gaze/VisualSearch-v0'
@@ -33,13 +39,26 @@ class VisualSearchEnv(gymnasium.Env):
 
     metadata = {'render_modes': ['rgb_array', 'ansi'], 'render_fps': 4}
 
-    def __init__(self, rows: int = 7, cols: int = 7, spacing_deg: float = 0.42,
-                 fpoc: str | FPOC = 'human', fpoc_params: dict | None = None,
-                 reward: str = 'infomax', observe: str = 'belief', confidence: float = 0.95,
+    def __init__(self, rows: int | None = None, cols: int | None = None,
+                 spacing_deg: float = 0.42, fpoc: str | FPOC = 'human',
+                 fpoc_params: dict | None = None, reward: str = 'infomax',
+                 observe: str = 'belief', confidence: float = 0.95,
                  max_steps: int | None = None, start_cell: int | None = None,
-                 render_mode: str | None = None):
-        self.grid = Grid(rows, cols, spacing_deg)
-        self.fpoc = fpoc if isinstance(fpoc, FPOC) else make_fpoc(fpoc, **(fpoc_params or {}))
+                 render_mode: str | None = None, observation=None):
+        if observation is not None:
+            if isinstance(observation, (str, Path)):
+                from .observation_file import load_observation
+                observation = load_observation(observation)
+            self.model = as_observation(observation.grid, observation)
+            self.grid, self.fpoc = self.model.grid, getattr(self.model, 'fpoc', None)
+            if (rows, cols) != (None, None) and (rows, cols) != self.grid.shape:
+                raise ValueError(f'rows, cols ({rows}, {cols}) disagree with the observation '
+                                 f"model's {self.grid.rows}x{self.grid.cols} grid")
+        else:
+            self.grid = Grid(7 if rows is None else rows, 7 if cols is None else cols,
+                             spacing_deg)
+            self.fpoc = fpoc if isinstance(fpoc, FPOC) else make_fpoc(fpoc, **(fpoc_params or {}))
+            self.model = GaussianObservation(self.grid, self.fpoc)
         if reward not in REWARDS:
             raise ValueError(f"unknown reward {reward!r}; valid rewards: {', '.join(REWARDS)}")
         if observe not in OBSERVE:
@@ -55,7 +74,6 @@ class VisualSearchEnv(gymnasium.Env):
         if not 0 <= self.start_cell < n:
             raise ValueError(f'start_cell must be a cell index below {n}, got {start_cell!r}')
         self.render_mode = render_mode
-        self.model = GaussianObservation(self.grid, self.fpoc)
         self.action_space = spaces.Discrete(n)
         if observe == 'belief':
             grid_space = spaces.Box(0.0, 1.0, shape=self.grid.shape, dtype=np.float64)

@@ -33,6 +33,8 @@ from .grid import Grid
 OVERFLOW_REASON = 'evidence too large: d * (o - d/2) overflows float64'
 # Largest grid whose (fixation, cell) d' matrix is kept for batched look-ups (8 * N^2 bytes).
 MATRIX_MAX_CELLS = 4096
+# Log-likelihood ratio of a count one hypothesis forbids: decisive, but finite.
+MAX_LOG_RATIO = 50.0
 
 
 def check_evidence(observation, n_cells: int) -> np.ndarray:
@@ -228,7 +230,229 @@ class GaussianObservation:
         return obs
 
 
-def as_observation(grid: Grid, model) -> GaussianObservation:
+def _fixation_index(grid: Grid, fixation) -> int:
+    """Check a single fixation: an integer cell index inside ``grid``."""
+    try:
+        k = operator.index(fixation)
+    except TypeError:
+        raise ValueError(f'fixation must be an integer cell index, got {fixation!r}') from None
+    if not 0 <= k < grid.n_cells:
+        raise ValueError(f'fixation {fixation!r} is outside a {grid.rows}x{grid.cols} grid')
+    return k
+
+
+def check_count_tables(p_target, p_null, grid: Grid, atol: float = 1e-6):
+    """
+    Validate the two count tables of a :class:`CountObservation`; return them as float64.
+
+    Both have shape ``(rows, cols, K)``: entry ``[|dr|, |dc|, c]`` is the probability of count c
+    in a cell ``|dr|`` rows and ``|dc|`` columns from the fixation, with the target in that cell
+    (``p_target``) or not (``p_null``). Every entry must be finite and non-negative, every
+    offset's K entries must sum to 1 (within ``atol``), and K >= 2.
+
+    Raises
+    ------
+    ValueError
+        Naming the table, the offset and the problem.
+
+    """
+    out = []
+    for name, table in (('target', p_target), ('null', p_null)):
+        try:
+            a = np.array(table, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f'{name} table must be numbers') from None
+        if a.ndim != 3 or a.shape[:2] != grid.shape or a.shape[2] < 2:
+            raise ValueError(f'{name} table must have shape ({grid.rows}, {grid.cols}, K) with '
+                             f'K >= 2 (offsets |dr|, |dc| of a {grid.rows}x{grid.cols} grid, '
+                             f'then counts), got {a.shape}')
+        bad = np.argwhere(~np.isfinite(a) | (a < 0))
+        if bad.size:
+            dr, dc, c = (int(x) for x in bad[0])
+            raise ValueError(f'{name} table must be finite and >= 0: offset ({dr}, {dc}) count '
+                             f'{c} is {a[dr, dc, c]}')
+        total = a.sum(axis=2)
+        off = np.argwhere(np.abs(total - 1.0) > atol)
+        if off.size:
+            dr, dc = (int(x) for x in off[0])
+            raise ValueError(f'{name} table must sum to 1 over counts at every offset: offset '
+                             f'({dr}, {dc}) sums to {total[dr, dc]:.9g}')
+        out.append(a / total[:, :, None])
+    if out[0].shape != out[1].shape:
+        raise ValueError(f'target and null tables must have the same shape, got '
+                         f'{out[0].shape} and {out[1].shape}')
+    return out[0], out[1]
+
+
+class CountObservation:
+    """
+    A count model learned from a real detector (docs/design.md section 6).
+
+    The frame of fixation k holds one detection count per cell (NaN = not observed). A cell
+    ``(|dr|, |dc|)`` from the fixation shows count c with probability ``p_target[|dr|, |dc|, c]``
+    if the target is in it and ``p_null[|dr|, |dc|, c]`` otherwise, independently across cells
+    (naive Bayes); counts above ``K - 1`` are clipped to ``K - 1``. The log-likelihood ratio of a
+    cell is ``log p_target(c | offset) - log p_null(c | offset)``, and ELM's kernel is
+    ``2 KL(p_target || p_null)`` per offset. The Gaussian model is the special case of
+    continuous ``o``; both plug into the same Bayes step.
+
+    Parameters
+    ----------
+    grid : Grid
+        The visual array the tables were measured on.
+    p_target, p_null : array (rows, cols, K)
+        The count tables (see :func:`check_count_tables`). A zero probability is allowed: a
+        count impossible under both hypotheses is refused as evidence, one impossible under one
+        hypothesis rules it out (log ratio -inf or +inf, clipped to +/- :data:`MAX_LOG_RATIO`).
+    meta : dict, optional
+        Where the model came from (image size, fovea, detector, calibration): kept as given.
+
+    """
+
+    name = 'counts'
+
+    def __init__(self, grid: Grid, p_target, p_null, meta: dict | None = None):
+        self.grid = grid
+        self.p_target, self.p_null = check_count_tables(p_target, p_null, grid)
+        self.max_count = self.p_target.shape[2] - 1
+        self.meta = dict(meta or {})
+        rows, cols, k = self.p_target.shape
+        with np.errstate(divide='ignore', invalid='ignore'):
+            ratio = np.log(self.p_target) - np.log(self.p_null)
+        both_zero = (self.p_target == 0) & (self.p_null == 0)
+        ratio = np.where(both_zero, np.nan, np.clip(ratio, -MAX_LOG_RATIO, MAX_LOG_RATIO))
+        # Offsets as a (2R-1, 2C-1) table: entry [dr + R-1, dc + C-1] = offset (|dr|, |dc|).
+        dr = np.abs(np.arange(-(rows - 1), rows))
+        dc = np.abs(np.arange(-(cols - 1), cols))
+        self._offset_id = dr[:, None] * cols + dc[None, :]
+        self._ratio = ratio.reshape(rows * cols, k)             # [offset id, count]
+        self._cdf = {'target': np.cumsum(self.p_target.reshape(rows * cols, k), axis=1),
+                     'null': np.cumsum(self.p_null.reshape(rows * cols, k), axis=1)}
+        self._pair_offsets = None
+
+    def __repr__(self):
+        return (f'CountObservation({self.grid.rows}x{self.grid.cols} grid, '
+                f'K={self.max_count + 1})')
+
+    def __eq__(self, other):
+        return isinstance(other, CountObservation) and self.grid.shape == other.grid.shape \
+            and np.array_equal(self.p_target, other.p_target) \
+            and np.array_equal(self.p_null, other.p_null)
+
+    def __hash__(self):
+        return hash((self.grid.shape, self.p_target.tobytes(), self.p_null.tobytes()))
+
+    def to_dict(self) -> dict:
+        """``{'model': 'counts', 'max_count': K-1, ...meta}``: what a policy file records."""
+        return {'model': self.name, 'max_count': self.max_count, **self.meta}
+
+    # -- offsets ---------------------------------------------------------------------------
+    def offsets(self, fixation) -> np.ndarray:
+        """Offset id ``|dr| * cols + |dc|`` of every cell: (N,) for one fixation, (E, N) for E."""
+        rows, cols = self.grid.shape
+        if np.ndim(fixation) == 0:
+            r, c = divmod(_fixation_index(self.grid, fixation), cols)
+            return self._offset_id[rows - 1 - r:2 * rows - 1 - r,
+                                   cols - 1 - c:2 * cols - 1 - c].reshape(-1)
+        if self._pair_offsets is None:
+            if self.grid.n_cells > MATRIX_MAX_CELLS:
+                raise ValueError(f'a batch of fixations needs an N x N offset table; a '
+                                 f'{rows}x{cols} grid has more than {MATRIX_MAX_CELLS} cells')
+            ri, ci = self.grid.pair_offset_index()            # [k, j]
+            self._pair_offsets = np.ascontiguousarray(self._offset_id[ri, ci])
+        return self._pair_offsets[np.asarray(fixation, dtype=np.intp)]
+
+    def observed(self, fixation: int) -> np.ndarray:
+        """Cells whose count says anything at this fixation (tables differ there), shape (N,)."""
+        informative = np.any(self.p_target != self.p_null, axis=2).reshape(-1)
+        return informative[self.offsets(fixation)]
+
+    def elm_kernel(self) -> np.ndarray:
+        """Return ELM's kernel on the ``(2R-1, 2C-1)`` offset table: ``2 KL(p_t || p_n)``."""
+        with np.errstate(divide='ignore', invalid='ignore'):
+            terms = np.where(self.p_target > 0, self.p_target
+                             * (np.log(self.p_target) - np.log(self.p_null)), 0.0)
+        kl = np.minimum(terms.sum(axis=2), MAX_LOG_RATIO)      # p_null = 0 where p_target > 0
+        return 2.0 * kl.reshape(-1)[self._offset_id]
+
+    # -- the model -------------------------------------------------------------------------
+    def counts(self, observation, validate: bool = True) -> tuple[np.ndarray, np.ndarray]:
+        """
+        Integer counts clipped to ``0..K-1`` and the mask of unobserved (NaN) cells.
+
+        Raises
+        ------
+        EvidenceError
+            For a negative, non-integer or non-finite (other than NaN) count.
+
+        """
+        obs = np.asarray(observation, dtype=float)
+        missing = np.isnan(obs)
+        if validate:
+            bad = ~missing & (~np.isfinite(obs) | (obs < 0) | (obs != np.floor(obs)))
+            if np.any(bad):
+                i = int(np.flatnonzero(bad)[0])
+                raise EvidenceError(f'counts must be integers >= 0 (NaN = not observed): cell '
+                                    f'{i % obs.shape[-1]} is {obs.flat[i]!r}')
+        counts = np.where(missing, 0.0, np.minimum(obs, self.max_count)).astype(np.intp)
+        return counts, missing
+
+    def log_likelihood_ratio(self, observation, fixation, validate: bool = True) -> np.ndarray:
+        """
+        Per-cell term ``log p_target(c_i | offset_ik) - log p_null(c_i | offset_ik)``.
+
+        Parameters
+        ----------
+        observation : array (N,) or (E, N)
+            Counts per cell (clipped to ``K - 1``); NaN = not observed (term 0).
+        fixation : int or array (E,)
+            Where each frame was taken.
+        validate : bool
+            Check the counts (only frames from :meth:`sample` skip it).
+
+        Raises
+        ------
+        EvidenceError
+            For invalid counts, or a count that neither hypothesis allows at its offset.
+
+        """
+        counts, missing = self.counts(observation, validate)
+        term = self._ratio[self.offsets(fixation), counts]
+        term[missing] = 0.0
+        if validate and np.any(np.isnan(term)):
+            i = int(np.flatnonzero(np.isnan(term))[0])
+            raise EvidenceError(f'count {counts.flat[i]} at cell {i % counts.shape[-1]} has '
+                                f'probability 0 with and without the target; the frame is '
+                                f'refused')
+        return term
+
+    def sample(self, targets, fixations, rng: np.random.Generator) -> np.ndarray:
+        """
+        Draw count frames: each cell from ``p_null`` at its offset, the target from ``p_target``.
+
+        One uniform draw per cell (``rng.random`` of the frames' shape) is turned into a count
+        by the inverse CDF, so a seeded stream gives every policy the same draws (common random
+        numbers). Scalars give one frame (N,), arrays (E,) give (E, N); counts are float64.
+        """
+        single = np.ndim(targets) == 0
+        targets = np.atleast_1d(np.asarray(targets, dtype=np.intp))
+        fixations = np.atleast_1d(np.asarray(fixations, dtype=np.intp))
+        if single:
+            offsets = self.offsets(int(fixations[0]))[None, :]
+        else:
+            offsets = self.offsets(fixations)
+        u = rng.random(offsets.shape)
+        frames = np.zeros(offsets.shape)
+        cdf_null = self._cdf['null']
+        for c in range(self.max_count):
+            frames += u > cdf_null[offsets, c]
+        rows = np.arange(targets.size)
+        u_t, off_t = u[rows, targets], offsets[rows, targets]
+        frames[rows, targets] = np.sum(u_t[:, None] > self._cdf['target'][off_t, :-1], axis=1)
+        return frames[0] if single else frames
+
+
+def as_observation(grid: Grid, model):
     """Return ``model`` if it is an observation model, or the Gaussian model of an FPOC."""
     if isinstance(model, FPOC):
         return GaussianObservation(grid, model)

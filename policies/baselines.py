@@ -116,5 +116,9 @@ def make_baseline(strategy: str, grid: Grid, model):
         return elm_policy(grid, model)
     if strategy == 'greedy':
         from .greedy import PercentCorrectGreedy
-        return PercentCorrectGreedy(grid, getattr(model, 'fpoc', model))
+        fpoc = getattr(as_observation(grid, model), 'fpoc', None)
+        if fpoc is None:
+            raise ValueError('policy greedy (the ideal searcher) needs the Gaussian model of an '
+                             'FPOC, not a count model')
+        return PercentCorrectGreedy(grid, fpoc)
     raise ValueError(f"unknown policy {strategy!r}; valid policies: {', '.join(STRATEGIES)}")

@@ -7,7 +7,8 @@ Format ``ipomdp_gaze/policy-v1`` (issue 3)::
 
     format: ipomdp_gaze/policy-v1
     grid: {rows: 7, cols: 7, spacing_deg: 0.42}
-    fpoc: {model: human, noise_contrast: 0.2, foveal_dprime: 2.0}
+    fpoc: {model: human, noise_contrast: 0.2, foveal_dprime: 2.0}   # or, for a count model:
+    observation: {model: counts, name: faces-420, sha256: ...}      # (docs/design.md 9)
     reward: infomax                  # or fixate_target
     family: conv                     # or logistic
     action: argmax                   # or sample; argmax if absent
@@ -17,11 +18,14 @@ Format ``ipomdp_gaze/policy-v1`` (issue 3)::
     training: {epochs: .., episodes_per_epoch: 150, learning_rate: .., beta: .., seed: ..}
     evaluation: {episodes: .., fixations_to_90: .., ci95: [.., ..]}
 
-Required: ``format``, ``grid``, ``fpoc``, ``reward``, ``family`` and the family's array
-(``kernel`` or ``theta``). Loading uses ``yaml.safe_load`` only and names exactly what is wrong
-with a file (:class:`PolicyFileError`). A source is a path or the name of a shipped kernel
-(``ipomdp_gaze/policies/kernels/<name>.yaml``, e.g. ``human-7x7-infomax``), installed once as
-package data and found with :mod:`importlib.resources`.
+Required: ``format``, ``grid``, ``reward``, ``family``, the family's array (``kernel`` or
+``theta``) and the observation model it was trained on: ``fpoc`` (the Gaussian model of that FPOC;
+every file before count models) or ``observation`` (a count model named by its file's stem and the
+SHA-256 of its tables, :func:`ipomdp_gaze.observation_file.fingerprint`). Loading uses
+``yaml.safe_load`` only and names exactly what is wrong with a file (:class:`PolicyFileError`). A
+source is a path or the name of a shipped kernel (``ipomdp_gaze/policies/kernels/<name>.yaml``,
+e.g. ``human-7x7-infomax``), installed once as package data and found with
+:mod:`importlib.resources`.
 """
 from __future__ import annotations
 
@@ -34,6 +38,8 @@ import warnings
 
 from ipomdp_gaze.fpoc import FPOC, fpoc_from_dict
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.observation import CountObservation, GaussianObservation
+from ipomdp_gaze.observation_file import fingerprint
 import numpy as np
 import yaml
 
@@ -45,8 +51,10 @@ FAMILIES = ('conv', 'logistic')
 REWARDS = ('infomax', 'fixate_target')
 # Shipped kernels are package data of ipomdp_gaze.policies (a plain directory: never zipped).
 KERNEL_DIR = Path(str(resources.files(__package__).joinpath('kernels')))
-REQUIRED = ('format', 'grid', 'fpoc', 'reward', 'family')
-KEYS = REQUIRED + ('action', 'kernel', 'radial', 'theta', 'training', 'evaluation')
+REQUIRED = ('format', 'grid', 'reward', 'family')
+KEYS = REQUIRED + ('fpoc', 'observation', 'action', 'kernel', 'radial', 'theta', 'training',
+                   'evaluation')
+OBSERVATION_MODELS = ('counts',)
 ARRAY_KEY = {'conv': 'kernel', 'logistic': 'theta'}
 # Radial weights and the kernel agree when every entry is within this of its shared weight.
 RADIAL_RTOL = 1e-6
@@ -70,10 +78,11 @@ class PolicySpec:
     """
 
     grid: Grid
-    fpoc: FPOC
+    fpoc: FPOC | None
     reward: str
     family: str
     action: str = 'argmax'
+    observation: dict | None = None
     kernel: np.ndarray | None = None
     theta: np.ndarray | None = None
     training: dict = field(default_factory=dict)
@@ -110,8 +119,12 @@ class PolicySpec:
 
     def to_dict(self) -> dict:
         """Return the YAML document as plain Python types (what :func:`save_policy` writes)."""
-        doc = {'format': FORMAT, 'grid': self.grid.to_dict(), 'fpoc': _plain(self.fpoc.to_dict()),
-               'reward': self.reward, 'family': self.family, 'action': self.action}
+        doc = {'format': FORMAT, 'grid': self.grid.to_dict()}
+        if self.observation is not None:
+            doc['observation'] = _plain(dict(self.observation))
+        else:
+            doc['fpoc'] = _plain(self.fpoc.to_dict())
+        doc.update({'reward': self.reward, 'family': self.family, 'action': self.action})
         if self.family == 'conv':
             doc['kernel'] = _plain(self.kernel)
             radial = self.radial()
@@ -271,6 +284,32 @@ def _check_radial(block, grid: Grid, kernel: np.ndarray) -> None:
             f'weight {float(expanded[r, c])!r} but kernel[{r}][{c}] is {float(kernel[r, c])!r}')
 
 
+def _observation(block) -> dict:
+    """Check the ``observation`` block: ``{model: counts, name: <stem>, sha256: <64 hex>}``."""
+    if not isinstance(block, dict):
+        raise PolicyFileError('observation must be a mapping {model, name, sha256}')
+    unknown = sorted(str(k) for k in set(block) - {'model', 'name', 'sha256'})
+    if unknown:
+        raise PolicyFileError(f'unknown key observation.{unknown[0]}; valid: model, name, sha256')
+    if block.get('model') not in OBSERVATION_MODELS:
+        raise PolicyFileError(f"unknown observation.model {block.get('model')!r}; valid: "
+                              f"{', '.join(OBSERVATION_MODELS)}")
+    digest = block.get('sha256')
+    if not (isinstance(digest, str) and len(digest) == 64
+            and all(ch in '0123456789abcdef' for ch in digest)):
+        raise PolicyFileError("observation.sha256 must be the 64 hex digits of the model's "
+                              'fingerprint')
+    if not isinstance(block.get('name', ''), str):
+        raise PolicyFileError('observation.name must be a string')
+    return dict(block)
+
+
+def observation_block(model: CountObservation) -> dict:
+    """Return what a policy file trained on ``model`` records of it."""
+    return {'model': model.name, 'name': str(model.meta.get('source', '')),
+            'sha256': fingerprint(model)}
+
+
 def _record(doc: dict, key: str) -> dict:
     block = doc.get(key)
     if block is None:
@@ -311,10 +350,20 @@ def spec_from_dict(doc, path: Path | None = None) -> PolicySpec:
     if doc['format'] != FORMAT:
         raise PolicyFileError(f"wrong format string {doc['format']!r}; expected {FORMAT!r}")
     grid = _grid(doc['grid'])
-    try:
-        fpoc = fpoc_from_dict(doc['fpoc'])
-    except ValueError as exc:
-        raise PolicyFileError(f'fpoc: {exc}') from None
+    if 'fpoc' not in doc and 'observation' not in doc:
+        raise PolicyFileError('missing key fpoc (or observation, for a count model): a policy '
+                              'file names the observation model it was trained on')
+    if 'fpoc' in doc and 'observation' in doc:
+        raise PolicyFileError('a policy file names one observation model: fpoc or '
+                              'observation, not both')
+    fpoc = observation = None
+    if 'fpoc' in doc:
+        try:
+            fpoc = fpoc_from_dict(doc['fpoc'])
+        except ValueError as exc:
+            raise PolicyFileError(f'fpoc: {exc}') from None
+    else:
+        observation = _observation(doc['observation'])
     reward = _choice(doc, 'reward', REWARDS)
     family = _choice(doc, 'family', FAMILIES)
     action = 'argmax' if doc.get('action') is None else _choice(doc, 'action', ACTIONS)
@@ -335,8 +384,9 @@ def spec_from_dict(doc, path: Path | None = None) -> PolicySpec:
         n = grid.n_cells
         theta = _array(doc, 'theta', (n, n), f'a {grid.rows}x{grid.cols} grid')
     return PolicySpec(grid=grid, fpoc=fpoc, reward=reward, family=family, action=action,
-                      kernel=kernel, theta=theta, training=_record(doc, 'training'),
-                      evaluation=_record(doc, 'evaluation'), path=path)
+                      observation=observation, kernel=kernel, theta=theta,
+                      training=_record(doc, 'training'), evaluation=_record(doc, 'evaluation'),
+                      path=path)
 
 
 def load_policy_spec(source) -> PolicySpec:
@@ -373,14 +423,15 @@ def _warn(message: str) -> None:
     warnings.warn(message, PolicyFileWarning, stacklevel=3)
 
 
-def check_task(spec: PolicySpec, grid: Grid | None = None, fpoc: FPOC | None = None,
+def check_task(spec: PolicySpec, grid: Grid | None = None, fpoc=None,
                warn: Callable[[str], None] | None = None) -> None:
     """
     Check a policy against the task it is used on.
 
     A different number of rows or columns is an error (the policy cannot act on that grid); a
-    different spacing or FPOC is allowed (the policy is used off its training task) and reported
-    through ``warn(message)`` (default: a :class:`PolicyFileWarning`).
+    different spacing or observation model (``fpoc``: an FPOC, a Gaussian or a count model) is
+    allowed (the policy is used off its training task) and reported through ``warn(message)``
+    (default: a :class:`PolicyFileWarning`).
     """
     warn = _warn if warn is None else warn
     where = f'{spec.path}: ' if spec.path is not None else ''
@@ -391,9 +442,16 @@ def check_task(spec: PolicySpec, grid: Grid | None = None, fpoc: FPOC | None = N
         if not math.isclose(grid.spacing_deg, spec.grid.spacing_deg, rel_tol=1e-9):
             warn(f'{where}policy was trained at spacing_deg {spec.grid.spacing_deg} but is used '
                  f'at {grid.spacing_deg}')
-    if fpoc is not None and fpoc != spec.fpoc:
-        warn(f'{where}policy was trained for FPOC {spec.fpoc.to_dict()} but is used with '
-             f'{fpoc.to_dict()}')
+    if isinstance(fpoc, GaussianObservation):
+        fpoc = fpoc.fpoc
+    trained = (f'FPOC {spec.fpoc.to_dict()}' if spec.observation is None else
+               f"count model {spec.observation.get('name') or spec.observation['sha256'][:12]}")
+    if isinstance(fpoc, CountObservation):
+        if spec.observation is None or spec.observation['sha256'] != fingerprint(fpoc):
+            name = fpoc.meta.get('source') or fingerprint(fpoc)[:12]
+            warn(f'{where}policy was trained for {trained} but is used with count model {name}')
+    elif fpoc is not None and (spec.observation is not None or fpoc != spec.fpoc):
+        warn(f'{where}policy was trained for {trained} but is used with FPOC {fpoc.to_dict()}')
 
 
 def load_policy(source, grid: Grid | None = None, fpoc: FPOC | None = None,

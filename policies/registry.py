@@ -62,5 +62,4 @@ def build_policy(name: str, grid, model, kernel=None, file: str = '', action: st
         resolve_source(file)
     except PolicyFileError as exc:
         raise PolicyUnavailable(str(exc)) from None
-    fpoc = getattr(model, 'fpoc', model)
-    return load_policy(file, grid=grid, fpoc=fpoc, action=action, warn=warn)
+    return load_policy(file, grid=grid, fpoc=model, action=action, warn=warn)

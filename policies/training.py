@@ -33,13 +33,14 @@ from ipomdp_gaze.belief import bayes_update, uniform_log_belief
 from ipomdp_gaze.evaluation import fixations_to_90_ci, fixations_to_level
 from ipomdp_gaze.fpoc import FPOC
 from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import as_observation
+from ipomdp_gaze.observation import as_observation, CountObservation
+from ipomdp_gaze.observation_file import fingerprint
 from ipomdp_gaze.simulate import simulate
 import numpy as np
 
 from .conv import ConvPolicy, kernel_from_radial, radial_bins
 from .logistic import LogisticPolicy, sample_rows, softmax
-from .policy_file import FAMILIES, PolicySpec, REWARDS
+from .policy_file import FAMILIES, observation_block, PolicySpec, REWARDS
 
 CSV_FIELDS = ('epoch', 'episodes', 'mean_return', 'fixations_to_90', 'wall_seconds')
 
@@ -280,7 +281,8 @@ class Trainer:
     def __init__(self, grid: Grid, fpoc: FPOC, config: TrainConfig,
                  params: np.ndarray | None = None, epoch: int = 0, wall_seconds: float = 0.0):
         self.grid = grid
-        self.fpoc = fpoc
+        self.model = as_observation(grid, fpoc)
+        self.fpoc = getattr(self.model, 'fpoc', None)          # None for a count model
         self.config = config
         self.family = Family(grid, config.family)
         if params is None:
@@ -293,7 +295,6 @@ class Trainer:
         self.epoch = int(epoch)
         self.wall_seconds = float(wall_seconds)
         self.horizon = grid.n_cells if config.horizon is None else int(config.horizon)
-        self.model = as_observation(grid, fpoc)
         self.curve: list[dict] = []
 
     def epoch_rng(self, epoch: int) -> np.random.Generator:
@@ -387,9 +388,12 @@ class Trainer:
             kernel = kernel_from_radial(self.grid, self.params)
         else:
             theta = self.family.theta(self.params).copy()
+        observation = None
+        if isinstance(self.model, CountObservation):
+            observation = observation_block(self.model)
         return PolicySpec(grid=self.grid, fpoc=self.fpoc, reward=cfg.reward, family=cfg.family,
-                          action=action, kernel=kernel, theta=theta, training=training,
-                          evaluation=dict(evaluation or {}))
+                          action=action, observation=observation, kernel=kernel, theta=theta,
+                          training=training, evaluation=dict(evaluation or {}))
 
 
 def config_from_spec(spec: PolicySpec, **overrides) -> TrainConfig:
@@ -403,11 +407,22 @@ def config_from_spec(spec: PolicySpec, **overrides) -> TrainConfig:
     return replace(config, **{k: v for k, v in overrides.items() if v is not None})
 
 
-def trainer_from_spec(spec: PolicySpec, **overrides) -> Trainer:
-    """Build a trainer that resumes a saved policy (its weights, epoch count and settings)."""
+def trainer_from_spec(spec: PolicySpec, model=None, **overrides) -> Trainer:
+    """
+    Build a trainer that resumes a saved policy (its weights, epoch count and settings).
+
+    ``model`` is the observation model of a policy trained on a count model (the file names
+    it by fingerprint only); an FPOC-trained policy uses its own FPOC.
+    """
     config = config_from_spec(spec, **overrides)
     family = Family(spec.grid, config.family)
-    return Trainer(spec.grid, spec.fpoc, config, params=family.params_from_spec(spec),
+    if spec.observation is not None:
+        if not isinstance(model, CountObservation) or \
+                fingerprint(model) != spec.observation['sha256']:
+            raise ValueError('resuming a policy trained on a count model needs that model')
+    else:
+        model = spec.fpoc
+    return Trainer(spec.grid, model, config, params=family.params_from_spec(spec),
                    epoch=int(spec.training.get('epochs', 0)),
                    wall_seconds=float(spec.training.get('wall_seconds', 0.0)))
 

@@ -73,7 +73,8 @@ def test_setup_installs_marker_package_xml_config_launch_and_kernels(monkeypatch
         assert expected == installed.get(f'share/ipomdp_gaze/{dest}', set()), dest
     # Kernels are package data of ipomdp_gaze.policies (importlib.resources), not share/ files.
     assert 'share/ipomdp_gaze/kernels' not in installed
-    assert dist.package_data == {'ipomdp_gaze.policies': ['kernels/*.yaml']}
+    assert dist.package_data == {'ipomdp_gaze.policies': ['kernels/*.yaml'],
+                                 'ipomdp_gaze': ['models/*.yaml']}
     assert list((ROOT / 'ipomdp_gaze' / 'policies').glob('kernels/*.yaml'))
     packages = set(dist.packages)
     assert {'ipomdp_gaze', 'ipomdp_gaze.policies', 'ipomdp_gaze.msg_adapters',

@@ -65,21 +65,49 @@ def fpoc_param(text: str) -> tuple[str, object]:
 
 def add_task_args(parser: argparse.ArgumentParser, grid: str = '7x7', spacing: float = 0.42,
                   fpoc: str = 'human') -> None:
-    """``--grid``, ``--spacing-deg``, ``--fpoc`` and repeated ``--fpoc-param name=value``."""
-    parser.add_argument('--grid', type=grid_arg, default=parse_grid(grid),
+    """
+    ``--grid``, ``--spacing-deg``, ``--fpoc``, repeated ``--fpoc-param`` and ``--observation``.
+
+    The task is the Gaussian model of an FPOC on a grid, or a count model read from an
+    observation file (which brings its own grid). Defaults are applied by
+    :func:`task_from_args`, so options given next to ``--observation`` can be refused.
+    """
+    parser.add_argument('--grid', type=grid_arg, default=None,
                         help=f'visual array ROWSxCOLS (default {grid})')
-    parser.add_argument('--spacing-deg', type=positive_float, default=spacing,
+    parser.add_argument('--spacing-deg', type=positive_float, default=None,
                         help=f'degrees between neighbouring cells (default {spacing})')
-    parser.add_argument('--fpoc', choices=tuple(MODELS), default=fpoc,
+    parser.add_argument('--fpoc', choices=tuple(MODELS), default=None,
                         help=f'FPOC model (default {fpoc})')
     parser.add_argument('--fpoc-param', type=fpoc_param, action='append', default=[],
                         metavar='NAME=VALUE',
                         help='FPOC parameter by its docs/design.md name, e.g. foveal_dprime=2.5 '
                              '(repeatable)')
+    parser.add_argument('--observation', default=None, metavar='FILE',
+                        help='a count model (ipomdp_gaze/observation-v1 file or shipped name) '
+                             'instead of an FPOC; it brings its grid')
+    parser.set_defaults(task_defaults=(parse_grid(grid), spacing, fpoc))
 
 
 def task_from_args(args) -> tuple[Grid, object]:
-    """Build ``(grid, fpoc)`` from :func:`add_task_args` arguments; errors name the problem."""
+    """
+    Build ``(grid, model)`` from :func:`add_task_args` arguments; errors name the problem.
+
+    ``model`` is an FPOC (the Gaussian model) or the count model of ``--observation``.
+    """
+    if getattr(args, 'observation', None):
+        from ipomdp_gaze.observation_file import load_observation
+        options = (('grid', args.grid), ('fpoc', args.fpoc), ('fpoc-param', args.fpoc_param),
+                   ('spacing-deg', args.spacing_deg))
+        given = [f'--{name}' for name, value in options if value]
+        if given:
+            raise ValueError(f'{given[0]} cannot be combined with --observation (the '
+                             f'observation file sets the task)')
+        model = load_observation(args.observation)
+        return model.grid, model
+    default_grid, default_spacing, default_fpoc = args.task_defaults
+    args.grid = default_grid if args.grid is None else args.grid
+    args.spacing_deg = default_spacing if args.spacing_deg is None else args.spacing_deg
+    args.fpoc = default_fpoc if args.fpoc is None else args.fpoc
     grid = Grid(args.grid[0], args.grid[1], args.spacing_deg)
     params = dict(args.fpoc_param)
     names = parameter_names(args.fpoc)

@@ -7,7 +7,8 @@ import json
 from pathlib import Path
 
 from ipomdp_gaze.evaluation import fixations_to_90_ci
-from ipomdp_gaze.observation import GaussianObservation
+from ipomdp_gaze.observation import as_observation, GaussianObservation
+from ipomdp_gaze.observation_file import fingerprint
 from ipomdp_gaze.policies.baselines import STRATEGIES
 from ipomdp_gaze.policies.registry import build_policy
 from ipomdp_gaze.simulate import draw_targets, simulate
@@ -51,9 +52,11 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
              episodes_greedy: int = 2000, bootstrap: int = 1000, progress=None) -> dict:
     """Run every policy on the same targets and noise; return the JSON-ready result."""
     horizon = grid.n_cells if horizon is None else horizon
-    model = GaussianObservation(grid, fpoc)
+    model = as_observation(grid, fpoc)
     targets = draw_targets(grid.n_cells, episodes, seed)
-    out = {'grid': grid.to_dict(), 'fpoc': fpoc.to_dict(), 'episodes': episodes,
+    task = ({'fpoc': model.fpoc.to_dict()} if isinstance(model, GaussianObservation)
+            else {'observation': {**model.to_dict(), 'sha256': fingerprint(model)}})
+    out = {'grid': grid.to_dict(), **task, 'episodes': episodes,
            'horizon': horizon, 'seed': seed, 'policies': {}}
     for name, policy in policies.items():
         n = min(episodes, episodes_greedy) if getattr(policy, 'name', '') == 'greedy' else episodes
@@ -86,8 +89,9 @@ def run(args) -> int:
     policies = load_policies(args, grid, fpoc)
     result = evaluate(grid, fpoc, policies, args.episodes, args.horizon, args.seed,
                       args.episodes_greedy, args.bootstrap)
-    print(f'{grid.rows}x{grid.cols} grid, {grid.spacing_deg} deg/cell, FPOC {fpoc.to_dict()}, '
-          f"horizon {result['horizon']}, seed {args.seed}")
+    task = (f'count model {args.observation}' if args.observation else
+            f'{grid.spacing_deg} deg/cell, FPOC {fpoc.to_dict()}')
+    print(f"{grid.rows}x{grid.cols} grid, {task}, horizon {result['horizon']}, seed {args.seed}")
     print(format_table(result))
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)

@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ipomdp_gaze.belief import bayes_update, entropy, map_cell, uniform_log_belief
-from ipomdp_gaze.observation import GaussianObservation
+from ipomdp_gaze.observation import as_observation
 from ipomdp_gaze.policies.baselines import STRATEGIES
 from ipomdp_gaze.policies.registry import build_policy
 import numpy as np
@@ -103,11 +103,12 @@ def run(args) -> int:
     if target >= grid.n_cells:
         raise ValueError(f'--target {target} is outside the {grid.n_cells}-cell grid')
     max_fix = args.max_fixations or 4 * grid.n_cells
-    guess, path, belief = run_search(grid, GaussianObservation(grid, fpoc), policy, target,
+    guess, path, belief = run_search(grid, as_observation(grid, fpoc), policy, target,
                                      args.confidence, max_fix, args.seed)
     if args.plot:
         name = args.policy_file or args.policy
-        title = (f'{grid.rows}x{grid.cols}, {fpoc.model} FPOC, {name}: '
+        task = f'{fpoc.model} FPOC' if args.observation is None else args.observation
+        title = (f'{grid.rows}x{grid.cols}, {task}, {name}: '
                  f'{len(path)} fixations (star = target)')
         plot_search(grid, belief, path, target, title, args.plot)
         print(f'wrote {args.plot}')

@@ -11,8 +11,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ipomdp_gaze.grid import parse_grid
-
 from .common import add_task_args, nonneg_int, positive_float, positive_int, task_from_args
 
 FAMILY_DEFAULT, REWARD_DEFAULT = 'conv', 'infomax'
@@ -73,6 +71,8 @@ def _task(args, spec):
     from ipomdp_gaze.policies.policy_file import PolicyFileError
     if spec is None:
         return task_from_args(args)
+    if spec.observation is not None or args.observation:
+        return _count_task(args, spec)
     given = {
         'grid': args.grid is not None and tuple(args.grid) != spec.grid.shape,
         'spacing-deg': args.spacing_deg is not None
@@ -92,6 +92,31 @@ def _task(args, spec):
     return Grid(spec.grid.rows, spec.grid.cols, spec.grid.spacing_deg), spec.fpoc
 
 
+def _count_task(args, spec):
+    """Return the count model of a resumed file: ``--observation`` must give the same one."""
+    from ipomdp_gaze.observation_file import fingerprint, load_observation
+    from ipomdp_gaze.policies.policy_file import PolicyFileError
+    if spec.observation is None:
+        raise PolicyFileError(f'--observation differs from the resumed file {args.resume} '
+                              f'(trained on an FPOC)')
+    name = spec.observation.get('name') or 'its count model'
+    if not args.observation:
+        raise PolicyFileError(f'{args.resume} was trained on {name}: give it with '
+                              f'--observation FILE to resume')
+    for option, value in (('grid', args.grid), ('fpoc', args.fpoc),
+                          ('fpoc-param', args.fpoc_param), ('spacing-deg', args.spacing_deg)):
+        if value:
+            raise PolicyFileError(f'--{option} cannot be combined with --observation')
+    model = load_observation(args.observation)
+    if fingerprint(model) != spec.observation['sha256']:
+        raise PolicyFileError(f'--observation {args.observation} is not the model {args.resume} '
+                              f'was trained on ({name})')
+    if args.reward is not None and args.reward != spec.reward or \
+            args.family is not None and args.family != spec.family:
+        raise PolicyFileError(f'--reward/--family differ from the resumed file {args.resume}')
+    return model.grid, model
+
+
 def run(args) -> int:
     from ipomdp_gaze.policies.policy_file import load_policy_spec, save_policy
     from ipomdp_gaze.policies.training import (evaluation_block, read_curve, TrainConfig, Trainer,
@@ -102,10 +127,6 @@ def run(args) -> int:
         raise ValueError('--out PATH.yaml is required (or --resume PATH.yaml)')
     if out.suffix != '.yaml':
         raise ValueError(f'--out must end in .yaml, got {out}')
-    if spec is None:
-        args.grid = args.grid if args.grid is not None else parse_grid('7x7')
-        args.spacing_deg = args.spacing_deg if args.spacing_deg is not None else 0.42
-        args.fpoc = args.fpoc if args.fpoc is not None else 'human'
     grid, fpoc = _task(args, spec)
     overrides = {
         'learning_rate': args.learning_rate, 'anneal_epochs': args.anneal_epochs,
@@ -120,7 +141,7 @@ def run(args) -> int:
         defaults.update({k: v for k, v in overrides.items() if v is not None})
         trainer = Trainer(grid, fpoc, TrainConfig(**defaults))
     else:
-        trainer = trainer_from_spec(spec, **overrides)
+        trainer = trainer_from_spec(spec, model=fpoc, **overrides)
     curve_path = out.with_suffix('.csv')
     rows = []
     if spec is not None and args.resume.with_suffix('.csv').is_file():
@@ -145,8 +166,9 @@ def run(args) -> int:
     save_policy(out, trainer.spec(evaluation=evaluation))
     write_curve(curve_path, rows)
     cfg = trainer.config
+    task = fpoc.model if hasattr(fpoc, 'model') else f'count model {args.observation}'
     print(f'trained {cfg.family} {cfg.reward} policy on {grid.rows}x{grid.cols} '
-          f'{fpoc.model}: {trainer.epoch} epochs, lr {cfg.learning_rate}, '
+          f'{task}: {trainer.epoch} epochs, lr {cfg.learning_rate}, '
           f'{trainer.wall_seconds:.1f} s of training')
     if evaluation:
         f90, ci = evaluation['fixations_to_90'], evaluation['ci95']

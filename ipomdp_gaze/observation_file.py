@@ -1,0 +1,228 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Observation files: a count model with the task it was measured on, as YAML.
+
+Format ``ipomdp_gaze/observation-v1`` (docs/design.md section 9)::
+
+    format: ipomdp_gaze/observation-v1
+    model: counts
+    grid: {rows: 21, cols: 21}            # spacing_deg too for a pan/tilt grid
+    image: {width: 420, height: 420}      # the image size it was calibrated at
+    fovea: {...}                          # the fovea settings it was measured with
+    detector: {...}                       # the detector settings it was measured with
+    target: [[[p0, p1, ...], ...], ...]   # P(c | target, |dr|, |dc|): rows x cols x K
+    null: [[[...]]]                       # P(c | no target, |dr|, |dc|): rows x cols x K
+    calibration: {...}                    # free-form record of how it was measured
+
+Loading uses ``yaml.safe_load`` only and names exactly what is wrong
+(:class:`ObservationFileError`, one line): missing or unknown keys, shapes, probabilities that are
+not finite, negative or do not sum to 1. A source is a path or the name of a shipped model
+(``ipomdp_gaze/models/<name>.yaml``, package data found with :mod:`importlib.resources`).
+"""
+from __future__ import annotations
+
+import hashlib
+from importlib import resources
+import math
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from .grid import Grid
+from .observation import CountObservation
+
+FORMAT = 'ipomdp_gaze/observation-v1'
+MODELS = ('counts',)
+REQUIRED = ('format', 'model', 'grid', 'target', 'null')
+KEYS = REQUIRED + ('image', 'fovea', 'detector', 'calibration')
+RECORDS = ('image', 'fovea', 'detector', 'calibration')
+MODEL_DIR = Path(str(resources.files(__package__).joinpath('models')))
+# Counts per cell a file may tabulate (K); far above any detector's clipped count.
+MAX_K = 256
+
+
+class ObservationFileError(ValueError):
+    """An observation file that cannot be used; the message says why."""
+
+
+def shipped_observations() -> list[str]:
+    """Names of the observation models shipped with the package."""
+    return sorted(p.stem for p in MODEL_DIR.glob('*.yaml')) if MODEL_DIR.is_dir() else []
+
+
+def resolve_source(source) -> Path:
+    """Return an existing path, or the file of a shipped model name (with or without .yaml)."""
+    path = Path(source)
+    if path.is_file():
+        return path
+    name = path.name[:-5] if path.name.endswith('.yaml') else path.name
+    if str(source) in (name, name + '.yaml') and (MODEL_DIR / f'{name}.yaml').is_file():
+        return MODEL_DIR / f'{name}.yaml'
+    names = ', '.join(shipped_observations()) or 'none'
+    raise ObservationFileError(f'observation file {str(source)!r} not found and not a shipped '
+                               f'model name (shipped: {names})')
+
+
+def fingerprint(model: CountObservation) -> str:
+    """SHA-256 of the two tables (float64, C order): names a model inside a policy file."""
+    digest = hashlib.sha256()
+    digest.update(np.ascontiguousarray(model.p_target, dtype=np.float64).tobytes())
+    digest.update(np.ascontiguousarray(model.p_null, dtype=np.float64).tobytes())
+    return digest.hexdigest()
+
+
+def _grid(block) -> Grid:
+    if not isinstance(block, dict):
+        raise ObservationFileError('grid must be a mapping {rows, cols[, spacing_deg]}')
+    unknown = sorted(set(block) - {'rows', 'cols', 'spacing_deg'})
+    if unknown:
+        raise ObservationFileError(f'unknown key grid.{unknown[0]}; valid: rows, cols, '
+                                   f'spacing_deg')
+    for key in ('rows', 'cols'):
+        value = block.get(key)
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise ObservationFileError(f'grid.{key} must be a positive integer, got {value!r}')
+    spacing = block.get('spacing_deg', 1.0)
+    if isinstance(spacing, bool) or not isinstance(spacing, (int, float)) \
+            or not math.isfinite(spacing) or spacing <= 0:
+        raise ObservationFileError(f'grid.spacing_deg must be a positive number, got '
+                                   f'{spacing!r}')
+    return Grid(block['rows'], block['cols'], float(spacing))
+
+
+def _table(doc: dict, key: str, grid: Grid) -> np.ndarray:
+    """Read a rows x cols x K list of lists, refused before numpy walks an oversized one."""
+    value = doc[key]
+    shape = f'{grid.rows} x {grid.cols} x K'
+    if not isinstance(value, list) or len(value) != grid.rows:
+        raise ObservationFileError(f'{key} must be a {shape} list of lists (one row per |dr| '
+                                   f'in 0..{grid.rows - 1})')
+    for row in value:
+        if not isinstance(row, list) or len(row) != grid.cols:
+            raise ObservationFileError(f'{key} must be a {shape} list of lists (one entry per '
+                                       f'|dc| in 0..{grid.cols - 1})')
+        for cell in row:
+            if not isinstance(cell, list) or not 2 <= len(cell) <= MAX_K or any(
+                    isinstance(x, (list, dict, bool)) or not isinstance(x, (int, float))
+                    for x in cell):
+                raise ObservationFileError(f'{key} must hold, per offset, a list of 2 to {MAX_K} '
+                                           f'probabilities (one per count)')
+    try:
+        return np.asarray(value, dtype=float)
+    except ValueError:
+        raise ObservationFileError(f'{key} must have the same number of counts K at every '
+                                   f'offset') from None
+
+
+def model_from_dict(doc, source: str = '') -> CountObservation:
+    """
+    Validate a parsed observation document and build its model.
+
+    Raises
+    ------
+    ObservationFileError
+        Naming the first problem found.
+
+    """
+    if not isinstance(doc, dict):
+        raise ObservationFileError(f'an observation file must be a YAML mapping, got '
+                                   f'{type(doc).__name__}')
+    for key in REQUIRED:
+        if key not in doc:
+            raise ObservationFileError(f'missing key {key}')
+    unknown = sorted(str(k) for k in set(doc) - set(KEYS))
+    if unknown:
+        raise ObservationFileError(f"unknown key {unknown[0]}; valid: {', '.join(KEYS)}")
+    if doc['format'] != FORMAT:
+        raise ObservationFileError(f"wrong format string {doc['format']!r}; expected "
+                                   f'{FORMAT!r}')
+    if doc['model'] not in MODELS:
+        raise ObservationFileError(f"unknown model {doc['model']!r}; valid: {', '.join(MODELS)}")
+    grid = _grid(doc['grid'])
+    meta = {}
+    for key in RECORDS:
+        block = doc.get(key)
+        if block is not None and not isinstance(block, dict):
+            raise ObservationFileError(f'{key} must be a mapping')
+        if block is not None:
+            meta[key] = dict(block)
+    target, null = _table(doc, 'target', grid), _table(doc, 'null', grid)
+    try:
+        model = CountObservation(grid, target, null, meta)
+    except ValueError as exc:
+        raise ObservationFileError(str(exc)) from None
+    if source:
+        model.meta['source'] = source
+    return model
+
+
+def load_observation(source) -> CountObservation:
+    """
+    Read and validate an observation file given by path or shipped name.
+
+    Raises
+    ------
+    ObservationFileError
+        If the file is missing, is not YAML or breaks the format; the message names the file.
+
+    """
+    path = resolve_source(source)
+    try:
+        text = path.read_text(encoding='utf-8')
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ObservationFileError(f'{path}: cannot read: {exc}') from None
+    try:
+        doc = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, 'problem_mark', None)
+        where = f' at line {mark.line + 1}' if mark is not None else ''
+        raise ObservationFileError(f'{path}: not YAML{where}') from None
+    except RecursionError:
+        raise ObservationFileError(f'{path}: YAML nested too deeply to read') from None
+    try:
+        return model_from_dict(doc, source=path.stem)
+    except ObservationFileError as exc:
+        raise ObservationFileError(f'{path}: {exc}') from None
+
+
+def model_to_dict(model: CountObservation) -> dict:
+    """Return the YAML document of a count model (plain Python types)."""
+    grid = {'rows': model.grid.rows, 'cols': model.grid.cols}
+    if model.grid.spacing_deg != 1.0:
+        grid['spacing_deg'] = model.grid.spacing_deg
+    doc = {'format': FORMAT, 'model': model.name, 'grid': grid}
+    for key in RECORDS[:3]:
+        if key in model.meta:
+            doc[key] = _plain(model.meta[key])
+    doc['target'] = np.round(model.p_target, 12).tolist()
+    doc['null'] = np.round(model.p_null, 12).tolist()
+    if 'calibration' in model.meta:
+        doc['calibration'] = _plain(model.meta['calibration'])
+    return doc
+
+
+def save_observation(path, model: CountObservation) -> Path:
+    """Write ``model`` as an observation file (validated first, so what is written loads)."""
+    doc = model_to_dict(model)
+    model_from_dict(doc)
+    path = Path(path)
+    if path.parent != Path(''):
+        path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=100),
+                    encoding='utf-8')
+    return path
+
+
+def _plain(value):
+    """Convert numpy scalars and arrays (nested in dicts and lists) to plain Python types."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    return value
