@@ -1,0 +1,318 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Object detectors for the digital fovea: the interface, OpenCV's Viola-Jones cascade, grey images.
+
+**The interface** (docs/design.md section 6) is deliberately small, so any detector can be plugged
+in: a detector is a callable ``detector(gray) -> boxes`` that takes a 2-D ``uint8`` grey image and
+returns an integer array of shape ``(M, 4)``, one row ``x, y, w, h`` per *raw* detection in that
+image's pixels (ungrouped: the count observation model counts the raw detections, so overlapping
+hits of one face are the evidence, not noise to be merged). Three optional attributes are used
+when present:
+
+- ``window_px``: ``(width, height)`` of the smallest image the detector can see anything in.
+  :func:`to_gray` rejects input images smaller than that;
+- ``settings()``: a plain dict recorded in observation files, so a model is only ever applied with
+  the detector it was measured with;
+- ``group(boxes, min_neighbors)``: how to merge raw boxes into final detections (else
+  :func:`group_boxes`).
+
+:class:`HaarDetector` is the reference detector of Butko & Movellan's CVPR 2009 follow-up:
+``haarcascade_frontalface_alt2.xml`` with ``detectMultiScale(gray, 1.1, minNeighbors=0)``.
+
+**Pixel coordinates.** A box ``(x, y, w, h)`` covers ``[x, x+w) x [y, y+h)`` and has its centre at
+``(x + w/2, y + h/2)``; pixel ``(r, c)`` covers ``[c, c+1) x [r, r+1)``.
+"""
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+from typing import Protocol, runtime_checkable
+
+import cv2
+import numpy as np
+
+REFERENCE_CASCADE = 'haarcascade_frontalface_alt2.xml'
+# Debian/Ubuntu's python3-opencv has no cv2.data; the cascades come with the opencv-data package.
+SYSTEM_CASCADE_DIRS = (Path('/usr/share/opencv4/haarcascades'),)
+# detectMultiScale's own grouping: clusters of rectangles whose sides and corners differ by less
+# than eps = 0.2 of the mean size merge; clusters of at most min_neighbors rectangles are dropped.
+GROUP_EPS = 0.2
+DEFAULT_MIN_NEIGHBORS = 3
+# Smallest image side anything is done with: a 1x1 image has no spatial structure at all.
+MIN_SIDE_PX = 2
+
+
+@runtime_checkable
+class Detector(Protocol):
+    """Anything called as ``detector(gray) -> (M, 4)`` integer boxes ``x, y, w, h`` (raw)."""
+
+    def __call__(self, gray: np.ndarray) -> np.ndarray:
+        """Detect objects in a 2-D ``uint8`` image; return the raw boxes in its pixels."""
+
+
+def as_boxes(boxes) -> np.ndarray:
+    """
+    Return ``boxes`` as an ``int64`` array of shape ``(M, 4)``, rows ``x, y, w, h``.
+
+    OpenCV returns an empty tuple when nothing is found; a user's detector may return a list.
+
+    Raises
+    ------
+    ValueError
+        If the boxes are not ``(M, 4)`` integers with positive widths and heights.
+
+    """
+    array = np.asarray(boxes)
+    if array.size == 0:
+        return np.empty((0, 4), dtype=np.int64)
+    if array.ndim != 2 or array.shape[1] != 4:
+        raise ValueError(f'a detector must return boxes of shape (M, 4), got {array.shape}')
+    if not np.issubdtype(array.dtype, np.integer):
+        if not np.array_equal(array, np.round(array)):
+            raise ValueError('a detector must return integer boxes x, y, w, h in pixels')
+    array = array.astype(np.int64)
+    if np.any(array[:, 2:] <= 0):
+        raise ValueError('every box must have a positive width and height')
+    return array
+
+
+def box_centres_px(boxes: np.ndarray) -> np.ndarray:
+    """Centres ``(x + w/2, y + h/2)`` of boxes ``(M, 4)``, as ``float64`` of shape ``(M, 2)``."""
+    boxes = np.asarray(boxes, dtype=np.float64).reshape(-1, 4)
+    return boxes[:, :2] + boxes[:, 2:] / 2.0
+
+
+def group_boxes(boxes, min_neighbors: int = DEFAULT_MIN_NEIGHBORS,
+                eps: float = GROUP_EPS) -> np.ndarray:
+    """
+    Merge raw detections as ``detectMultiScale(..., minNeighbors=min_neighbors)`` does.
+
+    Calls ``cv2.groupRectangles(boxes, min_neighbors, eps)``, the grouping OpenCV applies inside
+    ``detectMultiScale`` (with ``eps = 0.2``): rectangles are clustered when their corners differ
+    by less than ``eps`` times their mean size, each cluster of more than ``min_neighbors``
+    rectangles becomes its mean rectangle and the rest are dropped, as are grouped rectangles
+    lying inside a larger one. Grouping the raw (``minNeighbors=0``) detections of an image with
+    the default ``min_neighbors=3`` therefore gives OpenCV's default answer without running the
+    cascade twice. ``min_neighbors=0`` returns the boxes unchanged, as OpenCV does.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``int64`` of shape ``(G, 4)``, rows ``x, y, w, h``.
+
+    """
+    boxes = as_boxes(boxes)
+    if min_neighbors < 0:
+        raise ValueError(f'min_neighbors must be >= 0, got {min_neighbors!r}')
+    if len(boxes) == 0 or min_neighbors == 0:
+        return boxes
+    grouped, _ = cv2.groupRectangles(boxes.tolist(), int(min_neighbors), float(eps))
+    return as_boxes(grouped)
+
+
+def find_cascade(name: str = REFERENCE_CASCADE, path=None) -> Path:
+    """
+    Find a cascade file: ``path`` first, then OpenCV's own copy, then the system's.
+
+    Parameters
+    ----------
+    name : str
+        File name of the cascade, e.g. ``'haarcascade_frontalface_alt2.xml'``. A name with a
+        folder in it (``'models/my.xml'``) is itself the first place searched.
+    path : str or os.PathLike, optional
+        Searched first: a folder holding ``name``, or a cascade file. The other places are
+        searched for the file name of ``name``.
+
+    Returns
+    -------
+    pathlib.Path
+        The first existing file of: ``path``; ``cv2.data.haarcascades`` (pip's
+        opencv-python wheels; Debian's python3-opencv has no ``cv2.data``); then
+        :data:`SYSTEM_CASCADE_DIRS` (Debian's opencv-data package).
+
+    Raises
+    ------
+    FileNotFoundError
+        If no place has the file; the message lists every place searched, in order.
+
+    """
+    places = []
+    file_name = Path(name).name
+    if path is not None:
+        path = Path(path)
+        places.append(path / file_name if path.is_dir() else path)
+    if len(Path(name).parts) > 1:
+        places.append(Path(name))
+    data = getattr(cv2, 'data', None)
+    if data is not None and getattr(data, 'haarcascades', None):
+        places.append(Path(data.haarcascades) / file_name)
+    places += [folder / file_name for folder in SYSTEM_CASCADE_DIRS]
+    for place in places:
+        if place.is_file():
+            return place
+    searched = '\n  '.join(str(place) for place in places)
+    raise FileNotFoundError(
+        f'cascade {name!r} not found; searched, in order:\n  {searched}\n'
+        'install opencv-python-headless<5 (pip) or opencv-data (apt), or pass its path')
+
+
+def _size_pair(name: str, value) -> tuple[int, int] | None:
+    """``None``, or ``(width, height)`` in pixels from one side or a pair of positive ints."""
+    if value is None:
+        return None
+    pair = (value, value) if np.ndim(value) == 0 else tuple(value)
+    if len(pair) != 2 or any(isinstance(v, bool) or int(v) != v or v < 1 for v in pair):
+        raise ValueError(f'{name} must be a positive int or a (width, height) pair, got {value!r}')
+    return (int(pair[0]), int(pair[1]))
+
+
+class HaarDetector:
+    """
+    OpenCV's Viola-Jones cascade returning raw, ungrouped detections (the CVPR 2009 detector).
+
+    Parameters
+    ----------
+    cascade : str or os.PathLike
+        Cascade file name or path, resolved with :func:`find_cascade`.
+    scale_factor : float
+        Scale step of ``detectMultiScale``'s image pyramid (> 1).
+    min_neighbors : int
+        ``detectMultiScale``'s ``minNeighbors``; 0 (the reference) returns raw detections.
+    min_size_px, max_size_px : int or (int, int), optional
+        Smallest and largest box ``(width, height)`` searched for, in the pixels of the image the
+        detector is given (for the fovea: the resized window), or ``None`` for no limit.
+    cascade_dir : str or os.PathLike, optional
+        Folder (or file) searched before the default places.
+
+    """
+
+    def __init__(self, cascade=REFERENCE_CASCADE, scale_factor: float = 1.1,
+                 min_neighbors: int = 0, min_size_px=None, max_size_px=None, cascade_dir=None):
+        scale_factor = float(scale_factor)
+        if not np.isfinite(scale_factor) or scale_factor <= 1.0:
+            raise ValueError(f'scale_factor must be a finite number > 1, got {scale_factor!r}')
+        if isinstance(min_neighbors, bool) or int(min_neighbors) != min_neighbors \
+                or min_neighbors < 0:
+            raise ValueError(f'min_neighbors must be an int >= 0, got {min_neighbors!r}')
+        self.scale_factor = scale_factor
+        self.min_neighbors = int(min_neighbors)
+        self.min_size_px = _size_pair('min_size_px', min_size_px)
+        self.max_size_px = _size_pair('max_size_px', max_size_px)
+        self.path = find_cascade(str(cascade), cascade_dir)
+        self.cascade_name = self.path.name
+        self._classifier = cv2.CascadeClassifier(str(self.path))
+        if self._classifier.empty():
+            raise ValueError(f'{self.path} is not a cascade OpenCV can load')
+        width, height = self._classifier.getOriginalWindowSize()
+        self.window_px = (int(width), int(height))
+        self._sha256 = hashlib.sha256(self.path.read_bytes()).hexdigest()
+        self._options = {}
+        if self.min_size_px is not None:
+            self._options['minSize'] = self.min_size_px
+        if self.max_size_px is not None:
+            self._options['maxSize'] = self.max_size_px
+
+    def __call__(self, gray: np.ndarray) -> np.ndarray:
+        """
+        Raw boxes ``(M, 4)`` ``int64`` ``x, y, w, h`` in the pixels of ``gray`` (2-D ``uint8``).
+
+        An image smaller than the cascade's window (``window_px``) holds no detection and gives
+        ``(0, 4)``: a foveal window resized below the window size simply sees nothing. The rows
+        are sorted (lexicographically by ``x, y, w, h``): OpenCV searches in parallel and returns
+        them in an order that changes from run to run, which would make the grouped boxes'
+        order, and so ties between them, irreproducible.
+        """
+        if gray.ndim != 2 or gray.dtype != np.uint8:
+            raise ValueError(f'the detector needs a 2-D uint8 image, got {gray.dtype} '
+                             f'of shape {gray.shape}')
+        if gray.shape[1] < self.window_px[0] or gray.shape[0] < self.window_px[1]:
+            return np.empty((0, 4), dtype=np.int64)
+        boxes = as_boxes(self._classifier.detectMultiScale(
+            gray, scaleFactor=self.scale_factor, minNeighbors=self.min_neighbors,
+            **self._options))
+        return boxes[np.lexsort(boxes.T[::-1])]
+
+    def group(self, boxes, min_neighbors: int = DEFAULT_MIN_NEIGHBORS) -> np.ndarray:
+        """Group raw boxes as OpenCV does: :func:`group_boxes` with ``eps = 0.2``."""
+        return group_boxes(boxes, min_neighbors, GROUP_EPS)
+
+    def settings(self) -> dict:
+        """
+        Plain-typed settings, as recorded in an observation file.
+
+        The file's name and SHA-256 identify the cascade wherever it was installed from; the
+        OpenCV version is recorded because cascade evaluation has changed between releases.
+        """
+        return {
+            'kind': 'haar',
+            'cascade': self.cascade_name,
+            'cascade_sha256': self._sha256,
+            'scale_factor': self.scale_factor,
+            'min_neighbors': self.min_neighbors,
+            'min_size_px': None if self.min_size_px is None else list(self.min_size_px),
+            'max_size_px': None if self.max_size_px is None else list(self.max_size_px),
+            'window_px': list(self.window_px),
+            'opencv': cv2.__version__,
+        }
+
+    def __repr__(self) -> str:
+        """Show the cascade and the detectMultiScale arguments."""
+        return (f'HaarDetector({self.cascade_name!r}, scale_factor={self.scale_factor}, '
+                f'min_neighbors={self.min_neighbors}, min_size_px={self.min_size_px}, '
+                f'max_size_px={self.max_size_px})')
+
+
+def detector_settings(detector) -> dict:
+    """``detector.settings()`` if it has one, else ``{'kind': <its type name>}``."""
+    settings = getattr(detector, 'settings', None)
+    return dict(settings()) if callable(settings) else {'kind': type(detector).__name__}
+
+
+def detector_window_px(detector) -> tuple[int, int]:
+    """Smallest ``(width, height)`` the detector can see anything in (at least 2x2 pixels)."""
+    window = getattr(detector, 'window_px', None)
+    if window is None:
+        return (MIN_SIDE_PX, MIN_SIDE_PX)
+    return (max(int(window[0]), MIN_SIDE_PX), max(int(window[1]), MIN_SIDE_PX))
+
+
+def to_gray(image, min_size_px=(MIN_SIDE_PX, MIN_SIDE_PX)) -> np.ndarray:
+    """
+    Return a 2-D ``uint8`` grey image (C-contiguous) from a grey or an RGB ``uint8`` image.
+
+    Parameters
+    ----------
+    image : numpy.ndarray
+        ``(H, W)`` grey or ``(H, W, 3)`` in **RGB** channel order (what scikit-image, PIL and
+        the project's scenes use; an array read with ``cv2.imread`` is BGR and must be converted
+        first, ``cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB)``), ``uint8``. Converted with
+        ``cv2.cvtColor(image, cv2.COLOR_RGB2GRAY)`` (``0.299 R + 0.587 G + 0.114 B``).
+    min_size_px : (int, int)
+        Smallest accepted ``(width, height)``: the detector's window (20x20 for the reference
+        cascade; see :func:`detector_window_px`). Never below 2x2.
+
+    Raises
+    ------
+    ValueError
+        Naming the problem: not an array, not ``uint8``, a shape other than ``(H, W)`` or
+        ``(H, W, 3)`` (e.g. 4-channel RGBA), or smaller than ``min_size_px``.
+
+    """
+    if not isinstance(image, np.ndarray):
+        raise ValueError(f'image must be a numpy array, got {type(image).__name__}')
+    if image.dtype != np.uint8:
+        raise ValueError(f'image must be uint8 (0..255), got dtype {image.dtype}')
+    if image.ndim == 3 and image.shape[2] != 3:
+        raise ValueError(f'a colour image must have 3 channels (RGB), got {image.shape[2]} '
+                         f'(shape {image.shape}); convert RGBA or other layouts first')
+    if image.ndim not in (2, 3):
+        raise ValueError(f'image must be (H, W) grey or (H, W, 3) RGB, got shape {image.shape}')
+    min_width, min_height = (max(int(v), MIN_SIDE_PX) for v in min_size_px)
+    height, width = image.shape[:2]
+    if width < min_width or height < min_height:
+        raise ValueError(f'image of {width}x{height} pixels (WxH) is smaller than the '
+                         f'{min_width}x{min_height} the detector needs')
+    if image.ndim == 3:
+        return cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_RGB2GRAY)
+    return np.ascontiguousarray(image)

@@ -1,0 +1,406 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The digital fovea of Butko & Movellan's CVPR 2009 follow-up: count observations from a detector.
+
+A ``rows x cols`` grid tiles the whole image (docs/design.md section 6). Fixating a cell places
+nested square windows of :attr:`FoveaConfig.windows_cells` cells (reference ``(21, 15, 9, 3)``)
+centred on it. Each window is resized by its own scale factor and searched by the detector; the
+centre of every raw detection is mapped back to full-image pixels and binned to its cell. A
+cell's observation is the number of detections centred in it, summed over windows and clipped
+to ``0..max_count-1``; cells outside every window are NaN, "not observed" (section 1.4).
+
+**Geometry.** Per axis, a window of ``s`` cells on a grid of ``G`` cells covers
+``n = min(s, G)`` cells starting at ``clip(p - s // 2, 0, G - n)`` for a fixation at ``p``: it is
+centred on the fixated cell (odd sizes) and *shifted, not cropped*, to stay inside the grid, so
+it always covers ``n`` cells; a window as large as the grid covers the whole image. Cell ``r`` of
+an image ``H`` pixels high spans rows ``floor(r * H / rows)`` to ``floor((r + 1) * H / rows) - 1``
+(as in NMPT), so windows tile exactly when ``H`` is not a multiple of ``rows``. A point
+``(x, y)`` (a detection's box centre, ``(x + w/2, y + h/2)``) lies in cell
+``(floor(y * rows / H), floor(x * cols / W))``, the convention of the labelled scenes; the rare
+centre in the sub-pixel sliver where the integer window edge and this continuous cell edge
+disagree is counted in the window's own edge cell, so only covered cells ever get counts.
+
+**Resolution.** A window of ``w x h`` pixels is resized to ``round(w * scale) x round(h * scale)``
+(at least 1x1). NMPT's reference resizes every window to the pixel size of the smallest one
+(``scale = min(windows_cells) / cells``: the 3-cell window at full resolution, the 21-cell one 7x
+down); that is the default. Faces must still be about the cascade's 20 px where the detector
+sees them, so small faces vanish from the coarse windows: hence a scale per window. A window
+larger than the grid is resized by its own factor after being cut down to the grid.
+
+**Interpolation.** NMPT uses nearest neighbour. The default here is ``'area'``
+(``cv2.INTER_AREA``): at 7x down nearest neighbour keeps one pixel in 49 and aliases the Haar
+features, whereas area averaging is the anti-aliased decimation (a box filter, exact and fast for
+integer factors). The choice is recorded in :meth:`FoveaConfig.to_dict`, as a model measured with
+one interpolation is only valid with it.
+
+**Cost and caching.** The whole-image window does not depend on the fixation: its detections are
+computed on the first fixation after :meth:`Fovea.start` and reused for the rest of the image, so
+its pixels count once per image (as in NMPT). With ``reuse_windows=True`` every window's
+detections are kept per image, keyed by the cells it covers (the detector is deterministic, so a
+repeated window gives the same boxes); this changes the cost, never the counts.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+import time
+from typing import NamedTuple
+
+import cv2
+from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.vision.detector import (as_boxes, box_centres_px, detector_settings,
+                                         detector_window_px, to_gray)
+import numpy as np
+
+REFERENCE_WINDOWS_CELLS = (21, 15, 9, 3)
+REFERENCE_MAX_COUNT = 10
+INTERPOLATIONS = {
+    'area': cv2.INTER_AREA,
+    'nearest': cv2.INTER_NEAREST,
+    'nearest_exact': cv2.INTER_NEAREST_EXACT,
+    'linear': cv2.INTER_LINEAR,
+    'cubic': cv2.INTER_CUBIC,
+}
+
+
+def _positive_int(name: str, value) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise ValueError(f'{name} must be a positive int, got {value!r}')
+    return int(value)
+
+
+@dataclass(frozen=True)
+class FoveaConfig:
+    """
+    Windows, resolutions, count range and interpolation of a digital fovea (validated).
+
+    Parameters
+    ----------
+    windows_cells : tuple of int
+        Side of each square window in cells, strictly decreasing (largest first).
+    scales : tuple of float, optional
+        Resize factor in ``(0, 1]`` of each window. ``None`` means NMPT's
+        ``min(windows_cells) / cells`` and is replaced by those numbers, so two configurations
+        that resize alike compare equal and :meth:`to_dict` records the actual factors.
+    max_count : int
+        K: observations are clipped to ``0..K-1`` (at least 2).
+    interpolation : str
+        Resampling used to resize windows, a key of :data:`INTERPOLATIONS`.
+
+    """
+
+    windows_cells: tuple = REFERENCE_WINDOWS_CELLS
+    scales: tuple | None = None
+    max_count: int = REFERENCE_MAX_COUNT
+    interpolation: str = 'area'
+
+    def __post_init__(self):
+        windows = self.windows_cells
+        if np.ndim(windows) != 1 or len(windows) == 0:
+            raise ValueError(f'windows_cells must be a non-empty sequence, got {windows!r}')
+        windows = tuple(_positive_int('every window size (cells)', w) for w in windows)
+        if any(a <= b for a, b in zip(windows, windows[1:])):
+            raise ValueError(f'windows_cells must be strictly decreasing, got {windows}')
+        if self.scales is None:
+            scales = tuple(windows[-1] / w for w in windows)
+        else:
+            if np.ndim(self.scales) != 1 or len(self.scales) != len(windows):
+                raise ValueError(f'scales needs one factor per window ({len(windows)}), '
+                                 f'got {self.scales!r}')
+            scales = tuple(float(s) for s in self.scales)
+            if not all(np.isfinite(s) and 0.0 < s <= 1.0 for s in scales):
+                raise ValueError(f'every scale must be in (0, 1], got {scales}')
+        max_count = self.max_count
+        if isinstance(max_count, bool) or not isinstance(max_count, (int, np.integer)) \
+                or max_count < 2:
+            raise ValueError(f'max_count must be an int >= 2, got {max_count!r}')
+        if self.interpolation not in INTERPOLATIONS:
+            raise ValueError(f'interpolation must be one of {sorted(INTERPOLATIONS)}, '
+                             f'got {self.interpolation!r}')
+        object.__setattr__(self, 'windows_cells', windows)
+        object.__setattr__(self, 'scales', scales)
+        object.__setattr__(self, 'max_count', int(max_count))
+
+    @property
+    def cv2_interpolation(self) -> int:
+        """Return the ``cv2.INTER_*`` flag of :attr:`interpolation`."""
+        return INTERPOLATIONS[self.interpolation]
+
+    def to_dict(self) -> dict:
+        """Plain types for YAML/JSON: lists for the tuples, the scales resolved."""
+        return {'windows_cells': list(self.windows_cells), 'scales': list(self.scales),
+                'max_count': self.max_count, 'interpolation': self.interpolation}
+
+    @classmethod
+    def from_dict(cls, data: dict) -> FoveaConfig:
+        """Inverse of :meth:`to_dict`; missing keys take the defaults, unknown keys are errors."""
+        if not isinstance(data, dict):
+            raise ValueError(f'a fovea configuration must be a mapping, got {type(data).__name__}')
+        unknown = set(data) - {'windows_cells', 'scales', 'max_count', 'interpolation'}
+        if unknown:
+            raise ValueError(f'unknown fovea settings: {sorted(unknown)}')
+        values = dict(data)
+        for key in ('windows_cells', 'scales'):
+            if values.get(key) is not None:
+                values[key] = tuple(values[key])
+        return cls(**values)
+
+
+class Window(NamedTuple):
+    """One window of a fixation: where it is (cells and pixels) and the size it is resized to."""
+
+    cells: tuple
+    """``(row, col, n_rows, n_cols)``: first cell and extent in cells."""
+    rect_px: tuple
+    """``(x, y, width, height)`` in full-image pixels (OpenCV's rectangle order)."""
+    resized_px: tuple
+    """``(width, height)`` of the image the detector is given."""
+    scale: float
+    """The configured resize factor."""
+    whole_image: bool
+    """True if the window covers the whole grid, so it does not depend on the fixation."""
+
+
+@dataclass(frozen=True, eq=False)
+class Observation:
+    """
+    The count observation of one fixation, and what it cost.
+
+    Attributes
+    ----------
+    counts : numpy.ndarray
+        ``(N,)`` ``float64``: detections centred in each cell, summed over windows, clipped to
+        ``0..max_count-1``; NaN for cells outside every window.
+    raw_counts : numpy.ndarray
+        ``(N,)`` ``int64``: the same counts before clipping (0 where not observed).
+    fixation : int
+        Row-major index of the fixated cell.
+    windows : tuple of Window
+        The windows, largest first.
+    centres_px : numpy.ndarray
+        ``(M, 2)`` ``float64``: ``x, y`` of every raw detection's centre in full-image pixels.
+    window_index : numpy.ndarray
+        ``(M,)`` ``int64``: the window each detection came from.
+    detector_pixels : int
+        Pixels of the images given to the detector for this fixation (the resized windows);
+        a window whose detections were reused from the cache counts 0.
+    seconds : float
+        Wall time of this fixation: resizing, detector and binning.
+    from_cache : tuple of bool
+        For each window, whether its detections were reused rather than computed.
+
+    """
+
+    counts: np.ndarray
+    raw_counts: np.ndarray
+    fixation: int
+    windows: tuple
+    centres_px: np.ndarray
+    window_index: np.ndarray
+    detector_pixels: int
+    seconds: float
+    from_cache: tuple
+
+
+def cell_edges_px(size_px: int, n_cells: int) -> np.ndarray:
+    """First pixel of every cell and the end, ``floor(i * size_px / n_cells)``, shape (n+1,)."""
+    return (np.arange(n_cells + 1, dtype=np.int64) * int(size_px)) // int(n_cells)
+
+
+def window_cells(grid_shape: tuple[int, int], windows_cells, fixation_rc) -> np.ndarray:
+    """
+    Place the windows of one fixation: ``(K, 4)`` ``int64`` rows ``row, col, n_rows, n_cols``.
+
+    Per axis a window of ``s`` cells covers ``n = min(s, G)`` cells starting at
+    ``clip(p - s // 2, 0, G - n)``: centred on the fixated cell ``p`` and shifted (not cropped)
+    to stay inside the grid of ``G`` cells.
+    """
+    sizes = np.asarray(windows_cells, dtype=np.int64)
+    placed = []
+    for axis_cells, p in zip(grid_shape, fixation_rc):
+        n = np.minimum(sizes, axis_cells)
+        placed.append((np.clip(p - sizes // 2, 0, axis_cells - n), n))
+    (row, n_rows), (col, n_cols) = placed
+    return np.stack([row, col, n_rows, n_cols], axis=1)
+
+
+def _resized(size_px: int, scale: float) -> int:
+    """``round(size_px * scale)`` (halves up), at least 1."""
+    return max(1, int(np.floor(size_px * scale + 0.5)))
+
+
+class Fovea:
+    """
+    A digital fovea over one image at a time: ``start(image)``, then ``observe(fixation)``.
+
+    Parameters
+    ----------
+    detector : callable
+        ``detector(gray) -> (M, 4)`` raw boxes ``x, y, w, h`` (see
+        :mod:`ipomdp_gaze.vision.detector`).
+    grid : Grid or (int, int)
+        The grid tiling every image, ``rows x cols`` (the paper: 21x21).
+    config : FoveaConfig, optional
+        Windows, scales, K and interpolation; the reference configuration by default.
+    reuse_windows : bool
+        Keep every window's detections for the current image, not only the whole-image window's.
+
+    Attributes
+    ----------
+    image_detector_pixels : int
+        Detector pixels spent on the current image so far (all fixations).
+    image_seconds : float
+        Wall time spent on the current image so far: :meth:`start` (grey conversion) and every
+        :meth:`observe`.
+    n_fixations : int
+        Fixations observed on the current image.
+
+    """
+
+    def __init__(self, detector, grid=(21, 21), config: FoveaConfig | None = None,
+                 reuse_windows: bool = False):
+        if not callable(detector):
+            raise ValueError(f'detector must be callable, got {type(detector).__name__}')
+        self.detector = detector
+        self.grid = grid if isinstance(grid, Grid) else Grid(*grid)
+        self.config = FoveaConfig() if config is None else config
+        if not isinstance(self.config, FoveaConfig):
+            raise ValueError(f'config must be a FoveaConfig, got {type(self.config).__name__}')
+        self.reuse_windows = bool(reuse_windows)
+        self._scales = np.asarray(self.config.scales)
+        self._gray = None
+        self._row_edges_px = self._col_edges_px = None
+        self._cache = {}
+        self.image_detector_pixels = 0
+        self.image_seconds = 0.0
+        self.n_fixations = 0
+
+    def settings(self) -> dict:
+        """Grid, fovea and detector settings, as recorded in an observation file."""
+        return {'grid': [self.grid.rows, self.grid.cols], 'fovea': self.config.to_dict(),
+                'detector': detector_settings(self.detector)}
+
+    @property
+    def image_shape(self) -> tuple[int, int] | None:
+        """``(H, W)`` of the current image, or ``None`` before :meth:`start`."""
+        return None if self._gray is None else self._gray.shape
+
+    def start(self, image: np.ndarray) -> None:
+        """
+        Take a new image (grey or RGB ``uint8``, see :func:`to_gray`) and forget the last one.
+
+        Raises
+        ------
+        ValueError
+            If the image is not a valid grey/RGB ``uint8`` image, is smaller than the detector's
+            window, or has fewer pixels than the grid has cells along a side (a cell would be
+            empty).
+
+        """
+        t0 = time.perf_counter()
+        gray = to_gray(image, detector_window_px(self.detector))
+        height, width = gray.shape
+        if height < self.grid.rows or width < self.grid.cols:
+            raise ValueError(f'image of {width}x{height} pixels (WxH) is smaller than the '
+                             f'{self.grid.cols}x{self.grid.rows} grid: some cells would be empty')
+        self._gray = gray
+        self._row_edges_px = cell_edges_px(height, self.grid.rows)
+        self._col_edges_px = cell_edges_px(width, self.grid.cols)
+        self._cache = {}
+        self.image_detector_pixels = 0
+        self.n_fixations = 0
+        self.image_seconds = time.perf_counter() - t0
+
+    def window_rects(self, fixation: int, image_shape=None) -> tuple[Window, ...]:
+        """
+        Place the windows of a fixation, in cells and pixels, largest first (also for plots).
+
+        ``image_shape`` ``(H, W)`` defaults to the current image's.
+        """
+        row, col = self.grid.cell(fixation)
+        if image_shape is None:
+            if self._gray is None:
+                raise RuntimeError('no image: call start(image) first or pass image_shape')
+            row_edges, col_edges = self._row_edges_px, self._col_edges_px
+        else:
+            height, width = (int(v) for v in image_shape[:2])
+            row_edges = cell_edges_px(height, self.grid.rows)
+            col_edges = cell_edges_px(width, self.grid.cols)
+        placed = window_cells(self.grid.shape, self.config.windows_cells, (row, col))
+        whole = (placed[:, 2] == self.grid.rows) & (placed[:, 3] == self.grid.cols)
+        y0, y1 = row_edges[placed[:, 0]], row_edges[placed[:, 0] + placed[:, 2]]
+        x0, x1 = col_edges[placed[:, 1]], col_edges[placed[:, 1] + placed[:, 3]]
+        windows = []
+        for i, scale in enumerate(self.config.scales):
+            width_px, height_px = int(x1[i] - x0[i]), int(y1[i] - y0[i])
+            windows.append(Window(
+                cells=tuple(int(v) for v in placed[i]),
+                rect_px=(int(x0[i]), int(y0[i]), width_px, height_px),
+                resized_px=(_resized(width_px, scale), _resized(height_px, scale)),
+                scale=float(scale), whole_image=bool(whole[i])))
+        return tuple(windows)
+
+    def observe(self, fixation: int) -> Observation:
+        """
+        Fixate a cell of the current image and return its count :class:`Observation`.
+
+        Raises
+        ------
+        RuntimeError
+            Before :meth:`start`.
+        ValueError
+            If the fixation is not a cell of the grid, or the detector returns malformed boxes.
+
+        """
+        t0 = time.perf_counter()
+        windows = self.window_rects(fixation)
+        rows, cols = self.grid.shape
+        observed = np.zeros((rows, cols), dtype=bool)
+        cells, centres, window_index, from_cache = [], [], [], []
+        pixels = 0
+        for i, window in enumerate(windows):
+            row, col, n_rows, n_cols = window.cells
+            observed[row:row + n_rows, col:col + n_cols] = True
+            key = (i, window.cells)
+            found = self._cache.get(key)
+            from_cache.append(found is not None)
+            if found is None:
+                found = self._search(window)
+                pixels += window.resized_px[0] * window.resized_px[1]
+                if window.whole_image or self.reuse_windows:
+                    self._cache[key] = found
+            centres.append(found[0])
+            cells.append(found[1])
+            window_index.append(np.full(len(found[1]), i, dtype=np.int64))
+        cells = np.concatenate(cells)
+        raw = np.bincount(cells, minlength=rows * cols).astype(np.int64)
+        counts = np.where(observed.ravel(), np.minimum(raw, self.config.max_count - 1), np.nan)
+        seconds = time.perf_counter() - t0
+        self.image_detector_pixels += pixels
+        self.image_seconds += seconds
+        self.n_fixations += 1
+        return Observation(counts=counts.astype(np.float64), raw_counts=raw,
+                           fixation=self.grid.index(*self.grid.cell(fixation)),
+                           windows=windows, centres_px=np.concatenate(centres),
+                           window_index=np.concatenate(window_index), detector_pixels=pixels,
+                           seconds=seconds, from_cache=tuple(from_cache))
+
+    def _search(self, window: Window) -> tuple[np.ndarray, np.ndarray]:
+        """Detect in one window: centres ``(M, 2)`` in full-image pixels and their cells."""
+        x, y, width_px, height_px = window.rect_px
+        out_width, out_height = window.resized_px
+        crop = self._gray[y:y + height_px, x:x + width_px]
+        if (out_width, out_height) == (width_px, height_px):
+            view = np.ascontiguousarray(crop)
+        else:
+            view = cv2.resize(crop, (out_width, out_height),
+                              interpolation=self.config.cv2_interpolation)
+        boxes = as_boxes(self.detector(view))
+        centres = box_centres_px(boxes) * (width_px / out_width, height_px / out_height) + (x, y)
+        height, width = self._gray.shape
+        row, col, n_rows, n_cols = window.cells
+        cell_row = np.clip(np.floor(centres[:, 1] * self.grid.rows / height).astype(np.int64),
+                           row, row + n_rows - 1)
+        cell_col = np.clip(np.floor(centres[:, 0] * self.grid.cols / width).astype(np.int64),
+                           col, col + n_cols - 1)
+        return centres, cell_row * self.grid.cols + cell_col
