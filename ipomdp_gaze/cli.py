@@ -16,7 +16,7 @@ import sys
 
 # Modules under ipomdp_gaze.commands, in the order --help lists their subcommands: evaluate,
 # search, train, reproduce, demo, then controller and camera (both from nodes).
-COMMANDS = ('evaluate', 'search', 'train', 'reproduce', 'demo', 'nodes')
+COMMANDS = ('evaluate', 'search', 'train', 'calibrate', 'reproduce', 'demo', 'nodes')
 
 
 class CliError(Exception):

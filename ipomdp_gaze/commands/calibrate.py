@@ -1,0 +1,202 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+``ipomdp-gaze calibrate``: measure a count model of a real detector behind the digital fovea.
+
+From labelled images (a folder and a CSV of face-centre pixels, a user's own data) or from
+generated training scenes (``--scenes N``, the training split only: test faces and backgrounds
+are never used), every image is fixated at every cell and the counts tallied per offset
+(:mod:`ipomdp_gaze.vision.calibrate`). Writes the observation file, prints the hit and
+false-alarm rates ``P(c > 0)`` per offset, and draws the learned FPOC.
+"""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+import time
+
+from ipomdp_gaze.grid import Grid, parse_grid
+import numpy as np
+
+from .common import grid_arg, nonneg_int, positive_float, positive_int
+
+# The two tasks of the face issue: image side and face sizes in pixels.
+TASKS = {'paper': (420, (60, 140)), 'small': (840, (24, 140))}
+
+
+def _numbers(kind):
+    def parse(text: str):
+        try:
+            return tuple(kind(eval_fraction(part)) for part in text.split(','))
+        except (ValueError, ZeroDivisionError):
+            raise argparse.ArgumentTypeError(f'expected comma-separated numbers, got '
+                                             f'{text!r}') from None
+    return parse
+
+
+def eval_fraction(text: str) -> float:
+    """Read ``'0.25'`` or ``'1/7'`` as a number."""
+    num, sep, den = text.strip().partition('/')
+    return float(num) / float(den) if sep else float(num)
+
+
+def add_parser(sub):
+    p = sub.add_parser('calibrate', help='measure a count model of a detector behind the fovea',
+                       description='Fixate every cell of labelled images, tally the detector '
+                                   'counts per offset from the fixation with and without the '
+                                   'face, and write an ipomdp_gaze/observation-v1 file.')
+    source = p.add_mutually_exclusive_group(required=True)
+    source.add_argument('--scenes', type=positive_int, metavar='N',
+                        help='N generated training scenes (training faces and backgrounds only)')
+    source.add_argument('--images', type=Path, metavar='FOLDER',
+                        help='a folder of images, labelled by --labels')
+    p.add_argument('--labels', type=Path, metavar='CSV',
+                   help='CSV "path,x,y" of face-centre pixels (empty x,y: no face)')
+    p.add_argument('--task', choices=tuple(TASKS), default='paper',
+                   help='scene size and face sizes of --scenes: paper (420 px, faces 60-140) '
+                        'or small (840 px, faces 24-140); default paper')
+    p.add_argument('--absent-rate', type=float, default=0.0,
+                   help='fraction of --scenes without a face (default 0)')
+    p.add_argument('--seed', type=nonneg_int, default=0, help='scene seed (default 0)')
+    p.add_argument('--grid', type=grid_arg, default=parse_grid('21x21'),
+                   help='grid tiling each image (default 21x21)')
+    p.add_argument('--windows', type=_numbers(int), default=(21, 15, 9, 3), metavar='W,...',
+                   help='fovea window sides in cells, largest first (default 21,15,9,3)')
+    p.add_argument('--scales', type=_numbers(float), default=None, metavar='S,...',
+                   help='resize factor per window, e.g. 1/7,1/5,1/3,1 (default: NMPT, the '
+                        'pixel size of the smallest window)')
+    p.add_argument('--interpolation', default='area',
+                   help='window resampling: area (default), nearest, linear, cubic')
+    p.add_argument('--max-count', type=positive_int, default=10,
+                   help='K: counts are clipped to 0..K-1 (default 10)')
+    p.add_argument('--scale-factor', type=positive_float, default=1.1,
+                   help='detectMultiScale scale factor (default 1.1)')
+    p.add_argument('--prior', type=positive_float, default=1.0,
+                   help='Dirichlet prior per count (default 1)')
+    p.add_argument('--pool-radius', type=float, default=0.5,
+                   help='pool target tallies of offsets within this distance in cells '
+                        '(default 0.5; 0: none)')
+    p.add_argument('--min-tallies', type=nonneg_int, default=50,
+                   help='widen the pooling where an offset has fewer target observations '
+                        '(default 50)')
+    p.add_argument('--processes', type=positive_int, default=2)
+    p.add_argument('--out', type=Path, required=True, metavar='FILE.yaml')
+    p.add_argument('--plot', type=Path, default=None, metavar='PNG',
+                   help='figure of the learned FPOC (default: beside --out)')
+    p.add_argument('--quiet', action='store_true', help='no progress bar')
+    p.set_defaults(run=run)
+
+
+def _items(args, grid: Grid):
+    """Labelled items for the workers and the image size they share."""
+    if args.scenes is not None:
+        if args.labels is not None:
+            raise ValueError('--labels goes with --images, not --scenes')
+        size, faces = TASKS[args.task]
+        kwargs = {'split': 'train', 'size_px': size, 'face_px': faces, 'grid': grid.shape,
+                  'absent_rate': args.absent_rate, 'seed': args.seed}
+        from ipomdp_gaze.vision.scenes import SceneSet
+        SceneSet(**kwargs)                                   # validate before the workers
+        return [('scene', kwargs, i) for i in range(args.scenes)], (size, size), kwargs
+    if args.labels is None:
+        raise ValueError('--images needs --labels CSV')
+    from ipomdp_gaze.vision.scenes import cell_of_point, read_labelled_folder
+    labelled = read_labelled_folder(args.images, args.labels)
+    if not labelled:
+        raise ValueError(f'{args.labels} lists no images')
+    shapes = {item.image.shape[:2] for item in labelled}
+    if len(shapes) > 1:
+        raise ValueError(f'images must share one size to calibrate one model, got '
+                         f'{sorted(shapes)}')
+    shape = shapes.pop()
+    items = []
+    for item in labelled:
+        cell = None
+        if item.centre_px is not None:
+            r, c = cell_of_point(item.centre_px[0], item.centre_px[1], shape, grid.shape)
+            cell = r * grid.cols + c
+        items.append((item.image, cell))
+    return items, shape, {'images': str(args.images), 'labels': str(args.labels)}
+
+
+def rate_table(model, size: int = 6) -> str:
+    """Hit / false-alarm rates ``P(c > 0)`` for offsets up to ``size - 1`` cells, as text."""
+    from ipomdp_gaze.vision.calibrate import hit_false_alarm
+    hit, fa = hit_false_alarm(model)
+    size = min(size, hit.shape[0], hit.shape[1])
+    head = '|dr| \\ |dc| ' + ''.join(f'{dc:>14d}' for dc in range(size))
+    lines = ['P(count > 0): hit (target in the cell) / false alarm (no target)', head]
+    for dr in range(size):
+        cells = [f'  {hit[dr, dc]:.3f}/{fa[dr, dc]:.4f}' for dc in range(size)]
+        lines.append(f'{dr:>11d} ' + ''.join(cells))
+    return '\n'.join(lines)
+
+
+def plot_fpoc(model, path: Path, title: str) -> None:
+    """Heatmaps of the hit and false-alarm rates by offset, and both against distance."""
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    from ipomdp_gaze.vision.calibrate import hit_false_alarm
+    hit, fa = hit_false_alarm(model)
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4))
+    for ax, data, name in ((axes[0], hit, 'P(c > 0 | target)'),
+                           (axes[1], fa, 'P(c > 0 | no target)')):
+        image = ax.imshow(data, origin='upper', cmap='viridis')
+        fig.colorbar(image, ax=ax)
+        ax.set(title=name, xlabel='|dc| (cells)', ylabel='|dr| (cells)')
+    dr, dc = np.meshgrid(np.arange(hit.shape[0]), np.arange(hit.shape[1]), indexing='ij')
+    dist = np.hypot(dr, dc).ravel()
+    axes[2].plot(dist, hit.ravel(), 'o', ms=3, label='target')
+    axes[2].plot(dist, fa.ravel(), 's', ms=3, label='no target')
+    axes[2].set(yscale='log', xlabel='distance from the fixation (cells)',
+                ylabel='P(c > 0)', title='learned FPOC')
+    axes[2].legend()
+    axes[2].grid(True, alpha=0.3)
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def run(args) -> int:
+    from ipomdp_gaze.observation_file import save_observation
+    from ipomdp_gaze.vision.calibrate import count_model, tally_images
+    from ipomdp_gaze.vision.detector import HaarDetector
+    from ipomdp_gaze.vision.fovea import FoveaConfig
+    if args.out.suffix != '.yaml':
+        raise ValueError(f'--out must end in .yaml, got {args.out}')
+    if not np.isfinite(args.pool_radius) or args.pool_radius < 0:
+        raise ValueError(f'--pool-radius must be >= 0, got {args.pool_radius}')
+    grid = Grid(args.grid[0], args.grid[1], 1.0)
+    config = FoveaConfig(windows_cells=args.windows, scales=args.scales,
+                         max_count=args.max_count, interpolation=args.interpolation)
+    detector_kwargs = {'scale_factor': args.scale_factor}
+    detector = HaarDetector(**detector_kwargs)
+    items, (height, width), source = _items(args, grid)
+    from tqdm import tqdm
+    bar = tqdm(total=len(items), unit='image', disable=args.quiet, desc='calibrate')
+    start = time.perf_counter()
+    tallies = tally_images(items, detector_kwargs, grid, config, args.processes, bar.update)
+    bar.close()
+    wall = time.perf_counter() - start
+    meta = {'image': {'width': int(width), 'height': int(height)}, 'fovea': config.to_dict(),
+            'detector': detector.settings(),
+            'calibration': {'source': {'scenes': args.scenes, 'task': args.task,
+                                       'seed': args.seed, 'absent_rate': args.absent_rate}
+                            if args.scenes is not None else source,
+                            'images': tallies.images, 'fixations': tallies.fixations,
+                            'prior': args.prior, 'pool_radius': args.pool_radius,
+                            'min_tallies': args.min_tallies,
+                            'detector_pixels': int(tallies.detector_pixels),
+                            'wall_seconds': round(wall, 1)}}
+    model = count_model(tallies, grid, args.prior, args.pool_radius, args.min_tallies, meta)
+    save_observation(args.out, model)
+    print(rate_table(model))
+    plot = args.plot if args.plot is not None else args.out.with_suffix('.png')
+    plot_fpoc(model, plot, f'{args.out.stem}: {tallies.images} images of {width}x{height} px, '
+                           f'{grid.rows}x{grid.cols} grid, windows {list(config.windows_cells)}')
+    print(f'calibrated on {tallies.images} images ({tallies.fixations} fixations) in '
+          f'{wall:.1f} s; wrote {args.out} and {plot}')
+    return 0

@@ -1,0 +1,209 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Calibrate a count model from labelled images: the learned FPOC of a real detector and fovea.
+
+Every labelled image is fixated at every cell (docs/design.md section 6). For each fixation k
+and each observed cell j, the clipped count ``c_j`` is tallied at the offset
+``(|r_j - r_k|, |c_j - c_k|)``: in the target table when j holds the face centre, in the null
+table otherwise (every cell of a face-absent image is null). The tables are the tallies with a
+Dirichlet(``prior``) prior per offset, ``p(c | offset) = (n_c + prior) / (n + K prior)``.
+
+Target data are sparse: one cell per fixation holds the face, so an image gives each offset at
+most a few target tallies, and offsets a face centre never reaches (the far corners) none.
+``pool_radius`` pools the target tallies of offsets whose Euclidean distances
+``sqrt(dr^2 + dc^2)`` are within that many cells of each other (a radial FPOC, the paper's
+assumption), widened where fewer than ``min_tallies`` observations would remain; this trades
+angular detail for far less noise.
+
+The work is one fovea pass per (image, fixation): :func:`tally_images` spreads images over
+processes, each with its own detector (OpenCV objects cannot be shared).
+"""
+from __future__ import annotations
+
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+
+from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.observation import CountObservation
+from ipomdp_gaze.vision.detector import HaarDetector
+from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig
+import numpy as np
+
+
+@dataclass
+class Tallies:
+    """Count tallies per offset: ``target[|dr|, |dc|, c]`` and ``null[|dr|, |dc|, c]``."""
+
+    target: np.ndarray
+    null: np.ndarray
+    images: int = 0
+    fixations: int = 0
+    detector_pixels: int = 0
+    seconds: float = 0.0
+
+    @classmethod
+    def empty(cls, grid: Grid, max_count: int) -> Tallies:
+        """Zero tallies for a grid and K = ``max_count``."""
+        shape = grid.shape + (max_count,)
+        return cls(np.zeros(shape, dtype=np.int64), np.zeros(shape, dtype=np.int64))
+
+    def __iadd__(self, other: Tallies) -> Tallies:
+        self.target += other.target
+        self.null += other.null
+        self.images += other.images
+        self.fixations += other.fixations
+        self.detector_pixels += other.detector_pixels
+        self.seconds += other.seconds
+        return self
+
+
+def tally_image(fovea: Fovea, image: np.ndarray, target_cell: int | None,
+                fixations=None) -> Tallies:
+    """
+    Tally the clipped counts of one labelled image fixated at ``fixations`` (default: all).
+
+    ``target_cell`` is the cell holding the face centre, or None for a face-absent image.
+    """
+    grid, k_max = fovea.grid, fovea.config.max_count
+    rows, cols = grid.shape
+    fixations = np.arange(grid.n_cells) if fixations is None else np.asarray(fixations)
+    fovea.start(image)
+    frames = np.empty((fixations.size, grid.n_cells))
+    for i, k in enumerate(fixations):
+        frames[i] = fovea.observe(int(k)).counts
+    r, c = grid.rows_cols()
+    rk, ck = grid.cell(fixations)
+    dr = np.abs(r[None, :] - rk[:, None])
+    dc = np.abs(c[None, :] - ck[:, None])
+    seen = ~np.isnan(frames)
+    counts = np.where(seen, frames, 0).astype(np.intp)
+    flat = (dr * cols + dc) * k_max + counts
+    is_target = np.zeros(grid.n_cells, dtype=bool)
+    if target_cell is not None:
+        is_target[int(target_cell)] = True
+    size = rows * cols * k_max
+    null = np.bincount(flat[seen & ~is_target[None, :]], minlength=size)
+    target = np.bincount(flat[seen & is_target[None, :]], minlength=size)
+    shape = (rows, cols, k_max)
+    return Tallies(target.reshape(shape), null.reshape(shape), images=1,
+                   fixations=int(fixations.size), detector_pixels=fovea.image_detector_pixels,
+                   seconds=fovea.image_seconds)
+
+
+def _worker_tally(job) -> Tallies:
+    """Tally a chunk of images in a worker process (its own detector and fovea)."""
+    import cv2
+    cv2.setNumThreads(1)
+    detector_kwargs, grid_shape, config, items = job
+    fovea = Fovea(HaarDetector(**detector_kwargs), grid_shape, FoveaConfig.from_dict(config),
+                  reuse_windows=True)
+    total = Tallies.empty(fovea.grid, fovea.config.max_count)
+    for item in items:
+        image, target = _resolve(item)
+        total += tally_image(fovea, image, target)
+    return total
+
+
+def _resolve(item):
+    """Return ``(image, target_cell)`` of an item, regenerating ``('scene', kwargs, i)``."""
+    if len(item) == 3 and isinstance(item[0], str) and item[0] == 'scene':
+        from ipomdp_gaze.vision.scenes import SceneSet
+        scene = SceneSet(**item[1]).scene(item[2])
+        if scene.cell is None:
+            return scene.image, None
+        rows, cols = item[1]['grid']
+        return scene.image, scene.cell[0] * cols + scene.cell[1]
+    return item
+
+
+def tally_images(items, detector_kwargs: dict, grid: Grid, config: FoveaConfig,
+                 processes: int = 2, progress=None) -> Tallies:
+    """
+    Tally many labelled images, spread over ``processes`` worker processes.
+
+    Parameters
+    ----------
+    items : list
+        ``(image, target_cell)`` pairs (target None when the image has no face), or
+        ``('scene', SceneSet keyword arguments, index)`` triples regenerated in the workers.
+    detector_kwargs : dict
+        Arguments of :class:`HaarDetector`.
+    grid, config
+        The grid tiling each image and the fovea.
+    processes : int
+        Worker processes (1: in this process).
+    progress : callable, optional
+        Called with the number of images done after each chunk.
+
+    """
+    total = Tallies.empty(grid, config.max_count)
+    chunk = max(1, min(8, len(items) // max(1, 4 * processes)))
+    jobs = [(dict(detector_kwargs), grid.shape, config.to_dict(), items[i:i + chunk])
+            for i in range(0, len(items), chunk)]
+    if processes <= 1:
+        for job in jobs:
+            total += _worker_tally(job)
+            if progress:
+                progress(len(job[3]))
+        return total
+    with ProcessPoolExecutor(processes) as pool:
+        for job, part in zip(jobs, pool.map(_worker_tally, jobs)):
+            total += part
+            if progress:
+                progress(len(job[3]))
+    return total
+
+
+def pool_target(tallies: np.ndarray, pool_radius: float, min_tallies: int = 0) -> np.ndarray:
+    """
+    Pool the target tallies of offsets at similar Euclidean distances from the fixation.
+
+    Each offset sums the tallies of every offset whose distance ``sqrt(dr^2 + dc^2)`` is within
+    ``pool_radius`` cells of its own; where that holds fewer than ``min_tallies`` observations
+    the radius grows in half-cell steps until it does (offsets a face never reaches, such as
+    the far corners, borrow from the nearest distances that have data).
+    """
+    rows, cols, _ = tallies.shape
+    flat = tallies.reshape(rows * cols, -1).astype(float)
+    if pool_radius <= 0 and min_tallies <= 0:
+        return flat.reshape(tallies.shape)
+    dr, dc = np.meshgrid(np.arange(rows), np.arange(cols), indexing='ij')
+    dist = np.hypot(dr, dc).reshape(-1)
+    gap = np.abs(dist[:, None] - dist[None, :])                          # (RC, RC)
+    pooled = np.full_like(flat, np.nan)
+    radius = max(pool_radius, 0.0)
+    while np.isnan(pooled[:, 0]).any():
+        candidate = (gap <= radius + 1e-9).astype(float) @ flat
+        enough = np.isnan(pooled[:, 0]) & ((candidate.sum(axis=1) >= min_tallies)
+                                           | (radius > dist.max()))
+        pooled[enough] = candidate[enough]
+        radius += 0.5
+    return pooled.reshape(tallies.shape)
+
+
+def count_model(tallies: Tallies, grid: Grid, prior: float = 1.0, pool_radius: float = 0.5,
+                min_tallies: int = 50, meta: dict | None = None) -> CountObservation:
+    """
+    Build the count model: Dirichlet(``prior``) estimates, target tallies pooled radially.
+
+    Raises
+    ------
+    ValueError
+        For a prior that is not positive or tallies with no target observation at all.
+
+    """
+    if not np.isfinite(prior) or prior <= 0:
+        raise ValueError(f'prior must be a positive number, got {prior!r}')
+    if tallies.target.sum() == 0:
+        raise ValueError('no labelled face was observed: the target table would be the prior')
+    target = pool_target(tallies.target, pool_radius, min_tallies) + prior
+    null = tallies.null.astype(float) + prior
+    target /= target.sum(axis=2, keepdims=True)
+    null /= null.sum(axis=2, keepdims=True)
+    return CountObservation(grid, target, null, meta)
+
+
+def hit_false_alarm(model: CountObservation) -> tuple[np.ndarray, np.ndarray]:
+    """``P(c > 0 | target, offset)`` and ``P(c > 0 | no target, offset)``, each (rows, cols)."""
+    return 1.0 - model.p_target[:, :, 0], 1.0 - model.p_null[:, :, 0]

@@ -1,0 +1,126 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""Calibration of count models: tallies per offset, pooling, priors and the command."""
+import subprocess
+import sys
+
+from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.observation_file import load_observation
+from ipomdp_gaze.vision.calibrate import (count_model, hit_false_alarm, pool_target, Tallies,
+                                          tally_image)
+from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig
+from ipomdp_gaze.vision.scenes import SceneSet, write_scene_set
+import numpy as np
+import pytest
+
+GRID = Grid(5, 5, 1.0)
+
+
+def test_tally_image_counts_every_fixation_at_its_offset():
+    """A detector that always reports the target cell: hits at every offset, no false alarms."""
+    config = FoveaConfig(windows_cells=(5,), scales=(1.0,), max_count=3)
+
+    def detector(gray):
+        # The 50x50 image is one window: a detection centred in cell (1, 3) (x 35, y 15).
+        return np.array([[33, 13, 4, 4], [33, 13, 4, 4], [33, 13, 4, 4], [33, 13, 4, 4]])
+
+    fovea = Fovea(detector, GRID, config)
+    image = np.zeros((50, 50), dtype=np.uint8)
+    tallies = tally_image(fovea, image, target_cell=GRID.index(1, 3))
+    assert tallies.images == 1 and tallies.fixations == 25
+    # Every fixation sees count 4, clipped to K-1 = 2, in the target cell, at its own offset.
+    assert tallies.target[:, :, 2].sum() == 25 and tallies.target[:, :, :2].sum() == 0
+    rows, cols = np.meshgrid(range(5), range(5), indexing='ij')
+    expected = np.zeros((5, 5), dtype=int)
+    np.add.at(expected, (np.abs(rows - 1).ravel(), np.abs(cols - 3).ravel()), 1)
+    np.testing.assert_array_equal(tallies.target[:, :, 2], expected)
+    # Every other cell shows 0, at its offset, for each fixation: 24 null tallies per fixation.
+    assert tallies.null[:, :, 0].sum() == 25 * 24 and tallies.null[:, :, 1:].sum() == 0
+    absent = tally_image(fovea, image, target_cell=None)
+    assert absent.target.sum() == 0 and absent.null[:, :, 2].sum() == 25
+
+
+def test_count_model_uses_the_dirichlet_prior_and_pools_radially():
+    tallies = Tallies.empty(GRID, 3)
+    tallies.target[0, 0] = [0, 2, 8]
+    tallies.null[0, 0] = [97, 2, 1]
+    tallies.null[1:, :, 0] = 10
+    tallies.null[0, 1:, 0] = 10
+    model = count_model(tallies, GRID, prior=1.0, pool_radius=0.0, min_tallies=0)
+    np.testing.assert_allclose(model.p_target[0, 0], [1 / 13, 3 / 13, 9 / 13])
+    np.testing.assert_allclose(model.p_null[0, 0], [98 / 103, 3 / 103, 2 / 103])
+    np.testing.assert_allclose(model.p_target[4, 4], [1 / 3] * 3)        # no data: the prior
+    hit, fa = hit_false_alarm(model)
+    assert hit[0, 0] == pytest.approx(12 / 13) and fa[0, 0] == pytest.approx(5 / 103)
+    with pytest.raises(ValueError, match='no labelled face'):
+        count_model(Tallies.empty(GRID, 3), GRID)
+
+
+def test_pooling_sums_offsets_at_similar_distances_and_widens_where_data_are_thin():
+    tallies = np.zeros((3, 3, 2))
+    tallies[0, 1] = [1, 3]                      # distance 1
+    tallies[1, 0] = [2, 2]                      # distance 1
+    tallies[2, 2] = [0, 0]                      # distance 2.83: no data
+    pooled = pool_target(tallies, 0.0)
+    np.testing.assert_array_equal(pooled, tallies)
+    pooled = pool_target(tallies, 0.1)
+    np.testing.assert_array_equal(pooled[0, 1], [3, 5])
+    np.testing.assert_array_equal(pooled[1, 0], [3, 5])
+    wide = pool_target(tallies, 0.1, min_tallies=4)
+    np.testing.assert_array_equal(wide[2, 2], [3, 5])       # borrowed from distance 1
+    assert wide[2, 2].sum() >= 4
+
+
+def test_calibrate_command_on_scenes_and_on_a_labelled_folder(tmp_path):
+    """Tiny runs: the hit rate at offset 0 beats the false-alarm rate (real detector)."""
+    out = tmp_path / 'faces.yaml'
+    done = subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', 'calibrate', '--scenes', '6',
+                           '--grid', '7x7', '--windows', '7,3', '--scales', '1/2,1',
+                           '--processes', '1', '--out', str(out), '--quiet'],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    model = load_observation(out)
+    hit, fa = hit_false_alarm(model)
+    assert hit[0, 0] > fa[0, 0]
+    assert model.meta['image'] == {'width': 420, 'height': 420}
+    assert model.meta['fovea']['windows_cells'] == [7, 3]
+    assert model.meta['calibration']['images'] == 6
+    assert (tmp_path / 'faces.png').is_file() and 'hit' in done.stdout
+    folder = tmp_path / 'labelled'
+    write_scene_set([SceneSet('train', grid=(7, 7), seed=4)[i] for i in range(3)], folder)
+    done = subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', 'calibrate', '--images',
+                           str(folder), '--labels', str(folder / 'labels.csv'), '--grid', '7x7',
+                           '--windows', '7,3', '--processes', '1', '--out',
+                           str(tmp_path / 'mine.yaml'), '--quiet'],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert load_observation(tmp_path / 'mine.yaml').meta['calibration']['images'] == 3
+
+
+@pytest.mark.parametrize('args, message', [
+    (['--scenes', '2', '--labels', 'x.csv'], '--labels goes with --images'),
+    (['--images', '.'], '--images needs --labels CSV'),
+    (['--scenes', '2', '--windows', '3,7'], 'strictly decreasing'),
+    (['--scenes', '2', '--scales', '1/0'], 'expected comma-separated numbers'),
+    (['--scenes', '2', '--out', 'x.json'], '--out must end in .yaml'),
+])
+def test_bad_arguments_are_one_line(args, message, tmp_path):
+    argv = [sys.executable, '-m', 'ipomdp_gaze.cli', 'calibrate', *args]
+    if '--out' not in args:
+        argv += ['--out', str(tmp_path / 'o.yaml')]
+    done = subprocess.run(argv, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2 and 'Traceback' not in done.stderr
+    assert message in done.stderr.strip().splitlines()[-1]
+
+
+def test_a_csv_naming_pixels_outside_the_image_is_refused(tmp_path):
+    folder = tmp_path / 'labelled'
+    write_scene_set([SceneSet('train', seed=5)[0]], folder)
+    csv = folder / 'labels.csv'
+    name = csv.read_text().splitlines()[1].split(',')[0]
+    csv.write_text(f'path,x,y\n{name},999,5\n')
+    done = subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', 'calibrate', '--images',
+                           str(folder), '--labels', str(csv), '--out', str(tmp_path / 'o.yaml'),
+                           '--quiet'], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2 and 'Traceback' not in done.stderr
+    assert 'outside' in done.stderr.strip().splitlines()[-1]
