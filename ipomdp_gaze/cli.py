@@ -15,8 +15,8 @@ import importlib
 import sys
 
 # Modules under ipomdp_gaze.commands, in the order --help lists their subcommands: evaluate,
-# search, train, reproduce, demo, then controller and camera (both from nodes).
-COMMANDS = ('evaluate', 'search', 'train', 'calibrate', 'reproduce', 'demo', 'nodes')
+# search, find, train, calibrate, reproduce, demo, then controller and camera (both from nodes).
+COMMANDS = ('evaluate', 'search', 'find', 'train', 'calibrate', 'reproduce', 'demo', 'nodes')
 
 
 class CliError(Exception):

@@ -12,7 +12,7 @@ from __future__ import annotations
 from .baselines import make_baseline, STRATEGIES
 from .conv import check_action, ConvPolicy
 
-POLICY_NAMES = ('learned',) + STRATEGIES
+POLICY_NAMES = ('learned',) + STRATEGIES + ('nmpt',)
 
 
 class PolicyUnavailable(ValueError):
@@ -24,11 +24,12 @@ def build_policy(name: str, grid, model, kernel=None, file: str = '', action: st
     """
     Build the policy called ``name`` (one of :data:`POLICY_NAMES`).
 
-    ``model`` is the task's observation model (or an FPOC, for the Gaussian model). ``learned``
-    uses ``kernel`` (a convolutional kernel, 2-D or row-major) when it is non-empty, else the
-    policy ``file`` (a policy YAML path or a shipped kernel name); ``action`` (``argmax`` or
-    ``sample``) applies to it. A file trained on another FPOC is accepted and ``warn(message)``
-    is called; one for another grid is refused.
+    ``model`` is the task's observation model (or an FPOC, for the Gaussian model). ``nmpt`` is
+    NMPT's fixed policy (:class:`ipomdp_gaze.policies.nmpt.NMPTPolicy`; it always samples).
+    ``learned`` uses ``kernel`` (a convolutional kernel, 2-D or row-major) when it is non-empty,
+    else the policy ``file`` (a policy YAML path or a shipped kernel name); ``action``
+    (``argmax`` or ``sample``) applies to it. A file trained on another FPOC is accepted and
+    ``warn(message)`` is called; one for another grid is refused.
 
     Raises
     ------
@@ -47,6 +48,9 @@ def build_policy(name: str, grid, model, kernel=None, file: str = '', action: st
         except ImportError as exc:
             raise PolicyUnavailable(f'policy {name!r} is not available in this install '
                                     f'({exc})') from None
+    if name == 'nmpt':
+        from .nmpt import NMPTPolicy
+        return NMPTPolicy(grid)
     if name != 'learned':
         raise ValueError(f"unknown policy {name!r}; valid policies: {', '.join(POLICY_NAMES)}")
     if kernel is not None and len(kernel):

@@ -21,7 +21,8 @@ def test_help_lists_subcommands():
     for name in ('evaluate', 'search', 'demo'):
         assert name in out.stdout
     assert re.findall(r'^    (\w+)', out.stdout, re.M) == [
-        'evaluate', 'search', 'train', 'calibrate', 'reproduce', 'demo', 'controller', 'camera']
+        'evaluate', 'search', 'find', 'train', 'calibrate', 'reproduce', 'demo', 'controller',
+        'camera']
 
 
 @pytest.mark.parametrize('command, node', [('controller', 'gaze_controller'),

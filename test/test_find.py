@@ -1,0 +1,233 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""``ipomdp-gaze find`` on generated scenes, with a count model calibrated on train scenes."""
+import json
+from pathlib import Path
+import subprocess
+import sys
+
+import cv2
+from ipomdp_gaze.cli import main
+from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.observation import CountObservation
+from ipomdp_gaze.observation_file import load_observation, save_observation
+from ipomdp_gaze.vision.detector import HaarDetector
+from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig
+from ipomdp_gaze.vision.fullframe import scan
+from ipomdp_gaze.vision.scenes import SceneSet
+import numpy as np
+import pytest
+
+GRID = Grid(21, 21)
+TASK = {'size_px': 420, 'face_px': (60, 140), 'grid': (21, 21)}
+TRAIN_SCENES = 8
+JSON_KEYS = ['path', 'cell', 'pixel', 'probability', 'fixations', 'detector_pixels', 'seconds',
+             'stop']
+
+
+def run_find(*args, cwd=None):
+    return subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', 'find', *map(str, args)],
+                          capture_output=True, text=True, timeout=300, cwd=cwd)
+
+
+def calibrate(scenes, detector, config):
+    """
+    Count model from labelled scenes fixated at every cell (Dirichlet(1) prior).
+
+    Target tallies are pooled over offsets at the same Chebyshev distance, because a handful of
+    images gives each single offset only a few target observations.
+    """
+    fovea = Fovea(detector, GRID, config, reuse_windows=True)
+    n, k = GRID.n_cells, config.max_count
+    rows, cols = GRID.rows_cols()
+    offset = (np.abs(rows[None, :] - rows[:, None]) * GRID.cols
+              + np.abs(cols[None, :] - cols[:, None]))           # [fixation, cell]
+    target, null = np.zeros(n * k), np.zeros(n * k)
+    for scene in scenes:
+        fovea.start(scene.image)
+        frames = np.array([fovea.observe(f).counts for f in range(n)])
+        seen = ~np.isnan(frames)
+        flat = offset * k + np.where(seen, frames, 0).astype(np.intp)
+        face = np.arange(n) == GRID.index(*scene.cell)
+        target += np.bincount(flat[seen & face], minlength=n * k)
+        null += np.bincount(flat[seen & ~face], minlength=n * k)
+    target, null = target.reshape(GRID.shape + (k,)), null.reshape(GRID.shape + (k,))
+    ring = np.maximum(*np.meshgrid(np.arange(GRID.rows), np.arange(GRID.cols), indexing='ij'))
+    pooled = np.stack([target[ring == d].sum(axis=0) for d in range(ring.max() + 1)])[ring]
+    p_target = (pooled + 1.0) / (pooled + 1.0).sum(axis=2, keepdims=True)
+    p_null = (null + 1.0) / (null + 1.0).sum(axis=2, keepdims=True)
+    meta = {'image': {'width': TASK['size_px'], 'height': TASK['size_px']},
+            'fovea': config.to_dict(), 'detector': detector.settings()}
+    return CountObservation(GRID, p_target, p_null, meta)
+
+
+@pytest.fixture(scope='module')
+def task(tmp_path_factory):
+    """Calibrate a model on train scenes and write test scenes as PNG files."""
+    root = tmp_path_factory.mktemp('find')
+    detector, config = HaarDetector(), FoveaConfig()
+    model = calibrate(SceneSet('train', seed=0, n=TRAIN_SCENES, **TASK), detector, config)
+    model_path = save_observation(root / 'faces-test.yaml', model)
+    # The test scene: the first one whose face the full-frame scan finds (within one cell), so
+    # the choice depends on the detector only, never on the model or on find.
+    test = SceneSet('test', seed=0, **TASK)
+    chosen = []
+    for index in range(20):
+        scene = test[index]
+        found = scan(scene.image, detector, GRID).cell
+        if found is not None and max(np.abs(np.subtract(GRID.cell(found), scene.cell))) <= 1:
+            chosen.append(scene)
+        if len(chosen) == 2:
+            break
+    images = []
+    for i, scene in enumerate(chosen):
+        cv2.imwrite(str(root / f'scene{i}.png'), scene.image)
+        images.append(root / f'scene{i}.png')
+    return {'root': root, 'model': model_path, 'images': images, 'scenes': chosen}
+
+
+def within_one_cell(cell, scene):
+    return max(abs(cell[0] - scene.cell[0]), abs(cell[1] - scene.cell[1])) <= 1
+
+
+def test_find_locates_the_face_of_a_test_scene(task, tmp_path):
+    out = tmp_path / 'out.json'
+    result = run_find(task['images'][0], '--observation', task['model'], '--json', out)
+    assert result.returncode == 0, result.stderr
+    lines = result.stdout.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"{task['images'][0]}: cell (")
+    for word in ('pixel (', 'p=', 'fixations=', 'detector_pixels=', 'seconds='):
+        assert word in lines[0]
+    assert 'observation model faces-test' in result.stderr and 'policy elm' in result.stderr
+    entry = json.loads(out.read_text())['images'][0]
+    assert within_one_cell(entry['cell'], task['scenes'][0])
+    assert entry['probability'] >= 0.9 and entry['stop'] == 'found'
+    assert 0 < entry['detector_pixels'] < 420 * 420 and entry['seconds'] > 0
+
+
+def test_json_has_one_entry_per_image_in_input_order(task):
+    root = task['root']
+    names = [path.name for path in reversed(task['images'])]
+    out = root / 'two.json'
+    result = run_find(*names, '--observation', task['model'], '--json', 'two.json', cwd=root)
+    assert result.returncode == 0, result.stderr
+    data = json.loads(out.read_text())
+    assert list(data) == ['grid', 'images'] and data['grid'] == {'rows': 21, 'cols': 21}
+    assert [entry['path'] for entry in data['images']] == names
+    lines = result.stdout.strip().splitlines()
+    assert [line.split(': cell')[0] for line in lines] == names
+    for entry, scene in zip(data['images'], reversed(task['scenes'])):
+        assert list(entry) == JSON_KEYS
+        assert isinstance(entry['cell'], list) and len(entry['pixel']) == 2
+        row, col = entry['cell']
+        assert entry['pixel'] == [col * 20 + 10.0, row * 20 + 10.0]
+        assert isinstance(entry['fixations'], int) and isinstance(entry['detector_pixels'], int)
+        assert within_one_cell(entry['cell'], scene)
+
+
+def test_plot_writes_png_files(task, tmp_path, capsys):
+    one = tmp_path / 'one.png'
+    assert main(['find', str(task['images'][0]), '--observation', str(task['model']),
+                 '--plot', str(one)]) == 0
+    picture = cv2.imread(str(one))
+    assert picture is not None and picture.shape[0] > 100
+    many = tmp_path / 'many.png'
+    assert main(['find', *map(str, task['images']), '--observation', str(task['model']),
+                 '--plot', str(many)]) == 0
+    assert cv2.imread(str(tmp_path / 'many-0.png')) is not None
+    assert cv2.imread(str(tmp_path / 'many-1.png')) is not None
+    assert not many.exists()
+    assert 'wrote' in capsys.readouterr().err
+
+
+def test_nmpt_policy_and_another_image_size(task, tmp_path, capsys):
+    scene = task['scenes'][0]
+    big = tmp_path / 'big.png'
+    cv2.imwrite(str(big), cv2.resize(scene.image, (840, 840), interpolation=cv2.INTER_CUBIC))
+    assert main(['find', str(big), '--observation', str(task['model']), '--policy', 'nmpt',
+                 '--seed', '2']) == 0
+    out = capsys.readouterr()
+    assert '(image 840x840 px, model calibrated at 420x420)' in out.out
+    assert 'policy nmpt' in out.err
+
+
+def _model_copy(path, model, width, height):
+    meta = dict(model.meta)
+    meta.pop('source', None)
+    meta['image'] = {'width': width, 'height': height}
+    return save_observation(path, CountObservation(model.grid, model.p_target, model.p_null,
+                                                   meta))
+
+
+def test_default_model_is_the_shipped_one_calibrated_nearest(task, tmp_path, monkeypatch,
+                                                             capsys):
+    import ipomdp_gaze.observation_file as observation_file
+    models = tmp_path / 'models'
+    monkeypatch.setattr(observation_file, 'MODEL_DIR', models)
+    assert main(['find', str(task['images'][0])]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and 'pass --observation FILE' in err[0]
+    model = load_observation(task['model'])
+    _model_copy(models / 'a-faces-420.yaml', model, 420, 420)
+    _model_copy(models / 'b-faces-800.yaml', model, 800, 800)
+    big = tmp_path / 'big.png'
+    cv2.imwrite(str(big), cv2.resize(task['scenes'][0].image, (840, 840)))
+    assert main(['find', str(task['images'][0]), str(big)]) == 0
+    err = capsys.readouterr().err
+    assert 'shipped observation model a-faces-420' in err
+    assert 'shipped observation model b-faces-800' in err
+
+
+def test_default_policy_is_the_shipped_kernel_of_the_model(task, tmp_path, monkeypatch,
+                                                           capsys):
+    from ipomdp_gaze.policies import policy_file
+    from ipomdp_gaze.policies.baselines import elm_policy
+    kernels = tmp_path / 'kernels'
+    kernels.mkdir()
+    monkeypatch.setattr(policy_file, 'KERNEL_DIR', kernels)
+    model = load_observation(task['model'])
+    spec = policy_file.PolicySpec(grid=model.grid, fpoc=None, reward='infomax', family='conv',
+                                  observation=policy_file.observation_block(model),
+                                  kernel=elm_policy(model.grid, model).kernel)
+    policy_file.save_policy(kernels / 'faces-test-infomax.yaml', spec)
+    assert main(['find', str(task['images'][0]), '--observation', str(task['model'])]) == 0
+    assert 'shipped kernel faces-test-infomax (argmax)' in capsys.readouterr().err
+
+
+@pytest.mark.parametrize('make, message', [
+    (lambda d: d / 'missing.png', 'no such file'),
+    (lambda d: _write(d / 'text.png', b'not an image'), 'not an image OpenCV can decode'),
+    (lambda d: _png(d / 'deep.png', np.zeros((420, 420), dtype=np.uint16)), '16-bit'),
+    (lambda d: _png(d / 'dot.png', np.zeros((1, 1), dtype=np.uint8)), 'too small'),
+])
+def test_a_bad_image_is_one_error_line_before_any_search(task, tmp_path, make, message):
+    bad = make(tmp_path)
+    result = run_find(task['images'][0], bad, '--observation', task['model'])
+    assert result.returncode == 2
+    assert result.stdout == ''                           # the good first image was not searched
+    assert 'Traceback' not in result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, lines
+    assert lines[0].startswith(f'ipomdp-gaze find: error: {bad}: ') and message in lines[0]
+
+
+def test_a_malformed_observation_file_is_one_error_line(task, tmp_path):
+    broken = _write(tmp_path / 'broken.yaml', b'format: ipomdp_gaze/observation-v1\nmodel: [\n')
+    result = run_find(task['images'][0], '--observation', broken)
+    assert result.returncode == 2 and result.stdout == ''
+    assert 'Traceback' not in result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and str(broken) in lines[0] and 'not YAML' in lines[0]
+    truncated = _write(tmp_path / 'short.yaml', Path(task['model']).read_bytes()[:2000])
+    result = run_find(task['images'][0], '--observation', truncated)
+    assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1
+
+
+def _write(path, data: bytes):
+    path.write_bytes(data)
+    return path
+
+
+def _png(path, image):
+    assert cv2.imwrite(str(path), image)
+    return path
