@@ -4,7 +4,7 @@ VENV := .venv
 VPY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: venv demo test bench reproduce soak clean
+.PHONY: venv demo test bench reproduce faces soak clean
 
 venv: $(STAMP)
 
@@ -32,6 +32,10 @@ bench: $(STAMP)
 
 reproduce: $(STAMP)
 	$(VENV)/bin/ipomdp-gaze reproduce
+
+# Face search on 300 held-out scenes per task: writes docs/faces.md (about 15 minutes).
+faces: $(STAMP)
+	$(VPY) bench/faces.py
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache
