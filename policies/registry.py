@@ -13,6 +13,8 @@ from .baselines import make_baseline, STRATEGIES
 from .conv import check_action, ConvPolicy
 
 POLICY_NAMES = ('learned',) + STRATEGIES + ('nmpt',)
+# Policies built from a name alone (no kernel or file): what the CLI's --policy takes.
+NAMED_POLICIES = POLICY_NAMES[1:]
 
 
 class PolicyUnavailable(ValueError):

@@ -9,8 +9,7 @@ from pathlib import Path
 from ipomdp_gaze.evaluation import fixations_to_90_ci
 from ipomdp_gaze.observation import as_observation, GaussianObservation
 from ipomdp_gaze.observation_file import fingerprint
-from ipomdp_gaze.policies.baselines import STRATEGIES
-from ipomdp_gaze.policies.registry import build_policy
+from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
 from ipomdp_gaze.simulate import draw_targets, simulate
 import numpy as np
 
@@ -22,7 +21,7 @@ def add_parser(sub):
                        description='Simulate searches with common random numbers across '
                                    'policies; print a table and optionally write JSON.')
     add_task_args(p)
-    p.add_argument('--policy', action='append', default=[], choices=STRATEGIES,
+    p.add_argument('--policy', action='append', default=[], choices=NAMED_POLICIES,
                    help='a baseline by name (repeatable)')
     p.add_argument('--policy-file', action='append', default=[], type=Path, metavar='PATH',
                    help='a policy YAML file, keyed by its file stem (repeatable)')

@@ -7,8 +7,7 @@ from pathlib import Path
 
 from ipomdp_gaze.belief import bayes_update, entropy, map_cell, uniform_log_belief
 from ipomdp_gaze.observation import as_observation
-from ipomdp_gaze.policies.baselines import STRATEGIES
-from ipomdp_gaze.policies.registry import build_policy
+from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
 import numpy as np
 
 from .common import add_task_args, nonneg_int, positive_int, task_from_args
@@ -20,7 +19,7 @@ def add_parser(sub):
                                    'the policy looked, the belief at the most likely cell and '
                                    'whether that guess is right.')
     add_task_args(p)
-    p.add_argument('--policy', default='elm', choices=STRATEGIES)
+    p.add_argument('--policy', default='elm', choices=NAMED_POLICIES)
     p.add_argument('--policy-file', default=None, metavar='PATH',
                    help='a policy YAML file or a shipped kernel name (overrides --policy)')
     p.add_argument('--target', type=nonneg_int, default=None, help='target cell (default random)')

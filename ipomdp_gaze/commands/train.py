@@ -48,6 +48,8 @@ def add_parser(sub):
                    help='subtract a per-time-step reward baseline (the default)')
     p.add_argument('--no-baseline', dest='baseline', action='store_false',
                    help='plain GPOMDP without a baseline')
+    p.add_argument('--horizon', type=positive_int, default=None,
+                   help='fixations per training episode (default N, the number of cells)')
     p.add_argument('--episodes-per-epoch', type=positive_int, default=None,
                    help='episodes pooled per update (default 150, the paper)')
     p.add_argument('--eval-every', type=positive_int, default=None, metavar='K',
@@ -132,7 +134,8 @@ def run(args) -> int:
         'learning_rate': args.learning_rate, 'anneal_epochs': args.anneal_epochs,
         'reward_scale': args.reward_scale,
         'beta': args.beta, 'baseline': args.baseline, 'seed': args.seed,
-        'episodes_per_epoch': args.episodes_per_epoch, 'eval_every': args.eval_every,
+        'episodes_per_epoch': args.episodes_per_epoch, 'horizon': args.horizon,
+        'eval_every': args.eval_every,
         'eval_episodes': args.eval_episodes}
     if spec is None:
         defaults = {'reward': args.reward or REWARD_DEFAULT,
