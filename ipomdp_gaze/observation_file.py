@@ -28,10 +28,10 @@ import math
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from .grid import Grid
 from .observation import CountObservation
+from .yaml_files import check_header, plain, read_yaml, write_yaml
 
 FORMAT = 'ipomdp_gaze/observation-v1'
 MODELS = ('counts',)
@@ -126,18 +126,7 @@ def model_from_dict(doc, source: str = '') -> CountObservation:
         Naming the first problem found.
 
     """
-    if not isinstance(doc, dict):
-        raise ObservationFileError(f'an observation file must be a YAML mapping, got '
-                                   f'{type(doc).__name__}')
-    for key in REQUIRED:
-        if key not in doc:
-            raise ObservationFileError(f'missing key {key}')
-    unknown = sorted(str(k) for k in set(doc) - set(KEYS))
-    if unknown:
-        raise ObservationFileError(f"unknown key {unknown[0]}; valid: {', '.join(KEYS)}")
-    if doc['format'] != FORMAT:
-        raise ObservationFileError(f"wrong format string {doc['format']!r}; expected "
-                                   f'{FORMAT!r}')
+    check_header(doc, 'an observation file', FORMAT, REQUIRED, KEYS, ObservationFileError)
     if doc['model'] not in MODELS:
         raise ObservationFileError(f"unknown model {doc['model']!r}; valid: {', '.join(MODELS)}")
     grid = _grid(doc['grid'])
@@ -169,18 +158,7 @@ def load_observation(source) -> CountObservation:
 
     """
     path = resolve_source(source)
-    try:
-        text = path.read_text(encoding='utf-8')
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ObservationFileError(f'{path}: cannot read: {exc}') from None
-    try:
-        doc = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, 'problem_mark', None)
-        where = f' at line {mark.line + 1}' if mark is not None else ''
-        raise ObservationFileError(f'{path}: not YAML{where}') from None
-    except RecursionError:
-        raise ObservationFileError(f'{path}: YAML nested too deeply to read') from None
+    doc = read_yaml(path, ObservationFileError)
     try:
         return model_from_dict(doc, source=path.stem)
     except ObservationFileError as exc:
@@ -195,11 +173,11 @@ def model_to_dict(model: CountObservation) -> dict:
     doc = {'format': FORMAT, 'model': model.name, 'grid': grid}
     for key in RECORDS[:3]:
         if key in model.meta:
-            doc[key] = _plain(model.meta[key])
+            doc[key] = plain(model.meta[key])
     doc['target'] = np.round(model.p_target, 12).tolist()
     doc['null'] = np.round(model.p_null, 12).tolist()
     if 'calibration' in model.meta:
-        doc['calibration'] = _plain(model.meta['calibration'])
+        doc['calibration'] = plain(model.meta['calibration'])
     return doc
 
 
@@ -207,22 +185,4 @@ def save_observation(path, model: CountObservation) -> Path:
     """Write ``model`` as an observation file (validated first, so what is written loads)."""
     doc = model_to_dict(model)
     model_from_dict(doc)
-    path = Path(path)
-    if path.parent != Path(''):
-        path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=100),
-                    encoding='utf-8')
-    return path
-
-
-def _plain(value):
-    """Convert numpy scalars and arrays (nested in dicts and lists) to plain Python types."""
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    return value
+    return write_yaml(path, doc)

@@ -40,8 +40,8 @@ from ipomdp_gaze.fpoc import FPOC, fpoc_from_dict
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.observation import CountObservation, GaussianObservation
 from ipomdp_gaze.observation_file import fingerprint
+from ipomdp_gaze.yaml_files import check_header, plain, read_yaml, write_yaml
 import numpy as np
-import yaml
 
 from .conv import ACTIONS, ConvPolicy, radial_bins
 from .logistic import LogisticPolicy
@@ -121,33 +121,20 @@ class PolicySpec:
         """Return the YAML document as plain Python types (what :func:`save_policy` writes)."""
         doc = {'format': FORMAT, 'grid': self.grid.to_dict()}
         if self.observation is not None:
-            doc['observation'] = _plain(dict(self.observation))
+            doc['observation'] = plain(dict(self.observation))
         else:
-            doc['fpoc'] = _plain(self.fpoc.to_dict())
+            doc['fpoc'] = plain(self.fpoc.to_dict())
         doc.update({'reward': self.reward, 'family': self.family, 'action': self.action})
         if self.family == 'conv':
-            doc['kernel'] = _plain(self.kernel)
+            doc['kernel'] = plain(self.kernel)
             radial = self.radial()
             if radial is not None:
                 doc['radial'] = radial
         else:
-            doc['theta'] = _plain(self.theta)
-        doc['training'] = _plain(dict(self.training))
-        doc['evaluation'] = _plain(dict(self.evaluation))
+            doc['theta'] = plain(self.theta)
+        doc['training'] = plain(dict(self.training))
+        doc['evaluation'] = plain(dict(self.evaluation))
         return doc
-
-
-def _plain(value):
-    """Convert numpy scalars and arrays (nested in dicts and lists) to plain Python types."""
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    return value
 
 
 def shipped_kernels() -> list[str]:
@@ -338,17 +325,7 @@ def spec_from_dict(doc, path: Path | None = None) -> PolicySpec:
         Naming the first problem found.
 
     """
-    if not isinstance(doc, dict):
-        raise PolicyFileError(f'a policy file must be a YAML mapping, got '
-                              f'{type(doc).__name__}')
-    for key in REQUIRED:
-        if key not in doc:
-            raise PolicyFileError(f'missing key {key}')
-    unknown = sorted(str(k) for k in set(doc) - set(KEYS))
-    if unknown:
-        raise PolicyFileError(f"unknown key {unknown[0]}; valid: {', '.join(KEYS)}")
-    if doc['format'] != FORMAT:
-        raise PolicyFileError(f"wrong format string {doc['format']!r}; expected {FORMAT!r}")
+    check_header(doc, 'a policy file', FORMAT, REQUIRED, KEYS, PolicyFileError)
     grid = _grid(doc['grid'])
     if 'fpoc' not in doc and 'observation' not in doc:
         raise PolicyFileError('missing key fpoc (or observation, for a count model): a policy '
@@ -401,18 +378,7 @@ def load_policy_spec(source) -> PolicySpec:
 
     """
     path = resolve_source(source)
-    try:
-        text = path.read_text(encoding='utf-8')
-    except (OSError, UnicodeDecodeError) as exc:
-        raise PolicyFileError(f'{path}: cannot read: {exc}') from None
-    try:
-        doc = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, 'problem_mark', None)
-        where = f' at line {mark.line + 1}' if mark is not None else ''
-        raise PolicyFileError(f'{path}: not YAML{where}') from None
-    except RecursionError:
-        raise PolicyFileError(f'{path}: YAML nested too deeply to read') from None
+    doc = read_yaml(path, PolicyFileError)
     try:
         return spec_from_dict(doc, path=path)
     except PolicyFileError as exc:
@@ -482,9 +448,4 @@ def save_policy(path, spec: PolicySpec) -> Path:
     """Write ``spec`` as a policy file (validated first, so what is written always loads)."""
     doc = spec.to_dict()
     spec_from_dict(doc)
-    path = Path(path)
-    if path.parent != Path(''):
-        path.parent.mkdir(parents=True, exist_ok=True)
-    text = yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=100)
-    path.write_text(text, encoding='utf-8')
-    return path
+    return write_yaml(path, doc)

@@ -1,0 +1,85 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+What every versioned YAML file of the package shares: reading, the header checks, plain types.
+
+Policy files (``ipomdp_gaze/policy-v1``) and observation files (``ipomdp_gaze/observation-v1``)
+are mappings with a ``format`` string, required and allowed keys, and free-form records; both
+are read with ``yaml.safe_load`` only and report the first problem in one line through their own
+``ValueError`` subclass (docs/design.md section 9).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+
+def read_yaml(path: Path, error: type[ValueError]):
+    """
+    Parse a YAML file with the safe loader.
+
+    Raises
+    ------
+    error
+        ``<path>: cannot read``, ``<path>: not YAML at line N`` or nested too deeply.
+
+    """
+    try:
+        text = Path(path).read_text(encoding='utf-8')
+    except (OSError, UnicodeDecodeError) as exc:
+        raise error(f'{path}: cannot read: {exc}') from None
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, 'problem_mark', None)
+        where = f' at line {mark.line + 1}' if mark is not None else ''
+        raise error(f'{path}: not YAML{where}') from None
+    except RecursionError:
+        raise error(f'{path}: YAML nested too deeply to read') from None
+
+
+def check_header(doc, what: str, fmt: str, required, keys, error: type[ValueError]) -> None:
+    """
+    Check a document is a mapping with every required key, no unknown key and the format string.
+
+    Raises
+    ------
+    error
+        Naming the first problem.
+
+    """
+    if not isinstance(doc, dict):
+        raise error(f'{what} must be a YAML mapping, got {type(doc).__name__}')
+    for key in required:
+        if key not in doc:
+            raise error(f'missing key {key}')
+    unknown = sorted(str(k) for k in set(doc) - set(keys))
+    if unknown:
+        raise error(f"unknown key {unknown[0]}; valid: {', '.join(keys)}")
+    if doc['format'] != fmt:
+        raise error(f"wrong format string {doc['format']!r}; expected {fmt!r}")
+
+
+def plain(value):
+    """Convert numpy scalars and arrays (nested in dicts and lists) to plain Python types."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, dict):
+        return {str(k): plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [plain(v) for v in value]
+    return value
+
+
+def write_yaml(path, doc: dict) -> Path:
+    """Write ``doc`` (plain types) as block YAML, keys in order; create the folder."""
+    path = Path(path)
+    if path.parent != Path(''):
+        path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=100),
+                    encoding='utf-8')
+    return path
