@@ -106,19 +106,25 @@ def test_no_frame_taken_mid_saccade_is_used_and_the_search_completes(rig, camera
         'rate_hz': 20.0, 'saccade_time_s': SACCADE_S, 'publish_image': True, 'seed': 8})
     results += probe.set_parameters(NODE, {'settle_time_s': SETTLE_S})
     assert all(r.successful for r in results), [r.reason for r in results]
-    n_truth = len(rig['truth'])
-    assert probe.reset('simulated_camera').success
-    assert wait_for(lambda: len(rig['truth']) > n_truth)
-    n_belief = len(rig['belief'])
-    assert probe.reset(NODE).success
-    assert wait_for(lambda: len(rig['belief']) > n_belief)      # the uniform reset belief
-    n_belief, n_targets = len(rig['belief']), len(rig['targets'])
-    assert probe.enable(True, NODE).success
-    assert wait_for(lambda: _search_done(rig, n_belief), 60)
-
-    truth = grid_arrays.cell_from_ground_truth(rig['truth'][-1][1], grid)
-    beliefs = [grid_arrays.from_multiarray(m, grid) for _, m in rig['belief'][n_belief:]]
-    upto = next(i for i, b in enumerate(beliefs) if b.max() >= 0.999)
+    # The camera's noise depends on how many frames it took (20 Hz), so a search can end on its
+    # first frame; that proves nothing about timing, so search again (a new target) until one
+    # takes at least two updates.
+    for _ in range(5):
+        n_truth = len(rig['truth'])
+        assert probe.enable(False, NODE).success
+        assert probe.reset('simulated_camera').success
+        assert wait_for(lambda: len(rig['truth']) > n_truth)
+        n_belief = len(rig['belief'])
+        assert probe.reset(NODE).success
+        assert wait_for(lambda: len(rig['belief']) > n_belief)      # the uniform reset belief
+        n_belief, n_targets = len(rig['belief']), len(rig['targets'])
+        assert probe.enable(True, NODE).success
+        assert wait_for(lambda: _search_done(rig, n_belief), 60)
+        truth = grid_arrays.cell_from_ground_truth(rig['truth'][-1][1], grid)
+        beliefs = [grid_arrays.from_multiarray(m, grid) for _, m in rig['belief'][n_belief:]]
+        upto = next(i for i, b in enumerate(beliefs) if b.max() >= 0.999)
+        if upto >= 1:
+            break
     assert int(np.argmax(beliefs[upto])) == truth
     assert int(rig['status'].values['frames_skipped']) > 0
 
