@@ -43,6 +43,38 @@ FOVEATED = (('ELM', 'elm', 0.9, 60, False), ('ELM', 'elm', 0.99, 60, False),
             ('random', 'random', 0.999, 60, False), ('spiral', 'spiral', 0.999, 60, False),
             ('NMPT fixed policy', 'nmpt', 0.999, 60, True))
 SIZE_BINS = ((0, 40), (40, 64), (64, 100), (100, 141))
+# Ideas tried before this run, each measured on training scenes (seed 1, 80 scenes of the paper
+# task) or in simulation from the model, never on the test scenes above.
+IDEAS = [
+    '### What each idea gained (measured before this run, never on test scenes)', '',
+    '| idea | measured on | result |', '|---|---|---|',
+    "| NMPT's repeat rule (stop at the first repeated fixation), ELM, reference windows | "
+    'train, seed 1, 80 scenes | right 0.838 after 5.6 fixations (14.6 ms): ELM re-picks its '
+    'peak cell and the search stops early, often before it has looked near a small face |',
+    '| no repeat rule, ELM may re-fixate (the same counts counted again) | same | right 0.912 '
+    'at confidence 0.9-0.9999 (31.7-62.2 ms): the belief converges, sometimes on the wrong '
+    'cell |',
+    '| **inhibition of return** (never fixate a cell twice; the best unvisited cell) '
+    '| same | right 0.925 / 0.950 / 0.963 at confidence 0.9 / 0.99 / 0.999 (23 / 34 / 47 ms): '
+    'kept, the operating point of `find` |',
+    '| area instead of nearest-neighbour resampling of the windows | train, 80 scenes | '
+    'fixations with a detection within one cell of the face: 52.5% vs 51.2% at distance 6, '
+    '30.0% vs 27.5% at 9; about 0.1 ms more per fixation: kept |',
+    '| whole-image window at 1/3 resolution (windows 21, 9, 3 at 1/3, 1/3, 1) | train, seed 1 '
+    '| right 0.613: every window now sees the face and its neighbours, and the naive-Bayes '
+    "model, which only expects counts in the centre cell, spreads the belief over the face's "
+    'cells: dropped |',
+    '| a learned kernel (GPOMDP, conv family, 500 epochs, horizon 30) on `faces-420` | '
+    'simulation from the model, 5,000 episodes | fixations to 90%: kernel 7.34 [7.03, 7.64], '
+    "ELM 6.74 [6.50, 6.99], NMPT's fixed policy 8.87 [8.57, 9.14], MAP 8.33 [7.99, 8.64]: "
+    'better than NMPT, worse than ELM, so not shipped and not the default |', '',
+    'Why the fovea falls short: a face of 60-140 px covers 3-7 cells of the 21x21 grid, and '
+    'raw detections land in several of them; the count model treats cells as independent and '
+    'only the centre cell as the target, so a confident belief can settle two or more cells '
+    'from the centre (exact-cell accuracy is higher for the fovea than for the scans, '
+    'within-one-cell lower). On 840x840 the reference windows shrink 24-63 px faces below the '
+    "cascade's 20 px in every window but the smallest, which is the work the issue still asks "
+    "for (per-window resolutions tuned for small faces, a model of the face's extent).", '']
 
 
 def wilson(hits: int, n: int, z: float = 1.96) -> tuple[float, float]:
@@ -151,7 +183,7 @@ def verdict(task: dict) -> list[str]:
                key=lambda r: r['median_s'])
     fovea = [r for r in task['rows'] if r['label'].startswith('fovea')]
     ok = [r for r in fovea if r['right'] >= full['right'] - 0.02]
-    lines = [f"- Best full-frame baseline (cheapest within 2 points of full resolution): "
+    lines = [f'- Best full-frame baseline (cheapest within 2 points of full resolution): '
              f"**{best['label']}**, right {best['right']:.3f} at {best['speedup']:.2f}x."]
     if ok:
         top = max(ok, key=lambda r: r['speedup'])
@@ -161,19 +193,77 @@ def verdict(task: dict) -> list[str]:
                      f"{top['speedup']:.2f}x).")
         ratio = best['median_s'] / top['median_s']
         winner = 'the fovea' if ratio > 1 else 'the full-frame scan'
-        lines.append(f"- Against the best full-frame baseline at equal accuracy: {winner} wins "
+        lines.append(f'- Against the best full-frame baseline at equal accuracy: {winner} wins '
                      f"({top['label']} takes {ratio:.2f}x less time than {best['label']})."
                      if ratio > 1 else
                      f"- Against the best full-frame baseline: **{best['label']} wins**; the "
-                     f"fastest foveated search within 2 points of full resolution takes "
-                     f"{1 / ratio:.2f}x its time.")
+                     f'fastest foveated search within 2 points of full resolution takes '
+                     f'{1 / ratio:.2f}x its time.')
     else:
         top = max(fovea, key=lambda r: r['right'])
-        lines.append(f"- No foveated configuration is within 2 points of full resolution "
+        lines.append(f'- No foveated configuration is within 2 points of full resolution '
                      f"(best: {top['label']}, right {top['right']:.3f} vs {full['right']:.3f}, "
                      f"{top['speedup']:.2f}x): the paper's claim is **not met** here, and every "
-                     f"full-frame scan within 2 points beats the fovea.")
+                     f'full-frame scan within 2 points beats the fovea.')
     return lines
+
+
+def plot_speed_accuracy(results, path: Path) -> None:
+    """Right (within one cell) against speed-up over the full-resolution scan, per task."""
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, len(results), figsize=(6.5 * len(results), 4.8), squeeze=False)
+    for ax, task in zip(axes[0], results):
+        for r in task['rows']:
+            if r['label'].endswith('grouped'):
+                continue
+            fovea = r['label'].startswith('fovea')
+            low, high = r['ci']
+            ax.errorbar(r['speedup'], r['right'], yerr=[[r['right'] - low], [high - r['right']]],
+                        fmt='o' if fovea else 's', color='C1' if fovea else 'C0', capsize=2)
+            ax.annotate(r['label'].replace('fovea, ', '').replace(', confidence ', ' @'),
+                        (r['speedup'], r['right']), fontsize=7, xytext=(4, 2),
+                        textcoords='offset points')
+        full = next(r for r in task['rows'] if r['label'] == 'full frame x1')
+        ax.axhline(full['right'] - 0.02, color='k', linestyle=':', lw=1,
+                   label='full resolution - 2 points')
+        ax.axvline(2.0, color='k', linestyle='--', lw=1, label="2x (the paper's claim)")
+        ax.set(xscale='log', xlabel='speed-up vs full-resolution scan (median time)',
+               ylabel='right (within one cell)',
+               title=f"{task['size']}x{task['size']}, faces {task['faces'][0]}-"
+                     f"{task['faces'][1]} px (blue: full frame, orange: fovea)")
+        ax.grid(True, which='both', alpha=0.3)
+        ax.legend(fontsize=8, loc='lower left')
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def astronaut(figure: Path) -> list[str]:
+    """Search the real photograph end to end as ``ipomdp-gaze find`` does, and draw it."""
+    from ipomdp_gaze.commands.find import plot_image_search
+    import skimage.data
+    image = skimage.data.astronaut()
+    model = load_observation('faces-420')
+    fovea = fovea_for_model(model)
+    policy = build_policy('elm', model.grid, model)
+    policy.select(np.full((1, model.grid.n_cells), 1 / model.grid.n_cells), 0, None)  # warm up
+    result = search_image(image, fovea, model, policy, confidence=0.999, max_fixations=60,
+                          stop_on_repeat=False, inhibit_return=True)
+    full = scan(image, HaarDetector(), model.grid)
+    plot_image_search(image, result, fovea, figure,
+                      f'astronaut: cell {result.cell}, p={result.probability:.3f}, '
+                      f'{result.fixations} fixations')
+    row, col = divmod(full.cell, model.grid.cols) if full.cell is not None else (None, None)
+    return ['### The real photograph `astronaut` (512x512, model `faces-420`)', '',
+            f'![astronaut](figures/{figure.name})', '',
+            f'Foveated search (ELM, inhibition of return, confidence 0.999): cell '
+            f'{result.cell}, pixel {result.pixel}, probability {result.probability:.3f} after '
+            f'{result.fixations} fixations, {result.detector_pixels:,} detector pixels, '
+            f'{1000 * result.seconds:.1f} ms. Full-resolution scan: cell ({row}, {col}), '
+            f'{full.detector_pixels:,} detector pixels, {1000 * full.seconds:.1f} ms. The face '
+            f'centre is at about (225, 115) px, in cell (4, 9).', '']
 
 
 def main(argv=None) -> int:
@@ -195,15 +285,20 @@ def main(argv=None) -> int:
             __doc__.strip().split('\n\n', 1)[1].replace('Usage:', 'Regenerate with `make '
                                                         'faces`, or:'), '',
             'Fovea: the shipped models were calibrated (`ipomdp-gaze calibrate --scenes 200 '
-            '--seed 0 [--task small]`, training split) with NMPT\'s reference windows '
+            "--seed 0 [--task small]`, training split) with NMPT's reference windows "
             '`[21, 15, 9, 3]` cells, each at the pixel size of 3 cells, area resampling, '
             'K = 10; their learned FPOCs: `figures/fpoc_faces-420.png`, '
             '`figures/fpoc_faces-840.png`. The operating point of `ipomdp-gaze find` (ELM, '
             'inhibition of return, confidence 0.999, 60 fixations) was chosen on training '
             'scenes (seed 1) before this run. No learned kernel on the count models is shipped '
             'yet.', '']
+    figures = args.out.parent / 'figures'
+    figures.mkdir(parents=True, exist_ok=True)
+    plot_speed_accuracy(results, figures / 'faces_speed_accuracy.png')
+    text += ['![speed and accuracy](figures/faces_speed_accuracy.png)', '']
     for task in results:
         text += table(task) + [''] + verdict(task) + ['']
+    text += astronaut(figures / 'find_astronaut.png') + IDEAS
     text += [f'*Measured with OpenCV {cv2.__version__} (one thread) on `{platform.node()}` '
              f'({platform.machine()}), Python {platform.python_version()}; the run took '
              f'{wall:.0f} s. Times move with the load of this shared 2-core machine; the '
