@@ -54,13 +54,15 @@ IMPORT_CHECK = (
     'import importlib, importlib.resources, importlib.util, json, sys\n'
     'files = {n: importlib.import_module(n).__file__ for n in json.loads(sys.argv[1])}\n'
     'from ipomdp_gaze.policies.policy_file import shipped_kernels\n'
+    'from ipomdp_gaze.observation_file import MODEL_DIR, shipped_observations\n'
     'bare = {}\n'
     'for name in ("policies", "msg_adapters"):\n'
     '    spec = importlib.util.find_spec(name)\n'
     '    bare[name] = spec and str(spec.origin or spec.submodule_search_locations)\n'
     'kernel_dir = importlib.resources.files("ipomdp_gaze.policies").joinpath("kernels")\n'
     'print(json.dumps({"files": files, "bare": bare, "kernels": shipped_kernels(),\n'
-    '                  "kernel_dir": str(kernel_dir)}))\n')
+    '                  "kernel_dir": str(kernel_dir), "models": shipped_observations(),\n'
+    '                  "model_dir": str(MODEL_DIR)}))\n')
 
 
 def clean_copy(dest: Path) -> Path:
@@ -271,6 +273,9 @@ def test_every_module_imports_from_the_install_and_bare_names_do_not(install, tm
     assert 'human-7x7-infomax' in report['kernels']
     assert report['kernels'] == kernels
     assert is_inside(report['kernel_dir'], install.root), report['kernel_dir']
+    models = sorted(p.stem for p in (install.copy / 'ipomdp_gaze' / 'models').glob('*.yaml'))
+    assert 'faces-420' in report['models'] and report['models'] == models
+    assert is_inside(report['model_dir'], install.root), report['model_dir']
 
 
 class Node:
