@@ -99,6 +99,17 @@ def gaussian_log_likelihood_ratio(observation: np.ndarray, dprime: np.ndarray,
     return term
 
 
+def _fixation_index(grid: Grid, fixation) -> int:
+    """Check a single fixation: an integer cell index inside ``grid``."""
+    try:
+        k = operator.index(fixation)
+    except TypeError:
+        raise ValueError(f'fixation must be an integer cell index, got {fixation!r}') from None
+    if not 0 <= k < grid.n_cells:
+        raise ValueError(f'fixation {fixation!r} is outside a {grid.rows}x{grid.cols} grid')
+    return k
+
+
 class GaussianObservation:
     """
     The paper's observation model: unit-variance Gaussian evidence with FPOC means.
@@ -148,7 +159,7 @@ class GaussianObservation:
     def dprime_window(self, fixation: int) -> np.ndarray:
         """``d_jk`` of every cell j for one fixation k as a ``(rows, cols)`` view (no copy)."""
         rows, cols = self.grid.shape
-        r, c = divmod(self._fixation(fixation), cols)
+        r, c = divmod(_fixation_index(self.grid, fixation), cols)
         return self.table[rows - 1 - r:2 * rows - 1 - r, cols - 1 - c:2 * cols - 1 - c]
 
     def dprime_by_fixation(self) -> np.ndarray:
@@ -176,16 +187,6 @@ class GaussianObservation:
     def elm_kernel(self) -> np.ndarray:
         """Return ELM's kernel on the offset table: ``2 KL(N(d, 1) || N(0, 1)) = d^2``."""
         return self.table ** 2
-
-    def _fixation(self, fixation) -> int:
-        try:
-            k = operator.index(fixation)
-        except TypeError:
-            raise ValueError(f'fixation must be an integer cell index, got {fixation!r}') from None
-        if not 0 <= k < self.grid.n_cells:
-            raise ValueError(f'fixation {fixation!r} is outside a {self.grid.rows}x'
-                             f'{self.grid.cols} grid')
-        return k
 
     # -- the model -----------------------------------------------------------------------
     def log_likelihood_ratio(self, observation, fixation, validate: bool = True) -> np.ndarray:
@@ -228,17 +229,6 @@ class GaussianObservation:
         obs[np.arange(targets.size), targets] += self.dprime_by_fixation()[
             np.asarray(fixations, dtype=np.intp), targets]
         return obs
-
-
-def _fixation_index(grid: Grid, fixation) -> int:
-    """Check a single fixation: an integer cell index inside ``grid``."""
-    try:
-        k = operator.index(fixation)
-    except TypeError:
-        raise ValueError(f'fixation must be an integer cell index, got {fixation!r}') from None
-    if not 0 <= k < grid.n_cells:
-        raise ValueError(f'fixation {fixation!r} is outside a {grid.rows}x{grid.cols} grid')
-    return k
 
 
 def check_count_tables(p_target, p_null, grid: Grid, atol: float = 1e-6):
@@ -329,6 +319,7 @@ class CountObservation:
         self._cdf = {'target': np.cumsum(self.p_target.reshape(rows * cols, k), axis=1),
                      'null': np.cumsum(self.p_null.reshape(rows * cols, k), axis=1)}
         self._pair_offsets = None
+        self._informative = np.any(self.p_target != self.p_null, axis=2).reshape(-1)
 
     def __repr__(self):
         return (f'CountObservation({self.grid.rows}x{self.grid.cols} grid, '
@@ -364,8 +355,7 @@ class CountObservation:
 
     def observed(self, fixation: int) -> np.ndarray:
         """Cells whose count says anything at this fixation (tables differ there), shape (N,)."""
-        informative = np.any(self.p_target != self.p_null, axis=2).reshape(-1)
-        return informative[self.offsets(fixation)]
+        return self._informative[self.offsets(fixation)]
 
     def elm_kernel(self) -> np.ndarray:
         """Return ELM's kernel on the ``(2R-1, 2C-1)`` offset table: ``2 KL(p_t || p_n)``."""
