@@ -274,6 +274,39 @@ def check_count_tables(p_target, p_null, grid: Grid, atol: float = 1e-6):
     return out[0], out[1]
 
 
+def check_scan_tables(scan_target, scan_null, max_count: int, atol: float = 1e-6):
+    """
+    Validate the scan tables of a :class:`CountObservation`; return them as float64 (K,) each.
+
+    ``scan_target[c]`` and ``scan_null[c]`` are the probabilities of count c in a cell of the
+    one-time whole-image scan with and without the target in it (no offset: the scan does not
+    depend on the fixation). Same rules as :func:`check_count_tables`; K must be the tables'.
+
+    Raises
+    ------
+    ValueError
+        Naming the table and the problem.
+
+    """
+    out = []
+    for name, table in (('scan target', scan_target), ('scan null', scan_null)):
+        try:
+            a = np.array(table, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f'{name} table must be numbers') from None
+        if a.shape != (max_count + 1,):
+            raise ValueError(f'{name} table must have K = {max_count + 1} entries (one per '
+                             f'count, as the fixation tables), got shape {a.shape}')
+        bad = np.flatnonzero(~np.isfinite(a) | (a < 0))
+        if bad.size:
+            raise ValueError(f'{name} table must be finite and >= 0: count {int(bad[0])} is '
+                             f'{a[bad[0]]}')
+        if abs(a.sum() - 1.0) > atol:
+            raise ValueError(f'{name} table must sum to 1 over counts, got {a.sum():.9g}')
+        out.append(a / a.sum())
+    return out[0], out[1]
+
+
 class CountObservation:
     """
     A count model learned from a real detector (docs/design.md section 6).
@@ -296,15 +329,30 @@ class CountObservation:
         hypothesis rules it out (log ratio -inf or +inf, clipped to +/- :data:`MAX_LOG_RATIO`).
     meta : dict, optional
         Where the model came from (image size, fovea, detector, calibration): kept as given.
+    scan_target, scan_null : array (K,), optional
+        The tables of the one-time whole-image scan (:meth:`scan_log_likelihood_ratio`, a fovea
+        with ``scan_once``); both or neither (see :func:`check_scan_tables`).
 
     """
 
     name = 'counts'
 
-    def __init__(self, grid: Grid, p_target, p_null, meta: dict | None = None):
+    def __init__(self, grid: Grid, p_target, p_null, meta: dict | None = None,
+                 scan_target=None, scan_null=None):
         self.grid = grid
         self.p_target, self.p_null = check_count_tables(p_target, p_null, grid)
         self.max_count = self.p_target.shape[2] - 1
+        if (scan_target is None) != (scan_null is None):
+            raise ValueError('scan tables come in pairs: give both scan_target and scan_null '
+                             'or neither')
+        self.scan_target = self.scan_null = self._scan_ratio = None
+        if scan_target is not None:
+            self.scan_target, self.scan_null = check_scan_tables(scan_target, scan_null,
+                                                                 self.max_count)
+            with np.errstate(divide='ignore', invalid='ignore'):
+                ratio = np.log(self.scan_target) - np.log(self.scan_null)
+            self._scan_ratio = np.where((self.scan_target == 0) & (self.scan_null == 0), np.nan,
+                                        np.clip(ratio, -MAX_LOG_RATIO, MAX_LOG_RATIO))
         self.meta = dict(meta or {})
         rows, cols, k = self.p_target.shape
         with np.errstate(divide='ignore', invalid='ignore'):
@@ -322,16 +370,29 @@ class CountObservation:
         self._informative = np.any(self.p_target != self.p_null, axis=2).reshape(-1)
 
     def __repr__(self):
+        scan = ', with scan' if self.has_scan else ''
         return (f'CountObservation({self.grid.rows}x{self.grid.cols} grid, '
-                f'K={self.max_count + 1})')
+                f'K={self.max_count + 1}{scan})')
 
     def __eq__(self, other):
-        return isinstance(other, CountObservation) and self.grid.shape == other.grid.shape \
-            and np.array_equal(self.p_target, other.p_target) \
+        if not isinstance(other, CountObservation) or self.grid.shape != other.grid.shape \
+                or self.has_scan != other.has_scan:
+            return False
+        same = np.array_equal(self.p_target, other.p_target) \
             and np.array_equal(self.p_null, other.p_null)
+        if self.has_scan:
+            same = same and np.array_equal(self.scan_target, other.scan_target) \
+                and np.array_equal(self.scan_null, other.scan_null)
+        return same
 
     def __hash__(self):
-        return hash((self.grid.shape, self.p_target.tobytes(), self.p_null.tobytes()))
+        scan = (self.scan_target.tobytes(), self.scan_null.tobytes()) if self.has_scan else ()
+        return hash((self.grid.shape, self.p_target.tobytes(), self.p_null.tobytes()) + scan)
+
+    @property
+    def has_scan(self) -> bool:
+        """Whether the model has the tables of a one-time whole-image scan."""
+        return self.scan_target is not None
 
     def to_dict(self) -> dict:
         """``{'model': 'counts', 'max_count': K-1, ...meta}``: what a policy file records."""
@@ -414,6 +475,33 @@ class CountObservation:
             raise EvidenceError(f'count {counts.flat[i]} at cell {i % counts.shape[-1]} has '
                                 f'probability 0 with and without the target; the frame is '
                                 f'refused')
+        return term
+
+    def scan_log_likelihood_ratio(self, counts, validate: bool = True) -> np.ndarray:
+        """
+        Per-cell term of the whole-image scan: ``log scan_target(c_i) - log scan_null(c_i)``.
+
+        The scan is one observation per image, taken before the first fixation; its counts
+        are clipped to ``K - 1`` like a frame's, NaN = not observed (term 0).
+
+        Raises
+        ------
+        ValueError
+            If the model has no scan tables.
+        EvidenceError
+            For invalid counts, or a count neither hypothesis allows.
+
+        """
+        if not self.has_scan:
+            raise ValueError('this count model has no scan tables: it was measured without a '
+                             'whole-image scan (fovea scan_once false)')
+        counts, missing = self.counts(counts, validate)
+        term = self._scan_ratio[counts]
+        term[missing] = 0.0
+        if validate and np.any(np.isnan(term)):
+            i = int(np.flatnonzero(np.isnan(term))[0])
+            raise EvidenceError(f'scan count {counts.flat[i]} at cell {i % counts.shape[-1]} has '
+                                f'probability 0 with and without the target')
         return term
 
     def sample(self, targets, fixations, rng: np.random.Generator) -> np.ndarray:

@@ -13,6 +13,8 @@ Format ``ipomdp_gaze/observation-v1`` (docs/design.md section 9)::
     detector: {...}                       # the detector settings it was measured with
     target: [[[p0, p1, ...], ...], ...]   # P(c | target, |dr|, |dc|): rows x cols x K
     null: [[[...]]]                       # P(c | no target, |dr|, |dc|): rows x cols x K
+    scan: {target: [...], null: [...]}    # optional: P(c | target), P(c | no target) of the
+                                          # one-time whole-image scan (fovea scan_once), K each
     calibration: {...}                    # free-form record of how it was measured
 
 Loading uses ``yaml.safe_load`` only and names exactly what is wrong
@@ -36,7 +38,7 @@ from .yaml_files import check_header, plain, read_yaml, write_yaml
 FORMAT = 'ipomdp_gaze/observation-v1'
 MODELS = ('counts',)
 REQUIRED = ('format', 'model', 'grid', 'target', 'null')
-KEYS = REQUIRED + ('image', 'fovea', 'detector', 'calibration')
+KEYS = REQUIRED + ('image', 'fovea', 'detector', 'calibration', 'scan')
 RECORDS = ('image', 'fovea', 'detector', 'calibration')
 MODEL_DIR = Path(str(resources.files(__package__).joinpath('models')))
 # Counts per cell a file may tabulate (K); far above any detector's clipped count.
@@ -66,10 +68,13 @@ def resolve_source(source) -> Path:
 
 
 def fingerprint(model: CountObservation) -> str:
-    """SHA-256 of the two tables (float64, C order): names a model inside a policy file."""
+    """SHA-256 of the tables (float64, C order; the scan's too): names a model in a policy file."""
     digest = hashlib.sha256()
-    digest.update(np.ascontiguousarray(model.p_target, dtype=np.float64).tobytes())
-    digest.update(np.ascontiguousarray(model.p_null, dtype=np.float64).tobytes())
+    tables = [model.p_target, model.p_null]
+    if getattr(model, 'has_scan', False):
+        tables += [model.scan_target, model.scan_null]
+    for table in tables:
+        digest.update(np.ascontiguousarray(table, dtype=np.float64).tobytes())
     return digest.hexdigest()
 
 
@@ -116,6 +121,23 @@ def _table(doc: dict, key: str, grid: Grid) -> np.ndarray:
                                    f'offset') from None
 
 
+def _scan(block) -> tuple:
+    """Read the optional ``scan`` block: ``(target, null)`` lists of probabilities, or Nones."""
+    if block is None:
+        return None, None
+    if not isinstance(block, dict) or set(block) != {'target', 'null'}:
+        raise ObservationFileError('scan must be a mapping {target, null} of count '
+                                   'probabilities')
+    for key in ('target', 'null'):
+        value = block[key]
+        if not isinstance(value, list) or not 2 <= len(value) <= MAX_K or any(
+                isinstance(x, (list, dict, bool)) or not isinstance(x, (int, float))
+                for x in value):
+            raise ObservationFileError(f'scan.{key} must be a list of 2 to {MAX_K} '
+                                       f'probabilities (one per count)')
+    return block['target'], block['null']
+
+
 def model_from_dict(doc, source: str = '') -> CountObservation:
     """
     Validate a parsed observation document and build its model.
@@ -138,8 +160,9 @@ def model_from_dict(doc, source: str = '') -> CountObservation:
         if block is not None:
             meta[key] = dict(block)
     target, null = _table(doc, 'target', grid), _table(doc, 'null', grid)
+    scan_target, scan_null = _scan(doc.get('scan'))
     try:
-        model = CountObservation(grid, target, null, meta)
+        model = CountObservation(grid, target, null, meta, scan_target, scan_null)
     except ValueError as exc:
         raise ObservationFileError(str(exc)) from None
     if source:
@@ -176,6 +199,9 @@ def model_to_dict(model: CountObservation) -> dict:
             doc[key] = plain(model.meta[key])
     doc['target'] = np.round(model.p_target, 12).tolist()
     doc['null'] = np.round(model.p_null, 12).tolist()
+    if model.has_scan:
+        doc['scan'] = {'target': np.round(model.scan_target, 12).tolist(),
+                       'null': np.round(model.scan_null, 12).tolist()}
     if 'calibration' in model.meta:
         doc['calibration'] = plain(model.meta['calibration'])
     return doc

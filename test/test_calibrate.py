@@ -124,3 +124,31 @@ def test_a_csv_naming_pixels_outside_the_image_is_refused(tmp_path):
                            '--quiet'], capture_output=True, text=True, timeout=120)
     assert done.returncode == 2 and 'Traceback' not in done.stderr
     assert 'outside' in done.stderr.strip().splitlines()[-1]
+
+
+def test_scan_tallies_are_offset_free_and_build_the_scan_tables():
+    """A detector that always reports cell (1, 3): the scan tallies it once per image."""
+    config = FoveaConfig(windows_cells=(5, 3), scales=(1.0, 1.0), max_count=3, scan_once=True)
+
+    def detector(gray):
+        if gray.shape == (50, 50):                            # the whole-image window only
+            return np.array([[33, 13, 4, 4]])
+        return np.zeros((0, 4), dtype=int)
+
+    fovea = Fovea(detector, GRID, config)
+    tallies = tally_image(fovea, np.zeros((50, 50), dtype=np.uint8), GRID.index(1, 3))
+    np.testing.assert_array_equal(tallies.scan_target, [0, 1, 0])
+    np.testing.assert_array_equal(tallies.scan_null, [24, 0, 0])
+    # The fixation frames (3-cell windows) never count the scan's box: 9 of them see the cell.
+    assert tallies.target[:, :, 0].sum() == 9 and tallies.target[:, :, 1:].sum() == 0
+    model = count_model(tallies, GRID, prior=1.0, scan=True)
+    np.testing.assert_allclose(model.scan_target, [1 / 4, 2 / 4, 1 / 4])
+    np.testing.assert_allclose(model.scan_null, [25 / 27, 1 / 27, 1 / 27])
+    with pytest.raises(ValueError, match='no scan was tallied'):
+        count_model(_no_scan(), GRID, scan=True)
+
+
+def _no_scan():
+    tallies = Tallies.empty(GRID, 3)
+    tallies.target[0, 0] = [1, 0, 0]
+    return tallies

@@ -188,3 +188,57 @@ def test_unreadable_and_missing_files(tmp_path):
         load_observation(bad)
     with pytest.raises(ObservationFileError, match='not found and not a shipped model'):
         load_observation(tmp_path / 'missing.yaml')
+
+
+# ---- the one-time scan -------------------------------------------------------------------------
+
+SCAN_TARGET = np.array([0.2, 0.3, 0.25, 0.25])
+SCAN_NULL = np.array([0.9, 0.06, 0.03, 0.01])
+
+
+def test_scan_update_matches_brute_force_bayes():
+    model = CountObservation(GRID, *tables(8), scan_target=SCAN_TARGET, scan_null=SCAN_NULL)
+    rng = np.random.default_rng(3)
+    prior = rng.dirichlet(np.ones(GRID.n_cells))
+    counts = rng.integers(0, K + 2, GRID.n_cells).astype(float)
+    counts[3] = np.nan
+    post = np.exp(bayes_update(np.log(prior), model.scan_log_likelihood_ratio(counts)))
+    brute = prior.copy()
+    for i in range(GRID.n_cells):
+        for j in range(GRID.n_cells):
+            if not np.isnan(counts[j]):
+                c = int(min(counts[j], K - 1))
+                brute[i] *= (SCAN_TARGET if i == j else SCAN_NULL)[c]
+    np.testing.assert_allclose(post, brute / brute.sum(), rtol=1e-9)
+
+
+def test_scan_tables_are_validated_and_only_models_with_them_scan():
+    with pytest.raises(ValueError, match='both scan_target and scan_null'):
+        CountObservation(GRID, *tables(0), scan_target=SCAN_TARGET)
+    with pytest.raises(ValueError, match='K = 4 entries'):
+        CountObservation(GRID, *tables(0), scan_target=SCAN_TARGET[:3], scan_null=SCAN_NULL[:3])
+    with pytest.raises(ValueError, match='scan null table must sum to 1'):
+        CountObservation(GRID, *tables(0), scan_target=SCAN_TARGET, scan_null=SCAN_NULL * 2)
+    with pytest.raises(ValueError, match='no scan tables'):
+        MODEL.scan_log_likelihood_ratio(np.zeros(GRID.n_cells))
+    with pytest.raises(EvidenceError, match='integers >= 0'):
+        CountObservation(GRID, *tables(0), scan_target=SCAN_TARGET, scan_null=SCAN_NULL) \
+            .scan_log_likelihood_ratio(np.full(GRID.n_cells, -1.0))
+
+
+def test_scan_tables_round_trip_through_the_file_and_the_fingerprint(tmp_path):
+    plain = CountObservation(GRID, *tables(6))
+    model = CountObservation(GRID, *tables(6), scan_target=SCAN_TARGET, scan_null=SCAN_NULL)
+    path = save_observation(tmp_path / 'scan.yaml', model)
+    back = load_observation(path)
+    assert back.has_scan and back == load_observation(path) and back != plain
+    np.testing.assert_allclose(back.scan_null, SCAN_NULL, atol=1e-12)
+    assert fingerprint(back) == fingerprint(load_observation(path))
+    assert fingerprint(model) != fingerprint(plain)
+    doc = model_to_dict(model)
+    doc['scan'] = {'target': [0.5, 0.5]}
+    with pytest.raises(ObservationFileError, match='scan must be a mapping'):
+        model_from_dict(doc)
+    doc['scan'] = {'target': [0.5, 0.5], 'null': [0.5, 0.5]}
+    with pytest.raises(ObservationFileError, match='K = 4 entries'):
+        model_from_dict(doc)

@@ -378,3 +378,44 @@ def test_the_vision_package_imports_nothing_from_ros_or_the_policies(tmp_path):
                                                               'ipomdp_gaze.msg_adapters',
                                                               'ipomdp_gaze.nodes'))]
     assert not bad, bad
+
+
+# ---- the one-time scan (scan_once) -------------------------------------------------------------
+
+def test_scan_once_observes_the_whole_image_window_once_and_fixations_without_it():
+    # Every window reports a box at its own (10, 10) px: cell (1, 1) of the 420 px image for
+    # the whole-image window at 1/3 (30, 30 px), cell (0, 0) for the fixation windows at (0, 0).
+    fake = FakeDetector(lambda call, gray: [centred_box(10, 10)])
+    config = FoveaConfig(scales=(1 / 3, 1 / 5, 1 / 3, 1.0), scan_once=True)
+    fovea = Fovea(fake, GRID, config)
+    fovea.start(image())
+    scan = fovea.scan()
+    assert fake.shapes == [(140, 140)] and scan.detector_pixels == 140 * 140
+    assert [w.whole_image for w in scan.windows] == [True]
+    assert scan.counts[GRID.index(1, 1)] == 1 and scan.counts.sum() == 1
+    assert not np.isnan(scan.counts).any()
+    again = fovea.scan()                                      # same image: no detector work
+    assert len(fake.images) == 1 and again.detector_pixels == 0
+    np.testing.assert_array_equal(again.counts, scan.counts)
+    observation = fovea.observe(GRID.index(0, 0))
+    assert [w.whole_image for w in observation.windows] == [False] * 3
+    assert fake.shapes[1:] == [(60, 60), (60, 60), (60, 60)]
+    # The fixation windows' boxes land at 50, 30 and 10 px (15-, 9- and 3-cell windows at 1/5,
+    # 1/3 and 1): cells (2, 2), (1, 1), (0, 0); the scan's box in (1, 1) is not counted again.
+    counts = observation.counts.reshape(GRID.shape)
+    assert counts[0, 0] == counts[1, 1] == counts[2, 2] == 1 and np.nansum(counts) == 3
+    assert np.isnan(observation.counts[GRID.index(20, 20)])
+    assert fovea.image_detector_pixels == 140 * 140 + 3 * 3600
+
+
+def test_without_scan_once_there_is_no_scan_and_scan_once_needs_a_whole_image_window():
+    fovea = Fovea(FakeDetector(), GRID)
+    fovea.start(image())
+    assert fovea.scan() is None
+    with pytest.raises(ValueError, match='scan_once needs a whole-image window'):
+        Fovea(FakeDetector(), GRID, FoveaConfig(windows_cells=(15, 9, 3), scan_once=True))
+    with pytest.raises(ValueError, match='scan_once must be true or false'):
+        FoveaConfig(scan_once='yes')
+    config = FoveaConfig(scan_once=True)
+    assert FoveaConfig.from_dict(config.to_dict()) == config
+    assert FoveaConfig.from_dict({'windows_cells': [21, 15, 9, 3]}).scan_once is False

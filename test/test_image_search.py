@@ -293,3 +293,25 @@ def test_nmpt_parameters_and_registry():
     result = search_image(blob_image(), make_fovea(), STRONG, policy,
                           rng=np.random.default_rng(1))
     assert result.cell == FACE_CELL
+
+
+def test_a_scanning_fovea_updates_once_from_the_scan_then_fixates_the_policys_choice():
+    config = FoveaConfig(windows_cells=(7, 3), scales=(0.5, 1.0), max_count=4, scan_once=True)
+    fovea = Fovea(BlobDetector(3), GRID, config)
+    scan_tables = {'scan_target': [0.1, 0.1, 0.1, 0.7], 'scan_null': [0.97, 0.01, 0.01, 0.01]}
+    p_null = np.broadcast_to([0.97, 0.01, 0.01, 0.01], GRID.shape + (4,))
+    model = CountObservation(GRID, np.broadcast_to([0.9, 0.04, 0.03, 0.03], GRID.shape + (4,)),
+                             p_null, **scan_tables)
+    policy = build_policy('map', GRID, model)
+    result = search_image(blob_image(), fovea, model, policy, confidence=0.999,
+                          max_fixations=5, stop_on_repeat=False, inhibit_return=True)
+    # The scan (7-cell window at 1/2) sees the blob: the first fixation is MAP's, the blob's cell
+    # rather than the centre, and the scan's pixels are counted once.
+    assert result.path[0] == FACE_CELL and result.cell == FACE_CELL
+    assert fovea.detector.calls[0] == (105, 105) and (105, 105) not in fovea.detector.calls[1:]
+    assert result.detector_pixels == WHOLE_PX + FOVEA_PX * result.fixations
+    # A scanning fovea needs a model with scan tables, and the other way round.
+    with pytest.raises(ValueError, match='has no scan tables'):
+        search_image(blob_image(), fovea, STRONG, policy)
+    with pytest.raises(ValueError, match='the fovea does not scan'):
+        search_image(blob_image(), make_fovea(), model, policy)

@@ -67,6 +67,9 @@ def add_parser(sub):
                         'pixel size of the smallest window)')
     p.add_argument('--interpolation', default='area',
                    help='window resampling: area (default), nearest, linear, cubic')
+    p.add_argument('--scan-once', action='store_true',
+                   help='observe the whole-image window once per image, with its own table '
+                        '(the shipped models), instead of in every fixation (NMPT)')
     p.add_argument('--max-count', type=positive_int, default=10,
                    help='K: counts are clipped to 0..K-1 (default 10)')
     p.add_argument('--scale-factor', type=positive_float, default=1.1,
@@ -129,6 +132,9 @@ def rate_table(model, size: int = 6) -> str:
     for dr in range(size):
         cells = [f'  {hit[dr, dc]:.3f}/{fa[dr, dc]:.4f}' for dc in range(size)]
         lines.append(f'{dr:>11d} ' + ''.join(cells))
+    if model.has_scan:
+        lines.append(f'whole-image scan: hit {1 - model.scan_target[0]:.3f} / false alarm '
+                     f'{1 - model.scan_null[0]:.4f}')
     return '\n'.join(lines)
 
 
@@ -171,7 +177,11 @@ def run(args) -> int:
         raise ValueError(f'--pool-radius must be >= 0, got {args.pool_radius}')
     grid = Grid(args.grid[0], args.grid[1], 1.0)
     config = FoveaConfig(windows_cells=args.windows, scales=args.scales,
-                         max_count=args.max_count, interpolation=args.interpolation)
+                         max_count=args.max_count, interpolation=args.interpolation,
+                         scan_once=args.scan_once)
+    if args.scan_once and args.windows[0] < max(grid.shape):
+        raise ValueError(f'--scan-once needs a whole-image window: the largest of --windows '
+                         f'({args.windows[0]} cells) must cover the {grid.rows}x{grid.cols} grid')
     detector_kwargs = {'scale_factor': args.scale_factor}
     detector = HaarDetector(**detector_kwargs)
     items, (height, width), source = _items(args, grid)
@@ -191,7 +201,8 @@ def run(args) -> int:
                             'min_tallies': args.min_tallies,
                             'detector_pixels': int(tallies.detector_pixels),
                             'wall_seconds': round(wall, 1)}}
-    model = count_model(tallies, grid, args.prior, args.pool_radius, args.min_tallies, meta)
+    model = count_model(tallies, grid, args.prior, args.pool_radius, args.min_tallies, meta,
+                        scan=config.scan_once)
     save_observation(args.out, model)
     print(rate_table(model))
     plot = args.plot if args.plot is not None else args.out.with_suffix('.png')

@@ -16,6 +16,10 @@ most a few target tallies, and offsets a face centre never reaches (the far corn
 assumption), widened where fewer than ``min_tallies`` observations would remain; this trades
 angular detail for far less noise.
 
+With a fovea that scans once (``scan_once``) the whole-image windows are tallied apart, once per
+image and without an offset (the scan does not depend on the fixation): ``scan_target[c]`` from
+the cell holding the face centre, ``scan_null[c]`` from every other cell, with the same prior.
+
 The work is one fovea pass per (image, fixation): :func:`tally_images` spreads images over
 processes, each with its own detector (OpenCV objects cannot be shared).
 """
@@ -33,10 +37,12 @@ import numpy as np
 
 @dataclass
 class Tallies:
-    """Count tallies per offset: ``target[|dr|, |dc|, c]`` and ``null[|dr|, |dc|, c]``."""
+    """Count tallies per offset, ``target[|dr|, |dc|, c]`` and ``null[...]``, and of the scan."""
 
     target: np.ndarray
     null: np.ndarray
+    scan_target: np.ndarray
+    scan_null: np.ndarray
     images: int = 0
     fixations: int = 0
     detector_pixels: int = 0
@@ -46,11 +52,14 @@ class Tallies:
     def empty(cls, grid: Grid, max_count: int) -> Tallies:
         """Zero tallies for a grid and K = ``max_count``."""
         shape = grid.shape + (max_count,)
-        return cls(np.zeros(shape, dtype=np.int64), np.zeros(shape, dtype=np.int64))
+        return cls(np.zeros(shape, dtype=np.int64), np.zeros(shape, dtype=np.int64),
+                   np.zeros(max_count, dtype=np.int64), np.zeros(max_count, dtype=np.int64))
 
     def __iadd__(self, other: Tallies) -> Tallies:
         self.target += other.target
         self.null += other.null
+        self.scan_target += other.scan_target
+        self.scan_null += other.scan_null
         self.images += other.images
         self.fixations += other.fixations
         self.detector_pixels += other.detector_pixels
@@ -69,6 +78,7 @@ def tally_image(fovea: Fovea, image: np.ndarray, target_cell: int | None,
     rows, cols = grid.shape
     fixations = np.arange(grid.n_cells) if fixations is None else np.asarray(fixations)
     fovea.start(image)
+    scan = fovea.scan()
     frames = np.empty((fixations.size, grid.n_cells))
     for i, k in enumerate(fixations):
         frames[i] = fovea.observe(int(k)).counts
@@ -86,7 +96,13 @@ def tally_image(fovea: Fovea, image: np.ndarray, target_cell: int | None,
     null = np.bincount(flat[seen & ~is_target[None, :]], minlength=size)
     target = np.bincount(flat[seen & is_target[None, :]], minlength=size)
     shape = (rows, cols, k_max)
-    return Tallies(target.reshape(shape), null.reshape(shape), images=1,
+    scan_target = np.zeros(k_max, dtype=np.int64)
+    scan_null = np.zeros(k_max, dtype=np.int64)
+    if scan is not None:
+        scan_counts = scan.counts.astype(np.intp)
+        scan_target = np.bincount(scan_counts[is_target], minlength=k_max)
+        scan_null = np.bincount(scan_counts[~is_target], minlength=k_max)
+    return Tallies(target.reshape(shape), null.reshape(shape), scan_target, scan_null, images=1,
                    fixations=int(fixations.size), detector_pixels=fovea.image_detector_pixels,
                    seconds=fovea.image_seconds)
 
@@ -183,9 +199,12 @@ def pool_target(tallies: np.ndarray, pool_radius: float, min_tallies: int = 0) -
 
 
 def count_model(tallies: Tallies, grid: Grid, prior: float = 1.0, pool_radius: float = 0.5,
-                min_tallies: int = 50, meta: dict | None = None) -> CountObservation:
+                min_tallies: int = 50, meta: dict | None = None,
+                scan: bool = False) -> CountObservation:
     """
     Build the count model: Dirichlet(``prior``) estimates, target tallies pooled radially.
+
+    With ``scan`` the model also gets the scan tables, from the scan tallies with the same prior.
 
     Raises
     ------
@@ -201,7 +220,16 @@ def count_model(tallies: Tallies, grid: Grid, prior: float = 1.0, pool_radius: f
     null = tallies.null.astype(float) + prior
     target /= target.sum(axis=2, keepdims=True)
     null /= null.sum(axis=2, keepdims=True)
-    return CountObservation(grid, target, null, meta)
+    scan_target = scan_null = None
+    if scan:
+        if tallies.scan_null.sum() == 0:
+            raise ValueError('scan tables asked for, but no scan was tallied (fovea scan_once '
+                             'false)')
+        scan_target = (tallies.scan_target + prior) / (tallies.scan_target.sum()
+                                                       + prior * tallies.scan_target.size)
+        scan_null = (tallies.scan_null + prior) / (tallies.scan_null.sum()
+                                                   + prior * tallies.scan_null.size)
+    return CountObservation(grid, target, null, meta, scan_target, scan_null)
 
 
 def hit_false_alarm(model: CountObservation) -> tuple[np.ndarray, np.ndarray]:

@@ -36,9 +36,19 @@ one interpolation is only valid with it.
 
 **Cost and caching.** The whole-image window does not depend on the fixation: its detections are
 computed on the first fixation after :meth:`Fovea.start` and reused for the rest of the image, so
-its pixels count once per image (as in NMPT). With ``reuse_windows=True`` every window's
-detections are kept per image, keyed by the cells it covers (the detector is deterministic, so a
-repeated window gives the same boxes); this changes the cost, never the counts.
+its pixels count once per image (as in NMPT).
+
+**The scan** (``scan_once=True``). NMPT adds the whole-image window's counts to every fixation's
+frame, so the same detections enter the Bayes step again at each fixation: a single false alarm
+in that window, counted ten times, can make the belief confident. With ``scan_once`` the
+whole-image windows form a separate observation, :meth:`Fovea.scan`, taken once per image before
+the first fixation and modelled by its own offset-free table (docs/design.md section 6.6); the
+fixation frames then hold the other windows only. Without a whole-image window there is nothing to
+scan and the option is refused.
+
+With ``reuse_windows=True`` every window's detections are kept per image, keyed by the cells it
+covers and its resized size (the detector is deterministic, so a repeated window gives the same
+boxes); this changes the cost, never the counts.
 """
 from __future__ import annotations
 
@@ -86,6 +96,9 @@ class FoveaConfig:
         K: observations are clipped to ``0..K-1`` (at least 2).
     interpolation : str
         Resampling used to resize windows, a key of :data:`INTERPOLATIONS`.
+    scan_once : bool
+        Observe the whole-image windows once per image (:meth:`Fovea.scan`) instead of adding
+        their counts to every fixation's frame (NMPT).
 
     """
 
@@ -93,6 +106,7 @@ class FoveaConfig:
     scales: tuple | None = None
     max_count: int = REFERENCE_MAX_COUNT
     interpolation: str = 'area'
+    scan_once: bool = False
 
     def __post_init__(self):
         windows = self.windows_cells
@@ -117,7 +131,10 @@ class FoveaConfig:
         if self.interpolation not in INTERPOLATIONS:
             raise ValueError(f'interpolation must be one of {sorted(INTERPOLATIONS)}, '
                              f'got {self.interpolation!r}')
+        if not isinstance(self.scan_once, (bool, np.bool_)):
+            raise ValueError(f'scan_once must be true or false, got {self.scan_once!r}')
         object.__setattr__(self, 'windows_cells', windows)
+        object.__setattr__(self, 'scan_once', bool(self.scan_once))
         object.__setattr__(self, 'scales', scales)
         object.__setattr__(self, 'max_count', int(max_count))
 
@@ -129,14 +146,16 @@ class FoveaConfig:
     def to_dict(self) -> dict:
         """Plain types for YAML/JSON: lists for the tuples, the scales resolved."""
         return {'windows_cells': list(self.windows_cells), 'scales': list(self.scales),
-                'max_count': self.max_count, 'interpolation': self.interpolation}
+                'max_count': self.max_count, 'interpolation': self.interpolation,
+                'scan_once': self.scan_once}
 
     @classmethod
     def from_dict(cls, data: dict) -> FoveaConfig:
         """Inverse of :meth:`to_dict`; missing keys take the defaults, unknown keys are errors."""
         if not isinstance(data, dict):
             raise ValueError(f'a fovea configuration must be a mapping, got {type(data).__name__}')
-        unknown = set(data) - {'windows_cells', 'scales', 'max_count', 'interpolation'}
+        unknown = set(data) - {'windows_cells', 'scales', 'max_count', 'interpolation',
+                               'scan_once'}
         if unknown:
             raise ValueError(f'unknown fovea settings: {sorted(unknown)}')
         values = dict(data)
@@ -200,6 +219,37 @@ class Observation:
     detector_pixels: int
     seconds: float
     from_cache: tuple
+
+
+@dataclass(frozen=True, eq=False)
+class Scan:
+    """
+    The one-time observation of the whole-image windows (``scan_once``), and what it cost.
+
+    Attributes
+    ----------
+    counts : numpy.ndarray
+        ``(N,)`` ``float64``: detections of the whole-image windows centred in each cell,
+        clipped to ``0..max_count-1``; every cell is observed.
+    raw_counts : numpy.ndarray
+        ``(N,)`` ``int64``: the same counts before clipping.
+    windows : tuple of Window
+        The whole-image windows.
+    centres_px : numpy.ndarray
+        ``(M, 2)`` ``float64``: every raw detection's centre in full-image pixels.
+    detector_pixels : int
+        Pixels given to the detector (0 when the scan was already taken on this image).
+    seconds : float
+        Wall time of the scan.
+
+    """
+
+    counts: np.ndarray
+    raw_counts: np.ndarray
+    windows: tuple
+    centres_px: np.ndarray
+    detector_pixels: int
+    seconds: float
 
 
 def cell_edges_px(size_px: int, n_cells: int) -> np.ndarray:
@@ -266,6 +316,10 @@ class Fovea:
         self.config = FoveaConfig() if config is None else config
         if not isinstance(self.config, FoveaConfig):
             raise ValueError(f'config must be a FoveaConfig, got {type(self.config).__name__}')
+        if self.config.scan_once and self.config.windows_cells[0] < max(self.grid.shape):
+            raise ValueError(f'scan_once needs a whole-image window: the largest window '
+                             f'({self.config.windows_cells[0]} cells) does not cover the '
+                             f'{self.grid.rows}x{self.grid.cols} grid')
         self.reuse_windows = bool(reuse_windows)
         self._scales = np.asarray(self.config.scales)
         self._gray = None
@@ -340,9 +394,46 @@ class Fovea:
                 scale=float(scale), whole_image=bool(whole[i])))
         return tuple(windows)
 
+    def scan(self) -> Scan | None:
+        """
+        Observe the whole-image windows once (``scan_once``); None when the fovea has no scan.
+
+        The first call after :meth:`start` runs the detector; later calls on the same image
+        return the same counts at no detector cost.
+
+        Raises
+        ------
+        RuntimeError
+            Before :meth:`start`.
+
+        """
+        if not self.config.scan_once:
+            return None
+        t0 = time.perf_counter()
+        windows = tuple(w for w in self.window_rects(0) if w.whole_image)
+        centres, cells, pixels = [], [], 0
+        for window in windows:
+            key = (window.cells, window.resized_px)
+            found = self._cache.get(key)
+            if found is None:
+                found = self._search(window)
+                pixels += window.resized_px[0] * window.resized_px[1]
+                self._cache[key] = found
+            centres.append(found[0])
+            cells.append(found[1])
+        raw = np.bincount(np.concatenate(cells), minlength=self.grid.n_cells).astype(np.int64)
+        counts = np.minimum(raw, self.config.max_count - 1).astype(np.float64)
+        seconds = time.perf_counter() - t0
+        self.image_detector_pixels += pixels
+        self.image_seconds += seconds
+        return Scan(counts=counts, raw_counts=raw, windows=windows,
+                    centres_px=np.concatenate(centres), detector_pixels=pixels, seconds=seconds)
+
     def observe(self, fixation: int) -> Observation:
         """
         Fixate a cell of the current image and return its count :class:`Observation`.
+
+        With ``scan_once`` the whole-image windows are left out (they are :meth:`scan`'s).
 
         Raises
         ------
@@ -354,6 +445,8 @@ class Fovea:
         """
         t0 = time.perf_counter()
         windows = self.window_rects(fixation)
+        if self.config.scan_once:
+            windows = tuple(w for w in windows if not w.whole_image)
         rows, cols = self.grid.shape
         observed = np.zeros((rows, cols), dtype=bool)
         cells, centres, window_index, from_cache = [], [], [], []
@@ -361,7 +454,7 @@ class Fovea:
         for i, window in enumerate(windows):
             row, col, n_rows, n_cols = window.cells
             observed[row:row + n_rows, col:col + n_cols] = True
-            key = (i, window.cells)
+            key = (window.cells, window.resized_px)
             found = self._cache.get(key)
             from_cache.append(found is not None)
             if found is None:

@@ -5,9 +5,12 @@ Search one image for the target with the digital fovea and a count model (docs/d
 
 :func:`search_image` is the whole loop of the CVPR 2009 follow-up on one decoded image:
 
-1. start the fovea on the image (grey conversion) and fixate the **start cell**, the grid's
-   centre by default (docs/design.md section 4.2: on real pixels, as on the robot, the start
-   cell replaces the policy's first choice);
+1. start the fovea on the image (grey conversion); with a fovea that scans once
+   (``scan_once``), observe the whole-image windows and apply their one Bayes step with the
+   model's scan tables, ``model.scan_log_likelihood_ratio(counts)``; then fixate the **start
+   cell**: the policy's choice on the scanned belief, or without a scan the grid's centre
+   (docs/design.md section 4.2: on real pixels, as on the robot, the start cell replaces the
+   policy's first choice); an explicit ``start_cell`` wins in both cases;
 2. observe the fixation's detection counts and apply **one Bayes step** with the count model,
    ``bayes_update(log_b, model.log_likelihood_ratio(counts, k))`` (section 1.3);
 3. stop with ``'found'`` when the most likely cell's probability reaches ``confidence``, with
@@ -154,6 +157,12 @@ def check_model(model, fovea: Fovea) -> None:
     if grid.shape != fovea.grid.shape:
         raise ValueError(f'the observation model is for a {grid.rows}x{grid.cols} grid but the '
                          f'fovea tiles images with {fovea.grid.rows}x{fovea.grid.cols}')
+    scan = bool(getattr(model, 'has_scan', False))
+    if scan != fovea.config.scan_once:
+        raise ValueError('the fovea scans the whole image once but the observation model has '
+                         'no scan tables' if fovea.config.scan_once else
+                         'the observation model has scan tables but the fovea does not scan '
+                         '(scan_once false)')
     meta = getattr(model, 'meta', {})
     if meta.get('fovea') is not None:
         try:
@@ -296,7 +305,8 @@ def search_image(image: np.ndarray, fovea: Fovea, model, policy,
         look repeats the same counts, which the Bayes step would count twice; with this on,
         the search spends its budget on new cells instead of stopping.
     start_cell : int or (int, int), optional
-        First fixation (index or ``(row, col)``); the grid's centre by default.
+        First fixation (index or ``(row, col)``); by default the grid's centre, or with a
+        scan the policy's (best unvisited) choice on the scanned belief.
     rng : numpy.random.Generator, optional
         Passed to the policy; ``np.random.default_rng(0)`` by default.
 
@@ -325,6 +335,13 @@ def search_image(image: np.ndarray, fovea: Fovea, model, policy,
     belief = np.exp(log_belief)[None, :]                # what the policy sees: (1, N)
     visited = np.zeros(grid.n_cells, dtype=bool)
     path, pixels = [], 0
+    scan = fovea.scan()
+    if scan is not None:
+        pixels += scan.detector_pixels
+        bayes_update(log_belief, model.scan_log_likelihood_ratio(scan.counts), out=log_belief)
+        np.exp(log_belief, out=belief[0])
+        if start_cell is None:
+            fixation = unvisited_choice(policy, belief, visited, 0, rng, grid)
     while True:
         observation = fovea.observe(fixation)
         visited[fixation] = True
