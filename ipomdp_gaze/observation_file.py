@@ -28,6 +28,7 @@ import hashlib
 from importlib import resources
 import math
 from pathlib import Path
+import re
 
 import numpy as np
 
@@ -52,6 +53,17 @@ class ObservationFileError(ValueError):
 def shipped_observations() -> list[str]:
     """Names of the observation models shipped with the package."""
     return sorted(p.stem for p in MODEL_DIR.glob('*.yaml')) if MODEL_DIR.is_dir() else []
+
+
+def shipped_image_models() -> list[str]:
+    """
+    Return the shipped models ``find`` chooses from: ``faces-<size>``, one per image size.
+
+    Other shipped models are for other uses: ``faces-<size>-nmpt`` are NMPT's reference fovea
+    (reported in docs/faces.md, not the default), and a pan/tilt model tiles a head's grid, not
+    an image.
+    """
+    return [name for name in shipped_observations() if re.fullmatch(r'faces-\d+', name)]
 
 
 def resolve_source(source) -> Path:

@@ -164,6 +164,23 @@ class Family:
         return np.asarray(spec.theta, dtype=float).ravel().copy()
 
 
+def elm_init(grid: Grid, model, scale: float) -> np.ndarray:
+    """
+    Conv parameters that start training at ELM: ``scale`` times ELM's kernel, radially averaged.
+
+    ELM is itself a conv kernel (docs/design.md section 3.2): ``scores = B * K_ELM``. Its
+    kernel averaged over each distinct squared distance is in the conv family; ``scale`` sets the
+    softmax's sharpness (large: nearly ELM's argmax choices; policy gradient needs some spread).
+    """
+    if not np.isfinite(scale) or scale <= 0:
+        raise ValueError(f'the ELM initialisation scale must be a positive number, got {scale!r}')
+    values, bins = radial_bins(grid)
+    kernel = as_observation(grid, model).elm_kernel()
+    weight = np.bincount(bins.ravel(), weights=kernel.ravel(), minlength=values.size) \
+        / np.bincount(bins.ravel(), minlength=values.size)
+    return scale * weight
+
+
 def sample_episodes(theta: np.ndarray, model, reward: str, episodes: int,
                     horizon: int, rng: np.random.Generator) -> Episodes:
     """
@@ -279,8 +296,10 @@ class Trainer:
     """
 
     def __init__(self, grid: Grid, fpoc: FPOC, config: TrainConfig,
-                 params: np.ndarray | None = None, epoch: int = 0, wall_seconds: float = 0.0):
+                 params: np.ndarray | None = None, epoch: int = 0, wall_seconds: float = 0.0,
+                 init: str = 'zeros'):
         self.grid = grid
+        self.init = str(init)
         self.model = as_observation(grid, fpoc)
         self.fpoc = getattr(self.model, 'fpoc', None)          # None for a count model
         self.config = config
@@ -380,7 +399,7 @@ class Trainer:
                     'learning_rate': cfg.learning_rate, 'anneal_epochs': cfg.anneal_epochs,
                     'reward_scale': cfg.reward_scale,
                     'beta': cfg.beta, 'horizon': self.horizon, 'baseline': cfg.baseline,
-                    'seed': cfg.seed, 'init': 'zeros', 'eval_every': cfg.eval_every,
+                    'seed': cfg.seed, 'init': self.init, 'eval_every': cfg.eval_every,
                     'eval_episodes': cfg.eval_episodes, 'eval_seed': cfg.eval_seed,
                     'wall_seconds': round(self.wall_seconds, 3)}
         kernel = theta = None
@@ -424,7 +443,8 @@ def trainer_from_spec(spec: PolicySpec, model=None, **overrides) -> Trainer:
         model = spec.fpoc
     return Trainer(spec.grid, model, config, params=family.params_from_spec(spec),
                    epoch=int(spec.training.get('epochs', 0)),
-                   wall_seconds=float(spec.training.get('wall_seconds', 0.0)))
+                   wall_seconds=float(spec.training.get('wall_seconds', 0.0)),
+                   init=str(spec.training.get('init', 'zeros')))
 
 
 def write_curve(path, rows: list[dict], append: bool = False) -> Path:

@@ -156,7 +156,7 @@ def _model_copy(path, model, width, height):
     meta.pop('source', None)
     meta['image'] = {'width': width, 'height': height}
     return save_observation(path, CountObservation(model.grid, model.p_target, model.p_null,
-                                                   meta))
+                                                   meta, model.scan_target, model.scan_null))
 
 
 def test_default_model_is_the_shipped_one_calibrated_nearest(task, tmp_path, monkeypatch,
@@ -168,14 +168,15 @@ def test_default_model_is_the_shipped_one_calibrated_nearest(task, tmp_path, mon
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and 'pass --observation FILE' in err[0]
     model = load_observation(task['model'])
-    _model_copy(models / 'a-faces-420.yaml', model, 420, 420)
-    _model_copy(models / 'b-faces-800.yaml', model, 800, 800)
+    _model_copy(models / 'faces-420.yaml', model, 420, 420)
+    _model_copy(models / 'faces-800.yaml', model, 800, 800)
+    _model_copy(models / 'faces-840-nmpt.yaml', model, 840, 840)     # a reference: never chosen
     big = tmp_path / 'big.png'
     cv2.imwrite(str(big), cv2.resize(task['scenes'][0].image, (840, 840)))
     assert main(['find', str(task['images'][0]), str(big)]) == 0
     err = capsys.readouterr().err
-    assert 'shipped observation model a-faces-420' in err
-    assert 'shipped observation model b-faces-800' in err
+    assert 'shipped observation model faces-420 ' in err
+    assert 'shipped observation model faces-800 ' in err and 'nmpt' not in err
 
 
 def test_default_policy_is_the_shipped_kernel_of_the_model(task, tmp_path, monkeypatch,

@@ -9,7 +9,7 @@ from ipomdp_gaze.observation import GaussianObservation
 from ipomdp_gaze.policies.conv import ConvPolicy, kernel_from_radial, kernel_matrix, radial_bins
 from ipomdp_gaze.policies.logistic import LogisticPolicy
 from ipomdp_gaze.policies.policy_file import load_policy, load_policy_spec, save_policy
-from ipomdp_gaze.policies.training import (discounted_from, Family, leave_one_out_mean,
+from ipomdp_gaze.policies.training import (discounted_from, elm_init, Family, leave_one_out_mean,
                                            log_policy_gradient, read_curve, sample_episodes,
                                            theta_gradient, trace_gradient_reference, TrainConfig,
                                            Trainer, trainer_from_spec)
@@ -211,8 +211,32 @@ def test_train_cli_errors_are_one_line(tmp_path, capsys):
         (['--resume', str(path), '--epochs', '1'], 'less than the 2 epochs'),
         (['--epochs', '2'], '--out PATH.yaml is required'),
         (['--resume', str(tmp_path / 'none.yaml'), '--epochs', '2'], 'not found'),
+        (['--resume', str(path), '--epochs', '4', '--init-elm', '5'], 'keeps its kernel'),
+        (['--grid', '3x3', '--family', 'logistic', '--epochs', '1', '--init-elm', '5', '--out',
+          str(tmp_path / 'q.yaml')], 'use it with --family conv'),
     ]
     for argv, message in cases:
         assert main(['train', '--quiet'] + argv) == 2
         err = capsys.readouterr().err
         assert message in err and err.count('\n') == 1
+
+
+def test_elm_initialisation_starts_training_at_elms_choices(tmp_path):
+    """The Gaussian ELM kernel d'^2 is radial: the initial conv kernel picks what ELM picks."""
+    grid = Grid(5, 5)
+    model = GaussianObservation(grid, FPOC)
+    params = elm_init(grid, FPOC, 20.0)
+    np.testing.assert_allclose(kernel_from_radial(grid, params), 20.0 * model.elm_kernel())
+    start = Family(grid, 'conv').policy(params)
+    elm = ConvPolicy(grid, model.elm_kernel())
+    rng = np.random.default_rng(1)
+    beliefs = np.stack([random_belief(grid.n_cells, rng) for _ in range(200)])
+    np.testing.assert_array_equal(start.select(beliefs, 1, rng), elm.select(beliefs, 1, rng))
+    with pytest.raises(ValueError, match='positive number'):
+        elm_init(grid, FPOC, 0.0)
+    out = tmp_path / 'e.yaml'
+    assert main(['train', '--grid', '5x5', '--epochs', '0', '--init-elm', '20', '--out',
+                 str(out), '--final-episodes', '0', '--quiet']) == 0
+    spec = load_policy_spec(out)
+    assert spec.training['init'] == 'elm x 20'
+    np.testing.assert_allclose(spec.kernel, 20.0 * model.elm_kernel())

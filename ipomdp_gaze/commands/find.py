@@ -20,9 +20,10 @@ uniform belief before the first image, so e.g. ELM's N x N weight matrix is buil
 **Model.** ``--observation`` names an ``ipomdp_gaze/observation-v1`` file (or a shipped model);
 the fovea, the grid and the detector are rebuilt from what the file records (each window is
 detected at most once per image: the detector is deterministic, so this saves work and changes
-no count). Without it, each image uses the shipped model calibrated at the size nearest its own
-(``|log(w/w0)| + |log(h/h0)|``, ties to the first name); stderr says which model and policy are
-used. An image of another size than its model's is searched, and its line says so.
+no count). Without it, each image uses the shipped face model (``faces-<size>``) calibrated at
+the size nearest its own (``|log(w/w0)| + |log(h/h0)|``, ties to the first name); stderr says
+which model and policy are used. An image of another size than its model's is searched, and its
+line says so.
 
 **Policy.** ``--policy NAME`` (a baseline or ``nmpt``, built on the model) or ``--policy-file``;
 by default the shipped kernel trained on the model (a file in ``ipomdp_gaze/policies/kernels/``
@@ -39,7 +40,7 @@ import sys
 
 import cv2
 from ipomdp_gaze.belief import uniform_log_belief
-from ipomdp_gaze.observation_file import load_observation, shipped_observations
+from ipomdp_gaze.observation_file import load_observation, shipped_image_models
 from ipomdp_gaze.policies.policy_file import load_policy_spec, shipped_kernels
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
 from ipomdp_gaze.vision.search import (calibrated_size, cell_centre_px, check_image_size,
@@ -266,7 +267,7 @@ def prepare(args) -> list:
     if args.observation:
         models, shipped = [load_observation(args.observation)], False
     else:
-        names = shipped_observations()
+        names = shipped_image_models()
         if not names:
             raise ValueError('no observation model is shipped with this install; pass '
                              '--observation FILE (an ipomdp_gaze/observation-v1 file, e.g. from '

@@ -37,6 +37,9 @@ def add_parser(sub):
                    help='policy file to write (default: the --resume file)')
     p.add_argument('--resume', type=Path, default=None, metavar='PATH.yaml',
                    help='continue training the policy in this file with its recorded settings')
+    p.add_argument('--init-elm', type=positive_float, default=None, metavar='SCALE',
+                   help="start a conv kernel at SCALE times ELM's kernel (radially averaged) "
+                        'instead of zeros')
     p.add_argument('--learning-rate', type=positive_float, default=None,
                    help=f'step size of theta += lr * mean g (default {LEARNING_RATE})')
     p.add_argument('--anneal-epochs', type=positive_float, default=None, metavar='TAU',
@@ -142,8 +145,17 @@ def run(args) -> int:
                     'family': args.family or FAMILY_DEFAULT, 'learning_rate': LEARNING_RATE,
                     'reward_scale': REWARD_SCALE, 'baseline': True}
         defaults.update({k: v for k, v in overrides.items() if v is not None})
-        trainer = Trainer(grid, fpoc, TrainConfig(**defaults))
+        config = TrainConfig(**defaults)
+        params, init = None, 'zeros'
+        if args.init_elm is not None:
+            if config.family != 'conv':
+                raise ValueError('--init-elm starts a conv kernel: use it with --family conv')
+            from ipomdp_gaze.policies.training import elm_init
+            params, init = elm_init(grid, fpoc, args.init_elm), f'elm x {args.init_elm:g}'
+        trainer = Trainer(grid, fpoc, config, params=params, init=init)
     else:
+        if args.init_elm is not None:
+            raise ValueError('--init-elm starts a new training; a resumed one keeps its kernel')
         trainer = trainer_from_spec(spec, model=fpoc, **overrides)
     curve_path = out.with_suffix('.csv')
     rows = []
