@@ -9,9 +9,11 @@ here was fitted to them), in one run and on the same images:
 
 - the full-frame scan at full resolution and downscaled by 3/4, 1/2 and 1/3 (the answer is the
   cell with most raw detections, NMPT's rule; OpenCV's grouped detections are reported too);
-- the digital fovea with the shipped count model of that task and several policies and
-  confidence thresholds: ELM, MAP, random and spiral with inhibition of return, and NMPT's
-  fixed policy with NMPT's repeat rule.
+- the digital fovea with the shipped count model of that task (the scanning fovea) and several
+  policies and confidence thresholds: the shipped kernel when there is one, ELM, MAP, random
+  and spiral with inhibition of return, and NMPT's fixed policy with NMPT's repeat rule;
+- NMPT's reference fovea (windows 21, 15, 9, 3 cells, each at the pixel size of 3 cells, the
+  whole-image window in every frame; model ``faces-<size>-nmpt``) with ELM and NMPT's policy.
 
 Accuracy: the found cell within one cell (Chebyshev) of the cell holding the face centre, with a
 95% Wilson interval; also exact and the mean grid error. Cost: detector pixels and wall seconds
@@ -28,6 +30,7 @@ import time
 import cv2
 from ipomdp_gaze.observation_file import load_observation
 from ipomdp_gaze.policies.registry import build_policy
+from ipomdp_gaze.commands.find import default_policy_file
 from ipomdp_gaze.vision.detector import HaarDetector
 from ipomdp_gaze.vision.fullframe import scan
 from ipomdp_gaze.vision.scenes import SceneSet
@@ -35,13 +38,23 @@ from ipomdp_gaze.vision.search import fovea_for_model, search_image
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+OPERATING_CONFIDENCE = 0.99
 TASKS = {'paper': ('faces-420', 420, (60, 140)), 'small': ('faces-840', 840, (24, 140))}
 SCALES = (1.0, 0.75, 0.5, 1 / 3)
-# (label, policy name, confidence, budget, NMPT's repeat rule instead of inhibition of return)
-FOVEATED = (('ELM', 'elm', 0.9, 60, False), ('ELM', 'elm', 0.99, 60, False),
-            ('ELM', 'elm', 0.999, 60, False), ('MAP', 'map', 0.999, 60, False),
-            ('random', 'random', 0.999, 60, False), ('spiral', 'spiral', 0.999, 60, False),
-            ('NMPT fixed policy', 'nmpt', 0.999, 60, True))
+# (label, model: shipped or NMPT's reference, policy name ('kernel': the shipped kernel of the
+# model, skipped when there is none), confidence, budget, NMPT's repeat rule instead of
+# inhibition of return)
+FOVEATED = (('kernel', 'shipped', 'kernel', OPERATING_CONFIDENCE, 60, False),
+            ('ELM', 'shipped', 'elm', 0.9, 60, False),
+            ('ELM', 'shipped', 'elm', 0.99, 60, False),
+            ('ELM', 'shipped', 'elm', 0.999, 60, False),
+            ('MAP', 'shipped', 'map', OPERATING_CONFIDENCE, 60, False),
+            ('random', 'shipped', 'random', OPERATING_CONFIDENCE, 60, False),
+            ('spiral', 'shipped', 'spiral', OPERATING_CONFIDENCE, 60, False),
+            ('NMPT fixed policy', 'shipped', 'nmpt', OPERATING_CONFIDENCE, 60, True),
+            ('ELM', 'reference', 'elm', 0.99, 60, False),
+            ('ELM', 'reference', 'elm', 0.999, 60, False),
+            ('NMPT fixed policy', 'reference', 'nmpt', 0.999, 60, True))
 SIZE_BINS = ((0, 40), (40, 64), (64, 100), (100, 141))
 # Ideas tried before this run, each measured on training scenes (seed 1, 80 scenes of the paper
 # task) or in simulation from the model, never on the test scenes above.
@@ -98,11 +111,21 @@ def errors(cells, truth) -> np.ndarray:
 
 def run_task(name: str, n: int, seed: int, log) -> dict:
     model_name, size, faces = TASKS[name]
-    model = load_observation(model_name)
-    grid = model.grid
+    models = {'shipped': load_observation(model_name),
+              'reference': load_observation(f'{model_name}-nmpt')}
+    grid = models['shipped'].grid
     scenes = SceneSet('test', size_px=size, face_px=faces, grid=grid.shape, seed=seed)
     detector = HaarDetector()
-    fovea = fovea_for_model(model)
+    foveas = {key: fovea_for_model(model) for key, model in models.items()}
+    kernel = default_policy_file(models['shipped'])
+    policies = {}
+    for label, which, policy_name, *_ in FOVEATED:
+        if policy_name == 'kernel':
+            if kernel is not None:
+                policies[label, which] = build_policy('learned', grid, models[which],
+                                                      file=kernel, action='argmax')
+        else:
+            policies[label, which] = build_policy(policy_name, grid, models[which])
     truth, sizes = [], []
     rows = {}
     for i in range(n):
@@ -119,13 +142,16 @@ def run_task(name: str, n: int, seed: int, log) -> dict:
                 row['seconds'].append(result.seconds)
                 row['pixels'].append(result.detector_pixels)
                 row['fixations'].append(0)
-        for label, policy_name, confidence, budget, nmpt_rule in FOVEATED:
-            policy = build_policy(policy_name, grid, model)
-            result = search_image(scene.image, fovea, model, policy, confidence=confidence,
+        for label, which, policy_name, confidence, budget, nmpt_rule in FOVEATED:
+            if (label, which) not in policies:
+                continue
+            result = search_image(scene.image, foveas[which], models[which],
+                                  policies[label, which], confidence=confidence,
                                   max_fixations=budget, stop_on_repeat=nmpt_rule,
                                   inhibit_return=not nmpt_rule,
                                   rng=np.random.default_rng([seed, i]))
-            key = f'fovea, {label}, confidence {confidence}'
+            fovea_name = 'fovea' if which == 'shipped' else "NMPT's fovea"
+            key = f'{fovea_name}, {label}, confidence {confidence}'
             row = rows.setdefault(key, {'cells': [], 'seconds': [], 'pixels': [],
                                         'fixations': []})
             row['cells'].append(result.cell)
@@ -218,11 +244,14 @@ def plot_speed_accuracy(results, path: Path) -> None:
         for r in task['rows']:
             if r['label'].endswith('grouped'):
                 continue
-            fovea = r['label'].startswith('fovea')
+            full = r['label'].startswith('full frame')
+            reference = r['label'].startswith("NMPT's fovea")
             low, high = r['ci']
             ax.errorbar(r['speedup'], r['right'], yerr=[[r['right'] - low], [high - r['right']]],
-                        fmt='o' if fovea else 's', color='C1' if fovea else 'C0', capsize=2)
-            ax.annotate(r['label'].replace('fovea, ', '').replace(', confidence ', ' @'),
+                        fmt='s' if full else 'o', capsize=2,
+                        color='C0' if full else 'C2' if reference else 'C1')
+            ax.annotate(r['label'].replace("NMPT's fovea, ", 'ref. ').replace('fovea, ', '')
+                        .replace(', confidence ', ' @'),
                         (r['speedup'], r['right']), fontsize=7, xytext=(4, 2),
                         textcoords='offset points')
         full = next(r for r in task['rows'] if r['label'] == 'full frame x1')
@@ -232,7 +261,8 @@ def plot_speed_accuracy(results, path: Path) -> None:
         ax.set(xscale='log', xlabel='speed-up vs full-resolution scan (median time)',
                ylabel='right (within one cell)',
                title=f"{task['size']}x{task['size']}, faces {task['faces'][0]}-"
-                     f"{task['faces'][1]} px (blue: full frame, orange: fovea)")
+                     f"{task['faces'][1]} px\n(blue: full frame, orange: scanning fovea, green: "
+                     "NMPT's reference fovea)")
         ax.grid(True, which='both', alpha=0.3)
         ax.legend(fontsize=8, loc='lower left')
     fig.tight_layout()

@@ -152,3 +152,22 @@ def _no_scan():
     tallies = Tallies.empty(GRID, 3)
     tallies.target[0, 0] = [1, 0, 0]
     return tallies
+
+
+def test_lattice_fixations_keep_the_edges_and_calibration_can_use_them():
+    from ipomdp_gaze.vision.calibrate import lattice_fixations, tally_images
+    grid = Grid(5, 5, 1.0)
+    cells = lattice_fixations(grid, 2)
+    assert sorted(map(tuple, np.column_stack(grid.cell(cells)))) == \
+        [(r, c) for r in (0, 2, 4) for c in (0, 2, 4)]
+    assert sorted(lattice_fixations(grid, 3)) == sorted(
+        r * 5 + c for r in (0, 3, 4) for c in (0, 3, 4))
+    np.testing.assert_array_equal(np.sort(lattice_fixations(grid, 1)), np.arange(25))
+    with pytest.raises(ValueError, match='positive integer'):
+        lattice_fixations(grid, 0)
+    items = [('scene', {'split': 'train', 'size_px': 100, 'face_px': (30, 40), 'grid': (5, 5),
+                        'seed': 0}, i) for i in range(2)]
+    config = FoveaConfig(windows_cells=(5, 3), scales=(1.0, 1.0), max_count=4)
+    tallies = tally_images(items, {}, grid, config, processes=1, fixations=cells)
+    assert tallies.images == 2 and tallies.fixations == 2 * 9
+    assert tallies.null.sum() + tallies.target.sum() == 2 * 9 * 25     # 5-cell window: all seen

@@ -82,6 +82,9 @@ def add_parser(sub):
     p.add_argument('--min-tallies', type=nonneg_int, default=50,
                    help='widen the pooling where an offset has fewer target observations '
                         '(default 50)')
+    p.add_argument('--fixation-stride', type=positive_int, default=1, metavar='S',
+                   help='fixate the cells whose row and column are multiples of S (and the '
+                        'last row and column) instead of every cell (default 1: every cell)')
     p.add_argument('--processes', type=positive_int, default=2)
     p.add_argument('--out', type=Path, required=True, metavar='FILE.yaml')
     p.add_argument('--plot', type=Path, default=None, metavar='PNG',
@@ -188,7 +191,11 @@ def run(args) -> int:
     from tqdm import tqdm
     bar = tqdm(total=len(items), unit='image', disable=args.quiet, desc='calibrate')
     start = time.perf_counter()
-    tallies = tally_images(items, detector_kwargs, grid, config, args.processes, bar.update)
+    from ipomdp_gaze.vision.calibrate import lattice_fixations
+    fixations = None if args.fixation_stride == 1 else \
+        lattice_fixations(grid, args.fixation_stride)
+    tallies = tally_images(items, detector_kwargs, grid, config, args.processes, bar.update,
+                           fixations)
     bar.close()
     wall = time.perf_counter() - start
     meta = {'image': {'width': int(width), 'height': int(height)}, 'fovea': config.to_dict(),
@@ -199,6 +206,7 @@ def run(args) -> int:
                             'images': tallies.images, 'fixations': tallies.fixations,
                             'prior': args.prior, 'pool_radius': args.pool_radius,
                             'min_tallies': args.min_tallies,
+                            'fixation_stride': args.fixation_stride,
                             'detector_pixels': int(tallies.detector_pixels),
                             'wall_seconds': round(wall, 1)}}
     model = count_model(tallies, grid, args.prior, args.pool_radius, args.min_tallies, meta,
