@@ -28,9 +28,9 @@ import sys
 import time
 
 import cv2
+from ipomdp_gaze.commands.find import default_policy_file
 from ipomdp_gaze.observation_file import load_observation
 from ipomdp_gaze.policies.registry import build_policy
-from ipomdp_gaze.commands.find import default_policy_file
 from ipomdp_gaze.vision.detector import HaarDetector
 from ipomdp_gaze.vision.fullframe import scan
 from ipomdp_gaze.vision.scenes import SceneSet
