@@ -32,3 +32,23 @@ def test_paired_difference_of_identical_runs_is_zero():
     correct = np.arange(1, 13)[None, :] >= rng.integers(1, 11, size=500)[:, None]
     diff, (low, high) = paired_difference_ci(correct, correct, 100, rng, 200)
     assert diff == 0 and low == 0 and high == 0
+
+
+def test_evaluate_paired_compares_each_policy_with_the_first_on_the_same_episodes(capsys):
+    from ipomdp_gaze.cli import main
+    from ipomdp_gaze.commands.evaluate import evaluate
+    from ipomdp_gaze.fpoc import make_fpoc
+    from ipomdp_gaze.grid import Grid
+    from ipomdp_gaze.policies.registry import build_policy
+    grid, fpoc = Grid(5, 5, 0.42), make_fpoc('human')
+    policies = {name: build_policy(name, grid, fpoc) for name in ('map', 'elm')}
+    policies['map again'] = build_policy('map', grid, fpoc)
+    result = evaluate(grid, fpoc, policies, 3000, None, 0, paired=True)
+    same = result['paired']['map again - map']
+    assert same['difference'] == 0 and same['ci95'] == [0.0, 0.0]
+    better = result['paired']['elm - map']            # ELM beats MAP (docs/baselines.md)
+    assert better['ci95'][1] < 0 and better['episodes'] == 3000
+    assert 'paired' not in evaluate(grid, fpoc, policies, 300, None, 0)
+    assert main(['evaluate', '--grid', '3x3', '--policy', 'map', '--policy', 'random',
+                 '--episodes', '500', '--paired']) == 0
+    assert 'random - map: ' in capsys.readouterr().out

@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from ipomdp_gaze.evaluation import fixations_to_90_ci
+from ipomdp_gaze.evaluation import fixations_to_90_ci, paired_difference_ci
 from ipomdp_gaze.observation import as_observation, GaussianObservation
 from ipomdp_gaze.observation_file import fingerprint
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
@@ -33,6 +33,9 @@ def add_parser(sub):
     p.add_argument('--seed', type=nonneg_int, default=0)
     p.add_argument('--bootstrap', type=positive_int, default=1000,
                    help='bootstrap resamples for the 95%% interval (default 1000)')
+    p.add_argument('--paired', action='store_true',
+                   help='also give each policy minus the first, on the same episodes, with a '
+                        'paired bootstrap 95%% interval')
     p.add_argument('--json', type=Path, default=None, metavar='OUT', help='write results here')
     p.set_defaults(run=run)
 
@@ -48,8 +51,14 @@ def load_policies(args, grid, fpoc) -> dict:
 
 
 def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
-             episodes_greedy: int = 2000, bootstrap: int = 1000, progress=None) -> dict:
-    """Run every policy on the same targets and noise; return the JSON-ready result."""
+             episodes_greedy: int = 2000, bootstrap: int = 1000, progress=None,
+             paired: bool = False) -> dict:
+    """
+    Run every policy on the same targets and noise; return the JSON-ready result.
+
+    With ``paired``, ``result['paired']`` holds each later policy minus the first: the
+    difference of fixations to 90% on their common episodes with a paired bootstrap interval.
+    """
     horizon = grid.n_cells if horizon is None else horizon
     model = as_observation(grid, fpoc)
     targets = draw_targets(grid.n_cells, episodes, seed)
@@ -57,9 +66,12 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
             else {'observation': {**model.to_dict(), 'sha256': fingerprint(model)}})
     out = {'grid': grid.to_dict(), **task, 'episodes': episodes,
            'horizon': horizon, 'seed': seed, 'policies': {}}
+    correct = {}
     for name, policy in policies.items():
         n = min(episodes, episodes_greedy) if getattr(policy, 'name', '') == 'greedy' else episodes
         result = simulate(grid, model, policy, n, horizon, seed, targets=targets[:n])
+        if paired:
+            correct[name] = result.correct
         point, ci = fixations_to_90_ci(result.correct, grid.n_cells,
                                        np.random.default_rng([seed, 99]), bootstrap)
         out['policies'][name] = {
@@ -67,6 +79,15 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
             'percent_correct': [round(float(x), 6) for x in result.percent_correct]}
         if progress:
             progress(name, out['policies'][name])
+    if paired and len(correct) > 1:
+        names = list(correct)
+        out['paired'] = {}
+        for name in names[1:]:
+            diff, ci = paired_difference_ci(correct[name], correct[names[0]], grid.n_cells,
+                                            np.random.default_rng([seed, 98]), bootstrap)
+            out['paired'][f'{name} - {names[0]}'] = {
+                'episodes': int(min(correct[name].shape[0], correct[names[0]].shape[0])),
+                'difference': diff, 'ci95': list(ci) if ci else None}
     return out
 
 
@@ -80,6 +101,13 @@ def format_table(result: dict) -> str:
         ci = '' if r['ci95'] is None else f"[{r['ci95'][0]:.2f}, {r['ci95'][1]:.2f}]"
         at = [f'{pc[t - 1]:6.3f}' if t <= len(pc) else '     -' for t in (1, 5, 10)]
         lines.append(f"{name:<24} {r['episodes']:>8} {f90:>9} {ci:>17} {' '.join(at)}")
+    for label, r in result.get('paired', {}).items():
+        if r['difference'] is None:
+            lines.append(f'{label}: not defined (a policy never reaches 90%)')
+            continue
+        ci = '' if r['ci95'] is None else f" [{r['ci95'][0]:+.2f}, {r['ci95'][1]:+.2f}]"
+        lines.append(f"{label}: {r['difference']:+.2f}{ci} fixations to 90% "
+                     f"({r['episodes']} paired episodes)")
     return '\n'.join(lines)
 
 
@@ -87,7 +115,7 @@ def run(args) -> int:
     grid, fpoc = task_from_args(args)
     policies = load_policies(args, grid, fpoc)
     result = evaluate(grid, fpoc, policies, args.episodes, args.horizon, args.seed,
-                      args.episodes_greedy, args.bootstrap)
+                      args.episodes_greedy, args.bootstrap, paired=args.paired)
     task = (f'count model {args.observation}' if args.observation else
             f'{grid.spacing_deg} deg/cell, FPOC {fpoc.to_dict()}')
     print(f"{grid.rows}x{grid.cols} grid, {task}, horizon {result['horizon']}, seed {args.seed}")
