@@ -132,7 +132,7 @@ class Motion:
 
     def over(self, seconds: float) -> 'Motion':
         """
-        The motion over ``seconds`` when ``sigma_cells`` and ``jump_prob`` are per second.
+        Return the motion over ``seconds`` when ``sigma_cells`` and ``jump_prob`` are per second.
 
         ``sigma = sigma_cells * sqrt(seconds)`` (variance grows linearly in time) and
         ``jump = 1 - (1 - jump_prob)^seconds``; ``seconds <= 0`` is no motion.

@@ -59,14 +59,14 @@ def check_confidence(confidence: float) -> float:
     return float(confidence)
 
 
-def check_max_fixations(value) -> int | None:
+def check_max_fixations(value, name: str = 'max_fixations') -> int | None:
     """
     Return a fixation budget: a positive integer, or None for no budget (``None`` or 0).
 
     Raises
     ------
     ValueError
-        For a negative or non-integer value.
+        For a negative or non-integer value (the message starts with ``name``).
 
     """
     if value is None:
@@ -74,16 +74,15 @@ def check_max_fixations(value) -> int | None:
     try:
         budget = operator.index(value)
     except TypeError:
-        raise ValueError(f'max_fixations must be an integer >= 0 (0: no budget), '
-                         f'got {value!r}') from None
+        budget = -1
     if budget < 0:
-        raise ValueError(f'max_fixations must be an integer >= 0 (0: no budget), got {value!r}')
+        raise ValueError(f'{name} must be an integer >= 0 (0: no budget), got {value!r}')
     return budget or None
 
 
-def check_absent_prior(value) -> float:
+def check_absent_prior(value, name: str = 'absent_prior') -> float:
     """Return ``absent_prior`` in ``[0, 1)`` (ValueError with the reason otherwise)."""
-    return check_probability(value, 'absent_prior')
+    return check_probability(value, name)
 
 
 def initial_log_belief(n_cells: int, absent_prior: float = 0.0,

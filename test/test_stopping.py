@@ -24,7 +24,7 @@ HUMAN = make_fpoc('human')
 
 
 def with_absent(llr):
-    """The frame's terms with the absent hypothesis's 0 appended."""
+    """Append the absent hypothesis's 0 to the frame's terms."""
     return np.concatenate([llr, np.zeros(llr.shape[:-1] + (1,))], axis=-1)
 
 
