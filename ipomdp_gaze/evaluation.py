@@ -6,6 +6,12 @@ Honest evaluation: percent correct vs fixations, fixations to 90% correct, boots
 Fixations to 90% correct is the first t where percent correct reaches 0.90, interpolated linearly
 between t-1 and t (percent correct at t = 0 is the uniform guess, 1/N); ``None`` if never reached.
 Intervals are percentile bootstraps over episodes.
+
+For moving and absent targets and the stopping rules (docs/design.md section 7.4): the rates of
+right, wrong ``found``, wrong ``absent`` and ``gave_up`` decisions with Wilson intervals
+(:func:`decision_summary`), and the first lock and tracking accuracy of a moving target with
+bootstrap intervals, alone or paired (:func:`tracking_summary`,
+:func:`paired_tracking_difference`).
 """
 from __future__ import annotations
 

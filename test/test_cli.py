@@ -103,7 +103,8 @@ def test_bad_scene_arguments_exit_2_with_one_line(args, message):
 
 def test_evaluate_records_the_scene_options_and_decisions(tmp_path):
     path = tmp_path / 'scene.json'
-    rc = main(['evaluate', '--grid', '4x4', '--policy', 'elm', '--episodes', '400', '--seed', '2',
+    rc = main(['evaluate', '--grid', '4x4', '--policy', 'elm', '--policy', 'map',
+               '--episodes', '400', '--seed', '2',
                '--bootstrap', '50', '--motion-sigma-cells', '0.4', '--jump-prob', '0.01',
                '--absent-prior', '0.3', '--absent-rate', '0.2', '--confidence', '0.9',
                '--max-fixations', '12', '--compare-prediction', '--json', str(path)])
@@ -111,11 +112,12 @@ def test_evaluate_records_the_scene_options_and_decisions(tmp_path):
     data = json.loads(path.read_text())
     assert list(data) == ['grid', 'fpoc', 'episodes', 'horizon', 'seed', 'motion_sigma_cells',
                           'jump_prob', 'absent_prior', 'absent_rate', 'confidence',
-                          'max_fixations', 'policies', 'prediction_gain']
+                          'max_fixations', 'policies', 'tracking_paired', 'prediction_gain']
     assert (data['motion_sigma_cells'], data['jump_prob'], data['absent_prior'],
             data['absent_rate'], data['confidence'], data['max_fixations'],
             data['horizon']) == (0.4, 0.01, 0.3, 0.2, 0.9, 12, 12)
-    assert list(data['policies']) == ['elm', 'elm (no prediction)']
+    assert list(data['policies']) == ['elm', 'map', 'elm (no prediction)', 'map (no prediction)']
+    assert data['tracking_paired']['map']['minus'] == 'elm'
     d = data['policies']['elm']['decisions']
     groups = d['present']['searches'], d['absent']['searches']
     assert sum(groups) == 400 and 40 < groups[1] < 130

@@ -132,6 +132,12 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
                                                  np.random.default_rng([seed, 98]), bootstrap)
         if progress:
             progress(name, entry)
+    names = list(policies)
+    if motion.active and len(names) > 1:
+        out['tracking_paired'] = {
+            name: {'minus': names[0], **paired_tracking_difference(
+                results[name], results[names[0]], grid.cols, np.random.default_rng([seed, 96]),
+                bootstrap)} for name in names[1:]}
     if compare_prediction and motion.active:
         out['prediction_gain'] = {
             name: paired_tracking_difference(results[name], results[name + NO_PREDICTION],
@@ -191,6 +197,10 @@ def run(args) -> int:
               f"{result['absent_rate']}; confidence {result['confidence']}, budget "
               f"{result['max_fixations'] or result['horizon']}")
         print(format_decisions(result))
+    for name, gain in result.get('tracking_paired', {}).items():
+        ci = gain['ci95']
+        print(f"{name}: tracking accuracy minus {gain['minus']}'s {gain['difference']:+.4f}"
+              + (f' [{ci[0]:+.4f}, {ci[1]:+.4f}]' if ci else ''))
     for name, gain in result.get('prediction_gain', {}).items():
         ci = gain['ci95']
         print(f'{name}: tracking accuracy with minus without prediction '
