@@ -131,3 +131,20 @@ def test_evaluate_records_the_scene_options_and_decisions(tmp_path):
     assert 0 < tracking['value'] <= 1 and tracking['ci95'][0] <= tracking['value']
     assert data['prediction_gain']['elm']['ci95'][0] <= data['prediction_gain']['elm'][
         'difference'] <= data['prediction_gain']['elm']['ci95'][1]
+
+
+def test_explicit_zero_scene_options_change_no_number(tmp_path):
+    """The paper's task is the default: zeros give today's JSON plus the new keys only."""
+    plain, zeros = tmp_path / 'plain.json', tmp_path / 'zeros.json'
+    common = ['evaluate', '--grid', '5x5', '--policy', 'elm', '--policy', 'random',
+              '--episodes', '600', '--seed', '4', '--bootstrap', '50']
+    assert main(common + ['--json', str(plain)]) == 0
+    assert main(common + ['--motion-sigma-cells', '0', '--jump-prob', '0', '--absent-prior', '0',
+                          '--absent-rate', '0', '--json', str(zeros)]) == 0
+    a, b = json.loads(plain.read_text()), json.loads(zeros.read_text())
+    for key in ('motion_sigma_cells', 'jump_prob', 'absent_prior', 'absent_rate', 'confidence',
+                'max_fixations'):
+        b.pop(key)
+    for policy in b['policies'].values():
+        assert policy.pop('decisions')['absent']['searches'] == 0
+    assert json.dumps(a) == json.dumps(b)
