@@ -36,6 +36,7 @@ from .belief import normalize_log
 from .grid import Grid
 
 TRUNCATE_SIGMAS = 3.0
+ALMOST_ONE = math.nextafter(1.0, 0.0)
 
 
 def check_sigma_cells(value, name: str = 'sigma_cells') -> float:
@@ -135,11 +136,12 @@ class Motion:
         Return the motion over ``seconds`` when ``sigma_cells`` and ``jump_prob`` are per second.
 
         ``sigma = sigma_cells * sqrt(seconds)`` (variance grows linearly in time) and
-        ``jump = 1 - (1 - jump_prob)^seconds``; ``seconds <= 0`` is no motion.
+        ``jump = 1 - (1 - jump_prob)^seconds``, kept just below 1 for a very long gap (the
+        belief is then uniform); ``seconds <= 0`` is no motion.
         """
         dt = max(0.0, float(seconds))
-        return Motion(self.grid, self.sigma_cells * math.sqrt(dt),
-                      1.0 - (1.0 - self.jump_prob) ** dt)
+        jump = min(1.0 - (1.0 - self.jump_prob) ** dt, ALMOST_ONE)
+        return Motion(self.grid, self.sigma_cells * math.sqrt(dt), jump)
 
     # -- the belief ----------------------------------------------------------------------
     def transition_matrix(self) -> np.ndarray:

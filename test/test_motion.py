@@ -141,6 +141,13 @@ def test_per_second_motion_scales_with_elapsed_time():
     assert half.jump_prob == pytest.approx(1 - 0.8 ** 0.25)
     assert motion.over(1.0).sigma_cells == pytest.approx(0.6)
     assert not motion.over(0.0).active and not motion.over(-1.0).active
+    # A very long gap (a clock jump): the jump probability saturates below 1, the belief is
+    # then uniform over the cells and the absent mass is kept.
+    far = motion.over(1e9)
+    assert far.jump_prob < 1.0
+    log_b = np.log(np.append(np.full(25, 0.6 / 25) * np.linspace(0.1, 1.9, 25), 0.4))
+    far.predict_log(log_b)
+    np.testing.assert_allclose(np.exp(log_b), np.append(np.full(25, 0.6 / 25), 0.4), rtol=1e-9)
 
 
 def test_axis_matrix_rows_sum_to_one_and_zero_sigma_is_identity():
