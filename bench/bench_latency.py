@@ -7,7 +7,8 @@ Each call is exactly what the gaze controller node does per frame: ``GazeControl
 stamp)`` (check the frame, the observation model's log-likelihood ratio, the one Bayes step, the
 found check and the policy's choice), with the ELM kernel (``K = d'^2``, human FPOC) and frames
 drawn from the observation model (float32, like a ``Float32MultiArray`` buffer); the belief is
-reset every :data:`EPISODE` calls, so flat and peaked beliefs both occur. The direct and FFT
+reset every :data:`EPISODE` calls and when a search ends at its found event, so flat and
+peaked beliefs both occur. The direct and FFT
 paths run interleaved in rounds on the same frames (their fixation sequences must agree), beside
 naive references run in the same process: the probability-domain (exp) update with
 ``scipy.signal.correlate2d`` or ``scipy.signal.correlate(method='fft')`` scores, the allocating
@@ -98,7 +99,7 @@ class ControllerLoop:
     def _prepare(self):
         """Start an episode when due and fill the next frame (not timed)."""
         g = self.grid
-        if self.calls % EPISODE == 0:
+        if self.calls % EPISODE == 0 or self.core.stopped:    # found ends a search
             self.core.reset(0.0)
             self.target = int(self.targets[(self.calls // EPISODE) % self.targets.size])
         self.frame[:] = self.noise[self.calls % self.noise.shape[0]]
@@ -117,14 +118,16 @@ class ControllerLoop:
             result = core.offer(frame, 1.0)
             t1 = clock()
             c1 = cpu()
+            self.calls += 1
+            self.fixations.append(result.fixation)
+            if keep is not None:
+                keep.append(core.belief)
+            if not decided:                 # the frame ended the search: no choice to time
+                continue
             decide = decided.pop()
             self.update_ns.append(t1 - t0 - decide)
             self.decide_ns.append(decide)
             self.cpu_ns.append(c1 - c0)
-            self.fixations.append(result.fixation)
-            if keep is not None:
-                keep.append(core.belief)
-            self.calls += 1
 
 
 class ReferenceLoop:

@@ -6,7 +6,9 @@ ROS loop: simulated camera -> evidence -> gaze_controller -> pan_tilt -> camera,
 Each camera frame and the pose it was taken at (``joint_states``) carry one stamp; the camera
 sends its next frame as soon as the next ``pan_tilt`` arrives (``saccade_time_s`` 0), so the gap
 between consecutive frame stamps is one full loop (camera -> controller -> camera over DDS). A
-third process (this one) only listens. At 256x256 the camera streams at 60 Hz instead, and the
+third process (this one) only listens. The controller tracks (``motion.sigma_cells`` 0.5,
+docs/design.md section 7): its search never ends, and each frame includes the prediction step.
+At 256x256 the camera streams at 60 Hz instead, and the
 controller's own counters in ``/diagnostics`` say how many frames it applied, skipped (stale or
 superseded) or never saw (dropped by the keep-last queue), with its RSS from /proc.
 Run: ``.venv/bin/python bench/bench_ros_loop.py`` or ``make bench``.
@@ -63,8 +65,10 @@ class _Listener(Watch):
 
 def _start(nodes, rows, spacing, half, camera_args, controller_args=()):
     task = _task_args(rows, spacing, half)
+    # Motion on: a tracker never ends its search (a still one stops at found), so the loop runs.
     controller = nodes.start('controller', [
         *task, '-p', 'policy.name:=elm', '-p', 'settle_time_s:=0.0', '-p', 'retry_period_s:=0.5',
+        '-p', 'motion.sigma_cells:=0.5',
         '-p', 'pan_min_rad:=-3.0', '-p', 'pan_max_rad:=3.0', '-p', 'tilt_min_rad:=-1.5',
         '-p', 'tilt_max_rad:=1.5', *controller_args])
     camera = nodes.start('camera', [*task, *camera_args])

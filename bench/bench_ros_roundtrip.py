@@ -6,7 +6,9 @@ Round trip through the gaze_controller process: evidence frame in, belief and ne
 Run: ``.venv/bin/python bench/bench_ros_roundtrip.py [policy ...]`` (default ``elm map``). For each
 policy it starts the controller (shipped YAML, ``settle_time_s`` 0, no retries) on a private
 domain; this process plays the camera: on every new ``pan_tilt`` it publishes one 11x11 evidence
-frame and times until the next ``pan_tilt`` (and the ``belief``) arrive. 20 warm-up and 200 timed
+frame and times until the next ``pan_tilt`` (and the ``belief``) arrive; the controller tracks
+(``motion.sigma_cells`` 0.5, docs/design.md section 7), so its search never ends and each frame
+includes the prediction step. 20 warm-up and 200 timed
 round trips per policy; prints median and 90th percentile in ms. It also times the controller's
 work for one frame in-process (message in, update, choice, messages out) without DDS.
 """
@@ -41,12 +43,12 @@ def in_process(policy_name, repeats=2000):
     frames = [grid_arrays.to_multiarray(rng.standard_normal(121), GRID) for _ in range(50)]
     times = []
     for i in range(repeats):
-        if i % 20 == 0:
+        if i % 20 == 0 or core.stopped:            # a found event ends a still search
             core.reset(float(i))
         t0 = time.perf_counter()
-        result = core.offer(grid_arrays.from_multiarray(frames[i % 50], GRID), float(i))
+        core.offer(grid_arrays.from_multiarray(frames[i % 50], GRID), float(i))
         grid_arrays.to_multiarray(core.belief, GRID)
-        joints.joint_state(head, result.fixation, Time())
+        joints.joint_state(head, core.fixation, Time())
         t1 = time.perf_counter()
         images.belief_image(core.belief, GRID, core.fixation, 32, Time())
         t2 = time.perf_counter()
@@ -58,9 +60,11 @@ def in_process(policy_name, repeats=2000):
 def round_trips(policy_name, domain):
     """Median and p90 milliseconds of frame -> next pan_tilt, and frame -> belief."""
     with isolated_nodes(domain) as nodes:
+        # Motion on: a tracker never ends its search, so every frame gets a next target.
         proc = nodes.start('controller', [
             '--params-file', str(config_file('controller.yaml')), '-p', 'settle_time_s:=0.0',
-            '-p', 'retry_period_s:=0.0', '-p', f'policy.name:={policy_name}'])
+            '-p', 'retry_period_s:=0.0', '-p', f'policy.name:={policy_name}',
+            '-p', 'motion.sigma_cells:=0.5'])
         rng = np.random.default_rng(1)
         state = {'sent': None, 'target': [], 'belief': [], 'stamps': set()}
         done = threading.Event()

@@ -6,6 +6,12 @@ Honest evaluation: percent correct vs fixations, fixations to 90% correct, boots
 Fixations to 90% correct is the first t where percent correct reaches 0.90, interpolated linearly
 between t-1 and t (percent correct at t = 0 is the uniform guess, 1/N); ``None`` if never reached.
 Intervals are percentile bootstraps over episodes.
+
+For moving and absent targets and the stopping rules (docs/design.md section 7.4): the rates of
+right, wrong ``found``, wrong ``absent`` and ``gave_up`` decisions with Wilson intervals
+(:func:`decision_summary`), and the first lock and tracking accuracy of a moving target with
+bootstrap intervals, alone or paired (:func:`tracking_summary`,
+:func:`paired_tracking_difference`).
 """
 from __future__ import annotations
 
@@ -93,3 +99,180 @@ def paired_difference_ci(correct_a: np.ndarray, correct_b: np.ndarray, n_cells: 
     diff = va - vb
     low, high = np.nanpercentile(diff, [2.5, 97.5])
     return pa - pb, (float(low), float(high))
+
+
+# -- moving and absent targets, stopping (docs/design.md section 7) -----------------------------
+Z95 = 1.959963984540054
+OUTCOMES = ('right', 'wrong_found', 'wrong_absent', 'gave_up')
+CHUNK = 100
+
+
+def wilson_interval(successes: int, trials: int, z: float = Z95):
+    """
+    Return the Wilson score interval ``(low, high)`` of a proportion; None for 0 trials.
+
+    ``centre = (k + z^2/2) / (n + z^2)``, ``half = z sqrt(k (n - k) / n + z^2 / 4) / (n + z^2)``.
+    """
+    k, n = float(successes), float(trials)
+    if n <= 0:
+        return None
+    centre = (k + z * z / 2) / (n + z * z)
+    half = z * np.sqrt(k * (n - k) / n + z * z / 4) / (n + z * z)
+    return float(max(0.0, centre - half)), float(min(1.0, centre + half))
+
+
+def rate(mask: np.ndarray) -> dict:
+    """Return ``{count, rate, ci95}`` of a boolean array (Wilson 95% interval)."""
+    mask = np.asarray(mask, dtype=bool)
+    k, n = int(mask.sum()), int(mask.size)
+    ci = wilson_interval(k, n)
+    return {'count': k, 'rate': k / n if n else None, 'ci95': list(ci) if ci else None}
+
+
+def mean_ci(values: np.ndarray) -> dict:
+    """Return ``{mean, ci95}``: the mean and its normal 95% interval (None when empty)."""
+    v = np.asarray(values, dtype=float)
+    if v.size == 0:
+        return {'mean': None, 'ci95': None}
+    mean = float(v.mean())
+    if v.size < 2:
+        return {'mean': mean, 'ci95': None}
+    half = Z95 * float(v.std(ddof=1)) / np.sqrt(v.size)
+    return {'mean': mean, 'ci95': [mean - half, mean + half]}
+
+
+def search_outcomes(result, confidence: float, max_fixations: int | None = None):
+    """
+    Classify every search by its first decision (:func:`ipomdp_gaze.stopping.first_decisions`).
+
+    Returns ``(outcome, fixations)``: ``outcome[e]`` indexes :data:`OUTCOMES`: ``right`` (found
+    at the target's cell at that moment, or absent in an empty scene), ``wrong_found`` (found
+    anywhere else, or in an empty scene), ``wrong_absent`` (absent while the target is there) or
+    ``gave_up``; ``fixations[e]`` up to the decision (the budget when it gave up).
+    """
+    from .stopping import ABSENT, first_decisions, FOUND
+    kind, fixations = first_decisions(result.map_prob, result.absent_prob, confidence,
+                                      max_fixations)
+    rows = np.arange(kind.size)
+    step = fixations - 1
+    present = np.ones(kind.size, bool) if result.present is None else result.present
+    target = result.target_path[rows, step]
+    cell = result.guess[rows, step]
+    outcome = np.full(kind.size, OUTCOMES.index('gave_up'))
+    right = ((kind == FOUND) & present & (cell == target)) | ((kind == ABSENT) & ~present)
+    outcome[kind == FOUND] = OUTCOMES.index('wrong_found')
+    outcome[kind == ABSENT] = OUTCOMES.index('wrong_absent')
+    outcome[right] = OUTCOMES.index('right')
+    return outcome, fixations
+
+
+def decision_summary(result, confidence: float, max_fixations: int | None = None) -> dict:
+    """
+    Rates of right, wrong ``found``, wrong ``absent`` and ``gave_up`` with Wilson intervals.
+
+    Over all searches, over the decided ones (plus ``wrong``, both wrong kinds together: Bayes'
+    guarantee bounds it by ``1 - confidence`` when the model is right), and over the searches
+    with and without a target; with the fixations to a decision (mean, normal 95% interval) of
+    the decided searches in each group.
+    """
+    outcome, fixations = search_outcomes(result, confidence, max_fixations)
+    present = np.ones(outcome.size, bool) if result.present is None else result.present
+    gave_up = outcome == OUTCOMES.index('gave_up')
+
+    def group(mask):
+        o = outcome[mask]
+        out = {'searches': int(mask.sum())}
+        out.update({name: rate(o == i) for i, name in enumerate(OUTCOMES)})
+        out['fixations_to_decision'] = mean_ci(fixations[mask & ~gave_up])
+        return out
+
+    decided = {'searches': int((~gave_up).sum())}
+    o = outcome[~gave_up]
+    decided.update({name: rate(o == i) for i, name in enumerate(OUTCOMES[:3])})
+    decided['wrong'] = rate((o == 1) | (o == 2))
+    everyone = np.ones(outcome.size, bool)
+    return {'confidence': float(confidence), 'max_fixations': int(
+        result.map_prob.shape[1] if max_fixations is None else max_fixations),
+        'all': group(everyone), 'decided': decided, 'present': group(present),
+        'absent': group(~present)}
+
+
+def _near(guess: np.ndarray, path: np.ndarray, cols: int) -> np.ndarray:
+    gr, gc = np.divmod(guess, cols)
+    pr, pc = np.divmod(path, cols)
+    return (np.abs(gr - pr) <= 1) & (np.abs(gc - pc) <= 1)
+
+
+def tracking_arrays(result, cols: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """
+    Per search: the first lock and the tracking tallies after it.
+
+    Returns ``(first_lock, hits, after)``: ``first_lock[e]`` is the first fixation t (1-based)
+    whose most likely cell is the target's cell at that moment (0: never, or an empty scene);
+    ``after[e]`` counts the fixations after it and ``hits[e]`` those whose most likely cell is
+    within one cell (``max(|dr|, |dc|) <= 1``) of the target's cell then. ``cols`` is the grid's.
+    """
+    path, guess = result.target_path, result.guess
+    present = np.ones(path.shape[0], bool) if result.present is None else result.present
+    lock = (guess == path) & present[:, None]
+    locked = lock.any(axis=1)
+    first = np.argmax(lock, axis=1)
+    t = np.arange(path.shape[1])
+    after = (t[None, :] > first[:, None]) & locked[:, None]
+    hits = np.sum(after & _near(guess, path, cols), axis=1)
+    return np.where(locked, first + 1, 0), hits, after.sum(axis=1)
+
+
+def _ratio_bootstrap(numerators, denominators, rng: np.random.Generator, resamples: int):
+    """Percentile bootstrap over searches of ``sum(num_i) / sum(den_i)`` for each pair given."""
+    e = numerators[0].size
+    values = []
+    for start in range(0, resamples, CHUNK):
+        counts = bootstrap_counts(e, min(CHUNK, resamples - start), rng).astype(float)
+        values.append(np.stack([(counts @ num) / np.maximum(counts @ den, 1)
+                                for num, den in zip(numerators, denominators)]))
+    return np.concatenate(values, axis=1)
+
+
+def tracking_summary(result, cols: int, rng: np.random.Generator, resamples: int = 1000) -> dict:
+    """
+    First lock and tracking accuracy of moving-target searches, with 95% intervals.
+
+    ``locked``: the fraction of searches with a target that ever lock on (Wilson interval);
+    ``first_lock``: the mean fixation of the first lock of those that do (normal interval);
+    ``tracking_accuracy``: over all fixations after a first lock, the fraction whose most likely
+    cell is within one cell of the target (pooled over searches; percentile bootstrap over
+    searches).
+    """
+    first, hits, after = tracking_arrays(result, cols)
+    present = np.ones(first.size, bool) if result.present is None else result.present
+    total = int(after.sum())
+    accuracy = float(hits.sum() / total) if total else None
+    ci = None
+    if total:
+        boot = _ratio_bootstrap([hits.astype(float)], [after.astype(float)], rng, resamples)[0]
+        ci = [float(x) for x in np.percentile(boot, [2.5, 97.5])]
+    return {'locked': rate(first[present] > 0), 'first_lock': mean_ci(first[first > 0]),
+            'tracking_accuracy': {'value': accuracy, 'ci95': ci,
+                                  'fixations_after_lock': total}}
+
+
+def paired_tracking_difference(result_a, result_b, cols: int, rng: np.random.Generator,
+                               resamples: int = 1000) -> dict:
+    """
+    Tracking accuracy of ``a`` minus that of ``b`` on the same searches, paired 95% interval.
+
+    Both are pooled ratios (:func:`tracking_summary`); the bootstrap resamples the same searches
+    for both, so the interval is of the difference itself.
+    """
+    _, hits_a, after_a = tracking_arrays(result_a, cols)
+    _, hits_b, after_b = tracking_arrays(result_b, cols)
+    n = min(hits_a.size, hits_b.size)
+    hits_a, after_a, hits_b, after_b = hits_a[:n], after_a[:n], hits_b[:n], after_b[:n]
+    if not after_a.sum() or not after_b.sum():
+        return {'difference': None, 'ci95': None}
+    point = hits_a.sum() / after_a.sum() - hits_b.sum() / after_b.sum()
+    boot = _ratio_bootstrap([hits_a.astype(float), hits_b.astype(float)],
+                            [after_a.astype(float), after_b.astype(float)], rng, resamples)
+    low, high = np.percentile(boot[0] - boot[1], [2.5, 97.5])
+    return {'difference': float(point), 'ci95': [float(low), float(high)]}

@@ -17,9 +17,21 @@ Every frame is counted: ``received = applied + rejected + skipped``. The first f
 reset is the start cell (the centre by default, docs/design.md section 4); the policy picks the
 rest. Times are plain seconds on whatever clock the caller uses (the node's ROS clock).
 
-The settings are checked here, once: :func:`check_confidence`, :func:`check_settle_time` and
-:func:`start_cell` serve both the setters of :class:`GazeController` and the node, which checks
-a proposed parameter set before it takes it.
+Beyond the paper (docs/design.md section 7): with motion on, the belief is predicted over the
+time since the last applied frame before each update (``sigma_cells`` and ``jump_prob`` per
+second, :meth:`ipomdp_gaze.motion.Motion.over`); with ``absent_prior > 0`` the belief has the
+absent hypothesis, and :attr:`GazeController.belief` is the N cell probabilities, summing to
+``1 - P(absent)``. After each applied frame the stop rules of :mod:`ipomdp_gaze.stopping` run:
+``found``, ``absent`` or, at the fixation budget, ``gave_up``. For a still target a decision ends
+the search: later frames are skipped and no new target is chosen until :meth:`reset`. With
+motion on, ``found`` and ``absent`` only report: the controller keeps tracking, and each event is
+re-armed when its probability falls back below the confidence level. ``gave_up`` ends the search
+in both cases (a budget never applies once a search has decided).
+
+The settings are checked here, once: :func:`check_confidence`, :func:`check_settle_time`,
+:func:`start_cell` and the checks of :mod:`ipomdp_gaze.motion` and :mod:`ipomdp_gaze.stopping`
+serve both the setters of :class:`GazeController` and the node, which checks a proposed
+parameter set before it takes it.
 """
 from __future__ import annotations
 
@@ -27,24 +39,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .belief import bayes_update, entropy, EvidenceError, map_cell, uniform_log_belief
+from .belief import bayes_update, entropy, EvidenceError, map_cell
 from .grid import Grid
+from .motion import Motion
 from .observation import as_observation, check_evidence
-
-
-def check_confidence(confidence: float) -> float:
-    """
-    Return the confidence level of the found event as a float.
-
-    Raises
-    ------
-    ValueError
-        Unless ``0 < confidence < 1``.
-
-    """
-    if not 0 < confidence < 1:
-        raise ValueError(f'confidence must be between 0 and 1 (exclusive), got {confidence!r}')
-    return float(confidence)
+from .stopping import (ABSENT, check_absent_prior, check_confidence, check_max_fixations, decide,
+                       FOUND, initial_log_belief)
 
 
 def check_settle_time(settle_time_s: float) -> float:
@@ -82,10 +82,25 @@ def start_cell(grid: Grid, row: int | None = None, col: int | None = None) -> in
 
 @dataclass(frozen=True)
 class Found:
-    """The found event: the most likely cell first reached the confidence level."""
+    """The found event: the most likely cell reached the confidence level."""
 
     cell: int
     probability: float
+    fixations: int
+
+
+@dataclass(frozen=True)
+class Absent:
+    """The absent event: ``P(absent)`` reached the confidence level."""
+
+    probability: float
+    fixations: int
+
+
+@dataclass(frozen=True)
+class GaveUp:
+    """The gave-up event: the fixation budget ran out before any decision."""
+
     fixations: int
 
 
@@ -95,14 +110,17 @@ class FrameResult:
     What happened to one frame of evidence.
 
     ``status`` is ``'applied'``, ``'skipped'`` or ``'rejected'``; ``reason`` says why a frame was
-    not applied; ``fixation`` is the new target after an applied frame; ``found`` is set on the
-    frame that first made the most likely cell reach the confidence level.
+    not applied; ``fixation`` is the new target after an applied frame (None when the search has
+    ended: no new target); ``found``, ``absent`` and ``gave_up`` are set on the frame that fired
+    that event.
     """
 
     status: str
     reason: str = ''
     fixation: int | None = None
     found: Found | None = None
+    absent: Absent | None = None
+    gave_up: GaveUp | None = None
 
     @property
     def applied(self) -> bool:
@@ -157,31 +175,37 @@ class GazeController:
     settle_time_s
         Frames stamped earlier than this after the target was sent are skipped.
     confidence
-        The found event fires when the most likely cell's probability first reaches this.
+        ``found`` (``absent``) fires when the most likely cell's probability (``P(absent)``)
+        reaches this.
     seed
         Seed of the generator handed to the policy (``random``, ``sample``).
+    motion_sigma_cells, jump_prob
+        The target's random walk, per second (0, 0: a still target).
+    absent_prior
+        Prior of "no target in the grid" (0: no absent hypothesis).
+    max_fixations
+        Fixation budget of a search (None or 0: none).
 
     """
 
     def __init__(self, grid: Grid, observation, policy, start_cell: int | None = None,
-                 settle_time_s: float = 0.0, confidence: float = 0.95, seed: int = 0):
+                 settle_time_s: float = 0.0, confidence: float = 0.95, seed: int = 0,
+                 motion_sigma_cells: float = 0.0, jump_prob: float = 0.0,
+                 absent_prior: float = 0.0, max_fixations: int | None = None):
         self.grid = grid
         self.set_observation(observation)
         self.policy = policy
         self.set_start_cell(grid.center_index if start_cell is None else start_cell)
         self.set_settle_time(settle_time_s)
         self.set_confidence(confidence)
+        self.set_motion(motion_sigma_cells, jump_prob)
+        self.set_absent_prior(absent_prior)
+        self.set_max_fixations(max_fixations)
         self.reseed(seed)
         self.enabled = True
         self.received = self.applied = self.rejected = self.skipped = 0
         self.last_rejection = ''
-        self._log_belief = uniform_log_belief(grid.n_cells)
-        self._belief = np.exp(self._log_belief)
-        self.fixation = self.start_cell
-        self.fixations = 0
-        self.target_time_s = 0.0
-        self.usable_time_s = 0.0
-        self.found: Found | None = None
+        self.reset(0.0)
 
     # -- configuration -------------------------------------------------------------------
     def set_observation(self, observation) -> None:
@@ -202,8 +226,20 @@ class GazeController:
         self.settle_time_s = check_settle_time(settle_time_s)
 
     def set_confidence(self, confidence: float) -> None:
-        """Probability of the most likely cell at which the found event fires."""
+        """Probability of the most likely cell (or of absence) at which an event fires."""
         self.confidence = check_confidence(confidence)
+
+    def set_motion(self, sigma_cells: float, jump_prob: float) -> None:
+        """Set the target's random walk per second, used from the next applied frame on."""
+        self.motion = Motion(self.grid, sigma_cells, jump_prob)
+
+    def set_absent_prior(self, absent_prior: float) -> None:
+        """Prior of "no target in the grid" for the searches from the next :meth:`reset` on."""
+        self.absent_prior = check_absent_prior(absent_prior)
+
+    def set_max_fixations(self, max_fixations: int | None) -> None:
+        """Fixation budget of a search (None or 0: none); checked after each applied frame."""
+        self.max_fixations = check_max_fixations(max_fixations)
 
     def reseed(self, seed: int) -> None:
         """Restart the policy's random stream."""
@@ -212,8 +248,30 @@ class GazeController:
     # -- state -----------------------------------------------------------------------------
     @property
     def belief(self) -> np.ndarray:
-        """Probabilities ``B_i`` (N,), a copy."""
+        """Cell probabilities ``B_i`` (N,), a copy; they sum to ``1 - P(absent)``."""
         return self._belief.copy()
+
+    @property
+    def absent_probability(self) -> float:
+        """``P(absent)``: 0 without the absent hypothesis."""
+        if self._log_belief.size == self.grid.n_cells:
+            return 0.0
+        return float(np.exp(self._log_belief[-1]))
+
+    @property
+    def decision(self) -> str:
+        """
+        Return what the search has decided: ``'found'``, ``'absent'``, ``'gave_up'`` or ``''``.
+
+        With motion on this is the state of the tracker: ``found`` (``absent``) while that
+        event has fired and its probability has not fallen back below the confidence level.
+        """
+        return self._decision
+
+    @property
+    def stopped(self) -> bool:
+        """Whether the search has ended (frames are skipped, no target is sent until reset)."""
+        return self._stopped
 
     @property
     def map_cell(self) -> int:
@@ -227,8 +285,10 @@ class GazeController:
 
     @property
     def entropy_nats(self) -> float:
-        """Entropy of the belief in nats."""
-        return float(entropy(self._belief))
+        """Entropy of the belief in nats (over the N + 1 hypotheses with the absent one)."""
+        if self._log_belief.size == self.grid.n_cells:
+            return float(entropy(self._belief))
+        return float(entropy(np.exp(self._log_belief)))
 
     def counters(self) -> dict:
         """Frames received, applied, rejected and skipped (received = the other three)."""
@@ -237,13 +297,18 @@ class GazeController:
 
     # -- events ----------------------------------------------------------------------------
     def reset(self, now_s: float) -> int:
-        """Uniform belief, fixation back to the start cell; returns it (sent at ``now_s``)."""
-        self._log_belief = uniform_log_belief(self.grid.n_cells)
-        self._belief = np.exp(self._log_belief)
+        """
+        Start a new search from the prior at the start cell; return it (sent at ``now_s``).
+
+        The prior is uniform over the cells, with ``absent_prior`` on the absent hypothesis.
+        """
+        self._log_belief = initial_log_belief(self.grid.n_cells, self.absent_prior)
+        self._belief = np.exp(self._log_belief[:self.grid.n_cells])
         self.fixation = self.start_cell
         self.fixations = 0
-        self.found = None
-        self.target_time_s = self.usable_time_s = float(now_s)
+        self.found = self.absent = self.gave_up = None
+        self._decision, self._stopped, self._decided_once = '', False, False
+        self.target_time_s = self.usable_time_s = self.update_time_s = float(now_s)
         return self.fixation
 
     def retarget(self, now_s: float) -> int:
@@ -300,6 +365,10 @@ class GazeController:
         if not self.enabled:
             self.skipped += 1
             return FrameResult('skipped', 'disabled')
+        if self._stopped:
+            self.skipped += 1
+            return FrameResult('skipped', f'the search has ended ({self._decision}); ~/reset '
+                                          f'starts a new one')
         if stamp_s < self.target_time_s + self.settle_time_s:
             self.skipped += 1
             return FrameResult('skipped', 'taken before the fixation settled')
@@ -309,18 +378,51 @@ class GazeController:
             self.rejected += 1
             self.last_rejection = str(exc)
             return FrameResult('rejected', str(exc))
+        n = self.grid.n_cells
+        if self.motion.active and stamp_s > self.update_time_s:
+            self.motion.over(stamp_s - self.update_time_s).predict_log(self._log_belief)
+        self.update_time_s = max(self.update_time_s, float(stamp_s))
+        if self._log_belief.size > n:
+            term = np.append(term, 0.0)                 # the absent hypothesis: ratio 1
         bayes_update(self._log_belief, term, out=self._log_belief)
-        np.exp(self._log_belief, out=self._belief)
+        np.exp(self._log_belief[:n], out=self._belief)
         self.applied += 1
         self.fixations += 1
-        found = None
-        # max() first: map_probability (the tie rule's cell) is only needed when it can fire.
-        if self.found is None and self._belief.max() >= self.confidence \
-                and self.map_probability >= self.confidence:
-            found = self.found = Found(self.map_cell, self.map_probability, self.fixations)
-        self.fixation = self.choose()
+        events = self._events()
+        if not self._stopped:
+            self.fixation = self.choose()
         self.target_time_s = self.usable_time_s = float(stamp_s if now_s is None else now_s)
-        return FrameResult('applied', fixation=self.fixation, found=found)
+        return FrameResult('applied', fixation=None if self._stopped else self.fixation,
+                           **events)
+
+    def _events(self) -> dict:
+        """Run the stop rules after an applied frame; return the events that fired."""
+        events = {}
+        peak = self._belief.max()
+        absent = self.absent_probability
+        # peak first: map_probability (the tie rule's cell) is only needed when it can fire.
+        code = decide(peak, absent, self.confidence) if max(peak, absent) >= self.confidence \
+            else 0
+        if self.motion.active:
+            if code == FOUND and self._decision != 'found':
+                events['found'] = self.found = Found(self.map_cell, self.map_probability,
+                                                     self.fixations)
+            if code == ABSENT and self._decision != 'absent':
+                events['absent'] = self.absent = Absent(absent, self.fixations)
+            self._decision = {FOUND: 'found', ABSENT: 'absent'}.get(int(code), '')
+        elif code == FOUND:
+            events['found'] = self.found = Found(self.map_cell, self.map_probability,
+                                                 self.fixations)
+            self._decision, self._stopped = 'found', True
+        elif code == ABSENT:
+            events['absent'] = self.absent = Absent(absent, self.fixations)
+            self._decision, self._stopped = 'absent', True
+        self._decided_once = self._decided_once or bool(events)
+        if not self._decided_once and self.max_fixations is not None \
+                and self.fixations >= self.max_fixations:
+            events['gave_up'] = self.gave_up = GaveUp(self.fixations)
+            self._decision, self._stopped = 'gave_up', True
+        return events
 
     def choose(self) -> int:
         """Ask the policy for the next fixation given the current belief."""

@@ -14,6 +14,17 @@ fixations. The hidden target is in ``info['target']`` for oracle baselines.
 By default the observation model is the Gaussian model of ``fpoc`` on a ``rows x cols`` grid
 (7x7); ``observation=`` takes any observation model instead, for example a count model or the
 path or shipped name of an ``ipomdp_gaze/observation-v1`` file, and its grid.
+
+Beyond the paper (docs/design.md section 7), with the defaults off: ``motion_sigma_cells`` and
+``jump_prob`` make the target take a step of :class:`ipomdp_gaze.motion.Motion` after every
+fixation (the belief is predicted with the same step, so the observation is the belief the next
+fixation is chosen from; ``info`` describes the fixation just made, before the step); such an
+episode never terminates early, it tracks until ``max_steps``. ``absent_prior`` gives the belief
+the absent hypothesis: the observation gains ``'absent'`` (``P(absent)``, shape (1,)), the
+``belief`` grid holds the cells (summing to ``1 - P(absent)``), the infomax reward is over all
+N + 1 hypotheses, and an episode also terminates when ``P(absent)`` reaches ``confidence``.
+``absent_rate`` is the fraction of episodes whose scene is empty (drawn at reset from
+``np_random``; ``options={'present': False}`` forces one).
 """
 from __future__ import annotations
 
@@ -23,11 +34,13 @@ import gymnasium
 from gymnasium import spaces
 import numpy as np
 
-from .belief import bayes_update, entropy, infomax_reward, map_cell, uniform_log_belief
+from .belief import bayes_update, entropy, map_cell
 from .fpoc import FPOC, make_fpoc
 from .grid import Grid
+from .motion import check_probability, Motion
 from .observation import as_observation, GaussianObservation
 from .render import belief_heatmap, belief_text
+from .stopping import check_absent_prior, decide, DECISIONS, initial_log_belief
 
 ENV_ID = 'ipomdp_gaze/VisualSearch-v0'
 REWARDS = ('infomax', 'fixate_target')
@@ -44,7 +57,9 @@ class VisualSearchEnv(gymnasium.Env):
                  fpoc_params: dict | None = None, reward: str = 'infomax',
                  observe: str = 'belief', confidence: float = 0.95,
                  max_steps: int | None = None, start_cell: int | None = None,
-                 render_mode: str | None = None, observation=None):
+                 render_mode: str | None = None, observation=None,
+                 motion_sigma_cells: float = 0.0, jump_prob: float = 0.0,
+                 absent_prior: float = 0.0, absent_rate: float = 0.0):
         if observation is not None:
             if isinstance(observation, (str, Path)):
                 from .observation_file import load_observation
@@ -68,6 +83,9 @@ class VisualSearchEnv(gymnasium.Env):
         if render_mode is not None and render_mode not in self.metadata['render_modes']:
             raise ValueError(f'unknown render_mode {render_mode!r}; valid: rgb_array, ansi')
         n = self.grid.n_cells
+        self.motion = Motion(self.grid, motion_sigma_cells, jump_prob)
+        self.absent_prior = check_absent_prior(absent_prior)
+        self.absent_rate = check_probability(absent_rate, 'absent_rate')
         self.reward_name, self.observe, self.confidence = reward, observe, float(confidence)
         self.max_steps = n if max_steps is None else int(max_steps)
         self.start_cell = self.grid.center_index if start_cell is None else int(start_cell)
@@ -79,34 +97,55 @@ class VisualSearchEnv(gymnasium.Env):
             grid_space = spaces.Box(0.0, 1.0, shape=self.grid.shape, dtype=np.float64)
         else:
             grid_space = spaces.Box(-np.inf, np.inf, shape=self.grid.shape, dtype=np.float64)
-        self.observation_space = spaces.Dict({observe: grid_space, 'fixation': spaces.Discrete(n)})
-        self._log_b = uniform_log_belief(n)
+        spaces_ = {observe: grid_space, 'fixation': spaces.Discrete(n)}
+        if self.absent_prior > 0:
+            spaces_['absent'] = spaces.Box(0.0, 1.0, shape=(1,), dtype=np.float64)
+        self.observation_space = spaces.Dict(spaces_)
+        self._log_b = initial_log_belief(n, self.absent_prior)
         self._evidence = np.zeros(n)
         self._fixation = self.start_cell
         self._target = 0
+        self._present = True
         self._steps = 0
 
     @property
     def belief(self) -> np.ndarray:
-        """Return the current belief, shape (N,)."""
-        return np.exp(self._log_b)
+        """Return the cell probabilities, shape (N,) (summing to ``1 - P(absent)``)."""
+        return np.exp(self._log_b[:self.grid.n_cells])
+
+    @property
+    def absent_probability(self) -> float:
+        """Return ``P(absent)`` (0 without the absent hypothesis)."""
+        return float(np.exp(self._log_b[-1])) if self.absent_prior > 0 else 0.0
 
     def _obs(self):
         data = self.belief if self.observe == 'belief' else self._evidence
-        return {self.observe: data.reshape(self.grid.shape).copy(), 'fixation': self._fixation}
+        obs = {self.observe: data.reshape(self.grid.shape).copy(), 'fixation': self._fixation}
+        if self.absent_prior > 0:
+            obs['absent'] = np.array([min(1.0, self.absent_probability)])
+        return obs
 
-    def _info(self):
+    def _info(self, decision: str = ''):
         b = self.belief
         guess = int(map_cell(b))
+        full = np.exp(self._log_b)
         return {'target': self._target, 'map_cell': guess, 'map_probability': float(b[guess]),
-                'entropy': float(entropy(b)), 'steps': self._steps}
+                'entropy': float(entropy(full)), 'steps': self._steps,
+                'present': self._present, 'absent_probability': self.absent_probability,
+                'decision': decision}
 
     def reset(self, *, seed=None, options=None):
         super().reset(seed=seed)
         n = self.grid.n_cells
-        target = (options or {}).get('target')
+        options = options or {}
+        target = options.get('target')
         self._target = int(self.np_random.integers(n)) if target is None else int(target)
-        self._log_b = uniform_log_belief(n)
+        if 'present' in options:
+            self._present = bool(options['present'])
+        else:
+            self._present = self.absent_rate == 0 or \
+                bool(self.np_random.random() >= self.absent_rate)
+        self._log_b = initial_log_belief(n, self.absent_prior)
         self._evidence = np.zeros(n)
         self._fixation = self.start_cell
         self._steps = 0
@@ -117,16 +156,27 @@ class VisualSearchEnv(gymnasium.Env):
         if not self.action_space.contains(k):
             raise ValueError(
                 f'action must be a cell index in [0, {self.grid.n_cells}), got {action!r}')
-        obs = self.model.sample(self._target, k, self.np_random)
-        bayes_update(self._log_b, self.model.log_likelihood_ratio(obs, k, validate=False),
-                     out=self._log_b)
+        obs = self.model.sample(self._target, k, self.np_random, present=self._present)
+        term = self.model.log_likelihood_ratio(obs, k, validate=False)
+        if self.absent_prior > 0:
+            term = np.append(term, 0.0)                 # the absent hypothesis: ratio 1
+        bayes_update(self._log_b, term, out=self._log_b)
         self._evidence, self._fixation = obs, k
         self._steps += 1
         b = self.belief
-        reward = float(infomax_reward(b)) if self.reward_name == 'infomax' else float(b[k])
-        terminated = bool(b.max() >= self.confidence)
+        if self.reward_name == 'infomax':
+            full = np.exp(self._log_b)
+            reward = -float(entropy(full))
+        else:
+            reward = float(b[k])
+        code = int(decide(b.max(), self.absent_probability, self.confidence))
+        info = self._info(DECISIONS.get(code, ''))
+        terminated = bool(code) and not self.motion.active
         truncated = bool(not terminated and self._steps >= self.max_steps)
-        return self._obs(), reward, terminated, truncated, self._info()
+        if self.motion.active:
+            self._target = int(self.motion.move(np.array([self._target]), self.np_random)[0])
+            self.motion.predict_log(self._log_b)
+        return self._obs(), reward, terminated, truncated, info
 
     def render(self):
         if self.render_mode == 'rgb_array':

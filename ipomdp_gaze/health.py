@@ -13,7 +13,11 @@ period:
 - ``warn``, ``no usable evidence for X s``: no frame was applied for longer than the stall
   timeout, either because no frames arrive or because none of those that arrive is usable (then
   with the last rejection); the node also logs it;
-- ``ok``, ``target found``: the found event has fired in this search;
+- ``ok``, ``target found``: the found event has fired in this search (with motion on: while
+  the tracker is confident);
+- ``ok``, ``target absent`` / ``gave up after N fixations``: the search decided that the grid is
+  empty, or spent its fixation budget (docs/design.md section 7). A search that has ended is
+  never reported as stalled: it waits for ``~/reset`` and expects no frames;
 - ``warn``, ``no evidence received``: no frame arrived in the period;
 - ``warn``, ``evidence rejected: <reason>``: a frame was rejected in the period (replaces any
   ``ok`` report).
@@ -49,7 +53,8 @@ class Health:
 
 
 def classify(enabled: bool, stall_timeout_s: float, seconds_without_evidence: float,
-             arrived: int, rejected: int, last_rejection: str, found: bool) -> Health:
+             arrived: int, rejected: int, last_rejection: str, found: bool,
+             decision: str = '', stopped: bool = False, fixations: int = 0) -> Health:
     """
     Classify the controller's health from what happened since the last report.
 
@@ -68,12 +73,23 @@ def classify(enabled: bool, stall_timeout_s: float, seconds_without_evidence: fl
     last_rejection
         The reason of the last rejected frame.
     found
-        Whether the found event has fired in this search.
+        Whether the found event holds: it fired in this search (with motion on: and the
+        tracker is still confident).
+    decision
+        ``'found'``, ``'absent'``, ``'gave_up'`` or ``''`` (:attr:`GazeController.decision`).
+    stopped
+        Whether the search has ended (it waits for a reset).
+    fixations
+        Fixations of the search so far (for the gave-up message).
 
     """
     level, message, detail = 'ok', 'searching', ''
+    ended = {'found': 'target found', 'absent': 'target absent',
+             'gave_up': f'gave up after {fixations} fixations'}
     if not enabled:
         message = 'disabled'
+    elif stopped:
+        message = ended.get(decision, 'search ended')
     elif 0 < stall_timeout_s < seconds_without_evidence:
         level, message = 'warn', f'no usable evidence for {seconds_without_evidence:.1f} s'
         if arrived == 0:
@@ -83,7 +99,9 @@ def classify(enabled: bool, stall_timeout_s: float, seconds_without_evidence: fl
             if rejected:
                 detail += f'; last rejection: {last_rejection}'
     elif found:
-        message = 'target found'
+        message = ended['found']
+    elif decision == 'absent':
+        message = ended['absent']
     elif arrived == 0:
         level, message = 'warn', 'no evidence received'
     if rejected and last_rejection and level == 'ok':
@@ -152,7 +170,7 @@ class HealthMonitor:
         without_s = core.seconds_without_evidence(now_s)
         health = classify(core.enabled, stall_timeout_s, without_s, arrived,
                           core.rejected - self._rejected, core.last_rejection,
-                          core.found is not None)
+                          core.decision == 'found', core.decision, core.stopped, core.fixations)
         self._last_s, self._received, self._rejected = now_s, core.received, core.rejected
         counters = core.counters()
         grid = core.grid
@@ -167,5 +185,7 @@ class HealthMonitor:
             'entropy_nats': core.entropy_nats, 'most_likely_row': map_row,
             'most_likely_col': map_col, 'most_likely_probability': core.map_probability,
             'found': core.found is not None, 'pan_tilt_resends': resends,
-            'last_rejection': core.last_rejection}
+            'last_rejection': core.last_rejection,
+            'absent_probability': core.absent_probability, 'decision': core.decision,
+            'search_ended': core.stopped}
         return replace(health, values=values)

@@ -210,24 +210,30 @@ class GaussianObservation:
         """
         return gaussian_log_likelihood_ratio(observation, self.dprime(fixation), validate)
 
-    def sample(self, targets, fixations, rng: np.random.Generator) -> np.ndarray:
+    def sample(self, targets, fixations, rng: np.random.Generator,
+               present=None) -> np.ndarray:
         """
         Draw frames: ``N(0, 1)`` everywhere plus ``d_target,k`` at each target.
 
         ``targets`` and ``fixations`` are scalars (one frame (N,)) or arrays (E,) (frames (E, N)).
         The draws are ``rng.standard_normal`` of the frames' shape, so a seeded stream gives the
-        same noise to every policy (common random numbers).
+        same noise to every policy (common random numbers). ``present`` (bool, or (E,) bools)
+        marks scenes that hold their target; an empty scene's frame is pure null noise, drawn
+        the same way (its ``targets`` entry is ignored). Default: every scene has its target.
         """
         n = self.grid.n_cells
         if np.ndim(targets) == 0:
             obs = rng.standard_normal(n)
             target = int(targets)
-            obs[target] += self.dprime_window(fixations).flat[target]
+            if present is None or present:
+                obs[target] += self.dprime_window(fixations).flat[target]
             return obs
         targets = np.asarray(targets)
         obs = rng.standard_normal((targets.size, n))
-        obs[np.arange(targets.size), targets] += self.dprime_by_fixation()[
-            np.asarray(fixations, dtype=np.intp), targets]
+        signal = self.dprime_by_fixation()[np.asarray(fixations, dtype=np.intp), targets]
+        if present is not None:
+            signal = np.where(present, signal, 0.0)
+        obs[np.arange(targets.size), targets] += signal
         return obs
 
 
@@ -504,13 +510,16 @@ class CountObservation:
                                 f'probability 0 with and without the target')
         return term
 
-    def sample(self, targets, fixations, rng: np.random.Generator) -> np.ndarray:
+    def sample(self, targets, fixations, rng: np.random.Generator,
+               present=None) -> np.ndarray:
         """
         Draw count frames: each cell from ``p_null`` at its offset, the target from ``p_target``.
 
         One uniform draw per cell (``rng.random`` of the frames' shape) is turned into a count
         by the inverse CDF, so a seeded stream gives every policy the same draws (common random
         numbers). Scalars give one frame (N,), arrays (E,) give (E, N); counts are float64.
+        ``present`` (bool, or (E,) bools) marks scenes that hold their target; an empty scene
+        draws every cell from ``p_null`` with the same uniforms. Default: every scene does.
         """
         single = np.ndim(targets) == 0
         targets = np.atleast_1d(np.asarray(targets, dtype=np.intp))
@@ -525,6 +534,9 @@ class CountObservation:
         for c in range(self.max_count):
             frames += u > cdf_null[offsets, c]
         rows = np.arange(targets.size)
+        if present is not None:
+            rows = rows[np.broadcast_to(np.asarray(present, dtype=bool), rows.shape)]
+            targets = targets[rows]
         u_t, off_t = u[rows, targets], offsets[rows, targets]
         frames[rows, targets] = np.sum(u_t[:, None] > self._cdf['target'][off_t, :-1], axis=1)
         return frames[0] if single else frames

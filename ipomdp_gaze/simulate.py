@@ -8,6 +8,12 @@ Any policy plugs in through one method, ``select(belief, t, rng) -> fixations``:
 ``numpy.random.Generator`` for stochastic policies. Targets and observation noise come from their
 own seeded streams, so every policy run with the same seed sees the same targets and the same
 noise draws (common random numbers).
+
+Beyond the paper (docs/design.md section 7): the target may move between fixations (the true
+target follows a :class:`ipomdp_gaze.motion.Motion` and the belief is predicted with it, or not,
+``predict=False``), and scenes may be empty at a rate ``absent_rate`` that is set separately from
+the model's ``absent_prior`` (the belief's absent hypothesis). Target paths and empty scenes have
+their own streams, so they too are shared by every policy.
 """
 from __future__ import annotations
 
@@ -16,12 +22,15 @@ from typing import Protocol
 
 import numpy as np
 
-from .belief import bayes_update, map_cell, uniform_log_belief
+from .belief import bayes_update, map_cell
 from .grid import Grid
+from .motion import check_probability, Motion
 from .observation import as_observation
+from .stopping import check_absent_prior, initial_log_belief
 
-# Stream tags of the seed sequence: targets, noise per fixation, and the policy's own draws.
-_TARGET, _NOISE, _POLICY = 0, 1, 2
+# Stream tags of the seed sequence: targets, noise per fixation, the policy's own draws, the
+# target's steps between fixations, and which scenes are empty.
+_TARGET, _NOISE, _POLICY, _MOTION, _ABSENT = 0, 1, 2, 3, 4
 
 
 class Policy(Protocol):
@@ -36,8 +45,13 @@ class SearchResult:
     """
     What a batch of simulated searches produced.
 
-    ``correct[e, t-1]`` is whether episode e's MAP guess after t observations is its target;
-    ``fixations[e, t-1]`` is the t-th fixation; ``map_prob[e, t-1]`` the MAP probability then.
+    ``correct[e, t-1]`` is whether episode e's most likely hypothesis after t observations is
+    the truth (its target's cell then; "absent" for an empty scene, which only a belief with the
+    absent hypothesis can guess); ``fixations[e, t-1]`` is the t-th fixation; ``map_prob[e, t-1]``
+    the probability of the most likely cell then and ``guess[e, t-1]`` that cell;
+    ``target_path[e, t-1]`` the target's cell at fixation t (-1 in an empty scene); ``present``
+    whether each scene holds a target; ``absent_prob[e, t-1]`` is ``P(absent)`` (None without
+    the absent hypothesis).
     """
 
     targets: np.ndarray
@@ -45,6 +59,10 @@ class SearchResult:
     correct: np.ndarray
     map_prob: np.ndarray
     infomax: np.ndarray
+    guess: np.ndarray | None = None
+    target_path: np.ndarray | None = None
+    present: np.ndarray | None = None
+    absent_prob: np.ndarray | None = None
 
     @property
     def percent_correct(self) -> np.ndarray:
@@ -58,9 +76,27 @@ def draw_targets(n_cells: int, episodes: int, seed: int) -> np.ndarray:
     return rng.integers(0, n_cells, size=episodes)
 
 
+def draw_present(episodes: int, absent_rate: float, seed: int) -> np.ndarray:
+    """
+    Return which scenes hold a target: each is empty with probability ``absent_rate``.
+
+    Drawn from the seed's own stream (``random(episodes) >= absent_rate``), so it is
+    prefix-stable and shared by every policy; ``absent_rate = 0`` draws nothing.
+    """
+    rate = check_probability(absent_rate, 'absent_rate')
+    if rate == 0:
+        return np.ones(episodes, dtype=bool)
+    return np.random.default_rng([seed, _ABSENT]).random(episodes) >= rate
+
+
 def noise_stream(seed: int, t: int) -> np.random.Generator:
     """Return the generator of the observation noise for fixation ``t`` (0-based)."""
     return np.random.default_rng([seed, _NOISE, t])
+
+
+def motion_stream(seed: int, t: int) -> np.random.Generator:
+    """Return the generator of the target's step after fixation ``t`` (0-based)."""
+    return np.random.default_rng([seed, _MOTION, t])
 
 
 def policy_rng(seed: int) -> np.random.Generator:
@@ -69,9 +105,15 @@ def policy_rng(seed: int) -> np.random.Generator:
 
 
 def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | None = None,
-             seed: int = 0, targets: np.ndarray | None = None, progress=None) -> SearchResult:
+             seed: int = 0, targets: np.ndarray | None = None, progress=None,
+             motion: Motion | None = None, predict: bool = True, absent_prior: float = 0.0,
+             absent_rate: float = 0.0, present: np.ndarray | None = None) -> SearchResult:
     """
-    Run ``episodes`` searches of ``horizon`` fixations (default N) from a uniform belief.
+    Run ``episodes`` searches of ``horizon`` fixations (default N) from the prior.
+
+    Each fixation t: the policy picks a cell from the belief, a frame is drawn with the target
+    where it is now, the one Bayes step updates the belief; then the target takes a step of
+    ``motion`` and the belief is predicted with it (docs/design.md section 7).
 
     Parameters
     ----------
@@ -80,13 +122,25 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
     model
         The observation model (:mod:`ipomdp_gaze.observation`), or an FPOC for the Gaussian one.
     policy
-        Anything with ``select(belief, t, rng)``.
+        Anything with ``select(belief, t, rng)``; ``belief`` holds the N cell probabilities
+        (summing to ``1 - P(absent)`` with the absent hypothesis).
     episodes, horizon, seed
         Batch size, fixations per episode and the seed of all random streams.
     targets : array (episodes,), optional
-        Target cells; drawn from the seed's target stream when omitted.
+        Target cells at the first fixation; drawn from the seed's target stream when omitted.
     progress : callable, optional
         Called with the fixation number after each step.
+    motion : Motion, optional
+        How the true target moves between fixations (default: it stays put).
+    predict : bool
+        Whether the belief is predicted with ``motion`` (False: the searcher assumes a still
+        target, to measure what prediction is worth).
+    absent_prior : float
+        The belief's prior of "no target in the grid" (0: no such hypothesis, N entries).
+    absent_rate : float
+        Fraction of simulated scenes that are empty (their own stream, :func:`draw_present`).
+    present : bool array (episodes,), optional
+        Which scenes hold a target, instead of drawing them (a prefix of a larger run).
 
     """
     n = grid.n_cells
@@ -95,24 +149,61 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
         raise ValueError('episodes and horizon must be >= 1')
     model = as_observation(grid, model)
     targets = draw_targets(n, episodes, seed) if targets is None else np.asarray(targets)
+    absent_prior = check_absent_prior(absent_prior)
+    if present is None:
+        present = draw_present(episodes, absent_rate, seed)
+    present = np.asarray(present, dtype=bool)
+    all_present = bool(present.all())
+    moving = motion is not None and motion.active
     rows = np.arange(episodes)
     rng = policy_rng(seed)
-    log_b = uniform_log_belief(n, episodes)
-    belief = np.exp(log_b)
+    log_b = initial_log_belief(n, absent_prior, episodes)
+    with_absent = log_b.shape[1] > n
+    belief = np.exp(log_b[:, :n])
+    terms = np.zeros((episodes, n + 1)) if with_absent else None
     fixations = np.empty((episodes, horizon), dtype=np.int64)
     correct = np.empty((episodes, horizon), dtype=bool)
     map_prob = np.empty((episodes, horizon))
     infomax = np.empty((episodes, horizon))
+    guesses = np.empty((episodes, horizon), dtype=np.int64)
+    path = np.empty((episodes, horizon), dtype=np.int64)
+    absent_prob = np.empty((episodes, horizon)) if with_absent else None
+    where = targets.copy() if moving else targets
     for t in range(horizon):
         k = np.asarray(policy.select(belief, t, rng), dtype=np.int64)
         fixations[:, t] = k
-        frames = model.sample(targets, k, noise_stream(seed, t))
-        bayes_update(log_b, model.log_likelihood_ratio(frames, k, validate=False), out=log_b)
-        np.exp(log_b, out=belief)
+        frames = model.sample(where, k, noise_stream(seed, t),
+                              present=None if all_present else present)
+        llr = model.log_likelihood_ratio(frames, k, validate=False)
+        if with_absent:
+            terms[:, :n] = llr                  # the absent hypothesis's term stays 0
+            llr = terms
+        bayes_update(log_b, llr, out=log_b)
+        truth = where if all_present else np.where(present, where, -1)
+        path[:, t] = truth
+        if with_absent or moving:               # 0 log 0 = 0 where the step left a cell at 0
+            full = np.exp(log_b)
+            belief[...] = full[:, :n]
+            infomax[:, t] = np.sum(full * log_b, axis=1, where=full > 0)
+            if with_absent:
+                absent_prob[:, t] = full[:, n]
+        else:
+            np.exp(log_b, out=belief)
+            infomax[:, t] = np.sum(belief * log_b, axis=1)
         guess = map_cell(belief)
-        correct[:, t] = guess == targets
+        guesses[:, t] = guess
         map_prob[:, t] = belief[rows, guess]
-        infomax[:, t] = np.sum(belief * log_b, axis=1)
+        if with_absent:
+            says_absent = absent_prob[:, t] > map_prob[:, t]
+            correct[:, t] = np.where(present, ~says_absent & (guess == where), says_absent)
+        else:
+            correct[:, t] = guess == truth
+        if moving and t + 1 < horizon:
+            where = motion.move(where, motion_stream(seed, t))
+            if predict:
+                motion.predict_log(log_b)
+                belief[...] = np.exp(log_b[:, :n])
         if progress is not None:
             progress(t + 1)
-    return SearchResult(targets, fixations, correct, map_prob, infomax)
+    return SearchResult(targets, fixations, correct, map_prob, infomax, guesses, path, present,
+                        absent_prob)

@@ -1,12 +1,14 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-``diagnostic_msgs``: the controller's ``/diagnostics`` status and its ``found`` event.
+``diagnostic_msgs``: the controller's ``/diagnostics`` status and its search events.
 
 The ``found`` event is a ``diagnostic_msgs/DiagnosticStatus`` (level OK, a readable message)
 whose ``values`` carry the result as key/value strings: ``row``, ``col``, ``cell``, ``pan_rad``,
-``tilt_rad``, ``probability`` and ``fixations``. It reads well in ``ros2 topic echo`` and needs
-no custom interface package; :func:`parse_found` turns it back into numbers.
+``tilt_rad``, ``probability`` and ``fixations``. The ``absent`` event carries ``probability``
+(``P(absent)``) and ``fixations``, the ``gave_up`` event ``fixations`` (level WARN: the search
+ended undecided). They read well in ``ros2 topic echo`` and need no custom interface package;
+:func:`parse_found`, :func:`parse_absent` and :func:`parse_gave_up` turn them back into numbers.
 """
 from __future__ import annotations
 
@@ -16,6 +18,8 @@ from std_msgs.msg import Header
 LEVELS = {'ok': DiagnosticStatus.OK, 'warn': DiagnosticStatus.WARN,
           'error': DiagnosticStatus.ERROR, 'stale': DiagnosticStatus.STALE}
 FOUND_KEYS = ('row', 'col', 'cell', 'pan_rad', 'tilt_rad', 'probability', 'fixations')
+ABSENT_KEYS = ('probability', 'fixations')
+GAVE_UP_KEYS = ('fixations',)
 
 
 def _text(value) -> str:
@@ -55,6 +59,28 @@ def found_status(name: str, row: int, col: int, cell: int, pan_rad: float, tilt_
         'tilt_rad': float(tilt_rad), 'probability': float(probability), 'fixations': fixations})
 
 
+def absent_status(name: str, probability: float, fixations: int) -> DiagnosticStatus:
+    """Build the ``absent`` event: ``P(absent)`` reached the confidence level."""
+    message = (f'no target in the grid: probability {probability:.4f} after {fixations} '
+               f'fixations')
+    return status(name, 'ok', message, {'probability': float(probability),
+                                        'fixations': fixations})
+
+
+def gave_up_status(name: str, fixations: int) -> DiagnosticStatus:
+    """Build the ``gave_up`` event: the fixation budget ran out undecided (level WARN)."""
+    return status(name, 'warn', f'gave up undecided after {fixations} fixations (the budget)',
+                  {'fixations': fixations})
+
+
+def _parse(msg: DiagnosticStatus, event: str, keys, ints) -> dict:
+    kv = values_of(msg)
+    missing = [k for k in keys if k not in kv]
+    if missing:
+        raise ValueError(f'{event} event lacks {missing}')
+    return {k: int(kv[k]) if k in ints else float(kv[k]) for k in keys}
+
+
 def parse_found(msg: DiagnosticStatus) -> dict:
     """
     Read a ``found`` event (row, col, cell and fixations as int, the rest as float).
@@ -65,10 +91,14 @@ def parse_found(msg: DiagnosticStatus) -> dict:
         If a key is missing or not a number.
 
     """
-    kv = values_of(msg)
-    missing = [k for k in FOUND_KEYS if k not in kv]
-    if missing:
-        raise ValueError(f'found event lacks {missing}')
-    out = {k: int(kv[k]) for k in ('row', 'col', 'cell', 'fixations')}
-    out.update({k: float(kv[k]) for k in ('pan_rad', 'tilt_rad', 'probability')})
-    return out
+    return _parse(msg, 'found', FOUND_KEYS, ('row', 'col', 'cell', 'fixations'))
+
+
+def parse_absent(msg: DiagnosticStatus) -> dict:
+    """Read an ``absent`` event (probability as float, fixations as int); ValueError if bad."""
+    return _parse(msg, 'absent', ABSENT_KEYS, ('fixations',))
+
+
+def parse_gave_up(msg: DiagnosticStatus) -> dict:
+    """Read a ``gave_up`` event (fixations as int); ValueError if bad."""
+    return _parse(msg, 'gave_up', GAVE_UP_KEYS, ('fixations',))

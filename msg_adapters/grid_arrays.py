@@ -103,29 +103,31 @@ def from_multiarray(msg, grid: Grid) -> np.ndarray:
     return values.astype(np.float64)
 
 
-def ground_truth(grid: Grid, cell: int) -> Int32MultiArray:
-    """Build the simulated camera's ground truth: ``data = [row, col]``."""
-    row, col = grid.cell(cell)
+def ground_truth(grid: Grid, cell: int | None) -> Int32MultiArray:
+    """Build the simulated camera's ground truth: ``data = [row, col]``, ``[-1, -1]`` if empty."""
+    row, col = (-1, -1) if cell is None else grid.cell(cell)
     msg = Int32MultiArray(layout=MultiArrayLayout(
         dim=[MultiArrayDimension(label='row_col', size=2, stride=2)], data_offset=0))
     msg.data = [int(row), int(col)]
     return msg
 
 
-def cell_from_ground_truth(msg, grid: Grid) -> int:
+def cell_from_ground_truth(msg, grid: Grid) -> int | None:
     """
-    Return the cell index of a ground-truth ``[row, col]`` message.
+    Return the cell index of a ground-truth ``[row, col]`` message (None for an empty scene).
 
     Raises
     ------
     ValueError
-        If the message is not two integers inside the grid.
+        If the message is not two integers inside the grid, or ``[-1, -1]``.
 
     """
     data = list(msg.data)
     if len(data) != 2:
         raise ValueError(f'ground truth must be [row, col], got {data}')
     row, col = data
+    if (row, col) == (-1, -1):
+        return None
     if not (0 <= row < grid.rows and 0 <= col < grid.cols):
         raise ValueError(f'ground truth ({row}, {col}) is outside the '
                          f'{grid.rows}x{grid.cols} grid')

@@ -19,6 +19,13 @@ tie class (27 weights at 7x7, 61 at 11x11).
 
 Randomness: epoch ``i`` draws everything from ``numpy.random.default_rng([seed, i])``, so a run
 resumed from a saved policy after epoch i continues exactly as the uninterrupted run.
+
+Moving and absent targets (docs/design.md section 7): with ``motion_sigma_cells`` or
+``jump_prob`` the training targets take a step of :class:`ipomdp_gaze.motion.Motion` after every
+fixation and the belief is predicted with it; ``absent_prior`` gives the belief the absent
+hypothesis (the infomax reward is then over all N + 1 hypotheses; the policy sees the cells) and
+``absent_rate`` empties that fraction of the training scenes. All four default to 0, which draws
+exactly what the paper's task draws.
 """
 from __future__ import annotations
 
@@ -29,13 +36,15 @@ from pathlib import Path
 import time
 from typing import Callable
 
-from ipomdp_gaze.belief import bayes_update, uniform_log_belief
-from ipomdp_gaze.evaluation import fixations_to_90_ci, fixations_to_level
+from ipomdp_gaze.belief import bayes_update
+from ipomdp_gaze.evaluation import fixations_to_90_ci, fixations_to_level, tracking_summary
 from ipomdp_gaze.fpoc import FPOC
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.motion import check_probability, check_sigma_cells, Motion
 from ipomdp_gaze.observation import as_observation, CountObservation
 from ipomdp_gaze.observation_file import fingerprint
 from ipomdp_gaze.simulate import simulate
+from ipomdp_gaze.stopping import check_absent_prior, initial_log_belief
 import numpy as np
 
 from .conv import ConvPolicy, kernel_from_radial, radial_bins
@@ -54,7 +63,9 @@ class TrainConfig:
     scale); the step size of epoch i is ``learning_rate / (1 + i / anneal_epochs)`` (constant
     when ``anneal_epochs`` is None; the paper's "gamma_t can anneal over time"); ``baseline``
     subtracts a per-time-step reward baseline (the mean reward of the other episodes of the
-    epoch at the same step, which keeps the estimate unbiased).
+    epoch at the same step, which keeps the estimate unbiased). ``motion_sigma_cells``,
+    ``jump_prob``, ``absent_prior`` and ``absent_rate`` set the task of docs/design.md section 7
+    (per fixation).
     """
 
     reward: str = 'infomax'
@@ -70,6 +81,10 @@ class TrainConfig:
     eval_every: int = 50
     eval_episodes: int = 2000
     eval_seed: int = 1000003
+    motion_sigma_cells: float = 0.0
+    jump_prob: float = 0.0
+    absent_prior: float = 0.0
+    absent_rate: float = 0.0
 
     def __post_init__(self):
         if self.reward not in REWARDS:
@@ -93,6 +108,15 @@ class TrainConfig:
             raise ValueError('a reward baseline needs at least 2 episodes per epoch')
         if self.horizon is not None and int(self.horizon) < 1:
             raise ValueError(f'horizon must be >= 1, got {self.horizon!r}')
+        check_sigma_cells(self.motion_sigma_cells, 'motion_sigma_cells')
+        check_probability(self.jump_prob, 'jump_prob')
+        check_absent_prior(self.absent_prior)
+        check_probability(self.absent_rate, 'absent_rate')
+
+    def scene(self) -> dict:
+        """Return the settings of docs/design.md section 7 that are not 0 (the paper's task)."""
+        names = ('motion_sigma_cells', 'jump_prob', 'absent_prior', 'absent_rate')
+        return {k: getattr(self, k) for k in names if getattr(self, k)}
 
 
 @dataclass
@@ -182,7 +206,8 @@ def elm_init(grid: Grid, model, scale: float) -> np.ndarray:
 
 
 def sample_episodes(theta: np.ndarray, model, reward: str, episodes: int,
-                    horizon: int, rng: np.random.Generator) -> Episodes:
+                    horizon: int, rng: np.random.Generator, motion: Motion | None = None,
+                    absent_prior: float = 0.0, absent_rate: float = 0.0) -> Episodes:
     """
     Run a batch of episodes with the softmax policy ``p(k | B) ∝ exp(theta[k] . B)``.
 
@@ -197,15 +222,24 @@ def sample_episodes(theta: np.ndarray, model, reward: str, episodes: int,
     episodes, horizon : int
         Batch size and fixations per episode.
     rng : numpy.random.Generator
-        Source of the targets, the observation noise and the policy's samples.
+        Source of the targets, the observation noise and the policy's samples (and, when they
+        are on, of the empty scenes and the target's steps).
+    motion : Motion, optional
+        The target's step after every fixation; the belief is predicted with it.
+    absent_prior, absent_rate : float
+        The belief's prior that no target is in the grid, and the fraction of empty scenes.
 
     """
     n = theta.shape[0]
     rows = np.arange(episodes)
     theta_t = np.ascontiguousarray(theta.T)
     targets = rng.integers(0, n, size=episodes)
-    log_b = uniform_log_belief(n, episodes)
-    belief = np.exp(log_b)
+    present = rng.random(episodes) >= absent_rate if absent_rate > 0 else None
+    moving = motion is not None and motion.active
+    log_b = initial_log_belief(n, absent_prior, episodes)
+    with_absent = log_b.shape[1] > n
+    terms = np.zeros((episodes, n + 1)) if with_absent else None
+    belief = np.exp(log_b[:, :n])
     beliefs = np.empty((horizon, episodes, n))
     delta = np.empty((horizon, episodes, n))
     rewards = np.empty((horizon, episodes))
@@ -217,13 +251,24 @@ def sample_episodes(theta: np.ndarray, model, reward: str, episodes: int,
         fixations[t] = a
         np.negative(p, out=delta[t])
         delta[t, rows, a] += 1.0
-        frames = model.sample(targets, a, rng)
-        bayes_update(log_b, model.log_likelihood_ratio(frames, a, validate=False), out=log_b)
-        np.exp(log_b, out=belief)
-        if reward == 'infomax':
-            rewards[t] = np.sum(belief * log_b, axis=1)
+        frames = model.sample(targets, a, rng, present=present)
+        llr = model.log_likelihood_ratio(frames, a, validate=False)
+        if with_absent:
+            terms[:, :n] = llr                  # the absent hypothesis's term stays 0
+            llr = terms
+        bayes_update(log_b, llr, out=log_b)
+        if with_absent or moving:
+            full = np.exp(log_b)
+            belief[...] = full[:, :n]
+            infomax = np.sum(full * log_b, axis=1, where=full > 0)
         else:
-            rewards[t] = belief[rows, a]
+            np.exp(log_b, out=belief)
+            infomax = np.sum(belief * log_b, axis=1)
+        rewards[t] = infomax if reward == 'infomax' else belief[rows, a]
+        if moving:
+            targets = motion.move(targets, rng)
+            motion.predict_log(log_b)
+            belief[...] = np.exp(log_b[:, :n])
     return Episodes(beliefs, delta, rewards, fixations)
 
 
@@ -314,6 +359,7 @@ class Trainer:
         self.epoch = int(epoch)
         self.wall_seconds = float(wall_seconds)
         self.horizon = grid.n_cells if config.horizon is None else int(config.horizon)
+        self.motion = Motion(grid, config.motion_sigma_cells, config.jump_prob)
         self.curve: list[dict] = []
 
     def epoch_rng(self, epoch: int) -> np.random.Generator:
@@ -331,7 +377,8 @@ class Trainer:
         """Run one epoch and update the parameters."""
         cfg = self.config
         batch = sample_episodes(self.family.theta(self.params), self.model, cfg.reward,
-                                cfg.episodes_per_epoch, self.horizon, self.epoch_rng(self.epoch))
+                                cfg.episodes_per_epoch, self.horizon, self.epoch_rng(self.epoch),
+                                self.motion, cfg.absent_prior, cfg.absent_rate)
         grad = self.family.project(theta_gradient(batch, cfg.beta, cfg.reward_scale,
                                                   cfg.baseline))
         self.params += self.learning_rate(self.epoch) * grad
@@ -343,7 +390,8 @@ class Trainer:
         cfg = self.config
         result = simulate(self.grid, self.model, self.family.policy(self.params, 'argmax'),
                           cfg.eval_episodes if episodes is None else episodes, self.horizon,
-                          cfg.eval_seed if seed is None else seed)
+                          cfg.eval_seed if seed is None else seed, motion=self.motion,
+                          absent_prior=cfg.absent_prior, absent_rate=cfg.absent_rate)
         return fixations_to_level(result.percent_correct, self.grid.n_cells)
 
     def run(self, epochs: int, progress: bool = False,
@@ -401,7 +449,7 @@ class Trainer:
                     'beta': cfg.beta, 'horizon': self.horizon, 'baseline': cfg.baseline,
                     'seed': cfg.seed, 'init': self.init, 'eval_every': cfg.eval_every,
                     'eval_episodes': cfg.eval_episodes, 'eval_seed': cfg.eval_seed,
-                    'wall_seconds': round(self.wall_seconds, 3)}
+                    'wall_seconds': round(self.wall_seconds, 3), **cfg.scene()}
         kernel = theta = None
         if cfg.family == 'conv':
             kernel = kernel_from_radial(self.grid, self.params)
@@ -472,16 +520,30 @@ def read_curve(path) -> list[dict]:
 
 
 def evaluation_block(grid: Grid, fpoc: FPOC, policy, episodes: int = 20000, seed: int = 0,
-                     horizon: int | None = None, bootstrap: int = 1000) -> dict:
+                     horizon: int | None = None, bootstrap: int = 1000,
+                     scene: dict | None = None) -> dict:
     """
     Fixations to 90% correct with a 95% bootstrap interval, as a policy file records it.
 
     Uses the same targets, noise and bootstrap draws as ``ipomdp-gaze evaluate --seed SEED``, so
-    the numbers match that command's.
+    the numbers match that command's. ``scene`` holds the settings of docs/design.md section 7
+    (:meth:`TrainConfig.scene`); they are recorded, and a moving target adds its tracking
+    accuracy (:func:`ipomdp_gaze.evaluation.tracking_summary`).
     """
+    scene = dict(scene or {})
     horizon = grid.n_cells if horizon is None else int(horizon)
-    result = simulate(grid, fpoc, policy, episodes, horizon, seed)
+    motion = Motion(grid, scene.get('motion_sigma_cells', 0.0), scene.get('jump_prob', 0.0))
+    result = simulate(grid, fpoc, policy, episodes, horizon, seed, motion=motion,
+                      absent_prior=scene.get('absent_prior', 0.0),
+                      absent_rate=scene.get('absent_rate', 0.0))
     point, ci = fixations_to_90_ci(result.correct, grid.n_cells,
                                    np.random.default_rng([seed, 99]), bootstrap)
-    return {'episodes': int(episodes), 'seed': int(seed), 'action': policy.action,
-            'horizon': horizon, 'fixations_to_90': point, 'ci95': list(ci) if ci else None}
+    block = {'episodes': int(episodes), 'seed': int(seed), 'action': policy.action,
+             'horizon': horizon, 'fixations_to_90': point, 'ci95': list(ci) if ci else None}
+    block.update(scene)
+    if motion.active:
+        tracking = tracking_summary(result, grid.cols, np.random.default_rng([seed, 98]),
+                                    bootstrap)['tracking_accuracy']
+        block['tracking_accuracy'] = tracking['value']
+        block['tracking_accuracy_ci95'] = tracking['ci95']
+    return block

@@ -78,3 +78,73 @@ def test_search_prints_each_fixation(capsys):
     assert main(['search', '--grid', '5x5', '--target', '7', '--seed', '1']) == 0
     out = capsys.readouterr().out
     assert 'fixation   1: looked at' in out and 'found: the target is most likely at' in out
+
+
+@pytest.mark.parametrize('args, message', [
+    (['evaluate', '--motion-sigma-cells', '-0.5'], "expected a number >= 0, got '-0.5'"),
+    (['evaluate', '--motion-sigma-cells', 'nan'], "expected a number >= 0, got 'nan'"),
+    (['evaluate', '--jump-prob', '1'], "expected a probability in [0, 1), got '1'"),
+    (['evaluate', '--absent-prior', '-0.1'], "expected a probability in [0, 1), got '-0.1'"),
+    (['evaluate', '--absent-rate', '1.5'], "expected a probability in [0, 1), got '1.5'"),
+    (['evaluate', '--confidence', '1.0'], 'expected a number between 0 and 1 (exclusive)'),
+    (['evaluate', '--max-fixations', '0'], 'expected a positive integer'),
+    (['evaluate', '--horizon', '5', '--max-fixations', '9'], 'beyond the horizon 5'),
+    (['train', '--epochs', '1', '--out', 'x.yaml', '--jump-prob', '2'],
+     'expected a probability in [0, 1)'),
+])
+def test_bad_scene_arguments_exit_2_with_one_line(args, message):
+    out = run_cli(*args)
+    assert out.returncode == 2
+    lines = out.stderr.strip().splitlines()
+    assert message in lines[-1]
+    assert 'Traceback' not in out.stderr
+    assert len([ln for ln in lines if 'error' in ln]) == 1
+
+
+def test_evaluate_records_the_scene_options_and_decisions(tmp_path):
+    path = tmp_path / 'scene.json'
+    rc = main(['evaluate', '--grid', '4x4', '--policy', 'elm', '--policy', 'map',
+               '--episodes', '400', '--seed', '2',
+               '--bootstrap', '50', '--motion-sigma-cells', '0.4', '--jump-prob', '0.01',
+               '--absent-prior', '0.3', '--absent-rate', '0.2', '--confidence', '0.9',
+               '--max-fixations', '12', '--compare-prediction', '--json', str(path)])
+    assert rc == 0
+    data = json.loads(path.read_text())
+    assert list(data) == ['grid', 'fpoc', 'episodes', 'horizon', 'seed', 'motion_sigma_cells',
+                          'jump_prob', 'absent_prior', 'absent_rate', 'confidence',
+                          'max_fixations', 'policies', 'tracking_paired', 'prediction_gain']
+    assert (data['motion_sigma_cells'], data['jump_prob'], data['absent_prior'],
+            data['absent_rate'], data['confidence'], data['max_fixations'],
+            data['horizon']) == (0.4, 0.01, 0.3, 0.2, 0.9, 12, 12)
+    assert list(data['policies']) == ['elm', 'map', 'elm (no prediction)', 'map (no prediction)']
+    assert data['tracking_paired']['map']['minus'] == 'elm'
+    d = data['policies']['elm']['decisions']
+    groups = d['present']['searches'], d['absent']['searches']
+    assert sum(groups) == 400 and 40 < groups[1] < 130
+    for group in ('all', 'present', 'absent'):
+        total = sum(d[group][k]['count'] for k in ('right', 'wrong_found', 'wrong_absent',
+                                                   'gave_up'))
+        assert total == d[group]['searches']
+    assert d['decided']['searches'] == 400 - d['all']['gave_up']['count']
+    assert d['absent']['wrong_absent']['count'] == 0
+    tracking = data['policies']['elm']['tracking']['tracking_accuracy']
+    assert 0 < tracking['value'] <= 1 and tracking['ci95'][0] <= tracking['value']
+    assert data['prediction_gain']['elm']['ci95'][0] <= data['prediction_gain']['elm'][
+        'difference'] <= data['prediction_gain']['elm']['ci95'][1]
+
+
+def test_explicit_zero_scene_options_change_no_number(tmp_path):
+    """The paper's task is the default: zeros give today's JSON plus the new keys only."""
+    plain, zeros = tmp_path / 'plain.json', tmp_path / 'zeros.json'
+    common = ['evaluate', '--grid', '5x5', '--policy', 'elm', '--policy', 'random',
+              '--episodes', '600', '--seed', '4', '--bootstrap', '50']
+    assert main(common + ['--json', str(plain)]) == 0
+    assert main(common + ['--motion-sigma-cells', '0', '--jump-prob', '0', '--absent-prior', '0',
+                          '--absent-rate', '0', '--json', str(zeros)]) == 0
+    a, b = json.loads(plain.read_text()), json.loads(zeros.read_text())
+    for key in ('motion_sigma_cells', 'jump_prob', 'absent_prior', 'absent_rate', 'confidence',
+                'max_fixations'):
+        b.pop(key)
+    for policy in b['policies'].values():
+        assert policy.pop('decisions')['absent']['searches'] == 0
+    assert json.dumps(a) == json.dumps(b)

@@ -212,7 +212,8 @@ def test_controller_update_equals_the_bayes_step(dtype):
     grid = Grid(6, 8)
     fpoc = make_fpoc('human')
     d = dprime_matrix(grid, fpoc)
-    core = GazeController(grid, fpoc, elm_policy(grid, fpoc))
+    # A confidence the 40 updates never reach, so the search does not end at found.
+    core = GazeController(grid, fpoc, elm_policy(grid, fpoc), confidence=1 - 1e-12)
     core.reset(0.0)
     rng = np.random.default_rng(6)
     log_b = uniform_log_belief(grid.n_cells)

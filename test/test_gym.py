@@ -21,6 +21,59 @@ def test_passes_the_gymnasium_checker(kwargs):
     check_env(env, skip_render_check=True)
 
 
+@pytest.mark.filterwarnings('ignore:.*Box observation space m.* value is:UserWarning')
+@pytest.mark.parametrize('kwargs', [
+    {'motion_sigma_cells': 0.7, 'jump_prob': 0.05},
+    {'absent_prior': 0.4, 'absent_rate': 0.3},
+    {'absent_prior': 0.5, 'absent_rate': 0.5, 'motion_sigma_cells': 0.5, 'observe': 'evidence',
+     'fpoc': 'camera', 'rows': 5, 'cols': 6}])
+def test_moving_and_absent_targets_pass_the_gymnasium_checker(kwargs):
+    env = gymnasium.make(ENV_ID, **kwargs).unwrapped
+    check_env(env, skip_render_check=True)
+
+
+def test_empty_scene_terminates_absent_and_the_reward_counts_every_hypothesis():
+    env = VisualSearchEnv(rows=3, cols=3, fpoc='camera', fpoc_params={'dprime': 3.0},
+                          absent_prior=0.5, confidence=0.99)
+    obs, info = env.reset(seed=2, options={'present': False})
+    assert obs['absent'][0] == pytest.approx(0.5) and info['present'] is False
+    assert obs['belief'].sum() == pytest.approx(0.5)
+    for _ in range(30):
+        obs, reward, terminated, truncated, info = env.step(4)
+        full = np.append(env.belief, env.absent_probability)
+        assert reward == pytest.approx(np.sum(full * np.log(full)))
+        assert obs['belief'].sum() + obs['absent'][0] == pytest.approx(1.0)
+        if terminated:
+            break
+    assert terminated and info['decision'] == 'absent' and info['absent_probability'] >= 0.99
+
+
+def test_absent_rate_draws_empty_scenes_from_the_env_generator():
+    env = VisualSearchEnv(absent_prior=0.5, absent_rate=0.5)
+    present = [env.reset(seed=s)[1]['present'] for s in range(200)]
+    assert 60 < sum(present) < 140
+    assert [env.reset(seed=s)[1]['present'] for s in range(200)] == present
+
+
+def test_moving_target_walks_and_the_belief_is_predicted():
+    from ipomdp_gaze.motion import Motion
+    env = VisualSearchEnv(rows=5, cols=5, motion_sigma_cells=1.0, confidence=0.5, max_steps=40)
+    env.reset(seed=4, options={'target': 12})
+    d = dprime_matrix(env.grid, env.fpoc)
+    motion = Motion(env.grid, 1.0)
+    log_b = np.log(np.full(25, 1 / 25))
+    targets = []
+    for t in range(40):
+        obs, _, terminated, truncated, info = env.step(t % 25)
+        log_b = bayes_update(log_b, llr(env._evidence, d[:, t % 25]))
+        np.testing.assert_allclose(info['map_probability'], np.exp(log_b).max(), rtol=1e-9)
+        motion.predict_log(log_b)
+        np.testing.assert_allclose(obs['belief'].ravel(), np.exp(log_b), rtol=1e-9)
+        targets.append(info['target'])
+        assert not terminated                   # a tracker runs to max_steps
+    assert truncated and len(set(targets)) > 3
+
+
 def test_belief_follows_the_bayes_update_and_reward_is_negative_entropy():
     env = VisualSearchEnv(rows=4, cols=4, observe='evidence')
     obs, info = env.reset(seed=5)
@@ -95,3 +148,14 @@ def test_example_drives_the_env_with_a_shipped_kernel_and_baselines(capsys):
     for mean_steps, right in results.values():
         assert right >= 0.8 and 1 <= mean_steps < 49
     assert 'shipped kernel' in capsys.readouterr().out
+
+
+@pytest.mark.parametrize('kwargs, words', [
+    ({'motion_sigma_cells': -1.0}, 'sigma_cells must be finite and >= 0'),
+    ({'jump_prob': 1.0}, r'jump_prob must be a probability in \[0, 1\)'),
+    ({'absent_prior': 1.2}, r'absent_prior must be a probability in \[0, 1\)'),
+    ({'absent_rate': -0.1}, r'absent_rate must be a probability in \[0, 1\)'),
+])
+def test_bad_motion_and_absent_options_are_named(kwargs, words):
+    with pytest.raises(ValueError, match=words):
+        VisualSearchEnv(**kwargs)

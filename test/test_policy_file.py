@@ -270,7 +270,13 @@ def test_shipped_names_resolve_with_and_without_suffix(tmp_path, monkeypatch):
 def test_every_shipped_kernel_loads(name):
     spec = load_policy_spec(name)
     assert spec.path.parent == pf.KERNEL_DIR
-    assert name == f'{spec.fpoc.model}-{spec.grid.rows}x{spec.grid.cols}-{spec.reward}'
+    task = f'{spec.fpoc.model}-{spec.grid.rows}x{spec.grid.cols}-{spec.reward}'
+    # A kernel trained for a moving target (docs/design.md section 7) says so in its name.
+    moving = 'motion_sigma_cells' in spec.training
+    assert name == (f'{task}-tracking' if moving else task)
+    if moving:
+        assert spec.evaluation['motion_sigma_cells'] == spec.training['motion_sigma_cells']
+        assert 0 < spec.evaluation['tracking_accuracy'] <= 1
     assert spec.family == 'conv' and spec.radial() is not None
     evaluation = spec.evaluation
     assert evaluation['episodes'] == 20000 and evaluation['action'] == 'argmax'

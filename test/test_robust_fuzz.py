@@ -44,10 +44,13 @@ VALID, REJECT, SKIP = 'valid', 'rejected', 'skipped'
 def fuzz(launch, probe, tmp_path_factory):
     """Start the controller; return the helpers that talk to it."""
     from std_msgs.msg import Float32MultiArray
+    # Motion on: a tracker never ends its search, so every valid frame is applied (a still
+    # search skips the frames after its found event until ~/reset, docs/design.md section 7.3).
     proc = launch('controller', [
         '-p', 'settle_time_s:=0.0', '-p', 'diagnostics_period_s:=0.02',
         '-p', f'evidence_queue_depth:={QUEUE}', '-p', 'policy.name:=elm',
-        '-p', 'retry_period_s:=0.5', '-p', 'stall_timeout_s:=0.0'])
+        '-p', 'retry_period_s:=0.5', '-p', 'stall_timeout_s:=0.0',
+        '-p', 'motion.sigma_cells:=0.5'])
     from rclpy.qos import QoSProfile, ReliabilityPolicy
     qos = QoSProfile(depth=QUEUE, reliability=ReliabilityPolicy.RELIABLE)
     from sensor_msgs.msg import Image

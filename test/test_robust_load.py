@@ -46,10 +46,12 @@ def _flood(env, rows, rate_hz, seconds, burst):
 
 def _run(launch, probe, ros_env, rows, rate_hz, seconds, burst):
     spacing, policy = GRIDS[rows]
+    # Motion on: a tracker never ends its search, so the flood keeps the controller updating and
+    # publishing (a still search would skip every frame after its found event).
     proc = launch('controller', [
         '-p', f'grid.rows:={rows}', '-p', f'grid.cols:={rows}',
         '-p', f'grid.spacing_deg:={spacing}', '-p', f'policy.name:={policy}',
-        '-p', 'diagnostics_period_s:=0.25'])
+        '-p', 'diagnostics_period_s:=0.25', '-p', 'motion.sigma_cells:=0.5'])
     from sensor_msgs.msg import Image
     diag = probe.search_status()
     viewer = probe.latest(Image, 'belief_image', 2)           # someone watches the heatmap

@@ -5,7 +5,8 @@ The launch test with the simulated camera: both nodes as processes with the ship
 
 A probe node watches ``belief``, ``pan_tilt``, ``belief_image``, ``found`` and ``ground_truth``.
 For several seeds and targets the most likely cell is the target once its probability passes
-0.999 (the outcome is asserted, not the trajectory: timing varies on a loaded machine).
+0.999, where the controller (confidence 0.999) declares ``found`` and ends the search (the outcome
+is asserted, not the trajectory: timing varies on a loaded machine).
 """
 from __future__ import annotations
 
@@ -20,6 +21,7 @@ pytestmark = [pytest.mark.ros,
 
 CONTROLLER, CAMERA = 'gaze_controller', 'simulated_camera'
 SEARCH_TIMEOUT_S = 60.0
+CONFIDENCE = 0.999
 # (camera seed, target or None for the camera's random draw, controller start cell or None).
 CASES = [(11, None, None), (12, (0, 10), (0, 0)), (13, (10, 1), None), (14, None, (7, 2))]
 
@@ -32,7 +34,8 @@ def rig(launch, probe):
     search = SearchRecord(probe, depth=100)
     rec = {'belief': search.beliefs, 'pan_tilt': search.targets, 'found': search.found,
            'truth': search.truth, 'image': probe.record(Image, 'belief_image', 10)}
-    controller = launch('controller', ['--params-file', config_path('controller.yaml')])
+    controller = launch('controller', ['--params-file', config_path('controller.yaml'),
+                                       '-p', f'confidence:={CONFIDENCE}'])
     camera = launch('camera', ['--params-file', config_path('camera.yaml')])
     assert wait_for(lambda: rec['pan_tilt'] and rec['truth'], 30), \
         controller.output() + camera.output()
@@ -78,7 +81,7 @@ def _search(probe, rec, seed, target, start):
     _enable(probe, True)
 
     def confident():
-        return any(np.max(np.asarray(m.data)) >= 0.999 for _, m in rec['belief'][first:])
+        return any(np.max(np.asarray(m.data)) >= CONFIDENCE for _, m in rec['belief'][first:])
 
     assert wait_for(confident, SEARCH_TIMEOUT_S), 'no belief reached 0.999'
     assert wait_for(lambda: len(rec['found']) > n_found, 10)
@@ -95,7 +98,7 @@ def test_most_likely_cell_is_the_target_at_0999(searches):
     for (seed, target, _), (beliefs, _, truth, _) in searches:
         if target is not None:
             assert truth == target[0] * 11 + target[1]
-        done = next(b for b in beliefs if b.max() >= 0.999)
+        done = next(b for b in beliefs if b.max() >= CONFIDENCE)
         assert int(np.argmax(done)) == truth, f'seed {seed}: wrong cell at p >= 0.999'
     assert len({truth for _, (_, _, truth, _) in searches}) == len(CASES)
 
@@ -107,7 +110,7 @@ def test_found_event(searches):
     head = PanTiltMap(Grid(11, 11, 5.0))
     for _, (beliefs, _, _, found_msg) in searches:
         found = diagnostics.parse_found(found_msg)
-        i = next(i for i, b in enumerate(beliefs) if b.max() >= 0.95)
+        i = next(i for i, b in enumerate(beliefs) if b.max() >= CONFIDENCE)
         assert found['fixations'] == i + 1
         assert found['cell'] == int(np.argmax(beliefs[i])) == found['row'] * 11 + found['col']
         assert found['probability'] == pytest.approx(beliefs[i].max(), rel=1e-5)

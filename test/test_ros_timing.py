@@ -41,7 +41,7 @@ def rig(launch, probe):
     }
     controller = launch('controller', [
         '--params-file', config_path('controller.yaml'), '-p', f'retry_period_s:={RETRY_S}',
-        '-p', 'diagnostics_period_s:=0.2'])
+        '-p', 'diagnostics_period_s:=0.2', '-p', 'confidence:=0.999'])   # found ends a search
     assert wait_for(lambda: rec['targets'], 30), controller.output()
     return rec
 

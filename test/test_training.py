@@ -240,3 +240,64 @@ def test_elm_initialisation_starts_training_at_elms_choices(tmp_path):
     spec = load_policy_spec(out)
     assert spec.training['init'] == 'elm x 20'
     np.testing.assert_allclose(spec.kernel, 20.0 * model.elm_kernel())
+
+
+def test_moving_and_absent_training_episodes_follow_the_model():
+    """Targets walk, the belief is predicted, the infomax reward spans the N + 1 hypotheses."""
+    from ipomdp_gaze.belief import bayes_update
+    from ipomdp_gaze.motion import Motion
+    from ipomdp_gaze.stopping import initial_log_belief
+    grid = Grid(3, 4)
+    model = GaussianObservation(grid, FPOC)
+    motion = Motion(grid, 0.8, 0.05)
+    theta = np.random.default_rng(1).normal(size=(12, 12))
+    batch = sample_episodes(theta, model, 'infomax', 6, 5, np.random.default_rng(3), motion,
+                            absent_prior=0.3, absent_rate=0.5)
+    # Replay the draws in the same order: targets, empty scenes, then per step the policy's
+    # sample, the frames and the target's step.
+    rng = np.random.default_rng(3)
+    targets = rng.integers(0, 12, size=6)
+    present = rng.random(6) >= 0.5
+    assert 0 < present.sum() < 6
+    log_b = initial_log_belief(12, 0.3, 6)
+    for t in range(5):
+        np.testing.assert_allclose(batch.belief[t], np.exp(log_b[:, :12]), rtol=1e-9)
+        rng.random((6, 1))                      # the softmax policy's own draw
+        a = batch.fixations[t]
+        frames = model.sample(targets, a, rng, present=present)
+        llr = np.concatenate([model.log_likelihood_ratio(frames, a), np.zeros((6, 1))], axis=1)
+        log_b = bayes_update(log_b, llr)
+        full = np.exp(log_b)
+        np.testing.assert_allclose(batch.reward[t], np.sum(full * log_b, axis=1), rtol=1e-9)
+        targets = motion.move(targets, rng)
+        motion.predict_log(log_b)
+
+
+def test_scene_settings_are_recorded_resumed_and_checked(tmp_path):
+    grid = Grid(3, 4)
+    config = TrainConfig(seed=2, eval_every=2, eval_episodes=40, motion_sigma_cells=0.5,
+                         jump_prob=0.01, absent_prior=0.2, absent_rate=0.2)
+    trainer = Trainer(grid, FPOC, config)
+    trainer.run(2)
+    spec = trainer.spec()
+    assert {k: spec.training[k] for k in ('motion_sigma_cells', 'jump_prob', 'absent_prior',
+                                          'absent_rate')} == config.scene()
+    path = save_policy(tmp_path / 'moving.yaml', spec)
+    assert trainer_from_spec(load_policy_spec(path)).config == config
+    assert 'motion_sigma_cells' not in Trainer(grid, FPOC, TrainConfig()).spec().training
+    with pytest.raises(ValueError, match='motion_sigma_cells must be finite and >= 0'):
+        TrainConfig(motion_sigma_cells=-1.0)
+    with pytest.raises(ValueError, match=r'absent_rate must be a probability in \[0, 1\)'):
+        TrainConfig(absent_rate=1.0)
+
+
+def test_train_cli_on_a_moving_target_reports_tracking(tmp_path, capsys):
+    out = tmp_path / 'moving.yaml'
+    assert main(['train', '--grid', '4x4', '--epochs', '2', '--out', str(out), '--quiet',
+                 '--eval-every', '2', '--eval-episodes', '40', '--final-episodes', '200',
+                 '--motion-sigma-cells', '0.5', '--absent-prior', '0.1']) == 0
+    spec = load_policy_spec(out)
+    assert spec.training['motion_sigma_cells'] == 0.5 and spec.training['absent_prior'] == 0.1
+    assert spec.evaluation['motion_sigma_cells'] == 0.5
+    assert 0 <= spec.evaluation['tracking_accuracy'] <= 1
+    assert 'tracking accuracy' in capsys.readouterr().out

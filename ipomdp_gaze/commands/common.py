@@ -51,6 +51,63 @@ def positive_float(text: str) -> float:
     return value
 
 
+def _number(text: str, what: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'expected {what}, got {text!r}') from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f'expected {what}, got {text!r}')
+    return value
+
+
+def nonneg_float(text: str) -> float:
+    """Parse a finite number >= 0 (a motion sigma) for argparse."""
+    value = _number(text, 'a number >= 0')
+    if value < 0:
+        raise argparse.ArgumentTypeError(f'expected a number >= 0, got {text!r}')
+    return value
+
+
+def probability_arg(text: str) -> float:
+    """Parse a probability in [0, 1) (a jump probability, a prior, a rate) for argparse."""
+    value = _number(text, 'a probability in [0, 1)')
+    if not 0 <= value < 1:
+        raise argparse.ArgumentTypeError(f'expected a probability in [0, 1), got {text!r}')
+    return value
+
+
+def confidence_arg(text: str) -> float:
+    """Parse a confidence level strictly between 0 and 1 for argparse."""
+    value = _number(text, 'a number between 0 and 1 (exclusive)')
+    if not 0 < value < 1:
+        raise argparse.ArgumentTypeError(
+            f'expected a number between 0 and 1 (exclusive), got {text!r}')
+    return value
+
+
+def add_scene_args(parser: argparse.ArgumentParser, scenes: str) -> None:
+    """
+    ``--motion-sigma-cells``, ``--jump-prob``, ``--absent-prior`` and ``--absent-rate``.
+
+    The target's random walk per fixation and the absent hypothesis of docs/design.md section 7;
+    ``scenes`` names the scenes whose empty fraction ``--absent-rate`` sets (``simulated``,
+    ``training``). Each is None when not given, which means 0: a still target that is always
+    there.
+    """
+    parser.add_argument('--motion-sigma-cells', type=nonneg_float, default=None,
+                        help='the target moves between fixations: Gaussian step of this '
+                             'standard deviation in cells (default 0: still)')
+    parser.add_argument('--jump-prob', type=probability_arg, default=None,
+                        help='probability per fixation that the target jumps to a uniformly '
+                             'random cell instead (default 0)')
+    parser.add_argument('--absent-prior', type=probability_arg, default=None,
+                        help="the model's prior that no target is in the grid (default 0: "
+                             'always there)')
+    parser.add_argument('--absent-rate', type=probability_arg, default=None,
+                        help=f'fraction of the {scenes} scenes that are empty (default 0)')
+
+
 def fpoc_param(text: str) -> tuple[str, object]:
     """Parse ``name=value`` for argparse; the value is read as YAML (numbers, lists, words)."""
     name, sep, value = text.partition('=')

@@ -1,19 +1,34 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""``ipomdp-gaze evaluate``: fixations to 90% correct for baselines and policy files."""
+"""
+``ipomdp-gaze evaluate``: fixations to 90% correct for baselines and policy files.
+
+Beyond the paper (docs/design.md section 7) it simulates moving targets
+(``--motion-sigma-cells``, ``--jump-prob``; per fixation), empty scenes at ``--absent-rate``
+searched with the model's ``--absent-prior``, and the stopping rules at ``--confidence`` with a
+``--max-fixations`` budget; every policy then also gets its decision rates and, for a moving
+target, its first lock and tracking accuracy (``--compare-prediction`` adds each policy without
+the prediction step and the paired difference).
+"""
 from __future__ import annotations
 
 import json
 from pathlib import Path
 
-from ipomdp_gaze.evaluation import fixations_to_90_ci, paired_difference_ci
+from ipomdp_gaze.evaluation import (decision_summary, fixations_to_90_ci,
+                                    paired_difference_ci, paired_tracking_difference,
+                                    tracking_summary)
+from ipomdp_gaze.motion import Motion
 from ipomdp_gaze.observation import as_observation, GaussianObservation
 from ipomdp_gaze.observation_file import fingerprint
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
-from ipomdp_gaze.simulate import draw_targets, simulate
+from ipomdp_gaze.simulate import draw_present, draw_targets, simulate
 import numpy as np
 
-from .common import add_task_args, nonneg_int, positive_int, task_from_args
+from .common import (add_scene_args, add_task_args, confidence_arg, nonneg_int, positive_int,
+                     task_from_args)
+
+NO_PREDICTION = ' (no prediction)'
 
 
 def add_parser(sub):
@@ -36,6 +51,15 @@ def add_parser(sub):
     p.add_argument('--paired', action='store_true',
                    help='also give each policy minus the first, on the same episodes, with a '
                         'paired bootstrap 95%% interval')
+    add_scene_args(p, 'simulated')
+    p.add_argument('--confidence', type=confidence_arg, default=None,
+                   help='level at which a search decides found or absent (default 0.95)')
+    p.add_argument('--max-fixations', type=positive_int, default=None,
+                   help='fixation budget: undecided searches give up there (default: the '
+                        'horizon; also the horizon when --horizon is not given)')
+    p.add_argument('--compare-prediction', action='store_true',
+                   help='moving target: also run each policy without the prediction step and '
+                        'report the paired difference in tracking accuracy')
     p.add_argument('--json', type=Path, default=None, metavar='OUT', help='write results here')
     p.set_defaults(run=run)
 
@@ -52,42 +76,88 @@ def load_policies(args, grid, fpoc) -> dict:
 
 def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
              episodes_greedy: int = 2000, bootstrap: int = 1000, progress=None,
-             paired: bool = False) -> dict:
+             motion_sigma_cells: float | None = None, jump_prob: float | None = None,
+             absent_prior: float | None = None, absent_rate: float | None = None,
+             confidence: float | None = None, max_fixations: int | None = None,
+             compare_prediction: bool = False, paired: bool = False) -> dict:
     """
-    Run every policy on the same targets and noise; return the JSON-ready result.
+    Run every policy on the same targets, noise, target paths and empty scenes.
 
-    With ``paired``, ``result['paired']`` holds each later policy minus the first: the
-    difference of fixations to 90% on their common episodes with a paired bootstrap interval.
+    Returns the JSON-ready result (docs/design.md section 9.2): per policy, fixations to 90%
+    correct with its interval and percent correct. When any option of docs/design.md section 7
+    is given (not None; the others then take their defaults 0, 0, 0, 0, 0.95 and the horizon),
+    the result also records all six and each policy gets ``decisions``
+    (:func:`ipomdp_gaze.evaluation.decision_summary`) and, for a moving target, ``tracking``
+    (:func:`ipomdp_gaze.evaluation.tracking_summary`). Without them the result is exactly the
+    paper task's. With ``paired``, ``result['paired']`` holds each later policy minus the
+    first: the difference of fixations to 90% on their common episodes with a paired bootstrap
+    interval.
     """
-    horizon = grid.n_cells if horizon is None else horizon
+    scene = (motion_sigma_cells, jump_prob, absent_prior, absent_rate, confidence,
+             max_fixations)
+    extended = compare_prediction or any(v is not None for v in scene)
+    motion_sigma_cells, jump_prob, absent_prior, absent_rate = (
+        0.0 if v is None else v for v in scene[:4])
+    confidence = 0.95 if confidence is None else confidence
+    if horizon is None:
+        horizon = grid.n_cells if max_fixations is None else max_fixations
+    if max_fixations is not None and max_fixations > horizon:
+        raise ValueError(f'--max-fixations {max_fixations} is beyond the horizon {horizon}')
     model = as_observation(grid, fpoc)
+    motion = Motion(grid, motion_sigma_cells, jump_prob)
     targets = draw_targets(grid.n_cells, episodes, seed)
+    present = draw_present(episodes, absent_rate, seed)
     task = ({'fpoc': model.fpoc.to_dict()} if isinstance(model, GaussianObservation)
             else {'observation': {**model.to_dict(), 'sha256': fingerprint(model)}})
     out = {'grid': grid.to_dict(), **task, 'episodes': episodes,
-           'horizon': horizon, 'seed': seed, 'policies': {}}
-    correct = {}
-    for name, policy in policies.items():
+           'horizon': horizon, 'seed': seed}
+    if extended:
+        out.update({'motion_sigma_cells': motion.sigma_cells, 'jump_prob': motion.jump_prob,
+                    'absent_prior': float(absent_prior), 'absent_rate': float(absent_rate),
+                    'confidence': float(confidence), 'max_fixations': max_fixations})
+    out['policies'] = {}
+    runs = [(name, policy, True) for name, policy in policies.items()]
+    if compare_prediction and motion.active:
+        runs += [(name + NO_PREDICTION, policy, False) for name, policy in policies.items()]
+    results = {}
+    for name, policy, predict in runs:
         n = min(episodes, episodes_greedy) if getattr(policy, 'name', '') == 'greedy' else episodes
-        result = simulate(grid, model, policy, n, horizon, seed, targets=targets[:n])
-        if paired:
-            correct[name] = result.correct
+        result = simulate(grid, model, policy, n, horizon, seed, targets=targets[:n],
+                          motion=motion, predict=predict, absent_prior=absent_prior,
+                          present=present[:n])
+        results[name] = result
         point, ci = fixations_to_90_ci(result.correct, grid.n_cells,
                                        np.random.default_rng([seed, 99]), bootstrap)
-        out['policies'][name] = {
+        entry = out['policies'][name] = {
             'episodes': n, 'fixations_to_90': point, 'ci95': list(ci) if ci else None,
             'percent_correct': [round(float(x), 6) for x in result.percent_correct]}
+        if extended:
+            entry['decisions'] = decision_summary(result, confidence, max_fixations)
+        if motion.active:
+            entry['tracking'] = tracking_summary(result, grid.cols,
+                                                 np.random.default_rng([seed, 98]), bootstrap)
         if progress:
-            progress(name, out['policies'][name])
-    if paired and len(correct) > 1:
-        names = list(correct)
+            progress(name, entry)
+    names = list(policies)
+    if paired and len(names) > 1:
         out['paired'] = {}
         for name in names[1:]:
-            diff, ci = paired_difference_ci(correct[name], correct[names[0]], grid.n_cells,
-                                            np.random.default_rng([seed, 98]), bootstrap)
+            a, z = results[name].correct, results[names[0]].correct
+            diff, ci = paired_difference_ci(a, z, grid.n_cells,
+                                            np.random.default_rng([seed, 95]), bootstrap)
             out['paired'][f'{name} - {names[0]}'] = {
-                'episodes': int(min(correct[name].shape[0], correct[names[0]].shape[0])),
+                'episodes': int(min(a.shape[0], z.shape[0])),
                 'difference': diff, 'ci95': list(ci) if ci else None}
+    if motion.active and len(names) > 1:
+        out['tracking_paired'] = {
+            name: {'minus': names[0], **paired_tracking_difference(
+                results[name], results[names[0]], grid.cols, np.random.default_rng([seed, 96]),
+                bootstrap)} for name in names[1:]}
+    if compare_prediction and motion.active:
+        out['prediction_gain'] = {
+            name: paired_tracking_difference(results[name], results[name + NO_PREDICTION],
+                                             grid.cols, np.random.default_rng([seed, 97]),
+                                             bootstrap) for name in policies}
     return out
 
 
@@ -111,15 +181,52 @@ def format_table(result: dict) -> str:
     return '\n'.join(lines)
 
 
+def format_decisions(result: dict) -> str:
+    """Format the decision rates (over decided searches) and the tracking accuracy."""
+    lines = [f"{'policy':<24} {'decided':>8} {'wrong/dec':>10} {'upper95':>8} {'gave up':>8} "
+             f"{'fix->dec':>9} {'track':>7}"]
+    for name, r in result['policies'].items():
+        d = r['decisions']
+        wrong = d['decided']['wrong']
+        fix = d['all']['fixations_to_decision']['mean']
+        track = r.get('tracking', {}).get('tracking_accuracy', {}).get('value')
+        lines.append(
+            f"{name:<24} {d['decided']['searches']:>8} "
+            f"{'-' if wrong['rate'] is None else format(wrong['rate'], '.4f'):>10} "
+            f"{'-' if wrong['ci95'] is None else format(wrong['ci95'][1], '.4f'):>8} "
+            f"{d['all']['gave_up']['rate']:>8.4f} "
+            f"{'-' if fix is None else format(fix, '.2f'):>9} "
+            f"{'-' if track is None else format(track, '.4f'):>7}")
+    return '\n'.join(lines)
+
+
 def run(args) -> int:
     grid, fpoc = task_from_args(args)
     policies = load_policies(args, grid, fpoc)
     result = evaluate(grid, fpoc, policies, args.episodes, args.horizon, args.seed,
-                      args.episodes_greedy, args.bootstrap, paired=args.paired)
+                      args.episodes_greedy, args.bootstrap,
+                      motion_sigma_cells=args.motion_sigma_cells, jump_prob=args.jump_prob,
+                      absent_prior=args.absent_prior, absent_rate=args.absent_rate,
+                      confidence=args.confidence, max_fixations=args.max_fixations,
+                      compare_prediction=args.compare_prediction, paired=args.paired)
     task = (f'count model {args.observation}' if args.observation else
             f'{grid.spacing_deg} deg/cell, FPOC {fpoc.to_dict()}')
     print(f"{grid.rows}x{grid.cols} grid, {task}, horizon {result['horizon']}, seed {args.seed}")
     print(format_table(result))
+    if 'confidence' in result:
+        print(f"motion sigma {result['motion_sigma_cells']} cells, jump {result['jump_prob']} "
+              f"per fixation; absent prior {result['absent_prior']}, rate "
+              f"{result['absent_rate']}; confidence {result['confidence']}, budget "
+              f"{result['max_fixations'] or result['horizon']}")
+        print(format_decisions(result))
+    for name, gain in result.get('tracking_paired', {}).items():
+        ci = gain['ci95']
+        print(f"{name}: tracking accuracy minus {gain['minus']}'s {gain['difference']:+.4f}"
+              + (f' [{ci[0]:+.4f}, {ci[1]:+.4f}]' if ci else ''))
+    for name, gain in result.get('prediction_gain', {}).items():
+        ci = gain['ci95']
+        print(f'{name}: tracking accuracy with minus without prediction '
+              f"{gain['difference']:+.4f}" + (f' [{ci[0]:+.4f}, {ci[1]:+.4f}]' if ci else ''))
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)
         args.json.write_text(json.dumps(result, indent=1) + '\n')

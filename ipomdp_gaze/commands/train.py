@@ -11,7 +11,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .common import add_task_args, nonneg_int, positive_float, positive_int, task_from_args
+from .common import (add_scene_args, add_task_args, nonneg_int, positive_float, positive_int,
+                     task_from_args)
 
 FAMILY_DEFAULT, REWARD_DEFAULT = 'conv', 'infomax'
 # The defaults of the learning rate and reward scale: chosen on the 7x7 human task (README).
@@ -65,6 +66,7 @@ def add_parser(sub):
                         '0 skips it)')
     p.add_argument('--final-seed', type=nonneg_int, default=0,
                    help='seed of the final evaluation (default 0, as ipomdp-gaze evaluate)')
+    add_scene_args(p, 'training')
     p.add_argument('--quiet', action='store_true', help='no progress bar')
     p.set_defaults(run=run)
 
@@ -139,7 +141,9 @@ def run(args) -> int:
         'beta': args.beta, 'baseline': args.baseline, 'seed': args.seed,
         'episodes_per_epoch': args.episodes_per_epoch, 'horizon': args.horizon,
         'eval_every': args.eval_every,
-        'eval_episodes': args.eval_episodes}
+        'eval_episodes': args.eval_episodes, 'motion_sigma_cells': args.motion_sigma_cells,
+        'jump_prob': args.jump_prob, 'absent_prior': args.absent_prior,
+        'absent_rate': args.absent_rate}
     if spec is None:
         defaults = {'reward': args.reward or REWARD_DEFAULT,
                     'family': args.family or FAMILY_DEFAULT, 'learning_rate': LEARNING_RATE,
@@ -177,7 +181,8 @@ def run(args) -> int:
     evaluation = {}
     if args.final_episodes:
         evaluation = evaluation_block(grid, fpoc, trainer.family.policy(trainer.params),
-                                      args.final_episodes, args.final_seed, trainer.horizon)
+                                      args.final_episodes, args.final_seed, trainer.horizon,
+                                      scene=trainer.config.scene())
     save_policy(out, trainer.spec(evaluation=evaluation))
     write_curve(curve_path, rows)
     cfg = trainer.config
@@ -192,5 +197,9 @@ def run(args) -> int:
             text += f' [{ci[0]:.2f}, {ci[1]:.2f}]'
         print(f'fixations to 90% correct (argmax, {args.final_episodes} episodes, seed '
               f'{args.final_seed}): {text}')
+        if evaluation.get('tracking_accuracy') is not None:
+            ci = evaluation['tracking_accuracy_ci95']
+            print(f"tracking accuracy {evaluation['tracking_accuracy']:.4f} "
+                  f'[{ci[0]:.4f}, {ci[1]:.4f}]')
     print(f'wrote {out} and {curve_path}')
     return 0

@@ -14,9 +14,17 @@ where the FPOC gives ``d' = 0`` (outside the field of view, not observed).
 
 Publishes ``evidence`` (``Float32MultiArray``, best effort) or, with ``publish_image``, the
 stamped ``evidence_image`` (``32FC1``); ``joint_states`` (its pose, stamped like the frame taken
-there); and ``ground_truth`` (``std_msgs/Int32MultiArray`` ``[row, col]``, transient local).
-``~/reset`` (``std_srvs/Trigger``) draws a new target (``target_row``/``target_col``, or a random
-cell when they are -1).
+there); and ``ground_truth`` (``std_msgs/Int32MultiArray`` ``[row, col]``, transient local;
+``[-1, -1]`` for an empty scene). ``~/reset`` (``std_srvs/Trigger``) draws a new target
+(``target_row``/``target_col``, or a random cell when they are -1).
+
+Beyond the paper (docs/design.md section 7): with ``empty_scene`` there is no target (every
+frame is null noise) from the start or the next ``~/reset``; with ``target_motion_rate_hz > 0``
+the target takes a step of :class:`ipomdp_gaze.motion.Motion` (``target_motion_sigma_cells``,
+``target_jump_prob`` per step) that many times a second and ``ground_truth`` follows it. A
+controller models that walk with ``motion.sigma_cells = target_motion_sigma_cells *
+sqrt(target_motion_rate_hz)`` and ``motion.jump_prob = 1 - (1 - target_jump_prob) **
+target_motion_rate_hz`` per second.
 """
 from __future__ import annotations
 
@@ -24,6 +32,7 @@ from dataclasses import dataclass
 import sys
 
 from ipomdp_gaze.head import PanTiltMap
+from ipomdp_gaze.motion import check_probability, check_sigma_cells, Motion
 from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
 from ipomdp_gaze.observation import GaussianObservation
 import numpy as np
@@ -57,6 +66,15 @@ def camera_params() -> list[Param]:
               float_range=(0.0, 1000.0)),
         Param('publish_image', False, T.BOOL,
               'publish stamped 32FC1 evidence_image frames instead of evidence'),
+        Param('empty_scene', False, T.BOOL,
+              'no target at all (from the start or the next reset): every frame is null noise'),
+        Param('target_motion_sigma_cells', 0.0, T.DOUBLE,
+              'standard deviation in cells of each step of the random walk of the target, >= 0'),
+        Param('target_jump_prob', 0.0, T.DOUBLE,
+              'probability that a step is a jump to a random cell instead, in [0, 1)'),
+        Param('target_motion_rate_hz', 0.0, T.DOUBLE,
+              'steps of the random walk of the target per second (0: a still target)',
+              float_range=(0.0, 1000.0)),
     ]
 
 
@@ -69,6 +87,7 @@ class CameraConfig:
     observation: GaussianObservation
     head: PanTiltMap
     target: tuple
+    motion: Motion
 
 
 class SimulatedCameraNode(Node):
@@ -84,14 +103,14 @@ class SimulatedCameraNode(Node):
         self.rng = np.random.default_rng(v['seed'])
         self.pose = self.goal = self._config.grid.center_index
         self.moving = False
-        self.target = 0
+        self.target: int | None = 0
         self._evidence_pub = self.create_publisher(Float32MultiArray, 'evidence', FRAME_QOS)
         self._image_pub = self.create_publisher(Image, 'evidence_image', FRAME_QOS)
         self._joint_pub = self.create_publisher(JointState, 'joint_states', 10)
         self._truth_pub = self.create_publisher(Int32MultiArray, 'ground_truth', STATE_QOS)
         self.create_subscription(JointState, 'pan_tilt', self._on_command, STATE_QOS)
         self.create_service(Trigger, '~/reset', self._on_reset)
-        self._saccade_timer = self._frame_timer = None
+        self._saccade_timer = self._frame_timer = self._walk_timer = None
         self._make_timers(v)
         self._new_target()
         self._publish_pose(self.get_clock().now().to_msg())
@@ -108,21 +127,26 @@ class SimulatedCameraNode(Node):
         fpoc = fpoc_from(values)
         head = head_from(values, grid)
         target = row_col_from(values, grid, 'target_row', 'target_col')
-        return CameraConfig(dict(values), grid, GaussianObservation(grid, fpoc), head, target)
+        motion = Motion(grid, check_sigma_cells(values['target_motion_sigma_cells'],
+                                                'target_motion_sigma_cells'),
+                        check_probability(values['target_jump_prob'], 'target_jump_prob'))
+        return CameraConfig(dict(values), grid, GaussianObservation(grid, fpoc), head, target,
+                            motion)
 
     def _apply_config(self, old: CameraConfig, cfg: CameraConfig) -> None:
         """Follow a new configuration: a new seed restarts the noise, new times the timers."""
         v, ov = cfg.values, old.values
         if v['seed'] != ov['seed']:
             self.rng = np.random.default_rng(v['seed'])
-        if (v['saccade_time_s'], v['rate_hz']) != (ov['saccade_time_s'], ov['rate_hz']):
+        times = ('saccade_time_s', 'rate_hz', 'target_motion_rate_hz')
+        if any(v[k] != ov[k] for k in times):
             self._make_timers(v)
 
     def _make_timers(self, values: dict) -> None:
-        for timer in (self._saccade_timer, self._frame_timer):
+        for timer in (self._saccade_timer, self._frame_timer, self._walk_timer):
             if timer is not None:
                 self.destroy_timer(timer)
-        self._saccade_timer = self._frame_timer = None
+        self._saccade_timer = self._frame_timer = self._walk_timer = None
         if self.moving:
             self._arrive()
         if values['saccade_time_s'] > 0:
@@ -130,6 +154,9 @@ class SimulatedCameraNode(Node):
             self._saccade_timer.cancel()
         if values['rate_hz'] > 0:
             self._frame_timer = self.create_timer(1.0 / values['rate_hz'], self._publish_frame)
+        if values['target_motion_rate_hz'] > 0:
+            self._walk_timer = self.create_timer(1.0 / values['target_motion_rate_hz'],
+                                                 self._walk)
 
     # -- head ------------------------------------------------------------------------------
     def _on_command(self, msg: JointState) -> None:
@@ -163,7 +190,8 @@ class SimulatedCameraNode(Node):
     # -- outputs -------------------------------------------------------------------------
     def _publish_frame(self) -> None:
         cfg = self._config
-        obs = cfg.observation.sample(self.target, self.pose, self.rng)
+        obs = cfg.observation.sample(0 if self.target is None else self.target, self.pose,
+                                     self.rng, present=self.target is not None)
         obs[~cfg.observation.observed(self.pose)] = np.nan
         stamp = self.get_clock().now().to_msg()
         if cfg.values['publish_image']:
@@ -175,19 +203,36 @@ class SimulatedCameraNode(Node):
     def _publish_pose(self, stamp) -> None:
         self._joint_pub.publish(joints.joint_state(self._config.head, self.pose, stamp))
 
-    def _new_target(self) -> int:
+    def _new_target(self) -> int | None:
         cfg = self._config
-        row, col = cfg.target
-        row = int(self.rng.integers(cfg.grid.rows)) if row is None else row
-        col = int(self.rng.integers(cfg.grid.cols)) if col is None else col
-        self.target = cfg.grid.index(row, col)
+        if cfg.values['empty_scene']:
+            self.target = None
+        else:
+            row, col = cfg.target
+            row = int(self.rng.integers(cfg.grid.rows)) if row is None else row
+            col = int(self.rng.integers(cfg.grid.cols)) if col is None else col
+            self.target = cfg.grid.index(row, col)
         self._truth_pub.publish(grid_arrays.ground_truth(cfg.grid, self.target))
         return self.target
 
+    def _walk(self) -> None:
+        """Take one step of the target's random walk (nothing in an empty scene)."""
+        cfg = self._config
+        if self.target is None or not cfg.motion.active:
+            return
+        step = int(cfg.motion.move(np.array([self.target]), self.rng)[0])
+        if step != self.target:
+            self.target = step
+            self._truth_pub.publish(grid_arrays.ground_truth(cfg.grid, self.target))
+
     def _on_reset(self, request, response):
-        row, col = self._config.grid.cell(self._new_target())
+        target = self._new_target()
         response.success = True
-        response.message = f'new target at ({row}, {col})'
+        if target is None:
+            response.message = 'empty scene: no target'
+        else:
+            row, col = self._config.grid.cell(target)
+            response.message = f'new target at ({row}, {col})'
         self.get_logger().info(response.message)
         return response
 

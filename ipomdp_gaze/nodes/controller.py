@@ -14,10 +14,16 @@ remapping work:
   dropped on the way are counted from the publisher's sequence numbers);
 - publishes ``pan_tilt`` (``sensor_msgs/JointState``, transient local, depth 1, re-sent every
   ``retry_period_s`` until a usable frame arrives), ``belief`` (``Float32MultiArray``) and
-  ``belief_image`` (``rgb8``) after every update and reset, ``found``
-  (``diagnostic_msgs/DiagnosticStatus``, once per search) and ``/diagnostics``; optionally
+  ``belief_image`` (``rgb8``) after every update and reset (the N cell probabilities, summing to
+  ``1 - P(absent)``), the search events ``found``, ``absent`` and ``gave_up``
+  (``diagnostic_msgs/DiagnosticStatus``, reliable) and ``/diagnostics``; optionally
   ``Float64MultiArray`` and ``JointTrajectory`` head commands on the topics their parameters name;
 - services ``~/reset`` (``std_srvs/Trigger``) and ``~/enable`` (``std_srvs/SetBool``).
+
+For a still target a decision (``found``, ``absent``) or ``gave_up`` ends the search: no new
+target is sent until ``~/reset``. With ``motion.sigma_cells`` or ``motion.jump_prob`` set (per
+second), the belief is predicted over the time between frames and the controller keeps tracking
+after ``found`` (docs/design.md section 7).
 
 Run with ``ros2 run ipomdp_gaze controller`` (or ``ipomdp-gaze controller``) and the usual
 ``--ros-args``.
@@ -32,11 +38,13 @@ from ipomdp_gaze.belief import EvidenceError
 from ipomdp_gaze.gaze import check_confidence, FrameSequence, GazeController, start_cell
 from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.health import HealthMonitor, policy_label
+from ipomdp_gaze.motion import check_probability, check_sigma_cells
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, stamps
 from ipomdp_gaze.observation import GaussianObservation
 from ipomdp_gaze.policies.baselines import STRATEGIES
 from ipomdp_gaze.policies.conv import ACTIONS, check_kernel
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnavailable
+from ipomdp_gaze.stopping import check_absent_prior, check_max_fixations
 from rclpy.exceptions import NameValidationException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -80,8 +88,19 @@ def controller_params() -> list[Param]:
               'frames kept for the node per evidence topic; 1: the newest frame wins '
               '(read-only)', read_only=True, int_range=(1, 1000)),
         Param('confidence', 0.95, T.DOUBLE,
-              'the found event fires when the most likely cell first reaches this probability',
-              float_range=(0.0, 1.0)),
+              'found (absent) fires when the most likely cell (no target) reaches this '
+              'probability', float_range=(0.0, 1.0)),
+        Param('motion.sigma_cells', 0.0, T.DOUBLE,
+              'the target moves: standard deviation of its random walk in cells per second, '
+              '>= 0 (0: a still target)'),
+        Param('motion.jump_prob', 0.0, T.DOUBLE,
+              'probability per second that the target jumps to a random cell, in [0, 1)'),
+        Param('absent.prior', 0.0, T.DOUBLE,
+              'prior that no target is in the grid, in [0, 1) (0: always there); a change '
+              'starts a new search'),
+        Param('search.max_fixations', 0, T.INTEGER,
+              'fixation budget of a search: gave_up when it runs out undecided (0: none)',
+              int_range=(0, INT_MAX)),
         Param('policy.name', 'elm', T.STRING, 'fixation policy', choices=POLICY_NAMES),
         Param('policy.file', '', T.STRING,
               'policy YAML path or shipped kernel name; setting it selects learned'),
@@ -145,12 +164,16 @@ class GazeControllerNode(Node):
         cfg = self._config
         v = cfg.values
         self.core = GazeController(cfg.grid, cfg.fpoc, cfg.policy, cfg.start_cell,
-                                   v['settle_time_s'], v['confidence'], v['seed'])
+                                   v['settle_time_s'], v['confidence'], v['seed'],
+                                   v['motion.sigma_cells'], v['motion.jump_prob'],
+                                   v['absent.prior'], v['search.max_fixations'])
 
         self._pan_tilt_pub = self.create_publisher(JointState, 'pan_tilt', STATE_QOS)
         self._belief_pub = self.create_publisher(Float32MultiArray, 'belief', 10)
         self._image_pub = self.create_publisher(Image, 'belief_image', 2)
-        self._found_pub = self.create_publisher(DiagnosticStatus, 'found', 10)
+        # Events: reliable, volatile, depth 10, so a default-QoS subscriber receives them.
+        self._event_pubs = {name: self.create_publisher(DiagnosticStatus, name, 10)
+                            for name in ('found', 'absent', 'gave_up')}
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self._forward_pub = self._trajectory_pub = None
         self._make_command_publishers(v)
@@ -176,8 +199,18 @@ class GazeControllerNode(Node):
         self._send_target()
         self.get_logger().info(
             f'{cfg.grid.rows}x{cfg.grid.cols} grid at {cfg.grid.spacing_deg} deg/cell, FPOC '
-            f'{cfg.fpoc.to_dict()}, policy {cfg.policy_label}; first fixation '
-            f'{cfg.grid.cell(self.core.fixation)}')
+            f'{cfg.fpoc.to_dict()}, policy {cfg.policy_label}; {self._model_text()}; first '
+            f'fixation {cfg.grid.cell(self.core.fixation)}')
+
+    def _model_text(self) -> str:
+        """Describe the target model and the stop rules for the log."""
+        v = self._config.values
+        motion = ('a still target' if not self.core.motion.active else
+                  f"a moving target ({v['motion.sigma_cells']} cells/s, jump "
+                  f"{v['motion.jump_prob']}/s)")
+        budget = v['search.max_fixations'] or 'no'
+        return (f"{motion}, absent prior {v['absent.prior']}, confidence {v['confidence']}, "
+                f'{budget} fixation budget')
 
     @property
     def _config(self) -> Config:
@@ -192,6 +225,10 @@ class GazeControllerNode(Node):
         head = head_from(values, grid)
         start = start_cell(grid, *row_col_from(values, grid, 'start_row', 'start_col'))
         check_confidence(values['confidence'])
+        check_sigma_cells(values['motion.sigma_cells'], 'motion.sigma_cells')
+        check_probability(values['motion.jump_prob'], 'motion.jump_prob')
+        check_absent_prior(values['absent.prior'], 'absent.prior')
+        check_max_fixations(values['search.max_fixations'], 'search.max_fixations')
         for name in ('forward_command_topic', 'trajectory_topic'):
             if values[name]:
                 try:
@@ -266,6 +303,8 @@ class GazeControllerNode(Node):
         core.set_start_cell(cfg.start_cell)
         core.set_settle_time(v['settle_time_s'])
         core.set_confidence(v['confidence'])
+        core.set_motion(v['motion.sigma_cells'], v['motion.jump_prob'])
+        core.set_max_fixations(v['search.max_fixations'])
         if v['seed'] != ov['seed']:
             core.reseed(v['seed'])
         if (v['forward_command_topic'], v['trajectory_topic']) != \
@@ -274,7 +313,10 @@ class GazeControllerNode(Node):
         if (v['retry_period_s'], v['diagnostics_period_s']) != \
                 (ov['retry_period_s'], ov['diagnostics_period_s']):
             self._make_timers(v)
-        if cfg.head != old.head and core.enabled:
+        if v['absent.prior'] != ov['absent.prior']:
+            core.set_absent_prior(v['absent.prior'])
+            return f'policy {cfg.policy_label}; {self._restart()}'
+        if cfg.head != old.head and core.enabled and not core.stopped:
             core.retarget(self._now_s())
             self._send_target()
         return f'policy {cfg.policy_label}'
@@ -327,7 +369,7 @@ class GazeControllerNode(Node):
             self._retry_timer.reset()
 
     def _on_retry(self) -> None:
-        if self.core.enabled and self._pan_tilt_msg is not None:
+        if self.core.enabled and not self.core.stopped and self._pan_tilt_msg is not None:
             self._resends += 1
             self._publish_target()
 
@@ -345,17 +387,33 @@ class GazeControllerNode(Node):
         fit = max(1, MAX_IMAGE_SIDE_PX // max(grid.rows, grid.cols))
         return min(self._config.values['belief_image_scale_px'], fit)
 
-    def _publish_found(self, found) -> None:
-        grid = self._config.grid
-        row, col = grid.cell(found.cell)
-        pan, tilt = self._config.head.angles(found.cell)
-        self._found_pub.publish(diagnostics.found_status(
-            f'{self.get_fully_qualified_name()}: found', row, col, found.cell, pan, tilt,
-            found.probability, found.fixations))
-        self.get_logger().info(
-            f'found: target most likely at ({row}, {col}), pan {pan:+.4f} rad, tilt '
-            f'{tilt:+.4f} rad, probability {found.probability:.4f} after {found.fixations} '
-            f'fixations')
+    def _publish_events(self, result) -> None:
+        """Publish and log the events a frame fired (found, absent, gave_up)."""
+        name = self.get_fully_qualified_name()
+        ending = '' if not self.core.stopped else '; the search has ended until ~/reset'
+        if result.found is not None:
+            found = result.found
+            row, col = self._config.grid.cell(found.cell)
+            pan, tilt = self._config.head.angles(found.cell)
+            self._event_pubs['found'].publish(diagnostics.found_status(
+                f'{name}: found', row, col, found.cell, pan, tilt, found.probability,
+                found.fixations))
+            self.get_logger().info(
+                f'found: target most likely at ({row}, {col}), pan {pan:+.4f} rad, tilt '
+                f'{tilt:+.4f} rad, probability {found.probability:.4f} after {found.fixations} '
+                f'fixations{ending}')
+        if result.absent is not None:
+            absent = result.absent
+            self._event_pubs['absent'].publish(diagnostics.absent_status(
+                f'{name}: absent', absent.probability, absent.fixations))
+            self.get_logger().info(f'absent: no target in the grid, probability '
+                                   f'{absent.probability:.4f} after {absent.fixations} '
+                                   f'fixations{ending}')
+        if result.gave_up is not None:
+            self._event_pubs['gave_up'].publish(diagnostics.gave_up_status(
+                f'{name}: gave_up', result.gave_up.fixations))
+            self.get_logger().warning(f'gave up: no decision after {result.gave_up.fixations} '
+                                      f'fixations (search.max_fixations){ending}')
 
     def _publish_diagnostics(self) -> None:
         self._check_publishers()
@@ -410,28 +468,31 @@ class GazeControllerNode(Node):
             return
         if not result.applied:
             return
-        self._send_target()             # first: the head can start moving while we report
+        if result.fixation is not None:
+            self._send_target()         # first: the head can start moving while we report
         self._publish_belief()
-        if result.found is not None:
-            self._publish_found(result.found)
+        self._publish_events(result)
 
-    def _on_reset(self, request, response):
+    def _restart(self) -> str:
+        """Start a new search (``~/reset``); return what happened."""
         cell = self.core.reset(self._now_s())
         self._publish_belief()
         row, col = self._config.grid.cell(cell)
-        response.success = True
         if self.core.enabled:
             self._send_target()
-            response.message = f'belief reset; looking at ({row}, {col})'
-        else:
-            response.message = f'belief reset; disabled, ({row}, {col}) is sent when enabled'
+            return f'belief reset; looking at ({row}, {col})'
+        return f'belief reset; disabled, ({row}, {col}) is sent when enabled'
+
+    def _on_reset(self, request, response):
+        response.success = True
+        response.message = self._restart()
         self.get_logger().info(response.message)
         return response
 
     def _on_enable(self, request, response):
         changed = self.core.set_enabled(request.data, self._now_s())
         state = 'enabled' if self.core.enabled else 'disabled'
-        if changed and self.core.enabled:
+        if changed and self.core.enabled and not self.core.stopped:
             self._send_target()
         response.success = True
         response.message = state if changed else f'already {state}'

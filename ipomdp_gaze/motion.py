@@ -1,0 +1,217 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+A moving target: the forward dynamics applied to the belief between fixations.
+
+Between two fixations the target takes one step of a random walk (Butko's NMPT; docs/design.md
+section 7.1). From cell ``s = (r, c)`` it moves to ``d = (r', c')`` with probability
+
+    T[s, d] = (1 - jump_prob) * G[s, d] + jump_prob / N
+    G[s, d] = g(r' - r) g(c' - c) / Z(s),   g(x) = exp(-x^2 / (2 sigma_cells^2))  for |x| <= R
+
+with ``R = ceil(3 sigma_cells)`` cells (truncation) and ``Z(s)`` the sum of ``g g`` over the cells
+of the grid that ``s`` reaches, so no mass leaves the grid. The truncation box and the grid are
+both rectangles, so ``Z(s) = Z_row(r) Z_col(c)`` and ``G = G_row (x) G_col`` (a Kronecker
+product): the prediction of a belief ``P`` (rows x cols) is ``G_row^T P G_col`` (a separable
+truncated convolution, ``O(N (rows + cols))``) and a target's step draws its row and column move
+independently. The prediction of the cell mass ``B`` is therefore
+
+    B'_d = (1 - jump_prob) * sum_s B_s G[s, d] + jump_prob * (sum_s B_s) / N
+
+and an absent hypothesis (:mod:`ipomdp_gaze.stopping`) is left alone. ``sigma_cells = 0`` and
+``jump_prob = 0`` is a target that stays put (no prediction at all).
+
+Units: ``sigma_cells`` and ``jump_prob`` are per fixation in simulation and training. In the
+nodes they are per second (:meth:`Motion.over`): a step of ``dt`` seconds is a random walk of
+variance ``sigma_cells^2 dt`` (``sigma = sigma_cells sqrt(dt)``) and jumps with probability
+``1 - (1 - jump_prob)^dt``.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .belief import normalize_log
+from .grid import Grid
+
+TRUNCATE_SIGMAS = 3.0
+ALMOST_ONE = math.nextafter(1.0, 0.0)
+
+
+def check_sigma_cells(value, name: str = 'sigma_cells') -> float:
+    """
+    Return a motion standard deviation in cells as a float.
+
+    Raises
+    ------
+    ValueError
+        Unless it is a finite number >= 0.
+
+    """
+    try:
+        sigma = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f'{name} must be a number >= 0, got {value!r}') from None
+    if not math.isfinite(sigma) or sigma < 0:
+        raise ValueError(f'{name} must be finite and >= 0, got {value!r}')
+    return sigma
+
+
+def check_probability(value, name: str) -> float:
+    """
+    Return a probability in ``[0, 1)`` (a jump probability, a prior or a rate) as a float.
+
+    Raises
+    ------
+    ValueError
+        Unless ``0 <= value < 1``: 1 would make the hypothesis certain before any evidence.
+
+    """
+    try:
+        p = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f'{name} must be a probability in [0, 1), got {value!r}') from None
+    if not 0.0 <= p < 1.0:
+        raise ValueError(f'{name} must be a probability in [0, 1), got {value!r}')
+    return p
+
+
+def axis_transition(size: int, sigma_cells: float) -> np.ndarray:
+    """
+    One axis of the Gaussian step: ``G_axis[x, x'] = g(x' - x) / sum_{x''} g(x'' - x)``.
+
+    ``g(k) = exp(-k^2 / (2 sigma^2))`` for ``|k| <= ceil(3 sigma)`` and 0 beyond; the sum runs
+    over the ``size`` positions of the axis, so each row sums to 1 (mass kept inside the grid).
+    ``sigma_cells = 0`` gives the identity.
+    """
+    sigma = check_sigma_cells(sigma_cells)
+    if sigma == 0:
+        return np.eye(size)
+    radius = math.ceil(TRUNCATE_SIGMAS * sigma)
+    x = np.arange(size)
+    offset = x[None, :] - x[:, None]
+    weights = np.where(np.abs(offset) <= radius, np.exp(-0.5 * (offset / sigma) ** 2), 0.0)
+    return weights / weights.sum(axis=1, keepdims=True)
+
+
+class Motion:
+    """
+    The target's random walk on a grid (see the module docstring for the formulas).
+
+    Parameters
+    ----------
+    grid : Grid
+        The visual array.
+    sigma_cells : float
+        Standard deviation of a step in cells (>= 0; 0 = no Gaussian step).
+    jump_prob : float
+        Probability in ``[0, 1)`` that a step is instead a jump to a uniformly random cell.
+
+    """
+
+    def __init__(self, grid: Grid, sigma_cells: float = 0.0, jump_prob: float = 0.0):
+        self.grid = grid
+        self.sigma_cells = check_sigma_cells(sigma_cells)
+        self.jump_prob = check_probability(jump_prob, 'jump_prob')
+        self.row_matrix = axis_transition(grid.rows, self.sigma_cells)
+        self.col_matrix = axis_transition(grid.cols, self.sigma_cells)
+        self._row_t = np.ascontiguousarray(self.row_matrix.T)
+        self._cdf = [self._step_cdf(m) for m in (self.row_matrix, self.col_matrix)]
+
+    def __repr__(self):
+        return f'Motion({self.grid!r}, sigma_cells={self.sigma_cells}, jump_prob={self.jump_prob})'
+
+    @property
+    def active(self) -> bool:
+        """Whether the target moves at all (otherwise prediction is the identity)."""
+        return self.sigma_cells > 0 or self.jump_prob > 0
+
+    def to_dict(self) -> dict:
+        """``{'sigma_cells': ..., 'jump_prob': ...}``."""
+        return {'sigma_cells': self.sigma_cells, 'jump_prob': self.jump_prob}
+
+    def over(self, seconds: float) -> 'Motion':
+        """
+        Return the motion over ``seconds`` when ``sigma_cells`` and ``jump_prob`` are per second.
+
+        ``sigma = sigma_cells * sqrt(seconds)`` (variance grows linearly in time) and
+        ``jump = 1 - (1 - jump_prob)^seconds``, kept just below 1 for a very long gap (the
+        belief is then uniform); ``seconds <= 0`` is no motion.
+        """
+        dt = max(0.0, float(seconds))
+        jump = min(1.0 - (1.0 - self.jump_prob) ** dt, ALMOST_ONE)
+        return Motion(self.grid, self.sigma_cells * math.sqrt(dt), jump)
+
+    # -- the belief ----------------------------------------------------------------------
+    def transition_matrix(self) -> np.ndarray:
+        """Return the dense ``T[s, d]`` (N x N, each row sums to 1); for tests and small grids."""
+        n = self.grid.n_cells
+        return (1.0 - self.jump_prob) * np.kron(self.row_matrix, self.col_matrix) \
+            + self.jump_prob / n
+
+    def predict(self, cells: np.ndarray) -> np.ndarray:
+        """
+        Predict cell mass one step ahead: ``(1 - j) * B G + j * sum(B) / N`` (new array).
+
+        Parameters
+        ----------
+        cells : array (N,) or (E, N)
+            Probabilities of the cells (their sum may be below 1 when a target may be absent).
+
+        """
+        b = np.asarray(cells, dtype=float)
+        rows, cols = self.grid.shape
+        grid_b = b.reshape(b.shape[:-1] + (rows, cols))
+        moved = np.matmul(self._row_t, np.matmul(grid_b, self.col_matrix)).reshape(b.shape)
+        if self.jump_prob:
+            mass = b.sum(axis=-1, keepdims=True)
+            moved *= 1.0 - self.jump_prob
+            moved += self.jump_prob * mass / self.grid.n_cells
+        return moved
+
+    def predict_log(self, log_belief: np.ndarray) -> np.ndarray:
+        """
+        Predict a normalised log belief in place; an absent hypothesis (column N) is not moved.
+
+        ``log_belief`` has N columns, or N + 1 with the absent hypothesis last. The step runs on
+        probabilities relative to the largest entry, so nothing underflows that is within
+        ``exp(-745)`` of it; cells that the step leaves at exactly 0 get ``-inf``. The result is
+        renormalised (the step keeps the mass; this removes round-off). Returns ``log_belief``.
+        """
+        if not self.active:
+            return log_belief
+        n = self.grid.n_cells
+        peak = np.max(log_belief, axis=-1, keepdims=True)
+        cells = np.exp(log_belief[..., :n] - peak)
+        with np.errstate(divide='ignore'):
+            log_belief[..., :n] = np.log(self.predict(cells)) + peak
+        return normalize_log(log_belief)
+
+    # -- the target ----------------------------------------------------------------------
+    @staticmethod
+    def _step_cdf(matrix: np.ndarray) -> np.ndarray:
+        cdf = np.cumsum(matrix, axis=1)
+        return cdf / cdf[:, -1:]                # the last reachable entry is exactly 1
+
+    def move(self, targets: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        """
+        Draw each target's next cell from ``T[target, .]`` (new array, shape of ``targets``).
+
+        Four uniform numbers per target, ``rng.random((E, 4))``: the row move, the column move
+        (each by its axis's inverse CDF, which is exact because ``G`` is a Kronecker product),
+        whether the step is a jump (``u < jump_prob``) and, if so, the cell ``floor(u N)``. The
+        draws do not depend on where the targets are, so every policy run on the same stream
+        sees the same target paths (common random numbers).
+        """
+        t = np.asarray(targets, dtype=np.int64)
+        u = rng.random(t.shape + (4,))
+        cols = self.grid.cols
+        r, c = np.divmod(t, cols)
+        row_cdf, col_cdf = self._cdf
+        new_r = np.sum(u[..., 0, None] > row_cdf[r], axis=-1)
+        new_c = np.sum(u[..., 1, None] > col_cdf[c], axis=-1)
+        moved = new_r * cols + new_c
+        jump_to = np.minimum((u[..., 3] * self.grid.n_cells).astype(np.int64),
+                             self.grid.n_cells - 1)
+        return np.where(u[..., 2] < self.jump_prob, jump_to, moved)

@@ -1,0 +1,159 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+A target that may be absent, and when a search stops (docs/design.md section 7).
+
+**The absent hypothesis.** Besides "the target is in cell i" (i = 0..N-1) the belief may hold
+hypothesis N, "there is no target in the grid", with prior ``absent_prior``; the cells share the
+rest, ``(1 - absent_prior) / N`` each. Under it every cell draws from the null model, so its
+log-likelihood ratio against "no target anywhere" is exactly 0 and a frame's Bayes step is the
+usual one (:func:`ipomdp_gaze.belief.bayes_update`) on the N + 1 log probabilities with a 0
+appended to the frame's terms. The N cell probabilities then sum to ``1 - P(absent)``. The motion
+step (:mod:`ipomdp_gaze.motion`) leaves the absent mass alone. With ``absent_prior = 0`` the
+belief has N entries, exactly as without this module.
+
+**Stopping.** After each frame, with the confidence level ``c``:
+
+- ``found`` when the most likely cell's probability (on the N + 1 scale) reaches ``c``;
+- ``absent`` when ``P(absent)`` reaches ``c``;
+- ``gave_up`` when the fixation budget runs out first: undecided, not an error.
+
+The decision is the most probable hypothesis that reaches ``c`` (ties to the cell, the lower
+index); for ``c > 0.5`` at most one can. If the model is right (targets absent at the prior's
+rate, moving as modelled), Bayes' rule bounds the wrong decisions: among searches that decide,
+at most ``1 - c`` are wrong (in expectation), because at the moment of a decision the decided
+hypothesis has posterior probability at least ``c``.
+"""
+from __future__ import annotations
+
+import math
+import operator
+
+import numpy as np
+
+from .belief import uniform_log_belief
+from .motion import check_probability
+
+# Decision codes of :func:`decide` and :func:`first_decisions`.
+UNDECIDED, FOUND, ABSENT = 0, 1, 2
+GAVE_UP = UNDECIDED
+DECISIONS = {FOUND: 'found', ABSENT: 'absent'}
+
+
+def check_confidence(confidence: float) -> float:
+    """
+    Return the confidence level of a decision as a float.
+
+    Raises
+    ------
+    ValueError
+        Unless ``0 < confidence < 1``.
+
+    """
+    try:
+        ok = 0 < confidence < 1
+    except TypeError:
+        ok = False
+    if not ok or not math.isfinite(confidence):
+        raise ValueError(f'confidence must be between 0 and 1 (exclusive), got {confidence!r}')
+    return float(confidence)
+
+
+def check_max_fixations(value, name: str = 'max_fixations') -> int | None:
+    """
+    Return a fixation budget: a positive integer, or None for no budget (``None`` or 0).
+
+    Raises
+    ------
+    ValueError
+        For a negative or non-integer value (the message starts with ``name``).
+
+    """
+    if value is None:
+        return None
+    try:
+        budget = operator.index(value)
+    except TypeError:
+        budget = -1
+    if budget < 0:
+        raise ValueError(f'{name} must be an integer >= 0 (0: no budget), got {value!r}')
+    return budget or None
+
+
+def check_absent_prior(value, name: str = 'absent_prior') -> float:
+    """Return ``absent_prior`` in ``[0, 1)`` (ValueError with the reason otherwise)."""
+    return check_probability(value, name)
+
+
+def initial_log_belief(n_cells: int, absent_prior: float = 0.0,
+                       episodes: int | None = None) -> np.ndarray:
+    """
+    Return the prior's log probabilities: N cells, plus the absent hypothesis when it is used.
+
+    With ``absent_prior = 0`` this is :func:`ipomdp_gaze.belief.uniform_log_belief` (N columns).
+    Otherwise the last of N + 1 columns is ``log(absent_prior)`` and each cell has
+    ``log((1 - absent_prior) / N)``.
+    """
+    prior = check_absent_prior(absent_prior)
+    if prior == 0:
+        return uniform_log_belief(n_cells, episodes)
+    shape = (n_cells + 1,) if episodes is None else (episodes, n_cells + 1)
+    log_b = np.full(shape, math.log1p(-prior) - math.log(n_cells))
+    log_b[..., n_cells] = math.log(prior)
+    return log_b
+
+
+def decide(map_probability, absent_probability, confidence: float) -> np.ndarray:
+    """
+    Return the decision code(s) after a frame: :data:`FOUND`, :data:`ABSENT` or :data:`UNDECIDED`.
+
+    Parameters
+    ----------
+    map_probability : float or array
+        Probability of the most likely cell (on the N + 1 scale).
+    absent_probability : float or array
+        ``P(absent)`` (0 without the absent hypothesis).
+    confidence : float
+        The level ``c``.
+
+    """
+    cell = np.asarray(map_probability, dtype=float)
+    absent = np.asarray(absent_probability, dtype=float)
+    found = (cell >= confidence) & (cell >= absent)
+    gone = (absent >= confidence) & (absent > cell)
+    return np.where(found, FOUND, np.where(gone, ABSENT, UNDECIDED))
+
+
+def first_decisions(map_probability: np.ndarray, absent_probability, confidence: float,
+                    max_fixations: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Return the first decision of each search and the fixations it took.
+
+    Parameters
+    ----------
+    map_probability : array (E, T)
+        Probability of the most likely cell after fixation t = 1..T of each search.
+    absent_probability : array (E, T) or None
+        ``P(absent)`` after each fixation (None: no absent hypothesis).
+    confidence : float
+        The level ``c``.
+    max_fixations : int, optional
+        The budget (default T): decisions after it do not count.
+
+    Returns
+    -------
+    kind : int array (E,)
+        :data:`FOUND`, :data:`ABSENT` or :data:`GAVE_UP` (no decision within the budget).
+    fixations : int array (E,)
+        Fixations up to and including the deciding one; the budget for ``gave_up``.
+
+    """
+    p = np.asarray(map_probability, dtype=float)
+    budget = p.shape[1] if max_fixations is None else min(int(max_fixations), p.shape[1])
+    absent = np.zeros_like(p) if absent_probability is None else np.asarray(absent_probability)
+    codes = decide(p[:, :budget], absent[:, :budget], check_confidence(confidence))
+    decided = codes != UNDECIDED
+    first = np.argmax(decided, axis=1)
+    any_decided = decided[np.arange(p.shape[0]), first]
+    kind = np.where(any_decided, codes[np.arange(p.shape[0]), first], GAVE_UP)
+    return kind, np.where(any_decided, first + 1, budget)

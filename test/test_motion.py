@@ -1,0 +1,171 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""The motion step against a dense transition matrix built cell by cell, and the target's walk."""
+import math
+
+from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.motion import axis_transition, check_probability, check_sigma_cells, Motion
+import numpy as np
+import pytest
+
+
+def dense_transition(rows, cols, sigma, jump):
+    """``T[s, d]`` from the definition: truncated 2-D Gaussian, renormalised per source, jump."""
+    n = rows * cols
+    radius = math.ceil(3 * sigma)
+    t = np.zeros((n, n))
+    for s in range(n):
+        rs, cs = divmod(s, cols)
+        for d in range(n):
+            rd, cd = divmod(d, cols)
+            if sigma == 0:
+                t[s, d] = float(s == d)
+            elif abs(rd - rs) <= radius and abs(cd - cs) <= radius:
+                t[s, d] = math.exp(-((rd - rs) ** 2 + (cd - cs) ** 2) / (2 * sigma ** 2))
+        t[s] /= t[s].sum()
+    return (1 - jump) * t + jump / n
+
+
+CASES = [(1, 1, 0.5, 0.0), (1, 6, 0.7, 0.0), (3, 4, 0.3, 0.0), (4, 3, 0.5, 0.1),
+         (5, 5, 1.0, 0.0), (5, 5, 2.5, 0.05), (6, 2, 0.0, 0.2), (7, 7, 0.4, 0.001)]
+
+
+@pytest.mark.parametrize('rows, cols, sigma, jump', CASES)
+def test_transition_matches_the_dense_definition(rows, cols, sigma, jump):
+    motion = Motion(Grid(rows, cols), sigma, jump)
+    expected = dense_transition(rows, cols, sigma, jump)
+    np.testing.assert_allclose(motion.transition_matrix(), expected, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(motion.transition_matrix().sum(axis=1), 1.0, rtol=1e-12)
+
+
+@pytest.mark.parametrize('rows, cols, sigma, jump', CASES)
+def test_prediction_is_the_belief_times_the_transition(rows, cols, sigma, jump):
+    rng = np.random.default_rng(rows * 10 + cols)
+    n = rows * cols
+    motion = Motion(Grid(rows, cols), sigma, jump)
+    t = dense_transition(rows, cols, sigma, jump)
+    cells = rng.dirichlet(np.ones(n + 1), size=4)[:, :n]         # mass below 1: absent kept out
+    np.testing.assert_allclose(motion.predict(cells), cells @ t, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(motion.predict(cells[0]), cells[0] @ t, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(motion.predict(cells).sum(axis=1), cells.sum(axis=1), rtol=1e-12)
+
+
+def test_truncation_at_ceil_three_sigma_and_edges_keep_their_mass():
+    grid = Grid(9, 9)
+    motion = Motion(grid, 0.4, 0.0)                  # ceil(1.2) = 2 cells
+    t = motion.transition_matrix()
+    centre = grid.index(4, 4)
+    row = t[centre].reshape(9, 9)
+    assert row[4, 6] > 0 and row[6, 6] > 0 and row[4, 7] == 0 and row[1, 4] == 0
+    corner = t[0].reshape(9, 9)                      # reaches only 3x3 cells: all its mass there
+    assert corner[:3, :3].sum() == pytest.approx(1.0, rel=1e-12)
+    assert np.all(corner[3:, :] == 0) and np.all(corner[:, 3:] == 0)
+    # The corner's row is the centre's kernel cut to the grid and renormalised.
+    np.testing.assert_allclose(corner[:3, :3], row[4:7, 4:7] / row[4:7, 4:7].sum(), rtol=1e-12)
+
+
+def test_jump_alone_mixes_in_the_uniform_share_of_the_cell_mass():
+    motion = Motion(Grid(3, 3), 0.0, 0.25)
+    cells = np.array([0.5, 0, 0, 0, 0.2, 0, 0, 0, 0.1])          # 0.2 absent
+    np.testing.assert_allclose(motion.predict(cells), 0.75 * cells + 0.25 * 0.8 / 9, rtol=1e-12)
+
+
+def test_still_target_is_no_prediction_at_all():
+    motion = Motion(Grid(4, 4))
+    assert not motion.active
+    log_b = np.log(np.random.default_rng(0).dirichlet(np.ones(16)))
+    before = log_b.copy()
+    assert motion.predict_log(log_b) is log_b
+    np.testing.assert_array_equal(log_b, before)
+
+
+def test_log_prediction_moves_the_cells_and_leaves_the_absent_mass():
+    rng = np.random.default_rng(5)
+    grid = Grid(4, 5)
+    motion = Motion(grid, 0.8, 0.05)
+    p = rng.dirichlet(np.ones(21), size=3)
+    log_b = np.log(p)
+    motion.predict_log(log_b)
+    np.testing.assert_allclose(np.exp(log_b[:, :20]), motion.predict(p[:, :20]), rtol=1e-12)
+    np.testing.assert_allclose(np.exp(log_b[:, 20]), p[:, 20], rtol=1e-12)
+
+
+def test_log_prediction_of_a_certain_belief_and_of_zero_cells():
+    grid = Grid(5, 5)
+    log_b = np.full(25, -np.inf)
+    log_b[12] = 0.0
+    Motion(grid, 0.3, 0.0).predict_log(log_b)        # reaches the 3x3 block only
+    b = np.exp(log_b).reshape(5, 5)
+    assert b.sum() == pytest.approx(1.0) and np.all(b[1:4, 1:4] > 0)
+    assert np.all(np.isneginf(log_b.reshape(5, 5)[0]))
+
+
+def test_walk_of_the_target_follows_the_transition_rows():
+    grid = Grid(4, 5)
+    motion = Motion(grid, 0.9, 0.1)
+    t = motion.transition_matrix()
+    draws = 200_000
+    for start in (0, 7, 19):
+        moved = motion.move(np.full(draws, start), np.random.default_rng(start))
+        freq = np.bincount(moved, minlength=20) / draws
+        se = np.sqrt(t[start] * (1 - t[start]) / draws)
+        assert np.all(np.abs(freq - t[start]) <= 5 * se + 1e-12), start
+
+
+def test_walk_draws_do_not_depend_on_the_positions():
+    motion = Motion(Grid(6, 6), 0.7, 0.3)
+    a = motion.move(np.zeros(1000, int), np.random.default_rng(1))
+    b = motion.move(np.full(1000, 35), np.random.default_rng(1))
+    u = np.random.default_rng(1).random((1000, 4))
+    jumped = u[:, 2] < 0.3
+    np.testing.assert_array_equal(a[jumped], b[jumped])
+    np.testing.assert_array_equal(a[jumped], (u[jumped, 3] * 36).astype(int))
+    # Without a jump the row move comes from u[:, 0] alone: a smaller draw never moves further.
+    rows = a[~jumped] // 6
+    order = np.argsort(u[~jumped, 0])
+    assert np.all(np.diff(rows[order]) >= 0)
+
+
+def test_walk_stays_on_the_grid_at_the_edges():
+    grid = Grid(3, 7)
+    moved = Motion(grid, 3.0, 0.0).move(np.array([0, 6, 14, 20] * 5000),
+                                        np.random.default_rng(2))
+    assert moved.min() >= 0 and moved.max() < 21
+    assert set(np.unique(moved)) == set(range(21))
+
+
+def test_per_second_motion_scales_with_elapsed_time():
+    motion = Motion(Grid(5, 5), 0.6, 0.2)
+    half = motion.over(0.25)
+    assert half.sigma_cells == pytest.approx(0.3)
+    assert half.jump_prob == pytest.approx(1 - 0.8 ** 0.25)
+    assert motion.over(1.0).sigma_cells == pytest.approx(0.6)
+    assert not motion.over(0.0).active and not motion.over(-1.0).active
+    # A very long gap (a clock jump): the jump probability saturates below 1, the belief is
+    # then uniform over the cells and the absent mass is kept.
+    far = motion.over(1e9)
+    assert far.jump_prob < 1.0
+    log_b = np.log(np.append(np.full(25, 0.6 / 25) * np.linspace(0.1, 1.9, 25), 0.4))
+    far.predict_log(log_b)
+    np.testing.assert_allclose(np.exp(log_b), np.append(np.full(25, 0.6 / 25), 0.4), rtol=1e-9)
+
+
+def test_axis_matrix_rows_sum_to_one_and_zero_sigma_is_identity():
+    np.testing.assert_allclose(axis_transition(8, 1.3).sum(axis=1), 1.0)
+    np.testing.assert_array_equal(axis_transition(4, 0.0), np.eye(4))
+
+
+@pytest.mark.parametrize('value', [-0.1, float('nan'), float('inf'), 'x', None])
+def test_bad_sigma_is_refused_with_a_reason(value):
+    with pytest.raises(ValueError, match='sigma_cells must be'):
+        check_sigma_cells(value)
+    with pytest.raises(ValueError, match='sigma_cells must be'):
+        Motion(Grid(3, 3), value)
+
+
+@pytest.mark.parametrize('value', [-0.01, 1.0, 1.5, float('nan'), 'x'])
+def test_bad_probability_is_refused_with_a_reason(value):
+    with pytest.raises(ValueError, match=r'jump_prob must be a probability in \[0, 1\)'):
+        check_probability(value, 'jump_prob')
+    with pytest.raises(ValueError, match='jump_prob must be a probability'):
+        Motion(Grid(3, 3), 0.5, value)
