@@ -103,8 +103,8 @@ def from_multiarray(msg, grid: Grid) -> np.ndarray:
     return values.astype(np.float64)
 
 
-def ground_truth(grid: Grid, cell: int) -> Int32MultiArray:
-    """Build the simulated camera's ground truth: ``data = [row, col]``."""
+def row_col(grid: Grid, cell: int) -> Int32MultiArray:
+    """Build an ``Int32MultiArray`` ``[row, col]`` of a cell (``fixation``, ``ground_truth``)."""
     row, col = grid.cell(cell)
     msg = Int32MultiArray(layout=MultiArrayLayout(
         dim=[MultiArrayDimension(label='row_col', size=2, stride=2)], data_offset=0))
@@ -112,9 +112,14 @@ def ground_truth(grid: Grid, cell: int) -> Int32MultiArray:
     return msg
 
 
-def cell_from_ground_truth(msg, grid: Grid) -> int:
+def ground_truth(grid: Grid, cell: int) -> Int32MultiArray:
+    """Build a camera's ground truth: ``data = [row, col]`` of the target's cell."""
+    return row_col(grid, cell)
+
+
+def cell_from_row_col(msg, grid: Grid, what: str = 'a cell') -> int:
     """
-    Return the cell index of a ground-truth ``[row, col]`` message.
+    Return the cell index of an ``Int32MultiArray`` ``[row, col]`` (``what`` names it).
 
     Raises
     ------
@@ -124,9 +129,14 @@ def cell_from_ground_truth(msg, grid: Grid) -> int:
     """
     data = list(msg.data)
     if len(data) != 2:
-        raise ValueError(f'ground truth must be [row, col], got {data}')
+        raise ValueError(f'{what} must be [row, col], got {data}')
     row, col = data
     if not (0 <= row < grid.rows and 0 <= col < grid.cols):
-        raise ValueError(f'ground truth ({row}, {col}) is outside the '
+        raise ValueError(f'{what} ({row}, {col}) is outside the '
                          f'{grid.rows}x{grid.cols} grid')
     return grid.index(row, col)
+
+
+def cell_from_ground_truth(msg, grid: Grid) -> int:
+    """Return the cell index of a ground-truth ``[row, col]`` message (see above)."""
+    return cell_from_row_col(msg, grid, 'ground truth')
