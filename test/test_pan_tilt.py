@@ -118,8 +118,8 @@ def test_the_observer_bins_box_centres_with_the_head_pose_and_k():
     assert box_centres_uv(boxes)[0] == pytest.approx((159.5, 119.5))
     assert obs.counts[PAN_TILT_GRID.index(2, 3)] == 1
     assert obs.counts[PAN_TILT_GRID.index(2, 4)] == 1
-    np.testing.assert_array_equal(np.isnan(obs.counts), ~observed_cells(CAMERA, PAN_TILT_GRID,
-                                                                          (2, 3)))
+    seen = observed_cells(CAMERA, PAN_TILT_GRID, (2, 3))
+    np.testing.assert_array_equal(np.isnan(obs.counts), ~seen)
     assert obs.detector_pixels == 320 * 240
     with pytest.raises(ValueError, match='camera_info says 320x240'):
         observer.observe(np.zeros((100, 120), np.uint8), CAMERA, (2, 3))

@@ -16,8 +16,8 @@ fixation and counts its detections, and :mod:`msg_adapters` reads and fills ever
 
 Relative topic names:
 
-- subscribes ``image`` (``sensor_msgs/Image``: ``mono8``, ``rgb8`` or ``bgr8``; best effort,
-  the newest wins), ``camera_info`` (``sensor_msgs/CameraInfo``, ``camera`` mode),
+- subscribes ``image`` (``sensor_msgs/Image``: ``mono8``, ``rgb8`` or ``bgr8``; reliable, or
+  best effort with ``image_best_effort``; depth 1: the newest wins), ``camera_info`` (``sensor_msgs/CameraInfo``, ``camera`` mode),
   ``joint_states`` (``sensor_msgs/JointState``, ``camera`` mode) and ``fixation``
   (``std_msgs/Int32MultiArray`` ``[row, col]``, transient local: the controller's);
 - publishes ``evidence_image`` (``32FC1``, stamped with the image's capture stamp; NaN = not
@@ -47,6 +47,10 @@ from .spin import run_node
 
 NODE_NAME = NODE_NAMES['detector']
 SENSOR_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT)
+# Images are large: over best effort, Fast DDS drops a whole image when one fragment is lost,
+# so the subscription is reliable unless the driver only publishes best effort.
+IMAGE_QOS = {False: QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE),
+             True: SENSOR_QOS}
 FRAME_QOS = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
 STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                        durability=DurabilityPolicy.TRANSIENT_LOCAL)
@@ -86,6 +90,10 @@ def detector_params() -> list[Param]:
         Param('joint_state_tolerance_s', 0.0, T.DOUBLE,
               'camera mode: pair an image with a joint state stamped at most this far from it '
               '(0: the same stamp)', float_range=(0.0, 1.0)),
+        Param('image_best_effort', False, T.BOOL,
+              'subscribe image best effort, for a driver that publishes it so (default '
+              'reliable: large images lose fragments over best effort; read-only)',
+              read_only=True),
         Param('publish_image', True, T.BOOL,
               'publish stamped 32FC1 evidence_image frames (false: evidence)'),
         Param('max_image_side_px', images.MAX_IMAGE_SIDE_PX, T.INTEGER,
@@ -133,7 +141,8 @@ class FovealDetectorNode(Node):
         self._evidence_pub = self.create_publisher(Float32MultiArray, 'evidence', FRAME_QOS)
         self._image_pub = self.create_publisher(Image, 'evidence_image', FRAME_QOS)
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
-        self.create_subscription(Image, 'image', self._on_image, SENSOR_QOS)
+        self.create_subscription(Image, 'image', self._on_image,
+                                 IMAGE_QOS[v['image_best_effort']])
         self.create_subscription(Int32MultiArray, 'fixation', self._on_fixation, STATE_QOS)
         if cfg.setup.mode == 'camera':
             self.create_subscription(CameraInfo, 'camera_info', self._on_camera_info,
