@@ -150,7 +150,7 @@ def _bad_images():
     from sensor_msgs.msg import Image
     good = dict(height=30, width=40, encoding='rgb8', step=120, data=bytes(3600))
     cases = [
-        ({'encoding': '16UC1', 'step': 80, 'data': bytes(2400)}, "unsupported image encoding"),
+        ({'encoding': '16UC1', 'step': 80, 'data': bytes(2400)}, "unsupported image encoding '16UC1'"),
         ({'encoding': 'rgba8', 'step': 160, 'data': bytes(4800)}, 'unsupported image encoding'),
         ({'step': 100, 'data': bytes(3000)}, 'step 100 is less than width 40 x 3'),
         ({'data': bytes(3599)}, 'image data has 3599 bytes, expected step 120 x height 30'),
@@ -223,8 +223,7 @@ def test_camera_mode_waits_for_camera_info_with_a_warning(camera):
 
 
 @pytest.mark.parametrize('seed, offset', [(5, (0, 0)), (6, (1, -1)), (9, (-1, 1))])
-def test_camera_mode_bins_a_face_to_its_cell_and_the_rest_of_the_grid_is_nan(camera, seed,
-                                                                              offset):
+def test_camera_mode_bins_a_face_to_its_cell_and_the_rest_is_nan(camera, seed, offset):
     from ipomdp_gaze.head_camera import observed_cells
     from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, SceneGeometry, shipped_camera
     grid = camera.grid
