@@ -155,8 +155,14 @@ def _started(watch, record, node: str):
 
 
 def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = None,
-             verbose: bool = False, out=print) -> int:
-    """Run the demo; 0 when the target was found and every node stopped cleanly."""
+             verbose: bool = False, out=print, stats: dict | None = None) -> int:
+    """
+    Run the demo; 0 when the target was found and every node stopped cleanly.
+
+    ``stats``, when given, is filled with the ``found`` event's values (``row``, ``col``,
+    ``fixations``, ...), ``truth`` (the ground-truth ``(row, col)``), ``right`` and
+    ``search_s``: seconds from starting the last node to the ``found`` event.
+    """
     domain = domain_id_for() if domain_id is None else domain_id
     with isolated_nodes(domain, prefix='ipomdp-gaze-demo-') as nodes:
         procs = [nodes.add(node, args) for node, args in setup.nodes]
@@ -175,11 +181,14 @@ def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = 
         status = 1
         try:
             for proc in procs:
+                started = time.monotonic()
                 proc.start()
                 ready = _started(watch, record, proc.node)
                 if proc is not procs[-1] and ready is not None and not wait(ready):
                     raise RuntimeError(f'{proc.name} did not come up in time')
-            status = _follow(setup, record, wait, timeout_s, out)
+            status = _follow(setup, record, wait, timeout_s, out, stats)
+            if stats is not None and record.found:
+                stats['search_s'] = record.found[0][0] - started
         except RuntimeError as exc:
             out(f'ipomdp-gaze demo: error: {exc}')
         finally:
@@ -208,7 +217,8 @@ def _where(setup: DemoSetup, cell: int) -> str:
     return f'pan {math.degrees(pan):+6.2f} deg  tilt {math.degrees(tilt):+6.2f} deg'
 
 
-def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out) -> int:
+def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
+            stats: dict | None = None) -> int:
     """Print fixations until the found event; return 0 once the answer was checked."""
     grid, head = setup.grid, setup.head
     printed = 0
@@ -253,6 +263,8 @@ def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out)
     truth = grid_arrays.cell_from_ground_truth(record.truth[-1][1], grid)
     (tr, tc), (fr, fc) = grid.cell(truth), (found['row'], found['col'])
     right = max(abs(tr - fr), abs(tc - fc)) <= setup.tolerance_cells
+    if stats is not None:
+        stats.update(found, truth=(tr, tc), right=right)
     verdict = 'right' if right else 'wrong'
     if setup.scene == 'faces':
         out(f'the scene camera put the face centre in cell {grid.cell(truth)}: that is '
