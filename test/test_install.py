@@ -18,9 +18,9 @@ every module of the copy must import from the install (never from this checkout)
 top-level names ``policies`` and ``msg_adapters`` must not be importable, the shipped kernels
 must resolve, the installed ``controller`` and ``camera`` must talk over real DDS and shut
 down cleanly on SIGTERM, and so must the installed ``scene_camera`` and ``detector`` (which
-find the shipped face model and the Haar cascade from the install). The colcon nodes are started the way ``ros2 run`` does: after sourcing
-``install/setup.bash``, look the package up in the ament index and execute
-``<prefix>/lib/ipomdp_gaze/<executable>``.
+find the shipped face model and the Haar cascade from the install). The colcon nodes are
+started the way ``ros2 run`` does: after sourcing ``install/setup.bash``, look the package up
+in the ament index and execute ``<prefix>/lib/ipomdp_gaze/<executable>``.
 """
 from dataclasses import dataclass
 import json

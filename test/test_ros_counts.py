@@ -112,8 +112,8 @@ def test_an_observation_file_for_another_grid_is_refused(probe, nodes, detector)
     for args, words in (
             (['-p', 'observation.model:=counts', '-p', 'observation.file:=faces-420'],
              "'faces-420' is a count model for a 21x21 grid, not this 11x11 grid"),
-            (['-p', 'observation.model:=counts'], 'observation.model counts needs '
-                                                   'observation.file'),
+            (['-p', 'observation.model:=counts'],
+             'observation.model counts needs observation.file'),
             (['-p', 'observation.model:=counts', '-p', 'observation.file:=faces-pan-tilt',
               '-p', 'grid.spacing_deg:=4.0'], 'calibrated on a pan/tilt grid of 5.0 deg/cell')):
         # In a namespace the file's gaze_controller block does not apply: the defaults do.

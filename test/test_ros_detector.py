@@ -148,9 +148,10 @@ def test_an_image_taken_before_the_fixation_does_not_serve_it(fovea):
 
 def _bad_images():
     from sensor_msgs.msg import Image
-    good = dict(height=30, width=40, encoding='rgb8', step=120, data=bytes(3600))
+    good = {'height': 30, 'width': 40, 'encoding': 'rgb8', 'step': 120, 'data': bytes(3600)}
     cases = [
-        ({'encoding': '16UC1', 'step': 80, 'data': bytes(2400)}, "unsupported image encoding '16UC1'"),
+        ({'encoding': '16UC1', 'step': 80, 'data': bytes(2400)},
+         "unsupported image encoding '16UC1'"),
         ({'encoding': 'rgba8', 'step': 160, 'data': bytes(4800)}, 'unsupported image encoding'),
         ({'step': 100, 'data': bytes(3000)}, 'step 100 is less than width 40 x 3'),
         ({'data': bytes(3599)}, 'image data has 3599 bytes, expected step 120 x height 30'),

@@ -17,9 +17,10 @@ fixation and counts its detections, and :mod:`msg_adapters` reads and fills ever
 Relative topic names:
 
 - subscribes ``image`` (``sensor_msgs/Image``: ``mono8``, ``rgb8`` or ``bgr8``; reliable, or
-  best effort with ``image_best_effort``; depth 1: the newest wins), ``camera_info`` (``sensor_msgs/CameraInfo``, ``camera`` mode),
-  ``joint_states`` (``sensor_msgs/JointState``, ``camera`` mode) and ``fixation``
-  (``std_msgs/Int32MultiArray`` ``[row, col]``, transient local: the controller's);
+  best effort with ``image_best_effort``; depth 1: the newest wins), ``camera_info``
+  (``sensor_msgs/CameraInfo``, ``camera`` mode), ``joint_states`` (``sensor_msgs/JointState``,
+  ``camera`` mode) and ``fixation`` (``std_msgs/Int32MultiArray`` ``[row, col]``, transient
+  local: the controller's);
 - publishes ``evidence_image`` (``32FC1``, stamped with the image's capture stamp; NaN = not
   observed) or, with ``publish_image: false``, ``evidence``; and ``/diagnostics``.
 
