@@ -80,7 +80,7 @@ def add_parser(sub):
                    help='--pan-tilt: face sides in scene pixels (default 30,70)')
     p.add_argument('--null-scenes', type=nonneg_int, default=None, metavar='M',
                    help='--pan-tilt: the first M scenes are viewed from every pose (null '
-                        'tables); the others only from poses that see the face (default 25)')
+                        'tables); the others only from poses that see the face (default 40)')
     p.add_argument('--windows', type=_numbers(int), default=None, metavar='W,...',
                    help='fovea window sides in cells, largest first (default 21,15,9,3)')
     p.add_argument('--scales', type=_numbers(float), default=None, metavar='S,...',
@@ -230,7 +230,7 @@ def run_pan_tilt(args) -> int:
     face_px = tuple(args.face_px) if args.face_px else FACE_PX
     if len(face_px) != 2:
         raise ValueError(f'--face-px must be MIN,MAX, got {args.face_px}')
-    null_scenes = min(25 if args.null_scenes is None else args.null_scenes, args.scenes)
+    null_scenes = min(40 if args.null_scenes is None else args.null_scenes, args.scenes)
     scenes = PanTiltSceneSet('train', geometry, face_px, 'rgb', args.seed)
     detector_kwargs = {'scale_factor': args.scale_factor}
     detector = HaarDetector(**detector_kwargs)
