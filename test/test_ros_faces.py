@@ -62,3 +62,20 @@ def test_three_nodes_find_the_face_and_stop(ros_env, options, mode, where):
     assert 'stopped all 3 nodes (scene_camera exit status 0, detector exit status 0, ' \
            'controller exit status 0)' in out
     assert node_processes(domain) == []
+
+
+def test_without_a_confident_cell_the_demo_answers_with_the_most_likely_one(ros_env):
+    domain = int(ros_env['ROS_DOMAIN_ID'])
+    run = subprocess.run(
+        [sys.executable, '-m', 'ipomdp_gaze.cli', 'demo', '--scene', 'faces', '--fovea',
+         '--seed', '12', '--max-fixations', '4', '--domain-id', str(domain)], cwd=REPO,
+        env=ros_env, capture_output=True, text=True, timeout=180)
+    out = run.stdout
+    assert run.returncode == 0, out + run.stderr
+    assert len(FIXATION.findall(out)) == 4
+    gave_up = re.search(r'^gave up: no cell reached the confidence after 4 fixations; the face '
+                        r'is most likely at \((\d+), (\d+)\), pixel .*, probability (\d\.\d+), '
+                        r'after 4 fixations$', out, re.M)
+    assert gave_up and float(gave_up.group(3)) < 0.999, out
+    assert VERDICT.search(out) and 'found:' not in out
+    assert 'stopped all 3 nodes' in out and node_processes(domain) == []

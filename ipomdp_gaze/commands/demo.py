@@ -12,7 +12,7 @@ and the digital fovea. The offline, ROS-free search is ``ipomdp-gaze search``.
 """
 from __future__ import annotations
 
-from .common import nonneg_int, positive_float
+from .common import nonneg_int, positive_float, positive_int
 
 
 def add_parser(sub):
@@ -40,6 +40,9 @@ def add_parser(sub):
                         '--scene faces, which held-out test scene')
     p.add_argument('--target', default=None, metavar='ROW,COL',
                    help='where the camera hides the target (default: random)')
+    p.add_argument('--max-fixations', type=positive_int, default=60, metavar='N',
+                   help='without a found event after N fixations, answer with the most likely '
+                        'cell (default 60)')
     p.add_argument('--timeout', type=positive_float, default=60.0,
                    help='give up after this many seconds (default 60)')
     p.add_argument('--domain-id', type=int, default=None,
@@ -76,4 +79,5 @@ def run(args) -> int:
             raise ValueError('--fovea goes with --scene faces')
         setup = demo_setup(args.fpoc or 'camera', args.policy, args.seed,
                            parse_target(args.target))
-    return run_demo(setup, args.timeout, args.domain_id, args.verbose, out)
+    return run_demo(setup, args.timeout, args.domain_id, args.verbose, out,
+                    max_fixations=args.max_fixations)

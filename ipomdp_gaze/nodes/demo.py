@@ -155,13 +155,17 @@ def _started(watch, record, node: str):
 
 
 def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = None,
-             verbose: bool = False, out=print, stats: dict | None = None) -> int:
+             verbose: bool = False, out=print, stats: dict | None = None,
+             max_fixations: int = 60) -> int:
     """
-    Run the demo; 0 when the target was found and every node stopped cleanly.
+    Run the demo; 0 when an answer was judged in time and every node stopped cleanly.
 
-    ``stats``, when given, is filled with the ``found`` event's values (``row``, ``col``,
-    ``fixations``, ...), ``truth`` (the ground-truth ``(row, col)``), ``right`` and
-    ``search_s``: seconds from starting the last node to the ``found`` event.
+    The answer is the ``found`` event's cell or, when no cell reached the controller's
+    confidence after ``max_fixations`` fixations, the most likely cell then. ``stats``, when
+    given, is filled with the answer (``row``, ``col``, ``cell``, ``probability``,
+    ``fixations``), ``stop`` (``found``, ``budget`` or ``timeout``), ``truth`` (the ground
+    truth's ``(row, col)``), ``right`` and ``search_s``: seconds from starting the last node to
+    the belief of the answer's last fixation.
     """
     domain = domain_id_for() if domain_id is None else domain_id
     with isolated_nodes(domain, prefix='ipomdp-gaze-demo-') as nodes:
@@ -186,9 +190,9 @@ def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = 
                 ready = _started(watch, record, proc.node)
                 if proc is not procs[-1] and ready is not None and not wait(ready):
                     raise RuntimeError(f'{proc.name} did not come up in time')
-            status = _follow(setup, record, wait, timeout_s, out, stats)
-            if stats is not None and record.found:
-                stats['search_s'] = record.found[0][0] - started
+            status = _follow(setup, record, wait, timeout_s, out, stats, max_fixations)
+            if stats is not None and stats.get('fixations'):
+                stats['search_s'] = record.beliefs[stats['fixations'] - 1][0] - started
         except RuntimeError as exc:
             out(f'ipomdp-gaze demo: error: {exc}')
         finally:
@@ -217,17 +221,38 @@ def _where(setup: DemoSetup, cell: int) -> str:
     return f'pan {math.degrees(pan):+6.2f} deg  tilt {math.degrees(tilt):+6.2f} deg'
 
 
+def _answer(setup: DemoSetup, row: int, col: int, cell: int, probability: float,
+            fixations: int) -> str:
+    """Say where the answer is and how sure: ``(row, col), <where>, probability p, after n``."""
+    if setup.scene == 'faces':
+        place = ' '.join(_where(setup, cell).split())
+    else:
+        pan, tilt = setup.head.angles(cell)
+        place = f'pan {math.degrees(pan):+.2f} deg, tilt {math.degrees(tilt):+.2f} deg'
+    return (f'({row}, {col}), {place}, probability {probability:.3f}, after {fixations} '
+            f'fixations')
+
+
 def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
-            stats: dict | None = None) -> int:
-    """Print fixations until the found event; return 0 once the answer was checked."""
+            stats: dict | None = None, max_fixations: int = 60) -> int:
+    """
+    Print fixations until the found event (or ``max_fixations``); judge the answer.
+
+    Without a found event after ``max_fixations`` fixations (or at the deadline), the answer is
+    the most likely cell of the last belief. Returns 0 once an answer was judged before the
+    deadline, else 1.
+    """
     grid, head = setup.grid, setup.head
     printed = 0
 
+    def last() -> int:
+        if record.found:
+            return diagnostics.parse_found(record.found[0][1])['fixations']
+        return max_fixations
+
     def show_new():
         nonlocal printed
-        last = diagnostics.parse_found(record.found[0][1])['fixations'] if record.found \
-            else math.inf
-        while printed < min(len(record.beliefs), len(record.targets), last):
+        while printed < min(len(record.beliefs), len(record.targets), last()):
             belief = grid_arrays.from_multiarray(record.beliefs[printed][1], grid)
             pan, tilt = joints.angles_from_joint_state(record.targets[printed][1], head)
             looked = head.nearest_cell(pan, tilt)
@@ -239,36 +264,42 @@ def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
 
     def finished():
         show_new()
-        return bool(record.found) and \
-            printed >= diagnostics.parse_found(record.found[0][1])['fixations']
+        return printed >= last()
 
     what = 'face' if setup.scene == 'faces' else 'target'
-    if not wait(finished):
+    in_time = wait(finished)
+    if record.found and printed >= last():
+        found = diagnostics.parse_found(record.found[0][1])
+        answer, stop = (found['row'], found['col'], found['cell']), 'found'
+        out(f'found: the {what} is most likely at '
+            + _answer(setup, *answer, found['probability'], found['fixations']))
+    elif printed == 0:
         out(f'ipomdp-gaze demo: the {what} was not found within {timeout_s:g} s')
         return 1
-    found = diagnostics.parse_found(record.found[0][1])
-    if setup.scene == 'faces':
-        place = ' '.join(_where(setup, found['cell']).split())
-        out(f"found: the face is most likely at ({found['row']}, {found['col']}), {place}, "
-            f"probability {found['probability']:.3f}, after {found['fixations']} fixations")
     else:
-        out(f"found: the target is most likely at ({found['row']}, {found['col']}), pan "
-            f"{math.degrees(found['pan_rad']):+.2f} deg, tilt "
-            f"{math.degrees(found['tilt_rad']):+.2f} deg, probability "
-            f"{found['probability']:.3f}, after {found['fixations']} fixations")
+        belief = grid_arrays.from_multiarray(record.beliefs[printed - 1][1], grid)
+        cell = int(np.argmax(belief))
+        answer = (*grid.cell(cell), cell)
+        found = {'row': answer[0], 'col': answer[1], 'cell': cell, 'fixations': printed,
+                 'probability': float(belief[cell])}
+        stop = 'budget' if in_time else 'timeout'
+        why = f'after {max_fixations} fixations' if in_time else \
+            f'within {timeout_s:g} s'
+        out(f'gave up: no cell reached the confidence {why}; the {what} is most likely at '
+            + _answer(setup, *answer, float(belief[cell]), printed))
     camera = 'scene camera' if setup.scene == 'faces' else 'simulated camera'
     if not wait(lambda: record.truth):
         out(f'ipomdp-gaze demo: the {camera} did not report where the {what} is')
         return 1
     truth = grid_arrays.cell_from_ground_truth(record.truth[-1][1], grid)
-    (tr, tc), (fr, fc) = grid.cell(truth), (found['row'], found['col'])
+    (tr, tc), (fr, fc) = grid.cell(truth), answer[:2]
     right = max(abs(tr - fr), abs(tc - fc)) <= setup.tolerance_cells
     if stats is not None:
-        stats.update(found, truth=(tr, tc), right=right)
+        stats.update(found, truth=(tr, tc), right=right, stop=stop)
     verdict = 'right' if right else 'wrong'
     if setup.scene == 'faces':
         out(f'the scene camera put the face centre in cell {grid.cell(truth)}: that is '
             f'{verdict}')
     else:
         out(f'the simulated camera hid the target at {grid.cell(truth)}: that is {verdict}')
-    return 0
+    return 0 if stop != 'timeout' else 1
