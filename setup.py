@@ -49,6 +49,8 @@ setup(
             'ipomdp-gaze = ipomdp_gaze.cli:main',
             'controller = ipomdp_gaze.nodes.controller:main',
             'camera = ipomdp_gaze.nodes.camera:main',
+            'detector = ipomdp_gaze.nodes.detector:main',
+            'scene_camera = ipomdp_gaze.nodes.scene_camera:main',
         ],
     },
 )

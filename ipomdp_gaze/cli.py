@@ -15,7 +15,8 @@ import importlib
 import sys
 
 # Modules under ipomdp_gaze.commands, in the order --help lists their subcommands: evaluate,
-# search, find, train, calibrate, reproduce, demo, then controller and camera (both from nodes).
+# search, find, train, calibrate, reproduce, demo, then the nodes: controller, camera, detector
+# and scene_camera.
 COMMANDS = ('evaluate', 'search', 'find', 'train', 'calibrate', 'reproduce', 'demo', 'nodes')
 
 

@@ -6,8 +6,9 @@ The gaze controller's brain, without ROS: belief, frame acceptance, policy and f
 :class:`GazeController` is what the ``gaze_controller`` node wraps. It holds the belief over the
 target's cell and the current fixation, and decides what to do with every frame of evidence:
 
-- a frame that cannot be used (wrong length, +/-inf; the node adds layout errors through
-  :meth:`GazeController.reject`) is *rejected* and the belief is unchanged;
+- a frame that cannot be used (wrong length, +/-inf; with a count model also a negative or
+  fractional count; the node adds layout errors through :meth:`GazeController.reject`) is
+  *rejected* and the belief is unchanged; counts above ``K - 1`` are clipped, not refused;
 - while disabled, or before ``settle_time_s`` has passed since the current target was sent
   (a frame taken mid-saccade), a valid frame is *skipped*;
 - otherwise it is *applied*: one frame per fixation (the model assumes independent noise per
@@ -42,7 +43,7 @@ import numpy as np
 from .belief import bayes_update, entropy, EvidenceError, map_cell
 from .grid import Grid
 from .motion import Motion
-from .observation import as_observation, check_evidence
+from .observation import as_observation, check_evidence, CountObservation
 from .stopping import (ABSENT, check_absent_prior, check_confidence, check_max_fixations, decide,
                        FOUND, initial_log_belief)
 
@@ -359,6 +360,8 @@ class GazeController:
         """
         try:
             obs = check_evidence(evidence, self.grid.n_cells)
+            if isinstance(self.observation, CountObservation):
+                self.observation.counts(obs)    # negative or fractional counts: invalid frame
         except EvidenceError as exc:
             return self.reject(str(exc))
         self.received += 1

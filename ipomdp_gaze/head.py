@@ -81,14 +81,27 @@ class PanTiltMap:
             return pan, tilt
         return float(pan), float(tilt)
 
-    def nearest_cell(self, pan_rad: float, tilt_rad: float) -> int:
-        """Return the cell whose pan/tilt is nearest (snapped and clipped to the grid)."""
+    def position(self, pan_rad: float, tilt_rad: float) -> tuple[float, float]:
+        """
+        Return the head's ``(row, col)`` on the grid, not rounded: the inverse of :meth:`angles`.
+
+        Raises
+        ------
+        ValueError
+            If an angle is not finite.
+
+        """
         col = (self.grid.cols - 1) / 2 - (pan_rad - self.pan_offset_rad) / (
             self.pan_sign * self.spacing_rad)
         row = (self.grid.rows - 1) / 2 + (tilt_rad - self.tilt_offset_rad) / (
             self.tilt_sign * self.spacing_rad)
         if not (math.isfinite(col) and math.isfinite(row)):
             raise ValueError(f'pan/tilt must be finite, got {pan_rad!r}, {tilt_rad!r}')
+        return float(row), float(col)
+
+    def nearest_cell(self, pan_rad: float, tilt_rad: float) -> int:
+        """Return the cell whose pan/tilt is nearest (snapped and clipped to the grid)."""
+        row, col = self.position(pan_rad, tilt_rad)
         row = int(np.clip(np.floor(row + 0.5), 0, self.grid.rows - 1))
         col = int(np.clip(np.floor(col + 0.5), 0, self.grid.cols - 1))
         return self.grid.index(row, col)

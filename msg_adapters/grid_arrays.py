@@ -103,8 +103,8 @@ def from_multiarray(msg, grid: Grid) -> np.ndarray:
     return values.astype(np.float64)
 
 
-def ground_truth(grid: Grid, cell: int | None) -> Int32MultiArray:
-    """Build the simulated camera's ground truth: ``data = [row, col]``, ``[-1, -1]`` if empty."""
+def row_col(grid: Grid, cell: int | None) -> Int32MultiArray:
+    """Build an ``Int32MultiArray`` ``[row, col]`` of a cell (``fixation``, ``ground_truth``)."""
     row, col = (-1, -1) if cell is None else grid.cell(cell)
     msg = Int32MultiArray(layout=MultiArrayLayout(
         dim=[MultiArrayDimension(label='row_col', size=2, stride=2)], data_offset=0))
@@ -112,23 +112,36 @@ def ground_truth(grid: Grid, cell: int | None) -> Int32MultiArray:
     return msg
 
 
-def cell_from_ground_truth(msg, grid: Grid) -> int | None:
+def ground_truth(grid: Grid, cell: int | None) -> Int32MultiArray:
+    """Build a camera's ground truth: ``data = [row, col]``, ``[-1, -1]`` for an empty scene."""
+    return row_col(grid, cell)
+
+
+def cell_from_row_col(msg, grid: Grid, what: str = 'a cell',
+                      allow_empty: bool = False) -> int | None:
     """
-    Return the cell index of a ground-truth ``[row, col]`` message (None for an empty scene).
+    Return the cell index of an ``Int32MultiArray`` ``[row, col]`` (``what`` names it).
+
+    With ``allow_empty``, ``[-1, -1]`` (no target) gives None.
 
     Raises
     ------
     ValueError
-        If the message is not two integers inside the grid, or ``[-1, -1]``.
+        If the message is not two integers inside the grid (or ``[-1, -1]`` when allowed).
 
     """
     data = list(msg.data)
     if len(data) != 2:
-        raise ValueError(f'ground truth must be [row, col], got {data}')
+        raise ValueError(f'{what} must be [row, col], got {data}')
     row, col = data
-    if (row, col) == (-1, -1):
+    if allow_empty and (row, col) == (-1, -1):
         return None
     if not (0 <= row < grid.rows and 0 <= col < grid.cols):
-        raise ValueError(f'ground truth ({row}, {col}) is outside the '
+        raise ValueError(f'{what} ({row}, {col}) is outside the '
                          f'{grid.rows}x{grid.cols} grid')
     return grid.index(row, col)
+
+
+def cell_from_ground_truth(msg, grid: Grid) -> int | None:
+    """Return the cell of a ground-truth ``[row, col]`` message, None for ``[-1, -1]`` (empty)."""
+    return cell_from_row_col(msg, grid, 'ground truth', allow_empty=True)

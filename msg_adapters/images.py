@@ -1,11 +1,16 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-Images: the belief heatmap (``rgb8``) and per-cell evidence as ``32FC1``.
+Images: the belief heatmap (``rgb8``), per-cell evidence as ``32FC1``, and camera images.
 
 Float images look black in rqt_image_view unless its dynamic range is switched on, so the belief
 is published as the colour-mapped ``rgb8`` picture of :func:`ipomdp_gaze.render.belief_heatmap`
 (docs/design.md section 5).
+
+Camera images (``mono8``, ``rgb8``, ``bgr8``) are read without copying the pixels where numpy
+allows it (:func:`image_array`: a view of the message's buffer, row padding and BGR order
+included), and ``camera_info`` is read as a :class:`ipomdp_gaze.vision.pan_tilt.PinholeCamera`;
+there is no cv_bridge wheel for pip installs, and none is needed.
 """
 from __future__ import annotations
 
@@ -13,14 +18,23 @@ import sys
 
 from ipomdp_gaze.belief import EvidenceError
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.head_camera import PinholeCamera
 from ipomdp_gaze.render import belief_heatmap
 import numpy as np
-from sensor_msgs.msg import Image
+from sensor_msgs.msg import CameraInfo, Image
 from std_msgs.msg import Header
 
 from .grid_arrays import LayoutError
 
 _LITTLE = sys.byteorder == 'little'
+# Camera image encodings read by image_array, and their channels.
+IMAGE_ENCODINGS = {'mono8': 1, 'rgb8': 3, 'bgr8': 3}
+# Default limit of image_array: larger images are refused (a 4096x4096 rgb8 image is 50 MB).
+MAX_IMAGE_SIDE_PX = 4096
+
+
+class ImageError(ValueError):
+    """A camera image message that cannot be used; the message says why."""
 
 
 def _uint8(data) -> np.ndarray:
@@ -90,3 +104,88 @@ def evidence_from_image(msg: Image, grid: Grid) -> np.ndarray:
     rows = buf.reshape(msg.height, msg.step)[:, :4 * msg.width]
     dtype = np.dtype('>f4' if msg.is_bigendian else '<f4')
     return np.ascontiguousarray(rows).view(dtype).reshape(-1).astype(np.float64)
+
+
+def image_array(msg: Image, max_side_px: int = MAX_IMAGE_SIDE_PX) -> np.ndarray:
+    """
+    Read a ``mono8``, ``rgb8`` or ``bgr8`` image as ``(H, W)`` grey or ``(H, W, 3)`` RGB uint8.
+
+    The pixels are not copied: the result is a read-only view of the message's buffer (row
+    padding is sliced off, ``bgr8`` is viewed with its channels reversed), valid while the
+    message is.
+
+    Raises
+    ------
+    ImageError
+        For another encoding, an empty image, a side above ``max_side_px``, or a ``step`` or
+        data length that disagrees with the width and height.
+
+    """
+    channels = IMAGE_ENCODINGS.get(msg.encoding)
+    if channels is None:
+        raise ImageError(f'unsupported image encoding {msg.encoding!r} (expected one of '
+                         f"{', '.join(IMAGE_ENCODINGS)})")
+    width, height, step = int(msg.width), int(msg.height), int(msg.step)
+    buf = _uint8(msg.data)
+    if width == 0 or height == 0 or buf.size == 0:
+        raise ImageError(f'empty image ({width}x{height} px, {buf.size} bytes)')
+    if width > max_side_px or height > max_side_px:
+        raise ImageError(f'image of {width}x{height} px is larger than {max_side_px} px on a '
+                         f'side')
+    if step < channels * width:
+        raise ImageError(f'step {step} is less than width {width} x {channels} bytes '
+                         f'({msg.encoding})')
+    if buf.size != step * height:
+        raise ImageError(f'image data has {buf.size} bytes, expected step {step} x height '
+                         f'{height} = {step * height}')
+    rows = buf.reshape(height, step)[:, :channels * width]
+    if channels == 1:
+        view = rows
+    else:
+        view = rows.reshape(height, width, 3)
+        if msg.encoding == 'bgr8':
+            view = view[:, :, ::-1]
+    view.flags.writeable = False
+    return view
+
+
+def camera_image(pixels, stamp, frame_id: str = '') -> Image:
+    """Build a stamped ``rgb8`` (``(H, W, 3)``) or ``mono8`` (``(H, W)``) image of uint8 pixels."""
+    a = np.ascontiguousarray(pixels, dtype=np.uint8)
+    if a.ndim == 3 and a.shape[2] == 3:
+        encoding, channels = 'rgb8', 3
+    elif a.ndim == 2:
+        encoding, channels = 'mono8', 1
+    else:
+        raise ValueError(f'expected (H, W) grey or (H, W, 3) RGB pixels, got shape {a.shape}')
+    msg = Image(header=Header(stamp=stamp, frame_id=frame_id), height=a.shape[0],
+                width=a.shape[1], encoding=encoding, is_bigendian=0, step=channels * a.shape[1])
+    msg.data = a.tobytes()
+    return msg
+
+
+def camera_info(camera: PinholeCamera, stamp, frame_id: str = '') -> CameraInfo:
+    """Build the ``camera_info`` of a distortion-free pinhole camera (K, P, identity R)."""
+    k = camera.k
+    return CameraInfo(header=Header(stamp=stamp, frame_id=frame_id), width=camera.width,
+                      height=camera.height, distortion_model='plumb_bob', d=[0.0] * 5, k=k,
+                      r=[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+                      p=[k[0], 0.0, k[2], 0.0, 0.0, k[4], k[5], 0.0, 0.0, 0.0, 1.0, 0.0])
+
+
+def camera_from_info(msg: CameraInfo) -> PinholeCamera:
+    """
+    Read a ``camera_info``: image size and K (distortion is not used).
+
+    Raises
+    ------
+    ImageError
+        For a zero size or a K that is not a pinhole camera's.
+
+    """
+    if msg.width == 0 or msg.height == 0:
+        raise ImageError(f'camera_info has no image size ({msg.width}x{msg.height})')
+    try:
+        return PinholeCamera.from_k(msg.width, msg.height, list(msg.k))
+    except ValueError as exc:
+        raise ImageError(f'camera_info: {exc}') from None

@@ -22,11 +22,13 @@ def test_help_lists_subcommands():
         assert name in out.stdout
     assert re.findall(r'^    (\w+)', out.stdout, re.M) == [
         'evaluate', 'search', 'find', 'train', 'calibrate', 'reproduce', 'demo', 'controller',
-        'camera']
+        'camera', 'detector', 'scene_camera']
 
 
 @pytest.mark.parametrize('command, node', [('controller', 'gaze_controller'),
-                                           ('camera', 'simulated_camera')])
+                                           ('camera', 'simulated_camera'),
+                                           ('detector', 'foveal_detector'),
+                                           ('scene_camera', 'scene_camera')])
 def test_node_subcommands_run_their_node(command, node, capsys):
     with pytest.raises(SystemExit) as exit_info:
         main([command, '--help'])
@@ -46,6 +48,12 @@ def test_node_subcommands_run_their_node(command, node, capsys):
     (['evaluate', '--spacing-deg', 'nan'], 'expected a positive number'),
     (['evaluate', '--fpoc', 'laser'], "invalid choice: 'laser'"),
     (['search', '--target', '99'], 'outside the 49-cell grid'),
+    (['demo', '--fovea'], '--fovea goes with --scene faces'),
+    (['demo', '--scene', 'faces', '--target', '1,2'], '--target is for --scene simulated'),
+    (['demo', '--scene', 'faces', '--fpoc', 'human'], '--fpoc is for --scene simulated'),
+    (['demo', '--scene', 'pictures'], "invalid choice: 'pictures'"),
+    (['calibrate', '--pan-tilt', '--out', 'm.yaml', '--images', 'x'],
+     '--images is for the image task'),
 ])
 def test_bad_arguments_exit_nonzero_with_one_line(args, message):
     out = run_cli(*args)

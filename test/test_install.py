@@ -16,10 +16,11 @@ Everything runs with its working directory outside the checkout, so the source t
 shadow the install. In each mode the CLI must answer ``--help`` and run a small ``evaluate``,
 every module of the copy must import from the install (never from this checkout), the bare
 top-level names ``policies`` and ``msg_adapters`` must not be importable, the shipped kernels
-must resolve, and the installed ``controller`` and ``camera`` must talk over real DDS and shut
-down cleanly on SIGTERM. The colcon nodes are started the way ``ros2 run`` does: after sourcing
-``install/setup.bash``, look the package up in the ament index and execute
-``<prefix>/lib/ipomdp_gaze/<executable>``.
+must resolve, the installed ``controller`` and ``camera`` must talk over real DDS and shut
+down cleanly on SIGTERM, and so must the installed ``scene_camera`` and ``detector`` (which
+find the shipped face model and the Haar cascade from the install). The colcon nodes are
+started the way ``ros2 run`` does: after sourcing ``install/setup.bash``, look the package up
+in the ament index and execute ``<prefix>/lib/ipomdp_gaze/<executable>``.
 """
 from dataclasses import dataclass
 import json
@@ -31,13 +32,15 @@ import subprocess
 import sys
 
 from conftest import wait_for
+import numpy as np
 import pytest
 import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = 'ipomdp_gaze'
-SUBCOMMANDS = ('evaluate', 'search', 'train', 'reproduce', 'demo', 'controller', 'camera')
-EXECUTABLES = ('ipomdp-gaze', 'controller', 'camera')
+SUBCOMMANDS = ('evaluate', 'search', 'train', 'reproduce', 'demo', 'controller', 'camera',
+               'detector', 'scene_camera')
+EXECUTABLES = ('ipomdp-gaze', 'controller', 'camera', 'detector', 'scene_camera')
 BARE_NAMES = ('policies', 'msg_adapters')
 # Variables that would make a process find packages other than the install under test.
 LEAKY_ENV = ('PYTHONPATH', 'PYTHONHOME', 'PYTHONSTARTUP', 'VIRTUAL_ENV', 'CMAKE_PREFIX_PATH')
@@ -132,7 +135,7 @@ class Install:
     mode: str
     prefix: Path          # the install prefix: share/ and the executables are under it
     root: Path            # every ipomdp_gaze module must be loaded from below here
-    bin_dir: Path         # ipomdp-gaze, controller and camera
+    bin_dir: Path         # ipomdp-gaze and the node executables
     python: Path          # the interpreter the installed scripts use
     env: dict
     copy: Path            # the clean copy it was built from
@@ -230,7 +233,9 @@ def test_install_has_executables_index_marker_and_share_files(install):
     shipped = ['package.xml'] + [p.relative_to(install.copy).as_posix() for p in
                                  (*sorted(install.copy.glob('config/*.yaml')),
                                   *sorted(install.copy.glob('launch/*.launch.py')))]
-    assert {'config/controller.yaml', 'config/camera.yaml'} <= set(shipped)
+    assert {'config/controller.yaml', 'config/camera.yaml', 'config/faces_fovea_detector.yaml',
+            'config/faces_camera_scene_camera.yaml', 'launch/faces_demo.launch.py'} <= \
+        set(shipped)
     for name in shipped:
         assert (install.share / name).is_file(), install.share / name
 
@@ -281,14 +286,14 @@ def test_every_module_imports_from_the_install_and_bare_names_do_not(install, tm
 class Node:
     """An installed node in its own process; output in a log file; SIGTERM to stop."""
 
-    def __init__(self, install, executable, namespace, env, log_dir):
-        config = install.share / 'config' / f'{executable}.yaml'
+    def __init__(self, install, executable, namespace, env, log_dir, config=None, extra=()):
+        config = install.share / 'config' / (config or f'{executable}.yaml')
         self.name = executable
         self.log = log_dir / f'{executable}.log'
         with open(self.log, 'wb') as out:
             self.proc = subprocess.Popen(
                 install.node_argv(executable, '-r', f'__ns:={namespace}', '--params-file',
-                                  config),
+                                  config, *extra),
                 cwd=log_dir, env=env, stdout=out, stderr=subprocess.STDOUT,
                 stdin=subprocess.DEVNULL)
 
@@ -347,4 +352,39 @@ def test_installed_controller_and_camera_talk_over_dds(install, ros_env, probe, 
     finally:
         codes = {node.name: node.stop() for node in nodes}
     assert codes == {'controller': 0, 'camera': 0}, f'exit status {codes}:\n' + \
+        '\n'.join(f'--- {n.name}\n{n.output()}' for n in nodes)
+
+
+@pytest.mark.ros
+def test_installed_scene_camera_and_detector_serve_a_fixation(install, ros_env, probe, tmp_path):
+    from ipomdp_gaze.grid import Grid
+    from ipomdp_gaze.msg_adapters import grid_arrays, images
+    from ipomdp_gaze.nodes.watch import LATCHED
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from sensor_msgs.msg import Image
+    from std_msgs.msg import Int32MultiArray
+    namespace = '/install_faces_' + install.mode.replace('-', '_')
+    frames = probe.record(Image, f'{namespace}/evidence_image',
+                          QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
+    grid = Grid(21, 21)
+    probe.publisher(Int32MultiArray, f'{namespace}/fixation', LATCHED).publish(
+        grid_arrays.row_col(grid, grid.index(10, 10)))
+    env = dict(install.env)
+    env.pop('ROS_LOCALHOST_ONLY', None)
+    env.update({k: v for k, v in ros_env.items() if k.startswith('ROS_')})
+    env['PYTHONUNBUFFERED'] = '1'
+    # In a namespace the files' node blocks do not apply: the modes are given here.
+    nodes = [Node(install, 'detector', namespace, env, tmp_path, 'faces_fovea_detector.yaml',
+                  ['-p', 'mode:=fovea']),
+             Node(install, 'scene_camera', namespace, env, tmp_path,
+                  'faces_fovea_scene_camera.yaml', ['-p', 'view:=fixed', '-p', 'rate_hz:=5.0'])]
+    try:
+        assert wait_for(lambda: frames or any(n.proc.poll() is not None for n in nodes), 90) \
+            and frames, 'no evidence_image from the installed detector:\n' + \
+            '\n'.join(f'--- {n.name}\n{n.output()}' for n in nodes)
+        counts = images.evidence_from_image(frames[0][1], grid)
+        assert np.isfinite(counts).all() and (counts >= 0).all()
+    finally:
+        codes = {node.name: node.stop() for node in nodes}
+    assert codes == {'detector': 0, 'scene_camera': 0}, f'exit status {codes}:\n' + \
         '\n'.join(f'--- {n.name}\n{n.output()}' for n in nodes)

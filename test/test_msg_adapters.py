@@ -202,3 +202,80 @@ def test_stamps():
     assert stamps.is_zero(Time()) and not stamps.is_zero(t)
     with pytest.raises(ValueError):
         stamps.from_seconds(-1.0)
+
+
+def _image_msg(pixels: np.ndarray, encoding: str, pad: int = 0) -> Image:
+    """Build an image message of ``pixels`` (in the encoding's channel order), rows padded."""
+    height, width = pixels.shape[:2]
+    rows = pixels.reshape(height, -1)
+    step = rows.shape[1] + pad
+    data = np.zeros((height, step), np.uint8)
+    data[:, :rows.shape[1]] = rows
+    msg = Image(height=height, width=width, encoding=encoding, step=step)
+    msg.data = data.tobytes()
+    return msg
+
+
+@pytest.mark.parametrize('encoding, pad', [('mono8', 0), ('rgb8', 0), ('bgr8', 0),
+                                           ('mono8', 5), ('rgb8', 3), ('bgr8', 7)])
+def test_camera_images_are_read_without_copying_the_pixels(encoding, pad):
+    rng = np.random.default_rng(1)
+    shape = (6, 9) if encoding == 'mono8' else (6, 9, 3)
+    rgb = rng.integers(0, 256, shape, dtype=np.uint8)
+    sent = rgb[:, :, ::-1] if encoding == 'bgr8' else rgb
+    msg = _image_msg(np.ascontiguousarray(sent), encoding, pad)
+    got = images.image_array(msg)
+    np.testing.assert_array_equal(got, rgb)                  # RGB order, padding dropped
+    assert np.shares_memory(got, np.frombuffer(msg.data, np.uint8))
+    assert not got.flags.writeable
+
+
+def test_camera_image_and_camera_info_round_trip():
+    rgb = np.arange(4 * 5 * 3, dtype=np.uint8).reshape(4, 5, 3)
+    stamp = Time(sec=3, nanosec=7)
+    msg = images.camera_image(rgb, stamp, 'cam')
+    assert (msg.encoding, msg.step, msg.header.frame_id) == ('rgb8', 15, 'cam')
+    np.testing.assert_array_equal(images.image_array(msg), rgb)
+    assert images.camera_image(rgb[:, :, 0], stamp).encoding == 'mono8'
+    from ipomdp_gaze.head_camera import PinholeCamera
+    camera = PinholeCamera.from_fov(320, 240, 25.0)
+    info = images.camera_info(camera, stamp, 'cam')
+    assert (info.width, info.height, info.header.stamp) == (320, 240, stamp)
+    assert list(info.p)[:3] == [camera.fx, 0.0, camera.cx]
+    assert images.camera_from_info(info) == camera
+
+
+@pytest.mark.parametrize('change, words', [
+    ({'encoding': '16UC1'}, "unsupported image encoding '16UC1'"),
+    ({'encoding': 'rgba8'}, "unsupported image encoding 'rgba8'"),
+    ({'width': 0}, 'empty image'),
+    ({'data': b''}, 'empty image'),
+    ({'width': 5000, 'step': 15000}, 'larger than 4096 px'),
+    ({'step': 20}, 'step 20 is less than width 9 x 3'),
+    ({'step': 40}, 'expected step 40 x height 6'),
+    ({'height': 7}, 'expected step 27 x height 7'),
+    ({'data': bytes(161)}, 'image data has 161 bytes'),
+])
+def test_malformed_camera_images_are_refused_with_the_reason(change, words):
+    msg = _image_msg(np.zeros((6, 9, 3), np.uint8), 'rgb8')
+    for key, value in change.items():
+        setattr(msg, key, value)
+    with pytest.raises(images.ImageError, match=words):
+        images.image_array(msg)
+
+
+def test_bad_camera_info_is_refused():
+    from sensor_msgs.msg import CameraInfo
+    with pytest.raises(images.ImageError, match='no image size'):
+        images.camera_from_info(CameraInfo())
+    with pytest.raises(images.ImageError, match='fx and fy'):
+        images.camera_from_info(CameraInfo(width=4, height=3, k=[0.0] * 8 + [1.0]))
+
+
+def test_fixation_messages_are_row_col():
+    msg = grid_arrays.row_col(GRID, GRID.index(3, 8))
+    assert isinstance(msg, Int32MultiArray) and list(msg.data) == [3, 8]
+    assert grid_arrays.cell_from_row_col(msg, GRID, 'fixation') == GRID.index(3, 8)
+    msg.data = [3, 11]
+    with pytest.raises(ValueError, match=r'fixation \(3, 11\) is outside'):
+        grid_arrays.cell_from_row_col(msg, GRID, 'fixation')

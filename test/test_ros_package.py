@@ -33,15 +33,21 @@ def _flat(tree, prefix=''):
 
 
 @needs_rclpy
-@pytest.mark.parametrize('file, node, params', [
-    ('controller.yaml', 'gaze_controller', 'controller_params'),
-    ('camera.yaml', 'simulated_camera', 'camera_params'),
+@pytest.mark.parametrize('file, node, module, params', [
+    ('controller.yaml', 'gaze_controller', 'controller', 'controller_params'),
+    ('camera.yaml', 'simulated_camera', 'camera', 'camera_params'),
+    ('faces_camera_controller.yaml', 'gaze_controller', 'controller', 'controller_params'),
+    ('faces_fovea_controller.yaml', 'gaze_controller', 'controller', 'controller_params'),
+    ('faces_camera_detector.yaml', 'foveal_detector', 'detector', 'detector_params'),
+    ('faces_fovea_detector.yaml', 'foveal_detector', 'detector', 'detector_params'),
+    ('faces_camera_scene_camera.yaml', 'scene_camera', 'scene_camera', 'scene_camera_params'),
+    ('faces_fovea_scene_camera.yaml', 'scene_camera', 'scene_camera', 'scene_camera_params'),
 ])
-def test_yaml_names_declared_parameters_with_their_types(file, node, params):
+def test_yaml_names_declared_parameters_with_their_types(file, node, module, params):
     import importlib
 
     from rclpy.parameter import Parameter
-    module = importlib.import_module(f"ipomdp_gaze.nodes.{params.split('_')[0]}")
+    module = importlib.import_module(f'ipomdp_gaze.nodes.{module}')
     declared = {p.name: p for p in getattr(module, params)()}
     doc = _yaml(file)
     assert list(doc) == [node]
@@ -74,6 +80,34 @@ def test_the_two_yaml_files_describe_the_same_task():
     assert controller['policy.fallback'] == 'elm'
 
 
+@pytest.mark.parametrize('mode, view', [('camera', 'pan_tilt'), ('fovea', 'fixed')])
+def test_the_three_face_yaml_files_of_a_mode_describe_the_same_task(mode, view):
+    from ipomdp_gaze.observation_file import load_observation
+    controller = _flat(_yaml(f'faces_{mode}_controller.yaml')['gaze_controller']
+                       ['ros__parameters'])
+    detector = _flat(_yaml(f'faces_{mode}_detector.yaml')['foveal_detector']['ros__parameters'])
+    camera = _flat(_yaml(f'faces_{mode}_scene_camera.yaml')['scene_camera']['ros__parameters'])
+    assert detector['mode'] == mode and camera['view'] == view
+    assert controller['observation.model'] == 'counts'
+    assert controller['observation.file'] == detector['observation.file']
+    model = load_observation(detector['observation.file'])
+    assert (controller['grid.rows'], controller['grid.cols']) == model.grid.shape
+    assert (model.meta['image'].get('view', 'fixed')) == view
+    if mode == 'camera':
+        assert controller['grid.spacing_deg'] == model.grid.spacing_deg
+        assert (camera['grid.rows'], camera['grid.cols'], camera['grid.spacing_deg']) == \
+            (model.grid.rows, model.grid.cols, model.grid.spacing_deg)
+        image = model.meta['image']
+        assert (camera['camera.width'], camera['camera.height']) == (image['width'],
+                                                                     image['height'])
+        joints = [k for k in controller if k.endswith(('_joint', '_sign', '_offset_rad'))]
+        assert joints and all(controller[k] == detector[k] == camera[k] for k in joints)
+        assert controller['settle_time_s'] < camera['saccade_time_s']
+    else:
+        assert controller['settle_time_s'] == 0.0                   # nothing moves
+        assert camera['scene.size_px'] == model.meta['image']['width']
+
+
 def test_launch_file_starts_existing_executables_with_existing_config():
     tree = ast.parse((REPO / 'launch' / 'gaze_demo.launch.py').read_text())
     calls = [n for n in ast.walk(tree) if isinstance(n, ast.Call)
@@ -90,6 +124,26 @@ def test_launch_file_starts_existing_executables_with_existing_config():
     assert "'camera = ipomdp_gaze.nodes.camera:main'" in setup
 
 
+def test_face_launch_file_starts_the_three_nodes_with_the_files_of_its_mode():
+    tree = ast.parse((REPO / 'launch' / 'faces_demo.launch.py').read_text())
+    calls = [n for n in ast.walk(tree) if isinstance(n, ast.Call)
+             and getattr(n.func, 'id', '') == 'Node']
+    started = {(kw['executable'], kw['name']) for kw in (
+        {k.arg: k.value.value for k in c.keywords if isinstance(k.value, ast.Constant)}
+        for c in calls)}
+    assert started == {('controller', 'gaze_controller'), ('detector', 'foveal_detector'),
+                       ('scene_camera', 'scene_camera')}
+    strings = {n.value for n in ast.walk(tree) if isinstance(n, ast.Constant)
+               and isinstance(n.value, str)}
+    assert {'faces_', 'camera', 'ipomdp_gaze', 'config'} <= strings
+    for mode in ('camera', 'fovea'):
+        for node in ('controller', 'detector', 'scene_camera'):
+            assert (REPO / 'config' / f'faces_{mode}_{node}.yaml').is_file()
+    setup = (REPO / 'setup.py').read_text()
+    assert "'detector = ipomdp_gaze.nodes.detector:main'" in setup
+    assert "'scene_camera = ipomdp_gaze.nodes.scene_camera:main'" in setup
+
+
 @pytest.mark.ros
 @needs_rclpy
 @pytest.mark.parametrize('command, ros_args, words', [
@@ -98,6 +152,13 @@ def test_launch_file_starts_existing_executables_with_existing_config():
      "policy file '/no/such/policy.yaml' not found"),
     ('controller', ['-p', 'settle_time_s:=1'], 'settle_time_s'),
     ('camera', ['-p', 'fpoc.model:=sonar'], "fpoc.model must be one of 'human'"),
+    ('detector', ['-p', 'mode:=eyes'], "mode must be one of 'fovea', 'camera'"),
+    ('detector', ['-p', 'observation.file:=/no/such.yaml'], "'/no/such.yaml' not found"),
+    ('detector', ['-p', 'mode:=camera', '-p', 'observation.file:=faces-420'],
+     'calibrated with a fixed view'),
+    ('scene_camera', ['-p', 'view:=fisheye'], "view must be one of 'fixed', 'pan_tilt'"),
+    ('scene_camera', ['-p', 'scene.file:=/no/such.png'], 'missing or not an image'),
+    ('scene_camera', ['-p', 'scene.face_px:=[10]'], 'scene.face_px must be [min, max]'),
 ])
 def test_start_up_validation_through_the_cli(ros_env, command, ros_args, words):
     run = subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', command, '--ros-args',

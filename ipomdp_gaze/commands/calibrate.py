@@ -8,6 +8,12 @@ generated training scenes (``--scenes N``, the training split only: test faces a
 are never used), every image is fixated at every cell and the counts tallied per offset
 (:mod:`ipomdp_gaze.vision.calibrate`). Writes the observation file, prints the hit and
 false-alarm rates ``P(c > 0)`` per offset, and draws the learned FPOC.
+
+``--pan-tilt`` calibrates the pan/tilt task instead (docs/design.md section 6.5): training
+scenes spanning the pan/tilt grid are viewed through the scene camera's geometry from every
+head pose, the detector runs on each whole view and its detections are binned to pan/tilt
+cells, exactly as the ``scene_camera`` and ``foveal_detector`` nodes do. The file records no
+wall time, so running the same command again writes the same file.
 """
 from __future__ import annotations
 
@@ -15,7 +21,7 @@ import argparse
 from pathlib import Path
 import time
 
-from ipomdp_gaze.grid import Grid, parse_grid
+from ipomdp_gaze.grid import Grid
 import numpy as np
 
 from .common import grid_arg, nonneg_int, positive_float, positive_int
@@ -45,6 +51,9 @@ def add_parser(sub):
                        description='Fixate every cell of labelled images, tally the detector '
                                    'counts per offset from the fixation with and without the '
                                    'face, and write an ipomdp_gaze/observation-v1 file.')
+    p.add_argument('--pan-tilt', action='store_true',
+                   help='calibrate the pan/tilt task: a head camera looking around training '
+                        'scenes (--scenes N; the shipped faces-pan-tilt model)')
     source = p.add_mutually_exclusive_group(required=True)
     source.add_argument('--scenes', type=positive_int, metavar='N',
                         help='N generated training scenes (training faces and backgrounds only)')
@@ -52,20 +61,32 @@ def add_parser(sub):
                         help='a folder of images, labelled by --labels')
     p.add_argument('--labels', type=Path, metavar='CSV',
                    help='CSV "path,x,y" of face-centre pixels (empty x,y: no face)')
-    p.add_argument('--task', choices=tuple(TASKS), default='paper',
+    p.add_argument('--task', choices=tuple(TASKS), default=None,
                    help='scene size and face sizes of --scenes: paper (420 px, faces 60-140) '
                         'or small (840 px, faces 24-140); default paper')
-    p.add_argument('--absent-rate', type=float, default=0.0,
+    p.add_argument('--absent-rate', type=float, default=None,
                    help='fraction of --scenes without a face (default 0)')
     p.add_argument('--seed', type=nonneg_int, default=0, help='scene seed (default 0)')
-    p.add_argument('--grid', type=grid_arg, default=parse_grid('21x21'),
-                   help='grid tiling each image (default 21x21)')
-    p.add_argument('--windows', type=_numbers(int), default=(21, 15, 9, 3), metavar='W,...',
+    p.add_argument('--grid', type=grid_arg, default=None,
+                   help='grid tiling each image (default 21x21), or the pan/tilt grid '
+                        '(default 11x11)')
+    p.add_argument('--spacing-deg', type=positive_float, default=None,
+                   help='--pan-tilt: degrees between neighbouring cells (default 5)')
+    p.add_argument('--camera', type=grid_arg, default=None, metavar='WIDTHxHEIGHT',
+                   help='--pan-tilt: camera image size in pixels (default 320x240)')
+    p.add_argument('--hfov-deg', type=positive_float, default=None,
+                   help='--pan-tilt: horizontal field of view, edge to edge (default 25)')
+    p.add_argument('--face-px', type=_numbers(int), default=None, metavar='MIN,MAX',
+                   help='--pan-tilt: face sides in scene pixels (default 30,70)')
+    p.add_argument('--null-scenes', type=nonneg_int, default=None, metavar='M',
+                   help='--pan-tilt: the first M scenes are viewed from every pose (null '
+                        'tables); the others only from poses that see the face (default 40)')
+    p.add_argument('--windows', type=_numbers(int), default=None, metavar='W,...',
                    help='fovea window sides in cells, largest first (default 21,15,9,3)')
     p.add_argument('--scales', type=_numbers(float), default=None, metavar='S,...',
                    help='resize factor per window, e.g. 1/7,1/5,1/3,1 (default: NMPT, the '
                         'pixel size of the smallest window)')
-    p.add_argument('--interpolation', default='area',
+    p.add_argument('--interpolation', default=None,
                    help='window resampling: area (default), nearest, linear, cubic')
     p.add_argument('--scan-once', action='store_true',
                    help='observe the whole-image window once per image, with its own table '
@@ -76,12 +97,12 @@ def add_parser(sub):
                    help='detectMultiScale scale factor (default 1.1)')
     p.add_argument('--prior', type=positive_float, default=1.0,
                    help='Dirichlet prior per count (default 1)')
-    p.add_argument('--pool-radius', type=float, default=0.5,
+    p.add_argument('--pool-radius', type=float, default=None,
                    help='pool target tallies of offsets within this distance in cells '
-                        '(default 0.5; 0: none)')
-    p.add_argument('--min-tallies', type=nonneg_int, default=50,
+                        '(default 0.5; --pan-tilt 0: none, a view is not round)')
+    p.add_argument('--min-tallies', type=nonneg_int, default=None,
                    help='widen the pooling where an offset has fewer target observations '
-                        '(default 50)')
+                        '(default 50; --pan-tilt 0)')
     p.add_argument('--fixation-stride', type=positive_int, default=1, metavar='S',
                    help='fixate the cells whose row and column are multiples of S (and the '
                         'last row and column) instead of every cell (default 1: every cell)')
@@ -131,9 +152,11 @@ def rate_table(model, size: int = 6) -> str:
     hit, fa = hit_false_alarm(model)
     size = min(size, hit.shape[0], hit.shape[1])
     head = '|dr| \\ |dc| ' + ''.join(f'{dc:>14d}' for dc in range(size))
-    lines = ['P(count > 0): hit (target in the cell) / false alarm (no target)', head]
+    lines = ['P(count > 0): hit (target in the cell) / false alarm (no target); -: never seen',
+             head]
     for dr in range(size):
-        cells = [f'  {hit[dr, dc]:.3f}/{fa[dr, dc]:.4f}' for dc in range(size)]
+        cells = [f'  {hit[dr, dc]:.3f}/{fa[dr, dc]:.4f}' if np.isfinite(hit[dr, dc])
+                 else f'{"-":>14}' for dc in range(size)]
         lines.append(f'{dr:>11d} ' + ''.join(cells))
     if model.has_scan:
         lines.append(f'whole-image scan: hit {1 - model.scan_target[0]:.3f} / false alarm '
@@ -169,6 +192,90 @@ def plot_fpoc(model, path: Path, title: str) -> None:
     plt.close(fig)
 
 
+# Options of the image task that mean nothing for --pan-tilt, and the reverse.
+IMAGE_ONLY = ('images', 'labels', 'windows', 'scales', 'interpolation', 'absent_rate', 'task',
+              'scan_once', 'fixation_stride')
+PAN_TILT_ONLY = ('spacing_deg', 'camera', 'hfov_deg', 'face_px', 'null_scenes')
+IMAGE_DEFAULTS = {'windows': (21, 15, 9, 3), 'interpolation': 'area', 'absent_rate': 0.0,
+                  'task': 'paper', 'scan_once': False, 'fixation_stride': 1}
+
+
+def _check_options(args) -> None:
+    """Refuse options of the other task; fill in the defaults of this one."""
+    for name in PAN_TILT_ONLY if not args.pan_tilt else IMAGE_ONLY:
+        value = getattr(args, name)
+        if value is not None and value != IMAGE_DEFAULTS.get(name):
+            flag = '--' + name.replace('_', '-')
+            raise ValueError(f'{flag} needs --pan-tilt' if not args.pan_tilt else
+                             f'{flag} is for the image task, not --pan-tilt')
+    if args.pan_tilt:
+        args.grid = args.grid or (11, 11)
+        args.pool_radius = 0.0 if args.pool_radius is None else args.pool_radius
+        args.min_tallies = 0 if args.min_tallies is None else args.min_tallies
+    else:
+        for name, default in IMAGE_DEFAULTS.items():
+            if getattr(args, name) is None:
+                setattr(args, name, default)
+        args.grid = args.grid or (21, 21)
+        args.pool_radius = 0.5 if args.pool_radius is None else args.pool_radius
+        args.min_tallies = 50 if args.min_tallies is None else args.min_tallies
+    if not np.isfinite(args.pool_radius) or args.pool_radius < 0:
+        raise ValueError(f'--pool-radius must be >= 0, got {args.pool_radius}')
+
+
+def run_pan_tilt(args) -> int:
+    """Calibrate the pan/tilt task (``--pan-tilt``); see the module docstring."""
+    from ipomdp_gaze.observation_file import save_observation
+    from ipomdp_gaze.vision.calibrate import count_model, tally_pan_tilt_scenes
+    from ipomdp_gaze.vision.detector import HaarDetector
+    from ipomdp_gaze.head_camera import PinholeCamera
+    from ipomdp_gaze.vision.pan_tilt import (CAMERA_HFOV_DEG, CAMERA_SIZE_PX, FACE_PX,
+                                             PanTiltSceneSet, SceneGeometry)
+    if args.scenes is None:
+        raise ValueError('--pan-tilt needs --scenes N (training scenes)')
+    grid = Grid(args.grid[0], args.grid[1], args.spacing_deg or 5.0)
+    width, height = tuple(args.camera) if args.camera else CAMERA_SIZE_PX
+    camera = PinholeCamera.from_fov(width, height, args.hfov_deg or CAMERA_HFOV_DEG)
+    geometry = SceneGeometry(grid, camera)
+    face_px = tuple(args.face_px) if args.face_px else FACE_PX
+    if len(face_px) != 2:
+        raise ValueError(f'--face-px must be MIN,MAX, got {args.face_px}')
+    null_scenes = min(40 if args.null_scenes is None else args.null_scenes, args.scenes)
+    scenes = PanTiltSceneSet('train', geometry, face_px, 'rgb', args.seed)
+    detector_kwargs = {'scale_factor': args.scale_factor}
+    detector = HaarDetector(**detector_kwargs)
+    from tqdm import tqdm
+    bar = tqdm(total=args.scenes, unit='scene', disable=args.quiet, desc='calibrate')
+    start = time.perf_counter()
+    tallies = tally_pan_tilt_scenes(scenes, range(args.scenes), detector_kwargs,
+                                    args.max_count, null_scenes, args.processes, bar.update)
+    bar.close()
+    wall = time.perf_counter() - start
+    meta = {'image': {'width': width, 'height': height, 'view': 'pan_tilt',
+                      'camera': camera.to_dict()},
+            'detector': detector.settings(),
+            'calibration': {'source': {'pan_tilt_scenes': args.scenes, 'split': 'train',
+                                       'seed': args.seed, 'null_scenes': null_scenes,
+                                       'face_px': list(face_px),
+                                       'scene_px': list(geometry.size_px),
+                                       'px_per_deg': round(geometry.px_per_deg, 9)},
+                            'images': tallies.images, 'fixations': tallies.fixations,
+                            'prior': args.prior, 'pool_radius': args.pool_radius,
+                            'min_tallies': args.min_tallies,
+                            'detector_pixels': int(tallies.detector_pixels)}}
+    model = count_model(tallies, grid, args.prior, args.pool_radius, args.min_tallies, meta)
+    save_observation(args.out, model)
+    print(rate_table(model, size=4))
+    plot = args.plot if args.plot is not None else args.out.with_suffix('.png')
+    hfov, vfov = camera.fov_deg
+    plot_fpoc(model, plot, f'{args.out.stem}: {tallies.images} pan/tilt scenes, '
+                           f'{grid.rows}x{grid.cols} grid of {grid.spacing_deg:g} deg, '
+                           f'{width}x{height} camera, {hfov:.1f}x{vfov:.1f} deg view')
+    print(f'calibrated on {tallies.images} scenes ({tallies.fixations} views) in {wall:.1f} s; '
+          f'wrote {args.out} and {plot}')
+    return 0
+
+
 def run(args) -> int:
     from ipomdp_gaze.observation_file import save_observation
     from ipomdp_gaze.vision.calibrate import count_model, tally_images
@@ -176,8 +283,9 @@ def run(args) -> int:
     from ipomdp_gaze.vision.fovea import FoveaConfig
     if args.out.suffix != '.yaml':
         raise ValueError(f'--out must end in .yaml, got {args.out}')
-    if not np.isfinite(args.pool_radius) or args.pool_radius < 0:
-        raise ValueError(f'--pool-radius must be >= 0, got {args.pool_radius}')
+    _check_options(args)
+    if args.pan_tilt:
+        return run_pan_tilt(args)
     grid = Grid(args.grid[0], args.grid[1], 1.0)
     config = FoveaConfig(windows_cells=args.windows, scales=args.scales,
                          max_count=args.max_count, interpolation=args.interpolation,

@@ -1,7 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-``ipomdp-gaze controller`` and ``ipomdp-gaze camera``: run a node (what ``ros2 run`` starts).
+``ipomdp-gaze controller``, ``camera``, ``detector``, ``scene_camera``: run a node (``ros2 run``).
 
 One subcommand per executable of :data:`ipomdp_gaze.nodes.NODE_NAMES`, in that order; each runs
 the node's ``main`` exactly as ``ros2 run ipomdp_gaze <executable>`` does.

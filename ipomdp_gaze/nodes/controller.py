@@ -8,15 +8,18 @@ A thin wrapper: :class:`ipomdp_gaze.gaze.GazeController` holds the belief and de
 remapping work:
 
 - subscribes ``evidence`` (``std_msgs/Float32MultiArray``, one standardised detector response
-  per cell, NaN = not observed; arrival time counts) and ``evidence_image``
+  per cell, or with ``observation.model: counts`` one detection count per cell; NaN = not
+  observed; arrival time counts) and ``evidence_image``
   (``sensor_msgs/Image`` 32FC1, rows x cols; its header stamp counts, or its arrival when unset),
   both best effort and keep-last ``evidence_queue_depth`` (1: the newest frame wins; frames
   dropped on the way are counted from the publisher's sequence numbers);
 - publishes ``pan_tilt`` (``sensor_msgs/JointState``, transient local, depth 1, re-sent every
-  ``retry_period_s`` until a usable frame arrives), ``belief`` (``Float32MultiArray``) and
-  ``belief_image`` (``rgb8``) after every update and reset (the N cell probabilities, summing to
-  ``1 - P(absent)``), the search events ``found``, ``absent`` and ``gave_up``
-  (``diagnostic_msgs/DiagnosticStatus``, reliable) and ``/diagnostics``; optionally
+  ``retry_period_s`` until a usable frame arrives) and, with every target sent or re-sent,
+  ``fixation`` (``std_msgs/Int32MultiArray`` ``[row, col]``, transient local, depth 1: what a
+  foveal detector serves), ``belief`` (``Float32MultiArray``) and ``belief_image`` (``rgb8``)
+  after every update and reset (the N cell probabilities, summing to ``1 - P(absent)``), the
+  search events ``found``, ``absent`` and ``gave_up`` (``diagnostic_msgs/DiagnosticStatus``,
+  reliable) and ``/diagnostics``; optionally
   ``Float64MultiArray`` and ``JointTrajectory`` head commands on the topics their parameters name;
 - services ``~/reset`` (``std_srvs/Trigger``) and ``~/enable`` (``std_srvs/SetBool``).
 
@@ -41,6 +44,7 @@ from ipomdp_gaze.health import HealthMonitor, policy_label
 from ipomdp_gaze.motion import check_probability, check_sigma_cells
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, stamps
 from ipomdp_gaze.observation import GaussianObservation
+from ipomdp_gaze.observation_file import load_observation
 from ipomdp_gaze.policies.baselines import STRATEGIES
 from ipomdp_gaze.policies.conv import ACTIONS, check_kernel
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnavailable
@@ -51,7 +55,7 @@ from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.validate_topic_name import validate_topic_name
 from sensor_msgs.msg import Image, JointState
-from std_msgs.msg import Float32MultiArray, Float64MultiArray
+from std_msgs.msg import Float32MultiArray, Float64MultiArray, Int32MultiArray
 from std_srvs.srv import SetBool, Trigger
 from trajectory_msgs.msg import JointTrajectory
 
@@ -67,11 +71,19 @@ STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
 WARN_THROTTLE_S = 5.0
 # belief_image is at most this many pixels on a side (256x256 cells at 32 px would be 201 MB).
 MAX_IMAGE_SIDE_PX = 1024
+OBSERVATION_MODELS = ('gaussian', 'counts')
 
 
 def controller_params() -> list[Param]:
     """Every parameter of the controller, in declaration order (the grid first)."""
-    return grid_params() + fpoc_params() + cell_params(
+    return grid_params() + fpoc_params() + [
+        Param('observation.model', 'gaussian', T.STRING,
+              'gaussian: standardised responses and the FPOC; counts: detection counts and the '
+              'count model of observation.file (fpoc.* are then ignored)',
+              choices=OBSERVATION_MODELS),
+        Param('observation.file', '', T.STRING,
+              'count model: an ipomdp_gaze/observation-v1 path or shipped name (with counts)'),
+    ] + cell_params(
         'start', 'the first fixation after a reset', 'the centre {}') + [
         Param('seed', 0, T.INTEGER, 'seed of the random and sample policies',
               int_range=(0, INT_MAX)),
@@ -128,6 +140,7 @@ def controller_params() -> list[Param]:
 
 
 POLICY_KEYS = ('policy.name', 'policy.file', 'policy.kernel', 'policy.action')
+OBSERVATION_KEYS = ('observation.model', 'observation.file')
 
 
 @dataclass
@@ -137,10 +150,20 @@ class Config:
     values: dict
     grid: object
     fpoc: object
+    observation: object
     policy: object
     head: PanTiltMap
     start_cell: int
     warning: str = ''
+
+    @property
+    def observation_label(self) -> str:
+        """Describe the observation model for the log."""
+        if self.values['observation.model'] == 'counts':
+            model = self.observation
+            return (f"count model {self.values['observation.file']!r} (K = "
+                    f'{model.max_count + 1}; fpoc.* ignored)')
+        return f'FPOC {self.fpoc.to_dict()}'
 
     @property
     def policy_label(self) -> str:
@@ -163,12 +186,13 @@ class GazeControllerNode(Node):
         self._transaction.start(self._startup_config())
         cfg = self._config
         v = cfg.values
-        self.core = GazeController(cfg.grid, cfg.fpoc, cfg.policy, cfg.start_cell,
+        self.core = GazeController(cfg.grid, cfg.observation, cfg.policy, cfg.start_cell,
                                    v['settle_time_s'], v['confidence'], v['seed'],
                                    v['motion.sigma_cells'], v['motion.jump_prob'],
                                    v['absent.prior'], v['search.max_fixations'])
 
         self._pan_tilt_pub = self.create_publisher(JointState, 'pan_tilt', STATE_QOS)
+        self._fixation_pub = self.create_publisher(Int32MultiArray, 'fixation', STATE_QOS)
         self._belief_pub = self.create_publisher(Float32MultiArray, 'belief', 10)
         self._image_pub = self.create_publisher(Image, 'belief_image', 2)
         # Events: reliable, volatile, depth 10, so a default-QoS subscriber receives them.
@@ -198,8 +222,8 @@ class GazeControllerNode(Node):
         self._publish_belief()
         self._send_target()
         self.get_logger().info(
-            f'{cfg.grid.rows}x{cfg.grid.cols} grid at {cfg.grid.spacing_deg} deg/cell, FPOC '
-            f'{cfg.fpoc.to_dict()}, policy {cfg.policy_label}; {self._model_text()}; first '
+            f'{cfg.grid.rows}x{cfg.grid.cols} grid at {cfg.grid.spacing_deg} deg/cell, '
+            f'{cfg.observation_label}, policy {cfg.policy_label}; {self._model_text()}; first '
             f'fixation {cfg.grid.cell(self.core.fixation)}')
 
     def _model_text(self) -> str:
@@ -222,6 +246,12 @@ class GazeControllerNode(Node):
         """Derive a :class:`Config` from parameter values (ValueError names the problem)."""
         grid = grid_from(values)
         fpoc = fpoc_from(values)
+        observation_changed = changed is None or any(k in changed for k in OBSERVATION_KEYS)
+        if previous is not None and not observation_changed and \
+                values['observation.model'] == 'counts':
+            observation = previous.observation
+        else:
+            observation = observation_from(values, grid, fpoc)
         head = head_from(values, grid)
         start = start_cell(grid, *row_col_from(values, grid, 'start_row', 'start_col'))
         check_confidence(values['confidence'])
@@ -237,15 +267,16 @@ class GazeControllerNode(Node):
                     raise ValueError(f'{name}: {exc}') from None
         warnings = []
         policy_changed = changed is None or any(k in changed for k in POLICY_KEYS) or any(
-            k.startswith('fpoc.') for k in changed)
+            k.startswith('fpoc.') for k in changed) or observation_changed
         if previous is not None and not policy_changed:
             policy = previous.policy
         else:
-            policy = build_policy(values['policy.name'], grid, GaussianObservation(grid, fpoc),
+            policy = build_policy(values['policy.name'], grid, observation,
                                   values['policy.kernel'],
                                   values['policy.file'], values['policy.action'],
                                   warn=warnings.append)
-        return Config(dict(values), grid, fpoc, policy, head, start, '; '.join(warnings))
+        return Config(dict(values), grid, fpoc, observation, policy, head, start,
+                      '; '.join(warnings))
 
     def _startup_config(self) -> Config:
         values = self._transaction.values()
@@ -261,6 +292,10 @@ class GazeControllerNode(Node):
             cfg = self._build(values)
         if cfg.warning:
             self.get_logger().warning(cfg.warning)
+        if values['observation.model'] == 'counts':
+            self.get_logger().info('observation.model is counts: the fpoc.* parameters are '
+                                   'ignored, frames are detection counts for '
+                                   f"{values['observation.file']!r}")
         return cfg
 
     def _pre_set(self, params: list[Parameter]) -> list[Parameter]:
@@ -298,7 +333,7 @@ class GazeControllerNode(Node):
             self.get_logger().warning(cfg.warning)
         v, ov = cfg.values, old.values
         core = self.core
-        core.set_observation(cfg.fpoc)
+        core.set_observation(cfg.observation)
         core.set_policy(cfg.policy)
         core.set_start_cell(cfg.start_cell)
         core.set_settle_time(v['settle_time_s'])
@@ -360,6 +395,7 @@ class GazeControllerNode(Node):
     def _publish_target(self) -> None:
         head, cell = self._config.head, self.core.fixation
         self._pan_tilt_pub.publish(self._pan_tilt_msg)
+        self._fixation_pub.publish(grid_arrays.row_col(self._config.grid, cell))
         if self._forward_pub is not None:
             self._forward_pub.publish(joints.forward_command(head, cell))
         if self._trajectory_pub is not None:
@@ -498,6 +534,36 @@ class GazeControllerNode(Node):
         response.message = state if changed else f'already {state}'
         self.get_logger().info(f'gaze control {response.message}')
         return response
+
+
+def observation_from(values: dict, grid, fpoc):
+    """
+    Build the observation model the parameters select: Gaussian with the FPOC, or a count model.
+
+    Raises
+    ------
+    ValueError
+        For ``counts`` without a file, a file that does not load, or one for another grid (or,
+        for a model calibrated through a pan/tilt camera, another spacing).
+
+    """
+    if values['observation.model'] != 'counts':
+        return GaussianObservation(grid, fpoc)
+    source = values['observation.file']
+    if not source:
+        raise ValueError('observation.model counts needs observation.file (a path or a shipped '
+                         'count model name)')
+    model = load_observation(source)
+    if model.grid.shape != grid.shape:
+        raise ValueError(f'observation.file {source!r} is a count model for a '
+                         f'{model.grid.rows}x{model.grid.cols} grid, not this '
+                         f'{grid.rows}x{grid.cols} grid')
+    image = model.meta.get('image') or {}
+    if image.get('view') == 'pan_tilt' and \
+            abs(model.grid.spacing_deg - grid.spacing_deg) > 1e-9 * grid.spacing_deg:
+        raise ValueError(f'observation.file {source!r} was calibrated on a pan/tilt grid of '
+                         f'{model.grid.spacing_deg} deg/cell, not {grid.spacing_deg}')
+    return model
 
 
 def main(args=None) -> int:

@@ -1,12 +1,17 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-The ROS 2 demo: both nodes as separate processes, watched from this process.
+The ROS 2 demo: the nodes as separate processes, watched from this process.
 
 :func:`run_demo` starts ``gaze_controller`` and then ``simulated_camera`` (once the controller's
 first target has arrived here, so no update is missed), prints every fixation until the ``found``
 event, checks the answer against the camera's ``ground_truth`` and stops both with SIGTERM. It
 runs on its own ROS domain with discovery limited to this host, so it never drives a real head.
+
+:func:`faces_setup` is the face demo (``--scene faces``): ``gaze_controller``, then
+``foveal_detector`` (once the target is out) and ``scene_camera`` (once the detector listens to
+``image``), with the shipped ``config/faces_<mode>_*.yaml`` files; the answer is right when the
+found cell is within one cell (Chebyshev) of the face centre's cell.
 """
 from __future__ import annotations
 
@@ -22,7 +27,7 @@ import numpy as np
 import yaml
 
 from .config import config_file
-from .params import grid_from, head_from
+from .params import grid_from, head_from, joint_params
 from .processes import domain_id_for, isolated_nodes
 from .watch import SearchRecord, Watch
 
@@ -64,13 +69,33 @@ def _ros_value(value) -> str:
 
 @dataclass
 class DemoSetup:
-    """Arguments of both nodes and the controller's grid and head, as the YAML files say."""
+    """
+    The demo's nodes and the controller's grid and head, as the YAML files say.
 
-    controller_args: list
-    camera_args: list
+    ``nodes`` lists ``(node, ros_args)`` in start order (keys of ``NODE_NAMES``); ``scene`` is
+    ``'gaussian'`` (the simulated camera) or ``'faces'``; ``mode`` the detector's (faces);
+    ``image_px`` the ``(width, height)`` of the fixed scene (fovea mode, for pixel answers).
+    """
+
+    nodes: list
     grid: object
     head: PanTiltMap
     overrides: dict = field(default_factory=dict)
+    scene: str = 'gaussian'
+    mode: str = ''
+    image_px: tuple | None = None
+
+    @property
+    def tolerance_cells(self) -> int:
+        """How far (Chebyshev, cells) the answer may be from the truth and still be right."""
+        return 1 if self.scene == 'faces' else 0
+
+
+def _ros_args(path, overrides: dict) -> list:
+    args = ['--params-file', str(path)]
+    for name, value in overrides.items():
+        args += ['-p', f'{name}:={_ros_value(value)}']
+    return args
 
 
 def demo_setup(fpoc: str = 'camera', policy: str | None = None, seed: int = 0,
@@ -90,26 +115,63 @@ def demo_setup(fpoc: str = 'camera', policy: str | None = None, seed: int = 0,
     values = yaml_parameters(controller_yaml, 'gaze_controller')
     values.update(controller)
     grid = grid_from(values)
-
-    def ros_args(path, overrides):
-        args = ['--params-file', str(path)]
-        for name, value in overrides.items():
-            args += ['-p', f'{name}:={_ros_value(value)}']
-        return args
-
-    return DemoSetup(ros_args(controller_yaml, controller), ros_args(camera_yaml, camera), grid,
+    return DemoSetup([('controller', _ros_args(controller_yaml, controller)),
+                      ('camera', _ros_args(camera_yaml, camera))], grid,
                      head_from(values, grid), controller)
 
 
-def run_demo(setup: DemoSetup, timeout_s: float = 120.0, domain_id: int | None = None,
-             verbose: bool = False, out=print) -> int:
-    """Run the demo; 0 when the target was found and both nodes stopped cleanly."""
+def faces_setup(fovea: bool = False, policy: str | None = None, seed: int = 0) -> DemoSetup:
+    """
+    Build the face demo from ``config/faces_<mode>_*.yaml``: scene camera, detector, controller.
+
+    ``fovea`` selects the fixed camera and the digital fovea (mode ``fovea``), else the camera
+    on the pan/tilt head (mode ``camera``); ``seed`` picks the held-out test scene.
+    """
+    mode = 'fovea' if fovea else 'camera'
+    files = {node: config_file(f'faces_{mode}_{node}.yaml')
+             for node in ('controller', 'detector', 'scene_camera')}
+    controller = {'policy.name': policy} if policy else {}
+    values = {p.name: p.default for p in joint_params(limits=True)}
+    values.update(yaml_parameters(files['controller'], 'gaze_controller'))
+    values.update(controller)
+    grid = grid_from(values)
+    image_px = None
+    if fovea:
+        side = yaml_parameters(files['scene_camera'], 'scene_camera').get('scene.size_px', 420)
+        image_px = (int(side), int(side))
+    return DemoSetup([('controller', _ros_args(files['controller'], controller)),
+                      ('detector', _ros_args(files['detector'], {})),
+                      ('scene_camera', _ros_args(files['scene_camera'], {'seed': seed}))],
+                     grid, head_from(values, grid), controller, 'faces', mode, image_px)
+
+
+def _started(watch, record, node: str):
+    """Return what has to be seen before the node after ``node`` may start."""
+    if node == 'controller':
+        return lambda: bool(record.targets)
+    if node == 'detector':
+        return lambda: watch.node.count_subscribers('image') > 0
+    return None
+
+
+def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = None,
+             verbose: bool = False, out=print, stats: dict | None = None,
+             max_fixations: int = 60) -> int:
+    """
+    Run the demo; 0 when an answer was judged in time and every node stopped cleanly.
+
+    The answer is the ``found`` event's cell or, when no cell reached the controller's
+    confidence after ``max_fixations`` fixations, the most likely cell then. ``stats``, when
+    given, is filled with the answer (``row``, ``col``, ``cell``, ``probability``,
+    ``fixations``), ``stop`` (``found``, ``budget`` or ``timeout``), ``truth`` (the ground
+    truth's ``(row, col)``), ``right`` and ``search_s``: seconds from starting the last node to
+    the belief of the answer's last fixation.
+    """
     domain = domain_id_for() if domain_id is None else domain_id
     with isolated_nodes(domain, prefix='ipomdp-gaze-demo-') as nodes:
-        controller = nodes.add('controller', setup.controller_args)
-        camera = nodes.add('camera', setup.camera_args)
+        procs = [nodes.add(node, args) for node, args in setup.nodes]
         watch = Watch(domain, 'gaze_demo', nodes)
-        record = SearchRecord(watch, depth=50, updates_only=True)
+        record = SearchRecord(watch, depth=200, updates_only=True)
         deadline = time.monotonic() + timeout_s
 
         def wait(condition) -> bool:
@@ -117,65 +179,127 @@ def run_demo(setup: DemoSetup, timeout_s: float = 120.0, domain_id: int | None =
             return watch.wait_until(condition, max(0.0, deadline - time.monotonic()), POLL_S)
 
         g = setup.grid
-        out(f'ipomdp-gaze demo: {g.rows}x{g.cols} grid at {g.spacing_deg} deg/cell, ROS domain '
-            f'{domain}; starting gaze_controller, then simulated_camera')
+        where = f'{setup.scene} scene, detector mode {setup.mode}, ' if setup.mode else ''
+        out(f'ipomdp-gaze demo: {where}{g.rows}x{g.cols} grid at {g.spacing_deg} deg/cell, '
+            f'ROS domain {domain}; starting ' + ', then '.join(p.name for p in procs))
         status = 1
         try:
-            controller.start()
-            if not wait(lambda: record.targets):
-                raise RuntimeError('the controller sent no target in time')
-            camera.start()
-            status = _follow(setup, record, wait, timeout_s, out)
+            for proc in procs:
+                started = time.monotonic()
+                proc.start()
+                ready = _started(watch, record, proc.node)
+                if proc is not procs[-1] and ready is not None and not wait(ready):
+                    raise RuntimeError(f'{proc.name} did not come up in time')
+            status = _follow(setup, record, wait, timeout_s, out, stats, max_fixations)
+            if stats is not None and stats.get('fixations'):
+                stats['search_s'] = record.beliefs[stats['fixations'] - 1][0] - started
         except RuntimeError as exc:
             out(f'ipomdp-gaze demo: error: {exc}')
         finally:
-            alive = {p.node: p.running for p in (camera, controller)}
-            codes = {p.node: code for p, code in nodes.stop([camera, controller])}
+            alive = {p.node: p.running for p in procs}
+            codes = {p.node: code for p, code in nodes.stop(procs[::-1])}
             watch.close()
         if verbose or status:
-            for p in (controller, camera):
+            for p in procs:
                 out(f'--- {p.node} output ---\n{p.output().rstrip()}')
         clean = all(codes[k] == 0 for k, running in alive.items() if running)
         states = ', '.join(f'{k} exit status {v}' + ('' if alive[k] or v is None else
                                                      ' (had already exited)')
                            for k, v in codes.items())
-        out(f'stopped both nodes ({states})' + ('' if clean else ': NOT a clean shutdown'))
+        which = 'both nodes' if len(procs) == 2 else f'all {len(procs)} nodes'
+        out(f'stopped {which} ({states})' + ('' if clean else ': NOT a clean shutdown'))
         return status if clean else 1
 
 
-def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out) -> int:
-    """Print fixations until the found event; return 0 once the answer was checked."""
+def _where(setup: DemoSetup, cell: int) -> str:
+    """Say where a cell is: its pixel centre (a fixed camera) or its pan and tilt."""
+    if setup.image_px is not None:
+        from ipomdp_gaze.vision.search import cell_centre_px
+        x, y = cell_centre_px(setup.grid, cell, setup.image_px)
+        return f'pixel ({x:5.1f}, {y:5.1f})'
+    pan, tilt = setup.head.angles(cell)
+    return f'pan {math.degrees(pan):+6.2f} deg  tilt {math.degrees(tilt):+6.2f} deg'
+
+
+def _answer(setup: DemoSetup, row: int, col: int, cell: int, probability: float,
+            fixations: int) -> str:
+    """Say where the answer is and how sure: ``(row, col), <where>, probability p, after n``."""
+    if setup.scene == 'faces':
+        place = ' '.join(_where(setup, cell).split())
+    else:
+        pan, tilt = setup.head.angles(cell)
+        place = f'pan {math.degrees(pan):+.2f} deg, tilt {math.degrees(tilt):+.2f} deg'
+    return (f'({row}, {col}), {place}, probability {probability:.3f}, after {fixations} '
+            f'fixations')
+
+
+def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
+            stats: dict | None = None, max_fixations: int = 60) -> int:
+    """
+    Print fixations until the found event (or ``max_fixations``); judge the answer.
+
+    Without a found event after ``max_fixations`` fixations (or at the deadline), the answer is
+    the most likely cell of the last belief. Returns 0 once an answer was judged before the
+    deadline, else 1.
+    """
     grid, head = setup.grid, setup.head
     printed = 0
 
+    def last() -> int:
+        if record.found:
+            return diagnostics.parse_found(record.found[0][1])['fixations']
+        return max_fixations
+
     def show_new():
         nonlocal printed
-        while printed < min(len(record.beliefs), len(record.targets)):
+        while printed < min(len(record.beliefs), len(record.targets), last()):
             belief = grid_arrays.from_multiarray(record.beliefs[printed][1], grid)
             pan, tilt = joints.angles_from_joint_state(record.targets[printed][1], head)
-            looked = grid.cell(head.nearest_cell(pan, tilt))
+            looked = head.nearest_cell(pan, tilt)
             guess = int(np.argmax(belief))
-            out(f'fixation {printed + 1:3d}: looked at {looked}  pan {math.degrees(pan):+6.2f} '
-                f'deg  tilt {math.degrees(tilt):+6.2f} deg  ->  most likely {grid.cell(guess)} '
+            out(f'fixation {printed + 1:3d}: looked at {grid.cell(looked)}  '
+                f'{_where(setup, looked)}  ->  most likely {grid.cell(guess)} '
                 f'p={belief[guess]:.3f}  entropy {float(entropy(belief)):.2f} nats')
             printed += 1
 
     def finished():
         show_new()
-        return bool(record.found) and \
-            printed >= diagnostics.parse_found(record.found[0][1])['fixations']
+        return printed >= last()
 
-    if not wait(finished):
-        out(f'ipomdp-gaze demo: the target was not found within {timeout_s:g} s')
+    what = 'face' if setup.scene == 'faces' else 'target'
+    in_time = wait(finished)
+    if record.found and printed >= last():
+        found = diagnostics.parse_found(record.found[0][1])
+        answer, stop = (found['row'], found['col'], found['cell']), 'found'
+        out(f'found: the {what} is most likely at '
+            + _answer(setup, *answer, found['probability'], found['fixations']))
+    elif printed == 0:
+        out(f'ipomdp-gaze demo: the {what} was not found within {timeout_s:g} s')
         return 1
-    found = diagnostics.parse_found(record.found[0][1])
-    out(f"found: the target is most likely at ({found['row']}, {found['col']}), pan "
-        f"{math.degrees(found['pan_rad']):+.2f} deg, tilt {math.degrees(found['tilt_rad']):+.2f} "
-        f"deg, probability {found['probability']:.3f}, after {found['fixations']} fixations")
+    else:
+        belief = grid_arrays.from_multiarray(record.beliefs[printed - 1][1], grid)
+        cell = int(np.argmax(belief))
+        answer = (*grid.cell(cell), cell)
+        found = {'row': answer[0], 'col': answer[1], 'cell': cell, 'fixations': printed,
+                 'probability': float(belief[cell])}
+        stop = 'budget' if in_time else 'timeout'
+        why = f'after {max_fixations} fixations' if in_time else \
+            f'within {timeout_s:g} s'
+        out(f'gave up: no cell reached the confidence {why}; the {what} is most likely at '
+            + _answer(setup, *answer, float(belief[cell]), printed))
+    camera = 'scene camera' if setup.scene == 'faces' else 'simulated camera'
     if not wait(lambda: record.truth):
-        out('ipomdp-gaze demo: the simulated camera did not report where the target is')
+        out(f'ipomdp-gaze demo: the {camera} did not report where the {what} is')
         return 1
     truth = grid_arrays.cell_from_ground_truth(record.truth[-1][1], grid)
-    verdict = 'right' if truth == found['cell'] else 'wrong'
-    out(f'the simulated camera hid the target at {grid.cell(truth)}: that is {verdict}')
-    return 0
+    (tr, tc), (fr, fc) = grid.cell(truth), answer[:2]
+    right = max(abs(tr - fr), abs(tc - fc)) <= setup.tolerance_cells
+    if stats is not None:
+        stats.update(found, truth=(tr, tc), right=right, stop=stop)
+    verdict = 'right' if right else 'wrong'
+    if setup.scene == 'faces':
+        out(f'the scene camera put the face centre in cell {grid.cell(truth)}: that is '
+            f'{verdict}')
+    else:
+        out(f'the simulated camera hid the target at {grid.cell(truth)}: that is {verdict}')
+    return 0 if stop != 'timeout' else 1

@@ -72,7 +72,7 @@ class NodeProcess:
     def __init__(self, node: str, ros_args=(), env: dict | None = None, log_path=None,
                  stack_dump: bool = False):
         if node not in NODE_NAMES:
-            raise ValueError(f"node must be 'controller' or 'camera', got {node!r}")
+            raise ValueError(f"node must be one of {', '.join(NODE_NAMES)}, got {node!r}")
         self.node = node
         self.name = NODE_NAMES[node]
         main = ['-c', STACK_DUMP_MAIN.format(node=node)] if stack_dump else \
@@ -157,7 +157,7 @@ class NodeGroup:
         return int(self.env['ROS_DOMAIN_ID'])
 
     def add(self, node: str, ros_args=()) -> NodeProcess:
-        """Prepare a node process (``controller`` or ``camera``) of this run, not started yet."""
+        """Prepare a node process (a key of ``NODE_NAMES``) of this run, not started yet."""
         log = self.log_dir / f'{node}-{self._count}.log'
         self._count += 1
         proc = NodeProcess(node, ros_args, self.env, log, self.stack_dump)
@@ -165,7 +165,7 @@ class NodeGroup:
         return proc
 
     def start(self, node: str, ros_args=()) -> NodeProcess:
-        """Start a node process (``controller`` or ``camera``)."""
+        """Start a node process (a key of ``NODE_NAMES``)."""
         return self.add(node, ros_args).start()
 
     def kill(self, proc: NodeProcess) -> None:

@@ -9,7 +9,9 @@ Real pixels for the model (docs/design.md section 6): detectors, the digital fov
   count observations per fixation;
 - :mod:`~ipomdp_gaze.vision.fullframe`: the full-frame scan baseline (:func:`scan`);
 - :mod:`~ipomdp_gaze.vision.scenes`: labelled scenes built from scikit-image's photos and faces
-  (imported on its own, not re-exported here).
+  (imported on its own, not re-exported here);
+- :mod:`~ipomdp_gaze.vision.pan_tilt`: the pan/tilt face task, a scene a head camera looks
+  around in, its rendered views and their counts (imported on its own).
 
 Part of the core: numpy and OpenCV only, nothing from ROS or the policies.
 """

@@ -75,37 +75,53 @@ def tally_image(fovea: Fovea, image: np.ndarray, target_cell: int | None,
 
     ``target_cell`` is the cell holding the face centre, or None for a face-absent image.
     """
-    grid, k_max = fovea.grid, fovea.config.max_count
-    rows, cols = grid.shape
+    grid = fovea.grid
     fixations = np.arange(grid.n_cells) if fixations is None else np.asarray(fixations)
     fovea.start(image)
     scan = fovea.scan()
     frames = np.empty((fixations.size, grid.n_cells))
     for i, k in enumerate(fixations):
         frames[i] = fovea.observe(int(k)).counts
+    tallies = tally_frames(grid, fovea.config.max_count, frames, fixations, target_cell,
+                           None if scan is None else scan.counts)
+    tallies.detector_pixels = fovea.image_detector_pixels
+    tallies.seconds = fovea.image_seconds
+    return tallies
+
+
+def tally_frames(grid: Grid, max_count: int, frames: np.ndarray, fixations,
+                 target_cell: int | None, scan_counts=None) -> Tallies:
+    """
+    Tally count frames ``(F, N)`` of one labelled image taken at ``fixations`` ``(F,)``.
+
+    Each observed (not NaN) cell's count goes to its offset ``(|dr|, |dc|)`` from the frame's
+    fixation: in the target table for ``target_cell``, in the null table for every other cell.
+    ``scan_counts`` ``(N,)``, the image's one-time scan, goes to the offset-free scan tallies.
+    """
+    rows, cols = grid.shape
+    fixations = np.asarray(fixations)
     r, c = grid.rows_cols()
     rk, ck = grid.cell(fixations)
     dr = np.abs(r[None, :] - rk[:, None])
     dc = np.abs(c[None, :] - ck[:, None])
     seen = ~np.isnan(frames)
     counts = np.where(seen, frames, 0).astype(np.intp)
-    flat = (dr * cols + dc) * k_max + counts
+    flat = (dr * cols + dc) * max_count + counts
     is_target = np.zeros(grid.n_cells, dtype=bool)
     if target_cell is not None:
         is_target[int(target_cell)] = True
-    size = rows * cols * k_max
+    size = rows * cols * max_count
     null = np.bincount(flat[seen & ~is_target[None, :]], minlength=size)
     target = np.bincount(flat[seen & is_target[None, :]], minlength=size)
-    shape = (rows, cols, k_max)
-    scan_target = np.zeros(k_max, dtype=np.int64)
-    scan_null = np.zeros(k_max, dtype=np.int64)
-    if scan is not None:
-        scan_counts = scan.counts.astype(np.intp)
-        scan_target = np.bincount(scan_counts[is_target], minlength=k_max)
-        scan_null = np.bincount(scan_counts[~is_target], minlength=k_max)
+    shape = (rows, cols, max_count)
+    scan_target = np.zeros(max_count, dtype=np.int64)
+    scan_null = np.zeros(max_count, dtype=np.int64)
+    if scan_counts is not None:
+        scan_counts = np.asarray(scan_counts).astype(np.intp)
+        scan_target = np.bincount(scan_counts[is_target], minlength=max_count)
+        scan_null = np.bincount(scan_counts[~is_target], minlength=max_count)
     return Tallies(target.reshape(shape), null.reshape(shape), scan_target, scan_null, images=1,
-                   fixations=int(fixations.size), detector_pixels=fovea.image_detector_pixels,
-                   seconds=fovea.image_seconds)
+                   fixations=int(fixations.size))
 
 
 def _worker_tally(job) -> Tallies:
@@ -188,6 +204,109 @@ def tally_images(items, detector_kwargs: dict, grid: Grid, config: FoveaConfig,
     return total
 
 
+def tally_views(observer, geometry, scene_image: np.ndarray, target_cell: int | None,
+                fixations=None) -> Tallies:
+    """
+    Tally one pan/tilt scene viewed with the head at every cell of ``fixations`` (default: all).
+
+    Each view is rendered by ``geometry`` (:class:`ipomdp_gaze.vision.pan_tilt.SceneGeometry`)
+    and observed by ``observer`` (:class:`ipomdp_gaze.vision.pan_tilt.ViewObserver`), exactly as
+    the ``scene_camera`` and ``foveal_detector`` nodes do; cells outside a view are not tallied.
+    """
+    grid = observer.grid
+    fixations = np.arange(grid.n_cells) if fixations is None else np.asarray(fixations)
+    frames = np.empty((fixations.size, grid.n_cells))
+    pixels, seconds = 0, 0.0
+    for i, k in enumerate(fixations):
+        view = geometry.render(scene_image, grid.cell(int(k)))
+        observation = observer.observe(view, geometry.camera, grid.cell(int(k)))
+        frames[i] = observation.counts
+        pixels += observation.detector_pixels
+        seconds += observation.seconds
+    tallies = tally_frames(grid, observer.max_count, frames, fixations, target_cell)
+    tallies.detector_pixels, tallies.seconds = pixels, seconds
+    return tallies
+
+
+def _worker_tally_views(job) -> Tallies:
+    """Tally pan/tilt scenes in a worker process (its own detector)."""
+    import cv2
+    from ipomdp_gaze.head_camera import observed_cells
+    from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, ViewObserver
+    cv2.setNumThreads(1)
+    detector_kwargs, max_count, scene_kwargs, indices, null_scenes = job
+    scenes = PanTiltSceneSet.from_kwargs(scene_kwargs)
+    geometry = scenes.geometry
+    grid = geometry.grid
+    observer = ViewObserver(HaarDetector(**detector_kwargs), grid, max_count)
+    total = Tallies.empty(grid, max_count)
+    poses = np.arange(grid.n_cells)
+    for index in indices:
+        scene = scenes.scene(index)
+        target = grid.index(*scene.cell)
+        if index < null_scenes:
+            total += tally_views(observer, geometry, scene.image, target)
+            continue
+        sees = [k for k in poses
+                if observed_cells(geometry.camera, grid, grid.cell(int(k)))[target]]
+        part = tally_views(observer, geometry, scene.image, target, sees)
+        part.null[...] = 0
+        total += part
+    return total
+
+
+def tally_pan_tilt_scenes(scenes, indices, detector_kwargs: dict, max_count: int,
+                          null_scenes: int | None = None, processes: int = 2,
+                          progress=None) -> Tallies:
+    """
+    Tally pan/tilt scenes, the head at every pose, in worker processes.
+
+    The target tables need many faces and only the views that show the face; the null tables
+    need many views but few scenes. So scene ``i`` of ``indices`` is viewed from every pose (all
+    its cells tallied) when ``i < null_scenes``, and otherwise only from the poses whose view
+    shows the face's cell, of which only the face's cell is tallied. Both tables stay unbiased
+    (every tally of a table is taken under the same rule for every scene it uses), and the
+    calibration costs a fraction of viewing every scene from every pose.
+
+    Parameters
+    ----------
+    scenes : PanTiltSceneSet
+        The scenes (regenerated in the workers from :meth:`PanTiltSceneSet.kwargs`).
+    indices : sequence of int
+        Which scenes.
+    detector_kwargs : dict
+        Arguments of :class:`HaarDetector`.
+    max_count : int
+        K.
+    null_scenes : int, optional
+        Scene indices below this are viewed from every pose (default: all of them).
+    processes : int
+        Worker processes (1: in this process).
+    progress : callable, optional
+        Called with the number of scenes done after each chunk.
+
+    """
+    indices = [int(i) for i in indices]
+    null_scenes = max(indices, default=0) + 1 if null_scenes is None else int(null_scenes)
+    grid = scenes.geometry.grid
+    total = Tallies.empty(grid, max_count)
+    chunk = max(1, min(4, len(indices) // max(1, 4 * processes)))
+    jobs = [(dict(detector_kwargs), int(max_count), scenes.kwargs(), indices[i:i + chunk],
+             null_scenes) for i in range(0, len(indices), chunk)]
+    if processes <= 1:
+        for job in jobs:
+            total += _worker_tally_views(job)
+            if progress:
+                progress(len(job[3]))
+        return total
+    with ProcessPoolExecutor(processes) as pool:
+        for job, part in zip(jobs, pool.map(_worker_tally_views, jobs)):
+            total += part
+            if progress:
+                progress(len(job[3]))
+    return total
+
+
 def pool_target(tallies: np.ndarray, pool_radius: float, min_tallies: int = 0) -> np.ndarray:
     """
     Pool the target tallies of offsets at similar Euclidean distances from the fixation.
@@ -221,6 +340,9 @@ def count_model(tallies: Tallies, grid: Grid, prior: float = 1.0, pool_radius: f
     """
     Build the count model: Dirichlet(``prior``) estimates, target tallies pooled radially.
 
+    An offset never observed at all (no target and no null tally: outside a pan/tilt camera's
+    view) gets the same table for both hypotheses, so it adds nothing to the belief or to ELM.
+
     With ``scan`` the model also gets the scan tables, from the scan tallies with the same prior.
 
     Raises
@@ -237,6 +359,9 @@ def count_model(tallies: Tallies, grid: Grid, prior: float = 1.0, pool_radius: f
     null = tallies.null.astype(float) + prior
     target /= target.sum(axis=2, keepdims=True)
     null /= null.sum(axis=2, keepdims=True)
+    # An offset no frame ever observed (outside a pan/tilt camera's view) says nothing.
+    unseen = (tallies.target.sum(axis=2) == 0) & (tallies.null.sum(axis=2) == 0)
+    target[unseen] = null[unseen]
     scan_target = scan_null = None
     if scan:
         if tallies.scan_null.sum() == 0:
@@ -250,5 +375,12 @@ def count_model(tallies: Tallies, grid: Grid, prior: float = 1.0, pool_radius: f
 
 
 def hit_false_alarm(model: CountObservation) -> tuple[np.ndarray, np.ndarray]:
-    """``P(c > 0 | target, offset)`` and ``P(c > 0 | no target, offset)``, each (rows, cols)."""
-    return 1.0 - model.p_target[:, :, 0], 1.0 - model.p_null[:, :, 0]
+    """
+    ``P(c > 0 | target, offset)`` and ``P(c > 0 | no target, offset)``, each (rows, cols).
+
+    Offsets whose two tables are the same (never observed, e.g. outside a pan/tilt camera's
+    view) are NaN in both.
+    """
+    same = np.all(model.p_target == model.p_null, axis=2)
+    return (np.where(same, np.nan, 1.0 - model.p_target[:, :, 0]),
+            np.where(same, np.nan, 1.0 - model.p_null[:, :, 0]))

@@ -42,7 +42,7 @@ its pixels count once per image (as in NMPT).
 frame, so the same detections enter the Bayes step again at each fixation: a single false alarm
 in that window, counted ten times, can make the belief confident. With ``scan_once`` the
 whole-image windows form a separate observation, :meth:`Fovea.scan`, taken once per image before
-the first fixation and modelled by its own offset-free table (docs/design.md section 6.6); the
+the first fixation and modelled by its own offset-free table (docs/design.md section 6.8); the
 fixation frames then hold the other windows only. Without a whole-image window there is nothing to
 scan and the option is refused.
 

@@ -446,10 +446,15 @@ def fovea_for_model(model, detector=None, reuse_windows: bool = True) -> Fovea:
     Raises
     ------
     ValueError
-        If the model records neither a detector nor is given one, or a record is invalid.
+        If the model records neither a detector nor is given one, a record is invalid, or the
+        model was calibrated through a pan/tilt camera (``meta['image']['view']``).
 
     """
     meta = getattr(model, 'meta', {})
+    if (meta.get('image') or {}).get('view') == 'pan_tilt':
+        raise ValueError('the observation model was calibrated through a pan/tilt camera '
+                         '(image view pan_tilt): it describes views of a head camera, not a '
+                         'fovea over a still image; use a fixed-view model such as faces-420')
     if detector is None:
         if meta.get('detector') is None:
             raise ValueError('the observation model does not record its detector '

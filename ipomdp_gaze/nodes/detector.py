@@ -1,0 +1,281 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The ``foveal_detector`` node: camera images in, one frame of detection counts per fixation out.
+
+A thin wrapper: :class:`ipomdp_gaze.detection.DetectorLoop` decides which image serves which
+fixation and counts its detections, and :mod:`msg_adapters` reads and fills every message
+(docs/design.md section 6.6). Two modes (``mode``, read-only):
+
+- ``fovea``: a fixed camera; the grid tiles the image and the digital fovea is placed on the
+  fixated cell (the shipped ``faces-420-nmpt`` model by default);
+- ``camera``: a camera on the pan/tilt head; the detector runs on the whole view, its
+  detections are binned to pan/tilt cells with ``camera_info``'s K and the head pose of the
+  ``joint_states`` message stamped like the image, and cells outside the view are NaN (the
+  shipped ``faces-pan-tilt`` model by default).
+
+Relative topic names:
+
+- subscribes ``image`` (``sensor_msgs/Image``: ``mono8``, ``rgb8`` or ``bgr8``; reliable, or
+  best effort with ``image_best_effort``; depth 1: the newest wins), ``camera_info``
+  (``sensor_msgs/CameraInfo``, ``camera`` mode), ``joint_states`` (``sensor_msgs/JointState``,
+  ``camera`` mode) and ``fixation`` (``std_msgs/Int32MultiArray`` ``[row, col]``, transient
+  local: the controller's);
+- publishes ``evidence_image`` (``32FC1``, stamped with the image's capture stamp; NaN = not
+  observed) or, with ``publish_image: false``, ``evidence``; and ``/diagnostics``.
+
+A malformed image (another encoding, a step or data length that disagrees with the size, an
+empty or oversized image) is rejected with a throttled warning naming the reason and counted;
+nothing else changes. Run with ``ros2 run ipomdp_gaze detector`` (or ``ipomdp-gaze detector``).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+import sys
+
+from diagnostic_msgs.msg import DiagnosticArray
+from ipomdp_gaze.detection import build_setup, DetectorLoop, DetectorSetup, MODES
+from ipomdp_gaze.head import PanTiltMap
+from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, stamps
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import CameraInfo, Image, JointState
+from std_msgs.msg import Float32MultiArray, Int32MultiArray
+
+from . import NODE_NAMES
+from .params import head_from, joint_params, MAX_CELLS_PER_SIDE, Param, ParameterTransaction, T
+from .spin import run_node
+
+NODE_NAME = NODE_NAMES['detector']
+SENSOR_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT)
+# Images are large: over best effort, Fast DDS drops a whole image when one fragment is lost,
+# so the subscription is reliable unless the driver only publishes best effort.
+IMAGE_QOS = {False: QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE),
+             True: SENSOR_QOS}
+FRAME_QOS = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
+STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                       durability=DurabilityPolicy.TRANSIENT_LOCAL)
+WARN_THROTTLE_S = 5.0
+SETUP_KEYS = ('observation.file', 'grid.rows', 'grid.cols', 'grid.spacing_deg',
+              'detector.cascade', 'detector.scale_factor', 'detector.min_neighbors',
+              'detector.cascade_dir')
+
+
+def detector_params() -> list[Param]:
+    """Every parameter of the foveal detector, in declaration order."""
+    return [
+        Param('mode', 'fovea', T.STRING,
+              'fovea: a fixed camera, the grid tiles the image; camera: a camera on the pan/tilt '
+              'head (read-only)', read_only=True, choices=MODES),
+        Param('observation.file', '', T.STRING,
+              'count model: an ipomdp_gaze/observation-v1 path or shipped name ("": '
+              'faces-420-nmpt in fovea mode, faces-pan-tilt in camera mode); its grid, fovea '
+              'and detector win'),
+        Param('grid.rows', 0, T.INTEGER, "rows (0: the observation file's; read-only)",
+              read_only=True, int_range=(0, MAX_CELLS_PER_SIDE)),
+        Param('grid.cols', 0, T.INTEGER, "columns (0: the observation file's; read-only)",
+              read_only=True, int_range=(0, MAX_CELLS_PER_SIDE)),
+        Param('grid.spacing_deg', 0.0, T.DOUBLE,
+              "camera mode: pan/tilt degrees per cell (0.0: the observation file's; read-only)",
+              read_only=True, float_range=(0.0, 90.0)),
+        Param('detector.cascade', '', T.STRING,
+              "Haar cascade file name (\"\": the observation file's; another is refused)"),
+        Param('detector.scale_factor', 0.0, T.DOUBLE,
+              "detectMultiScale scale factor (0.0: the observation file's)",
+              float_range=(0.0, 10.0)),
+        Param('detector.min_neighbors', -1, T.INTEGER,
+              "detectMultiScale minNeighbors (-1: the observation file's)",
+              int_range=(-1, 1000)),
+        Param('detector.cascade_dir', '', T.STRING,
+              'folder searched first for the cascade ("": cv2.data, then /usr/share/opencv4)'),
+    ] + joint_params(limits=False) + [
+        Param('joint_state_tolerance_s', 0.0, T.DOUBLE,
+              'camera mode: pair an image with a joint state stamped at most this far from it '
+              '(0: the same stamp)', float_range=(0.0, 1.0)),
+        Param('image_best_effort', False, T.BOOL,
+              'subscribe image best effort, for a driver that publishes it so (default '
+              'reliable: large images lose fragments over best effort; read-only)',
+              read_only=True),
+        Param('publish_image', True, T.BOOL,
+              'publish stamped 32FC1 evidence_image frames (false: evidence)'),
+        Param('max_image_side_px', images.MAX_IMAGE_SIDE_PX, T.INTEGER,
+              'images larger than this on a side are rejected (read-only)', read_only=True,
+              int_range=(32, 65536)),
+        Param('diagnostics_period_s', 1.0, T.DOUBLE, 'period of /diagnostics',
+              float_range=(0.01, 3600.0)),
+    ]
+
+
+@dataclass
+class DetectorConfig:
+    """What the node derives from its parameters."""
+
+    values: dict
+    setup: DetectorSetup
+    head: PanTiltMap | None
+
+
+def _detector_settings(values: dict) -> dict:
+    """Return the detector settings given as parameters (unset ones left out)."""
+    given = {}
+    if values['detector.cascade']:
+        given['cascade'] = values['detector.cascade']
+    if values['detector.scale_factor'] > 0:
+        given['scale_factor'] = values['detector.scale_factor']
+    if values['detector.min_neighbors'] >= 0:
+        given['min_neighbors'] = values['detector.min_neighbors']
+    return given
+
+
+class FovealDetectorNode(Node):
+    """ROS 2 wrapper of :class:`ipomdp_gaze.detection.DetectorLoop`."""
+
+    def __init__(self, **kwargs):
+        super().__init__(NODE_NAME, **kwargs)
+        self._transaction = ParameterTransaction(self, detector_params(), self._build,
+                                                 self._apply_config)
+        self._transaction.declare()
+        self._transaction.start(self._build(self._transaction.values()))
+        cfg = self._config
+        v = cfg.values
+        self.loop = DetectorLoop(cfg.setup, cfg.head, v['joint_state_tolerance_s'])
+        self._reported_rejections = 0
+        self._evidence_pub = self.create_publisher(Float32MultiArray, 'evidence', FRAME_QOS)
+        self._image_pub = self.create_publisher(Image, 'evidence_image', FRAME_QOS)
+        self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
+        self.create_subscription(Image, 'image', self._on_image,
+                                 IMAGE_QOS[v['image_best_effort']])
+        self.create_subscription(Int32MultiArray, 'fixation', self._on_fixation, STATE_QOS)
+        if cfg.setup.mode == 'camera':
+            self.create_subscription(CameraInfo, 'camera_info', self._on_camera_info,
+                                     SENSOR_QOS)
+            self.create_subscription(JointState, 'joint_states', self._on_joint_states,
+                                     QoSProfile(depth=50,
+                                                reliability=ReliabilityPolicy.BEST_EFFORT))
+        self._diag_timer = self.create_timer(v['diagnostics_period_s'],
+                                             self._publish_diagnostics)
+        g = cfg.setup.grid
+        self.get_logger().info(
+            f'{cfg.setup.mode} mode, count model {cfg.setup.name!r} ({g.rows}x{g.cols} grid, '
+            f'K = {cfg.setup.model.max_count + 1}), detector {cfg.setup.detector!r}; waiting '
+            f'for fixation and image')
+
+    @property
+    def _config(self) -> DetectorConfig:
+        """Return the configuration in force."""
+        return self._transaction.config
+
+    # -- parameters ----------------------------------------------------------------------
+    def _build(self, values: dict, changed=None,
+               previous: DetectorConfig | None = None) -> DetectorConfig:
+        """Derive a :class:`DetectorConfig` (ValueError names the problem)."""
+        if previous is not None and not any(k in changed for k in SETUP_KEYS):
+            setup = previous.setup
+        else:
+            setup = build_setup(
+                values['mode'], values['observation.file'],
+                (values['grid.rows'], values['grid.cols'], values['grid.spacing_deg']),
+                _detector_settings(values), values['detector.cascade_dir'])
+        head = head_from(values, setup.grid) if setup.mode == 'camera' else None
+        return DetectorConfig(dict(values), setup, head)
+
+    def _apply_config(self, old: DetectorConfig, cfg: DetectorConfig) -> None:
+        """Follow a new configuration: model, head mapping, tolerance and period."""
+        self.loop.set_setup(cfg.setup)
+        self.loop.head = cfg.head
+        self.loop.tolerance_s = cfg.values['joint_state_tolerance_s']
+        if cfg.values['diagnostics_period_s'] != old.values['diagnostics_period_s']:
+            self.destroy_timer(self._diag_timer)
+            self._diag_timer = self.create_timer(cfg.values['diagnostics_period_s'],
+                                                 self._publish_diagnostics)
+
+    # -- inputs --------------------------------------------------------------------------
+    def _now_s(self) -> float:
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def _stamp_s(self, stamp) -> float:
+        """Seconds of a header stamp; its arrival time when the stamp was left at zero."""
+        return self._now_s() if stamps.is_zero(stamp) else stamps.to_seconds(stamp)
+
+    def _on_image(self, msg: Image) -> None:
+        try:
+            pixels = images.image_array(msg, self._config.values['max_image_side_px'])
+        except images.ImageError as exc:
+            self._handle(self.loop.reject(str(exc)))
+            return
+        stamp = msg.header.stamp
+        if stamps.is_zero(stamp):
+            stamp = self.get_clock().now().to_msg()
+        self._handle(self.loop.add_image(stamps.to_seconds(stamp), pixels, stamp))
+
+    def _on_camera_info(self, msg: CameraInfo) -> None:
+        try:
+            camera = images.camera_from_info(msg)
+        except images.ImageError as exc:
+            self.get_logger().warning(f'ignored a camera_info: {exc}',
+                                      throttle_duration_sec=WARN_THROTTLE_S)
+            return
+        if camera != self.loop.camera:
+            mismatch = self.loop.set_camera(camera)
+            if mismatch:
+                self.get_logger().warning(mismatch)
+        self._handle(self.loop.serve())
+
+    def _on_joint_states(self, msg: JointState) -> None:
+        head = self._config.head
+        if head is None:
+            return
+        try:
+            pan, tilt = joints.angles_from_joint_state(msg, head)
+        except ValueError:
+            return              # a joint state of other joints: not the head's
+        self._handle(self.loop.add_pose(self._stamp_s(msg.header.stamp), pan, tilt))
+
+    def _on_fixation(self, msg: Int32MultiArray) -> None:
+        try:
+            cell = grid_arrays.cell_from_row_col(msg, self._config.setup.grid, 'fixation')
+        except ValueError as exc:
+            self.get_logger().warning(f'ignored a fixation: {exc}',
+                                      throttle_duration_sec=WARN_THROTTLE_S)
+            return
+        self._handle(self.loop.fixate(cell, self._now_s()))
+
+    # -- outputs -------------------------------------------------------------------------
+    def _handle(self, outcome) -> None:
+        if outcome.status == 'published':
+            frame, grid = outcome.frame, self._config.setup.grid
+            if self._config.values['publish_image']:
+                self._image_pub.publish(images.evidence_image(frame.counts, grid, frame.token))
+            else:
+                self._evidence_pub.publish(grid_arrays.to_multiarray(frame.counts, grid))
+        elif outcome.status == 'rejected':
+            self.get_logger().warning(
+                f'rejected an image ({self.loop.rejected} so far): {outcome.reason}',
+                throttle_duration_sec=WARN_THROTTLE_S)
+        elif outcome.status == 'waiting' and outcome.reason.startswith('no camera_info'):
+            self.get_logger().warning(
+                f"a fixation waits: {outcome.reason}; is the camera driver's camera_info "
+                f"remapped to {self.resolve_topic_name('camera_info')}?",
+                throttle_duration_sec=WARN_THROTTLE_S)
+
+    def _publish_diagnostics(self) -> None:
+        values = self.loop.values()
+        level, message = 'ok', 'serving fixations'
+        if values['waiting_for_image'] and self.loop.waiting.startswith('no camera_info'):
+            level, message = 'warn', 'no camera_info received'
+        elif self.loop.rejected > self._reported_rejections:
+            level = 'warn'
+            message = f'{self.loop.rejected - self._reported_rejections} images rejected'
+        self._reported_rejections = self.loop.rejected
+        self._diag_pub.publish(diagnostics.diagnostic_array(
+            [diagnostics.status(f'{self.get_fully_qualified_name()}: detector', level, message,
+                                values)], self.get_clock().now().to_msg()))
+
+
+def main(args=None) -> int:
+    """Run the ``foveal_detector`` node until shutdown (Ctrl-C or SIGTERM)."""
+    return run_node(FovealDetectorNode, NODE_NAME, args)
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,271 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The ``scene_camera`` node: a simulated camera over a real photograph, published as a driver does.
+
+It stands in for camera hardware as ``simulated_camera`` stands in for a detector
+(docs/design.md section 6.6). The scene is a held-out test scene (a test background with one
+pasted test face, from ``seed``) or a user's image (``scene.file``, with the face centre as
+``scene.face_x_px``/``scene.face_y_px``):
+
+- ``view: fixed``: a fixed camera that sees the whole scene (for the detector's ``fovea`` mode);
+  the grid (21x21 by default) tiles the image;
+- ``view: pan_tilt``: a camera on the pan/tilt head; the scene spans the pan/tilt grid plus half
+  the field of view on each side (:class:`ipomdp_gaze.vision.pan_tilt.SceneGeometry`), and the
+  node publishes the field of view at the head's pose. ``camera_info.K`` follows from the image
+  size and ``camera.hfov_deg``.
+
+It subscribes ``pan_tilt`` (``sensor_msgs/JointState``, transient local), snaps it to the
+nearest cell and arrives there after ``saccade_time_s`` (a fixed camera does not move: a
+command only triggers a frame). With ``rate_hz = 0`` it publishes one frame on each arrival,
+with ``rate_hz > 0`` it streams frames like a video camera, also while moving. A frame is
+``image`` (``rgb8``), ``camera_info`` and, for ``pan_tilt``, ``joint_states`` (its pose), all
+with one stamp. ``ground_truth`` (``std_msgs/Int32MultiArray`` ``[row, col]`` of the face
+centre's cell in the grid of the view, transient local) is published once when it is known.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+import sys
+
+from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.head_camera import PinholeCamera
+from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import CameraInfo, Image, JointState
+from std_msgs.msg import Int32MultiArray
+
+from . import NODE_NAMES
+from .params import head_from, INT_MAX, joint_params, MAX_CELLS_PER_SIDE, Param, \
+    ParameterTransaction, T
+from .spin import run_node
+
+NODE_NAME = NODE_NAMES['scene_camera']
+VIEWS = ('fixed', 'pan_tilt')
+# Defaults of each view: the grid, the scene's side (fixed) and the face sizes in pixels.
+VIEW_GRIDS = {'fixed': (21, 21, 1.0), 'pan_tilt': (11, 11, 5.0)}
+VIEW_FACES = {'fixed': (60, 140), 'pan_tilt': (30, 70)}
+IMAGE_QOS = QoSProfile(depth=2, reliability=ReliabilityPolicy.RELIABLE)
+STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                       durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
+def scene_camera_params() -> list[Param]:
+    """Every parameter of the scene camera, in declaration order."""
+    return [
+        Param('view', 'pan_tilt', T.STRING,
+              'fixed: the whole scene (fovea mode); pan_tilt: the field of view at the head '
+              'pose (read-only)', read_only=True, choices=VIEWS),
+        Param('seed', 0, T.INTEGER, 'which held-out test scene (read-only)', read_only=True,
+              int_range=(0, INT_MAX)),
+        Param('scene.file', '', T.STRING,
+              "a user's image instead of a test scene (read-only)", read_only=True),
+        Param('scene.face_x_px', -1.0, T.DOUBLE,
+              "x of the face centre in scene.file's pixels (-1.0: no ground truth; read-only)",
+              read_only=True, float_range=(-1.0, 1e6)),
+        Param('scene.face_y_px', -1.0, T.DOUBLE,
+              "y of the face centre in scene.file's pixels (read-only)", read_only=True,
+              float_range=(-1.0, 1e6)),
+        Param('scene.size_px', 420, T.INTEGER,
+              'fixed view: side of the generated scene in pixels (read-only)', read_only=True,
+              int_range=(64, 4096)),
+        Param('scene.face_px', [0, 0], T.INTEGER_ARRAY,
+              'smallest and largest face side in scene pixels ([0, 0]: 60-140 fixed, 30-70 '
+              'pan_tilt; read-only)', read_only=True),
+        Param('grid.rows', 0, T.INTEGER, "rows (0: the view's, 21 fixed, 11 pan_tilt)",
+              read_only=True, int_range=(0, MAX_CELLS_PER_SIDE)),
+        Param('grid.cols', 0, T.INTEGER, "columns (0: the view's, 21 fixed, 11 pan_tilt)",
+              read_only=True, int_range=(0, MAX_CELLS_PER_SIDE)),
+        Param('grid.spacing_deg', 5.0, T.DOUBLE, 'pan_tilt: degrees per cell (read-only)',
+              read_only=True, float_range=(1e-6, 90.0)),
+        Param('camera.width', 320, T.INTEGER, 'pan_tilt: image width in pixels (read-only)',
+              read_only=True, int_range=(20, 4096)),
+        Param('camera.height', 240, T.INTEGER, 'pan_tilt: image height in pixels (read-only)',
+              read_only=True, int_range=(20, 4096)),
+        Param('camera.hfov_deg', 25.0, T.DOUBLE,
+              'horizontal field of view, edge to edge, of camera_info.K (read-only)',
+              read_only=True, float_range=(1.0, 170.0)),
+        Param('frame_id', 'camera', T.STRING, 'frame_id of image and camera_info',
+              read_only=True),
+    ] + joint_params(limits=False) + [
+        Param('saccade_time_s', 0.15, T.DOUBLE, 'time to move to a new cell',
+              float_range=(0.0, 60.0)),
+        Param('rate_hz', 0.0, T.DOUBLE,
+              'frames per second like a video camera (0: one frame per arrival)',
+              float_range=(0.0, 100.0)),
+    ]
+
+
+@dataclass
+class SceneConfig:
+    """What the scene camera derives from its parameters."""
+
+    values: dict
+    grid: Grid
+    camera: PinholeCamera
+    scene: object
+    geometry: object = None
+    head: object = None
+
+
+def _scene_config(values: dict) -> SceneConfig:
+    """Build the scene of the parameters (ValueError names the problem)."""
+    from ipomdp_gaze.vision.pan_tilt import (PanTiltSceneSet, read_scene_file, SceneGeometry,
+                                             user_scene)
+    from ipomdp_gaze.vision.scenes import SceneSet
+    view = values['view']
+    rows, cols, spacing = VIEW_GRIDS[view]
+    rows, cols = values['grid.rows'] or rows, values['grid.cols'] or cols
+    if view == 'pan_tilt':
+        spacing = values['grid.spacing_deg']
+    grid = Grid(rows, cols, spacing)
+    faces = tuple(values['scene.face_px'])
+    if len(faces) != 2:
+        raise ValueError(f'scene.face_px must be [min, max], got {list(faces)}')
+    faces = VIEW_FACES[view] if faces == (0, 0) else faces
+    centre = None
+    if values['scene.face_x_px'] >= 0 or values['scene.face_y_px'] >= 0:
+        centre = (values['scene.face_x_px'], values['scene.face_y_px'])
+    if view == 'pan_tilt':
+        camera = PinholeCamera.from_fov(values['camera.width'], values['camera.height'],
+                                        values['camera.hfov_deg'])
+        geometry = SceneGeometry(grid, camera)
+        if values['scene.file']:
+            scene = user_scene(read_scene_file(values['scene.file']), centre, geometry)
+        else:
+            scene = PanTiltSceneSet('test', geometry, faces, 'rgb', values['seed']).scene(0)
+        return SceneConfig(dict(values), grid, camera, scene, geometry,
+                           head_from(values, grid))
+    if values['scene.file']:
+        scene = user_scene(read_scene_file(values['scene.file']), centre, grid=grid.shape)
+    else:
+        scene = SceneSet('test', values['scene.size_px'], faces, grid.shape,
+                         color='rgb', seed=values['seed']).scene(0)
+    height, width = scene.image.shape[:2]
+    camera = PinholeCamera.from_fov(width, height, values['camera.hfov_deg'])
+    return SceneConfig(dict(values), grid, camera, scene)
+
+
+class SceneCameraNode(Node):
+    """A simulated camera over a real photograph (see the module docstring)."""
+
+    def __init__(self, **kwargs):
+        super().__init__(NODE_NAME, **kwargs)
+        self._transaction = ParameterTransaction(self, scene_camera_params(), self._build,
+                                                 self._apply_config)
+        self._transaction.declare()
+        self._transaction.start(_scene_config(self._transaction.values()))
+        cfg = self._config
+        self.pose = self.goal = cfg.grid.center_index
+        self.moving = False
+        self._views = {}
+        self._image_pub = self.create_publisher(Image, 'image', IMAGE_QOS)
+        self._info_pub = self.create_publisher(CameraInfo, 'camera_info', IMAGE_QOS)
+        self._joint_pub = self.create_publisher(JointState, 'joint_states', 10)
+        self._truth_pub = self.create_publisher(Int32MultiArray, 'ground_truth', STATE_QOS)
+        self.create_subscription(JointState, 'pan_tilt', self._on_command, STATE_QOS)
+        self._saccade_timer = self._frame_timer = None
+        self._make_timers(cfg.values)
+        scene = cfg.scene
+        if scene.cell is not None:
+            self._truth_pub.publish(grid_arrays.ground_truth(cfg.grid, cfg.grid.index(
+                *scene.cell)))
+        height, width = self._view(self.pose).shape[:2]
+        where = 'no face given' if scene.face_centre_px is None else \
+            f'face centre ({scene.face_centre_px[0]:.1f}, {scene.face_centre_px[1]:.1f}) px ' \
+            f'in cell {scene.cell}'
+        self.get_logger().info(
+            f"{cfg.values['view']} view of {scene.background} scene "
+            f'{scene.image.shape[1]}x{scene.image.shape[0]} px ({where}); {width}x{height} px '
+            f'images, {cfg.grid.rows}x{cfg.grid.cols} grid')
+
+    @property
+    def _config(self) -> SceneConfig:
+        """Return the configuration in force."""
+        return self._transaction.config
+
+    # -- parameters ----------------------------------------------------------------------
+    def _build(self, values: dict, changed=None, previous=None) -> SceneConfig:
+        """Keep the scene; follow the joint mapping and times (ValueError names the problem)."""
+        cfg = previous
+        head = head_from(values, cfg.grid) if cfg.geometry is not None else None
+        return SceneConfig(dict(values), cfg.grid, cfg.camera, cfg.scene, cfg.geometry, head)
+
+    def _apply_config(self, old: SceneConfig, cfg: SceneConfig) -> None:
+        v, ov = cfg.values, old.values
+        if (v['saccade_time_s'], v['rate_hz']) != (ov['saccade_time_s'], ov['rate_hz']):
+            self._make_timers(v)
+
+    def _make_timers(self, values: dict) -> None:
+        for timer in (self._saccade_timer, self._frame_timer):
+            if timer is not None:
+                self.destroy_timer(timer)
+        self._saccade_timer = self._frame_timer = None
+        if self.moving:
+            self._arrive()
+        if values['saccade_time_s'] > 0:
+            self._saccade_timer = self.create_timer(values['saccade_time_s'], self._on_arrival)
+            self._saccade_timer.cancel()
+        if values['rate_hz'] > 0:
+            self._frame_timer = self.create_timer(1.0 / values['rate_hz'], self._publish_frame)
+
+    # -- head ------------------------------------------------------------------------------
+    def _on_command(self, msg: JointState) -> None:
+        cfg = self._config
+        if cfg.head is None:
+            goal = self.pose                     # a fixed camera: the command triggers a frame
+        else:
+            try:
+                goal = cfg.head.nearest_cell(*joints.angles_from_joint_state(msg, cfg.head))
+            except ValueError as exc:
+                self.get_logger().warning(f'ignored a pan_tilt command: {exc}',
+                                          throttle_duration_sec=5.0)
+                return
+        if goal == self.goal and self.moving:
+            return
+        self.goal, self.moving = goal, True
+        if self._saccade_timer is None:
+            self._arrive()
+        else:
+            self._saccade_timer.reset()
+
+    def _on_arrival(self) -> None:
+        self._saccade_timer.cancel()
+        if self.moving:
+            self._arrive()
+
+    def _arrive(self) -> None:
+        self.pose, self.moving = self.goal, False
+        if self._config.values['rate_hz'] == 0:
+            self._publish_frame()
+
+    # -- outputs -------------------------------------------------------------------------
+    def _view(self, cell: int):
+        """Return the image the camera takes with the head at ``cell`` (rendered once)."""
+        cfg = self._config
+        if cfg.geometry is None:
+            return cfg.scene.image
+        view = self._views.get(cell)
+        if view is None:
+            view = self._views[cell] = cfg.geometry.render(cfg.scene.image,
+                                                           cfg.grid.cell(cell))
+        return view
+
+    def _publish_frame(self) -> None:
+        cfg = self._config
+        stamp = self.get_clock().now().to_msg()
+        frame_id = cfg.values['frame_id']
+        if cfg.head is not None:
+            self._joint_pub.publish(joints.joint_state(cfg.head, self.pose, stamp))
+        self._info_pub.publish(images.camera_info(cfg.camera, stamp, frame_id))
+        self._image_pub.publish(images.camera_image(self._view(self.pose), stamp, frame_id))
+
+
+def main(args=None) -> int:
+    """Run the ``scene_camera`` node until shutdown (Ctrl-C or SIGTERM)."""
+    return run_node(SceneCameraNode, NODE_NAME, args)
+
+
+if __name__ == '__main__':
+    sys.exit(main())

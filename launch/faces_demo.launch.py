@@ -1,0 +1,47 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Launch the face search: gaze controller, foveal detector and, for bench testing, the scene camera.
+
+``ros2 launch ipomdp_gaze faces_demo.launch.py`` runs the pan/tilt version (``mode:=camera``)
+with ``config/faces_camera_*.yaml``; ``mode:=fovea`` the fixed camera with the digital fovea
+(``config/faces_fovea_*.yaml``). ``scene_camera:=false`` leaves the camera to a real driver:
+remap its topics, e.g. ``image:=/camera/image_raw camera_info:=/camera/camera_info``.
+"""
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument
+from launch.conditions import IfCondition
+from launch.substitutions import LaunchConfiguration, PathJoinSubstitution
+from launch_ros.actions import Node
+from launch_ros.substitutions import FindPackageShare
+
+
+def generate_launch_description():
+    """Build the launch description."""
+    config = PathJoinSubstitution([FindPackageShare('ipomdp_gaze'), 'config'])
+    mode = LaunchConfiguration('mode')
+
+    def params(node):
+        return PathJoinSubstitution([config, ['faces_', mode, f'_{node}.yaml']])
+
+    return LaunchDescription([
+        DeclareLaunchArgument('mode', default_value='camera',
+                              description='camera (pan/tilt head) or fovea (fixed camera)'),
+        DeclareLaunchArgument('scene_camera', default_value='true',
+                              description='also start the scene camera (false: a real driver)'),
+        DeclareLaunchArgument('seed', default_value='0',
+                              description='which held-out test scene the scene camera shows'),
+        DeclareLaunchArgument('image', default_value='image',
+                              description='the camera image topic the detector reads'),
+        DeclareLaunchArgument('camera_info', default_value='camera_info',
+                              description='the camera_info topic the detector reads'),
+        Node(package='ipomdp_gaze', executable='controller', name='gaze_controller',
+             parameters=[params('controller')], output='screen'),
+        Node(package='ipomdp_gaze', executable='detector', name='foveal_detector',
+             parameters=[params('detector')], output='screen',
+             remappings=[('image', LaunchConfiguration('image')),
+                         ('camera_info', LaunchConfiguration('camera_info'))]),
+        Node(package='ipomdp_gaze', executable='scene_camera', name='scene_camera',
+             parameters=[params('scene_camera'), {'seed': LaunchConfiguration('seed')}],
+             output='screen', condition=IfCondition(LaunchConfiguration('scene_camera'))),
+    ])

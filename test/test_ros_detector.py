@@ -1,0 +1,261 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The foveal_detector process alone, with this test as the camera driver and the controller.
+
+Covers: an image published here gives exactly the counts the core computes for the same image
+and fixation (fovea mode); camera mode marks the cells outside the view NaN and bins a pasted
+face's detections into the right cells for a known pose and camera_info, and waits with a
+warning while camera_info is missing; every malformed image is rejected with its reason and
+counted while the node keeps serving; settings that contradict the observation file are
+refused.
+"""
+from __future__ import annotations
+
+from conftest import HAVE_RCLPY, wait_for
+import numpy as np
+import pytest
+
+pytestmark = [pytest.mark.ros,
+              pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
+
+NODE = 'foveal_detector'
+
+
+class Driver:
+    """This test as the camera driver and the controller of one detector (in a namespace)."""
+
+    def __init__(self, probe, nodes, namespace: str, mode: str):
+        from diagnostic_msgs.msg import DiagnosticArray
+        from ipomdp_gaze.nodes.watch import LATCHED
+        from rclpy.qos import QoSProfile, ReliabilityPolicy
+        from sensor_msgs.msg import CameraInfo, Image, JointState
+        from std_msgs.msg import Int32MultiArray
+        self.probe, self.ns = probe, namespace
+        best_effort = QoSProfile(depth=50, reliability=ReliabilityPolicy.BEST_EFFORT)
+        self.frames = probe.record(Image, f'{namespace}/evidence_image', best_effort)
+        self.status = []
+        name = f'{namespace}/{NODE}: detector'
+
+        def on_diagnostics(msg):
+            from ipomdp_gaze.msg_adapters import diagnostics
+            for status in msg.status:
+                if status.name == name:
+                    self.status.append((status.level, status.message,
+                                        diagnostics.values_of(status)))
+
+        probe.node.create_subscription(DiagnosticArray, '/diagnostics', on_diagnostics, 50)
+        self.image = probe.publisher(Image, f'{namespace}/image')
+        self.camera_info = probe.publisher(CameraInfo, f'{namespace}/camera_info')
+        self.joint_states = probe.publisher(JointState, f'{namespace}/joint_states')
+        self.fixation = probe.publisher(Int32MultiArray, f'{namespace}/fixation', LATCHED)
+        self.proc = nodes.start('detector', ['-r', f'__ns:={namespace}', '-p', f'mode:={mode}',
+                                             '-p', 'diagnostics_period_s:=0.2'])
+        assert wait_for(lambda: self.image.get_subscription_count() > 0 and self.status, 60), \
+            self.proc.output()
+
+    def now(self):
+        return self.probe.node.get_clock().now().to_msg()
+
+    def values(self) -> dict:
+        return self.status[-1][2]
+
+    def wait_values(self, **want) -> dict:
+        n = len(self.status)
+        ok = wait_for(lambda: len(self.status) > n + 1 and all(
+            self.values().get(k) == str(v) for k, v in want.items()), 20)
+        assert ok, f'diagnostics {self.values()} never showed {want}'
+        return self.values()
+
+    def fixate(self, grid, cell) -> None:
+        """Send a fixation and wait until the detector has it."""
+        from ipomdp_gaze.msg_adapters import grid_arrays
+        n = int(self.wait_values()['fixations_received'])
+        self.fixation.publish(grid_arrays.row_col(grid, cell))
+        self.wait_values(fixations_received=n + 1)
+
+    def frame_after(self, publish):
+        """Call ``publish()`` and return the next evidence frame (counts, header stamp)."""
+        from ipomdp_gaze.msg_adapters import images
+        n = len(self.frames)
+        publish()
+        assert wait_for(lambda: len(self.frames) > n, 30), (self.values(),
+                                                            self.proc.output()[-3000:])
+        msg = self.frames[n][1]
+        return images.evidence_from_image(msg, self.grid), msg.header.stamp
+
+
+@pytest.fixture(scope='module')
+def fovea(probe, nodes):
+    from ipomdp_gaze.detection import build_setup
+    driver = Driver(probe, nodes, '/fov', 'fovea')
+    driver.setup = build_setup('fovea')
+    driver.grid = driver.setup.grid
+    return driver
+
+
+@pytest.fixture(scope='module')
+def camera(probe, nodes):
+    from ipomdp_gaze.detection import build_setup
+    driver = Driver(probe, nodes, '/cam', 'camera')
+    driver.setup = build_setup('camera')
+    driver.grid = driver.setup.grid
+    return driver
+
+
+def _scene(seed, color='rgb'):
+    from ipomdp_gaze.vision.scenes import PAPER_TASK, SceneSet
+    return SceneSet('test', **PAPER_TASK, color=color, seed=seed).scene(0)
+
+
+@pytest.mark.parametrize('seed, encoding, row_col', [(0, 'rgb8', (10, 10)),
+                                                     (1, 'bgr8', (3, 17)),
+                                                     (2, 'mono8', (20, 0))])
+def test_an_image_gives_exactly_the_counts_of_the_core(fovea, seed, encoding, row_col):
+    from ipomdp_gaze.msg_adapters import images
+    from ipomdp_gaze.vision.search import fovea_for_model
+    scene = _scene(seed, 'gray' if encoding == 'mono8' else 'rgb')
+    cell = fovea.grid.index(*row_col)
+    fovea.fixate(fovea.grid, cell)
+    stamp = fovea.now()
+    msg = images.camera_image(scene.image, stamp)
+    if encoding == 'bgr8':
+        msg = images.camera_image(np.ascontiguousarray(scene.image[:, :, ::-1]), stamp)
+        msg.encoding = 'bgr8'
+    counts, got_stamp = fovea.frame_after(lambda: fovea.image.publish(msg))
+    assert got_stamp == stamp                                   # the image's capture stamp
+    core = fovea_for_model(fovea.setup.model)
+    core.start(scene.image)
+    np.testing.assert_array_equal(counts, core.observe(cell).counts)
+    if scene.cell is not None and scene.cell == row_col:
+        assert counts[cell] > 0
+
+
+def test_an_image_taken_before_the_fixation_does_not_serve_it(fovea):
+    from ipomdp_gaze.msg_adapters import images
+    scene = _scene(3)
+    early = fovea.now()
+    fovea.fixate(fovea.grid, 0)
+    n = len(fovea.frames)
+    processed = int(fovea.values()['images_processed'])
+    fovea.image.publish(images.camera_image(scene.image, early))
+    values = fovea.wait_values(images_processed=processed)
+    assert values['waiting_for_image'] == 'true' and len(fovea.frames) == n
+    counts, _ = fovea.frame_after(
+        lambda: fovea.image.publish(images.camera_image(scene.image, fovea.now())))
+    assert counts.shape == (441,)
+
+
+def _bad_images():
+    from sensor_msgs.msg import Image
+    good = {'height': 30, 'width': 40, 'encoding': 'rgb8', 'step': 120, 'data': bytes(3600)}
+    cases = [
+        ({'encoding': '16UC1', 'step': 80, 'data': bytes(2400)},
+         "unsupported image encoding '16UC1'"),
+        ({'encoding': 'rgba8', 'step': 160, 'data': bytes(4800)}, 'unsupported image encoding'),
+        ({'step': 100, 'data': bytes(3000)}, 'step 100 is less than width 40 x 3'),
+        ({'data': bytes(3599)}, 'image data has 3599 bytes, expected step 120 x height 30'),
+        ({'height': 31}, 'expected step 120 x height 31'),
+        ({'width': 0, 'height': 0, 'step': 0, 'data': b''}, 'empty image'),
+        ({'width': 5000, 'step': 15000}, 'larger than 4096 px'),
+        ({'width': 10, 'height': 10, 'step': 30, 'data': bytes(300)},
+         'smaller than the 20x20 the detector needs'),
+    ]
+    out = []
+    for change, words in cases:
+        fields = dict(good, **change)
+        msg = Image(height=fields['height'], width=fields['width'],
+                    encoding=fields['encoding'], step=fields['step'])
+        msg.data = fields['data']
+        out.append((msg, words))
+    return out
+
+
+def test_malformed_images_are_rejected_with_the_reason_and_the_node_keeps_serving(fovea):
+    from ipomdp_gaze.msg_adapters import images
+    fovea.fixate(fovea.grid, fovea.grid.index(4, 4))
+    for msg, words in _bad_images():
+        before = fovea.wait_values()
+        msg.header.stamp = fovea.now()
+        fovea.image.publish(msg)
+        after = fovea.wait_values(images_rejected=int(before['images_rejected']) + 1)
+        assert words in after['last_rejection'], after['last_rejection']
+        assert after['images_processed'] == before['images_processed']
+        assert int(after['images_received']) == int(after['images_processed']) + int(
+            after['images_rejected']) + int(after['images_unused'])
+    warnings = [line for line in fovea.proc.output().splitlines() if 'rejected an image' in line]
+    assert 1 <= len(warnings) < 8, warnings                      # throttled
+    assert any(level == b'\x01' or level == 1 for level, _, _ in fovea.status)   # WARN
+    counts, _ = fovea.frame_after(
+        lambda: fovea.image.publish(images.camera_image(_scene(4).image, fovea.now())))
+    assert np.isfinite(counts).all()
+
+
+def _pose_frame(camera, scene, head_cell, stamp, info=True):
+    """Publish joint_states, camera_info (optional) and the view of ``head_cell``."""
+    from ipomdp_gaze.head import PanTiltMap
+    from ipomdp_gaze.msg_adapters import images, joints
+    from ipomdp_gaze.vision.pan_tilt import SceneGeometry, shipped_camera
+    geometry = SceneGeometry(camera.grid, shipped_camera())
+    view = geometry.render(scene.image, camera.grid.cell(head_cell))
+    camera.joint_states.publish(joints.joint_state(PanTiltMap(camera.grid), head_cell, stamp))
+    if info:
+        camera.camera_info.publish(images.camera_info(shipped_camera(), stamp))
+    camera.image.publish(images.camera_image(view, stamp))
+    return view
+
+
+def test_camera_mode_waits_for_camera_info_with_a_warning(camera):
+    from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, SceneGeometry, shipped_camera
+    scene = PanTiltSceneSet('test', SceneGeometry(camera.grid, shipped_camera()),
+                            seed=5).scene(0)
+    cell = camera.grid.index(*scene.cell)
+    camera.fixate(camera.grid, cell)
+    n = len(camera.frames)
+    _pose_frame(camera, scene, cell, camera.now(), info=False)
+    assert wait_for(lambda: camera.status and camera.status[-1][1] == 'no camera_info received',
+                    20), camera.status[-1:]
+    values = camera.values()
+    assert values['camera_info'] == 'false' and values['waiting_for_image'] == 'true'
+    assert 'no camera_info received' in values['waiting_because']
+    assert len(camera.frames) == n and camera.proc.running
+    assert wait_for(lambda: 'a fixation waits: no camera_info received' in camera.proc.output(),
+                    20)
+
+
+@pytest.mark.parametrize('seed, offset', [(5, (0, 0)), (6, (1, -1)), (9, (-1, 1))])
+def test_camera_mode_bins_a_face_to_its_cell_and_the_rest_is_nan(camera, seed, offset):
+    from ipomdp_gaze.head_camera import observed_cells
+    from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, SceneGeometry, shipped_camera
+    grid = camera.grid
+    scene = PanTiltSceneSet('test', SceneGeometry(grid, shipped_camera()), seed=seed).scene(0)
+    row = min(max(scene.cell[0] + offset[0], 0), 10)
+    col = min(max(scene.cell[1] + offset[1], 0), 10)
+    head = grid.index(row, col)
+    camera.fixate(grid, head)
+    views = []
+    counts, _ = camera.frame_after(
+        lambda: views.append(_pose_frame(camera, scene, head, camera.now())))
+    seen = observed_cells(shipped_camera(), grid, (row, col))
+    np.testing.assert_array_equal(~np.isnan(counts), seen)
+    assert seen.sum() < grid.n_cells
+    want = camera.setup.observer.observe(views[0], shipped_camera(), (row, col)).counts
+    np.testing.assert_array_equal(counts, want)
+    target = grid.index(*scene.cell)
+    assert counts[target] > 0 and counts[target] == np.nanmax(counts)
+
+
+def test_settings_that_contradict_the_observation_file_are_refused(probe, nodes, fovea):
+    bad = nodes.start('detector', ['-r', '__ns:=/bad', '-p', 'grid.rows:=11'])
+    assert wait_for(lambda: not bad.running, 60)
+    assert bad.proc.returncode == 1
+    lines = [line for line in bad.output().splitlines() if line.strip()]
+    assert any('grid.rows 11 contradicts observation.file' in line for line in lines), lines
+    assert 'Traceback' not in bad.output()
+    nodes.killed.append(bad)                                     # exited on purpose
+    result = probe.set_parameters('fov/' + NODE, {'detector.scale_factor': 1.3})[0]
+    assert not result.successful
+    assert 'detector.scale_factor 1.3 contradicts observation.file' in result.reason
+    result = probe.set_parameters('fov/' + NODE, {'observation.file': 'faces-pan-tilt'})[0]
+    assert not result.successful and 'calibrated with a pan_tilt view' in result.reason
+    assert probe.set_parameters('fov/' + NODE, {'detector.scale_factor': 1.1})[0].successful

@@ -1,0 +1,81 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The pixel loop end to end: scene camera, foveal detector and controller as three processes.
+
+``ipomdp-gaze demo --scene faces [--fovea]`` on held-out test scenes of fixed seeds: the face is
+found in the right place (within one cell of its centre's cell) and all three nodes stop
+cleanly, in both detector modes.
+"""
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+
+from conftest import HAVE_RCLPY, REPO
+import pytest
+from test_ros_demo import node_processes
+
+pytestmark = [pytest.mark.ros,
+              pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
+
+FIXATION = re.compile(r'^fixation +(\d+): looked at \((\d+), (\d+)\)  (.*)  ->  most likely '
+                      r'\((\d+), (\d+)\) p=(\d\.\d+) +entropy (\d+\.\d+) nats$', re.M)
+FOUND = re.compile(r'^found: the face is most likely at \((\d+), (\d+)\), (.*), probability '
+                   r'(\d\.\d+), after (\d+) fixations$', re.M)
+VERDICT = re.compile(r'^the scene camera put the face centre in cell \((\d+), (\d+)\): that is '
+                     r'(right|wrong)$', re.M)
+
+
+@pytest.mark.parametrize('options, mode, where', [
+    (['--fovea', '--seed', '0'], 'fovea', r'pixel \( *\d+\.\d, +\d+\.\d\)'),
+    (['--fovea', '--seed', '2'], 'fovea', r'pixel \( *\d+\.\d, +\d+\.\d\)'),
+    (['--seed', '0'], 'camera', r'pan +[-+]\d+\.\d\d deg +tilt +[-+]\d+\.\d\d deg'),
+    (['--seed', '2'], 'camera', r'pan +[-+]\d+\.\d\d deg +tilt +[-+]\d+\.\d\d deg'),
+])
+def test_three_nodes_find_the_face_and_stop(ros_env, options, mode, where):
+    domain = int(ros_env['ROS_DOMAIN_ID'])
+    run = subprocess.run(
+        [sys.executable, '-m', 'ipomdp_gaze.cli', 'demo', '--scene', 'faces', '--domain-id',
+         str(domain), *options], cwd=REPO, env=ros_env, capture_output=True, text=True,
+        timeout=180)
+    out = run.stdout
+    assert run.returncode == 0, out + run.stderr
+    grid = '21x21 grid' if mode == 'fovea' else '11x11 grid at 5.0 deg/cell'
+    assert f'faces scene, detector mode {mode}, {grid}' in out
+    assert 'starting gaze_controller, then foveal_detector, then scene_camera' in out
+    fixations = FIXATION.findall(out)
+    found, verdict = FOUND.search(out), VERDICT.search(out)
+    assert fixations and found and verdict, out
+    assert [int(f[0]) for f in fixations] == list(range(1, len(fixations) + 1))
+    assert int(found.group(5)) == len(fixations)
+    centre = '(10, 10)' if mode == 'fovea' else '(5, 5)'
+    assert f'({fixations[0][1]}, {fixations[0][2]})' == centre       # the first: the centre
+    assert all(re.fullmatch(where, f[3].strip()) for f in fixations), fixations
+    assert re.fullmatch(where, found.group(3))
+    assert (fixations[-1][4], fixations[-1][5]) == found.group(1, 2)
+    truth = int(verdict.group(1)), int(verdict.group(2))
+    answer = int(found.group(1)), int(found.group(2))
+    assert max(abs(truth[0] - answer[0]), abs(truth[1] - answer[1])) <= 1
+    assert verdict.group(3) == 'right'
+    assert 'stopped all 3 nodes (scene_camera exit status 0, detector exit status 0, ' \
+           'controller exit status 0)' in out
+    assert node_processes(domain) == []
+
+
+def test_without_a_confident_cell_the_demo_answers_with_the_most_likely_one(ros_env):
+    domain = int(ros_env['ROS_DOMAIN_ID'])
+    run = subprocess.run(
+        [sys.executable, '-m', 'ipomdp_gaze.cli', 'demo', '--scene', 'faces', '--fovea',
+         '--seed', '12', '--max-fixations', '4', '--domain-id', str(domain)], cwd=REPO,
+        env=ros_env, capture_output=True, text=True, timeout=180)
+    out = run.stdout
+    assert run.returncode == 0, out + run.stderr
+    assert len(FIXATION.findall(out)) == 4
+    gave_up = re.search(r'^gave up: no cell reached the confidence after 4 fixations; the face '
+                        r'is most likely at \((\d+), (\d+)\), pixel .*, probability (\d\.\d+), '
+                        r'after 4 fixations$', out, re.M)
+    assert gave_up and float(gave_up.group(3)) < 0.999, out
+    assert VERDICT.search(out) and 'found:' not in out
+    assert 'stopped all 3 nodes' in out and node_processes(domain) == []
