@@ -42,6 +42,7 @@ import numpy as np
 
 from .belief import bayes_update, entropy, EvidenceError, map_cell
 from .grid import Grid
+from .inhibition import unvisited_choice
 from .motion import Motion
 from .observation import as_observation, check_evidence, CountObservation
 from .stopping import (ABSENT, check_absent_prior, check_confidence, check_max_fixations, decide,
@@ -186,13 +187,19 @@ class GazeController:
         Prior of "no target in the grid" (0: no absent hypothesis).
     max_fixations
         Fixation budget of a search (None or 0: none).
+    inhibit_return
+        For a still target (motion off): never fixate a cell twice in a search, the policy's
+        best unvisited cell instead (:func:`ipomdp_gaze.inhibition.unvisited_choice`); once
+        every cell has been fixated, all are open again. For a deterministic detector on a still
+        scene, whose second look at a cell repeats the same counts.
 
     """
 
     def __init__(self, grid: Grid, observation, policy, start_cell: int | None = None,
                  settle_time_s: float = 0.0, confidence: float = 0.95, seed: int = 0,
                  motion_sigma_cells: float = 0.0, jump_prob: float = 0.0,
-                 absent_prior: float = 0.0, max_fixations: int | None = None):
+                 absent_prior: float = 0.0, max_fixations: int | None = None,
+                 inhibit_return: bool = False):
         self.grid = grid
         self.set_observation(observation)
         self.policy = policy
@@ -202,6 +209,7 @@ class GazeController:
         self.set_motion(motion_sigma_cells, jump_prob)
         self.set_absent_prior(absent_prior)
         self.set_max_fixations(max_fixations)
+        self.set_inhibit_return(inhibit_return)
         self.reseed(seed)
         self.enabled = True
         self.received = self.applied = self.rejected = self.skipped = 0
@@ -241,6 +249,10 @@ class GazeController:
     def set_max_fixations(self, max_fixations: int | None) -> None:
         """Fixation budget of a search (None or 0: none); checked after each applied frame."""
         self.max_fixations = check_max_fixations(max_fixations)
+
+    def set_inhibit_return(self, inhibit_return: bool) -> None:
+        """Whether the next choices avoid the cells already fixated in this search."""
+        self.inhibit_return = bool(inhibit_return)
 
     def reseed(self, seed: int) -> None:
         """Restart the policy's random stream."""
@@ -307,6 +319,7 @@ class GazeController:
         self._belief = np.exp(self._log_belief[:self.grid.n_cells])
         self.fixation = self.start_cell
         self.fixations = 0
+        self._visited = np.zeros(self.grid.n_cells, dtype=bool)
         self.found = self.absent = self.gave_up = None
         self._decision, self._stopped, self._decided_once = '', False, False
         self.target_time_s = self.usable_time_s = self.update_time_s = float(now_s)
@@ -391,6 +404,7 @@ class GazeController:
         np.exp(self._log_belief[:n], out=self._belief)
         self.applied += 1
         self.fixations += 1
+        self._visited[self.fixation] = True
         events = self._events()
         if not self._stopped:
             self.fixation = self.choose()
@@ -429,6 +443,11 @@ class GazeController:
 
     def choose(self) -> int:
         """Ask the policy for the next fixation given the current belief."""
+        if self.inhibit_return and not self.motion.active:
+            if self._visited.all():
+                self._visited[:] = False
+            return unvisited_choice(self.policy, self._belief[None, :], self._visited,
+                                    self.fixations, self.rng, self.grid)
         choice = self.policy.select(self._belief[None, :], self.fixations, self.rng)
         cell = int(np.asarray(choice).ravel()[0])
         self.grid.cell(cell)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from ipomdp_gaze.belief import bayes_update, uniform_log_belief
+from ipomdp_gaze.belief import argmax_ties_low, bayes_update, uniform_log_belief
 from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
 from ipomdp_gaze.gaze import GazeController
 from ipomdp_gaze.grid import Grid
@@ -205,3 +205,52 @@ def test_search_with_the_camera_observation_model_finds_the_target(seed):
     assert core.map_probability >= 0.999
     assert core.map_cell == target
     assert core.found is not None and core.found.fixations <= core.fixations
+
+
+def test_inhibition_of_return_never_fixates_a_cell_twice_then_opens_them_again():
+    """A still scene: the same frame again and again. MAP would stare; with IOR it moves on."""
+    frame = np.zeros(121)
+    frame[5] = 1.0                                 # weak evidence near the top edge, every look
+    kwargs = {'settle_time_s': 0.0, 'confidence': 1 - 1e-9}
+    stare = controller('map', **kwargs)
+    ior = controller('map', inhibit_return=True, **kwargs)
+    fixations = {'stare': [], 'ior': []}
+    for t in range(1, 41):
+        for name, core in (('stare', stare), ('ior', ior)):
+            fixations[name].append(core.fixation)
+            assert core.offer(frame, float(t)).applied
+    assert len(set(fixations['stare'])) < 30              # MAP goes back to cells it saw
+    assert len(set(fixations['ior'])) == 40                # never the same cell twice
+    ior.reset(100.0)
+    assert ior.fixation == GRID.center_index and not ior._visited.any()
+    # Once every cell of a small grid has been fixated, all are open again.
+    grid = Grid(2, 2)
+    small = GazeController(grid, CAMERA, build_policy('map', grid, CAMERA), settle_time_s=0.0,
+                           confidence=1 - 1e-9, inhibit_return=True)
+    seen = []
+    for t in range(1, 6):
+        seen.append(small.fixation)
+        assert small.offer(np.zeros(4), float(t)).applied
+    assert sorted(seen[:4]) == [0, 1, 2, 3] and small._visited.sum() == 1
+
+
+def test_inhibition_of_return_gives_the_best_unvisited_cell_of_elm_and_is_off_for_motion():
+    rng = np.random.default_rng(4)
+    elm = build_policy('elm', GRID, CAMERA)
+    core = controller('elm', settle_time_s=0.0, inhibit_return=True)
+    seen = [core.fixation]
+    for t in range(1, 30):
+        core.offer(rng.standard_normal(121), float(t))
+        scores = elm.scores(core.belief[None]).reshape(-1)
+        scores[seen] = -np.inf
+        assert core.fixation == int(argmax_ties_low(scores)) and core.fixation not in seen
+        seen.append(core.fixation)
+    moving = controller('map', settle_time_s=0.0, inhibit_return=True, motion_sigma_cells=0.1,
+                        confidence=1 - 1e-9)
+    frame = np.zeros(121)
+    frame[5] = 1.0
+    picks = []
+    for t in range(1, 41):
+        picks.append(moving.fixation)
+        moving.offer(frame, float(t))
+    assert len(set(picks)) < 30                            # a moving target: cells looked at again

@@ -113,6 +113,9 @@ def controller_params() -> list[Param]:
         Param('search.max_fixations', 0, T.INTEGER,
               'fixation budget of a search: gave_up when it runs out undecided (0: none)',
               int_range=(0, INT_MAX)),
+        Param('search.inhibit_return', False, T.BOOL,
+              'still target: never fixate a cell twice in a search (a deterministic detector '
+              'on a still scene repeats its counts; the Bayes step would count them twice)'),
         Param('policy.name', 'elm', T.STRING, 'fixation policy', choices=POLICY_NAMES),
         Param('policy.file', '', T.STRING,
               'policy YAML path or shipped kernel name; setting it selects learned'),
@@ -189,7 +192,8 @@ class GazeControllerNode(Node):
         self.core = GazeController(cfg.grid, cfg.observation, cfg.policy, cfg.start_cell,
                                    v['settle_time_s'], v['confidence'], v['seed'],
                                    v['motion.sigma_cells'], v['motion.jump_prob'],
-                                   v['absent.prior'], v['search.max_fixations'])
+                                   v['absent.prior'], v['search.max_fixations'],
+                                   v['search.inhibit_return'])
 
         self._pan_tilt_pub = self.create_publisher(JointState, 'pan_tilt', STATE_QOS)
         self._fixation_pub = self.create_publisher(Int32MultiArray, 'fixation', STATE_QOS)
@@ -233,8 +237,9 @@ class GazeControllerNode(Node):
                   f"a moving target ({v['motion.sigma_cells']} cells/s, jump "
                   f"{v['motion.jump_prob']}/s)")
         budget = v['search.max_fixations'] or 'no'
+        ior = ', inhibition of return' if v['search.inhibit_return'] else ''
         return (f"{motion}, absent prior {v['absent.prior']}, confidence {v['confidence']}, "
-                f'{budget} fixation budget')
+                f'{budget} fixation budget{ior}')
 
     @property
     def _config(self) -> Config:
@@ -340,6 +345,7 @@ class GazeControllerNode(Node):
         core.set_confidence(v['confidence'])
         core.set_motion(v['motion.sigma_cells'], v['motion.jump_prob'])
         core.set_max_fixations(v['search.max_fixations'])
+        core.set_inhibit_return(v['search.inhibit_return'])
         if v['seed'] != ov['seed']:
             core.reseed(v['seed'])
         if (v['forward_command_topic'], v['trajectory_topic']) != \

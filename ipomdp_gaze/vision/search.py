@@ -45,8 +45,9 @@ import math
 import operator
 import time
 
-from ipomdp_gaze.belief import argmax_ties_low, bayes_update, map_cell, uniform_log_belief
+from ipomdp_gaze.belief import bayes_update, map_cell, uniform_log_belief
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.inhibition import policy_choice, unvisited_choice
 from ipomdp_gaze.vision.detector import detector_settings, detector_window_px, HaarDetector
 from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea, FoveaConfig
 import numpy as np
@@ -261,18 +262,6 @@ def _start_index(grid: Grid, start_cell) -> int:
     return index
 
 
-def _choice(selected, n_cells: int) -> int:
-    """Check and return the cell a policy's ``select`` returned for a one-belief batch."""
-    flat = np.asarray(selected).reshape(-1)
-    if flat.size != 1 or not np.issubdtype(flat.dtype, np.integer):
-        raise ValueError(f'the policy must return one integer cell for a (1, N) belief, got '
-                         f'{selected!r}')
-    index = int(flat[0])
-    if not 0 <= index < n_cells:
-        raise ValueError(f'the policy chose cell {index}, outside the {n_cells}-cell grid')
-    return index
-
-
 def search_image(image: np.ndarray, fovea: Fovea, model, policy,
                  confidence: float = DEFAULT_CONFIDENCE,
                  max_fixations: int = DEFAULT_MAX_FIXATIONS, stop_on_repeat: bool = True,
@@ -301,9 +290,9 @@ def search_image(image: np.ndarray, fovea: Fovea, model, policy,
         Stop (``'repeat'``) instead of fixating a cell a second time (NMPT's rule).
     inhibit_return : bool
         Never fixate a cell twice: the next fixation is the policy's best unvisited cell
-        (:func:`unvisited_choice`). On a static image with a deterministic detector a second
-        look repeats the same counts, which the Bayes step would count twice; with this on,
-        the search spends its budget on new cells instead of stopping.
+        (:func:`ipomdp_gaze.inhibition.unvisited_choice`). On a static image with a
+        deterministic detector a second look repeats the same counts, which the Bayes step
+        would count twice; with this on, the search spends its budget on new cells instead.
     start_cell : int or (int, int), optional
         First fixation (index or ``(row, col)``); by default the grid's centre, or with a
         scan the policy's (best unvisited) choice on the scanned belief.
@@ -363,7 +352,7 @@ def search_image(image: np.ndarray, fovea: Fovea, model, policy,
                 break
             following = unvisited_choice(policy, belief, visited, len(path), rng, grid)
         else:
-            following = _choice(policy.select(belief, len(path), rng), grid.n_cells)
+            following = policy_choice(policy.select(belief, len(path), rng), grid.n_cells)
         if stop_on_repeat and visited[following]:
             stop = 'repeat'
             break
@@ -376,31 +365,6 @@ def search_image(image: np.ndarray, fovea: Fovea, model, policy,
                        path=tuple(tuple(int(v) for v in grid.cell(k)) for k in path), stop=stop,
                        detector_pixels=int(pixels), seconds=seconds, belief=belief[0].copy(),
                        image_px=image_px, calibrated_px=calibrated)
-
-
-def unvisited_choice(policy, belief: np.ndarray, visited: np.ndarray, t: int, rng,
-                     grid: Grid) -> int:
-    """
-    Return the policy's best cell among the unvisited ones (inhibition of return).
-
-    A policy with ``scores`` (ELM, learned kernels) gets its scores masked; ``map`` the belief
-    masked; any other policy's choice, when already visited, is replaced by the nearest
-    unvisited cell (Chebyshev distance, then the lowest index).
-    """
-    n = visited.size
-    scorer = getattr(policy, 'scores', None)
-    if callable(scorer) or getattr(policy, 'name', '') == 'map':
-        scores = np.array(scorer(belief) if callable(scorer) else belief,
-                          dtype=float).reshape(-1)
-        scores[visited] = -np.inf
-        return int(argmax_ties_low(scores))
-    choice = _choice(policy.select(belief, t, rng), n)
-    if not visited[choice]:
-        return choice
-    rows, cols = grid.rows_cols()
-    r, c = divmod(choice, grid.cols)
-    distance = np.maximum(np.abs(rows - r), np.abs(cols - c))
-    return int(np.argmin(np.where(visited, n + grid.rows + grid.cols, distance)))
 
 
 def detector_from_settings(settings: dict, cascade_dir=None) -> HaarDetector:
