@@ -6,6 +6,7 @@ from pathlib import Path
 from ipomdp_gaze.cli import main
 from ipomdp_gaze.fpoc import make_fpoc
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.observation_file import fingerprint, load_observation
 from ipomdp_gaze.policies import policy_file as pf
 from ipomdp_gaze.policies.conv import ConvPolicy, kernel_from_radial, radial_bins
 from ipomdp_gaze.policies.logistic import LogisticPolicy
@@ -270,7 +271,12 @@ def test_shipped_names_resolve_with_and_without_suffix(tmp_path, monkeypatch):
 def test_every_shipped_kernel_loads(name):
     spec = load_policy_spec(name)
     assert spec.path.parent == pf.KERNEL_DIR
-    task = f'{spec.fpoc.model}-{spec.grid.rows}x{spec.grid.cols}-{spec.reward}'
+    if spec.fpoc is not None:
+        task = f'{spec.fpoc.model}-{spec.grid.rows}x{spec.grid.cols}-{spec.reward}'
+    else:                       # a count model's kernel is named for the model it was trained on
+        task = f"{spec.observation['name']}-{spec.reward}"
+        model = load_observation(spec.observation['name'])
+        assert spec.observation['sha256'] == fingerprint(model)
     # A kernel trained for a moving target (docs/design.md section 7) says so in its name.
     moving = 'motion_sigma_cells' in spec.training
     assert name == (f'{task}-tracking' if moving else task)
