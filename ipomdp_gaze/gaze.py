@@ -450,7 +450,7 @@ class GazeController:
                            **events)
 
     def _add_still_frame(self, obs: np.ndarray, term: np.ndarray) -> None:
-        """The belief from the search's frames, repeated views of a cell weighted (still target)."""
+        """Recompute the belief from the search's frames, a cell's repeated views weighted."""
         if self._kernel is None:
             self._kernel = np.asarray(self.observation.elm_kernel(), dtype=float)
         information = cell_information(self._kernel, self.grid.shape, self.fixation)

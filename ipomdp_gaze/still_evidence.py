@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 
-def check_repeat_weight(weight: float) -> float:
+def check_repeat_weight(weight: float, name: str = 'repeat_weight') -> float:
     """
     Return the weight of a cell's repeated views as a float.
 
@@ -33,7 +33,7 @@ def check_repeat_weight(weight: float) -> float:
     """
     if not (isinstance(weight, (int, float, np.integer, np.floating))
             and not isinstance(weight, bool) and 0.0 <= float(weight) <= 1.0):
-        raise ValueError(f'repeat_weight must be in [0, 1], got {weight!r}')
+        raise ValueError(f'{name} must be in [0, 1], got {weight!r}')
     return float(weight)
 
 
