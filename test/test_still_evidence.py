@@ -1,6 +1,6 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""search.repeat_weight: a cell's repeated views of a still scene, weighted, against brute force."""
+"""search.repeat_weight: a cell's repeated views of a still scene weighted, vs brute force."""
 from ipomdp_gaze.belief import bayes_update, uniform_log_belief
 from ipomdp_gaze.fpoc import make_fpoc
 from ipomdp_gaze.gaze import GazeController
@@ -28,8 +28,10 @@ def count_model(seed=0):
 
 def brute_force(model, frames, weight, absent_prior=0.0):
     """
-    The belief from first principles: per cell, the frames that observed it at an informative
-    offset; the first of the most informative counts fully, every other one by ``weight``.
+    Compute the belief from first principles.
+
+    Per cell, the frames that observed it at an informative offset: the first of the most
+    informative counts fully, every other one by ``weight``.
     """
     kernel = model.elm_kernel()
     n = GRID.n_cells
