@@ -45,6 +45,7 @@ from .grid import Grid
 from .inhibition import unvisited_choice
 from .motion import Motion
 from .observation import as_observation, check_evidence, CountObservation
+from .still_evidence import cell_information, check_repeat_weight, StillEvidence
 from .stopping import (ABSENT, check_absent_prior, check_confidence, check_max_fixations, decide,
                        FOUND, initial_log_belief)
 
@@ -192,6 +193,12 @@ class GazeController:
         best unvisited cell instead (:func:`ipomdp_gaze.inhibition.unvisited_choice`); once
         every cell has been fixated, all are open again. For a deterministic detector on a still
         scene, whose second look at a cell repeats the same counts.
+    repeat_weight
+        For a still target (motion off): the weight, in [0, 1], of a cell's evidence from views
+        other than the one that saw it at its most informative offset
+        (:mod:`ipomdp_gaze.still_evidence`). 1 (the default) counts every frame fully, as the
+        naive-Bayes step does; 0 counts each cell's evidence once, for overlapping views of a
+        still scene taken by a deterministic detector.
 
     """
 
@@ -199,8 +206,10 @@ class GazeController:
                  settle_time_s: float = 0.0, confidence: float = 0.95, seed: int = 0,
                  motion_sigma_cells: float = 0.0, jump_prob: float = 0.0,
                  absent_prior: float = 0.0, max_fixations: int | None = None,
-                 inhibit_return: bool = False):
+                 inhibit_return: bool = False, repeat_weight: float = 1.0):
         self.grid = grid
+        self._still = StillEvidence(grid.n_cells)
+        self.repeat_weight = 1.0
         self.set_observation(observation)
         self.policy = policy
         self.set_start_cell(grid.center_index if start_cell is None else start_cell)
@@ -214,12 +223,14 @@ class GazeController:
         self.enabled = True
         self.received = self.applied = self.rejected = self.skipped = 0
         self.last_rejection = ''
+        self.set_repeat_weight(repeat_weight)
         self.reset(0.0)
 
     # -- configuration -------------------------------------------------------------------
     def set_observation(self, observation) -> None:
         """Use another observation model (or FPOC) for the following updates; keep the belief."""
         self.observation = as_observation(self.grid, observation)
+        self._kernel = None                         # ELM's kernel, when repeat_weight < 1
 
     def set_policy(self, policy) -> None:
         """Use another policy from the next choice on."""
@@ -240,7 +251,11 @@ class GazeController:
 
     def set_motion(self, sigma_cells: float, jump_prob: float) -> None:
         """Set the target's random walk per second, used from the next applied frame on."""
-        self.motion = Motion(self.grid, sigma_cells, jump_prob)
+        motion = Motion(self.grid, sigma_cells, jump_prob)
+        changed = getattr(self, 'motion', None) is not None and motion.active != self.motion.active
+        self.motion = motion
+        if changed:
+            self._restart_still_evidence()
 
     def set_absent_prior(self, absent_prior: float) -> None:
         """Prior of "no target in the grid" for the searches from the next :meth:`reset` on."""
@@ -253,6 +268,23 @@ class GazeController:
     def set_inhibit_return(self, inhibit_return: bool) -> None:
         """Whether the next choices avoid the cells already fixated in this search."""
         self.inhibit_return = bool(inhibit_return)
+
+    def set_repeat_weight(self, repeat_weight: float) -> None:
+        """
+        Weight of a cell's repeated views (still target), from the next applied frame on.
+
+        A change keeps the belief: the frames before it stay counted as they were.
+        """
+        weight = check_repeat_weight(repeat_weight)
+        if weight != self.repeat_weight:
+            self.repeat_weight = weight
+            self._restart_still_evidence()
+
+    def _restart_still_evidence(self) -> None:
+        """Count the still scene's evidence per cell from here on, on top of the belief now."""
+        self._still.reset()
+        if hasattr(self, '_log_belief'):
+            self._still_base = self._log_belief.copy()
 
     def reseed(self, seed: int) -> None:
         """Restart the policy's random stream."""
@@ -317,6 +349,8 @@ class GazeController:
         """
         self._log_belief = initial_log_belief(self.grid.n_cells, self.absent_prior)
         self._belief = np.exp(self._log_belief[:self.grid.n_cells])
+        self._still.reset()
+        self._still_base = self._log_belief.copy()
         self.fixation = self.start_cell
         self.fixations = 0
         self._visited = np.zeros(self.grid.n_cells, dtype=bool)
@@ -398,9 +432,12 @@ class GazeController:
         if self.motion.active and stamp_s > self.update_time_s:
             self.motion.over(stamp_s - self.update_time_s).predict_log(self._log_belief)
         self.update_time_s = max(self.update_time_s, float(stamp_s))
-        if self._log_belief.size > n:
-            term = np.append(term, 0.0)                 # the absent hypothesis: ratio 1
-        bayes_update(self._log_belief, term, out=self._log_belief)
+        if self.repeat_weight < 1.0 and not self.motion.active:
+            self._add_still_frame(obs, term)
+        else:
+            if self._log_belief.size > n:
+                term = np.append(term, 0.0)             # the absent hypothesis: ratio 1
+            bayes_update(self._log_belief, term, out=self._log_belief)
         np.exp(self._log_belief[:n], out=self._belief)
         self.applied += 1
         self.fixations += 1
@@ -411,6 +448,18 @@ class GazeController:
         self.target_time_s = self.usable_time_s = float(stamp_s if now_s is None else now_s)
         return FrameResult('applied', fixation=None if self._stopped else self.fixation,
                            **events)
+
+    def _add_still_frame(self, obs: np.ndarray, term: np.ndarray) -> None:
+        """Recompute the belief from the search's frames, a cell's repeated views weighted."""
+        if self._kernel is None:
+            self._kernel = np.asarray(self.observation.elm_kernel(), dtype=float)
+        information = cell_information(self._kernel, self.grid.shape, self.fixation)
+        self._still.add(term, np.where(np.isnan(obs), 0.0, information))
+        total = self._still.log_likelihood_ratio(self.repeat_weight)
+        n = self.grid.n_cells
+        if self._log_belief.size > n:
+            total = np.append(total, 0.0)               # the absent hypothesis: ratio 1
+        bayes_update(self._still_base, total, out=self._log_belief)
 
     def _events(self) -> dict:
         """Run the stop rules after an applied frame; return the events that fired."""

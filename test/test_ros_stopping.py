@@ -156,6 +156,8 @@ def test_with_motion_the_controller_keeps_tracking_after_found(rig, probe, found
     (CONTROLLER, {'absent.prior': 1.0}, 'absent.prior must be a probability in [0, 1)'),
     (CONTROLLER, {'absent.prior': 2.5}, 'absent.prior must be a probability in [0, 1)'),
     (CONTROLLER, {'search.max_fixations': -3}, 'search.max_fixations'),
+    (CONTROLLER, {'search.repeat_weight': 1.5}, 'search.repeat_weight'),
+    (CONTROLLER, {'search.repeat_weight': -0.25}, 'search.repeat_weight'),
     (CAMERA, {'target_motion_sigma_cells': -0.5}, 'target_motion_sigma_cells must be finite'),
     (CAMERA, {'target_jump_prob': 1.0}, 'target_jump_prob must be a probability in [0, 1)'),
 ])

@@ -48,6 +48,7 @@ from ipomdp_gaze.observation_file import load_observation
 from ipomdp_gaze.policies.baselines import STRATEGIES
 from ipomdp_gaze.policies.conv import ACTIONS, check_kernel
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnavailable
+from ipomdp_gaze.still_evidence import check_repeat_weight
 from ipomdp_gaze.stopping import check_absent_prior, check_max_fixations
 from rclpy.exceptions import NameValidationException
 from rclpy.node import Node
@@ -116,6 +117,11 @@ def controller_params() -> list[Param]:
         Param('search.inhibit_return', False, T.BOOL,
               'still target: never fixate a cell twice in a search (a deterministic detector '
               'on a still scene repeats its counts; the Bayes step would count them twice)'),
+        Param('search.repeat_weight', 1.0, T.DOUBLE,
+              'still target: weight of the evidence a cell gets from views other than the one '
+              'that saw it at its most informative offset, in [0, 1] (1: every frame counts '
+              'fully, naive Bayes; 0: the evidence of each cell once, for overlapping views of a '
+              'still scene and a deterministic detector)', float_range=(0.0, 1.0)),
         Param('policy.name', 'elm', T.STRING, 'fixation policy', choices=POLICY_NAMES),
         Param('policy.file', '', T.STRING,
               'policy YAML path or shipped kernel name; setting it selects learned'),
@@ -193,7 +199,7 @@ class GazeControllerNode(Node):
                                    v['settle_time_s'], v['confidence'], v['seed'],
                                    v['motion.sigma_cells'], v['motion.jump_prob'],
                                    v['absent.prior'], v['search.max_fixations'],
-                                   v['search.inhibit_return'])
+                                   v['search.inhibit_return'], v['search.repeat_weight'])
 
         self._pan_tilt_pub = self.create_publisher(JointState, 'pan_tilt', STATE_QOS)
         self._fixation_pub = self.create_publisher(Int32MultiArray, 'fixation', STATE_QOS)
@@ -238,6 +244,8 @@ class GazeControllerNode(Node):
                   f"{v['motion.jump_prob']}/s)")
         budget = v['search.max_fixations'] or 'no'
         ior = ', inhibition of return' if v['search.inhibit_return'] else ''
+        if v['search.repeat_weight'] < 1.0:
+            ior += f", repeated views weighted {v['search.repeat_weight']}"
         return (f"{motion}, absent prior {v['absent.prior']}, confidence {v['confidence']}, "
                 f'{budget} fixation budget{ior}')
 
@@ -264,6 +272,7 @@ class GazeControllerNode(Node):
         check_probability(values['motion.jump_prob'], 'motion.jump_prob')
         check_absent_prior(values['absent.prior'], 'absent.prior')
         check_max_fixations(values['search.max_fixations'], 'search.max_fixations')
+        check_repeat_weight(values['search.repeat_weight'], 'search.repeat_weight')
         for name in ('forward_command_topic', 'trajectory_topic'):
             if values[name]:
                 try:
@@ -346,6 +355,7 @@ class GazeControllerNode(Node):
         core.set_motion(v['motion.sigma_cells'], v['motion.jump_prob'])
         core.set_max_fixations(v['search.max_fixations'])
         core.set_inhibit_return(v['search.inhibit_return'])
+        core.set_repeat_weight(v['search.repeat_weight'])
         if v['seed'] != ov['seed']:
             core.reseed(v['seed'])
         if (v['forward_command_topic'], v['trajectory_topic']) != \
