@@ -38,3 +38,24 @@ def test_a_run_cut_before_it_is_reliably_at_90_percent_is_refused():
     runner.collect()
     with pytest.raises(RuntimeError, match='raise the horizon'):
         runner.summary('random')
+
+
+def test_cached_pieces_are_reused_only_for_the_same_inputs(tmp_path):
+    def run(name, cache, recipe=None, seed=2):
+        runner = reproduce._Runner(GRID, FPOC, 30, seed, 20, cache=cache)
+        runner.submit('p', make_baseline(name, GRID, FPOC), horizon=10, chunk=10,
+                      recipe=('baseline', name) if recipe is None else recipe)
+        runner.collect()
+        return runner.correct['p']
+
+    first = reproduce.PieceCache(tmp_path)
+    fresh = run('elm', first)
+    assert first.hits == 0 and len(list(tmp_path.glob('*.npz'))) == 3
+    again = reproduce.PieceCache(tmp_path)
+    np.testing.assert_array_equal(run('elm', again), fresh)
+    assert again.hits == 3
+    other = reproduce.PieceCache(tmp_path)
+    np.testing.assert_array_equal(run('map', other), run('map', None))
+    run('elm', other, seed=3)
+    assert other.hits == 0                 # another policy, another seed: simulated again
+    assert reproduce.PieceCache(tmp_path).key(None, GRID, FPOC, np.zeros(3), 4, 0, (0, 3)) is None

@@ -12,8 +12,10 @@ from __future__ import annotations
 from concurrent.futures import ProcessPoolExecutor
 import csv
 import functools
+import hashlib
 import os
 from pathlib import Path
+import resource
 import time
 
 from ipomdp_gaze.evaluation import bootstrap_counts, fixations_to_90_ci, paired_difference_ci
@@ -53,6 +55,11 @@ def add_parser(sub):
     p.add_argument('--seed', type=nonneg_int, default=0)
     p.add_argument('--bootstrap', type=positive_int, default=1000)
     p.add_argument('--retrain', action='store_true', help='retrain every shipped kernel first')
+    p.add_argument('--cache', type=Path, default=ROOT / '.cache' / 'reproduce', metavar='DIR',
+                   help='keep every simulated piece here and reuse it while its inputs and the '
+                        'package source are unchanged (default .cache/reproduce)')
+    p.add_argument('--no-cache', dest='cache', action='store_const', const=None,
+                   help='simulate everything, keep nothing')
     p.add_argument('--jobs', type=positive_int, default=os.cpu_count() or 1,
                    help='worker processes (default: one per core; the numbers do not depend on '
                         'it)')
@@ -85,6 +92,65 @@ def _retrain(log):
             raise RuntimeError(f'retraining {name} failed')
 
 
+def source_digest() -> str:
+    """SHA-256 of every Python source of the package (a cached result is stale when it moves)."""
+    digest = hashlib.sha256()
+    package = Path(__file__).resolve().parents[1]
+    for folder in (package, package / 'policies'):
+        for path in sorted(folder.resolve().rglob('*.py')):
+            digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+class PieceCache:
+    """
+    Results of simulated pieces on disk, keyed by everything that decides them.
+
+    The key is the SHA-256 of a piece's recipe (how its policy is built: a baseline's name, or
+    a policy file's name and kernel), its task (grid, FPOC), targets, horizon, seed and rows,
+    and of :func:`source_digest` (the code that builds and runs the policy), so a changed
+    kernel, setting or line of code misses the cache. ``folder=None`` caches nothing.
+    """
+
+    def __init__(self, folder: Path | None):
+        self.folder = None if folder is None else Path(folder)
+        self.source = source_digest() if folder is not None else ''
+        self.hits = 0
+
+    def key(self, recipe, grid, fpoc, targets, horizon, seed, rows) -> str | None:
+        """Return the hex key of one piece (None without a recipe: never cached)."""
+        if self.folder is None or recipe is None:
+            return None
+        digest = hashlib.sha256(self.source.encode())
+        text = repr((recipe, (grid.rows, grid.cols, grid.spacing_deg), fpoc.model,
+                     sorted(fpoc.params().items()), horizon, seed, rows))
+        digest.update(text.encode())
+        digest.update(np.ascontiguousarray(targets, dtype=np.int64).tobytes())
+        return digest.hexdigest()
+
+    def load(self, key):
+        """Return the cached ``(correct, cpu_seconds, decisions)`` of a piece, or None."""
+        if key is None:
+            return None
+        path = self.folder / f'{key}.npz'
+        try:
+            with np.load(path) as data:
+                found = (data['correct'], float(data['seconds']), int(data['decisions']))
+        except (OSError, KeyError, ValueError):
+            return None
+        self.hits += 1
+        return found
+
+    def store(self, key, result):
+        """Write one piece's result (atomically: a temporary file renamed into place)."""
+        if key is None:
+            return
+        self.folder.mkdir(parents=True, exist_ok=True)
+        tmp = self.folder / f'{key}.{os.getpid()}.tmp.npz'
+        np.savez(tmp, correct=result[0], seconds=result[1], decisions=result[2])
+        os.replace(tmp, self.folder / f'{key}.npz')
+
+
 def _simulate_rows(grid, model, policy, targets, horizon, seed, rows):
     """Run one piece of work in a worker: correctness matrix, CPU seconds, decisions."""
     t0 = time.process_time()
@@ -102,33 +168,51 @@ class _Runner:
     (:func:`ipomdp_gaze.simulate.simulate` with ``rows``), so a deterministic policy's matrix is
     the one a single serial run gives, whatever the number of processes. A stochastic policy's
     own draws come from one stream per piece (fixed ``chunk``, so still deterministic).
-    :meth:`collect` waits for every submitted run.
+    :meth:`collect` waits for every submitted run. Pieces found in ``cache`` (a
+    :class:`PieceCache`) are not run again; new ones are stored there.
     """
 
-    def __init__(self, grid, fpoc, episodes, seed, bootstrap, pool=None):
+    def __init__(self, grid, fpoc, episodes, seed, bootstrap, pool=None, cache=None):
         self.grid, self.fpoc, self.seed = grid, fpoc, seed
         self.episodes, self.bootstrap, self.pool = episodes, bootstrap, pool
+        self.cache = PieceCache(None) if cache is None else cache
         self.model = GaussianObservation(grid, fpoc)
         self.targets = draw_targets(grid.n_cells, episodes, seed)
         self.correct, self.seconds, self.decisions = {}, {}, {}
         self._pending = {}
 
-    def submit(self, name, policy, episodes=None, horizon=None, chunk=None):
-        """Queue ``episodes`` (default all) of ``policy`` for ``horizon`` fixations."""
+    def submit(self, name, policy, episodes=None, horizon=None, chunk=None, recipe=None):
+        """
+        Queue ``episodes`` (default all) of ``policy`` for ``horizon`` fixations.
+
+        ``recipe`` says how ``policy`` was built (see :class:`PieceCache`); without one the run
+        is never cached.
+        """
         n = self.episodes if episodes is None else min(episodes, self.episodes)
         chunk = n if chunk is None else int(chunk)
         jobs = []
         for start in range(0, n, chunk):
             args = (self.grid, self.model, policy, self.targets[:n], horizon, self.seed,
                     (start, min(start + chunk, n)))
-            jobs.append(self.pool.submit(_simulate_rows, *args) if self.pool is not None
-                        else _simulate_rows(*args))
+            key = self.cache.key(recipe, self.grid, self.fpoc, *args[3:])
+            found = self.cache.load(key)
+            if found is not None:
+                jobs.append((None, found))
+            elif self.pool is not None:
+                jobs.append((key, self.pool.submit(_simulate_rows, *args)))
+            else:
+                jobs.append((key, _simulate_rows(*args)))
         self._pending[name] = jobs
 
     def collect(self):
         """Wait for every queued run and store its matrix, summed CPU seconds and decisions."""
         for name, jobs in self._pending.items():
-            parts = [job.result() if hasattr(job, 'result') else job for job in jobs]
+            parts = []
+            for key, job in jobs:                     # key None: the piece came from the cache
+                job = job.result() if hasattr(job, 'result') else job
+                if key is not None:
+                    self.cache.store(key, job)
+                parts.append(job)
             self.correct[name] = np.concatenate([p[0] for p in parts])
             self.seconds[name] = sum(p[1] for p in parts)
             self.decisions[name] = sum(p[2] for p in parts)
@@ -260,7 +344,22 @@ def _read_curve(path):
     return out
 
 
-def _simulate_all(args, specs, pool, log):
+def _policy(source, spec):
+    """
+    Return ``(policy, recipe)``: the kernel of a policy file, or a baseline on its task.
+
+    ``source`` is a policy spec, ``'tempered'`` (tempered ELM at its defaults) or a baseline's
+    name; the recipe names it for the cache (a kernel by its bytes).
+    """
+    if not isinstance(source, str):
+        kernel = hashlib.sha256(np.ascontiguousarray(source.kernel).tobytes()).hexdigest()
+        return source.make_policy('argmax'), ('kernel', source.family, kernel)
+    if source == 'tempered':
+        return TemperedELM(spec.grid, spec.fpoc), ('tempered elm', 'defaults')
+    return make_baseline(source, spec.grid, spec.fpoc), ('baseline', source)
+
+
+def _simulate_all(args, specs, pool, cache, log):
     """
     Queue every simulation of the report (the slowest first), then wait for all of them.
 
@@ -268,47 +367,42 @@ def _simulate_all(args, specs, pool, log):
     """
     h7 = specs['human-7x7-infomax']
     grid7, fpoc7 = h7.grid, h7.fpoc
-    r7 = _Runner(grid7, fpoc7, args.episodes, args.seed, args.bootstrap, pool)
+    r7 = _Runner(grid7, fpoc7, args.episodes, args.seed, args.bootstrap, pool, cache)
     log(f'7x7 planner and ideal searcher ({args.jobs} processes)')
     r7.submit('planner', make_planner(grid7, fpoc7), args.episodes_planner, COSTLY_HORIZON,
-              COSTLY_CHUNK['planner'])
+              COSTLY_CHUNK['planner'], ('planner', 'defaults'))
     r7.submit('greedy', make_baseline('greedy', grid7, fpoc7), args.episodes_greedy,
-              COSTLY_HORIZON, COSTLY_CHUNK['greedy'])
+              COSTLY_HORIZON, COSTLY_CHUNK['greedy'], ('baseline', 'greedy'))
 
     # 11x11: infomax-trained vs fixate-target-trained.
     h11 = specs['human-11x11-infomax']
-    r11 = _Runner(h11.grid, h11.fpoc, args.episodes, args.seed, args.bootstrap, pool)
+    r11 = _Runner(h11.grid, h11.fpoc, args.episodes, args.seed, args.bootstrap, pool, cache)
     ft11 = specs['human-11x11-fixate_target']
     log('11x11 human and the other FPOCs')
-    for name, policy in (('infomax-trained', h11.make_policy('argmax')),
-                         ('fixate-target-trained', ft11.make_policy('argmax')),
-                         ('elm', make_baseline('elm', h11.grid, h11.fpoc)),
-                         ('map', make_baseline('map', h11.grid, h11.fpoc))):
-        r11.submit(name, policy, horizon=HORIZON_11X11)
+    for name, source in (('infomax-trained', h11), ('fixate-target-trained', ft11), ('elm', 'elm'),
+                         ('map', 'map')):
+        r11.submit(name, *_policy(source, h11), horizon=HORIZON_11X11)
 
     # Other FPOCs at 11x11 (the kernels of Fig. 6), each against ELM and MAP on its own task.
     others = {}
     for name in ('exponential-11x11-infomax', 'camera-11x11-infomax'):
         spec = specs[name]
-        runner = _Runner(spec.grid, spec.fpoc, args.episodes, args.seed, args.bootstrap, pool)
-        for label, policy in (('learned', spec.make_policy('argmax')),
-                              ('elm', make_baseline('elm', spec.grid, spec.fpoc)),
-                              ('map', make_baseline('map', spec.grid, spec.fpoc))):
-            runner.submit(label, policy, horizon=HORIZON_11X11)
+        runner = _Runner(spec.grid, spec.fpoc, args.episodes, args.seed, args.bootstrap, pool,
+                         cache)
+        for label, source in (('learned', spec), ('elm', 'elm'), ('map', 'map')):
+            runner.submit(label, *_policy(source, spec), horizon=HORIZON_11X11)
         others[name] = runner
 
     # Table I: 7x7, human FPOC.
     log('7x7 fast policies')
-    for name, policy in (('learned infomax', h7.make_policy('argmax')),
-                         ('elm', make_baseline('elm', grid7, fpoc7)),
-                         ('tempered elm', TemperedELM(grid7, fpoc7)),
-                         ('map', make_baseline('map', grid7, fpoc7)),
-                         ('center', make_baseline('center', grid7, fpoc7)),
-                         ('random', make_baseline('random', grid7, fpoc7))):
-        r7.submit(name, policy, horizon=HORIZON_7X7)
+    for name, source in (('learned infomax', h7), ('elm', 'elm'), ('tempered elm', 'tempered'),
+                         ('map', 'map'), ('center', 'center'), ('random', 'random')):
+        r7.submit(name, *_policy(source, h7), horizon=HORIZON_7X7)
     for label, runner in (('11x11', r11), *others.items(), ('7x7', r7)):
         runner.collect()
         log(f'{label} done')
+    if args.cache is not None:
+        log(f'{cache.hits} pieces from the cache {args.cache}')
     return r7, r11, others
 
 
@@ -316,6 +410,7 @@ def run(args) -> int:
     out, figures = args.out, args.out / 'figures'
     figures.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
+    load_start = os.getloadavg()[0]
 
     def log(message):
         print(f'[{time.perf_counter() - started:6.0f} s] {message}', flush=True)
@@ -327,7 +422,8 @@ def run(args) -> int:
     lines = []
     pool = ProcessPoolExecutor(args.jobs) if args.jobs > 1 else None
     try:
-        r7, r11, others = _simulate_all(args, specs, pool, log)
+        cache = PieceCache(args.cache)
+        r7, r11, others = _simulate_all(args, specs, pool, cache, log)
     finally:
         if pool is not None:
             pool.shutdown(cancel_futures=True)
@@ -385,8 +481,16 @@ def run(args) -> int:
     plt.close(fig)
 
     lines += _report(args, r7, r11, others, specs, planner_ms, curves)
+    cpu = sum(getattr(resource.getrusage(who), field) for field in ('ru_utime', 'ru_stime')
+              for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
+    wall = time.perf_counter() - started
+    load_end = os.getloadavg()[0]
+    lines += [f'This report: {wall / 60:.1f} min wall, {cpu / 60:.1f} min CPU in {args.jobs} '
+              f'processes ({cache.hits} of the pieces from the cache), load average '
+              f'{load_start:.1f} at the start and {load_end:.1f} at the end (this machine: '
+              f'{os.cpu_count()} cores).', '']
     (out / 'reproduction.md').write_text('\n'.join(lines) + '\n')
-    log(f'wrote {out / "reproduction.md"} and {figures}/')
+    log(f'wrote {out / "reproduction.md"} and {figures}/ ({wall:.0f} s wall, {cpu:.0f} s CPU)')
     return 0
 
 
