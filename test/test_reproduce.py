@@ -2,6 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """``ipomdp-gaze reproduce``: its runs split over processes give the serial run's numbers."""
 from concurrent.futures import ProcessPoolExecutor
+from dataclasses import replace
 
 from ipomdp_gaze.commands import reproduce
 from ipomdp_gaze.fpoc import make_fpoc
@@ -59,3 +60,13 @@ def test_cached_pieces_are_reused_only_for_the_same_inputs(tmp_path):
     run('elm', other, seed=3)
     assert other.hits == 0                 # another policy, another seed: simulated again
     assert reproduce.PieceCache(tmp_path).key(None, GRID, FPOC, np.zeros(3), 4, 0, (0, 3)) is None
+
+
+def test_retraining_starts_a_kernel_where_its_file_says():
+    spec = reproduce._load('human-7x7-infomax')
+    argv = reproduce.retrain_argv(spec, 'k.yaml')
+    assert '--init-elm' not in argv and argv[argv.index('--fpoc') + 1] == 'human'
+    started = replace(spec, training={**spec.training, 'init': 'elm x 15'})
+    argv = reproduce.retrain_argv(started, 'k.yaml')
+    assert argv[argv.index('--init-elm') + 1] == '15'
+    assert argv[argv.index('--epochs') + 1] == str(spec.training['epochs'])

@@ -71,22 +71,35 @@ def _load(name):
     return load_policy_spec(name)
 
 
+def retrain_argv(spec, out) -> list[str]:
+    """
+    Return the ``ipomdp-gaze train`` arguments that retrain a shipped kernel as its file records.
+
+    Task, reward, family, epochs, seed and learning rate come from the file; a kernel that was
+    started at a multiple of ELM's (``init: elm x SCALE``) is started there again.
+    """
+    training = spec.training or {}
+    fpoc_args = []
+    for key, value in spec.fpoc.params().items():
+        fpoc_args += ['--fpoc-param', f'{key}={value}']
+    argv = ['train', '--grid', f'{spec.grid.rows}x{spec.grid.cols}',
+            '--spacing-deg', str(spec.grid.spacing_deg), '--fpoc', spec.fpoc.model,
+            *fpoc_args, '--reward', spec.reward, '--family', spec.family,
+            '--epochs', str(int(training.get('epochs', 300))),
+            '--seed', str(int(training.get('seed', 0))), '--out', str(out)]
+    if 'learning_rate' in training:
+        argv += ['--learning-rate', str(training['learning_rate'])]
+    init = str(training.get('init', 'zeros'))
+    if init.startswith('elm x '):
+        argv += ['--init-elm', init[len('elm x '):]]
+    return argv
+
+
 def _retrain(log):
     from ipomdp_gaze.cli import main as cli_main
     from ipomdp_gaze.policies.policy_file import resolve_source
     for name in KERNELS:
-        spec = _load(name)
-        training = spec.training or {}
-        fpoc_args = []
-        for key, value in spec.fpoc.params().items():
-            fpoc_args += ['--fpoc-param', f'{key}={value}']
-        argv = ['train', '--grid', f'{spec.grid.rows}x{spec.grid.cols}',
-                '--spacing-deg', str(spec.grid.spacing_deg), '--fpoc', spec.fpoc.model,
-                *fpoc_args, '--reward', spec.reward, '--family', spec.family,
-                '--epochs', str(int(training.get('epochs', 300))),
-                '--seed', str(int(training.get('seed', 0))), '--out', str(resolve_source(name))]
-        if 'learning_rate' in training:
-            argv += ['--learning-rate', str(training['learning_rate'])]
+        argv = retrain_argv(_load(name), resolve_source(name))
         log(f'retraining {name}: ipomdp-gaze {" ".join(argv)}')
         if cli_main(argv) != 0:
             raise RuntimeError(f'retraining {name} failed')
