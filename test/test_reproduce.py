@@ -70,3 +70,10 @@ def test_retraining_starts_a_kernel_where_its_file_says():
     argv = reproduce.retrain_argv(started, 'k.yaml')
     assert argv[argv.index('--init-elm') + 1] == '15'
     assert argv[argv.index('--epochs') + 1] == str(spec.training['epochs'])
+
+
+def test_the_shipped_exponential_kernel_looks_straight_at_a_likely_target():
+    """The paper's claim for the exponential FPOC (Fig. 6), on the shipped kernel."""
+    spec = reproduce._load('exponential-11x11-infomax')
+    assert reproduce.preferred_offset_cells(spec.kernel) == 0.0
+    assert reproduce.preferred_offset_cells(reproduce._load('human-7x7-infomax').kernel) == 1.0
