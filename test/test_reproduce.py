@@ -4,6 +4,7 @@
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import replace
 
+from ipomdp_gaze.cli import main as cli_main
 from ipomdp_gaze.commands import reproduce
 from ipomdp_gaze.fpoc import make_fpoc
 from ipomdp_gaze.grid import Grid
@@ -77,3 +78,30 @@ def test_the_shipped_exponential_kernel_looks_straight_at_a_likely_target():
     spec = reproduce._load('exponential-11x11-infomax')
     assert reproduce.preferred_offset_cells(spec.kernel) == 0.0
     assert reproduce.preferred_offset_cells(reproduce._load('human-7x7-infomax').kernel) == 1.0
+
+
+def _tables(path):
+    """The report without its timing lines (the planner's ms and the run's own time)."""
+    return [line for line in path.read_text().splitlines()
+            if not line.startswith(('Planner decision time', 'This report:'))]
+
+
+def test_the_report_is_the_same_on_one_or_two_processes_and_from_the_cache(tmp_path, capsys):
+    small = ['--episodes', '300', '--episodes-greedy', '12', '--episodes-planner', '12',
+             '--bootstrap', '50']
+    cache = tmp_path / 'cache'
+    assert cli_main(['reproduce', '--out', str(tmp_path / 'a'), '--jobs', '2', '--cache',
+                     str(cache), *small]) == 0
+    assert cli_main(['reproduce', '--out', str(tmp_path / 'b'), '--jobs', '1', '--cache',
+                     str(cache), *small]) == 0
+    assert cli_main(['reproduce', '--out', str(tmp_path / 'c'), '--jobs', '1', '--no-cache',
+                     *small]) == 0
+    log = capsys.readouterr().out
+    pieces = len(list(cache.glob('*.npz')))
+    assert pieces > 0 and f'{pieces} pieces from the cache' in log
+    report = _tables(tmp_path / 'a' / 'reproduction.md')
+    assert report == _tables(tmp_path / 'b' / 'reproduction.md')
+    assert report == _tables(tmp_path / 'c' / 'reproduction.md')
+    assert sum(line.startswith('| rollout planner') for line in report) == 1
+    for figure in ('fig3_learning_curves', 'fig4a_percent_correct', 'fig6_kernels_by_fpoc'):
+        assert (tmp_path / 'a' / 'figures' / f'{figure}.png').stat().st_size > 0

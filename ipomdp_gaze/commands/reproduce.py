@@ -194,7 +194,7 @@ class _Runner:
         self.correct, self.seconds, self.decisions = {}, {}, {}
         self._pending = {}
 
-    def submit(self, name, policy, episodes=None, horizon=None, chunk=None, recipe=None):
+    def submit(self, name, policy, episodes=None, horizon=None, chunk=None, *, recipe=None):
         """
         Queue ``episodes`` (default all) of ``policy`` for ``horizon`` fixations.
 
@@ -383,9 +383,9 @@ def _simulate_all(args, specs, pool, cache, log):
     r7 = _Runner(grid7, fpoc7, args.episodes, args.seed, args.bootstrap, pool, cache)
     log(f'7x7 planner and ideal searcher ({args.jobs} processes)')
     r7.submit('planner', make_planner(grid7, fpoc7), args.episodes_planner, COSTLY_HORIZON,
-              COSTLY_CHUNK['planner'], ('planner', 'defaults'))
+              COSTLY_CHUNK['planner'], recipe=('planner', 'defaults'))
     r7.submit('greedy', make_baseline('greedy', grid7, fpoc7), args.episodes_greedy,
-              COSTLY_HORIZON, COSTLY_CHUNK['greedy'], ('baseline', 'greedy'))
+              COSTLY_HORIZON, COSTLY_CHUNK['greedy'], recipe=('baseline', 'greedy'))
 
     # 11x11: infomax-trained vs fixate-target-trained.
     h11 = specs['human-11x11-infomax']
@@ -394,7 +394,8 @@ def _simulate_all(args, specs, pool, cache, log):
     log('11x11 human and the other FPOCs')
     for name, source in (('infomax-trained', h11), ('fixate-target-trained', ft11), ('elm', 'elm'),
                          ('map', 'map')):
-        r11.submit(name, *_policy(source, h11), horizon=HORIZON_11X11)
+        policy, recipe = _policy(source, h11)
+        r11.submit(name, policy, horizon=HORIZON_11X11, recipe=recipe)
 
     # Other FPOCs at 11x11 (the kernels of Fig. 6), each against ELM and MAP on its own task.
     others = {}
@@ -403,14 +404,16 @@ def _simulate_all(args, specs, pool, cache, log):
         runner = _Runner(spec.grid, spec.fpoc, args.episodes, args.seed, args.bootstrap, pool,
                          cache)
         for label, source in (('learned', spec), ('elm', 'elm'), ('map', 'map')):
-            runner.submit(label, *_policy(source, spec), horizon=HORIZON_11X11)
+            policy, recipe = _policy(source, spec)
+            runner.submit(label, policy, horizon=HORIZON_11X11, recipe=recipe)
         others[name] = runner
 
     # Table I: 7x7, human FPOC.
     log('7x7 fast policies')
     for name, source in (('learned infomax', h7), ('elm', 'elm'), ('tempered elm', 'tempered'),
                          ('map', 'map'), ('center', 'center'), ('random', 'random')):
-        r7.submit(name, *_policy(source, h7), horizon=HORIZON_7X7)
+        policy, recipe = _policy(source, h7)
+        r7.submit(name, policy, horizon=HORIZON_7X7, recipe=recipe)
     for label, runner in (('11x11', r11), *others.items(), ('7x7', r7)):
         runner.collect()
         log(f'{label} done')
@@ -434,12 +437,17 @@ def run(args) -> int:
     plt = _pyplot()
     lines = []
     pool = ProcessPoolExecutor(args.jobs) if args.jobs > 1 else None
+    cache = PieceCache(args.cache)
     try:
-        cache = PieceCache(args.cache)
         r7, r11, others = _simulate_all(args, specs, pool, cache, log)
-    finally:
-        if pool is not None:
-            pool.shutdown(cancel_futures=True)
+    except BaseException:
+        if pool is not None:                    # do not wait for the pieces still running
+            for process in list((pool._processes or {}).values()):
+                process.terminate()
+            pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    if pool is not None:
+        pool.shutdown()
     h7, h11 = specs['human-7x7-infomax'], specs['human-11x11-infomax']
     planner_ms = 1000 * r7.seconds['planner'] / r7.decisions['planner']
 
