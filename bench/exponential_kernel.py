@@ -35,10 +35,12 @@ def gradient_by_class(grid, fpoc, params, epochs, seed=5):
     """Mean and standard error over epochs of the per-class gradient at ``params``."""
     trainer = Trainer(grid, fpoc, TrainConfig(learning_rate=5.0, baseline=True), params=params)
     theta = trainer.family.theta(trainer.params)
-    grads = np.array([trainer.family.project(theta_gradient(
-        sample_episodes(theta, trainer.model, 'infomax', 150, grid.n_cells,
-                        np.random.default_rng([seed, i])), 0.75, 1.0, True))
-        for i in range(epochs)])
+    grads = []
+    for i in range(epochs):
+        batch = sample_episodes(theta, trainer.model, 'infomax', 150, grid.n_cells,
+                                np.random.default_rng([seed, i]))
+        grads.append(trainer.family.project(theta_gradient(batch, 0.75, 1.0, True)))
+    grads = np.array(grads)
     return grads.mean(axis=0), grads.std(axis=0, ddof=1) / np.sqrt(epochs)
 
 

@@ -81,7 +81,7 @@ def test_the_shipped_exponential_kernel_looks_straight_at_a_likely_target():
 
 
 def _tables(path):
-    """The report without its timing lines (the planner's ms and the run's own time)."""
+    """Return the report's lines without its timing lines (planner ms, the run's own time)."""
     return [line for line in path.read_text().splitlines()
             if not line.startswith(('Planner decision time', 'This report:'))]
 
