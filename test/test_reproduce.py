@@ -52,7 +52,7 @@ def test_cached_pieces_are_reused_only_for_the_same_inputs(tmp_path):
 
     first = reproduce.PieceCache(tmp_path)
     fresh = run('elm', first)
-    assert first.hits == 0 and len(list(tmp_path.glob('*.npz'))) == 3
+    assert first.hits == 0 and len(list(tmp_path.glob('*.bin'))) == 3
     again = reproduce.PieceCache(tmp_path)
     np.testing.assert_array_equal(run('elm', again), fresh)
     assert again.hits == 3
@@ -61,6 +61,11 @@ def test_cached_pieces_are_reused_only_for_the_same_inputs(tmp_path):
     run('elm', other, seed=3)
     assert other.hits == 0                 # another policy, another seed: simulated again
     assert reproduce.PieceCache(tmp_path).key(None, GRID, FPOC, np.zeros(3), 4, 0, (0, 3)) is None
+    for path in tmp_path.glob('*.bin'):                     # damaged pieces are simulated again
+        path.write_bytes(path.read_bytes()[:-1])
+    damaged = reproduce.PieceCache(tmp_path)
+    np.testing.assert_array_equal(run('elm', damaged), fresh)
+    assert damaged.hits == 0
 
 
 def test_retraining_starts_a_kernel_where_its_file_says():
@@ -97,7 +102,7 @@ def test_the_report_is_the_same_on_one_or_two_processes_and_from_the_cache(tmp_p
     assert cli_main(['reproduce', '--out', str(tmp_path / 'c'), '--jobs', '1', '--no-cache',
                      *small]) == 0
     log = capsys.readouterr().out
-    pieces = len(list(cache.glob('*.npz')))
+    pieces = len(list(cache.glob('*.bin')))
     assert pieces > 0 and f'{pieces} pieces from the cache' in log
     report = _tables(tmp_path / 'a' / 'reproduction.md')
     assert report == _tables(tmp_path / 'b' / 'reproduction.md')

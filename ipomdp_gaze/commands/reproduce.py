@@ -13,6 +13,7 @@ from concurrent.futures import ProcessPoolExecutor
 import csv
 import functools
 import hashlib
+import json
 import os
 from pathlib import Path
 import resource
@@ -145,23 +146,36 @@ class PieceCache:
         """Return the cached ``(correct, cpu_seconds, decisions)`` of a piece, or None."""
         if key is None:
             return None
-        path = self.folder / f'{key}.npz'
         try:
-            with np.load(path) as data:
-                found = (data['correct'], float(data['seconds']), int(data['decisions']))
-        except (OSError, KeyError, ValueError):
+            raw = (self.folder / f'{key}.bin').read_bytes()
+            head, _, body = raw.partition(b'\n')
+            meta = json.loads(head)
+            shape = tuple(int(v) for v in meta['shape'])
+            if len(body) != -(-int(np.prod(shape)) // 8):
+                return None                     # a truncated or foreign file: simulate again
+            bits = np.unpackbits(np.frombuffer(body, dtype=np.uint8), count=int(np.prod(shape)))
+            found = (bits.reshape(shape).astype(bool), float(meta['seconds']),
+                     int(meta['decisions']))
+        except (OSError, KeyError, ValueError, TypeError):
             return None
         self.hits += 1
         return found
 
     def store(self, key, result):
-        """Write one piece's result (atomically: a temporary file renamed into place)."""
+        """
+        Write one piece: a JSON line (shape, CPU seconds, decisions), then the packed bits.
+
+        Written to a temporary file and renamed into place, so a reader never sees half a piece.
+        """
         if key is None:
             return
+        correct, seconds, decisions = result
         self.folder.mkdir(parents=True, exist_ok=True)
-        tmp = self.folder / f'{key}.{os.getpid()}.tmp.npz'
-        np.savez(tmp, correct=result[0], seconds=result[1], decisions=result[2])
-        os.replace(tmp, self.folder / f'{key}.npz')
+        head = json.dumps({'shape': list(correct.shape), 'seconds': float(seconds),
+                           'decisions': int(decisions)}).encode()
+        tmp = self.folder / f'{key}.{os.getpid()}.tmp'
+        tmp.write_bytes(head + b'\n' + np.packbits(correct.astype(bool)).tobytes())
+        os.replace(tmp, self.folder / f'{key}.bin')
 
 
 def _simulate_rows(grid, model, policy, targets, horizon, seed, rows):
