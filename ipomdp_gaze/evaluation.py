@@ -85,15 +85,23 @@ def fixations_to_90_ci(correct: np.ndarray, n_cells: int, rng: np.random.Generat
 
 
 def paired_difference_ci(correct_a: np.ndarray, correct_b: np.ndarray, n_cells: int,
-                         rng: np.random.Generator, resamples: int = 1000):
-    """Difference ``a - b`` of fixations to 90% on the same episodes, with a paired 95% CI."""
+                         rng: np.random.Generator, resamples: int = 1000,
+                         counts: np.ndarray | None = None):
+    """
+    Difference ``a - b`` of fixations to 90% on the same episodes, with a paired 95% CI.
+
+    Both are measured on the first ``n = min`` episodes; each bootstrap resample weights the same
+    episodes of a and b (``counts``, shape (resamples, n), drawn from ``rng`` when omitted).
+    """
     n = min(correct_a.shape[0], correct_b.shape[0])
     a, b = correct_a[:n], correct_b[:n]
     pa = fixations_to_level(a.mean(axis=0), n_cells)
     pb = fixations_to_level(b.mean(axis=0), n_cells)
     if pa is None or pb is None:
         return None, None
-    counts = bootstrap_counts(n, resamples, rng).astype(np.float32)
+    if counts is None:
+        counts = bootstrap_counts(n, resamples, rng)
+    counts = counts.astype(np.float32)
     va = fixations_to_level(counts @ a.astype(np.float32) / n, n_cells)
     vb = fixations_to_level(counts @ b.astype(np.float32) / n, n_cells)
     diff = va - vb

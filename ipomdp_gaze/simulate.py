@@ -104,10 +104,51 @@ def policy_rng(seed: int) -> np.random.Generator:
     return np.random.default_rng([seed, _POLICY])
 
 
+class RowsOf:
+    """
+    The rows ``start:stop`` of every batch a generator would draw for a whole run.
+
+    ``standard_normal(shape)`` and ``random(shape)`` with ``shape[0] == stop - start`` draw the
+    whole run's ``(episodes,) + shape[1:]`` from the wrapped generator and return rows
+    ``start:stop``, so a slice of episodes gets exactly the numbers it gets in the whole run.
+    Any other shape is drawn directly. The cost is the whole run's draws, for every slice.
+    """
+
+    def __init__(self, rng: np.random.Generator, start: int, stop: int, episodes: int):
+        self.rng, self.start, self.stop, self.episodes = rng, start, stop, episodes
+
+    def _draw(self, method, size, **kwargs):
+        shape = tuple(np.atleast_1d(size)) if size is not None else ()
+        if not shape or shape[0] != self.stop - self.start:
+            return method(size, **kwargs)
+        return method((self.episodes,) + shape[1:], **kwargs)[self.start:self.stop]
+
+    def standard_normal(self, size=None, **kwargs):
+        """Rows ``start:stop`` of the whole run's standard normal draws."""
+        return self._draw(self.rng.standard_normal, size, **kwargs)
+
+    def random(self, size=None, **kwargs):
+        """Rows ``start:stop`` of the whole run's uniform draws."""
+        return self._draw(self.rng.random, size, **kwargs)
+
+
+def check_rows(rows, episodes: int) -> tuple[int, int]:
+    """Validate ``rows = (start, stop)`` within a run of ``episodes``; return it as ints."""
+    try:
+        start, stop = (int(v) for v in rows)
+    except (TypeError, ValueError):
+        raise ValueError(f'rows must be (start, stop), got {rows!r}') from None
+    if not 0 <= start < stop <= episodes:
+        raise ValueError(f'rows must satisfy 0 <= start < stop <= episodes ({episodes}), '
+                         f'got ({start}, {stop})')
+    return start, stop
+
+
 def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | None = None,
              seed: int = 0, targets: np.ndarray | None = None, progress=None,
              motion: Motion | None = None, predict: bool = True, absent_prior: float = 0.0,
-             absent_rate: float = 0.0, present: np.ndarray | None = None) -> SearchResult:
+             absent_rate: float = 0.0, present: np.ndarray | None = None,
+             rows: tuple[int, int] | None = None) -> SearchResult:
     """
     Run ``episodes`` searches of ``horizon`` fixations (default N) from the prior.
 
@@ -141,6 +182,13 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
         Fraction of simulated scenes that are empty (their own stream, :func:`draw_present`).
     present : bool array (episodes,), optional
         Which scenes hold a target, instead of drawing them (a prefix of a larger run).
+    rows : (start, stop), optional
+        Simulate only episodes ``start:stop`` of this run of ``episodes``: targets, empty scenes,
+        noise and target steps are drawn for the whole run and sliced (:class:`RowsOf`), so the
+        rows are exactly those of the whole run for any policy that draws nothing itself (every
+        deterministic one); ``targets`` and ``present`` are then the whole run's. A stochastic
+        policy's own draws come from ``[seed, 2, start]`` instead. This is how the work of one
+        run is split over processes (``ipomdp-gaze reproduce``).
 
     """
     n = grid.n_cells
@@ -153,10 +201,27 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
     if present is None:
         present = draw_present(episodes, absent_rate, seed)
     present = np.asarray(present, dtype=bool)
+    total = episodes
+    if rows is not None:
+        start, stop = check_rows(rows, episodes)
+        targets, present, episodes = targets[start:stop], present[start:stop], stop - start
+
+        def noise(t):
+            return RowsOf(noise_stream(seed, t), start, stop, total)
+
+        def steps(t):
+            return RowsOf(motion_stream(seed, t), start, stop, total)
+        rng = np.random.default_rng([seed, _POLICY, start])
+    else:
+        def noise(t):
+            return noise_stream(seed, t)
+
+        def steps(t):
+            return motion_stream(seed, t)
+        rng = policy_rng(seed)
     all_present = bool(present.all())
     moving = motion is not None and motion.active
-    rows = np.arange(episodes)
-    rng = policy_rng(seed)
+    index = np.arange(episodes)
     log_b = initial_log_belief(n, absent_prior, episodes)
     with_absent = log_b.shape[1] > n
     belief = np.exp(log_b[:, :n])
@@ -172,7 +237,7 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
     for t in range(horizon):
         k = np.asarray(policy.select(belief, t, rng), dtype=np.int64)
         fixations[:, t] = k
-        frames = model.sample(where, k, noise_stream(seed, t),
+        frames = model.sample(where, k, noise(t),
                               present=None if all_present else present)
         llr = model.log_likelihood_ratio(frames, k, validate=False)
         if with_absent:
@@ -192,14 +257,14 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
             infomax[:, t] = np.sum(belief * log_b, axis=1)
         guess = map_cell(belief)
         guesses[:, t] = guess
-        map_prob[:, t] = belief[rows, guess]
+        map_prob[:, t] = belief[index, guess]
         if with_absent:
             says_absent = absent_prob[:, t] > map_prob[:, t]
             correct[:, t] = np.where(present, ~says_absent & (guess == where), says_absent)
         else:
             correct[:, t] = guess == truth
         if moving and t + 1 < horizon:
-            where = motion.move(where, motion_stream(seed, t))
+            where = motion.move(where, steps(t))
             if predict:
                 motion.predict_log(log_b)
                 belief[...] = np.exp(log_b[:, :n])

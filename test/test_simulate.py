@@ -5,6 +5,8 @@ from ipomdp_gaze.belief import bayes_update, map_cell, uniform_log_belief
 from ipomdp_gaze.evaluation import fixations_to_90_ci
 from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.motion import Motion
+from ipomdp_gaze.observation import CountObservation
 from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.simulate import draw_targets, noise_stream, simulate
@@ -77,3 +79,35 @@ def test_fewer_episodes_see_a_prefix_of_the_same_draws():
     large = simulate(GRID, HUMAN, policy, 1000, 8, seed=9)
     np.testing.assert_array_equal(small.correct, large.correct[:300])
     np.testing.assert_array_equal(small.fixations, large.fixations[:300])
+
+
+@pytest.mark.parametrize('name', ['elm', 'greedy'])
+def test_pieces_of_a_run_are_the_rows_of_the_whole_run(name):
+    """``rows``: pieces of a run (moving, sometimes absent target) stack into the serial run."""
+    grid = Grid(4, 4, 0.42)
+    policy = make_baseline(name, grid, HUMAN)
+    scene = {'motion': Motion(grid, 0.5, 0.1), 'absent_prior': 0.1, 'absent_rate': 0.2}
+    whole = simulate(grid, HUMAN, policy, 23, 7, seed=3, **scene)
+    pieces = [simulate(grid, HUMAN, policy, 23, 7, seed=3, rows=(a, min(a + 5, 23)), **scene)
+              for a in range(0, 23, 5)]
+    for key in ('fixations', 'correct', 'map_prob', 'target_path', 'present', 'absent_prob'):
+        np.testing.assert_array_equal(getattr(whole, key),
+                                      np.concatenate([getattr(p, key) for p in pieces]), key)
+
+
+def test_pieces_of_a_count_model_run_are_its_rows():
+    grid, rng = Grid(3, 4, 1.0), np.random.default_rng(0)
+    p_target = rng.dirichlet(np.ones(4), size=grid.shape)
+    p_null = rng.dirichlet(np.ones(4), size=grid.shape)
+    model = CountObservation(grid, p_target, p_null)
+    policy = make_baseline('elm', model.grid, model)
+    whole = simulate(model.grid, model, policy, 9, 5, seed=1)
+    pieces = [simulate(model.grid, model, policy, 9, 5, seed=1, rows=r) for r in ((0, 4), (4, 9))]
+    np.testing.assert_array_equal(whole.correct, np.concatenate([p.correct for p in pieces]))
+    np.testing.assert_array_equal(whole.fixations, np.concatenate([p.fixations for p in pieces]))
+
+
+@pytest.mark.parametrize('rows', [(0, 0), (-1, 3), (2, 11), (5, 2), 'ab', (1,)])
+def test_bad_rows_are_refused(rows):
+    with pytest.raises(ValueError, match='rows must'):
+        simulate(GRID, HUMAN, make_baseline('elm', GRID, HUMAN), 10, 3, seed=0, rows=rows)

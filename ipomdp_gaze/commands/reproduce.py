@@ -9,11 +9,17 @@ the run that writes the report, with common random numbers across policies.
 """
 from __future__ import annotations
 
+from concurrent.futures import ProcessPoolExecutor
 import csv
+import functools
+import hashlib
+import json
+import os
 from pathlib import Path
+import resource
 import time
 
-from ipomdp_gaze.evaluation import fixations_to_90_ci, paired_difference_ci
+from ipomdp_gaze.evaluation import bootstrap_counts, fixations_to_90_ci, paired_difference_ci
 from ipomdp_gaze.fpoc import dprime_table
 from ipomdp_gaze.observation import GaussianObservation
 from ipomdp_gaze.policies.baselines import make_baseline
@@ -30,6 +36,12 @@ KERNELS = ('human-7x7-infomax', 'human-11x11-infomax', 'human-11x11-fixate_targe
 PAPER_7X7 = {'learned infomax': 7.86, 'greedy': 8.96, 'map': 9.25, 'random': 11.33}
 # The ideal searcher and the planner run this many fixations (90% is reached by about 9).
 COSTLY_HORIZON = 16
+# The other runs stop here instead of at N: Fig. 4a plots 25 fixations, and every 11x11 policy
+# reaches 90% by 30. A run must be REACHED correct at its last fixation (checked).
+HORIZON_7X7, HORIZON_11X11, REACHED = 25, 60, 0.95
+# The ideal searcher and the planner are split into pieces of this many episodes (fixed, so the
+# planner's own draws, one stream per piece, do not depend on the number of processes).
+COSTLY_CHUNK = {'planner': 500, 'greedy': 250}
 PAPER_11X11 = {'infomax-trained': 18.0, 'fixate-target-trained': 20.0}
 
 
@@ -44,6 +56,14 @@ def add_parser(sub):
     p.add_argument('--seed', type=nonneg_int, default=0)
     p.add_argument('--bootstrap', type=positive_int, default=1000)
     p.add_argument('--retrain', action='store_true', help='retrain every shipped kernel first')
+    p.add_argument('--cache', type=Path, default=ROOT / '.cache' / 'reproduce', metavar='DIR',
+                   help='keep every simulated piece here and reuse it while its inputs and the '
+                        'package source are unchanged (default .cache/reproduce)')
+    p.add_argument('--no-cache', dest='cache', action='store_const', const=None,
+                   help='simulate everything, keep nothing')
+    p.add_argument('--jobs', type=positive_int, default=os.cpu_count() or 1,
+                   help='worker processes (default: one per core; the numbers do not depend on '
+                        'it)')
     p.set_defaults(run=run)
 
 
@@ -52,57 +72,222 @@ def _load(name):
     return load_policy_spec(name)
 
 
+def retrain_argv(spec, out) -> list[str]:
+    """
+    Return the ``ipomdp-gaze train`` arguments that retrain a shipped kernel as its file records.
+
+    Task, reward, family, epochs, seed and learning rate come from the file; a kernel that was
+    started at a multiple of ELM's (``init: elm x SCALE``) is started there again.
+    """
+    training = spec.training or {}
+    fpoc_args = []
+    for key, value in spec.fpoc.params().items():
+        fpoc_args += ['--fpoc-param', f'{key}={value}']
+    argv = ['train', '--grid', f'{spec.grid.rows}x{spec.grid.cols}',
+            '--spacing-deg', str(spec.grid.spacing_deg), '--fpoc', spec.fpoc.model,
+            *fpoc_args, '--reward', spec.reward, '--family', spec.family,
+            '--epochs', str(int(training.get('epochs', 300))),
+            '--seed', str(int(training.get('seed', 0))), '--out', str(out)]
+    if 'learning_rate' in training:
+        argv += ['--learning-rate', str(training['learning_rate'])]
+    init = str(training.get('init', 'zeros'))
+    if init.startswith('elm x '):
+        argv += ['--init-elm', init[len('elm x '):]]
+    return argv
+
+
 def _retrain(log):
     from ipomdp_gaze.cli import main as cli_main
     from ipomdp_gaze.policies.policy_file import resolve_source
     for name in KERNELS:
-        spec = _load(name)
-        training = spec.training or {}
-        fpoc_args = []
-        for key, value in spec.fpoc.params().items():
-            fpoc_args += ['--fpoc-param', f'{key}={value}']
-        argv = ['train', '--grid', f'{spec.grid.rows}x{spec.grid.cols}',
-                '--spacing-deg', str(spec.grid.spacing_deg), '--fpoc', spec.fpoc.model,
-                *fpoc_args, '--reward', spec.reward, '--family', spec.family,
-                '--epochs', str(int(training.get('epochs', 300))),
-                '--seed', str(int(training.get('seed', 0))), '--out', str(resolve_source(name))]
-        if 'learning_rate' in training:
-            argv += ['--learning-rate', str(training['learning_rate'])]
+        argv = retrain_argv(_load(name), resolve_source(name))
         log(f'retraining {name}: ipomdp-gaze {" ".join(argv)}')
         if cli_main(argv) != 0:
             raise RuntimeError(f'retraining {name} failed')
 
 
-class _Runner:
-    """Simulate policies on shared targets and noise; keep each one's correctness matrix."""
+def source_digest() -> str:
+    """SHA-256 of every Python source of the package (a cached result is stale when it moves)."""
+    digest = hashlib.sha256()
+    package = Path(__file__).resolve().parents[1]
+    for folder in (package, package / 'policies'):
+        for path in sorted(folder.resolve().rglob('*.py')):
+            digest.update(path.read_bytes())
+    return digest.hexdigest()
 
-    def __init__(self, grid, fpoc, episodes, seed, bootstrap):
+
+class PieceCache:
+    """
+    Results of simulated pieces on disk, keyed by everything that decides them.
+
+    The key is the SHA-256 of a piece's recipe (how its policy is built: a baseline's name, or
+    a policy file's name and kernel), its task (grid, FPOC), targets, horizon, seed and rows,
+    and of :func:`source_digest` (the code that builds and runs the policy), so a changed
+    kernel, setting or line of code misses the cache. ``folder=None`` caches nothing.
+    """
+
+    def __init__(self, folder: Path | None):
+        self.folder = None if folder is None else Path(folder)
+        self.source = source_digest() if folder is not None else ''
+        self.hits = 0
+
+    def key(self, recipe, grid, fpoc, targets, horizon, seed, rows) -> str | None:
+        """Return the hex key of one piece (None without a recipe: never cached)."""
+        if self.folder is None or recipe is None:
+            return None
+        digest = hashlib.sha256(self.source.encode())
+        text = repr((recipe, (grid.rows, grid.cols, grid.spacing_deg), fpoc.model,
+                     sorted(fpoc.params().items()), horizon, seed, rows))
+        digest.update(text.encode())
+        digest.update(np.ascontiguousarray(targets, dtype=np.int64).tobytes())
+        return digest.hexdigest()
+
+    def load(self, key):
+        """Return the cached ``(correct, cpu_seconds, decisions)`` of a piece, or None."""
+        if key is None:
+            return None
+        try:
+            raw = (self.folder / f'{key}.bin').read_bytes()
+            head, _, body = raw.partition(b'\n')
+            meta = json.loads(head)
+            shape = tuple(int(v) for v in meta['shape'])
+            if len(body) != -(-int(np.prod(shape)) // 8):
+                return None                     # a truncated or foreign file: simulate again
+            bits = np.unpackbits(np.frombuffer(body, dtype=np.uint8), count=int(np.prod(shape)))
+            found = (bits.reshape(shape).astype(bool), float(meta['seconds']),
+                     int(meta['decisions']))
+        except (OSError, KeyError, ValueError, TypeError):
+            return None
+        self.hits += 1
+        return found
+
+    def store(self, key, result):
+        """
+        Write one piece: a JSON line (shape, CPU seconds, decisions), then the packed bits.
+
+        Written to a temporary file and renamed into place, so a reader never sees half a piece.
+        """
+        if key is None:
+            return
+        correct, seconds, decisions = result
+        self.folder.mkdir(parents=True, exist_ok=True)
+        head = json.dumps({'shape': list(correct.shape), 'seconds': float(seconds),
+                           'decisions': int(decisions)}).encode()
+        tmp = self.folder / f'{key}.{os.getpid()}.tmp'
+        tmp.write_bytes(head + b'\n' + np.packbits(correct.astype(bool)).tobytes())
+        os.replace(tmp, self.folder / f'{key}.bin')
+
+
+def _simulate_rows(grid, model, policy, targets, horizon, seed, rows):
+    """Run one piece of work in a worker: correctness matrix, CPU seconds, decisions."""
+    t0 = time.process_time()
+    result = simulate(grid, model, policy, targets.size, horizon, seed, targets=targets,
+                      rows=rows)
+    return result.correct, time.process_time() - t0, result.fixations.size
+
+
+class _Runner:
+    """
+    Simulate policies on shared targets and noise; keep each one's correctness matrix.
+
+    Every run is submitted to ``pool`` (a process pool, or None to run in this process) in
+    pieces of ``chunk`` episodes: each piece is the rows ``start:stop`` of the whole run
+    (:func:`ipomdp_gaze.simulate.simulate` with ``rows``), so a deterministic policy's matrix is
+    the one a single serial run gives, whatever the number of processes. A stochastic policy's
+    own draws come from one stream per piece (fixed ``chunk``, so still deterministic).
+    :meth:`collect` waits for every submitted run. Pieces found in ``cache`` (a
+    :class:`PieceCache`) are not run again; new ones are stored there.
+    """
+
+    def __init__(self, grid, fpoc, episodes, seed, bootstrap, pool=None, cache=None):
         self.grid, self.fpoc, self.seed = grid, fpoc, seed
-        self.episodes, self.bootstrap = episodes, bootstrap
+        self.episodes, self.bootstrap, self.pool = episodes, bootstrap, pool
+        self.cache = PieceCache(None) if cache is None else cache
         self.model = GaussianObservation(grid, fpoc)
         self.targets = draw_targets(grid.n_cells, episodes, seed)
-        self.correct, self.seconds = {}, {}
+        self.correct, self.seconds, self.decisions = {}, {}, {}
+        self._pending = {}
 
-    def run(self, name, policy, episodes=None, horizon=None):
+    def submit(self, name, policy, episodes=None, horizon=None, chunk=None, *, recipe=None):
+        """
+        Queue ``episodes`` (default all) of ``policy`` for ``horizon`` fixations.
+
+        ``recipe`` says how ``policy`` was built (see :class:`PieceCache`); without one the run
+        is never cached.
+        """
         n = self.episodes if episodes is None else min(episodes, self.episodes)
-        t0 = time.perf_counter()
-        result = simulate(self.grid, self.model, policy, n, horizon, self.seed,
-                          targets=self.targets[:n])
-        self.seconds[name] = time.perf_counter() - t0
-        self.correct[name] = result.correct
-        return result
+        chunk = n if chunk is None else int(chunk)
+        jobs = []
+        for start in range(0, n, chunk):
+            args = (self.grid, self.model, policy, self.targets[:n], horizon, self.seed,
+                    (start, min(start + chunk, n)))
+            key = self.cache.key(recipe, self.grid, self.fpoc, *args[3:])
+            found = self.cache.load(key)
+            if found is not None:
+                jobs.append((None, found))
+            elif self.pool is not None:
+                jobs.append((key, self.pool.submit(_simulate_rows, *args)))
+            else:
+                jobs.append((key, _simulate_rows(*args)))
+        self._pending[name] = jobs
+
+    def collect(self):
+        """Wait for every queued run and store its matrix, summed CPU seconds and decisions."""
+        for name, jobs in self._pending.items():
+            parts = []
+            for key, job in jobs:                     # key None: the piece came from the cache
+                job = job.result() if hasattr(job, 'result') else job
+                if key is not None:
+                    self.cache.store(key, job)
+                parts.append(job)
+            self.correct[name] = np.concatenate([p[0] for p in parts])
+            self.seconds[name] = sum(p[1] for p in parts)
+            self.decisions[name] = sum(p[2] for p in parts)
+        self._pending = {}
 
     def summary(self, name):
         correct = self.correct[name]
-        point, ci = fixations_to_90_ci(correct, self.grid.n_cells,
-                                       np.random.default_rng([self.seed, 7]), self.bootstrap)
+        _check_reached(name, correct)
+        counts = _bootstrap_counts(correct.shape[0], self.bootstrap, (self.seed, 7))
+        point, ci = fixations_to_90_ci(correct, self.grid.n_cells, None, self.bootstrap,
+                                       counts=counts)
         return correct.shape[0], point, ci
 
     def paired(self, a, b):
         horizon = min(self.correct[a].shape[1], self.correct[b].shape[1])
+        n = min(self.correct[a].shape[0], self.correct[b].shape[0])
+        for name in (a, b):
+            _check_reached(name, self.correct[name][:n, :horizon])
+        counts = _bootstrap_counts(n, self.bootstrap, (self.seed, 8))
         return paired_difference_ci(self.correct[a][:, :horizon], self.correct[b][:, :horizon],
-                                    self.grid.n_cells,
-                                    np.random.default_rng([self.seed, 8]), self.bootstrap)
+                                    self.grid.n_cells, None, self.bootstrap, counts=counts)
+
+
+@functools.lru_cache(maxsize=8)
+def _bootstrap_counts(episodes, resamples, key):
+    """
+    Return the resampling weights ``default_rng(key)`` draws for ``episodes`` (computed once).
+
+    Every summary (and every paired difference) of a run drew the same weights from the same
+    seed; drawing them once gives the same numbers at a fraction of the cost.
+    """
+    counts = bootstrap_counts(episodes, resamples, np.random.default_rng(list(key)))
+    counts.flags.writeable = False
+    return counts
+
+
+def _check_reached(name, correct):
+    """
+    Refuse a run cut too short: every bootstrap resample must reach 90% within its horizon.
+
+    Runs stop at :data:`HORIZON_7X7` / :data:`HORIZON_11X11` fixations, not N (fixations to 90%
+    only needs the curve up to its first crossing, and fixation t's numbers do not depend on
+    later ones). Requiring 95% correct at the last fixation leaves no resample short of 90%.
+    """
+    final = float(correct[:, -1].mean())
+    if final < REACHED:
+        raise RuntimeError(f'{name}: only {final:.1%} correct after {correct.shape[1]} fixations; '
+                           f'raise the horizon of this run')
 
 
 def _fmt(point, ci):
@@ -186,10 +371,76 @@ def _read_curve(path):
     return out
 
 
+def _policy(source, spec):
+    """
+    Return ``(policy, recipe)``: the kernel of a policy file, or a baseline on its task.
+
+    ``source`` is a policy spec, ``'tempered'`` (tempered ELM at its defaults) or a baseline's
+    name; the recipe names it for the cache (a kernel by its bytes).
+    """
+    if not isinstance(source, str):
+        kernel = hashlib.sha256(np.ascontiguousarray(source.kernel).tobytes()).hexdigest()
+        return source.make_policy('argmax'), ('kernel', source.family, kernel)
+    if source == 'tempered':
+        return TemperedELM(spec.grid, spec.fpoc), ('tempered elm', 'defaults')
+    return make_baseline(source, spec.grid, spec.fpoc), ('baseline', source)
+
+
+def _simulate_all(args, specs, pool, cache, log):
+    """
+    Queue every simulation of the report (the slowest first), then wait for all of them.
+
+    Returns the runners of Table I (7x7), of the 11x11 comparison and of the other FPOCs.
+    """
+    h7 = specs['human-7x7-infomax']
+    grid7, fpoc7 = h7.grid, h7.fpoc
+    r7 = _Runner(grid7, fpoc7, args.episodes, args.seed, args.bootstrap, pool, cache)
+    log(f'7x7 planner and ideal searcher ({args.jobs} processes)')
+    r7.submit('planner', make_planner(grid7, fpoc7), args.episodes_planner, COSTLY_HORIZON,
+              COSTLY_CHUNK['planner'], recipe=('planner', 'defaults'))
+    r7.submit('greedy', make_baseline('greedy', grid7, fpoc7), args.episodes_greedy,
+              COSTLY_HORIZON, COSTLY_CHUNK['greedy'], recipe=('baseline', 'greedy'))
+
+    # 11x11: infomax-trained vs fixate-target-trained.
+    h11 = specs['human-11x11-infomax']
+    r11 = _Runner(h11.grid, h11.fpoc, args.episodes, args.seed, args.bootstrap, pool, cache)
+    ft11 = specs['human-11x11-fixate_target']
+    log('11x11 human and the other FPOCs')
+    for name, source in (('infomax-trained', h11), ('fixate-target-trained', ft11), ('elm', 'elm'),
+                         ('map', 'map')):
+        policy, recipe = _policy(source, h11)
+        r11.submit(name, policy, horizon=HORIZON_11X11, recipe=recipe)
+
+    # Other FPOCs at 11x11 (the kernels of Fig. 6), each against ELM and MAP on its own task.
+    others = {}
+    for name in ('exponential-11x11-infomax', 'camera-11x11-infomax'):
+        spec = specs[name]
+        runner = _Runner(spec.grid, spec.fpoc, args.episodes, args.seed, args.bootstrap, pool,
+                         cache)
+        for label, source in (('learned', spec), ('elm', 'elm'), ('map', 'map')):
+            policy, recipe = _policy(source, spec)
+            runner.submit(label, policy, horizon=HORIZON_11X11, recipe=recipe)
+        others[name] = runner
+
+    # Table I: 7x7, human FPOC.
+    log('7x7 fast policies')
+    for name, source in (('learned infomax', h7), ('elm', 'elm'), ('tempered elm', 'tempered'),
+                         ('map', 'map'), ('center', 'center'), ('random', 'random')):
+        policy, recipe = _policy(source, h7)
+        r7.submit(name, policy, horizon=HORIZON_7X7, recipe=recipe)
+    for label, runner in (('11x11', r11), *others.items(), ('7x7', r7)):
+        runner.collect()
+        log(f'{label} done')
+    if args.cache is not None:
+        log(f'{cache.hits} pieces from the cache {args.cache}')
+    return r7, r11, others
+
+
 def run(args) -> int:
     out, figures = args.out, args.out / 'figures'
     figures.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
+    load_start = os.getloadavg()[0]
 
     def log(message):
         print(f'[{time.perf_counter() - started:6.0f} s] {message}', flush=True)
@@ -199,27 +450,20 @@ def run(args) -> int:
     specs = {name: _load(name) for name in KERNELS}
     plt = _pyplot()
     lines = []
-
-    # Table I: 7x7, human FPOC.
-    h7 = specs['human-7x7-infomax']
-    grid7, fpoc7 = h7.grid, h7.fpoc
-    r7 = _Runner(grid7, fpoc7, args.episodes, args.seed, args.bootstrap)
-    policies7 = {'learned infomax': h7.make_policy('argmax'),
-                 'elm': make_baseline('elm', grid7, fpoc7),
-                 'tempered elm': TemperedELM(grid7, fpoc7),
-                 'map': make_baseline('map', grid7, fpoc7),
-                 'center': make_baseline('center', grid7, fpoc7),
-                 'random': make_baseline('random', grid7, fpoc7)}
-    for name, policy in policies7.items():
-        log(f'7x7 {name}')
-        r7.run(name, policy)
-    log('7x7 greedy (ideal searcher)')
-    r7.run('greedy', make_baseline('greedy', grid7, fpoc7), args.episodes_greedy,
-           COSTLY_HORIZON)
-    log('7x7 planner')
-    result = r7.run('planner', make_planner(grid7, fpoc7), args.episodes_planner,
-                    COSTLY_HORIZON)
-    planner_ms = 1000 * r7.seconds['planner'] / result.fixations.size
+    pool = ProcessPoolExecutor(args.jobs) if args.jobs > 1 else None
+    cache = PieceCache(args.cache)
+    try:
+        r7, r11, others = _simulate_all(args, specs, pool, cache, log)
+    except BaseException:
+        if pool is not None:                    # do not wait for the pieces still running
+            for process in list((pool._processes or {}).values()):
+                process.terminate()
+            pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    if pool is not None:
+        pool.shutdown()
+    h7, h11 = specs['human-7x7-infomax'], specs['human-11x11-infomax']
+    planner_ms = 1000 * r7.seconds['planner'] / r7.decisions['planner']
 
     # Figure 4a.
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
@@ -235,30 +479,6 @@ def run(args) -> int:
     fig.tight_layout()
     fig.savefig(figures / 'fig4a_percent_correct.png', dpi=110)
     plt.close(fig)
-
-    # 11x11: infomax-trained vs fixate-target-trained.
-    h11 = specs['human-11x11-infomax']
-    r11 = _Runner(h11.grid, h11.fpoc, args.episodes, args.seed, args.bootstrap)
-    ft11 = specs['human-11x11-fixate_target']
-    policies11 = {'infomax-trained': h11.make_policy('argmax'),
-                  'fixate-target-trained': ft11.make_policy('argmax'),
-                  'elm': make_baseline('elm', h11.grid, h11.fpoc),
-                  'map': make_baseline('map', h11.grid, h11.fpoc)}
-    for name, policy in policies11.items():
-        log(f'11x11 {name}')
-        r11.run(name, policy)
-
-    # Other FPOCs at 11x11 (the kernels of Fig. 6), each against ELM and MAP on its own task.
-    others = {}
-    for name in ('exponential-11x11-infomax', 'camera-11x11-infomax'):
-        spec = specs[name]
-        runner = _Runner(spec.grid, spec.fpoc, args.episodes, args.seed, args.bootstrap)
-        for label, policy in (('learned', spec.make_policy('argmax')),
-                              ('elm', make_baseline('elm', spec.grid, spec.fpoc)),
-                              ('map', make_baseline('map', spec.grid, spec.fpoc))):
-            log(f'{name} {label}')
-            runner.run(label, policy)
-        others[name] = runner
 
     # Kernel figures.
     _plot_kernels(plt, [h7], ['learned infomax kernel, 7x7 human'],
@@ -296,8 +516,16 @@ def run(args) -> int:
     plt.close(fig)
 
     lines += _report(args, r7, r11, others, specs, planner_ms, curves)
+    cpu = sum(getattr(resource.getrusage(who), field) for field in ('ru_utime', 'ru_stime')
+              for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
+    wall = time.perf_counter() - started
+    load_end = os.getloadavg()[0]
+    lines += [f'This report: {wall / 60:.1f} min wall, {cpu / 60:.1f} min CPU in {args.jobs} '
+              f'processes ({cache.hits} of the pieces from the cache), load average '
+              f'{load_start:.1f} at the start and {load_end:.1f} at the end (this machine: '
+              f'{os.cpu_count()} cores).', '']
     (out / 'reproduction.md').write_text('\n'.join(lines) + '\n')
-    log(f'wrote {out / "reproduction.md"} and {figures}/')
+    log(f'wrote {out / "reproduction.md"} and {figures}/ ({wall:.0f} s wall, {cpu:.0f} s CPU)')
     return 0
 
 
@@ -342,8 +570,9 @@ def _report(args, r7, r11, others, specs, planner_ms, curves):
         diff, ci = r7.paired(a, b)
         n = min(r7.correct[a].shape[0], r7.correct[b].shape[0])
         lines.append(f'- {a} - {b}: {_fmt(diff, ci)} fixations ({n} paired episodes)')
-    lines += ['', f'Planner decision time: {planner_ms:.2f} ms per decision, measured as wall '
-              'time of the batched evaluation divided by its decisions (this machine, 2 cores).',
+    lines += ['', f'Planner decision time: {planner_ms:.2f} ms of CPU per decision, measured as '
+              'the CPU time of the batched evaluation (pieces of '
+              f"{COSTLY_CHUNK['planner']} episodes) divided by its decisions (this machine).",
               '', '![Fig. 4a](figures/fig4a_percent_correct.png)', '']
 
     lines += ['## 11x11 (121-AFC), human FPOC: infomax-trained vs fixate-target-trained', '',

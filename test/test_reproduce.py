@@ -1,0 +1,112 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""``ipomdp-gaze reproduce``: its runs split over processes give the serial run's numbers."""
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import replace
+
+from ipomdp_gaze.cli import main as cli_main
+from ipomdp_gaze.commands import reproduce
+from ipomdp_gaze.fpoc import make_fpoc
+from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.policies.baselines import make_baseline
+from ipomdp_gaze.simulate import simulate
+import numpy as np
+import pytest
+
+GRID, FPOC = Grid(4, 4, 0.42), make_fpoc('human')
+
+
+def test_pieces_on_two_processes_give_the_serial_matrices_and_intervals():
+    serial = reproduce._Runner(GRID, FPOC, 60, 5, 50)
+    with ProcessPoolExecutor(2) as pool:
+        split = reproduce._Runner(GRID, FPOC, 60, 5, 50, pool)
+        for runner, chunk in ((serial, None), (split, 7)):
+            runner.submit('elm', make_baseline('elm', GRID, FPOC), horizon=12, chunk=chunk)
+            runner.submit('greedy', make_baseline('greedy', GRID, FPOC), 40, 12, chunk)
+            runner.collect()
+    whole = simulate(GRID, FPOC, make_baseline('greedy', GRID, FPOC), 40, 12, 5,
+                     targets=serial.targets[:40])
+    np.testing.assert_array_equal(split.correct['greedy'], whole.correct)
+    for name in ('elm', 'greedy'):
+        np.testing.assert_array_equal(split.correct[name], serial.correct[name])
+        assert split.summary(name) == serial.summary(name)
+    assert split.paired('greedy', 'elm') == serial.paired('greedy', 'elm')
+    assert split.decisions['greedy'] == 40 * 12
+
+
+def test_a_run_cut_before_it_is_reliably_at_90_percent_is_refused():
+    runner = reproduce._Runner(GRID, FPOC, 200, 0, 20)
+    runner.submit('random', make_baseline('random', GRID, FPOC), horizon=3)
+    runner.collect()
+    with pytest.raises(RuntimeError, match='raise the horizon'):
+        runner.summary('random')
+
+
+def test_cached_pieces_are_reused_only_for_the_same_inputs(tmp_path):
+    def run(name, cache, recipe=None, seed=2):
+        runner = reproduce._Runner(GRID, FPOC, 30, seed, 20, cache=cache)
+        runner.submit('p', make_baseline(name, GRID, FPOC), horizon=10, chunk=10,
+                      recipe=('baseline', name) if recipe is None else recipe)
+        runner.collect()
+        return runner.correct['p']
+
+    first = reproduce.PieceCache(tmp_path)
+    fresh = run('elm', first)
+    assert first.hits == 0 and len(list(tmp_path.glob('*.bin'))) == 3
+    again = reproduce.PieceCache(tmp_path)
+    np.testing.assert_array_equal(run('elm', again), fresh)
+    assert again.hits == 3
+    other = reproduce.PieceCache(tmp_path)
+    np.testing.assert_array_equal(run('map', other), run('map', None))
+    run('elm', other, seed=3)
+    assert other.hits == 0                 # another policy, another seed: simulated again
+    assert reproduce.PieceCache(tmp_path).key(None, GRID, FPOC, np.zeros(3), 4, 0, (0, 3)) is None
+    for path in tmp_path.glob('*.bin'):                     # damaged pieces are simulated again
+        path.write_bytes(path.read_bytes()[:-1])
+    damaged = reproduce.PieceCache(tmp_path)
+    np.testing.assert_array_equal(run('elm', damaged), fresh)
+    assert damaged.hits == 0
+
+
+def test_retraining_starts_a_kernel_where_its_file_says():
+    spec = reproduce._load('human-7x7-infomax')
+    argv = reproduce.retrain_argv(spec, 'k.yaml')
+    assert '--init-elm' not in argv and argv[argv.index('--fpoc') + 1] == 'human'
+    started = replace(spec, training={**spec.training, 'init': 'elm x 15'})
+    argv = reproduce.retrain_argv(started, 'k.yaml')
+    assert argv[argv.index('--init-elm') + 1] == '15'
+    assert argv[argv.index('--epochs') + 1] == str(spec.training['epochs'])
+
+
+def test_the_shipped_exponential_kernel_looks_straight_at_a_likely_target():
+    """The paper's claim for the exponential FPOC (Fig. 6), on the shipped kernel."""
+    spec = reproduce._load('exponential-11x11-infomax')
+    assert reproduce.preferred_offset_cells(spec.kernel) == 0.0
+    assert reproduce.preferred_offset_cells(reproduce._load('human-7x7-infomax').kernel) == 1.0
+
+
+def _tables(path):
+    """Return the report's lines without its timing lines (planner ms, the run's own time)."""
+    return [line for line in path.read_text().splitlines()
+            if not line.startswith(('Planner decision time', 'This report:'))]
+
+
+def test_the_report_is_the_same_on_one_or_two_processes_and_from_the_cache(tmp_path, capsys):
+    small = ['--episodes', '300', '--episodes-greedy', '12', '--episodes-planner', '12',
+             '--bootstrap', '50']
+    cache = tmp_path / 'cache'
+    assert cli_main(['reproduce', '--out', str(tmp_path / 'a'), '--jobs', '2', '--cache',
+                     str(cache), *small]) == 0
+    assert cli_main(['reproduce', '--out', str(tmp_path / 'b'), '--jobs', '1', '--cache',
+                     str(cache), *small]) == 0
+    assert cli_main(['reproduce', '--out', str(tmp_path / 'c'), '--jobs', '1', '--no-cache',
+                     *small]) == 0
+    log = capsys.readouterr().out
+    pieces = len(list(cache.glob('*.bin')))
+    assert pieces > 0 and f'{pieces} pieces from the cache' in log
+    report = _tables(tmp_path / 'a' / 'reproduction.md')
+    assert report == _tables(tmp_path / 'b' / 'reproduction.md')
+    assert report == _tables(tmp_path / 'c' / 'reproduction.md')
+    assert sum(line.startswith('| rollout planner') for line in report) == 1
+    for figure in ('fig3_learning_curves', 'fig4a_percent_correct', 'fig6_kernels_by_fpoc'):
+        assert (tmp_path / 'a' / 'figures' / f'{figure}.png').stat().st_size > 0
