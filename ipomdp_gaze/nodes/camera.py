@@ -45,6 +45,7 @@ from std_srvs.srv import Trigger
 from . import NODE_NAMES
 from .params import (cell_params, fpoc_from, fpoc_params, grid_from, grid_params, head_from,
                      INT_MAX, joint_params, Param, ParameterTransaction, row_col_from, T)
+from .saccade import SaccadeMixin
 from .spin import run_node
 
 NODE_NAME = NODE_NAMES['camera']
@@ -90,7 +91,7 @@ class CameraConfig:
     motion: Motion
 
 
-class SimulatedCameraNode(Node):
+class SimulatedCameraNode(SaccadeMixin, Node):
     """A simulated pan/tilt head with a detector (see the module docstring)."""
 
     def __init__(self, **kwargs):
@@ -167,21 +168,9 @@ class SimulatedCameraNode(Node):
             self.get_logger().warning(f'ignored a pan_tilt command: {exc}',
                                       throttle_duration_sec=5.0)
             return
-        if cell == self.goal and self.moving:
-            return
-        self.goal, self.moving = cell, True
-        if self._saccade_timer is None:
-            self._arrive()
-        else:
-            self._saccade_timer.reset()
+        self._saccade_to(cell)
 
-    def _on_arrival(self) -> None:
-        self._saccade_timer.cancel()
-        if self.moving:
-            self._arrive()
-
-    def _arrive(self) -> None:
-        self.pose, self.moving = self.goal, False
+    def _arrived(self) -> None:
         if self._config.values['rate_hz'] == 0:
             self._publish_frame()
         else:

@@ -37,8 +37,9 @@ from sensor_msgs.msg import CameraInfo, Image, JointState
 from std_msgs.msg import Int32MultiArray
 
 from . import NODE_NAMES
-from .params import head_from, INT_MAX, joint_params, MAX_CELLS_PER_SIDE, Param, \
-    ParameterTransaction, T
+from .params import (head_from, INT_MAX, joint_params, MAX_CELLS_PER_SIDE, Param,
+                     ParameterTransaction, T)
+from .saccade import SaccadeMixin
 from .spin import run_node
 
 NODE_NAME = NODE_NAMES['scene_camera']
@@ -147,7 +148,7 @@ def _scene_config(values: dict) -> SceneConfig:
     return SceneConfig(dict(values), grid, camera, scene)
 
 
-class SceneCameraNode(Node):
+class SceneCameraNode(SaccadeMixin, Node):
     """A simulated camera over a real photograph (see the module docstring)."""
 
     def __init__(self, **kwargs):
@@ -222,21 +223,9 @@ class SceneCameraNode(Node):
                 self.get_logger().warning(f'ignored a pan_tilt command: {exc}',
                                           throttle_duration_sec=5.0)
                 return
-        if goal == self.goal and self.moving:
-            return
-        self.goal, self.moving = goal, True
-        if self._saccade_timer is None:
-            self._arrive()
-        else:
-            self._saccade_timer.reset()
+        self._saccade_to(goal)
 
-    def _on_arrival(self) -> None:
-        self._saccade_timer.cancel()
-        if self.moving:
-            self._arrive()
-
-    def _arrive(self) -> None:
-        self.pose, self.moving = self.goal, False
+    def _arrived(self) -> None:
         if self._config.values['rate_hz'] == 0:
             self._publish_frame()
 

@@ -164,6 +164,28 @@ def _resolve(item):
     return item
 
 
+def _run_jobs(worker, jobs: list, total: Tallies, processes: int, progress) -> Tallies:
+    """
+    Add ``worker(job)`` of every job to ``total``, in ``processes`` workers (1: here).
+
+    ``job[3]`` is the job's list of images or scenes: ``progress`` gets its length.
+    """
+    if processes <= 1:
+        parts = map(worker, jobs)
+    else:
+        pool = ProcessPoolExecutor(processes)
+        parts = pool.map(worker, jobs)
+    try:
+        for job, part in zip(jobs, parts):
+            total += part
+            if progress:
+                progress(len(job[3]))
+    finally:
+        if processes > 1:
+            pool.shutdown()
+    return total
+
+
 def tally_images(items, detector_kwargs: dict, grid: Grid, config: FoveaConfig,
                  processes: int = 2, progress=None, fixations=None) -> Tallies:
     """
@@ -190,18 +212,7 @@ def tally_images(items, detector_kwargs: dict, grid: Grid, config: FoveaConfig,
     chunk = max(1, min(8, len(items) // max(1, 4 * processes)))
     jobs = [(dict(detector_kwargs), grid.shape, config.to_dict(), items[i:i + chunk], fixations)
             for i in range(0, len(items), chunk)]
-    if processes <= 1:
-        for job in jobs:
-            total += _worker_tally(job)
-            if progress:
-                progress(len(job[3]))
-        return total
-    with ProcessPoolExecutor(processes) as pool:
-        for job, part in zip(jobs, pool.map(_worker_tally, jobs)):
-            total += part
-            if progress:
-                progress(len(job[3]))
-    return total
+    return _run_jobs(_worker_tally, jobs, total, processes, progress)
 
 
 def tally_views(observer, geometry, scene_image: np.ndarray, target_cell: int | None,
@@ -293,18 +304,7 @@ def tally_pan_tilt_scenes(scenes, indices, detector_kwargs: dict, max_count: int
     chunk = max(1, min(4, len(indices) // max(1, 4 * processes)))
     jobs = [(dict(detector_kwargs), int(max_count), scenes.kwargs(), indices[i:i + chunk],
              null_scenes) for i in range(0, len(indices), chunk)]
-    if processes <= 1:
-        for job in jobs:
-            total += _worker_tally_views(job)
-            if progress:
-                progress(len(job[3]))
-        return total
-    with ProcessPoolExecutor(processes) as pool:
-        for job, part in zip(jobs, pool.map(_worker_tally_views, jobs)):
-            total += part
-            if progress:
-                progress(len(job[3]))
-    return total
+    return _run_jobs(_worker_tally_views, jobs, total, processes, progress)
 
 
 def pool_target(tallies: np.ndarray, pool_radius: float, min_tallies: int = 0) -> np.ndarray:
