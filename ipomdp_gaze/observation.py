@@ -237,6 +237,37 @@ class GaussianObservation:
         return obs
 
 
+def _distributions(name: str, table, shape_problem, atol: float) -> np.ndarray:
+    """
+    Check a table of count distributions (counts on the last axis); return it normalised.
+
+    ``shape_problem(shape)`` returns what is wrong with the shape, or ''. Entries must be
+    finite and non-negative, and each distribution must sum to 1 within ``atol``.
+    """
+    try:
+        a = np.array(table, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f'{name} table must be numbers') from None
+    problem = shape_problem(a.shape)
+    if problem:
+        raise ValueError(f'{name} table must {problem}, got shape {a.shape}')
+    bad = np.argwhere(~np.isfinite(a) | (a < 0))
+    if bad.size:
+        *offset, c = (int(x) for x in bad[0])
+        where = f'offset ({offset[0]}, {offset[1]}) ' if offset else ''
+        raise ValueError(f'{name} table must be finite and >= 0: {where}count {c} is '
+                         f'{a[tuple(bad[0])]}')
+    total = a.sum(axis=-1)
+    off = np.argwhere(np.abs(np.atleast_1d(total) - 1.0) > atol)
+    if off.size:
+        if a.ndim == 1:
+            raise ValueError(f'{name} table must sum to 1 over counts, got {float(total):.9g}')
+        dr, dc = (int(x) for x in off[0])
+        raise ValueError(f'{name} table must sum to 1 over counts at every offset: offset '
+                         f'({dr}, {dc}) sums to {total[dr, dc]:.9g}')
+    return a / total[..., None]
+
+
 def check_count_tables(p_target, p_null, grid: Grid, atol: float = 1e-6):
     """
     Validate the two count tables of a :class:`CountObservation`; return them as float64.
@@ -252,32 +283,18 @@ def check_count_tables(p_target, p_null, grid: Grid, atol: float = 1e-6):
         Naming the table, the offset and the problem.
 
     """
-    out = []
-    for name, table in (('target', p_target), ('null', p_null)):
-        try:
-            a = np.array(table, dtype=float)
-        except (TypeError, ValueError):
-            raise ValueError(f'{name} table must be numbers') from None
-        if a.ndim != 3 or a.shape[:2] != grid.shape or a.shape[2] < 2:
-            raise ValueError(f'{name} table must have shape ({grid.rows}, {grid.cols}, K) with '
-                             f'K >= 2 (offsets |dr|, |dc| of a {grid.rows}x{grid.cols} grid, '
-                             f'then counts), got {a.shape}')
-        bad = np.argwhere(~np.isfinite(a) | (a < 0))
-        if bad.size:
-            dr, dc, c = (int(x) for x in bad[0])
-            raise ValueError(f'{name} table must be finite and >= 0: offset ({dr}, {dc}) count '
-                             f'{c} is {a[dr, dc, c]}')
-        total = a.sum(axis=2)
-        off = np.argwhere(np.abs(total - 1.0) > atol)
-        if off.size:
-            dr, dc = (int(x) for x in off[0])
-            raise ValueError(f'{name} table must sum to 1 over counts at every offset: offset '
-                             f'({dr}, {dc}) sums to {total[dr, dc]:.9g}')
-        out.append(a / total[:, :, None])
-    if out[0].shape != out[1].shape:
+    def shape_problem(shape):
+        if len(shape) != 3 or shape[:2] != grid.shape or shape[2] < 2:
+            return (f'have shape ({grid.rows}, {grid.cols}, K) with K >= 2 (offsets |dr|, '
+                    f'|dc| of a {grid.rows}x{grid.cols} grid, then counts)')
+        return ''
+
+    target, null = (_distributions(name, table, shape_problem, atol)
+                    for name, table in (('target', p_target), ('null', p_null)))
+    if target.shape != null.shape:
         raise ValueError(f'target and null tables must have the same shape, got '
-                         f'{out[0].shape} and {out[1].shape}')
-    return out[0], out[1]
+                         f'{target.shape} and {null.shape}')
+    return target, null
 
 
 def check_scan_tables(scan_target, scan_null, max_count: int, atol: float = 1e-6):
@@ -294,23 +311,12 @@ def check_scan_tables(scan_target, scan_null, max_count: int, atol: float = 1e-6
         Naming the table and the problem.
 
     """
-    out = []
-    for name, table in (('scan target', scan_target), ('scan null', scan_null)):
-        try:
-            a = np.array(table, dtype=float)
-        except (TypeError, ValueError):
-            raise ValueError(f'{name} table must be numbers') from None
-        if a.shape != (max_count + 1,):
-            raise ValueError(f'{name} table must have K = {max_count + 1} entries (one per '
-                             f'count, as the fixation tables), got shape {a.shape}')
-        bad = np.flatnonzero(~np.isfinite(a) | (a < 0))
-        if bad.size:
-            raise ValueError(f'{name} table must be finite and >= 0: count {int(bad[0])} is '
-                             f'{a[bad[0]]}')
-        if abs(a.sum() - 1.0) > atol:
-            raise ValueError(f'{name} table must sum to 1 over counts, got {a.sum():.9g}')
-        out.append(a / a.sum())
-    return out[0], out[1]
+    def shape_problem(shape):
+        return ('' if shape == (max_count + 1,) else
+                f'have K = {max_count + 1} entries (one per count, as the fixation tables)')
+
+    return tuple(_distributions(name, table, shape_problem, atol)
+                 for name, table in (('scan target', scan_target), ('scan null', scan_null)))
 
 
 class CountObservation:
