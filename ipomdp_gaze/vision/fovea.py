@@ -413,12 +413,8 @@ class Fovea:
         windows = tuple(w for w in self.window_rects(0) if w.whole_image)
         centres, cells, pixels = [], [], 0
         for window in windows:
-            key = (window.cells, window.resized_px)
-            found = self._cache.get(key)
-            if found is None:
-                found = self._search(window)
-                pixels += window.resized_px[0] * window.resized_px[1]
-                self._cache[key] = found
+            found, cost = self._detect(window)
+            pixels += cost
             centres.append(found[0])
             cells.append(found[1])
         raw = np.bincount(np.concatenate(cells), minlength=self.grid.n_cells).astype(np.int64)
@@ -454,14 +450,9 @@ class Fovea:
         for i, window in enumerate(windows):
             row, col, n_rows, n_cols = window.cells
             observed[row:row + n_rows, col:col + n_cols] = True
-            key = (window.cells, window.resized_px)
-            found = self._cache.get(key)
-            from_cache.append(found is not None)
-            if found is None:
-                found = self._search(window)
-                pixels += window.resized_px[0] * window.resized_px[1]
-                if window.whole_image or self.reuse_windows:
-                    self._cache[key] = found
+            found, cost = self._detect(window)
+            from_cache.append(cost == 0)
+            pixels += cost
             centres.append(found[0])
             cells.append(found[1])
             window_index.append(np.full(len(found[1]), i, dtype=np.int64))
@@ -477,6 +468,22 @@ class Fovea:
                            windows=windows, centres_px=np.concatenate(centres),
                            window_index=np.concatenate(window_index), detector_pixels=pixels,
                            seconds=seconds, from_cache=tuple(from_cache))
+
+    def _detect(self, window: Window) -> tuple[tuple, int]:
+        """
+        Return a window's detections (from the image's cache when it holds them) and their cost.
+
+        The cost is the pixels given to the detector (0 from the cache). Whole-image windows are
+        always kept for the image, the others with ``reuse_windows``.
+        """
+        key = (window.cells, window.resized_px)
+        found = self._cache.get(key)
+        if found is not None:
+            return found, 0
+        found = self._search(window)
+        if window.whole_image or self.reuse_windows:
+            self._cache[key] = found
+        return found, window.resized_px[0] * window.resized_px[1]
 
     def _search(self, window: Window) -> tuple[np.ndarray, np.ndarray]:
         """Detect in one window: centres ``(M, 2)`` in full-image pixels and their cells."""
