@@ -480,14 +480,8 @@ class CountObservation:
 
         """
         counts, missing = self.counts(observation, validate)
-        term = self._ratio[self.offsets(fixation), counts]
-        term[missing] = 0.0
-        if validate and np.any(np.isnan(term)):
-            i = int(np.flatnonzero(np.isnan(term))[0])
-            raise EvidenceError(f'count {counts.flat[i]} at cell {i % counts.shape[-1]} has '
-                                f'probability 0 with and without the target; the frame is '
-                                f'refused')
-        return term
+        return self._terms(self._ratio[self.offsets(fixation), counts], counts, missing,
+                           validate, 'count')
 
     def scan_log_likelihood_ratio(self, counts, validate: bool = True) -> np.ndarray:
         """
@@ -508,12 +502,18 @@ class CountObservation:
             raise ValueError('this count model has no scan tables: it was measured without a '
                              'whole-image scan (fovea scan_once false)')
         counts, missing = self.counts(counts, validate)
-        term = self._scan_ratio[counts]
+        return self._terms(self._scan_ratio[counts], counts, missing, validate, 'scan count')
+
+    @staticmethod
+    def _terms(term: np.ndarray, counts: np.ndarray, missing: np.ndarray, validate: bool,
+               what: str) -> np.ndarray:
+        """Zero the unobserved cells' terms; refuse a count neither hypothesis allows (NaN)."""
         term[missing] = 0.0
         if validate and np.any(np.isnan(term)):
             i = int(np.flatnonzero(np.isnan(term))[0])
-            raise EvidenceError(f'scan count {counts.flat[i]} at cell {i % counts.shape[-1]} has '
-                                f'probability 0 with and without the target')
+            raise EvidenceError(f'{what} {counts.flat[i]} at cell {i % counts.shape[-1]} has '
+                                f'probability 0 with and without the target; the frame is '
+                                f'refused')
         return term
 
     def sample(self, targets, fixations, rng: np.random.Generator,
