@@ -103,6 +103,8 @@ def test_calibrate_command_on_scenes_and_on_a_labelled_folder(tmp_path):
     (['--scenes', '2', '--windows', '3,7'], 'strictly decreasing'),
     (['--scenes', '2', '--scales', '1/0'], 'expected comma-separated numbers'),
     (['--scenes', '2', '--out', 'x.json'], '--out must end in .yaml'),
+    (['--scenes', '2', '--scan-once', '--windows', '15,9,3'],
+     'scan_once needs a whole-image window'),
 ])
 def test_bad_arguments_are_one_line(args, message, tmp_path):
     argv = [sys.executable, '-m', 'ipomdp_gaze.cli', 'calibrate', *args]

@@ -278,9 +278,9 @@ def run_pan_tilt(args) -> int:
 
 def run(args) -> int:
     from ipomdp_gaze.observation_file import save_observation
-    from ipomdp_gaze.vision.calibrate import count_model, tally_images
+    from ipomdp_gaze.vision.calibrate import count_model, lattice_fixations, tally_images
     from ipomdp_gaze.vision.detector import HaarDetector
-    from ipomdp_gaze.vision.fovea import FoveaConfig
+    from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig
     if args.out.suffix != '.yaml':
         raise ValueError(f'--out must end in .yaml, got {args.out}')
     _check_options(args)
@@ -290,16 +290,13 @@ def run(args) -> int:
     config = FoveaConfig(windows_cells=args.windows, scales=args.scales,
                          max_count=args.max_count, interpolation=args.interpolation,
                          scan_once=args.scan_once)
-    if args.scan_once and args.windows[0] < max(grid.shape):
-        raise ValueError(f'--scan-once needs a whole-image window: the largest of --windows '
-                         f'({args.windows[0]} cells) must cover the {grid.rows}x{grid.cols} grid')
     detector_kwargs = {'scale_factor': args.scale_factor}
     detector = HaarDetector(**detector_kwargs)
+    Fovea(detector, grid, config)        # refuses a bad configuration before any work
     items, (height, width), source = _items(args, grid)
     from tqdm import tqdm
     bar = tqdm(total=len(items), unit='image', disable=args.quiet, desc='calibrate')
     start = time.perf_counter()
-    from ipomdp_gaze.vision.calibrate import lattice_fixations
     fixations = None if args.fixation_stride == 1 else \
         lattice_fixations(grid, args.fixation_stride)
     tallies = tally_images(items, detector_kwargs, grid, config, args.processes, bar.update,
