@@ -267,9 +267,7 @@ def prepare(args) -> list:
     if args.observation:
         models, shipped = [load_observation(args.observation)], False
     else:
-        # Models calibrated through a pan/tilt camera describe a head's views, not still images.
-        models = [model for model in map(load_observation, shipped_image_models())
-                  if (model.meta.get('image') or {}).get('view') != 'pan_tilt']
+        models = [load_observation(name) for name in shipped_image_models()]
         if not models:
             raise ValueError('no observation model is shipped with this install; pass '
                              '--observation FILE (an ipomdp_gaze/observation-v1 file, e.g. from '
