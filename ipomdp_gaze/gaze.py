@@ -453,7 +453,7 @@ class GazeController:
         """Recompute the belief from the search's frames, a cell's repeated views weighted."""
         if self._kernel is None:
             self._kernel = np.asarray(self.observation.elm_kernel(), dtype=float)
-        information = cell_information(self._kernel, self.grid.shape, self.fixation)
+        information = cell_information(self._kernel, self.grid, self.fixation)
         self._still.add(term, np.where(np.isnan(obs), 0.0, information))
         total = self._still.log_likelihood_ratio(self.repeat_weight)
         n = self.grid.n_cells

@@ -102,6 +102,17 @@ class Grid:
         r, c = self.rows_cols()
         return self.spacing_deg * (c - cf), self.spacing_deg * (r - rf)
 
+    def fixation_window(self, table: np.ndarray, row: int, col: int) -> np.ndarray:
+        """
+        Return the ``(rows, cols)`` view of an offset table centred on fixation ``(row, col)``.
+
+        ``table`` has shape ``(2*rows-1, 2*cols-1, ...)`` with entry ``[dr + rows-1, dc + cols-1]``
+        for a cell ``dr`` rows and ``dc`` columns from the fixation (:meth:`offset_table_deg`,
+        a d' table, ELM's kernel); the view's entry ``[i, j]`` is cell ``(i, j)``'s. No copy.
+        """
+        return table[self.rows - 1 - row:2 * self.rows - 1 - row,
+                     self.cols - 1 - col:2 * self.cols - 1 - col]
+
     def offset_table_deg(self) -> tuple[np.ndarray, np.ndarray]:
         """
         Offsets ``(dx, dy)`` of shape ``(2*rows-1, 2*cols-1)``.

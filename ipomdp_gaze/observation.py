@@ -158,9 +158,8 @@ class GaussianObservation:
     # -- d' ------------------------------------------------------------------------------
     def dprime_window(self, fixation: int) -> np.ndarray:
         """``d_jk`` of every cell j for one fixation k as a ``(rows, cols)`` view (no copy)."""
-        rows, cols = self.grid.shape
-        r, c = divmod(_fixation_index(self.grid, fixation), cols)
-        return self.table[rows - 1 - r:2 * rows - 1 - r, cols - 1 - c:2 * cols - 1 - c]
+        r, c = divmod(_fixation_index(self.grid, fixation), self.grid.cols)
+        return self.grid.fixation_window(self.table, r, c)
 
     def dprime_by_fixation(self) -> np.ndarray:
         """Return the N x N matrix ``d[k, j]`` (fixation k, cell j), built once (small grids)."""
@@ -416,8 +415,7 @@ class CountObservation:
         rows, cols = self.grid.shape
         if np.ndim(fixation) == 0:
             r, c = divmod(_fixation_index(self.grid, fixation), cols)
-            return self._offset_id[rows - 1 - r:2 * rows - 1 - r,
-                                   cols - 1 - c:2 * cols - 1 - c].reshape(-1)
+            return self.grid.fixation_window(self._offset_id, r, c).reshape(-1)
         if self._pair_offsets is None:
             if self.grid.n_cells > MATRIX_MAX_CELLS:
                 raise ValueError(f'a batch of fixations needs an N x N offset table; a '

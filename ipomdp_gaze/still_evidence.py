@@ -37,18 +37,15 @@ def check_repeat_weight(weight: float, name: str = 'repeat_weight') -> float:
     return float(weight)
 
 
-def cell_information(kernel: np.ndarray, shape: tuple[int, int], fixation: int) -> np.ndarray:
+def cell_information(kernel: np.ndarray, grid, fixation: int) -> np.ndarray:
     """
     How much a frame from ``fixation`` says about each cell: ELM's kernel at the cell's offset.
 
-    ``kernel`` is an observation model's ``elm_kernel()``, ``(2R-1, 2C-1)`` with entry
-    ``[dr + R-1, dc + C-1]`` for the offset ``(dr, dc)`` of a cell from the fixation
-    (``2 KL(p_target || p_null)`` for a count model, ``d'^2`` for the Gaussian one). Returns
-    ``(N,)``, 0 where the frame says nothing.
+    ``kernel`` is an observation model's ``elm_kernel()`` on ``grid`` (an offset table,
+    :meth:`ipomdp_gaze.grid.Grid.fixation_window`: ``2 KL(p_target || p_null)`` for a count
+    model, ``d'^2`` for the Gaussian one). Returns ``(N,)``, 0 where the frame says nothing.
     """
-    rows, cols = shape
-    r, c = divmod(int(fixation), cols)
-    return kernel[rows - 1 - r:2 * rows - 1 - r, cols - 1 - c:2 * cols - 1 - c].reshape(-1)
+    return grid.fixation_window(kernel, *grid.cell(int(fixation))).reshape(-1)
 
 
 class StillEvidence:

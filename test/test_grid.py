@@ -43,3 +43,13 @@ def test_bad_grid_values():
         Grid(3, 3, 0.0)
     with pytest.raises(ValueError, match='rows'):
         Grid(0, 3)
+
+
+def test_fixation_window_gives_each_cells_offset_from_the_fixation():
+    grid = Grid(3, 5, 2.0)
+    dx, dy = grid.offset_table_deg()
+    for fixation in (0, 7, 14):
+        r, c = grid.cell(fixation)
+        want_dx, want_dy = grid.offsets_deg(fixation)
+        np.testing.assert_array_equal(grid.fixation_window(dx, r, c).ravel(), want_dx)
+        np.testing.assert_array_equal(grid.fixation_window(dy, r, c).ravel(), want_dy)

@@ -109,7 +109,7 @@ def test_a_persistent_false_alarm_seen_from_many_poses_is_counted_once():
     assert [f for f, _ in frames] != [frames[0][0]] * len(frames)     # several poses
     np.testing.assert_allclose(once.belief, brute_force(model, frames, 0.0), rtol=1e-9)
     assert naive.belief[false_alarm] > once.belief[false_alarm]
-    information = cell_information(model.elm_kernel(), GRID.shape, false_alarm)
+    information = cell_information(model.elm_kernel(), GRID, false_alarm)
     assert information[false_alarm] == model.elm_kernel()[GRID.rows - 1, GRID.cols - 1]
 
 
@@ -149,7 +149,7 @@ def test_motion_turns_it_off_and_a_change_keeps_the_belief():
 def test_gaussian_model_uses_dprime_squared_as_information():
     fpoc = make_fpoc('camera', half_width_deg=1.0, half_height_deg=1.0)
     model = GaussianObservation(GRID, fpoc)
-    info = cell_information(model.elm_kernel(), GRID.shape, 7)
+    info = cell_information(model.elm_kernel(), GRID, 7)
     np.testing.assert_allclose(info, model.dprime(7) ** 2)
     controller = GazeController(GRID, fpoc, build_policy('map', GRID, fpoc), settle_time_s=0.0,
                                 confidence=1 - 1e-12, repeat_weight=0.0)
