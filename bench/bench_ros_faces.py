@@ -14,6 +14,7 @@ backgrounds); nothing was fitted to them.
 """
 import math
 
+from ipomdp_gaze.evaluation import wilson_interval
 from ipomdp_gaze.nodes.demo import faces_setup, run_demo
 from ipomdp_gaze.nodes.processes import domain_id_for
 import numpy as np
@@ -25,14 +26,6 @@ MODES = (('camera', False, 'a camera on the pan/tilt head (11x11 grid of 5 deg, 
                            'repeated views weighted 0.1)'),
          ('fovea', True, 'a fixed camera and the digital fovea (21x21 grid over 420x420 '
                          'scenes, `faces-420-nmpt`, ELM, confidence 0.999, inhibition of return)'))
-
-
-def wilson(hits: int, n: int, z: float = 1.96) -> tuple[float, float]:
-    """95% Wilson score interval of a proportion ``hits / n``."""
-    p = hits / n
-    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return centre - half, centre + half
 
 
 def run_mode(fovea: bool, seeds, log) -> list:
@@ -68,7 +61,7 @@ def bench(ctx) -> str:
         results = run_mode(fovea, seeds, ctx.log)
         done = [r for r in results if r['status'] == 0 and 'fixations' in r]
         hits = sum(bool(r['right']) for r in results)
-        low, high = wilson(hits, len(results))
+        low, high = wilson_interval(hits, len(results))
         fix = np.asarray([r['fixations'] for r in done], dtype=float)
         secs = np.asarray([r['search_s'] for r in done], dtype=float)
         found = [r for r in done if r['stop'] == 'found']

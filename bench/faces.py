@@ -29,6 +29,7 @@ import time
 
 import cv2
 from ipomdp_gaze.commands.find import default_policy_file
+from ipomdp_gaze.evaluation import wilson_interval
 from ipomdp_gaze.observation_file import load_observation
 from ipomdp_gaze.policies.registry import build_policy
 from ipomdp_gaze.vision.detector import HaarDetector
@@ -119,16 +120,6 @@ IDEAS = [
     'pays for its misses in fixations.', '']
 
 
-def wilson(hits: int, n: int, z: float = 1.96) -> tuple[float, float]:
-    """95% Wilson score interval of a proportion."""
-    if n == 0:
-        return float('nan'), float('nan')
-    p = hits / n
-    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
-    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return centre - half, centre + half
-
-
 def errors(cells, truth) -> np.ndarray:
     """Chebyshev distance in cells of each answer (None: no answer, counted as wrong)."""
     out = []
@@ -197,7 +188,7 @@ def run_task(name: str, n: int, seed: int, log) -> dict:
         hits = int(np.sum(err <= 1))
         finite = err[np.isfinite(err)]
         out['rows'].append({
-            'label': label, 'right': hits / n, 'ci': wilson(hits, n),
+            'label': label, 'right': hits / n, 'ci': wilson_interval(hits, n),
             'exact': float(np.mean(err == 0)),
             'grid_error': float(finite.mean()) if finite.size else float('nan'),
             'answered': finite.size / n, 'fixations': float(np.mean(row['fixations'])),
