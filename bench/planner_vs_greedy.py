@@ -1,48 +1,78 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-7x7 human FPOC: the planner and tempered ELM against ELM and the ideal searcher, on both cores.
+7x7 human FPOC: the searchers beyond the paper against ELM and the ideal searcher, on both cores.
 
-Run: ``.venv/bin/python bench/planner_vs_greedy.py [--episodes 4000] [--seed 1] [--jobs 2]``
-(about 10 CPU-minutes at 4,000 episodes; docs/reproduction_notes.md quotes a run).
+Run: ``.venv/bin/python bench/planner_vs_greedy.py [--episodes 4000] [--seed 1] [--jobs 2]
+[--horizon 16] [--policies elm,tempered,greedy,planner] [--cache DIR] [--json OUT]``.
+docs/reproduction.md quotes two runs: ``--episodes 4000 --seed 1`` (about 10 CPU-minutes) and
+``--episodes 60000 --seed 1 --horizon 9 --policies elm,tempered,greedy,switching`` (about 45
+CPU-minutes, nearly all of it the ideal searcher).
 
-Every policy runs the same episodes (common random numbers) for 16 fixations, split into pieces
-of 500 episodes over a process pool (``simulate(..., rows=)``, so ELM, tempered ELM and the
-ideal searcher give exactly their serial numbers). Printed: fixations to 90% correct by the
-indicator (MAP guess right) and by the expected percent correct (mean of ``max_i B_i``, the same
-curve with less variance), each with a 95% bootstrap interval, then the paired differences.
+Every policy runs the same episodes (common random numbers), split into pieces over a process pool
+(``simulate(..., rows=)``, so every deterministic policy gives exactly its serial numbers; the
+planner draws its rollouts from one stream per piece of 500 episodes). Printed: fixations to 90%
+correct by the indicator (MAP guess right) and by the expected percent correct (mean of
+``max_i B_i``, the same curve with less variance), each with a 95% bootstrap interval, then the
+paired differences. ``--cache DIR`` keeps finished pieces (``.npz``), so an interrupted run
+resumes; the key is the policy, seed, episodes, horizon and rows, so change nothing else between
+runs sharing a cache.
 """
 import argparse
 from concurrent.futures import ProcessPoolExecutor
+import itertools
+import json
+from pathlib import Path
 import time
 
 from ipomdp_gaze.evaluation import fixations_to_90_ci, paired_difference_ci
 from ipomdp_gaze.fpoc import make_fpoc
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.policies.baselines import make_baseline
-from ipomdp_gaze.policies.planner import make_planner, TemperedELM
+from ipomdp_gaze.policies.planner import make_planner
 from ipomdp_gaze.simulate import simulate
 import numpy as np
 
 GRID, FPOC = Grid(7, 7, 0.42), make_fpoc('human')
-HORIZON, CHUNK = 16, 500
-NAMES = ('elm', 'tempered', 'greedy', 'planner')
+NAMES = ('elm', 'tempered', 'greedy', 'switching', 'planner')
+# Episodes per piece: the planner's rollout streams are per piece, so its size is fixed.
+CHUNK = {'planner': 500}
+DEFAULT_CHUNK = 2000
 
 
 def build(name):
     """Return the policy called ``name``."""
-    if name == 'tempered':
-        return TemperedELM(GRID, FPOC)
     if name == 'planner':
         return make_planner(GRID, FPOC)
     return make_baseline(name, GRID, FPOC)
 
 
-def piece(name, episodes, seed, rows):
+def piece(name, episodes, horizon, seed, rows, cache):
     """Simulate rows ``start:stop`` of the run: correct, max_i B_i and CPU seconds."""
+    path = None
+    if cache is not None:
+        path = Path(cache) / f'{name}_{seed}_{episodes}_{horizon}_{rows[0]}_{rows[1]}.npz'
+        if path.exists():
+            with np.load(path) as data:
+                return data['correct'], data['map_prob'], float(data['cpu'])
     start = time.process_time()
-    result = simulate(GRID, FPOC, build(name), episodes, HORIZON, seed, rows=rows)
-    return result.correct, result.map_prob, time.process_time() - start
+    result = simulate(GRID, FPOC, build(name), episodes, horizon, seed, rows=rows)
+    cpu = time.process_time() - start
+    if path is not None:
+        partial = path.with_suffix('.part.npz')
+        np.savez(partial, correct=result.correct, map_prob=result.map_prob, cpu=cpu)
+        partial.replace(path)
+    return result.correct, result.map_prob, cpu
+
+
+def policy_list(text):
+    """Comma-separated names from :data:`NAMES`."""
+    names = [name for name in text.split(',') if name]
+    unknown = sorted(set(names) - set(NAMES))
+    if unknown or not names:
+        raise argparse.ArgumentTypeError(f"policies must be some of {', '.join(NAMES)}, "
+                                         f'got {text!r}')
+    return names
 
 
 def main():
@@ -50,29 +80,46 @@ def main():
     parser.add_argument('--episodes', type=int, default=4000)
     parser.add_argument('--seed', type=int, default=1)
     parser.add_argument('--jobs', type=int, default=2)
+    parser.add_argument('--horizon', type=int, default=16)
+    parser.add_argument('--policies', type=policy_list,
+                        default=['elm', 'tempered', 'greedy', 'planner'])
+    parser.add_argument('--cache', type=Path, default=None)
+    parser.add_argument('--json', type=Path, default=None)
     args = parser.parse_args()
-    n = args.episodes
-    results = {}
+    n, names = args.episodes, args.policies
+    if args.cache is not None:
+        args.cache.mkdir(parents=True, exist_ok=True)
+    results, out = {}, {'episodes': n, 'seed': args.seed, 'horizon': args.horizon,
+                        'policies': {}, 'paired': {}}
     with ProcessPoolExecutor(args.jobs) as pool:
-        jobs = {name: [pool.submit(piece, name, n, args.seed, (a, min(a + CHUNK, n)))
-                       for a in range(0, n, CHUNK)] for name in NAMES[::-1]}
-        for name in NAMES:
+        jobs = {}
+        for name in sorted(names, key=lambda x: x not in ('greedy', 'switching', 'planner')):
+            chunk = CHUNK.get(name, DEFAULT_CHUNK)
+            jobs[name] = [pool.submit(piece, name, n, args.horizon, args.seed,
+                                      (a, min(a + chunk, n)), args.cache)
+                          for a in range(0, n, chunk)]
+        for name in names:
             parts = [job.result() for job in jobs[name]]
             results[name] = [np.concatenate([p[i] for p in parts]) for i in (0, 1)]
             cpu = sum(p[2] for p in parts)
-            print(f'{name}: {cpu:.0f} s CPU, {1000 * cpu / (n * HORIZON):.2f} ms per decision')
+            ms = 1000 * cpu / (n * args.horizon)
+            out['policies'][name] = {'cpu_s': cpu, 'ms_per_decision': ms}
+            print(f'{name}: {cpu:.0f} s CPU, {ms:.2f} ms per decision')
     measures = ('indicator', 'expected')
-    for name in NAMES:
+    for name in names:
         for i, label in enumerate(measures):
             point, ci = fixations_to_90_ci(results[name][i], GRID.n_cells,
                                            np.random.default_rng([args.seed, 7]), 1000)
+            out['policies'][name][label] = {'fixations_to_90': point, 'ci95': ci}
             print(f'{name:9s} {label:9s} {point:.3f} [{ci[0]:.3f}, {ci[1]:.3f}]')
-    for a, b in (('planner', 'elm'), ('planner', 'greedy'), ('planner', 'tempered'),
-                 ('tempered', 'elm'), ('tempered', 'greedy'), ('greedy', 'elm')):
+    for a, b in itertools.combinations(names[::-1], 2):
         for i, label in enumerate(measures):
             diff, ci = paired_difference_ci(results[a][i], results[b][i], GRID.n_cells,
                                             np.random.default_rng([args.seed, 8]), 1000)
+            out['paired'].setdefault(f'{a} - {b}', {})[label] = {'difference': diff, 'ci95': ci}
             print(f'{a} - {b} ({label}, {n} paired): {diff:+.3f} [{ci[0]:+.3f}, {ci[1]:+.3f}]')
+    if args.json is not None:
+        args.json.write_text(json.dumps(out, indent=1) + '\n')
 
 
 if __name__ == '__main__':

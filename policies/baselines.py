@@ -17,7 +17,10 @@ import numpy as np
 
 from .conv import ConvPolicy
 
-STRATEGIES = ('map', 'random', 'center', 'elm', 'spiral', 'greedy')
+STRATEGIES = ('map', 'random', 'center', 'elm', 'spiral', 'greedy', 'tempered', 'switching')
+
+_NEEDS_FPOC = {'greedy': 'the ideal searcher', 'tempered': 'tempered ELM',
+               'switching': 'tempered ELM, then the ideal searcher'}
 
 
 class MapPolicy:
@@ -114,11 +117,17 @@ def make_baseline(strategy: str, grid: Grid, model):
         return SpiralPolicy(grid)
     if strategy == 'elm':
         return elm_policy(grid, model)
-    if strategy == 'greedy':
-        from .greedy import PercentCorrectGreedy
+    if strategy in ('greedy', 'tempered', 'switching'):
         fpoc = getattr(as_observation(grid, model), 'fpoc', None)
         if fpoc is None:
-            raise ValueError('policy greedy (the ideal searcher) needs the Gaussian model of an '
-                             'FPOC, not a count model')
-        return PercentCorrectGreedy(grid, fpoc)
+            raise ValueError(f'policy {strategy} ({_NEEDS_FPOC[strategy]}) needs the Gaussian '
+                             'model of an FPOC, not a count model')
+        if strategy == 'greedy':
+            from .greedy import PercentCorrectGreedy
+            return PercentCorrectGreedy(grid, fpoc)
+        if strategy == 'tempered':
+            from .planner import TemperedELM
+            return TemperedELM(grid, fpoc)
+        from .switching import SwitchingSearcher
+        return SwitchingSearcher(grid, fpoc)
     raise ValueError(f"unknown policy {strategy!r}; valid policies: {', '.join(STRATEGIES)}")

@@ -29,6 +29,8 @@ from .common import (add_scene_args, add_task_args, confidence_arg, nonneg_int, 
                      task_from_args)
 
 NO_PREDICTION = ' (no prediction)'
+# Policies (by ``name``) that run on the first ``--episodes-greedy`` episodes only.
+COSTLY = ('greedy', 'switching')
 
 
 def add_parser(sub):
@@ -42,7 +44,7 @@ def add_parser(sub):
                    help='a policy YAML file, keyed by its file stem (repeatable)')
     p.add_argument('--episodes', type=positive_int, default=20000)
     p.add_argument('--episodes-greedy', type=positive_int, default=2000,
-                   help='episodes for the slow ideal searcher (default 2000)')
+                   help='episodes for the slow searchers, greedy and switching (default 2000)')
     p.add_argument('--horizon', type=positive_int, default=None,
                    help="fixations per episode (default N, the paper's T)")
     p.add_argument('--seed', type=nonneg_int, default=0)
@@ -121,7 +123,8 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
         runs += [(name + NO_PREDICTION, policy, False) for name, policy in policies.items()]
     results = {}
     for name, policy, predict in runs:
-        n = min(episodes, episodes_greedy) if getattr(policy, 'name', '') == 'greedy' else episodes
+        costly = getattr(policy, 'name', '') in COSTLY
+        n = min(episodes, episodes_greedy) if costly else episodes
         result = simulate(grid, model, policy, n, horizon, seed, targets=targets[:n],
                           motion=motion, predict=predict, absent_prior=absent_prior,
                           present=present[:n])

@@ -34,14 +34,15 @@ ROOT = Path(__file__).resolve().parents[2]
 KERNELS = ('human-7x7-infomax', 'human-11x11-infomax', 'human-11x11-fixate_target',
            'exponential-11x11-infomax', 'camera-11x11-infomax')
 PAPER_7X7 = {'learned infomax': 7.86, 'greedy': 8.96, 'map': 9.25, 'random': 11.33}
-# The ideal searcher and the planner run this many fixations (90% is reached by about 9).
+# The ideal searcher, the switching searcher and the planner run this many fixations (90% is
+# reached by about 9).
 COSTLY_HORIZON = 16
 # The other runs stop here instead of at N: Fig. 4a plots 25 fixations, and every 11x11 policy
 # reaches 90% by 30. A run must be REACHED correct at its last fixation (checked).
 HORIZON_7X7, HORIZON_11X11, REACHED = 25, 60, 0.95
-# The ideal searcher and the planner are split into pieces of this many episodes (fixed, so the
+# The costly searchers are split into pieces of this many episodes (fixed, so the
 # planner's own draws, one stream per piece, do not depend on the number of processes).
-COSTLY_CHUNK = {'planner': 500, 'greedy': 250}
+COSTLY_CHUNK = {'planner': 500, 'greedy': 250, 'switching': 250}
 PAPER_11X11 = {'infomax-trained': 18.0, 'fixate-target-trained': 20.0}
 
 
@@ -395,11 +396,12 @@ def _simulate_all(args, specs, pool, cache, log):
     h7 = specs['human-7x7-infomax']
     grid7, fpoc7 = h7.grid, h7.fpoc
     r7 = _Runner(grid7, fpoc7, args.episodes, args.seed, args.bootstrap, pool, cache)
-    log(f'7x7 planner and ideal searcher ({args.jobs} processes)')
+    log(f'7x7 planner, ideal searcher and switching searcher ({args.jobs} processes)')
     r7.submit('planner', make_planner(grid7, fpoc7), args.episodes_planner, COSTLY_HORIZON,
               COSTLY_CHUNK['planner'], recipe=('planner', 'defaults'))
-    r7.submit('greedy', make_baseline('greedy', grid7, fpoc7), args.episodes_greedy,
-              COSTLY_HORIZON, COSTLY_CHUNK['greedy'], recipe=('baseline', 'greedy'))
+    for name in ('greedy', 'switching'):
+        r7.submit(name, make_baseline(name, grid7, fpoc7), args.episodes_greedy,
+                  COSTLY_HORIZON, COSTLY_CHUNK[name], recipe=('baseline', name))
 
     # 11x11: infomax-trained vs fixate-target-trained.
     h11 = specs['human-11x11-infomax']
@@ -467,8 +469,8 @@ def run(args) -> int:
 
     # Figure 4a.
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
-    for name in ('planner', 'learned infomax', 'tempered elm', 'elm', 'greedy', 'map', 'center',
-                 'random'):
+    for name in ('switching', 'planner', 'learned infomax', 'tempered elm', 'elm', 'greedy', 'map',
+                 'center', 'random'):
         pc = r7.correct[name].mean(axis=0)[:25]
         ax.plot(np.arange(1, pc.size + 1), pc, marker='o', ms=3, label=name)
     ax.axhline(0.9, color='0.5', ls='--', lw=0.8)
@@ -544,8 +546,8 @@ def _report(args, r7, r11, others, specs, planner_ms, curves):
              '## Table I: fixations to 90% correct, 7x7 (49-AFC), human FPOC',
              '',
              f'Human FPOC at the calibrated default (noise_contrast 0.20, foveal_dprime 2.0, '
-             f'0.42 deg/cell); argmax actions; {args.episodes} episodes (the ideal searcher '
-             f'{min(args.episodes_greedy, args.episodes)}, the planner '
+             f'0.42 deg/cell); argmax actions; {args.episodes} episodes (the ideal searcher and '
+             f'the switching searcher {min(args.episodes_greedy, args.episodes)}, the planner '
              f'{min(args.episodes_planner, args.episodes)}, each on the first episodes of the '
              f'same set and for {COSTLY_HORIZON} fixations, enough to pass 90%).',
              '',
@@ -555,9 +557,10 @@ def _report(args, r7, r11, others, specs, planner_ms, curves):
               'percent-correct greedy (ideal searcher)', 'map': 'fixate target (MAP)',
               'random': 'fixate random', 'elm': 'ELM (N&G 2009)', 'center': 'fixate centre',
               'tempered elm': 'tempered ELM (ours: B^0.7, d^1.75)',
-              'planner': 'rollout planner on tempered ELM (ours)'}
+              'planner': 'rollout planner on tempered ELM (ours)',
+              'switching': 'switching: tempered ELM, the ideal searcher from fixation 6 (ours)'}
     for name in ('learned infomax', 'greedy', 'map', 'random', 'elm', 'center', 'tempered elm',
-                 'planner'):
+                 'planner', 'switching'):
         n, point, ci = r7.summary(name)
         paper = PAPER_7X7.get(name)
         lines.append(f"| {labels[name]} | {'' if paper is None else paper} | "
@@ -566,7 +569,8 @@ def _report(args, r7, r11, others, specs, planner_ms, curves):
     for a, b in (('learned infomax', 'elm'), ('learned infomax', 'map'),
                  ('tempered elm', 'elm'), ('tempered elm', 'greedy'), ('planner', 'elm'),
                  ('planner', 'tempered elm'), ('planner', 'greedy'), ('greedy', 'elm'),
-                 ('learned infomax', 'greedy')):
+                 ('learned infomax', 'greedy'), ('switching', 'elm'), ('switching', 'greedy'),
+                 ('switching', 'tempered elm')):
         diff, ci = r7.paired(a, b)
         n = min(r7.correct[a].shape[0], r7.correct[b].shape[0])
         lines.append(f'- {a} - {b}: {_fmt(diff, ci)} fixations ({n} paired episodes)')
