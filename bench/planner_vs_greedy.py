@@ -4,7 +4,8 @@
 7x7 human FPOC: the searchers beyond the paper against ELM and the ideal searcher, on both cores.
 
 Run: ``.venv/bin/python bench/planner_vs_greedy.py [--episodes 4000] [--seed 1] [--jobs 2]
-[--horizon 16] [--policies elm,tempered,greedy,planner] [--cache DIR] [--json OUT]``.
+[--horizon 16] [--policies elm,tempered,greedy,planner] [--planner-options K=V,...]
+[--cache DIR] [--json OUT]``.
 docs/reproduction.md quotes two runs: ``--episodes 4000 --seed 1`` (about 10 CPU-minutes) and
 ``--episodes 60000 --seed 1 --horizon 9 --policies elm,tempered,greedy,switching`` (about 45
 CPU-minutes, nearly all of it the ideal searcher).
@@ -15,8 +16,9 @@ planner draws its rollouts from one stream per piece of 500 episodes). Printed: 
 correct by the indicator (MAP guess right) and by the expected percent correct (mean of
 ``max_i B_i``, the same curve with less variance), each with a 95% bootstrap interval, then the
 paired differences. ``--cache DIR`` keeps finished pieces (``.npz``), so an interrupted run
-resumes; the key is the policy, seed, episodes, horizon and rows, so change nothing else between
-runs sharing a cache.
+resumes and a longer run reuses a shorter one: a run of n episodes is the first n episodes of a
+longer one (test_simulate.py), so the key is the policy, seed, horizon and rows. Change nothing
+else between runs sharing a cache.
 """
 import argparse
 from concurrent.futures import ProcessPoolExecutor
@@ -40,23 +42,27 @@ CHUNK = {'planner': 500}
 DEFAULT_CHUNK = 2000
 
 
-def build(name):
+def build(name, planner_options):
     """Return the policy called ``name``."""
     if name == 'planner':
-        return make_planner(GRID, FPOC)
+        return make_planner(GRID, FPOC, **planner_options)
     return make_baseline(name, GRID, FPOC)
 
 
-def piece(name, episodes, horizon, seed, rows, cache):
+def piece(name, episodes, horizon, seed, rows, cache, planner_options):
     """Simulate rows ``start:stop`` of the run: correct, max_i B_i and CPU seconds."""
     path = None
     if cache is not None:
-        path = Path(cache) / f'{name}_{seed}_{episodes}_{horizon}_{rows[0]}_{rows[1]}.npz'
+        tag = name
+        if name == 'planner' and planner_options:
+            tag += '-' + '-'.join(f'{k}{v}' for k, v in sorted(planner_options.items()))
+        path = Path(cache) / f'{tag}_{seed}_{horizon}_{rows[0]}_{rows[1]}.npz'
         if path.exists():
             with np.load(path) as data:
                 return data['correct'], data['map_prob'], float(data['cpu'])
     start = time.process_time()
-    result = simulate(GRID, FPOC, build(name), episodes, horizon, seed, rows=rows)
+    result = simulate(GRID, FPOC, build(name, planner_options), episodes, horizon, seed,
+                      rows=rows)
     cpu = time.process_time() - start
     if path is not None:
         partial = path.with_suffix('.part.npz')
@@ -75,6 +81,22 @@ def policy_list(text):
     return names
 
 
+def planner_options(text):
+    """``key=value,...`` options of :class:`RolloutPlanner` (numbers or words)."""
+    options = {}
+    for item in filter(None, text.split(',')):
+        key, sep, value = item.partition('=')
+        if not sep or not key:
+            raise argparse.ArgumentTypeError(f'planner options are key=value, got {item!r}')
+        for kind in (int, float, str):
+            try:
+                options[key] = kind(value)
+                break
+            except ValueError:
+                continue
+    return options
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
     parser.add_argument('--episodes', type=int, default=4000)
@@ -83,6 +105,8 @@ def main():
     parser.add_argument('--horizon', type=int, default=16)
     parser.add_argument('--policies', type=policy_list,
                         default=['elm', 'tempered', 'greedy', 'planner'])
+    parser.add_argument('--planner-options', type=planner_options, default={},
+                        help='RolloutPlanner options, e.g. candidates=8,rollout_budget=8192')
     parser.add_argument('--cache', type=Path, default=None)
     parser.add_argument('--json', type=Path, default=None)
     args = parser.parse_args()
@@ -96,7 +120,8 @@ def main():
         for name in sorted(names, key=lambda x: x not in ('greedy', 'switching', 'planner')):
             chunk = CHUNK.get(name, DEFAULT_CHUNK)
             jobs[name] = [pool.submit(piece, name, n, args.horizon, args.seed,
-                                      (a, min(a + chunk, n)), args.cache)
+                                      (a, min(a + chunk, n)), args.cache,
+                                      args.planner_options)
                           for a in range(0, n, chunk)]
         for name in names:
             parts = [job.result() for job in jobs[name]]
