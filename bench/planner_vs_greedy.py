@@ -7,8 +7,8 @@ Run: ``.venv/bin/python bench/planner_vs_greedy.py [--episodes 4000] [--seed 1] 
 [--horizon 16] [--policies elm,tempered,greedy,planner] [--planner-options K=V,...]
 [--cache DIR] [--json OUT]``.
 docs/reproduction.md quotes two runs: ``--episodes 4000 --seed 1`` (about 10 CPU-minutes) and
-``--episodes 60000 --seed 1 --horizon 9 --policies elm,tempered,greedy,switching`` (about 45
-CPU-minutes, nearly all of it the ideal searcher).
+``--episodes 200000 --seed 1 --horizon 9 --policies elm,tempered,greedy,switching --json
+docs/data/searchers-7x7.json`` (about 2.5 CPU-hours, two thirds of it the ideal searcher).
 
 Every policy runs the same episodes (common random numbers), split into pieces over a process pool
 (``simulate(..., rows=)``, so every deterministic policy gives exactly its serial numbers; the
