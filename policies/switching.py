@@ -26,7 +26,7 @@ from ipomdp_gaze.grid import Grid
 import numpy as np
 
 from .greedy import PercentCorrectGreedy
-from .planner import TemperedELM
+from .planner import BELIEF_POWER, DPRIME_POWER, TemperedELM
 
 SWITCH_AT = 5
 
@@ -51,13 +51,13 @@ class SwitchingSearcher:
     action = 'argmax'
 
     def __init__(self, grid: Grid, fpoc: FPOC, switch_at: int = SWITCH_AT,
-                 belief_power: float = 0.7, dprime_power: float = 1.75):
+                 belief_power: float = BELIEF_POWER, dprime_power: float = DPRIME_POWER):
         if isinstance(switch_at, bool) or not isinstance(switch_at, (int, np.integer)) \
                 or switch_at < 0:
             raise ValueError(f'switch_at must be an integer >= 0, got {switch_at!r}')
         self.switch_at = int(switch_at)
-        self.early = TemperedELM(grid, fpoc, belief_power, dprime_power)
         self.late = PercentCorrectGreedy(grid, fpoc)
+        self.early = TemperedELM(grid, fpoc, belief_power, dprime_power, dprime=self.late.dprime)
 
     def select(self, belief, t, rng):
         """Fixation for each belief row at fixation index ``t`` (the same for the whole batch)."""
