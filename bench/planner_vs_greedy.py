@@ -5,34 +5,36 @@
 
 Run: ``.venv/bin/python bench/planner_vs_greedy.py [--episodes 4000] [--seed 1] [--jobs 2]
 [--horizon 16] [--policies elm,tempered,greedy,planner] [--planner-options K=V,...]
-[--cache DIR] [--json OUT]``.
+[--cache DIR] [--chunk 2000] [--json OUT]``.
 docs/reproduction.md quotes two runs: ``--episodes 4000 --seed 1`` (about 10 CPU-minutes) and
 ``--episodes 200000 --seed 1 --horizon 9 --policies elm,tempered,greedy,switching --json
 docs/data/searchers-7x7.json`` (about 2.5 CPU-hours, two thirds of it the ideal searcher).
 
 Every policy runs the same episodes (common random numbers), split into pieces over a process pool
-(``simulate(..., rows=)``, so every deterministic policy gives exactly its serial numbers; the
-planner draws its rollouts from one stream per piece of 500 episodes). Printed: fixations to 90%
-correct by the indicator (MAP guess right) and by the expected percent correct (mean of
-``max_i B_i``, the same curve with less variance), each with a 95% bootstrap interval, then the
-paired differences. ``--cache DIR`` keeps finished pieces (``.npz``), so an interrupted run
-resumes and a longer run reuses a shorter one: a run of n episodes is the first n episodes of a
-longer one (test_simulate.py), so the key is the policy, seed, horizon and rows. Change nothing
-else between runs sharing a cache.
+(``reproduce.Runner``: ``simulate(..., rows=)``, so every deterministic policy gives exactly its
+serial numbers; the planner draws its rollouts from one stream per piece of 500 episodes).
+Printed: fixations to 90% correct by the indicator (MAP guess right) and by the expected percent
+correct (mean of ``max_i B_i``, the same curve with less variance), each with a 95% bootstrap
+interval, then the paired differences. ``--cache DIR`` keeps finished pieces in
+``reproduce.PieceCache``, so an interrupted run resumes and a longer run reuses a shorter one: a
+run of n episodes is the first n episodes of a longer one (test_simulate.py), so a piece's key
+is its policy and options, task, own targets, seed, horizon and rows and the package source, not
+the run's length. The pieces of the other policies are ``--chunk`` episodes (default 2000; their
+numbers do not depend on it).
 """
 import argparse
 from concurrent.futures import ProcessPoolExecutor
 import itertools
 import json
 from pathlib import Path
-import time
 
+from ipomdp_gaze.commands.common import positive_int
+from ipomdp_gaze.commands.reproduce import PieceCache, Runner
 from ipomdp_gaze.evaluation import fixations_to_90_ci, paired_difference_ci
 from ipomdp_gaze.fpoc import make_fpoc
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.policies.planner import make_planner
-from ipomdp_gaze.simulate import simulate
 import numpy as np
 
 GRID, FPOC = Grid(7, 7, 0.42), make_fpoc('human')
@@ -40,35 +42,15 @@ NAMES = ('elm', 'tempered', 'greedy', 'switching', 'planner')
 # Episodes per piece: the planner's rollout streams are per piece, so its size is fixed.
 CHUNK = {'planner': 500}
 DEFAULT_CHUNK = 2000
+RESAMPLES = 1000                        # bootstrap resamples of every interval
 
 
 def build(name, planner_options):
-    """Return the policy called ``name``."""
+    """Return the policy called ``name`` and its recipe (how the piece cache names it)."""
     if name == 'planner':
-        return make_planner(GRID, FPOC, **planner_options)
-    return make_baseline(name, GRID, FPOC)
-
-
-def piece(name, episodes, horizon, seed, rows, cache, planner_options):
-    """Simulate rows ``start:stop`` of the run: correct, max_i B_i and CPU seconds."""
-    path = None
-    if cache is not None:
-        tag = name
-        if name == 'planner' and planner_options:
-            tag += '-' + '-'.join(f'{k}{v}' for k, v in sorted(planner_options.items()))
-        path = Path(cache) / f'{tag}_{seed}_{horizon}_{rows[0]}_{rows[1]}.npz'
-        if path.exists():
-            with np.load(path) as data:
-                return data['correct'], data['map_prob'], float(data['cpu'])
-    start = time.process_time()
-    result = simulate(GRID, FPOC, build(name, planner_options), episodes, horizon, seed,
-                      rows=rows)
-    cpu = time.process_time() - start
-    if path is not None:
-        partial = path.with_suffix('.part.npz')
-        np.savez(partial, correct=result.correct, map_prob=result.map_prob, cpu=cpu)
-        partial.replace(path)
-    return result.correct, result.map_prob, cpu
+        return (make_planner(GRID, FPOC, **planner_options),
+                ('planner', tuple(sorted(planner_options.items()))))
+    return make_baseline(name, GRID, FPOC), ('baseline', name)
 
 
 def policy_list(text):
@@ -108,39 +90,43 @@ def main():
     parser.add_argument('--planner-options', type=planner_options, default={},
                         help='RolloutPlanner options, e.g. candidates=8,rollout_budget=8192')
     parser.add_argument('--cache', type=Path, default=None)
+    parser.add_argument('--chunk', type=positive_int, default=DEFAULT_CHUNK,
+                        help='episodes per piece of every policy but the planner (its pieces '
+                             'are 500)')
     parser.add_argument('--json', type=Path, default=None)
     args = parser.parse_args()
     n, names = args.episodes, args.policies
-    if args.cache is not None:
-        args.cache.mkdir(parents=True, exist_ok=True)
-    results, out = {}, {'episodes': n, 'seed': args.seed, 'horizon': args.horizon,
-                        'policies': {}, 'paired': {}}
+    policies = {name: build(name, args.planner_options) for name in names}
+    cache = PieceCache(args.cache)
+    out = {'episodes': n, 'seed': args.seed, 'horizon': args.horizon, 'policies': {},
+           'paired': {}}
+    pieces = 0
     with ProcessPoolExecutor(args.jobs) as pool:
-        jobs = {}
-        for name in sorted(names, key=lambda x: x not in ('greedy', 'switching', 'planner')):
-            chunk = CHUNK.get(name, DEFAULT_CHUNK)
-            jobs[name] = [pool.submit(piece, name, n, args.horizon, args.seed,
-                                      (a, min(a + chunk, n)), args.cache,
-                                      args.planner_options)
-                          for a in range(0, n, chunk)]
-        for name in names:
-            parts = [job.result() for job in jobs[name]]
-            results[name] = [np.concatenate([p[i] for p in parts]) for i in (0, 1)]
-            cpu = sum(p[2] for p in parts)
-            ms = 1000 * cpu / (n * args.horizon)
-            out['policies'][name] = {'cpu_s': cpu, 'ms_per_decision': ms}
-            print(f'{name}: {cpu:.0f} s CPU, {ms:.2f} ms per decision')
+        runner = Runner(GRID, FPOC, n, args.seed, RESAMPLES, pool, cache)
+        for name in sorted(names, key=lambda x: not getattr(policies[x][0], 'costly', False)):
+            policy, recipe = policies[name]
+            pieces += runner.submit(name, policy, horizon=args.horizon,
+                                    chunk=CHUNK.get(name, args.chunk), recipe=recipe)
+        runner.collect()
+    if args.cache is not None:
+        print(f'{cache.hits} of {pieces} pieces from the cache {args.cache}')
+    results = {name: (runner.correct[name], runner.map_prob[name]) for name in names}
+    for name in names:
+        cpu = runner.seconds[name]
+        ms = 1000 * cpu / (n * args.horizon)
+        out['policies'][name] = {'cpu_s': cpu, 'ms_per_decision': ms}
+        print(f'{name}: {cpu:.0f} s CPU, {ms:.2f} ms per decision')
     measures = ('indicator', 'expected')
     for name in names:
         for i, label in enumerate(measures):
             point, ci = fixations_to_90_ci(results[name][i], GRID.n_cells,
-                                           np.random.default_rng([args.seed, 7]), 1000)
+                                           np.random.default_rng([args.seed, 7]), RESAMPLES)
             out['policies'][name][label] = {'fixations_to_90': point, 'ci95': ci}
             print(f'{name:9s} {label:9s} {point:.3f} [{ci[0]:.3f}, {ci[1]:.3f}]')
     for a, b in itertools.combinations(names[::-1], 2):
         for i, label in enumerate(measures):
             diff, ci = paired_difference_ci(results[a][i], results[b][i], GRID.n_cells,
-                                            np.random.default_rng([args.seed, 8]), 1000)
+                                            np.random.default_rng([args.seed, 8]), RESAMPLES)
             out['paired'].setdefault(f'{a} - {b}', {})[label] = {'difference': diff, 'ci95': ci}
             print(f'{a} - {b} ({label}, {n} paired): {diff:+.3f} [{ci[0]:+.3f}, {ci[1]:+.3f}]')
     if args.json is not None:

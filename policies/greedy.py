@@ -384,6 +384,8 @@ class PercentCorrectGreedy:
     """
 
     name = 'greedy'
+    # A slow searcher: evaluate and reproduce run it on fewer episodes.
+    costly = True
 
     def __init__(self, grid: Grid, fpoc: FPOC, tol: float = DEFAULT_TOL,
                  nodes: int | None = None, power: int | None = None,

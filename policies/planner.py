@@ -179,6 +179,8 @@ class RolloutPlanner:
     """
 
     name = 'planner'
+    # A slow searcher: evaluate and reproduce run it on fewer episodes.
+    costly = True
 
     def __init__(self, grid: Grid, fpoc: FPOC, base=None, candidates: int = 4,
                  rollouts: int = 64, rollout_budget: int | None = 2048, horizon: int = 2,

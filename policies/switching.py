@@ -48,6 +48,8 @@ class SwitchingSearcher:
     """
 
     name = 'switching'
+    # A slow searcher: evaluate and reproduce run it on fewer episodes.
+    costly = True
     action = 'argmax'
 
     def __init__(self, grid: Grid, fpoc: FPOC, switch_at: int = SWITCH_AT,

@@ -52,3 +52,27 @@ def test_evaluate_paired_compares_each_policy_with_the_first_on_the_same_episode
     assert main(['evaluate', '--grid', '3x3', '--policy', 'map', '--policy', 'random',
                  '--episodes', '500', '--paired']) == 0
     assert 'random - map: ' in capsys.readouterr().out
+
+
+def test_slow_searchers_say_so_and_evaluate_runs_them_on_fewer_episodes():
+    """The policy class, not its name, marks a slow searcher (``costly``)."""
+    from ipomdp_gaze.commands.evaluate import evaluate
+    from ipomdp_gaze.fpoc import make_fpoc
+    from ipomdp_gaze.grid import Grid
+    from ipomdp_gaze.policies.baselines import make_baseline, STRATEGIES
+    from ipomdp_gaze.policies.planner import make_planner
+    from ipomdp_gaze.simulate import simulate
+    grid, fpoc = Grid(3, 3, 0.42), make_fpoc('human')
+    slow = {name for name in STRATEGIES
+            if getattr(make_baseline(name, grid, fpoc), 'costly', False)}
+    assert slow == {'greedy', 'switching'} and make_planner(grid, fpoc).costly
+    named = make_baseline('elm', grid, fpoc)
+    named.name = 'greedy'                   # a policy file called greedy.yaml is not slow
+    policies = {'map': make_baseline('map', grid, fpoc),
+                'greedy': make_baseline('greedy', grid, fpoc), 'named': named}
+    result = evaluate(grid, fpoc, policies, 200, 5, 0, episodes_greedy=40, bootstrap=20)
+    assert {name: r['episodes'] for name, r in result['policies'].items()} == {
+        'map': 200, 'greedy': 40, 'named': 200}
+    first = simulate(grid, fpoc, make_baseline('greedy', grid, fpoc), 40, 5, 0)
+    np.testing.assert_allclose(result['policies']['greedy']['percent_correct'],
+                               first.percent_correct, atol=1e-6)

@@ -3,6 +3,7 @@
 """``ipomdp-gaze reproduce``: its runs split over processes give the serial run's numbers."""
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import replace
+import json
 
 from ipomdp_gaze.cli import main as cli_main
 from ipomdp_gaze.commands import reproduce
@@ -17,9 +18,9 @@ GRID, FPOC = Grid(4, 4, 0.42), make_fpoc('human')
 
 
 def test_pieces_on_two_processes_give_the_serial_matrices_and_intervals():
-    serial = reproduce._Runner(GRID, FPOC, 60, 5, 50)
+    serial = reproduce.Runner(GRID, FPOC, 60, 5, 50)
     with ProcessPoolExecutor(2) as pool:
-        split = reproduce._Runner(GRID, FPOC, 60, 5, 50, pool)
+        split = reproduce.Runner(GRID, FPOC, 60, 5, 50, pool)
         for runner, chunk in ((serial, None), (split, 7)):
             runner.submit('elm', make_baseline('elm', GRID, FPOC), horizon=12, chunk=chunk)
             runner.submit('greedy', make_baseline('greedy', GRID, FPOC), 40, 12, chunk)
@@ -35,7 +36,7 @@ def test_pieces_on_two_processes_give_the_serial_matrices_and_intervals():
 
 
 def test_a_run_cut_before_it_is_reliably_at_90_percent_is_refused():
-    runner = reproduce._Runner(GRID, FPOC, 200, 0, 20)
+    runner = reproduce.Runner(GRID, FPOC, 200, 0, 20)
     runner.submit('random', make_baseline('random', GRID, FPOC), horizon=3)
     runner.collect()
     with pytest.raises(RuntimeError, match='raise the horizon'):
@@ -44,28 +45,94 @@ def test_a_run_cut_before_it_is_reliably_at_90_percent_is_refused():
 
 def test_cached_pieces_are_reused_only_for_the_same_inputs(tmp_path):
     def run(name, cache, recipe=None, seed=2):
-        runner = reproduce._Runner(GRID, FPOC, 30, seed, 20, cache=cache)
+        runner = reproduce.Runner(GRID, FPOC, 30, seed, 20, cache=cache)
         runner.submit('p', make_baseline(name, GRID, FPOC), horizon=10, chunk=10,
                       recipe=('baseline', name) if recipe is None else recipe)
         runner.collect()
-        return runner.correct['p']
+        return runner.correct['p'], runner.map_prob['p']
 
     first = reproduce.PieceCache(tmp_path)
     fresh = run('elm', first)
     assert first.hits == 0 and len(list(tmp_path.glob('*.bin'))) == 3
+    whole = simulate(GRID, FPOC, make_baseline('elm', GRID, FPOC), 30, 10, 2)
+    np.testing.assert_array_equal(fresh[0], whole.correct)
+    np.testing.assert_array_equal(fresh[1], whole.map_prob)
     again = reproduce.PieceCache(tmp_path)
-    np.testing.assert_array_equal(run('elm', again), fresh)
-    assert again.hits == 3
+    cached = run('elm', again)
+    assert again.hits == 3 and cached[1].dtype == np.float64
+    for kept, new in zip(cached, fresh):
+        np.testing.assert_array_equal(kept, new)
     other = reproduce.PieceCache(tmp_path)
-    np.testing.assert_array_equal(run('map', other), run('map', None))
+    for kept, new in zip(run('map', other), run('map', None)):
+        np.testing.assert_array_equal(kept, new)
     run('elm', other, seed=3)
     assert other.hits == 0                 # another policy, another seed: simulated again
     assert reproduce.PieceCache(tmp_path).key(None, GRID, FPOC, np.zeros(3), 4, 0, (0, 3)) is None
     for path in tmp_path.glob('*.bin'):                     # damaged pieces are simulated again
         path.write_bytes(path.read_bytes()[:-1])
     damaged = reproduce.PieceCache(tmp_path)
-    np.testing.assert_array_equal(run('elm', damaged), fresh)
+    for kept, new in zip(run('elm', damaged), fresh):
+        np.testing.assert_array_equal(kept, new)
     assert damaged.hits == 0
+
+
+def test_a_piece_file_of_another_layout_is_simulated_again(tmp_path):
+    """A file with only the packed bits (no ``map_prob``), whatever its length, is not read."""
+    def run(cache):
+        runner = reproduce.Runner(GRID, FPOC, 20, 1, 20, cache=cache)
+        runner.submit('elm', make_baseline('elm', GRID, FPOC), horizon=8,
+                      recipe=('baseline', 'elm'))
+        runner.collect()
+        return runner.correct['elm'], runner.map_prob['elm']
+
+    fresh = run(reproduce.PieceCache(tmp_path))
+    (path,) = tmp_path.glob('*.bin')
+    head, _, body = path.read_bytes().partition(b'\n')
+    meta = json.loads(head)
+    bits = np.packbits(fresh[0]).tobytes()
+    for layout in ({'correct': 'packbits'}, None):
+        foreign = {**meta, 'layout': layout} if layout else {k: v for k, v in meta.items()
+                                                             if k != 'layout'}
+        for tail in (bits, body):
+            path.write_bytes(json.dumps(foreign).encode() + b'\n' + tail)
+            cache = reproduce.PieceCache(tmp_path)
+            for kept, new in zip(run(cache), fresh):
+                np.testing.assert_array_equal(kept, new)
+            assert cache.hits == 0
+
+
+def test_a_longer_run_reuses_the_pieces_of_a_shorter_one(tmp_path):
+    """
+    Runs of n and 2n episodes with the same chunk share the first n episodes' pieces.
+
+    The pieces are keyed by their own targets and rows, not the run's length; that reuse is
+    right because a run of n episodes is the first n of a longer one (targets, noise and, for a
+    stochastic policy, each piece's own stream).
+    """
+    def run(episodes, cache):
+        runner = reproduce.Runner(GRID, FPOC, episodes, 4, 20, cache=cache)
+        for name in ('elm', 'random'):
+            runner.submit(name, make_baseline(name, GRID, FPOC), horizon=9, chunk=10,
+                          recipe=('baseline', name))
+        runner.collect()
+        return runner
+
+    short = run(30, reproduce.PieceCache(tmp_path))
+    cache = reproduce.PieceCache(tmp_path)
+    long = run(60, cache)
+    assert cache.hits == 2 * 3 and len(list(tmp_path.glob('*.bin'))) == 2 * 6
+    alone = run(60, None)
+    for name in ('elm', 'random'):
+        for matrices in ('correct', 'map_prob'):
+            kept, fresh = getattr(long, matrices)[name], getattr(alone, matrices)[name]
+            np.testing.assert_array_equal(kept[:30], getattr(short, matrices)[name])
+            np.testing.assert_array_equal(kept, fresh)
+    other = reproduce.PieceCache(tmp_path)
+    runner = reproduce.Runner(GRID, FPOC, 60, 4, 20, cache=other)
+    runner.submit('elm', make_baseline('elm', GRID, FPOC), horizon=9, chunk=20,
+                  recipe=('baseline', 'elm'))
+    runner.collect()
+    assert other.hits == 0                 # other chunk boundaries: other pieces
 
 
 def test_retraining_starts_a_kernel_where_its_file_says():

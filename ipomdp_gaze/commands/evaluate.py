@@ -29,8 +29,6 @@ from .common import (add_scene_args, add_task_args, confidence_arg, nonneg_int, 
                      task_from_args)
 
 NO_PREDICTION = ' (no prediction)'
-# Policies (by ``name``) that run on the first ``--episodes-greedy`` episodes only.
-COSTLY = ('greedy', 'switching')
 
 
 def add_parser(sub):
@@ -44,7 +42,8 @@ def add_parser(sub):
                    help='a policy YAML file, keyed by its file stem (repeatable)')
     p.add_argument('--episodes', type=positive_int, default=20000)
     p.add_argument('--episodes-greedy', type=positive_int, default=2000,
-                   help='episodes for the slow searchers, greedy and switching (default 2000)')
+                   help='episodes for the slow searchers, greedy and switching (policies '
+                        'whose class sets costly; default 2000)')
     p.add_argument('--horizon', type=positive_int, default=None,
                    help="fixations per episode (default N, the paper's T)")
     p.add_argument('--seed', type=nonneg_int, default=0)
@@ -86,14 +85,15 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
     Run every policy on the same targets, noise, target paths and empty scenes.
 
     Returns the JSON-ready result (docs/design.md section 9.2): per policy, fixations to 90%
-    correct with its interval and percent correct. When any option of docs/design.md section 7
-    is given (not None; the others then take their defaults 0, 0, 0, 0, 0.95 and the horizon),
-    the result also records all six and each policy gets ``decisions``
-    (:func:`ipomdp_gaze.evaluation.decision_summary`) and, for a moving target, ``tracking``
-    (:func:`ipomdp_gaze.evaluation.tracking_summary`). Without them the result is exactly the
-    paper task's. With ``paired``, ``result['paired']`` holds each later policy minus the
-    first: the difference of fixations to 90% on their common episodes with a paired bootstrap
-    interval.
+    correct with its interval and percent correct. A slow searcher (its class sets ``costly``,
+    as the ideal searcher's does) runs on the first ``episodes_greedy`` episodes only. When any
+    option of docs/design.md section 7 is given (not None; the others then take their defaults
+    0, 0, 0, 0, 0.95 and the horizon), the result also records all six and each policy gets
+    ``decisions`` (:func:`ipomdp_gaze.evaluation.decision_summary`) and, for a moving target,
+    ``tracking`` (:func:`ipomdp_gaze.evaluation.tracking_summary`). Without them the result is
+    exactly the paper task's. With ``paired``, ``result['paired']`` holds each later policy
+    minus the first: the difference of fixations to 90% on their common episodes with a paired
+    bootstrap interval.
     """
     scene = (motion_sigma_cells, jump_prob, absent_prior, absent_rate, confidence,
              max_fixations)
@@ -123,7 +123,7 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
         runs += [(name + NO_PREDICTION, policy, False) for name, policy in policies.items()]
     results = {}
     for name, policy, predict in runs:
-        costly = getattr(policy, 'name', '') in COSTLY
+        costly = getattr(policy, 'costly', False)
         n = min(episodes, episodes_greedy) if costly else episodes
         result = simulate(grid, model, policy, n, horizon, seed, targets=targets[:n],
                           motion=motion, predict=predict, absent_prior=absent_prior,

@@ -40,9 +40,10 @@ COSTLY_HORIZON = 16
 # The other runs stop here instead of at N: Fig. 4a plots 25 fixations, and every 11x11 policy
 # reaches 90% by 30. A run must be REACHED correct at its last fixation (checked).
 HORIZON_7X7, HORIZON_11X11, REACHED = 25, 60, 0.95
-# The costly searchers are split into pieces of this many episodes (fixed, so the
-# planner's own draws, one stream per piece, do not depend on the number of processes).
-COSTLY_CHUNK = {'planner': 500, 'greedy': 250, 'switching': 250}
+# The slow searchers (policies whose class sets ``costly = True``) are split into pieces of this
+# many episodes, the planner into PLANNER_CHUNK (fixed, so the planner's own draws, one stream
+# per piece, do not depend on the number of processes).
+COSTLY_CHUNK, PLANNER_CHUNK = 250, 500
 PAPER_11X11 = {'infomax-trained': 18.0, 'fixate-target-trained': 20.0}
 
 
@@ -122,10 +123,16 @@ class PieceCache:
     Results of simulated pieces on disk, keyed by everything that decides them.
 
     The key is the SHA-256 of a piece's recipe (how its policy is built: a baseline's name, or
-    a policy file's name and kernel), its task (grid, FPOC), targets, horizon, seed and rows,
-    and of :func:`source_digest` (the code that builds and runs the policy), so a changed
-    kernel, setting or line of code misses the cache. ``folder=None`` caches nothing.
+    a policy file's name and kernel), its task (grid, FPOC), its own targets, horizon, seed and
+    rows, and of :func:`source_digest` (the code that builds and runs the policy), so a changed
+    kernel, setting or line of code misses the cache. The run's length is not in the key: a run
+    of n episodes is the first n episodes of a longer one (targets, noise and each piece's
+    policy stream are prefix-stable), so a longer run reuses every piece of a shorter one whose
+    rows it shares. ``folder=None`` caches nothing.
     """
+
+    # What a piece file holds after its JSON line, in this order (the line records it).
+    LAYOUT = {'correct': 'packbits', 'map_prob': '<f8'}
 
     def __init__(self, folder: Path | None):
         self.folder = None if folder is None else Path(folder)
@@ -133,30 +140,41 @@ class PieceCache:
         self.hits = 0
 
     def key(self, recipe, grid, fpoc, targets, horizon, seed, rows) -> str | None:
-        """Return the hex key of one piece (None without a recipe: never cached)."""
+        """
+        Return the hex key of rows ``start:stop`` of a run on ``targets`` (None: never cached).
+
+        Only the piece's own targets, ``targets[start:stop]``, enter the key, so runs of any
+        length share it (see the class docstring). None without a recipe or a folder.
+        """
         if self.folder is None or recipe is None:
             return None
+        start, stop = rows
         digest = hashlib.sha256(self.source.encode())
         text = repr((recipe, (grid.rows, grid.cols, grid.spacing_deg), fpoc.model,
-                     sorted(fpoc.params().items()), horizon, seed, rows))
+                     sorted(fpoc.params().items()), horizon, seed, (start, stop)))
         digest.update(text.encode())
-        digest.update(np.ascontiguousarray(targets, dtype=np.int64).tobytes())
+        digest.update(np.ascontiguousarray(targets[start:stop], dtype=np.int64).tobytes())
         return digest.hexdigest()
 
     def load(self, key):
-        """Return the cached ``(correct, cpu_seconds, decisions)`` of a piece, or None."""
+        """Return a cached piece, ``(correct, map_prob, cpu_seconds, decisions)``, or None."""
         if key is None:
             return None
         try:
             raw = (self.folder / f'{key}.bin').read_bytes()
             head, _, body = raw.partition(b'\n')
             meta = json.loads(head)
+            if meta['layout'] != self.LAYOUT:
+                return None                     # another layout: simulate again
             shape = tuple(int(v) for v in meta['shape'])
-            if len(body) != -(-int(np.prod(shape)) // 8):
+            size = int(np.prod(shape))
+            packed = -(-size // 8)
+            if len(body) != packed + 8 * size:
                 return None                     # a truncated or foreign file: simulate again
-            bits = np.unpackbits(np.frombuffer(body, dtype=np.uint8), count=int(np.prod(shape)))
-            found = (bits.reshape(shape).astype(bool), float(meta['seconds']),
-                     int(meta['decisions']))
+            bits = np.unpackbits(np.frombuffer(body, dtype=np.uint8, count=packed), count=size)
+            map_prob = np.frombuffer(body, dtype='<f8', offset=packed).astype(np.float64)
+            found = (bits.reshape(shape).astype(bool), map_prob.reshape(shape),
+                     float(meta['seconds']), int(meta['decisions']))
         except (OSError, KeyError, ValueError, TypeError):
             return None
         self.hits += 1
@@ -164,40 +182,46 @@ class PieceCache:
 
     def store(self, key, result):
         """
-        Write one piece: a JSON line (shape, CPU seconds, decisions), then the packed bits.
+        Write one piece: a JSON line, the packed bits of ``correct``, then ``map_prob``.
 
-        Written to a temporary file and renamed into place, so a reader never sees half a piece.
+        The JSON line holds the shape, ``LAYOUT``, CPU seconds and decisions; ``map_prob``
+        is little-endian float64. Written to a temporary file and renamed into place, so a
+        reader never sees half a piece.
         """
         if key is None:
             return
-        correct, seconds, decisions = result
+        correct, map_prob, seconds, decisions = result
         self.folder.mkdir(parents=True, exist_ok=True)
-        head = json.dumps({'shape': list(correct.shape), 'seconds': float(seconds),
-                           'decisions': int(decisions)}).encode()
+        head = json.dumps({'shape': list(correct.shape), 'layout': self.LAYOUT,
+                           'seconds': float(seconds), 'decisions': int(decisions)}).encode()
+        bits = np.packbits(correct.astype(bool)).tobytes()
+        values = np.ascontiguousarray(map_prob, dtype='<f8').tobytes()
         tmp = self.folder / f'{key}.{os.getpid()}.tmp'
-        tmp.write_bytes(head + b'\n' + np.packbits(correct.astype(bool)).tobytes())
+        tmp.write_bytes(head + b'\n' + bits + values)
         os.replace(tmp, self.folder / f'{key}.bin')
 
 
 def _simulate_rows(grid, model, policy, targets, horizon, seed, rows):
-    """Run one piece of work in a worker: correctness matrix, CPU seconds, decisions."""
+    """Run one piece of work in a worker: correct, max_i B_i, CPU seconds, decisions."""
     t0 = time.process_time()
     result = simulate(grid, model, policy, targets.size, horizon, seed, targets=targets,
                       rows=rows)
-    return result.correct, time.process_time() - t0, result.fixations.size
+    return result.correct, result.map_prob, time.process_time() - t0, result.fixations.size
 
 
-class _Runner:
+class Runner:
     """
-    Simulate policies on shared targets and noise; keep each one's correctness matrix.
+    Simulate policies on shared targets and noise; keep each one's per-episode matrices.
 
     Every run is submitted to ``pool`` (a process pool, or None to run in this process) in
     pieces of ``chunk`` episodes: each piece is the rows ``start:stop`` of the whole run
     (:func:`ipomdp_gaze.simulate.simulate` with ``rows``), so a deterministic policy's matrix is
     the one a single serial run gives, whatever the number of processes. A stochastic policy's
     own draws come from one stream per piece (fixed ``chunk``, so still deterministic).
-    :meth:`collect` waits for every submitted run. Pieces found in ``cache`` (a
-    :class:`PieceCache`) are not run again; new ones are stored there.
+    :meth:`collect` waits for every submitted run and keeps, per name, ``correct`` (MAP guess
+    right), ``map_prob`` (``max_i B_i``), CPU ``seconds`` and ``decisions``. Pieces found in
+    ``cache`` (a :class:`PieceCache`) are not run again; new ones are stored there. Used by
+    ``reproduce`` and ``bench/planner_vs_greedy.py``.
     """
 
     def __init__(self, grid, fpoc, episodes, seed, bootstrap, pool=None, cache=None):
@@ -206,7 +230,7 @@ class _Runner:
         self.cache = PieceCache(None) if cache is None else cache
         self.model = GaussianObservation(grid, fpoc)
         self.targets = draw_targets(grid.n_cells, episodes, seed)
-        self.correct, self.seconds, self.decisions = {}, {}, {}
+        self.correct, self.map_prob, self.seconds, self.decisions = {}, {}, {}, {}
         self._pending = {}
 
     def submit(self, name, policy, episodes=None, horizon=None, chunk=None, *, recipe=None):
@@ -214,7 +238,7 @@ class _Runner:
         Queue ``episodes`` (default all) of ``policy`` for ``horizon`` fixations.
 
         ``recipe`` says how ``policy`` was built (see :class:`PieceCache`); without one the run
-        is never cached.
+        is never cached. Returns the number of pieces.
         """
         n = self.episodes if episodes is None else min(episodes, self.episodes)
         chunk = n if chunk is None else int(chunk)
@@ -231,9 +255,10 @@ class _Runner:
             else:
                 jobs.append((key, _simulate_rows(*args)))
         self._pending[name] = jobs
+        return len(jobs)
 
     def collect(self):
-        """Wait for every queued run and store its matrix, summed CPU seconds and decisions."""
+        """Wait for every queued run; keep its matrices, summed CPU seconds and decisions."""
         for name, jobs in self._pending.items():
             parts = []
             for key, job in jobs:                     # key None: the piece came from the cache
@@ -242,11 +267,13 @@ class _Runner:
                     self.cache.store(key, job)
                 parts.append(job)
             self.correct[name] = np.concatenate([p[0] for p in parts])
-            self.seconds[name] = sum(p[1] for p in parts)
-            self.decisions[name] = sum(p[2] for p in parts)
+            self.map_prob[name] = np.concatenate([p[1] for p in parts])
+            self.seconds[name] = sum(p[2] for p in parts)
+            self.decisions[name] = sum(p[3] for p in parts)
         self._pending = {}
 
     def summary(self, name):
+        """Return episodes, fixations to 90% correct and its bootstrap interval of a run."""
         correct = self.correct[name]
         _check_reached(name, correct)
         counts = _bootstrap_counts(correct.shape[0], self.bootstrap, (self.seed, 7))
@@ -255,6 +282,7 @@ class _Runner:
         return correct.shape[0], point, ci
 
     def paired(self, a, b):
+        """Return the paired difference ``a - b`` of fixations to 90% and its interval."""
         horizon = min(self.correct[a].shape[1], self.correct[b].shape[1])
         n = min(self.correct[a].shape[0], self.correct[b].shape[0])
         for name in (a, b):
@@ -391,21 +419,30 @@ def _simulate_all(args, specs, pool, cache, log):
     """
     Queue every simulation of the report (the slowest first), then wait for all of them.
 
-    Returns the runners of Table I (7x7), of the 11x11 comparison and of the other FPOCs.
+    The slow searchers of Table I, the planner and every policy whose class sets ``costly``,
+    run on the first ``--episodes-planner`` / ``--episodes-greedy`` episodes for
+    :data:`COSTLY_HORIZON` fixations. Returns the runners of Table I (7x7), of the 11x11
+    comparison and of the other FPOCs.
     """
     h7 = specs['human-7x7-infomax']
     grid7, fpoc7 = h7.grid, h7.fpoc
-    r7 = _Runner(grid7, fpoc7, args.episodes, args.seed, args.bootstrap, pool, cache)
-    log(f'7x7 planner, ideal searcher and switching searcher ({args.jobs} processes)')
+    r7 = Runner(grid7, fpoc7, args.episodes, args.seed, args.bootstrap, pool, cache)
+    table = {name: _policy(source, h7) for name, source in (
+        ('learned infomax', h7), ('elm', 'elm'), ('tempered elm', 'tempered'), ('map', 'map'),
+        ('center', 'center'), ('random', 'random'), ('greedy', 'greedy'),
+        ('switching', 'switching'))}
+    slow = [name for name, (policy, _) in table.items() if getattr(policy, 'costly', False)]
+    log(f"7x7 slow searchers: planner, {', '.join(slow)} ({args.jobs} processes)")
     r7.submit('planner', make_planner(grid7, fpoc7), args.episodes_planner, COSTLY_HORIZON,
-              COSTLY_CHUNK['planner'], recipe=('planner', 'defaults'))
-    for name in ('greedy', 'switching'):
-        r7.submit(name, make_baseline(name, grid7, fpoc7), args.episodes_greedy,
-                  COSTLY_HORIZON, COSTLY_CHUNK[name], recipe=('baseline', name))
+              PLANNER_CHUNK, recipe=('planner', 'defaults'))
+    for name in slow:
+        policy, recipe = table[name]
+        r7.submit(name, policy, args.episodes_greedy, COSTLY_HORIZON, COSTLY_CHUNK,
+                  recipe=recipe)
 
     # 11x11: infomax-trained vs fixate-target-trained.
     h11 = specs['human-11x11-infomax']
-    r11 = _Runner(h11.grid, h11.fpoc, args.episodes, args.seed, args.bootstrap, pool, cache)
+    r11 = Runner(h11.grid, h11.fpoc, args.episodes, args.seed, args.bootstrap, pool, cache)
     ft11 = specs['human-11x11-fixate_target']
     log('11x11 human and the other FPOCs')
     for name, source in (('infomax-trained', h11), ('fixate-target-trained', ft11), ('elm', 'elm'),
@@ -417,8 +454,8 @@ def _simulate_all(args, specs, pool, cache, log):
     others = {}
     for name in ('exponential-11x11-infomax', 'camera-11x11-infomax'):
         spec = specs[name]
-        runner = _Runner(spec.grid, spec.fpoc, args.episodes, args.seed, args.bootstrap, pool,
-                         cache)
+        runner = Runner(spec.grid, spec.fpoc, args.episodes, args.seed, args.bootstrap, pool,
+                        cache)
         for label, source in (('learned', spec), ('elm', 'elm'), ('map', 'map')):
             policy, recipe = _policy(source, spec)
             runner.submit(label, policy, horizon=HORIZON_11X11, recipe=recipe)
@@ -426,10 +463,9 @@ def _simulate_all(args, specs, pool, cache, log):
 
     # Table I: 7x7, human FPOC.
     log('7x7 fast policies')
-    for name, source in (('learned infomax', h7), ('elm', 'elm'), ('tempered elm', 'tempered'),
-                         ('map', 'map'), ('center', 'center'), ('random', 'random')):
-        policy, recipe = _policy(source, h7)
-        r7.submit(name, policy, horizon=HORIZON_7X7, recipe=recipe)
+    for name, (policy, recipe) in table.items():
+        if name not in slow:
+            r7.submit(name, policy, horizon=HORIZON_7X7, recipe=recipe)
     for label, runner in (('11x11', r11), *others.items(), ('7x7', r7)):
         runner.collect()
         log(f'{label} done')
@@ -576,7 +612,7 @@ def _report(args, r7, r11, others, specs, planner_ms, curves):
         lines.append(f'- {a} - {b}: {_fmt(diff, ci)} fixations ({n} paired episodes)')
     lines += ['', f'Planner decision time: {planner_ms:.2f} ms of CPU per decision, measured as '
               'the CPU time of the batched evaluation (pieces of '
-              f"{COSTLY_CHUNK['planner']} episodes) divided by its decisions (this machine).",
+              f'{PLANNER_CHUNK} episodes) divided by its decisions (this machine).',
               '', '![Fig. 4a](figures/fig4a_percent_correct.png)', '']
 
     lines += ['## 11x11 (121-AFC), human FPOC: infomax-trained vs fixate-target-trained', '',
