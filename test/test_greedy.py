@@ -6,7 +6,8 @@ from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
 from ipomdp_gaze.policies.baselines import make_baseline
-from ipomdp_gaze.policies.greedy import (expected_percent_correct, percent_correct_given_target,
+from ipomdp_gaze.policies.greedy import (expected_percent_correct, expected_percent_correct_at,
+                                         percent_correct_given_target,
                                          PercentCorrectGreedy)
 import numpy as np
 import pytest
@@ -182,3 +183,23 @@ def test_bad_belief_is_a_clear_error(belief, message):
 def test_too_large_dprime_is_a_clear_error():
     with pytest.raises(ValueError, match="d' up to"):
         PercentCorrectGreedy(GRID5, make_fpoc('camera', dprime=40.0))
+
+
+@pytest.mark.parametrize('fpoc', [HUMAN, make_fpoc('camera')], ids=['human', 'camera'])
+def test_score_at_one_fixation_is_that_column_of_every_score(fpoc):
+    grid = Grid(7, 7, 0.42)
+    d = dprime_matrix(grid, fpoc)
+    beliefs = np.vstack([np.full(grid.n_cells, 1.0 / grid.n_cells),
+                         peaked_beliefs(grid.n_cells, 12, 3), skewed_belief(grid.n_cells, 4),
+                         np.eye(grid.n_cells)[5]])
+    fixations = np.random.default_rng(2).integers(0, grid.n_cells, len(beliefs))
+    every = expected_percent_correct(beliefs, d)
+    np.testing.assert_allclose(expected_percent_correct_at(beliefs, d, fixations),
+                               every[np.arange(len(beliefs)), fixations], rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize('fixations', [[0], [0, 1, 2], [0.0, 1.0], [-1, 0], [0, 49]])
+def test_bad_fixations_for_the_score_at_one_fixation_are_a_clear_error(fixations):
+    d = dprime_matrix(Grid(7, 7, 0.42), HUMAN)
+    with pytest.raises(ValueError, match='fixations must be 2 cell indices'):
+        expected_percent_correct_at(np.ones((2, 49)), d, np.array(fixations))

@@ -177,3 +177,32 @@ def test_the_report_is_the_same_on_one_or_two_processes_and_from_the_cache(tmp_p
     assert sum(line.startswith('| rollout planner') for line in report) == 1
     for figure in ('fig3_learning_curves', 'fig4a_percent_correct', 'fig6_kernels_by_fpoc'):
         assert (tmp_path / 'a' / 'figures' / f'{figure}.png').stat().st_size > 0
+
+
+def test_rao_blackwellised_runs_keep_the_searches_and_the_curve_with_less_variance(tmp_path):
+    """Same fixations and correctness; E[max B'] has the mean of max B and no more variance."""
+    greedy = make_baseline('greedy', GRID, FPOC)
+    cache = reproduce.PieceCache(tmp_path)
+    plain = reproduce.Runner(GRID, FPOC, 3000, 6, 20, cache=cache)
+    plain.submit('greedy', greedy, horizon=5, chunk=1000, recipe=('baseline', 'greedy'))
+    plain.collect()
+    smooth = reproduce.Runner(GRID, FPOC, 3000, 6, 20, cache=cache, rao_blackwell=True)
+    smooth.submit('greedy', greedy, horizon=5, chunk=1000, recipe=('baseline', 'greedy'))
+    smooth.collect()
+    assert cache.hits == 0                      # a Rao-Blackwellised piece has its own key
+    np.testing.assert_array_equal(smooth.correct['greedy'], plain.correct['greedy'])
+    rb, raw = smooth.map_prob['greedy'], plain.map_prob['greedy']
+    # From the uniform prior every episode makes the same first fixation, so the first column
+    # is one number: the score of that fixation.
+    first = make_baseline('greedy', GRID, FPOC).expected_percent_correct(np.ones(16))
+    np.testing.assert_allclose(rb[:, 0], first.max(), rtol=0, atol=1e-14)
+    # Same mean (paired differences, 5 standard errors) and smaller variance at every fixation.
+    diff = rb - raw
+    error = diff.std(axis=0) / np.sqrt(diff.shape[0])
+    assert np.all(np.abs(diff.mean(axis=0)) < 5 * error)
+    assert np.all(rb.var(axis=0) < raw.var(axis=0))
+    again = reproduce.Runner(GRID, FPOC, 3000, 6, 20, cache=cache, rao_blackwell=True)
+    again.submit('greedy', greedy, horizon=5, chunk=1000, recipe=('baseline', 'greedy'))
+    again.collect()
+    assert cache.hits == 3
+    np.testing.assert_array_equal(again.map_prob['greedy'], rb)
