@@ -261,28 +261,8 @@ def expected_percent_correct(belief, dprime: np.ndarray, tol: float = DEFAULT_TO
         And, with ``return_bound``, ``(scores, bound (E,), kept (E,))``.
 
     """
-    d = check_dprime(dprime)
-    n = d.shape[0]
-    if not np.isfinite(tol) or tol < 0:
-        raise ValueError(f'tol must be finite and >= 0, got {tol!r}')
     single = np.ndim(belief) == 1
-    b = check_belief(belief, n)
-    auto_nodes, auto_power = default_nodes(d)
-    t_nodes, w_nodes = mapped_nodes(auto_nodes if nodes is None else nodes,
-                                    auto_power if power is None else power)
-    order, sizes, bound = prune(b, np.sqrt(2.0) * float(d.max(initial=0.0)), tol)
-    scores = np.empty_like(b)
-    for size in np.unique(sizes):
-        rows = np.flatnonzero(sizes == size)
-        if size == 1:
-            scores[rows] = b[rows, order[rows, 0]][:, None]
-            continue
-        chunk = max(1, int(max_elements // (size * n * t_nodes.size)))
-        for start in range(0, rows.size, chunk):
-            part = rows[start:start + chunk]
-            cells = order[part, :size]
-            log_b = np.log(np.take_along_axis(b[part], cells, axis=1))
-            scores[part] = _group_scores(log_b, d[cells], t_nodes, w_nodes)
+    scores, bound, sizes = _scores(belief, dprime, None, tol, nodes, power, max_elements)
     if single:
         scores, bound, sizes = scores[0], bound[0], sizes[0]
     return (scores, bound, sizes) if return_bound else scores
@@ -316,34 +296,47 @@ def expected_percent_correct_at(belief, dprime: np.ndarray, fixations, tol: floa
     array (E,)
 
     """
+    return _scores(belief, dprime, fixations, tol, nodes, power, max_elements)[0]
+
+
+def _scores(belief, dprime, fixations, tol, nodes, power, max_elements):
+    """
+    Validate, prune and integrate: ``(scores, bound, kept)`` of every fixation, or of one per row.
+
+    ``fixations`` None scores every fixation k (scores (E, N)); an int array (E,) scores only
+    ``k_e`` of row e (scores (E,)). The shared work of :func:`expected_percent_correct` and
+    :func:`expected_percent_correct_at`.
+    """
     d = check_dprime(dprime)
     n = d.shape[0]
     if not np.isfinite(tol) or tol < 0:
         raise ValueError(f'tol must be finite and >= 0, got {tol!r}')
     b = check_belief(belief, n)
-    k = np.asarray(fixations)
-    if k.shape != (b.shape[0],) or not np.issubdtype(k.dtype, np.integer) \
-            or np.any((k < 0) | (k >= n)):
-        raise ValueError(f'fixations must be {b.shape[0]} cell indices in [0, {n}), got '
-                         f'{np.asarray(fixations)!r}')
+    if fixations is not None:
+        k = np.asarray(fixations)
+        if k.shape != (b.shape[0],) or not np.issubdtype(k.dtype, np.integer) \
+                or np.any((k < 0) | (k >= n)):
+            raise ValueError(f'fixations must be {b.shape[0]} cell indices in [0, {n}), got '
+                             f'{k!r}')
     auto_nodes, auto_power = default_nodes(d)
     t_nodes, w_nodes = mapped_nodes(auto_nodes if nodes is None else nodes,
                                     auto_power if power is None else power)
-    order, sizes, _ = prune(b, np.sqrt(2.0) * float(d.max(initial=0.0)), tol)
-    scores = np.empty(b.shape[0])
+    order, sizes, bound = prune(b, np.sqrt(2.0) * float(d.max(initial=0.0)), tol)
+    columns = n if fixations is None else 1
+    scores = np.empty((b.shape[0], columns))
     for size in np.unique(sizes):
         rows = np.flatnonzero(sizes == size)
         if size == 1:
-            scores[rows] = b[rows, order[rows, 0]]
+            scores[rows] = b[rows, order[rows, 0]][:, None]
             continue
-        chunk = max(1, int(max_elements // (size * t_nodes.size)))
+        chunk = max(1, int(max_elements // (size * columns * t_nodes.size)))
         for start in range(0, rows.size, chunk):
             part = rows[start:start + chunk]
             cells = order[part, :size]
             log_b = np.log(np.take_along_axis(b[part], cells, axis=1))
-            dk = d[cells, k[part, None]][:, :, None]                    # (G, S, 1)
-            scores[part] = _group_scores(log_b, dk, t_nodes, w_nodes)[:, 0]
-    return scores
+            dk = d[cells] if fixations is None else d[cells, k[part, None]][:, :, None]
+            scores[part] = _group_scores(log_b, dk, t_nodes, w_nodes)
+    return (scores if fixations is None else scores[:, 0]), bound, sizes
 
 
 def _pairwise_tie_win(b_i, b_j, i_lower):
