@@ -36,7 +36,7 @@ import json
 from pathlib import Path
 
 from ipomdp_gaze.commands.common import positive_int
-from ipomdp_gaze.commands.reproduce import PieceCache, Runner
+from ipomdp_gaze.commands.reproduce import PieceCache, PLANNER_CHUNK, Runner
 from ipomdp_gaze.evaluation import fixations_to_90_ci, paired_difference_ci
 from ipomdp_gaze.fpoc import make_fpoc
 from ipomdp_gaze.grid import Grid
@@ -46,8 +46,6 @@ import numpy as np
 
 GRID, FPOC = Grid(7, 7, 0.42), make_fpoc('human')
 NAMES = ('elm', 'tempered', 'greedy', 'switching', 'planner')
-# Episodes per piece: the planner's rollout streams are per piece, so its size is fixed.
-CHUNK = {'planner': 500}
 DEFAULT_CHUNK = 2000
 RESAMPLES = 1000                        # bootstrap resamples of every interval
 
@@ -116,7 +114,8 @@ def main():
         for name in sorted(names, key=lambda x: not getattr(policies[x][0], 'costly', False)):
             policy, recipe = policies[name]
             pieces += runner.submit(name, policy, horizon=args.horizon,
-                                    chunk=CHUNK.get(name, args.chunk), recipe=recipe)
+                                    chunk=PLANNER_CHUNK if name == 'planner' else args.chunk,
+                                    recipe=recipe)
         runner.collect()
     if args.cache is not None:
         print(f'{cache.hits} of {pieces} pieces from the cache {args.cache}')
