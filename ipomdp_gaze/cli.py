@@ -20,6 +20,15 @@ import sys
 COMMANDS = ('evaluate', 'search', 'find', 'train', 'calibrate', 'reproduce', 'demo', 'nodes')
 
 
+def package_version() -> str:
+    """Return the installed package's version (``setup.py``), or ``unknown`` without metadata."""
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version('ipomdp_gaze')
+    except PackageNotFoundError:
+        return 'unknown'
+
+
 class CliError(Exception):
     """A user-facing error: printed as one line, exit status 2."""
 
@@ -36,6 +45,8 @@ def build_parser() -> argparse.ArgumentParser:
         prog='ipomdp-gaze',
         description='I-POMDP infomax gaze control (Butko & Movellan, ICDL 2008): '
                     'evaluate, train and run policies that choose where to look next.')
+    parser.add_argument('--version', action='version',
+                        version=f'%(prog)s {package_version()}')
     sub = parser.add_subparsers(dest='command', metavar='COMMAND', parser_class=_Parser)
     sub.required = True
     for name in COMMANDS:
@@ -46,11 +57,19 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv=None) -> int:
     """Entry point of the console script."""
     parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if not argv:
+        parser.print_help(sys.stderr)       # a bare command: what there is to run
+        return 2
     args = parser.parse_args(argv)
     try:
         return int(args.run(args) or 0)
     except (CliError, ValueError, OSError) as exc:
         print(f'ipomdp-gaze {args.command}: error: {exc}', file=sys.stderr)
+        return 2
+    except MemoryError:
+        print(f'ipomdp-gaze {args.command}: error: out of memory: the task is too large for '
+              f'this machine (a smaller --grid or fewer --episodes)', file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         return 130

@@ -26,7 +26,7 @@ ones the counts mean anything with, so settings given next to it may only repeat
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 import time
 
 from ipomdp_gaze.grid import Grid
@@ -154,7 +154,12 @@ def camera_mismatch(model_camera_: PinholeCamera | None, camera: PinholeCamera) 
 
 @dataclass(frozen=True)
 class Frame:
-    """One count frame for the controller, and what it cost."""
+    """
+    One count frame for the controller, and what it cost.
+
+    ``image``, ``detections_px`` (raw detection centres ``(M, 2)`` in its pixels), ``windows``
+    (fovea windows) and ``head_rc`` (camera mode) say how it was made, for pictures of the search.
+    """
 
     fixation: int
     stamp_s: float
@@ -162,6 +167,10 @@ class Frame:
     counts: np.ndarray
     detector_pixels: int
     seconds: float
+    image: np.ndarray | None = field(default=None, compare=False, repr=False)
+    detections_px: np.ndarray | None = field(default=None, compare=False, repr=False)
+    windows: tuple = field(default=(), compare=False, repr=False)
+    head_rc: tuple | None = field(default=None, compare=False, repr=False)
 
 
 @dataclass(frozen=True)
@@ -301,9 +310,11 @@ class DetectorLoop:
                 setup.fovea.start(image)
                 observation = setup.fovea.observe(cell)
                 counts, pixels = observation.counts, observation.detector_pixels
+                centres, windows = observation.centres_px - 0.5, observation.windows
             else:
                 observation = setup.observer.observe(image, self.camera, head_rc)
                 counts, pixels = observation.counts, observation.detector_pixels
+                centres, windows = observation.centres_uv, ()
         except ValueError as exc:
             self._drop_through(stamp_s)
             return self._rejected(str(exc))
@@ -314,7 +325,8 @@ class DetectorLoop:
         self._seconds.append(seconds)
         self._pixels.append(pixels)
         return Outcome('published',
-                       frame=Frame(cell, stamp_s, token, counts, int(pixels), seconds))
+                       frame=Frame(cell, stamp_s, token, counts, int(pixels), seconds, image,
+                                   centres, windows, head_rc))
 
     # -- reporting -------------------------------------------------------------------------
     def values(self) -> dict:

@@ -12,6 +12,10 @@ and the digital fovea. The offline, ROS-free search is ``ipomdp-gaze search``.
 """
 from __future__ import annotations
 
+import argparse
+
+from ipomdp_gaze.nodes.processes import MAX_DOMAIN_ID
+
 from .common import nonneg_int, positive_float, positive_int
 
 
@@ -45,7 +49,7 @@ def add_parser(sub):
                         'cell (default 60)')
     p.add_argument('--timeout', type=positive_float, default=60.0,
                    help='give up after this many seconds (default 60)')
-    p.add_argument('--domain-id', type=int, default=None,
+    p.add_argument('--domain-id', type=domain_arg, default=None,
                    help='ROS domain id, 0..101 (default: derived from the process id)')
     p.add_argument('--verbose', action='store_true', help="print the nodes' own output")
     p.set_defaults(run=run)
@@ -59,7 +63,21 @@ def parse_target(text):
         row, col = (int(x) for x in text.split(','))
     except ValueError:
         raise ValueError(f'--target must be ROW,COL, got {text!r}') from None
+    if row < 0 or col < 0:
+        raise ValueError(f'--target must be ROW,COL of a cell (0 or more), got {text!r}')
     return row, col
+
+
+def domain_arg(text: str) -> int:
+    """Parse a ROS domain id in 0..101 for argparse."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if not 0 <= value <= MAX_DOMAIN_ID:
+        raise argparse.ArgumentTypeError(f'expected a ROS domain id in 0..{MAX_DOMAIN_ID}, got '
+                                         f'{text!r}')
+    return value
 
 
 def run(args) -> int:

@@ -10,7 +10,7 @@ from ipomdp_gaze.observation import as_observation
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
 import numpy as np
 
-from .common import add_task_args, nonneg_int, positive_int, task_from_args
+from .common import add_task_args, cell_arg, cell_index, nonneg_int, positive_int, task_from_args
 
 
 def add_parser(sub):
@@ -22,7 +22,8 @@ def add_parser(sub):
     p.add_argument('--policy', default='elm', choices=NAMED_POLICIES)
     p.add_argument('--policy-file', default=None, metavar='PATH',
                    help='a policy YAML file or a shipped kernel name (overrides --policy)')
-    p.add_argument('--target', type=nonneg_int, default=None, help='target cell (default random)')
+    p.add_argument('--target', type=cell_arg, default=None, metavar='ROW,COL',
+                   help='target cell as ROW,COL or a flat index (default random)')
     p.add_argument('--confidence', type=float, default=0.95,
                    help='stop when the most likely cell reaches this probability')
     p.add_argument('--max-fixations', type=positive_int, default=None)
@@ -98,9 +99,8 @@ def run(args) -> int:
     if not 0 < args.confidence < 1:
         raise ValueError(f'--confidence must be between 0 and 1, got {args.confidence}')
     rng = np.random.default_rng([args.seed, 1])
-    target = int(rng.integers(grid.n_cells)) if args.target is None else args.target
-    if target >= grid.n_cells:
-        raise ValueError(f'--target {target} is outside the {grid.n_cells}-cell grid')
+    target = int(rng.integers(grid.n_cells)) if args.target is None else \
+        cell_index(args.target, grid, '--target')
     max_fix = args.max_fixations or 4 * grid.n_cells
     guess, path, belief = run_search(grid, as_observation(grid, fpoc), policy, target,
                                      args.confidence, max_fix, args.seed)

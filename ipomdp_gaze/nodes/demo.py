@@ -27,7 +27,7 @@ import numpy as np
 import yaml
 
 from .config import config_file
-from .params import grid_from, head_from, joint_params
+from .params import fpoc_from, grid_from, head_from, joint_params
 from .processes import domain_id_for, isolated_nodes
 from .watch import SearchRecord, Watch
 
@@ -91,6 +91,44 @@ class DemoSetup:
         return 1 if self.scene == 'faces' else 0
 
 
+def check_controller(values: dict) -> None:
+    """
+    Build the controller's grid, observation model and policy as the node will, here.
+
+    ``values`` are the controller's parameters from its YAML file and the demo's overrides (the
+    rest take the node's defaults). A bad ``--policy`` (an unknown name, a policy that needs an
+    FPOC on a count model, a policy file that does not fit) is refused before any node starts;
+    a missing ``policy.file`` is accepted when ``policy.fallback`` names a baseline, as the node
+    does.
+
+    Raises
+    ------
+    ValueError
+        Naming the problem.
+
+    """
+    from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnavailable
+
+    from .controller import controller_params, observation_from
+    full = {p.name: p.default for p in controller_params()}
+    full.update(values)
+    name = full['policy.name']
+    if name not in POLICY_NAMES:
+        raise ValueError(f"--policy must be one of {', '.join(POLICY_NAMES)}, got {name!r}")
+    grid = grid_from(full)
+    fpoc = fpoc_from(full) if full['observation.model'] != 'counts' else None
+    model = observation_from(full, grid, fpoc)
+    try:
+        build_policy(name, grid, model, kernel=full['policy.kernel'] or None,
+                     file=full['policy.file'], action=full['policy.action'],
+                     warn=lambda message: None)
+    except PolicyUnavailable:
+        if name != 'learned' or not full['policy.fallback']:
+            raise
+    except ValueError as exc:
+        raise ValueError(f'--policy {name}: {exc}') from None
+
+
 def _ros_args(path, overrides: dict) -> list:
     args = ['--params-file', str(path)]
     for name, value in overrides.items():
@@ -114,7 +152,12 @@ def demo_setup(fpoc: str = 'camera', policy: str | None = None, seed: int = 0,
         camera.update({'target_row': int(target[0]), 'target_col': int(target[1])})
     values = yaml_parameters(controller_yaml, 'gaze_controller')
     values.update(controller)
+    check_controller(values)
     grid = grid_from(values)
+    if target is not None and not (0 <= target[0] < grid.rows and 0 <= target[1] < grid.cols):
+        raise ValueError(f'--target {target[0]},{target[1]} is outside the {grid.rows}x'
+                         f'{grid.cols} grid (rows 0..{grid.rows - 1}, columns '
+                         f'0..{grid.cols - 1})')
     return DemoSetup([('controller', _ros_args(controller_yaml, controller)),
                       ('camera', _ros_args(camera_yaml, camera))], grid,
                      head_from(values, grid), controller)
@@ -134,6 +177,7 @@ def faces_setup(fovea: bool = False, policy: str | None = None, seed: int = 0) -
     values = {p.name: p.default for p in joint_params(limits=True)}
     values.update(yaml_parameters(files['controller'], 'gaze_controller'))
     values.update(controller)
+    check_controller(values)
     grid = grid_from(values)
     image_px = None
     if fovea:

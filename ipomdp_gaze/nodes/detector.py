@@ -43,6 +43,7 @@ from sensor_msgs.msg import CameraInfo, Image, JointState
 from std_msgs.msg import Float32MultiArray, Int32MultiArray
 
 from . import NODE_NAMES
+from .annotation import Annotator
 from .params import head_from, joint_params, MAX_CELLS_PER_SIDE, Param, ParameterTransaction, T
 from .spin import run_node
 
@@ -98,6 +99,10 @@ def detector_params() -> list[Param]:
               read_only=True),
         Param('publish_image', True, T.BOOL,
               'publish stamped 32FC1 evidence_image frames (false: evidence)'),
+        Param('publish_annotated', False, T.BOOL,
+              'publish annotated_image: the camera image with the belief, fixations, fovea '
+              'windows, detections and the found cell drawn on it (rgb8; read-only)',
+              read_only=True),
         Param('max_image_side_px', images.MAX_IMAGE_SIDE_PX, T.INTEGER,
               'images larger than this on a side are rejected (read-only)', read_only=True,
               int_range=(32, 65536)),
@@ -154,6 +159,7 @@ class FovealDetectorNode(Node):
                                                 reliability=ReliabilityPolicy.BEST_EFFORT))
         self._diag_timer = self.create_timer(v['diagnostics_period_s'],
                                              self._publish_diagnostics)
+        self._annotator = Annotator(self) if v['publish_annotated'] else None
         g = cfg.setup.grid
         self.get_logger().info(
             f'{cfg.setup.mode} mode, count model {cfg.setup.name!r} ({g.rows}x{g.cols} grid, '
@@ -252,6 +258,8 @@ class FovealDetectorNode(Node):
                 self._image_pub.publish(images.evidence_image(frame.counts, grid, frame.token))
             else:
                 self._evidence_pub.publish(grid_arrays.to_multiarray(frame.counts, grid))
+            if self._annotator is not None:
+                self._annotator.on_frame(frame)
         elif outcome.status == 'rejected':
             self.get_logger().warning(
                 f'rejected an image ({self.loop.rejected} so far): {outcome.reason}',
