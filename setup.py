@@ -53,6 +53,7 @@ setup(
             'camera = ipomdp_gaze.nodes.camera:main',
             'detector = ipomdp_gaze.nodes.detector:main',
             'scene_camera = ipomdp_gaze.nodes.scene_camera:main',
+            'recorder = ipomdp_gaze.nodes.recorder:main',
         ],
     },
 )

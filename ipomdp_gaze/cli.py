@@ -15,9 +15,10 @@ import importlib
 import sys
 
 # Modules under ipomdp_gaze.commands, in the order --help lists their subcommands: evaluate,
-# search, find, train, calibrate, reproduce, demo, then the nodes: controller, camera, detector
-# and scene_camera.
-COMMANDS = ('evaluate', 'search', 'find', 'train', 'calibrate', 'reproduce', 'demo', 'nodes')
+# search, find, train, calibrate, reproduce, demo, record and replay, then the nodes:
+# controller, camera, detector, scene_camera and recorder.
+COMMANDS = ('evaluate', 'search', 'find', 'train', 'calibrate', 'reproduce', 'demo', 'record',
+            'nodes')
 
 
 def package_version() -> str:

@@ -225,16 +225,17 @@ def annotate(image: np.ndarray, cell_map: CellMap, belief=None, fixations=(), wi
         points = np.round(centres[[k for _, k in visible]]).astype(np.int32)
         cv2.polylines(canvas, [points.reshape(-1, 1, 2)], False, (200, 220, 255), thick,
                       cv2.LINE_AA)
-    radius = max(3, int(round(cell_px * 0.27)))
+    radius = int(np.clip(round(cell_px * 0.27), 3, 9))
     for i, k in visible:
         x, y = (int(round(v)) for v in centres[k])
         colour = _order_colour(i, len(fixations))
         cv2.circle(canvas, (x, y), radius, colour, -1, cv2.LINE_AA)
         cv2.circle(canvas, (x, y), radius, (0, 0, 0), 1, cv2.LINE_AA)
         text = str(i + 1)
-        (tw, th), _ = cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, scale * 0.8, 1)
+        size = min(scale * 0.8, radius / 16.0 * (1.6 if i < 9 else 1.0))
+        (tw, th), _ = cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, size, 1)
         cv2.putText(canvas, text, (x - tw // 2, y + th // 2), cv2.FONT_HERSHEY_SIMPLEX,
-                    scale * 0.8, (0, 0, 0), 1, cv2.LINE_AA)
+                    size, (0, 0, 0), 1, cv2.LINE_AA)
     if detections is not None:
         points = np.asarray(detections, dtype=np.float64).reshape(-1, 2)
         size = max(5, int(round(cell_px * 0.3)))
