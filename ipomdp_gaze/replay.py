@@ -260,9 +260,26 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
     return result
 
 
+def search_rate(bag) -> tuple[float, float]:
+    """
+    Return ``(seconds, MB per minute)`` of the search: the bag's growth while frames came.
+
+    The search spans the recorded frames, from one mean frame interval before the first to the
+    last; the bytes of the messages recorded in it are scaled by the file's compression.
+    """
+    frames = sorted(m.time_ns for topic in ('evidence_image', 'evidence')
+                    for m in bag.topic(topic))
+    raw = sum(m.size for m in bag.messages)
+    if len(frames) < 2 or raw == 0:
+        return 0.0, math.nan
+    start = frames[0] - (frames[-1] - frames[0]) / (len(frames) - 1)
+    inside = sum(m.size for m in bag.messages if start <= m.time_ns <= frames[-1])
+    seconds = (frames[-1] - start) * 1e-9
+    return seconds, inside * bag.size_bytes / raw / 1e6 / (seconds / 60.0)
+
+
 def describe_size(bag) -> str:
-    """Say how large the bag is, per minute of recording."""
-    minutes = bag.duration_s / 60.0
-    per_minute = bag.size_bytes / 1e6 / minutes if minutes > 0 else math.nan
-    return (f'{bag.size_bytes / 1e6:.1f} MB for {bag.duration_s:.1f} s of recording: '
-            f'{per_minute:.0f} MB per minute')
+    """Say how large the bag is and how fast it grows per minute of search."""
+    seconds, per_minute = search_rate(bag)
+    return (f'{bag.size_bytes / 1e6:.2f} MB, {bag.duration_s:.1f} s recorded; '
+            f'{per_minute:.1f} MB per minute of search (over {seconds:.1f} s of frames)')

@@ -24,6 +24,7 @@ from ipomdp_gaze.belief import entropy
 from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, joints
 import numpy as np
+from diagnostic_msgs.msg import DiagnosticArray
 from sensor_msgs.msg import Image
 import yaml
 
@@ -216,8 +217,31 @@ def _with_recorder(setup: DemoSetup, record, compression: str, pictures) -> list
             args += ['-p', f'compression:={compression}']
         if setup.scene != 'faces':
             args += ['-p', f"nodes:=[{NODE_NAMES['controller']}]"]
+        args += ['-p', 'diagnostics_period_s:=0.1']
+        if setup.scene != 'faces':
+            # The camera publishes a frame as soon as it sees the first target: it starts
+            # before the controller, so the recorder has matched its publishers by then.
+            nodes = nodes[::-1]
         nodes.insert(0, ('recorder', args))
     return nodes
+
+
+class RecorderStatus:
+    """The recorder's latest ``recording`` status on ``/diagnostics``: matched publishers."""
+
+    def __init__(self, watch):
+        self.values = {}
+        watch.node.create_subscription(DiagnosticArray, '/diagnostics', self, 50)
+
+    def __call__(self, msg) -> None:
+        """Take a ``/diagnostics`` message."""
+        for status in msg.status:
+            if status.name.endswith(f"{NODE_NAMES['recorder']}: recording"):
+                self.values = diagnostics.values_of(status)
+
+    def matched(self, *topics) -> bool:
+        """Whether the recorder has matched a publisher on one of ``topics``."""
+        return any(int(self.values.get(f'publishers_{t}', 0)) > 0 for t in topics)
 
 
 def _pictures(setup: DemoSetup, record: SearchRecord, annotated: list, stats: dict) -> list:
@@ -274,6 +298,7 @@ def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = 
         record_ = SearchRecord(watch, depth=200, updates_only=True)
         annotated = watch.record(Image, 'annotated_image', 50) if pictures is not None \
             else []
+        recorder = RecorderStatus(watch) if record else None
         deadline = time.monotonic() + timeout_s
 
         def wait(condition) -> bool:
@@ -290,6 +315,11 @@ def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = 
                 started = time.monotonic()
                 proc.start()
                 ready = _started(watch, record_, proc.node)
+                if recorder is not None and len(procs) > 2 and proc is procs[-2]:
+                    # The search starts with the last node: the recorder must see the frames.
+                    before = ready or (lambda: True)
+                    ready = lambda: before() and recorder.matched(  # noqa: E731
+                        'evidence', 'evidence_image')
                 if proc is not procs[-1] and ready is not None and not wait(ready):
                     raise RuntimeError(f'{proc.name} did not come up in time')
             status = _follow(setup, record_, wait, timeout_s, out, stats, max_fixations)

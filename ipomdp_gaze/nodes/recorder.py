@@ -16,8 +16,9 @@ The bag's ``custom_data`` (in ``metadata.yaml``) holds ``ipomdp_gaze/version`` (
 ``ipomdp_gaze/parameters/<node>`` (every parameter of each node in ``nodes``, as YAML, fetched
 once they answer) and ``ipomdp_gaze/files`` (the sha256 of each policy and observation file
 those parameters name): what ``ipomdp-gaze replay`` needs to re-run the search. ``compression``
-``zstd`` compresses the whole file on close (rosbag2's file mode: ``ros2 bag play`` reads it,
-the ``mcap`` reader needs it decompressed first).
+``zstd`` compresses the MCAP chunks (as rosbag2's ``zstd`` storage presets do; every MCAP
+reader decompresses them). ``/diagnostics`` carries ``<node>: recording`` with the messages
+written and the publishers matched per topic.
 """
 from __future__ import annotations
 
@@ -26,6 +27,7 @@ from pathlib import Path
 import sys
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from ipomdp_gaze.msg_adapters import diagnostics
 from rcl_interfaces.srv import GetParameters, ListParameters
 from rclpy.node import Node
 from rclpy.parameter import parameter_value_to_python
@@ -45,7 +47,8 @@ BEST_EFFORT = QoSProfile(depth=50, reliability=ReliabilityPolicy.BEST_EFFORT)
 RELIABLE = QoSProfile(depth=50, reliability=ReliabilityPolicy.RELIABLE)
 # Relative topic -> (message type, ROS type name, QoS of the subscription).
 TOPICS = {
-    'image': (Image, 'sensor_msgs/msg/Image', BEST_EFFORT),
+    # Images reliable: over best effort a large image is lost whole when one fragment is.
+    'image': (Image, 'sensor_msgs/msg/Image', RELIABLE),
     'camera_info': (CameraInfo, 'sensor_msgs/msg/CameraInfo', BEST_EFFORT),
     'joint_states': (JointState, 'sensor_msgs/msg/JointState', BEST_EFFORT),
     'fixation': (Int32MultiArray, 'std_msgs/msg/Int32MultiArray', LATCHED),
@@ -58,7 +61,7 @@ TOPICS = {
     'gave_up': (DiagnosticStatus, 'diagnostic_msgs/msg/DiagnosticStatus', RELIABLE),
     '/diagnostics': (DiagnosticArray, 'diagnostic_msgs/msg/DiagnosticArray', RELIABLE),
     'ground_truth': (Int32MultiArray, 'std_msgs/msg/Int32MultiArray', LATCHED),
-    'annotated_image': (Image, 'sensor_msgs/msg/Image', BEST_EFFORT),
+    'annotated_image': (Image, 'sensor_msgs/msg/Image', RELIABLE),
 }
 FILE_PARAMETERS = ('policy.file', 'observation.file')
 PARAMETER_RETRY_S = 0.5
@@ -75,8 +78,12 @@ def recorder_params() -> list[Param]:
         Param('nodes', [NODE_NAMES['controller'], NODE_NAMES['detector']], T.STRING_ARRAY,
               "nodes whose parameters go into the bag's metadata (read-only)", read_only=True),
         Param('compression', '', T.STRING,
-              "'' (none) or 'zstd' (the whole file, on close; read-only)", read_only=True,
+              "'' (none) or 'zstd' (the MCAP chunks; read-only)", read_only=True,
               choices=('', 'zstd')),
+        Param('diagnostics_period_s', 1.0, T.DOUBLE,
+              'period of the recorder: recording status on /diagnostics (messages and '
+              'matched publishers per topic; read-only)', read_only=True,
+              float_range=(0.01, 3600.0)),
     ]
 
 
@@ -115,11 +122,15 @@ class RecorderNode(Node):
         self.writer.set_custom_data('ipomdp_gaze/version', package_version())
         self.connections = {}
         self.counts = dict.fromkeys(values['topics'], 0)
+        self.subscriptions_ = {}
         for topic in values['topics']:
             msg_type, type_name, qos = TOPICS[topic]
             self.connections[topic] = self.writer.add_connection(
                 self.resolve_topic_name(topic), type_name)
-            self.create_subscription(msg_type, topic, self._writer_for(topic), qos, raw=True)
+            self.subscriptions_[topic] = self.create_subscription(
+                msg_type, topic, self._writer_for(topic), qos, raw=True)
+        self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
+        self.create_timer(values['diagnostics_period_s'], self._publish_diagnostics)
         self.parameters: dict = {}
         self._pending = list(values['nodes'])
         self._futures = {}
@@ -180,6 +191,19 @@ class RecorderNode(Node):
         if node in self._pending:
             self._pending.remove(node)
         self.get_logger().info(f'recorded the parameters of {node}')
+
+    def _publish_diagnostics(self) -> None:
+        """Publish ``<node>: recording``: messages and matched publishers of each topic."""
+        values = {}
+        for topic, sub in self.subscriptions_.items():
+            name = topic.lstrip('/')
+            values[f'messages_{name}'] = self.counts[topic]
+            values[f'publishers_{name}'] = sub.get_publisher_count()
+        values['parameters_of'] = ','.join(sorted(self.parameters))
+        self._diag_pub.publish(diagnostics.diagnostic_array(
+            [diagnostics.status(f'{self.get_fully_qualified_name()}: recording', 'ok',
+                                f'{sum(self.counts.values())} messages', values)],
+            self.get_clock().now().to_msg()))
 
     def destroy_node(self):
         """Close the bag (writes metadata.yaml), then destroy the node."""

@@ -10,8 +10,9 @@ See the search on the camera image: belief, fixations, fovea windows, detections
   (``inferno``: dark purple at ``1e-3`` of the most likely cell or less, yellow at the most
   likely cell), the tint's opacity rising with the probability, so that the image stays visible
   where the belief is low;
-- the **fixations** so far as numbered discs at their cells' centres, joined by a thin line, the
-  colour running from blue (first) to white (latest), so that a long scan path stays readable;
+- the **fixations** so far as discs at their cells' centres, joined by a thin line, the colour
+  running from blue (first) to white (latest), numbered where a cell is large enough (discs of
+  6 px or more), so that a long scan path stays readable;
 - the current **fovea windows** (fixed camera) as cyan rectangles, dashed for a whole-image
   window, or, with a camera on the head, the fixated cell outlined in cyan;
 - the raw **detections** (box centres) as yellow crosses;
@@ -22,7 +23,8 @@ column of every pixel column (-1 off the grid). A fixed camera's grid tiles the 
 (:func:`fovea_cell_map`, the fovea's ``floor(i * size / n)`` edges); a camera on the pan/tilt head
 shows a rectangle of cells that depends on where the head points (:func:`view_cell_map`, the
 mapping of :mod:`ipomdp_gaze.head_camera`). Both are separable, which keeps the overlay a
-gather of a ``(rows, cols)`` colour table: about 1-3 ms for a 320x240 or 420x420 image
+repeat of a ``(rows, cols)`` colour table: about 3 ms for a 320x240 view and 7 ms for a
+420x420 image on this project's 2-core machine
 (``bench/annotate.py``).
 """
 from __future__ import annotations
@@ -92,9 +94,10 @@ class CellMap:
 
 def fovea_cell_map(grid: Grid, width: int, height: int) -> CellMap:
     """Map of a fixed camera whose image the grid tiles (the fovea's cell edges)."""
-    cols = (np.arange(int(width)) * grid.cols) // int(width)
-    rows = (np.arange(int(height)) * grid.rows) // int(height)
-    return CellMap(grid, rows.astype(np.int64), cols.astype(np.int64))
+    def cells(size: int, n: int) -> np.ndarray:
+        edges = (np.arange(n + 1, dtype=np.int64) * int(size)) // int(n)
+        return np.searchsorted(edges, np.arange(int(size)), side='right').astype(np.int64) - 1
+    return CellMap(grid, cells(height, grid.rows), cells(width, grid.cols))
 
 
 def view_cell_map(grid: Grid, camera: PinholeCamera, head_rc) -> CellMap:
@@ -200,12 +203,7 @@ def annotate(image: np.ndarray, cell_map: CellMap, belief=None, fixations=(), wi
         belief = np.asarray(belief, dtype=np.float64).reshape(-1)
         if belief.size != grid.n_cells:
             raise ValueError(f'belief has {belief.size} cells, the grid {grid.n_cells}')
-        colours, opacity = belief_colours(belief, float(alpha))
-        index = cell_map.cell_index()
-        on = index >= 0
-        cells = index[on]
-        a = opacity[cells][:, None]
-        canvas[on] = np.round(canvas[on] * (1.0 - a) + colours[cells] * a).astype(np.uint8)
+        canvas = _overlay(canvas, cell_map, *belief_colours(belief, float(alpha)))
     centres = np.stack([(boxes[:, 0] + boxes[:, 2]) / 2.0, (boxes[:, 1] + boxes[:, 3]) / 2.0],
                        axis=1)
     fixations = [int(k) for k in fixations]
@@ -231,6 +229,8 @@ def annotate(image: np.ndarray, cell_map: CellMap, belief=None, fixations=(), wi
         colour = _order_colour(i, len(fixations))
         cv2.circle(canvas, (x, y), radius, colour, -1, cv2.LINE_AA)
         cv2.circle(canvas, (x, y), radius, (0, 0, 0), 1, cv2.LINE_AA)
+        if radius < 6:
+            continue                    # too small to read: the colour gives the order
         text = str(i + 1)
         size = min(scale * 0.8, radius / 16.0 * (1.6 if i < 9 else 1.0))
         (tw, th), _ = cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, size, 1)
@@ -253,6 +253,36 @@ def annotate(image: np.ndarray, cell_map: CellMap, belief=None, fixations=(), wi
     if label:
         _text(canvas, label, (4, int(14 + 20 * scale)), scale, (255, 255, 255), thick)
     return canvas
+
+
+def _overlay(canvas: np.ndarray, cell_map: CellMap, colours: np.ndarray,
+             opacity: np.ndarray) -> np.ndarray:
+    """
+    Blend each cell's colour over its pixels: ``out = (1 - a) * image + a * colour``.
+
+    Separable: ``(rows + 1, cols + 1)`` tables of colour and opacity (the extra row and column
+    transparent, for pixels off the grid) repeated over each cell's run of pixel rows and
+    columns, then OpenCV's ``blendLinear``.
+    """
+    grid = cell_map.grid
+    colour = np.zeros((grid.rows + 1, grid.cols + 1, 3), dtype=np.uint8)
+    colour[:-1, :-1] = colours.reshape(grid.rows, grid.cols, 3)
+    weight = np.zeros((grid.rows + 1, grid.cols + 1), dtype=np.float32)
+    weight[:-1, :-1] = opacity.reshape(grid.shape)
+    row_cells, row_runs = _runs(np.where(cell_map.rows >= 0, cell_map.rows, grid.rows))
+    col_cells, col_runs = _runs(np.where(cell_map.cols >= 0, cell_map.cols, grid.cols))
+
+    def spread(table):
+        return np.ascontiguousarray(np.repeat(np.repeat(table[row_cells][:, col_cells], row_runs,
+                                                        axis=0), col_runs, axis=1))
+    a = spread(weight)
+    return cv2.blendLinear(canvas, spread(colour), 1.0 - a, a)
+
+
+def _runs(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Runs of equal values: ``(value of each run, its length)``."""
+    starts = np.flatnonzero(np.r_[True, labels[1:] != labels[:-1]])
+    return labels[starts], np.diff(np.r_[starts, labels.size])
 
 
 def _dashed_rect(canvas: np.ndarray, p0, p1, colour, thick: int = 1, dash: int = 6) -> None:
