@@ -87,7 +87,7 @@ def test_bad_cells_exit_with_one_line(args, message):
 
 
 @pytest.mark.parametrize('args, message', [
-    (['--policy', 'nonsense'], "--policy must be one of learned, map"),
+    (['--policy', 'nonsense'], '--policy must be one of learned, map'),
     (['--target', '99,99'], '--target 99,99 is outside the 11x11 grid'),
     (['--scene', 'faces', '--policy', 'greedy'], 'needs the Gaussian model of an FPOC'),
     (['--domain-id', '300'], 'expected a ROS domain id in 0..101'),

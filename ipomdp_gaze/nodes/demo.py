@@ -20,11 +20,11 @@ import math
 from pathlib import Path
 import time
 
+from diagnostic_msgs.msg import DiagnosticArray
 from ipomdp_gaze.belief import entropy
 from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, joints
 import numpy as np
-from diagnostic_msgs.msg import DiagnosticArray
 from sensor_msgs.msg import Image
 import yaml
 

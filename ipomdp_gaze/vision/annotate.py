@@ -280,7 +280,7 @@ def _overlay(canvas: np.ndarray, cell_map: CellMap, colours: np.ndarray,
 
 
 def _runs(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Runs of equal values: ``(value of each run, its length)``."""
+    """Return the runs of equal values: ``(value of each run, its length)``."""
     starts = np.flatnonzero(np.r_[True, labels[1:] != labels[:-1]])
     return labels[starts], np.diff(np.r_[starts, labels.size])
 
