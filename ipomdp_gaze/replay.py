@@ -14,7 +14,10 @@ recording: every next fixation and the final event.
 
 The frames were taken where the *recorded* search looked. A replay that chooses another fixation
 would need a frame from a view nobody took, so it stops at the first fixation that differs and
-says so; up to there every decision is compared. No rclpy here: messages come from ``rosbags``.
+says so; up to there every decision is compared. A fixed camera (the detector's ``fovea`` mode)
+records the whole scene, so :func:`new_search` can instead run a whole new search on the last
+recorded image, with the detector's recorded count model and fovea and the (overridden)
+controller settings. No rclpy here: messages come from ``rosbags``.
 """
 from __future__ import annotations
 
@@ -28,6 +31,8 @@ from ipomdp_gaze.head import PanTiltMap
 import numpy as np
 
 CONTROLLER = 'gaze_controller'
+DETECTOR = 'foveal_detector'
+IMAGE_CHANNELS = {'mono8': 1, 'rgb8': 3, 'bgr8': 3}
 # What ``replay`` may change, and the controller parameter each one sets.
 OVERRIDES = {'observation': 'observation.file', 'policy': 'policy.name',
              'policy_file': 'policy.file', 'confidence': 'confidence',
@@ -283,3 +288,61 @@ def describe_size(bag) -> str:
     seconds, per_minute = search_rate(bag)
     return (f'{bag.size_bytes / 1e6:.2f} MB, {bag.duration_s:.1f} s recorded; '
             f'{per_minute:.1f} MB per minute of search (over {seconds:.1f} s of frames)')
+
+
+def _last_image(bag) -> np.ndarray:
+    """Return the last recorded camera image as grey ``(H, W)`` or RGB ``(H, W, 3)`` uint8."""
+    msgs = bag.topic('image')
+    if not msgs:
+        raise ValueError(f'{bag.path} has no camera image to search')
+    msg = msgs[-1].msg
+    channels = IMAGE_CHANNELS.get(msg.encoding)
+    if channels is None:
+        raise ValueError(f'the recorded image is {msg.encoding!r}; expected mono8, rgb8 or bgr8')
+    data = np.asarray(msg.data, dtype=np.uint8).reshape(msg.height, msg.step)
+    pixels = data[:, :msg.width * channels].reshape(msg.height, msg.width, channels)
+    if msg.encoding == 'bgr8':
+        pixels = pixels[:, :, ::-1]
+    return np.ascontiguousarray(pixels[:, :, 0] if channels == 1 else pixels)
+
+
+def new_search(bag, overrides: dict | None = None, out=print):
+    """
+    Run a whole new search on the last recorded image of a fixed camera (``fovea`` mode).
+
+    The fovea and detector are the recorded detector's; the count model, policy, confidence,
+    budget and inhibition of return the controller's, with ``overrides``. Returns the
+    :class:`ipomdp_gaze.vision.search.ImageSearch`.
+
+    Raises
+    ------
+    ValueError
+        If the recording is not of a fixed camera or holds no image.
+
+    """
+    from ipomdp_gaze.detection import build_setup
+    from ipomdp_gaze.vision.search import search_image
+    detector = bag.parameters(DETECTOR)
+    if detector.get('mode') != 'fovea':
+        raise ValueError('a new search needs a recording of a fixed camera (the detector in '
+                         'fovea mode): a camera on the head only recorded the views it took')
+    values = settings_from(bag.parameters(CONTROLLER), overrides)
+    core, _ = build_controller(values)
+    given = {k: v for k, v in (('cascade', detector.get('detector.cascade')),
+                               ('scale_factor', detector.get('detector.scale_factor', 0) or None),
+                               ('min_neighbors', detector.get('detector.min_neighbors', -1)))
+             if v not in (None, '', -1)}
+    setup = build_setup('fovea', detector.get('observation.file', ''),
+                        (detector.get('grid.rows', 0), detector.get('grid.cols', 0),
+                         detector.get('grid.spacing_deg', 0.0)), given,
+                        detector.get('detector.cascade_dir') or None)
+    budget = int(values.get('search.max_fixations') or 0) or 4 * core.grid.n_cells
+    result = search_image(_last_image(bag), setup.fovea, core.observation, core.policy,
+                          confidence=core.confidence, max_fixations=budget,
+                          stop_on_repeat=False, start_cell=core.start_cell,
+                          rng=np.random.default_rng(int(values.get('seed', 0))),
+                          inhibit_return=bool(values.get('search.inhibit_return')))
+    r, c = result.cell
+    out(f'new search on the recorded image: {result.stop} at ({r}, {c}) '
+        f'p={result.probability:.3f} after {result.fixations} fixations')
+    return result

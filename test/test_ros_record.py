@@ -166,3 +166,23 @@ def test_the_face_demo_records_the_annotated_image_and_replays(ros_env, tmp_path
     replayed = _cli(ros_env, 'replay', str(tmp_path / 'bag'))
     assert replayed.returncode == 0, replayed.stdout + replayed.stderr
     assert 'the same fixations and the same decision' in replayed.stdout
+    refused = _cli(ros_env, 'replay', str(tmp_path / 'bag'), '--new-search')
+    assert refused.returncode == 2
+    assert 'a new search needs a recording of a fixed camera' in refused.stderr
+
+
+def test_a_fixed_camera_recording_can_be_searched_anew(ros_env, tmp_path):
+    run = _cli(ros_env, 'demo', '--scene', 'faces', '--fovea', '--domain-id',
+               ros_env['ROS_DOMAIN_ID'], '--seed', '0', '--record', str(tmp_path / 'bag'))
+    assert run.returncode == 0, run.stdout + run.stderr
+    row, col, fixations = _found(run.stdout)
+    again = _cli(ros_env, 'replay', str(tmp_path / 'bag'), '--new-search')
+    assert again.returncode == 0, again.stdout + again.stderr
+    # The detector is deterministic on a still scene: the new search is the recorded one.
+    assert re.search(rf'^new search on the recorded image: found at \({row}, {col}\) '
+                     rf'p=\d\.\d+ after {fixations} fixations$', again.stdout, re.M), again.stdout
+    other = _cli(ros_env, 'replay', str(tmp_path / 'bag'), '--new-search', '--policy', 'map')
+    assert other.returncode == 0, other.stdout + other.stderr
+    assert 'settings: recorded, with policy=map' in other.stdout
+    assert re.search(r'^new search on the recorded image: (found|budget) at \(\d+, \d+\)',
+                     other.stdout, re.M), other.stdout

@@ -49,6 +49,10 @@ def add_parser(sub):
                    help='another policy file or shipped kernel (selects learned)')
     p.add_argument('--confidence', type=confidence_arg, default=None)
     p.add_argument('--max-fixations', type=nonneg_int, default=None, metavar='N')
+    p.add_argument('--new-search', action='store_true',
+                   help='a fixed camera (detector in fovea mode) only: run a whole new search '
+                        'on the last recorded image with these settings, instead of following '
+                        'the recorded frames')
     p.set_defaults(run=run_replay)
 
 
@@ -83,6 +87,13 @@ def run_replay(args) -> int:
     changed = [f'{k}={v}' for k, v in overrides.items() if v is not None]
     print('settings: ' + ('recorded' if not changed else
                           'recorded, with ' + ', '.join(changed)))
+    if args.new_search:
+        from ipomdp_gaze.replay import new_search
+        new_search(bag, overrides)
+        return 0
     result = replay(bag, overrides)
     print(f'{result.frames} frames recorded, {result.applied} applied by the replay')
+    if result.stopped_early and bag.parameters('foveal_detector').get('mode') == 'fovea':
+        print('the recording is of a fixed camera: --new-search runs a whole new search on '
+              'its last image with these settings')
     return 0
