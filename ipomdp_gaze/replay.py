@@ -286,8 +286,9 @@ def search_rate(bag) -> tuple[float, float]:
 def describe_size(bag) -> str:
     """Say how large the bag is and how fast it grows per minute of search."""
     seconds, per_minute = search_rate(bag)
-    return (f'{bag.size_bytes / 1e6:.2f} MB, {bag.duration_s:.1f} s recorded; '
-            f'{per_minute:.1f} MB per minute of search (over {seconds:.1f} s of frames)')
+    rate = f'{per_minute:.1f} MB per minute of search (over {seconds:.1f} s of frames)' \
+        if seconds > 0 else 'fewer than two frames'
+    return f'{bag.size_bytes / 1e6:.2f} MB, {bag.duration_s:.1f} s recorded; {rate}'
 
 
 def _last_image(bag) -> np.ndarray:
