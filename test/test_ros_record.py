@@ -149,7 +149,7 @@ def test_the_face_demo_records_the_annotated_image_and_replays(ros_env, tmp_path
     from ipomdp_gaze.msg_adapters import images
     from PIL import Image
     run = _cli(ros_env, 'demo', '--scene', 'faces', '--domain-id', ros_env['ROS_DOMAIN_ID'],
-               '--seed', '3', '--record', str(tmp_path / 'bag'), '--compression', 'zstd',
+               '--seed', '0', '--record', str(tmp_path / 'bag'), '--compression', 'zstd',
                '--plot', str(tmp_path / 'faces.png'))
     assert run.returncode == 0, run.stdout + run.stderr
     messages = _mcap_messages(tmp_path / 'bag')
@@ -163,6 +163,14 @@ def test_the_face_demo_records_the_annotated_image_and_replays(ros_env, tmp_path
         annotated[-1].height, annotated[-1].width, 3)
     assert np.array_equal(np.asarray(Image.open(tmp_path / 'faces.png').convert('RGB')), last)
     assert images.MAX_IMAGE_SIDE_PX >= last.shape[1]
+    _, _, fixations = _found(run.stdout)
+    detections = messages['/detections']                   # the raw detections, per frame
+    assert len(detections) == fixations
+    stamps = {(m.header.stamp.sec, m.header.stamp.nanosec) for m in messages['/evidence_image']}
+    assert {(m.header.stamp.sec, m.header.stamp.nanosec) for m in detections} <= stamps
+    points = np.array([[p.position.x, p.position.y] for m in detections for p in m.poses])
+    assert len(points) and (points >= -0.5).all()
+    assert (points[:, 0] < last.shape[1]).all() and (points[:, 1] < last.shape[0]).all()
     replayed = _cli(ros_env, 'replay', str(tmp_path / 'bag'))
     assert replayed.returncode == 0, replayed.stdout + replayed.stderr
     assert 'the same fixations and the same decision' in replayed.stdout

@@ -1,7 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-The detector's ``annotated_image``: the camera image with the search drawn on it.
+The detector's ``annotated_image`` (the search drawn on the camera image) and ``detections``.
 
 :class:`Annotator` is attached to the ``foveal_detector`` node when ``publish_annotated`` is
 true (off by default: drawing costs about 3-7 ms a frame, ``bench/annotate.py``). It follows the
@@ -9,16 +9,21 @@ controller's ``belief`` and ``found`` and keeps the fixations of the current sea
 belief, sent at every reset, starts a new one); for every frame the detector publishes, and again
 for every belief and ``found`` that follows it, it publishes ``annotated_image`` (``rgb8``, at the
 camera's resolution, stamped like the camera image): the drawing of
-:func:`ipomdp_gaze.vision.annotate.annotate`, for ``rqt_image_view`` and Foxglove.
+:func:`ipomdp_gaze.vision.annotate.annotate`, for ``rqt_image_view`` and Foxglove. With every
+frame it also publishes the raw detections on ``detections`` (``geometry_msgs/PoseArray``,
+stamped like the camera image: one pose per raw detection, ``position.x, position.y`` its box
+centre in image pixels, OpenCV / ROS pixel coordinates). Nothing is drawn or sent to a topic
+nobody subscribes to.
 """
 from __future__ import annotations
 
 from diagnostic_msgs.msg import DiagnosticStatus
+from geometry_msgs.msg import Point, Pose, PoseArray
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images
 from ipomdp_gaze.vision.annotate import annotate, fovea_cell_map, view_cell_map
 import numpy as np
 from sensor_msgs.msg import Image
-from std_msgs.msg import Float32MultiArray
+from std_msgs.msg import Float32MultiArray, Header
 
 TOPIC = 'annotated_image'
 
@@ -29,6 +34,7 @@ class Annotator:
     def __init__(self, node):
         self.node = node
         self.publisher = node.create_publisher(Image, TOPIC, 2)
+        self.detections = node.create_publisher(PoseArray, 'detections', 10)
         node.create_subscription(Float32MultiArray, 'belief', self._on_belief, 10)
         node.create_subscription(DiagnosticStatus, 'found', self._on_found, 10)
         self.fixations: list[int] = []
@@ -46,6 +52,11 @@ class Annotator:
         self.frame = frame
         if not self.fixations or self.fixations[-1] != frame.fixation:
             self.fixations.append(int(frame.fixation))
+        if frame.detections_px is not None and self.detections.get_subscription_count() > 0:
+            msg = PoseArray(header=Header(stamp=frame.token))
+            msg.poses = [Pose(position=Point(x=float(x), y=float(y)))
+                         for x, y in np.asarray(frame.detections_px, dtype=float).reshape(-1, 2)]
+            self.detections.publish(msg)
         self._publish()
 
     def _on_belief(self, msg: Float32MultiArray) -> None:

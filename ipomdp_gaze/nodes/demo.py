@@ -208,11 +208,15 @@ def _started(watch, record, node: str):
 def _with_recorder(setup: DemoSetup, record, compression: str, pictures) -> list:
     """Return the nodes to start: a recorder first (``record``), the detector drawing."""
     nodes = list(setup.nodes)
-    if pictures is not None and setup.scene == 'faces':
+    if (pictures is not None or record) and setup.scene == 'faces':
+        # The detector's annotated_image (pictures) and its raw detections (recorded).
         nodes = [(node, args + ['-p', 'publish_annotated:=true'] if node == 'detector' else args)
                  for node, args in nodes]
     if record:
         args = ['-p', f'path:={Path(record).resolve()}']
+        if pictures is None:            # no pictures asked for: the bag without them
+            from .recorder import TOPICS
+            args += ['-p', f"topics:=[{','.join(t for t in TOPICS if t != 'annotated_image')}]"]
         if compression:
             args += ['-p', f'compression:={compression}']
         if setup.scene != 'faces':

@@ -100,8 +100,9 @@ def detector_params() -> list[Param]:
         Param('publish_image', True, T.BOOL,
               'publish stamped 32FC1 evidence_image frames (false: evidence)'),
         Param('publish_annotated', False, T.BOOL,
-              'publish annotated_image: the camera image with the belief, fixations, fovea '
-              'windows, detections and the found cell drawn on it (rgb8; read-only)',
+              'publish annotated_image (the camera image with the belief, fixations, fovea '
+              'windows, detections and the found cell drawn on it, rgb8) and the raw '
+              'detections (geometry_msgs/PoseArray of box centres in pixels; read-only)',
               read_only=True),
         Param('max_image_side_px', images.MAX_IMAGE_SIDE_PX, T.INTEGER,
               'images larger than this on a side are rejected (read-only)', read_only=True,

@@ -10,7 +10,8 @@ serialized (CDR) as they arrive, timestamped with the node's clock on arrival. `
 the relative topic names to record (:data:`TOPICS` gives each one's type and QoS; the default
 is every one of them: camera images, ``camera_info``, ``joint_states``, ``fixation``,
 ``pan_tilt``, ``evidence``, ``evidence_image``, ``belief``, ``found``, ``absent``, ``gave_up``,
-``/diagnostics``, ``ground_truth`` and the detector's ``annotated_image``).
+``/diagnostics``, ``ground_truth`` and the detector's ``annotated_image`` and raw
+``detections``).
 
 The bag's ``custom_data`` (in ``metadata.yaml``) holds ``ipomdp_gaze/version`` (the package),
 ``ipomdp_gaze/parameters/<node>`` (every parameter of each node in ``nodes``, as YAML, fetched
@@ -27,6 +28,7 @@ from pathlib import Path
 import sys
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from geometry_msgs.msg import PoseArray
 from ipomdp_gaze.msg_adapters import diagnostics
 from rcl_interfaces.srv import GetParameters, ListParameters
 from rclpy.node import Node
@@ -62,6 +64,7 @@ TOPICS = {
     '/diagnostics': (DiagnosticArray, 'diagnostic_msgs/msg/DiagnosticArray', RELIABLE),
     'ground_truth': (Int32MultiArray, 'std_msgs/msg/Int32MultiArray', LATCHED),
     'annotated_image': (Image, 'sensor_msgs/msg/Image', RELIABLE),
+    'detections': (PoseArray, 'geometry_msgs/msg/PoseArray', RELIABLE),
 }
 FILE_PARAMETERS = ('policy.file', 'observation.file')
 PARAMETER_RETRY_S = 0.5
