@@ -40,9 +40,12 @@ GAVE_UP = UNDECIDED
 DECISIONS = {FOUND: 'found', ABSENT: 'absent'}
 
 
-def check_confidence(confidence: float) -> float:
+def check_confidence(confidence, name: str = 'confidence') -> float:
     """
-    Return the confidence level of a decision as a float.
+    Return the confidence level of a decision as a float: strictly between 0 and 1.
+
+    1 is refused: a posterior reaches it only by rounding, so a search at 1 would never stop by
+    evidence; 0 would decide before any frame. The one check of every driver.
 
     Raises
     ------
@@ -51,17 +54,17 @@ def check_confidence(confidence: float) -> float:
 
     """
     try:
-        ok = 0 < confidence < 1
-    except TypeError:
+        ok = not isinstance(confidence, bool) and 0.0 < float(confidence) < 1.0
+    except (TypeError, ValueError):
         ok = False
-    if not ok or not math.isfinite(confidence):
-        raise ValueError(f'confidence must be between 0 and 1 (exclusive), got {confidence!r}')
+    if not ok:
+        raise ValueError(f'{name} must be between 0 and 1 (exclusive), got {confidence!r}')
     return float(confidence)
 
 
-def check_max_fixations(value, name: str = 'max_fixations') -> int | None:
+def check_budget(value, name: str = 'search.max_fixations') -> int:
     """
-    Return a fixation budget: a positive integer, or None for no budget (``None`` or 0).
+    Return a fixation budget as an int >= 0; 0 means no budget (everywhere).
 
     Raises
     ------
@@ -69,15 +72,18 @@ def check_max_fixations(value, name: str = 'max_fixations') -> int | None:
         For a negative or non-integer value (the message starts with ``name``).
 
     """
-    if value is None:
-        return None
     try:
-        budget = operator.index(value)
+        budget = -1 if isinstance(value, bool) else operator.index(value)
     except TypeError:
         budget = -1
     if budget < 0:
         raise ValueError(f'{name} must be an integer >= 0 (0: no budget), got {value!r}')
-    return budget or None
+    return budget
+
+
+def check_max_fixations(value, name: str = 'max_fixations') -> int | None:
+    """:func:`check_budget` as None for no budget (``None`` or 0 in)."""
+    return None if value is None else (check_budget(value, name) or None)
 
 
 def check_absent_prior(value, name: str = 'absent_prior') -> float:
