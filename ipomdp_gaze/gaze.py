@@ -176,22 +176,22 @@ class GazeController:
     # -- configuration -------------------------------------------------------------------
     @property
     def settings(self) -> SearchSettings:
-        """The settings in force."""
+        """Return the settings in force."""
         return self.session.settings
 
     @property
     def observation(self):
-        """The observation model the search assumes."""
+        """Return the observation model the search assumes."""
         return self.session.observation
 
     @property
     def policy(self):
-        """The policy that chooses the fixations."""
+        """Return the policy that chooses the fixations."""
         return self.session.policy
 
     @property
     def motion(self):
-        """The target's motion per second (:class:`ipomdp_gaze.motion.Motion`)."""
+        """Return the target's motion per second (:class:`ipomdp_gaze.motion.Motion`)."""
         return self.session.motion
 
     def configure(self, settings: SearchSettings, settle_time_s: float | None = None) -> None:
@@ -244,7 +244,7 @@ class GazeController:
 
     @property
     def fixation(self) -> int:
-        """The current target cell (settable: the next frame is taken there)."""
+        """Return the current target cell (settable: the next frame is taken there)."""
         return self.session.fixation
 
     @fixation.setter
@@ -363,7 +363,7 @@ class GazeController:
         return FrameResult('applied', fixation=step.fixation, **events)
 
     def _events(self, fired: str) -> dict:
-        """The event objects of what a frame fired (found, absent or gave_up)."""
+        """Return the event objects of what a frame fired (found, absent or gave_up)."""
         if fired == 'found':
             self.found = Found(self.map_cell, self.map_probability, self.fixations)
             return {'found': self.found}

@@ -33,10 +33,10 @@ class Sensor(Protocol):
         """Look at a new scene (a target cell, an image, a panorama)."""
 
     def scan(self) -> Frame | None:
-        """The one-time scan of the scene, or None for a sensor without one."""
+        """Return the one-time scan of the scene, or None for a sensor without one."""
 
     def observe(self, cell: int) -> Frame:
-        """The frame of a fixation at ``cell`` (row-major index)."""
+        """Return the frame of a fixation at ``cell`` (row-major index)."""
 
 
 class ModelSensor:

@@ -161,7 +161,7 @@ class SearchSettings:
                                  f'{grid.cols} grid')
 
     def to_parameters(self) -> dict:
-        """The settings under their parameter names (the form of YAML files and event logs)."""
+        """Return the settings under their parameter names, as YAML files and event logs."""
         out = {PARAMETER_NAMES[f.name]: getattr(self, f.name) for f in fields(self)}
         out['start_cell'] = None if self.start_cell is None else list(self.start_cell)
         return out
@@ -198,7 +198,7 @@ class SearchSettings:
 
 
 def start_index(grid: Grid, settings: SearchSettings) -> int | None:
-    """The cell index of ``settings.start_cell`` on ``grid``, or None (the default rule)."""
+    """Return the cell index of ``settings.start_cell`` on ``grid``, or None (the default rule)."""
     settings.check_grid(grid)
     if settings.start_cell is None:
         return None
@@ -224,7 +224,7 @@ class Frame:
     detections: tuple = ()
 
     def summary(self) -> dict:
-        """What the event log keeps of a frame: cells observed, sum and peak, cost."""
+        """Return what the event log keeps of a frame: cells observed, sum and peak, cost."""
         values = np.asarray(self.values, dtype=float)
         seen = ~np.isnan(values)
         return {'kind': self.kind, 'observed_cells': int(seen.sum()),
@@ -382,7 +382,7 @@ class SearchSession:
 
     @property
     def map_cell(self) -> int:
-        """The most likely cell (ties to the lowest index)."""
+        """Return the most likely cell (ties to the lowest index)."""
         return int(map_cell(self.belief))
 
     @property
@@ -397,12 +397,12 @@ class SearchSession:
 
     @property
     def fixation(self) -> int | None:
-        """The current fixation (None before :meth:`start`)."""
+        """Return the current fixation; None before :meth:`start`."""
         return self._state().fixation
 
     @property
     def visited(self) -> np.ndarray:
-        """Cells fixated in this search since inhibition of return last reopened them (N,)."""
+        """Cells fixated in this search since inhibition of return last reopened them."""
         return self._state().visited.copy()
 
     @property
@@ -417,12 +417,12 @@ class SearchSession:
 
     @property
     def path(self) -> tuple:
-        """The fixations whose frames were applied, in order."""
+        """Return the fixations whose frames were applied, in order."""
         return tuple(self._state().path)
 
     @property
     def decision(self) -> str:
-        """``'found'``, ``'absent'``, ``'gave_up'`` or ``''`` (with motion: the tracker's state)."""
+        """Return ``'found'``, ``'absent'``, ``'gave_up'`` or ``''``; with motion, the tracker's state."""
         return self._state().decision
 
     @property
@@ -432,12 +432,12 @@ class SearchSession:
 
     @property
     def ended(self) -> bool:
-        """Whether the search has ended (no more frames are taken until :meth:`reset`)."""
+        """Return whether the search has ended: no more frames until :meth:`reset`."""
         return self._state().ended
 
     @property
     def log(self) -> tuple:
-        """The event log of the session (dicts, oldest first; the newest ``log_size``)."""
+        """Return the events, oldest first: dicts, the newest ``log_size`` of them."""
         return tuple(self._log)
 
     # -- the steps -----------------------------------------------------------------------
@@ -455,8 +455,10 @@ class SearchSession:
 
     def reset(self, *, seed=None) -> None:
         """
-        Start a new search from the prior; a ``seed`` (an int, or a Generator to use as it is)
-        restarts the policy's random stream, which otherwise runs on.
+        Start a new search from the prior.
+
+        A ``seed`` (an int, or a Generator to use as it is) restarts the policy's random
+        stream, which otherwise runs on.
 
         The prior is ``(1 - absent_prior) / N`` per cell and ``absent_prior`` on the absent
         hypothesis (none when it is 0).
@@ -621,7 +623,7 @@ class SearchSession:
         return fired
 
     def _choose(self) -> int | None:
-        """The policy's next fixation; None when ``stop_on_repeat`` forbids every choice."""
+        """Return the policy's next fixation; None when ``stop_on_repeat`` forbids every choice."""
         search, settings = self._search, self.settings
         belief = self.belief[None, :]
         if settings.inhibit_return and not self.motion.active:
@@ -655,4 +657,3 @@ class SearchSession:
         return StepResult(status, search.fixations, cell, float(self.belief[cell]),
                           self.absent_probability, reason or search.reason, search.decision,
                           fired, None if search.ended else search.fixation, search.ended)
-

@@ -11,10 +11,10 @@ from __future__ import annotations
 
 from ipomdp_gaze.fpoc import make_fpoc
 from ipomdp_gaze.gaze import check_settle_time, GazeController
-from ipomdp_gaze.session import SearchSettings, start_index
-from ipomdp_gaze.stopping import check_confidence
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.health import classify, Health, HealthMonitor, policy_label
+from ipomdp_gaze.session import SearchSettings, start_index
+from ipomdp_gaze.stopping import check_confidence
 import numpy as np
 import pytest
 
@@ -225,6 +225,7 @@ def test_confidence_settle_time_and_start_cell_are_checked_once():
     for bad in (-1.0, float('nan'), float('inf')):
         with pytest.raises(ValueError, match='settle_time_s must be finite and >= 0'):
             check_settle_time(bad)
+
     def start(row, col, grid=GRID):
         values = {'start_row': row, 'start_col': col}
         return start_index(grid, SearchSettings.from_parameters(values, grid=grid))

@@ -1,8 +1,9 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-Sensors over pixels (:class:`ipomdp_gaze.sensors.Sensor`): the fovea over a still image, and the
-pan/tilt head's camera looking around a scene.
+Sensors over pixels (:class:`ipomdp_gaze.sensors.Sensor`).
+
+The fovea over a still image, and the pan/tilt head's camera looking around a scene.
 
 Both run a real detector and count its raw detections per cell, exactly as the ROS detector node
 does (:mod:`ipomdp_gaze.detection`), so an offline search through them is the node's search
@@ -69,7 +70,7 @@ class PanTiltSensor:
         return None
 
     def view(self, cell: int):
-        """The camera image with the head at ``cell``."""
+        """Render the camera image with the head at ``cell``."""
         return self.geometry.render(self.image, self.grid.cell(int(cell)))
 
     def observe(self, cell: int) -> Frame:
