@@ -422,7 +422,7 @@ class SearchSession:
 
     @property
     def decision(self) -> str:
-        """Return ``'found'``, ``'absent'``, ``'gave_up'`` or ``''``; with motion, the tracker's state."""
+        """Return found, absent, gave_up or ''; with motion, the tracker's state."""
         return self._state().decision
 
     @property
