@@ -73,13 +73,13 @@ def _check_flag(value, name: str) -> bool:
 
 
 def _check_start(value, name: str = 'start_cell'):
-    if value is None:
-        return None
+    if value is None or (isinstance(value, str) and value == 'policy'):
+        return value
     try:
         row, col = (operator.index(v) for v in value)
     except (TypeError, ValueError):
-        raise ValueError(f'{name} must be (row, col) integers or none (the default), got '
-                         f'{value!r}') from None
+        raise ValueError(f"{name} must be (row, col) integers, 'policy' or none (the "
+                         f'default), got {value!r}') from None
     if row < 0 or col < 0:
         raise ValueError(f'{name} must be (row, col) with row, col >= 0, got {value!r}')
     return (int(row), int(col))
@@ -110,8 +110,10 @@ class SearchSettings:
     motion_sigma_cells, motion_jump_prob : float
         The target's random walk per unit of ``dt_s`` (per second on the robot, per fixation in
         simulation); both 0 for a still target.
-    start_cell : (int, int) or None
-        First fixation ``(row, col)``; None: the policy's choice after a scan, else the centre.
+    start_cell : (int, int), 'policy' or None
+        First fixation ``(row, col)``; ``'policy'``: the policy's choice on the prior (the
+        paper's measurement convention, docs/design.md section 4.1); None: the policy's choice
+        after a scan, else the grid's centre (the robot's convention, section 4.2).
     scan : bool
         Apply the one-time scan when the sensor and the model have one.
 
@@ -154,7 +156,7 @@ class SearchSettings:
 
     def check_grid(self, grid: Grid) -> None:
         """Refuse a start cell outside ``grid`` (ValueError naming both)."""
-        if self.start_cell is not None:
+        if isinstance(self.start_cell, tuple):
             row, col = self.start_cell
             if row >= grid.rows or col >= grid.cols:
                 raise ValueError(f'start cell ({row}, {col}) is outside a {grid.rows}x'
@@ -163,7 +165,8 @@ class SearchSettings:
     def to_parameters(self) -> dict:
         """Return the settings under their parameter names, as YAML files and event logs."""
         out = {PARAMETER_NAMES[f.name]: getattr(self, f.name) for f in fields(self)}
-        out['start_cell'] = None if self.start_cell is None else list(self.start_cell)
+        if isinstance(self.start_cell, tuple):
+            out['start_cell'] = list(self.start_cell)
         return out
 
     @classmethod
@@ -200,7 +203,7 @@ class SearchSettings:
 def start_index(grid: Grid, settings: SearchSettings) -> int | None:
     """Return the cell index of ``settings.start_cell`` on ``grid``, or None (the default rule)."""
     settings.check_grid(grid)
-    if settings.start_cell is None:
+    if not isinstance(settings.start_cell, tuple):
         return None
     return grid.index(*settings.start_cell)
 
@@ -306,7 +309,8 @@ class SearchSession:
         The observation model the searcher assumes (:mod:`ipomdp_gaze.observation`) or an FPOC.
     policy
         Anything with ``select(belief (1, N), t, rng)``; with ``scores(belief)`` inhibition of
-        return masks the scores.
+        return masks the scores. None: the driver chooses every fixation itself
+        (:meth:`fixate`, as a Gymnasium agent does); the session then never chooses.
     settings : SearchSettings
         Checked already; the start cell is checked against ``grid`` here.
     log_size : int
@@ -509,8 +513,9 @@ class SearchSession:
         """
         Choose the first fixation and return it.
 
-        ``settings.start_cell`` if set; otherwise, after a scan, the policy's choice (its best
-        unvisited cell with inhibition of return) on the scanned belief; otherwise the centre.
+        ``settings.start_cell`` if it is a cell; the policy's choice (its best unvisited cell
+        with inhibition of return) on the belief if it is ``'policy'`` or after a scan;
+        otherwise the grid's centre.
         """
         search = self._state()
         if search.fixation is not None:
@@ -518,7 +523,7 @@ class SearchSession:
         fixed = start_index(self.grid, self.settings)
         if fixed is not None:
             search.fixation = fixed
-        elif search.scanned:
+        elif search.scanned or self.settings.start_cell == 'policy':
             search.fixation = self._choose()
         else:
             search.fixation = self.grid.center_index
@@ -625,6 +630,8 @@ class SearchSession:
     def _choose(self) -> int | None:
         """Return the policy's next fixation; None when ``stop_on_repeat`` forbids every choice."""
         search, settings = self._search, self.settings
+        if self.policy is None:
+            return search.fixation
         belief = self.belief[None, :]
         if settings.inhibit_return and not self.motion.active:
             if search.visited.all():

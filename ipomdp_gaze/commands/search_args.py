@@ -81,7 +81,7 @@ def settings_from_args(args, defaults: SearchSettings, grid=None) -> SearchSetti
     """Return the settings of ``args`` (flags left out keep ``defaults``), checked once."""
     changes = {key: getattr(args, key) for key in FLAGS[:-1] if hasattr(args, key)}
     start = getattr(args, 'start', defaults.start_cell)
-    if start is not None and grid is not None and not isinstance(start, tuple):
+    if isinstance(start, int) and grid is not None:
         start = grid.cell(cell_index(start, grid, 'start cell'))
     changes['start_cell'] = start
     settings = replace(defaults, **changes)
