@@ -44,7 +44,7 @@ from .motion import check_probability, check_sigma_cells, Motion
 from .observation import as_observation, check_evidence, CountObservation
 from .still_evidence import cell_information, check_repeat_weight, StillEvidence
 from .stopping import (ABSENT, check_absent_prior, check_budget, check_confidence, decide, FOUND,
-                       initial_log_belief)
+                       initial_log_belief, with_absent)
 
 # Decisions a search can end with; '' while undecided.
 DECISIONS = ('found', 'absent', 'gave_up')
@@ -502,9 +502,8 @@ class SearchSession:
         except EvidenceError as exc:
             return self._result('rejected', reason=str(exc))
         search.scanned = True
-        if search.log_belief.size > self.grid.n_cells:
-            term = np.append(term, 0.0)
-        bayes_update(search.log_belief, term, out=search.log_belief)
+        bayes_update(search.log_belief, with_absent(term, search.log_belief),
+                     out=search.log_belief)
         search.still_base = search.log_belief.copy()
         self._event('scan', frame=frame.summary(), belief=self._belief_summary())
         return self._result('applied')
@@ -573,16 +572,13 @@ class SearchSession:
         except EvidenceError as exc:
             return self._result('rejected', reason=str(exc))
         self.predict(dt_s)
-        n = self.grid.n_cells
         if self.settings.repeat_weight < 1.0 and not self.motion.active:
-            term = self._still_term(obs, term)
-            if search.log_belief.size > n:
-                term = np.append(term, 0.0)
-            bayes_update(search.still_base, term, out=search.log_belief)
+            bayes_update(search.still_base,
+                         with_absent(self._still_term(obs, term), search.log_belief),
+                         out=search.log_belief)
         else:
-            if search.log_belief.size > n:
-                term = np.append(term, 0.0)             # the absent hypothesis: ratio 1
-            bayes_update(search.log_belief, term, out=search.log_belief)
+            bayes_update(search.log_belief, with_absent(term, search.log_belief),
+                         out=search.log_belief)
         search.fixations += 1
         search.path.append(search.fixation)
         search.visited[search.fixation] = True

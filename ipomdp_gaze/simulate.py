@@ -22,11 +22,11 @@ from typing import Protocol
 
 import numpy as np
 
-from .belief import bayes_update, map_cell
+from .belief import map_cell
 from .grid import Grid
 from .motion import check_probability, Motion
 from .observation import as_observation
-from .stopping import check_absent_prior, initial_log_belief
+from .stopping import BatchBelief, check_absent_prior
 
 # Stream tags of the seed sequence: targets, noise per fixation, the policy's own draws, the
 # target's steps between fixations, and which scenes are empty.
@@ -222,10 +222,8 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
     all_present = bool(present.all())
     moving = motion is not None and motion.active
     index = np.arange(episodes)
-    log_b = initial_log_belief(n, absent_prior, episodes)
-    with_absent = log_b.shape[1] > n
-    belief = np.exp(log_b[:, :n])
-    terms = np.zeros((episodes, n + 1)) if with_absent else None
+    beliefs = BatchBelief(n, absent_prior, episodes, moving)
+    with_absent, belief = beliefs.has_absent, beliefs.belief
     fixations = np.empty((episodes, horizon), dtype=np.int64)
     correct = np.empty((episodes, horizon), dtype=bool)
     map_prob = np.empty((episodes, horizon))
@@ -239,22 +237,11 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
         fixations[:, t] = k
         frames = model.sample(where, k, noise(t),
                               present=None if all_present else present)
-        llr = model.log_likelihood_ratio(frames, k, validate=False)
-        if with_absent:
-            terms[:, :n] = llr                  # the absent hypothesis's term stays 0
-            llr = terms
-        bayes_update(log_b, llr, out=log_b)
+        infomax[:, t] = beliefs.update(model.log_likelihood_ratio(frames, k, validate=False))
         truth = where if all_present else np.where(present, where, -1)
         path[:, t] = truth
-        if with_absent or moving:               # 0 log 0 = 0 where the step left a cell at 0
-            full = np.exp(log_b)
-            belief[...] = full[:, :n]
-            infomax[:, t] = np.sum(full * log_b, axis=1, where=full > 0)
-            if with_absent:
-                absent_prob[:, t] = full[:, n]
-        else:
-            np.exp(log_b, out=belief)
-            infomax[:, t] = np.sum(belief * log_b, axis=1)
+        if with_absent:
+            absent_prob[:, t] = beliefs.absent_probability
         guess = map_cell(belief)
         guesses[:, t] = guess
         map_prob[:, t] = belief[index, guess]
@@ -266,8 +253,7 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
         if moving and t + 1 < horizon:
             where = motion.move(where, steps(t))
             if predict:
-                motion.predict_log(log_b)
-                belief[...] = np.exp(log_b[:, :n])
+                beliefs.predict(motion)
         if progress is not None:
             progress(t + 1)
     return SearchResult(targets, fixations, correct, map_prob, infomax, guesses, path, present,
