@@ -28,9 +28,9 @@ import sys
 import time
 
 import cv2
-from ipomdp_gaze.commands.find import default_policy_file
 from ipomdp_gaze.evaluation import wilson_interval
 from ipomdp_gaze.observation_file import load_observation
+from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy
 from ipomdp_gaze.session import SearchSettings
 from ipomdp_gaze.vision.detector import HaarDetector

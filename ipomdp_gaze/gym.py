@@ -11,7 +11,8 @@ of the new belief (``reward='fixate_target'``: the belief at the fixated cell). 
 terminates when the most likely cell reaches ``confidence`` (in (0, 1), as everywhere) and is
 truncated after ``max_steps`` fixations; stepping on after it terminated needs a reset. The
 belief, the Bayes step and the stop rules are the search session's (:mod:`ipomdp_gaze.session`,
-with the agent choosing every fixation). The hidden target is in ``info['target']`` for oracle baselines.
+with the agent choosing every fixation). The hidden target is in ``info['target']`` for oracle
+baselines.
 
 By default the observation model is the Gaussian model of ``fpoc`` on a ``rows x cols`` grid
 (7x7); ``observation=`` takes any observation model instead, for example a count model or the

@@ -206,7 +206,8 @@ def elm_init(grid: Grid, model, scale: float) -> np.ndarray:
 
 def sample_episodes(theta: np.ndarray, model, reward: str, episodes: int,
                     horizon: int, rng: np.random.Generator, motion: Motion | None = None,
-                    absent_prior: float = 0.0, absent_rate: float = 0.0) -> Episodes:
+                    absent_prior: float = 0.0, absent_rate: float = 0.0,
+                    scan: bool = True) -> Episodes:
     """
     Run a batch of episodes with the softmax policy ``p(k | B) ∝ exp(theta[k] . B)``.
 
@@ -227,6 +228,9 @@ def sample_episodes(theta: np.ndarray, model, reward: str, episodes: int,
         The target's step after every fixation; the belief is predicted with it.
     absent_prior, absent_rate : float
         The belief's prior that no target is in the grid, and the fraction of empty scenes.
+    scan : bool
+        With a count model that has scan tables, first apply the one-time scan (drawn from the
+        scan tables), as ``find`` does: the policy learns from the beliefs it will see.
 
     """
     n = theta.shape[0]
@@ -237,6 +241,9 @@ def sample_episodes(theta: np.ndarray, model, reward: str, episodes: int,
     moving = motion is not None and motion.active
     batch = BatchBelief(n, absent_prior, episodes, moving)
     belief = batch.belief
+    if scan and getattr(model, 'has_scan', False):
+        frames = model.sample_scan(targets, rng, present=present)
+        batch.update(model.scan_log_likelihood_ratio(frames, validate=False))
     beliefs = np.empty((horizon, episodes, n))
     delta = np.empty((horizon, episodes, n))
     rewards = np.empty((horizon, episodes))

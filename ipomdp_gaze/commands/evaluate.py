@@ -12,8 +12,12 @@ the prediction step and the paired difference).
 """
 from __future__ import annotations
 
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import replace
 import json
+import os
 from pathlib import Path
+import sys
 
 from ipomdp_gaze.evaluation import (decision_summary, fixations_to_90_ci,
                                     paired_difference_ci, paired_tracking_difference,
@@ -23,7 +27,10 @@ from ipomdp_gaze.observation import as_observation, GaussianObservation
 from ipomdp_gaze.observation_file import fingerprint
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
 from ipomdp_gaze.simulate import draw_present, draw_targets, simulate
+from ipomdp_gaze.vision.scene_eval import (DEFAULT_BUDGET, evaluate_scenes, format_summary,
+                                           results_json, summarise, task_spec, TASKS, write_json)
 import numpy as np
+from tqdm import tqdm
 
 from .common import (add_scene_args, add_task_args, confidence_arg, nonneg_int, positive_int,
                      task_from_args)
@@ -40,7 +47,16 @@ def add_parser(sub):
                    help='a baseline by name (repeatable)')
     p.add_argument('--policy-file', action='append', default=[], type=Path, metavar='PATH',
                    help='a policy YAML file, keyed by its file stem (repeatable)')
-    p.add_argument('--episodes', type=positive_int, default=20000)
+    p.add_argument('--episodes', type=positive_int, default=None,
+                   help='simulated episodes (default 20000), or scenes with --scenes (default '
+                        '200)')
+    p.add_argument('--scenes', default=None, choices=TASKS,
+                   help='evaluate an image task on held-out scenes through the real detector '
+                        'and sensor (the search session of the nodes and find) instead of '
+                        'simulating: pan-tilt (config/faces_camera_controller.yaml), faces-420 '
+                        "or faces-840 (find's settings); --policy, --policy-file, "
+                        '--confidence, --max-fixations (default 60) and --absent-prior change '
+                        'the shipped configuration')
     p.add_argument('--episodes-greedy', type=positive_int, default=2000,
                    help='episodes for the slow searchers, greedy and switching (policies '
                         'whose class sets costly; default 2000)')
@@ -203,7 +219,39 @@ def format_decisions(result: dict) -> str:
     return '\n'.join(lines)
 
 
+def run_scenes(args) -> int:
+    """``evaluate --scenes TASK``: held-out scenes through the search session (scene_eval)."""
+    if len(args.policy) + len(args.policy_file) > 1:
+        raise ValueError('--scenes evaluates one policy at a time')
+    spec = task_spec(args.scenes, args.policy[0] if args.policy else None,
+                     str(args.policy_file[0]) if args.policy_file else None, seed=args.seed,
+                     max_fixations=DEFAULT_BUDGET if args.max_fixations is None
+                     else args.max_fixations)
+    changes = {key: value for key, value in (('confidence', args.confidence),
+                                             ('absent_prior', args.absent_prior))
+               if value is not None}
+    spec = replace(spec, settings=replace(spec.settings, **changes))
+    episodes = args.episodes or 200
+    bar = tqdm(total=episodes, desc=f'{args.scenes} scenes', unit='scene', file=sys.stderr,
+               disable=None)
+    with ProcessPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
+        results = evaluate_scenes(spec, episodes, pool, progress=lambda done: bar.update(1))
+    bar.close()
+    summary = summarise(results)
+    print(f'{args.scenes}: policy {spec.policy_file or spec.policy}, test scenes {args.seed}..'
+          f'{args.seed + episodes - 1}, settings {spec.settings.to_parameters()}')
+    for line in format_summary(spec, summary):
+        print(line)
+    if args.json:
+        write_json(args.json, results_json(spec, results, summary))
+        print(f'wrote {args.json}')
+    return 0
+
+
 def run(args) -> int:
+    if args.scenes:
+        return run_scenes(args)
+    args.episodes = args.episodes or 20000
     grid, fpoc = task_from_args(args)
     policies = load_policies(args, grid, fpoc)
     result = evaluate(grid, fpoc, policies, args.episodes, args.horizon, args.seed,

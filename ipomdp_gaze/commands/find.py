@@ -39,22 +39,16 @@ import sys
 import cv2
 from ipomdp_gaze.belief import uniform_log_belief
 from ipomdp_gaze.observation_file import load_observation, shipped_image_models
-from ipomdp_gaze.policies.policy_file import load_policy_spec, shipped_kernels
+from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
-from ipomdp_gaze.session import SearchSettings
 from ipomdp_gaze.vision.search import (calibrated_size, cell_centre_px, check_image_size,
-                                       fovea_for_model, search_image, size_distance)
+                                       FIND_SETTINGS, fovea_for_model, search_image,
+                                       size_distance)
 import numpy as np
 
 from .common import nonneg_int
 from .search_args import add_search_args, settings_from_args
 
-# The operating point, chosen on training scenes (seed 1, 150, never on test scenes): with the
-# one-time scan of faces-420 and inhibition of return, its shipped kernel was right (within one
-# cell) on 0.973 at confidence 0.9 (4.8 fixations) and 0.980 at 0.99 (8.0 fixations). A search
-# never fixates a cell twice and gives up (repeat) once every cell was fixated.
-FIND_SETTINGS = SearchSettings(confidence=0.99, max_fixations=60, inhibit_return=True,
-                               stop_on_repeat=True)
 POLICY_CHOICES = tuple(name for name in POLICY_NAMES if name != 'learned')
 READ_FLAGS = cv2.IMREAD_ANYDEPTH | cv2.IMREAD_ANYCOLOR
 
@@ -138,18 +132,6 @@ def nearest_model(models: list, image_px: tuple[int, int]):
     sized = [(size_distance(image_px, size), i) for i, model in enumerate(models)
              if (size := calibrated_size(model)) is not None]
     return models[min(sized)[1]] if sized else models[0]
-
-
-def default_policy_file(model) -> str | None:
-    """Return the shipped kernel whose ``observation.name`` is the model's name, or None."""
-    name = model.meta.get('source')
-    if not name:
-        return None
-    for kernel in shipped_kernels():
-        spec = load_policy_spec(kernel)
-        if spec.observation is not None and spec.observation.get('name') == name:
-            return kernel
-    return None
 
 
 def build_find_policy(args, model, warn):
