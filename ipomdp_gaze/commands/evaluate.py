@@ -26,13 +26,14 @@ from ipomdp_gaze.motion import Motion
 from ipomdp_gaze.observation import as_observation, GaussianObservation
 from ipomdp_gaze.observation_file import fingerprint
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
+from ipomdp_gaze.session import SearchSettings
 from ipomdp_gaze.simulate import draw_present, draw_targets, simulate
 from ipomdp_gaze.vision.scene_eval import (DEFAULT_BUDGET, evaluate_scenes, format_summary,
                                            results_json, summarise, task_spec, TASKS, write_json)
 import numpy as np
 from tqdm import tqdm
 
-from .common import (add_scene_args, add_task_args, confidence_arg, nonneg_int, positive_int,
+from .common import (add_scene_args, add_task_args, nonneg_int, positive_int,
                      task_from_args)
 
 NO_PREDICTION = ' (no prediction)'
@@ -69,10 +70,10 @@ def add_parser(sub):
                    help='also give each policy minus the first, on the same episodes, with a '
                         'paired bootstrap 95%% interval')
     add_scene_args(p, 'simulated')
-    p.add_argument('--confidence', type=confidence_arg, default=None,
+    p.add_argument('--confidence', type=float, default=None,
                    help='level at which a search decides found or absent (default 0.95)')
-    p.add_argument('--max-fixations', type=positive_int, default=None,
-                   help='fixation budget: undecided searches give up there (default: the '
+    p.add_argument('--max-fixations', type=int, default=None,
+                   help='fixation budget: undecided searches give up there (default and 0: the '
                         'horizon; also the horizon when --horizon is not given)')
     p.add_argument('--compare-prediction', action='store_true',
                    help='moving target: also run each policy without the prediction step and '
@@ -219,6 +220,15 @@ def format_decisions(result: dict) -> str:
     return '\n'.join(lines)
 
 
+def check_settings(args) -> SearchSettings:
+    """Check the search settings given as flags before any work (the session's messages)."""
+    given = {key: value for key, value in (
+        ('confidence', args.confidence), ('absent_prior', args.absent_prior),
+        ('max_fixations', args.max_fixations), ('motion_sigma_cells', args.motion_sigma_cells),
+        ('motion_jump_prob', args.jump_prob)) if value is not None}
+    return SearchSettings(**given)
+
+
 def run_scenes(args) -> int:
     """``evaluate --scenes TASK``: held-out scenes through the search session (scene_eval)."""
     if len(args.policy) + len(args.policy_file) > 1:
@@ -249,9 +259,11 @@ def run_scenes(args) -> int:
 
 
 def run(args) -> int:
+    check_settings(args)
     if args.scenes:
         return run_scenes(args)
     args.episodes = args.episodes or 20000
+    args.max_fixations = args.max_fixations or None           # 0: no budget, the horizon
     grid, fpoc = task_from_args(args)
     policies = load_policies(args, grid, fpoc)
     result = evaluate(grid, fpoc, policies, args.episodes, args.horizon, args.seed,

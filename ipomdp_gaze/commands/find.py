@@ -270,6 +270,7 @@ def prepare(args) -> list:
 
 
 def run(args) -> int:
+    settings_from_args(args, FIND_SETTINGS)             # bad settings: refused before any work
     tasks = prepare(args)
     settings = [settings_from_args(args, FIND_SETTINGS, task.model.grid) for task in tasks]
     plots = plot_paths(args.plot, len(args.images)) if args.plot else []

@@ -81,8 +81,9 @@ def settings_from_args(args, defaults: SearchSettings, grid=None) -> SearchSetti
     """Return the settings of ``args`` (flags left out keep ``defaults``), checked once."""
     changes = {key: getattr(args, key) for key in FLAGS[:-1] if hasattr(args, key)}
     start = getattr(args, 'start', defaults.start_cell)
-    if isinstance(start, int) and grid is not None:
-        start = grid.cell(cell_index(start, grid, 'start cell'))
+    if isinstance(start, int):          # a flat index: a cell only once the grid is known
+        start = defaults.start_cell if grid is None else \
+            grid.cell(cell_index(start, grid, 'start cell'))
     changes['start_cell'] = start
     settings = replace(defaults, **changes)
     if grid is not None:

@@ -100,7 +100,7 @@ def controller_params() -> list[Param]:
               '(read-only)', read_only=True, int_range=(1, 1000)),
         Param('confidence', 0.95, T.DOUBLE,
               'found (absent) fires when the most likely cell (no target) reaches this '
-              'probability', float_range=(0.0, 1.0)),
+              'probability, in (0, 1)'),
         Param('motion.sigma_cells', 0.0, T.DOUBLE,
               'the target moves: standard deviation of its random walk in cells per second, '
               '>= 0 (0: a still target)'),
@@ -110,8 +110,7 @@ def controller_params() -> list[Param]:
               'prior that no target is in the grid, in [0, 1) (0: always there); a change '
               'starts a new search'),
         Param('search.max_fixations', 0, T.INTEGER,
-              'fixation budget of a search: gave_up when it runs out undecided (0: none)',
-              int_range=(0, INT_MAX)),
+              'fixation budget of a search: gave_up when it runs out undecided (0: none)'),
         Param('search.inhibit_return', False, T.BOOL,
               'still target: never fixate a cell twice in a search (a deterministic detector '
               'on a still scene repeats its counts; the Bayes step would count them twice)'),
@@ -119,7 +118,7 @@ def controller_params() -> list[Param]:
               'still target: weight of the evidence a cell gets from views other than the one '
               'that saw it at its most informative offset, in [0, 1] (1: every frame counts '
               'fully, naive Bayes; 0: the evidence of each cell once, for overlapping views of a '
-              'still scene and a deterministic detector)', float_range=(0.0, 1.0)),
+              'still scene and a deterministic detector)'),
         Param('policy.name', 'elm', T.STRING, 'fixation policy', choices=POLICY_NAMES),
         Param('policy.file', '', T.STRING,
               'policy YAML path or shipped kernel name; setting it selects learned'),
