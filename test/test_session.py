@@ -44,7 +44,7 @@ def count_model(seed=0, scan=True) -> CountObservation:
 
 
 def brute_force_log_posterior(model, scan, frames, absent_prior):
-    """log P(h | scan, frames) for h = each cell, then absent: likelihoods multiplied out."""
+    """Return log P(h | scan, frames) for each cell h, then absent: likelihoods multiplied out."""
     n = GRID.n_cells
     hypotheses = list(range(n)) + ([None] if absent_prior > 0 else [])
     out = []
@@ -66,7 +66,7 @@ def brute_force_log_posterior(model, scan, frames, absent_prior):
 
 
 def weighted_log_posterior(model, scan, frames, absent_prior, weight):
-    """The repeat-weighted posterior with loops: per cell, the best view's term + weight * rest."""
+    """Return the repeat-weighted posterior, by loops: per cell, best view + weight * the rest."""
     n = GRID.n_cells
     kernel = model.elm_kernel()
     log_b = np.full(n, math.log((1 - absent_prior) / n))
@@ -331,6 +331,7 @@ def test_the_controller_and_finds_driver_agree_on_the_same_frames():
     policy = build_policy('elm', GRID, model)
 
     class Recording(ModelSensor):
+
         def observe(self, cell):
             frame = super().observe(cell)
             self.recorded.append((cell, frame.values))

@@ -1,8 +1,9 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-Every driver of the search session refuses a bad setting with the same message, and the offline
-image-task evaluation runs the session with the real detector.
+Every driver of the search session refuses a bad setting with the same message.
+
+The offline image-task evaluation runs the session with the real detector.
 
 The CLI (``search``, ``find``, ``evaluate --scenes``) and the ``gaze_controller`` node (a parameter
 set, in process) are given the same bad values; the line the CLI prints and the reason the node
@@ -95,8 +96,8 @@ def test_the_node_refuses_the_same_values_with_the_same_message(ros_env):
     ({'policy.file': 'camera-11x11-infomax', 'policy.name': 'map'}, 'map', 'map'),
     ({}, 'elm', 'elm'),
 ])
-def test_policy_file_alone_selects_the_learned_policy_at_start_up(ros_env, overrides,
-                                                                   expected, policy):
+def test_policy_file_alone_selects_the_learned_policy_at_start_up(ros_env, overrides, expected,
+                                                                   policy):
     import rclpy
     from rclpy.parameter import Parameter
     from ipomdp_gaze.nodes.controller import GazeControllerNode
