@@ -96,8 +96,7 @@ def test_the_node_refuses_the_same_values_with_the_same_message(ros_env):
     ({'policy.file': 'camera-11x11-infomax', 'policy.name': 'map'}, 'map', 'map'),
     ({}, 'elm', 'elm'),
 ])
-def test_policy_file_alone_selects_the_learned_policy_at_start_up(ros_env, overrides, expected,
-                                                                   policy):
+def test_policy_file_alone_selects_learned_at_start_up(ros_env, overrides, expected, policy):
     import rclpy
     from rclpy.parameter import Parameter
     from ipomdp_gaze.nodes.controller import GazeControllerNode
