@@ -28,10 +28,11 @@ import sys
 import time
 
 import cv2
-from ipomdp_gaze.commands.find import default_policy_file
 from ipomdp_gaze.evaluation import wilson_interval
 from ipomdp_gaze.observation_file import load_observation
+from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy
+from ipomdp_gaze.session import SearchSettings
 from ipomdp_gaze.vision.detector import HaarDetector
 from ipomdp_gaze.vision.fullframe import scan
 from ipomdp_gaze.vision.scenes import SceneSet
@@ -165,10 +166,10 @@ def run_task(name: str, n: int, seed: int, log) -> dict:
         for label, which, policy_name, confidence, budget, nmpt_rule in FOVEATED:
             if (label, which) not in policies:
                 continue
+            settings = SearchSettings(confidence=confidence, max_fixations=budget,
+                                      stop_on_repeat=True, inhibit_return=not nmpt_rule)
             result = search_image(scene.image, foveas[which], models[which],
-                                  policies[label, which], confidence=confidence,
-                                  max_fixations=budget, stop_on_repeat=nmpt_rule,
-                                  inhibit_return=not nmpt_rule,
+                                  policies[label, which], settings,
                                   rng=np.random.default_rng([seed, i]))
             fovea_name = 'fovea' if which == 'shipped' else "NMPT's fovea"
             key = f'{fovea_name}, {label}, confidence {confidence}'
@@ -299,9 +300,9 @@ def astronaut(figure: Path) -> list[str]:
     fovea = fovea_for_model(model)
     policy = build_policy('elm', model.grid, model)
     policy.select(np.full((1, model.grid.n_cells), 1 / model.grid.n_cells), 0, None)  # warm up
-    result = search_image(image, fovea, model, policy, confidence=OPERATING_CONFIDENCE,
-                          max_fixations=60,
-                          stop_on_repeat=False, inhibit_return=True)
+    result = search_image(image, fovea, model, policy, SearchSettings(
+        confidence=OPERATING_CONFIDENCE, max_fixations=60, stop_on_repeat=True,
+        inhibit_return=True))
     full = scan(image, HaarDetector(), model.grid)
     plot_image_search(image, result, fovea, figure,
                       f'astronaut: cell {result.cell}, p={result.probability:.3f}, '

@@ -8,8 +8,11 @@ observation model (docs/design.md section 1) and updates the belief with the one
 observation is a ``Dict`` with the belief grid (or, with ``observe='evidence'``, the raw evidence
 of the last frame) and the current fixation. The reward is the infomax reward ``sum_i B_i log B_i``
 of the new belief (``reward='fixate_target'``: the belief at the fixated cell). An episode
-terminates when the most likely cell reaches ``confidence`` and is truncated after ``max_steps``
-fixations. The hidden target is in ``info['target']`` for oracle baselines.
+terminates when the most likely cell reaches ``confidence`` (in (0, 1), as everywhere) and is
+truncated after ``max_steps`` fixations; stepping on after it terminated needs a reset. The
+belief, the Bayes step and the stop rules are the search session's (:mod:`ipomdp_gaze.session`,
+with the agent choosing every fixation). The hidden target is in ``info['target']`` for oracle
+baselines.
 
 By default the observation model is the Gaussian model of ``fpoc`` on a ``rows x cols`` grid
 (7x7); ``observation=`` takes any observation model instead, for example a count model or the
@@ -34,13 +37,13 @@ import gymnasium
 from gymnasium import spaces
 import numpy as np
 
-from .belief import bayes_update, entropy, map_cell
+from .belief import map_cell
 from .fpoc import FPOC, make_fpoc
 from .grid import Grid
-from .motion import check_probability, Motion
+from .motion import check_probability
 from .observation import as_observation, GaussianObservation
 from .render import belief_heatmap, belief_text
-from .stopping import check_absent_prior, decide, DECISIONS, initial_log_belief
+from .session import Frame, SearchSession, SearchSettings
 
 ENV_ID = 'ipomdp_gaze/VisualSearch-v0'
 REWARDS = ('infomax', 'fixate_target')
@@ -78,15 +81,19 @@ class VisualSearchEnv(gymnasium.Env):
             raise ValueError(f"unknown reward {reward!r}; valid rewards: {', '.join(REWARDS)}")
         if observe not in OBSERVE:
             raise ValueError(f"unknown observe {observe!r}; valid: {', '.join(OBSERVE)}")
-        if not 0.0 < confidence <= 1.0:
-            raise ValueError(f'confidence must be in (0, 1], got {confidence!r}')
         if render_mode is not None and render_mode not in self.metadata['render_modes']:
             raise ValueError(f'unknown render_mode {render_mode!r}; valid: rgb_array, ansi')
         n = self.grid.n_cells
-        self.motion = Motion(self.grid, motion_sigma_cells, jump_prob)
-        self.absent_prior = check_absent_prior(absent_prior)
+        # The agent chooses every fixation (no policy); the budget is the env's truncation.
+        self.settings = SearchSettings(confidence=confidence, absent_prior=absent_prior,
+                                       motion_sigma_cells=motion_sigma_cells,
+                                       motion_jump_prob=jump_prob)
+        self.session = SearchSession(self.grid, self.model, None, self.settings)
+        self.motion = self.session.motion
+        self.absent_prior = self.settings.absent_prior
         self.absent_rate = check_probability(absent_rate, 'absent_rate')
-        self.reward_name, self.observe, self.confidence = reward, observe, float(confidence)
+        self.reward_name, self.observe = reward, observe
+        self.confidence = self.settings.confidence
         self.max_steps = n if max_steps is None else int(max_steps)
         self.start_cell = self.grid.center_index if start_cell is None else int(start_cell)
         if not 0 <= self.start_cell < n:
@@ -101,7 +108,7 @@ class VisualSearchEnv(gymnasium.Env):
         if self.absent_prior > 0:
             spaces_['absent'] = spaces.Box(0.0, 1.0, shape=(1,), dtype=np.float64)
         self.observation_space = spaces.Dict(spaces_)
-        self._log_b = initial_log_belief(n, self.absent_prior)
+        self.session.reset()
         self._evidence = np.zeros(n)
         self._fixation = self.start_cell
         self._target = 0
@@ -111,12 +118,12 @@ class VisualSearchEnv(gymnasium.Env):
     @property
     def belief(self) -> np.ndarray:
         """Return the cell probabilities, shape (N,) (summing to ``1 - P(absent)``)."""
-        return np.exp(self._log_b[:self.grid.n_cells])
+        return self.session.belief
 
     @property
     def absent_probability(self) -> float:
         """Return ``P(absent)`` (0 without the absent hypothesis)."""
-        return float(np.exp(self._log_b[-1])) if self.absent_prior > 0 else 0.0
+        return self.session.absent_probability
 
     def _obs(self):
         data = self.belief if self.observe == 'belief' else self._evidence
@@ -128,9 +135,8 @@ class VisualSearchEnv(gymnasium.Env):
     def _info(self, decision: str = ''):
         b = self.belief
         guess = int(map_cell(b))
-        full = np.exp(self._log_b)
         return {'target': self._target, 'map_cell': guess, 'map_probability': float(b[guess]),
-                'entropy': float(entropy(full)), 'steps': self._steps,
+                'entropy': self.session.entropy_nats, 'steps': self._steps,
                 'present': self._present, 'absent_probability': self.absent_probability,
                 'decision': decision}
 
@@ -145,7 +151,8 @@ class VisualSearchEnv(gymnasium.Env):
         else:
             self._present = self.absent_rate == 0 or \
                 bool(self.np_random.random() >= self.absent_rate)
-        self._log_b = initial_log_belief(n, self.absent_prior)
+        self.session.reset()
+        self.session.start()
         self._evidence = np.zeros(n)
         self._fixation = self.start_cell
         self._steps = 0
@@ -156,26 +163,24 @@ class VisualSearchEnv(gymnasium.Env):
         if not self.action_space.contains(k):
             raise ValueError(
                 f'action must be a cell index in [0, {self.grid.n_cells}), got {action!r}')
+        if self.session.ended:
+            raise gymnasium.error.ResetNeeded('the episode has terminated: call reset() before '
+                                              'step()')
         obs = self.model.sample(self._target, k, self.np_random, present=self._present)
-        term = self.model.log_likelihood_ratio(obs, k, validate=False)
-        if self.absent_prior > 0:
-            term = np.append(term, 0.0)                 # the absent hypothesis: ratio 1
-        bayes_update(self._log_b, term, out=self._log_b)
+        self.session.fixate(k)
+        result = self.session.update(Frame(obs))
         self._evidence, self._fixation = obs, k
         self._steps += 1
-        b = self.belief
         if self.reward_name == 'infomax':
-            full = np.exp(self._log_b)
-            reward = -float(entropy(full))
+            reward = -self.session.entropy_nats
         else:
-            reward = float(b[k])
-        code = int(decide(b.max(), self.absent_probability, self.confidence))
-        info = self._info(DECISIONS.get(code, ''))
-        terminated = bool(code) and not self.motion.active
+            reward = float(self.belief[k])
+        info = self._info(result.decision)
+        terminated = result.terminated
         truncated = bool(not terminated and self._steps >= self.max_steps)
         if self.motion.active:
             self._target = int(self.motion.move(np.array([self._target]), self.np_random)[0])
-            self.motion.predict_log(self._log_b)
+            self.session.predict(1.0)
         return self._obs(), reward, terminated, truncated, info
 
     def render(self):

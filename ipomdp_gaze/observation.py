@@ -545,6 +545,34 @@ class CountObservation:
         frames[rows, targets] = np.sum(u_t[:, None] > self._cdf['target'][off_t, :-1], axis=1)
         return frames[0] if single else frames
 
+    def sample_scan(self, targets, rng: np.random.Generator, present=None) -> np.ndarray:
+        """
+        Draw one-time scan frames: each cell from ``scan_null``, the target from ``scan_target``.
+
+        As :meth:`sample` (one uniform per cell, inverse CDF, ``present`` for empty scenes), with
+        the position-independent scan tables; scalars give (N,), arrays (E,) give (E, N).
+
+        Raises
+        ------
+        ValueError
+            If the model has no scan tables.
+
+        """
+        if not self.has_scan:
+            raise ValueError('this count model has no scan tables: it was measured without a '
+                             'whole-image scan (fovea scan_once false)')
+        single = np.ndim(targets) == 0
+        targets = np.atleast_1d(np.asarray(targets, dtype=np.intp))
+        u = rng.random((targets.size, self.grid.n_cells))
+        frames = np.searchsorted(np.cumsum(self.scan_null)[:-1], u, side='left').astype(float)
+        rows = np.arange(targets.size)
+        if present is not None:
+            rows = rows[np.broadcast_to(np.asarray(present, dtype=bool), rows.shape)]
+            targets = targets[rows]
+        frames[rows, targets] = np.searchsorted(np.cumsum(self.scan_target)[:-1],
+                                                u[rows, targets], side='left')
+        return frames[0] if single else frames
+
 
 def as_observation(grid: Grid, model):
     """Return ``model`` if it is an observation model, or the Gaussian model of an FPOC."""

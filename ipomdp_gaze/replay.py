@@ -21,13 +21,15 @@ controller settings. No rclpy here: messages come from ``rosbags``.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 import math
 
 from ipomdp_gaze.fpoc import make_fpoc, parameter_names
-from ipomdp_gaze.gaze import GazeController, start_cell
+from ipomdp_gaze.gaze import GazeController
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.head import PanTiltMap
+from ipomdp_gaze.session import SearchSettings
 import numpy as np
 
 CONTROLLER = 'gaze_controller'
@@ -135,13 +137,9 @@ def build_controller(values: dict) -> tuple[GazeController, PanTiltMap]:
                           values['tilt_offset_rad'],
                           (values['pan_min_rad'], values['pan_max_rad']),
                           (values['tilt_min_rad'], values['tilt_max_rad']))
-        row, col = values.get('start_row', -1), values.get('start_col', -1)
-        first = start_cell(grid, None if row < 0 else row, None if col < 0 else col)
-        core = GazeController(grid, model, policy, first, values['settle_time_s'],
-                              values['confidence'], values['seed'],
-                              values['motion.sigma_cells'], values['motion.jump_prob'],
-                              values['absent.prior'], values['search.max_fixations'],
-                              values['search.inhibit_return'], values['search.repeat_weight'])
+        settings = SearchSettings.from_parameters(values, grid=grid)
+        core = GazeController(grid, model, policy, settings, values['settle_time_s'],
+                              values['seed'])
     except KeyError as exc:
         raise ValueError(f'the recording has no controller parameter {exc}') from None
     return core, head
@@ -337,12 +335,11 @@ def new_search(bag, overrides: dict | None = None, out=print):
                         (detector.get('grid.rows', 0), detector.get('grid.cols', 0),
                          detector.get('grid.spacing_deg', 0.0)), given,
                         detector.get('detector.cascade_dir') or None)
-    budget = int(values.get('search.max_fixations') or 0) or 4 * core.grid.n_cells
+    settings = core.settings
+    if not settings.max_fixations:        # the demo's budget: a still image needs an end
+        settings = dataclasses.replace(settings, max_fixations=4 * core.grid.n_cells)
     result = search_image(_last_image(bag), setup.fovea, core.observation, core.policy,
-                          confidence=core.confidence, max_fixations=budget,
-                          stop_on_repeat=False, start_cell=core.start_cell,
-                          rng=np.random.default_rng(int(values.get('seed', 0))),
-                          inhibit_return=bool(values.get('search.inhibit_return')))
+                          settings, rng=np.random.default_rng(int(values.get('seed', 0))))
     r, c = result.cell
     out(f'new search on the recorded image: {result.stop} at ({r}, {c}) '
         f'p={result.probability:.3f} after {result.fixations} fixations')

@@ -22,15 +22,15 @@ from typing import Protocol
 
 import numpy as np
 
-from .belief import bayes_update, map_cell
+from .belief import map_cell
 from .grid import Grid
 from .motion import check_probability, Motion
 from .observation import as_observation
-from .stopping import check_absent_prior, initial_log_belief
+from .stopping import BatchBelief, check_absent_prior
 
 # Stream tags of the seed sequence: targets, noise per fixation, the policy's own draws, the
 # target's steps between fixations, and which scenes are empty.
-_TARGET, _NOISE, _POLICY, _MOTION, _ABSENT = 0, 1, 2, 3, 4
+_TARGET, _NOISE, _POLICY, _MOTION, _ABSENT, _SCAN = 0, 1, 2, 3, 4, 5
 
 
 class Policy(Protocol):
@@ -148,7 +148,7 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
              seed: int = 0, targets: np.ndarray | None = None, progress=None,
              motion: Motion | None = None, predict: bool = True, absent_prior: float = 0.0,
              absent_rate: float = 0.0, present: np.ndarray | None = None,
-             rows: tuple[int, int] | None = None) -> SearchResult:
+             rows: tuple[int, int] | None = None, scan: bool = True) -> SearchResult:
     """
     Run ``episodes`` searches of ``horizon`` fixations (default N) from the prior.
 
@@ -189,6 +189,10 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
         deterministic one); ``targets`` and ``present`` are then the whole run's. A stochastic
         policy's own draws come from ``[seed, 2, start]`` instead. This is how the work of one
         run is split over processes (``ipomdp-gaze reproduce``).
+    scan : bool
+        With a count model that has scan tables, first apply the one-time scan (drawn from the
+        scan tables, its own stream ``[seed, 5]``), as ``find`` and the fovea do; the first
+        fixation is then the policy's choice on the scanned belief.
 
     """
     n = grid.n_cells
@@ -211,6 +215,7 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
 
         def steps(t):
             return RowsOf(motion_stream(seed, t), start, stop, total)
+        scan_rng = RowsOf(np.random.default_rng([seed, _SCAN]), start, stop, total)
         rng = np.random.default_rng([seed, _POLICY, start])
     else:
         def noise(t):
@@ -218,14 +223,13 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
 
         def steps(t):
             return motion_stream(seed, t)
+        scan_rng = np.random.default_rng([seed, _SCAN])
         rng = policy_rng(seed)
     all_present = bool(present.all())
     moving = motion is not None and motion.active
     index = np.arange(episodes)
-    log_b = initial_log_belief(n, absent_prior, episodes)
-    with_absent = log_b.shape[1] > n
-    belief = np.exp(log_b[:, :n])
-    terms = np.zeros((episodes, n + 1)) if with_absent else None
+    beliefs = BatchBelief(n, absent_prior, episodes, moving)
+    with_absent, belief = beliefs.has_absent, beliefs.belief
     fixations = np.empty((episodes, horizon), dtype=np.int64)
     correct = np.empty((episodes, horizon), dtype=bool)
     map_prob = np.empty((episodes, horizon))
@@ -234,27 +238,19 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
     path = np.empty((episodes, horizon), dtype=np.int64)
     absent_prob = np.empty((episodes, horizon)) if with_absent else None
     where = targets.copy() if moving else targets
+    if scan and getattr(model, 'has_scan', False):
+        frames = model.sample_scan(where, scan_rng, present=None if all_present else present)
+        beliefs.update(model.scan_log_likelihood_ratio(frames, validate=False))
     for t in range(horizon):
         k = np.asarray(policy.select(belief, t, rng), dtype=np.int64)
         fixations[:, t] = k
         frames = model.sample(where, k, noise(t),
                               present=None if all_present else present)
-        llr = model.log_likelihood_ratio(frames, k, validate=False)
-        if with_absent:
-            terms[:, :n] = llr                  # the absent hypothesis's term stays 0
-            llr = terms
-        bayes_update(log_b, llr, out=log_b)
+        infomax[:, t] = beliefs.update(model.log_likelihood_ratio(frames, k, validate=False))
         truth = where if all_present else np.where(present, where, -1)
         path[:, t] = truth
-        if with_absent or moving:               # 0 log 0 = 0 where the step left a cell at 0
-            full = np.exp(log_b)
-            belief[...] = full[:, :n]
-            infomax[:, t] = np.sum(full * log_b, axis=1, where=full > 0)
-            if with_absent:
-                absent_prob[:, t] = full[:, n]
-        else:
-            np.exp(log_b, out=belief)
-            infomax[:, t] = np.sum(belief * log_b, axis=1)
+        if with_absent:
+            absent_prob[:, t] = beliefs.absent_probability
         guess = map_cell(belief)
         guesses[:, t] = guess
         map_prob[:, t] = belief[index, guess]
@@ -266,8 +262,7 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
         if moving and t + 1 < horizon:
             where = motion.move(where, steps(t))
             if predict:
-                motion.predict_log(log_b)
-                belief[...] = np.exp(log_b[:, :n])
+                beliefs.predict(motion)
         if progress is not None:
             progress(t + 1)
     return SearchResult(targets, fixations, correct, map_prob, infomax, guesses, path, present,

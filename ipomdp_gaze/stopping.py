@@ -31,7 +31,7 @@ import operator
 
 import numpy as np
 
-from .belief import uniform_log_belief
+from .belief import bayes_update, uniform_log_belief
 from .motion import check_probability
 
 # Decision codes of :func:`decide` and :func:`first_decisions`.
@@ -40,9 +40,12 @@ GAVE_UP = UNDECIDED
 DECISIONS = {FOUND: 'found', ABSENT: 'absent'}
 
 
-def check_confidence(confidence: float) -> float:
+def check_confidence(confidence, name: str = 'confidence') -> float:
     """
-    Return the confidence level of a decision as a float.
+    Return the confidence level of a decision as a float: strictly between 0 and 1.
+
+    1 is refused: a posterior reaches it only by rounding, so a search at 1 would never stop by
+    evidence; 0 would decide before any frame. The one check of every driver.
 
     Raises
     ------
@@ -51,17 +54,17 @@ def check_confidence(confidence: float) -> float:
 
     """
     try:
-        ok = 0 < confidence < 1
-    except TypeError:
+        ok = not isinstance(confidence, bool) and 0.0 < float(confidence) < 1.0
+    except (TypeError, ValueError):
         ok = False
-    if not ok or not math.isfinite(confidence):
-        raise ValueError(f'confidence must be between 0 and 1 (exclusive), got {confidence!r}')
+    if not ok:
+        raise ValueError(f'{name} must be between 0 and 1 (exclusive), got {confidence!r}')
     return float(confidence)
 
 
-def check_max_fixations(value, name: str = 'max_fixations') -> int | None:
+def check_budget(value, name: str = 'search.max_fixations') -> int:
     """
-    Return a fixation budget: a positive integer, or None for no budget (``None`` or 0).
+    Return a fixation budget as an int >= 0; 0 means no budget (everywhere).
 
     Raises
     ------
@@ -69,15 +72,18 @@ def check_max_fixations(value, name: str = 'max_fixations') -> int | None:
         For a negative or non-integer value (the message starts with ``name``).
 
     """
-    if value is None:
-        return None
     try:
-        budget = operator.index(value)
+        budget = -1 if isinstance(value, bool) else operator.index(value)
     except TypeError:
         budget = -1
     if budget < 0:
         raise ValueError(f'{name} must be an integer >= 0 (0: no budget), got {value!r}')
-    return budget or None
+    return budget
+
+
+def check_max_fixations(value, name: str = 'max_fixations') -> int | None:
+    """:func:`check_budget` as None for no budget (``None`` or 0 in)."""
+    return None if value is None else (check_budget(value, name) or None)
 
 
 def check_absent_prior(value, name: str = 'absent_prior') -> float:
@@ -157,3 +163,67 @@ def first_decisions(map_probability: np.ndarray, absent_probability, confidence:
     any_decided = decided[np.arange(p.shape[0]), first]
     kind = np.where(any_decided, codes[np.arange(p.shape[0]), first], GAVE_UP)
     return kind, np.where(any_decided, first + 1, budget)
+
+
+def with_absent(term: np.ndarray, log_belief: np.ndarray) -> np.ndarray:
+    """
+    Return per-cell terms ``(..., N)`` ready for a belief of N or N + 1 hypotheses.
+
+    With the absent hypothesis (``log_belief`` has one more entry than ``term``) its term is 0:
+    under it every cell draws from the null model, so its likelihood ratio is 1.
+    """
+    if log_belief.shape[-1] == term.shape[-1]:
+        return term
+    pad = [(0, 0)] * (term.ndim - 1) + [(0, 1)]
+    return np.pad(term, pad)
+
+
+class BatchBelief:
+    """
+    The beliefs of a batch of searches, ``(E, N)`` or ``(E, N + 1)``, and their one Bayes step.
+
+    The batched counterpart of a search session's belief, shared by the simulator
+    (:func:`ipomdp_gaze.simulate.simulate`) and policy-gradient training
+    (:func:`ipomdp_gaze.policies.training.sample_episodes`): the prior, the step
+    ``log B += llr`` with the absent hypothesis's 0 (:func:`with_absent`) and renormalisation,
+    the infomax reward ``sum_h B_h log B_h`` over every hypothesis (0 log 0 = 0 where a motion
+    step left a cell at 0), and the motion prediction.
+
+    Attributes
+    ----------
+    log_belief : array (E, N) or (E, N + 1)
+        Log probabilities, the absent hypothesis last.
+    belief : array (E, N)
+        The cell probabilities (what a policy sees), kept in step with ``log_belief``.
+
+    """
+
+    def __init__(self, n_cells: int, absent_prior: float, episodes: int, moving: bool = False):
+        self.n = n_cells
+        self.log_belief = initial_log_belief(n_cells, absent_prior, episodes)
+        self.has_absent = self.log_belief.shape[1] > n_cells
+        self.moving = bool(moving)
+        self._terms = np.zeros((episodes, n_cells + 1)) if self.has_absent else None
+        self.belief = np.exp(self.log_belief[:, :n_cells])
+        self.absent_probability = None
+
+    def update(self, llr: np.ndarray) -> np.ndarray:
+        """Apply one frame per search (``llr`` (E, N)); return the infomax reward (E,)."""
+        log_b, n = self.log_belief, self.n
+        if self.has_absent:
+            self._terms[:, :n] = llr                # the absent hypothesis's term stays 0
+            llr = self._terms
+        bayes_update(log_b, llr, out=log_b)
+        if self.has_absent or self.moving:
+            full = np.exp(log_b)
+            self.belief[...] = full[:, :n]
+            if self.has_absent:
+                self.absent_probability = full[:, n]
+            return np.sum(full * log_b, axis=1, where=full > 0)
+        np.exp(log_b, out=self.belief)
+        return np.sum(self.belief * log_b, axis=1)
+
+    def predict(self, motion) -> None:
+        """Spread every belief by one step of ``motion`` (the absent mass stays)."""
+        motion.predict_log(self.log_belief)
+        self.belief[...] = np.exp(self.log_belief[:, :self.n])

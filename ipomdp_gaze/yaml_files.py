@@ -83,3 +83,24 @@ def write_yaml(path, doc: dict) -> Path:
     path.write_text(yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=100),
                     encoding='utf-8')
     return path
+
+
+def flatten(tree: dict, prefix: str = '') -> dict:
+    """Nested YAML parameters -> dotted names (``{'grid': {'rows': 11}}`` -> ``grid.rows``)."""
+    out = {}
+    for key, value in tree.items():
+        name = f'{prefix}{key}'
+        if isinstance(value, dict):
+            out.update(flatten(value, name + '.'))
+        else:
+            out[name] = value
+    return out
+
+
+def yaml_parameters(path, node_name: str) -> dict:
+    """Read the ``ros__parameters`` of ``node_name`` from a parameter file, dotted names."""
+    tree = yaml.safe_load(Path(path).read_text())
+    try:
+        return flatten(tree[node_name]['ros__parameters'])
+    except (KeyError, TypeError):
+        raise ValueError(f'{path} has no {node_name}: ros__parameters block') from None

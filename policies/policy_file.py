@@ -449,3 +449,15 @@ def save_policy(path, spec: PolicySpec) -> Path:
     doc = spec.to_dict()
     spec_from_dict(doc)
     return write_yaml(path, doc)
+
+
+def default_policy_file(model) -> str | None:
+    """Return the shipped kernel whose ``observation.name`` is the model's name, or None."""
+    name = model.meta.get('source')
+    if not name:
+        return None
+    for kernel in shipped_kernels():
+        spec = load_policy_spec(kernel)
+        if spec.observation is not None and spec.observation.get('name') == name:
+            return kernel
+    return None

@@ -36,7 +36,6 @@ from pathlib import Path
 import time
 from typing import Callable
 
-from ipomdp_gaze.belief import bayes_update
 from ipomdp_gaze.evaluation import fixations_to_90_ci, fixations_to_level, tracking_summary
 from ipomdp_gaze.fpoc import FPOC
 from ipomdp_gaze.grid import Grid
@@ -44,7 +43,7 @@ from ipomdp_gaze.motion import check_probability, check_sigma_cells, Motion
 from ipomdp_gaze.observation import as_observation, CountObservation
 from ipomdp_gaze.observation_file import fingerprint
 from ipomdp_gaze.simulate import simulate
-from ipomdp_gaze.stopping import check_absent_prior, initial_log_belief
+from ipomdp_gaze.stopping import BatchBelief, check_absent_prior
 import numpy as np
 
 from .conv import ConvPolicy, kernel_from_radial, radial_bins
@@ -207,7 +206,8 @@ def elm_init(grid: Grid, model, scale: float) -> np.ndarray:
 
 def sample_episodes(theta: np.ndarray, model, reward: str, episodes: int,
                     horizon: int, rng: np.random.Generator, motion: Motion | None = None,
-                    absent_prior: float = 0.0, absent_rate: float = 0.0) -> Episodes:
+                    absent_prior: float = 0.0, absent_rate: float = 0.0,
+                    scan: bool = True) -> Episodes:
     """
     Run a batch of episodes with the softmax policy ``p(k | B) ∝ exp(theta[k] . B)``.
 
@@ -228,6 +228,9 @@ def sample_episodes(theta: np.ndarray, model, reward: str, episodes: int,
         The target's step after every fixation; the belief is predicted with it.
     absent_prior, absent_rate : float
         The belief's prior that no target is in the grid, and the fraction of empty scenes.
+    scan : bool
+        With a count model that has scan tables, first apply the one-time scan (drawn from the
+        scan tables), as ``find`` does: the policy learns from the beliefs it will see.
 
     """
     n = theta.shape[0]
@@ -236,10 +239,11 @@ def sample_episodes(theta: np.ndarray, model, reward: str, episodes: int,
     targets = rng.integers(0, n, size=episodes)
     present = rng.random(episodes) >= absent_rate if absent_rate > 0 else None
     moving = motion is not None and motion.active
-    log_b = initial_log_belief(n, absent_prior, episodes)
-    with_absent = log_b.shape[1] > n
-    terms = np.zeros((episodes, n + 1)) if with_absent else None
-    belief = np.exp(log_b[:, :n])
+    batch = BatchBelief(n, absent_prior, episodes, moving)
+    belief = batch.belief
+    if scan and getattr(model, 'has_scan', False):
+        frames = model.sample_scan(targets, rng, present=present)
+        batch.update(model.scan_log_likelihood_ratio(frames, validate=False))
     beliefs = np.empty((horizon, episodes, n))
     delta = np.empty((horizon, episodes, n))
     rewards = np.empty((horizon, episodes))
@@ -252,23 +256,11 @@ def sample_episodes(theta: np.ndarray, model, reward: str, episodes: int,
         np.negative(p, out=delta[t])
         delta[t, rows, a] += 1.0
         frames = model.sample(targets, a, rng, present=present)
-        llr = model.log_likelihood_ratio(frames, a, validate=False)
-        if with_absent:
-            terms[:, :n] = llr                  # the absent hypothesis's term stays 0
-            llr = terms
-        bayes_update(log_b, llr, out=log_b)
-        if with_absent or moving:
-            full = np.exp(log_b)
-            belief[...] = full[:, :n]
-            infomax = np.sum(full * log_b, axis=1, where=full > 0)
-        else:
-            np.exp(log_b, out=belief)
-            infomax = np.sum(belief * log_b, axis=1)
+        infomax = batch.update(model.log_likelihood_ratio(frames, a, validate=False))
         rewards[t] = infomax if reward == 'infomax' else belief[rows, a]
         if moving:
             targets = motion.move(targets, rng)
-            motion.predict_log(log_b)
-            belief[...] = np.exp(log_b[:, :n])
+            batch.predict(motion)
     return Episodes(beliefs, delta, rewards, fixations)
 
 

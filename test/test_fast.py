@@ -15,6 +15,7 @@ from ipomdp_gaze.observation import GaussianObservation
 from ipomdp_gaze.policies import conv
 from ipomdp_gaze.policies.baselines import elm_policy
 from ipomdp_gaze.policies.conv import ConvPolicy, kernel_matrix, support_box
+from ipomdp_gaze.session import SearchSettings
 import numpy as np
 import pytest
 
@@ -213,7 +214,7 @@ def test_controller_update_equals_the_bayes_step(dtype):
     fpoc = make_fpoc('human')
     d = dprime_matrix(grid, fpoc)
     # A confidence the 40 updates never reach, so the search does not end at found.
-    core = GazeController(grid, fpoc, elm_policy(grid, fpoc), confidence=1 - 1e-12)
+    core = GazeController(grid, fpoc, elm_policy(grid, fpoc), SearchSettings(confidence=1 - 1e-12))
     core.reset(0.0)
     rng = np.random.default_rng(6)
     log_b = uniform_log_belief(grid.n_cells)

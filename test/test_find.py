@@ -22,7 +22,7 @@ GRID = Grid(21, 21)
 TASK = {'size_px': 420, 'face_px': (60, 140), 'grid': (21, 21)}
 TRAIN_SCENES = 8
 JSON_KEYS = ['path', 'cell', 'pixel', 'probability', 'fixations', 'detector_pixels', 'seconds',
-             'stop']
+             'decision', 'absent_probability', 'stop']
 
 
 def run_find(*args, cwd=None):
@@ -101,7 +101,7 @@ def test_find_locates_the_face_of_a_test_scene(task, tmp_path):
     assert 'observation model faces-test' in result.stderr and 'policy elm' in result.stderr
     entry = json.loads(out.read_text())['images'][0]
     assert within_one_cell(entry['cell'], task['scenes'][0])
-    assert entry['probability'] >= 0.9 and entry['stop'] == 'found'
+    assert entry['probability'] >= 0.9 and entry['stop'] == entry['decision'] == 'found'
     assert 0 < entry['detector_pixels'] < 420 * 420 and entry['seconds'] > 0
 
 

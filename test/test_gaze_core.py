@@ -3,6 +3,8 @@
 """The gaze controller core without ROS: frames, belief, policy choice, found, counters."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from ipomdp_gaze.belief import argmax_ties_low, bayes_update, uniform_log_belief
@@ -12,6 +14,7 @@ from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
 from ipomdp_gaze.policies.baselines import spiral_order
 from ipomdp_gaze.policies.registry import build_policy
+from ipomdp_gaze.session import SearchSettings
 import numpy as np
 import pytest
 
@@ -21,7 +24,7 @@ CAMERA = make_fpoc('camera', half_width_deg=10.0, half_height_deg=10.0)
 
 def controller(policy='elm', settle_time_s=0.5, **kwargs):
     policy = build_policy(policy, GRID, CAMERA) if isinstance(policy, str) else policy
-    core = GazeController(GRID, CAMERA, policy, settle_time_s=settle_time_s, **kwargs)
+    core = GazeController(GRID, CAMERA, policy, SearchSettings(**kwargs), settle_time_s)
     core.reset(0.0)
     return core
 
@@ -150,14 +153,14 @@ def test_policy_time_index_counts_fixations_since_reset():
 
 
 def test_start_cell_and_validation():
-    core = controller(start_cell=GRID.index(0, 10))
+    core = controller(start_cell=(0, 10))
     assert core.reset(0.0) == 10
     with pytest.raises(ValueError, match='outside'):
-        core.set_start_cell(121)
+        core.configure(replace(core.settings, start_cell=(11, 0)))
     with pytest.raises(ValueError, match='settle_time_s'):
-        core.set_settle_time(-1.0)
+        core.configure(core.settings, settle_time_s=-1.0)
     with pytest.raises(ValueError, match='confidence'):
-        core.set_confidence(1.0)
+        replace(core.settings, confidence=1.0)
 
 
 @settings(max_examples=40, deadline=None)
@@ -222,16 +225,16 @@ def test_inhibition_of_return_never_fixates_a_cell_twice_then_opens_them_again()
     assert len(set(fixations['stare'])) < 30              # MAP goes back to cells it saw
     assert len(set(fixations['ior'])) == 40                # never the same cell twice
     ior.reset(100.0)
-    assert ior.fixation == GRID.center_index and not ior._visited.any()
+    assert ior.fixation == GRID.center_index and not ior.session.visited.any()
     # Once every cell of a small grid has been fixated, all are open again.
     grid = Grid(2, 2)
-    small = GazeController(grid, CAMERA, build_policy('map', grid, CAMERA), settle_time_s=0.0,
-                           confidence=1 - 1e-9, inhibit_return=True)
+    small = GazeController(grid, CAMERA, build_policy('map', grid, CAMERA),
+                           SearchSettings(confidence=1 - 1e-9, inhibit_return=True))
     seen = []
     for t in range(1, 6):
         seen.append(small.fixation)
         assert small.offer(np.zeros(4), float(t)).applied
-    assert sorted(seen[:4]) == [0, 1, 2, 3] and small._visited.sum() == 1
+    assert sorted(seen[:4]) == [0, 1, 2, 3] and small.session.visited.sum() == 1
 
 
 def test_inhibition_of_return_gives_the_best_unvisited_cell_of_elm_and_is_off_for_motion():

@@ -3,6 +3,8 @@
 """The controller core with a moving or absent target: events, the end of a search, tracking."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 from ipomdp_gaze.belief import bayes_update
 from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
 from ipomdp_gaze.gaze import GazeController
@@ -11,6 +13,7 @@ from ipomdp_gaze.health import HealthMonitor
 from ipomdp_gaze.motion import Motion
 from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
 from ipomdp_gaze.policies.registry import build_policy
+from ipomdp_gaze.session import SearchSettings
 from ipomdp_gaze.stopping import initial_log_belief
 import numpy as np
 import pytest
@@ -21,7 +24,8 @@ D = dprime_matrix(GRID, CAMERA)
 
 
 def controller(**kwargs):
-    core = GazeController(GRID, CAMERA, build_policy('elm', GRID, CAMERA), **kwargs)
+    core = GazeController(GRID, CAMERA, build_policy('elm', GRID, CAMERA),
+                          SearchSettings(**kwargs))
     core.reset(0.0)
     return core
 
@@ -104,7 +108,7 @@ def test_a_decision_on_the_last_budgeted_fixation_is_not_giving_up():
 
 
 def test_motion_predicts_over_the_time_since_the_last_update():
-    core = controller(motion_sigma_cells=0.8, jump_prob=0.1, absent_prior=0.2,
+    core = controller(motion_sigma_cells=0.8, motion_jump_prob=0.1, absent_prior=0.2,
                       confidence=0.999999)
     rng = np.random.default_rng(3)
     log_b = initial_log_belief(GRID.n_cells, 0.2)
@@ -141,21 +145,23 @@ def test_with_motion_found_reports_keeps_tracking_and_rearms():
 
 def test_absent_prior_changes_apply_from_the_next_reset():
     core = controller()
-    core.set_absent_prior(0.4)
+    core.configure(replace(core.settings, absent_prior=0.4))
     assert core.absent_probability == 0.0
     core.reset(1.0)
     assert core.absent_probability == pytest.approx(0.4)
     assert core.belief.sum() == pytest.approx(0.6)
 
 
-@pytest.mark.parametrize('setter, args, message', [
-    ('set_motion', (-0.5, 0.0), 'sigma_cells must be finite and >= 0'),
-    ('set_motion', (0.5, 1.0), r'jump_prob must be a probability in \[0, 1\)'),
-    ('set_absent_prior', (1.0,), r'absent_prior must be a probability in \[0, 1\)'),
-    ('set_absent_prior', (-0.1,), r'absent_prior must be a probability in \[0, 1\)'),
-    ('set_max_fixations', (-2,), 'max_fixations must be an integer >= 0'),
+@pytest.mark.parametrize('changes, message', [
+    ({'motion_sigma_cells': -0.5}, r'^motion.sigma_cells must be finite and >= 0'),
+    ({'motion_jump_prob': 1.0}, r'^motion.jump_prob must be a probability in \[0, 1\)'),
+    ({'absent_prior': 1.0}, r'^absent.prior must be a probability in \[0, 1\)'),
+    ({'absent_prior': -0.1}, r'^absent.prior must be a probability in \[0, 1\)'),
+    ({'max_fixations': -2}, r'^search.max_fixations must be an integer >= 0'),
 ])
-def test_bad_settings_are_refused_with_their_reason(setter, args, message):
+def test_bad_settings_are_refused_with_their_reason(changes, message):
     core = controller()
+    before = core.settings
     with pytest.raises(ValueError, match=message):
-        getattr(core, setter)(*args)
+        core.configure(replace(core.settings, **changes))
+    assert core.settings is before

@@ -153,7 +153,8 @@ def test_example_drives_the_env_with_a_shipped_kernel_and_baselines(capsys):
 @pytest.mark.parametrize('kwargs, words', [
     ({'motion_sigma_cells': -1.0}, 'sigma_cells must be finite and >= 0'),
     ({'jump_prob': 1.0}, r'jump_prob must be a probability in \[0, 1\)'),
-    ({'absent_prior': 1.2}, r'absent_prior must be a probability in \[0, 1\)'),
+    ({'absent_prior': 1.2}, r'absent.prior must be a probability in \[0, 1\)'),
+    ({'confidence': 1.0}, r'confidence must be between 0 and 1 \(exclusive\)'),
     ({'absent_rate': -0.1}, r'absent_rate must be a probability in \[0, 1\)'),
 ])
 def test_bad_motion_and_absent_options_are_named(kwargs, words):

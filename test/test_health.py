@@ -10,9 +10,11 @@ real :class:`ipomdp_gaze.gaze.GazeController` (per-period counts, rate, values i
 from __future__ import annotations
 
 from ipomdp_gaze.fpoc import make_fpoc
-from ipomdp_gaze.gaze import check_confidence, check_settle_time, GazeController, start_cell
+from ipomdp_gaze.gaze import check_settle_time, GazeController
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.health import classify, Health, HealthMonitor, policy_label
+from ipomdp_gaze.session import SearchSettings, start_index
+from ipomdp_gaze.stopping import check_confidence
 import numpy as np
 import pytest
 
@@ -123,7 +125,8 @@ class Centre:
 
 
 def controller(**kwargs) -> GazeController:
-    core = GazeController(GRID, FPOC, Centre(), **kwargs)
+    settle_time_s = kwargs.pop('settle_time_s', 0.0)
+    core = GazeController(GRID, FPOC, Centre(), SearchSettings(**kwargs), settle_time_s)
     core.reset(0.0)
     return core
 
@@ -222,10 +225,16 @@ def test_confidence_settle_time_and_start_cell_are_checked_once():
     for bad in (-1.0, float('nan'), float('inf')):
         with pytest.raises(ValueError, match='settle_time_s must be finite and >= 0'):
             check_settle_time(bad)
-    assert start_cell(GRID) == GRID.center_index
-    assert start_cell(GRID, 0, None) == GRID.index(0, 2)
-    assert start_cell(GRID, None, 4) == GRID.index(2, 4)
-    assert start_cell(Grid(4, 6, 1.0), 3, 5) == 23
-    for row, col in ((5, 0), (0, 5), (-1, 0)):
+
+    def start(row, col, grid=GRID):
+        values = {'start_row': row, 'start_col': col}
+        return start_index(grid, SearchSettings.from_parameters(values, grid=grid))
+    assert start(-1, -1) is None and controller().fixation == GRID.center_index
+    assert start(0, -1) == GRID.index(0, 2)
+    assert start(-1, 4) == GRID.index(2, 4)
+    assert start(3, 5, Grid(4, 6, 1.0)) == 23
+    for row, col in ((5, 0), (0, 5)):
         with pytest.raises(ValueError, match='outside a 5x5 grid'):
-            start_cell(GRID, row, col)
+            start(row, col)
+    with pytest.raises(ValueError, match='start_cell must be'):
+        start(-2, 0)

@@ -1,6 +1,8 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """Searching one image with the fovea and a count model; NMPT's fixed policy."""
+from dataclasses import replace
+
 import cv2
 from ipomdp_gaze.belief import map_cell
 from ipomdp_gaze.grid import Grid
@@ -10,10 +12,16 @@ from ipomdp_gaze.policies.nmpt import (gaussian_taps, NMPT_SOURCE_TAPS, NMPTPoli
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
 from ipomdp_gaze.vision.detector import HaarDetector
 from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig
-from ipomdp_gaze.vision.search import (check_model, detector_from_settings, fovea_for_model,
-                                       ImageSearch, search_image)
+from ipomdp_gaze.vision.search import (check_model, DEFAULT_SETTINGS, detector_from_settings,
+                                       fovea_for_model, ImageSearch, search_image)
 import numpy as np
 import pytest
+
+
+def image_settings(**changes):
+    """search_image's default settings with some changed."""
+    return replace(DEFAULT_SETTINGS, **changes)
+
 
 GRID = Grid(7, 7)
 CELL_PX = 30
@@ -82,7 +90,7 @@ def make_fovea(boxes=3, reuse=False):
 
 def test_found_after_one_look_gives_the_map_cell_and_its_pixel_centre():
     fovea = make_fovea()
-    result = search_image(blob_image(), fovea, STRONG, Scan([0]), confidence=0.9)
+    result = search_image(blob_image(), fovea, STRONG, Scan([0]), image_settings(confidence=0.9))
     assert isinstance(result, ImageSearch)
     assert result.stop == 'found' and result.fixations == 1
     assert result.path == ((3, 3),)                     # the grid centre comes first
@@ -98,8 +106,8 @@ def test_found_after_one_look_gives_the_map_cell_and_its_pixel_centre():
 
 def test_budget_stops_an_undecided_search_and_the_policy_sees_each_belief():
     policy = Scan([10, 20, 30, 40])
-    result = search_image(blob_image(), make_fovea(), WEAK, policy, confidence=0.9,
-                          max_fixations=3)
+    result = search_image(blob_image(), make_fovea(), WEAK, policy,
+                          image_settings(confidence=0.9, max_fixations=3))
     assert result.stop == 'budget' and result.fixations == 3
     assert result.path == ((3, 3), (1, 3), (2, 6))
     assert [t for _, _, t in policy.calls] == [1, 2]
@@ -110,18 +118,19 @@ def test_budget_stops_an_undecided_search_and_the_policy_sees_each_belief():
 
 def test_repeat_stops_before_fixating_a_cell_again():
     centre = GRID.center_index
-    result = search_image(blob_image(), make_fovea(), WEAK, Scan([centre]), confidence=0.9)
+    result = search_image(blob_image(), make_fovea(), WEAK, Scan([centre]),
+                          image_settings(confidence=0.9))
     assert result.stop == 'repeat' and result.fixations == 1 and result.path == ((3, 3),)
     back = Scan([10, centre])
-    result = search_image(blob_image(), make_fovea(), WEAK, back, confidence=0.9)
+    result = search_image(blob_image(), make_fovea(), WEAK, back, image_settings(confidence=0.9))
     assert result.stop == 'repeat' and result.path == ((3, 3), (1, 3))
 
 
 def test_without_the_repeat_rule_the_same_evidence_is_counted_again():
     fovea = make_fovea()
     centre = GRID.center_index
-    result = search_image(blob_image(), fovea, WEAK, Scan([centre]), confidence=0.9,
-                          max_fixations=10, stop_on_repeat=False)
+    result = search_image(blob_image(), fovea, WEAK, Scan([centre]),
+                          image_settings(confidence=0.9, max_fixations=10, stop_on_repeat=False))
     assert result.stop == 'found' and result.fixations == 6   # log-odds grow by ~1.17 a look
     assert result.path == ((3, 3),) * 6
 
@@ -130,48 +139,53 @@ def test_inhibition_of_return_moves_on_to_the_best_unvisited_cell():
     from ipomdp_gaze.policies.baselines import make_baseline
     centre = GRID.center_index
     stuck = Scan([centre])                   # would look at the centre again and again
-    result = search_image(blob_image(), make_fovea(), WEAK, stuck, confidence=0.9,
-                          max_fixations=6, inhibit_return=True)
+    result = search_image(blob_image(), make_fovea(), WEAK, stuck,
+                          image_settings(confidence=0.9, max_fixations=6, inhibit_return=True))
     assert len(set(result.path)) == len(result.path) == 6 and result.stop in ('found', 'budget')
     # The replacement of a visited choice is its nearest unvisited cell (Chebyshev, low index).
     assert result.path[1] == (2, 2)
     elm = make_baseline('elm', GRID, WEAK)
-    scored = search_image(blob_image(), make_fovea(), WEAK, elm, confidence=0.99,
-                          max_fixations=12, inhibit_return=True)
+    scored = search_image(blob_image(), make_fovea(), WEAK, elm,
+                          image_settings(confidence=0.99, max_fixations=12, inhibit_return=True))
     assert len(set(scored.path)) == len(scored.path) and scored.cell == FACE_CELL
 
 
 def test_detector_pixels_count_the_whole_image_window_once():
     fovea = make_fovea()
-    result = search_image(blob_image(), fovea, WEAK, Scan([10, 20, 30, 40]), max_fixations=4)
+    result = search_image(blob_image(), fovea, WEAK, Scan([10, 20, 30, 40]),
+                          image_settings(max_fixations=4))
     detector = fovea.detector
     assert result.detector_pixels == WHOLE_PX + 4 * FOVEA_PX == fovea.image_detector_pixels
     assert detector.calls.count((105, 105)) == 1 and len(detector.calls) == 5
     assert result.seconds > 0 and result.seconds >= fovea.image_seconds
-    again = search_image(blob_image(), fovea, WEAK, Scan([10, 20, 30, 40]), max_fixations=4)
+    again = search_image(blob_image(), fovea, WEAK, Scan([10, 20, 30, 40]),
+                         image_settings(max_fixations=4))
     assert again.detector_pixels == result.detector_pixels        # a new image starts afresh
     reuse = make_fovea(reuse=True)
     looped = search_image(blob_image(), reuse, WEAK, Scan([GRID.center_index]),
-                          max_fixations=3, stop_on_repeat=False)
+                          image_settings(max_fixations=3, stop_on_repeat=False))
     assert looped.detector_pixels == WHOLE_PX + FOVEA_PX
 
 
 def test_start_cell_rng_and_policy_checks():
-    result = search_image(blob_image(), make_fovea(), STRONG, Scan([0]), start_cell=(2, 5))
+    result = search_image(blob_image(), make_fovea(), STRONG, Scan([0]),
+                          image_settings(start_cell=(2, 5)))
     assert result.path == (FACE_CELL,)
-    same = search_image(blob_image(), make_fovea(), STRONG, Scan([0]),
-                        start_cell=GRID.index(*FACE_CELL))
-    assert same.path == result.path
     for bad in ((7, 0), (1.5, 2), 49, -1, 'centre'):
         with pytest.raises(ValueError, match='start'):
-            search_image(blob_image(), make_fovea(), STRONG, Scan([0]), start_cell=bad)
+            search_image(blob_image(), make_fovea(), STRONG, Scan([0]),
+                         image_settings(start_cell=bad))
     with pytest.raises(ValueError, match='outside the 49-cell grid'):
         search_image(blob_image(), make_fovea(), WEAK, Scan([49]))
     for confidence in (0.0, 1.0, float('nan')):
         with pytest.raises(ValueError, match='confidence'):
-            search_image(blob_image(), make_fovea(), WEAK, Scan([0]), confidence=confidence)
-    with pytest.raises(ValueError, match='max_fixations'):
-        search_image(blob_image(), make_fovea(), WEAK, Scan([0]), max_fixations=0)
+            search_image(blob_image(), make_fovea(), WEAK, Scan([0]),
+                         image_settings(confidence=confidence))
+    with pytest.raises(ValueError, match='^search.max_fixations must be an integer >= 0'):
+        search_image(blob_image(), make_fovea(), WEAK, Scan([0]), image_settings(max_fixations=-1))
+    with pytest.raises(ValueError, match='needs a fixation budget'):
+        search_image(blob_image(), make_fovea(), WEAK, Scan([0]),
+                     image_settings(max_fixations=0, stop_on_repeat=False))
 
 
 def test_grid_fovea_and_detector_of_the_model_must_match():
@@ -303,8 +317,8 @@ def test_a_scanning_fovea_updates_once_from_the_scan_then_fixates_the_policys_ch
     model = CountObservation(GRID, np.broadcast_to([0.9, 0.04, 0.03, 0.03], GRID.shape + (4,)),
                              p_null, **scan_tables)
     policy = build_policy('map', GRID, model)
-    result = search_image(blob_image(), fovea, model, policy, confidence=0.999,
-                          max_fixations=5, stop_on_repeat=False, inhibit_return=True)
+    result = search_image(blob_image(), fovea, model, policy,
+                          image_settings(confidence=0.999, max_fixations=5, inhibit_return=True))
     # The scan (7-cell window at 1/2) sees the blob: the first fixation is MAP's, the blob's cell
     # rather than the centre, and the scan's pixels are counted once.
     assert result.path[0] == FACE_CELL and result.cell == FACE_CELL

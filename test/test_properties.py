@@ -20,6 +20,7 @@ from ipomdp_gaze.belief import bayes_update, EvidenceError, uniform_log_belief
 from ipomdp_gaze.fpoc import make_fpoc
 from ipomdp_gaze.gaze import GazeController
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.inhibition import unvisited_choice
 from ipomdp_gaze.observation import check_evidence, gaussian_log_likelihood_ratio as llr
 from ipomdp_gaze.policies.baselines import make_baseline, STRATEGIES
 from ipomdp_gaze.policies.conv import ConvPolicy
@@ -247,5 +248,5 @@ def test_conv_policy_with_any_finite_kernel_chooses_a_valid_cell(grid, action, s
     belief = data.draw(beliefs(grid.n_cells))
     rng = np.random.default_rng(data.draw(st.integers(0, 2 ** 32)))
     assert_cells(policy.select(belief, 0, rng), belief, grid)
-    core = GazeController(grid, make_fpoc('camera'), policy)
-    assert 0 <= core.choose() < grid.n_cells
+    visited = np.zeros(grid.n_cells, dtype=bool)
+    assert 0 <= unvisited_choice(policy, belief[:1], visited, 0, rng, grid) < grid.n_cells

@@ -1,12 +1,15 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """search.repeat_weight: a cell's repeated views of a still scene weighted, vs brute force."""
+from dataclasses import replace
+
 from ipomdp_gaze.belief import bayes_update, uniform_log_belief
 from ipomdp_gaze.fpoc import make_fpoc
 from ipomdp_gaze.gaze import GazeController
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.observation import CountObservation, GaussianObservation
 from ipomdp_gaze.policies.registry import build_policy
+from ipomdp_gaze.session import SearchSettings
 from ipomdp_gaze.still_evidence import cell_information, check_repeat_weight, StillEvidence
 from ipomdp_gaze.stopping import initial_log_belief
 import numpy as np
@@ -58,8 +61,8 @@ def brute_force(model, frames, weight, absent_prior=0.0):
 
 
 def core(model, weight, **kwargs):
-    return GazeController(GRID, model, build_policy('elm', GRID, model), settle_time_s=0.0,
-                          confidence=1 - 1e-12, repeat_weight=weight, **kwargs)
+    return GazeController(GRID, model, build_policy('elm', GRID, model),
+                          SearchSettings(confidence=1 - 1e-12, repeat_weight=weight, **kwargs))
 
 
 @pytest.mark.parametrize('weight', [0.0, 0.3, 1.0])
@@ -130,7 +133,7 @@ def test_motion_turns_it_off_and_a_change_keeps_the_belief():
         frame = rng.integers(0, K, GRID.n_cells).astype(float)
         controller.offer(frame, float(t))
     before = controller.belief
-    controller.set_repeat_weight(0.0)
+    controller.configure(replace(controller.settings, repeat_weight=0.0))
     np.testing.assert_array_equal(controller.belief, before)
     base = np.log(before)
     for t in range(5, 9):
@@ -143,7 +146,7 @@ def test_motion_turns_it_off_and_a_change_keeps_the_belief():
                                / np.exp(log_b - log_b.max()).sum(), rtol=1e-9)
     controller.reset(10.0)
     np.testing.assert_allclose(controller.belief, 1 / GRID.n_cells)
-    assert not controller._still.total.any()
+    assert not controller.session.repeated_evidence.any()
 
 
 def test_gaussian_model_uses_dprime_squared_as_information():
@@ -151,8 +154,8 @@ def test_gaussian_model_uses_dprime_squared_as_information():
     model = GaussianObservation(GRID, fpoc)
     info = cell_information(model.elm_kernel(), GRID, 7)
     np.testing.assert_allclose(info, model.dprime(7) ** 2)
-    controller = GazeController(GRID, fpoc, build_policy('map', GRID, fpoc), settle_time_s=0.0,
-                                confidence=1 - 1e-12, repeat_weight=0.0)
+    controller = GazeController(GRID, fpoc, build_policy('map', GRID, fpoc),
+                                SearchSettings(confidence=1 - 1e-12, repeat_weight=0.0))
     frame = np.random.default_rng(2).standard_normal(GRID.n_cells)
     fixation = controller.fixation
     controller.offer(frame, 1.0)

@@ -142,7 +142,7 @@ def add_scene_args(parser: argparse.ArgumentParser, scenes: str) -> None:
     parser.add_argument('--jump-prob', type=probability_arg, default=None,
                         help='probability per fixation that the target jumps to a uniformly '
                              'random cell instead (default 0)')
-    parser.add_argument('--absent-prior', type=probability_arg, default=None,
+    parser.add_argument('--absent-prior', type=float, default=None,
                         help="the model's prior that no target is in the grid (default 0: "
                              'always there)')
     parser.add_argument('--absent-rate', type=probability_arg, default=None,

@@ -12,8 +12,12 @@ the prediction step and the paired difference).
 """
 from __future__ import annotations
 
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import replace
 import json
+import os
 from pathlib import Path
+import sys
 
 from ipomdp_gaze.evaluation import (decision_summary, fixations_to_90_ci,
                                     paired_difference_ci, paired_tracking_difference,
@@ -22,10 +26,14 @@ from ipomdp_gaze.motion import Motion
 from ipomdp_gaze.observation import as_observation, GaussianObservation
 from ipomdp_gaze.observation_file import fingerprint
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
+from ipomdp_gaze.session import SearchSettings
 from ipomdp_gaze.simulate import draw_present, draw_targets, simulate
+from ipomdp_gaze.vision.scene_eval import (DEFAULT_BUDGET, evaluate_scenes, format_summary,
+                                           results_json, summarise, task_spec, TASKS, write_json)
 import numpy as np
+from tqdm import tqdm
 
-from .common import (add_scene_args, add_task_args, confidence_arg, nonneg_int, positive_int,
+from .common import (add_scene_args, add_task_args, nonneg_int, positive_int,
                      task_from_args)
 
 NO_PREDICTION = ' (no prediction)'
@@ -40,7 +48,16 @@ def add_parser(sub):
                    help='a baseline by name (repeatable)')
     p.add_argument('--policy-file', action='append', default=[], type=Path, metavar='PATH',
                    help='a policy YAML file, keyed by its file stem (repeatable)')
-    p.add_argument('--episodes', type=positive_int, default=20000)
+    p.add_argument('--episodes', type=positive_int, default=None,
+                   help='simulated episodes (default 20000), or scenes with --scenes (default '
+                        '200)')
+    p.add_argument('--scenes', default=None, choices=TASKS,
+                   help='evaluate an image task on held-out scenes through the real detector '
+                        'and sensor (the search session of the nodes and find) instead of '
+                        'simulating: pan-tilt (config/faces_camera_controller.yaml), faces-420 '
+                        "or faces-840 (find's settings); --policy, --policy-file, "
+                        '--confidence, --max-fixations (default 60) and --absent-prior change '
+                        'the shipped configuration')
     p.add_argument('--episodes-greedy', type=positive_int, default=2000,
                    help='episodes for the slow searchers, greedy and switching (policies '
                         'whose class sets costly; default 2000)')
@@ -53,10 +70,10 @@ def add_parser(sub):
                    help='also give each policy minus the first, on the same episodes, with a '
                         'paired bootstrap 95%% interval')
     add_scene_args(p, 'simulated')
-    p.add_argument('--confidence', type=confidence_arg, default=None,
+    p.add_argument('--confidence', type=float, default=None,
                    help='level at which a search decides found or absent (default 0.95)')
-    p.add_argument('--max-fixations', type=positive_int, default=None,
-                   help='fixation budget: undecided searches give up there (default: the '
+    p.add_argument('--max-fixations', type=int, default=None,
+                   help='fixation budget: undecided searches give up there (default and 0: the '
                         'horizon; also the horizon when --horizon is not given)')
     p.add_argument('--compare-prediction', action='store_true',
                    help='moving target: also run each policy without the prediction step and '
@@ -203,7 +220,50 @@ def format_decisions(result: dict) -> str:
     return '\n'.join(lines)
 
 
+def check_settings(args) -> SearchSettings:
+    """Check the search settings given as flags before any work (the session's messages)."""
+    given = {key: value for key, value in (
+        ('confidence', args.confidence), ('absent_prior', args.absent_prior),
+        ('max_fixations', args.max_fixations), ('motion_sigma_cells', args.motion_sigma_cells),
+        ('motion_jump_prob', args.jump_prob)) if value is not None}
+    return SearchSettings(**given)
+
+
+def run_scenes(args) -> int:
+    """``evaluate --scenes TASK``: held-out scenes through the search session (scene_eval)."""
+    if len(args.policy) + len(args.policy_file) > 1:
+        raise ValueError('--scenes evaluates one policy at a time')
+    spec = task_spec(args.scenes, args.policy[0] if args.policy else None,
+                     str(args.policy_file[0]) if args.policy_file else None, seed=args.seed,
+                     max_fixations=DEFAULT_BUDGET if args.max_fixations is None
+                     else args.max_fixations)
+    changes = {key: value for key, value in (('confidence', args.confidence),
+                                             ('absent_prior', args.absent_prior))
+               if value is not None}
+    spec = replace(spec, settings=replace(spec.settings, **changes))
+    episodes = args.episodes or 200
+    bar = tqdm(total=episodes, desc=f'{args.scenes} scenes', unit='scene', file=sys.stderr,
+               disable=None)
+    with ProcessPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
+        results = evaluate_scenes(spec, episodes, pool, progress=lambda done: bar.update(1))
+    bar.close()
+    summary = summarise(results)
+    print(f'{args.scenes}: policy {spec.policy_file or spec.policy}, test scenes {args.seed}..'
+          f'{args.seed + episodes - 1}, settings {spec.settings.to_parameters()}')
+    for line in format_summary(spec, summary):
+        print(line)
+    if args.json:
+        write_json(args.json, results_json(spec, results, summary))
+        print(f'wrote {args.json}')
+    return 0
+
+
 def run(args) -> int:
+    check_settings(args)
+    if args.scenes:
+        return run_scenes(args)
+    args.episodes = args.episodes or 20000
+    args.max_fixations = args.max_fixations or None           # 0: no budget, the horizon
     grid, fpoc = task_from_args(args)
     policies = load_policies(args, grid, fpoc)
     result = evaluate(grid, fpoc, policies, args.episodes, args.horizon, args.seed,

@@ -32,53 +32,38 @@ whose ``observation.name`` is the model's name), else ELM on the model, acting b
 """
 from __future__ import annotations
 
-import argparse
 import json
-import math
 from pathlib import Path
 import sys
 
 import cv2
 from ipomdp_gaze.belief import uniform_log_belief
 from ipomdp_gaze.observation_file import load_observation, shipped_image_models
-from ipomdp_gaze.policies.policy_file import load_policy_spec, shipped_kernels
+from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
-from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, fovea_for_model,
-                                       search_image, size_distance)
+from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, FIND_SETTINGS,
+                                       fovea_for_model, search_image, size_distance)
 import numpy as np
 
-from .common import nonneg_int, positive_int
+from .common import nonneg_int
+from .search_args import add_search_args, settings_from_args
 
-# The operating point, chosen on training scenes (seed 1, 150, never on test scenes): with the
-# one-time scan of faces-420 and inhibition of return, its shipped kernel was right (within one
-# cell) on 0.973 at confidence 0.9 (4.8 fixations) and 0.980 at 0.99 (8.0 fixations).
-CONFIDENCE = 0.99
-MAX_FIXATIONS = 60
 POLICY_CHOICES = tuple(name for name in POLICY_NAMES if name != 'learned')
 READ_FLAGS = cv2.IMREAD_ANYDEPTH | cv2.IMREAD_ANYCOLOR
-
-
-def probability(text: str) -> float:
-    """Parse a number strictly between 0 and 1 for argparse."""
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not 0.0 < value < 1.0:
-        raise argparse.ArgumentTypeError(f'expected a number strictly between 0 and 1, got '
-                                         f'{text!r}')
-    return value
 
 
 def add_parser(sub):
     p = sub.add_parser(
         'find', help='find the face in images with the digital fovea and a count model',
-        description='Search each image with the digital fovea: fixate the grid centre, update '
-                    'the belief with the count model, stop when a cell reaches --confidence, '
-                    'at --max-fixations, or before fixating a cell twice; print one line per '
-                    'image (path, cell and pixel found, probability, fixations, detector '
-                    'pixels, seconds). Images are read with OpenCV (BGR converted to RGB, then '
-                    'grey); 8 bits per channel.')
+        description='Search each image with the digital fovea: scan the whole image once '
+                    "(when the model has scan tables) and fixate the policy's choice on the "
+                    'scanned belief (without a scan: the grid centre), update the belief with '
+                    'the count model, stop when a cell reaches --confidence (found), when no '
+                    'face reaches it (absent, with --absent-prior > 0), at --max-fixations or '
+                    'once every cell was fixated (gave_up); print one line per image (path, '
+                    'cell and pixel found, probability, fixations, detector pixels, seconds, '
+                    'decision). Images are read with OpenCV (BGR converted to RGB, then grey); '
+                    '8 bits per channel.')
     p.add_argument('images', nargs='+', metavar='IMAGE', help='image files (PNG, JPEG, ...)')
     p.add_argument('--observation', default=None, metavar='FILE',
                    help='count model (ipomdp_gaze/observation-v1 file or shipped name); default: '
@@ -89,18 +74,15 @@ def add_parser(sub):
                              'kernel trained on the model, else elm)')
     policy.add_argument('--policy-file', default=None, metavar='FILE',
                         help='a policy YAML file or a shipped kernel name')
-    p.add_argument('--confidence', type=probability, default=CONFIDENCE, metavar='P',
-                   help=f'stop when the most likely cell reaches P (default {CONFIDENCE}, the '
-                        f'operating point chosen on training scenes)')
-    p.add_argument('--max-fixations', type=positive_int, default=MAX_FIXATIONS, metavar='N',
-                   help=f'fixation budget per image (default {MAX_FIXATIONS}); fixations never '
-                        f'repeat a cell (inhibition of return)')
+    add_search_args(p, FIND_SETTINGS, ('confidence', 'max_fixations', 'absent_prior',
+                                       'repeat_weight', 'start'))
     p.add_argument('--plot', type=Path, default=None, metavar='OUT.png',
                    help='draw the image, the numbered fixations and the windows of the last '
                         'one; with several images, OUT-<i>.png for image i (0-based)')
     p.add_argument('--json', type=Path, default=None, metavar='OUT.json',
                    help='write {grid, images: [{path, cell, pixel, probability, fixations, '
-                        'detector_pixels, seconds, stop}]} in input order')
+                        'detector_pixels, seconds, decision, absent_probability, stop}]} in '
+                        'input order')
     p.add_argument('--seed', type=nonneg_int, default=0, metavar='S',
                    help='seed of a sampling policy (image i uses default_rng([S, i]))')
     p.set_defaults(run=run)
@@ -149,18 +131,6 @@ def nearest_model(models: list, image_px: tuple[int, int]):
     sized = [(size_distance(image_px, size), i) for i, model in enumerate(models)
              if (size := calibrated_size(model)) is not None]
     return models[min(sized)[1]] if sized else models[0]
-
-
-def default_policy_file(model) -> str | None:
-    """Return the shipped kernel whose ``observation.name`` is the model's name, or None."""
-    name = model.meta.get('source')
-    if not name:
-        return None
-    for kernel in shipped_kernels():
-        spec = load_policy_spec(kernel)
-        if spec.observation is not None and spec.observation.get('name') == name:
-            return kernel
-    return None
 
 
 def build_find_policy(args, model, warn):
@@ -217,7 +187,7 @@ def format_line(path: str, result) -> str:
     x, y = result.pixel
     line = (f'{path}: cell ({r}, {c}) pixel ({x:.1f}, {y:.1f}) p={result.probability:.3f} '
             f'fixations={result.fixations} detector_pixels={result.detector_pixels} '
-            f'seconds={result.seconds:.4f} stop={result.stop}')
+            f'seconds={result.seconds:.4f} decision={result.decision} stop={result.stop}')
     if not result.size_matches:
         w0, h0 = result.calibrated_px
         w, h = result.image_px
@@ -266,21 +236,22 @@ def prepare(args) -> list:
 
 
 def run(args) -> int:
+    settings_from_args(args, FIND_SETTINGS)             # bad settings: refused before any work
     tasks = prepare(args)
+    settings = [settings_from_args(args, FIND_SETTINGS, task.model.grid) for task in tasks]
     plots = plot_paths(args.plot, len(args.images)) if args.plot else []
     entries = []
     for i, (path, task) in enumerate(zip(args.images, tasks)):
         image = read_image(path)
-        result = search_image(image, task.fovea, task.model, task.policy,
-                              confidence=args.confidence, max_fixations=args.max_fixations,
-                              rng=np.random.default_rng([args.seed, i]),
-                              stop_on_repeat=False, inhibit_return=True)
+        result = search_image(image, task.fovea, task.model, task.policy, settings[i],
+                              rng=np.random.default_rng([args.seed, i]))
         print(format_line(path, result), flush=True)
         entries.append({'path': path, 'cell': list(result.cell),
                         'pixel': [result.pixel[0], result.pixel[1]],
                         'probability': result.probability, 'fixations': result.fixations,
                         'detector_pixels': result.detector_pixels, 'seconds': result.seconds,
-                        'stop': result.stop})
+                        'decision': result.decision,
+                        'absent_probability': result.absent_probability, 'stop': result.stop})
         if plots:
             title = (f'{Path(path).name}: cell {result.cell}, p={result.probability:.3f}, '
                      f'{result.fixations} fixations ({result.stop})')

@@ -5,12 +5,17 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ipomdp_gaze.belief import bayes_update, entropy, map_cell, uniform_log_belief
 from ipomdp_gaze.observation import as_observation
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
+from ipomdp_gaze.sensors import ModelSensor
+from ipomdp_gaze.session import SearchSession, SearchSettings
 import numpy as np
 
-from .common import add_task_args, cell_arg, cell_index, nonneg_int, positive_int, task_from_args
+from .common import add_task_args, cell_arg, cell_index, nonneg_int, task_from_args
+from .search_args import add_search_args, settings_from_args
+
+# The paper's convention: the policy picks every fixation, the first included (design 4.1).
+SEARCH_SETTINGS = SearchSettings(confidence=0.95, start_cell='policy')
 
 
 def add_parser(sub):
@@ -24,45 +29,48 @@ def add_parser(sub):
                    help='a policy YAML file or a shipped kernel name (overrides --policy)')
     p.add_argument('--target', type=cell_arg, default=None, metavar='ROW,COL',
                    help='target cell as ROW,COL or a flat index (default random)')
-    p.add_argument('--confidence', type=float, default=0.95,
-                   help='stop when the most likely cell reaches this probability')
-    p.add_argument('--max-fixations', type=positive_int, default=None)
+    add_search_args(p, SEARCH_SETTINGS, ('confidence',))
+    p.add_argument('--max-fixations', type=nonneg_int, default=None, metavar='N',
+                   help='fixation budget: gave up when it runs out undecided (default 4 N; 0 = '
+                        'no budget)')
     p.add_argument('--seed', type=nonneg_int, default=0)
     p.add_argument('--plot', type=Path, default=None, metavar='PNG',
                    help='save the final belief with the scan path as a picture')
     p.set_defaults(run=run)
 
 
-def run_search(grid, model, policy, target, confidence, max_fixations, seed, out=print):
-    """Search until the MAP probability reaches ``confidence``; return (guess, path, belief)."""
+def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=print):
+    """
+    Run one simulated search on the search session, printing each fixation.
+
+    The model's own sampler is the world (:class:`ipomdp_gaze.sensors.ModelSensor`); one
+    generator, ``default_rng(seed)``, serves the policy and the noise. Returns ``(guess, path,
+    belief)``.
+    """
     rng = np.random.default_rng(seed)
-    log_b = uniform_log_belief(grid.n_cells, 1)
-    belief = np.exp(log_b)
-    targets = np.array([target])
+    session = SearchSession(grid, model, policy, settings)
+    sensor = ModelSensor(grid, model, rng)
+    sensor.start(target)
+    session.reset(seed=rng)
     tr, tc = grid.cell(target)
     out(f'target hidden at cell {target} (row {tr}, col {tc}) of a {grid.rows}x{grid.cols} grid')
-    guess = 0
-    path = []
-    for t in range(max_fixations):
-        k = int(policy.select(belief, t, rng)[0])
-        path.append(k)
-        fixations = np.array([k])
-        frames = model.sample(targets, fixations, rng)
-        bayes_update(log_b, model.log_likelihood_ratio(frames, fixations), out=log_b)
-        np.exp(log_b, out=belief)
-        guess = int(map_cell(belief)[0])
-        kr, kc = grid.cell(k)
+    cell = session.start()
+    while True:
+        result = session.update(sensor.observe(cell))
+        guess = result.map_cell
+        kr, kc = grid.cell(session.path[-1])
         gr, gc = grid.cell(guess)
-        p = belief[0, guess]
-        out(f'fixation {t + 1:3d}: looked at ({kr},{kc})  most likely ({gr},{gc}) '
-            f'p={p:.3f}  entropy={entropy(belief)[0]:.2f} nats  '
+        out(f'fixation {result.fixations:3d}: looked at ({kr},{kc})  most likely ({gr},{gc}) '
+            f'p={result.map_probability:.3f}  entropy={session.entropy_nats:.2f} nats  '
             f"{'right' if guess == target else 'wrong'}")
-        if p >= confidence:
+        if result.ended:
             break
+        cell = result.fixation
     verdict = 'right' if guess == target else 'wrong'
-    out(f'found: the target is most likely at ({grid.cell(guess)[0]},{grid.cell(guess)[1]}) '
-        f'after {t + 1} fixations, which is {verdict}')
-    return guess, path, belief[0]
+    what = 'found' if result.decision == 'found' else 'gave up'
+    out(f'{what}: the target is most likely at ({gr},{gc}) after {result.fixations} fixations, '
+        f'which is {verdict}')
+    return guess, session.path, session.belief
 
 
 def plot_search(grid, belief, path, target, title, out_path):
@@ -96,14 +104,14 @@ def run(args) -> int:
         policy = build_policy('learned', grid, fpoc, file=args.policy_file)
     else:
         policy = build_policy(args.policy, grid, fpoc)
-    if not 0 < args.confidence < 1:
-        raise ValueError(f'--confidence must be between 0 and 1, got {args.confidence}')
+    if args.max_fixations is None:
+        args.max_fixations = 4 * grid.n_cells
+    settings = settings_from_args(args, SEARCH_SETTINGS, grid)
     rng = np.random.default_rng([args.seed, 1])
     target = int(rng.integers(grid.n_cells)) if args.target is None else \
         cell_index(args.target, grid, '--target')
-    max_fix = args.max_fixations or 4 * grid.n_cells
     guess, path, belief = run_search(grid, as_observation(grid, fpoc), policy, target,
-                                     args.confidence, max_fix, args.seed)
+                                     settings, args.seed)
     if args.plot:
         name = args.policy_file or args.policy
         task = f'{fpoc.model} FPOC' if args.observation is None else args.observation

@@ -38,18 +38,16 @@ import sys
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from ipomdp_gaze.belief import EvidenceError
-from ipomdp_gaze.gaze import check_confidence, FrameSequence, GazeController, start_cell
+from ipomdp_gaze.gaze import check_settle_time, FrameSequence, GazeController
 from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.health import HealthMonitor, policy_label
-from ipomdp_gaze.motion import check_probability, check_sigma_cells
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, stamps
 from ipomdp_gaze.observation import GaussianObservation
 from ipomdp_gaze.observation_file import load_observation
 from ipomdp_gaze.policies.baselines import STRATEGIES
 from ipomdp_gaze.policies.conv import ACTIONS, check_kernel
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnavailable
-from ipomdp_gaze.still_evidence import check_repeat_weight
-from ipomdp_gaze.stopping import check_absent_prior, check_max_fixations
+from ipomdp_gaze.session import SearchSettings
 from rclpy.exceptions import NameValidationException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -102,7 +100,7 @@ def controller_params() -> list[Param]:
               '(read-only)', read_only=True, int_range=(1, 1000)),
         Param('confidence', 0.95, T.DOUBLE,
               'found (absent) fires when the most likely cell (no target) reaches this '
-              'probability', float_range=(0.0, 1.0)),
+              'probability, in (0, 1)'),
         Param('motion.sigma_cells', 0.0, T.DOUBLE,
               'the target moves: standard deviation of its random walk in cells per second, '
               '>= 0 (0: a still target)'),
@@ -112,8 +110,7 @@ def controller_params() -> list[Param]:
               'prior that no target is in the grid, in [0, 1) (0: always there); a change '
               'starts a new search'),
         Param('search.max_fixations', 0, T.INTEGER,
-              'fixation budget of a search: gave_up when it runs out undecided (0: none)',
-              int_range=(0, INT_MAX)),
+              'fixation budget of a search: gave_up when it runs out undecided (0: none)'),
         Param('search.inhibit_return', False, T.BOOL,
               'still target: never fixate a cell twice in a search (a deterministic detector '
               'on a still scene repeats its counts; the Bayes step would count them twice)'),
@@ -121,7 +118,7 @@ def controller_params() -> list[Param]:
               'still target: weight of the evidence a cell gets from views other than the one '
               'that saw it at its most informative offset, in [0, 1] (1: every frame counts '
               'fully, naive Bayes; 0: the evidence of each cell once, for overlapping views of a '
-              'still scene and a deterministic detector)', float_range=(0.0, 1.0)),
+              'still scene and a deterministic detector)'),
         Param('policy.name', 'elm', T.STRING, 'fixation policy', choices=POLICY_NAMES),
         Param('policy.file', '', T.STRING,
               'policy YAML path or shipped kernel name; setting it selects learned'),
@@ -162,7 +159,7 @@ class Config:
     observation: object
     policy: object
     head: PanTiltMap
-    start_cell: int
+    settings: SearchSettings
     warning: str = ''
 
     @property
@@ -195,11 +192,8 @@ class GazeControllerNode(Node):
         self._transaction.start(self._startup_config())
         cfg = self._config
         v = cfg.values
-        self.core = GazeController(cfg.grid, cfg.observation, cfg.policy, cfg.start_cell,
-                                   v['settle_time_s'], v['confidence'], v['seed'],
-                                   v['motion.sigma_cells'], v['motion.jump_prob'],
-                                   v['absent.prior'], v['search.max_fixations'],
-                                   v['search.inhibit_return'], v['search.repeat_weight'])
+        self.core = GazeController(cfg.grid, cfg.observation, cfg.policy, cfg.settings,
+                                   v['settle_time_s'], v['seed'])
 
         self._pan_tilt_pub = self.create_publisher(JointState, 'pan_tilt', STATE_QOS)
         self._fixation_pub = self.create_publisher(Int32MultiArray, 'fixation', STATE_QOS)
@@ -266,13 +260,9 @@ class GazeControllerNode(Node):
         else:
             observation = observation_from(values, grid, fpoc)
         head = head_from(values, grid)
-        start = start_cell(grid, *row_col_from(values, grid, 'start_row', 'start_col'))
-        check_confidence(values['confidence'])
-        check_sigma_cells(values['motion.sigma_cells'], 'motion.sigma_cells')
-        check_probability(values['motion.jump_prob'], 'motion.jump_prob')
-        check_absent_prior(values['absent.prior'], 'absent.prior')
-        check_max_fixations(values['search.max_fixations'], 'search.max_fixations')
-        check_repeat_weight(values['search.repeat_weight'], 'search.repeat_weight')
+        row_col_from(values, grid, 'start_row', 'start_col')
+        settings = SearchSettings.from_parameters(values, grid=grid)
+        check_settle_time(values['settle_time_s'])
         for name in ('forward_command_topic', 'trajectory_topic'):
             if values[name]:
                 try:
@@ -289,11 +279,12 @@ class GazeControllerNode(Node):
                                   values['policy.kernel'],
                                   values['policy.file'], values['policy.action'],
                                   warn=warnings.append)
-        return Config(dict(values), grid, fpoc, observation, policy, head, start,
+        return Config(dict(values), grid, fpoc, observation, policy, head, settings,
                       '; '.join(warnings))
 
     def _startup_config(self) -> Config:
         values = self._transaction.values()
+        self._learned_from_file(values)
         try:
             cfg = self._build(values)
         except PolicyUnavailable as exc:
@@ -311,6 +302,25 @@ class GazeControllerNode(Node):
                                    'ignored, frames are detection counts for '
                                    f"{values['observation.file']!r}")
         return cfg
+
+    def _learned_from_file(self, values: dict) -> None:
+        """
+        At start-up, as at run time: a policy.file or policy.kernel alone selects ``learned``.
+
+        Given together with an explicit ``policy.name`` other than ``learned``, the name wins and
+        the log says the file is not used.
+        """
+        given = values['policy.file'] or len(values['policy.kernel'] or [])
+        if not given or values['policy.name'] == 'learned':
+            return
+        if 'policy.name' in self._parameter_overrides:
+            self.get_logger().warning(
+                f"policy.name is {values['policy.name']!r}: policy.file "
+                f"{values['policy.file']!r} / policy.kernel are not used (policy.name: learned "
+                f'uses them)')
+            return
+        values['policy.name'] = 'learned'
+        self.set_parameters([Parameter('policy.name', T.STRING, 'learned')])
 
     def _pre_set(self, params: list[Parameter]) -> list[Parameter]:
         """
@@ -349,13 +359,7 @@ class GazeControllerNode(Node):
         core = self.core
         core.set_observation(cfg.observation)
         core.set_policy(cfg.policy)
-        core.set_start_cell(cfg.start_cell)
-        core.set_settle_time(v['settle_time_s'])
-        core.set_confidence(v['confidence'])
-        core.set_motion(v['motion.sigma_cells'], v['motion.jump_prob'])
-        core.set_max_fixations(v['search.max_fixations'])
-        core.set_inhibit_return(v['search.inhibit_return'])
-        core.set_repeat_weight(v['search.repeat_weight'])
+        core.configure(cfg.settings, v['settle_time_s'])
         if v['seed'] != ov['seed']:
             core.reseed(v['seed'])
         if (v['forward_command_topic'], v['trajectory_topic']) != \
@@ -365,7 +369,6 @@ class GazeControllerNode(Node):
                 (ov['retry_period_s'], ov['diagnostics_period_s']):
             self._make_timers(v)
         if v['absent.prior'] != ov['absent.prior']:
-            core.set_absent_prior(v['absent.prior'])
             return f'policy {cfg.policy_label}; {self._restart()}'
         if cfg.head != old.head and core.enabled and not core.stopped:
             core.retarget(self._now_s())

@@ -24,9 +24,9 @@ from diagnostic_msgs.msg import DiagnosticArray
 from ipomdp_gaze.belief import entropy
 from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, joints
+from ipomdp_gaze.yaml_files import yaml_parameters
 import numpy as np
 from sensor_msgs.msg import Image
-import yaml
 
 from . import NODE_NAMES
 from .config import config_file
@@ -43,27 +43,6 @@ FPOC_OVERRIDES = {
     # The human FPOC is calibrated at 0.42 degrees per cell (docs/design.md section 2).
     'human': {'fpoc.model': 'human', 'grid.spacing_deg': 0.42},
 }
-
-
-def flatten(tree: dict, prefix: str = '') -> dict:
-    """Nested YAML parameters -> dotted names (``{'grid': {'rows': 11}}`` -> ``grid.rows``)."""
-    out = {}
-    for key, value in tree.items():
-        name = f'{prefix}{key}'
-        if isinstance(value, dict):
-            out.update(flatten(value, name + '.'))
-        else:
-            out[name] = value
-    return out
-
-
-def yaml_parameters(path, node_name: str) -> dict:
-    """Read the ``ros__parameters`` of ``node_name`` from a parameter file, dotted names."""
-    tree = yaml.safe_load(Path(path).read_text())
-    try:
-        return flatten(tree[node_name]['ros__parameters'])
-    except (KeyError, TypeError):
-        raise ValueError(f'{path} has no {node_name}: ros__parameters block') from None
 
 
 def _ros_value(value) -> str:

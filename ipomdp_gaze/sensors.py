@@ -1,0 +1,149 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Sensors: what turns a scene and a fixation into a :class:`ipomdp_gaze.session.Frame`.
+
+A sensor states its grid and whether it scans when built; :meth:`Sensor.start` gives it a scene,
+:meth:`Sensor.scan` the one-time scan (None when it has none) and :meth:`Sensor.observe` the frame
+of a fixation. The model's own sampler (:class:`ModelSensor`, the simulator) lives here; the
+fovea over a still image and the pan/tilt view of a scene are in
+:mod:`ipomdp_gaze.vision.sensors`. An offline search of any task is then ``session + sensor +
+scene`` (:func:`run_search`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+import time
+from typing import Protocol
+
+import numpy as np
+
+from .grid import Grid
+from .observation import as_observation
+from .session import Frame, SearchSession
+
+
+class Sensor(Protocol):
+    """Produces the frames of one scene at a time."""
+
+    grid: Grid
+    scans: bool
+
+    def start(self, scene) -> None:
+        """Look at a new scene (a target cell, an image, a panorama)."""
+
+    def scan(self) -> Frame | None:
+        """Return the one-time scan of the scene, or None for a sensor without one."""
+
+    def observe(self, cell: int) -> Frame:
+        """Return the frame of a fixation at ``cell`` (row-major index)."""
+
+
+class ModelSensor:
+    """
+    The world as an observation model says it is: frames drawn from the model's own tables.
+
+    The scene is the target's cell, or None for an empty scene. A fixation's frame draws every
+    cell from ``p_N`` at its offset and the target's cell from ``p_T``
+    (``model.sample``); the scan, for a count model with scan tables, draws every cell from the
+    scan's null table and the target's from its target table (``model.sample_scan``). This is
+    the world's model: a session may assume another one.
+    """
+
+    def __init__(self, grid: Grid, model, rng: np.random.Generator):
+        self.grid = grid
+        self.model = as_observation(grid, model)
+        self.rng = rng
+        self.scans = bool(getattr(self.model, 'has_scan', False))
+        self.target: int | None = None
+
+    def start(self, scene) -> None:
+        """``scene``: the target's cell index, or None (no target)."""
+        if scene is not None:
+            self.grid.cell(int(scene))
+        self.target = None if scene is None else int(scene)
+
+    def scan(self) -> Frame | None:
+        if not self.scans:
+            return None
+        values = self.model.sample_scan(self.target or 0, self.rng,
+                                        present=self.target is not None)
+        return Frame(values, kind='scan')
+
+    def observe(self, cell: int) -> Frame:
+        values = self.model.sample(self.target or 0, int(cell), self.rng,
+                                   present=self.target is not None)
+        return Frame(values)
+
+
+@dataclass(frozen=True)
+class SearchOutcome:
+    """
+    One offline search: what it decided, where it looked and what it cost.
+
+    ``decision`` is ``found``, ``absent`` or ``gave_up`` (``reason`` ``budget`` or ``repeat``),
+    or '' when the driver's frame limit stopped it first; ``cell`` the most likely cell then,
+    ``path`` the fixated cells, ``detector_pixels`` and ``seconds`` the sensor's cost plus, for
+    ``seconds``, the session's (wall time from start to answer).
+    """
+
+    decision: str
+    reason: str
+    cell: int
+    probability: float
+    absent_probability: float
+    fixations: int
+    path: tuple
+    detector_pixels: int
+    seconds: float
+    belief: np.ndarray
+    log: tuple
+
+
+def run_search(session: SearchSession, sensor: Sensor, scene, *, seed=None,
+               limit: int | None = None) -> SearchOutcome:
+    """
+    Search one scene: reset, scan once (if the sensor and model have one), fixate until the end.
+
+    ``limit`` caps the frames when the settings have no budget (an offline search must end).
+
+    Raises
+    ------
+    ValueError
+        Without a budget, ``stop_on_repeat`` or ``limit``; for a frame the session rejects.
+
+    """
+    settings = session.settings
+    if not (settings.max_fixations or settings.stop_on_repeat or limit):
+        raise ValueError('an offline search needs a fixation budget (search.max_fixations) '
+                         'or a frame limit')
+    if sensor.grid.shape != session.grid.shape:
+        raise ValueError(f'the sensor observes a {sensor.grid.rows}x{sensor.grid.cols} grid, '
+                         f'the session searches {session.grid.rows}x{session.grid.cols}')
+    t0 = time.perf_counter()
+    pixels = 0
+    sensor.start(scene)
+    session.reset(seed=seed)
+    if sensor.scans and settings.scan:
+        frame = sensor.scan()
+        pixels += frame.detector_pixels
+        _check(session.scan(frame))
+    cell = session.start()
+    while limit is None or session.fixations < limit:
+        frame = sensor.observe(cell)
+        pixels += frame.detector_pixels
+        result = _check(session.update(frame))
+        if result.ended:
+            break
+        cell = result.fixation
+    best = session.map_cell
+    return SearchOutcome(session.decision, session.gave_up_reason, best,
+                         session.map_probability, session.absent_probability,
+                         session.fixations, session.path, int(pixels),
+                         time.perf_counter() - t0, session.belief, session.log)
+
+
+def _check(result):
+    if not result.applied:
+        raise ValueError(f'the sensor produced a frame the session refused: {result.reason}')
+    return result

@@ -1,0 +1,662 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The one search engine: a search session that every driver runs (docs/design.md section 10).
+
+A search is a short sequence of pure steps on one belief over the N cells (plus, with
+``absent_prior > 0``, the hypothesis "no target in the grid"):
+
+1. :meth:`SearchSession.reset` -- the prior: ``(1 - absent_prior) / N`` per cell and
+   ``absent_prior`` on the absent hypothesis (:func:`ipomdp_gaze.stopping.initial_log_belief`);
+2. :meth:`SearchSession.scan` -- optional, once, before the first fixation: the one-time scan of
+   a model with scan tables, ``log B_i += log s_T(c_i) - log s_N(c_i)``;
+3. :meth:`SearchSession.start` -- the first fixation: ``settings.start_cell``, or by default
+   the policy's choice on the scanned belief after a scan and the grid's centre without one
+   (docs/design.md section 4.2);
+4. :meth:`SearchSession.update` with each frame taken at the current fixation: predict the belief
+   over ``dt_s`` seconds (a moving target, :mod:`ipomdp_gaze.motion`), the Bayes step
+   ``log B_i += log p_T(o_i | offset_ik) - log p_N(o_i | offset_ik)`` (or, for a still scene with
+   ``repeat_weight < 1``, the still-scene evidence of :mod:`ipomdp_gaze.still_evidence`), then
+   the stop rules (:func:`ipomdp_gaze.stopping.decide`): ``found``, ``absent`` (terminated: the
+   evidence decided), ``gave_up`` (truncated: the budget, or every cell seen with
+   ``stop_on_repeat``); if the search goes on, the policy chooses the next fixation.
+
+The session holds the model it *assumes*; a sensor (:mod:`ipomdp_gaze.sensors`) produces the
+frames from the world, which may follow another model. The session imports no ROS, reads no
+clock (times arrive as ``dt_s``), prints nothing and writes nothing: drivers (the
+``gaze_controller`` node through :class:`ipomdp_gaze.gaze.GazeController`, ``ipomdp-gaze find``,
+``search``, the offline evaluation and the Gymnasium environment) build settings, a sensor and a
+session, then loop. Its per-search event log (:attr:`SearchSession.log`) is what drivers save.
+"""
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field, fields, replace
+import operator
+from typing import Mapping
+
+import numpy as np
+
+from .belief import bayes_update, entropy, EvidenceError, map_cell
+from .grid import Grid
+from .inhibition import policy_choice, unvisited_choice
+from .motion import check_probability, check_sigma_cells, Motion
+from .observation import as_observation, check_evidence, CountObservation
+from .still_evidence import cell_information, check_repeat_weight, StillEvidence
+from .stopping import (ABSENT, check_absent_prior, check_budget, check_confidence, decide, FOUND,
+                       initial_log_belief, with_absent)
+
+# Decisions a search can end with; '' while undecided.
+DECISIONS = ('found', 'absent', 'gave_up')
+# Why a search gave up: the fixation budget, or (stop_on_repeat) the next fixation would repeat
+# a cell (NMPT's rule; with inhibition of return: every cell has been fixated).
+GAVE_UP_REASONS = ('budget', 'repeat')
+# The parameter (node, YAML) name of each setting: the name every refusal message uses.
+PARAMETER_NAMES = {
+    'confidence': 'confidence',
+    'max_fixations': 'search.max_fixations',
+    'inhibit_return': 'search.inhibit_return',
+    'stop_on_repeat': 'search.stop_on_repeat',
+    'repeat_weight': 'search.repeat_weight',
+    'absent_prior': 'absent.prior',
+    'motion_sigma_cells': 'motion.sigma_cells',
+    'motion_jump_prob': 'motion.jump_prob',
+    'start_cell': 'start_cell',
+    'scan': 'search.scan',
+}
+
+
+def _check_flag(value, name: str) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f'{name} must be true or false, got {value!r}')
+    return bool(value)
+
+
+def _check_start(value, name: str = 'start_cell'):
+    if value is None or (isinstance(value, str) and value == 'policy'):
+        return value
+    try:
+        row, col = (operator.index(v) for v in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be (row, col) integers, 'policy' or none (the "
+                         f'default), got {value!r}') from None
+    if row < 0 or col < 0:
+        raise ValueError(f'{name} must be (row, col) with row, col >= 0, got {value!r}')
+    return (int(row), int(col))
+
+
+@dataclass(frozen=True)
+class SearchSettings:
+    """
+    How a search decides and stops, checked once here (the same message from every driver).
+
+    Attributes
+    ----------
+    confidence : float
+        ``found`` (``absent``) when the most likely cell (``P(absent)``) reaches it; in (0, 1).
+    max_fixations : int
+        Fixation budget: ``gave_up`` when it runs out undecided; 0 means no budget.
+    inhibit_return : bool
+        Still target: never fixate a cell twice in a search (the policy's best unvisited cell).
+    stop_on_repeat : bool
+        Give up (reason ``repeat``) instead of fixating a cell a second time (NMPT's rule); with
+        ``inhibit_return`` that is when every cell has been fixated. Off: with inhibition of
+        return every cell is open again once all were fixated.
+    repeat_weight : float
+        Still target: weight in [0, 1] of a cell's evidence from views other than its most
+        informative one (1: naive Bayes; :mod:`ipomdp_gaze.still_evidence`).
+    absent_prior : float
+        Prior of "no target in the grid", in [0, 1) (0: no absent hypothesis).
+    motion_sigma_cells, motion_jump_prob : float
+        The target's random walk per unit of ``dt_s`` (per second on the robot, per fixation in
+        simulation); both 0 for a still target.
+    start_cell : (int, int), 'policy' or None
+        First fixation ``(row, col)``; ``'policy'``: the policy's choice on the prior (the
+        paper's measurement convention, docs/design.md section 4.1); None: the policy's choice
+        after a scan, else the grid's centre (the robot's convention, section 4.2).
+    scan : bool
+        Apply the one-time scan when the sensor and the model have one.
+
+    """
+
+    confidence: float = 0.95
+    max_fixations: int = 0
+    inhibit_return: bool = False
+    stop_on_repeat: bool = False
+    repeat_weight: float = 1.0
+    absent_prior: float = 0.0
+    motion_sigma_cells: float = 0.0
+    motion_jump_prob: float = 0.0
+    start_cell: tuple | None = None
+    scan: bool = True
+
+    def __post_init__(self):
+        names = PARAMETER_NAMES
+        checked = {
+            'confidence': check_confidence(self.confidence, names['confidence']),
+            'max_fixations': check_budget(self.max_fixations, names['max_fixations']),
+            'inhibit_return': _check_flag(self.inhibit_return, names['inhibit_return']),
+            'stop_on_repeat': _check_flag(self.stop_on_repeat, names['stop_on_repeat']),
+            'repeat_weight': check_repeat_weight(self.repeat_weight, names['repeat_weight']),
+            'absent_prior': check_absent_prior(self.absent_prior, names['absent_prior']),
+            'motion_sigma_cells': check_sigma_cells(self.motion_sigma_cells,
+                                                    names['motion_sigma_cells']),
+            'motion_jump_prob': check_probability(self.motion_jump_prob,
+                                                  names['motion_jump_prob']),
+            'start_cell': _check_start(self.start_cell, names['start_cell']),
+            'scan': _check_flag(self.scan, names['scan']),
+        }
+        for key, value in checked.items():
+            object.__setattr__(self, key, value)
+
+    @property
+    def moving(self) -> bool:
+        """Whether the target is modelled as moving."""
+        return self.motion_sigma_cells > 0 or self.motion_jump_prob > 0
+
+    def check_grid(self, grid: Grid) -> None:
+        """Refuse a start cell outside ``grid`` (ValueError naming both)."""
+        if isinstance(self.start_cell, tuple):
+            row, col = self.start_cell
+            if row >= grid.rows or col >= grid.cols:
+                raise ValueError(f'start cell ({row}, {col}) is outside a {grid.rows}x'
+                                 f'{grid.cols} grid')
+
+    def to_parameters(self) -> dict:
+        """Return the settings under their parameter names, as YAML files and event logs."""
+        out = {PARAMETER_NAMES[f.name]: getattr(self, f.name) for f in fields(self)}
+        if isinstance(self.start_cell, tuple):
+            out['start_cell'] = list(self.start_cell)
+        return out
+
+    @classmethod
+    def from_parameters(cls, values: Mapping, base: SearchSettings | None = None,
+                        grid: Grid | None = None) -> SearchSettings:
+        """
+        Build settings from parameter names (node parameters, a YAML block, CLI flags).
+
+        Unknown names are ignored (a node has many other parameters). ``start_row`` and
+        ``start_col`` give ``start_cell`` as the node declares it: -1 is the centre's row
+        (column) of ``grid``, both -1 the default rule. With ``grid`` the start cell is checked
+        against it.
+        """
+        changes = {}
+        for key, name in PARAMETER_NAMES.items():
+            if name in values:
+                changes[key] = values[name]
+        if 'start_row' in values or 'start_col' in values:
+            row, col = values.get('start_row', -1), values.get('start_col', -1)
+            if row == -1 and col == -1:
+                changes['start_cell'] = None
+            elif grid is None:
+                raise ValueError('start_row / start_col of -1 (the centre) need the grid')
+            else:
+                centre_row, centre_col = grid.cell(grid.center_index)
+                changes['start_cell'] = (centre_row if row == -1 else row,
+                                         centre_col if col == -1 else col)
+        settings = replace(base or cls(), **changes)
+        if grid is not None:
+            settings.check_grid(grid)
+        return settings
+
+
+def start_index(grid: Grid, settings: SearchSettings) -> int | None:
+    """Return the cell index of ``settings.start_cell`` on ``grid``, or None (the default rule)."""
+    settings.check_grid(grid)
+    if not isinstance(settings.start_cell, tuple):
+        return None
+    return grid.index(*settings.start_cell)
+
+
+@dataclass(frozen=True)
+class Frame:
+    """
+    One observation of the whole grid.
+
+    ``values`` holds one number per cell, row-major (N,): a standardised response for the
+    Gaussian model, a detection count for a count model; NaN means not observed. ``kind`` is
+    ``'fixation'`` (taken at the session's current fixation) or ``'scan'`` (the one-time scan).
+    ``detector_pixels`` and ``seconds`` are what producing it cost; ``detections`` any boxes
+    the sensor wants drivers to draw or record.
+    """
+
+    values: np.ndarray
+    kind: str = 'fixation'
+    detector_pixels: int = 0
+    seconds: float = 0.0
+    detections: tuple = ()
+
+    def summary(self) -> dict:
+        """Return what the event log keeps of a frame: cells observed, sum and peak, cost."""
+        values = np.asarray(self.values, dtype=float)
+        seen = ~np.isnan(values)
+        return {'kind': self.kind, 'observed_cells': int(seen.sum()),
+                'sum': float(values[seen].sum()) if seen.any() else 0.0,
+                'peak': float(values[seen].max()) if seen.any() else None,
+                'detector_pixels': int(self.detector_pixels)}
+
+
+@dataclass(frozen=True)
+class StepResult:
+    """
+    What one frame did (as Gymnasium's ``step``: terminated and truncated kept apart).
+
+    ``status`` is ``'applied'`` or ``'rejected'`` (``reason`` says why; the belief is then
+    unchanged). ``decision`` is ``found`` / ``absent`` (``terminated``: the evidence decided),
+    ``gave_up`` (``truncated``: a limit, ``reason`` ``budget`` or ``repeat``) or ``''``;
+    ``fired`` names the decision first reached by this frame ('' if none: with motion on a
+    decision can be reported, lost and reached again). ``fixation`` is the next fixation, None
+    once the search has ended.
+    """
+
+    status: str
+    fixations: int
+    map_cell: int
+    map_probability: float
+    absent_probability: float
+    reason: str = ''
+    decision: str = ''
+    fired: str = ''
+    fixation: int | None = None
+    ended: bool = False
+
+    @property
+    def applied(self) -> bool:
+        """Whether the frame updated the belief."""
+        return self.status == 'applied'
+
+    @property
+    def terminated(self) -> bool:
+        """Whether the evidence decided (``found`` or ``absent``) and the search ended."""
+        return self.ended and self.decision in ('found', 'absent')
+
+    @property
+    def truncated(self) -> bool:
+        """Whether a limit ended the search undecided (``gave_up``)."""
+        return self.ended and self.decision == 'gave_up'
+
+
+class OrderError(RuntimeError):
+    """A session step called out of order (update before start, a scan after a fixation)."""
+
+
+@dataclass
+class _Search:
+    """Per-search state of a session (replaced whole by :meth:`SearchSession.reset`)."""
+
+    log_belief: np.ndarray
+    still_base: np.ndarray
+    visited: np.ndarray
+    fixation: int | None = None
+    fixations: int = 0
+    scanned: bool = False
+    decision: str = ''
+    reason: str = ''
+    ended: bool = False
+    decided_once: bool = False
+    path: list = field(default_factory=list)
+
+
+class SearchSession:
+    """
+    One search at a time on one grid, with an assumed observation model and a policy.
+
+    Parameters
+    ----------
+    grid : Grid
+        The visual array.
+    observation
+        The observation model the searcher assumes (:mod:`ipomdp_gaze.observation`) or an FPOC.
+    policy
+        Anything with ``select(belief (1, N), t, rng)``; with ``scores(belief)`` inhibition of
+        return masks the scores. None: the driver chooses every fixation itself
+        (:meth:`fixate`, as a Gymnasium agent does); the session then never chooses.
+    settings : SearchSettings
+        Checked already; the start cell is checked against ``grid`` here.
+    log_size : int
+        Events kept in :attr:`log` (the newest); a tracking search never ends.
+
+    """
+
+    def __init__(self, grid: Grid, observation, policy, settings: SearchSettings | None = None,
+                 log_size: int = 10_000):
+        self.grid = grid
+        self.observation = as_observation(grid, observation)
+        self.policy = policy
+        self.settings = settings or SearchSettings()
+        self.settings.check_grid(grid)
+        self.motion = Motion(grid, self.settings.motion_sigma_cells,
+                             self.settings.motion_jump_prob)
+        self._kernel = None
+        self._still = StillEvidence(grid.n_cells)
+        self._log = deque(maxlen=int(log_size))
+        self.rng = np.random.default_rng(0)
+        self._search = None
+        self._counts = isinstance(self.observation, CountObservation)
+
+    # -- configuration -------------------------------------------------------------------
+    def configure(self, settings: SearchSettings) -> None:
+        """
+        Use new settings from the next frame on, keeping the belief of the search under way.
+
+        A new ``absent_prior`` applies from the next :meth:`reset`; a change of
+        ``repeat_weight`` or of motion on/off counts the still scene's evidence afresh from the
+        belief now.
+        """
+        settings.check_grid(self.grid)
+        old = self.settings
+        self.settings = settings
+        self.motion = Motion(self.grid, settings.motion_sigma_cells, settings.motion_jump_prob)
+        if self._search is not None and (settings.repeat_weight != old.repeat_weight
+                                         or settings.moving != old.moving):
+            self._still.reset()
+            self._search.still_base = self._search.log_belief.copy()
+
+    def set_observation(self, observation) -> None:
+        """Assume another observation model (or FPOC) from the next frame on."""
+        self.observation = as_observation(self.grid, observation)
+        self._counts = isinstance(self.observation, CountObservation)
+        self._kernel = None
+
+    def set_policy(self, policy) -> None:
+        """Choose with another policy from the next choice on."""
+        self.policy = policy
+
+    # -- read-only views -----------------------------------------------------------------
+    def _state(self) -> _Search:
+        if self._search is None:
+            raise OrderError('reset the session before using it')
+        return self._search
+
+    @property
+    def log_belief(self) -> np.ndarray:
+        """Log probabilities, (N,) or (N + 1,) with the absent hypothesis last; a copy."""
+        return self._state().log_belief.copy()
+
+    @property
+    def belief(self) -> np.ndarray:
+        """Cell probabilities ``B_i`` (N,), a copy; they sum to ``1 - P(absent)``."""
+        return np.exp(self._state().log_belief[:self.grid.n_cells])
+
+    @property
+    def absent_probability(self) -> float:
+        """``P(absent)``: 0 without the absent hypothesis."""
+        log_b = self._state().log_belief
+        return float(np.exp(log_b[-1])) if log_b.size > self.grid.n_cells else 0.0
+
+    @property
+    def map_cell(self) -> int:
+        """Return the most likely cell (ties to the lowest index)."""
+        return int(map_cell(self.belief))
+
+    @property
+    def map_probability(self) -> float:
+        """Probability of the most likely cell."""
+        return float(self.belief[self.map_cell])
+
+    @property
+    def entropy_nats(self) -> float:
+        """Entropy of the belief over all its hypotheses, in nats."""
+        return float(entropy(np.exp(self._state().log_belief)))
+
+    @property
+    def fixation(self) -> int | None:
+        """Return the current fixation; None before :meth:`start`."""
+        return self._state().fixation
+
+    @property
+    def visited(self) -> np.ndarray:
+        """Cells fixated in this search since inhibition of return last reopened them."""
+        return self._state().visited.copy()
+
+    @property
+    def repeated_evidence(self) -> np.ndarray:
+        """Per cell, the still-scene evidence beyond its most informative view (N,)."""
+        return self._still.total - self._still.kept
+
+    @property
+    def fixations(self) -> int:
+        """Frames applied in this search."""
+        return self._state().fixations
+
+    @property
+    def path(self) -> tuple:
+        """Return the fixations whose frames were applied, in order."""
+        return tuple(self._state().path)
+
+    @property
+    def decision(self) -> str:
+        """Return found, absent, gave_up or ''; with motion, the tracker's state."""
+        return self._state().decision
+
+    @property
+    def gave_up_reason(self) -> str:
+        """``'budget'`` or ``'repeat'`` after ``gave_up``, else ``''``."""
+        return self._state().reason
+
+    @property
+    def ended(self) -> bool:
+        """Return whether the search has ended: no more frames until :meth:`reset`."""
+        return self._state().ended
+
+    @property
+    def log(self) -> tuple:
+        """Return the events, oldest first: dicts, the newest ``log_size`` of them."""
+        return tuple(self._log)
+
+    # -- the steps -----------------------------------------------------------------------
+    def check_frame(self, values) -> np.ndarray:
+        """
+        Return a frame's values as floats (N,), or raise :class:`EvidenceError` with the reason.
+
+        Refused: a wrong length, +/-inf, and for a count model a negative or fractional count.
+        NaN is allowed (not observed).
+        """
+        obs = check_evidence(values, self.grid.n_cells)
+        if self._counts:
+            self.observation.counts(obs)
+        return obs
+
+    def reset(self, *, seed=None) -> None:
+        """
+        Start a new search from the prior.
+
+        A ``seed`` (an int, or a Generator to use as it is) restarts the policy's random
+        stream, which otherwise runs on.
+
+        The prior is ``(1 - absent_prior) / N`` per cell and ``absent_prior`` on the absent
+        hypothesis (none when it is 0).
+        """
+        if isinstance(seed, np.random.Generator):
+            self.rng = seed
+        elif seed is not None:
+            self.rng = np.random.default_rng(seed)
+        log_b = initial_log_belief(self.grid.n_cells, self.settings.absent_prior)
+        self._still.reset()
+        self._search = _Search(log_b, log_b.copy(), np.zeros(self.grid.n_cells, dtype=bool))
+        self._event('reset', settings=self.settings.to_parameters())
+
+    def scan(self, frame: Frame) -> StepResult:
+        """
+        Apply the one-time scan, before the first fixation is chosen (at most once a search).
+
+        ``log B_i += log s_T(c_i) - log s_N(c_i)`` with the model's scan tables. Skipped
+        (status ``applied``, reason ``scan off``) with ``settings.scan`` false.
+
+        Raises
+        ------
+        OrderError
+            After :meth:`start` or a second time.
+        ValueError
+            If the model has no scan tables.
+
+        """
+        search = self._state()
+        if search.fixation is not None or search.scanned:
+            raise OrderError('the one-time scan comes once, before the first fixation')
+        if not self.settings.scan:
+            return self._result('applied', reason='scan off')
+        try:
+            obs = check_evidence(frame.values, self.grid.n_cells)
+            term = self.observation.scan_log_likelihood_ratio(obs)
+        except EvidenceError as exc:
+            return self._result('rejected', reason=str(exc))
+        search.scanned = True
+        bayes_update(search.log_belief, with_absent(term, search.log_belief),
+                     out=search.log_belief)
+        search.still_base = search.log_belief.copy()
+        self._event('scan', frame=frame.summary(), belief=self._belief_summary())
+        return self._result('applied')
+
+    def start(self) -> int:
+        """
+        Choose the first fixation and return it.
+
+        ``settings.start_cell`` if it is a cell; the policy's choice (its best unvisited cell
+        with inhibition of return) on the belief if it is ``'policy'`` or after a scan;
+        otherwise the grid's centre.
+        """
+        search = self._state()
+        if search.fixation is not None:
+            raise OrderError('the search has started already; reset starts a new one')
+        fixed = start_index(self.grid, self.settings)
+        if fixed is not None:
+            search.fixation = fixed
+        elif search.scanned or self.settings.start_cell == 'policy':
+            search.fixation = self._choose()
+        else:
+            search.fixation = self.grid.center_index
+        self._event('start', fixation=self._rc(search.fixation))
+        return search.fixation
+
+    def fixate(self, cell: int) -> None:
+        """
+        Take the next frame at ``cell`` instead of the policy's choice.
+
+        For a driver that follows fixations made elsewhere (a recording, a head that could not
+        reach the chosen cell, a test).
+        """
+        search = self._state()
+        if search.fixation is None:
+            raise OrderError('start the search before fixating')
+        self.grid.cell(int(cell))
+        search.fixation = int(cell)
+
+    def predict(self, dt_s: float) -> None:
+        """Spread the belief over ``dt_s`` of the target's motion (nothing for a still target)."""
+        if self.motion.active and dt_s > 0:
+            self.motion.over(dt_s).predict_log(self._state().log_belief)
+
+    def update(self, frame: Frame, dt_s: float = 0.0) -> StepResult:
+        """
+        Apply a frame taken at the current fixation; decide; choose the next fixation.
+
+        Validate (a frame of the wrong length, with +/-inf, or, for a count model, a negative or
+        fractional count is rejected and the belief unchanged), predict over ``dt_s`` (motion),
+        the Bayes step (or the still-scene evidence), the stop rules, the next choice.
+
+        Raises
+        ------
+        OrderError
+            Before :meth:`start`, or after the search has ended.
+
+        """
+        search = self._state()
+        if search.fixation is None:
+            raise OrderError('start the search (the first fixation) before updating it')
+        if search.ended:
+            raise OrderError(f'the search has ended ({search.decision}); reset starts a new one')
+        try:
+            obs = self.check_frame(frame.values)
+            term = self.observation.log_likelihood_ratio(obs, search.fixation)
+        except EvidenceError as exc:
+            return self._result('rejected', reason=str(exc))
+        self.predict(dt_s)
+        if self.settings.repeat_weight < 1.0 and not self.motion.active:
+            bayes_update(search.still_base,
+                         with_absent(self._still_term(obs, term), search.log_belief),
+                         out=search.log_belief)
+        else:
+            bayes_update(search.log_belief, with_absent(term, search.log_belief),
+                         out=search.log_belief)
+        search.fixations += 1
+        search.path.append(search.fixation)
+        search.visited[search.fixation] = True
+        fired = self._decide()
+        if not search.ended:
+            following = self._choose()
+            if following is None:
+                search.decision, search.reason, search.ended = 'gave_up', 'repeat', True
+                fired = 'gave_up'
+            else:
+                search.fixation = following
+        self._event('frame', fixation=self._rc(search.path[-1]), frame=frame.summary(),
+                    belief=self._belief_summary(), decision=search.decision,
+                    fired=fired, reason=search.reason)
+        return self._result('applied', fired=fired)
+
+    # -- inside ------------------------------------------------------------------------------
+    def _still_term(self, obs: np.ndarray, term: np.ndarray) -> np.ndarray:
+        if self._kernel is None:
+            self._kernel = np.asarray(self.observation.elm_kernel(), dtype=float)
+        information = cell_information(self._kernel, self.grid, self._search.fixation)
+        self._still.add(term, np.where(np.isnan(obs), 0.0, information))
+        return self._still.log_likelihood_ratio(self.settings.repeat_weight)
+
+    def _decide(self) -> str:
+        """Run the stop rules after an applied frame; return the decision it fired ('')."""
+        search, settings = self._search, self.settings
+        belief = self.belief
+        peak, absent = float(belief.max()), self.absent_probability
+        code = int(decide(peak, absent, settings.confidence))
+        decision = {FOUND: 'found', ABSENT: 'absent'}.get(code, '')
+        fired = ''
+        if self.motion.active:
+            fired = decision if decision and decision != search.decision else ''
+            search.decision = decision
+        elif decision:
+            search.decision, search.ended, fired = decision, True, decision
+        search.decided_once = search.decided_once or bool(fired)
+        if not search.decided_once and settings.max_fixations \
+                and search.fixations >= settings.max_fixations:
+            search.decision, search.reason, search.ended = 'gave_up', 'budget', True
+            fired = 'gave_up'
+        return fired
+
+    def _choose(self) -> int | None:
+        """Return the policy's next fixation; None when ``stop_on_repeat`` forbids every choice."""
+        search, settings = self._search, self.settings
+        if self.policy is None:
+            return search.fixation
+        belief = self.belief[None, :]
+        if settings.inhibit_return and not self.motion.active:
+            if search.visited.all():
+                if settings.stop_on_repeat:
+                    return None
+                search.visited[:] = False
+            return unvisited_choice(self.policy, belief, search.visited, search.fixations,
+                                    self.rng, self.grid)
+        choice = policy_choice(self.policy.select(belief, search.fixations, self.rng),
+                               self.grid.n_cells)
+        if settings.stop_on_repeat and search.visited[choice]:
+            return None
+        return choice
+
+    def _rc(self, cell: int) -> list:
+        return [int(v) for v in self.grid.cell(int(cell))]
+
+    def _belief_summary(self) -> dict:
+        cell = self.map_cell
+        return {'map_cell': self._rc(cell), 'map_probability': self.map_probability,
+                'absent_probability': self.absent_probability,
+                'entropy_nats': self.entropy_nats}
+
+    def _event(self, kind: str, **data) -> None:
+        self._log.append({'event': kind, **data})
+
+    def _result(self, status: str, reason: str = '', fired: str = '') -> StepResult:
+        search = self._search
+        cell = self.map_cell
+        return StepResult(status, search.fixations, cell, float(self.belief[cell]),
+                          self.absent_probability, reason or search.reason, search.decision,
+                          fired, None if search.ended else search.fixation, search.ended)

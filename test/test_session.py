@@ -1,0 +1,350 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The search session (ipomdp_gaze.session) and its sensors, against brute force and each driver.
+
+The belief after a scan and frames is the brute-force posterior (every hypothesis's likelihood
+multiplied out, the absent hypothesis included); a repeat weight below 1 counts each cell's
+views beyond its most informative one at that weight, recomputed here with plain loops; the
+stop rules, the call order and every refused setting are checked; and the same frames give the
+same fixations and decisions through find's driver and through the controller's.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+import itertools
+import math
+
+from ipomdp_gaze.gaze import GazeController
+from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.observation import CountObservation
+from ipomdp_gaze.policies.registry import build_policy
+from ipomdp_gaze.sensors import ModelSensor, run_search
+from ipomdp_gaze.session import (Frame, OrderError, SearchSession, SearchSettings, start_index)
+from ipomdp_gaze.still_evidence import cell_information
+import numpy as np
+import pytest
+
+GRID = Grid(3, 4, 1.0)          # not square, an even side
+K = 4
+
+
+def count_model(seed=0, scan=True) -> CountObservation:
+    """Random count tables on GRID (target tables favour higher counts near the fixation)."""
+    rng = np.random.default_rng(seed)
+    shape = GRID.shape + (K,)
+    p_null = rng.dirichlet([6.0, 2.0, 1.0, 1.0], size=GRID.shape)
+    p_target = rng.dirichlet([1.0, 1.0, 2.0, 3.0], size=GRID.shape)
+    scan_tables = {}
+    if scan:
+        scan_tables = {'scan_target': rng.dirichlet([1.0, 1.0, 2.0, 3.0]),
+                       'scan_null': rng.dirichlet([6.0, 2.0, 1.0, 1.0])}
+    return CountObservation(GRID, p_target.reshape(shape), p_null.reshape(shape),
+                            **scan_tables)
+
+
+def brute_force_log_posterior(model, scan, frames, absent_prior):
+    """Return log P(h | scan, frames) for each cell h, then absent: likelihoods multiplied out."""
+    n = GRID.n_cells
+    hypotheses = list(range(n)) + ([None] if absent_prior > 0 else [])
+    out = []
+    for h in hypotheses:
+        prior = absent_prior if h is None else (1 - absent_prior) / n
+        log_p = math.log(prior)
+        for i in range(n):
+            if scan is not None:
+                table = model.scan_target if i == h else model.scan_null
+                log_p += math.log(table[int(scan[i])])
+            for fixation, frame in frames:
+                fr, fc = GRID.cell(fixation)
+                r, c = GRID.cell(i)
+                table = model.p_target if i == h else model.p_null
+                log_p += math.log(table[abs(r - fr), abs(c - fc), int(frame[i])])
+        out.append(log_p)
+    out = np.array(out)
+    return out - np.logaddexp.reduce(out)
+
+
+def weighted_log_posterior(model, scan, frames, absent_prior, weight):
+    """Return the repeat-weighted posterior, by loops: per cell, best view + weight * the rest."""
+    n = GRID.n_cells
+    kernel = model.elm_kernel()
+    log_b = np.full(n, math.log((1 - absent_prior) / n))
+    if absent_prior > 0:
+        log_b = np.append(log_b, math.log(absent_prior))
+    if scan is not None:
+        for i in range(n):
+            log_b[i] += math.log(model.scan_target[int(scan[i])]) - \
+                math.log(model.scan_null[int(scan[i])])
+    for i in range(n):
+        terms, infos = [], []
+        for fixation, frame in frames:
+            fr, fc = GRID.cell(fixation)
+            r, c = GRID.cell(i)
+            dr, dc = abs(r - fr), abs(c - fc)
+            count = int(frame[i])
+            terms.append(math.log(model.p_target[dr, dc, count])
+                         - math.log(model.p_null[dr, dc, count]))
+            infos.append(cell_information(kernel, GRID, fixation)[i])
+        if not terms:
+            continue
+        best = int(np.argmax(infos)) if max(infos) > 0 else None
+        kept = terms[best] if best is not None else 0.0
+        log_b[i] += kept + weight * (sum(terms) - kept)
+    return log_b - np.logaddexp.reduce(log_b)
+
+
+@pytest.mark.parametrize('absent_prior', [0.0, 0.3])
+@pytest.mark.parametrize('with_scan', [False, True])
+def test_the_belief_is_the_brute_force_posterior(absent_prior, with_scan):
+    model = count_model(1, scan=with_scan)
+    settings = SearchSettings(confidence=1 - 1e-12, absent_prior=absent_prior,
+                              max_fixations=8)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model), settings)
+    sensor = ModelSensor(GRID, model, np.random.default_rng(4))
+    sensor.start(5)
+    session.reset(seed=0)
+    scan = None
+    if with_scan:
+        frame = sensor.scan()
+        scan = frame.values
+        session.scan(frame)
+        np.testing.assert_allclose(session.log_belief,
+                                   brute_force_log_posterior(model, scan, [], absent_prior),
+                                   atol=1e-12)
+    cell, frames = session.start(), []
+    for _ in range(8):
+        frame = sensor.observe(cell)
+        frames.append((cell, frame.values))
+        result = session.update(frame)
+        expected = brute_force_log_posterior(model, scan, frames, absent_prior)
+        np.testing.assert_allclose(session.log_belief, expected, atol=1e-10)
+        if result.ended:
+            break
+        cell = result.fixation
+    assert result.ended and result.decision == 'gave_up' and result.truncated
+
+
+@pytest.mark.parametrize('weight', [0.0, 0.25])
+@pytest.mark.parametrize('absent_prior', [0.0, 0.2])
+def test_repeat_weight_counts_a_cells_repeated_views_at_that_weight(weight, absent_prior):
+    model = count_model(2)
+    settings = SearchSettings(confidence=1 - 1e-12, absent_prior=absent_prior,
+                              repeat_weight=weight, inhibit_return=True)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model), settings)
+    sensor = ModelSensor(GRID, model, np.random.default_rng(8))
+    sensor.start(None)                                  # an empty scene
+    session.reset()
+    scan = sensor.scan()
+    session.scan(scan)
+    cell, frames = session.start(), []
+    for _ in range(2 * GRID.n_cells):                   # every cell, then every cell again
+        frame = sensor.observe(cell)
+        frames.append((cell, frame.values))
+        cell = session.update(frame).fixation
+    np.testing.assert_allclose(
+        session.log_belief,
+        weighted_log_posterior(model, scan.values, frames, absent_prior, weight), atol=1e-10)
+
+
+def test_calls_out_of_order_fail_loudly():
+    model = count_model(3)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model), SearchSettings())
+    frame = Frame(np.zeros(GRID.n_cells))
+    with pytest.raises(OrderError, match='reset'):
+        session.update(frame)
+    session.reset()
+    with pytest.raises(OrderError, match='start the search'):
+        session.update(frame)
+    session.start()
+    with pytest.raises(OrderError, match='before the first fixation'):
+        session.scan(Frame(np.zeros(GRID.n_cells), kind='scan'))
+    with pytest.raises(OrderError, match='has started'):
+        session.start()
+
+
+def test_stop_rules_found_absent_budget_and_repeat():
+    model = count_model(4, scan=False)
+    elm = build_policy('elm', GRID, model)
+    strong = np.zeros(GRID.n_cells)
+    # found: a frame only the target explains (count 3 at the fixation, impossible without it)
+    p_null, p_target = model.p_null.copy(), model.p_target.copy()
+    p_null[0, 0], p_target[0, 0] = [0.7, 0.2, 0.1, 0.0], [0.1, 0.1, 0.1, 0.7]
+    sure = CountObservation(GRID, p_target, p_null)
+    session = SearchSession(GRID, sure, elm, SearchSettings(confidence=0.6))
+    session.reset()
+    k = session.start()
+    strong[k] = 3
+    result = session.update(Frame(strong))
+    assert (result.decision, result.map_cell, result.fixations) == ('found', k, 1)
+    assert result.terminated and not result.truncated and result.fixation is None
+    # absent: zero counts everywhere with an absent prior decide absent sooner or later
+    session = SearchSession(GRID, model, elm, SearchSettings(confidence=0.9, absent_prior=0.5,
+                                                             inhibit_return=True))
+    session.reset()
+    session.start()
+    for _ in range(50):
+        result = session.update(Frame(np.zeros(GRID.n_cells)))
+        if result.ended:
+            break
+    assert result.decision == 'absent' and result.terminated
+    assert result.absent_probability >= 0.9
+    with pytest.raises(OrderError, match='ended'):
+        session.update(Frame(np.zeros(GRID.n_cells)))
+    # gave_up (budget) and gave_up (repeat: every cell fixated once), with a weak detector
+    weak = CountObservation(GRID, 0.9 * model.p_null + 0.1 / K, model.p_null)
+    elm = build_policy('elm', GRID, weak)
+    for settings, fixations, reason in (
+            (SearchSettings(confidence=1 - 1e-12, max_fixations=3), 3, 'budget'),
+            (SearchSettings(confidence=1 - 1e-12, inhibit_return=True, stop_on_repeat=True),
+             GRID.n_cells, 'repeat')):
+        session = SearchSession(GRID, weak, elm, settings)
+        outcome = run_search(session, ModelSensor(GRID, weak, np.random.default_rng(0)), 2)
+        assert (outcome.decision, outcome.reason, outcome.fixations) == \
+            ('gave_up', reason, fixations)
+        if reason == 'repeat':
+            assert sorted(outcome.path) == list(range(GRID.n_cells))
+
+
+def test_start_rules_centre_policy_and_cell():
+    model = count_model(5)
+    elm = build_policy('elm', GRID, model)
+    for start, expected in ((None, GRID.center_index), ((2, 3), GRID.index(2, 3))):
+        session = SearchSession(GRID, model, elm, SearchSettings(start_cell=start))
+        session.reset()
+        assert session.start() == expected
+    # 'policy': the policy's choice on the prior; after a scan the default is the same rule.
+    session = SearchSession(GRID, model, elm, SearchSettings(start_cell='policy'))
+    session.reset()
+    prior = np.full((1, GRID.n_cells), 1 / GRID.n_cells)
+    assert session.start() == int(elm.select(prior, 0, None)[0])
+    session = SearchSession(GRID, model, elm, SearchSettings())
+    session.reset()
+    scan = np.zeros(GRID.n_cells)
+    scan[7] = 3
+    session.scan(Frame(scan, kind='scan'))
+    assert session.start() == int(elm.select(session.belief[None, :], 0, None)[0])
+    assert start_index(GRID, SearchSettings(start_cell=(1, 1))) == 5
+    with pytest.raises(ValueError, match='outside a 3x4 grid'):
+        SearchSession(GRID, model, elm, SearchSettings(start_cell=(3, 0)))
+
+
+@pytest.mark.parametrize('changes, message', [
+    ({'confidence': 1.0}, r'^confidence must be between 0 and 1 \(exclusive\), got 1.0$'),
+    ({'confidence': 0}, r'^confidence must be between 0 and 1 \(exclusive\), got 0$'),
+    ({'confidence': 'high'}, r"^confidence must be between 0 and 1 \(exclusive\), got 'high'$"),
+    ({'max_fixations': -1}, r'^search.max_fixations must be an integer >= 0 \(0: no budget\)'),
+    ({'max_fixations': 2.5}, r'^search.max_fixations must be an integer >= 0'),
+    ({'inhibit_return': 'yes'}, r'^search.inhibit_return must be true or false'),
+    ({'repeat_weight': 1.5}, r'^search.repeat_weight must be in \[0, 1\]'),
+    ({'absent_prior': 1.0}, r'^absent.prior must be a probability in \[0, 1\)'),
+    ({'motion_sigma_cells': -1.0}, r'^motion.sigma_cells must be finite and >= 0'),
+    ({'motion_jump_prob': 2.0}, r'^motion.jump_prob must be a probability in \[0, 1\)'),
+    ({'start_cell': (1,)}, r'^start_cell must be \(row, col\) integers'),
+    ({'start_cell': (-1, 0)}, r'^start_cell must be \(row, col\) with row, col >= 0'),
+    ({'scan': 1}, r'^search.scan must be true or false'),
+])
+def test_every_bad_setting_is_refused_with_one_message(changes, message):
+    with pytest.raises(ValueError, match=message):
+        SearchSettings(**changes)
+    with pytest.raises(ValueError, match=message):
+        replace(SearchSettings(), **changes)
+
+
+def test_settings_from_parameters_as_the_node_and_yaml_name_them():
+    values = {'confidence': 0.99, 'search.max_fixations': 0, 'search.inhibit_return': True,
+              'search.repeat_weight': 0.1, 'absent.prior': 0.2, 'start_row': 0,
+              'start_col': -1, 'fpoc.dprime': 4.0}
+    settings = SearchSettings.from_parameters(values, grid=GRID)
+    assert settings == SearchSettings(confidence=0.99, inhibit_return=True, repeat_weight=0.1,
+                                      absent_prior=0.2, start_cell=(0, 1))
+    assert SearchSettings.from_parameters(settings.to_parameters()) == settings
+    assert SearchSettings.from_parameters({'start_row': -1, 'start_col': -1}).start_cell is None
+    with pytest.raises(ValueError, match='outside a 3x4 grid'):
+        SearchSettings.from_parameters({'start_row': 3, 'start_col': 0}, grid=GRID)
+
+
+def test_a_session_without_a_policy_takes_the_drivers_fixations():
+    model = count_model(6)
+    session = SearchSession(GRID, model, None, SearchSettings(confidence=1 - 1e-9))
+    session.reset()
+    session.start()
+    for cell in (0, 11, 4):
+        session.fixate(cell)
+        assert session.update(Frame(np.zeros(GRID.n_cells))).fixation == cell
+    assert session.path == (0, 11, 4)
+    with pytest.raises(ValueError):
+        session.fixate(GRID.n_cells)
+
+
+def test_a_rejected_frame_changes_nothing_and_says_why():
+    model = count_model(7)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model), SearchSettings())
+    session.reset()
+    session.start()
+    before = session.log_belief
+    for values, reason in ((np.full(GRID.n_cells, 0.5), 'integers'),
+                           (np.zeros(GRID.n_cells + 1), 'expected 12'),
+                           (np.full(GRID.n_cells, np.inf), 'inf')):
+        result = session.update(Frame(values))
+        assert result.status == 'rejected' and reason in result.reason
+        np.testing.assert_array_equal(session.log_belief, before)
+        assert session.fixations == 0
+
+
+def test_the_event_log_records_each_step():
+    model = count_model(8)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model),
+                            SearchSettings(max_fixations=2, confidence=1 - 1e-12))
+    outcome = run_search(session, ModelSensor(GRID, model, np.random.default_rng(1)), 3)
+    kinds = [event['event'] for event in outcome.log]
+    assert kinds == ['reset', 'scan', 'start', 'frame', 'frame']
+    last = outcome.log[-1]
+    assert last['decision'] == 'gave_up' and last['reason'] == 'budget'
+    assert last['fixation'] == list(GRID.cell(outcome.path[-1]))
+    assert last['belief']['map_cell'] == list(GRID.cell(outcome.cell))
+    assert outcome.log[0]['settings']['search.max_fixations'] == 2
+
+
+def test_sample_scan_draws_from_the_scan_tables():
+    model = count_model(9)
+    rng = np.random.default_rng(3)
+    targets = np.full(40_000, 5)
+    frames = model.sample_scan(targets, rng)
+    for column, table in ((frames[:, 5], model.scan_target), (frames[:, 0], model.scan_null)):
+        observed = np.bincount(column.astype(int), minlength=K)
+        expected = table * column.size
+        chi2 = float(((observed - expected) ** 2 / expected).sum())
+        assert chi2 < 16.3                          # chi-square, 3 dof, p = 0.001
+    empty = model.sample_scan(targets[:10], np.random.default_rng(3), present=False)
+    nulls = model.sample_scan(np.zeros(10, dtype=int), np.random.default_rng(3),
+                              present=np.zeros(10, dtype=bool))
+    np.testing.assert_array_equal(empty, nulls)
+    assert model.sample_scan(5, np.random.default_rng(3)).shape == (GRID.n_cells,)
+
+
+def test_the_controller_and_finds_driver_agree_on_the_same_frames():
+    """Frames recorded from find's driver, replayed into the controller: same fixations."""
+    model = count_model(10, scan=False)
+    settings = SearchSettings(confidence=0.99, inhibit_return=True, repeat_weight=0.3,
+                              absent_prior=0.1, max_fixations=9)
+    policy = build_policy('elm', GRID, model)
+
+    class Recording(ModelSensor):
+
+        def observe(self, cell):
+            frame = super().observe(cell)
+            self.recorded.append((cell, frame.values))
+            return frame
+
+    for target in itertools.islice(range(GRID.n_cells), 0, None, 3):
+        sensor = Recording(GRID, model, np.random.default_rng(target))
+        sensor.recorded = []
+        outcome = run_search(SearchSession(GRID, model, policy, settings), sensor, target)
+        controller = GazeController(GRID, model, policy, settings)
+        for t, (cell, values) in enumerate(sensor.recorded):
+            assert controller.fixation == cell
+            controller.offer(values, float(t + 1))
+        assert controller.stopped and controller.decision == outcome.decision
+        assert controller.map_cell == outcome.cell
+        np.testing.assert_array_equal(controller.belief, outcome.belief)
