@@ -158,7 +158,7 @@ def _text(canvas, text: str, org, scale: float, colour, thickness: int = 1) -> N
 
 
 def annotate(image: np.ndarray, cell_map: CellMap, belief=None, fixations=(), windows=(),
-             detections=None, found=None, alpha: float = 0.6, label: str = '',
+             detections=None, found=None, alpha: float = 0.45, label: str = '',
              found_label: str = 'found') -> np.ndarray:
     """
     Draw the search on a copy of ``image``; return ``(H, W, 3)`` uint8 RGB.
@@ -219,16 +219,21 @@ def annotate(image: np.ndarray, cell_map: CellMap, belief=None, fixations=(), wi
         x0, y0, x1, y1 = boxes[fixations[-1]]
         cv2.rectangle(canvas, (int(x0), int(y0)), (int(x1), int(y1)), WINDOW_RGB, thick + 1)
     visible = [(i, k) for i, k in enumerate(fixations) if shown[k]]
+    # The path and the discs at 70% opacity, so that what lies under them stays visible.
+    layer = canvas.copy()
     if len(visible) > 1:
         points = np.round(centres[[k for _, k in visible]]).astype(np.int32)
-        cv2.polylines(canvas, [points.reshape(-1, 1, 2)], False, (200, 220, 255), thick,
+        cv2.polylines(layer, [points.reshape(-1, 1, 2)], False, (200, 220, 255), thick,
                       cv2.LINE_AA)
-    radius = int(np.clip(round(cell_px * 0.27), 3, 9))
+    radius = int(np.clip(round(cell_px * 0.27), 3, 11))
     for i, k in visible:
         x, y = (int(round(v)) for v in centres[k])
-        colour = _order_colour(i, len(fixations))
-        cv2.circle(canvas, (x, y), radius, colour, -1, cv2.LINE_AA)
-        cv2.circle(canvas, (x, y), radius, (0, 0, 0), 1, cv2.LINE_AA)
+        cv2.circle(layer, (x, y), radius, _order_colour(i, len(fixations)), -1, cv2.LINE_AA)
+        cv2.circle(layer, (x, y), radius, (0, 0, 0), 1, cv2.LINE_AA)
+    if visible:
+        canvas = cv2.addWeighted(layer, 0.7, canvas, 0.3, 0.0)
+    for i, k in visible:
+        x, y = (int(round(v)) for v in centres[k])
         if radius < 6:
             continue                    # too small to read: the colour gives the order
         text = str(i + 1)
@@ -238,15 +243,14 @@ def annotate(image: np.ndarray, cell_map: CellMap, belief=None, fixations=(), wi
                     size, (0, 0, 0), 1, cv2.LINE_AA)
     if detections is not None:
         points = np.asarray(detections, dtype=np.float64).reshape(-1, 2)
-        size = max(5, int(round(cell_px * 0.3)))
+        size = max(5, int(round(cell_px * 0.15)))
         for x, y in np.round(points).astype(np.int64):
-            cv2.drawMarker(canvas, (int(x), int(y)), DETECTION_RGB, cv2.MARKER_CROSS, size,
-                           thick)
+            cv2.drawMarker(canvas, (int(x), int(y)), DETECTION_RGB, cv2.MARKER_CROSS, size, 1)
     if found is not None:
         cell, probability = int(found[0]), float(found[1])
         if shown[cell]:
             x0, y0, x1, y1 = (int(v) for v in boxes[cell])
-            cv2.rectangle(canvas, (x0 - 1, y0 - 1), (x1 + 1, y1 + 1), FOUND_RGB, 2 * thick + 1)
+            cv2.rectangle(canvas, (x0 - 1, y0 - 1), (x1 + 1, y1 + 1), FOUND_RGB, thick + 1)
         row, col = grid.cell(cell)
         _text(canvas, f'{found_label} ({row}, {col}) p={probability:.3f}',
               (4, height - int(6 + 8 * scale)), scale, FOUND_RGB, thick)
