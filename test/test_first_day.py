@@ -120,3 +120,14 @@ def test_find_names_a_policy_file_given_as_the_observation_model(tmp_path):
         f'ipomdp-gaze find: error: {policy} is a policy file (ipomdp_gaze/policy-v1), not an '
         f'observation model (ipomdp_gaze/observation-v1): pass it as --policy-file (node: '
         f'policy.file)')
+
+
+def test_the_human_fpoc_far_out_is_zero_without_a_numpy_warning():
+    import warnings
+
+    from ipomdp_gaze.fpoc import make_fpoc
+    import numpy as np
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        d = make_fpoc('human')(np.array([0.0, 800.0]), np.array([0.0, 0.0]))
+    assert d[0] == pytest.approx(2.0) and d[1] == 0.0
