@@ -194,3 +194,35 @@ def test_a_fixed_camera_recording_can_be_searched_anew(ros_env, tmp_path):
     assert 'settings: recorded, with policy=map' in other.stdout
     assert re.search(r'^new search on the recorded image: (found|budget) at \(\d+, \d+\)',
                      other.stdout, re.M), other.stdout
+
+
+def test_ipomdp_gaze_record_records_another_run_until_sigint(ros_env, tmp_path):
+    import signal
+
+    from ipomdp_gaze.nodes.processes import wait_for
+    log = tmp_path / 'recorder.log'
+    with open(log, 'wb') as out:
+        recorder = subprocess.Popen(
+            [sys.executable, '-m', 'ipomdp_gaze.cli', 'record', str(tmp_path / 'bag'),
+             '--topics', 'pan_tilt,belief,found,ground_truth'],
+            cwd=REPO, env=ros_env, stdout=out, stderr=subprocess.STDOUT)
+    try:
+        assert wait_for(lambda: b'recording pan_tilt' in log.read_bytes(), 60), \
+            log.read_text()
+        run = _cli(ros_env, 'demo', '--domain-id', ros_env['ROS_DOMAIN_ID'], '--seed', '5',
+                   '--target', '3,3')
+        assert run.returncode == 0, run.stdout + run.stderr
+        assert wait_for(lambda: b'recorded the parameters of gaze_controller' in
+                        log.read_bytes(), 30), log.read_text()
+    finally:
+        recorder.send_signal(signal.SIGINT)
+        assert recorder.wait(30) == 0, log.read_text()
+    messages = _mcap_messages(tmp_path / 'bag')
+    assert set(messages) <= {'/pan_tilt', '/belief', '/found', '/ground_truth'}
+    row, col, fixations = _found(run.stdout)
+    found = {kv.key: kv.value for kv in messages['/found'][0].values}
+    assert (int(found['row']), int(found['col'])) == (row, col)
+    assert list(messages['/ground_truth'][-1].data) == [3, 3]
+    meta = yaml.safe_load((tmp_path / 'bag' / 'metadata.yaml').read_text())
+    custom = meta['rosbag2_bagfile_information']['custom_data']
+    assert yaml.safe_load(custom['ipomdp_gaze/parameters/gaze_controller'])['seed'] == 5

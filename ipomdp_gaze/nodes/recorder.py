@@ -137,6 +137,7 @@ class RecorderNode(Node):
         self.parameters: dict = {}
         self._pending = list(values['nodes'])
         self._futures = {}
+        self._parameter_clients = {}
         self._parameter_timer = self.create_timer(PARAMETER_RETRY_S, self._ask_parameters)
         self.get_logger().info(f"recording {', '.join(values['topics'])} to {values['path']}")
 
@@ -164,9 +165,11 @@ class RecorderNode(Node):
         for node in list(self._pending):
             if node in self._futures:
                 continue
-            client = self.create_client(ListParameters, f'/{node}/list_parameters')
+            client = self._parameter_clients.get(node)
+            if client is None:      # kept: a service is discovered some time after the client
+                client = self._parameter_clients[node] = self.create_client(
+                    ListParameters, f'/{node}/list_parameters')
             if not client.service_is_ready():
-                self.destroy_client(client)
                 continue
             future = client.call_async(ListParameters.Request())
             self._futures[node] = future
