@@ -35,6 +35,8 @@ import numpy as np
 CONTROLLER = 'gaze_controller'
 DETECTOR = 'foveal_detector'
 IMAGE_CHANNELS = {'mono8': 1, 'rgb8': 3, 'bgr8': 3}
+# The target sent with a reset is stamped at most this long after the reset belief arrived.
+RESET_TARGET_S = 0.005
 # What ``replay`` may change, and the controller parameter each one sets.
 OVERRIDES = {'observation': 'observation.file', 'policy': 'policy.name',
              'policy_file': 'policy.file', 'confidence': 'confidence',
@@ -189,11 +191,36 @@ def _targets(bag, head: PanTiltMap) -> list:
     return out
 
 
+def last_search(bag, head: PanTiltMap, start: int):
+    """
+    Return the bag from the controller's last reset on (its uniform ``belief``), if any.
+
+    A bag may hold several searches (``~/reset`` starts a new one; the demo resets once the
+    recorder hears every node): a replay follows the last one. The recorder takes the topics
+    in its own order and a busy machine delays some, so the reset is pinned by the target sent
+    with it: the latest target at the ``start`` cell stamped before the reset belief arrived.
+    """
+    grid = head.grid
+    resets = [m.time_ns for m in bag.topic('belief')
+              if np.size(m.msg.data) == grid.n_cells and np.ptp(np.asarray(m.msg.data)) == 0]
+    if not resets:
+        return bag
+    cut = resets[-1]
+    sent = [m for m in bag.topic('pan_tilt')
+            if _seconds(m.msg.header.stamp) * 1e9 <= cut + RESET_TARGET_S * 1e9 and
+            head.nearest_cell(*_angles(m.msg, head)) == start]
+    if sent:
+        first = max(sent, key=lambda m: _seconds(m.msg.header.stamp))
+        stamp = first.msg.header.stamp
+        cut = min(cut, min(m.time_ns for m in sent if m.msg.header.stamp == stamp))
+    return dataclasses.replace(bag, messages=[m for m in bag.messages if m.time_ns >= cut])
+
+
 def _recorded_decision(bag) -> Decision:
     for kind in ('found', 'absent', 'gave_up'):
         events = bag.topic(kind)
-        if events:
-            values = {kv.key: kv.value for kv in events[0].msg.values}
+        if events:                  # the last: one of an earlier search may arrive late
+            values = {kv.key: kv.value for kv in events[-1].msg.values}
             cell = int(values['cell']) if 'cell' in values else None
             p = float(values['probability']) if 'probability' in values else None
             return Decision(kind, cell, p, int(values['fixations']))
@@ -213,6 +240,7 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
                          f'it recorded by the recorder node with the controller running?')
     core, head = build_controller(settings_from(recorded_values, overrides))
     grid = core.grid
+    bag = last_search(bag, head, core.reset(0.0))
     frames = _frames(bag, grid)
     targets = _targets(bag, head)
     if not targets:

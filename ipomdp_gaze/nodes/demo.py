@@ -201,12 +201,29 @@ def _with_recorder(setup: DemoSetup, record, compression: str, pictures) -> list
         if setup.scene != 'faces':
             args += ['-p', f"nodes:=[{NODE_NAMES['controller']}]"]
         args += ['-p', 'diagnostics_period_s:=0.1']
-        if setup.scene != 'faces':
-            # The camera publishes a frame as soon as it sees the first target: it starts
-            # before the controller, so the recorder has matched its publishers by then.
-            nodes = nodes[::-1]
         nodes.insert(0, ('recorder', args))
     return nodes
+
+
+def _restart_recorded(setup: DemoSetup, watch, recorder, wait, records) -> float:
+    """
+    Start the search again once the recorder hears every node; return when (monotonic).
+
+    The first frames go out as soon as the last node meets the controller, often before the
+    recorder has discovered that node, so the search the bag keeps is a new one: the demo
+    waits until the recorder has matched the frame publishers (and the camera images), calls
+    the controller's ``~/reset`` and forgets what it saw of the first search.
+    """
+    topics = [('evidence', 'evidence_image')]
+    if setup.scene == 'faces':
+        topics.append(('image',))
+    if not wait(lambda: all(recorder.matched(*t) for t in topics)):
+        raise RuntimeError('the recorder did not hear the nodes in time')
+    since = time.monotonic()
+    watch.reset(NODE_NAMES['controller'])
+    for entries in records:
+        entries[:] = [e for e in entries if e[0] >= since]
+    return since
 
 
 class RecorderStatus:
@@ -298,13 +315,12 @@ def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = 
                 started = time.monotonic()
                 proc.start()
                 ready = _started(watch, record_, proc.node)
-                if recorder is not None and len(procs) > 2 and proc is procs[-2]:
-                    # The search starts with the last node: the recorder must see the frames.
-                    before = ready or (lambda: True)
-                    ready = lambda: before() and recorder.matched(  # noqa: E731
-                        'evidence', 'evidence_image')
                 if proc is not procs[-1] and ready is not None and not wait(ready):
                     raise RuntimeError(f'{proc.name} did not come up in time')
+            if recorder is not None:
+                started = _restart_recorded(setup, watch, recorder, wait,
+                                            [record_.beliefs, record_.targets, record_.found,
+                                             annotated])
             status = _follow(setup, record_, wait, timeout_s, out, stats, max_fixations)
             if stats.get('fixations'):
                 stats['search_s'] = record_.beliefs[stats['fixations'] - 1][0] - started
