@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 
 # Modules under ipomdp_gaze.commands, in the order --help lists their subcommands: evaluate,
@@ -65,6 +66,10 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     try:
         return int(args.run(args) or 0)
+    except BrokenPipeError:
+        # The reader went away (``| head``): stop quietly, and let nothing flush to the pipe.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     except (CliError, ValueError, OSError) as exc:
         print(f'ipomdp-gaze {args.command}: error: {exc}', file=sys.stderr)
         return 2

@@ -295,11 +295,14 @@ def search_rate(bag) -> tuple[float, float]:
     """
     Return ``(seconds, MB per minute)`` of the search: the bag's growth while frames came.
 
-    The search spans the recorded frames, from one mean frame interval before the first to the
-    last; the bytes of the messages recorded in it are scaled by the file's compression.
+    The search (the bag's last) spans its recorded frames, from one mean frame interval before
+    the first to the last; the bytes of the messages recorded in it are scaled by the file's
+    compression.
     """
+    resets = [m.time_ns for m in bag.topic('belief') if np.ptp(np.asarray(m.msg.data)) == 0]
+    since = resets[-1] if resets else 0          # the last search (see last_search)
     frames = sorted(m.time_ns for topic in ('evidence_image', 'evidence')
-                    for m in bag.topic(topic))
+                    for m in bag.topic(topic) if m.time_ns >= since)
     raw = sum(m.size for m in bag.messages)
     if len(frames) < 2 or raw == 0:
         return 0.0, math.nan
