@@ -322,6 +322,13 @@ def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = 
                                             [record_.beliefs, record_.targets, record_.found,
                                              annotated])
             status = _follow(setup, record_, wait, timeout_s, out, stats, max_fixations)
+            if recorder is not None:        # the bag's metadata: the nodes' parameters
+                nodes_ = [NODE_NAMES[n] for n in ('controller', 'detector')
+                          if n in {p.node for p in procs}]
+                if not wait(lambda: set(nodes_) <= set(
+                        str(recorder.values.get('parameters_of', '')).split(','))):
+                    out('ipomdp-gaze demo: the recorder did not get the parameters of '
+                        + ', '.join(nodes_))
             if stats.get('fixations'):
                 stats['search_s'] = record_.beliefs[stats['fixations'] - 1][0] - started
             if pictures is not None:

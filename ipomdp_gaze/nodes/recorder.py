@@ -4,10 +4,10 @@
 The ``recorder`` node: write a search to a rosbag2 bag (MCAP), as ``ros2 bag record -s mcap``.
 
 No ``ros2 bag`` is installable here, so the node writes the bag itself with ``rosbags`` (pure
-Python): a directory ``path`` with ``metadata.yaml`` and one ``.mcap`` file, readable by
-``ros2 bag play``, Foxglove and the ``mcap`` and ``rosbags`` readers. Messages are recorded
-serialized (CDR) as they arrive, timestamped with the node's clock on arrival. ``topics`` lists
-the relative topic names to record (:data:`TOPICS` gives each one's type and QoS; the default
+Python): a directory ``path`` with ``metadata.yaml`` and one ``.mcap`` file in rosbag2's layout
+(read here with the ``mcap`` and ``rosbags`` readers). Messages are recorded serialized (CDR)
+as they arrive, timestamped with the time the middleware received them. ``topics`` lists the
+relative topic names to record (:data:`TOPICS` gives each one's type and QoS; the default
 is every one of them: camera images, ``camera_info``, ``joint_states``, ``fixation``,
 ``pan_tilt``, ``evidence``, ``evidence_image``, ``belief``, ``found``, ``absent``, ``gave_up``,
 ``/diagnostics``, ``ground_truth`` and the detector's ``annotated_image`` and raw
@@ -155,8 +155,12 @@ class RecorderNode(Node):
     def _writer_for(self, topic: str):
         connection = self.connections[topic]
 
-        def write(data: bytes) -> None:
-            self.writer.write(connection, self.get_clock().now().nanoseconds, data)
+        def write(data: bytes, info=None) -> None:
+            # When the middleware received it (as ros2 bag), not when this callback ran: a
+            # busy executor takes the topics in its own order, later.
+            received = info.get('received_timestamp') if isinstance(info, dict) else None
+            stamp = int(received) if received else self.get_clock().now().nanoseconds
+            self.writer.write(connection, stamp, data)
             self.counts[topic] += 1
         return write
 
