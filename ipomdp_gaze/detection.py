@@ -37,7 +37,7 @@ import numpy as np
 
 MODES = ('fovea', 'camera')
 # The observation model of each mode when none is given: the shipped face models.
-DEFAULT_MODELS = {'fovea': 'faces-420-nmpt', 'camera': 'faces-pan-tilt'}
+DEFAULT_MODELS = {'fovea': 'faces-420', 'camera': 'faces-pan-tilt'}
 # The view a model was calibrated with (its image record), per mode.
 MODE_VIEWS = {'fovea': 'fixed', 'camera': 'pan_tilt'}
 # Detector settings a node parameter may repeat (an empty or negative value: the file's).
@@ -154,14 +154,21 @@ def camera_mismatch(model_camera_: PinholeCamera | None, camera: PinholeCamera) 
 
 @dataclass(frozen=True)
 class Frame:
-    """One count frame for the controller, and what it cost."""
+    """
+    One count frame for the controller, and what it cost.
 
-    fixation: int
+    ``kind`` is ``'fixation'`` or ``'scan'`` (the one-time scan, ``fixation`` None then);
+    ``search_id`` the search it was asked for (None: the request did not say).
+    """
+
+    fixation: int | None
     stamp_s: float
     token: object
     counts: np.ndarray
     detector_pixels: int
     seconds: float
+    kind: str = 'fixation'
+    search_id: int | None = None
 
 
 @dataclass(frozen=True)
@@ -198,7 +205,9 @@ class DetectorLoop:
         self.head = head
         self.tolerance_s = float(tolerance_s)
         self.camera: PinholeCamera | None = None
-        self.pending: tuple[int, float] | None = None
+        self.pending: tuple[int | None, float] | None = None
+        self.search_id: int | None = None
+        self.scans = 0
         self._images = deque(maxlen=keep)
         self._poses = deque(maxlen=50 * keep)
         self.received = self.processed = self.rejected = self.fixations = 0
@@ -208,11 +217,31 @@ class DetectorLoop:
         self._pixels = deque(maxlen=TIMING_WINDOW)
 
     # -- inputs ------------------------------------------------------------------------------
-    def fixate(self, cell: int, now_s: float) -> Outcome:
-        """Take a fixation commanded at ``now_s``: wait for an image captured from then on."""
+    def fixate(self, cell: int, now_s: float, search_id: int | None = None) -> Outcome:
+        """
+        Take a fixation commanded at ``now_s``: wait for an image captured from then on.
+
+        ``search_id`` (the controller's, when it says) comes back with the frame; a new id is a
+        new search, and whatever the previous one still waited for is dropped.
+        """
         self.setup.grid.cell(cell)
         self.fixations += 1
+        self.search_id = search_id
         self.pending = (int(cell), float(now_s))
+        return self.serve()
+
+    def request_scan(self, search_id: int, now_s: float) -> Outcome:
+        """
+        Take a request for the one-time scan of search ``search_id`` (docs/design.md 10.3).
+
+        Served with the next image captured from ``now_s`` on: the fovea's whole-image windows
+        (``fovea`` mode with a scanning fovea); a sensor without a scan (``camera`` mode, or a
+        fovea that does not scan) answers with a frame of NaN (nothing observed), so the
+        controller can start its search all the same.
+        """
+        self.fixations += 1
+        self.search_id = int(search_id)
+        self.pending = (None, float(now_s))
         return self.serve()
 
     def add_image(self, stamp_s: float, image: np.ndarray, token=None) -> Outcome:
@@ -273,7 +302,7 @@ class DetectorLoop:
         if not fresh:
             return Outcome('waiting', 'no image captured since the fixation was commanded')
         stamp, image, token = fresh[-1]
-        if self.setup.mode == 'fovea':
+        if self.setup.mode == 'fovea' or cell is None:
             return self._count(cell, stamp, image, token)
         if self.camera is None:
             return Outcome('waiting', 'no camera_info received: camera mode needs the '
@@ -297,7 +326,9 @@ class DetectorLoop:
         setup = self.setup
         t0 = time.perf_counter()
         try:
-            if setup.mode == 'fovea':
+            if cell is None:
+                counts, pixels = self._scan(image)
+            elif setup.mode == 'fovea':
                 setup.fovea.start(image)
                 observation = setup.fovea.observe(cell)
                 counts, pixels = observation.counts, observation.detector_pixels
@@ -311,10 +342,21 @@ class DetectorLoop:
         self._drop_through(stamp_s)
         self.pending = None
         self.processed += 1
+        self.scans += cell is None
         self._seconds.append(seconds)
         self._pixels.append(pixels)
-        return Outcome('published',
-                       frame=Frame(cell, stamp_s, token, counts, int(pixels), seconds))
+        return Outcome('published', frame=Frame(
+            cell, stamp_s, token, counts, int(pixels), seconds,
+            'scan' if cell is None else 'fixation', self.search_id))
+
+    def _scan(self, image) -> tuple[np.ndarray, int]:
+        """Return the one-time scan's counts of an image: NaN everywhere without a scan."""
+        fovea = self.setup.fovea
+        if self.setup.mode == 'fovea' and fovea.config.scan_once:
+            fovea.start(image)
+            scan = fovea.scan()
+            return scan.counts, scan.detector_pixels
+        return np.full(self.setup.grid.n_cells, np.nan), 0
 
     # -- reporting -------------------------------------------------------------------------
     def values(self) -> dict:
@@ -325,6 +367,8 @@ class DetectorLoop:
         return {
             'mode': self.setup.mode, 'observation': self.setup.name,
             'images_received': self.received, 'images_processed': self.processed,
+            'scans_served': self.scans, 'search_id': -1 if self.search_id is None
+            else self.search_id,
             'images_rejected': self.rejected,
             'images_unused': self.received - self.processed - self.rejected,
             'fixations_received': self.fixations, 'waiting_for_image': waiting,

@@ -28,6 +28,18 @@ VERDICT = re.compile(r'^the scene camera put the face centre in cell \((\d+), (\
                      r'(right|wrong)$', re.M)
 
 
+def find_path(seed: int) -> tuple:
+    """Return the fixations `find` makes on the scene camera's fixed scene of ``seed``."""
+    from ipomdp_gaze.observation_file import load_observation
+    from ipomdp_gaze.policies.registry import build_policy
+    from ipomdp_gaze.vision.scenes import SceneSet
+    from ipomdp_gaze.vision.search import FIND_SETTINGS, fovea_for_model, search_image
+    model = load_observation('faces-420')
+    scene = SceneSet('test', 420, (60, 140), model.grid.shape, color='rgb', seed=seed).scene(0)
+    policy = build_policy('learned', model.grid, model, file='faces-420-infomax')
+    return search_image(scene.image, fovea_for_model(model), model, policy, FIND_SETTINGS).path
+
+
 @pytest.mark.parametrize('options, mode, where', [
     (['--fovea', '--seed', '0'], 'fovea', r'pixel \( *\d+\.\d, +\d+\.\d\)'),
     (['--fovea', '--seed', '2'], 'fovea', r'pixel \( *\d+\.\d, +\d+\.\d\)'),
@@ -50,8 +62,12 @@ def test_three_nodes_find_the_face_and_stop(ros_env, options, mode, where):
     assert fixations and found and verdict, out
     assert [int(f[0]) for f in fixations] == list(range(1, len(fixations) + 1))
     assert int(found.group(5)) == len(fixations)
-    centre = '(10, 10)' if mode == 'fovea' else '(5, 5)'
-    assert f'({fixations[0][1]}, {fixations[0][2]})' == centre       # the first: the centre
+    looked = [(int(f[1]), int(f[2])) for f in fixations]
+    if mode == 'fovea':             # the scan, then exactly find's fixations on this image
+        assert 'scan: the whole image once  ->  most likely' in out
+        assert looked == list(find_path(int(options[-1])))
+    else:
+        assert looked[0] == (5, 5)                                     # the first: the centre
     assert all(re.fullmatch(where, f[3].strip()) for f in fixations), fixations
     assert re.fullmatch(where, found.group(3))
     assert (fixations[-1][4], fixations[-1][5]) == found.group(1, 2)

@@ -114,6 +114,12 @@ def controller_params() -> list[Param]:
         Param('search.inhibit_return', False, T.BOOL,
               'still target: never fixate a cell twice in a search (a deterministic detector '
               'on a still scene repeats its counts; the Bayes step would count them twice)'),
+        Param('search.stop_on_repeat', False, T.BOOL,
+              'give up (gave_up) instead of fixating a cell a second time; with '
+              'inhibit_return: once every cell has been fixated (find does this)'),
+        Param('search.scan', True, T.BOOL,
+              'with a count model that has scan tables: start each search with the one-time '
+              'whole-image scan (asked of the detector as fixation [-1, -1, search_id])'),
         Param('search.repeat_weight', 1.0, T.DOUBLE,
               'still target: weight of the evidence a cell gets from views other than the one '
               'that saw it at its most informative offset, in [0, 1] (1: every frame counts '
@@ -414,7 +420,9 @@ class GazeControllerNode(Node):
     def _publish_target(self) -> None:
         head, cell = self._config.head, self.core.fixation
         self._pan_tilt_pub.publish(self._pan_tilt_msg)
-        self._fixation_pub.publish(grid_arrays.row_col(self._config.grid, cell))
+        core = self.core
+        self._fixation_pub.publish(grid_arrays.fixation(
+            self._config.grid, None if core.scanning else cell, core.search_id))
         if self._forward_pub is not None:
             self._forward_pub.publish(joints.forward_command(head, cell))
         if self._trajectory_pub is not None:
@@ -501,10 +509,17 @@ class GazeControllerNode(Node):
         self._take('evidence', info, grid_arrays.from_multiarray, msg)
 
     def _on_evidence_image(self, msg: Image, info) -> None:
-        self._take('evidence_image', info, images.evidence_from_image, msg, msg.header.stamp)
+        self._take('evidence_image', info, images.evidence_from_image, msg, msg.header.stamp,
+                   images.read_frame_tag(msg))
 
-    def _take(self, topic: str, info, read, msg, stamp=None) -> None:
-        """Offer a frame to the core: taken at its stamp, or at its arrival when there is none."""
+    def _take(self, topic: str, info, read, msg, stamp=None, tag=('fixation', None)) -> None:
+        """
+        Offer a frame to the core: taken at its stamp, or at its arrival when there is none.
+
+        A frame tagged as a search's one-time scan (``header.frame_id`` ``scan/<id>``) goes to
+        :meth:`GazeController.offer_scan`; one tagged ``fixation/<id>`` is skipped unless it
+        belongs to the current search.
+        """
         now = self._now_s()
         self._count_drops(topic, info)
         try:
@@ -512,8 +527,12 @@ class GazeControllerNode(Node):
         except EvidenceError as exc:
             self._handle(self.core.reject(str(exc)))
             return
+        kind, search_id = tag
+        if kind == 'scan':
+            self._handle(self.core.offer_scan(values, search_id, now))
+            return
         taken = now if stamp is None or stamps.is_zero(stamp) else stamps.to_seconds(stamp)
-        self._handle(self.core.offer(values, taken, now))
+        self._handle(self.core.offer(values, taken, now, search_id))
 
     def _handle(self, result) -> None:
         if result.status == 'rejected':

@@ -52,7 +52,8 @@ class DemoSetup:
 
     ``nodes`` lists ``(node, ros_args)`` in start order (keys of ``NODE_NAMES``); ``scene`` is
     ``'gaussian'`` (the simulated camera) or ``'faces'``; ``mode`` the detector's (faces);
-    ``image_px`` the ``(width, height)`` of the fixed scene (fovea mode, for pixel answers).
+    ``image_px`` the ``(width, height)`` of the fixed scene (fovea mode, for pixel answers);
+    ``scan`` whether each search starts with the one-time scan (its belief comes first).
     """
 
     nodes: list
@@ -62,6 +63,7 @@ class DemoSetup:
     scene: str = 'gaussian'
     mode: str = ''
     image_px: tuple | None = None
+    scan: bool = False
 
     @property
     def tolerance_cells(self) -> int:
@@ -117,10 +119,13 @@ def faces_setup(fovea: bool = False, policy: str | None = None, seed: int = 0) -
     if fovea:
         side = yaml_parameters(files['scene_camera'], 'scene_camera').get('scene.size_px', 420)
         image_px = (int(side), int(side))
+    from ipomdp_gaze.observation_file import load_observation
+    scan = bool(values.get('search.scan', True)) and \
+        load_observation(values['observation.file']).has_scan
     return DemoSetup([('controller', _ros_args(files['controller'], controller)),
                       ('detector', _ros_args(files['detector'], {})),
                       ('scene_camera', _ros_args(files['scene_camera'], {'seed': seed}))],
-                     grid, head_from(values, grid), controller, 'faces', mode, image_px)
+                     grid, head_from(values, grid), controller, 'faces', mode, image_px, scan)
 
 
 def _started(watch, record, node: str):
@@ -222,6 +227,8 @@ def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
     """
     grid, head = setup.grid, setup.head
     printed = 0
+    skip = 1 if setup.scan else 0           # the scan's belief (and the pose it was taken at)
+    scan_shown = False
 
     def last() -> int:
         if record.found:
@@ -229,10 +236,16 @@ def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
         return max_fixations
 
     def show_new():
-        nonlocal printed
-        while printed < min(len(record.beliefs), len(record.targets), last()):
-            belief = grid_arrays.from_multiarray(record.beliefs[printed][1], grid)
-            pan, tilt = joints.angles_from_joint_state(record.targets[printed][1], head)
+        nonlocal printed, scan_shown
+        if skip and not scan_shown and record.beliefs:
+            belief = grid_arrays.from_multiarray(record.beliefs[0][1], grid)
+            guess = int(np.argmax(belief))
+            out(f'scan: the whole image once  ->  most likely {grid.cell(guess)} '
+                f'p={belief[guess]:.3f}  entropy {float(entropy(belief)):.2f} nats')
+            scan_shown = True
+        while printed < min(len(record.beliefs) - skip, len(record.targets) - skip, last()):
+            belief = grid_arrays.from_multiarray(record.beliefs[printed + skip][1], grid)
+            pan, tilt = joints.angles_from_joint_state(record.targets[printed + skip][1], head)
             looked = head.nearest_cell(pan, tilt)
             guess = int(np.argmax(belief))
             out(f'fixation {printed + 1:3d}: looked at {grid.cell(looked)}  '
@@ -255,7 +268,7 @@ def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
         out(f'ipomdp-gaze demo: the {what} was not found within {timeout_s:g} s')
         return 1
     else:
-        belief = grid_arrays.from_multiarray(record.beliefs[printed - 1][1], grid)
+        belief = grid_arrays.from_multiarray(record.beliefs[printed - 1 + skip][1], grid)
         cell = int(np.argmax(belief))
         answer = (*grid.cell(cell), cell)
         found = {'row': answer[0], 'col': answer[1], 'cell': cell, 'fixations': printed,

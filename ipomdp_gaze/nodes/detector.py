@@ -8,7 +8,7 @@ fixation and counts its detections, and :mod:`msg_adapters` reads and fills ever
 (docs/design.md section 6.6). Two modes (``mode``, read-only):
 
 - ``fovea``: a fixed camera; the grid tiles the image and the digital fovea is placed on the
-  fixated cell (the shipped ``faces-420-nmpt`` model by default);
+  fixated cell (the shipped ``faces-420`` model by default);
 - ``camera``: a camera on the pan/tilt head; the detector runs on the whole view, its
   detections are binned to pan/tilt cells with ``camera_info``'s K and the head pose of the
   ``joint_states`` message stamped like the image, and cells outside the view are NaN (the
@@ -69,7 +69,7 @@ def detector_params() -> list[Param]:
               'head (read-only)', read_only=True, choices=MODES),
         Param('observation.file', '', T.STRING,
               'count model: an ipomdp_gaze/observation-v1 path or shipped name ("": '
-              'faces-420-nmpt in fovea mode, faces-pan-tilt in camera mode); its grid, fovea '
+              'faces-420 in fovea mode, faces-pan-tilt in camera mode); its grid, fovea '
               'and detector win'),
         Param('grid.rows', 0, T.INTEGER, "rows (0: the observation file's; read-only)",
               read_only=True, int_range=(0, MAX_CELLS_PER_SIDE)),
@@ -159,10 +159,6 @@ class FovealDetectorNode(Node):
             f'{cfg.setup.mode} mode, count model {cfg.setup.name!r} ({g.rows}x{g.cols} grid, '
             f'K = {cfg.setup.model.max_count + 1}), detector {cfg.setup.detector!r}; waiting '
             f'for fixation and image')
-        if getattr(cfg.setup.model, 'has_scan', False):
-            self.get_logger().warning(
-                f'{cfg.setup.name!r} has a one-time whole-image scan, which this node does not '
-                f'serve: its frames hold the fovea windows only (faces-420-nmpt has none)')
 
     @property
     def _config(self) -> DetectorConfig:
@@ -237,19 +233,29 @@ class FovealDetectorNode(Node):
 
     def _on_fixation(self, msg: Int32MultiArray) -> None:
         try:
-            cell = grid_arrays.cell_from_row_col(msg, self._config.setup.grid, 'fixation')
+            cell, search_id = grid_arrays.read_fixation(msg, self._config.setup.grid)
         except ValueError as exc:
             self.get_logger().warning(f'ignored a fixation: {exc}',
                                       throttle_duration_sec=WARN_THROTTLE_S)
             return
-        self._handle(self.loop.fixate(cell, self._now_s()))
+        if cell is None:
+            if not self._config.values['publish_image']:
+                self.get_logger().warning(
+                    'ignored a scan request: a scan frame is tagged in evidence_image, which '
+                    'needs publish_image: true', throttle_duration_sec=WARN_THROTTLE_S)
+                return
+            self._handle(self.loop.request_scan(search_id, self._now_s()))
+            return
+        self._handle(self.loop.fixate(cell, self._now_s(), search_id))
 
     # -- outputs -------------------------------------------------------------------------
     def _handle(self, outcome) -> None:
         if outcome.status == 'published':
             frame, grid = outcome.frame, self._config.setup.grid
             if self._config.values['publish_image']:
-                self._image_pub.publish(images.evidence_image(frame.counts, grid, frame.token))
+                self._image_pub.publish(images.evidence_image(
+                    frame.counts, grid, frame.token,
+                    images.frame_tag(frame.kind, frame.search_id)))
             else:
                 self._evidence_pub.publish(grid_arrays.to_multiarray(frame.counts, grid))
         elif outcome.status == 'rejected':
