@@ -12,6 +12,7 @@ returns carry the message of :class:`ipomdp_gaze.session.SearchSettings`. The no
 """
 from __future__ import annotations
 
+from contextlib import contextmanager
 import json
 import subprocess
 import sys
@@ -61,32 +62,41 @@ def test_the_cli_prints_the_settings_message_in_one_line(flag, text, _param, _ty
         assert 'Traceback' not in out.stderr
 
 
-@pytest.mark.ros
-@pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')
-def test_the_node_refuses_the_same_values_with_the_same_message(ros_env):
+@contextmanager
+def controller_node(ros_env, overrides=None):
+    """A ``gaze_controller`` in this process, on its own context, with parameter overrides."""
     import rclpy
     from rclpy.parameter import Parameter
     from ipomdp_gaze.nodes.controller import GazeControllerNode
     ctx = rclpy.Context()
     rclpy.init(context=ctx, domain_id=int(ros_env['ROS_DOMAIN_ID']), args=[])
     try:
-        node = GazeControllerNode(context=ctx)
+        params = [Parameter(name, value=value) for name, value in (overrides or {}).items()]
+        node = GazeControllerNode(context=ctx, parameter_overrides=params)
         try:
-            for _flag, _text, param, type_name, field, value in BAD:
-                before = node.get_parameter(param).value
-                result = node.set_parameters([Parameter(
-                    param, getattr(Parameter.Type, type_name), value)])[0]
-                assert not result.successful
-                assert message(field, value) in result.reason, (param, result.reason)
-                assert node.get_parameter(param).value == before
-                assert node.core.settings == SearchSettings.from_parameters(
-                    {p: node.get_parameter(p).value for p in
-                     ('confidence', 'search.max_fixations', 'absent.prior',
-                      'search.repeat_weight', 'search.inhibit_return')})
+            yield node
         finally:
             node.destroy_node()
     finally:
         rclpy.try_shutdown(context=ctx)
+
+
+@pytest.mark.ros
+@pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')
+def test_the_node_refuses_the_same_values_with_the_same_message(ros_env):
+    from rclpy.parameter import Parameter
+    with controller_node(ros_env) as node:
+        for _flag, _text, param, type_name, field, value in BAD:
+            before = node.get_parameter(param).value
+            result = node.set_parameters([Parameter(
+                param, getattr(Parameter.Type, type_name), value)])[0]
+            assert not result.successful
+            assert message(field, value) in result.reason, (param, result.reason)
+            assert node.get_parameter(param).value == before
+            assert node.core.settings == SearchSettings.from_parameters(
+                {p: node.get_parameter(p).value for p in
+                 ('confidence', 'search.max_fixations', 'absent.prior',
+                  'search.repeat_weight', 'search.inhibit_return')})
 
 
 @pytest.mark.ros
@@ -97,37 +107,17 @@ def test_the_node_refuses_the_same_values_with_the_same_message(ros_env):
     ({}, 'elm', 'elm'),
 ])
 def test_policy_file_alone_selects_learned_at_start_up(ros_env, overrides, expected, policy):
-    import rclpy
-    from rclpy.parameter import Parameter
-    from ipomdp_gaze.nodes.controller import GazeControllerNode
-    ctx = rclpy.Context()
-    rclpy.init(context=ctx, domain_id=int(ros_env['ROS_DOMAIN_ID']), args=[])
-    try:
-        params = [Parameter(name, value=value) for name, value in overrides.items()]
-        node = GazeControllerNode(context=ctx, parameter_overrides=params)
-        try:
-            assert node.get_parameter('policy.name').value == expected
-            assert node.core.policy.name == policy
-        finally:
-            node.destroy_node()
-    finally:
-        rclpy.try_shutdown(context=ctx)
+    with controller_node(ros_env, overrides) as node:
+        assert node.get_parameter('policy.name').value == expected
+        assert node.core.policy.name == policy
 
 
 @pytest.mark.ros
 @pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')
 def test_a_missing_policy_file_alone_is_refused_at_start_up(ros_env):
-    import rclpy
-    from rclpy.parameter import Parameter
-    from ipomdp_gaze.nodes.controller import GazeControllerNode
-    ctx = rclpy.Context()
-    rclpy.init(context=ctx, domain_id=int(ros_env['ROS_DOMAIN_ID']), args=[])
-    try:
-        with pytest.raises(Exception, match='nothere.yaml'):
-            GazeControllerNode(context=ctx, parameter_overrides=[
-                Parameter('policy.file', value='nothere.yaml')])
-    finally:
-        rclpy.try_shutdown(context=ctx)
+    with pytest.raises(Exception, match='nothere.yaml'):
+        with controller_node(ros_env, {'policy.file': 'nothere.yaml'}):
+            pass
 
 
 def test_evaluate_scenes_runs_the_pan_tilt_task_and_writes_json(tmp_path):
