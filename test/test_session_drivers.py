@@ -64,7 +64,7 @@ def test_the_cli_prints_the_settings_message_in_one_line(flag, text, _param, _ty
 
 @contextmanager
 def controller_node(ros_env, overrides=None):
-    """A ``gaze_controller`` in this process, on its own context, with parameter overrides."""
+    """Run a ``gaze_controller`` in this process, on its own context, with these overrides."""
     import rclpy
     from rclpy.parameter import Parameter
     from ipomdp_gaze.nodes.controller import GazeControllerNode
