@@ -298,7 +298,7 @@ def _simulate_piece(grid, model, policy, episodes, horizon, seed, rows, options)
 
 
 def simulate_pieces(executor, grid, model, policy, episodes: int, horizon, seed: int,
-                    chunk: int | None = None, **options) -> list:
+                    chunk: int | None = None, progress=None, **options) -> list:
     """
     Submit ``simulate(grid, model, policy, episodes, horizon, seed, **options)`` in pieces.
 
@@ -308,14 +308,22 @@ def simulate_pieces(executor, grid, model, policy, episodes: int, horizon, seed:
     pieces of ``chunk`` rows (:func:`ipomdp_gaze.simulate.simulate` with ``rows``): exactly
     the unsplit rows for a deterministic policy, and for a stochastic one a result that depends
     on ``chunk`` but not on the executor. ``options`` are passed on (``targets``, ``present``,
-    ``motion`` ...).
+    ``motion`` ...); ``progress`` (``add`` / ``update``) counts the pieces.
     """
     if chunk is None or chunk >= episodes:
-        return [executor.submit(_simulate_piece, grid, model, policy, episodes, horizon, seed,
-                                None, options)]
-    return [executor.submit(_simulate_piece, grid, model, policy, episodes, horizon, seed,
-                            (start, min(start + chunk, episodes)), options)
-            for start in range(0, episodes, int(chunk))]
+        rows = [None]
+    else:
+        rows = [(start, min(start + chunk, episodes)) for start in range(0, episodes, chunk)]
+    if progress is not None:
+        progress.add(len(rows))
+    futures = []
+    for piece in rows:
+        future = executor.submit(_simulate_piece, grid, model, policy, episodes, horizon, seed,
+                                 piece, options)
+        if progress is not None:
+            future.add_done_callback(lambda f: f.cancelled() or progress.update(1))
+        futures.append(future)
+    return futures
 
 
 def concat_results(parts) -> SearchResult:

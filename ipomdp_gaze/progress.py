@@ -50,6 +50,9 @@ class Progress:
             from tqdm import tqdm
             self._bar = tqdm(total=total, desc=desc, unit=unit, file=self.stream,
                              dynamic_ncols=True)
+        elif not self.quiet:                    # a line every few seconds, pieces done or not
+            self._stop = threading.Event()
+            threading.Thread(target=self._tick, daemon=True, name='progress').start()
 
     def __enter__(self):
         return self
@@ -57,6 +60,14 @@ class Progress:
     def __exit__(self, *exc):
         self.close()
         return False
+
+    def _tick(self) -> None:
+        while not self._stop.wait(self.every_s):
+            with self._lock:
+                now = time.monotonic()
+                if not self._closed and now - self._last >= self.every_s * 0.999:
+                    self._last = now
+                    self._line(now)
 
     def add(self, n: float) -> None:
         """Count ``n`` more units to do (a job that learns its size as it submits)."""
@@ -99,4 +110,5 @@ class Progress:
             if self._bar is not None:
                 self._bar.close()
             else:
+                self._stop.set()
                 self._line(time.monotonic())
