@@ -32,10 +32,12 @@ Typical use::
 from __future__ import annotations
 
 import concurrent.futures as cf
+import functools
 import hashlib
 import os
 from pathlib import Path
 import signal
+import socket
 
 SCHEDULER_ENV = 'DASK_SCHEDULER_ADDRESS'
 # Seconds to wait for a Dask scheduler before giving up with one line.
@@ -50,8 +52,14 @@ class ClusterError(OSError):
     """
 
 
+@functools.lru_cache(maxsize=1)
 def source_digest() -> str:
-    """SHA-256 of every Python source of the package (a cached result is stale when it moves)."""
+    """
+    SHA-256 of every Python source of the package (a cached result is stale when it moves).
+
+    Read once per process, as near as can be to when its code was imported: a worker that
+    outlives a change of the files keeps the digest of the code it runs.
+    """
     digest = hashlib.sha256()
     package = Path(__file__).resolve().parent
     for folder in (package, package / 'policies'):
@@ -135,6 +143,7 @@ class DaskExecutor(_Executor):
             raise ClusterError('--scheduler needs Dask: pip install "ipomdp_gaze[cluster]" '
                                '(dask[distributed])') from None
         self.address = address
+        _probe(address, timeout_s)
         try:
             self.client = Client(address, timeout=timeout_s, set_as_default=False)
         except (OSError, TimeoutError, ValueError) as exc:
@@ -167,9 +176,9 @@ class DaskExecutor(_Executor):
         theirs = self.client.run(_worker_source)
         for worker, digest in sorted(theirs.items()):
             if digest != mine:
-                raise ClusterError(f'Dask worker {worker} runs another ipomdp_gaze ({digest}) '
-                                   f'than this process ({mine[:12]}): install the same code '
-                                   'on every worker')
+                raise ClusterError(f'Dask worker {worker} runs another ipomdp_gaze (source '
+                                   f'{digest[:12]}) than this process ({mine[:12]}): install '
+                                   'the same code on every worker')
         if not theirs:
             raise ClusterError(f'the Dask scheduler at {self.address} has no workers')
 
@@ -186,9 +195,30 @@ class DaskExecutor(_Executor):
             self.client.close()
 
 
+def _probe(address: str, timeout_s: float) -> None:
+    """
+    Refuse a malformed or unreachable TCP address at once, with the reason, in one line.
+
+    Dask would retry a refused connection until its timeout and then say only that it timed
+    out; other transports (``ucx://`` ...) are left to Dask.
+    """
+    scheme, sep, rest = address.rpartition('://')
+    if sep and scheme not in ('tcp', 'tls'):
+        return
+    host, colon, port = rest.rpartition(':')
+    if not colon or not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise ClusterError(f'--scheduler wants [tcp://]HOST:PORT, e.g. tcp://10.0.0.5:8786, '
+                           f'got {address!r}')
+    try:
+        socket.create_connection((host.strip('[]'), int(port)), timeout=timeout_s).close()
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise ClusterError(f'cannot reach the Dask scheduler at {address}: {reason}') from None
+
+
 def _worker_source() -> str:
-    """Return the short source digest of the ipomdp_gaze a worker imports (run there)."""
-    return source_digest()[:12]
+    """Return the source digest of the ipomdp_gaze a worker imports (run there)."""
+    return source_digest()
 
 
 def scheduler_address(scheduler: str | None = None) -> str | None:

@@ -336,3 +336,23 @@ def concat_results(parts) -> SearchResult:
         values = [getattr(p, name) for p in parts]
         fields[name] = None if values[0] is None else np.concatenate(values)
     return SearchResult(**fields)
+
+
+def train_piece(grid, model, config, params, init: str, epochs: int, final_episodes: int,
+                final_seed: int):
+    """
+    Train one policy of a sweep in a worker; return ``(spec, curve rows, evaluation)``.
+
+    ``config`` is a :class:`ipomdp_gaze.policies.training.TrainConfig` (its seed decides every
+    epoch's draws), ``params`` the starting parameters (None: zeros). The closing evaluation on
+    ``final_episodes`` episodes (0: none) is :func:`evaluation_block`'s, as ``train`` writes.
+    """
+    from ipomdp_gaze.policies.training import evaluation_block, Trainer
+    trainer = Trainer(grid, model, config, params=params, init=init)
+    rows = trainer.run(epochs)
+    evaluation = {}
+    if final_episodes:
+        evaluation = evaluation_block(grid, model, trainer.family.policy(trainer.params),
+                                      final_episodes, final_seed, trainer.horizon,
+                                      scene=config.scene())
+    return trainer.spec(evaluation=evaluation), rows, evaluation

@@ -45,7 +45,7 @@ class Progress:
             terminal = bool(isatty and isatty())
         self.done, self._lock = 0, threading.Lock()
         self._start = self._last = time.monotonic()
-        self._bar, self._closed = None, False
+        self._bar, self._closed, self._note = None, False, ''
         if not self.quiet and terminal:
             from tqdm import tqdm
             self._bar = tqdm(total=total, desc=desc, unit=unit, file=self.stream,
@@ -68,6 +68,12 @@ class Progress:
                 if not self._closed and now - self._last >= self.every_s * 0.999:
                     self._last = now
                     self._line(now)
+
+    def note(self, text: str) -> None:
+        """Show ``text`` after the count (the bar's postfix, or the end of the next line)."""
+        self._note = str(text)
+        if self._bar is not None:
+            self._bar.set_postfix_str(self._note, refresh=False)
 
     def add(self, n: float) -> None:
         """Count ``n`` more units to do (a job that learns its size as it submits)."""
@@ -99,6 +105,8 @@ class Progress:
         text += f', {_clock(elapsed)} elapsed'
         if 0 < self.done < self.total:
             text += f', ETA {_clock(elapsed * (self.total - self.done) / self.done)}'
+        if self._note:
+            text += f' ({self._note})'
         print(text, file=self.stream, flush=True)
 
     def close(self) -> None:
