@@ -234,6 +234,10 @@ class Runner:
         if self.progress is not None:
             self.progress.update(1)
 
+    def pending(self, name) -> list:
+        """Return the pieces of a run not yet collected: futures, or results from the cache."""
+        return list(self._pending.get(name, []))
+
     def collect(self):
         """Wait for every queued run; keep its matrices, summed CPU seconds and decisions."""
         for name, jobs in self._pending.items():
