@@ -226,11 +226,13 @@ def scheduler_address(scheduler: str | None = None) -> str | None:
     return scheduler or os.environ.get(SCHEDULER_ENV) or None
 
 
-def make_executor(jobs: int | None = None, scheduler: str | None = None):
+def make_executor(jobs: int | None = None, scheduler: str | None = None,
+                  pieces: int | None = None):
     """
     Return the executor for a job: Dask when a scheduler is given, else local ``jobs`` processes.
 
-    ``jobs`` None means one process per core; 1 runs every piece in this process. Raises
+    ``jobs`` None means one process per core; 1 runs every piece in this process, and so does a
+    small job, of ``pieces`` < 2 when the caller knows its size (no pool to start). Raises
     :class:`ClusterError` (one line) when the scheduler cannot be used.
     """
     address = scheduler_address(scheduler)
@@ -239,7 +241,8 @@ def make_executor(jobs: int | None = None, scheduler: str | None = None):
     jobs = (os.cpu_count() or 1) if jobs is None else int(jobs)
     if jobs < 1:
         raise ValueError(f'jobs must be >= 1, got {jobs}')
-    return InlineExecutor() if jobs == 1 else LocalExecutor(jobs)
+    small = pieces is not None and pieces < 2
+    return InlineExecutor() if jobs == 1 or small else LocalExecutor(min(jobs, pieces or jobs))
 
 
 def track(futures, progress=None, weights=None):

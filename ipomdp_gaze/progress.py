@@ -50,8 +50,9 @@ class Progress:
             from tqdm import tqdm
             self._bar = tqdm(total=total, desc=desc, unit=unit, file=self.stream,
                              dynamic_ncols=True)
-        elif not self.quiet:                    # a line every few seconds, pieces done or not
-            self._stop = threading.Event()
+        self._stop = threading.Event()
+        if not self.quiet and not terminal and self.every_s > 0:
+            # A line every few seconds, pieces done or not (0: a line at every update only).
             threading.Thread(target=self._tick, daemon=True, name='progress').start()
 
     def __enter__(self):

@@ -222,10 +222,23 @@ def format_decisions(result: dict) -> str:
     return '\n'.join(lines)
 
 
+def _pieces(args, policies) -> int:
+    """Return how many pieces :func:`evaluate` submits for these arguments."""
+    count = 0
+    for policy in policies.values():
+        if getattr(policy, 'costly', False):
+            chunk = PLANNER_CHUNK if getattr(policy, 'name', '') == 'planner' else COSTLY_CHUNK
+            count += -(-min(args.episodes, args.episodes_greedy) // chunk)
+        else:
+            count += 1
+    moving = bool(args.motion_sigma_cells) or bool(args.jump_prob)
+    return 2 * count if args.compare_prediction and moving else count
+
+
 def run(args) -> int:
     grid, fpoc = task_from_args(args)
     policies = load_policies(args, grid, fpoc)
-    with executor_from_args(args) as executor, \
+    with executor_from_args(args, _pieces(args, policies)) as executor, \
             progress_from_args(args, 0, 'evaluate') as bar:
         result = evaluate(grid, fpoc, policies, args.episodes, args.horizon, args.seed,
                           args.episodes_greedy, args.bootstrap,

@@ -25,9 +25,13 @@ def add_run_args(p, jobs_help: str = '') -> None:
                         'seconds)')
 
 
-def executor_from_args(args):
-    """Return the executor of ``--jobs`` / ``--scheduler`` (``ClusterError``: one line)."""
-    return make_executor(args.jobs, args.scheduler)
+def executor_from_args(args, pieces: int | None = None):
+    """
+    Return the executor of ``--jobs`` / ``--scheduler`` (``ClusterError``: one line).
+
+    ``pieces``, when known, lets a small job run here and a pool start no idle processes.
+    """
+    return make_executor(args.jobs, args.scheduler, pieces)
 
 
 def progress_from_args(args, total, desc: str, unit: str = 'piece') -> Progress:

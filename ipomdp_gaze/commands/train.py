@@ -251,7 +251,7 @@ def run_sweep(args, grid, model, config, params, init, out) -> int:
     rates = args.learning_rates
     runs = [(seed, rate) for rate in (rates or [config.learning_rate]) for seed in seeds]
     epochs = args.epochs
-    with executor_from_args(args) as executor, \
+    with executor_from_args(args, len(runs)) as executor, \
             progress_from_args(args, len(runs), 'train sweep', 'training') as bar:
         futures = {}
         for seed, rate in runs:
