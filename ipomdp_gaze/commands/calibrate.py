@@ -25,6 +25,7 @@ from ipomdp_gaze.grid import Grid
 import numpy as np
 
 from .common import grid_arg, nonneg_int, positive_float, positive_int
+from .running import add_run_args, executor_from_args, progress_from_args
 
 # The two tasks of the face issue: image side and face sizes in pixels.
 TASKS = {'paper': (420, (60, 140)), 'small': (840, (24, 140))}
@@ -106,11 +107,11 @@ def add_parser(sub):
     p.add_argument('--fixation-stride', type=positive_int, default=1, metavar='S',
                    help='fixate the cells whose row and column are multiples of S (and the '
                         'last row and column) instead of every cell (default 1: every cell)')
-    p.add_argument('--processes', type=positive_int, default=2)
+    p.add_argument('--processes', dest='jobs', type=positive_int, help=argparse.SUPPRESS)
     p.add_argument('--out', type=Path, required=True, metavar='FILE.yaml')
     p.add_argument('--plot', type=Path, default=None, metavar='PNG',
                    help='figure of the learned FPOC (default: beside --out)')
-    p.add_argument('--quiet', action='store_true', help='no progress bar')
+    add_run_args(p)
     p.set_defaults(run=run)
 
 
@@ -244,12 +245,12 @@ def run_pan_tilt(args) -> int:
     scenes = PanTiltSceneSet('train', geometry, face_px, 'rgb', args.seed)
     detector_kwargs = {'scale_factor': args.scale_factor}
     detector = HaarDetector(**detector_kwargs)
-    from tqdm import tqdm
-    bar = tqdm(total=args.scenes, unit='scene', disable=args.quiet, desc='calibrate')
     start = time.perf_counter()
-    tallies = tally_pan_tilt_scenes(scenes, range(args.scenes), detector_kwargs,
-                                    args.max_count, null_scenes, args.processes, bar.update)
-    bar.close()
+    with executor_from_args(args) as executor, \
+            progress_from_args(args, args.scenes, 'calibrate', 'scene') as bar:
+        tallies = tally_pan_tilt_scenes(scenes, range(args.scenes), detector_kwargs,
+                                        args.max_count, null_scenes, progress=bar.update,
+                                        executor=executor)
     wall = time.perf_counter() - start
     meta = {'image': {'width': width, 'height': height, 'view': 'pan_tilt',
                       'camera': camera.to_dict()},
@@ -294,14 +295,13 @@ def run(args) -> int:
     detector = HaarDetector(**detector_kwargs)
     Fovea(detector, grid, config)        # refuses a bad configuration before any work
     items, (height, width), source = _items(args, grid)
-    from tqdm import tqdm
-    bar = tqdm(total=len(items), unit='image', disable=args.quiet, desc='calibrate')
     start = time.perf_counter()
     fixations = None if args.fixation_stride == 1 else \
         lattice_fixations(grid, args.fixation_stride)
-    tallies = tally_images(items, detector_kwargs, grid, config, args.processes, bar.update,
-                           fixations)
-    bar.close()
+    with executor_from_args(args) as executor, \
+            progress_from_args(args, len(items), 'calibrate', 'image') as bar:
+        tallies = tally_images(items, detector_kwargs, grid, config, progress=bar.update,
+                               fixations=fixations, executor=executor)
     wall = time.perf_counter() - start
     meta = {'image': {'width': int(width), 'height': int(height)}, 'fovea': config.to_dict(),
             'detector': detector.settings(),

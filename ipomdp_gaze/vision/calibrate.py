@@ -26,7 +26,6 @@ processes, each with its own detector (OpenCV objects cannot be shared).
 """
 from __future__ import annotations
 
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 
 from ipomdp_gaze.grid import Grid
@@ -164,30 +163,39 @@ def _resolve(item):
     return item
 
 
-def _run_jobs(worker, jobs: list, total: Tallies, processes: int, progress) -> Tallies:
+def _run_jobs(worker, jobs: list, total: Tallies, processes: int, progress,
+              executor=None) -> Tallies:
     """
-    Add ``worker(job)`` of every job to ``total``, in ``processes`` workers (1: here).
+    Add ``worker(job)`` of every job to ``total``, on ``executor`` (:mod:`ipomdp_gaze.executor`).
 
-    ``job[3]`` is the job's list of images or scenes: ``progress`` gets its length.
+    Without an executor, ``processes`` local workers (1: here). ``job[3]`` is the job's list of
+    images or scenes: ``progress`` gets its length as each job finishes. The parts are added in
+    job order, so the tallies are the same wherever the jobs ran.
     """
-    if processes <= 1:
-        parts = map(worker, jobs)
-    else:
-        pool = ProcessPoolExecutor(processes)
-        parts = pool.map(worker, jobs)
+    from ipomdp_gaze.executor import make_executor
+    own = executor is None
+    executor = make_executor(processes) if own else executor
     try:
-        for job, part in zip(jobs, parts):
-            total += part
+        futures = []
+        for job in jobs:
+            future = executor.submit(worker, job)
             if progress:
-                progress(len(job[3]))
-    finally:
-        if processes > 1:
-            pool.shutdown()
+                future.add_done_callback(
+                    lambda f, n=len(job[3]): f.cancelled() or f.exception() or progress(n))
+            futures.append(future)
+        for future in futures:
+            total += future.result()
+    except BaseException:
+        if own:
+            executor.close(cancel=True)
+        raise
+    if own:
+        executor.close()
     return total
 
 
 def tally_images(items, detector_kwargs: dict, grid: Grid, config: FoveaConfig,
-                 processes: int = 2, progress=None, fixations=None) -> Tallies:
+                 processes: int = 2, progress=None, fixations=None, executor=None) -> Tallies:
     """
     Tally many labelled images, spread over ``processes`` worker processes.
 
@@ -201,18 +209,22 @@ def tally_images(items, detector_kwargs: dict, grid: Grid, config: FoveaConfig,
     grid, config
         The grid tiling each image and the fovea.
     processes : int
-        Worker processes (1: in this process).
+        Worker processes (1: in this process) when no ``executor`` is given.
     progress : callable, optional
         Called with the number of images done after each chunk.
     fixations : array of int, optional
         The fixated cells of every image (default: all; see :func:`lattice_fixations`).
+    executor : optional
+        Where the chunks run (:func:`ipomdp_gaze.executor.make_executor`); the tallies do not
+        depend on it.
 
     """
     total = Tallies.empty(grid, config.max_count)
-    chunk = max(1, min(8, len(items) // max(1, 4 * processes)))
+    workers = processes if executor is None else executor.workers
+    chunk = max(1, min(8, len(items) // max(1, 4 * workers)))
     jobs = [(dict(detector_kwargs), grid.shape, config.to_dict(), items[i:i + chunk], fixations)
             for i in range(0, len(items), chunk)]
-    return _run_jobs(_worker_tally, jobs, total, processes, progress)
+    return _run_jobs(_worker_tally, jobs, total, processes, progress, executor)
 
 
 def tally_views(observer, geometry, scene_image: np.ndarray, target_cell: int | None,
@@ -268,7 +280,7 @@ def _worker_tally_views(job) -> Tallies:
 
 def tally_pan_tilt_scenes(scenes, indices, detector_kwargs: dict, max_count: int,
                           null_scenes: int | None = None, processes: int = 2,
-                          progress=None) -> Tallies:
+                          progress=None, executor=None) -> Tallies:
     """
     Tally pan/tilt scenes, the head at every pose, in worker processes.
 
@@ -292,19 +304,22 @@ def tally_pan_tilt_scenes(scenes, indices, detector_kwargs: dict, max_count: int
     null_scenes : int, optional
         Scene indices below this are viewed from every pose (default: all of them).
     processes : int
-        Worker processes (1: in this process).
+        Worker processes (1: in this process) when no ``executor`` is given.
     progress : callable, optional
         Called with the number of scenes done after each chunk.
+    executor : optional
+        Where the chunks run (:func:`ipomdp_gaze.executor.make_executor`).
 
     """
     indices = [int(i) for i in indices]
     null_scenes = max(indices, default=0) + 1 if null_scenes is None else int(null_scenes)
     grid = scenes.geometry.grid
     total = Tallies.empty(grid, max_count)
-    chunk = max(1, min(4, len(indices) // max(1, 4 * processes)))
+    workers = processes if executor is None else executor.workers
+    chunk = max(1, min(4, len(indices) // max(1, 4 * workers)))
     jobs = [(dict(detector_kwargs), int(max_count), scenes.kwargs(), indices[i:i + chunk],
              null_scenes) for i in range(0, len(indices), chunk)]
-    return _run_jobs(_worker_tally_views, jobs, total, processes, progress)
+    return _run_jobs(_worker_tally_views, jobs, total, processes, progress, executor)
 
 
 def pool_target(tallies: np.ndarray, pool_radius: float, min_tallies: int = 0) -> np.ndarray:

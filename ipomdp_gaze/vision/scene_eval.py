@@ -30,6 +30,7 @@ import math
 from pathlib import Path
 
 from ipomdp_gaze.evaluation import wilson_interval
+from ipomdp_gaze.executor import InlineExecutor, track
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.observation_file import load_observation
@@ -183,27 +184,18 @@ def head_travel_deg(grid: Grid, path) -> float:
     return float(grid.spacing_deg * np.hypot(np.diff(rows), np.diff(cols)).sum())
 
 
-def evaluate_scenes(spec: TaskSpec, episodes: int, pool=None, progress=None) -> list:
+def evaluate_scenes(spec: TaskSpec, episodes: int, executor=None, progress=None) -> list:
     """
-    Search scenes ``0..episodes-1`` of ``spec``; one piece of work per scene.
+    Search scenes ``0..episodes-1`` of ``spec``; one piece of work per scene, in scene order.
 
-    ``pool`` is anything with ``submit(fn, *args)`` returning futures (a process pool), or None
-    to run here; ``progress`` is called with the number of scenes done.
+    ``executor`` is an :mod:`ipomdp_gaze.executor` executor (in-process when None: a local pool
+    or a Dask cluster give the same results); ``progress`` anything with ``update(n)``.
     """
-    if pool is None:
-        results = []
-        for i in range(episodes):
-            results.append(evaluate_scene(spec, i))
-            if progress is not None:
-                progress(i + 1)
-        return results
-    futures = [pool.submit(evaluate_scene, spec, i) for i in range(episodes)]
-    results = []
-    for done, future in enumerate(futures, 1):
-        results.append(future.result())
-        if progress is not None:
-            progress(done)
-    return results
+    executor = InlineExecutor() if executor is None else executor
+    futures = [executor.submit(evaluate_scene, spec, i) for i in range(episodes)]
+    for _ in track(futures, progress):
+        pass
+    return [future.result() for future in futures]
 
 
 def summarise(results: list) -> dict:
