@@ -3,7 +3,8 @@
 """
 Shared fixtures; the ROS ones run real nodes over real DDS, isolated per test run.
 
-Every run gets its own ``ROS_DOMAIN_ID`` (derived from the pytest process id, 0..101), discovery
+Every run gets its own ``ROS_DOMAIN_ID`` (1..101, reserved with a lock file so that two runs at
+once never share one: :func:`ipomdp_gaze.nodes.processes.domain_id_for`), discovery
 limited to this host and node log files in a temporary directory. Nodes under test run as
 separate processes (as a user runs them, :class:`ipomdp_gaze.nodes.processes.NodeGroup`); the
 test's own node (``probe``, an :class:`ipomdp_gaze.nodes.watch.Watch`) spins a
