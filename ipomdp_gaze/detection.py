@@ -32,11 +32,14 @@ has (:func:`check_camera`: a field of view outside :data:`FOV_RANGE_DEG` or a pr
 outside the image, ``camera_info_rejected``).
 
 **Bounded cost per frame.** Images are held only while a fixation waits, at most ``keep`` (4)
-of them. In ``camera`` mode a view more than :data:`RESIZE_ABOVE` times wider or taller than the
-camera the model was calibrated with is resized (``cv2.INTER_AREA``) to that camera's width
-when it arrives, and ``camera_info``'s K is scaled with it: the detector then sees faces at the
-pixel size the counts were calibrated at, and its cost is that of the model's camera whatever
-the driver sends (refusing such views instead would make every HD camera unusable).
+of them. An image more than :data:`RESIZE_ABOVE` times wider or taller than the images the
+model was calibrated on (420x420 for the shipped fovea models, the 320x240 camera of
+``faces-pan-tilt``) is resized (``cv2.INTER_AREA``, aspect kept) to fit that size when it
+arrives; in ``camera`` mode ``camera_info``'s K is scaled with it. The detector then sees faces
+at the pixel size the counts were calibrated at, and its cost is that of the model's images
+whatever the driver sends. (Refusing such images instead would make every HD camera unusable;
+the grid tiles the image in ``fovea`` mode and K follows the resize in ``camera`` mode, so the
+cells seen do not change.)
 
 :func:`build_setup` reads the observation file: its grid, fovea and detector settings are the
 ones the counts mean anything with, so settings given next to it may only repeat them.
@@ -66,8 +69,8 @@ TIMING_WINDOW = 100
 MAX_JOINT_RAD = 2 * math.pi
 # Fields of view (degrees, edge to edge) a camera_info may describe.
 FOV_RANGE_DEG = (0.5, 175.0)
-# camera mode: views more than this many times the model camera's width or height are resized.
-RESIZE_ABOVE = 1.5
+# Images more than this many times the model's image width or height are resized (far larger).
+RESIZE_ABOVE = 2.0
 # Defaults of the time sanity rule (seconds).
 STAMP_TOLERANCE_S = 0.5
 MAX_AGE_S = 10.0
@@ -77,6 +80,16 @@ def model_view(model) -> str:
     """``'pan_tilt'`` for a model calibrated through a head camera, else ``'fixed'``."""
     image = getattr(model, 'meta', {}).get('image') or {}
     return str(image.get('view', 'fixed'))
+
+
+def model_image_size(model) -> tuple[int, int] | None:
+    """Return the ``(width, height)`` of the images a model was calibrated on, or None."""
+    image = getattr(model, 'meta', {}).get('image') or {}
+    try:
+        size = int(image['width']), int(image['height'])
+    except (KeyError, TypeError, ValueError):
+        return None
+    return size if min(size) > 0 else None
 
 
 def model_camera(model) -> PinholeCamera | None:
@@ -98,6 +111,7 @@ class DetectorSetup:
     fovea: object = None
     observer: object = None
     camera: PinholeCamera | None = None
+    image_size: tuple[int, int] | None = None
 
     @property
     def grid(self) -> Grid:
@@ -163,9 +177,11 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
     haar = detector_from_settings(recorded, cascade_dir or None)
     if mode == 'fovea':
         return DetectorSetup(mode, model, name, haar,
-                             fovea=fovea_for_model(model, haar, reuse_windows=False))
+                             fovea=fovea_for_model(model, haar, reuse_windows=False),
+                             image_size=model_image_size(model))
     observer = ViewObserver(haar, g, model.max_count + 1)
-    return DetectorSetup(mode, model, name, haar, observer=observer, camera=model_camera(model))
+    return DetectorSetup(mode, model, name, haar, observer=observer, camera=model_camera(model),
+                         image_size=model_image_size(model))
 
 
 def camera_mismatch(model_camera_: PinholeCamera | None, camera: PinholeCamera) -> str:
@@ -211,18 +227,19 @@ def scaled_camera(camera: PinholeCamera, width: int, height: int) -> PinholeCame
                          (camera.cx + 0.5) * sx - 0.5, (camera.cy + 0.5) * sy - 0.5)
 
 
-def resized_size(size: tuple[int, int], model: PinholeCamera | None) -> tuple[int, int] | None:
+def resized_size(size: tuple[int, int],
+                 model_size: tuple[int, int] | None) -> tuple[int, int] | None:
     """
-    ``(width, height)`` a camera-mode view of ``size`` is resized to, or None to keep it.
+    Return the ``(width, height)`` an image of ``size`` is resized to, or None to keep it.
 
-    A view more than :data:`RESIZE_ABOVE` times the model camera's width or height is scaled
-    (aspect kept) to fit within the model camera's size.
+    An image more than :data:`RESIZE_ABOVE` times the model's image width or height is scaled
+    (aspect kept) to fit within the model's image size.
     """
     width, height = size
-    if model is None or (width <= RESIZE_ABOVE * model.width and
-                         height <= RESIZE_ABOVE * model.height):
+    if model_size is None or (width <= RESIZE_ABOVE * model_size[0] and
+                              height <= RESIZE_ABOVE * model_size[1]):
         return None
-    scale = min(model.width / width, model.height / height)
+    scale = min(model_size[0] / width, model_size[1] / height)
     return max(1, round(width * scale)), max(1, round(height * scale))
 
 
@@ -344,12 +361,13 @@ class DetectorLoop:
         if now_s is not None and (self.pending is None or now_s < self.pending[1]):
             return Outcome('idle')
         size = (image.shape[1], image.shape[0])
-        if self.setup.mode == 'camera' and image.ndim in (2, 3):
-            target = resized_size(size, self.setup.camera)
+        t0 = time.perf_counter()
+        if image.ndim in (2, 3):
+            target = resized_size(size, self.setup.image_size)
             if target is not None:
                 image = resize_view(image, target)
                 self.resized += 1
-        self._images.append((float(stamp_s), image, token, size))
+        self._images.append((float(stamp_s), image, token, size, time.perf_counter() - t0))
         return self.serve()
 
     def reject(self, reason: str) -> Outcome:
@@ -429,9 +447,9 @@ class DetectorLoop:
         fresh = [item for item in self._images if item[0] >= since]
         if not fresh:
             return Outcome('waiting', 'no image captured since the fixation was commanded')
-        stamp, image, token, size = fresh[-1]
+        stamp, image, token, size, prep_s = fresh[-1]
         if self.setup.mode == 'fovea':
-            return self._count(cell, stamp, image, token)
+            return self._count(cell, stamp, image, token, prep_s=prep_s)
         if self.camera is None:
             return Outcome('waiting', 'no camera_info received: camera mode needs the '
                                       'intrinsics K to map pixels to cells')
@@ -444,7 +462,7 @@ class DetectorLoop:
             self._drop_through(stamp)
             return Outcome('waiting', f'the head is at {self.setup.grid.cell(at)}, not yet at '
                                       f'the fixation {self.setup.grid.cell(cell)}')
-        return self._count(cell, stamp, image, token, head_rc, size)
+        return self._count(cell, stamp, image, token, head_rc, size, prep_s)
 
     def _drop_through(self, stamp_s: float) -> None:
         while self._images and self._images[0][0] <= stamp_s:
@@ -462,7 +480,8 @@ class DetectorLoop:
         return scaled_camera(camera, width, height)
 
     def _count(self, cell: int, stamp_s: float, image, token, head_rc=None,
-               size=None) -> Outcome:
+               size=None, prep_s: float = 0.0) -> Outcome:
+        """Detect and count; the frame's ``seconds`` include the resize on arrival."""
         setup = self.setup
         t0 = time.perf_counter()
         try:
@@ -477,7 +496,7 @@ class DetectorLoop:
         except ValueError as exc:
             self._drop_through(stamp_s)
             return self._rejected(str(exc))
-        seconds = time.perf_counter() - t0
+        seconds = time.perf_counter() - t0 + prep_s
         self._drop_through(stamp_s)
         self.pending = None
         self.processed += 1

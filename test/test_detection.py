@@ -197,7 +197,7 @@ def test_absurd_joint_angles_and_intrinsics_are_refused_and_counted(camera_setup
     assert 'camera_info' in values['last_input_rejection']
 
 
-@pytest.mark.parametrize('scale', [2, 4])
+@pytest.mark.parametrize('scale', [3, 4])
 def test_a_large_view_is_resized_to_the_model_camera_with_the_same_counts(camera_setup, scale):
     import cv2
     from ipomdp_gaze.detection import scaled_camera
@@ -237,3 +237,23 @@ def test_no_more_than_keep_images_are_held(camera_setup):
         loop.add_image(float(t), view, now_s=float(t))
     values = loop.values()
     assert values['images_held'] == 4 and values['images_unused'] == 20
+
+
+def test_a_large_fovea_image_is_resized_to_the_model_image(fovea_setup):
+    import cv2
+    image = SceneSet('test', **PAPER_TASK, color='rgb', seed=2).scene(0).image     # 420x420
+    big = cv2.resize(image, (1700, 1300), interpolation=cv2.INTER_NEAREST)
+    loop = DetectorLoop(fovea_setup)
+    cell = fovea_setup.grid.index(10, 10)
+    loop.fixate(cell, 0.0)
+    out = loop.add_image(1.0, big, now_s=1.0)
+    small = cv2.resize(big, (420, 321), interpolation=cv2.INTER_AREA)
+    fovea = fovea_for_model(fovea_setup.model, reuse_windows=False)
+    fovea.start(small)
+    want = fovea.observe(cell)
+    np.testing.assert_array_equal(out.frame.counts, want.counts)
+    assert out.frame.detector_pixels == want.detector_pixels
+    assert loop.values()['images_resized'] == 1
+    loop.fixate(cell, 2.0)
+    assert loop.add_image(3.0, cv2.resize(image, (840, 840)), now_s=3.0).status == 'published'
+    assert loop.values()['images_resized'] == 1            # twice the model's side: kept
