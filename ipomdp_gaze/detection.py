@@ -29,7 +29,8 @@ no limit) is rejected as stale (``images_stale``; a clock behind, or a replay).
 **Finite but absurd values** are refused where they enter, counted like image rejections: joint
 angles beyond :data:`MAX_JOINT_RAD` (``joint_states_rejected``) and intrinsics that no camera
 has (:func:`check_camera`: a field of view outside :data:`FOV_RANGE_DEG` or a principal point
-outside the image, ``camera_info_rejected``).
+outside the image, ``camera_info_rejected``). As for images, ``<input>_received`` counts every
+message of that input, the rejected ones included.
 
 **Bounded cost per frame.** Images are held only while a fixation waits, at most ``keep`` (4)
 of them. An image more than :data:`RESIZE_ABOVE` times wider or taller than the images the
@@ -518,7 +519,7 @@ class DetectorLoop:
             'images_unused': self.received - self.processed - self.rejected,
             'images_future': self.future, 'images_stale': self.stale,
             'images_resized': self.resized, 'images_held': len(self._images),
-            'fixations_received': self.fixations, 'waiting_for_image': waiting,
+            'fixations_received': self.inputs['fixation'][0], 'waiting_for_image': waiting,
             'waiting_because': self.waiting if waiting else '',
             'camera_info': self.camera is not None,
             'detector_ms_last': 1e3 * seconds[-1] if seconds.size else 0.0,
