@@ -88,7 +88,7 @@ def model_image_size(model) -> tuple[int, int] | None:
     image = getattr(model, 'meta', {}).get('image') or {}
     try:
         size = int(image['width']), int(image['height'])
-    except (KeyError, TypeError, ValueError):
+    except (KeyError, TypeError, ValueError, OverflowError):
         return None
     return size if min(size) > 0 else None
 
@@ -175,14 +175,26 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
         if asked != recorded.get(key):
             raise ValueError(f'detector.{key} {asked!r} contradicts observation.file {name!r}, '
                              f'measured with {recorded.get(key)!r} (leave it unset to take it)')
-    haar = detector_from_settings(recorded, cascade_dir or None)
-    if mode == 'fovea':
-        return DetectorSetup(mode, model, name, haar,
-                             fovea=fovea_for_model(model, haar, reuse_windows=False),
-                             image_size=model_image_size(model))
-    observer = ViewObserver(haar, g, model.max_count + 1)
-    return DetectorSetup(mode, model, name, haar, observer=observer, camera=model_camera(model),
-                         image_size=model_image_size(model))
+    try:
+        haar = detector_from_settings(recorded, cascade_dir or None)
+        if mode == 'fovea':
+            return DetectorSetup(mode, model, name, haar,
+                                 fovea=fovea_for_model(model, haar, reuse_windows=False),
+                                 image_size=model_image_size(model))
+        observer = ViewObserver(haar, g, model.max_count + 1)
+        return DetectorSetup(mode, model, name, haar, observer=observer,
+                             camera=model_camera(model), image_size=model_image_size(model))
+    except ValueError as exc:
+        raise ValueError(_one_line(exc)) from None
+    except (TypeError, KeyError, IndexError, OverflowError, AttributeError, OSError) as exc:
+        # A record of the file with the wrong types (a fuzzed or hand-edited file).
+        raise ValueError(f'observation.file {name!r}: its detector or fovea record is unusable '
+                         f'({type(exc).__name__}: {_one_line(exc)})') from None
+
+
+def _one_line(exc: BaseException) -> str:
+    """Return an exception's message on one line (its lines joined with '; ')."""
+    return '; '.join(line.strip() for line in str(exc).splitlines() if line.strip())
 
 
 def camera_mismatch(model_camera_: PinholeCamera | None, camera: PinholeCamera) -> str:
