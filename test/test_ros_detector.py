@@ -137,9 +137,12 @@ def test_an_image_taken_before_the_fixation_does_not_serve_it(fovea):
     early = fovea.now()
     fovea.fixate(fovea.grid, 0)
     n = len(fovea.frames)
-    processed = int(fovea.values()['images_processed'])
+    before = fovea.values()
     fovea.image.publish(images.camera_image(scene.image, early))
-    values = fovea.wait_values(images_processed=processed)
+    # Wait until the node has taken the image (a counter that moves), then check it unused.
+    values = fovea.wait_values(images_received=int(before['images_received']) + 1)
+    assert values['images_processed'] == before['images_processed']
+    assert int(values['images_unused']) == int(before['images_unused']) + 1
     assert values['waiting_for_image'] == 'true' and len(fovea.frames) == n
     counts, _ = fovea.frame_after(
         lambda: fovea.image.publish(images.camera_image(scene.image, fovea.now())))
