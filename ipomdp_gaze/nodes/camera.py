@@ -16,7 +16,9 @@ Publishes ``evidence`` (``Float32MultiArray``, best effort) or, with ``publish_i
 stamped ``evidence_image`` (``32FC1``); ``joint_states`` (its pose, stamped like the frame taken
 there); and ``ground_truth`` (``std_msgs/Int32MultiArray`` ``[row, col]``, transient local;
 ``[-1, -1]`` for an empty scene). ``~/reset`` (``std_srvs/Trigger``) draws a new target
-(``target_row``/``target_col``, or a random cell when they are -1).
+(``target_row``/``target_col``, or a random cell when they are -1). Every callback runs under a
+:class:`ipomdp_gaze.nodes.guard.CallbackGuard` (its counts in the ``/diagnostics`` status
+``<node>: callbacks``).
 
 Beyond the paper (docs/design.md section 7): with ``empty_scene`` there is no target (every
 frame is null noise) from the start or the next ``~/reset``; with ``target_motion_rate_hz > 0``

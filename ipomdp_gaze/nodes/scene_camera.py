@@ -22,6 +22,8 @@ with ``rate_hz > 0`` it streams frames like a video camera, also while moving. A
 ``image`` (``rgb8``), ``camera_info`` and, for ``pan_tilt``, ``joint_states`` (its pose), all
 with one stamp. ``ground_truth`` (``std_msgs/Int32MultiArray`` ``[row, col]`` of the face
 centre's cell in the grid of the view, transient local) is published once when it is known.
+Every callback runs under a :class:`ipomdp_gaze.nodes.guard.CallbackGuard` (its counts in the
+``/diagnostics`` status ``<node>: callbacks``).
 """
 from __future__ import annotations
 
