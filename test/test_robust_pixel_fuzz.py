@@ -7,9 +7,10 @@ This test is the camera driver and the controller. It sends hostile messages one
 waits, on ``/diagnostics``, until the node has counted each one, so every counter can be
 predicted exactly: images with wrong encodings, steps and lengths that disagree with the size,
 zero and huge sizes, random bytes, stamps an hour ahead or decades old, images too small for
-the detector or taken before the fixation; fixations outside the grid or of the wrong length;
-in ``camera`` mode ``camera_info`` with NaN, skewed, absurd or oversized intrinsics and
-``joint_states`` with 1e308, NaN or out-of-turn angles, missing positions or future stamps.
+the detector or taken before the fixation, one real 5000x5000 image; fixations outside the grid
+or of the wrong length; in ``camera`` mode ``camera_info`` with NaN, skewed, absurd or
+oversized intrinsics and ``joint_states`` with 1e308, NaN or out-of-turn angles, missing
+positions or future stamps.
 Between them go valid requests (a fixation, then an image; in ``camera`` mode with its
 ``camera_info`` and the joint state of its stamp), each of which must be answered with counts
 stamped like its image. Afterwards every counter matches the prediction
@@ -327,6 +328,13 @@ def _fuzz(rig: Rig, hostile: int, seed: int) -> dict:
     kinds_used = set()
     t0 = time.monotonic()
     cycles = -(-hostile // HOSTILE_PER_CYCLE)
+    # One real 5000x5000 image (25 MB), once: refused for its size, before anything is copied.
+    want['images_received'] += 1
+    want['images_rejected'] += 1
+    rig.image.publish(messages._image(5000, 5000))
+    rig.wait_counts({k: want[k] for k in ('images_received', 'images_rejected')}, '5000x5000')
+    assert 'larger than 4096 px' in rig.values['last_rejection']
+    sent['hostile'] += 1
     for i in range(cycles):
         split = int(rng.integers(0, HOSTILE_PER_CYCLE + 1))    # some while idle, some waiting
         index = None
