@@ -243,7 +243,9 @@ def report(r: dict) -> tuple[str, bool]:
         f"{'exact' if ctl_exact else 'NOT EXACT'}; pan_tilt re-sends "
         f"{c.get('pan_tilt_resends')}.",
         f"Callback errors: {r['guards']}. Exit statuses after SIGTERM: {r['codes']}.", '',
-        f"**{'All checks passed.' if ok else 'A CHECK FAILED.'}**",
+        f"**{'All checks passed.' if ok else 'A CHECK FAILED.'}**", '',
+        "The scene camera's growth is its cache of rendered views (one 320x240 RGB view per "
+        'head cell, at most 121, 27.9 MB), filled as searches visit new cells.',
     ]
     return '\n'.join(lines) + '\n', ok
 
