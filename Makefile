@@ -20,12 +20,16 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(VPY) -m pytest -q test
 
-# The long robustness runs (minutes): 100,000 fuzzed frames, a minute of load at 1 kHz (11x11)
-# and 60 Hz (256x256), 50 start/SIGTERM cycles, and 1,000 examples per property test.
+# The long robustness runs (minutes): 100,000 fuzzed frames, 10,080 hostile messages to the
+# detector per mode, a minute of load at 1 kHz (11x11) and 60 Hz (256x256), 50 start/SIGTERM
+# cycles, 1,000 examples per property test and fuzzed observation file, and the three-node face
+# loop streaming at 30 Hz for 10 minutes (its section of docs/benchmarks.md).
 soak: $(STAMP)
 	$(VPY) -m pytest -q -s -m soak test
-	PROPERTY_EXAMPLES=1000 $(VPY) -m pytest -q test/test_properties.py
+	PROPERTY_EXAMPLES=1000 $(VPY) -m pytest -q test/test_properties.py \
+		test/test_robust_observation_files.py
 	$(VPY) bench/shutdown_cycles.py --cycles 50
+	$(VPY) bench/soak_face_loop.py --minutes 10
 
 bench: $(STAMP)
 	$(VPY) bench/run.py

@@ -59,6 +59,7 @@ from std_srvs.srv import SetBool, Trigger
 from trajectory_msgs.msg import JointTrajectory
 
 from . import NODE_NAMES
+from .guard import CallbackGuard
 from .params import (cell_params, current_values, fpoc_from, fpoc_params, grid_from, grid_params,
                      head_from, INT_MAX, joint_params, Param, ParameterTransaction, row_col_from,
                      T)
@@ -211,18 +212,22 @@ class GazeControllerNode(Node):
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self._forward_pub = self._trajectory_pub = None
         self._make_command_publishers(v)
+        self.guard = CallbackGuard(self)
         evidence_qos = QoSProfile(history=HistoryPolicy.KEEP_LAST,
                                   depth=v['evidence_queue_depth'],
                                   reliability=ReliabilityPolicy.BEST_EFFORT)
         self._sequences = {'evidence': FrameSequence(), 'evidence_image': FrameSequence()}
         self._evidence_subs = {
             'evidence': self.create_subscription(Float32MultiArray, 'evidence',
-                                                 self._on_evidence, evidence_qos),
+                                                 self.guard.wrap(self._on_evidence),
+                                                 evidence_qos),
             'evidence_image': self.create_subscription(Image, 'evidence_image',
-                                                       self._on_evidence_image, evidence_qos)}
+                                                       self.guard.wrap(self._on_evidence_image),
+                                                       evidence_qos)}
         self._single_publisher = dict.fromkeys(self._sequences, True)
-        self.create_service(Trigger, '~/reset', self._on_reset)
-        self.create_service(SetBool, '~/enable', self._on_enable)
+        self.create_service(Trigger, '~/reset', self.guard.wrap(self._on_reset))
+        self.create_service(SetBool, '~/enable', self.guard.wrap(self._on_enable))
+        self.guard.publish_status()
         self._retry_timer = self._diag_timer = None
         self._make_timers(v)
         self._resends = 0
@@ -399,9 +404,10 @@ class GazeControllerNode(Node):
                 self.destroy_timer(timer)
         self._retry_timer = None
         if values['retry_period_s'] > 0:
-            self._retry_timer = self.create_timer(values['retry_period_s'], self._on_retry)
+            self._retry_timer = self.create_timer(values['retry_period_s'],
+                                                  self.guard.wrap(self._on_retry))
         self._diag_timer = self.create_timer(values['diagnostics_period_s'],
-                                             self._publish_diagnostics)
+                                             self.guard.wrap(self._publish_diagnostics))
 
     # -- time ----------------------------------------------------------------------------
     def _now(self):

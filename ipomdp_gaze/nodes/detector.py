@@ -25,8 +25,12 @@ Relative topic names:
   observed) or, with ``publish_image: false``, ``evidence``; and ``/diagnostics``.
 
 A malformed image (another encoding, a step or data length that disagrees with the size, an
-empty or oversized image) is rejected with a throttled warning naming the reason and counted;
-nothing else changes. Run with ``ros2 run ipomdp_gaze detector`` (or ``ipomdp-gaze detector``).
+empty or oversized image, a stamp that breaks the time sanity rule) is rejected with a throttled
+warning naming the reason and counted; so are absurd joint states, ``camera_info`` and
+fixations (:mod:`ipomdp_gaze.detection`). Every callback runs under a
+:class:`ipomdp_gaze.nodes.guard.CallbackGuard`: an unexpected error is counted
+(``callback_errors``) and the node carries on. Run with ``ros2 run ipomdp_gaze detector`` (or
+``ipomdp-gaze detector``).
 """
 from __future__ import annotations
 
@@ -34,7 +38,8 @@ from dataclasses import dataclass
 import sys
 
 from diagnostic_msgs.msg import DiagnosticArray
-from ipomdp_gaze.detection import build_setup, DetectorLoop, DetectorSetup, MODES
+from ipomdp_gaze.detection import (build_setup, DetectorLoop, DetectorSetup, MAX_AGE_S, MODES,
+                                   STAMP_TOLERANCE_S)
 from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, stamps
 from rclpy.node import Node
@@ -43,6 +48,7 @@ from sensor_msgs.msg import CameraInfo, Image, JointState
 from std_msgs.msg import Float32MultiArray, Int32MultiArray
 
 from . import NODE_NAMES
+from .guard import CallbackGuard
 from .params import head_from, joint_params, MAX_CELLS_PER_SIDE, Param, ParameterTransaction, T
 from .spin import run_node
 
@@ -96,6 +102,12 @@ def detector_params() -> list[Param]:
               'subscribe image best effort, for a driver that publishes it so (default '
               'reliable: large images lose fragments over best effort; read-only)',
               read_only=True),
+        Param('stamp_tolerance_s', STAMP_TOLERANCE_S, T.DOUBLE,
+              "images and joint states stamped more than this ahead of the node's clock are "
+              'rejected (a camera clock running ahead)', float_range=(0.0, 3600.0)),
+        Param('max_image_age_s', MAX_AGE_S, T.DOUBLE,
+              'images and joint states stamped more than this before they arrive are rejected '
+              'as stale (0: no limit)', float_range=(0.0, 1e6)),
         Param('publish_image', True, T.BOOL,
               'publish stamped 32FC1 evidence_image frames (false: evidence)'),
         Param('max_image_side_px', images.MAX_IMAGE_SIDE_PX, T.INTEGER,
@@ -132,28 +144,34 @@ class FovealDetectorNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__(NODE_NAME, **kwargs)
-        self._transaction = ParameterTransaction(self, detector_params(), self._build,
-                                                 self._apply_config)
+        self.guard = guard = CallbackGuard(self)
+        self._transaction = ParameterTransaction(self, detector_params(),
+                                                 guard.refusing(self._build),
+                                                 guard.wrap(self._apply_config))
         self._transaction.declare()
         self._transaction.start(self._build(self._transaction.values()))
         cfg = self._config
         v = cfg.values
-        self.loop = DetectorLoop(cfg.setup, cfg.head, v['joint_state_tolerance_s'])
-        self._reported_rejections = 0
+        self.loop = DetectorLoop(cfg.setup, cfg.head, v['joint_state_tolerance_s'],
+                                 stamp_tolerance_s=v['stamp_tolerance_s'],
+                                 max_age_s=v['max_image_age_s'])
+        self._reported = (0, 0, 0)
         self._evidence_pub = self.create_publisher(Float32MultiArray, 'evidence', FRAME_QOS)
         self._image_pub = self.create_publisher(Image, 'evidence_image', FRAME_QOS)
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
-        self.create_subscription(Image, 'image', self._on_image,
+        self.create_subscription(Image, 'image', guard.wrap(self._on_image),
                                  IMAGE_QOS[v['image_best_effort']])
-        self.create_subscription(Int32MultiArray, 'fixation', self._on_fixation, STATE_QOS)
+        self.create_subscription(Int32MultiArray, 'fixation', guard.wrap(self._on_fixation),
+                                 STATE_QOS)
         if cfg.setup.mode == 'camera':
-            self.create_subscription(CameraInfo, 'camera_info', self._on_camera_info,
+            self.create_subscription(CameraInfo, 'camera_info', guard.wrap(self._on_camera_info),
                                      SENSOR_QOS)
-            self.create_subscription(JointState, 'joint_states', self._on_joint_states,
+            self.create_subscription(JointState, 'joint_states',
+                                     guard.wrap(self._on_joint_states),
                                      QoSProfile(depth=50,
                                                 reliability=ReliabilityPolicy.BEST_EFFORT))
         self._diag_timer = self.create_timer(v['diagnostics_period_s'],
-                                             self._publish_diagnostics)
+                                             guard.wrap(self._publish_diagnostics))
         g = cfg.setup.grid
         self.get_logger().info(
             f'{cfg.setup.mode} mode, count model {cfg.setup.name!r} ({g.rows}x{g.cols} grid, '
@@ -184,10 +202,12 @@ class FovealDetectorNode(Node):
         self.loop.set_setup(cfg.setup)
         self.loop.head = cfg.head
         self.loop.tolerance_s = cfg.values['joint_state_tolerance_s']
+        self.loop.stamp_tolerance_s = cfg.values['stamp_tolerance_s']
+        self.loop.max_age_s = cfg.values['max_image_age_s']
         if cfg.values['diagnostics_period_s'] != old.values['diagnostics_period_s']:
             self.destroy_timer(self._diag_timer)
             self._diag_timer = self.create_timer(cfg.values['diagnostics_period_s'],
-                                                 self._publish_diagnostics)
+                                                 self.guard.wrap(self._publish_diagnostics))
 
     # -- inputs --------------------------------------------------------------------------
     def _now_s(self) -> float:
@@ -203,46 +223,48 @@ class FovealDetectorNode(Node):
         except images.ImageError as exc:
             self._handle(self.loop.reject(str(exc)))
             return
+        now = self.get_clock().now()
         stamp = msg.header.stamp
         if stamps.is_zero(stamp):
-            stamp = self.get_clock().now().to_msg()
-        self._handle(self.loop.add_image(stamps.to_seconds(stamp), pixels, stamp))
+            stamp = now.to_msg()
+        self._handle(self.loop.add_image(stamps.to_seconds(stamp), pixels, stamp,
+                                         now.nanoseconds * 1e-9))
 
     def _on_camera_info(self, msg: CameraInfo) -> None:
         try:
             camera = images.camera_from_info(msg)
         except images.ImageError as exc:
-            self.get_logger().warning(f'ignored a camera_info: {exc}',
-                                      throttle_duration_sec=WARN_THROTTLE_S)
+            self._handle(self.loop.refuse('camera_info', str(exc)))
             return
-        if camera != self.loop.camera:
-            mismatch = self.loop.set_camera(camera)
-            if mismatch:
-                self.get_logger().warning(mismatch)
-        self._handle(self.loop.serve())
+        outcome = self.loop.set_camera(camera, self._config.values['max_image_side_px'])
+        if self.loop.mismatch:
+            self.get_logger().warning(self.loop.mismatch)
+            self.loop.mismatch = ''
+        self._handle(outcome)
 
     def _on_joint_states(self, msg: JointState) -> None:
         head = self._config.head
-        if head is None:
-            return
+        if head is None or head.pan_joint not in msg.name or head.tilt_joint not in msg.name:
+            return              # a joint state of other joints: not the head's
         try:
             pan, tilt = joints.angles_from_joint_state(msg, head)
-        except ValueError:
-            return              # a joint state of other joints: not the head's
-        self._handle(self.loop.add_pose(self._stamp_s(msg.header.stamp), pan, tilt))
+        except ValueError as exc:
+            self._handle(self.loop.refuse('joint_states', str(exc)))
+            return
+        self._handle(self.loop.add_pose(self._stamp_s(msg.header.stamp), pan, tilt,
+                                        self._now_s()))
 
     def _on_fixation(self, msg: Int32MultiArray) -> None:
         try:
             cell, search_id = grid_arrays.read_fixation(msg, self._config.setup.grid)
         except ValueError as exc:
-            self.get_logger().warning(f'ignored a fixation: {exc}',
-                                      throttle_duration_sec=WARN_THROTTLE_S)
+            self._handle(self.loop.refuse('fixation', str(exc)))
             return
         if cell is None:
             if not self._config.values['publish_image']:
-                self.get_logger().warning(
-                    'ignored a scan request: a scan frame is tagged in evidence_image, which '
-                    'needs publish_image: true', throttle_duration_sec=WARN_THROTTLE_S)
+                self._handle(self.loop.refuse(
+                    'fixation', 'a scan request needs publish_image: true (a scan frame is '
+                                'tagged in evidence_image)'))
                 return
             self._handle(self.loop.request_scan(search_id, self._now_s()))
             return
@@ -262,6 +284,11 @@ class FovealDetectorNode(Node):
             self.get_logger().warning(
                 f'rejected an image ({self.loop.rejected} so far): {outcome.reason}',
                 throttle_duration_sec=WARN_THROTTLE_S)
+        elif outcome.status == 'refused':
+            refused = sum(counts[1] for counts in self.loop.inputs.values())
+            self.get_logger().warning(
+                f'ignored a message ({refused} so far): {outcome.reason}',
+                throttle_duration_sec=WARN_THROTTLE_S)
         elif outcome.status == 'waiting' and outcome.reason.startswith('no camera_info'):
             self.get_logger().warning(
                 f"a fixation waits: {outcome.reason}; is the camera driver's camera_info "
@@ -269,14 +296,18 @@ class FovealDetectorNode(Node):
                 throttle_duration_sec=WARN_THROTTLE_S)
 
     def _publish_diagnostics(self) -> None:
-        values = self.loop.values()
+        values = {**self.loop.values(), **self.guard.values()}
         level, message = 'ok', 'serving fixations'
+        now = (self.loop.rejected, sum(c[1] for c in self.loop.inputs.values()),
+               self.guard.errors)
+        new = [b - a for a, b in zip(self._reported, now)]
         if values['waiting_for_image'] and self.loop.waiting.startswith('no camera_info'):
             level, message = 'warn', 'no camera_info received'
-        elif self.loop.rejected > self._reported_rejections:
+        elif any(new):
             level = 'warn'
-            message = f'{self.loop.rejected - self._reported_rejections} images rejected'
-        self._reported_rejections = self.loop.rejected
+            message = ', '.join(f'{n} {what}' for n, what in zip(
+                new, ('images rejected', 'other messages ignored', 'callback errors')) if n)
+        self._reported = now
         self._diag_pub.publish(diagnostics.diagnostic_array(
             [diagnostics.status(f'{self.get_fully_qualified_name()}: detector', level, message,
                                 values)], self.get_clock().now().to_msg()))

@@ -22,6 +22,8 @@ with ``rate_hz > 0`` it streams frames like a video camera, also while moving. A
 ``image`` (``rgb8``), ``camera_info`` and, for ``pan_tilt``, ``joint_states`` (its pose), all
 with one stamp. ``ground_truth`` (``std_msgs/Int32MultiArray`` ``[row, col]`` of the face
 centre's cell in the grid of the view, transient local) is published once when it is known.
+Every callback runs under a :class:`ipomdp_gaze.nodes.guard.CallbackGuard` (its counts in the
+``/diagnostics`` status ``<node>: callbacks``).
 """
 from __future__ import annotations
 
@@ -37,6 +39,7 @@ from sensor_msgs.msg import CameraInfo, Image, JointState
 from std_msgs.msg import Int32MultiArray
 
 from . import NODE_NAMES
+from .guard import CallbackGuard
 from .params import (head_from, INT_MAX, joint_params, MAX_CELLS_PER_SIDE, Param,
                      ParameterTransaction, T)
 from .saccade import SaccadeMixin
@@ -153,8 +156,10 @@ class SceneCameraNode(SaccadeMixin, Node):
 
     def __init__(self, **kwargs):
         super().__init__(NODE_NAME, **kwargs)
-        self._transaction = ParameterTransaction(self, scene_camera_params(), self._build,
-                                                 self._apply_config)
+        self.guard = CallbackGuard(self)
+        self._transaction = ParameterTransaction(self, scene_camera_params(),
+                                                 self.guard.refusing(self._build),
+                                                 self.guard.wrap(self._apply_config))
         self._transaction.declare()
         self._transaction.start(_scene_config(self._transaction.values()))
         cfg = self._config
@@ -165,13 +170,15 @@ class SceneCameraNode(SaccadeMixin, Node):
         self._info_pub = self.create_publisher(CameraInfo, 'camera_info', IMAGE_QOS)
         self._joint_pub = self.create_publisher(JointState, 'joint_states', 10)
         self._truth_pub = self.create_publisher(Int32MultiArray, 'ground_truth', STATE_QOS)
-        self.create_subscription(JointState, 'pan_tilt', self._on_command, STATE_QOS)
+        self.create_subscription(JointState, 'pan_tilt', self.guard.wrap(self._on_command),
+                                 STATE_QOS)
         self._saccade_timer = self._frame_timer = None
         self._make_timers(cfg.values)
         scene = cfg.scene
         if scene.cell is not None:
             self._truth_pub.publish(grid_arrays.ground_truth(cfg.grid, cfg.grid.index(
                 *scene.cell)))
+        self.guard.publish_status()
         height, width = self._view(self.pose).shape[:2]
         where = 'no face given' if scene.face_centre_px is None else \
             f'face centre ({scene.face_centre_px[0]:.1f}, {scene.face_centre_px[1]:.1f}) px ' \
@@ -206,10 +213,12 @@ class SceneCameraNode(SaccadeMixin, Node):
         if self.moving:
             self._arrive()
         if values['saccade_time_s'] > 0:
-            self._saccade_timer = self.create_timer(values['saccade_time_s'], self._on_arrival)
+            self._saccade_timer = self.create_timer(values['saccade_time_s'],
+                                                    self.guard.wrap(self._on_arrival))
             self._saccade_timer.cancel()
         if values['rate_hz'] > 0:
-            self._frame_timer = self.create_timer(1.0 / values['rate_hz'], self._publish_frame)
+            self._frame_timer = self.create_timer(1.0 / values['rate_hz'],
+                                                  self.guard.wrap(self._publish_frame))
 
     # -- head ------------------------------------------------------------------------------
     def _on_command(self, msg: JointState) -> None:
