@@ -40,7 +40,8 @@ MODES = ('fovea', 'camera')
 DEFAULT_MODELS = {'fovea': 'faces-420-nmpt', 'camera': 'faces-pan-tilt'}
 # The view a model was calibrated with (its image record), per mode.
 MODE_VIEWS = {'fovea': 'fixed', 'camera': 'pan_tilt'}
-# Detector settings a node parameter may repeat (an empty or negative value: the file's).
+# The Haar detector's settings with node parameters of their own (an empty or negative value:
+# the file's); any detector's other settings go in detector.options.
 DETECTOR_KEYS = ('cascade', 'scale_factor', 'min_neighbors')
 TIMING_WINDOW = 100
 
@@ -91,8 +92,8 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
     grid : (int, int, float)
         ``rows, cols, spacing_deg`` asked for; 0 takes the file's. Another value must repeat it.
     detector : dict, optional
-        Detector settings asked for (keys of :data:`DETECTOR_KEYS`); each must repeat the
-        file's.
+        Detector settings asked for (``kind`` and the detector's own settings, e.g. those of
+        :data:`DETECTOR_KEYS` for ``haar``); each must repeat the file's.
     cascade_dir : str, optional
         Folder (or file) searched first for the cascade the file names.
 
@@ -104,7 +105,9 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
 
     """
     from ipomdp_gaze.vision.pan_tilt import ViewObserver
-    from ipomdp_gaze.vision.search import detector_from_settings, fovea_for_model
+    from ipomdp_gaze.vision.cell_observation import cell_observation_of
+    from ipomdp_gaze.vision.detectors import detector_from_settings
+    from ipomdp_gaze.vision.search import fovea_for_model
     if mode not in MODES:
         raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
     name = source or DEFAULT_MODELS[mode]
@@ -127,17 +130,20 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
     if not recorded:
         raise ValueError(f'observation.file {name!r} does not record its detector')
     for key, asked in (detector or {}).items():
-        if key not in DETECTOR_KEYS:
-            raise ValueError(f'unknown detector setting {key!r}')
+        if key not in recorded:
+            raise ValueError(f'detector.{key}: the detector {recorded.get("kind")!r} of '
+                             f'observation.file {name!r} has no setting {key!r} (it has '
+                             f'{", ".join(sorted(recorded))})')
         if asked != recorded.get(key):
             raise ValueError(f'detector.{key} {asked!r} contradicts observation.file {name!r}, '
                              f'measured with {recorded.get(key)!r} (leave it unset to take it)')
-    haar = detector_from_settings(recorded, cascade_dir or None)
+    built = detector_from_settings(recorded, cascade_dir or None)
     if mode == 'fovea':
-        return DetectorSetup(mode, model, name, haar,
-                             fovea=fovea_for_model(model, haar, reuse_windows=False))
-    observer = ViewObserver(haar, g, model.max_count + 1)
-    return DetectorSetup(mode, model, name, haar, observer=observer, camera=model_camera(model))
+        return DetectorSetup(mode, model, name, built,
+                             fovea=fovea_for_model(model, built, reuse_windows=False))
+    observer = ViewObserver(built, g, model.max_count + 1,
+                            cell_observation_of(model.meta, model.max_count + 1))
+    return DetectorSetup(mode, model, name, built, observer=observer, camera=model_camera(model))
 
 
 def camera_mismatch(model_camera_: PinholeCamera | None, camera: PinholeCamera) -> str:
