@@ -51,6 +51,8 @@ MIN_SIDE_PX = 2
 COLORS = ('gray', 'rgb')
 # Settings recorded for information only unless a detector names its own (``info_keys``).
 INFO_KEYS = ('opencv', 'window_px')
+# Set by the factory (ipomdp_gaze.vision.detectors) on what it builds: the kind it built it by.
+KIND_ATTRIBUTE = '_ipomdp_gaze_kind'
 
 
 @runtime_checkable
@@ -346,16 +348,20 @@ class HaarDetector:
 
 def detector_settings(detector) -> dict:
     """
-    ``detector.settings()`` if it has one, else ``{'kind': 'module:Class'}`` of its type.
+    Return ``detector.settings()`` (if it has one) with the detector's ``kind`` first.
 
-    The fallback names the detector's class so that the factory
-    (:func:`ipomdp_gaze.vision.detectors.make_detector`) can rebuild it when it takes no options.
+    ``kind`` is the name the factory (:func:`ipomdp_gaze.vision.detectors.make_detector`) built
+    the detector by; for a detector built otherwise, the kind its settings give, else its class
+    as ``module:Class``, so that the factory can rebuild it when it takes no options.
     """
     settings = getattr(detector, 'settings', None)
-    if callable(settings):
-        return dict(settings())
-    kind = type(detector)
-    return {'kind': f'{kind.__module__}:{kind.__qualname__}'}
+    out = dict(settings()) if callable(settings) else {}
+    kind = getattr(detector, KIND_ATTRIBUTE, None)
+    if kind is None and 'kind' not in out:
+        kind = f'{type(detector).__module__}:{type(detector).__qualname__}'
+    if kind is not None:
+        out['kind'] = kind
+    return {'kind': out.pop('kind'), **out}
 
 
 def detector_window_px(detector) -> tuple[int, int]:

@@ -18,13 +18,15 @@ A detector **kind** is one of:
   module does, so only use files and modules you trust.
 
 ``Factory(**options)`` returns the detector (the interface is in
-:mod:`ipomdp_gaze.vision.detector`). Its ``settings()`` must return ``kind`` and the options it
-was built with, so that :func:`detector_from_settings` can rebuild it from an observation file:
-a factory with a ``from_settings(settings, **context)`` class method is rebuilt with it (the Haar
-cascade checks its file's SHA-256 there), any other with ``Factory(**options)``, the options
-being the settings without ``kind`` and the detector's ``info_keys``. The rebuilt detector's
-settings must then equal the recorded ones, except the ``info_keys`` (the OpenCV version, the
-window), which are reported as notes when they differ.
+:mod:`ipomdp_gaze.vision.detector`). Its ``settings()`` must return the options it was built
+with; the factory records the kind it built the detector by (so a plug-in need not know the
+name it was installed under). :func:`detector_from_settings` rebuilds a detector from an
+observation file's record: a factory with a ``from_settings(settings, **context)`` class method
+with it (the Haar cascade and YuNet check their file's SHA-256 there), any other with
+``Factory(**options)``, the options being the settings without ``kind`` and the detector's
+``info_keys``. The rebuilt detector's settings must then equal the recorded ones, except the
+``info_keys`` (the OpenCV version, the window), which :func:`compare_settings` reports as notes
+when they differ.
 """
 from __future__ import annotations
 
@@ -33,7 +35,7 @@ from importlib import metadata
 import inspect
 import re
 
-from ipomdp_gaze.vision.detector import COLORS, detector_settings, INFO_KEYS
+from ipomdp_gaze.vision.detector import COLORS, detector_settings, INFO_KEYS, KIND_ATTRIBUTE
 
 ENTRY_POINT_GROUP = 'ipomdp_gaze.detectors'
 # The shipped detectors: declared as entry points in setup.py, and found here without them.
@@ -112,6 +114,10 @@ def _checked(detector, kind: str):
     if color not in COLORS:
         raise ValueError(f'detector {kind!r}: color must be one of {", ".join(COLORS)}, got '
                          f'{color!r}')
+    try:
+        setattr(detector, KIND_ATTRIBUTE, kind)
+    except AttributeError:
+        pass                    # a detector with __slots__ records its own kind
     return detector
 
 
