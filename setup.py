@@ -13,7 +13,8 @@ setup(
     # One import namespace: policies/ and msg_adapters/ are reached through the committed
     # symlinks ipomdp_gaze/policies and ipomdp_gaze/msg_adapters (docs/design.md section 8).
     packages=find_packages(include=[PACKAGE, f'{PACKAGE}.*']),
-    package_data={f'{PACKAGE}.policies': ['kernels/*.yaml'], PACKAGE: ['models/*.yaml']},
+    package_data={f'{PACKAGE}.policies': ['kernels/*.yaml'],
+                  PACKAGE: ['models/*.yaml', 'data/*.csv']},
     data_files=[
         ('share/ament_index/resource_index/packages', [f'resource/{PACKAGE}']),
         (f'share/{PACKAGE}', ['package.xml']),
