@@ -125,8 +125,9 @@ def quantile_edges(best_scores, n_bins: int) -> tuple:
     Edges giving ``n_bins`` bins of about equal shares of ``best_scores`` (training data).
 
     The ``n_bins - 1`` edges are the quantiles at ``1/n_bins .. (n_bins-1)/n_bins``, rounded to
-    6 decimals; equal quantiles (a detector with few distinct scores) are merged, so fewer bins
-    may come back.
+    6 decimals; equal quantiles (a detector with few distinct scores) are merged and an edge at
+    the lowest score (which would leave the first bin empty) is dropped, so fewer bins may come
+    back.
 
     Raises
     ------
@@ -140,7 +141,7 @@ def quantile_edges(best_scores, n_bins: int) -> tuple:
         raise ValueError('no detection on the training data: no score to choose bin edges from')
     q = np.arange(1, n_bins) / n_bins
     edges = np.unique(np.round(np.quantile(scores, q), 6))
-    return tuple(float(e) for e in edges)
+    return tuple(float(e) for e in edges if e > scores.min())
 
 
 def cell_observation_of(meta: dict, max_count: int) -> CellObservation:
