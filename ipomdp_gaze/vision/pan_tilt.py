@@ -105,7 +105,8 @@ class ViewObserver:
     Parameters
     ----------
     detector : callable
-        ``detector(gray) -> (M, 4)`` raw boxes (:mod:`ipomdp_gaze.vision.detector`).
+        ``detector(image) -> (M, 5)`` raw boxes with scores, or ``(M, 4)``, in the colour space
+        it declares (:mod:`ipomdp_gaze.vision.detector`).
     grid : Grid
         The pan/tilt grid (its ``spacing_deg`` matters).
     max_count : int
