@@ -84,3 +84,30 @@ def test_group_pictures_are_reproducible_and_their_faces_are_found(yunet):
     centres = found[:, :2] + found[:, 2:] / 2
     hit = [any(inside(c, box) for c in centres) for box in boxes]
     assert sum(hit) >= 5, hit
+
+
+@pytest.mark.parametrize('name', ['faces-420-yunet', 'faces-840-yunet', 'faces-pan-tilt-yunet'])
+def test_the_shipped_yunet_models_record_score_bins_and_rebuild_their_detector(name):
+    from ipomdp_gaze.observation_file import load_observation
+    from ipomdp_gaze.vision.cell_observation import cell_observation_of
+    model = load_observation(name)
+    rule = cell_observation_of(model.meta, model.max_count + 1)
+    assert rule.kind == 'score_bins' and model.meta['detector']['kind'] == 'yunet'
+    assert model.meta['calibration']['source'].get('split', 'train') == 'train'
+    detector = detector_from_settings(dict(model.meta['detector']))
+    assert detector_settings(detector)['model_sha256'] == model.meta['detector']['model_sha256']
+
+
+def test_find_with_the_yunet_model_finds_the_cameraman_that_haar_misses(tmp_path):
+    import json
+    from ipomdp_gaze.cli import main as cli
+    photo = next(p for p in real_photos() if p.name == 'camera')
+    path = tmp_path / 'camera.png'
+    cv2.imwrite(str(path), photo.image[:, :, ::-1])
+    assert cli(['find', str(path), '--observation', 'faces-420-yunet', '--json',
+                str(tmp_path / 'out.json')]) == 0
+    found = json.loads((tmp_path / 'out.json').read_text())['images'][0]
+    x, y, w, h = photo.boxes[0]
+    rows, cols = 21, 21
+    face = (int((y + h / 2) * rows // 512), int((x + w / 2) * cols // 512))
+    assert max(abs(found['cell'][0] - face[0]), abs(found['cell'][1] - face[1])) <= 1
