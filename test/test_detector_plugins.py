@@ -216,3 +216,40 @@ def test_the_detector_node_serves_an_outside_detector(ros_env, probe, plugin_dir
     finally:
         bad = group.close()
     assert not bad, bad
+
+
+@pytest.mark.parametrize('extra, words', [
+    (['--cells', 'threshold'], '--cells threshold needs --threshold T'),
+    (['--cells', 'score_bins', '--threshold', '0.5'], '--threshold goes with --cells threshold'),
+    (['--scale-factor', '1.2'], '--scale-factor is a haar setting'),
+    (['--detector-option', 'min_red'], 'a detector option must be NAME=VALUE'),
+])
+def test_calibrate_refuses_options_that_do_not_fit_in_one_line(on_path, tmp_path, capsys,
+                                                               extra, words):
+    labels = labelled_folder(tmp_path / 'images', n=2)
+    rc = cli(['calibrate', '--images', str(tmp_path / 'images'), '--labels', str(labels),
+              '--detector', 'blob', '--out', str(tmp_path / 'x.yaml'), '--quiet', *extra])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and words in err[0], err
+
+
+def test_a_threshold_model_counts_only_boxes_scoring_above_it(on_path, tmp_path):
+    from ipomdp_gaze.observation_file import load_observation
+    from ipomdp_gaze.vision.search import fovea_for_model
+    labels = labelled_folder(tmp_path / 'images')
+    out = tmp_path / 'above.yaml'
+    assert cli(['calibrate', '--images', str(tmp_path / 'images'), '--labels', str(labels),
+                '--grid', f'{CELLS}x{CELLS}', '--windows', f'{CELLS},3', '--max-count', '3',
+                '--detector', 'blob', '--cells', 'threshold', '--threshold', '0.6',
+                '--min-tallies', '0', '--processes', '1', '--quiet', '--out', str(out)]) == 0
+    model = load_observation(out)
+    assert model.meta['cells'] == {'kind': 'threshold', 'max_count': 3, 'threshold': 0.6}
+    fovea = fovea_for_model(model)
+    cell = fovea.grid.index(3, 3)
+    # Scores (red - 30) / 255: 0.86, 0.51; both windows (7 and 3 cells) see the square.
+    for red, expected in ((250, 2), (160, 0)):
+        image = np.full((SIZE, SIZE, 3), 100, np.uint8)
+        image[35:49, 35:49] = (red, 30, 30)              # centred in cell (3, 3)
+        fovea.start(image)
+        assert len(fovea.detector(image)) == 1
+        assert fovea.observe(cell).counts[cell] == expected
