@@ -71,6 +71,8 @@ class DetectorSetup:
     fovea: object = None
     observer: object = None
     camera: PinholeCamera | None = None
+    notes: tuple = ()
+    """What differs from the file in information-only detector settings (the OpenCV version)."""
 
     @property
     def grid(self) -> Grid:
@@ -137,13 +139,16 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
         if asked != recorded.get(key):
             raise ValueError(f'detector.{key} {asked!r} contradicts observation.file {name!r}, '
                              f'measured with {recorded.get(key)!r} (leave it unset to take it)')
-    built = detector_from_settings(recorded, cascade_dir or None)
+    notes = []
+    built = detector_from_settings(recorded, cascade_dir or None, notes.append)
     if mode == 'fovea':
         return DetectorSetup(mode, model, name, built,
-                             fovea=fovea_for_model(model, built, reuse_windows=False))
+                             fovea=fovea_for_model(model, built, reuse_windows=False),
+                             notes=tuple(notes))
     observer = ViewObserver(built, g, model.max_count + 1,
                             cell_observation_of(model.meta, model.max_count + 1))
-    return DetectorSetup(mode, model, name, built, observer=observer, camera=model_camera(model))
+    return DetectorSetup(mode, model, name, built, observer=observer, camera=model_camera(model),
+                         notes=tuple(notes))
 
 
 def camera_mismatch(model_camera_: PinholeCamera | None, camera: PinholeCamera) -> str:

@@ -151,3 +151,16 @@ def test_settings_that_repeat_the_observation_file_are_accepted():
                          'cascade': 'haarcascade_frontalface_alt2.xml'})
     assert setup.grid.shape == (21, 21) and setup.fovea is not None
     assert build_setup('camera', grid=(11, 11, 5.0)).observer is not None
+
+
+def test_another_opencv_version_is_a_note_and_another_cascade_is_refused(tmp_path):
+    from ipomdp_gaze.observation_file import load_observation, save_observation
+    model = load_observation('faces-420-nmpt')
+    model.meta['detector'] = {**model.meta['detector'], 'opencv': '4.5.0'}
+    path = save_observation(tmp_path / 'old.yaml', model)
+    setup = build_setup('fovea', str(path))
+    assert len(setup.notes) == 1 and "detector opencv '4.5.0'" in setup.notes[0]
+    model.meta['detector']['cascade_sha256'] = '0' * 64
+    path = save_observation(tmp_path / 'other.yaml', model)
+    with pytest.raises(ValueError, match='differs from the one the observation model'):
+        build_setup('fovea', str(path))

@@ -169,6 +169,8 @@ class FovealDetectorNode(Node):
             f'{cfg.setup.mode} mode, count model {cfg.setup.name!r} ({g.rows}x{g.cols} grid, '
             f'K = {cfg.setup.model.max_count + 1}), detector {cfg.setup.detector!r}; waiting '
             f'for fixation and image')
+        for note in cfg.setup.notes:
+            self.get_logger().warning(note)
         if getattr(cfg.setup.model, 'has_scan', False):
             self.get_logger().warning(
                 f'{cfg.setup.name!r} has a one-time whole-image scan, which this node does not '

@@ -182,12 +182,14 @@ def compare_settings(recorded: dict, current: dict, info_keys=INFO_KEYS) -> list
             if key in info_keys and key in recorded and recorded.get(key) != current.get(key)]
 
 
-def detector_from_settings(settings: dict, cascade_dir=None):
+def detector_from_settings(settings: dict, cascade_dir=None, on_note=None):
     """
     Rebuild the detector an observation model records (``meta['detector']``).
 
     ``cascade_dir`` is passed to factories whose ``from_settings`` takes it (the Haar cascade:
-    a folder searched first for the cascade file).
+    a folder searched first for the cascade file). ``on_note(text)``, if given, hears each
+    information-only setting that differs (:func:`compare_settings`), e.g. another OpenCV
+    version, whose DNN scores may differ in their last digits.
 
     Raises
     ------
@@ -217,7 +219,9 @@ def detector_from_settings(settings: dict, cascade_dir=None):
             raise ValueError(f'detector {kind!r} cannot be rebuilt from {sorted(options)} '
                              f'({exc})') from None
     detector = _checked(detector, kind)
-    compare_settings(settings, detector_settings(detector), info_keys_of(detector))
+    for note in compare_settings(settings, detector_settings(detector), info_keys_of(detector)):
+        if on_note is not None:
+            on_note(note)
     return detector
 
 
