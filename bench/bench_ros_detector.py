@@ -20,7 +20,7 @@ from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.msg_adapters import grid_arrays, images
 from ipomdp_gaze.nodes.processes import domain_id_for, isolated_nodes
 from ipomdp_gaze.nodes.watch import LATCHED, Watch
-from ipomdp_gaze.vision.detector import HaarDetector
+from ipomdp_gaze.vision.detectors import make_detector
 from ipomdp_gaze.vision.fullframe import scan
 from ipomdp_gaze.vision.scenes import SceneSet
 import numpy as np
@@ -91,7 +91,7 @@ def node_costs(pictures: list, seed: int = 0) -> dict:
 
 def full_frame_ms(pictures: list) -> np.ndarray:
     """Full-frame Haar scans of the same frames, in this process (ms each)."""
-    detector = HaarDetector()
+    detector = make_detector('haar')
     scan(pictures[0], detector, GRID)                         # warm-up: cascade in the cache
     return np.asarray([1e3 * scan(p, detector, GRID).seconds for p in pictures])
 

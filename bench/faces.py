@@ -34,7 +34,7 @@ from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy
 from ipomdp_gaze.progress import Progress
 from ipomdp_gaze.session import SearchSettings
-from ipomdp_gaze.vision.detector import HaarDetector
+from ipomdp_gaze.vision.detectors import make_detector
 from ipomdp_gaze.vision.fullframe import scan
 from ipomdp_gaze.vision.scenes import SceneSet
 from ipomdp_gaze.vision.search import fovea_for_model, search_image
@@ -143,7 +143,7 @@ def run_task(name: str, n: int, seed: int, progress=None) -> dict:
               'reference': load_observation(f'{model_name}-nmpt')}
     grid = models['shipped'].grid
     scenes = SceneSet('test', size_px=size, face_px=faces, grid=grid.shape, seed=seed)
-    detector = HaarDetector()
+    detector = make_detector('haar')
     foveas = {key: fovea_for_model(model) for key, model in models.items()}
     kernel = default_policy_file(models['shipped'])
     policies = {}
@@ -310,7 +310,7 @@ def astronaut(figure: Path) -> list[str]:
     result = search_image(image, fovea, model, policy, SearchSettings(
         confidence=OPERATING_CONFIDENCE, max_fixations=60, stop_on_repeat=True,
         inhibit_return=True))
-    full = scan(image, HaarDetector(), model.grid)
+    full = scan(image, make_detector('haar'), model.grid)
     plot_image_search(image, result, fovea, figure,
                       f'astronaut: cell {result.cell}, p={result.probability:.3f}, '
                       f'{result.fixations} fixations')

@@ -63,7 +63,8 @@ MODES = ('fovea', 'camera')
 DEFAULT_MODELS = {'fovea': 'faces-420', 'camera': 'faces-pan-tilt'}
 # The view a model was calibrated with (its image record), per mode.
 MODE_VIEWS = {'fovea': 'fixed', 'camera': 'pan_tilt'}
-# Detector settings a node parameter may repeat (an empty or negative value: the file's).
+# The Haar detector's settings with node parameters of their own (an empty or negative value:
+# the file's); any detector's other settings go in detector.options.
 DETECTOR_KEYS = ('cascade', 'scale_factor', 'min_neighbors')
 TIMING_WINDOW = 100
 # Joint angles farther than this from zero are absurd: no pan/tilt head turns more than a turn.
@@ -113,6 +114,8 @@ class DetectorSetup:
     observer: object = None
     camera: PinholeCamera | None = None
     image_size: tuple[int, int] | None = None
+    notes: tuple = ()
+    """What differs from the file in information-only detector settings (the OpenCV version)."""
 
     @property
     def grid(self) -> Grid:
@@ -134,8 +137,8 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
     grid : (int, int, float)
         ``rows, cols, spacing_deg`` asked for; 0 takes the file's. Another value must repeat it.
     detector : dict, optional
-        Detector settings asked for (keys of :data:`DETECTOR_KEYS`); each must repeat the
-        file's.
+        Detector settings asked for (``kind`` and the detector's own settings, e.g. those of
+        :data:`DETECTOR_KEYS` for ``haar``); each must repeat the file's.
     cascade_dir : str, optional
         Folder (or file) searched first for the cascade the file names.
 
@@ -147,7 +150,9 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
 
     """
     from ipomdp_gaze.vision.pan_tilt import ViewObserver
-    from ipomdp_gaze.vision.search import detector_from_settings, fovea_for_model
+    from ipomdp_gaze.vision.cell_observation import cell_observation_of
+    from ipomdp_gaze.vision.detectors import detector_from_settings
+    from ipomdp_gaze.vision.search import fovea_for_model
     if mode not in MODES:
         raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
     name = source or DEFAULT_MODELS[mode]
@@ -170,20 +175,25 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
     if not recorded:
         raise ValueError(f'observation.file {name!r} does not record its detector')
     for key, asked in (detector or {}).items():
-        if key not in DETECTOR_KEYS:
-            raise ValueError(f'unknown detector setting {key!r}')
+        if key not in recorded:
+            raise ValueError(f'detector.{key}: the detector {recorded.get("kind")!r} of '
+                             f'observation.file {name!r} has no setting {key!r} (it has '
+                             f'{", ".join(sorted(recorded))})')
         if asked != recorded.get(key):
             raise ValueError(f'detector.{key} {asked!r} contradicts observation.file {name!r}, '
                              f'measured with {recorded.get(key)!r} (leave it unset to take it)')
+    notes = []
     try:
-        haar = detector_from_settings(recorded, cascade_dir or None)
+        built = detector_from_settings(recorded, cascade_dir or None, notes.append)
         if mode == 'fovea':
-            return DetectorSetup(mode, model, name, haar,
-                                 fovea=fovea_for_model(model, haar, reuse_windows=False),
-                                 image_size=model_image_size(model))
-        observer = ViewObserver(haar, g, model.max_count + 1)
-        return DetectorSetup(mode, model, name, haar, observer=observer,
-                             camera=model_camera(model), image_size=model_image_size(model))
+            return DetectorSetup(mode, model, name, built,
+                                 fovea=fovea_for_model(model, built, reuse_windows=False),
+                                 image_size=model_image_size(model), notes=tuple(notes))
+        observer = ViewObserver(built, g, model.max_count + 1,
+                                cell_observation_of(model.meta, model.max_count + 1))
+        return DetectorSetup(mode, model, name, built, observer=observer,
+                             camera=model_camera(model), image_size=model_image_size(model),
+                             notes=tuple(notes))
     except ValueError as exc:
         raise ValueError(_one_line(exc)) from None
     except (TypeError, KeyError, IndexError, OverflowError, AttributeError, OSError) as exc:

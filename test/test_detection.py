@@ -257,3 +257,16 @@ def test_a_large_fovea_image_is_resized_to_the_model_image(fovea_setup):
     loop.fixate(cell, 2.0)
     assert loop.add_image(3.0, cv2.resize(image, (840, 840)), now_s=3.0).status == 'published'
     assert loop.values()['images_resized'] == 1            # twice the model's side: kept
+
+
+def test_another_opencv_version_is_a_note_and_another_cascade_is_refused(tmp_path):
+    from ipomdp_gaze.observation_file import load_observation, save_observation
+    model = load_observation('faces-420-nmpt')
+    model.meta['detector'] = {**model.meta['detector'], 'opencv': '4.5.0'}
+    path = save_observation(tmp_path / 'old.yaml', model)
+    setup = build_setup('fovea', str(path))
+    assert len(setup.notes) == 1 and "detector opencv '4.5.0'" in setup.notes[0]
+    model.meta['detector']['cascade_sha256'] = '0' * 64
+    path = save_observation(tmp_path / 'other.yaml', model)
+    with pytest.raises(ValueError, match='differs from the one the observation model'):
+        build_setup('fovea', str(path))

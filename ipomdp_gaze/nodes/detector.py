@@ -63,8 +63,8 @@ STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                        durability=DurabilityPolicy.TRANSIENT_LOCAL)
 WARN_THROTTLE_S = 5.0
 SETUP_KEYS = ('observation.file', 'grid.rows', 'grid.cols', 'grid.spacing_deg',
-              'detector.cascade', 'detector.scale_factor', 'detector.min_neighbors',
-              'detector.cascade_dir')
+              'detector.kind', 'detector.options', 'detector.cascade', 'detector.scale_factor',
+              'detector.min_neighbors', 'detector.cascade_dir')
 
 
 def detector_params() -> list[Param]:
@@ -84,6 +84,13 @@ def detector_params() -> list[Param]:
         Param('grid.spacing_deg', 0.0, T.DOUBLE,
               "camera mode: pan/tilt degrees per cell (0.0: the observation file's; read-only)",
               read_only=True, float_range=(0.0, 90.0)),
+        Param('detector.kind', '', T.STRING,
+              'detector kind: haar, yunet, an ipomdp_gaze.detectors entry point or '
+              'package.module:Factory, whose code runs ("": the observation file\'s; another '
+              'is refused)'),
+        Param('detector.options', None, T.STRING_ARRAY,
+              'settings of the detector itself as NAME=VALUE (YAML values); each must repeat '
+              'the value in the observation file'),
         Param('detector.cascade', '', T.STRING,
               "Haar cascade file name (\"\": the observation file's; another is refused)"),
         Param('detector.scale_factor', 0.0, T.DOUBLE,
@@ -129,7 +136,10 @@ class DetectorConfig:
 
 def _detector_settings(values: dict) -> dict:
     """Return the detector settings given as parameters (unset ones left out)."""
-    given = {}
+    from ipomdp_gaze.vision.detectors import parse_options
+    given = parse_options(values['detector.options'])
+    if values['detector.kind']:
+        given['kind'] = values['detector.kind']
     if values['detector.cascade']:
         given['cascade'] = values['detector.cascade']
     if values['detector.scale_factor'] > 0:
@@ -177,6 +187,8 @@ class FovealDetectorNode(Node):
             f'{cfg.setup.mode} mode, count model {cfg.setup.name!r} ({g.rows}x{g.cols} grid, '
             f'K = {cfg.setup.model.max_count + 1}), detector {cfg.setup.detector!r}; waiting '
             f'for fixation and image')
+        for note in cfg.setup.notes:
+            self.get_logger().warning(note)
 
     @property
     def _config(self) -> DetectorConfig:

@@ -48,7 +48,10 @@ import time
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.sensors import run_search
 from ipomdp_gaze.session import SearchSession, SearchSettings
-from ipomdp_gaze.vision.detector import detector_settings, detector_window_px, HaarDetector
+from ipomdp_gaze.vision.cell_observation import cell_observation_of
+from ipomdp_gaze.vision.detector import detector_settings, detector_window_px
+from ipomdp_gaze.vision.detectors import (compare_settings, detector_from_settings,  # noqa: F401
+                                          info_keys_of)
 from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea, FoveaConfig
 from ipomdp_gaze.vision.sensors import FoveaSensor
 import numpy as np
@@ -64,8 +67,6 @@ DEFAULT_SETTINGS = SearchSettings(confidence=0.9, max_fixations=25, stop_on_repe
 FIND_SETTINGS = SearchSettings(confidence=0.99, max_fixations=60, inhibit_return=True,
                                stop_on_repeat=True)
 STOP_REASONS = ('found', 'absent', 'budget', 'repeat')
-# Detector settings recorded for information only: every other setting must match the model's.
-DETECTOR_INFO_KEYS = ('opencv', 'window_px')
 
 
 @dataclass(frozen=True, eq=False)
@@ -160,7 +161,7 @@ def check_model(model, fovea: Fovea) -> None:
 
     The grid must match always; the fovea settings and the detector only when the model's
     ``meta`` records them (``meta['fovea']``, ``meta['detector']``). For the detector, every
-    setting is compared except those recorded for information (:data:`DETECTOR_INFO_KEYS`: the
+    setting is compared except those recorded for information (the detector's ``info_keys``: the
     OpenCV version and the cascade's window size).
 
     Raises
@@ -191,14 +192,11 @@ def check_model(model, fovea: Fovea) -> None:
             raise ValueError(f'the observation model was measured with fovea '
                              f'{measured.to_dict()} but the fovea is {fovea.config.to_dict()}')
     if meta.get('detector') is not None:
-        recorded = dict(meta['detector'])
-        current = detector_settings(fovea.detector)
-        keys = sorted((set(recorded) | set(current)) - set(DETECTOR_INFO_KEYS))
-        differ = [key for key in keys if recorded.get(key) != current.get(key)]
-        if differ:
-            key = differ[0]
-            raise ValueError(f'the observation model was measured with detector {key} '
-                             f'{recorded.get(key)!r} but the detector has {current.get(key)!r}')
+        compare_settings(dict(meta['detector']), detector_settings(fovea.detector),
+                         info_keys_of(fovea.detector))
+    if fovea.cells != cell_observation_of(meta, fovea.config.max_count):
+        raise ValueError(f'the observation model records cells {meta.get("cells")!r} but the '
+                         f'fovea observes {fovea.cells.to_dict()}')
 
 
 def check_image_size(image_px: tuple[int, int], fovea: Fovea) -> None:
@@ -312,37 +310,6 @@ def search_image(image: np.ndarray, fovea: Fovea, model, policy,
                        absent_probability=outcome.absent_probability, log=outcome.log)
 
 
-def detector_from_settings(settings: dict, cascade_dir=None) -> HaarDetector:
-    """
-    Rebuild the detector an observation model records (``meta['detector']``).
-
-    Only the Haar cascade (``kind: haar``, :meth:`HaarDetector.settings`) can be rebuilt; the
-    cascade is looked up by file name (:func:`ipomdp_gaze.vision.detector.find_cascade`), and a
-    copy whose SHA-256 differs from the recorded one is refused.
-
-    Raises
-    ------
-    ValueError
-        For another kind of detector, a cascade that differs from the recorded one, or bad
-        settings.
-    FileNotFoundError
-        If the cascade file is not installed.
-
-    """
-    if not isinstance(settings, dict) or settings.get('kind') != 'haar':
-        kind = settings.get('kind') if isinstance(settings, dict) else settings
-        raise ValueError(f"only a Haar cascade detector (kind 'haar') can be rebuilt from an "
-                         f'observation model, this one records kind {kind!r}')
-    options = {key: settings[key] for key in ('cascade', 'scale_factor', 'min_neighbors',
-                                              'min_size_px', 'max_size_px') if key in settings}
-    detector = HaarDetector(cascade_dir=cascade_dir, **options)
-    recorded = settings.get('cascade_sha256')
-    if recorded is not None and recorded != detector.settings()['cascade_sha256']:
-        raise ValueError(f'the installed cascade {detector.path} differs from the one the '
-                         f'observation model was measured with (SHA-256 {recorded[:12]}...)')
-    return detector
-
-
 def fovea_for_model(model, detector=None, reuse_windows: bool = True) -> Fovea:
     """
     Build the fovea an observation model was measured with: its grid, fovea and detector.
@@ -371,7 +338,8 @@ def fovea_for_model(model, detector=None, reuse_windows: bool = True) -> Fovea:
         detector = detector_from_settings(dict(meta['detector']))
     config = FoveaConfig() if meta.get('fovea') is None else \
         FoveaConfig.from_dict(dict(meta['fovea']))
-    fovea = Fovea(detector, model.grid, config, reuse_windows=reuse_windows)
+    fovea = Fovea(detector, model.grid, config, reuse_windows=reuse_windows,
+                  cells=cell_observation_of(meta, config.max_count))
     check_model(model, fovea)
     return fovea
 
