@@ -89,9 +89,10 @@ def _posterior(belief, frame, fixation, grid) -> np.ndarray:
 
 
 def _matched(probe, topic: str) -> bool:
-    """Whether every subscription of the probe to ``topic`` has matched a publisher."""
+    """Whether the probe's subscriptions to ``topic`` have matched every publisher in the graph."""
+    publishers = probe.node.count_publishers(f'/{topic}')
     subs = [s for s in probe.node.subscriptions if s.topic_name == f'/{topic}']
-    return bool(subs) and all(s.get_publisher_count() > 0 for s in subs)
+    return bool(subs) and all(s.get_publisher_count() >= publishers for s in subs)
 
 
 def _mid_search(probe, watch):
@@ -143,11 +144,16 @@ def test_camera_killed_mid_search_then_restarted(nodes, probe, watch):
     # updates the kept belief by Bayes' rule.
     target = watch.cell(watch.targets[-1][1])
     assert probe.enable(False).success
+    graph = probe.node
+    publishers = graph.count_publishers('evidence'), graph.count_publishers('joint_states')
     camera = nodes.start('camera', CAMERA_ARGS)
-    # The probe's own subscriptions have matched the new camera's publishers (DDS matching,
-    # not just the graph), so the probe records what it sends from now on.
-    assert wait_for(lambda: _matched(probe, 'evidence') and _matched(probe, 'joint_states'),
-                    30), camera.output()
+    # The new camera is in the graph (the killed one may still be), and the probe's own
+    # subscriptions have matched every publisher there (DDS matching, which follows the graph),
+    # so the probe records what the new camera sends from now on.
+    assert wait_for(lambda: graph.count_publishers('evidence') > publishers[0] and
+                    graph.count_publishers('joint_states') > publishers[1] and
+                    _matched(probe, 'evidence') and _matched(probe, 'joint_states'), 30), \
+        camera.output()
     n_frames, n_poses = len(watch.frames), len(watch.poses)
     assert len(watch.beliefs) == kept_beliefs
     assert probe.enable(True).success
