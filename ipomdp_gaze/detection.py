@@ -152,7 +152,7 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
     from ipomdp_gaze.vision.pan_tilt import ViewObserver
     from ipomdp_gaze.vision.cell_observation import cell_observation_of
     from ipomdp_gaze.vision.detectors import detector_from_settings
-    from ipomdp_gaze.vision.search import fovea_for_model
+    from ipomdp_gaze.vision.fovea_model import fovea_for_model
     if mode not in MODES:
         raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
     name = source or DEFAULT_MODELS[mode]

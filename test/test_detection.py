@@ -270,3 +270,17 @@ def test_another_opencv_version_is_a_note_and_another_cascade_is_refused(tmp_pat
     path = save_observation(tmp_path / 'other.yaml', model)
     with pytest.raises(ValueError, match='differs from the one the observation model'):
         build_setup('fovea', str(path))
+
+
+def test_the_detector_logic_does_not_import_finds_driver():
+    """detection.py (core) builds its fovea without vision.search (layers only import down)."""
+    import subprocess
+    import sys
+    code = ('import sys\n'
+            'from ipomdp_gaze.detection import build_setup\n'
+            "build_setup('fovea'); build_setup('camera')\n"
+            "print('ipomdp_gaze.vision.search' in sys.modules)\n")
+    out = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                         timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == 'False'

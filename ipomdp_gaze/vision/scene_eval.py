@@ -136,7 +136,7 @@ class _Task:
                 return PanTiltSceneSet('test', geometry, color='rgb', seed=spec.seed + i).scene(0)
         else:
             from ipomdp_gaze.vision.scenes import SceneSet
-            from ipomdp_gaze.vision.search import fovea_for_model
+            from ipomdp_gaze.vision.fovea_model import fovea_for_model
             from ipomdp_gaze.vision.sensors import FoveaSensor
             name, size, faces = _FOVEA_TASKS[spec.task]
             self.model = load_observation(name)
