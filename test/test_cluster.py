@@ -81,15 +81,14 @@ def cluster(tmp_path_factory):
         with distributed.Client(running.address, timeout=20, set_as_default=False) as client:
             client.wait_for_workers(2, timeout=60)
         yield running
-    finally:
-        for proc in running.processes:
-            if proc.poll() is None:
-                proc.terminate()
-        for proc in running.processes:
+    finally:                    # the workers first: without a scheduler they retry for long
+        for proc in reversed(running.processes):
+            proc.terminate()
             try:
-                proc.wait(timeout=20)
+                proc.wait(timeout=10)
             except subprocess.TimeoutExpired:
                 proc.kill()
+                proc.wait()
 
 
 def _run(argv, capsys) -> str:
