@@ -219,8 +219,14 @@ def test_ctrl_c_stops_at_once_and_keeps_the_finished_pieces(tmp_path):
     assert found > 0
 
 
-def test_a_worker_killed_mid_run_changes_nothing(cluster):
-    """The scheduler runs the dead worker's pieces again elsewhere: the same matrices."""
+def test_a_worker_killed_mid_run_changes_nothing(cluster, monkeypatch):
+    """
+    The scheduler runs the dead worker's pieces again elsewhere: the same matrices.
+
+    The run's targets go to the cluster once, shared by the pieces (a threshold of 1 byte makes
+    them count as large), so the lost worker may take the only copy with it.
+    """
+    monkeypatch.setattr(DaskExecutor, 'SHARE_BYTES', 1)
     here = _greedy_runner(None)
     here.collect()
     first_done = threading.Event()
