@@ -22,12 +22,30 @@ Workers run pickled code that the client sends, and a Dask scheduler accepts any
 default: run one only on a network you trust (docs/cluster.md). Results come back to this
 process, which alone writes caches and files.
 
+Writing a job for it (what ``evaluate``, ``calibrate`` and ``train --seeds`` do):
+
+- a piece is a module-level function of ``ipomdp_gaze`` (pickled by reference, so importable on
+  the workers) whose result depends only on its arguments: pass the seed, never a generator
+  shared between pieces; fix the piece size, not the number of pieces per worker;
+- submit every piece first, then collect in a fixed order (``future.result()``) so sums and
+  concatenations do not depend on which piece finished first;
+- write files and caches here, from results (``future.add_done_callback`` to keep each as soon as
+  it is done); count progress the same way (:func:`track`, or ``Progress.update`` in a
+  callback);
+- on the command line, ``commands/running.py``: ``add_run_args(parser)`` (``--jobs``,
+  ``--scheduler``, ``--quiet``), ``executor_from_args(args, pieces)`` and
+  ``progress_from_args(args, total, desc, unit)``.
+
 Typical use::
 
     with make_executor(jobs=args.jobs, scheduler=args.scheduler) as executor:
+        progress = Progress(len(pieces), 'scenes')
         futures = [executor.submit(piece, *arguments) for arguments in pieces]
         for future in track(futures, progress):
             ...
+        progress.close()
+
+Leaving the ``with`` block on an exception or Ctrl-C cancels the pieces still queued or running.
 """
 from __future__ import annotations
 
