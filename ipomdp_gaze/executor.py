@@ -22,12 +22,30 @@ Workers run pickled code that the client sends, and a Dask scheduler accepts any
 default: run one only on a network you trust (docs/cluster.md). Results come back to this
 process, which alone writes caches and files.
 
+Writing a job for it (what ``evaluate``, ``calibrate`` and ``train --seeds`` do):
+
+- a piece is a module-level function of ``ipomdp_gaze`` (pickled by reference, so importable on
+  the workers) whose result depends only on its arguments: pass the seed, never a generator
+  shared between pieces; fix the piece size, not the number of pieces per worker;
+- submit every piece first, then collect in a fixed order (``future.result()``) so sums and
+  concatenations do not depend on which piece finished first;
+- write files and caches here, from results (``future.add_done_callback`` to keep each as soon as
+  it is done); count progress the same way (:func:`track`, or ``Progress.update`` in a
+  callback);
+- on the command line, ``commands/running.py``: ``add_run_args(parser)`` (``--jobs``,
+  ``--scheduler``, ``--quiet``), ``executor_from_args(args, pieces)`` and
+  ``progress_from_args(args, total, desc, unit)``.
+
 Typical use::
 
     with make_executor(jobs=args.jobs, scheduler=args.scheduler) as executor:
+        progress = Progress(len(pieces), 'scenes')
         futures = [executor.submit(piece, *arguments) for arguments in pieces]
         for future in track(futures, progress):
             ...
+        progress.close()
+
+Leaving the ``with`` block on an exception or Ctrl-C cancels the pieces still queued or running.
 """
 from __future__ import annotations
 
@@ -133,8 +151,13 @@ class DaskExecutor(_Executor):
     The pieces on a Dask cluster through ``distributed``'s ``concurrent.futures`` executor.
 
     Connecting checks the cluster (:meth:`check`). A worker that dies has its pieces run again
-    on another one by the scheduler (up to Dask's ``allowed-failures``).
+    on another one by the scheduler (up to Dask's ``allowed-failures``). A large array that
+    many pieces share (a run's targets) goes to the cluster once, as a task of its own that
+    the scheduler can recompute when the worker holding it dies (scattered data could not be).
     """
+
+    # Arrays of at least this many bytes are sent once and shared by the pieces.
+    SHARE_BYTES = 1 << 20
 
     def __init__(self, address: str, timeout_s: float = CONNECT_TIMEOUT_S, check: bool = True):
         try:
@@ -157,6 +180,7 @@ class DaskExecutor(_Executor):
             self.client.close()
             raise
         self._executor = self.client.get_executor(pure=False)
+        self._shared = {}
 
     def check(self) -> None:
         """
@@ -184,7 +208,18 @@ class DaskExecutor(_Executor):
 
     def submit(self, fn, *args, **kwargs) -> cf.Future:
         """Send ``fn(*args, **kwargs)`` to the cluster; the future resolves here."""
-        return self._executor.submit(fn, *args, **kwargs)
+        return self._executor.submit(fn, *(self._share(a) for a in args), **kwargs)
+
+    def _share(self, value):
+        """Return a large array as the one cluster future that holds it (else ``value``)."""
+        nbytes = getattr(value, 'nbytes', 0)
+        if not isinstance(nbytes, int) or nbytes < self.SHARE_BYTES:
+            return value
+        from dask.base import tokenize
+        key = f'ipomdp-array-{tokenize(value)}'
+        if key not in self._shared:
+            self._shared[key] = self.client.submit(_same, value, key=key)
+        return self._shared[key]
 
     def close(self, cancel: bool = False) -> None:
         """Disconnect; with ``cancel``, the scheduler first drops the pieces still queued."""
@@ -192,7 +227,13 @@ class DaskExecutor(_Executor):
             if cancel:
                 self.client.cancel(list(self._executor._futures), force=True)
         finally:
+            self._shared.clear()
             self.client.close()
+
+
+def _same(value):
+    """Return ``value`` (a task that holds a shared array on the cluster)."""
+    return value
 
 
 def _probe(address: str, timeout_s: float) -> None:

@@ -30,8 +30,9 @@ class Progress:
     Count ``total`` units of work labelled ``desc``; ``update(n)`` after each piece.
 
     On a terminal a tqdm bar (rate and ETA); on anything else a line ``desc: done/total
-    (pct) elapsed, ETA`` at most every ``every_s`` seconds and once at the end; with ``quiet``
-    nothing. ``stream`` defaults to stderr. Safe to update from several threads. Use it as a
+    (pct) elapsed, ETA`` every ``every_s`` seconds (from a timer thread, so a long piece does
+    not leave the log silent) and once at the end; with ``quiet`` nothing. ``add(n)`` grows
+    the total (a job that learns its size as it submits), ``note(text)`` shows a status. ``stream`` defaults to stderr. Safe to update from several threads. Use it as a
     context manager, or call :meth:`close`.
     """
 

@@ -5,7 +5,7 @@ import io
 
 from conftest import wait_for
 from ipomdp_gaze.cli import main as cli_main
-from ipomdp_gaze.executor import InlineExecutor, make_executor, track
+from ipomdp_gaze.executor import InlineExecutor, LocalExecutor, make_executor, track
 from ipomdp_gaze.progress import Progress
 
 
@@ -61,3 +61,11 @@ def test_long_commands_report_on_stderr_unless_quiet(capsys):
     assert err.startswith('evaluate: 1/1 pieces (100%)'), err
     assert cli_main([*argv, '--quiet']) == 0
     assert capsys.readouterr().err == ''
+
+
+def test_a_small_job_runs_here_and_a_pool_never_outnumbers_its_pieces(monkeypatch):
+    monkeypatch.delenv('DASK_SCHEDULER_ADDRESS', raising=False)
+    assert isinstance(make_executor(jobs=4, pieces=1), InlineExecutor)
+    with make_executor(jobs=4, pieces=2) as executor:
+        assert isinstance(executor, LocalExecutor) and executor.workers == 2
+        assert executor.submit(pow, 3, 2).result() == 9
