@@ -15,9 +15,19 @@ import importlib
 import sys
 
 # Modules under ipomdp_gaze.commands, in the order --help lists their subcommands: evaluate,
-# search, find, train, calibrate, reproduce, demo, then the nodes: controller, camera, detector
-# and scene_camera.
-COMMANDS = ('evaluate', 'search', 'find', 'train', 'calibrate', 'reproduce', 'demo', 'nodes')
+# search, find, train, calibrate, reproduce, demo, record and replay, then the nodes:
+# controller, camera, detector, scene_camera and recorder.
+COMMANDS = ('evaluate', 'search', 'find', 'train', 'calibrate', 'reproduce', 'demo', 'record',
+            'nodes')
+
+
+def package_version() -> str:
+    """Return the installed package's version (``setup.py``), or ``unknown`` without metadata."""
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version('ipomdp_gaze')
+    except PackageNotFoundError:
+        return 'unknown'
 
 
 class CliError(Exception):
@@ -36,6 +46,8 @@ def build_parser() -> argparse.ArgumentParser:
         prog='ipomdp-gaze',
         description='I-POMDP infomax gaze control (Butko & Movellan, ICDL 2008): '
                     'evaluate, train and run policies that choose where to look next.')
+    parser.add_argument('--version', action='version',
+                        version=f'%(prog)s {package_version()}')
     sub = parser.add_subparsers(dest='command', metavar='COMMAND', parser_class=_Parser)
     sub.required = True
     for name in COMMANDS:
@@ -46,11 +58,19 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv=None) -> int:
     """Entry point of the console script."""
     parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if not argv:
+        parser.print_help(sys.stderr)       # a bare command: what there is to run
+        return 2
     args = parser.parse_args(argv)
     try:
         return int(args.run(args) or 0)
     except (CliError, ValueError, OSError) as exc:
         print(f'ipomdp-gaze {args.command}: error: {exc}', file=sys.stderr)
+        return 2
+    except MemoryError:
+        print(f'ipomdp-gaze {args.command}: error: out of memory: the task is too large for '
+              f'this machine (a smaller --grid or fewer --episodes)', file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         return 130

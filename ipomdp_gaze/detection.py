@@ -48,7 +48,7 @@ ones the counts mean anything with, so settings given next to it may only repeat
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 import math
 import time
 
@@ -278,7 +278,9 @@ class Frame:
     One count frame for the controller, and what it cost.
 
     ``kind`` is ``'fixation'`` or ``'scan'`` (the one-time scan, ``fixation`` None then);
-    ``search_id`` the search it was asked for (None: the request did not say).
+    ``search_id`` the search it was asked for (None: the request did not say). ``image``,
+    ``detections_px`` (raw detection centres ``(M, 2)`` in its pixels), ``windows`` (fovea
+    windows) and ``head_rc`` (camera mode) say how it was made, for pictures of the search.
     """
 
     fixation: int | None
@@ -289,6 +291,10 @@ class Frame:
     seconds: float
     kind: str = 'fixation'
     search_id: int | None = None
+    image: np.ndarray | None = field(default=None, compare=False, repr=False)
+    detections_px: np.ndarray | None = field(default=None, compare=False, repr=False)
+    windows: tuple = field(default=(), compare=False, repr=False)
+    head_rc: tuple | None = field(default=None, compare=False, repr=False)
 
 
 @dataclass(frozen=True)
@@ -539,15 +545,17 @@ class DetectorLoop:
         t0 = time.perf_counter()
         try:
             if cell is None:
-                counts, pixels = self._scan(image)
+                counts, pixels, centres, windows = self._scan(image)
             elif setup.mode == 'fovea':
                 setup.fovea.start(image)
                 observation = setup.fovea.observe(cell)
                 counts, pixels = observation.counts, observation.detector_pixels
+                centres, windows = observation.centres_px - 0.5, observation.windows
             else:
                 camera = self._view_camera(image, size)
                 observation = setup.observer.observe(image, camera, head_rc)
                 counts, pixels = observation.counts, observation.detector_pixels
+                centres, windows = observation.centres_uv, ()
         except ValueError as exc:
             self._drop_through(stamp_s)
             return self._rejected(str(exc))
@@ -560,16 +568,21 @@ class DetectorLoop:
         self._pixels.append(pixels)
         return Outcome('published', frame=Frame(
             cell, stamp_s, token, counts, int(pixels), seconds,
-            'scan' if cell is None else 'fixation', self.search_id))
+            'scan' if cell is None else 'fixation', self.search_id, image, centres, windows,
+            head_rc))
 
-    def _scan(self, image) -> tuple[np.ndarray, int]:
-        """Return the one-time scan's counts of an image: NaN everywhere without a scan."""
+    def _scan(self, image) -> tuple[np.ndarray, int, np.ndarray, tuple]:
+        """
+        Return the one-time scan of an image: counts, pixels, detections, windows.
+
+        A sensor without a scan gives NaN everywhere (nothing observed) and no detections.
+        """
         fovea = self.setup.fovea
         if self.setup.mode == 'fovea' and fovea.config.scan_once:
             fovea.start(image)
             scan = fovea.scan()
-            return scan.counts, scan.detector_pixels
-        return np.full(self.setup.grid.n_cells, np.nan), 0
+            return scan.counts, scan.detector_pixels, scan.centres_px - 0.5, scan.windows
+        return np.full(self.setup.grid.n_cells, np.nan), 0, np.zeros((0, 2)), ()
 
     # -- reporting -------------------------------------------------------------------------
     def values(self) -> dict:

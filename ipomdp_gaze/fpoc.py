@@ -86,7 +86,8 @@ class HumanFPOC(FPOC):
 
     def _threshold_sq(self, ecc):
         n2 = self.noise_contrast ** 2
-        return 0.002130 * np.exp(0.9790 * ecc) + 0.6712 * np.exp(0.4905 * ecc) * n2
+        with np.errstate(over='ignore'):        # far out: an infinite threshold, d' = 0
+            return 0.002130 * np.exp(0.9790 * ecc) + 0.6712 * np.exp(0.4905 * ecc) * n2
 
     def of_eccentricity(self, ecc_deg) -> np.ndarray:
         """Evaluate d' as a function of eccentricity in degrees."""

@@ -39,6 +39,9 @@ from .observation import CountObservation
 from .yaml_files import check_header, plain, read_yaml, write_yaml
 
 FORMAT = 'ipomdp_gaze/observation-v1'
+# What a policy file says it is (ipomdp_gaze.policies.policy_file.FORMAT; not imported: the
+# core imports no policies), so one given as a count model is named for what it is.
+POLICY_FORMAT = 'ipomdp_gaze/policy-v1'
 MODELS = ('counts',)
 REQUIRED = ('format', 'model', 'grid', 'target', 'null')
 KEYS = REQUIRED + ('image', 'fovea', 'detector', 'cells', 'calibration', 'scan')
@@ -202,6 +205,10 @@ def load_observation(source) -> CountObservation:
     """
     path = resolve_source(source)
     doc = read_yaml(path, ObservationFileError)
+    if isinstance(doc, dict) and doc.get('format') == POLICY_FORMAT:
+        raise ObservationFileError(f'{path} is a policy file ({POLICY_FORMAT}), not an '
+                                   f'observation model ({FORMAT}): pass it as --policy-file '
+                                   f'(node: policy.file)')
     try:
         return model_from_dict(doc, source=path.stem)
     except ObservationFileError as exc:

@@ -21,14 +21,15 @@ def test_help_lists_subcommands():
     for name in ('evaluate', 'search', 'demo'):
         assert name in out.stdout
     assert re.findall(r'^    (\w+)', out.stdout, re.M) == [
-        'evaluate', 'search', 'find', 'train', 'calibrate', 'reproduce', 'demo', 'controller',
-        'camera', 'detector', 'scene_camera']
+        'evaluate', 'search', 'find', 'train', 'calibrate', 'reproduce', 'demo', 'record',
+        'replay', 'controller', 'camera', 'detector', 'scene_camera', 'recorder']
 
 
 @pytest.mark.parametrize('command, node', [('controller', 'gaze_controller'),
                                            ('camera', 'simulated_camera'),
                                            ('detector', 'foveal_detector'),
-                                           ('scene_camera', 'scene_camera')])
+                                           ('scene_camera', 'scene_camera'),
+                                           ('recorder', 'recorder')])
 def test_node_subcommands_run_their_node(command, node, capsys):
     with pytest.raises(SystemExit) as exit_info:
         main([command, '--help'])

@@ -8,6 +8,7 @@ import math
 
 from ipomdp_gaze.fpoc import make_fpoc, MODELS, parameter_names
 from ipomdp_gaze.grid import Grid, parse_grid
+from ipomdp_gaze.observation import MATRIX_MAX_CELLS
 import yaml
 
 
@@ -17,6 +18,46 @@ def grid_arg(text: str) -> tuple[int, int]:
         return parse_grid(text)
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def cell_arg(text: str):
+    """
+    Parse a cell for argparse: ``ROW,COL`` (every command), or a flat row-major index.
+
+    Returns ``(row, col)`` or the flat index as an int; :func:`cell_index` checks it against
+    the grid once the grid is known.
+    """
+    parts = str(text).split(',')
+    try:
+        values = [int(x) for x in parts]
+    except ValueError:
+        values = []
+    if len(values) not in (1, 2) or min(values) < 0:
+        raise argparse.ArgumentTypeError(f'expected a cell as ROW,COL (or a flat index), got '
+                                         f'{text!r}')
+    return values[0] if len(values) == 1 else tuple(values)
+
+
+def cell_index(value, grid, flag: str) -> int:
+    """
+    Return the row-major index of a :func:`cell_arg` value on ``grid``.
+
+    Raises
+    ------
+    ValueError
+        If the cell is outside the grid; the message names ``flag`` and the grid.
+
+    """
+    if isinstance(value, tuple):
+        row, col = value
+        if not (0 <= row < grid.rows and 0 <= col < grid.cols):
+            raise ValueError(f'{flag} {row},{col} is outside the {grid.rows}x{grid.cols} grid '
+                             f'(rows 0..{grid.rows - 1}, columns 0..{grid.cols - 1})')
+        return row * grid.cols + col
+    if not 0 <= value < grid.n_cells:
+        raise ValueError(f'{flag} {value} is outside the {grid.n_cells}-cell grid (give '
+                         f'ROW,COL, or a flat index 0..{grid.n_cells - 1})')
+    return int(value)
 
 
 def _int_at_least(text: str, low: int, what: str) -> int:
@@ -166,6 +207,11 @@ def task_from_args(args) -> tuple[Grid, object]:
     args.spacing_deg = default_spacing if args.spacing_deg is None else args.spacing_deg
     args.fpoc = default_fpoc if args.fpoc is None else args.fpoc
     grid = Grid(args.grid[0], args.grid[1], args.spacing_deg)
+    if grid.n_cells > MATRIX_MAX_CELLS:
+        # Checked before any FPOC is evaluated on the grid: a clean error, no numpy warning.
+        raise ValueError(f'a {grid.rows}x{grid.cols} grid has {grid.n_cells} cells; the '
+                         f'offline commands hold N x N matrices and take at most '
+                         f'{MATRIX_MAX_CELLS} cells (e.g. 64x64)')
     params = dict(args.fpoc_param)
     names = parameter_names(args.fpoc)
     for name in params:

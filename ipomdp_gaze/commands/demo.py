@@ -12,6 +12,11 @@ and the digital fovea. The offline, ROS-free search is ``ipomdp-gaze search``.
 """
 from __future__ import annotations
 
+import argparse
+from pathlib import Path
+
+from ipomdp_gaze.nodes.processes import MAX_DOMAIN_ID
+
 from .common import nonneg_int, positive_float, positive_int
 
 
@@ -45,9 +50,19 @@ def add_parser(sub):
                         'cell (default 60)')
     p.add_argument('--timeout', type=positive_float, default=60.0,
                    help='give up after this many seconds (default 60)')
-    p.add_argument('--domain-id', type=int, default=None,
+    p.add_argument('--domain-id', type=domain_arg, default=None,
                    help='ROS domain id, 0..101 (default: derived from the process id)')
     p.add_argument('--verbose', action='store_true', help="print the nodes' own output")
+    p.add_argument('--plot', type=Path, default=None, metavar='PNG',
+                   help='write the final picture of the search: the belief over the camera '
+                        "image (faces: the detector's annotated_image) with the fixations")
+    p.add_argument('--animate', type=Path, default=None, metavar='GIF',
+                   help='write an animated GIF of the search, one picture per belief')
+    p.add_argument('--record', type=Path, default=None, metavar='PATH',
+                   help='record the search to a rosbag2 bag (a new directory: metadata.yaml '
+                        'and MCAP) with the recorder node; replay it with ipomdp-gaze replay')
+    p.add_argument('--compression', choices=('none', 'zstd'), default='none',
+                   help='with --record: zstd-compress the MCAP chunks (default none)')
     p.set_defaults(run=run)
 
 
@@ -59,7 +74,21 @@ def parse_target(text):
         row, col = (int(x) for x in text.split(','))
     except ValueError:
         raise ValueError(f'--target must be ROW,COL, got {text!r}') from None
+    if row < 0 or col < 0:
+        raise ValueError(f'--target must be ROW,COL of a cell (0 or more), got {text!r}')
     return row, col
+
+
+def domain_arg(text: str) -> int:
+    """Parse a ROS domain id in 0..101 for argparse."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if not 0 <= value <= MAX_DOMAIN_ID:
+        raise argparse.ArgumentTypeError(f'expected a ROS domain id in 0..{MAX_DOMAIN_ID}, got '
+                                         f'{text!r}')
+    return value
 
 
 def run(args) -> int:
@@ -68,6 +97,11 @@ def run(args) -> int:
     def out(line):
         print(line, flush=True)
 
+    if args.record is not None and args.record.exists():
+        raise ValueError(f'--record {args.record} exists; a bag needs a new directory')
+    for flag, path, suffix in (('--plot', args.plot, '.png'), ('--animate', args.animate, '.gif')):
+        if path is not None and path.suffix.lower() != suffix:
+            raise ValueError(f'{flag} writes a {suffix} file, got {path}')
     if args.scene == 'faces':
         for flag, value in (('--fpoc', args.fpoc), ('--target', args.target)):
             if value is not None:
@@ -79,5 +113,20 @@ def run(args) -> int:
             raise ValueError('--fovea goes with --scene faces')
         setup = demo_setup(args.fpoc or 'camera', args.policy, args.seed,
                            parse_target(args.target))
-    return run_demo(setup, args.timeout, args.domain_id, args.verbose, out,
-                    max_fixations=args.max_fixations)
+    pictures = [] if args.plot or args.animate else None
+    status = run_demo(setup, args.timeout, args.domain_id, args.verbose, out,
+                      max_fixations=args.max_fixations, record=args.record,
+                      compression='' if args.compression == 'none' else args.compression,
+                      pictures=pictures)
+    if pictures is not None:
+        from ipomdp_gaze.vision.search_plots import save_gif, save_png
+        if not pictures:
+            out('ipomdp-gaze demo: no picture of the search to write')
+            return status or 1
+        if args.plot:
+            save_png(pictures[-1], args.plot)
+            out(f'wrote {args.plot}')
+        if args.animate:
+            count = save_gif(pictures, args.animate)
+            out(f'wrote {args.animate} ({count} pictures)')
+    return status

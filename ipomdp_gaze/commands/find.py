@@ -41,9 +41,8 @@ from ipomdp_gaze.belief import uniform_log_belief
 from ipomdp_gaze.observation_file import load_observation, shipped_image_models
 from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
-from ipomdp_gaze.vision.search import (calibrated_size, cell_centre_px, check_image_size,
-                                       FIND_SETTINGS, fovea_for_model, search_image,
-                                       size_distance)
+from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, FIND_SETTINGS,
+                                       fovea_for_model, search_image, size_distance)
 import numpy as np
 
 from .common import nonneg_int
@@ -170,42 +169,9 @@ class _Task:
 
 
 def plot_image_search(image: np.ndarray, result, fovea, out_path: Path, title: str) -> None:
-    """Draw the image, the numbered fixations, the last one's windows and the cell found."""
-    import matplotlib
-    matplotlib.use('Agg')
-    from matplotlib.patches import Rectangle
-    import matplotlib.pyplot as plt
-    height, width = image.shape[:2]
-    grid = fovea.grid
-    fig, ax = plt.subplots(figsize=(6.4, 6.4 * height / width + 0.5))
-    if image.ndim == 2:
-        ax.imshow(image, cmap='gray', vmin=0, vmax=255)
-    else:
-        ax.imshow(image)
-    last = grid.index(*result.path[-1])
-    for window in fovea.window_rects(last, image.shape):
-        x, y, w, h = window.rect_px
-        ax.add_patch(Rectangle((x - 0.5, y - 0.5), w, h, fill=False, ec='cyan', lw=1.2,
-                               ls='--' if window.whole_image else '-'))
-    found = grid.index(*result.cell)
-    x, y = cell_centre_px(grid, found, (width, height))
-    cell_w, cell_h = width / grid.cols, height / grid.rows
-    ax.add_patch(Rectangle((x - cell_w / 2 - 0.5, y - cell_h / 2 - 0.5), cell_w, cell_h,
-                           fill=False, ec='lime', lw=2.0))
-    points = np.array([cell_centre_px(grid, grid.index(*cell), (width, height))
-                       for cell in result.path]) - 0.5
-    ax.plot(points[:, 0], points[:, 1], '-', color='yellow', lw=1.2, alpha=0.8)
-    for i, (px, py) in enumerate(points):
-        ax.text(px, py, str(i + 1), color='black', ha='center', va='center', fontsize=7,
-                bbox={'boxstyle': 'circle,pad=0.2', 'fc': 'yellow', 'ec': 'none'})
-    ax.set_xlim(-0.5, width - 0.5)
-    ax.set_ylim(height - 0.5, -0.5)
-    ax.set_title(title, fontsize=9)
-    ax.set_axis_off()
-    fig.tight_layout()
-    out_path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out_path, dpi=100, format='png')
-    plt.close(fig)
+    """Draw the image, the final belief, the numbered scan path, the windows, the cell found."""
+    from ipomdp_gaze.vision.search_plots import annotate_image_search, save_figure
+    save_figure(annotate_image_search(image, result, fovea), out_path, title)
 
 
 def plot_paths(out: Path, count: int) -> list[Path]:

@@ -11,7 +11,7 @@ from ipomdp_gaze.sensors import ModelSensor
 from ipomdp_gaze.session import SearchSession, SearchSettings
 import numpy as np
 
-from .common import add_task_args, nonneg_int, task_from_args
+from .common import add_task_args, cell_arg, cell_index, nonneg_int, task_from_args
 from .search_args import add_search_args, settings_from_args
 
 # The paper's convention: the policy picks every fixation, the first included (design 4.1).
@@ -27,7 +27,8 @@ def add_parser(sub):
     p.add_argument('--policy', default='elm', choices=NAMED_POLICIES)
     p.add_argument('--policy-file', default=None, metavar='PATH',
                    help='a policy YAML file or a shipped kernel name (overrides --policy)')
-    p.add_argument('--target', type=nonneg_int, default=None, help='target cell (default random)')
+    p.add_argument('--target', type=cell_arg, default=None, metavar='ROW,COL',
+                   help='target cell as ROW,COL or a flat index (default random)')
     add_search_args(p, SEARCH_SETTINGS, ('confidence',))
     p.add_argument('--max-fixations', type=nonneg_int, default=None, metavar='N',
                    help='fixation budget: gave up when it runs out undecided (default 4 N; 0 = '
@@ -107,9 +108,8 @@ def run(args) -> int:
         args.max_fixations = 4 * grid.n_cells
     settings = settings_from_args(args, SEARCH_SETTINGS, grid)
     rng = np.random.default_rng([args.seed, 1])
-    target = int(rng.integers(grid.n_cells)) if args.target is None else args.target
-    if target >= grid.n_cells:
-        raise ValueError(f'--target {target} is outside the {grid.n_cells}-cell grid')
+    target = int(rng.integers(grid.n_cells)) if args.target is None else \
+        cell_index(args.target, grid, '--target')
     guess, path, belief = run_search(grid, as_observation(grid, fpoc), policy, target,
                                      settings, args.seed)
     if args.plot:

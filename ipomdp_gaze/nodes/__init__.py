@@ -4,4 +4,5 @@
 
 # Executable (module under ipomdp_gaze.nodes, ``ros2 run`` name, CLI subcommand) -> node name.
 NODE_NAMES = {'controller': 'gaze_controller', 'camera': 'simulated_camera',
-              'detector': 'foveal_detector', 'scene_camera': 'scene_camera'}
+              'detector': 'foveal_detector', 'scene_camera': 'scene_camera',
+              'recorder': 'recorder'}

@@ -17,21 +17,27 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 import math
+from pathlib import Path
 import time
 
+from diagnostic_msgs.msg import DiagnosticArray
 from ipomdp_gaze.belief import entropy
 from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, joints
 from ipomdp_gaze.yaml_files import yaml_parameters
 import numpy as np
+from sensor_msgs.msg import Image
 
+from . import NODE_NAMES
 from .config import config_file
-from .params import grid_from, head_from, joint_params
+from .params import fpoc_from, grid_from, head_from, joint_params
 from .processes import domain_id_for, isolated_nodes
 from .watch import SearchRecord, Watch
 
 # The watcher's wait for a condition (it polls; the records fill in the watch's spin thread).
 POLL_S = 0.05
+# Pictures: after the answer, wait until the detector's annotated_image has been quiet this long.
+PICTURE_QUIET_S, PICTURE_WAIT_S = 0.5, 3.0
 FPOC_OVERRIDES = {
     'camera': {},
     # The human FPOC is calibrated at 0.42 degrees per cell (docs/design.md section 2).
@@ -71,6 +77,44 @@ class DemoSetup:
         return 1 if self.scene == 'faces' else 0
 
 
+def check_controller(values: dict) -> None:
+    """
+    Build the controller's grid, observation model and policy as the node will, here.
+
+    ``values`` are the controller's parameters from its YAML file and the demo's overrides (the
+    rest take the node's defaults). A bad ``--policy`` (an unknown name, a policy that needs an
+    FPOC on a count model, a policy file that does not fit) is refused before any node starts;
+    a missing ``policy.file`` is accepted when ``policy.fallback`` names a baseline, as the node
+    does.
+
+    Raises
+    ------
+    ValueError
+        Naming the problem.
+
+    """
+    from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnavailable
+
+    from .controller import controller_params, observation_from
+    full = {p.name: p.default for p in controller_params()}
+    full.update(values)
+    name = full['policy.name']
+    if name not in POLICY_NAMES:
+        raise ValueError(f"--policy must be one of {', '.join(POLICY_NAMES)}, got {name!r}")
+    grid = grid_from(full)
+    fpoc = fpoc_from(full) if full['observation.model'] != 'counts' else None
+    model = observation_from(full, grid, fpoc)
+    try:
+        build_policy(name, grid, model, kernel=full['policy.kernel'] or None,
+                     file=full['policy.file'], action=full['policy.action'],
+                     warn=lambda message: None)
+    except PolicyUnavailable:
+        if name != 'learned' or not full['policy.fallback']:
+            raise
+    except ValueError as exc:
+        raise ValueError(f'--policy {name}: {exc}') from None
+
+
 def _ros_args(path, overrides: dict) -> list:
     args = ['--params-file', str(path)]
     for name, value in overrides.items():
@@ -94,7 +138,12 @@ def demo_setup(fpoc: str = 'camera', policy: str | None = None, seed: int = 0,
         camera.update({'target_row': int(target[0]), 'target_col': int(target[1])})
     values = yaml_parameters(controller_yaml, 'gaze_controller')
     values.update(controller)
+    check_controller(values)
     grid = grid_from(values)
+    if target is not None and not (0 <= target[0] < grid.rows and 0 <= target[1] < grid.cols):
+        raise ValueError(f'--target {target[0]},{target[1]} is outside the {grid.rows}x'
+                         f'{grid.cols} grid (rows 0..{grid.rows - 1}, columns '
+                         f'0..{grid.cols - 1})')
     return DemoSetup([('controller', _ros_args(controller_yaml, controller)),
                       ('camera', _ros_args(camera_yaml, camera))], grid,
                      head_from(values, grid), controller)
@@ -114,6 +163,7 @@ def faces_setup(fovea: bool = False, policy: str | None = None, seed: int = 0) -
     values = {p.name: p.default for p in joint_params(limits=True)}
     values.update(yaml_parameters(files['controller'], 'gaze_controller'))
     values.update(controller)
+    check_controller(values)
     grid = grid_from(values)
     image_px = None
     if fovea:
@@ -130,6 +180,8 @@ def faces_setup(fovea: bool = False, policy: str | None = None, seed: int = 0) -
 
 def _started(watch, record, node: str):
     """Return what has to be seen before the node after ``node`` may start."""
+    if node == 'recorder':
+        return lambda: NODE_NAMES['recorder'] in watch.node.get_node_names()
     if node == 'controller':
         return lambda: bool(record.targets)
     if node == 'detector':
@@ -137,9 +189,81 @@ def _started(watch, record, node: str):
     return None
 
 
+def _with_recorder(setup: DemoSetup, record, compression: str, pictures) -> list:
+    """Return the nodes to start: a recorder first (``record``), the detector drawing."""
+    nodes = list(setup.nodes)
+    if (pictures is not None or record) and setup.scene == 'faces':
+        # The detector's annotated_image (pictures) and its raw detections (recorded).
+        nodes = [(node, args + ['-p', 'publish_annotated:=true'] if node == 'detector' else args)
+                 for node, args in nodes]
+    if record:
+        args = ['-p', f'path:={Path(record).resolve()}']
+        if pictures is None:            # no pictures asked for: the bag without them
+            from .recorder import TOPICS
+            args += ['-p', f"topics:=[{','.join(t for t in TOPICS if t != 'annotated_image')}]"]
+        if compression:
+            args += ['-p', f'compression:={compression}']
+        if setup.scene != 'faces':
+            args += ['-p', f"nodes:=[{NODE_NAMES['controller']}]"]
+        args += ['-p', 'diagnostics_period_s:=0.1']
+        if setup.scene != 'faces':
+            # The camera publishes a frame as soon as it sees the first target: it starts
+            # before the controller, so the recorder has matched its publishers by then.
+            nodes = nodes[::-1]
+        nodes.insert(0, ('recorder', args))
+    return nodes
+
+
+class RecorderStatus:
+    """The recorder's latest ``recording`` status on ``/diagnostics``: matched publishers."""
+
+    def __init__(self, watch):
+        self.values = {}
+        watch.node.create_subscription(DiagnosticArray, '/diagnostics', self, 50)
+
+    def __call__(self, msg) -> None:
+        """Take a ``/diagnostics`` message."""
+        for status in msg.status:
+            if status.name.endswith(f"{NODE_NAMES['recorder']}: recording"):
+                self.values = diagnostics.values_of(status)
+
+    def matched(self, *topics) -> bool:
+        """Whether the recorder has matched a publisher on one of ``topics``."""
+        return any(int(self.values.get(f'publishers_{t}', 0)) > 0 for t in topics)
+
+
+def _pictures(setup: DemoSetup, record: SearchRecord, annotated: list, stats: dict) -> list:
+    """
+    Return pictures of the search, one per belief.
+
+    The detector's ``annotated_image`` (faces) or, without a camera image (the simulated
+    camera), the belief and fixations drawn on the grid.
+    """
+    from ipomdp_gaze.msg_adapters import images
+    if setup.scene == 'faces':
+        return [images.rgb8_array(msg) for _, msg in annotated]
+    from ipomdp_gaze.vision.annotate import annotate, grid_canvas
+    grid, head = setup.grid, setup.head
+    n = min(int(stats.get('fixations') or 0), len(record.beliefs), len(record.targets))
+    looked = [head.nearest_cell(*joints.angles_from_joint_state(msg, head))
+              for _, msg in record.targets[:n]]
+    canvas, cell_map = grid_canvas(grid, 40)
+    frames = []
+    for i in range(n):
+        belief = grid_arrays.from_multiarray(record.beliefs[i][1], grid)
+        found = (stats['cell'], stats['probability']) if i == n - 1 and 'cell' in stats \
+            else None
+        frames.append(annotate(canvas, cell_map, belief, looked[:i + 1], found=found,
+                               label=f'fixation {i + 1}',
+                               found_label='found' if stats.get('stop') == 'found'
+                               else 'most likely'))
+    return frames
+
+
 def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = None,
              verbose: bool = False, out=print, stats: dict | None = None,
-             max_fixations: int = 60) -> int:
+             max_fixations: int = 60, record=None, compression: str = '',
+             pictures: list | None = None) -> int:
     """
     Run the demo; 0 when an answer was judged in time and every node stopped cleanly.
 
@@ -148,13 +272,21 @@ def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = 
     given, is filled with the answer (``row``, ``col``, ``cell``, ``probability``,
     ``fixations``), ``stop`` (``found``, ``budget`` or ``timeout``), ``truth`` (the ground
     truth's ``(row, col)``), ``right`` and ``search_s``: seconds from starting the last node to
-    the belief of the answer's last fixation.
+    the belief of the answer's last fixation. ``record``: a ``recorder`` node writes the
+    search to this new bag directory (``compression``: ``''`` or ``zstd``). ``pictures``, when
+    given, is filled with an RGB picture of the search per belief (the last one shows the
+    answer).
     """
     domain = domain_id_for() if domain_id is None else domain_id
+    stats = {} if stats is None else stats
     with isolated_nodes(domain, prefix='ipomdp-gaze-demo-') as nodes:
-        procs = [nodes.add(node, args) for node, args in setup.nodes]
+        procs = [nodes.add(node, args)
+                 for node, args in _with_recorder(setup, record, compression, pictures)]
         watch = Watch(domain, 'gaze_demo', nodes)
-        record = SearchRecord(watch, depth=200, updates_only=True)
+        record_ = SearchRecord(watch, depth=200, updates_only=True)
+        annotated = watch.record(Image, 'annotated_image', 50) if pictures is not None \
+            else []
+        recorder = RecorderStatus(watch) if record else None
         deadline = time.monotonic() + timeout_s
 
         def wait(condition) -> bool:
@@ -170,12 +302,23 @@ def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = 
             for proc in procs:
                 started = time.monotonic()
                 proc.start()
-                ready = _started(watch, record, proc.node)
+                ready = _started(watch, record_, proc.node)
+                if recorder is not None and len(procs) > 2 and proc is procs[-2]:
+                    # The search starts with the last node: the recorder must see the frames.
+                    before = ready or (lambda: True)
+                    ready = lambda: before() and recorder.matched(  # noqa: E731
+                        'evidence', 'evidence_image')
                 if proc is not procs[-1] and ready is not None and not wait(ready):
                     raise RuntimeError(f'{proc.name} did not come up in time')
-            status = _follow(setup, record, wait, timeout_s, out, stats, max_fixations)
-            if stats is not None and stats.get('fixations'):
-                stats['search_s'] = record.beliefs[stats['fixations'] - 1][0] - started
+            status = _follow(setup, record_, wait, timeout_s, out, stats, max_fixations)
+            if stats.get('fixations'):
+                stats['search_s'] = record_.beliefs[stats['fixations'] - 1][0] - started
+            if pictures is not None:
+                if setup.scene == 'faces':        # the redraw after the answer, then quiet
+                    watch.wait_until(lambda: annotated and
+                                     time.monotonic() - annotated[-1][0] > PICTURE_QUIET_S,
+                                     PICTURE_WAIT_S)
+                pictures.extend(_pictures(setup, record_, annotated, stats))
         except RuntimeError as exc:
             out(f'ipomdp-gaze demo: error: {exc}')
         finally:
@@ -190,6 +333,8 @@ def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = 
                                                      ' (had already exited)')
                            for k, v in codes.items())
         which = 'both nodes' if len(procs) == 2 else f'all {len(procs)} nodes'
+        if record and codes.get('recorder') == 0:
+            out(f'recorded the search to {record}')
         out(f'stopped {which} ({states})' + ('' if clean else ': NOT a clean shutdown'))
         return status if clean else 1
 

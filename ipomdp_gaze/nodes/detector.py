@@ -48,6 +48,7 @@ from sensor_msgs.msg import CameraInfo, Image, JointState
 from std_msgs.msg import Float32MultiArray, Int32MultiArray
 
 from . import NODE_NAMES
+from .annotation import Annotator
 from .guard import CallbackGuard
 from .params import head_from, joint_params, MAX_CELLS_PER_SIDE, Param, ParameterTransaction, T
 from .spin import run_node
@@ -117,6 +118,11 @@ def detector_params() -> list[Param]:
               'as stale (0: no limit)', float_range=(0.0, 1e6)),
         Param('publish_image', True, T.BOOL,
               'publish stamped 32FC1 evidence_image frames (false: evidence)'),
+        Param('publish_annotated', False, T.BOOL,
+              'publish annotated_image (the camera image with the belief, fixations, fovea '
+              'windows, detections and the found cell drawn on it, rgb8) and the raw '
+              'detections (geometry_msgs/PoseArray of box centres in pixels; read-only)',
+              read_only=True),
         Param('max_image_side_px', images.MAX_IMAGE_SIDE_PX, T.INTEGER,
               'images larger than this on a side are rejected (read-only)', read_only=True,
               int_range=(32, 65536)),
@@ -182,6 +188,7 @@ class FovealDetectorNode(Node):
                                                 reliability=ReliabilityPolicy.BEST_EFFORT))
         self._diag_timer = self.create_timer(v['diagnostics_period_s'],
                                              guard.wrap(self._publish_diagnostics))
+        self._annotator = Annotator(self) if v['publish_annotated'] else None
         g = cfg.setup.grid
         self.get_logger().info(
             f'{cfg.setup.mode} mode, count model {cfg.setup.name!r} ({g.rows}x{g.cols} grid, '
@@ -292,6 +299,8 @@ class FovealDetectorNode(Node):
                     images.frame_tag(frame.kind, frame.search_id)))
             else:
                 self._evidence_pub.publish(grid_arrays.to_multiarray(frame.counts, grid))
+            if self._annotator is not None:
+                self._annotator.on_frame(frame)
         elif outcome.status == 'rejected':
             self.get_logger().warning(
                 f'rejected an image ({self.loop.rejected} so far): {outcome.reason}',

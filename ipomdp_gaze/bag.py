@@ -1,0 +1,134 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+rosbag2 bags of a search (MCAP storage), written and read in pure Python with ``rosbags``.
+
+A bag is a directory with ``metadata.yaml`` and one ``.mcap`` file, as ``ros2 bag record -s
+mcap`` writes it. :func:`open_writer` starts one (``compression='zstd'`` compresses the MCAP
+chunks, as rosbag2's ``zstd`` storage presets do, so ``mcap`` readers and Foxglove still read
+it); :func:`read_bag` returns every message deserialized (``rosbags`` message classes, with
+the fields of the ROS messages) and the bag's ``custom_data``, where the recorder keeps the
+package version, each node's parameters and the hashes of the files they name. No rclpy here.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import yaml
+
+DISTRO_STORE = 'ROS2_JAZZY'
+COMPRESSIONS = ('', 'zstd')
+
+
+def _typestore():
+    from rosbags.typesys import get_typestore, Stores
+    return get_typestore(getattr(Stores, DISTRO_STORE))
+
+
+def open_writer(path, compression: str = ''):
+    """
+    Create a bag at ``path`` (a new directory) and return the open ``rosbags`` writer.
+
+    Raises
+    ------
+    ValueError
+        If ``path`` exists or ``compression`` is not ``''`` or ``'zstd'``.
+
+    """
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
+    if compression not in COMPRESSIONS:
+        raise ValueError(f"compression must be '' or 'zstd', got {compression!r}")
+    path = Path(path)
+    if path.exists():
+        raise ValueError(f'{path} exists; a bag needs a new directory')
+    writer = Writer(path, version=Writer.VERSION_LATEST, storage_plugin=StoragePlugin.MCAP)
+    if compression:
+        writer.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)
+    writer.open()
+    store = _typestore()
+    add = writer.add_connection
+
+    def add_connection(topic, msgtype, **kw):
+        return add(topic, msgtype, typestore=store, **kw)
+    writer.add_connection = add_connection
+    return writer
+
+
+@dataclass
+class BagMessage:
+    """One recorded message: topic, arrival time (ns), the message, its serialized size."""
+
+    topic: str
+    time_ns: int
+    msg: object
+    size: int
+
+
+@dataclass
+class Bag:
+    """What a bag holds: messages in time order, custom data, file size and duration."""
+
+    path: Path
+    messages: list
+    custom_data: dict
+    size_bytes: int
+    duration_s: float
+
+    def topic(self, name: str) -> list:
+        """Return the messages of the topic ``name`` (with or without its leading slash)."""
+        name = name.lstrip('/')
+        return [m for m in self.messages if m.topic.lstrip('/') == name]
+
+    def parameters(self, node: str) -> dict:
+        """Return the recorded parameters of ``node`` (empty if the recorder had none)."""
+        text = self.custom_data.get(f'ipomdp_gaze/parameters/{node}')
+        return yaml.safe_load(text) if text else {}
+
+    @property
+    def megabytes_per_minute(self) -> float:
+        """Size of the bag's files per minute of recording."""
+        return self.size_bytes / 1e6 / max(self.duration_s / 60.0, 1e-9)
+
+
+def read_metadata(path) -> dict:
+    """Return ``rosbag2_bagfile_information`` of a bag's ``metadata.yaml``."""
+    meta = Path(path) / 'metadata.yaml'
+    if not meta.is_file():
+        raise ValueError(f'{path} is not a rosbag2 bag: no metadata.yaml')
+    try:
+        return yaml.safe_load(meta.read_text())['rosbag2_bagfile_information']
+    except (yaml.YAMLError, KeyError, TypeError):
+        raise ValueError(f'{meta} is not rosbag2 metadata') from None
+
+
+def read_bag(path, topics=None) -> Bag:
+    """
+    Read a bag: every message (of ``topics``, relative names, if given), deserialized.
+
+    Raises
+    ------
+    ValueError
+        If ``path`` is not a readable rosbag2 bag.
+
+    """
+    from rosbags.rosbag2 import Reader
+    from rosbags.rosbag2.errors import ReaderError
+    path = Path(path)
+    info = read_metadata(path)
+    store = _typestore()
+    wanted = None if topics is None else {t.lstrip('/') for t in topics}
+    messages = []
+    try:
+        with Reader(path) as reader:
+            connections = [c for c in reader.connections
+                           if wanted is None or c.topic.lstrip('/') in wanted]
+            for connection, stamp, raw in reader.messages(connections=connections):
+                msg = store.deserialize_cdr(raw, connection.msgtype)
+                messages.append(BagMessage(connection.topic, int(stamp), msg, len(raw)))
+            duration = reader.duration * 1e-9
+    except ReaderError as exc:
+        raise ValueError(f'{path}: {exc}') from None
+    size = sum(f.stat().st_size for f in path.iterdir() if f.is_file())
+    return Bag(path, messages, dict(info.get('custom_data') or {}), size, duration)

@@ -1,0 +1,99 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+``ipomdp-gaze record PATH`` and ``ipomdp-gaze replay PATH``: a search to a bag, and back.
+
+``record`` runs the ``recorder`` node (:mod:`ipomdp_gaze.nodes.recorder`) until Ctrl-C or SIGTERM,
+writing a rosbag2 bag with MCAP storage at PATH; ``replay`` re-runs a bag's frames through the
+controller's core with the recorded settings or others (:mod:`ipomdp_gaze.replay`) and prints
+where the decisions differ.
+"""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from .common import confidence_arg, nonneg_int
+
+
+def add_parser(sub):
+    p = sub.add_parser(
+        'record', help='record a search to a rosbag2 bag (MCAP) with the recorder node',
+        description='Run the recorder node: subscribe to the search topics and write them, '
+                    "with the nodes' parameters, the package version and the hashes of the "
+                    'model files, to a rosbag2 bag (metadata.yaml and MCAP, as ros2 bag record '
+                    '-s mcap writes) at PATH, until Ctrl-C or SIGTERM. Same as `ros2 run '
+                    'ipomdp_gaze recorder --ros-args -p path:=PATH`.')
+    p.add_argument('path', type=Path, metavar='PATH', help='the bag directory to create')
+    p.add_argument('--topics', default=None, metavar='T1,T2',
+                   help='relative topics to record (default: every search topic)')
+    p.add_argument('--compression', choices=('none', 'zstd'), default='none',
+                   help='zstd-compress the MCAP chunks (default none)')
+    p.add_argument('--ros-args', dest='ros_args', nargs=argparse.REMAINDER, default=None,
+                   metavar='ARG', help='ROS arguments (remapping, namespace, -p nodes:=[...])')
+    p.set_defaults(run=run_record)
+
+    p = sub.add_parser(
+        'replay', help='re-run a recorded search through the controller; print differences',
+        description='Read a bag written by `ipomdp-gaze record` or `demo --record`, rebuild '
+                    'the controller from the recorded parameters (or with the options below '
+                    'changed), offer it the recorded frames as the node did and print where '
+                    'its fixations and decision differ from the recording. The frames were '
+                    'taken where the recorded search looked, so the replay stops at the first '
+                    'fixation that differs.')
+    p.add_argument('path', type=Path, metavar='PATH', help='the bag directory')
+    p.add_argument('--observation', default=None, metavar='FILE',
+                   help='another count model (path or shipped name)')
+    p.add_argument('--policy', default=None, help='another policy.name')
+    p.add_argument('--policy-file', default=None, metavar='FILE',
+                   help='another policy file or shipped kernel (selects learned)')
+    p.add_argument('--confidence', type=confidence_arg, default=None)
+    p.add_argument('--max-fixations', type=nonneg_int, default=None, metavar='N')
+    p.add_argument('--new-search', action='store_true',
+                   help='a fixed camera (detector in fovea mode) only: run a whole new search '
+                        'on the last recorded image with these settings, instead of following '
+                        'the recorded frames')
+    p.set_defaults(run=run_replay)
+
+
+def run_record(args) -> int:
+    from ipomdp_gaze.nodes.recorder import main, TOPICS
+    if args.path.exists():
+        raise ValueError(f'{args.path} exists; a bag needs a new directory')
+    ros = ['-p', f'path:={args.path.resolve()}']
+    if args.topics:
+        topics = [t.strip() for t in args.topics.split(',') if t.strip()]
+        unknown = [t for t in topics if t not in TOPICS]
+        if unknown:
+            raise ValueError(f"--topics: unknown {', '.join(unknown)}; known: "
+                             f"{', '.join(TOPICS)}")
+        ros += ['-p', f"topics:=[{','.join(topics)}]"]
+    if args.compression != 'none':
+        ros += ['-p', f'compression:={args.compression}']
+    return main(['ipomdp-gaze-record', '--ros-args', *ros, *(args.ros_args or [])])
+
+
+def run_replay(args) -> int:
+    from ipomdp_gaze.bag import read_bag
+    from ipomdp_gaze.replay import describe_size, replay
+    if not args.path.is_dir():
+        raise ValueError(f'{args.path} is not a bag directory')
+    bag = read_bag(args.path)
+    print(f'{args.path}: {len(bag.messages)} messages, {describe_size(bag)}; package '
+          f"{bag.custom_data.get('ipomdp_gaze/version', 'unknown')}")
+    overrides = {'observation': args.observation, 'policy': args.policy,
+                 'policy_file': args.policy_file, 'confidence': args.confidence,
+                 'max_fixations': args.max_fixations}
+    changed = [f'{k}={v}' for k, v in overrides.items() if v is not None]
+    print('settings: ' + ('recorded' if not changed else
+                          'recorded, with ' + ', '.join(changed)))
+    if args.new_search:
+        from ipomdp_gaze.replay import new_search
+        new_search(bag, overrides)
+        return 0
+    result = replay(bag, overrides)
+    print(f'{result.frames} frames recorded, {result.applied} applied by the replay')
+    if result.stopped_early and bag.parameters('foveal_detector').get('mode') == 'fovea':
+        print('the recording is of a fixed camera: --new-search runs a whole new search on '
+              'its last image with these settings')
+    return 0

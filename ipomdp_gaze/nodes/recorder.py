@@ -1,0 +1,228 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The ``recorder`` node: write a search to a rosbag2 bag (MCAP), as ``ros2 bag record -s mcap``.
+
+No ``ros2 bag`` is installable here, so the node writes the bag itself with ``rosbags`` (pure
+Python): a directory ``path`` with ``metadata.yaml`` and one ``.mcap`` file, readable by
+``ros2 bag play``, Foxglove and the ``mcap`` and ``rosbags`` readers. Messages are recorded
+serialized (CDR) as they arrive, timestamped with the node's clock on arrival. ``topics`` lists
+the relative topic names to record (:data:`TOPICS` gives each one's type and QoS; the default
+is every one of them: camera images, ``camera_info``, ``joint_states``, ``fixation``,
+``pan_tilt``, ``evidence``, ``evidence_image``, ``belief``, ``found``, ``absent``, ``gave_up``,
+``/diagnostics``, ``ground_truth`` and the detector's ``annotated_image`` and raw
+``detections``).
+
+The bag's ``custom_data`` (in ``metadata.yaml``) holds ``ipomdp_gaze/version`` (the package),
+``ipomdp_gaze/parameters/<node>`` (every parameter of each node in ``nodes``, as YAML, fetched
+once they answer) and ``ipomdp_gaze/files`` (the sha256 of each policy and observation file
+those parameters name): what ``ipomdp-gaze replay`` needs to re-run the search. ``compression``
+``zstd`` compresses the MCAP chunks (as rosbag2's ``zstd`` storage presets do; every MCAP
+reader decompresses them). ``/diagnostics`` carries ``<node>: recording`` with the messages
+written and the publishers matched per topic.
+"""
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+import sys
+
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from geometry_msgs.msg import PoseArray
+from ipomdp_gaze.msg_adapters import diagnostics
+from rcl_interfaces.srv import GetParameters, ListParameters
+from rclpy.node import Node
+from rclpy.parameter import parameter_value_to_python
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import CameraInfo, Image, JointState
+from std_msgs.msg import Float32MultiArray, Int32MultiArray
+import yaml
+
+from . import NODE_NAMES
+from .params import Param, ParameterTransaction, T
+from .spin import run_node
+
+NODE_NAME = NODE_NAMES['recorder']
+LATCHED = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE,
+                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
+BEST_EFFORT = QoSProfile(depth=50, reliability=ReliabilityPolicy.BEST_EFFORT)
+RELIABLE = QoSProfile(depth=50, reliability=ReliabilityPolicy.RELIABLE)
+# Relative topic -> (message type, ROS type name, QoS of the subscription).
+TOPICS = {
+    # Images reliable: over best effort a large image is lost whole when one fragment is.
+    'image': (Image, 'sensor_msgs/msg/Image', RELIABLE),
+    'camera_info': (CameraInfo, 'sensor_msgs/msg/CameraInfo', BEST_EFFORT),
+    'joint_states': (JointState, 'sensor_msgs/msg/JointState', BEST_EFFORT),
+    'fixation': (Int32MultiArray, 'std_msgs/msg/Int32MultiArray', LATCHED),
+    'pan_tilt': (JointState, 'sensor_msgs/msg/JointState', LATCHED),
+    'evidence': (Float32MultiArray, 'std_msgs/msg/Float32MultiArray', BEST_EFFORT),
+    'evidence_image': (Image, 'sensor_msgs/msg/Image', BEST_EFFORT),
+    'belief': (Float32MultiArray, 'std_msgs/msg/Float32MultiArray', RELIABLE),
+    'found': (DiagnosticStatus, 'diagnostic_msgs/msg/DiagnosticStatus', RELIABLE),
+    'absent': (DiagnosticStatus, 'diagnostic_msgs/msg/DiagnosticStatus', RELIABLE),
+    'gave_up': (DiagnosticStatus, 'diagnostic_msgs/msg/DiagnosticStatus', RELIABLE),
+    '/diagnostics': (DiagnosticArray, 'diagnostic_msgs/msg/DiagnosticArray', RELIABLE),
+    'ground_truth': (Int32MultiArray, 'std_msgs/msg/Int32MultiArray', LATCHED),
+    'annotated_image': (Image, 'sensor_msgs/msg/Image', RELIABLE),
+    'detections': (PoseArray, 'geometry_msgs/msg/PoseArray', RELIABLE),
+}
+FILE_PARAMETERS = ('policy.file', 'observation.file')
+PARAMETER_RETRY_S = 0.5
+
+
+def recorder_params() -> list[Param]:
+    """Every parameter of the recorder, in declaration order."""
+    return [
+        Param('path', '', T.STRING, 'the bag directory to create (it must not exist; read-only)',
+              read_only=True),
+        Param('topics', list(TOPICS), T.STRING_ARRAY,
+              f"relative topics to record, of: {', '.join(TOPICS)} (read-only)",
+              read_only=True),
+        Param('nodes', [NODE_NAMES['controller'], NODE_NAMES['detector']], T.STRING_ARRAY,
+              "nodes whose parameters go into the bag's metadata (read-only)", read_only=True),
+        Param('compression', '', T.STRING,
+              "'' (none) or 'zstd' (the MCAP chunks; read-only)", read_only=True,
+              choices=('', 'zstd')),
+        Param('diagnostics_period_s', 1.0, T.DOUBLE,
+              'period of the recorder: recording status on /diagnostics (messages and '
+              'matched publishers per topic; read-only)', read_only=True,
+              float_range=(0.01, 3600.0)),
+    ]
+
+
+def file_hashes(parameters: dict) -> dict:
+    """``{name or path: sha256}`` of the policy and observation files named by parameters."""
+    from ipomdp_gaze.policies.policy_file import resolve_source as policy_source
+    from ipomdp_gaze.observation_file import resolve_source as observation_source
+    out = {}
+    for values in parameters.values():
+        for key, resolve in (('policy.file', policy_source),
+                             ('observation.file', observation_source)):
+            name = values.get(key)
+            if not name:
+                continue
+            try:
+                path = Path(resolve(name))
+                out[str(name)] = hashlib.sha256(path.read_bytes()).hexdigest()
+            except (OSError, ValueError):
+                out[str(name)] = 'not found'
+    return out
+
+
+class RecorderNode(Node):
+    """Subscribe to the search's topics (serialized) and write them to a rosbag2 MCAP bag."""
+
+    def __init__(self, **kwargs):
+        super().__init__(NODE_NAME, **kwargs)
+        self._transaction = ParameterTransaction(self, recorder_params(), self._build,
+                                                 lambda old, new: None)
+        self._transaction.declare()
+        values = self._transaction.values()
+        self._transaction.start(self._build(values))
+        from ipomdp_gaze.bag import open_writer
+        from ipomdp_gaze.cli import package_version
+        self.writer = open_writer(values['path'], values['compression'])
+        self.writer.set_custom_data('ipomdp_gaze/version', package_version())
+        self.connections = {}
+        self.counts = dict.fromkeys(values['topics'], 0)
+        self.subscriptions_ = {}
+        for topic in values['topics']:
+            msg_type, type_name, qos = TOPICS[topic]
+            self.connections[topic] = self.writer.add_connection(
+                self.resolve_topic_name(topic), type_name)
+            self.subscriptions_[topic] = self.create_subscription(
+                msg_type, topic, self._writer_for(topic), qos, raw=True)
+        self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
+        self.create_timer(values['diagnostics_period_s'], self._publish_diagnostics)
+        self.parameters: dict = {}
+        self._pending = list(values['nodes'])
+        self._futures = {}
+        self._parameter_clients = {}
+        self._parameter_timer = self.create_timer(PARAMETER_RETRY_S, self._ask_parameters)
+        self.get_logger().info(f"recording {', '.join(values['topics'])} to {values['path']}")
+
+    def _build(self, values: dict, changed=None, previous=None) -> dict:
+        if not values['path']:
+            raise ValueError('path is required: the bag directory to create')
+        if Path(values['path']).exists():
+            raise ValueError(f"path {values['path']} exists; a bag needs a new directory")
+        unknown = [t for t in values['topics'] if t not in TOPICS]
+        if unknown:
+            raise ValueError(f"topics: unknown {', '.join(unknown)}; known: "
+                             f"{', '.join(TOPICS)}")
+        return dict(values)
+
+    def _writer_for(self, topic: str):
+        connection = self.connections[topic]
+
+        def write(data: bytes) -> None:
+            self.writer.write(connection, self.get_clock().now().nanoseconds, data)
+            self.counts[topic] += 1
+        return write
+
+    # -- the other nodes' parameters ---------------------------------------------------------
+    def _ask_parameters(self) -> None:
+        for node in list(self._pending):
+            if node in self._futures:
+                continue
+            client = self._parameter_clients.get(node)
+            if client is None:      # kept: a service is discovered some time after the client
+                client = self._parameter_clients[node] = self.create_client(
+                    ListParameters, f'/{node}/list_parameters')
+            if not client.service_is_ready():
+                continue
+            future = client.call_async(ListParameters.Request())
+            self._futures[node] = future
+            future.add_done_callback(lambda f, n=node: self._listed(n, f))
+        if not self._pending:
+            self.destroy_timer(self._parameter_timer)
+
+    def _listed(self, node: str, future) -> None:
+        names = list(future.result().result.names)
+        client = self.create_client(GetParameters, f'/{node}/get_parameters')
+        got = client.call_async(GetParameters.Request(names=names))
+        got.add_done_callback(lambda f: self._got(node, names, f))
+
+    def _got(self, node: str, names: list, future) -> None:
+        values = {n: parameter_value_to_python(v) for n, v in zip(names, future.result().values)}
+        values = {k: (list(v) if isinstance(v, (list, tuple)) or hasattr(v, 'tolist') else v)
+                  for k, v in values.items()}
+        values = {k: ([float(x) if isinstance(x, float) else x for x in v]
+                      if isinstance(v, list) else v) for k, v in values.items()}
+        self.parameters[node] = values
+        self.writer.set_custom_data(f'ipomdp_gaze/parameters/{node}',
+                                    yaml.safe_dump(values, sort_keys=True))
+        self.writer.set_custom_data('ipomdp_gaze/files',
+                                    yaml.safe_dump(file_hashes(self.parameters), sort_keys=True))
+        if node in self._pending:
+            self._pending.remove(node)
+        self.get_logger().info(f'recorded the parameters of {node}')
+
+    def _publish_diagnostics(self) -> None:
+        """Publish ``<node>: recording``: messages and matched publishers of each topic."""
+        values = {}
+        for topic, sub in self.subscriptions_.items():
+            name = topic.lstrip('/')
+            values[f'messages_{name}'] = self.counts[topic]
+            values[f'publishers_{name}'] = sub.get_publisher_count()
+        values['parameters_of'] = ','.join(sorted(self.parameters))
+        self._diag_pub.publish(diagnostics.diagnostic_array(
+            [diagnostics.status(f'{self.get_fully_qualified_name()}: recording', 'ok',
+                                f'{sum(self.counts.values())} messages', values)],
+            self.get_clock().now().to_msg()))
+
+    def destroy_node(self):
+        """Close the bag (writes metadata.yaml), then destroy the node."""
+        writer, self.writer = getattr(self, 'writer', None), None
+        if writer is not None:
+            writer.close()
+        return super().destroy_node()
+
+
+def main(args=None) -> int:
+    """Run the ``recorder`` node until shutdown (Ctrl-C or SIGTERM); the bag is closed then."""
+    return run_node(RecorderNode, NODE_NAME, args)
+
+
+if __name__ == '__main__':
+    sys.exit(main())

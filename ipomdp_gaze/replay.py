@@ -1,0 +1,355 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Replay a recorded search: its frames through the controller's core, with its settings or others.
+
+A bag written by the ``recorder`` node (:mod:`ipomdp_gaze.bag`) holds the frames of evidence the
+controller was offered (``evidence_image``, stamped, or ``evidence``), the targets it sent
+(``pan_tilt``, one stamp per target), its events (``found``, ``absent``, ``gave_up``) and its
+parameters. :func:`replay` builds a :class:`ipomdp_gaze.gaze.GazeController` from those
+parameters, with any of them replaced (``overrides``: another observation model, policy,
+confidence ...), drives it with ``reset`` and ``offer(evidence, stamp_s, now_s)`` exactly as the
+node did (``now_s``: when the node sent the next target) and compares each decision with the
+recording: every next fixation and the final event.
+
+The frames were taken where the *recorded* search looked. A replay that chooses another fixation
+would need a frame from a view nobody took, so it stops at the first fixation that differs and
+says so; up to there every decision is compared. A fixed camera (the detector's ``fovea`` mode)
+records the whole scene, so :func:`new_search` can instead run a whole new search on the last
+recorded image, with the detector's recorded count model and fovea and the (overridden)
+controller settings. No rclpy here: messages come from ``rosbags``.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+import math
+
+from ipomdp_gaze.fpoc import make_fpoc, parameter_names
+from ipomdp_gaze.gaze import GazeController
+from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.head import PanTiltMap
+from ipomdp_gaze.session import SearchSettings
+import numpy as np
+
+CONTROLLER = 'gaze_controller'
+DETECTOR = 'foveal_detector'
+IMAGE_CHANNELS = {'mono8': 1, 'rgb8': 3, 'bgr8': 3}
+# What ``replay`` may change, and the controller parameter each one sets.
+OVERRIDES = {'observation': 'observation.file', 'policy': 'policy.name',
+             'policy_file': 'policy.file', 'confidence': 'confidence',
+             'max_fixations': 'search.max_fixations', 'repeat_weight': 'search.repeat_weight',
+             'inhibit_return': 'search.inhibit_return'}
+
+
+@dataclass
+class Decision:
+    """The end of a search: ``kind`` found, absent, gave_up or '' (none), cell, probability."""
+
+    kind: str = ''
+    cell: int | None = None
+    probability: float | None = None
+    fixations: int | None = None
+
+    def describe(self, grid: Grid) -> str:
+        """Say it in one phrase."""
+        if not self.kind:
+            return 'no decision'
+        where = f' at {grid.cell(self.cell)}' if self.cell is not None else ''
+        p = f' p={self.probability:.3f}' if self.probability is not None else ''
+        return f'{self.kind}{where}{p} after {self.fixations} fixations'
+
+    def same(self, other: Decision) -> bool:
+        """Whether both are the same decision (kind, cell and fixations)."""
+        return (self.kind, self.cell, self.fixations) == (other.kind, other.cell, other.fixations)
+
+
+@dataclass
+class ReplayResult:
+    """What the replay did, next to what the recording says."""
+
+    grid: Grid
+    recorded_fixations: list
+    replay_fixations: list
+    recorded: Decision
+    replayed: Decision
+    frames: int
+    applied: int
+    first_difference: int | None = None
+    stopped_early: bool = False
+    lines: list = field(default_factory=list)
+
+    @property
+    def same(self) -> bool:
+        """Whether every compared fixation and the final decision agree."""
+        return self.first_difference is None and self.recorded.same(self.replayed)
+
+
+def settings_from(parameters: dict, overrides: dict | None = None) -> dict:
+    """Return the controller's parameters with ``overrides`` (keys of :data:`OVERRIDES`) set."""
+    values = dict(parameters)
+    for key, value in (overrides or {}).items():
+        if value is None:
+            continue
+        if key not in OVERRIDES:
+            raise ValueError(f"cannot override {key!r}; one of {', '.join(OVERRIDES)}")
+        values[OVERRIDES[key]] = value
+        if key == 'observation':
+            values['observation.model'] = 'counts'
+        if key == 'policy_file':
+            values['policy.name'] = 'learned'
+        if key == 'policy' and value != 'learned':
+            values['policy.kernel'] = []
+    return values
+
+
+def build_controller(values: dict) -> tuple[GazeController, PanTiltMap]:
+    """
+    Build the core and the head mapping from the ``gaze_controller`` parameters, as the node does.
+
+    Raises
+    ------
+    ValueError
+        If a parameter is missing or refused (the message names it).
+
+    """
+    from ipomdp_gaze.observation_file import load_observation
+    from ipomdp_gaze.policies.registry import build_policy
+    try:
+        grid = Grid(int(values['grid.rows']), int(values['grid.cols']),
+                    float(values['grid.spacing_deg']))
+        if values.get('observation.model') == 'counts':
+            model = load_observation(values['observation.file'])
+            if model.grid.shape != grid.shape:
+                raise ValueError(f"observation {values['observation.file']!r} is for a "
+                                 f'{model.grid.rows}x{model.grid.cols} grid, the recording '
+                                 f'{grid.rows}x{grid.cols}')
+        else:
+            name = values['fpoc.model']
+            model = make_fpoc(name, **{p: values[f'fpoc.{p}'] for p in parameter_names(name)})
+        kernel = values.get('policy.kernel') or None
+        policy = build_policy(values['policy.name'], grid, model, kernel=kernel,
+                              file=values.get('policy.file', ''),
+                              action=values.get('policy.action', 'argmax'),
+                              warn=lambda message: None)
+        head = PanTiltMap(grid, values['pan_joint'], values['tilt_joint'], values['pan_sign'],
+                          values['tilt_sign'], values['pan_offset_rad'],
+                          values['tilt_offset_rad'],
+                          (values['pan_min_rad'], values['pan_max_rad']),
+                          (values['tilt_min_rad'], values['tilt_max_rad']))
+        settings = SearchSettings.from_parameters(values, grid=grid)
+        core = GazeController(grid, model, policy, settings, values['settle_time_s'],
+                              values['seed'])
+    except KeyError as exc:
+        raise ValueError(f'the recording has no controller parameter {exc}') from None
+    return core, head
+
+
+def _seconds(stamp) -> float:
+    return float(stamp.sec) + 1e-9 * float(stamp.nanosec)
+
+
+def _angles(msg, head: PanTiltMap) -> tuple[float, float]:
+    names = list(msg.name)
+    return tuple(float(msg.position[names.index(j)]) for j in (head.pan_joint, head.tilt_joint))
+
+
+def _frames(bag, grid: Grid) -> list:
+    """
+    Return ``(stamp_s, arrival_s, values, kind)`` of every recorded frame, in arrival order.
+
+    ``kind`` is ``'scan'`` for a one-time scan (``header.frame_id`` ``scan/<id>``, design §10.3),
+    else ``'fixation'``.
+    """
+    frames = []
+    for m in bag.topic('evidence_image'):
+        msg = m.msg
+        data = np.asarray(msg.data, dtype=np.uint8)
+        rows = data.reshape(msg.height, msg.step)[:, :4 * msg.width]
+        values = np.ascontiguousarray(rows).view('>f4' if msg.is_bigendian else '<f4')
+        stamp = _seconds(msg.header.stamp)
+        kind = 'scan' if str(msg.header.frame_id).startswith('scan/') else 'fixation'
+        frames.append((stamp or m.time_ns * 1e-9, m.time_ns * 1e-9,
+                       values.reshape(-1).astype(np.float64), kind))
+    for m in bag.topic('evidence'):
+        frames.append((m.time_ns * 1e-9, m.time_ns * 1e-9,
+                       np.asarray(m.msg.data, dtype=np.float64), 'fixation'))
+    frames.sort(key=lambda f: f[1])
+    if not frames:
+        raise ValueError(f'{bag.path} has no evidence_image or evidence frame to replay')
+    if any(f[2].size != grid.n_cells for f in frames):
+        raise ValueError(f'{bag.path}: a frame does not have the {grid.n_cells} cells of the '
+                         f'recorded {grid.rows}x{grid.cols} grid')
+    return frames
+
+
+def _targets(bag, head: PanTiltMap) -> list:
+    """Return ``(sent_s, cell)`` of each target the controller sent (re-sends dropped)."""
+    seen, out = set(), []
+    for m in bag.topic('pan_tilt'):
+        key = (m.msg.header.stamp.sec, m.msg.header.stamp.nanosec)
+        if key in seen:
+            continue
+        seen.add(key)
+        out.append((_seconds(m.msg.header.stamp), head.nearest_cell(*_angles(m.msg, head))))
+    return out
+
+
+def _recorded_decision(bag) -> Decision:
+    for kind in ('found', 'absent', 'gave_up'):
+        events = bag.topic(kind)
+        if events:
+            values = {kv.key: kv.value for kv in events[0].msg.values}
+            cell = int(values['cell']) if 'cell' in values else None
+            p = float(values['probability']) if 'probability' in values else None
+            return Decision(kind, cell, p, int(values['fixations']))
+    return Decision()
+
+
+def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
+    """
+    Re-run the recorded frames through the controller; print and return where decisions differ.
+
+    ``bag`` is an :class:`ipomdp_gaze.bag.Bag`; ``overrides`` replace recorded settings
+    (:data:`OVERRIDES`).
+    """
+    recorded_values = bag.parameters(CONTROLLER)
+    if not recorded_values:
+        raise ValueError(f'{bag.path} has no parameters of {CONTROLLER} in its metadata: was '
+                         f'it recorded by the recorder node with the controller running?')
+    core, head = build_controller(settings_from(recorded_values, overrides))
+    grid = core.grid
+    frames = _frames(bag, grid)
+    targets = _targets(bag, head)
+    if not targets:
+        raise ValueError(f'{bag.path} has no pan_tilt target of the controller')
+    recorded = _recorded_decision(bag)
+    recorded_cells = [cell for _, cell in targets]
+    core.reset(targets[0][0])
+    replayed_cells = [core.fixation]
+    result = ReplayResult(grid, recorded_cells, replayed_cells, recorded, Decision(),
+                          len(frames), 0)
+    say = result.lines.append
+    if core.fixation != recorded_cells[0]:
+        result.first_difference = 1
+    for stamp, arrival, values, kind in frames:
+        if result.first_difference is not None or core.stopped:
+            break
+        k = core.fixations
+        # The node sent its next target when it took the frame: the recorded send time.
+        now = targets[k + 1][0] if k + 1 < len(targets) else arrival
+        if kind == 'scan':          # the one-time scan of this (the only recorded) search
+            step = core.offer_scan(values, core.search_id, now)
+        else:
+            step = core.offer(values, stamp, now)
+        if not step.applied:
+            continue
+        result.applied += 1
+        event = step.found or step.absent or step.gave_up
+        if event is not None:
+            kind = 'found' if step.found else 'absent' if step.absent else 'gave_up'
+            result.replayed = Decision(kind, getattr(event, 'cell', None),
+                                       getattr(event, 'probability', None), event.fixations)
+        if step.fixation is None:
+            continue
+        replayed_cells.append(step.fixation)
+        n = len(replayed_cells)
+        if n <= len(recorded_cells) and step.fixation != recorded_cells[n - 1]:
+            result.first_difference = n
+    if result.first_difference is not None:
+        n = result.first_difference
+        rec = grid.cell(recorded_cells[n - 1]) if n <= len(recorded_cells) else None
+        say(f'fixation {n} differs: recorded {rec}, replay {grid.cell(replayed_cells[n - 1])}; '
+            f'the recorded frames after it were taken elsewhere, so the replay stops here')
+        result.stopped_early = True
+    say(f'recorded: {recorded.describe(grid)}')
+    say(f'replay:   {result.replayed.describe(grid)}')
+    if result.first_difference is None:
+        say('the same fixations and the same decision' if result.same else
+            'the same fixations, another decision')
+    for line in result.lines:
+        out(line)
+    return result
+
+
+def search_rate(bag) -> tuple[float, float]:
+    """
+    Return ``(seconds, MB per minute)`` of the search: the bag's growth while frames came.
+
+    The search spans the recorded frames, from one mean frame interval before the first to the
+    last; the bytes of the messages recorded in it are scaled by the file's compression.
+    """
+    frames = sorted(m.time_ns for topic in ('evidence_image', 'evidence')
+                    for m in bag.topic(topic))
+    raw = sum(m.size for m in bag.messages)
+    if len(frames) < 2 or raw == 0:
+        return 0.0, math.nan
+    start = frames[0] - (frames[-1] - frames[0]) / (len(frames) - 1)
+    inside = sum(m.size for m in bag.messages if start <= m.time_ns <= frames[-1])
+    seconds = (frames[-1] - start) * 1e-9
+    return seconds, inside * bag.size_bytes / raw / 1e6 / (seconds / 60.0)
+
+
+def describe_size(bag) -> str:
+    """Say how large the bag is and how fast it grows per minute of search."""
+    seconds, per_minute = search_rate(bag)
+    rate = f'{per_minute:.1f} MB per minute of search (over {seconds:.1f} s of frames)' \
+        if seconds > 0 else 'fewer than two frames'
+    return f'{bag.size_bytes / 1e6:.2f} MB, {bag.duration_s:.1f} s recorded; {rate}'
+
+
+def _last_image(bag) -> np.ndarray:
+    """Return the last recorded camera image as grey ``(H, W)`` or RGB ``(H, W, 3)`` uint8."""
+    msgs = bag.topic('image')
+    if not msgs:
+        raise ValueError(f'{bag.path} has no camera image to search')
+    msg = msgs[-1].msg
+    channels = IMAGE_CHANNELS.get(msg.encoding)
+    if channels is None:
+        raise ValueError(f'the recorded image is {msg.encoding!r}; expected mono8, rgb8 or bgr8')
+    data = np.asarray(msg.data, dtype=np.uint8).reshape(msg.height, msg.step)
+    pixels = data[:, :msg.width * channels].reshape(msg.height, msg.width, channels)
+    if msg.encoding == 'bgr8':
+        pixels = pixels[:, :, ::-1]
+    return np.ascontiguousarray(pixels[:, :, 0] if channels == 1 else pixels)
+
+
+def new_search(bag, overrides: dict | None = None, out=print):
+    """
+    Run a whole new search on the last recorded image of a fixed camera (``fovea`` mode).
+
+    The fovea and detector are the recorded detector's; the count model, policy, confidence,
+    budget and inhibition of return the controller's, with ``overrides``. Returns the
+    :class:`ipomdp_gaze.vision.search.ImageSearch`.
+
+    Raises
+    ------
+    ValueError
+        If the recording is not of a fixed camera or holds no image.
+
+    """
+    from ipomdp_gaze.detection import build_setup
+    from ipomdp_gaze.vision.search import search_image
+    detector = bag.parameters(DETECTOR)
+    if detector.get('mode') != 'fovea':
+        raise ValueError('a new search needs a recording of a fixed camera (the detector in '
+                         'fovea mode): a camera on the head only recorded the views it took')
+    values = settings_from(bag.parameters(CONTROLLER), overrides)
+    core, _ = build_controller(values)
+    given = {k: v for k, v in (('cascade', detector.get('detector.cascade')),
+                               ('scale_factor', detector.get('detector.scale_factor', 0) or None),
+                               ('min_neighbors', detector.get('detector.min_neighbors', -1)))
+             if v not in (None, '', -1)}
+    setup = build_setup('fovea', detector.get('observation.file', ''),
+                        (detector.get('grid.rows', 0), detector.get('grid.cols', 0),
+                         detector.get('grid.spacing_deg', 0.0)), given,
+                        detector.get('detector.cascade_dir') or None)
+    settings = core.settings
+    if not settings.max_fixations:        # the demo's budget: a still image needs an end
+        settings = dataclasses.replace(settings, max_fixations=4 * core.grid.n_cells)
+    result = search_image(_last_image(bag), setup.fovea, core.observation, core.policy,
+                          settings, rng=np.random.default_rng(int(values.get('seed', 0))))
+    r, c = result.cell
+    out(f'new search on the recorded image: {result.stop} at ({r}, {c}) '
+        f'p={result.probability:.3f} after {result.fixations} fixations')
+    return result

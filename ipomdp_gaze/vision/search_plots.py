@@ -1,0 +1,106 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Pictures of a search, for ``find --plot`` and the demo's ``--plot`` and ``--animate``.
+
+Each picture is an :func:`ipomdp_gaze.vision.annotate.annotate` image (the belief as an overlay,
+the numbered fixations, the fovea windows, the detections, the cell found), enlarged to at least
+:data:`MIN_SIDE_PX` so that fixation numbers stay readable, with a title and the belief's colour
+scale. :func:`save_gif` writes an animation of such images (Pillow, which matplotlib needs).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from .annotate import annotate, fovea_cell_map, LOG_RANGE
+
+MIN_SIDE_PX = 640
+
+
+def enlarged(image: np.ndarray, min_side: int = MIN_SIDE_PX) -> tuple[np.ndarray, int]:
+    """Return the image scaled by a whole factor (nearest) so its short side >= min_side."""
+    factor = max(1, int(np.ceil(min_side / max(1, min(image.shape[:2])))))
+    if factor == 1:
+        return image, 1
+    return cv2.resize(image, (image.shape[1] * factor, image.shape[0] * factor),
+                      interpolation=cv2.INTER_NEAREST), factor
+
+
+def annotate_image_search(image: np.ndarray, result, fovea) -> np.ndarray:
+    """
+    Draw an offline image search (:class:`ipomdp_gaze.vision.search.ImageSearch`) on its image.
+
+    The image is enlarged first (:func:`enlarged`), then the final belief, the scan path, the
+    last fixation's windows and the answer (``found``, or ``most likely`` at another stop) are
+    drawn on it.
+    """
+    big, factor = enlarged(image)
+    grid = fovea.grid
+    cell_map = fovea_cell_map(grid, big.shape[1], big.shape[0])
+    path = [grid.index(*cell) for cell in result.path]
+    windows = [(x * factor, y * factor, w * factor, h * factor, win.whole_image)
+               for win in fovea.window_rects(path[-1], image.shape)
+               for x, y, w, h in [win.rect_px]] if path else []
+    answer = (grid.index(*result.cell), result.probability)
+    return annotate(big, cell_map, result.belief, path, windows, found=answer,
+                    found_label='found' if result.stop == 'found' else 'most likely')
+
+
+def save_figure(picture: np.ndarray, out_path: Path, title: str) -> None:
+    """Save an annotated RGB picture with a title and the belief's colour scale as a PNG."""
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import Normalize
+    height, width = picture.shape[:2]
+    fig_w = 7.0
+    fig, ax = plt.subplots(figsize=(fig_w, fig_w * height / width * 0.9 + 0.6))
+    ax.imshow(picture, interpolation='nearest')
+    ax.set_axis_off()
+    ax.set_title(title, fontsize=9)
+    bar = fig.colorbar(ScalarMappable(Normalize(-LOG_RANGE, 0), 'inferno'), ax=ax,
+                       fraction=0.04, pad=0.02)
+    bar.set_label('log10 belief / most likely cell (overlay)', fontsize=8)
+    fig.tight_layout()
+    out_path = Path(out_path)
+    out_path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out_path, dpi=100, format='png')
+    plt.close(fig)
+
+
+def save_png(picture: np.ndarray, out_path: Path) -> None:
+    """Save an RGB picture as it is (no title, no scale)."""
+    out_path = Path(out_path)
+    out_path.parent.mkdir(parents=True, exist_ok=True)
+    if not cv2.imwrite(str(out_path), np.ascontiguousarray(picture[:, :, ::-1])):
+        raise OSError(f'cannot write {out_path}')
+
+
+def save_gif(frames, out_path: Path, seconds_per_frame: float = 0.6,
+             last_seconds: float = 2.0) -> int:
+    """
+    Write RGB pictures of one size as an animated GIF (looping); return the frame count.
+
+    The last frame stays ``last_seconds`` so the answer can be read.
+
+    Raises
+    ------
+    ValueError
+        With no frame.
+
+    """
+    from PIL import Image
+    frames = [np.asarray(f, dtype=np.uint8) for f in frames]
+    if not frames:
+        raise ValueError('no frame to animate: the search published no picture')
+    images = [Image.fromarray(f) for f in frames]
+    durations = [int(seconds_per_frame * 1000)] * (len(images) - 1) + [int(last_seconds * 1000)]
+    out_path = Path(out_path)
+    out_path.parent.mkdir(parents=True, exist_ok=True)
+    images[0].save(out_path, format='GIF', save_all=True, append_images=images[1:],
+                   duration=durations, loop=0, optimize=True)
+    return len(images)

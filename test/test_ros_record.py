@@ -1,0 +1,228 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Record a demo search, read the bag with readers that are not ours, and replay it (issue 24).
+
+The demo runs the nodes as processes with the ``recorder`` node (``--record``); the bag is read
+with the ``mcap`` reader and its ROS 2 decoder and with ``rosbags``, then ``ipomdp-gaze replay``
+re-runs the recorded frames through the controller's core and must reach the same decision. The
+face demo also draws the search: the detector's ``annotated_image`` is recorded and written as
+the demo's ``--plot`` PNG and ``--animate`` GIF.
+"""
+import hashlib
+from pathlib import Path
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import yaml
+
+REPO = Path(__file__).resolve().parents[1]
+SEARCH_TOPICS = {'/fixation', '/pan_tilt', '/belief', '/found', '/diagnostics', '/ground_truth'}
+
+
+def _cli(ros_env, *args, timeout=240):
+    return subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', *args], cwd=REPO,
+                          env=ros_env, capture_output=True, text=True, timeout=timeout)
+
+
+def _mcap_messages(bag: Path) -> dict:
+    """Decode every message with the mcap reader: {topic: [decoded message, ...]}."""
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+    files = list(bag.glob('*.mcap'))
+    assert len(files) == 1
+    out = {}
+    with open(files[0], 'rb') as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        for _, channel, _, msg in reader.iter_decoded_messages():
+            out.setdefault(channel.topic, []).append(msg)
+    return out
+
+
+def _rosbags_topics(bag: Path) -> dict:
+    """Count messages per topic with the rosbags reader (its own rosbag2 metadata parsing)."""
+    from rosbags.rosbag2 import Reader
+    with Reader(bag) as reader:
+        return {c.topic: c.msgcount for c in reader.connections}
+
+
+def _found(out: str) -> tuple:
+    found = re.search(r'^found: the (?:target|face) is most likely at \((\d+), (\d+)\).*after '
+                      r'(\d+) fixations$', out, re.M)
+    assert found, out
+    return int(found.group(1)), int(found.group(2)), int(found.group(3))
+
+
+@pytest.fixture(scope='module')
+def simulated(ros_env, tmp_path_factory):
+    tmp = tmp_path_factory.mktemp('record')
+    run = _cli(ros_env, 'demo', '--domain-id', ros_env['ROS_DOMAIN_ID'], '--seed', '4',
+               '--target', '8,2', '--record', str(tmp / 'bag'), '--plot', str(tmp / 'p.png'),
+               '--animate', str(tmp / 'a.gif'))
+    assert run.returncode == 0, run.stdout + run.stderr
+    return tmp, run.stdout
+
+
+def test_the_demo_bag_is_rosbag2_mcap_that_other_readers_read(simulated):
+    tmp, out = simulated
+    bag = tmp / 'bag'
+    assert f'recorded the search to {bag}' in out
+    assert 'recorder exit status 0' in out
+    meta = yaml.safe_load((bag / 'metadata.yaml').read_text())['rosbag2_bagfile_information']
+    assert meta['storage_identifier'] == 'mcap'
+    messages = _mcap_messages(bag)
+    assert SEARCH_TOPICS <= set(messages)
+    counts = _rosbags_topics(bag)
+    assert {t: len(m) for t, m in messages.items()} == {t: n for t, n in counts.items() if n}
+    row, col, fixations = _found(out)
+    found = {kv.key: kv.value for kv in messages['/found'][0].values}
+    assert (int(found['row']), int(found['col']), int(found['fixations'])) == \
+        (row, col, fixations)
+    assert list(messages['/ground_truth'][-1].data) == [8, 2]
+    frames = messages.get('/evidence_image', []) + messages.get('/evidence', [])
+    assert len(frames) >= fixations
+    custom = meta['custom_data']
+    params = yaml.safe_load(custom['ipomdp_gaze/parameters/gaze_controller'])
+    assert params['grid.rows'] == 11 and params['confidence'] == 0.95
+    from ipomdp_gaze.policies.policy_file import resolve_source
+    kernel = params['policy.file']
+    digest = hashlib.sha256(resolve_source(kernel).read_bytes()).hexdigest()
+    assert yaml.safe_load(custom['ipomdp_gaze/files']) == {kernel: digest}
+    from ipomdp_gaze.cli import package_version
+    assert custom['ipomdp_gaze/version'] == package_version()
+
+
+def test_the_replay_reaches_the_recorded_decision(simulated, ros_env):
+    tmp, out = simulated
+    row, col, fixations = _found(out)
+    run = _cli(ros_env, 'replay', str(tmp / 'bag'))
+    assert run.returncode == 0, run.stdout + run.stderr
+    expected = f'found at ({row}, {col}) p='
+    assert re.search(rf'^recorded: {re.escape(expected)}\d\.\d+ after {fixations} fixations$',
+                     run.stdout, re.M), run.stdout
+    assert re.search(rf'^replay:   {re.escape(expected)}\d\.\d+ after {fixations} fixations$',
+                     run.stdout, re.M), run.stdout
+    assert 'the same fixations and the same decision' in run.stdout
+    assert re.search(r'MB per minute', run.stdout)
+
+
+def test_a_replay_with_another_policy_stops_at_the_first_other_fixation(simulated, ros_env):
+    tmp, _ = simulated
+    run = _cli(ros_env, 'replay', str(tmp / 'bag'), '--policy', 'map')
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert 'settings: recorded, with policy=map' in run.stdout
+    # MAP looks at cell (0, 0) first from a uniform belief: the recording went elsewhere.
+    assert re.search(r'^fixation 2 differs: recorded \(\d+, \d+\), replay \(\d+, \d+\); the '
+                     r'recorded frames after it were taken elsewhere, so the replay stops here$',
+                     run.stdout, re.M), run.stdout
+    assert 'replay:   no decision' in run.stdout
+
+
+def test_the_demo_draws_the_search(simulated):
+    from PIL import Image
+    tmp, out = simulated
+    _, _, fixations = _found(out)
+    picture = np.asarray(Image.open(tmp / 'p.png').convert('RGB'))
+    assert picture.shape == (440, 440, 3)                  # 11x11 cells of 40 px
+    assert ((picture[..., 1] > 200) & (picture[..., 0] < 80)).any()     # the found cell
+    gif = Image.open(tmp / 'a.gif')
+    assert gif.n_frames == fixations
+    assert f'wrote {tmp / "a.gif"} ({fixations} pictures)' in out
+
+
+@pytest.mark.parametrize('bad, message', [
+    (['replay', 'nowhere'], 'nowhere is not a bag directory'),
+    (['record', str(REPO)], 'exists; a bag needs a new directory'),
+    (['record', 'x', '--topics', 'image,pictures'], '--topics: unknown pictures'),
+])
+def test_record_and_replay_refuse_bad_paths_with_one_line(bad, message, ros_env):
+    run = _cli(ros_env, *bad)
+    assert run.returncode == 2
+    assert message in run.stderr.strip().splitlines()[-1]
+    assert 'Traceback' not in run.stderr
+
+
+def test_the_face_demo_records_the_annotated_image_and_replays(ros_env, tmp_path):
+    from ipomdp_gaze.msg_adapters import images
+    from PIL import Image
+    run = _cli(ros_env, 'demo', '--scene', 'faces', '--domain-id', ros_env['ROS_DOMAIN_ID'],
+               '--seed', '0', '--record', str(tmp_path / 'bag'), '--compression', 'zstd',
+               '--plot', str(tmp_path / 'faces.png'))
+    assert run.returncode == 0, run.stdout + run.stderr
+    messages = _mcap_messages(tmp_path / 'bag')
+    annotated = messages['/annotated_image']
+    images_in = messages['/image']
+    assert annotated and images_in
+    assert {(m.width, m.height, m.encoding) for m in annotated} == \
+        {(images_in[0].width, images_in[0].height, 'rgb8')}
+    # The last picture written is the last annotated image the detector published.
+    last = np.frombuffer(bytes(annotated[-1].data), np.uint8).reshape(
+        annotated[-1].height, annotated[-1].width, 3)
+    assert np.array_equal(np.asarray(Image.open(tmp_path / 'faces.png').convert('RGB')), last)
+    assert images.MAX_IMAGE_SIDE_PX >= last.shape[1]
+    _, _, fixations = _found(run.stdout)
+    detections = messages['/detections']                   # the raw detections, per frame
+    assert len(detections) == fixations
+    stamps = {(m.header.stamp.sec, m.header.stamp.nanosec) for m in messages['/evidence_image']}
+    assert {(m.header.stamp.sec, m.header.stamp.nanosec) for m in detections} <= stamps
+    points = np.array([[p.position.x, p.position.y] for m in detections for p in m.poses])
+    assert len(points) and (points >= -0.5).all()
+    assert (points[:, 0] < last.shape[1]).all() and (points[:, 1] < last.shape[0]).all()
+    replayed = _cli(ros_env, 'replay', str(tmp_path / 'bag'))
+    assert replayed.returncode == 0, replayed.stdout + replayed.stderr
+    assert 'the same fixations and the same decision' in replayed.stdout
+    refused = _cli(ros_env, 'replay', str(tmp_path / 'bag'), '--new-search')
+    assert refused.returncode == 2
+    assert 'a new search needs a recording of a fixed camera' in refused.stderr
+
+
+def test_a_fixed_camera_recording_can_be_searched_anew(ros_env, tmp_path):
+    run = _cli(ros_env, 'demo', '--scene', 'faces', '--fovea', '--domain-id',
+               ros_env['ROS_DOMAIN_ID'], '--seed', '0', '--record', str(tmp_path / 'bag'))
+    assert run.returncode == 0, run.stdout + run.stderr
+    row, col, fixations = _found(run.stdout)
+    again = _cli(ros_env, 'replay', str(tmp_path / 'bag'), '--new-search')
+    assert again.returncode == 0, again.stdout + again.stderr
+    # The detector is deterministic on a still scene: the new search is the recorded one.
+    assert re.search(rf'^new search on the recorded image: found at \({row}, {col}\) '
+                     rf'p=\d\.\d+ after {fixations} fixations$', again.stdout, re.M), again.stdout
+    other = _cli(ros_env, 'replay', str(tmp_path / 'bag'), '--new-search', '--policy', 'map')
+    assert other.returncode == 0, other.stdout + other.stderr
+    assert 'settings: recorded, with policy=map' in other.stdout
+    assert re.search(r'^new search on the recorded image: (found|budget) at \(\d+, \d+\)',
+                     other.stdout, re.M), other.stdout
+
+
+def test_ipomdp_gaze_record_records_another_run_until_sigint(ros_env, tmp_path):
+    import signal
+
+    from ipomdp_gaze.nodes.processes import wait_for
+    log = tmp_path / 'recorder.log'
+    with open(log, 'wb') as out:
+        recorder = subprocess.Popen(
+            [sys.executable, '-m', 'ipomdp_gaze.cli', 'record', str(tmp_path / 'bag'),
+             '--topics', 'pan_tilt,belief,found,ground_truth'],
+            cwd=REPO, env=ros_env, stdout=out, stderr=subprocess.STDOUT)
+    try:
+        assert wait_for(lambda: b'recording pan_tilt' in log.read_bytes(), 60), \
+            log.read_text()
+        run = _cli(ros_env, 'demo', '--domain-id', ros_env['ROS_DOMAIN_ID'], '--seed', '5',
+                   '--target', '3,3')
+        assert run.returncode == 0, run.stdout + run.stderr
+        assert wait_for(lambda: b'recorded the parameters of gaze_controller' in
+                        log.read_bytes(), 30), log.read_text()
+    finally:
+        recorder.send_signal(signal.SIGINT)
+        assert recorder.wait(30) == 0, log.read_text()
+    messages = _mcap_messages(tmp_path / 'bag')
+    assert set(messages) <= {'/pan_tilt', '/belief', '/found', '/ground_truth'}
+    row, col, fixations = _found(run.stdout)
+    found = {kv.key: kv.value for kv in messages['/found'][0].values}
+    assert (int(found['row']), int(found['col'])) == (row, col)
+    assert list(messages['/ground_truth'][-1].data) == [3, 3]
+    meta = yaml.safe_load((tmp_path / 'bag' / 'metadata.yaml').read_text())
+    custom = meta['rosbag2_bagfile_information']['custom_data']
+    assert yaml.safe_load(custom['ipomdp_gaze/parameters/gaze_controller'])['seed'] == 5
