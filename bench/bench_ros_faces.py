@@ -25,7 +25,9 @@ MODES = (('camera', False, 'a camera on the pan/tilt head (11x11 grid of 5 deg, 
                            '`faces-pan-tilt`, ELM, confidence 0.99, inhibition of return, '
                            'repeated views weighted 0.1)'),
          ('fovea', True, 'a fixed camera and the digital fovea (21x21 grid over 420x420 '
-                         'scenes, `faces-420-nmpt`, ELM, confidence 0.999, inhibition of return)'))
+                         'scenes, `faces-420` with its one-time scan and kernel '
+                         '`faces-420-infomax`, confidence 0.99, inhibition of return, as '
+                         '`find` searches)'))
 
 
 def run_mode(fovea: bool, seeds, log) -> list:
