@@ -148,3 +148,23 @@ def test_find_with_an_absent_prior_says_absent_on_a_face_free_photo(tmp_path):
     entry = json.loads((tmp_path / 'o.json').read_text())['images'][0]
     assert entry['decision'] == entry['stop'] == 'absent'
     assert entry['absent_probability'] >= 0.99 and 'decision=absent' in out.stdout
+
+
+def test_find_saves_each_images_event_log(tmp_path):
+    import cv2
+    from skimage import data
+    path = tmp_path / 'astronaut.png'
+    cv2.imwrite(str(path), cv2.cvtColor(data.astronaut(), cv2.COLOR_RGB2BGR))
+    out = cli('find', str(path), '--log', str(tmp_path / 'log.jsonl'), '--json',
+              str(tmp_path / 'o.json'))
+    assert out.returncode == 0, out.stderr
+    entry = json.loads((tmp_path / 'o.json').read_text())['images'][0]
+    lines = (tmp_path / 'log.jsonl').read_text().splitlines()
+    assert len(lines) == 1
+    events = json.loads(lines[0])['events']
+    assert [e['event'] for e in events[:3]] == ['reset', 'scan', 'start']
+    frames = [e for e in events if e['event'] == 'frame']
+    assert len(frames) == entry['fixations']
+    assert frames[-1]['decision'] == entry['decision']
+    assert frames[-1]['belief']['map_cell'] == entry['cell']
+    assert events[0]['settings']['confidence'] == 0.99
