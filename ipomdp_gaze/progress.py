@@ -32,8 +32,9 @@ class Progress:
     On a terminal a tqdm bar (rate and ETA); on anything else a line ``desc: done/total
     (pct) elapsed, ETA`` every ``every_s`` seconds (from a timer thread, so a long piece does
     not leave the log silent) and once at the end; with ``quiet`` nothing. ``add(n)`` grows
-    the total (a job that learns its size as it submits), ``note(text)`` shows a status. ``stream`` defaults to stderr. Safe to update from several threads. Use it as a
-    context manager, or call :meth:`close`.
+    the total (a job that learns its size as it submits), ``note(text)`` shows a status.
+    ``stream`` defaults to stderr. Safe to update from several threads. Use it as a context
+    manager, or call :meth:`close`.
     """
 
     def __init__(self, total: float, desc: str, unit: str = 'piece', quiet: bool = False,
