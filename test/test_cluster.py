@@ -219,6 +219,29 @@ def test_ctrl_c_stops_at_once_and_keeps_the_finished_pieces(tmp_path):
     assert found > 0
 
 
+def test_ctrl_c_on_a_cluster_run_cancels_its_pieces(cluster):
+    """The command exits at once (status 130) and the scheduler drops every piece of the run."""
+    proc = subprocess.Popen(
+        [sys.executable, '-m', 'ipomdp_gaze.cli', 'evaluate', '--grid', '5x5', '--policy',
+         'greedy', '--episodes', '4000', '--episodes-greedy', '4000', '--scheduler',
+         cluster.address],
+        start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        first = proc.stderr.readline()          # the first progress line, after 5 s
+        assert first.startswith('evaluate: ') and '16/16' not in first, first
+        os.killpg(proc.pid, signal.SIGINT)
+        proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert proc.returncode == 130
+
+    def tasks():
+        with distributed.Client(cluster.address, timeout=20, set_as_default=False) as client:
+            return client.run_on_scheduler(lambda dask_scheduler: len(dask_scheduler.tasks))
+    assert wait_for(lambda: tasks() == 0, 30)
+
+
 def test_a_worker_killed_mid_run_changes_nothing(cluster, monkeypatch):
     """
     The scheduler runs the dead worker's pieces again elsewhere: the same matrices.
