@@ -283,7 +283,8 @@ def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = 
         procs = [nodes.add(node, args)
                  for node, args in _with_recorder(setup, record, compression, pictures)]
         watch = Watch(domain, 'gaze_demo', nodes)
-        record_ = SearchRecord(watch, depth=200, updates_only=True)
+        record_ = SearchRecord(watch, depth=200, updates_only=True,
+                               n_cells=setup.grid.n_cells)
         annotated = watch.record(Image, 'annotated_image', 50) if pictures is not None \
             else []
         recorder = RecorderStatus(watch) if record else None

@@ -288,13 +288,16 @@ class SearchRecord:
     What the controller and the camera publish during searches, as ``(t, msg)`` lists.
 
     ``beliefs`` (``belief``, keep-last ``depth``; with ``updates_only`` not the uniform belief of
-    a reset), ``targets`` (``pan_tilt``, latched, each sent target once), ``found`` and ``truth``
+    a reset; with ``n_cells`` only beliefs of that many cells, not a previous run's grid), ``targets`` (``pan_tilt``, latched, each sent target once), ``found`` and ``truth``
     (the camera's ``ground_truth``, latched).
     """
 
-    def __init__(self, watch: Watch, depth: int = 200, updates_only: bool = False):
-        self.beliefs = watch.record(Float32MultiArray, 'belief', depth,
-                                    keep=is_update if updates_only else None)
+    def __init__(self, watch: Watch, depth: int = 200, updates_only: bool = False,
+                 n_cells: int | None = None):
+        def keep(msg) -> bool:
+            fits = n_cells is None or len(msg.data) == n_cells    # not another run's grid
+            return fits and (not updates_only or is_update(msg))
+        self.beliefs = watch.record(Float32MultiArray, 'belief', depth, keep=keep)
         self.targets = watch.record(JointState, 'pan_tilt', LATCHED, distinct_stamps=True)
         self.found = watch.record(DiagnosticStatus, 'found', 10)
         self.truth = watch.record(Int32MultiArray, 'ground_truth', LATCHED)
