@@ -288,8 +288,9 @@ class SearchRecord:
     What the controller and the camera publish during searches, as ``(t, msg)`` lists.
 
     ``beliefs`` (``belief``, keep-last ``depth``; with ``updates_only`` not the uniform belief of
-    a reset; with ``n_cells`` only beliefs of that many cells, not a previous run's grid), ``targets`` (``pan_tilt``, latched, each sent target once), ``found`` and ``truth``
-    (the camera's ``ground_truth``, latched).
+    a reset; with ``n_cells`` only beliefs of that many cells, not a previous run's grid),
+    ``targets`` (``pan_tilt``, latched, each sent target once), ``found`` and ``truth`` (the
+    camera's ``ground_truth``, latched).
     """
 
     def __init__(self, watch: Watch, depth: int = 200, updates_only: bool = False,
