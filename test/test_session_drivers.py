@@ -138,7 +138,7 @@ def test_evaluate_scenes_runs_the_pan_tilt_task_and_writes_json(tmp_path):
     record = json.loads((tmp_path / 'pt.json').read_text())
     assert record['settings']['search.max_fixations'] == 6
     assert record['settings']['search.repeat_weight'] == 0.1      # the shipped config's
-    scenes = record['scenes']
+    scenes = record['scenes']['elm']
     assert [s['index'] for s in scenes] == [0, 1]
     for s in scenes:
         assert 1 <= s['fixations'] <= 6 and len(s['path']) == s['fixations']
@@ -146,6 +146,9 @@ def test_evaluate_scenes_runs_the_pan_tilt_task_and_writes_json(tmp_path):
         assert s['decision'] in ('found', 'gave_up')
         assert s['right'] == (max(abs(a - b) for a, b in zip(s['cell'], s['face_cell'])) <= 1)
         assert s['head_travel_deg'] >= 5.0 * (s['fixations'] - 1) - 1e-9
+        # A stopped search keeps its answer: the MAP after its last fixation onwards is it.
+        assert len(s['map_right']) == 20 and set(s['map_right'][s['fixations'] - 1:]) == \
+            {s['right']}
 
 
 def test_find_with_an_absent_prior_says_absent_on_a_face_free_photo(tmp_path):
