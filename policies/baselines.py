@@ -17,8 +17,10 @@ import numpy as np
 
 from .conv import ConvPolicy
 
-STRATEGIES = ('map', 'random', 'center', 'elm', 'spiral', 'sweep', 'greedy', 'tempered',
-              'switching')
+STRATEGIES = ('map', 'random', 'center', 'elm', 'spiral', 'sweep', 'coverage', 'greedy',
+              'tempered', 'switching')
+# coverage: the sweep's tile poses come first while no cell's belief reaches this.
+COVERAGE_PEAK = 0.3
 # A model without a camera's field of view (the Gaussian FPOCs, the fovea): the sweep's raster
 # looks at every SWEEP_STEP-th cell in each direction.
 SWEEP_STEP = 3
@@ -176,6 +178,39 @@ def elm_policy(grid: Grid, model) -> ConvPolicy:
     return policy
 
 
+class CoveragePolicy:
+    """
+    ELM that covers the grid with the sweep's tiles while the belief is diffuse.
+
+    While no cell's belief reaches ``peak`` (:data:`COVERAGE_PEAK`), the best of the sweep's
+    tile poses by ELM's score (with inhibition of return: the unvisited ones; then every other
+    cell by ELM); after that, ELM. ELM alone starts from the centre and takes the rows two
+    cells from it (5-degree cells, a 3-row view): the grid's edge rows are then left at the
+    view's nearly blind offset and are covered last. ``scores`` lets inhibition of return mask
+    visited cells.
+    """
+
+    name = 'coverage'
+
+    def __init__(self, grid: Grid, model, peak: float = COVERAGE_PEAK):
+        self.elm = elm_policy(grid, model)
+        poses, _ = sweep_tiles(grid, model)
+        self.tile = np.zeros(grid.n_cells)
+        self.tile[poses] = 1.0
+        self.peak = float(peak)
+
+    def scores(self, belief) -> np.ndarray:
+        """Return ELM's scores, those of the tile poses raised above the rest while diffuse."""
+        belief = np.atleast_2d(belief)
+        scores = np.array(self.elm.scores(belief), dtype=float).reshape(belief.shape)
+        diffuse = belief.max(axis=1, keepdims=True) < self.peak
+        bonus = np.abs(scores).max(axis=1, keepdims=True) + 1.0
+        return scores + diffuse * bonus * self.tile
+
+    def select(self, belief, t, rng):
+        return argmax_ties_low(self.scores(belief))
+
+
 def make_baseline(strategy: str, grid: Grid, model):
     """Build the baseline called ``strategy`` (one of :data:`STRATEGIES`) for ``model``."""
     if strategy == 'map':
@@ -190,6 +225,8 @@ def make_baseline(strategy: str, grid: Grid, model):
         return elm_policy(grid, model)
     if strategy == 'sweep':
         return SweepPolicy(grid, model)
+    if strategy == 'coverage':
+        return CoveragePolicy(grid, model)
     if strategy in ('greedy', 'tempered', 'switching'):
         fpoc = getattr(as_observation(grid, model), 'fpoc', None)
         if fpoc is None:

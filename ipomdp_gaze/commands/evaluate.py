@@ -28,7 +28,7 @@ from ipomdp_gaze.observation_file import fingerprint
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
 from ipomdp_gaze.session import SearchSettings
 from ipomdp_gaze.simulate import draw_present, draw_targets, simulate
-from ipomdp_gaze.vision.scene_eval import (DEFAULT_BUDGET, evaluate_scenes, format_summary,
+from ipomdp_gaze.vision.scene_eval import (evaluate_scenes, format_summary,
                                            paired_map_difference, results_json, summarise,
                                            task_spec, TASKS, write_json)
 import numpy as np
@@ -57,8 +57,8 @@ def add_parser(sub):
                         'and sensor (the search session of the nodes and find) instead of '
                         'simulating: pan-tilt (config/faces_camera_controller.yaml), faces-420 '
                         "or faces-840 (find's settings); --policy, --policy-file, "
-                        '--confidence, --max-fixations (default 60) and --absent-prior change '
-                        'the shipped configuration')
+                        '--confidence, --max-fixations (default: the configuration budget, '
+                        'else 60) and --absent-prior change the shipped configuration')
     p.add_argument('--split', choices=('train', 'test'), default='test',
                    help='--scenes: training scenes (for every choice) or held-out test scenes '
                         '(default)')
@@ -250,8 +250,7 @@ def run_scenes(args) -> int:
         raise ValueError('--scenes evaluates one policy at a time (others: --compare)')
     spec = task_spec(args.scenes, args.policy[0] if args.policy else None,
                      str(args.policy_file[0]) if args.policy_file else None, seed=args.seed,
-                     max_fixations=DEFAULT_BUDGET if args.max_fixations is None
-                     else args.max_fixations, split=args.split, model=args.scene_model,
+                     max_fixations=args.max_fixations, split=args.split, model=args.scene_model,
                      compare=tuple(args.compare), empty=False)
     changes = {key: value for key, value in (('confidence', args.confidence),
                                              ('absent_prior', args.absent_prior))

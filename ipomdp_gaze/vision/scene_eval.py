@@ -33,7 +33,7 @@ from ipomdp_gaze.evaluation import wilson_interval
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.observation_file import load_observation
-from ipomdp_gaze.session import SearchSession, SearchSettings
+from ipomdp_gaze.session import PARAMETER_NAMES, SearchSession, SearchSettings
 from ipomdp_gaze.yaml_files import yaml_parameters
 import numpy as np
 
@@ -76,17 +76,21 @@ class TaskSpec:
 
 def task_spec(task: str, policy: str | None = None, policy_file: str | None = None,
               settings: SearchSettings | None = None, seed: int = 0,
-              max_fixations: int = DEFAULT_BUDGET, split: str = 'test', empty: bool = False,
+              max_fixations: int | None = None, split: str = 'test', empty: bool = False,
               model: str = '', compare=()) -> TaskSpec:
     """
     Return the shipped configuration of ``task``, with any of its parts replaced.
 
     ``pan-tilt`` takes its policy and settings from ``config/faces_camera_controller.yaml``;
-    the fixed-camera tasks take ``find``'s (the shipped kernel of the model, else ELM).
+    the fixed-camera tasks take ``find``'s (the shipped kernel of the model, else ELM). The
+    budget ``max_fixations`` is the configuration's when it has one, else
+    :data:`DEFAULT_BUDGET`.
     ``split`` picks training or held-out test scenes, ``empty`` the same scenes without a face
     (pan-tilt), ``model`` another pan/tilt observation file (its camera is the sensor's) and
     ``compare`` more searchers run on the same scenes and views: policy names (with the same
-    settings; ``sweep`` starts at its own first pose) and :data:`SWEEP_RULES`.
+    settings; ``sweep`` starts at its own first pose), optionally with changed settings as
+    ``name:parameter=value,...`` (parameter names of docs/design.md section 10.1, e.g.
+    ``elm:search.repeat_weight=0.1,absent.prior=0``), and :data:`SWEEP_RULES`.
     """
     if task not in TASKS:
         raise ValueError(f"unknown scene task {task!r}; choose from {', '.join(TASKS)}")
@@ -95,7 +99,10 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
     if (empty or model) and task != 'pan-tilt':
         raise ValueError('empty scenes and another model are for the pan-tilt task')
     from ipomdp_gaze.policies.registry import NAMED_POLICIES
-    for name in compare:
+    for label in compare:
+        name = label.split(':')[0]
+        if ':' in label:
+            compare_settings(SearchSettings(), label)
         if name not in NAMED_POLICIES and name not in SWEEP_RULES:
             raise ValueError(f'unknown searcher {name!r}; choose from '
                              f"{', '.join(NAMED_POLICIES + SWEEP_RULES)}")
@@ -116,9 +123,30 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
         name = 'learned' if file else 'elm'
     if policy is not None or policy_file:
         name, file = ('learned', policy_file) if policy_file else (policy, '')
+    if max_fixations is None:
+        max_fixations = base.max_fixations or DEFAULT_BUDGET
     settings = settings or replace(base, max_fixations=max_fixations)
     return TaskSpec(task, name, file, settings, int(seed), split, bool(empty), model,
                     tuple(compare))
+
+
+def compare_settings(settings: SearchSettings, label: str) -> SearchSettings:
+    """
+    Return ``settings`` changed by a searcher label's ``:parameter=value,...`` part.
+
+    Values are read as YAML scalars (``0.1``, ``true``, ``60``).
+    """
+    if ':' not in label:
+        return settings
+    import yaml
+    values = {}
+    for item in label.split(':', 1)[1].split(','):
+        key, sep, value = item.partition('=')
+        if not sep or key.strip() not in PARAMETER_NAMES.values():
+            raise ValueError(f'searcher {label!r}: expected parameter=value with a parameter '
+                             f"of {', '.join(PARAMETER_NAMES.values())}, got {item!r}")
+        values[key.strip()] = yaml.safe_load(value)
+    return SearchSettings.from_parameters(values, base=settings)
 
 
 @dataclass(frozen=True)
@@ -246,8 +274,8 @@ class _Task:
         self.scene = scene
         self.policy = build_policy(spec.policy, self.model.grid, self.model,
                                    file=spec.policy_file or None)
-        self.compare = {name: build_policy(name, self.model.grid, self.model)
-                        for name in spec.compare if name not in SWEEP_RULES}
+        self.compare = {label: build_policy(label.split(':')[0], self.model.grid, self.model)
+                        for label in spec.compare if label not in SWEEP_RULES}
         if any(name in SWEEP_RULES for name in spec.compare):
             self.sweep = build_policy('sweep', self.model.grid, self.model)
 
@@ -269,8 +297,9 @@ def evaluate_scene(spec: TaskSpec, index: int) -> list:
             results.append(_sweep_rule(spec, task, scene, index, name))
         else:
             settings = spec.settings
-            if name == 'sweep':
+            if name.split(':')[0] == 'sweep':
                 settings = replace(settings, start_cell='policy')
+            settings = compare_settings(settings, name)
             results.append(_search(spec, task, scene, index, name, task.compare[name],
                                    settings))
     return results
