@@ -64,6 +64,7 @@ PARAMETER_NAMES = {
     'start_cell': 'start_cell',
     'scan': 'search.scan',
     'found_radius': 'search.found_radius',
+    'decide_at_budget': 'search.decide_at_budget',
 }
 
 
@@ -138,6 +139,10 @@ class SearchSettings:
         Still target: ``found`` when the belief within this many cells (Chebyshev) of a cell
         reaches ``confidence``, and that cell is the answer (``map_cell``); 0: the cell alone.
         A face straddling two cells splits its evidence; an answer within one cell is right.
+    decide_at_budget : bool
+        Still target: when the budget runs out undecided, decide anyway (reason ``budget``):
+        ``absent`` if ``P(absent)`` is at least the answer's probability, else ``found``;
+        off: ``gave_up``. A deadline: the robot must say something.
 
     """
 
@@ -152,6 +157,7 @@ class SearchSettings:
     start_cell: tuple | None = None
     scan: bool = True
     found_radius: int = 0
+    decide_at_budget: bool = False
 
     def __post_init__(self):
         names = PARAMETER_NAMES
@@ -169,6 +175,7 @@ class SearchSettings:
             'start_cell': _check_start(self.start_cell, names['start_cell']),
             'scan': _check_flag(self.scan, names['scan']),
             'found_radius': _check_radius(self.found_radius, names['found_radius']),
+            'decide_at_budget': _check_flag(self.decide_at_budget, names['decide_at_budget']),
         }
         for key, value in checked.items():
             object.__setattr__(self, key, value)
@@ -650,8 +657,10 @@ class SearchSession:
         search.decided_once = search.decided_once or bool(fired)
         if not search.decided_once and settings.max_fixations \
                 and search.fixations >= settings.max_fixations:
-            search.decision, search.reason, search.ended = 'gave_up', 'budget', True
             fired = 'gave_up'
+            if settings.decide_at_budget and not self.motion.active:
+                fired = 'absent' if absent >= peak else 'found'
+            search.decision, search.reason, search.ended = fired, 'budget', True
         return fired
 
     def _choose(self) -> int | None:

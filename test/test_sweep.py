@@ -62,3 +62,85 @@ def test_task_spec_refuses_unknown_searchers_and_splits():
         task_spec('pan-tilt', split='validation')
     with pytest.raises(ValueError, match='pan/tilt answer rule'):
         task_spec('faces-420', compare=('sweep-tile',))
+
+
+def _session(settings, policy=None):
+    from ipomdp_gaze.session import SearchSession
+    model = load_observation('faces-pan-tilt')
+    return model, SearchSession(model.grid, model, policy, settings)
+
+
+def test_found_radius_decides_on_the_belief_around_a_cell_and_answers_that_cell():
+    from ipomdp_gaze.session import Frame, pooled_belief, SearchSettings
+    grid = Grid(11, 11, 5.0)
+    belief = np.zeros(121)
+    belief[[grid.index(5, 8), grid.index(6, 8)]] = 0.5         # a face split over two cells
+    pooled = pooled_belief(belief, grid, 1)
+    assert pooled.max() == pytest.approx(1.0) and pooled[grid.index(5, 8)] == pytest.approx(1.0)
+    assert pooled[grid.index(8, 8)] == 0.0
+    # Frames that split a face's detections between two cells: the cell rule stays undecided,
+    # the radius rule finds it (and answers within one cell of both).
+    counts = np.zeros(121)
+    counts[[grid.index(5, 5), grid.index(5, 6)]] = 9.0
+    decisions = {}
+    for radius in (0, 1):
+        _, session = _session(SearchSettings(confidence=0.6, found_radius=radius,
+                                             repeat_weight=1.0))
+        session.reset(seed=0)
+        session.start()
+        result = session.update(Frame(counts))
+        decisions[radius] = (result.decision, session.map_cell, session.map_probability)
+    assert decisions[0][0] == '' and decisions[0][2] < 0.6
+    assert decisions[1][0] == 'found' and decisions[1][2] >= 0.6
+    r, c = grid.cell(decisions[1][1])
+    assert all(max(abs(r - 5), abs(c - col)) <= 1 for col in (5, 6))   # right for either cell
+
+
+def test_decide_at_budget_says_absent_or_found_instead_of_giving_up():
+    from ipomdp_gaze.session import Frame, SearchSettings
+    grid = Grid(11, 11, 5.0)
+    empty = np.zeros(121)
+    out = {}
+    for deadline in (False, True):
+        _, session = _session(SearchSettings(confidence=0.999, max_fixations=1,
+                                             absent_prior=0.5, decide_at_budget=deadline))
+        session.reset(seed=0)
+        session.start()
+        out[deadline] = session.update(Frame(empty))
+    assert out[False].decision == 'gave_up'
+    assert out[True].decision == 'absent' and out[True].reason == 'budget' and out[True].ended
+    # Without the absent hypothesis the deadline answers found (the most likely square).
+    _, session = _session(SearchSettings(confidence=0.999, max_fixations=1,
+                                         decide_at_budget=True))
+    session.reset(seed=0)
+    session.start()
+    assert session.update(Frame(empty)).decision == 'found'
+    assert grid.n_cells == 121
+
+
+def test_settings_refuse_a_bad_found_radius_with_the_parameter_name():
+    from ipomdp_gaze.session import SearchSettings
+    with pytest.raises(ValueError, match='search.found_radius must be an integer from 0 to 5'):
+        SearchSettings(found_radius=-1)
+    with pytest.raises(ValueError, match='search.decide_at_budget must be true or false'):
+        SearchSettings(decide_at_budget='yes')
+
+
+def test_coverage_takes_the_sweeps_tiles_while_the_belief_is_diffuse_then_elm():
+    from ipomdp_gaze.policies.baselines import COVERAGE_PEAK
+    model = load_observation('faces-pan-tilt')
+    coverage = build_policy('coverage', model.grid, model)
+    elm = build_policy('elm', model.grid, model)
+    poses = set(int(k) for k in build_policy('sweep', model.grid, model).poses)
+    uniform = np.full((1, 121), 1 / 121)
+    assert int(coverage.select(uniform, 0, None)[0]) in poses
+    peaked = np.full((1, 121), (1 - 0.9) / 120)
+    peaked[0, 3] = 0.9
+    assert 0.9 >= COVERAGE_PEAK
+    assert coverage.select(peaked, 0, None)[0] == elm.select(peaked, 0, None)[0]
+    # Inhibition of return masks its scores: the best unvisited tile next.
+    from ipomdp_gaze.inhibition import unvisited_choice
+    visited = np.zeros(121, bool)
+    visited[list(poses)[:11]] = True
+    left = (poses - set(list(poses)[:11])).pop()
+    assert unvisited_choice(coverage, uniform, visited, 1, None, model.grid) == left
