@@ -182,7 +182,8 @@ class CoveragePolicy:
     """
     ELM that covers the grid with the sweep's tiles while the belief is diffuse.
 
-    While no cell's belief reaches ``peak`` (:data:`COVERAGE_PEAK`), the best of the sweep's
+    While no cell's belief given a target is present reaches ``peak``
+    (:data:`COVERAGE_PEAK`), the best of the sweep's
     tile poses by ELM's score (with inhibition of return: the unvisited ones; then every other
     cell by ELM); after that, ELM. ELM alone starts from the centre and takes the rows two
     cells from it (5-degree cells, a 3-row view): the grid's edge rows are then left at the
@@ -201,7 +202,9 @@ class CoveragePolicy:
 
     def scores(self, belief) -> np.ndarray:
         """Return ELM's scores, those of the tile poses raised above the rest while diffuse."""
-        belief = np.atleast_2d(belief)
+        belief = np.atleast_2d(np.asarray(belief, dtype=float))
+        # Given a target is present: with the absent hypothesis the cells sum to 1 - P(absent).
+        belief = belief / np.maximum(belief.sum(axis=1, keepdims=True), 1e-300)
         scores = np.array(self.elm.scores(belief), dtype=float).reshape(belief.shape)
         diffuse = belief.max(axis=1, keepdims=True) < self.peak
         bonus = np.abs(scores).max(axis=1, keepdims=True) + 1.0
