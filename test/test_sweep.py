@@ -144,3 +144,22 @@ def test_coverage_takes_the_sweeps_tiles_while_the_belief_is_diffuse_then_elm():
     visited[list(poses)[:11]] = True
     left = (poses - set(list(poses)[:11])).pop()
     assert unvisited_choice(coverage, uniform, visited, 1, None, model.grid) == left
+
+
+def test_the_face_demo_can_show_the_scene_without_its_face():
+    from ipomdp_gaze.nodes.demo import faces_setup
+    setup = faces_setup(seed=3, empty=True)
+    camera = dict(setup.nodes)['scene_camera']
+    assert 'scene.empty:=true' in camera and 'seed:=3' in camera
+    assert 'scene.empty:=true' not in dict(faces_setup(seed=3).nodes)['scene_camera']
+
+
+def test_the_scene_camera_builds_the_empty_scene_it_is_asked_for():
+    from ipomdp_gaze.nodes.scene_camera import _scene_config, scene_camera_params
+    values = {p.name: p.default for p in scene_camera_params()}
+    values.update({'seed': 5, 'scene.empty': True})
+    empty = _scene_config(values).scene
+    values['scene.empty'] = False
+    face = _scene_config(values).scene
+    assert empty.cell is None and face.cell is not None
+    assert empty.background == face.background

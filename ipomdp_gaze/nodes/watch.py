@@ -288,8 +288,8 @@ class SearchRecord:
     What the controller and the camera publish during searches, as ``(t, msg)`` lists.
 
     ``beliefs`` (``belief``, keep-last ``depth``; with ``updates_only`` not the uniform belief of
-    a reset), ``targets`` (``pan_tilt``, latched, each sent target once), ``found`` and ``truth``
-    (the camera's ``ground_truth``, latched).
+    a reset), ``targets`` (``pan_tilt``, latched, each sent target once), ``found``, ``absent``
+    and ``truth`` (the camera's ``ground_truth``, latched).
     """
 
     def __init__(self, watch: Watch, depth: int = 200, updates_only: bool = False):
@@ -297,6 +297,7 @@ class SearchRecord:
                                     keep=is_update if updates_only else None)
         self.targets = watch.record(JointState, 'pan_tilt', LATCHED, distinct_stamps=True)
         self.found = watch.record(DiagnosticStatus, 'found', 10)
+        self.absent = watch.record(DiagnosticStatus, 'absent', 10)
         self.truth = watch.record(Int32MultiArray, 'ground_truth', LATCHED)
 
     def belief(self, i: int = -1) -> np.ndarray:
