@@ -131,7 +131,7 @@ def test_coverage_takes_the_sweeps_tiles_while_the_belief_is_diffuse_then_elm():
     model = load_observation('faces-pan-tilt')
     coverage = build_policy('coverage', model.grid, model)
     elm = build_policy('elm', model.grid, model)
-    poses = set(int(k) for k in build_policy('sweep', model.grid, model).poses)
+    poses = {int(k) for k in build_policy('sweep', model.grid, model).poses}
     uniform = np.full((1, 121), 1 / 121)
     assert int(coverage.select(uniform, 0, None)[0]) in poses
     peaked = np.full((1, 121), (1 - 0.9) / 120)
