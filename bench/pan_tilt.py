@@ -12,9 +12,10 @@ same photo crops without the face) are reported apart, empty ones per background
 camera (a 40-degree lens, model ``faces-pan-tilt-40`` calibrated on training scenes) checks that
 nothing is tuned to one camera.
 
-Regenerate with ``make pan-tilt`` (about 30 minutes on two cores), or
-``python bench/pan_tilt.py [--faces 400] [--empty 200]``; ``--from-json`` rewrites the page from
-the last run's record without searching.
+Regenerate with ``make pan-tilt`` (about 30 minutes on two cores, and 20 more for the ROS demo
+on 50 seeds), or ``python bench/pan_tilt.py [--faces 400] [--empty 200] [--ros-seeds 50]``;
+``--from-json`` rewrites the page from the last run's record without searching (with
+``--ros-seeds`` it adds the ROS comparison to it).
 """
 from __future__ import annotations
 
@@ -72,6 +73,46 @@ def run(args) -> dict:
             'results': {name: [r.__dict__ for r in group] for name, group in results.items()}}
     record['finished'] = time.strftime('%Y-%m-%d %H:%M:%S UTC', time.gmtime())
     return record
+
+
+def run_ros(record: dict, seeds: int) -> None:
+    """
+    Run the three-process ROS demo on test scenes ``0..seeds-1``; add its answers to the record.
+
+    Each is ``ipomdp-gaze demo --scene faces --seed S`` (scene camera, detector, controller with
+    the shipped configuration); the offline evaluation's scene S is the same scene.
+    """
+    from bench_ros_faces import run_mode
+    rows = run_mode(False, range(seeds), lambda line: print(line, file=sys.stderr))
+    record['ros'] = [{k: (list(v) if isinstance(v, tuple) else v) for k, v in row.items()}
+                     for row in rows]
+
+
+def _ros_lines(record: dict) -> list[str]:
+    rows = record.get('ros')
+    if not rows:
+        return []
+    offline = {r['index']: r for r in record['runs']['main']['results'][SHIPPED]
+               if r['has_face']}
+    same, lines = 0, []
+    for row in rows:
+        off = offline.get(row['seed'])
+        if off is None:
+            continue
+        ros_answer = 'absent' if row.get('stop') == 'absent' else \
+            (row.get('row'), row.get('col'))
+        off_answer = 'absent' if off['decision'] == 'absent' else tuple(off['cell'])
+        agree = ros_answer == off_answer and row.get('fixations') == off['fixations']
+        same += agree
+        if not agree:
+            lines.append(f"| {row['seed']} | {off_answer} after {off['fixations']} | "
+                         f"{ros_answer} after {row.get('fixations')} ({row.get('stop')}, "
+                         f"status {row.get('status')}) |")
+    head = [f'{same} of {len(rows)} seeds give the same answer and fixation count over ROS '
+            '(three processes, `ipomdp-gaze demo --scene faces --seed S`) as offline.']
+    if lines:
+        head += ['', '| seed | offline | ROS |', '|---|---|---|'] + lines
+    return head
 
 
 def _sweep_poses(spec):
@@ -221,6 +262,9 @@ def write_page(record: dict, out: Path) -> None:
         if label == 'main':
             lines += ['', '### The targets of issue 22', '']
             lines += _checks(results, passes, sweep_name)
+            ros = _ros_lines(record)
+            if ros:
+                lines += ['', '### The same searches over ROS', ''] + ros
         lines.append('')
     ideas = IDEAS.read_text().split('\n', 2)[2]
     lines += ['## Ideas, measured on training scenes', '',
@@ -243,11 +287,19 @@ def main(argv=None) -> int:
     p.add_argument('--out', type=Path, default=ROOT / 'docs' / 'pan_tilt.md')
     p.add_argument('--from-json', action='store_true',
                    help='write the page from --json without searching')
+    p.add_argument('--ros-seeds', type=int, default=0, metavar='N',
+                   help='also run the three-process ROS demo on test scenes 0..N-1 and compare '
+                        'it per seed with the offline searches (about 22 s per seed)')
     args = p.parse_args(argv)
     if args.from_json:
         record = json.loads(args.json.read_text())
+        if args.ros_seeds:
+            run_ros(record, args.ros_seeds)
+            args.json.write_text(json.dumps(record) + '\n')
     else:
         record = run(args)
+        if args.ros_seeds:
+            run_ros(record, args.ros_seeds)
         args.json.parent.mkdir(parents=True, exist_ok=True)
         args.json.write_text(json.dumps(record) + '\n')
     write_page(record, args.out)
