@@ -38,7 +38,7 @@ faces: $(STAMP)
 	$(VPY) bench/faces.py
 
 # The pan/tilt face search against a blind sweep on 400 + 200 held-out scenes and a second camera:
-# writes docs/pan_tilt.md and docs/data/pan_tilt.json (about 30 minutes on two cores).
+# writes docs/pan_tilt.md and docs/data/pan_tilt.json.gz (10-30 minutes, and 15 for the ROS demo).
 pan-tilt: $(STAMP)
 	$(VPY) bench/pan_tilt.py --ros-seeds 50
 

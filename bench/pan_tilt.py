@@ -12,7 +12,7 @@ same photo crops without the face) are reported apart, empty ones per background
 camera (a 40-degree lens, model ``faces-pan-tilt-40`` calibrated on training scenes) checks that
 nothing is tuned to one camera.
 
-Regenerate with ``make pan-tilt`` (about 30 minutes on two cores, and 20 more for the ROS demo
+Regenerate with ``make pan-tilt`` (about 10 minutes on two idle cores, and 15 more for the ROS demo
 on 50 seeds), or ``python bench/pan_tilt.py [--faces 400] [--empty 200] [--ros-seeds 50]``;
 ``--from-json`` rewrites the page from the last run's record without searching (with
 ``--ros-seeds`` it adds the ROS comparison to it).
@@ -274,6 +274,19 @@ def write_page(record: dict, out: Path) -> None:
     out.write_text('\n'.join(lines) + '\n')
 
 
+def _read(path: Path) -> dict:
+    import gzip
+    data = gzip.decompress(path.read_bytes()) if path.suffix == '.gz' else path.read_bytes()
+    return json.loads(data)
+
+
+def _write(path: Path, record: dict) -> None:
+    import gzip
+    path.parent.mkdir(parents=True, exist_ok=True)
+    data = (json.dumps(record) + '\n').encode()
+    path.write_bytes(gzip.compress(data, mtime=0) if path.suffix == '.gz' else data)
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     p.add_argument('--faces', type=int, default=400, help='test scenes with a face')
@@ -283,7 +296,8 @@ def main(argv=None) -> int:
     p.add_argument('--second-empty', type=int, default=50)
     p.add_argument('--seed', type=int, default=0)
     p.add_argument('--processes', type=int, default=2)
-    p.add_argument('--json', type=Path, default=ROOT / 'docs' / 'data' / 'pan_tilt.json')
+    p.add_argument('--json', type=Path, default=ROOT / 'docs' / 'data' / 'pan_tilt.json.gz',
+                   help='the run record (gzip when the name ends in .gz)')
     p.add_argument('--out', type=Path, default=ROOT / 'docs' / 'pan_tilt.md')
     p.add_argument('--from-json', action='store_true',
                    help='write the page from --json without searching')
@@ -292,16 +306,15 @@ def main(argv=None) -> int:
                         'it per seed with the offline searches (about 22 s per seed)')
     args = p.parse_args(argv)
     if args.from_json:
-        record = json.loads(args.json.read_text())
+        record = _read(args.json)
         if args.ros_seeds:
             run_ros(record, args.ros_seeds)
-            args.json.write_text(json.dumps(record) + '\n')
+            _write(args.json, record)
     else:
         record = run(args)
         if args.ros_seeds:
             run_ros(record, args.ros_seeds)
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(json.dumps(record) + '\n')
+        _write(args.json, record)
     write_page(record, args.out)
     print(f'wrote {args.out}')
     return 0
