@@ -163,3 +163,16 @@ def test_the_scene_camera_builds_the_empty_scene_it_is_asked_for():
     face = _scene_config(values).scene
     assert empty.cell is None and face.cell is not None
     assert empty.background == face.background
+
+
+def test_evaluate_scenes_refuses_bad_searchers_and_empty_fovea_scenes_in_one_line():
+    import subprocess
+    import sys
+    for args, message in ((['--scenes', 'faces-420', '--empty-scenes', '1'],
+                           '--empty-scenes is for --scenes pan-tilt'),
+                          (['--scenes', 'pan-tilt', '--compare', 'elm:search.bogus=1'],
+                           "searcher 'elm:search.bogus=1': expected parameter=value")):
+        out = subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', 'evaluate', '--episodes',
+                              '1', *args], capture_output=True, text=True, timeout=120)
+        assert out.returncode != 0 and message in out.stderr
+        assert 'Traceback' not in out.stderr

@@ -257,6 +257,8 @@ def run_scenes(args) -> int:
                if value is not None}
     spec = replace(spec, settings=replace(spec.settings, **changes))
     episodes = args.episodes or 200
+    if args.empty_scenes and args.scenes != 'pan-tilt':
+        raise ValueError('--empty-scenes is for --scenes pan-tilt')
     specs = [(spec, episodes)]
     if args.empty_scenes:
         specs.append((replace(spec, empty=True), args.empty_scenes))
