@@ -176,3 +176,26 @@ def test_evaluate_scenes_refuses_bad_searchers_and_empty_fovea_scenes_in_one_lin
                               '1', *args], capture_output=True, text=True, timeout=120)
         assert out.returncode != 0 and message in out.stderr
         assert 'Traceback' not in out.stderr
+
+
+def test_every_searcher_of_a_scene_shares_its_views_and_the_sweep_rules_follow_the_poses():
+    from ipomdp_gaze.vision.scene_eval import _Task, evaluate_scene, SWEEP_RULES
+    spec = task_spec('pan-tilt', split='train', seed=7, compare=('sweep',) + SWEEP_RULES)
+    results = {r.searcher: r for r in evaluate_scene(spec, 0)}
+    assert list(results) == ['coverage', 'sweep'] + list(SWEEP_RULES)
+    poses = tuple(int(k) for k in _Task.get(spec).sweep.poses)
+    assert results['sweep-tile'].path == poses and results['sweep-tile'].fixations == 12
+    for rule in SWEEP_RULES[1:]:
+        path = results[rule].path
+        assert path == poses[:len(path)]
+        assert results[rule].decision in ('found', 'absent')
+        if results[rule].decision == 'absent':              # nothing seen in the whole pass
+            assert len(path) == 12
+    assert results['sweep'].path[:len(poses)] == poses[:results['sweep'].fixations]
+    # Every view was rendered and detected once for all six searchers.
+    seen = set().union(*(r.path for r in results.values()))
+    assert set(_Task.get(spec).sensor.frames) == seen
+    for r in results.values():
+        assert r.head_time_s > r.detector_s > 0
+        if r.map_right:
+            assert len(r.map_right) == 20 and r.map_right[-1] == r.right
