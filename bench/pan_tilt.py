@@ -9,8 +9,9 @@ once per scene, :mod:`ipomdp_gaze.vision.scene_eval`): the shipped configuration
 belief and stop rule for one pass, and the sweep's answer rules (best tile count after one
 pass; first view with a raw or a grouped detection). Scenes with a face and empty scenes (the
 same photo crops without the face) are reported apart, empty ones per background. A second
-camera (a 40-degree lens, model ``faces-pan-tilt-40`` calibrated on training scenes) checks that
-nothing is tuned to one camera.
+camera (a 40-degree lens, model ``faces-pan-tilt-40``: ``ipomdp-gaze calibrate --pan-tilt
+--scenes 60 --null-scenes 20 --hfov-deg 40``, training scenes) checks that nothing is tuned to one
+camera.
 
 Regenerate with ``make pan-tilt`` (about 10 minutes on two idle cores, and 15 more for the ROS demo
 on 50 seeds), or ``python bench/pan_tilt.py [--faces 400] [--empty 200] [--ros-seeds 50]``;
