@@ -4,7 +4,7 @@ VENV := .venv
 VPY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: venv demo test bench reproduce faces soak clean
+.PHONY: venv demo test bench reproduce faces pan-tilt soak clean
 
 venv: $(STAMP)
 
@@ -40,6 +40,11 @@ reproduce: $(STAMP)
 # Face search on 300 held-out scenes per task: writes docs/faces.md (about 15 minutes).
 faces: $(STAMP)
 	$(VPY) bench/faces.py
+
+# The pan/tilt face search against a blind sweep on 400 + 200 held-out scenes and a second camera:
+# writes docs/pan_tilt.md and docs/data/pan_tilt.json.gz (10-30 minutes, and 15 for the ROS demo).
+pan-tilt: $(STAMP)
+	$(VPY) bench/pan_tilt.py --ros-seeds 50
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache

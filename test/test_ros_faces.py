@@ -70,9 +70,12 @@ def test_three_nodes_find_the_face_and_stop(ros_env, options, mode, where):
         assert looked[0] == (5, 5)                                     # the first: the centre
     assert all(re.fullmatch(where, f[3].strip()) for f in fixations), fixations
     assert re.fullmatch(where, found.group(3))
-    assert (fixations[-1][4], fixations[-1][5]) == found.group(1, 2)
-    truth = int(verdict.group(1)), int(verdict.group(2))
+    # The answer: the last most likely cell, or with search.found_radius (the pan/tilt config:
+    # 1) the centre of the most likely 3x3 square, within one cell of it.
+    last = int(fixations[-1][4]), int(fixations[-1][5])
     answer = int(found.group(1)), int(found.group(2))
+    assert max(abs(last[0] - answer[0]), abs(last[1] - answer[1])) <= (mode == 'camera')
+    truth = int(verdict.group(1)), int(verdict.group(2))
     assert max(abs(truth[0] - answer[0]), abs(truth[1] - answer[1])) <= 1
     assert verdict.group(3) == 'right'
     assert 'stopped all 3 nodes (scene_camera exit status 0, detector exit status 0, ' \
@@ -94,4 +97,20 @@ def test_without_a_confident_cell_the_demo_answers_with_the_most_likely_one(ros_
                         r'after 4 fixations$', out, re.M)
     assert gave_up and float(gave_up.group(3)) < 0.999, out
     assert VERDICT.search(out) and 'found:' not in out
+    assert 'stopped all 3 nodes' in out and node_processes(domain) == []
+
+
+def test_on_a_scene_without_a_face_the_controller_says_absent(ros_env):
+    domain = int(ros_env['ROS_DOMAIN_ID'])
+    run = subprocess.run(
+        [sys.executable, '-m', 'ipomdp_gaze.cli', 'demo', '--scene', 'faces', '--empty',
+         '--seed', '0', '--domain-id', str(domain)], cwd=REPO, env=ros_env,
+        capture_output=True, text=True, timeout=180)
+    out = run.stdout
+    assert run.returncode == 0, out + run.stderr
+    absent = re.search(r'^absent: nobody is here, probability (\d\.\d+), after (\d+) '
+                       r'fixations$', out, re.M)
+    assert absent and 'found:' not in out, out
+    assert int(absent.group(2)) == len(FIXATION.findall(out))
+    assert 'the scene camera showed a scene with nobody in it: that is right' in out
     assert 'stopped all 3 nodes' in out and node_processes(domain) == []

@@ -127,15 +127,20 @@ def test_evaluate_scenes_runs_the_pan_tilt_task_and_writes_json(tmp_path):
     assert 'pan-tilt (2 scenes with a face): right' in out.stdout
     record = json.loads((tmp_path / 'pt.json').read_text())
     assert record['settings']['search.max_fixations'] == 6
-    assert record['settings']['search.repeat_weight'] == 0.1      # the shipped config's
-    scenes = record['scenes']
+    assert record['settings']['search.repeat_weight'] == 0.3      # the shipped config's
+    assert record['settings']['search.found_radius'] == 1
+    scenes = record['scenes']['coverage']
     assert [s['index'] for s in scenes] == [0, 1]
     for s in scenes:
         assert 1 <= s['fixations'] <= 6 and len(s['path']) == s['fixations']
         assert s['path'][0] == 60                                  # the centre cell first
-        assert s['decision'] in ('found', 'gave_up')
-        assert s['right'] == (max(abs(a - b) for a, b in zip(s['cell'], s['face_cell'])) <= 1)
+        assert s['decision'] in ('found', 'absent')                # decided at the deadline
+        assert s['right'] == (s['decision'] == 'found' and max(
+            abs(a - b) for a, b in zip(s['cell'], s['face_cell'])) <= 1)
         assert s['head_travel_deg'] >= 5.0 * (s['fixations'] - 1) - 1e-9
+        # A stopped search keeps its answer: the MAP after its last fixation onwards is it.
+        assert len(s['map_right']) == 20 and set(s['map_right'][s['fixations'] - 1:]) == \
+            {s['right']}
 
 
 def test_find_with_an_absent_prior_says_absent_on_a_face_free_photo(tmp_path):

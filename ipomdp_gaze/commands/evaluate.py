@@ -27,8 +27,9 @@ from ipomdp_gaze.pieces import concat_results, COSTLY_CHUNK, PLANNER_CHUNK, simu
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
 from ipomdp_gaze.session import SearchSettings
 from ipomdp_gaze.simulate import draw_present, draw_targets
-from ipomdp_gaze.vision.scene_eval import (DEFAULT_BUDGET, evaluate_scenes, format_summary,
-                                           results_json, summarise, task_spec, TASKS, write_json)
+from ipomdp_gaze.vision.scene_eval import (evaluate_scenes, format_summary,
+                                           paired_map_difference, results_json, summarise,
+                                           task_spec, TASKS, write_json)
 import numpy as np
 
 from .common import (add_scene_args, add_task_args, nonneg_int, positive_int,
@@ -55,8 +56,22 @@ def add_parser(sub):
                         'and sensor (the search session of the nodes and find) instead of '
                         'simulating: pan-tilt (config/faces_camera_controller.yaml), faces-420 '
                         "or faces-840 (find's settings); --policy, --policy-file, "
-                        '--confidence, --max-fixations (default 60) and --absent-prior change '
-                        'the shipped configuration')
+                        '--confidence, --max-fixations (default: the configuration budget, '
+                        'else 60) and --absent-prior change the shipped configuration')
+    p.add_argument('--split', choices=('train', 'test'), default='test',
+                   help='--scenes: training scenes (for every choice) or held-out test scenes '
+                        '(default)')
+    p.add_argument('--empty-scenes', type=nonneg_int, default=0, metavar='M',
+                   help='--scenes pan-tilt: also M scenes without a face (the same photo crops), '
+                        'reported apart per background')
+    p.add_argument('--scene-model', default='', metavar='FILE',
+                   help='--scenes pan-tilt: another pan/tilt observation file (its camera is the '
+                        "scene camera's)")
+    p.add_argument('--compare', action='append', default=[], metavar='SEARCHER',
+                   help='--scenes: another searcher on the same scenes and views (repeatable): '
+                        'a policy name (sweep starts at its first pose) or a sweep answer rule '
+                        '(sweep-tile, sweep-first-raw, sweep-first-grouped3, '
+                        'sweep-first-grouped5)')
     p.add_argument('--episodes-greedy', type=positive_int, default=2000,
                    help='episodes for the slow searchers, greedy and switching (policies '
                         'whose class sets costly; default 2000)')
@@ -247,24 +262,42 @@ def check_settings(args) -> SearchSettings:
 def run_scenes(args) -> int:
     """``evaluate --scenes TASK``: held-out scenes through the search session (scene_eval)."""
     if len(args.policy) + len(args.policy_file) > 1:
-        raise ValueError('--scenes evaluates one policy at a time')
+        raise ValueError('--scenes evaluates one policy at a time (others: --compare)')
     spec = task_spec(args.scenes, args.policy[0] if args.policy else None,
                      str(args.policy_file[0]) if args.policy_file else None, seed=args.seed,
-                     max_fixations=DEFAULT_BUDGET if args.max_fixations is None
-                     else args.max_fixations)
+                     max_fixations=args.max_fixations, split=args.split, model=args.scene_model,
+                     compare=tuple(args.compare), empty=False)
     changes = {key: value for key, value in (('confidence', args.confidence),
                                              ('absent_prior', args.absent_prior))
                if value is not None}
     spec = replace(spec, settings=replace(spec.settings, **changes))
     episodes = args.episodes or 200
-    with executor_from_args(args, episodes) as executor, \
-            progress_from_args(args, episodes, f'{args.scenes} scenes', 'scene') as bar:
-        results = evaluate_scenes(spec, episodes, executor, progress=bar)
-    summary = summarise(results)
-    print(f'{args.scenes}: policy {spec.policy_file or spec.policy}, test scenes {args.seed}..'
-          f'{args.seed + episodes - 1}, settings {spec.settings.to_parameters()}')
-    for line in format_summary(spec, summary):
-        print(line)
+    if args.empty_scenes and args.scenes != 'pan-tilt':
+        raise ValueError('--empty-scenes is for --scenes pan-tilt')
+    specs = [(spec, episodes)]
+    if args.empty_scenes:
+        specs.append((replace(spec, empty=True), args.empty_scenes))
+    total = sum(n for _, n in specs)
+    results = {}
+    with executor_from_args(args, total) as executor, \
+            progress_from_args(args, total, f'{args.scenes} scenes', 'scene') as bar:
+        for one, n in specs:
+            for name, group in evaluate_scenes(one, n, executor, progress=bar).items():
+                results.setdefault(name, []).extend(group)
+    summary = {name: summarise(group) for name, group in results.items()}
+    print(f'{args.scenes}: policy {spec.policy_file or spec.policy}, {args.split} scenes '
+          f'{args.seed}..{args.seed + episodes - 1}'
+          + (f' (+ {args.empty_scenes} empty)' if args.empty_scenes else '')
+          + f', settings {spec.settings.to_parameters()}')
+    for name, s in summary.items():
+        for line in format_summary(spec, s, name if len(summary) > 1 else ''):
+            print(line)
+    main = next(iter(results))
+    if 'sweep' in results and main != 'sweep':
+        diff = paired_map_difference(results[main], results['sweep'])
+        print(f'MAP right, {main} minus sweep [paired bootstrap 95%]: '
+              + '; '.join(f'{k}: {d:+.3f} [{lo:+.3f}, {hi:+.3f}]'
+                          for k, (d, lo, hi) in diff.items()))
     if args.json:
         write_json(args.json, results_json(spec, results, summary))
         print(f'wrote {args.json}')

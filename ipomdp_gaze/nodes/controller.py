@@ -126,6 +126,13 @@ def controller_params() -> list[Param]:
               'that saw it at its most informative offset, in [0, 1] (1: every frame counts '
               'fully, naive Bayes; 0: the evidence of each cell once, for overlapping views of a '
               'still scene and a deterministic detector)'),
+        Param('search.found_radius', 0, T.INTEGER,
+              'still target: found when the belief within this many cells of a cell reaches '
+              'the confidence, and that cell is the answer (0: the cell alone)',
+              int_range=(0, 5)),
+        Param('search.decide_at_budget', False, T.BOOL,
+              'still target: when the budget runs out undecided, say absent or found '
+              '(whichever is more probable) instead of gave_up'),
         Param('policy.name', 'elm', T.STRING, 'fixation policy', choices=POLICY_NAMES),
         Param('policy.file', '', T.STRING,
               'policy YAML path or shipped kernel name; setting it selects learned'),

@@ -149,12 +149,14 @@ def demo_setup(fpoc: str = 'camera', policy: str | None = None, seed: int = 0,
                      head_from(values, grid), controller)
 
 
-def faces_setup(fovea: bool = False, policy: str | None = None, seed: int = 0) -> DemoSetup:
+def faces_setup(fovea: bool = False, policy: str | None = None, seed: int = 0,
+                empty: bool = False) -> DemoSetup:
     """
     Build the face demo from ``config/faces_<mode>_*.yaml``: scene camera, detector, controller.
 
     ``fovea`` selects the fixed camera and the digital fovea (mode ``fovea``), else the camera
-    on the pan/tilt head (mode ``camera``); ``seed`` picks the held-out test scene.
+    on the pan/tilt head (mode ``camera``); ``seed`` picks the held-out test scene, ``empty``
+    shows it without its face (the pan/tilt camera's ``scene.empty``).
     """
     mode = 'fovea' if fovea else 'camera'
     files = {node: config_file(f'faces_{mode}_{node}.yaml')
@@ -172,9 +174,10 @@ def faces_setup(fovea: bool = False, policy: str | None = None, seed: int = 0) -
     from ipomdp_gaze.observation_file import load_observation
     scan = bool(values.get('search.scan', True)) and \
         load_observation(values['observation.file']).has_scan
+    camera = {'seed': seed, 'scene.empty': True} if empty else {'seed': seed}
     return DemoSetup([('controller', _ros_args(files['controller'], controller)),
                       ('detector', _ros_args(files['detector'], {})),
-                      ('scene_camera', _ros_args(files['scene_camera'], {'seed': seed}))],
+                      ('scene_camera', _ros_args(files['scene_camera'], camera))],
                      grid, head_from(values, grid), controller, 'faces', mode, image_px, scan)
 
 
@@ -365,11 +368,12 @@ def _answer(setup: DemoSetup, row: int, col: int, cell: int, probability: float,
 def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
             stats: dict | None = None, max_fixations: int = 60) -> int:
     """
-    Print fixations until the found event (or ``max_fixations``); judge the answer.
+    Print fixations until the found or absent event (or ``max_fixations``); judge the answer.
 
-    Without a found event after ``max_fixations`` fixations (or at the deadline), the answer is
-    the most likely cell of the last belief. Returns 0 once an answer was judged before the
-    deadline, else 1.
+    Without an event after ``max_fixations`` fixations (or at the deadline), the answer is the
+    most likely cell of the last belief. ``absent`` is right on an empty scene (ground truth
+    ``[-1, -1]``) and wrong otherwise; a cell is wrong on an empty scene. Returns 0 once an
+    answer was judged before the deadline, else 1.
     """
     grid, head = setup.grid, setup.head
     printed = 0
@@ -379,6 +383,8 @@ def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
     def last() -> int:
         if record.found:
             return diagnostics.parse_found(record.found[0][1])['fixations']
+        if record.absent:
+            return diagnostics.parse_absent(record.absent[0][1])['fixations']
         return max_fixations
 
     def show_new():
@@ -410,6 +416,11 @@ def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
         answer, stop = (found['row'], found['col'], found['cell']), 'found'
         out(f'found: the {what} is most likely at '
             + _answer(setup, *answer, found['probability'], found['fixations']))
+    elif record.absent and printed >= last():
+        found = diagnostics.parse_absent(record.absent[0][1])
+        answer, stop = None, 'absent'
+        out(f"absent: nobody is here, probability {found['probability']:.3f}, after "
+            f"{found['fixations']} fixations")
     elif printed == 0:
         out(f'ipomdp-gaze demo: the {what} was not found within {timeout_s:g} s')
         return 1
@@ -429,12 +440,19 @@ def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
         out(f'ipomdp-gaze demo: the {camera} did not report where the {what} is')
         return 1
     truth = grid_arrays.cell_from_ground_truth(record.truth[-1][1], grid)
-    (tr, tc), (fr, fc) = grid.cell(truth), answer[:2]
-    right = max(abs(tr - fr), abs(tc - fc)) <= setup.tolerance_cells
+    if truth is None or answer is None:
+        right, (tr, tc) = truth is None and answer is None, (-1, -1)
+        if truth is not None:
+            tr, tc = grid.cell(truth)
+    else:
+        (tr, tc), (fr, fc) = grid.cell(truth), answer[:2]
+        right = max(abs(tr - fr), abs(tc - fc)) <= setup.tolerance_cells
     if stats is not None:
         stats.update(found, truth=(tr, tc), right=right, stop=stop)
     verdict = 'right' if right else 'wrong'
-    if setup.scene == 'faces':
+    if truth is None:
+        out(f'the {camera} showed a scene with nobody in it: that is {verdict}')
+    elif setup.scene == 'faces':
         out(f'the scene camera put the face centre in cell {grid.cell(truth)}: that is '
             f'{verdict}')
     else:

@@ -63,6 +63,9 @@ def scene_camera_params() -> list[Param]:
               'pose (read-only)', read_only=True, choices=VIEWS),
         Param('seed', 0, T.INTEGER, 'which held-out test scene (read-only)', read_only=True,
               int_range=(0, INT_MAX)),
+        Param('scene.empty', False, T.BOOL,
+              'pan_tilt view: the test scene of seed without its face, nobody here (read-only)',
+              read_only=True),
         Param('scene.file', '', T.STRING,
               "a user's image instead of a test scene (read-only)", read_only=True),
         Param('scene.face_x_px', -1.0, T.DOUBLE,
@@ -138,7 +141,8 @@ def _scene_config(values: dict) -> SceneConfig:
         if values['scene.file']:
             scene = user_scene(read_scene_file(values['scene.file']), centre, geometry)
         else:
-            scene = PanTiltSceneSet('test', geometry, faces, 'rgb', values['seed']).scene(0)
+            scene = PanTiltSceneSet('test', geometry, faces, 'rgb', values['seed'],
+                                    empty=values['scene.empty']).scene(0)
         return SceneConfig(dict(values), grid, camera, scene, geometry,
                            head_from(values, grid))
     if values['scene.file']:
@@ -178,9 +182,12 @@ class SceneCameraNode(SaccadeMixin, Node):
         if scene.cell is not None:
             self._truth_pub.publish(grid_arrays.ground_truth(cfg.grid, cfg.grid.index(
                 *scene.cell)))
+        elif cfg.values.get('scene.empty'):
+            self._truth_pub.publish(grid_arrays.ground_truth(cfg.grid, None))   # [-1, -1]
         self.guard.publish_status()
         height, width = self._view(self.pose).shape[:2]
-        where = 'no face given' if scene.face_centre_px is None else \
+        where = 'nobody here' if cfg.values.get('scene.empty') else 'no face given' \
+            if scene.face_centre_px is None else \
             f'face centre ({scene.face_centre_px[0]:.1f}, {scene.face_centre_px[1]:.1f}) px ' \
             f'in cell {scene.cell}'
         self.get_logger().info(

@@ -289,8 +289,8 @@ class SearchRecord:
 
     ``beliefs`` (``belief``, keep-last ``depth``; with ``updates_only`` not the uniform belief of
     a reset; with ``n_cells`` only beliefs of that many cells, not a previous run's grid),
-    ``targets`` (``pan_tilt``, latched, each sent target once), ``found`` and ``truth`` (the
-    camera's ``ground_truth``, latched).
+    ``targets`` (``pan_tilt``, latched, each sent target once), ``found``, ``absent`` and
+    ``truth`` (the camera's ``ground_truth``, latched).
     """
 
     def __init__(self, watch: Watch, depth: int = 200, updates_only: bool = False,
@@ -301,6 +301,7 @@ class SearchRecord:
         self.beliefs = watch.record(Float32MultiArray, 'belief', depth, keep=keep)
         self.targets = watch.record(JointState, 'pan_tilt', LATCHED, distinct_stamps=True)
         self.found = watch.record(DiagnosticStatus, 'found', 10)
+        self.absent = watch.record(DiagnosticStatus, 'absent', 10)
         self.truth = watch.record(Int32MultiArray, 'ground_truth', LATCHED)
 
     def belief(self, i: int = -1) -> np.ndarray:

@@ -306,7 +306,8 @@ class PanTiltSceneSet:
     """
 
     def __init__(self, split: str = 'test', geometry: SceneGeometry | None = None,
-                 face_px: tuple[int, int] = FACE_PX, color: str = 'rgb', seed: int = 0):
+                 face_px: tuple[int, int] = FACE_PX, color: str = 'rgb', seed: int = 0,
+                 empty: bool = False):
         if split not in SPLITS:
             raise ValueError(f'unknown split {split!r}; expected one of {tuple(SPLITS)}')
         self.split = split
@@ -323,12 +324,14 @@ class PanTiltSceneSet:
         if isinstance(seed, bool) or int(seed) != seed or seed < 0:
             raise ValueError(f'seed must be a non-negative integer, got {seed!r}')
         self.seed = int(seed)
+        self.empty = bool(empty)
         self.faces, self.backgrounds = SPLITS[split]
 
     def kwargs(self) -> dict:
         """Keyword arguments that rebuild this set (for worker processes)."""
         return {'split': self.split, 'geometry': self.geometry.to_dict(),
-                'face_px': self.face_px, 'color': self.color, 'seed': self.seed}
+                'face_px': self.face_px, 'color': self.color, 'seed': self.seed,
+                'empty': self.empty}
 
     @classmethod
     def from_kwargs(cls, kwargs: dict) -> PanTiltSceneSet:
@@ -338,7 +341,12 @@ class PanTiltSceneSet:
         return cls(**values)
 
     def scene(self, index: int) -> Scene:
-        """Build scene ``index``; its ``cell`` is the face centre's cell on the pan/tilt grid."""
+        """
+        Build scene ``index``; its ``cell`` is the face centre's cell on the pan/tilt grid.
+
+        An ``empty`` set's scene ``index`` is the same photo crop with no face (``cell`` None):
+        "nobody is here" on the backgrounds the faces are searched on.
+        """
         index = int(index)
         if index < 0:
             raise IndexError(f'scene indices are non-negative, got {index}')
@@ -351,6 +359,9 @@ class PanTiltSceneSet:
         top = _pick(u_top, photo.shape[0] - height + 1)
         left = _pick(u_left, photo.shape[1] - width + 1)
         image = photo[top:top + height, left:left + width].copy()
+        if self.empty:
+            image.setflags(write=False)
+            return Scene(image, None, None, None, None, name, self.seed, index)
         face_index = self.faces[_pick(u_face, len(self.faces))]
         lo, hi = self.face_px
         side = lo + _pick(u_size, hi - lo + 1)
