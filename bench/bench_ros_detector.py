@@ -50,16 +50,7 @@ def node_costs(pictures: list, seed: int = 0) -> dict:
     with isolated_nodes(domain, prefix='ipomdp-gaze-bench-') as nodes:
         nodes.start('detector', ['-p', 'mode:=fovea', '-p', 'diagnostics_period_s:=0.1'])
         with Watch(domain, 'bench_detector', nodes) as watch:
-            status = []
-
-            def on_diagnostics(msg):
-                from ipomdp_gaze.msg_adapters import diagnostics
-                for item in msg.status:
-                    if item.name.endswith('foveal_detector: detector'):
-                        status.append(diagnostics.values_of(item))
-
-            from diagnostic_msgs.msg import DiagnosticArray
-            watch.node.create_subscription(DiagnosticArray, '/diagnostics', on_diagnostics, 50)
+            status = watch.status_values('foveal_detector: detector')
             counts = watch.record(Image, 'evidence_image',
                                   QoSProfile(depth=50, reliability=ReliabilityPolicy.BEST_EFFORT))
             image_pub = watch.publisher(Image, 'image')

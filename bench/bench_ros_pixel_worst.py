@@ -72,16 +72,7 @@ def measure(mode: str, size, n: int) -> dict:
     with isolated_nodes(domain, prefix='ipomdp-gaze-bench-') as nodes:
         proc = nodes.start('detector', ['-p', f'mode:={mode}', '-p', 'diagnostics_period_s:=0.05'])
         with Watch(domain, 'bench_pixel_worst', nodes) as watch:
-            status = []
-
-            def on_diagnostics(msg):
-                from ipomdp_gaze.msg_adapters import diagnostics
-                for item in msg.status:
-                    if item.name.endswith('foveal_detector: detector'):
-                        status.append(diagnostics.values_of(item))
-
-            from diagnostic_msgs.msg import DiagnosticArray
-            watch.node.create_subscription(DiagnosticArray, '/diagnostics', on_diagnostics, 50)
+            status = watch.status_values('foveal_detector: detector')
             counts = watch.record(Image, 'evidence_image',
                                   QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
             image_pub = watch.publisher(Image, 'image')
@@ -107,12 +98,14 @@ def measure(mode: str, size, n: int) -> dict:
                 k = len(counts)
                 t0 = time.monotonic()
                 image_pub.publish(msg)
-                # joint_states is best effort, as a driver streams it: one may be lost, so it
-                # is sent again (same stamp) until the counts come, as a stream would.
+                # joint_states and camera_info are best effort, as a driver streams them: one
+                # may be lost, so they are sent again (same stamp) until the counts come, as a
+                # stream would.
                 for _ in range(300):
                     if watch.wait_until(lambda: len(counts) > k, 0.2, 0.001):
                         break
                     if mode == 'camera':
+                        info_pub.publish(images.camera_info(camera, stamp))
                         joint_pub.publish(joints.joint_state(head, cell, stamp))
                 else:
                     raise RuntimeError(f'no counts for a {size} image: {status[-1]}')

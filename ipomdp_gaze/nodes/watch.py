@@ -193,6 +193,16 @@ class Watch:
         self.node.create_subscription(DiagnosticArray, '/diagnostics', status, 50)
         return status
 
+    def status_values(self, suffix: str) -> list:
+        """Collect the values of every ``/diagnostics`` status whose name ends with ``suffix``."""
+        values = []
+
+        def on_diagnostics(msg: DiagnosticArray) -> None:
+            values.extend(diagnostics.values_of(item) for item in msg.status
+                          if item.name.endswith(suffix))
+        self.node.create_subscription(DiagnosticArray, '/diagnostics', on_diagnostics, 50)
+        return values
+
     def publisher(self, msg_type, topic: str, qos=10):
         """Create a publisher on ``topic``."""
         return self.node.create_publisher(msg_type, topic, qos)
