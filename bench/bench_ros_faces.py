@@ -22,10 +22,13 @@ import numpy as np
 TITLE = 'Face search over DDS: scene camera, foveal detector and controller (three processes)'
 ORDER = 61
 MODES = (('camera', False, 'a camera on the pan/tilt head (11x11 grid of 5 deg, '
-                           '`faces-pan-tilt`, ELM, confidence 0.99, inhibition of return, '
-                           'repeated views weighted 0.1)'),
+                           '`faces-pan-tilt`, coverage, confidence 0.99 within one cell, '
+                           'inhibition of return, repeated views weighted 0.3, absent prior 0.8, '
+                           'decided at 20 fixations)'),
          ('fovea', True, 'a fixed camera and the digital fovea (21x21 grid over 420x420 '
-                         'scenes, `faces-420-nmpt`, ELM, confidence 0.999, inhibition of return)'))
+                         'scenes, `faces-420` with its one-time scan and kernel '
+                         '`faces-420-infomax`, confidence 0.99, inhibition of return, as '
+                         '`find` searches)'))
 
 
 def run_mode(fovea: bool, seeds, log) -> list:
@@ -52,8 +55,8 @@ def bench(ctx) -> str:
              "the face centre's cell; the answer is the `found` cell or, when no cell reached "
              "the controller's confidence after 60 fixations, the most likely cell then (the "
              'demo gives up); seconds from starting the scene camera to the answer.', '',
-             '| mode | searches | right [95% CI] | found / gave up / failed | right when found | '
-             'fixations mean / median / max | seconds median / p90 |',
+             '| mode | searches | right [95% CI] | found / absent / gave up / failed | '
+             'right when found | fixations mean / median / max | seconds median / p90 |',
              '|---|---|---|---|---|---|---|']
     wrong = []
     for mode, fovea, what in MODES:
@@ -65,8 +68,8 @@ def bench(ctx) -> str:
         fix = np.asarray([r['fixations'] for r in done], dtype=float)
         secs = np.asarray([r['search_s'] for r in done], dtype=float)
         found = [r for r in done if r['stop'] == 'found']
-        stops = f"{len(found)} / {sum(r['stop'] == 'budget' for r in done)} / " \
-            f'{len(results) - len(done)}'
+        stops = f"{len(found)} / {sum(r['stop'] == 'absent' for r in done)} / " \
+            f"{sum(r['stop'] == 'budget' for r in done)} / {len(results) - len(done)}"
         right_found = sum(bool(r['right']) for r in found) / max(1, len(found))
         lines.append(
             f'| {mode}: {what} | {len(results)} | {hits / len(results):.2f} [{low:.2f}, '

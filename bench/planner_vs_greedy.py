@@ -5,18 +5,19 @@
 
 Run: ``.venv/bin/python bench/planner_vs_greedy.py [--episodes 4000] [--seed 1] [--jobs 2]
 [--horizon 16] [--policies elm,tempered,greedy,planner] [--planner-options K=V,...]
-[--cache DIR] [--chunk 2000] [--rao-blackwell] [--json OUT]``.
+[--cache DIR] [--chunk 2000] [--rao-blackwell] [--json OUT] [--scheduler ADDRESS] [--quiet]``.
 docs/reproduction.md quotes two runs: ``--episodes 4000 --seed 1`` (about 10 CPU-minutes) and
 ``--episodes 200000 --seed 1 --horizon 9 --policies elm,tempered,greedy,switching --json
 docs/data/searchers-7x7.json`` (about 2.5 CPU-hours, two thirds of it the ideal searcher).
 
-Every policy runs the same episodes (common random numbers), split into pieces over a process pool
-(``reproduce.Runner``: ``simulate(..., rows=)``, so every deterministic policy gives exactly its
+Every policy runs the same episodes (common random numbers), split into pieces over an
+executor (``ipomdp_gaze.pieces.Runner`` on ``--jobs`` processes or the Dask cluster of
+``--scheduler``: ``simulate(..., rows=)``, so every deterministic policy gives exactly its
 serial numbers; the planner draws its rollouts from one stream per piece of 500 episodes).
 Printed: fixations to 90% correct by the indicator (MAP guess right) and by the expected percent
 correct (mean of ``max_i B_i``, the same curve with less variance), each with a 95% bootstrap
 interval, then the paired differences. ``--cache DIR`` keeps finished pieces in
-``reproduce.PieceCache``, so an interrupted run resumes and a longer run reuses a shorter one: a
+``pieces.PieceCache``, so an interrupted run resumes and a longer run reuses a shorter one: a
 run of n episodes is the first n episodes of a longer one (test_simulate.py), so a piece's key
 is its policy and options, task, own targets, seed, horizon and rows and the package source, not
 the run's length. The pieces of the other policies are ``--chunk`` episodes (default 2000; their
@@ -30,18 +31,19 @@ Same curve, about half the variance of paired differences at 7x7. docs/reproduct
 --rao-blackwell --json docs/data/searchers-7x7-rb.json``.
 """
 import argparse
-from concurrent.futures import ProcessPoolExecutor
 import itertools
 import json
 from pathlib import Path
 
 from ipomdp_gaze.commands.common import positive_int
-from ipomdp_gaze.commands.reproduce import PieceCache, PLANNER_CHUNK, Runner
 from ipomdp_gaze.evaluation import fixations_to_90_ci, paired_difference_ci
+from ipomdp_gaze.executor import make_executor
 from ipomdp_gaze.fpoc import make_fpoc
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.pieces import PieceCache, PLANNER_CHUNK, Runner
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.policies.planner import make_planner
+from ipomdp_gaze.progress import Progress
 import numpy as np
 
 GRID, FPOC = Grid(7, 7, 0.42), make_fpoc('human')
@@ -102,6 +104,9 @@ def main():
                         help="the expected measure from E[max_i B'_i] given the belief and "
                              'fixation before each observation (less variance)')
     parser.add_argument('--json', type=Path, default=None)
+    parser.add_argument('--scheduler', default=None, metavar='ADDRESS',
+                        help='a Dask scheduler to run the pieces on (docs/cluster.md)')
+    parser.add_argument('--quiet', action='store_true', help='no progress on stderr')
     args = parser.parse_args()
     n, names = args.episodes, args.policies
     policies = {name: build(name, args.planner_options) for name in names}
@@ -109,8 +114,10 @@ def main():
     out = {'episodes': n, 'seed': args.seed, 'horizon': args.horizon,
            'rao_blackwell': args.rao_blackwell, 'policies': {}, 'paired': {}}
     pieces = 0
-    with ProcessPoolExecutor(args.jobs) as pool:
-        runner = Runner(GRID, FPOC, n, args.seed, RESAMPLES, pool, cache, args.rao_blackwell)
+    with make_executor(args.jobs, args.scheduler) as pool, \
+            Progress(0, 'planner_vs_greedy', quiet=args.quiet) as progress:
+        runner = Runner(GRID, FPOC, n, args.seed, RESAMPLES, pool, cache, args.rao_blackwell,
+                        progress)
         for name in sorted(names, key=lambda x: not getattr(policies[x][0], 'costly', False)):
             policy, recipe = policies[name]
             pieces += runner.submit(name, policy, horizon=args.horizon,

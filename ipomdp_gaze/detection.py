@@ -7,8 +7,9 @@ The foveal detector's brain, without ROS: which image serves which fixation, and
 It turns camera images into count frames for the controller, one frame per fixation:
 
 - the controller sends a fixation (a cell; re-sends count as new requests), and the loop waits
-  for the **newest image captured after the fixation was commanded** (its stamp not earlier
-  than the time the fixation arrived);
+  for the **newest image captured after the fixation was commanded**: its stamp not earlier
+  than the time the fixation arrived, and the image itself arrived after the fixation (so an
+  image stamped ahead by a camera whose clock runs fast cannot answer a later fixation);
 - in ``camera`` mode that image must also be paired with the head's joint state of the same
   stamp (within ``tolerance_s``), the head must be at the fixated cell (an image taken on the
   way there is not used) and the camera's intrinsics must be known; the detections are binned
@@ -20,6 +21,27 @@ Every image is counted: ``received = processed + rejected + unused`` (unused: no
 waiting for it, or a newer image served it). An image the detector cannot take (too small, or
 not the size ``camera_info`` says) is rejected with the reason and the fixation keeps waiting.
 
+**Time sanity.** Each input is checked against the node's clock when it arrives: an image or
+joint state stamped more than ``stamp_tolerance_s`` ahead of it is rejected (``images_future``;
+a camera whose clock runs ahead), and one stamped more than ``max_age_s`` before it (``0``:
+no limit) is rejected as stale (``images_stale``; a clock behind, or a replay).
+
+**Finite but absurd values** are refused where they enter, counted like image rejections: joint
+angles beyond :data:`MAX_JOINT_RAD` (``joint_states_rejected``) and intrinsics that no camera
+has (:func:`check_camera`: a field of view outside :data:`FOV_RANGE_DEG` or a principal point
+outside the image, ``camera_info_rejected``). As for images, ``<input>_received`` counts every
+message of that input, the rejected ones included.
+
+**Bounded cost per frame.** Images are held only while a fixation waits, at most ``keep`` (4)
+of them. An image more than :data:`RESIZE_ABOVE` times wider or taller than the images the
+model was calibrated on (420x420 for the shipped fovea models, the 320x240 camera of
+``faces-pan-tilt``) is resized (``cv2.INTER_AREA``, aspect kept) to fit that size when it
+arrives; in ``camera`` mode ``camera_info``'s K is scaled with it. The detector then sees faces
+at the pixel size the counts were calibrated at, and its cost is that of the model's images
+whatever the driver sends. (Refusing such images instead would make every HD camera unusable;
+the grid tiles the image in ``fovea`` mode and K follows the resize in ``camera`` mode, so the
+cells seen do not change.)
+
 :func:`build_setup` reads the observation file: its grid, fovea and detector settings are the
 ones the counts mean anything with, so settings given next to it may only repeat them.
 """
@@ -27,6 +49,7 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass, field
+import math
 import time
 
 from ipomdp_gaze.grid import Grid
@@ -37,18 +60,38 @@ import numpy as np
 
 MODES = ('fovea', 'camera')
 # The observation model of each mode when none is given: the shipped face models.
-DEFAULT_MODELS = {'fovea': 'faces-420-nmpt', 'camera': 'faces-pan-tilt'}
+DEFAULT_MODELS = {'fovea': 'faces-420', 'camera': 'faces-pan-tilt'}
 # The view a model was calibrated with (its image record), per mode.
 MODE_VIEWS = {'fovea': 'fixed', 'camera': 'pan_tilt'}
-# Detector settings a node parameter may repeat (an empty or negative value: the file's).
+# The Haar detector's settings with node parameters of their own (an empty or negative value:
+# the file's); any detector's other settings go in detector.options.
 DETECTOR_KEYS = ('cascade', 'scale_factor', 'min_neighbors')
 TIMING_WINDOW = 100
+# Joint angles farther than this from zero are absurd: no pan/tilt head turns more than a turn.
+MAX_JOINT_RAD = 2 * math.pi
+# Fields of view (degrees, edge to edge) a camera_info may describe.
+FOV_RANGE_DEG = (0.5, 175.0)
+# Images more than this many times the model's image width or height are resized (far larger).
+RESIZE_ABOVE = 2.0
+# Defaults of the time sanity rule (seconds).
+STAMP_TOLERANCE_S = 0.5
+MAX_AGE_S = 10.0
 
 
 def model_view(model) -> str:
     """``'pan_tilt'`` for a model calibrated through a head camera, else ``'fixed'``."""
     image = getattr(model, 'meta', {}).get('image') or {}
     return str(image.get('view', 'fixed'))
+
+
+def model_image_size(model) -> tuple[int, int] | None:
+    """Return the ``(width, height)`` of the images a model was calibrated on, or None."""
+    image = getattr(model, 'meta', {}).get('image') or {}
+    try:
+        size = int(image['width']), int(image['height'])
+    except (KeyError, TypeError, ValueError, OverflowError):
+        return None
+    return size if min(size) > 0 else None
 
 
 def model_camera(model) -> PinholeCamera | None:
@@ -70,6 +113,9 @@ class DetectorSetup:
     fovea: object = None
     observer: object = None
     camera: PinholeCamera | None = None
+    image_size: tuple[int, int] | None = None
+    notes: tuple = ()
+    """What differs from the file in information-only detector settings (the OpenCV version)."""
 
     @property
     def grid(self) -> Grid:
@@ -91,8 +137,8 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
     grid : (int, int, float)
         ``rows, cols, spacing_deg`` asked for; 0 takes the file's. Another value must repeat it.
     detector : dict, optional
-        Detector settings asked for (keys of :data:`DETECTOR_KEYS`); each must repeat the
-        file's.
+        Detector settings asked for (``kind`` and the detector's own settings, e.g. those of
+        :data:`DETECTOR_KEYS` for ``haar``); each must repeat the file's.
     cascade_dir : str, optional
         Folder (or file) searched first for the cascade the file names.
 
@@ -104,7 +150,9 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
 
     """
     from ipomdp_gaze.vision.pan_tilt import ViewObserver
-    from ipomdp_gaze.vision.search import detector_from_settings, fovea_for_model
+    from ipomdp_gaze.vision.cell_observation import cell_observation_of
+    from ipomdp_gaze.vision.detectors import detector_from_settings
+    from ipomdp_gaze.vision.fovea_model import fovea_for_model
     if mode not in MODES:
         raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
     name = source or DEFAULT_MODELS[mode]
@@ -127,17 +175,36 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
     if not recorded:
         raise ValueError(f'observation.file {name!r} does not record its detector')
     for key, asked in (detector or {}).items():
-        if key not in DETECTOR_KEYS:
-            raise ValueError(f'unknown detector setting {key!r}')
+        if key not in recorded:
+            raise ValueError(f'detector.{key}: the detector {recorded.get("kind")!r} of '
+                             f'observation.file {name!r} has no setting {key!r} (it has '
+                             f'{", ".join(sorted(recorded))})')
         if asked != recorded.get(key):
             raise ValueError(f'detector.{key} {asked!r} contradicts observation.file {name!r}, '
                              f'measured with {recorded.get(key)!r} (leave it unset to take it)')
-    haar = detector_from_settings(recorded, cascade_dir or None)
-    if mode == 'fovea':
-        return DetectorSetup(mode, model, name, haar,
-                             fovea=fovea_for_model(model, haar, reuse_windows=False))
-    observer = ViewObserver(haar, g, model.max_count + 1)
-    return DetectorSetup(mode, model, name, haar, observer=observer, camera=model_camera(model))
+    notes = []
+    try:
+        built = detector_from_settings(recorded, cascade_dir or None, notes.append)
+        if mode == 'fovea':
+            return DetectorSetup(mode, model, name, built,
+                                 fovea=fovea_for_model(model, built, reuse_windows=False),
+                                 image_size=model_image_size(model), notes=tuple(notes))
+        observer = ViewObserver(built, g, model.max_count + 1,
+                                cell_observation_of(model.meta, model.max_count + 1))
+        return DetectorSetup(mode, model, name, built, observer=observer,
+                             camera=model_camera(model), image_size=model_image_size(model),
+                             notes=tuple(notes))
+    except ValueError as exc:
+        raise ValueError(_one_line(exc)) from None
+    except (TypeError, KeyError, IndexError, OverflowError, AttributeError, OSError) as exc:
+        # A record of the file with the wrong types (a fuzzed or hand-edited file).
+        raise ValueError(f'observation.file {name!r}: its detector or fovea record is unusable '
+                         f'({type(exc).__name__}: {_one_line(exc)})') from None
+
+
+def _one_line(exc: BaseException) -> str:
+    """Return an exception's message on one line (its lines joined with '; ')."""
+    return '; '.join(line.strip() for line in str(exc).splitlines() if line.strip())
 
 
 def camera_mismatch(model_camera_: PinholeCamera | None, camera: PinholeCamera) -> str:
@@ -152,21 +219,78 @@ def camera_mismatch(model_camera_: PinholeCamera | None, camera: PinholeCamera) 
             f'counts may not follow the model')
 
 
+def check_camera(camera: PinholeCamera, max_side_px: int | None = None) -> None:
+    """
+    Refuse intrinsics that are finite but absurd.
+
+    Raises
+    ------
+    ValueError
+        If a side is above ``max_side_px``, a field of view is outside :data:`FOV_RANGE_DEG`, or
+        the principal point ``(cx, cy)`` lies outside the image.
+
+    """
+    if max_side_px and max(camera.width, camera.height) > max_side_px:
+        raise ValueError(f'camera_info describes a {camera.width}x{camera.height} image, larger '
+                         f'than {max_side_px} px on a side')
+    low, high = FOV_RANGE_DEG
+    for axis, fov in zip(('horizontal', 'vertical'), camera.fov_deg):
+        if not low <= fov <= high:
+            raise ValueError(f'camera_info K gives a {axis} field of view of {fov:.4g} deg, '
+                             f'outside [{low}, {high}] (fx {camera.fx:.6g}, fy {camera.fy:.6g})')
+    if not (-0.5 <= camera.cx <= camera.width - 0.5 and -0.5 <= camera.cy <= camera.height - 0.5):
+        raise ValueError(f'camera_info principal point ({camera.cx:.6g}, {camera.cy:.6g}) lies '
+                         f'outside the {camera.width}x{camera.height} image')
+
+
+def scaled_camera(camera: PinholeCamera, width: int, height: int) -> PinholeCamera:
+    """Return the camera as seen through an image resized to ``width x height`` (K scaled)."""
+    sx, sy = width / camera.width, height / camera.height
+    return PinholeCamera(width, height, camera.fx * sx, camera.fy * sy,
+                         (camera.cx + 0.5) * sx - 0.5, (camera.cy + 0.5) * sy - 0.5)
+
+
+def resized_size(size: tuple[int, int],
+                 model_size: tuple[int, int] | None) -> tuple[int, int] | None:
+    """
+    Return the ``(width, height)`` an image of ``size`` is resized to, or None to keep it.
+
+    An image more than :data:`RESIZE_ABOVE` times the model's image width or height is scaled
+    (aspect kept) to fit within the model's image size.
+    """
+    width, height = size
+    if model_size is None or (width <= RESIZE_ABOVE * model_size[0] and
+                              height <= RESIZE_ABOVE * model_size[1]):
+        return None
+    scale = min(model_size[0] / width, model_size[1] / height)
+    return max(1, round(width * scale)), max(1, round(height * scale))
+
+
+def resize_view(image: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """Resize a view to ``(width, height)`` by pixel area averaging (a new array)."""
+    import cv2
+    return cv2.resize(np.ascontiguousarray(image), size, interpolation=cv2.INTER_AREA)
+
+
 @dataclass(frozen=True)
 class Frame:
     """
     One count frame for the controller, and what it cost.
 
-    ``image``, ``detections_px`` (raw detection centres ``(M, 2)`` in its pixels), ``windows``
-    (fovea windows) and ``head_rc`` (camera mode) say how it was made, for pictures of the search.
+    ``kind`` is ``'fixation'`` or ``'scan'`` (the one-time scan, ``fixation`` None then);
+    ``search_id`` the search it was asked for (None: the request did not say). ``image``,
+    ``detections_px`` (raw detection centres ``(M, 2)`` in its pixels), ``windows`` (fovea
+    windows) and ``head_rc`` (camera mode) say how it was made, for pictures of the search.
     """
 
-    fixation: int
+    fixation: int | None
     stamp_s: float
     token: object
     counts: np.ndarray
     detector_pixels: int
     seconds: float
+    kind: str = 'fixation'
+    search_id: int | None = None
     image: np.ndarray | None = field(default=None, compare=False, repr=False)
     detections_px: np.ndarray | None = field(default=None, compare=False, repr=False)
     windows: tuple = field(default=(), compare=False, repr=False)
@@ -177,7 +301,7 @@ class Frame:
 class Outcome:
     """What happened when the loop tried to serve the waiting fixation."""
 
-    status: str          # 'published', 'rejected', 'waiting' or 'idle'
+    status: str          # 'published', 'rejected', 'refused', 'waiting' or 'idle'
     reason: str = ''
     frame: Frame | None = None
 
@@ -195,43 +319,114 @@ class DetectorLoop:
     tolerance_s : float
         ``camera`` mode: a joint state pairs with an image stamped at most this far apart.
     keep : int
-        Images and joint states kept while a fixation waits (the newest).
+        Images kept while a fixation waits (the newest; none while no fixation waits), and
+        ``50 * keep`` joint states.
+    stamp_tolerance_s : float
+        Inputs stamped more than this ahead of the clock on arrival are rejected.
+    max_age_s : float
+        Inputs stamped more than this before the clock on arrival are rejected (0: no limit).
 
     """
 
     def __init__(self, setup: DetectorSetup, head: PanTiltMap | None = None,
-                 tolerance_s: float = 0.0, keep: int = 4):
+                 tolerance_s: float = 0.0, keep: int = 4,
+                 stamp_tolerance_s: float = STAMP_TOLERANCE_S, max_age_s: float = MAX_AGE_S):
         if setup.mode == 'camera' and head is None:
             raise ValueError('camera mode needs the head mapping (joint names, signs, offsets)')
         self.setup = setup
         self.head = head
         self.tolerance_s = float(tolerance_s)
+        self.stamp_tolerance_s = float(stamp_tolerance_s)
+        self.max_age_s = float(max_age_s)
         self.camera: PinholeCamera | None = None
-        self.pending: tuple[int, float] | None = None
+        self.pending: tuple[int | None, float] | None = None
+        self.search_id: int | None = None
+        self.scans = 0
         self._images = deque(maxlen=keep)
         self._poses = deque(maxlen=50 * keep)
         self.received = self.processed = self.rejected = self.fixations = 0
+        self.future = self.stale = self.resized = 0
+        # Other inputs: received and refused (joint_states, camera_info, fixation).
+        self.inputs = {k: [0, 0] for k in ('joint_states', 'camera_info', 'fixation')}
         self.last_rejection = ''
+        self.last_refusal = ''
+        self.mismatch = ''
         self.waiting = ''
         self._seconds = deque(maxlen=TIMING_WINDOW)
         self._pixels = deque(maxlen=TIMING_WINDOW)
 
     # -- inputs ------------------------------------------------------------------------------
-    def fixate(self, cell: int, now_s: float) -> Outcome:
-        """Take a fixation commanded at ``now_s``: wait for an image captured from then on."""
+    def _stamp_problem(self, stamp_s: float, now_s: float | None) -> str:
+        """Why a stamp breaks the time sanity rule ('' if it does not, or no clock is given)."""
+        if now_s is None:
+            return ''
+        ahead = stamp_s - now_s
+        if not math.isfinite(ahead):
+            return f'stamp {stamp_s!r} is not a finite time'
+        if ahead > self.stamp_tolerance_s:
+            return (f"stamped {ahead:.3f} s ahead of this node's clock (more than "
+                    f'stamp_tolerance_s {self.stamp_tolerance_s:g} s): its clock runs ahead')
+        if self.max_age_s > 0 and -ahead > self.max_age_s:
+            return (f'stamped {-ahead:.3f} s before it arrived (more than max_image_age_s '
+                    f'{self.max_age_s:g} s): stale, or its clock runs behind')
+        return ''
+
+    def fixate(self, cell: int, now_s: float, search_id: int | None = None) -> Outcome:
+        """
+        Take a fixation commanded at ``now_s``: wait for an image captured from then on.
+
+        ``search_id`` (the controller's, when it says) comes back with the frame; a new id is a
+        new search, and whatever the previous one still waited for is dropped.
+        """
         self.setup.grid.cell(cell)
         self.fixations += 1
+        self.inputs['fixation'][0] += 1
+        self.search_id = search_id
         self.pending = (int(cell), float(now_s))
         return self.serve()
 
-    def add_image(self, stamp_s: float, image: np.ndarray, token=None) -> Outcome:
+    def request_scan(self, search_id: int, now_s: float) -> Outcome:
         """
-        Take a decoded image captured at ``stamp_s``; serve the waiting fixation if due.
+        Take a request for the one-time scan of search ``search_id`` (docs/design.md 10.3).
+
+        Served with the next image captured from ``now_s`` on: the fovea's whole-image windows
+        (``fovea`` mode with a scanning fovea); a sensor without a scan (``camera`` mode, or a
+        fovea that does not scan) answers with a frame of NaN (nothing observed), so the
+        controller can start its search all the same.
+        """
+        self.fixations += 1
+        self.inputs['fixation'][0] += 1
+        self.search_id = int(search_id)
+        self.pending = (None, float(now_s))
+        return self.serve()
+
+    def add_image(self, stamp_s: float, image: np.ndarray, token=None,
+                  now_s: float | None = None) -> Outcome:
+        """
+        Take a decoded image captured at ``stamp_s`` and arrived at ``now_s``; serve if due.
 
         ``token`` comes back in the :class:`Frame` the image serves (the node's exact stamp).
+        With ``now_s``, the time sanity rule applies and an image that arrived while no fixation
+        waited is not kept (it can serve no fixation).
         """
         self.received += 1
-        self._images.append((float(stamp_s), image, token))
+        problem = self._stamp_problem(float(stamp_s), now_s)
+        if problem:
+            if 'ahead' in problem:
+                self.future += 1
+            else:
+                self.stale += 1
+            return self._rejected(f'image {problem}')
+        if now_s is not None and (self.pending is None or now_s < self.pending[1]):
+            return Outcome('idle')
+        size = (image.shape[1], image.shape[0])
+        t0 = time.perf_counter()
+        if image.ndim in (2, 3):
+            target = resized_size(size, self.setup.image_size)
+            if target is not None:
+                image = resize_view(image, target)
+                self.resized += 1
+        self._images.append((float(stamp_s), image, token, size, time.perf_counter() - t0))
         return self.serve()
 
     def reject(self, reason: str) -> Outcome:
@@ -239,15 +434,45 @@ class DetectorLoop:
         self.received += 1
         return self._rejected(reason)
 
-    def add_pose(self, stamp_s: float, pan_rad: float, tilt_rad: float) -> Outcome:
-        """Take the head's joint angles at ``stamp_s`` (``camera`` mode)."""
-        self._poses.append((float(stamp_s), float(pan_rad), float(tilt_rad)))
+    def refuse(self, kind: str, reason: str) -> Outcome:
+        """Count a ``joint_states``, ``camera_info`` or ``fixation`` message refused at entry."""
+        counts = self.inputs[kind]
+        counts[0] += 1
+        counts[1] += 1
+        self.last_refusal = f'{kind}: {reason}'
+        return Outcome('refused', f'{kind}: {reason}')
+
+    def add_pose(self, stamp_s: float, pan_rad: float, tilt_rad: float,
+                 now_s: float | None = None) -> Outcome:
+        """Take the head's joint angles at ``stamp_s`` (``camera`` mode); refuse absurd ones."""
+        pan, tilt = float(pan_rad), float(tilt_rad)
+        if not (abs(pan) <= MAX_JOINT_RAD and abs(tilt) <= MAX_JOINT_RAD):
+            return self.refuse('joint_states', f'pan/tilt {pan!r}, {tilt!r} rad: beyond '
+                                               f'+/-{MAX_JOINT_RAD:.4f} rad (one turn)')
+        problem = self._stamp_problem(float(stamp_s), now_s)
+        if problem:
+            return self.refuse('joint_states', problem)
+        self.inputs['joint_states'][0] += 1
+        self._poses.append((float(stamp_s), pan, tilt))
         return self.serve()
 
-    def set_camera(self, camera: PinholeCamera) -> str:
-        """Use these intrinsics from now on; return a warning if the model expects others."""
-        self.camera = camera
-        return camera_mismatch(self.setup.camera, camera)
+    def set_camera(self, camera: PinholeCamera, max_side_px: int | None = None) -> Outcome:
+        """
+        Use these intrinsics from now on unless :func:`check_camera` refuses them.
+
+        Returns the outcome of serving the waiting fixation (``refused`` with the reason when
+        refused); a warning when the model expects another camera is in ``mismatch``.
+        """
+        try:
+            check_camera(camera, max_side_px)
+        except ValueError as exc:
+            return self.refuse('camera_info', str(exc))
+        self.inputs['camera_info'][0] += 1
+        self.mismatch = ''
+        if camera != self.camera:
+            self.camera = camera
+            self.mismatch = camera_mismatch(self.setup.camera, camera)
+        return self.serve()
 
     def set_setup(self, setup: DetectorSetup) -> None:
         """Use another model and detector from the next image on."""
@@ -281,9 +506,9 @@ class DetectorLoop:
         fresh = [item for item in self._images if item[0] >= since]
         if not fresh:
             return Outcome('waiting', 'no image captured since the fixation was commanded')
-        stamp, image, token = fresh[-1]
-        if self.setup.mode == 'fovea':
-            return self._count(cell, stamp, image, token)
+        stamp, image, token, size, prep_s = fresh[-1]
+        if self.setup.mode == 'fovea' or cell is None:
+            return self._count(cell, stamp, image, token, prep_s=prep_s)
         if self.camera is None:
             return Outcome('waiting', 'no camera_info received: camera mode needs the '
                                       'intrinsics K to map pixels to cells')
@@ -296,37 +521,68 @@ class DetectorLoop:
             self._drop_through(stamp)
             return Outcome('waiting', f'the head is at {self.setup.grid.cell(at)}, not yet at '
                                       f'the fixation {self.setup.grid.cell(cell)}')
-        return self._count(cell, stamp, image, token, head_rc)
+        return self._count(cell, stamp, image, token, head_rc, size, prep_s)
 
     def _drop_through(self, stamp_s: float) -> None:
         while self._images and self._images[0][0] <= stamp_s:
             self._images.popleft()
 
-    def _count(self, cell: int, stamp_s: float, image, token, head_rc=None) -> Outcome:
+    def _view_camera(self, image, size) -> PinholeCamera:
+        """Return the camera_info camera as seen through ``image`` (K scaled if resized)."""
+        camera = self.camera
+        if (camera.width, camera.height) != tuple(size):
+            raise ValueError(f'the image is {size[0]}x{size[1]} px but camera_info says '
+                             f'{camera.width}x{camera.height}')
+        height, width = image.shape[:2]
+        if (width, height) == tuple(size):
+            return camera
+        return scaled_camera(camera, width, height)
+
+    def _count(self, cell: int, stamp_s: float, image, token, head_rc=None,
+               size=None, prep_s: float = 0.0) -> Outcome:
+        """Detect and count; the frame's ``seconds`` include the resize on arrival."""
         setup = self.setup
         t0 = time.perf_counter()
         try:
-            if setup.mode == 'fovea':
+            if cell is None:
+                counts, pixels, centres, windows = self._scan(image)
+            elif setup.mode == 'fovea':
                 setup.fovea.start(image)
                 observation = setup.fovea.observe(cell)
                 counts, pixels = observation.counts, observation.detector_pixels
                 centres, windows = observation.centres_px - 0.5, observation.windows
             else:
-                observation = setup.observer.observe(image, self.camera, head_rc)
+                camera = self._view_camera(image, size)
+                observation = setup.observer.observe(image, camera, head_rc)
                 counts, pixels = observation.counts, observation.detector_pixels
                 centres, windows = observation.centres_uv, ()
         except ValueError as exc:
             self._drop_through(stamp_s)
             return self._rejected(str(exc))
-        seconds = time.perf_counter() - t0
+        seconds = time.perf_counter() - t0 + prep_s
         self._drop_through(stamp_s)
         self.pending = None
         self.processed += 1
+        self.scans += cell is None
         self._seconds.append(seconds)
         self._pixels.append(pixels)
-        return Outcome('published',
-                       frame=Frame(cell, stamp_s, token, counts, int(pixels), seconds, image,
-                                   centres, windows, head_rc))
+        return Outcome('published', frame=Frame(
+            cell, stamp_s, token, counts, int(pixels), seconds,
+            'scan' if cell is None else 'fixation', self.search_id, image, centres, windows,
+            head_rc))
+
+    def _scan(self, image) -> tuple[np.ndarray, int, np.ndarray, tuple]:
+        """
+        Return the one-time scan of an image: counts, pixels, detections, windows.
+
+        A sensor without a scan gives NaN everywhere (nothing observed) and no detections.
+        """
+        fovea = self.setup.fovea
+        if self.setup.mode == 'fovea' and fovea.config.scan_once:
+            fovea.start(image)
+            scan = fovea.scan()
+            return scan.counts, scan.detector_pixels, scan.centres_px - 0.5, scan.windows
+        return np.full(self.setup.grid.n_cells, np.nan), 0, np.zeros((0, 2)), ()
 
     # -- reporting -------------------------------------------------------------------------
     def values(self) -> dict:
@@ -337,9 +593,13 @@ class DetectorLoop:
         return {
             'mode': self.setup.mode, 'observation': self.setup.name,
             'images_received': self.received, 'images_processed': self.processed,
+            'scans_served': self.scans, 'search_id': -1 if self.search_id is None
+            else self.search_id,
             'images_rejected': self.rejected,
             'images_unused': self.received - self.processed - self.rejected,
-            'fixations_received': self.fixations, 'waiting_for_image': waiting,
+            'images_future': self.future, 'images_stale': self.stale,
+            'images_resized': self.resized, 'images_held': len(self._images),
+            'fixations_received': self.inputs['fixation'][0], 'waiting_for_image': waiting,
             'waiting_because': self.waiting if waiting else '',
             'camera_info': self.camera is not None,
             'detector_ms_last': 1e3 * seconds[-1] if seconds.size else 0.0,
@@ -347,4 +607,8 @@ class DetectorLoop:
             'pixels_per_fixation_last': int(pixels[-1]) if pixels.size else 0,
             'pixels_per_fixation_mean': float(pixels.mean()) if pixels.size else 0.0,
             'last_rejection': self.last_rejection,
+            'fixations_rejected': self.inputs['fixation'][1],
+            **{f'{kind}_{what}': self.inputs[kind][i] for kind in ('joint_states', 'camera_info')
+               for i, what in enumerate(('received', 'rejected'))},
+            'last_input_rejection': self.last_refusal,
         }

@@ -168,6 +168,7 @@ class GazeController:
                                      log_size=1000)
         self.settle_time_s = check_settle_time(settle_time_s)
         self.session.reset(seed=seed)
+        self.search_id = 0
         self.enabled = True
         self.received = self.applied = self.rejected = self.skipped = 0
         self.last_rejection = ''
@@ -244,12 +245,30 @@ class GazeController:
 
     @property
     def fixation(self) -> int:
-        """Return the current target cell (settable: the next frame is taken there)."""
+        """
+        Return the current target cell (settable: the next frame is taken there).
+
+        While the one-time scan is awaited (:attr:`scanning`) the head holds the start cell the
+        settings name, or the grid's centre.
+        """
+        if self.session.fixation is None:
+            cell = self.settings.start_cell
+            return self.grid.index(*cell) if isinstance(cell, tuple) else self.grid.center_index
         return self.session.fixation
 
     @fixation.setter
     def fixation(self, cell: int) -> None:
         self.session.fixate(cell)
+
+    @property
+    def wants_scan(self) -> bool:
+        """Whether searches start with the one-time scan (the model has one, settings.scan)."""
+        return bool(getattr(self.observation, 'has_scan', False)) and self.settings.scan
+
+    @property
+    def scanning(self) -> bool:
+        """Whether the search awaits its one-time scan (no fixation has been chosen yet)."""
+        return self.session.fixation is None
 
     @property
     def fixations(self) -> int:
@@ -284,7 +303,9 @@ class GazeController:
         The prior is uniform over the cells, with ``absent_prior`` on the absent hypothesis.
         """
         self.session.reset()
-        self.session.start()
+        self.search_id += 1
+        if not self.wants_scan:
+            self.session.start()
         self.found = self.absent = self.gave_up = None
         self.target_time_s = self.usable_time_s = self.update_time_s = float(now_s)
         return self.fixation
@@ -321,7 +342,41 @@ class GazeController:
         self.last_rejection = str(reason)
         return FrameResult('rejected', str(reason))
 
-    def offer(self, evidence, stamp_s: float, now_s: float | None = None) -> FrameResult:
+    def offer_scan(self, evidence, search_id: int, now_s: float) -> FrameResult:
+        """
+        Use, skip or reject the one-time scan of search ``search_id`` (docs/design.md 6.8, 10.3).
+
+        Applied only while this search awaits it; then the first fixation is chosen (the
+        policy's choice on the scanned belief, or the settings' start cell) and returned, to be
+        sent at ``now_s``. A scan of another search, or one nobody waits for, is skipped.
+        """
+        try:
+            obs = self.session.check_frame(evidence)
+        except EvidenceError as exc:
+            return self.reject(str(exc))
+        self.received += 1
+        reason = ''
+        if not self.enabled:
+            reason = 'disabled'
+        elif int(search_id) != self.search_id:
+            reason = f'a scan of search {search_id}, this is search {self.search_id}'
+        elif not self.scanning:
+            reason = 'not waiting for a scan: the search has started'
+        if reason:
+            self.skipped += 1
+            return FrameResult('skipped', reason)
+        step = self.session.scan(Frame(obs, kind='scan'))
+        if not step.applied:
+            self.rejected += 1
+            self.last_rejection = step.reason
+            return FrameResult('rejected', step.reason)
+        self.applied += 1
+        cell = self.session.start()
+        self.target_time_s = self.usable_time_s = float(now_s)
+        return FrameResult('applied', fixation=cell)
+
+    def offer(self, evidence, stamp_s: float, now_s: float | None = None,
+              search_id: int | None = None) -> FrameResult:
         """
         Use, skip or reject one frame of evidence taken at ``stamp_s``.
 
@@ -333,6 +388,9 @@ class GazeController:
             When the frame was taken (its header stamp, or its arrival time).
         now_s : float, optional
             Current time, when the next target is sent (default ``stamp_s``).
+        search_id : int, optional
+            The search the frame was taken for (a detector that says so); a frame of another
+            search is skipped. None: unknown, judged by its time alone.
 
         """
         try:
@@ -343,6 +401,13 @@ class GazeController:
         if not self.enabled:
             self.skipped += 1
             return FrameResult('skipped', 'disabled')
+        if search_id is not None and int(search_id) != self.search_id:
+            self.skipped += 1
+            return FrameResult('skipped', f'a frame of search {search_id}, this is search '
+                                          f'{self.search_id}')
+        if self.scanning:
+            self.skipped += 1
+            return FrameResult('skipped', 'waiting for the one-time scan')
         if self.stopped:
             self.skipped += 1
             return FrameResult('skipped', f'the search has ended ({self.decision}); ~/reset '

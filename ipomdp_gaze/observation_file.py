@@ -11,6 +11,8 @@ Format ``ipomdp_gaze/observation-v1`` (docs/design.md section 9)::
     image: {width: 420, height: 420}      # the image size it was calibrated at
     fovea: {...}                          # the fovea settings it was measured with
     detector: {...}                       # the detector settings it was measured with
+    cells: {kind: score_bins, ...}        # optional: what a cell's observation is (absent:
+                                          # the clipped count; ipomdp_gaze.vision.cell_observation)
     target: [[[p0, p1, ...], ...], ...]   # P(c | target, |dr|, |dc|): rows x cols x K
     null: [[[...]]]                       # P(c | no target, |dr|, |dc|): rows x cols x K
     scan: {target: [...], null: [...]}    # optional: P(c | target), P(c | no target) of the
@@ -42,8 +44,8 @@ FORMAT = 'ipomdp_gaze/observation-v1'
 POLICY_FORMAT = 'ipomdp_gaze/policy-v1'
 MODELS = ('counts',)
 REQUIRED = ('format', 'model', 'grid', 'target', 'null')
-KEYS = REQUIRED + ('image', 'fovea', 'detector', 'calibration', 'scan')
-RECORDS = ('image', 'fovea', 'detector', 'calibration')
+KEYS = REQUIRED + ('image', 'fovea', 'detector', 'cells', 'calibration', 'scan')
+RECORDS = ('image', 'fovea', 'detector', 'cells', 'calibration')
 MODEL_DIR = Path(str(resources.files(__package__).joinpath('models')))
 # Counts per cell a file may tabulate (K); far above any detector's clipped count.
 MAX_K = 256
@@ -180,6 +182,12 @@ def model_from_dict(doc, source: str = '') -> CountObservation:
         model = CountObservation(grid, target, null, meta, scan_target, scan_null)
     except ValueError as exc:
         raise ObservationFileError(str(exc)) from None
+    if 'cells' in meta:
+        from .vision.cell_observation import cell_observation_of
+        try:
+            cell_observation_of(meta, model.max_count + 1)
+        except (TypeError, ValueError) as exc:
+            raise ObservationFileError(f'cells: {exc}') from None
     if source:
         model.meta['source'] = source
     return model
@@ -213,7 +221,7 @@ def model_to_dict(model: CountObservation) -> dict:
     if model.grid.spacing_deg != 1.0:
         grid['spacing_deg'] = model.grid.spacing_deg
     doc = {'format': FORMAT, 'model': model.name, 'grid': grid}
-    for key in RECORDS[:3]:
+    for key in RECORDS[:4]:
         if key in model.meta:
             doc[key] = plain(model.meta[key])
     doc['target'] = np.round(model.p_target, 12).tolist()

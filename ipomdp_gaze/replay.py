@@ -157,7 +157,12 @@ def _angles(msg, head: PanTiltMap) -> tuple[float, float]:
 
 
 def _frames(bag, grid: Grid) -> list:
-    """Return ``(stamp_s, arrival_s, values)`` of every recorded frame, in arrival order."""
+    """
+    Return ``(stamp_s, arrival_s, values, kind)`` of every recorded frame, in arrival order.
+
+    ``kind`` is ``'scan'`` for a one-time scan (``header.frame_id`` ``scan/<id>``, design §10.3),
+    else ``'fixation'``.
+    """
     frames = []
     for m in bag.topic('evidence_image'):
         msg = m.msg
@@ -165,11 +170,12 @@ def _frames(bag, grid: Grid) -> list:
         rows = data.reshape(msg.height, msg.step)[:, :4 * msg.width]
         values = np.ascontiguousarray(rows).view('>f4' if msg.is_bigendian else '<f4')
         stamp = _seconds(msg.header.stamp)
+        kind = 'scan' if str(msg.header.frame_id).startswith('scan/') else 'fixation'
         frames.append((stamp or m.time_ns * 1e-9, m.time_ns * 1e-9,
-                       values.reshape(-1).astype(np.float64)))
+                       values.reshape(-1).astype(np.float64), kind))
     for m in bag.topic('evidence'):
         frames.append((m.time_ns * 1e-9, m.time_ns * 1e-9,
-                       np.asarray(m.msg.data, dtype=np.float64)))
+                       np.asarray(m.msg.data, dtype=np.float64), 'fixation'))
     frames.sort(key=lambda f: f[1])
     if not frames:
         raise ValueError(f'{bag.path} has no evidence_image or evidence frame to replay')
@@ -254,13 +260,16 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
     say = result.lines.append
     if core.fixation != recorded_cells[0]:
         result.first_difference = 1
-    for stamp, arrival, values in frames:
+    for stamp, arrival, values, kind in frames:
         if result.first_difference is not None or core.stopped:
             break
         k = core.fixations
         # The node sent its next target when it took the frame: the recorded send time.
         now = targets[k + 1][0] if k + 1 < len(targets) else arrival
-        step = core.offer(values, stamp, now)
+        if kind == 'scan':          # the one-time scan of this (the only recorded) search
+            step = core.offer_scan(values, core.search_id, now)
+        else:
+            step = core.offer(values, stamp, now)
         if not step.applied:
             continue
         result.applied += 1

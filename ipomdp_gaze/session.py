@@ -63,6 +63,8 @@ PARAMETER_NAMES = {
     'motion_jump_prob': 'motion.jump_prob',
     'start_cell': 'start_cell',
     'scan': 'search.scan',
+    'found_radius': 'search.found_radius',
+    'decide_at_budget': 'search.decide_at_budget',
 }
 
 
@@ -70,6 +72,23 @@ def _check_flag(value, name: str) -> bool:
     if not isinstance(value, (bool, np.bool_)):
         raise ValueError(f'{name} must be true or false, got {value!r}')
     return bool(value)
+
+
+def _check_radius(value, name: str) -> int:
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) \
+            or not 0 <= value <= 5:
+        raise ValueError(f'{name} must be an integer from 0 to 5 (cells), got {value!r}')
+    return int(value)
+
+
+def pooled_belief(belief: np.ndarray, grid: Grid, radius: int) -> np.ndarray:
+    """Return, per cell, the belief within ``radius`` cells (Chebyshev) of it, ``(N,)``."""
+    if radius <= 0:
+        return belief
+    side = 2 * radius + 1
+    padded = np.pad(np.asarray(belief, dtype=float).reshape(grid.rows, grid.cols), radius)
+    window = np.lib.stride_tricks.sliding_window_view(padded, (side, side))
+    return window.sum(axis=(2, 3)).reshape(-1)
 
 
 def _check_start(value, name: str = 'start_cell'):
@@ -116,6 +135,14 @@ class SearchSettings:
         after a scan, else the grid's centre (the robot's convention, section 4.2).
     scan : bool
         Apply the one-time scan when the sensor and the model have one.
+    found_radius : int
+        Still target: ``found`` when the belief within this many cells (Chebyshev) of a cell
+        reaches ``confidence``, and that cell is the answer (``map_cell``); 0: the cell alone.
+        A face straddling two cells splits its evidence; an answer within one cell is right.
+    decide_at_budget : bool
+        Still target: when the budget runs out undecided, decide anyway (reason ``budget``):
+        ``absent`` if ``P(absent)`` is at least the answer's probability, else ``found``;
+        off: ``gave_up``. A deadline: the robot must say something.
 
     """
 
@@ -129,6 +156,8 @@ class SearchSettings:
     motion_jump_prob: float = 0.0
     start_cell: tuple | None = None
     scan: bool = True
+    found_radius: int = 0
+    decide_at_budget: bool = False
 
     def __post_init__(self):
         names = PARAMETER_NAMES
@@ -145,6 +174,8 @@ class SearchSettings:
                                                   names['motion_jump_prob']),
             'start_cell': _check_start(self.start_cell, names['start_cell']),
             'scan': _check_flag(self.scan, names['scan']),
+            'found_radius': _check_radius(self.found_radius, names['found_radius']),
+            'decide_at_budget': _check_flag(self.decide_at_budget, names['decide_at_budget']),
         }
         for key, value in checked.items():
             object.__setattr__(self, key, value)
@@ -386,13 +417,21 @@ class SearchSession:
 
     @property
     def map_cell(self) -> int:
-        """Return the most likely cell (ties to the lowest index)."""
-        return int(map_cell(self.belief))
+        """
+        Return the answer: the most likely cell (ties to the lowest index).
+
+        With ``found_radius`` r > 0: the cell whose (2r + 1)-square holds the most belief.
+        """
+        return int(map_cell(self._pooled()))
+
+    def _pooled(self) -> np.ndarray:
+        radius = self.settings.found_radius if not self.motion.active else 0
+        return pooled_belief(self.belief, self.grid, radius)
 
     @property
     def map_probability(self) -> float:
-        """Probability of the most likely cell."""
-        return float(self.belief[self.map_cell])
+        """Probability of the answer: its cell, or its square with ``found_radius``."""
+        return float(self._pooled()[self.map_cell])
 
     @property
     def entropy_nats(self) -> float:
@@ -606,8 +645,7 @@ class SearchSession:
     def _decide(self) -> str:
         """Run the stop rules after an applied frame; return the decision it fired ('')."""
         search, settings = self._search, self.settings
-        belief = self.belief
-        peak, absent = float(belief.max()), self.absent_probability
+        peak, absent = float(self._pooled().max()), self.absent_probability
         code = int(decide(peak, absent, settings.confidence))
         decision = {FOUND: 'found', ABSENT: 'absent'}.get(code, '')
         fired = ''
@@ -619,8 +657,10 @@ class SearchSession:
         search.decided_once = search.decided_once or bool(fired)
         if not search.decided_once and settings.max_fixations \
                 and search.fixations >= settings.max_fixations:
-            search.decision, search.reason, search.ended = 'gave_up', 'budget', True
             fired = 'gave_up'
+            if settings.decide_at_budget and not self.motion.active:
+                fired = 'absent' if absent >= peak else 'found'
+            search.decision, search.reason, search.ended = fired, 'budget', True
         return fired
 
     def _choose(self) -> int | None:
@@ -657,6 +697,6 @@ class SearchSession:
     def _result(self, status: str, reason: str = '', fired: str = '') -> StepResult:
         search = self._search
         cell = self.map_cell
-        return StepResult(status, search.fixations, cell, float(self.belief[cell]),
+        return StepResult(status, search.fixations, cell, self.map_probability,
                           self.absent_probability, reason or search.reason, search.decision,
                           fired, None if search.ended else search.fixation, search.ended)

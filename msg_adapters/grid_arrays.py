@@ -112,6 +112,49 @@ def row_col(grid: Grid, cell: int | None) -> Int32MultiArray:
     return msg
 
 
+def fixation(grid: Grid, cell: int | None, search_id: int) -> Int32MultiArray:
+    """
+    Build the controller's ``fixation``: ``[row, col, search_id]``, or ``[-1, -1, search_id]``.
+
+    ``[-1, -1, id]`` asks the detector for the one-time scan of search ``id`` (``cell`` None);
+    the id tells the detector which search a request belongs to, so that a reset is seen and a
+    frame is never paired with the wrong search.
+    """
+    msg = row_col(grid, cell)
+    msg.layout.dim[0].label, msg.layout.dim[0].size, msg.layout.dim[0].stride = \
+        'row_col_search', 3, 3
+    msg.data = list(msg.data) + [int(search_id)]
+    return msg
+
+
+def read_fixation(msg, grid: Grid) -> tuple[int | None, int | None]:
+    """
+    Return ``(cell, search_id)`` of a ``fixation``: cell None for a scan request.
+
+    ``[row, col]`` (no id, an older controller) gives ``(cell, None)``.
+
+    Raises
+    ------
+    ValueError
+        If the message is not ``[row, col]``, ``[row, col, id]`` or ``[-1, -1, id]`` with a
+        cell inside the grid and an id >= 0.
+
+    """
+    data = list(msg.data)
+    if len(data) not in (2, 3):
+        raise ValueError(f'fixation must be [row, col] or [row, col, search_id], got {data}')
+    if len(data) == 2:
+        return cell_from_row_col(msg, grid, 'fixation'), None
+    row, col, search_id = data
+    if search_id < 0:
+        raise ValueError(f'fixation search_id must be >= 0, got {search_id}')
+    if (row, col) == (-1, -1):
+        return None, int(search_id)
+    if not (0 <= row < grid.rows and 0 <= col < grid.cols):
+        raise ValueError(f'fixation ({row}, {col}) is outside the {grid.rows}x{grid.cols} grid')
+    return grid.index(row, col), int(search_id)
+
+
 def ground_truth(grid: Grid, cell: int | None) -> Int32MultiArray:
     """Build a camera's ground truth: ``data = [row, col]``, ``[-1, -1]`` for an empty scene."""
     return row_col(grid, cell)

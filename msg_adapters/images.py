@@ -80,6 +80,23 @@ def evidence_image(values, grid: Grid, stamp, frame_id: str = '') -> Image:
     return msg
 
 
+def frame_tag(kind: str, search_id: int | None) -> str:
+    """``header.frame_id`` of a detector's frame: ``'scan/<id>'``, ``'fixation/<id>'`` or ''."""
+    return '' if search_id is None else f'{kind}/{int(search_id)}'
+
+
+def read_frame_tag(msg: Image) -> tuple[str, int | None]:
+    """
+    Return ``(kind, search_id)`` of an evidence image, from ``header.frame_id`` (``frame_tag``).
+
+    Any other frame id (a detector that does not tag its frames) gives ``('fixation', None)``.
+    """
+    kind, _, number = msg.header.frame_id.partition('/')
+    if kind in ('scan', 'fixation') and number.isdigit():
+        return kind, int(number)
+    return 'fixation', None
+
+
 def evidence_from_image(msg: Image, grid: Grid) -> np.ndarray:
     """
     Read a ``32FC1`` evidence image as float64 values, shape (N,), row-major.

@@ -17,7 +17,13 @@ import numpy as np
 
 from .conv import ConvPolicy
 
-STRATEGIES = ('map', 'random', 'center', 'elm', 'spiral', 'greedy', 'tempered', 'switching')
+STRATEGIES = ('map', 'random', 'center', 'elm', 'spiral', 'sweep', 'coverage', 'greedy',
+              'tempered', 'switching')
+# coverage: the sweep's tile poses come first while no cell's belief reaches this.
+COVERAGE_PEAK = 0.3
+# A model without a camera's field of view (the Gaussian FPOCs, the fovea): the sweep's raster
+# looks at every SWEEP_STEP-th cell in each direction.
+SWEEP_STEP = 3
 
 _NEEDS_FPOC = {'greedy': 'the ideal searcher', 'tempered': 'tempered ELM',
                'switching': 'tempered ELM, then the ideal searcher'}
@@ -93,6 +99,73 @@ class SpiralPolicy:
         return np.full(np.shape(belief)[0], self.order[t % self.order.size], dtype=np.int64)
 
 
+def sweep_tile_cells(grid: Grid, model) -> tuple[int, int]:
+    """
+    Return ``(rows, cols)`` of cells one view covers: the camera's field of view over the spacing.
+
+    The camera is the one a pan/tilt count model was calibrated with (its ``meta``); a model
+    without one (Gaussian FPOCs, the fovea) gets the raster's :data:`SWEEP_STEP`.
+    """
+    image = (getattr(model, 'meta', None) or {}).get('image') or {}
+    camera = image.get('camera') if image.get('view') == 'pan_tilt' else None
+    if not camera:
+        return SWEEP_STEP, SWEEP_STEP
+    from ipomdp_gaze.head_camera import PinholeCamera
+    hfov, vfov = PinholeCamera.from_k(camera['width'], camera['height'], camera['K']).fov_deg
+    return (max(1, min(grid.rows, int(vfov // grid.spacing_deg))),
+            max(1, min(grid.cols, int(hfov // grid.spacing_deg))))
+
+
+def _tile_centres(n_cells: int, side: int) -> np.ndarray:
+    """Centres of the fewest tiles of ``side`` cells covering ``n_cells``, spread evenly."""
+    n_tiles = -(-n_cells // side)
+    half = (side - 1) / 2.0
+    if n_tiles == 1:
+        return np.array([(n_cells - 1) // 2], dtype=np.int64)
+    return np.round(np.linspace(half, n_cells - 1 - half, n_tiles)).astype(np.int64)
+
+
+def sweep_tiles(grid: Grid, model) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Return the sweep's poses (cells, boustrophedon order) and each cell's own pose.
+
+    The grid is tiled by views of :func:`sweep_tile_cells` cells (the fewest tiles per
+    direction, evenly spread); rows of tiles top to bottom, left to right then right to left.
+    ``owner[k]`` is the index in ``poses`` of the tile cell ``k`` belongs to (the nearest pose in
+    tile units).
+    """
+    tile_rows, tile_cols = sweep_tile_cells(grid, model)
+    rows, cols = _tile_centres(grid.rows, tile_rows), _tile_centres(grid.cols, tile_cols)
+    poses = []
+    for i, r in enumerate(rows):
+        for c in (cols if i % 2 == 0 else cols[::-1]):
+            poses.append(grid.index(int(r), int(c)))
+    poses = np.asarray(poses, dtype=np.int64)
+    pr, pc = np.divmod(poses, grid.cols)
+    cr, cc = grid.rows_cols()
+    distance = np.maximum(np.abs(cr.reshape(-1, 1) - pr) / tile_rows,
+                          np.abs(cc.reshape(-1, 1) - pc) / tile_cols)
+    return poses, np.argmin(distance, axis=1)
+
+
+class SweepPolicy:
+    """
+    The blind sweep a robot team starts with: tile the grid by the camera's view, boustrophedon.
+
+    Fixation ``t`` is pose ``t mod P`` of :func:`sweep_tiles` (the next pass repeats the order;
+    with inhibition of return the session moves a repeat to the nearest unvisited cell). It
+    ignores the belief. Start it with ``start_cell='policy'`` so its first pose is its own.
+    """
+
+    name = 'sweep'
+
+    def __init__(self, grid: Grid, model):
+        self.poses, self.owner = sweep_tiles(grid, model)
+
+    def select(self, belief, t, rng):
+        return np.full(np.shape(belief)[0], self.poses[t % self.poses.size], dtype=np.int64)
+
+
 def elm_policy(grid: Grid, model) -> ConvPolicy:
     """
     ELM (Najemnik & Geisler 2009): ``argmax_k sum_i B_i 2 KL_ik``, a conv policy.
@@ -103,6 +176,42 @@ def elm_policy(grid: Grid, model) -> ConvPolicy:
     policy = ConvPolicy(grid, as_observation(grid, model).elm_kernel(), action='argmax')
     policy.name = 'elm'
     return policy
+
+
+class CoveragePolicy:
+    """
+    ELM that covers the grid with the sweep's tiles while the belief is diffuse.
+
+    While no cell's belief given a target is present reaches ``peak``
+    (:data:`COVERAGE_PEAK`), the best of the sweep's
+    tile poses by ELM's score (with inhibition of return: the unvisited ones; then every other
+    cell by ELM); after that, ELM. ELM alone starts from the centre and takes the rows two
+    cells from it (5-degree cells, a 3-row view): the grid's edge rows are then left at the
+    view's nearly blind offset and are covered last. ``scores`` lets inhibition of return mask
+    visited cells.
+    """
+
+    name = 'coverage'
+
+    def __init__(self, grid: Grid, model, peak: float = COVERAGE_PEAK):
+        self.elm = elm_policy(grid, model)
+        poses, _ = sweep_tiles(grid, model)
+        self.tile = np.zeros(grid.n_cells)
+        self.tile[poses] = 1.0
+        self.peak = float(peak)
+
+    def scores(self, belief) -> np.ndarray:
+        """Return ELM's scores, those of the tile poses raised above the rest while diffuse."""
+        belief = np.atleast_2d(np.asarray(belief, dtype=float))
+        # Given a target is present: with the absent hypothesis the cells sum to 1 - P(absent).
+        belief = belief / np.maximum(belief.sum(axis=1, keepdims=True), 1e-300)
+        scores = np.array(self.elm.scores(belief), dtype=float).reshape(belief.shape)
+        diffuse = belief.max(axis=1, keepdims=True) < self.peak
+        bonus = np.abs(scores).max(axis=1, keepdims=True) + 1.0
+        return scores + diffuse * bonus * self.tile
+
+    def select(self, belief, t, rng):
+        return argmax_ties_low(self.scores(belief))
 
 
 def make_baseline(strategy: str, grid: Grid, model):
@@ -117,6 +226,10 @@ def make_baseline(strategy: str, grid: Grid, model):
         return SpiralPolicy(grid)
     if strategy == 'elm':
         return elm_policy(grid, model)
+    if strategy == 'sweep':
+        return SweepPolicy(grid, model)
+    if strategy == 'coverage':
+        return CoveragePolicy(grid, model)
     if strategy in ('greedy', 'tempered', 'switching'):
         fpoc = getattr(as_observation(grid, model), 'fpoc', None)
         if fpoc is None:

@@ -386,7 +386,7 @@ class Trainer:
                           absent_prior=cfg.absent_prior, absent_rate=cfg.absent_rate)
         return fixations_to_level(result.percent_correct, self.grid.n_cells)
 
-    def run(self, epochs: int, progress: bool = False,
+    def run(self, epochs: int, progress=False,
             callback: Callable[[dict], None] | None = None) -> list[dict]:
         """
         Train ``epochs`` more epochs; every ``eval_every`` epochs append a learning-curve row.
@@ -395,14 +395,17 @@ class Trainer:
         return (sum of the unscaled rewards of an episode, sampled policy) over the epochs since
         the previous row, and fixations to 90% correct of the argmax policy on the fixed
         evaluation set (None if never reached). ``callback(row)`` is called after each row.
-        Evaluation time is not counted in ``wall_seconds``. With ``progress`` a tqdm bar on
-        stderr shows the epoch and the mean return.
+        Evaluation time is not counted in ``wall_seconds``. ``progress`` True shows the epochs,
+        the mean return and fixations to 90% on stderr (:class:`ipomdp_gaze.progress.Progress`:
+        a bar on a terminal, a line every few seconds otherwise); or pass a ``Progress``.
         """
         cfg = self.config
         bar = None
-        if progress:
-            from tqdm import tqdm
-            bar = tqdm(total=epochs, unit='epoch', dynamic_ncols=True, disable=None)
+        if progress is True:
+            from ipomdp_gaze.progress import Progress
+            bar = Progress(epochs, 'train', 'epoch')
+        elif progress:
+            bar = progress
         returns = []
         f90_text = '-'
         start = time.perf_counter()
@@ -423,12 +426,12 @@ class Trainer:
                         callback(row)
                     start = time.perf_counter()
                 if bar is not None:
-                    bar.set_description(f'epoch {self.epoch}')
-                    bar.set_postfix_str(f'return {last_return:.3f} fix->90% {f90_text}')
+                    bar.note(f'epoch {self.epoch}, return {last_return:.3f}, '
+                             f'fix->90% {f90_text}')
                     bar.update(1)
         finally:
             self.wall_seconds += time.perf_counter() - start
-            if bar is not None:
+            if bar is not None and progress is True:
                 bar.close()
         return self.curve
 
@@ -513,21 +516,23 @@ def read_curve(path) -> list[dict]:
 
 def evaluation_block(grid: Grid, fpoc: FPOC, policy, episodes: int = 20000, seed: int = 0,
                      horizon: int | None = None, bootstrap: int = 1000,
-                     scene: dict | None = None) -> dict:
+                     scene: dict | None = None, progress=None) -> dict:
     """
     Fixations to 90% correct with a 95% bootstrap interval, as a policy file records it.
 
     Uses the same targets, noise and bootstrap draws as ``ipomdp-gaze evaluate --seed SEED``, so
     the numbers match that command's. ``scene`` holds the settings of docs/design.md section 7
     (:meth:`TrainConfig.scene`); they are recorded, and a moving target adds its tracking
-    accuracy (:func:`ipomdp_gaze.evaluation.tracking_summary`).
+    accuracy (:func:`ipomdp_gaze.evaluation.tracking_summary`). ``progress`` (``update(n)``)
+    counts the fixations simulated.
     """
     scene = dict(scene or {})
     horizon = grid.n_cells if horizon is None else int(horizon)
     motion = Motion(grid, scene.get('motion_sigma_cells', 0.0), scene.get('jump_prob', 0.0))
     result = simulate(grid, fpoc, policy, episodes, horizon, seed, motion=motion,
                       absent_prior=scene.get('absent_prior', 0.0),
-                      absent_rate=scene.get('absent_rate', 0.0))
+                      absent_rate=scene.get('absent_rate', 0.0),
+                      progress=None if progress is None else lambda t: progress.update(1))
     point, ci = fixations_to_90_ci(result.correct, grid.n_cells,
                                    np.random.default_rng([seed, 99]), bootstrap)
     block = {'episodes': int(episodes), 'seed': int(seed), 'action': policy.action,

@@ -3,7 +3,8 @@
 """
 Shared fixtures; the ROS ones run real nodes over real DDS, isolated per test run.
 
-Every run gets its own ``ROS_DOMAIN_ID`` (derived from the pytest process id, 0..101), discovery
+Every run gets its own ``ROS_DOMAIN_ID`` (1..101, reserved with a lock file so that two runs at
+once never share one: :func:`ipomdp_gaze.nodes.processes.domain_id_for`), discovery
 limited to this host and node log files in a temporary directory. Nodes under test run as
 separate processes (as a user runs them, :class:`ipomdp_gaze.nodes.processes.NodeGroup`); the
 test's own node (``probe``, an :class:`ipomdp_gaze.nodes.watch.Watch`) spins a
@@ -27,8 +28,8 @@ if os.environ.get('CI'):
 
 HAVE_RCLPY = importlib.util.find_spec('rclpy') is not None
 HAVE_ROS_MSGS = importlib.util.find_spec('std_msgs') is not None
-# The message adapters need the ROS message packages (the `ros` extra); skip them without it.
-collect_ignore = [] if HAVE_ROS_MSGS else ['test_msg_adapters.py']
+# The message adapters need the ROS message packages (the `ros` extra): without them
+# test_msg_adapters.py reports itself skipped, and an installed but broken package fails.
 REPO = Path(__file__).resolve().parents[1]
 
 

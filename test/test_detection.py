@@ -96,7 +96,8 @@ def test_camera_mode_needs_k_and_the_joint_state_of_the_image(camera_setup):
     out = loop.add_image(1.0, view)
     assert out.status == 'waiting' and out.reason.startswith('no camera_info')
     assert loop.waiting.startswith('no camera_info')
-    assert loop.set_camera(shipped_camera()) == ''
+    out = loop.set_camera(shipped_camera())
+    assert loop.mismatch == '' and 'no joint state' in out.reason
     assert 'no joint state' in loop.serve().reason
     loop.add_pose(0.9, *HEAD.angles(target))                      # another stamp
     assert 'no joint state' in loop.serve().reason
@@ -126,7 +127,8 @@ def test_camera_mode_waits_while_the_head_is_not_at_the_fixation(camera_setup):
 def test_camera_info_of_another_camera_is_warned_about(camera_setup):
     from ipomdp_gaze.head_camera import PinholeCamera
     loop = DetectorLoop(camera_setup, HEAD)
-    warning = loop.set_camera(PinholeCamera.from_fov(640, 480, 60.0))
+    loop.set_camera(PinholeCamera.from_fov(640, 480, 60.0))
+    warning = loop.mismatch
     assert '640x480 camera with a 60.0x' in warning and 'calibrated with 320x240' in warning
 
 
@@ -151,3 +153,134 @@ def test_settings_that_repeat_the_observation_file_are_accepted():
                          'cascade': 'haarcascade_frontalface_alt2.xml'})
     assert setup.grid.shape == (21, 21) and setup.fovea is not None
     assert build_setup('camera', grid=(11, 11, 5.0)).observer is not None
+
+
+def test_an_image_from_the_future_or_the_past_is_rejected_and_counted(fovea_setup):
+    loop = DetectorLoop(fovea_setup, stamp_tolerance_s=0.5, max_age_s=10.0)
+    image = SceneSet('test', **PAPER_TASK, color='rgb', seed=2).scene(0).image
+    out = loop.add_image(100.0 + 3600.0, image, now_s=100.0)         # an hour ahead
+    assert out.status == 'rejected' and 'ahead of this node' in out.reason
+    out = loop.add_image(100.0 - 60.0, image, now_s=100.0)           # a minute old
+    assert out.status == 'rejected' and 'stale' in out.reason
+    assert loop.add_image(100.3, image, now_s=100.0).status == 'idle'     # within tolerance
+    # The image that arrived while idle, stamped after the fixation, does not answer it.
+    waiting = loop.fixate(fovea_setup.grid.index(3, 3), 100.1)
+    assert waiting.status == 'waiting'
+    assert loop.add_image(100.2, image, now_s=100.2).status == 'published'
+    values = loop.values()
+    assert (values['images_received'], values['images_processed'], values['images_rejected'],
+            values['images_unused'], values['images_future'], values['images_stale'],
+            values['images_held']) == (4, 1, 2, 1, 1, 1, 0)
+
+
+def test_absurd_joint_angles_and_intrinsics_are_refused_and_counted(camera_setup):
+    from ipomdp_gaze.head_camera import PinholeCamera
+    loop = DetectorLoop(camera_setup, HEAD)
+    cam = shipped_camera()
+    for pan, tilt in ((1e308, 0.0), (0.0, -1e30), (7.0, 0.0)):
+        out = loop.add_pose(1.0, pan, tilt, now_s=1.0)
+        assert out.status == 'refused' and 'one turn' in out.reason
+    assert loop.add_pose(1.0 + 1e6, 0.0, 0.0, now_s=1.0).status == 'refused'
+    absurd = [PinholeCamera(cam.width, cam.height, 1e-300, cam.fy, cam.cx, cam.cy),
+              PinholeCamera(cam.width, cam.height, 1e300, 1e300, cam.cx, cam.cy),
+              PinholeCamera(cam.width, cam.height, cam.fx, cam.fy, 1e9, cam.cy),
+              PinholeCamera(cam.width, cam.height, cam.fx, cam.fy, cam.cx, -3.0)]
+    for camera in absurd:
+        out = loop.set_camera(camera)
+        assert out.status == 'refused' and out.reason.startswith('camera_info: ')
+    assert loop.camera is None
+    assert loop.set_camera(cam, max_side_px=100).status == 'refused'
+    assert loop.set_camera(cam).status == 'idle' and loop.camera == cam
+    values = loop.values()
+    assert (values['joint_states_received'], values['joint_states_rejected'],
+            values['camera_info_received'], values['camera_info_rejected']) == (4, 4, 6, 5)
+    assert 'camera_info' in values['last_input_rejection']
+
+
+@pytest.mark.parametrize('scale', [3, 4])
+def test_a_large_view_is_resized_to_the_model_camera_with_the_same_counts(camera_setup, scale):
+    import cv2
+    from ipomdp_gaze.detection import scaled_camera
+    cam = shipped_camera()
+    big_cam = scaled_camera(cam, cam.width * scale, cam.height * scale)
+    scene, _ = _view(1, 0)
+    target = GRID.index(*scene.cell)
+    _, view = _view(1, target)
+    big = cv2.resize(view, (big_cam.width, big_cam.height), interpolation=cv2.INTER_NEAREST)
+    loop = DetectorLoop(camera_setup, HEAD)
+    loop.set_camera(big_cam)
+    loop.fixate(target, 0.0)
+    loop.add_pose(1.0, *HEAD.angles(target), now_s=1.0)
+    out = loop.add_image(1.0, big, now_s=1.0)
+    assert out.status == 'published', out.reason
+    assert out.frame.detector_pixels == cam.width * cam.height        # the model camera's cost
+    small = cv2.resize(big, (cam.width, cam.height), interpolation=cv2.INTER_AREA)
+    want = camera_setup.observer.observe(small, cam, GRID.cell(target)).counts
+    np.testing.assert_array_equal(out.frame.counts, want)
+    assert loop.values()['images_resized'] == 1
+    # camera_info must still describe the view as sent.
+    loop.fixate(target, 2.0)
+    loop.set_camera(cam)
+    loop.add_pose(3.0, *HEAD.angles(target), now_s=3.0)
+    out = loop.add_image(3.0, big, now_s=3.0)
+    assert out.status == 'rejected' and 'camera_info says 320x240' in out.reason
+
+
+def test_no_more_than_keep_images_are_held(camera_setup):
+    loop = DetectorLoop(camera_setup, HEAD, keep=4)
+    _, view = _view(1, 0)
+    for t in range(10):                                   # idle: nothing is held
+        loop.add_image(float(t), view, now_s=float(t))
+    assert loop.values()['images_held'] == 0
+    loop.fixate(0, 10.0)                                  # waiting for camera_info
+    for t in range(10, 20):
+        loop.add_image(float(t), view, now_s=float(t))
+    values = loop.values()
+    assert values['images_held'] == 4 and values['images_unused'] == 20
+
+
+def test_a_large_fovea_image_is_resized_to_the_model_image(fovea_setup):
+    import cv2
+    image = SceneSet('test', **PAPER_TASK, color='rgb', seed=2).scene(0).image     # 420x420
+    big = cv2.resize(image, (1700, 1300), interpolation=cv2.INTER_NEAREST)
+    loop = DetectorLoop(fovea_setup)
+    cell = fovea_setup.grid.index(10, 10)
+    loop.fixate(cell, 0.0)
+    out = loop.add_image(1.0, big, now_s=1.0)
+    small = cv2.resize(big, (420, 321), interpolation=cv2.INTER_AREA)
+    fovea = fovea_for_model(fovea_setup.model, reuse_windows=False)
+    fovea.start(small)
+    want = fovea.observe(cell)
+    np.testing.assert_array_equal(out.frame.counts, want.counts)
+    assert out.frame.detector_pixels == want.detector_pixels
+    assert loop.values()['images_resized'] == 1
+    loop.fixate(cell, 2.0)
+    assert loop.add_image(3.0, cv2.resize(image, (840, 840)), now_s=3.0).status == 'published'
+    assert loop.values()['images_resized'] == 1            # twice the model's side: kept
+
+
+def test_another_opencv_version_is_a_note_and_another_cascade_is_refused(tmp_path):
+    from ipomdp_gaze.observation_file import load_observation, save_observation
+    model = load_observation('faces-420-nmpt')
+    model.meta['detector'] = {**model.meta['detector'], 'opencv': '4.5.0'}
+    path = save_observation(tmp_path / 'old.yaml', model)
+    setup = build_setup('fovea', str(path))
+    assert len(setup.notes) == 1 and "detector opencv '4.5.0'" in setup.notes[0]
+    model.meta['detector']['cascade_sha256'] = '0' * 64
+    path = save_observation(tmp_path / 'other.yaml', model)
+    with pytest.raises(ValueError, match='differs from the one the observation model'):
+        build_setup('fovea', str(path))
+
+
+def test_the_detector_logic_does_not_import_finds_driver():
+    """detection.py (core) builds its fovea without vision.search (layers only import down)."""
+    import subprocess
+    import sys
+    code = ('import sys\n'
+            'from ipomdp_gaze.detection import build_setup\n'
+            "build_setup('fovea'); build_setup('camera')\n"
+            "print('ipomdp_gaze.vision.search' in sys.modules)\n")
+    out = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                         timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == 'False'

@@ -319,7 +319,7 @@ def test_config_defaults_to_nmpt_and_round_trips_through_plain_dicts():
     assert FoveaConfig.from_dict(json.loads(json.dumps(custom.to_dict()))) == custom
     settings = Fovea(FakeDetector(), GRID, custom).settings()
     assert settings == {'grid': [21, 21], 'fovea': custom.to_dict(),
-                        'detector': {'kind': 'FakeDetector'}}
+                        'detector': {'kind': 'test_fovea:FakeDetector'}}
 
 
 @pytest.mark.parametrize('kwargs, reason', [

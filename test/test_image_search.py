@@ -247,7 +247,7 @@ def test_the_model_records_rebuild_the_haar_detector_and_the_fovea():
         'fovea': config.to_dict(), 'detector': settings})
     fovea = fovea_for_model(model)
     assert fovea.config == config and fovea.grid.shape == GRID.shape and fovea.reuse_windows
-    with pytest.raises(ValueError, match="kind 'blob'"):
+    with pytest.raises(ValueError, match="unknown detector 'blob'"):
         detector_from_settings({'kind': 'blob'})
     with pytest.raises(ValueError, match='differs from the one'):
         detector_from_settings({**settings, 'cascade_sha256': '0' * 64})

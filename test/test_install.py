@@ -383,7 +383,8 @@ def test_installed_scene_camera_and_detector_serve_a_fixation(install, ros_env, 
             and frames, 'no evidence_image from the installed detector:\n' + \
             '\n'.join(f'--- {n.name}\n{n.output()}' for n in nodes)
         counts = images.evidence_from_image(frames[0][1], grid)
-        assert np.isfinite(counts).all() and (counts >= 0).all()
+        seen = ~np.isnan(counts)             # faces-420: the windows around (10, 10), else NaN
+        assert seen[grid.index(10, 10)] and (counts[seen] >= 0).all()
     finally:
         codes = {node.name: node.stop() for node in nodes}
     assert codes == {'detector': 0, 'scene_camera': 0}, f'exit status {codes}:\n' + \

@@ -74,7 +74,12 @@ def test_setup_installs_marker_package_xml_config_launch_and_kernels(monkeypatch
     # Kernels are package data of ipomdp_gaze.policies (importlib.resources), not share/ files.
     assert 'share/ipomdp_gaze/kernels' not in installed
     assert dist.package_data == {'ipomdp_gaze.policies': ['kernels/*.yaml'],
-                                 'ipomdp_gaze': ['models/*.yaml']}
+                                 'ipomdp_gaze': ['models/*.yaml', 'data/*.csv']}
+    # The shipped detectors are entry points too, pointing where the factory finds them.
+    from ipomdp_gaze.vision.detectors import BUILTIN, ENTRY_POINT_GROUP
+    declared = dict(line.replace(' ', '').split('=')
+                    for line in dist.entry_points[ENTRY_POINT_GROUP])
+    assert declared == BUILTIN
     assert list((ROOT / 'ipomdp_gaze' / 'policies').glob('kernels/*.yaml'))
     packages = set(dist.packages)
     assert {'ipomdp_gaze', 'ipomdp_gaze.policies', 'ipomdp_gaze.msg_adapters',

@@ -142,8 +142,8 @@ def small_scenes():
 
 
 def test_tallying_views_learns_a_camera_fpoc(small_scenes):
-    tallies = tally_pan_tilt_scenes(small_scenes, range(4), {}, 10, processes=1)
-    assert tallies.images == 4 and tallies.fixations == 4 * 25
+    tallies = tally_pan_tilt_scenes(small_scenes, range(6), {}, 10, processes=1)
+    assert tallies.images == 6 and tallies.fixations == 6 * 25
     model = count_model(tallies, SMALL.grid, pool_radius=0.0, min_tallies=0)
     hit = 1 - model.p_target[:, :, 0]
     false_alarm = 1 - model.p_null[:, :, 0]

@@ -1,12 +1,13 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """``ipomdp-gaze reproduce``: its runs split over processes give the serial run's numbers."""
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import replace
 import json
 
+from ipomdp_gaze import pieces
 from ipomdp_gaze.cli import main as cli_main
 from ipomdp_gaze.commands import reproduce
+from ipomdp_gaze.executor import LocalExecutor
 from ipomdp_gaze.fpoc import make_fpoc
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.policies.baselines import make_baseline
@@ -18,9 +19,9 @@ GRID, FPOC = Grid(4, 4, 0.42), make_fpoc('human')
 
 
 def test_pieces_on_two_processes_give_the_serial_matrices_and_intervals():
-    serial = reproduce.Runner(GRID, FPOC, 60, 5, 50)
-    with ProcessPoolExecutor(2) as pool:
-        split = reproduce.Runner(GRID, FPOC, 60, 5, 50, pool)
+    serial = pieces.Runner(GRID, FPOC, 60, 5, 50)
+    with LocalExecutor(2) as pool:
+        split = pieces.Runner(GRID, FPOC, 60, 5, 50, pool)
         for runner, chunk in ((serial, None), (split, 7)):
             runner.submit('elm', make_baseline('elm', GRID, FPOC), horizon=12, chunk=chunk)
             runner.submit('greedy', make_baseline('greedy', GRID, FPOC), 40, 12, chunk)
@@ -36,7 +37,7 @@ def test_pieces_on_two_processes_give_the_serial_matrices_and_intervals():
 
 
 def test_a_run_cut_before_it_is_reliably_at_90_percent_is_refused():
-    runner = reproduce.Runner(GRID, FPOC, 200, 0, 20)
+    runner = pieces.Runner(GRID, FPOC, 200, 0, 20)
     runner.submit('random', make_baseline('random', GRID, FPOC), horizon=3)
     runner.collect()
     with pytest.raises(RuntimeError, match='raise the horizon'):
@@ -45,32 +46,32 @@ def test_a_run_cut_before_it_is_reliably_at_90_percent_is_refused():
 
 def test_cached_pieces_are_reused_only_for_the_same_inputs(tmp_path):
     def run(name, cache, recipe=None, seed=2):
-        runner = reproduce.Runner(GRID, FPOC, 30, seed, 20, cache=cache)
+        runner = pieces.Runner(GRID, FPOC, 30, seed, 20, cache=cache)
         runner.submit('p', make_baseline(name, GRID, FPOC), horizon=10, chunk=10,
                       recipe=('baseline', name) if recipe is None else recipe)
         runner.collect()
         return runner.correct['p'], runner.map_prob['p']
 
-    first = reproduce.PieceCache(tmp_path)
+    first = pieces.PieceCache(tmp_path)
     fresh = run('elm', first)
     assert first.hits == 0 and len(list(tmp_path.glob('*.bin'))) == 3
     whole = simulate(GRID, FPOC, make_baseline('elm', GRID, FPOC), 30, 10, 2)
     np.testing.assert_array_equal(fresh[0], whole.correct)
     np.testing.assert_array_equal(fresh[1], whole.map_prob)
-    again = reproduce.PieceCache(tmp_path)
+    again = pieces.PieceCache(tmp_path)
     cached = run('elm', again)
     assert again.hits == 3 and cached[1].dtype == np.float64
     for kept, new in zip(cached, fresh):
         np.testing.assert_array_equal(kept, new)
-    other = reproduce.PieceCache(tmp_path)
+    other = pieces.PieceCache(tmp_path)
     for kept, new in zip(run('map', other), run('map', None)):
         np.testing.assert_array_equal(kept, new)
     run('elm', other, seed=3)
     assert other.hits == 0                 # another policy, another seed: simulated again
-    assert reproduce.PieceCache(tmp_path).key(None, GRID, FPOC, np.zeros(3), 4, 0, (0, 3)) is None
+    assert pieces.PieceCache(tmp_path).key(None, GRID, FPOC, np.zeros(3), 4, 0, (0, 3)) is None
     for path in tmp_path.glob('*.bin'):                     # damaged pieces are simulated again
         path.write_bytes(path.read_bytes()[:-1])
-    damaged = reproduce.PieceCache(tmp_path)
+    damaged = pieces.PieceCache(tmp_path)
     for kept, new in zip(run('elm', damaged), fresh):
         np.testing.assert_array_equal(kept, new)
     assert damaged.hits == 0
@@ -79,13 +80,13 @@ def test_cached_pieces_are_reused_only_for_the_same_inputs(tmp_path):
 def test_a_piece_file_of_another_layout_is_simulated_again(tmp_path):
     """A file with only the packed bits (no ``map_prob``), whatever its length, is not read."""
     def run(cache):
-        runner = reproduce.Runner(GRID, FPOC, 20, 1, 20, cache=cache)
+        runner = pieces.Runner(GRID, FPOC, 20, 1, 20, cache=cache)
         runner.submit('elm', make_baseline('elm', GRID, FPOC), horizon=8,
                       recipe=('baseline', 'elm'))
         runner.collect()
         return runner.correct['elm'], runner.map_prob['elm']
 
-    fresh = run(reproduce.PieceCache(tmp_path))
+    fresh = run(pieces.PieceCache(tmp_path))
     (path,) = tmp_path.glob('*.bin')
     head, _, body = path.read_bytes().partition(b'\n')
     meta = json.loads(head)
@@ -95,7 +96,7 @@ def test_a_piece_file_of_another_layout_is_simulated_again(tmp_path):
                                                              if k != 'layout'}
         for tail in (bits, body):
             path.write_bytes(json.dumps(foreign).encode() + b'\n' + tail)
-            cache = reproduce.PieceCache(tmp_path)
+            cache = pieces.PieceCache(tmp_path)
             for kept, new in zip(run(cache), fresh):
                 np.testing.assert_array_equal(kept, new)
             assert cache.hits == 0
@@ -110,15 +111,15 @@ def test_a_longer_run_reuses_the_pieces_of_a_shorter_one(tmp_path):
     stochastic policy, each piece's own stream).
     """
     def run(episodes, cache):
-        runner = reproduce.Runner(GRID, FPOC, episodes, 4, 20, cache=cache)
+        runner = pieces.Runner(GRID, FPOC, episodes, 4, 20, cache=cache)
         for name in ('elm', 'random'):
             runner.submit(name, make_baseline(name, GRID, FPOC), horizon=9, chunk=10,
                           recipe=('baseline', name))
         runner.collect()
         return runner
 
-    short = run(30, reproduce.PieceCache(tmp_path))
-    cache = reproduce.PieceCache(tmp_path)
+    short = run(30, pieces.PieceCache(tmp_path))
+    cache = pieces.PieceCache(tmp_path)
     long = run(60, cache)
     assert cache.hits == 2 * 3 and len(list(tmp_path.glob('*.bin'))) == 2 * 6
     alone = run(60, None)
@@ -127,8 +128,8 @@ def test_a_longer_run_reuses_the_pieces_of_a_shorter_one(tmp_path):
             kept, fresh = getattr(long, matrices)[name], getattr(alone, matrices)[name]
             np.testing.assert_array_equal(kept[:30], getattr(short, matrices)[name])
             np.testing.assert_array_equal(kept, fresh)
-    other = reproduce.PieceCache(tmp_path)
-    runner = reproduce.Runner(GRID, FPOC, 60, 4, 20, cache=other)
+    other = pieces.PieceCache(tmp_path)
+    runner = pieces.Runner(GRID, FPOC, 60, 4, 20, cache=other)
     runner.submit('elm', make_baseline('elm', GRID, FPOC), horizon=9, chunk=20,
                   recipe=('baseline', 'elm'))
     runner.collect()
@@ -182,11 +183,11 @@ def test_the_report_is_the_same_on_one_or_two_processes_and_from_the_cache(tmp_p
 def test_rao_blackwellised_runs_keep_the_searches_and_the_curve_with_less_variance(tmp_path):
     """Same fixations and correctness; E[max B'] has the mean of max B and no more variance."""
     greedy = make_baseline('greedy', GRID, FPOC)
-    cache = reproduce.PieceCache(tmp_path)
-    plain = reproduce.Runner(GRID, FPOC, 3000, 6, 20, cache=cache)
+    cache = pieces.PieceCache(tmp_path)
+    plain = pieces.Runner(GRID, FPOC, 3000, 6, 20, cache=cache)
     plain.submit('greedy', greedy, horizon=5, chunk=1000, recipe=('baseline', 'greedy'))
     plain.collect()
-    smooth = reproduce.Runner(GRID, FPOC, 3000, 6, 20, cache=cache, rao_blackwell=True)
+    smooth = pieces.Runner(GRID, FPOC, 3000, 6, 20, cache=cache, rao_blackwell=True)
     smooth.submit('greedy', greedy, horizon=5, chunk=1000, recipe=('baseline', 'greedy'))
     smooth.collect()
     assert cache.hits == 0                      # a Rao-Blackwellised piece has its own key
@@ -201,7 +202,7 @@ def test_rao_blackwellised_runs_keep_the_searches_and_the_curve_with_less_varian
     error = diff.std(axis=0) / np.sqrt(diff.shape[0])
     assert np.all(np.abs(diff.mean(axis=0)) < 5 * error)
     assert np.all(rb.var(axis=0) < raw.var(axis=0))
-    again = reproduce.Runner(GRID, FPOC, 3000, 6, 20, cache=cache, rao_blackwell=True)
+    again = pieces.Runner(GRID, FPOC, 3000, 6, 20, cache=cache, rao_blackwell=True)
     again.submit('greedy', greedy, horizon=5, chunk=1000, recipe=('baseline', 'greedy'))
     again.collect()
     assert cache.hits == 3

@@ -4,8 +4,9 @@
 Fault injection: nodes killed mid-search and restarted, evidence that stops, a signal race.
 
 - The camera is killed (SIGKILL) mid-search. The controller keeps its belief, reports the stall
-  in ``/diagnostics`` (WARN, ``no usable evidence for X s``) and its log, re-sends its target
-  and uses little CPU (``/proc/<pid>/stat`` over 5 s). A new camera gets the target, and its
+  in ``/diagnostics`` (WARN, ``no usable evidence for X s``) and its log, and re-sends its
+  target (its CPU use meanwhile is a benchmark, ``bench/bench_ros_idle.py``, not a test
+  threshold). A new camera gets the target, and its
   first frame updates the kept belief (checked against Bayes' rule); the search completes on
   the camera's target.
 - The controller is killed and a new one started: the camera keeps serving, and the new
@@ -23,7 +24,6 @@ import textwrap
 from conftest import HAVE_RCLPY, REPO, wait_for
 import numpy as np
 import pytest
-from robust_support import cpu_fraction
 
 pytestmark = [pytest.mark.ros,
               pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
@@ -31,7 +31,7 @@ pytestmark = [pytest.mark.ros,
 TARGET = (2, 8)
 DPRIME = 2.5                       # a weak camera: a search takes several fixations
 STALL_S = 1.0
-CPU_WINDOW_S = 5.0
+STALLED_RESENDS = 5                # re-sends (0.3 s apart) seen while no evidence comes
 TASK = ['-p', 'grid.rows:=11', '-p', 'grid.cols:=11', '-p', 'grid.spacing_deg:=5.0',
         '-p', f'fpoc.dprime:={DPRIME}', '-p', 'fpoc.half_width_deg:=10.0',
         '-p', 'fpoc.half_height_deg:=10.0']
@@ -88,6 +88,13 @@ def _posterior(belief, frame, fixation, grid) -> np.ndarray:
     return np.exp(log_b - np.logaddexp.reduce(log_b))
 
 
+def _matched(probe, topic: str) -> bool:
+    """Whether the probe's subscriptions to ``topic`` have matched every publisher in the graph."""
+    publishers = probe.node.count_publishers(f'/{topic}')
+    subs = [s for s in probe.node.subscriptions if s.topic_name == f'/{topic}']
+    return bool(subs) and all(s.get_publisher_count() >= publishers for s in subs)
+
+
 def _mid_search(probe, watch):
     """Reset; wait for a search with a few applied frames that has not found the target."""
     for _ in range(5):
@@ -110,22 +117,24 @@ def test_camera_killed_mid_search_then_restarted(nodes, probe, watch):
     _mid_search(probe, watch)
 
     nodes.kill(camera)
-    wait_for(lambda: False, 0.3)                 # frames in flight arrive or are lost
+    watch.diag.wait_fresh()
+    killed = int(watch.diag.values['pan_tilt_resends'])
+    # A re-send after the kill: the frames in flight then have arrived or are lost.
+    assert wait_for(lambda: int(watch.diag.values['pan_tilt_resends']) > killed, 30)
     kept_beliefs = len(watch.beliefs)
     kept = watch.belief()
     before = watch.diag.wait_fresh()
     resends = int(watch.diag.values['pan_tilt_resends'])
-    # Evidence has stopped: low CPU, then a warning in /diagnostics and in the log.
-    cpu = cpu_fraction(controller.proc.pid, CPU_WINDOW_S)
+    # Evidence has stopped: the target is re-sent, and a warning is in /diagnostics and the log.
+    assert wait_for(lambda: int(watch.diag.values['pan_tilt_resends']) >= resends
+                    + STALLED_RESENDS and watch.diag.message.startswith('no usable'), 30), \
+        (watch.diag.values, watch.diag.message)
     stalled = watch.diag.wait_fresh()
-    print(f'\ncontroller CPU with no evidence: {cpu:.1%} of a core over {CPU_WINDOW_S} s')
-    assert cpu < 0.2
     assert stalled['applied'] == before['applied'] and len(watch.beliefs) == kept_beliefs
     assert watch.diag.level == 1, watch.diag.message                 # WARN
     assert watch.diag.message.startswith('no usable evidence for '), watch.diag.message
     waited = float(watch.diag.message.split()[4])
-    assert waited >= CPU_WINDOW_S
-    assert int(watch.diag.values['pan_tilt_resends']) >= resends + 5
+    assert waited >= STALL_S
     assert 'no usable evidence for' in controller.output()
     assert controller.running
 
@@ -138,9 +147,13 @@ def test_camera_killed_mid_search_then_restarted(nodes, probe, watch):
     graph = probe.node
     publishers = graph.count_publishers('evidence'), graph.count_publishers('joint_states')
     camera = nodes.start('camera', CAMERA_ARGS)
+    # The new camera is in the graph (the killed one may still be), and the probe's own
+    # subscriptions have matched every publisher there (DDS matching, which follows the graph),
+    # so the probe records what the new camera sends from now on.
     assert wait_for(lambda: graph.count_publishers('evidence') > publishers[0] and
-                    graph.count_publishers('joint_states') > publishers[1], 30), camera.output()
-    wait_for(lambda: False, 0.5)                 # let the probe's side of the match settle
+                    graph.count_publishers('joint_states') > publishers[1] and
+                    _matched(probe, 'evidence') and _matched(probe, 'joint_states'), 30), \
+        camera.output()
     n_frames, n_poses = len(watch.frames), len(watch.poses)
     assert len(watch.beliefs) == kept_beliefs
     assert probe.enable(True).success
@@ -203,8 +216,10 @@ RACE = textwrap.dedent("""
 
 
 def test_spin_returns_when_the_signal_wakes_the_executor_before_shutdown(ros_env):
+    # Before the fix the process never returned (the subprocess timeout ends it, and fails the
+    # test); how soon it returns is not a test threshold.
     proc = subprocess.run([sys.executable, '-c', RACE], env=ros_env, cwd=REPO, timeout=60,
                           capture_output=True, text=True)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     seconds = float(proc.stdout.split()[-2])
-    assert math.isfinite(seconds) and seconds < 1.3 + 4 * 0.25 + 5.0
+    assert math.isfinite(seconds)

@@ -27,7 +27,7 @@ class Detector:
         from ipomdp_gaze.nodes.watch import LATCHED
         from ipomdp_gaze.observation_file import load_observation
         from std_msgs.msg import Float32MultiArray, Int32MultiArray
-        self.model = load_observation('faces-420-nmpt')     # the config's model
+        self.model = load_observation('faces-420-nmpt')     # a model without the scan
         self.grid = self.model.grid
         self.probe = probe
         self.fixations = probe.record(Int32MultiArray, 'fixation', LATCHED)
@@ -36,6 +36,7 @@ class Detector:
         self.evidence = probe.publisher(Float32MultiArray, 'evidence', 10)
         self.proc = nodes.start('controller', [
             '--params-file', config_path('faces_fovea_controller.yaml'),
+            '-p', 'observation.file:=faces-420-nmpt', '-p', "policy.file:=''",
             '-p', 'retry_period_s:=0.3', '-p', 'policy.name:=map',
             '-p', 'diagnostics_period_s:=0.2', '-p', 'evidence_queue_depth:=10'])
         assert wait_for(lambda: self.fixations and self.evidence.get_subscription_count() > 0,
@@ -43,7 +44,7 @@ class Detector:
 
     def fixation(self) -> int:
         from ipomdp_gaze.msg_adapters import grid_arrays
-        return grid_arrays.cell_from_row_col(self.fixations[-1][1], self.grid)
+        return grid_arrays.read_fixation(self.fixations[-1][1], self.grid)[0]
 
     def belief(self) -> np.ndarray:
         return np.asarray(self.beliefs[-1][1].data, dtype=np.float64)
@@ -62,7 +63,8 @@ def test_fixation_is_published_with_every_target_and_every_resend(detector):
     assert detector.fixation() == detector.grid.center_index
     n = len(detector.fixations)
     assert wait_for(lambda: len(detector.fixations) >= n + 3, 20)     # re-sent every 0.3 s
-    assert {tuple(m.data) for _, m in detector.fixations[n:]} == {(10, 10)}
+    sent = {tuple(m.data) for _, m in detector.fixations[n:]}
+    assert len(sent) == 1 and next(iter(sent))[:2] == (10, 10)    # [row, col, search_id]
     assert 'observation.model is counts: the fpoc.* parameters are ignored' in \
         detector.proc.output()
 

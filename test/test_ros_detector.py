@@ -137,9 +137,12 @@ def test_an_image_taken_before_the_fixation_does_not_serve_it(fovea):
     early = fovea.now()
     fovea.fixate(fovea.grid, 0)
     n = len(fovea.frames)
-    processed = int(fovea.values()['images_processed'])
+    before = fovea.values()
     fovea.image.publish(images.camera_image(scene.image, early))
-    values = fovea.wait_values(images_processed=processed)
+    # Wait until the node has taken the image (a counter that moves), then check it unused.
+    values = fovea.wait_values(images_received=int(before['images_received']) + 1)
+    assert values['images_processed'] == before['images_processed']
+    assert int(values['images_unused']) == int(before['images_unused']) + 1
     assert values['waiting_for_image'] == 'true' and len(fovea.frames) == n
     counts, _ = fovea.frame_after(
         lambda: fovea.image.publish(images.camera_image(scene.image, fovea.now())))
@@ -188,7 +191,9 @@ def test_malformed_images_are_rejected_with_the_reason_and_the_node_keeps_servin
     assert any(level == b'\x01' or level == 1 for level, _, _ in fovea.status)   # WARN
     counts, _ = fovea.frame_after(
         lambda: fovea.image.publish(images.camera_image(_scene(4).image, fovea.now())))
-    assert np.isfinite(counts).all()
+    seen = ~np.isnan(counts)             # the fovea's windows around (4, 4): counts, else NaN
+    assert seen[fovea.grid.index(4, 4)] and np.all(counts[seen] >= 0)
+    assert np.all(counts[seen] == np.floor(counts[seen]))
 
 
 def _pose_frame(camera, scene, head_cell, stamp, info=True):
@@ -259,3 +264,40 @@ def test_settings_that_contradict_the_observation_file_are_refused(probe, nodes,
     result = probe.set_parameters('fov/' + NODE, {'observation.file': 'faces-pan-tilt'})[0]
     assert not result.successful and 'calibrated with a pan_tilt view' in result.reason
     assert probe.set_parameters('fov/' + NODE, {'detector.scale_factor': 1.1})[0].successful
+
+
+def test_an_absurd_joint_angle_is_refused_and_counted_and_the_node_lives(camera):
+    """The fault of issue 26: pan = 1e308 under the stamp of a valid image, a fixation waiting."""
+    from ipomdp_gaze.head import PanTiltMap
+    from ipomdp_gaze.msg_adapters import images, joints
+    from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, SceneGeometry, shipped_camera
+    from sensor_msgs.msg import JointState
+    grid = camera.grid
+    head = PanTiltMap(grid)
+    scene = PanTiltSceneSet('test', SceneGeometry(grid, shipped_camera()), seed=5).scene(0)
+    cell = grid.index(*scene.cell)
+    camera.fixate(grid, cell)
+    before = camera.wait_values()
+    n = len(camera.frames)
+    stamp = camera.now()
+    view = SceneGeometry(grid, shipped_camera()).render(scene.image, scene.cell)
+    camera.camera_info.publish(images.camera_info(shipped_camera(), stamp))
+    camera.image.publish(images.camera_image(view, stamp))
+    absurd = joints.joint_state(head, cell, stamp)
+    absurd.position = [1e308, 0.0]
+    camera.joint_states.publish(absurd)
+    after = camera.wait_values(
+        joint_states_rejected=int(before['joint_states_rejected']) + 1)
+    reason = after['last_input_rejection']
+    assert '1e+308' in reason and 'one turn' in reason
+    assert camera.proc.running and len(camera.frames) == n
+    assert after['waiting_for_image'] == 'true' and after['callback_errors'] == '0'
+    # Joint states of other joints are not the head's: neither used nor refused.
+    camera.joint_states.publish(JointState(name=['wheel'], position=[1e308]))
+    # The valid joint state of the same stamp then serves the waiting fixation.
+    counts, got = camera.frame_after(
+        lambda: camera.joint_states.publish(joints.joint_state(head, cell, stamp)))
+    assert got == stamp and counts[cell] > 0
+    final = camera.wait_values()
+    assert final['joint_states_rejected'] == after['joint_states_rejected']
+    assert 'ignored a message' in camera.proc.output()

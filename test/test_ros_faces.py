@@ -28,6 +28,18 @@ VERDICT = re.compile(r'^the scene camera put the face centre in cell \((\d+), (\
                      r'(right|wrong)$', re.M)
 
 
+def find_path(seed: int) -> tuple:
+    """Return the fixations `find` makes on the scene camera's fixed scene of ``seed``."""
+    from ipomdp_gaze.observation_file import load_observation
+    from ipomdp_gaze.policies.registry import build_policy
+    from ipomdp_gaze.vision.scenes import SceneSet
+    from ipomdp_gaze.vision.search import FIND_SETTINGS, fovea_for_model, search_image
+    model = load_observation('faces-420')
+    scene = SceneSet('test', 420, (60, 140), model.grid.shape, color='rgb', seed=seed).scene(0)
+    policy = build_policy('learned', model.grid, model, file='faces-420-infomax')
+    return search_image(scene.image, fovea_for_model(model), model, policy, FIND_SETTINGS).path
+
+
 @pytest.mark.parametrize('options, mode, where', [
     (['--fovea', '--seed', '0'], 'fovea', r'pixel \( *\d+\.\d, +\d+\.\d\)'),
     (['--fovea', '--seed', '2'], 'fovea', r'pixel \( *\d+\.\d, +\d+\.\d\)'),
@@ -50,13 +62,20 @@ def test_three_nodes_find_the_face_and_stop(ros_env, options, mode, where):
     assert fixations and found and verdict, out
     assert [int(f[0]) for f in fixations] == list(range(1, len(fixations) + 1))
     assert int(found.group(5)) == len(fixations)
-    centre = '(10, 10)' if mode == 'fovea' else '(5, 5)'
-    assert f'({fixations[0][1]}, {fixations[0][2]})' == centre       # the first: the centre
+    looked = [(int(f[1]), int(f[2])) for f in fixations]
+    if mode == 'fovea':             # the scan, then exactly find's fixations on this image
+        assert 'scan: the whole image once  ->  most likely' in out
+        assert looked == list(find_path(int(options[-1])))
+    else:
+        assert looked[0] == (5, 5)                                     # the first: the centre
     assert all(re.fullmatch(where, f[3].strip()) for f in fixations), fixations
     assert re.fullmatch(where, found.group(3))
-    assert (fixations[-1][4], fixations[-1][5]) == found.group(1, 2)
-    truth = int(verdict.group(1)), int(verdict.group(2))
+    # The answer: the last most likely cell, or with search.found_radius (the pan/tilt config:
+    # 1) the centre of the most likely 3x3 square, within one cell of it.
+    last = int(fixations[-1][4]), int(fixations[-1][5])
     answer = int(found.group(1)), int(found.group(2))
+    assert max(abs(last[0] - answer[0]), abs(last[1] - answer[1])) <= (mode == 'camera')
+    truth = int(verdict.group(1)), int(verdict.group(2))
     assert max(abs(truth[0] - answer[0]), abs(truth[1] - answer[1])) <= 1
     assert verdict.group(3) == 'right'
     assert 'stopped all 3 nodes (scene_camera exit status 0, detector exit status 0, ' \
@@ -78,4 +97,20 @@ def test_without_a_confident_cell_the_demo_answers_with_the_most_likely_one(ros_
                         r'after 4 fixations$', out, re.M)
     assert gave_up and float(gave_up.group(3)) < 0.999, out
     assert VERDICT.search(out) and 'found:' not in out
+    assert 'stopped all 3 nodes' in out and node_processes(domain) == []
+
+
+def test_on_a_scene_without_a_face_the_controller_says_absent(ros_env):
+    domain = int(ros_env['ROS_DOMAIN_ID'])
+    run = subprocess.run(
+        [sys.executable, '-m', 'ipomdp_gaze.cli', 'demo', '--scene', 'faces', '--empty',
+         '--seed', '0', '--domain-id', str(domain)], cwd=REPO, env=ros_env,
+        capture_output=True, text=True, timeout=180)
+    out = run.stdout
+    assert run.returncode == 0, out + run.stderr
+    absent = re.search(r'^absent: nobody is here, probability (\d\.\d+), after (\d+) '
+                       r'fixations$', out, re.M)
+    assert absent and 'found:' not in out, out
+    assert int(absent.group(2)) == len(FIXATION.findall(out))
+    assert 'the scene camera showed a scene with nobody in it: that is right' in out
     assert 'stopped all 3 nodes' in out and node_processes(domain) == []

@@ -243,8 +243,10 @@ def test_bad_parameters_raise_clear_errors(kwargs, match):
 def test_unknown_background_and_colour():
     with pytest.raises(ValueError, match='unknown background'):
         scenes.load_background('astronaut')
+    with pytest.raises(ValueError, match='unknown background'):
+        scenes.load_background('camera')          # holds a face: a real photo, not a background
     with pytest.raises(ValueError, match='unknown color'):
-        scenes.load_background('camera', 'grey')
+        scenes.load_background('grass', 'grey')
 
 
 @pytest.mark.parametrize('color', ['gray', 'rgb'])

@@ -12,6 +12,7 @@ returns carry the message of :class:`ipomdp_gaze.session.SearchSettings`. The no
 """
 from __future__ import annotations
 
+from contextlib import contextmanager
 import json
 import subprocess
 import sys
@@ -61,32 +62,41 @@ def test_the_cli_prints_the_settings_message_in_one_line(flag, text, _param, _ty
         assert 'Traceback' not in out.stderr
 
 
-@pytest.mark.ros
-@pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')
-def test_the_node_refuses_the_same_values_with_the_same_message(ros_env):
+@contextmanager
+def controller_node(ros_env, overrides=None):
+    """Run a ``gaze_controller`` in this process, on its own context, with these overrides."""
     import rclpy
     from rclpy.parameter import Parameter
     from ipomdp_gaze.nodes.controller import GazeControllerNode
     ctx = rclpy.Context()
     rclpy.init(context=ctx, domain_id=int(ros_env['ROS_DOMAIN_ID']), args=[])
     try:
-        node = GazeControllerNode(context=ctx)
+        params = [Parameter(name, value=value) for name, value in (overrides or {}).items()]
+        node = GazeControllerNode(context=ctx, parameter_overrides=params)
         try:
-            for _flag, _text, param, type_name, field, value in BAD:
-                before = node.get_parameter(param).value
-                result = node.set_parameters([Parameter(
-                    param, getattr(Parameter.Type, type_name), value)])[0]
-                assert not result.successful
-                assert message(field, value) in result.reason, (param, result.reason)
-                assert node.get_parameter(param).value == before
-                assert node.core.settings == SearchSettings.from_parameters(
-                    {p: node.get_parameter(p).value for p in
-                     ('confidence', 'search.max_fixations', 'absent.prior',
-                      'search.repeat_weight', 'search.inhibit_return')})
+            yield node
         finally:
             node.destroy_node()
     finally:
         rclpy.try_shutdown(context=ctx)
+
+
+@pytest.mark.ros
+@pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')
+def test_the_node_refuses_the_same_values_with_the_same_message(ros_env):
+    from rclpy.parameter import Parameter
+    with controller_node(ros_env) as node:
+        for _flag, _text, param, type_name, field, value in BAD:
+            before = node.get_parameter(param).value
+            result = node.set_parameters([Parameter(
+                param, getattr(Parameter.Type, type_name), value)])[0]
+            assert not result.successful
+            assert message(field, value) in result.reason, (param, result.reason)
+            assert node.get_parameter(param).value == before
+            assert node.core.settings == SearchSettings.from_parameters(
+                {p: node.get_parameter(p).value for p in
+                 ('confidence', 'search.max_fixations', 'absent.prior',
+                  'search.repeat_weight', 'search.inhibit_return')})
 
 
 @pytest.mark.ros
@@ -97,37 +107,17 @@ def test_the_node_refuses_the_same_values_with_the_same_message(ros_env):
     ({}, 'elm', 'elm'),
 ])
 def test_policy_file_alone_selects_learned_at_start_up(ros_env, overrides, expected, policy):
-    import rclpy
-    from rclpy.parameter import Parameter
-    from ipomdp_gaze.nodes.controller import GazeControllerNode
-    ctx = rclpy.Context()
-    rclpy.init(context=ctx, domain_id=int(ros_env['ROS_DOMAIN_ID']), args=[])
-    try:
-        params = [Parameter(name, value=value) for name, value in overrides.items()]
-        node = GazeControllerNode(context=ctx, parameter_overrides=params)
-        try:
-            assert node.get_parameter('policy.name').value == expected
-            assert node.core.policy.name == policy
-        finally:
-            node.destroy_node()
-    finally:
-        rclpy.try_shutdown(context=ctx)
+    with controller_node(ros_env, overrides) as node:
+        assert node.get_parameter('policy.name').value == expected
+        assert node.core.policy.name == policy
 
 
 @pytest.mark.ros
 @pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')
 def test_a_missing_policy_file_alone_is_refused_at_start_up(ros_env):
-    import rclpy
-    from rclpy.parameter import Parameter
-    from ipomdp_gaze.nodes.controller import GazeControllerNode
-    ctx = rclpy.Context()
-    rclpy.init(context=ctx, domain_id=int(ros_env['ROS_DOMAIN_ID']), args=[])
-    try:
-        with pytest.raises(Exception, match='nothere.yaml'):
-            GazeControllerNode(context=ctx, parameter_overrides=[
-                Parameter('policy.file', value='nothere.yaml')])
-    finally:
-        rclpy.try_shutdown(context=ctx)
+    with pytest.raises(Exception, match='nothere.yaml'):
+        with controller_node(ros_env, {'policy.file': 'nothere.yaml'}):
+            pass
 
 
 def test_evaluate_scenes_runs_the_pan_tilt_task_and_writes_json(tmp_path):
@@ -137,15 +127,20 @@ def test_evaluate_scenes_runs_the_pan_tilt_task_and_writes_json(tmp_path):
     assert 'pan-tilt (2 scenes with a face): right' in out.stdout
     record = json.loads((tmp_path / 'pt.json').read_text())
     assert record['settings']['search.max_fixations'] == 6
-    assert record['settings']['search.repeat_weight'] == 0.1      # the shipped config's
-    scenes = record['scenes']
+    assert record['settings']['search.repeat_weight'] == 0.3      # the shipped config's
+    assert record['settings']['search.found_radius'] == 1
+    scenes = record['scenes']['coverage']
     assert [s['index'] for s in scenes] == [0, 1]
     for s in scenes:
         assert 1 <= s['fixations'] <= 6 and len(s['path']) == s['fixations']
         assert s['path'][0] == 60                                  # the centre cell first
-        assert s['decision'] in ('found', 'gave_up')
-        assert s['right'] == (max(abs(a - b) for a, b in zip(s['cell'], s['face_cell'])) <= 1)
+        assert s['decision'] in ('found', 'absent')                # decided at the deadline
+        assert s['right'] == (s['decision'] == 'found' and max(
+            abs(a - b) for a, b in zip(s['cell'], s['face_cell'])) <= 1)
         assert s['head_travel_deg'] >= 5.0 * (s['fixations'] - 1) - 1e-9
+        # A stopped search keeps its answer: the MAP after its last fixation onwards is it.
+        assert len(s['map_right']) == 20 and set(s['map_right'][s['fixations'] - 1:]) == \
+            {s['right']}
 
 
 def test_find_with_an_absent_prior_says_absent_on_a_face_free_photo(tmp_path):
@@ -158,3 +153,23 @@ def test_find_with_an_absent_prior_says_absent_on_a_face_free_photo(tmp_path):
     entry = json.loads((tmp_path / 'o.json').read_text())['images'][0]
     assert entry['decision'] == entry['stop'] == 'absent'
     assert entry['absent_probability'] >= 0.99 and 'decision=absent' in out.stdout
+
+
+def test_find_saves_each_images_event_log(tmp_path):
+    import cv2
+    from skimage import data
+    path = tmp_path / 'astronaut.png'
+    cv2.imwrite(str(path), cv2.cvtColor(data.astronaut(), cv2.COLOR_RGB2BGR))
+    out = cli('find', str(path), '--log', str(tmp_path / 'log.jsonl'), '--json',
+              str(tmp_path / 'o.json'))
+    assert out.returncode == 0, out.stderr
+    entry = json.loads((tmp_path / 'o.json').read_text())['images'][0]
+    lines = (tmp_path / 'log.jsonl').read_text().splitlines()
+    assert len(lines) == 1
+    events = json.loads(lines[0])['events']
+    assert [e['event'] for e in events[:3]] == ['reset', 'scan', 'start']
+    frames = [e for e in events if e['event'] == 'frame']
+    assert len(frames) == entry['fixations']
+    assert frames[-1]['decision'] == entry['decision']
+    assert frames[-1]['belief']['map_cell'] == entry['cell']
+    assert events[0]['settings']['confidence'] == 0.99

@@ -14,10 +14,18 @@ scenes spanning the pan/tilt grid are viewed through the scene camera's geometry
 head pose, the detector runs on each whole view and its detections are binned to pan/tilt
 cells, exactly as the ``scene_camera`` and ``foveal_detector`` nodes do. The file records no
 wall time, so running the same command again writes the same file.
+
+**Any detector.** ``--detector KIND`` (``haar``, ``yunet``, an ``ipomdp_gaze.detectors`` entry
+point or ``package.module:Factory``, whose code then runs) with ``--detector-option NAME=VALUE``
+for its own settings; the file records the detector's settings and fingerprint. ``--cells``
+says what a cell's observation is: ``counts`` (the default), ``score_bins`` (the cell's best
+score in K - 1 bins whose edges are chosen here, on the first ``--edge-images`` training images
+or scenes, and recorded) or ``threshold`` (detections scoring at least ``--threshold``).
 """
 from __future__ import annotations
 
 import argparse
+import dataclasses
 from pathlib import Path
 import time
 
@@ -25,6 +33,7 @@ from ipomdp_gaze.grid import Grid
 import numpy as np
 
 from .common import grid_arg, nonneg_int, positive_float, positive_int
+from .running import add_run_args, executor_from_args, progress_from_args
 
 # The two tasks of the face issue: image side and face sizes in pixels.
 TASKS = {'paper': (420, (60, 140)), 'small': (840, (24, 140))}
@@ -94,7 +103,21 @@ def add_parser(sub):
     p.add_argument('--max-count', type=positive_int, default=10,
                    help='K: counts are clipped to 0..K-1 (default 10)')
     p.add_argument('--scale-factor', type=positive_float, default=1.1,
-                   help='detectMultiScale scale factor (default 1.1)')
+                   help='haar: detectMultiScale scale factor (default 1.1)')
+    p.add_argument('--detector', default='haar', metavar='KIND',
+                   help='detector: haar (default), yunet, an ipomdp_gaze.detectors entry point '
+                        'or package.module:Factory (this imports and runs that module)')
+    p.add_argument('--detector-option', action='append', default=[], metavar='NAME=VALUE',
+                   help="one of the detector's own settings (repeat for more; YAML values)")
+    p.add_argument('--cells', choices=('counts', 'score_bins', 'threshold'), default='counts',
+                   help="a cell's observation: the count of detections centred in it "
+                        '(default), its best score in K - 1 bins chosen on training data, or '
+                        'the count of detections scoring at least --threshold')
+    p.add_argument('--threshold', type=float, default=None,
+                   help='--cells threshold: the lowest score counted')
+    p.add_argument('--edge-images', type=positive_int, default=20, metavar='M',
+                   help='--cells score_bins: choose the bin edges on the first M training '
+                        'images or scenes (default 20)')
     p.add_argument('--prior', type=positive_float, default=1.0,
                    help='Dirichlet prior per count (default 1)')
     p.add_argument('--pool-radius', type=float, default=None,
@@ -106,11 +129,11 @@ def add_parser(sub):
     p.add_argument('--fixation-stride', type=positive_int, default=1, metavar='S',
                    help='fixate the cells whose row and column are multiples of S (and the '
                         'last row and column) instead of every cell (default 1: every cell)')
-    p.add_argument('--processes', type=positive_int, default=2)
+    p.add_argument('--processes', dest='jobs', type=positive_int, help=argparse.SUPPRESS)
     p.add_argument('--out', type=Path, required=True, metavar='FILE.yaml')
     p.add_argument('--plot', type=Path, default=None, metavar='PNG',
                    help='figure of the learned FPOC (default: beside --out)')
-    p.add_argument('--quiet', action='store_true', help='no progress bar')
+    add_run_args(p)
     p.set_defaults(run=run)
 
 
@@ -223,11 +246,43 @@ def _check_options(args) -> None:
         raise ValueError(f'--pool-radius must be >= 0, got {args.pool_radius}')
 
 
+def _detector(args):
+    """Return the detector's plain settings for the workers, and the detector built from them."""
+    from ipomdp_gaze.vision.detectors import detector_from_spec, parse_options
+    spec = {'kind': args.detector, **parse_options(args.detector_option)}
+    if args.detector == 'haar':
+        spec.setdefault('scale_factor', args.scale_factor)
+    elif args.scale_factor != 1.1:
+        raise ValueError('--scale-factor is a haar setting; use --detector-option')
+    return spec, detector_from_spec(spec)
+
+
+def _cell_rule(args, pilot):
+    """Return the cell observation rule of ``--cells``; ``pilot()`` tallies the edge images."""
+    from ipomdp_gaze.vision.calibrate import choose_edges
+    from ipomdp_gaze.vision.cell_observation import CellObservation
+    if args.cells == 'threshold':
+        if args.threshold is None:
+            raise ValueError('--cells threshold needs --threshold T')
+        return CellObservation('threshold', args.max_count, threshold=args.threshold)
+    if args.threshold is not None:
+        raise ValueError('--threshold goes with --cells threshold')
+    return choose_edges(pilot(), args.max_count)
+
+
+def _record_cells(meta: dict, cells, args) -> None:
+    """Record the cell observation rule (none for plain counts: older files stay the same)."""
+    if cells is not None:
+        meta['cells'] = cells.to_dict()
+        if cells.kind == 'score_bins':
+            meta['calibration']['edges_from'] = args.edge_images
+
+
 def run_pan_tilt(args) -> int:
     """Calibrate the pan/tilt task (``--pan-tilt``); see the module docstring."""
     from ipomdp_gaze.observation_file import save_observation
     from ipomdp_gaze.vision.calibrate import count_model, tally_pan_tilt_scenes
-    from ipomdp_gaze.vision.detector import HaarDetector
+    from ipomdp_gaze.vision.detector import detector_settings
     from ipomdp_gaze.head_camera import PinholeCamera
     from ipomdp_gaze.vision.pan_tilt import (CAMERA_HFOV_DEG, CAMERA_SIZE_PX, FACE_PX,
                                              PanTiltSceneSet, SceneGeometry)
@@ -242,18 +297,23 @@ def run_pan_tilt(args) -> int:
         raise ValueError(f'--face-px must be MIN,MAX, got {args.face_px}')
     null_scenes = min(40 if args.null_scenes is None else args.null_scenes, args.scenes)
     scenes = PanTiltSceneSet('train', geometry, face_px, 'rgb', args.seed)
-    detector_kwargs = {'scale_factor': args.scale_factor}
-    detector = HaarDetector(**detector_kwargs)
-    from tqdm import tqdm
-    bar = tqdm(total=args.scenes, unit='scene', disable=args.quiet, desc='calibrate')
+    detector_kwargs, detector = _detector(args)
+    cells, max_count = None, args.max_count
     start = time.perf_counter()
-    tallies = tally_pan_tilt_scenes(scenes, range(args.scenes), detector_kwargs,
-                                    args.max_count, null_scenes, args.processes, bar.update)
-    bar.close()
+    with executor_from_args(args) as executor:
+        if args.cells != 'counts':
+            cells = _cell_rule(args, lambda: tally_pan_tilt_scenes(
+                scenes, range(min(args.edge_images, args.scenes)), detector_kwargs,
+                args.max_count, None, executor=executor))
+            max_count = cells.max_count
+        with progress_from_args(args, args.scenes, 'calibrate', 'scene') as bar:
+            tallies = tally_pan_tilt_scenes(scenes, range(args.scenes), detector_kwargs,
+                                            max_count, null_scenes, progress=bar.update,
+                                            executor=executor, cells=cells)
     wall = time.perf_counter() - start
     meta = {'image': {'width': width, 'height': height, 'view': 'pan_tilt',
                       'camera': camera.to_dict()},
-            'detector': detector.settings(),
+            'detector': detector_settings(detector),
             'calibration': {'source': {'pan_tilt_scenes': args.scenes, 'split': 'train',
                                        'seed': args.seed, 'null_scenes': null_scenes,
                                        'face_px': list(face_px),
@@ -263,6 +323,7 @@ def run_pan_tilt(args) -> int:
                             'prior': args.prior, 'pool_radius': args.pool_radius,
                             'min_tallies': args.min_tallies,
                             'detector_pixels': int(tallies.detector_pixels)}}
+    _record_cells(meta, cells, args)
     model = count_model(tallies, grid, args.prior, args.pool_radius, args.min_tallies, meta)
     save_observation(args.out, model)
     print(rate_table(model, size=4))
@@ -279,7 +340,7 @@ def run_pan_tilt(args) -> int:
 def run(args) -> int:
     from ipomdp_gaze.observation_file import save_observation
     from ipomdp_gaze.vision.calibrate import count_model, lattice_fixations, tally_images
-    from ipomdp_gaze.vision.detector import HaarDetector
+    from ipomdp_gaze.vision.detector import detector_settings
     from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig
     if args.out.suffix != '.yaml':
         raise ValueError(f'--out must end in .yaml, got {args.out}')
@@ -290,21 +351,25 @@ def run(args) -> int:
     config = FoveaConfig(windows_cells=args.windows, scales=args.scales,
                          max_count=args.max_count, interpolation=args.interpolation,
                          scan_once=args.scan_once)
-    detector_kwargs = {'scale_factor': args.scale_factor}
-    detector = HaarDetector(**detector_kwargs)
+    detector_kwargs, detector = _detector(args)
     Fovea(detector, grid, config)        # refuses a bad configuration before any work
     items, (height, width), source = _items(args, grid)
-    from tqdm import tqdm
-    bar = tqdm(total=len(items), unit='image', disable=args.quiet, desc='calibrate')
     start = time.perf_counter()
     fixations = None if args.fixation_stride == 1 else \
         lattice_fixations(grid, args.fixation_stride)
-    tallies = tally_images(items, detector_kwargs, grid, config, args.processes, bar.update,
-                           fixations)
-    bar.close()
+    cells = None
+    with executor_from_args(args) as executor:
+        if args.cells != 'counts':
+            cells = _cell_rule(args, lambda: tally_images(
+                items[:args.edge_images], detector_kwargs, grid, config, fixations=fixations,
+                executor=executor))
+            config = dataclasses.replace(config, max_count=cells.max_count)
+        with progress_from_args(args, len(items), 'calibrate', 'image') as bar:
+            tallies = tally_images(items, detector_kwargs, grid, config, progress=bar.update,
+                                   fixations=fixations, executor=executor, cells=cells)
     wall = time.perf_counter() - start
     meta = {'image': {'width': int(width), 'height': int(height)}, 'fovea': config.to_dict(),
-            'detector': detector.settings(),
+            'detector': detector_settings(detector),
             'calibration': {'source': {'scenes': args.scenes, 'task': args.task,
                                        'seed': args.seed, 'absent_rate': args.absent_rate}
                             if args.scenes is not None else source,
@@ -314,6 +379,7 @@ def run(args) -> int:
                             'fixation_stride': args.fixation_stride,
                             'detector_pixels': int(tallies.detector_pixels),
                             'wall_seconds': round(wall, 1)}}
+    _record_cells(meta, cells, args)
     model = count_model(tallies, grid, args.prior, args.pool_radius, args.min_tallies, meta,
                         scan=config.scan_once)
     save_observation(args.out, model)

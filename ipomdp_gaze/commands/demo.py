@@ -36,6 +36,9 @@ def add_parser(sub):
     p.add_argument('--fovea', action='store_true',
                    help='with --scene faces: a fixed camera and the digital fovea instead of '
                         'a camera on the pan/tilt head')
+    p.add_argument('--empty', action='store_true',
+                   help='with --scene faces: the held-out scene without its face (nobody '
+                        'here); right when the controller says absent')
     p.add_argument('--fpoc', choices=('camera', 'human'), default=None,
                    help='FPOC of both nodes (human: 0.42 deg/cell and ELM; default camera)')
     p.add_argument('--policy', default=None,
@@ -107,10 +110,12 @@ def run(args) -> int:
             if value is not None:
                 raise ValueError(f'{flag} is for --scene simulated; the face scene comes from '
                                  f'--seed')
-        setup = faces_setup(args.fovea, args.policy, args.seed)
+        if args.empty and args.fovea:
+            raise ValueError('--empty is for the pan/tilt camera, not --fovea')
+        setup = faces_setup(args.fovea, args.policy, args.seed, empty=args.empty)
     else:
-        if args.fovea:
-            raise ValueError('--fovea goes with --scene faces')
+        if args.fovea or args.empty:
+            raise ValueError(f"{'--fovea' if args.fovea else '--empty'} goes with --scene faces")
         setup = demo_setup(args.fpoc or 'camera', args.policy, args.seed,
                            parse_target(args.target))
     pictures = [] if args.plot or args.animate else None

@@ -12,29 +12,29 @@ the prediction step and the paired difference).
 """
 from __future__ import annotations
 
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import replace
 import json
-import os
 from pathlib import Path
-import sys
 
 from ipomdp_gaze.evaluation import (decision_summary, fixations_to_90_ci,
                                     paired_difference_ci, paired_tracking_difference,
                                     tracking_summary)
+from ipomdp_gaze.executor import InlineExecutor
 from ipomdp_gaze.motion import Motion
 from ipomdp_gaze.observation import as_observation, GaussianObservation
 from ipomdp_gaze.observation_file import fingerprint
+from ipomdp_gaze.pieces import concat_results, COSTLY_CHUNK, PLANNER_CHUNK, simulate_pieces
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
 from ipomdp_gaze.session import SearchSettings
-from ipomdp_gaze.simulate import draw_present, draw_targets, simulate
-from ipomdp_gaze.vision.scene_eval import (DEFAULT_BUDGET, evaluate_scenes, format_summary,
-                                           results_json, summarise, task_spec, TASKS, write_json)
+from ipomdp_gaze.simulate import draw_present, draw_targets
+from ipomdp_gaze.vision.scene_eval import (evaluate_scenes, format_summary,
+                                           paired_map_difference, results_json, summarise,
+                                           task_spec, TASKS, write_json)
 import numpy as np
-from tqdm import tqdm
 
 from .common import (add_scene_args, add_task_args, nonneg_int, positive_int,
                      task_from_args)
+from .running import add_run_args, executor_from_args, progress_from_args
 
 NO_PREDICTION = ' (no prediction)'
 
@@ -56,8 +56,22 @@ def add_parser(sub):
                         'and sensor (the search session of the nodes and find) instead of '
                         'simulating: pan-tilt (config/faces_camera_controller.yaml), faces-420 '
                         "or faces-840 (find's settings); --policy, --policy-file, "
-                        '--confidence, --max-fixations (default 60) and --absent-prior change '
-                        'the shipped configuration')
+                        '--confidence, --max-fixations (default: the configuration budget, '
+                        'else 60) and --absent-prior change the shipped configuration')
+    p.add_argument('--split', choices=('train', 'test'), default='test',
+                   help='--scenes: training scenes (for every choice) or held-out test scenes '
+                        '(default)')
+    p.add_argument('--empty-scenes', type=nonneg_int, default=0, metavar='M',
+                   help='--scenes pan-tilt: also M scenes without a face (the same photo crops), '
+                        'reported apart per background')
+    p.add_argument('--scene-model', default='', metavar='FILE',
+                   help='--scenes pan-tilt: another pan/tilt observation file (its camera is the '
+                        "scene camera's)")
+    p.add_argument('--compare', action='append', default=[], metavar='SEARCHER',
+                   help='--scenes: another searcher on the same scenes and views (repeatable): '
+                        'a policy name (sweep starts at its first pose) or a sweep answer rule '
+                        '(sweep-tile, sweep-first-raw, sweep-first-grouped3, '
+                        'sweep-first-grouped5)')
     p.add_argument('--episodes-greedy', type=positive_int, default=2000,
                    help='episodes for the slow searchers, greedy and switching (policies '
                         'whose class sets costly; default 2000)')
@@ -79,6 +93,7 @@ def add_parser(sub):
                    help='moving target: also run each policy without the prediction step and '
                         'report the paired difference in tracking accuracy')
     p.add_argument('--json', type=Path, default=None, metavar='OUT', help='write results here')
+    add_run_args(p)
     p.set_defaults(run=run)
 
 
@@ -97,7 +112,8 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
              motion_sigma_cells: float | None = None, jump_prob: float | None = None,
              absent_prior: float | None = None, absent_rate: float | None = None,
              confidence: float | None = None, max_fixations: int | None = None,
-             compare_prediction: bool = False, paired: bool = False) -> dict:
+             compare_prediction: bool = False, paired: bool = False, executor=None,
+             bar=None) -> dict:
     """
     Run every policy on the same targets, noise, target paths and empty scenes.
 
@@ -110,7 +126,11 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
     ``tracking`` (:func:`ipomdp_gaze.evaluation.tracking_summary`). Without them the result is
     exactly the paper task's. With ``paired``, ``result['paired']`` holds each later policy
     minus the first: the difference of fixations to 90% on their common episodes with a paired
-    bootstrap interval.
+    bootstrap interval. The simulations run on ``executor`` (:mod:`ipomdp_gaze.executor`;
+    default: here), a slow searcher in pieces of ``COSTLY_CHUNK`` episodes
+    (``PLANNER_CHUNK`` for the planner), with the same numbers wherever they run; ``bar``
+    (:class:`ipomdp_gaze.progress.Progress`) counts the pieces, ``progress(name, entry)`` is
+    called as each policy's entry is ready.
     """
     scene = (motion_sigma_cells, jump_prob, absent_prior, absent_rate, confidence,
              max_fixations)
@@ -138,13 +158,23 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
     runs = [(name, policy, True) for name, policy in policies.items()]
     if compare_prediction and motion.active:
         runs += [(name + NO_PREDICTION, policy, False) for name, policy in policies.items()]
-    results = {}
+    # Every run goes to the executor first (a slow searcher in pieces), then is summarised in
+    # order as its pieces come back.
+    executor = InlineExecutor() if executor is None else executor
+    submitted = []
     for name, policy, predict in runs:
         costly = getattr(policy, 'costly', False)
         n = min(episodes, episodes_greedy) if costly else episodes
-        result = simulate(grid, model, policy, n, horizon, seed, targets=targets[:n],
-                          motion=motion, predict=predict, absent_prior=absent_prior,
-                          present=present[:n])
+        chunk = (PLANNER_CHUNK if getattr(policy, 'name', '') == 'planner' else COSTLY_CHUNK
+                 ) if costly else None
+        futures = simulate_pieces(executor, grid, model, policy, n, horizon, seed, chunk,
+                                  targets=targets[:n], motion=motion, predict=predict,
+                                  absent_prior=absent_prior, present=present[:n],
+                                  progress=bar)
+        submitted.append((name, n, futures))
+    results = {}
+    for name, n, futures in submitted:
+        result = concat_results(f.result() for f in futures)
         results[name] = result
         point, ci = fixations_to_90_ci(result.correct, grid.n_cells,
                                        np.random.default_rng([seed, 99]), bootstrap)
@@ -232,30 +262,59 @@ def check_settings(args) -> SearchSettings:
 def run_scenes(args) -> int:
     """``evaluate --scenes TASK``: held-out scenes through the search session (scene_eval)."""
     if len(args.policy) + len(args.policy_file) > 1:
-        raise ValueError('--scenes evaluates one policy at a time')
+        raise ValueError('--scenes evaluates one policy at a time (others: --compare)')
     spec = task_spec(args.scenes, args.policy[0] if args.policy else None,
                      str(args.policy_file[0]) if args.policy_file else None, seed=args.seed,
-                     max_fixations=DEFAULT_BUDGET if args.max_fixations is None
-                     else args.max_fixations)
+                     max_fixations=args.max_fixations, split=args.split, model=args.scene_model,
+                     compare=tuple(args.compare), empty=False)
     changes = {key: value for key, value in (('confidence', args.confidence),
                                              ('absent_prior', args.absent_prior))
                if value is not None}
     spec = replace(spec, settings=replace(spec.settings, **changes))
     episodes = args.episodes or 200
-    bar = tqdm(total=episodes, desc=f'{args.scenes} scenes', unit='scene', file=sys.stderr,
-               disable=None)
-    with ProcessPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
-        results = evaluate_scenes(spec, episodes, pool, progress=lambda done: bar.update(1))
-    bar.close()
-    summary = summarise(results)
-    print(f'{args.scenes}: policy {spec.policy_file or spec.policy}, test scenes {args.seed}..'
-          f'{args.seed + episodes - 1}, settings {spec.settings.to_parameters()}')
-    for line in format_summary(spec, summary):
-        print(line)
+    if args.empty_scenes and args.scenes != 'pan-tilt':
+        raise ValueError('--empty-scenes is for --scenes pan-tilt')
+    specs = [(spec, episodes)]
+    if args.empty_scenes:
+        specs.append((replace(spec, empty=True), args.empty_scenes))
+    total = sum(n for _, n in specs)
+    results = {}
+    with executor_from_args(args, total) as executor, \
+            progress_from_args(args, total, f'{args.scenes} scenes', 'scene') as bar:
+        for one, n in specs:
+            for name, group in evaluate_scenes(one, n, executor, progress=bar).items():
+                results.setdefault(name, []).extend(group)
+    summary = {name: summarise(group) for name, group in results.items()}
+    print(f'{args.scenes}: policy {spec.policy_file or spec.policy}, {args.split} scenes '
+          f'{args.seed}..{args.seed + episodes - 1}'
+          + (f' (+ {args.empty_scenes} empty)' if args.empty_scenes else '')
+          + f', settings {spec.settings.to_parameters()}')
+    for name, s in summary.items():
+        for line in format_summary(spec, s, name if len(summary) > 1 else ''):
+            print(line)
+    main = next(iter(results))
+    if 'sweep' in results and main != 'sweep':
+        diff = paired_map_difference(results[main], results['sweep'])
+        print(f'MAP right, {main} minus sweep [paired bootstrap 95%]: '
+              + '; '.join(f'{k}: {d:+.3f} [{lo:+.3f}, {hi:+.3f}]'
+                          for k, (d, lo, hi) in diff.items()))
     if args.json:
         write_json(args.json, results_json(spec, results, summary))
         print(f'wrote {args.json}')
     return 0
+
+
+def _pieces(args, policies) -> int:
+    """Return how many pieces :func:`evaluate` submits for these arguments."""
+    count = 0
+    for policy in policies.values():
+        if getattr(policy, 'costly', False):
+            chunk = PLANNER_CHUNK if getattr(policy, 'name', '') == 'planner' else COSTLY_CHUNK
+            count += -(-min(args.episodes, args.episodes_greedy) // chunk)
+        else:
+            count += 1
+    moving = bool(args.motion_sigma_cells) or bool(args.jump_prob)
+    return 2 * count if args.compare_prediction and moving else count
 
 
 def run(args) -> int:
@@ -266,12 +325,15 @@ def run(args) -> int:
     args.max_fixations = args.max_fixations or None           # 0: no budget, the horizon
     grid, fpoc = task_from_args(args)
     policies = load_policies(args, grid, fpoc)
-    result = evaluate(grid, fpoc, policies, args.episodes, args.horizon, args.seed,
-                      args.episodes_greedy, args.bootstrap,
-                      motion_sigma_cells=args.motion_sigma_cells, jump_prob=args.jump_prob,
-                      absent_prior=args.absent_prior, absent_rate=args.absent_rate,
-                      confidence=args.confidence, max_fixations=args.max_fixations,
-                      compare_prediction=args.compare_prediction, paired=args.paired)
+    with executor_from_args(args, _pieces(args, policies)) as executor, \
+            progress_from_args(args, 0, 'evaluate') as bar:
+        result = evaluate(grid, fpoc, policies, args.episodes, args.horizon, args.seed,
+                          args.episodes_greedy, args.bootstrap,
+                          motion_sigma_cells=args.motion_sigma_cells, jump_prob=args.jump_prob,
+                          absent_prior=args.absent_prior, absent_rate=args.absent_rate,
+                          confidence=args.confidence, max_fixations=args.max_fixations,
+                          compare_prediction=args.compare_prediction, paired=args.paired,
+                          executor=executor, bar=bar)
     task = (f'count model {args.observation}' if args.observation else
             f'{grid.spacing_deg} deg/cell, FPOC {fpoc.to_dict()}')
     print(f"{grid.rows}x{grid.cols} grid, {task}, horizon {result['horizon']}, seed {args.seed}")

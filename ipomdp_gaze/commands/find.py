@@ -83,6 +83,10 @@ def add_parser(sub):
                    help='write {grid, images: [{path, cell, pixel, probability, fixations, '
                         'detector_pixels, seconds, decision, absent_probability, stop}]} in '
                         'input order')
+    p.add_argument('--log', type=Path, default=None, metavar='OUT.jsonl',
+                   help="write each image's search session event log (reset with the "
+                        'settings, scan, start, one event per fixation with the frame and '
+                        'belief summaries and the decision) as one JSON line per image')
     p.add_argument('--seed', type=nonneg_int, default=0, metavar='S',
                    help='seed of a sampling policy (image i uses default_rng([S, i]))')
     p.set_defaults(run=run)
@@ -240,7 +244,7 @@ def run(args) -> int:
     tasks = prepare(args)
     settings = [settings_from_args(args, FIND_SETTINGS, task.model.grid) for task in tasks]
     plots = plot_paths(args.plot, len(args.images)) if args.plot else []
-    entries = []
+    entries, logs = [], []
     for i, (path, task) in enumerate(zip(args.images, tasks)):
         image = read_image(path)
         result = search_image(image, task.fovea, task.model, task.policy, settings[i],
@@ -252,11 +256,16 @@ def run(args) -> int:
                         'detector_pixels': result.detector_pixels, 'seconds': result.seconds,
                         'decision': result.decision,
                         'absent_probability': result.absent_probability, 'stop': result.stop})
+        logs.append(json.dumps({'path': path, 'events': list(result.log)}))
         if plots:
             title = (f'{Path(path).name}: cell {result.cell}, p={result.probability:.3f}, '
                      f'{result.fixations} fixations ({result.stop})')
             plot_image_search(image, result, task.fovea, plots[i], title)
             _note(f'wrote {plots[i]}')
+    if args.log:
+        args.log.parent.mkdir(parents=True, exist_ok=True)
+        args.log.write_text('\n'.join(logs) + '\n')
+        _note(f'wrote {args.log}')
     if args.json:
         rows, cols = tasks[0].model.grid.shape
         args.json.parent.mkdir(parents=True, exist_ok=True)

@@ -9,27 +9,22 @@ the run that writes the report, with common random numbers across policies.
 """
 from __future__ import annotations
 
-from concurrent.futures import ProcessPoolExecutor
 import csv
-import functools
 import hashlib
-import json
 import os
 from pathlib import Path
 import resource
 import time
 
-from ipomdp_gaze.evaluation import bootstrap_counts, fixations_to_90_ci, paired_difference_ci
-from ipomdp_gaze.fpoc import dprime_matrix, dprime_table
-from ipomdp_gaze.observation import GaussianObservation
+from ipomdp_gaze.fpoc import dprime_table
+from ipomdp_gaze.pieces import COSTLY_CHUNK, PieceCache, PLANNER_CHUNK, Runner
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.policies.conv import radial_bins
-from ipomdp_gaze.policies.greedy import expected_percent_correct_at
 from ipomdp_gaze.policies.planner import make_planner, TemperedELM
-from ipomdp_gaze.simulate import draw_targets, simulate
 import numpy as np
 
 from .common import nonneg_int, positive_int
+from .running import add_run_args, executor_from_args, progress_from_args
 
 ROOT = Path(__file__).resolve().parents[2]
 KERNELS = ('human-7x7-infomax', 'human-11x11-infomax', 'human-11x11-fixate_target',
@@ -39,12 +34,9 @@ PAPER_7X7 = {'learned infomax': 7.86, 'greedy': 8.96, 'map': 9.25, 'random': 11.
 # reached by about 9).
 COSTLY_HORIZON = 16
 # The other runs stop here instead of at N: Fig. 4a plots 25 fixations, and every 11x11 policy
-# reaches 90% by 30. A run must be REACHED correct at its last fixation (checked).
-HORIZON_7X7, HORIZON_11X11, REACHED = 25, 60, 0.95
-# The slow searchers (policies whose class sets ``costly = True``) are split into pieces of this
-# many episodes, the planner into PLANNER_CHUNK (fixed, so the planner's own draws, one stream
-# per piece, do not depend on the number of processes).
-COSTLY_CHUNK, PLANNER_CHUNK = 250, 500
+# reaches 90% by 30. A run must be pieces.REACHED correct at its last fixation (checked). The
+# slow searchers run in pieces of pieces.COSTLY_CHUNK episodes, the planner of PLANNER_CHUNK.
+HORIZON_7X7, HORIZON_11X11 = 25, 60
 PAPER_11X11 = {'infomax-trained': 18.0, 'fixate-target-trained': 20.0}
 
 
@@ -64,9 +56,7 @@ def add_parser(sub):
                         'package source are unchanged (default .cache/reproduce)')
     p.add_argument('--no-cache', dest='cache', action='store_const', const=None,
                    help='simulate everything, keep nothing')
-    p.add_argument('--jobs', type=positive_int, default=os.cpu_count() or 1,
-                   help='worker processes (default: one per core; the numbers do not depend on '
-                        'it)')
+    add_run_args(p)
     p.set_defaults(run=run)
 
 
@@ -109,254 +99,11 @@ def _retrain(log):
             raise RuntimeError(f'retraining {name} failed')
 
 
-def source_digest() -> str:
-    """SHA-256 of every Python source of the package (a cached result is stale when it moves)."""
-    digest = hashlib.sha256()
-    package = Path(__file__).resolve().parents[1]
-    for folder in (package, package / 'policies'):
-        for path in sorted(folder.resolve().rglob('*.py')):
-            digest.update(path.read_bytes())
-    return digest.hexdigest()
-
-
-class PieceCache:
-    """
-    Results of simulated pieces on disk, keyed by everything that decides them.
-
-    The key is the SHA-256 of a piece's recipe (how its policy is built: a baseline's name, or
-    a policy file's name and kernel), its task (grid, FPOC), its own targets, horizon, seed and
-    rows, and of :func:`source_digest` (the code that builds and runs the policy), so a changed
-    kernel, setting or line of code misses the cache. The run's length is not in the key: a run
-    of n episodes is the first n episodes of a longer one (targets, noise and each piece's
-    policy stream are prefix-stable), so a longer run reuses every piece of a shorter one whose
-    rows it shares. ``folder=None`` caches nothing.
-    """
-
-    # What a piece file holds after its JSON line, in this order (the line records it).
-    LAYOUT = {'correct': 'packbits', 'map_prob': '<f8'}
-
-    def __init__(self, folder: Path | None):
-        self.folder = None if folder is None else Path(folder)
-        self.source = source_digest() if folder is not None else ''
-        self.hits = 0
-
-    def key(self, recipe, grid, fpoc, targets, horizon, seed, rows) -> str | None:
-        """
-        Return the hex key of rows ``start:stop`` of a run on ``targets`` (None: never cached).
-
-        Only the piece's own targets, ``targets[start:stop]``, enter the key, so runs of any
-        length share it (see the class docstring). None without a recipe or a folder.
-        """
-        if self.folder is None or recipe is None:
-            return None
-        start, stop = rows
-        digest = hashlib.sha256(self.source.encode())
-        text = repr((recipe, (grid.rows, grid.cols, grid.spacing_deg), fpoc.model,
-                     sorted(fpoc.params().items()), horizon, seed, (start, stop)))
-        digest.update(text.encode())
-        digest.update(np.ascontiguousarray(targets[start:stop], dtype=np.int64).tobytes())
-        return digest.hexdigest()
-
-    def load(self, key):
-        """Return a cached piece, ``(correct, map_prob, cpu_seconds, decisions)``, or None."""
-        if key is None:
-            return None
-        try:
-            raw = (self.folder / f'{key}.bin').read_bytes()
-            head, _, body = raw.partition(b'\n')
-            meta = json.loads(head)
-            if meta['layout'] != self.LAYOUT:
-                return None                     # another layout: simulate again
-            shape = tuple(int(v) for v in meta['shape'])
-            size = int(np.prod(shape))
-            packed = -(-size // 8)
-            if len(body) != packed + 8 * size:
-                return None                     # a truncated or foreign file: simulate again
-            bits = np.unpackbits(np.frombuffer(body, dtype=np.uint8, count=packed), count=size)
-            map_prob = np.frombuffer(body, dtype='<f8', offset=packed).astype(np.float64)
-            found = (bits.reshape(shape).astype(bool), map_prob.reshape(shape),
-                     float(meta['seconds']), int(meta['decisions']))
-        except (OSError, KeyError, ValueError, TypeError):
-            return None
-        self.hits += 1
-        return found
-
-    def store(self, key, result):
-        """
-        Write one piece: a JSON line, the packed bits of ``correct``, then ``map_prob``.
-
-        The JSON line holds the shape, ``LAYOUT``, CPU seconds and decisions; ``map_prob``
-        is little-endian float64. Written to a temporary file and renamed into place, so a
-        reader never sees half a piece.
-        """
-        if key is None:
-            return
-        correct, map_prob, seconds, decisions = result
-        self.folder.mkdir(parents=True, exist_ok=True)
-        head = json.dumps({'shape': list(correct.shape), 'layout': self.LAYOUT,
-                           'seconds': float(seconds), 'decisions': int(decisions)}).encode()
-        bits = np.packbits(correct.astype(bool)).tobytes()
-        values = np.ascontiguousarray(map_prob, dtype='<f8').tobytes()
-        tmp = self.folder / f'{key}.{os.getpid()}.tmp'
-        tmp.write_bytes(head + b'\n' + bits + values)
-        os.replace(tmp, self.folder / f'{key}.bin')
-
-
-class _RaoBlackwell:
-    """
-    A policy that also records, after each decision, ``E[max_i B'_i | belief, fixation]``.
-
-    That is :func:`ipomdp_gaze.policies.greedy.expected_percent_correct_at`: the probability that
-    the MAP guess is right after the observation, with that observation's noise integrated out.
-    Its mean over episodes is the percent-correct curve (the simulated belief is the exact
-    posterior), with less variance than ``max_i B_i``. ``seconds`` is the CPU time spent on it,
-    kept out of the policy's decision time.
-    """
-
-    def __init__(self, policy, dprime):
-        self.policy, self.dprime = policy, dprime
-        self.scores, self.seconds = [], 0.0
-
-    def select(self, belief, t, rng):
-        fixations = np.asarray(self.policy.select(belief, t, rng), dtype=np.int64)
-        t0 = time.process_time()
-        self.scores.append(expected_percent_correct_at(belief, self.dprime, fixations))
-        self.seconds += time.process_time() - t0
-        return fixations
-
-
-def _simulate_rows(grid, model, policy, targets, horizon, seed, rows, rao_blackwell=False):
-    """
-    Run one piece of work in a worker: correct, max_i B_i, CPU seconds, decisions.
-
-    With ``rao_blackwell`` the second matrix is the Rao-Blackwellised ``max_i B_i`` of
-    :class:`_RaoBlackwell` instead (the same mean).
-    """
-    t0 = time.process_time()
-    scored = _RaoBlackwell(policy, dprime_matrix(grid, model.fpoc)) if rao_blackwell else None
-    result = simulate(grid, model, scored or policy, targets.size, horizon, seed,
-                      targets=targets, rows=rows)
-    seconds = time.process_time() - t0
-    if scored is None:
-        return result.correct, result.map_prob, seconds, result.fixations.size
-    return (result.correct, np.stack(scored.scores, axis=1), seconds - scored.seconds,
-            result.fixations.size)
-
-
-class Runner:
-    """
-    Simulate policies on shared targets and noise; keep each one's per-episode matrices.
-
-    Every run is submitted to ``pool`` (a process pool, or None to run in this process) in
-    pieces of ``chunk`` episodes: each piece is the rows ``start:stop`` of the whole run
-    (:func:`ipomdp_gaze.simulate.simulate` with ``rows``), so a deterministic policy's matrix is
-    the one a single serial run gives, whatever the number of processes. A stochastic policy's
-    own draws come from one stream per piece (fixed ``chunk``, so still deterministic).
-    :meth:`collect` waits for every submitted run and keeps, per name, ``correct`` (MAP guess
-    right), ``map_prob`` (``max_i B_i``), CPU ``seconds`` and ``decisions``. Pieces found in
-    ``cache`` (a :class:`PieceCache`) are not run again; new ones are stored there. Used by
-    ``reproduce`` and ``bench/planner_vs_greedy.py``. With ``rao_blackwell`` (Gaussian FPOC
-    model), ``map_prob`` holds ``E[max_i B'_i]`` given the belief and fixation before each
-    observation (:class:`_RaoBlackwell`): the same curve, less variance.
-    """
-
-    def __init__(self, grid, fpoc, episodes, seed, bootstrap, pool=None, cache=None,
-                 rao_blackwell=False):
-        self.rao_blackwell = bool(rao_blackwell)
-        self.grid, self.fpoc, self.seed = grid, fpoc, seed
-        self.episodes, self.bootstrap, self.pool = episodes, bootstrap, pool
-        self.cache = PieceCache(None) if cache is None else cache
-        self.model = GaussianObservation(grid, fpoc)
-        self.targets = draw_targets(grid.n_cells, episodes, seed)
-        self.correct, self.map_prob, self.seconds, self.decisions = {}, {}, {}, {}
-        self._pending = {}
-
-    def submit(self, name, policy, episodes=None, horizon=None, chunk=None, *, recipe=None):
-        """
-        Queue ``episodes`` (default all) of ``policy`` for ``horizon`` fixations.
-
-        ``recipe`` says how ``policy`` was built (see :class:`PieceCache`); without one the run
-        is never cached. Returns the number of pieces.
-        """
-        n = self.episodes if episodes is None else min(episodes, self.episodes)
-        chunk = n if chunk is None else int(chunk)
-        jobs = []
-        for start in range(0, n, chunk):
-            args = (self.grid, self.model, policy, self.targets[:n], horizon, self.seed,
-                    (start, min(start + chunk, n)), self.rao_blackwell)
-            key = self.cache.key(recipe if not self.rao_blackwell or recipe is None
-                                 else (recipe, 'rao-blackwell'),
-                                 self.grid, self.fpoc, *args[3:7])
-            found = self.cache.load(key)
-            if found is not None:
-                jobs.append((None, found))
-            elif self.pool is not None:
-                jobs.append((key, self.pool.submit(_simulate_rows, *args)))
-            else:
-                jobs.append((key, _simulate_rows(*args)))
-        self._pending[name] = jobs
-        return len(jobs)
-
-    def collect(self):
-        """Wait for every queued run; keep its matrices, summed CPU seconds and decisions."""
-        for name, jobs in self._pending.items():
-            parts = []
-            for key, job in jobs:                     # key None: the piece came from the cache
-                job = job.result() if hasattr(job, 'result') else job
-                if key is not None:
-                    self.cache.store(key, job)
-                parts.append(job)
-            self.correct[name] = np.concatenate([p[0] for p in parts])
-            self.map_prob[name] = np.concatenate([p[1] for p in parts])
-            self.seconds[name] = sum(p[2] for p in parts)
-            self.decisions[name] = sum(p[3] for p in parts)
-        self._pending = {}
-
-    def summary(self, name):
-        """Return episodes, fixations to 90% correct and its bootstrap interval of a run."""
-        correct = self.correct[name]
-        _check_reached(name, correct)
-        counts = _bootstrap_counts(correct.shape[0], self.bootstrap, (self.seed, 7))
-        point, ci = fixations_to_90_ci(correct, self.grid.n_cells, None, self.bootstrap,
-                                       counts=counts)
-        return correct.shape[0], point, ci
-
-    def paired(self, a, b):
-        """Return the paired difference ``a - b`` of fixations to 90% and its interval."""
-        horizon = min(self.correct[a].shape[1], self.correct[b].shape[1])
-        n = min(self.correct[a].shape[0], self.correct[b].shape[0])
-        for name in (a, b):
-            _check_reached(name, self.correct[name][:n, :horizon])
-        counts = _bootstrap_counts(n, self.bootstrap, (self.seed, 8))
-        return paired_difference_ci(self.correct[a][:, :horizon], self.correct[b][:, :horizon],
-                                    self.grid.n_cells, None, self.bootstrap, counts=counts)
-
-
-@functools.lru_cache(maxsize=8)
-def _bootstrap_counts(episodes, resamples, key):
-    """
-    Return the resampling weights ``default_rng(key)`` draws for ``episodes`` (computed once).
-
-    Every summary (and every paired difference) of a run drew the same weights from the same
-    seed; drawing them once gives the same numbers at a fraction of the cost.
-    """
-    counts = bootstrap_counts(episodes, resamples, np.random.default_rng(list(key)))
-    counts.flags.writeable = False
-    return counts
-
-
-def _check_reached(name, correct):
-    """
-    Refuse a run cut too short: every bootstrap resample must reach 90% within its horizon.
-
-    Runs stop at :data:`HORIZON_7X7` / :data:`HORIZON_11X11` fixations, not N (fixations to 90%
-    only needs the curve up to its first crossing, and fixation t's numbers do not depend on
-    later ones). Requiring 95% correct at the last fixation leaves no resample short of 90%.
-    """
-    final = float(correct[:, -1].mean())
-    if final < REACHED:
-        raise RuntimeError(f'{name}: only {final:.1%} correct after {correct.shape[1]} fixations; '
-                           f'raise the horizon of this run')
+def _where(executor) -> str:
+    """Where the pieces ran, for the log and the report: ``2 processes``, ``3 Dask workers``."""
+    if hasattr(executor, 'client'):
+        return f'{executor.workers} Dask workers'
+    return f"{executor.workers} process{'es' if executor.workers > 1 else ''}"
 
 
 def _fmt(point, ci):
@@ -455,7 +202,7 @@ def _policy(source, spec):
     return make_baseline(source, spec.grid, spec.fpoc), ('baseline', source)
 
 
-def _simulate_all(args, specs, pool, cache, log):
+def _simulate_all(args, specs, pool, cache, log, progress=None):
     """
     Queue every simulation of the report (the slowest first), then wait for all of them.
 
@@ -466,13 +213,14 @@ def _simulate_all(args, specs, pool, cache, log):
     """
     h7 = specs['human-7x7-infomax']
     grid7, fpoc7 = h7.grid, h7.fpoc
-    r7 = Runner(grid7, fpoc7, args.episodes, args.seed, args.bootstrap, pool, cache)
+    r7 = Runner(grid7, fpoc7, args.episodes, args.seed, args.bootstrap, pool, cache,
+                progress=progress)
     table = {name: _policy(source, h7) for name, source in (
         ('learned infomax', h7), ('elm', 'elm'), ('tempered elm', 'tempered'), ('map', 'map'),
         ('center', 'center'), ('random', 'random'), ('greedy', 'greedy'),
         ('switching', 'switching'))}
     slow = [name for name, (policy, _) in table.items() if getattr(policy, 'costly', False)]
-    log(f"7x7 slow searchers: planner, {', '.join(slow)} ({args.jobs} processes)")
+    log(f"7x7 slow searchers: planner, {', '.join(slow)} ({_where(pool)})")
     r7.submit('planner', make_planner(grid7, fpoc7), args.episodes_planner, COSTLY_HORIZON,
               PLANNER_CHUNK, recipe=('planner', 'defaults'))
     for name in slow:
@@ -482,7 +230,8 @@ def _simulate_all(args, specs, pool, cache, log):
 
     # 11x11: infomax-trained vs fixate-target-trained.
     h11 = specs['human-11x11-infomax']
-    r11 = Runner(h11.grid, h11.fpoc, args.episodes, args.seed, args.bootstrap, pool, cache)
+    r11 = Runner(h11.grid, h11.fpoc, args.episodes, args.seed, args.bootstrap, pool, cache,
+                 progress=progress)
     ft11 = specs['human-11x11-fixate_target']
     log('11x11 human and the other FPOCs')
     for name, source in (('infomax-trained', h11), ('fixate-target-trained', ft11), ('elm', 'elm'),
@@ -495,7 +244,7 @@ def _simulate_all(args, specs, pool, cache, log):
     for name in ('exponential-11x11-infomax', 'camera-11x11-infomax'):
         spec = specs[name]
         runner = Runner(spec.grid, spec.fpoc, args.episodes, args.seed, args.bootstrap, pool,
-                        cache)
+                        cache, progress=progress)
         for label, source in (('learned', spec), ('elm', 'elm'), ('map', 'map')):
             policy, recipe = _policy(source, spec)
             runner.submit(label, policy, horizon=HORIZON_11X11, recipe=recipe)
@@ -528,18 +277,12 @@ def run(args) -> int:
     specs = {name: _load(name) for name in KERNELS}
     plt = _pyplot()
     lines = []
-    pool = ProcessPoolExecutor(args.jobs) if args.jobs > 1 else None
     cache = PieceCache(args.cache)
-    try:
-        r7, r11, others = _simulate_all(args, specs, pool, cache, log)
-    except BaseException:
-        if pool is not None:                    # do not wait for the pieces still running
-            for process in list((pool._processes or {}).values()):
-                process.terminate()
-            pool.shutdown(wait=False, cancel_futures=True)
-        raise
-    if pool is not None:
-        pool.shutdown()
+    # An error or Ctrl-C cancels the pieces still running; the finished ones are in the cache.
+    with executor_from_args(args) as pool, \
+            progress_from_args(args, 0, 'reproduce') as progress:
+        r7, r11, others = _simulate_all(args, specs, pool, cache, log, progress)
+    where = _where(pool)
     h7, h11 = specs['human-7x7-infomax'], specs['human-11x11-infomax']
     planner_ms = 1000 * r7.seconds['planner'] / r7.decisions['planner']
 
@@ -596,10 +339,12 @@ def run(args) -> int:
     lines += _report(args, r7, r11, others, specs, planner_ms, curves)
     cpu = sum(getattr(resource.getrusage(who), field) for field in ('ru_utime', 'ru_stime')
               for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
+    if hasattr(pool, 'client'):                 # the pieces' CPU time on the cluster's workers
+        cpu += sum(sum(r.seconds.values()) for r in (r7, r11, *others.values()))
     wall = time.perf_counter() - started
     load_end = os.getloadavg()[0]
-    lines += [f'This report: {wall / 60:.1f} min wall, {cpu / 60:.1f} min CPU in {args.jobs} '
-              f'processes ({cache.hits} of the pieces from the cache), load average '
+    lines += [f'This report: {wall / 60:.1f} min wall, {cpu / 60:.1f} min CPU in {where} '
+              f'({cache.hits} of the pieces from the cache), load average '
               f'{load_start:.1f} at the start and {load_end:.1f} at the end (this machine: '
               f'{os.cpu_count()} cores).', '']
     (out / 'reproduction.md').write_text('\n'.join(lines) + '\n')

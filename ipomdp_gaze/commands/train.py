@@ -9,10 +9,12 @@ at every evaluation point, so an interrupted run resumes with ``--resume PATH.ya
 """
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
 from .common import (add_scene_args, add_task_args, nonneg_int, positive_float, positive_int,
                      task_from_args)
+from .running import add_run_args, executor_from_args, progress_from_args
 
 FAMILY_DEFAULT, REWARD_DEFAULT = 'conv', 'infomax'
 # The defaults of the learning rate and reward scale: chosen on the 7x7 human task (README).
@@ -67,8 +69,25 @@ def add_parser(sub):
     p.add_argument('--final-seed', type=nonneg_int, default=0,
                    help='seed of the final evaluation (default 0, as ipomdp-gaze evaluate)')
     add_scene_args(p, 'training')
-    p.add_argument('--quiet', action='store_true', help='no progress bar')
+    p.add_argument('--seeds', type=_list(nonneg_int), default=None, metavar='S,...',
+                   help='a sweep: train one policy per seed (and per --learning-rates value) '
+                        'on the workers of --jobs / --scheduler, write PATH-seedS.yaml each and '
+                        'report the spread of their fixations to 90%%')
+    p.add_argument('--learning-rates', type=_list(positive_float), default=None,
+                   metavar='LR,...', help='a sweep over these step sizes (with --seeds, every '
+                                          'pair; files PATH-seedS-lrLR.yaml)')
+    add_run_args(p, '; used by a --seeds / --learning-rates sweep')
     p.set_defaults(run=run)
+
+
+def _list(kind):
+    """Parse ``a,b,...`` into a list of ``kind`` (its own message for a bad item)."""
+    def parse(text: str) -> list:
+        values = [kind(item) for item in text.split(',') if item.strip()]
+        if not values:
+            raise argparse.ArgumentTypeError(f'expected a comma-separated list, got {text!r}')
+        return values
+    return parse
 
 
 def _task(args, spec):
@@ -144,6 +163,9 @@ def run(args) -> int:
         'eval_episodes': args.eval_episodes, 'motion_sigma_cells': args.motion_sigma_cells,
         'jump_prob': args.jump_prob, 'absent_prior': args.absent_prior,
         'absent_rate': args.absent_rate}
+    sweep = args.seeds is not None or args.learning_rates is not None
+    if sweep and spec is not None:
+        raise ValueError('--seeds / --learning-rates start new trainings: drop --resume')
     if spec is None:
         defaults = {'reward': args.reward or REWARD_DEFAULT,
                     'family': args.family or FAMILY_DEFAULT, 'learning_rate': LEARNING_RATE,
@@ -156,6 +178,8 @@ def run(args) -> int:
                 raise ValueError('--init-elm starts a conv kernel: use it with --family conv')
             from ipomdp_gaze.policies.training import elm_init
             params, init = elm_init(grid, fpoc, args.init_elm), f'elm x {args.init_elm:g}'
+        if sweep:
+            return run_sweep(args, grid, fpoc, config, params, init, out)
         trainer = Trainer(grid, fpoc, config, params=params, init=init)
     else:
         if args.init_elm is not None:
@@ -177,12 +201,15 @@ def run(args) -> int:
         save_policy(out, trainer.spec())
         write_curve(curve_path, rows)
 
-    trainer.run(remaining, progress=not args.quiet, callback=checkpoint)
+    with progress_from_args(args, remaining, 'train', 'epoch') as bar:
+        trainer.run(remaining, progress=bar, callback=checkpoint)
     evaluation = {}
     if args.final_episodes:
-        evaluation = evaluation_block(grid, fpoc, trainer.family.policy(trainer.params),
-                                      args.final_episodes, args.final_seed, trainer.horizon,
-                                      scene=trainer.config.scene())
+        with progress_from_args(args, trainer.horizon, 'final evaluation', 'fixation') as bar:
+            evaluation = evaluation_block(grid, fpoc, trainer.family.policy(trainer.params),
+                                          args.final_episodes, args.final_seed,
+                                          trainer.horizon, scene=trainer.config.scene(),
+                                          progress=bar)
     save_policy(out, trainer.spec(evaluation=evaluation))
     write_curve(curve_path, rows)
     cfg = trainer.config
@@ -202,4 +229,64 @@ def run(args) -> int:
             print(f"tracking accuracy {evaluation['tracking_accuracy']:.4f} "
                   f'[{ci[0]:.4f}, {ci[1]:.4f}]')
     print(f'wrote {out} and {curve_path}')
+    return 0
+
+
+def run_sweep(args, grid, model, config, params, init, out) -> int:
+    """
+    Train one policy per (seed, learning rate) on the executor; write each and the spread.
+
+    Each training is one piece (its seed decides all its draws), so every file is the one a
+    plain ``train --seed S --learning-rate LR`` writes, wherever it ran. Files are written here
+    as the trainings finish: ``PATH-seedS[-lrLR].yaml`` and its ``.csv``.
+    """
+    from dataclasses import replace
+
+    from ipomdp_gaze.executor import track
+    from ipomdp_gaze.pieces import train_piece
+    from ipomdp_gaze.policies.policy_file import save_policy
+    from ipomdp_gaze.policies.training import write_curve
+    import numpy as np
+    seeds = args.seeds if args.seeds is not None else [config.seed]
+    rates = args.learning_rates
+    runs = [(seed, rate) for rate in (rates or [config.learning_rate]) for seed in seeds]
+    epochs = args.epochs
+    with executor_from_args(args, len(runs)) as executor, \
+            progress_from_args(args, len(runs), 'train sweep', 'training') as bar:
+        futures = {}
+        for seed, rate in runs:
+            run_config = replace(config, seed=seed, learning_rate=rate)
+            futures[executor.submit(train_piece, grid, model, run_config, params, init, epochs,
+                                    args.final_episodes, args.final_seed)] = (seed, rate)
+        results = {}
+        for future in track(list(futures), bar):
+            seed, rate = futures[future]
+            spec, rows, evaluation = future.result()
+            tag = f'-seed{seed}' + (f'-lr{rate:g}' if rates else '')
+            path = out.with_name(f'{out.stem}{tag}.yaml')
+            save_policy(path, spec)
+            write_curve(path.with_suffix('.csv'), rows)
+            results[seed, rate] = (path, rows, evaluation)
+    print(f'{"file":<32} {"seed":>5} {"lr":>6} {"fix->90% (final)":>26} {"last curve":>10}')
+    spread = {}
+    for seed, rate in runs:
+        path, rows, evaluation = results[seed, rate]
+        f90 = evaluation.get('fixations_to_90')
+        ci = evaluation.get('ci95')
+        last = rows[-1]['fixations_to_90'] if rows else None
+        final = '-' if not evaluation else 'never' if f90 is None else f'{f90:.2f}'
+        if ci:
+            final += f' [{ci[0]:.2f}, {ci[1]:.2f}]'
+        curve = '-' if last is None else f'{last:.2f}'
+        print(f'{path.name:<32} {seed:>5} {rate:>6g} {final:>26} {curve:>10}')
+        value = f90 if evaluation else last
+        if value is not None:
+            spread.setdefault(rate, []).append(value)
+    measure = (f'final evaluation ({args.final_episodes} episodes, seed {args.final_seed})'
+               if args.final_episodes else 'last learning-curve point')
+    for rate, values in spread.items():
+        v = np.asarray(values, dtype=float)
+        sd = f'{v.std(ddof=1):.2f}' if v.size > 1 else '-'
+        print(f'lr {rate:g}: fixations to 90% by {measure} over {v.size} seeds: mean '
+              f'{v.mean():.2f}, sd {sd}, range {v.min():.2f} to {v.max():.2f}')
     return 0

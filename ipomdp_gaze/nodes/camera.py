@@ -16,7 +16,9 @@ Publishes ``evidence`` (``Float32MultiArray``, best effort) or, with ``publish_i
 stamped ``evidence_image`` (``32FC1``); ``joint_states`` (its pose, stamped like the frame taken
 there); and ``ground_truth`` (``std_msgs/Int32MultiArray`` ``[row, col]``, transient local;
 ``[-1, -1]`` for an empty scene). ``~/reset`` (``std_srvs/Trigger``) draws a new target
-(``target_row``/``target_col``, or a random cell when they are -1).
+(``target_row``/``target_col``, or a random cell when they are -1). Every callback runs under a
+:class:`ipomdp_gaze.nodes.guard.CallbackGuard` (its counts in the ``/diagnostics`` status
+``<node>: callbacks``).
 
 Beyond the paper (docs/design.md section 7): with ``empty_scene`` there is no target (every
 frame is null noise) from the start or the next ``~/reset``; with ``target_motion_rate_hz > 0``
@@ -43,6 +45,7 @@ from std_msgs.msg import Float32MultiArray, Int32MultiArray
 from std_srvs.srv import Trigger
 
 from . import NODE_NAMES
+from .guard import CallbackGuard
 from .params import (cell_params, fpoc_from, fpoc_params, grid_from, grid_params, head_from,
                      INT_MAX, joint_params, Param, ParameterTransaction, row_col_from, T)
 from .saccade import SaccadeMixin
@@ -96,8 +99,10 @@ class SimulatedCameraNode(SaccadeMixin, Node):
 
     def __init__(self, **kwargs):
         super().__init__(NODE_NAME, **kwargs)
-        self._transaction = ParameterTransaction(self, camera_params(), self._build,
-                                                 self._apply_config)
+        self.guard = CallbackGuard(self)
+        self._transaction = ParameterTransaction(self, camera_params(),
+                                                 self.guard.refusing(self._build),
+                                                 self.guard.wrap(self._apply_config))
         self._transaction.declare()
         self._transaction.start(self._build(self._transaction.values()))
         v = self._config.values
@@ -109,8 +114,10 @@ class SimulatedCameraNode(SaccadeMixin, Node):
         self._image_pub = self.create_publisher(Image, 'evidence_image', FRAME_QOS)
         self._joint_pub = self.create_publisher(JointState, 'joint_states', 10)
         self._truth_pub = self.create_publisher(Int32MultiArray, 'ground_truth', STATE_QOS)
-        self.create_subscription(JointState, 'pan_tilt', self._on_command, STATE_QOS)
-        self.create_service(Trigger, '~/reset', self._on_reset)
+        self.create_subscription(JointState, 'pan_tilt', self.guard.wrap(self._on_command),
+                                 STATE_QOS)
+        self.create_service(Trigger, '~/reset', self.guard.wrap(self._on_reset))
+        self.guard.publish_status()
         self._saccade_timer = self._frame_timer = self._walk_timer = None
         self._make_timers(v)
         self._new_target()
@@ -151,13 +158,15 @@ class SimulatedCameraNode(SaccadeMixin, Node):
         if self.moving:
             self._arrive()
         if values['saccade_time_s'] > 0:
-            self._saccade_timer = self.create_timer(values['saccade_time_s'], self._on_arrival)
+            self._saccade_timer = self.create_timer(values['saccade_time_s'],
+                                                    self.guard.wrap(self._on_arrival))
             self._saccade_timer.cancel()
         if values['rate_hz'] > 0:
-            self._frame_timer = self.create_timer(1.0 / values['rate_hz'], self._publish_frame)
+            self._frame_timer = self.create_timer(1.0 / values['rate_hz'],
+                                                  self.guard.wrap(self._publish_frame))
         if values['target_motion_rate_hz'] > 0:
             self._walk_timer = self.create_timer(1.0 / values['target_motion_rate_hz'],
-                                                 self._walk)
+                                                 self.guard.wrap(self._walk))
 
     # -- head ------------------------------------------------------------------------------
     def _on_command(self, msg: JointState) -> None:

@@ -59,6 +59,7 @@ from std_srvs.srv import SetBool, Trigger
 from trajectory_msgs.msg import JointTrajectory
 
 from . import NODE_NAMES
+from .guard import CallbackGuard
 from .params import (cell_params, current_values, fpoc_from, fpoc_params, grid_from, grid_params,
                      head_from, INT_MAX, joint_params, Param, ParameterTransaction, row_col_from,
                      T)
@@ -114,11 +115,24 @@ def controller_params() -> list[Param]:
         Param('search.inhibit_return', False, T.BOOL,
               'still target: never fixate a cell twice in a search (a deterministic detector '
               'on a still scene repeats its counts; the Bayes step would count them twice)'),
+        Param('search.stop_on_repeat', False, T.BOOL,
+              'give up (gave_up) instead of fixating a cell a second time; with '
+              'inhibit_return: once every cell has been fixated (find does this)'),
+        Param('search.scan', True, T.BOOL,
+              'with a count model that has scan tables: start each search with the one-time '
+              'whole-image scan (asked of the detector as fixation [-1, -1, search_id])'),
         Param('search.repeat_weight', 1.0, T.DOUBLE,
               'still target: weight of the evidence a cell gets from views other than the one '
               'that saw it at its most informative offset, in [0, 1] (1: every frame counts '
               'fully, naive Bayes; 0: the evidence of each cell once, for overlapping views of a '
               'still scene and a deterministic detector)'),
+        Param('search.found_radius', 0, T.INTEGER,
+              'still target: found when the belief within this many cells of a cell reaches '
+              'the confidence, and that cell is the answer (0: the cell alone)',
+              int_range=(0, 5)),
+        Param('search.decide_at_budget', False, T.BOOL,
+              'still target: when the budget runs out undecided, say absent or found '
+              '(whichever is more probable) instead of gave_up'),
         Param('policy.name', 'elm', T.STRING, 'fixation policy', choices=POLICY_NAMES),
         Param('policy.file', '', T.STRING,
               'policy YAML path or shipped kernel name; setting it selects learned'),
@@ -205,18 +219,22 @@ class GazeControllerNode(Node):
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self._forward_pub = self._trajectory_pub = None
         self._make_command_publishers(v)
+        self.guard = CallbackGuard(self)
         evidence_qos = QoSProfile(history=HistoryPolicy.KEEP_LAST,
                                   depth=v['evidence_queue_depth'],
                                   reliability=ReliabilityPolicy.BEST_EFFORT)
         self._sequences = {'evidence': FrameSequence(), 'evidence_image': FrameSequence()}
         self._evidence_subs = {
             'evidence': self.create_subscription(Float32MultiArray, 'evidence',
-                                                 self._on_evidence, evidence_qos),
+                                                 self.guard.wrap(self._on_evidence),
+                                                 evidence_qos),
             'evidence_image': self.create_subscription(Image, 'evidence_image',
-                                                       self._on_evidence_image, evidence_qos)}
+                                                       self.guard.wrap(self._on_evidence_image),
+                                                       evidence_qos)}
         self._single_publisher = dict.fromkeys(self._sequences, True)
-        self.create_service(Trigger, '~/reset', self._on_reset)
-        self.create_service(SetBool, '~/enable', self._on_enable)
+        self.create_service(Trigger, '~/reset', self.guard.wrap(self._on_reset))
+        self.create_service(SetBool, '~/enable', self.guard.wrap(self._on_enable))
+        self.guard.publish_status()
         self._retry_timer = self._diag_timer = None
         self._make_timers(v)
         self._resends = 0
@@ -393,9 +411,10 @@ class GazeControllerNode(Node):
                 self.destroy_timer(timer)
         self._retry_timer = None
         if values['retry_period_s'] > 0:
-            self._retry_timer = self.create_timer(values['retry_period_s'], self._on_retry)
+            self._retry_timer = self.create_timer(values['retry_period_s'],
+                                                  self.guard.wrap(self._on_retry))
         self._diag_timer = self.create_timer(values['diagnostics_period_s'],
-                                             self._publish_diagnostics)
+                                             self.guard.wrap(self._publish_diagnostics))
 
     # -- time ----------------------------------------------------------------------------
     def _now(self):
@@ -414,7 +433,9 @@ class GazeControllerNode(Node):
     def _publish_target(self) -> None:
         head, cell = self._config.head, self.core.fixation
         self._pan_tilt_pub.publish(self._pan_tilt_msg)
-        self._fixation_pub.publish(grid_arrays.row_col(self._config.grid, cell))
+        core = self.core
+        self._fixation_pub.publish(grid_arrays.fixation(
+            self._config.grid, None if core.scanning else cell, core.search_id))
         if self._forward_pub is not None:
             self._forward_pub.publish(joints.forward_command(head, cell))
         if self._trajectory_pub is not None:
@@ -501,10 +522,17 @@ class GazeControllerNode(Node):
         self._take('evidence', info, grid_arrays.from_multiarray, msg)
 
     def _on_evidence_image(self, msg: Image, info) -> None:
-        self._take('evidence_image', info, images.evidence_from_image, msg, msg.header.stamp)
+        self._take('evidence_image', info, images.evidence_from_image, msg, msg.header.stamp,
+                   images.read_frame_tag(msg))
 
-    def _take(self, topic: str, info, read, msg, stamp=None) -> None:
-        """Offer a frame to the core: taken at its stamp, or at its arrival when there is none."""
+    def _take(self, topic: str, info, read, msg, stamp=None, tag=('fixation', None)) -> None:
+        """
+        Offer a frame to the core: taken at its stamp, or at its arrival when there is none.
+
+        A frame tagged as a search's one-time scan (``header.frame_id`` ``scan/<id>``) goes to
+        :meth:`GazeController.offer_scan`; one tagged ``fixation/<id>`` is skipped unless it
+        belongs to the current search.
+        """
         now = self._now_s()
         self._count_drops(topic, info)
         try:
@@ -512,8 +540,12 @@ class GazeControllerNode(Node):
         except EvidenceError as exc:
             self._handle(self.core.reject(str(exc)))
             return
+        kind, search_id = tag
+        if kind == 'scan':
+            self._handle(self.core.offer_scan(values, search_id, now))
+            return
         taken = now if stamp is None or stamps.is_zero(stamp) else stamps.to_seconds(stamp)
-        self._handle(self.core.offer(values, taken, now))
+        self._handle(self.core.offer(values, taken, now, search_id))
 
     def _handle(self, result) -> None:
         if result.status == 'rejected':

@@ -58,7 +58,8 @@ class DemoSetup:
 
     ``nodes`` lists ``(node, ros_args)`` in start order (keys of ``NODE_NAMES``); ``scene`` is
     ``'gaussian'`` (the simulated camera) or ``'faces'``; ``mode`` the detector's (faces);
-    ``image_px`` the ``(width, height)`` of the fixed scene (fovea mode, for pixel answers).
+    ``image_px`` the ``(width, height)`` of the fixed scene (fovea mode, for pixel answers);
+    ``scan`` whether each search starts with the one-time scan (its belief comes first).
     """
 
     nodes: list
@@ -68,6 +69,7 @@ class DemoSetup:
     scene: str = 'gaussian'
     mode: str = ''
     image_px: tuple | None = None
+    scan: bool = False
 
     @property
     def tolerance_cells(self) -> int:
@@ -147,12 +149,14 @@ def demo_setup(fpoc: str = 'camera', policy: str | None = None, seed: int = 0,
                      head_from(values, grid), controller)
 
 
-def faces_setup(fovea: bool = False, policy: str | None = None, seed: int = 0) -> DemoSetup:
+def faces_setup(fovea: bool = False, policy: str | None = None, seed: int = 0,
+                empty: bool = False) -> DemoSetup:
     """
     Build the face demo from ``config/faces_<mode>_*.yaml``: scene camera, detector, controller.
 
     ``fovea`` selects the fixed camera and the digital fovea (mode ``fovea``), else the camera
-    on the pan/tilt head (mode ``camera``); ``seed`` picks the held-out test scene.
+    on the pan/tilt head (mode ``camera``); ``seed`` picks the held-out test scene, ``empty``
+    shows it without its face (the pan/tilt camera's ``scene.empty``).
     """
     mode = 'fovea' if fovea else 'camera'
     files = {node: config_file(f'faces_{mode}_{node}.yaml')
@@ -167,10 +171,14 @@ def faces_setup(fovea: bool = False, policy: str | None = None, seed: int = 0) -
     if fovea:
         side = yaml_parameters(files['scene_camera'], 'scene_camera').get('scene.size_px', 420)
         image_px = (int(side), int(side))
+    from ipomdp_gaze.observation_file import load_observation
+    scan = bool(values.get('search.scan', True)) and \
+        load_observation(values['observation.file']).has_scan
+    camera = {'seed': seed, 'scene.empty': True} if empty else {'seed': seed}
     return DemoSetup([('controller', _ros_args(files['controller'], controller)),
                       ('detector', _ros_args(files['detector'], {})),
-                      ('scene_camera', _ros_args(files['scene_camera'], {'seed': seed}))],
-                     grid, head_from(values, grid), controller, 'faces', mode, image_px)
+                      ('scene_camera', _ros_args(files['scene_camera'], camera))],
+                     grid, head_from(values, grid), controller, 'faces', mode, image_px, scan)
 
 
 def _started(watch, record, node: str):
@@ -295,7 +303,8 @@ def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = 
         procs = [nodes.add(node, args)
                  for node, args in _with_recorder(setup, record, compression, pictures)]
         watch = Watch(domain, 'gaze_demo', nodes)
-        record_ = SearchRecord(watch, depth=200, updates_only=True)
+        record_ = SearchRecord(watch, depth=200, updates_only=True,
+                               n_cells=setup.grid.n_cells)
         annotated = watch.record(Image, 'annotated_image', 50) if pictures is not None \
             else []
         recorder = RecorderStatus(watch) if record else None
@@ -382,25 +391,36 @@ def _answer(setup: DemoSetup, row: int, col: int, cell: int, probability: float,
 def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
             stats: dict | None = None, max_fixations: int = 60) -> int:
     """
-    Print fixations until the found event (or ``max_fixations``); judge the answer.
+    Print fixations until the found or absent event (or ``max_fixations``); judge the answer.
 
-    Without a found event after ``max_fixations`` fixations (or at the deadline), the answer is
-    the most likely cell of the last belief. Returns 0 once an answer was judged before the
-    deadline, else 1.
+    Without an event after ``max_fixations`` fixations (or at the deadline), the answer is the
+    most likely cell of the last belief. ``absent`` is right on an empty scene (ground truth
+    ``[-1, -1]``) and wrong otherwise; a cell is wrong on an empty scene. Returns 0 once an
+    answer was judged before the deadline, else 1.
     """
     grid, head = setup.grid, setup.head
     printed = 0
+    skip = 1 if setup.scan else 0           # the scan's belief (and the pose it was taken at)
+    scan_shown = False
 
     def last() -> int:
         if record.found:
             return diagnostics.parse_found(record.found[0][1])['fixations']
+        if record.absent:
+            return diagnostics.parse_absent(record.absent[0][1])['fixations']
         return max_fixations
 
     def show_new():
-        nonlocal printed
-        while printed < min(len(record.beliefs), len(record.targets), last()):
-            belief = grid_arrays.from_multiarray(record.beliefs[printed][1], grid)
-            pan, tilt = joints.angles_from_joint_state(record.targets[printed][1], head)
+        nonlocal printed, scan_shown
+        if skip and not scan_shown and record.beliefs:
+            belief = grid_arrays.from_multiarray(record.beliefs[0][1], grid)
+            guess = int(np.argmax(belief))
+            out(f'scan: the whole image once  ->  most likely {grid.cell(guess)} '
+                f'p={belief[guess]:.3f}  entropy {float(entropy(belief)):.2f} nats')
+            scan_shown = True
+        while printed < min(len(record.beliefs) - skip, len(record.targets) - skip, last()):
+            belief = grid_arrays.from_multiarray(record.beliefs[printed + skip][1], grid)
+            pan, tilt = joints.angles_from_joint_state(record.targets[printed + skip][1], head)
             looked = head.nearest_cell(pan, tilt)
             guess = int(np.argmax(belief))
             out(f'fixation {printed + 1:3d}: looked at {grid.cell(looked)}  '
@@ -419,11 +439,16 @@ def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
         answer, stop = (found['row'], found['col'], found['cell']), 'found'
         out(f'found: the {what} is most likely at '
             + _answer(setup, *answer, found['probability'], found['fixations']))
+    elif record.absent and printed >= last():
+        found = diagnostics.parse_absent(record.absent[0][1])
+        answer, stop = None, 'absent'
+        out(f"absent: nobody is here, probability {found['probability']:.3f}, after "
+            f"{found['fixations']} fixations")
     elif printed == 0:
         out(f'ipomdp-gaze demo: the {what} was not found within {timeout_s:g} s')
         return 1
     else:
-        belief = grid_arrays.from_multiarray(record.beliefs[printed - 1][1], grid)
+        belief = grid_arrays.from_multiarray(record.beliefs[printed - 1 + skip][1], grid)
         cell = int(np.argmax(belief))
         answer = (*grid.cell(cell), cell)
         found = {'row': answer[0], 'col': answer[1], 'cell': cell, 'fixations': printed,
@@ -438,12 +463,19 @@ def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
         out(f'ipomdp-gaze demo: the {camera} did not report where the {what} is')
         return 1
     truth = grid_arrays.cell_from_ground_truth(record.truth[-1][1], grid)
-    (tr, tc), (fr, fc) = grid.cell(truth), answer[:2]
-    right = max(abs(tr - fr), abs(tc - fc)) <= setup.tolerance_cells
+    if truth is None or answer is None:
+        right, (tr, tc) = truth is None and answer is None, (-1, -1)
+        if truth is not None:
+            tr, tc = grid.cell(truth)
+    else:
+        (tr, tc), (fr, fc) = grid.cell(truth), answer[:2]
+        right = max(abs(tr - fr), abs(tc - fc)) <= setup.tolerance_cells
     if stats is not None:
         stats.update(found, truth=(tr, tc), right=right, stop=stop)
     verdict = 'right' if right else 'wrong'
-    if setup.scene == 'faces':
+    if truth is None:
+        out(f'the {camera} showed a scene with nobody in it: that is {verdict}')
+    elif setup.scene == 'faces':
         out(f'the scene camera put the face centre in cell {grid.cell(truth)}: that is '
             f'{verdict}')
     else:

@@ -8,7 +8,7 @@ fixation and counts its detections, and :mod:`msg_adapters` reads and fills ever
 (docs/design.md section 6.6). Two modes (``mode``, read-only):
 
 - ``fovea``: a fixed camera; the grid tiles the image and the digital fovea is placed on the
-  fixated cell (the shipped ``faces-420-nmpt`` model by default);
+  fixated cell (the shipped ``faces-420`` model by default);
 - ``camera``: a camera on the pan/tilt head; the detector runs on the whole view, its
   detections are binned to pan/tilt cells with ``camera_info``'s K and the head pose of the
   ``joint_states`` message stamped like the image, and cells outside the view are NaN (the
@@ -25,8 +25,12 @@ Relative topic names:
   observed) or, with ``publish_image: false``, ``evidence``; and ``/diagnostics``.
 
 A malformed image (another encoding, a step or data length that disagrees with the size, an
-empty or oversized image) is rejected with a throttled warning naming the reason and counted;
-nothing else changes. Run with ``ros2 run ipomdp_gaze detector`` (or ``ipomdp-gaze detector``).
+empty or oversized image, a stamp that breaks the time sanity rule) is rejected with a throttled
+warning naming the reason and counted; so are absurd joint states, ``camera_info`` and
+fixations (:mod:`ipomdp_gaze.detection`). Every callback runs under a
+:class:`ipomdp_gaze.nodes.guard.CallbackGuard`: an unexpected error is counted
+(``callback_errors``) and the node carries on. Run with ``ros2 run ipomdp_gaze detector`` (or
+``ipomdp-gaze detector``).
 """
 from __future__ import annotations
 
@@ -34,7 +38,8 @@ from dataclasses import dataclass
 import sys
 
 from diagnostic_msgs.msg import DiagnosticArray
-from ipomdp_gaze.detection import build_setup, DetectorLoop, DetectorSetup, MODES
+from ipomdp_gaze.detection import (build_setup, DetectorLoop, DetectorSetup, MAX_AGE_S, MODES,
+                                   STAMP_TOLERANCE_S)
 from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, stamps
 from rclpy.node import Node
@@ -44,6 +49,7 @@ from std_msgs.msg import Float32MultiArray, Int32MultiArray
 
 from . import NODE_NAMES
 from .annotation import Annotator
+from .guard import CallbackGuard
 from .params import head_from, joint_params, MAX_CELLS_PER_SIDE, Param, ParameterTransaction, T
 from .spin import run_node
 
@@ -58,8 +64,8 @@ STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                        durability=DurabilityPolicy.TRANSIENT_LOCAL)
 WARN_THROTTLE_S = 5.0
 SETUP_KEYS = ('observation.file', 'grid.rows', 'grid.cols', 'grid.spacing_deg',
-              'detector.cascade', 'detector.scale_factor', 'detector.min_neighbors',
-              'detector.cascade_dir')
+              'detector.kind', 'detector.options', 'detector.cascade', 'detector.scale_factor',
+              'detector.min_neighbors', 'detector.cascade_dir')
 
 
 def detector_params() -> list[Param]:
@@ -70,7 +76,7 @@ def detector_params() -> list[Param]:
               'head (read-only)', read_only=True, choices=MODES),
         Param('observation.file', '', T.STRING,
               'count model: an ipomdp_gaze/observation-v1 path or shipped name ("": '
-              'faces-420-nmpt in fovea mode, faces-pan-tilt in camera mode); its grid, fovea '
+              'faces-420 in fovea mode, faces-pan-tilt in camera mode); its grid, fovea '
               'and detector win'),
         Param('grid.rows', 0, T.INTEGER, "rows (0: the observation file's; read-only)",
               read_only=True, int_range=(0, MAX_CELLS_PER_SIDE)),
@@ -79,6 +85,13 @@ def detector_params() -> list[Param]:
         Param('grid.spacing_deg', 0.0, T.DOUBLE,
               "camera mode: pan/tilt degrees per cell (0.0: the observation file's; read-only)",
               read_only=True, float_range=(0.0, 90.0)),
+        Param('detector.kind', '', T.STRING,
+              'detector kind: haar, yunet, an ipomdp_gaze.detectors entry point or '
+              'package.module:Factory, whose code runs ("": the observation file\'s; another '
+              'is refused)'),
+        Param('detector.options', None, T.STRING_ARRAY,
+              'settings of the detector itself as NAME=VALUE (YAML values); each must repeat '
+              'the value in the observation file'),
         Param('detector.cascade', '', T.STRING,
               "Haar cascade file name (\"\": the observation file's; another is refused)"),
         Param('detector.scale_factor', 0.0, T.DOUBLE,
@@ -97,6 +110,12 @@ def detector_params() -> list[Param]:
               'subscribe image best effort, for a driver that publishes it so (default '
               'reliable: large images lose fragments over best effort; read-only)',
               read_only=True),
+        Param('stamp_tolerance_s', STAMP_TOLERANCE_S, T.DOUBLE,
+              "images and joint states stamped more than this ahead of the node's clock are "
+              'rejected (a camera clock running ahead)', float_range=(0.0, 3600.0)),
+        Param('max_image_age_s', MAX_AGE_S, T.DOUBLE,
+              'images and joint states stamped more than this before they arrive are rejected '
+              'as stale (0: no limit)', float_range=(0.0, 1e6)),
         Param('publish_image', True, T.BOOL,
               'publish stamped 32FC1 evidence_image frames (false: evidence)'),
         Param('publish_annotated', False, T.BOOL,
@@ -123,7 +142,10 @@ class DetectorConfig:
 
 def _detector_settings(values: dict) -> dict:
     """Return the detector settings given as parameters (unset ones left out)."""
-    given = {}
+    from ipomdp_gaze.vision.detectors import parse_options
+    given = parse_options(values['detector.options'])
+    if values['detector.kind']:
+        given['kind'] = values['detector.kind']
     if values['detector.cascade']:
         given['cascade'] = values['detector.cascade']
     if values['detector.scale_factor'] > 0:
@@ -138,38 +160,42 @@ class FovealDetectorNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__(NODE_NAME, **kwargs)
-        self._transaction = ParameterTransaction(self, detector_params(), self._build,
-                                                 self._apply_config)
+        self.guard = guard = CallbackGuard(self)
+        self._transaction = ParameterTransaction(self, detector_params(),
+                                                 guard.refusing(self._build),
+                                                 guard.wrap(self._apply_config))
         self._transaction.declare()
         self._transaction.start(self._build(self._transaction.values()))
         cfg = self._config
         v = cfg.values
-        self.loop = DetectorLoop(cfg.setup, cfg.head, v['joint_state_tolerance_s'])
-        self._reported_rejections = 0
+        self.loop = DetectorLoop(cfg.setup, cfg.head, v['joint_state_tolerance_s'],
+                                 stamp_tolerance_s=v['stamp_tolerance_s'],
+                                 max_age_s=v['max_image_age_s'])
+        self._reported = (0, 0, 0)
         self._evidence_pub = self.create_publisher(Float32MultiArray, 'evidence', FRAME_QOS)
         self._image_pub = self.create_publisher(Image, 'evidence_image', FRAME_QOS)
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
-        self.create_subscription(Image, 'image', self._on_image,
+        self.create_subscription(Image, 'image', guard.wrap(self._on_image),
                                  IMAGE_QOS[v['image_best_effort']])
-        self.create_subscription(Int32MultiArray, 'fixation', self._on_fixation, STATE_QOS)
+        self.create_subscription(Int32MultiArray, 'fixation', guard.wrap(self._on_fixation),
+                                 STATE_QOS)
         if cfg.setup.mode == 'camera':
-            self.create_subscription(CameraInfo, 'camera_info', self._on_camera_info,
+            self.create_subscription(CameraInfo, 'camera_info', guard.wrap(self._on_camera_info),
                                      SENSOR_QOS)
-            self.create_subscription(JointState, 'joint_states', self._on_joint_states,
+            self.create_subscription(JointState, 'joint_states',
+                                     guard.wrap(self._on_joint_states),
                                      QoSProfile(depth=50,
                                                 reliability=ReliabilityPolicy.BEST_EFFORT))
         self._diag_timer = self.create_timer(v['diagnostics_period_s'],
-                                             self._publish_diagnostics)
+                                             guard.wrap(self._publish_diagnostics))
         self._annotator = Annotator(self) if v['publish_annotated'] else None
         g = cfg.setup.grid
         self.get_logger().info(
             f'{cfg.setup.mode} mode, count model {cfg.setup.name!r} ({g.rows}x{g.cols} grid, '
             f'K = {cfg.setup.model.max_count + 1}), detector {cfg.setup.detector!r}; waiting '
             f'for fixation and image')
-        if getattr(cfg.setup.model, 'has_scan', False):
-            self.get_logger().warning(
-                f'{cfg.setup.name!r} has a one-time whole-image scan, which this node does not '
-                f'serve: its frames hold the fovea windows only (faces-420-nmpt has none)')
+        for note in cfg.setup.notes:
+            self.get_logger().warning(note)
 
     @property
     def _config(self) -> DetectorConfig:
@@ -195,10 +221,12 @@ class FovealDetectorNode(Node):
         self.loop.set_setup(cfg.setup)
         self.loop.head = cfg.head
         self.loop.tolerance_s = cfg.values['joint_state_tolerance_s']
+        self.loop.stamp_tolerance_s = cfg.values['stamp_tolerance_s']
+        self.loop.max_age_s = cfg.values['max_image_age_s']
         if cfg.values['diagnostics_period_s'] != old.values['diagnostics_period_s']:
             self.destroy_timer(self._diag_timer)
             self._diag_timer = self.create_timer(cfg.values['diagnostics_period_s'],
-                                                 self._publish_diagnostics)
+                                                 self.guard.wrap(self._publish_diagnostics))
 
     # -- inputs --------------------------------------------------------------------------
     def _now_s(self) -> float:
@@ -214,49 +242,61 @@ class FovealDetectorNode(Node):
         except images.ImageError as exc:
             self._handle(self.loop.reject(str(exc)))
             return
+        now = self.get_clock().now()
         stamp = msg.header.stamp
         if stamps.is_zero(stamp):
-            stamp = self.get_clock().now().to_msg()
-        self._handle(self.loop.add_image(stamps.to_seconds(stamp), pixels, stamp))
+            stamp = now.to_msg()
+        self._handle(self.loop.add_image(stamps.to_seconds(stamp), pixels, stamp,
+                                         now.nanoseconds * 1e-9))
 
     def _on_camera_info(self, msg: CameraInfo) -> None:
         try:
             camera = images.camera_from_info(msg)
         except images.ImageError as exc:
-            self.get_logger().warning(f'ignored a camera_info: {exc}',
-                                      throttle_duration_sec=WARN_THROTTLE_S)
+            self._handle(self.loop.refuse('camera_info', str(exc)))
             return
-        if camera != self.loop.camera:
-            mismatch = self.loop.set_camera(camera)
-            if mismatch:
-                self.get_logger().warning(mismatch)
-        self._handle(self.loop.serve())
+        outcome = self.loop.set_camera(camera, self._config.values['max_image_side_px'])
+        if self.loop.mismatch:
+            self.get_logger().warning(self.loop.mismatch)
+            self.loop.mismatch = ''
+        self._handle(outcome)
 
     def _on_joint_states(self, msg: JointState) -> None:
         head = self._config.head
-        if head is None:
-            return
+        if head is None or head.pan_joint not in msg.name or head.tilt_joint not in msg.name:
+            return              # a joint state of other joints: not the head's
         try:
             pan, tilt = joints.angles_from_joint_state(msg, head)
-        except ValueError:
-            return              # a joint state of other joints: not the head's
-        self._handle(self.loop.add_pose(self._stamp_s(msg.header.stamp), pan, tilt))
+        except ValueError as exc:
+            self._handle(self.loop.refuse('joint_states', str(exc)))
+            return
+        self._handle(self.loop.add_pose(self._stamp_s(msg.header.stamp), pan, tilt,
+                                        self._now_s()))
 
     def _on_fixation(self, msg: Int32MultiArray) -> None:
         try:
-            cell = grid_arrays.cell_from_row_col(msg, self._config.setup.grid, 'fixation')
+            cell, search_id = grid_arrays.read_fixation(msg, self._config.setup.grid)
         except ValueError as exc:
-            self.get_logger().warning(f'ignored a fixation: {exc}',
-                                      throttle_duration_sec=WARN_THROTTLE_S)
+            self._handle(self.loop.refuse('fixation', str(exc)))
             return
-        self._handle(self.loop.fixate(cell, self._now_s()))
+        if cell is None:
+            if not self._config.values['publish_image']:
+                self._handle(self.loop.refuse(
+                    'fixation', 'a scan request needs publish_image: true (a scan frame is '
+                                'tagged in evidence_image)'))
+                return
+            self._handle(self.loop.request_scan(search_id, self._now_s()))
+            return
+        self._handle(self.loop.fixate(cell, self._now_s(), search_id))
 
     # -- outputs -------------------------------------------------------------------------
     def _handle(self, outcome) -> None:
         if outcome.status == 'published':
             frame, grid = outcome.frame, self._config.setup.grid
             if self._config.values['publish_image']:
-                self._image_pub.publish(images.evidence_image(frame.counts, grid, frame.token))
+                self._image_pub.publish(images.evidence_image(
+                    frame.counts, grid, frame.token,
+                    images.frame_tag(frame.kind, frame.search_id)))
             else:
                 self._evidence_pub.publish(grid_arrays.to_multiarray(frame.counts, grid))
             if self._annotator is not None:
@@ -265,6 +305,11 @@ class FovealDetectorNode(Node):
             self.get_logger().warning(
                 f'rejected an image ({self.loop.rejected} so far): {outcome.reason}',
                 throttle_duration_sec=WARN_THROTTLE_S)
+        elif outcome.status == 'refused':
+            refused = sum(counts[1] for counts in self.loop.inputs.values())
+            self.get_logger().warning(
+                f'ignored a message ({refused} so far): {outcome.reason}',
+                throttle_duration_sec=WARN_THROTTLE_S)
         elif outcome.status == 'waiting' and outcome.reason.startswith('no camera_info'):
             self.get_logger().warning(
                 f"a fixation waits: {outcome.reason}; is the camera driver's camera_info "
@@ -272,14 +317,18 @@ class FovealDetectorNode(Node):
                 throttle_duration_sec=WARN_THROTTLE_S)
 
     def _publish_diagnostics(self) -> None:
-        values = self.loop.values()
+        values = {**self.loop.values(), **self.guard.values()}
         level, message = 'ok', 'serving fixations'
+        now = (self.loop.rejected, sum(c[1] for c in self.loop.inputs.values()),
+               self.guard.errors)
+        new = [b - a for a, b in zip(self._reported, now)]
         if values['waiting_for_image'] and self.loop.waiting.startswith('no camera_info'):
             level, message = 'warn', 'no camera_info received'
-        elif self.loop.rejected > self._reported_rejections:
+        elif any(new):
             level = 'warn'
-            message = f'{self.loop.rejected - self._reported_rejections} images rejected'
-        self._reported_rejections = self.loop.rejected
+            message = ', '.join(f'{n} {what}' for n, what in zip(
+                new, ('images rejected', 'other messages ignored', 'callback errors')) if n)
+        self._reported = now
         self._diag_pub.publish(diagnostics.diagnostic_array(
             [diagnostics.status(f'{self.get_fully_qualified_name()}: detector', level, message,
                                 values)], self.get_clock().now().to_msg()))

@@ -29,9 +29,45 @@ STACK_DUMP_MAIN = ('import faulthandler, signal, sys; '
                    'from ipomdp_gaze.nodes.{node} import main; sys.exit(main())')
 
 
+_RESERVED: dict[int, object] = {}
+
+
 def domain_id_for(pid: int | None = None) -> int:
-    """Derive a ROS domain id in 0..101 from a process id (default: this process)."""
-    return (os.getpid() if pid is None else int(pid)) % (MAX_DOMAIN_ID + 1)
+    """
+    Return a ROS domain id for this run: one no other run on this host holds.
+
+    With ``pid``, the old derivation ``pid mod 102`` (no reservation). Without, this process
+    reserves a domain in 1..101 (0 is the default domain of a real robot) by holding an
+    exclusive ``flock`` on ``<tmp>/ipomdp_gaze-ros-domains/<id>.lock`` until it exits, starting
+    from its pid and taking the next free one; later calls return the same id. Two test runs,
+    benches or demos at once therefore never share a domain (the pid modulo 102 once collided).
+
+    Raises
+    ------
+    RuntimeError
+        If every domain 1..101 is held by another process.
+
+    """
+    if pid is not None:
+        return int(pid) % (MAX_DOMAIN_ID + 1)
+    if _RESERVED:
+        return next(iter(_RESERVED))
+    import fcntl
+    folder = Path(tempfile.gettempdir()) / 'ipomdp_gaze-ros-domains'
+    folder.mkdir(parents=True, exist_ok=True)
+    start = os.getpid()
+    for k in range(MAX_DOMAIN_ID):
+        domain = 1 + (start + k) % MAX_DOMAIN_ID
+        handle = open(folder / f'{domain}.lock', 'a')
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            handle.close()
+            continue
+        _RESERVED[domain] = handle            # held (and the lock with it) until exit
+        return domain
+    raise RuntimeError(f'every ROS domain id 1..{MAX_DOMAIN_ID} is held by another run '
+                       f'(locks in {folder})')
 
 
 def ros_environment(domain_id: int, log_dir, base: dict | None = None) -> dict:
@@ -210,8 +246,8 @@ def isolated_nodes(domain_id: int | None = None, prefix: str = 'ipomdp-gaze-',
     """
     Yield a :class:`NodeGroup` on a domain of its own with its logs in a temporary folder.
 
-    The domain defaults to :func:`domain_id_for` this process. Every node still running at the
-    end is stopped (SIGTERM), and the folder is removed.
+    The domain defaults to the one :func:`domain_id_for` reserves for this process. Every node
+    still running at the end is stopped (SIGTERM), and the folder is removed.
     """
     domain = domain_id_for() if domain_id is None else domain_id
     with tempfile.TemporaryDirectory(prefix=prefix) as tmp:

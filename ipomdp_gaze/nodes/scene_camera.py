@@ -22,6 +22,8 @@ with ``rate_hz > 0`` it streams frames like a video camera, also while moving. A
 ``image`` (``rgb8``), ``camera_info`` and, for ``pan_tilt``, ``joint_states`` (its pose), all
 with one stamp. ``ground_truth`` (``std_msgs/Int32MultiArray`` ``[row, col]`` of the face
 centre's cell in the grid of the view, transient local) is published once when it is known.
+Every callback runs under a :class:`ipomdp_gaze.nodes.guard.CallbackGuard` (its counts in the
+``/diagnostics`` status ``<node>: callbacks``).
 """
 from __future__ import annotations
 
@@ -37,6 +39,7 @@ from sensor_msgs.msg import CameraInfo, Image, JointState
 from std_msgs.msg import Int32MultiArray
 
 from . import NODE_NAMES
+from .guard import CallbackGuard
 from .params import (head_from, INT_MAX, joint_params, MAX_CELLS_PER_SIDE, Param,
                      ParameterTransaction, T)
 from .saccade import SaccadeMixin
@@ -60,6 +63,9 @@ def scene_camera_params() -> list[Param]:
               'pose (read-only)', read_only=True, choices=VIEWS),
         Param('seed', 0, T.INTEGER, 'which held-out test scene (read-only)', read_only=True,
               int_range=(0, INT_MAX)),
+        Param('scene.empty', False, T.BOOL,
+              'pan_tilt view: the test scene of seed without its face, nobody here (read-only)',
+              read_only=True),
         Param('scene.file', '', T.STRING,
               "a user's image instead of a test scene (read-only)", read_only=True),
         Param('scene.face_x_px', -1.0, T.DOUBLE,
@@ -135,7 +141,8 @@ def _scene_config(values: dict) -> SceneConfig:
         if values['scene.file']:
             scene = user_scene(read_scene_file(values['scene.file']), centre, geometry)
         else:
-            scene = PanTiltSceneSet('test', geometry, faces, 'rgb', values['seed']).scene(0)
+            scene = PanTiltSceneSet('test', geometry, faces, 'rgb', values['seed'],
+                                    empty=values['scene.empty']).scene(0)
         return SceneConfig(dict(values), grid, camera, scene, geometry,
                            head_from(values, grid))
     if values['scene.file']:
@@ -153,8 +160,10 @@ class SceneCameraNode(SaccadeMixin, Node):
 
     def __init__(self, **kwargs):
         super().__init__(NODE_NAME, **kwargs)
-        self._transaction = ParameterTransaction(self, scene_camera_params(), self._build,
-                                                 self._apply_config)
+        self.guard = CallbackGuard(self)
+        self._transaction = ParameterTransaction(self, scene_camera_params(),
+                                                 self.guard.refusing(self._build),
+                                                 self.guard.wrap(self._apply_config))
         self._transaction.declare()
         self._transaction.start(_scene_config(self._transaction.values()))
         cfg = self._config
@@ -165,15 +174,20 @@ class SceneCameraNode(SaccadeMixin, Node):
         self._info_pub = self.create_publisher(CameraInfo, 'camera_info', IMAGE_QOS)
         self._joint_pub = self.create_publisher(JointState, 'joint_states', 10)
         self._truth_pub = self.create_publisher(Int32MultiArray, 'ground_truth', STATE_QOS)
-        self.create_subscription(JointState, 'pan_tilt', self._on_command, STATE_QOS)
+        self.create_subscription(JointState, 'pan_tilt', self.guard.wrap(self._on_command),
+                                 STATE_QOS)
         self._saccade_timer = self._frame_timer = None
         self._make_timers(cfg.values)
         scene = cfg.scene
         if scene.cell is not None:
             self._truth_pub.publish(grid_arrays.ground_truth(cfg.grid, cfg.grid.index(
                 *scene.cell)))
+        elif cfg.values.get('scene.empty'):
+            self._truth_pub.publish(grid_arrays.ground_truth(cfg.grid, None))   # [-1, -1]
+        self.guard.publish_status()
         height, width = self._view(self.pose).shape[:2]
-        where = 'no face given' if scene.face_centre_px is None else \
+        where = 'nobody here' if cfg.values.get('scene.empty') else 'no face given' \
+            if scene.face_centre_px is None else \
             f'face centre ({scene.face_centre_px[0]:.1f}, {scene.face_centre_px[1]:.1f}) px ' \
             f'in cell {scene.cell}'
         self.get_logger().info(
@@ -206,10 +220,12 @@ class SceneCameraNode(SaccadeMixin, Node):
         if self.moving:
             self._arrive()
         if values['saccade_time_s'] > 0:
-            self._saccade_timer = self.create_timer(values['saccade_time_s'], self._on_arrival)
+            self._saccade_timer = self.create_timer(values['saccade_time_s'],
+                                                    self.guard.wrap(self._on_arrival))
             self._saccade_timer.cancel()
         if values['rate_hz'] > 0:
-            self._frame_timer = self.create_timer(1.0 / values['rate_hz'], self._publish_frame)
+            self._frame_timer = self.create_timer(1.0 / values['rate_hz'],
+                                                  self.guard.wrap(self._publish_frame))
 
     # -- head ------------------------------------------------------------------------------
     def _on_command(self, msg: JointState) -> None:

@@ -45,7 +45,10 @@ def run_node(make_node, node_name: str, args=None) -> int:
     Run a node with the Jazzy idiom: init, spin until SIGINT/SIGTERM, destroy, try_shutdown.
 
     An invalid start-up parameter (``ValueError`` or ``ParameterException`` from the node's
-    constructor) prints one line naming it and returns 1; a clean shutdown returns 0.
+    constructor) prints one line naming it and returns 1; a clean shutdown returns 0. Only the
+    constructor's errors are configuration errors: an exception that escapes a callback while
+    spinning (a callback not guarded by :class:`ipomdp_gaze.nodes.guard.CallbackGuard`) is a
+    bug, and is raised with its traceback.
     """
     from rclpy.exceptions import ParameterException
     from rclpy.executors import ExternalShutdownException
@@ -54,17 +57,19 @@ def run_node(make_node, node_name: str, args=None) -> int:
     node = None
     status = 0
     try:
-        node = make_node()
-        spin(node)
+        try:
+            node = make_node()
+        except (ValueError, ParameterException) as exc:
+            print(f'{node_name}: error: {exc}', file=sys.stderr)
+            status = 1
+        else:
+            spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except _rclpy.RCLError:
         # SIGTERM/SIGINT shut the context down while the executor was building its wait set.
         if rclpy.ok():
             raise
-    except (ValueError, ParameterException) as exc:
-        print(f'{node_name}: error: {exc}', file=sys.stderr)
-        status = 1
     finally:
         if node is not None:
             node.destroy_node()

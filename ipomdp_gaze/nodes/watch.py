@@ -193,6 +193,16 @@ class Watch:
         self.node.create_subscription(DiagnosticArray, '/diagnostics', status, 50)
         return status
 
+    def status_values(self, suffix: str) -> list:
+        """Collect the values of every ``/diagnostics`` status whose name ends with ``suffix``."""
+        values = []
+
+        def on_diagnostics(msg: DiagnosticArray) -> None:
+            values.extend(diagnostics.values_of(item) for item in msg.status
+                          if item.name.endswith(suffix))
+        self.node.create_subscription(DiagnosticArray, '/diagnostics', on_diagnostics, 50)
+        return values
+
     def publisher(self, msg_type, topic: str, qos=10):
         """Create a publisher on ``topic``."""
         return self.node.create_publisher(msg_type, topic, qos)
@@ -288,15 +298,20 @@ class SearchRecord:
     What the controller and the camera publish during searches, as ``(t, msg)`` lists.
 
     ``beliefs`` (``belief``, keep-last ``depth``; with ``updates_only`` not the uniform belief of
-    a reset), ``targets`` (``pan_tilt``, latched, each sent target once), ``found`` and ``truth``
-    (the camera's ``ground_truth``, latched).
+    a reset; with ``n_cells`` only beliefs of that many cells, not a previous run's grid),
+    ``targets`` (``pan_tilt``, latched, each sent target once), ``found``, ``absent`` and
+    ``truth`` (the camera's ``ground_truth``, latched).
     """
 
-    def __init__(self, watch: Watch, depth: int = 200, updates_only: bool = False):
-        self.beliefs = watch.record(Float32MultiArray, 'belief', depth,
-                                    keep=is_update if updates_only else None)
+    def __init__(self, watch: Watch, depth: int = 200, updates_only: bool = False,
+                 n_cells: int | None = None):
+        def keep(msg) -> bool:
+            fits = n_cells is None or len(msg.data) == n_cells    # not another run's grid
+            return fits and (not updates_only or is_update(msg))
+        self.beliefs = watch.record(Float32MultiArray, 'belief', depth, keep=keep)
         self.targets = watch.record(JointState, 'pan_tilt', LATCHED, distinct_stamps=True)
         self.found = watch.record(DiagnosticStatus, 'found', 10)
+        self.absent = watch.record(DiagnosticStatus, 'absent', 10)
         self.truth = watch.record(Int32MultiArray, 'ground_truth', LATCHED)
 
     def belief(self, i: int = -1) -> np.ndarray:

@@ -22,16 +22,23 @@ image and without an offset (the scan does not depend on the fixation): ``scan_t
 the cell holding the face centre, ``scan_null[c]`` from every other cell, with the same prior.
 
 The work is one fovea pass per (image, fixation): :func:`tally_images` spreads images over
-processes, each with its own detector (OpenCV objects cannot be shared).
+processes, each with its own detector (OpenCV objects cannot be shared), built by the factory
+(:func:`ipomdp_gaze.vision.detectors.detector_from_spec`) from plain settings: ``kind`` (default
+``haar``) and the detector's own options.
+
+**What is tallied** is each cell's observation under a :class:`CellObservation` rule (the clipped
+count by default; the best score in bins, or the count above a score threshold). Every tally also
+keeps the best score of each observed cell holding a detection (:attr:`Tallies.scores`), from
+which :func:`choose_edges` picks the bins of a ``score_bins`` rule on training data.
 """
 from __future__ import annotations
 
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.observation import CountObservation
-from ipomdp_gaze.vision.detector import HaarDetector
+from ipomdp_gaze.vision.cell_observation import CellObservation, quantile_edges
+from ipomdp_gaze.vision.detectors import detector_from_spec
 from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig
 import numpy as np
 
@@ -48,6 +55,11 @@ class Tallies:
     fixations: int = 0
     detector_pixels: int = 0
     seconds: float = 0.0
+    scores: np.ndarray = None
+
+    def __post_init__(self):
+        if self.scores is None:
+            self.scores = np.empty(0)
 
     @classmethod
     def empty(cls, grid: Grid, max_count: int) -> Tallies:
@@ -65,7 +77,28 @@ class Tallies:
         self.fixations += other.fixations
         self.detector_pixels += other.detector_pixels
         self.seconds += other.seconds
+        self.scores = np.concatenate([self.scores, other.scores])
         return self
+
+
+def best_scores(cells, scores, observed=None) -> np.ndarray:
+    """
+    Return the best score of each cell holding a detection, ``(C,)``, in cell order.
+
+    ``cells`` ``(M,)`` and ``scores`` ``(M,)`` describe the detections; with ``observed``
+    (a boolean mask over cells) only those cells count.
+    """
+    cells = np.asarray(cells, dtype=np.int64)
+    scores = np.asarray(scores, dtype=np.float64)
+    keep = cells >= 0
+    if observed is not None:
+        keep &= np.asarray(observed)[np.clip(cells, 0, None)]
+    cells, scores = cells[keep], scores[keep]
+    if cells.size == 0:
+        return np.empty(0)
+    order = np.lexsort((-scores, cells))
+    first = np.r_[True, cells[order][1:] != cells[order][:-1]]
+    return scores[order][first]
 
 
 def tally_image(fovea: Fovea, image: np.ndarray, target_cell: int | None,
@@ -80,12 +113,17 @@ def tally_image(fovea: Fovea, image: np.ndarray, target_cell: int | None,
     fovea.start(image)
     scan = fovea.scan()
     frames = np.empty((fixations.size, grid.n_cells))
+    scores = [np.empty(0)] if scan is None else [best_scores(scan.cells, scan.scores)]
     for i, k in enumerate(fixations):
-        frames[i] = fovea.observe(int(k)).counts
+        observation = fovea.observe(int(k))
+        frames[i] = observation.counts
+        scores.append(best_scores(observation.cells, observation.scores,
+                                  ~np.isnan(observation.counts)))
     tallies = tally_frames(grid, fovea.config.max_count, frames, fixations, target_cell,
                            None if scan is None else scan.counts)
     tallies.detector_pixels = fovea.image_detector_pixels
     tallies.seconds = fovea.image_seconds
+    tallies.scores = np.concatenate(scores)
     return tallies
 
 
@@ -128,9 +166,10 @@ def _worker_tally(job) -> Tallies:
     """Tally a chunk of images in a worker process (its own detector and fovea)."""
     import cv2
     cv2.setNumThreads(1)
-    detector_kwargs, grid_shape, config, items, fixations = job
-    fovea = Fovea(HaarDetector(**detector_kwargs), grid_shape, FoveaConfig.from_dict(config),
-                  reuse_windows=True)
+    detector_spec, grid_shape, config, items, fixations, cells = job
+    config = FoveaConfig.from_dict(config)
+    fovea = Fovea(detector_from_spec(detector_spec), grid_shape, config, reuse_windows=True,
+                  cells=_cells(cells, config.max_count))
     total = Tallies.empty(fovea.grid, fovea.config.max_count)
     for item in items:
         image, target = _resolve(item)
@@ -152,6 +191,24 @@ def lattice_fixations(grid: Grid, stride: int) -> np.ndarray:
     return (rows[:, None] * grid.cols + cols[None, :]).ravel()
 
 
+def _cells(cells: dict | None, max_count: int) -> CellObservation:
+    """Return the cell observation rule of a job (None: counts clipped at ``max_count``)."""
+    return CellObservation('counts', max_count) if cells is None else \
+        CellObservation.from_dict(cells)
+
+
+def choose_edges(tallies: Tallies, max_count: int) -> CellObservation:
+    """
+    Return the ``score_bins`` rule of K = ``max_count`` whose bins share out the training scores.
+
+    The edges are :func:`ipomdp_gaze.vision.cell_observation.quantile_edges` of
+    ``tallies.scores`` (the best score of every observed cell holding a detection), ``K - 1``
+    bins; a detector with fewer distinct scores gets fewer bins (a smaller K).
+    """
+    edges = quantile_edges(tallies.scores, max_count - 1)
+    return CellObservation('score_bins', len(edges) + 2, edges)
+
+
 def _resolve(item):
     """Return ``(image, target_cell)`` of an item, regenerating ``('scene', kwargs, i)``."""
     if len(item) == 3 and isinstance(item[0], str) and item[0] == 'scene':
@@ -164,30 +221,40 @@ def _resolve(item):
     return item
 
 
-def _run_jobs(worker, jobs: list, total: Tallies, processes: int, progress) -> Tallies:
+def _run_jobs(worker, jobs: list, total: Tallies, processes: int, progress,
+              executor=None) -> Tallies:
     """
-    Add ``worker(job)`` of every job to ``total``, in ``processes`` workers (1: here).
+    Add ``worker(job)`` of every job to ``total``, on ``executor`` (:mod:`ipomdp_gaze.executor`).
 
-    ``job[3]`` is the job's list of images or scenes: ``progress`` gets its length.
+    Without an executor, ``processes`` local workers (1: here). ``job[3]`` is the job's list of
+    images or scenes: ``progress`` gets its length as each job finishes. The parts are added in
+    job order, so the tallies are the same wherever the jobs ran.
     """
-    if processes <= 1:
-        parts = map(worker, jobs)
-    else:
-        pool = ProcessPoolExecutor(processes)
-        parts = pool.map(worker, jobs)
+    from ipomdp_gaze.executor import make_executor
+    own = executor is None
+    executor = make_executor(processes) if own else executor
     try:
-        for job, part in zip(jobs, parts):
-            total += part
+        futures = []
+        for job in jobs:
+            future = executor.submit(worker, job)
             if progress:
-                progress(len(job[3]))
-    finally:
-        if processes > 1:
-            pool.shutdown()
+                future.add_done_callback(
+                    lambda f, n=len(job[3]): f.cancelled() or f.exception() or progress(n))
+            futures.append(future)
+        for future in futures:
+            total += future.result()
+    except BaseException:
+        if own:
+            executor.close(cancel=True)
+        raise
+    if own:
+        executor.close()
     return total
 
 
 def tally_images(items, detector_kwargs: dict, grid: Grid, config: FoveaConfig,
-                 processes: int = 2, progress=None, fixations=None) -> Tallies:
+                 processes: int = 2, progress=None, fixations=None, executor=None,
+                 cells: CellObservation | None = None) -> Tallies:
     """
     Tally many labelled images, spread over ``processes`` worker processes.
 
@@ -197,22 +264,30 @@ def tally_images(items, detector_kwargs: dict, grid: Grid, config: FoveaConfig,
         ``(image, target_cell)`` pairs (target None when the image has no face), or
         ``('scene', SceneSet keyword arguments, index)`` triples regenerated in the workers.
     detector_kwargs : dict
-        Arguments of :class:`HaarDetector`.
+        The detector's ``kind`` (default ``haar``) and options
+        (:func:`ipomdp_gaze.vision.detectors.detector_from_spec`).
     grid, config
         The grid tiling each image and the fovea.
     processes : int
-        Worker processes (1: in this process).
+        Worker processes (1: in this process) when no ``executor`` is given.
     progress : callable, optional
         Called with the number of images done after each chunk.
     fixations : array of int, optional
         The fixated cells of every image (default: all; see :func:`lattice_fixations`).
+    executor : optional
+        Where the chunks run (:func:`ipomdp_gaze.executor.make_executor`); the tallies do not
+        depend on it.
+    cells : CellObservation, optional
+        What a cell's observation is (default: the clipped count); its K is the fovea's.
 
     """
     total = Tallies.empty(grid, config.max_count)
-    chunk = max(1, min(8, len(items) // max(1, 4 * processes)))
-    jobs = [(dict(detector_kwargs), grid.shape, config.to_dict(), items[i:i + chunk], fixations)
-            for i in range(0, len(items), chunk)]
-    return _run_jobs(_worker_tally, jobs, total, processes, progress)
+    workers = processes if executor is None else executor.workers
+    chunk = max(1, min(8, len(items) // max(1, 4 * workers)))
+    rule = None if cells is None else cells.to_dict()
+    jobs = [(dict(detector_kwargs), grid.shape, config.to_dict(), items[i:i + chunk], fixations,
+             rule) for i in range(0, len(items), chunk)]
+    return _run_jobs(_worker_tally, jobs, total, processes, progress, executor)
 
 
 def tally_views(observer, geometry, scene_image: np.ndarray, target_cell: int | None,
@@ -227,15 +302,18 @@ def tally_views(observer, geometry, scene_image: np.ndarray, target_cell: int | 
     grid = observer.grid
     fixations = np.arange(grid.n_cells) if fixations is None else np.asarray(fixations)
     frames = np.empty((fixations.size, grid.n_cells))
-    pixels, seconds = 0, 0.0
+    pixels, seconds, scores = 0, 0.0, [np.empty(0)]
     for i, k in enumerate(fixations):
         view = geometry.render(scene_image, grid.cell(int(k)))
         observation = observer.observe(view, geometry.camera, grid.cell(int(k)))
         frames[i] = observation.counts
         pixels += observation.detector_pixels
         seconds += observation.seconds
+        scores.append(best_scores(observation.cells, observation.scores,
+                                  ~np.isnan(observation.counts)))
     tallies = tally_frames(grid, observer.max_count, frames, fixations, target_cell)
     tallies.detector_pixels, tallies.seconds = pixels, seconds
+    tallies.scores = np.concatenate(scores)
     return tallies
 
 
@@ -245,11 +323,12 @@ def _worker_tally_views(job) -> Tallies:
     from ipomdp_gaze.head_camera import observed_cells
     from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, ViewObserver
     cv2.setNumThreads(1)
-    detector_kwargs, max_count, scene_kwargs, indices, null_scenes = job
+    detector_spec, max_count, scene_kwargs, indices, null_scenes, cells = job
     scenes = PanTiltSceneSet.from_kwargs(scene_kwargs)
     geometry = scenes.geometry
     grid = geometry.grid
-    observer = ViewObserver(HaarDetector(**detector_kwargs), grid, max_count)
+    observer = ViewObserver(detector_from_spec(detector_spec), grid, max_count,
+                            _cells(cells, max_count))
     total = Tallies.empty(grid, max_count)
     poses = np.arange(grid.n_cells)
     for index in indices:
@@ -268,7 +347,8 @@ def _worker_tally_views(job) -> Tallies:
 
 def tally_pan_tilt_scenes(scenes, indices, detector_kwargs: dict, max_count: int,
                           null_scenes: int | None = None, processes: int = 2,
-                          progress=None) -> Tallies:
+                          progress=None, executor=None,
+                          cells: CellObservation | None = None) -> Tallies:
     """
     Tally pan/tilt scenes, the head at every pose, in worker processes.
 
@@ -286,25 +366,31 @@ def tally_pan_tilt_scenes(scenes, indices, detector_kwargs: dict, max_count: int
     indices : sequence of int
         Which scenes.
     detector_kwargs : dict
-        Arguments of :class:`HaarDetector`.
+        The detector's ``kind`` (default ``haar``) and options.
     max_count : int
         K.
     null_scenes : int, optional
         Scene indices below this are viewed from every pose (default: all of them).
     processes : int
-        Worker processes (1: in this process).
+        Worker processes (1: in this process) when no ``executor`` is given.
     progress : callable, optional
         Called with the number of scenes done after each chunk.
+    executor : optional
+        Where the chunks run (:func:`ipomdp_gaze.executor.make_executor`).
+    cells : CellObservation, optional
+        What a cell's observation is (default: the clipped count); its K must be ``max_count``.
 
     """
     indices = [int(i) for i in indices]
     null_scenes = max(indices, default=0) + 1 if null_scenes is None else int(null_scenes)
     grid = scenes.geometry.grid
     total = Tallies.empty(grid, max_count)
-    chunk = max(1, min(4, len(indices) // max(1, 4 * processes)))
+    workers = processes if executor is None else executor.workers
+    chunk = max(1, min(4, len(indices) // max(1, 4 * workers)))
+    rule = None if cells is None else cells.to_dict()
     jobs = [(dict(detector_kwargs), int(max_count), scenes.kwargs(), indices[i:i + chunk],
-             null_scenes) for i in range(0, len(indices), chunk)]
-    return _run_jobs(_worker_tally_views, jobs, total, processes, progress)
+             null_scenes, rule) for i in range(0, len(indices), chunk)]
+    return _run_jobs(_worker_tally_views, jobs, total, processes, progress, executor)
 
 
 def pool_target(tallies: np.ndarray, pool_radius: float, min_tallies: int = 0) -> np.ndarray:

@@ -4,21 +4,27 @@
 Object detectors for the digital fovea: the interface, OpenCV's Viola-Jones cascade, grey images.
 
 **The interface** (docs/design.md section 6) is deliberately small, so any detector can be plugged
-in: a detector is a callable ``detector(gray) -> boxes`` that takes a 2-D ``uint8`` grey image and
-returns an integer array of shape ``(M, 4)``, one row ``x, y, w, h`` per *raw* detection in that
-image's pixels (ungrouped: the count observation model counts the raw detections, so overlapping
-hits of one face are the evidence, not noise to be merged). Three optional attributes are used
-when present:
+in (:mod:`ipomdp_gaze.vision.detectors` finds and builds them by name). A detector is a callable
+``detector(image) -> boxes`` that takes a ``uint8`` image in the colour space it declares and
+returns an array of shape ``(M, 5)``, one row ``x, y, w, h, score`` per *raw* detection in that
+image's pixels, as floats (or ``(M, 4)``: every score is then 1). Raw means ungrouped: the count
+observation model counts the raw detections, so overlapping hits of one face are the evidence,
+not noise to be merged. :func:`as_detections` reads any such answer. The attributes:
 
+- ``color``: ``'gray'`` (a 2-D image, the default when absent) or ``'rgb'`` (``(H, W, 3)`` in
+  RGB order); :func:`to_detector_image` converts every input to it;
 - ``window_px``: ``(width, height)`` of the smallest image the detector can see anything in.
   :func:`to_gray` rejects input images smaller than that;
-- ``settings()``: a plain dict recorded in observation files, so a model is only ever applied with
-  the detector it was measured with;
+- ``settings()``: a plain dict recorded in observation files, with ``kind`` (the name the
+  factory builds it by) and every option needed to rebuild it, so a model is only ever applied
+  with the detector it was measured with; ``info_keys`` names the settings recorded for
+  information only (the OpenCV version, the window), which may differ when it is rebuilt;
 - ``group(boxes, min_neighbors)``: how to merge raw boxes into final detections (else
   :func:`group_boxes`).
 
 :class:`HaarDetector` is the reference detector of Butko & Movellan's CVPR 2009 follow-up:
-``haarcascade_frontalface_alt2.xml`` with ``detectMultiScale(gray, 1.1, minNeighbors=0)``.
+``haarcascade_frontalface_alt2.xml`` with ``detectMultiScale(gray, 1.1, minNeighbors=0)``. It
+returns ``(M, 4)`` integer boxes (its detections carry no score).
 
 **Pixel coordinates.** A box ``(x, y, w, h)`` covers ``[x, x+w) x [y, y+h)`` and has its centre at
 ``(x + w/2, y + h/2)``; pixel ``(r, c)`` covers ``[c, c+1) x [r, r+1)``.
@@ -41,14 +47,59 @@ GROUP_EPS = 0.2
 DEFAULT_MIN_NEIGHBORS = 3
 # Smallest image side anything is done with: a 1x1 image has no spatial structure at all.
 MIN_SIDE_PX = 2
+# The colour spaces a detector may declare (its ``color`` attribute).
+COLORS = ('gray', 'rgb')
+# Settings recorded for information only unless a detector names its own (``info_keys``).
+INFO_KEYS = ('opencv', 'window_px')
+# Set by the factory (ipomdp_gaze.vision.detectors) on what it builds: the kind it built it by.
+KIND_ATTRIBUTE = '_ipomdp_gaze_kind'
 
 
 @runtime_checkable
 class Detector(Protocol):
-    """Anything called as ``detector(gray) -> (M, 4)`` integer boxes ``x, y, w, h`` (raw)."""
+    """
+    A detector: ``detector(image) -> (M, 5)`` raw boxes ``x, y, w, h, score`` (module docstring).
 
-    def __call__(self, gray: np.ndarray) -> np.ndarray:
-        """Detect objects in a 2-D ``uint8`` image; return the raw boxes in its pixels."""
+    ``color`` (``'gray'`` or ``'rgb'``), ``window_px`` and ``settings()`` are read when present.
+    """
+
+    def __call__(self, image: np.ndarray) -> np.ndarray:
+        """Detect objects in a ``uint8`` image; return the raw boxes in its pixels."""
+
+
+def as_detections(result) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Read a detector's answer: boxes ``(M, 4)`` ``float64`` ``x, y, w, h`` and scores ``(M,)``.
+
+    ``result`` is ``(M, 5)`` rows ``x, y, w, h, score`` or ``(M, 4)`` (every score 1), any
+    numeric type; OpenCV's empty tuple and a plain list are accepted.
+
+    Raises
+    ------
+    ValueError
+        If the shape is not ``(M, 4)`` or ``(M, 5)``, a number is not finite, or a box has no
+        positive width and height.
+
+    """
+    array = np.asarray(result, dtype=np.float64) if np.size(result) else np.empty((0, 5))
+    if array.ndim != 2 or array.shape[1] not in (4, 5):
+        raise ValueError(f'a detector must return boxes of shape (M, 5) x, y, w, h, score or '
+                         f'(M, 4), got {array.shape}')
+    if not np.all(np.isfinite(array)):
+        raise ValueError('a detector returned a box or score that is not a finite number')
+    if np.any(array[:, 2:4] <= 0):
+        raise ValueError('every box must have a positive width and height')
+    scores = array[:, 4].copy() if array.shape[1] == 5 else np.ones(len(array))
+    return np.ascontiguousarray(array[:, :4]), scores
+
+
+def detector_color(detector) -> str:
+    """Return the colour space ``detector`` takes: its ``color`` attribute, else ``'gray'``."""
+    color = getattr(detector, 'color', 'gray')
+    if color not in COLORS:
+        raise ValueError(f"a detector's color must be one of {', '.join(COLORS)}, got "
+                         f'{color!r}')
+    return color
 
 
 def as_boxes(boxes) -> np.ndarray:
@@ -171,6 +222,8 @@ class HaarDetector:
     """
     OpenCV's Viola-Jones cascade returning raw, ungrouped detections (the CVPR 2009 detector).
 
+    Detector kind ``haar``: grey images in, ``(M, 4)`` integer boxes out (no scores).
+
     Parameters
     ----------
     cascade : str or os.PathLike
@@ -186,6 +239,10 @@ class HaarDetector:
         Folder (or file) searched before the default places.
 
     """
+
+    kind = 'haar'
+    color = 'gray'
+    info_keys = INFO_KEYS
 
     def __init__(self, cascade=REFERENCE_CASCADE, scale_factor: float = 1.1,
                  min_neighbors: int = 0, min_size_px=None, max_size_px=None, cascade_dir=None):
@@ -212,6 +269,32 @@ class HaarDetector:
             self._options['minSize'] = self.min_size_px
         if self.max_size_px is not None:
             self._options['maxSize'] = self.max_size_px
+
+    @classmethod
+    def from_settings(cls, settings: dict, cascade_dir=None) -> HaarDetector:
+        """
+        Rebuild the detector :meth:`settings` describes (an observation model's record).
+
+        The cascade is looked up by file name (:func:`find_cascade`, ``cascade_dir`` first), and
+        a copy whose SHA-256 differs from the recorded one is refused.
+
+        Raises
+        ------
+        ValueError
+            For a cascade that differs from the recorded one, or bad settings.
+        FileNotFoundError
+            If the cascade file is not installed.
+
+        """
+        options = {key: settings[key] for key in ('cascade', 'scale_factor', 'min_neighbors',
+                                                  'min_size_px', 'max_size_px')
+                   if key in settings}
+        detector = cls(cascade_dir=cascade_dir, **options)
+        recorded = settings.get('cascade_sha256')
+        if recorded is not None and recorded != detector._sha256:
+            raise ValueError(f'the installed cascade {detector.path} differs from the one the '
+                             f'observation model was measured with (SHA-256 {recorded[:12]}...)')
+        return detector
 
     def __call__(self, gray: np.ndarray) -> np.ndarray:
         """
@@ -264,9 +347,21 @@ class HaarDetector:
 
 
 def detector_settings(detector) -> dict:
-    """``detector.settings()`` if it has one, else ``{'kind': <its type name>}``."""
+    """
+    Return ``detector.settings()`` (if it has one) with the detector's ``kind`` first.
+
+    ``kind`` is the name the factory (:func:`ipomdp_gaze.vision.detectors.make_detector`) built
+    the detector by; for a detector built otherwise, the kind its settings give, else its class
+    as ``module:Class``, so that the factory can rebuild it when it takes no options.
+    """
     settings = getattr(detector, 'settings', None)
-    return dict(settings()) if callable(settings) else {'kind': type(detector).__name__}
+    out = dict(settings()) if callable(settings) else {}
+    kind = getattr(detector, KIND_ATTRIBUTE, None)
+    if kind is None and 'kind' not in out:
+        kind = f'{type(detector).__module__}:{type(detector).__qualname__}'
+    if kind is not None:
+        out['kind'] = kind
+    return {'kind': out.pop('kind'), **out}
 
 
 def detector_window_px(detector) -> tuple[int, int]:
@@ -315,4 +410,22 @@ def to_gray(image, min_size_px=(MIN_SIDE_PX, MIN_SIDE_PX)) -> np.ndarray:
                          f'{min_width}x{min_height} the detector needs')
     if image.ndim == 3:
         return cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_RGB2GRAY)
+    return np.ascontiguousarray(image)
+
+
+def to_detector_image(image, color: str = 'gray',
+                      min_size_px=(MIN_SIDE_PX, MIN_SIDE_PX)) -> np.ndarray:
+    """
+    Return ``image`` in a detector's colour space (C-contiguous ``uint8``).
+
+    ``'gray'``: :func:`to_gray`. ``'rgb'``: an ``(H, W, 3)`` RGB image as given, a grey one with
+    its value in all three channels. Checks as :func:`to_gray` does.
+    """
+    gray = to_gray(image, min_size_px)
+    if color == 'gray':
+        return gray
+    if color != 'rgb':
+        raise ValueError(f"color must be one of {', '.join(COLORS)}, got {color!r}")
+    if image.ndim == 2:
+        return cv2.cvtColor(gray, cv2.COLOR_GRAY2RGB)
     return np.ascontiguousarray(image)

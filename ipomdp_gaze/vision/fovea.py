@@ -58,8 +58,10 @@ from typing import NamedTuple
 
 import cv2
 from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.vision.detector import (as_boxes, box_centres_px, detector_settings,
-                                         detector_window_px, to_gray)
+from ipomdp_gaze.vision.cell_observation import CellObservation
+from ipomdp_gaze.vision.detector import (as_detections, box_centres_px, detector_color,
+                                         detector_settings, detector_window_px,
+                                         to_detector_image)
 import numpy as np
 
 REFERENCE_WINDOWS_CELLS = (21, 15, 9, 3)
@@ -200,6 +202,10 @@ class Observation:
         ``(M, 2)`` ``float64``: ``x, y`` of every raw detection's centre in full-image pixels.
     window_index : numpy.ndarray
         ``(M,)`` ``int64``: the window each detection came from.
+    scores : numpy.ndarray
+        ``(M,)`` ``float64``: each detection's score (1 for a detector without scores).
+    cells : numpy.ndarray
+        ``(M,)`` ``int64``: the cell each detection was binned to.
     detector_pixels : int
         Pixels of the images given to the detector for this fixation (the resized windows);
         a window whose detections were reused from the cache counts 0.
@@ -219,6 +225,8 @@ class Observation:
     detector_pixels: int
     seconds: float
     from_cache: tuple
+    scores: np.ndarray = None
+    cells: np.ndarray = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -250,6 +258,8 @@ class Scan:
     centres_px: np.ndarray
     detector_pixels: int
     seconds: float
+    scores: np.ndarray = None
+    cells: np.ndarray = None
 
 
 def cell_edges_px(size_px: int, n_cells: int) -> np.ndarray:
@@ -294,6 +304,10 @@ class Fovea:
         Windows, scales, K and interpolation; the reference configuration by default.
     reuse_windows : bool
         Keep every window's detections for the current image, not only the whole-image window's.
+    cells : CellObservation, optional
+        What a cell's observation is (:mod:`ipomdp_gaze.vision.cell_observation`); default the
+        count of detections centred in it, clipped to ``config.max_count - 1``. Its K must be
+        ``config.max_count``.
 
     Attributes
     ----------
@@ -308,7 +322,7 @@ class Fovea:
     """
 
     def __init__(self, detector, grid=(21, 21), config: FoveaConfig | None = None,
-                 reuse_windows: bool = False):
+                 reuse_windows: bool = False, cells: CellObservation | None = None):
         if not callable(detector):
             raise ValueError(f'detector must be callable, got {type(detector).__name__}')
         self.detector = detector
@@ -321,6 +335,12 @@ class Fovea:
                              f'({self.config.windows_cells[0]} cells) does not cover the '
                              f'{self.grid.rows}x{self.grid.cols} grid')
         self.reuse_windows = bool(reuse_windows)
+        self.cells = CellObservation('counts', self.config.max_count) if cells is None else cells
+        if not isinstance(self.cells, CellObservation) or \
+                self.cells.max_count != self.config.max_count:
+            raise ValueError(f'cells must be a CellObservation with K = max_count '
+                             f'({self.config.max_count}), got {self.cells!r}')
+        self._color = detector_color(detector)
         self._scales = np.asarray(self.config.scales)
         self._gray = None
         self._row_edges_px = self._col_edges_px = None
@@ -337,11 +357,13 @@ class Fovea:
     @property
     def image_shape(self) -> tuple[int, int] | None:
         """``(H, W)`` of the current image, or ``None`` before :meth:`start`."""
-        return None if self._gray is None else self._gray.shape
+        return None if self._gray is None else self._gray.shape[:2]
 
     def start(self, image: np.ndarray) -> None:
         """
         Take a new image (grey or RGB ``uint8``, see :func:`to_gray`) and forget the last one.
+
+        The image is kept in the detector's colour space (:func:`to_detector_image`).
 
         Raises
         ------
@@ -352,8 +374,8 @@ class Fovea:
 
         """
         t0 = time.perf_counter()
-        gray = to_gray(image, detector_window_px(self.detector))
-        height, width = gray.shape
+        gray = to_detector_image(image, self._color, detector_window_px(self.detector))
+        height, width = gray.shape[:2]
         if height < self.grid.rows or width < self.grid.cols:
             raise ValueError(f'image of {width}x{height} pixels (WxH) is smaller than the '
                              f'{self.grid.cols}x{self.grid.rows} grid: some cells would be empty')
@@ -411,19 +433,22 @@ class Fovea:
             return None
         t0 = time.perf_counter()
         windows = tuple(w for w in self.window_rects(0) if w.whole_image)
-        centres, cells, pixels = [], [], 0
+        centres, cells, scores, pixels = [], [], [], 0
         for window in windows:
             found, cost = self._detect(window)
             pixels += cost
             centres.append(found[0])
             cells.append(found[1])
-        raw = np.bincount(np.concatenate(cells), minlength=self.grid.n_cells).astype(np.int64)
-        counts = np.minimum(raw, self.config.max_count - 1).astype(np.float64)
+            scores.append(found[2])
+        cells, scores = np.concatenate(cells), np.concatenate(scores)
+        raw = np.bincount(cells, minlength=self.grid.n_cells).astype(np.int64)
+        counts = self.cells.values(cells, scores, self.grid.n_cells).astype(np.float64)
         seconds = time.perf_counter() - t0
         self.image_detector_pixels += pixels
         self.image_seconds += seconds
         return Scan(counts=counts, raw_counts=raw, windows=windows,
-                    centres_px=np.concatenate(centres), detector_pixels=pixels, seconds=seconds)
+                    centres_px=np.concatenate(centres), detector_pixels=pixels, seconds=seconds,
+                    scores=scores, cells=cells)
 
     def observe(self, fixation: int) -> Observation:
         """
@@ -445,7 +470,7 @@ class Fovea:
             windows = tuple(w for w in windows if not w.whole_image)
         rows, cols = self.grid.shape
         observed = np.zeros((rows, cols), dtype=bool)
-        cells, centres, window_index, from_cache = [], [], [], []
+        cells, centres, scores, window_index, from_cache = [], [], [], [], []
         pixels = 0
         for i, window in enumerate(windows):
             row, col, n_rows, n_cols = window.cells
@@ -455,10 +480,12 @@ class Fovea:
             pixels += cost
             centres.append(found[0])
             cells.append(found[1])
+            scores.append(found[2])
             window_index.append(np.full(len(found[1]), i, dtype=np.int64))
-        cells = np.concatenate(cells)
+        cells, scores = np.concatenate(cells), np.concatenate(scores)
         raw = np.bincount(cells, minlength=rows * cols).astype(np.int64)
-        counts = np.where(observed.ravel(), np.minimum(raw, self.config.max_count - 1), np.nan)
+        counts = np.where(observed.ravel(), self.cells.values(cells, scores, rows * cols),
+                          np.nan)
         seconds = time.perf_counter() - t0
         self.image_detector_pixels += pixels
         self.image_seconds += seconds
@@ -467,7 +494,8 @@ class Fovea:
                            fixation=self.grid.index(*self.grid.cell(fixation)),
                            windows=windows, centres_px=np.concatenate(centres),
                            window_index=np.concatenate(window_index), detector_pixels=pixels,
-                           seconds=seconds, from_cache=tuple(from_cache))
+                           seconds=seconds, from_cache=tuple(from_cache), scores=scores,
+                           cells=cells)
 
     def _detect(self, window: Window) -> tuple[tuple, int]:
         """
@@ -485,8 +513,8 @@ class Fovea:
             self._cache[key] = found
         return found, window.resized_px[0] * window.resized_px[1]
 
-    def _search(self, window: Window) -> tuple[np.ndarray, np.ndarray]:
-        """Detect in one window: centres ``(M, 2)`` in full-image pixels and their cells."""
+    def _search(self, window: Window) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Detect in one window: centres ``(M, 2)`` in full-image pixels, cells, scores."""
         x, y, width_px, height_px = window.rect_px
         out_width, out_height = window.resized_px
         crop = self._gray[y:y + height_px, x:x + width_px]
@@ -495,12 +523,12 @@ class Fovea:
         else:
             view = cv2.resize(crop, (out_width, out_height),
                               interpolation=self.config.cv2_interpolation)
-        boxes = as_boxes(self.detector(view))
+        boxes, scores = as_detections(self.detector(view))
         centres = box_centres_px(boxes) * (width_px / out_width, height_px / out_height) + (x, y)
-        height, width = self._gray.shape
+        height, width = self._gray.shape[:2]
         row, col, n_rows, n_cols = window.cells
         cell_row = np.clip(np.floor(centres[:, 1] * self.grid.rows / height).astype(np.int64),
                            row, row + n_rows - 1)
         cell_col = np.clip(np.floor(centres[:, 0] * self.grid.cols / width).astype(np.int64),
                            col, col + n_cols - 1)
-        return centres, cell_row * self.grid.cols + cell_col
+        return centres, cell_row * self.grid.cols + cell_col, scores

@@ -22,8 +22,9 @@ import time
 
 import cv2
 from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.vision.detector import (as_boxes, box_centres_px, DEFAULT_MIN_NEIGHBORS,
-                                         detector_window_px, group_boxes, to_gray)
+from ipomdp_gaze.vision.detector import (as_detections, box_centres_px, DEFAULT_MIN_NEIGHBORS,
+                                         detector_color, detector_window_px, group_boxes,
+                                         to_detector_image)
 import numpy as np
 
 
@@ -52,6 +53,8 @@ class ScanResult:
     seconds : float
         Wall time from the decoded array to the answer: grey conversion, resizing, detector,
         grouping and binning.
+    scores : numpy.ndarray
+        ``(M,)`` score of each raw box (1 for a detector without scores).
 
     """
 
@@ -63,6 +66,7 @@ class ScanResult:
     scale: float
     detector_pixels: int
     seconds: float
+    scores: np.ndarray = None
 
 
 def cells_of_points(points_px: np.ndarray, image_shape: tuple[int, int], grid: Grid) -> np.ndarray:
@@ -90,8 +94,8 @@ def scan(image: np.ndarray, detector, grid=(21, 21), scale: float = 1.0,
     image : numpy.ndarray
         ``uint8`` grey ``(H, W)`` or RGB ``(H, W, 3)`` (:func:`to_gray`).
     detector : callable
-        ``detector(gray) -> (M, 4)`` raw boxes; its ``group`` method, if any, merges them
-        (else :func:`group_boxes`).
+        ``detector(image) -> (M, 5)`` or ``(M, 4)`` raw boxes, in its colour space; its
+        ``group`` method, if any, merges them (else :func:`group_boxes` on the rounded boxes).
     grid : Grid or (int, int)
         The grid tiling the image.
     scale : float
@@ -114,16 +118,16 @@ def scan(image: np.ndarray, detector, grid=(21, 21), scale: float = 1.0,
     scale = float(scale)
     if not (np.isfinite(scale) and 0.0 < scale <= 1.0):
         raise ValueError(f'scale must be in (0, 1], got {scale!r}')
-    gray = to_gray(image, detector_window_px(detector))
-    height, width = gray.shape
+    gray = to_detector_image(image, detector_color(detector), detector_window_px(detector))
+    height, width = gray.shape[:2]
     out_width = max(1, int(np.floor(width * scale + 0.5)))
     out_height = max(1, int(np.floor(height * scale + 0.5)))
     if (out_width, out_height) != (width, height):
         gray = cv2.resize(gray, (out_width, out_height), interpolation=interpolation)
-    raw = as_boxes(detector(gray))
+    raw, scores = as_detections(detector(gray))
     group = getattr(detector, 'group', None)
-    grouped = as_boxes(group(raw, min_neighbors) if callable(group)
-                       else group_boxes(raw, min_neighbors))
+    grouped = as_detections(group(raw, min_neighbors) if callable(group)
+                            else group_boxes(np.round(raw), min_neighbors))[0]
     back = np.array([width / out_width, height / out_height] * 2)
     boxes_px, grouped_px = raw * back, grouped * back
     counts = np.bincount(cells_of_points(box_centres_px(boxes_px), (height, width), grid),
@@ -137,4 +141,4 @@ def scan(image: np.ndarray, detector, grid=(21, 21), scale: float = 1.0,
     return ScanResult(counts=counts, cell=cell, boxes_px=boxes_px, grouped_px=grouped_px,
                       grouped_cell=grouped_cell, scale=scale,
                       detector_pixels=out_width * out_height,
-                      seconds=time.perf_counter() - t0)
+                      seconds=time.perf_counter() - t0, scores=scores)

@@ -33,8 +33,9 @@ import time
 import cv2
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.head_camera import bin_points, PinholeCamera
-from ipomdp_gaze.vision.detector import (as_boxes, box_centres_px, detector_window_px,
-                                         to_gray)
+from ipomdp_gaze.vision.cell_observation import CellObservation
+from ipomdp_gaze.vision.detector import (as_detections, box_centres_px, detector_color,
+                                         detector_window_px, to_detector_image)
 from ipomdp_gaze.vision.scenes import (_paste, load_background, load_faces, Scene, SPLITS)
 import numpy as np
 
@@ -82,6 +83,8 @@ class ViewObservation:
         Pixels given to the detector (the whole view).
     seconds : float
         Wall time: grey conversion, detector and binning.
+    scores : numpy.ndarray
+        ``(M,)`` score of each detection (1 for a detector without scores).
 
     """
 
@@ -92,6 +95,7 @@ class ViewObservation:
     cells: np.ndarray
     detector_pixels: int
     seconds: float
+    scores: np.ndarray = None
 
 
 class ViewObserver:
@@ -101,15 +105,19 @@ class ViewObserver:
     Parameters
     ----------
     detector : callable
-        ``detector(gray) -> (M, 4)`` raw boxes (:mod:`ipomdp_gaze.vision.detector`).
+        ``detector(image) -> (M, 5)`` raw boxes with scores, or ``(M, 4)``, in the colour space
+        it declares (:mod:`ipomdp_gaze.vision.detector`).
     grid : Grid
         The pan/tilt grid (its ``spacing_deg`` matters).
     max_count : int
         K: counts are clipped to ``0..K-1``.
+    cells : CellObservation, optional
+        What a cell's observation is (default: the clipped count); its K must be ``max_count``.
 
     """
 
-    def __init__(self, detector, grid: Grid, max_count: int = 10):
+    def __init__(self, detector, grid: Grid, max_count: int = 10,
+                 cells: CellObservation | None = None):
         if not callable(detector):
             raise ValueError(f'detector must be callable, got {type(detector).__name__}')
         if isinstance(max_count, bool) or int(max_count) != max_count or max_count < 2:
@@ -117,6 +125,11 @@ class ViewObserver:
         self.detector = detector
         self.grid = grid
         self.max_count = int(max_count)
+        self.cells = CellObservation('counts', self.max_count) if cells is None else cells
+        if not isinstance(self.cells, CellObservation) or self.cells.max_count != self.max_count:
+            raise ValueError(f'cells must be a CellObservation with K = max_count '
+                             f'({self.max_count}), got {self.cells!r}')
+        self._color = detector_color(detector)
 
     def observe(self, image: np.ndarray, camera: PinholeCamera, head_rc) -> ViewObservation:
         """
@@ -130,15 +143,21 @@ class ViewObserver:
 
         """
         t0 = time.perf_counter()
-        gray = to_gray(image, detector_window_px(self.detector))
-        if gray.shape != (camera.height, camera.width):
-            raise ValueError(f'the image is {gray.shape[1]}x{gray.shape[0]} px but camera_info '
-                             f'says {camera.width}x{camera.height}')
-        centres = box_centres_uv(as_boxes(self.detector(gray)))
+        pixels = to_detector_image(image, self._color, detector_window_px(self.detector))
+        if pixels.shape[:2] != (camera.height, camera.width):
+            raise ValueError(f'the image is {pixels.shape[1]}x{pixels.shape[0]} px but '
+                             f'camera_info says {camera.width}x{camera.height}')
+        boxes, scores = as_detections(self.detector(pixels))
+        centres = box_centres_uv(boxes)
         head = (float(head_rc[0]), float(head_rc[1]))
         counts, raw, cells = bin_points(centres, camera, self.grid, head, self.max_count)
-        return ViewObservation(counts, raw, head, centres, cells, int(gray.size),
-                               time.perf_counter() - t0)
+        if self.cells.kind != 'counts':
+            inside = cells >= 0
+            values = self.cells.values(cells[inside], scores[inside], self.grid.n_cells)
+            counts = np.where(np.isnan(counts), np.nan, values)
+        return ViewObservation(counts, raw, head, centres, cells,
+                               int(pixels.shape[0] * pixels.shape[1]),
+                               time.perf_counter() - t0, scores)
 
 
 @dataclass(frozen=True)
@@ -287,7 +306,8 @@ class PanTiltSceneSet:
     """
 
     def __init__(self, split: str = 'test', geometry: SceneGeometry | None = None,
-                 face_px: tuple[int, int] = FACE_PX, color: str = 'rgb', seed: int = 0):
+                 face_px: tuple[int, int] = FACE_PX, color: str = 'rgb', seed: int = 0,
+                 empty: bool = False):
         if split not in SPLITS:
             raise ValueError(f'unknown split {split!r}; expected one of {tuple(SPLITS)}')
         self.split = split
@@ -304,12 +324,14 @@ class PanTiltSceneSet:
         if isinstance(seed, bool) or int(seed) != seed or seed < 0:
             raise ValueError(f'seed must be a non-negative integer, got {seed!r}')
         self.seed = int(seed)
+        self.empty = bool(empty)
         self.faces, self.backgrounds = SPLITS[split]
 
     def kwargs(self) -> dict:
         """Keyword arguments that rebuild this set (for worker processes)."""
         return {'split': self.split, 'geometry': self.geometry.to_dict(),
-                'face_px': self.face_px, 'color': self.color, 'seed': self.seed}
+                'face_px': self.face_px, 'color': self.color, 'seed': self.seed,
+                'empty': self.empty}
 
     @classmethod
     def from_kwargs(cls, kwargs: dict) -> PanTiltSceneSet:
@@ -319,7 +341,12 @@ class PanTiltSceneSet:
         return cls(**values)
 
     def scene(self, index: int) -> Scene:
-        """Build scene ``index``; its ``cell`` is the face centre's cell on the pan/tilt grid."""
+        """
+        Build scene ``index``; its ``cell`` is the face centre's cell on the pan/tilt grid.
+
+        An ``empty`` set's scene ``index`` is the same photo crop with no face (``cell`` None):
+        "nobody is here" on the backgrounds the faces are searched on.
+        """
         index = int(index)
         if index < 0:
             raise IndexError(f'scene indices are non-negative, got {index}')
@@ -332,6 +359,9 @@ class PanTiltSceneSet:
         top = _pick(u_top, photo.shape[0] - height + 1)
         left = _pick(u_left, photo.shape[1] - width + 1)
         image = photo[top:top + height, left:left + width].copy()
+        if self.empty:
+            image.setflags(write=False)
+            return Scene(image, None, None, None, None, name, self.seed, index)
         face_index = self.faces[_pick(u_face, len(self.faces))]
         lo, hi = self.face_px
         side = lo + _pick(u_size, hi - lo + 1)

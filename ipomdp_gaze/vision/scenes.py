@@ -46,8 +46,9 @@ import numpy as np
 
 TRAIN_FACES = range(0, 60)
 TEST_FACES = range(60, 100)
-TRAIN_BACKGROUNDS = ('camera', 'grass', 'brick', 'coffee', 'rocket', 'coins',
-                     'immunohistochemistry')
+# `camera` (the cameraman) holds a real face: it is in the real-photo set
+# (ipomdp_gaze.vision.photos), no longer a training background (docs/design.md section 6).
+TRAIN_BACKGROUNDS = ('grass', 'brick', 'coffee', 'rocket', 'coins', 'immunohistochemistry')
 TEST_BACKGROUNDS = ('gravel', 'chelsea', 'hubble_deep_field', 'retina', 'cell', 'moon', 'page')
 SPLITS = {'train': (TRAIN_FACES, TRAIN_BACKGROUNDS), 'test': (TEST_FACES, TEST_BACKGROUNDS)}
 COLORS = ('gray', 'rgb')

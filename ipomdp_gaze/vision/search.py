@@ -48,8 +48,10 @@ import time
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.sensors import run_search
 from ipomdp_gaze.session import SearchSession, SearchSettings
-from ipomdp_gaze.vision.detector import detector_settings, detector_window_px, HaarDetector
-from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea, FoveaConfig
+from ipomdp_gaze.vision.detector import detector_window_px
+from ipomdp_gaze.vision.detectors import detector_from_settings  # noqa: F401 (its old home)
+from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea
+from ipomdp_gaze.vision.fovea_model import check_model, fovea_for_model  # noqa: F401
 from ipomdp_gaze.vision.sensors import FoveaSensor
 import numpy as np
 
@@ -64,8 +66,6 @@ DEFAULT_SETTINGS = SearchSettings(confidence=0.9, max_fixations=25, stop_on_repe
 FIND_SETTINGS = SearchSettings(confidence=0.99, max_fixations=60, inhibit_return=True,
                                stop_on_repeat=True)
 STOP_REASONS = ('found', 'absent', 'budget', 'repeat')
-# Detector settings recorded for information only: every other setting must match the model's.
-DETECTOR_INFO_KEYS = ('opencv', 'window_px')
 
 
 @dataclass(frozen=True, eq=False)
@@ -152,53 +152,6 @@ def calibrated_size(model) -> tuple[int, int] | None:
             raise ValueError(f"the model's image.{name} must be a positive integer, got "
                              f'{value!r}')
     return (int(width), int(height))
-
-
-def check_model(model, fovea: Fovea) -> None:
-    """
-    Check that ``model`` was measured on ``fovea``'s grid, fovea settings and detector.
-
-    The grid must match always; the fovea settings and the detector only when the model's
-    ``meta`` records them (``meta['fovea']``, ``meta['detector']``). For the detector, every
-    setting is compared except those recorded for information (:data:`DETECTOR_INFO_KEYS`: the
-    OpenCV version and the cascade's window size).
-
-    Raises
-    ------
-    ValueError
-        Naming what differs.
-
-    """
-    grid = getattr(model, 'grid', None)
-    if grid is None or not hasattr(model, 'log_likelihood_ratio'):
-        raise ValueError(f'expected an observation model with a grid, got {type(model).__name__}')
-    if grid.shape != fovea.grid.shape:
-        raise ValueError(f'the observation model is for a {grid.rows}x{grid.cols} grid but the '
-                         f'fovea tiles images with {fovea.grid.rows}x{fovea.grid.cols}')
-    scan = bool(getattr(model, 'has_scan', False))
-    if scan != fovea.config.scan_once:
-        raise ValueError('the fovea scans the whole image once but the observation model has '
-                         'no scan tables' if fovea.config.scan_once else
-                         'the observation model has scan tables but the fovea does not scan '
-                         '(scan_once false)')
-    meta = getattr(model, 'meta', {})
-    if meta.get('fovea') is not None:
-        try:
-            measured = FoveaConfig.from_dict(dict(meta['fovea']))
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"the model's fovea record is invalid: {exc}") from None
-        if measured != fovea.config:
-            raise ValueError(f'the observation model was measured with fovea '
-                             f'{measured.to_dict()} but the fovea is {fovea.config.to_dict()}')
-    if meta.get('detector') is not None:
-        recorded = dict(meta['detector'])
-        current = detector_settings(fovea.detector)
-        keys = sorted((set(recorded) | set(current)) - set(DETECTOR_INFO_KEYS))
-        differ = [key for key in keys if recorded.get(key) != current.get(key)]
-        if differ:
-            key = differ[0]
-            raise ValueError(f'the observation model was measured with detector {key} '
-                             f'{recorded.get(key)!r} but the detector has {current.get(key)!r}')
 
 
 def check_image_size(image_px: tuple[int, int], fovea: Fovea) -> None:
@@ -310,70 +263,6 @@ def search_image(image: np.ndarray, fovea: Fovea, model, policy,
                        seconds=time.perf_counter() - t0, belief=outcome.belief,
                        image_px=image_px, calibrated_px=calibrated, decision=outcome.decision,
                        absent_probability=outcome.absent_probability, log=outcome.log)
-
-
-def detector_from_settings(settings: dict, cascade_dir=None) -> HaarDetector:
-    """
-    Rebuild the detector an observation model records (``meta['detector']``).
-
-    Only the Haar cascade (``kind: haar``, :meth:`HaarDetector.settings`) can be rebuilt; the
-    cascade is looked up by file name (:func:`ipomdp_gaze.vision.detector.find_cascade`), and a
-    copy whose SHA-256 differs from the recorded one is refused.
-
-    Raises
-    ------
-    ValueError
-        For another kind of detector, a cascade that differs from the recorded one, or bad
-        settings.
-    FileNotFoundError
-        If the cascade file is not installed.
-
-    """
-    if not isinstance(settings, dict) or settings.get('kind') != 'haar':
-        kind = settings.get('kind') if isinstance(settings, dict) else settings
-        raise ValueError(f"only a Haar cascade detector (kind 'haar') can be rebuilt from an "
-                         f'observation model, this one records kind {kind!r}')
-    options = {key: settings[key] for key in ('cascade', 'scale_factor', 'min_neighbors',
-                                              'min_size_px', 'max_size_px') if key in settings}
-    detector = HaarDetector(cascade_dir=cascade_dir, **options)
-    recorded = settings.get('cascade_sha256')
-    if recorded is not None and recorded != detector.settings()['cascade_sha256']:
-        raise ValueError(f'the installed cascade {detector.path} differs from the one the '
-                         f'observation model was measured with (SHA-256 {recorded[:12]}...)')
-    return detector
-
-
-def fovea_for_model(model, detector=None, reuse_windows: bool = True) -> Fovea:
-    """
-    Build the fovea an observation model was measured with: its grid, fovea and detector.
-
-    ``detector`` defaults to :func:`detector_from_settings` of ``meta['detector']``; the fovea
-    settings come from ``meta['fovea']`` (the reference :class:`FoveaConfig` if absent).
-    ``reuse_windows`` keeps every window's detections per image (the detector is deterministic,
-    so this changes the cost, never the counts).
-
-    Raises
-    ------
-    ValueError
-        If the model records neither a detector nor is given one, a record is invalid, or the
-        model was calibrated through a pan/tilt camera (``meta['image']['view']``).
-
-    """
-    meta = getattr(model, 'meta', {})
-    if (meta.get('image') or {}).get('view') == 'pan_tilt':
-        raise ValueError('the observation model was calibrated through a pan/tilt camera '
-                         '(image view pan_tilt): it describes views of a head camera, not a '
-                         'fovea over a still image; use a fixed-view model such as faces-420')
-    if detector is None:
-        if meta.get('detector') is None:
-            raise ValueError('the observation model does not record its detector '
-                             '(meta detector); pass one')
-        detector = detector_from_settings(dict(meta['detector']))
-    config = FoveaConfig() if meta.get('fovea') is None else \
-        FoveaConfig.from_dict(dict(meta['fovea']))
-    fovea = Fovea(detector, model.grid, config, reuse_windows=reuse_windows)
-    check_model(model, fovea)
-    return fovea
 
 
 def size_distance(image_px: tuple[int, int], calibrated_px: tuple[int, int]) -> float:

@@ -1,0 +1,129 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+No callback can end a node: every subscription, timer and service callback runs guarded.
+
+rclpy lets an exception raised in a callback escape ``rclpy.spin``, which ends the node (and
+:func:`ipomdp_gaze.nodes.spin.run_node` used to report it as a bad start-up parameter). A node
+registers each callback through :meth:`CallbackGuard.wrap`; an exception the callback did not
+expect is then counted with its reason (per callback, and the last one in full), logged as a
+throttled warning, and the node carries on with the next message. Only start-up configuration
+errors end a node.
+
+The counts are in ``/diagnostics``: merged into the node's own status (:meth:`values`), or, for
+a node without one, in a status of their own, ``<node>: callbacks`` (:meth:`publish_status`):
+OK while ``callback_errors`` is 0, WARN after an error.
+"""
+from __future__ import annotations
+
+from collections import Counter
+import functools
+
+WARN_THROTTLE_S = 5.0
+DIAGNOSTICS_PERIOD_S = 1.0
+# Exceptions that mean "stop the process", never swallowed.
+_PASS_THROUGH = (KeyboardInterrupt, SystemExit)
+
+
+def _shutdown_exceptions() -> tuple:
+    from rclpy.executors import ExternalShutdownException
+    return _PASS_THROUGH + (ExternalShutdownException,)
+
+
+class CallbackGuard:
+    """
+    Wrap a node's callbacks so that an unexpected exception is counted, logged and survived.
+
+    Parameters
+    ----------
+    node : rclpy.node.Node
+        The node whose logger reports the errors.
+
+    """
+
+    def __init__(self, node):
+        self.node = node
+        self.errors = 0
+        self.by_callback: Counter = Counter()
+        self.last_error = ''
+        self._pass_through = _shutdown_exceptions()
+        self._status_pub = None
+
+    def record(self, name: str, exc: BaseException) -> str:
+        """Count an exception raised in callback ``name``; return its one-line reason."""
+        reason = f'{type(exc).__name__}: {exc}'.replace('\n', ' ')[:300]
+        self.errors += 1
+        self.by_callback[name] += 1
+        self.last_error = f'{name}: {reason}'
+        self.node.get_logger().warning(
+            f'callback {name} failed ({self.errors} so far), carrying on: {reason}',
+            throttle_duration_sec=WARN_THROTTLE_S)
+        return reason
+
+    def wrap(self, callback, name: str | None = None):
+        """
+        Return ``callback`` guarded: what it raises is counted and it returns None instead.
+
+        A service callback (called with ``request, response``) returns the response it was
+        given, with ``success = False`` and the reason as ``message`` when it has those fields.
+        """
+        name = name or getattr(callback, '__name__', 'callback').lstrip('_')
+        pass_through = self._pass_through
+
+        @functools.wraps(callback)
+        def guarded(*args):
+            try:
+                return callback(*args)
+            except pass_through:
+                raise
+            except Exception as exc:  # noqa: B902 (that is the point of the guard)
+                reason = self.record(name, exc)
+                if len(args) == 2:                      # a service: (request, response)
+                    response = args[1]
+                    if hasattr(response, 'success'):
+                        response.success = False
+                    if hasattr(response, 'message'):
+                        response.message = f'internal error: {reason}'
+                    return response
+                return None
+        return guarded
+
+    def refusing(self, build, name: str = 'parameters'):
+        """
+        Return ``build`` with an unexpected exception turned into a ``ValueError`` (counted).
+
+        For a parameter callback: a ``ValueError`` refuses the change with its reason; anything
+        else would end the node inside the set-parameters service.
+        """
+        pass_through = self._pass_through
+
+        @functools.wraps(build)
+        def guarded(*args, **kwargs):
+            try:
+                return build(*args, **kwargs)
+            except (ValueError, *pass_through):
+                raise
+            except Exception as exc:  # noqa: B902
+                raise ValueError(f'internal error: {self.record(name, exc)}') from None
+        return guarded
+
+    def values(self) -> dict:
+        """``callback_errors``, ``last_callback_error`` and one count per failed callback."""
+        out = {'callback_errors': self.errors, 'last_callback_error': self.last_error}
+        out.update({f'callback_errors.{k}': v for k, v in sorted(self.by_callback.items())})
+        return out
+
+    def publish_status(self, period_s: float = DIAGNOSTICS_PERIOD_S) -> None:
+        """Publish ``<node>: callbacks`` on ``/diagnostics`` every ``period_s`` from now on."""
+        from diagnostic_msgs.msg import DiagnosticArray
+        self._status_pub = self.node.create_publisher(DiagnosticArray, '/diagnostics', 10)
+        self.node.create_timer(period_s, self.wrap(self._publish, 'diagnostics'))
+
+    def _publish(self) -> None:
+        from ipomdp_gaze.msg_adapters import diagnostics
+        level, message = ('warn', f'{self.errors} callback errors: {self.last_error}') \
+            if self.errors else ('ok', 'no callback errors')
+        self._status_pub.publish(diagnostics.diagnostic_array(
+            [diagnostics.status(f'{self.node.get_fully_qualified_name()}: callbacks', level,
+                                message, self.values())],
+            self.node.get_clock().now().to_msg()))

@@ -1,0 +1,253 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Detectors by name: the one factory every command, worker and node builds its detector with.
+
+A detector **kind** is one of:
+
+- a name declared in the entry-point group ``ipomdp_gaze.detectors`` (:data:`ENTRY_POINT_GROUP`)
+  by any installed distribution, e.g. in its ``setup.py``::
+
+      entry_points={'ipomdp_gaze.detectors': ['blob = my_package.blob:BlobDetector']}
+
+  This package declares ``haar`` (:class:`ipomdp_gaze.vision.detector.HaarDetector`) and
+  ``yunet`` (:class:`ipomdp_gaze.vision.yunet.YuNetDetector`); these two are also found in a
+  source checkout whose metadata is not installed, and an entry point cannot replace them;
+- ``package.module:Factory``: the module is imported and ``Factory`` called. **Importing a
+  module runs its code**: a kind read from an observation file or a parameter runs whatever that
+  module does, so only use files and modules you trust.
+
+``Factory(**options)`` returns the detector (the interface is in
+:mod:`ipomdp_gaze.vision.detector`). Its ``settings()`` must return the options it was built
+with; the factory records the kind it built the detector by (so a plug-in need not know the
+name it was installed under). :func:`detector_from_settings` rebuilds a detector from an
+observation file's record: a factory with a ``from_settings(settings, **context)`` class method
+with it (the Haar cascade and YuNet check their file's SHA-256 there), any other with
+``Factory(**options)``, the options being the settings without ``kind`` and the detector's
+``info_keys``. The rebuilt detector's settings must then equal the recorded ones, except the
+``info_keys`` (the OpenCV version, the window), which :func:`compare_settings` reports as notes
+when they differ.
+"""
+from __future__ import annotations
+
+import importlib
+from importlib import metadata
+import inspect
+import re
+
+from ipomdp_gaze.vision.detector import COLORS, detector_settings, INFO_KEYS, KIND_ATTRIBUTE
+
+ENTRY_POINT_GROUP = 'ipomdp_gaze.detectors'
+# The shipped detectors: declared as entry points in setup.py, and found here without them.
+BUILTIN = {
+    'haar': 'ipomdp_gaze.vision.detector:HaarDetector',
+    'yunet': 'ipomdp_gaze.vision.yunet:YuNetDetector',
+}
+DEFAULT_KIND = 'haar'
+_TARGET = re.compile(r'[A-Za-z_][\w.]*:[A-Za-z_][\w.]*')
+
+
+def entry_point_kinds() -> dict:
+    """Detector names declared in :data:`ENTRY_POINT_GROUP` by installed distributions."""
+    return {ep.name: ep for ep in metadata.entry_points(group=ENTRY_POINT_GROUP)}
+
+
+def detector_kinds() -> list[str]:
+    """Every detector name that can be built: the shipped ones, then the entry points."""
+    return list(BUILTIN) + sorted(set(entry_point_kinds()) - set(BUILTIN))
+
+
+def _import_target(target: str, kind: str):
+    module_name, _, attribute = target.partition(':')
+    try:
+        obj = importlib.import_module(module_name)
+    except ImportError as exc:
+        raise ValueError(f'detector {kind!r}: cannot import module {module_name!r} ({exc})') \
+            from None
+    for part in attribute.split('.'):
+        try:
+            obj = getattr(obj, part)
+        except AttributeError:
+            raise ValueError(f'detector {kind!r}: module {module_name!r} has no '
+                             f'{attribute!r}') from None
+    return obj
+
+
+def load_factory(kind: str):
+    """
+    Return the factory of a detector kind (module docstring): a name or ``module:Factory``.
+
+    Raises
+    ------
+    ValueError
+        For a kind that is neither a known name nor an importable ``module:Factory``; the
+        message lists the known names.
+
+    """
+    if not isinstance(kind, str) or not kind:
+        raise ValueError(f'a detector kind must be a non-empty string, got {kind!r}')
+    if kind in BUILTIN:
+        factory = _import_target(BUILTIN[kind], kind)
+    elif _TARGET.fullmatch(kind):
+        factory = _import_target(kind, kind)
+    else:
+        found = entry_point_kinds().get(kind)
+        if found is None:
+            raise ValueError(f'unknown detector {kind!r}; known: {", ".join(detector_kinds())} '
+                             f'(or give package.module:Factory)')
+        try:
+            factory = found.load()
+        except (ImportError, AttributeError) as exc:
+            raise ValueError(f'detector {kind!r}: its entry point {found.value!r} does not '
+                             f'load ({exc})') from None
+    if not callable(factory):
+        raise ValueError(f'detector {kind!r} is not callable: {factory!r}')
+    return factory
+
+
+def _checked(detector, kind: str):
+    """Check what a factory returned against the interface; return it."""
+    if not callable(detector):
+        raise ValueError(f'detector {kind!r}: the factory returned {type(detector).__name__}, '
+                         f'which is not callable')
+    color = getattr(detector, 'color', 'gray')
+    if color not in COLORS:
+        raise ValueError(f'detector {kind!r}: color must be one of {", ".join(COLORS)}, got '
+                         f'{color!r}')
+    try:
+        setattr(detector, KIND_ATTRIBUTE, kind)
+    except AttributeError:
+        pass                    # a detector with __slots__ records its own kind
+    return detector
+
+
+def make_detector(kind: str = DEFAULT_KIND, **options):
+    """
+    Build a detector by kind with its own options, ``Factory(**options)``.
+
+    Raises
+    ------
+    ValueError
+        For an unknown kind, options the factory refuses (its message), or a result that is not
+        a detector.
+
+    """
+    factory = load_factory(kind)
+    try:
+        detector = factory(**options)
+    except TypeError as exc:
+        raise ValueError(f'detector {kind!r}: bad options {sorted(options)} ({exc})') from None
+    return _checked(detector, kind)
+
+
+def detector_from_spec(spec: dict | None):
+    """
+    Build a detector from ``{'kind': ..., option: value, ...}`` (no kind: ``haar``).
+
+    This is what calibration workers receive: plain types that cross process boundaries.
+    """
+    spec = dict(spec or {})
+    return make_detector(spec.pop('kind', DEFAULT_KIND), **spec)
+
+
+def info_keys_of(detector_or_factory) -> tuple:
+    """Return the settings a detector records for information only (default :data:`INFO_KEYS`)."""
+    return tuple(getattr(detector_or_factory, 'info_keys', INFO_KEYS))
+
+
+def compare_settings(recorded: dict, current: dict, info_keys=INFO_KEYS) -> list[str]:
+    """
+    Check a detector's ``current`` settings against the ``recorded`` ones; return notes.
+
+    Raises
+    ------
+    ValueError
+        Naming the first setting (sorted) that differs, other than ``info_keys``.
+
+    Returns
+    -------
+    list of str
+        One note per information-only setting that differs (e.g. another OpenCV version).
+
+    """
+    keys = sorted(set(recorded) | set(current))
+    for key in keys:
+        if key in info_keys:
+            continue
+        if recorded.get(key) != current.get(key):
+            raise ValueError(f'the observation model was measured with detector {key} '
+                             f'{recorded.get(key)!r} but the detector has {current.get(key)!r}')
+    return [f'the observation model was measured with detector {key} {recorded.get(key)!r}, '
+            f'this one has {current.get(key)!r}' for key in keys
+            if key in info_keys and key in recorded and recorded.get(key) != current.get(key)]
+
+
+def detector_from_settings(settings: dict, cascade_dir=None, on_note=None):
+    """
+    Rebuild the detector an observation model records (``meta['detector']``).
+
+    ``cascade_dir`` is passed to factories whose ``from_settings`` takes it (the Haar cascade:
+    a folder searched first for the cascade file). ``on_note(text)``, if given, hears each
+    information-only setting that differs (:func:`compare_settings`), e.g. another OpenCV
+    version, whose DNN scores may differ in their last digits.
+
+    Raises
+    ------
+    ValueError
+        For an unknown kind, bad settings, or a rebuilt detector whose settings differ from the
+        recorded ones (for example another cascade or model file: its SHA-256 differs).
+    FileNotFoundError
+        If a file the detector needs is not installed.
+
+    """
+    if not isinstance(settings, dict) or not settings.get('kind'):
+        raise ValueError(f'detector settings must be a mapping with a kind, got {settings!r}')
+    kind = settings['kind']
+    factory = load_factory(kind)
+    info = info_keys_of(factory)
+    from_settings = getattr(factory, 'from_settings', None)
+    if callable(from_settings):
+        params = inspect.signature(from_settings).parameters
+        takes = 'cascade_dir' in params or any(p.kind == p.VAR_KEYWORD for p in params.values())
+        context = {'cascade_dir': cascade_dir} if cascade_dir is not None and takes else {}
+        detector = from_settings(dict(settings), **context)
+    else:
+        options = {k: v for k, v in settings.items() if k != 'kind' and k not in info}
+        try:
+            detector = factory(**options)
+        except TypeError as exc:
+            raise ValueError(f'detector {kind!r} cannot be rebuilt from {sorted(options)} '
+                             f'({exc})') from None
+    detector = _checked(detector, kind)
+    for note in compare_settings(settings, detector_settings(detector), info_keys_of(detector)):
+        if on_note is not None:
+            on_note(note)
+    return detector
+
+
+def parse_options(pairs) -> dict:
+    """
+    Read ``name=value`` strings into detector options; values are YAML scalars.
+
+    ``['score_threshold=0.5', 'model=my.onnx']`` gives ``{'score_threshold': 0.5,
+    'model': 'my.onnx'}``.
+
+    Raises
+    ------
+    ValueError
+        For a string without ``=`` or with an empty name.
+
+    """
+    import yaml
+    options = {}
+    for pair in pairs or ():
+        name, sep, text = str(pair).partition('=')
+        name = name.strip()
+        if not sep or not name:
+            raise ValueError(f'a detector option must be NAME=VALUE, got {pair!r}')
+        try:
+            value = yaml.safe_load(text) if text.strip() else ''
+        except yaml.YAMLError:
+            value = text
+        options[name] = value
+    return options

@@ -1,0 +1,255 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Detectors from outside the package: the factory, ``calibrate``, ``find`` and the detector node.
+
+A tiny colour-blob detector is written to a temporary folder that is put on the path, once as a
+plain module (``blobdet:BlobDetector``) and once declared as the entry point ``blob`` of a
+``*.dist-info`` folder there (what ``pip install`` of a plug-in package leaves). Each is
+calibrated on labelled images with scores in bins, used by ``find``, and served by a
+``foveal_detector`` process over DDS, which must publish exactly the core's observation.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import textwrap
+
+from conftest import HAVE_RCLPY, wait_for
+import cv2
+from ipomdp_gaze.cli import main as cli
+import numpy as np
+import pytest
+
+BLOB = '''
+import numpy as np
+import cv2
+
+
+class BlobDetector:
+    """Red squares; the score is how red the box is on average (0..1)."""
+
+    color = 'rgb'
+    window_px = (4, 4)
+
+    def __init__(self, min_red=150):
+        self.min_red = int(min_red)
+
+    def __call__(self, rgb):
+        r, g, b = (rgb[:, :, i].astype(int) for i in range(3))
+        mask = ((r > self.min_red) & (g < 100) & (b < 100)).astype(np.uint8)
+        n, _, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=4)
+        rows = []
+        for x, y, w, h, area in stats[1:]:
+            box = rgb[y:y + h, x:x + w].astype(float)
+            red = (box[:, :, 0] - (box[:, :, 1] + box[:, :, 2]) / 2).mean() / 255
+            rows.append([x, y, w, h, min(max(red, 0.01), 1.0)])
+        return np.array(rows, dtype=float).reshape(-1, 5)
+
+    def settings(self):
+        return {'kind': 'ignored: the factory records the name it built this by',
+                'min_red': self.min_red}
+'''
+SIZE, CELLS, SQUARE = 84, 7, 14
+KINDS = {'module': 'blobdet:BlobDetector', 'entry point': 'blob'}
+
+
+@pytest.fixture(scope='module')
+def plugin_dir(tmp_path_factory):
+    """Write the plug-in module and a dist-info declaring its entry point to a folder."""
+    folder = tmp_path_factory.mktemp('plugin')
+    (folder / 'blobdet.py').write_text(textwrap.dedent(BLOB))
+    info = folder / 'blobdet_plugin-0.1.dist-info'
+    info.mkdir()
+    (info / 'METADATA').write_text('Metadata-Version: 2.1\nName: blobdet-plugin\nVersion: 0.1\n')
+    (info / 'entry_points.txt').write_text('[ipomdp_gaze.detectors]\n'
+                                           'blob = blobdet:BlobDetector\n')
+    return folder
+
+
+@pytest.fixture()
+def on_path(plugin_dir, monkeypatch):
+    monkeypatch.syspath_prepend(str(plugin_dir))
+    return plugin_dir
+
+
+def blob_image(rng, cell=None) -> np.ndarray:
+    """Draw a noisy grey 84x84 RGB image, with a red square centred in ``cell`` (row, col)."""
+    image = np.repeat(rng.integers(60, 140, (SIZE, SIZE, 1), dtype=np.uint8), 3, axis=2)
+    if cell is not None:
+        side = SIZE // CELLS
+        cx, cy = cell[1] * side + side // 2, cell[0] * side + side // 2
+        red = int(rng.integers(170, 256))
+        image[cy - SQUARE // 2:cy + SQUARE // 2, cx - SQUARE // 2:cx + SQUARE // 2] = \
+            (red, 30, 30)
+    return image
+
+
+def labelled_folder(folder, n=16, seed=0):
+    """Write ``n`` labelled images (every fourth without a square) and their CSV."""
+    rng = np.random.default_rng(seed)
+    folder.mkdir(parents=True, exist_ok=True)
+    with open(folder / 'labels.csv', 'w', newline='') as handle:
+        writer = csv.writer(handle)
+        writer.writerow(['path', 'x', 'y'])
+        for i in range(n):
+            cell = None if i % 4 == 3 else tuple(int(v) for v in rng.integers(1, CELLS - 1, 2))
+            cv2.imwrite(str(folder / f'{i}.png'), blob_image(rng, cell)[:, :, ::-1])
+            side = SIZE // CELLS
+            centre = ('', '') if cell is None else (cell[1] * side + side // 2,
+                                                    cell[0] * side + side // 2)
+            writer.writerow([f'{i}.png', *centre])
+    return folder / 'labels.csv'
+
+
+def calibrate(tmp_path, kind):
+    labels = labelled_folder(tmp_path / 'images')
+    out = tmp_path / 'blob.yaml'
+    rc = cli(['calibrate', '--images', str(tmp_path / 'images'), '--labels', str(labels),
+              '--grid', f'{CELLS}x{CELLS}', '--windows', f'{CELLS},3', '--max-count', '4',
+              '--detector', kind, '--detector-option', 'min_red=150', '--cells',
+              'score_bins', '--edge-images', '8', '--min-tallies', '0', '--processes', '1',
+              '--quiet', '--out', str(out)])
+    assert rc == 0
+    return out
+
+
+def test_the_factory_builds_shipped_and_outside_detectors_by_name(on_path):
+    from ipomdp_gaze.vision.detectors import (detector_from_settings, detector_kinds,
+                                              make_detector)
+    assert {'haar', 'yunet', 'blob'} <= set(detector_kinds())
+    for kind in KINDS.values():
+        detector = make_detector(kind, min_red=120)
+        from ipomdp_gaze.vision.detector import detector_settings
+        settings = detector_settings(detector)
+        assert settings == {'kind': kind, 'min_red': 120}
+        assert detector_settings(detector_from_settings(settings)) == settings
+    with pytest.raises(ValueError, match="unknown detector 'nope'; known: haar, yunet"):
+        make_detector('nope')
+    with pytest.raises(ValueError, match="cannot import module 'no_such_module'"):
+        make_detector('no_such_module:Thing')
+    with pytest.raises(ValueError, match="module 'blobdet' has no 'Nothing'"):
+        make_detector('blobdet:Nothing')
+    with pytest.raises(ValueError, match='bad options'):
+        make_detector('blob', colour='red')
+    with pytest.raises(ValueError, match='min_red 120 but the detector has 150'):
+        from ipomdp_gaze.vision.detectors import compare_settings
+        compare_settings({'kind': 'blob', 'min_red': 120}, {'kind': 'blob', 'min_red': 150})
+
+
+@pytest.mark.parametrize('how', list(KINDS))
+def test_an_outside_detector_is_calibrated_with_score_bins_and_found_by_find(
+        on_path, tmp_path, how, capsys):
+    from ipomdp_gaze.observation_file import load_observation
+    out = calibrate(tmp_path, KINDS[how])
+    model = load_observation(out)
+    assert model.meta['detector'] == {'kind': KINDS[how], 'min_red': 150}
+    cells = model.meta['cells']
+    assert cells['kind'] == 'score_bins' and cells['max_count'] == model.max_count + 1
+    assert len(cells['edges']) == cells['max_count'] - 2
+    assert np.all(np.diff(cells['edges']) > 0)
+    # Bin 0 is "no detection": at the fixation it is far likelier without the target.
+    assert model.p_target[0, 0, 0] < 0.5 < model.p_null[0, 0, 0]
+    image = blob_image(np.random.default_rng(7), (2, 4))
+    path = tmp_path / 'test.png'
+    cv2.imwrite(str(path), image[:, :, ::-1])
+    capsys.readouterr()
+    assert cli(['find', str(path), '--observation', str(out), '--policy', 'elm',
+                '--json', str(tmp_path / 'found.json')]) == 0
+    found = json.loads((tmp_path / 'found.json').read_text())['images'][0]
+    assert found['cell'] == [2, 4]
+
+
+def test_an_unknown_detector_in_calibrate_is_one_line(tmp_path, capsys):
+    labels = labelled_folder(tmp_path / 'images', n=2)
+    rc = cli(['calibrate', '--images', str(tmp_path / 'images'), '--labels', str(labels),
+              '--detector', 'nope', '--out', str(tmp_path / 'x.yaml'), '--quiet'])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and "unknown detector 'nope'" in err[0]
+
+
+@pytest.mark.ros
+@pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')
+@pytest.mark.parametrize('how', list(KINDS))
+def test_the_detector_node_serves_an_outside_detector(ros_env, probe, plugin_dir, tmp_path,
+                                                      how, monkeypatch):
+    import os
+    from ipomdp_gaze.detection import build_setup
+    from ipomdp_gaze.msg_adapters import grid_arrays, images
+    from ipomdp_gaze.nodes.processes import NodeGroup
+    from ipomdp_gaze.nodes.watch import LATCHED
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from sensor_msgs.msg import Image
+    from std_msgs.msg import Int32MultiArray
+    monkeypatch.syspath_prepend(str(plugin_dir))
+    out = calibrate(tmp_path, KINDS[how])
+    env = dict(ros_env)
+    env['PYTHONPATH'] = os.pathsep.join(p for p in (str(plugin_dir), env.get('PYTHONPATH'))
+                                        if p)
+    ns = '/blob_' + how.replace(' ', '_')
+    (tmp_path / 'logs').mkdir()
+    group = NodeGroup(env, tmp_path / 'logs')
+    try:
+        frames = probe.record(Image, f'{ns}/evidence_image',
+                              QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
+        image_pub = probe.publisher(Image, f'{ns}/image')
+        fixation_pub = probe.publisher(Int32MultiArray, f'{ns}/fixation', LATCHED)
+        proc = group.start('detector', ['-r', f'__ns:={ns}', '-p', f'observation.file:={out}',
+                                        '-p', f'detector.kind:={KINDS[how]}',
+                                        '-p', 'detector.options:=["min_red=150"]'])
+        assert wait_for(lambda: image_pub.get_subscription_count() > 0, 60), proc.output()
+        setup = build_setup('fovea', str(out))
+        grid = setup.grid
+        cell = grid.index(2, 4)
+        fixation_pub.publish(grid_arrays.row_col(grid, cell))
+        image = blob_image(np.random.default_rng(3), (2, 4))
+
+        def served():
+            image_pub.publish(images.camera_image(image, probe.node.get_clock().now().to_msg()))
+            return wait_for(lambda: len(frames) > 0, 1.0)
+        assert wait_for(served, 30), proc.output()
+        counts = images.evidence_from_image(frames[0][1], grid)
+        setup.fovea.start(image)
+        expected = setup.fovea.observe(cell).counts
+        np.testing.assert_array_equal(counts, expected)
+        assert counts[cell] > 0                   # the square's score bin, not "nothing"
+    finally:
+        bad = group.close()
+    assert not bad, bad
+
+
+@pytest.mark.parametrize('extra, words', [
+    (['--cells', 'threshold'], '--cells threshold needs --threshold T'),
+    (['--cells', 'score_bins', '--threshold', '0.5'], '--threshold goes with --cells threshold'),
+    (['--scale-factor', '1.2'], '--scale-factor is a haar setting'),
+    (['--detector-option', 'min_red'], 'a detector option must be NAME=VALUE'),
+])
+def test_calibrate_refuses_options_that_do_not_fit_in_one_line(on_path, tmp_path, capsys,
+                                                               extra, words):
+    labels = labelled_folder(tmp_path / 'images', n=2)
+    rc = cli(['calibrate', '--images', str(tmp_path / 'images'), '--labels', str(labels),
+              '--detector', 'blob', '--out', str(tmp_path / 'x.yaml'), '--quiet', *extra])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and words in err[0], err
+
+
+def test_a_threshold_model_counts_only_boxes_scoring_above_it(on_path, tmp_path):
+    from ipomdp_gaze.observation_file import load_observation
+    from ipomdp_gaze.vision.search import fovea_for_model
+    labels = labelled_folder(tmp_path / 'images')
+    out = tmp_path / 'above.yaml'
+    assert cli(['calibrate', '--images', str(tmp_path / 'images'), '--labels', str(labels),
+                '--grid', f'{CELLS}x{CELLS}', '--windows', f'{CELLS},3', '--max-count', '3',
+                '--detector', 'blob', '--cells', 'threshold', '--threshold', '0.6',
+                '--min-tallies', '0', '--processes', '1', '--quiet', '--out', str(out)]) == 0
+    model = load_observation(out)
+    assert model.meta['cells'] == {'kind': 'threshold', 'max_count': 3, 'threshold': 0.6}
+    fovea = fovea_for_model(model)
+    cell = fovea.grid.index(3, 3)
+    # Scores (red - 30) / 255: 0.86, 0.51; both windows (7 and 3 cells) see the square.
+    for red, expected in ((250, 2), (160, 0)):
+        image = np.full((SIZE, SIZE, 3), 100, np.uint8)
+        image[35:49, 35:49] = (red, 30, 30)              # centred in cell (3, 3)
+        fovea.start(image)
+        assert len(fovea.detector(image)) == 1
+        assert fovea.observe(cell).counts[cell] == expected

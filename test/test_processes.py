@@ -1,0 +1,34 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""Domain ids of concurrent runs: each process holds its own (no rclpy needed)."""
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+
+from conftest import REPO
+
+HOLD = textwrap.dedent("""
+    import sys
+    from ipomdp_gaze.nodes.processes import domain_id_for
+    print(domain_id_for(), domain_id_for(), flush=True)
+    sys.stdin.read()                     # hold the domain until the test closes stdin
+""")
+
+
+def test_concurrent_runs_never_share_a_domain_id():
+    procs = [subprocess.Popen([sys.executable, '-c', HOLD], cwd=REPO, stdin=subprocess.PIPE,
+                              stdout=subprocess.PIPE, text=True) for _ in range(6)]
+    try:
+        ids = []
+        for proc in procs:
+            first, again = map(int, proc.stdout.readline().split())
+            assert first == again                  # a process keeps its domain
+            ids.append(first)
+    finally:
+        for proc in procs:
+            proc.stdin.close()
+            proc.wait(30)
+    assert len(set(ids)) == len(ids), ids
+    assert all(1 <= i <= 101 for i in ids), ids

