@@ -192,7 +192,8 @@ class Messages:
 
         bad = {'fixation-row-out': [g.rows, 0], 'fixation-col-out': [0, g.cols],
                'fixation-negative': [-1, 3], 'fixation-short': [3], 'fixation-empty': [],
-               'fixation-long': [1, 2, 3], 'fixation-int32-max': [2 ** 31 - 1, 0]}
+               'fixation-long': [1, 2, 3, 4], 'fixation-negative-search-id': [1, 2, -3],
+               'fixation-int32-max': [2 ** 31 - 1, 0]}
         moved = {'fixations_received': 1, 'fixations_rejected': 1}
         return {k: ((lambda d=d: fix(d)), moved) for k, d in bad.items()}
 
