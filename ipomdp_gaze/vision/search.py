@@ -69,7 +69,7 @@ DEFAULT_SETTINGS = SearchSettings(confidence=0.9, max_fixations=25, stop_on_repe
 # full-resolution scan of detector pixels on 1 to 5 of the 7 photos; 0.5 said absent on all six
 # face-free ones and found the astronaut in 2 fixations.
 FIND_SETTINGS = SearchSettings(confidence=0.99, max_fixations=60, inhibit_return=True,
-                               stop_on_repeat=True, absent_prior=0.5)
+                               stop_on_repeat=True, absent_prior=0.5, decide_at_budget=True)
 STOP_REASONS = ('found', 'absent', 'budget', 'repeat', 'pixels')
 METHODS = ('fovea', 'full_frame')
 
@@ -300,8 +300,12 @@ def search_image(image: np.ndarray, fovea: Fovea, model, policy,
         cell = result.fixation
     grid = fovea.grid
     best = session.map_cell
-    decision = 'gave_up' if stop else session.decision
-    if not stop:
+    decision = session.decision
+    if stop and settings.decide_at_budget:      # the pixel budget is a deadline too
+        decision = 'absent' if session.absent_probability >= session.map_probability else 'found'
+    elif stop:
+        decision = 'gave_up'
+    else:
         stop = session.gave_up_reason if decision == 'gave_up' else decision
     return ImageSearch(cell=tuple(int(v) for v in grid.cell(best)),
                        pixel=cell_centre_px(grid, best, image_px),
@@ -341,19 +345,19 @@ def search_all(image: np.ndarray, fovea: Fovea, model, policy,
     Find every face: search, rule the found face's cells out (:func:`face_cells`), search again.
 
     Each search starts from the prior (the absent hypothesis included) with every found face's
-    cells excluded and reuses the fovea's cached windows, so the budget ``pixel_budget`` is for
-    all of them together. Returns the searches in order: each ``found`` one a face, the last
+    cells excluded and reuses the fovea's cached windows (a window is detected at most once per
+    image); ``pixel_budget`` is each search's (``find --all``: one full scan per face found and
+    one for the last search, so at most F + 1 full scans for F faces). Returns the searches in order: each ``found`` one a face, the last
     ``absent`` (no more faces) or ``gave_up``.
     """
     rng = np.random.default_rng(0) if rng is None else rng
     excluded = np.zeros(fovea.grid.n_cells, dtype=bool)
     budget = math.inf if pixel_budget is None else int(pixel_budget)
-    spent, searches = 0, []
+    searches = []
     while True:
         result = search_image(image, fovea, model, policy, settings, rng=rng,
-                              pixel_budget=budget - spent, excluded=np.flatnonzero(excluded),
+                              pixel_budget=budget, excluded=np.flatnonzero(excluded),
                               restart=not searches)
-        spent += result.detector_pixels
         searches.append(result)
         if result.decision != 'found':
             return searches
@@ -362,7 +366,7 @@ def search_all(image: np.ndarray, fovea: Fovea, model, policy,
             return searches
 
 
-def full_frame_reason(fovea: Fovea, image_px: tuple[int, int]) -> str:
+def full_frame_reason(fovea: Fovea, image_px: tuple[int, int], calibrated_px=None) -> str:
     """
     Why one full-resolution detector scan should replace the fovea on this image, or ''.
 
@@ -370,7 +374,12 @@ def full_frame_reason(fovea: Fovea, image_px: tuple[int, int]) -> str:
       whole image (a small image: the detector's minimum window makes windows expensive);
     - the fovea's smallest window is resized below the detector's window: the image is so much
       smaller than the model's calibrated size that those windows can see nothing, and a face
-      there fills much of the frame (a 112x112 close-up portrait).
+      there fills much of the frame (a 112x112 close-up portrait);
+    - the image is at most half ``calibrated_px`` (the model's calibrated size) on both sides:
+      faces there are far larger, relative to the windows, than those calibrated on.
+
+    An image larger than the model's size is searched with the fovea (its faces appear larger
+    in the windows than during calibration, and its line says so) within the pixel budget.
     """
     width, height = image_px
     probe = fovea.window_rects(fovea.grid.center_index, (height, width))
@@ -387,6 +396,11 @@ def full_frame_reason(fovea: Fovea, image_px: tuple[int, int]) -> str:
         return (f"the fovea's smallest window ({small.resized_px[0]}x{small.resized_px[1]} px) "
                 f"is smaller than the detector's ({min_w}x{min_h}): the image is far below "
                 f'the size the model was calibrated at')
+    if calibrated_px is not None and 2 * width <= calibrated_px[0] \
+            and 2 * height <= calibrated_px[1]:
+        return (f'the image ({width}x{height} px) is at most half the size the model was '
+                f'calibrated at ({calibrated_px[0]}x{calibrated_px[1]}) on both sides: a face '
+                f'there fills far more of the frame than the fovea was calibrated for')
     return ''
 
 
