@@ -271,6 +271,9 @@ def search_image(image: np.ndarray, fovea: Fovea, model, policy,
     settings = DEFAULT_SETTINGS if settings is None else settings
     calibrated = calibrated_size(model)
     image_px = check_image(image, fovea)
+    if not (settings.max_fixations or settings.stop_on_repeat):
+        raise ValueError('an offline search needs a fixation budget (search.max_fixations) '
+                         'or stop_on_repeat')
     session = SearchSession(fovea.grid, model, policy, settings)
     sensor = FoveaSensor(fovea)
     budget = math.inf if pixel_budget is None else int(pixel_budget)
