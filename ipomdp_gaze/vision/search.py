@@ -41,7 +41,7 @@ Part of the core: numpy and OpenCV only; the policy is any object with ``select`
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 import math
 import time
 
@@ -70,6 +70,10 @@ DEFAULT_SETTINGS = SearchSettings(confidence=0.9, max_fixations=25, stop_on_repe
 # face-free ones and found the astronaut in 2 fixations.
 FIND_SETTINGS = SearchSettings(confidence=0.99, max_fixations=60, inhibit_return=True,
                                stop_on_repeat=True, absent_prior=0.5, decide_at_budget=True)
+# The fovea scene tasks (evaluate --scenes, the ROS fovea demo's reference path) keep their
+# settings: find's without the absent hypothesis and the deadline decision (every scene holds a
+# face; on 40 training scenes, seed 1, faces-420 was right on 38 with or without them).
+SCENE_SETTINGS = replace(FIND_SETTINGS, absent_prior=0.0, decide_at_budget=False)
 STOP_REASONS = ('found', 'absent', 'budget', 'repeat', 'pixels')
 METHODS = ('fovea', 'full_frame')
 
