@@ -106,3 +106,28 @@ def test_an_empty_folder_is_refused_in_one_line(tmp_path):
     result = run_find(tmp_path)
     assert result.returncode == 2 and 'no image files' in result.stderr
     assert np.size(result.stderr.strip().splitlines()) == 1
+
+
+def test_the_pixel_budget_stops_the_fovea_before_it_would_be_passed():
+    from dataclasses import replace
+    from ipomdp_gaze.observation_file import load_observation
+    from ipomdp_gaze.policies.registry import build_policy
+    from ipomdp_gaze.vision.search import FIND_SETTINGS, fovea_for_model, search_image
+    model = load_observation('faces-420-yunet')
+    fovea, policy = fovea_for_model(model), build_policy('elm', model.grid, model)
+    image = load_photo('moon')
+    for decide, decision in ((False, 'gave_up'), (True, 'absent')):
+        settings = replace(FIND_SETTINGS, decide_at_budget=decide)
+        result = search_image(image, fovea, model, policy, settings, pixel_budget=60000)
+        assert result.stop == 'pixels' and result.decision == decision
+        assert 0 < result.detector_pixels <= 60000 and result.fixations >= 1
+    result = search_image(image, fovea, model, policy, FIND_SETTINGS, pixel_budget=1000)
+    assert result.detector_pixels == 0 and result.stop == 'pixels'   # not even the scan
+
+
+def test_a_found_face_takes_the_cells_within_its_radius():
+    from ipomdp_gaze.vision.search import face_cells
+    assert sorted(face_cells(GRID, GRID.index(0, 0), 1)) == [0, 1, 21, 22]
+    cells = face_cells(GRID, GRID.index(10, 10), 2)
+    assert len(cells) == 25 and all(max(abs(r - 10), abs(c - 10)) <= 2
+                                    for r, c in map(GRID.cell, cells))

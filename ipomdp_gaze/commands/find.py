@@ -81,9 +81,10 @@ def add_parser(sub):
     add_search_args(p, FIND_SETTINGS, ('confidence', 'max_fixations', 'absent_prior',
                                        'repeat_weight', 'start'))
     p.add_argument('--all', action='store_true',
-                   help='find every face: each found face is printed and its cell and the 8 '
-                        'round it leave the hypothesis set, then the search goes on until '
-                        'absent (or gave_up)')
+                   help='find every face: each found face is printed and the cells within 2 '
+                        'of it leave the hypothesis set (faces closer than that count as one), '
+                        'then the search goes on until absent (or gave_up); each search may '
+                        'spend one full scan of detector pixels')
     p.add_argument('--plot', type=Path, default=None, metavar='OUT.png',
                    help='draw the image, the numbered fixations and the windows of the last '
                         'one, in the format the extension names (.png, .pdf, .svg, .jpg, ...; '

@@ -76,6 +76,10 @@ FIND_SETTINGS = SearchSettings(confidence=0.99, max_fixations=60, inhibit_return
 SCENE_SETTINGS = replace(FIND_SETTINGS, absent_prior=0.0, decide_at_budget=False)
 STOP_REASONS = ('found', 'absent', 'budget', 'repeat', 'pixels')
 METHODS = ('fovea', 'full_frame')
+# find --all: a found face takes the cells within 2 (Chebyshev) of its answer out of the search.
+# One cell was too few on the composed group photos (docs/faces.md): a 48-90 px face spans 2-4
+# cells of a 640x480 picture and its spread-out detections were found again as a second face.
+FACE_RADIUS = 2
 
 
 @dataclass(frozen=True, eq=False)
@@ -330,17 +334,17 @@ def _applied(result):
     return result
 
 
-def face_cells(grid: Grid, cell: int) -> np.ndarray:
+def face_cells(grid: Grid, cell: int, radius: int = 1) -> np.ndarray:
     """
-    Return the cells a found face takes out of the hypothesis set: its cell and the 8 round it.
+    Return the cells a found face takes out of the hypothesis set: those within ``radius``.
 
-    A face's detections centre on its middle, so a face spanning several cells leaves its
-    evidence within one cell of the answer (the answer is right within one cell); two faces
-    whose centres are within one cell of each other are therefore found as one.
+    A face's detections centre round its middle, so a face spanning several cells leaves its
+    evidence within a cell or two of the answer; two faces whose centres are within ``radius``
+    cells of each other are therefore found as one (:data:`FACE_RADIUS` for ``find --all``).
     """
     row, col = grid.cell(int(cell))
-    rows = np.arange(max(0, row - 1), min(grid.rows, row + 2))
-    cols = np.arange(max(0, col - 1), min(grid.cols, col + 2))
+    rows = np.arange(max(0, row - radius), min(grid.rows, row + radius + 1))
+    cols = np.arange(max(0, col - radius), min(grid.cols, col + radius + 1))
     return (rows[:, None] * grid.cols + cols[None, :]).ravel()
 
 
@@ -368,7 +372,7 @@ def search_all(image: np.ndarray, fovea: Fovea, model, policy,
         searches.append(result)
         if result.decision != 'found':
             return searches
-        excluded[face_cells(fovea.grid, fovea.grid.index(*result.cell))] = True
+        excluded[face_cells(fovea.grid, fovea.grid.index(*result.cell), FACE_RADIUS)] = True
         if excluded.all():
             return searches
 
