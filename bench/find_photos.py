@@ -31,7 +31,7 @@ def near(cell, cells) -> bool:
 
 
 def truth_cells(boxes, shape, grid) -> list:
-    """The cells ``(row, col)`` of the face boxes' centres."""
+    """Return the cells ``(row, col)`` of the face boxes' centres."""
     centres = boxes[:, :2] + boxes[:, 2:] / 2
     return [tuple(grid.cell(c)) for c in cells_of_points(centres, shape, grid)]
 

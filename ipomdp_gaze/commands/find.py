@@ -3,12 +3,22 @@
 """
 ``ipomdp-gaze find``: find the face in image files with the digital fovea and a count model.
 
-Every input is checked before any search: each image must exist, decode, have 8 bits per
-channel and be large enough for the detector and the grid; the observation model and the policy
-must load. A problem is one line naming the file, exit status 2. Then each image is searched
-(:func:`ipomdp_gaze.vision.search.search_image`) and one line is printed per image, in input
-order: the path as given, the cell and pixel found, its probability, the fixations, the detector
-pixels and the seconds.
+The observation model and the policy must load first (else one line, exit status 2). A folder
+stands for its image files (by suffix, sorted by name). Each image must exist, decode, have 8
+bits per channel and be large enough for the detector and the grid: a bad one is reported in one
+line and the others are still searched; the exit status is then 2 at the end, else 0 (every
+image got a decision). One line is printed per image, in input order: the path as given, the
+**decision** (``found``, ``absent`` or ``gave_up``), ``cell (row, col)`` and ``pixel (x, y)``
+(``none`` unless found), the probability, the fixations, the detector pixels against one
+full-resolution scan's, the seconds, why it stopped and the method.
+
+**Pixels.** The fovea (:func:`ipomdp_gaze.vision.search.search_image`) never spends more
+detector pixels than one full-resolution scan of the image: it stops before a fixation that
+would, and decides then (``decide_at_budget``; stop ``pixels``). When the fovea would cost more
+or cannot see (a small image, an image at most half the model's calibrated size, a close-up
+portrait: :func:`ipomdp_gaze.vision.search.full_frame_reason`) the whole frame is scanned once
+instead and stderr says why. ``--all`` finds every face
+(:func:`ipomdp_gaze.vision.search.search_all`): one line per face, then the last decision.
 
 **Images** are read with OpenCV (``IMREAD_ANYDEPTH | IMREAD_ANYCOLOR``: EXIF orientation applied,
 an alpha channel dropped, the bit depth kept so a 16-bit file is refused rather than silently
@@ -20,7 +30,8 @@ uniform belief before the first image, so e.g. ELM's N x N weight matrix is buil
 **Model.** ``--observation`` names an ``ipomdp_gaze/observation-v1`` file (or a shipped model);
 the fovea, the grid and the detector are rebuilt from what the file records (each window is
 detected at most once per image: the detector is deterministic, so this saves work and changes
-no count). Without it, each image uses the shipped face model (``faces-<size>``) calibrated at
+no count). Without it, each image uses the shipped face model (``faces-<size>-yunet`` when the
+YuNet model is installed, else ``faces-<size>``, :func:`default_models`) calibrated at
 the size nearest its own (``|log(w/w0)| + |log(h/h0)|``, ties to the first name); stderr says
 which model and policy are used. An image of another size than its model's is searched, and its
 line says so.
@@ -61,11 +72,13 @@ def add_parser(sub):
         description='Search each image with the digital fovea: scan the whole image once '
                     "(when the model has scan tables) and fixate the policy's choice on the "
                     'scanned belief (without a scan: the grid centre), update the belief with '
-                    'the count model, stop when a cell reaches --confidence (found), when no '
-                    'face reaches it (absent, with --absent-prior > 0), at --max-fixations or '
-                    'once every cell was fixated (gave_up); print one line per image (path, '
-                    'cell and pixel found, probability, fixations, detector pixels, seconds, '
-                    'decision). Images are read with OpenCV (BGR converted to RGB, then grey); '
+                    'the count model, stop when a cell reaches --confidence (found), when '
+                    '"no face" reaches it (absent), at --max-fixations or once every cell was '
+                    'fixated (gave_up), and before spending more detector pixels than one '
+                    'full-resolution scan (deciding then); small images are scanned whole '
+                    'instead. Print one line per image (path, decision, cell (row, col) and '
+                    'pixel (x, y) found, probability, fixations, detector pixels, seconds). '
+                    'Images are read with OpenCV (BGR converted to RGB, then grey); '
                     '8 bits per channel.')
     p.add_argument('images', nargs='+', metavar='IMAGE',
                    help='image files (PNG, JPEG, ...) or folders (their image files, by name)')
@@ -91,9 +104,11 @@ def add_parser(sub):
                         'others refused); with several images, OUT-<i>.ext for image i '
                         '(0-based)')
     p.add_argument('--json', type=Path, default=None, metavar='OUT.json',
-                   help='write {grid, images: [{path, cell, pixel, probability, fixations, '
-                        'detector_pixels, seconds, decision, absent_probability, stop}]} in '
-                        'input order')
+                   help='write {grid, axes, images: [{path, cell [row, col], pixel [x, y] '
+                        '(null unless found), probability, fixations, detector_pixels, '
+                        'full_scan_pixels, seconds, decision, absent_probability, stop, method, '
+                        'note, grid}]} in input order (with --all: one entry per face, with '
+                        '"face", then the last decision)')
     p.add_argument('--log', type=Path, default=None, metavar='OUT.jsonl',
                    help="write each image's search session event log (reset with the "
                         'settings, scan, start, one event per fixation with the frame and '
