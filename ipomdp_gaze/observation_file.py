@@ -60,15 +60,19 @@ def shipped_observations() -> list[str]:
     return sorted(p.stem for p in MODEL_DIR.glob('*.yaml')) if MODEL_DIR.is_dir() else []
 
 
-def shipped_image_models() -> list[str]:
+def shipped_image_models(detector: str = 'haar') -> list[str]:
     """
-    Return the shipped models ``find`` chooses from: ``faces-<size>``, one per image size.
+    Return the shipped models ``find`` chooses from, one per image size.
+
+    ``faces-<size>`` for the Haar cascade, ``faces-<size>-yunet`` for ``detector='yunet'``.
 
     Other shipped models are for other uses: ``faces-<size>-nmpt`` are NMPT's reference fovea
     (reported in docs/faces.md, not the default), and a pan/tilt model tiles a head's grid, not
     an image.
     """
-    return [name for name in shipped_observations() if re.fullmatch(r'faces-\d+', name)]
+    suffix = '' if detector == 'haar' else f'-{detector}'
+    return [name for name in shipped_observations()
+            if re.fullmatch(r'faces-\d+' + re.escape(suffix), name)]
 
 
 def resolve_source(source) -> Path:

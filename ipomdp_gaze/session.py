@@ -37,7 +37,7 @@ from typing import Mapping
 
 import numpy as np
 
-from .belief import bayes_update, entropy, EvidenceError, map_cell
+from .belief import bayes_update, entropy, EvidenceError, map_cell, normalize_log
 from .grid import Grid
 from .inhibition import policy_choice, unvisited_choice
 from .motion import check_probability, check_sigma_cells, Motion
@@ -514,6 +514,36 @@ class SearchSession:
         self._still.reset()
         self._search = _Search(log_b, log_b.copy(), np.zeros(self.grid.n_cells, dtype=bool))
         self._event('reset', settings=self.settings.to_parameters())
+
+    def exclude(self, cells) -> None:
+        """
+        Rule cells out of the search under way: their probability becomes 0, the rest renormalised.
+
+        For a search for *another* target once one was found there (``find --all``): the
+        posterior is the Bayes posterior under the prior restricted to the other hypotheses
+        (the other cells, and the absent one), since a likelihood times a zero prior stays zero.
+        Excluded cells may still be fixated (their views see the cells round them). Call it after
+        :meth:`reset` and before the frames it should condition; at least one cell must remain.
+
+        Raises
+        ------
+        ValueError
+            For a cell outside the grid, or when no cell would remain.
+
+        """
+        search = self._state()
+        index = np.unique(np.asarray(cells, dtype=np.int64).reshape(-1))
+        if index.size and (index.min() < 0 or index.max() >= self.grid.n_cells):
+            raise ValueError(f'cells to exclude must be in 0..{self.grid.n_cells - 1}, got '
+                             f'{index.tolist()}')
+        open_cells = np.isfinite(search.log_belief[:self.grid.n_cells])
+        open_cells[index] = False
+        if not open_cells.any():
+            raise ValueError('excluding these cells would leave no cell to search')
+        for log_b in (search.log_belief, search.still_base):
+            log_b[index] = -np.inf
+            normalize_log(log_b)
+        self._event('exclude', cells=[self._rc(c) for c in index])
 
     def scan(self, frame: Frame) -> StepResult:
         """

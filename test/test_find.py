@@ -21,8 +21,9 @@ import pytest
 GRID = Grid(21, 21)
 TASK = {'size_px': 420, 'face_px': (60, 140), 'grid': (21, 21)}
 TRAIN_SCENES = 8
-JSON_KEYS = ['path', 'cell', 'pixel', 'probability', 'fixations', 'detector_pixels', 'seconds',
-             'decision', 'absent_probability', 'stop']
+JSON_KEYS = ['path', 'cell', 'pixel', 'probability', 'fixations', 'detector_pixels',
+             'full_scan_pixels', 'seconds', 'decision', 'absent_probability', 'stop', 'method',
+             'note', 'grid']
 
 
 def run_find(*args, cwd=None):
@@ -95,8 +96,9 @@ def test_find_locates_the_face_of_a_test_scene(task, tmp_path):
     result = run_find(task['images'][0], '--observation', task['model'], '--json', out)
     assert result.returncode == 0, result.stderr
     lines = result.stdout.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith(f"{task['images'][0]}: cell (")
-    for word in ('pixel (', 'p=', 'fixations=', 'detector_pixels=', 'seconds='):
+    assert len(lines) == 1
+    assert lines[0].startswith(f"{task['images'][0]}: decision=found cell (row, col)=(")
+    for word in ('pixel (x, y)=(', 'p=', 'fixations=', 'detector_pixels=', 'seconds='):
         assert word in lines[0]
     assert 'observation model faces-test' in result.stderr and 'policy elm' in result.stderr
     entry = json.loads(out.read_text())['images'][0]
@@ -112,10 +114,11 @@ def test_json_has_one_entry_per_image_in_input_order(task):
     result = run_find(*names, '--observation', task['model'], '--json', 'two.json', cwd=root)
     assert result.returncode == 0, result.stderr
     data = json.loads(out.read_text())
-    assert list(data) == ['grid', 'images'] and data['grid'] == {'rows': 21, 'cols': 21}
+    assert list(data) == ['grid', 'axes', 'images'] and data['grid'] == {'rows': 21, 'cols': 21}
+    assert data['axes'] == {'cell': ['row', 'col'], 'pixel': ['x', 'y']}
     assert [entry['path'] for entry in data['images']] == names
     lines = result.stdout.strip().splitlines()
-    assert [line.split(': cell')[0] for line in lines] == names
+    assert [line.split(': decision')[0] for line in lines] == names
     for entry, scene in zip(data['images'], reversed(task['scenes'])):
         assert list(entry) == JSON_KEYS
         assert isinstance(entry['cell'], list) and len(entry['pixel']) == 2
@@ -201,15 +204,19 @@ def test_default_policy_is_the_shipped_kernel_of_the_model(task, tmp_path, monke
     (lambda d: _png(d / 'deep.png', np.zeros((420, 420), dtype=np.uint16)), '16-bit'),
     (lambda d: _png(d / 'dot.png', np.zeros((1, 1), dtype=np.uint8)), 'too small'),
 ])
-def test_a_bad_image_is_one_error_line_before_any_search(task, tmp_path, make, message):
+def test_a_bad_image_is_one_error_line_and_the_others_are_searched(task, tmp_path, make,
+                                                                   message):
     bad = make(tmp_path)
-    result = run_find(task['images'][0], bad, '--observation', task['model'])
-    assert result.returncode == 2
-    assert result.stdout == ''                           # the good first image was not searched
+    result = run_find(task['images'][0], bad, task['images'][1], '--observation', task['model'])
+    assert result.returncode == 2                       # non-zero at the end
+    out = result.stdout.strip().splitlines()
+    searched = [line.split(':')[0] for line in out]
+    assert searched == [str(task['images'][0]), str(task['images'][1])]
     assert 'Traceback' not in result.stderr
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1, lines
-    assert lines[0].startswith(f'ipomdp-gaze find: error: {bad}: ') and message in lines[0]
+    errors = [line for line in result.stderr.splitlines() if 'error:' in line]
+    assert len(errors) == 2, errors
+    assert errors[0].startswith(f'ipomdp-gaze find: error: {bad}: ') and message in errors[0]
+    assert errors[1] == 'ipomdp-gaze find: error: 1 of 3 inputs could not be searched'
 
 
 def test_a_malformed_observation_file_is_one_error_line(task, tmp_path):

@@ -33,11 +33,11 @@ def find_path(seed: int) -> tuple:
     from ipomdp_gaze.observation_file import load_observation
     from ipomdp_gaze.policies.registry import build_policy
     from ipomdp_gaze.vision.scenes import SceneSet
-    from ipomdp_gaze.vision.search import FIND_SETTINGS, fovea_for_model, search_image
+    from ipomdp_gaze.vision.search import fovea_for_model, SCENE_SETTINGS, search_image
     model = load_observation('faces-420')
     scene = SceneSet('test', 420, (60, 140), model.grid.shape, color='rgb', seed=seed).scene(0)
     policy = build_policy('learned', model.grid, model, file='faces-420-infomax')
-    return search_image(scene.image, fovea_for_model(model), model, policy, FIND_SETTINGS).path
+    return search_image(scene.image, fovea_for_model(model), model, policy, SCENE_SETTINGS).path
 
 
 @pytest.mark.parametrize('options, mode, where', [

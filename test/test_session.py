@@ -348,3 +348,35 @@ def test_the_controller_and_finds_driver_agree_on_the_same_frames():
         assert controller.stopped and controller.decision == outcome.decision
         assert controller.map_cell == outcome.cell
         np.testing.assert_array_equal(controller.belief, outcome.belief)
+
+
+@pytest.mark.parametrize('absent_prior', [0.0, 0.4])
+def test_excluded_cells_get_the_brute_force_posterior_of_a_prior_without_them(absent_prior):
+    model = count_model(2)
+    settings = SearchSettings(confidence=1 - 1e-12, absent_prior=absent_prior, max_fixations=6)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model), settings)
+    sensor = ModelSensor(GRID, model, np.random.default_rng(7))
+    sensor.start(3)
+    session.reset(seed=0)
+    frame = sensor.scan()
+    session.scan(frame)
+    excluded = [0, 1, 3, 3]
+    session.exclude(excluded)
+    cell, frames = session.start(), []
+    for _ in range(6):
+        obs = sensor.observe(cell)
+        frames.append((cell, obs.values))
+        result = session.update(obs)
+        # the Bayes posterior under the prior restricted to the other hypotheses
+        expected = brute_force_log_posterior(model, frame.values, frames, absent_prior)
+        expected[[0, 1, 3]] = -np.inf
+        expected -= np.logaddexp.reduce(expected)
+        np.testing.assert_allclose(session.log_belief, expected, atol=1e-10)
+        assert session.map_cell not in (0, 1, 3)
+        if result.ended:
+            break
+        cell = result.fixation
+    with pytest.raises(ValueError, match='outside|in 0'):
+        session.exclude([GRID.n_cells])
+    with pytest.raises(ValueError, match='no cell to search'):
+        session.exclude(np.arange(GRID.n_cells))

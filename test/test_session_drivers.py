@@ -148,11 +148,18 @@ def test_find_with_an_absent_prior_says_absent_on_a_face_free_photo(tmp_path):
     from skimage import data
     path = tmp_path / 'brick.png'
     cv2.imwrite(str(path), data.brick())
-    out = cli('find', str(path), '--absent-prior', '0.5', '--json', str(tmp_path / 'o.json'))
+    out = cli('find', str(path), '--absent-prior', '0.5', '--json', str(tmp_path / 'o.json'),
+              '--observation', 'faces-420')
     assert out.returncode == 0, out.stderr
     entry = json.loads((tmp_path / 'o.json').read_text())['images'][0]
-    assert entry['decision'] == entry['stop'] == 'absent'
+    assert entry['decision'] == entry['stop'] == 'absent'       # the evidence decided
     assert entry['absent_probability'] >= 0.99 and 'decision=absent' in out.stdout
+    # by default (the absent hypothesis on): absent, by the evidence or at the pixel deadline
+    out = cli('find', str(path), '--json', str(tmp_path / 'o.json'))
+    entry = json.loads((tmp_path / 'o.json').read_text())['images'][0]
+    assert out.returncode == 0 and entry['decision'] == 'absent', out.stderr
+    assert entry['stop'] in ('absent', 'pixels') and entry['cell'] is None
+    assert entry['absent_probability'] > 0.5 and entry['detector_pixels'] <= 512 * 512
 
 
 def test_find_saves_each_images_event_log(tmp_path):

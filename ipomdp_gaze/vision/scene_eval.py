@@ -118,8 +118,8 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
         file = values.get('policy.file', '') if name == 'learned' else ''
     else:
         from ipomdp_gaze.policies.policy_file import default_policy_file
-        from ipomdp_gaze.vision.search import FIND_SETTINGS
-        base = FIND_SETTINGS
+        from ipomdp_gaze.vision.search import SCENE_SETTINGS
+        base = SCENE_SETTINGS
         file = default_policy_file(load_observation(_FOVEA_TASKS[task][0])) or ''
         name = 'learned' if file else 'elm'
     if policy is not None or policy_file:

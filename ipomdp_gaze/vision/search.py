@@ -41,12 +41,11 @@ Part of the core: numpy and OpenCV only; the policy is any object with ``select`
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 import math
 import time
 
 from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.sensors import run_search
 from ipomdp_gaze.session import SearchSession, SearchSettings
 from ipomdp_gaze.vision.detector import detector_window_px
 from ipomdp_gaze.vision.detectors import detector_from_settings  # noqa: F401 (its old home)
@@ -63,9 +62,24 @@ DEFAULT_SETTINGS = SearchSettings(confidence=0.9, max_fixations=25, stop_on_repe
 # right (within one cell) on 0.973 at confidence 0.9 (4.8 fixations) and 0.980 at 0.99 (8.0
 # fixations). A search never fixates a cell twice and gives up (repeat) once every cell was
 # fixated.
+#
+# The absent hypothesis is on (prior 0.5), chosen on the training photos only (the astronaut and
+# the six face-free training backgrounds of ipomdp_gaze/data/photos.csv; docs/faces.md "find on
+# real photographs"): with faces-420, prior 0.05 and 0.1 said `found` on coins and ran past one
+# full-resolution scan of detector pixels on 1 to 5 of the 7 photos; 0.5 said absent on all six
+# face-free ones and found the astronaut in 2 fixations.
 FIND_SETTINGS = SearchSettings(confidence=0.99, max_fixations=60, inhibit_return=True,
-                               stop_on_repeat=True)
-STOP_REASONS = ('found', 'absent', 'budget', 'repeat')
+                               stop_on_repeat=True, absent_prior=0.5, decide_at_budget=True)
+# The fovea scene tasks (evaluate --scenes, the ROS fovea demo's reference path) keep their
+# settings: find's without the absent hypothesis and the deadline decision (every scene holds a
+# face; on 40 training scenes, seed 1, faces-420 was right on 38 with or without them).
+SCENE_SETTINGS = replace(FIND_SETTINGS, absent_prior=0.0, decide_at_budget=False)
+STOP_REASONS = ('found', 'absent', 'budget', 'repeat', 'pixels')
+METHODS = ('fovea', 'full_frame')
+# find --all: a found face takes the cells within 2 (Chebyshev) of its answer out of the search.
+# One cell was too few on the composed group photos (docs/faces.md): a 48-90 px face spans 2-4
+# cells of a 640x480 picture and its spread-out detections were found again as a second face.
+FACE_RADIUS = 2
 
 
 @dataclass(frozen=True, eq=False)
@@ -105,6 +119,11 @@ class ImageSearch:
         ``P(absent)`` at stop (0 without the absent hypothesis).
     log : tuple
         The session's event log of this search.
+    method : str
+        ``fovea`` (the search) or ``full_frame`` (one full-resolution detector scan instead,
+        :func:`full_frame_reason`); a full-frame answer has ``probability`` NaN.
+    note : str
+        Why the full frame was scanned ('' for the fovea).
 
     """
 
@@ -122,6 +141,8 @@ class ImageSearch:
     decision: str = ''
     absent_probability: float = 0.0
     log: tuple = ()
+    method: str = 'fovea'
+    note: str = ''
 
     @property
     def size_matches(self) -> bool:
@@ -211,7 +232,8 @@ def cell_centre_px(grid: Grid, cell: int, image_px: tuple[int, int]) -> tuple[fl
 
 def search_image(image: np.ndarray, fovea: Fovea, model, policy,
                  settings: SearchSettings | None = None, *,
-                 rng: np.random.Generator | None = None) -> ImageSearch:
+                 rng: np.random.Generator | None = None, pixel_budget: int | None = None,
+                 excluded=(), restart: bool = True) -> ImageSearch:
     """
     Search one decoded image with the fovea, the count model and a policy (module docstring).
 
@@ -236,6 +258,14 @@ def search_image(image: np.ndarray, fovea: Fovea, model, policy,
         needs a budget or ``stop_on_repeat`` to end for sure.
     rng : numpy.random.Generator, optional
         Passed to the policy; ``np.random.default_rng(0)`` by default.
+    pixel_budget : int, optional
+        Detector pixels the search may spend (``find``: one full-resolution scan of the image);
+        it stops undecided (``gave_up``, stop ``pixels``) before a fixation that would pass it.
+    excluded : sequence of int
+        Cells ruled out before the search (:meth:`SearchSession.exclude`; ``find --all``).
+    restart : bool
+        Start the fovea on ``image`` (False: the fovea already holds it, and its cached windows
+        are reused at no detector cost, as in a second search of the same image).
 
     Raises
     ------
@@ -249,20 +279,176 @@ def search_image(image: np.ndarray, fovea: Fovea, model, policy,
     settings = DEFAULT_SETTINGS if settings is None else settings
     calibrated = calibrated_size(model)
     image_px = check_image(image, fovea)
+    if not (settings.max_fixations or settings.stop_on_repeat):
+        raise ValueError('an offline search needs a fixation budget (search.max_fixations) '
+                         'or stop_on_repeat')
     session = SearchSession(fovea.grid, model, policy, settings)
-    outcome = run_search(session, FoveaSensor(fovea), image,
-                         seed=np.random.default_rng(0) if rng is None else rng)
+    sensor = FoveaSensor(fovea)
+    budget = math.inf if pixel_budget is None else int(pixel_budget)
+    if restart:
+        sensor.start(image)
+    session.reset(seed=np.random.default_rng(0) if rng is None else rng)
+    pixels, stop = 0, ''
+    if sensor.scans and settings.scan:
+        if fovea.scan_cost() > budget:
+            stop = 'pixels'
+        else:
+            frame = sensor.scan()
+            pixels += frame.detector_pixels
+            _applied(session.scan(frame))
+    if len(excluded):
+        session.exclude(excluded)
+    cell = session.start()
+    while not stop:
+        if pixels + fovea.fixation_cost(cell) > budget:
+            stop = 'pixels'
+            break
+        frame = sensor.observe(cell)
+        pixels += frame.detector_pixels
+        result = _applied(session.update(frame))
+        if result.ended:
+            break
+        cell = result.fixation
     grid = fovea.grid
-    best = outcome.cell
-    stop = outcome.reason if outcome.decision == 'gave_up' else outcome.decision
+    best = session.map_cell
+    decision = session.decision
+    if stop and settings.decide_at_budget:      # the pixel budget is a deadline too
+        decision = 'absent' if session.absent_probability >= session.map_probability else 'found'
+    elif stop:
+        decision = 'gave_up'
+    else:
+        stop = session.gave_up_reason if decision == 'gave_up' else decision
     return ImageSearch(cell=tuple(int(v) for v in grid.cell(best)),
                        pixel=cell_centre_px(grid, best, image_px),
-                       probability=outcome.probability, fixations=outcome.fixations,
-                       path=tuple(tuple(int(v) for v in grid.cell(k)) for k in outcome.path),
-                       stop=stop, detector_pixels=outcome.detector_pixels,
-                       seconds=time.perf_counter() - t0, belief=outcome.belief,
-                       image_px=image_px, calibrated_px=calibrated, decision=outcome.decision,
-                       absent_probability=outcome.absent_probability, log=outcome.log)
+                       probability=session.map_probability, fixations=session.fixations,
+                       path=tuple(tuple(int(v) for v in grid.cell(k)) for k in session.path),
+                       stop=stop, detector_pixels=int(pixels),
+                       seconds=time.perf_counter() - t0, belief=session.belief,
+                       image_px=image_px, calibrated_px=calibrated, decision=decision,
+                       absent_probability=session.absent_probability, log=session.log)
+
+
+def _applied(result):
+    if not result.applied:
+        raise ValueError(f'the fovea produced a frame the session refused: {result.reason}')
+    return result
+
+
+def face_cells(grid: Grid, cell: int, radius: int = 1) -> np.ndarray:
+    """
+    Return the cells a found face takes out of the hypothesis set: those within ``radius``.
+
+    A face's detections centre round its middle, so a face spanning several cells leaves its
+    evidence within a cell or two of the answer; two faces whose centres are within ``radius``
+    cells of each other are therefore found as one (:data:`FACE_RADIUS` for ``find --all``).
+    """
+    row, col = grid.cell(int(cell))
+    rows = np.arange(max(0, row - radius), min(grid.rows, row + radius + 1))
+    cols = np.arange(max(0, col - radius), min(grid.cols, col + radius + 1))
+    return (rows[:, None] * grid.cols + cols[None, :]).ravel()
+
+
+def search_all(image: np.ndarray, fovea: Fovea, model, policy,
+               settings: SearchSettings | None = None, *,
+               rng: np.random.Generator | None = None,
+               pixel_budget: int | None = None) -> list[ImageSearch]:
+    """
+    Find every face: search, rule the found face's cells out (:func:`face_cells`), search again.
+
+    Each search starts from the prior (the absent hypothesis included) with every found face's
+    cells excluded and reuses the fovea's cached windows (a window is detected at most once per
+    image); ``pixel_budget`` is each search's (``find --all``: one full scan per face found and
+    one for the last search, so at most F + 1 full scans for F faces). Returns the searches in
+    order: each ``found`` one a face, the last ``absent`` (no more faces) or ``gave_up``.
+    """
+    rng = np.random.default_rng(0) if rng is None else rng
+    excluded = np.zeros(fovea.grid.n_cells, dtype=bool)
+    budget = math.inf if pixel_budget is None else int(pixel_budget)
+    searches = []
+    while True:
+        result = search_image(image, fovea, model, policy, settings, rng=rng,
+                              pixel_budget=budget, excluded=np.flatnonzero(excluded),
+                              restart=not searches)
+        searches.append(result)
+        if result.decision != 'found':
+            return searches
+        excluded[face_cells(fovea.grid, fovea.grid.index(*result.cell), FACE_RADIUS)] = True
+        if excluded.all():
+            return searches
+
+
+def full_frame_reason(fovea: Fovea, image_px: tuple[int, int], calibrated_px=None) -> str:
+    """
+    Why one full-resolution detector scan should replace the fovea on this image, or ''.
+
+    - the fovea's one-time scan and cheapest first fixation cost more detector pixels than the
+      whole image (a small image: the detector's minimum window makes windows expensive);
+    - the fovea's smallest window is resized below the detector's window: the image is so much
+      smaller than the model's calibrated size that those windows can see nothing, and a face
+      there fills much of the frame (a 112x112 close-up portrait);
+    - the image is at most half ``calibrated_px`` (the model's calibrated size) on both sides:
+      faces there are far larger, relative to the windows, than those calibrated on.
+
+    An image larger than the model's size is searched with the fovea (its faces appear larger
+    in the windows than during calibration, and its line says so) within the pixel budget.
+    """
+    width, height = image_px
+    probe = fovea.window_rects(fovea.grid.center_index, (height, width))
+    scan = sum(w.resized_px[0] * w.resized_px[1] for w in probe
+               if w.whole_image) if fovea.config.scan_once else 0
+    fixation = sum(w.resized_px[0] * w.resized_px[1] for w in probe
+                   if not (fovea.config.scan_once and w.whole_image))
+    if scan + fixation > width * height:
+        return (f'the fovea would cost more detector pixels ({scan + fixation}) than one '
+                f'full-resolution scan ({width * height})')
+    min_w, min_h = detector_window_px(fovea.detector)
+    small = min(probe, key=lambda w: w.resized_px[0] * w.resized_px[1])
+    if small.resized_px[0] < min_w or small.resized_px[1] < min_h:
+        return (f"the fovea's smallest window ({small.resized_px[0]}x{small.resized_px[1]} px) "
+                f"is smaller than the detector's ({min_w}x{min_h}): the image is far below "
+                f'the size the model was calibrated at')
+    if calibrated_px is not None and 2 * width <= calibrated_px[0] \
+            and 2 * height <= calibrated_px[1]:
+        return (f'the image ({width}x{height} px) is at most half the size the model was '
+                f'calibrated at ({calibrated_px[0]}x{calibrated_px[1]}) on both sides: a face '
+                f'there fills far more of the frame than the fovea was calibrated for')
+    return ''
+
+
+def full_frame_search(image: np.ndarray, fovea: Fovea, note: str = '',
+                      calibrated_px=None) -> list[ImageSearch]:
+    """
+    One full-resolution detector scan instead of the fovea: each grouped detection a face.
+
+    Returns one ``found`` result per grouped box (largest first), then one ``absent``; the
+    probability is NaN (no belief is computed).
+    """
+    from ipomdp_gaze.vision.fullframe import cells_of_points, scan
+    t0 = time.perf_counter()
+    image_px = check_image(image, fovea)
+    grid = fovea.grid
+    found = scan(image, fovea.detector, grid, 1.0)
+    boxes = found.grouped_px
+    order = np.argsort(-(boxes[:, 2] * boxes[:, 3]), kind='stable') if len(boxes) else []
+    seconds = time.perf_counter() - t0
+    common = {'fixations': 0, 'path': (), 'detector_pixels': found.detector_pixels,
+              'seconds': seconds, 'image_px': image_px, 'calibrated_px': calibrated_px,
+              'method': 'full_frame', 'note': note}
+    results = []
+    for k in order:
+        x, y, w, h = boxes[k]
+        centre = np.array([[x + w / 2, y + h / 2]])
+        cell = int(cells_of_points(centre, image.shape[:2], grid)[0])
+        belief = np.zeros(grid.n_cells)
+        belief[cell] = 1.0
+        results.append(ImageSearch(cell=tuple(int(v) for v in grid.cell(cell)),
+                                   pixel=(float(centre[0, 0]), float(centre[0, 1])),
+                                   probability=math.nan, stop='found', belief=belief,
+                                   decision='found', **common))
+    results.append(ImageSearch(cell=(0, 0), pixel=(math.nan, math.nan), probability=math.nan,
+                               stop='absent', belief=np.zeros(grid.n_cells), decision='absent',
+                               absent_probability=math.nan, **common))
+    return results
 
 
 def size_distance(image_px: tuple[int, int], calibrated_px: tuple[int, int]) -> float:

@@ -50,7 +50,7 @@ def annotate_image_search(image: np.ndarray, result, fovea) -> np.ndarray:
 
 
 def save_figure(picture: np.ndarray, out_path: Path, title: str) -> None:
-    """Save an annotated RGB picture with a title and the belief's colour scale as a PNG."""
+    """Save an annotated picture with a title and the belief's scale (format: the suffix's)."""
     import matplotlib
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
@@ -68,7 +68,7 @@ def save_figure(picture: np.ndarray, out_path: Path, title: str) -> None:
     fig.tight_layout()
     out_path = Path(out_path)
     out_path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out_path, dpi=100, format='png')
+    fig.savefig(out_path, dpi=100, format=out_path.suffix.lstrip('.').lower() or 'png')
     plt.close(fig)
 
 

