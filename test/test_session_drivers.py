@@ -180,3 +180,24 @@ def test_find_saves_each_images_event_log(tmp_path):
     assert frames[-1]['decision'] == entry['decision']
     assert frames[-1]['belief']['map_cell'] == entry['cell']
     assert events[0]['settings']['confidence'] == 0.99
+
+
+@pytest.mark.ros
+@pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')
+def test_an_unexpected_error_in_a_parameter_set_is_counted_and_refused(ros_env, monkeypatch):
+    """The controller's parameter callback is guarded: the set is refused, the node lives on."""
+    from rclpy.parameter import Parameter
+    from ipomdp_gaze.nodes import controller as module
+
+    def broken(*args, **kwargs):
+        raise RuntimeError('injected fault in build_policy')
+
+    with controller_node(ros_env) as node:
+        monkeypatch.setattr(module, 'build_policy', broken)
+        result = node.set_parameters([Parameter('policy.name', value='map')])[0]
+        assert not result.successful
+        assert result.reason.startswith('internal error: RuntimeError: injected fault')
+        assert node.guard.errors == 1 and node.get_parameter('policy.name').value == 'elm'
+        monkeypatch.undo()
+        assert node.set_parameters([Parameter('policy.name', value='map')])[0].successful
+        assert node.core.policy.name == 'map'

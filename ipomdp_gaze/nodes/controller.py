@@ -198,10 +198,13 @@ class GazeControllerNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__(NODE_NAME, **kwargs)
+        self.guard = CallbackGuard(self)
         self.add_pre_set_parameters_callback(self._pre_set)
+        # At run time an unexpected error while building or applying a parameter set is
+        # counted and refuses the set; at start-up (_startup_config) it ends the node.
         self._transaction = ParameterTransaction(
-            self, controller_params(), self._build, self._apply_config,
-            self._check_while_declaring)
+            self, controller_params(), self.guard.refusing(self._build),
+            self.guard.wrap(self._apply_config), self._check_while_declaring)
         self._transaction.declare()
         self._transaction.start(self._startup_config())
         cfg = self._config
@@ -219,7 +222,6 @@ class GazeControllerNode(Node):
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self._forward_pub = self._trajectory_pub = None
         self._make_command_publishers(v)
-        self.guard = CallbackGuard(self)
         evidence_qos = QoSProfile(history=HistoryPolicy.KEEP_LAST,
                                   depth=v['evidence_queue_depth'],
                                   reliability=ReliabilityPolicy.BEST_EFFORT)
