@@ -38,8 +38,8 @@ import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = 'ipomdp_gaze'
-SUBCOMMANDS = ('evaluate', 'search', 'train', 'reproduce', 'demo', 'controller', 'camera',
-               'detector', 'scene_camera')
+SUBCOMMANDS = ('evaluate', 'search', 'find', 'train', 'calibrate', 'reproduce', 'demo',
+               'record', 'replay', 'controller', 'camera', 'detector', 'scene_camera')
 EXECUTABLES = ('ipomdp-gaze', 'controller', 'camera', 'detector', 'scene_camera')
 BARE_NAMES = ('policies', 'msg_adapters')
 # Variables that would make a process find packages other than the install under test.
@@ -257,6 +257,28 @@ def test_evaluate_runs_and_writes_json(install, tmp_path):
     for name, policy in result['policies'].items():
         value = policy['fixations_to_90']
         assert isinstance(value, (int, float)) and not isinstance(value, bool), (name, value)
+
+
+def test_the_image_tasks_run_from_the_install(install, tmp_path):
+    """The shipped models, YuNet, the photo labels and the face configs are found installed."""
+    from skimage import data
+    import cv2
+    rgb = data.astronaut()
+    cv2.imwrite(str(tmp_path / 'astronaut.png'), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+    cli = install.bin_dir / 'ipomdp-gaze'
+    for observation in ('faces-420', 'faces-420-yunet'):
+        out = install.run(cli, 'find', 'astronaut.png', '--observation', observation, '--json',
+                          f'{observation}.json', cwd=tmp_path)
+        assert out.returncode == 0, out.stdout + out.stderr
+        entry = json.loads((tmp_path / f'{observation}.json').read_text())['images'][0]
+        assert entry['decision'] == 'found' and entry['cell'] == [4, 9], (observation, entry)
+    out = install.run(cli, 'evaluate', '--scenes', 'pan-tilt', '--episodes', '1',
+                      '--max-fixations', '3', '--jobs', '1', '--quiet', cwd=tmp_path)
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert 'pan-tilt (1 scenes with a face): right' in out.stdout
+    out = install.run(install.python, '-c', 'from ipomdp_gaze.vision.photos import read_labels; '
+                      'print(len(read_labels()))', cwd=tmp_path)
+    assert out.returncode == 0 and int(out.stdout) >= 21, out.stdout + out.stderr
 
 
 def test_every_module_imports_from_the_install_and_bare_names_do_not(install, tmp_path):
