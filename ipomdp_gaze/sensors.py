@@ -13,6 +13,7 @@ scene`` (:func:`run_search`).
 from __future__ import annotations
 
 from dataclasses import dataclass
+import math
 import time
 from typing import Protocol
 
@@ -101,11 +102,17 @@ class SearchOutcome:
 
 
 def run_search(session: SearchSession, sensor: Sensor, scene, *, seed=None,
-               limit: int | None = None) -> SearchOutcome:
+               limit: int | None = None, pixel_budget: int | None = None, exclude=(),
+               restart: bool = True) -> SearchOutcome:
     """
     Search one scene: reset, scan once (if the sensor and model have one), fixate until the end.
 
     ``limit`` caps the frames when the settings have no budget (an offline search must end).
+    ``pixel_budget`` caps the detector pixels: before a scan or a fixation that would pass it
+    (the sensor's ``scan_cost()`` / ``fixation_cost(cell)``) the search stops there
+    (:meth:`SearchSession.stop`, reason ``pixels``). ``exclude`` rules cells out after the scan
+    (:meth:`SearchSession.exclude`, ``find --all``); ``restart=False`` keeps the scene the sensor
+    already holds (a second search of the same image reuses its detections).
 
     Raises
     ------
@@ -121,21 +128,32 @@ def run_search(session: SearchSession, sensor: Sensor, scene, *, seed=None,
         raise ValueError(f'the sensor observes a {sensor.grid.rows}x{sensor.grid.cols} grid, '
                          f'the session searches {session.grid.rows}x{session.grid.cols}')
     t0 = time.perf_counter()
-    pixels = 0
-    sensor.start(scene)
+    budget = math.inf if pixel_budget is None else int(pixel_budget)
+    pixels, over = 0, False
+    if restart:
+        sensor.start(scene)
     session.reset(seed=seed)
     if sensor.scans and settings.scan:
-        frame = sensor.scan()
-        pixels += frame.detector_pixels
-        _check(session.scan(frame))
+        over = pixel_budget is not None and sensor.scan_cost() > budget
+        if not over:
+            frame = sensor.scan()
+            pixels += frame.detector_pixels
+            _check(session.scan(frame))
+    if len(exclude):
+        session.exclude(exclude)
     cell = session.start()
-    while limit is None or session.fixations < limit:
+    while not over and (limit is None or session.fixations < limit):
+        if pixel_budget is not None and pixels + sensor.fixation_cost(cell) > budget:
+            over = True
+            break
         frame = sensor.observe(cell)
         pixels += frame.detector_pixels
         result = _check(session.update(frame))
         if result.ended:
             break
         cell = result.fixation
+    if over:
+        session.stop('pixels')
     best = session.map_cell
     return SearchOutcome(session.decision, session.gave_up_reason, best,
                          session.map_probability, session.absent_probability,

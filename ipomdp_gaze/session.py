@@ -470,7 +470,7 @@ class SearchSession:
 
     @property
     def gave_up_reason(self) -> str:
-        """``'budget'`` or ``'repeat'`` after ``gave_up``, else ``''``."""
+        """Return the limit that ended the search (budget, repeat or a driver's), else ''."""
         return self._state().reason
 
     @property
@@ -687,11 +687,42 @@ class SearchSession:
         search.decided_once = search.decided_once or bool(fired)
         if not search.decided_once and settings.max_fixations \
                 and search.fixations >= settings.max_fixations:
-            fired = 'gave_up'
-            if settings.decide_at_budget and not self.motion.active:
-                fired = 'absent' if absent >= peak else 'found'
-            search.decision, search.reason, search.ended = fired, 'budget', True
+            fired = self._limit('budget')
         return fired
+
+    def _limit(self, reason: str) -> str:
+        """
+        End the search at a limit; return its decision.
+
+        ``gave_up``, or with ``decide_at_budget`` (still target) the likelier of ``absent``
+        and ``found``: ``absent`` if ``P(absent)`` is at least the answer's probability.
+        """
+        search = self._search
+        decision = 'gave_up'
+        if self.settings.decide_at_budget and not self.motion.active:
+            decision = 'absent' if self.absent_probability >= self.map_probability else 'found'
+        search.decision, search.reason, search.ended = decision, reason, True
+        return decision
+
+    def stop(self, reason: str) -> StepResult:
+        """
+        End the search now at a limit outside the session (a driver's pixel budget, a deadline).
+
+        Decides as the fixation budget does (:attr:`SearchSettings.decide_at_budget`);
+        ``reason`` names the limit (:attr:`gave_up_reason`).
+
+        Raises
+        ------
+        OrderError
+            Before :meth:`start`, or after the search has ended.
+
+        """
+        search = self._state()
+        if search.fixation is None or search.ended:
+            raise OrderError('stop a search that has started and not ended')
+        fired = self._limit(str(reason))
+        self._event('stop', reason=search.reason, decision=fired, belief=self._belief_summary())
+        return self._result('applied', fired=fired)
 
     def _choose(self) -> int | None:
         """Return the policy's next fixation; None when ``stop_on_repeat`` forbids every choice."""

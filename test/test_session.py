@@ -380,3 +380,24 @@ def test_excluded_cells_get_the_brute_force_posterior_of_a_prior_without_them(ab
         session.exclude([GRID.n_cells])
     with pytest.raises(ValueError, match='no cell to search'):
         session.exclude(np.arange(GRID.n_cells))
+
+
+def test_a_drivers_limit_ends_the_search_as_the_budget_does():
+    model = count_model(11)
+    weak = CountObservation(GRID, 0.9 * model.p_null + 0.1 / K, model.p_null)
+    elm = build_policy('elm', GRID, weak)
+    for decide, expected in ((False, 'gave_up'), (True, None)):
+        session = SearchSession(GRID, weak, elm, SearchSettings(absent_prior=0.5,
+                                                                decide_at_budget=decide))
+        session.reset()
+        with pytest.raises(OrderError, match='started'):
+            session.stop('pixels')
+        session.start()
+        session.update(Frame(np.zeros(GRID.n_cells)))
+        absent, peak = session.absent_probability, session.map_probability
+        result = session.stop('pixels')
+        want = expected or ('absent' if absent >= peak else 'found')
+        assert (result.decision, result.reason, result.ended) == (want, 'pixels', True)
+        assert session.log[-1]['event'] == 'stop'
+        with pytest.raises(OrderError):
+            session.stop('pixels')

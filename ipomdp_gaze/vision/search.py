@@ -46,6 +46,7 @@ import math
 import time
 
 from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.sensors import run_search
 from ipomdp_gaze.session import SearchSession, SearchSettings
 from ipomdp_gaze.vision.detector import detector_window_px
 from ipomdp_gaze.vision.detectors import detector_from_settings  # noqa: F401 (its old home)
@@ -279,59 +280,23 @@ def search_image(image: np.ndarray, fovea: Fovea, model, policy,
     settings = DEFAULT_SETTINGS if settings is None else settings
     calibrated = calibrated_size(model)
     image_px = check_image(image, fovea)
-    if not (settings.max_fixations or settings.stop_on_repeat):
-        raise ValueError('an offline search needs a fixation budget (search.max_fixations) '
-                         'or stop_on_repeat')
-    session = SearchSession(fovea.grid, model, policy, settings)
-    sensor = FoveaSensor(fovea)
-    budget = math.inf if pixel_budget is None else int(pixel_budget)
-    if restart:
-        sensor.start(image)
-    session.reset(seed=np.random.default_rng(0) if rng is None else rng)
-    pixels, stop = 0, ''
-    if sensor.scans and settings.scan:
-        if fovea.scan_cost() > budget:
-            stop = 'pixels'
-        else:
-            frame = sensor.scan()
-            pixels += frame.detector_pixels
-            _applied(session.scan(frame))
-    if len(excluded):
-        session.exclude(excluded)
-    cell = session.start()
-    while not stop:
-        if pixels + fovea.fixation_cost(cell) > budget:
-            stop = 'pixels'
-            break
-        frame = sensor.observe(cell)
-        pixels += frame.detector_pixels
-        result = _applied(session.update(frame))
-        if result.ended:
-            break
-        cell = result.fixation
+    outcome = run_search(SearchSession(fovea.grid, model, policy, settings), FoveaSensor(fovea),
+                         image, seed=np.random.default_rng(0) if rng is None else rng,
+                         pixel_budget=pixel_budget, exclude=excluded, restart=restart)
     grid = fovea.grid
-    best = session.map_cell
-    decision = session.decision
-    if stop and settings.decide_at_budget:      # the pixel budget is a deadline too
-        decision = 'absent' if session.absent_probability >= session.map_probability else 'found'
-    elif stop:
-        decision = 'gave_up'
+    best = outcome.cell
+    if outcome.reason == 'pixels' or outcome.decision == 'gave_up':
+        stop = outcome.reason
     else:
-        stop = session.gave_up_reason if decision == 'gave_up' else decision
+        stop = outcome.decision
     return ImageSearch(cell=tuple(int(v) for v in grid.cell(best)),
                        pixel=cell_centre_px(grid, best, image_px),
-                       probability=session.map_probability, fixations=session.fixations,
-                       path=tuple(tuple(int(v) for v in grid.cell(k)) for k in session.path),
-                       stop=stop, detector_pixels=int(pixels),
-                       seconds=time.perf_counter() - t0, belief=session.belief,
-                       image_px=image_px, calibrated_px=calibrated, decision=decision,
-                       absent_probability=session.absent_probability, log=session.log)
-
-
-def _applied(result):
-    if not result.applied:
-        raise ValueError(f'the fovea produced a frame the session refused: {result.reason}')
-    return result
+                       probability=outcome.probability, fixations=outcome.fixations,
+                       path=tuple(tuple(int(v) for v in grid.cell(k)) for k in outcome.path),
+                       stop=stop, detector_pixels=outcome.detector_pixels,
+                       seconds=time.perf_counter() - t0, belief=outcome.belief,
+                       image_px=image_px, calibrated_px=calibrated, decision=outcome.decision,
+                       absent_probability=outcome.absent_probability, log=outcome.log)
 
 
 def face_cells(grid: Grid, cell: int, radius: int = 1) -> np.ndarray:

@@ -28,6 +28,14 @@ class FoveaSensor:
     def start(self, scene) -> None:
         self.fovea.start(scene)
 
+    def scan_cost(self) -> int:
+        """Detector pixels the scan would spend now (:meth:`Fovea.scan_cost`)."""
+        return self.fovea.scan_cost()
+
+    def fixation_cost(self, cell: int) -> int:
+        """Detector pixels a fixation at ``cell`` would spend now."""
+        return self.fovea.fixation_cost(int(cell))
+
     def scan(self) -> Frame | None:
         scan = self.fovea.scan()
         if scan is None:
