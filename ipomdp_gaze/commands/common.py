@@ -118,15 +118,6 @@ def probability_arg(text: str) -> float:
     return value
 
 
-def confidence_arg(text: str) -> float:
-    """Parse a confidence level strictly between 0 and 1 for argparse."""
-    value = _number(text, 'a number between 0 and 1 (exclusive)')
-    if not 0 < value < 1:
-        raise argparse.ArgumentTypeError(
-            f'expected a number between 0 and 1 (exclusive), got {text!r}')
-    return value
-
-
 def add_scene_args(parser: argparse.ArgumentParser, scenes: str) -> None:
     """
     ``--motion-sigma-cells``, ``--jump-prob``, ``--absent-prior`` and ``--absent-rate``.

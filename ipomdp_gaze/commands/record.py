@@ -13,7 +13,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .common import confidence_arg, nonneg_int
+from .common import nonneg_int
 
 
 def add_parser(sub):
@@ -47,7 +47,8 @@ def add_parser(sub):
     p.add_argument('--policy', default=None, help='another policy.name')
     p.add_argument('--policy-file', default=None, metavar='FILE',
                    help='another policy file or shipped kernel (selects learned)')
-    p.add_argument('--confidence', type=confidence_arg, default=None)
+    p.add_argument('--confidence', type=float, default=None,
+                   help='another confidence, in (0, 1) (checked as the node checks it)')
     p.add_argument('--max-fixations', type=nonneg_int, default=None, metavar='N')
     p.add_argument('--new-search', action='store_true',
                    help='a fixed camera (detector in fovea mode) only: run a whole new search '
