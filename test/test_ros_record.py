@@ -196,30 +196,49 @@ def test_a_fixed_camera_recording_can_be_searched_anew(ros_env, tmp_path):
                      other.stdout, re.M), other.stdout
 
 
-def test_ipomdp_gaze_record_records_another_run_until_sigint(ros_env, tmp_path):
+def test_ipomdp_gaze_record_records_another_run_until_sigint(ros_env, tmp_path, probe):
+    """A user's own nodes, recorded by ``ipomdp-gaze record``: the search it heard whole."""
     import signal
 
-    from ipomdp_gaze.nodes.processes import wait_for
+    from conftest import config_path
+    from ipomdp_gaze.msg_adapters import diagnostics
+    from ipomdp_gaze.nodes.processes import NodeGroup, wait_for
+    from ipomdp_gaze.nodes.watch import SearchRecord
+    topics = ('pan_tilt', 'belief', 'found', 'ground_truth')
+    search = SearchRecord(probe, updates_only=True)
+    status = probe.status_values('recorder: recording')
     log = tmp_path / 'recorder.log'
+    group = NodeGroup(ros_env, tmp_path)
     with open(log, 'wb') as out:
         recorder = subprocess.Popen(
             [sys.executable, '-m', 'ipomdp_gaze.cli', 'record', str(tmp_path / 'bag'),
-             '--topics', 'pan_tilt,belief,found,ground_truth'],
+             '--topics', ','.join(topics)],
             cwd=REPO, env=ros_env, stdout=out, stderr=subprocess.STDOUT)
     try:
         assert wait_for(lambda: b'recording pan_tilt' in log.read_bytes(), 60), \
             log.read_text()
-        run = _cli(ros_env, 'demo', '--domain-id', ros_env['ROS_DOMAIN_ID'], '--seed', '5',
-                   '--target', '3,3')
-        assert run.returncode == 0, run.stdout + run.stderr
+        group.start('controller', ['--params-file', config_path('controller.yaml')])
+        group.start('camera', ['--params-file', config_path('camera.yaml'), '-p', 'seed:=5',
+                               '-p', 'target_row:=3', '-p', 'target_col:=3'])
+        # A search from a reset once the recorder and the probe have matched every publisher
+        # (a volatile topic's messages before that are lost: the first search may be).
+        assert wait_for(lambda: status and probe.matched('found') and all(
+            int(status[-1].get(f'publishers_{t}', 0)) > 0 for t in topics), 60), \
+            log.read_text()
+        n_found = len(search.found)
+        assert probe.reset('gaze_controller').success
+        assert wait_for(lambda: len(search.found) > n_found, 60)
     finally:
         recorder.send_signal(signal.SIGINT)
         assert recorder.wait(30) == 0, log.read_text()
+        bad = group.close()
+        assert not bad, bad
     messages = _mcap_messages(tmp_path / 'bag')
-    assert set(messages) <= {'/pan_tilt', '/belief', '/found', '/ground_truth'}
-    row, col, fixations = _found(run.stdout)
+    assert set(messages) == {f'/{t}' for t in topics}
+    heard = diagnostics.parse_found(search.found[-1][1])
     found = {kv.key: kv.value for kv in messages['/found'][-1].values}   # the last search
-    assert (int(found['row']), int(found['col'])) == (row, col)
+    assert (int(found['row']), int(found['col']), int(found['fixations'])) == \
+        (heard['row'], heard['col'], heard['fixations'])
     assert list(messages['/ground_truth'][-1].data) == [3, 3]
     meta = yaml.safe_load((tmp_path / 'bag' / 'metadata.yaml').read_text())
     custom = meta['rosbag2_bagfile_information']['custom_data']

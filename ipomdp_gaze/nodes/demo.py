@@ -213,24 +213,31 @@ def _with_recorder(setup: DemoSetup, record, compression: str, pictures) -> list
     return nodes
 
 
-def _restart_recorded(setup: DemoSetup, watch, recorder, wait, records) -> float:
+def _restart_heard(setup: DemoSetup, watch, recorder, wait, records, pictures: bool) -> float:
     """
-    Start the search again once the recorder hears every node; return when (monotonic).
+    Start the search again once everyone listening hears every node; return when (monotonic).
 
     The first frames go out as soon as the last node meets the controller, often before the
-    recorder has discovered that node, so the search the bag keeps is a new one: the demo
-    waits until the recorder has matched the frame publishers (and the camera images), calls
-    the controller's ``~/reset`` and forgets what it saw of the first search.
+    recorder (``recorder``, when recording) or the demo's own subscriptions have matched that
+    node's publishers, and what a volatile topic sends before it is matched is lost. So the
+    search that is recorded and drawn is a new one: the demo waits until the recorder has
+    matched the frame publishers (and the camera images) and its own watch the controller's
+    topics (and the annotated image, when drawing faces), calls the controller's ``~/reset``
+    and forgets what it saw of the first search.
     """
     topics = [('evidence', 'evidence_image')]
     if setup.scene == 'faces':
         topics.append(('image',))
-    if not wait(lambda: all(recorder.matched(*t) for t in topics)):
-        raise RuntimeError('the recorder did not hear the nodes in time')
+    own = ['belief', 'pan_tilt', 'found'] + \
+        (['annotated_image'] if pictures and setup.scene == 'faces' else [])
+    if not wait(lambda: (recorder is None or all(recorder.matched(*t) for t in topics))
+                and all(watch.matched(t) for t in own)):
+        raise RuntimeError('the recorder or the demo did not hear the nodes in time')
     since = time.monotonic()
     watch.reset(NODE_NAMES['controller'])
     for entries in records:
-        entries[:] = [e for e in entries if e[0] >= since]
+        # Arrival order is time order; what the spin thread appends meanwhile is kept.
+        del entries[:next((i for i, e in enumerate(entries) if e[0] >= since), len(entries))]
     return since
 
 
@@ -326,10 +333,10 @@ def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = 
                 ready = _started(watch, record_, proc.node)
                 if proc is not procs[-1] and ready is not None and not wait(ready):
                     raise RuntimeError(f'{proc.name} did not come up in time')
-            if recorder is not None:
-                started = _restart_recorded(setup, watch, recorder, wait,
-                                            [record_.beliefs, record_.targets, record_.found,
-                                             annotated])
+            if recorder is not None or pictures is not None:
+                started = _restart_heard(setup, watch, recorder, wait,
+                                         [record_.beliefs, record_.targets, record_.found,
+                                          record_.absent, annotated], pictures is not None)
             status = _follow(setup, record_, wait, timeout_s, out, stats, max_fixations)
             if recorder is not None:        # the bag's metadata: the nodes' parameters
                 nodes_ = [NODE_NAMES[n] for n in ('controller', 'detector')

@@ -124,6 +124,7 @@ class Watch:
         self.executor.add_node(self.node)
         self.nodes = nodes
         self._clients = {}
+        self._subscriptions: dict = {}
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._spin, daemon=True)
         self._thread.start()
@@ -178,14 +179,28 @@ class Watch:
                 stamps.add(key)
             received.append((time.monotonic(), msg))
 
-        self.node.create_subscription(msg_type, topic, on_message, qos)
+        self._subscribe(msg_type, topic, on_message, qos)
         return received
 
     def latest(self, msg_type, topic: str, qos=10) -> Latest:
         """Subscribe and keep only the latest message and the count."""
         latest = Latest()
-        self.node.create_subscription(msg_type, topic, latest, qos)
+        self._subscribe(msg_type, topic, latest, qos)
         return latest
+
+    def _subscribe(self, msg_type, topic: str, callback, qos) -> None:
+        subscription = self.node.create_subscription(msg_type, topic, callback, qos)
+        self._subscriptions.setdefault(topic, []).append(subscription)
+
+    def matched(self, topic: str) -> int:
+        """
+        Return how many publishers every subscription of this watch on ``topic`` has matched.
+
+        The least count over them (0 without a subscription): a publisher known from the graph
+        may not be matched yet, and what it sends before it is lost (volatile topics).
+        """
+        subscriptions = self._subscriptions.get(topic, [])
+        return min((s.get_publisher_count() for s in subscriptions), default=0)
 
     def search_status(self, node: str = CONTROLLER) -> SearchStatus:
         """Follow the ``search`` status of a controller on ``/diagnostics``."""
