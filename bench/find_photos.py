@@ -12,15 +12,18 @@ For each model (by default each detector's shipped models, chosen nearest each i
 - **groups** (``find --all``): composed group pictures, faces found (within one cell), found
   answers near no face, the last decision and the detector pixels of all the searches.
 
-Usage: ``python bench/find_photos.py [--split train|test|all] [--groups] [--observation NAME]``.
+Usage: ``python bench/find_photos.py [--split train|test|all] [--groups] [--detector haar|yunet |
+--observation NAME]``. With ``--split train`` the groups are the training ones (the astronaut
+three times on each training background), which may inform a choice; otherwise the test ones.
 Prints markdown rows.
 """
 import argparse
+from dataclasses import replace
 from types import SimpleNamespace
 
-from ipomdp_gaze.commands.find import _Tasks, search_one
+from ipomdp_gaze.commands.find import _Tasks, FIND_DETECTORS, search_one
 from ipomdp_gaze.vision.fullframe import cells_of_points
-from ipomdp_gaze.vision.photos import group_photo, real_photos
+from ipomdp_gaze.vision.photos import group_photo, real_photos, TRAIN_GROUP_BACKGROUNDS
 from ipomdp_gaze.vision.search import FIND_SETTINGS
 import numpy as np
 
@@ -36,7 +39,7 @@ def truth_cells(boxes, shape, grid) -> list:
     return [tuple(grid.cell(c)) for c in cells_of_points(centres, shape, grid)]
 
 
-def photos(tasks, split) -> None:
+def photos(tasks, split, settings) -> None:
     """Print one row per photo and the totals."""
     print('| photo | split | size | model | decision | stop | method | right | pixels / full |')
     print('|---|---|---|---|---|---|---|---|---|')
@@ -45,7 +48,7 @@ def photos(tasks, split) -> None:
     for i, photo in enumerate(real_photos(None if split == 'all' else split)):
         image = photo.image
         task = tasks.task((image.shape[1], image.shape[0]))
-        result = search_one(image, task, FIND_SETTINGS, np.random.default_rng([0, i]), False)[0]
+        result = search_one(image, task, settings, np.random.default_rng([0, i]), False)[0]
         full = image.shape[0] * image.shape[1]
         if len(photo.boxes):
             n_faces += 1
@@ -65,24 +68,44 @@ def photos(tasks, split) -> None:
           f'{over} photos over one full scan')
 
 
-def groups(tasks) -> None:
-    """Print one row per composed group picture searched with ``--all``."""
-    print('| group | faces found | found near no face | last | searches | pixels / full |')
-    print('|---|---|---|---|---|---|')
+def group_pictures(split):
+    """Yield ``(label, seed, image, boxes)``: the composed group pictures of a split."""
+    if split == 'train':        # the training face, 3 times, on each training background
+        for seed, background in enumerate(TRAIN_GROUP_BACKGROUNDS):
+            for size in ((640, 480), (1280, 886)):
+                yield (f'{size[0]}x{size[1]} {background}', seed,
+                       *group_photo(size, seed, background, split='train', copies=3))
+        return
     for seed in (0, 1, 2):
         for size in ((640, 480), (1280, 886)):
-            image, boxes = group_photo(size, seed)
-            task = tasks.task(size)
-            results = search_one(image, task, FIND_SETTINGS, np.random.default_rng([0, seed]),
-                                 True)
-            truth = truth_cells(boxes, image.shape, task.model.grid)
-            found = [r.cell for r in results if r.decision == 'found']
-            hit = sum(near(t, found) for t in truth)
-            wrong = sum(not near(f, truth) for f in found)
-            pixels = sum(r.detector_pixels for r in results)
-            print(f'| {size[0]}x{size[1]} seed {seed} | {hit}/{len(truth)} | {wrong} | '
-                  f'{results[-1].decision} ({results[-1].stop}) | {len(results)} | '
-                  f'{pixels / (size[0] * size[1]):.2f} |')
+            yield f'{size[0]}x{size[1]} seed {seed}', seed, *group_photo(size, seed)
+
+
+def groups(tasks, split, settings) -> None:
+    """Print one row per composed group picture searched with ``--all``, then the totals."""
+    print('| group | faces found | found near no face | last | searches | pixels / full |')
+    print('|---|---|---|---|---|---|')
+    totals = dict.fromkeys(('faces', 'hit', 'wrong', 'pictures', 'no_more'), 0)
+    for label, seed, image, boxes in group_pictures(split):
+        size = (image.shape[1], image.shape[0])
+        task = tasks.task(size)
+        results = search_one(image, task, settings, np.random.default_rng([0, seed]),
+                             True)
+        truth = truth_cells(boxes, image.shape, task.model.grid)
+        found = [r.cell for r in results if r.decision == 'found']
+        hit = sum(near(t, found) for t in truth)
+        wrong = sum(not near(f, truth) for f in found)
+        pixels = sum(r.detector_pixels for r in results)
+        totals['faces'] += len(truth)
+        totals['hit'] += hit
+        totals['wrong'] += wrong
+        totals['pictures'] += 1
+        totals['no_more'] += results[-1].decision == 'absent'
+        print(f'| {label} | {hit}/{len(truth)} | {wrong} | '
+              f'{results[-1].decision} ({results[-1].stop}) | {len(results)} | '
+              f'{pixels / (size[0] * size[1]):.2f} |')
+    print(f"\nfaces found {totals['hit']}/{totals['faces']}; {totals['wrong']} found near no "
+          f"face; 'no more' after {totals['no_more']}/{totals['pictures']} pictures")
 
 
 def main() -> None:
@@ -91,13 +114,16 @@ def main() -> None:
     parser.add_argument('--split', default='all', choices=('train', 'test', 'all'))
     parser.add_argument('--groups', action='store_true')
     parser.add_argument('--observation', default=None)
+    parser.add_argument('--detector', default=None, choices=FIND_DETECTORS)
+    parser.add_argument('--absent-prior', type=float, default=FIND_SETTINGS.absent_prior)
     args = parser.parse_args()
-    tasks = _Tasks(SimpleNamespace(observation=args.observation, policy=None,
-                                   policy_file=None))
-    photos(tasks, args.split)
+    settings = replace(FIND_SETTINGS, absent_prior=args.absent_prior)
+    tasks = _Tasks(SimpleNamespace(observation=args.observation, detector=args.detector,
+                                   policy=None, policy_file=None))
+    photos(tasks, args.split, settings)
     if args.groups:
         print()
-        groups(tasks)
+        groups(tasks, 'train' if args.split == 'train' else 'test', settings)
 
 
 if __name__ == '__main__':

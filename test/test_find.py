@@ -162,24 +162,30 @@ def _model_copy(path, model, width, height):
                                                    meta, model.scan_target, model.scan_null))
 
 
+@pytest.mark.parametrize('detector, suffix', [(None, '-yunet'), ('haar', '')])
 def test_default_model_is_the_shipped_one_calibrated_nearest(task, tmp_path, monkeypatch,
-                                                             capsys):
+                                                             capsys, detector, suffix):
+    """The detector's shipped models (YuNet's by default) nearest each image's size."""
     import ipomdp_gaze.observation_file as observation_file
     models = tmp_path / 'models'
     monkeypatch.setattr(observation_file, 'MODEL_DIR', models)
-    assert main(['find', str(task['images'][0])]) == 2
+    flags = ['--detector', detector] if detector else []
+    assert main(['find', str(task['images'][0]), *flags]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and 'pass --observation FILE' in err[0]
     model = load_observation(task['model'])
-    _model_copy(models / 'faces-420.yaml', model, 420, 420)
-    _model_copy(models / 'faces-800.yaml', model, 800, 800)
+    _model_copy(models / f'faces-420{suffix}.yaml', model, 420, 420)
+    _model_copy(models / f'faces-800{suffix}.yaml', model, 800, 800)
     _model_copy(models / 'faces-840-nmpt.yaml', model, 840, 840)     # a reference: never chosen
+    other = '' if suffix else '-yunet'          # the other detector's model: not chosen
+    _model_copy(models / f'faces-420{other}.yaml', model, 420, 420)
     big = tmp_path / 'big.png'
     cv2.imwrite(str(big), cv2.resize(task['scenes'][0].image, (840, 840)))
-    assert main(['find', str(task['images'][0]), str(big)]) == 0
+    assert main(['find', str(task['images'][0]), str(big), *flags]) == 0
     err = capsys.readouterr().err
-    assert 'shipped observation model faces-420 ' in err
-    assert 'shipped observation model faces-800 ' in err and 'nmpt' not in err
+    assert f'shipped observation model faces-420{suffix} ' in err
+    assert f'shipped observation model faces-800{suffix} ' in err and 'nmpt' not in err
+    assert f'faces-420{other} ' not in err
 
 
 def test_default_policy_is_the_shipped_kernel_of_the_model(task, tmp_path, monkeypatch,

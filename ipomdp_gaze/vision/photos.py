@@ -21,7 +21,9 @@ of the scene set) and which are for measuring only (``test``).
 
 :func:`group_photo` composes a group picture from the three faces (each cropped with a margin
 round its box, pasted twice, the second mirrored) on a test photo without faces, at a given size:
-real faces, several per image, with known boxes.
+real faces, several per image, with known boxes. With ``split='train'`` it composes from the
+training face (the astronaut) on the training backgrounds only, which is what may inform a
+choice such as ``find``'s default detector.
 """
 from __future__ import annotations
 
@@ -44,6 +46,8 @@ MATPLOTLIB_PHOTOS = {'grace_hopper': 'grace_hopper.jpg',
 # Group pictures: (width, height) and the range of face sides in pixels at that size.
 GROUP_SIZES = {(320, 240): (28, 44), (640, 480): (48, 90), (1280, 886): (90, 150)}
 GROUP_BACKGROUNDS = ('stereo_motorcycle', 'gravel')
+# Training groups: the training face on training backgrounds (for choices; the others measure).
+TRAIN_GROUP_BACKGROUNDS = ('coffee', 'rocket', 'brick', 'grass')
 FACE_MARGIN = 0.3
 _STREAM_TAG = 0x6A0F0
 
@@ -115,15 +119,15 @@ def real_photos(split: str | None = None) -> list[Photo]:
             if split is None or photo_split == split]
 
 
-def face_crops() -> list[tuple[np.ndarray, np.ndarray]]:
+def face_crops(split: str | None = None) -> list[tuple[np.ndarray, np.ndarray]]:
     """
-    Crop each labelled face with :data:`FACE_MARGIN` of its larger side round its box.
+    Crop each labelled face (of one ``split``) with :data:`FACE_MARGIN` round its box.
 
     Returns ``(crop, box)`` pairs: the RGB crop and the face box ``x, y, w, h`` in its pixels.
     """
     crops = []
-    for name, (boxes, _) in read_labels().items():
-        if len(boxes) == 0:
+    for name, (boxes, photo_split) in read_labels().items():
+        if len(boxes) == 0 or (split is not None and photo_split != split):
             continue
         image = load_photo(name)
         height, width = image.shape[:2]
@@ -136,9 +140,14 @@ def face_crops() -> list[tuple[np.ndarray, np.ndarray]]:
     return crops
 
 
-def group_photo(size_px=(640, 480), seed: int = 0, background: str = GROUP_BACKGROUNDS[0]):
+def group_photo(size_px=(640, 480), seed: int = 0, background: str | None = None,
+                split: str | None = None, copies: int = 2):
     """
-    Compose a group picture: every labelled face twice (once mirrored) on a face-free photo.
+    Compose a group picture: every labelled face ``copies`` times (every other one mirrored).
+
+    ``split``: the faces of that split only (default every face); ``background``: a face-free
+    photo (default the first of :data:`GROUP_BACKGROUNDS`, or of
+    :data:`TRAIN_GROUP_BACKGROUNDS` for ``split='train'``).
 
     Faces get larger sides drawn uniformly from :data:`GROUP_SIZES` for the size (scaled with
     the width for another size) and places that keep their crops, margins included, from
@@ -153,17 +162,19 @@ def group_photo(size_px=(640, 480), seed: int = 0, background: str = GROUP_BACKG
     width, height = (int(v) for v in size_px)
     low, high = GROUP_SIZES.get((width, height), tuple(v * width / 640 for v in (48, 90)))
     rng = np.random.default_rng([_STREAM_TAG, width, height, int(seed)])
+    if background is None:
+        background = (TRAIN_GROUP_BACKGROUNDS if split == 'train' else GROUP_BACKGROUNDS)[0]
     back = load_photo(background)
     scale = max(width / back.shape[1], height / back.shape[0])
     back = cv2.resize(back, (math.ceil(back.shape[1] * scale), math.ceil(back.shape[0] * scale)),
                       interpolation=cv2.INTER_AREA if scale < 1 else cv2.INTER_CUBIC)
     top, left = (back.shape[0] - height) // 2, (back.shape[1] - width) // 2
     image = np.ascontiguousarray(back[top:top + height, left:left + width])
-    crops = face_crops()
+    crops = face_crops(split)
     mirrored = [(crop[:, ::-1], np.array([crop.shape[1] - x - w, y, w, h]))
                 for crop, (x, y, w, h) in crops]
     boxes, taken = [], []
-    for crop, box in crops + mirrored:
+    for crop, box in [pair for k in range(copies) for pair in (mirrored if k % 2 else crops)]:
         crop_h, crop_w = crop.shape[:2]
         for _ in range(200):
             side = rng.uniform(low, high)                   # the face's larger side
@@ -177,7 +188,7 @@ def group_photo(size_px=(640, 480), seed: int = 0, background: str = GROUP_BACKG
                    for a, b, aw, bh in taken):
                 break
         else:
-            raise ValueError(f'{2 * len(crops)} faces of {low}-{high} px do not fit in '
+            raise ValueError(f'{copies * len(crops)} faces of {low}-{high} px do not fit in '
                              f'{width}x{height}')
         taken.append((x0, y0, out_w, out_h))
         _paste_rgb(image, crop, x0, y0, out_w, out_h)
