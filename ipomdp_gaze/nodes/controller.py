@@ -391,7 +391,6 @@ class GazeControllerNode(Node):
         if v['absent.prior'] != ov['absent.prior']:
             return f'policy {cfg.policy_label}; {self._restart()}'
         if cfg.head != old.head and core.enabled and not core.stopped:
-            core.retarget(self._now_s())
             self._send_target()
         return f'policy {cfg.policy_label}'
 
@@ -427,9 +426,16 @@ class GazeControllerNode(Node):
 
     # -- outputs -------------------------------------------------------------------------
     def _send_target(self) -> None:
-        """Publish the current fixation as the head's target."""
+        """
+        Publish the current fixation as the head's target, stamped now.
+
+        Frames settle from that stamp: the core's target time is read on the same clock reading,
+        not before the Bayes step and the choice, which take milliseconds on a loaded machine.
+        """
         head, cell = self._config.head, self.core.fixation
-        self._pan_tilt_msg = joints.joint_state(head, cell, self._now().to_msg())
+        now = self._now()
+        self.core.retarget(now.nanoseconds * 1e-9)
+        self._pan_tilt_msg = joints.joint_state(head, cell, now.to_msg())
         self._publish_target()
 
     def _publish_target(self) -> None:
