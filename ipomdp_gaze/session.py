@@ -65,8 +65,6 @@ PARAMETER_NAMES = {
     'scan': 'search.scan',
     'found_radius': 'search.found_radius',
     'decide_at_budget': 'search.decide_at_budget',
-    'faint_prior': 'search.faint_prior',
-    'faint_visibility': 'search.faint_visibility',
 }
 
 
@@ -145,13 +143,6 @@ class SearchSettings:
         Still target: when the budget runs out undecided, decide anyway (reason ``budget``):
         ``absent`` if ``P(absent)`` is at least the answer's probability, else ``found``;
         off: ``gave_up``. A deadline: the robot must say something.
-    faint_prior, faint_visibility : float
-        Still target: the prior, in [0, 1), that the target is *faint* (0: every target is
-        typical), and how visible a faint one is, in [0, 1). A faint target's observations
-        follow ``v p_T + (1 - v) p_N``, and faintness is a property of the target, the same in
-        every view: each cell's evidence is the mixture of its whole-search likelihood ratios
-        as a typical and as a faint target (docs/design.md section 10.5), so a face the
-        detector keeps missing stays possible instead of being ruled out view after view.
 
     """
 
@@ -167,8 +158,6 @@ class SearchSettings:
     scan: bool = True
     found_radius: int = 0
     decide_at_budget: bool = False
-    faint_prior: float = 0.0
-    faint_visibility: float = 0.3
 
     def __post_init__(self):
         names = PARAMETER_NAMES
@@ -187,9 +176,6 @@ class SearchSettings:
             'scan': _check_flag(self.scan, names['scan']),
             'found_radius': _check_radius(self.found_radius, names['found_radius']),
             'decide_at_budget': _check_flag(self.decide_at_budget, names['decide_at_budget']),
-            'faint_prior': check_probability(self.faint_prior, names['faint_prior']),
-            'faint_visibility': check_probability(self.faint_visibility,
-                                                  names['faint_visibility']),
         }
         for key, value in checked.items():
             object.__setattr__(self, key, value)
@@ -243,21 +229,6 @@ class SearchSettings:
         if grid is not None:
             settings.check_grid(grid)
         return settings
-
-
-def faint_log_likelihood_ratio(term: np.ndarray, visibility: float) -> np.ndarray:
-    """
-    Per-frame log-likelihood ratio of a faint target from a typical one's ``term``.
-
-    A faint target's observation follows ``v p_T + (1 - v) p_N``, so its ratio to ``p_N`` is
-    ``v exp(term) + 1 - v``: 0 where ``term`` is 0 (a cell the frame did not see), and for
-    ``v = 0`` (an invisible target) 0 everywhere.
-    """
-    term = np.asarray(term, dtype=float)
-    if visibility == 0.0:
-        return np.zeros_like(term)
-    with np.errstate(divide='ignore'):
-        return np.logaddexp(np.log(visibility) + term, np.log1p(-visibility))
 
 
 def start_index(grid: Grid, settings: SearchSettings) -> int | None:
@@ -389,7 +360,6 @@ class SearchSession:
                              self.settings.motion_jump_prob)
         self._kernel = None
         self._still = StillEvidence(grid.n_cells)
-        self._still_faint = StillEvidence(grid.n_cells)
         self._log = deque(maxlen=int(log_size))
         self.rng = np.random.default_rng(0)
         self._search = None
@@ -401,19 +371,16 @@ class SearchSession:
         Use new settings from the next frame on, keeping the belief of the search under way.
 
         A new ``absent_prior`` applies from the next :meth:`reset`; a change of
-        ``repeat_weight``, of the faint target or of motion on/off counts the still scene's
-        evidence afresh from the belief now.
+        ``repeat_weight`` or of motion on/off counts the still scene's evidence afresh from the
+        belief now.
         """
         settings.check_grid(self.grid)
         old = self.settings
         self.settings = settings
         self.motion = Motion(self.grid, settings.motion_sigma_cells, settings.motion_jump_prob)
-        if self._search is not None and (
-                (settings.repeat_weight, settings.moving, settings.faint_prior,
-                 settings.faint_visibility)
-                != (old.repeat_weight, old.moving, old.faint_prior, old.faint_visibility)):
+        if self._search is not None and (settings.repeat_weight != old.repeat_weight
+                                         or settings.moving != old.moving):
             self._still.reset()
-            self._still_faint.reset()
             self._search.still_base = self._search.log_belief.copy()
 
     def set_observation(self, observation) -> None:
@@ -545,7 +512,6 @@ class SearchSession:
             self.rng = np.random.default_rng(seed)
         log_b = initial_log_belief(self.grid.n_cells, self.settings.absent_prior)
         self._still.reset()
-        self._still_faint.reset()
         self._search = _Search(log_b, log_b.copy(), np.zeros(self.grid.n_cells, dtype=bool))
         self._event('reset', settings=self.settings.to_parameters())
 
@@ -675,7 +641,7 @@ class SearchSession:
         except EvidenceError as exc:
             return self._result('rejected', reason=str(exc))
         self.predict(dt_s)
-        if self._still_scene:
+        if self.settings.repeat_weight < 1.0 and not self.motion.active:
             bayes_update(search.still_base,
                          with_absent(self._still_term(obs, term), search.log_belief),
                          out=search.log_belief)
@@ -699,29 +665,12 @@ class SearchSession:
         return self._result('applied', fired=fired)
 
     # -- inside ------------------------------------------------------------------------------
-    @property
-    def _still_scene(self) -> bool:
-        """Whether frames go through the still scene's evidence (repeats or a faint target)."""
-        settings = self.settings
-        return not self.motion.active and (settings.repeat_weight < 1.0
-                                           or settings.faint_prior > 0.0)
-
     def _still_term(self, obs: np.ndarray, term: np.ndarray) -> np.ndarray:
-        """Each cell's whole-search log-likelihood ratio, from the frames so far and this one."""
-        settings = self.settings
         if self._kernel is None:
             self._kernel = np.asarray(self.observation.elm_kernel(), dtype=float)
-        information = np.where(np.isnan(obs), 0.0,
-                               cell_information(self._kernel, self.grid, self._search.fixation))
-        self._still.add(term, information)
-        typical = self._still.log_likelihood_ratio(settings.repeat_weight)
-        if settings.faint_prior == 0.0:
-            return typical
-        self._still_faint.add(faint_log_likelihood_ratio(term, settings.faint_visibility),
-                              information)
-        faint = self._still_faint.log_likelihood_ratio(settings.repeat_weight)
-        return np.logaddexp(np.log1p(-settings.faint_prior) + typical,
-                            np.log(settings.faint_prior) + faint)
+        information = cell_information(self._kernel, self.grid, self._search.fixation)
+        self._still.add(term, np.where(np.isnan(obs), 0.0, information))
+        return self._still.log_likelihood_ratio(self.settings.repeat_weight)
 
     def _decide(self) -> str:
         """Run the stop rules after an applied frame; return the decision it fired ('')."""
