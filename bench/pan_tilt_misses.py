@@ -1,0 +1,88 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Why the shipped pan/tilt search misses a face: each miss on training scenes, view by view.
+
+Runs the shipped face configuration (``config/faces_camera_controller.yaml``) offline on
+training scenes with a face (never the test split), as ``ipomdp-gaze evaluate --scenes pan-tilt
+--split train`` does, and for every scene it gets wrong prints what the detector said about the
+face's cell: in each view that had the cell within one cell of its centre (where the model
+expects a face to give about eight raw detections), and in a view centred on the face (which the
+search may never have taken). The last line compares those centred counts for the scenes it got
+right and wrong.
+
+Usage: ``python bench/pan_tilt_misses.py [--scenes 200] [--seed 1000]``. Prints markdown.
+"""
+import argparse
+
+from ipomdp_gaze.session import SearchSession
+from ipomdp_gaze.vision import scene_eval
+import numpy as np
+
+
+def centred_count(task, scene) -> int:
+    """Raw detections in the face's cell with the head centred on it."""
+    grid = task.model.grid
+    cell = grid.index(*scene.cell)
+    return int(task.sensor.observe(cell).values[cell])
+
+
+def search(spec, task, scene, index):
+    """Run the shipped search on one scene; return the session and the frames in order."""
+    grid = task.model.grid
+    session = SearchSession(grid, task.model, task.policy, spec.settings)
+    session.reset(seed=np.random.default_rng([spec.seed, index]))
+    cell, frames = session.start(), []
+    while True:
+        frame = task.sensor.observe(cell)
+        frames.append((cell, np.asarray(frame.values, dtype=float)))
+        result = session.update(frame)
+        if result.ended:
+            return session, frames
+        cell = result.fixation
+
+
+def main() -> None:
+    """Print one row per missed face and the centred counts of right and wrong scenes."""
+    parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
+    parser.add_argument('--scenes', type=int, default=200)
+    parser.add_argument('--seed', type=int, default=1000)
+    args = parser.parse_args()
+    spec = scene_eval.task_spec('pan-tilt', seed=args.seed, split='train')
+    task = scene_eval._Task.get(spec)
+    grid = task.model.grid
+    print('| scene | background | face px | face cell | decision (answer) | fixations | '
+          'closest fixation | counts in the face cell from views within one cell | centred '
+          'view |')
+    print('|---|---|---|---|---|---|---|---|---|')
+    centred = {True: [], False: []}
+    for index in range(args.scenes):
+        scene = task.scene(index)
+        task.sensor.start(scene.image)
+        session, frames = search(spec, task, scene, index)
+        face = tuple(int(v) for v in scene.cell)
+        answer = tuple(int(v) for v in grid.cell(session.map_cell))
+        right = session.decision != 'absent' and max(abs(answer[0] - face[0]),
+                                                     abs(answer[1] - face[1])) <= 1
+        count = centred_count(task, scene)
+        centred[right].append(count)
+        if right:
+            continue
+        j = grid.index(*face)
+        offsets = [max(abs(r - face[0]), abs(c - face[1]))
+                   for r, c in (grid.cell(cell) for cell, _ in frames)]
+        near = [int(values[j]) for (_, values), off in zip(frames, offsets) if off <= 1]
+        shown = session.decision if session.decision == 'absent' else \
+            f'{session.decision} {answer}'
+        print(f'| {index} | {scene.background} | {scene.face_px} | {face} | {shown} | '
+              f'{session.fixations} | {min(offsets)} | {near or "none"} | {count} |')
+    for right, label in ((True, 'right'), (False, 'wrong')):
+        counts = np.asarray(centred[right])
+        if counts.size:
+            print(f'\n{label}: {counts.size} scenes; detections in the face cell with the head '
+                  f'centred on it: median {np.median(counts):.0f}, none in '
+                  f'{int((counts == 0).sum())}, 1-2 in {int(((counts > 0) & (counts < 3)).sum())}')
+
+
+if __name__ == '__main__':
+    main()
