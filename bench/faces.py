@@ -649,7 +649,7 @@ def plot_speed_accuracy(results, path: Path) -> None:
     import matplotlib
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, len(results), figsize=(6.5 * len(results), 4.8), squeeze=False)
+    fig, axes = plt.subplots(1, len(results), figsize=(6.5 * len(results), 5.2), squeeze=False)
     for ax, task in zip(axes[0], results):
         for r in task['rows']:
             if r['label'].endswith('grouped'):
@@ -672,7 +672,7 @@ def plot_speed_accuracy(results, path: Path) -> None:
         ax.set(xscale='log', xlabel='speed-up vs full-resolution scan (median time)',
                ylabel='right (within one cell)',
                title=f"{task['size']}x{task['size']}, faces {task['faces'][0]}-"
-                     f"{task['faces'][1]} px\n(blue: Haar full frame, orange: Haar fovea, green: "
+                     f"{task['faces'][1]} px\n(blue: Haar full frame, orange: Haar fovea,\ngreen: "
                      "NMPT's reference fovea, red: YuNet)")
         ax.grid(True, which='both', alpha=0.3)
         ax.legend(fontsize=8, loc='lower left')
