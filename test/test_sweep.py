@@ -199,3 +199,16 @@ def test_every_searcher_of_a_scene_shares_its_views_and_the_sweep_rules_follow_t
         assert r.head_time_s > r.detector_s > 0
         if r.map_right:
             assert len(r.map_right) == 20 and r.map_right[-1] == r.right
+
+
+def test_the_pan_tilt_task_runs_with_yunet_whose_boxes_carry_a_score():
+    # YuNet returns (M, 5) boxes with a score; the view cache keeps boxes only, so the sweep's
+    # grouped answer rules work for a scoring detector too.
+    from ipomdp_gaze.vision.scene_eval import _Task, evaluate_scene, SWEEP_RULES
+    spec = task_spec('pan-tilt', split='train', seed=7, model='faces-pan-tilt-yunet',
+                     compare=SWEEP_RULES)
+    results = {r.searcher: r for r in evaluate_scene(spec, 0)}
+    assert list(results) == ['coverage'] + list(SWEEP_RULES)
+    boxes = _Task.get(spec).sensor.boxes
+    assert boxes and all(b.ndim == 2 and b.shape[1] == 4 for b in boxes.values())
+    assert any(len(b) for b in boxes.values())                 # YuNet saw the face somewhere

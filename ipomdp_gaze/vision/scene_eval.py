@@ -222,7 +222,9 @@ class _ViewCache:
         if cell not in self.frames:
             self.frames[cell] = self.sensor.observe(cell)
             if self.recorder is not None:
-                self.boxes[cell] = np.asarray(self.recorder.boxes).reshape(-1, 4)
+                # boxes only: a scoring detector (YuNet) returns (M, 5) with its scores
+                from ipomdp_gaze.vision.detector import as_detections
+                self.boxes[cell] = as_detections(self.recorder.boxes)[0]
         return self.frames[cell]
 
 
@@ -400,7 +402,11 @@ def _sweep_rule(spec: TaskSpec, task: _Task, scene, index: int, rule: str) -> Sc
                 answer = int(np.argmax(counts))
                 break
             continue
-        boxes = group_boxes(task.sensor.boxes[int(pose)], int(rule[-1]))
+        # the detector's own grouping (YuNet's boxes are already suppressed), as fullframe.scan
+        group = getattr(task.sensor.recorder.detector, 'group', None)
+        raw = task.sensor.boxes[int(pose)]
+        boxes = np.asarray(group(raw, int(rule[-1])) if callable(group)
+                           else group_boxes(np.round(raw), int(rule[-1]))).reshape(-1, 4)
         if len(boxes):
             order = np.argsort(-(boxes[:, 2] * boxes[:, 3]), kind='stable')
             centres = box_centres_px(boxes[order]) - 0.5
