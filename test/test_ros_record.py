@@ -196,6 +196,19 @@ def test_a_fixed_camera_recording_can_be_searched_anew(ros_env, tmp_path):
                      other.stdout, re.M), other.stdout
 
 
+def _quiet(lists, quiet_s: float = 0.3):
+    """Return a condition: none of ``lists`` has grown for ``quiet_s`` seconds."""
+    import time
+    state = {'lengths': [len(x) for x in lists], 'since': time.monotonic()}
+
+    def quiet() -> bool:
+        lengths = [len(x) for x in lists]
+        if lengths != state['lengths']:
+            state['lengths'], state['since'] = lengths, time.monotonic()
+        return time.monotonic() - state['since'] >= quiet_s
+    return quiet
+
+
 def test_ipomdp_gaze_record_records_another_run_until_sigint(ros_env, tmp_path, probe):
     """A user's own nodes, recorded by ``ipomdp-gaze record``: the search it heard whole."""
     import signal
@@ -221,13 +234,23 @@ def test_ipomdp_gaze_record_records_another_run_until_sigint(ros_env, tmp_path, 
         group.start('camera', ['--params-file', config_path('camera.yaml'), '-p', 'seed:=5',
                                '-p', 'target_row:=3', '-p', 'target_col:=3'])
         # A search from a reset once the recorder and the probe have matched every publisher
-        # (a volatile topic's messages before that are lost: the first search may be).
+        # (a volatile topic's messages before that are lost: the first search may be). The
+        # controller is disabled until its topics are quiet, so nothing of the first search is
+        # still in flight when the new one starts.
         assert wait_for(lambda: status and probe.matched('found') and all(
             int(status[-1].get(f'publishers_{t}', 0)) > 0 for t in topics), 60), \
             log.read_text()
-        n_found = len(search.found)
+        assert probe.enable(False, 'gaze_controller').success
+        assert wait_for(_quiet([search.found, search.beliefs, search.targets]), 30)
         assert probe.reset('gaze_controller').success
+        n_found, n_status = len(search.found), len(status)
+        assert wait_for(lambda: len(status) > n_status + 1, 30)      # a status after the quiet
+        written = int(status[-1]['messages_found'])
+        assert probe.enable(True, 'gaze_controller').success
         assert wait_for(lambda: len(search.found) > n_found, 60)
+        # SIGINT ends the recorder without what is still queued: stop once it wrote the event.
+        assert wait_for(lambda: int(status[-1]['messages_found']) > written, 30), \
+            log.read_text()
     finally:
         recorder.send_signal(signal.SIGINT)
         assert recorder.wait(30) == 0, log.read_text()

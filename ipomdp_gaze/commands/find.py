@@ -22,19 +22,21 @@ instead and stderr says why. ``--all`` finds every face
 
 **Images** are read with OpenCV (``IMREAD_ANYDEPTH | IMREAD_ANYCOLOR``: EXIF orientation applied,
 an alpha channel dropped, the bit depth kept so a 16-bit file is refused rather than silently
-rescaled). Colour arrays arrive in OpenCV's BGR order and are converted to RGB; the fovea turns
-them grey. ``seconds`` starts from the decoded array, so reading and decoding are not in it; nor
-is the one-time set-up of the detector, the fovea and the policy (the policy is run once on the
-uniform belief before the first image, so e.g. ELM's N x N weight matrix is built then).
+rescaled). Colour arrays arrive in OpenCV's BGR order and are converted to RGB; the fovea gives
+each window to the detector in the colour space it declares (RGB for YuNet, grey for Haar; a grey
+image is repeated into three channels for an RGB detector). ``seconds`` starts from the decoded
+array, so reading and decoding are not in it; nor is the one-time set-up of the detector, the
+fovea and the policy (the policy is run once on the uniform belief before the first image, so
+e.g. ELM's N x N weight matrix is built then).
 
 **Model.** ``--observation`` names an ``ipomdp_gaze/observation-v1`` file (or a shipped model);
 the fovea, the grid and the detector are rebuilt from what the file records (each window is
 detected at most once per image: the detector is deterministic, so this saves work and changes
-no count). Without it, each image uses the shipped Haar face model (``faces-<size>``,
-:func:`default_models`; ``--observation faces-<size>-yunet`` for YuNet) calibrated at
-the size nearest its own (``|log(w/w0)| + |log(h/h0)|``, ties to the first name); stderr says
-which model and policy are used. An image of another size than its model's is searched, and its
-line says so.
+no count). Without it, each image uses the shipped model of ``--detector`` (YuNet's
+``faces-<size>-yunet`` by default, chosen on training photos; ``haar``: ``faces-<size>``;
+:func:`default_models`) calibrated at the size nearest its own (``|log(w/w0)| +
+|log(h/h0)|``, ties to the first name); stderr says which model and policy are used. An image of
+another size than its model's is searched, and its line says so.
 
 **Policy.** ``--policy NAME`` (a baseline or ``nmpt``, built on the model) or ``--policy-file``;
 by default the shipped kernel trained on the model (a file in ``ipomdp_gaze/policies/kernels/``
@@ -80,8 +82,8 @@ def add_parser(sub):
                     'full-resolution scan (deciding then); small images are scanned whole '
                     'instead. Print one line per image (path, decision, cell (row, col) and '
                     'pixel (x, y) found, probability, fixations, detector pixels, seconds). '
-                    'Images are read with OpenCV (BGR converted to RGB, then grey); '
-                    '8 bits per channel.')
+                    'Images are read with OpenCV (BGR converted to RGB; grey for a grey '
+                    'detector such as Haar); 8 bits per channel.')
     p.add_argument('images', nargs='+', metavar='IMAGE',
                    help='image files (PNG, JPEG, ...) or folders (their image files, by name)')
     source = p.add_mutually_exclusive_group()
@@ -320,9 +322,10 @@ class _Tasks:
             detector = getattr(args, 'detector', None) or FIND_DETECTORS[0]
             self.models = [load_observation(name) for name in default_models(detector)]
             if not self.models:
-                raise ValueError('no observation model is shipped with this install; pass '
-                                 '--observation FILE (an ipomdp_gaze/observation-v1 file, e.g. '
-                                 'from ipomdp-gaze calibrate)')
+                raise ValueError(f'no observation model of the {detector} detector is shipped '
+                                 f'with this install; pass --observation FILE (an '
+                                 f'ipomdp_gaze/observation-v1 file, e.g. from ipomdp-gaze '
+                                 f'calibrate)')
             self.shipped = True
         self.tasks = {}
         if args.observation:                    # a bad model or policy: refused before any image

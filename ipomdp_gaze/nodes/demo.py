@@ -38,6 +38,8 @@ from .watch import SearchRecord, Watch
 POLL_S = 0.05
 # Pictures: after the answer, wait until the detector's annotated_image has been quiet this long.
 PICTURE_QUIET_S, PICTURE_WAIT_S = 0.5, 3.0
+# How long the disabled controller's topics must stay silent before the demo's new search.
+QUIET_S = 0.3
 FPOC_OVERRIDES = {
     'camera': {},
     # The human FPOC is calibrated at 0.42 degrees per cell (docs/design.md section 2).
@@ -222,23 +224,42 @@ def _restart_heard(setup: DemoSetup, watch, recorder, wait, records, pictures: b
     node's publishers, and what a volatile topic sends before it is matched is lost. So the
     search that is recorded and drawn is a new one: the demo waits until the recorder has
     matched the frame publishers (and the camera images) and its own watch the controller's
-    topics (and the annotated image, when drawing faces), calls the controller's ``~/reset``
-    and forgets what it saw of the first search.
+    topics (and the annotated image, when drawing faces); then it disables the controller,
+    waits until the controller's topics (``records`` but the last, the annotated images) are
+    quiet, resets it, forgets everything of the first search and enables it again. Nothing the
+    controller sends while disabled belongs to either search, so no message in flight from
+    the first search is taken for one of the new search.
     """
     topics = [('evidence', 'evidence_image')]
     if setup.scene == 'faces':
         topics.append(('image',))
-    own = ['belief', 'pan_tilt', 'found'] + \
+    own = ['belief', 'pan_tilt', 'found', 'absent'] + \
         (['annotated_image'] if pictures and setup.scene == 'faces' else [])
     if not wait(lambda: (recorder is None or all(recorder.matched(*t) for t in topics))
                 and all(watch.matched(t) for t in own)):
         raise RuntimeError('the recorder or the demo did not hear the nodes in time')
-    since = time.monotonic()
-    watch.reset(NODE_NAMES['controller'])
+    controller = NODE_NAMES['controller']
+    watch.enable(False, controller)
+    if not wait(_quiet(records[:-1], QUIET_S)):
+        raise RuntimeError('the controller did not fall quiet once disabled')
+    watch.reset(controller)
     for entries in records:
-        # Arrival order is time order; what the spin thread appends meanwhile is kept.
-        del entries[:next((i for i, e in enumerate(entries) if e[0] >= since), len(entries))]
-    return since
+        del entries[:]
+    started = time.monotonic()
+    watch.enable(True, controller)
+    return started
+
+
+def _quiet(lists, quiet_s: float):
+    """Return a condition: none of ``lists`` has grown for ``quiet_s`` seconds."""
+    state = {'lengths': [len(x) for x in lists], 'since': time.monotonic()}
+
+    def quiet() -> bool:
+        lengths = [len(x) for x in lists]
+        if lengths != state['lengths']:
+            state['lengths'], state['since'] = lengths, time.monotonic()
+        return time.monotonic() - state['since'] >= quiet_s
+    return quiet
 
 
 class RecorderStatus:
