@@ -35,8 +35,11 @@ import numpy as np
 CONTROLLER = 'gaze_controller'
 DETECTOR = 'foveal_detector'
 IMAGE_CHANNELS = {'mono8': 1, 'rgb8': 3, 'bgr8': 3}
-# The target sent with a reset is stamped at most this long after the reset belief arrived.
+# The target sent with a reset is stamped at most this long after the reset belief arrived, and
+# at most RESET_WINDOW_S before (a reset of a disabled controller sends none: its first target
+# comes when it is enabled, after the reset belief).
 RESET_TARGET_S = 0.005
+RESET_WINDOW_S = 0.25
 # What ``replay`` may change, and the controller parameter each one sets.
 OVERRIDES = {'observation': 'observation.file', 'policy': 'policy.name',
              'policy_file': 'policy.file', 'confidence': 'confidence',
@@ -204,7 +207,9 @@ def last_search(bag, head: PanTiltMap, start: int):
     A bag may hold several searches (``~/reset`` starts a new one; the demo resets once the
     recorder hears every node): a replay follows the last one. The recorder takes the topics
     in its own order and a busy machine delays some, so the reset is pinned by the target sent
-    with it: the latest target at the ``start`` cell stamped before the reset belief arrived.
+    with it: the latest target at the ``start`` cell stamped at most :data:`RESET_WINDOW_S`
+    before the reset belief arrived (and :data:`RESET_TARGET_S` after). A reset of a disabled
+    controller sends no target; the search's first target is then the next one.
     """
     grid = head.grid
     resets = [m.time_ns for m in bag.topic('belief')
@@ -213,8 +218,8 @@ def last_search(bag, head: PanTiltMap, start: int):
         return bag
     cut = resets[-1]
     sent = [m for m in bag.topic('pan_tilt')
-            if _seconds(m.msg.header.stamp) * 1e9 <= cut + RESET_TARGET_S * 1e9 and
-            head.nearest_cell(*_angles(m.msg, head)) == start]
+            if cut - RESET_WINDOW_S * 1e9 <= _seconds(m.msg.header.stamp) * 1e9
+            <= cut + RESET_TARGET_S * 1e9 and head.nearest_cell(*_angles(m.msg, head)) == start]
     if sent:
         first = max(sent, key=lambda m: _seconds(m.msg.header.stamp))
         stamp = first.msg.header.stamp
