@@ -80,13 +80,8 @@ def dask_cluster(workers: int, folder: Path):
 
 def stop(procs) -> None:
     """Stop the workers, then the scheduler (a worker without one retries for a long time)."""
-    for proc in reversed(procs):
-        proc.terminate()
-        try:
-            proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+    from ipomdp_gaze.nodes.processes import stop_processes
+    stop_processes(procs)
 
 
 TITLE = 'Cluster: the 7x7 ideal-searcher evaluation over workers'

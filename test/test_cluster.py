@@ -82,13 +82,8 @@ def cluster(tmp_path_factory):
             client.wait_for_workers(2, timeout=60)
         yield running
     finally:                    # the workers first: without a scheduler they retry for long
-        for proc in reversed(running.processes):
-            proc.terminate()
-            try:
-                proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
+        from ipomdp_gaze.nodes.processes import stop_processes
+        stop_processes(running.processes)
 
 
 def _run(argv, capsys) -> str:

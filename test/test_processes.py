@@ -32,3 +32,23 @@ def test_concurrent_runs_never_share_a_domain_id():
             proc.wait(30)
     assert len(set(ids)) == len(ids), ids
     assert all(1 <= i <= 101 for i in ids), ids
+
+
+STUBBORN = textwrap.dedent("""
+    import signal, sys, time
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)        # ignores SIGTERM: needs SIGKILL
+    print('ready', flush=True)
+    time.sleep(120)
+""")
+
+
+def test_stop_processes_terminates_the_polite_and_kills_the_stubborn():
+    from ipomdp_gaze.nodes.processes import stop_processes
+    polite = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(120)'])
+    stubborn = subprocess.Popen([sys.executable, '-c', STUBBORN], stdout=subprocess.PIPE,
+                                text=True)
+    assert stubborn.stdout.readline().strip() == 'ready'
+    stop_processes([polite, stubborn], timeout_s=1.0)
+    assert polite.returncode == -15                      # SIGTERM
+    assert stubborn.returncode == -9                     # SIGKILL after the wait
+    stubborn.stdout.close()

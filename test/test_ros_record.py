@@ -196,19 +196,6 @@ def test_a_fixed_camera_recording_can_be_searched_anew(ros_env, tmp_path):
                      other.stdout, re.M), other.stdout
 
 
-def _quiet(lists, quiet_s: float = 0.3):
-    """Return a condition: none of ``lists`` has grown for ``quiet_s`` seconds."""
-    import time
-    state = {'lengths': [len(x) for x in lists], 'since': time.monotonic()}
-
-    def quiet() -> bool:
-        lengths = [len(x) for x in lists]
-        if lengths != state['lengths']:
-            state['lengths'], state['since'] = lengths, time.monotonic()
-        return time.monotonic() - state['since'] >= quiet_s
-    return quiet
-
-
 def test_ipomdp_gaze_record_records_another_run_until_sigint(ros_env, tmp_path, probe):
     """A user's own nodes, recorded by ``ipomdp-gaze record``: the search it heard whole."""
     import signal
@@ -216,7 +203,7 @@ def test_ipomdp_gaze_record_records_another_run_until_sigint(ros_env, tmp_path, 
     from conftest import config_path
     from ipomdp_gaze.msg_adapters import diagnostics
     from ipomdp_gaze.nodes.processes import NodeGroup, wait_for
-    from ipomdp_gaze.nodes.watch import SearchRecord
+    from ipomdp_gaze.nodes.watch import quiet_condition, SearchRecord
     topics = ('pan_tilt', 'belief', 'found', 'ground_truth')
     search = SearchRecord(probe, updates_only=True)
     status = probe.status_values('recorder: recording')
@@ -241,7 +228,7 @@ def test_ipomdp_gaze_record_records_another_run_until_sigint(ros_env, tmp_path, 
             int(status[-1].get(f'publishers_{t}', 0)) > 0 for t in topics), 60), \
             log.read_text()
         assert probe.enable(False, 'gaze_controller').success
-        assert wait_for(_quiet([search.found, search.beliefs, search.targets]), 30)
+        assert wait_for(quiet_condition([search.found, search.beliefs, search.targets], 0.3), 30)
         assert probe.reset('gaze_controller').success
         n_found, n_status = len(search.found), len(status)
         assert wait_for(lambda: len(status) > n_status + 1, 30)      # a status after the quiet

@@ -32,7 +32,7 @@ from . import NODE_NAMES
 from .config import config_file
 from .params import fpoc_from, grid_from, head_from, joint_params
 from .processes import domain_id_for, isolated_nodes
-from .watch import SearchRecord, Watch
+from .watch import quiet_condition, SearchRecord, Watch
 
 # The watcher's wait for a condition (it polls; the records fill in the watch's spin thread).
 POLL_S = 0.05
@@ -240,7 +240,7 @@ def _restart_heard(setup: DemoSetup, watch, recorder, wait, records, pictures: b
         raise RuntimeError('the recorder or the demo did not hear the nodes in time')
     controller = NODE_NAMES['controller']
     watch.enable(False, controller)
-    if not wait(_quiet(records[:-1], QUIET_S)):
+    if not wait(quiet_condition(records[:-1], QUIET_S)):
         raise RuntimeError('the controller did not fall quiet once disabled')
     watch.reset(controller)
     for entries in records:
@@ -248,18 +248,6 @@ def _restart_heard(setup: DemoSetup, watch, recorder, wait, records, pictures: b
     started = time.monotonic()
     watch.enable(True, controller)
     return started
-
-
-def _quiet(lists, quiet_s: float):
-    """Return a condition: none of ``lists`` has grown for ``quiet_s`` seconds."""
-    state = {'lengths': [len(x) for x in lists], 'since': time.monotonic()}
-
-    def quiet() -> bool:
-        lengths = [len(x) for x in lists]
-        if lengths != state['lengths']:
-            state['lengths'], state['since'] = lengths, time.monotonic()
-        return time.monotonic() - state['since'] >= quiet_s
-    return quiet
 
 
 class RecorderStatus:

@@ -93,6 +93,22 @@ def wait_for(condition, timeout_s: float = 20.0, interval_s: float = 0.02) -> bo
         time.sleep(interval_s)
 
 
+def stop_processes(procs, timeout_s: float = 10.0) -> None:
+    """
+    Stop ``subprocess.Popen`` processes, the last started first: SIGTERM, SIGKILL after a wait.
+
+    The reverse order matters for a cluster: workers first, since a worker without its
+    scheduler retries for a long time.
+    """
+    for proc in reversed(list(procs)):
+        proc.terminate()
+        try:
+            proc.wait(timeout=timeout_s)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
 class NodeExited(RuntimeError):
     """A node process that should be running has exited."""
 

@@ -296,6 +296,23 @@ class Watch:
         return True
 
 
+def quiet_condition(lists, quiet_s: float):
+    """
+    Return a condition for :meth:`Watch.wait_until`: none of ``lists`` grew for ``quiet_s``.
+
+    For a node that was told to stop sending (a disabled controller): once its topics are quiet,
+    nothing it sent before is still in flight.
+    """
+    state = {'lengths': [len(x) for x in lists], 'since': time.monotonic()}
+
+    def quiet() -> bool:
+        lengths = [len(x) for x in lists]
+        if lengths != state['lengths']:
+            state['lengths'], state['since'] = lengths, time.monotonic()
+        return time.monotonic() - state['since'] >= quiet_s
+    return quiet
+
+
 def _parameter_msgs(params) -> list:
     if isinstance(params, dict):
         params = [v if isinstance(v, Parameter) else Parameter(k, value=v)
