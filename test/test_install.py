@@ -272,6 +272,11 @@ def test_the_image_tasks_run_from_the_install(install, tmp_path):
         assert out.returncode == 0, out.stdout + out.stderr
         entry = json.loads((tmp_path / f'{observation}.json').read_text())['images'][0]
         assert entry['decision'] == 'found' and entry['cell'] == [4, 9], (observation, entry)
+    out = install.run(cli, 'find', 'astronaut.png', '--json', 'default.json', cwd=tmp_path)
+    assert out.returncode == 0, out.stdout + out.stderr         # the default detector's models
+    assert 'shipped observation model faces-420-yunet ' in out.stderr, out.stderr
+    entry = json.loads((tmp_path / 'default.json').read_text())['images'][0]
+    assert entry['decision'] == 'found' and entry['cell'] == [4, 9], entry
     out = install.run(cli, 'evaluate', '--scenes', 'pan-tilt', '--episodes', '1',
                       '--max-fixations', '3', '--jobs', '1', '--quiet', cwd=tmp_path)
     assert out.returncode == 0, out.stdout + out.stderr
