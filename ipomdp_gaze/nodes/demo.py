@@ -223,16 +223,19 @@ def _restart_heard(setup: DemoSetup, watch, recorder, wait, records, pictures: b
     recorder (``recorder``, when recording) or the demo's own subscriptions have matched that
     node's publishers, and what a volatile topic sends before it is matched is lost. So the
     search that is recorded and drawn is a new one: the demo waits until the recorder has
-    matched the frame publishers (and the camera images) and its own watch the controller's
-    topics (and the annotated image, when drawing faces); then it disables the controller,
-    waits until the controller's topics (``records`` but the last, the annotated images) are
-    quiet, resets it, forgets everything of the first search and enables it again. Nothing the
-    controller sends while disabled belongs to either search, so no message in flight from
-    the first search is taken for one of the new search.
+    matched the frame publishers and the controller's (and the camera images and annotated
+    images) and its own watch the controller's topics (and the annotated image, when drawing
+    faces); then it disables the controller, waits until the controller's topics (``records``
+    but the last, the annotated images) are quiet, resets it, forgets everything of the first
+    search and enables it again. Nothing the controller sends while disabled belongs to either
+    search, so no message in flight from the first search is taken for one of the new search.
     """
-    topics = [('evidence', 'evidence_image')]
+    topics = [('evidence', 'evidence_image'), ('fixation',), ('pan_tilt',), ('belief',),
+              ('found',), ('absent',), ('gave_up',)]
     if setup.scene == 'faces':
         topics.append(('image',))
+        if pictures:
+            topics.append(('annotated_image',))
     own = ['belief', 'pan_tilt', 'found', 'absent'] + \
         (['annotated_image'] if pictures and setup.scene == 'faces' else [])
     if not wait(lambda: (recorder is None or all(recorder.matched(*t) for t in topics))
