@@ -58,7 +58,8 @@ DEFAULT = ('faces-420', 'faces-420-nmpt', 'faces-840', 'faces-840-nmpt', 'faces-
 
 
 def run(name: str, out: Path) -> tuple:
-    """Run one recipe into ``out``; return (name, wall seconds).
+    """
+    Run one recipe into ``out``; return (name, wall seconds).
 
     The kernel trains on the shipped ``faces-420`` (install a new one first).
     """
@@ -106,6 +107,7 @@ def compare(name: str, new: Path) -> str:
 
 
 def main() -> int:
+    """Regenerate the chosen models, compare them with the shipped ones, install on request."""
     parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
     parser.add_argument('--only', default=','.join(DEFAULT),
                         help=f'models to regenerate, of {", ".join([*RECIPES, KERNEL[0]])}')
