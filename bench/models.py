@@ -49,8 +49,10 @@ RECIPES = {
                               *YUNET], True),
 }
 #: The kernel trained on ``faces-420`` (run after it: it records that model's fingerprint).
+#: Seed 2 of seeds 0-3, picked by right on training scenes (seed 1, 150; ties to fewer
+#: fixations) when the models were recalibrated (docs/faces.md, ideas).
 KERNEL = ('faces-420-infomax', ['train', '--observation', 'faces-420', '--horizon', '30',
-                                '--init-elm', '10', '--epochs', '300', '--seed', '0'])
+                                '--init-elm', '10', '--epochs', '300', '--seed', '2'])
 #: What ``make models`` regenerates: the Haar models (the YuNet ones and ``faces-pan-tilt-40``
 #: were calibrated after ``camera`` left the training backgrounds) and the kernel.
 DEFAULT = ('faces-420', 'faces-420-nmpt', 'faces-840', 'faces-840-nmpt', 'faces-pan-tilt',

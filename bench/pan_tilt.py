@@ -28,6 +28,7 @@ from pathlib import Path
 import sys
 import time
 
+from ipomdp_gaze.progress import Progress
 from ipomdp_gaze.vision.scene_eval import (evaluate_scenes, HEAD_SPEED_DEG_S,
                                            paired_map_difference, SACCADE_TIME_S,
                                            SceneResult, SETTLE_TIME_S, summarise, SWEEP_RULES,
@@ -62,8 +63,9 @@ def run(args) -> dict:
                 if not n:
                     continue
                 t0 = time.perf_counter()
-                done = evaluate_scenes(one, n, pool, progress=_progress(label, n))
-                print(f'\n{label}: {n} scenes in {time.perf_counter() - t0:.0f} s',
+                with Progress(n, f'{label}{" empty" if one.empty else ""}', 'scene') as bar:
+                    done = evaluate_scenes(one, n, pool, progress=bar)
+                print(f'{label}: {n} scenes in {time.perf_counter() - t0:.0f} s',
                       file=sys.stderr)
                 for name, group in done.items():
                     results.setdefault(SHIPPED if name == spec.policy else name,
@@ -121,13 +123,6 @@ def _sweep_poses(spec):
     from ipomdp_gaze.policies.baselines import sweep_tiles
     model = load_observation(spec.model or 'faces-pan-tilt')
     return sweep_tiles(model.grid, model)[0]
-
-
-def _progress(label: str, n: int):
-    def report(done):
-        if done % 20 == 0 or done == n:
-            print(f'{label}: {done}/{n}', end='\r', file=sys.stderr, flush=True)
-    return report
 
 
 def _results(run_record: dict) -> dict:

@@ -150,7 +150,7 @@ def test_find_with_an_absent_prior_says_absent_on_a_face_free_photo(tmp_path):
     cv2.imwrite(str(path), data.brick())
     # every view counting fully, the evidence decides before the pixel deadline
     out = cli('find', str(path), '--absent-prior', '0.5', '--json', str(tmp_path / 'o.json'),
-              '--observation', 'faces-420', '--repeat-weight', '1')
+              '--observation', 'faces-420', '--repeat-weight', '1', '--policy', 'elm')
     assert out.returncode == 0, out.stderr
     entry = json.loads((tmp_path / 'o.json').read_text())['images'][0]
     assert entry['decision'] == entry['stop'] == 'absent'       # the evidence decided
