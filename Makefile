@@ -4,7 +4,7 @@ VENV := .venv
 VPY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: venv demo test bench reproduce faces pan-tilt soak clean
+.PHONY: venv demo test bench reproduce faces pan-tilt models soak clean
 
 venv: $(STAMP)
 
@@ -46,6 +46,11 @@ faces: $(STAMP)
 # writes docs/pan_tilt.md and docs/data/pan_tilt.json.gz (10-30 minutes, and 15 for the ROS demo).
 pan-tilt: $(STAMP)
 	$(VPY) bench/pan_tilt.py --ros-seeds 50
+
+# Recalibrate every shipped Haar model and retrain faces-420-infomax from their recipes on training
+# scenes, print what moved and install the new files (bench/models.py; about 15 minutes).
+models: $(STAMP)
+	$(VPY) bench/models.py --install
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache
