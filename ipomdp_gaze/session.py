@@ -38,6 +38,7 @@ from typing import Mapping
 import numpy as np
 
 from .belief import bayes_update, entropy, EvidenceError, map_cell, normalize_log
+from .false_alarms import check_false_alarm_scales, FalseAlarmMixture
 from .grid import Grid
 from .inhibition import policy_choice, unvisited_choice
 from .motion import check_probability, check_sigma_cells, Motion
@@ -65,6 +66,7 @@ PARAMETER_NAMES = {
     'scan': 'search.scan',
     'found_radius': 'search.found_radius',
     'decide_at_budget': 'search.decide_at_budget',
+    'false_alarm_scales': 'search.false_alarm_scales',
 }
 
 
@@ -143,6 +145,10 @@ class SearchSettings:
         Still target: when the budget runs out undecided, decide anyway (reason ``budget``):
         ``absent`` if ``P(absent)`` is at least the answer's probability, else ``found``;
         off: ``gave_up``. A deadline: the robot must say something.
+    false_alarm_scales : tuple of float
+        Still target, count model: the scene's false-alarm rate is the model's times one of
+        these factors, equally likely a priori, learned from every cell's counts during the
+        search (:mod:`ipomdp_gaze.false_alarms`); ``(1.0,)``: the rates as calibrated.
 
     """
 
@@ -158,6 +164,7 @@ class SearchSettings:
     scan: bool = True
     found_radius: int = 0
     decide_at_budget: bool = False
+    false_alarm_scales: tuple = (1.0,)
 
     def __post_init__(self):
         names = PARAMETER_NAMES
@@ -176,6 +183,8 @@ class SearchSettings:
             'scan': _check_flag(self.scan, names['scan']),
             'found_radius': _check_radius(self.found_radius, names['found_radius']),
             'decide_at_budget': _check_flag(self.decide_at_budget, names['decide_at_budget']),
+            'false_alarm_scales': check_false_alarm_scales(self.false_alarm_scales,
+                                                           names['false_alarm_scales']),
         }
         for key, value in checked.items():
             object.__setattr__(self, key, value)
@@ -198,6 +207,7 @@ class SearchSettings:
         out = {PARAMETER_NAMES[f.name]: getattr(self, f.name) for f in fields(self)}
         if isinstance(self.start_cell, tuple):
             out['start_cell'] = list(self.start_cell)
+        out[PARAMETER_NAMES['false_alarm_scales']] = list(self.false_alarm_scales)
         return out
 
     @classmethod
@@ -229,6 +239,14 @@ class SearchSettings:
         if grid is not None:
             settings.check_grid(grid)
         return settings
+
+
+def _check_mixture_model(settings: SearchSettings, observation) -> None:
+    """Refuse false-alarm scales with a model that has no count tables to scale."""
+    if len(settings.false_alarm_scales) > 1 and not isinstance(observation, CountObservation):
+        raise ValueError(f"{PARAMETER_NAMES['false_alarm_scales']} needs a count model "
+                         f'(observation.model: counts); this search uses '
+                         f'{getattr(observation, "name", type(observation).__name__)}')
 
 
 def start_index(grid: Grid, settings: SearchSettings) -> int | None:
@@ -364,6 +382,8 @@ class SearchSession:
         self.rng = np.random.default_rng(0)
         self._search = None
         self._counts = isinstance(self.observation, CountObservation)
+        self._mixture = None
+        self._check_mixture()
 
     # -- configuration -------------------------------------------------------------------
     def configure(self, settings: SearchSettings) -> None:
@@ -375,19 +395,29 @@ class SearchSession:
         belief now.
         """
         settings.check_grid(self.grid)
+        _check_mixture_model(settings, self.observation)
         old = self.settings
         self.settings = settings
         self.motion = Motion(self.grid, settings.motion_sigma_cells, settings.motion_jump_prob)
+        if settings.false_alarm_scales != old.false_alarm_scales:
+            self._mixture = None
         if self._search is not None and (settings.repeat_weight != old.repeat_weight
-                                         or settings.moving != old.moving):
+                                         or settings.moving != old.moving
+                                         or settings.false_alarm_scales
+                                         != old.false_alarm_scales):
             self._still.reset()
+            if self._mixture is not None:
+                self._mixture.reset()
             self._search.still_base = self._search.log_belief.copy()
 
     def set_observation(self, observation) -> None:
         """Assume another observation model (or FPOC) from the next frame on."""
-        self.observation = as_observation(self.grid, observation)
+        observation = as_observation(self.grid, observation)
+        _check_mixture_model(self.settings, observation)
+        self.observation = observation
         self._counts = isinstance(self.observation, CountObservation)
         self._kernel = None
+        self._mixture = None
 
     def set_policy(self, policy) -> None:
         """Choose with another policy from the next choice on."""
@@ -512,6 +542,8 @@ class SearchSession:
             self.rng = np.random.default_rng(seed)
         log_b = initial_log_belief(self.grid.n_cells, self.settings.absent_prior)
         self._still.reset()
+        if self._mixture is not None:
+            self._mixture.reset()
         self._search = _Search(log_b, log_b.copy(), np.zeros(self.grid.n_cells, dtype=bool))
         self._event('reset', settings=self.settings.to_parameters())
 
@@ -641,7 +673,14 @@ class SearchSession:
         except EvidenceError as exc:
             return self._result('rejected', reason=str(exc))
         self.predict(dt_s)
-        if self.settings.repeat_weight < 1.0 and not self.motion.active:
+        mixture = self._active_mixture()
+        if mixture is not None:
+            information = self._still_information(obs)
+            self._still.add(term, information)
+            mixture.add(obs, search.fixation, information)
+            search.log_belief[:] = mixture.log_belief(search.still_base,
+                                                      self.settings.repeat_weight)
+        elif self.settings.repeat_weight < 1.0 and not self.motion.active:
             bayes_update(search.still_base,
                          with_absent(self._still_term(obs, term), search.log_belief),
                          out=search.log_belief)
@@ -665,12 +704,26 @@ class SearchSession:
         return self._result('applied', fired=fired)
 
     # -- inside ------------------------------------------------------------------------------
-    def _still_term(self, obs: np.ndarray, term: np.ndarray) -> np.ndarray:
+    def _still_information(self, obs: np.ndarray) -> np.ndarray:
         if self._kernel is None:
             self._kernel = np.asarray(self.observation.elm_kernel(), dtype=float)
         information = cell_information(self._kernel, self.grid, self._search.fixation)
-        self._still.add(term, np.where(np.isnan(obs), 0.0, information))
+        return np.where(np.isnan(obs), 0.0, information)
+
+    def _still_term(self, obs: np.ndarray, term: np.ndarray) -> np.ndarray:
+        self._still.add(term, self._still_information(obs))
         return self._still.log_likelihood_ratio(self.settings.repeat_weight)
+
+    def _check_mixture(self) -> None:
+        _check_mixture_model(self.settings, self.observation)
+
+    def _active_mixture(self) -> FalseAlarmMixture | None:
+        """Return the false-alarm mixture when the settings ask for one and the target is still."""
+        if len(self.settings.false_alarm_scales) < 2 or self.motion.active:
+            return None
+        if self._mixture is None:
+            self._mixture = FalseAlarmMixture(self.observation, self.settings.false_alarm_scales)
+        return self._mixture
 
     def _decide(self) -> str:
         """Run the stop rules after an applied frame; return the decision it fired ('')."""

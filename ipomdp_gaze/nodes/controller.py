@@ -133,6 +133,10 @@ def controller_params() -> list[Param]:
         Param('search.decide_at_budget', False, T.BOOL,
               'still target: when the budget runs out undecided, say absent or found '
               '(whichever is more probable) instead of gave_up'),
+        Param('search.false_alarm_scales', [1.0], T.DOUBLE_ARRAY,
+              'still target, count model: the scene may fire the detector this many times as '
+              'often as the model expects, each factor equally likely, learned from every '
+              "cell's counts during the search ([1.0]: the model's rates as calibrated)"),
         Param('policy.name', 'elm', T.STRING, 'fixation policy', choices=POLICY_NAMES),
         Param('policy.file', '', T.STRING,
               'policy YAML path or shipped kernel name; setting it selects learned'),

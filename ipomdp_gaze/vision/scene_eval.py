@@ -28,6 +28,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 import math
 from pathlib import Path
+import re
 
 from ipomdp_gaze.evaluation import wilson_interval
 from ipomdp_gaze.executor import InlineExecutor, track
@@ -135,13 +136,14 @@ def compare_settings(settings: SearchSettings, label: str) -> SearchSettings:
     """
     Return ``settings`` changed by a searcher label's ``:parameter=value,...`` part.
 
-    Values are read as YAML scalars (``0.1``, ``true``, ``60``).
+    Values are read as YAML (``0.1``, ``true``, ``60``, ``[1, 2, 4, 8]``: commas inside brackets
+    belong to the value).
     """
     if ':' not in label:
         return settings
     import yaml
     values = {}
-    for item in label.split(':', 1)[1].split(','):
+    for item in re.split(r',(?![^\[]*\])', label.split(':', 1)[1]):
         key, sep, value = item.partition('=')
         if not sep or key.strip() not in PARAMETER_NAMES.values():
             raise ValueError(f'searcher {label!r}: expected parameter=value with a parameter '

@@ -1,0 +1,154 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""A scene's own false-alarm rate (``search.false_alarm_scales``) against brute-force Bayes."""
+import itertools
+
+from ipomdp_gaze.false_alarms import check_false_alarm_scales, FalseAlarmMixture, scaled_null
+from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.observation import CountObservation
+from ipomdp_gaze.session import Frame, SearchSession, SearchSettings
+from ipomdp_gaze.vision.scene_eval import compare_settings
+import numpy as np
+import pytest
+
+
+def _model(rng, rows=3, cols=3, k=3):
+    """Return a count model whose target and null tables differ at every offset."""
+    grid = Grid(rows, cols)
+    target = rng.dirichlet([1.0, 2.0, 3.0][:k], size=(rows, cols))
+    null = rng.dirichlet([20.0, 1.0, 0.5][:k], size=(rows, cols))
+    return grid, CountObservation(grid, target, null)
+
+
+def _brute_posterior(model, frames, scales, absent_prior):
+    """P(cell or absent | frames) by enumerating (scale, hypothesis), full likelihoods."""
+    grid = model.grid
+    n = grid.n_cells
+    cells = [grid.cell(i) for i in range(n)]
+    post = np.zeros(n + 1)
+    for s in scales:
+        null = model.p_null.copy()
+        null[..., 1:] *= s                              # small scales: no cap is reached
+        null[..., 0] = 1.0 - null[..., 1:].sum(axis=-1)
+        for h in range(n + 1):
+            prior = absent_prior if h == n else (1 - absent_prior) / n
+            like = 1.0
+            for fixation, counts in frames:
+                fr, fc = cells[fixation]
+                for j in range(n):
+                    if np.isnan(counts[j]):
+                        continue
+                    r, c = cells[j]
+                    off = (abs(r - fr), abs(c - fc))
+                    table = model.p_target if j == h else null
+                    like *= table[off][int(counts[j])]
+            post[h] += prior * like / len(scales)
+    return post / post.sum()
+
+
+@pytest.mark.parametrize('seed', range(4))
+def test_the_belief_is_the_brute_force_posterior_marginal_over_the_scales(seed):
+    rng = np.random.default_rng(seed)
+    grid, model = _model(rng)
+    scales = (0.5, 1.0, 2.5)
+    settings = SearchSettings(confidence=0.999999, absent_prior=0.3, false_alarm_scales=scales)
+    session = SearchSession(grid, model, None, settings)
+    session.reset(seed=0)
+    session.start()
+    session.fixate(int(rng.integers(grid.n_cells)))
+    frames = []
+    for _ in range(5):
+        counts = rng.integers(0, 3, size=grid.n_cells).astype(float)
+        counts[rng.random(grid.n_cells) < 0.2] = np.nan          # some cells not observed
+        frames.append((session.fixation, counts))
+        assert session.update(Frame(counts)).applied
+        session.fixate(int(rng.integers(grid.n_cells)))
+    expected = _brute_posterior(model, frames, scales, 0.3)
+    assert session.belief == pytest.approx(expected[:-1], rel=1e-9, abs=1e-12)
+    assert session.absent_probability == pytest.approx(expected[-1], rel=1e-9)
+
+
+def test_a_busy_scene_makes_each_detection_weigh_less_and_learns_its_rate():
+    rng = np.random.default_rng(7)
+    grid, model = _model(rng, 5, 5)
+    busy = (rng.random(grid.n_cells) < 0.6).astype(float)   # a texture firing in most cells
+    busy[6] = 2.0                                            # and one cell firing twice
+    peak = {}
+    for scales in ((1.0,), (1.0, 4.0)):
+        session = SearchSession(grid, model, None,
+                                SearchSettings(confidence=0.999999, false_alarm_scales=scales))
+        session.reset(seed=0)
+        session.start()
+        session.fixate(12)
+        session.update(Frame(busy))
+        peak[scales] = session.belief[6]
+        if len(scales) > 1:
+            scale_posterior = np.exp(session._active_mixture().log_scale_posterior)
+            assert scale_posterior[1] > 0.99                 # the scene fires about 4x as often
+    # its double detection is as likely from the texture: the cell gets less of the belief
+    assert peak[(1.0, 4.0)] < peak[(1.0,)]
+
+
+def test_one_scale_of_one_is_the_plain_model_bit_for_bit():
+    rng = np.random.default_rng(3)
+    grid, model = _model(rng)
+    beliefs = []
+    for settings in (SearchSettings(repeat_weight=0.3),
+                     SearchSettings(repeat_weight=0.3, false_alarm_scales=[1.0])):
+        session = SearchSession(grid, model, None, settings)
+        session.reset(seed=0)
+        session.start()
+        session.fixate(4)
+        for counts in rng.integers(0, 3, size=(3, grid.n_cells)).astype(float):
+            session.update(Frame(counts))
+        beliefs.append(session.log_belief.copy())
+        rng = np.random.default_rng(3)
+        _model(rng)
+    assert np.array_equal(beliefs[0], beliefs[1])
+
+
+def test_the_scaled_null_table_keeps_uninformative_offsets_and_caps_detections():
+    target = np.array([[[0.5, 0.5], [0.9, 0.1]]])
+    null = np.array([[[0.5, 0.5], [0.8, 0.2]]])
+    out = scaled_null(target, null, 10.0)
+    assert np.array_equal(out[0, 0], null[0, 0])                   # target = null: says nothing
+    assert out[0, 1] == pytest.approx([0.05, 0.95])                 # 10 x 0.2, capped at 0.95
+    assert out.sum(axis=-1) == pytest.approx(np.ones((1, 2)))
+
+
+@pytest.mark.parametrize('value', [[], [0.0], [1.0, 1.0], [float('nan')], [-2.0],
+                                   list(range(1, 10)), 'abc', None])
+def test_bad_scales_are_refused_with_the_parameter_name(value):
+    with pytest.raises(ValueError, match='search.false_alarm_scales must be 1 to 8 distinct'):
+        SearchSettings(false_alarm_scales=value)
+
+
+def test_settings_round_trip_and_a_searcher_label_takes_a_list():
+    settings = SearchSettings(false_alarm_scales=(8, 1, 2))
+    assert settings.false_alarm_scales == (1.0, 2.0, 8.0)
+    params = settings.to_parameters()
+    assert params['search.false_alarm_scales'] == [1.0, 2.0, 8.0]
+    assert SearchSettings.from_parameters(params) == settings
+    changed = compare_settings(SearchSettings(), 'coverage:search.false_alarm_scales=[1, 4],'
+                                                 'search.repeat_weight=0.3')
+    assert changed.false_alarm_scales == (1.0, 4.0) and changed.repeat_weight == 0.3
+
+
+def test_a_gaussian_model_refuses_scales_it_cannot_apply():
+    from ipomdp_gaze.fpoc import make_fpoc
+    grid = Grid(5, 5, 1.0)
+    with pytest.raises(ValueError, match='search.false_alarm_scales needs a count model'):
+        SearchSession(grid, make_fpoc('human'), None,
+                      SearchSettings(false_alarm_scales=[1.0, 2.0]))
+    session = SearchSession(grid, make_fpoc('human'), None, SearchSettings())
+    with pytest.raises(ValueError, match='needs a count model'):
+        session.configure(SearchSettings(false_alarm_scales=[1.0, 2.0]))
+
+
+def test_check_accepts_any_order_and_mixture_needs_valid_scales():
+    assert check_false_alarm_scales([4, 0.5]) == (0.5, 4.0)
+    rng = np.random.default_rng(0)
+    _, model = _model(rng)
+    with pytest.raises(ValueError):
+        FalseAlarmMixture(model, [])
+    assert list(itertools.islice(FalseAlarmMixture(model, [1, 2]).scales, 2)) == [1.0, 2.0]
