@@ -94,10 +94,15 @@ class FalseAlarmMixture:
         self.log_scale_posterior = self.log_scale_prior.copy()
 
     def add(self, observation: np.ndarray, fixation: int, information: np.ndarray) -> None:
-        """Record one frame under every scale (``information`` as :class:`StillEvidence` takes)."""
+        """
+        Record one validated frame under every scale (``information`` as StillEvidence takes).
+
+        A count that two tables both rule out says nothing here (term 0): the frame was
+        checked against the model itself already.
+        """
         for s in range(len(self.scales)):
-            cell = self._cell[s].log_likelihood_ratio(observation, fixation)
-            null = self._null[s].log_likelihood_ratio(observation, fixation)
+            cell = self._cell[s].log_likelihood_ratio(observation, fixation, validate=False)
+            null = self._null[s].log_likelihood_ratio(observation, fixation, validate=False)
             self._cell_evidence[s].add(np.nan_to_num(cell), information)
             self._null_evidence[s].add(np.nan_to_num(null), information)
 

@@ -152,3 +152,19 @@ def test_check_accepts_any_order_and_mixture_needs_valid_scales():
     with pytest.raises(ValueError):
         FalseAlarmMixture(model, [])
     assert list(itertools.islice(FalseAlarmMixture(model, [1, 2]).scales, 2)) == [1.0, 2.0]
+
+
+def test_a_count_the_null_rules_out_is_still_a_frame_with_scales():
+    rng = np.random.default_rng(5)
+    grid, model = _model(rng)
+    null = model.p_null.copy()
+    null[..., 2] = 0.0                                      # the background never gives 2
+    null /= null.sum(axis=-1, keepdims=True)
+    model = CountObservation(grid, model.p_target, null)
+    session = SearchSession(grid, model, None, SearchSettings(false_alarm_scales=[1.0, 3.0]))
+    session.reset(seed=0)
+    session.start()
+    counts = np.zeros(grid.n_cells)
+    counts[4] = 2.0
+    assert session.update(Frame(counts)).applied
+    assert np.all(np.isfinite(session.belief)) and session.map_cell == 4
