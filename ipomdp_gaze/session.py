@@ -383,7 +383,7 @@ class SearchSession:
         self._search = None
         self._counts = isinstance(self.observation, CountObservation)
         self._mixture = None
-        self._check_mixture()
+        _check_mixture_model(self.settings, self.observation)
 
     # -- configuration -------------------------------------------------------------------
     def configure(self, settings: SearchSettings) -> None:
@@ -713,9 +713,6 @@ class SearchSession:
     def _still_term(self, obs: np.ndarray, term: np.ndarray) -> np.ndarray:
         self._still.add(term, self._still_information(obs))
         return self._still.log_likelihood_ratio(self.settings.repeat_weight)
-
-    def _check_mixture(self) -> None:
-        _check_mixture_model(self.settings, self.observation)
 
     def _active_mixture(self) -> FalseAlarmMixture | None:
         """Return the false-alarm mixture when the settings ask for one and the target is still."""
