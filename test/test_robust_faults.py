@@ -88,6 +88,16 @@ def _posterior(belief, frame, fixation, grid) -> np.ndarray:
     return np.exp(log_b - np.logaddexp.reduce(log_b))
 
 
+def _kept_outside_view(kept, belief, fixation, grid) -> bool:
+    """Whether ``belief`` is ``kept`` times one factor on the cells a frame says nothing of."""
+    from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
+    d = dprime_matrix(grid, make_fpoc('camera', dprime=DPRIME, half_width_deg=10.0,
+                                      half_height_deg=10.0))[:, fixation]
+    outside = (d == 0) & (kept > 1e-12)
+    ratio = belief[outside] / kept[outside]
+    return bool(outside.sum() >= 2 and np.allclose(ratio, ratio[0], rtol=1e-4))
+
+
 def _matched(probe, topic: str) -> bool:
     """Whether the probe's subscriptions to ``topic`` have matched every publisher in the graph."""
     publishers = probe.node.count_publishers(f'/{topic}')
@@ -161,9 +171,13 @@ def test_camera_killed_mid_search_then_restarted(nodes, probe, watch):
         (target, [watch.cell(m) for _, m in watch.poses[n_poses:]], camera.output())
     assert wait_for(lambda: len(watch.beliefs) > kept_beliefs, 30), controller.output()
     first = watch.belief(kept_beliefs)
-    assert any(np.allclose(first, _posterior(kept, frame.data, target, watch.grid), rtol=1e-4,
-                           atol=1e-7) for _, frame in watch.frames[n_frames:]), \
-        'the first update after the restart is not the kept belief times a camera frame'
+    if not any(np.allclose(first, _posterior(kept, frame.data, target, watch.grid), rtol=1e-4,
+                           atol=1e-7) for _, frame in watch.frames[n_frames:]):
+        # Frames travel best effort, so the probe may have lost the one the controller applied.
+        # Then check what any camera frame at the target does: the cells out of its view keep
+        # the kept belief's ratios, and so the kept belief was updated, not a fresh one.
+        assert _kept_outside_view(kept, first, target, watch.grid), \
+            'the first update after the restart is not the kept belief times a camera frame'
     assert wait_for(lambda: watch.finished(kept_beliefs), 60), 'the search did not complete'
     done = next(np.asarray(m.data) for _, m in watch.beliefs[kept_beliefs:]
                 if max(m.data) >= 0.999)
