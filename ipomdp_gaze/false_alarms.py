@@ -20,6 +20,19 @@ from the most informative view plus the weighted rest, as for the plain model. T
 table multiplies every nonzero count's probability by ``s`` (the total capped at
 :data:`MAX_DETECTION_PROBABILITY`) at the offsets where the model's tables differ; where they
 are equal the offset says nothing, for every scale. The one-time scan keeps the model's tables.
+
+**Hotspots.** A texture may also fire at one place, view after view (a tuft of grass, a printed
+letter): a scale for the whole scene does not explain it, and to the plain model a spot that
+gives two or three detections from every pose looks like a face, more so with every view. With
+``hotspot_prior`` > 0 each cell without the face is, independently and with that prior, a
+hotspot whose counts follow the model's null tables scaled by ``hotspot_scale`` (the same
+:func:`scaled_null`), persistent across the search. A cell's background evidence is then the
+mixture ``B_s(i) = (1 - rho) + rho * prod p_hot / p_null_s`` over its own views, and
+
+    P(frames | s, target at i) / P(frames | model's null) = G_s * prod_j B_s(j) * R_s(i) / B_s(i)
+
+so weak counts repeated at one spot are worth at most about ``1 / rho`` for a face there, while
+the counts a face gives near the view's centre (far more than a hotspot's) still are.
 """
 from __future__ import annotations
 
@@ -32,6 +45,8 @@ from .observation import CountObservation
 from .still_evidence import StillEvidence
 
 MAX_SCALES = 8
+# A hotspot fires this many times as often as the model's null tables by default.
+DEFAULT_HOTSPOT_SCALE = 20.0
 # A scaled null table never gives a cell a detection with more than this probability.
 MAX_DETECTION_PROBABILITY = 0.95
 
@@ -48,6 +63,23 @@ def check_false_alarm_scales(value, name: str = 'false_alarm_scales') -> tuple:
                          f"model's false-alarm rates ([1.0]: the rates as calibrated), got "
                          f'{value!r}')
     return tuple(sorted(scales))
+
+
+def check_hotspot_prior(value, name: str = 'hotspot_prior') -> float:
+    """Return the prior that a cell is a hotspot as a float in [0, 0.5], or raise ValueError."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not 0.0 <= float(value) <= 0.5:
+        raise ValueError(f'{name} must be in [0, 0.5] (0: no hotspots), got {value!r}')
+    return float(value)
+
+
+def check_hotspot_scale(value, name: str = 'hotspot_scale') -> float:
+    """Return the factor of a hotspot's detection rate as a float > 1, or raise ValueError."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not (math.isfinite(float(value)) and float(value) > 1.0):
+        raise ValueError(f"{name} must be a finite factor > 1 of the model's false-alarm rates, "
+                         f'got {value!r}')
+    return float(value)
 
 
 def scaled_null(p_target: np.ndarray, p_null: np.ndarray, scale: float) -> np.ndarray:
@@ -72,11 +104,18 @@ class FalseAlarmMixture:
         The count model the searcher assumes.
     scales : sequence of float
         The factors (checked by :func:`check_false_alarm_scales`), equally likely a priori.
+    hotspot_prior : float
+        The prior that a cell without the face is a hotspot (module docstring); 0: none.
+    hotspot_scale : float
+        A hotspot's detections are this many times as likely as the model's null tables say.
 
     """
 
-    def __init__(self, model: CountObservation, scales):
+    def __init__(self, model: CountObservation, scales, hotspot_prior: float = 0.0,
+                 hotspot_scale: float = DEFAULT_HOTSPOT_SCALE):
         self.scales = check_false_alarm_scales(scales)
+        self.hotspot_prior = check_hotspot_prior(hotspot_prior)
+        self.hotspot_scale = check_hotspot_scale(hotspot_scale)
         grid = model.grid
         nulls = [scaled_null(model.p_target, model.p_null, s) for s in self.scales]
         # R_s: target against the scaled null; G_s per cell: the scaled null against the model's.
@@ -84,12 +123,17 @@ class FalseAlarmMixture:
         self._null = [CountObservation(grid, n, model.p_null) for n in nulls]
         self._cell_evidence = [StillEvidence(grid.n_cells) for _ in self.scales]
         self._null_evidence = [StillEvidence(grid.n_cells) for _ in self.scales]
+        # A hotspot against the model's null (the scale's null is divided out in log_belief).
+        self._hot = CountObservation(
+            grid, scaled_null(model.p_target, model.p_null, self.hotspot_scale), model.p_null) \
+            if self.hotspot_prior > 0 else None
+        self._hot_evidence = StillEvidence(grid.n_cells)
         self.log_scale_prior = np.full(len(self.scales), -math.log(len(self.scales)))
         self.log_scale_posterior = self.log_scale_prior.copy()
 
     def reset(self) -> None:
         """Forget every frame (a new search, or the evidence counted afresh)."""
-        for evidence in (*self._cell_evidence, *self._null_evidence):
+        for evidence in (*self._cell_evidence, *self._null_evidence, self._hot_evidence):
             evidence.reset()
         self.log_scale_posterior = self.log_scale_prior.copy()
 
@@ -105,6 +149,9 @@ class FalseAlarmMixture:
             null = self._null[s].log_likelihood_ratio(observation, fixation, validate=False)
             self._cell_evidence[s].add(np.nan_to_num(cell), information)
             self._null_evidence[s].add(np.nan_to_num(null), information)
+        if self._hot is not None:
+            hot = self._hot.log_likelihood_ratio(observation, fixation, validate=False)
+            self._hot_evidence.add(np.nan_to_num(hot), information)
 
     def log_belief(self, base: np.ndarray, repeat_weight: float) -> np.ndarray:
         """
@@ -115,12 +162,20 @@ class FalseAlarmMixture:
         """
         n = self._cell_evidence[0].kept.size
         joint = np.empty((len(self.scales), base.size))
+        rho = self.hotspot_prior
+        hot = self._hot_evidence.log_likelihood_ratio(repeat_weight) if rho > 0 else None
         for s in range(len(self.scales)):
+            cell = self._cell_evidence[s].log_likelihood_ratio(repeat_weight)
+            null = self._null_evidence[s].log_likelihood_ratio(repeat_weight)
+            if hot is not None:
+                # log B_s per cell: background or hotspot, each against the scale's null.
+                background = np.logaddexp(math.log1p(-rho), math.log(rho) + hot - null)
+                cell = cell - background
+                null = null + background
             joint[s] = base
             with np.errstate(invalid='ignore'):     # an excluded cell stays at -inf
-                joint[s, :n] += self._cell_evidence[s].log_likelihood_ratio(repeat_weight)
-            joint[s] += self._null_evidence[s].log_likelihood_ratio(repeat_weight).sum() \
-                + self.log_scale_prior[s]
+                joint[s, :n] += cell
+            joint[s] += null.sum() + self.log_scale_prior[s]
         peak = joint.max()
         with np.errstate(divide='ignore'):
             marginal = peak + np.log(np.exp(joint - peak).sum(axis=0))

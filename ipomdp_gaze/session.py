@@ -38,7 +38,8 @@ from typing import Mapping
 import numpy as np
 
 from .belief import bayes_update, entropy, EvidenceError, map_cell, normalize_log
-from .false_alarms import check_false_alarm_scales, FalseAlarmMixture
+from .false_alarms import (check_false_alarm_scales, check_hotspot_prior, check_hotspot_scale,
+                           DEFAULT_HOTSPOT_SCALE, FalseAlarmMixture)
 from .grid import Grid
 from .inhibition import policy_choice, unvisited_choice
 from .motion import check_probability, check_sigma_cells, Motion
@@ -67,6 +68,8 @@ PARAMETER_NAMES = {
     'found_radius': 'search.found_radius',
     'decide_at_budget': 'search.decide_at_budget',
     'false_alarm_scales': 'search.false_alarm_scales',
+    'hotspot_prior': 'search.hotspot_prior',
+    'hotspot_scale': 'search.hotspot_scale',
 }
 
 
@@ -149,6 +152,12 @@ class SearchSettings:
         Still target, count model: the scene's false-alarm rate is the model's times one of
         these factors, equally likely a priori, learned from every cell's counts during the
         search (:mod:`ipomdp_gaze.false_alarms`); ``(1.0,)``: the rates as calibrated.
+    hotspot_prior : float
+        Still target, count model: the prior that a cell without the target is a hotspot, a
+        spot that fires the detector ``hotspot_scale`` times as often as the model's null
+        tables in every view (:mod:`ipomdp_gaze.false_alarms`); 0: no hotspots.
+    hotspot_scale : float
+        A hotspot's factor (> 1) of the model's false-alarm rates.
 
     """
 
@@ -165,6 +174,8 @@ class SearchSettings:
     found_radius: int = 0
     decide_at_budget: bool = False
     false_alarm_scales: tuple = (1.0,)
+    hotspot_prior: float = 0.0
+    hotspot_scale: float = DEFAULT_HOTSPOT_SCALE
 
     def __post_init__(self):
         names = PARAMETER_NAMES
@@ -185,6 +196,8 @@ class SearchSettings:
             'decide_at_budget': _check_flag(self.decide_at_budget, names['decide_at_budget']),
             'false_alarm_scales': check_false_alarm_scales(self.false_alarm_scales,
                                                            names['false_alarm_scales']),
+            'hotspot_prior': check_hotspot_prior(self.hotspot_prior, names['hotspot_prior']),
+            'hotspot_scale': check_hotspot_scale(self.hotspot_scale, names['hotspot_scale']),
         }
         for key, value in checked.items():
             object.__setattr__(self, key, value)
@@ -241,12 +254,23 @@ class SearchSettings:
         return settings
 
 
+def _mixture_settings(settings: SearchSettings) -> tuple:
+    """Return the settings the false-alarm mixture is built from."""
+    return settings.false_alarm_scales, settings.hotspot_prior, settings.hotspot_scale
+
+
+def _wants_mixture(settings: SearchSettings) -> bool:
+    return len(settings.false_alarm_scales) > 1 or settings.hotspot_prior > 0
+
+
 def _check_mixture_model(settings: SearchSettings, observation) -> None:
-    """Refuse false-alarm scales with a model that has no count tables to scale."""
-    if len(settings.false_alarm_scales) > 1 and not isinstance(observation, CountObservation):
-        raise ValueError(f"{PARAMETER_NAMES['false_alarm_scales']} needs a count model "
-                         f'(observation.model: counts); this search uses '
-                         f'{getattr(observation, "name", type(observation).__name__)}')
+    """Refuse false-alarm scales or hotspots with a model that has no count tables to scale."""
+    if not _wants_mixture(settings) or isinstance(observation, CountObservation):
+        return
+    name = 'false_alarm_scales' if len(settings.false_alarm_scales) > 1 else 'hotspot_prior'
+    raise ValueError(f'{PARAMETER_NAMES[name]} needs a count model '
+                     f'(observation.model: counts); this search uses '
+                     f'{getattr(observation, "name", type(observation).__name__)}')
 
 
 def start_index(grid: Grid, settings: SearchSettings) -> int | None:
@@ -399,12 +423,11 @@ class SearchSession:
         old = self.settings
         self.settings = settings
         self.motion = Motion(self.grid, settings.motion_sigma_cells, settings.motion_jump_prob)
-        if settings.false_alarm_scales != old.false_alarm_scales:
+        mixture_changed = _mixture_settings(settings) != _mixture_settings(old)
+        if mixture_changed:
             self._mixture = None
         if self._search is not None and (settings.repeat_weight != old.repeat_weight
-                                         or settings.moving != old.moving
-                                         or settings.false_alarm_scales
-                                         != old.false_alarm_scales):
+                                         or settings.moving != old.moving or mixture_changed):
             self._still.reset()
             if self._mixture is not None:
                 self._mixture.reset()
@@ -716,10 +739,10 @@ class SearchSession:
 
     def _active_mixture(self) -> FalseAlarmMixture | None:
         """Return the false-alarm mixture when the settings ask for one and the target is still."""
-        if len(self.settings.false_alarm_scales) < 2 or self.motion.active:
+        if not _wants_mixture(self.settings) or self.motion.active:
             return None
         if self._mixture is None:
-            self._mixture = FalseAlarmMixture(self.observation, self.settings.false_alarm_scales)
+            self._mixture = FalseAlarmMixture(self.observation, *_mixture_settings(self.settings))
         return self._mixture
 
     def _decide(self) -> str:

@@ -1,6 +1,6 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""A scene's own false-alarm rate (``search.false_alarm_scales``) against brute-force Bayes."""
+"""A scene's own false-alarm rate and its hotspots (``ipomdp_gaze.false_alarms``) against Bayes."""
 from ipomdp_gaze.false_alarms import check_false_alarm_scales, FalseAlarmMixture, scaled_null
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.observation import CountObservation
@@ -18,29 +18,47 @@ def _model(rng, rows=3, cols=3, k=3):
     return grid, CountObservation(grid, target, null)
 
 
-def _brute_posterior(model, frames, scales, absent_prior):
-    """P(cell or absent | frames) by enumerating (scale, hypothesis), full likelihoods."""
+def _scaled(table, s):
+    out = table.copy()
+    out[..., 1:] *= s                                   # small scales: no cap is reached
+    out[..., 0] = 1.0 - out[..., 1:].sum(axis=-1)
+    return out
+
+
+def _brute_posterior(model, frames, scales, absent_prior, hotspot_prior=0.0, hotspot_scale=2.0):
+    """
+    P(cell or absent | frames) by enumerating (scale, hypothesis, which cells are hotspots).
+
+    Full likelihoods: every frame's probability under each joint hypothesis, no factoring.
+    """
+    import itertools
     grid = model.grid
     n = grid.n_cells
     cells = [grid.cell(i) for i in range(n)]
+    hot_table = _scaled(model.p_null, hotspot_scale)
+    patterns = itertools.product((False, True), repeat=n) if hotspot_prior > 0 else [(False,) * n]
+    patterns = list(patterns)
     post = np.zeros(n + 1)
     for s in scales:
-        null = model.p_null.copy()
-        null[..., 1:] *= s                              # small scales: no cap is reached
-        null[..., 0] = 1.0 - null[..., 1:].sum(axis=-1)
+        null = _scaled(model.p_null, s)
         for h in range(n + 1):
             prior = absent_prior if h == n else (1 - absent_prior) / n
-            like = 1.0
-            for fixation, counts in frames:
-                fr, fc = cells[fixation]
-                for j in range(n):
-                    if np.isnan(counts[j]):
-                        continue
-                    r, c = cells[j]
-                    off = (abs(r - fr), abs(c - fc))
-                    table = model.p_target if j == h else null
-                    like *= table[off][int(counts[j])]
-            post[h] += prior * like / len(scales)
+            for hot in patterns:
+                if h < n and hot[h]:
+                    continue                            # the face's cell is no hotspot
+                p_hot = np.prod([hotspot_prior if hot[j] else 1 - hotspot_prior
+                                 for j in range(n) if j != h])
+                like = 1.0
+                for fixation, counts in frames:
+                    fr, fc = cells[fixation]
+                    for j in range(n):
+                        if np.isnan(counts[j]):
+                            continue
+                        r, c = cells[j]
+                        off = (abs(r - fr), abs(c - fc))
+                        table = model.p_target if j == h else hot_table if hot[j] else null
+                        like *= table[off][int(counts[j])]
+                post[h] += prior * p_hot * like / len(scales)
     return post / post.sum()
 
 
@@ -64,6 +82,51 @@ def test_the_belief_is_the_brute_force_posterior_marginal_over_the_scales(seed):
     expected = _brute_posterior(model, frames, scales, 0.3)
     assert session.belief == pytest.approx(expected[:-1], rel=1e-9, abs=1e-12)
     assert session.absent_probability == pytest.approx(expected[-1], rel=1e-9)
+
+
+@pytest.mark.parametrize('seed', range(3))
+def test_with_hotspots_the_belief_is_the_brute_force_posterior(seed):
+    rng = np.random.default_rng(10 + seed)
+    grid, model = _model(rng, 2, 3)
+    scales, rho, hot = (1.0, 1.5), 0.2, 2.5
+    settings = SearchSettings(confidence=0.999999, absent_prior=0.3, false_alarm_scales=scales,
+                              hotspot_prior=rho, hotspot_scale=hot)
+    session = SearchSession(grid, model, None, settings)
+    session.reset(seed=0)
+    session.start()
+    frames = []
+    for _ in range(4):
+        counts = rng.integers(0, 3, size=grid.n_cells).astype(float)
+        counts[rng.random(grid.n_cells) < 0.2] = np.nan
+        frames.append((session.fixation, counts))
+        assert session.update(Frame(counts)).applied
+        session.fixate(int(rng.integers(grid.n_cells)))
+    expected = _brute_posterior(model, frames, scales, 0.3, rho, hot)
+    assert session.belief == pytest.approx(expected[:-1], rel=1e-9, abs=1e-12)
+    assert session.absent_probability == pytest.approx(expected[-1], rel=1e-9)
+
+
+def test_a_spot_firing_weakly_from_every_view_is_not_taken_for_a_face_with_hotspots():
+    grid = Grid(5, 5)
+    # a face mostly gives 2, the background 0; one detection is rare for both, 2.5x likelier
+    # for a face, and a hotspot's tables (the null's x 5) give it 0.2
+    target = np.broadcast_to([0.3, 0.1, 0.6], (5, 5, 3))
+    model = CountObservation(grid, target, np.broadcast_to([0.95, 0.04, 0.01], (5, 5, 3)))
+    peak = {}
+    for rho in (0.0, 0.05):
+        session = SearchSession(grid, model, None,
+                                SearchSettings(confidence=0.999999, absent_prior=0.5,
+                                               hotspot_prior=rho, hotspot_scale=5.0))
+        session.reset(seed=0)
+        session.start()
+        for fixation in (12, 6, 8, 16, 18):
+            session.fixate(fixation)
+            counts = np.zeros(grid.n_cells)
+            counts[12] = 1.0                               # the same weak count every view
+            session.update(Frame(counts))
+        peak[rho] = session.belief[12]
+    # without hotspots every view adds to the face there; with them the spot is as likely
+    assert peak[0.0] > 0.5 and peak[0.05] < 0.1
 
 
 def test_a_busy_scene_makes_each_detection_weigh_less_and_learns_its_rate():
@@ -120,11 +183,39 @@ def test_bad_scales_are_refused_with_the_parameter_name(value):
         SearchSettings(false_alarm_scales=value)
 
 
+@pytest.mark.parametrize('name, value', [('hotspot_prior', -0.1), ('hotspot_prior', 0.6),
+                                         ('hotspot_prior', True), ('hotspot_prior', 'x'),
+                                         ('hotspot_scale', 1.0), ('hotspot_scale', float('inf')),
+                                         ('hotspot_scale', None)])
+def test_bad_hotspot_settings_are_refused_with_the_parameter_name(name, value):
+    with pytest.raises(ValueError, match=f'search.{name} must be'):
+        SearchSettings(**{name: value})
+
+
+def test_a_hotspot_prior_of_zero_is_the_plain_model_bit_for_bit():
+    rng = np.random.default_rng(4)
+    grid, model = _model(rng)
+    frames = rng.integers(0, 3, size=(3, grid.n_cells)).astype(float)
+    beliefs = []
+    for settings in (SearchSettings(repeat_weight=0.3, false_alarm_scales=[1.0, 2.0]),
+                     SearchSettings(repeat_weight=0.3, false_alarm_scales=[1.0, 2.0],
+                                    hotspot_prior=0.0, hotspot_scale=50.0)):
+        session = SearchSession(grid, model, None, settings)
+        session.reset(seed=0)
+        session.start()
+        session.fixate(4)
+        for counts in frames:
+            session.update(Frame(counts))
+        beliefs.append(session.log_belief)
+    assert np.array_equal(beliefs[0], beliefs[1])
+
+
 def test_settings_round_trip_and_a_searcher_label_takes_a_list():
-    settings = SearchSettings(false_alarm_scales=(8, 1, 2))
+    settings = SearchSettings(false_alarm_scales=(8, 1, 2), hotspot_prior=0.02, hotspot_scale=10)
     assert settings.false_alarm_scales == (1.0, 2.0, 8.0)
     params = settings.to_parameters()
     assert params['search.false_alarm_scales'] == [1.0, 2.0, 8.0]
+    assert params['search.hotspot_prior'] == 0.02 and params['search.hotspot_scale'] == 10.0
     assert SearchSettings.from_parameters(params) == settings
     changed = compare_settings(SearchSettings(), 'coverage:search.false_alarm_scales=[1, 4],'
                                                  'search.repeat_weight=0.3')
@@ -140,6 +231,8 @@ def test_a_gaussian_model_refuses_scales_it_cannot_apply():
     session = SearchSession(grid, make_fpoc('human'), None, SearchSettings())
     with pytest.raises(ValueError, match='needs a count model'):
         session.configure(SearchSettings(false_alarm_scales=[1.0, 2.0]))
+    with pytest.raises(ValueError, match='search.hotspot_prior needs a count model'):
+        session.configure(SearchSettings(hotspot_prior=0.1))
 
 
 def test_check_accepts_any_order_and_mixture_needs_valid_scales():

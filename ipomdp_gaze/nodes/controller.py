@@ -137,6 +137,13 @@ def controller_params() -> list[Param]:
               'still target, count model: the scene may fire the detector this many times as '
               'often as the model expects, each factor equally likely, learned from every '
               "cell's counts during the search ([1.0]: the model's rates as calibrated)"),
+        Param('search.hotspot_prior', 0.0, T.DOUBLE,
+              'still target, count model: prior that a cell without the target is a hotspot '
+              'that fires in every view (hotspot_scale times the false-alarm rate), in [0, 0.5] '
+              '(0: none)'),
+        Param('search.hotspot_scale', 20.0, T.DOUBLE,
+              "still target, count model: a hotspot's factor of the model's false-alarm rate, "
+              '> 1'),
         Param('policy.name', 'elm', T.STRING, 'fixation policy', choices=POLICY_NAMES),
         Param('policy.file', '', T.STRING,
               'policy YAML path or shipped kernel name; setting it selects learned'),
