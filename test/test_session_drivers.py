@@ -127,7 +127,11 @@ def test_evaluate_scenes_runs_the_pan_tilt_task_and_writes_json(tmp_path):
     assert 'pan-tilt (2 scenes with a face): right' in out.stdout
     record = json.loads((tmp_path / 'pt.json').read_text())
     assert record['settings']['search.max_fixations'] == 6
-    assert record['settings']['search.repeat_weight'] == 0.3      # the shipped config's
+    from ipomdp_gaze.nodes.config import config_file
+    from ipomdp_gaze.yaml_files import yaml_parameters
+    shipped = yaml_parameters(config_file('faces_camera_controller.yaml'), 'gaze_controller')
+    for name in ('search.repeat_weight', 'absent.prior', 'search.hotspot_prior'):
+        assert record['settings'][name] == shipped[name]           # the shipped config's
     assert record['settings']['search.found_radius'] == 1
     scenes = record['scenes']['coverage']
     assert [s['index'] for s in scenes] == [0, 1]
