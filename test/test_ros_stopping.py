@@ -158,6 +158,8 @@ def test_with_motion_the_controller_keeps_tracking_after_found(rig, probe, found
     (CONTROLLER, {'search.max_fixations': -3}, 'search.max_fixations'),
     (CONTROLLER, {'search.repeat_weight': 1.5}, 'search.repeat_weight'),
     (CONTROLLER, {'search.repeat_weight': -0.25}, 'search.repeat_weight'),
+    (CONTROLLER, {'search.hotspot_prior': 0.75}, 'search.hotspot_prior must be in [0, 0.5]'),
+    (CONTROLLER, {'search.hotspot_scale': 0.5}, 'search.hotspot_scale must be a finite factor'),
     (CAMERA, {'target_motion_sigma_cells': -0.5}, 'target_motion_sigma_cells must be finite'),
     (CAMERA, {'target_jump_prob': 1.0}, 'target_jump_prob must be a probability in [0, 1)'),
 ])
