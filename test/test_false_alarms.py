@@ -150,13 +150,18 @@ def test_a_busy_scene_makes_each_detection_weigh_less_and_learns_its_rate():
     assert peak[(1.0, 4.0)] < peak[(1.0,)]
 
 
-def test_one_scale_of_one_is_the_plain_model_bit_for_bit():
+@pytest.mark.parametrize('plain, same', [
+    ({}, {'false_alarm_scales': [1.0]}),                               # one scale of one
+    ({'false_alarm_scales': [1.0, 2.0]},                                # hotspot prior 0
+     {'false_alarm_scales': [1.0, 2.0], 'hotspot_prior': 0.0, 'hotspot_scale': 50.0}),
+])
+def test_the_plain_settings_give_the_plain_model_bit_for_bit(plain, same):
     rng = np.random.default_rng(3)
     grid, model = _model(rng)
     frames = rng.integers(0, 3, size=(3, grid.n_cells)).astype(float)
     beliefs = []
-    for settings in (SearchSettings(repeat_weight=0.3),
-                     SearchSettings(repeat_weight=0.3, false_alarm_scales=[1.0])):
+    for settings in (SearchSettings(repeat_weight=0.3, **plain),
+                     SearchSettings(repeat_weight=0.3, **same)):
         session = SearchSession(grid, model, None, settings)
         session.reset(seed=0)
         session.start()
@@ -190,24 +195,6 @@ def test_bad_scales_are_refused_with_the_parameter_name(value):
 def test_bad_hotspot_settings_are_refused_with_the_parameter_name(name, value):
     with pytest.raises(ValueError, match=f'search.{name} must be'):
         SearchSettings(**{name: value})
-
-
-def test_a_hotspot_prior_of_zero_is_the_plain_model_bit_for_bit():
-    rng = np.random.default_rng(4)
-    grid, model = _model(rng)
-    frames = rng.integers(0, 3, size=(3, grid.n_cells)).astype(float)
-    beliefs = []
-    for settings in (SearchSettings(repeat_weight=0.3, false_alarm_scales=[1.0, 2.0]),
-                     SearchSettings(repeat_weight=0.3, false_alarm_scales=[1.0, 2.0],
-                                    hotspot_prior=0.0, hotspot_scale=50.0)):
-        session = SearchSession(grid, model, None, settings)
-        session.reset(seed=0)
-        session.start()
-        session.fixate(4)
-        for counts in frames:
-            session.update(Frame(counts))
-        beliefs.append(session.log_belief)
-    assert np.array_equal(beliefs[0], beliefs[1])
 
 
 def test_settings_round_trip_and_a_searcher_label_takes_a_list():
