@@ -659,6 +659,7 @@ def plot_speed_accuracy(results, path: Path) -> None:
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
     fig, axes = plt.subplots(1, len(results), figsize=(6.5 * len(results), 5.2), squeeze=False)
+    labels = []
     for ax, task in zip(axes[0], results):
         for r in task['rows']:
             if r['label'].endswith('grouped'):
@@ -670,10 +671,9 @@ def plot_speed_accuracy(results, path: Path) -> None:
             ax.errorbar(r['speedup'], r['right'], yerr=[[r['right'] - low], [high - r['right']]],
                         fmt='s' if full else 'o', capsize=2,
                         color='C3' if yunet else 'C0' if full else 'C2' if reference else 'C1')
-            ax.annotate(r['label'].replace("NMPT's fovea, ", 'ref. ').replace('fovea, ', '')
-                        .replace(', confidence ', ' @').replace('YuNet full frame', 'YuNet'),
-                        (r['speedup'], r['right']), fontsize=7, xytext=(4, 2),
-                        textcoords='offset points')
+            labels.append((ax, r['label'].replace("NMPT's fovea, ", 'ref. ')
+                           .replace('fovea, ', '').replace(', confidence ', ' @')
+                           .replace('YuNet full frame', 'YuNet'), (r['speedup'], r['right'])))
         full = next(r for r in task['rows'] if r['label'] == 'full frame x1')
         ax.axhline(full['right'] - 0.02, color='k', linestyle=':', lw=1,
                    label='full resolution - 2 points')
@@ -686,8 +686,50 @@ def plot_speed_accuracy(results, path: Path) -> None:
         ax.grid(True, which='both', alpha=0.3)
         ax.legend(fontsize=8, loc='lower left')
     fig.tight_layout()
+    _place_labels(fig, labels)
     fig.savefig(path, dpi=100)
     plt.close(fig)
+
+
+# Label offsets tried in turn (points from the marker; negative dx: left of it), nearest first.
+_LABEL_OFFSETS = [(4, 2), (-4, 2)] + [(dx, sign * dy) for dy in range(10, 90, 8)
+                                      for sign in (-1, 1) for dx in (8, -8, 40, -40)]
+
+
+def _place_labels(fig, labels) -> None:
+    """
+    Annotate each point where its text stays readable.
+
+    The first offset whose text stays inside the axes and covers neither another label nor a
+    marker wins; a thin line joins a text placed away from its point.
+    """
+    from matplotlib.text import Text
+    from matplotlib.transforms import Bbox
+    renderer = fig.canvas.get_renderer()
+    taken = {}
+    for ax, _, xy in labels:
+        x, y = ax.transData.transform(xy)
+        taken.setdefault(ax, []).append(Bbox.from_extents(x - 5, y - 5, x + 5, y + 5))
+    for ax, text, xy in sorted(labels, key=lambda item: -item[2][1]):
+        inside = ax.get_window_extent(renderer)
+        for dx, dy in _LABEL_OFFSETS:
+            far = abs(dy) > 2
+            note = ax.annotate(text, xy, fontsize=7, xytext=(dx, dy), textcoords='offset points',
+                               ha='left' if dx > 0 else 'right',
+                               arrowprops={'arrowstyle': '-', 'lw': 0.4, 'color': '0.5'}
+                               if far else None)
+            note.update_positions(renderer)
+            box = Text.get_window_extent(note, renderer).expanded(1.02, 1.1)   # not the line
+            if inside.contains(box.x0, box.y0) and inside.contains(box.x1, box.y1) \
+                    and not any(box.overlaps(other) for other in taken[ax]):
+                break
+            note.remove()
+        else:
+            note = ax.annotate(text, xy, fontsize=7, xytext=_LABEL_OFFSETS[0],
+                               textcoords='offset points')
+            note.update_positions(renderer)
+            box = Text.get_window_extent(note, renderer)
+        taken[ax].append(box)
 
 
 def astronaut(figure: Path) -> list[str]:

@@ -35,3 +35,35 @@ def test_models_script_refuses_an_unknown_model_with_one_line():
                          capture_output=True, text=True, timeout=120)
     assert run.returncode == 2
     assert 'unknown model(s) faces-999' in run.stderr and 'Traceback' not in run.stderr
+
+
+def test_figure_labels_of_a_dense_cluster_neither_overlap_nor_leave_the_axes():
+    """``bench/faces.py`` labels its speed-accuracy points so that each stays readable."""
+    import importlib.util
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    from matplotlib.text import Text
+    import numpy as np
+    spec = importlib.util.spec_from_file_location('bench_faces', BENCH / 'faces.py')
+    faces = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(faces)
+    fig, ax = plt.subplots(figsize=(6, 4))
+    rng = np.random.default_rng(0)
+    points = [(3 + rng.random(), 0.95 + 0.03 * rng.random()) for _ in range(12)]  # one cluster
+    points += [(1.0, 0.4), (30.0, 0.5)]                                           # near edges
+    ax.plot(*zip(*points), 'o')
+    ax.set(xscale='log', xlim=(0.8, 40), ylim=(0.3, 1.05))
+    fig.tight_layout()
+    faces._place_labels(fig, [(ax, f'searcher number {i} @0.99', p) for i, p in enumerate(points)])
+    renderer = fig.canvas.get_renderer()
+    boxes = []
+    for note in ax.texts:
+        note.update_positions(renderer)
+        boxes.append(Text.get_window_extent(note, renderer))
+    assert len(boxes) == len(points)
+    inside = ax.get_window_extent(renderer)
+    for i, box in enumerate(boxes):
+        assert inside.contains(box.x0, box.y0) and inside.contains(box.x1, box.y1), ax.texts[i]
+        assert not any(box.overlaps(other) for other in boxes[i + 1:]), ax.texts[i]
+    plt.close(fig)
