@@ -184,6 +184,53 @@ def test_haar_detector_settings_and_size_limits(astronaut, haar):
     assert len(boxes) and np.all((boxes[:, 2] >= 60) & (boxes[:, 2] <= 90))
 
 
+def test_several_cascades_return_every_cascades_raw_boxes_and_mirror_maps_back(astronaut):
+    gray = cv2.cvtColor(astronaut, cv2.COLOR_RGB2GRAY)
+    names = [REFERENCE_CASCADE, 'haarcascade_profileface.xml']
+    both = HaarDetector(names, mirror=[False, True])
+    frontal = cv2.CascadeClassifier(str(find_cascade(names[0])))
+    profile = cv2.CascadeClassifier(str(find_cascade(names[1])))
+    flipped = as_boxes(profile.detectMultiScale(np.ascontiguousarray(gray[:, ::-1]), 1.1, 0))
+    assert len(flipped)
+    flipped[:, 0] = gray.shape[1] - flipped[:, 0] - flipped[:, 2]
+    expected = np.concatenate([as_boxes(frontal.detectMultiScale(gray, 1.1, 0)),
+                               as_boxes(profile.detectMultiScale(gray, 1.1, 0)), flipped])
+    raw = both(gray)
+    assert np.array_equal(raw, sorted(raw.tolist()))
+    assert np.array_equal(raw, expected[np.lexsort(expected.T[::-1])])
+    # A mirrored box covers the mirror image of what the cascade saw in the flipped image.
+    x, y, w, h = flipped[0]
+    assert 0 <= x and x + w <= gray.shape[1]
+
+
+def test_several_cascades_are_recorded_as_lists_and_rebuilt_from_them():
+    names = [REFERENCE_CASCADE, 'haarcascade_profileface.xml']
+    both = HaarDetector(names, mirror=[False, True])
+    settings = both.settings()
+    assert settings['cascade'] == names and settings['mirror'] == [False, True]
+    assert [len(sha) for sha in settings['cascade_sha256']] == [64, 64]
+    assert settings['window_px'] == [20, 20]
+    assert HaarDetector.from_settings(settings).settings() == settings
+    # One cascade without mirroring keeps the reference's record, so old model files still load.
+    assert 'mirror' not in HaarDetector(names[:1]).settings()
+    assert HaarDetector(names[:1], mirror=True).settings()['cascade'] == names[:1]
+    wrong = dict(settings, cascade_sha256=[settings['cascade_sha256'][0], '0' * 64])
+    with pytest.raises(ValueError, match='profileface.*differs'):
+        HaarDetector.from_settings(wrong)
+
+
+@pytest.mark.parametrize('cascade, mirror, reason', [
+    ([], False, 'non-empty list'),
+    ([REFERENCE_CASCADE, 3], False, 'non-empty list'),
+    ([REFERENCE_CASCADE], [True, False], 'list of 1'),
+    ([REFERENCE_CASCADE], 'yes', 'mirror must be'),
+    ([REFERENCE_CASCADE], [1], 'mirror must be'),
+])
+def test_several_cascades_refuse_bad_lists(cascade, mirror, reason):
+    with pytest.raises(ValueError, match=reason):
+        HaarDetector(cascade, mirror=mirror)
+
+
 # ---- the full-frame scan -----------------------------------------------------------------------
 
 def test_cells_of_points_follow_the_floor_rule_on_non_multiple_sizes():

@@ -220,14 +220,20 @@ def _size_pair(name: str, value) -> tuple[int, int] | None:
 
 class HaarDetector:
     """
-    OpenCV's Viola-Jones cascade returning raw, ungrouped detections (the CVPR 2009 detector).
+    OpenCV's Viola-Jones cascades returning raw, ungrouped detections (the CVPR 2009 detector).
 
-    Detector kind ``haar``: grey images in, ``(M, 4)`` integer boxes out (no scores).
+    Detector kind ``haar``: grey images in, ``(M, 4)`` integer boxes out (no scores). With one
+    cascade it is the reference detector. With several, every cascade runs on the image and the
+    raw boxes of all are returned together, so a count model counts them all: a face one cascade
+    barely sees (a turned head for the frontal cascade) may be seen by another (the profile
+    cascade). A cascade trained on one side only (``haarcascade_profileface.xml`` sees faces
+    turned to one side) also runs on the mirrored image when its ``mirror`` flag is set; its
+    boxes are mapped back to the image's own pixels.
 
     Parameters
     ----------
-    cascade : str or os.PathLike
-        Cascade file name or path, resolved with :func:`find_cascade`.
+    cascade : str, os.PathLike or list of them
+        Cascade file name or path, resolved with :func:`find_cascade`, or several.
     scale_factor : float
         Scale step of ``detectMultiScale``'s image pyramid (> 1).
     min_neighbors : int
@@ -237,6 +243,8 @@ class HaarDetector:
         detector is given (for the fovea: the resized window), or ``None`` for no limit.
     cascade_dir : str or os.PathLike, optional
         Folder (or file) searched before the default places.
+    mirror : bool or list of bool
+        Per cascade (one flag for all): also detect in the mirrored image.
 
     """
 
@@ -245,37 +253,57 @@ class HaarDetector:
     info_keys = INFO_KEYS
 
     def __init__(self, cascade=REFERENCE_CASCADE, scale_factor: float = 1.1,
-                 min_neighbors: int = 0, min_size_px=None, max_size_px=None, cascade_dir=None):
+                 min_neighbors: int = 0, min_size_px=None, max_size_px=None, cascade_dir=None,
+                 mirror=False):
         scale_factor = float(scale_factor)
         if not np.isfinite(scale_factor) or scale_factor <= 1.0:
             raise ValueError(f'scale_factor must be a finite number > 1, got {scale_factor!r}')
         if isinstance(min_neighbors, bool) or int(min_neighbors) != min_neighbors \
                 or min_neighbors < 0:
             raise ValueError(f'min_neighbors must be an int >= 0, got {min_neighbors!r}')
+        names = [cascade] if isinstance(cascade, (str, Path)) else list(cascade)
+        if not names or not all(isinstance(name, (str, Path)) for name in names):
+            raise ValueError(f'cascade must be a file name or a non-empty list of them, '
+                             f'got {cascade!r}')
+        self.mirror = _mirror_flags(mirror, len(names))
         self.scale_factor = scale_factor
         self.min_neighbors = int(min_neighbors)
         self.min_size_px = _size_pair('min_size_px', min_size_px)
         self.max_size_px = _size_pair('max_size_px', max_size_px)
-        self.path = find_cascade(str(cascade), cascade_dir)
-        self.cascade_name = self.path.name
-        self._classifier = cv2.CascadeClassifier(str(self.path))
-        if self._classifier.empty():
-            raise ValueError(f'{self.path} is not a cascade OpenCV can load')
-        width, height = self._classifier.getOriginalWindowSize()
-        self.window_px = (int(width), int(height))
-        self._sha256 = hashlib.sha256(self.path.read_bytes()).hexdigest()
+        self.paths = [find_cascade(str(name), cascade_dir) for name in names]
+        self.path = self.paths[0]
+        self.cascade_names = [path.name for path in self.paths]
+        self.cascade_name = self.cascade_names[0]
+        self._classifiers = []
+        windows = []
+        for path in self.paths:
+            classifier = cv2.CascadeClassifier(str(path))
+            if classifier.empty():
+                raise ValueError(f'{path} is not a cascade OpenCV can load')
+            width, height = classifier.getOriginalWindowSize()
+            windows.append((int(width), int(height)))
+            self._classifiers.append(classifier)
+        self._windows = windows
+        self.window_px = (min(w for w, _ in windows), min(h for _, h in windows))
+        self._sha256s = [hashlib.sha256(path.read_bytes()).hexdigest() for path in self.paths]
+        self._sha256 = self._sha256s[0]
         self._options = {}
         if self.min_size_px is not None:
             self._options['minSize'] = self.min_size_px
         if self.max_size_px is not None:
             self._options['maxSize'] = self.max_size_px
 
+    @property
+    def single(self) -> bool:
+        """Tell whether this is the one-cascade detector (recorded as the reference is)."""
+        return len(self.paths) == 1 and not self.mirror[0]
+
     @classmethod
     def from_settings(cls, settings: dict, cascade_dir=None) -> HaarDetector:
         """
         Rebuild the detector :meth:`settings` describes (an observation model's record).
 
-        The cascade is looked up by file name (:func:`find_cascade`, ``cascade_dir`` first), and
+        Each cascade is looked up by file name (:func:`find_cascade`, ``cascade_dir`` first), and
         a copy whose SHA-256 differs from the recorded one is refused.
 
         Raises
@@ -283,38 +311,56 @@ class HaarDetector:
         ValueError
             For a cascade that differs from the recorded one, or bad settings.
         FileNotFoundError
-            If the cascade file is not installed.
+            If a cascade file is not installed.
 
         """
         options = {key: settings[key] for key in ('cascade', 'scale_factor', 'min_neighbors',
-                                                  'min_size_px', 'max_size_px')
+                                                  'min_size_px', 'max_size_px', 'mirror')
                    if key in settings}
         detector = cls(cascade_dir=cascade_dir, **options)
         recorded = settings.get('cascade_sha256')
-        if recorded is not None and recorded != detector._sha256:
-            raise ValueError(f'the installed cascade {detector.path} differs from the one the '
-                             f'observation model was measured with (SHA-256 {recorded[:12]}...)')
+        if recorded is not None:
+            recorded = [recorded] if isinstance(recorded, str) else list(recorded)
+            for path, want, have in zip(detector.paths, recorded, detector._sha256s):
+                if want != have:
+                    raise ValueError(f'the installed cascade {path} differs from the one the '
+                                     f'observation model was measured with (SHA-256 '
+                                     f'{str(want)[:12]}...)')
         return detector
 
     def __call__(self, gray: np.ndarray) -> np.ndarray:
         """
         Raw boxes ``(M, 4)`` ``int64`` ``x, y, w, h`` in the pixels of ``gray`` (2-D ``uint8``).
 
-        An image smaller than the cascade's window (``window_px``) holds no detection and gives
-        ``(0, 4)``: a foveal window resized below the window size simply sees nothing. The rows
-        are sorted (lexicographically by ``x, y, w, h``): OpenCV searches in parallel and returns
-        them in an order that changes from run to run, which would make the grouped boxes'
-        order, and so ties between them, irreproducible.
+        An image smaller than a cascade's window (``window_px`` is the smallest) holds no
+        detection of that cascade: a foveal window resized below the window size simply sees
+        nothing. The rows are sorted (lexicographically by ``x, y, w, h``): OpenCV searches in
+        parallel and returns them in an order that changes from run to run, which would make the
+        grouped boxes' order, and so ties between them, irreproducible.
         """
         if gray.ndim != 2 or gray.dtype != np.uint8:
             raise ValueError(f'the detector needs a 2-D uint8 image, got {gray.dtype} '
                              f'of shape {gray.shape}')
-        if gray.shape[1] < self.window_px[0] or gray.shape[0] < self.window_px[1]:
-            return np.empty((0, 4), dtype=np.int64)
-        boxes = as_boxes(self._classifier.detectMultiScale(
+        found = []
+        mirrored = None
+        for classifier, (width, height), mirror in zip(self._classifiers, self._windows,
+                                                       self.mirror):
+            if gray.shape[1] < width or gray.shape[0] < height:
+                continue
+            found.append(self._detect(classifier, gray))
+            if mirror:
+                if mirrored is None:
+                    mirrored = np.ascontiguousarray(gray[:, ::-1])
+                flipped = self._detect(classifier, mirrored)
+                flipped[:, 0] = gray.shape[1] - flipped[:, 0] - flipped[:, 2]
+                found.append(flipped)
+        boxes = np.concatenate(found) if found else np.empty((0, 4), dtype=np.int64)
+        return boxes[np.lexsort(boxes.T[::-1])]
+
+    def _detect(self, classifier, gray: np.ndarray) -> np.ndarray:
+        return as_boxes(classifier.detectMultiScale(
             gray, scaleFactor=self.scale_factor, minNeighbors=self.min_neighbors,
             **self._options))
-        return boxes[np.lexsort(boxes.T[::-1])]
 
     def group(self, boxes, min_neighbors: int = DEFAULT_MIN_NEIGHBORS) -> np.ndarray:
         """Group raw boxes as OpenCV does: :func:`group_boxes` with ``eps = 0.2``."""
@@ -326,11 +372,12 @@ class HaarDetector:
 
         The file's name and SHA-256 identify the cascade wherever it was installed from; the
         OpenCV version is recorded because cascade evaluation has changed between releases.
+        Several cascades (or a mirrored one) are recorded as lists, with ``mirror``.
         """
-        return {
+        out = {
             'kind': 'haar',
-            'cascade': self.cascade_name,
-            'cascade_sha256': self._sha256,
+            'cascade': self.cascade_name if self.single else list(self.cascade_names),
+            'cascade_sha256': self._sha256 if self.single else list(self._sha256s),
             'scale_factor': self.scale_factor,
             'min_neighbors': self.min_neighbors,
             'min_size_px': None if self.min_size_px is None else list(self.min_size_px),
@@ -338,12 +385,31 @@ class HaarDetector:
             'window_px': list(self.window_px),
             'opencv': cv2.__version__,
         }
+        if not self.single:
+            out['mirror'] = list(self.mirror)
+        return out
 
     def __repr__(self) -> str:
-        """Show the cascade and the detectMultiScale arguments."""
-        return (f'HaarDetector({self.cascade_name!r}, scale_factor={self.scale_factor}, '
+        """Show the cascades and the detectMultiScale arguments."""
+        cascade = repr(self.cascade_name) if self.single else repr(self.cascade_names)
+        mirror = '' if self.single else f', mirror={self.mirror}'
+        return (f'HaarDetector({cascade}, scale_factor={self.scale_factor}, '
                 f'min_neighbors={self.min_neighbors}, min_size_px={self.min_size_px}, '
-                f'max_size_px={self.max_size_px})')
+                f'max_size_px={self.max_size_px}{mirror})')
+
+
+def _mirror_flags(mirror, n: int) -> list[bool]:
+    """One ``mirror`` flag per cascade, from one bool or a list of ``n``."""
+    flags = [mirror] * n if isinstance(mirror, (bool, np.bool_)) else mirror
+    try:
+        flags = list(flags)
+    except TypeError:
+        flags = None
+    if flags is None or len(flags) != n or not all(isinstance(f, (bool, np.bool_))
+                                                   for f in flags):
+        raise ValueError(f'mirror must be true, false or a list of {n} of them (one per '
+                         f'cascade), got {mirror!r}')
+    return [bool(f) for f in flags]
 
 
 def detector_settings(detector) -> dict:
