@@ -11,7 +11,8 @@ expects a face to give about eight raw detections), and in a view centred on the
 search may never have taken). The last line compares those centred counts for the scenes it got
 right and wrong.
 
-Usage: ``python bench/pan_tilt_misses.py [--scenes 200] [--seed 1000]``. Prints markdown.
+Usage: ``python bench/pan_tilt_misses.py [--scenes 200] [--seed 1000] [--model FILE]``
+(``--model``: another pan/tilt observation file, as ``evaluate --scene-model``). Prints markdown.
 """
 import argparse
 
@@ -47,8 +48,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
     parser.add_argument('--scenes', type=int, default=200)
     parser.add_argument('--seed', type=int, default=1000)
+    parser.add_argument('--model', default='', help='another pan/tilt observation file')
     args = parser.parse_args()
-    spec = scene_eval.task_spec('pan-tilt', seed=args.seed, split='train')
+    spec = scene_eval.task_spec('pan-tilt', seed=args.seed, split='train', model=args.model)
     task = scene_eval._Task.get(spec)
     grid = task.model.grid
     print('| scene | background | face px | face cell | decision (answer) | fixations | '

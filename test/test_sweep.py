@@ -1,9 +1,13 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """The blind sweep baseline, empty pan/tilt scenes and the head-time model (issue 22)."""
+import itertools
+import math
+
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.observation_file import load_observation
-from ipomdp_gaze.policies.baselines import SWEEP_STEP, sweep_tile_cells
+from ipomdp_gaze.policies.baselines import (axis_poses, SWEEP_STEP, sweep_tile_cells,
+                                            TILE_MARGIN_CELLS)
 from ipomdp_gaze.policies.registry import build_policy
 from ipomdp_gaze.vision.scene_eval import (head_time_s, SACCADE_TIME_S, SETTLE_TIME_S,
                                            task_spec)
@@ -16,7 +20,10 @@ def test_sweep_tiles_the_pan_tilt_grid_by_the_cameras_field_of_view():
     assert sweep_tile_cells(model.grid, model) == (3, 5)
     sweep = build_policy('sweep', model.grid, model)
     rc = [divmod(int(k), 11) for k in sweep.poses]
-    assert len(rc) == 12 and rc[:4] == [(1, 2), (1, 5), (1, 8), (4, 8)]   # boustrophedon
+    # Columns 1, 5, 9: the edge columns one cell from a view's centre, not at the image's
+    # border where a face is cut; columns 3 and 7 are seen from both sides.
+    assert len(rc) == 12 and rc[:4] == [(1, 1), (1, 5), (1, 9), (4, 9)]   # boustrophedon
+    assert sorted({r for r, _ in rc}) == [1, 4, 6, 9]
     # Every cell belongs to one pose's tile, within the view's half-size of it.
     pr, pc = np.divmod(sweep.poses[sweep.owner], 11)
     rows, cols = np.divmod(np.arange(121), 11)
@@ -24,6 +31,37 @@ def test_sweep_tiles_the_pan_tilt_grid_by_the_cameras_field_of_view():
     # The next pass repeats the order; the sweep ignores the belief.
     belief = np.random.default_rng(0).dirichlet(np.ones(121), size=1)
     assert sweep.select(belief, 13, None)[0] == sweep.poses[1]
+
+
+def test_a_wider_lens_gets_fewer_poses_that_keep_the_edges_inside_the_image():
+    model = load_observation('faces-pan-tilt-40')       # 40 x 30.5 degrees: 8 x 6.1 cells
+    poses = build_policy('sweep', model.grid, model).poses
+    rows, cols = np.divmod(poses, 11)
+    assert sorted(set(cols)) == [3, 7] and sorted(set(rows)) == [2, 5, 8]
+
+
+def _brute_covers(poses, n_cells, seen, well):
+    for x in range(n_cells):
+        offsets = [x - p for p in poses]
+        if any(abs(d) <= well for d in offsets):
+            continue
+        if not (any(0 <= d <= seen for d in offsets) and any(-seen <= d <= 0 for d in offsets)):
+            return False
+    return True
+
+
+@pytest.mark.parametrize('n_cells', range(1, 10))
+def test_axis_poses_are_the_fewest_views_that_see_every_cell(n_cells):
+    for view_cells in np.arange(0.5, 12.0, 0.25):
+        seen = max(0, math.floor(view_cells / 2 - 0.5 + 1e-9))
+        well = min(seen, max(0, math.floor(view_cells / 2 - 0.5 - TILE_MARGIN_CELLS + 1e-9)))
+        poses = axis_poses(n_cells, view_cells)
+        assert list(poses) == sorted(set(poses)) and 0 <= poses.min() <= poses.max() < n_cells
+        assert _brute_covers(poses, n_cells, seen, well)
+        fewest = next(k for k in range(1, n_cells + 1)
+                      if any(_brute_covers(c, n_cells, seen, well)
+                             for c in itertools.combinations(range(n_cells), k)))
+        assert len(poses) == fewest, (n_cells, view_cells)
 
 
 def test_sweep_without_a_field_of_view_is_a_raster_with_the_stated_step():
