@@ -41,6 +41,7 @@ import sys
 import time
 
 import cv2
+from ipomdp_gaze.detection import DEFAULT_MODELS
 from ipomdp_gaze.evaluation import wilson_interval
 from ipomdp_gaze.observation_file import load_observation
 from ipomdp_gaze.policies.policy_file import default_policy_file
@@ -443,7 +444,7 @@ def run_pan_tilt(detectors, n: int, empty: int, split: str, progress=None) -> di
             if count:
                 results += next(iter(evaluate_scenes(one, count, progress=progress).values()))
         summary = summarise(results)
-        summary['model'] = PAN_TILT_MODELS[kind] or 'faces-pan-tilt'
+        summary['model'] = PAN_TILT_MODELS[kind] or DEFAULT_MODELS['camera']
         summary['policy'] = spec.policy_file or spec.policy
         out[kind] = summary
     return out
@@ -905,8 +906,9 @@ def main(argv=None) -> int:
     if pan_tilt:
         text += ['## The pan/tilt search per detector', '',
                  f'`ipomdp-gaze evaluate --scenes pan-tilt --episodes {args.pan_tilt_scenes} '
-                 f'--empty-scenes {args.pan_tilt_empty}` (Haar, `faces-pan-tilt`) and the same '
-                 'with `--observation faces-pan-tilt-yunet`: the shipped controller '
+                 f'--empty-scenes {args.pan_tilt_empty}` (Haar, `{DEFAULT_MODELS["camera"]}`: the '
+                 'frontal and the profile cascade) and the same with `--scene-model '
+                 'faces-pan-tilt-yunet`: the shipped controller '
                  'configuration (`config/faces_camera_controller.yaml`: its policy, absent '
                  "hypothesis and settings) with each detector's own pan/tilt model, on the same "
                  f'{args.pan_tilt_scenes} test scenes with a face (seeds 0..) and '

@@ -9,9 +9,8 @@ once per scene, :mod:`ipomdp_gaze.vision.scene_eval`): the shipped configuration
 belief and stop rule for one pass, and the sweep's answer rules (best tile count after one
 pass; first view with a raw or a grouped detection). Scenes with a face and empty scenes (the
 same photo crops without the face) are reported apart, empty ones per background. A second
-camera (a 40-degree lens, model ``faces-pan-tilt-40``: ``ipomdp-gaze calibrate --pan-tilt
---scenes 60 --null-scenes 20 --hfov-deg 40``, training scenes) checks that nothing is tuned to one
-camera.
+camera (a 40-degree lens, model ``faces-pan-tilt-40-profile``: its recipe in
+``bench/models.py``, training scenes) checks that nothing is tuned to one camera.
 
 Regenerate with ``make pan-tilt`` (about 10 minutes on two idle cores, and 15 more for the ROS demo
 on 50 seeds), or ``python bench/pan_tilt.py [--faces 400] [--empty 200] [--ros-seeds 50]``;
@@ -28,6 +27,7 @@ from pathlib import Path
 import sys
 import time
 
+from ipomdp_gaze.detection import DEFAULT_MODELS
 from ipomdp_gaze.progress import Progress
 from ipomdp_gaze.vision.scene_eval import (evaluate_scenes, HEAD_SPEED_DEG_S,
                                            paired_map_difference, SACCADE_TIME_S,
@@ -38,7 +38,7 @@ ROOT = Path(__file__).resolve().parents[1]
 SHIPPED = 'shipped'
 # The sweep with the shipped belief and stop rule, one pass of its poses.
 SWEEP = 'sweep:search.max_fixations={passes}'
-SECOND_MODEL = 'faces-pan-tilt-40'
+SECOND_MODEL = 'faces-pan-tilt-40-profile'
 
 # Ideas tried on TRAINING scenes: a hand-kept table (docs/data/pan_tilt_ideas.md).
 IDEAS = ROOT / 'docs' / 'data' / 'pan_tilt_ideas.md'
@@ -71,7 +71,7 @@ def run(args) -> dict:
                     results.setdefault(SHIPPED if name == spec.policy else name,
                                        []).extend(group)
         record['runs'][label] = {
-            'model': model or 'faces-pan-tilt', 'policy': spec.policy,
+            'model': model or DEFAULT_MODELS['camera'], 'policy': spec.policy,
             'settings': spec.settings.to_parameters(), 'sweep_poses': passes,
             'results': {name: [r.__dict__ for r in group] for name, group in results.items()}}
     record['finished'] = time.strftime('%Y-%m-%d %H:%M:%S UTC', time.gmtime())
@@ -121,7 +121,7 @@ def _ros_lines(record: dict) -> list[str]:
 def _sweep_poses(spec):
     from ipomdp_gaze.observation_file import load_observation
     from ipomdp_gaze.policies.baselines import sweep_tiles
-    model = load_observation(spec.model or 'faces-pan-tilt')
+    model = load_observation(spec.model or DEFAULT_MODELS['camera'])
     return sweep_tiles(model.grid, model)[0]
 
 
@@ -236,9 +236,10 @@ def write_page(record: dict, out: Path) -> None:
              f'{SETTLE_TIME_S} s settling; per saccade {SACCADE_TIME_S} s plus the largest joint '
              f'angle over {HEAD_SPEED_DEG_S:g} deg/s; the head starts at the centre.', '']
     for label, title in (('main', 'The shipped camera: 320x240, 25-degree lens, '
-                                  '`faces-pan-tilt`'),
+                                  '`faces-pan-tilt-profile`'),
                          ('second', 'A second camera: 320x240, 40-degree lens, '
-                                    '`faces-pan-tilt-40` (calibrated on training scenes)')):
+                                    '`faces-pan-tilt-40-profile` (calibrated on training '
+                                    'scenes)')):
         run_record = record['runs'].get(label)
         if not run_record:
             continue
