@@ -22,9 +22,10 @@ import numpy as np
 TITLE = 'Face search over DDS: scene camera, foveal detector and controller (three processes)'
 ORDER = 61
 MODES = (('camera', False, 'a camera on the pan/tilt head (11x11 grid of 5 deg, '
-                           '`faces-pan-tilt`, coverage, confidence 0.99 within one cell, '
-                           'inhibition of return, repeated views weighted 0.7, absent prior '
-                           '0.65, false-alarm scales and hotspots, decided at 20 fixations)'),
+                           '`faces-pan-tilt-profile`: the frontal and the profile cascade, '
+                           'coverage, confidence 0.99 within one cell, inhibition of return, '
+                           'absent prior 0.8, false-alarm scales and hotspots, decided at 20 '
+                           'fixations)'),
          ('fovea', True, 'a fixed camera and the digital fovea (21x21 grid over 420x420 '
                          'scenes, `faces-420` with its one-time scan and kernel '
                          '`faces-420-infomax`, confidence 0.99, inhibition of return, as '
