@@ -36,7 +36,6 @@ def test_the_shipped_models_say_which_view_they_were_calibrated_with():
         fovea_for_model(pan_tilt)
 
 
-
 def test_the_shipped_camera_model_counts_the_frontal_and_the_profile_cascade(camera_setup):
     assert camera_setup.name == 'faces-pan-tilt-profile'
     detector = camera_setup.detector
@@ -45,6 +44,7 @@ def test_the_shipped_camera_model_counts_the_frontal_and_the_profile_cascade(cam
     assert detector.mirror == [False, True]
     assert model_camera(camera_setup.model) == shipped_camera()
     assert camera_setup.grid == GRID
+
 
 def test_a_fixation_is_served_by_the_first_image_captured_after_it(fovea_setup):
     loop = DetectorLoop(fovea_setup)
