@@ -127,19 +127,16 @@ def sweep_tile_cells(grid: Grid, model) -> tuple[int, int]:
     return (max(1, min(grid.rows, int(view[0]))), max(1, min(grid.cols, int(view[1]))))
 
 
-def _tile_centres(n_cells: int, side: int) -> np.ndarray:
-    """Centres of the fewest tiles of ``side`` cells covering ``n_cells``, spread evenly."""
-    n_tiles = -(-n_cells // side)
-    half = (side - 1) / 2.0
-    if n_tiles == 1:
-        return np.array([(n_cells - 1) // 2], dtype=np.int64)
-    return np.round(np.linspace(half, n_cells - 1 - half, n_tiles)).astype(np.int64)
-
-
-def _spread(n_cells: int, n_poses: int, margin: int) -> np.ndarray:
+def _spread(n_cells: int, n_poses: int, margin: float) -> np.ndarray:
+    """Centres of ``n_poses`` views spread evenly, the outer ones ``margin`` cells in."""
     if n_poses == 1:
         return np.array([(n_cells - 1) // 2], dtype=np.int64)
     return np.round(np.linspace(margin, n_cells - 1 - margin, n_poses)).astype(np.int64)
+
+
+def _tile_centres(n_cells: int, side: int) -> np.ndarray:
+    """Centres of the fewest tiles of ``side`` cells covering ``n_cells``, spread evenly."""
+    return _spread(n_cells, -(-n_cells // side), (side - 1) / 2.0)
 
 
 def _covers(poses: np.ndarray, n_cells: int, seen: int, well: int) -> bool:

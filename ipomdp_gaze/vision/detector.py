@@ -286,7 +286,6 @@ class HaarDetector:
         self._windows = windows
         self.window_px = (min(w for w, _ in windows), min(h for _, h in windows))
         self._sha256s = [hashlib.sha256(path.read_bytes()).hexdigest() for path in self.paths]
-        self._sha256 = self._sha256s[0]
         self._options = {}
         if self.min_size_px is not None:
             self._options['minSize'] = self.min_size_px
@@ -377,7 +376,7 @@ class HaarDetector:
         out = {
             'kind': 'haar',
             'cascade': self.cascade_name if self.single else list(self.cascade_names),
-            'cascade_sha256': self._sha256 if self.single else list(self._sha256s),
+            'cascade_sha256': self._sha256s[0] if self.single else list(self._sha256s),
             'scale_factor': self.scale_factor,
             'min_neighbors': self.min_neighbors,
             'min_size_px': None if self.min_size_px is None else list(self.min_size_px),
