@@ -63,6 +63,7 @@ setup(
         'ipomdp_gaze.detectors': [
             'haar = ipomdp_gaze.vision.detector:HaarDetector',
             'yunet = ipomdp_gaze.vision.yunet:YuNetDetector',
+            'ensemble = ipomdp_gaze.vision.ensemble:EnsembleDetector',
         ],
     },
 )

@@ -10,8 +10,9 @@ A detector **kind** is one of:
 
       entry_points={'ipomdp_gaze.detectors': ['blob = my_package.blob:BlobDetector']}
 
-  This package declares ``haar`` (:class:`ipomdp_gaze.vision.detector.HaarDetector`) and
-  ``yunet`` (:class:`ipomdp_gaze.vision.yunet.YuNetDetector`); these two are also found in a
+  This package declares ``haar`` (:class:`ipomdp_gaze.vision.detector.HaarDetector`),
+  ``yunet`` (:class:`ipomdp_gaze.vision.yunet.YuNetDetector`) and ``ensemble`` (several of
+  them as one, :class:`ipomdp_gaze.vision.ensemble.EnsembleDetector`); these are also found in a
   source checkout whose metadata is not installed, and an entry point cannot replace them;
 - ``package.module:Factory``: the module is imported and ``Factory`` called. **Importing a
   module runs its code**: a kind read from an observation file or a parameter runs whatever that
@@ -42,6 +43,7 @@ ENTRY_POINT_GROUP = 'ipomdp_gaze.detectors'
 BUILTIN = {
     'haar': 'ipomdp_gaze.vision.detector:HaarDetector',
     'yunet': 'ipomdp_gaze.vision.yunet:YuNetDetector',
+    'ensemble': 'ipomdp_gaze.vision.ensemble:EnsembleDetector',
 }
 DEFAULT_KIND = 'haar'
 _TARGET = re.compile(r'[A-Za-z_][\w.]*:[A-Za-z_][\w.]*')

