@@ -22,8 +22,8 @@ import numpy as np
 TITLE = 'Face search over DDS: scene camera, foveal detector and controller (three processes)'
 ORDER = 61
 MODES = (('camera', False, 'a camera on the pan/tilt head (11x11 grid of 5 deg, '
-                           '`faces-pan-tilt-ensemble`: the frontal and profile cascades and '
-                           'YuNet, coverage, confidence 0.99 within one cell, inhibition of return, '
+                           '`faces-pan-tilt-ensemble`: two cascades and YuNet, '
+                           'coverage, confidence 0.99 within one cell, inhibition of return, '
                            'absent prior 0.8, false-alarm scales and hotspots, decided at 20 '
                            'fixations)'),
          ('fovea', True, 'a fixed camera and the digital fovea (21x21 grid over 420x420 '
