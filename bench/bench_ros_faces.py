@@ -22,7 +22,7 @@ import numpy as np
 TITLE = 'Face search over DDS: scene camera, foveal detector and controller (three processes)'
 ORDER = 61
 MODES = (('camera', False, 'a camera on the pan/tilt head (11x11 grid of 5 deg, '
-                           '`faces-pan-tilt-ensemble`: two cascades and YuNet, '
+                           '`faces-pan-tilt-profile`: the frontal and the profile cascade, '
                            'coverage, confidence 0.99 within one cell, inhibition of return, '
                            'absent prior 0.8, false-alarm scales and hotspots, decided at 20 '
                            'fixations)'),

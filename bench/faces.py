@@ -914,9 +914,9 @@ def main(argv=None) -> int:
                  f'{args.pan_tilt_scenes} test scenes with a face (seeds 0..) and '
                  f'{args.pan_tilt_empty} without; head time is the head-time model of '
                  '`ipomdp_gaze.vision.scene_eval` (detector time, settle and saccades). The '
-                 'full pan/tilt benchmark (sweeps, a second camera) is docs/pan_tilt.md, with '
-                 f'the shipped default model `{DEFAULT_MODELS["camera"]}`, which counts both '
-                 "detectors' boxes (docs/design.md section 6.11).", '']
+                 'full pan/tilt benchmark (sweeps, a second camera) is docs/pan_tilt.md; '
+                 "`faces-pan-tilt-ensemble` counts both detectors' boxes (docs/design.md "
+                 'section 6.11).', '']
         text += pan_tilt_table(pan_tilt, args.pan_tilt_scenes, args.pan_tilt_empty) + ['']
     if photos:
         text += ['## `find` on real photographs (`bench/find_photos.py`)', '']

@@ -9,7 +9,7 @@ once per scene, :mod:`ipomdp_gaze.vision.scene_eval`): the shipped configuration
 belief and stop rule for one pass, and the sweep's answer rules (best tile count after one
 pass; first view with a raw or a grouped detection). Scenes with a face and empty scenes (the
 same photo crops without the face) are reported apart, empty ones per background. A second
-camera (a 40-degree lens, model ``faces-pan-tilt-40-ensemble``: its recipe in
+camera (a 40-degree lens, model ``faces-pan-tilt-40-profile``: its recipe in
 ``bench/models.py``, training scenes) checks that nothing is tuned to one camera.
 
 Regenerate with ``make pan-tilt`` (about 10 minutes on two idle cores, and 15 more for the ROS demo
@@ -38,7 +38,7 @@ ROOT = Path(__file__).resolve().parents[1]
 SHIPPED = 'shipped'
 # The sweep with the shipped belief and stop rule, one pass of its poses.
 SWEEP = 'sweep:search.max_fixations={passes}'
-SECOND_MODEL = 'faces-pan-tilt-40-ensemble'
+SECOND_MODEL = 'faces-pan-tilt-40-profile'
 
 # Ideas tried on TRAINING scenes: a hand-kept table (docs/data/pan_tilt_ideas.md).
 IDEAS = ROOT / 'docs' / 'data' / 'pan_tilt_ideas.md'

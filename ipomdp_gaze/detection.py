@@ -35,7 +35,7 @@ message of that input, the rejected ones included.
 **Bounded cost per frame.** Images are held only while a fixation waits, at most ``keep`` (4)
 of them. An image more than :data:`RESIZE_ABOVE` times wider or taller than the images the
 model was calibrated on (420x420 for the shipped fovea models, the 320x240 camera of
-``faces-pan-tilt-ensemble``) is resized (``cv2.INTER_AREA``, aspect kept) to fit that size when it
+``faces-pan-tilt-profile``) is resized (``cv2.INTER_AREA``, aspect kept) to fit that size when it
 arrives; in ``camera`` mode ``camera_info``'s K is scaled with it. The detector then sees faces
 at the pixel size the counts were calibrated at, and its cost is that of the model's images
 whatever the driver sends. (Refusing such images instead would make every HD camera unusable;
@@ -60,7 +60,7 @@ import numpy as np
 
 MODES = ('fovea', 'camera')
 # The observation model of each mode when none is given: the shipped face models.
-DEFAULT_MODELS = {'fovea': 'faces-420', 'camera': 'faces-pan-tilt-ensemble'}
+DEFAULT_MODELS = {'fovea': 'faces-420', 'camera': 'faces-pan-tilt-profile'}
 # The view a model was calibrated with (its image record), per mode.
 MODE_VIEWS = {'fovea': 'fixed', 'camera': 'pan_tilt'}
 # The Haar detector's settings with node parameters of their own (an empty or negative value:

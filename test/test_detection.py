@@ -36,14 +36,12 @@ def test_the_shipped_models_say_which_view_they_were_calibrated_with():
         fovea_for_model(pan_tilt)
 
 
-def test_the_shipped_camera_model_counts_the_cascades_and_yunet(camera_setup):
-    assert camera_setup.name == 'faces-pan-tilt-ensemble'
-    haar, yunet = camera_setup.detector.members
-    assert camera_setup.detector.weights == [1, 5]
-    assert haar.cascade_names == ['haarcascade_frontalface_alt2.xml',
-                                  'haarcascade_profileface.xml']
-    assert haar.mirror == [False, True]
-    assert yunet.kind == 'yunet' and yunet.upscale == 2.0
+def test_the_shipped_camera_model_counts_the_frontal_and_the_profile_cascade(camera_setup):
+    assert camera_setup.name == 'faces-pan-tilt-profile'
+    detector = camera_setup.detector
+    assert detector.cascade_names == ['haarcascade_frontalface_alt2.xml',
+                                      'haarcascade_profileface.xml']
+    assert detector.mirror == [False, True]
     assert model_camera(camera_setup.model) == shipped_camera()
     assert camera_setup.grid == GRID
 

@@ -12,7 +12,7 @@ fixation and counts its detections, and :mod:`msg_adapters` reads and fills ever
 - ``camera``: a camera on the pan/tilt head; the detector runs on the whole view, its
   detections are binned to pan/tilt cells with ``camera_info``'s K and the head pose of the
   ``joint_states`` message stamped like the image, and cells outside the view are NaN (the
-  shipped ``faces-pan-tilt-ensemble`` model by default).
+  shipped ``faces-pan-tilt-profile`` model by default).
 
 Relative topic names:
 
@@ -76,7 +76,7 @@ def detector_params() -> list[Param]:
               'head (read-only)', read_only=True, choices=MODES),
         Param('observation.file', '', T.STRING,
               'count model: an ipomdp_gaze/observation-v1 path or shipped name ("": '
-              'faces-420 in fovea mode, faces-pan-tilt-ensemble in camera mode); its grid, '
+              'faces-420 in fovea mode, faces-pan-tilt-profile in camera mode); its grid, '
               'fovea and detector win'),
         Param('grid.rows', 0, T.INTEGER, "rows (0: the observation file's; read-only)",
               read_only=True, int_range=(0, MAX_CELLS_PER_SIDE)),

@@ -10,7 +10,7 @@ Tasks (:data:`TASKS`):
 
 - ``pan-tilt``: a camera on the pan/tilt head looking around a panorama with one face
   (:class:`ipomdp_gaze.vision.pan_tilt.PanTiltSceneSet`, test split), the shipped
-  ``faces-pan-tilt-ensemble`` model and the settings of ``config/faces_camera_controller.yaml``;
+  ``faces-pan-tilt-profile`` model and the settings of ``config/faces_camera_controller.yaml``;
   scene ``seed + i`` is the scene the scene camera shows with parameter ``seed: seed + i`` (scene 0
   of that seed), so ``ipomdp-gaze demo --scene faces --seed S`` and this evaluation search the
   same panorama;
