@@ -122,11 +122,7 @@ class EnsembleDetector:
         image = np.asarray(image)
         parts = []
         for member, weight in zip(self.members, self.weights):
-            color = getattr(member, 'color', 'gray')
-            if color == 'gray' and image.ndim == 3:
-                own = np.ascontiguousarray(cv2.cvtColor(image, cv2.COLOR_RGB2GRAY))
-            else:
-                own = to_detector_image(image, color)
+            own = to_detector_image(image, getattr(member, 'color', 'gray'))
             boxes, scores = as_detections(member(own))
             parts.append(np.repeat(np.column_stack([boxes, scores]), weight, axis=0))
         return np.concatenate(parts, axis=0) if parts else np.empty((0, 5))
