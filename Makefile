@@ -48,7 +48,7 @@ pan-tilt: $(STAMP)
 	$(VPY) bench/pan_tilt.py --ros-seeds 50
 
 # Recalibrate every shipped Haar model and retrain faces-420-infomax from their recipes on training
-# scenes, print what moved and install the new files (bench/models.py; about 45 minutes).
+# scenes, print what moved and install the new files (bench/models.py; about 70 minutes).
 models: $(STAMP)
 	$(VPY) bench/models.py --install
 

@@ -11,7 +11,8 @@ false-alarm rates ``P(count > 0)`` at the fixation, one cell off and two off. ``
 copies the new files over the shipped ones (and the FPOC figures into ``docs/figures``).
 
 Usage: ``python bench/models.py [--only NAME,...] [--out DIR] [--install] [--jobs 2]``
-(``make models``: every Haar model and the kernel, installed; about 45 minutes on 2 cores).
+(``make models``: every Haar and ensemble model and the kernel, installed; about 70 minutes on
+2 cores).
 """
 import argparse
 from concurrent.futures import ThreadPoolExecutor
@@ -70,8 +71,9 @@ RECIPES = {
 #: fixations) when the models were recalibrated (docs/faces.md, ideas).
 KERNEL = ('faces-420-infomax', ['train', '--observation', 'faces-420', '--horizon', '30',
                                 '--init-elm', '10', '--epochs', '300', '--seed', '2'])
-#: What ``make models`` regenerates: the Haar models and the kernel (the YuNet models were
-#: calibrated after ``camera`` left the training backgrounds; their recipes give the same tables).
+#: What ``make models`` regenerates: the Haar and ensemble models and the kernel (the YuNet
+#: models were calibrated after ``camera`` left the training backgrounds; their recipes give the
+#: same tables).
 DEFAULT = ('faces-420', 'faces-420-nmpt', 'faces-840', 'faces-840-nmpt', 'faces-pan-tilt',
            'faces-pan-tilt-profile', 'faces-pan-tilt-40', 'faces-pan-tilt-40-profile',
            'faces-pan-tilt-ensemble', 'faces-pan-tilt-40-ensemble', 'faces-420-infomax')
