@@ -16,6 +16,7 @@ from __future__ import annotations
 import importlib.util
 import os
 from pathlib import Path
+import signal
 
 from hypothesis import settings
 from ipomdp_gaze.nodes.processes import wait_for  # noqa: F401 (the tests import it from here)
@@ -25,6 +26,12 @@ import pytest
 settings.register_profile('ci', derandomize=True, deadline=None, print_blob=True)
 if os.environ.get('CI'):
     settings.load_profile('ci')
+
+# A run started in the background by a shell without job control (`make test &`, nohup) has
+# SIGINT ignored, and every process it starts inherits that. The Ctrl-C tests send SIGINT as a
+# terminal does, to processes that take it as a terminal's do: give them the default back.
+if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 HAVE_RCLPY = importlib.util.find_spec('rclpy') is not None
 HAVE_ROS_MSGS = importlib.util.find_spec('std_msgs') is not None
