@@ -74,23 +74,12 @@ class EnsembleDetector:
 
     def __init__(self, members, cascade_dir=None):
         from ipomdp_gaze.vision.detectors import make_detector
-        specs = _members(members)
-        self.weights = [weight for _, weight, _ in specs]
-        self.members = []
-        for i, (kind, _, options) in enumerate(specs):
+
+        def build(kind, options):
             if cascade_dir is not None and kind == 'haar':
                 options = {**options, 'cascade_dir': cascade_dir}
-            try:
-                self.members.append(make_detector(kind, **options))
-            except ValueError as exc:
-                raise ValueError(f'ensemble member {i}: {exc}') from None
-        self._init_common()
-
-    def _init_common(self):
-        colors = {getattr(member, 'color', 'gray') for member in self.members}
-        self.color = 'rgb' if 'rgb' in colors else 'gray'
-        windows = [detector_window_px(member) for member in self.members]
-        self.window_px = (max(w for w, _ in windows), max(h for _, h in windows))
+            return make_detector(kind, **options)
+        self._set_members(members, build)
 
     @classmethod
     def from_settings(cls, settings: dict, cascade_dir=None) -> EnsembleDetector:
@@ -104,18 +93,25 @@ class EnsembleDetector:
 
         """
         from ipomdp_gaze.vision.detectors import detector_from_settings
-        specs = _members(settings.get('members'))
         detector = cls.__new__(cls)
-        detector.weights = [weight for _, weight, _ in specs]
-        detector.members = []
+        detector._set_members(settings.get('members'), lambda kind, options: (
+            detector_from_settings({'kind': kind, **options}, cascade_dir=cascade_dir)))
+        return detector
+
+    def _set_members(self, members, build):
+        """Build each member with ``build(kind, options)``; an error names the member."""
+        specs = _members(members)
+        self.weights = [weight for _, weight, _ in specs]
+        self.members = []
         for i, (kind, _, options) in enumerate(specs):
             try:
-                detector.members.append(detector_from_settings({'kind': kind, **options},
-                                                               cascade_dir=cascade_dir))
+                self.members.append(build(kind, options))
             except ValueError as exc:
                 raise ValueError(f'ensemble member {i}: {exc}') from None
-        detector._init_common()
-        return detector
+        colors = {getattr(member, 'color', 'gray') for member in self.members}
+        self.color = 'rgb' if 'rgb' in colors else 'gray'
+        windows = [detector_window_px(member) for member in self.members]
+        self.window_px = (max(w for w, _ in windows), max(h for _, h in windows))
 
     def __call__(self, image: np.ndarray) -> np.ndarray:
         """Boxes ``(M, 5)`` ``x, y, w, h, score`` of every member, member by member."""
