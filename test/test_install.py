@@ -281,6 +281,16 @@ def test_the_image_tasks_run_from_the_install(install, tmp_path):
                       '--max-fixations', '3', '--jobs', '1', '--quiet', cwd=tmp_path)
     assert out.returncode == 0, out.stdout + out.stderr
     assert 'pan-tilt (1 scenes with a face): right' in out.stdout
+    # The ensemble detector by its entry point, and its model (two cascades and YuNet) installed.
+    out = install.run(install.python, '-c', 'from importlib.metadata import entry_points; '
+                      "print(sorted(e.name for e in entry_points(group='ipomdp_gaze.detectors')))",
+                      cwd=tmp_path)
+    assert out.returncode == 0 and "'ensemble'" in out.stdout, out.stdout + out.stderr
+    out = install.run(cli, 'evaluate', '--scenes', 'pan-tilt', '--scene-model',
+                      'faces-pan-tilt-ensemble', '--episodes', '1', '--max-fixations', '3',
+                      '--jobs', '1', '--quiet', cwd=tmp_path)
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert 'pan-tilt (1 scenes with a face): right' in out.stdout
     out = install.run(install.python, '-c', 'from ipomdp_gaze.vision.photos import read_labels; '
                       'print(len(read_labels()))', cwd=tmp_path)
     assert out.returncode == 0 and int(out.stdout) >= 21, out.stdout + out.stderr
