@@ -120,13 +120,21 @@ def tables(faces: list, empty: list) -> list[str]:
         peaks = np.array([row['statistics'][name].max() for row in empty])
         rights = []
         for rate in EMPTY_RATES:
-            threshold = np.quantile(peaks, 1 - rate, method='higher') + 1e-9
+            threshold = lowest_threshold(peaks, rate)
             rights.append(np.mean([row['statistics'][name].max() >= threshold
                                    and near(_peak(row, name), row['face']) for row in faces]))
         anywhere = np.mean([near(_peak(row, name), row['face']) for row in faces])
         lines.append(f'| {name} | ' + ' / '.join(f'{r:.3f}' for r in rights)
                      + f' | {anywhere:.3f} |')
     return lines
+
+
+def lowest_threshold(peaks: np.ndarray, rate: float) -> float:
+    """Return the lowest threshold ``t`` with ``peak >= t`` in at most ``rate`` of ``peaks``."""
+    for threshold in np.unique(peaks):
+        if np.mean(peaks >= threshold) <= rate:
+            return float(threshold)
+    return float(np.inf)
 
 
 def _peak(row, name) -> tuple:

@@ -78,3 +78,78 @@ def test_figure_labels_of_a_dense_cluster_neither_overlap_nor_leave_the_axes():
         assert inside.contains(box.x0, box.y0) and inside.contains(box.x1, box.y1), ax.texts[i]
         assert not any(box.overlaps(other) for other in boxes[i + 1:]), ax.texts[i]
     plt.close(fig)
+
+
+def _bench_module(name):
+    import importlib.util
+    spec = importlib.util.spec_from_file_location(f'bench_{name}', BENCH / f'{name}.py')
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_bound_statistics_skip_the_cells_a_view_does_not_see():
+    """``pan_tilt_bound.statistics``: the centred count, the largest and the sum over views."""
+    import numpy as np
+    bound = _bench_module('pan_tilt_bound')
+    nan = np.nan
+    counts = np.array([[3.0, 1.0, nan],       # view centred on cell 0
+                       [0.0, 2.0, 5.0],       # on cell 1
+                       [nan, 4.0, 1.0]])      # on cell 2
+    stats = bound.statistics(counts)
+    assert stats['centred'].tolist() == [3.0, 2.0, 1.0]
+    assert stats['largest over views'].tolist() == [3.0, 4.0, 5.0]
+    assert stats['sum over views'].tolist() == [3.0, 7.0, 6.0]
+
+
+def test_bound_tables_score_answers_against_the_empty_scenes():
+    """The trade-off rows: right within one cell, a face named on empty scenes, thresholds."""
+    import numpy as np
+    bound = _bench_module('pan_tilt_bound')
+
+    def row(face, absent, answer, peak_cell, peak):
+        values = np.zeros(121)
+        values[peak_cell] = peak
+        stats = {name: values for name in bound.STATISTICS}
+        return {'face': face, 'absent': absent, 'answer': answer, 'statistics': stats,
+                'columns': 11}
+    faces = [row((5, 5), 0.1, (5, 6), 5 * 11 + 5, 9.0),      # right, strong
+             row((2, 2), 0.95, (2, 2), 2 * 11 + 3, 3.0),     # right cell, weak: called absent
+             row((8, 8), 0.2, (0, 0), 0, 9.0),               # wrong cell
+             row((1, 9), 1e-3, (1, 9), 1 * 11 + 9, 6.0)]     # right, middling
+    empty = [row(None, 0.999, (0, 0), 0, 2.0) for _ in range(19)]
+    empty.append(row(None, 0.5, (4, 4), 4 * 11 + 4, 5.0))   # one empty scene looks like a face
+    lines = bound.tables(faces, empty)
+    by_level = {line.split(' | ')[0].strip('| '): line
+                for line in lines if line.startswith('| 0.')}
+    assert by_level['0.9'] == '| 0.9 | 0.500 | 0.050 |'        # faces 1 and 4; 1 of 20 empty
+    assert by_level['0.99'] == '| 0.99 | 0.750 | 0.050 |'      # the weak face too
+    assert '| (the MAP cell, never absent) | 0.750 | 1.000 |' in lines
+    # the empty scenes' peaks: nineteen 2s and one 5, so a face is named from 5 up at every
+    # rate (1 of 20 empty scenes): faces 1 and 4 are right there, face 3 names the wrong cell
+    centred = next(line for line in lines if line.startswith('| centred |'))
+    assert centred == '| centred | 0.500 / 0.500 / 0.500 | 0.750 |'
+    assert bound.lowest_threshold(np.array([2.0] * 19 + [5.0]), 0.04) == np.inf
+    assert bound.lowest_threshold(np.array([2.0] * 18 + [5.0] * 2), 0.1) == 5.0
+    assert bound.lowest_threshold(np.array([2.0] * 18 + [5.0] * 2), 1.0) == 2.0
+
+
+def test_bound_report_runs_on_a_scene_with_every_view(tmp_path):
+    """``bench/pan_tilt_bound.py`` gives one scene with a face and one empty all 121 views."""
+    run = subprocess.run([sys.executable, str(BENCH / 'pan_tilt_bound.py'), '--scenes', '1',
+                          '--empty-scenes', '1', '--jobs', '1'],
+                         capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert '1 with a face, 1 empty, every one of the 121 poses' in run.stdout
+    assert '| the model: found when P(absent) below | right | empty: wrong found |' in run.stdout
+    assert '| sum over views |' in run.stdout
+
+
+def test_weak_faces_report_runs_on_a_few_scenes():
+    """``bench/weak_faces.py`` scores YuNet at three sizes on the centred views."""
+    run = subprocess.run([sys.executable, str(BENCH / 'weak_faces.py'), '--scenes', '2'],
+                         capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr[-2000:]
+    rows = [line for line in run.stdout.splitlines() if line.startswith('| YuNet')]
+    assert len(rows) == 9
+    assert 'Weak faces no detector sees at its middle level' in run.stdout
