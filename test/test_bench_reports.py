@@ -140,7 +140,8 @@ def test_bound_report_runs_on_a_scene_with_every_view(tmp_path):
                           '--empty-scenes', '1', '--jobs', '1'],
                          capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, run.stderr[-2000:]
-    assert '1 with a face, 1 empty, every one of the 121 poses' in run.stdout
+    assert 'Training scenes, seed 1000: 1 with a face, 1 empty, every one of the 121 poses' \
+        in run.stdout
     assert '| the model: found when P(absent) below | right | empty: wrong found |' in run.stdout
     assert '| sum over views |' in run.stdout
 
