@@ -46,7 +46,7 @@ def _never(cell, absent, confidence):
 
 
 def every_view(args) -> dict:
-    """All poses of one training scene through the shipped belief; its answer and its counts."""
+    """All poses of one scene through the shipped belief; its answer and its statistics."""
     seed, split, model, empty, index = args
     ipomdp_gaze.session.decide = _never
     spec = scene_eval.task_spec('pan-tilt', seed=seed, split=split, empty=empty, model=model)
