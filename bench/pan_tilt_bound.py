@@ -79,9 +79,9 @@ def statistics(counts: np.ndarray) -> dict:
             'sum over views': np.nansum(counts, axis=0)}
 
 
-def near(a, b) -> bool:
-    """Within one cell (Chebyshev), the evaluation's rule for a right answer."""
-    return max(abs(a[0] - b[0]), abs(a[1] - b[1])) <= 1
+def near(answer, face) -> bool:
+    """Return whether ``answer`` is right for ``face`` by the evaluation's own rule."""
+    return scene_eval._right(answer, face, 'found')
 
 
 def main() -> None:
