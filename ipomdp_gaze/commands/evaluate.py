@@ -32,9 +32,9 @@ from ipomdp_gaze.vision.scene_eval import (evaluate_scenes, format_summary,
                                            task_spec, TASKS, write_json)
 import numpy as np
 
-from .common import (add_scene_args, add_task_args, nonneg_int, positive_int,
-                     task_from_args)
+from .common import add_task_args, nonneg_int, positive_int, task_from_args
 from .running import add_run_args, executor_from_args, progress_from_args
+from .search_args import add_scene_args, add_search_args, settings_from_args
 
 NO_PREDICTION = ' (no prediction)'
 
@@ -84,11 +84,10 @@ def add_parser(sub):
                    help='also give each policy minus the first, on the same episodes, with a '
                         'paired bootstrap 95%% interval')
     add_scene_args(p, 'simulated')
-    p.add_argument('--confidence', type=float, default=None,
-                   help='level at which a search decides found or absent (default 0.95)')
-    p.add_argument('--max-fixations', type=int, default=None,
-                   help='fixation budget: undecided searches give up there (default and 0: the '
-                        'horizon; also the horizon when --horizon is not given)')
+    add_search_args(p, None, ('confidence',), task_default='0.95')
+    add_search_args(p, None, ('max_fixations',),
+                    task_default='and 0: the horizon; also the horizon when --horizon is not '
+                                 'given')
     p.add_argument('--compare-prediction', action='store_true',
                    help='moving target: also run each policy without the prediction step and '
                         'report the paired difference in tracking accuracy')
@@ -252,11 +251,7 @@ def format_decisions(result: dict) -> str:
 
 def check_settings(args) -> SearchSettings:
     """Check the search settings given as flags before any work (the session's messages)."""
-    given = {key: value for key, value in (
-        ('confidence', args.confidence), ('absent_prior', args.absent_prior),
-        ('max_fixations', args.max_fixations), ('motion_sigma_cells', args.motion_sigma_cells),
-        ('motion_jump_prob', args.jump_prob)) if value is not None}
-    return SearchSettings(**given)
+    return settings_from_args(args, SearchSettings())
 
 
 def run_scenes(args) -> int:
@@ -313,7 +308,7 @@ def _pieces(args, policies) -> int:
             count += -(-min(args.episodes, args.episodes_greedy) // chunk)
         else:
             count += 1
-    moving = bool(args.motion_sigma_cells) or bool(args.jump_prob)
+    moving = bool(args.motion_sigma_cells) or bool(args.motion_jump_prob)
     return 2 * count if args.compare_prediction and moving else count
 
 
@@ -329,7 +324,8 @@ def run(args) -> int:
             progress_from_args(args, 0, 'evaluate') as bar:
         result = evaluate(grid, fpoc, policies, args.episodes, args.horizon, args.seed,
                           args.episodes_greedy, args.bootstrap,
-                          motion_sigma_cells=args.motion_sigma_cells, jump_prob=args.jump_prob,
+                          motion_sigma_cells=args.motion_sigma_cells,
+                          jump_prob=args.motion_jump_prob,
                           absent_prior=args.absent_prior, absent_rate=args.absent_rate,
                           confidence=args.confidence, max_fixations=args.max_fixations,
                           compare_prediction=args.compare_prediction, paired=args.paired,

@@ -102,7 +102,7 @@ def add_parser(sub):
     policy.add_argument('--policy-file', default=None, metavar='FILE',
                         help='a policy YAML file or a shipped kernel name')
     add_search_args(p, FIND_SETTINGS, ('confidence', 'max_fixations', 'absent_prior',
-                                       'repeat_weight', 'start'))
+                                       'repeat_weight', 'start_cell'))
     p.add_argument('--all', action='store_true',
                    help='find every face: each found face is printed and the cells within 2 '
                         'of it leave the hypothesis set (faces closer than that count as one), '

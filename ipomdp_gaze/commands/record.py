@@ -13,7 +13,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .common import nonneg_int
+from .search_args import add_search_args
 
 
 def add_parser(sub):
@@ -47,9 +47,7 @@ def add_parser(sub):
     p.add_argument('--policy', default=None, help='another policy.name')
     p.add_argument('--policy-file', default=None, metavar='FILE',
                    help='another policy file or shipped kernel (selects learned)')
-    p.add_argument('--confidence', type=float, default=None,
-                   help='another confidence, in (0, 1) (checked as the node checks it)')
-    p.add_argument('--max-fixations', type=nonneg_int, default=None, metavar='N')
+    add_search_args(p, None, ('confidence', 'max_fixations'), task_default="the recording's")
     p.add_argument('--new-search', action='store_true',
                    help='a fixed camera (detector in fovea mode) only: run a whole new search '
                         'on the last recorded image with these settings, instead of following '

@@ -30,9 +30,7 @@ def add_parser(sub):
     p.add_argument('--target', type=cell_arg, default=None, metavar='ROW,COL',
                    help='target cell as ROW,COL or a flat index (default random)')
     add_search_args(p, SEARCH_SETTINGS, ('confidence',))
-    p.add_argument('--max-fixations', type=nonneg_int, default=None, metavar='N',
-                   help='fixation budget: gave up when it runs out undecided (default 4 N; 0 = '
-                        'no budget)')
+    add_search_args(p, None, ('max_fixations',), task_default='4 N')
     p.add_argument('--seed', type=nonneg_int, default=0)
     p.add_argument('--plot', type=Path, default=None, metavar='PNG',
                    help='save the final belief with the scan path as a picture')

@@ -62,7 +62,7 @@ from . import NODE_NAMES
 from .guard import CallbackGuard
 from .params import (cell_params, current_values, fpoc_from, fpoc_params, grid_from, grid_params,
                      head_from, INT_MAX, joint_params, Param, ParameterTransaction, row_col_from,
-                     T)
+                     search_params, T)
 from .spin import run_node
 
 NODE_NAME = NODE_NAMES['controller']
@@ -99,51 +99,7 @@ def controller_params() -> list[Param]:
         Param('evidence_queue_depth', 1, T.INTEGER,
               'frames kept for the node per evidence topic; 1: the newest frame wins '
               '(read-only)', read_only=True, int_range=(1, 1000)),
-        Param('confidence', 0.95, T.DOUBLE,
-              'found (absent) fires when the most likely cell (no target) reaches this '
-              'probability, in (0, 1)'),
-        Param('motion.sigma_cells', 0.0, T.DOUBLE,
-              'the target moves: standard deviation of its random walk in cells per second, '
-              '>= 0 (0: a still target)'),
-        Param('motion.jump_prob', 0.0, T.DOUBLE,
-              'probability per second that the target jumps to a random cell, in [0, 1)'),
-        Param('absent.prior', 0.0, T.DOUBLE,
-              'prior that no target is in the grid, in [0, 1) (0: always there); a change '
-              'starts a new search'),
-        Param('search.max_fixations', 0, T.INTEGER,
-              'fixation budget of a search: gave_up when it runs out undecided (0: none)'),
-        Param('search.inhibit_return', False, T.BOOL,
-              'still target: never fixate a cell twice in a search (a deterministic detector '
-              'on a still scene repeats its counts; the Bayes step would count them twice)'),
-        Param('search.stop_on_repeat', False, T.BOOL,
-              'give up (gave_up) instead of fixating a cell a second time; with '
-              'inhibit_return: once every cell has been fixated (find does this)'),
-        Param('search.scan', True, T.BOOL,
-              'with a count model that has scan tables: start each search with the one-time '
-              'whole-image scan (asked of the detector as fixation [-1, -1, search_id])'),
-        Param('search.repeat_weight', 1.0, T.DOUBLE,
-              'still target: weight of the evidence a cell gets from views other than the one '
-              'that saw it at its most informative offset, in [0, 1] (1: every frame counts '
-              'fully, naive Bayes; 0: the evidence of each cell once, for overlapping views of a '
-              'still scene and a deterministic detector)'),
-        Param('search.found_radius', 0, T.INTEGER,
-              'still target: found when the belief within this many cells of a cell reaches '
-              'the confidence, and that cell is the answer (0: the cell alone)',
-              int_range=(0, 5)),
-        Param('search.decide_at_budget', False, T.BOOL,
-              'still target: when the budget runs out undecided, say absent or found '
-              '(whichever is more probable) instead of gave_up'),
-        Param('search.false_alarm_scales', [1.0], T.DOUBLE_ARRAY,
-              'still target, count model: the scene may fire the detector this many times as '
-              'often as the model expects, each factor equally likely, learned from every '
-              "cell's counts during the search ([1.0]: the model's rates as calibrated)"),
-        Param('search.hotspot_prior', 0.0, T.DOUBLE,
-              'still target, count model: prior that a cell without the target is a hotspot '
-              'that fires in every view (hotspot_scale times the false-alarm rate), in [0, 0.5] '
-              '(0: none)'),
-        Param('search.hotspot_scale', 20.0, T.DOUBLE,
-              "still target, count model: a hotspot's factor of the model's false-alarm rate, "
-              '> 1'),
+    ] + search_params() + [
         Param('policy.name', 'elm', T.STRING, 'fixation policy', choices=POLICY_NAMES),
         Param('policy.file', '', T.STRING,
               'policy YAML path or shipped kernel name; setting it selects learned'),

@@ -21,6 +21,7 @@ import math
 from ipomdp_gaze.fpoc import CameraFPOC, make_fpoc, MODELS, parameter_names
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.head import PanTiltMap
+from ipomdp_gaze.settings import SCHEMA
 from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
                                 SetParametersResult)
 from rclpy.parameter import Parameter
@@ -158,6 +159,20 @@ def cell_params(prefix: str, what: str, unset: str) -> list[Param]:
     return [Param(f'{prefix}_{axis[:3]}', -1, T.INTEGER,
                   f'{axis} of {what} (-1: {unset.format(axis)})',
                   int_range=(-1, MAX_CELLS_PER_SIDE - 1)) for axis in ('row', 'column')]
+
+
+_PARAMETER_TYPES = {'float': T.DOUBLE, 'int': T.INTEGER, 'bool': T.BOOL, 'floats': T.DOUBLE_ARRAY}
+
+
+def search_params(schema=SCHEMA) -> list[Param]:
+    """
+    Return the search settings as parameters, generated from :mod:`ipomdp_gaze.settings`.
+
+    The start cell is declared as ``start_row`` / ``start_col`` (:func:`cell_params`).
+    """
+    return [Param(s.parameter, list(s.default) if s.kind == 'floats' else s.default,
+                  _PARAMETER_TYPES[s.kind], s.help_text, int_range=s.int_range)
+            for s in schema if s.kind != 'cell']
 
 
 def declare(node, params: list[Param]) -> None:

@@ -36,6 +36,7 @@ from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.observation_file import load_observation
 from ipomdp_gaze.session import PARAMETER_NAMES, SearchSession, SearchSettings
+from ipomdp_gaze.settings import check_parameters
 from ipomdp_gaze.yaml_files import yaml_parameters
 import numpy as np
 
@@ -112,9 +113,10 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
             raise ValueError(f'{name} is a pan/tilt answer rule')
     if task == 'pan-tilt':
         from ipomdp_gaze.nodes.config import config_file
-        values = yaml_parameters(config_file('faces_camera_controller.yaml'), 'gaze_controller')
-        base = SearchSettings.from_parameters(values, grid=Grid(values['grid.rows'],
-                                                                values['grid.cols']))
+        path = config_file('faces_camera_controller.yaml')
+        values = yaml_parameters(path, 'gaze_controller')
+        base = check_parameters(values, grid=Grid(values['grid.rows'], values['grid.cols']),
+                                where=f'{path}: ')
         name = values.get('policy.name', 'elm')
         file = values.get('policy.file', '') if name == 'learned' else ''
     else:
