@@ -435,7 +435,7 @@ def run_pan_tilt(detectors, n: int, empty: int, split: str, progress=None) -> di
     ``evaluate --scenes pan-tilt [--observation faces-pan-tilt-yunet]``: the shipped controller
     configuration (policy, settings) with each detector's own pan/tilt model and camera.
     """
-    from ipomdp_gaze.vision.scene_eval import evaluate_scenes, summarise, task_spec
+    from ipomdp_gaze.drivers.scene_eval import evaluate_scenes, summarise, task_spec
     out = {}
     for kind in detectors:
         spec = task_spec('pan-tilt', model=PAN_TILT_MODELS[kind], split=split)
@@ -913,7 +913,7 @@ def main(argv=None) -> int:
                  "hypothesis and settings) with each detector's own pan/tilt model, on the same "
                  f'{args.pan_tilt_scenes} test scenes with a face (seeds 0..) and '
                  f'{args.pan_tilt_empty} without; head time is the head-time model of '
-                 '`ipomdp_gaze.vision.scene_eval` (detector time, settle and saccades). The '
+                 '`ipomdp_gaze.drivers.scene_eval` (detector time, settle and saccades). The '
                  'full pan/tilt benchmark (sweeps, a second camera) is docs/pan_tilt.md; '
                  "`faces-pan-tilt-ensemble` counts both detectors' boxes (docs/design.md "
                  'section 6.11).', '']

@@ -27,10 +27,10 @@ from dataclasses import replace
 import json
 from pathlib import Path
 
+from ipomdp_gaze.drivers import scene_eval
 import ipomdp_gaze.session
 from ipomdp_gaze.session import SearchSession
 from ipomdp_gaze.stopping import UNDECIDED
-from ipomdp_gaze.vision import scene_eval
 import numpy as np
 
 # Highest P(absent) at which the model's answer is still `found` (the shipped rule says absent at

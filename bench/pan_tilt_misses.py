@@ -16,8 +16,8 @@ Usage: ``python bench/pan_tilt_misses.py [--scenes 200] [--seed 1000] [--model F
 """
 import argparse
 
+from ipomdp_gaze.drivers import scene_eval
 from ipomdp_gaze.session import SearchSession
-from ipomdp_gaze.vision import scene_eval
 import numpy as np
 
 

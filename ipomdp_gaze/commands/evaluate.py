@@ -16,20 +16,18 @@ from dataclasses import replace
 import json
 from pathlib import Path
 
-from ipomdp_gaze.evaluation import (decision_summary, fixations_to_90_ci,
-                                    paired_difference_ci, paired_tracking_difference,
-                                    tracking_summary)
+from ipomdp_gaze.drivers.pieces import concat_results, COSTLY_CHUNK, PLANNER_CHUNK, simulate_pieces
+from ipomdp_gaze.drivers.scene_eval import (evaluate_scenes, format_summary, paired_map_difference,
+                                            results_json, summarise, task_spec, TASKS, write_json)
+from ipomdp_gaze.evaluation import (decision_summary, fixations_to_90_ci, paired_difference_ci,
+                                    paired_tracking_difference, tracking_summary)
 from ipomdp_gaze.executor import InlineExecutor
 from ipomdp_gaze.motion import Motion
 from ipomdp_gaze.observation import as_observation, GaussianObservation
 from ipomdp_gaze.observation_file import fingerprint
-from ipomdp_gaze.pieces import concat_results, COSTLY_CHUNK, PLANNER_CHUNK, simulate_pieces
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
 from ipomdp_gaze.session import SearchSettings
 from ipomdp_gaze.simulate import draw_present, draw_targets
-from ipomdp_gaze.vision.scene_eval import (evaluate_scenes, format_summary,
-                                           paired_map_difference, results_json, summarise,
-                                           task_spec, TASKS, write_json)
 import numpy as np
 
 from .common import add_task_args, nonneg_int, positive_int, task_from_args

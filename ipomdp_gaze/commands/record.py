@@ -5,8 +5,8 @@
 
 ``record`` runs the ``recorder`` node (:mod:`ipomdp_gaze.nodes.recorder`) until Ctrl-C or SIGTERM,
 writing a rosbag2 bag with MCAP storage at PATH; ``replay`` re-runs a bag's frames through the
-controller's core with the recorded settings or others (:mod:`ipomdp_gaze.replay`) and prints
-where the decisions differ.
+controller's core with the recorded settings or others (:mod:`ipomdp_gaze.drivers.replay`) and
+prints where the decisions differ.
 """
 from __future__ import annotations
 
@@ -74,7 +74,7 @@ def run_record(args) -> int:
 
 def run_replay(args) -> int:
     from ipomdp_gaze.bag import read_bag
-    from ipomdp_gaze.replay import describe_size, replay
+    from ipomdp_gaze.drivers.replay import describe_size, replay
     if not args.path.is_dir():
         raise ValueError(f'{args.path} is not a bag directory')
     bag = read_bag(args.path)
@@ -87,7 +87,7 @@ def run_replay(args) -> int:
     print('settings: ' + ('recorded' if not changed else
                           'recorded, with ' + ', '.join(changed)))
     if args.new_search:
-        from ipomdp_gaze.replay import new_search
+        from ipomdp_gaze.drivers.replay import new_search
         new_search(bag, overrides)
         return 0
     result = replay(bag, overrides)

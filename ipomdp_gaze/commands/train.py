@@ -246,7 +246,7 @@ def run_sweep(args, grid, model, config, params, init, out) -> int:
     from dataclasses import replace
 
     from ipomdp_gaze.executor import track
-    from ipomdp_gaze.pieces import train_piece
+    from ipomdp_gaze.drivers.pieces import train_piece
     from ipomdp_gaze.policies.policy_file import save_policy
     from ipomdp_gaze.policies.training import write_curve
     import numpy as np

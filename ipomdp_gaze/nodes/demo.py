@@ -22,15 +22,16 @@ import time
 
 from diagnostic_msgs.msg import DiagnosticArray
 from ipomdp_gaze.belief import entropy
+from ipomdp_gaze.controller_config import fpoc_from, grid_from, head_from, observation_from
 from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, joints
+from ipomdp_gaze.share_files import config_file
 from ipomdp_gaze.yaml_files import yaml_parameters
 import numpy as np
 from sensor_msgs.msg import Image
 
 from . import NODE_NAMES
-from .config import config_file
-from .params import fpoc_from, grid_from, head_from, joint_params
+from .params import joint_params
 from .processes import domain_id_for, isolated_nodes
 from .watch import quiet_condition, SearchRecord, Watch
 
@@ -97,7 +98,7 @@ def check_controller(values: dict) -> None:
     """
     from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnavailable
 
-    from .controller import controller_params, observation_from
+    from .controller import controller_params
     full = {p.name: p.default for p in controller_params()}
     full.update(values)
     name = full['policy.name']

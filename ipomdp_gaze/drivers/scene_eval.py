@@ -112,7 +112,7 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
         if name in SWEEP_RULES and task != 'pan-tilt':
             raise ValueError(f'{name} is a pan/tilt answer rule')
     if task == 'pan-tilt':
-        from ipomdp_gaze.nodes.config import config_file
+        from ipomdp_gaze.share_files import config_file
         path = config_file('faces_camera_controller.yaml')
         values = yaml_parameters(path, 'gaze_controller')
         base = check_parameters(values, grid=Grid(values['grid.rows'], values['grid.cols']),
