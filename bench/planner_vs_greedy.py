@@ -115,7 +115,7 @@ def main():
            'rao_blackwell': args.rao_blackwell, 'policies': {}, 'paired': {}}
     pieces = 0
     with make_executor(args.jobs, args.scheduler) as pool, \
-            Progress(0, 'planner_vs_greedy', quiet=args.quiet) as progress:
+            Progress(0, 'planner_vs_greedy', 'episode', quiet=args.quiet) as progress:
         runner = Runner(GRID, FPOC, n, args.seed, RESAMPLES, pool, cache, args.rao_blackwell,
                         progress)
         for name in sorted(names, key=lambda x: not getattr(policies[x][0], 'costly', False)):

@@ -126,7 +126,7 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
     bootstrap interval. The simulations run on ``executor`` (:mod:`ipomdp_gaze.executor`;
     default: here), a slow searcher in pieces of ``COSTLY_CHUNK`` episodes
     (``PLANNER_CHUNK`` for the planner), with the same numbers wherever they run; ``bar``
-    (:class:`ipomdp_gaze.progress.Progress`) counts the pieces, ``progress(name, entry)`` is
+    (:class:`ipomdp_gaze.progress.Progress`) counts episodes, ``progress(name, entry)`` is
     called as each policy's entry is ready.
     """
     scene = (motion_sigma_cells, jump_prob, absent_prior, absent_rate, confidence,
@@ -319,7 +319,7 @@ def run(args) -> int:
     grid, fpoc = task_from_args(args)
     policies = load_policies(args, grid, fpoc)
     with executor_from_args(args, _pieces(args, policies)) as executor, \
-            progress_from_args(args, 0, 'evaluate') as bar:
+            progress_from_args(args, 0, 'evaluate', 'episode') as bar:
         result = evaluate(grid, fpoc, policies, args.episodes, args.horizon, args.seed,
                           args.episodes_greedy, args.bootstrap,
                           motion_sigma_cells=args.motion_sigma_cells,

@@ -280,7 +280,7 @@ def run(args) -> int:
     cache = PieceCache(args.cache)
     # An error or Ctrl-C cancels the pieces still running; the finished ones are in the cache.
     with executor_from_args(args) as pool, \
-            progress_from_args(args, 0, 'reproduce') as progress:
+            progress_from_args(args, 0, 'reproduce', 'episode') as progress:
         r7, r11, others = _simulate_all(args, specs, pool, cache, log, progress)
     where = _where(pool)
     h7, h11 = specs['human-7x7-infomax'], specs['human-11x11-infomax']
