@@ -177,9 +177,9 @@ class Runner:
     one is stored there by this process as soon as it finishes (so Ctrl-C keeps the finished
     ones). ``progress`` (``add(n)`` / ``update(n)``, :class:`ipomdp_gaze.progress.Progress`)
     counts episodes as their pieces finish. Used by ``reproduce`` and
-    ``bench/planner_vs_greedy.py``. With ``rao_blackwell`` (Gaussian FPOC model), ``map_prob`` holds ``E[max_i B'_i]`` given the
-    belief and fixation before each observation (:class:`_RaoBlackwell`): the same curve, less
-    variance.
+    ``bench/planner_vs_greedy.py``. With ``rao_blackwell`` (Gaussian FPOC model), ``map_prob``
+    holds ``E[max_i B'_i]`` given the belief and fixation before each observation
+    (:class:`_RaoBlackwell`): the same curve, less variance.
     """
 
     def __init__(self, grid, fpoc, episodes, seed, bootstrap, executor=None, cache=None,
