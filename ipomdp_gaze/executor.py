@@ -146,7 +146,7 @@ class _InlineFuture(cf.Future):
         return super().result(timeout)
 
     def exception(self, timeout=None):
-        """Run the piece if it has not run, then return its exception (or None)."""
+        """Run the piece if it has not run, then return what it raised (or None)."""
         self.run()
         return super().exception(timeout)
 
