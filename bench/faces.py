@@ -42,7 +42,7 @@ import time
 
 import cv2
 from ipomdp_gaze.detection import DEFAULT_MODELS
-from ipomdp_gaze.evaluation import wilson_interval
+from ipomdp_gaze.evaluation import cells_apart, wilson_interval
 from ipomdp_gaze.observation_file import load_observation
 from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy
@@ -168,8 +168,7 @@ def errors(cells, truth) -> np.ndarray:
     """Chebyshev distance in cells of each answer (None: no answer, counted as wrong)."""
     out = []
     for found, true in zip(cells, truth):
-        out.append(np.inf if found is None else max(abs(found[0] - true[0]),
-                                                    abs(found[1] - true[1])))
+        out.append(np.inf if found is None else cells_apart(found, true))
     return np.asarray(out, dtype=float)
 
 

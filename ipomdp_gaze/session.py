@@ -565,13 +565,14 @@ class SearchSession:
         code = int(decide(peak, absent, settings.confidence))
         decision = {FOUND: 'found', ABSENT: 'absent'}.get(code, '')
         fired = ''
-        if self.motion.active:
+        if self.motion.active or not settings.stop_on_decision:
             fired = decision if decision and decision != search.decision else ''
             search.decision = decision
         elif decision:
             search.decision, search.ended, fired = decision, True, decision
         search.decided_once = search.decided_once or bool(fired)
-        if not search.decided_once and settings.max_fixations \
+        budget_applies = not search.decided_once or not settings.stop_on_decision
+        if budget_applies and settings.max_fixations \
                 and search.fixations >= settings.max_fixations:
             fired = self._limit('budget')
         return fired

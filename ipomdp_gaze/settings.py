@@ -106,6 +106,9 @@ SCHEMA: tuple[Setting, ...] = (
             'still target: found when the belief within this many cells of a cell reaches the '
             'confidence, and that cell is the answer (0: the cell alone)', bounds='0 to 5',
             int_range=(0, 5), metavar='CELLS'),
+    Setting('stop_on_decision', 'search.stop_on_decision', 'bool', True, check_flag,
+            'found and absent end a search (off: they are only reported, as for a moving target, '
+            'and the search goes on to its budget: to measure what every view would give)'),
     Setting('decide_at_budget', 'search.decide_at_budget', 'bool', False, check_flag,
             'still target: when the budget runs out undecided, say absent or found (whichever '
             'is more probable) instead of gave_up'),

@@ -23,6 +23,7 @@ import time
 from diagnostic_msgs.msg import DiagnosticArray
 from ipomdp_gaze.belief import entropy
 from ipomdp_gaze.controller_config import fpoc_from, grid_from, head_from, observation_from
+from ipomdp_gaze.evaluation import answer_is_right, RIGHT_RADIUS_CELLS
 from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, joints
 from ipomdp_gaze.share_files import config_file
@@ -77,7 +78,7 @@ class DemoSetup:
     @property
     def tolerance_cells(self) -> int:
         """How far (Chebyshev, cells) the answer may be from the truth and still be right."""
-        return 1 if self.scene == 'faces' else 0
+        return RIGHT_RADIUS_CELLS if self.scene == 'faces' else 0
 
 
 def check_controller(values: dict) -> None:
@@ -489,7 +490,7 @@ def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
             tr, tc = grid.cell(truth)
     else:
         (tr, tc), (fr, fc) = grid.cell(truth), answer[:2]
-        right = max(abs(tr - fr), abs(tc - fc)) <= setup.tolerance_cells
+        right = answer_is_right((fr, fc), (tr, tc), radius=setup.tolerance_cells)
     if stats is not None:
         stats.update(found, truth=(tr, tc), right=right, stop=stop)
     verdict = 'right' if right else 'wrong'
