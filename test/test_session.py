@@ -445,7 +445,7 @@ def test_run_search_calls_the_frame_hook_once_per_applied_frame_with_the_frame()
     seen = []
     sensor = ModelSensor(GRID, model, np.random.default_rng(3))
     outcome = run_search(session, sensor, 2, seed=0,
-                         on_frame=lambda frame, result: seen.append((frame.kind, result.fixations)))
+                         on_frame=lambda frame, step: seen.append((frame.kind, step.fixations)))
     assert seen == [('fixation', k) for k in range(1, outcome.fixations + 1)]
 
 
