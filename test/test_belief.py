@@ -1,10 +1,11 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """The log-domain belief update against a brute-force Bayes posterior, and its edge cases."""
-from ipomdp_gaze.belief import (argmax_ties_low, bayes_update, entropy, EvidenceError,
-                                fixate_target_reward, infomax_reward, map_cell, uniform_log_belief)
-from ipomdp_gaze.observation import check_evidence
-from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
+from ipomdp_gaze.model.belief import (argmax_ties_low, bayes_update, entropy, EvidenceError,
+                                      fixate_target_reward, infomax_reward, map_cell,
+                                      uniform_log_belief)
+from ipomdp_gaze.model.observation import check_evidence
+from ipomdp_gaze.model.observation import gaussian_log_likelihood_ratio as llr
 import numpy as np
 import pytest
 from scipy.stats import norm
@@ -124,10 +125,10 @@ def test_tie_rule_goes_to_lowest_index_within_relative_tolerance():
 
 
 def test_overflowing_evidence_is_rejected_and_the_belief_kept():
-    from ipomdp_gaze.fpoc import make_fpoc
-    from ipomdp_gaze.gaze import GazeController
-    from ipomdp_gaze.grid import Grid
+    from ipomdp_gaze.model.fpoc import make_fpoc
+    from ipomdp_gaze.model.grid import Grid
     from ipomdp_gaze.policies.baselines import make_baseline
+    from ipomdp_gaze.search.gaze import GazeController
     obs = np.zeros(9)
     obs[4] = 1.7e308
     with pytest.raises(EvidenceError, match='refused'):

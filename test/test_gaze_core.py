@@ -7,14 +7,14 @@ from dataclasses import replace
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from ipomdp_gaze.belief import argmax_ties_low, bayes_update, uniform_log_belief
-from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
-from ipomdp_gaze.gaze import GazeController
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
+from ipomdp_gaze.model.belief import argmax_ties_low, bayes_update, uniform_log_belief
+from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import gaussian_log_likelihood_ratio as llr
 from ipomdp_gaze.policies.baselines import spiral_order
 from ipomdp_gaze.policies.registry import build_policy
-from ipomdp_gaze.session import SearchSettings
+from ipomdp_gaze.search.gaze import GazeController
+from ipomdp_gaze.search.session import SearchSettings
 import numpy as np
 import pytest
 

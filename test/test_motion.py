@@ -3,8 +3,8 @@
 """The motion step against a dense transition matrix built cell by cell, and the target's walk."""
 import math
 
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.motion import axis_transition, check_probability, check_sigma_cells, Motion
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.motion import axis_transition, check_probability, check_sigma_cells, Motion
 import numpy as np
 import pytest
 

@@ -1,7 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-The search session (ipomdp_gaze.session) and its sensors, against brute force and each driver.
+The search session (ipomdp_gaze.search.session) and its sensors, against brute force, by driver.
 
 The belief after a scan and frames is the brute-force posterior (every hypothesis's likelihood
 multiplied out, the absent hypothesis included); a repeat weight below 1 counts each cell's
@@ -15,13 +15,14 @@ from dataclasses import replace
 import itertools
 import math
 
-from ipomdp_gaze.gaze import GazeController
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import CountObservation
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import CountObservation
+from ipomdp_gaze.model.still_evidence import cell_information
 from ipomdp_gaze.policies.registry import build_policy
-from ipomdp_gaze.sensors import ModelSensor, run_search
-from ipomdp_gaze.session import (Frame, OrderError, SearchSession, SearchSettings, start_index)
-from ipomdp_gaze.still_evidence import cell_information
+from ipomdp_gaze.search.gaze import GazeController
+from ipomdp_gaze.search.sensors import ModelSensor, run_search
+from ipomdp_gaze.search.session import (Frame, OrderError, SearchSession, SearchSettings,
+                                        start_index)
 import numpy as np
 import pytest
 
@@ -455,5 +456,5 @@ def test_run_search_calls_the_frame_hook_once_per_applied_frame_with_the_frame()
     ((3, 4), None, 'absent', True), ((3, 4), None, 'found', False),
     ((2, 3), (3, 4), 'gave_up', True), (None, (3, 4), 'gave_up', False)])
 def test_the_one_right_answer_rule(cell, truth, decision, right):
-    from ipomdp_gaze.evaluation import answer_is_right
+    from ipomdp_gaze.simulation.evaluation import answer_is_right
     assert answer_is_right(cell, truth, decision) is right

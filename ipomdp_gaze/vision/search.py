@@ -4,7 +4,7 @@
 Search one image for the target with the digital fovea and a count model (docs/design.md 6).
 
 :func:`search_image` is the whole loop of the CVPR 2009 follow-up on one decoded image, run by the
-search session (:mod:`ipomdp_gaze.session`) with the fovea as its sensor:
+search session (:mod:`ipomdp_gaze.search.session`) with the fovea as its sensor:
 
 1. start the fovea on the image (grey conversion); with a fovea that scans once
    (``scan_once``), observe the whole-image windows and apply their one Bayes step with the
@@ -45,9 +45,9 @@ from dataclasses import dataclass, replace
 import math
 import time
 
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.sensors import run_search
-from ipomdp_gaze.session import SearchSession, SearchSettings
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.search.sensors import run_search
+from ipomdp_gaze.search.session import SearchSession, SearchSettings
 from ipomdp_gaze.vision.detector import detector_window_px
 from ipomdp_gaze.vision.detectors import detector_from_settings  # noqa: F401 (its old home)
 from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea
@@ -248,7 +248,7 @@ def search_image(image: np.ndarray, fovea: Fovea, model, policy,
     """
     Search one decoded image with the fovea, the count model and a policy (module docstring).
 
-    A thin driver of the search session (:mod:`ipomdp_gaze.session`) with the fovea as its
+    A thin driver of the search session (:mod:`ipomdp_gaze.search.session`) with the fovea as its
     sensor (:class:`ipomdp_gaze.vision.sensors.FoveaSensor`).
 
     Parameters

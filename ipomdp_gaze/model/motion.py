@@ -18,7 +18,7 @@ independently. The prediction of the cell mass ``B`` is therefore
 
     B'_d = (1 - jump_prob) * sum_s B_s G[s, d] + jump_prob * (sum_s B_s) / N
 
-and an absent hypothesis (:mod:`ipomdp_gaze.stopping`) is left alone. ``sigma_cells = 0`` and
+and an absent hypothesis (:mod:`ipomdp_gaze.model.stopping`) is left alone. ``sigma_cells = 0`` and
 ``jump_prob = 0`` is a target that stays put (no prediction at all).
 
 Units: ``sigma_cells`` and ``jump_prob`` are per fixation in simulation and training. In the
@@ -30,11 +30,10 @@ from __future__ import annotations
 
 import math
 
+from ipomdp_gaze.model.belief import normalize_log
+from ipomdp_gaze.model.checks import check_probability, check_sigma_cells  # noqa: F401
+from ipomdp_gaze.model.grid import Grid
 import numpy as np
-
-from .belief import normalize_log
-from .checks import check_probability, check_sigma_cells  # noqa: F401
-from .grid import Grid
 
 TRUNCATE_SIGMAS = 3.0
 ALMOST_ONE = math.nextafter(1.0, 0.0)

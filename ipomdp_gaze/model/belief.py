@@ -5,7 +5,7 @@ Belief over the target's cell: the one Bayes step, rewards and the MAP guess.
 
 The belief is kept in the log domain. Every consumer (controller, simulator, Gymnasium env,
 ``search``, training, benches) updates it with :func:`bayes_update`, adding the per-cell
-log-likelihood ratio of a frame that an observation model (:mod:`ipomdp_gaze.observation`)
+log-likelihood ratio of a frame that an observation model (:mod:`ipomdp_gaze.model.observation`)
 computed, then renormalising (paper eq. 6; docs/design.md section 1). All functions work on a
 single belief (N,) or a batch (episodes, N).
 """

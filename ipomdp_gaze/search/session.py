@@ -7,24 +7,28 @@ A search is a short sequence of pure steps on one belief over the N cells (plus,
 ``absent_prior > 0``, the hypothesis "no target in the grid"):
 
 1. :meth:`SearchSession.reset` -- the prior: ``(1 - absent_prior) / N`` per cell and
-   ``absent_prior`` on the absent hypothesis (:func:`ipomdp_gaze.stopping.initial_log_belief`);
+   ``absent_prior`` on the absent hypothesis
+   (:func:`ipomdp_gaze.model.stopping.initial_log_belief`);
 2. :meth:`SearchSession.scan` -- optional, once, before the first fixation: the one-time scan of
    a model with scan tables, ``log B_i += log s_T(c_i) - log s_N(c_i)``;
 3. :meth:`SearchSession.start` -- the first fixation: ``settings.start_cell``, or by default
    the policy's choice on the scanned belief after a scan and the grid's centre without one
    (docs/design.md section 4.2);
 4. :meth:`SearchSession.update` with each frame taken at the current fixation: predict the belief
-   over ``dt_s`` seconds (a moving target, :mod:`ipomdp_gaze.motion`), the Bayes step
+   over ``dt_s`` seconds (a moving target, :mod:`ipomdp_gaze.model.motion`), the Bayes step
    ``log B_i += log p_T(o_i | offset_ik) - log p_N(o_i | offset_ik)`` (or, for a still scene with
-   ``repeat_weight < 1``, the still-scene evidence of :mod:`ipomdp_gaze.still_evidence`), then
-   the stop rules (:func:`ipomdp_gaze.stopping.decide`): ``found``, ``absent`` (terminated: the
+   ``repeat_weight < 1``, the still-scene evidence of :mod:`ipomdp_gaze.model.still_evidence`),
+   then
+   the stop rules (:func:`ipomdp_gaze.model.stopping.decide`): ``found``, ``absent`` (terminated:
+   the
    evidence decided), ``gave_up`` (truncated: the budget, or every cell seen with
    ``stop_on_repeat``); if the search goes on, the policy chooses the next fixation.
 
-The session holds the model it *assumes*; a sensor (:mod:`ipomdp_gaze.sensors`) produces the
+The session holds the model it *assumes*; a sensor (:mod:`ipomdp_gaze.search.sensors`) produces the
 frames from the world, which may follow another model. The session imports no ROS, reads no
 clock (times arrive as ``dt_s``), prints nothing and writes nothing: drivers (the
-``gaze_controller`` node through :class:`ipomdp_gaze.gaze.GazeController`, ``ipomdp-gaze find``,
+``gaze_controller`` node through :class:`ipomdp_gaze.search.gaze.GazeController`, ``ipomdp-gaze
+find``,
 ``search``, the offline evaluation and the Gymnasium environment) build settings, a sensor and a
 session, then loop. Its per-search event log (:attr:`SearchSession.log`) is what drivers save.
 """
@@ -33,17 +37,16 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass, field
 
+from ipomdp_gaze.model.belief import bayes_update, entropy, EvidenceError, map_cell, normalize_log
+from ipomdp_gaze.model.false_alarms import FalseAlarmMixture
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.inhibition import policy_choice, unvisited_choice
+from ipomdp_gaze.model.motion import Motion
+from ipomdp_gaze.model.observation import as_observation, check_evidence, CountObservation
+from ipomdp_gaze.model.still_evidence import cell_information, StillEvidence
+from ipomdp_gaze.model.stopping import ABSENT, decide, FOUND, initial_log_belief, with_absent
+from ipomdp_gaze.search.settings import parameter_names, settings_class
 import numpy as np
-
-from .belief import bayes_update, entropy, EvidenceError, map_cell, normalize_log
-from .false_alarms import FalseAlarmMixture
-from .grid import Grid
-from .inhibition import policy_choice, unvisited_choice
-from .motion import Motion
-from .observation import as_observation, check_evidence, CountObservation
-from .settings import parameter_names, settings_class
-from .still_evidence import cell_information, StillEvidence
-from .stopping import ABSENT, decide, FOUND, initial_log_belief, with_absent
 
 # Decisions a search can end with; '' while undecided.
 DECISIONS = ('found', 'absent', 'gave_up')
@@ -52,7 +55,7 @@ DECISIONS = ('found', 'absent', 'gave_up')
 GAVE_UP_REASONS = ('budget', 'repeat')
 # The parameter (node, YAML) name of each setting: the name every refusal message uses.
 PARAMETER_NAMES = parameter_names()
-# The settings object, generated from the schema (ipomdp_gaze.settings.SCHEMA): one checked
+# The settings object, generated from the schema (ipomdp_gaze.search.settings.SCHEMA): one checked
 # field per setting; SearchSettings(confidence=0.99, max_fixations=60), replace() to change.
 SearchSettings = settings_class(module=__name__)
 
@@ -192,7 +195,8 @@ class SearchSession:
     grid : Grid
         The visual array.
     observation
-        The observation model the searcher assumes (:mod:`ipomdp_gaze.observation`) or an FPOC.
+        The observation model the searcher assumes (:mod:`ipomdp_gaze.model.observation`) or an
+        FPOC.
     policy
         Anything with ``select(belief (1, N), t, rng)``; with ``scores(belief)`` inhibition of
         return masks the scores. None: the driver chooses every fixation itself
