@@ -368,6 +368,9 @@ class _Search:
     ended: bool = False
     decided_once: bool = False
     path: list = field(default_factory=list)
+    # What the read-only views derive from log_belief, each computed once: emptied whenever
+    # log_belief (or a setting a view depends on) changes.
+    views: dict = field(default_factory=dict)
 
 
 class SearchSession:
@@ -423,6 +426,7 @@ class SearchSession:
         old = self.settings
         self.settings = settings
         self.motion = Motion(self.grid, settings.motion_sigma_cells, settings.motion_jump_prob)
+        self._changed()                 # the answer's square follows found_radius and motion
         mixture_changed = _mixture_settings(settings) != _mixture_settings(old)
         if mixture_changed:
             self._mixture = None
@@ -457,10 +461,30 @@ class SearchSession:
         """Log probabilities, (N,) or (N + 1,) with the absent hypothesis last; a copy."""
         return self._state().log_belief.copy()
 
+    def _view(self, name: str, compute):
+        """Return a view of the belief, computed once after each change (:meth:`_changed`)."""
+        views = self._state().views
+        if name not in views:
+            views[name] = compute()
+        return views[name]
+
+    def _changed(self) -> None:
+        """Forget the views: the log belief, or a setting a view depends on, has changed."""
+        if self._search is not None:
+            self._search.views.clear()
+
+    def _cells(self) -> np.ndarray:
+        """Cell probabilities ``exp(log B_i)`` (N,), shared and read-only."""
+        def compute():
+            cells = np.exp(self._search.log_belief[:self.grid.n_cells])
+            cells.flags.writeable = False
+            return cells
+        return self._view('cells', compute)
+
     @property
     def belief(self) -> np.ndarray:
         """Cell probabilities ``B_i`` (N,), a copy; they sum to ``1 - P(absent)``."""
-        return np.exp(self._state().log_belief[:self.grid.n_cells])
+        return self._cells().copy()
 
     @property
     def absent_probability(self) -> float:
@@ -475,21 +499,22 @@ class SearchSession:
 
         With ``found_radius`` r > 0: the cell whose (2r + 1)-square holds the most belief.
         """
-        return int(map_cell(self._pooled()))
+        return self._view('map_cell', lambda: int(map_cell(self._pooled())))
 
     def _pooled(self) -> np.ndarray:
         radius = self.settings.found_radius if not self.motion.active else 0
-        return pooled_belief(self.belief, self.grid, radius)
+        return self._view('pooled', lambda: pooled_belief(self._cells(), self.grid, radius))
 
     @property
     def map_probability(self) -> float:
         """Probability of the answer: its cell, or its square with ``found_radius``."""
-        return float(self._pooled()[self.map_cell])
+        return self._view('map_probability', lambda: float(self._pooled()[self.map_cell]))
 
     @property
     def entropy_nats(self) -> float:
         """Entropy of the belief over all its hypotheses, in nats."""
-        return float(entropy(np.exp(self._state().log_belief)))
+        return self._view('entropy_nats',
+                          lambda: float(entropy(np.exp(self._search.log_belief))))
 
     @property
     def fixation(self) -> int | None:
@@ -598,6 +623,7 @@ class SearchSession:
         for log_b in (search.log_belief, search.still_base):
             log_b[index] = -np.inf
             normalize_log(log_b)
+        self._changed()
         self._event('exclude', cells=[self._rc(c) for c in index])
 
     def scan(self, frame: Frame) -> StepResult:
@@ -628,6 +654,7 @@ class SearchSession:
         search.scanned = True
         bayes_update(search.log_belief, with_absent(term, search.log_belief),
                      out=search.log_belief)
+        self._changed()
         search.still_base = search.log_belief.copy()
         self._event('scan', frame=frame.summary(), belief=self._belief_summary())
         return self._result('applied')
@@ -670,6 +697,7 @@ class SearchSession:
         """Spread the belief over ``dt_s`` of the target's motion (nothing for a still target)."""
         if self.motion.active and dt_s > 0:
             self.motion.over(dt_s).predict_log(self._state().log_belief)
+            self._changed()
 
     def update(self, frame: Frame, dt_s: float = 0.0) -> StepResult:
         """
@@ -710,6 +738,7 @@ class SearchSession:
         else:
             bayes_update(search.log_belief, with_absent(term, search.log_belief),
                          out=search.log_belief)
+        self._changed()
         search.fixations += 1
         search.path.append(search.fixation)
         search.visited[search.fixation] = True
@@ -802,7 +831,7 @@ class SearchSession:
         search, settings = self._search, self.settings
         if self.policy is None:
             return search.fixation
-        belief = self.belief[None, :]
+        belief = self._cells()[None, :]
         if settings.inhibit_return and not self.motion.active:
             if search.visited.all():
                 if settings.stop_on_repeat:

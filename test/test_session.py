@@ -401,3 +401,74 @@ def test_a_drivers_limit_ends_the_search_as_the_budget_does():
         assert session.log[-1]['event'] == 'stop'
         with pytest.raises(OrderError):
             session.stop('pixels')
+
+
+def _views_from_scratch(session, radius):
+    """The read-only views recomputed from the log belief alone, as first written."""
+    log_b = session.log_belief
+    cells = np.exp(log_b[:GRID.n_cells])
+    if radius:
+        padded = np.pad(cells.reshape(GRID.shape), radius)
+        square = np.lib.stride_tricks.sliding_window_view(padded, (2 * radius + 1,) * 2)
+        pooled = square.sum(axis=(2, 3)).reshape(-1)
+    else:
+        pooled = cells
+    peak = pooled.max()
+    answer = int(np.argmax(pooled >= peak - 1e-9 * abs(peak)))
+    full = np.exp(log_b)
+    entropy = float(-np.sum(np.where(full > 0, full * np.log(np.where(full > 0, full, 1.0)),
+                                     0.0)))
+    return cells, answer, float(pooled[answer]), entropy
+
+
+def _assert_views_follow(session, radius):
+    cells, answer, probability, entropy = _views_from_scratch(session, radius)
+    assert session.belief.tobytes() == cells.tobytes()
+    assert (session.map_cell, session.map_probability) == (answer, probability)
+    assert session.entropy_nats == entropy
+
+
+def test_the_views_follow_every_change_of_the_belief_and_of_the_settings():
+    """Views computed once per belief: reset, scan, exclude, update, predict, configure."""
+    model = count_model(12)
+    settings = SearchSettings(confidence=1 - 1e-12, absent_prior=0.3, found_radius=1)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model), settings)
+    sensor = ModelSensor(GRID, model, np.random.default_rng(4))
+    sensor.start(5)
+    session.reset(seed=0)
+    _assert_views_follow(session, 1)
+    session.scan(sensor.scan())
+    _assert_views_follow(session, 1)
+    session.exclude([5, 6])
+    _assert_views_follow(session, 1)
+    cell = session.start()
+    for _ in range(3):
+        before = session.belief
+        result = session.update(sensor.observe(cell))
+        assert not np.array_equal(session.belief, before)
+        _assert_views_follow(session, 1)
+        cell = result.fixation
+    session.configure(replace(settings, found_radius=0))
+    _assert_views_follow(session, 0)
+    session.configure(replace(settings, found_radius=2))
+    _assert_views_follow(session, 2)
+    session.configure(replace(settings, motion_sigma_cells=0.8))  # moving: the cell alone
+    _assert_views_follow(session, 0)
+    before = session.belief
+    session.predict(1.5)
+    assert not np.array_equal(session.belief, before)
+    _assert_views_follow(session, 0)
+    session.reset()
+    _assert_views_follow(session, 0)
+    np.testing.assert_allclose(session.belief, 0.7 / GRID.n_cells)
+
+
+def test_the_belief_a_caller_gets_is_its_own_copy():
+    model = count_model(13)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model), SearchSettings())
+    session.reset()
+    session.start()
+    mine = session.belief
+    mine[:] = 0.0
+    assert session.belief.sum() == pytest.approx(1.0)
+    assert session.map_probability == pytest.approx(1.0 / GRID.n_cells)
