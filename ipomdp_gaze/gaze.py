@@ -43,7 +43,7 @@ import numpy as np
 
 from .belief import EvidenceError
 from .grid import Grid
-from .session import Frame, SearchSession, SearchSettings
+from .session import SearchSession, SearchSettings
 
 
 def check_settle_time(settle_time_s: float) -> float:
@@ -351,7 +351,7 @@ class GazeController:
         sent at ``now_s``. A scan of another search, or one nobody waits for, is skipped.
         """
         try:
-            obs = self.session.check_frame(evidence)
+            frame = self.session.checked_frame(evidence, kind='scan')
         except EvidenceError as exc:
             return self.reject(str(exc))
         self.received += 1
@@ -365,7 +365,7 @@ class GazeController:
         if reason:
             self.skipped += 1
             return FrameResult('skipped', reason)
-        step = self.session.scan(Frame(obs, kind='scan'))
+        step = self.session.scan(frame)
         if not step.applied:
             self.rejected += 1
             self.last_rejection = step.reason
@@ -394,7 +394,7 @@ class GazeController:
 
         """
         try:
-            obs = self.session.check_frame(evidence)
+            frame = self.session.checked_frame(evidence)    # the one check of a frame's values
         except EvidenceError as exc:
             return self.reject(str(exc))
         self.received += 1
@@ -416,7 +416,7 @@ class GazeController:
             self.skipped += 1
             return FrameResult('skipped', 'taken before the fixation settled')
         dt_s = float(stamp_s) - self.update_time_s
-        step = self.session.update(Frame(obs), dt_s=dt_s)
+        step = self.session.update(frame, dt_s=dt_s)
         if not step.applied:
             self.rejected += 1
             self.last_rejection = step.reason

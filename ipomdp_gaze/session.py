@@ -290,7 +290,9 @@ class Frame:
     Gaussian model, a detection count for a count model; NaN means not observed. ``kind`` is
     ``'fixation'`` (taken at the session's current fixation) or ``'scan'`` (the one-time scan).
     ``detector_pixels`` and ``seconds`` are what producing it cost; ``detections`` any boxes
-    the sensor wants drivers to draw or record.
+    the sensor wants drivers to draw or record. A frame built by
+    :meth:`SearchSession.checked_frame` carries the session and model that checked it, so that
+    session does not check it again.
     """
 
     values: np.ndarray
@@ -298,6 +300,7 @@ class Frame:
     detector_pixels: int = 0
     seconds: float = 0.0
     detections: tuple = ()
+    _checked_by: tuple = field(default=(), init=False, repr=False, compare=False)
 
     def summary(self) -> dict:
         """Return what the event log keeps of a frame: cells observed, sum and peak, cost."""
@@ -574,6 +577,33 @@ class SearchSession:
             self.observation.counts(obs)
         return obs
 
+    def checked_frame(self, values, kind: str = 'fixation') -> Frame:
+        """
+        Return ``Frame(values, kind)`` checked here, once (:meth:`check_frame`).
+
+        :meth:`update` and :meth:`scan` take it without checking it again while the session
+        assumes the same model. For a driver that must know whether a frame is usable before
+        deciding what to do with it (the controller counts a bad frame as rejected even when it
+        would skip it). The values are :meth:`check_frame`'s floats; change none of them before
+        the frame is applied.
+
+        Raises
+        ------
+        EvidenceError
+            With the reason, as :meth:`check_frame`.
+
+        """
+        frame = Frame(self.check_frame(values), kind=kind)
+        object.__setattr__(frame, '_checked_by', (self, self.observation))
+        return frame
+
+    def _frame_values(self, frame: Frame) -> np.ndarray:
+        """Return a frame's checked values: checked here unless this session checked them."""
+        checked = frame._checked_by
+        if checked and checked[0] is self and checked[1] is self.observation:
+            return frame.values
+        return self.check_frame(frame.values)
+
     def reset(self, *, seed=None) -> None:
         """
         Start a new search from the prior.
@@ -647,7 +677,7 @@ class SearchSession:
         if not self.settings.scan:
             return self._result('applied', reason='scan off')
         try:
-            obs = check_evidence(frame.values, self.grid.n_cells)
+            obs = self._frame_values(frame)
             term = self.observation.scan_log_likelihood_ratio(obs)
         except EvidenceError as exc:
             return self._result('rejected', reason=str(exc))
@@ -719,7 +749,7 @@ class SearchSession:
         if search.ended:
             raise OrderError(f'the search has ended ({search.decision}); reset starts a new one')
         try:
-            obs = self.check_frame(frame.values)
+            obs = self._frame_values(frame)
             term = self.observation.log_likelihood_ratio(obs, search.fixation)
         except EvidenceError as exc:
             return self._result('rejected', reason=str(exc))

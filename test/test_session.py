@@ -15,6 +15,8 @@ from dataclasses import replace
 import itertools
 import math
 
+from ipomdp_gaze.belief import EvidenceError
+from ipomdp_gaze.fpoc import make_fpoc
 from ipomdp_gaze.gaze import GazeController
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.observation import CountObservation
@@ -404,7 +406,7 @@ def test_a_drivers_limit_ends_the_search_as_the_budget_does():
 
 
 def _views_from_scratch(session, radius):
-    """The read-only views recomputed from the log belief alone, as first written."""
+    """Return the read-only views recomputed from the log belief alone, as first written."""
     log_b = session.log_belief
     cells = np.exp(log_b[:GRID.n_cells])
     if radius:
@@ -472,3 +474,41 @@ def test_the_belief_a_caller_gets_is_its_own_copy():
     mine[:] = 0.0
     assert session.belief.sum() == pytest.approx(1.0)
     assert session.map_probability == pytest.approx(1.0 / GRID.n_cells)
+
+
+def test_a_frame_checked_by_the_session_is_not_checked_again_by_it(monkeypatch):
+    model = count_model(14)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model), SearchSettings())
+    session.reset()
+    session.start()
+    checks = []
+    original = session.check_frame
+    monkeypatch.setattr(session, 'check_frame', lambda v: checks.append(1) or original(v))
+    frame = session.checked_frame(np.zeros(GRID.n_cells))
+    assert session.update(frame).applied and len(checks) == 1
+    assert session.update(Frame(np.zeros(GRID.n_cells))).applied and len(checks) == 2
+    with pytest.raises(EvidenceError, match='integers'):
+        session.checked_frame(np.full(GRID.n_cells, 0.5))
+
+
+def test_a_checked_frame_is_checked_again_by_another_session_or_model():
+    model = count_model(15)
+    gaussian = SearchSession(GRID, make_fpoc('camera', half_width_deg=1.0,
+                                             half_height_deg=1.0), None, SearchSettings())
+    fractional = gaussian.checked_frame(np.full(GRID.n_cells, 0.5))   # fine for a Gaussian
+    counts = SearchSession(GRID, model, None, SearchSettings())
+    counts.reset()
+    counts.start()
+    result = counts.update(fractional)
+    assert result.status == 'rejected' and 'integers' in result.reason
+    gaussian.reset()
+    gaussian.start()
+    frame = gaussian.checked_frame(np.full(GRID.n_cells, 0.5))
+    gaussian.set_observation(model)                 # the model changed since the check
+    result = gaussian.update(frame)
+    assert result.status == 'rejected' and 'integers' in result.reason
+    assert gaussian.fixations == 0
+    fresh = SearchSession(GRID, model, None, SearchSettings())
+    fresh.reset()
+    scan = fresh.checked_frame(np.zeros(GRID.n_cells), kind='scan')
+    assert scan.kind == 'scan' and fresh.scan(scan).applied
