@@ -91,7 +91,7 @@ def bench(ctx=None) -> str:
                      f"{r['update'][0]:.3f} | {r['update'][1]:.3f} |")
     lines += ['', 'Camera FPOC, ELM, motion on (sigma 0.5 cells per second), frames drawn at '
               "the controller's fixation, NaN outside the view, the loop's period between "
-              'stamps with 20% jitter; one timing per call. `offer` is the node\'s call '
+              "stamps with 20% jitter; one timing per call. `offer` is the node's call "
               '(frame check, update, counters, events); `update` the bare session step.', '']
     return '\n'.join(lines)
 
