@@ -156,7 +156,7 @@ def test_axis_matrix_rows_sum_to_one_and_zero_sigma_is_identity():
 
 
 def _dense_axis(size, sigma):
-    """The axis matrix as first written: ``g`` evaluated for every pair of positions."""
+    """Return the axis matrix as first written: ``g`` evaluated for every pair of positions."""
     if sigma == 0:
         return np.eye(size)
     x = np.arange(size)
