@@ -94,7 +94,9 @@ def axis_transition(size: int, sigma_cells: float) -> np.ndarray:
     offset = np.arange(-reach, reach + 1)
     table = np.zeros(2 * size - 1)              # entry size - 1 + k: g(k)
     table[size - 1 - reach:size + reach] = np.exp(-0.5 * (offset / sigma) ** 2)
-    weights = np.ascontiguousarray(np.lib.stride_tricks.sliding_window_view(table, size)[::-1])
+    # Row x is table[size - 1 - x:][:size]: a view stepping back one entry per row, copied.
+    weights = np.ndarray((size, size), buffer=table, offset=(size - 1) * table.itemsize,
+                         strides=(-table.itemsize, table.itemsize)).copy()
     return weights / weights.sum(axis=1, keepdims=True)
 
 
@@ -192,9 +194,10 @@ class Motion:
             return log_belief
         n = self.grid.n_cells
         peak = np.max(log_belief, axis=-1, keepdims=True)
-        cells = np.exp(log_belief[..., :n] - peak)
+        cells = np.subtract(log_belief[..., :n], peak)
+        moved = self.predict(np.exp(cells, out=cells))
         with np.errstate(divide='ignore'):
-            log_belief[..., :n] = np.log(self.predict(cells)) + peak
+            np.add(np.log(moved, out=moved), peak, out=log_belief[..., :n])
         return normalize_log(log_belief)
 
     # -- the target ----------------------------------------------------------------------

@@ -305,10 +305,10 @@ class Frame:
     def summary(self) -> dict:
         """Return what the event log keeps of a frame: cells observed, sum and peak, cost."""
         values = np.asarray(self.values, dtype=float)
-        seen = ~np.isnan(values)
-        return {'kind': self.kind, 'observed_cells': int(seen.sum()),
-                'sum': float(values[seen].sum()) if seen.any() else 0.0,
-                'peak': float(values[seen].max()) if seen.any() else None,
+        seen = values[~np.isnan(values)]
+        return {'kind': self.kind, 'observed_cells': int(seen.size),
+                'sum': float(seen.sum()) if seen.size else 0.0,
+                'peak': float(seen.max()) if seen.size else None,
                 'detector_pixels': int(self.detector_pixels)}
 
 
