@@ -326,8 +326,11 @@ class ConvPolicy:
         if cand.size <= RESCORE_MAX:
             return int(cand[argmax_ties_low(self.exact_scores(belief, cand))])
         if self.truncate > 0 and not lossless:  # too blurred by truncation: use every entry
-            exact = score if self._fft(True) is self._fft() else self._fft_scores(belief, True)
-            return self._decide_fft(belief, exact, lossless=True)
+            if self._fft(True) is not self._fft():
+                return self._decide_fft(belief, self._fft_scores(belief, True), lossless=True)
+            # Truncation dropped nothing: the lossless pass would have these scores, bound and
+            # candidates; it counts as a second re-scoring, as it did.
+            self.rescored += 1
         return self._decide_flat(belief, score, cand, eps)
 
     def _decide_flat(self, belief, score, cand, eps) -> int:

@@ -137,6 +137,11 @@ def test_a_truncation_that_drops_nothing_shares_the_lossless_fft_and_its_scores(
     belief = np.full(grid.n_cells, 1.0 / grid.n_cells)
     expected = int(argmax_ties_low(belief @ kernel_matrix(grid, box.kernel).T))
     assert box.decide(belief) == expected and scored == [()] and box.rescored == 2
+    flat = []
+    original_flat = ConvPolicy._decide_flat
+    monkeypatch.setattr(ConvPolicy, '_decide_flat',
+                        lambda self, *a: flat.append(a[3]) or original_flat(self, *a))
+    assert box.decide(belief) == expected and flat == [box.fft_error_bound(belief, True)]
 
 
 @pytest.mark.parametrize('truncate', [1e-6, 1e-3, 1e-1])
