@@ -7,7 +7,7 @@ The core is grouped by what each module is (docs/design.md section 8): ``model``
 observation, belief, motion, stopping, ...), ``search`` (settings, session, sensors, the
 controller's logic), ``simulation`` (simulate, evaluation, gym, executor, progress), ``files``
 (observation and YAML files, bags, render) and ``vision``. The flat names of earlier releases
-(``ipomdp_gaze.search.session``, ``ipomdp_gaze.files.observation_file``, ...) still import, as the same module
+(``ipomdp_gaze.session``, ``ipomdp_gaze.observation_file``, ...) still import, as the same module
 objects, with a ``DeprecationWarning`` naming the new path (README, "Changes").
 """
 from __future__ import annotations

@@ -142,3 +142,17 @@ def test_overflowing_evidence_is_rejected_and_the_belief_kept():
     assert result.status == 'rejected' and 'overflows' in result.reason
     np.testing.assert_array_equal(core.belief, before)
     assert np.all(np.isfinite(np.log(core.belief[core.belief > 0])))
+
+
+def test_entropy_and_the_tie_rule_of_one_belief_are_those_of_a_batch_bit_for_bit():
+    rng = np.random.default_rng(3)
+    beliefs = rng.dirichlet(np.full(50, 0.2), size=6)
+    beliefs[1, 7] = beliefs[2, :10] = 0.0                # 0 log 0 = 0
+    beliefs[3, 20] = beliefs[3].max()                     # a tie
+    with np.errstate(divide='ignore', invalid='ignore'):
+        terms = np.where(beliefs > 0, beliefs * np.log(np.where(beliefs > 0, beliefs, 1.0)), 0)
+    assert entropy(beliefs).tobytes() == (-np.sum(terms, axis=-1)).tobytes()
+    batch = argmax_ties_low(beliefs)
+    for row, belief in enumerate(beliefs):
+        assert entropy(belief) == entropy(beliefs)[row]
+        assert argmax_ties_low(belief) == batch[row]

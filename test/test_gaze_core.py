@@ -103,6 +103,17 @@ def test_invalid_frames_are_rejected_and_change_nothing(frame, words):
     assert core.counters() == {'received': 1, 'applied': 0, 'rejected': 1, 'skipped': 0}
 
 
+def test_each_frame_is_checked_once_whatever_becomes_of_it(monkeypatch):
+    core = controller(settle_time_s=0.5)
+    checks = []
+    original = core.session.check_frame
+    monkeypatch.setattr(core.session, 'check_frame', lambda v: checks.append(1) or original(v))
+    statuses = [core.offer(np.zeros(121), 0.1).status,            # before settling
+                core.offer(np.zeros(120), 0.6).status,            # wrong length
+                core.offer(np.zeros(121), 0.6).status]            # applied
+    assert statuses == ['skipped', 'rejected', 'applied'] and len(checks) == 3
+
+
 def test_reject_counts_frames_the_node_could_not_read():
     core = controller()
     result = core.reject('layout is 7x7, the grid is 11x11')

@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 from ipomdp_gaze.model.belief import EvidenceError
 from ipomdp_gaze.model.grid import Grid
-from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
+from ipomdp_gaze.search.session import SearchSession, SearchSettings
 import numpy as np
 
 
@@ -353,7 +353,7 @@ class GazeController:
         sent at ``now_s``. A scan of another search, or one nobody waits for, is skipped.
         """
         try:
-            obs = self.session.check_frame(evidence)
+            frame = self.session.checked_frame(evidence, kind='scan')
         except EvidenceError as exc:
             return self.reject(str(exc))
         self.received += 1
@@ -367,7 +367,7 @@ class GazeController:
         if reason:
             self.skipped += 1
             return FrameResult('skipped', reason)
-        step = self.session.scan(Frame(obs, kind='scan'))
+        step = self.session.scan(frame)
         if not step.applied:
             self.rejected += 1
             self.last_rejection = step.reason
@@ -396,7 +396,7 @@ class GazeController:
 
         """
         try:
-            obs = self.session.check_frame(evidence)
+            frame = self.session.checked_frame(evidence)    # the one check of a frame's values
         except EvidenceError as exc:
             return self.reject(str(exc))
         self.received += 1
@@ -418,7 +418,7 @@ class GazeController:
             self.skipped += 1
             return FrameResult('skipped', 'taken before the fixation settled')
         dt_s = float(stamp_s) - self.update_time_s
-        step = self.session.update(Frame(obs), dt_s=dt_s)
+        step = self.session.update(frame, dt_s=dt_s)
         if not step.applied:
             self.rejected += 1
             self.last_rejection = step.reason

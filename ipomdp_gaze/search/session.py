@@ -106,7 +106,9 @@ class Frame:
     Gaussian model, a detection count for a count model; NaN means not observed. ``kind`` is
     ``'fixation'`` (taken at the session's current fixation) or ``'scan'`` (the one-time scan).
     ``detector_pixels`` and ``seconds`` are what producing it cost; ``detections`` any boxes
-    the sensor wants drivers to draw or record.
+    the sensor wants drivers to draw or record. A frame built by
+    :meth:`SearchSession.checked_frame` carries the session and model that checked it, so that
+    session does not check it again.
     """
 
     values: np.ndarray
@@ -114,14 +116,15 @@ class Frame:
     detector_pixels: int = 0
     seconds: float = 0.0
     detections: tuple = ()
+    _checked_by: tuple = field(default=(), init=False, repr=False, compare=False)
 
     def summary(self) -> dict:
         """Return what the event log keeps of a frame: cells observed, sum and peak, cost."""
         values = np.asarray(self.values, dtype=float)
-        seen = ~np.isnan(values)
-        return {'kind': self.kind, 'observed_cells': int(seen.sum()),
-                'sum': float(values[seen].sum()) if seen.any() else 0.0,
-                'peak': float(values[seen].max()) if seen.any() else None,
+        seen = values[~np.isnan(values)]
+        return {'kind': self.kind, 'observed_cells': int(seen.size),
+                'sum': float(seen.sum()) if seen.size else 0.0,
+                'peak': float(seen.max()) if seen.size else None,
                 'detector_pixels': int(self.detector_pixels)}
 
 
@@ -184,6 +187,9 @@ class _Search:
     ended: bool = False
     decided_once: bool = False
     path: list = field(default_factory=list)
+    # What the read-only views derive from log_belief, each computed once: emptied whenever
+    # log_belief (or a setting a view depends on) changes.
+    views: dict = field(default_factory=dict)
 
 
 class SearchSession:
@@ -240,6 +246,7 @@ class SearchSession:
         old = self.settings
         self.settings = settings
         self.motion = Motion(self.grid, settings.motion_sigma_cells, settings.motion_jump_prob)
+        self._changed()                 # the answer's square follows found_radius and motion
         mixture_changed = _mixture_settings(settings) != _mixture_settings(old)
         if mixture_changed:
             self._mixture = None
@@ -274,10 +281,30 @@ class SearchSession:
         """Log probabilities, (N,) or (N + 1,) with the absent hypothesis last; a copy."""
         return self._state().log_belief.copy()
 
+    def _view(self, name: str, compute):
+        """Return a view of the belief, computed once after each change (:meth:`_changed`)."""
+        views = self._state().views
+        if name not in views:
+            views[name] = compute()
+        return views[name]
+
+    def _changed(self) -> None:
+        """Forget the views: the log belief, or a setting a view depends on, has changed."""
+        if self._search is not None:
+            self._search.views.clear()
+
+    def _cells(self) -> np.ndarray:
+        """Cell probabilities ``exp(log B_i)`` (N,), shared and read-only."""
+        def compute():
+            cells = np.exp(self._search.log_belief[:self.grid.n_cells])
+            cells.flags.writeable = False
+            return cells
+        return self._view('cells', compute)
+
     @property
     def belief(self) -> np.ndarray:
         """Cell probabilities ``B_i`` (N,), a copy; they sum to ``1 - P(absent)``."""
-        return np.exp(self._state().log_belief[:self.grid.n_cells])
+        return self._cells().copy()
 
     @property
     def absent_probability(self) -> float:
@@ -292,21 +319,22 @@ class SearchSession:
 
         With ``found_radius`` r > 0: the cell whose (2r + 1)-square holds the most belief.
         """
-        return int(map_cell(self._pooled()))
+        return self._view('map_cell', lambda: int(map_cell(self._pooled())))
 
     def _pooled(self) -> np.ndarray:
         radius = self.settings.found_radius if not self.motion.active else 0
-        return pooled_belief(self.belief, self.grid, radius)
+        return self._view('pooled', lambda: pooled_belief(self._cells(), self.grid, radius))
 
     @property
     def map_probability(self) -> float:
         """Probability of the answer: its cell, or its square with ``found_radius``."""
-        return float(self._pooled()[self.map_cell])
+        return self._view('map_probability', lambda: float(self._pooled()[self.map_cell]))
 
     @property
     def entropy_nats(self) -> float:
         """Entropy of the belief over all its hypotheses, in nats."""
-        return float(entropy(np.exp(self._state().log_belief)))
+        return self._view('entropy_nats',
+                          lambda: float(entropy(np.exp(self._search.log_belief))))
 
     @property
     def fixation(self) -> int | None:
@@ -366,6 +394,33 @@ class SearchSession:
             self.observation.counts(obs)
         return obs
 
+    def checked_frame(self, values, kind: str = 'fixation') -> Frame:
+        """
+        Return ``Frame(values, kind)`` checked here, once (:meth:`check_frame`).
+
+        :meth:`update` and :meth:`scan` take it without checking it again while the session
+        assumes the same model. For a driver that must know whether a frame is usable before
+        deciding what to do with it (the controller counts a bad frame as rejected even when it
+        would skip it). The values are :meth:`check_frame`'s floats; change none of them before
+        the frame is applied.
+
+        Raises
+        ------
+        EvidenceError
+            With the reason, as :meth:`check_frame`.
+
+        """
+        frame = Frame(self.check_frame(values), kind=kind)
+        object.__setattr__(frame, '_checked_by', (self, self.observation))
+        return frame
+
+    def _frame_values(self, frame: Frame) -> np.ndarray:
+        """Return a frame's checked values: checked here unless this session checked them."""
+        checked = frame._checked_by
+        if checked and checked[0] is self and checked[1] is self.observation:
+            return frame.values
+        return self.check_frame(frame.values)
+
     def reset(self, *, seed=None) -> None:
         """
         Start a new search from the prior.
@@ -415,6 +470,7 @@ class SearchSession:
         for log_b in (search.log_belief, search.still_base):
             log_b[index] = -np.inf
             normalize_log(log_b)
+        self._changed()
         self._event('exclude', cells=[self._rc(c) for c in index])
 
     def scan(self, frame: Frame) -> StepResult:
@@ -438,13 +494,14 @@ class SearchSession:
         if not self.settings.scan:
             return self._result('applied', reason='scan off')
         try:
-            obs = check_evidence(frame.values, self.grid.n_cells)
+            obs = self._frame_values(frame)
             term = self.observation.scan_log_likelihood_ratio(obs)
         except EvidenceError as exc:
             return self._result('rejected', reason=str(exc))
         search.scanned = True
         bayes_update(search.log_belief, with_absent(term, search.log_belief),
                      out=search.log_belief)
+        self._changed()
         search.still_base = search.log_belief.copy()
         self._event('scan', frame=frame.summary(), belief=self._belief_summary())
         return self._result('applied')
@@ -487,6 +544,7 @@ class SearchSession:
         """Spread the belief over ``dt_s`` of the target's motion (nothing for a still target)."""
         if self.motion.active and dt_s > 0:
             self.motion.over(dt_s).predict_log(self._state().log_belief)
+            self._changed()
 
     def update(self, frame: Frame, dt_s: float = 0.0) -> StepResult:
         """
@@ -508,7 +566,7 @@ class SearchSession:
         if search.ended:
             raise OrderError(f'the search has ended ({search.decision}); reset starts a new one')
         try:
-            obs = self.check_frame(frame.values)
+            obs = self._frame_values(frame)
             term = self.observation.log_likelihood_ratio(obs, search.fixation)
         except EvidenceError as exc:
             return self._result('rejected', reason=str(exc))
@@ -527,6 +585,7 @@ class SearchSession:
         else:
             bayes_update(search.log_belief, with_absent(term, search.log_belief),
                          out=search.log_belief)
+        self._changed()
         search.fixations += 1
         search.path.append(search.fixation)
         search.visited[search.fixation] = True
@@ -620,7 +679,7 @@ class SearchSession:
         search, settings = self._search, self.settings
         if self.policy is None:
             return search.fixation
-        belief = self.belief[None, :]
+        belief = self._cells()[None, :]
         if settings.inhibit_return and not self.motion.active:
             if search.visited.all():
                 if settings.stop_on_repeat:
