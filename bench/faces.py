@@ -434,7 +434,9 @@ def run_pan_tilt(detectors, n: int, empty: int, split: str, progress=None) -> di
     ``evaluate --scenes pan-tilt [--observation faces-pan-tilt-yunet]``: the shipped controller
     configuration (policy, settings) with each detector's own pan/tilt model and camera.
     """
-    from ipomdp_gaze.drivers.scene_eval import evaluate_scenes, summarise, task_spec
+    from ipomdp_gaze.drivers.scene_eval import evaluate_scenes
+    from ipomdp_gaze.drivers.scene_report import summarise
+    from ipomdp_gaze.drivers.scene_tasks import task_spec
     out = {}
     for kind in detectors:
         spec = task_spec('pan-tilt', model=PAN_TILT_MODELS[kind], split=split)

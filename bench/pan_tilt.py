@@ -27,9 +27,11 @@ from pathlib import Path
 import sys
 import time
 
-from ipomdp_gaze.drivers.scene_eval import (evaluate_scenes, HEAD_SPEED_DEG_S,
-                                            paired_map_difference, SACCADE_TIME_S, SceneResult,
-                                            SETTLE_TIME_S, summarise, SWEEP_RULES, task_spec)
+from ipomdp_gaze.drivers.scene_eval import evaluate_scenes
+from ipomdp_gaze.drivers.scene_report import paired_map_difference, SceneResult, summarise
+from ipomdp_gaze.drivers.scene_tasks import task_spec
+from ipomdp_gaze.drivers.sweep_rules import SWEEP_RULES
+from ipomdp_gaze.model.head_time import HEAD_SPEED_DEG_S, SACCADE_TIME_S, SETTLE_TIME_S
 from ipomdp_gaze.simulation.progress import Progress
 from ipomdp_gaze.vision.detection import DEFAULT_MODELS
 

@@ -27,7 +27,7 @@ from dataclasses import replace
 import json
 from pathlib import Path
 
-from ipomdp_gaze.drivers import scene_eval
+from ipomdp_gaze.drivers.scene_tasks import SceneTask, task_spec
 from ipomdp_gaze.search.sensors import run_search
 from ipomdp_gaze.search.session import SearchSession
 from ipomdp_gaze.simulation.evaluation import answer_is_right
@@ -43,11 +43,11 @@ STATISTICS = ('centred', 'largest over views', 'sum over views')
 def every_view(args) -> dict:
     """All poses of one scene through the shipped belief; its answer and its statistics."""
     seed, split, model, empty, index = args
-    spec = scene_eval.task_spec('pan-tilt', seed=seed, split=split, empty=empty, model=model)
+    spec = task_spec('pan-tilt', seed=seed, split=split, empty=empty, model=model)
     # The stop rule off (decisions only reported): every view is taken.
     settings = replace(spec.settings, inhibit_return=False, max_fixations=0,
                        stop_on_decision=False)
-    task = scene_eval._Task.get(spec)
+    task = SceneTask.get(spec)
     scene = task.scene(index)
     grid = task.model.grid
     session = SearchSession(grid, task.model, task.policy, settings)

@@ -16,7 +16,7 @@ Usage: ``python bench/pan_tilt_misses.py [--scenes 200] [--seed 1000] [--model F
 """
 import argparse
 
-from ipomdp_gaze.drivers import scene_eval
+from ipomdp_gaze.drivers.scene_tasks import SceneTask, task_spec
 from ipomdp_gaze.search.sensors import run_search
 from ipomdp_gaze.search.session import SearchSession
 from ipomdp_gaze.simulation.evaluation import answer_is_right, cells_apart
@@ -50,8 +50,8 @@ def main() -> None:
     parser.add_argument('--seed', type=int, default=1000)
     parser.add_argument('--model', default='', help='another pan/tilt observation file')
     args = parser.parse_args()
-    spec = scene_eval.task_spec('pan-tilt', seed=args.seed, split='train', model=args.model)
-    task = scene_eval._Task.get(spec)
+    spec = task_spec('pan-tilt', seed=args.seed, split='train', model=args.model)
+    task = SceneTask.get(spec)
     grid = task.model.grid
     print('| scene | background | face px | face cell | decision (answer) | fixations | '
           'closest fixation | counts in the face cell from views within one cell | centred '

@@ -1,7 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """A scene's own false-alarm rate and hotspots (``model.false_alarms``) against Bayes."""
-from ipomdp_gaze.drivers.scene_eval import compare_settings
+from ipomdp_gaze.drivers.scene_tasks import compare_settings
 from ipomdp_gaze.model.false_alarms import check_false_alarm_scales, FalseAlarmMixture, scaled_null
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.observation import CountObservation

@@ -4,9 +4,10 @@
 import itertools
 import math
 
-from ipomdp_gaze.drivers.scene_eval import head_time_s, SACCADE_TIME_S, SETTLE_TIME_S, task_spec
+from ipomdp_gaze.drivers.scene_tasks import task_spec
 from ipomdp_gaze.files.observation_file import load_observation
 from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head_time import head_time_s, SACCADE_TIME_S, SETTLE_TIME_S
 from ipomdp_gaze.policies.baselines import (axis_poses, SWEEP_STEP, sweep_tile_cells,
                                             TILE_MARGIN_CELLS)
 from ipomdp_gaze.policies.registry import build_policy
@@ -217,11 +218,13 @@ def test_evaluate_scenes_refuses_bad_searchers_and_empty_fovea_scenes_in_one_lin
 
 
 def test_every_searcher_of_a_scene_shares_its_views_and_the_sweep_rules_follow_the_poses():
-    from ipomdp_gaze.drivers.scene_eval import _Task, evaluate_scene, SWEEP_RULES
+    from ipomdp_gaze.drivers.scene_eval import evaluate_scene
+    from ipomdp_gaze.drivers.scene_tasks import SceneTask
+    from ipomdp_gaze.drivers.sweep_rules import SWEEP_RULES
     spec = task_spec('pan-tilt', split='train', seed=7, compare=('sweep',) + SWEEP_RULES)
     results = {r.searcher: r for r in evaluate_scene(spec, 0)}
     assert list(results) == ['coverage', 'sweep'] + list(SWEEP_RULES)
-    poses = tuple(int(k) for k in _Task.get(spec).sweep.poses)
+    poses = tuple(int(k) for k in SceneTask.get(spec).sweep.poses)
     assert results['sweep-tile'].path == poses and results['sweep-tile'].fixations == 12
     for rule in SWEEP_RULES[1:]:
         path = results[rule].path
@@ -232,7 +235,7 @@ def test_every_searcher_of_a_scene_shares_its_views_and_the_sweep_rules_follow_t
     assert results['sweep'].path[:len(poses)] == poses[:results['sweep'].fixations]
     # Every view was rendered and detected once for all six searchers.
     seen = set().union(*(r.path for r in results.values()))
-    assert set(_Task.get(spec).sensor.frames) == seen
+    assert set(SceneTask.get(spec).sensor.frames) == seen
     for r in results.values():
         assert r.head_time_s > r.detector_s > 0
         if r.map_right:
@@ -242,11 +245,13 @@ def test_every_searcher_of_a_scene_shares_its_views_and_the_sweep_rules_follow_t
 def test_the_pan_tilt_task_runs_with_yunet_whose_boxes_carry_a_score():
     # YuNet returns (M, 5) boxes with a score; the view cache keeps boxes only, so the sweep's
     # grouped answer rules work for a scoring detector too.
-    from ipomdp_gaze.drivers.scene_eval import _Task, evaluate_scene, SWEEP_RULES
+    from ipomdp_gaze.drivers.scene_eval import evaluate_scene
+    from ipomdp_gaze.drivers.scene_tasks import SceneTask
+    from ipomdp_gaze.drivers.sweep_rules import SWEEP_RULES
     spec = task_spec('pan-tilt', split='train', seed=7, model='faces-pan-tilt-yunet',
                      compare=SWEEP_RULES)
     results = {r.searcher: r for r in evaluate_scene(spec, 0)}
     assert list(results) == ['coverage'] + list(SWEEP_RULES)
-    boxes = _Task.get(spec).sensor.boxes
+    boxes = SceneTask.get(spec).sensor.boxes
     assert boxes and all(b.ndim == 2 and b.shape[1] == 4 for b in boxes.values())
     assert any(len(b) for b in boxes.values())                 # YuNet saw the face somewhere

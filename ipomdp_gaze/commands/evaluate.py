@@ -17,8 +17,10 @@ import json
 from pathlib import Path
 
 from ipomdp_gaze.drivers.pieces import concat_results, COSTLY_CHUNK, PLANNER_CHUNK, simulate_pieces
-from ipomdp_gaze.drivers.scene_eval import (evaluate_scenes, format_summary, paired_map_difference,
-                                            results_json, summarise, task_spec, TASKS, write_json)
+from ipomdp_gaze.drivers.scene_eval import evaluate_scenes
+from ipomdp_gaze.drivers.scene_report import (format_summary, paired_map_difference, results_json,
+                                              summarise, write_json)
+from ipomdp_gaze.drivers.scene_tasks import task_spec, TASKS
 from ipomdp_gaze.files.observation_file import fingerprint
 from ipomdp_gaze.model.motion import Motion
 from ipomdp_gaze.model.observation import as_observation, GaussianObservation

@@ -37,6 +37,7 @@ import sys
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from ipomdp_gaze.model.belief import EvidenceError
+from ipomdp_gaze.model.head_time import SETTLE_TIME_S
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, stamps
 from ipomdp_gaze.policies.baselines import STRATEGIES
 from ipomdp_gaze.policies.conv import ACTIONS, check_kernel
@@ -84,7 +85,7 @@ def controller_params() -> list[Param]:
         'start', 'the first fixation after a reset', 'the centre {}') + [
         Param('seed', 0, T.INTEGER, 'seed of the random and sample policies',
               int_range=(0, INT_MAX)),
-        Param('settle_time_s', 0.1, T.DOUBLE,
+        Param('settle_time_s', SETTLE_TIME_S, T.DOUBLE,
               'frames taken earlier than this after a target was sent are skipped',
               float_range=(0.0, 60.0)),
         Param('retry_period_s', 1.0, T.DOUBLE,

@@ -32,6 +32,7 @@ import sys
 
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head_camera import PinholeCamera
+from ipomdp_gaze.model.head_time import SACCADE_TIME_S
 from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
 from ipomdp_gaze.search.controller_config import head_from
 from rclpy.node import Node
@@ -96,7 +97,7 @@ def scene_camera_params() -> list[Param]:
         Param('frame_id', 'camera', T.STRING, 'frame_id of image and camera_info',
               read_only=True),
     ] + joint_params(limits=False) + [
-        Param('saccade_time_s', 0.15, T.DOUBLE, 'time to move to a new cell',
+        Param('saccade_time_s', SACCADE_TIME_S, T.DOUBLE, 'time to move to a new cell',
               float_range=(0.0, 60.0)),
         Param('rate_hz', 0.0, T.DOUBLE,
               'frames per second like a video camera (0: one frame per arrival)',

@@ -1,0 +1,223 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The image tasks of the offline evaluation: which scenes, model, policy, settings and sensor.
+
+:func:`task_spec` describes a run (:class:`TaskSpec`, picklable, checked once); :class:`SceneTask`
+builds, once per process, the model, policy, sensor and scenes it names, with a sensor that
+renders and detects each view of a scene once for every searcher (:class:`ViewCache`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+import re
+
+from ipomdp_gaze.drivers.sweep_rules import SWEEP_RULES
+from ipomdp_gaze.files.observation_file import load_observation
+from ipomdp_gaze.files.share_files import config_file
+from ipomdp_gaze.files.yaml_files import yaml_parameters
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head import PanTiltMap
+from ipomdp_gaze.policies.policy_file import default_policy_file
+from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
+from ipomdp_gaze.search.session import PARAMETER_NAMES, SearchSettings
+from ipomdp_gaze.search.settings import check_parameters
+from ipomdp_gaze.vision.detection import build_setup
+from ipomdp_gaze.vision.detector import as_detections
+from ipomdp_gaze.vision.fovea_model import fovea_for_model
+from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, SceneGeometry
+from ipomdp_gaze.vision.scenes import SceneSet
+from ipomdp_gaze.vision.search import SCENE_SETTINGS
+from ipomdp_gaze.vision.sensors import FoveaSensor, PanTiltSensor
+import numpy as np
+import yaml
+
+TASKS = ('pan-tilt', 'faces-420', 'faces-840')
+# The budget every task's searches get unless told otherwise: the ROS bench's (60 fixations).
+DEFAULT_BUDGET = 60
+# The fixed-camera tasks: model, scene side (px), face sizes (px), as bench/faces.py.
+_FOVEA_TASKS = {'faces-420': ('faces-420', 420, (60, 140)),
+                'faces-840': ('faces-840', 840, (24, 140))}
+
+
+@dataclass(frozen=True)
+class TaskSpec:
+    """What one task runs with: the model file, the policy, the settings and the scene seed."""
+
+    task: str
+    policy: str
+    policy_file: str
+    settings: SearchSettings
+    seed: int
+    split: str = 'test'
+    empty: bool = False
+    model: str = ''
+    compare: tuple = ()
+
+
+def task_spec(task: str, policy: str | None = None, policy_file: str | None = None,
+              settings: SearchSettings | None = None, seed: int = 0,
+              max_fixations: int | None = None, split: str = 'test', empty: bool = False,
+              model: str = '', compare=()) -> TaskSpec:
+    """
+    Return the shipped configuration of ``task``, with any of its parts replaced.
+
+    ``pan-tilt`` takes its policy and settings from ``config/faces_camera_controller.yaml``;
+    the fixed-camera tasks take ``find``'s (the shipped kernel of the model, else ELM). The
+    budget ``max_fixations`` is the configuration's when it has one, else
+    :data:`DEFAULT_BUDGET`.
+    ``split`` picks training or held-out test scenes, ``empty`` the same scenes without a face
+    (pan-tilt), ``model`` another pan/tilt observation file (its camera is the sensor's) and
+    ``compare`` more searchers run on the same scenes and views: policy names (with the same
+    settings; ``sweep`` starts at its own first pose), optionally with changed settings as
+    ``name:parameter=value,...`` (parameter names of docs/design.md section 10.1, e.g.
+    ``elm:search.repeat_weight=0.1,absent.prior=0``), and :data:`SWEEP_RULES`.
+    """
+    if task not in TASKS:
+        raise ValueError(f"unknown scene task {task!r}; choose from {', '.join(TASKS)}")
+    if split not in ('train', 'test'):
+        raise ValueError(f"split must be 'train' or 'test', got {split!r}")
+    if (empty or model) and task != 'pan-tilt':
+        raise ValueError('empty scenes and another model are for the pan-tilt task')
+    for label in compare:
+        name = label.split(':')[0]
+        if ':' in label:
+            compare_settings(SearchSettings(), label)
+        if name not in NAMED_POLICIES and name not in SWEEP_RULES:
+            raise ValueError(f'unknown searcher {name!r}; choose from '
+                             f"{', '.join(NAMED_POLICIES + SWEEP_RULES)}")
+        if name in SWEEP_RULES and task != 'pan-tilt':
+            raise ValueError(f'{name} is a pan/tilt answer rule')
+    if task == 'pan-tilt':
+        path = config_file('faces_camera_controller.yaml')
+        values = yaml_parameters(path, 'gaze_controller')
+        base = check_parameters(values, grid=Grid(values['grid.rows'], values['grid.cols']),
+                                where=f'{path}: ')
+        name = values.get('policy.name', 'elm')
+        file = values.get('policy.file', '') if name == 'learned' else ''
+    else:
+        base = SCENE_SETTINGS
+        file = default_policy_file(load_observation(_FOVEA_TASKS[task][0])) or ''
+        name = 'learned' if file else 'elm'
+    if policy is not None or policy_file:
+        name, file = ('learned', policy_file) if policy_file else (policy, '')
+    if max_fixations is None:
+        max_fixations = base.max_fixations or DEFAULT_BUDGET
+    settings = settings or replace(base, max_fixations=max_fixations)
+    return TaskSpec(task, name, file, settings, int(seed), split, bool(empty), model,
+                    tuple(compare))
+
+
+def compare_settings(settings: SearchSettings, label: str) -> SearchSettings:
+    """
+    Return ``settings`` changed by a searcher label's ``:parameter=value,...`` part.
+
+    Values are read as YAML (``0.1``, ``true``, ``60``, ``[1, 2, 4, 8]``: commas inside brackets
+    belong to the value).
+    """
+    if ':' not in label:
+        return settings
+    values = {}
+    for item in re.split(r',(?![^\[]*\])', label.split(':', 1)[1]):
+        key, sep, value = item.partition('=')
+        if not sep or key.strip() not in PARAMETER_NAMES.values():
+            raise ValueError(f'searcher {label!r}: expected parameter=value with a parameter '
+                             f"of {', '.join(PARAMETER_NAMES.values())}, got {item!r}")
+        values[key.strip()] = yaml.safe_load(value)
+    return SearchSettings.from_parameters(values, base=settings)
+
+
+class _Recording:
+    """A detector that keeps the raw boxes of its last call (for the grouped answer rules)."""
+
+    def __init__(self, detector):
+        self.detector = detector
+        self.boxes = np.zeros((0, 4), dtype=np.int64)
+
+    def __call__(self, gray):
+        self.boxes = self.detector(gray)
+        return self.boxes
+
+    def __getattr__(self, name):
+        return getattr(self.detector, name)
+
+
+class ViewCache:
+    """
+    A sensor that renders and detects each view of a scene once, for every searcher.
+
+    A still scene and a deterministic detector give the same frame at the same pose, so the
+    searchers of one scene share the views (and the detector time measured for each).
+    """
+
+    def __init__(self, sensor, recorder=None):
+        self.sensor = sensor
+        self.recorder = recorder
+        self.grid = sensor.grid
+        self.scans = sensor.scans
+        self.frames = {}
+        self.boxes = {}
+
+    def start(self, scene) -> None:
+        self.sensor.start(scene)
+        self.frames, self.boxes = {}, {}
+
+    def scan(self):
+        return self.sensor.scan()
+
+    def observe(self, cell: int):
+        cell = int(cell)
+        if cell not in self.frames:
+            self.frames[cell] = self.sensor.observe(cell)
+            if self.recorder is not None:
+                # boxes only: a scoring detector (YuNet) returns (M, 5) with its scores
+                self.boxes[cell] = as_detections(self.recorder.boxes)[0]
+        return self.frames[cell]
+
+
+class SceneTask:
+    """The model, policy, sensor and scenes of a task, built once per process."""
+
+    _cache: dict = {}
+
+    @classmethod
+    def get(cls, spec: TaskSpec) -> SceneTask:
+        key = (spec.task, spec.policy, spec.policy_file, spec.seed, spec.split, spec.empty,
+               spec.model, spec.compare)
+        if key not in cls._cache:
+            cls._cache = {key: cls(spec)}
+        return cls._cache[key]
+
+    def __init__(self, spec: TaskSpec):
+        self.spec = spec
+        if spec.task == 'pan-tilt':
+            setup = build_setup('camera', spec.model)
+            self.model = setup.model
+            geometry = SceneGeometry(self.model.grid, setup.camera)
+            recorder = _Recording(setup.observer.detector)
+            setup.observer.detector = recorder
+            self.sensor = ViewCache(PanTiltSensor(setup.observer, geometry), recorder)
+            self.camera = setup.camera
+            self.max_count = setup.observer.max_count
+            self.head = PanTiltMap(self.model.grid)
+
+            def scene(i):
+                return PanTiltSceneSet(spec.split, geometry, color='rgb', seed=spec.seed + i,
+                                       empty=spec.empty).scene(0)
+        else:
+            name, size, faces = _FOVEA_TASKS[spec.task]
+            self.model = load_observation(name)
+            self.sensor = ViewCache(FoveaSensor(fovea_for_model(self.model)))
+            self.head = None
+            scenes = SceneSet(spec.split, size_px=size, face_px=faces, grid=self.model.grid.shape,
+                              seed=spec.seed)
+
+            def scene(i):
+                return scenes[i]
+        self.scene = scene
+        self.policy = build_policy(spec.policy, self.model.grid, self.model,
+                                   file=spec.policy_file or None)
+        self.compare = {label: build_policy(label.split(':')[0], self.model.grid, self.model)
+                        for label in spec.compare if label not in SWEEP_RULES}
+        if any(name in SWEEP_RULES for name in spec.compare):
+            self.sweep = build_policy('sweep', self.model.grid, self.model)
