@@ -49,7 +49,7 @@ from . import NODE_NAMES
 from .guard import CallbackGuard
 from .params import (cell_params, fpoc_params, grid_params, INT_MAX, joint_params, Param,
                      ParameterTransaction, T)
-from .saccade import SaccadeMixin
+from .saccade import saccade_params, SaccadeMixin
 from .spin import run_node
 
 NODE_NAME = NODE_NAMES['camera']
@@ -64,11 +64,7 @@ def camera_params() -> list[Param]:
         'target', 'the target', 'a random {} at each reset') + [
         Param('seed', 0, T.INTEGER, 'seed of the targets and the observation noise',
               int_range=(0, INT_MAX)),
-        Param('saccade_time_s', 0.15, T.DOUBLE, 'time to move to a new cell',
-              float_range=(0.0, 60.0)),
-        Param('rate_hz', 0.0, T.DOUBLE,
-              'frames per second like a video camera (0: one frame per arrival)',
-              float_range=(0.0, 1000.0)),
+    ] + saccade_params(max_rate_hz=1000.0) + [
         Param('publish_image', False, T.BOOL,
               'publish stamped 32FC1 evidence_image frames instead of evidence'),
         Param('empty_scene', False, T.BOOL,
@@ -152,33 +148,19 @@ class SimulatedCameraNode(SaccadeMixin, Node):
             self._make_timers(v)
 
     def _make_timers(self, values: dict) -> None:
-        for timer in (self._saccade_timer, self._frame_timer, self._walk_timer):
-            if timer is not None:
-                self.destroy_timer(timer)
-        self._saccade_timer = self._frame_timer = self._walk_timer = None
-        if self.moving:
-            self._arrive()
-        if values['saccade_time_s'] > 0:
-            self._saccade_timer = self.create_timer(values['saccade_time_s'],
-                                                    self.guard.wrap(self._on_arrival))
-            self._saccade_timer.cancel()
-        if values['rate_hz'] > 0:
-            self._frame_timer = self.create_timer(1.0 / values['rate_hz'],
-                                                  self.guard.wrap(self._publish_frame))
+        if self._walk_timer is not None:
+            self.destroy_timer(self._walk_timer)
+        self._walk_timer = None
+        self._make_saccade_timers(values)
         if values['target_motion_rate_hz'] > 0:
             self._walk_timer = self.create_timer(1.0 / values['target_motion_rate_hz'],
                                                  self.guard.wrap(self._walk))
 
     # -- head ------------------------------------------------------------------------------
     def _on_command(self, msg: JointState) -> None:
-        try:
-            pan, tilt = joints.angles_from_joint_state(msg, self._config.head)
-            cell = self._config.head.nearest_cell(pan, tilt)
-        except ValueError as exc:
-            self.get_logger().warning(f'ignored a pan_tilt command: {exc}',
-                                      throttle_duration_sec=5.0)
-            return
-        self._saccade_to(cell)
+        cell = self._commanded_cell(msg, self._config.head)
+        if cell is not None:
+            self._saccade_to(cell)
 
     def _arrived(self) -> None:
         if self._config.values['rate_hz'] == 0:

@@ -3,15 +3,56 @@
 """The simulated head's saccades, shared by ``simulated_camera`` and ``scene_camera``."""
 from __future__ import annotations
 
+from ipomdp_gaze.model.head_time import SACCADE_TIME_S
+from ipomdp_gaze.msg_adapters import joints
+
+from .params import Param, T
+
+
+def saccade_params(max_rate_hz: float) -> list[Param]:
+    """Return ``saccade_time_s`` and ``rate_hz`` (frames per second up to ``max_rate_hz``)."""
+    return [
+        Param('saccade_time_s', SACCADE_TIME_S, T.DOUBLE, 'time to move to a new cell',
+              float_range=(0.0, 60.0)),
+        Param('rate_hz', 0.0, T.DOUBLE,
+              'frames per second like a video camera (0: one frame per arrival)',
+              float_range=(0.0, float(max_rate_hz))),
+    ]
+
 
 class SaccadeMixin:
     """
-    Pose, goal and the saccade timer of a simulated pan/tilt head.
+    Pose, goal, the saccade and frame timers, and pan/tilt commands of a simulated head.
 
-    The node sets ``pose``, ``goal``, ``moving`` and ``_saccade_timer`` (None: saccades are
-    instantaneous; else a cancelled timer of the saccade time calling :meth:`_on_arrival`) and
-    implements :meth:`_arrived`, called when the head reaches its goal.
+    The node sets ``pose``, ``goal``, ``moving``, ``guard``, ``_saccade_timer`` and
+    ``_frame_timer`` (None until :meth:`_make_saccade_timers`), and implements
+    :meth:`_arrived` (the head reached its goal) and ``_publish_frame``.
     """
+
+    def _make_saccade_timers(self, values: dict) -> None:
+        """Rebuild the saccade timer (None: instantaneous) and the frame timer (``rate_hz``)."""
+        for timer in (self._saccade_timer, self._frame_timer):
+            if timer is not None:
+                self.destroy_timer(timer)
+        self._saccade_timer = self._frame_timer = None
+        if self.moving:
+            self._arrive()
+        if values['saccade_time_s'] > 0:
+            self._saccade_timer = self.create_timer(values['saccade_time_s'],
+                                                    self.guard.wrap(self._on_arrival))
+            self._saccade_timer.cancel()
+        if values['rate_hz'] > 0:
+            self._frame_timer = self.create_timer(1.0 / values['rate_hz'],
+                                                  self.guard.wrap(self._publish_frame))
+
+    def _commanded_cell(self, msg, head):
+        """Return the cell nearest a ``pan_tilt`` command, or None (warned, throttled)."""
+        try:
+            return head.nearest_cell(*joints.angles_from_joint_state(msg, head))
+        except ValueError as exc:
+            self.get_logger().warning(f'ignored a pan_tilt command: {exc}',
+                                      throttle_duration_sec=5.0)
+            return None
 
     def _saccade_to(self, goal: int) -> None:
         """Start a saccade to ``goal`` (a re-sent goal does not restart one under way)."""

@@ -32,7 +32,6 @@ import sys
 
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head_camera import PinholeCamera
-from ipomdp_gaze.model.head_time import SACCADE_TIME_S
 from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
 from ipomdp_gaze.search.controller_config import head_from
 from rclpy.node import Node
@@ -43,7 +42,7 @@ from std_msgs.msg import Int32MultiArray
 from . import NODE_NAMES
 from .guard import CallbackGuard
 from .params import INT_MAX, joint_params, MAX_CELLS_PER_SIDE, Param, ParameterTransaction, T
-from .saccade import SaccadeMixin
+from .saccade import saccade_params, SaccadeMixin
 from .spin import run_node
 
 NODE_NAME = NODE_NAMES['scene_camera']
@@ -96,13 +95,7 @@ def scene_camera_params() -> list[Param]:
               read_only=True, float_range=(1.0, 170.0)),
         Param('frame_id', 'camera', T.STRING, 'frame_id of image and camera_info',
               read_only=True),
-    ] + joint_params(limits=False) + [
-        Param('saccade_time_s', SACCADE_TIME_S, T.DOUBLE, 'time to move to a new cell',
-              float_range=(0.0, 60.0)),
-        Param('rate_hz', 0.0, T.DOUBLE,
-              'frames per second like a video camera (0: one frame per arrival)',
-              float_range=(0.0, 100.0)),
-    ]
+    ] + joint_params(limits=False) + saccade_params(max_rate_hz=100.0)
 
 
 @dataclass
@@ -214,33 +207,15 @@ class SceneCameraNode(SaccadeMixin, Node):
             self._make_timers(v)
 
     def _make_timers(self, values: dict) -> None:
-        for timer in (self._saccade_timer, self._frame_timer):
-            if timer is not None:
-                self.destroy_timer(timer)
-        self._saccade_timer = self._frame_timer = None
-        if self.moving:
-            self._arrive()
-        if values['saccade_time_s'] > 0:
-            self._saccade_timer = self.create_timer(values['saccade_time_s'],
-                                                    self.guard.wrap(self._on_arrival))
-            self._saccade_timer.cancel()
-        if values['rate_hz'] > 0:
-            self._frame_timer = self.create_timer(1.0 / values['rate_hz'],
-                                                  self.guard.wrap(self._publish_frame))
+        self._make_saccade_timers(values)
 
     # -- head ------------------------------------------------------------------------------
     def _on_command(self, msg: JointState) -> None:
         cfg = self._config
-        if cfg.head is None:
-            goal = self.pose                     # a fixed camera: the command triggers a frame
-        else:
-            try:
-                goal = cfg.head.nearest_cell(*joints.angles_from_joint_state(msg, cfg.head))
-            except ValueError as exc:
-                self.get_logger().warning(f'ignored a pan_tilt command: {exc}',
-                                          throttle_duration_sec=5.0)
-                return
-        self._saccade_to(goal)
+        # a fixed camera: the command triggers a frame
+        goal = self.pose if cfg.head is None else self._commanded_cell(msg, cfg.head)
+        if goal is not None:
+            self._saccade_to(goal)
 
     def _arrived(self) -> None:
         if self._config.values['rate_hz'] == 0:
