@@ -252,7 +252,8 @@ def annotate(image: np.ndarray, cell_map: CellMap, belief=None, fixations=(), wi
             x0, y0, x1, y1 = (int(v) for v in boxes[cell])
             cv2.rectangle(canvas, (x0 - 1, y0 - 1), (x1 + 1, y1 + 1), FOUND_RGB, thick + 1)
         row, col = grid.cell(cell)
-        _text(canvas, f'{found_label} ({row}, {col}) p={probability:.3f}',
+        p = 'n/a' if np.isnan(probability) else f'{probability:.3f}'
+        _text(canvas, f'{found_label} ({row}, {col}) p={p}',
               (4, height - int(6 + 8 * scale)), scale, FOUND_RGB, thick)
     if label:
         _text(canvas, label, (4, int(14 + 20 * scale)), scale, (255, 255, 255), thick)
