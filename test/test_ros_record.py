@@ -50,8 +50,9 @@ def _rosbags_topics(bag: Path) -> dict:
 
 
 def _found(out: str) -> tuple:
-    found = re.search(r'^found: the (?:target|face) is most likely at \((\d+), (\d+)\).*after '
-                      r'(\d+) fixations$', out, re.M)
+    found = re.search(r'^found(?:, forced by the fixation budget)?: the (?:target|face) is most '
+                      r'likely at \((\d+), (\d+)\).*after (\d+) fixations \((?:reached|below) '
+                      r'the confidence [\d.]+\)$', out, re.M)
     assert found, out
     return int(found.group(1)), int(found.group(2)), int(found.group(3))
 
