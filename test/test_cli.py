@@ -87,6 +87,16 @@ def test_search_prints_each_fixation(capsys):
     assert main(['search', '--grid', '5x5', '--target', '7', '--seed', '1']) == 0
     out = capsys.readouterr().out
     assert 'fixation   1: looked at' in out and 'found: the target is most likely at' in out
+    # Issue 35: one cell format, (row, col) as the demo writes it, and how the search ended.
+    assert re.search(r'^fixation   1: looked at \(\d+, \d+\)  most likely \(\d+, \d+\) p=',
+                     out, re.M), out
+    assert re.search(r'^found: the target is most likely at \(\d+, \d+\), probability '
+                     r'\d\.\d+, after \d+ fixations \(reached the confidence 0\.95\), which '
+                     r'is (right|wrong)$', out, re.M), out
+    assert main(['search', '--grid', '7x7', '--seed', '3', '--max-fixations', '2']) == 0
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert last.startswith('gave up: no cell reached the confidence 0.95 at the fixation '
+                           'budget; the target is most likely at (')
 
 
 @pytest.mark.parametrize('args, message', [

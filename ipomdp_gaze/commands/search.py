@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ipomdp_gaze import answer
 from ipomdp_gaze.observation import as_observation
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
 from ipomdp_gaze.sensors import ModelSensor
@@ -53,23 +54,31 @@ def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=
     sensor.start(target)
     session.reset(seed=rng)
     tr, tc = grid.cell(target)
-    out(f'target hidden at cell {target} (row {tr}, col {tc}) of a {grid.rows}x{grid.cols} grid')
+    out(f'target hidden at cell {target} ({tr}, {tc}) of a {grid.rows}x{grid.cols} grid')
     cell = session.start()
     while True:
         result = session.update(sensor.observe(cell))
         guess = result.map_cell
         kr, kc = grid.cell(session.path[-1])
         gr, gc = grid.cell(guess)
-        out(f'fixation {result.fixations:3d}: looked at ({kr},{kc})  most likely ({gr},{gc}) '
+        out(f'fixation {result.fixations:3d}: looked at ({kr}, {kc})  most likely ({gr}, {gc}) '
             f'p={result.map_probability:.3f}  entropy={session.entropy_nats:.2f} nats  '
             f"{'right' if guess == target else 'wrong'}")
         if result.ended:
             break
         cell = result.fixation
     verdict = 'right' if guess == target else 'wrong'
-    what = 'found' if result.decision == 'found' else 'gave up'
-    out(f'{what}: the target is most likely at ({gr},{gc}) after {result.fixations} fixations, '
-        f'which is {verdict}')
+    clause = answer.confidence_clause(result.decision, result.reason, result.map_probability,
+                                      settings.confidence)
+    if result.decision == 'gave_up':
+        out(f'gave up: no cell reached the confidence {settings.confidence:g} at '
+            f'{answer.LIMITS.get(result.reason, result.reason)}; the target is most likely at '
+            f'({gr}, {gc}), probability {result.map_probability:.3f}, after '
+            f'{result.fixations} fixations, which is {verdict}')
+    else:
+        out(f'{answer.heading(result.decision, result.reason)}: the target is most likely at '
+            f'({gr}, {gc}), probability {result.map_probability:.3f}, after '
+            f'{result.fixations} fixations{clause}, which is {verdict}')
     return guess, session.path, session.belief
 
 
