@@ -168,3 +168,12 @@ def test_explicit_zero_scene_options_change_no_number(tmp_path):
     for policy in b['policies'].values():
         assert policy.pop('decisions')['absent']['searches'] == 0
     assert json.dumps(a) == json.dumps(b)
+
+
+def test_demo_help_says_the_target_follows_the_seed(capsys):
+    """Issue 35: --help said the target is random; --seed 0 (the default) always hides (9, 7)."""
+    with pytest.raises(SystemExit):
+        main(['demo', '--help'])
+    out = ' '.join(capsys.readouterr().out.split())
+    assert '(default: random)' not in out
+    assert 'drawn from --seed, so the same cell for the same seed: (9, 7) for seed 0' in out

@@ -401,3 +401,19 @@ def test_a_drivers_limit_ends_the_search_as_the_budget_does():
         assert session.log[-1]['event'] == 'stop'
         with pytest.raises(OrderError):
             session.stop('pixels')
+
+
+def test_the_fixation_as_row_and_col():
+    """Issue 35: start() stays a row-major index; fixation_cell is the same cell as (row, col)."""
+    from ipomdp_gaze.fpoc import make_fpoc
+    from ipomdp_gaze.grid import Grid
+    from ipomdp_gaze.policies.registry import build_policy
+    from ipomdp_gaze.session import SearchSession
+    grid = Grid(5, 7)
+    fpoc = make_fpoc('human')
+    session = SearchSession(grid, fpoc, build_policy('elm', grid, fpoc))
+    session.reset(seed=0)
+    assert session.fixation_cell is None
+    cell = session.start()
+    assert isinstance(cell, int) and cell == grid.center_index
+    assert session.fixation_cell == (2, 3) == tuple(int(v) for v in grid.cell(cell))
