@@ -177,3 +177,13 @@ def test_demo_help_says_the_target_follows_the_seed(capsys):
     out = ' '.join(capsys.readouterr().out.split())
     assert '(default: random)' not in out
     assert 'drawn from --seed, so the same cell for the same seed: (9, 7) for seed 0' in out
+
+
+def test_search_plot_title_says_how_the_search_ended(monkeypatch, tmp_path):
+    import ipomdp_gaze.commands.search as search
+    titles = []
+    monkeypatch.setattr(search, 'plot_search', lambda *args: titles.append(args[4]))
+    assert main(['search', '--grid', '7x7', '--seed', '3', '--max-fixations', '2', '--plot',
+                 str(tmp_path / 's.png')]) == 0
+    assert re.fullmatch(r'7x7, human FPOC, elm: gave up at the fixation budget, p=0\.\d{3}, 2 '
+                        r'fixations \(star = target\)', titles[0]), titles

@@ -46,7 +46,7 @@ def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=
 
     The model's own sampler is the world (:class:`ipomdp_gaze.sensors.ModelSensor`); one
     generator, ``default_rng(seed)``, serves the policy and the noise. Returns ``(guess, path,
-    belief)``.
+    belief, result)`` (``result``: the last :class:`ipomdp_gaze.session.StepResult`).
     """
     rng = np.random.default_rng(seed)
     session = SearchSession(grid, model, policy, settings)
@@ -79,7 +79,7 @@ def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=
         out(f'{answer.heading(result.decision, result.reason)}: the target is most likely at '
             f'({gr}, {gc}), probability {result.map_probability:.3f}, after '
             f'{result.fixations} fixations{clause}, which is {verdict}')
-    return guess, session.path, session.belief
+    return guess, session.path, session.belief, result
 
 
 def plot_search(grid, belief, path, target, title, out_path):
@@ -119,13 +119,16 @@ def run(args) -> int:
     rng = np.random.default_rng([args.seed, 1])
     target = int(rng.integers(grid.n_cells)) if args.target is None else \
         cell_index(args.target, grid, '--target')
-    guess, path, belief = run_search(grid, as_observation(grid, fpoc), policy, target,
-                                     settings, args.seed)
+    guess, path, belief, result = run_search(grid, as_observation(grid, fpoc), policy, target,
+                                             settings, args.seed)
     if args.plot:
         name = args.policy_file or args.policy
         task = f'{fpoc.model} FPOC' if args.observation is None else args.observation
-        title = (f'{grid.rows}x{grid.cols}, {task}, {name}: '
-                 f'{len(path)} fixations (star = target)')
+        ending = answer.heading(result.decision, result.reason)
+        if result.decision == 'gave_up':
+            ending += f' at {answer.LIMITS.get(result.reason, result.reason)}'
+        title = (f'{grid.rows}x{grid.cols}, {task}, {name}: {ending}, '
+                 f'p={result.map_probability:.3f}, {len(path)} fixations (star = target)')
         plot_search(grid, belief, path, target, title, args.plot)
         print(f'wrote {args.plot}')
     return 0
