@@ -94,3 +94,18 @@ def test_the_gaussian_demo_shows_no_absent_probability():
     assert 'nobody' not in lines[0] and '->  most likely (9, 7) p=0.990  entropy' in lines[0]
     assert lines[1].startswith('found: the target is most likely at (9, 7), pan')
     assert lines[1].endswith('(reached the confidence 0.95)')
+
+
+def test_the_detectors_picture_labels_a_forced_answer():
+    """The annotated image calls a found the fixation budget forced ``found, forced``."""
+    from ipomdp_gaze.msg_adapters import diagnostics
+    from ipomdp_gaze.nodes.annotation import Annotator
+    node = SimpleNamespace(create_publisher=lambda *a: None,
+                           create_subscription=lambda *a: None)
+    annotator = Annotator(node)
+    annotator._publish = lambda: None
+    annotator._on_found(diagnostics.found_status('c: found', 1, 2, 13, 0.0, 0.0, 0.6, 20,
+                                                 'budget', 0.99))
+    assert annotator.found == (13, 0.6) and annotator.found_label == 'found, forced'
+    annotator._on_found(diagnostics.found_status('c: found', 1, 2, 13, 0.0, 0.0, 0.999, 4))
+    assert annotator.found_label == 'found'

@@ -294,15 +294,17 @@ def _pictures(setup: DemoSetup, record: SearchRecord, annotated: list, stats: di
     looked = [head.nearest_cell(*joints.angles_from_joint_state(msg, head))
               for _, msg in record.targets[:n]]
     canvas, cell_map = grid_canvas(grid, 40)
+    label = 'most likely'
+    if stats.get('stop') == 'found':
+        label = 'found, forced' if str(stats.get('ended', '')).startswith('forced:') \
+            else 'found'
     frames = []
     for i in range(n):
         belief = grid_arrays.from_multiarray(record.beliefs[i][1], grid)
         found = (stats['cell'], stats['probability']) if i == n - 1 and 'cell' in stats \
             else None
         frames.append(annotate(canvas, cell_map, belief, looked[:i + 1], found=found,
-                               label=f'fixation {i + 1}',
-                               found_label='found' if stats.get('stop') == 'found'
-                               else 'most likely'))
+                               label=f'fixation {i + 1}', found_label=label))
     return frames
 
 
