@@ -352,7 +352,7 @@ def describe_size(bag) -> str:
 
     The rate is extrapolated only from at least :data:`MIN_RATE_S` seconds and
     :data:`MIN_RATE_FRAMES` frames; a shorter search says so instead (0.6 s of frames once gave
-    749.1 MB per minute).
+    749.1 MB per minute) and gives the size per minute of the whole recording.
     """
     seconds, per_minute = search_rate(bag)
     frames = _search_frames(bag)
@@ -360,8 +360,9 @@ def describe_size(bag) -> str:
         rate = 'fewer than two frames'
     elif seconds < MIN_RATE_S or len(frames) < MIN_RATE_FRAMES:
         rate = (f'{len(frames)} frames over {seconds:.1f} s: too short a search to '
-                f'extrapolate MB per minute (at least {MIN_RATE_FRAMES} frames over '
-                f'{MIN_RATE_S:g} s)')
+                f'extrapolate MB per minute of search (at least {MIN_RATE_FRAMES} frames over '
+                f'{MIN_RATE_S:g} s); {bag.megabytes_per_minute:.1f} MB per minute of '
+                f'recording')
     else:
         rate = f'{per_minute:.1f} MB per minute of search (over {seconds:.1f} s of frames)'
     return f'{bag.size_bytes / 1e6:.2f} MB, {bag.duration_s:.1f} s recorded; {rate}'

@@ -73,8 +73,9 @@ def test_the_rate_per_minute_is_not_extrapolated_from_a_short_search():
     short = [_belief(True, 0.0)] + [_frame(0.1 + 0.15 * i, 1_000_000) for i in range(5)]
     bag = Bag(Path('bag'), short, {}, 5_000_000, 0.8)
     text = describe_size(bag)
-    assert 'MB per minute of search' not in text, text
-    assert '5 frames over 0.8 s: too short a search to extrapolate MB per minute' in text
+    assert 'MB per minute of search (over' not in text, text
+    assert '5 frames over 0.8 s: too short a search to extrapolate MB per minute of search' \
+        in text and '375.0 MB per minute of recording' in text
     long = [_belief(True, 0.0)] + [_frame(0.5 * i, 1_000_000) for i in range(1, 11)]
     text = describe_size(Bag(Path('bag'), long, {}, 10_000_000, 5.0))
     assert '120.0 MB per minute of search (over 5.0 s of frames)' in text
