@@ -64,14 +64,18 @@ def _ending(forced_by: str, confidence: float | None) -> tuple[str, dict]:
 
 def found_status(name: str, row: int, col: int, cell: int, pan_rad: float, tilt_rad: float,
                  probability: float, fixations: int, forced_by: str = '',
-                 confidence: float | None = None) -> DiagnosticStatus:
+                 confidence: float | None = None, radius: int = 0) -> DiagnosticStatus:
     """
     Build the ``found`` event.
 
     ``ended`` (``confidence``, or ``forced:budget`` when the fixation budget forced it with
-    ``search.decide_at_budget``) and ``confidence`` say how it was reached.
+    ``search.decide_at_budget``) and ``confidence`` say how it was reached; ``radius`` (only
+    when > 0) that the answer is the centre of the likeliest square of that radius
+    (``search.found_radius``), whose belief is ``probability``.
     """
     clause, ending = _ending(forced_by, confidence)
+    if radius:
+        ending['radius'] = int(radius)
     message = (f'target found at row {row}, col {col} (pan {pan_rad:+.4f} rad, tilt '
                f'{tilt_rad:+.4f} rad) with probability {probability:.4f} after {fixations} '
                f'fixations{clause}')
@@ -109,6 +113,8 @@ def _with_ending(msg: DiagnosticStatus, values: dict) -> dict:
     """Add ``ended`` ('confidence' for an event that does not say) and ``confidence`` (None)."""
     kv = values_of(msg)
     values['ended'] = kv.get('ended', 'confidence')
+    if 'cell' in values:
+        values['radius'] = int(kv.get('radius', 0))
     values['confidence'] = float(kv['confidence']) if 'confidence' in kv else None
     return values
 

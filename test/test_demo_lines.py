@@ -107,5 +107,6 @@ def test_the_detectors_picture_labels_a_forced_answer():
     annotator._on_found(diagnostics.found_status('c: found', 1, 2, 13, 0.0, 0.0, 0.6, 20,
                                                  'budget', 0.99))
     assert annotator.found == (13, 0.6) and annotator.found_label == 'found, forced'
-    annotator._on_found(diagnostics.found_status('c: found', 1, 2, 13, 0.0, 0.0, 0.999, 4))
-    assert annotator.found_label == 'found'
+    annotator._on_found(diagnostics.found_status('c: found', 1, 2, 13, 0.0, 0.0, 0.999, 4,
+                                                 radius=1))
+    assert annotator.found_label == 'found' and annotator.found_radius == 1

@@ -189,7 +189,7 @@ def test_found_event_round_trip():
     assert 'row 3, col 7' in msg.message
     assert diagnostics.parse_found(msg) == {
         'row': 3, 'col': 7, 'cell': 40, 'fixations': 6, 'pan_rad': 0.1, 'tilt_rad': -0.2,
-        'probability': 0.9734, 'ended': 'confidence', 'confidence': None}
+        'probability': 0.9734, 'ended': 'confidence', 'confidence': None, 'radius': 0}
     # Issue 35: a decision the fixation budget forced says so, with the confidence it missed.
     forced = diagnostics.found_status('/gaze_controller: found', 3, 7, 40, 0.1, -0.2, 0.62, 20,
                                       'budget', 0.95)

@@ -494,7 +494,8 @@ class GazeControllerNode(Node):
             pan, tilt = self._config.head.angles(found.cell)
             self._event_pubs['found'].publish(diagnostics.found_status(
                 f'{name}: found', row, col, found.cell, pan, tilt, found.probability,
-                found.fixations, found.forced_by, confidence))
+                found.fixations, found.forced_by, confidence,
+                0 if self.core.settings.moving else self.core.settings.found_radius))
             clause = answer.confidence_clause('found', found.forced_by, found.probability,
                                               confidence)
             self.get_logger().info(
