@@ -88,7 +88,7 @@ def test_search_prints_each_fixation(capsys):
     out = capsys.readouterr().out
     assert 'fixation   1: looked at' in out and 'found: the target is most likely at' in out
     # Issue 35: one cell format, (row, col) as the demo writes it, and how the search ended.
-    assert re.search(r'^fixation   1: looked at \(\d+, \d+\)  most likely \(\d+, \d+\) p=',
+    assert re.search(r'^fixation   1: looked at \(\d+, \d+\)  ->  most likely \(\d+, \d+\) p=',
                      out, re.M), out
     assert re.search(r'^found: the target is most likely at \(\d+, \d+\), probability '
                      r'\d\.\d+, after \d+ fixations \(reached the confidence 0\.95\), which '

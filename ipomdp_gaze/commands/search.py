@@ -61,8 +61,8 @@ def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=
         guess = result.map_cell
         kr, kc = grid.cell(session.path[-1])
         gr, gc = grid.cell(guess)
-        out(f'fixation {result.fixations:3d}: looked at ({kr}, {kc})  most likely ({gr}, {gc}) '
-            f'p={result.map_probability:.3f}  entropy={session.entropy_nats:.2f} nats  '
+        out(f'fixation {result.fixations:3d}: looked at ({kr}, {kc})  ->  most likely ({gr}, '
+            f'{gc}) p={result.map_probability:.3f}  entropy {session.entropy_nats:.2f} nats  '
             f"{'right' if guess == target else 'wrong'}")
         if result.ended:
             break
