@@ -205,3 +205,14 @@ def test_find_refuses_a_model_of_another_detector(images):
     assert result.stderr.strip() == ('ipomdp-gaze find: error: --observation faces-420 was '
                                      "calibrated with the detector 'haar', not --detector "
                                      "'yunet'")
+
+
+def test_a_large_16_bit_png_is_converted_with_its_note_and_resized(tmp_path):
+    from ipomdp_gaze.commands.find import read_image
+    path = tmp_path / 'large16.png'
+    cv2.imwrite(str(path), np.full((1200, 1600), 30000, np.uint16))
+    notes, size = [], []
+    image = read_image(str(path), notes, 300, size)
+    assert size == [(1600, 1200)] and image.shape == (225, 300) and image.dtype == np.uint8
+    assert int(image[0, 0]) == round(30000 / 257)
+    assert notes == [f'{path}: 16-bit image converted to 8 bits per channel (divided by 257)']

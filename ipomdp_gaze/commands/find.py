@@ -200,7 +200,8 @@ def _read_flags(file: Path, max_side: int) -> tuple[int, tuple | None]:
 
     OpenCV decodes a colour JPEG through a second full-size buffer (an 8000x6000 photo: 280 MB);
     ``IMREAD_REDUCED_COLOR_<k>`` decodes it at 1/k instead (libjpeg scales while decoding), for
-    the largest k of 8, 4, 2 that keeps the longer side at least ``max_side``. The size comes
+    the largest k of 8, 4, 2 that keeps the longer side at least ``max_side``. Other formats
+    are decoded whole (and a 16-bit one converted with its note), then resized. The size comes
     from the file's header (Pillow, which reads no pixels) and is returned with the flags
     (None when the decode is not reduced); a file Pillow cannot read is decoded whole.
     """
@@ -209,8 +210,10 @@ def _read_flags(file: Path, max_side: int) -> tuple[int, tuple | None]:
     try:
         from PIL import Image
         with Image.open(file) as header:
-            size = tuple(int(v) for v in header.size)
+            size, kind = tuple(int(v) for v in header.size), header.format
     except Exception:           # noqa: B902 (any failure: OpenCV decodes it, or says why)
+        return READ_FLAGS, None
+    if kind != 'JPEG':          # only libjpeg scales while decoding; 16-bit PNGs keep depth
         return READ_FLAGS, None
     for k, flag in ((8, cv2.IMREAD_REDUCED_COLOR_8), (4, cv2.IMREAD_REDUCED_COLOR_4),
                     (2, cv2.IMREAD_REDUCED_COLOR_2)):
