@@ -216,3 +216,14 @@ def test_a_large_16_bit_png_is_converted_with_its_note_and_resized(tmp_path):
     assert size == [(1600, 1200)] and image.shape == (225, 300) and image.dtype == np.uint8
     assert int(image[0, 0]) == round(30000 / 257)
     assert notes == [f'{path}: 16-bit image converted to 8 bits per channel (divided by 257)']
+
+
+def test_calibrate_reads_a_corrupt_image_without_libpngs_lines(images, tmp_path, capfd):
+    """The labelled images of calibrate --images go through the same quiet decoder."""
+    from ipomdp_gaze.vision.scenes import _read_image
+    path = tmp_path / 'corrupt.png'
+    path.write_bytes(images['astronaut'].read_bytes()[:20000])
+    capfd.readouterr()
+    with pytest.raises(ValueError, match=f'labels.csv:2: cannot decode {path} as an image'):
+        _read_image(path, 'labels.csv:2')
+    assert capfd.readouterr().err == ''

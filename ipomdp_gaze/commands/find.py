@@ -51,11 +51,9 @@ whose ``observation.name`` is the model's name), else ELM on the model, acting b
 """
 from __future__ import annotations
 
-from contextlib import contextmanager
 from dataclasses import replace
 import json
 import math
-import os
 from pathlib import Path
 import sys
 
@@ -66,6 +64,7 @@ from ipomdp_gaze.observation_file import load_observation, shipped_image_models
 from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
 from ipomdp_gaze.vision.detectors import load_factory
+from ipomdp_gaze.vision.image_files import decode_quietly
 from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, FIND_SETTINGS,
                                        fovea_for_model, full_frame_reason, full_frame_search,
                                        search_all, search_image, size_distance)
@@ -156,42 +155,6 @@ def add_parser(sub):
     p.add_argument('--seed', type=nonneg_int, default=0, metavar='S',
                    help='seed of a sampling policy (image i uses default_rng([S, i]))')
     p.set_defaults(run=run)
-
-
-@contextmanager
-def _quiet_fd(fd: int = 2):
-    """Send what C code writes to file descriptor ``fd`` (stderr) to /dev/null meanwhile."""
-    try:
-        saved = os.dup(fd)
-    except OSError:                      # no such descriptor: nothing to silence
-        yield
-        return
-    try:
-        sys.stderr.flush()
-        with open(os.devnull, 'wb') as null:
-            os.dup2(null.fileno(), fd)
-        yield
-    finally:
-        os.dup2(saved, fd)
-        os.close(saved)
-
-
-def decode_quietly(data: np.ndarray, flags: int = READ_FLAGS):
-    """
-    ``cv2.imdecode`` with OpenCV's and libpng's own messages silenced (None if it fails).
-
-    A corrupt file makes libpng and OpenCV print their own lines (``libpng error: PNG input
-    buffer is incomplete``, ``[ERROR:0@...] global grfmt_png.cpp ...``) on stderr before our
-    one-line message says the same; libpng writes to the file descriptor itself, so that is
-    redirected for the call.
-    """
-    level = cv2.utils.logging.getLogLevel()
-    cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_SILENT)
-    try:
-        with _quiet_fd(2):
-            return cv2.imdecode(data, flags)
-    finally:
-        cv2.utils.logging.setLogLevel(level)
 
 
 def _read_flags(file: Path, max_side: int) -> tuple[int, tuple | None]:
