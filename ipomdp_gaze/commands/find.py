@@ -516,9 +516,9 @@ def run(args) -> int:
     for i, path in enumerate(images):
         notes = []
         try:
-            given = []
-            image = read_image(path, notes, args.max_side, given)
-            given = given[0]
+            sizes = []                          # the decoded size, before --max-side
+            image = read_image(path, notes, args.max_side, sizes)
+            given = sizes[0]
             scale = (given[0] / image.shape[1], given[1] / image.shape[0])
             if scale != (1.0, 1.0):
                 notes.append(f'{path}: resized from {given[0]}x{given[1]} to '
