@@ -2,10 +2,26 @@
 # SPDX-License-Identifier: Apache-2.0
 """Install ipomdp_gaze: an ament_python ROS 2 package that is also a plain pip package."""
 from glob import glob
+import sys
 
 from setuptools import find_packages, setup
 
 PACKAGE = 'ipomdp_gaze'
+# The nodes' executables, for `ros2 run ipomdp_gaze <name>` and the launch files. colcon builds
+# the package with `setup.py install` (or `develop` for --symlink-install), which puts console
+# scripts in lib/ipomdp_gaze (setup.cfg), where `ros2 run` looks. pip builds a wheel instead,
+# whose console scripts land on the user's PATH: there generic names such as `camera` or
+# `controller` would clash with other programs, so a pip install gets `ipomdp-gaze` only, whose
+# subcommands (`ipomdp-gaze controller --ros-args ...`, `camera`, `detector`, `scene_camera`,
+# `record`) run the same nodes.
+NODE_SCRIPTS = [
+    'controller = ipomdp_gaze.nodes.controller:main',
+    'camera = ipomdp_gaze.nodes.camera:main',
+    'detector = ipomdp_gaze.nodes.detector:main',
+    'scene_camera = ipomdp_gaze.nodes.scene_camera:main',
+    'recorder = ipomdp_gaze.nodes.recorder:main',
+]
+ROS_INSTALL = bool({'install', 'develop'} & set(sys.argv[1:]))
 
 setup(
     name=PACKAGE,
@@ -52,14 +68,8 @@ setup(
     description='I-POMDP infomax gaze control (Butko & Movellan 2008) for ROS 2 pan/tilt heads',
     license='Apache-2.0',
     entry_points={
-        'console_scripts': [
-            'ipomdp-gaze = ipomdp_gaze.cli:main',
-            'controller = ipomdp_gaze.nodes.controller:main',
-            'camera = ipomdp_gaze.nodes.camera:main',
-            'detector = ipomdp_gaze.nodes.detector:main',
-            'scene_camera = ipomdp_gaze.nodes.scene_camera:main',
-            'recorder = ipomdp_gaze.nodes.recorder:main',
-        ],
+        'console_scripts': ['ipomdp-gaze = ipomdp_gaze.cli:main',
+                            *(NODE_SCRIPTS if ROS_INSTALL else [])],
         # Detectors by name (ipomdp_gaze.vision.detectors); other packages may add their own.
         'ipomdp_gaze.detectors': [
             'haar = ipomdp_gaze.vision.detector:HaarDetector',

@@ -24,7 +24,7 @@ MOVED = {
         'grid', 'fpoc', 'observation', 'belief', 'motion', 'stopping', 'false_alarms', 'checks',
         'still_evidence', 'inhibition', 'head', 'head_camera')},
     **{name: f'search.{name}' for name in (
-        'session', 'sensors', 'settings', 'gaze', 'health', 'controller_config')},
+        'session', 'sensors', 'settings', 'gaze', 'health', 'controller_config', 'answer')},
     **{name: f'simulation.{name}' for name in (
         'simulate', 'evaluation', 'gym', 'executor', 'progress')},
     **{name: f'files.{name}' for name in (

@@ -48,23 +48,51 @@ def values_of(msg: DiagnosticStatus) -> dict:
     return {kv.key: kv.value for kv in msg.values}
 
 
+def _ending(forced_by: str, confidence: float | None) -> tuple[str, dict]:
+    """Return the message's clause and the values that say how a decision was reached."""
+    values = {'ended': f'forced:{forced_by}' if forced_by else 'confidence'}
+    if confidence is not None:
+        values['confidence'] = float(confidence)
+    limit = {'budget': 'the fixation budget'}.get(forced_by, forced_by)
+    if forced_by:
+        below = f' below the confidence {confidence:g}' if confidence is not None else ''
+        clause = f', forced by {limit}{below}'
+    else:
+        clause = f' (reached the confidence {confidence:g})' if confidence is not None else ''
+    return clause, values
+
+
 def found_status(name: str, row: int, col: int, cell: int, pan_rad: float, tilt_rad: float,
-                 probability: float, fixations: int) -> DiagnosticStatus:
-    """Build the ``found`` event."""
+                 probability: float, fixations: int, forced_by: str = '',
+                 confidence: float | None = None, radius: int = 0) -> DiagnosticStatus:
+    """
+    Build the ``found`` event.
+
+    ``ended`` (``confidence``, or ``forced:budget`` when the fixation budget forced it with
+    ``search.decide_at_budget``) and ``confidence`` say how it was reached; ``radius`` (only
+    when > 0) that the answer is the centre of the likeliest square of that radius
+    (``search.found_radius``), whose belief is ``probability``.
+    """
+    clause, ending = _ending(forced_by, confidence)
+    if radius:
+        ending['radius'] = int(radius)
     message = (f'target found at row {row}, col {col} (pan {pan_rad:+.4f} rad, tilt '
                f'{tilt_rad:+.4f} rad) with probability {probability:.4f} after {fixations} '
-               f'fixations')
+               f'fixations{clause}')
     return status(name, 'ok', message, {
         'row': row, 'col': col, 'cell': cell, 'pan_rad': float(pan_rad),
-        'tilt_rad': float(tilt_rad), 'probability': float(probability), 'fixations': fixations})
+        'tilt_rad': float(tilt_rad), 'probability': float(probability), 'fixations': fixations,
+        **ending})
 
 
-def absent_status(name: str, probability: float, fixations: int) -> DiagnosticStatus:
-    """Build the ``absent`` event: ``P(absent)`` reached the confidence level."""
-    message = (f'no target in the grid: probability {probability:.4f} after {fixations} '
-               f'fixations')
+def absent_status(name: str, probability: float, fixations: int, forced_by: str = '',
+                  confidence: float | None = None) -> DiagnosticStatus:
+    """Build the ``absent`` event: ``P(absent)`` reached the confidence (or was forced)."""
+    clause, ending = _ending(forced_by, confidence)
+    message = (f'no target in the grid: probability {probability:.4f} that nobody is there '
+               f'after {fixations} fixations{clause}')
     return status(name, 'ok', message, {'probability': float(probability),
-                                        'fixations': fixations})
+                                        'fixations': fixations, **ending})
 
 
 def gave_up_status(name: str, fixations: int) -> DiagnosticStatus:
@@ -81,9 +109,21 @@ def _parse(msg: DiagnosticStatus, event: str, keys, ints) -> dict:
     return {k: int(kv[k]) if k in ints else float(kv[k]) for k in keys}
 
 
+def _with_ending(msg: DiagnosticStatus, values: dict) -> dict:
+    """Add ``ended`` ('confidence' for an event that does not say) and ``confidence`` (None)."""
+    kv = values_of(msg)
+    values['ended'] = kv.get('ended', 'confidence')
+    if 'cell' in values:
+        values['radius'] = int(kv.get('radius', 0))
+    values['confidence'] = float(kv['confidence']) if 'confidence' in kv else None
+    return values
+
+
 def parse_found(msg: DiagnosticStatus) -> dict:
     """
     Read a ``found`` event (row, col, cell and fixations as int, the rest as float).
+
+    ``ended`` and ``confidence`` are added ('confidence' and None for an event without them).
 
     Raises
     ------
@@ -91,12 +131,13 @@ def parse_found(msg: DiagnosticStatus) -> dict:
         If a key is missing or not a number.
 
     """
-    return _parse(msg, 'found', FOUND_KEYS, ('row', 'col', 'cell', 'fixations'))
+    return _with_ending(msg, _parse(msg, 'found', FOUND_KEYS, ('row', 'col', 'cell',
+                                                               'fixations')))
 
 
 def parse_absent(msg: DiagnosticStatus) -> dict:
-    """Read an ``absent`` event (probability as float, fixations as int); ValueError if bad."""
-    return _parse(msg, 'absent', ABSENT_KEYS, ('fixations',))
+    """Read an ``absent`` event (as :func:`parse_found`); ValueError if bad."""
+    return _with_ending(msg, _parse(msg, 'absent', ABSENT_KEYS, ('fixations',)))
 
 
 def parse_gave_up(msg: DiagnosticStatus) -> dict:

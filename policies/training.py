@@ -391,7 +391,10 @@ class Trainer:
     def run(self, epochs: int, progress=False,
             callback: Callable[[dict], None] | None = None) -> list[dict]:
         """
-        Train ``epochs`` more epochs; every ``eval_every`` epochs append a learning-curve row.
+        Train ``epochs`` more epochs, with a learning-curve row every ``eval_every`` epochs.
+
+        A row is added after the last epoch too, so that a run shorter than ``eval_every`` (or
+        not a multiple of it) still ends its curve with an evaluation.
 
         A row is ``{epoch, episodes, mean_return, fixations_to_90, wall_seconds}``: the mean
         return (sum of the unscaled rewards of an episode, sampled policy) over the epochs since
@@ -412,22 +415,28 @@ class Trainer:
         returns = []
         f90_text = '-'
         start = time.perf_counter()
+
+        def add_row():
+            nonlocal returns, f90_text, start
+            self.wall_seconds += time.perf_counter() - start
+            f90 = self.evaluate()
+            row = {'epoch': self.epoch, 'episodes': self.epoch * cfg.episodes_per_epoch,
+                   'mean_return': float(np.mean(returns)), 'fixations_to_90': f90,
+                   'wall_seconds': round(self.wall_seconds, 3)}
+            self.curve.append(row)
+            returns = []
+            f90_text = 'never' if f90 is None else f'{f90:.2f}'
+            if callback is not None:
+                callback(row)
+            start = time.perf_counter()
         try:
-            for _ in range(epochs):
+            for i in range(epochs):
                 returns.append(float(self.step().returns.mean()))
                 last_return = returns[-1]
-                if self.epoch % cfg.eval_every == 0:
-                    self.wall_seconds += time.perf_counter() - start
-                    f90 = self.evaluate()
-                    row = {'epoch': self.epoch, 'episodes': self.epoch * cfg.episodes_per_epoch,
-                           'mean_return': float(np.mean(returns)), 'fixations_to_90': f90,
-                           'wall_seconds': round(self.wall_seconds, 3)}
-                    self.curve.append(row)
-                    returns = []
-                    f90_text = 'never' if f90 is None else f'{f90:.2f}'
-                    if callback is not None:
-                        callback(row)
-                    start = time.perf_counter()
+                # Every eval_every epochs, and after the last one: a run shorter than
+                # eval_every (or not a multiple of it) still ends its curve with an evaluation.
+                if self.epoch % cfg.eval_every == 0 or i == epochs - 1:
+                    add_row()
                 if bar is not None:
                     bar.note(f'epoch {self.epoch}, return {last_return:.3f}, '
                              f'fix->90% {f90_text}')

@@ -86,6 +86,18 @@ def test_fixations_detections_windows_and_the_answer_are_drawn_where_they_belong
     assert not np.array_equal(centre, plain[210, 210])
 
 
+def test_an_answer_with_a_found_radius_outlines_its_square():
+    """Issue 35: the answer is the likeliest square's centre; the square is drawn around it."""
+    canvas, cell_map = grid_canvas(GRID, 20)
+    boxes = cell_map.cell_boxes()
+    above = boxes[GRID.index(9, 10)]             # a cell of the square, above the answer
+    x = int((above[0] + above[2]) / 2)
+    alone = annotate(canvas, cell_map, found=(GRID.index(10, 10), 0.99))
+    square = annotate(canvas, cell_map, found=(GRID.index(10, 10), 0.99), found_radius=1)
+    top = int(boxes[GRID.index(9, 10)][1])
+    assert tuple(square[top, x]) == (0, 255, 0) and tuple(alone[top, x]) != (0, 255, 0)
+
+
 @pytest.mark.parametrize('kwargs, message', [
     ({'belief': np.ones(5)}, 'belief has 5 cells, the grid 441'),
     ({'image': np.zeros((10, 10), np.uint8)}, 'the image is 10x10 px but the cell map is for'),

@@ -87,6 +87,16 @@ def test_search_prints_each_fixation(capsys):
     assert main(['search', '--grid', '5x5', '--target', '7', '--seed', '1']) == 0
     out = capsys.readouterr().out
     assert 'fixation   1: looked at' in out and 'found: the target is most likely at' in out
+    # Issue 35: one cell format, (row, col) as the demo writes it, and how the search ended.
+    assert re.search(r'^fixation   1: looked at \(\d+, \d+\)  ->  most likely \(\d+, \d+\) p=',
+                     out, re.M), out
+    assert re.search(r'^found: the target is most likely at \(\d+, \d+\), probability '
+                     r'\d\.\d+, after \d+ fixations \(reached the confidence 0\.95\), which '
+                     r'is (right|wrong)$', out, re.M), out
+    assert main(['search', '--grid', '7x7', '--seed', '3', '--max-fixations', '2']) == 0
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert last.startswith('gave up: no cell reached the confidence 0.95 at the fixation '
+                           'budget; the target is most likely at (')
 
 
 @pytest.mark.parametrize('args, message', [
@@ -164,3 +174,22 @@ def test_explicit_zero_scene_options_change_no_number(tmp_path):
     for policy in b['policies'].values():
         assert policy.pop('decisions')['absent']['searches'] == 0
     assert json.dumps(a) == json.dumps(b)
+
+
+def test_demo_help_says_the_target_follows_the_seed(capsys):
+    """Issue 35: --help said the target is random; --seed 0 (the default) always hides (9, 7)."""
+    with pytest.raises(SystemExit):
+        main(['demo', '--help'])
+    out = ' '.join(capsys.readouterr().out.split())
+    assert '(default: random)' not in out
+    assert 'drawn from --seed, so the same cell for the same seed: (9, 7) for seed 0' in out
+
+
+def test_search_plot_title_says_how_the_search_ended(monkeypatch, tmp_path):
+    import ipomdp_gaze.commands.search as search
+    titles = []
+    monkeypatch.setattr(search, 'plot_search', lambda *args: titles.append(args[4]))
+    assert main(['search', '--grid', '7x7', '--seed', '3', '--max-fixations', '2', '--plot',
+                 str(tmp_path / 's.png')]) == 0
+    assert re.fullmatch(r'7x7, human FPOC, elm: gave up at the fixation budget, p=0\.\d{3}, 2 '
+                        r'fixations \(star = target\)', titles[0]), titles

@@ -157,6 +157,16 @@ def test_an_outside_detector_is_calibrated_with_score_bins_and_found_by_find(
                 '--json', str(tmp_path / 'found.json')]) == 0
     found = json.loads((tmp_path / 'found.json').read_text())['images'][0]
     assert found['cell'] == [2, 4]
+    # find --detector takes the plug-in by its name and searches with its calibrated model
+    # (today: refused, "choose from 'yunet', 'haar'"); without a model it says how to make one.
+    assert cli(['find', str(path), '--detector', KINDS[how], '--observation', str(out),
+                '--policy', 'elm', '--json', str(tmp_path / 'named.json')]) == 0
+    assert json.loads((tmp_path / 'named.json').read_text())['images'][0]['cell'] == [2, 4]
+    capsys.readouterr()
+    assert cli(['find', str(path), '--detector', KINDS[how]]) == 2
+    err = capsys.readouterr().err
+    assert f'calibrate one on labelled images, ipomdp-gaze calibrate --images DIR --labels ' \
+        f'faces.csv --detector {KINDS[how]} --out model.yaml' in err
 
 
 def test_an_unknown_detector_in_calibrate_is_one_line(tmp_path, capsys):

@@ -22,8 +22,8 @@ GRID = Grid(21, 21)
 TASK = {'size_px': 420, 'face_px': (60, 140), 'grid': (21, 21)}
 TRAIN_SCENES = 8
 JSON_KEYS = ['path', 'cell', 'pixel', 'probability', 'fixations', 'detector_pixels',
-             'full_scan_pixels', 'seconds', 'decision', 'absent_probability', 'stop', 'method',
-             'note', 'grid']
+             'full_scan_pixels', 'seconds', 'decision', 'ended', 'confidence', 'map_probability',
+             'absent_probability', 'stop', 'method', 'note', 'resized_from', 'grid']
 
 
 def run_find(*args, cwd=None):
@@ -97,7 +97,8 @@ def test_find_locates_the_face_of_a_test_scene(task, tmp_path):
     assert result.returncode == 0, result.stderr
     lines = result.stdout.strip().splitlines()
     assert len(lines) == 1
-    assert lines[0].startswith(f"{task['images'][0]}: decision=found cell (row, col)=(")
+    assert lines[0].startswith(f"{task['images'][0]}: decision=found ended=confidence "
+                               'cell (row, col)=(')
     for word in ('pixel (x, y)=(', 'p=', 'fixations=', 'detector_pixels=', 'seconds='):
         assert word in lines[0]
     assert 'observation model faces-test' in result.stderr and 'policy elm' in result.stderr
@@ -207,7 +208,9 @@ def test_default_policy_is_the_shipped_kernel_of_the_model(task, tmp_path, monke
 @pytest.mark.parametrize('make, message', [
     (lambda d: d / 'missing.png', 'no such file'),
     (lambda d: _write(d / 'text.png', b'not an image'), 'not an image OpenCV can decode'),
-    (lambda d: _png(d / 'deep.png', np.zeros((420, 420), dtype=np.uint16)), '16-bit'),
+    # 16-bit images are converted (test_find_truth.py); a float image is still refused.
+    (lambda d: _png(d / 'deep.tiff', np.zeros((420, 420), dtype=np.float32)),
+     '32-bit float32 image; find needs 8 or 16 bits per channel'),
     (lambda d: _png(d / 'dot.png', np.zeros((1, 1), dtype=np.uint8)), 'too small'),
 ])
 def test_a_bad_image_is_one_error_line_and_the_others_are_searched(task, tmp_path, make,

@@ -68,7 +68,7 @@ def test_search_takes_row_col_and_still_a_flat_index():
     by_cell = run_cli('search', '--target', '3,4', '--seed', '1', '--max-fixations', '3')
     by_index = run_cli('search', '--target', '25', '--seed', '1', '--max-fixations', '3')
     assert by_cell.returncode == by_index.returncode == 0
-    assert 'target hidden at cell 25 (row 3, col 4)' in by_cell.stdout
+    assert 'target hidden at cell 25 (3, 4)' in by_cell.stdout
     assert by_cell.stdout == by_index.stdout
 
 

@@ -165,3 +165,14 @@ def test_bad_settings_are_refused_with_their_reason(changes, message):
     with pytest.raises(ValueError, match=message):
         core.configure(replace(core.settings, **changes))
     assert core.settings is before
+
+
+def test_a_decision_the_budget_forced_says_so():
+    """Issue 35: found at the budget (decide_at_budget) carries the limit that forced it."""
+    core = controller(confidence=0.999, max_fixations=1, decide_at_budget=True)
+    result = core.offer(frame_at(core, GRID.center_index, strength=1.0), 1.0)
+    assert result.found is not None and result.found.forced_by == 'budget'
+    assert result.found.probability < 0.999
+    confident = controller(confidence=0.95)
+    result = confident.offer(frame_at(confident, GRID.center_index, strength=10.0), 1.0)
+    assert result.found is not None and result.found.forced_by == ''

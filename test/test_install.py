@@ -20,7 +20,8 @@ must resolve, the installed ``controller`` and ``camera`` must talk over real DD
 down cleanly on SIGTERM, and so must the installed ``scene_camera`` and ``detector`` (which
 find the shipped face model and the Haar cascade from the install). The colcon nodes are
 started the way ``ros2 run`` does: after sourcing ``install/setup.bash``, look the package up
-in the ament index and execute ``<prefix>/lib/ipomdp_gaze/<executable>``.
+in the ament index and execute ``<prefix>/lib/ipomdp_gaze/<executable>``; a pip install has no
+node executables on PATH (``ipomdp-gaze controller`` and the like run them).
 """
 from dataclasses import dataclass
 import json
@@ -41,6 +42,10 @@ PACKAGE = 'ipomdp_gaze'
 SUBCOMMANDS = ('evaluate', 'search', 'find', 'train', 'calibrate', 'reproduce', 'demo',
                'record', 'replay', 'controller', 'camera', 'detector', 'scene_camera')
 EXECUTABLES = ('ipomdp-gaze', 'controller', 'camera', 'detector', 'scene_camera')
+# The node executables (`ros2 run ipomdp_gaze <name>`): colcon installs them in lib/ipomdp_gaze;
+# a pip install puts only `ipomdp-gaze` on PATH, whose subcommands run the nodes (issue 35: no
+# generic command such as `camera` on the user's PATH).
+NODE_EXECUTABLES = ('controller', 'camera', 'detector', 'scene_camera', 'recorder')
 BARE_NAMES = ('policies', 'msg_adapters')
 # Variables that would make a process find packages other than the install under test.
 LEAKY_ENV = ('PYTHONPATH', 'PYTHONHOME', 'PYTHONSTARTUP', 'VIRTUAL_ENV', 'CMAKE_PREFIX_PATH')
@@ -160,11 +165,16 @@ class Install:
                               capture_output=True, text=True, timeout=timeout)
 
     def node_argv(self, executable: str, *ros_args) -> list:
-        """Start an installed node: ``ros2 run``-style for colcon, the venv's script for pip."""
+        """Start an installed node: ``ros2 run``-style for colcon, ``ipomdp-gaze NODE`` (pip)."""
         if self.ros2run is not None:
             return self.argv(sys.executable, self.ros2run, PACKAGE, executable, '--ros-args',
                              *ros_args)
-        return self.argv(self.bin_dir / executable, '--ros-args', *ros_args)
+        return self.argv(self.bin_dir / 'ipomdp-gaze', executable, '--ros-args', *ros_args)
+
+    @property
+    def executables(self) -> tuple:
+        """Return what the install puts in ``bin_dir``: the nodes only for ``ros2 run``."""
+        return EXECUTABLES if self.ros2run is not None else ('ipomdp-gaze',)
 
 
 @pytest.fixture(scope='module')
@@ -225,9 +235,11 @@ def install(request):
 
 
 def test_install_has_executables_index_marker_and_share_files(install):
-    for exe in EXECUTABLES:
+    for exe in install.executables:
         path = install.bin_dir / exe
         assert path.is_file() and os.access(path, os.X_OK), path
+    if install.ros2run is None:                 # pip: nothing generic on the user's PATH
+        assert not [n for n in NODE_EXECUTABLES if (install.bin_dir / n).exists()]
     marker = install.prefix / 'share' / 'ament_index' / 'resource_index' / 'packages' / PACKAGE
     assert marker.is_file(), marker
     shipped = ['package.xml'] + [p.relative_to(install.copy).as_posix() for p in

@@ -189,7 +189,19 @@ def test_found_event_round_trip():
     assert 'row 3, col 7' in msg.message
     assert diagnostics.parse_found(msg) == {
         'row': 3, 'col': 7, 'cell': 40, 'fixations': 6, 'pan_rad': 0.1, 'tilt_rad': -0.2,
-        'probability': 0.9734}
+        'probability': 0.9734, 'ended': 'confidence', 'confidence': None, 'radius': 0}
+    # Issue 35: a decision the fixation budget forced says so, with the confidence it missed.
+    forced = diagnostics.found_status('/gaze_controller: found', 3, 7, 40, 0.1, -0.2, 0.62, 20,
+                                      'budget', 0.95)
+    assert forced.message.endswith('after 20 fixations, forced by the fixation budget below '
+                                   'the confidence 0.95')
+    assert diagnostics.parse_found(forced)['ended'] == 'forced:budget'
+    assert diagnostics.parse_found(forced)['confidence'] == 0.95
+    absent = diagnostics.absent_status('/gaze_controller: absent', 0.993, 13, '', 0.99)
+    assert absent.message == ('no target in the grid: probability 0.9930 that nobody is there '
+                              'after 13 fixations (reached the confidence 0.99)')
+    assert diagnostics.parse_absent(absent) == {'probability': 0.993, 'fixations': 13,
+                                                'ended': 'confidence', 'confidence': 0.99}
     msg.values = msg.values[:2]
     with pytest.raises(ValueError, match='lacks'):
         diagnostics.parse_found(msg)

@@ -63,7 +63,7 @@ def test_every_imported_ros_package_is_an_exec_depend():
 
 def test_setup_installs_marker_package_xml_config_launch_and_kernels(monkeypatch):
     monkeypatch.chdir(ROOT)         # setup.py globs its data files relative to the cwd
-    dist = run_setup(str(ROOT / 'setup.py'), stop_after='init')
+    dist = run_setup(str(ROOT / 'setup.py'), script_args=[], stop_after='init')
     installed = {dest: {Path(f).as_posix() for f in files} for dest, files in dist.data_files}
     assert 'resource/ipomdp_gaze' in installed['share/ament_index/resource_index/packages']
     assert 'package.xml' in installed['share/ipomdp_gaze']
@@ -91,6 +91,16 @@ def test_setup_installs_marker_package_xml_config_launch_and_kernels(monkeypatch
              if '__init__.py' in files}
     assert found <= packages, f'packages left out of the install: {sorted(found - packages)}'
     assert (ROOT / 'resource' / 'ipomdp_gaze').is_file()
+    # Console scripts: ipomdp-gaze; the nodes only for colcon's `setup.py install` / `develop`
+    # (they go to lib/ipomdp_gaze for `ros2 run`), never in a wheel, whose scripts land on
+    # the user's PATH (issue 35: no generic `camera` or `controller` there).
+    assert dist.entry_points['console_scripts'] == ['ipomdp-gaze = ipomdp_gaze.cli:main']
+    nodes = {'controller', 'camera', 'detector', 'scene_camera', 'recorder'}
+    for command in (['bdist_wheel'], ['install', '--prefix', 'x'], ['develop', '--editable']):
+        scripts = run_setup(str(ROOT / 'setup.py'), script_args=command,
+                            stop_after='init').entry_points['console_scripts']
+        names = {line.split('=')[0].strip() for line in scripts}
+        assert names == ({'ipomdp-gaze'} | (nodes if command[0] != 'bdist_wheel' else set()))
     setup_cfg = (ROOT / 'setup.cfg').read_text()
     assert 'script_dir=$base/lib/ipomdp_gaze' in setup_cfg
     assert 'install_scripts=$base/lib/ipomdp_gaze' in setup_cfg
@@ -130,10 +140,12 @@ def test_no_python_file_imports_the_bare_top_level_names():
 
 
 def _core_modules() -> list:
-    """List the rclpy-free core: ipomdp_gaze's own modules and every module of its policies."""
-    names = ['ipomdp_gaze'] + [f'ipomdp_gaze.{p.stem}' for p in
-                               sorted((ROOT / 'ipomdp_gaze').glob('*.py'))
-                               if p.stem != '__init__']
+    """List the rclpy-free layers: the core's groups, vision, the drivers and the policies."""
+    names = ['ipomdp_gaze']
+    for group in ('model', 'files', 'search', 'simulation', 'vision', 'drivers'):
+        for path in sorted((ROOT / 'ipomdp_gaze' / group).glob('*.py')):
+            names.append(f'ipomdp_gaze.{group}' if path.stem == '__init__'
+                         else f'ipomdp_gaze.{group}.{path.stem}')
     for path in sorted((ROOT / 'policies').rglob('*.py')):
         parts = path.relative_to(ROOT).with_suffix('').parts
         names.append('.'.join(('ipomdp_gaze',) + (parts[:-1] if parts[-1] == '__init__'

@@ -61,3 +61,50 @@ def test_a_disabled_reset_starts_at_its_belief_and_the_next_target_is_the_first(
     old = [_target(START, 100.0, 100.001), _belief(False, 100.3)]
     reset = [_belief(True, 101.0), _target(START, 101.02, 101.021), _belief(False, 101.3)]
     assert _first_target(_bag(old + reset)) == (101.02, 2)
+
+
+def _frame(arrival_s: float, size: int) -> BagMessage:
+    return BagMessage('/evidence_image', int(arrival_s * 1e9), SimpleNamespace(), size)
+
+
+def test_the_rate_per_minute_is_not_extrapolated_from_a_short_search():
+    """Issue 35: 0.6 s of frames gave '749.1 MB per minute'; say it is too short instead."""
+    from ipomdp_gaze.drivers.replay import describe_size
+    short = [_belief(True, 0.0)] + [_frame(0.1 + 0.15 * i, 1_000_000) for i in range(5)]
+    bag = Bag(Path('bag'), short, {}, 5_000_000, 0.8)
+    text = describe_size(bag)
+    assert 'MB per minute of search (over' not in text, text
+    assert '5 frames over 0.8 s: too short a search to extrapolate MB per minute of search' \
+        in text and '375.0 MB per minute of recording' in text
+    long = [_belief(True, 0.0)] + [_frame(0.5 * i, 1_000_000) for i in range(1, 11)]
+    text = describe_size(Bag(Path('bag'), long, {}, 10_000_000, 5.0))
+    assert '120.0 MB per minute of search (over 5.0 s of frames)' in text
+
+
+def test_a_decision_is_said_in_the_shared_words():
+    from ipomdp_gaze.drivers.replay import Decision
+    assert Decision('found', GRID.index(5, 9), 0.994, 9).describe(GRID) == \
+        'found at (5, 9) p=0.994 after 9 fixations'
+    assert Decision('absent', None, 0.993, 13).describe(GRID) == \
+        'absent p=0.993 that nobody is here after 13 fixations'
+    assert Decision('found', GRID.index(6, 9), 0.62, 20, 'budget').describe(GRID) == \
+        'found, forced by the fixation budget at (6, 9) p=0.620 after 20 fixations'
+
+
+def test_record_says_what_it_wrote(tmp_path):
+    """Issue 35: ``record`` printed nothing on Ctrl-C about what it wrote."""
+    from ipomdp_gaze.commands.record import describe_written
+    bag = tmp_path / 'bag'
+    bag.mkdir()
+    (bag / 'bag_0.mcap').write_bytes(b'x' * 1_500_000)
+    (bag / 'metadata.yaml').write_text(
+        'rosbag2_bagfile_information:\n  version: 9\n  message_count: 12\n'
+        '  duration: {nanoseconds: 2500000000}\n  topics_with_message_count:\n'
+        '  - {topic_metadata: {name: /belief}, message_count: 9}\n'
+        '  - {topic_metadata: {name: /found}, message_count: 1}\n'
+        '  - {topic_metadata: {name: /pan_tilt}, message_count: 2}\n'
+        '  - {topic_metadata: {name: /absent}, message_count: 0}\n')
+    assert describe_written(bag) == (f'wrote {bag}: 12 messages over 2.5 s, 1.50 MB (belief 9, '
+                                     f'found 1, pan_tilt 2)')
+    assert describe_written(tmp_path / 'none').startswith(
+        'ipomdp-gaze record: nothing readable was written')

@@ -569,3 +569,19 @@ def test_a_checked_frame_is_checked_again_by_another_session_or_model():
     fresh.reset()
     scan = fresh.checked_frame(np.zeros(GRID.n_cells), kind='scan')
     assert scan.kind == 'scan' and fresh.scan(scan).applied
+
+
+def test_the_fixation_as_row_and_col():
+    """Issue 35: start() stays a row-major index; fixation_cell is the same cell as (row, col)."""
+    from ipomdp_gaze.model.fpoc import make_fpoc
+    from ipomdp_gaze.model.grid import Grid
+    from ipomdp_gaze.policies.registry import build_policy
+    from ipomdp_gaze.search.session import SearchSession
+    grid = Grid(5, 7)
+    fpoc = make_fpoc('human')
+    session = SearchSession(grid, fpoc, build_policy('elm', grid, fpoc))
+    session.reset(seed=0)
+    assert session.fixation_cell is None
+    cell = session.start()
+    assert isinstance(cell, int) and cell == grid.center_index
+    assert session.fixation_cell == (2, 3) == tuple(int(v) for v in grid.cell(cell))

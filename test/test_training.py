@@ -301,3 +301,15 @@ def test_train_cli_on_a_moving_target_reports_tracking(tmp_path, capsys):
     assert spec.evaluation['motion_sigma_cells'] == 0.5
     assert 0 <= spec.evaluation['tracking_accuracy'] <= 1
     assert 'tracking accuracy' in capsys.readouterr().out
+
+
+def test_a_run_shorter_than_eval_every_still_ends_with_an_evaluation(tmp_path, capsys):
+    """Issue 35: train --epochs 30 (--eval-every 50) wrote a learning curve with a header only."""
+    out = tmp_path / 'short.yaml'
+    assert main(['train', '--grid', '3x3', '--epochs', '3', '--eval-every', '50',
+                 '--eval-episodes', '50', '--seed', '5', '--quiet', '--out', str(out)]) == 0
+    rows = read_curve(tmp_path / 'short.csv')
+    assert [r['epoch'] for r in rows] == [3]
+    assert rows[0]['fixations_to_90'] is not None and rows[0]['episodes'] == 3 * 150
+    trainer = Trainer(Grid(3, 3), FPOC, TrainConfig(eval_every=2, eval_episodes=50, seed=1))
+    assert [r['epoch'] for r in trainer.run(5)] == [2, 4, 5]

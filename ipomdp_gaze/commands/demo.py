@@ -47,7 +47,8 @@ def add_parser(sub):
                    help='seed of both nodes (the camera draws target and noise from it); with '
                         '--scene faces, which held-out test scene')
     p.add_argument('--target', default=None, metavar='ROW,COL',
-                   help='where the camera hides the target (default: random)')
+                   help='where the camera hides the target (default: drawn from --seed, so '
+                        'the same cell for the same seed: (9, 7) for seed 0)')
     p.add_argument('--max-fixations', type=positive_int, default=60, metavar='N',
                    help='without a found event after N fixations, answer with the most likely '
                         'cell (default 60)')

@@ -8,9 +8,12 @@ stands for its image files (by suffix, sorted by name). Each image must exist, d
 bits per channel and be large enough for the detector and the grid: a bad one is reported in one
 line and the others are still searched; the exit status is then 2 at the end, else 0 (every
 image got a decision). One line is printed per image, in input order: the path as given, the
-**decision** (``found``, ``absent`` or ``gave_up``), ``cell (row, col)`` and ``pixel (x, y)``
-(``none`` unless found), the probability, the fixations, the detector pixels against one
-full-resolution scan's, the seconds, why it stopped and the method.
+**decision** (``found``, ``absent`` or ``gave_up``), how it **ended** (``confidence``: the
+evidence reached ``--confidence``; ``forced:pixels`` / ``forced:budget``: the pixel cap or the
+fixation budget forced the likelier answer below it; :mod:`.search.answer`), ``cell (row,
+col)`` and ``pixel (x, y)`` (``none`` unless found), ``p``, the probability of *that* answer
+(the found cell's, or for ``absent`` that nobody is there), the fixations, the detector pixels
+against one full-resolution scan's, the seconds, why it stopped and the method.
 
 **Pixels.** The fovea (:func:`ipomdp_gaze.vision.search.search_image`) never spends more
 detector pixels than one full-resolution scan of the image: it stops before a fixation that
@@ -21,10 +24,13 @@ instead and stderr says why. ``--all`` finds every face
 (:func:`ipomdp_gaze.vision.search.search_all`): one line per face, then the last decision.
 
 **Images** are read with OpenCV (``IMREAD_ANYDEPTH | IMREAD_ANYCOLOR``: EXIF orientation applied,
-an alpha channel dropped, the bit depth kept so a 16-bit file is refused rather than silently
-rescaled). Colour arrays arrive in OpenCV's BGR order and are converted to RGB; the fovea gives
-each window to the detector in the colour space it declares (RGB for YuNet, grey for Haar; a grey
-image is repeated into three channels for an RGB detector). ``seconds`` starts from the decoded
+an alpha channel dropped; OpenCV's and libpng's own messages silenced, our one line says it). A
+16-bit image is converted to 8 bits (divided by 257) with a note; one longer than ``--max-side``
+(2048) on a side is resized before the search (a JPEG decoded at 1/2, 1/4 or 1/8 first, so an
+8000x6000 photo peaks at about 180 MB) and its answer given in its own pixels. Colour arrays
+arrive in OpenCV's BGR order and are converted to RGB; the fovea gives each window to the
+detector in the colour space it declares (RGB for YuNet, grey for Haar; a grey image is repeated
+into three channels for an RGB detector). ``seconds`` starts from the decoded
 array, so reading and decoding are not in it; nor is the one-time set-up of the detector, the
 fovea and the policy (the policy is run once on the uniform belief before the first image, so
 e.g. ELM's N x N weight matrix is built then).
@@ -45,6 +51,7 @@ whose ``observation.name`` is the model's name), else ELM on the model, acting b
 """
 from __future__ import annotations
 
+from dataclasses import replace
 import json
 import math
 from pathlib import Path
@@ -55,6 +62,9 @@ from ipomdp_gaze.files.observation_file import load_observation, shipped_image_m
 from ipomdp_gaze.model.belief import uniform_log_belief
 from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
+from ipomdp_gaze.search import answer
+from ipomdp_gaze.vision.detectors import load_factory
+from ipomdp_gaze.vision.image_files import decode_quietly
 from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, FIND_SETTINGS,
                                        fovea_for_model, full_frame_reason, full_frame_search,
                                        search_all, search_image, size_distance)
@@ -68,6 +78,15 @@ POLICY_CHOICES = tuple(name for name in POLICY_NAMES if name != 'learned')
 # photos and training group pictures (docs/faces.md, "find on real photographs").
 FIND_DETECTORS = ('yunet', 'haar')
 READ_FLAGS = cv2.IMREAD_ANYDEPTH | cv2.IMREAD_ANYCOLOR
+# --json - writes the JSON to stdout (the lines then go to stderr).
+STDOUT = Path('-')
+# Images longer than this on a side are resized before the search (--max-side; the detector
+# node refuses images over its max_image_side_px instead). Measured on an 8000x6000 JPEG with
+# no face (/usr/bin/time -v): 2048 (decoded at 1/2, then resized): 177 MB peak resident, 3.1 s;
+# 4096: 386 MB, 5.5 s; no resizing: 658 MB, 12.5 s. The shipped models are calibrated at 420
+# and 840 px, so a 2048 px image still holds every window at the resolution they were measured
+# at.
+MAX_SIDE_PX = 2048
 
 
 def add_parser(sub):
@@ -86,15 +105,16 @@ def add_parser(sub):
                     'detector such as Haar); 8 bits per channel.')
     p.add_argument('images', nargs='+', metavar='IMAGE',
                    help='image files (PNG, JPEG, ...) or folders (their image files, by name)')
-    source = p.add_mutually_exclusive_group()
-    source.add_argument('--observation', default=None, metavar='FILE',
-                        help='count model (ipomdp_gaze/observation-v1 file or shipped name); '
-                             "default: the shipped model calibrated nearest each image's size "
-                             'for --detector')
-    source.add_argument('--detector', default=None, choices=FIND_DETECTORS,
-                        help='the detector whose shipped models (one per calibrated size) are '
-                             f'used (default {FIND_DETECTORS[0]}, chosen on training photos: '
-                             'docs/faces.md)')
+    p.add_argument('--observation', default=None, metavar='FILE',
+                   help='count model (ipomdp_gaze/observation-v1 file or shipped name); '
+                        "default: the shipped model calibrated nearest each image's size "
+                        'for --detector')
+    p.add_argument('--detector', default=None, metavar='KIND',
+                   help='the detector: yunet or haar use their shipped models (one per '
+                        f'calibrated size; default {FIND_DETECTORS[0]}, chosen on training '
+                        'photos: docs/faces.md); any other registered name or '
+                        'package.module:Factory needs its model from ipomdp-gaze calibrate '
+                        '--detector KIND, given with --observation (which must record KIND)')
     policy = p.add_mutually_exclusive_group()
     policy.add_argument('--policy', default=None, choices=POLICY_CHOICES,
                         help='a baseline or nmpt, built on the model (default: the shipped '
@@ -115,10 +135,19 @@ def add_parser(sub):
                         '(0-based)')
     p.add_argument('--json', type=Path, default=None, metavar='OUT.json',
                    help='write {grid, axes, images: [{path, cell [row, col], pixel [x, y] '
-                        '(null unless found), probability, fixations, detector_pixels, '
-                        'full_scan_pixels, seconds, decision, absent_probability, stop, method, '
-                        'note, grid}]} in input order (with --all: one entry per face, with '
-                        '"face", then the last decision)')
+                        '(null unless found), probability (of the answer: the cell found, or '
+                        'that nobody is there for absent), fixations, detector_pixels, '
+                        'full_scan_pixels, seconds, decision, ended (confidence, '
+                        'forced:pixels, forced:budget, repeat, ...), confidence, '
+                        'map_probability, absent_probability, stop, method, note, '
+                        'resized_from, grid}]} in input order (with --all: one entry per face, '
+                        'with "face", then the last decision); "-" writes it to stdout (the '
+                        'lines then go to stderr)')
+    p.add_argument('--max-side', type=nonneg_int, default=MAX_SIDE_PX, metavar='PX',
+                   help='resize an image longer than this on a side before the search '
+                        f'(default {MAX_SIDE_PX}; 0: never), a JPEG while it is decoded, as '
+                        'the detector node bounds its images (max_image_side_px); its pixels '
+                        'are then given in the original image')
     p.add_argument('--log', type=Path, default=None, metavar='OUT.jsonl',
                    help="write each image's search session event log (reset with the "
                         'settings, scan, start, one event per fixation with the frame and '
@@ -128,14 +157,50 @@ def add_parser(sub):
     p.set_defaults(run=run)
 
 
-def read_image(path: str) -> np.ndarray:
+def _read_flags(file: Path, max_side: int) -> tuple[int, tuple | None]:
+    """
+    Return :data:`READ_FLAGS`, or a reduced decode for an image far over ``max_side``.
+
+    OpenCV decodes a colour JPEG through a second full-size buffer (an 8000x6000 photo: 280 MB);
+    ``IMREAD_REDUCED_COLOR_<k>`` decodes it at 1/k instead (libjpeg scales while decoding), for
+    the largest k of 8, 4, 2 that keeps the longer side at least ``max_side``. Other formats
+    are decoded whole (and a 16-bit one converted with its note), then resized. The size comes
+    from the file's header (Pillow, which reads no pixels) and is returned with the flags
+    (None when the decode is not reduced); a file Pillow cannot read is decoded whole.
+    """
+    if not max_side:
+        return READ_FLAGS, None
+    try:
+        from PIL import Image
+        with Image.open(file) as header:
+            size, kind = tuple(int(v) for v in header.size), header.format
+    except Exception:           # noqa: B902 (any failure: OpenCV decodes it, or says why)
+        return READ_FLAGS, None
+    if kind != 'JPEG':          # only libjpeg scales while decoding; 16-bit PNGs keep depth
+        return READ_FLAGS, None
+    for k, flag in ((8, cv2.IMREAD_REDUCED_COLOR_8), (4, cv2.IMREAD_REDUCED_COLOR_4),
+                    (2, cv2.IMREAD_REDUCED_COLOR_2)):
+        if max(size) // k >= max_side:
+            return flag, size
+    return READ_FLAGS, None
+
+
+def read_image(path: str, notes: list | None = None, max_side: int = 0,
+               size: list | None = None) -> np.ndarray:
     """
     Read an image file as ``uint8`` grey ``(H, W)`` or RGB ``(H, W, 3)``.
+
+    A 16-bit image is converted to 8 bits (``round(v / 257)``, 65535 -> 255), and ``notes``,
+    when given, gets a line saying so; ``size``, when given, gets the decoded ``(width,
+    height)``. With ``max_side``, an image longer than that on a side
+    is resized (:func:`shrink`) before its colours are converted, so that no second full-size
+    copy is made (an 8000x6000 photo peaks at about 270 MB resident, most of it the decoded
+    array).
 
     Raises
     ------
     ValueError
-        Naming the file: missing, unreadable, not decodable, or not 8 bits per channel.
+        Naming the file: missing, unreadable, not decodable, or of another depth (float).
 
     """
     file = Path(path)
@@ -147,18 +212,48 @@ def read_image(path: str) -> np.ndarray:
         data = np.fromfile(file, dtype=np.uint8)
     except OSError as exc:
         raise ValueError(f'{path}: cannot read: {exc.strerror or exc}') from None
-    image = cv2.imdecode(data, READ_FLAGS) if data.size else None
+    flags, header = _read_flags(file, max_side) if data.size else (READ_FLAGS, None)
+    image = decode_quietly(data, flags) if data.size else None
+    del data
     if image is None:
         raise ValueError(f'{path}: not an image OpenCV can decode')
+    if image.dtype == np.uint16:
+        image = cv2.convertScaleAbs(image, alpha=1.0 / 257.0)
+        if notes is not None:
+            notes.append(f'{path}: 16-bit image converted to 8 bits per channel (divided by '
+                         f'257)')
     if image.dtype != np.uint8:
         bits = 8 * image.dtype.itemsize
-        raise ValueError(f'{path}: {bits}-bit {image.dtype} image; find needs 8 bits per '
-                         f'channel (convert it, e.g. to 8-bit PNG)')
+        raise ValueError(f'{path}: {bits}-bit {image.dtype} image; find needs 8 or 16 bits '
+                         f'per channel (convert it, e.g. to 8-bit PNG)')
     if image.ndim == 3 and image.shape[2] == 1:
         image = image[:, :, 0]
+    if size is not None:
+        decoded = (image.shape[1], image.shape[0])
+        if header is not None and (header[0] > header[1]) != (decoded[0] > decoded[1]):
+            header = header[::-1]               # the decode applied an EXIF rotation
+        size.append(decoded if header is None else header)
+    image, _ = shrink(image, max_side)
     if image.ndim == 3:
         image = cv2.cvtColor(image, cv2.COLOR_BGR2RGB)
     return image
+
+
+def shrink(image: np.ndarray, max_side: int) -> tuple[np.ndarray, tuple]:
+    """
+    Resize ``image`` so its longer side is at most ``max_side`` (``INTER_AREA``); 0: never.
+
+    Returns the image and the factors ``(sx, sy)`` from its pixels to the given image's.
+    As the detector node does with ``max_image_side_px``, but resizing instead of refusing: a
+    search over an 8000x6000 image would otherwise take seconds and gigabytes.
+    """
+    height, width = image.shape[:2]
+    if not max_side or max(width, height) <= max_side:
+        return image, (1.0, 1.0)
+    scale = max_side / max(width, height)
+    size = (max(1, round(width * scale)), max(1, round(height * scale)))
+    small = cv2.resize(image, size, interpolation=cv2.INTER_AREA)
+    return small, (width / size[0], height / size[1])
 
 
 def model_name(model) -> str:
@@ -259,34 +354,65 @@ def _cell_text(result) -> str:
 
 
 def format_line(path: str, result, face: int | None = None) -> str:
-    """Format the one line printed per image (per face with ``--all``)."""
+    """
+    Format the one line printed per image (per face with ``--all``).
+
+    ``ended`` says how the search ended (:func:`.search.answer.ended`: ``confidence``, or
+    ``forced:pixels`` / ``forced:budget`` when a cost cap or the budget forced the decision
+    below the confidence) and ``p`` is the probability of *that* answer: the found cell's, or
+    for ``absent`` the probability that nobody is there.
+    """
     width, height = result.image_px
-    probability = 'n/a' if math.isnan(result.probability) else f'{result.probability:.3f}'
+    p = result.answer_probability
+    probability = 'n/a' if math.isnan(p) else f'{p:.3f}'
     which = '' if face is None else f' face={face}'
-    line = (f'{path}:{which} decision={result.decision} {_cell_text(result)} '
-            f'p={probability} fixations={result.fixations} '
+    line = (f'{path}:{which} decision={result.decision} ended={result.ended} '
+            f'{_cell_text(result)} p={probability} fixations={result.fixations} '
             f'detector_pixels={result.detector_pixels} (full scan {width * height}) '
             f'seconds={result.seconds:.4f} stop={result.stop} method={result.method}')
     if not result.size_matches:
         w0, h0 = result.calibrated_px
         line += f' (image {width}x{height} px, model calibrated at {w0}x{h0})'
+    if result.resized_from is not None:
+        line += f' (resized from {result.resized_from[0]}x{result.resized_from[1]} px)'
     return line
 
 
-def entry(path: str, result, grid) -> dict:
-    """Return one result's JSON entry: ``cell`` [row, col], ``pixel`` [x, y], null unless found."""
+def plot_title(path: str, result, confidence: float) -> str:
+    """Return a plot's title: the decision, how it ended, the answer and its probability."""
+    p = result.answer_probability
+    where = f', cell (row, col) {result.cell}' if result.decision == 'found' else ''
+    return (f'{Path(path).name}: {answer.heading(result.decision, _reason(result))}{where}, '
+            f'{answer.probability_text(result.decision, p)}'
+            f'{answer.confidence_clause(result.decision, _reason(result), p, confidence)}, '
+            f'{result.fixations} fixations ({result.stop})')
+
+
+def _reason(result) -> str:
+    return 'full_frame' if result.method == 'full_frame' else result.stop
+
+
+def entry(path: str, result, grid, confidence: float | None = None) -> dict:
+    """
+    Return one result's JSON entry: ``cell`` [row, col], ``pixel`` [x, y], null unless found.
+
+    ``probability`` is the answer's (the found cell's; ``P(absent)`` for ``absent``),
+    ``map_probability`` the most likely cell's, ``ended`` how the search ended.
+    """
     found = result.decision == 'found'
 
     def number(value):
         return None if math.isnan(value) else float(value)
     return {'path': path, 'cell': list(result.cell) if found else None,
             'pixel': [result.pixel[0], result.pixel[1]] if found else None,
-            'probability': number(result.probability), 'fixations': result.fixations,
+            'probability': number(result.answer_probability), 'fixations': result.fixations,
             'detector_pixels': result.detector_pixels,
             'full_scan_pixels': result.image_px[0] * result.image_px[1],
-            'seconds': result.seconds, 'decision': result.decision,
+            'seconds': result.seconds, 'decision': result.decision, 'ended': result.ended,
+            'confidence': confidence, 'map_probability': number(result.probability),
             'absent_probability': number(result.absent_probability), 'stop': result.stop,
             'method': result.method, 'note': result.note,
+            'resized_from': None if result.resized_from is None else list(result.resized_from),
             'grid': {'rows': grid.rows, 'cols': grid.cols}}
 
 
@@ -316,16 +442,30 @@ class _Tasks:
 
     def __init__(self, args):
         self.args = args
+        detector = getattr(args, 'detector', None)
+        if detector is not None:
+            load_factory(detector)              # unknown or not importable: one line
         if args.observation:
             self.models, self.shipped = [load_observation(args.observation)], False
+            recorded = (self.models[0].meta.get('detector') or {}).get('kind', 'haar')
+            if detector is not None and recorded != detector:
+                raise ValueError(f'--observation {args.observation} was calibrated with the '
+                                 f'detector {recorded!r}, not --detector {detector!r}')
         else:
-            detector = getattr(args, 'detector', None) or FIND_DETECTORS[0]
+            detector = detector or FIND_DETECTORS[0]
             self.models = [load_observation(name) for name in default_models(detector)]
-            if not self.models:
+            if not self.models and detector in FIND_DETECTORS:
                 raise ValueError(f'no observation model of the {detector} detector is shipped '
                                  f'with this install; pass --observation FILE (an '
                                  f'ipomdp_gaze/observation-v1 file, e.g. from ipomdp-gaze '
                                  f'calibrate)')
+            if not self.models:
+                raise ValueError(
+                    f'no observation model of the detector {detector!r} is shipped (find '
+                    f'ships models for {" and ".join(FIND_DETECTORS)}); calibrate one on '
+                    f'labelled images, ipomdp-gaze calibrate --images DIR --labels faces.csv '
+                    f'--detector {detector} --out model.yaml, then pass --observation '
+                    f'model.yaml')
             self.shipped = True
         self.tasks = {}
         if args.observation:                    # a bad model or policy: refused before any image
@@ -337,6 +477,14 @@ class _Tasks:
             self.tasks[id(model)] = _Task(self.args, model, self.shipped, _note)
             _note(self.tasks[id(model)].description)
         return self.tasks[id(model)]
+
+
+def _in_given_pixels(result, scale: tuple, given: tuple):
+    """Return a result on a resized image with its pixels in the given image's."""
+    sx, sy = scale
+    x, y = result.pixel
+    return replace(result, pixel=(x * sx, y * sy), resized_from=tuple(given),
+                   detections=tuple((u * sx, v * sy) for u, v in result.detections))
 
 
 def search_one(image, task, settings, rng, find_all: bool) -> list:
@@ -364,9 +512,18 @@ def run(args) -> int:
     tasks = _Tasks(args)
     plots = plot_paths(args.plot, len(images)) if args.plot else []
     entries, logs, failed, grid = [], [], 0, None
+    out = sys.stderr if args.json == STDOUT else sys.stdout
     for i, path in enumerate(images):
+        notes = []
         try:
-            image = read_image(path)
+            sizes = []                          # the decoded size, before --max-side
+            image = read_image(path, notes, args.max_side, sizes)
+            given = sizes[0]
+            scale = (given[0] / image.shape[1], given[1] / image.shape[0])
+            if scale != (1.0, 1.0):
+                notes.append(f'{path}: resized from {given[0]}x{given[1]} to '
+                             f'{image.shape[1]}x{image.shape[0]} px before the search '
+                             f'(--max-side {args.max_side})')
             task = tasks.task((image.shape[1], image.shape[0]))
             check_image_size((image.shape[1], image.shape[0]), task.fovea)
             settings = settings_from_args(args, FIND_SETTINGS, task.model.grid)
@@ -375,34 +532,41 @@ def run(args) -> int:
             _error(message if message.startswith(path) else f'{path}: {message}')
             failed += 1
             continue
+        for note in notes:
+            _note(note)
         grid = task.model.grid
         results = search_one(image, task, settings, np.random.default_rng([args.seed, i]),
                              args.all)
+        searched = results                      # in the searched image's pixels (the plot)
+        if scale != (1.0, 1.0):
+            results = [_in_given_pixels(r, scale, given) for r in results]
         if results[0].method == 'full_frame':
             _note(f'{path}: scanned the whole frame once: {results[0].note}')
         for k, result in enumerate(results):
-            print(format_line(path, result, k if args.all else None), flush=True)
-            entries.append({**entry(path, result, grid), **({'face': k} if args.all else {})})
+            print(format_line(path, result, k if args.all else None), file=out, flush=True)
+            entries.append({**entry(path, result, grid, settings.confidence),
+                            **({'face': k} if args.all else {})})
         logs.append(json.dumps({'path': path, 'events': [e for r in results for e in r.log]}))
-        if plots and results[0].method == 'fovea':
-            result = results[0]
-            title = (f'{Path(path).name}: {result.decision}, cell (row, col) {result.cell}, '
-                     f'p={result.probability:.3f}, {result.fixations} fixations ({result.stop})')
-            plot_image_search(image, result, task.fovea, plots[i], title)
+        if plots:
+            plot_image_search(image, searched[0], task.fovea, plots[i],
+                              plot_title(path, results[0], settings.confidence))
             _note(f'wrote {plots[i]}')
-        elif plots:
-            _note(f'{path}: no plot (the full frame was scanned, no fixations to draw)')
     if args.log:
         args.log.parent.mkdir(parents=True, exist_ok=True)
         args.log.write_text('\n'.join(logs) + '\n')
         _note(f'wrote {args.log}')
     if args.json:
-        args.json.parent.mkdir(parents=True, exist_ok=True)
         rows, cols = grid.shape if grid is not None else (None, None)
-        args.json.write_text(json.dumps({'grid': {'rows': rows, 'cols': cols},
-                                         'axes': {'cell': ['row', 'col'], 'pixel': ['x', 'y']},
-                                         'images': entries}, indent=1) + '\n')
-        _note(f'wrote {args.json}')
+        text = json.dumps({'grid': {'rows': rows, 'cols': cols},
+                           'axes': {'cell': ['row', 'col'], 'pixel': ['x', 'y']},
+                           'images': entries}, indent=1) + '\n'
+        if args.json == STDOUT:
+            sys.stdout.write(text)
+            sys.stdout.flush()
+        else:
+            args.json.parent.mkdir(parents=True, exist_ok=True)
+            args.json.write_text(text)
+            _note(f'wrote {args.json}')
     if failed:
         _error(f'{failed} of {len(images)} inputs could not be searched')
         return 2

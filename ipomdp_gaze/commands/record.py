@@ -69,7 +69,30 @@ def run_record(args) -> int:
         ros += ['-p', f"topics:=[{','.join(topics)}]"]
     if args.compression != 'none':
         ros += ['-p', f'compression:={args.compression}']
-    return main(['ipomdp-gaze-record', '--ros-args', *ros, *(args.ros_args or [])])
+    status = main(['ipomdp-gaze-record', '--ros-args', *ros, *(args.ros_args or [])])
+    print(describe_written(args.path), flush=True)
+    return status
+
+
+def describe_written(path: Path) -> str:
+    """
+    Say what a stopped recording wrote: messages per topic, seconds and megabytes.
+
+    From the bag's ``metadata.yaml`` (written when the recorder closes the bag, on Ctrl-C or
+    SIGTERM), so it is what a reader will find.
+    """
+    from ipomdp_gaze.files.bag import read_metadata
+    try:
+        info = read_metadata(path)
+    except ValueError as exc:
+        return f'ipomdp-gaze record: nothing readable was written ({exc})'
+    counts = {t['topic_metadata']['name'].lstrip('/'): int(t['message_count'])
+              for t in info.get('topics_with_message_count') or []}
+    seconds = int((info.get('duration') or {}).get('nanoseconds', 0)) * 1e-9
+    size = sum(f.stat().st_size for f in Path(path).iterdir() if f.is_file())
+    topics = ', '.join(f'{topic} {n}' for topic, n in sorted(counts.items()) if n)
+    return (f'wrote {path}: {int(info.get("message_count", 0))} messages over {seconds:.1f} s, '
+            f'{size / 1e6:.2f} MB' + (f' ({topics})' if topics else ''))
 
 
 def run_replay(args) -> int:

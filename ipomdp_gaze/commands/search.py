@@ -7,6 +7,7 @@ from pathlib import Path
 
 from ipomdp_gaze.model.observation import as_observation
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
+from ipomdp_gaze.search import answer
 from ipomdp_gaze.search.sensors import ModelSensor
 from ipomdp_gaze.search.sensors import run_search as run_offline
 from ipomdp_gaze.search.session import SearchSession, SearchSettings
@@ -31,7 +32,9 @@ def add_parser(sub):
     p.add_argument('--target', type=cell_arg, default=None, metavar='ROW,COL',
                    help='target cell as ROW,COL or a flat index (default random)')
     add_search_args(p, SEARCH_SETTINGS, ('confidence',))
-    add_search_args(p, None, ('max_fixations',), task_default='4 N')
+    p.add_argument('--max-fixations', type=nonneg_int, default=None, metavar='N',
+                   help='fixation budget: gave up when it runs out undecided (default 4 N; 0 = '
+                        'no budget)')
     p.add_argument('--seed', type=nonneg_int, default=0)
     p.add_argument('--plot', type=Path, default=None, metavar='PNG',
                    help='save the final belief with the scan path as a picture')
@@ -48,30 +51,42 @@ def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=
 
     The model's own sampler is the world (:class:`ipomdp_gaze.search.sensors.ModelSensor`); one
     generator, ``default_rng(seed)``, serves the policy and the noise; the loop is
-    :func:`ipomdp_gaze.search.sensors.run_search`. Returns ``(guess, path, belief)``.
+    :func:`ipomdp_gaze.search.sensors.run_search`. Returns ``(guess, path, belief, result)``
+    (``result``: the last :class:`ipomdp_gaze.search.session.StepResult`).
     """
     rng = np.random.default_rng(seed)
     session = SearchSession(grid, model, policy, settings)
     sensor = ModelSensor(grid, model, rng)
     tr, tc = grid.cell(target)
-    out(f'target hidden at cell {target} (row {tr}, col {tc}) of a {grid.rows}x{grid.cols} grid')
+    out(f'target hidden at cell {target} ({tr}, {tc}) of a {grid.rows}x{grid.cols} grid')
+    steps = []
 
     def show(frame, result):
+        steps.append(result)
         kr, kc = grid.cell(session.path[-1])
         gr, gc = grid.cell(result.map_cell)
-        out(f'fixation {result.fixations:3d}: looked at ({kr},{kc})  most likely ({gr},{gc}) '
-            f'p={result.map_probability:.3f}  entropy={session.entropy_nats:.2f} nats  '
+        out(f'fixation {result.fixations:3d}: looked at ({kr}, {kc})  ->  most likely ({gr}, '
+            f'{gc}) p={result.map_probability:.3f}  entropy {session.entropy_nats:.2f} nats  '
             f"{'right' if result.map_cell == target else 'wrong'}")
 
     limit = None if settings.max_fixations else NO_BUDGET_FRAMES_PER_CELL * grid.n_cells
-    outcome = run_offline(session, sensor, target, seed=rng, limit=limit, on_frame=show)
-    guess = outcome.cell
+    run_offline(session, sensor, target, seed=rng, limit=limit, on_frame=show)
+    result = steps[-1]
+    guess = result.map_cell
     gr, gc = grid.cell(guess)
     verdict = 'right' if guess == target else 'wrong'
-    what = 'found' if outcome.decision == 'found' else 'gave up'
-    out(f'{what}: the target is most likely at ({gr},{gc}) after {outcome.fixations} fixations, '
-        f'which is {verdict}')
-    return guess, session.path, session.belief
+    clause = answer.confidence_clause(result.decision, result.reason, result.map_probability,
+                                      settings.confidence)
+    if result.decision == 'gave_up':
+        out(f'gave up: no cell reached the confidence {settings.confidence:g} at '
+            f'{answer.LIMITS.get(result.reason, result.reason)}; the target is most likely at '
+            f'({gr}, {gc}), probability {result.map_probability:.3f}, after '
+            f'{result.fixations} fixations, which is {verdict}')
+    else:
+        out(f'{answer.heading(result.decision, result.reason)}: the target is most likely at '
+            f'({gr}, {gc}), probability {result.map_probability:.3f}, after '
+            f'{result.fixations} fixations{clause}, which is {verdict}')
+    return guess, session.path, session.belief, result
 
 
 def plot_search(grid, belief, path, target, title, out_path):
@@ -111,13 +126,16 @@ def run(args) -> int:
     rng = np.random.default_rng([args.seed, 1])
     target = int(rng.integers(grid.n_cells)) if args.target is None else \
         cell_index(args.target, grid, '--target')
-    guess, path, belief = run_search(grid, as_observation(grid, fpoc), policy, target,
-                                     settings, args.seed)
+    guess, path, belief, result = run_search(grid, as_observation(grid, fpoc), policy, target,
+                                             settings, args.seed)
     if args.plot:
         name = args.policy_file or args.policy
         task = f'{fpoc.model} FPOC' if args.observation is None else args.observation
-        title = (f'{grid.rows}x{grid.cols}, {task}, {name}: '
-                 f'{len(path)} fixations (star = target)')
+        ending = answer.heading(result.decision, result.reason)
+        if result.decision == 'gave_up':
+            ending += f' at {answer.LIMITS.get(result.reason, result.reason)}'
+        title = (f'{grid.rows}x{grid.cols}, {task}, {name}: {ending}, '
+                 f'p={result.map_probability:.3f}, {len(path)} fixations (star = target)')
         plot_search(grid, belief, path, target, title, args.plot)
         print(f'wrote {args.plot}')
     return 0

@@ -29,6 +29,7 @@ import math
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.policies.registry import build_policy
+from ipomdp_gaze.search import answer
 from ipomdp_gaze.search.controller_config import build_config
 from ipomdp_gaze.search.gaze import GazeController
 import numpy as np
@@ -41,6 +42,9 @@ IMAGE_CHANNELS = {'mono8': 1, 'rgb8': 3, 'bgr8': 3}
 # comes when it is enabled, after the reset belief).
 RESET_TARGET_S = 0.005
 RESET_WINDOW_S = 0.25
+# The bag's growth per minute of search is extrapolated from at least this many seconds and
+# frames (a face demo's search: 3-10 frames over 2.5-10 s).
+MIN_RATE_S, MIN_RATE_FRAMES = 2.0, 3
 # What ``replay`` may change, and the controller parameter each one sets.
 OVERRIDES = {'observation': 'observation.file', 'policy': 'policy.name',
              'policy_file': 'policy.file', 'confidence': 'confidence',
@@ -50,20 +54,29 @@ OVERRIDES = {'observation': 'observation.file', 'policy': 'policy.name',
 
 @dataclass
 class Decision:
-    """The end of a search: ``kind`` found, absent, gave_up or '' (none), cell, probability."""
+    """
+    The end of a search: ``kind`` found, absent, gave_up or '' (none), cell, probability.
+
+    ``probability`` is the answer's (``P(absent)`` for absent); ``forced_by`` the limit that
+    forced a found or absent below the confidence ('' when the evidence reached it).
+    """
 
     kind: str = ''
     cell: int | None = None
     probability: float | None = None
     fixations: int | None = None
+    forced_by: str = ''
 
     def describe(self, grid: Grid) -> str:
-        """Say it in one phrase."""
+        """Say it in one phrase, in the words of :mod:`ipomdp_gaze.search.answer`."""
         if not self.kind:
             return 'no decision'
-        where = f' at {grid.cell(self.cell)}' if self.cell is not None else ''
-        p = f' p={self.probability:.3f}' if self.probability is not None else ''
-        return f'{self.kind}{where}{p} after {self.fixations} fixations'
+        where = f' at {tuple(int(v) for v in grid.cell(self.cell))}' \
+            if self.cell is not None else ''
+        nobody = ' that nobody is here' if self.kind == 'absent' else ''
+        p = f' p={self.probability:.3f}{nobody}' if self.probability is not None else ''
+        return (f'{answer.heading(self.kind, self.forced_by)}{where}{p} after '
+                f'{self.fixations} fixations')
 
     def same(self, other: Decision) -> bool:
         """Whether both are the same decision (kind, cell and fixations)."""
@@ -216,7 +229,8 @@ def _recorded_decision(bag) -> Decision:
             values = {kv.key: kv.value for kv in events[-1].msg.values}
             cell = int(values['cell']) if 'cell' in values else None
             p = float(values['probability']) if 'probability' in values else None
-            return Decision(kind, cell, p, int(values['fixations']))
+            forced = values.get('ended', '').partition('forced:')[2]
+            return Decision(kind, cell, p, int(values['fixations']), forced)
     return Decision()
 
 
@@ -264,7 +278,8 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
         if event is not None:
             kind = 'found' if step.found else 'absent' if step.absent else 'gave_up'
             result.replayed = Decision(kind, getattr(event, 'cell', None),
-                                       getattr(event, 'probability', None), event.fixations)
+                                       getattr(event, 'probability', None), event.fixations,
+                                       getattr(event, 'forced_by', ''))
         if step.fixation is None:
             continue
         replayed_cells.append(step.fixation)
@@ -287,6 +302,14 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
     return result
 
 
+def _search_frames(bag) -> list:
+    """Return the arrival times (ns) of the last search's frames, sorted."""
+    resets = [m.time_ns for m in bag.topic('belief') if np.ptp(np.asarray(m.msg.data)) == 0]
+    since = resets[-1] if resets else 0          # the last search (see last_search)
+    return sorted(m.time_ns for topic in ('evidence_image', 'evidence')
+                  for m in bag.topic(topic) if m.time_ns >= since)
+
+
 def search_rate(bag) -> tuple[float, float]:
     """
     Return ``(seconds, MB per minute)`` of the search: the bag's growth while frames came.
@@ -295,10 +318,7 @@ def search_rate(bag) -> tuple[float, float]:
     the first to the last; the bytes of the messages recorded in it are scaled by the file's
     compression.
     """
-    resets = [m.time_ns for m in bag.topic('belief') if np.ptp(np.asarray(m.msg.data)) == 0]
-    since = resets[-1] if resets else 0          # the last search (see last_search)
-    frames = sorted(m.time_ns for topic in ('evidence_image', 'evidence')
-                    for m in bag.topic(topic) if m.time_ns >= since)
+    frames = _search_frames(bag)
     raw = sum(m.size for m in bag.messages)
     if len(frames) < 2 or raw == 0:
         return 0.0, math.nan
@@ -309,10 +329,24 @@ def search_rate(bag) -> tuple[float, float]:
 
 
 def describe_size(bag) -> str:
-    """Say how large the bag is and how fast it grows per minute of search."""
+    """
+    Say how large the bag is and how fast it grows per minute of search.
+
+    The rate is extrapolated only from at least :data:`MIN_RATE_S` seconds and
+    :data:`MIN_RATE_FRAMES` frames; a shorter search says so instead (0.6 s of frames once gave
+    749.1 MB per minute) and gives the size per minute of the whole recording.
+    """
     seconds, per_minute = search_rate(bag)
-    rate = f'{per_minute:.1f} MB per minute of search (over {seconds:.1f} s of frames)' \
-        if seconds > 0 else 'fewer than two frames'
+    frames = _search_frames(bag)
+    if len(frames) < 2:
+        rate = 'fewer than two frames'
+    elif seconds < MIN_RATE_S or len(frames) < MIN_RATE_FRAMES:
+        rate = (f'{len(frames)} frames over {seconds:.1f} s: too short a search to '
+                f'extrapolate MB per minute of search (at least {MIN_RATE_FRAMES} frames over '
+                f'{MIN_RATE_S:g} s); {bag.megabytes_per_minute:.1f} MB per minute of '
+                f'recording')
+    else:
+        rate = f'{per_minute:.1f} MB per minute of search (over {seconds:.1f} s of frames)'
     return f'{bag.size_bytes / 1e6:.2f} MB, {bag.duration_s:.1f} s recorded; {rate}'
 
 
@@ -367,7 +401,13 @@ def new_search(bag, overrides: dict | None = None, out=print):
         settings = dataclasses.replace(settings, max_fixations=4 * core.grid.n_cells)
     result = search_image(_last_image(bag), setup.fovea, core.observation, core.policy,
                           settings, rng=np.random.default_rng(int(values.get('seed', 0))))
-    r, c = result.cell
-    out(f'new search on the recorded image: {result.stop} at ({r}, {c}) '
-        f'p={result.probability:.3f} after {result.fixations} fixations')
+    cell = setup.fovea.grid.index(*result.cell) if result.decision != 'absent' else None
+    decision = Decision(result.decision, cell, result.answer_probability, result.fixations,
+                        result.stop if answer.forced(result.decision, result.stop) else '')
+    if result.decision == 'gave_up':
+        out(f'new search on the recorded image: gave up at '
+            f'{answer.LIMITS.get(result.stop, result.stop)}; most likely {result.cell} '
+            f'p={result.probability:.3f} after {result.fixations} fixations')
+    else:
+        out(f'new search on the recorded image: {decision.describe(setup.fovea.grid)}')
     return result

@@ -40,6 +40,8 @@ class Annotator:
         self.fixations: list[int] = []
         self.belief = None
         self.found = None
+        self.found_label = 'found'
+        self.found_radius = 0
         self.frame = None
         self.published = 0
 
@@ -76,6 +78,8 @@ class Annotator:
         except (KeyError, ValueError):
             return
         self.found = (int(found['cell']), float(found['probability']))
+        self.found_label = 'found, forced' if found['ended'].startswith('forced:') else 'found'
+        self.found_radius = found['radius']
         self._publish()
 
     def _publish(self) -> None:
@@ -92,6 +96,7 @@ class Annotator:
         windows = [(*w.rect_px, w.whole_image) for w in frame.windows]
         picture = annotate(frame.image, cell_map, self.belief, self.fixations, windows,
                            frame.detections_px, self.found,
-                           label=f'fixation {len(self.fixations)}')
+                           label=f'fixation {len(self.fixations)}',
+                           found_label=self.found_label, found_radius=self.found_radius)
         self.publisher.publish(images.camera_image(picture, frame.token))
         self.published += 1

@@ -42,9 +42,9 @@ from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, s
 from ipomdp_gaze.policies.baselines import STRATEGIES
 from ipomdp_gaze.policies.conv import ACTIONS, check_kernel
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnavailable
-from ipomdp_gaze.search.controller_config import build_config
-from ipomdp_gaze.search.controller_config import ControllerConfig as Config
-from ipomdp_gaze.search.controller_config import grid_from
+from ipomdp_gaze.search import answer
+from ipomdp_gaze.search.controller_config import (build_config, ControllerConfig as Config,
+                                                  grid_from)
 from ipomdp_gaze.search.gaze import FrameSequence
 from ipomdp_gaze.search.health import HealthMonitor
 from rclpy.exceptions import NameValidationException
@@ -383,24 +383,32 @@ class GazeControllerNode(Node):
         """Publish and log the events a frame fired (found, absent, gave_up)."""
         name = self.get_fully_qualified_name()
         ending = '' if not self.core.stopped else '; the search has ended until ~/reset'
+        confidence = self.core.settings.confidence
         if result.found is not None:
             found = result.found
             row, col = self._config.grid.cell(found.cell)
             pan, tilt = self._config.head.angles(found.cell)
             self._event_pubs['found'].publish(diagnostics.found_status(
                 f'{name}: found', row, col, found.cell, pan, tilt, found.probability,
-                found.fixations))
+                found.fixations, found.forced_by, confidence,
+                0 if self.core.settings.moving else self.core.settings.found_radius))
+            clause = answer.confidence_clause('found', found.forced_by, found.probability,
+                                              confidence)
             self.get_logger().info(
-                f'found: target most likely at ({row}, {col}), pan {pan:+.4f} rad, tilt '
-                f'{tilt:+.4f} rad, probability {found.probability:.4f} after {found.fixations} '
-                f'fixations{ending}')
+                f'{answer.heading("found", found.forced_by)}: the target is most likely at '
+                f'({row}, {col}), pan {pan:+.4f} rad, tilt {tilt:+.4f} rad, probability '
+                f'{found.probability:.4f}, after {found.fixations} fixations{clause}{ending}')
         if result.absent is not None:
             absent = result.absent
             self._event_pubs['absent'].publish(diagnostics.absent_status(
-                f'{name}: absent', absent.probability, absent.fixations))
-            self.get_logger().info(f'absent: no target in the grid, probability '
-                                   f'{absent.probability:.4f} after {absent.fixations} '
-                                   f'fixations{ending}')
+                f'{name}: absent', absent.probability, absent.fixations, absent.forced_by,
+                confidence))
+            clause = answer.confidence_clause('absent', absent.forced_by, absent.probability,
+                                              confidence)
+            self.get_logger().info(
+                f'{answer.heading("absent", absent.forced_by)}: nobody is here, probability '
+                f'{absent.probability:.4f} that nobody is here, after {absent.fixations} '
+                f'fixations{clause}{ending}')
         if result.gave_up is not None:
             self._event_pubs['gave_up'].publish(diagnostics.gave_up_status(
                 f'{name}: gave_up', result.gave_up.fixations))

@@ -26,7 +26,9 @@ from ipomdp_gaze.files.yaml_files import yaml_parameters
 from ipomdp_gaze.model.belief import entropy
 from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, joints
+from ipomdp_gaze.search import answer as words
 from ipomdp_gaze.search.controller_config import fpoc_from, grid_from, head_from, observation_from
+from ipomdp_gaze.search.session import pooled_belief, SearchSettings
 from ipomdp_gaze.simulation.evaluation import answer_is_right, RIGHT_RADIUS_CELLS
 import numpy as np
 from sensor_msgs.msg import Image
@@ -63,7 +65,9 @@ class DemoSetup:
     ``nodes`` lists ``(node, ros_args)`` in start order (keys of ``NODE_NAMES``); ``scene`` is
     ``'gaussian'`` (the simulated camera) or ``'faces'``; ``mode`` the detector's (faces);
     ``image_px`` the ``(width, height)`` of the fixed scene (fovea mode, for pixel answers);
-    ``scan`` whether each search starts with the one-time scan (its belief comes first).
+    ``scan`` whether each search starts with the one-time scan (its belief comes first);
+    ``settings`` the controller's search settings (its confidence, absent prior and found
+    radius: the progress lines name the answer as the controller decides it).
     """
 
     nodes: list
@@ -74,6 +78,7 @@ class DemoSetup:
     mode: str = ''
     image_px: tuple | None = None
     scan: bool = False
+    settings: SearchSettings = field(default_factory=SearchSettings)
 
     @property
     def tolerance_cells(self) -> int:
@@ -150,7 +155,8 @@ def demo_setup(fpoc: str = 'camera', policy: str | None = None, seed: int = 0,
                          f'0..{grid.cols - 1})')
     return DemoSetup([('controller', _ros_args(controller_yaml, controller)),
                       ('camera', _ros_args(camera_yaml, camera))], grid,
-                     head_from(values, grid), controller)
+                     head_from(values, grid), controller,
+                     settings=SearchSettings.from_parameters(values, grid=grid))
 
 
 def faces_setup(fovea: bool = False, policy: str | None = None, seed: int = 0,
@@ -182,7 +188,8 @@ def faces_setup(fovea: bool = False, policy: str | None = None, seed: int = 0,
     return DemoSetup([('controller', _ros_args(files['controller'], controller)),
                       ('detector', _ros_args(files['detector'], {})),
                       ('scene_camera', _ros_args(files['scene_camera'], camera))],
-                     grid, head_from(values, grid), controller, 'faces', mode, image_px, scan)
+                     grid, head_from(values, grid), controller, 'faces', mode, image_px, scan,
+                     SearchSettings.from_parameters(values, grid=grid))
 
 
 def _started(watch, record, node: str):
@@ -289,15 +296,17 @@ def _pictures(setup: DemoSetup, record: SearchRecord, annotated: list, stats: di
     looked = [head.nearest_cell(*joints.angles_from_joint_state(msg, head))
               for _, msg in record.targets[:n]]
     canvas, cell_map = grid_canvas(grid, 40)
+    label = 'most likely'
+    if stats.get('stop') == 'found':
+        label = 'found, forced' if str(stats.get('ended', '')).startswith('forced:') \
+            else 'found'
     frames = []
     for i in range(n):
         belief = grid_arrays.from_multiarray(record.beliefs[i][1], grid)
         found = (stats['cell'], stats['probability']) if i == n - 1 and 'cell' in stats \
             else None
         frames.append(annotate(canvas, cell_map, belief, looked[:i + 1], found=found,
-                               label=f'fixation {i + 1}',
-                               found_label='found' if stats.get('stop') == 'found'
-                               else 'most likely'))
+                               label=f'fixation {i + 1}', found_label=label))
     return frames
 
 
@@ -397,6 +406,35 @@ def _where(setup: DemoSetup, cell: int) -> str:
     return f'pan {math.degrees(pan):+6.2f} deg  tilt {math.degrees(tilt):+6.2f} deg'
 
 
+def most_likely(setup: DemoSetup, belief: np.ndarray) -> tuple[int, float, float]:
+    """
+    Return the answer as the controller decides it: its cell, its probability and P(absent).
+
+    The cell whose square of ``search.found_radius`` cells holds the most belief (the cell
+    alone with radius 0; ties to the lowest index), as the controller's ``found`` rule; the
+    belief message's cells sum to ``1 - P(absent)``.
+    """
+    settings = setup.settings
+    radius = 0 if settings.moving else settings.found_radius
+    pooled = pooled_belief(np.asarray(belief, dtype=float), setup.grid, radius)
+    cell = int(np.argmax(pooled))
+    absent = max(0.0, 1.0 - float(np.sum(belief))) if settings.absent_prior > 0 else 0.0
+    return cell, float(pooled[cell]), absent
+
+
+def _state(setup: DemoSetup, belief: np.ndarray) -> str:
+    """
+    Say what a belief would answer: ``most likely (r, c) p=..  nobody p=..  entropy .. nats``.
+
+    ``nobody p`` (P(absent)) only when the search can end ``absent`` (``absent.prior`` > 0).
+    """
+    cell, probability, absent = most_likely(setup, belief)
+    nobody = f'  nobody p={absent:.3f}' if setup.settings.absent_prior > 0 else ''
+    everything = np.append(belief, absent) if setup.settings.absent_prior > 0 else belief
+    return (f'most likely {setup.grid.cell(cell)} p={probability:.3f}{nobody}  '
+            f'entropy {float(entropy(everything)):.2f} nats')
+
+
 def _answer(setup: DemoSetup, row: int, col: int, cell: int, probability: float,
             fixations: int) -> str:
     """Say where the answer is and how sure: ``(row, col), <where>, probability p, after n``."""
@@ -435,18 +473,14 @@ def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
         nonlocal printed, scan_shown
         if skip and not scan_shown and record.beliefs:
             belief = grid_arrays.from_multiarray(record.beliefs[0][1], grid)
-            guess = int(np.argmax(belief))
-            out(f'scan: the whole image once  ->  most likely {grid.cell(guess)} '
-                f'p={belief[guess]:.3f}  entropy {float(entropy(belief)):.2f} nats')
+            out(f'scan: the whole image once  ->  {_state(setup, belief)}')
             scan_shown = True
         while printed < min(len(record.beliefs) - skip, len(record.targets) - skip, last()):
             belief = grid_arrays.from_multiarray(record.beliefs[printed + skip][1], grid)
             pan, tilt = joints.angles_from_joint_state(record.targets[printed + skip][1], head)
             looked = head.nearest_cell(pan, tilt)
-            guess = int(np.argmax(belief))
             out(f'fixation {printed + 1:3d}: looked at {grid.cell(looked)}  '
-                f'{_where(setup, looked)}  ->  most likely {grid.cell(guess)} '
-                f'p={belief[guess]:.3f}  entropy {float(entropy(belief)):.2f} nats')
+                f'{_where(setup, looked)}  ->  {_state(setup, belief)}')
             printed += 1
 
     def finished():
@@ -455,30 +489,36 @@ def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
 
     what = 'face' if setup.scene == 'faces' else 'target'
     in_time = wait(finished)
+    confidence = setup.settings.confidence
     if record.found and printed >= last():
         found = diagnostics.parse_found(record.found[0][1])
         answer, stop = (found['row'], found['col'], found['cell']), 'found'
-        out(f'found: the {what} is most likely at '
-            + _answer(setup, *answer, found['probability'], found['fixations']))
+        forced = found['ended'].partition('forced:')[2]
+        out(f'{words.heading("found", forced)}: the {what} is most likely at '
+            + _answer(setup, *answer, found['probability'], found['fixations'])
+            + words.confidence_clause('found', forced, found['probability'], confidence))
     elif record.absent and printed >= last():
         found = diagnostics.parse_absent(record.absent[0][1])
         answer, stop = None, 'absent'
-        out(f"absent: nobody is here, probability {found['probability']:.3f}, after "
-            f"{found['fixations']} fixations")
+        forced = found['ended'].partition('forced:')[2]
+        clause = words.confidence_clause('absent', forced, found['probability'], confidence)
+        out(f"{words.heading('absent', forced)}: nobody is here, probability "
+            f"{found['probability']:.3f} that nobody is here, after {found['fixations']} "
+            f'fixations{clause}')
     elif printed == 0:
         out(f'ipomdp-gaze demo: the {what} was not found within {timeout_s:g} s')
         return 1
     else:
         belief = grid_arrays.from_multiarray(record.beliefs[printed - 1 + skip][1], grid)
-        cell = int(np.argmax(belief))
+        cell, probability, _ = most_likely(setup, belief)
         answer = (*grid.cell(cell), cell)
         found = {'row': answer[0], 'col': answer[1], 'cell': cell, 'fixations': printed,
-                 'probability': float(belief[cell])}
+                 'probability': probability}
         stop = 'budget' if in_time else 'timeout'
         why = f'after {max_fixations} fixations' if in_time else \
             f'within {timeout_s:g} s'
-        out(f'gave up: no cell reached the confidence {why}; the {what} is most likely at '
-            + _answer(setup, *answer, float(belief[cell]), printed))
+        out(f'gave up: no cell reached the confidence {confidence:g} {why}; the {what} is '
+            f'most likely at ' + _answer(setup, *answer, probability, printed))
     camera = 'scene camera' if setup.scene == 'faces' else 'simulated camera'
     if not wait(lambda: record.truth):
         out(f'ipomdp-gaze demo: the {camera} did not report where the {what} is')

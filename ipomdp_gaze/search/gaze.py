@@ -64,19 +64,26 @@ def check_settle_time(settle_time_s: float) -> float:
 
 @dataclass(frozen=True)
 class Found:
-    """The found event: the most likely cell reached the confidence level."""
+    """
+    The found event: the most likely cell reached the confidence level.
+
+    ``forced_by`` names the limit (``budget``) that forced it below the confidence
+    (``search.decide_at_budget``), '' when the evidence reached it.
+    """
 
     cell: int
     probability: float
     fixations: int
+    forced_by: str = ''
 
 
 @dataclass(frozen=True)
 class Absent:
-    """The absent event: ``P(absent)`` reached the confidence level."""
+    """The absent event: ``P(absent)`` reached the confidence level (or a limit forced it)."""
 
     probability: float
     fixations: int
+    forced_by: str = ''
 
 
 @dataclass(frozen=True)
@@ -431,11 +438,12 @@ class GazeController:
 
     def _events(self, fired: str) -> dict:
         """Return the event objects of what a frame fired (found, absent or gave_up)."""
+        forced_by = self.session.gave_up_reason if fired in ('found', 'absent') else ''
         if fired == 'found':
-            self.found = Found(self.map_cell, self.map_probability, self.fixations)
+            self.found = Found(self.map_cell, self.map_probability, self.fixations, forced_by)
             return {'found': self.found}
         if fired == 'absent':
-            self.absent = Absent(self.absent_probability, self.fixations)
+            self.absent = Absent(self.absent_probability, self.fixations, forced_by)
             return {'absent': self.absent}
         if fired == 'gave_up':
             self.gave_up = GaveUp(self.fixations)

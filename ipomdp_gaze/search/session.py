@@ -338,8 +338,20 @@ class SearchSession:
 
     @property
     def fixation(self) -> int | None:
-        """Return the current fixation; None before :meth:`start`."""
+        """Return the current fixation, a row-major index; None before :meth:`start`."""
         return self._state().fixation
+
+    @property
+    def fixation_cell(self) -> tuple[int, int] | None:
+        """
+        Return the current fixation as ``(row, col)``; None before :meth:`start`.
+
+        :meth:`start`, :attr:`fixation`, :attr:`map_cell` and ``StepResult.fixation`` stay
+        row-major indices ``row * cols + col`` (what :meth:`fixate`, :meth:`exclude` and the
+        policies take); this is the same cell for a driver that moves a head by row and column.
+        """
+        cell = self._state().fixation
+        return None if cell is None else tuple(int(v) for v in self.grid.cell(cell))
 
     @property
     def visited(self) -> np.ndarray:
@@ -508,7 +520,7 @@ class SearchSession:
 
     def start(self) -> int:
         """
-        Choose the first fixation and return it.
+        Choose the first fixation and return it, a row-major index (:attr:`fixation_cell`).
 
         ``settings.start_cell`` if it is a cell; the policy's choice (its best unvisited cell
         with inhibition of return) on the belief if it is ``'policy'`` or after a scan;

@@ -159,7 +159,7 @@ def _text(canvas, text: str, org, scale: float, colour, thickness: int = 1) -> N
 
 def annotate(image: np.ndarray, cell_map: CellMap, belief=None, fixations=(), windows=(),
              detections=None, found=None, alpha: float = 0.45, label: str = '',
-             found_label: str = 'found') -> np.ndarray:
+             found_label: str = 'found', found_radius: int = 0) -> np.ndarray:
     """
     Draw the search on a copy of ``image``; return ``(H, W, 3)`` uint8 RGB.
 
@@ -185,6 +185,10 @@ def annotate(image: np.ndarray, cell_map: CellMap, belief=None, fixations=(), wi
         A line of text at the top left (for example the fixation count).
     found_label : str
         What the answer is called (``found``; ``most likely`` at the budget).
+    found_radius : int
+        With ``search.found_radius`` r > 0 the answer is the centre of the likeliest
+        (2r + 1)-square of cells: that square is outlined too (thin), so that a face a cell
+        off the centre is inside what is drawn as found.
 
     """
     canvas = as_rgb(image)
@@ -252,7 +256,18 @@ def annotate(image: np.ndarray, cell_map: CellMap, belief=None, fixations=(), wi
             x0, y0, x1, y1 = (int(v) for v in boxes[cell])
             cv2.rectangle(canvas, (x0 - 1, y0 - 1), (x1 + 1, y1 + 1), FOUND_RGB, thick + 1)
         row, col = grid.cell(cell)
-        _text(canvas, f'{found_label} ({row}, {col}) p={probability:.3f}',
+        if found_radius > 0:
+            r = int(found_radius)
+            square = [grid.index(i, j)
+                      for i in range(max(0, row - r), min(grid.rows, row + r + 1))
+                      for j in range(max(0, col - r), min(grid.cols, col + r + 1))]
+            square = [k for k in square if shown[k]]
+            if square:
+                x0, y0 = (int(v) for v in boxes[square, :2].min(axis=0))
+                x1, y1 = (int(v) for v in boxes[square, 2:].max(axis=0))
+                cv2.rectangle(canvas, (x0, y0), (x1, y1), FOUND_RGB, 1)
+        p = 'n/a' if np.isnan(probability) else f'{probability:.3f}'
+        _text(canvas, f'{found_label} ({row}, {col}) p={p}',
               (4, height - int(6 + 8 * scale)), scale, FOUND_RGB, thick)
     if label:
         _text(canvas, label, (4, int(14 + 20 * scale)), scale, (255, 255, 255), thick)

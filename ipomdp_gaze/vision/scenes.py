@@ -510,7 +510,9 @@ def read_labelled_folder(folder, csv_path) -> list[LabelledImage]:
 def _read_image(path: Path, where: str) -> np.ndarray:
     if not path.is_file():
         raise FileNotFoundError(f'{where}: image {path} does not exist')
-    image = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    from .image_files import decode_quietly
+    data = np.fromfile(path, dtype=np.uint8)
+    image = decode_quietly(data, cv2.IMREAD_UNCHANGED) if data.size else None
     if image is None:
         raise ValueError(f'{where}: cannot decode {path} as an image')
     if image.dtype != np.uint8:

@@ -46,6 +46,7 @@ import math
 import time
 
 from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.search import answer
 from ipomdp_gaze.search.sensors import run_search
 from ipomdp_gaze.search.session import SearchSession, SearchSettings
 from ipomdp_gaze.vision.detector import detector_window_px
@@ -135,6 +136,11 @@ class ImageSearch:
         :func:`full_frame_reason`); a full-frame answer has ``probability`` NaN.
     note : str
         Why the full frame was scanned ('' for the fovea).
+    resized_from : (int, int) or None
+        ``(width, height)`` of the image as given when it was resized before the search
+        (``find --max-side``; ``pixel`` is then in the given image's pixels), else None.
+    detections : tuple of (float, float)
+        A full-frame scan's grouped detections, box centres ``(x, y)`` in image pixels.
 
     """
 
@@ -154,6 +160,20 @@ class ImageSearch:
     log: tuple = ()
     method: str = 'fovea'
     note: str = ''
+    resized_from: tuple | None = None
+    detections: tuple = ()
+
+    @property
+    def ended(self) -> str:
+        """How the search ended: ``confidence``, ``forced:<limit>``, ... (:mod:`..answer`)."""
+        return answer.ended(self.decision,
+                            'full_frame' if self.method == 'full_frame' else self.stop)
+
+    @property
+    def answer_probability(self) -> float:
+        """Return the answer's probability: ``P(absent)`` for ``absent``, else the cell's."""
+        return answer.answer_probability(self.decision, self.probability,
+                                         self.absent_probability)
 
     @property
     def size_matches(self) -> bool:
@@ -295,10 +315,8 @@ def search_image(image: np.ndarray, fovea: Fovea, model, policy,
                          pixel_budget=pixel_budget, exclude=excluded, restart=restart)
     grid = fovea.grid
     best = outcome.cell
-    if outcome.reason == 'pixels' or outcome.decision == 'gave_up':
-        stop = outcome.reason
-    else:
-        stop = outcome.decision
+    # A limit's name when one ended it (a decision it forced included), else the decision.
+    stop = outcome.reason or outcome.decision
     return ImageSearch(cell=tuple(int(v) for v in grid.cell(best)),
                        pixel=cell_centre_px(grid, best, image_px),
                        probability=outcome.probability, fixations=outcome.fixations,
@@ -406,9 +424,10 @@ def full_frame_search(image: np.ndarray, fovea: Fovea, note: str = '',
     boxes = found.grouped_px
     order = np.argsort(-(boxes[:, 2] * boxes[:, 3]), kind='stable') if len(boxes) else []
     seconds = time.perf_counter() - t0
+    centres = tuple((float(x + w / 2), float(y + h / 2)) for x, y, w, h in boxes)
     common = {'fixations': 0, 'path': (), 'detector_pixels': found.detector_pixels,
               'seconds': seconds, 'image_px': image_px, 'calibrated_px': calibrated_px,
-              'method': 'full_frame', 'note': note}
+              'method': 'full_frame', 'note': note, 'detections': centres}
     results = []
     for k in order:
         x, y, w, h = boxes[k]

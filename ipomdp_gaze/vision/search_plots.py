@@ -11,6 +11,7 @@ scale. :func:`save_gif` writes an animation of such images (Pillow, which matplo
 from __future__ import annotations
 
 from pathlib import Path
+import textwrap
 
 import cv2
 import numpy as np
@@ -34,9 +35,13 @@ def annotate_image_search(image: np.ndarray, result, fovea) -> np.ndarray:
     Draw an offline image search (:class:`ipomdp_gaze.vision.search.ImageSearch`) on its image.
 
     The image is enlarged first (:func:`enlarged`), then the final belief, the scan path, the
-    last fixation's windows and the answer (``found``, or ``most likely`` at another stop) are
-    drawn on it.
+    last fixation's windows and the answer are drawn on it: ``found`` (``found, forced`` when a
+    limit forced it), ``most likely`` when the search gave up; on an ``absent`` answer no cell
+    is drawn as found, only the probability that nobody is there. A full-frame scan (a small
+    image) has no fixations: its picture is the scan's detections (yellow crosses) and its
+    belief.
     """
+    from ipomdp_gaze.search import answer
     big, factor = enlarged(image)
     grid = fovea.grid
     cell_map = fovea_cell_map(grid, big.shape[1], big.shape[0])
@@ -44,9 +49,24 @@ def annotate_image_search(image: np.ndarray, result, fovea) -> np.ndarray:
     windows = [(x * factor, y * factor, w * factor, h * factor, win.whole_image)
                for win in fovea.window_rects(path[-1], image.shape)
                for x, y, w, h in [win.rect_px]] if path else []
-    answer = (grid.index(*result.cell), result.probability)
-    return annotate(big, cell_map, result.belief, path, windows, found=answer,
-                    found_label='found' if result.stop == 'found' else 'most likely')
+    detections = None
+    if getattr(result, 'detections', ()):
+        detections = np.asarray(result.detections, dtype=np.float64) * factor
+    reason = 'full_frame' if result.method == 'full_frame' else result.stop
+    label = ''
+    if result.decision == 'absent':
+        found = None
+        label = (f'{answer.heading("absent", reason)}: '
+                 f'{answer.probability_text("absent", result.answer_probability)}')
+    else:
+        found = (grid.index(*result.cell), result.probability)
+        if result.decision == 'gave_up':
+            found_label = 'most likely'
+        else:
+            found_label = 'found, forced' if answer.forced('found', reason) else 'found'
+    return annotate(big, cell_map, result.belief, path, windows, detections=detections,
+                    found=found, label=label,
+                    **({} if found is None else {'found_label': found_label}))
 
 
 def save_figure(picture: np.ndarray, out_path: Path, title: str) -> None:
@@ -61,7 +81,7 @@ def save_figure(picture: np.ndarray, out_path: Path, title: str) -> None:
     fig, ax = plt.subplots(figsize=(fig_w, fig_w * height / width * 0.9 + 0.6))
     ax.imshow(picture, interpolation='nearest')
     ax.set_axis_off()
-    ax.set_title(title, fontsize=9)
+    ax.set_title(textwrap.fill(title, 100), fontsize=9)
     bar = fig.colorbar(ScalarMappable(Normalize(-LOG_RANGE, 0), 'inferno'), ax=ax,
                        fraction=0.04, pad=0.02)
     bar.set_label('log10 belief / most likely cell (overlay)', fontsize=8)

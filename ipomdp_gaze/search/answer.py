@@ -1,0 +1,86 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+How a search ended, in one wording for every driver (find, demo, search, replay, the node).
+
+A search ends with a **decision** (``found``, ``absent`` or ``gave_up``) and a **reason**: the
+evidence reached ``confidence`` (reason ``found`` / ``absent`` / ''), or a limit ended it:
+``budget`` (the fixation budget), ``pixels`` (``find``'s cost cap: one full-resolution scan of
+detector pixels), ``repeat`` (every cell fixated once), ``timeout``. At a limit a search gives up,
+or, with ``decide_at_budget``, is **forced** to the likelier of ``found`` and ``absent``, whose
+probability is then below ``confidence``.
+
+The probability of an answer is that of *that* answer: the found cell's (its square with
+``found_radius``) for ``found``, ``P(absent)`` (nobody is there) for ``absent``, the most likely
+cell's for ``gave_up``.
+
+:func:`ended` is the one-token form (``find``'s line and JSON), :func:`how` the words, for
+example ``found: ... probability 0.998, after 8 fixations (reached the confidence 0.99)`` and
+``found, forced by the pixel budget: ... probability 0.847 (below the confidence 0.99)``.
+"""
+from __future__ import annotations
+
+import math
+
+# The limits that can end a search, and their words.
+LIMITS = {'budget': 'the fixation budget', 'pixels': 'the pixel budget (one full scan)',
+          'repeat': 'every cell fixated once', 'timeout': 'the time limit'}
+
+
+def ended(decision: str, reason: str = '') -> str:
+    """
+    Return how a search ended as one token.
+
+    ``confidence`` (the evidence reached the confidence), ``forced:<limit>`` (a limit forced a
+    ``found`` or ``absent``), ``<limit>`` for ``gave_up``, ``scan`` for ``full_frame`` answers
+    (one detector scan, no belief), '' for no decision.
+    """
+    if not decision:
+        return ''
+    if reason == 'full_frame':
+        return 'scan'
+    if decision == 'gave_up':
+        return reason or 'limit'
+    if reason in LIMITS:
+        return f'forced:{reason}'
+    return 'confidence'
+
+
+def forced(decision: str, reason: str = '') -> bool:
+    """Whether a limit forced a ``found`` or ``absent`` (its probability below confidence)."""
+    return ended(decision, reason).startswith('forced:')
+
+
+def answer_probability(decision: str, cell_probability: float,
+                       absent_probability: float) -> float:
+    """Return the probability of the answer: ``P(absent)`` for ``absent``, else the cell's."""
+    return float(absent_probability if decision == 'absent' else cell_probability)
+
+
+def heading(decision: str, reason: str = '') -> str:
+    """Return the decision word with how it ended: ``found``, ``absent, forced by ...``."""
+    if decision == 'gave_up':
+        return 'gave up'
+    if reason == 'full_frame':
+        return f'{decision} by one full-frame detector scan'
+    if forced(decision, reason):
+        return f'{decision}, forced by {LIMITS[reason]}'
+    return decision
+
+
+def confidence_clause(decision: str, reason: str, probability: float,
+                      confidence: float | None) -> str:
+    """Return ``(reached the confidence C)``, ``(below the confidence C)`` or ''."""
+    if confidence is None or not decision or math.isnan(probability):
+        return ''
+    word = 'reached' if probability >= confidence and not forced(decision, reason) \
+        else 'below'
+    return f' ({word} the confidence {confidence:g})'
+
+
+def probability_text(decision: str, probability: float) -> str:
+    """Return ``probability 0.998``; for ``absent``, ``probability 0.993 that nobody is here``."""
+    if math.isnan(probability):
+        return 'probability n/a'
+    nobody = ' that nobody is here' if decision == 'absent' else ''
+    return f'probability {probability:.3f}{nobody}'

@@ -1,0 +1,112 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The demo's printed lines say what the controller decided (issue 35), without node processes.
+
+The demo follows the controller's messages; here they are built directly and handed to
+:func:`ipomdp_gaze.nodes.demo._follow` as the watch would record them: the face demo's progress
+lines name the answer as the controller's ``found`` rule does (``search.found_radius``), show the
+probability that nobody is there when the search can end ``absent``, and the last line says how
+the search ended.
+"""
+from types import SimpleNamespace
+
+from conftest import HAVE_RCLPY
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')
+
+
+def _record(setup, beliefs, looked, found=None, absent=None, truth=None):
+    from builtin_interfaces.msg import Time
+    from ipomdp_gaze.msg_adapters import grid_arrays, joints
+    grid, head = setup.grid, setup.head
+    return SimpleNamespace(
+        beliefs=[(0.0, grid_arrays.to_multiarray(b, grid)) for b in beliefs],
+        targets=[(0.0, joints.joint_state(head, c, Time())) for c in looked],
+        found=[] if found is None else [(0.0, found)],
+        absent=[] if absent is None else [(0.0, absent)],
+        truth=[(0.0, grid_arrays.ground_truth(grid, truth))])
+
+
+def _follow(setup, record):
+    from ipomdp_gaze.nodes.demo import _follow
+    lines, stats = [], {}
+    assert _follow(setup, record, lambda condition: condition(), 60.0, lines.append,
+                   stats) == 0
+    return lines, stats
+
+
+def test_the_face_demos_lines_name_the_answer_the_controller_found():
+    from ipomdp_gaze.msg_adapters import diagnostics
+    from ipomdp_gaze.nodes.demo import faces_setup
+    setup = faces_setup()
+    grid = setup.grid
+    assert setup.settings.found_radius == 1 and setup.settings.absent_prior > 0
+    # A face straddling (5, 9) and (6, 9): (5, 9) the likeliest single cell, the square round
+    # (6, 9) the likeliest square (what the controller's found rule answers).
+    belief = np.zeros(grid.n_cells)
+    belief[grid.index(5, 9)], belief[grid.index(6, 9)] = 0.50, 0.40
+    belief[grid.index(7, 9)], belief[grid.index(7, 10)] = 0.05, 0.045
+    cell = grid.index(6, 9)
+    found = diagnostics.found_status('c: found', 6, 9, cell, 0.0, 0.0, 0.995, 2, '', 0.99)
+    lines, stats = _follow(setup, _record(setup, [belief * 0.5, belief], [60, 61], found=found,
+                                          truth=cell))
+    assert lines[1].startswith('fixation   2: looked at (5, 6)')
+    assert '->  most likely (6, 9) p=0.995  nobody p=0.005  entropy' in lines[1]
+    assert lines[2].startswith('found: the face is most likely at (6, 9), ')
+    assert lines[2].endswith('probability 0.995, after 2 fixations (reached the confidence '
+                             '0.99)')
+    assert stats['stop'] == 'found' and stats['right']
+
+
+def test_a_forced_found_and_an_absent_answer_say_so():
+    from ipomdp_gaze.msg_adapters import diagnostics
+    from ipomdp_gaze.nodes.demo import faces_setup
+    setup = faces_setup(empty=True)
+    grid = setup.grid
+    belief = np.full(grid.n_cells, 0.3 / grid.n_cells)
+    forced = diagnostics.found_status('c: found', 0, 0, 0, 0.0, 0.0, 0.62, 1, 'budget', 0.99)
+    lines, _ = _follow(setup, _record(setup, [belief], [60], found=forced, truth=0))
+    assert lines[-2].startswith('found, forced by the fixation budget: the face is most likely '
+                                'at (0, 0), ')
+    assert lines[-2].endswith('probability 0.620, after 1 fixations (below the confidence 0.99)')
+    absent = diagnostics.absent_status('c: absent', 0.7, 1, '', 0.99)
+    lines, stats = _follow(setup, _record(setup, [belief], [60], absent=absent))
+    assert '->  most likely' in lines[0] and 'nobody p=0.700' in lines[0]   # today: p=0.002 only
+    assert lines[1] == ('absent: nobody is here, probability 0.700 that nobody is here, after 1 '
+                        'fixations (below the confidence 0.99)')
+    assert stats['stop'] == 'absent' and stats['right']
+
+
+def test_the_gaussian_demo_shows_no_absent_probability():
+    from ipomdp_gaze.msg_adapters import diagnostics
+    from ipomdp_gaze.nodes.demo import demo_setup
+    setup = demo_setup(target=(9, 7))
+    grid = setup.grid
+    belief = np.full(grid.n_cells, 0.01 / (grid.n_cells - 1))
+    belief[grid.index(9, 7)] = 0.99
+    found = diagnostics.found_status('c: found', 9, 7, grid.index(9, 7), 0.0, 0.0, 0.99, 1, '',
+                                     0.95)
+    lines, _ = _follow(setup, _record(setup, [belief], [60], found=found,
+                                      truth=grid.index(9, 7)))
+    assert 'nobody' not in lines[0] and '->  most likely (9, 7) p=0.990  entropy' in lines[0]
+    assert lines[1].startswith('found: the target is most likely at (9, 7), pan')
+    assert lines[1].endswith('(reached the confidence 0.95)')
+
+
+def test_the_detectors_picture_labels_a_forced_answer():
+    """The annotated image calls a found the fixation budget forced ``found, forced``."""
+    from ipomdp_gaze.msg_adapters import diagnostics
+    from ipomdp_gaze.nodes.annotation import Annotator
+    node = SimpleNamespace(create_publisher=lambda *a: None,
+                           create_subscription=lambda *a: None)
+    annotator = Annotator(node)
+    annotator._publish = lambda: None
+    annotator._on_found(diagnostics.found_status('c: found', 1, 2, 13, 0.0, 0.0, 0.6, 20,
+                                                 'budget', 0.99))
+    assert annotator.found == (13, 0.6) and annotator.found_label == 'found, forced'
+    annotator._on_found(diagnostics.found_status('c: found', 1, 2, 13, 0.0, 0.0, 0.999, 4,
+                                                 radius=1))
+    assert annotator.found_label == 'found' and annotator.found_radius == 1

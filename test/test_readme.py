@@ -1,0 +1,117 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The README's shown commands print what the README shows (issue 35, item 3; a first part).
+
+A fenced block whose lines start with ``$ `` is a transcript: each command (with its backslash
+continuation lines) is run in a fresh folder, in order, with ``.venv/bin/python`` and
+``.venv/bin/ipomdp-gaze`` standing for this interpreter and its CLI; what it prints (stdout and
+stderr, in order) must be the lines shown under it, numbers included, with times aside
+(``seconds=...``). A ``...`` line stands for any lines. Transcripts of commands that start ROS
+nodes (``demo``, ``record``, ``replay`` of a demo's bag) and those whose inputs the README does
+not create (``mine/``, ``photo.png``) are not run; the demo outputs the README shows are
+compared with ``ipomdp-gaze demo`` runs by a ROS test here.
+"""
+from pathlib import Path
+import re
+import subprocess
+import sys
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+FENCE = re.compile(r'^```[a-z]*\n(.*?)^```', re.S | re.M)
+# What a transcript may run here: fast commands without ROS nodes.
+RUNNABLE = re.compile(r'^\$ \.venv/bin/(python -c|ipomdp-gaze (find|search))\b')
+TIMES = (re.compile(r'seconds=\d+\.\d+'), 'seconds=<time>')
+
+
+def transcripts() -> list:
+    """Return ``[(commands, outputs)]`` of the README's runnable transcripts."""
+    found = []
+    for block in FENCE.findall((ROOT / 'README.md').read_text()):
+        lines = block.splitlines()
+        if not lines or not lines[0].startswith('$ '):
+            continue
+        steps, i = [], 0
+        while i < len(lines):
+            command = lines[i]
+            while command.endswith('\\'):
+                i += 1
+                command = command[:-1] + ' ' + lines[i].strip()
+            i += 1
+            shown = []
+            while i < len(lines) and not lines[i].startswith('$ '):
+                shown.append(lines[i])
+                i += 1
+            steps.append((command, shown))
+        if all(RUNNABLE.match(command) for command, _ in steps):
+            found.append(steps)
+    return found
+
+
+def _shell(command: str) -> str:
+    python = sys.executable
+    command = command[2:].replace('.venv/bin/python', python, 1)
+    return command.replace('.venv/bin/ipomdp-gaze', f'{python} -m ipomdp_gaze.cli', 1)
+
+
+def _matches(shown: list, printed: list) -> bool:
+    """Whether the printed lines are the shown ones (``...``: any lines)."""
+    pattern = ''.join('(?:.*\n)*?' if line == '...' else re.escape(line) + '\n'
+                      for line in shown)
+    return re.fullmatch(pattern, ''.join(line + '\n' for line in printed)) is not None
+
+
+def test_the_readme_has_runnable_transcripts():
+    assert transcripts(), 'no runnable transcript found in README.md'
+
+
+@pytest.mark.parametrize('steps', transcripts(), ids=lambda steps: steps[-1][0][2:60])
+def test_a_readme_transcript_prints_what_it_shows(steps, tmp_path):
+    for command, shown in steps:
+        run = subprocess.run(['bash', '-c', _shell(command) + ' 2>&1'], cwd=tmp_path,
+                             capture_output=True, text=True, timeout=600)
+        assert run.returncode == 0, run.stdout
+        printed = [TIMES[0].sub(TIMES[1], line) for line in run.stdout.splitlines()]
+        expected = [TIMES[0].sub(TIMES[1], line) for line in shown]
+        assert _matches(expected, printed), (f'{command}\nREADME shows:\n' + '\n'.join(shown)
+                                             + '\nprinted:\n' + '\n'.join(printed))
+
+
+def _block_with(text: str) -> list:
+    """Return the lines of the README's one fenced block that holds ``text``."""
+    blocks = [b for b in FENCE.findall((ROOT / 'README.md').read_text()) if text in b]
+    assert len(blocks) == 1, f'{len(blocks)} README blocks hold {text!r}'
+    return blocks[0].splitlines()
+
+
+def _contains(shown: list, printed: list) -> bool:
+    """Whether the shown lines (``...``: any lines) are a run of whole printed lines."""
+    pattern = ''.join('(?:.*\n)*?' if line == '...' else re.escape(line) + '\n'
+                      for line in shown)
+    return re.search('(?:^|\n)' + pattern, ''.join(line + '\n' for line in printed)) is not None
+
+
+# The demo outputs the README shows, by a line only that block holds, and the options that make
+# them (each demo is deterministic for its seed: the simulated camera's noise, the scene and the
+# detector).
+DEMOS = [('the simulated camera hid the target at (9, 7)', []),
+         ('stopped all 3 nodes (scene_camera exit status 0', ['--scene', 'faces']),
+         ('the scene camera showed a scene with nobody in it', ['--scene', 'faces', '--empty'])]
+
+
+@pytest.mark.ros
+@pytest.mark.parametrize('line, options', DEMOS, ids=['demo', 'faces', 'faces-empty'])
+def test_the_readme_shows_what_the_demo_prints(ros_env, line, options):
+    """Issue 35: the README showed a demo output the command no longer printed."""
+    from conftest import HAVE_RCLPY, REPO
+    if not HAVE_RCLPY:
+        pytest.skip('rclpy is not installed')
+    run = subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', 'demo', '--domain-id',
+                          ros_env['ROS_DOMAIN_ID'], *options], cwd=REPO, env=ros_env,
+                         capture_output=True, text=True, timeout=180)
+    assert run.returncode == 0, run.stdout + run.stderr
+    shown = _block_with(line)
+    assert _contains(shown, run.stdout.splitlines()), \
+        'README shows:\n' + '\n'.join(shown) + '\nprinted:\n' + run.stdout
