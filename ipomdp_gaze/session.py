@@ -70,7 +70,11 @@ PARAMETER_NAMES = {
     'false_alarm_scales': 'search.false_alarm_scales',
     'hotspot_prior': 'search.hotspot_prior',
     'hotspot_scale': 'search.hotspot_scale',
+    'targets': 'search.targets',
 }
+# search.targets: the paper's one target (or none), or many (an occupancy per cell,
+# ipomdp_gaze.many); SearchSession runs 'one', OccupancySession 'many'.
+TARGETS = ('one', 'many')
 
 
 def _check_flag(value, name: str) -> bool:
@@ -158,6 +162,9 @@ class SearchSettings:
         tables in every view (:mod:`ipomdp_gaze.false_alarms`); 0: no hotspots.
     hotspot_scale : float
         A hotspot's factor (> 1) of the model's false-alarm rates.
+    targets : str
+        ``'one'`` (the paper's belief over one target, or none) or ``'many'`` (an occupancy
+        per cell, :mod:`ipomdp_gaze.many`).
 
     """
 
@@ -176,6 +183,7 @@ class SearchSettings:
     false_alarm_scales: tuple = (1.0,)
     hotspot_prior: float = 0.0
     hotspot_scale: float = DEFAULT_HOTSPOT_SCALE
+    targets: str = 'one'
 
     def __post_init__(self):
         names = PARAMETER_NAMES
@@ -199,6 +207,9 @@ class SearchSettings:
             'hotspot_prior': check_hotspot_prior(self.hotspot_prior, names['hotspot_prior']),
             'hotspot_scale': check_hotspot_scale(self.hotspot_scale, names['hotspot_scale']),
         }
+        if not (isinstance(self.targets, str) and self.targets in TARGETS):
+            raise ValueError(f"{names['targets']} must be one of {', '.join(TARGETS)}, got "
+                             f'{self.targets!r}')
         for key, value in checked.items():
             object.__setattr__(self, key, value)
 
