@@ -15,14 +15,15 @@ The same steps and results as :class:`ipomdp_gaze.session.SearchSession` (``rese
    scene's repeated views weighted by ``repeat_weight`` (:mod:`ipomdp_gaze.still_evidence`:
    1 is naive Bayes);
 4. stop when every cell is decided at ``confidence`` either way (``P(x_j) >= c`` occupied,
-   ``<= 1 - c`` empty): ``found`` if a cell is occupied, else ``absent``; at the fixation budget
-   or a driver's cost cap (:meth:`stop`), ``gave_up`` or, with ``decide_at_budget``, every cell
-   by its likelier side; ``gave_up`` (reason ``repeat``) when no view left would tell anything
-   new;
+   ``<= 1 - c`` empty; with ``link`` r > 0 a cell within r cells of an occupied one is
+   settled too: it would join that face's cluster, so it cannot be another face): ``found``
+   if a cell is occupied, else ``absent``; at the fixation budget or a driver's cost cap
+   (:meth:`stop`), ``gave_up`` or, with ``decide_at_budget``, every cell by its likelier side;
+   ``gave_up`` (reason ``repeat``) when no view left would tell anything new;
 5. otherwise the next fixation maximises the expected reduction of the summed cell entropies per
    unit cost: ``argmax_k sum_j w_kj I(P(x_j); offset_jk) / cost_k`` over unvisited cells, with
    ``w_kj = 1`` where view k sees cell j at a more informative offset (ELM kernel) than any view
-   so far and ``repeat_weight`` otherwise.
+   so far, ``repeat_weight`` otherwise, and 0 for a cell settled by ``link``.
 
 The answer for drivers: :meth:`OccupancySession.faces` (one face per cluster of occupied cells,
 :func:`ipomdp_gaze.occupancy.count_faces`). The session imports no ROS, prints and writes nothing.
@@ -32,6 +33,7 @@ from __future__ import annotations
 from collections import deque
 
 import numpy as np
+from scipy.ndimage import maximum_filter
 
 from .belief import argmax_ties_low, EvidenceError
 from .observation import as_observation, check_evidence, CountObservation
@@ -69,19 +71,23 @@ class OccupancySession:
         ``repeat_weight``, ``absent_prior``, ``start_cell``, ``scan``, ``decide_at_budget``.
     costs : array (N,), optional
         Cost of a fixation at each cell (detector pixels for the fovea); 1 each by default.
+    link : int
+        Cells within this many cells (Chebyshev) of a cell decided occupied are settled
+        (module docstring); 0: every cell is decided on its own.
     log_size : int
         Events kept in :attr:`log`.
 
     """
 
     def __init__(self, grid, observation, settings: SearchSettings | None = None,
-                 costs=None, log_size: int = 10_000):
+                 costs=None, link: int = 0, log_size: int = 10_000):
         self.grid = grid
         self.observation = as_observation(grid, observation)
         self.settings = settings or SearchSettings(targets='many')
         self.settings.check_grid(grid)
         check_many_settings(self.settings)
         self.policy = None
+        self.link = int(link)
         self.table = InformationTable(self.observation)
         ri, ci = grid.pair_offset_index()
         kernel = np.asarray(self.observation.elm_kernel(), dtype=float)
@@ -266,6 +272,14 @@ class OccupancySession:
         return self._result('applied', fired=fired)
 
     # -- inside ------------------------------------------------------------------------------
+    def settled(self, occupied: np.ndarray) -> np.ndarray:
+        """Cells (N,) within ``link`` cells of an occupied one, the occupied ones included."""
+        if self.link <= 0:
+            return occupied
+        side = 2 * self.link + 1
+        grid = occupied.reshape(self.grid.shape)
+        return maximum_filter(grid, size=side, mode='constant', cval=False).reshape(-1)
+
     def gains(self, log_odds: np.ndarray | None = None) -> np.ndarray:
         """
         Return the expected drop of the summed cell entropies per fixation cell (N,), nats.
@@ -277,6 +291,9 @@ class OccupancySession:
         info = self.table(log_odds)                                        # (N, N) [k, j]
         weight = np.where(self._view_info > self._best[None, :], 1.0,
                           self.settings.repeat_weight)
+        if self.link > 0:
+            settled = self.settled(decided(log_odds, self.settings.confidence)[0])
+            weight = weight * ~settled[None, :]
         return np.einsum('kj,kj->k', info, weight)
 
     def _choose(self) -> int | None:
@@ -291,7 +308,7 @@ class OccupancySession:
     def _decide(self) -> str:
         s, settings = self._state, self.settings
         occupied, empty = decided(self.log_odds, settings.confidence)
-        if np.all(occupied | empty):
+        if np.all(self.settled(occupied) | empty):
             s['decision'] = 'found' if occupied.any() else 'absent'
             s['ended'] = True
             return s['decision']

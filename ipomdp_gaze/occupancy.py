@@ -226,31 +226,39 @@ def clusters(cells: np.ndarray, grid, link: int = 1) -> np.ndarray:
     return order[labels]
 
 
-def box_iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Intersection over union (A, B) of boxes ``x, y, w, h`` (A, 4) and (B, 4)."""
+def box_iou(a: np.ndarray, b: np.ndarray, over: str = 'union') -> np.ndarray:
+    """
+    Intersection over union (A, B) of boxes ``x, y, w, h`` (A, 4) and (B, 4).
+
+    ``over='smaller'``: over the smaller box's area (1 when one box lies inside the other).
+    """
     a, b = np.asarray(a, dtype=float).reshape(-1, 4), np.asarray(b, dtype=float).reshape(-1, 4)
     x0 = np.maximum(a[:, None, 0], b[None, :, 0])
     y0 = np.maximum(a[:, None, 1], b[None, :, 1])
     x1 = np.minimum(a[:, None, 0] + a[:, None, 2], b[None, :, 0] + b[None, :, 2])
     y1 = np.minimum(a[:, None, 1] + a[:, None, 3], b[None, :, 1] + b[None, :, 3])
     inter = np.clip(x1 - x0, 0, None) * np.clip(y1 - y0, 0, None)
-    union = (a[:, 2] * a[:, 3])[:, None] + (b[:, 2] * b[:, 3])[None, :] - inter
+    area_a, area_b = (a[:, 2] * a[:, 3])[:, None], (b[:, 2] * b[:, 3])[None, :]
+    union = np.minimum(area_a, area_b) if over == 'smaller' else area_a + area_b - inter
     return np.where(union > 0, inter / np.where(union > 0, union, 1.0), 0.0)
 
 
-def merge_boxes(boxes, scores=None, iou: float = 0.3) -> tuple[np.ndarray, np.ndarray]:
+def merge_boxes(boxes, scores=None, iou: float = 0.3,
+                inside: float = 0.6) -> tuple[np.ndarray, np.ndarray]:
     """
-    Greedy non-maximum suppression: the distinct boxes ``(F, 4)`` and how many raw boxes each kept.
+    Greedy non-maximum suppression: the distinct boxes ``(F, 4)`` and their support ``(F,)``.
 
     Boxes in decreasing score (then area) order; a box overlapping a kept one by more than
-    ``iou`` joins it. One face seen by several windows and scales is one box.
+    ``iou`` (of the union), or lying in it by more than ``inside`` (of the smaller box), joins
+    it. One face seen by several windows and scales is one box; its support is the sum of the
+    scores of the raw boxes it took (1 each for a detector without scores).
     """
     boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
     if boxes.shape[0] == 0:
         return boxes, np.zeros(0, dtype=np.intp)
     scores = np.ones(len(boxes)) if scores is None else np.asarray(scores, dtype=float)
     order = np.lexsort((-boxes[:, 2] * boxes[:, 3], -scores))
-    overlap = box_iou(boxes, boxes) > iou
+    overlap = (box_iou(boxes, boxes) > iou) | (box_iou(boxes, boxes, 'smaller') > inside)
     owner = np.full(len(boxes), -1)
     kept = []
     for i in order:                       # over detections (a handful per face), not cells
@@ -259,7 +267,7 @@ def merge_boxes(boxes, scores=None, iou: float = 0.3) -> tuple[np.ndarray, np.nd
         owner[i] = len(kept)
         owner[(owner < 0) & overlap[i]] = len(kept)
         kept.append(i)
-    return boxes[kept], np.bincount(owner, minlength=len(kept))
+    return boxes[kept], np.bincount(owner, weights=scores, minlength=len(kept))
 
 
 def cell_boxes_px(grid, cells, image_px) -> np.ndarray:
@@ -272,7 +280,8 @@ def cell_boxes_px(grid, cells, image_px) -> np.ndarray:
 
 
 def count_faces(log_odds: np.ndarray, grid, occupied: np.ndarray, boxes=None, scores=None,
-                image_px=None, link: int = 2, iou: float = 0.3) -> list[dict]:
+                image_px=None, link: int = 2, iou: float = 0.3,
+                support: float = 0.5) -> list[dict]:
     """
     Return one face per cluster of occupied cells, split where the detector's boxes differ.
 
@@ -292,6 +301,9 @@ def count_faces(log_odds: np.ndarray, grid, occupied: np.ndarray, boxes=None, sc
         Occupied cells within this many cells (Chebyshev) belong to one cluster.
     iou : float
         Raw boxes overlapping more than this are one face (:func:`merge_boxes`).
+    support : float
+        A cluster is split only by merged boxes with at least this share of the support of its
+        best-supported box (a stray raw box beside a face does not make a second face).
 
     Returns
     -------
@@ -325,6 +337,8 @@ def count_faces(log_odds: np.ndarray, grid, occupied: np.ndarray, boxes=None, sc
             br, bc = np.divmod(centre_cells, grid.cols)
             dist = np.maximum(np.abs(br[:, None] - r[None, :]), np.abs(bc[:, None] - c[None, :]))
             own = np.flatnonzero(dist.min(axis=1) <= 1)
+            if own.size:
+                own = own[counts[own] >= support * counts[own].max()]
         if own.size >= 2:
             r, c = np.divmod(cells, grid.cols)
             br, bc = np.divmod(centre_cells[own], grid.cols)

@@ -17,8 +17,11 @@ detector pixels than one full-resolution scan of the image: it stops before a fi
 would, and decides then (``decide_at_budget``; stop ``pixels``). When the fovea would cost more
 or cannot see (a small image, an image at most half the model's calibrated size, a close-up
 portrait: :func:`ipomdp_gaze.vision.search.full_frame_reason`) the whole frame is scanned once
-instead and stderr says why. ``--all`` finds every face
-(:func:`ipomdp_gaze.vision.search.search_all`): one line per face, then the last decision.
+instead and stderr says why. ``--all`` finds every face in one search over the many-target
+belief (``--targets many``, its default: :func:`ipomdp_gaze.vision.search.search_many`;
+docs/design.md section 11): one line per face with its box, then the image's line;
+``--targets one`` keeps the old loop (:func:`ipomdp_gaze.vision.search.search_all`: find one
+face, rule its cells out, search again).
 
 **Images** are read with OpenCV (``IMREAD_ANYDEPTH | IMREAD_ANYCOLOR``: EXIF orientation applied,
 an alpha channel dropped, the bit depth kept so a 16-bit file is refused rather than silently
@@ -45,6 +48,7 @@ whose ``observation.name`` is the model's name), else ELM on the model, acting b
 """
 from __future__ import annotations
 
+from dataclasses import replace
 import json
 import math
 from pathlib import Path
@@ -55,9 +59,10 @@ from ipomdp_gaze.belief import uniform_log_belief
 from ipomdp_gaze.observation_file import load_observation, shipped_image_models
 from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
+from ipomdp_gaze.session import TARGETS
 from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, FIND_SETTINGS,
                                        fovea_for_model, full_frame_reason, full_frame_search,
-                                       search_all, search_image, size_distance)
+                                       search_all, search_image, search_many, size_distance)
 import numpy as np
 
 from .common import nonneg_int
@@ -104,10 +109,15 @@ def add_parser(sub):
     add_search_args(p, FIND_SETTINGS, ('confidence', 'max_fixations', 'absent_prior',
                                        'repeat_weight', 'start'))
     p.add_argument('--all', action='store_true',
-                   help='find every face: each found face is printed and the cells within 2 '
-                        'of it leave the hypothesis set (faces closer than that count as one), '
-                        'then the search goes on until absent (or gave_up); each search may '
-                        'spend one full scan of detector pixels')
+                   help='find every face in one search over the many-target belief (an '
+                        'occupancy per cell, infomax per detector pixel, within one full scan '
+                        'of detector pixels); each face is printed with its box and '
+                        'probability, counted once per cluster of occupied cells (split where '
+                        "the detector's boxes are distinct faces)")
+    p.add_argument('--targets', choices=TARGETS, default=None,
+                   help="search.targets: one (the paper's belief) or many (an occupancy per "
+                        'cell); default many with --all, else one. --all --targets one: find '
+                        'a face, rule the cells within 2 of it out, search again')
     p.add_argument('--plot', type=Path, default=None, metavar='OUT.png',
                    help='draw the image, the numbered fixations and the windows of the last '
                         'one, in the format the extension names (.png, .pdf, .svg, .jpg, ...; '
@@ -117,8 +127,9 @@ def add_parser(sub):
                    help='write {grid, axes, images: [{path, cell [row, col], pixel [x, y] '
                         '(null unless found), probability, fixations, detector_pixels, '
                         'full_scan_pixels, seconds, decision, absent_probability, stop, method, '
-                        'note, grid}]} in input order (with --all: one entry per face, with '
-                        '"face", then the last decision)')
+                        'note, grid, and with --targets many faces: [{box [x, y, w, h], cell '
+                        '[row, col], probability}]}]} in input order (--all --targets one: one '
+                        'entry per face, with "face", then the last decision)')
     p.add_argument('--log', type=Path, default=None, metavar='OUT.jsonl',
                    help="write each image's search session event log (reset with the "
                         'settings, scan, start, one event per fixation with the frame and '
@@ -273,6 +284,15 @@ def format_line(path: str, result, face: int | None = None) -> str:
     return line
 
 
+def face_line(path: str, result, face: int) -> str:
+    """Format the line of one face of a many-target search."""
+    found = result.faces[face]
+    x, y, w, h = found.box
+    probability = 'n/a' if math.isnan(found.probability) else f'{found.probability:.3f}'
+    return (f'{path}: face={face} box (x, y, w, h)=({x:.0f}, {y:.0f}, {w:.0f}, {h:.0f}) '
+            f'cell (row, col)=({found.cell[0]}, {found.cell[1]}) p={probability}')
+
+
 def entry(path: str, result, grid) -> dict:
     """Return one result's JSON entry: ``cell`` [row, col], ``pixel`` [x, y], null unless found."""
     found = result.decision == 'found'
@@ -345,8 +365,12 @@ def search_one(image, task, settings, rng, find_all: bool) -> list:
     reason = full_frame_reason(task.fovea, (width, height), calibrated_size(task.model))
     if reason:
         results = full_frame_search(image, task.fovea, reason, calibrated_size(task.model))
+        if settings.targets == 'many':
+            return [results[0]]
         return results if find_all else results[:1]
     budget = width * height
+    if settings.targets == 'many':
+        return [search_many(image, task.fovea, task.model, settings, pixel_budget=budget)]
     if find_all:
         return search_all(image, task.fovea, task.model, task.policy, settings, rng=rng,
                           pixel_budget=budget)
@@ -369,7 +393,8 @@ def run(args) -> int:
             image = read_image(path)
             task = tasks.task((image.shape[1], image.shape[0]))
             check_image_size((image.shape[1], image.shape[0]), task.fovea)
-            settings = settings_from_args(args, FIND_SETTINGS, task.model.grid)
+            settings = replace(settings_from_args(args, FIND_SETTINGS, task.model.grid),
+                               targets=args.targets or ('many' if args.all else 'one'))
         except ValueError as exc:
             message = str(exc)
             _error(message if message.startswith(path) else f'{path}: {message}')
@@ -380,15 +405,26 @@ def run(args) -> int:
                              args.all)
         if results[0].method == 'full_frame':
             _note(f'{path}: scanned the whole frame once: {results[0].note}')
+        many = settings.targets == 'many'
         for k, result in enumerate(results):
-            print(format_line(path, result, k if args.all else None), flush=True)
-            entries.append({**entry(path, result, grid), **({'face': k} if args.all else {})})
+            for face in range(len(result.faces) if many else 0):
+                print(face_line(path, result, face), flush=True)
+            print(format_line(path, result, k if args.all and not many else None), flush=True)
+            extra = ({'faces': [face.to_dict() for face in result.faces]} if many else
+                     {'face': k} if args.all else {})
+            entries.append({**entry(path, result, grid), **extra})
         logs.append(json.dumps({'path': path, 'events': [e for r in results for e in r.log]}))
         if plots and results[0].method == 'fovea':
             result = results[0]
             title = (f'{Path(path).name}: {result.decision}, cell (row, col) {result.cell}, '
                      f'p={result.probability:.3f}, {result.fixations} fixations ({result.stop})')
             plot_image_search(image, result, task.fovea, plots[i], title)
+            _note(f'wrote {plots[i]}')
+        elif plots and many:
+            from ipomdp_gaze.vision.search_plots import draw_faces, enlarged, save_figure
+            big, factor = enlarged(image if image.ndim == 3 else np.dstack([image] * 3))
+            save_figure(draw_faces(big, results[0].faces, factor), plots[i],
+                        f'{Path(path).name}: {len(results[0].faces)} faces (full frame)')
             _note(f'wrote {plots[i]}')
         elif plots:
             _note(f'{path}: no plot (the full frame was scanned, no fixations to draw)')

@@ -45,8 +45,23 @@ def annotate_image_search(image: np.ndarray, result, fovea) -> np.ndarray:
                for win in fovea.window_rects(path[-1], image.shape)
                for x, y, w, h in [win.rect_px]] if path else []
     answer = (grid.index(*result.cell), result.probability)
-    return annotate(big, cell_map, result.belief, path, windows, found=answer,
-                    found_label='found' if result.stop == 'found' else 'most likely')
+    faces = getattr(result, 'faces', ())
+    picture = annotate(big, cell_map, result.belief, path, windows,
+                       found=None if faces else answer,
+                       found_label='found' if result.stop == 'found' else 'most likely')
+    return draw_faces(picture, faces, factor)
+
+
+def draw_faces(picture: np.ndarray, faces, factor: int = 1) -> np.ndarray:
+    """Draw each face's box (image pixels times ``factor``) and its number on an RGB picture."""
+    out = np.ascontiguousarray(picture)
+    thickness = max(2, factor)
+    for i, face in enumerate(faces):
+        x, y, w, h = (int(round(v * factor)) for v in face.box)
+        cv2.rectangle(out, (x, y), (x + w, y + h), (0, 255, 0), thickness)
+        cv2.putText(out, str(i), (x + 2, max(12, y - 4)), cv2.FONT_HERSHEY_SIMPLEX,
+                    0.5 * max(1, factor), (0, 255, 0), max(1, factor // 2 + 1))
+    return out
 
 
 def save_figure(picture: np.ndarray, out_path: Path, title: str) -> None:
