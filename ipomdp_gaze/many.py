@@ -37,7 +37,7 @@ from scipy.ndimage import maximum_filter
 
 from .belief import argmax_ties_low, EvidenceError
 from .observation import as_observation, check_evidence, CountObservation
-from .occupancy import (binary_entropy, cell_prior, count_faces, decided, InformationTable,
+from .occupancy import (binary_entropy, cell_prior, count_faces, decided, information_table,
                         log_nobody, occupancy, prior_log_odds)
 from .session import Frame, OrderError, SearchSettings, start_index, StepResult
 from .still_evidence import StillEvidence
@@ -88,10 +88,8 @@ class OccupancySession:
         check_many_settings(self.settings)
         self.policy = None
         self.link = int(link)
-        self.table = InformationTable(self.observation)
-        ri, ci = grid.pair_offset_index()
-        kernel = np.asarray(self.observation.elm_kernel(), dtype=float)
-        self._view_info = np.ascontiguousarray(kernel[ri, ci])            # [k, j]
+        self.table = information_table(self.observation)
+        self._view_info = self.table.view_information                     # [k, j]
         self.costs = np.ones(grid.n_cells) if costs is None else \
             np.broadcast_to(np.asarray(costs, dtype=float), (grid.n_cells,)).copy()
         if np.any(~np.isfinite(self.costs) | (self.costs <= 0)):
@@ -207,7 +205,11 @@ class OccupancySession:
         return self._result('applied')
 
     def start(self) -> int:
-        """Choose the first fixation: the start cell, the choice after a scan, or the centre."""
+        """
+        Choose the first fixation: the start cell, the choice after a scan, or the centre.
+
+        After a scan that decided every cell the search ends here (:attr:`ended`): no fixation.
+        """
         s = self._s()
         if s['fixation'] is not None:
             raise OrderError('the search has started already; reset starts a new one')
@@ -220,7 +222,8 @@ class OccupancySession:
                 s['fixation'] = self.grid.center_index
         else:
             s['fixation'] = self.grid.center_index
-        self._event('start', fixation=self._rc(s['fixation']))
+        fired = self._decide() if s['scanned'] else ''
+        self._event('start', fixation=self._rc(s['fixation']), decision=fired)
         return s['fixation']
 
     def fixate(self, cell: int) -> None:

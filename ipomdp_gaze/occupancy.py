@@ -191,14 +191,34 @@ class InformationTable:
                                          pn[first][:, None, :])             # (M, B)
         ri, ci = self.grid.pair_offset_index()
         self.pair = np.ascontiguousarray(self.offset_id[ri, ci])          # [k, j] channel
+        kernel = np.asarray(model.elm_kernel(), dtype=float)
+        self.view_information = np.ascontiguousarray(kernel[ri, ci])     # [k, j] ELM kernel
+
+    def by_channel(self, log_odds: np.ndarray) -> np.ndarray:
+        """``I`` of every cell (N,) through every distinct channel: (M, N), interpolated."""
+        x = (np.clip(log_odds, -TABLE_LOG_ODDS, TABLE_LOG_ODDS) + TABLE_LOG_ODDS) / TABLE_STEP
+        i0 = np.minimum(np.floor(x).astype(np.intp), self.log_odds.size - 2)
+        f = x - i0
+        return self.table[:, i0] * (1 - f) + self.table[:, i0 + 1] * f
 
     def __call__(self, log_odds: np.ndarray, candidates=None) -> np.ndarray:
         """``I[k, j]`` of cell j seen from candidate k: (K, N), K = all cells by default."""
         pair = self.pair if candidates is None else self.pair[np.asarray(candidates)]
-        x = (np.clip(log_odds, -TABLE_LOG_ODDS, TABLE_LOG_ODDS) + TABLE_LOG_ODDS) / TABLE_STEP
-        i0 = np.minimum(np.floor(x).astype(np.intp), self.log_odds.size - 2)
-        f = x - i0
-        return self.table[pair, i0] * (1 - f) + self.table[pair, i0 + 1] * f
+        return self.by_channel(log_odds)[pair, np.arange(pair.shape[1])[None, :]]
+
+
+_TABLES = {}
+
+
+def information_table(model) -> InformationTable:
+    """Return the :class:`InformationTable` of a model, built once per model (a small cache)."""
+    key = id(model)
+    cached = _TABLES.get(key)
+    if cached is None or cached[0] is not model:
+        if len(_TABLES) >= 8:
+            _TABLES.pop(next(iter(_TABLES)))
+        cached = _TABLES[key] = (model, InformationTable(model))
+    return cached[1]
 
 
 def decided(log_odds: np.ndarray, confidence: float) -> tuple[np.ndarray, np.ndarray]:

@@ -112,7 +112,8 @@ def run_search(session: SearchSession, sensor: Sensor, scene, *, seed=None,
     (the sensor's ``scan_cost()`` / ``fixation_cost(cell)``) the search stops there
     (:meth:`SearchSession.stop`, reason ``pixels``). ``exclude`` rules cells out after the scan
     (:meth:`SearchSession.exclude`, ``find --all``); ``restart=False`` keeps the scene the sensor
-    already holds (a second search of the same image reuses its detections).
+    already holds (a second search of the same image reuses its detections). A session that
+    ends at ``start`` (a many-target scan that decided every cell) takes no fixation.
 
     Raises
     ------
@@ -142,7 +143,7 @@ def run_search(session: SearchSession, sensor: Sensor, scene, *, seed=None,
     if len(exclude):
         session.exclude(exclude)
     cell = session.start()
-    while not over and (limit is None or session.fixations < limit):
+    while not over and not session.ended and (limit is None or session.fixations < limit):
         if pixel_budget is not None and pixels + sensor.fixation_cost(cell) > budget:
             over = True
             break

@@ -323,3 +323,20 @@ def test_clusters_link_distance():
     cells = np.array([0, 7, 4, 17])                   # (0,0) (1,1) | (0,4) | (2,5)
     assert clusters(cells, grid, 1).tolist() == [0, 0, 1, 2]
     assert clusters(cells, grid, 2).tolist() == [0, 0, 1, 1]
+
+
+def test_run_search_on_simulated_scenes_ends_after_a_decisive_scan():
+    from ipomdp_gaze.sensors import ModelSensor, run_search
+    grid = Grid(3, 3)
+    pt = np.tile([0.1, 0.9], (3, 3, 1))
+    pn = np.tile([0.9, 0.1], (3, 3, 1))
+    model = CountObservation(grid, pt, pn, scan_target=[0.0001, 0.9999],
+                             scan_null=[0.9999, 0.0001])
+    settings = SearchSettings(targets='many', confidence=0.99, absent_prior=0.5,
+                              max_fixations=20, inhibit_return=True)
+    session = OccupancySession(grid, model, settings)
+    empty = run_search(session, ModelSensor(grid, model, np.random.default_rng(0)), None)
+    assert empty.decision == 'absent' and empty.fixations == 0 and empty.path == ()
+    one = run_search(session, ModelSensor(grid, model, np.random.default_rng(0)), 4)
+    assert one.decision == 'found' and one.fixations == 0
+    assert [f['cell'] for f in session.faces()] == [4]
