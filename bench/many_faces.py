@@ -12,6 +12,8 @@ Per scene, in the same run and on the same decoded image:
 
 - ``find --all``: ``find``'s own path (:func:`ipomdp_gaze.commands.find.search_one` with the
   shipped models of ``--detector``, the model nearest the image's size, ``targets`` many);
+- with ``--old-loop``, the single-target loop (``--targets one``: find a face, rule the cells
+  within 2 of it out, search again; its answers are points, scored as boxes of size 0);
 - the detector alone on the whole image at each of ``--scales`` (1, 1/2, 1/3, 1/4 by default,
   :func:`ipomdp_gaze.vision.fullframe.scan`), every answer box (YuNet's own boxes after its
   non-maximum suppression, OpenCV's grouping for Haar) a face.
@@ -22,7 +24,8 @@ one, else a **false face**. Seconds are wall time from the decoded array (as ``f
 them); detector pixels are the pixels given to the detector.
 
 Usage: ``python bench/many_faces.py [--split train|test] [--scenes N] [--copies C]
-[--sizes 640x480,1280x886] [--detector yunet|haar] [--absent-prior P] [--confidence C]``;
+[--sizes 640x480,1280x886] [--detector yunet|haar] [--absent-prior P] [--confidence C]
+[--old-loop]``;
 prints one markdown row per method and size, totals over the scenes.
 """
 import argparse
@@ -87,6 +90,17 @@ def run(args) -> list[dict]:
             if args.verbose:
                 print(name, len(truth), score(boxes, truth), result.fixations, result.stop,
                       f'{seconds:.3f}')
+            if args.old_loop:
+                t0 = time.perf_counter()
+                results = search_one(image, task, replace(settings, targets='one'),
+                                     np.random.default_rng(0), True)
+                seconds = time.perf_counter() - t0
+                points = np.array([[*r.pixel, 0.0, 0.0] for r in results
+                                   if r.decision == 'found']).reshape(-1, 4)
+                _add(totals, 'find --all --targets one (old loop)', score(points, truth),
+                     len(truth), seconds,
+                     sum(r.detector_pixels for r in results) if results[0].method == 'fovea'
+                     else results[0].detector_pixels)
             for scale in SCALES:
                 t0 = time.perf_counter()
                 alone = scan(image, task.fovea.detector, task.fovea.grid, scale)
@@ -127,6 +141,7 @@ def main(argv=None):
     p.add_argument('--absent-prior', type=float, default=FIND_SETTINGS.absent_prior)
     p.add_argument('--confidence', type=float, default=FIND_SETTINGS.confidence)
     p.add_argument('--verbose', action='store_true')
+    p.add_argument('--old-loop', action='store_true')
     args = p.parse_args(argv)
     rows = run(args)
     print(f'split {args.split}, {args.scenes} scenes per size, {args.copies} copies of each '

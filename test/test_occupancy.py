@@ -340,3 +340,10 @@ def test_run_search_on_simulated_scenes_ends_after_a_decisive_scan():
     one = run_search(session, ModelSensor(grid, model, np.random.default_rng(0)), 4)
     assert one.decision == 'found' and one.fixations == 0
     assert [f['cell'] for f in session.faces()] == [4]
+
+
+def test_the_single_target_session_refuses_many_targets():
+    grid = Grid(2, 2)
+    with pytest.raises(ValueError, match='search.targets many is searched by '
+                                         'ipomdp_gaze.many.OccupancySession'):
+        SearchSession(grid, _model(grid), None, SearchSettings(targets='many'))
