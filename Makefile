@@ -17,7 +17,9 @@ $(STAMP): setup.py
 demo: $(STAMP)
 	$(VENV)/bin/ipomdp-gaze demo
 
+# The layer contract first (.importlinter, docs/design.md section 8), then the suite.
 test: $(STAMP)
+	$(VENV)/bin/lint-imports
 	$(VPY) -m pytest -q test
 
 # The long robustness runs (minutes): 100,000 fuzzed frames, 10,080 hostile messages to the

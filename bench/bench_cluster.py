@@ -25,10 +25,10 @@ import tempfile
 import time
 
 from ipomdp_gaze.commands.evaluate import evaluate
+from ipomdp_gaze.drivers.pieces import COSTLY_CHUNK
 from ipomdp_gaze.executor import DaskExecutor, InlineExecutor, LocalExecutor
 from ipomdp_gaze.fpoc import make_fpoc
 from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.pieces import COSTLY_CHUNK
 from ipomdp_gaze.policies.baselines import make_baseline
 
 GRID, FPOC = Grid(7, 7, 0.42), make_fpoc('human')

@@ -15,11 +15,12 @@ resolution, nothing fitted here:
   (``minNeighbors=3``) for Haar and YuNet's own boxes (after its non-maximum suppression, score
   at least the detector's ``score_threshold``, 0.5).
 
-- **pan/tilt search** (offline, the controller's loop of the shipped face config without ROS):
-  each detector with its own pan/tilt model (``faces-pan-tilt``, ``faces-pan-tilt-yunet``), ELM
-  with inhibition of return from the centre cell, repeated views weighted 0.1
-  (:class:`ipomdp_gaze.still_evidence.StillEvidence`), stop at 0.99 or after 60 fixations; right
-  = the answer within one cell of the face's cell; seconds = detector and belief updates (the
+- **pan/tilt search** (offline, the search session and :func:`ipomdp_gaze.sensors.run_search`
+  without ROS): each detector with its own pan/tilt model (``faces-pan-tilt``,
+  ``faces-pan-tilt-yunet``), ELM with inhibition of return from the centre cell, repeated views
+  weighted 0.1 (:class:`ipomdp_gaze.still_evidence.StillEvidence`), stop at 0.99 or after 60
+  fixations; right = the answer within one cell of the face's cell
+  (:func:`ipomdp_gaze.evaluation.answer_is_right`); seconds = detector and belief updates (the
   saccades of a real head are not included).
 
 Usage: ``python bench/detectors.py [--views 40] [--searches 40] [--repeat 3]
@@ -84,13 +85,15 @@ def photo_answer(detector, image, boxes, repeat: int) -> dict:
 
 def pan_tilt_searches(kind: str, model_name: str, n: int) -> dict:
     """Search ``n`` test pan/tilt scenes offline with ``kind`` and its pan/tilt model."""
-    from ipomdp_gaze.inhibition import unvisited_choice
+    from ipomdp_gaze.evaluation import answer_is_right
     from ipomdp_gaze.observation_file import load_observation
     from ipomdp_gaze.policies.registry import build_policy
-    from ipomdp_gaze.still_evidence import cell_information, StillEvidence
+    from ipomdp_gaze.sensors import run_search
+    from ipomdp_gaze.session import SearchSession, SearchSettings
     from ipomdp_gaze.vision.cell_observation import cell_observation_of
     from ipomdp_gaze.vision.detectors import detector_from_settings
     from ipomdp_gaze.vision.pan_tilt import SceneGeometry
+    from ipomdp_gaze.vision.sensors import PanTiltSensor
     model = load_observation(model_name)
     grid = model.grid
     detector = detector_from_settings(dict(model.meta['detector']))
@@ -99,38 +102,18 @@ def pan_tilt_searches(kind: str, model_name: str, n: int) -> dict:
     observer = ViewObserver(detector, grid, k, cell_observation_of(model.meta, k))
     geometry = SceneGeometry(grid, shipped_camera())
     scenes = PanTiltSceneSet('test', geometry, seed=0)
-    policy = build_policy('elm', grid, model)
-    kernel = model.elm_kernel()
-    rng = np.random.default_rng(0)
+    sensor = PanTiltSensor(observer, geometry)
+    settings = SearchSettings(confidence=0.99, max_fixations=60, inhibit_return=True,
+                              repeat_weight=0.1)
+    session = SearchSession(grid, model, build_policy('elm', grid, model), settings)
     right, fixations, found, seconds = 0, [], 0, []
     for i in range(n):
         scene = scenes.scene(i)
-        evidence = StillEvidence(grid.n_cells)
-        visited = np.zeros(grid.n_cells, dtype=bool)
-        cell = grid.index(grid.rows // 2, grid.cols // 2)
-        spent = 0.0
-        for t in range(1, 61):
-            view = geometry.render(scene.image, grid.cell(cell))
-            t0 = time.perf_counter()
-            obs = observer.observe(view, geometry.camera, grid.cell(cell))
-            evidence.add(model.log_likelihood_ratio(obs.counts, cell),
-                         cell_information(kernel, grid, cell))
-            log_b = evidence.log_likelihood_ratio(0.1)
-            belief = np.exp(log_b - log_b.max())
-            belief /= belief.sum()
-            visited[cell] = True
-            best = int(np.argmax(belief))
-            done = belief[best] >= 0.99
-            if not done and t < 60:
-                cell = unvisited_choice(policy, belief[None, :], visited, t, rng, grid)
-            spent += time.perf_counter() - t0
-            if done or t == 60:
-                break
-        r, c = grid.cell(best)
-        right += int(max(abs(r - scene.cell[0]), abs(c - scene.cell[1])) <= 1)
-        found += int(done)
-        fixations.append(t)
-        seconds.append(spent)
+        outcome = run_search(session, sensor, scene.image, seed=0)
+        right += int(answer_is_right(grid.cell(outcome.cell), scene.cell))
+        found += int(outcome.decision == 'found')
+        fixations.append(outcome.fixations)
+        seconds.append(outcome.seconds)
     return {'model': model_name, 'searches': n, 'right': right, 'found': found,
             'fixations_mean': round(float(np.mean(fixations)), 2),
             'seconds_median': round(float(np.median(seconds)), 3)}

@@ -42,7 +42,7 @@ import time
 
 import cv2
 from ipomdp_gaze.detection import DEFAULT_MODELS
-from ipomdp_gaze.evaluation import wilson_interval
+from ipomdp_gaze.evaluation import cells_apart, wilson_interval
 from ipomdp_gaze.observation_file import load_observation
 from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy
@@ -168,8 +168,7 @@ def errors(cells, truth) -> np.ndarray:
     """Chebyshev distance in cells of each answer (None: no answer, counted as wrong)."""
     out = []
     for found, true in zip(cells, truth):
-        out.append(np.inf if found is None else max(abs(found[0] - true[0]),
-                                                    abs(found[1] - true[1])))
+        out.append(np.inf if found is None else cells_apart(found, true))
     return np.asarray(out, dtype=float)
 
 
@@ -435,7 +434,7 @@ def run_pan_tilt(detectors, n: int, empty: int, split: str, progress=None) -> di
     ``evaluate --scenes pan-tilt [--observation faces-pan-tilt-yunet]``: the shipped controller
     configuration (policy, settings) with each detector's own pan/tilt model and camera.
     """
-    from ipomdp_gaze.vision.scene_eval import evaluate_scenes, summarise, task_spec
+    from ipomdp_gaze.drivers.scene_eval import evaluate_scenes, summarise, task_spec
     out = {}
     for kind in detectors:
         spec = task_spec('pan-tilt', model=PAN_TILT_MODELS[kind], split=split)
@@ -913,7 +912,7 @@ def main(argv=None) -> int:
                  "hypothesis and settings) with each detector's own pan/tilt model, on the same "
                  f'{args.pan_tilt_scenes} test scenes with a face (seeds 0..) and '
                  f'{args.pan_tilt_empty} without; head time is the head-time model of '
-                 '`ipomdp_gaze.vision.scene_eval` (detector time, settle and saccades). The '
+                 '`ipomdp_gaze.drivers.scene_eval` (detector time, settle and saccades). The '
                  'full pan/tilt benchmark (sweeps, a second camera) is docs/pan_tilt.md; '
                  "`faces-pan-tilt-ensemble` counts both detectors' boxes (docs/design.md "
                  'section 6.11).', '']

@@ -26,6 +26,7 @@ import time
 from types import SimpleNamespace
 
 from ipomdp_gaze.commands.find import _Tasks, FIND_DETECTORS, search_one
+from ipomdp_gaze.evaluation import answer_is_right
 from ipomdp_gaze.vision.fullframe import cells_of_points, scan
 from ipomdp_gaze.vision.photos import group_photo, real_photos, TRAIN_GROUP_BACKGROUNDS
 from ipomdp_gaze.vision.search import FIND_SETTINGS
@@ -34,7 +35,7 @@ import numpy as np
 
 def near(cell, cells) -> bool:
     """Whether ``cell`` is within one cell of any of ``cells``."""
-    return any(max(abs(cell[0] - r), abs(cell[1] - c)) <= 1 for r, c in cells)
+    return any(answer_is_right(cell, truth) for truth in cells)
 
 
 def truth_cells(boxes, shape, grid) -> list:

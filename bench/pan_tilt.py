@@ -4,7 +4,7 @@
 The pan/tilt face search against a blind sweep, on held-out test scenes: writes docs/pan_tilt.md.
 
 One run, every searcher on the same scenes and the same views (a view is rendered and detected
-once per scene, :mod:`ipomdp_gaze.vision.scene_eval`): the shipped configuration
+once per scene, :mod:`ipomdp_gaze.drivers.scene_eval`): the shipped configuration
 (``config/faces_camera_controller.yaml``, absent hypothesis on), the sweep policy with the same
 belief and stop rule for one pass, and the sweep's answer rules (best tile count after one
 pass; first view with a raw or a grouped detection). Scenes with a face and empty scenes (the
@@ -28,11 +28,10 @@ import sys
 import time
 
 from ipomdp_gaze.detection import DEFAULT_MODELS
+from ipomdp_gaze.drivers.scene_eval import (evaluate_scenes, HEAD_SPEED_DEG_S,
+                                            paired_map_difference, SACCADE_TIME_S, SceneResult,
+                                            SETTLE_TIME_S, summarise, SWEEP_RULES, task_spec)
 from ipomdp_gaze.progress import Progress
-from ipomdp_gaze.vision.scene_eval import (evaluate_scenes, HEAD_SPEED_DEG_S,
-                                           paired_map_difference, SACCADE_TIME_S,
-                                           SceneResult, SETTLE_TIME_S, summarise, SWEEP_RULES,
-                                           task_spec)
 
 ROOT = Path(__file__).resolve().parents[1]
 SHIPPED = 'shipped'

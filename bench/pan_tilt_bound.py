@@ -27,10 +27,10 @@ from dataclasses import replace
 import json
 from pathlib import Path
 
-import ipomdp_gaze.session
+from ipomdp_gaze.drivers import scene_eval
+from ipomdp_gaze.evaluation import answer_is_right
+from ipomdp_gaze.sensors import run_search
 from ipomdp_gaze.session import SearchSession
-from ipomdp_gaze.stopping import UNDECIDED
-from ipomdp_gaze.vision import scene_eval
 import numpy as np
 
 # Highest P(absent) at which the model's answer is still `found` (the shipped rule says absent at
@@ -40,32 +40,22 @@ EMPTY_RATES = (0.05, 0.10, 0.20)
 STATISTICS = ('centred', 'largest over views', 'sum over views')
 
 
-def _never(cell, absent, confidence):
-    """Never decide: the stop rule switched off, so every view is taken."""
-    return np.full(np.shape(cell), UNDECIDED)
-
-
 def every_view(args) -> dict:
     """All poses of one scene through the shipped belief; its answer and its statistics."""
     seed, split, model, empty, index = args
-    ipomdp_gaze.session.decide = _never
     spec = scene_eval.task_spec('pan-tilt', seed=seed, split=split, empty=empty, model=model)
-    settings = replace(spec.settings, inhibit_return=False, max_fixations=0)
+    # The stop rule off (decisions only reported): every view is taken.
+    settings = replace(spec.settings, inhibit_return=False, max_fixations=0,
+                       stop_on_decision=False)
     task = scene_eval._Task.get(spec)
     scene = task.scene(index)
-    task.sensor.start(scene.image)
     grid = task.model.grid
     session = SearchSession(grid, task.model, task.policy, settings)
-    session.reset(seed=np.random.default_rng([seed, index]))
-    if task.sensor.scans and settings.scan:
-        session.scan(task.sensor.scan())
-    session.start()
-    counts = np.full((grid.n_cells, grid.n_cells), np.nan)
-    for cell in range(grid.n_cells):
-        session.fixate(cell)
-        frame = task.sensor.observe(cell)
-        counts[cell] = frame.values
-        session.update(frame)
+    counts = []
+    run_search(session, task.sensor, scene.image, seed=np.random.default_rng([seed, index]),
+               fixations=range(grid.n_cells),
+               on_frame=lambda frame, result: counts.append(frame.values))
+    counts = np.array(counts, dtype=float)
     return {'face': None if scene.cell is None else tuple(int(v) for v in scene.cell),
             'absent': session.absent_probability,
             'answer': tuple(int(v) for v in grid.cell(session.map_cell)),
@@ -81,7 +71,7 @@ def statistics(counts: np.ndarray) -> dict:
 
 def near(answer, face) -> bool:
     """Return whether ``answer`` is right for ``face`` by the evaluation's own rule."""
-    return scene_eval._right(answer, face, 'found')
+    return answer_is_right(answer, face)
 
 
 def main() -> None:

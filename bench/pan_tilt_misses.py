@@ -16,8 +16,10 @@ Usage: ``python bench/pan_tilt_misses.py [--scenes 200] [--seed 1000] [--model F
 """
 import argparse
 
+from ipomdp_gaze.drivers import scene_eval
+from ipomdp_gaze.evaluation import answer_is_right, cells_apart
+from ipomdp_gaze.sensors import run_search
 from ipomdp_gaze.session import SearchSession
-from ipomdp_gaze.vision import scene_eval
 import numpy as np
 
 
@@ -30,17 +32,15 @@ def centred_count(task, scene) -> int:
 
 def search(spec, task, scene, index):
     """Run the shipped search on one scene; return the session and the frames in order."""
-    grid = task.model.grid
-    session = SearchSession(grid, task.model, task.policy, spec.settings)
-    session.reset(seed=np.random.default_rng([spec.seed, index]))
-    cell, frames = session.start(), []
-    while True:
-        frame = task.sensor.observe(cell)
-        frames.append((cell, np.asarray(frame.values, dtype=float)))
-        result = session.update(frame)
-        if result.ended:
-            return session, frames
-        cell = result.fixation
+    session = SearchSession(task.model.grid, task.model, task.policy, spec.settings)
+    frames = []
+
+    def record(frame, result):
+        frames.append((session.path[-1], np.asarray(frame.values, dtype=float)))
+
+    run_search(session, task.sensor, scene.image, seed=np.random.default_rng([spec.seed, index]),
+               on_frame=record)
+    return session, frames
 
 
 def main() -> None:
@@ -60,19 +60,16 @@ def main() -> None:
     centred = {True: [], False: []}
     for index in range(args.scenes):
         scene = task.scene(index)
-        task.sensor.start(scene.image)
         session, frames = search(spec, task, scene, index)
         face = tuple(int(v) for v in scene.cell)
         answer = tuple(int(v) for v in grid.cell(session.map_cell))
-        right = session.decision != 'absent' and max(abs(answer[0] - face[0]),
-                                                     abs(answer[1] - face[1])) <= 1
+        right = answer_is_right(answer, face, session.decision)
         count = centred_count(task, scene)
         centred[right].append(count)
         if right:
             continue
         j = grid.index(*face)
-        offsets = [max(abs(r - face[0]), abs(c - face[1]))
-                   for r, c in (grid.cell(cell) for cell, _ in frames)]
+        offsets = [cells_apart(grid.cell(cell), face) for cell, _ in frames]
         near = [int(values[j]) for (_, values), off in zip(frames, offsets) if off <= 1]
         shown = session.decision if session.decision == 'absent' else \
             f'{session.decision} {answer}'

@@ -11,7 +11,7 @@ docs/reproduction.md quotes two runs: ``--episodes 4000 --seed 1`` (about 10 CPU
 docs/data/searchers-7x7.json`` (about 2.5 CPU-hours, two thirds of it the ideal searcher).
 
 Every policy runs the same episodes (common random numbers), split into pieces over an
-executor (``ipomdp_gaze.pieces.Runner`` on ``--jobs`` processes or the Dask cluster of
+executor (``ipomdp_gaze.drivers.pieces.Runner`` on ``--jobs`` processes or the Dask cluster of
 ``--scheduler``: ``simulate(..., rows=)``, so every deterministic policy gives exactly its
 serial numbers; the planner draws its rollouts from one stream per piece of 500 episodes).
 Printed: fixations to 90% correct by the indicator (MAP guess right) and by the expected percent
@@ -36,11 +36,11 @@ import json
 from pathlib import Path
 
 from ipomdp_gaze.commands.common import positive_int
+from ipomdp_gaze.drivers.pieces import PieceCache, PLANNER_CHUNK, Runner
 from ipomdp_gaze.evaluation import fixations_to_90_ci, paired_difference_ci
 from ipomdp_gaze.executor import make_executor
 from ipomdp_gaze.fpoc import make_fpoc
 from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.pieces import PieceCache, PLANNER_CHUNK, Runner
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.policies.planner import make_planner
 from ipomdp_gaze.progress import Progress
@@ -115,7 +115,7 @@ def main():
            'rao_blackwell': args.rao_blackwell, 'policies': {}, 'paired': {}}
     pieces = 0
     with make_executor(args.jobs, args.scheduler) as pool, \
-            Progress(0, 'planner_vs_greedy', quiet=args.quiet) as progress:
+            Progress(0, 'planner_vs_greedy', 'episode', quiet=args.quiet) as progress:
         runner = Runner(GRID, FPOC, n, args.seed, RESAMPLES, pool, cache, args.rao_blackwell,
                         progress)
         for name in sorted(names, key=lambda x: not getattr(policies[x][0], 'costly', False)):

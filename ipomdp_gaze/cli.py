@@ -15,20 +15,13 @@ import importlib
 import os
 import sys
 
+from ipomdp_gaze.share_files import package_version
+
 # Modules under ipomdp_gaze.commands, in the order --help lists their subcommands: evaluate,
 # search, find, train, calibrate, reproduce, demo, record and replay, then the nodes:
 # controller, camera, detector, scene_camera and recorder.
 COMMANDS = ('evaluate', 'search', 'find', 'train', 'calibrate', 'reproduce', 'demo', 'record',
             'nodes')
-
-
-def package_version() -> str:
-    """Return the installed package's version (``setup.py``), or ``unknown`` without metadata."""
-    from importlib.metadata import PackageNotFoundError, version
-    try:
-        return version('ipomdp_gaze')
-    except PackageNotFoundError:
-        return 'unknown'
 
 
 class CliError(Exception):

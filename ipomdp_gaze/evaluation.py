@@ -112,6 +112,30 @@ def paired_difference_ci(correct_a: np.ndarray, correct_b: np.ndarray, n_cells: 
 # -- moving and absent targets, stopping (docs/design.md section 7) -----------------------------
 Z95 = 1.959963984540054
 OUTCOMES = ('right', 'wrong_found', 'wrong_absent', 'gave_up')
+# An answer within this many cells (Chebyshev) of the target's cell is right on pixels: a face
+# straddles cells and splits its evidence (docs/design.md section 10.4).
+RIGHT_RADIUS_CELLS = 1
+
+
+def cells_apart(a, b) -> int:
+    """Return the Chebyshev distance in cells between two ``(row, col)`` cells."""
+    return int(max(abs(int(a[0]) - int(b[0])), abs(int(a[1]) - int(b[1]))))
+
+
+def answer_is_right(cell, truth, decision: str = 'found',
+                    radius: int = RIGHT_RADIUS_CELLS) -> bool:
+    """
+    Return whether a search's answer is right: the one rule of every image evaluation.
+
+    ``truth`` is the target's ``(row, col)`` or None (nobody there): then only ``absent`` is
+    right. With a target, any answer but ``absent`` (``found``, or a budget's forced answer) is
+    right when ``cell`` is within ``radius`` cells (Chebyshev) of it.
+    """
+    if truth is None:
+        return decision == 'absent'
+    return decision != 'absent' and cell is not None and cells_apart(cell, truth) <= radius
+
+
 CHUNK = 100
 
 

@@ -11,7 +11,8 @@ manager. A piece's result depends only on its arguments (its seed travels with i
 gives the same numbers bit for bit on one process, a local pool or a cluster of any size; a
 piece lost with a dead Dask worker is simply run again elsewhere by the scheduler.
 
-- ``make_executor(jobs=1)``: :class:`InlineExecutor`, every piece runs here when submitted.
+- ``make_executor(jobs=1)``: :class:`InlineExecutor`, every piece runs here when it is first
+  waited for (``result()`` or :func:`track`), so progress moves piece by piece.
 - ``make_executor(jobs=N)``: :class:`LocalExecutor`, N worker processes of this machine.
 - ``make_executor(scheduler=ADDRESS)`` (or ``DASK_SCHEDULER_ADDRESS`` in the environment):
   :class:`DaskExecutor` on a running Dask scheduler (the extra ``ipomdp_gaze[cluster]``). It
@@ -105,21 +106,57 @@ class _Executor:
         """Release the workers; ``cancel`` drops pieces not yet finished (Ctrl-C, an error)."""
 
 
-class InlineExecutor(_Executor):
-    """Run each piece in this process when it is submitted (``--jobs 1``, small jobs)."""
+class _InlineFuture(cf.Future):
+    """
+    A piece of :class:`InlineExecutor`: run in this process the first time it is waited for.
 
-    def submit(self, fn, *args, **kwargs) -> cf.Future:
-        """Run ``fn(*args, **kwargs)`` now; return a finished future holding its result."""
-        future = cf.Future()
+    ``result()``, ``exception()`` or :func:`track` run it (once); until then it is pending, so a
+    progress count advances as each piece finishes, not all at once when they were submitted.
+    Cancelling it before it ran drops it.
+    """
+
+    def __init__(self, fn, args, kwargs):
+        super().__init__()
+        self._call = (fn, args, kwargs)
+
+    def run(self) -> None:
+        """Run the piece now unless it ran or was cancelled (KeyboardInterrupt propagates)."""
+        if self._call is None or not self.set_running_or_notify_cancel():
+            self._call = None
+            return
+        fn, args, kwargs = self._call
+        self._call = None
         try:
             result = fn(*args, **kwargs)
         except BaseException as exc:            # KeyboardInterrupt too: handed to the caller
             if not isinstance(exc, Exception):
+                self.cancel_interrupted()
                 raise
-            future.set_exception(exc)
+            self.set_exception(exc)
         else:
-            future.set_result(result)
-        return future
+            self.set_result(result)
+
+    def cancel_interrupted(self) -> None:
+        """Mark a piece interrupted by Ctrl-C as finished with that interruption."""
+        self.set_exception(KeyboardInterrupt())
+
+    def result(self, timeout=None):
+        """Run the piece if it has not run, then return its result."""
+        self.run()
+        return super().result(timeout)
+
+    def exception(self, timeout=None):
+        """Run the piece if it has not run, then return what it raised (or None)."""
+        self.run()
+        return super().exception(timeout)
+
+
+class InlineExecutor(_Executor):
+    """Run each piece in this process, in submission order, when it is first waited for."""
+
+    def submit(self, fn, *args, **kwargs) -> cf.Future:
+        """Return a future of ``fn(*args, **kwargs)`` that runs here when waited for."""
+        return _InlineFuture(fn, args, kwargs)
 
 
 class LocalExecutor(_Executor):
@@ -291,11 +328,19 @@ def track(futures, progress=None, weights=None):
     Yield the futures as they finish, advancing ``progress`` by each one's weight (default 1).
 
     ``progress`` is anything with ``update(n)`` (:class:`ipomdp_gaze.progress.Progress`).
+    Pieces of an :class:`InlineExecutor` are run here, one by one in submission order.
     """
     futures = list(futures)
     weights = [1] * len(futures) if weights is None else list(weights)
     weight = {id(f): w for f, w in zip(futures, weights)}
-    for future in cf.as_completed(futures):
+    inline = [f for f in futures if isinstance(f, _InlineFuture)]
+    others = [f for f in futures if not isinstance(f, _InlineFuture)]
+    for future in inline:
+        future.run()
+        if progress is not None:
+            progress.update(weight[id(future)])
+        yield future
+    for future in cf.as_completed(others):
         if progress is not None:
             progress.update(weight[id(future)])
         yield future

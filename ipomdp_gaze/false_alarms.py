@@ -41,6 +41,7 @@ import math
 import numpy as np
 
 from .belief import normalize_log
+from .checks import check_factor_above_one, check_in_range
 from .observation import CountObservation
 from .still_evidence import StillEvidence
 
@@ -67,19 +68,12 @@ def check_false_alarm_scales(value, name: str = 'false_alarm_scales') -> tuple:
 
 def check_hotspot_prior(value, name: str = 'hotspot_prior') -> float:
     """Return the prior that a cell is a hotspot as a float in [0, 0.5], or raise ValueError."""
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
-            or not 0.0 <= float(value) <= 0.5:
-        raise ValueError(f'{name} must be in [0, 0.5] (0: no hotspots), got {value!r}')
-    return float(value)
+    return check_in_range(value, name, 0.0, 0.5, ' (0: no hotspots)')
 
 
 def check_hotspot_scale(value, name: str = 'hotspot_scale') -> float:
     """Return the factor of a hotspot's detection rate as a float > 1, or raise ValueError."""
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
-            or not (math.isfinite(float(value)) and float(value) > 1.0):
-        raise ValueError(f"{name} must be a finite factor > 1 of the model's false-alarm rates, "
-                         f'got {value!r}')
-    return float(value)
+    return check_factor_above_one(value, name, "the model's false-alarm rates")
 
 
 def scaled_null(p_target: np.ndarray, p_null: np.ndarray, scale: float) -> np.ndarray:

@@ -26,15 +26,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 
+from ipomdp_gaze.checks import finite as _finite
 from ipomdp_gaze.grid import Grid
 import numpy as np
-
-
-def _finite(name: str, value) -> float:
-    value = float(value)
-    if not math.isfinite(value):
-        raise ValueError(f'{name} must be finite, got {value!r}')
-    return value
 
 
 @dataclass(frozen=True)

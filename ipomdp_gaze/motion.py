@@ -33,48 +33,11 @@ import math
 import numpy as np
 
 from .belief import normalize_log
+from .checks import check_probability, check_sigma_cells  # noqa: F401
 from .grid import Grid
 
 TRUNCATE_SIGMAS = 3.0
 ALMOST_ONE = math.nextafter(1.0, 0.0)
-
-
-def check_sigma_cells(value, name: str = 'sigma_cells') -> float:
-    """
-    Return a motion standard deviation in cells as a float.
-
-    Raises
-    ------
-    ValueError
-        Unless it is a finite number >= 0.
-
-    """
-    try:
-        sigma = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f'{name} must be a number >= 0, got {value!r}') from None
-    if not math.isfinite(sigma) or sigma < 0:
-        raise ValueError(f'{name} must be finite and >= 0, got {value!r}')
-    return sigma
-
-
-def check_probability(value, name: str) -> float:
-    """
-    Return a probability in ``[0, 1)`` (a jump probability, a prior or a rate) as a float.
-
-    Raises
-    ------
-    ValueError
-        Unless ``0 <= value < 1``: 1 would make the hypothesis certain before any evidence.
-
-    """
-    try:
-        p = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f'{name} must be a probability in [0, 1), got {value!r}') from None
-    if not 0.0 <= p < 1.0:
-        raise ValueError(f'{name} must be a probability in [0, 1), got {value!r}')
-    return p
 
 
 def axis_transition(size: int, sigma_cells: float) -> np.ndarray:

@@ -103,26 +103,33 @@ class SearchOutcome:
 
 def run_search(session: SearchSession, sensor: Sensor, scene, *, seed=None,
                limit: int | None = None, pixel_budget: int | None = None, exclude=(),
-               restart: bool = True) -> SearchOutcome:
+               restart: bool = True, fixations=None, on_frame=None) -> SearchOutcome:
     """
     Search one scene: reset, scan once (if the sensor and model have one), fixate until the end.
 
-    ``limit`` caps the frames when the settings have no budget (an offline search must end).
-    ``pixel_budget`` caps the detector pixels: before a scan or a fixation that would pass it
-    (the sensor's ``scan_cost()`` / ``fixation_cost(cell)``) the search stops there
+    The one offline search loop: ``find``, ``search``, the image-task evaluation and the benches
+    run it. ``limit`` caps the frames when the settings have no budget (an offline search must
+    end). ``pixel_budget`` caps the detector pixels: before a scan or a fixation that would pass
+    it (the sensor's ``scan_cost()`` / ``fixation_cost(cell)``) the search stops there
     (:meth:`SearchSession.stop`, reason ``pixels``). ``exclude`` rules cells out after the scan
     (:meth:`SearchSession.exclude`, ``find --all``); ``restart=False`` keeps the scene the sensor
-    already holds (a second search of the same image reuses its detections). A session that
-    ends at ``start`` (a many-target scan that decided every cell) takes no fixation.
+    already holds (a second search of the same image reuses its detections). ``fixations``, a
+    sequence of cells, is fixated in that order instead of the policy's choices (every view of a
+    scene, a recorded path); the search then also ends when they run out. ``on_frame(frame,
+    result)`` is called after every fixation frame the session applied (a driver's per-frame
+    record: the answer so far, the detector's time). A session that ends at ``start`` (a
+    many-target scan that decided every cell) takes no fixation.
 
     Raises
     ------
     ValueError
-        Without a budget, ``stop_on_repeat`` or ``limit``; for a frame the session rejects.
+        Without a budget, ``stop_on_repeat``, ``limit`` or ``fixations``; for a frame the
+        session rejects.
 
     """
     settings = session.settings
-    if not (settings.max_fixations or settings.stop_on_repeat or limit):
+    if not (settings.max_fixations or settings.stop_on_repeat or limit
+            or fixations is not None):
         raise ValueError('an offline search needs a fixation budget (search.max_fixations) '
                          'or a frame limit')
     if sensor.grid.shape != session.grid.shape:
@@ -131,6 +138,7 @@ def run_search(session: SearchSession, sensor: Sensor, scene, *, seed=None,
     t0 = time.perf_counter()
     budget = math.inf if pixel_budget is None else int(pixel_budget)
     pixels, over = 0, False
+    order = None if fixations is None else iter([int(c) for c in fixations])
     if restart:
         sensor.start(scene)
     session.reset(seed=seed)
@@ -144,12 +152,19 @@ def run_search(session: SearchSession, sensor: Sensor, scene, *, seed=None,
         session.exclude(exclude)
     cell = session.start()
     while not over and not session.ended and (limit is None or session.fixations < limit):
+        if order is not None:
+            cell = next(order, None)
+            if cell is None:
+                break
+            session.fixate(cell)
         if pixel_budget is not None and pixels + sensor.fixation_cost(cell) > budget:
             over = True
             break
         frame = sensor.observe(cell)
         pixels += frame.detector_pixels
         result = _check(session.update(frame))
+        if on_frame is not None:
+            on_frame(frame, result)
         if result.ended:
             break
         cell = result.fixation

@@ -31,22 +31,19 @@ session, then loop. Its per-search event log (:attr:`SearchSession.log`) is what
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import dataclass, field, fields, replace
-import operator
-from typing import Mapping
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from .belief import bayes_update, entropy, EvidenceError, map_cell, normalize_log
-from .false_alarms import (check_false_alarm_scales, check_hotspot_prior, check_hotspot_scale,
-                           DEFAULT_HOTSPOT_SCALE, FalseAlarmMixture)
+from .false_alarms import FalseAlarmMixture
 from .grid import Grid
 from .inhibition import policy_choice, unvisited_choice
-from .motion import check_probability, check_sigma_cells, Motion
+from .motion import Motion
 from .observation import as_observation, check_evidence, CountObservation
-from .still_evidence import cell_information, check_repeat_weight, StillEvidence
-from .stopping import (ABSENT, check_absent_prior, check_budget, check_confidence, decide, FOUND,
-                       initial_log_belief, with_absent)
+from .settings import parameter_names, settings_class
+from .still_evidence import cell_information, StillEvidence
+from .stopping import ABSENT, decide, FOUND, initial_log_belief, with_absent
 
 # Decisions a search can end with; '' while undecided.
 DECISIONS = ('found', 'absent', 'gave_up')
@@ -54,40 +51,10 @@ DECISIONS = ('found', 'absent', 'gave_up')
 # a cell (NMPT's rule; with inhibition of return: every cell has been fixated).
 GAVE_UP_REASONS = ('budget', 'repeat')
 # The parameter (node, YAML) name of each setting: the name every refusal message uses.
-PARAMETER_NAMES = {
-    'confidence': 'confidence',
-    'max_fixations': 'search.max_fixations',
-    'inhibit_return': 'search.inhibit_return',
-    'stop_on_repeat': 'search.stop_on_repeat',
-    'repeat_weight': 'search.repeat_weight',
-    'absent_prior': 'absent.prior',
-    'motion_sigma_cells': 'motion.sigma_cells',
-    'motion_jump_prob': 'motion.jump_prob',
-    'start_cell': 'start_cell',
-    'scan': 'search.scan',
-    'found_radius': 'search.found_radius',
-    'decide_at_budget': 'search.decide_at_budget',
-    'false_alarm_scales': 'search.false_alarm_scales',
-    'hotspot_prior': 'search.hotspot_prior',
-    'hotspot_scale': 'search.hotspot_scale',
-    'targets': 'search.targets',
-}
-# search.targets: the paper's one target (or none), or many (an occupancy per cell,
-# ipomdp_gaze.many); SearchSession runs 'one', OccupancySession 'many'.
-TARGETS = ('one', 'many')
-
-
-def _check_flag(value, name: str) -> bool:
-    if not isinstance(value, (bool, np.bool_)):
-        raise ValueError(f'{name} must be true or false, got {value!r}')
-    return bool(value)
-
-
-def _check_radius(value, name: str) -> int:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) \
-            or not 0 <= value <= 5:
-        raise ValueError(f'{name} must be an integer from 0 to 5 (cells), got {value!r}')
-    return int(value)
+PARAMETER_NAMES = parameter_names()
+# The settings object, generated from the schema (ipomdp_gaze.settings.SCHEMA): one checked
+# field per setting; SearchSettings(confidence=0.99, max_fixations=60), replace() to change.
+SearchSettings = settings_class(module=__name__)
 
 
 def pooled_belief(belief: np.ndarray, grid: Grid, radius: int) -> np.ndarray:
@@ -98,171 +65,6 @@ def pooled_belief(belief: np.ndarray, grid: Grid, radius: int) -> np.ndarray:
     padded = np.pad(np.asarray(belief, dtype=float).reshape(grid.rows, grid.cols), radius)
     window = np.lib.stride_tricks.sliding_window_view(padded, (side, side))
     return window.sum(axis=(2, 3)).reshape(-1)
-
-
-def _check_start(value, name: str = 'start_cell'):
-    if value is None or (isinstance(value, str) and value == 'policy'):
-        return value
-    try:
-        row, col = (operator.index(v) for v in value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be (row, col) integers, 'policy' or none (the "
-                         f'default), got {value!r}') from None
-    if row < 0 or col < 0:
-        raise ValueError(f'{name} must be (row, col) with row, col >= 0, got {value!r}')
-    return (int(row), int(col))
-
-
-@dataclass(frozen=True)
-class SearchSettings:
-    """
-    How a search decides and stops, checked once here (the same message from every driver).
-
-    Attributes
-    ----------
-    confidence : float
-        ``found`` (``absent``) when the most likely cell (``P(absent)``) reaches it; in (0, 1).
-    max_fixations : int
-        Fixation budget: ``gave_up`` when it runs out undecided; 0 means no budget.
-    inhibit_return : bool
-        Still target: never fixate a cell twice in a search (the policy's best unvisited cell).
-    stop_on_repeat : bool
-        Give up (reason ``repeat``) instead of fixating a cell a second time (NMPT's rule); with
-        ``inhibit_return`` that is when every cell has been fixated. Off: with inhibition of
-        return every cell is open again once all were fixated.
-    repeat_weight : float
-        Still target: weight in [0, 1] of a cell's evidence from views other than its most
-        informative one (1: naive Bayes; :mod:`ipomdp_gaze.still_evidence`).
-    absent_prior : float
-        Prior of "no target in the grid", in [0, 1) (0: no absent hypothesis).
-    motion_sigma_cells, motion_jump_prob : float
-        The target's random walk per unit of ``dt_s`` (per second on the robot, per fixation in
-        simulation); both 0 for a still target.
-    start_cell : (int, int), 'policy' or None
-        First fixation ``(row, col)``; ``'policy'``: the policy's choice on the prior (the
-        paper's measurement convention, docs/design.md section 4.1); None: the policy's choice
-        after a scan, else the grid's centre (the robot's convention, section 4.2).
-    scan : bool
-        Apply the one-time scan when the sensor and the model have one.
-    found_radius : int
-        Still target: ``found`` when the belief within this many cells (Chebyshev) of a cell
-        reaches ``confidence``, and that cell is the answer (``map_cell``); 0: the cell alone.
-        A face straddling two cells splits its evidence; an answer within one cell is right.
-    decide_at_budget : bool
-        Still target: when the budget runs out undecided, decide anyway (reason ``budget``):
-        ``absent`` if ``P(absent)`` is at least the answer's probability, else ``found``;
-        off: ``gave_up``. A deadline: the robot must say something.
-    false_alarm_scales : tuple of float
-        Still target, count model: the scene's false-alarm rate is the model's times one of
-        these factors, equally likely a priori, learned from every cell's counts during the
-        search (:mod:`ipomdp_gaze.false_alarms`); ``(1.0,)``: the rates as calibrated.
-    hotspot_prior : float
-        Still target, count model: the prior that a cell without the target is a hotspot, a
-        spot that fires the detector ``hotspot_scale`` times as often as the model's null
-        tables in every view (:mod:`ipomdp_gaze.false_alarms`); 0: no hotspots.
-    hotspot_scale : float
-        A hotspot's factor (> 1) of the model's false-alarm rates.
-    targets : str
-        ``'one'`` (the paper's belief over one target, or none) or ``'many'`` (an occupancy
-        per cell, :mod:`ipomdp_gaze.many`).
-
-    """
-
-    confidence: float = 0.95
-    max_fixations: int = 0
-    inhibit_return: bool = False
-    stop_on_repeat: bool = False
-    repeat_weight: float = 1.0
-    absent_prior: float = 0.0
-    motion_sigma_cells: float = 0.0
-    motion_jump_prob: float = 0.0
-    start_cell: tuple | None = None
-    scan: bool = True
-    found_radius: int = 0
-    decide_at_budget: bool = False
-    false_alarm_scales: tuple = (1.0,)
-    hotspot_prior: float = 0.0
-    hotspot_scale: float = DEFAULT_HOTSPOT_SCALE
-    targets: str = 'one'
-
-    def __post_init__(self):
-        names = PARAMETER_NAMES
-        checked = {
-            'confidence': check_confidence(self.confidence, names['confidence']),
-            'max_fixations': check_budget(self.max_fixations, names['max_fixations']),
-            'inhibit_return': _check_flag(self.inhibit_return, names['inhibit_return']),
-            'stop_on_repeat': _check_flag(self.stop_on_repeat, names['stop_on_repeat']),
-            'repeat_weight': check_repeat_weight(self.repeat_weight, names['repeat_weight']),
-            'absent_prior': check_absent_prior(self.absent_prior, names['absent_prior']),
-            'motion_sigma_cells': check_sigma_cells(self.motion_sigma_cells,
-                                                    names['motion_sigma_cells']),
-            'motion_jump_prob': check_probability(self.motion_jump_prob,
-                                                  names['motion_jump_prob']),
-            'start_cell': _check_start(self.start_cell, names['start_cell']),
-            'scan': _check_flag(self.scan, names['scan']),
-            'found_radius': _check_radius(self.found_radius, names['found_radius']),
-            'decide_at_budget': _check_flag(self.decide_at_budget, names['decide_at_budget']),
-            'false_alarm_scales': check_false_alarm_scales(self.false_alarm_scales,
-                                                           names['false_alarm_scales']),
-            'hotspot_prior': check_hotspot_prior(self.hotspot_prior, names['hotspot_prior']),
-            'hotspot_scale': check_hotspot_scale(self.hotspot_scale, names['hotspot_scale']),
-        }
-        if not (isinstance(self.targets, str) and self.targets in TARGETS):
-            raise ValueError(f"{names['targets']} must be one of {', '.join(TARGETS)}, got "
-                             f'{self.targets!r}')
-        for key, value in checked.items():
-            object.__setattr__(self, key, value)
-
-    @property
-    def moving(self) -> bool:
-        """Whether the target is modelled as moving."""
-        return self.motion_sigma_cells > 0 or self.motion_jump_prob > 0
-
-    def check_grid(self, grid: Grid) -> None:
-        """Refuse a start cell outside ``grid`` (ValueError naming both)."""
-        if isinstance(self.start_cell, tuple):
-            row, col = self.start_cell
-            if row >= grid.rows or col >= grid.cols:
-                raise ValueError(f'start cell ({row}, {col}) is outside a {grid.rows}x'
-                                 f'{grid.cols} grid')
-
-    def to_parameters(self) -> dict:
-        """Return the settings under their parameter names, as YAML files and event logs."""
-        out = {PARAMETER_NAMES[f.name]: getattr(self, f.name) for f in fields(self)}
-        if isinstance(self.start_cell, tuple):
-            out['start_cell'] = list(self.start_cell)
-        out[PARAMETER_NAMES['false_alarm_scales']] = list(self.false_alarm_scales)
-        return out
-
-    @classmethod
-    def from_parameters(cls, values: Mapping, base: SearchSettings | None = None,
-                        grid: Grid | None = None) -> SearchSettings:
-        """
-        Build settings from parameter names (node parameters, a YAML block, CLI flags).
-
-        Unknown names are ignored (a node has many other parameters). ``start_row`` and
-        ``start_col`` give ``start_cell`` as the node declares it: -1 is the centre's row
-        (column) of ``grid``, both -1 the default rule. With ``grid`` the start cell is checked
-        against it.
-        """
-        changes = {}
-        for key, name in PARAMETER_NAMES.items():
-            if name in values:
-                changes[key] = values[name]
-        if 'start_row' in values or 'start_col' in values:
-            row, col = values.get('start_row', -1), values.get('start_col', -1)
-            if row == -1 and col == -1:
-                changes['start_cell'] = None
-            elif grid is None:
-                raise ValueError('start_row / start_col of -1 (the centre) need the grid')
-            else:
-                centre_row, centre_col = grid.cell(grid.center_index)
-                changes['start_cell'] = (centre_row if row == -1 else row,
-                                         centre_col if col == -1 else col)
-        settings = replace(base or cls(), **changes)
-        if grid is not None:
-            settings.check_grid(grid)
-        return settings
 
 
 def _mixture_settings(settings: SearchSettings) -> tuple:
@@ -766,13 +568,14 @@ class SearchSession:
         code = int(decide(peak, absent, settings.confidence))
         decision = {FOUND: 'found', ABSENT: 'absent'}.get(code, '')
         fired = ''
-        if self.motion.active:
+        if self.motion.active or not settings.stop_on_decision:
             fired = decision if decision and decision != search.decision else ''
             search.decision = decision
         elif decision:
             search.decision, search.ended, fired = decision, True, decision
         search.decided_once = search.decided_once or bool(fired)
-        if not search.decided_once and settings.max_fixations \
+        budget_applies = not search.decided_once or not settings.stop_on_decision
+        if budget_applies and settings.max_fixations \
                 and search.fixations >= settings.max_fixations:
             fired = self._limit('budget')
         return fired

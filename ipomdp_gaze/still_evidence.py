@@ -20,6 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .checks import check_in_range
+
 
 def check_repeat_weight(weight: float, name: str = 'repeat_weight') -> float:
     """
@@ -31,10 +33,7 @@ def check_repeat_weight(weight: float, name: str = 'repeat_weight') -> float:
         Unless it is in [0, 1].
 
     """
-    if not (isinstance(weight, (int, float, np.integer, np.floating))
-            and not isinstance(weight, bool) and 0.0 <= float(weight) <= 1.0):
-        raise ValueError(f'{name} must be in [0, 1], got {weight!r}')
-    return float(weight)
+    return check_in_range(weight, name, 0.0, 1.0)
 
 
 def cell_information(kernel: np.ndarray, grid, fixation: int) -> np.ndarray:

@@ -27,58 +27,16 @@ hypothesis has posterior probability at least ``c``.
 from __future__ import annotations
 
 import math
-import operator
 
 import numpy as np
 
 from .belief import bayes_update, uniform_log_belief
-from .motion import check_probability
+from .checks import check_budget, check_confidence, check_probability  # noqa: F401
 
 # Decision codes of :func:`decide` and :func:`first_decisions`.
 UNDECIDED, FOUND, ABSENT = 0, 1, 2
 GAVE_UP = UNDECIDED
 DECISIONS = {FOUND: 'found', ABSENT: 'absent'}
-
-
-def check_confidence(confidence, name: str = 'confidence') -> float:
-    """
-    Return the confidence level of a decision as a float: strictly between 0 and 1.
-
-    1 is refused: a posterior reaches it only by rounding, so a search at 1 would never stop by
-    evidence; 0 would decide before any frame. The one check of every driver.
-
-    Raises
-    ------
-    ValueError
-        Unless ``0 < confidence < 1``.
-
-    """
-    try:
-        ok = not isinstance(confidence, bool) and 0.0 < float(confidence) < 1.0
-    except (TypeError, ValueError):
-        ok = False
-    if not ok:
-        raise ValueError(f'{name} must be between 0 and 1 (exclusive), got {confidence!r}')
-    return float(confidence)
-
-
-def check_budget(value, name: str = 'search.max_fixations') -> int:
-    """
-    Return a fixation budget as an int >= 0; 0 means no budget (everywhere).
-
-    Raises
-    ------
-    ValueError
-        For a negative or non-integer value (the message starts with ``name``).
-
-    """
-    try:
-        budget = -1 if isinstance(value, bool) else operator.index(value)
-    except TypeError:
-        budget = -1
-    if budget < 0:
-        raise ValueError(f'{name} must be an integer >= 0 (0: no budget), got {value!r}')
-    return budget
 
 
 def check_max_fixations(value, name: str = 'max_fixations') -> int | None:

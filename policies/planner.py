@@ -35,6 +35,7 @@ can be the base, for example a learned convolutional kernel.
 from __future__ import annotations
 
 from ipomdp_gaze.belief import argmax_ties_low
+from ipomdp_gaze.checks import finite as _finite, positive_int as _positive_int
 from ipomdp_gaze.fpoc import dprime_matrix, FPOC
 from ipomdp_gaze.grid import Grid
 import numpy as np
@@ -46,23 +47,6 @@ DTYPES = ('float32', 'float64')
 LOG_FLOOR = -700.0
 # Tempered ELM's defaults, tuned on held-out seeds (bench/bench_planner.py).
 BELIEF_POWER, DPRIME_POWER = 0.7, 1.75
-
-
-def _positive_int(name: str, value) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-        raise ValueError(f'{name} must be a positive integer, got {value!r}')
-    return int(value)
-
-
-def _finite(name: str, value, positive: bool = False) -> float:
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f'{name} must be a number, got {value!r}') from None
-    if not np.isfinite(value) or (positive and value <= 0):
-        bound = 'finite and > 0' if positive else 'finite'
-        raise ValueError(f'{name} must be {bound}, got {value!r}')
-    return value
 
 
 class TemperedELM:

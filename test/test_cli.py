@@ -90,9 +90,13 @@ def test_search_prints_each_fixation(capsys):
 
 
 @pytest.mark.parametrize('args, message', [
-    (['evaluate', '--motion-sigma-cells', '-0.5'], "expected a number >= 0, got '-0.5'"),
-    (['evaluate', '--motion-sigma-cells', 'nan'], "expected a number >= 0, got 'nan'"),
-    (['evaluate', '--jump-prob', '1'], "expected a probability in [0, 1), got '1'"),
+    # The search settings: the message of SearchSettings, as the node's (one schema).
+    (['evaluate', '--motion-sigma-cells', '-0.5'],
+     'motion.sigma_cells must be finite and >= 0, got -0.5'),
+    (['evaluate', '--motion-sigma-cells', 'nan'],
+     'motion.sigma_cells must be finite and >= 0, got nan'),
+    (['evaluate', '--jump-prob', '1'],
+     'motion.jump_prob must be a probability in [0, 1), got 1.0'),
     (['evaluate', '--absent-prior', '-0.1'],
      'absent.prior must be a probability in [0, 1), got -0.1'),
     (['evaluate', '--absent-rate', '1.5'], "expected a probability in [0, 1), got '1.5'"),
@@ -100,7 +104,9 @@ def test_search_prints_each_fixation(capsys):
     (['evaluate', '--max-fixations', '-1'], 'search.max_fixations must be an integer >= 0'),
     (['evaluate', '--horizon', '5', '--max-fixations', '9'], 'beyond the horizon 5'),
     (['train', '--epochs', '1', '--out', 'x.yaml', '--jump-prob', '2'],
-     'expected a probability in [0, 1)'),
+     'motion.jump_prob must be a probability in [0, 1), got 2.0'),
+    (['train', '--epochs', '1', '--out', 'x.yaml', '--motion-sigma-cells', '-1'],
+     'motion.sigma_cells must be finite and >= 0, got -1.0'),
 ])
 def test_bad_scene_arguments_exit_2_with_one_line(args, message):
     out = run_cli(*args)

@@ -19,8 +19,8 @@ import threading
 
 from conftest import wait_for
 from ipomdp_gaze import executor as executor_module
-from ipomdp_gaze import pieces
 from ipomdp_gaze.cli import main as cli_main
+from ipomdp_gaze.drivers import pieces
 from ipomdp_gaze.executor import ClusterError, DaskExecutor
 from ipomdp_gaze.fpoc import make_fpoc
 from ipomdp_gaze.grid import Grid

@@ -1,11 +1,11 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """A scene's own false-alarm rate and its hotspots (``ipomdp_gaze.false_alarms``) against Bayes."""
+from ipomdp_gaze.drivers.scene_eval import compare_settings
 from ipomdp_gaze.false_alarms import check_false_alarm_scales, FalseAlarmMixture, scaled_null
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.observation import CountObservation
 from ipomdp_gaze.session import Frame, SearchSession, SearchSettings
-from ipomdp_gaze.vision.scene_eval import compare_settings
 import numpy as np
 import pytest
 

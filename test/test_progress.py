@@ -2,11 +2,13 @@
 # SPDX-License-Identifier: Apache-2.0
 """Progress on stderr: a bar on a terminal, lines in a log, nothing with --quiet."""
 import io
+from types import SimpleNamespace
 
 from conftest import wait_for
 from ipomdp_gaze.cli import main as cli_main
 from ipomdp_gaze.executor import InlineExecutor, LocalExecutor, make_executor, track
 from ipomdp_gaze.progress import Progress
+import pytest
 
 
 def test_a_log_gets_lines_with_the_count_and_an_eta():
@@ -53,12 +55,55 @@ def test_progress_follows_the_futures():
         assert progress.done == 3
 
 
+def test_an_inline_piece_runs_when_tracked_so_the_count_moves_piece_by_piece():
+    ran, seen = [], []
+    with make_executor(jobs=1) as executor, \
+            Progress(3, 'scenes', 'scene', stream=io.StringIO(), every_s=1e9) as progress:
+        futures = [executor.submit(ran.append, k) for k in range(3)]
+        assert ran == [] and not any(f.done() for f in futures)     # nothing ran at submit
+        for future in track(futures, progress):
+            seen.append((len(ran), progress.done))
+    assert ran == [0, 1, 2]
+    assert seen == [(1, 1), (2, 2), (3, 3)]         # one piece run, one counted, then the next
+
+
+def test_an_inline_piece_runs_once_and_keeps_its_error():
+    calls = []
+
+    def fail():
+        calls.append(1)
+        raise ValueError('bad piece')
+
+    future = InlineExecutor().submit(fail)
+    assert isinstance(future.exception(), ValueError)
+    with pytest.raises(ValueError, match='bad piece'):
+        future.result()
+    assert calls == [1]
+    cancelled = InlineExecutor().submit(calls.append, 2)
+    assert cancelled.cancel() and cancelled.cancelled() and calls == [1]
+
+
+def test_scene_evaluation_counts_each_scene_as_it_finishes(monkeypatch):
+    from ipomdp_gaze.drivers import scene_eval
+    counts = []
+
+    def one_scene(spec, index):
+        counts.append(progress.done)                # what the bar showed when this scene ran
+        return [SimpleNamespace(searcher='elm', index=index)]
+
+    monkeypatch.setattr(scene_eval, 'evaluate_scene', one_scene)
+    with Progress(4, 'scenes', 'scene', stream=io.StringIO(), every_s=1e9) as progress:
+        results = scene_eval.evaluate_scenes(None, 4, InlineExecutor(), progress=progress)
+    assert counts == [0, 1, 2, 3] and progress.done == 4
+    assert [r.index for r in results['elm']] == [0, 1, 2, 3]
+
+
 def test_long_commands_report_on_stderr_unless_quiet(capsys):
     argv = ['evaluate', '--grid', '4x4', '--policy', 'elm', '--episodes', '200',
             '--bootstrap', '20', '--jobs', '1']
     assert cli_main(argv) == 0
     err = capsys.readouterr().err
-    assert err.startswith('evaluate: 1/1 pieces (100%)'), err
+    assert err.startswith('evaluate: 200/200 episodes (100%)'), err
     assert cli_main([*argv, '--quiet']) == 0
     assert capsys.readouterr().err == ''
 

@@ -11,9 +11,9 @@ from pathlib import Path
 from types import SimpleNamespace
 
 from ipomdp_gaze.bag import Bag, BagMessage
+from ipomdp_gaze.drivers.replay import last_search
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.head import PanTiltMap
-from ipomdp_gaze.replay import last_search
 import numpy as np
 
 GRID = Grid(11, 11, 5.0)

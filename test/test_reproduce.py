@@ -4,9 +4,9 @@
 from dataclasses import replace
 import json
 
-from ipomdp_gaze import pieces
 from ipomdp_gaze.cli import main as cli_main
 from ipomdp_gaze.commands import reproduce
+from ipomdp_gaze.drivers import pieces
 from ipomdp_gaze.executor import LocalExecutor
 from ipomdp_gaze.fpoc import make_fpoc
 from ipomdp_gaze.grid import Grid

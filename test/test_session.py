@@ -401,3 +401,59 @@ def test_a_drivers_limit_ends_the_search_as_the_budget_does():
         assert session.log[-1]['event'] == 'stop'
         with pytest.raises(OrderError):
             session.stop('pixels')
+
+
+def test_with_the_stop_rule_off_decisions_are_reported_and_every_fixation_is_taken():
+    model = count_model(scan=False)
+    policy = build_policy('elm', GRID, model)
+    on = SearchSettings(confidence=0.9, absent_prior=0.3, max_fixations=40)
+    off = replace(on, stop_on_decision=False)
+    stopped = SearchSession(GRID, model, policy, on)
+    first = run_search(stopped, ModelSensor(GRID, model, np.random.default_rng(5)), 7, seed=1,
+                       fixations=range(GRID.n_cells))
+    assert first.decision in ('found', 'absent') and first.fixations < GRID.n_cells
+    session = SearchSession(GRID, model, policy, off)
+    fired, beliefs = [], []
+
+    def record(frame, result):
+        fired.append(result.fired)
+        beliefs.append(session.log_belief.copy())
+        assert not result.ended
+
+    outcome = run_search(session, ModelSensor(GRID, model, np.random.default_rng(5)), 7, seed=1,
+                         fixations=range(GRID.n_cells), on_frame=record)
+    assert outcome.fixations == GRID.n_cells and outcome.path == tuple(range(GRID.n_cells))
+    # The same frames: the belief when the stopped search ended is the one at that frame here,
+    # and the decision it ended with is the one reported (fired) then.
+    np.testing.assert_allclose(beliefs[first.fixations - 1], stopped.log_belief)
+    assert fired[first.fixations - 1] == first.decision
+    assert sum(bool(f) for f in fired[:first.fixations - 1]) == 0
+
+
+def test_with_the_stop_rule_off_the_budget_still_ends_the_search():
+    model = count_model(scan=False)
+    settings = SearchSettings(confidence=0.6, max_fixations=5, stop_on_decision=False)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model), settings)
+    outcome = run_search(session, ModelSensor(GRID, model, np.random.default_rng(2)), 3, seed=0)
+    assert outcome.fixations == 5 and outcome.decision == 'gave_up' and outcome.reason == 'budget'
+
+
+def test_run_search_calls_the_frame_hook_once_per_applied_frame_with_the_frame():
+    model = count_model()
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model),
+                            SearchSettings(confidence=0.99, max_fixations=6))
+    seen = []
+    sensor = ModelSensor(GRID, model, np.random.default_rng(3))
+    outcome = run_search(session, sensor, 2, seed=0,
+                         on_frame=lambda frame, step: seen.append((frame.kind, step.fixations)))
+    assert seen == [('fixation', k) for k in range(1, outcome.fixations + 1)]
+
+
+@pytest.mark.parametrize('cell, truth, decision, right', [
+    ((3, 4), (3, 4), 'found', True), ((2, 5), (3, 4), 'found', True),
+    ((1, 4), (3, 4), 'found', False), ((3, 4), (3, 4), 'absent', False),
+    ((3, 4), None, 'absent', True), ((3, 4), None, 'found', False),
+    ((2, 3), (3, 4), 'gave_up', True), (None, (3, 4), 'gave_up', False)])
+def test_the_one_right_answer_rule(cell, truth, decision, right):
+    from ipomdp_gaze.evaluation import answer_is_right
+    assert answer_is_right(cell, truth, decision) is right

@@ -65,9 +65,9 @@ def test_the_cli_prints_the_settings_message_in_one_line(flag, text, _param, _ty
 @contextmanager
 def controller_node(ros_env, overrides=None):
     """Run a ``gaze_controller`` in this process, on its own context, with these overrides."""
+    from ipomdp_gaze.nodes.controller import GazeControllerNode
     import rclpy
     from rclpy.parameter import Parameter
-    from ipomdp_gaze.nodes.controller import GazeControllerNode
     ctx = rclpy.Context()
     rclpy.init(context=ctx, domain_id=int(ros_env['ROS_DOMAIN_ID']), args=[])
     try:
@@ -127,7 +127,7 @@ def test_evaluate_scenes_runs_the_pan_tilt_task_and_writes_json(tmp_path):
     assert 'pan-tilt (2 scenes with a face): right' in out.stdout
     record = json.loads((tmp_path / 'pt.json').read_text())
     assert record['settings']['search.max_fixations'] == 6
-    from ipomdp_gaze.nodes.config import config_file
+    from ipomdp_gaze.share_files import config_file
     from ipomdp_gaze.yaml_files import yaml_parameters
     shipped = yaml_parameters(config_file('faces_camera_controller.yaml'), 'gaze_controller')
     for name in ('search.repeat_weight', 'absent.prior', 'search.hotspot_prior'):
@@ -191,8 +191,8 @@ def test_find_saves_each_images_event_log(tmp_path):
 @pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')
 def test_an_unexpected_error_in_a_parameter_set_is_counted_and_refused(ros_env, monkeypatch):
     """The controller's parameter callback is guarded: the set is refused, the node lives on."""
-    from rclpy.parameter import Parameter
     from ipomdp_gaze.nodes import controller as module
+    from rclpy.parameter import Parameter
 
     def broken(*args, **kwargs):
         raise RuntimeError('injected fault in build_policy')

@@ -4,13 +4,12 @@
 import itertools
 import math
 
+from ipomdp_gaze.drivers.scene_eval import head_time_s, SACCADE_TIME_S, SETTLE_TIME_S, task_spec
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.observation_file import load_observation
 from ipomdp_gaze.policies.baselines import (axis_poses, SWEEP_STEP, sweep_tile_cells,
                                             TILE_MARGIN_CELLS)
 from ipomdp_gaze.policies.registry import build_policy
-from ipomdp_gaze.vision.scene_eval import (head_time_s, SACCADE_TIME_S, SETTLE_TIME_S,
-                                           task_spec)
 import numpy as np
 import pytest
 
@@ -218,7 +217,7 @@ def test_evaluate_scenes_refuses_bad_searchers_and_empty_fovea_scenes_in_one_lin
 
 
 def test_every_searcher_of_a_scene_shares_its_views_and_the_sweep_rules_follow_the_poses():
-    from ipomdp_gaze.vision.scene_eval import _Task, evaluate_scene, SWEEP_RULES
+    from ipomdp_gaze.drivers.scene_eval import _Task, evaluate_scene, SWEEP_RULES
     spec = task_spec('pan-tilt', split='train', seed=7, compare=('sweep',) + SWEEP_RULES)
     results = {r.searcher: r for r in evaluate_scene(spec, 0)}
     assert list(results) == ['coverage', 'sweep'] + list(SWEEP_RULES)
@@ -243,7 +242,7 @@ def test_every_searcher_of_a_scene_shares_its_views_and_the_sweep_rules_follow_t
 def test_the_pan_tilt_task_runs_with_yunet_whose_boxes_carry_a_score():
     # YuNet returns (M, 5) boxes with a score; the view cache keeps boxes only, so the sweep's
     # grouped answer rules work for a scoring detector too.
-    from ipomdp_gaze.vision.scene_eval import _Task, evaluate_scene, SWEEP_RULES
+    from ipomdp_gaze.drivers.scene_eval import _Task, evaluate_scene, SWEEP_RULES
     spec = task_spec('pan-tilt', split='train', seed=7, model='faces-pan-tilt-yunet',
                      compare=SWEEP_RULES)
     results = {r.searcher: r for r in evaluate_scene(spec, 0)}

@@ -118,28 +118,6 @@ def probability_arg(text: str) -> float:
     return value
 
 
-def add_scene_args(parser: argparse.ArgumentParser, scenes: str) -> None:
-    """
-    ``--motion-sigma-cells``, ``--jump-prob``, ``--absent-prior`` and ``--absent-rate``.
-
-    The target's random walk per fixation and the absent hypothesis of docs/design.md section 7;
-    ``scenes`` names the scenes whose empty fraction ``--absent-rate`` sets (``simulated``,
-    ``training``). Each is None when not given, which means 0: a still target that is always
-    there.
-    """
-    parser.add_argument('--motion-sigma-cells', type=nonneg_float, default=None,
-                        help='the target moves between fixations: Gaussian step of this '
-                             'standard deviation in cells (default 0: still)')
-    parser.add_argument('--jump-prob', type=probability_arg, default=None,
-                        help='probability per fixation that the target jumps to a uniformly '
-                             'random cell instead (default 0)')
-    parser.add_argument('--absent-prior', type=float, default=None,
-                        help="the model's prior that no target is in the grid (default 0: "
-                             'always there)')
-    parser.add_argument('--absent-rate', type=probability_arg, default=None,
-                        help=f'fraction of the {scenes} scenes that are empty (default 0)')
-
-
 def fpoc_param(text: str) -> tuple[str, object]:
     """Parse ``name=value`` for argparse; the value is read as YAML (numbers, lists, words)."""
     name, sep, value = text.partition('=')

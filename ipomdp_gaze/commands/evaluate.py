@@ -16,25 +16,23 @@ from dataclasses import replace
 import json
 from pathlib import Path
 
-from ipomdp_gaze.evaluation import (decision_summary, fixations_to_90_ci,
-                                    paired_difference_ci, paired_tracking_difference,
-                                    tracking_summary)
+from ipomdp_gaze.drivers.pieces import concat_results, COSTLY_CHUNK, PLANNER_CHUNK, simulate_pieces
+from ipomdp_gaze.drivers.scene_eval import (evaluate_scenes, format_summary, paired_map_difference,
+                                            results_json, summarise, task_spec, TASKS, write_json)
+from ipomdp_gaze.evaluation import (decision_summary, fixations_to_90_ci, paired_difference_ci,
+                                    paired_tracking_difference, tracking_summary)
 from ipomdp_gaze.executor import InlineExecutor
 from ipomdp_gaze.motion import Motion
 from ipomdp_gaze.observation import as_observation, GaussianObservation
 from ipomdp_gaze.observation_file import fingerprint
-from ipomdp_gaze.pieces import concat_results, COSTLY_CHUNK, PLANNER_CHUNK, simulate_pieces
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
 from ipomdp_gaze.session import SearchSettings
 from ipomdp_gaze.simulate import draw_present, draw_targets
-from ipomdp_gaze.vision.scene_eval import (evaluate_scenes, format_summary,
-                                           paired_map_difference, results_json, summarise,
-                                           task_spec, TASKS, write_json)
 import numpy as np
 
-from .common import (add_scene_args, add_task_args, nonneg_int, positive_int,
-                     task_from_args)
+from .common import add_task_args, nonneg_int, positive_int, task_from_args
 from .running import add_run_args, executor_from_args, progress_from_args
+from .search_args import add_scene_args, add_search_args, settings_from_args
 
 NO_PREDICTION = ' (no prediction)'
 
@@ -84,11 +82,10 @@ def add_parser(sub):
                    help='also give each policy minus the first, on the same episodes, with a '
                         'paired bootstrap 95%% interval')
     add_scene_args(p, 'simulated')
-    p.add_argument('--confidence', type=float, default=None,
-                   help='level at which a search decides found or absent (default 0.95)')
-    p.add_argument('--max-fixations', type=int, default=None,
-                   help='fixation budget: undecided searches give up there (default and 0: the '
-                        'horizon; also the horizon when --horizon is not given)')
+    add_search_args(p, None, ('confidence',), task_default='0.95')
+    add_search_args(p, None, ('max_fixations',),
+                    task_default='and 0: the horizon; also the horizon when --horizon is not '
+                                 'given')
     p.add_argument('--compare-prediction', action='store_true',
                    help='moving target: also run each policy without the prediction step and '
                         'report the paired difference in tracking accuracy')
@@ -129,7 +126,7 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
     bootstrap interval. The simulations run on ``executor`` (:mod:`ipomdp_gaze.executor`;
     default: here), a slow searcher in pieces of ``COSTLY_CHUNK`` episodes
     (``PLANNER_CHUNK`` for the planner), with the same numbers wherever they run; ``bar``
-    (:class:`ipomdp_gaze.progress.Progress`) counts the pieces, ``progress(name, entry)`` is
+    (:class:`ipomdp_gaze.progress.Progress`) counts episodes, ``progress(name, entry)`` is
     called as each policy's entry is ready.
     """
     scene = (motion_sigma_cells, jump_prob, absent_prior, absent_rate, confidence,
@@ -252,11 +249,7 @@ def format_decisions(result: dict) -> str:
 
 def check_settings(args) -> SearchSettings:
     """Check the search settings given as flags before any work (the session's messages)."""
-    given = {key: value for key, value in (
-        ('confidence', args.confidence), ('absent_prior', args.absent_prior),
-        ('max_fixations', args.max_fixations), ('motion_sigma_cells', args.motion_sigma_cells),
-        ('motion_jump_prob', args.jump_prob)) if value is not None}
-    return SearchSettings(**given)
+    return settings_from_args(args, SearchSettings())
 
 
 def run_scenes(args) -> int:
@@ -313,7 +306,7 @@ def _pieces(args, policies) -> int:
             count += -(-min(args.episodes, args.episodes_greedy) // chunk)
         else:
             count += 1
-    moving = bool(args.motion_sigma_cells) or bool(args.jump_prob)
+    moving = bool(args.motion_sigma_cells) or bool(args.motion_jump_prob)
     return 2 * count if args.compare_prediction and moving else count
 
 
@@ -326,10 +319,11 @@ def run(args) -> int:
     grid, fpoc = task_from_args(args)
     policies = load_policies(args, grid, fpoc)
     with executor_from_args(args, _pieces(args, policies)) as executor, \
-            progress_from_args(args, 0, 'evaluate') as bar:
+            progress_from_args(args, 0, 'evaluate', 'episode') as bar:
         result = evaluate(grid, fpoc, policies, args.episodes, args.horizon, args.seed,
                           args.episodes_greedy, args.bootstrap,
-                          motion_sigma_cells=args.motion_sigma_cells, jump_prob=args.jump_prob,
+                          motion_sigma_cells=args.motion_sigma_cells,
+                          jump_prob=args.motion_jump_prob,
                           absent_prior=args.absent_prior, absent_rate=args.absent_rate,
                           confidence=args.confidence, max_fixations=args.max_fixations,
                           compare_prediction=args.compare_prediction, paired=args.paired,

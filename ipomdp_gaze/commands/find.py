@@ -59,14 +59,13 @@ from ipomdp_gaze.belief import uniform_log_belief
 from ipomdp_gaze.observation_file import load_observation, shipped_image_models
 from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
-from ipomdp_gaze.session import TARGETS
 from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, FIND_SETTINGS,
                                        fovea_for_model, full_frame_reason, full_frame_search,
                                        search_all, search_image, search_many, size_distance)
 import numpy as np
 
 from .common import nonneg_int
-from .search_args import add_search_args, settings_from_args
+from .search_args import add_search_args, settings_from_args, TASK_DEFAULT
 
 POLICY_CHOICES = tuple(name for name in POLICY_NAMES if name != 'learned')
 # The detectors with shipped find models; the first is the default, chosen on the training
@@ -107,17 +106,16 @@ def add_parser(sub):
     policy.add_argument('--policy-file', default=None, metavar='FILE',
                         help='a policy YAML file or a shipped kernel name')
     add_search_args(p, FIND_SETTINGS, ('confidence', 'max_fixations', 'absent_prior',
-                                       'repeat_weight', 'start'))
+                                       'repeat_weight', 'start_cell'))
     p.add_argument('--all', action='store_true',
                    help='find every face in one search over the many-target belief (an '
                         'occupancy per cell, infomax per detector pixel, within one full scan '
                         'of detector pixels); each face is printed with its box and '
                         'probability, counted once per cluster of occupied cells (split where '
                         "the detector's boxes are distinct faces)")
-    p.add_argument('--targets', choices=TARGETS, default=None,
-                   help="search.targets: one (the paper's belief) or many (an occupancy per "
-                        'cell); default many with --all, else one. --all --targets one: find '
-                        'a face, rule the cells within 2 of it out, search again')
+    add_search_args(p, None, ('targets',), task_default='many with --all, else one; --all '
+                    '--targets one: find a face, rule the cells within 2 of it out, search '
+                    'again')
     p.add_argument('--plot', type=Path, default=None, metavar='OUT.png',
                    help='draw the image, the numbered fixations and the windows of the last '
                         'one, in the format the extension names (.png, .pdf, .svg, .jpg, ...; '
@@ -393,8 +391,9 @@ def run(args) -> int:
             image = read_image(path)
             task = tasks.task((image.shape[1], image.shape[0]))
             check_image_size((image.shape[1], image.shape[0]), task.fovea)
-            settings = replace(settings_from_args(args, FIND_SETTINGS, task.model.grid),
-                               targets=args.targets or ('many' if args.all else 'one'))
+            settings = settings_from_args(args, FIND_SETTINGS, task.model.grid)
+            if args.all and args.targets is TASK_DEFAULT:
+                settings = replace(settings, targets='many')
         except ValueError as exc:
             message = str(exc)
             _error(message if message.startswith(path) else f'{path}: {message}')

@@ -5,15 +5,15 @@
 
 ``record`` runs the ``recorder`` node (:mod:`ipomdp_gaze.nodes.recorder`) until Ctrl-C or SIGTERM,
 writing a rosbag2 bag with MCAP storage at PATH; ``replay`` re-runs a bag's frames through the
-controller's core with the recorded settings or others (:mod:`ipomdp_gaze.replay`) and prints
-where the decisions differ.
+controller's core with the recorded settings or others (:mod:`ipomdp_gaze.drivers.replay`) and
+prints where the decisions differ.
 """
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
 
-from .common import nonneg_int
+from .search_args import add_search_args
 
 
 def add_parser(sub):
@@ -47,9 +47,7 @@ def add_parser(sub):
     p.add_argument('--policy', default=None, help='another policy.name')
     p.add_argument('--policy-file', default=None, metavar='FILE',
                    help='another policy file or shipped kernel (selects learned)')
-    p.add_argument('--confidence', type=float, default=None,
-                   help='another confidence, in (0, 1) (checked as the node checks it)')
-    p.add_argument('--max-fixations', type=nonneg_int, default=None, metavar='N')
+    add_search_args(p, None, ('confidence', 'max_fixations'), task_default="the recording's")
     p.add_argument('--new-search', action='store_true',
                    help='a fixed camera (detector in fovea mode) only: run a whole new search '
                         'on the last recorded image with these settings, instead of following '
@@ -76,7 +74,7 @@ def run_record(args) -> int:
 
 def run_replay(args) -> int:
     from ipomdp_gaze.bag import read_bag
-    from ipomdp_gaze.replay import describe_size, replay
+    from ipomdp_gaze.drivers.replay import describe_size, replay
     if not args.path.is_dir():
         raise ValueError(f'{args.path} is not a bag directory')
     bag = read_bag(args.path)
@@ -89,7 +87,7 @@ def run_replay(args) -> int:
     print('settings: ' + ('recorded' if not changed else
                           'recorded, with ' + ', '.join(changed)))
     if args.new_search:
-        from ipomdp_gaze.replay import new_search
+        from ipomdp_gaze.drivers.replay import new_search
         new_search(bag, overrides)
         return 0
     result = replay(bag, overrides)

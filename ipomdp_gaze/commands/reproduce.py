@@ -16,8 +16,8 @@ from pathlib import Path
 import resource
 import time
 
+from ipomdp_gaze.drivers.pieces import COSTLY_CHUNK, PieceCache, PLANNER_CHUNK, Runner
 from ipomdp_gaze.fpoc import dprime_table
-from ipomdp_gaze.pieces import COSTLY_CHUNK, PieceCache, PLANNER_CHUNK, Runner
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.policies.conv import radial_bins
 from ipomdp_gaze.policies.planner import make_planner, TemperedELM
@@ -280,7 +280,7 @@ def run(args) -> int:
     cache = PieceCache(args.cache)
     # An error or Ctrl-C cancels the pieces still running; the finished ones are in the cache.
     with executor_from_args(args) as pool, \
-            progress_from_args(args, 0, 'reproduce') as progress:
+            progress_from_args(args, 0, 'reproduce', 'episode') as progress:
         r7, r11, others = _simulate_all(args, specs, pool, cache, log, progress)
     where = _where(pool)
     h7, h11 = specs['human-7x7-infomax'], specs['human-11x11-infomax']

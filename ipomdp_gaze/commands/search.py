@@ -8,6 +8,7 @@ from pathlib import Path
 from ipomdp_gaze.observation import as_observation
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
 from ipomdp_gaze.sensors import ModelSensor
+from ipomdp_gaze.sensors import run_search as run_offline
 from ipomdp_gaze.session import SearchSession, SearchSettings
 import numpy as np
 
@@ -30,13 +31,15 @@ def add_parser(sub):
     p.add_argument('--target', type=cell_arg, default=None, metavar='ROW,COL',
                    help='target cell as ROW,COL or a flat index (default random)')
     add_search_args(p, SEARCH_SETTINGS, ('confidence',))
-    p.add_argument('--max-fixations', type=nonneg_int, default=None, metavar='N',
-                   help='fixation budget: gave up when it runs out undecided (default 4 N; 0 = '
-                        'no budget)')
+    add_search_args(p, None, ('max_fixations',), task_default='4 N')
     p.add_argument('--seed', type=nonneg_int, default=0)
     p.add_argument('--plot', type=Path, default=None, metavar='PNG',
                    help='save the final belief with the scan path as a picture')
     p.set_defaults(run=run)
+
+
+# With no budget (--max-fixations 0) an offline search still ends: after this many frames per cell.
+NO_BUDGET_FRAMES_PER_CELL = 100
 
 
 def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=print):
@@ -44,31 +47,29 @@ def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=
     Run one simulated search on the search session, printing each fixation.
 
     The model's own sampler is the world (:class:`ipomdp_gaze.sensors.ModelSensor`); one
-    generator, ``default_rng(seed)``, serves the policy and the noise. Returns ``(guess, path,
-    belief)``.
+    generator, ``default_rng(seed)``, serves the policy and the noise; the loop is
+    :func:`ipomdp_gaze.sensors.run_search`. Returns ``(guess, path, belief)``.
     """
     rng = np.random.default_rng(seed)
     session = SearchSession(grid, model, policy, settings)
     sensor = ModelSensor(grid, model, rng)
-    sensor.start(target)
-    session.reset(seed=rng)
     tr, tc = grid.cell(target)
     out(f'target hidden at cell {target} (row {tr}, col {tc}) of a {grid.rows}x{grid.cols} grid')
-    cell = session.start()
-    while True:
-        result = session.update(sensor.observe(cell))
-        guess = result.map_cell
+
+    def show(frame, result):
         kr, kc = grid.cell(session.path[-1])
-        gr, gc = grid.cell(guess)
+        gr, gc = grid.cell(result.map_cell)
         out(f'fixation {result.fixations:3d}: looked at ({kr},{kc})  most likely ({gr},{gc}) '
             f'p={result.map_probability:.3f}  entropy={session.entropy_nats:.2f} nats  '
-            f"{'right' if guess == target else 'wrong'}")
-        if result.ended:
-            break
-        cell = result.fixation
+            f"{'right' if result.map_cell == target else 'wrong'}")
+
+    limit = None if settings.max_fixations else NO_BUDGET_FRAMES_PER_CELL * grid.n_cells
+    outcome = run_offline(session, sensor, target, seed=rng, limit=limit, on_frame=show)
+    guess = outcome.cell
+    gr, gc = grid.cell(guess)
     verdict = 'right' if guess == target else 'wrong'
-    what = 'found' if result.decision == 'found' else 'gave up'
-    out(f'{what}: the target is most likely at ({gr},{gc}) after {result.fixations} fixations, '
+    what = 'found' if outcome.decision == 'found' else 'gave up'
+    out(f'{what}: the target is most likely at ({gr},{gc}) after {outcome.fixations} fixations, '
         f'which is {verdict}')
     return guess, session.path, session.belief
 

@@ -1,11 +1,14 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-The search settings as CLI flags: the same names and checks as the node's parameters.
+The search settings as CLI flags, generated from the schema (:mod:`ipomdp_gaze.settings`).
 
-Each flag is parsed only as a number (or a cell); :class:`ipomdp_gaze.session.SearchSettings`
-checks every value, so a bad one gets the same one-line message from every command and from the
-``gaze_controller`` node (``confidence must be between 0 and 1 (exclusive), got 1.5``).
+A command names the settings it lets users change; each flag's name, type, placeholder and help
+come from the schema, as the node's parameters do. Each flag is parsed only as a number, a
+true/false switch or a cell (``ROW,COL``, the one cell rule of :func:`.common.cell_arg`);
+:class:`ipomdp_gaze.session.SearchSettings` checks every value, so a bad one gets the same
+one-line message from every command and from the ``gaze_controller`` node
+(``confidence must be between 0 and 1 (exclusive), got 1.5``).
 """
 from __future__ import annotations
 
@@ -13,78 +16,78 @@ import argparse
 from dataclasses import replace
 
 from ipomdp_gaze.session import SearchSettings
+from ipomdp_gaze.settings import by_key, SCHEMA
 
-FLAGS = ('confidence', 'max_fixations', 'inhibit_return', 'repeat_weight', 'absent_prior',
-         'start')
+from .common import cell_arg, cell_index, probability_arg
 
-
-def cell_arg(text: str) -> tuple[int, int] | int:
-    """Parse a cell: ``ROW,COL`` (row first, 0-based), or a flat row-major index."""
-    parts = text.split(',')
-    try:
-        values = tuple(int(p) for p in parts)
-    except ValueError:
-        values = ()
-    if len(values) not in (1, 2):
-        raise argparse.ArgumentTypeError(f'expected a cell as ROW,COL (or a row-major index), '
-                                         f'got {text!r}')
-    return values if len(values) == 2 else values[0]
+# A flag left at this default keeps the command's (or its task's) own setting.
+TASK_DEFAULT = None
 
 
-def cell_index(cell, grid, what: str = 'cell') -> int:
-    """Return the row-major index of a parsed cell on ``grid`` (ValueError when outside)."""
-    if isinstance(cell, tuple):
-        row, col = cell
-        if not (0 <= row < grid.rows and 0 <= col < grid.cols):
-            raise ValueError(f'{what} ({row}, {col}) is outside the {grid.rows}x{grid.cols} grid')
-        return grid.index(row, col)
-    if not 0 <= cell < grid.n_cells:
-        raise ValueError(f'{what} {cell} is outside the {grid.rows}x{grid.cols} grid '
-                         f'({grid.n_cells} cells)')
-    return int(cell)
+def _shown(value) -> str:
+    if isinstance(value, tuple) and value and isinstance(value[0], float):
+        return ' '.join(f'{v:g}' for v in value)
+    return 'none' if value is None else str(value)
 
 
-def add_search_args(parser: argparse.ArgumentParser, defaults: SearchSettings,
-                    flags=FLAGS) -> None:
-    """Add the flags of the settings a command lets users change, with its defaults shown."""
-    d = defaults
-    if 'confidence' in flags:
-        parser.add_argument('--confidence', type=float, default=d.confidence, metavar='P',
-                            help=f'found (absent) when the most likely cell (no target) reaches '
-                                 f'P, in (0, 1) (default {d.confidence})')
-    if 'max_fixations' in flags:
-        parser.add_argument('--max-fixations', type=int, default=d.max_fixations, metavar='N',
-                            help=f'fixation budget: gave_up when it runs out undecided; 0 = no '
-                                 f'budget (default {d.max_fixations})')
-    if 'inhibit_return' in flags:
-        parser.add_argument('--inhibit-return', action=argparse.BooleanOptionalAction,
-                            default=d.inhibit_return,
-                            help="never fixate a cell twice in a search (the policy's best "
-                                 'unvisited cell)')
-    if 'repeat_weight' in flags:
-        parser.add_argument('--repeat-weight', type=float, default=d.repeat_weight,
-                            metavar='W',
-                            help=f"weight in [0, 1] of a cell's evidence beyond its most "
-                                 f'informative view, for a still scene (default '
-                                 f'{d.repeat_weight})')
-    if 'absent_prior' in flags:
-        parser.add_argument('--absent-prior', type=float, default=d.absent_prior, metavar='P',
-                            help=f'prior that no target is there at all, in [0, 1); above 0 a '
-                                 f'search can end with absent (default {d.absent_prior})')
-    if 'start' in flags:
-        parser.add_argument('--start', type=cell_arg, default=d.start_cell, metavar='ROW,COL',
-                            help="first fixation (default: the policy's choice after a scan, "
-                                 "else the grid's centre)")
+def add_search_args(parser: argparse.ArgumentParser, defaults: SearchSettings | None,
+                    keys, schema=SCHEMA, task_default: str = "the task's") -> None:
+    """
+    Add the flags of the settings ``keys`` (field names) with the schema's help.
+
+    ``defaults`` are the command's settings, shown in the help; None leaves every flag at
+    :data:`TASK_DEFAULT` (the task's own value, named ``task_default`` in the help).
+    """
+    settings = by_key(schema)
+    for key in keys:
+        s = settings[key]
+        default = TASK_DEFAULT if defaults is None else getattr(defaults, key)
+        shown = task_default if defaults is None else _shown(default)
+        help_ = f'{s.help_text} (parameter {s.parameter}; default {shown})'.replace('%', '%%')
+        kwargs = {'dest': key, 'default': default, 'help': help_}
+        if s.kind == 'bool':
+            kwargs['action'] = argparse.BooleanOptionalAction
+        else:
+            kwargs['metavar'] = s.metavar or key.upper()
+            kwargs['type'] = {'float': float, 'int': int, 'floats': float,
+                              'cell': cell_arg, 'str': str}[s.kind]
+            if s.kind == 'floats':
+                kwargs['nargs'] = '+'
+        parser.add_argument(s.flag, **kwargs)
 
 
-def settings_from_args(args, defaults: SearchSettings, grid=None) -> SearchSettings:
-    """Return the settings of ``args`` (flags left out keep ``defaults``), checked once."""
-    changes = {key: getattr(args, key) for key in FLAGS[:-1] if hasattr(args, key)}
-    start = getattr(args, 'start', defaults.start_cell)
-    if isinstance(start, int):          # a flat index: a cell only once the grid is known
-        start = defaults.start_cell if grid is None else \
-            grid.cell(cell_index(start, grid, 'start cell'))
-    changes['start_cell'] = start
+def add_scene_args(parser: argparse.ArgumentParser, scenes: str) -> None:
+    """
+    Add the target's random walk per fixation, the absent hypothesis and ``--absent-rate``.
+
+    docs/design.md section 7; ``scenes`` names the scenes whose empty fraction
+    ``--absent-rate`` sets (``simulated``, ``training``). Each is None when not given, which
+    means 0: a still target that is always there.
+    """
+    add_search_args(parser, None, ('motion_sigma_cells', 'motion_jump_prob', 'absent_prior'),
+                    task_default='0')
+    parser.add_argument('--absent-rate', type=probability_arg, default=None,
+                        help=f'fraction of the {scenes} scenes that are empty (default 0)')
+
+
+def settings_from_args(args, defaults: SearchSettings, grid=None,
+                       schema=SCHEMA) -> SearchSettings:
+    """
+    Return the settings of ``args``, checked once.
+
+    Flags a command does not have, or left at :data:`TASK_DEFAULT`, keep ``defaults``; a flat
+    start index becomes a cell once ``grid`` is known.
+    """
+    changes = {}
+    for s in schema:
+        value = getattr(args, s.key, TASK_DEFAULT)
+        if value is TASK_DEFAULT:
+            continue
+        if s.kind == 'cell' and isinstance(value, int):
+            if grid is None:            # a flat index: a cell only once the grid is known
+                continue
+            value = grid.cell(cell_index(value, grid, s.flag))
+        changes[s.key] = tuple(value) if s.kind == 'floats' else value
     settings = replace(defaults, **changes)
     if grid is not None:
         settings.check_grid(grid)

@@ -12,9 +12,11 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .common import (add_scene_args, add_task_args, nonneg_int, positive_float, positive_int,
-                     task_from_args)
+from ipomdp_gaze.session import SearchSettings
+
+from .common import add_task_args, nonneg_int, positive_float, positive_int, task_from_args
 from .running import add_run_args, executor_from_args, progress_from_args
+from .search_args import add_scene_args, settings_from_args
 
 FAMILY_DEFAULT, REWARD_DEFAULT = 'conv', 'infomax'
 # The defaults of the learning rate and reward scale: chosen on the 7x7 human task (README).
@@ -147,6 +149,7 @@ def run(args) -> int:
     from ipomdp_gaze.policies.policy_file import load_policy_spec, save_policy
     from ipomdp_gaze.policies.training import (evaluation_block, read_curve, TrainConfig, Trainer,
                                                trainer_from_spec, write_curve)
+    settings_from_args(args, SearchSettings())       # bad settings: refused before any work
     spec = load_policy_spec(args.resume) if args.resume is not None else None
     out = args.out if args.out is not None else args.resume
     if out is None:
@@ -161,7 +164,7 @@ def run(args) -> int:
         'episodes_per_epoch': args.episodes_per_epoch, 'horizon': args.horizon,
         'eval_every': args.eval_every,
         'eval_episodes': args.eval_episodes, 'motion_sigma_cells': args.motion_sigma_cells,
-        'jump_prob': args.jump_prob, 'absent_prior': args.absent_prior,
+        'jump_prob': args.motion_jump_prob, 'absent_prior': args.absent_prior,
         'absent_rate': args.absent_rate}
     sweep = args.seeds is not None or args.learning_rates is not None
     if sweep and spec is not None:
@@ -243,7 +246,7 @@ def run_sweep(args, grid, model, config, params, init, out) -> int:
     from dataclasses import replace
 
     from ipomdp_gaze.executor import track
-    from ipomdp_gaze.pieces import train_piece
+    from ipomdp_gaze.drivers.pieces import train_piece
     from ipomdp_gaze.policies.policy_file import save_policy
     from ipomdp_gaze.policies.training import write_curve
     import numpy as np

@@ -33,6 +33,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 import sys
 
+from ipomdp_gaze.controller_config import fpoc_from, grid_from, head_from, row_col_from
 from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.motion import check_probability, check_sigma_cells, Motion
 from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
@@ -46,8 +47,8 @@ from std_srvs.srv import Trigger
 
 from . import NODE_NAMES
 from .guard import CallbackGuard
-from .params import (cell_params, fpoc_from, fpoc_params, grid_from, grid_params, head_from,
-                     INT_MAX, joint_params, Param, ParameterTransaction, row_col_from, T)
+from .params import (cell_params, fpoc_params, grid_params, INT_MAX, joint_params, Param,
+                     ParameterTransaction, T)
 from .saccade import SaccadeMixin
 from .spin import run_node
 

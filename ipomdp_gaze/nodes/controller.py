@@ -33,21 +33,19 @@ Run with ``ros2 run ipomdp_gaze controller`` (or ``ipomdp-gaze controller``) and
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 import sys
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from ipomdp_gaze.belief import EvidenceError
-from ipomdp_gaze.gaze import check_settle_time, FrameSequence, GazeController
-from ipomdp_gaze.head import PanTiltMap
-from ipomdp_gaze.health import HealthMonitor, policy_label
+from ipomdp_gaze.controller_config import build_config
+from ipomdp_gaze.controller_config import ControllerConfig as Config
+from ipomdp_gaze.controller_config import grid_from
+from ipomdp_gaze.gaze import FrameSequence
+from ipomdp_gaze.health import HealthMonitor
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, stamps
-from ipomdp_gaze.observation import GaussianObservation
-from ipomdp_gaze.observation_file import load_observation
 from ipomdp_gaze.policies.baselines import STRATEGIES
 from ipomdp_gaze.policies.conv import ACTIONS, check_kernel
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnavailable
-from ipomdp_gaze.session import SearchSettings
 from rclpy.exceptions import NameValidationException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -60,9 +58,8 @@ from trajectory_msgs.msg import JointTrajectory
 
 from . import NODE_NAMES
 from .guard import CallbackGuard
-from .params import (cell_params, current_values, fpoc_from, fpoc_params, grid_from, grid_params,
-                     head_from, INT_MAX, joint_params, Param, ParameterTransaction, row_col_from,
-                     T)
+from .params import (cell_params, current_values, fpoc_params, grid_params, INT_MAX, joint_params,
+                     Param, ParameterTransaction, search_params, T)
 from .spin import run_node
 
 NODE_NAME = NODE_NAMES['controller']
@@ -99,51 +96,7 @@ def controller_params() -> list[Param]:
         Param('evidence_queue_depth', 1, T.INTEGER,
               'frames kept for the node per evidence topic; 1: the newest frame wins '
               '(read-only)', read_only=True, int_range=(1, 1000)),
-        Param('confidence', 0.95, T.DOUBLE,
-              'found (absent) fires when the most likely cell (no target) reaches this '
-              'probability, in (0, 1)'),
-        Param('motion.sigma_cells', 0.0, T.DOUBLE,
-              'the target moves: standard deviation of its random walk in cells per second, '
-              '>= 0 (0: a still target)'),
-        Param('motion.jump_prob', 0.0, T.DOUBLE,
-              'probability per second that the target jumps to a random cell, in [0, 1)'),
-        Param('absent.prior', 0.0, T.DOUBLE,
-              'prior that no target is in the grid, in [0, 1) (0: always there); a change '
-              'starts a new search'),
-        Param('search.max_fixations', 0, T.INTEGER,
-              'fixation budget of a search: gave_up when it runs out undecided (0: none)'),
-        Param('search.inhibit_return', False, T.BOOL,
-              'still target: never fixate a cell twice in a search (a deterministic detector '
-              'on a still scene repeats its counts; the Bayes step would count them twice)'),
-        Param('search.stop_on_repeat', False, T.BOOL,
-              'give up (gave_up) instead of fixating a cell a second time; with '
-              'inhibit_return: once every cell has been fixated (find does this)'),
-        Param('search.scan', True, T.BOOL,
-              'with a count model that has scan tables: start each search with the one-time '
-              'whole-image scan (asked of the detector as fixation [-1, -1, search_id])'),
-        Param('search.repeat_weight', 1.0, T.DOUBLE,
-              'still target: weight of the evidence a cell gets from views other than the one '
-              'that saw it at its most informative offset, in [0, 1] (1: every frame counts '
-              'fully, naive Bayes; 0: the evidence of each cell once, for overlapping views of a '
-              'still scene and a deterministic detector)'),
-        Param('search.found_radius', 0, T.INTEGER,
-              'still target: found when the belief within this many cells of a cell reaches '
-              'the confidence, and that cell is the answer (0: the cell alone)',
-              int_range=(0, 5)),
-        Param('search.decide_at_budget', False, T.BOOL,
-              'still target: when the budget runs out undecided, say absent or found '
-              '(whichever is more probable) instead of gave_up'),
-        Param('search.false_alarm_scales', [1.0], T.DOUBLE_ARRAY,
-              'still target, count model: the scene may fire the detector this many times as '
-              'often as the model expects, each factor equally likely, learned from every '
-              "cell's counts during the search ([1.0]: the model's rates as calibrated)"),
-        Param('search.hotspot_prior', 0.0, T.DOUBLE,
-              'still target, count model: prior that a cell without the target is a hotspot '
-              'that fires in every view (hotspot_scale times the false-alarm rate), in [0, 0.5] '
-              '(0: none)'),
-        Param('search.hotspot_scale', 20.0, T.DOUBLE,
-              "still target, count model: a hotspot's factor of the model's false-alarm rate, "
-              '> 1'),
+    ] + search_params() + [
         Param('policy.name', 'elm', T.STRING, 'fixation policy', choices=POLICY_NAMES),
         Param('policy.file', '', T.STRING,
               'policy YAML path or shipped kernel name; setting it selects learned'),
@@ -170,40 +123,6 @@ def controller_params() -> list[Param]:
     ]
 
 
-POLICY_KEYS = ('policy.name', 'policy.file', 'policy.kernel', 'policy.action')
-OBSERVATION_KEYS = ('observation.model', 'observation.file')
-
-
-@dataclass
-class Config:
-    """Everything the node derives from its parameters."""
-
-    values: dict
-    grid: object
-    fpoc: object
-    observation: object
-    policy: object
-    head: PanTiltMap
-    settings: SearchSettings
-    warning: str = ''
-
-    @property
-    def observation_label(self) -> str:
-        """Describe the observation model for the log."""
-        if self.values['observation.model'] == 'counts':
-            model = self.observation
-            return (f"count model {self.values['observation.file']!r} (K = "
-                    f'{model.max_count + 1}; fpoc.* ignored)')
-        return f'FPOC {self.fpoc.to_dict()}'
-
-    @property
-    def policy_label(self) -> str:
-        """Describe the policy for the log and ``/diagnostics``."""
-        v = self.values
-        return policy_label(v['policy.name'], v['policy.kernel'], v['policy.file'],
-                            v['policy.action'])
-
-
 class GazeControllerNode(Node):
     """ROS 2 wrapper of :class:`ipomdp_gaze.gaze.GazeController`."""
 
@@ -220,8 +139,7 @@ class GazeControllerNode(Node):
         self._transaction.start(self._startup_config())
         cfg = self._config
         v = cfg.values
-        self.core = GazeController(cfg.grid, cfg.observation, cfg.policy, cfg.settings,
-                                   v['settle_time_s'], v['seed'])
+        self.core = cfg.controller()
 
         self._pan_tilt_pub = self.create_publisher(JointState, 'pan_tilt', STATE_QOS)
         self._fixation_pub = self.create_publisher(Int32MultiArray, 'fixation', STATE_QOS)
@@ -282,36 +200,14 @@ class GazeControllerNode(Node):
     # -- parameters ----------------------------------------------------------------------
     def _build(self, values: dict, changed=None, previous: Config | None = None) -> Config:
         """Derive a :class:`Config` from parameter values (ValueError names the problem)."""
-        grid = grid_from(values)
-        fpoc = fpoc_from(values)
-        observation_changed = changed is None or any(k in changed for k in OBSERVATION_KEYS)
-        if previous is not None and not observation_changed and \
-                values['observation.model'] == 'counts':
-            observation = previous.observation
-        else:
-            observation = observation_from(values, grid, fpoc)
-        head = head_from(values, grid)
-        row_col_from(values, grid, 'start_row', 'start_col')
-        settings = SearchSettings.from_parameters(values, grid=grid)
-        check_settle_time(values['settle_time_s'])
+        cfg = build_config(values, build_policy, changed, previous)
         for name in ('forward_command_topic', 'trajectory_topic'):
             if values[name]:
                 try:
                     validate_topic_name(values[name])
                 except NameValidationException as exc:
                     raise ValueError(f'{name}: {exc}') from None
-        warnings = []
-        policy_changed = changed is None or any(k in changed for k in POLICY_KEYS) or any(
-            k.startswith('fpoc.') for k in changed) or observation_changed
-        if previous is not None and not policy_changed:
-            policy = previous.policy
-        else:
-            policy = build_policy(values['policy.name'], grid, observation,
-                                  values['policy.kernel'],
-                                  values['policy.file'], values['policy.action'],
-                                  warn=warnings.append)
-        return Config(dict(values), grid, fpoc, observation, policy, head, settings,
-                      '; '.join(warnings))
+        return cfg
 
     def _startup_config(self) -> Config:
         values = self._transaction.values()
@@ -604,36 +500,6 @@ class GazeControllerNode(Node):
         response.message = state if changed else f'already {state}'
         self.get_logger().info(f'gaze control {response.message}')
         return response
-
-
-def observation_from(values: dict, grid, fpoc):
-    """
-    Build the observation model the parameters select: Gaussian with the FPOC, or a count model.
-
-    Raises
-    ------
-    ValueError
-        For ``counts`` without a file, a file that does not load, or one for another grid (or,
-        for a model calibrated through a pan/tilt camera, another spacing).
-
-    """
-    if values['observation.model'] != 'counts':
-        return GaussianObservation(grid, fpoc)
-    source = values['observation.file']
-    if not source:
-        raise ValueError('observation.model counts needs observation.file (a path or a shipped '
-                         'count model name)')
-    model = load_observation(source)
-    if model.grid.shape != grid.shape:
-        raise ValueError(f'observation.file {source!r} is a count model for a '
-                         f'{model.grid.rows}x{model.grid.cols} grid, not this '
-                         f'{grid.rows}x{grid.cols} grid')
-    image = model.meta.get('image') or {}
-    if image.get('view') == 'pan_tilt' and \
-            abs(model.grid.spacing_deg - grid.spacing_deg) > 1e-9 * grid.spacing_deg:
-        raise ValueError(f'observation.file {source!r} was calibrated on a pan/tilt grid of '
-                         f'{model.grid.spacing_deg} deg/cell, not {grid.spacing_deg}')
-    return model
 
 
 def main(args=None) -> int:

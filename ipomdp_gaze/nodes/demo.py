@@ -22,15 +22,17 @@ import time
 
 from diagnostic_msgs.msg import DiagnosticArray
 from ipomdp_gaze.belief import entropy
+from ipomdp_gaze.controller_config import fpoc_from, grid_from, head_from, observation_from
+from ipomdp_gaze.evaluation import answer_is_right, RIGHT_RADIUS_CELLS
 from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, joints
+from ipomdp_gaze.share_files import config_file
 from ipomdp_gaze.yaml_files import yaml_parameters
 import numpy as np
 from sensor_msgs.msg import Image
 
 from . import NODE_NAMES
-from .config import config_file
-from .params import fpoc_from, grid_from, head_from, joint_params
+from .params import joint_params
 from .processes import domain_id_for, isolated_nodes
 from .watch import quiet_condition, SearchRecord, Watch
 
@@ -76,7 +78,7 @@ class DemoSetup:
     @property
     def tolerance_cells(self) -> int:
         """How far (Chebyshev, cells) the answer may be from the truth and still be right."""
-        return 1 if self.scene == 'faces' else 0
+        return RIGHT_RADIUS_CELLS if self.scene == 'faces' else 0
 
 
 def check_controller(values: dict) -> None:
@@ -97,7 +99,7 @@ def check_controller(values: dict) -> None:
     """
     from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnavailable
 
-    from .controller import controller_params, observation_from
+    from .controller import controller_params
     full = {p.name: p.default for p in controller_params()}
     full.update(values)
     name = full['policy.name']
@@ -488,7 +490,7 @@ def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
             tr, tc = grid.cell(truth)
     else:
         (tr, tc), (fr, fc) = grid.cell(truth), answer[:2]
-        right = max(abs(tr - fr), abs(tc - fc)) <= setup.tolerance_cells
+        right = answer_is_right((fr, fc), (tr, tc), radius=setup.tolerance_cells)
     if stats is not None:
         stats.update(found, truth=(tr, tc), right=right, stop=stop)
     verdict = 'right' if right else 'wrong'

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 import sys
 
 from diagnostic_msgs.msg import DiagnosticArray
+from ipomdp_gaze.controller_config import head_from
 from ipomdp_gaze.detection import (build_setup, DetectorLoop, DetectorSetup, MAX_AGE_S, MODES,
                                    STAMP_TOLERANCE_S)
 from ipomdp_gaze.head import PanTiltMap
@@ -50,7 +51,7 @@ from std_msgs.msg import Float32MultiArray, Int32MultiArray
 from . import NODE_NAMES
 from .annotation import Annotator
 from .guard import CallbackGuard
-from .params import head_from, joint_params, MAX_CELLS_PER_SIDE, Param, ParameterTransaction, T
+from .params import joint_params, MAX_CELLS_PER_SIDE, Param, ParameterTransaction, T
 from .spin import run_node
 
 NODE_NAME = NODE_NAMES['detector']

@@ -18,9 +18,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 
-from ipomdp_gaze.fpoc import CameraFPOC, make_fpoc, MODELS, parameter_names
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.head import PanTiltMap
+from ipomdp_gaze.fpoc import CameraFPOC, MODELS
+from ipomdp_gaze.settings import SCHEMA
 from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
                                 SetParametersResult)
 from rclpy.parameter import Parameter
@@ -153,11 +152,27 @@ def cell_params(prefix: str, what: str, unset: str) -> list[Param]:
     ``<prefix>_row`` and ``<prefix>_col``: a cell, each coordinate -1 when it is not fixed.
 
     ``what`` names the cell (``'the target'``) and ``unset`` says what -1 means, with ``{}`` for
-    the word row or column (``'a random {} at each reset'``); :func:`row_col_from` reads them.
+    the word row or column (``'a random {} at each reset'``);
+    :func:`ipomdp_gaze.controller_config.row_col_from` reads them.
     """
     return [Param(f'{prefix}_{axis[:3]}', -1, T.INTEGER,
                   f'{axis} of {what} (-1: {unset.format(axis)})',
                   int_range=(-1, MAX_CELLS_PER_SIDE - 1)) for axis in ('row', 'column')]
+
+
+_PARAMETER_TYPES = {'float': T.DOUBLE, 'int': T.INTEGER, 'bool': T.BOOL, 'floats': T.DOUBLE_ARRAY,
+                    'str': T.STRING}
+
+
+def search_params(schema=SCHEMA) -> list[Param]:
+    """
+    Return the search settings as parameters, generated from :mod:`ipomdp_gaze.settings`.
+
+    The start cell is declared as ``start_row`` / ``start_col`` (:func:`cell_params`).
+    """
+    return [Param(s.parameter, list(s.default) if s.kind == 'floats' else s.default,
+                  _PARAMETER_TYPES[s.kind], s.help_text, int_range=s.int_range)
+            for s in schema if s.kind != 'cell']
 
 
 def declare(node, params: list[Param]) -> None:
@@ -184,56 +199,6 @@ def short_repr(value, limit: int = 6) -> str:
             return f'[{len(items)} values: {items[0]!r}, {items[1]!r}, ...]'
         return repr(items)
     return repr(value)
-
-
-def grid_from(values: dict) -> Grid:
-    """Build the grid described by ``grid.*``."""
-    return Grid(values['grid.rows'], values['grid.cols'], values['grid.spacing_deg'])
-
-
-def fpoc_from(values: dict):
-    """Build the FPOC described by ``fpoc.model`` and its ``fpoc.<name>`` parameters."""
-    model = values['fpoc.model']
-    kwargs = {}
-    for name in parameter_names(model):
-        value = values[f'fpoc.{name}']
-        kwargs[name] = list(value) if isinstance(value, (list, tuple)) else value
-    if model == 'table' and not isinstance(kwargs['dprime'], list):
-        raise ValueError('the table FPOC needs fpoc.dprime as a list matching fpoc.ecc_deg')
-    return make_fpoc(model, **kwargs)
-
-
-def head_from(values: dict, grid: Grid) -> PanTiltMap:
-    """Build the pan/tilt mapping; joint limits are used when they were declared."""
-    limits = {}
-    if 'pan_min_rad' in values:
-        limits = {'pan_limits_rad': (values['pan_min_rad'], values['pan_max_rad']),
-                  'tilt_limits_rad': (values['tilt_min_rad'], values['tilt_max_rad'])}
-    return PanTiltMap(grid, values['pan_joint'], values['tilt_joint'], values['pan_sign'],
-                      values['tilt_sign'], values['pan_offset_rad'], values['tilt_offset_rad'],
-                      **limits)
-
-
-def row_col_from(values: dict, grid: Grid, row_name: str, col_name: str) -> tuple:
-    """
-    ``(row, col)`` from two parameters where -1 means "not fixed" (returned as None).
-
-    Each coordinate stands on its own, so ``ros2 param set`` can change one at a time.
-
-    Raises
-    ------
-    ValueError
-        If a coordinate is outside the grid.
-
-    """
-    out = []
-    for name, size in ((row_name, grid.rows), (col_name, grid.cols)):
-        value = values[name]
-        if value != -1 and not 0 <= value < size:
-            raise ValueError(f'{name} must be -1 or in 0..{size - 1} for a '
-                             f'{grid.rows}x{grid.cols} grid, got {value}')
-        out.append(None if value == -1 else int(value))
-    return tuple(out)
 
 
 class ParameterTransaction:

@@ -120,7 +120,7 @@ class RecorderNode(Node):
         values = self._transaction.values()
         self._transaction.start(self._build(values))
         from ipomdp_gaze.bag import open_writer
-        from ipomdp_gaze.cli import package_version
+        from ipomdp_gaze.share_files import package_version
         self.writer = open_writer(values['path'], values['compression'])
         self.writer.set_custom_data('ipomdp_gaze/version', package_version())
         self.connections = {}

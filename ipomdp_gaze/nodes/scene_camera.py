@@ -30,6 +30,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 import sys
 
+from ipomdp_gaze.controller_config import head_from
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.head_camera import PinholeCamera
 from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
@@ -40,8 +41,7 @@ from std_msgs.msg import Int32MultiArray
 
 from . import NODE_NAMES
 from .guard import CallbackGuard
-from .params import (head_from, INT_MAX, joint_params, MAX_CELLS_PER_SIDE, Param,
-                     ParameterTransaction, T)
+from .params import INT_MAX, joint_params, MAX_CELLS_PER_SIDE, Param, ParameterTransaction, T
 from .saccade import SaccadeMixin
 from .spin import run_node
 

@@ -57,6 +57,7 @@ import time
 from typing import NamedTuple
 
 import cv2
+from ipomdp_gaze.checks import positive_int as _positive_int
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.vision.cell_observation import CellObservation
 from ipomdp_gaze.vision.detector import (as_detections, box_centres_px, detector_color,
@@ -73,12 +74,6 @@ INTERPOLATIONS = {
     'linear': cv2.INTER_LINEAR,
     'cubic': cv2.INTER_CUBIC,
 }
-
-
-def _positive_int(name: str, value) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-        raise ValueError(f'{name} must be a positive int, got {value!r}')
-    return int(value)
 
 
 @dataclass(frozen=True)

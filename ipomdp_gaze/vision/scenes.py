@@ -42,6 +42,7 @@ from pathlib import Path
 from typing import Iterator, NamedTuple
 
 import cv2
+from ipomdp_gaze.checks import positive_int as _positive_int
 import numpy as np
 
 TRAIN_FACES = range(0, 60)
@@ -379,15 +380,6 @@ def _pick(u: float, n: int) -> int:
 def _check_color(color) -> None:
     if color not in COLORS:
         raise ValueError(f'unknown color mode {color!r}; expected one of {COLORS}')
-
-
-def _positive_int(name: str, value, allow_zero: bool = False) -> int:
-    floor = 0 if allow_zero else 1
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) \
-            or value < floor:
-        kind = 'a non-negative' if allow_zero else 'a positive'
-        raise ValueError(f'{name} must be {kind} integer, got {value!r}')
-    return int(value)
 
 
 def _pair(name: str, value) -> tuple:

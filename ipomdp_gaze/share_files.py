@@ -1,7 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-Where the package's shared files (config YAML, launch files) are found.
+Where the package's shared files (config YAML, launch files) are found, and its version.
 
 A colcon or pip install puts them under ``<prefix>/share/ipomdp_gaze``; an editable install has no
 ``share/`` tree, so the source tree is the fallback (docs/design.md section 5).
@@ -13,7 +13,7 @@ from pathlib import Path
 import sys
 
 PACKAGE = 'ipomdp_gaze'
-SOURCE_ROOT = Path(__file__).resolve().parents[2]
+SOURCE_ROOT = Path(__file__).resolve().parents[1]
 
 
 def share_dirs() -> list[Path]:
@@ -39,3 +39,12 @@ def config_file(name: str) -> Path:
             return path
     raise FileNotFoundError(f'config file {name!r} not found; searched '
                             + ', '.join(str(p) for p in searched))
+
+
+def package_version() -> str:
+    """Return the installed package's version (``setup.py``), or ``unknown`` without metadata."""
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version('ipomdp_gaze')
+    except PackageNotFoundError:
+        return 'unknown'

@@ -30,12 +30,14 @@ import math
 from pathlib import Path
 import re
 
-from ipomdp_gaze.evaluation import wilson_interval
+from ipomdp_gaze.evaluation import answer_is_right, wilson_interval
 from ipomdp_gaze.executor import InlineExecutor, track
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.head import PanTiltMap
 from ipomdp_gaze.observation_file import load_observation
+from ipomdp_gaze.sensors import run_search
 from ipomdp_gaze.session import PARAMETER_NAMES, SearchSession, SearchSettings
+from ipomdp_gaze.settings import check_parameters
 from ipomdp_gaze.yaml_files import yaml_parameters
 import numpy as np
 
@@ -111,10 +113,11 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
         if name in SWEEP_RULES and task != 'pan-tilt':
             raise ValueError(f'{name} is a pan/tilt answer rule')
     if task == 'pan-tilt':
-        from ipomdp_gaze.nodes.config import config_file
-        values = yaml_parameters(config_file('faces_camera_controller.yaml'), 'gaze_controller')
-        base = SearchSettings.from_parameters(values, grid=Grid(values['grid.rows'],
-                                                                values['grid.cols']))
+        from ipomdp_gaze.share_files import config_file
+        path = config_file('faces_camera_controller.yaml')
+        values = yaml_parameters(path, 'gaze_controller')
+        base = check_parameters(values, grid=Grid(values['grid.rows'], values['grid.cols']),
+                                where=f'{path}: ')
         name = values.get('policy.name', 'elm')
         file = values.get('policy.file', '') if name == 'learned' else ''
     else:
@@ -264,8 +267,8 @@ class _Task:
                 return PanTiltSceneSet(spec.split, geometry, color='rgb', seed=spec.seed + i,
                                        empty=spec.empty).scene(0)
         else:
-            from ipomdp_gaze.vision.scenes import SceneSet
             from ipomdp_gaze.vision.fovea_model import fovea_for_model
+            from ipomdp_gaze.vision.scenes import SceneSet
             from ipomdp_gaze.vision.sensors import FoveaSensor
             name, size, faces = _FOVEA_TASKS[spec.task]
             self.model = load_observation(name)
@@ -310,53 +313,32 @@ def evaluate_scene(spec: TaskSpec, index: int) -> list:
     return results
 
 
-def _right(cell, face, decision: str) -> bool:
-    if face is None:
-        return decision == 'absent'
-    return decision != 'absent' and max(abs(cell[0] - face[0]), abs(cell[1] - face[1])) <= 1
-
-
 def _search(spec: TaskSpec, task: _Task, scene, index: int, name: str, policy,
             settings: SearchSettings) -> SceneResult:
     """One session over the task's (cached) sensor; the MAP cell is kept after every frame."""
     grid = task.model.grid
-    sensor = task.sensor
     session = SearchSession(grid, task.model, policy, settings)
-    session.reset(seed=np.random.default_rng([spec.seed, index]))
-    pixels = 0
-    detector_s = []
-    if sensor.scans and settings.scan:
-        frame = sensor.scan()
-        pixels += frame.detector_pixels
-        _applied(session.scan(frame))
-    limit = settings.max_fixations or 4 * grid.n_cells
-    cell = session.start()
-    maps = []
-    while True:
-        frame = sensor.observe(cell)
-        pixels += frame.detector_pixels
-        detector_s.append(frame.seconds)
-        result = _applied(session.update(frame))
+    maps, detector_s = [], []
+
+    def record(frame, result):
         maps.append(session.map_cell)
-        if result.ended or session.fixations >= limit:
-            break
-        cell = result.fixation
+        detector_s.append(frame.seconds)
+
+    outcome = run_search(session, task.sensor, None,
+                         seed=np.random.default_rng([spec.seed, index]),
+                         limit=settings.max_fixations or 4 * grid.n_cells, restart=False,
+                         on_frame=record)
     face = None if scene.cell is None else tuple(int(v) for v in scene.cell)
-    answer = tuple(int(v) for v in grid.cell(session.map_cell))
-    decision = session.decision if result.ended else 'gave_up'
+    answer = tuple(int(v) for v in grid.cell(outcome.cell))
+    ended = bool(outcome.decision)
+    decision = outcome.decision if ended else 'gave_up'
     n = len(maps)
     map_right = tuple(
-        _right(tuple(int(v) for v in grid.cell(maps[k - 1])), face, 'found') if k < n
-        else _right(answer, face, decision) for k in range(1, MAP_BUDGETS + 1))
+        answer_is_right(tuple(int(v) for v in grid.cell(maps[k - 1])), face) if k < n
+        else answer_is_right(answer, face, decision) for k in range(1, MAP_BUDGETS + 1))
     return _result(task, scene, index, name, answer, face, decision,
-                   session.gave_up_reason if result.ended else 'limit', session.path, pixels,
-                   detector_s, map_right)
-
-
-def _applied(result):
-    if not result.applied:
-        raise ValueError(f'the sensor produced a frame the session refused: {result.reason}')
-    return result
+                   outcome.reason if ended else 'limit', outcome.path,
+                   outcome.detector_pixels, detector_s, map_right)
 
 
 def _result(task, scene, index, name, answer, face, decision, reason, path, pixels,
@@ -367,7 +349,7 @@ def _result(task, scene, index, name, answer, face, decision, reason, path, pixe
         travel = head_travel_deg(grid, path)
         head_time = head_time_s(grid, path, detector_s)
     return SceneResult(str(name), int(index), face is not None, str(scene.background),
-                       _right(answer, face, decision), decision, reason, answer, face,
+                       answer_is_right(answer, face, decision), decision, reason, answer, face,
                        len(path), tuple(int(k) for k in path), int(pixels),
                        float(sum(detector_s)), travel, tuple(map_right), head_time,
                        float(sum(detector_s)))

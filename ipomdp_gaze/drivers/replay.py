@@ -25,11 +25,11 @@ import dataclasses
 from dataclasses import dataclass, field
 import math
 
-from ipomdp_gaze.fpoc import make_fpoc, parameter_names
+from ipomdp_gaze.controller_config import build_config
 from ipomdp_gaze.gaze import GazeController
 from ipomdp_gaze.grid import Grid
 from ipomdp_gaze.head import PanTiltMap
-from ipomdp_gaze.session import SearchSettings
+from ipomdp_gaze.policies.registry import build_policy
 import numpy as np
 
 CONTROLLER = 'gaze_controller'
@@ -112,42 +112,22 @@ def build_controller(values: dict) -> tuple[GazeController, PanTiltMap]:
     """
     Build the core and the head mapping from the ``gaze_controller`` parameters, as the node does.
 
+    The node's own builder (:func:`ipomdp_gaze.controller_config.build_config`), so a recording
+    replays with every check the node makes (a count model's grid and pan/tilt spacing among
+    them).
+
     Raises
     ------
     ValueError
         If a parameter is missing or refused (the message names it).
 
     """
-    from ipomdp_gaze.observation_file import load_observation
-    from ipomdp_gaze.policies.registry import build_policy
+    values = {'policy.kernel': None, 'policy.file': '', 'policy.action': 'argmax', **values}
     try:
-        grid = Grid(int(values['grid.rows']), int(values['grid.cols']),
-                    float(values['grid.spacing_deg']))
-        if values.get('observation.model') == 'counts':
-            model = load_observation(values['observation.file'])
-            if model.grid.shape != grid.shape:
-                raise ValueError(f"observation {values['observation.file']!r} is for a "
-                                 f'{model.grid.rows}x{model.grid.cols} grid, the recording '
-                                 f'{grid.rows}x{grid.cols}')
-        else:
-            name = values['fpoc.model']
-            model = make_fpoc(name, **{p: values[f'fpoc.{p}'] for p in parameter_names(name)})
-        kernel = values.get('policy.kernel') or None
-        policy = build_policy(values['policy.name'], grid, model, kernel=kernel,
-                              file=values.get('policy.file', ''),
-                              action=values.get('policy.action', 'argmax'),
-                              warn=lambda message: None)
-        head = PanTiltMap(grid, values['pan_joint'], values['tilt_joint'], values['pan_sign'],
-                          values['tilt_sign'], values['pan_offset_rad'],
-                          values['tilt_offset_rad'],
-                          (values['pan_min_rad'], values['pan_max_rad']),
-                          (values['tilt_min_rad'], values['tilt_max_rad']))
-        settings = SearchSettings.from_parameters(values, grid=grid)
-        core = GazeController(grid, model, policy, settings, values['settle_time_s'],
-                              values['seed'])
-    except KeyError as exc:
-        raise ValueError(f'the recording has no controller parameter {exc}') from None
-    return core, head
+        config = build_config(values, build_policy)
+    except ValueError as exc:
+        raise ValueError(f'the recording: {exc}') from None
+    return config.controller(), config.head
 
 
 def _seconds(stamp) -> float:

@@ -176,10 +176,10 @@ class Runner:
     ``decisions``. Pieces found in ``cache`` (a :class:`PieceCache`) are not run again; each new
     one is stored there by this process as soon as it finishes (so Ctrl-C keeps the finished
     ones). ``progress`` (``add(n)`` / ``update(n)``, :class:`ipomdp_gaze.progress.Progress`)
-    counts pieces. Used by ``reproduce`` and ``bench/planner_vs_greedy.py``. With
-    ``rao_blackwell`` (Gaussian FPOC model), ``map_prob`` holds ``E[max_i B'_i]`` given the
-    belief and fixation before each observation (:class:`_RaoBlackwell`): the same curve, less
-    variance.
+    counts episodes as their pieces finish. Used by ``reproduce`` and
+    ``bench/planner_vs_greedy.py``. With ``rao_blackwell`` (Gaussian FPOC model), ``map_prob``
+    holds ``E[max_i B'_i]`` given the belief and fixation before each observation
+    (:class:`_RaoBlackwell`): the same curve, less variance.
     """
 
     def __init__(self, grid, fpoc, episodes, seed, bootstrap, executor=None, cache=None,
@@ -206,11 +206,12 @@ class Runner:
         chunk = n if chunk is None else int(chunk)
         starts = range(0, n, chunk)
         if self.progress is not None:
-            self.progress.add(len(starts))
+            self.progress.add(n)
         jobs = []
         for start in starts:
+            size = min(start + chunk, n) - start
             args = (self.grid, self.model, policy, self.targets[:n], horizon, self.seed,
-                    (start, min(start + chunk, n)), self.rao_blackwell)
+                    (start, start + size), self.rao_blackwell)
             key = self.cache.key(recipe if not self.rao_blackwell or recipe is None
                                  else (recipe, 'rao-blackwell'),
                                  self.grid, self.fpoc, *args[3:7])
@@ -218,21 +219,21 @@ class Runner:
             if found is not None:
                 jobs.append(found)
                 if self.progress is not None:
-                    self.progress.update(1)
+                    self.progress.update(size)
                 continue
             future = self.executor.submit(_simulate_rows, *args)
-            future.add_done_callback(functools.partial(self._finished, key))
+            future.add_done_callback(functools.partial(self._finished, key, size))
             jobs.append(future)
         self._pending[name] = jobs
         return len(jobs)
 
-    def _finished(self, key, future):
-        """Store a piece the moment it is done (in this process), and count it."""
+    def _finished(self, key, episodes, future):
+        """Store a piece the moment it is done (in this process), and count its episodes."""
         if future.cancelled() or future.exception() is not None:
             return
         self.cache.store(key, future.result())
         if self.progress is not None:
-            self.progress.update(1)
+            self.progress.update(episodes)
 
     def pending(self, name) -> list:
         """Return the pieces of a run not yet collected: futures, or results from the cache."""
@@ -312,20 +313,22 @@ def simulate_pieces(executor, grid, model, policy, episodes: int, horizon, seed:
     pieces of ``chunk`` rows (:func:`ipomdp_gaze.simulate.simulate` with ``rows``): exactly
     the unsplit rows for a deterministic policy, and for a stochastic one a result that depends
     on ``chunk`` but not on the executor. ``options`` are passed on (``targets``, ``present``,
-    ``motion`` ...); ``progress`` (``add`` / ``update``) counts the pieces.
+    ``motion`` ...); ``progress`` (``add`` / ``update``) counts episodes as pieces finish.
     """
     if chunk is None or chunk >= episodes:
         rows = [None]
     else:
         rows = [(start, min(start + chunk, episodes)) for start in range(0, episodes, chunk)]
     if progress is not None:
-        progress.add(len(rows))
+        progress.add(episodes)
     futures = []
     for piece in rows:
         future = executor.submit(_simulate_piece, grid, model, policy, episodes, horizon, seed,
                                  piece, options)
         if progress is not None:
-            future.add_done_callback(lambda f: f.cancelled() or progress.update(1))
+            size = episodes if piece is None else piece[1] - piece[0]
+            future.add_done_callback(
+                lambda f, n=size: f.cancelled() or f.exception() is not None or progress.update(n))
         futures.append(future)
     return futures
 

@@ -1,0 +1,151 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The scalar checks every layer uses: one place for each rule and its message.
+
+Each check takes the value and the name users know it by (a parameter, a flag, a field), returns
+the value in its plain Python type and raises ``ValueError`` with one line that starts with the
+name and ends with ``got <value>``. Booleans are never numbers here (``True`` is not a count).
+The search settings (:mod:`ipomdp_gaze.settings`) name the check of each setting.
+"""
+from __future__ import annotations
+
+import math
+import operator
+
+import numpy as np
+
+_NUMBERS = (int, float, np.integer, np.floating)
+
+
+def _is_bool(value) -> bool:
+    return isinstance(value, (bool, np.bool_))
+
+
+def check_flag(value, name: str) -> bool:
+    """Return a true/false value as a bool (not 0/1, not a string)."""
+    if not _is_bool(value):
+        raise ValueError(f'{name} must be true or false, got {value!r}')
+    return bool(value)
+
+
+def positive_int(name: str, value, allow_zero: bool = False) -> int:
+    """Return an integer >= 1 (>= 0 with ``allow_zero``); floats such as 2.0 are refused."""
+    floor = 0 if allow_zero else 1
+    if _is_bool(value) or not isinstance(value, (int, np.integer)) or value < floor:
+        kind = 'a non-negative' if allow_zero else 'a positive'
+        raise ValueError(f'{name} must be {kind} integer, got {value!r}')
+    return int(value)
+
+
+def finite(name: str, value, positive: bool = False) -> float:
+    """Return a finite number (> 0 with ``positive``) as a float."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f'{name} must be a number, got {value!r}') from None
+    if not math.isfinite(number) or (positive and number <= 0):
+        bound = 'finite and > 0' if positive else 'finite'
+        raise ValueError(f'{name} must be {bound}, got {value!r}')
+    return number
+
+
+def check_confidence(confidence, name: str = 'confidence') -> float:
+    """
+    Return the confidence level of a decision as a float: strictly between 0 and 1.
+
+    1 is refused: a posterior reaches it only by rounding, so a search at 1 would never stop by
+    evidence; 0 would decide before any frame.
+    """
+    try:
+        ok = not _is_bool(confidence) and 0.0 < float(confidence) < 1.0
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise ValueError(f'{name} must be between 0 and 1 (exclusive), got {confidence!r}')
+    return float(confidence)
+
+
+def check_budget(value, name: str = 'search.max_fixations') -> int:
+    """Return a fixation budget as an int >= 0; 0 means no budget (everywhere)."""
+    try:
+        budget = -1 if _is_bool(value) else operator.index(value)
+    except TypeError:
+        budget = -1
+    if budget < 0:
+        raise ValueError(f'{name} must be an integer >= 0 (0: no budget), got {value!r}')
+    return budget
+
+
+def check_probability(value, name: str) -> float:
+    """
+    Return a probability in ``[0, 1)`` (a jump probability, a prior or a rate) as a float.
+
+    1 is refused: it would make the hypothesis certain before any evidence.
+    """
+    try:
+        p = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f'{name} must be a probability in [0, 1), got {value!r}') from None
+    if not 0.0 <= p < 1.0:
+        raise ValueError(f'{name} must be a probability in [0, 1), got {value!r}')
+    return p
+
+
+def check_sigma_cells(value, name: str = 'sigma_cells') -> float:
+    """Return a motion standard deviation in cells: a finite number >= 0."""
+    try:
+        sigma = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f'{name} must be a number >= 0, got {value!r}') from None
+    if not math.isfinite(sigma) or sigma < 0:
+        raise ValueError(f'{name} must be finite and >= 0, got {value!r}')
+    return sigma
+
+
+def check_in_range(value, name: str, low: float, high: float, note: str = '') -> float:
+    """Return a number in the closed interval ``[low, high]`` as a float (``note`` explains)."""
+    if _is_bool(value) or not isinstance(value, _NUMBERS) or not low <= float(value) <= high:
+        raise ValueError(f'{name} must be in [{low:g}, {high:g}]{note}, got {value!r}')
+    return float(value)
+
+
+def check_factor_above_one(value, name: str, what: str) -> float:
+    """Return a finite factor > 1 as a float (``what``: of what it is a factor)."""
+    if _is_bool(value) or not isinstance(value, _NUMBERS) \
+            or not (math.isfinite(float(value)) and float(value) > 1.0):
+        raise ValueError(f'{name} must be a finite factor > 1 of {what}, got {value!r}')
+    return float(value)
+
+
+def check_radius(value, name: str) -> int:
+    """Return a radius in cells, an integer from 0 to 5."""
+    if _is_bool(value) or not isinstance(value, (int, np.integer)) or not 0 <= value <= 5:
+        raise ValueError(f'{name} must be an integer from 0 to 5 (cells), got {value!r}')
+    return int(value)
+
+
+def check_start_cell(value, name: str = 'start_cell'):
+    """Return a start cell: ``(row, col)`` integers >= 0, ``'policy'`` or None."""
+    if value is None or (isinstance(value, str) and value == 'policy'):
+        return value
+    try:
+        row, col = (operator.index(v) for v in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be (row, col) integers, 'policy' or none (the "
+                         f'default), got {value!r}') from None
+    if row < 0 or col < 0:
+        raise ValueError(f'{name} must be (row, col) with row, col >= 0, got {value!r}')
+    return (int(row), int(col))
+
+
+# search.targets: the paper's one target (or none), or many (an occupancy per cell,
+# ipomdp_gaze.many).
+TARGETS = ('one', 'many')
+
+
+def check_targets(value, name: str = 'search.targets') -> str:
+    """Return ``'one'`` or ``'many'``: the belief a search holds (docs/design.md section 11)."""
+    if not (isinstance(value, str) and value in TARGETS):
+        raise ValueError(f"{name} must be one of {', '.join(TARGETS)}, got {value!r}")
+    return value

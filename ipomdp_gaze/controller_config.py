@@ -1,0 +1,190 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The controller's configuration from a flat parameter mapping: one pure builder for every driver.
+
+The ``gaze_controller`` node, ``ipomdp-gaze record`` / replay, the offline evaluation of the
+pan/tilt task and the benches describe a controller with the node's parameter names
+(``grid.*``, ``fpoc.*``, ``observation.*``, the joints, the search settings of
+:mod:`ipomdp_gaze.settings`, ``policy.*``). :func:`build_config` turns such a mapping into the
+grid, FPOC, observation model, pan/tilt mapping, settings and policy, with every check the node
+makes, so a recording replays and an evaluation runs exactly what the node would run.
+
+The core does not import the policies (docs/design.md section 8): the caller passes
+``build_policy`` (``ipomdp_gaze.policies.registry.build_policy``), and ``build_config`` calls it as
+``build_policy(name, grid, observation, kernel, file, action, warn=...)``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Mapping
+
+from .fpoc import make_fpoc, parameter_names
+from .gaze import check_settle_time, GazeController
+from .grid import Grid
+from .head import PanTiltMap
+from .health import policy_label
+from .observation import GaussianObservation
+from .observation_file import load_observation
+from .session import SearchSettings
+
+POLICY_KEYS = ('policy.name', 'policy.file', 'policy.kernel', 'policy.action')
+OBSERVATION_KEYS = ('observation.model', 'observation.file')
+
+
+def grid_from(values: Mapping) -> Grid:
+    """Build the grid described by ``grid.*``."""
+    return Grid(values['grid.rows'], values['grid.cols'], values['grid.spacing_deg'])
+
+
+def fpoc_from(values: Mapping):
+    """Build the FPOC described by ``fpoc.model`` and its ``fpoc.<name>`` parameters."""
+    model = values['fpoc.model']
+    kwargs = {}
+    for name in parameter_names(model):
+        value = values[f'fpoc.{name}']
+        kwargs[name] = list(value) if isinstance(value, (list, tuple)) else value
+    if model == 'table' and not isinstance(kwargs['dprime'], list):
+        raise ValueError('the table FPOC needs fpoc.dprime as a list matching fpoc.ecc_deg')
+    return make_fpoc(model, **kwargs)
+
+
+def head_from(values: Mapping, grid: Grid) -> PanTiltMap:
+    """Build the pan/tilt mapping; joint limits are used when they are given."""
+    limits = {}
+    if 'pan_min_rad' in values:
+        limits = {'pan_limits_rad': (values['pan_min_rad'], values['pan_max_rad']),
+                  'tilt_limits_rad': (values['tilt_min_rad'], values['tilt_max_rad'])}
+    return PanTiltMap(grid, values['pan_joint'], values['tilt_joint'], values['pan_sign'],
+                      values['tilt_sign'], values['pan_offset_rad'], values['tilt_offset_rad'],
+                      **limits)
+
+
+def row_col_from(values: Mapping, grid: Grid, row_name: str, col_name: str) -> tuple:
+    """
+    Return ``(row, col)`` from two parameters where -1 means "not fixed" (returned as None).
+
+    Each coordinate stands on its own, so ``ros2 param set`` can change one at a time.
+
+    Raises
+    ------
+    ValueError
+        If a coordinate is outside the grid.
+
+    """
+    out = []
+    for name, size in ((row_name, grid.rows), (col_name, grid.cols)):
+        value = values[name]
+        if value != -1 and not 0 <= value < size:
+            raise ValueError(f'{name} must be -1 or in 0..{size - 1} for a '
+                             f'{grid.rows}x{grid.cols} grid, got {value}')
+        out.append(None if value == -1 else int(value))
+    return tuple(out)
+
+
+def observation_from(values: Mapping, grid: Grid, fpoc):
+    """
+    Build the observation model the parameters select: Gaussian with the FPOC, or a count model.
+
+    Raises
+    ------
+    ValueError
+        For ``counts`` without a file, a file that does not load, or one for another grid (or,
+        for a model calibrated through a pan/tilt camera, another spacing).
+
+    """
+    if values['observation.model'] != 'counts':
+        return GaussianObservation(grid, fpoc)
+    source = values['observation.file']
+    if not source:
+        raise ValueError('observation.model counts needs observation.file (a path or a shipped '
+                         'count model name)')
+    model = load_observation(source)
+    if model.grid.shape != grid.shape:
+        raise ValueError(f'observation.file {source!r} is a count model for a '
+                         f'{model.grid.rows}x{model.grid.cols} grid, not this '
+                         f'{grid.rows}x{grid.cols} grid')
+    image = model.meta.get('image') or {}
+    if image.get('view') == 'pan_tilt' and \
+            abs(model.grid.spacing_deg - grid.spacing_deg) > 1e-9 * grid.spacing_deg:
+        raise ValueError(f'observation.file {source!r} was calibrated on a pan/tilt grid of '
+                         f'{model.grid.spacing_deg} deg/cell, not {grid.spacing_deg}')
+    return model
+
+
+@dataclass
+class ControllerConfig:
+    """Everything a controller derives from its parameters (``values`` keeps them all)."""
+
+    values: dict
+    grid: Grid
+    fpoc: object
+    observation: object
+    policy: object
+    head: PanTiltMap
+    settings: SearchSettings
+    warning: str = ''
+
+    @property
+    def observation_label(self) -> str:
+        """Describe the observation model for the log."""
+        if self.values['observation.model'] == 'counts':
+            model = self.observation
+            return (f"count model {self.values['observation.file']!r} (K = "
+                    f'{model.max_count + 1}; fpoc.* ignored)')
+        return f'FPOC {self.fpoc.to_dict()}'
+
+    @property
+    def policy_label(self) -> str:
+        """Describe the policy for the log and ``/diagnostics``."""
+        v = self.values
+        return policy_label(v['policy.name'], v.get('policy.kernel'), v.get('policy.file', ''),
+                            v.get('policy.action', 'argmax'))
+
+    def controller(self) -> GazeController:
+        """Return a new :class:`ipomdp_gaze.gaze.GazeController` with this configuration."""
+        v = self.values
+        return GazeController(self.grid, self.observation, self.policy, self.settings,
+                              v['settle_time_s'], v['seed'])
+
+
+def build_config(values: Mapping, build_policy: Callable, changed=None,
+                 previous: ControllerConfig | None = None) -> ControllerConfig:
+    """
+    Derive a :class:`ControllerConfig` from the controller's parameter values.
+
+    ``changed`` names the parameters that changed since ``previous`` (None: build everything);
+    an unchanged count model or policy is taken from ``previous`` instead of loaded again.
+
+    Raises
+    ------
+    ValueError
+        Naming the parameter that is missing or refused (a missing one as ``KeyError``'s name).
+
+    """
+    try:
+        grid = grid_from(values)
+        fpoc = fpoc_from(values)
+        observation_changed = changed is None or any(k in changed for k in OBSERVATION_KEYS)
+        if previous is not None and not observation_changed and \
+                values['observation.model'] == 'counts':
+            observation = previous.observation
+        else:
+            observation = observation_from(values, grid, fpoc)
+        head = head_from(values, grid)
+        row_col_from(values, grid, 'start_row', 'start_col')
+        settings = SearchSettings.from_parameters(values, grid=grid)
+        check_settle_time(values['settle_time_s'])
+        warnings = []
+        policy_changed = changed is None or any(k in changed for k in POLICY_KEYS) or any(
+            k.startswith('fpoc.') for k in changed) or observation_changed
+        if previous is not None and not policy_changed:
+            policy = previous.policy
+        else:
+            policy = build_policy(values['policy.name'], grid, observation,
+                                  values.get('policy.kernel'), values.get('policy.file', ''),
+                                  values.get('policy.action', 'argmax'), warn=warnings.append)
+    except KeyError as exc:
+        raise ValueError(f'no controller parameter {exc}') from None
+    return ControllerConfig(dict(values), grid, fpoc, observation, policy, head, settings,
+                            '; '.join(warnings))

@@ -1,0 +1,271 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The search settings schema: every setting described once (docs/design.md section 10.1).
+
+Each :class:`Setting` gives a setting's field name, its parameter name (node, YAML, event log and
+every refusal message), its kind, default, the check of its values (:mod:`ipomdp_gaze.checks`)
+and its help. Everything else is generated from :data:`SCHEMA`:
+
+- :class:`ipomdp_gaze.session.SearchSettings`, the frozen settings object, by
+  :func:`settings_class` (its fields, defaults and checks);
+- the ``gaze_controller`` node's parameter declarations (``nodes/params.py``,
+  ``search_params``), with the same help;
+- the CLI flags of every command (``commands/search_args.py``, ``add_search_args``): a command
+  names the settings it exposes, the flag, type and help come from here;
+- the YAML check of parameter files (:func:`check_parameters`).
+
+A setting added to the schema therefore appears in the node, the CLI and the YAML check with no
+other edit. The module is pure: no rclpy, no argparse.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields, make_dataclass, replace
+from typing import Callable, Mapping
+
+from .checks import (check_budget, check_confidence, check_flag, check_probability,
+                     check_radius, check_sigma_cells, check_start_cell, check_targets)
+from .false_alarms import (check_false_alarm_scales, check_hotspot_prior, check_hotspot_scale,
+                           DEFAULT_HOTSPOT_SCALE)
+from .still_evidence import check_repeat_weight
+
+# What a setting's values are: the node declares them with the matching parameter type and a
+# CLI flag parses them so (a cell is ``ROW,COL``; the node declares it as two integers).
+KINDS = ('float', 'int', 'bool', 'floats', 'cell', 'str')
+
+
+@dataclass(frozen=True)
+class Setting:
+    """
+    One search setting: everything every driver needs to know about it.
+
+    ``key`` is the field of the settings object, ``parameter`` the node / YAML name,
+    ``kind`` one of :data:`KINDS`, ``check(value, parameter)`` returns the value in its plain
+    type or raises ``ValueError`` with one line. ``bounds`` is the allowed range as text for
+    help and descriptors; ``int_range`` (inclusive) is also enforced by rclpy when declared.
+    ``flag`` is the CLI flag (default ``--key-with-dashes``) and ``metavar`` its placeholder.
+    """
+
+    key: str
+    parameter: str
+    kind: str
+    default: object
+    check: Callable
+    help: str  # noqa: A003 (the schema's word, as argparse's)
+    bounds: str = ''
+    int_range: tuple | None = None
+    flag: str = ''
+    metavar: str = ''
+
+    def __post_init__(self):
+        if self.kind not in KINDS:
+            raise ValueError(f'setting {self.key}: kind must be one of {KINDS}, got {self.kind!r}')
+        if not self.flag:
+            object.__setattr__(self, 'flag', '--' + self.key.replace('_', '-'))
+
+    @property
+    def help_text(self) -> str:
+        """Return the help with the allowed range, as the descriptor and ``--help`` show it."""
+        return f'{self.help}, {self.bounds}' if self.bounds else self.help
+
+
+SCHEMA: tuple[Setting, ...] = (
+    Setting('confidence', 'confidence', 'float', 0.95, check_confidence,
+            'found (absent) fires when the most likely cell (no target) reaches this probability',
+            bounds='in (0, 1)', metavar='P'),
+    Setting('max_fixations', 'search.max_fixations', 'int', 0, check_budget,
+            'fixation budget of a search: gave_up when it runs out undecided', bounds='0: none',
+            metavar='N'),
+    Setting('inhibit_return', 'search.inhibit_return', 'bool', False, check_flag,
+            'still target: never fixate a cell twice in a search (a deterministic detector on a '
+            'still scene repeats its counts; the Bayes step would count them twice)'),
+    Setting('stop_on_repeat', 'search.stop_on_repeat', 'bool', False, check_flag,
+            'give up (gave_up) instead of fixating a cell a second time; with inhibit_return: '
+            'once every cell has been fixated (find does this)'),
+    Setting('repeat_weight', 'search.repeat_weight', 'float', 1.0, check_repeat_weight,
+            'still target: weight of the evidence a cell gets from views other than the one that '
+            'saw it at its most informative offset (1: every frame counts fully, naive Bayes; 0: '
+            'the evidence of each cell once, for overlapping views of a still scene and a '
+            'deterministic detector)', bounds='in [0, 1]', metavar='W'),
+    Setting('absent_prior', 'absent.prior', 'float', 0.0, check_probability,
+            'prior that no target is in the grid (0: always there); a change starts a new '
+            'search', bounds='in [0, 1)', metavar='P'),
+    Setting('motion_sigma_cells', 'motion.sigma_cells', 'float', 0.0, check_sigma_cells,
+            'the target moves: standard deviation of its random walk in cells per second (per '
+            'fixation in simulation; 0: a still target)', bounds='>= 0', metavar='CELLS'),
+    Setting('motion_jump_prob', 'motion.jump_prob', 'float', 0.0, check_probability,
+            'probability per second (per fixation in simulation) that the target jumps to a '
+            'random cell', bounds='in [0, 1)', flag='--jump-prob', metavar='P'),
+    Setting('start_cell', 'start_cell', 'cell', None, check_start_cell,
+            "the first fixation (default: the policy's choice after a scan, else the grid's "
+            'centre)', flag='--start', metavar='ROW,COL'),
+    Setting('scan', 'search.scan', 'bool', True, check_flag,
+            'with a count model that has scan tables: start each search with the one-time '
+            'whole-image scan (asked of the detector as fixation [-1, -1, search_id])'),
+    Setting('found_radius', 'search.found_radius', 'int', 0, check_radius,
+            'still target: found when the belief within this many cells of a cell reaches the '
+            'confidence, and that cell is the answer (0: the cell alone)', bounds='0 to 5',
+            int_range=(0, 5), metavar='CELLS'),
+    Setting('stop_on_decision', 'search.stop_on_decision', 'bool', True, check_flag,
+            'found and absent end a search (off: they are only reported, as for a moving target, '
+            'and the search goes on to its budget: to measure what every view would give)'),
+    Setting('decide_at_budget', 'search.decide_at_budget', 'bool', False, check_flag,
+            'still target: when the budget runs out undecided, say absent or found (whichever '
+            'is more probable) instead of gave_up'),
+    Setting('false_alarm_scales', 'search.false_alarm_scales', 'floats', (1.0,),
+            check_false_alarm_scales,
+            'still target, count model: the scene may fire the detector this many times as '
+            'often as the model expects, each factor equally likely, learned from every '
+            "cell's counts during the search ([1.0]: the model's rates as calibrated)",
+            metavar='F'),
+    Setting('hotspot_prior', 'search.hotspot_prior', 'float', 0.0, check_hotspot_prior,
+            'still target, count model: prior that a cell without the target is a hotspot that '
+            'fires in every view (hotspot_scale times the false-alarm rate; 0: none)',
+            bounds='in [0, 0.5]', metavar='P'),
+    Setting('hotspot_scale', 'search.hotspot_scale', 'float', DEFAULT_HOTSPOT_SCALE,
+            check_hotspot_scale,
+            "still target, count model: a hotspot's factor of the model's false-alarm rate",
+            bounds='> 1', metavar='F'),
+    Setting('targets', 'search.targets', 'str', 'one', check_targets,
+            "the belief: one target or none (the paper's) or many (an occupancy per cell, "
+            'ipomdp_gaze.many; the gaze_controller node searches one)', bounds='one or many',
+            metavar='one|many'),
+)
+
+
+def parameter_names(schema=SCHEMA) -> dict:
+    """Return ``{field: parameter name}`` of every setting."""
+    return {s.key: s.parameter for s in schema}
+
+
+def by_key(schema=SCHEMA) -> dict:
+    """Return ``{field: Setting}``."""
+    return {s.key: s for s in schema}
+
+
+class SettingsBase:
+    """What every generated settings class shares: the checks, conversions and helpers."""
+
+    SCHEMA: tuple = ()
+
+    def __post_init__(self):
+        for s in self.SCHEMA:
+            object.__setattr__(self, s.key, s.check(getattr(self, s.key), s.parameter))
+
+    @property
+    def moving(self) -> bool:
+        """Whether the target is modelled as moving."""
+        return self.motion_sigma_cells > 0 or self.motion_jump_prob > 0
+
+    def check_grid(self, grid) -> None:
+        """Refuse a start cell outside ``grid`` (ValueError naming both)."""
+        if isinstance(self.start_cell, tuple):
+            row, col = self.start_cell
+            if row >= grid.rows or col >= grid.cols:
+                raise ValueError(f'start cell ({row}, {col}) is outside a {grid.rows}x'
+                                 f'{grid.cols} grid')
+
+    def to_parameters(self) -> dict:
+        """Return the settings under their parameter names, as YAML files and event logs."""
+        out = {}
+        for s in self.SCHEMA:
+            value = getattr(self, s.key)
+            out[s.parameter] = list(value) if isinstance(value, tuple) else value
+        return out
+
+    @classmethod
+    def from_parameters(cls, values: Mapping, base=None, grid=None):
+        """
+        Build settings from parameter names (node parameters, a YAML block, CLI flags).
+
+        Unknown names are ignored (a node has many other parameters). ``start_row`` and
+        ``start_col`` give ``start_cell`` as the node declares it: -1 is the centre's row
+        (column) of ``grid``, both -1 the default rule. With ``grid`` the start cell is checked
+        against it.
+        """
+        changes = {s.key: values[s.parameter] for s in cls.SCHEMA if s.parameter in values}
+        if 'start_row' in values or 'start_col' in values:
+            row, col = values.get('start_row', -1), values.get('start_col', -1)
+            if row == -1 and col == -1:
+                changes['start_cell'] = None
+            elif grid is None:
+                raise ValueError('start_row / start_col of -1 (the centre) need the grid')
+            else:
+                centre_row, centre_col = grid.cell(grid.center_index)
+                changes['start_cell'] = (centre_row if row == -1 else row,
+                                         centre_col if col == -1 else col)
+        settings = replace(base or cls(), **changes)
+        if grid is not None:
+            settings.check_grid(grid)
+        return settings
+
+
+def _docstring(schema) -> str:
+    lines = ['How a search decides and stops, checked once (the same message from every driver).',
+             '', 'Generated from :data:`ipomdp_gaze.settings.SCHEMA`; each field is checked',
+             'when the object is built and keeps its plain type.', '', 'Attributes', '----------']
+    for s in schema:
+        lines += [f'{s.key} : {s.kind}', f'    ``{s.parameter}``: {s.help_text}.']
+    return '\n'.join(lines) + '\n'
+
+
+def settings_class(schema=SCHEMA, name: str = 'SearchSettings', module: str = __name__):
+    """
+    Return a frozen dataclass with one checked field per setting of ``schema``.
+
+    ``module`` is where the class is importable from (pickling across processes needs it).
+    """
+    fields_ = [(s.key, object, field(default=s.default)) for s in schema]
+    cls = make_dataclass(name, fields_, bases=(SettingsBase,), frozen=True,
+                         namespace={'SCHEMA': tuple(schema), '__doc__': _docstring(schema)})
+    cls.__module__ = module
+    return cls
+
+
+_KIND_WORDS = {'float': 'a number', 'int': 'an integer', 'bool': 'true or false',
+               'floats': 'a list of numbers', 'cell': '[row, col]', 'str': 'a string'}
+
+
+def _check_kind(setting: Setting, value, where: str) -> None:
+    """Refuse a YAML value of the wrong kind (a string for a number, 1 for true)."""
+    kind = setting.kind
+    ok = {'float': isinstance(value, (int, float)) and not isinstance(value, bool),
+          'int': isinstance(value, int) and not isinstance(value, bool),
+          'bool': isinstance(value, bool),
+          'floats': isinstance(value, list) and all(
+              isinstance(v, (int, float)) and not isinstance(v, bool) for v in value),
+          'cell': value is None or isinstance(value, (list, str)),
+          'str': isinstance(value, str)}[kind]
+    if not ok:
+        raise ValueError(f'{where}{setting.parameter} must be {_KIND_WORDS[kind]}, got {value!r}')
+
+
+def check_parameters(values: Mapping, settings_cls=None, base=None, grid=None, where: str = ''):
+    """
+    Check the search settings of a flat parameter mapping (a YAML ``ros__parameters`` block).
+
+    Each setting present must have the kind the node declares (YAML ``1`` is not ``true``), and
+    the whole goes through the settings' own checks; a parameter in a settings namespace
+    (``search.``, ``motion.``, ``absent.``) that no setting has is refused, so a typo does not
+    pass silently. Returns the settings object. ``where`` prefixes messages (a file name).
+    """
+    if settings_cls is None:
+        from .session import SearchSettings as settings_cls
+    schema = settings_cls.SCHEMA
+    known = {s.parameter: s for s in schema}
+    namespaces = {s.parameter.split('.')[0] + '.' for s in schema if '.' in s.parameter}
+    for name, value in values.items():
+        if name in known:
+            _check_kind(known[name], value, where)
+        elif name.startswith(tuple(namespaces)):
+            raise ValueError(f'{where}unknown search parameter {name!r}; known: '
+                             f"{', '.join(sorted(known))}")
+    try:
+        return settings_cls.from_parameters(values, base=base, grid=grid)
+    except ValueError as exc:
+        raise ValueError(f'{where}{exc}') from None
+
+
+def field_names(settings_cls) -> tuple:
+    """Return the field names of a settings class, in schema order."""
+    return tuple(f.name for f in fields(settings_cls))

@@ -1,0 +1,129 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The settings schema is the one description of every search setting.
+
+The settings object, the node's parameter declarations, the CLI flags and the YAML check are
+generated from :data:`ipomdp_gaze.settings.SCHEMA`: a setting added there appears in all four
+with no other edit, and each refuses a bad value with the same message.
+"""
+from __future__ import annotations
+
+import argparse
+from dataclasses import fields, replace
+import pickle
+
+from conftest import HAVE_RCLPY, REPO
+from ipomdp_gaze.checks import check_sigma_cells
+from ipomdp_gaze.commands.search_args import add_search_args, settings_from_args
+from ipomdp_gaze.session import PARAMETER_NAMES, SearchSettings
+from ipomdp_gaze.settings import check_parameters, SCHEMA, Setting, settings_class
+from ipomdp_gaze.yaml_files import yaml_parameters
+import pytest
+
+NEW = Setting('dwell_s', 'search.dwell_s', 'float', 1.5, check_sigma_cells,
+              'seconds each found person is kept in view', bounds='>= 0', metavar='S')
+EXTENDED = SCHEMA + (NEW,)
+Extended = settings_class(EXTENDED, name='Extended', module=__name__)
+
+
+def test_the_settings_object_has_one_field_per_setting_in_schema_order():
+    assert [f.name for f in fields(SearchSettings)] == [s.key for s in SCHEMA]
+    assert PARAMETER_NAMES == {s.key: s.parameter for s in SCHEMA}
+    defaults = SearchSettings()
+    for s in SCHEMA:
+        assert getattr(defaults, s.key) == s.default, s.key
+
+
+def test_the_settings_object_is_frozen_and_pickles_across_processes():
+    settings = SearchSettings(confidence=0.99, false_alarm_scales=[2.0, 1.0])
+    assert settings.false_alarm_scales == (1.0, 2.0)
+    with pytest.raises(AttributeError):
+        settings.confidence = 0.5
+    assert pickle.loads(pickle.dumps(settings)) == settings
+    assert replace(settings, max_fixations=3).max_fixations == 3
+
+
+def test_an_added_setting_is_a_checked_field():
+    assert Extended().dwell_s == 1.5
+    assert Extended(dwell_s=2).dwell_s == 2.0
+    with pytest.raises(ValueError, match=r'^search.dwell_s must be finite and >= 0, got -1'):
+        Extended(dwell_s=-1)
+    assert Extended.from_parameters({'search.dwell_s': 3.0}).dwell_s == 3.0
+    assert Extended(dwell_s=4.0).to_parameters()['search.dwell_s'] == 4.0
+
+
+def test_an_added_setting_is_a_cli_flag_with_the_same_check():
+    parser = argparse.ArgumentParser()
+    add_search_args(parser, Extended(), ('confidence', 'dwell_s'), schema=EXTENDED)
+    assert 'seconds each found person is kept in view, >= 0' in parser.format_help()
+    args = parser.parse_args(['--dwell-s', '2.5', '--confidence', '0.9'])
+    settings = settings_from_args(args, Extended(), schema=EXTENDED)
+    assert (settings.dwell_s, settings.confidence) == (2.5, 0.9)
+    args = parser.parse_args(['--dwell-s', '-2'])
+    with pytest.raises(ValueError, match=r'^search.dwell_s must be finite and >= 0, got -2.0'):
+        settings_from_args(args, Extended(), schema=EXTENDED)
+
+
+def test_an_added_setting_is_checked_in_yaml():
+    assert check_parameters({'search.dwell_s': 2.0}, Extended).dwell_s == 2.0
+    with pytest.raises(ValueError, match=r"^my.yaml: search.dwell_s must be a number, got 'x'"):
+        check_parameters({'search.dwell_s': 'x'}, Extended, where='my.yaml: ')
+    with pytest.raises(ValueError, match=r'search.dwell_s must be finite and >= 0, got -3'):
+        check_parameters({'search.dwell_s': -3}, Extended)
+    # Without the setting the name is a typo in the search namespace.
+    with pytest.raises(ValueError, match=r"unknown search parameter 'search.dwell_s'"):
+        check_parameters({'search.dwell_s': 2.0})
+
+
+@pytest.mark.skipif(not HAVE_RCLPY, reason='the node parameters need rclpy')
+def test_an_added_setting_is_a_node_parameter():
+    from ipomdp_gaze.nodes.params import search_params
+    from rclpy.parameter import Parameter
+    declared = {p.name: p for p in search_params(EXTENDED)}
+    param = declared['search.dwell_s']
+    assert (param.default, param.ptype) == (1.5, Parameter.Type.DOUBLE)
+    assert param.description == 'seconds each found person is kept in view, >= 0'
+
+
+@pytest.mark.skipif(not HAVE_RCLPY, reason='the node parameters need rclpy')
+def test_the_controller_declares_every_setting_from_the_schema():
+    from ipomdp_gaze.nodes.controller import controller_params
+    from ipomdp_gaze.nodes.params import search_params
+    declared = {p.name: p for p in controller_params()}
+    for param in search_params():
+        assert declared[param.name] == param
+    assert {'start_row', 'start_col'} <= set(declared)       # the start cell, as two integers
+    names = {s.parameter for s in SCHEMA if s.kind != 'cell'}
+    assert names <= set(declared)
+
+
+@pytest.mark.parametrize('kind, value, message', [
+    ('int', 2.5, 'search.max_fixations must be an integer, got 2.5'),
+    ('bool', 1, 'search.inhibit_return must be true or false, got 1'),
+    ('floats', 2.0, 'search.false_alarm_scales must be a list of numbers, got 2.0'),
+])
+def test_yaml_values_of_the_wrong_kind_are_refused(kind, value, message):
+    name = next(s.parameter for s in SCHEMA if s.kind == kind)
+    with pytest.raises(ValueError, match=message.replace('.', r'\.')):
+        check_parameters({name: value})
+
+
+def test_a_typo_in_a_settings_namespace_is_refused_other_parameters_pass():
+    with pytest.raises(ValueError, match=r"unknown search parameter 'search.max_fixation'"):
+        check_parameters({'search.max_fixation': 5})
+    settings = check_parameters({'grid.rows': 11, 'policy.name': 'elm', 'confidence': 0.9})
+    assert settings.confidence == 0.9
+
+
+@pytest.mark.parametrize('name', ['controller.yaml', 'faces_camera_controller.yaml',
+                                  'faces_fovea_controller.yaml'])
+def test_every_shipped_controller_file_passes_the_yaml_check(name):
+    values = yaml_parameters(REPO / 'config' / name, 'gaze_controller')
+    settings = check_parameters(values, where=f'{name}: ')
+    for s in SCHEMA:
+        if s.parameter in values:
+            expected = values[s.parameter]
+            got = getattr(settings, s.key)
+            assert (list(got) if isinstance(got, tuple) else got) == \
+                (sorted(expected) if s.kind == 'floats' else expected), s.parameter
