@@ -347,3 +347,23 @@ def test_the_single_target_session_refuses_many_targets():
     with pytest.raises(ValueError, match='search.targets many is searched by '
                                          'ipomdp_gaze.many.OccupancySession'):
         SearchSession(grid, _model(grid), None, SearchSettings(targets='many'))
+
+
+def test_gaussian_information_equals_the_integral_of_the_entropy_drop():
+    """The Gaussian channel's information (binned for the table) against direct integration."""
+    grid = Grid(3, 3)
+    model = GaussianObservation(grid, make_fpoc('human'))
+    log_odds = np.array([-4.0, -1.0, 0.0, 0.5, 2.0, -6.0, 1.0, -0.3, 3.0])
+    p = occupancy(log_odds)
+    o = np.linspace(-12.0, 14.0, 26_001)
+    phi0 = np.exp(-0.5 * o ** 2) / math.sqrt(2 * math.pi)
+
+    def drop(p_j, d):
+        phi1 = np.exp(-0.5 * (o - d) ** 2) / math.sqrt(2 * math.pi)
+        m = p_j * phi1 + (1 - p_j) * phi0
+        after = binary_entropy(np.divide(p_j * phi1, m, out=np.zeros_like(m), where=m > 0))
+        return binary_entropy(p_j) - np.trapezoid(m * after, o)
+
+    d = model.dprime(np.arange(9))                                      # [k, j]
+    brute = np.array([[drop(p[j], d[k, j]) for j in range(9)] for k in range(9)])
+    np.testing.assert_allclose(InformationTable(model)(log_odds), brute, rtol=2e-3, atol=1e-6)
