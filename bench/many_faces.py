@@ -3,10 +3,14 @@
 """
 ``find --all`` (the many-target belief) on composed group scenes against the detector alone.
 
-Scenes: :func:`ipomdp_gaze.vision.photos.group_photo` with ``split='train'`` (the training
-faces, each ``--copies`` times, every other one mirrored) on the training backgrounds
-(:data:`~ipomdp_gaze.vision.photos.TRAIN_GROUP_BACKGROUNDS`), at ``--sizes``. ``--split test``
-composes the test faces on the test backgrounds, for a report only: never choose on it.
+Scenes (``--faces``): ``photos``, :func:`ipomdp_gaze.vision.photos.group_photo` with
+``split='train'`` (the training photo faces, each ``--copies`` times, every other one mirrored)
+on the training group backgrounds (:data:`~ipomdp_gaze.vision.photos.TRAIN_GROUP_BACKGROUNDS`);
+or ``lfw``, :func:`lfw_group`: ``--copies`` distinct ``lfw_subset`` thumbnails of the split
+(faces 0-59 for training) pasted as the scene set does (bicubic, feathered) on crops of the
+split's backgrounds (:data:`~ipomdp_gaze.vision.scenes.TRAIN_BACKGROUNDS`), grey, at
+``--sizes``. ``--split test`` composes test faces on test backgrounds, for a report only:
+never choose on it.
 
 Per scene, in the same run and on the same decoded image:
 
@@ -25,7 +29,7 @@ them); detector pixels are the pixels given to the detector.
 
 Usage: ``python bench/many_faces.py [--split train|test] [--scenes N] [--copies C]
 [--sizes 640x480,1280x886] [--detector yunet|haar] [--absent-prior P] [--confidence C]
-[--old-loop]``;
+[--old-loop] [--faces photos|lfw]``;
 prints one markdown row per method and size, totals over the scenes.
 """
 import argparse
@@ -37,10 +41,13 @@ from ipomdp_gaze.commands.find import search_one
 from ipomdp_gaze.vision.fullframe import scan
 from ipomdp_gaze.vision.photos import (GROUP_BACKGROUNDS, group_photo,
                                        TRAIN_GROUP_BACKGROUNDS)
+from ipomdp_gaze.vision.scenes import (_paste as paste, DEFAULT_FEATHER, load_background,
+                                       load_faces, SPLITS)
 from ipomdp_gaze.vision.search import FIND_SETTINGS
 import numpy as np
 
 SCALES = (1.0, 1 / 2, 1 / 3, 1 / 4)
+SPLITS_CODE = {'train': 0, 'test': 1}
 
 
 def score(boxes, truth) -> tuple[int, int, int]:
@@ -61,8 +68,45 @@ def score(boxes, truth) -> tuple[int, int, int]:
     return found, false, duplicates
 
 
-def scenes(split: str, count: int, size, copies: int):
+def lfw_group(size, seed: int, split: str, count: int):
+    """
+    Paste ``count`` distinct thumbnails of the split on a crop of one of its backgrounds.
+
+    Sides uniform in 48-90 px scaled with the width (as the photo groups), places that do not
+    overlap; returns the grey image as RGB ``(H, W, 3)`` and the pasted squares ``(F, 4)``.
+    """
+    width, height = size
+    rng = np.random.default_rng([0x3A17, width, height, seed, SPLITS_CODE[split]])
+    faces_range, backgrounds = SPLITS[split]
+    name = backgrounds[seed % len(backgrounds)]
+    back = load_background(name, 'gray', min_side=max(width, height))
+    y = int(rng.integers(0, back.shape[0] - height + 1))
+    x = int(rng.integers(0, back.shape[1] - width + 1))
+    image = np.array(back[y:y + height, x:x + width])
+    low, high = 48 * width / 640, 90 * width / 640
+    boxes = []
+    for face in rng.choice(np.array(faces_range), size=count, replace=False):
+        for _ in range(200):
+            side = int(rng.uniform(low, high))
+            x0 = int(rng.integers(0, width - side))
+            y0 = int(rng.integers(0, height - side))
+            if all(x0 + side <= a or a + w <= x0 or y0 + side <= b or b + h <= y0
+                   for a, b, w, h in boxes):
+                break
+        else:
+            raise ValueError(f'{count} faces do not fit in {width}x{height}')
+        paste(image, load_faces()[face], y0, x0, side, DEFAULT_FEATHER)
+        boxes.append((x0, y0, side, side))
+    return name, np.repeat(image[:, :, None], 3, axis=2), np.array(boxes, dtype=float)
+
+
+def scenes(split: str, count: int, size, copies: int, faces: str = 'photos'):
     """Yield ``(name, image, boxes)`` of the composed group scenes of a split."""
+    if faces == 'lfw':
+        for i in range(count):
+            name, image, boxes = lfw_group(size, i, split, copies)
+            yield f'lfw-{name}-{i}', image, boxes
+        return
     backgrounds = TRAIN_GROUP_BACKGROUNDS if split == 'train' else GROUP_BACKGROUNDS
     for i in range(count):
         background = backgrounds[i % len(backgrounds)]
@@ -79,7 +123,8 @@ def run(args) -> list[dict]:
     rows = []
     for size in args.sizes:
         totals = {}
-        for name, image, truth in scenes(args.split, args.scenes, size, args.copies):
+        for name, image, truth in scenes(args.split, args.scenes, size, args.copies,
+                                         args.faces):
             task = tasks.task((image.shape[1], image.shape[0]))
             t0 = time.perf_counter()
             [result] = search_one(image, task, settings, np.random.default_rng(0), True)
@@ -142,11 +187,20 @@ def main(argv=None):
     p.add_argument('--confidence', type=float, default=FIND_SETTINGS.confidence)
     p.add_argument('--verbose', action='store_true')
     p.add_argument('--old-loop', action='store_true')
+    p.add_argument('--faces', choices=('photos', 'lfw'), default='photos')
+    p.add_argument('--empty-by-evidence', action='store_true',
+                   help="decide a cell empty by its evidence alone (OccupancySession's "
+                        'empty_by_evidence) instead of its posterior')
     args = p.parse_args(argv)
+    if args.empty_by_evidence:
+        import functools
+        from ipomdp_gaze.commands import find
+        find.search_many = functools.partial(find.search_many, empty_by_evidence=True)
     rows = run(args)
-    print(f'split {args.split}, {args.scenes} scenes per size, {args.copies} copies of each '
-          f'face, detector {args.detector}, absent prior {args.absent_prior}, confidence '
-          f'{args.confidence}')
+    print(f'split {args.split}, {args.faces} faces, {args.scenes} scenes per size, '
+          f'{args.copies} copies (lfw: faces) per scene, detector {args.detector}, absent prior '
+          f'{args.absent_prior}, confidence {args.confidence}, empty by evidence '
+          f'{args.empty_by_evidence}')
     print('| size | method | faces | found | false | duplicates | s / scene | '
           'detector px / scene |')
     print('|---|---|---|---|---|---|---|---|')

@@ -74,13 +74,19 @@ class OccupancySession:
     link : int
         Cells within this many cells (Chebyshev) of a cell decided occupied are settled
         (module docstring); 0: every cell is decided on its own.
+    empty_by_evidence : bool
+        Decide a cell empty only when its evidence alone says so: ``L_j - L_prior <=
+        -log(c / (1 - c))`` (a likelihood-ratio test, so a sparse prior cannot decide a cell
+        nobody looked at well; Wald: a face's cell is decided empty with probability at most
+        ``(1 - c) / c``). Off: the posterior ``P <= 1 - c`` decides.
     log_size : int
         Events kept in :attr:`log`.
 
     """
 
     def __init__(self, grid, observation, settings: SearchSettings | None = None,
-                 costs=None, link: int = 0, log_size: int = 10_000):
+                 costs=None, link: int = 0, empty_by_evidence: bool = False,
+                 log_size: int = 10_000):
         self.grid = grid
         self.observation = as_observation(grid, observation)
         self.settings = settings or SearchSettings(targets='many')
@@ -88,6 +94,7 @@ class OccupancySession:
         check_many_settings(self.settings)
         self.policy = None
         self.link = int(link)
+        self.empty_by_evidence = bool(empty_by_evidence)
         self.table = information_table(self.observation)
         self._view_info = self.table.view_information                     # [k, j]
         self.costs = np.ones(grid.n_cells) if costs is None else \
@@ -142,7 +149,7 @@ class OccupancySession:
         s, log_odds = self._s(), self.log_odds
         if s['reason'] and self.settings.decide_at_budget:
             return log_odds > 0
-        return decided(log_odds, self.settings.confidence)[0]
+        return self._decided(log_odds)[0]
 
     fixation = property(lambda self: self._s()['fixation'])
     fixations = property(lambda self: self._s()['fixations'])
@@ -168,7 +175,8 @@ class OccupancySession:
         q = cell_prior(self.grid.n_cells, self.settings.absent_prior)
         self._still.reset()
         self._best = np.zeros(self.grid.n_cells)
-        self._state = {'base': prior_log_odds(self.grid.n_cells, q), 'fixation': None,
+        prior = prior_log_odds(self.grid.n_cells, q)
+        self._state = {'base': prior, 'prior': prior, 'fixation': None,
                        'fixations': 0, 'path': [], 'scanned': False, 'decision': '',
                        'reason': '', 'ended': False,
                        'visited': np.zeros(self.grid.n_cells, dtype=bool)}
@@ -295,7 +303,7 @@ class OccupancySession:
         weight = np.where(self._view_info > self._best[None, :], 1.0,
                           self.settings.repeat_weight)
         if self.link > 0:
-            settled = self.settled(decided(log_odds, self.settings.confidence)[0])
+            settled = self.settled(self._decided(log_odds)[0])
             weight = weight * ~settled[None, :]
         return np.einsum('kj,kj->k', info, weight)
 
@@ -308,9 +316,16 @@ class OccupancySession:
             return None
         return int(argmax_ties_low(score))
 
+    def _decided(self, log_odds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Cells decided occupied and empty (N,) (``empty_by_evidence``: the evidence alone)."""
+        occupied, empty = decided(log_odds, self.settings.confidence)
+        if self.empty_by_evidence:
+            empty = empty & decided(log_odds - self._s()['prior'], self.settings.confidence)[1]
+        return occupied, empty
+
     def _decide(self) -> str:
         s, settings = self._state, self.settings
-        occupied, empty = decided(self.log_odds, settings.confidence)
+        occupied, empty = self._decided(self.log_odds)
         if np.all(self.settled(occupied) | empty):
             s['decision'] = 'found' if occupied.any() else 'absent'
             s['ended'] = True
@@ -331,7 +346,7 @@ class OccupancySession:
         return [int(v) for v in self.grid.cell(int(cell))]
 
     def _summary(self) -> dict:
-        occupied, empty = decided(self.log_odds, self.settings.confidence)
+        occupied, empty = self._decided(self.log_odds)
         return {'map_cell': self._rc(self.map_cell), 'map_probability': self.map_probability,
                 'absent_probability': self.absent_probability,
                 'entropy_nats': self.entropy_nats, 'occupied': int(occupied.sum()),

@@ -367,3 +367,25 @@ def test_gaussian_information_equals_the_integral_of_the_entropy_drop():
     d = model.dprime(np.arange(9))                                      # [k, j]
     brute = np.array([[drop(p[j], d[k, j]) for j in range(9)] for k in range(9)])
     np.testing.assert_allclose(InformationTable(model)(log_odds), brute, rtol=2e-3, atol=1e-6)
+
+
+def test_empty_by_evidence_needs_looks_where_a_sparse_prior_decides_at_once():
+    """A sparse prior decides every cell empty before any look; the evidence rule does not."""
+    from ipomdp_gaze.sensors import ModelSensor, run_search
+    grid = Grid(3, 3)
+    pt = np.tile([0.1, 0.9], (3, 3, 1))
+    pn = np.tile([0.9, 0.1], (3, 3, 1))
+    model = CountObservation(grid, pt, pn, scan_target=[0.5, 0.5], scan_null=[0.5, 0.5])
+    settings = SearchSettings(targets='many', confidence=0.99, absent_prior=0.95,
+                              max_fixations=30, inhibit_return=True)
+    assert cell_prior(9, 0.95) < 0.01                     # every cell "empty" a priori
+    eager = run_search(OccupancySession(grid, model, settings),
+                       ModelSensor(grid, model, np.random.default_rng(0)), 4)
+    assert eager.decision == 'absent' and eager.fixations == 0      # it never looked
+    session = OccupancySession(grid, model, settings, empty_by_evidence=True)
+    careful = run_search(session, ModelSensor(grid, model, np.random.default_rng(0)), 4)
+    assert careful.fixations > 0 and careful.decision == 'found'
+    assert [f['cell'] for f in session.faces()] == [4]
+    log_odds, prior = session.log_odds, prior_log_odds(9, cell_prior(9, 0.95))
+    empty = ~session.occupied()
+    assert np.all(log_odds[empty] - prior[empty] <= -math.log(99))

@@ -522,7 +522,7 @@ def fixation_costs(fovea: Fovea, image_px: tuple[int, int]) -> np.ndarray:
 def search_many(image: np.ndarray, fovea: Fovea, model,
                 settings: SearchSettings | None = None, *,
                 pixel_budget: int | None = None, link: int = FACE_RADIUS,
-                settle: int = SETTLE_RADIUS) -> ImageSearch:
+                settle: int = SETTLE_RADIUS, empty_by_evidence: bool = False) -> ImageSearch:
     """
     Search one image for every face at once: the many-target belief (``search.targets: many``).
 
@@ -547,7 +547,8 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     settings = replace(FIND_SETTINGS if settings is None else settings, targets='many')
     image_px = check_image(image, fovea)
     session = OccupancySession(fovea.grid, model, settings,
-                               costs=fixation_costs(fovea, image_px), link=settle)
+                               costs=fixation_costs(fovea, image_px), link=settle,
+                               empty_by_evidence=empty_by_evidence)
     sensor = _Recorder(fovea)
     outcome = run_search(session, sensor, image, pixel_budget=pixel_budget)
     boxes = np.concatenate(sensor.boxes) if sensor.boxes else np.zeros((0, 4))
