@@ -157,8 +157,10 @@ def channels(model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """
     if hasattr(model, 'p_target'):
         rows, cols, k = model.p_target.shape
+        dr = np.abs(np.arange(-(rows - 1), rows))
+        dc = np.abs(np.arange(-(cols - 1), cols))
         return (model.p_target.reshape(rows * cols, k), model.p_null.reshape(rows * cols, k),
-                model._offset_id)
+                dr[:, None] * cols + dc[None, :])
     from scipy.stats import norm
     d, inverse = np.unique(np.asarray(model.table, dtype=float), return_inverse=True)
     edges = np.linspace(-9.0, d.max() + 9.0, GAUSSIAN_BINS + 1)

@@ -124,6 +124,23 @@ def test_find_all_reports_every_face_once_with_its_box_in_one_search(tmp_path):
     assert plot.exists()
 
 
+def test_find_all_on_a_close_up_portrait_reports_the_full_frame_box(tmp_path):
+    image = load_photo('astronaut')
+    x, y, w, h = read_labels()['astronaut'][0][0]
+    cx, cy = int(x + w / 2), int(y + h / 2)
+    portrait = cv2.resize(image[cy - 60:cy + 60, cx - 60:cx + 60], (112, 112),
+                          interpolation=cv2.INTER_AREA)
+    out = tmp_path / 'portrait.json'
+    result = run_find(write(tmp_path / 'portrait.png', portrait), '--all', '--json', out)
+    assert result.returncode == 0, result.stderr
+    [entry] = json.loads(out.read_text())['images']
+    assert entry['method'] == 'full_frame' and entry['decision'] == 'found'
+    [face] = entry['faces']
+    bx, by, bw, bh = face['box']
+    assert face['probability'] is None and bx < 56 < bx + bw and by < 56 < by + bh
+    assert len(result.stdout.strip().splitlines()) == 2
+
+
 def test_face_boxes_are_drawn_where_the_json_says():
     from ipomdp_gaze.vision.search import Face
     from ipomdp_gaze.vision.search_plots import draw_faces

@@ -417,6 +417,9 @@ def run(args) -> int:
             result = results[0]
             title = (f'{Path(path).name}: {result.decision}, cell (row, col) {result.cell}, '
                      f'p={result.probability:.3f}, {result.fixations} fixations ({result.stop})')
+            if many:
+                title = (f'{Path(path).name}: {len(result.faces)} faces, {result.fixations} '
+                         f'fixations ({result.stop})')
             plot_image_search(image, result, task.fovea, plots[i], title)
             _note(f'wrote {plots[i]}')
         elif plots and many:

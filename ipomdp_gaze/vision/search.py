@@ -511,6 +511,8 @@ def fixation_costs(fovea: Fovea, image_px: tuple[int, int]) -> np.ndarray:
     """
     key = (fovea.grid.shape, fovea.config, image_px)
     if key not in _COSTS:
+        if len(_COSTS) >= 64:
+            _COSTS.pop(next(iter(_COSTS)))
         shape = (image_px[1], image_px[0])
         _COSTS[key] = np.array([
             sum(w.resized_px[0] * w.resized_px[1] for w in fovea.window_rects(k, shape)
