@@ -13,7 +13,7 @@ Usage: ``python bench/annotate.py [--repeats 200]``.
 import argparse
 import time
 
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.vision.annotate import annotate, fovea_cell_map, view_cell_map
 from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig
 from ipomdp_gaze.vision.pan_tilt import PAN_TILT_GRID, shipped_camera

@@ -26,10 +26,10 @@ import time
 
 from ipomdp_gaze.commands.evaluate import evaluate
 from ipomdp_gaze.drivers.pieces import COSTLY_CHUNK
-from ipomdp_gaze.executor import DaskExecutor, InlineExecutor, LocalExecutor
-from ipomdp_gaze.fpoc import make_fpoc
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.fpoc import make_fpoc
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.policies.baselines import make_baseline
+from ipomdp_gaze.simulation.executor import DaskExecutor, InlineExecutor, LocalExecutor
 
 GRID, FPOC = Grid(7, 7, 0.42), make_fpoc('human')
 TICK = os.sysconf('SC_CLK_TCK')

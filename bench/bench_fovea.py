@@ -25,7 +25,7 @@ from pathlib import Path
 import time
 
 import cv2
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.vision.detectors import make_detector
 from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig
 from ipomdp_gaze.vision.fullframe import scan

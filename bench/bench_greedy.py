@@ -19,13 +19,13 @@ import json
 from pathlib import Path
 import time
 
-from ipomdp_gaze.belief import argmax_ties_low
-from ipomdp_gaze.fpoc import make_fpoc
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.belief import argmax_ties_low
+from ipomdp_gaze.model.fpoc import make_fpoc
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.policies.greedy import (expected_percent_correct, percent_correct_given_target,
                                          PercentCorrectGreedy)
-from ipomdp_gaze.simulate import simulate
+from ipomdp_gaze.simulation.simulate import simulate
 import numpy as np
 
 

@@ -23,14 +23,14 @@ import sys
 import time
 import tracemalloc
 
-from ipomdp_gaze.belief import argmax_ties_low, bayes_update, TIE_RTOL, uniform_log_belief
-from ipomdp_gaze.fpoc import dprime_table, make_fpoc
-from ipomdp_gaze.gaze import GazeController
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import gaussian_log_likelihood_ratio, GaussianObservation
+from ipomdp_gaze.model.belief import argmax_ties_low, bayes_update, TIE_RTOL, uniform_log_belief
+from ipomdp_gaze.model.fpoc import dprime_table, make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import gaussian_log_likelihood_ratio, GaussianObservation
 from ipomdp_gaze.policies import conv
 from ipomdp_gaze.policies.baselines import elm_policy
 from ipomdp_gaze.policies.conv import ConvPolicy, kernel_matrix
+from ipomdp_gaze.search.gaze import GazeController
 import numpy as np
 import scipy.signal
 

@@ -4,7 +4,8 @@
 The motion step: the separable truncated convolution beside a dense N x N transition.
 
 Run: ``.venv/bin/python bench/bench_motion.py [--quick]``. For a batch of beliefs (simulation,
-training) and for one belief (the controller), it times :meth:`ipomdp_gaze.motion.Motion.predict`
+training) and for one belief (the controller), it times
+:meth:`ipomdp_gaze.model.motion.Motion.predict`
 (``G_row^T P G_col`` plus the jump) and the same prediction as ``B @ T`` with the dense matrix of
 :meth:`Motion.transition_matrix` (built once, not timed), checks that both agree, and prints the
 median microseconds per call. The dense matrix is only tried up to 4,096 cells (N^2 doubles).
@@ -13,8 +14,8 @@ median microseconds per call. The dense matrix is only tried up to 4,096 cells (
 import sys
 import time
 
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.motion import Motion
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.motion import Motion
 import numpy as np
 
 DENSE_MAX_CELLS = 4096

@@ -25,14 +25,14 @@ import json
 from pathlib import Path
 import time
 
-from ipomdp_gaze.belief import bayes_update
-from ipomdp_gaze.evaluation import fixations_to_90_ci, paired_difference_ci
-from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import GaussianObservation
+from ipomdp_gaze.model.belief import bayes_update
+from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import GaussianObservation
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.policies.planner import make_planner, TemperedELM
-from ipomdp_gaze.simulate import draw_targets, simulate
+from ipomdp_gaze.simulation.evaluation import fixations_to_90_ci, paired_difference_ci
+from ipomdp_gaze.simulation.simulate import draw_targets, simulate
 import numpy as np
 
 

@@ -16,7 +16,7 @@ In the same run, on the same frames and in this process, OpenCV's full-frame Haa
 import time
 
 import cv2
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.msg_adapters import grid_arrays, images
 from ipomdp_gaze.nodes.processes import domain_id_for, isolated_nodes
 from ipomdp_gaze.nodes.watch import LATCHED, Watch

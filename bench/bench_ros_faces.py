@@ -14,9 +14,9 @@ backgrounds); nothing was fitted to them.
 """
 import math
 
-from ipomdp_gaze.evaluation import wilson_interval
 from ipomdp_gaze.nodes.demo import faces_setup, run_demo
 from ipomdp_gaze.nodes.processes import domain_id_for
+from ipomdp_gaze.simulation.evaluation import wilson_interval
 import numpy as np
 
 TITLE = 'Face search over DDS: scene camera, foveal detector and controller (three processes)'

@@ -11,18 +11,19 @@ processing time of a frame (``detector_ms_last`` in ``/diagnostics``: the resize
 the fovea or view, the detector and the counts), the worst time from sending the image to
 receiving its counts here (DDS transport of the image included), and the node's peak resident
 memory (``VmHWM`` of ``/proc/<pid>/status``). Images more than twice the model's calibration
-image on a side are resized on arrival (:mod:`ipomdp_gaze.detection`), so the detector's cost
+image on a side are resized on arrival (:mod:`ipomdp_gaze.vision.detection`), so the detector's
+cost
 stops growing with the image; what still grows is the message itself (a 4096x4096 ``rgb8``
 image is 48 MiB, which rclpy deserialises into the node).
 """
 import time
 
 import cv2
-from ipomdp_gaze.detection import build_setup, scaled_camera
-from ipomdp_gaze.head import PanTiltMap
+from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
 from ipomdp_gaze.nodes.processes import domain_id_for, isolated_nodes
 from ipomdp_gaze.nodes.watch import LATCHED, Watch
+from ipomdp_gaze.vision.detection import build_setup, scaled_camera
 from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, SceneGeometry, shipped_camera
 from ipomdp_gaze.vision.scenes import PAPER_TASK, SceneSet
 from rclpy.qos import QoSProfile, ReliabilityPolicy

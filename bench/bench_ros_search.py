@@ -12,14 +12,14 @@ the wall time per search, and the same numbers from the numpy core on 2,000 simu
 import sys
 import time
 
-from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
-from ipomdp_gaze.gaze import GazeController
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.files.share_files import config_file
+from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays
 from ipomdp_gaze.nodes.processes import domain_id_for, isolated_nodes
 from ipomdp_gaze.nodes.watch import CAMERA, SearchRecord, Watch
 from ipomdp_gaze.policies.registry import build_policy
-from ipomdp_gaze.share_files import config_file
+from ipomdp_gaze.search.gaze import GazeController
 import numpy as np
 
 GRID = Grid(11, 11, 5.0)

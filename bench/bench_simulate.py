@@ -9,12 +9,12 @@ second, beside a naive per-episode Python loop on a subsample (the reference rat
 """
 import time
 
-from ipomdp_gaze.belief import bayes_update, map_cell, uniform_log_belief
-from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
+from ipomdp_gaze.model.belief import bayes_update, map_cell, uniform_log_belief
+from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import gaussian_log_likelihood_ratio as llr
 from ipomdp_gaze.policies.baselines import make_baseline
-from ipomdp_gaze.simulate import simulate
+from ipomdp_gaze.simulation.simulate import simulate
 import numpy as np
 
 

@@ -30,13 +30,13 @@ import argparse  # noqa: E402, I100
 import json  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from ipomdp_gaze.evaluation import (fixations_to_90_ci, fixations_to_level,  # noqa: E402
-                                    paired_difference_ci)
-from ipomdp_gaze.fpoc import make_fpoc  # noqa: E402
-from ipomdp_gaze.grid import Grid  # noqa: E402
+from ipomdp_gaze.model.fpoc import make_fpoc  # noqa: E402
+from ipomdp_gaze.model.grid import Grid  # noqa: E402
 from ipomdp_gaze.policies.baselines import make_baseline  # noqa: E402
 from ipomdp_gaze.policies.training import TrainConfig, Trainer, write_curve  # noqa: E402
-from ipomdp_gaze.simulate import simulate  # noqa: E402
+from ipomdp_gaze.simulation.evaluation import (  # noqa: E402
+    fixations_to_90_ci, fixations_to_level, paired_difference_ci)
+from ipomdp_gaze.simulation.simulate import simulate  # noqa: E402
 import numpy as np  # noqa: E402
 
 TARGET_FIXATIONS = 7.86

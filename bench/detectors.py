@@ -15,12 +15,14 @@ resolution, nothing fitted here:
   (``minNeighbors=3``) for Haar and YuNet's own boxes (after its non-maximum suppression, score
   at least the detector's ``score_threshold``, 0.5).
 
-- **pan/tilt search** (offline, the search session and :func:`ipomdp_gaze.sensors.run_search`
+- **pan/tilt search** (offline, the search session and
+  :func:`ipomdp_gaze.search.sensors.run_search`
   without ROS): each detector with its own pan/tilt model (``faces-pan-tilt``,
   ``faces-pan-tilt-yunet``), ELM with inhibition of return from the centre cell, repeated views
-  weighted 0.1 (:class:`ipomdp_gaze.still_evidence.StillEvidence`), stop at 0.99 or after 60
+  weighted 0.1 (:class:`ipomdp_gaze.model.still_evidence.StillEvidence`), stop at 0.99 or after 60
   fixations; right = the answer within one cell of the face's cell
-  (:func:`ipomdp_gaze.evaluation.answer_is_right`); seconds = detector and belief updates (the
+  (:func:`ipomdp_gaze.simulation.evaluation.answer_is_right`); seconds = detector and belief
+  updates (the
   saccades of a real head are not included).
 
 Usage: ``python bench/detectors.py [--views 40] [--searches 40] [--repeat 3]
@@ -85,12 +87,12 @@ def photo_answer(detector, image, boxes, repeat: int) -> dict:
 
 def pan_tilt_searches(kind: str, model_name: str, n: int) -> dict:
     """Search ``n`` test pan/tilt scenes offline with ``kind`` and its pan/tilt model."""
-    from ipomdp_gaze.evaluation import answer_is_right
-    from ipomdp_gaze.observation_file import load_observation
+    from ipomdp_gaze.files.observation_file import load_observation
+    from ipomdp_gaze.model.cell_observation import cell_observation_of
     from ipomdp_gaze.policies.registry import build_policy
-    from ipomdp_gaze.sensors import run_search
-    from ipomdp_gaze.session import SearchSession, SearchSettings
-    from ipomdp_gaze.vision.cell_observation import cell_observation_of
+    from ipomdp_gaze.search.sensors import run_search
+    from ipomdp_gaze.search.session import SearchSession, SearchSettings
+    from ipomdp_gaze.simulation.evaluation import answer_is_right
     from ipomdp_gaze.vision.detectors import detector_from_settings
     from ipomdp_gaze.vision.pan_tilt import SceneGeometry
     from ipomdp_gaze.vision.sensors import PanTiltSensor

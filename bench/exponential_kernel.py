@@ -23,9 +23,9 @@ import argparse
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.policies.conv import radial_bins
 from ipomdp_gaze.policies.policy_file import load_policy_spec
-from ipomdp_gaze.policies.training import (elm_init, sample_episodes, theta_gradient,
-                                           TrainConfig, Trainer)
-from ipomdp_gaze.simulate import simulate
+from ipomdp_gaze.policies.training import (elm_init, sample_episodes, theta_gradient, TrainConfig,
+                                           Trainer)
+from ipomdp_gaze.simulation.simulate import simulate
 import numpy as np
 
 KERNEL = 'exponential-11x11-infomax'

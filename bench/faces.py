@@ -41,13 +41,13 @@ import sys
 import time
 
 import cv2
-from ipomdp_gaze.detection import DEFAULT_MODELS
-from ipomdp_gaze.evaluation import cells_apart, wilson_interval
-from ipomdp_gaze.observation_file import load_observation
+from ipomdp_gaze.files.observation_file import load_observation
 from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy
-from ipomdp_gaze.progress import Progress
-from ipomdp_gaze.session import SearchSettings
+from ipomdp_gaze.search.session import SearchSettings
+from ipomdp_gaze.simulation.evaluation import cells_apart, wilson_interval
+from ipomdp_gaze.simulation.progress import Progress
+from ipomdp_gaze.vision.detection import DEFAULT_MODELS
 from ipomdp_gaze.vision.detector import box_centres_px
 from ipomdp_gaze.vision.detectors import make_detector
 from ipomdp_gaze.vision.fullframe import cells_of_points, scan

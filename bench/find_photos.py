@@ -26,7 +26,7 @@ import time
 from types import SimpleNamespace
 
 from ipomdp_gaze.commands.find import _Tasks, FIND_DETECTORS, search_one
-from ipomdp_gaze.evaluation import answer_is_right
+from ipomdp_gaze.simulation.evaluation import answer_is_right
 from ipomdp_gaze.vision.fullframe import cells_of_points, scan
 from ipomdp_gaze.vision.photos import group_photo, real_photos, TRAIN_GROUP_BACKGROUNDS
 from ipomdp_gaze.vision.search import FIND_SETTINGS

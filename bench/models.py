@@ -22,7 +22,7 @@ import subprocess
 import sys
 import time
 
-from ipomdp_gaze.observation_file import load_observation
+from ipomdp_gaze.files.observation_file import load_observation
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent

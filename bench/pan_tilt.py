@@ -27,11 +27,11 @@ from pathlib import Path
 import sys
 import time
 
-from ipomdp_gaze.detection import DEFAULT_MODELS
 from ipomdp_gaze.drivers.scene_eval import (evaluate_scenes, HEAD_SPEED_DEG_S,
                                             paired_map_difference, SACCADE_TIME_S, SceneResult,
                                             SETTLE_TIME_S, summarise, SWEEP_RULES, task_spec)
-from ipomdp_gaze.progress import Progress
+from ipomdp_gaze.simulation.progress import Progress
+from ipomdp_gaze.vision.detection import DEFAULT_MODELS
 
 ROOT = Path(__file__).resolve().parents[1]
 SHIPPED = 'shipped'
@@ -118,7 +118,7 @@ def _ros_lines(record: dict) -> list[str]:
 
 
 def _sweep_poses(spec):
-    from ipomdp_gaze.observation_file import load_observation
+    from ipomdp_gaze.files.observation_file import load_observation
     from ipomdp_gaze.policies.baselines import sweep_tiles
     model = load_observation(spec.model or DEFAULT_MODELS['camera'])
     return sweep_tiles(model.grid, model)[0]

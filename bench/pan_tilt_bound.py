@@ -28,9 +28,9 @@ import json
 from pathlib import Path
 
 from ipomdp_gaze.drivers import scene_eval
-from ipomdp_gaze.evaluation import answer_is_right
-from ipomdp_gaze.sensors import run_search
-from ipomdp_gaze.session import SearchSession
+from ipomdp_gaze.search.sensors import run_search
+from ipomdp_gaze.search.session import SearchSession
+from ipomdp_gaze.simulation.evaluation import answer_is_right
 import numpy as np
 
 # Highest P(absent) at which the model's answer is still `found` (the shipped rule says absent at

@@ -17,9 +17,9 @@ Usage: ``python bench/pan_tilt_misses.py [--scenes 200] [--seed 1000] [--model F
 import argparse
 
 from ipomdp_gaze.drivers import scene_eval
-from ipomdp_gaze.evaluation import answer_is_right, cells_apart
-from ipomdp_gaze.sensors import run_search
-from ipomdp_gaze.session import SearchSession
+from ipomdp_gaze.search.sensors import run_search
+from ipomdp_gaze.search.session import SearchSession
+from ipomdp_gaze.simulation.evaluation import answer_is_right, cells_apart
 import numpy as np
 
 

@@ -37,13 +37,13 @@ from pathlib import Path
 
 from ipomdp_gaze.commands.common import positive_int
 from ipomdp_gaze.drivers.pieces import PieceCache, PLANNER_CHUNK, Runner
-from ipomdp_gaze.evaluation import fixations_to_90_ci, paired_difference_ci
-from ipomdp_gaze.executor import make_executor
-from ipomdp_gaze.fpoc import make_fpoc
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.fpoc import make_fpoc
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.policies.planner import make_planner
-from ipomdp_gaze.progress import Progress
+from ipomdp_gaze.simulation.evaluation import fixations_to_90_ci, paired_difference_ci
+from ipomdp_gaze.simulation.executor import make_executor
+from ipomdp_gaze.simulation.progress import Progress
 import numpy as np
 
 GRID, FPOC = Grid(7, 7, 0.42), make_fpoc('human')

@@ -26,8 +26,8 @@ import time
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
+from ipomdp_gaze.files.share_files import config_file  # noqa: E402
 from ipomdp_gaze.nodes.processes import domain_id_for, NodeGroup, ros_environment  # noqa: E402
-from ipomdp_gaze.share_files import config_file  # noqa: E402
 
 
 def main(argv=None) -> int:

@@ -23,7 +23,7 @@ Prints markdown.
 import argparse
 import time
 
-from ipomdp_gaze.detection import build_setup
+from ipomdp_gaze.vision.detection import build_setup
 from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, SceneGeometry, ViewObserver
 from ipomdp_gaze.vision.yunet import YuNetDetector
 import numpy as np

@@ -8,9 +8,9 @@ returns and picks the next fixation; an episode ends when the most likely cell r
 confidence threshold. Prints fixations per episode and how often the final guess is right.
 """
 import gymnasium
-import ipomdp_gaze.gym  # noqa: F401  (registers ipomdp_gaze/VisualSearch-v0)
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.policies.policy_file import load_policy_spec
+import ipomdp_gaze.simulation.gym  # noqa: F401  (registers ipomdp_gaze/VisualSearch-v0)
 import numpy as np
 
 

@@ -15,7 +15,7 @@ import importlib
 import os
 import sys
 
-from ipomdp_gaze.share_files import package_version
+from ipomdp_gaze.files.share_files import package_version
 
 # Modules under ipomdp_gaze.commands, in the order --help lists their subcommands: evaluate,
 # search, find, train, calibrate, reproduce, demo, record and replay, then the nodes:

@@ -9,7 +9,7 @@ grid_arrays
     Grid-shaped ``Float32MultiArray`` (belief, evidence) and the ``Int32MultiArray`` ground truth.
 joints
     The head commands (``JointState``, ``Float64MultiArray``, ``JointTrajectory``) of the
-    angles that :class:`ipomdp_gaze.head.PanTiltMap` gives a cell.
+    angles that :class:`ipomdp_gaze.model.head.PanTiltMap` gives a cell.
 images
     The colour-mapped belief heatmap (``rgb8``) and ``32FC1`` evidence images.
 diagnostics

@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import array
 
-from ipomdp_gaze.belief import EvidenceError
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.belief import EvidenceError
+from ipomdp_gaze.model.grid import Grid
 import numpy as np
 from std_msgs.msg import Float32MultiArray, Int32MultiArray, MultiArrayDimension, MultiArrayLayout
 
@@ -85,7 +85,7 @@ def from_multiarray(msg, grid: Grid) -> np.ndarray:
     Read a grid-shaped ``Float32MultiArray`` as float64 values, shape (N,).
 
     The layout is checked (:func:`check_layout`) and the length must be N; the values themselves
-    (NaN, inf) are left for :func:`ipomdp_gaze.belief.check_evidence`.
+    (NaN, inf) are left for :func:`ipomdp_gaze.model.belief.check_evidence`.
 
     Raises
     ------

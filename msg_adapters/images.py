@@ -4,7 +4,8 @@
 Images: the belief heatmap (``rgb8``), per-cell evidence as ``32FC1``, and camera images.
 
 Float images look black in rqt_image_view unless its dynamic range is switched on, so the belief
-is published as the colour-mapped ``rgb8`` picture of :func:`ipomdp_gaze.render.belief_heatmap`
+is published as the colour-mapped ``rgb8`` picture of
+:func:`ipomdp_gaze.files.render.belief_heatmap`
 (docs/design.md section 5).
 
 Camera images (``mono8``, ``rgb8``, ``bgr8``) are read without copying the pixels where numpy
@@ -16,10 +17,10 @@ from __future__ import annotations
 
 import sys
 
-from ipomdp_gaze.belief import EvidenceError
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.head_camera import PinholeCamera
-from ipomdp_gaze.render import belief_heatmap
+from ipomdp_gaze.files.render import belief_heatmap
+from ipomdp_gaze.model.belief import EvidenceError
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head_camera import PinholeCamera
 import numpy as np
 from sensor_msgs.msg import CameraInfo, Image
 from std_msgs.msg import Header

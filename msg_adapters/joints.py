@@ -3,7 +3,8 @@
 """
 The head command messages: ``JointState``, ``Float64MultiArray`` and ``JointTrajectory``.
 
-The angles of a cell come from :class:`ipomdp_gaze.head.PanTiltMap` (REP 103 signs, offsets and
+The angles of a cell come from :class:`ipomdp_gaze.model.head.PanTiltMap` (REP 103 signs, offsets
+and
 joint limits, docs/design.md section 5); this module only reads and fills the messages.
 """
 from __future__ import annotations
@@ -11,7 +12,7 @@ from __future__ import annotations
 import math
 
 from builtin_interfaces.msg import Duration
-from ipomdp_gaze.head import PanTiltMap
+from ipomdp_gaze.model.head import PanTiltMap
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, Header
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint

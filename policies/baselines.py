@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import math
 
-from ipomdp_gaze.belief import argmax_ties_low
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import as_observation
+from ipomdp_gaze.model.belief import argmax_ties_low
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import as_observation
 import numpy as np
 
 from .conv import ConvPolicy
@@ -109,7 +109,7 @@ def _view_cells(grid: Grid, model) -> tuple[float, float] | None:
     camera = image.get('camera') if image.get('view') == 'pan_tilt' else None
     if not camera:
         return None
-    from ipomdp_gaze.head_camera import PinholeCamera
+    from ipomdp_gaze.model.head_camera import PinholeCamera
     hfov, vfov = PinholeCamera.from_k(camera['width'], camera['height'], camera['K']).fov_deg
     return vfov / grid.spacing_deg, hfov / grid.spacing_deg
 

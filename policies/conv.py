@@ -29,8 +29,8 @@ from __future__ import annotations
 
 import math
 
-from ipomdp_gaze.belief import argmax_ties_low, TIE_RTOL
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.belief import argmax_ties_low, TIE_RTOL
+from ipomdp_gaze.model.grid import Grid
 import numpy as np
 import scipy.fft
 
@@ -167,7 +167,7 @@ class _Spectrum:
 
     def __init__(self, grid: Grid, kernel: np.ndarray, truncate: float):
         rows, cols = grid.shape
-        box_r, box_c = support_box(kernel, truncate)
+        box_r, box_c = self.box = support_box(kernel, truncate)
         self.shape = (fft_size(rows, box_r, real=False), fft_size(cols, box_c, real=True))
         p, q = self.shape
         crop = kernel[box_r, box_c]
@@ -257,7 +257,10 @@ class ConvPolicy:
         """Return the FFT set-up for ``truncate`` (or for 0: lossless), built on first use."""
         tol = 0.0 if lossless else self.truncate
         if tol not in self._spectra:
-            self._spectra[tol] = _Spectrum(self.grid, self.kernel, tol)
+            # A truncation that drops no entry has the lossless set-up: the same one serves both.
+            box = support_box(self.kernel, tol)
+            same = [s for s in self._spectra.values() if s.box == box]
+            self._spectra[tol] = same[0] if same else _Spectrum(self.grid, self.kernel, tol)
         return self._spectra[tol]
 
     def _fft_scores(self, belief: np.ndarray, lossless: bool = False) -> np.ndarray:
@@ -323,7 +326,11 @@ class ConvPolicy:
         if cand.size <= RESCORE_MAX:
             return int(cand[argmax_ties_low(self.exact_scores(belief, cand))])
         if self.truncate > 0 and not lossless:  # too blurred by truncation: use every entry
-            return self._decide_fft(belief, self._fft_scores(belief, True), lossless=True)
+            if self._fft(True) is not self._fft():
+                return self._decide_fft(belief, self._fft_scores(belief, True), lossless=True)
+            # Truncation dropped nothing: the lossless pass would have these scores, bound and
+            # candidates; it counts as a second re-scoring, as it did.
+            self.rescored += 1
         return self._decide_flat(belief, score, cand, eps)
 
     def _decide_flat(self, belief, score, cand, eps) -> int:

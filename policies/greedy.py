@@ -56,9 +56,9 @@ from __future__ import annotations
 
 import functools
 
-from ipomdp_gaze.belief import argmax_ties_low, TIE_RTOL
-from ipomdp_gaze.fpoc import dprime_matrix, FPOC
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.belief import argmax_ties_low, TIE_RTOL
+from ipomdp_gaze.model.fpoc import dprime_matrix, FPOC
+from ipomdp_gaze.model.grid import Grid
 import numpy as np
 from scipy.special import ndtr
 
@@ -245,7 +245,7 @@ def expected_percent_correct(belief, dprime: np.ndarray, tol: float = DEFAULT_TO
     belief : array (N,) or (E, N)
         Probabilities (normalised here).
     dprime : array (N, N)
-        ``d[j, k]``, from :func:`ipomdp_gaze.fpoc.dprime_matrix`.
+        ``d[j, k]``, from :func:`ipomdp_gaze.model.fpoc.dprime_matrix`.
     tol : float
         Bound on the pruning error of every score (0 keeps every cell with non-zero belief).
     nodes, power : int, optional
@@ -357,7 +357,7 @@ def percent_correct_given_target(belief, dprime: np.ndarray, nodes: int = 512,
     This is the reference the fast score is checked against (``sum_i B_i P[i, k]`` equals
     :func:`expected_percent_correct`); it costs O(N^3 Q). Steps from ``d_jk = 0`` cells become a
     lower limit on w; with ``d_ik = 0`` too the factor is the project tie rule applied to the
-    pair (ties go to the lower index), so ``P`` is what :func:`ipomdp_gaze.belief.map_cell`
+    pair (ties go to the lower index), so ``P`` is what :func:`ipomdp_gaze.model.belief.map_cell`
     scores. The integral over ``w in [lower, 8.3]`` uses ``nodes`` Gauss-Legendre nodes.
 
     Parameters

@@ -9,8 +9,8 @@ Sec. III. The convolutional family of :mod:`policies.conv` is the special case
 """
 from __future__ import annotations
 
-from ipomdp_gaze.belief import argmax_ties_low
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.belief import argmax_ties_low
+from ipomdp_gaze.model.grid import Grid
 import numpy as np
 
 from .conv import check_action

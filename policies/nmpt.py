@@ -33,8 +33,8 @@ from __future__ import annotations
 
 import math
 
-from ipomdp_gaze.belief import argmax_ties_low
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.belief import argmax_ties_low
+from ipomdp_gaze.model.grid import Grid
 import numpy as np
 
 from .conv import check_action

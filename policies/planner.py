@@ -34,10 +34,11 @@ can be the base, for example a learned convolutional kernel.
 """
 from __future__ import annotations
 
-from ipomdp_gaze.belief import argmax_ties_low
-from ipomdp_gaze.checks import finite as _finite, positive_int as _positive_int
-from ipomdp_gaze.fpoc import dprime_matrix, FPOC
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.belief import argmax_ties_low
+from ipomdp_gaze.model.checks import finite as _finite
+from ipomdp_gaze.model.checks import positive_int as _positive_int
+from ipomdp_gaze.model.fpoc import dprime_matrix, FPOC
+from ipomdp_gaze.model.grid import Grid
 import numpy as np
 
 from .conv import kernel_matrix

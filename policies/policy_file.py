@@ -21,7 +21,7 @@ Format ``ipomdp_gaze/policy-v1`` (issue 3)::
 Required: ``format``, ``grid``, ``reward``, ``family``, the family's array (``kernel`` or
 ``theta``) and the observation model it was trained on: ``fpoc`` (the Gaussian model of that FPOC;
 every file before count models) or ``observation`` (a count model named by its file's stem and the
-SHA-256 of its tables, :func:`ipomdp_gaze.observation_file.fingerprint`). Loading uses
+SHA-256 of its tables, :func:`ipomdp_gaze.files.observation_file.fingerprint`). Loading uses
 ``yaml.safe_load`` only and names exactly what is wrong with a file (:class:`PolicyFileError`). A
 source is a path or the name of a shipped kernel (``ipomdp_gaze/policies/kernels/<name>.yaml``,
 e.g. ``human-7x7-infomax``), installed once as package data and found with
@@ -36,11 +36,11 @@ from pathlib import Path
 from typing import Callable
 import warnings
 
-from ipomdp_gaze.fpoc import FPOC, fpoc_from_dict
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import CountObservation, GaussianObservation
-from ipomdp_gaze.observation_file import fingerprint
-from ipomdp_gaze.yaml_files import check_header, plain, read_yaml, write_yaml
+from ipomdp_gaze.files.observation_file import fingerprint
+from ipomdp_gaze.files.yaml_files import check_header, plain, read_yaml, write_yaml
+from ipomdp_gaze.model.fpoc import FPOC, fpoc_from_dict
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import CountObservation, GaussianObservation
 import numpy as np
 
 from .conv import ACTIONS, ConvPolicy, radial_bins

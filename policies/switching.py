@@ -21,8 +21,8 @@ model of an FPOC.
 """
 from __future__ import annotations
 
-from ipomdp_gaze.fpoc import FPOC
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.fpoc import FPOC
+from ipomdp_gaze.model.grid import Grid
 import numpy as np
 
 from .greedy import PercentCorrectGreedy

@@ -21,7 +21,8 @@ Randomness: epoch ``i`` draws everything from ``numpy.random.default_rng([seed, 
 resumed from a saved policy after epoch i continues exactly as the uninterrupted run.
 
 Moving and absent targets (docs/design.md section 7): with ``motion_sigma_cells`` or
-``jump_prob`` the training targets take a step of :class:`ipomdp_gaze.motion.Motion` after every
+``jump_prob`` the training targets take a step of :class:`ipomdp_gaze.model.motion.Motion` after
+every
 fixation and the belief is predicted with it; ``absent_prior`` gives the belief the absent
 hypothesis (the infomax reward is then over all N + 1 hypotheses; the policy sees the cells) and
 ``absent_rate`` empties that fraction of the training scenes. All four default to 0, which draws
@@ -36,14 +37,15 @@ from pathlib import Path
 import time
 from typing import Callable
 
-from ipomdp_gaze.evaluation import fixations_to_90_ci, fixations_to_level, tracking_summary
-from ipomdp_gaze.fpoc import FPOC
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.motion import check_probability, check_sigma_cells, Motion
-from ipomdp_gaze.observation import as_observation, CountObservation
-from ipomdp_gaze.observation_file import fingerprint
-from ipomdp_gaze.simulate import simulate
-from ipomdp_gaze.stopping import BatchBelief, check_absent_prior
+from ipomdp_gaze.files.observation_file import fingerprint
+from ipomdp_gaze.model.fpoc import FPOC
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.motion import check_probability, check_sigma_cells, Motion
+from ipomdp_gaze.model.observation import as_observation, CountObservation
+from ipomdp_gaze.model.stopping import BatchBelief, check_absent_prior
+from ipomdp_gaze.simulation.evaluation import (fixations_to_90_ci, fixations_to_level,
+                                               tracking_summary)
+from ipomdp_gaze.simulation.simulate import simulate
 import numpy as np
 
 from .conv import ConvPolicy, kernel_from_radial, radial_bins
@@ -216,7 +218,7 @@ def sample_episodes(theta: np.ndarray, model, reward: str, episodes: int,
     theta : array (N, N)
         ``theta[k, j]``.
     model
-        The observation model the frames are drawn from (:mod:`ipomdp_gaze.observation`).
+        The observation model the frames are drawn from (:mod:`ipomdp_gaze.model.observation`).
     reward : {'infomax', 'fixate_target'}
         The reward computed on the belief after each observation.
     episodes, horizon : int
@@ -396,13 +398,14 @@ class Trainer:
         the previous row, and fixations to 90% correct of the argmax policy on the fixed
         evaluation set (None if never reached). ``callback(row)`` is called after each row.
         Evaluation time is not counted in ``wall_seconds``. ``progress`` True shows the epochs,
-        the mean return and fixations to 90% on stderr (:class:`ipomdp_gaze.progress.Progress`:
+        the mean return and fixations to 90% on stderr
+        (:class:`ipomdp_gaze.simulation.progress.Progress`:
         a bar on a terminal, a line every few seconds otherwise); or pass a ``Progress``.
         """
         cfg = self.config
         bar = None
         if progress is True:
-            from ipomdp_gaze.progress import Progress
+            from ipomdp_gaze.simulation.progress import Progress
             bar = Progress(epochs, 'train', 'epoch')
         elif progress:
             bar = progress
@@ -523,7 +526,8 @@ def evaluation_block(grid: Grid, fpoc: FPOC, policy, episodes: int = 20000, seed
     Uses the same targets, noise and bootstrap draws as ``ipomdp-gaze evaluate --seed SEED``, so
     the numbers match that command's. ``scene`` holds the settings of docs/design.md section 7
     (:meth:`TrainConfig.scene`); they are recorded, and a moving target adds its tracking
-    accuracy (:func:`ipomdp_gaze.evaluation.tracking_summary`). ``progress`` (``update(n)``)
+    accuracy (:func:`ipomdp_gaze.simulation.evaluation.tracking_summary`). ``progress``
+    (``update(n)``)
     counts the fixations simulated.
     """
     scene = dict(scene or {})

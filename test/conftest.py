@@ -93,5 +93,5 @@ def launch(nodes):
 
 def config_path(name: str) -> str:
     """Find a shipped config file as the nodes do."""
-    from ipomdp_gaze.share_files import config_file
+    from ipomdp_gaze.files.share_files import config_file
     return str(config_file(name))

@@ -74,10 +74,10 @@ def bad_policy_files(folder, grid_rows: int = 11, grid_cols: int = 11, marker=No
     """
     from pathlib import Path
 
-    from ipomdp_gaze.fpoc import make_fpoc
-    from ipomdp_gaze.grid import Grid
-    import numpy as np
+    from ipomdp_gaze.model.fpoc import make_fpoc
+    from ipomdp_gaze.model.grid import Grid
     from ipomdp_gaze.policies.policy_file import PolicySpec, save_policy
+    import numpy as np
     import yaml
 
     folder = Path(folder)

@@ -1,8 +1,8 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """The search drawn on the camera image (``ipomdp_gaze.vision.annotate``) and its files."""
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.head_camera import observed_cells, pixel_cells
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head_camera import observed_cells, pixel_cells
 from ipomdp_gaze.vision.annotate import annotate, fovea_cell_map, grid_canvas, view_cell_map
 from ipomdp_gaze.vision.fovea import cell_edges_px
 from ipomdp_gaze.vision.pan_tilt import PAN_TILT_GRID, shipped_camera

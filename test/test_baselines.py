@@ -1,8 +1,8 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """Baselines by strategy string and the convolutional policy's scores."""
-from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.policies.baselines import make_baseline, spiral_order, STRATEGIES
 from ipomdp_gaze.policies.conv import ConvPolicy, kernel_from_radial, radial_bins
 import numpy as np

@@ -1,10 +1,11 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """The log-domain belief update against a brute-force Bayes posterior, and its edge cases."""
-from ipomdp_gaze.belief import (argmax_ties_low, bayes_update, entropy, EvidenceError,
-                                fixate_target_reward, infomax_reward, map_cell, uniform_log_belief)
-from ipomdp_gaze.observation import check_evidence
-from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
+from ipomdp_gaze.model.belief import (argmax_ties_low, bayes_update, entropy, EvidenceError,
+                                      fixate_target_reward, infomax_reward, map_cell,
+                                      uniform_log_belief)
+from ipomdp_gaze.model.observation import check_evidence
+from ipomdp_gaze.model.observation import gaussian_log_likelihood_ratio as llr
 import numpy as np
 import pytest
 from scipy.stats import norm
@@ -124,10 +125,10 @@ def test_tie_rule_goes_to_lowest_index_within_relative_tolerance():
 
 
 def test_overflowing_evidence_is_rejected_and_the_belief_kept():
-    from ipomdp_gaze.fpoc import make_fpoc
-    from ipomdp_gaze.gaze import GazeController
-    from ipomdp_gaze.grid import Grid
+    from ipomdp_gaze.model.fpoc import make_fpoc
+    from ipomdp_gaze.model.grid import Grid
     from ipomdp_gaze.policies.baselines import make_baseline
+    from ipomdp_gaze.search.gaze import GazeController
     obs = np.zeros(9)
     obs[4] = 1.7e308
     with pytest.raises(EvidenceError, match='refused'):
@@ -141,3 +142,17 @@ def test_overflowing_evidence_is_rejected_and_the_belief_kept():
     assert result.status == 'rejected' and 'overflows' in result.reason
     np.testing.assert_array_equal(core.belief, before)
     assert np.all(np.isfinite(np.log(core.belief[core.belief > 0])))
+
+
+def test_entropy_and_the_tie_rule_of_one_belief_are_those_of_a_batch_bit_for_bit():
+    rng = np.random.default_rng(3)
+    beliefs = rng.dirichlet(np.full(50, 0.2), size=6)
+    beliefs[1, 7] = beliefs[2, :10] = 0.0                # 0 log 0 = 0
+    beliefs[3, 20] = beliefs[3].max()                     # a tie
+    with np.errstate(divide='ignore', invalid='ignore'):
+        terms = np.where(beliefs > 0, beliefs * np.log(np.where(beliefs > 0, beliefs, 1.0)), 0)
+    assert entropy(beliefs).tobytes() == (-np.sum(terms, axis=-1)).tobytes()
+    batch = argmax_ties_low(beliefs)
+    for row, belief in enumerate(beliefs):
+        assert entropy(belief) == entropy(beliefs)[row]
+        assert argmax_ties_low(belief) == batch[row]

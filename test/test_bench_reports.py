@@ -51,6 +51,7 @@ def test_every_shipped_count_model_has_its_recipe():
 def test_figure_labels_of_a_dense_cluster_neither_overlap_nor_leave_the_axes():
     """``bench/faces.py`` labels its speed-accuracy points so that each stays readable."""
     import importlib.util
+
     import matplotlib
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt

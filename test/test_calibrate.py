@@ -4,8 +4,8 @@
 import subprocess
 import sys
 
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation_file import load_observation
+from ipomdp_gaze.files.observation_file import load_observation
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.vision.calibrate import (count_model, hit_false_alarm, pool_target, Tallies,
                                           tally_image)
 from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig

@@ -1,11 +1,10 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """What a cell's observation is: counts, the best score in bins, counts above a threshold."""
-from ipomdp_gaze.observation_file import (load_observation, model_from_dict, model_to_dict,
-                                          ObservationFileError, save_observation)
+from ipomdp_gaze.files.observation_file import (load_observation, model_from_dict, model_to_dict,
+                                                ObservationFileError, save_observation)
+from ipomdp_gaze.model.cell_observation import cell_observation_of, CellObservation, quantile_edges
 from ipomdp_gaze.vision.calibrate import best_scores, choose_edges, Tallies
-from ipomdp_gaze.vision.cell_observation import (cell_observation_of, CellObservation,
-                                                 quantile_edges)
 from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig
 from ipomdp_gaze.vision.search import check_model
 import numpy as np
@@ -85,7 +84,7 @@ class ScoredBlob:
 
 
 def test_the_fovea_observes_best_scores_in_bins_and_the_file_records_the_rule(tmp_path):
-    from ipomdp_gaze.observation import CountObservation
+    from ipomdp_gaze.model.observation import CountObservation
     rule = CellObservation('score_bins', 4, edges=(0.5, 0.8))
     config = FoveaConfig(windows_cells=(6,), max_count=4)      # the whole image, full size
     fovea = Fovea(ScoredBlob(), (6, 6), config, cells=rule)

@@ -18,13 +18,13 @@ import sys
 import threading
 
 from conftest import wait_for
-from ipomdp_gaze import executor as executor_module
 from ipomdp_gaze.cli import main as cli_main
 from ipomdp_gaze.drivers import pieces
-from ipomdp_gaze.executor import ClusterError, DaskExecutor
-from ipomdp_gaze.fpoc import make_fpoc
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.fpoc import make_fpoc
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.policies.baselines import make_baseline
+from ipomdp_gaze.simulation import executor as executor_module
+from ipomdp_gaze.simulation.executor import ClusterError, DaskExecutor
 import numpy as np
 import pytest
 

@@ -1,13 +1,14 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """The count observation model: Bayes against brute force, samples against the tables, files."""
-from ipomdp_gaze.belief import bayes_update, EvidenceError, uniform_log_belief
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import CountObservation
-from ipomdp_gaze.observation_file import (fingerprint, load_observation, model_from_dict,
-                                          model_to_dict, ObservationFileError, save_observation)
+from ipomdp_gaze.files.observation_file import (fingerprint, load_observation, model_from_dict,
+                                                model_to_dict, ObservationFileError,
+                                                save_observation)
+from ipomdp_gaze.model.belief import bayes_update, EvidenceError, uniform_log_belief
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import CountObservation
 from ipomdp_gaze.policies.baselines import make_baseline
-from ipomdp_gaze.simulate import simulate
+from ipomdp_gaze.simulation.simulate import simulate
 import numpy as np
 import pytest
 from scipy.stats import chi2

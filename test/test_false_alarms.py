@@ -1,11 +1,11 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""A scene's own false-alarm rate and its hotspots (``ipomdp_gaze.false_alarms``) against Bayes."""
+"""A scene's own false-alarm rate and hotspots (``model.false_alarms``) against Bayes."""
 from ipomdp_gaze.drivers.scene_eval import compare_settings
-from ipomdp_gaze.false_alarms import check_false_alarm_scales, FalseAlarmMixture, scaled_null
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import CountObservation
-from ipomdp_gaze.session import Frame, SearchSession, SearchSettings
+from ipomdp_gaze.model.false_alarms import check_false_alarm_scales, FalseAlarmMixture, scaled_null
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import CountObservation
+from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
 import numpy as np
 import pytest
 
@@ -210,7 +210,7 @@ def test_settings_round_trip_and_a_searcher_label_takes_a_list():
 
 
 def test_a_gaussian_model_refuses_scales_it_cannot_apply():
-    from ipomdp_gaze.fpoc import make_fpoc
+    from ipomdp_gaze.model.fpoc import make_fpoc
     grid = Grid(5, 5, 1.0)
     with pytest.raises(ValueError, match='search.false_alarm_scales needs a count model'):
         SearchSession(grid, make_fpoc('human'), None,

@@ -6,16 +6,16 @@ import os
 from pathlib import Path
 import tracemalloc
 
-from ipomdp_gaze.belief import argmax_ties_low, bayes_update, TIE_RTOL, uniform_log_belief
-from ipomdp_gaze.fpoc import dprime_matrix, dprime_table, make_fpoc
-from ipomdp_gaze.gaze import GazeController
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
-from ipomdp_gaze.observation import GaussianObservation
+from ipomdp_gaze.model.belief import argmax_ties_low, bayes_update, TIE_RTOL, uniform_log_belief
+from ipomdp_gaze.model.fpoc import dprime_matrix, dprime_table, make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import gaussian_log_likelihood_ratio as llr
+from ipomdp_gaze.model.observation import GaussianObservation
 from ipomdp_gaze.policies import conv
 from ipomdp_gaze.policies.baselines import elm_policy
 from ipomdp_gaze.policies.conv import ConvPolicy, kernel_matrix, support_box
-from ipomdp_gaze.session import SearchSettings
+from ipomdp_gaze.search.gaze import GazeController
+from ipomdp_gaze.search.session import SearchSettings
 import numpy as np
 import pytest
 
@@ -119,6 +119,29 @@ def test_a_flat_belief_on_a_large_grid_takes_the_massive_tie_path(monkeypatch):
     belief = np.full(grid.n_cells, 1.0 / grid.n_cells)
     expected = int(argmax_ties_low(belief @ kernel_matrix(grid, kernel).T))
     assert fft.decide(belief) == expected and calls
+
+
+def test_a_truncation_that_drops_nothing_shares_the_lossless_fft_and_its_scores(monkeypatch):
+    # The camera kernel is a box: the default truncation drops no entry, so the massive-tie
+    # path's lossless pass reuses the scores it has; a kernel that truncation cuts does not.
+    grid = Grid(40, 40)
+    box = ConvPolicy(grid, dprime_table(grid, make_fpoc('camera')) ** 2, method='fft')
+    assert box._fft(True) is box._fft()
+    cut = ConvPolicy(grid, dprime_table(grid, make_fpoc('exponential')) ** 2, method='fft',
+                     truncate=1e-3)
+    assert cut._fft(True) is not cut._fft() and cut._fft(True).box != cut._fft().box
+    scored = []
+    original = ConvPolicy._fft_scores
+    monkeypatch.setattr(ConvPolicy, '_fft_scores',
+                        lambda self, *a: scored.append(a[1:]) or original(self, *a))
+    belief = np.full(grid.n_cells, 1.0 / grid.n_cells)
+    expected = int(argmax_ties_low(belief @ kernel_matrix(grid, box.kernel).T))
+    assert box.decide(belief) == expected and scored == [()] and box.rescored == 2
+    flat = []
+    original_flat = ConvPolicy._decide_flat
+    monkeypatch.setattr(ConvPolicy, '_decide_flat',
+                        lambda self, *a: flat.append(a[3]) or original_flat(self, *a))
+    assert box.decide(belief) == expected and flat == [box.fft_error_bound(belief, True)]
 
 
 @pytest.mark.parametrize('truncate', [1e-6, 1e-3, 1e-1])

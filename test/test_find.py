@@ -8,9 +8,9 @@ import sys
 
 import cv2
 from ipomdp_gaze.cli import main
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import CountObservation
-from ipomdp_gaze.observation_file import load_observation, save_observation
+from ipomdp_gaze.files.observation_file import load_observation, save_observation
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import CountObservation
 from ipomdp_gaze.vision.detector import HaarDetector
 from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig
 from ipomdp_gaze.vision.fullframe import scan
@@ -166,7 +166,7 @@ def _model_copy(path, model, width, height):
 def test_default_model_is_the_shipped_one_calibrated_nearest(task, tmp_path, monkeypatch,
                                                              capsys, detector, suffix):
     """The detector's shipped models (YuNet's by default) nearest each image's size."""
-    import ipomdp_gaze.observation_file as observation_file
+    import ipomdp_gaze.files.observation_file as observation_file
     models = tmp_path / 'models'
     monkeypatch.setattr(observation_file, 'MODEL_DIR', models)
     flags = ['--detector', detector] if detector else []

@@ -17,8 +17,8 @@ import subprocess
 import sys
 
 import cv2
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation_file import load_observation
+from ipomdp_gaze.files.observation_file import load_observation
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.vision.detector import HaarDetector
 from ipomdp_gaze.vision.fullframe import scan
 from ipomdp_gaze.vision.scenes import SceneSet

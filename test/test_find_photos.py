@@ -6,7 +6,7 @@ import subprocess
 import sys
 
 import cv2
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.vision.fullframe import cells_of_points
 from ipomdp_gaze.vision.photos import group_photo, load_photo, read_labels
 import numpy as np
@@ -172,7 +172,8 @@ def test_an_empty_folder_is_refused_in_one_line(tmp_path):
 
 def test_the_pixel_budget_stops_the_fovea_before_it_would_be_passed():
     from dataclasses import replace
-    from ipomdp_gaze.observation_file import load_observation
+
+    from ipomdp_gaze.files.observation_file import load_observation
     from ipomdp_gaze.policies.registry import build_policy
     from ipomdp_gaze.vision.search import FIND_SETTINGS, fovea_for_model, search_image
     model = load_observation('faces-420-yunet')

@@ -125,7 +125,7 @@ def test_find_names_a_policy_file_given_as_the_observation_model(tmp_path):
 def test_the_human_fpoc_far_out_is_zero_without_a_numpy_warning():
     import warnings
 
-    from ipomdp_gaze.fpoc import make_fpoc
+    from ipomdp_gaze.model.fpoc import make_fpoc
     import numpy as np
     with warnings.catch_warnings():
         warnings.simplefilter('error')

@@ -6,7 +6,7 @@ import subprocess
 import sys
 
 import cv2
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.vision.detector import HaarDetector
 from ipomdp_gaze.vision.fovea import (cell_edges_px, Fovea, FoveaConfig, REFERENCE_WINDOWS_CELLS,
                                       window_cells)

@@ -1,9 +1,9 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """FPOC values against docs/design.md section 2 and their parameter checks."""
-from ipomdp_gaze.fpoc import (CameraFPOC, dprime_matrix, dprime_table, fpoc_from_dict, HumanFPOC,
-                              make_fpoc)
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.fpoc import (CameraFPOC, dprime_matrix, dprime_table, fpoc_from_dict,
+                                    HumanFPOC, make_fpoc)
+from ipomdp_gaze.model.grid import Grid
 import numpy as np
 import pytest
 

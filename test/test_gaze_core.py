@@ -7,14 +7,14 @@ from dataclasses import replace
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from ipomdp_gaze.belief import argmax_ties_low, bayes_update, uniform_log_belief
-from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
-from ipomdp_gaze.gaze import GazeController
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
+from ipomdp_gaze.model.belief import argmax_ties_low, bayes_update, uniform_log_belief
+from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import gaussian_log_likelihood_ratio as llr
 from ipomdp_gaze.policies.baselines import spiral_order
 from ipomdp_gaze.policies.registry import build_policy
-from ipomdp_gaze.session import SearchSettings
+from ipomdp_gaze.search.gaze import GazeController
+from ipomdp_gaze.search.session import SearchSettings
 import numpy as np
 import pytest
 
@@ -101,6 +101,17 @@ def test_invalid_frames_are_rejected_and_change_nothing(frame, words):
     np.testing.assert_array_equal(core.belief, before)
     assert core.fixation == fixation and core.last_rejection == result.reason
     assert core.counters() == {'received': 1, 'applied': 0, 'rejected': 1, 'skipped': 0}
+
+
+def test_each_frame_is_checked_once_whatever_becomes_of_it(monkeypatch):
+    core = controller(settle_time_s=0.5)
+    checks = []
+    original = core.session.check_frame
+    monkeypatch.setattr(core.session, 'check_frame', lambda v: checks.append(1) or original(v))
+    statuses = [core.offer(np.zeros(121), 0.1).status,            # before settling
+                core.offer(np.zeros(120), 0.6).status,            # wrong length
+                core.offer(np.zeros(121), 0.6).status]            # applied
+    assert statuses == ['skipped', 'rejected', 'applied'] and len(checks) == 3
 
 
 def test_reject_counts_frames_the_node_could_not_read():

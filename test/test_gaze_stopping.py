@@ -5,16 +5,16 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from ipomdp_gaze.belief import bayes_update
-from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
-from ipomdp_gaze.gaze import GazeController
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.health import HealthMonitor
-from ipomdp_gaze.motion import Motion
-from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
+from ipomdp_gaze.model.belief import bayes_update
+from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.motion import Motion
+from ipomdp_gaze.model.observation import gaussian_log_likelihood_ratio as llr
+from ipomdp_gaze.model.stopping import initial_log_belief
 from ipomdp_gaze.policies.registry import build_policy
-from ipomdp_gaze.session import SearchSettings
-from ipomdp_gaze.stopping import initial_log_belief
+from ipomdp_gaze.search.gaze import GazeController
+from ipomdp_gaze.search.health import HealthMonitor
+from ipomdp_gaze.search.session import SearchSettings
 import numpy as np
 import pytest
 

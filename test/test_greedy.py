@@ -1,14 +1,13 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """The percent-correct greedy searcher (Najemnik & Geisler ideal searcher)."""
-from ipomdp_gaze.belief import bayes_update, map_cell
-from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
+from ipomdp_gaze.model.belief import bayes_update, map_cell
+from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import gaussian_log_likelihood_ratio as llr
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.policies.greedy import (expected_percent_correct, expected_percent_correct_at,
-                                         percent_correct_given_target,
-                                         PercentCorrectGreedy)
+                                         percent_correct_given_target, PercentCorrectGreedy)
 import numpy as np
 import pytest
 

@@ -1,7 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """Grid geometry: row-major indices, offsets and the offset table."""
-from ipomdp_gaze.grid import Grid, parse_grid
+from ipomdp_gaze.model.grid import Grid, parse_grid
 import numpy as np
 import pytest
 

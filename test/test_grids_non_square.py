@@ -13,9 +13,9 @@ from __future__ import annotations
 import math
 
 from conftest import HAVE_ROS_MSGS
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.head import PanTiltMap
-from ipomdp_gaze.head_camera import bin_points, observed_cells, PinholeCamera
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head import PanTiltMap
+from ipomdp_gaze.model.head_camera import bin_points, observed_cells, PinholeCamera
 import numpy as np
 import pytest
 

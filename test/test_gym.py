@@ -3,11 +3,11 @@
 """The Gymnasium environment: API conformance and the model it wraps."""
 import gymnasium
 from gymnasium.utils.env_checker import check_env
-from ipomdp_gaze.belief import bayes_update, uniform_log_belief
-from ipomdp_gaze.fpoc import dprime_matrix
-import ipomdp_gaze.gym  # noqa: F401  (registers the environment)
-from ipomdp_gaze.gym import ENV_ID, VisualSearchEnv
-from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
+from ipomdp_gaze.model.belief import bayes_update, uniform_log_belief
+from ipomdp_gaze.model.fpoc import dprime_matrix
+from ipomdp_gaze.model.observation import gaussian_log_likelihood_ratio as llr
+import ipomdp_gaze.simulation.gym  # noqa: F401  (registers the environment)
+from ipomdp_gaze.simulation.gym import ENV_ID, VisualSearchEnv
 import numpy as np
 import pytest
 
@@ -56,7 +56,7 @@ def test_absent_rate_draws_empty_scenes_from_the_env_generator():
 
 
 def test_moving_target_walks_and_the_belief_is_predicted():
-    from ipomdp_gaze.motion import Motion
+    from ipomdp_gaze.model.motion import Motion
     env = VisualSearchEnv(rows=5, cols=5, motion_sigma_cells=1.0, confidence=0.5, max_steps=40)
     env.reset(seed=4, options={'target': 12})
     d = dprime_matrix(env.grid, env.fpoc)

@@ -3,8 +3,8 @@
 """Pan/tilt head geometry without ROS: REP 103 angles of cells, signs, offsets and limits."""
 import math
 
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.head import PanTiltMap
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head import PanTiltMap
 import numpy as np
 import pytest
 

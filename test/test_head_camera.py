@@ -3,10 +3,10 @@
 """A camera on the pan/tilt head without ROS: K, pixel to cell, the cells a view shows."""
 import math
 
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.head import PanTiltMap
-from ipomdp_gaze.head_camera import (bin_points, observed_cells, PinholeCamera, pixel_cells,
-                                     view_extent)
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head import PanTiltMap
+from ipomdp_gaze.model.head_camera import (bin_points, observed_cells, PinholeCamera, pixel_cells,
+                                           view_extent)
 import numpy as np
 import pytest
 

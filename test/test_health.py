@@ -3,18 +3,21 @@
 """
 The controller's health report and the settings it checks, without ROS.
 
-:func:`ipomdp_gaze.health.classify` decides what ``/diagnostics`` says; every branch is checked
-here with its level, message and detail, and :class:`ipomdp_gaze.health.HealthMonitor` with a
-real :class:`ipomdp_gaze.gaze.GazeController` (per-period counts, rate, values in their order).
+:func:`ipomdp_gaze.search.health.classify` decides what ``/diagnostics`` says; every branch is
+checked
+here with its level, message and detail, and :class:`ipomdp_gaze.search.health.HealthMonitor` with
+a
+real :class:`ipomdp_gaze.search.gaze.GazeController` (per-period counts, rate, values in their
+order).
 """
 from __future__ import annotations
 
-from ipomdp_gaze.fpoc import make_fpoc
-from ipomdp_gaze.gaze import check_settle_time, GazeController
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.health import classify, Health, HealthMonitor, policy_label
-from ipomdp_gaze.session import SearchSettings, start_index
-from ipomdp_gaze.stopping import check_confidence
+from ipomdp_gaze.model.fpoc import make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.stopping import check_confidence
+from ipomdp_gaze.search.gaze import check_settle_time, GazeController
+from ipomdp_gaze.search.health import classify, Health, HealthMonitor, policy_label
+from ipomdp_gaze.search.session import SearchSettings, start_index
 import numpy as np
 import pytest
 

@@ -4,11 +4,10 @@
 from dataclasses import replace
 
 import cv2
-from ipomdp_gaze.belief import map_cell
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import CountObservation
-from ipomdp_gaze.policies.nmpt import (gaussian_taps, NMPT_SOURCE_TAPS, NMPTPolicy,
-                                       smoothing_matrix)
+from ipomdp_gaze.model.belief import map_cell
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import CountObservation
+from ipomdp_gaze.policies.nmpt import gaussian_taps, NMPT_SOURCE_TAPS, NMPTPolicy, smoothing_matrix
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
 from ipomdp_gaze.vision.detector import HaarDetector
 from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig

@@ -57,7 +57,7 @@ IMPORT_CHECK = (
     'import importlib, importlib.resources, importlib.util, json, sys\n'
     'files = {n: importlib.import_module(n).__file__ for n in json.loads(sys.argv[1])}\n'
     'from ipomdp_gaze.policies.policy_file import shipped_kernels\n'
-    'from ipomdp_gaze.observation_file import MODEL_DIR, shipped_observations\n'
+    'from ipomdp_gaze.files.observation_file import MODEL_DIR, shipped_observations\n'
     'bare = {}\n'
     'for name in ("policies", "msg_adapters"):\n'
     '    spec = importlib.util.find_spec(name)\n'
@@ -261,8 +261,8 @@ def test_evaluate_runs_and_writes_json(install, tmp_path):
 
 def test_the_image_tasks_run_from_the_install(install, tmp_path):
     """The shipped models, YuNet, the photo labels and the face configs are found installed."""
-    from skimage import data
     import cv2
+    from skimage import data
     rgb = data.astronaut()
     cv2.imwrite(str(tmp_path / 'astronaut.png'), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
     cli = install.bin_dir / 'ipomdp-gaze'
@@ -394,7 +394,7 @@ def test_installed_controller_and_camera_talk_over_dds(install, ros_env, probe, 
 
 @pytest.mark.ros
 def test_installed_scene_camera_and_detector_serve_a_fixation(install, ros_env, probe, tmp_path):
-    from ipomdp_gaze.grid import Grid
+    from ipomdp_gaze.model.grid import Grid
     from ipomdp_gaze.msg_adapters import grid_arrays, images
     from ipomdp_gaze.nodes.watch import LATCHED
     from rclpy.qos import QoSProfile, ReliabilityPolicy

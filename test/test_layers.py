@@ -48,7 +48,7 @@ def test_the_tree_keeps_the_layer_contract():
 @pytest.mark.parametrize('where', ['top', 'function'])
 def test_a_core_module_that_imports_nodes_breaks_the_contract(tmp_path, where):
     root = copy_tree(tmp_path)
-    grid = root / 'ipomdp_gaze' / 'grid.py'
+    grid = root / 'ipomdp_gaze' / 'model' / 'grid.py'
     text = grid.read_text()
     if where == 'top':
         text += '\nimport ipomdp_gaze.nodes.params  # noqa\n'
@@ -58,7 +58,7 @@ def test_a_core_module_that_imports_nodes_breaks_the_contract(tmp_path, where):
     out = lint_imports(root)
     assert out.returncode == 1, out.stdout
     assert 'Each layer imports only the layers below it BROKEN' in out.stdout
-    assert 'ipomdp_gaze.grid -> ipomdp_gaze.nodes.params' in out.stdout
+    assert 'ipomdp_gaze.model.grid -> ipomdp_gaze.nodes.params' in out.stdout
 
 
 def test_a_new_module_must_be_placed_in_a_layer(tmp_path):
@@ -78,3 +78,23 @@ def test_design_md_shows_the_contract_layers():
     block = re.search(r'<!-- layers: \.importlinter -->\n```\n(.*?)```', design, re.S)
     assert block, 'docs/design.md has no layers block'
     assert [line.strip() for line in block.group(1).strip().splitlines()] == layers
+
+
+def test_the_old_flat_names_import_the_moved_modules_with_a_warning():
+    code = ('import warnings, importlib\n'
+            'warnings.simplefilter("error")\n'
+            'from ipomdp_gaze.search import session\n'
+            'try:\n'
+            '    importlib.import_module("ipomdp_gaze.session")\n'
+            'except DeprecationWarning as exc:\n'
+            '    print(exc)\n'
+            'warnings.simplefilter("ignore")\n'
+            'import ipomdp_gaze.session as old, ipomdp_gaze.observation_file as files\n'
+            'from ipomdp_gaze.files import observation_file\n'
+            'print(old is session, files is observation_file, old.SearchSettings.__module__)\n')
+    out = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                         timeout=120, cwd=REPO)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.splitlines() == [
+        'ipomdp_gaze.session moved to ipomdp_gaze.search.session',
+        'True True ipomdp_gaze.search.session']

@@ -3,8 +3,8 @@
 """The motion step against a dense transition matrix built cell by cell, and the target's walk."""
 import math
 
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.motion import axis_transition, check_probability, check_sigma_cells, Motion
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.motion import axis_transition, check_probability, check_sigma_cells, Motion
 import numpy as np
 import pytest
 
@@ -153,6 +153,43 @@ def test_per_second_motion_scales_with_elapsed_time():
 def test_axis_matrix_rows_sum_to_one_and_zero_sigma_is_identity():
     np.testing.assert_allclose(axis_transition(8, 1.3).sum(axis=1), 1.0)
     np.testing.assert_array_equal(axis_transition(4, 0.0), np.eye(4))
+
+
+def _dense_axis(size, sigma):
+    """Return the axis matrix as first written: ``g`` evaluated for every pair of positions."""
+    if sigma == 0:
+        return np.eye(size)
+    x = np.arange(size)
+    offset = x[None, :] - x[:, None]
+    weights = np.where(np.abs(offset) <= math.ceil(3 * sigma),
+                       np.exp(-0.5 * (offset / sigma) ** 2), 0.0)
+    return weights / weights.sum(axis=1, keepdims=True)
+
+
+@pytest.mark.parametrize('size', [1, 2, 7, 11, 16, 128])
+@pytest.mark.parametrize('sigma', [0.0, 0.01, 0.5 * math.sqrt(0.0021), 0.3, 1.0, 2.7, 40.0])
+def test_axis_matrix_built_along_its_diagonals_is_the_dense_formula_bit_for_bit(size, sigma):
+    np.testing.assert_array_equal(axis_transition(size, sigma), _dense_axis(size, sigma))
+    assert axis_transition(size, sigma).tobytes() == _dense_axis(size, sigma).tobytes()
+
+
+def test_motion_over_a_time_step_is_reused_for_the_same_step_only():
+    motion = Motion(Grid(5, 4), 0.6, 0.2)
+    step = motion.over(0.25)
+    assert motion.over(0.25) is step
+    other = motion.over(0.5)
+    assert other is not step and other.sigma_cells == pytest.approx(0.6 * math.sqrt(0.5))
+    again = motion.over(0.25)
+    assert again.sigma_cells == step.sigma_cells and again.jump_prob == step.jump_prob
+    # Another motion (a new setting) does not see this one's steps.
+    assert Motion(Grid(5, 4), 1.2, 0.2).over(0.25).sigma_cells == pytest.approx(0.6)
+
+
+def test_the_target_walk_builds_its_step_distribution_on_first_use_only():
+    motion = Motion(Grid(5, 5), 0.7, 0.1)
+    first = motion.move(np.arange(25), np.random.default_rng(0))
+    again = Motion(Grid(5, 5), 0.7, 0.1).move(np.arange(25), np.random.default_rng(0))
+    np.testing.assert_array_equal(first, again)
 
 
 @pytest.mark.parametrize('value', [-0.1, float('nan'), float('inf'), 'x', None])

@@ -7,10 +7,10 @@ import array
 import math
 
 from conftest import HAVE_ROS_MSGS
-from ipomdp_gaze.belief import EvidenceError
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.head import PanTiltMap
-from ipomdp_gaze.render import MARK_RGB
+from ipomdp_gaze.files.render import MARK_RGB
+from ipomdp_gaze.model.belief import EvidenceError
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head import PanTiltMap
 import numpy as np
 import pytest
 
@@ -245,7 +245,7 @@ def test_camera_image_and_camera_info_round_trip():
     assert (msg.encoding, msg.step, msg.header.frame_id) == ('rgb8', 15, 'cam')
     np.testing.assert_array_equal(images.image_array(msg), rgb)
     assert images.camera_image(rgb[:, :, 0], stamp).encoding == 'mono8'
-    from ipomdp_gaze.head_camera import PinholeCamera
+    from ipomdp_gaze.model.head_camera import PinholeCamera
     camera = PinholeCamera.from_fov(320, 240, 25.0)
     info = images.camera_info(camera, stamp, 'cam')
     assert (info.width, info.height, info.header.stamp) == (320, 240, stamp)

@@ -1,10 +1,10 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """The Gaussian observation model: its likelihood ratio, its samples and its ELM kernel."""
-from ipomdp_gaze.belief import bayes_update, EvidenceError, uniform_log_belief
-from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import as_observation, GaussianObservation
+from ipomdp_gaze.model.belief import bayes_update, EvidenceError, uniform_log_belief
+from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import as_observation, GaussianObservation
 import numpy as np
 import pytest
 from scipy.stats import norm

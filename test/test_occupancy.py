@@ -4,15 +4,15 @@
 import itertools
 import math
 
-from ipomdp_gaze.fpoc import make_fpoc
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.many import OccupancySession
-from ipomdp_gaze.observation import CountObservation, GaussianObservation
-from ipomdp_gaze.occupancy import (binary_entropy, cell_prior, channel_information, clusters,
-                                   count_faces, decided, InformationTable, log_nobody,
-                                   occupancy, one_target_belief, prior_log_odds,
-                                   update_log_odds)
-from ipomdp_gaze.session import Frame, SearchSession, SearchSettings
+from ipomdp_gaze.model.fpoc import make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import CountObservation, GaussianObservation
+from ipomdp_gaze.model.occupancy import (binary_entropy, cell_prior, channel_information,
+                                         clusters, count_faces, decided, InformationTable,
+                                         log_nobody, occupancy, one_target_belief,
+                                         prior_log_odds, update_log_odds)
+from ipomdp_gaze.search.many import OccupancySession
+from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
 import numpy as np
 import pytest
 
@@ -326,7 +326,7 @@ def test_clusters_link_distance():
 
 
 def test_run_search_on_simulated_scenes_ends_after_a_decisive_scan():
-    from ipomdp_gaze.sensors import ModelSensor, run_search
+    from ipomdp_gaze.search.sensors import ModelSensor, run_search
     grid = Grid(3, 3)
     pt = np.tile([0.1, 0.9], (3, 3, 1))
     pn = np.tile([0.9, 0.1], (3, 3, 1))
@@ -345,7 +345,7 @@ def test_run_search_on_simulated_scenes_ends_after_a_decisive_scan():
 def test_the_single_target_session_refuses_many_targets():
     grid = Grid(2, 2)
     with pytest.raises(ValueError, match='search.targets many is searched by '
-                                         'ipomdp_gaze.many.OccupancySession'):
+                                         'ipomdp_gaze.search.many.OccupancySession'):
         SearchSession(grid, _model(grid), None, SearchSettings(targets='many'))
 
 
@@ -371,7 +371,7 @@ def test_gaussian_information_equals_the_integral_of_the_entropy_drop():
 
 def test_empty_by_evidence_needs_looks_where_a_sparse_prior_decides_at_once():
     """A sparse prior decides every cell empty before any look; the evidence rule does not."""
-    from ipomdp_gaze.sensors import ModelSensor, run_search
+    from ipomdp_gaze.search.sensors import ModelSensor, run_search
     grid = Grid(3, 3)
     pt = np.tile([0.1, 0.9], (3, 3, 1))
     pn = np.tile([0.9, 0.1], (3, 3, 1))

@@ -149,8 +149,8 @@ def _is_ros_module(name: str) -> bool:
 
 def test_the_core_and_the_policies_import_nothing_from_ros(tmp_path):
     modules = _core_modules()
-    assert {'ipomdp_gaze.gaze', 'ipomdp_gaze.policies', 'ipomdp_gaze.policies.policy_file'} <= \
-        set(modules)
+    assert {'ipomdp_gaze.search.gaze', 'ipomdp_gaze.policies',
+            'ipomdp_gaze.policies.policy_file'} <= set(modules)
     code = ('import importlib, json, sys\n'
             'for name in json.loads(sys.argv[1]):\n'
             '    importlib.import_module(name)\n'

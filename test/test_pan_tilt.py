@@ -6,14 +6,13 @@ import subprocess
 import sys
 
 from conftest import REPO
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.head_camera import observed_cells, pixel_cells
-from ipomdp_gaze.observation_file import load_observation
+from ipomdp_gaze.files.observation_file import load_observation
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head_camera import observed_cells, pixel_cells
 from ipomdp_gaze.vision.calibrate import count_model, tally_pan_tilt_scenes, tally_views
 from ipomdp_gaze.vision.detector import HaarDetector
 from ipomdp_gaze.vision.pan_tilt import (box_centres_uv, PAN_TILT_GRID, PanTiltSceneSet,
-                                         SceneGeometry, shipped_camera, user_scene,
-                                         ViewObserver)
+                                         SceneGeometry, shipped_camera, user_scene, ViewObserver)
 from ipomdp_gaze.vision.scenes import TEST_FACES, TRAIN_FACES
 import numpy as np
 import pytest

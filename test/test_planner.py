@@ -1,12 +1,12 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """Look-ahead planner (policies/planner.py): validity, determinism, rollouts, quality."""
-from ipomdp_gaze.fpoc import dprime_matrix, dprime_table, make_fpoc
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.fpoc import dprime_matrix, dprime_table, make_fpoc
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.policies.baselines import elm_policy, MapPolicy
 from ipomdp_gaze.policies.conv import ConvPolicy
 from ipomdp_gaze.policies.planner import make_planner, RolloutPlanner, TemperedELM, TemperedPolicy
-from ipomdp_gaze.simulate import noise_stream, simulate
+from ipomdp_gaze.simulation.simulate import noise_stream, simulate
 import numpy as np
 import pytest
 

@@ -4,15 +4,15 @@
 from pathlib import Path
 
 from ipomdp_gaze.cli import main
-from ipomdp_gaze.fpoc import make_fpoc
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation_file import fingerprint, load_observation
+from ipomdp_gaze.files.observation_file import fingerprint, load_observation
+from ipomdp_gaze.model.fpoc import make_fpoc
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.policies import policy_file as pf
 from ipomdp_gaze.policies.conv import ConvPolicy, kernel_from_radial, radial_bins
 from ipomdp_gaze.policies.logistic import LogisticPolicy
 from ipomdp_gaze.policies.policy_file import (load_policy, load_policy_spec, PolicyFileError,
                                               PolicySpec, save_policy, shipped_kernels)
-from ipomdp_gaze.simulate import simulate
+from ipomdp_gaze.simulation.simulate import simulate
 import numpy as np
 import pytest
 import yaml

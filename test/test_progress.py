@@ -6,8 +6,8 @@ from types import SimpleNamespace
 
 from conftest import wait_for
 from ipomdp_gaze.cli import main as cli_main
-from ipomdp_gaze.executor import InlineExecutor, LocalExecutor, make_executor, track
-from ipomdp_gaze.progress import Progress
+from ipomdp_gaze.simulation.executor import InlineExecutor, LocalExecutor, make_executor, track
+from ipomdp_gaze.simulation.progress import Progress
 import pytest
 
 

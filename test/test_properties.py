@@ -5,7 +5,8 @@ Property tests of the model core under any input (hypothesis; derandomized under
 
 For any frame (finite, NaN, +/-inf, 1e300, the largest doubles), any d' >= 0 (up to 1e300) and
 any sequence of fixations, the Bayes update either refuses the frame with an
-:class:`~ipomdp_gaze.belief.EvidenceError` naming the reason, leaving the belief as it was, or
+:class:`~ipomdp_gaze.model.belief.EvidenceError` naming the reason, leaving the belief as it was,
+or
 returns a finite, non-negative belief that sums to 1. NaN entries are unobserved cells: they
 change nothing. Every policy's choice is a valid cell for any belief, including one-hot beliefs,
 beliefs with zeros and denormal probabilities.
@@ -16,15 +17,16 @@ import os
 
 from hypothesis import assume, given, HealthCheck, settings
 from hypothesis import strategies as st
-from ipomdp_gaze.belief import bayes_update, EvidenceError, uniform_log_belief
-from ipomdp_gaze.fpoc import make_fpoc
-from ipomdp_gaze.gaze import GazeController
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.inhibition import unvisited_choice
-from ipomdp_gaze.observation import check_evidence, gaussian_log_likelihood_ratio as llr
+from ipomdp_gaze.model.belief import bayes_update, EvidenceError, uniform_log_belief
+from ipomdp_gaze.model.fpoc import make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.inhibition import unvisited_choice
+from ipomdp_gaze.model.observation import check_evidence
+from ipomdp_gaze.model.observation import gaussian_log_likelihood_ratio as llr
 from ipomdp_gaze.policies.baselines import make_baseline, STRATEGIES
 from ipomdp_gaze.policies.conv import ConvPolicy
 from ipomdp_gaze.policies.registry import build_policy
+from ipomdp_gaze.search.gaze import GazeController
 import numpy as np
 import pytest
 

@@ -3,9 +3,9 @@
 """The policy registry: baselines by name, kernels checked once, policy files against the task."""
 import sys
 
-from ipomdp_gaze.fpoc import make_fpoc
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import GaussianObservation
+from ipomdp_gaze.model.fpoc import make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import GaussianObservation
 from ipomdp_gaze.policies.conv import check_kernel, ConvPolicy
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnavailable
 import numpy as np

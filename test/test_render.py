@@ -1,7 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """The one belief heatmap (Gymnasium render and the controller's belief_image) and text grid."""
-from ipomdp_gaze.render import belief_heatmap, belief_text, colour_map, MARK_RGB
+from ipomdp_gaze.files.render import belief_heatmap, belief_text, colour_map, MARK_RGB
 import numpy as np
 import pytest
 

@@ -10,10 +10,10 @@ belief, while a disabled controller sends its first target only when enabled aga
 from pathlib import Path
 from types import SimpleNamespace
 
-from ipomdp_gaze.bag import Bag, BagMessage
 from ipomdp_gaze.drivers.replay import last_search
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.head import PanTiltMap
+from ipomdp_gaze.files.bag import Bag, BagMessage
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head import PanTiltMap
 import numpy as np
 
 GRID = Grid(11, 11, 5.0)

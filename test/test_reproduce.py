@@ -7,11 +7,11 @@ import json
 from ipomdp_gaze.cli import main as cli_main
 from ipomdp_gaze.commands import reproduce
 from ipomdp_gaze.drivers import pieces
-from ipomdp_gaze.executor import LocalExecutor
-from ipomdp_gaze.fpoc import make_fpoc
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.fpoc import make_fpoc
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.policies.baselines import make_baseline
-from ipomdp_gaze.simulate import simulate
+from ipomdp_gaze.simulation.executor import LocalExecutor
+from ipomdp_gaze.simulation.simulate import simulate
 import numpy as np
 import pytest
 

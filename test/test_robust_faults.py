@@ -46,8 +46,8 @@ class Watch:
     """What the probe sees of the search: beliefs, targets, camera poses and frames, status."""
 
     def __init__(self, probe):
-        from ipomdp_gaze.grid import Grid
-        from ipomdp_gaze.head import PanTiltMap
+        from ipomdp_gaze.model.grid import Grid
+        from ipomdp_gaze.model.head import PanTiltMap
         from ipomdp_gaze.nodes.watch import SearchRecord
         from rclpy.qos import QoSProfile, ReliabilityPolicy
         from sensor_msgs.msg import JointState
@@ -79,7 +79,7 @@ def watch(probe):
 
 def _posterior(belief, frame, fixation, grid) -> np.ndarray:
     """Bayes' rule offline: the kept belief updated with one camera frame."""
-    from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
+    from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
     d = dprime_matrix(grid, make_fpoc('camera', dprime=DPRIME, half_width_deg=10.0,
                                       half_height_deg=10.0))[:, fixation]
     o = np.asarray(frame, np.float32).astype(np.float64)
@@ -90,7 +90,7 @@ def _posterior(belief, frame, fixation, grid) -> np.ndarray:
 
 def _kept_outside_view(kept, belief, fixation, grid) -> bool:
     """Whether ``belief`` is ``kept`` times one factor on the cells a frame says nothing of."""
-    from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
+    from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
     d = dprime_matrix(grid, make_fpoc('camera', dprime=DPRIME, half_width_deg=10.0,
                                       half_height_deg=10.0))[:, fixation]
     outside = (d == 0) & (kept > 1e-12)

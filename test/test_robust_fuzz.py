@@ -44,6 +44,7 @@ VALID, REJECT, SKIP = 'valid', 'rejected', 'skipped'
 def fuzz(launch, probe, tmp_path_factory):
     """Start the controller; return the helpers that talk to it."""
     from std_msgs.msg import Float32MultiArray
+
     # Motion on: a tracker never ends its search, so every valid frame is applied (a still
     # search skips the frames after its found event until ~/reset, docs/design.md section 7.3).
     proc = launch('controller', [
@@ -182,7 +183,7 @@ class Frames:
 
 
 def _grid():
-    from ipomdp_gaze.grid import Grid
+    from ipomdp_gaze.model.grid import Grid
     return Grid(ROWS, COLS, 5.0)
 
 

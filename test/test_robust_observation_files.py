@@ -23,8 +23,8 @@ import sys
 from conftest import HAVE_RCLPY, REPO
 from hypothesis import given, HealthCheck, settings
 from hypothesis import strategies as st
-from ipomdp_gaze.observation_file import (load_observation, model_to_dict, ObservationFileError,
-                                          resolve_source)
+from ipomdp_gaze.files.observation_file import (load_observation, model_to_dict,
+                                                ObservationFileError, resolve_source)
 import pytest
 import yaml
 
@@ -147,7 +147,7 @@ def test_a_fuzzed_observation_file_loads_or_gives_one_line(tmp_path_factory, tex
 @FUZZ
 @given(bad_documents())
 def test_the_detector_setup_builds_or_gives_one_line(tmp_path_factory, text):
-    from ipomdp_gaze.detection import build_setup
+    from ipomdp_gaze.vision.detection import build_setup
     path = tmp_path_factory.mktemp('obs') / 'fuzzed.yaml'
     path.write_text(text)
     try:

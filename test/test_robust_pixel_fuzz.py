@@ -45,10 +45,10 @@ class Rig:
 
     def __init__(self, probe, nodes, mode: str):
         from diagnostic_msgs.msg import DiagnosticArray
-        from ipomdp_gaze.detection import build_setup
         from ipomdp_gaze.msg_adapters import diagnostics
         from ipomdp_gaze.nodes.detector import FRAME_QOS
         from ipomdp_gaze.nodes.watch import LATCHED
+        from ipomdp_gaze.vision.detection import build_setup
         from sensor_msgs.msg import CameraInfo, Image, JointState
         from std_msgs.msg import Int32MultiArray
         self.mode, self.probe = mode, probe
@@ -109,7 +109,7 @@ class Messages:
     """Hostile messages of every kind, each with the counters it must move."""
 
     def __init__(self, rig: Rig, rng: np.random.Generator):
-        from ipomdp_gaze.head import PanTiltMap
+        from ipomdp_gaze.model.head import PanTiltMap
         self.rig, self.rng = rig, rng
         self.head = PanTiltMap(rig.grid) if rig.mode == 'camera' else None
 
@@ -266,7 +266,7 @@ class Valid:
     """Valid requests: a fixation, then an image (camera mode: camera_info, joint state)."""
 
     def __init__(self, rig: Rig):
-        from ipomdp_gaze.head import PanTiltMap
+        from ipomdp_gaze.model.head import PanTiltMap
         from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, SceneGeometry, shipped_camera
         from ipomdp_gaze.vision.scenes import PAPER_TASK, SceneSet
         self.rig = rig

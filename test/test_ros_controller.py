@@ -26,9 +26,9 @@ class Camera:
     """This test as the camera: sends frames, sees the controller's beliefs and targets."""
 
     def __init__(self, probe, launch):
-        from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
-        from ipomdp_gaze.grid import Grid
-        from ipomdp_gaze.head import PanTiltMap
+        from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
+        from ipomdp_gaze.model.grid import Grid
+        from ipomdp_gaze.model.head import PanTiltMap
         from ipomdp_gaze.nodes.watch import SearchRecord
         from sensor_msgs.msg import Image
         from std_msgs.msg import Float32MultiArray
@@ -144,7 +144,7 @@ def _frames(seed, n):
 
 def _conv_choice(kernel, belief):
     """Evaluate the kernel's next fixation offline, and its margin over the runner-up."""
-    from ipomdp_gaze.grid import Grid
+    from ipomdp_gaze.model.grid import Grid
     from ipomdp_gaze.policies.conv import ConvPolicy
     policy = ConvPolicy(Grid(11, 11, 5.0), np.asarray(kernel).reshape(21, 21))
     scores = policy.scores(belief[None])[0]
@@ -308,8 +308,8 @@ def test_pan_tilt_of_known_cells_and_signs(probe, cam, params, cell, pan_deg, ti
 
 @pytest.fixture(scope='module')
 def policy_files(tmp_path_factory):
-    from ipomdp_gaze.fpoc import make_fpoc
-    from ipomdp_gaze.grid import Grid
+    from ipomdp_gaze.model.fpoc import make_fpoc
+    from ipomdp_gaze.model.grid import Grid
     from ipomdp_gaze.policies.policy_file import PolicySpec, save_policy
     folder = tmp_path_factory.mktemp('policies')
     camera = make_fpoc('camera', half_width_deg=10.0, half_height_deg=10.0)

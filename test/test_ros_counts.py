@@ -24,8 +24,8 @@ class Detector:
     """This test as the foveal detector: sees fixations and beliefs, sends count frames."""
 
     def __init__(self, probe, nodes):
+        from ipomdp_gaze.files.observation_file import load_observation
         from ipomdp_gaze.nodes.watch import LATCHED
-        from ipomdp_gaze.observation_file import load_observation
         from std_msgs.msg import Float32MultiArray, Int32MultiArray
         self.model = load_observation('faces-420-nmpt')     # a model without the scan
         self.grid = self.model.grid
@@ -70,7 +70,7 @@ def test_fixation_is_published_with_every_target_and_every_resend(detector):
 
 
 def test_count_frames_are_applied_with_the_count_model_and_clipped(detector):
-    from ipomdp_gaze.belief import bayes_update
+    from ipomdp_gaze.model.belief import bayes_update
     start = detector.fixation()
     prior = np.full(detector.grid.n_cells, 1 / detector.grid.n_cells)
     if detector.beliefs:

@@ -87,7 +87,7 @@ class Driver:
 
 @pytest.fixture(scope='module')
 def fovea(probe, nodes):
-    from ipomdp_gaze.detection import build_setup
+    from ipomdp_gaze.vision.detection import build_setup
     driver = Driver(probe, nodes, '/fov', 'fovea')
     driver.setup = build_setup('fovea')
     driver.grid = driver.setup.grid
@@ -96,7 +96,7 @@ def fovea(probe, nodes):
 
 @pytest.fixture(scope='module')
 def camera(probe, nodes):
-    from ipomdp_gaze.detection import build_setup
+    from ipomdp_gaze.vision.detection import build_setup
     driver = Driver(probe, nodes, '/cam', 'camera')
     driver.setup = build_setup('camera')
     driver.grid = driver.setup.grid
@@ -198,7 +198,7 @@ def test_malformed_images_are_rejected_with_the_reason_and_the_node_keeps_servin
 
 def _pose_frame(camera, scene, head_cell, stamp, info=True):
     """Publish joint_states, camera_info (optional) and the view of ``head_cell``."""
-    from ipomdp_gaze.head import PanTiltMap
+    from ipomdp_gaze.model.head import PanTiltMap
     from ipomdp_gaze.msg_adapters import images, joints
     from ipomdp_gaze.vision.pan_tilt import SceneGeometry, shipped_camera
     geometry = SceneGeometry(camera.grid, shipped_camera())
@@ -230,7 +230,7 @@ def test_camera_mode_waits_for_camera_info_with_a_warning(camera):
 
 @pytest.mark.parametrize('seed, offset', [(5, (0, 0)), (6, (1, -1)), (9, (-1, 1))])
 def test_camera_mode_bins_a_face_to_its_cell_and_the_rest_is_nan(camera, seed, offset):
-    from ipomdp_gaze.head_camera import observed_cells
+    from ipomdp_gaze.model.head_camera import observed_cells
     from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, SceneGeometry, shipped_camera
     grid = camera.grid
     scene = PanTiltSceneSet('test', SceneGeometry(grid, shipped_camera()), seed=seed).scene(0)
@@ -268,7 +268,7 @@ def test_settings_that_contradict_the_observation_file_are_refused(probe, nodes,
 
 def test_an_absurd_joint_angle_is_refused_and_counted_and_the_node_lives(camera):
     """The fault of issue 26: pan = 1e308 under the stamp of a valid image, a fixation waiting."""
-    from ipomdp_gaze.head import PanTiltMap
+    from ipomdp_gaze.model.head import PanTiltMap
     from ipomdp_gaze.msg_adapters import images, joints
     from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, SceneGeometry, shipped_camera
     from sensor_msgs.msg import JointState

@@ -30,7 +30,7 @@ VERDICT = re.compile(r'^the scene camera put the face centre in cell \((\d+), (\
 
 def find_path(seed: int) -> tuple:
     """Return the fixations `find` makes on the scene camera's fixed scene of ``seed``."""
-    from ipomdp_gaze.observation_file import load_observation
+    from ipomdp_gaze.files.observation_file import load_observation
     from ipomdp_gaze.policies.registry import build_policy
     from ipomdp_gaze.vision.scenes import SceneSet
     from ipomdp_gaze.vision.search import fovea_for_model, SCENE_SETTINGS, search_image

@@ -82,7 +82,7 @@ def test_the_two_yaml_files_describe_the_same_task():
 
 @pytest.mark.parametrize('mode, view', [('camera', 'pan_tilt'), ('fovea', 'fixed')])
 def test_the_three_face_yaml_files_of_a_mode_describe_the_same_task(mode, view):
-    from ipomdp_gaze.observation_file import load_observation
+    from ipomdp_gaze.files.observation_file import load_observation
     controller = _flat(_yaml(f'faces_{mode}_controller.yaml')['gaze_controller']
                        ['ros__parameters'])
     detector = _flat(_yaml(f'faces_{mode}_detector.yaml')['foveal_detector']['ros__parameters'])

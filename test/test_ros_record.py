@@ -91,7 +91,7 @@ def test_the_demo_bag_is_rosbag2_mcap_that_other_readers_read(simulated):
     kernel = params['policy.file']
     digest = hashlib.sha256(resolve_source(kernel).read_bytes()).hexdigest()
     assert yaml.safe_load(custom['ipomdp_gaze/files']) == {kernel: digest}
-    from ipomdp_gaze.share_files import package_version
+    from ipomdp_gaze.files.share_files import package_version
     assert custom['ipomdp_gaze/version'] == package_version()
 
 

@@ -44,8 +44,8 @@ def _last(rec) -> list:
 
 
 def _send(rec, probe, counts, tag: str) -> None:
+    from ipomdp_gaze.files.observation_file import load_observation
     from ipomdp_gaze.msg_adapters import images
-    from ipomdp_gaze.observation_file import load_observation
     grid = load_observation('faces-420').grid
     stamp = probe.node.get_clock().now().to_msg()
     rec['frames'].publish(images.evidence_image(np.asarray(counts, float), grid, stamp, tag))
@@ -53,9 +53,9 @@ def _send(rec, probe, counts, tag: str) -> None:
 
 def _expected_first_fixation(scan_counts) -> int:
     """Return the search session's first fixation after this scan (find's rule)."""
-    from ipomdp_gaze.observation_file import load_observation
+    from ipomdp_gaze.files.observation_file import load_observation
     from ipomdp_gaze.policies.registry import build_policy
-    from ipomdp_gaze.session import Frame, SearchSession, SearchSettings
+    from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
     model = load_observation('faces-420')
     policy = build_policy('learned', model.grid, model, file='faces-420-infomax')
     session = SearchSession(model.grid, model, policy,

@@ -56,7 +56,7 @@ def _enable(probe, flag):
 
 def _search(probe, rec, seed, target, start):
     """Run one search from a reset; return (beliefs, targets, truth, found) of this search."""
-    from ipomdp_gaze.grid import Grid
+    from ipomdp_gaze.model.grid import Grid
     from ipomdp_gaze.msg_adapters import grid_arrays
     grid = Grid(11, 11, 5.0)
     _enable(probe, False)
@@ -104,8 +104,8 @@ def test_most_likely_cell_is_the_target_at_0999(searches):
 
 
 def test_found_event(searches):
-    from ipomdp_gaze.grid import Grid
-    from ipomdp_gaze.head import PanTiltMap
+    from ipomdp_gaze.model.grid import Grid
+    from ipomdp_gaze.model.head import PanTiltMap
     from ipomdp_gaze.msg_adapters import diagnostics
     head = PanTiltMap(Grid(11, 11, 5.0))
     for _, (beliefs, _, _, found_msg) in searches:
@@ -143,8 +143,8 @@ def test_pan_tilt_angles_signs_and_start_cells(rig, searches):
 
 
 def test_belief_image_size_encoding_and_fixation_mark(rig, searches):
+    from ipomdp_gaze.files.render import MARK_RGB
     from ipomdp_gaze.msg_adapters import images
-    from ipomdp_gaze.render import MARK_RGB
     assert rig['image'], 'no belief_image received'
     msg = rig['image'][-1][1]
     assert (msg.encoding, msg.height, msg.width, msg.step) == ('rgb8', 352, 352, 1056)

@@ -81,7 +81,7 @@ def found_search(rig, probe, absent_search):
 
 
 def test_an_empty_scene_is_declared_absent(rig, absent_search):
-    from ipomdp_gaze.grid import Grid
+    from ipomdp_gaze.model.grid import Grid
     from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays
     beliefs, msg, founds = absent_search
     assert grid_arrays.cell_from_ground_truth(rig['truth'][-1][1], Grid(11, 11, 5.0)) is None
@@ -113,7 +113,7 @@ def test_no_new_target_after_a_decision_until_reset(rig, probe, found_search):
     n_target, n_belief = len(rig['targets']), len(rig['belief'])
     skipped = int(status.values['frames_skipped'])
     frame = np.random.default_rng(0).standard_normal(121).astype(np.float32)
-    from ipomdp_gaze.grid import Grid
+    from ipomdp_gaze.model.grid import Grid
     from ipomdp_gaze.msg_adapters import grid_arrays
     msg = grid_arrays.to_multiarray(frame, Grid(11, 11, 5.0))
     for _ in range(3):              # frames that arrive after the decision are skipped

@@ -83,7 +83,7 @@ def camera(rig, launch):
 
 
 def test_camera_that_starts_late_picks_up_the_target(rig, camera):
-    from ipomdp_gaze.grid import Grid
+    from ipomdp_gaze.model.grid import Grid
     from ipomdp_gaze.msg_adapters import grid_arrays
     assert wait_for(lambda: _search_done(rig, 0), 60), camera.output()
     assert wait_for(lambda: rig['truth'])
@@ -94,9 +94,9 @@ def test_camera_that_starts_late_picks_up_the_target(rig, camera):
 
 
 def test_no_frame_taken_mid_saccade_is_used_and_the_search_completes(rig, camera, probe):
-    from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
-    from ipomdp_gaze.grid import Grid
-    from ipomdp_gaze.head import PanTiltMap
+    from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
+    from ipomdp_gaze.model.grid import Grid
+    from ipomdp_gaze.model.head import PanTiltMap
     from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
     grid = Grid(11, 11, 5.0)
     head = PanTiltMap(grid)

@@ -4,7 +4,7 @@
 import math
 
 import cv2
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.vision import scenes
 from ipomdp_gaze.vision.scenes import read_labelled_folder, Scene, SceneSet, write_scene_set
 import numpy as np

@@ -1,7 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-The search session (ipomdp_gaze.session) and its sensors, against brute force and each driver.
+The search session (ipomdp_gaze.search.session) and its sensors, against brute force, by driver.
 
 The belief after a scan and frames is the brute-force posterior (every hypothesis's likelihood
 multiplied out, the absent hypothesis included); a repeat weight below 1 counts each cell's
@@ -15,13 +15,16 @@ from dataclasses import replace
 import itertools
 import math
 
-from ipomdp_gaze.gaze import GazeController
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import CountObservation
+from ipomdp_gaze.model.belief import EvidenceError
+from ipomdp_gaze.model.fpoc import make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import CountObservation
+from ipomdp_gaze.model.still_evidence import cell_information
 from ipomdp_gaze.policies.registry import build_policy
-from ipomdp_gaze.sensors import ModelSensor, run_search
-from ipomdp_gaze.session import (Frame, OrderError, SearchSession, SearchSettings, start_index)
-from ipomdp_gaze.still_evidence import cell_information
+from ipomdp_gaze.search.gaze import GazeController
+from ipomdp_gaze.search.sensors import ModelSensor, run_search
+from ipomdp_gaze.search.session import (Frame, OrderError, SearchSession, SearchSettings,
+                                        start_index)
 import numpy as np
 import pytest
 
@@ -455,5 +458,114 @@ def test_run_search_calls_the_frame_hook_once_per_applied_frame_with_the_frame()
     ((3, 4), None, 'absent', True), ((3, 4), None, 'found', False),
     ((2, 3), (3, 4), 'gave_up', True), (None, (3, 4), 'gave_up', False)])
 def test_the_one_right_answer_rule(cell, truth, decision, right):
-    from ipomdp_gaze.evaluation import answer_is_right
+    from ipomdp_gaze.simulation.evaluation import answer_is_right
     assert answer_is_right(cell, truth, decision) is right
+
+
+def _views_from_scratch(session, radius):
+    """Return the read-only views recomputed from the log belief alone, as first written."""
+    log_b = session.log_belief
+    cells = np.exp(log_b[:GRID.n_cells])
+    if radius:
+        padded = np.pad(cells.reshape(GRID.shape), radius)
+        square = np.lib.stride_tricks.sliding_window_view(padded, (2 * radius + 1,) * 2)
+        pooled = square.sum(axis=(2, 3)).reshape(-1)
+    else:
+        pooled = cells
+    peak = pooled.max()
+    answer = int(np.argmax(pooled >= peak - 1e-9 * abs(peak)))
+    full = np.exp(log_b)
+    entropy = float(-np.sum(np.where(full > 0, full * np.log(np.where(full > 0, full, 1.0)),
+                                     0.0)))
+    return cells, answer, float(pooled[answer]), entropy
+
+
+def _assert_views_follow(session, radius):
+    cells, answer, probability, entropy = _views_from_scratch(session, radius)
+    assert session.belief.tobytes() == cells.tobytes()
+    assert (session.map_cell, session.map_probability) == (answer, probability)
+    assert session.entropy_nats == entropy
+
+
+def test_the_views_follow_every_change_of_the_belief_and_of_the_settings():
+    """Views computed once per belief: reset, scan, exclude, update, predict, configure."""
+    model = count_model(12)
+    settings = SearchSettings(confidence=1 - 1e-12, absent_prior=0.3, found_radius=1)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model), settings)
+    sensor = ModelSensor(GRID, model, np.random.default_rng(4))
+    sensor.start(5)
+    session.reset(seed=0)
+    _assert_views_follow(session, 1)
+    session.scan(sensor.scan())
+    _assert_views_follow(session, 1)
+    session.exclude([5, 6])
+    _assert_views_follow(session, 1)
+    cell = session.start()
+    for _ in range(3):
+        before = session.belief
+        result = session.update(sensor.observe(cell))
+        assert not np.array_equal(session.belief, before)
+        _assert_views_follow(session, 1)
+        cell = result.fixation
+    session.configure(replace(settings, found_radius=0))
+    _assert_views_follow(session, 0)
+    session.configure(replace(settings, found_radius=2))
+    _assert_views_follow(session, 2)
+    session.configure(replace(settings, motion_sigma_cells=0.8))  # moving: the cell alone
+    _assert_views_follow(session, 0)
+    before = session.belief
+    session.predict(1.5)
+    assert not np.array_equal(session.belief, before)
+    _assert_views_follow(session, 0)
+    session.reset()
+    _assert_views_follow(session, 0)
+    np.testing.assert_allclose(session.belief, 0.7 / GRID.n_cells)
+
+
+def test_the_belief_a_caller_gets_is_its_own_copy():
+    model = count_model(13)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model), SearchSettings())
+    session.reset()
+    session.start()
+    mine = session.belief
+    mine[:] = 0.0
+    assert session.belief.sum() == pytest.approx(1.0)
+    assert session.map_probability == pytest.approx(1.0 / GRID.n_cells)
+
+
+def test_a_frame_checked_by_the_session_is_not_checked_again_by_it(monkeypatch):
+    model = count_model(14)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model), SearchSettings())
+    session.reset()
+    session.start()
+    checks = []
+    original = session.check_frame
+    monkeypatch.setattr(session, 'check_frame', lambda v: checks.append(1) or original(v))
+    frame = session.checked_frame(np.zeros(GRID.n_cells))
+    assert session.update(frame).applied and len(checks) == 1
+    assert session.update(Frame(np.zeros(GRID.n_cells))).applied and len(checks) == 2
+    with pytest.raises(EvidenceError, match='integers'):
+        session.checked_frame(np.full(GRID.n_cells, 0.5))
+
+
+def test_a_checked_frame_is_checked_again_by_another_session_or_model():
+    model = count_model(15)
+    gaussian = SearchSession(GRID, make_fpoc('camera', half_width_deg=1.0,
+                                             half_height_deg=1.0), None, SearchSettings())
+    fractional = gaussian.checked_frame(np.full(GRID.n_cells, 0.5))   # fine for a Gaussian
+    counts = SearchSession(GRID, model, None, SearchSettings())
+    counts.reset()
+    counts.start()
+    result = counts.update(fractional)
+    assert result.status == 'rejected' and 'integers' in result.reason
+    gaussian.reset()
+    gaussian.start()
+    frame = gaussian.checked_frame(np.full(GRID.n_cells, 0.5))
+    gaussian.set_observation(model)                 # the model changed since the check
+    result = gaussian.update(frame)
+    assert result.status == 'rejected' and 'integers' in result.reason
+    assert gaussian.fixations == 0
+    fresh = SearchSession(GRID, model, None, SearchSettings())
+    fresh.reset()
+    scan = fresh.checked_frame(np.zeros(GRID.n_cells), kind='scan')
+    assert scan.kind == 'scan' and fresh.scan(scan).applied

@@ -7,7 +7,8 @@ The offline image-task evaluation runs the session with the real detector.
 
 The CLI (``search``, ``find``, ``evaluate --scenes``) and the ``gaze_controller`` node (a parameter
 set, in process) are given the same bad values; the line the CLI prints and the reason the node
-returns carry the message of :class:`ipomdp_gaze.session.SearchSettings`. The node also takes
+returns carry the message of :class:`ipomdp_gaze.search.session.SearchSettings`. The node also
+takes
 ``policy.file`` alone as the learned policy at start-up.
 """
 from __future__ import annotations
@@ -18,7 +19,7 @@ import subprocess
 import sys
 
 from conftest import HAVE_RCLPY, REPO
-from ipomdp_gaze.session import SearchSettings
+from ipomdp_gaze.search.session import SearchSettings
 import pytest
 
 BAD = [  # (CLI flag, value, node parameter, ROS type name, settings field, value)
@@ -127,8 +128,8 @@ def test_evaluate_scenes_runs_the_pan_tilt_task_and_writes_json(tmp_path):
     assert 'pan-tilt (2 scenes with a face): right' in out.stdout
     record = json.loads((tmp_path / 'pt.json').read_text())
     assert record['settings']['search.max_fixations'] == 6
-    from ipomdp_gaze.share_files import config_file
-    from ipomdp_gaze.yaml_files import yaml_parameters
+    from ipomdp_gaze.files.share_files import config_file
+    from ipomdp_gaze.files.yaml_files import yaml_parameters
     shipped = yaml_parameters(config_file('faces_camera_controller.yaml'), 'gaze_controller')
     for name in ('search.repeat_weight', 'absent.prior', 'search.hotspot_prior'):
         assert record['settings'][name] == shipped[name]           # the shipped config's

@@ -4,7 +4,8 @@
 The settings schema is the one description of every search setting.
 
 The settings object, the node's parameter declarations, the CLI flags and the YAML check are
-generated from :data:`ipomdp_gaze.settings.SCHEMA`: a setting added there appears in all four
+generated from :data:`ipomdp_gaze.search.settings.SCHEMA`: a setting added there appears in all
+four
 with no other edit, and each refuses a bad value with the same message.
 """
 from __future__ import annotations
@@ -14,11 +15,11 @@ from dataclasses import fields, replace
 import pickle
 
 from conftest import HAVE_RCLPY, REPO
-from ipomdp_gaze.checks import check_sigma_cells
 from ipomdp_gaze.commands.search_args import add_search_args, settings_from_args
-from ipomdp_gaze.session import PARAMETER_NAMES, SearchSettings
-from ipomdp_gaze.settings import check_parameters, SCHEMA, Setting, settings_class
-from ipomdp_gaze.yaml_files import yaml_parameters
+from ipomdp_gaze.files.yaml_files import yaml_parameters
+from ipomdp_gaze.model.checks import check_sigma_cells
+from ipomdp_gaze.search.session import PARAMETER_NAMES, SearchSettings
+from ipomdp_gaze.search.settings import check_parameters, SCHEMA, Setting, settings_class
 import pytest
 
 NEW = Setting('dwell_s', 'search.dwell_s', 'float', 1.5, check_sigma_cells,

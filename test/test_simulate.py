@@ -1,15 +1,15 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """Batched simulator: common random numbers, agreement with step-by-step updates, calibration."""
-from ipomdp_gaze.belief import bayes_update, map_cell, uniform_log_belief
-from ipomdp_gaze.evaluation import fixations_to_90_ci
-from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.motion import Motion
-from ipomdp_gaze.observation import CountObservation
-from ipomdp_gaze.observation import gaussian_log_likelihood_ratio as llr
+from ipomdp_gaze.model.belief import bayes_update, map_cell, uniform_log_belief
+from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.motion import Motion
+from ipomdp_gaze.model.observation import CountObservation
+from ipomdp_gaze.model.observation import gaussian_log_likelihood_ratio as llr
 from ipomdp_gaze.policies.baselines import make_baseline
-from ipomdp_gaze.simulate import draw_targets, noise_stream, simulate
+from ipomdp_gaze.simulation.evaluation import fixations_to_90_ci
+from ipomdp_gaze.simulation.simulate import draw_targets, noise_stream, simulate
 import numpy as np
 import pytest
 

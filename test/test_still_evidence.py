@@ -3,15 +3,15 @@
 """search.repeat_weight: a cell's repeated views of a still scene weighted, vs brute force."""
 from dataclasses import replace
 
-from ipomdp_gaze.belief import bayes_update, uniform_log_belief
-from ipomdp_gaze.fpoc import make_fpoc
-from ipomdp_gaze.gaze import GazeController
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import CountObservation, GaussianObservation
+from ipomdp_gaze.model.belief import bayes_update, uniform_log_belief
+from ipomdp_gaze.model.fpoc import make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import CountObservation, GaussianObservation
+from ipomdp_gaze.model.still_evidence import cell_information, check_repeat_weight, StillEvidence
+from ipomdp_gaze.model.stopping import initial_log_belief
 from ipomdp_gaze.policies.registry import build_policy
-from ipomdp_gaze.session import SearchSettings
-from ipomdp_gaze.still_evidence import cell_information, check_repeat_weight, StillEvidence
-from ipomdp_gaze.stopping import initial_log_belief
+from ipomdp_gaze.search.gaze import GazeController
+from ipomdp_gaze.search.session import SearchSettings
 import numpy as np
 import pytest
 

@@ -1,20 +1,20 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """The absent hypothesis against brute-force N+1-state posteriors, and the stopping rules."""
-from ipomdp_gaze.belief import bayes_update, uniform_log_belief
-from ipomdp_gaze.evaluation import (decision_summary, paired_tracking_difference,
-                                    search_outcomes, tracking_arrays, tracking_summary,
-                                    wilson_interval)
-from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.motion import Motion
-from ipomdp_gaze.observation import CountObservation, GaussianObservation
+from ipomdp_gaze.model.belief import bayes_update, uniform_log_belief
+from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.motion import Motion
+from ipomdp_gaze.model.observation import CountObservation, GaussianObservation
+from ipomdp_gaze.model.stopping import (ABSENT, check_absent_prior, check_confidence,
+                                        check_max_fixations, decide, first_decisions, FOUND,
+                                        GAVE_UP, initial_log_belief, UNDECIDED)
 from ipomdp_gaze.policies.baselines import make_baseline
-from ipomdp_gaze.simulate import (draw_present, motion_stream, noise_stream, SearchResult,
-                                  simulate)
-from ipomdp_gaze.stopping import (ABSENT, check_absent_prior, check_confidence,
-                                  check_max_fixations, decide, first_decisions, FOUND, GAVE_UP,
-                                  initial_log_belief, UNDECIDED)
+from ipomdp_gaze.simulation.evaluation import (decision_summary, paired_tracking_difference,
+                                               search_outcomes, tracking_arrays, tracking_summary,
+                                               wilson_interval)
+from ipomdp_gaze.simulation.simulate import (draw_present, motion_stream, noise_stream,
+                                             SearchResult, simulate)
 import numpy as np
 import pytest
 from scipy.stats import norm

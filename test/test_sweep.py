@@ -5,8 +5,8 @@ import itertools
 import math
 
 from ipomdp_gaze.drivers.scene_eval import head_time_s, SACCADE_TIME_S, SETTLE_TIME_S, task_spec
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation_file import load_observation
+from ipomdp_gaze.files.observation_file import load_observation
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.policies.baselines import (axis_poses, SWEEP_STEP, sweep_tile_cells,
                                             TILE_MARGIN_CELLS)
 from ipomdp_gaze.policies.registry import build_policy
@@ -64,7 +64,7 @@ def test_axis_poses_are_the_fewest_views_that_see_every_cell(n_cells):
 
 
 def test_sweep_without_a_field_of_view_is_a_raster_with_the_stated_step():
-    from ipomdp_gaze.fpoc import HumanFPOC
+    from ipomdp_gaze.model.fpoc import HumanFPOC
     grid = Grid(7, 7, 1.0)
     sweep = build_policy('sweep', grid, HumanFPOC())
     rows, cols = np.divmod(sweep.poses, grid.cols)
@@ -102,13 +102,13 @@ def test_task_spec_refuses_unknown_searchers_and_splits():
 
 
 def _session(settings, policy=None):
-    from ipomdp_gaze.session import SearchSession
+    from ipomdp_gaze.search.session import SearchSession
     model = load_observation('faces-pan-tilt')
     return model, SearchSession(model.grid, model, policy, settings)
 
 
 def test_found_radius_decides_on_the_belief_around_a_cell_and_answers_that_cell():
-    from ipomdp_gaze.session import Frame, pooled_belief, SearchSettings
+    from ipomdp_gaze.search.session import Frame, pooled_belief, SearchSettings
     grid = Grid(11, 11, 5.0)
     belief = np.zeros(121)
     belief[[grid.index(5, 8), grid.index(6, 8)]] = 0.5         # a face split over two cells
@@ -135,7 +135,7 @@ def test_found_radius_decides_on_the_belief_around_a_cell_and_answers_that_cell(
 
 
 def test_decide_at_budget_says_absent_or_found_instead_of_giving_up():
-    from ipomdp_gaze.session import Frame, SearchSettings
+    from ipomdp_gaze.search.session import Frame, SearchSettings
     grid = Grid(11, 11, 5.0)
     empty = np.zeros(121)
     out = {}
@@ -157,7 +157,7 @@ def test_decide_at_budget_says_absent_or_found_instead_of_giving_up():
 
 
 def test_settings_refuse_a_bad_found_radius_with_the_parameter_name():
-    from ipomdp_gaze.session import SearchSettings
+    from ipomdp_gaze.search.session import SearchSettings
     with pytest.raises(ValueError, match='search.found_radius must be an integer from 0 to 5'):
         SearchSettings(found_radius=-1)
     with pytest.raises(ValueError, match='search.decide_at_budget must be true or false'):
@@ -177,7 +177,7 @@ def test_coverage_takes_the_sweeps_tiles_while_the_belief_is_diffuse_then_elm():
     assert 0.9 >= COVERAGE_PEAK
     assert coverage.select(peaked, 0, None)[0] == elm.select(peaked, 0, None)[0]
     # Inhibition of return masks its scores: the best unvisited tile next.
-    from ipomdp_gaze.inhibition import unvisited_choice
+    from ipomdp_gaze.model.inhibition import unvisited_choice
     visited = np.zeros(121, bool)
     visited[list(poses)[:11]] = True
     left = (poses - set(list(poses)[:11])).pop()

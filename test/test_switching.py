@@ -1,14 +1,14 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """The switching searcher: tempered ELM before ``switch_at``, the ideal searcher from then on."""
-from ipomdp_gaze.fpoc import dprime_matrix, make_fpoc
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import CountObservation
+from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import CountObservation
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.policies.greedy import expected_percent_correct
 from ipomdp_gaze.policies.registry import build_policy
 from ipomdp_gaze.policies.switching import SWITCH_AT, SwitchingSearcher
-from ipomdp_gaze.simulate import simulate
+from ipomdp_gaze.simulation.simulate import simulate
 import numpy as np
 import pytest
 

@@ -1,11 +1,11 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """GPOMDP training: exact gradients, the eligibility trace, improvement, resume and the CLI."""
-from ipomdp_gaze.belief import entropy
 from ipomdp_gaze.cli import main
-from ipomdp_gaze.fpoc import make_fpoc
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import GaussianObservation
+from ipomdp_gaze.model.belief import entropy
+from ipomdp_gaze.model.fpoc import make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import GaussianObservation
 from ipomdp_gaze.policies.conv import ConvPolicy, kernel_from_radial, kernel_matrix, radial_bins
 from ipomdp_gaze.policies.logistic import LogisticPolicy
 from ipomdp_gaze.policies.policy_file import load_policy, load_policy_spec, save_policy
@@ -244,9 +244,9 @@ def test_elm_initialisation_starts_training_at_elms_choices(tmp_path):
 
 def test_moving_and_absent_training_episodes_follow_the_model():
     """Targets walk, the belief is predicted, the infomax reward spans the N + 1 hypotheses."""
-    from ipomdp_gaze.belief import bayes_update
-    from ipomdp_gaze.motion import Motion
-    from ipomdp_gaze.stopping import initial_log_belief
+    from ipomdp_gaze.model.belief import bayes_update
+    from ipomdp_gaze.model.motion import Motion
+    from ipomdp_gaze.model.stopping import initial_log_belief
     grid = Grid(3, 4)
     model = GaussianObservation(grid, FPOC)
     motion = Motion(grid, 0.8, 0.05)

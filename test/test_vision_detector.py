@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The detector interface, the Haar cascade, grey conversion and the full-frame scan baseline."""
 import cv2
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.vision import detector as detector_module
 from ipomdp_gaze.vision.detector import (as_boxes, find_cascade, group_boxes, HaarDetector,
                                          REFERENCE_CASCADE, to_gray)

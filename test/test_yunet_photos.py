@@ -88,8 +88,8 @@ def test_group_pictures_are_reproducible_and_their_faces_are_found(yunet):
 
 @pytest.mark.parametrize('name', ['faces-420-yunet', 'faces-840-yunet', 'faces-pan-tilt-yunet'])
 def test_the_shipped_yunet_models_record_score_bins_and_rebuild_their_detector(name):
-    from ipomdp_gaze.observation_file import load_observation
-    from ipomdp_gaze.vision.cell_observation import cell_observation_of
+    from ipomdp_gaze.files.observation_file import load_observation
+    from ipomdp_gaze.model.cell_observation import cell_observation_of
     model = load_observation(name)
     rule = cell_observation_of(model.meta, model.max_count + 1)
     assert rule.kind == 'score_bins' and model.meta['detector']['kind'] == 'yunet'
@@ -100,6 +100,7 @@ def test_the_shipped_yunet_models_record_score_bins_and_rebuild_their_detector(n
 
 def test_find_with_the_yunet_model_finds_the_cameraman_that_haar_misses(tmp_path):
     import json
+
     from ipomdp_gaze.cli import main as cli
     photo = next(p for p in real_photos() if p.name == 'camera')
     path = tmp_path / 'camera.png'

@@ -29,7 +29,7 @@ import dataclasses
 from pathlib import Path
 import time
 
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.grid import Grid
 import numpy as np
 
 from .common import grid_arg, nonneg_int, positive_float, positive_int
@@ -191,8 +191,8 @@ def plot_fpoc(model, path: Path, title: str) -> None:
     """Heatmaps of the hit and false-alarm rates by offset, and both against distance."""
     import matplotlib
     matplotlib.use('Agg')
-    import matplotlib.pyplot as plt
     from ipomdp_gaze.vision.calibrate import hit_false_alarm
+    import matplotlib.pyplot as plt
     hit, fa = hit_false_alarm(model)
     fig, axes = plt.subplots(1, 3, figsize=(13, 4))
     for ax, data, name in ((axes[0], hit, 'P(c > 0 | target)'),
@@ -259,8 +259,8 @@ def _detector(args):
 
 def _cell_rule(args, pilot):
     """Return the cell observation rule of ``--cells``; ``pilot()`` tallies the edge images."""
+    from ipomdp_gaze.model.cell_observation import CellObservation
     from ipomdp_gaze.vision.calibrate import choose_edges
-    from ipomdp_gaze.vision.cell_observation import CellObservation
     if args.cells == 'threshold':
         if args.threshold is None:
             raise ValueError('--cells threshold needs --threshold T')
@@ -280,10 +280,10 @@ def _record_cells(meta: dict, cells, args) -> None:
 
 def run_pan_tilt(args) -> int:
     """Calibrate the pan/tilt task (``--pan-tilt``); see the module docstring."""
-    from ipomdp_gaze.observation_file import save_observation
+    from ipomdp_gaze.files.observation_file import save_observation
+    from ipomdp_gaze.model.head_camera import PinholeCamera
     from ipomdp_gaze.vision.calibrate import count_model, tally_pan_tilt_scenes
     from ipomdp_gaze.vision.detector import detector_settings
-    from ipomdp_gaze.head_camera import PinholeCamera
     from ipomdp_gaze.vision.pan_tilt import (CAMERA_HFOV_DEG, CAMERA_SIZE_PX, FACE_PX,
                                              PanTiltSceneSet, SceneGeometry)
     if args.scenes is None:
@@ -338,7 +338,7 @@ def run_pan_tilt(args) -> int:
 
 
 def run(args) -> int:
-    from ipomdp_gaze.observation_file import save_observation
+    from ipomdp_gaze.files.observation_file import save_observation
     from ipomdp_gaze.vision.calibrate import count_model, lattice_fixations, tally_images
     from ipomdp_gaze.vision.detector import detector_settings
     from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig

@@ -6,9 +6,9 @@ from __future__ import annotations
 import argparse
 import math
 
-from ipomdp_gaze.fpoc import make_fpoc, MODELS, parameter_names
-from ipomdp_gaze.grid import Grid, parse_grid
-from ipomdp_gaze.observation import MATRIX_MAX_CELLS
+from ipomdp_gaze.model.fpoc import make_fpoc, MODELS, parameter_names
+from ipomdp_gaze.model.grid import Grid, parse_grid
+from ipomdp_gaze.model.observation import MATRIX_MAX_CELLS
 import yaml
 
 
@@ -162,7 +162,7 @@ def task_from_args(args) -> tuple[Grid, object]:
     ``model`` is an FPOC (the Gaussian model) or the count model of ``--observation``.
     """
     if getattr(args, 'observation', None):
-        from ipomdp_gaze.observation_file import load_observation
+        from ipomdp_gaze.files.observation_file import load_observation
         options = (('grid', args.grid), ('fpoc', args.fpoc), ('fpoc-param', args.fpoc_param),
                    ('spacing-deg', args.spacing_deg))
         given = [f'--{name}' for name, value in options if value]

@@ -19,15 +19,16 @@ from pathlib import Path
 from ipomdp_gaze.drivers.pieces import concat_results, COSTLY_CHUNK, PLANNER_CHUNK, simulate_pieces
 from ipomdp_gaze.drivers.scene_eval import (evaluate_scenes, format_summary, paired_map_difference,
                                             results_json, summarise, task_spec, TASKS, write_json)
-from ipomdp_gaze.evaluation import (decision_summary, fixations_to_90_ci, paired_difference_ci,
-                                    paired_tracking_difference, tracking_summary)
-from ipomdp_gaze.executor import InlineExecutor
-from ipomdp_gaze.motion import Motion
-from ipomdp_gaze.observation import as_observation, GaussianObservation
-from ipomdp_gaze.observation_file import fingerprint
+from ipomdp_gaze.files.observation_file import fingerprint
+from ipomdp_gaze.model.motion import Motion
+from ipomdp_gaze.model.observation import as_observation, GaussianObservation
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
-from ipomdp_gaze.session import SearchSettings
-from ipomdp_gaze.simulate import draw_present, draw_targets
+from ipomdp_gaze.search.session import SearchSettings
+from ipomdp_gaze.simulation.evaluation import (decision_summary, fixations_to_90_ci,
+                                               paired_difference_ci, paired_tracking_difference,
+                                               tracking_summary)
+from ipomdp_gaze.simulation.executor import InlineExecutor
+from ipomdp_gaze.simulation.simulate import draw_present, draw_targets
 import numpy as np
 
 from .common import add_task_args, nonneg_int, positive_int, task_from_args
@@ -119,14 +120,18 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
     as the ideal searcher's does) runs on the first ``episodes_greedy`` episodes only. When any
     option of docs/design.md section 7 is given (not None; the others then take their defaults
     0, 0, 0, 0, 0.95 and the horizon), the result also records all six and each policy gets
-    ``decisions`` (:func:`ipomdp_gaze.evaluation.decision_summary`) and, for a moving target,
-    ``tracking`` (:func:`ipomdp_gaze.evaluation.tracking_summary`). Without them the result is
+    ``decisions`` (:func:`ipomdp_gaze.simulation.evaluation.decision_summary`) and, for a moving
+    target,
+    ``tracking`` (:func:`ipomdp_gaze.simulation.evaluation.tracking_summary`). Without them the
+    result is
     exactly the paper task's. With ``paired``, ``result['paired']`` holds each later policy
     minus the first: the difference of fixations to 90% on their common episodes with a paired
-    bootstrap interval. The simulations run on ``executor`` (:mod:`ipomdp_gaze.executor`;
+    bootstrap interval. The simulations run on ``executor``
+    (:mod:`ipomdp_gaze.simulation.executor`;
     default: here), a slow searcher in pieces of ``COSTLY_CHUNK`` episodes
     (``PLANNER_CHUNK`` for the planner), with the same numbers wherever they run; ``bar``
-    (:class:`ipomdp_gaze.progress.Progress`) counts episodes, ``progress(name, entry)`` is
+    (:class:`ipomdp_gaze.simulation.progress.Progress`) counts episodes, ``progress(name, entry)``
+    is
     called as each policy's entry is ready.
     """
     scene = (motion_sigma_cells, jump_prob, absent_prior, absent_rate, confidence,

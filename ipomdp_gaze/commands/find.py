@@ -55,8 +55,8 @@ from pathlib import Path
 import sys
 
 import cv2
-from ipomdp_gaze.belief import uniform_log_belief
-from ipomdp_gaze.observation_file import load_observation, shipped_image_models
+from ipomdp_gaze.files.observation_file import load_observation, shipped_image_models
+from ipomdp_gaze.model.belief import uniform_log_belief
 from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
 from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, FIND_SETTINGS,

@@ -73,8 +73,8 @@ def run_record(args) -> int:
 
 
 def run_replay(args) -> int:
-    from ipomdp_gaze.bag import read_bag
     from ipomdp_gaze.drivers.replay import describe_size, replay
+    from ipomdp_gaze.files.bag import read_bag
     if not args.path.is_dir():
         raise ValueError(f'{args.path} is not a bag directory')
     bag = read_bag(args.path)

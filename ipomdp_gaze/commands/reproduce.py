@@ -17,7 +17,7 @@ import resource
 import time
 
 from ipomdp_gaze.drivers.pieces import COSTLY_CHUNK, PieceCache, PLANNER_CHUNK, Runner
-from ipomdp_gaze.fpoc import dprime_table
+from ipomdp_gaze.model.fpoc import dprime_table
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.policies.conv import radial_bins
 from ipomdp_gaze.policies.planner import make_planner, TemperedELM

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import os
 
-from ipomdp_gaze.executor import make_executor, SCHEDULER_ENV
-from ipomdp_gaze.progress import Progress
+from ipomdp_gaze.simulation.executor import make_executor, SCHEDULER_ENV
+from ipomdp_gaze.simulation.progress import Progress
 
 from .common import positive_int
 

@@ -5,11 +5,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ipomdp_gaze.observation import as_observation
+from ipomdp_gaze.model.observation import as_observation
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
-from ipomdp_gaze.sensors import ModelSensor
-from ipomdp_gaze.sensors import run_search as run_offline
-from ipomdp_gaze.session import SearchSession, SearchSettings
+from ipomdp_gaze.search.sensors import ModelSensor
+from ipomdp_gaze.search.sensors import run_search as run_offline
+from ipomdp_gaze.search.session import SearchSession, SearchSettings
 import numpy as np
 
 from .common import add_task_args, cell_arg, cell_index, nonneg_int, task_from_args
@@ -46,9 +46,9 @@ def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=
     """
     Run one simulated search on the search session, printing each fixation.
 
-    The model's own sampler is the world (:class:`ipomdp_gaze.sensors.ModelSensor`); one
+    The model's own sampler is the world (:class:`ipomdp_gaze.search.sensors.ModelSensor`); one
     generator, ``default_rng(seed)``, serves the policy and the noise; the loop is
-    :func:`ipomdp_gaze.sensors.run_search`. Returns ``(guess, path, belief)``.
+    :func:`ipomdp_gaze.search.sensors.run_search`. Returns ``(guess, path, belief)``.
     """
     rng = np.random.default_rng(seed)
     session = SearchSession(grid, model, policy, settings)

@@ -1,12 +1,12 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-The search settings as CLI flags, generated from the schema (:mod:`ipomdp_gaze.settings`).
+The search settings as CLI flags, generated from the schema (:mod:`ipomdp_gaze.search.settings`).
 
 A command names the settings it lets users change; each flag's name, type, placeholder and help
 come from the schema, as the node's parameters do. Each flag is parsed only as a number, a
 true/false switch or a cell (``ROW,COL``, the one cell rule of :func:`.common.cell_arg`);
-:class:`ipomdp_gaze.session.SearchSettings` checks every value, so a bad one gets the same
+:class:`ipomdp_gaze.search.session.SearchSettings` checks every value, so a bad one gets the same
 one-line message from every command and from the ``gaze_controller`` node
 (``confidence must be between 0 and 1 (exclusive), got 1.5``).
 """
@@ -15,8 +15,8 @@ from __future__ import annotations
 import argparse
 from dataclasses import replace
 
-from ipomdp_gaze.session import SearchSettings
-from ipomdp_gaze.settings import by_key, SCHEMA
+from ipomdp_gaze.search.session import SearchSettings
+from ipomdp_gaze.search.settings import by_key, SCHEMA
 
 from .common import cell_arg, cell_index, probability_arg
 

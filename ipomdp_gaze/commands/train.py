@@ -12,7 +12,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ipomdp_gaze.session import SearchSettings
+from ipomdp_gaze.search.session import SearchSettings
 
 from .common import add_task_args, nonneg_int, positive_float, positive_int, task_from_args
 from .running import add_run_args, executor_from_args, progress_from_args
@@ -94,8 +94,8 @@ def _list(kind):
 
 def _task(args, spec):
     """Return the task of the command line or of the resumed file (explicit options must agree)."""
-    from ipomdp_gaze.fpoc import make_fpoc
-    from ipomdp_gaze.grid import Grid
+    from ipomdp_gaze.model.fpoc import make_fpoc
+    from ipomdp_gaze.model.grid import Grid
     from ipomdp_gaze.policies.policy_file import PolicyFileError
     if spec is None:
         return task_from_args(args)
@@ -122,7 +122,7 @@ def _task(args, spec):
 
 def _count_task(args, spec):
     """Return the count model of a resumed file: ``--observation`` must give the same one."""
-    from ipomdp_gaze.observation_file import fingerprint, load_observation
+    from ipomdp_gaze.files.observation_file import fingerprint, load_observation
     from ipomdp_gaze.policies.policy_file import PolicyFileError
     if spec.observation is None:
         raise PolicyFileError(f'--observation differs from the resumed file {args.resume} '
@@ -245,10 +245,10 @@ def run_sweep(args, grid, model, config, params, init, out) -> int:
     """
     from dataclasses import replace
 
-    from ipomdp_gaze.executor import track
     from ipomdp_gaze.drivers.pieces import train_piece
     from ipomdp_gaze.policies.policy_file import save_policy
     from ipomdp_gaze.policies.training import write_curve
+    from ipomdp_gaze.simulation.executor import track
     import numpy as np
     seeds = args.seeds if args.seeds is not None else [config.seed]
     rates = args.learning_rates

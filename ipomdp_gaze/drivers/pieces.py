@@ -4,8 +4,9 @@
 Seeded pieces of simulation work, their cache on disk, and the runner that spreads them.
 
 A run of ``episodes`` searches is split into pieces of rows ``start:stop``
-(:func:`ipomdp_gaze.simulate.simulate` with ``rows``); each piece is sent to an executor
-(:mod:`ipomdp_gaze.executor`: this process, a local pool or a Dask cluster) and its result
+(:func:`ipomdp_gaze.simulation.simulate.simulate` with ``rows``); each piece is sent to an executor
+(:mod:`ipomdp_gaze.simulation.executor`: this process, a local pool or a Dask cluster) and its
+result
 depends only on its arguments, so the assembled matrices are the same wherever the pieces ran.
 :class:`PieceCache` keeps every finished piece on disk (written here, in the client, as each
 piece finishes, so an interrupted run keeps what it finished), and :class:`Runner` assembles
@@ -22,12 +23,13 @@ import os
 from pathlib import Path
 import time
 
-from ipomdp_gaze.evaluation import bootstrap_counts, fixations_to_90_ci, paired_difference_ci
-from ipomdp_gaze.executor import InlineExecutor, source_digest
-from ipomdp_gaze.fpoc import dprime_matrix
-from ipomdp_gaze.observation import GaussianObservation
+from ipomdp_gaze.model.fpoc import dprime_matrix
+from ipomdp_gaze.model.observation import GaussianObservation
 from ipomdp_gaze.policies.greedy import expected_percent_correct_at
-from ipomdp_gaze.simulate import draw_targets, SearchResult, simulate
+from ipomdp_gaze.simulation.evaluation import (bootstrap_counts, fixations_to_90_ci,
+                                               paired_difference_ci)
+from ipomdp_gaze.simulation.executor import InlineExecutor, source_digest
+from ipomdp_gaze.simulation.simulate import draw_targets, SearchResult, simulate
 import numpy as np
 
 # The slow searchers (policies whose class sets ``costly = True``) are split into pieces of this
@@ -166,16 +168,19 @@ class Runner:
     """
     Simulate policies on shared targets and noise; keep each one's per-episode matrices.
 
-    Every run is submitted to ``executor`` (:mod:`ipomdp_gaze.executor`; None runs each piece
+    Every run is submitted to ``executor`` (:mod:`ipomdp_gaze.simulation.executor`; None runs each
+    piece
     here) in pieces of ``chunk`` episodes: each piece is the rows ``start:stop`` of the whole run
-    (:func:`ipomdp_gaze.simulate.simulate` with ``rows``), so a deterministic policy's matrix is
+    (:func:`ipomdp_gaze.simulation.simulate.simulate` with ``rows``), so a deterministic policy's
+    matrix is
     the one a single serial run gives, wherever and on however many workers the pieces ran. A
     stochastic policy's own draws come from one stream per piece (fixed ``chunk``, so still
     deterministic). :meth:`collect` waits for every submitted run and keeps, per name,
     ``correct`` (MAP guess right), ``map_prob`` (``max_i B_i``), CPU ``seconds`` and
     ``decisions``. Pieces found in ``cache`` (a :class:`PieceCache`) are not run again; each new
     one is stored there by this process as soon as it finishes (so Ctrl-C keeps the finished
-    ones). ``progress`` (``add(n)`` / ``update(n)``, :class:`ipomdp_gaze.progress.Progress`)
+    ones). ``progress`` (``add(n)`` / ``update(n)``,
+    :class:`ipomdp_gaze.simulation.progress.Progress`)
     counts episodes as their pieces finish. Used by ``reproduce`` and
     ``bench/planner_vs_greedy.py``. With ``rao_blackwell`` (Gaussian FPOC model), ``map_prob``
     holds ``E[max_i B'_i]`` given the belief and fixation before each observation
@@ -310,7 +315,8 @@ def simulate_pieces(executor, grid, model, policy, episodes: int, horizon, seed:
     Returns the futures of the pieces, in row order; :func:`concat_results` of their results is
     the whole run. ``chunk`` None (or at least ``episodes``) is one piece, the plain run
     without ``rows`` (so a stochastic policy keeps the unsplit run's own stream); otherwise
-    pieces of ``chunk`` rows (:func:`ipomdp_gaze.simulate.simulate` with ``rows``): exactly
+    pieces of ``chunk`` rows (:func:`ipomdp_gaze.simulation.simulate.simulate` with ``rows``):
+    exactly
     the unsplit rows for a deterministic policy, and for a stochastic one a result that depends
     on ``chunk`` but not on the executor. ``options`` are passed on (``targets``, ``present``,
     ``motion`` ...); ``progress`` (``add`` / ``update``) counts episodes as pieces finish.

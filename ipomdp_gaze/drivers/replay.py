@@ -3,10 +3,11 @@
 """
 Replay a recorded search: its frames through the controller's core, with its settings or others.
 
-A bag written by the ``recorder`` node (:mod:`ipomdp_gaze.bag`) holds the frames of evidence the
+A bag written by the ``recorder`` node (:mod:`ipomdp_gaze.files.bag`) holds the frames of evidence
+the
 controller was offered (``evidence_image``, stamped, or ``evidence``), the targets it sent
 (``pan_tilt``, one stamp per target), its events (``found``, ``absent``, ``gave_up``) and its
-parameters. :func:`replay` builds a :class:`ipomdp_gaze.gaze.GazeController` from those
+parameters. :func:`replay` builds a :class:`ipomdp_gaze.search.gaze.GazeController` from those
 parameters, with any of them replaced (``overrides``: another observation model, policy,
 confidence ...), drives it with ``reset`` and ``offer(evidence, stamp_s, now_s)`` exactly as the
 node did (``now_s``: when the node sent the next target) and compares each decision with the
@@ -25,11 +26,11 @@ import dataclasses
 from dataclasses import dataclass, field
 import math
 
-from ipomdp_gaze.controller_config import build_config
-from ipomdp_gaze.gaze import GazeController
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.head import PanTiltMap
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.policies.registry import build_policy
+from ipomdp_gaze.search.controller_config import build_config
+from ipomdp_gaze.search.gaze import GazeController
 import numpy as np
 
 CONTROLLER = 'gaze_controller'
@@ -112,7 +113,8 @@ def build_controller(values: dict) -> tuple[GazeController, PanTiltMap]:
     """
     Build the core and the head mapping from the ``gaze_controller`` parameters, as the node does.
 
-    The node's own builder (:func:`ipomdp_gaze.controller_config.build_config`), so a recording
+    The node's own builder (:func:`ipomdp_gaze.search.controller_config.build_config`), so a
+    recording
     replays with every check the node makes (a count model's grid and pan/tilt spacing among
     them).
 
@@ -222,7 +224,7 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
     """
     Re-run the recorded frames through the controller; print and return where decisions differ.
 
-    ``bag`` is an :class:`ipomdp_gaze.bag.Bag`; ``overrides`` replace recorded settings
+    ``bag`` is an :class:`ipomdp_gaze.files.bag.Bag`; ``overrides`` replace recorded settings
     (:data:`OVERRIDES`).
     """
     recorded_values = bag.parameters(CONTROLLER)
@@ -344,7 +346,7 @@ def new_search(bag, overrides: dict | None = None, out=print):
         If the recording is not of a fixed camera or holds no image.
 
     """
-    from ipomdp_gaze.detection import build_setup
+    from ipomdp_gaze.vision.detection import build_setup
     from ipomdp_gaze.vision.search import search_image
     detector = bag.parameters(DETECTOR)
     if detector.get('mode') != 'fovea':

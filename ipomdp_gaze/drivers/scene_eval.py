@@ -30,15 +30,15 @@ import math
 from pathlib import Path
 import re
 
-from ipomdp_gaze.evaluation import answer_is_right, wilson_interval
-from ipomdp_gaze.executor import InlineExecutor, track
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.head import PanTiltMap
-from ipomdp_gaze.observation_file import load_observation
-from ipomdp_gaze.sensors import run_search
-from ipomdp_gaze.session import PARAMETER_NAMES, SearchSession, SearchSettings
-from ipomdp_gaze.settings import check_parameters
-from ipomdp_gaze.yaml_files import yaml_parameters
+from ipomdp_gaze.files.observation_file import load_observation
+from ipomdp_gaze.files.yaml_files import yaml_parameters
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head import PanTiltMap
+from ipomdp_gaze.search.sensors import run_search
+from ipomdp_gaze.search.session import PARAMETER_NAMES, SearchSession, SearchSettings
+from ipomdp_gaze.search.settings import check_parameters
+from ipomdp_gaze.simulation.evaluation import answer_is_right, wilson_interval
+from ipomdp_gaze.simulation.executor import InlineExecutor, track
 import numpy as np
 
 TASKS = ('pan-tilt', 'faces-420', 'faces-840')
@@ -113,7 +113,7 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
         if name in SWEEP_RULES and task != 'pan-tilt':
             raise ValueError(f'{name} is a pan/tilt answer rule')
     if task == 'pan-tilt':
-        from ipomdp_gaze.share_files import config_file
+        from ipomdp_gaze.files.share_files import config_file
         path = config_file('faces_camera_controller.yaml')
         values = yaml_parameters(path, 'gaze_controller')
         base = check_parameters(values, grid=Grid(values['grid.rows'], values['grid.cols']),
@@ -250,7 +250,7 @@ class _Task:
         from ipomdp_gaze.policies.registry import build_policy
         self.spec = spec
         if spec.task == 'pan-tilt':
-            from ipomdp_gaze.detection import build_setup
+            from ipomdp_gaze.vision.detection import build_setup
             from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, SceneGeometry
             from ipomdp_gaze.vision.sensors import PanTiltSensor
             setup = build_setup('camera', spec.model)
@@ -364,7 +364,7 @@ def _sweep_rule(spec: TaskSpec, task: _Task, scene, index: int, rule: str) -> Sc
     or grouped with min_neighbors 3 / 5: the largest group) and answer its cell. No detection
     in the whole pass: ``absent``.
     """
-    from ipomdp_gaze.head_camera import bin_points
+    from ipomdp_gaze.model.head_camera import bin_points
     from ipomdp_gaze.vision.detector import box_centres_px, group_boxes
     grid = task.model.grid
     poses, owner = task.sweep.poses, task.sweep.owner
@@ -440,7 +440,8 @@ def evaluate_scenes(spec: TaskSpec, episodes: int, executor=None,
     Search scenes ``0..episodes-1`` of ``spec``; one piece of work per scene, in scene order.
 
     Returns ``{searcher: [SceneResult per scene]}``, ``spec``'s policy first. ``executor`` is
-    an :mod:`ipomdp_gaze.executor` executor (in-process when None: a local pool or a Dask
+    an :mod:`ipomdp_gaze.simulation.executor` executor (in-process when None: a local pool or a
+    Dask
     cluster give the same results); ``progress`` anything with ``update(n)``.
     """
     executor = InlineExecutor() if executor is None else executor

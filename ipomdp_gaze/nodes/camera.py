@@ -9,7 +9,7 @@ is still at the old cell; a repeated command for the cell it is moving to is ign
 cell it is at takes ``saccade_time_s`` to settle again). With ``rate_hz = 0`` it publishes one
 evidence frame when it arrives; with ``rate_hz > 0`` it publishes frames at that rate like a video
 camera, including while it moves. Each frame is drawn from the Gaussian observation model with
-the camera's own FPOC (:meth:`ipomdp_gaze.observation.GaussianObservation.sample`), with NaN
+the camera's own FPOC (:meth:`ipomdp_gaze.model.observation.GaussianObservation.sample`), with NaN
 where the FPOC gives ``d' = 0`` (outside the field of view, not observed).
 
 Publishes ``evidence`` (``Float32MultiArray``, best effort) or, with ``publish_image``, the
@@ -22,7 +22,7 @@ there); and ``ground_truth`` (``std_msgs/Int32MultiArray`` ``[row, col]``, trans
 
 Beyond the paper (docs/design.md section 7): with ``empty_scene`` there is no target (every
 frame is null noise) from the start or the next ``~/reset``; with ``target_motion_rate_hz > 0``
-the target takes a step of :class:`ipomdp_gaze.motion.Motion` (``target_motion_sigma_cells``,
+the target takes a step of :class:`ipomdp_gaze.model.motion.Motion` (``target_motion_sigma_cells``,
 ``target_jump_prob`` per step) that many times a second and ``ground_truth`` follows it. A
 controller models that walk with ``motion.sigma_cells = target_motion_sigma_cells *
 sqrt(target_motion_rate_hz)`` and ``motion.jump_prob = 1 - (1 - target_jump_prob) **
@@ -33,11 +33,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 import sys
 
-from ipomdp_gaze.controller_config import fpoc_from, grid_from, head_from, row_col_from
-from ipomdp_gaze.head import PanTiltMap
-from ipomdp_gaze.motion import check_probability, check_sigma_cells, Motion
+from ipomdp_gaze.model.head import PanTiltMap
+from ipomdp_gaze.model.motion import check_probability, check_sigma_cells, Motion
+from ipomdp_gaze.model.observation import GaussianObservation
 from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
-from ipomdp_gaze.observation import GaussianObservation
+from ipomdp_gaze.search.controller_config import fpoc_from, grid_from, head_from, row_col_from
 import numpy as np
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy

@@ -3,7 +3,7 @@
 """
 The ``gaze_controller`` node: I-POMDP gaze control of a pan/tilt head.
 
-A thin wrapper: :class:`ipomdp_gaze.gaze.GazeController` holds the belief and decides, and
+A thin wrapper: :class:`ipomdp_gaze.search.gaze.GazeController` holds the belief and decides, and
 :mod:`msg_adapters` reads and fills every message. Relative topic names, so namespaces and
 remapping work:
 
@@ -36,16 +36,16 @@ from __future__ import annotations
 import sys
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-from ipomdp_gaze.belief import EvidenceError
-from ipomdp_gaze.controller_config import build_config
-from ipomdp_gaze.controller_config import ControllerConfig as Config
-from ipomdp_gaze.controller_config import grid_from
-from ipomdp_gaze.gaze import FrameSequence
-from ipomdp_gaze.health import HealthMonitor
+from ipomdp_gaze.model.belief import EvidenceError
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, stamps
 from ipomdp_gaze.policies.baselines import STRATEGIES
 from ipomdp_gaze.policies.conv import ACTIONS, check_kernel
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnavailable
+from ipomdp_gaze.search.controller_config import build_config
+from ipomdp_gaze.search.controller_config import ControllerConfig as Config
+from ipomdp_gaze.search.controller_config import grid_from
+from ipomdp_gaze.search.gaze import FrameSequence
+from ipomdp_gaze.search.health import HealthMonitor
 from rclpy.exceptions import NameValidationException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -124,7 +124,7 @@ def controller_params() -> list[Param]:
 
 
 class GazeControllerNode(Node):
-    """ROS 2 wrapper of :class:`ipomdp_gaze.gaze.GazeController`."""
+    """ROS 2 wrapper of :class:`ipomdp_gaze.search.gaze.GazeController`."""
 
     def __init__(self, **kwargs):
         super().__init__(NODE_NAME, **kwargs)

@@ -21,13 +21,13 @@ from pathlib import Path
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray
-from ipomdp_gaze.belief import entropy
-from ipomdp_gaze.controller_config import fpoc_from, grid_from, head_from, observation_from
-from ipomdp_gaze.evaluation import answer_is_right, RIGHT_RADIUS_CELLS
-from ipomdp_gaze.head import PanTiltMap
+from ipomdp_gaze.files.share_files import config_file
+from ipomdp_gaze.files.yaml_files import yaml_parameters
+from ipomdp_gaze.model.belief import entropy
+from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, joints
-from ipomdp_gaze.share_files import config_file
-from ipomdp_gaze.yaml_files import yaml_parameters
+from ipomdp_gaze.search.controller_config import fpoc_from, grid_from, head_from, observation_from
+from ipomdp_gaze.simulation.evaluation import answer_is_right, RIGHT_RADIUS_CELLS
 import numpy as np
 from sensor_msgs.msg import Image
 
@@ -175,7 +175,7 @@ def faces_setup(fovea: bool = False, policy: str | None = None, seed: int = 0,
     if fovea:
         side = yaml_parameters(files['scene_camera'], 'scene_camera').get('scene.size_px', 420)
         image_px = (int(side), int(side))
-    from ipomdp_gaze.observation_file import load_observation
+    from ipomdp_gaze.files.observation_file import load_observation
     scan = bool(values.get('search.scan', True)) and \
         load_observation(values['observation.file']).has_scan
     camera = {'seed': seed, 'scene.empty': True} if empty else {'seed': seed}

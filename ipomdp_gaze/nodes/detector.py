@@ -3,7 +3,7 @@
 """
 The ``foveal_detector`` node: camera images in, one frame of detection counts per fixation out.
 
-A thin wrapper: :class:`ipomdp_gaze.detection.DetectorLoop` decides which image serves which
+A thin wrapper: :class:`ipomdp_gaze.vision.detection.DetectorLoop` decides which image serves which
 fixation and counts its detections, and :mod:`msg_adapters` reads and fills every message
 (docs/design.md section 6.6). Two modes (``mode``, read-only):
 
@@ -27,7 +27,7 @@ Relative topic names:
 A malformed image (another encoding, a step or data length that disagrees with the size, an
 empty or oversized image, a stamp that breaks the time sanity rule) is rejected with a throttled
 warning naming the reason and counted; so are absurd joint states, ``camera_info`` and
-fixations (:mod:`ipomdp_gaze.detection`). Every callback runs under a
+fixations (:mod:`ipomdp_gaze.vision.detection`). Every callback runs under a
 :class:`ipomdp_gaze.nodes.guard.CallbackGuard`: an unexpected error is counted
 (``callback_errors``) and the node carries on. Run with ``ros2 run ipomdp_gaze detector`` (or
 ``ipomdp-gaze detector``).
@@ -38,11 +38,11 @@ from dataclasses import dataclass
 import sys
 
 from diagnostic_msgs.msg import DiagnosticArray
-from ipomdp_gaze.controller_config import head_from
-from ipomdp_gaze.detection import (build_setup, DetectorLoop, DetectorSetup, MAX_AGE_S, MODES,
-                                   STAMP_TOLERANCE_S)
-from ipomdp_gaze.head import PanTiltMap
+from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, stamps
+from ipomdp_gaze.search.controller_config import head_from
+from ipomdp_gaze.vision.detection import (build_setup, DetectorLoop, DetectorSetup, MAX_AGE_S,
+                                          MODES, STAMP_TOLERANCE_S)
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import CameraInfo, Image, JointState
@@ -157,7 +157,7 @@ def _detector_settings(values: dict) -> dict:
 
 
 class FovealDetectorNode(Node):
-    """ROS 2 wrapper of :class:`ipomdp_gaze.detection.DetectorLoop`."""
+    """ROS 2 wrapper of :class:`ipomdp_gaze.vision.detection.DetectorLoop`."""
 
     def __init__(self, **kwargs):
         super().__init__(NODE_NAME, **kwargs)

@@ -18,8 +18,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 
-from ipomdp_gaze.fpoc import CameraFPOC, MODELS
-from ipomdp_gaze.settings import SCHEMA
+from ipomdp_gaze.model.fpoc import CameraFPOC, MODELS
+from ipomdp_gaze.search.settings import SCHEMA
 from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
                                 SetParametersResult)
 from rclpy.parameter import Parameter
@@ -153,7 +153,7 @@ def cell_params(prefix: str, what: str, unset: str) -> list[Param]:
 
     ``what`` names the cell (``'the target'``) and ``unset`` says what -1 means, with ``{}`` for
     the word row or column (``'a random {} at each reset'``);
-    :func:`ipomdp_gaze.controller_config.row_col_from` reads them.
+    :func:`ipomdp_gaze.search.controller_config.row_col_from` reads them.
     """
     return [Param(f'{prefix}_{axis[:3]}', -1, T.INTEGER,
                   f'{axis} of {what} (-1: {unset.format(axis)})',
@@ -166,7 +166,7 @@ _PARAMETER_TYPES = {'float': T.DOUBLE, 'int': T.INTEGER, 'bool': T.BOOL, 'floats
 
 def search_params(schema=SCHEMA) -> list[Param]:
     """
-    Return the search settings as parameters, generated from :mod:`ipomdp_gaze.settings`.
+    Return the search settings as parameters, generated from :mod:`ipomdp_gaze.search.settings`.
 
     The start cell is declared as ``start_row`` / ``start_col`` (:func:`cell_params`).
     """

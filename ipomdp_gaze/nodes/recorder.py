@@ -92,8 +92,8 @@ def recorder_params() -> list[Param]:
 
 def file_hashes(parameters: dict) -> dict:
     """``{name or path: sha256}`` of the policy and observation files named by parameters."""
+    from ipomdp_gaze.files.observation_file import resolve_source as observation_source
     from ipomdp_gaze.policies.policy_file import resolve_source as policy_source
-    from ipomdp_gaze.observation_file import resolve_source as observation_source
     out = {}
     for values in parameters.values():
         for key, resolve in (('policy.file', policy_source),
@@ -119,8 +119,8 @@ class RecorderNode(Node):
         self._transaction.declare()
         values = self._transaction.values()
         self._transaction.start(self._build(values))
-        from ipomdp_gaze.bag import open_writer
-        from ipomdp_gaze.share_files import package_version
+        from ipomdp_gaze.files.bag import open_writer
+        from ipomdp_gaze.files.share_files import package_version
         self.writer = open_writer(values['path'], values['compression'])
         self.writer.set_custom_data('ipomdp_gaze/version', package_version())
         self.connections = {}

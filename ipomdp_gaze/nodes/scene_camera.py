@@ -30,10 +30,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 import sys
 
-from ipomdp_gaze.controller_config import head_from
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.head_camera import PinholeCamera
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head_camera import PinholeCamera
 from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
+from ipomdp_gaze.search.controller_config import head_from
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import CameraInfo, Image, JointState

@@ -22,7 +22,7 @@ Where a pixel is on the grid is a :class:`CellMap`: the cell row of every pixel 
 column of every pixel column (-1 off the grid). A fixed camera's grid tiles the image
 (:func:`fovea_cell_map`, the fovea's ``floor(i * size / n)`` edges); a camera on the pan/tilt head
 shows a rectangle of cells that depends on where the head points (:func:`view_cell_map`, the
-mapping of :mod:`ipomdp_gaze.head_camera`). Both are separable, which keeps the overlay a
+mapping of :mod:`ipomdp_gaze.model.head_camera`). Both are separable, which keeps the overlay a
 repeat of a ``(rows, cols)`` colour table: about 3 ms for a 320x240 view and 7 ms for a
 420x420 image on this project's 2-core machine
 (``bench/annotate.py``).
@@ -32,8 +32,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import cv2
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.head_camera import PinholeCamera, pixel_cells
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head_camera import PinholeCamera, pixel_cells
 import numpy as np
 
 # Log10 range of the belief overlay, relative to the most likely cell.

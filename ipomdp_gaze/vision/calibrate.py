@@ -35,9 +35,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.observation import CountObservation
-from ipomdp_gaze.vision.cell_observation import CellObservation, quantile_edges
+from ipomdp_gaze.model.cell_observation import CellObservation, quantile_edges
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import CountObservation
 from ipomdp_gaze.vision.detectors import detector_from_spec
 from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig
 import numpy as np
@@ -201,7 +201,7 @@ def choose_edges(tallies: Tallies, max_count: int) -> CellObservation:
     """
     Return the ``score_bins`` rule of K = ``max_count`` whose bins share out the training scores.
 
-    The edges are :func:`ipomdp_gaze.vision.cell_observation.quantile_edges` of
+    The edges are :func:`ipomdp_gaze.model.cell_observation.quantile_edges` of
     ``tallies.scores`` (the best score of every observed cell holding a detection), ``K - 1``
     bins; a detector with fewer distinct scores gets fewer bins (a smaller K).
     """
@@ -224,13 +224,13 @@ def _resolve(item):
 def _run_jobs(worker, jobs: list, total: Tallies, processes: int, progress,
               executor=None) -> Tallies:
     """
-    Add ``worker(job)`` of every job to ``total``, on ``executor`` (:mod:`ipomdp_gaze.executor`).
+    Add ``worker(job)`` of every job to ``total``, on ``executor`` (an executor of ``simulation``).
 
     Without an executor, ``processes`` local workers (1: here). ``job[3]`` is the job's list of
     images or scenes: ``progress`` gets its length as each job finishes. The parts are added in
     job order, so the tallies are the same wherever the jobs ran.
     """
-    from ipomdp_gaze.executor import make_executor
+    from ipomdp_gaze.simulation.executor import make_executor
     own = executor is None
     executor = make_executor(processes) if own else executor
     try:
@@ -275,7 +275,8 @@ def tally_images(items, detector_kwargs: dict, grid: Grid, config: FoveaConfig,
     fixations : array of int, optional
         The fixated cells of every image (default: all; see :func:`lattice_fixations`).
     executor : optional
-        Where the chunks run (:func:`ipomdp_gaze.executor.make_executor`); the tallies do not
+        Where the chunks run (:func:`ipomdp_gaze.simulation.executor.make_executor`); the tallies
+        do not
         depend on it.
     cells : CellObservation, optional
         What a cell's observation is (default: the clipped count); its K is the fovea's.
@@ -320,7 +321,7 @@ def tally_views(observer, geometry, scene_image: np.ndarray, target_cell: int | 
 def _worker_tally_views(job) -> Tallies:
     """Tally pan/tilt scenes in a worker process (its own detector)."""
     import cv2
-    from ipomdp_gaze.head_camera import observed_cells
+    from ipomdp_gaze.model.head_camera import observed_cells
     from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, ViewObserver
     cv2.setNumThreads(1)
     detector_spec, max_count, scene_kwargs, indices, null_scenes, cells = job
@@ -376,7 +377,7 @@ def tally_pan_tilt_scenes(scenes, indices, detector_kwargs: dict, max_count: int
     progress : callable, optional
         Called with the number of scenes done after each chunk.
     executor : optional
-        Where the chunks run (:func:`ipomdp_gaze.executor.make_executor`).
+        Where the chunks run (:func:`ipomdp_gaze.simulation.executor.make_executor`).
     cells : CellObservation, optional
         What a cell's observation is (default: the clipped count); its K must be ``max_count``.
 

@@ -57,12 +57,11 @@ import time
 from typing import NamedTuple
 
 import cv2
-from ipomdp_gaze.checks import positive_int as _positive_int
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.vision.cell_observation import CellObservation
+from ipomdp_gaze.model.cell_observation import CellObservation
+from ipomdp_gaze.model.checks import positive_int as _positive_int
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.vision.detector import (as_detections, box_centres_px, detector_color,
-                                         detector_settings, detector_window_px,
-                                         to_detector_image)
+                                         detector_settings, detector_window_px, to_detector_image)
 import numpy as np
 
 REFERENCE_WINDOWS_CELLS = (21, 15, 9, 3)
@@ -306,7 +305,7 @@ class Fovea:
     reuse_windows : bool
         Keep every window's detections for the current image, not only the whole-image window's.
     cells : CellObservation, optional
-        What a cell's observation is (:mod:`ipomdp_gaze.vision.cell_observation`); default the
+        What a cell's observation is (:mod:`ipomdp_gaze.model.cell_observation`); default the
         count of detections centred in it, clipped to ``config.max_count - 1``. Its K must be
         ``config.max_count``.
 

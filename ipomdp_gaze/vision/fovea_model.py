@@ -4,11 +4,12 @@
 The fovea an observation model was measured with, and the check that a model fits a fovea.
 
 Vision layer, below every driver: ``find`` (:mod:`ipomdp_gaze.vision.search`), the detector
-node's logic (:mod:`ipomdp_gaze.detection`) and the offline evaluation build their fovea here.
+node's logic (:mod:`ipomdp_gaze.vision.detection`) and the offline evaluation build their fovea
+here.
 """
 from __future__ import annotations
 
-from ipomdp_gaze.vision.cell_observation import cell_observation_of
+from ipomdp_gaze.model.cell_observation import cell_observation_of
 from ipomdp_gaze.vision.detector import detector_settings
 from ipomdp_gaze.vision.detectors import compare_settings, detector_from_settings, info_keys_of
 from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import time
 
 import cv2
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.vision.detector import (as_detections, box_centres_px, DEFAULT_MIN_NEIGHBORS,
                                          detector_color, detector_window_px, group_boxes,
                                          to_detector_image)

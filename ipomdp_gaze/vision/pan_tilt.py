@@ -4,14 +4,14 @@
 The pan/tilt face task: a scene a head camera looks around in, its views, and their counts.
 
 Pixels and scenes; the geometry itself (pixel to cell with K and the head pose) is in
-:mod:`ipomdp_gaze.head_camera` (docs/design.md section 6.5).
+:mod:`ipomdp_gaze.model.head_camera` (docs/design.md section 6.5).
 
 **The scene.** :class:`SceneGeometry` is a flat panorama indexed by direction: it spans the
 grid's extreme cell centres plus half the camera's field of view on each side, at
 ``px_per_deg`` pixels per degree (by default the camera's own resolution on its optical axis,
 ``fx pi / 180``, so things appear at the same size at the centre of a view as in the scene).
 :meth:`SceneGeometry.render` draws the view of a head pose with the mapping of
-:mod:`ipomdp_gaze.head_camera`: view pixel ``(u, v)`` shows the scene in the direction
+:mod:`ipomdp_gaze.model.head_camera`: view pixel ``(u, v)`` shows the scene in the direction
 ``(c_h + atan((u - cx) / fx) / spacing, r_h + atan((v - cy) / fy) / spacing)``, so rendering and
 binning agree exactly. :class:`PanTiltSceneSet` pastes a face into such a scene, built like
 :class:`ipomdp_gaze.vision.scenes.SceneSet` (the same faces, photos and train/test split).
@@ -31,12 +31,12 @@ import math
 import time
 
 import cv2
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.head_camera import bin_points, PinholeCamera
-from ipomdp_gaze.vision.cell_observation import CellObservation
+from ipomdp_gaze.model.cell_observation import CellObservation
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head_camera import bin_points, PinholeCamera
 from ipomdp_gaze.vision.detector import (as_detections, box_centres_px, detector_color,
                                          detector_window_px, to_detector_image)
-from ipomdp_gaze.vision.scenes import (_paste, load_background, load_faces, Scene, SPLITS)
+from ipomdp_gaze.vision.scenes import _paste, load_background, load_faces, Scene, SPLITS
 import numpy as np
 
 # The shipped pan/tilt face task: an 11x11 grid of 5-degree cells (config/controller.yaml), a

@@ -42,7 +42,7 @@ from pathlib import Path
 from typing import Iterator, NamedTuple
 
 import cv2
-from ipomdp_gaze.checks import positive_int as _positive_int
+from ipomdp_gaze.model.checks import positive_int as _positive_int
 import numpy as np
 
 TRAIN_FACES = range(0, 60)

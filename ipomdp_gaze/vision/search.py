@@ -4,7 +4,7 @@
 Search one image for the target with the digital fovea and a count model (docs/design.md 6).
 
 :func:`search_image` is the whole loop of the CVPR 2009 follow-up on one decoded image, run by the
-search session (:mod:`ipomdp_gaze.session`) with the fovea as its sensor:
+search session (:mod:`ipomdp_gaze.search.session`) with the fovea as its sensor:
 
 1. start the fovea on the image (grey conversion); with a fovea that scans once
    (``scan_once``), observe the whole-image windows and apply their one Bayes step with the
@@ -45,10 +45,10 @@ from dataclasses import dataclass, replace
 import math
 import time
 
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.many import OccupancySession
-from ipomdp_gaze.sensors import run_search
-from ipomdp_gaze.session import Frame, SearchSession, SearchSettings
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.search.many import OccupancySession
+from ipomdp_gaze.search.sensors import run_search
+from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
 from ipomdp_gaze.vision.detector import detector_window_px
 from ipomdp_gaze.vision.detectors import detector_from_settings  # noqa: F401 (its old home)
 from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea
@@ -276,7 +276,7 @@ def search_image(image: np.ndarray, fovea: Fovea, model, policy,
     """
     Search one decoded image with the fovea, the count model and a policy (module docstring).
 
-    A thin driver of the search session (:mod:`ipomdp_gaze.session`) with the fovea as its
+    A thin driver of the search session (:mod:`ipomdp_gaze.search.session`) with the fovea as its
     sensor (:class:`ipomdp_gaze.vision.sensors.FoveaSensor`).
 
     Parameters
@@ -528,14 +528,14 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     """
     Search one image for every face at once: the many-target belief (``search.targets: many``).
 
-    One search session over the occupancy of every cell (:class:`ipomdp_gaze.many.
+    One search session over the occupancy of every cell (:class:`ipomdp_gaze.search.many.
     OccupancySession`): the scan, then the fixation with the largest expected drop of the
     summed cell entropies per detector pixel, until every cell is decided at the confidence
     (or the budget, or ``pixel_budget``: one full scan for ``find``). The faces are the clusters
     of occupied cells, each counted once and split where the detector's merged boxes are
-    distinct faces (:func:`ipomdp_gaze.occupancy.count_faces`, cells within ``link`` of each
+    distinct faces (:func:`ipomdp_gaze.model.occupancy.count_faces`, cells within ``link`` of each
     other are one cluster); cells within ``settle`` of an occupied cell need no decision of
-    their own (:class:`~ipomdp_gaze.many.OccupancySession`, ``link``). ``decision`` is
+    their own (:class:`~ipomdp_gaze.search.many.OccupancySession`, ``link``). ``decision`` is
     ``found`` when a face was reported, else ``absent`` (or ``gave_up``).
 
     Raises

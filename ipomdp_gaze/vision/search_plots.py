@@ -68,9 +68,9 @@ def save_figure(picture: np.ndarray, out_path: Path, title: str) -> None:
     """Save an annotated picture with a title and the belief's scale (format: the suffix's)."""
     import matplotlib
     matplotlib.use('Agg')
-    import matplotlib.pyplot as plt
     from matplotlib.cm import ScalarMappable
     from matplotlib.colors import Normalize
+    import matplotlib.pyplot as plt
     height, width = picture.shape[:2]
     fig_w = 7.0
     fig, ax = plt.subplots(figsize=(fig_w, fig_w * height / width * 0.9 + 0.6))

@@ -1,18 +1,18 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-Sensors over pixels (:class:`ipomdp_gaze.sensors.Sensor`).
+Sensors over pixels (:class:`ipomdp_gaze.search.sensors.Sensor`).
 
 The fovea over a still image, and the pan/tilt head's camera looking around a scene.
 
 Both run a real detector and count its raw detections per cell, exactly as the ROS detector node
-does (:mod:`ipomdp_gaze.detection`), so an offline search through them is the node's search
+does (:mod:`ipomdp_gaze.vision.detection`), so an offline search through them is the node's search
 without the transport.
 """
 from __future__ import annotations
 
-from ipomdp_gaze.head_camera import PinholeCamera
-from ipomdp_gaze.session import Frame
+from ipomdp_gaze.model.head_camera import PinholeCamera
+from ipomdp_gaze.search.session import Frame
 from ipomdp_gaze.vision.fovea import Fovea
 from ipomdp_gaze.vision.pan_tilt import SceneGeometry, ViewObserver
 

@@ -6,7 +6,8 @@ Progress of a long job on stderr.
 A bar with an ETA on a terminal, a line every few seconds otherwise (CI logs), nothing when
 quiet.
 
-Jobs advance it as their pieces finish (:func:`ipomdp_gaze.executor.track`), so what it shows
+Jobs advance it as their pieces finish (:func:`ipomdp_gaze.simulation.executor.track`), so what it
+shows
 is work done wherever it ran.
 """
 from __future__ import annotations

@@ -19,9 +19,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 
+from ipomdp_gaze.model.grid import Grid
 import numpy as np
-
-from .grid import Grid
 
 
 @dataclass(frozen=True)

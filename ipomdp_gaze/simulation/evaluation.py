@@ -175,14 +175,14 @@ def mean_ci(values: np.ndarray) -> dict:
 
 def search_outcomes(result, confidence: float, max_fixations: int | None = None):
     """
-    Classify every search by its first decision (:func:`ipomdp_gaze.stopping.first_decisions`).
+    Classify every search by its first decision (:func:`ipomdp_gaze.model.stopping`).
 
     Returns ``(outcome, fixations)``: ``outcome[e]`` indexes :data:`OUTCOMES`: ``right`` (found
     at the target's cell at that moment, or absent in an empty scene), ``wrong_found`` (found
     anywhere else, or in an empty scene), ``wrong_absent`` (absent while the target is there) or
     ``gave_up``; ``fixations[e]`` up to the decision (the budget when it gave up).
     """
-    from .stopping import ABSENT, first_decisions, FOUND
+    from ipomdp_gaze.model.stopping import ABSENT, first_decisions, FOUND
     kind, fixations = first_decisions(result.map_prob, result.absent_prob, confidence,
                                       max_fixations)
     rows = np.arange(kind.size)

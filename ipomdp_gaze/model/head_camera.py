@@ -4,11 +4,11 @@
 What a camera on a pan/tilt head sees: pixels to grid cells (docs/design.md section 6.5).
 
 Pure geometry, numpy only. The grid is the controller's pan/tilt grid: cell ``(r, c)`` is the
-head pose of :class:`ipomdp_gaze.head.PanTiltMap`, and directions are measured in grid units
+head pose of :class:`ipomdp_gaze.model.head.PanTiltMap`, and directions are measured in grid units
 from the grid's centre, columns to the right and rows down (as image x and y).
 
 A view taken with the head at grid position ``(r_h, c_h)`` (the cell it was sent to, or the
-unrounded position its joint angles give, :meth:`ipomdp_gaze.head.PanTiltMap.position`) by a
+unrounded position its joint angles give, :meth:`ipomdp_gaze.model.head.PanTiltMap.position`) by a
 pinhole camera with intrinsics ``K = [fx 0 cx; 0 fy cy; 0 0 1]`` shows pixel ``(u, v)`` at the
 cell::
 
@@ -26,8 +26,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 
-from ipomdp_gaze.checks import finite as _finite
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.checks import finite as _finite
+from ipomdp_gaze.model.grid import Grid
 import numpy as np
 
 

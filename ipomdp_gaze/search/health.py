@@ -4,7 +4,7 @@
 What the gaze controller says about itself: its health and the values it reports.
 
 Once per diagnostics period the ``gaze_controller`` node asks :class:`HealthMonitor` for a
-:class:`Health` report of its :class:`ipomdp_gaze.gaze.GazeController` and publishes it on
+:class:`Health` report of its :class:`ipomdp_gaze.search.gaze.GazeController` and publishes it on
 ``/diagnostics``. The decision itself is :func:`classify`, from what happened since the last
 period:
 
@@ -125,7 +125,7 @@ def policy_label(name: str, kernel=None, file: str = '', action: str = 'argmax')
 
 class HealthMonitor:
     """
-    Health reports of a :class:`ipomdp_gaze.gaze.GazeController`, one per period.
+    Health reports of a :class:`ipomdp_gaze.search.gaze.GazeController`, one per period.
 
     It remembers when the last report was made and the frame counters at that time, so each
     report speaks of the period since (frames arrived, rejections, the evidence rate).

@@ -18,7 +18,7 @@ independently. The prediction of the cell mass ``B`` is therefore
 
     B'_d = (1 - jump_prob) * sum_s B_s G[s, d] + jump_prob * (sum_s B_s) / N
 
-and an absent hypothesis (:mod:`ipomdp_gaze.stopping`) is left alone. ``sigma_cells = 0`` and
+and an absent hypothesis (:mod:`ipomdp_gaze.model.stopping`) is left alone. ``sigma_cells = 0`` and
 ``jump_prob = 0`` is a target that stays put (no prediction at all).
 
 Units: ``sigma_cells`` and ``jump_prob`` are per fixation in simulation and training. In the
@@ -30,11 +30,10 @@ from __future__ import annotations
 
 import math
 
+from ipomdp_gaze.model.belief import normalize_log
+from ipomdp_gaze.model.checks import check_probability, check_sigma_cells  # noqa: F401
+from ipomdp_gaze.model.grid import Grid
 import numpy as np
-
-from .belief import normalize_log
-from .checks import check_probability, check_sigma_cells  # noqa: F401
-from .grid import Grid
 
 TRUNCATE_SIGMAS = 3.0
 ALMOST_ONE = math.nextafter(1.0, 0.0)
@@ -46,15 +45,20 @@ def axis_transition(size: int, sigma_cells: float) -> np.ndarray:
 
     ``g(k) = exp(-k^2 / (2 sigma^2))`` for ``|k| <= ceil(3 sigma)`` and 0 beyond; the sum runs
     over the ``size`` positions of the axis, so each row sums to 1 (mass kept inside the grid).
-    ``sigma_cells = 0`` gives the identity.
+    ``sigma_cells = 0`` gives the identity. ``g`` is evaluated once per offset ``k`` in
+    ``-R..R`` and laid out along the diagonals (row x is the table ``g(x' - x)`` seen from x):
+    the same entries, row sums and quotients as evaluating it for every pair of positions.
     """
     sigma = check_sigma_cells(sigma_cells)
     if sigma == 0:
         return np.eye(size)
-    radius = math.ceil(TRUNCATE_SIGMAS * sigma)
-    x = np.arange(size)
-    offset = x[None, :] - x[:, None]
-    weights = np.where(np.abs(offset) <= radius, np.exp(-0.5 * (offset / sigma) ** 2), 0.0)
+    reach = min(math.ceil(TRUNCATE_SIGMAS * sigma), size - 1)
+    offset = np.arange(-reach, reach + 1)
+    table = np.zeros(2 * size - 1)              # entry size - 1 + k: g(k)
+    table[size - 1 - reach:size + reach] = np.exp(-0.5 * (offset / sigma) ** 2)
+    # Row x is table[size - 1 - x:][:size]: a view stepping back one entry per row, copied.
+    weights = np.ndarray((size, size), buffer=table, offset=(size - 1) * table.itemsize,
+                         strides=(-table.itemsize, table.itemsize)).copy()
     return weights / weights.sum(axis=1, keepdims=True)
 
 
@@ -78,9 +82,11 @@ class Motion:
         self.sigma_cells = check_sigma_cells(sigma_cells)
         self.jump_prob = check_probability(jump_prob, 'jump_prob')
         self.row_matrix = axis_transition(grid.rows, self.sigma_cells)
-        self.col_matrix = axis_transition(grid.cols, self.sigma_cells)
+        self.col_matrix = self.row_matrix if grid.cols == grid.rows else \
+            axis_transition(grid.cols, self.sigma_cells)
         self._row_t = np.ascontiguousarray(self.row_matrix.T)
-        self._cdf = [self._step_cdf(m) for m in (self.row_matrix, self.col_matrix)]
+        self._cdf = None                        # the step's CDFs, built on the first move
+        self._over = None                       # the last (seconds, Motion) of over()
 
     def __repr__(self):
         return f'Motion({self.grid!r}, sigma_cells={self.sigma_cells}, jump_prob={self.jump_prob})'
@@ -103,8 +109,12 @@ class Motion:
         belief is then uniform); ``seconds <= 0`` is no motion.
         """
         dt = max(0.0, float(seconds))
+        if self._over is not None and self._over[0] == dt:
+            return self._over[1]
         jump = min(1.0 - (1.0 - self.jump_prob) ** dt, ALMOST_ONE)
-        return Motion(self.grid, self.sigma_cells * math.sqrt(dt), jump)
+        motion = Motion(self.grid, self.sigma_cells * math.sqrt(dt), jump)
+        self._over = (dt, motion)
+        return motion
 
     # -- the belief ----------------------------------------------------------------------
     def transition_matrix(self) -> np.ndarray:
@@ -146,9 +156,10 @@ class Motion:
             return log_belief
         n = self.grid.n_cells
         peak = np.max(log_belief, axis=-1, keepdims=True)
-        cells = np.exp(log_belief[..., :n] - peak)
+        cells = np.subtract(log_belief[..., :n], peak)
+        moved = self.predict(np.exp(cells, out=cells))
         with np.errstate(divide='ignore'):
-            log_belief[..., :n] = np.log(self.predict(cells)) + peak
+            np.add(np.log(moved, out=moved), peak, out=log_belief[..., :n])
         return normalize_log(log_belief)
 
     # -- the target ----------------------------------------------------------------------
@@ -171,6 +182,8 @@ class Motion:
         u = rng.random(t.shape + (4,))
         cols = self.grid.cols
         r, c = np.divmod(t, cols)
+        if self._cdf is None:
+            self._cdf = [self._step_cdf(m) for m in (self.row_matrix, self.col_matrix)]
         row_cdf, col_cdf = self._cdf
         new_r = np.sum(u[..., 0, None] > row_cdf[r], axis=-1)
         new_c = np.sum(u[..., 1, None] > col_cdf[c], axis=-1)

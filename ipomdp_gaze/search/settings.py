@@ -4,10 +4,11 @@
 The search settings schema: every setting described once (docs/design.md section 10.1).
 
 Each :class:`Setting` gives a setting's field name, its parameter name (node, YAML, event log and
-every refusal message), its kind, default, the check of its values (:mod:`ipomdp_gaze.checks`)
+every refusal message), its kind, default, the check of its values
+(:mod:`ipomdp_gaze.model.checks`)
 and its help. Everything else is generated from :data:`SCHEMA`:
 
-- :class:`ipomdp_gaze.session.SearchSettings`, the frozen settings object, by
+- :class:`ipomdp_gaze.search.session.SearchSettings`, the frozen settings object, by
   :func:`settings_class` (its fields, defaults and checks);
 - the ``gaze_controller`` node's parameter declarations (``nodes/params.py``,
   ``search_params``), with the same help;
@@ -23,11 +24,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field, fields, make_dataclass, replace
 from typing import Callable, Mapping
 
-from .checks import (check_budget, check_confidence, check_flag, check_probability,
-                     check_radius, check_sigma_cells, check_start_cell, check_targets)
-from .false_alarms import (check_false_alarm_scales, check_hotspot_prior, check_hotspot_scale,
-                           DEFAULT_HOTSPOT_SCALE)
-from .still_evidence import check_repeat_weight
+from ipomdp_gaze.model.checks import (check_budget, check_confidence, check_flag,
+                                      check_probability, check_radius, check_sigma_cells,
+                                      check_start_cell, check_targets)
+from ipomdp_gaze.model.false_alarms import (check_false_alarm_scales, check_hotspot_prior,
+                                            check_hotspot_scale, DEFAULT_HOTSPOT_SCALE)
+from ipomdp_gaze.model.still_evidence import check_repeat_weight
 
 # What a setting's values are: the node declares them with the matching parameter type and a
 # CLI flag parses them so (a cell is ``ROW,COL``; the node declares it as two integers).
@@ -202,8 +204,9 @@ class SettingsBase:
 
 def _docstring(schema) -> str:
     lines = ['How a search decides and stops, checked once (the same message from every driver).',
-             '', 'Generated from :data:`ipomdp_gaze.settings.SCHEMA`; each field is checked',
-             'when the object is built and keeps its plain type.', '', 'Attributes', '----------']
+             '', 'Generated from :data:`ipomdp_gaze.search.settings.SCHEMA`; each field is',
+             'checked when the object is built and keeps its plain type.', '', 'Attributes',
+             '----------']
     for s in schema:
         lines += [f'{s.key} : {s.kind}', f'    ``{s.parameter}``: {s.help_text}.']
     return '\n'.join(lines) + '\n'
@@ -250,7 +253,7 @@ def check_parameters(values: Mapping, settings_cls=None, base=None, grid=None, w
     pass silently. Returns the settings object. ``where`` prefixes messages (a file name).
     """
     if settings_cls is None:
-        from .session import SearchSettings as settings_cls
+        from ipomdp_gaze.search.session import SearchSettings as settings_cls
     schema = settings_cls.SCHEMA
     known = {s.parameter: s for s in schema}
     namespaces = {s.parameter.split('.')[0] + '.' for s in schema if '.' in s.parameter}

@@ -6,7 +6,7 @@ The scalar checks every layer uses: one place for each rule and its message.
 Each check takes the value and the name users know it by (a parameter, a flag, a field), returns
 the value in its plain Python type and raises ``ValueError`` with one line that starts with the
 name and ends with ``got <value>``. Booleans are never numbers here (``True`` is not a count).
-The search settings (:mod:`ipomdp_gaze.settings`) name the check of each setting.
+The search settings (:mod:`ipomdp_gaze.search.settings`) name the check of each setting.
 """
 from __future__ import annotations
 

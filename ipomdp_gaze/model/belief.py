@@ -5,7 +5,7 @@ Belief over the target's cell: the one Bayes step, rewards and the MAP guess.
 
 The belief is kept in the log domain. Every consumer (controller, simulator, Gymnasium env,
 ``search``, training, benches) updates it with :func:`bayes_update`, adding the per-cell
-log-likelihood ratio of a frame that an observation model (:mod:`ipomdp_gaze.observation`)
+log-likelihood ratio of a frame that an observation model (:mod:`ipomdp_gaze.model.observation`)
 computed, then renormalising (paper eq. 6; docs/design.md section 1). All functions work on a
 single belief (N,) or a batch (episodes, N).
 """
@@ -71,8 +71,10 @@ def bayes_update(log_belief: np.ndarray, log_likelihood_ratio: np.ndarray,
 def entropy(belief: np.ndarray) -> np.ndarray:
     """Shannon entropy ``-sum_i B_i log B_i`` in nats (0 log 0 = 0)."""
     b = np.asarray(belief, dtype=float)
-    with np.errstate(divide='ignore', invalid='ignore'):
-        terms = np.where(b > 0, b * np.log(np.where(b > 0, b, 1.0)), 0.0)
+    positive = b > 0
+    terms = np.zeros(b.shape)
+    np.log(b, out=terms, where=positive)
+    np.multiply(terms, b, out=terms, where=positive)
     return -np.sum(terms, axis=-1)
 
 
@@ -96,6 +98,9 @@ def argmax_ties_low(scores: np.ndarray, rtol: float = TIE_RTOL) -> np.ndarray:
     This is the project-wide tie rule (docs/design.md section 4), so runs are reproducible.
     """
     s = np.asarray(scores, dtype=float)
+    if s.ndim == 1:                             # one belief: scalar arithmetic, same numbers
+        peak = s.max()
+        return np.argmax(s >= peak - rtol * abs(peak))
     peak = np.max(s, axis=-1, keepdims=True)
     near = s >= peak - rtol * np.abs(peak)
     return np.argmax(near, axis=-1)

@@ -10,8 +10,8 @@ the gaze controller then take the policy's best cell among those not yet fixated
 """
 from __future__ import annotations
 
-from ipomdp_gaze.belief import argmax_ties_low
-from ipomdp_gaze.grid import Grid
+from ipomdp_gaze.model.belief import argmax_ties_low
+from ipomdp_gaze.model.grid import Grid
 import numpy as np
 
 

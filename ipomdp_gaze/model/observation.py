@@ -8,7 +8,8 @@ It answers two questions for a fixation k, on one frame (N,) or a batch (E, N):
 
 - ``log_likelihood_ratio(observation, fixation)``: the per-cell term
   ``log p(o | target at i) - log p(o | no target anywhere)`` that the one Bayes step
-  (:func:`ipomdp_gaze.belief.bayes_update`) adds to the log belief (cells whose observation is NaN
+  (:func:`ipomdp_gaze.model.belief.bayes_update`) adds to the log belief (cells whose observation
+  is NaN
   were not observed and add 0);
 - ``sample(targets, fixations, rng)``: frames drawn from the model, for simulation and training.
 
@@ -24,11 +25,10 @@ from __future__ import annotations
 import math
 import operator
 
+from ipomdp_gaze.model.belief import EvidenceError
+from ipomdp_gaze.model.fpoc import dprime_table, FPOC
+from ipomdp_gaze.model.grid import Grid
 import numpy as np
-
-from .belief import EvidenceError
-from .fpoc import dprime_table, FPOC
-from .grid import Grid
 
 OVERFLOW_REASON = 'evidence too large: d * (o - d/2) overflows float64'
 # Largest grid whose (fixation, cell) d' matrix is kept for batched look-ups (8 * N^2 bytes).
@@ -124,7 +124,7 @@ class GaussianObservation:
     Notes
     -----
     ``d_jk`` is read from the ``(2R-1, 2C-1)`` offset table
-    (:func:`ipomdp_gaze.fpoc.dprime_table`): the cells seen from k are the ``rows x cols``
+    (:func:`ipomdp_gaze.model.fpoc.dprime_table`): the cells seen from k are the ``rows x cols``
     window starting at ``(R-1-r_k, C-1-c_k)``, so a single frame never needs an N x N matrix.
     Batches of fixations use the N x N matrix ``d[k, j]``, built on first use for grids of up
     to :data:`MATRIX_MAX_CELLS` cells.

@@ -1,7 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-Sensors: what turns a scene and a fixation into a :class:`ipomdp_gaze.session.Frame`.
+Sensors: what turns a scene and a fixation into a :class:`ipomdp_gaze.search.session.Frame`.
 
 A sensor states its grid and whether it scans when built; :meth:`Sensor.start` gives it a scene,
 :meth:`Sensor.scan` the one-time scan (None when it has none) and :meth:`Sensor.observe` the frame
@@ -17,11 +17,10 @@ import math
 import time
 from typing import Protocol
 
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import as_observation
+from ipomdp_gaze.search.session import Frame, SearchSession
 import numpy as np
-
-from .grid import Grid
-from .observation import as_observation
-from .session import Frame, SearchSession
 
 
 class Sensor(Protocol):

@@ -13,7 +13,7 @@ It turns camera images into count frames for the controller, one frame per fixat
 - in ``camera`` mode that image must also be paired with the head's joint state of the same
   stamp (within ``tolerance_s``), the head must be at the fixated cell (an image taken on the
   way there is not used) and the camera's intrinsics must be known; the detections are binned
-  to pan/tilt cells with :mod:`ipomdp_gaze.head_camera`, cells outside the view are NaN;
+  to pan/tilt cells with :mod:`ipomdp_gaze.model.head_camera`, cells outside the view are NaN;
 - in ``fovea`` mode the grid tiles the image and the digital fovea is placed on the fixated cell
   (:class:`ipomdp_gaze.vision.fovea.Fovea`).
 
@@ -52,10 +52,10 @@ from dataclasses import dataclass, field
 import math
 import time
 
-from ipomdp_gaze.grid import Grid
-from ipomdp_gaze.head import PanTiltMap
-from ipomdp_gaze.head_camera import PinholeCamera
-from ipomdp_gaze.observation_file import load_observation
+from ipomdp_gaze.files.observation_file import load_observation
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head import PanTiltMap
+from ipomdp_gaze.model.head_camera import PinholeCamera
 import numpy as np
 
 MODES = ('fovea', 'camera')
@@ -149,10 +149,10 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
         the file (the file wins: it says what the counts were measured with).
 
     """
-    from ipomdp_gaze.vision.pan_tilt import ViewObserver
-    from ipomdp_gaze.vision.cell_observation import cell_observation_of
+    from ipomdp_gaze.model.cell_observation import cell_observation_of
     from ipomdp_gaze.vision.detectors import detector_from_settings
     from ipomdp_gaze.vision.fovea_model import fovea_for_model
+    from ipomdp_gaze.vision.pan_tilt import ViewObserver
     if mode not in MODES:
         raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
     name = source or DEFAULT_MODELS[mode]

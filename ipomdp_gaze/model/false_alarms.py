@@ -38,12 +38,11 @@ from __future__ import annotations
 
 import math
 
+from ipomdp_gaze.model.belief import normalize_log
+from ipomdp_gaze.model.checks import check_factor_above_one, check_in_range
+from ipomdp_gaze.model.observation import CountObservation
+from ipomdp_gaze.model.still_evidence import StillEvidence
 import numpy as np
-
-from .belief import normalize_log
-from .checks import check_factor_above_one, check_in_range
-from .observation import CountObservation
-from .still_evidence import StillEvidence
 
 MAX_SCALES = 8
 # A hotspot fires this many times as often as the model's null tables by default.

@@ -12,7 +12,7 @@ Format ``ipomdp_gaze/observation-v1`` (docs/design.md section 9)::
     fovea: {...}                          # the fovea settings it was measured with
     detector: {...}                       # the detector settings it was measured with
     cells: {kind: score_bins, ...}        # optional: what a cell's observation is (absent:
-                                          # the clipped count; ipomdp_gaze.vision.cell_observation)
+                                          # the clipped count; ipomdp_gaze.model.cell_observation)
     target: [[[p0, p1, ...], ...], ...]   # P(c | target, |dr|, |dc|): rows x cols x K
     null: [[[...]]]                       # P(c | no target, |dr|, |dc|): rows x cols x K
     scan: {target: [...], null: [...]}    # optional: P(c | target), P(c | no target) of the
@@ -32,11 +32,10 @@ import math
 from pathlib import Path
 import re
 
+from ipomdp_gaze.files.yaml_files import check_header, plain, read_yaml, write_yaml
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import CountObservation
 import numpy as np
-
-from .grid import Grid
-from .observation import CountObservation
-from .yaml_files import check_header, plain, read_yaml, write_yaml
 
 FORMAT = 'ipomdp_gaze/observation-v1'
 # What a policy file says it is (ipomdp_gaze.policies.policy_file.FORMAT; not imported: the
@@ -46,7 +45,7 @@ MODELS = ('counts',)
 REQUIRED = ('format', 'model', 'grid', 'target', 'null')
 KEYS = REQUIRED + ('image', 'fovea', 'detector', 'cells', 'calibration', 'scan')
 RECORDS = ('image', 'fovea', 'detector', 'cells', 'calibration')
-MODEL_DIR = Path(str(resources.files(__package__).joinpath('models')))
+MODEL_DIR = Path(str(resources.files('ipomdp_gaze').joinpath('models')))
 # Counts per cell a file may tabulate (K); far above any detector's clipped count.
 MAX_K = 256
 
@@ -187,7 +186,7 @@ def model_from_dict(doc, source: str = '') -> CountObservation:
     except ValueError as exc:
         raise ObservationFileError(str(exc)) from None
     if 'cells' in meta:
-        from .vision.cell_observation import cell_observation_of
+        from ipomdp_gaze.model.cell_observation import cell_observation_of
         try:
             cell_observation_of(meta, model.max_count + 1)
         except (TypeError, ValueError) as exc:

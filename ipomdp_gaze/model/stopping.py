@@ -7,9 +7,9 @@ A target that may be absent, and when a search stops (docs/design.md section 7).
 hypothesis N, "there is no target in the grid", with prior ``absent_prior``; the cells share the
 rest, ``(1 - absent_prior) / N`` each. Under it every cell draws from the null model, so its
 log-likelihood ratio against "no target anywhere" is exactly 0 and a frame's Bayes step is the
-usual one (:func:`ipomdp_gaze.belief.bayes_update`) on the N + 1 log probabilities with a 0
+usual one (:func:`ipomdp_gaze.model.belief.bayes_update`) on the N + 1 log probabilities with a 0
 appended to the frame's terms. The N cell probabilities then sum to ``1 - P(absent)``. The motion
-step (:mod:`ipomdp_gaze.motion`) leaves the absent mass alone. With ``absent_prior = 0`` the
+step (:mod:`ipomdp_gaze.model.motion`) leaves the absent mass alone. With ``absent_prior = 0`` the
 belief has N entries, exactly as without this module.
 
 **Stopping.** After each frame, with the confidence level ``c``:
@@ -28,10 +28,10 @@ from __future__ import annotations
 
 import math
 
+from ipomdp_gaze.model.belief import bayes_update, uniform_log_belief
+from ipomdp_gaze.model.checks import (check_budget, check_confidence,  # noqa: F401
+                                      check_probability)
 import numpy as np
-
-from .belief import bayes_update, uniform_log_belief
-from .checks import check_budget, check_confidence, check_probability  # noqa: F401
 
 # Decision codes of :func:`decide` and :func:`first_decisions`.
 UNDECIDED, FOUND, ABSENT = 0, 1, 2
@@ -54,7 +54,8 @@ def initial_log_belief(n_cells: int, absent_prior: float = 0.0,
     """
     Return the prior's log probabilities: N cells, plus the absent hypothesis when it is used.
 
-    With ``absent_prior = 0`` this is :func:`ipomdp_gaze.belief.uniform_log_belief` (N columns).
+    With ``absent_prior = 0`` this is :func:`ipomdp_gaze.model.belief.uniform_log_belief` (N
+    columns).
     Otherwise the last of N + 1 columns is ``log(absent_prior)`` and each cell has
     ``log((1 - absent_prior) / N)``.
     """
@@ -141,7 +142,7 @@ class BatchBelief:
     The beliefs of a batch of searches, ``(E, N)`` or ``(E, N + 1)``, and their one Bayes step.
 
     The batched counterpart of a search session's belief, shared by the simulator
-    (:func:`ipomdp_gaze.simulate.simulate`) and policy-gradient training
+    (:func:`ipomdp_gaze.simulation.simulate.simulate`) and policy-gradient training
     (:func:`ipomdp_gaze.policies.training.sample_episodes`): the prior, the step
     ``log B += llr`` with the absent hypothesis's 0 (:func:`with_absent`) and renormalisation,
     the infomax reward ``sum_h B_h log B_h`` over every hypothesis (0 log 0 = 0 where a motion

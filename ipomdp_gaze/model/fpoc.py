@@ -16,10 +16,9 @@ from __future__ import annotations
 import math
 from typing import Callable
 
+from ipomdp_gaze.model.grid import Grid
 import numpy as np
 from scipy.special import ndtr, ndtri
-
-from .grid import Grid
 
 EDGE_TOL_DEG = 1e-9
 

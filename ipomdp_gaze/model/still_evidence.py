@@ -18,9 +18,8 @@ best view, between them a partial discount of the repeats.
 """
 from __future__ import annotations
 
+from ipomdp_gaze.model.checks import check_in_range
 import numpy as np
-
-from .checks import check_in_range
 
 
 def check_repeat_weight(weight: float, name: str = 'repeat_weight') -> float:
@@ -41,7 +40,7 @@ def cell_information(kernel: np.ndarray, grid, fixation: int) -> np.ndarray:
     How much a frame from ``fixation`` says about each cell: ELM's kernel at the cell's offset.
 
     ``kernel`` is an observation model's ``elm_kernel()`` on ``grid`` (an offset table,
-    :meth:`ipomdp_gaze.grid.Grid.fixation_window`: ``2 KL(p_target || p_null)`` for a count
+    :meth:`ipomdp_gaze.model.grid.Grid.fixation_window`: ``2 KL(p_target || p_null)`` for a count
     model, ``d'^2`` for the Gaussian one). Returns ``(N,)``, 0 where the frame says nothing.
     """
     return grid.fixation_window(kernel, *grid.cell(int(fixation))).reshape(-1)

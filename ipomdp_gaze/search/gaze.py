@@ -20,9 +20,10 @@ rest. Times are plain seconds on whatever clock the caller uses (the node's ROS 
 
 Beyond the paper (docs/design.md section 7): with motion on, the belief is predicted over the
 time since the last applied frame before each update (``sigma_cells`` and ``jump_prob`` per
-second, :meth:`ipomdp_gaze.motion.Motion.over`); with ``absent_prior > 0`` the belief has the
+second, :meth:`ipomdp_gaze.model.motion.Motion.over`); with ``absent_prior > 0`` the belief has the
 absent hypothesis, and :attr:`GazeController.belief` is the N cell probabilities, summing to
-``1 - P(absent)``. After each applied frame the stop rules of :mod:`ipomdp_gaze.stopping` run:
+``1 - P(absent)``. After each applied frame the stop rules of :mod:`ipomdp_gaze.model.stopping`
+run:
 ``found``, ``absent`` or, at the fixation budget, ``gave_up``. For a still target a decision ends
 the search: later frames are skipped and no new target is chosen until :meth:`reset`. With
 motion on, ``found`` and ``absent`` only report: the controller keeps tracking, and each event is
@@ -30,20 +31,20 @@ re-armed when its probability falls back below the confidence level. ``gave_up``
 in both cases (a budget never applies once a search has decided).
 
 The belief, the Bayes step, the stop rules and the choice of the next fixation are the search
-session's (:mod:`ipomdp_gaze.session`), which every driver runs; this class adds only what a live
+session's (:mod:`ipomdp_gaze.search.session`), which every driver runs; this class adds only what a
+live
 camera needs: times, settling, enable, counters and the events of a frame. Its settings are one
-:class:`ipomdp_gaze.session.SearchSettings`, checked once and replaced whole
+:class:`ipomdp_gaze.search.session.SearchSettings`, checked once and replaced whole
 (:meth:`GazeController.configure`).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ipomdp_gaze.model.belief import EvidenceError
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.search.session import SearchSession, SearchSettings
 import numpy as np
-
-from .belief import EvidenceError
-from .grid import Grid
-from .session import Frame, SearchSession, SearchSettings
 
 
 def check_settle_time(settle_time_s: float) -> float:
@@ -148,11 +149,12 @@ class GazeController:
         The visual array.
     observation
         The controller's model of its camera and detector: an observation model
-        (:mod:`ipomdp_gaze.observation`) or an FPOC (the Gaussian model).
+        (:mod:`ipomdp_gaze.model.observation`) or an FPOC (the Gaussian model).
     policy
         Anything with ``select(belief (1, N), t, rng)``.
     settings
-        How searches decide and stop (:class:`ipomdp_gaze.session.SearchSettings`); motion is
+        How searches decide and stop (:class:`ipomdp_gaze.search.session.SearchSettings`); motion
+        is
         per second here.
     settle_time_s
         Frames stamped earlier than this after the target was sent are skipped.
@@ -192,7 +194,7 @@ class GazeController:
 
     @property
     def motion(self):
-        """Return the target's motion per second (:class:`ipomdp_gaze.motion.Motion`)."""
+        """Return the target's motion per second (:class:`ipomdp_gaze.model.motion.Motion`)."""
         return self.session.motion
 
     def configure(self, settings: SearchSettings, settle_time_s: float | None = None) -> None:
@@ -351,7 +353,7 @@ class GazeController:
         sent at ``now_s``. A scan of another search, or one nobody waits for, is skipped.
         """
         try:
-            obs = self.session.check_frame(evidence)
+            frame = self.session.checked_frame(evidence, kind='scan')
         except EvidenceError as exc:
             return self.reject(str(exc))
         self.received += 1
@@ -365,7 +367,7 @@ class GazeController:
         if reason:
             self.skipped += 1
             return FrameResult('skipped', reason)
-        step = self.session.scan(Frame(obs, kind='scan'))
+        step = self.session.scan(frame)
         if not step.applied:
             self.rejected += 1
             self.last_rejection = step.reason
@@ -394,7 +396,7 @@ class GazeController:
 
         """
         try:
-            obs = self.session.check_frame(evidence)
+            frame = self.session.checked_frame(evidence)    # the one check of a frame's values
         except EvidenceError as exc:
             return self.reject(str(exc))
         self.received += 1
@@ -416,7 +418,7 @@ class GazeController:
             self.skipped += 1
             return FrameResult('skipped', 'taken before the fixation settled')
         dt_s = float(stamp_s) - self.update_time_s
-        step = self.session.update(Frame(obs), dt_s=dt_s)
+        step = self.session.update(frame, dt_s=dt_s)
         if not step.applied:
             self.rejected += 1
             self.last_rejection = step.reason

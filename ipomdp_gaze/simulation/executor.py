@@ -80,7 +80,7 @@ def source_digest() -> str:
     outlives a change of the files keeps the digest of the code it runs.
     """
     digest = hashlib.sha256()
-    package = Path(__file__).resolve().parent
+    package = Path(__file__).resolve().parents[1]
     for folder in (package, package / 'policies'):
         for path in sorted(folder.resolve().rglob('*.py')):
             digest.update(path.read_bytes())
@@ -327,7 +327,8 @@ def track(futures, progress=None, weights=None):
     """
     Yield the futures as they finish, advancing ``progress`` by each one's weight (default 1).
 
-    ``progress`` is anything with ``update(n)`` (:class:`ipomdp_gaze.progress.Progress`).
+    ``progress`` is anything with ``update(n)``
+    (:class:`ipomdp_gaze.simulation.progress.Progress`).
     Pieces of an :class:`InlineExecutor` are run here, one by one in submission order.
     """
     futures = list(futures)

@@ -3,16 +3,16 @@
 """
 The search session for many targets (``search.targets: many``; docs/design.md section 11).
 
-The same steps and results as :class:`ipomdp_gaze.session.SearchSession` (``reset``, ``scan``,
-``start``, ``update``, ``stop``; :class:`~ipomdp_gaze.session.StepResult`), so
-:func:`ipomdp_gaze.sensors.run_search` drives either, on the occupancy belief of
-:mod:`ipomdp_gaze.occupancy`:
+The same steps and results as :class:`ipomdp_gaze.search.session.SearchSession` (``reset``,
+``scan``, ``start``, ``update``, ``stop``; :class:`~ipomdp_gaze.search.session.StepResult`), so
+:func:`ipomdp_gaze.search.sensors.run_search` drives either, on the occupancy belief of
+:mod:`ipomdp_gaze.model.occupancy`:
 
 1. ``reset``: every cell's log odds ``log(q / (1 - q))`` with ``(1 - q)^N = absent_prior``
-   (:func:`~ipomdp_gaze.occupancy.cell_prior`; ``q = 1/N`` without one);
+   (:func:`~ipomdp_gaze.model.occupancy.cell_prior`; ``q = 1/N`` without one);
 2. ``scan``: ``L_j += log s_T(c_j) - log s_N(c_j)``;
 3. ``update``: ``L_j += l_j`` of the frame (the single-target belief's own term), with a still
-   scene's repeated views weighted by ``repeat_weight`` (:mod:`ipomdp_gaze.still_evidence`:
+   scene's repeated views weighted by ``repeat_weight`` (:mod:`ipomdp_gaze.model.still_evidence`:
    1 is naive Bayes);
 4. stop when every cell is decided at ``confidence`` either way (``P(x_j) >= c`` occupied,
    ``<= 1 - c`` empty; with ``link`` r > 0 a cell within r cells of an occupied one is
@@ -26,21 +26,22 @@ The same steps and results as :class:`ipomdp_gaze.session.SearchSession` (``rese
    so far, ``repeat_weight`` otherwise, and 0 for a cell settled by ``link``.
 
 The answer for drivers: :meth:`OccupancySession.faces` (one face per cluster of occupied cells,
-:func:`ipomdp_gaze.occupancy.count_faces`). The session imports no ROS, prints and writes nothing.
+:func:`ipomdp_gaze.model.occupancy.count_faces`). The session imports no ROS, prints and writes
+nothing.
 """
 from __future__ import annotations
 
 from collections import deque
 
+from ipomdp_gaze.model.belief import argmax_ties_low, EvidenceError
+from ipomdp_gaze.model.observation import as_observation, check_evidence, CountObservation
+from ipomdp_gaze.model.occupancy import (binary_entropy, cell_prior, count_faces, decided,
+                                         information_table, log_nobody, occupancy,
+                                         prior_log_odds)
+from ipomdp_gaze.model.still_evidence import StillEvidence
+from ipomdp_gaze.search.session import Frame, OrderError, SearchSettings, start_index, StepResult
 import numpy as np
 from scipy.ndimage import maximum_filter
-
-from .belief import argmax_ties_low, EvidenceError
-from .observation import as_observation, check_evidence, CountObservation
-from .occupancy import (binary_entropy, cell_prior, count_faces, decided, information_table,
-                        log_nobody, occupancy, prior_log_odds)
-from .session import Frame, OrderError, SearchSettings, start_index, StepResult
-from .still_evidence import StillEvidence
 
 # Gains below this (nats per unit cost, relative to the best) count as nothing left to learn.
 MIN_GAIN = 1e-9
@@ -161,7 +162,7 @@ class OccupancySession:
     log = property(lambda self: tuple(self._log))
 
     def faces(self, boxes=None, scores=None, image_px=None, link: int = 2) -> list[dict]:
-        """Return the faces, each counted once (:func:`ipomdp_gaze.occupancy.count_faces`)."""
+        """Return the faces, each counted once (:func:`ipomdp_gaze.model.occupancy.count_faces`)."""
         return count_faces(self.log_odds, self.grid, self.occupied(), boxes, scores, image_px,
                            link)
 

@@ -6,7 +6,8 @@ The controller's configuration from a flat parameter mapping: one pure builder f
 The ``gaze_controller`` node, ``ipomdp-gaze record`` / replay, the offline evaluation of the
 pan/tilt task and the benches describe a controller with the node's parameter names
 (``grid.*``, ``fpoc.*``, ``observation.*``, the joints, the search settings of
-:mod:`ipomdp_gaze.settings`, ``policy.*``). :func:`build_config` turns such a mapping into the
+:mod:`ipomdp_gaze.search.settings`, ``policy.*``). :func:`build_config` turns such a mapping into
+the
 grid, FPOC, observation model, pan/tilt mapping, settings and policy, with every check the node
 makes, so a recording replays and an evaluation runs exactly what the node would run.
 
@@ -19,14 +20,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable, Mapping
 
-from .fpoc import make_fpoc, parameter_names
-from .gaze import check_settle_time, GazeController
-from .grid import Grid
-from .head import PanTiltMap
-from .health import policy_label
-from .observation import GaussianObservation
-from .observation_file import load_observation
-from .session import SearchSettings
+from ipomdp_gaze.files.observation_file import load_observation
+from ipomdp_gaze.model.fpoc import make_fpoc, parameter_names
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head import PanTiltMap
+from ipomdp_gaze.model.observation import GaussianObservation
+from ipomdp_gaze.search.gaze import check_settle_time, GazeController
+from ipomdp_gaze.search.health import policy_label
+from ipomdp_gaze.search.session import SearchSettings
 
 POLICY_KEYS = ('policy.name', 'policy.file', 'policy.kernel', 'policy.action')
 OBSERVATION_KEYS = ('observation.model', 'observation.file')
@@ -142,7 +143,7 @@ class ControllerConfig:
                             v.get('policy.action', 'argmax'))
 
     def controller(self) -> GazeController:
-        """Return a new :class:`ipomdp_gaze.gaze.GazeController` with this configuration."""
+        """Return a new :class:`ipomdp_gaze.search.gaze.GazeController` with this configuration."""
         v = self.values
         return GazeController(self.grid, self.observation, self.policy, self.settings,
                               v['settle_time_s'], v['seed'])

@@ -10,7 +10,8 @@ of the last frame) and the current fixation. The reward is the infomax reward ``
 of the new belief (``reward='fixate_target'``: the belief at the fixated cell). An episode
 terminates when the most likely cell reaches ``confidence`` (in (0, 1), as everywhere) and is
 truncated after ``max_steps`` fixations; stepping on after it terminated needs a reset. The
-belief, the Bayes step and the stop rules are the search session's (:mod:`ipomdp_gaze.session`,
+belief, the Bayes step and the stop rules are the search session's
+(:mod:`ipomdp_gaze.search.session`,
 with the agent choosing every fixation). The hidden target is in ``info['target']`` for oracle
 baselines.
 
@@ -19,7 +20,7 @@ By default the observation model is the Gaussian model of ``fpoc`` on a ``rows x
 path or shipped name of an ``ipomdp_gaze/observation-v1`` file, and its grid.
 
 Beyond the paper (docs/design.md section 7), with the defaults off: ``motion_sigma_cells`` and
-``jump_prob`` make the target take a step of :class:`ipomdp_gaze.motion.Motion` after every
+``jump_prob`` make the target take a step of :class:`ipomdp_gaze.model.motion.Motion` after every
 fixation (the belief is predicted with the same step, so the observation is the belief the next
 fixation is chosen from; ``info`` describes the fixation just made, before the step); such an
 episode never terminates early, it tracks until ``max_steps``. ``absent_prior`` gives the belief
@@ -35,15 +36,14 @@ from pathlib import Path
 
 import gymnasium
 from gymnasium import spaces
+from ipomdp_gaze.files.render import belief_heatmap, belief_text
+from ipomdp_gaze.model.belief import map_cell
+from ipomdp_gaze.model.fpoc import FPOC, make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.motion import check_probability
+from ipomdp_gaze.model.observation import as_observation, GaussianObservation
+from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
 import numpy as np
-
-from .belief import map_cell
-from .fpoc import FPOC, make_fpoc
-from .grid import Grid
-from .motion import check_probability
-from .observation import as_observation, GaussianObservation
-from .render import belief_heatmap, belief_text
-from .session import Frame, SearchSession, SearchSettings
 
 ENV_ID = 'ipomdp_gaze/VisualSearch-v0'
 REWARDS = ('infomax', 'fixate_target')
@@ -65,7 +65,7 @@ class VisualSearchEnv(gymnasium.Env):
                  absent_prior: float = 0.0, absent_rate: float = 0.0):
         if observation is not None:
             if isinstance(observation, (str, Path)):
-                from .observation_file import load_observation
+                from ipomdp_gaze.files.observation_file import load_observation
                 observation = load_observation(observation)
             self.model = as_observation(observation.grid, observation)
             self.grid, self.fpoc = self.model.grid, getattr(self.model, 'fpoc', None)
@@ -194,7 +194,7 @@ class VisualSearchEnv(gymnasium.Env):
 def register_env() -> None:
     """Register :data:`ENV_ID` with Gymnasium (idempotent)."""
     if ENV_ID not in gymnasium.registry:
-        gymnasium.register(id=ENV_ID, entry_point='ipomdp_gaze.gym:VisualSearchEnv')
+        gymnasium.register(id=ENV_ID, entry_point='ipomdp_gaze.simulation.gym:VisualSearchEnv')
 
 
 register_env()

@@ -13,7 +13,7 @@ from pathlib import Path
 import sys
 
 PACKAGE = 'ipomdp_gaze'
-SOURCE_ROOT = Path(__file__).resolve().parents[1]
+SOURCE_ROOT = Path(__file__).resolve().parents[2]
 
 
 def share_dirs() -> list[Path]:

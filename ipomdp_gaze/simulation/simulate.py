@@ -10,7 +10,8 @@ own seeded streams, so every policy run with the same seed sees the same targets
 noise draws (common random numbers).
 
 Beyond the paper (docs/design.md section 7): the target may move between fixations (the true
-target follows a :class:`ipomdp_gaze.motion.Motion` and the belief is predicted with it, or not,
+target follows a :class:`ipomdp_gaze.model.motion.Motion` and the belief is predicted with it, or
+not,
 ``predict=False``), and scenes may be empty at a rate ``absent_rate`` that is set separately from
 the model's ``absent_prior`` (the belief's absent hypothesis). Target paths and empty scenes have
 their own streams, so they too are shared by every policy.
@@ -20,13 +21,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Protocol
 
+from ipomdp_gaze.model.belief import map_cell
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.motion import check_probability, Motion
+from ipomdp_gaze.model.observation import as_observation
+from ipomdp_gaze.model.stopping import BatchBelief, check_absent_prior
 import numpy as np
-
-from .belief import map_cell
-from .grid import Grid
-from .motion import check_probability, Motion
-from .observation import as_observation
-from .stopping import BatchBelief, check_absent_prior
 
 # Stream tags of the seed sequence: targets, noise per fixation, the policy's own draws, the
 # target's steps between fixations, and which scenes are empty.
@@ -161,7 +161,8 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
     grid
         The visual array.
     model
-        The observation model (:mod:`ipomdp_gaze.observation`), or an FPOC for the Gaussian one.
+        The observation model (:mod:`ipomdp_gaze.model.observation`), or an FPOC for the Gaussian
+        one.
     policy
         Anything with ``select(belief, t, rng)``; ``belief`` holds the N cell probabilities
         (summing to ``1 - P(absent)`` with the absent hypothesis).

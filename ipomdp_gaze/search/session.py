@@ -7,24 +7,28 @@ A search is a short sequence of pure steps on one belief over the N cells (plus,
 ``absent_prior > 0``, the hypothesis "no target in the grid"):
 
 1. :meth:`SearchSession.reset` -- the prior: ``(1 - absent_prior) / N`` per cell and
-   ``absent_prior`` on the absent hypothesis (:func:`ipomdp_gaze.stopping.initial_log_belief`);
+   ``absent_prior`` on the absent hypothesis
+   (:func:`ipomdp_gaze.model.stopping.initial_log_belief`);
 2. :meth:`SearchSession.scan` -- optional, once, before the first fixation: the one-time scan of
    a model with scan tables, ``log B_i += log s_T(c_i) - log s_N(c_i)``;
 3. :meth:`SearchSession.start` -- the first fixation: ``settings.start_cell``, or by default
    the policy's choice on the scanned belief after a scan and the grid's centre without one
    (docs/design.md section 4.2);
 4. :meth:`SearchSession.update` with each frame taken at the current fixation: predict the belief
-   over ``dt_s`` seconds (a moving target, :mod:`ipomdp_gaze.motion`), the Bayes step
+   over ``dt_s`` seconds (a moving target, :mod:`ipomdp_gaze.model.motion`), the Bayes step
    ``log B_i += log p_T(o_i | offset_ik) - log p_N(o_i | offset_ik)`` (or, for a still scene with
-   ``repeat_weight < 1``, the still-scene evidence of :mod:`ipomdp_gaze.still_evidence`), then
-   the stop rules (:func:`ipomdp_gaze.stopping.decide`): ``found``, ``absent`` (terminated: the
+   ``repeat_weight < 1``, the still-scene evidence of :mod:`ipomdp_gaze.model.still_evidence`),
+   then
+   the stop rules (:func:`ipomdp_gaze.model.stopping.decide`): ``found``, ``absent`` (terminated:
+   the
    evidence decided), ``gave_up`` (truncated: the budget, or every cell seen with
    ``stop_on_repeat``); if the search goes on, the policy chooses the next fixation.
 
-The session holds the model it *assumes*; a sensor (:mod:`ipomdp_gaze.sensors`) produces the
+The session holds the model it *assumes*; a sensor (:mod:`ipomdp_gaze.search.sensors`) produces the
 frames from the world, which may follow another model. The session imports no ROS, reads no
 clock (times arrive as ``dt_s``), prints nothing and writes nothing: drivers (the
-``gaze_controller`` node through :class:`ipomdp_gaze.gaze.GazeController`, ``ipomdp-gaze find``,
+``gaze_controller`` node through :class:`ipomdp_gaze.search.gaze.GazeController`, ``ipomdp-gaze
+find``,
 ``search``, the offline evaluation and the Gymnasium environment) build settings, a sensor and a
 session, then loop. Its per-search event log (:attr:`SearchSession.log`) is what drivers save.
 """
@@ -33,17 +37,16 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass, field
 
+from ipomdp_gaze.model.belief import bayes_update, entropy, EvidenceError, map_cell, normalize_log
+from ipomdp_gaze.model.false_alarms import FalseAlarmMixture
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.inhibition import policy_choice, unvisited_choice
+from ipomdp_gaze.model.motion import Motion
+from ipomdp_gaze.model.observation import as_observation, check_evidence, CountObservation
+from ipomdp_gaze.model.still_evidence import cell_information, StillEvidence
+from ipomdp_gaze.model.stopping import ABSENT, decide, FOUND, initial_log_belief, with_absent
+from ipomdp_gaze.search.settings import parameter_names, settings_class
 import numpy as np
-
-from .belief import bayes_update, entropy, EvidenceError, map_cell, normalize_log
-from .false_alarms import FalseAlarmMixture
-from .grid import Grid
-from .inhibition import policy_choice, unvisited_choice
-from .motion import Motion
-from .observation import as_observation, check_evidence, CountObservation
-from .settings import parameter_names, settings_class
-from .still_evidence import cell_information, StillEvidence
-from .stopping import ABSENT, decide, FOUND, initial_log_belief, with_absent
 
 # Decisions a search can end with; '' while undecided.
 DECISIONS = ('found', 'absent', 'gave_up')
@@ -52,7 +55,7 @@ DECISIONS = ('found', 'absent', 'gave_up')
 GAVE_UP_REASONS = ('budget', 'repeat')
 # The parameter (node, YAML) name of each setting: the name every refusal message uses.
 PARAMETER_NAMES = parameter_names()
-# The settings object, generated from the schema (ipomdp_gaze.settings.SCHEMA): one checked
+# The settings object, generated from the schema (ipomdp_gaze.search.settings.SCHEMA): one checked
 # field per setting; SearchSettings(confidence=0.99, max_fixations=60), replace() to change.
 SearchSettings = settings_class(module=__name__)
 
@@ -80,7 +83,8 @@ def _check_mixture_model(settings: SearchSettings, observation) -> None:
     """Refuse many targets, and false-alarm scales or hotspots without count tables to scale."""
     if settings.targets != 'one':
         raise ValueError(f"{PARAMETER_NAMES['targets']} {settings.targets} is searched by "
-                         f'ipomdp_gaze.many.OccupancySession; this session holds one target')
+                         f'ipomdp_gaze.search.many.OccupancySession; this session holds one '
+                         f'target')
     if not _wants_mixture(settings) or isinstance(observation, CountObservation):
         return
     name = 'false_alarm_scales' if len(settings.false_alarm_scales) > 1 else 'hotspot_prior'
@@ -106,7 +110,9 @@ class Frame:
     Gaussian model, a detection count for a count model; NaN means not observed. ``kind`` is
     ``'fixation'`` (taken at the session's current fixation) or ``'scan'`` (the one-time scan).
     ``detector_pixels`` and ``seconds`` are what producing it cost; ``detections`` any boxes
-    the sensor wants drivers to draw or record.
+    the sensor wants drivers to draw or record. A frame built by
+    :meth:`SearchSession.checked_frame` carries the session and model that checked it, so that
+    session does not check it again.
     """
 
     values: np.ndarray
@@ -114,14 +120,15 @@ class Frame:
     detector_pixels: int = 0
     seconds: float = 0.0
     detections: tuple = ()
+    _checked_by: tuple = field(default=(), init=False, repr=False, compare=False)
 
     def summary(self) -> dict:
         """Return what the event log keeps of a frame: cells observed, sum and peak, cost."""
         values = np.asarray(self.values, dtype=float)
-        seen = ~np.isnan(values)
-        return {'kind': self.kind, 'observed_cells': int(seen.sum()),
-                'sum': float(values[seen].sum()) if seen.any() else 0.0,
-                'peak': float(values[seen].max()) if seen.any() else None,
+        seen = values[~np.isnan(values)]
+        return {'kind': self.kind, 'observed_cells': int(seen.size),
+                'sum': float(seen.sum()) if seen.size else 0.0,
+                'peak': float(seen.max()) if seen.size else None,
                 'detector_pixels': int(self.detector_pixels)}
 
 
@@ -184,6 +191,9 @@ class _Search:
     ended: bool = False
     decided_once: bool = False
     path: list = field(default_factory=list)
+    # What the read-only views derive from log_belief, each computed once: emptied whenever
+    # log_belief (or a setting a view depends on) changes.
+    views: dict = field(default_factory=dict)
 
 
 class SearchSession:
@@ -195,7 +205,8 @@ class SearchSession:
     grid : Grid
         The visual array.
     observation
-        The observation model the searcher assumes (:mod:`ipomdp_gaze.observation`) or an FPOC.
+        The observation model the searcher assumes (:mod:`ipomdp_gaze.model.observation`) or an
+        FPOC.
     policy
         Anything with ``select(belief (1, N), t, rng)``; with ``scores(belief)`` inhibition of
         return masks the scores. None: the driver chooses every fixation itself
@@ -239,6 +250,7 @@ class SearchSession:
         old = self.settings
         self.settings = settings
         self.motion = Motion(self.grid, settings.motion_sigma_cells, settings.motion_jump_prob)
+        self._changed()                 # the answer's square follows found_radius and motion
         mixture_changed = _mixture_settings(settings) != _mixture_settings(old)
         if mixture_changed:
             self._mixture = None
@@ -273,10 +285,30 @@ class SearchSession:
         """Log probabilities, (N,) or (N + 1,) with the absent hypothesis last; a copy."""
         return self._state().log_belief.copy()
 
+    def _view(self, name: str, compute):
+        """Return a view of the belief, computed once after each change (:meth:`_changed`)."""
+        views = self._state().views
+        if name not in views:
+            views[name] = compute()
+        return views[name]
+
+    def _changed(self) -> None:
+        """Forget the views: the log belief, or a setting a view depends on, has changed."""
+        if self._search is not None:
+            self._search.views.clear()
+
+    def _cells(self) -> np.ndarray:
+        """Cell probabilities ``exp(log B_i)`` (N,), shared and read-only."""
+        def compute():
+            cells = np.exp(self._search.log_belief[:self.grid.n_cells])
+            cells.flags.writeable = False
+            return cells
+        return self._view('cells', compute)
+
     @property
     def belief(self) -> np.ndarray:
         """Cell probabilities ``B_i`` (N,), a copy; they sum to ``1 - P(absent)``."""
-        return np.exp(self._state().log_belief[:self.grid.n_cells])
+        return self._cells().copy()
 
     @property
     def absent_probability(self) -> float:
@@ -291,21 +323,22 @@ class SearchSession:
 
         With ``found_radius`` r > 0: the cell whose (2r + 1)-square holds the most belief.
         """
-        return int(map_cell(self._pooled()))
+        return self._view('map_cell', lambda: int(map_cell(self._pooled())))
 
     def _pooled(self) -> np.ndarray:
         radius = self.settings.found_radius if not self.motion.active else 0
-        return pooled_belief(self.belief, self.grid, radius)
+        return self._view('pooled', lambda: pooled_belief(self._cells(), self.grid, radius))
 
     @property
     def map_probability(self) -> float:
         """Probability of the answer: its cell, or its square with ``found_radius``."""
-        return float(self._pooled()[self.map_cell])
+        return self._view('map_probability', lambda: float(self._pooled()[self.map_cell]))
 
     @property
     def entropy_nats(self) -> float:
         """Entropy of the belief over all its hypotheses, in nats."""
-        return float(entropy(np.exp(self._state().log_belief)))
+        return self._view('entropy_nats',
+                          lambda: float(entropy(np.exp(self._search.log_belief))))
 
     @property
     def fixation(self) -> int | None:
@@ -365,6 +398,33 @@ class SearchSession:
             self.observation.counts(obs)
         return obs
 
+    def checked_frame(self, values, kind: str = 'fixation') -> Frame:
+        """
+        Return ``Frame(values, kind)`` checked here, once (:meth:`check_frame`).
+
+        :meth:`update` and :meth:`scan` take it without checking it again while the session
+        assumes the same model. For a driver that must know whether a frame is usable before
+        deciding what to do with it (the controller counts a bad frame as rejected even when it
+        would skip it). The values are :meth:`check_frame`'s floats; change none of them before
+        the frame is applied.
+
+        Raises
+        ------
+        EvidenceError
+            With the reason, as :meth:`check_frame`.
+
+        """
+        frame = Frame(self.check_frame(values), kind=kind)
+        object.__setattr__(frame, '_checked_by', (self, self.observation))
+        return frame
+
+    def _frame_values(self, frame: Frame) -> np.ndarray:
+        """Return a frame's checked values: checked here unless this session checked them."""
+        checked = frame._checked_by
+        if checked and checked[0] is self and checked[1] is self.observation:
+            return frame.values
+        return self.check_frame(frame.values)
+
     def reset(self, *, seed=None) -> None:
         """
         Start a new search from the prior.
@@ -414,6 +474,7 @@ class SearchSession:
         for log_b in (search.log_belief, search.still_base):
             log_b[index] = -np.inf
             normalize_log(log_b)
+        self._changed()
         self._event('exclude', cells=[self._rc(c) for c in index])
 
     def scan(self, frame: Frame) -> StepResult:
@@ -437,13 +498,14 @@ class SearchSession:
         if not self.settings.scan:
             return self._result('applied', reason='scan off')
         try:
-            obs = check_evidence(frame.values, self.grid.n_cells)
+            obs = self._frame_values(frame)
             term = self.observation.scan_log_likelihood_ratio(obs)
         except EvidenceError as exc:
             return self._result('rejected', reason=str(exc))
         search.scanned = True
         bayes_update(search.log_belief, with_absent(term, search.log_belief),
                      out=search.log_belief)
+        self._changed()
         search.still_base = search.log_belief.copy()
         self._event('scan', frame=frame.summary(), belief=self._belief_summary())
         return self._result('applied')
@@ -486,6 +548,7 @@ class SearchSession:
         """Spread the belief over ``dt_s`` of the target's motion (nothing for a still target)."""
         if self.motion.active and dt_s > 0:
             self.motion.over(dt_s).predict_log(self._state().log_belief)
+            self._changed()
 
     def update(self, frame: Frame, dt_s: float = 0.0) -> StepResult:
         """
@@ -507,7 +570,7 @@ class SearchSession:
         if search.ended:
             raise OrderError(f'the search has ended ({search.decision}); reset starts a new one')
         try:
-            obs = self.check_frame(frame.values)
+            obs = self._frame_values(frame)
             term = self.observation.log_likelihood_ratio(obs, search.fixation)
         except EvidenceError as exc:
             return self._result('rejected', reason=str(exc))
@@ -526,6 +589,7 @@ class SearchSession:
         else:
             bayes_update(search.log_belief, with_absent(term, search.log_belief),
                          out=search.log_belief)
+        self._changed()
         search.fixations += 1
         search.path.append(search.fixation)
         search.visited[search.fixation] = True
@@ -619,7 +683,7 @@ class SearchSession:
         search, settings = self._search, self.settings
         if self.policy is None:
             return search.fixation
-        belief = self.belief[None, :]
+        belief = self._cells()[None, :]
         if settings.inhibit_return and not self.motion.active:
             if search.visited.all():
                 if settings.stop_on_repeat:
