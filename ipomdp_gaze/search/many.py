@@ -162,7 +162,7 @@ class OccupancySession:
     log = property(lambda self: tuple(self._log))
 
     def faces(self, boxes=None, scores=None, image_px=None, link: int = 2) -> list[dict]:
-        """Return the faces, each counted once (:func:`ipomdp_gaze.model.occupancy.count_faces`)."""
+        """Return the faces, each counted once (``occupancy.count_faces``)."""
         return count_faces(self.log_odds, self.grid, self.occupied(), boxes, scores, image_px,
                            link)
 
