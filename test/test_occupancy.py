@@ -389,3 +389,31 @@ def test_empty_by_evidence_needs_looks_where_a_sparse_prior_decides_at_once():
     log_odds, prior = session.log_odds, prior_log_odds(9, cell_prior(9, 0.95))
     empty = ~session.occupied()
     assert np.all(log_odds[empty] - prior[empty] <= -math.log(99))
+
+
+def test_faces_with_spill_over_are_counted_once_across_random_scenes():
+    """Scenes of 0-2 faces whose detections spill into both neighbours: no face comes out twice."""
+    grid = Grid(1, 9)
+    pt = np.tile([0.15, 0.25, 0.6], (1, 9, 1))
+    pn = np.tile([0.85, 0.1, 0.05], (1, 9, 1))
+    model = CountObservation(grid, pt, pn)
+    rng = np.random.default_rng(12)
+    exact = 0
+    for trial in range(60):
+        n_faces = trial % 3
+        truth = np.zeros(9, dtype=bool)
+        if n_faces:
+            truth[rng.choice([1, 4, 7], size=n_faces, replace=False)] = True  # 3 cells apart
+        fixations = list(rng.integers(0, 9, size=6))
+        frames = _frames(model, rng, fixations, truth, nan_share=0.0, spill=1)
+        log_odds = prior_log_odds(9, 0.1)
+        for frame, k in zip(frames, fixations):
+            log_odds = update_log_odds(log_odds, model.log_likelihood_ratio(frame, k))
+        faces = count_faces(log_odds, grid, decided(log_odds, 0.95)[0], link=2)
+        cells = [f['cell'] for f in faces]
+        assert len(faces) <= n_faces                                 # never twice
+        assert all(np.abs(np.flatnonzero(truth) - c).min() <= 1 for c in cells)
+        exact += len(faces) == n_faces
+        if n_faces == 1:                      # a lone face's spill-over is one cluster
+            assert len(faces) == 1
+    assert exact >= 45       # two faces 3 cells apart can merge (their spill-over touches)
