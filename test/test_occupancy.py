@@ -241,7 +241,7 @@ def test_stop_rules_decided_budget_and_repeat():
     result = session.update(Frame(np.zeros(4)))
     while not result.ended:
         result = session.update(Frame(np.zeros(4)))
-    assert result.decision == 'absent' and result.fixations == 1
+    assert result.decision == 'absent' and result.fixations == 2      # evidence 2 x log(1/19)
     budget = OccupancySession(grid, model, SearchSettings(targets='many', max_fixations=1,
                                                           absent_prior=0.5))
     budget.reset()
@@ -379,10 +379,10 @@ def test_empty_by_evidence_needs_looks_where_a_sparse_prior_decides_at_once():
     settings = SearchSettings(targets='many', confidence=0.99, absent_prior=0.95,
                               max_fixations=30, inhibit_return=True)
     assert cell_prior(9, 0.95) < 0.01                     # every cell "empty" a priori
-    eager = run_search(OccupancySession(grid, model, settings),
+    eager = run_search(OccupancySession(grid, model, settings, empty_by_evidence=False),
                        ModelSensor(grid, model, np.random.default_rng(0)), 4)
     assert eager.decision == 'absent' and eager.fixations == 0      # it never looked
-    session = OccupancySession(grid, model, settings, empty_by_evidence=True)
+    session = OccupancySession(grid, model, settings)                # the default
     careful = run_search(session, ModelSensor(grid, model, np.random.default_rng(0)), 4)
     assert careful.fixations > 0 and careful.decision == 'found'
     assert [f['cell'] for f in session.faces()] == [4]
@@ -417,3 +417,24 @@ def test_faces_with_spill_over_are_counted_once_across_random_scenes():
         if n_faces == 1:                      # a lone face's spill-over is one cluster
             assert len(faces) == 1
     assert exact >= 45       # two faces 3 cells apart can merge (their spill-over touches)
+
+
+def test_simulated_searches_of_the_paper_task_find_the_target_or_nobody():
+    """7x7, human FPOC, one target or none: each target found within one cell, none invented."""
+    from ipomdp_gaze.search.sensors import ModelSensor, run_search
+    grid = Grid(7, 7)
+    model = GaussianObservation(grid, make_fpoc('human'))
+    settings = SearchSettings(targets='many', confidence=0.95, max_fixations=60,
+                              absent_prior=0.5)
+    session = OccupancySession(grid, model, settings)
+    for e in range(12):
+        target = None if e % 4 == 0 else int(np.random.default_rng(e).integers(49))
+        outcome = run_search(session, ModelSensor(grid, model, np.random.default_rng([7, e])),
+                             target)
+        cells = [grid.cell(f['cell']) for f in session.faces()]
+        assert outcome.decision == ('absent' if target is None else 'found')
+        if target is not None:
+            [(r, c)] = cells
+            assert max(abs(r - target // 7), abs(c - target % 7)) <= 1
+        else:
+            assert cells == []

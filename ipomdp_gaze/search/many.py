@@ -14,9 +14,11 @@ The same steps and results as :class:`ipomdp_gaze.search.session.SearchSession` 
 3. ``update``: ``L_j += l_j`` of the frame (the single-target belief's own term), with a still
    scene's repeated views weighted by ``repeat_weight`` (:mod:`ipomdp_gaze.model.still_evidence`:
    1 is naive Bayes);
-4. stop when every cell is decided at ``confidence`` either way (``P(x_j) >= c`` occupied,
-   ``<= 1 - c`` empty; with ``link`` r > 0 a cell within r cells of an occupied one is
-   settled too: it would join that face's cluster, so it cannot be another face): ``found``
+4. stop when every cell is decided at ``confidence`` either way (``P(x_j) >= c`` occupied;
+   empty by default when its evidence alone says so, ``L_j - L_prior <= -log(c / (1 - c))``,
+   or with ``empty_by_evidence=False`` when ``P(x_j) <= 1 - c``; with ``link`` r > 0 a cell
+   within r cells of an occupied one is settled too: it would join that face's cluster, so it
+   cannot be another face): ``found``
    if a cell is occupied, else ``absent``; at the fixation budget or a driver's cost cap
    (:meth:`stop`), ``gave_up`` or, with ``decide_at_budget``, every cell by its likelier side;
    ``gave_up`` (reason ``repeat``) when no view left would tell anything new;
@@ -79,14 +81,15 @@ class OccupancySession:
         Decide a cell empty only when its evidence alone says so: ``L_j - L_prior <=
         -log(c / (1 - c))`` (a likelihood-ratio test, so a sparse prior cannot decide a cell
         nobody looked at well; Wald: a face's cell is decided empty with probability at most
-        ``(1 - c) / c``). Off: the posterior ``P <= 1 - c`` decides.
+        ``(1 - c) / c``). Off: the posterior ``P <= 1 - c`` decides, and a sparse prior
+        decides every cell nobody looked at (``find`` chooses that, for its cost).
     log_size : int
         Events kept in :attr:`log`.
 
     """
 
     def __init__(self, grid, observation, settings: SearchSettings | None = None,
-                 costs=None, link: int = 0, empty_by_evidence: bool = False,
+                 costs=None, link: int = 0, empty_by_evidence: bool = True,
                  log_size: int = 10_000):
         self.grid = grid
         self.observation = as_observation(grid, observation)

@@ -96,6 +96,12 @@ FACE_RADIUS = 2
 # searched on; on the training groups (bench/many_faces.py) the spill-over cells next to a face
 # otherwise stayed undecided and drew fixations until the pixel budget.
 SETTLE_RADIUS = 1
+# search_many decides a cell empty by its posterior, not by its evidence alone
+# (OccupancySession's empty_by_evidence): on the training groups (bench/many_faces.py
+# --empty-by-evidence) the evidence rule found the same photo-group faces (47 and 48 of 48) and
+# 17 instead of 9 of 64 small lfw faces at 640x480, but ran every scene to the pixel cap (one full
+# scan); the full-resolution detector alone finds 61 of 64 for those pixels.
+EMPTY_BY_EVIDENCE = False
 
 
 @dataclass(frozen=True)
@@ -524,7 +530,8 @@ def fixation_costs(fovea: Fovea, image_px: tuple[int, int]) -> np.ndarray:
 def search_many(image: np.ndarray, fovea: Fovea, model,
                 settings: SearchSettings | None = None, *,
                 pixel_budget: int | None = None, link: int = FACE_RADIUS,
-                settle: int = SETTLE_RADIUS, empty_by_evidence: bool = False) -> ImageSearch:
+                settle: int = SETTLE_RADIUS,
+                empty_by_evidence: bool = EMPTY_BY_EVIDENCE) -> ImageSearch:
     """
     Search one image for every face at once: the many-target belief (``search.targets: many``).
 
