@@ -472,14 +472,16 @@ def pan_tilt_table(test: dict, n: int, empty: int) -> list[str]:
 
 def run_photos(detectors) -> dict:
     """``find`` (fovea) and one full scan per detector on every photo and group picture."""
+    from dataclasses import replace
     from ipomdp_gaze.vision.search import FIND_SETTINGS
+    all_settings = replace(FIND_SETTINGS, targets='many')     # find --all: the many targets
     out = {}
     for kind in detectors:
         tasks = find_photos.find_tasks(kind)
         out[kind] = {'find': find_photos.photo_rows(tasks, 'all', FIND_SETTINGS),
                      'full': find_photos.full_frame_rows(tasks, 'all'),
-                     'groups_train': find_photos.group_rows(tasks, 'train', FIND_SETTINGS),
-                     'groups_test': find_photos.group_rows(tasks, 'test', FIND_SETTINGS)}
+                     'groups_train': find_photos.group_rows(tasks, 'train', all_settings),
+                     'groups_test': find_photos.group_rows(tasks, 'test', all_settings)}
     return out
 
 
@@ -779,14 +781,13 @@ FIND_TEXT = [
     'size (`faces-420[-yunet]` or `faces-840[-yunet]`, `|log(w/w0)| + |log(h/h0)|`); an image '
     "larger than the model's size is searched by the fovea within the same budget, and its "
     'line names both sizes.', '',
-    '**`--all`** finds a face, takes the cells within 2 of its answer out of the hypothesis set '
-    '(`SearchSession.exclude`: their prior becomes 0, tested against brute-force Bayes) and '
-    "searches again from the prior, reusing the fovea's cached windows, until `absent` (or "
-    '`gave_up`). A face spanning several cells leaves its detections within a cell or two of '
-    'its answer (one cell was too few: a 48-90 px face spans 2-4 cells of a 640x480 picture '
-    'and was found twice); two faces whose centres are within 2 cells of each other are found '
-    'as one. Each search may spend one full scan of pixels, so F faces cost up to F + 1 full '
-    'scans (the pixel column of the group table).', '',
+    '**`--all`** runs one search over the many-target belief (docs/design.md section 11: an '
+    'occupancy per cell, infomax per detector pixel, every cell decided either way, within one '
+    'full scan of detector pixels) and reports each face once, per cluster of occupied cells '
+    "split where the detector's boxes are distinct faces, as a box with its probability. "
+    '`--all --targets one` keeps the single-target loop: find a face, take the cells within 2 '
+    'of its answer out (`SearchSession.exclude`), search again, one full scan per search. '
+    '`bench/many_faces.py` compares both with the detector alone at each scale.', '',
     '**Choices, and which photos informed them.** Only the *training* photos (the astronaut '
     'and the six face-free photos that are training backgrounds of the scene set: brick, '
     'coffee, coins, grass, immunohistochemistry, rocket) and the *training* group pictures '

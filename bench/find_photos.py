@@ -110,7 +110,12 @@ def group_pictures(split):
 
 
 def group_rows(tasks, split, settings) -> list[dict]:
-    """``find --all`` on each composed group picture of ``split``: one dict per picture."""
+    """
+    ``find --all`` on each composed group picture of ``split``: one dict per picture.
+
+    ``settings.targets`` many: the one many-target search's faces (what ``find --all`` runs);
+    one: the single-target loop's found answers (``--all --targets one``).
+    """
     rows = []
     for label, seed, image, boxes in group_pictures(split):
         size = (image.shape[1], image.shape[0])
@@ -119,11 +124,17 @@ def group_rows(tasks, split, settings) -> list[dict]:
         results = search_one(image, task, settings, np.random.default_rng([0, seed]), True)
         seconds = time.perf_counter() - t0
         truth = truth_cells(boxes, image.shape, task.model.grid)
-        found = [r.cell for r in results if r.decision == 'found']
+        last = results[-1].decision
+        if settings.targets == 'many':                    # one search, every face in it
+            found = [face.cell for face in results[0].faces]
+            # "no more faces": every cell decided (else the limit that stopped it)
+            last = 'absent' if results[0].stop in ('found', 'absent') else last
+        else:
+            found = [r.cell for r in results if r.decision == 'found']
         rows.append({'group': label, 'faces': len(truth),
                      'found': sum(near(t, found) for t in truth),
                      'wrong': sum(not near(f, truth) for f in found),
-                     'last': results[-1].decision, 'stop': results[-1].stop,
+                     'last': last, 'stop': results[-1].stop,
                      'searches': len(results),
                      'pixels_ratio': sum(r.detector_pixels for r in results)
                      / (size[0] * size[1]), 'seconds': seconds})
@@ -174,7 +185,8 @@ def main() -> None:
     photos(tasks, args.split, settings)
     if args.groups:
         print()
-        groups(tasks, 'train' if args.split == 'train' else 'test', settings)
+        groups(tasks, 'train' if args.split == 'train' else 'test',
+               replace(settings, targets='many'))
 
 
 if __name__ == '__main__':

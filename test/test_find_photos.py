@@ -80,10 +80,11 @@ def test_a_close_up_portrait_scans_the_whole_frame_and_finds_the_face(tmp_path):
     assert 'detector_pixels=12544 (full scan 12544)' in line
 
 
-def test_find_all_finds_the_faces_of_a_group_photo_then_no_more(tmp_path):
+def test_find_all_one_target_loop_finds_the_faces_of_a_group_photo_then_no_more(tmp_path):
     image, boxes = group_photo((640, 480), seed=0)
     out = tmp_path / 'all.json'
-    result = run_find(write(tmp_path / 'group.png', image), '--all', '--json', out)
+    result = run_find(write(tmp_path / 'group.png', image), '--all', '--targets', 'one',
+                      '--json', out)
     assert result.returncode == 0, result.stderr
     entries = json.loads(out.read_text())['images']
     assert [e['face'] for e in entries] == list(range(len(entries)))
@@ -95,6 +96,62 @@ def test_find_all_finds_the_faces_of_a_group_photo_then_no_more(tmp_path):
     for a in range(len(found)):                 # a found face's cells leave the hypothesis set
         for b in range(a):
             assert max(abs(found[a][0] - found[b][0]), abs(found[a][1] - found[b][1])) > 1
+
+
+def test_find_all_reports_every_face_once_with_its_box_in_one_search(tmp_path):
+    image, boxes = group_photo((640, 480), seed=1, background='rocket', split='train',
+                               copies=6)
+    out, plot = tmp_path / 'many.json', tmp_path / 'many.png'
+    result = run_find(write(tmp_path / 'group.png', image), '--all', '--json', out,
+                      '--plot', plot)
+    assert result.returncode == 0, result.stderr
+    [entry] = json.loads(out.read_text())['images']
+    faces = entry['faces']
+    lines = result.stdout.strip().splitlines()
+    assert len(lines) == len(faces) + 1 and all('face=' in line for line in lines[:-1])
+    assert entry['decision'] == 'found' and entry['detector_pixels'] <= 640 * 480
+    truth = face_cells(boxes, image.shape)
+    assert len(faces) == len(boxes) == 6
+    matched = []
+    for face in faces:
+        x, y, w, h = face['box']
+        assert 0 < face['probability'] <= 1 and w > 0 and h > 0
+        centre = face_cells(np.array([[x, y, w, h]]), image.shape)[0]
+        assert list(centre) == face['cell'] and near(centre, truth)
+        matched.append(min(range(len(truth)), key=lambda i: max(abs(truth[i][0] - centre[0]),
+                                                                abs(truth[i][1] - centre[1]))))
+    assert len(set(matched)) == len(matched)                  # no face comes out twice
+    assert plot.exists()
+
+
+def test_find_all_on_a_close_up_portrait_reports_the_full_frame_box(tmp_path):
+    image = load_photo('astronaut')
+    x, y, w, h = read_labels()['astronaut'][0][0]
+    cx, cy = int(x + w / 2), int(y + h / 2)
+    portrait = cv2.resize(image[cy - 60:cy + 60, cx - 60:cx + 60], (112, 112),
+                          interpolation=cv2.INTER_AREA)
+    out = tmp_path / 'portrait.json'
+    result = run_find(write(tmp_path / 'portrait.png', portrait), '--all', '--json', out)
+    assert result.returncode == 0, result.stderr
+    [entry] = json.loads(out.read_text())['images']
+    assert entry['method'] == 'full_frame' and entry['decision'] == 'found'
+    [face] = entry['faces']
+    bx, by, bw, bh = face['box']
+    assert face['probability'] is None and bx < 56 < bx + bw and by < 56 < by + bh
+    assert len(result.stdout.strip().splitlines()) == 2
+
+
+def test_face_boxes_are_drawn_where_the_json_says():
+    from ipomdp_gaze.vision.search import Face
+    from ipomdp_gaze.vision.search_plots import draw_faces
+    picture = np.zeros((100, 120, 3), dtype=np.uint8)
+    face = Face(box=(10.0, 20.0, 30.0, 40.0), cell=(4, 5), probability=0.9)
+    assert face.to_dict() == {'box': [10.0, 20.0, 30.0, 40.0], 'cell': [4, 5],
+                              'probability': 0.9}
+    drawn = draw_faces(picture, [face], factor=2)
+    green = np.all(drawn == (0, 255, 0), axis=2)
+    assert green[40, 20:80].all() and green[40:120, 20].all()      # top and left edges, x2
+    assert green[40:120, 80].all() and not green[60:100, 30:70].any()
 
 
 def test_plot_refuses_a_format_it_cannot_write_and_writes_the_one_named(photos, tmp_path):

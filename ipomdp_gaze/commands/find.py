@@ -20,8 +20,11 @@ detector pixels than one full-resolution scan of the image: it stops before a fi
 would, and decides then (``decide_at_budget``; stop ``pixels``). When the fovea would cost more
 or cannot see (a small image, an image at most half the model's calibrated size, a close-up
 portrait: :func:`ipomdp_gaze.vision.search.full_frame_reason`) the whole frame is scanned once
-instead and stderr says why. ``--all`` finds every face
-(:func:`ipomdp_gaze.vision.search.search_all`): one line per face, then the last decision.
+instead and stderr says why. ``--all`` finds every face in one search over the many-target
+belief (``--targets many``, its default: :func:`ipomdp_gaze.vision.search.search_many`;
+docs/design.md section 11): one line per face with its box, then the image's line;
+``--targets one`` keeps the old loop (:func:`ipomdp_gaze.vision.search.search_all`: find one
+face, rule its cells out, search again).
 
 **Images** are read with OpenCV (``IMREAD_ANYDEPTH | IMREAD_ANYCOLOR``: EXIF orientation applied,
 an alpha channel dropped; OpenCV's and libpng's own messages silenced, our one line says it). A
@@ -67,11 +70,11 @@ from ipomdp_gaze.vision.detectors import load_factory
 from ipomdp_gaze.vision.image_files import decode_quietly
 from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, FIND_SETTINGS,
                                        fovea_for_model, full_frame_reason, full_frame_search,
-                                       search_all, search_image, size_distance)
+                                       search_all, search_image, search_many, size_distance)
 import numpy as np
 
 from .common import nonneg_int
-from .search_args import add_search_args, settings_from_args
+from .search_args import add_search_args, settings_from_args, TASK_DEFAULT
 
 POLICY_CHOICES = tuple(name for name in POLICY_NAMES if name != 'learned')
 # The detectors with shipped find models; the first is the default, chosen on the training
@@ -124,10 +127,14 @@ def add_parser(sub):
     add_search_args(p, FIND_SETTINGS, ('confidence', 'max_fixations', 'absent_prior',
                                        'repeat_weight', 'start_cell'))
     p.add_argument('--all', action='store_true',
-                   help='find every face: each found face is printed and the cells within 2 '
-                        'of it leave the hypothesis set (faces closer than that count as one), '
-                        'then the search goes on until absent (or gave_up); each search may '
-                        'spend one full scan of detector pixels')
+                   help='find every face in one search over the many-target belief (an '
+                        'occupancy per cell, infomax per detector pixel, within one full scan '
+                        'of detector pixels); each face is printed with its box and '
+                        'probability, counted once per cluster of occupied cells (split where '
+                        "the detector's boxes are distinct faces)")
+    add_search_args(p, None, ('targets',), task_default='many with --all, else one; --all '
+                    '--targets one: find a face, rule the cells within 2 of it out, search '
+                    'again')
     p.add_argument('--plot', type=Path, default=None, metavar='OUT.png',
                    help='draw the image, the numbered fixations and the windows of the last '
                         'one, in the format the extension names (.png, .pdf, .svg, .jpg, ...; '
@@ -140,9 +147,10 @@ def add_parser(sub):
                         'full_scan_pixels, seconds, decision, ended (confidence, '
                         'forced:pixels, forced:budget, repeat, ...), confidence, '
                         'map_probability, absent_probability, stop, method, note, '
-                        'resized_from, grid}]} in input order (with --all: one entry per face, '
-                        'with "face", then the last decision); "-" writes it to stdout (the '
-                        'lines then go to stderr)')
+                        'resized_from, grid, and with --targets many faces: [{box [x, y, w, h], '
+                        'cell [row, col], probability}]}]} in input order (--all --targets one: '
+                        'one entry per face, with "face", then the last decision); "-" writes it '
+                        'to stdout (the lines then go to stderr)')
     p.add_argument('--max-side', type=nonneg_int, default=MAX_SIDE_PX, metavar='PX',
                    help='resize an image longer than this on a side before the search '
                         f'(default {MAX_SIDE_PX}; 0: never), a JPEG while it is decoded, as '
@@ -378,6 +386,15 @@ def format_line(path: str, result, face: int | None = None) -> str:
     return line
 
 
+def face_line(path: str, result, face: int) -> str:
+    """Format the line of one face of a many-target search."""
+    found = result.faces[face]
+    x, y, w, h = found.box
+    probability = 'n/a' if math.isnan(found.probability) else f'{found.probability:.3f}'
+    return (f'{path}: face={face} box (x, y, w, h)=({x:.0f}, {y:.0f}, {w:.0f}, {h:.0f}) '
+            f'cell (row, col)=({found.cell[0]}, {found.cell[1]}) p={probability}')
+
+
 def plot_title(path: str, result, confidence: float) -> str:
     """Return a plot's title: the decision, how it ended, the answer and its probability."""
     p = result.answer_probability
@@ -483,8 +500,10 @@ def _in_given_pixels(result, scale: tuple, given: tuple):
     """Return a result on a resized image with its pixels in the given image's."""
     sx, sy = scale
     x, y = result.pixel
+    faces = tuple(replace(face, box=(face.box[0] * sx, face.box[1] * sy, face.box[2] * sx,
+                                     face.box[3] * sy)) for face in result.faces)
     return replace(result, pixel=(x * sx, y * sy), resized_from=tuple(given),
-                   detections=tuple((u * sx, v * sy) for u, v in result.detections))
+                   detections=tuple((u * sx, v * sy) for u, v in result.detections), faces=faces)
 
 
 def search_one(image, task, settings, rng, find_all: bool) -> list:
@@ -493,8 +512,12 @@ def search_one(image, task, settings, rng, find_all: bool) -> list:
     reason = full_frame_reason(task.fovea, (width, height), calibrated_size(task.model))
     if reason:
         results = full_frame_search(image, task.fovea, reason, calibrated_size(task.model))
+        if settings.targets == 'many':
+            return [results[0]]
         return results if find_all else results[:1]
     budget = width * height
+    if settings.targets == 'many':
+        return [search_many(image, task.fovea, task.model, settings, pixel_budget=budget)]
     if find_all:
         return search_all(image, task.fovea, task.model, task.policy, settings, rng=rng,
                           pixel_budget=budget)
@@ -527,6 +550,8 @@ def run(args) -> int:
             task = tasks.task((image.shape[1], image.shape[0]))
             check_image_size((image.shape[1], image.shape[0]), task.fovea)
             settings = settings_from_args(args, FIND_SETTINGS, task.model.grid)
+            if args.all and args.targets is TASK_DEFAULT:
+                settings = replace(settings, targets='many')
         except ValueError as exc:
             message = str(exc)
             _error(message if message.startswith(path) else f'{path}: {message}')
@@ -542,14 +567,22 @@ def run(args) -> int:
             results = [_in_given_pixels(r, scale, given) for r in results]
         if results[0].method == 'full_frame':
             _note(f'{path}: scanned the whole frame once: {results[0].note}')
+        many = settings.targets == 'many'
         for k, result in enumerate(results):
-            print(format_line(path, result, k if args.all else None), file=out, flush=True)
-            entries.append({**entry(path, result, grid, settings.confidence),
-                            **({'face': k} if args.all else {})})
+            for face in range(len(result.faces) if many else 0):
+                print(face_line(path, result, face), file=out, flush=True)
+            print(format_line(path, result, k if args.all and not many else None), file=out,
+                  flush=True)
+            extra = ({'faces': [face.to_dict() for face in result.faces]} if many else
+                     {'face': k} if args.all else {})
+            entries.append({**entry(path, result, grid, settings.confidence), **extra})
         logs.append(json.dumps({'path': path, 'events': [e for r in results for e in r.log]}))
         if plots:
-            plot_image_search(image, searched[0], task.fovea, plots[i],
-                              plot_title(path, results[0], settings.confidence))
+            title = plot_title(path, results[0], settings.confidence)
+            if many:
+                title = (f'{Path(path).name}: {len(results[0].faces)} faces, '
+                         f'{results[0].fixations} fixations ({results[0].stop})')
+            plot_image_search(image, searched[0], task.fovea, plots[i], title)
             _note(f'wrote {plots[i]}')
     if args.log:
         args.log.parent.mkdir(parents=True, exist_ok=True)

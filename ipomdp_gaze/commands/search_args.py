@@ -50,7 +50,7 @@ def add_search_args(parser: argparse.ArgumentParser, defaults: SearchSettings | 
         else:
             kwargs['metavar'] = s.metavar or key.upper()
             kwargs['type'] = {'float': float, 'int': int, 'floats': float,
-                              'cell': cell_arg}[s.kind]
+                              'cell': cell_arg, 'str': str}[s.kind]
             if s.kind == 'floats':
                 kwargs['nargs'] = '+'
         parser.add_argument(s.flag, **kwargs)

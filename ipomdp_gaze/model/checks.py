@@ -137,3 +137,15 @@ def check_start_cell(value, name: str = 'start_cell'):
     if row < 0 or col < 0:
         raise ValueError(f'{name} must be (row, col) with row, col >= 0, got {value!r}')
     return (int(row), int(col))
+
+
+# search.targets: the paper's one target (or none), or many (an occupancy per cell,
+# ipomdp_gaze.many).
+TARGETS = ('one', 'many')
+
+
+def check_targets(value, name: str = 'search.targets') -> str:
+    """Return ``'one'`` or ``'many'``: the belief a search holds (docs/design.md section 11)."""
+    if not (isinstance(value, str) and value in TARGETS):
+        raise ValueError(f"{name} must be one of {', '.join(TARGETS)}, got {value!r}")
+    return value

@@ -160,7 +160,8 @@ def cell_params(prefix: str, what: str, unset: str) -> list[Param]:
                   int_range=(-1, MAX_CELLS_PER_SIDE - 1)) for axis in ('row', 'column')]
 
 
-_PARAMETER_TYPES = {'float': T.DOUBLE, 'int': T.INTEGER, 'bool': T.BOOL, 'floats': T.DOUBLE_ARRAY}
+_PARAMETER_TYPES = {'float': T.DOUBLE, 'int': T.INTEGER, 'bool': T.BOOL, 'floats': T.DOUBLE_ARRAY,
+                    'str': T.STRING}
 
 
 def search_params(schema=SCHEMA) -> list[Param]:

@@ -116,7 +116,8 @@ def run_search(session: SearchSession, sensor: Sensor, scene, *, seed=None,
     sequence of cells, is fixated in that order instead of the policy's choices (every view of a
     scene, a recorded path); the search then also ends when they run out. ``on_frame(frame,
     result)`` is called after every fixation frame the session applied (a driver's per-frame
-    record: the answer so far, the detector's time).
+    record: the answer so far, the detector's time). A session that ends at ``start`` (a
+    many-target scan that decided every cell) takes no fixation.
 
     Raises
     ------
@@ -149,7 +150,7 @@ def run_search(session: SearchSession, sensor: Sensor, scene, *, seed=None,
     if len(exclude):
         session.exclude(exclude)
     cell = session.start()
-    while not over and (limit is None or session.fixations < limit):
+    while not over and not session.ended and (limit is None or session.fixations < limit):
         if order is not None:
             cell = next(order, None)
             if cell is None:

@@ -80,7 +80,11 @@ def _wants_mixture(settings: SearchSettings) -> bool:
 
 
 def _check_mixture_model(settings: SearchSettings, observation) -> None:
-    """Refuse false-alarm scales or hotspots with a model that has no count tables to scale."""
+    """Refuse many targets, and false-alarm scales or hotspots without count tables to scale."""
+    if settings.targets != 'one':
+        raise ValueError(f"{PARAMETER_NAMES['targets']} {settings.targets} is searched by "
+                         f'ipomdp_gaze.search.many.OccupancySession; this session holds one '
+                         f'target')
     if not _wants_mixture(settings) or isinstance(observation, CountObservation):
         return
     name = 'false_alarm_scales' if len(settings.false_alarm_scales) > 1 else 'hotspot_prior'

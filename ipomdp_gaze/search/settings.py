@@ -26,14 +26,14 @@ from typing import Callable, Mapping
 
 from ipomdp_gaze.model.checks import (check_budget, check_confidence, check_flag,
                                       check_probability, check_radius, check_sigma_cells,
-                                      check_start_cell)
+                                      check_start_cell, check_targets)
 from ipomdp_gaze.model.false_alarms import (check_false_alarm_scales, check_hotspot_prior,
                                             check_hotspot_scale, DEFAULT_HOTSPOT_SCALE)
 from ipomdp_gaze.model.still_evidence import check_repeat_weight
 
 # What a setting's values are: the node declares them with the matching parameter type and a
 # CLI flag parses them so (a cell is ``ROW,COL``; the node declares it as two integers).
-KINDS = ('float', 'int', 'bool', 'floats', 'cell')
+KINDS = ('float', 'int', 'bool', 'floats', 'cell', 'str')
 
 
 @dataclass(frozen=True)
@@ -128,6 +128,10 @@ SCHEMA: tuple[Setting, ...] = (
             check_hotspot_scale,
             "still target, count model: a hotspot's factor of the model's false-alarm rate",
             bounds='> 1', metavar='F'),
+    Setting('targets', 'search.targets', 'str', 'one', check_targets,
+            "the belief: one target or none (the paper's) or many (an occupancy per cell, "
+            'ipomdp_gaze.many; the gaze_controller node searches one)', bounds='one or many',
+            metavar='one|many'),
 )
 
 
@@ -222,7 +226,7 @@ def settings_class(schema=SCHEMA, name: str = 'SearchSettings', module: str = __
 
 
 _KIND_WORDS = {'float': 'a number', 'int': 'an integer', 'bool': 'true or false',
-               'floats': 'a list of numbers', 'cell': '[row, col]'}
+               'floats': 'a list of numbers', 'cell': '[row, col]', 'str': 'a string'}
 
 
 def _check_kind(setting: Setting, value, where: str) -> None:
@@ -233,7 +237,8 @@ def _check_kind(setting: Setting, value, where: str) -> None:
           'bool': isinstance(value, bool),
           'floats': isinstance(value, list) and all(
               isinstance(v, (int, float)) and not isinstance(v, bool) for v in value),
-          'cell': value is None or isinstance(value, (list, str))}[kind]
+          'cell': value is None or isinstance(value, (list, str)),
+          'str': isinstance(value, str)}[kind]
     if not ok:
         raise ValueError(f'{where}{setting.parameter} must be {_KIND_WORDS[kind]}, got {value!r}')
 

@@ -207,6 +207,8 @@ class Observation:
         Wall time of this fixation: resizing, detector and binning.
     from_cache : tuple of bool
         For each window, whether its detections were reused rather than computed.
+    boxes_px : numpy.ndarray
+        ``(M, 4)`` ``float64``: every raw detection's box ``x, y, w, h`` in full-image pixels.
 
     """
 
@@ -221,6 +223,7 @@ class Observation:
     from_cache: tuple
     scores: np.ndarray = None
     cells: np.ndarray = None
+    boxes_px: np.ndarray = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -243,6 +246,8 @@ class Scan:
         Pixels given to the detector (0 when the scan was already taken on this image).
     seconds : float
         Wall time of the scan.
+    boxes_px : numpy.ndarray
+        ``(M, 4)`` ``float64``: every raw detection's box ``x, y, w, h`` in full-image pixels.
 
     """
 
@@ -254,6 +259,7 @@ class Scan:
     seconds: float
     scores: np.ndarray = None
     cells: np.ndarray = None
+    boxes_px: np.ndarray = None
 
 
 def cell_edges_px(size_px: int, n_cells: int) -> np.ndarray:
@@ -445,13 +451,14 @@ class Fovea:
             return None
         t0 = time.perf_counter()
         windows = tuple(w for w in self.window_rects(0) if w.whole_image)
-        centres, cells, scores, pixels = [], [], [], 0
+        centres, cells, scores, boxes, pixels = [], [], [], [], 0
         for window in windows:
             found, cost = self._detect(window)
             pixels += cost
             centres.append(found[0])
             cells.append(found[1])
             scores.append(found[2])
+            boxes.append(found[3])
         cells, scores = np.concatenate(cells), np.concatenate(scores)
         raw = np.bincount(cells, minlength=self.grid.n_cells).astype(np.int64)
         counts = self.cells.values(cells, scores, self.grid.n_cells).astype(np.float64)
@@ -460,7 +467,7 @@ class Fovea:
         self.image_seconds += seconds
         return Scan(counts=counts, raw_counts=raw, windows=windows,
                     centres_px=np.concatenate(centres), detector_pixels=pixels, seconds=seconds,
-                    scores=scores, cells=cells)
+                    scores=scores, cells=cells, boxes_px=np.concatenate(boxes))
 
     def observe(self, fixation: int) -> Observation:
         """
@@ -482,7 +489,7 @@ class Fovea:
             windows = tuple(w for w in windows if not w.whole_image)
         rows, cols = self.grid.shape
         observed = np.zeros((rows, cols), dtype=bool)
-        cells, centres, scores, window_index, from_cache = [], [], [], [], []
+        cells, centres, scores, window_index, from_cache, boxes = [], [], [], [], [], []
         pixels = 0
         for i, window in enumerate(windows):
             row, col, n_rows, n_cols = window.cells
@@ -493,6 +500,7 @@ class Fovea:
             centres.append(found[0])
             cells.append(found[1])
             scores.append(found[2])
+            boxes.append(found[3])
             window_index.append(np.full(len(found[1]), i, dtype=np.int64))
         cells, scores = np.concatenate(cells), np.concatenate(scores)
         raw = np.bincount(cells, minlength=rows * cols).astype(np.int64)
@@ -507,7 +515,7 @@ class Fovea:
                            windows=windows, centres_px=np.concatenate(centres),
                            window_index=np.concatenate(window_index), detector_pixels=pixels,
                            seconds=seconds, from_cache=tuple(from_cache), scores=scores,
-                           cells=cells)
+                           cells=cells, boxes_px=np.concatenate(boxes))
 
     def _detect(self, window: Window) -> tuple[tuple, int]:
         """
@@ -525,8 +533,8 @@ class Fovea:
             self._cache[key] = found
         return found, window.resized_px[0] * window.resized_px[1]
 
-    def _search(self, window: Window) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Detect in one window: centres ``(M, 2)`` in full-image pixels, cells, scores."""
+    def _search(self, window: Window) -> tuple:
+        """Detect in one window: centres ``(M, 2)``, cells, scores, boxes ``(M, 4)`` (image px)."""
         x, y, width_px, height_px = window.rect_px
         out_width, out_height = window.resized_px
         crop = self._gray[y:y + height_px, x:x + width_px]
@@ -536,11 +544,13 @@ class Fovea:
             view = cv2.resize(crop, (out_width, out_height),
                               interpolation=self.config.cv2_interpolation)
         boxes, scores = as_detections(self.detector(view))
-        centres = box_centres_px(boxes) * (width_px / out_width, height_px / out_height) + (x, y)
+        back = np.array([width_px / out_width, height_px / out_height])
+        centres = box_centres_px(boxes) * back + (x, y)
+        boxes_px = np.concatenate([boxes[:, :2] * back + (x, y), boxes[:, 2:4] * back], axis=1)
         height, width = self._gray.shape[:2]
         row, col, n_rows, n_cols = window.cells
         cell_row = np.clip(np.floor(centres[:, 1] * self.grid.rows / height).astype(np.int64),
                            row, row + n_rows - 1)
         cell_col = np.clip(np.floor(centres[:, 0] * self.grid.cols / width).astype(np.int64),
                            col, col + n_cols - 1)
-        return centres, cell_row * self.grid.cols + cell_col, scores
+        return centres, cell_row * self.grid.cols + cell_col, scores, boxes_px

@@ -47,8 +47,9 @@ import time
 
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.search import answer
+from ipomdp_gaze.search.many import OccupancySession
 from ipomdp_gaze.search.sensors import run_search
-from ipomdp_gaze.search.session import SearchSession, SearchSettings
+from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
 from ipomdp_gaze.vision.detector import detector_window_px
 from ipomdp_gaze.vision.detectors import detector_from_settings  # noqa: F401 (its old home)
 from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea
@@ -92,6 +93,36 @@ METHODS = ('fovea', 'full_frame')
 # One cell was too few on the composed group photos (docs/faces.md): a 48-90 px face spans 2-4
 # cells of a 640x480 picture and its spread-out detections were found again as a second face.
 FACE_RADIUS = 2
+# search_many: cells within 1 of a face's occupied cell are settled (its spill-over), not
+# searched on; on the training groups (bench/many_faces.py) the spill-over cells next to a face
+# otherwise stayed undecided and drew fixations until the pixel budget.
+SETTLE_RADIUS = 1
+# search_many decides a cell empty by its posterior, not by its evidence alone
+# (OccupancySession's empty_by_evidence): on the training groups (bench/many_faces.py
+# --empty-by-evidence) the evidence rule found the same photo-group faces (47 and 48 of 48) and
+# 17 instead of 9 of 64 small lfw faces at 640x480, but ran every scene to the pixel cap (one full
+# scan); the full-resolution detector alone finds 61 of 64 for those pixels.
+EMPTY_BY_EVIDENCE = False
+
+
+@dataclass(frozen=True)
+class Face:
+    """
+    One face of a many-target search: its box in image pixels, its cell and its probability.
+
+    ``box`` is ``(x, y, w, h)`` in pixels: the detector's merged box, or the rectangle of the
+    face's cells when no box was found there; ``cell`` is ``(row, col)``; ``probability`` is
+    ``P(at least one of the face's cells holds a face)`` (NaN for a full-frame answer).
+    """
+
+    box: tuple
+    cell: tuple
+    probability: float
+
+    def to_dict(self) -> dict:
+        """``{box: [x, y, w, h], cell: [row, col], probability}`` (probability null if NaN)."""
+        return {'box': [float(v) for v in self.box], 'cell': [int(v) for v in self.cell],
+                'probability': None if math.isnan(self.probability) else self.probability}
 
 
 @dataclass(frozen=True, eq=False)
@@ -141,6 +172,8 @@ class ImageSearch:
         (``find --max-side``; ``pixel`` is then in the given image's pixels), else None.
     detections : tuple of (float, float)
         A full-frame scan's grouped detections, box centres ``(x, y)`` in image pixels.
+    faces : tuple of Face
+        A many-target search's faces (:func:`search_many`), most probable first; () otherwise.
 
     """
 
@@ -174,6 +207,7 @@ class ImageSearch:
         """Return the answer's probability: ``P(absent)`` for ``absent``, else the cell's."""
         return answer.answer_probability(self.decision, self.probability,
                                          self.absent_probability)
+    faces: tuple = ()
 
     @property
     def size_matches(self) -> bool:
@@ -414,7 +448,7 @@ def full_frame_search(image: np.ndarray, fovea: Fovea, note: str = '',
     One full-resolution detector scan instead of the fovea: each grouped detection a face.
 
     Returns one ``found`` result per grouped box (largest first), then one ``absent``; the
-    probability is NaN (no belief is computed).
+    probability is NaN (no belief is computed). Each result's ``faces`` holds every box.
     """
     from ipomdp_gaze.vision.fullframe import cells_of_points, scan
     t0 = time.perf_counter()
@@ -424,15 +458,19 @@ def full_frame_search(image: np.ndarray, fovea: Fovea, note: str = '',
     boxes = found.grouped_px
     order = np.argsort(-(boxes[:, 2] * boxes[:, 3]), kind='stable') if len(boxes) else []
     seconds = time.perf_counter() - t0
-    centres = tuple((float(x + w / 2), float(y + h / 2)) for x, y, w, h in boxes)
     common = {'fixations': 0, 'path': (), 'detector_pixels': found.detector_pixels,
               'seconds': seconds, 'image_px': image_px, 'calibrated_px': calibrated_px,
-              'method': 'full_frame', 'note': note, 'detections': centres}
+              'method': 'full_frame', 'note': note}
+    centres = boxes[:, :2] + boxes[:, 2:] / 2 if len(boxes) else np.zeros((0, 2))
+    common['detections'] = tuple((float(x), float(y)) for x, y in centres)
+    cells = cells_of_points(centres, image.shape[:2], grid)
+    common['faces'] = tuple(Face(box=tuple(float(v) for v in boxes[k]),
+                                 cell=tuple(int(v) for v in grid.cell(int(cells[k]))),
+                                 probability=math.nan) for k in order)
     results = []
     for k in order:
-        x, y, w, h = boxes[k]
-        centre = np.array([[x + w / 2, y + h / 2]])
-        cell = int(cells_of_points(centre, image.shape[:2], grid)[0])
+        centre = centres[k][None, :]
+        cell = int(cells[k])
         belief = np.zeros(grid.n_cells)
         belief[cell] = 1.0
         results.append(ImageSearch(cell=tuple(int(v) for v in grid.cell(cell)),
@@ -449,3 +487,116 @@ def size_distance(image_px: tuple[int, int], calibrated_px: tuple[int, int]) -> 
     """How far apart two image sizes are in scale: ``|log(w/w0)| + |log(h/h0)|``."""
     return abs(math.log(image_px[0] / calibrated_px[0])) + \
         abs(math.log(image_px[1] / calibrated_px[1]))
+
+
+class _Recorder:
+    """A fovea sensor that keeps every raw box and score it produced (for counting faces)."""
+
+    def __init__(self, fovea: Fovea):
+        self.sensor = FoveaSensor(fovea)
+        self.grid, self.scans = self.sensor.grid, self.sensor.scans
+        self.boxes, self.scores = [], []
+
+    def start(self, scene):
+        self.sensor.start(scene)
+
+    def scan_cost(self):
+        return self.sensor.scan_cost()
+
+    def fixation_cost(self, cell):
+        return self.sensor.fixation_cost(cell)
+
+    def _keep(self, observation):
+        self.boxes.append(observation.boxes_px)
+        self.scores.append(observation.scores)
+
+    def scan(self):
+        scan = self.sensor.fovea.scan()
+        if scan is None:
+            return None
+        self._keep(scan)
+        return Frame(scan.counts, kind='scan', detector_pixels=scan.detector_pixels,
+                     seconds=scan.seconds)
+
+    def observe(self, cell):
+        obs = self.sensor.fovea.observe(int(cell))
+        self._keep(obs)
+        return Frame(obs.counts, detector_pixels=obs.detector_pixels, seconds=obs.seconds)
+
+
+_COSTS = {}
+
+
+def fixation_costs(fovea: Fovea, image_px: tuple[int, int]) -> np.ndarray:
+    """
+    Detector pixels of a fixation at each cell of an image of ``image_px``, (N,), cached.
+
+    The windows of the fixation without the whole-image ones when the fovea scans once (as
+    :meth:`Fovea.fixation_cost` on a fresh image).
+    """
+    key = (fovea.grid.shape, fovea.config, image_px)
+    if key not in _COSTS:
+        if len(_COSTS) >= 64:
+            _COSTS.pop(next(iter(_COSTS)))
+        shape = (image_px[1], image_px[0])
+        _COSTS[key] = np.array([
+            sum(w.resized_px[0] * w.resized_px[1] for w in fovea.window_rects(k, shape)
+                if not (fovea.config.scan_once and w.whole_image))
+            for k in range(fovea.grid.n_cells)], dtype=float)
+    return _COSTS[key]
+
+
+def search_many(image: np.ndarray, fovea: Fovea, model,
+                settings: SearchSettings | None = None, *,
+                pixel_budget: int | None = None, link: int = FACE_RADIUS,
+                settle: int = SETTLE_RADIUS,
+                empty_by_evidence: bool = EMPTY_BY_EVIDENCE) -> ImageSearch:
+    """
+    Search one image for every face at once: the many-target belief (``search.targets: many``).
+
+    One search session over the occupancy of every cell (:class:`ipomdp_gaze.search.many.
+    OccupancySession`): the scan, then the fixation with the largest expected drop of the
+    summed cell entropies per detector pixel, until every cell is decided at the confidence
+    (or the budget, or ``pixel_budget``: one full scan for ``find``). The faces are the clusters
+    of occupied cells, each counted once and split where the detector's merged boxes are
+    distinct faces (:func:`ipomdp_gaze.model.occupancy.count_faces`, cells within ``link`` of each
+    other are one cluster); cells within ``settle`` of an occupied cell need no decision of
+    their own (:class:`~ipomdp_gaze.search.many.OccupancySession`, ``link``). ``decision`` is
+    ``found`` when a face was reported, else ``absent`` (or ``gave_up``).
+
+    Raises
+    ------
+    ValueError
+        For a model that does not fit the fovea, a bad image or settings the belief refuses.
+
+    """
+    t0 = time.perf_counter()
+    check_model(model, fovea)
+    settings = replace(FIND_SETTINGS if settings is None else settings, targets='many')
+    image_px = check_image(image, fovea)
+    session = OccupancySession(fovea.grid, model, settings,
+                               costs=fixation_costs(fovea, image_px), link=settle,
+                               empty_by_evidence=empty_by_evidence)
+    sensor = _Recorder(fovea)
+    outcome = run_search(session, sensor, image, pixel_budget=pixel_budget)
+    boxes = np.concatenate(sensor.boxes) if sensor.boxes else np.zeros((0, 4))
+    scores = np.concatenate(sensor.scores) if sensor.scores else np.zeros(0)
+    grid = fovea.grid
+    found = session.faces(boxes, scores, image_px, link)
+    faces = tuple(Face(box=tuple(float(v) for v in f['box']),
+                       cell=tuple(int(v) for v in grid.cell(f['cell'])),
+                       probability=f['probability']) for f in found)
+    stop = outcome.reason if outcome.reason else outcome.decision
+    decision = outcome.decision
+    if decision in ('found', 'absent'):
+        decision = 'found' if faces else 'absent'
+    best = outcome.cell
+    return ImageSearch(cell=tuple(int(v) for v in grid.cell(best)),
+                       pixel=cell_centre_px(grid, best, image_px),
+                       probability=outcome.probability, fixations=outcome.fixations,
+                       path=tuple(tuple(int(v) for v in grid.cell(k)) for k in outcome.path),
+                       stop=stop, detector_pixels=outcome.detector_pixels,
+                       seconds=time.perf_counter() - t0, belief=outcome.belief,
+                       image_px=image_px, calibrated_px=calibrated_size(model),
+                       decision=decision, absent_probability=outcome.absent_probability,
+                       log=outcome.log, faces=faces)

@@ -54,6 +54,7 @@ def annotate_image_search(image: np.ndarray, result, fovea) -> np.ndarray:
         detections = np.asarray(result.detections, dtype=np.float64) * factor
     reason = 'full_frame' if result.method == 'full_frame' else result.stop
     label = ''
+    faces = getattr(result, 'faces', ())
     if result.decision == 'absent':
         found = None
         label = (f'{answer.heading("absent", reason)}: '
@@ -64,9 +65,24 @@ def annotate_image_search(image: np.ndarray, result, fovea) -> np.ndarray:
             found_label = 'most likely'
         else:
             found_label = 'found, forced' if answer.forced('found', reason) else 'found'
-    return annotate(big, cell_map, result.belief, path, windows, detections=detections,
-                    found=found, label=label,
-                    **({} if found is None else {'found_label': found_label}))
+    if faces:                   # many targets: every face's box instead of one answer
+        found = None
+    picture = annotate(big, cell_map, result.belief, path, windows, detections=detections,
+                       found=found, label=label,
+                       **({} if found is None else {'found_label': found_label}))
+    return draw_faces(picture, faces, factor)
+
+
+def draw_faces(picture: np.ndarray, faces, factor: int = 1) -> np.ndarray:
+    """Draw each face's box (image pixels times ``factor``) and its number on an RGB picture."""
+    out = np.ascontiguousarray(picture)
+    thickness = max(2, factor)
+    for i, face in enumerate(faces):
+        x, y, w, h = (int(round(v * factor)) for v in face.box)
+        cv2.rectangle(out, (x, y), (x + w, y + h), (0, 255, 0), thickness)
+        cv2.putText(out, str(i), (x + 2, max(12, y - 4)), cv2.FONT_HERSHEY_SIMPLEX,
+                    0.5 * max(1, factor), (0, 255, 0), max(1, factor // 2 + 1))
+    return out
 
 
 def save_figure(picture: np.ndarray, out_path: Path, title: str) -> None:

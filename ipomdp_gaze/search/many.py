@@ -1,0 +1,366 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The search session for many targets (``search.targets: many``; docs/design.md section 11).
+
+The same steps and results as :class:`ipomdp_gaze.search.session.SearchSession` (``reset``,
+``scan``, ``start``, ``update``, ``stop``; :class:`~ipomdp_gaze.search.session.StepResult`), so
+:func:`ipomdp_gaze.search.sensors.run_search` drives either, on the occupancy belief of
+:mod:`ipomdp_gaze.model.occupancy`:
+
+1. ``reset``: every cell's log odds ``log(q / (1 - q))`` with ``(1 - q)^N = absent_prior``
+   (:func:`~ipomdp_gaze.model.occupancy.cell_prior`; ``q = 1/N`` without one);
+2. ``scan``: ``L_j += log s_T(c_j) - log s_N(c_j)``;
+3. ``update``: ``L_j += l_j`` of the frame (the single-target belief's own term), with a still
+   scene's repeated views weighted by ``repeat_weight`` (:mod:`ipomdp_gaze.model.still_evidence`:
+   1 is naive Bayes);
+4. stop when every cell is decided at ``confidence`` either way (``P(x_j) >= c`` occupied;
+   empty by default when its evidence alone says so, ``L_j - L_prior <= -log(c / (1 - c))``,
+   or with ``empty_by_evidence=False`` when ``P(x_j) <= 1 - c``; with ``link`` r > 0 a cell
+   within r cells of an occupied one is settled too: it would join that face's cluster, so it
+   cannot be another face): ``found``
+   if a cell is occupied, else ``absent``; at the fixation budget or a driver's cost cap
+   (:meth:`stop`), ``gave_up`` or, with ``decide_at_budget``, every cell by its likelier side;
+   ``gave_up`` (reason ``repeat``) when no view left would tell anything new;
+5. otherwise the next fixation maximises the expected reduction of the summed cell entropies per
+   unit cost: ``argmax_k sum_j w_kj I(P(x_j); offset_jk) / cost_k`` over unvisited cells, with
+   ``w_kj = 1`` where view k sees cell j at a more informative offset (ELM kernel) than any view
+   so far, ``repeat_weight`` otherwise, and 0 for a cell settled by ``link``.
+
+The answer for drivers: :meth:`OccupancySession.faces` (one face per cluster of occupied cells,
+:func:`ipomdp_gaze.model.occupancy.count_faces`). The session imports no ROS, prints and writes
+nothing.
+"""
+from __future__ import annotations
+
+from collections import deque
+
+from ipomdp_gaze.model.belief import argmax_ties_low, EvidenceError
+from ipomdp_gaze.model.observation import as_observation, check_evidence, CountObservation
+from ipomdp_gaze.model.occupancy import (binary_entropy, cell_prior, count_faces, decided,
+                                         information_table, log_nobody, occupancy,
+                                         prior_log_odds)
+from ipomdp_gaze.model.still_evidence import StillEvidence
+from ipomdp_gaze.search.session import Frame, OrderError, SearchSettings, start_index, StepResult
+import numpy as np
+from scipy.ndimage import maximum_filter
+
+# Gains below this (nats per unit cost, relative to the best) count as nothing left to learn.
+MIN_GAIN = 1e-9
+
+
+def check_many_settings(settings: SearchSettings) -> None:
+    """Refuse settings the many-target belief does not model (ValueError naming them)."""
+    if settings.moving:
+        raise ValueError('search.targets many models still targets: set motion.sigma_cells '
+                         'and motion.jump_prob to 0')
+    if len(settings.false_alarm_scales) > 1 or settings.hotspot_prior > 0:
+        raise ValueError('search.targets many does not model false-alarm scales or hotspots: '
+                         'leave search.false_alarm_scales [1.0] and search.hotspot_prior 0')
+
+
+class OccupancySession:
+    """
+    One many-target search at a time on one grid (module docstring).
+
+    Parameters
+    ----------
+    grid : Grid
+        The visual array.
+    observation
+        The assumed observation model (count or Gaussian) or an FPOC.
+    settings : SearchSettings
+        ``confidence``, ``max_fixations``, ``inhibit_return``, ``stop_on_repeat``,
+        ``repeat_weight``, ``absent_prior``, ``start_cell``, ``scan``, ``decide_at_budget``.
+    costs : array (N,), optional
+        Cost of a fixation at each cell (detector pixels for the fovea); 1 each by default.
+    link : int
+        Cells within this many cells (Chebyshev) of a cell decided occupied are settled
+        (module docstring); 0: every cell is decided on its own.
+    empty_by_evidence : bool
+        Decide a cell empty only when its evidence alone says so: ``L_j - L_prior <=
+        -log(c / (1 - c))`` (a likelihood-ratio test, so a sparse prior cannot decide a cell
+        nobody looked at well; Wald: a face's cell is decided empty with probability at most
+        ``(1 - c) / c``). Off: the posterior ``P <= 1 - c`` decides, and a sparse prior
+        decides every cell nobody looked at (``find`` chooses that, for its cost).
+    log_size : int
+        Events kept in :attr:`log`.
+
+    """
+
+    def __init__(self, grid, observation, settings: SearchSettings | None = None,
+                 costs=None, link: int = 0, empty_by_evidence: bool = True,
+                 log_size: int = 10_000):
+        self.grid = grid
+        self.observation = as_observation(grid, observation)
+        self.settings = settings or SearchSettings(targets='many')
+        self.settings.check_grid(grid)
+        check_many_settings(self.settings)
+        self.policy = None
+        self.link = int(link)
+        self.empty_by_evidence = bool(empty_by_evidence)
+        self.table = information_table(self.observation)
+        self._view_info = self.table.view_information                     # [k, j]
+        self.costs = np.ones(grid.n_cells) if costs is None else \
+            np.broadcast_to(np.asarray(costs, dtype=float), (grid.n_cells,)).copy()
+        if np.any(~np.isfinite(self.costs) | (self.costs <= 0)):
+            raise ValueError('fixation costs must be finite and > 0')
+        self._counts = isinstance(self.observation, CountObservation)
+        self._still = StillEvidence(grid.n_cells)
+        self._log = deque(maxlen=int(log_size))
+        self.rng = np.random.default_rng(0)
+        self._state = None
+
+    # -- read-only views -----------------------------------------------------------------
+    def _s(self) -> dict:
+        if self._state is None:
+            raise OrderError('reset the session before using it')
+        return self._state
+
+    @property
+    def log_odds(self) -> np.ndarray:
+        """``L_j`` (N,), a copy."""
+        s = self._s()
+        return s['base'] + self._still.log_likelihood_ratio(self.settings.repeat_weight)
+
+    @property
+    def belief(self) -> np.ndarray:
+        """``P(x_j = 1)`` (N,): each cell's probability of holding a target."""
+        return occupancy(self.log_odds)
+
+    @property
+    def absent_probability(self) -> float:
+        """``P(nobody here) = prod_j (1 - P(x_j = 1))``."""
+        return float(np.exp(log_nobody(self.log_odds)))
+
+    @property
+    def map_cell(self) -> int:
+        """Return the most probable cell (ties to the lowest index)."""
+        return int(argmax_ties_low(self.log_odds))
+
+    @property
+    def map_probability(self) -> float:
+        """``P(x_j = 1)`` of :attr:`map_cell`."""
+        return float(occupancy(self.log_odds[self.map_cell]))
+
+    @property
+    def entropy_nats(self) -> float:
+        """Return the summed cell entropies ``sum_j H(P(x_j))`` in nats."""
+        return float(binary_entropy(self.belief).sum())
+
+    def occupied(self) -> np.ndarray:
+        """Return the occupied cells (N,): ``P >= confidence``; after a deadline ``P > 1/2``."""
+        s, log_odds = self._s(), self.log_odds
+        if s['reason'] and self.settings.decide_at_budget:
+            return log_odds > 0
+        return self._decided(log_odds)[0]
+
+    fixation = property(lambda self: self._s()['fixation'])
+    fixations = property(lambda self: self._s()['fixations'])
+    path = property(lambda self: tuple(self._s()['path']))
+    visited = property(lambda self: self._s()['visited'].copy())
+    decision = property(lambda self: self._s()['decision'])
+    gave_up_reason = property(lambda self: self._s()['reason'])
+    ended = property(lambda self: self._s()['ended'])
+    log = property(lambda self: tuple(self._log))
+
+    def faces(self, boxes=None, scores=None, image_px=None, link: int = 2) -> list[dict]:
+        """Return the faces, each counted once (``occupancy.count_faces``)."""
+        return count_faces(self.log_odds, self.grid, self.occupied(), boxes, scores, image_px,
+                           link)
+
+    # -- the steps -----------------------------------------------------------------------
+    def reset(self, *, seed=None) -> None:
+        """Start a new search: every cell at the prior ``q`` (module docstring)."""
+        if isinstance(seed, np.random.Generator):
+            self.rng = seed
+        elif seed is not None:
+            self.rng = np.random.default_rng(seed)
+        q = cell_prior(self.grid.n_cells, self.settings.absent_prior)
+        self._still.reset()
+        self._best = np.zeros(self.grid.n_cells)
+        prior = prior_log_odds(self.grid.n_cells, q)
+        self._state = {'base': prior, 'prior': prior, 'fixation': None,
+                       'fixations': 0, 'path': [], 'scanned': False, 'decision': '',
+                       'reason': '', 'ended': False,
+                       'visited': np.zeros(self.grid.n_cells, dtype=bool)}
+        self._event('reset', settings=self.settings.to_parameters(), cell_prior=q)
+
+    def exclude(self, cells) -> None:
+        """Not used by the many-target belief: every cell stays a hypothesis of its own."""
+        if len(np.atleast_1d(cells)):
+            raise ValueError('a many-target search excludes no cells: each cell is its own '
+                             'occupancy')
+
+    def check_frame(self, values) -> np.ndarray:
+        """Return a frame's values as floats (N,), or raise :class:`EvidenceError`."""
+        obs = check_evidence(values, self.grid.n_cells)
+        if self._counts:
+            self.observation.counts(obs)
+        return obs
+
+    def scan(self, frame: Frame) -> StepResult:
+        """Apply the one-time scan: ``L_j += log s_T(c_j) - log s_N(c_j)`` (once, first)."""
+        s = self._s()
+        if s['fixation'] is not None or s['scanned']:
+            raise OrderError('the one-time scan comes once, before the first fixation')
+        if not self.settings.scan:
+            return self._result('applied', reason='scan off')
+        try:
+            term = self.observation.scan_log_likelihood_ratio(
+                check_evidence(frame.values, self.grid.n_cells))
+        except EvidenceError as exc:
+            return self._result('rejected', reason=str(exc))
+        s['scanned'] = True
+        s['base'] = s['base'] + term
+        self._event('scan', frame=frame.summary(), belief=self._summary())
+        return self._result('applied')
+
+    def start(self) -> int:
+        """
+        Choose the first fixation: the start cell, the choice after a scan, or the centre.
+
+        After a scan that decided every cell the search ends here (:attr:`ended`): no fixation.
+        """
+        s = self._s()
+        if s['fixation'] is not None:
+            raise OrderError('the search has started already; reset starts a new one')
+        fixed = start_index(self.grid, self.settings)
+        if fixed is not None:
+            s['fixation'] = fixed
+        elif s['scanned'] or self.settings.start_cell == 'policy':
+            s['fixation'] = self._choose()
+            if s['fixation'] is None:
+                s['fixation'] = self.grid.center_index
+        else:
+            s['fixation'] = self.grid.center_index
+        fired = self._decide() if s['scanned'] else ''
+        self._event('start', fixation=self._rc(s['fixation']), decision=fired)
+        return s['fixation']
+
+    def fixate(self, cell: int) -> None:
+        """Take the next frame at ``cell`` instead of the chosen one."""
+        s = self._s()
+        if s['fixation'] is None:
+            raise OrderError('start the search before fixating')
+        self.grid.cell(int(cell))
+        s['fixation'] = int(cell)
+
+    def update(self, frame: Frame, dt_s: float = 0.0) -> StepResult:
+        """Apply a frame taken at the current fixation; decide; choose the next fixation."""
+        s = self._s()
+        if s['fixation'] is None:
+            raise OrderError('start the search (the first fixation) before updating it')
+        if s['ended']:
+            raise OrderError(f'the search has ended ({s["decision"]}); reset starts a new one')
+        k = s['fixation']
+        try:
+            obs = self.check_frame(frame.values)
+            term = self.observation.log_likelihood_ratio(obs, k)
+        except EvidenceError as exc:
+            return self._result('rejected', reason=str(exc))
+        information = np.where(np.isnan(obs), 0.0, self._view_info[k])
+        self._still.add(term, information)
+        np.maximum(self._best, information, out=self._best)
+        s['fixations'] += 1
+        s['path'].append(k)
+        s['visited'][k] = True
+        fired = self._decide()
+        if not s['ended']:
+            following = self._choose()
+            if following is None:
+                fired = self._limit('repeat')
+            else:
+                s['fixation'] = following
+        self._event('frame', fixation=self._rc(k), frame=frame.summary(),
+                    belief=self._summary(), decision=s['decision'], fired=fired,
+                    reason=s['reason'])
+        return self._result('applied', fired=fired)
+
+    def stop(self, reason: str) -> StepResult:
+        """End the search at a limit outside the session (a cost cap), as the budget does."""
+        s = self._s()
+        if s['fixation'] is None or s['ended']:
+            raise OrderError('stop a search that has started and not ended')
+        fired = self._limit(str(reason))
+        self._event('stop', reason=s['reason'], decision=fired, belief=self._summary())
+        return self._result('applied', fired=fired)
+
+    # -- inside ------------------------------------------------------------------------------
+    def settled(self, occupied: np.ndarray) -> np.ndarray:
+        """Cells (N,) within ``link`` cells of an occupied one, the occupied ones included."""
+        if self.link <= 0:
+            return occupied
+        side = 2 * self.link + 1
+        grid = occupied.reshape(self.grid.shape)
+        return maximum_filter(grid, size=side, mode='constant', cval=False).reshape(-1)
+
+    def gains(self, log_odds: np.ndarray | None = None) -> np.ndarray:
+        """
+        Return the expected drop of the summed cell entropies per fixation cell (N,), nats.
+
+        ``sum_j w_kj I(P(x_j); offset_jk)``, ``w_kj`` 1 for a view more informative than any
+        so far (ELM kernel), else ``repeat_weight`` (module docstring).
+        """
+        log_odds = self.log_odds if log_odds is None else log_odds
+        info = self.table(log_odds)                                        # (N, N) [k, j]
+        weight = np.where(self._view_info > self._best[None, :], 1.0,
+                          self.settings.repeat_weight)
+        if self.link > 0:
+            settled = self.settled(self._decided(log_odds)[0])
+            weight = weight * ~settled[None, :]
+        return np.einsum('kj,kj->k', info, weight)
+
+    def _choose(self) -> int | None:
+        s = self._s()
+        score = self.gains() / self.costs
+        if self.settings.inhibit_return:
+            score = np.where(s['visited'], -np.inf, score)
+        if not np.isfinite(score).any() or score.max() <= MIN_GAIN / self.costs.min():
+            return None
+        return int(argmax_ties_low(score))
+
+    def _decided(self, log_odds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Cells decided occupied and empty (N,) (``empty_by_evidence``: the evidence alone)."""
+        occupied, empty = decided(log_odds, self.settings.confidence)
+        if self.empty_by_evidence:
+            empty = empty & decided(log_odds - self._s()['prior'], self.settings.confidence)[1]
+        return occupied, empty
+
+    def _decide(self) -> str:
+        s, settings = self._state, self.settings
+        occupied, empty = self._decided(self.log_odds)
+        if np.all(self.settled(occupied) | empty):
+            s['decision'] = 'found' if occupied.any() else 'absent'
+            s['ended'] = True
+            return s['decision']
+        if settings.max_fixations and s['fixations'] >= settings.max_fixations:
+            return self._limit('budget')
+        return ''
+
+    def _limit(self, reason: str) -> str:
+        s = self._state
+        decision = 'gave_up'
+        if self.settings.decide_at_budget:
+            decision = 'found' if np.any(self.log_odds > 0) else 'absent'
+        s['decision'], s['reason'], s['ended'] = decision, reason, True
+        return decision
+
+    def _rc(self, cell: int) -> list:
+        return [int(v) for v in self.grid.cell(int(cell))]
+
+    def _summary(self) -> dict:
+        occupied, empty = self._decided(self.log_odds)
+        return {'map_cell': self._rc(self.map_cell), 'map_probability': self.map_probability,
+                'absent_probability': self.absent_probability,
+                'entropy_nats': self.entropy_nats, 'occupied': int(occupied.sum()),
+                'undecided': int((~occupied & ~empty).sum())}
+
+    def _event(self, kind: str, **data) -> None:
+        self._log.append({'event': kind, **data})
+
+    def _result(self, status: str, reason: str = '', fired: str = '') -> StepResult:
+        s = self._state
+        return StepResult(status, s['fixations'], self.map_cell, self.map_probability,
+                          self.absent_probability, reason or s['reason'], s['decision'], fired,
+                          None if s['ended'] else s['fixation'], s['ended'])

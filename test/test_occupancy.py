@@ -1,0 +1,440 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""The many-target occupancy belief against brute-force Bayes over every occupancy pattern."""
+import itertools
+import math
+
+from ipomdp_gaze.model.fpoc import make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import CountObservation, GaussianObservation
+from ipomdp_gaze.model.occupancy import (binary_entropy, cell_prior, channel_information,
+                                         clusters, count_faces, decided, InformationTable,
+                                         log_nobody, occupancy, one_target_belief,
+                                         prior_log_odds, update_log_odds)
+from ipomdp_gaze.search.many import OccupancySession
+from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
+import numpy as np
+import pytest
+
+
+def _tables(grid, k, rng, informative_radius=None):
+    """Random count tables (rows, cols, K); offsets beyond the radius equal (say nothing)."""
+    pt = rng.dirichlet(np.ones(k), size=grid.shape)
+    pn = rng.dirichlet(np.ones(k), size=grid.shape)
+    if informative_radius is not None:
+        dr, dc = np.meshgrid(np.arange(grid.rows), np.arange(grid.cols), indexing='ij')
+        far = np.maximum(dr, dc) > informative_radius
+        pt[far] = pn[far]
+    return pt, pn
+
+
+def _model(grid, k=3, seed=0, radius=None):
+    rng = np.random.default_rng(seed)
+    pt, pn = _tables(grid, k, rng, radius)
+    return CountObservation(grid, pt, pn, scan_target=rng.dirichlet(np.ones(k)),
+                            scan_null=rng.dirichlet(np.ones(k)))
+
+
+def _patterns(n):
+    return np.array(list(itertools.product((0, 1), repeat=n)), dtype=bool)       # (2^N, N)
+
+
+def _cell_log_lik(model, frame, fixation, occupied):
+    """Return log p(o_j | x_j) per cell (N,) for the pattern's x; NaN cells 0."""
+    offsets = model.offsets(fixation)
+    counts = np.nan_to_num(frame).astype(int)
+    table = np.where(occupied[:, None], model.p_target.reshape(-1, model.max_count + 1)[offsets],
+                     model.p_null.reshape(-1, model.max_count + 1)[offsets])
+    out = np.log(table[np.arange(frame.size), counts])
+    return np.where(np.isnan(frame), 0.0, out)
+
+
+def _brute_posterior(model, q, frames, fixations, scan=None):
+    """P(pattern | frames) over all 2^N patterns, exactly by enumeration."""
+    n = model.grid.n_cells
+    patterns = _patterns(n)
+    log_p = patterns.sum(1) * math.log(q) + (n - patterns.sum(1)) * math.log1p(-q)
+    for x, pattern in enumerate(patterns):
+        if scan is not None:
+            counts = scan.astype(int)
+            log_p[x] += np.log(np.where(pattern, model.scan_target[counts],
+                                        model.scan_null[counts])).sum()
+        for frame, k in zip(frames, fixations):
+            log_p[x] += _cell_log_lik(model, frame, k, pattern).sum()
+    post = np.exp(log_p - log_p.max())
+    return patterns, post / post.sum()
+
+
+def _frames(model, rng, fixations, truth, nan_share=0.3, spill=0):
+    """Frames from a world with targets at ``truth``; neighbours of a target get +spill counts."""
+    grid, k = model.grid, model.max_count + 1
+    frames = []
+    for fixation in fixations:
+        frame = np.zeros(grid.n_cells)
+        offsets = model.offsets(fixation)
+        for j in range(grid.n_cells):
+            table = model.p_target if truth[j] else model.p_null
+            frame[j] = rng.choice(k, p=table.reshape(-1, k)[offsets[j]])
+        if spill:
+            r, c = np.divmod(np.flatnonzero(truth), grid.cols)
+            rr, cc = np.divmod(np.arange(grid.n_cells), grid.cols)
+            near = np.any((np.maximum(np.abs(rr[:, None] - r), np.abs(cc[:, None] - c)) == 1),
+                          axis=1)
+            frame = np.where(near, np.minimum(frame + spill, k - 1), frame)
+        frame[rng.random(grid.n_cells) < nan_share] = np.nan
+        frames.append(frame)
+    return frames
+
+
+@pytest.mark.parametrize('spill', [0, 2])
+def test_occupancy_equals_brute_force_enumeration(spill):
+    grid = Grid(2, 3)
+    model = _model(grid, k=4, seed=3)
+    rng = np.random.default_rng(7)
+    truth = np.zeros(grid.n_cells, dtype=bool)
+    truth[[1, 5]] = True
+    fixations = [0, 4, 2, 2]
+    frames = _frames(model, rng, fixations, truth, spill=spill)
+    scan = rng.integers(0, 4, grid.n_cells).astype(float)
+    q = 0.2
+    log_odds = prior_log_odds(grid.n_cells, q) + model.scan_log_likelihood_ratio(scan)
+    for frame, k in zip(frames, fixations):
+        log_odds = update_log_odds(log_odds, model.log_likelihood_ratio(frame, k))
+    patterns, post = _brute_posterior(model, q, frames, fixations, scan)
+    assert np.any(np.isnan(np.array(frames)))                    # unobserved cells are tested
+    np.testing.assert_allclose(occupancy(log_odds), post @ patterns, rtol=1e-10)
+    np.testing.assert_allclose(np.exp(log_nobody(log_odds)), post[0], rtol=1e-10)
+    # Conditioned on exactly one occupied cell: the single-target belief's softmax.
+    one = patterns.sum(1) == 1
+    np.testing.assert_allclose(one_target_belief(log_odds),
+                               post[one][np.argsort(np.argmax(patterns[one], 1))]
+                               / post[one].sum(), rtol=1e-10)
+
+
+def test_session_matches_brute_force_and_in_place_update():
+    grid = Grid(2, 2)
+    model = _model(grid, seed=11)
+    rng = np.random.default_rng(2)
+    truth = np.array([True, False, False, True])
+    fixations = [3, 0, 1]
+    frames = _frames(model, rng, fixations, truth)
+    settings = SearchSettings(targets='many', confidence=0.999, absent_prior=0.3)
+    session = OccupancySession(grid, model, settings)
+    session.reset()
+    session.start()
+    for frame, k in zip(frames, fixations):
+        session.fixate(k)
+        assert session.update(Frame(frame)).applied
+    q = cell_prior(grid.n_cells, 0.3)
+    assert (1 - q) ** grid.n_cells == pytest.approx(0.3)
+    patterns, post = _brute_posterior(model, q, frames, fixations)
+    np.testing.assert_allclose(session.belief, post @ patterns, rtol=1e-10)
+    assert session.absent_probability == pytest.approx(post[0], rel=1e-10)
+    out = np.zeros(grid.n_cells)
+    update_log_odds(np.ones(grid.n_cells), np.arange(4.0), out=out)
+    np.testing.assert_array_equal(out, [1, 2, 3, 4])
+
+
+@pytest.mark.parametrize('absent_prior', [0.0, 0.25])
+@pytest.mark.parametrize('kind', ['gaussian', 'counts'])
+def test_single_target_is_occupancy_conditioned_on_one(kind, absent_prior):
+    """The paper's belief (session, one target) = the occupancy given exactly / at most one."""
+    grid = Grid(3, 3)
+    model = (GaussianObservation(grid, make_fpoc('human')) if kind == 'gaussian'
+             else _model(grid, k=5, seed=4))
+    rng = np.random.default_rng(5)
+    settings = SearchSettings(absent_prior=absent_prior, confidence=1 - 1e-15)
+    one = SearchSession(grid, model, None, settings)
+    one.reset()
+    one.start()
+    n = grid.n_cells
+    # q / (1 - q) = (1 - a) / (N a): the at-most-one conditional has the absent prior a.
+    q = 1.0 / n if absent_prior == 0 else 1.0 / (1.0 + n * absent_prior / (1 - absent_prior))
+    log_odds = prior_log_odds(n, q)
+    for t in range(6):
+        k = int(rng.integers(n))
+        frame = model.sample(4, k, rng)
+        frame[rng.random(n) < 0.2] = np.nan
+        one.fixate(k)
+        one.update(Frame(frame))
+        log_odds = update_log_odds(log_odds, model.log_likelihood_ratio(frame, k))
+    expected = one_target_belief(log_odds, absent=absent_prior > 0)
+    np.testing.assert_allclose(np.exp(one.log_belief), expected, rtol=1e-9, atol=1e-15)
+
+
+def _brute_expected_entropy_drop(model, log_odds, fixation):
+    """H(before) - E[H(after)] of the summed cell entropies, over every possible frame."""
+    k = model.max_count + 1
+    n = model.grid.n_cells
+    p = occupancy(log_odds)
+    offsets = model.offsets(fixation)
+    pt = model.p_target.reshape(-1, k)[offsets]
+    pn = model.p_null.reshape(-1, k)[offsets]
+    before = binary_entropy(p).sum()
+    expected = 0.0
+    for frame in itertools.product(range(k), repeat=n):
+        c = np.array(frame)
+        m = p * pt[np.arange(n), c] + (1 - p) * pn[np.arange(n), c]
+        prob = np.prod(m)
+        after = update_log_odds(log_odds, model.log_likelihood_ratio(c.astype(float), fixation))
+        expected += prob * binary_entropy(occupancy(after)).sum()
+    return before - expected
+
+
+def test_infomax_gain_equals_brute_force_expected_entropy():
+    grid = Grid(2, 2)
+    model = _model(grid, k=3, seed=21, radius=0)     # a view tells only about its own cell
+    log_odds = np.array([-2.0, 0.3, 1.5, -0.2])
+    table = InformationTable(model)
+    gains = table(log_odds).sum(axis=1)
+    brute = np.array([_brute_expected_entropy_drop(model, log_odds, k) for k in range(4)])
+    offsets = model.offsets(np.arange(4))
+    k = model.max_count + 1
+    exact = channel_information(occupancy(log_odds)[None, :],
+                                model.p_target.reshape(-1, k)[offsets],
+                                model.p_null.reshape(-1, k)[offsets]).sum(axis=1)
+    np.testing.assert_allclose(exact, brute, rtol=1e-10)
+    np.testing.assert_allclose(gains, brute, rtol=2e-3)
+    session = OccupancySession(grid, model, SearchSettings(targets='many'),
+                               costs=[1.0, 1.0, 3.0, 1.0])
+    session.reset()
+    np.testing.assert_allclose(session.gains(log_odds), brute, rtol=2e-3)
+    assert session.gains(log_odds).argmax() == brute.argmax()
+
+
+def test_infomax_choice_per_cost_with_spread_views():
+    grid = Grid(3, 3)
+    model = _model(grid, k=3, seed=8, radius=1)
+    costs = np.linspace(1.0, 2.0, 9)
+    session = OccupancySession(grid, model, SearchSettings(targets='many', scan=False,
+                                                           start_cell='policy'), costs=costs)
+    session.reset()
+    first = session.start()
+    k = model.max_count + 1
+    offsets = model.offsets(np.arange(9))
+    p = session.belief
+    exact = channel_information(p[None, :], model.p_target.reshape(-1, k)[offsets],
+                                model.p_null.reshape(-1, k)[offsets]).sum(axis=1)
+    assert first == int(np.argmax(exact / costs))
+    assert np.all(exact[[0, 2, 6, 8]] < exact[4])       # corners see 4 cells, the centre 9
+
+
+def test_stop_rules_decided_budget_and_repeat():
+    grid = Grid(2, 2)
+    pt = np.tile([0.05, 0.95], (2, 2, 1))
+    pn = np.tile([0.95, 0.05], (2, 2, 1))
+    model = CountObservation(grid, pt, pn)
+    settings = SearchSettings(targets='many', confidence=0.99, absent_prior=0.5,
+                              inhibit_return=True)
+    session = OccupancySession(grid, model, settings)
+    session.reset()
+    session.start()
+    for _ in range(2):                                # two looks at 0.95 / 0.05: not 0.99 yet
+        result = session.update(Frame(np.array([1.0, 0.0, 0.0, 0.0])))
+        assert not result.ended
+    result = session.update(Frame(np.array([1.0, 0.0, 0.0, 0.0])))
+    occupied, empty = decided(session.log_odds, 0.99)
+    assert result.ended and result.decision == 'found' and result.terminated
+    assert occupied.tolist() == [True, False, False, False] and np.all(occupied | empty)
+    session.reset()
+    session.start()
+    result = session.update(Frame(np.zeros(4)))
+    while not result.ended:
+        result = session.update(Frame(np.zeros(4)))
+    assert result.decision == 'absent' and result.fixations == 2      # evidence 2 x log(1/19)
+    budget = OccupancySession(grid, model, SearchSettings(targets='many', max_fixations=1,
+                                                          absent_prior=0.5))
+    budget.reset()
+    budget.start()
+    result = budget.update(Frame(np.array([1.0, 0.0, np.nan, 0.0])))
+    assert result.truncated and result.reason == 'budget'
+    deadline = OccupancySession(grid, model, SearchSettings(
+        targets='many', max_fixations=1, absent_prior=0.5, decide_at_budget=True))
+    deadline.reset()
+    deadline.start()
+    result = deadline.update(Frame(np.array([1.0, 0.0, np.nan, 0.0])))
+    assert result.decision == 'found'
+    assert deadline.occupied().tolist() == [True, False, False, False]
+    # Nothing left to learn: a model whose views say nothing gives up (repeat) at once.
+    blind = OccupancySession(grid, CountObservation(grid, pn, pn),
+                             SearchSettings(targets='many'))
+    blind.reset()
+    blind.start()
+    result = blind.update(Frame(np.zeros(4)))
+    assert result.truncated and result.reason == 'repeat'
+
+
+def test_settings_refusals():
+    with pytest.raises(ValueError, match=r"search.targets must be one of one, many, got 'all'"):
+        SearchSettings(targets='all')
+    assert SearchSettings().targets == 'one'
+    assert SearchSettings.from_parameters({'search.targets': 'many'}).targets == 'many'
+    grid = Grid(2, 2)
+    with pytest.raises(ValueError, match='still targets'):
+        OccupancySession(grid, _model(grid), SearchSettings(targets='many',
+                                                            motion_sigma_cells=0.5))
+    with pytest.raises(ValueError, match='excludes no cells'):
+        session = OccupancySession(grid, _model(grid), SearchSettings(targets='many'))
+        session.reset()
+        session.exclude([1])
+
+
+def test_one_face_with_spill_over_is_counted_once():
+    """A face whose detections spill into its neighbours makes several occupied cells: one face."""
+    grid = Grid(1, 5)
+    pt = np.tile([0.1, 0.2, 0.7], (1, 5, 1))
+    pn = np.tile([0.8, 0.15, 0.05], (1, 5, 1))
+    model = CountObservation(grid, pt, pn)
+    truth = np.array([False, False, True, False, False])
+    rng = np.random.default_rng(0)
+    frames = _frames(model, rng, [2, 1, 3, 2], truth, nan_share=0.0, spill=2)
+    log_odds = prior_log_odds(5, 0.1)
+    for frame, k in zip(frames, [2, 1, 3, 2]):
+        log_odds = update_log_odds(log_odds, model.log_likelihood_ratio(frame, k))
+    occupied = decided(log_odds, 0.95)[0]
+    assert occupied.sum() >= 2                            # the spill-over looks like faces
+    faces = count_faces(log_odds, grid, occupied, image_px=(100, 20))
+    assert len(faces) == 1 and faces[0]['cell'] == 2
+    assert faces[0]['probability'] == pytest.approx(
+        1 - np.prod(1 - occupancy(log_odds[faces[0]['cells']])))
+    cells = faces[0]['cells']
+    np.testing.assert_array_equal(faces[0]['box'], [20 * cells.min(), 0,
+                                                    20 * (cells.max() - cells.min() + 1), 20])
+    # Raw boxes of one face from several windows merge into one (equal scores: the largest).
+    one_box = np.array([[40, 0, 20, 20], [42, 1, 19, 19], [38, 0, 22, 20]], dtype=float)
+    faces = count_faces(log_odds, grid, occupied, one_box, image_px=(100, 20))
+    assert len(faces) == 1 and faces[0]['cell'] == 2
+    assert faces[0]['box'].tolist() == [38, 0, 22, 20]
+
+
+def test_two_faces_in_one_cell_when_the_boxes_say_so():
+    grid = Grid(2, 2)
+    log_odds = np.array([5.0, -5.0, -5.0, -5.0])
+    occupied = log_odds > 0
+    boxes = np.array([[2, 2, 20, 20], [24, 3, 20, 20], [3, 2, 19, 20]], dtype=float)
+    faces = count_faces(log_odds, grid, occupied, boxes, image_px=(100, 100))
+    assert len(faces) == 2
+    assert sorted(f['box'][0] for f in faces) == [2, 24]
+    assert {f['cell'] for f in faces} == {0}
+
+
+def test_clusters_link_distance():
+    grid = Grid(3, 6)
+    cells = np.array([0, 7, 4, 17])                   # (0,0) (1,1) | (0,4) | (2,5)
+    assert clusters(cells, grid, 1).tolist() == [0, 0, 1, 2]
+    assert clusters(cells, grid, 2).tolist() == [0, 0, 1, 1]
+
+
+def test_run_search_on_simulated_scenes_ends_after_a_decisive_scan():
+    from ipomdp_gaze.search.sensors import ModelSensor, run_search
+    grid = Grid(3, 3)
+    pt = np.tile([0.1, 0.9], (3, 3, 1))
+    pn = np.tile([0.9, 0.1], (3, 3, 1))
+    model = CountObservation(grid, pt, pn, scan_target=[0.0001, 0.9999],
+                             scan_null=[0.9999, 0.0001])
+    settings = SearchSettings(targets='many', confidence=0.99, absent_prior=0.5,
+                              max_fixations=20, inhibit_return=True)
+    session = OccupancySession(grid, model, settings)
+    empty = run_search(session, ModelSensor(grid, model, np.random.default_rng(0)), None)
+    assert empty.decision == 'absent' and empty.fixations == 0 and empty.path == ()
+    one = run_search(session, ModelSensor(grid, model, np.random.default_rng(0)), 4)
+    assert one.decision == 'found' and one.fixations == 0
+    assert [f['cell'] for f in session.faces()] == [4]
+
+
+def test_the_single_target_session_refuses_many_targets():
+    grid = Grid(2, 2)
+    with pytest.raises(ValueError, match='search.targets many is searched by '
+                                         'ipomdp_gaze.search.many.OccupancySession'):
+        SearchSession(grid, _model(grid), None, SearchSettings(targets='many'))
+
+
+def test_gaussian_information_equals_the_integral_of_the_entropy_drop():
+    """The Gaussian channel's information (binned for the table) against direct integration."""
+    grid = Grid(3, 3)
+    model = GaussianObservation(grid, make_fpoc('human'))
+    log_odds = np.array([-4.0, -1.0, 0.0, 0.5, 2.0, -6.0, 1.0, -0.3, 3.0])
+    p = occupancy(log_odds)
+    o = np.linspace(-12.0, 14.0, 26_001)
+    phi0 = np.exp(-0.5 * o ** 2) / math.sqrt(2 * math.pi)
+
+    def drop(p_j, d):
+        phi1 = np.exp(-0.5 * (o - d) ** 2) / math.sqrt(2 * math.pi)
+        m = p_j * phi1 + (1 - p_j) * phi0
+        after = binary_entropy(np.divide(p_j * phi1, m, out=np.zeros_like(m), where=m > 0))
+        return binary_entropy(p_j) - np.trapezoid(m * after, o)
+
+    d = model.dprime(np.arange(9))                                      # [k, j]
+    brute = np.array([[drop(p[j], d[k, j]) for j in range(9)] for k in range(9)])
+    np.testing.assert_allclose(InformationTable(model)(log_odds), brute, rtol=2e-3, atol=1e-6)
+
+
+def test_empty_by_evidence_needs_looks_where_a_sparse_prior_decides_at_once():
+    """A sparse prior decides every cell empty before any look; the evidence rule does not."""
+    from ipomdp_gaze.search.sensors import ModelSensor, run_search
+    grid = Grid(3, 3)
+    pt = np.tile([0.1, 0.9], (3, 3, 1))
+    pn = np.tile([0.9, 0.1], (3, 3, 1))
+    model = CountObservation(grid, pt, pn, scan_target=[0.5, 0.5], scan_null=[0.5, 0.5])
+    settings = SearchSettings(targets='many', confidence=0.99, absent_prior=0.95,
+                              max_fixations=30, inhibit_return=True)
+    assert cell_prior(9, 0.95) < 0.01                     # every cell "empty" a priori
+    eager = run_search(OccupancySession(grid, model, settings, empty_by_evidence=False),
+                       ModelSensor(grid, model, np.random.default_rng(0)), 4)
+    assert eager.decision == 'absent' and eager.fixations == 0      # it never looked
+    session = OccupancySession(grid, model, settings)                # the default
+    careful = run_search(session, ModelSensor(grid, model, np.random.default_rng(0)), 4)
+    assert careful.fixations > 0 and careful.decision == 'found'
+    assert [f['cell'] for f in session.faces()] == [4]
+    log_odds, prior = session.log_odds, prior_log_odds(9, cell_prior(9, 0.95))
+    empty = ~session.occupied()
+    assert np.all(log_odds[empty] - prior[empty] <= -math.log(99))
+
+
+def test_faces_with_spill_over_are_counted_once_across_random_scenes():
+    """Scenes of 0-2 faces whose detections spill into both neighbours: no face comes out twice."""
+    grid = Grid(1, 9)
+    pt = np.tile([0.15, 0.25, 0.6], (1, 9, 1))
+    pn = np.tile([0.85, 0.1, 0.05], (1, 9, 1))
+    model = CountObservation(grid, pt, pn)
+    rng = np.random.default_rng(12)
+    exact = 0
+    for trial in range(60):
+        n_faces = trial % 3
+        truth = np.zeros(9, dtype=bool)
+        if n_faces:
+            truth[rng.choice([1, 4, 7], size=n_faces, replace=False)] = True  # 3 cells apart
+        fixations = list(rng.integers(0, 9, size=6))
+        frames = _frames(model, rng, fixations, truth, nan_share=0.0, spill=1)
+        log_odds = prior_log_odds(9, 0.1)
+        for frame, k in zip(frames, fixations):
+            log_odds = update_log_odds(log_odds, model.log_likelihood_ratio(frame, k))
+        faces = count_faces(log_odds, grid, decided(log_odds, 0.95)[0], link=2)
+        cells = [f['cell'] for f in faces]
+        assert len(faces) <= n_faces                                 # never twice
+        assert all(np.abs(np.flatnonzero(truth) - c).min() <= 1 for c in cells)
+        exact += len(faces) == n_faces
+        if n_faces == 1:                      # a lone face's spill-over is one cluster
+            assert len(faces) == 1
+    assert exact >= 45       # two faces 3 cells apart can merge (their spill-over touches)
+
+
+def test_simulated_searches_of_the_paper_task_find_the_target_or_nobody():
+    """7x7, human FPOC, one target or none: each target found within one cell, none invented."""
+    from ipomdp_gaze.search.sensors import ModelSensor, run_search
+    grid = Grid(7, 7)
+    model = GaussianObservation(grid, make_fpoc('human'))
+    settings = SearchSettings(targets='many', confidence=0.95, max_fixations=60,
+                              absent_prior=0.5)
+    session = OccupancySession(grid, model, settings)
+    for e in range(12):
+        target = None if e % 4 == 0 else int(np.random.default_rng(e).integers(49))
+        outcome = run_search(session, ModelSensor(grid, model, np.random.default_rng([7, e])),
+                             target)
+        cells = [grid.cell(f['cell']) for f in session.faces()]
+        assert outcome.decision == ('absent' if target is None else 'found')
+        if target is not None:
+            [(r, c)] = cells
+            assert max(abs(r - target // 7), abs(c - target % 7)) <= 1
+        else:
+            assert cells == []
