@@ -30,8 +30,8 @@ soak: $(STAMP)
 	$(VPY) -m pytest -q -s -m soak test
 	PROPERTY_EXAMPLES=1000 $(VPY) -m pytest -q test/test_properties.py \
 		test/test_robust_observation_files.py
-	$(VPY) bench/shutdown_cycles.py --cycles 50
-	$(VPY) bench/soak_face_loop.py --minutes 10
+	$(VPY) bench/ros/shutdown_cycles.py --cycles 50
+	$(VPY) bench/ros/soak_face_loop.py --minutes 10
 
 bench: $(STAMP)
 	$(VPY) bench/run.py
@@ -42,17 +42,17 @@ reproduce: $(STAMP)
 # Face search, Haar and YuNet, on 300 held-out scenes per task, the pan/tilt search and the
 # real-photo set: writes docs/faces.md and docs/data/faces.json (about 20 minutes).
 faces: $(STAMP)
-	$(VPY) bench/faces.py
+	$(VPY) bench/faces/faces.py
 
 # The pan/tilt face search against a blind sweep on 400 + 200 held-out scenes and a second camera:
 # writes docs/pan_tilt.md and docs/data/pan_tilt.json.gz (10-30 minutes, and 15 for the ROS demo).
 pan-tilt: $(STAMP)
-	$(VPY) bench/pan_tilt.py --ros-seeds 50
+	$(VPY) bench/pan_tilt/pan_tilt.py --ros-seeds 50
 
 # Recalibrate every shipped Haar model and retrain faces-420-infomax from their recipes on training
-# scenes, print what moved and install the new files (bench/models.py; about 70 minutes).
+# scenes, print what moved and install the new files (bench/faces/models.py; about 70 minutes).
 models: $(STAMP)
-	$(VPY) bench/models.py --install
+	$(VPY) bench/faces/models.py --install
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache

@@ -3,8 +3,9 @@
 """
 Run the benchmarks (``make bench``) and write ``docs/benchmarks.md`` with its figures.
 
-Every ``bench/bench_*.py`` is one section of the report, found by name, so a new benchmark
-(for example ``bench_ros_loop.py``) only has to be dropped into ``bench/``. A module takes part in
+Every ``bench/<group>/bench_*.py`` is one section of the report, found by name, so a new
+benchmark (for example ``ros/bench_ros_loop.py``) only has to be dropped into a group folder
+(``simulation``, ``ros``, ``faces``, ``pan_tilt``). A module takes part in
 one of two ways:
 
 - it defines ``bench(ctx) -> str``: markdown of its section, without the title. ``ctx`` is a
@@ -63,7 +64,7 @@ class Context:
 
 def discover() -> dict:
     """Map benchmark name (``bench_NAME.py``) to its path."""
-    return {p.stem[len('bench_'):]: p for p in sorted(BENCH_DIR.glob('bench_*.py'))}
+    return {p.stem[len('bench_'):]: p for p in sorted(BENCH_DIR.rglob('bench_*.py'))}
 
 
 def load(path: Path):

@@ -37,7 +37,8 @@ import scipy.fft
 ACTIONS = ('argmax', 'sample')
 METHODS = ('auto', 'direct', 'fft')
 
-# Break-even between the N x N product and the FFT path, measured with bench/bench_latency.py
+# Break-even between the N x N product and the FFT path, measured with
+# bench/simulation/bench_latency.py
 # (docs/benchmarks.md): for one belief (the controller) the two cost the same at 24x24-28x28 (the
 # crossing moved within that range over three runs); for a batch of 256 beliefs (simulation)
 # direct stays faster up to 40x40-44x44 and FFT wins from 48x48.

@@ -78,7 +78,8 @@ def default_nodes(dprime: np.ndarray) -> tuple[int, int]:
     """
     Quadrature ``(nodes, power)`` for a d' matrix.
 
-    Measured against 1024 nodes on beliefs from simulated searches (``bench/bench_greedy.py``):
+    Measured against 1024 nodes on beliefs from simulated searches
+    (``bench/simulation/bench_greedy.py``):
     112 nodes with power 2 stay within 2e-11 (7x7 human) and 3e-10 (7x7 exponential); 192 with
     power 3 below 2e-9 at 11x11 human, where d' reaches 0.002.
     """

@@ -29,7 +29,8 @@ Scores (``objective``) of one simulated future:
 
 The default base policy is :class:`TemperedELM`, ELM (Najemnik & Geisler 2009, kernel ``d^2``)
 applied to a flattened belief ``B^a``; the tempering was tuned on held-out seeds for fixations to
-90% correct (bench/bench_planner.py has the numbers). Any policy with ``select(belief, t, rng)``
+90% correct (bench/simulation/bench_planner.py has the numbers). Any policy with ``select(belief,
+t, rng)``
 can be the base, for example a learned convolutional kernel.
 """
 from __future__ import annotations
@@ -46,7 +47,7 @@ from .conv import kernel_matrix
 OBJECTIVES = ('correct', 'correct_sum', 'infomax', 'entropy')
 DTYPES = ('float32', 'float64')
 LOG_FLOOR = -700.0
-# Tempered ELM's defaults, tuned on held-out seeds (bench/bench_planner.py).
+# Tempered ELM's defaults, tuned on held-out seeds (bench/simulation/bench_planner.py).
 BELIEF_POWER, DPRIME_POWER = 0.7, 1.75
 
 

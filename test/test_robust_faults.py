@@ -5,7 +5,7 @@ Fault injection: nodes killed mid-search and restarted, evidence that stops, a s
 
 - The camera is killed (SIGKILL) mid-search. The controller keeps its belief, reports the stall
   in ``/diagnostics`` (WARN, ``no usable evidence for X s``) and its log, and re-sends its
-  target (its CPU use meanwhile is a benchmark, ``bench/bench_ros_idle.py``, not a test
+  target (its CPU use meanwhile is a benchmark, ``bench/ros/bench_ros_idle.py``, not a test
   threshold). A new camera gets the target, and its
   first frame updates the kept belief (checked against Bayes' rule); the search completes on
   the camera's target.

@@ -3,7 +3,8 @@
 """
 Load: a camera faster than the controller, at 1 kHz on 11x11 and at 60 Hz on 256x256.
 
-``bench/evidence_flood.py`` (its own process) publishes the frames; the controller keeps only the
+``bench/ros/evidence_flood.py`` (its own process) publishes the frames; the controller keeps only
+the
 newest one (``evidence_queue_depth`` 1), so a frame it has not taken yet is replaced by the next
 one and counted as dropped from the publisher's sequence numbers. Every frame is accounted for:
 received + dropped = sent, received = applied + rejected + skipped. At 11x11 the steady
@@ -30,7 +31,7 @@ from robust_support import RssSampler
 pytestmark = [pytest.mark.ros,
               pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
 
-FLOOD = REPO / 'bench' / 'evidence_flood.py'
+FLOOD = REPO / 'bench' / 'ros' / 'evidence_flood.py'
 MB = 2 ** 20
 MAX_RSS_MB = 400                    # 256x256 with a belief_image viewer once took 1.27 GB
 # (rows, spacing_deg, policy) of each grid.

@@ -15,7 +15,7 @@ Tasks (:data:`TASKS`):
   of that seed), so ``ipomdp-gaze demo --scene faces --seed S`` and this evaluation search the
   same panorama;
 - ``faces-420`` / ``faces-840``: the digital fovea over a still image with a face (the test
-  scenes of ``bench/faces.py``, ``SceneSet('test', ..., seed)[i]``) and ``find``'s model,
+  scenes of ``bench/faces/faces.py``, ``SceneSet('test', ..., seed)[i]``) and ``find``'s model,
   kernel and settings.
 
 A scene is *right* when the cell the search answers (its ``found`` cell, or the most likely cell

@@ -35,7 +35,7 @@ import yaml
 TASKS = ('pan-tilt', 'faces-420', 'faces-840')
 # The budget every task's searches get unless told otherwise: the ROS bench's (60 fixations).
 DEFAULT_BUDGET = 60
-# The fixed-camera tasks: model, scene side (px), face sizes (px), as bench/faces.py.
+# The fixed-camera tasks: model, scene side (px), face sizes (px), as bench/faces/faces.py.
 _FOVEA_TASKS = {'faces-420': ('faces-420', 420, (60, 140)),
                 'faces-840': ('faces-840', 840, (24, 140))}
 

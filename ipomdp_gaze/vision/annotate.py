@@ -25,7 +25,7 @@ shows a rectangle of cells that depends on where the head points (:func:`view_ce
 mapping of :mod:`ipomdp_gaze.model.head_camera`). Both are separable, which keeps the overlay a
 repeat of a ``(rows, cols)`` colour table: about 3 ms for a 320x240 view and 7 ms for a
 420x420 image on this project's 2-core machine
-(``bench/annotate.py``).
+(``bench/faces/annotate.py``).
 """
 from __future__ import annotations
 

@@ -94,11 +94,11 @@ METHODS = ('fovea', 'full_frame')
 # cells of a 640x480 picture and its spread-out detections were found again as a second face.
 FACE_RADIUS = 2
 # search_many: cells within 1 of a face's occupied cell are settled (its spill-over), not
-# searched on; on the training groups (bench/many_faces.py) the spill-over cells next to a face
+# searched on; on the training groups (bench/faces/many_faces.py) the spill-over cells next to a face
 # otherwise stayed undecided and drew fixations until the pixel budget.
 SETTLE_RADIUS = 1
 # search_many decides a cell empty by its posterior, not by its evidence alone
-# (OccupancySession's empty_by_evidence): on the training groups (bench/many_faces.py
+# (OccupancySession's empty_by_evidence): on the training groups (bench/faces/many_faces.py
 # --empty-by-evidence) the evidence rule found the same photo-group faces (47 and 48 of 48) and
 # 17 instead of 9 of 64 small lfw faces at 640x480, but ran every scene to the pixel cap (one full
 # scan); the full-resolution detector alone finds 61 of 64 for those pixels.

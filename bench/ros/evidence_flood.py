@@ -14,7 +14,7 @@ sent (the first frame, the burst and the marker included), seconds, achieved rat
 
 Usage (in the controller's ROS domain)::
 
-    .venv/bin/python bench/evidence_flood.py --rows 11 --cols 11 --rate-hz 1000 --seconds 60
+    .venv/bin/python bench/ros/evidence_flood.py --rows 11 --cols 11 --rate-hz 1000 --seconds 60
 """
 from __future__ import annotations
 

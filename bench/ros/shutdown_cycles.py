@@ -11,7 +11,7 @@ has not exited ``--timeout-s`` after SIGTERM gets SIGUSR1 first, which makes Pyt
 
 Usage::
 
-    .venv/bin/python bench/shutdown_cycles.py --cycles 50
+    .venv/bin/python bench/ros/shutdown_cycles.py --cycles 50
 """
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ import sys
 import tempfile
 import time
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO))
 
 from ipomdp_gaze.files.share_files import config_file  # noqa: E402

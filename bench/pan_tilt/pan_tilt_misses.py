@@ -11,7 +11,7 @@ expects a face to give about eight raw detections), and in a view centred on the
 search may never have taken). The last line compares those centred counts for the scenes it got
 right and wrong.
 
-Usage: ``python bench/pan_tilt_misses.py [--scenes 200] [--seed 1000] [--model FILE]``
+Usage: ``python bench/pan_tilt/pan_tilt_misses.py [--scenes 200] [--seed 1000] [--model FILE]``
 (``--model``: another pan/tilt observation file, as ``evaluate --scene-model``). Prints markdown.
 """
 import argparse

@@ -17,7 +17,7 @@ one cell of the face) and the empty scenes where a face is named (wrong ``found`
 If neither reaches the issue's target (right >= 0.98 with a wrong ``found`` on at most 5% of
 empty scenes) with every view, the target is beyond the detector, not the search.
 
-Usage: ``python bench/pan_tilt_bound.py [--scenes 200] [--empty-scenes 100] [--seed 1000]
+Usage: ``python bench/pan_tilt/pan_tilt_bound.py [--scenes 200] [--empty-scenes 100] [--seed 1000]
 [--model FILE] [--jobs 2] [--split train|test] [--json OUT]``. Prints markdown. ``--split test``
 measures the same on held-out scenes for a report; nothing may be chosen with it.
 """

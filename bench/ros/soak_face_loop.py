@@ -21,7 +21,7 @@ Checked, and reported in ``docs/benchmarks.md`` (section ``soak_face_loop``):
 
 The exit status is 1 if a check fails. ``make soak`` runs it for 10 minutes::
 
-    .venv/bin/python bench/soak_face_loop.py --minutes 10
+    .venv/bin/python bench/ros/soak_face_loop.py --minutes 10
 """
 from __future__ import annotations
 
@@ -32,8 +32,8 @@ import sys
 import threading
 import time
 
-BENCH = Path(__file__).resolve().parent
-sys.path[:0] = [str(BENCH.parent), str(BENCH)]
+BENCH = Path(__file__).resolve().parents[1]
+sys.path[:0] = [str(BENCH.parent), str(BENCH), str(BENCH / 'ros')]
 
 import numpy as np  # noqa: E402
 

@@ -8,7 +8,7 @@ for every frame it publishes, on the two shipped geometries: the pan/tilt camera
 (11x11 grid, camera mode) and a 420x420 fixed-camera image (21x21 grid, four fovea windows),
 each with a spread belief, 30 fixations and 40 raw detections; the median and the 90th
 percentile over ``--repeats`` frames, and the detector's own time per frame for comparison.
-Usage: ``python bench/annotate.py [--repeats 200]``.
+Usage: ``python bench/faces/annotate.py [--repeats 200]``.
 """
 import argparse
 import time

@@ -3,7 +3,7 @@
 """
 The controller's per-frame cost in process: ``GazeController.offer`` and ``SearchSession.update``.
 
-The settings of the ROS loop bench (``bench/bench_ros_loop.py``): a camera FPOC (a box of
+The settings of the ROS loop bench (``bench/ros/bench_ros_loop.py``): a camera FPOC (a box of
 ``d'`` over the camera's field of view), ELM, motion on (``sigma_cells`` 0.5 per second, so
 every frame includes the prediction step), settle time 0, on 11x11, 128x128 and 256x256 grids.
 Frames are drawn from the controller's own model at its fixation, NaN outside the camera's view,
@@ -15,7 +15,7 @@ update, counters and events) and once through a bare ``SearchSession.update`` (a
 controller built the same way, its session driven directly).
 
 Run through ``bench/run.py`` (``--only controller``), or alone: ``python
-bench/bench_controller.py [--quick]`` prints the markdown section. Pointing ``PYTHONPATH`` at
+bench/simulation/bench_controller.py [--quick]`` prints the markdown section. Pointing ``PYTHONPATH`` at
 another checkout measures that code with the same script (a before/after comparison).
 """
 import sys

@@ -3,7 +3,7 @@
 """
 Live searches over DDS with the shipped YAML files, beside the same task simulated offline.
 
-Run: ``.venv/bin/python bench/bench_ros_search.py [searches]`` (default 30). Starts
+Run: ``.venv/bin/python bench/ros/bench_ros_search.py [searches]`` (default 30). Starts
 ``gaze_controller`` and ``simulated_camera`` as processes on a private domain, then repeats:
 disable, camera reset (a new random target), controller reset, enable, wait for ``found``.
 Prints fixations to ``found`` (median, 90th percentile), the fraction found at the right cell and

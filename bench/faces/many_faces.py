@@ -27,7 +27,7 @@ matched (boxes taken most probable first), a **duplicate** when it lies in an al
 one, else a **false face**. Seconds are wall time from the decoded array (as ``find`` reports
 them); detector pixels are the pixels given to the detector.
 
-Usage: ``python bench/many_faces.py [--split train|test] [--scenes N] [--copies C]
+Usage: ``python bench/faces/many_faces.py [--split train|test] [--scenes N] [--copies C]
 [--sizes 640x480,1280x886] [--detector yunet|haar] [--absent-prior P] [--confidence C]
 [--old-loop] [--faces photos|lfw]``;
 prints one markdown row per method and size, totals over the scenes.

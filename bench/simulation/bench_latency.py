@@ -15,7 +15,7 @@ naive references run in the same process: the probability-domain (exp) update wi
 library path (N x N matrices, as before issue 5) and a per-cell Python loop. Also: the measured
 direct/FFT break-even, peak memory (tracemalloc) and the effect of kernel truncation.
 
-Run through ``bench/run.py`` (``make bench``), or alone: ``python bench/bench_latency.py
+Run through ``bench/run.py`` (``make bench``), or alone: ``python bench/simulation/bench_latency.py
 [--quick]`` prints the markdown section.
 """
 import math
@@ -584,6 +584,6 @@ def bench(ctx) -> str:
 
 
 if __name__ == '__main__':
-    sys.path.insert(0, str(__import__('pathlib').Path(__file__).resolve().parent))
+    sys.path.insert(0, str(__import__('pathlib').Path(__file__).resolve().parents[1]))
     from run import Context, FIGURES
     print(bench(Context('--quick' in sys.argv, FIGURES)))

@@ -11,7 +11,7 @@ docs/design.md section 7): its search never ends, and each frame includes the pr
 At 256x256 the camera streams at 60 Hz instead, and the
 controller's own counters in ``/diagnostics`` say how many frames it applied, skipped (stale or
 superseded) or never saw (dropped by the keep-last queue), with its RSS from /proc.
-Run: ``.venv/bin/python bench/bench_ros_loop.py`` or ``make bench``.
+Run: ``.venv/bin/python bench/ros/bench_ros_loop.py`` or ``make bench``.
 """
 import sys
 import time

@@ -3,7 +3,7 @@
 """
 Why a zero-start kernel on the exponential FPOC looks next to a likely target, not at it.
 
-Run: ``.venv/bin/python bench/exponential_kernel.py [--old OLD.yaml] [--episodes 4000]``
+Run: ``.venv/bin/python bench/simulation/exponential_kernel.py [--old OLD.yaml] [--episodes 4000]``
 (a few minutes; the numbers are quoted in docs/reproduction_notes.md).
 
 Three measurements on the 11x11 exponential task (0.42 deg/cell, d' = 2 exp(-e / 1.5 deg)):

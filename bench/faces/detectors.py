@@ -25,7 +25,7 @@ resolution, nothing fitted here:
   updates (the
   saccades of a real head are not included).
 
-Usage: ``python bench/detectors.py [--views 40] [--searches 40] [--repeat 3]
+Usage: ``python bench/faces/detectors.py [--views 40] [--searches 40] [--repeat 3]
 [--out docs/data/detectors.json]``.
 """
 import argparse

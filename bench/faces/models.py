@@ -10,7 +10,7 @@ file: the largest change of any probability per table (target, null, scan) and o
 false-alarm rates ``P(count > 0)`` at the fixation, one cell off and two off. ``--install``
 copies the new files over the shipped ones (and the FPOC figures into ``docs/figures``).
 
-Usage: ``python bench/models.py [--only NAME,...] [--out DIR] [--install] [--jobs 2]``
+Usage: ``python bench/faces/models.py [--only NAME,...] [--out DIR] [--install] [--jobs 2]``
 (``make models``: every Haar and ensemble model and the kernel, installed; about 70 minutes on
 2 cores).
 """
@@ -25,7 +25,7 @@ import time
 from ipomdp_gaze.files.observation_file import load_observation
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 MODELS = ROOT / 'ipomdp_gaze' / 'models'
 KERNELS = ROOT / 'policies' / 'kernels'
 FIGURES = ROOT / 'docs' / 'figures'

@@ -3,7 +3,7 @@
 """
 Cost and accuracy of the percent-correct greedy searcher (the Najemnik & Geisler ideal searcher).
 
-Run: ``.venv/bin/python bench/bench_greedy.py [--quick] [--json OUT]``.
+Run: ``.venv/bin/python bench/simulation/bench_greedy.py [--quick] [--json OUT]``.
 
 Beliefs come from simulated searches (7x7: the greedy searcher's own; 11x11: ELM searches, as
 simulating the greedy searcher there is slow), one decision per call (a batch of one), timed
