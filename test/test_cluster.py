@@ -183,8 +183,8 @@ def test_ctrl_c_stops_at_once_and_keeps_the_finished_pieces(tmp_path):
     proc = subprocess.Popen(
         [sys.executable, str(ROOT / 'bench' / 'simulation' / 'planner_vs_greedy.py'),
          '--episodes', '4000', '--policies', 'greedy', '--horizon', '10', '--chunk', '50',
-         '--jobs', '2', '--cache', str(cache), '--quiet'], start_new_session=True, stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE, text=True)
+         '--jobs', '2', '--cache', str(cache), '--quiet'], start_new_session=True,
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         assert wait_for(lambda: any(cache.glob('*.bin')) or proc.poll() is not None, 120)
         os.killpg(proc.pid, signal.SIGINT)

@@ -94,8 +94,8 @@ METHODS = ('fovea', 'full_frame')
 # cells of a 640x480 picture and its spread-out detections were found again as a second face.
 FACE_RADIUS = 2
 # search_many: cells within 1 of a face's occupied cell are settled (its spill-over), not
-# searched on; on the training groups (bench/faces/many_faces.py) the spill-over cells next to a face
-# otherwise stayed undecided and drew fixations until the pixel budget.
+# searched on; on the training groups (bench/faces/many_faces.py) the spill-over cells next to a
+# face otherwise stayed undecided and drew fixations until the pixel budget.
 SETTLE_RADIUS = 1
 # search_many decides a cell empty by its posterior, not by its evidence alone
 # (OccupancySession's empty_by_evidence): on the training groups (bench/faces/many_faces.py
