@@ -20,7 +20,8 @@ and on the same images:
 
 Then, per detector (Haar, YuNet): the pan/tilt search (the shipped controller configuration
 with each detector's pan/tilt model, test scenes), ``find`` and one full-resolution scan on the
-real-photo set and ``find --all`` on composed group pictures (``bench/faces/find_photos.py``), training
+real-photo set and ``find --all`` on composed group pictures (``bench/faces/find_photos.py``),
+training
 and test apart; and the default detector of each task, chosen by a stated rule from this run's
 training rows (training scenes, training photos and groups, training pan/tilt scenes).
 
@@ -928,8 +929,9 @@ def main(argv=None) -> int:
                  'wrong `found`: a face-free photo with a `found` (full frame: with any answer '
                  'box). Detector pixels are against one full-resolution scan of the photo; '
                  'times are wall milliseconds from the decoded image to the answer.', '']
-        text += photo_tables(photos) + ['', 'Per photo (`python bench/faces/find_photos.py --groups '
-                                        '--detector haar|yunet` prints these rows):', '']
+        text += photo_tables(photos) + ['', 'Per photo (`python bench/faces/find_photos.py '
+                                        '--groups --detector haar|yunet` prints these rows):',
+                                        '']
         text += photo_detail(photos) + ['']
     text += choices_text(trainings, photos, pan_tilt_train, args)
     text += IDEAS

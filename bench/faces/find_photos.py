@@ -15,10 +15,12 @@ For each model (by default each detector's shipped models, chosen nearest each i
   scan of the model's detector, every answer box (OpenCV's grouped detections for Haar, YuNet's
   own boxes after its non-maximum suppression) a face, scored on the same cells.
 
-Usage: ``python bench/faces/find_photos.py [--split train|test|all] [--groups] [--detector haar|yunet |
+Usage: ``python bench/faces/find_photos.py [--split train|test|all] [--groups] [--detector
+haar|yunet |
 --observation NAME]``. With ``--split train`` the groups are the training ones (the astronaut
 three times on each training background), which may inform a choice; otherwise the test ones.
-Prints markdown rows. ``bench/faces/faces.py`` (``make faces``) calls the row functions for its tables.
+Prints markdown rows. ``bench/faces/faces.py`` (``make faces``) calls the row functions for its
+tables.
 """
 import argparse
 from dataclasses import replace

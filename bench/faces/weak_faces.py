@@ -17,7 +17,8 @@ from the ``face_recognition_models`` package) dlib's CNN detector upsampled once
 faces and their face-free cells only (seconds per view). dlib is not a dependency of
 ipomdp_gaze (``pip install dlib-bin``); the last line names the weak faces no detector sees.
 
-Usage: ``python bench/faces/weak_faces.py [--scenes 300] [--seed 1000] [--dlib] [--dlib-cnn FILE]``.
+Usage: ``python bench/faces/weak_faces.py [--scenes 300] [--seed 1000] [--dlib] [--dlib-cnn
+FILE]``.
 Prints markdown.
 """
 import argparse

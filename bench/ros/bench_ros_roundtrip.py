@@ -3,7 +3,8 @@
 """
 Round trip through the gaze_controller process: evidence frame in, belief and next target out.
 
-Run: ``.venv/bin/python bench/ros/bench_ros_roundtrip.py [policy ...]`` (default ``elm map``). For each
+Run: ``.venv/bin/python bench/ros/bench_ros_roundtrip.py [policy ...]`` (default ``elm map``). For
+each
 policy it starts the controller (shipped YAML, ``settle_time_s`` 0, no retries) on a private
 domain; this process plays the camera: on every new ``pan_tilt`` it publishes one 11x11 evidence
 frame and times until the next ``pan_tilt`` (and the ``belief``) arrive; the controller tracks

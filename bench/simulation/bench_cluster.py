@@ -3,7 +3,8 @@
 """
 Scaling of the 7x7 ideal-searcher evaluation over workers (docs/benchmarks.md, docs/cluster.md).
 
-Run: ``.venv/bin/python bench/simulation/bench_cluster.py [--episodes-greedy 1000] [--workers 1,2]``;
+Run: ``.venv/bin/python bench/simulation/bench_cluster.py [--episodes-greedy 1000] [--workers
+1,2]``;
 ``bench/run.py --only cluster`` writes its section of docs/benchmarks.md.
 The job is ``ipomdp-gaze evaluate --grid 7x7 --policy greedy`` (horizon N = 49), whose
 ``--episodes-greedy`` episodes go out in pieces of 250. It runs
@@ -143,9 +144,9 @@ def table(rows, episodes_greedy: int) -> str:
     lines = [f'`ipomdp-gaze evaluate --grid 7x7 --policy greedy --episodes-greedy '
              f'{episodes_greedy}` (horizon 49, {pieces} piece{"s" * (pieces > 1)} of '
              f'{COSTLY_CHUNK} episodes), '
-             'run by `bench/simulation/bench_cluster.py`. Dask workers are single-threaded processes on '
-             'this machine, started by the benchmark. *Busiest* is the CPU time of the busiest '
-             "worker plus the client's: the run's wall time on otherwise idle cores. The "
+             'run by `bench/simulation/bench_cluster.py`. Dask workers are single-threaded '
+             'processes on this machine, started by the benchmark. *Busiest* is the CPU time of '
+             "the busiest worker plus the client's: the run's wall time on otherwise idle cores. The "
              'machine is shared (wall times move with its load), so the CPU-time speed-up '
              '(pieced CPU / busiest) is the honest measure; the wall-time one is shown too.', '',
              '| run | wall s | CPU s (all) | busiest s | speed-up (CPU time) | '

@@ -15,7 +15,8 @@ update, counters and events) and once through a bare ``SearchSession.update`` (a
 controller built the same way, its session driven directly).
 
 Run through ``bench/run.py`` (``--only controller``), or alone: ``python
-bench/simulation/bench_controller.py [--quick]`` prints the markdown section. Pointing ``PYTHONPATH`` at
+bench/simulation/bench_controller.py [--quick]`` prints the markdown section. Pointing
+``PYTHONPATH`` at
 another checkout measures that code with the same script (a before/after comparison).
 """
 import sys

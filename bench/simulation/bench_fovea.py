@@ -3,7 +3,8 @@
 """
 Detector cost of the digital fovea against full-frame scans, on a real photo with a real face.
 
-Run: ``.venv/bin/python bench/simulation/bench_fovea.py [--quick] [--size 420] [--threads N] [--json OUT]``.
+Run: ``.venv/bin/python bench/simulation/bench_fovea.py [--quick] [--size 420] [--threads N]
+[--json OUT]``.
 
 The image is scikit-image's ``astronaut`` resized to ``size x size`` grey (``cv2.INTER_AREA``);
 the detector is the reference ``HaarDetector`` (alt2, 1.1, minNeighbors=0) on a 21x21 grid.

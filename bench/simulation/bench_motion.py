@@ -3,7 +3,8 @@
 """
 The motion step: the separable truncated convolution beside a dense N x N transition.
 
-Run: ``.venv/bin/python bench/simulation/bench_motion.py [--quick]``. For a batch of beliefs (simulation,
+Run: ``.venv/bin/python bench/simulation/bench_motion.py [--quick]``. For a batch of beliefs
+(simulation,
 training) and for one belief (the controller), it times
 :meth:`ipomdp_gaze.model.motion.Motion.predict`
 (``G_row^T P G_col`` plus the jump) and the same prediction as ``B @ T`` with the dense matrix of

@@ -3,7 +3,8 @@
 """
 Look-ahead planner vs the baselines on paired episodes (7x7, human FPOC, calibrated default).
 
-Run: ``.venv/bin/python bench/simulation/bench_planner.py [--episodes 2000] [--episodes-fast 20000]``.
+Run: ``.venv/bin/python bench/simulation/bench_planner.py [--episodes 2000] [--episodes-fast
+20000]``.
 
 Every policy sees the same targets and observation noise (common random numbers; a run of n
 episodes is the first n episodes of a longer one). Printed for each policy: fixations to 90%

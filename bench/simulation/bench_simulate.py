@@ -3,7 +3,8 @@
 """
 Simulation throughput: 20,000 episodes x 49 fixations of the 7x7 task per baseline.
 
-Run: ``.venv/bin/python bench/simulation/bench_simulate.py``. Prints wall seconds and episode-fixations per
+Run: ``.venv/bin/python bench/simulation/bench_simulate.py``. Prints wall seconds and
+episode-fixations per
 second, beside a naive per-episode Python loop on a subsample (the reference ratio).
 ``bench/run.py`` calls :func:`bench` instead, which also times 11x11 and writes a markdown table.
 """

@@ -6,7 +6,8 @@ Benchmark: GPOMDP training from scratch on the 7x7 human task, and the weight-sh
 Run from the repository root::
 
     .venv/bin/python bench/simulation/bench_training.py                 # conv from a zero kernel
-    .venv/bin/python bench/simulation/bench_training.py --logistic      # + full logistic, same settings
+    .venv/bin/python bench/simulation/bench_training.py --logistic      # + full logistic, same
+    settings
 
 The conv run trains the radially weight-shared policy from a zero kernel for ``--epochs`` epochs
 (the wall time counts training only), then evaluates the argmax policy once on the 20,000

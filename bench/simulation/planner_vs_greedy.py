@@ -3,7 +3,8 @@
 """
 7x7 human FPOC: the searchers beyond the paper against ELM and the ideal searcher, on both cores.
 
-Run: ``.venv/bin/python bench/simulation/planner_vs_greedy.py [--episodes 4000] [--seed 1] [--jobs 2]
+Run: ``.venv/bin/python bench/simulation/planner_vs_greedy.py [--episodes 4000] [--seed 1] [--jobs
+2]
 [--horizon 16] [--policies elm,tempered,greedy,planner] [--planner-options K=V,...]
 [--cache DIR] [--chunk 2000] [--rao-blackwell] [--json OUT] [--scheduler ADDRESS] [--quiet]``.
 docs/reproduction.md quotes two runs: ``--episodes 4000 --seed 1`` (about 10 CPU-minutes) and

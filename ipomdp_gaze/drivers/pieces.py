@@ -182,7 +182,8 @@ class Runner:
     ones). ``progress`` (``add(n)`` / ``update(n)``,
     :class:`ipomdp_gaze.simulation.progress.Progress`)
     counts episodes as their pieces finish. Used by ``reproduce`` and
-    ``bench/simulation/planner_vs_greedy.py``. With ``rao_blackwell`` (Gaussian FPOC model), ``map_prob``
+    ``bench/simulation/planner_vs_greedy.py``. With ``rao_blackwell`` (Gaussian FPOC model),
+    ``map_prob``
     holds ``E[max_i B'_i]`` given the belief and fixation before each observation
     (:class:`_RaoBlackwell`): the same curve, less variance.
     """

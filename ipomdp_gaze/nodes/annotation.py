@@ -4,7 +4,8 @@
 The detector's ``annotated_image`` (the search drawn on the camera image) and ``detections``.
 
 :class:`Annotator` is attached to the ``foveal_detector`` node when ``publish_annotated`` is
-true (off by default: drawing costs about 3-7 ms a frame, ``bench/faces/annotate.py``). It follows the
+true (off by default: drawing costs about 3-7 ms a frame, ``bench/faces/annotate.py``). It follows
+the
 controller's ``belief`` and ``found`` and keeps the fixations of the current search (a uniform
 belief, sent at every reset, starts a new one); for every frame the detector publishes, and again
 for every belief and ``found`` that follows it, it publishes ``annotated_image`` (``rgb8``, at the
