@@ -146,8 +146,8 @@ def table(rows, episodes_greedy: int) -> str:
              f'{COSTLY_CHUNK} episodes), '
              'run by `bench/simulation/bench_cluster.py`. Dask workers are single-threaded '
              'processes on this machine, started by the benchmark. *Busiest* is the CPU time of '
-             "the busiest worker plus the client's: the run's wall time on otherwise idle cores. The "
-             'machine is shared (wall times move with its load), so the CPU-time speed-up '
+             "the busiest worker plus the client's: the run's wall time on otherwise idle cores. "
+             'The machine is shared (wall times move with its load), so the CPU-time speed-up '
              '(pieced CPU / busiest) is the honest measure; the wall-time one is shown too.', '',
              '| run | wall s | CPU s (all) | busiest s | speed-up (CPU time) | '
              'speed-up (wall) | same JSON |', '|---|---|---|---|---|---|---|']
