@@ -23,13 +23,12 @@ import math
 import re
 import time
 
-from conftest import HAVE_RCLPY, wait_for
+from conftest import wait_for
 import numpy as np
 import pytest
 from robust_support import bad_policy_files
 
-pytestmark = [pytest.mark.ros,
-              pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
+pytestmark = pytest.mark.ros
 
 CONTROLLER = 'gaze_controller'
 ROWS = COLS = 11

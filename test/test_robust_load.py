@@ -23,12 +23,11 @@ import json
 import subprocess
 import sys
 
-from conftest import HAVE_RCLPY, REPO, wait_for
+from conftest import REPO, wait_for
 import pytest
 from robust_support import RssSampler
 
-pytestmark = [pytest.mark.ros,
-              pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
+pytestmark = pytest.mark.ros
 
 FLOOD = REPO / 'bench' / 'evidence_flood.py'
 MB = 2 ** 20

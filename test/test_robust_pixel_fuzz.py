@@ -25,12 +25,11 @@ from __future__ import annotations
 import re
 import time
 
-from conftest import HAVE_RCLPY, wait_for
+from conftest import wait_for
 import numpy as np
 import pytest
 
-pytestmark = [pytest.mark.ros,
-              pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
+pytestmark = pytest.mark.ros
 
 NODE = 'foveal_detector'
 HOSTILE_PER_CYCLE = 12
