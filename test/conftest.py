@@ -88,6 +88,14 @@ def _ros_missing():
     return None
 
 
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(items):
+    """Mark `ros` every test that uses the ROS fixtures, so that it is counted (before -m)."""
+    for item in items:
+        if 'ros_env' in getattr(item, 'fixturenames', ()) and not item.get_closest_marker('ros'):
+            item.add_marker(pytest.mark.ros)
+
+
 def pytest_runtest_setup(item):
     """Skip a `ros` test without the `ros` extra; fail it when the extra is broken or required."""
     if item.get_closest_marker('ros') is None:
@@ -145,7 +153,7 @@ def pytest_terminal_summary(terminalreporter):
 def ros_env(tmp_path_factory):
     """Environment of an isolated ROS run; this process uses it too (set before rclpy.init)."""
     why = _ros_missing()
-    if why is not None:      # only a test not marked `ros` gets here
+    if why is not None:      # a test that reaches it late (getfixturevalue) and is not marked
         pytest.fail(f'this fixture needs ROS (mark the test `ros`): {why}', pytrace=False)
     from ipomdp_gaze.nodes.processes import domain_id_for, ros_environment
     env = ros_environment(domain_id_for(), tmp_path_factory.mktemp('ros_log'))
