@@ -33,18 +33,128 @@ if os.environ.get('CI'):
 if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
 
-HAVE_RCLPY = importlib.util.find_spec('rclpy') is not None
-HAVE_ROS_MSGS = importlib.util.find_spec('std_msgs') is not None
-# The message adapters need the ROS message packages (the `ros` extra): without them
-# test_msg_adapters.py reports itself skipped, and an installed but broken package fails.
+
+def _import_error(name: str):
+    """
+    Return ``None`` when module ``name`` imports, ``False`` when it is not installed at all.
+
+    An installed module that fails to import (any exception, a missing library of its own
+    included) returns that exception: the tests that need it then fail instead of skipping.
+    """
+    try:
+        if importlib.util.find_spec(name.split('.')[0]) is None:
+            return False
+        importlib.import_module(name)
+    except Exception as exc:  # noqa: B902 (an installed but broken package, whatever it raises)
+        return exc
+    return None
+
+
+# The `ros` extra: rclpy and the message packages. A test marked `ros` (pytest.ini) needs them:
+# not installed, it is skipped (a run without the extra); installed but broken, it fails; and
+# with IPOMDP_GAZE_REQUIRE_ROS=<n> set (`make test`, so CI) a skip is an error too, and the run
+# fails unless every collected `ros` test ran and at least n did.
+RCLPY_ERROR = _import_error('rclpy')
+ROS_MSGS_ERROR = _import_error('std_msgs.msg')
+HAVE_RCLPY = RCLPY_ERROR is None
+HAVE_ROS_MSGS = ROS_MSGS_ERROR is None
+REQUIRE_ROS = os.environ.get('IPOMDP_GAZE_REQUIRE_ROS', '')
 REPO = Path(__file__).resolve().parents[1]
+
+
+def require_extra(name: str, extra: str):
+    """
+    Import module ``name`` of an optional extra, for a test module that needs it.
+
+    Not installed: the module is skipped, or fails with IPOMDP_GAZE_REQUIRE_ROS set (`make test`
+    installs every extra). Installed but broken: the import error fails the module.
+    """
+    error = _import_error(name)
+    if error is False:
+        why = f'{name} is not installed (pip install -e ".[{extra}]")'
+        if REQUIRE_ROS:
+            pytest.fail(f'{why}; IPOMDP_GAZE_REQUIRE_ROS is set', pytrace=False)
+        pytest.skip(why, allow_module_level=True)
+    return importlib.import_module(name)
+
+
+def _ros_missing():
+    """Say why the `ros` tests cannot run here, or return ``None``."""
+    for name, error in (('rclpy', RCLPY_ERROR), ('the ROS message packages', ROS_MSGS_ERROR)):
+        if error is False:
+            return f'{name} not installed (pip install -e ".[ros]")'
+        if error is not None:
+            return f'{name} installed but broken: {type(error).__name__}: {error}'
+    return None
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(items):
+    """Mark `ros` every test that uses the ROS fixtures, so that it is counted (before -m)."""
+    for item in items:
+        if 'ros_env' in getattr(item, 'fixturenames', ()) and not item.get_closest_marker('ros'):
+            item.add_marker(pytest.mark.ros)
+
+
+def pytest_runtest_setup(item):
+    """Skip a `ros` test without the `ros` extra; fail it when the extra is broken or required."""
+    if item.get_closest_marker('ros') is None:
+        return
+    why = _ros_missing()
+    if why is None:
+        return
+    if REQUIRE_ROS or 'broken' in why:
+        pytest.fail(f'a ROS test cannot run: {why}' +
+                    (' (IPOMDP_GAZE_REQUIRE_ROS is set)' if REQUIRE_ROS else ''), pytrace=False)
+    pytest.skip(why)
+
+
+class _RosCount:
+    """The `ros` tests collected and those that ran (their test body was called)."""
+
+    collected: set = set()
+    ran = 0
+    problem = ''
+
+
+def pytest_collection_finish(session):
+    """Count the `ros` tests that will run (after -m / -k selection)."""
+    _RosCount.collected = {item.nodeid for item in session.items if item.get_closest_marker('ros')}
+
+
+def pytest_runtest_logreport(report):
+    """Count a `ros` test whose body ran, passed or failed (a skip is not a run)."""
+    if report.when == 'call' and report.nodeid in _RosCount.collected and not report.skipped:
+        _RosCount.ran += 1
+
+
+def pytest_sessionfinish(session, exitstatus):
+    """With IPOMDP_GAZE_REQUIRE_ROS=<n>: every collected `ros` test ran, and at least n did."""
+    if not REQUIRE_ROS or exitstatus == pytest.ExitCode.INTERRUPTED:
+        return
+    least = int(REQUIRE_ROS)
+    ran, collected = _RosCount.ran, len(_RosCount.collected)
+    if ran < collected or ran < least:
+        _RosCount.problem = (f'IPOMDP_GAZE_REQUIRE_ROS={least}: {ran} of {collected} collected '
+                             f'ROS tests ran (at least {least} must, and all that were collected)')
+        session.exitstatus = pytest.ExitCode.TESTS_FAILED
+
+
+def pytest_terminal_summary(terminalreporter):
+    """Report how many `ros` tests ran, and the failed count check."""
+    if REQUIRE_ROS or _RosCount.collected:
+        terminalreporter.write_line(
+            f'ROS tests: {_RosCount.ran} of {len(_RosCount.collected)} ran')
+    if _RosCount.problem:
+        terminalreporter.write_line(_RosCount.problem, red=True, bold=True)
 
 
 @pytest.fixture(scope='session')
 def ros_env(tmp_path_factory):
     """Environment of an isolated ROS run; this process uses it too (set before rclpy.init)."""
-    if not HAVE_RCLPY:
-        pytest.skip('rclpy is not installed (pip install -e ".[ros]")')
+    why = _ros_missing()
+    if why is not None:      # a test that reaches it late (getfixturevalue) and is not marked
+        pytest.fail(f'this fixture needs ROS (mark the test `ros`): {why}', pytrace=False)
     from ipomdp_gaze.nodes.processes import domain_id_for, ros_environment
     env = ros_environment(domain_id_for(), tmp_path_factory.mktemp('ros_log'))
     keys = ('ROS_DOMAIN_ID', 'ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_LOG_DIR', 'ROS_LOCALHOST_ONLY')

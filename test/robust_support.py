@@ -10,6 +10,7 @@ The controller's diagnostics, services and parameters are reached through the ``
 from __future__ import annotations
 
 import os
+import re
 import threading
 import time
 
@@ -39,11 +40,16 @@ def cpu_fraction(pid: int, seconds: float) -> float:
 
 
 class RssSampler:
-    """Sample a process's RSS and CPU time in a thread every ``period_s`` until :meth:`stop`."""
+    """
+    Sample a process's RSS and CPU time in a thread every ``period_s`` until :meth:`stop`.
 
-    def __init__(self, pid: int, period_s: float = 0.25):
-        self.pid, self.period_s = pid, period_s
-        self.samples: list[tuple[float, int, float]] = []
+    ``count`` (optional) is read with each sample, e.g. the frames the process has taken so far,
+    so that a test can compare memory and CPU with the work done rather than with time.
+    """
+
+    def __init__(self, pid: int, period_s: float = 0.25, count=None):
+        self.pid, self.period_s, self.count = pid, period_s, count or (lambda: 0)
+        self.samples: list[tuple[float, int, float, int]] = []
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, daemon=True)
         self._thread.start()
@@ -53,16 +59,34 @@ class RssSampler:
         while not self._stop.is_set():
             try:
                 self.samples.append((time.monotonic() - t0, rss_bytes(self.pid),
-                                     cpu_seconds(self.pid)))
+                                     cpu_seconds(self.pid), self.count()))
             except OSError:
                 return
             self._stop.wait(self.period_s)
 
-    def stop(self) -> list[tuple[float, int, float]]:
-        """Stop sampling; return ``[(seconds, rss_bytes, cpu_seconds), ...]``."""
+    def stop(self) -> list[tuple[float, int, float, int]]:
+        """Stop sampling; return ``[(seconds, rss_bytes, cpu_seconds, count), ...]``."""
         self._stop.set()
         self._thread.join(5)
         return self.samples
+
+
+def log_times(lines) -> list[float]:
+    """Return the times (s) in the `[LEVEL] [seconds.nanoseconds] [node]:` prefix of log lines."""
+    return [float(re.search(r'\[(\d+\.\d+)\]', line).group(1)) for line in lines]
+
+
+def assert_throttled(lines, period_s: float) -> None:
+    """
+    Check warnings of one call site were throttled to one per ``period_s`` (the node's setting).
+
+    Holds at any machine speed: it compares the warnings' own time stamps, not their number with
+    the length of a run. The 0.25 s slack covers the stamp being taken a moment after the
+    throttle's own clock reading, on a loaded machine.
+    """
+    times = log_times(lines)
+    gaps = [b - a for a, b in zip(times, times[1:])]
+    assert all(gap >= period_s - 0.25 for gap in gaps), (period_s, gaps)
 
 
 def bad_policy_files(folder, grid_rows: int = 11, grid_cols: int = 11, marker=None) -> dict:

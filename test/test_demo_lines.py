@@ -11,11 +11,10 @@ the search ended.
 """
 from types import SimpleNamespace
 
-from conftest import HAVE_RCLPY
 import numpy as np
 import pytest
 
-pytestmark = pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')
+pytestmark = pytest.mark.ros
 
 
 def _record(setup, beliefs, looked, found=None, absent=None, truth=None):

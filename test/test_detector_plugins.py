@@ -15,7 +15,7 @@ import csv
 import json
 import textwrap
 
-from conftest import HAVE_RCLPY, wait_for
+from conftest import wait_for
 import cv2
 from ipomdp_gaze.cli import main as cli
 import numpy as np
@@ -178,7 +178,6 @@ def test_an_unknown_detector_in_calibrate_is_one_line(tmp_path, capsys):
 
 
 @pytest.mark.ros
-@pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')
 @pytest.mark.parametrize('how', list(KINDS))
 def test_the_detector_node_serves_an_outside_detector(ros_env, probe, plugin_dir, tmp_path,
                                                       how, monkeypatch):

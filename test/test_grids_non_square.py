@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import math
 
-from conftest import HAVE_ROS_MSGS
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.model.head_camera import bin_points, observed_cells, PinholeCamera
@@ -22,7 +21,6 @@ import pytest
 GRIDS = [Grid(4, 6, 5.0), Grid(6, 4, 5.0), Grid(2, 8, 3.0), Grid(1, 5, 4.0), Grid(8, 8, 2.0)]
 IDS = [f'{g.rows}x{g.cols}' for g in GRIDS]
 DEG = math.pi / 180
-needs_msgs = pytest.mark.skipif(not HAVE_ROS_MSGS, reason='the ROS messages are not installed')
 
 
 @pytest.mark.parametrize('row, col, pan_deg, tilt_deg', [
@@ -71,7 +69,7 @@ def test_a_point_at_the_image_centre_is_counted_in_the_head_cell(grid):
         np.testing.assert_array_equal(np.isnan(counts), ~seen.reshape(-1))
 
 
-@needs_msgs
+@pytest.mark.ros
 @pytest.mark.parametrize('grid', GRIDS, ids=IDS)
 def test_multiarray_layout_and_row_major_order(grid):
     from ipomdp_gaze.msg_adapters import grid_arrays
@@ -88,7 +86,7 @@ def test_multiarray_layout_and_row_major_order(grid):
             grid_arrays.from_multiarray(msg, transposed)
 
 
-@needs_msgs
+@pytest.mark.ros
 @pytest.mark.parametrize('grid', GRIDS, ids=IDS)
 def test_evidence_image_is_rows_high_and_cols_wide(grid):
     from builtin_interfaces.msg import Time
@@ -106,7 +104,7 @@ def test_evidence_image_is_rows_high_and_cols_wide(grid):
     assert (picture.height, picture.width) == (8 * grid.rows, 8 * grid.cols)
 
 
-@needs_msgs
+@pytest.mark.ros
 @pytest.mark.parametrize('grid', GRIDS, ids=IDS)
 def test_row_col_and_joint_states_of_the_last_cell(grid):
     from builtin_interfaces.msg import Time

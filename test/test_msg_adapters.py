@@ -14,7 +14,8 @@ from ipomdp_gaze.model.head import PanTiltMap
 import numpy as np
 import pytest
 
-# Not installed at all: a visible skip. Installed but broken: the import fails the run.
+# The message packages (the `ros` extra): without them conftest skips every test here, and an
+# installed but broken package fails them (IPOMDP_GAZE_REQUIRE_ROS: a skip fails too).
 if HAVE_ROS_MSGS:
     from builtin_interfaces.msg import Time
     from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, stamps
@@ -22,9 +23,8 @@ if HAVE_ROS_MSGS:
     from sensor_msgs.msg import Image, JointState
     from std_msgs.msg import (Float32MultiArray, Int32MultiArray, MultiArrayDimension,
                               MultiArrayLayout)
-else:
-    pytest.skip('the ROS message packages are not installed (pip install -e ".[ros]")',
-                allow_module_level=True)
+
+pytestmark = pytest.mark.ros
 
 GRID = Grid(11, 11, 5.0)
 DEG = math.pi / 180

@@ -7,10 +7,10 @@ import math
 from ipomdp_gaze.model.fpoc import make_fpoc
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.observation import CountObservation, GaussianObservation
-from ipomdp_gaze.model.occupancy import (binary_entropy, cell_prior, channel_information,
-                                         clusters, count_faces, decided, InformationTable,
-                                         log_nobody, occupancy, one_target_belief,
-                                         prior_log_odds, update_log_odds)
+from ipomdp_gaze.model.occupancy import (binary_entropy, cell_prior, channel_information, clusters,
+                                         count_faces, decided, InformationTable, log_nobody,
+                                         occupancy, one_target_belief, prior_log_odds,
+                                         update_log_odds)
 from ipomdp_gaze.search.many import OccupancySession
 from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
 import numpy as np

@@ -21,12 +21,11 @@ import subprocess
 import sys
 import textwrap
 
-from conftest import HAVE_RCLPY, REPO, wait_for
+from conftest import REPO, wait_for
 import numpy as np
 import pytest
 
-pytestmark = [pytest.mark.ros,
-              pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
+pytestmark = pytest.mark.ros
 
 TARGET = (2, 8)
 DPRIME = 2.5                       # a weak camera: a search takes several fixations

@@ -12,12 +12,10 @@ from __future__ import annotations
 
 import time
 
-from conftest import HAVE_RCLPY
 import numpy as np
 import pytest
 
-pytestmark = [pytest.mark.ros,
-              pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
+pytestmark = pytest.mark.ros
 
 
 class Rig:

@@ -8,11 +8,17 @@ the
 newest one (``evidence_queue_depth`` 1), so a frame it has not taken yet is replaced by the next
 one and counted as dropped from the publisher's sequence numbers. Every frame is accounted for:
 received + dropped = sent, received = applied + rejected + skipped. At 11x11 the steady
-1 kHz is followed by 5,000 frames at once, which must mostly be dropped rather than queued. The
+1 kHz is followed by 5,000 frames at once, which must be dropped rather than queued. The
 flood ends with one invalid frame; it is the newest, so it must be received (and rejected)
 however far behind the node was. A viewer subscribes to ``belief_image`` (at 256x256 and 32 px
 per cell the heatmap would be 201 MB; it is capped at 1024 px). The controller's RSS is sampled
 from ``/proc`` during the run and must not grow, and its CPU use is reported.
+
+Every check holds at any machine speed. A fast node may take every frame and a slow one drops
+many: neither is required. What is required is that no backlog is left when the flood ends, and
+that frames are dropped whenever the node's own measured cost per frame says it could not have
+taken the burst in the time the burst took. Memory is compared from the moment the node has
+taken its first frames (warm), not from a fixed share of the run's time.
 
 Both grids run ELM (at 256x256 an FFT convolution on the offset table: no N x N array).
 
@@ -24,16 +30,17 @@ import json
 import subprocess
 import sys
 
-from conftest import HAVE_RCLPY, REPO, wait_for
+from conftest import REPO, wait_for
 import pytest
 from robust_support import RssSampler
 
-pytestmark = [pytest.mark.ros,
-              pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
+pytestmark = pytest.mark.ros
 
 FLOOD = REPO / 'bench' / 'ros' / 'evidence_flood.py'
 MB = 2 ** 20
 MAX_RSS_MB = 400                    # 256x256 with a belief_image viewer once took 1.27 GB
+WARM_FRAMES = 20                    # taken before memory is compared (lazy set-up done by then)
+QUEUE = 1                           # evidence_queue_depth, the node's default
 # (rows, spacing_deg, policy) of each grid.
 GRIDS = {11: (5.0, 'elm'), 256: (0.5, 'elm')}
 
@@ -59,11 +66,14 @@ def _run(launch, probe, ros_env, rows, rate_hz, seconds, burst):
     flood = _flood(ros_env, rows, rate_hz, seconds, burst)    # it waits for the controller
     try:
         assert wait_for(lambda: diag.count > 0, 60), proc.output()
-        rss = RssSampler(proc.proc.pid)
+        rss = RssSampler(proc.proc.pid, count=lambda: diag.counter('received'))
         out, _ = flood.communicate(timeout=seconds + 120)
+        # A status published after the flood's last frame (the marker, 0.3 s before it exited).
+        ended = diag.wait_fresh()
         samples = rss.stop()
         assert flood.returncode == 0, out
         report = json.loads(out.strip().splitlines()[-1])
+        report['received_at_end'] = ended['received']
         sent = report['sent']
 
         def accounted():
@@ -86,24 +96,32 @@ def _run(launch, probe, ros_env, rows, rate_hz, seconds, burst):
 
 def _check(report, got, samples, label, max_growth_mb):
     sent = report['sent']
-    third = max(1, len(samples) // 3)
-    early = max(r for _, r, _ in samples[:third])
-    late = max(r for _, r, _ in samples[-third:])
-    peak = max(r for _, r, _ in samples)
-    (t0, _, c0), (t1, _, c1) = samples[third], samples[-third]
-    cpu = (c1 - c0) / (t1 - t0)                        # the middle third: steady flooding
+    # Memory from the first sample after the node had taken WARM_FRAMES frames to the end: the
+    # same work on a fast or a slow machine, whatever share of the run's time the start took.
+    warm = next((i for i, s in enumerate(samples) if s[3] >= WARM_FRAMES), None)
+    assert warm is not None and warm + 1 < len(samples), [s[3] for s in samples]
+    early = max(r for _, r, _, _ in samples[:warm + 1])
+    late = max(r for _, r, _, _ in samples[warm + 1:])
+    peak = max(r for _, r, _, _ in samples)
+    (t0, _, c0, n0), (t1, _, c1, n1) = samples[warm], samples[-1]
+    cpu = (c1 - c0) / (t1 - t0)
+    cost = (c1 - c0) / max(1, n1 - n0)                 # CPU seconds per frame taken
     rate, duration = report['rate_hz'], report['seconds']
     print(f'\n{label}: sent {sent} frames at {rate} Hz for {duration} s; controller received '
           f'{got["received"]}, dropped {got["dropped"]}, applied {got["applied"]}, rejected '
-          f'{got["rejected"]}, skipped {got["skipped"]}; CPU {cpu:.0%} of a core; '
-          f'RSS {early / MB:.1f} MB in the first third, {late / MB:.1f} MB in the last, peak '
-          f'{peak / MB:.1f} MB ({len(samples)} samples)')
+          f'{got["rejected"]}, skipped {got["skipped"]}; CPU {cpu:.0%} of a core, '
+          f'{cost * 1e3:.2f} ms per frame; RSS {early / MB:.1f} MB when warm, {late / MB:.1f} MB '
+          f'after, peak {peak / MB:.1f} MB ({len(samples)} samples)')
     assert got['received'] + got['dropped'] == sent
     assert got['rejected'] == 1                        # the newest frame, the marker
     assert got['received'] == got['applied'] + got['rejected'] + got['skipped']
     assert got['applied'] >= 1 and got['skipped'] >= 1
+    # No backlog: once the flood has ended, at most the frame in hand and the QUEUE kept are
+    # still to be taken, however slow the node (a queue that grew would still be draining).
+    assert got['received'] - report['received_at_end'] <= QUEUE + 1, (got, report)
     assert late - early <= max_growth_mb * MB, (early, late)
     assert peak <= MAX_RSS_MB * MB, peak
+    return cost
 
 
 @pytest.mark.parametrize('rows, rate_hz, seconds, burst', [
@@ -115,8 +133,11 @@ def _check(report, got, samples, label, max_growth_mb):
 def test_fast_camera_memory_and_queue_stay_bounded(launch, probe, ros_env, rows, rate_hz,
                                                    seconds, burst):
     report, got, samples = _run(launch, probe, ros_env, rows, rate_hz, seconds, burst)
-    _check(report, got, samples, f'{rows}x{rows} at {rate_hz:g} Hz'
-           + (f', then {burst} frames at once' if burst else ''), max_growth_mb=16)
-    if burst:
-        # Frames that came faster than the node took them were replaced, not queued.
-        assert got['dropped'] > 0 and got['received'] < report['sent']
+    cost = _check(report, got, samples, f'{rows}x{rows} at {rate_hz:g} Hz'
+                  + (f', then {burst} frames at once' if burst else ''), max_growth_mb=16)
+    if burst and cost * burst > 2 * report['burst_seconds']:
+        # The node, at its own measured cost per frame, needed over twice the time the burst
+        # took to take it all (the factor 2 covers the cost estimate's noise): frames that came
+        # faster than it took them must have been replaced, not queued. A node fast enough to
+        # keep up is not required to drop any.
+        assert got['dropped'] > 0 and got['received'] < report['sent'], (cost, report)

@@ -20,7 +20,7 @@ from pathlib import Path
 import subprocess
 import sys
 
-from conftest import HAVE_RCLPY, REPO
+from conftest import REPO
 from hypothesis import given, HealthCheck, settings
 from hypothesis import strategies as st
 from ipomdp_gaze.files.observation_file import (load_observation, model_to_dict,
@@ -160,7 +160,6 @@ def test_the_detector_setup_builds_or_gives_one_line(tmp_path_factory, text):
 
 
 @pytest.mark.ros
-@pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')
 @pytest.mark.parametrize('case', ['truncated', 'nan', 'tag', 'fovea-type'])
 def test_the_detector_node_exits_1_with_one_line(ros_env, tmp_path, case):
     doc = copy.deepcopy(BASE)

@@ -11,12 +11,11 @@ re-sent target makes the scene camera take a new frame, and the search finishes 
 """
 from __future__ import annotations
 
-from conftest import HAVE_RCLPY, wait_for
+from conftest import wait_for
 import numpy as np
 import pytest
 
-pytestmark = [pytest.mark.ros,
-              pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
+pytestmark = pytest.mark.ros
 
 RETRY_S = 0.3
 

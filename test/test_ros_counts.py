@@ -10,12 +10,11 @@ start-up and at run time.
 """
 from __future__ import annotations
 
-from conftest import config_path, HAVE_RCLPY, wait_for
+from conftest import config_path, wait_for
 import numpy as np
 import pytest
 
-pytestmark = [pytest.mark.ros,
-              pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
+pytestmark = pytest.mark.ros
 
 NODE = 'gaze_controller'
 

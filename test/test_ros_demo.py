@@ -8,11 +8,10 @@ import re
 import subprocess
 import sys
 
-from conftest import HAVE_RCLPY, REPO
+from conftest import REPO
 import pytest
 
-pytestmark = [pytest.mark.ros,
-              pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
+pytestmark = pytest.mark.ros
 
 
 def node_processes(domain_id: int) -> list:

@@ -13,12 +13,11 @@ import re
 import subprocess
 import sys
 
-from conftest import HAVE_RCLPY, REPO
+from conftest import REPO
 import pytest
 from test_ros_demo import node_processes
 
-pytestmark = [pytest.mark.ros,
-              pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
+pytestmark = pytest.mark.ros
 
 FIXATION = re.compile(r'^fixation +(\d+): looked at \((\d+), (\d+)\)  (.*)  ->  most likely '
                       r'\((\d+), (\d+)\) p=(\d\.\d+)(?:  nobody p=\d\.\d+)? +entropy '

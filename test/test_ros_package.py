@@ -11,11 +11,9 @@ import ast
 import subprocess
 import sys
 
-from conftest import HAVE_RCLPY, REPO
+from conftest import REPO
 import pytest
 import yaml
-
-needs_rclpy = pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')
 
 
 def _yaml(name):
@@ -32,7 +30,7 @@ def _flat(tree, prefix=''):
     return out
 
 
-@needs_rclpy
+@pytest.mark.ros
 @pytest.mark.parametrize('file, node, module, params', [
     ('controller.yaml', 'gaze_controller', 'controller', 'controller_params'),
     ('camera.yaml', 'simulated_camera', 'camera', 'camera_params'),
@@ -145,7 +143,6 @@ def test_face_launch_file_starts_the_three_nodes_with_the_files_of_its_mode():
 
 
 @pytest.mark.ros
-@needs_rclpy
 @pytest.mark.parametrize('command, ros_args, words', [
     ('controller', ['-p', 'policy.kernel:=[1.0, 2.0]'], 'policy.kernel must have 441 values'),
     ('controller', ['-p', 'policy.name:=learned', '-p', 'policy.file:=/no/such/policy.yaml'],

@@ -10,11 +10,9 @@ the same callbacks.
 """
 from __future__ import annotations
 
-from conftest import HAVE_RCLPY
 import pytest
 
-pytestmark = [pytest.mark.ros,
-              pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
+pytestmark = pytest.mark.ros
 
 
 @pytest.fixture

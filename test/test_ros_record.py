@@ -19,6 +19,8 @@ import numpy as np
 import pytest
 import yaml
 
+pytestmark = pytest.mark.ros
+
 REPO = Path(__file__).resolve().parents[1]
 SEARCH_TOPICS = {'/fixation', '/pan_tilt', '/belief', '/found', '/diagnostics', '/ground_truth'}
 

@@ -12,12 +12,11 @@ from __future__ import annotations
 
 import math
 
-from conftest import config_path, HAVE_RCLPY, wait_for
+from conftest import config_path, wait_for
 import numpy as np
 import pytest
 
-pytestmark = [pytest.mark.ros,
-              pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
+pytestmark = pytest.mark.ros
 
 CONTROLLER, CAMERA = 'gaze_controller', 'simulated_camera'
 SEARCH_TIMEOUT_S = 60.0

@@ -11,12 +11,11 @@ tracking after ``found``. Invalid values of the new parameters are refused with 
 """
 from __future__ import annotations
 
-from conftest import config_path, HAVE_RCLPY, wait_for
+from conftest import config_path, wait_for
 import numpy as np
 import pytest
 
-pytestmark = [pytest.mark.ros,
-              pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
+pytestmark = pytest.mark.ros
 
 CONTROLLER, CAMERA = 'gaze_controller', 'simulated_camera'
 CONFIDENCE = 0.999

@@ -12,12 +12,11 @@ frame taken mid-saccade is used, and the search still completes.
 """
 from __future__ import annotations
 
-from conftest import config_path, HAVE_RCLPY, wait_for
+from conftest import config_path, wait_for
 import numpy as np
 import pytest
 
-pytestmark = [pytest.mark.ros,
-              pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')]
+pytestmark = pytest.mark.ros
 
 NODE = 'gaze_controller'
 SETTLE_S, SACCADE_S, RETRY_S = 0.5, 0.3, 0.3

@@ -18,7 +18,7 @@ import json
 import subprocess
 import sys
 
-from conftest import HAVE_RCLPY, REPO
+from conftest import REPO
 from ipomdp_gaze.search.session import SearchSettings
 import pytest
 
@@ -83,7 +83,6 @@ def controller_node(ros_env, overrides=None):
 
 
 @pytest.mark.ros
-@pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')
 def test_the_node_refuses_the_same_values_with_the_same_message(ros_env):
     from rclpy.parameter import Parameter
     with controller_node(ros_env) as node:
@@ -101,7 +100,6 @@ def test_the_node_refuses_the_same_values_with_the_same_message(ros_env):
 
 
 @pytest.mark.ros
-@pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')
 @pytest.mark.parametrize('overrides, expected, policy', [
     ({'policy.file': 'camera-11x11-infomax'}, 'learned', 'camera-11x11-infomax'),
     ({'policy.file': 'camera-11x11-infomax', 'policy.name': 'map'}, 'map', 'map'),
@@ -114,7 +112,6 @@ def test_policy_file_alone_selects_learned_at_start_up(ros_env, overrides, expec
 
 
 @pytest.mark.ros
-@pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')
 def test_a_missing_policy_file_alone_is_refused_at_start_up(ros_env):
     with pytest.raises(Exception, match='nothere.yaml'):
         with controller_node(ros_env, {'policy.file': 'nothere.yaml'}):
@@ -189,7 +186,6 @@ def test_find_saves_each_images_event_log(tmp_path):
 
 
 @pytest.mark.ros
-@pytest.mark.skipif(not HAVE_RCLPY, reason='rclpy is not installed')
 def test_an_unexpected_error_in_a_parameter_set_is_counted_and_refused(ros_env, monkeypatch):
     """The controller's parameter callback is guarded: the set is refused, the node lives on."""
     from ipomdp_gaze.nodes import controller as module

