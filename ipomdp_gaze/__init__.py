@@ -32,6 +32,8 @@ MOVED = {
     'detection': 'vision.detection', 'replay': 'drivers.replay', 'pieces': 'drivers.pieces',
     'vision.scene_eval': 'drivers.scene_eval', 'nodes.config': 'files.share_files',
     'vision.cell_observation': 'model.cell_observation',
+    'nodes.processes': 'harness.processes', 'nodes.watch': 'harness.watch',
+    'nodes.demo': 'harness.demo',
 }
 
 

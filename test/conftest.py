@@ -4,10 +4,10 @@
 Shared fixtures; the ROS ones run real nodes over real DDS, isolated per test run.
 
 Every run gets its own ``ROS_DOMAIN_ID`` (1..101, reserved with a lock file so that two runs at
-once never share one: :func:`ipomdp_gaze.nodes.processes.domain_id_for`), discovery
+once never share one: :func:`ipomdp_gaze.harness.processes.domain_id_for`), discovery
 limited to this host and node log files in a temporary directory. Nodes under test run as
-separate processes (as a user runs them, :class:`ipomdp_gaze.nodes.processes.NodeGroup`); the
-test's own node (``probe``, an :class:`ipomdp_gaze.nodes.watch.Watch`) spins a
+separate processes (as a user runs them, :class:`ipomdp_gaze.harness.processes.NodeGroup`); the
+test's own node (``probe``, an :class:`ipomdp_gaze.harness.watch.Watch`) spins a
 ``SingleThreadedExecutor`` in a thread with a stop flag and is joined at teardown (ROS_NOTES.md
 section 7). The demo and the benches watch their nodes the same way.
 """
@@ -19,7 +19,7 @@ from pathlib import Path
 import signal
 
 from hypothesis import settings
-from ipomdp_gaze.nodes.processes import wait_for  # noqa: F401 (the tests import it from here)
+from ipomdp_gaze.harness.processes import wait_for  # noqa: F401 (the tests import it from here)
 import pytest
 
 # Property tests: the same examples on every CI run (CI=1), fresh ones on a developer's machine.
@@ -155,7 +155,7 @@ def ros_env(tmp_path_factory):
     why = _ros_missing()
     if why is not None:      # a test that reaches it late (getfixturevalue) and is not marked
         pytest.fail(f'this fixture needs ROS (mark the test `ros`): {why}', pytrace=False)
-    from ipomdp_gaze.nodes.processes import domain_id_for, ros_environment
+    from ipomdp_gaze.harness.processes import domain_id_for, ros_environment
     env = ros_environment(domain_id_for(), tmp_path_factory.mktemp('ros_log'))
     keys = ('ROS_DOMAIN_ID', 'ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_LOG_DIR', 'ROS_LOCALHOST_ONLY')
     saved = {k: os.environ.get(k) for k in keys}
@@ -175,7 +175,7 @@ def ros_env(tmp_path_factory):
 @pytest.fixture(scope='module')
 def probe(ros_env):
     """Provide the test's own node (a ``Watch``) on this run's domain, shared by a module."""
-    from ipomdp_gaze.nodes.watch import Watch
+    from ipomdp_gaze.harness.watch import Watch
     with Watch(int(ros_env['ROS_DOMAIN_ID']), 'test_probe') as watch:
         yield watch
 
@@ -188,7 +188,7 @@ def nodes(ros_env, tmp_path_factory):
     At teardown every process not killed on purpose gets SIGTERM and must exit with status 0
     (a clean shutdown).
     """
-    from ipomdp_gaze.nodes.processes import NodeGroup
+    from ipomdp_gaze.harness.processes import NodeGroup
     group = NodeGroup(ros_env, tmp_path_factory.mktemp('node_output'))
     yield group
     bad = group.close()

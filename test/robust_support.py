@@ -4,7 +4,7 @@
 Helpers of the robustness tests: /proc readings and policy files that must be refused.
 
 The controller's diagnostics, services and parameters are reached through the ``probe`` fixture
-(:class:`ipomdp_gaze.nodes.watch.Watch`). ``make soak`` runs the long versions
+(:class:`ipomdp_gaze.harness.watch.Watch`). ``make soak`` runs the long versions
 (``pytest -m soak``); ``make test`` runs the short ones.
 """
 from __future__ import annotations

@@ -84,7 +84,7 @@ def cluster(tmp_path_factory):
             client.wait_for_workers(2, timeout=60)
         yield running
     finally:                    # the workers first: without a scheduler they retry for long
-        from ipomdp_gaze.nodes.processes import stop_processes
+        from ipomdp_gaze.harness.processes import stop_processes
         stop_processes(running.processes)
 
 

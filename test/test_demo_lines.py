@@ -4,7 +4,7 @@
 The demo's printed lines say what the controller decided (issue 35), without node processes.
 
 The demo follows the controller's messages; here they are built directly and handed to
-:func:`ipomdp_gaze.nodes.demo._follow` as the watch would record them: the face demo's progress
+:func:`ipomdp_gaze.harness.demo._follow` as the watch would record them: the face demo's progress
 lines name the answer as the controller's ``found`` rule does (``search.found_radius``), show the
 probability that nobody is there when the search can end ``absent``, and the last line says how
 the search ended.
@@ -30,7 +30,7 @@ def _record(setup, beliefs, looked, found=None, absent=None, truth=None):
 
 
 def _follow(setup, record):
-    from ipomdp_gaze.nodes.demo import _follow
+    from ipomdp_gaze.harness.demo import _follow
     lines, stats = [], {}
     assert _follow(setup, record, lambda condition: condition(), 60.0, lines.append,
                    stats) == 0
@@ -38,8 +38,8 @@ def _follow(setup, record):
 
 
 def test_the_face_demos_lines_name_the_answer_the_controller_found():
+    from ipomdp_gaze.harness.demo import faces_setup
     from ipomdp_gaze.msg_adapters import diagnostics
-    from ipomdp_gaze.nodes.demo import faces_setup
     setup = faces_setup()
     grid = setup.grid
     assert setup.settings.found_radius == 1 and setup.settings.absent_prior > 0
@@ -61,8 +61,8 @@ def test_the_face_demos_lines_name_the_answer_the_controller_found():
 
 
 def test_a_forced_found_and_an_absent_answer_say_so():
+    from ipomdp_gaze.harness.demo import faces_setup
     from ipomdp_gaze.msg_adapters import diagnostics
-    from ipomdp_gaze.nodes.demo import faces_setup
     setup = faces_setup(empty=True)
     grid = setup.grid
     belief = np.full(grid.n_cells, 0.3 / grid.n_cells)
@@ -80,8 +80,8 @@ def test_a_forced_found_and_an_absent_answer_say_so():
 
 
 def test_the_gaussian_demo_shows_no_absent_probability():
+    from ipomdp_gaze.harness.demo import demo_setup
     from ipomdp_gaze.msg_adapters import diagnostics
-    from ipomdp_gaze.nodes.demo import demo_setup
     setup = demo_setup(target=(9, 7))
     grid = setup.grid
     belief = np.full(grid.n_cells, 0.01 / (grid.n_cells - 1))

@@ -183,9 +183,9 @@ def test_the_detector_node_serves_an_outside_detector(ros_env, probe, plugin_dir
                                                       how, monkeypatch):
     import os
 
+    from ipomdp_gaze.harness.processes import NodeGroup
+    from ipomdp_gaze.harness.watch import LATCHED
     from ipomdp_gaze.msg_adapters import grid_arrays, images
-    from ipomdp_gaze.nodes.processes import NodeGroup
-    from ipomdp_gaze.nodes.watch import LATCHED
     from ipomdp_gaze.vision.detection import build_setup
     from rclpy.qos import QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import Image

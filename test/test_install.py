@@ -408,9 +408,9 @@ def test_installed_controller_and_camera_talk_over_dds(install, ros_env, probe, 
 
 @pytest.mark.ros
 def test_installed_scene_camera_and_detector_serve_a_fixation(install, ros_env, probe, tmp_path):
+    from ipomdp_gaze.harness.watch import LATCHED
     from ipomdp_gaze.model.grid import Grid
     from ipomdp_gaze.msg_adapters import grid_arrays, images
-    from ipomdp_gaze.nodes.watch import LATCHED
     from rclpy.qos import QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import Image
     from std_msgs.msg import Int32MultiArray

@@ -11,7 +11,7 @@ from conftest import REPO
 
 HOLD = textwrap.dedent("""
     import sys
-    from ipomdp_gaze.nodes.processes import domain_id_for
+    from ipomdp_gaze.harness.processes import domain_id_for
     print(domain_id_for(), domain_id_for(), flush=True)
     sys.stdin.read()                     # hold the domain until the test closes stdin
 """)
@@ -43,7 +43,7 @@ STUBBORN = textwrap.dedent("""
 
 
 def test_stop_processes_terminates_the_polite_and_kills_the_stubborn():
-    from ipomdp_gaze.nodes.processes import stop_processes
+    from ipomdp_gaze.harness.processes import stop_processes
     polite = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(120)'])
     stubborn = subprocess.Popen([sys.executable, '-c', STUBBORN], stdout=subprocess.PIPE,
                                 text=True)

@@ -45,9 +45,9 @@ class Watch:
     """What the probe sees of the search: beliefs, targets, camera poses and frames, status."""
 
     def __init__(self, probe):
+        from ipomdp_gaze.harness.watch import SearchRecord
         from ipomdp_gaze.model.grid import Grid
         from ipomdp_gaze.model.head import PanTiltMap
-        from ipomdp_gaze.nodes.watch import SearchRecord
         from rclpy.qos import QoSProfile, ReliabilityPolicy
         from sensor_msgs.msg import JointState
         from std_msgs.msg import Float32MultiArray

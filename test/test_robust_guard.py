@@ -57,8 +57,8 @@ def detector(ros_env):
 
 def test_an_injected_failing_callback_is_counted_and_the_node_carries_on(detector):
     from diagnostic_msgs.msg import DiagnosticArray
+    from ipomdp_gaze.harness.watch import LATCHED
     from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images
-    from ipomdp_gaze.nodes.watch import LATCHED
     from ipomdp_gaze.vision.scenes import PAPER_TASK, SceneSet
     from sensor_msgs.msg import Image
     from std_msgs.msg import Int32MultiArray

@@ -25,8 +25,8 @@ def _args(setup, node: str, extra=()) -> list:
 
 
 def test_detector_killed_mid_search_then_restarted_and_the_search_finishes(nodes, probe):
-    from ipomdp_gaze.nodes.demo import faces_setup
-    from ipomdp_gaze.nodes.watch import SearchRecord
+    from ipomdp_gaze.harness.demo import faces_setup
+    from ipomdp_gaze.harness.watch import SearchRecord
     setup = faces_setup(fovea=False, seed=0)
     record = SearchRecord(probe, depth=200, updates_only=True)
     diag = probe.search_status()

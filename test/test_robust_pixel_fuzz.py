@@ -45,9 +45,9 @@ class Rig:
 
     def __init__(self, probe, nodes, mode: str):
         from diagnostic_msgs.msg import DiagnosticArray
+        from ipomdp_gaze.harness.watch import LATCHED
         from ipomdp_gaze.msg_adapters import diagnostics
         from ipomdp_gaze.nodes.detector import FRAME_QOS
-        from ipomdp_gaze.nodes.watch import LATCHED
         from ipomdp_gaze.vision.detection import build_setup
         from sensor_msgs.msg import CameraInfo, Image, JointState
         from std_msgs.msg import Int32MultiArray

@@ -26,10 +26,10 @@ class Camera:
     """This test as the camera: sends frames, sees the controller's beliefs and targets."""
 
     def __init__(self, probe, launch):
+        from ipomdp_gaze.harness.watch import SearchRecord
         from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
         from ipomdp_gaze.model.grid import Grid
         from ipomdp_gaze.model.head import PanTiltMap
-        from ipomdp_gaze.nodes.watch import SearchRecord
         from sensor_msgs.msg import Image
         from std_msgs.msg import Float32MultiArray
         self.grid = Grid(11, 11, 5.0)

@@ -24,7 +24,7 @@ class Detector:
 
     def __init__(self, probe, nodes):
         from ipomdp_gaze.files.observation_file import load_observation
-        from ipomdp_gaze.nodes.watch import LATCHED
+        from ipomdp_gaze.harness.watch import LATCHED
         from std_msgs.msg import Float32MultiArray, Int32MultiArray
         self.model = load_observation('faces-420-nmpt')     # a model without the scan
         self.grid = self.model.grid

@@ -27,7 +27,7 @@ class Driver:
 
     def __init__(self, probe, nodes, namespace: str, mode: str):
         from diagnostic_msgs.msg import DiagnosticArray
-        from ipomdp_gaze.nodes.watch import LATCHED
+        from ipomdp_gaze.harness.watch import LATCHED
         from rclpy.qos import QoSProfile, ReliabilityPolicy
         from sensor_msgs.msg import CameraInfo, Image, JointState
         from std_msgs.msg import Int32MultiArray

@@ -207,9 +207,9 @@ def test_ipomdp_gaze_record_records_another_run_until_sigint(ros_env, tmp_path, 
     import signal
 
     from conftest import config_path
+    from ipomdp_gaze.harness.processes import NodeGroup, wait_for
+    from ipomdp_gaze.harness.watch import quiet_condition, SearchRecord
     from ipomdp_gaze.msg_adapters import diagnostics
-    from ipomdp_gaze.nodes.processes import NodeGroup, wait_for
-    from ipomdp_gaze.nodes.watch import quiet_condition, SearchRecord
     topics = ('pan_tilt', 'belief', 'found', 'ground_truth')
     search = SearchRecord(probe, updates_only=True)
     status = probe.status_values('recorder: recording')

@@ -24,7 +24,7 @@ NODE = 'gaze_controller'
 
 @pytest.fixture(scope='module')
 def rig(probe, nodes):
-    from ipomdp_gaze.nodes.watch import LATCHED
+    from ipomdp_gaze.harness.watch import LATCHED
     from sensor_msgs.msg import Image
     from std_msgs.msg import Int32MultiArray
     rec = {'fixations': probe.record(Int32MultiArray, 'fixation', LATCHED),

@@ -27,7 +27,7 @@ CASES = [(11, None, None), (12, (0, 10), (0, 0)), (13, (10, 1), None), (14, None
 
 @pytest.fixture(scope='module')
 def rig(launch, probe):
-    from ipomdp_gaze.nodes.watch import SearchRecord
+    from ipomdp_gaze.harness.watch import SearchRecord
     from sensor_msgs.msg import Image
 
     search = SearchRecord(probe, depth=100)

@@ -25,7 +25,7 @@ SEARCH_TIMEOUT_S = 90.0
 @pytest.fixture(scope='module')
 def rig(launch, probe):
     from diagnostic_msgs.msg import DiagnosticStatus
-    from ipomdp_gaze.nodes.watch import SearchRecord
+    from ipomdp_gaze.harness.watch import SearchRecord
     from std_msgs.msg import Float32MultiArray
 
     search = SearchRecord(probe, depth=200)

@@ -24,7 +24,7 @@ SETTLE_S, SACCADE_S, RETRY_S = 0.5, 0.3, 0.3
 
 @pytest.fixture(scope='module')
 def rig(launch, probe):
-    from ipomdp_gaze.nodes.watch import SearchRecord
+    from ipomdp_gaze.harness.watch import SearchRecord
     from rclpy.qos import QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import Image, JointState
 

@@ -186,7 +186,7 @@ def test_coverage_takes_the_sweeps_tiles_while_the_belief_is_diffuse_then_elm():
 
 
 def test_the_face_demo_can_show_the_scene_without_its_face():
-    from ipomdp_gaze.nodes.demo import faces_setup
+    from ipomdp_gaze.harness.demo import faces_setup
     setup = faces_setup(seed=3, empty=True)
     camera = dict(setup.nodes)['scene_camera']
     assert 'scene.empty:=true' in camera and 'seed:=3' in camera

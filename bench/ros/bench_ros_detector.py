@@ -16,10 +16,10 @@ In the same run, on the same frames and in this process, OpenCV's full-frame Haa
 import time
 
 import cv2
+from ipomdp_gaze.harness.processes import domain_id_for, isolated_nodes
+from ipomdp_gaze.harness.watch import LATCHED, Watch
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.msg_adapters import grid_arrays, images
-from ipomdp_gaze.nodes.processes import domain_id_for, isolated_nodes
-from ipomdp_gaze.nodes.watch import LATCHED, Watch
 from ipomdp_gaze.vision.detectors import make_detector
 from ipomdp_gaze.vision.fullframe import scan
 from ipomdp_gaze.vision.scenes import SceneSet

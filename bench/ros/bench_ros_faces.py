@@ -6,7 +6,7 @@ The face demo over DDS: scene camera, foveal detector and controller, many held-
 For each mode (``camera``: a camera on the pan/tilt head; ``fovea``: a fixed camera and the
 digital fovea) and each seed, runs exactly what ``ipomdp-gaze demo --scene faces [--fovea]
 --seed S`` runs (three processes with the shipped ``config/faces_<mode>_*.yaml``, started,
-watched and stopped by :func:`ipomdp_gaze.nodes.demo.run_demo`, 60 fixations at most) and
+watched and stopped by :func:`ipomdp_gaze.harness.demo.run_demo`, 60 fixations at most) and
 records whether the answer (the ``found`` cell, or the most likely cell after 60 fixations
 without one) is within one cell of the face centre's cell, the fixations and the seconds from
 starting the last node (the scene camera) to the answer. Test scenes only (test faces and
@@ -14,8 +14,8 @@ backgrounds); nothing was fitted to them.
 """
 import math
 
-from ipomdp_gaze.nodes.demo import faces_setup, run_demo
-from ipomdp_gaze.nodes.processes import domain_id_for
+from ipomdp_gaze.harness.demo import faces_setup, run_demo
+from ipomdp_gaze.harness.processes import domain_id_for
 from ipomdp_gaze.simulation.evaluation import wilson_interval
 import numpy as np
 

@@ -12,8 +12,8 @@ system CPU time is read from ``/proc/<pid>/stat`` over the same ``WINDOW_S`` sec
 import os
 import time
 
-from ipomdp_gaze.nodes.processes import domain_id_for, isolated_nodes
-from ipomdp_gaze.nodes.watch import Watch
+from ipomdp_gaze.harness.processes import domain_id_for, isolated_nodes
+from ipomdp_gaze.harness.watch import Watch
 
 TITLE = 'Idle nodes: CPU with no evidence and no images'
 ORDER = 62

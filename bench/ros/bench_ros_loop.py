@@ -16,8 +16,8 @@ Run: ``.venv/bin/python bench/ros/bench_ros_loop.py`` or ``make bench``.
 import sys
 import time
 
-from ipomdp_gaze.nodes.processes import domain_id_for, isolated_nodes
-from ipomdp_gaze.nodes.watch import Watch
+from ipomdp_gaze.harness.processes import domain_id_for, isolated_nodes
+from ipomdp_gaze.harness.watch import Watch
 import numpy as np
 from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import JointState

@@ -19,10 +19,10 @@ image is 48 MiB, which rclpy deserialises into the node).
 import time
 
 import cv2
+from ipomdp_gaze.harness.processes import domain_id_for, isolated_nodes
+from ipomdp_gaze.harness.watch import LATCHED, Watch
 from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
-from ipomdp_gaze.nodes.processes import domain_id_for, isolated_nodes
-from ipomdp_gaze.nodes.watch import LATCHED, Watch
 from ipomdp_gaze.vision.detection import build_setup, scaled_camera
 from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, SceneGeometry, shipped_camera
 from ipomdp_gaze.vision.scenes import PAPER_TASK, SceneSet

@@ -19,12 +19,12 @@ import time
 
 from builtin_interfaces.msg import Time
 from ipomdp_gaze.files.share_files import config_file
+from ipomdp_gaze.harness.processes import domain_id_for, isolated_nodes
+from ipomdp_gaze.harness.watch import LATCHED, Watch
 from ipomdp_gaze.model.fpoc import make_fpoc
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
-from ipomdp_gaze.nodes.processes import domain_id_for, isolated_nodes
-from ipomdp_gaze.nodes.watch import LATCHED, Watch
 from ipomdp_gaze.policies.registry import build_policy
 from ipomdp_gaze.search.gaze import GazeController
 import numpy as np

@@ -13,11 +13,11 @@ import sys
 import time
 
 from ipomdp_gaze.files.share_files import config_file
+from ipomdp_gaze.harness.processes import domain_id_for, isolated_nodes
+from ipomdp_gaze.harness.watch import CAMERA, SearchRecord, Watch
 from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays
-from ipomdp_gaze.nodes.processes import domain_id_for, isolated_nodes
-from ipomdp_gaze.nodes.watch import CAMERA, SearchRecord, Watch
 from ipomdp_gaze.policies.registry import build_policy
 from ipomdp_gaze.search.gaze import GazeController
 import numpy as np

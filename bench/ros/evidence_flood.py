@@ -39,7 +39,7 @@ def main(argv=None) -> int:
     parser.add_argument('--seed', type=int, default=0)
     args = parser.parse_args(argv)
 
-    from ipomdp_gaze.nodes.processes import wait_for
+    from ipomdp_gaze.harness.processes import wait_for
     import numpy as np
     import rclpy
     from rclpy.node import Node

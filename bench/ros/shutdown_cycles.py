@@ -27,7 +27,7 @@ REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO))
 
 from ipomdp_gaze.files.share_files import config_file  # noqa: E402
-from ipomdp_gaze.nodes.processes import domain_id_for, NodeGroup, ros_environment  # noqa: E402
+from ipomdp_gaze.harness.processes import domain_id_for, NodeGroup, ros_environment  # noqa: E402
 
 
 def main(argv=None) -> int:
@@ -40,7 +40,7 @@ def main(argv=None) -> int:
     parser.add_argument('--keep', default='', help='folder for the logs of hung nodes')
     args = parser.parse_args(argv)
 
-    from ipomdp_gaze.nodes.watch import Watch
+    from ipomdp_gaze.harness.watch import Watch
     from std_msgs.msg import Float32MultiArray
 
     work = Path(tempfile.mkdtemp(prefix='shutdown_cycles_'))

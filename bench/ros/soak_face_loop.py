@@ -76,8 +76,8 @@ class Events:
 
     def __init__(self, watch):
         from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+        from ipomdp_gaze.harness.watch import is_update, LATCHED
         from ipomdp_gaze.msg_adapters import diagnostics
-        from ipomdp_gaze.nodes.watch import is_update, LATCHED
         from std_msgs.msg import Float32MultiArray, Int32MultiArray
         self.log, self.ends, self.status = [], [], {}
         self.truth = None
@@ -145,9 +145,9 @@ def unanswered(log: list, ends: list) -> tuple[int, int]:
 
 def soak(minutes: float, seed: int) -> dict:
     """Run the loop for ``minutes``; return what was measured and checked."""
-    from ipomdp_gaze.nodes.demo import faces_setup
-    from ipomdp_gaze.nodes.processes import domain_id_for, isolated_nodes
-    from ipomdp_gaze.nodes.watch import Watch
+    from ipomdp_gaze.harness.demo import faces_setup
+    from ipomdp_gaze.harness.processes import domain_id_for, isolated_nodes
+    from ipomdp_gaze.harness.watch import Watch
     setup = faces_setup(fovea=False, seed=seed)
     args = {name: list(a) for name, a in setup.nodes}
     args['controller'] += ['-p', f'search.max_fixations:={BUDGET}',

@@ -81,7 +81,7 @@ def dask_cluster(workers: int, folder: Path):
 
 def stop(procs) -> None:
     """Stop the workers, then the scheduler (a worker without one retries for a long time)."""
-    from ipomdp_gaze.nodes.processes import stop_processes
+    from ipomdp_gaze.harness.processes import stop_processes
     stop_processes(procs)
 
 

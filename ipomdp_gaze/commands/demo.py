@@ -5,7 +5,7 @@
 
 Starts ``gaze_controller`` and ``simulated_camera`` as two processes with the shipped YAML files,
 prints each fixation until the ``found`` event, says where the target is and whether that is
-right, and shuts both nodes down (see :mod:`ipomdp_gaze.nodes.demo`). With ``--scene faces``
+right, and shuts both nodes down (see :mod:`ipomdp_gaze.harness.demo`). With ``--scene faces``
 it finds a face in a held-out photograph instead: ``scene_camera``, ``foveal_detector`` and
 ``gaze_controller`` on a camera on the pan/tilt head, or with ``--fovea`` on a fixed camera
 and the digital fovea. The offline, ROS-free search is ``ipomdp-gaze search``.
@@ -15,7 +15,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ipomdp_gaze.nodes.processes import MAX_DOMAIN_ID
+from ipomdp_gaze.harness.processes import MAX_DOMAIN_ID
 
 from .common import nonneg_int, positive_float, positive_int
 
@@ -96,7 +96,7 @@ def domain_arg(text: str) -> int:
 
 
 def run(args) -> int:
-    from ipomdp_gaze.nodes.demo import demo_setup, faces_setup, run_demo
+    from ipomdp_gaze.harness.demo import demo_setup, faces_setup, run_demo
 
     def out(line):
         print(line, flush=True)

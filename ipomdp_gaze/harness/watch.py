@@ -16,7 +16,9 @@ import threading
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from ipomdp_gaze.harness.processes import wait_for
 from ipomdp_gaze.msg_adapters import diagnostics
+from ipomdp_gaze.nodes import NODE_NAMES
 import numpy as np
 from rcl_interfaces.srv import GetParameters, SetParameters, SetParametersAtomically
 import rclpy
@@ -27,9 +29,6 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float32MultiArray, Int32MultiArray
 from std_srvs.srv import SetBool, Trigger
-
-from . import NODE_NAMES
-from .processes import wait_for
 
 CONTROLLER, CAMERA = NODE_NAMES['controller'], NODE_NAMES['camera']
 # What the nodes publish once and keep for late joiners (pan_tilt, ground_truth).
@@ -112,7 +111,7 @@ class Watch:
         Name of this node.
     nodes : NodeGroup, optional
         Node processes to keep an eye on: :meth:`wait_until` raises
-        :class:`ipomdp_gaze.nodes.processes.NodeExited` when one of them exits.
+        :class:`ipomdp_gaze.harness.processes.NodeExited` when one of them exits.
 
     """
 

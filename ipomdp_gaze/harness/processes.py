@@ -7,7 +7,7 @@ Each node runs as ``python -m ipomdp_gaze.nodes.<name> --ros-args ...`` with its
 file. :func:`ros_environment` isolates a run: its own ``ROS_DOMAIN_ID``, discovery limited to this
 host, and node log files in a directory of its own. A :class:`NodeGroup` holds the processes of
 one run (:func:`isolated_nodes` makes one in a temporary folder); what they publish is watched
-from this process by :class:`ipomdp_gaze.nodes.watch.Watch`. This module does not import rclpy.
+from this process by :class:`ipomdp_gaze.harness.watch.Watch`. This module does not import rclpy.
 """
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ import sys
 import tempfile
 import time
 
-from . import NODE_NAMES
+from ipomdp_gaze.nodes import NODE_NAMES
 
 MAX_DOMAIN_ID = 101
 # Run a node with a faulthandler: SIGUSR1 prints every thread's stack to its log.

@@ -23,20 +23,19 @@ import time
 from diagnostic_msgs.msg import DiagnosticArray
 from ipomdp_gaze.files.share_files import config_file
 from ipomdp_gaze.files.yaml_files import yaml_parameters
+from ipomdp_gaze.harness.processes import domain_id_for, isolated_nodes
+from ipomdp_gaze.harness.watch import quiet_condition, SearchRecord, Watch
 from ipomdp_gaze.model.belief import entropy
 from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, joints
+from ipomdp_gaze.nodes import NODE_NAMES
+from ipomdp_gaze.nodes.params import joint_params
 from ipomdp_gaze.search import answer as words
 from ipomdp_gaze.search.controller_config import fpoc_from, grid_from, head_from, observation_from
 from ipomdp_gaze.search.session import pooled_belief, SearchSettings
 from ipomdp_gaze.simulation.evaluation import answer_is_right, RIGHT_RADIUS_CELLS
 import numpy as np
 from sensor_msgs.msg import Image
-
-from . import NODE_NAMES
-from .params import joint_params
-from .processes import domain_id_for, isolated_nodes
-from .watch import quiet_condition, SearchRecord, Watch
 
 # The watcher's wait for a condition (it polls; the records fill in the watch's spin thread).
 POLL_S = 0.05
@@ -102,9 +101,8 @@ def check_controller(values: dict) -> None:
         Naming the problem.
 
     """
+    from ipomdp_gaze.nodes.controller import controller_params
     from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnavailable
-
-    from .controller import controller_params
     full = {p.name: p.default for p in controller_params()}
     full.update(values)
     name = full['policy.name']
@@ -213,7 +211,7 @@ def _with_recorder(setup: DemoSetup, record, compression: str, pictures) -> list
     if record:
         args = ['-p', f'path:={Path(record).resolve()}']
         if pictures is None:            # no pictures asked for: the bag without them
-            from .recorder import TOPICS
+            from ipomdp_gaze.nodes.recorder import TOPICS
             args += ['-p', f"topics:=[{','.join(t for t in TOPICS if t != 'annotated_image')}]"]
         if compression:
             args += ['-p', f'compression:={compression}']
