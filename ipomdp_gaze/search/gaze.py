@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 from ipomdp_gaze.model.belief import EvidenceError
 from ipomdp_gaze.model.grid import Grid
-from ipomdp_gaze.search.session import SearchSession, SearchSettings
+from ipomdp_gaze.search.session import SearchSession, SearchSettings, session_view
 import numpy as np
 
 
@@ -184,25 +184,15 @@ class GazeController:
         self.reset(0.0)
 
     # -- configuration -------------------------------------------------------------------
-    @property
-    def settings(self) -> SearchSettings:
-        """Return the settings in force."""
-        return self.session.settings
+    settings = session_view('settings', 'Return the settings in force.')
 
-    @property
-    def observation(self):
-        """Return the observation model the search assumes."""
-        return self.session.observation
+    observation = session_view('observation', 'Return the observation model the search assumes.')
 
-    @property
-    def policy(self):
-        """Return the policy that chooses the fixations."""
-        return self.session.policy
+    policy = session_view('policy', 'Return the policy that chooses the fixations.')
 
-    @property
-    def motion(self):
-        """Return the target's motion per second (:class:`ipomdp_gaze.model.motion.Motion`)."""
-        return self.session.motion
+    motion = session_view(
+        'motion',
+        "Return the target's motion per second (:class:`ipomdp_gaze.model.motion.Motion`).")
 
     def configure(self, settings: SearchSettings, settle_time_s: float | None = None) -> None:
         """
@@ -227,30 +217,21 @@ class GazeController:
         self.session.rng = np.random.default_rng(seed)
 
     # -- state -----------------------------------------------------------------------------
-    @property
-    def belief(self) -> np.ndarray:
-        """Cell probabilities ``B_i`` (N,), a copy; they sum to ``1 - P(absent)``."""
-        return self.session.belief
+    belief = session_view(
+        'belief', 'Cell probabilities ``B_i`` (N,), a copy; they sum to ``1 - P(absent)``.')
 
-    @property
-    def absent_probability(self) -> float:
-        """``P(absent)``: 0 without the absent hypothesis."""
-        return self.session.absent_probability
+    absent_probability = session_view(
+        'absent_probability', '``P(absent)``: 0 without the absent hypothesis.')
 
-    @property
-    def decision(self) -> str:
-        """
-        Return what the search has decided: ``'found'``, ``'absent'``, ``'gave_up'`` or ``''``.
+    decision = session_view(
+        'decision',
+        "Return what the search has decided: ``'found'``, ``'absent'``, ``'gave_up'`` or ``''``. "
+        'With motion on this is the state of the tracker: ``found`` (``absent``) while that event '
+        'has fired and its probability has not fallen back below the confidence level.')
 
-        With motion on this is the state of the tracker: ``found`` (``absent``) while that
-        event has fired and its probability has not fallen back below the confidence level.
-        """
-        return self.session.decision
-
-    @property
-    def stopped(self) -> bool:
-        """Whether the search has ended (frames are skipped, no target is sent until reset)."""
-        return self.session.ended
+    stopped = session_view(
+        'ended',
+        'Whether the search has ended (frames are skipped, no target is sent until reset).')
 
     @property
     def fixation(self) -> int:
@@ -279,25 +260,15 @@ class GazeController:
         """Whether the search awaits its one-time scan (no fixation has been chosen yet)."""
         return self.session.fixation is None
 
-    @property
-    def fixations(self) -> int:
-        """Frames applied in this search."""
-        return self.session.fixations
+    fixations = session_view('fixations', 'Frames applied in this search.')
 
-    @property
-    def map_cell(self) -> int:
-        """Return the most likely cell (ties to the lowest index)."""
-        return self.session.map_cell
+    map_cell = session_view('map_cell', 'Return the most likely cell (ties to the lowest index).')
 
-    @property
-    def map_probability(self) -> float:
-        """Probability of the most likely cell."""
-        return self.session.map_probability
+    map_probability = session_view('map_probability', 'Probability of the most likely cell.')
 
-    @property
-    def entropy_nats(self) -> float:
-        """Entropy of the belief in nats (over the N + 1 hypotheses with the absent one)."""
-        return self.session.entropy_nats
+    entropy_nats = session_view(
+        'entropy_nats',
+        'Entropy of the belief in nats (over the N + 1 hypotheses with the absent one).')
 
     def counters(self) -> dict:
         """Frames received, applied, rejected and skipped (received = the other three)."""

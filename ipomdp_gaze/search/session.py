@@ -60,6 +60,17 @@ PARAMETER_NAMES = parameter_names()
 SearchSettings = settings_class(module=__name__)
 
 
+def session_view(name: str, doc: str) -> property:
+    """
+    Return a read-only property that reads ``self.session.<name>``.
+
+    For wrappers of a search session (the controller's logic, the Gymnasium environment): each
+    view they pass through is declared in one line with its own docstring, the session's value
+    unchanged.
+    """
+    return property(lambda self: getattr(self.session, name), doc=doc)
+
+
 def pooled_belief(belief: np.ndarray, grid: Grid, radius: int) -> np.ndarray:
     """Return, per cell, the belief within ``radius`` cells (Chebyshev) of it, ``(N,)``."""
     if radius <= 0:

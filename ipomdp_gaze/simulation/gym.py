@@ -42,7 +42,7 @@ from ipomdp_gaze.model.fpoc import FPOC, make_fpoc
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.motion import check_probability
 from ipomdp_gaze.model.observation import as_observation, GaussianObservation
-from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
+from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings, session_view
 import numpy as np
 
 ENV_ID = 'ipomdp_gaze/VisualSearch-v0'
@@ -115,15 +115,10 @@ class VisualSearchEnv(gymnasium.Env):
         self._present = True
         self._steps = 0
 
-    @property
-    def belief(self) -> np.ndarray:
-        """Return the cell probabilities, shape (N,) (summing to ``1 - P(absent)``)."""
-        return self.session.belief
-
-    @property
-    def absent_probability(self) -> float:
-        """Return ``P(absent)`` (0 without the absent hypothesis)."""
-        return self.session.absent_probability
+    belief = session_view(
+        'belief', 'Return the cell probabilities, shape (N,) (summing to ``1 - P(absent)``).')
+    absent_probability = session_view(
+        'absent_probability', 'Return ``P(absent)`` (0 without the absent hypothesis).')
 
     def _obs(self):
         data = self.belief if self.observe == 'belief' else self._evidence
