@@ -347,7 +347,12 @@ def search_image(image: np.ndarray, fovea: Fovea, model, policy,
     outcome = run_search(SearchSession(fovea.grid, model, policy, settings), FoveaSensor(fovea),
                          image, seed=np.random.default_rng(0) if rng is None else rng,
                          pixel_budget=pixel_budget, exclude=excluded, restart=restart)
-    grid = fovea.grid
+    return _image_search(outcome, fovea.grid, image_px, calibrated, t0, outcome.decision)
+
+
+def _image_search(outcome, grid, image_px, calibrated, t0: float, decision: str,
+                  faces=()) -> ImageSearch:
+    """Return the :class:`ImageSearch` of a fovea search's outcome (``t0``: its start)."""
     best = outcome.cell
     # A limit's name when one ended it (a decision it forced included), else the decision.
     stop = outcome.reason or outcome.decision
@@ -357,8 +362,9 @@ def search_image(image: np.ndarray, fovea: Fovea, model, policy,
                        path=tuple(tuple(int(v) for v in grid.cell(k)) for k in outcome.path),
                        stop=stop, detector_pixels=outcome.detector_pixels,
                        seconds=time.perf_counter() - t0, belief=outcome.belief,
-                       image_px=image_px, calibrated_px=calibrated, decision=outcome.decision,
-                       absent_probability=outcome.absent_probability, log=outcome.log)
+                       image_px=image_px, calibrated_px=calibrated, decision=decision,
+                       absent_probability=outcome.absent_probability, log=outcome.log,
+                       faces=faces)
 
 
 def face_cells(grid: Grid, cell: int, radius: int = 1) -> np.ndarray:
@@ -586,17 +592,7 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     faces = tuple(Face(box=tuple(float(v) for v in f['box']),
                        cell=tuple(int(v) for v in grid.cell(f['cell'])),
                        probability=f['probability']) for f in found)
-    stop = outcome.reason if outcome.reason else outcome.decision
     decision = outcome.decision
     if decision in ('found', 'absent'):
         decision = 'found' if faces else 'absent'
-    best = outcome.cell
-    return ImageSearch(cell=tuple(int(v) for v in grid.cell(best)),
-                       pixel=cell_centre_px(grid, best, image_px),
-                       probability=outcome.probability, fixations=outcome.fixations,
-                       path=tuple(tuple(int(v) for v in grid.cell(k)) for k in outcome.path),
-                       stop=stop, detector_pixels=outcome.detector_pixels,
-                       seconds=time.perf_counter() - t0, belief=outcome.belief,
-                       image_px=image_px, calibrated_px=calibrated_size(model),
-                       decision=decision, absent_probability=outcome.absent_probability,
-                       log=outcome.log, faces=faces)
+    return _image_search(outcome, grid, image_px, calibrated_size(model), t0, decision, faces)
