@@ -190,11 +190,24 @@ def test_controller_killed_and_restarted_camera_keeps_serving(nodes, probe, watc
     nodes.kill(controller)
     reply = probe.reset('simulated_camera')
     assert reply.success and f'({TARGET[0]}, {TARGET[1]})' in reply.message
-    n = len(watch.beliefs)
+    n, statuses = len(watch.beliefs), watch.diag.count
     controller = nodes.start('controller', CONTROLLER_ARGS)
-    assert wait_for(lambda: watch.finished(n), 60), controller.output()[-2000:]
-    done = next(np.asarray(m.data) for _, m in watch.beliefs[n:] if max(m.data) >= 0.999)
-    assert watch.grid.cell(int(np.argmax(done))) == TARGET
+
+    def found_by_the_new_controller() -> bool:
+        # The belief topic is volatile: on a loaded machine the new controller can end its search
+        # before this probe has matched its publisher, and then every belief of it is lost. Its
+        # /diagnostics come every second whatever the timing, so they tell the answer too.
+        return watch.finished(n) or (watch.diag.count > statuses + 1
+                                     and watch.diag.values.get('decision') == 'found')
+
+    assert wait_for(found_by_the_new_controller, 60), controller.output()[-2000:]
+    if watch.finished(n):
+        done = next(np.asarray(m.data) for _, m in watch.beliefs[n:] if max(m.data) >= 0.999)
+        assert watch.grid.cell(int(np.argmax(done))) == TARGET
+    else:
+        values = watch.diag.values          # strings, as DiagnosticStatus carries them
+        assert (int(values['most_likely_row']), int(values['most_likely_col'])) == TARGET
+        assert float(values['most_likely_probability']) >= 0.999
     assert camera.running and controller.running
 
 
