@@ -1,0 +1,151 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Rooms with several faces (or none) on the pan/tilt task: the searchers and their scores.
+
+A room is a pan/tilt scene with 0-4 faces (``PanTiltSceneSet(faces=...)``, ``evaluate --scenes
+pan-tilt --faces K|LO-HI``). Its searchers, all on the same views of the task's
+:class:`~ipomdp_gaze.drivers.scene_tasks.ViewCache`:
+
+- ``many`` (optionally ``many:parameter=value,...``): the many-target session
+  (:class:`ipomdp_gaze.search.many.OccupancySession`, ``search.targets: many``) on the task's
+  model, with the configuration's settings less what it does not model (false-alarm scales,
+  hotspots) and :data:`ROOM_CHANGES`; its answer is every face of
+  :meth:`~ipomdp_gaze.search.many.OccupancySession.faces` (one per cluster of occupied cells);
+- ``sweep-all-grouped3`` / ``sweep-all-grouped5``: one pass of the sweep's poses answering every
+  detection grouped as ``detectMultiScale`` does (``min_neighbors`` 3 / 5), each at the cell of
+  its box centre; a detection within one cell of one already answered is the same face (the
+  sweep's views overlap).
+
+Scores (:func:`room_result`): a true face is found when an answer lies within one cell
+(Chebyshev) of its cell, each face and each answer matched at most once
+(:func:`ipomdp_gaze.simulation.evaluation.match_faces`); the other answers are false faces; the
+room is *right* when every face was found and no false face named; *done* when the searcher ended
+by its own rule (every cell decided, or the sweep's pass over), not at a budget; head time from
+:mod:`ipomdp_gaze.model.head_time`.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+from ipomdp_gaze.drivers.scene_report import scene_result, SceneResult
+from ipomdp_gaze.drivers.scene_tasks import compare_settings
+from ipomdp_gaze.drivers.sweep_rules import grouped_cells
+from ipomdp_gaze.search.many import OccupancySession
+from ipomdp_gaze.search.sensors import run_search
+from ipomdp_gaze.simulation.evaluation import cells_apart, match_faces, wilson_interval
+import numpy as np
+
+# What the many-target session changes in the pan/tilt configuration: the setting itself, and
+# no false-alarm scales or hotspots (the occupancy belief does not model them).
+ROOM_CHANGES = {'targets': 'many', 'false_alarm_scales': (1.0,), 'hotspot_prior': 0.0}
+# Cells (Chebyshev) within which occupied cells settle their neighbours (find's SETTLE_RADIUS)
+# and within which occupied cells are one face (count_faces' FACE_RADIUS).
+SETTLE_LINK = 1
+FACE_LINK = 2
+
+
+def room_settings(settings, label: str = 'many'):
+    """Return a label's many-target settings: ``settings``, :data:`ROOM_CHANGES`, the label's."""
+    return compare_settings(replace(settings, **ROOM_CHANGES), label)
+
+
+def room_search(spec, task, scene, index: int, label: str) -> SceneResult:
+    """Search a room with the many-target session; answer every face it counted."""
+    grid = task.model.grid
+    settings = room_settings(spec.settings, label)
+    session = OccupancySession(grid, task.model, settings, link=SETTLE_LINK)
+    detector_s = []
+    outcome = run_search(session, task.sensor, None,
+                         seed=np.random.default_rng([spec.seed, index]),
+                         limit=settings.max_fixations or 4 * grid.n_cells, restart=False,
+                         on_frame=lambda frame, result: detector_s.append(frame.seconds))
+    answers = [tuple(int(v) for v in grid.cell(f['cell']))
+               for f in session.faces(link=FACE_LINK)]
+    ended = bool(outcome.decision)
+    decision = outcome.decision if ended else 'gave_up'
+    reason = outcome.reason if ended else 'limit'
+    return room_result(task, scene, index, label, answers, decision, reason, outcome.path,
+                       outcome.detector_pixels, detector_s, done=ended and not reason)
+
+
+def room_sweep(spec, task, scene, index: int, rule: str) -> SceneResult:
+    """One pass of the sweep's poses answering every grouped detection (module docstring)."""
+    grid = task.model.grid
+    answers, path, pixels, detector_s = [], [], 0, []
+    for pose in task.sweep.poses:
+        frame = task.sensor.observe(int(pose))
+        path.append(int(pose))
+        pixels += frame.detector_pixels
+        detector_s.append(frame.seconds)
+        for cell in grouped_cells(task, int(pose), int(rule[-1])):
+            rc = tuple(int(v) for v in grid.cell(int(cell)))
+            if all(cells_apart(rc, seen) > 1 for seen in answers):
+                answers.append(rc)
+    return room_result(task, scene, index, rule, answers, 'found' if answers else 'absent', '',
+                       path, pixels, detector_s, done=True)
+
+
+def room_result(task, scene, index, name, answers, decision, reason, path, pixels, detector_s,
+                done: bool) -> SceneResult:
+    """One room's :class:`SceneResult`: faces found, false faces, right and done."""
+    truths = [tuple(int(v) for v in f.cell) for f in scene.faces]
+    found = match_faces(answers, truths)
+    first = answers[0] if answers else tuple(int(v) for v in task.model.grid.cell(
+        task.model.grid.center_index))
+    result = scene_result(task, scene, index, name, first, truths[0] if truths else None,
+                          decision, reason, path, pixels, detector_s)
+    return replace(result, has_face=bool(truths),
+                   right=found == len(truths) and len(answers) == found,
+                   face_cells=tuple(truths), answers=tuple(answers), faces_found=found,
+                   done=bool(done))
+
+
+def summarise_rooms(results: list) -> dict:
+    """
+    One searcher's room summary.
+
+    ``faces``, ``recall`` (faces found over faces), ``false_per_scene``, ``rooms_right`` (every
+    face found and no false face) [Wilson 95% CI], ``rooms_done`` (ended by its own rule) and
+    ``rooms_done_right`` (done and right), ``head_time_s_mean`` (to the end of the search),
+    fixations and, per count of faces, rooms and right.
+    """
+    faces = sum(len(r.face_cells) for r in results)
+    found = sum(r.faces_found for r in results)
+    false = sum(len(r.answers) - r.faces_found for r in results)
+    right = sum(r.right for r in results)
+    per = {}
+    for r in results:
+        row = per.setdefault(len(r.face_cells), {'scenes': 0, 'right': 0, 'found': 0,
+                                                 'false': 0})
+        row['scenes'] += 1
+        row['right'] += int(r.right)
+        row['found'] += r.faces_found
+        row['false'] += len(r.answers) - r.faces_found
+    fixations = np.array([r.fixations for r in results], dtype=float)
+    n = len(results)
+    return {'scenes': n, 'faces': faces, 'faces_found': found,
+            'recall': found / faces if faces else None, 'false_faces': false,
+            'false_per_scene': false / n, 'rooms_right': right / n,
+            'rooms_right_ci95': wilson_interval(right, n),
+            'rooms_done': sum(r.done for r in results) / n,
+            'rooms_done_right': sum(r.done and r.right for r in results) / n,
+            'head_time_s_mean': float(np.mean([r.head_time_s for r in results])),
+            'fixations_mean': float(fixations.mean()),
+            'fixations_p90': float(np.percentile(fixations, 90)),
+            'per_face_count': dict(sorted(per.items()))}
+
+
+def format_rooms(name: str, s: dict) -> list[str]:
+    """Lines of the printed room report for one searcher."""
+    recall = 'n/a' if s['recall'] is None else f"{s['recall']:.3f}"
+    low, high = s['rooms_right_ci95']
+    lines = [f"{name} ({s['scenes']} rooms, {s['faces']} faces): recall {recall}, false faces "
+             f"{s['false_per_scene']:.3f} per room, rooms right {s['rooms_right']:.3f} "
+             f"[{low:.3f}, {high:.3f}], done {s['rooms_done']:.3f} (done and right "
+             f"{s['rooms_done_right']:.3f}), head time {s['head_time_s_mean']:.2f} s, fixations "
+             f"mean {s['fixations_mean']:.2f} / p90 {s['fixations_p90']:.1f}"]
+    lines.append('  per face count: ' + '; '.join(
+        f"{k}: {row['scenes']} rooms, right {row['right']}, found {row['found']}, false "
+        f"{row['false']}" for k, row in s['per_face_count'].items()))
+    return lines
