@@ -150,3 +150,39 @@ def test_evaluate_scores_a_small_room_run(tmp_path, capsys):
         assert len(scene['face_cells']) == 2
         assert scene['faces_found'] == match_faces(scene['answers'], scene['face_cells'])
     assert np.isfinite(record['summary']['many']['head_time_s_mean'])
+
+
+def test_the_room_demo_ends_with_one_verdict_line():
+    from ipomdp_gaze.drivers.rooms import room_demo
+    lines = []
+    status = room_demo(2, 1, lines.append)
+    last = lines[-1]
+    assert last.startswith('found ') and last.endswith(('that is right', 'that is wrong'))
+    assert ' of 2 faces: that is ' in last
+    assert status == (0 if last.endswith('right') else 1)
+    assert sum(line.startswith('fixation ') for line in lines) >= 1
+
+
+@pytest.mark.parametrize('args', [['--faces', '2'], ['--scene', 'faces', '--faces', '2',
+                                                     '--fovea'],
+                                  ['--scene', 'faces', '--faces', '0-3', '--empty'],
+                                  ['--scene', 'faces', '--faces', '2', '--plot', 'x.png'],
+                                  ['--scene', 'faces', '--faces', '2-1']])
+def test_the_demo_refuses_faces_where_they_do_not_apply_in_one_line(args, capsys):
+    assert main(['demo', *args]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith('ipomdp-gaze demo: error: ')
+
+
+def test_the_scene_camera_builds_a_room_and_refuses_one_on_a_fixed_view():
+    from ipomdp_gaze.nodes.scene_camera import _scene_config, scene_camera_params
+    values = {p.name: p.default for p in scene_camera_params()}
+    values.update({'seed': 5, 'scene.faces': '3'})
+    room = _scene_config(values).scene
+    assert len(room.faces) == 3
+    assert room.faces == PanTiltSceneSet('test', seed=5, faces=3).scene(0).faces
+    values['scene.faces'] = '1'
+    assert _scene_config(values).scene.faces == room.faces[:1]
+    values.update({'view': 'fixed', 'scene.faces': '2'})
+    with pytest.raises(ValueError, match='scene.faces is for the pan_tilt view'):
+        _scene_config(values)

@@ -27,6 +27,7 @@ by its own rule (every cell decided, or the sweep's pass over), not at a budget;
 from __future__ import annotations
 
 from dataclasses import replace
+import math
 
 from ipomdp_gaze.drivers.scene_report import scene_result, SceneResult
 from ipomdp_gaze.drivers.scene_tasks import compare_settings
@@ -50,8 +51,14 @@ def room_settings(settings, label: str = 'many'):
     return compare_settings(replace(settings, **ROOM_CHANGES), label)
 
 
-def room_search(spec, task, scene, index: int, label: str) -> SceneResult:
-    """Search a room with the many-target session; answer every face it counted."""
+def room_session(spec, task, index: int, label: str = 'many'):
+    """
+    Run the many-target session of ``label`` on the scene the task's sensor holds.
+
+    Returns ``(session, outcome, detector_s, faces)``: the ended session, its
+    :class:`~ipomdp_gaze.search.sensors.SearchOutcome`, the detector's seconds per fixation and
+    its faces (:meth:`~ipomdp_gaze.search.many.OccupancySession.faces`, ``link`` 2).
+    """
     grid = task.model.grid
     settings = room_settings(spec.settings, label)
     session = OccupancySession(grid, task.model, settings, link=SETTLE_LINK)
@@ -60,8 +67,14 @@ def room_search(spec, task, scene, index: int, label: str) -> SceneResult:
                          seed=np.random.default_rng([spec.seed, index]),
                          limit=settings.max_fixations or 4 * grid.n_cells, restart=False,
                          on_frame=lambda frame, result: detector_s.append(frame.seconds))
-    answers = [tuple(int(v) for v in grid.cell(f['cell']))
-               for f in session.faces(link=FACE_LINK)]
+    return session, outcome, detector_s, session.faces(link=FACE_LINK)
+
+
+def room_search(spec, task, scene, index: int, label: str) -> SceneResult:
+    """Search a room with the many-target session; answer every face it counted."""
+    grid = task.model.grid
+    session, outcome, detector_s, faces = room_session(spec, task, index, label)
+    answers = [tuple(int(v) for v in grid.cell(f['cell'])) for f in faces]
     ended = bool(outcome.decision)
     decision = outcome.decision if ended else 'gave_up'
     reason = outcome.reason if ended else 'limit'
@@ -149,3 +162,43 @@ def format_rooms(name: str, s: dict) -> list[str]:
         f"{k}: {row['scenes']} rooms, right {row['right']}, found {row['found']}, false "
         f"{row['false']}" for k, row in s['per_face_count'].items()))
     return lines
+
+
+def room_demo(faces, seed: int, out, max_fixations: int | None = None) -> int:
+    """
+    ``demo --scene faces --faces K`` offline: the scene camera's room of ``seed``, searched.
+
+    The held-out room the scene camera shows with ``seed`` and ``scene.faces`` (scene 0 of that
+    seed), the shipped pan/tilt model, camera and detector, and the many-target session
+    (``many``, :data:`ROOM_CHANGES`; ``max_fixations`` replaces the budget). Prints every
+    fixation, every face found and, last, ``found N of M faces: that is right`` (every face
+    found, nothing else named) or ``that is wrong``. Returns 0 when right, else 1.
+    """
+    from ipomdp_gaze.drivers.scene_tasks import SceneTask, task_spec
+    spec = task_spec('pan-tilt', seed=seed, faces=faces, max_fixations=max_fixations)
+    task = SceneTask.get(spec)
+    scene = task.scene(0)
+    grid = task.model.grid
+    task.sensor.start(scene.image)
+    out(f'the scene camera shows held-out room {seed} ({scene.background}, '
+        f'{len(scene.faces)} faces); the many-target search runs offline on the detector '
+        f"node's views")
+    session, outcome, _, found = room_session(spec, task, 0)
+    for k, cell in enumerate(outcome.path, 1):
+        pan, tilt = task.head.angles(int(cell))
+        out(f'fixation {k}: cell {tuple(int(v) for v in grid.cell(int(cell)))} pan '
+            f'{math.degrees(pan):+.1f} deg tilt {math.degrees(tilt):+.1f} deg')
+    how = outcome.decision or 'gave_up'
+    out(f"{how}{f' ({outcome.reason})' if outcome.reason else ''} after "
+        f'{outcome.fixations} fixations: {len(found)} faces')
+    for i, face in enumerate(found, 1):
+        out(f"face {i}: cell {tuple(int(v) for v in grid.cell(face['cell']))} p="
+            f"{face['probability']:.3f}")
+    truths = [tuple(int(v) for v in f.cell) for f in scene.faces]
+    out('the scene camera put the faces in cells '
+        + (', '.join(str(t) for t in truths) if truths else '(none)'))
+    answers = [tuple(int(v) for v in grid.cell(f['cell'])) for f in found]
+    n = match_faces(answers, truths)
+    right = n == len(truths) and n == len(answers)
+    out(f"found {n} of {len(truths)} faces: that is {'right' if right else 'wrong'}")
+    return 0 if right else 1
