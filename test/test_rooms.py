@@ -186,3 +186,31 @@ def test_the_scene_camera_builds_a_room_and_refuses_one_on_a_fixed_view():
     values.update({'view': 'fixed', 'scene.faces': '2'})
     with pytest.raises(ValueError, match='scene.faces is for the pan_tilt view'):
         _scene_config(values)
+
+
+def test_room_boxes_put_one_face_seen_from_two_views_at_one_place():
+    import math
+    from types import SimpleNamespace
+
+    from ipomdp_gaze.drivers.rooms import room_boxes, ROOM_CELL_PX
+    from ipomdp_gaze.vision.pan_tilt import PAN_TILT_GRID, shipped_camera
+    camera, grid = shipped_camera(), PAN_TILT_GRID
+    side = 40
+    # the face at grid position (5, 6): centred in the view from (5, 6), 5 degrees right of
+    # the centre of the view from (5, 5)
+    u = camera.cx + camera.fx * math.tan(math.radians(5.0))
+    boxes = {grid.index(5, 6): np.array([[camera.cx - (side - 1) / 2,
+                                          camera.cy - (side - 1) / 2, side, side]]),
+             grid.index(5, 5): np.array([[u - (side - 1) / 2, camera.cy - (side - 1) / 2,
+                                          side, side]]),
+             grid.index(0, 0): np.zeros((0, 4))}
+    task = SimpleNamespace(model=SimpleNamespace(grid=grid), camera=camera,
+                           sensor=SimpleNamespace(boxes=boxes))
+    out = room_boxes(task, [grid.index(5, 5), grid.index(0, 0), grid.index(5, 6),
+                            grid.index(5, 6)])
+    assert out.shape == (2, 4)
+    centres = out[:, :2] + out[:, 2:] / 2
+    np.testing.assert_allclose(centres, [[6.5 * ROOM_CELL_PX, 5.5 * ROOM_CELL_PX]] * 2, atol=1e-6)
+    width = side / camera.fx * 180 / math.pi / grid.spacing_deg * ROOM_CELL_PX
+    np.testing.assert_allclose(out[:, 2], [width, width])
+    assert room_boxes(task, [grid.index(0, 0)]).shape == (0, 4)

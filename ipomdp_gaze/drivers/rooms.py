@@ -11,7 +11,12 @@ pan-tilt --faces K|LO-HI``). Its searchers, all on the same views of the task's
   (:class:`ipomdp_gaze.search.many.OccupancySession`, ``search.targets: many``) on the task's
   model, with the configuration's settings less what it does not model (false-alarm scales,
   hotspots) and :data:`ROOM_CHANGES`; its answer is every face of
-  :meth:`~ipomdp_gaze.search.many.OccupancySession.faces` (one per cluster of occupied cells);
+  :meth:`~ipomdp_gaze.search.many.OccupancySession.faces`: one per cluster of occupied cells,
+  split where the detector's raw boxes of its views, drawn into one picture of the room
+  (:func:`room_boxes`), are distinct faces (docs/design.md section 11.3); ``many-cells``: one
+  face per cluster, boxes unused; ``many-posterior``: a cell is decided empty by its posterior
+  (``P(x_j) <= 1 - c``, ``OccupancySession(empty_by_evidence=False)``) instead of its evidence
+  alone;
 - ``sweep-all-grouped3`` / ``sweep-all-grouped5``: one pass of the sweep's poses answering every
   detection grouped as ``detectMultiScale`` does (``min_neighbors`` 3 / 5), each at the cell of
   its box centre; a detection within one cell of one already answered is the same face (the
@@ -44,6 +49,8 @@ ROOM_CHANGES = {'targets': 'many', 'false_alarm_scales': (1.0,), 'hotspot_prior'
 # and within which occupied cells are one face (count_faces' FACE_RADIUS).
 SETTLE_LINK = 1
 FACE_LINK = 2
+# Pixels per cell of the room picture the searcher's boxes are drawn into (room_boxes).
+ROOM_CELL_PX = 100
 
 
 def room_settings(settings, label: str = 'many'):
@@ -61,13 +68,57 @@ def room_session(spec, task, index: int, label: str = 'many'):
     """
     grid = task.model.grid
     settings = room_settings(spec.settings, label)
-    session = OccupancySession(grid, task.model, settings, link=SETTLE_LINK)
+    name = label.split(':')[0]
+    session = OccupancySession(grid, task.model, settings, link=SETTLE_LINK,
+                               empty_by_evidence=name != 'many-posterior')
     detector_s = []
     outcome = run_search(session, task.sensor, None,
                          seed=np.random.default_rng([spec.seed, index]),
                          limit=settings.max_fixations or 4 * grid.n_cells, restart=False,
                          on_frame=lambda frame, result: detector_s.append(frame.seconds))
-    return session, outcome, detector_s, session.faces(link=FACE_LINK)
+    boxes = None
+    if name != 'many-cells':
+        boxes = room_boxes(task, outcome.path)
+    faces = session.faces(boxes, None, _room_px(grid), link=FACE_LINK) if boxes is not None \
+        else session.faces(link=FACE_LINK)
+    return session, outcome, detector_s, faces
+
+
+def _room_px(grid) -> tuple[int, int]:
+    """``(width, height)`` of the room picture the grid tiles, :data:`ROOM_CELL_PX` per cell."""
+    return grid.cols * ROOM_CELL_PX, grid.rows * ROOM_CELL_PX
+
+
+def room_boxes(task, path) -> np.ndarray:
+    """
+    Every raw box of the views of ``path`` in one picture of the room that the grid tiles.
+
+    A view's box ``(x, y, w, h)`` centred at pixel ``(u, v)`` with the head at cell
+    ``(r_h, c_h)`` lies at grid position ``(r_h + atan((v - cy) / fy) / spacing, c_h +
+    atan((u - cx) / fx) / spacing)`` (docs/design.md section 6.5); in the picture, cell ``(r, c)``
+    spans ``[c, c + 1) x [r, r + 1)`` times :data:`ROOM_CELL_PX` with its centre at ``+ 0.5``,
+    and the box keeps its angular size (``w / fx`` radians). The same face seen from several
+    views then gives boxes at one place, which ``occupancy.merge_boxes`` merges. ``(M, 4)``.
+    """
+    grid, camera = task.model.grid, task.camera
+    scale = ROOM_CELL_PX * 180.0 / (np.pi * grid.spacing_deg)
+    out = []
+    for cell in dict.fromkeys(int(c) for c in path):
+        raw = np.asarray(task.sensor.boxes.get(cell, np.zeros((0, 4))), dtype=float)
+        if not len(raw):
+            continue
+        raw = raw.reshape(-1, 4)
+        head_r, head_c = grid.cell(cell)
+        u = raw[:, 0] + (raw[:, 2] - 1) / 2
+        v = raw[:, 1] + (raw[:, 3] - 1) / 2
+        du, dv = camera.angles_deg(u, v)
+        col = head_c + du / grid.spacing_deg
+        row = head_r + dv / grid.spacing_deg
+        w = raw[:, 2] / camera.fx * scale
+        h = raw[:, 3] / camera.fy * scale
+        out.append(np.stack([(col + 0.5) * ROOM_CELL_PX - w / 2,
+                             (row + 0.5) * ROOM_CELL_PX - h / 2, w, h], axis=1))
+    return np.concatenate(out) if out else np.zeros((0, 4))
 
 
 def room_search(spec, task, scene, index: int, label: str) -> SceneResult:

@@ -36,9 +36,10 @@ TASKS = ('pan-tilt', 'faces-420', 'faces-840')
 # The budget every task's searches get unless told otherwise: the ROS bench's (60 fixations).
 DEFAULT_BUDGET = 60
 # The fixed-camera tasks: model, scene side (px), face sizes (px), as bench/faces.py.
-# The searchers of rooms with several faces (drivers/rooms.py): the many-target session and the
-# sweeps answering every grouped detection.
-ROOM_SEARCHERS = ('many',) + ROOM_SWEEPS
+# The searchers of rooms with several faces (drivers/rooms.py): the many-target session (its
+# faces split by the detector's boxes, or one per cluster of cells) and the sweeps answering
+# every grouped detection.
+ROOM_SEARCHERS = ('many', 'many-cells', 'many-posterior') + ROOM_SWEEPS
 _FOVEA_TASKS = {'faces-420': ('faces-420', 420, (60, 140)),
                 'faces-840': ('faces-840', 840, (24, 140))}
 
@@ -100,7 +101,7 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
         if ':' in label:
             compare_settings(SearchSettings(), label)
         if faces != (1, 1):
-            if name not in ROOM_SEARCHERS or (':' in label and name != 'many'):
+            if name not in ROOM_SEARCHERS or (':' in label and name in ROOM_SWEEPS):
                 raise ValueError(f'unknown room searcher {label!r}; choose from '
                                  f"{', '.join(ROOM_SEARCHERS)} (many:parameter=value,...)")
             continue
