@@ -10,7 +10,7 @@ pan-tilt --faces K|LO-HI``). Its searchers, all on the same views of the task's
 - ``many`` (optionally ``many:parameter=value,...``): the many-target session
   (:class:`ipomdp_gaze.search.many.OccupancySession`, ``search.targets: many``) on the task's
   model, with the configuration's settings less what it does not model (false-alarm scales,
-  hotspots) and :data:`ROOM_CHANGES`; its answer is every face of
+  hotspots) and the choices of ``scene_tasks.ROOM_CHOICES``; its answer is every face of
   :meth:`~ipomdp_gaze.search.many.OccupancySession.faces`: one per cluster of occupied cells,
   split where the detector's raw boxes of its views, drawn into one picture of the room
   (:func:`room_boxes`), are distinct faces (docs/design.md section 11.3); ``many-cells``: one
@@ -35,16 +35,13 @@ from dataclasses import replace
 import math
 
 from ipomdp_gaze.drivers.scene_report import scene_result, SceneResult
-from ipomdp_gaze.drivers.scene_tasks import compare_settings
+from ipomdp_gaze.drivers.scene_tasks import compare_settings, ROOM_MODEL
 from ipomdp_gaze.drivers.sweep_rules import grouped_cells
 from ipomdp_gaze.search.many import OccupancySession
 from ipomdp_gaze.search.sensors import run_search
 from ipomdp_gaze.simulation.evaluation import cells_apart, match_faces, wilson_interval
 import numpy as np
 
-# What the many-target session changes in the pan/tilt configuration: the setting itself, and
-# no false-alarm scales or hotspots (the occupancy belief does not model them).
-ROOM_CHANGES = {'targets': 'many', 'false_alarm_scales': (1.0,), 'hotspot_prior': 0.0}
 # Cells (Chebyshev) within which occupied cells settle their neighbours (find's SETTLE_RADIUS)
 # and within which occupied cells are one face (count_faces' FACE_RADIUS).
 SETTLE_LINK = 1
@@ -54,8 +51,8 @@ ROOM_CELL_PX = 100
 
 
 def room_settings(settings, label: str = 'many'):
-    """Return a label's many-target settings: ``settings``, :data:`ROOM_CHANGES`, the label's."""
-    return compare_settings(replace(settings, **ROOM_CHANGES), label)
+    """Return a label's many-target settings: ``settings``, ``ROOM_MODEL``, the label's."""
+    return compare_settings(replace(settings, **ROOM_MODEL), label)
 
 
 def room_session(spec, task, index: int, label: str = 'many'):
@@ -221,9 +218,9 @@ def room_demo(faces, seed: int, out, max_fixations: int | None = None) -> int:
 
     The held-out room the scene camera shows with ``seed`` and ``scene.faces`` (scene 0 of that
     seed), the shipped pan/tilt model, camera and detector, and the many-target session
-    (``many``, :data:`ROOM_CHANGES`; ``max_fixations`` replaces the budget). Prints every
-    fixation, every face found and, last, ``found N of M faces: that is right`` (every face
-    found, nothing else named) or ``that is wrong``. Returns 0 when right, else 1.
+    (``many``, the settings of ``evaluate --faces``; ``max_fixations`` replaces the budget).
+    Prints every fixation, every face found and, last, ``found N of M faces: that is right``
+    (every face found, nothing else named) or ``that is wrong``. Returns 0 when right, else 1.
     """
     from ipomdp_gaze.drivers.scene_tasks import SceneTask, task_spec
     spec = task_spec('pan-tilt', seed=seed, faces=faces, max_fixations=max_fixations)

@@ -40,6 +40,14 @@ DEFAULT_BUDGET = 60
 # faces split by the detector's boxes, or one per cluster of cells) and the sweeps answering
 # every grouped detection.
 ROOM_SEARCHERS = ('many', 'many-cells', 'many-posterior') + ROOM_SWEEPS
+# What rooms change in the pan/tilt configuration: the many-target setting, without what the
+# occupancy belief does not model (false-alarm scales, hotspots) ...
+ROOM_MODEL = {'targets': 'many', 'false_alarm_scales': (1.0,), 'hotspot_prior': 0.0}
+# ... and the settings chosen on training rooms (docs/design.md section 11.5): repeated views
+# of a cell weigh 0.1 (at 1, texture seen from several views became false faces), within the
+# configuration's budget of 20 fixations (40 found one more face of 50 in twice the head time).
+ROOM_CHOICES = {'repeat_weight': 0.1}
+ROOM_BUDGET = 20
 _FOVEA_TASKS = {'faces-420': ('faces-420', 420, (60, 140)),
                 'faces-840': ('faces-840', 840, (24, 140))}
 
@@ -84,7 +92,9 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
     ``elm:search.repeat_weight=0.1,absent.prior=0``), and :data:`SWEEP_RULES`.
     ``faces`` (pan-tilt: K or ``LO-HI``, ``vision.pan_tilt.parse_faces``) other than 1 makes
     the scenes rooms of that many faces, searched by the many-target session ``many`` and
-    compared with :data:`ROOM_SEARCHERS` only (drivers/rooms.py).
+    compared with :data:`ROOM_SEARCHERS` only (drivers/rooms.py); the settings are then the
+    configuration's with :data:`ROOM_MODEL` and :data:`ROOM_CHOICES`, and the budget
+    :data:`ROOM_BUDGET` unless ``max_fixations`` is given.
     """
     if task not in TASKS:
         raise ValueError(f"unknown scene task {task!r}; choose from {', '.join(TASKS)}")
@@ -123,6 +133,10 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
         name = 'learned' if file else 'elm'
     if policy is not None or policy_file:
         name, file = ('learned', policy_file) if policy_file else (policy, '')
+    if faces != (1, 1):
+        base = replace(base, **ROOM_MODEL, **ROOM_CHOICES)
+        if max_fixations is None:
+            max_fixations = ROOM_BUDGET
     if max_fixations is None:
         max_fixations = base.max_fixations or DEFAULT_BUDGET
     settings = settings or replace(base, max_fixations=max_fixations)
