@@ -120,6 +120,13 @@ def test_room_specs_take_room_searchers_only():
     spec = task_spec('pan-tilt', faces='0-4', compare=('sweep-all-grouped5',
                                                        'many:search.repeat_weight=0.1'))
     assert spec.rooms and spec.faces == (0, 4)
+    assert spec.settings.targets == 'many' and spec.settings.repeat_weight == 0.1
+    assert spec.settings.max_fixations == 20 and spec.settings.hotspot_prior == 0
+    for name in ('many-cells', 'many-posterior:absent.prior=0.13', 'every-view-many',
+                 'every-view-grouped3', 'sweep-all-grouped3'):
+        assert task_spec('pan-tilt', faces=2, compare=(name,)).compare == (name,)
+    with pytest.raises(ValueError, match='unknown room searcher'):
+        task_spec('pan-tilt', faces=2, compare=('sweep-all-grouped3:confidence=0.9',))
     assert not task_spec('pan-tilt').rooms
     with pytest.raises(ValueError, match='unknown room searcher'):
         task_spec('pan-tilt', faces=2, compare=('sweep-first-grouped5',))

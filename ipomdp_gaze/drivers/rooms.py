@@ -20,7 +20,10 @@ pan-tilt --faces K|LO-HI``). Its searchers, all on the same views of the task's
 - ``sweep-all-grouped3`` / ``sweep-all-grouped5``: one pass of the sweep's poses answering every
   detection grouped as ``detectMultiScale`` does (``min_neighbors`` 3 / 5), each at the cell of
   its box centre; a detection within one cell of one already answered is the same face (the
-  sweep's views overlap).
+  sweep's views overlap);
+- bounds, every view of the grid (row by row): ``every-view-grouped3`` / ``-5`` answer every
+  grouped detection as above; ``every-view-many`` feeds every view to the ``many`` session
+  (no stop rule) and answers the faces decided at its ``confidence``.
 
 Scores (:func:`room_result`): a true face is found when an answer lies within one cell
 (Chebyshev) of its cell, each face and each answer matched at most once
@@ -66,19 +69,39 @@ def room_session(spec, task, index: int, label: str = 'many'):
     grid = task.model.grid
     settings = room_settings(spec.settings, label)
     name = label.split(':')[0]
+    every = name == 'every-view-many'
+    if every:            # every view, then the budget's answer: a bound on the belief
+        settings = replace(settings, max_fixations=grid.n_cells, decide_at_budget=False,
+                           confidence=1 - 1e-12)
     session = OccupancySession(grid, task.model, settings, link=SETTLE_LINK,
                                empty_by_evidence=name != 'many-posterior')
     detector_s = []
     outcome = run_search(session, task.sensor, None,
                          seed=np.random.default_rng([spec.seed, index]),
                          limit=settings.max_fixations or 4 * grid.n_cells, restart=False,
-                         on_frame=lambda frame, result: detector_s.append(frame.seconds))
+                         on_frame=lambda frame, result: detector_s.append(frame.seconds),
+                         fixations=range(grid.n_cells) if every else None)
+    if every:
+        session = _Decided(session, room_settings(spec.settings, 'many').confidence)
     boxes = None
     if name != 'many-cells':
         boxes = room_boxes(task, outcome.path)
     faces = session.faces(boxes, None, _room_px(grid), link=FACE_LINK) if boxes is not None \
         else session.faces(link=FACE_LINK)
     return session, outcome, detector_s, faces
+
+
+class _Decided:
+    """A finished session's faces at ``confidence`` (the every-view bound's answer)."""
+
+    def __init__(self, session, confidence: float):
+        self.session, self.confidence = session, confidence
+
+    def faces(self, boxes=None, scores=None, image_px=None, link: int = FACE_LINK):
+        from ipomdp_gaze.model.occupancy import count_faces, decided
+        log_odds = self.session.log_odds
+        occupied = decided(log_odds, self.confidence)[0]
+        return count_faces(log_odds, self.session.grid, occupied, boxes, scores, image_px, link)
 
 
 def _room_px(grid) -> tuple[int, int]:
@@ -131,10 +154,16 @@ def room_search(spec, task, scene, index: int, label: str) -> SceneResult:
 
 
 def room_sweep(spec, task, scene, index: int, rule: str) -> SceneResult:
-    """One pass of the sweep's poses answering every grouped detection (module docstring)."""
+    """
+    One pass of the sweep's poses answering every grouped detection (module docstring).
+
+    ``every-view-grouped3`` / ``-5``: the same over every pose of the grid (row by row), a
+    bound on what grouping sees.
+    """
     grid = task.model.grid
     answers, path, pixels, detector_s = [], [], 0, []
-    for pose in task.sweep.poses:
+    poses = range(grid.n_cells) if rule.startswith('every-view') else task.sweep.poses
+    for pose in poses:
         frame = task.sensor.observe(int(pose))
         path.append(int(pose))
         pixels += frame.detector_pixels

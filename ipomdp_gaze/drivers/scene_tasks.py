@@ -39,7 +39,7 @@ DEFAULT_BUDGET = 60
 # The searchers of rooms with several faces (drivers/rooms.py): the many-target session (its
 # faces split by the detector's boxes, or one per cluster of cells) and the sweeps answering
 # every grouped detection.
-ROOM_SEARCHERS = ('many', 'many-cells', 'many-posterior') + ROOM_SWEEPS
+ROOM_SEARCHERS = ('many', 'many-cells', 'many-posterior', 'every-view-many') + ROOM_SWEEPS
 # What rooms change in the pan/tilt configuration: the many-target setting, without what the
 # occupancy belief does not model (false-alarm scales, hotspots) ...
 ROOM_MODEL = {'targets': 'many', 'false_alarm_scales': (1.0,), 'hotspot_prior': 0.0}

@@ -18,7 +18,8 @@ import numpy as np
 # first view with a detection grouped as OpenCV does with min_neighbors 3 or 5.
 SWEEP_RULES = ('sweep-tile', 'sweep-first-raw', 'sweep-first-grouped3', 'sweep-first-grouped5')
 # Rooms with several faces (drivers/rooms.py): one pass answering every grouped detection.
-ROOM_SWEEPS = ('sweep-all-grouped3', 'sweep-all-grouped5')
+ROOM_SWEEPS = ('sweep-all-grouped3', 'sweep-all-grouped5', 'every-view-grouped3',
+               'every-view-grouped5')
 # OpenCV's detectMultiScale groups its raw windows with groupRectangles(eps=0.2).
 _GROUP_EPS = 0.2
 
