@@ -23,7 +23,7 @@ pan-tilt --faces K|LO-HI``). Its searchers, all on the same views of the task's
   sweep's views overlap);
 - bounds, every view of the grid (row by row): ``every-view-grouped3`` / ``-5`` answer every
   grouped detection as above; ``every-view-many`` feeds every view to the ``many`` session
-  (no stop rule) and answers the faces decided at its ``confidence``.
+  (no stop rule) and answers as ``many`` does at its budget (every cell on its likelier side).
 
 Scores (:func:`room_result`): a true face is found when an answer lies within one cell
 (Chebyshev) of its cell, each face and each answer matched at most once
@@ -40,6 +40,7 @@ import math
 from ipomdp_gaze.drivers.scene_report import scene_result, SceneResult
 from ipomdp_gaze.drivers.scene_tasks import compare_settings, ROOM_MODEL
 from ipomdp_gaze.drivers.sweep_rules import grouped_cells
+from ipomdp_gaze.model.occupancy import count_faces
 from ipomdp_gaze.search.many import OccupancySession
 from ipomdp_gaze.search.sensors import run_search
 from ipomdp_gaze.simulation.evaluation import cells_apart, match_faces, wilson_interval
@@ -82,7 +83,7 @@ def room_session(spec, task, index: int, label: str = 'many'):
                          on_frame=lambda frame, result: detector_s.append(frame.seconds),
                          fixations=range(grid.n_cells) if every else None)
     if every:
-        session = _Decided(session, room_settings(spec.settings, 'many').confidence)
+        session = _Decided(session)
     boxes = None
     if name != 'many-cells':
         boxes = room_boxes(task, outcome.path)
@@ -92,16 +93,19 @@ def room_session(spec, task, index: int, label: str = 'many'):
 
 
 class _Decided:
-    """A finished session's faces at ``confidence`` (the every-view bound's answer)."""
+    """
+    A finished session's faces, every cell on its likelier side (the every-view bound's answer).
 
-    def __init__(self, session, confidence: float):
-        self.session, self.confidence = session, confidence
+    As ``many`` answers at its budget (``decide_at_budget``: occupied when ``P(x_j) > 1/2``).
+    """
+
+    def __init__(self, session):
+        self.session = session
 
     def faces(self, boxes=None, scores=None, image_px=None, link: int = FACE_LINK):
-        from ipomdp_gaze.model.occupancy import count_faces, decided
         log_odds = self.session.log_odds
-        occupied = decided(log_odds, self.confidence)[0]
-        return count_faces(log_odds, self.session.grid, occupied, boxes, scores, image_px, link)
+        return count_faces(log_odds, self.session.grid, log_odds > 0, boxes, scores, image_px,
+                           link)
 
 
 def _room_px(grid) -> tuple[int, int]:
