@@ -16,6 +16,7 @@ import argparse
 from pathlib import Path
 
 from ipomdp_gaze.harness.processes import MAX_DOMAIN_ID
+from ipomdp_gaze.vision.pan_tilt import parse_faces
 
 from .common import nonneg_int, positive_float, positive_int
 
@@ -39,6 +40,10 @@ def add_parser(sub):
     p.add_argument('--empty', action='store_true',
                    help='with --scene faces: the held-out scene without its face (nobody '
                         'here); right when the controller says absent')
+    p.add_argument('--faces', default='1', metavar='K|LO-HI',
+                   help='with --scene faces: a held-out room of K faces (or LO-HI drawn from '
+                        '--seed), 0-8, searched for every face by the many-target session '
+                        'offline (not yet on ROS); default 1: the ROS demo of one face')
     p.add_argument('--fpoc', choices=('camera', 'human'), default=None,
                    help='FPOC of both nodes (human: 0.42 deg/cell and ELM; default camera)')
     p.add_argument('--policy', default=None,
@@ -49,9 +54,9 @@ def add_parser(sub):
     p.add_argument('--target', default=None, metavar='ROW,COL',
                    help='where the camera hides the target (default: drawn from --seed, so '
                         'the same cell for the same seed: (9, 7) for seed 0)')
-    p.add_argument('--max-fixations', type=positive_int, default=60, metavar='N',
+    p.add_argument('--max-fixations', type=positive_int, default=None, metavar='N',
                    help='without a found event after N fixations, answer with the most likely '
-                        'cell (default 60)')
+                        'cell (default 60; with --faces the budget of evaluate --faces)')
     p.add_argument('--timeout', type=positive_float, default=60.0,
                    help='give up after this many seconds (default 60)')
     p.add_argument('--domain-id', type=domain_arg, default=None,
@@ -106,6 +111,19 @@ def run(args) -> int:
     for flag, path, suffix in (('--plot', args.plot, '.png'), ('--animate', args.animate, '.gif')):
         if path is not None and path.suffix.lower() != suffix:
             raise ValueError(f'{flag} writes a {suffix} file, got {path}')
+    faces = parse_faces(args.faces)
+    if faces != (1, 1):
+        if args.scene != 'faces' or args.fovea or args.empty:
+            raise ValueError('--faces goes with --scene faces on the pan/tilt camera, without '
+                             '--fovea or --empty (--faces 0 is nobody here)')
+        for flag, value in (('--plot', args.plot), ('--animate', args.animate),
+                            ('--record', args.record), ('--policy', args.policy),
+                            ('--target', args.target), ('--fpoc', args.fpoc)):
+            if value is not None:
+                raise ValueError(f'{flag} is not available with --faces (an offline search)')
+        from ipomdp_gaze.drivers.rooms import room_demo
+        return room_demo(faces, args.seed, lambda line: print(line, flush=True),
+                         args.max_fixations)
     if args.scene == 'faces':
         for flag, value in (('--fpoc', args.fpoc), ('--target', args.target)):
             if value is not None:
@@ -121,7 +139,7 @@ def run(args) -> int:
                            parse_target(args.target))
     pictures = [] if args.plot or args.animate else None
     status = run_demo(setup, args.timeout, args.domain_id, args.verbose, out,
-                      max_fixations=args.max_fixations, record=args.record,
+                      max_fixations=args.max_fixations or 60, record=args.record,
                       compression='' if args.compression == 'none' else args.compression,
                       pictures=pictures)
     if pictures is not None:

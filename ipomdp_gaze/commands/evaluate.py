@@ -17,6 +17,7 @@ import json
 from pathlib import Path
 
 from ipomdp_gaze.drivers.pieces import concat_results, COSTLY_CHUNK, PLANNER_CHUNK, simulate_pieces
+from ipomdp_gaze.drivers.rooms import format_rooms, room_settings, summarise_rooms
 from ipomdp_gaze.drivers.scene_eval import evaluate_scenes
 from ipomdp_gaze.drivers.scene_report import (format_summary, paired_map_difference, results_json,
                                               summarise, write_json)
@@ -31,6 +32,7 @@ from ipomdp_gaze.simulation.evaluation import (decision_summary, fixations_to_90
                                                tracking_summary)
 from ipomdp_gaze.simulation.executor import InlineExecutor
 from ipomdp_gaze.simulation.simulate import draw_present, draw_targets
+from ipomdp_gaze.vision.pan_tilt import parse_faces
 import numpy as np
 
 from .common import add_task_args, nonneg_int, positive_int, task_from_args
@@ -65,6 +67,12 @@ def add_parser(sub):
     p.add_argument('--empty-scenes', type=nonneg_int, default=0, metavar='M',
                    help='--scenes pan-tilt: also M scenes without a face (the same photo crops), '
                         'reported apart per background')
+    p.add_argument('--faces', default='1', metavar='K|LO-HI',
+                   help='--scenes pan-tilt: rooms of K faces, or LO..HI drawn uniformly per '
+                        'scene (0-8; default 1: the one-face scenes), searched by the '
+                        'many-target session and scored by faces found, false faces, rooms '
+                        'right and head time; --compare then takes many:parameter=value,... '
+                        'and sweep-all-grouped3 / sweep-all-grouped5')
     p.add_argument('--scene-model', default='', metavar='FILE',
                    help='--scenes pan-tilt: another pan/tilt observation file (its camera is the '
                         "scene camera's)")
@@ -266,7 +274,7 @@ def run_scenes(args) -> int:
     spec = task_spec(args.scenes, args.policy[0] if args.policy else None,
                      str(args.policy_file[0]) if args.policy_file else None, seed=args.seed,
                      max_fixations=args.max_fixations, split=args.split, model=args.scene_model,
-                     compare=tuple(args.compare), empty=False)
+                     compare=tuple(args.compare), empty=False, faces=parse_faces(args.faces))
     changes = {key: value for key, value in (('confidence', args.confidence),
                                              ('absent_prior', args.absent_prior))
                if value is not None}
@@ -274,6 +282,9 @@ def run_scenes(args) -> int:
     episodes = args.episodes or 200
     if args.empty_scenes and args.scenes != 'pan-tilt':
         raise ValueError('--empty-scenes is for --scenes pan-tilt')
+    if args.empty_scenes and spec.rooms:
+        raise ValueError('--empty-scenes is for one-face scenes: rooms take --faces 0 or a '
+                         'range from 0')
     specs = [(spec, episodes)]
     if args.empty_scenes:
         specs.append((replace(spec, empty=True), args.empty_scenes))
@@ -284,6 +295,8 @@ def run_scenes(args) -> int:
         for one, n in specs:
             for name, group in evaluate_scenes(one, n, executor, progress=bar).items():
                 results.setdefault(name, []).extend(group)
+    if spec.rooms:
+        return _report_rooms(args, spec, results, episodes)
     summary = {name: summarise(group) for name, group in results.items()}
     print(f'{args.scenes}: policy {spec.policy_file or spec.policy}, {args.split} scenes '
           f'{args.seed}..{args.seed + episodes - 1}'
@@ -298,6 +311,23 @@ def run_scenes(args) -> int:
         print(f'MAP right, {main} minus sweep [paired bootstrap 95%]: '
               + '; '.join(f'{k}: {d:+.3f} [{lo:+.3f}, {hi:+.3f}]'
                           for k, (d, lo, hi) in diff.items()))
+    if args.json:
+        write_json(args.json, results_json(spec, results, summary))
+        print(f'wrote {args.json}')
+    return 0
+
+
+def _report_rooms(args, spec, results: dict, episodes: int) -> int:
+    """Print (and write) the room summaries of ``evaluate --scenes pan-tilt --faces``."""
+    summary = {name: summarise_rooms(group) for name, group in results.items()}
+    lo, hi = spec.faces
+    count = f'{lo}' if lo == hi else f'{lo}-{hi}'
+    print(f'{args.scenes}: rooms of {count} faces, {args.split} scenes {args.seed}..'
+          f'{args.seed + episodes - 1}, many-target settings '
+          f'{room_settings(spec.settings).to_parameters()}')
+    for name, s in summary.items():
+        for line in format_rooms(name, s):
+            print(line)
     if args.json:
         write_json(args.json, results_json(spec, results, summary))
         print(f'wrote {args.json}')
@@ -319,6 +349,9 @@ def _pieces(args, policies) -> int:
 
 def run(args) -> int:
     check_settings(args)
+    faces = parse_faces(args.faces)          # one line for a bad K or LO-HI, before any work
+    if faces != (1, 1) and args.scenes != 'pan-tilt':
+        raise ValueError('--faces is for --scenes pan-tilt')
     if args.scenes:
         return run_scenes(args)
     args.episodes = args.episodes or 20000

@@ -27,9 +27,10 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from ipomdp_gaze.drivers.rooms import room_search, room_sweep
 from ipomdp_gaze.drivers.scene_report import MAP_BUDGETS, scene_result, SceneResult
 from ipomdp_gaze.drivers.scene_tasks import compare_settings, SceneTask, TaskSpec
-from ipomdp_gaze.drivers.sweep_rules import sweep_rule, SWEEP_RULES
+from ipomdp_gaze.drivers.sweep_rules import ROOM_SWEEPS, sweep_rule, SWEEP_RULES
 from ipomdp_gaze.search.sensors import run_search
 from ipomdp_gaze.search.session import SearchSession, SearchSettings
 from ipomdp_gaze.simulation.evaluation import answer_is_right
@@ -42,11 +43,16 @@ def evaluate_scene(spec: TaskSpec, index: int) -> list:
     Search scene ``index`` with ``spec``'s policy, then each of ``spec.compare`` on the same views.
 
     Returns one :class:`SceneResult` per searcher, ``spec``'s own first. Every session's policy
-    draws come from ``[seed, index]``.
+    draws come from ``[seed, index]``. Rooms (``spec.faces`` other than 1): the many-target
+    session ``many`` first, then ``spec.compare`` (drivers/rooms.py).
     """
     task = SceneTask.get(spec)
     scene = task.scene(index)
     task.sensor.start(scene.image)
+    if spec.rooms:
+        return [room_search(spec, task, scene, index, 'many')] + [
+            room_sweep(spec, task, scene, index, name) if name in ROOM_SWEEPS
+            else room_search(spec, task, scene, index, name) for name in spec.compare]
     results = [_search(spec, task, scene, index, spec.policy_file or spec.policy, task.policy,
                        spec.settings)]
     for name in spec.compare:

@@ -31,7 +31,9 @@ class SceneResult:
 
     ``map_right[k]`` is whether the answer after ``k + 1`` fixations (the MAP cell, or the
     answer of a search that stopped sooner) is right; ``head_time_s`` the head-time model's total
-    (module constants) and ``detector_s`` its detector part.
+    (module constants) and ``detector_s`` its detector part. A room with several faces
+    (drivers/rooms.py) also has every face's cell, every answered cell, the faces found and
+    whether the searcher ended by its own rule (``done``).
     """
 
     searcher: str
@@ -51,6 +53,10 @@ class SceneResult:
     map_right: tuple = ()
     head_time_s: float = 0.0
     detector_s: float = 0.0
+    face_cells: tuple = ()
+    answers: tuple = ()
+    faces_found: int = 0
+    done: bool = False
 
 
 def scene_result(task, scene, index, name, answer, face, decision, reason, path, pixels,
@@ -175,6 +181,7 @@ def results_json(spec, results, summary: dict) -> dict:
     return {'task': spec.task, 'policy': spec.policy, 'policy_file': spec.policy_file,
             'settings': spec.settings.to_parameters(), 'seed': spec.seed, 'split': spec.split,
             'empty': spec.empty, 'model': spec.model, 'compare': list(spec.compare),
+            'faces': list(spec.faces),
             'summary': summary,
             'scenes': {name: [{'index': r.index, 'has_face': r.has_face,
                                'background': r.background, 'right': r.right,
@@ -186,7 +193,11 @@ def results_json(spec, results, summary: dict) -> dict:
                                'seconds': r.seconds if math.isfinite(r.seconds) else None,
                                'head_travel_deg': r.head_travel_deg,
                                'head_time_s': r.head_time_s,
-                               'map_right': [bool(v) for v in r.map_right]} for r in group]
+                               'map_right': [bool(v) for v in r.map_right],
+                               **({'face_cells': [list(c) for c in r.face_cells],
+                                   'answers': [list(c) for c in r.answers],
+                                   'faces_found': r.faces_found, 'done': r.done}
+                                  if spec.faces != (1, 1) else {})} for r in group]
                        for name, group in results.items()}}
 
 

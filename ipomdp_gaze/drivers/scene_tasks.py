@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 import re
 
-from ipomdp_gaze.drivers.sweep_rules import SWEEP_RULES
+from ipomdp_gaze.drivers.sweep_rules import ROOM_SWEEPS, SWEEP_RULES
 from ipomdp_gaze.files.observation_file import load_observation
 from ipomdp_gaze.files.share_files import config_file
 from ipomdp_gaze.files.yaml_files import yaml_parameters
@@ -25,7 +25,7 @@ from ipomdp_gaze.search.settings import check_parameters
 from ipomdp_gaze.vision.detection import build_setup
 from ipomdp_gaze.vision.detector import as_detections
 from ipomdp_gaze.vision.fovea_model import fovea_for_model
-from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, SceneGeometry
+from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, parse_faces, SceneGeometry
 from ipomdp_gaze.vision.scenes import SceneSet
 from ipomdp_gaze.vision.search import SCENE_SETTINGS
 from ipomdp_gaze.vision.sensors import FoveaSensor, PanTiltSensor
@@ -36,6 +36,18 @@ TASKS = ('pan-tilt', 'faces-420', 'faces-840')
 # The budget every task's searches get unless told otherwise: the ROS bench's (60 fixations).
 DEFAULT_BUDGET = 60
 # The fixed-camera tasks: model, scene side (px), face sizes (px), as bench/faces/faces.py.
+# The searchers of rooms with several faces (drivers/rooms.py): the many-target session (its
+# faces split by the detector's boxes, or one per cluster of cells) and the sweeps answering
+# every grouped detection.
+ROOM_SEARCHERS = ('many', 'many-cells', 'many-posterior', 'every-view-many') + ROOM_SWEEPS
+# What rooms change in the pan/tilt configuration: the many-target setting, without what the
+# occupancy belief does not model (false-alarm scales, hotspots) ...
+ROOM_MODEL = {'targets': 'many', 'false_alarm_scales': (1.0,), 'hotspot_prior': 0.0}
+# ... and the settings chosen on training rooms (docs/design.md section 11.5): repeated views
+# of a cell weigh 0.1 (at 1, texture seen from several views became false faces), within the
+# configuration's budget of 20 fixations (40 found one more face of 50 in twice the head time).
+ROOM_CHOICES = {'repeat_weight': 0.1}
+ROOM_BUDGET = 20
 _FOVEA_TASKS = {'faces-420': ('faces-420', 420, (60, 140)),
                 'faces-840': ('faces-840', 840, (24, 140))}
 
@@ -53,12 +65,18 @@ class TaskSpec:
     empty: bool = False
     model: str = ''
     compare: tuple = ()
+    faces: tuple = (1, 1)
+
+    @property
+    def rooms(self) -> bool:
+        """Whether the scenes are rooms of :attr:`faces` faces other than exactly one."""
+        return self.faces != (1, 1)
 
 
 def task_spec(task: str, policy: str | None = None, policy_file: str | None = None,
               settings: SearchSettings | None = None, seed: int = 0,
               max_fixations: int | None = None, split: str = 'test', empty: bool = False,
-              model: str = '', compare=()) -> TaskSpec:
+              model: str = '', compare=(), faces=1) -> TaskSpec:
     """
     Return the shipped configuration of ``task``, with any of its parts replaced.
 
@@ -72,6 +90,11 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
     settings; ``sweep`` starts at its own first pose), optionally with changed settings as
     ``name:parameter=value,...`` (parameter names of docs/design.md section 10.1, e.g.
     ``elm:search.repeat_weight=0.1,absent.prior=0``), and :data:`SWEEP_RULES`.
+    ``faces`` (pan-tilt: K or ``LO-HI``, ``vision.pan_tilt.parse_faces``) other than 1 makes
+    the scenes rooms of that many faces, searched by the many-target session ``many`` and
+    compared with :data:`ROOM_SEARCHERS` only (drivers/rooms.py); the settings are then the
+    configuration's with :data:`ROOM_MODEL` and :data:`ROOM_CHOICES`, and the budget
+    :data:`ROOM_BUDGET` unless ``max_fixations`` is given.
     """
     if task not in TASKS:
         raise ValueError(f"unknown scene task {task!r}; choose from {', '.join(TASKS)}")
@@ -79,10 +102,19 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
         raise ValueError(f"split must be 'train' or 'test', got {split!r}")
     if (empty or model) and task != 'pan-tilt':
         raise ValueError('empty scenes and another model are for the pan-tilt task')
+    faces = parse_faces(faces)
+    if faces != (1, 1) and (task != 'pan-tilt' or empty):
+        raise ValueError('rooms of several faces are for the pan-tilt task (0 faces: faces=0, '
+                         'not empty)')
     for label in compare:
         name = label.split(':')[0]
         if ':' in label:
             compare_settings(SearchSettings(), label)
+        if faces != (1, 1):
+            if name not in ROOM_SEARCHERS or (':' in label and name in ROOM_SWEEPS):
+                raise ValueError(f'unknown room searcher {label!r}; choose from '
+                                 f"{', '.join(ROOM_SEARCHERS)} (many:parameter=value,...)")
+            continue
         if name not in NAMED_POLICIES and name not in SWEEP_RULES:
             raise ValueError(f'unknown searcher {name!r}; choose from '
                              f"{', '.join(NAMED_POLICIES + SWEEP_RULES)}")
@@ -101,11 +133,15 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
         name = 'learned' if file else 'elm'
     if policy is not None or policy_file:
         name, file = ('learned', policy_file) if policy_file else (policy, '')
+    if faces != (1, 1):
+        base = replace(base, **ROOM_MODEL, **ROOM_CHOICES)
+        if max_fixations is None:
+            max_fixations = ROOM_BUDGET
     if max_fixations is None:
         max_fixations = base.max_fixations or DEFAULT_BUDGET
     settings = settings or replace(base, max_fixations=max_fixations)
     return TaskSpec(task, name, file, settings, int(seed), split, bool(empty), model,
-                    tuple(compare))
+                    tuple(compare), faces)
 
 
 def compare_settings(settings: SearchSettings, label: str) -> SearchSettings:
@@ -183,7 +219,7 @@ class SceneTask:
     @classmethod
     def get(cls, spec: TaskSpec) -> SceneTask:
         key = (spec.task, spec.policy, spec.policy_file, spec.seed, spec.split, spec.empty,
-               spec.model, spec.compare)
+               spec.model, spec.compare, spec.faces)
         if key not in cls._cache:
             cls._cache = {key: cls(spec)}
         return cls._cache[key]
@@ -203,7 +239,7 @@ class SceneTask:
 
             def scene(i):
                 return PanTiltSceneSet(spec.split, geometry, color='rgb', seed=spec.seed + i,
-                                       empty=spec.empty).scene(0)
+                                       empty=spec.empty, faces=spec.faces).scene(0)
         else:
             name, size, faces = _FOVEA_TASKS[spec.task]
             self.model = load_observation(name)
@@ -218,6 +254,7 @@ class SceneTask:
         self.policy = build_policy(spec.policy, self.model.grid, self.model,
                                    file=spec.policy_file or None)
         self.compare = {label: build_policy(label.split(':')[0], self.model.grid, self.model)
-                        for label in spec.compare if label not in SWEEP_RULES}
-        if any(name in SWEEP_RULES for name in spec.compare):
+                        for label in spec.compare
+                        if label not in SWEEP_RULES and not spec.rooms}
+        if spec.rooms or any(name in SWEEP_RULES for name in spec.compare):
             self.sweep = build_policy('sweep', self.model.grid, self.model)

@@ -17,6 +17,9 @@ import numpy as np
 # the cell with most raw detections in its own tile; the first view with a raw detection; the
 # first view with a detection grouped as OpenCV does with min_neighbors 3 or 5.
 SWEEP_RULES = ('sweep-tile', 'sweep-first-raw', 'sweep-first-grouped3', 'sweep-first-grouped5')
+# Rooms with several faces (drivers/rooms.py): one pass answering every grouped detection.
+ROOM_SWEEPS = ('sweep-all-grouped3', 'sweep-all-grouped5', 'every-view-grouped3',
+               'every-view-grouped5')
 # OpenCV's detectMultiScale groups its raw windows with groupRectangles(eps=0.2).
 _GROUP_EPS = 0.2
 
@@ -50,20 +53,10 @@ def sweep_rule(spec, task, scene, index: int, rule: str) -> SceneResult:
                 answer = int(np.argmax(counts))
                 break
             continue
-        # the detector's own grouping (YuNet's boxes are already suppressed), as fullframe.scan
-        group = getattr(task.sensor.recorder.detector, 'group', None)
-        raw = task.sensor.boxes[int(pose)]
-        boxes = np.asarray(group(raw, int(rule[-1])) if callable(group)
-                           else group_boxes(np.round(raw), int(rule[-1]))).reshape(-1, 4)
-        if len(boxes):
-            order = np.argsort(-(boxes[:, 2] * boxes[:, 3]), kind='stable')
-            centres = box_centres_px(boxes[order]) - 0.5
-            _, _, cells = bin_points(centres, task.camera, grid, grid.cell(int(pose)),
-                                     task.max_count)
-            inside = cells[cells >= 0]
-            if inside.size:
-                answer = int(inside[0])
-                break
+        inside = grouped_cells(task, int(pose), int(rule[-1]))
+        if inside.size:
+            answer = int(inside[0])
+            break
     if rule == 'sweep-tile' and best.max() > 0:
         answer = int(np.argmax(best))
     if answer is not None:
@@ -72,3 +65,24 @@ def sweep_rule(spec, task, scene, index: int, rule: str) -> SceneResult:
     face = None if scene.cell is None else tuple(int(v) for v in scene.cell)
     return scene_result(task, scene, index, rule, cell, face, decision, '', tuple(path), pixels,
                         detector_s)
+
+
+def grouped_cells(task, pose: int, min_neighbors: int) -> np.ndarray:
+    """
+    Cells of the grouped detections of the view at ``pose``, the largest box first.
+
+    The raw boxes the task's sensor recorded for that view, grouped by the detector's own rule
+    (YuNet's boxes are already suppressed), else as ``detectMultiScale`` does with
+    ``min_neighbors`` (as ``fullframe.scan``); boxes whose centre is off the grid are dropped.
+    """
+    grid = task.model.grid
+    group = getattr(task.sensor.recorder.detector, 'group', None)
+    raw = task.sensor.boxes[int(pose)]
+    boxes = np.asarray(group(raw, min_neighbors) if callable(group)
+                       else group_boxes(np.round(raw), min_neighbors)).reshape(-1, 4)
+    if not len(boxes):
+        return np.zeros(0, dtype=np.int64)
+    order = np.argsort(-(boxes[:, 2] * boxes[:, 3]), kind='stable')
+    centres = box_centres_px(boxes[order]) - 0.5
+    _, _, cells = bin_points(centres, task.camera, grid, grid.cell(int(pose)), task.max_count)
+    return cells[cells >= 0]

@@ -21,7 +21,8 @@ command only triggers a frame). With ``rate_hz = 0`` it publishes one frame on e
 with ``rate_hz > 0`` it streams frames like a video camera, also while moving. A frame is
 ``image`` (``rgb8``), ``camera_info`` and, for ``pan_tilt``, ``joint_states`` (its pose), all
 with one stamp. ``ground_truth`` (``std_msgs/Int32MultiArray`` ``[row, col]`` of the face
-centre's cell in the grid of the view, transient local) is published once when it is known.
+centre's cell in the grid of the view, transient local; ``[-1, -1]`` for nobody; a room of
+``scene.faces`` faces: its first face) is published once when it is known.
 Every callback runs under a :class:`ipomdp_gaze.nodes.guard.CallbackGuard` (its counts in the
 ``/diagnostics`` status ``<node>: callbacks``).
 """
@@ -66,6 +67,9 @@ def scene_camera_params() -> list[Param]:
         Param('scene.empty', False, T.BOOL,
               'pan_tilt view: the test scene of seed without its face, nobody here (read-only)',
               read_only=True),
+        Param('scene.faces', '1', T.STRING,
+              'pan_tilt view: a room of K faces or LO-HI drawn per seed, 0-8 (1: the one-face '
+              'test scene; ground_truth is its first face; read-only)', read_only=True),
         Param('scene.file', '', T.STRING,
               "a user's image instead of a test scene (read-only)", read_only=True),
         Param('scene.face_x_px', -1.0, T.DOUBLE,
@@ -112,8 +116,8 @@ class SceneConfig:
 
 def _scene_config(values: dict) -> SceneConfig:
     """Build the scene of the parameters (ValueError names the problem)."""
-    from ipomdp_gaze.vision.pan_tilt import (PanTiltSceneSet, read_scene_file, SceneGeometry,
-                                             user_scene)
+    from ipomdp_gaze.vision.pan_tilt import (PanTiltSceneSet, parse_faces, read_scene_file,
+                                             SceneGeometry, user_scene)
     from ipomdp_gaze.vision.scenes import SceneSet
     view = values['view']
     rows, cols, spacing = VIEW_GRIDS[view]
@@ -128,6 +132,8 @@ def _scene_config(values: dict) -> SceneConfig:
     centre = None
     if values['scene.face_x_px'] >= 0 or values['scene.face_y_px'] >= 0:
         centre = (values['scene.face_x_px'], values['scene.face_y_px'])
+    if view != 'pan_tilt' and parse_faces(values.get('scene.faces', '1')) != (1, 1):
+        raise ValueError('scene.faces is for the pan_tilt view')
     if view == 'pan_tilt':
         camera = PinholeCamera.from_fov(values['camera.width'], values['camera.height'],
                                         values['camera.hfov_deg'])
@@ -136,7 +142,8 @@ def _scene_config(values: dict) -> SceneConfig:
             scene = user_scene(read_scene_file(values['scene.file']), centre, geometry)
         else:
             scene = PanTiltSceneSet('test', geometry, faces, 'rgb', values['seed'],
-                                    empty=values['scene.empty']).scene(0)
+                                    empty=values['scene.empty'],
+                                    faces=values.get('scene.faces', '1')).scene(0)
         return SceneConfig(dict(values), grid, camera, scene, geometry,
                            head_from(values, grid))
     if values['scene.file']:
@@ -176,7 +183,7 @@ class SceneCameraNode(SaccadeMixin, Node):
         if scene.cell is not None:
             self._truth_pub.publish(grid_arrays.ground_truth(cfg.grid, cfg.grid.index(
                 *scene.cell)))
-        elif cfg.values.get('scene.empty'):
+        elif cfg.values.get('scene.empty') or not cfg.values.get('scene.file'):
             self._truth_pub.publish(grid_arrays.ground_truth(cfg.grid, None))   # [-1, -1]
         self.guard.publish_status()
         height, width = self._view(self.pose).shape[:2]
@@ -184,6 +191,9 @@ class SceneCameraNode(SaccadeMixin, Node):
             if scene.face_centre_px is None else \
             f'face centre ({scene.face_centre_px[0]:.1f}, {scene.face_centre_px[1]:.1f}) px ' \
             f'in cell {scene.cell}'
+        if len(scene.faces) > 1:
+            where = f'{len(scene.faces)} faces in cells ' + ', '.join(
+                str(f.cell) for f in scene.faces)
         self.get_logger().info(
             f"{cfg.values['view']} view of {scene.background} scene "
             f'{scene.image.shape[1]}x{scene.image.shape[0]} px ({where}); {width}x{height} px '

@@ -16,6 +16,7 @@ bootstrap intervals, alone or paired (:func:`tracking_summary`,
 from __future__ import annotations
 
 import numpy as np
+from scipy.optimize import linear_sum_assignment
 
 LEVEL = 0.90
 
@@ -134,6 +135,25 @@ def answer_is_right(cell, truth, decision: str = 'found',
     if truth is None:
         return decision == 'absent'
     return decision != 'absent' and cell is not None and cells_apart(cell, truth) <= radius
+
+
+def match_faces(answers, truths, radius: int = RIGHT_RADIUS_CELLS) -> int:
+    """
+    Return how many true faces a room's answers found: the most pairs matched at once.
+
+    ``answers`` and ``truths`` are ``(row, col)`` cells. An answer finds a true face when it is
+    within ``radius`` cells (Chebyshev) of it; each true face and each answer is matched at most
+    once, and the count is the largest such matching (``scipy.optimize.linear_sum_assignment``
+    on the ``(A, T)`` table of pairs within reach). The room's false faces are
+    ``len(answers) - match_faces(...)``, its recall ``match_faces(...) / len(truths)``.
+    """
+    answers = [tuple(int(v) for v in a) for a in answers]
+    truths = [tuple(int(v) for v in t) for t in truths]
+    if not answers or not truths:
+        return 0
+    near = np.array([[cells_apart(a, t) <= radius for t in truths] for a in answers])
+    rows, cols = linear_sum_assignment(near.astype(float), maximize=True)
+    return int(near[rows, cols].sum())
 
 
 CHUNK = 100

@@ -36,7 +36,7 @@ from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head_camera import bin_points, PinholeCamera
 from ipomdp_gaze.vision.detector import (as_detections, box_centres_px, detector_color,
                                          detector_window_px, to_detector_image)
-from ipomdp_gaze.vision.scenes import _paste, load_background, load_faces, Scene, SPLITS
+from ipomdp_gaze.vision.scenes import _paste, load_background, load_faces, Scene, SceneFace, SPLITS
 import numpy as np
 
 # The shipped pan/tilt face task: an 11x11 grid of 5-degree cells (config/controller.yaml), a
@@ -46,6 +46,9 @@ PAN_TILT_GRID = Grid(11, 11, 5.0)
 CAMERA_SIZE_PX = (320, 240)
 CAMERA_HFOV_DEG = 25.0
 FACE_PX = (30, 70)
+# Faces a room may hold (PanTiltSceneSet's ``faces``), and the draws tried to place each one.
+MAX_FACES = 8
+_PLACE_TRIES = 1000
 VIEW = 'pan_tilt'
 _STREAM_TAG = 0x9A4711
 _SPLIT_CODE = {'train': 0, 'test': 1}
@@ -294,20 +297,59 @@ class SceneGeometry:
                          borderMode=cv2.BORDER_REPLICATE)
 
 
+def parse_faces(value) -> tuple[int, int]:
+    """
+    Return a room's face count as ``(lo, hi)``: an int K, a pair, or the text ``K`` / ``LO-HI``.
+
+    Raises
+    ------
+    ValueError
+        Unless ``0 <= lo <= hi <= MAX_FACES`` (one line naming the value).
+
+    """
+    text = value.strip() if isinstance(value, str) else value
+    try:
+        if isinstance(text, str):
+            lo, sep, hi = text.partition('-')
+            pair = (int(lo), int(hi) if sep else int(lo))
+        elif isinstance(text, (tuple, list)):
+            pair = tuple(text)
+            if len(pair) != 2:
+                raise ValueError
+        else:
+            pair = (text, text)
+        if any(isinstance(v, bool) or int(v) != v for v in pair):
+            raise ValueError
+        lo, hi = (int(v) for v in pair)
+    except (TypeError, ValueError):
+        lo = hi = -1
+    if not 0 <= lo <= hi <= MAX_FACES:
+        raise ValueError(f'faces must be a count K or a range LO-HI with 0 <= LO <= HI <= '
+                         f'{MAX_FACES}, got {value!r}')
+    return lo, hi
+
+
 class PanTiltSceneSet:
     """
-    Deterministic scenes of the pan/tilt task: a photo crop with one face inside the grid's reach.
+    Deterministic scenes of the pan/tilt task: a photo crop with faces inside the grid's reach.
 
     Scene ``i`` is drawn from its own stream ``default_rng([tag, split, seed, i])``, from the
     faces and photos of ``split`` (the split of :mod:`ipomdp_gaze.vision.scenes`: calibrate and
     train on ``'train'`` only). The face, ``face_px`` pixels on a side, is pasted with feathered
     edges so that its centre's nearest cell is inside the grid (anywhere in it, uniformly); the
     scene is ``geometry.size_px`` and RGB (``color='rgb'``) or grey.
+
+    **Rooms** (``faces`` K or ``(lo, hi)``, default 1: the scenes above, bit for bit). A range
+    draws the scene's count uniformly in ``lo..hi`` from the same stream, after the seven draws
+    of a one-face scene; a count of 0 is the empty crop (``empty``), and the first face is the
+    one-face scene's. Each further face (another face of the split, its own size and place,
+    drawn the same way) is redrawn until its square overlaps no face already pasted. A scene
+    with K faces has them all in :attr:`Scene.faces`, the first also as its ``cell``.
     """
 
     def __init__(self, split: str = 'test', geometry: SceneGeometry | None = None,
                  face_px: tuple[int, int] = FACE_PX, color: str = 'rgb', seed: int = 0,
-                 empty: bool = False):
+                 empty: bool = False, faces=1):
         if split not in SPLITS:
             raise ValueError(f'unknown split {split!r}; expected one of {tuple(SPLITS)}')
         self.split = split
@@ -325,13 +367,16 @@ class PanTiltSceneSet:
             raise ValueError(f'seed must be a non-negative integer, got {seed!r}')
         self.seed = int(seed)
         self.empty = bool(empty)
+        self.room = parse_faces(faces)
+        if self.empty and self.room != (1, 1):
+            raise ValueError('an empty set has no faces: give faces=0 instead of empty=True')
         self.faces, self.backgrounds = SPLITS[split]
 
     def kwargs(self) -> dict:
         """Keyword arguments that rebuild this set (for worker processes)."""
         return {'split': self.split, 'geometry': self.geometry.to_dict(),
                 'face_px': self.face_px, 'color': self.color, 'seed': self.seed,
-                'empty': self.empty}
+                'empty': self.empty, 'faces': self.room}
 
     @classmethod
     def from_kwargs(cls, kwargs: dict) -> PanTiltSceneSet:
@@ -359,9 +404,37 @@ class PanTiltSceneSet:
         top = _pick(u_top, photo.shape[0] - height + 1)
         left = _pick(u_left, photo.shape[1] - width + 1)
         image = photo[top:top + height, left:left + width].copy()
-        if self.empty:
+        lo, hi = self.room
+        count = lo if lo == hi else lo + _pick(rng.random(), hi - lo + 1)
+        if self.empty or count == 0:
             image.setflags(write=False)
             return Scene(image, None, None, None, None, name, self.seed, index)
+        placed = [self._face(u_face, u_size, u_x, u_y)]
+        for _ in range(count - 1):
+            for _ in range(_PLACE_TRIES):
+                face = self._face(*rng.random(4))
+                if face[0] not in [f[0] for f in placed] and \
+                        not any(_overlap(face, f) for f in placed):
+                    placed.append(face)
+                    break
+            else:
+                raise ValueError(f'could not place {count} non-overlapping faces in scene '
+                                 f'{index}')
+        faces = []
+        for face_index, side, x0, y0 in placed:
+            _paste(image, load_faces()[face_index], y0, x0, side, 0.15)
+            centre = (x0 + side / 2.0, y0 + side / 2.0)
+            faces.append(SceneFace(centre, side, geometry.cell_of_point(*centre),
+                                   int(face_index)))
+        image.setflags(write=False)
+        first = faces[0]
+        return Scene(image, first.centre_px, first.side_px, first.cell, first.face_index, name,
+                     self.seed, index, tuple(faces))
+
+    def _face(self, u_face: float, u_size: float, u_x: float, u_y: float) -> tuple:
+        """``(face_index, side, x0, y0)`` of a face drawn from four uniform draws."""
+        geometry = self.geometry
+        width, height = geometry.size_px
         face_index = self.faces[_pick(u_face, len(self.faces))]
         lo, hi = self.face_px
         side = lo + _pick(u_size, hi - lo + 1)
@@ -371,11 +444,13 @@ class PanTiltSceneSet:
         y0_min, y0_max = _corner_range(y_lo, y_hi, side, height)
         x0 = x0_min + _pick(u_x, x0_max - x0_min + 1)
         y0 = y0_min + _pick(u_y, y0_max - y0_min + 1)
-        _paste(image, load_faces()[face_index], y0, x0, side, 0.15)
-        image.setflags(write=False)
-        centre = (x0 + side / 2.0, y0 + side / 2.0)
-        cell = geometry.cell_of_point(*centre)
-        return Scene(image, centre, side, cell, int(face_index), name, self.seed, index)
+        return int(face_index), int(side), int(x0), int(y0)
+
+
+def _overlap(a: tuple, b: tuple) -> bool:
+    """Whether two pasted squares ``(face, side, x0, y0)`` share a pixel."""
+    return (a[2] < b[2] + b[1] and b[2] < a[2] + a[1]
+            and a[3] < b[3] + b[1] and b[3] < a[3] + a[1])
 
 
 def _corner_range(lo: float, hi: float, side: int, size: int) -> tuple[int, int]:

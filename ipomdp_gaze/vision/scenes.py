@@ -178,6 +178,15 @@ def cell_of_point(x: float, y: float, size: tuple[int, int],
     return int(math.floor(y * rows / h)), int(math.floor(x * cols / w))
 
 
+class SceneFace(NamedTuple):
+    """One pasted face: its centre ``(x, y)`` and side in image pixels, its cell and which."""
+
+    centre_px: tuple
+    side_px: int
+    cell: tuple
+    face_index: int
+
+
 @dataclass(frozen=True, eq=False)
 class Scene:
     """
@@ -199,6 +208,9 @@ class Scene:
         Name of the scikit-image photo the scene was cropped from.
     seed, index : int
         The set's seed and the scene's index in the set.
+    faces : tuple of SceneFace
+        Every face of a scene with several (a pan/tilt room, ``PanTiltSceneSet(faces=...)``),
+        the first one the face above; empty for the other sets.
 
     """
 
@@ -210,6 +222,7 @@ class Scene:
     background: str
     seed: int
     index: int
+    faces: tuple = ()
 
     @property
     def has_face(self) -> bool:

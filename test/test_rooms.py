@@ -1,0 +1,223 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""Rooms of several faces on the pan/tilt task (issue 37): the scenes, the scores, the CLI."""
+import hashlib
+
+from ipomdp_gaze.cli import main
+from ipomdp_gaze.drivers.scene_tasks import task_spec
+from ipomdp_gaze.simulation.evaluation import match_faces
+from ipomdp_gaze.vision.pan_tilt import MAX_FACES, PanTiltSceneSet, parse_faces
+import numpy as np
+import pytest
+
+# sha256 of today's one-face scenes (before rooms existed), with their face.
+TODAY = {('train', 0, 0): ('598c1b225217d4858f877a206145568e0b599467f2f2694ecf36961bbd71b608',
+                           (9, 4), (403.5, 712.5), 67, 43),
+         ('test', 5, 2): ('0dd474f135c9e57e16d641e5ff81bc1cecbcd361b8f1cfbf3753f61112d6a50a',
+                          (9, 6), (519.5, 712.5), 43, 86)}
+
+
+def _sha(image) -> str:
+    return hashlib.sha256(image.tobytes()).hexdigest()
+
+
+@pytest.mark.parametrize('key', sorted(TODAY))
+def test_one_face_scenes_are_todays_bit_for_bit(key):
+    split, seed, index = key
+    digest, cell, centre, side, face = TODAY[key]
+    for faces in (1, '1', (1, 1)):
+        scene = PanTiltSceneSet(split, seed=seed, faces=faces).scene(index)
+        assert _sha(scene.image) == digest
+        assert (scene.cell, scene.face_centre_px, scene.face_px, scene.face_index) == \
+            (cell, centre, side, face)
+        assert [f.cell for f in scene.faces] == [cell]
+
+
+def _squares_apart(faces) -> bool:
+    for i, a in enumerate(faces):
+        for b in faces[i + 1:]:
+            ax, ay = (v - a.side_px / 2 for v in a.centre_px)
+            bx, by = (v - b.side_px / 2 for v in b.centre_px)
+            if ax < bx + b.side_px and bx < ax + a.side_px and \
+                    ay < by + b.side_px and by < ay + a.side_px:
+                return False
+    return True
+
+
+@pytest.mark.parametrize('count', [0, 2, 3, 4])
+def test_rooms_hold_k_faces_apart_inside_the_reach_the_same_per_seed(count):
+    rooms = PanTiltSceneSet('train', seed=7, faces=count)
+    width, height = rooms.geometry.size_px
+    for index in range(3):
+        scene = rooms.scene(index)
+        assert len(scene.faces) == count and scene.has_face == (count > 0)
+        assert len({f.face_index for f in scene.faces}) == count
+        assert all(f.face_index in rooms.faces for f in scene.faces)
+        for f in scene.faces:
+            lo, hi = rooms.face_px
+            assert lo <= f.side_px <= hi
+            assert 0 <= f.cell[0] < 11 and 0 <= f.cell[1] < 11
+            assert rooms.geometry.cell_of_point(*f.centre_px) == f.cell
+            x0, y0 = (v - f.side_px / 2 for v in f.centre_px)
+            assert 0 <= x0 and x0 + f.side_px <= width and 0 <= y0 and y0 + f.side_px <= height
+        assert _squares_apart(scene.faces)
+        again = PanTiltSceneSet('train', seed=7, faces=count).scene(index)
+        assert _sha(again.image) == _sha(scene.image) and again.faces == scene.faces
+    if count == 0:           # the empty crop of the one-face scene
+        empty = PanTiltSceneSet('train', seed=7, empty=True).scene(0)
+        assert _sha(empty.image) == _sha(rooms.scene(0).image) and rooms.scene(0).cell is None
+    else:                    # its first face is the one-face scene's
+        assert rooms.scene(0).faces[0] == PanTiltSceneSet('train', seed=7).scene(0).faces[0]
+    other = PanTiltSceneSet('train', seed=8, faces=count).scene(0)
+    assert _sha(other.image) != _sha(rooms.scene(0).image)
+
+
+def test_a_range_draws_each_count_and_a_room_of_one_is_todays_scene():
+    rooms = PanTiltSceneSet('train', seed=3, faces='0-4')
+    counts = [len(rooms.scene(i).faces) for i in range(20)]
+    assert set(counts) <= set(range(5)) and len(set(counts)) >= 4
+    one = counts.index(1)
+    assert _sha(rooms.scene(one).image) == \
+        _sha(PanTiltSceneSet('train', seed=3).scene(one).image)
+    assert PanTiltSceneSet.from_kwargs(rooms.kwargs()).room == (0, 4)
+
+
+@pytest.mark.parametrize('value, pair', [(0, (0, 0)), (4, (4, 4)), ('2', (2, 2)),
+                                         ('0-4', (0, 4)), (' 1-3 ', (1, 3)), ((2, 2), (2, 2))])
+def test_parse_faces_reads_k_and_lo_hi(value, pair):
+    assert parse_faces(value) == pair
+
+
+@pytest.mark.parametrize('value', ['', 'x', '3-1', '-1', '1-', '0-9', MAX_FACES + 1, 1.5,
+                                   True, None, (1, 2, 3), '1-2-3'])
+def test_parse_faces_refuses_bad_values_with_one_message(value):
+    with pytest.raises(ValueError, match=r'^faces must be a count K or a range LO-HI'):
+        parse_faces(value)
+
+
+def test_an_empty_set_refuses_faces():
+    with pytest.raises(ValueError, match='give faces=0'):
+        PanTiltSceneSet('train', empty=True, faces=2)
+
+
+@pytest.mark.parametrize('answers, truths, found', [
+    ([], [], 0),
+    ([(5, 5)], [], 0),                                   # a false face in an empty room
+    ([], [(5, 5)], 0),
+    ([(5, 5)], [(6, 6)], 1),                             # one cell off diagonally: found
+    ([(5, 5)], [(5, 7)], 0),                             # two cells off: not found
+    ([(5, 5), (5, 6)], [(5, 5)], 1),                     # one face matched once: one false
+    ([(5, 5)], [(5, 5), (5, 6)], 1),                     # one answer finds one face only
+    ([(5, 6), (5, 4)], [(5, 5), (5, 7)], 2),             # the matching, not greedy order
+    ([(0, 0), (3, 3), (9, 9)], [(1, 1), (3, 4), (7, 7)], 2),
+])
+def test_match_faces_counts_each_face_and_answer_once(answers, truths, found):
+    assert match_faces(answers, truths) == found
+    assert match_faces(answers[::-1], truths[::-1]) == found
+
+
+def test_room_specs_take_room_searchers_only():
+    spec = task_spec('pan-tilt', faces='0-4', compare=('sweep-all-grouped5',
+                                                       'many:search.repeat_weight=0.1'))
+    assert spec.rooms and spec.faces == (0, 4)
+    assert spec.settings.targets == 'many' and spec.settings.repeat_weight == 0.1
+    assert spec.settings.max_fixations == 20 and spec.settings.hotspot_prior == 0
+    for name in ('many-cells', 'many-posterior:absent.prior=0.13', 'every-view-many',
+                 'every-view-grouped3', 'sweep-all-grouped3'):
+        assert task_spec('pan-tilt', faces=2, compare=(name,)).compare == (name,)
+    with pytest.raises(ValueError, match='unknown room searcher'):
+        task_spec('pan-tilt', faces=2, compare=('sweep-all-grouped3:confidence=0.9',))
+    assert not task_spec('pan-tilt').rooms
+    with pytest.raises(ValueError, match='unknown room searcher'):
+        task_spec('pan-tilt', faces=2, compare=('sweep-first-grouped5',))
+    with pytest.raises(ValueError, match='pan-tilt task'):
+        task_spec('faces-420', faces=2)
+
+
+@pytest.mark.parametrize('value', ['5-2', 'x', '9'])
+def test_evaluate_refuses_a_bad_faces_value_with_one_line(value, capsys):
+    assert main(['evaluate', '--scenes', 'pan-tilt', '--faces', value, '--episodes', '1']) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f'ipomdp-gaze evaluate: error: faces must be a count K or a range LO-HI '
+                   f"with 0 <= LO <= HI <= {MAX_FACES}, got '{value}'"]
+
+
+def test_evaluate_scores_a_small_room_run(tmp_path, capsys):
+    import json
+    out = tmp_path / 'rooms.json'
+    assert main(['evaluate', '--scenes', 'pan-tilt', '--faces', '2', '--split', 'train',
+                 '--episodes', '1', '--seed', '1000', '--compare', 'sweep-all-grouped5',
+                 '--jobs', '1', '--json', str(out)]) == 0
+    record = json.loads(out.read_text())
+    assert record['faces'] == [2, 2]
+    for name in ('many', 'sweep-all-grouped5'):
+        s = record['summary'][name]
+        assert s['faces'] == 2 and 0 <= s['recall'] <= 1 and s['false_per_scene'] >= 0
+        scene = record['scenes'][name][0]
+        assert len(scene['face_cells']) == 2
+        assert scene['faces_found'] == match_faces(scene['answers'], scene['face_cells'])
+    assert np.isfinite(record['summary']['many']['head_time_s_mean'])
+
+
+def test_the_room_demo_ends_with_one_verdict_line():
+    from ipomdp_gaze.drivers.rooms import room_demo
+    lines = []
+    status = room_demo(2, 1, lines.append)
+    last = lines[-1]
+    assert last.startswith('found ') and last.endswith(('that is right', 'that is wrong'))
+    assert ' of 2 faces: that is ' in last
+    assert status == (0 if last.endswith('right') else 1)
+    assert sum(line.startswith('fixation ') for line in lines) >= 1
+
+
+@pytest.mark.parametrize('args', [['--faces', '2'], ['--scene', 'faces', '--faces', '2',
+                                                     '--fovea'],
+                                  ['--scene', 'faces', '--faces', '0-3', '--empty'],
+                                  ['--scene', 'faces', '--faces', '2', '--plot', 'x.png'],
+                                  ['--scene', 'faces', '--faces', '2-1']])
+def test_the_demo_refuses_faces_where_they_do_not_apply_in_one_line(args, capsys):
+    assert main(['demo', *args]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith('ipomdp-gaze demo: error: ')
+
+
+def test_the_scene_camera_builds_a_room_and_refuses_one_on_a_fixed_view():
+    from ipomdp_gaze.nodes.scene_camera import _scene_config, scene_camera_params
+    values = {p.name: p.default for p in scene_camera_params()}
+    values.update({'seed': 5, 'scene.faces': '3'})
+    room = _scene_config(values).scene
+    assert len(room.faces) == 3
+    assert room.faces == PanTiltSceneSet('test', seed=5, faces=3).scene(0).faces
+    values['scene.faces'] = '1'
+    assert _scene_config(values).scene.faces == room.faces[:1]
+    values.update({'view': 'fixed', 'scene.faces': '2'})
+    with pytest.raises(ValueError, match='scene.faces is for the pan_tilt view'):
+        _scene_config(values)
+
+
+def test_room_boxes_put_one_face_seen_from_two_views_at_one_place():
+    import math
+    from types import SimpleNamespace
+
+    from ipomdp_gaze.drivers.rooms import room_boxes, ROOM_CELL_PX
+    from ipomdp_gaze.vision.pan_tilt import PAN_TILT_GRID, shipped_camera
+    camera, grid = shipped_camera(), PAN_TILT_GRID
+    side = 40
+    # the face at grid position (5, 6): centred in the view from (5, 6), 5 degrees right of
+    # the centre of the view from (5, 5)
+    u = camera.cx + camera.fx * math.tan(math.radians(5.0))
+    boxes = {grid.index(5, 6): np.array([[camera.cx - (side - 1) / 2,
+                                          camera.cy - (side - 1) / 2, side, side]]),
+             grid.index(5, 5): np.array([[u - (side - 1) / 2, camera.cy - (side - 1) / 2,
+                                          side, side]]),
+             grid.index(0, 0): np.zeros((0, 4))}
+    task = SimpleNamespace(model=SimpleNamespace(grid=grid), camera=camera,
+                           sensor=SimpleNamespace(boxes=boxes))
+    out = room_boxes(task, [grid.index(5, 5), grid.index(0, 0), grid.index(5, 6),
+                            grid.index(5, 6)])
+    assert out.shape == (2, 4)
+    centres = out[:, :2] + out[:, 2:] / 2
+    np.testing.assert_allclose(centres, [[6.5 * ROOM_CELL_PX, 5.5 * ROOM_CELL_PX]] * 2, atol=1e-6)
+    width = side / camera.fx * 180 / math.pi / grid.spacing_deg * ROOM_CELL_PX
+    np.testing.assert_allclose(out[:, 2], [width, width])
+    assert room_boxes(task, [grid.index(0, 0)]).shape == (0, 4)
