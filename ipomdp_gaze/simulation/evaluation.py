@@ -16,7 +16,6 @@ bootstrap intervals, alone or paired (:func:`tracking_summary`,
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 LEVEL = 0.90
 
@@ -152,6 +151,8 @@ def match_faces(answers, truths, radius: int = RIGHT_RADIUS_CELLS) -> int:
     if not answers or not truths:
         return 0
     near = np.array([[cells_apart(a, t) <= radius for t in truths] for a in answers])
+    # scipy.optimize takes ~0.17 s to import; every command imports this module, few match rooms.
+    from scipy.optimize import linear_sum_assignment
     rows, cols = linear_sum_assignment(near.astype(float), maximize=True)
     return int(near[rows, cols].sum())
 
