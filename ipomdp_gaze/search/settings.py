@@ -21,7 +21,7 @@ other edit. The module is pure: no rclpy, no argparse.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields, make_dataclass, replace
+from dataclasses import dataclass, field, make_dataclass, replace
 from typing import Callable, Mapping
 
 from ipomdp_gaze.model.checks import (check_budget, check_confidence, check_flag,
@@ -267,8 +267,3 @@ def check_parameters(values: Mapping, settings_cls=None, base=None, grid=None, w
         return settings_cls.from_parameters(values, base=base, grid=grid)
     except ValueError as exc:
         raise ValueError(f'{where}{exc}') from None
-
-
-def field_names(settings_cls) -> tuple:
-    """Return the field names of a settings class, in schema order."""
-    return tuple(f.name for f in fields(settings_cls))
