@@ -191,5 +191,5 @@ def test_search_plot_title_says_how_the_search_ended(monkeypatch, tmp_path):
     monkeypatch.setattr(search, 'plot_search', lambda *args: titles.append(args[4]))
     assert main(['search', '--grid', '7x7', '--seed', '3', '--max-fixations', '2', '--plot',
                  str(tmp_path / 's.png')]) == 0
-    assert re.fullmatch(r'7x7, human FPOC, elm: gave up at the fixation budget, p=0\.\d{3}, 2 '
+    assert re.fullmatch(r'7x7, human FPOC, elm\ngave up at the fixation budget, p=0\.\d{3}, 2 '
                         r'fixations \(star = target\)', titles[0]), titles

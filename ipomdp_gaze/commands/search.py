@@ -134,7 +134,8 @@ def run(args) -> int:
         ending = answer.heading(result.decision, result.reason)
         if result.decision == 'gave_up':
             ending += f' at {answer.LIMITS.get(result.reason, result.reason)}'
-        title = (f'{grid.rows}x{grid.cols}, {task}, {name}: {ending}, '
+        # Two lines: one would run past the figure's edges and under the colour bar.
+        title = (f'{grid.rows}x{grid.cols}, {task}, {name}\n{ending}, '
                  f'p={result.map_probability:.3f}, {len(path)} fixations (star = target)')
         plot_search(grid, belief, path, target, title, args.plot)
         print(f'wrote {args.plot}')
