@@ -206,3 +206,32 @@ def test_bad_probability_is_refused_with_a_reason(value):
         check_probability(value, 'jump_prob')
     with pytest.raises(ValueError, match='jump_prob must be a probability'):
         Motion(Grid(3, 3), 0.5, value)
+
+
+@pytest.mark.parametrize('rows, cols, sigma, jump', CASES)
+@pytest.mark.parametrize('leave', [0.0, 0.03, 0.4])
+def test_leaving_and_coming_back_is_the_belief_times_the_dense_chain(rows, cols, sigma, jump,
+                                                                     leave):
+    """With the absent column: the (N + 1)-state chain built by hand, brute force."""
+    n = rows * cols
+    chain = np.zeros((n + 1, n + 1))
+    chain[:n, :n] = (1 - leave) * dense_transition(rows, cols, sigma, jump)
+    chain[:n, n] = leave
+    chain[n, :n] = leave / n
+    chain[n, n] = 1 - leave
+    rng = np.random.default_rng(rows * 31 + cols)
+    belief = rng.dirichlet(np.ones(n + 1))
+    log_b = np.log(belief)
+    Motion(Grid(rows, cols), sigma, jump, leave).predict_log(log_b)
+    np.testing.assert_allclose(np.exp(log_b), belief @ chain, rtol=1e-9, atol=1e-15)
+
+
+def test_leaving_needs_an_absent_column_and_scales_with_time():
+    """Without the absent hypothesis leave_prob changes nothing; per second it compounds."""
+    grid = Grid(4, 4)
+    log_b = np.log(np.full(16, 1 / 16))
+    Motion(grid, 0.0, 0.0, 0.5).predict_log(log_b)
+    np.testing.assert_allclose(np.exp(log_b), 1 / 16)
+    over = Motion(grid, 0.0, 0.0, 0.2).over(2.5)
+    assert over.leave_prob == pytest.approx(1 - 0.8 ** 2.5)
+    assert Motion(grid, leave_prob=0.1).active and not Motion(grid).active

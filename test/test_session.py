@@ -511,14 +511,14 @@ def test_the_views_follow_every_change_of_the_belief_and_of_the_settings():
     _assert_views_follow(session, 0)
     session.configure(replace(settings, found_radius=2))
     _assert_views_follow(session, 2)
-    session.configure(replace(settings, motion_sigma_cells=0.8))  # moving: the cell alone
-    _assert_views_follow(session, 0)
+    session.configure(replace(settings, motion_sigma_cells=0.8))  # moving: the square too
+    _assert_views_follow(session, 1)
     before = session.belief
     session.predict(1.5)
     assert not np.array_equal(session.belief, before)
-    _assert_views_follow(session, 0)
+    _assert_views_follow(session, 1)
     session.reset()
-    _assert_views_follow(session, 0)
+    _assert_views_follow(session, 1)
     np.testing.assert_allclose(session.belief, 0.7 / GRID.n_cells)
 
 

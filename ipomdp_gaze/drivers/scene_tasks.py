@@ -163,7 +163,7 @@ def compare_settings(settings: SearchSettings, label: str) -> SearchSettings:
     return SearchSettings.from_parameters(values, base=settings)
 
 
-class _Recording:
+class Recording:
     """A detector that keeps the raw boxes of its last call (for the grouped answer rules)."""
 
     def __init__(self, detector):
@@ -230,7 +230,7 @@ class SceneTask:
             setup = build_setup('camera', spec.model)
             self.model = setup.model
             geometry = SceneGeometry(self.model.grid, setup.camera)
-            recorder = _Recording(setup.observer.detector)
+            recorder = Recording(setup.observer.detector)
             setup.observer.detector = recorder
             self.sensor = ViewCache(PanTiltSensor(setup.observer, geometry), recorder)
             self.camera = setup.camera

@@ -71,18 +71,28 @@ def grouped_cells(task, pose: int, min_neighbors: int) -> np.ndarray:
     """
     Cells of the grouped detections of the view at ``pose``, the largest box first.
 
-    The raw boxes the task's sensor recorded for that view, grouped by the detector's own rule
-    (YuNet's boxes are already suppressed), else as ``detectMultiScale`` does with
-    ``min_neighbors`` (as ``fullframe.scan``); boxes whose centre is off the grid are dropped.
+    The raw boxes the task's sensor recorded for that view (:func:`group_cells`).
     """
     grid = task.model.grid
-    group = getattr(task.sensor.recorder.detector, 'group', None)
-    raw = task.sensor.boxes[int(pose)]
+    return group_cells(task.sensor.recorder.detector, task.sensor.boxes[int(pose)], task.camera,
+                       grid, grid.cell(int(pose)), task.max_count, min_neighbors)
+
+
+def group_cells(detector, raw, camera, grid, head_rc, max_count: int,
+                min_neighbors: int) -> np.ndarray:
+    """
+    Cells of a view's raw boxes grouped as a team would, the largest box first.
+
+    Grouped by the detector's own rule (YuNet's boxes are already suppressed), else as
+    ``detectMultiScale`` does with ``min_neighbors`` (as ``fullframe.scan``); boxes whose centre
+    is off the grid are dropped.
+    """
+    group = getattr(detector, 'group', None)
     boxes = np.asarray(group(raw, min_neighbors) if callable(group)
                        else group_boxes(np.round(raw), min_neighbors)).reshape(-1, 4)
     if not len(boxes):
         return np.zeros(0, dtype=np.int64)
     order = np.argsort(-(boxes[:, 2] * boxes[:, 3]), kind='stable')
     centres = box_centres_px(boxes[order]) - 0.5
-    _, _, cells = bin_points(centres, task.camera, grid, grid.cell(int(pose)), task.max_count)
+    _, _, cells = bin_points(centres, camera, grid, head_rc, max_count)
     return cells[cells >= 0]

@@ -18,13 +18,20 @@ independently. The prediction of the cell mass ``B`` is therefore
 
     B'_d = (1 - jump_prob) * sum_s B_s G[s, d] + jump_prob * (sum_s B_s) / N
 
-and an absent hypothesis (:mod:`ipomdp_gaze.model.stopping`) is left alone. ``sigma_cells = 0`` and
-``jump_prob = 0`` is a target that stays put (no prediction at all).
+and an absent hypothesis (:mod:`ipomdp_gaze.model.stopping`) is left alone, unless the target
+may leave the grid and come back (``leave_prob`` l > 0, a person walking out of the head's reach;
+docs/design.md section 12.2): then, with ``A`` the absent hypothesis's probability,
+
+    A'   = (1 - l) A + l sum_s B_s
+    B''_d = (1 - l) B'_d + l A / N
+
+(a target leaves from anywhere, and comes back anywhere). ``sigma_cells = 0``, ``jump_prob = 0``
+and ``leave_prob = 0`` is a target that stays put (no prediction at all).
 
 Units: ``sigma_cells`` and ``jump_prob`` are per fixation in simulation and training. In the
 nodes they are per second (:meth:`Motion.over`): a step of ``dt`` seconds is a random walk of
 variance ``sigma_cells^2 dt`` (``sigma = sigma_cells sqrt(dt)``) and jumps with probability
-``1 - (1 - jump_prob)^dt``.
+``1 - (1 - jump_prob)^dt`` (``leave_prob`` likewise).
 """
 from __future__ import annotations
 
@@ -74,13 +81,18 @@ class Motion:
         Standard deviation of a step in cells (>= 0; 0 = no Gaussian step).
     jump_prob : float
         Probability in ``[0, 1)`` that a step is instead a jump to a uniformly random cell.
+    leave_prob : float
+        Probability in ``[0, 1)`` that a present target leaves the grid in a step, and that an
+        absent one comes back (to a uniformly random cell); only with an absent hypothesis.
 
     """
 
-    def __init__(self, grid: Grid, sigma_cells: float = 0.0, jump_prob: float = 0.0):
+    def __init__(self, grid: Grid, sigma_cells: float = 0.0, jump_prob: float = 0.0,
+                 leave_prob: float = 0.0):
         self.grid = grid
         self.sigma_cells = check_sigma_cells(sigma_cells)
         self.jump_prob = check_probability(jump_prob, 'jump_prob')
+        self.leave_prob = check_probability(leave_prob, 'leave_prob')
         self.row_matrix = axis_transition(grid.rows, self.sigma_cells)
         self.col_matrix = self.row_matrix if grid.cols == grid.rows else \
             axis_transition(grid.cols, self.sigma_cells)
@@ -89,30 +101,33 @@ class Motion:
         self._over = None                       # the last (seconds, Motion) of over()
 
     def __repr__(self):
-        return f'Motion({self.grid!r}, sigma_cells={self.sigma_cells}, jump_prob={self.jump_prob})'
+        return (f'Motion({self.grid!r}, sigma_cells={self.sigma_cells}, '
+                f'jump_prob={self.jump_prob}, leave_prob={self.leave_prob})')
 
     @property
     def active(self) -> bool:
         """Whether the target moves at all (otherwise prediction is the identity)."""
-        return self.sigma_cells > 0 or self.jump_prob > 0
+        return self.sigma_cells > 0 or self.jump_prob > 0 or self.leave_prob > 0
 
     def to_dict(self) -> dict:
-        """``{'sigma_cells': ..., 'jump_prob': ...}``."""
-        return {'sigma_cells': self.sigma_cells, 'jump_prob': self.jump_prob}
+        """``{'sigma_cells': ..., 'jump_prob': ..., 'leave_prob': ...}``."""
+        return {'sigma_cells': self.sigma_cells, 'jump_prob': self.jump_prob,
+                'leave_prob': self.leave_prob}
 
     def over(self, seconds: float) -> 'Motion':
         """
         Return the motion over ``seconds`` when ``sigma_cells`` and ``jump_prob`` are per second.
 
         ``sigma = sigma_cells * sqrt(seconds)`` (variance grows linearly in time) and
-        ``jump = 1 - (1 - jump_prob)^seconds``, kept just below 1 for a very long gap (the
-        belief is then uniform); ``seconds <= 0`` is no motion.
+        ``jump = 1 - (1 - jump_prob)^seconds`` (``leave`` likewise), kept just below 1 for a very
+        long gap (the belief is then uniform); ``seconds <= 0`` is no motion.
         """
         dt = max(0.0, float(seconds))
         if self._over is not None and self._over[0] == dt:
             return self._over[1]
         jump = min(1.0 - (1.0 - self.jump_prob) ** dt, ALMOST_ONE)
-        motion = Motion(self.grid, self.sigma_cells * math.sqrt(dt), jump)
+        leave = min(1.0 - (1.0 - self.leave_prob) ** dt, ALMOST_ONE)
+        motion = Motion(self.grid, self.sigma_cells * math.sqrt(dt), jump, leave)
         self._over = (dt, motion)
         return motion
 
@@ -145,9 +160,10 @@ class Motion:
 
     def predict_log(self, log_belief: np.ndarray) -> np.ndarray:
         """
-        Predict a normalised log belief in place; an absent hypothesis (column N) is not moved.
+        Predict a normalised log belief in place (an absent column N moves by ``leave_prob``).
 
-        ``log_belief`` has N columns, or N + 1 with the absent hypothesis last. The step runs on
+        ``log_belief`` has N columns, or N + 1 with the absent hypothesis last (which only
+        ``leave_prob`` changes: the module docstring). The step runs on
         probabilities relative to the largest entry, so nothing underflows that is within
         ``exp(-745)`` of it; cells that the step leaves at exactly 0 get ``-inf``. The result is
         renormalised (the step keeps the mass; this removes round-off). Returns ``log_belief``.
@@ -158,6 +174,14 @@ class Motion:
         peak = np.max(log_belief, axis=-1, keepdims=True)
         cells = np.subtract(log_belief[..., :n], peak)
         moved = self.predict(np.exp(cells, out=cells))
+        if self.leave_prob and log_belief.shape[-1] > n:
+            leave = self.leave_prob
+            absent = np.exp(log_belief[..., n:] - peak)
+            present = moved.sum(axis=-1, keepdims=True)
+            moved *= 1.0 - leave
+            moved += leave * absent / n
+            with np.errstate(divide='ignore'):
+                log_belief[..., n:] = np.log((1.0 - leave) * absent + leave * present) + peak
         with np.errstate(divide='ignore'):
             np.add(np.log(moved, out=moved), peak, out=log_belief[..., :n])
         return normalize_log(log_belief)

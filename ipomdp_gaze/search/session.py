@@ -86,6 +86,12 @@ def _mixture_settings(settings: SearchSettings) -> tuple:
     return settings.false_alarm_scales, settings.hotspot_prior, settings.hotspot_scale
 
 
+def _motion(grid: Grid, settings: SearchSettings) -> Motion:
+    """Return the target's motion of ``settings`` (per second in the nodes)."""
+    return Motion(grid, settings.motion_sigma_cells, settings.motion_jump_prob,
+                  settings.motion_leave_prob)
+
+
 def _wants_mixture(settings: SearchSettings) -> bool:
     return len(settings.false_alarm_scales) > 1 or settings.hotspot_prior > 0
 
@@ -236,8 +242,7 @@ class SearchSession:
         self.policy = policy
         self.settings = settings or SearchSettings()
         self.settings.check_grid(grid)
-        self.motion = Motion(grid, self.settings.motion_sigma_cells,
-                             self.settings.motion_jump_prob)
+        self.motion = _motion(grid, self.settings)
         self._kernel = None
         self._still = StillEvidence(grid.n_cells)
         self._log = deque(maxlen=int(log_size))
@@ -260,7 +265,7 @@ class SearchSession:
         _check_mixture_model(settings, self.observation)
         old = self.settings
         self.settings = settings
-        self.motion = Motion(self.grid, settings.motion_sigma_cells, settings.motion_jump_prob)
+        self.motion = _motion(self.grid, settings)
         self._changed()                 # the answer's square follows found_radius and motion
         mixture_changed = _mixture_settings(settings) != _mixture_settings(old)
         if mixture_changed:
@@ -337,7 +342,7 @@ class SearchSession:
         return self._view('map_cell', lambda: int(map_cell(self._pooled())))
 
     def _pooled(self) -> np.ndarray:
-        radius = self.settings.found_radius if not self.motion.active else 0
+        radius = self.settings.found_radius
         return self._view('pooled', lambda: pooled_belief(self._cells(), self.grid, radius))
 
     @property
@@ -654,6 +659,10 @@ class SearchSession:
         peak, absent = float(self._pooled().max()), self.absent_probability
         code = int(decide(peak, absent, settings.confidence))
         decision = {FOUND: 'found', ABSENT: 'absent'}.get(code, '')
+        keep = settings.motion_keep_probability
+        if self.motion.active and not decision and search.decision == 'found' and keep \
+                and peak >= keep and peak >= absent:
+            decision = 'found'              # tracking: found holds until below keep_probability
         fired = ''
         if self.motion.active or not settings.stop_on_decision:
             fired = decision if decision and decision != search.decision else ''

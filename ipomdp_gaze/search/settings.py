@@ -98,6 +98,15 @@ SCHEMA: tuple[Setting, ...] = (
     Setting('motion_jump_prob', 'motion.jump_prob', 'float', 0.0, check_probability,
             'probability per second (per fixation in simulation) that the target jumps to a '
             'random cell', bounds='in [0, 1)', flag='--jump-prob', metavar='P'),
+    Setting('motion_leave_prob', 'motion.leave_prob', 'float', 0.0, check_probability,
+            'with absent.prior: probability per second that the target leaves the grid, and '
+            'that an absent one comes back (a person walking out of reach and in again)',
+            bounds='in [0, 1)', metavar='P'),
+    Setting('motion_keep_probability', 'motion.keep_probability', 'float', 0.0,
+            check_probability,
+            'moving target: once found, it stays found while the answer holds at least this '
+            'probability, and is lost below it (0: the confidence)', bounds='in [0, 1)',
+            metavar='P'),
     Setting('start_cell', 'start_cell', 'cell', None, check_start_cell,
             "the first fixation (default: the policy's choice after a scan, else the grid's "
             'centre)', flag='--start', metavar='ROW,COL'),
@@ -105,7 +114,7 @@ SCHEMA: tuple[Setting, ...] = (
             'with a count model that has scan tables: start each search with the one-time '
             'whole-image scan (asked of the detector as fixation [-1, -1, search_id])'),
     Setting('found_radius', 'search.found_radius', 'int', 0, check_radius,
-            'still target: found when the belief within this many cells of a cell reaches the '
+            'found when the belief within this many cells of a cell reaches the '
             'confidence, and that cell is the answer (0: the cell alone)', bounds='0 to 5',
             int_range=(0, 5), metavar='CELLS'),
     Setting('stop_on_decision', 'search.stop_on_decision', 'bool', True, check_flag,
@@ -157,7 +166,8 @@ class SettingsBase:
     @property
     def moving(self) -> bool:
         """Whether the target is modelled as moving."""
-        return self.motion_sigma_cells > 0 or self.motion_jump_prob > 0
+        return self.motion_sigma_cells > 0 or self.motion_jump_prob > 0 \
+            or self.motion_leave_prob > 0
 
     def check_grid(self, grid) -> None:
         """Refuse a start cell outside ``grid`` (ValueError naming both)."""

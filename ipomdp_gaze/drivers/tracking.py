@@ -1,0 +1,356 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+People who move: search, track and search again on walk scenes (docs/design.md section 12).
+
+Every searcher runs on the same walk scene (:mod:`ipomdp_gaze.vision.walks`) on one clock: a view
+is taken when the head has moved there and settled (the head-time model of
+:mod:`ipomdp_gaze.model.head_time`: a saccade, then ``SETTLE_TIME_S``), the face is drawn where it
+is at that time, and the detector's :data:`DETECTOR_TIME_S` passes before the next move. The
+searchers:
+
+- ``track`` (the shipped tracker): the search session with the walk configuration's motion
+  (``motion.*``, calibrated on training walks, :func:`calibrate_motion`): the belief predicted
+  over the time between frames, updated with each view's counts. While it says ``found`` the
+  head looks at the most likely cell (``motion.track_view: map``; ``policy`` leaves the choice to
+  the search policy); otherwise the search policy chooses. ``lost`` when ``found`` ends,
+  ``reacquired`` when it comes back;
+- ``track-last-detection``, what a team would write: sweep the sweep policy's poses; centre the
+  head on the last grouped detection (``min_neighbors`` :data:`BASELINE_NEIGHBORS`, the largest
+  box); after :data:`BASELINE_LOST_FRAMES` views without one, lost: sweep again from the pose
+  nearest to where it was last seen.
+
+Scores per scene (:func:`walk_result`), over the frames where the face is within the grid's
+reach: ``in_view`` (the face centre inside the camera's view) and ``in_centre`` (the face in the
+head's cell); ``first_find_s``, the time of the first frame whose answer is within one cell of
+the face; ``reacquire_s``, from the face's return into reach to the first such frame after it.
+A searcher that never finds is charged the rest of the walk (censored), and counted.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+import math
+
+from ipomdp_gaze.drivers.scene_tasks import Recording
+from ipomdp_gaze.drivers.sweep_rules import group_cells
+from ipomdp_gaze.files.share_files import config_file
+from ipomdp_gaze.files.yaml_files import yaml_parameters
+from ipomdp_gaze.model.head_time import HEAD_SPEED_DEG_S, SACCADE_TIME_S, SETTLE_TIME_S
+from ipomdp_gaze.policies.registry import build_policy
+from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
+from ipomdp_gaze.search.settings import check_parameters
+from ipomdp_gaze.simulation.evaluation import cells_apart, wilson_interval
+from ipomdp_gaze.vision.detection import build_setup
+from ipomdp_gaze.vision.detector import as_detections
+from ipomdp_gaze.vision.pan_tilt import SceneGeometry
+from ipomdp_gaze.vision.walks import WalkSceneSet
+import numpy as np
+
+# The detector's time per 320x240 view on the clock (s): a constant, so that where the face is
+# when a view is taken does not depend on the machine (the median measured here, bench/pan_tilt).
+DETECTOR_TIME_S = 0.03
+TRACKERS = ('track-last-detection',)
+# The baseline: grouped detections as OpenCV's default-ish min_neighbors 3, and the views without
+# one after which it sweeps again (both chosen on training walks, docs/pan_tilt.md).
+BASELINE_NEIGHBORS = 3
+BASELINE_LOST_FRAMES = 3
+WALK_CONFIG = 'faces_camera_tracking.yaml'
+
+
+@dataclass(frozen=True)
+class WalkFrame:
+    """One view on the walk's clock: when, where the head and the face were, the answer."""
+
+    t_s: float
+    head: tuple
+    cell: tuple | None
+    in_view: bool
+    in_centre: bool
+    answer: tuple | None
+    event: str = ''
+
+
+@dataclass(frozen=True)
+class WalkResult:
+    """One searcher on one walk scene: its frames and the scores of the module docstring."""
+
+    searcher: str
+    index: int
+    frames: tuple
+    reach_frames: int
+    in_view: float
+    in_centre: float
+    first_find_s: float
+    found: bool
+    reacquire_s: float | None
+    reacquired: bool | None
+    lost: int
+    reacquired_events: int
+
+    def to_dict(self) -> dict:
+        """Plain types, without the frames."""
+        return {'searcher': self.searcher, 'index': self.index,
+                'reach_frames': self.reach_frames, 'in_view': self.in_view,
+                'in_centre': self.in_centre, 'first_find_s': self.first_find_s,
+                'found': self.found, 'reacquire_s': self.reacquire_s,
+                'reacquired': self.reacquired, 'lost': self.lost,
+                'reacquired_events': self.reacquired_events}
+
+
+def walk_settings(path=None) -> tuple[SearchSettings, str, dict]:
+    """Return the walk configuration's settings, policy name and parameters (``WALK_CONFIG``)."""
+    from ipomdp_gaze.model.grid import Grid
+    path = config_file(WALK_CONFIG) if path is None else path
+    values = yaml_parameters(path, 'gaze_controller')
+    settings = check_parameters(values, grid=Grid(values['grid.rows'], values['grid.cols']),
+                                where=f'{path}: ')
+    return settings, values.get('policy.name', 'coverage'), values
+
+
+class WalkTask:
+    """The model, detector, view geometry and policies of the walk evaluation (per process)."""
+
+    _cache: dict = {}
+
+    @classmethod
+    def get(cls, settings: SearchSettings, policy: str) -> WalkTask:
+        key = (settings, policy)
+        if key not in cls._cache:
+            cls._cache = {key: cls(settings, policy)}
+        return cls._cache[key]
+
+    def __init__(self, settings: SearchSettings, policy: str):
+        setup = build_setup('camera', '')
+        self.model = setup.model
+        self.grid = self.model.grid
+        self.camera = setup.camera
+        self.observer = setup.observer
+        self.geometry = SceneGeometry(self.grid, self.camera)
+        self.settings = settings
+        self.policy = build_policy(policy, self.grid, self.model)
+        self.sweep = build_policy('sweep', self.grid, self.model)
+        self.recorder = Recording(setup.observer.detector)
+        self.observer.detector = self.recorder
+        self.detector = self.recorder.detector
+
+    def view(self, scene, t_s: float, head: int):
+        """Take the view at ``head`` of the scene at ``t_s``: its observation and raw boxes."""
+        head_rc = self.grid.cell(int(head))
+        image = self.geometry.render(scene.image_at(t_s), head_rc)
+        obs = self.observer.observe(image, self.camera, head_rc)
+        return obs, as_detections(self.recorder.boxes)[0]
+
+    def in_view(self, truth, head: int) -> bool:
+        """Whether the face centre is inside the camera's view with the head at ``head``."""
+        row, col = truth.position
+        r, c = self.grid.cell(int(head))
+        spacing = self.grid.spacing_deg
+        left, top = self.camera.angles_deg(-0.5, -0.5)
+        right, bottom = self.camera.angles_deg(self.camera.width - 0.5,
+                                               self.camera.height - 0.5)
+        dx, dy = (col - c) * spacing, (row - r) * spacing
+        return bool(left <= dx <= right and top <= dy <= bottom)
+
+
+class SessionTracker:
+    """The search session on the walk: ``found`` is having the face, its MAP cell the answer."""
+
+    def __init__(self, task: WalkTask, settings: SearchSettings, seed, view: str = 'map'):
+        if view not in ('map', 'policy'):
+            raise ValueError(f"view must be 'map' or 'policy', got {view!r}")
+        self.task, self.view = task, view
+        self.session = SearchSession(task.grid, task.model, task.policy, settings)
+        self.session.reset(seed=seed)
+        self.last_t = None
+        self.had = False
+
+    def first(self) -> int:
+        return self.session.start()
+
+    def step(self, t_s: float, obs, boxes) -> tuple:
+        """Apply the view taken at ``t_s``; return ``(next head, answer, event)``."""
+        session = self.session
+        dt = 0.0 if self.last_t is None else t_s - self.last_t
+        self.last_t = t_s
+        result = session.update(Frame(obs.counts, detector_pixels=obs.detector_pixels), dt_s=dt)
+        has = session.decision == 'found'
+        event = '' if has == self.had else ('found' if has else 'lost')
+        self.had = has
+        answer = tuple(int(v) for v in self.task.grid.cell(session.map_cell)) if has else None
+        if has and self.view == 'map':
+            session.fixate(session.map_cell)
+        return session._state().fixation if result.fixation is not None else \
+            session.map_cell, answer, event
+
+
+class LastDetectionTracker:
+    """The baseline of the module docstring: centre the last grouped detection, else sweep."""
+
+    def __init__(self, task: WalkTask, neighbors: int = BASELINE_NEIGHBORS,
+                 lost_frames: int = BASELINE_LOST_FRAMES):
+        self.task = task
+        self.neighbors, self.lost_frames = int(neighbors), int(lost_frames)
+        self.poses = np.asarray(task.sweep.poses, dtype=np.int64)
+        self.pose = 0
+        self.last = None
+        self.misses = 0
+
+    def first(self) -> int:
+        return int(self.poses[0])
+
+    def step(self, t_s: float, obs, boxes) -> tuple:
+        """Apply the view; return ``(next head, answer, event)``."""
+        task = self.task
+        grid = task.grid
+        head = obs.head
+        cells = group_cells(task.detector, boxes, task.camera, grid, head,
+                            task.observer.max_count, self.neighbors) \
+            if boxes is not None and len(boxes) else np.zeros(0, dtype=np.int64)
+        had = self.last is not None
+        if cells.size:
+            self.last, self.misses = int(cells[0]), 0
+        elif self.last is not None:
+            self.misses += 1
+            if self.misses >= self.lost_frames:
+                rows, cols = grid.cell(self.poses)
+                r, c = grid.cell(self.last)
+                self.pose = int(np.argmin(np.maximum(abs(rows - r), abs(cols - c))))
+                self.last = None
+        has = self.last is not None
+        event = '' if has == had else ('found' if has else 'lost')
+        if has:
+            return self.last, tuple(int(v) for v in grid.cell(self.last)), event
+        here = int(grid.index(*(int(round(v)) for v in head)))
+        if here == int(self.poses[self.pose]):
+            self.pose = (self.pose + 1) % len(self.poses)
+        return int(self.poses[self.pose]), None, event
+
+
+def run_walk(task: WalkTask, scene, tracker) -> list:
+    """Run one searcher over a walk scene on the clock of the module docstring."""
+    grid = task.grid
+    head = int(tracker.first())
+    previous = grid.center_index
+    t, frames = 0.0, []
+    while True:
+        if head != previous:
+            r0, c0 = grid.cell(previous)
+            r1, c1 = grid.cell(head)
+            step_deg = max(abs(r1 - r0), abs(c1 - c0)) * grid.spacing_deg
+            t += SACCADE_TIME_S + step_deg / HEAD_SPEED_DEG_S
+        t += SETTLE_TIME_S
+        if t > scene.duration_s:
+            break
+        obs, boxes = task.view(scene, t, head)
+        truth = scene.truth_at(t)
+        nxt, answer, event = tracker.step(t, obs, boxes)
+        head_rc = tuple(int(v) for v in grid.cell(head))
+        frames.append(WalkFrame(t, head_rc, truth.cell, task.in_view(truth, head) and
+                                truth.cell is not None, truth.cell == head_rc, answer, event))
+        t += DETECTOR_TIME_S
+        previous, head = head, int(nxt)
+    return frames
+
+
+def walk_result(searcher: str, index: int, scene, frames: list) -> WalkResult:
+    """Score a searcher's frames on a walk scene (module docstring)."""
+    reach = [f for f in frames if f.cell is not None]
+    n = len(reach)
+    in_view = sum(f.in_view for f in reach) / n if n else math.nan
+    in_centre = sum(f.in_centre for f in reach) / n if n else math.nan
+
+    def right(f):
+        return f.cell is not None and f.answer is not None and cells_apart(f.answer, f.cell) <= 1
+
+    duration = scene.duration_s
+    first = next((f.t_s for f in frames if right(f)), None)
+    back = return_time(scene)
+    reacquire, reacquired = None, None
+    if back is not None:
+        hit = next((f.t_s for f in frames if f.t_s >= back and right(f)), None)
+        reacquired = hit is not None
+        reacquire = (hit if reacquired else duration) - back
+    lost = sum(f.event == 'lost' for f in frames)
+    found_events = [i for i, f in enumerate(frames) if f.event == 'found']
+    again = max(len(found_events) - 1, 0)
+    return WalkResult(searcher, index, tuple(frames), n, in_view, in_centre,
+                      first if first is not None else duration, first is not None, reacquire,
+                      reacquired, lost, again)
+
+
+def return_time(scene, step_s: float = 0.01) -> float | None:
+    """Return when the face comes back into the grid's reach after leaving it (None: never)."""
+    times = np.arange(0.0, scene.duration_s, step_s)
+    inside = np.array([scene.truth_at(t).cell is not None for t in times])
+    out = np.flatnonzero(~inside)
+    if not out.size:
+        return None
+    back = np.flatnonzero(inside[out[0]:])
+    return float(times[out[0] + back[0]]) if back.size else None
+
+
+@dataclass(frozen=True)
+class WalkSpec:
+    """What a walk evaluation runs: scenes, the tracker's settings and the searchers compared."""
+
+    split: str
+    seed: int
+    speed_deg_s: float
+    duration_s: float
+    settings: SearchSettings
+    policy: str
+    view: str = 'map'
+    compare: tuple = ('track-last-detection',)
+
+
+def evaluate_walk(spec: WalkSpec, index: int) -> list:
+    """Run ``track`` and each of ``spec.compare`` on walk scene ``index``."""
+    task = WalkTask.get(spec.settings, spec.policy)
+    scene = WalkSceneSet(spec.split, task.geometry, spec.seed, spec.speed_deg_s,
+                         spec.duration_s).scene(index)
+    out = []
+    tracker = SessionTracker(task, spec.settings, np.random.default_rng([spec.seed, index]),
+                             spec.view)
+    out.append(walk_result('track', index, scene, run_walk(task, scene, tracker)))
+    for name in spec.compare:
+        label, _, rest = name.partition(':')
+        if label != 'track-last-detection':
+            raise ValueError(f'unknown walk searcher {name!r}; choose from {TRACKERS}')
+        kwargs = {k: int(v) for k, v in (item.split('=') for item in rest.split(',') if item)}
+        out.append(walk_result(name, index, scene,
+                               run_walk(task, scene, LastDetectionTracker(task, **kwargs))))
+    return out
+
+
+def summarise_walks(results: list, reference: list | None = None) -> dict:
+    """Return the means over scenes and paired 95% intervals of differences to ``reference``."""
+    def mean(values):
+        values = [v for v in values if v is not None and not math.isnan(v)]
+        return float(np.mean(values)) if values else math.nan
+
+    found = sum(r.found for r in results)
+    back = [r for r in results if r.reacquired is not None]
+    s = {'scenes': len(results), 'in_view': mean([r.in_view for r in results]),
+         'in_centre': mean([r.in_centre for r in results]),
+         'first_find_s_mean': mean([r.first_find_s for r in results]),
+         'found': found, 'found_interval': wilson_interval(found, len(results)),
+         'reacquire_s_mean': mean([r.reacquire_s for r in back]),
+         'reacquired': sum(bool(r.reacquired) for r in back), 'returns': len(back),
+         'lost_mean': mean([r.lost for r in results])}
+    if reference is not None and reference is not results:
+        for key in ('in_view', 'in_centre', 'reacquire_s'):
+            d = np.array([(a.to_dict()[key] or 0.0) - (b.to_dict()[key] or 0.0)
+                          for a, b in zip(results, reference)
+                          if a.to_dict()[key] is not None and b.to_dict()[key] is not None])
+            d = d[~np.isnan(d)]
+            if d.size > 1:
+                half = 1.96 * d.std(ddof=1) / math.sqrt(d.size)
+                s[f'{key}_minus_reference'] = [float(d.mean()), float(d.mean() - half),
+                                               float(d.mean() + half)]
+    return s
+
+
+def with_motion(settings: SearchSettings, sigma_cells: float, jump_prob: float = 0.0):
+    """Return ``settings`` with a moving target's motion (per second)."""
+    return replace(settings, motion_sigma_cells=float(sigma_cells),
+                   motion_jump_prob=float(jump_prob))
