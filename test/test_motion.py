@@ -4,7 +4,8 @@
 import math
 
 from ipomdp_gaze.model.grid import Grid
-from ipomdp_gaze.model.motion import axis_transition, check_probability, check_sigma_cells, Motion
+from ipomdp_gaze.model.motion import (axis_drift, axis_transition, check_probability,
+                                      check_sigma_cells, Motion, VelocityMotion)
 import numpy as np
 import pytest
 
@@ -235,3 +236,90 @@ def test_leaving_needs_an_absent_column_and_scales_with_time():
     over = Motion(grid, 0.0, 0.0, 0.2).over(2.5)
     assert over.leave_prob == pytest.approx(1 - 0.8 ** 2.5)
     assert Motion(grid, leave_prob=0.1).active and not Motion(grid).active
+
+
+def dense_drift(size, sigma, shift):
+    """One axis: shift by linear interpolation (mass past the ends leaves), then the step."""
+    out = np.zeros((size, size))
+    step = dense_transition(1, size, sigma, 0.0)
+    for x in range(size):
+        to = x + shift
+        low = math.floor(to)
+        for target, weight in ((low, 1 - (to - low)), (low + 1, to - low)):
+            if 0 <= target < size:
+                out[x] += weight * step[target]
+    return out
+
+
+@pytest.mark.parametrize('shift', [-3.2, -0.4, 0.0, 0.75, 2.0, 12.0])
+@pytest.mark.parametrize('sigma', [0.0, 0.6])
+def test_a_drifting_axis_is_the_shift_then_the_step(shift, sigma):
+    np.testing.assert_allclose(axis_drift(6, sigma, shift), dense_drift(6, sigma, shift),
+                               atol=1e-15)
+
+
+@pytest.mark.parametrize('absent', [True, False])
+def test_the_walking_target_is_the_exact_filter_of_the_joint_chain(absent):
+    """Cells x velocities (+ absent), built state by state: drift, jump, turn, return."""
+    rows, cols, classes, dt = 4, 5, 3, 0.7
+    grid = Grid(rows, cols)
+    n, k = grid.n_cells, classes * classes
+    motion = VelocityMotion(grid, 0.4, 0.05, 0.1, 1.5, 0.2, speed_cells=1.0, classes=classes)
+    rng = np.random.default_rng(1)
+    motion.velocity = rng.dirichlet(np.ones(k), size=n).T.reshape(classes, classes, n)
+    prior = motion.prior.reshape(-1)
+    belief = rng.dirichlet(np.ones(n + 1)) if absent else rng.dirichlet(np.ones(n))
+    sigma = 0.4 * math.sqrt(dt)
+    jump, turn, back = (1 - (1 - p) ** dt for p in (0.05, 0.2, 0.1))
+    chain = np.zeros((n * k + 1, n * k + 1))
+    for a in range(classes):
+        for b in range(classes):
+            v = a * classes + b
+            move = np.kron(dense_drift(rows, sigma, motion.speeds[a] * dt),
+                           dense_drift(cols, sigma, motion.speeds[b] * dt))
+            out = 1 - move.sum(axis=1)
+            move = (1 - jump) * move + jump * move.sum(axis=1, keepdims=True) / n
+            for w in range(k):
+                stay = (1 - turn) * (v == w) + turn * prior[w]
+                chain[v * n:(v + 1) * n, w * n:(w + 1) * n] = move * stay
+            chain[v * n:(v + 1) * n, -1] = out
+    chain[-1, :-1] = back * np.repeat(prior, n) / n
+    chain[-1, -1] = 1 - back
+    np.testing.assert_allclose(chain.sum(axis=1), 1.0)
+    joint = np.append((motion.velocity.reshape(k, n) * belief[:n]).reshape(-1),
+                      belief[n] if absent else 0.0)
+    after = joint @ chain
+    log_b = np.log(belief)
+    motion.predict_over(log_b, dt)
+    cells = after[:-1].reshape(k, n).sum(axis=0)
+    if not absent:                      # no absent hypothesis: what walked out is renormalised
+        cells, after = cells / cells.sum(), after / cells.sum()
+    else:
+        assert np.exp(log_b[n]) == pytest.approx(after[-1], rel=1e-10)
+    np.testing.assert_allclose(np.exp(log_b[:n]), cells, rtol=1e-10)
+    np.testing.assert_allclose(motion.velocity.reshape(k, n),
+                               after[:-1].reshape(k, n) / after[:-1].reshape(k, n).sum(axis=0),
+                               rtol=1e-9)
+
+
+def test_a_look_ahead_leaves_the_velocities_and_a_reset_forgets_them():
+    grid = Grid(5, 5)
+    motion = VelocityMotion(grid, 0.2, max_speed_cells=2.0, turn_prob=0.1, speed_cells=1.0)
+    log_b = np.log(np.full(25, 1 / 25))
+    motion.velocity[:, :, 3] = 0
+    motion.velocity[4, 8, 3] = 1
+    before = motion.velocity.copy()
+    motion.predict_over(log_b.copy(), 0.5, update=False)
+    assert np.array_equal(motion.velocity, before)
+    motion.reset()
+    np.testing.assert_allclose(motion.velocity[:, :, 3], motion.prior)
+    assert motion.active and motion.velocity_mean(np.full(25, 1 / 25)) == pytest.approx([0, 0])
+
+
+@pytest.mark.parametrize('kwargs, message', [({'max_speed_cells': 0}, 'max_speed_cells'),
+                                             ({'max_speed_cells': 1, 'classes': 1}, 'classes'),
+                                             ({'max_speed_cells': 1, 'turn_prob': 1.0},
+                                              'turn_prob')])
+def test_bad_velocity_settings_are_refused_with_a_reason(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        VelocityMotion(Grid(3, 3), **kwargs)

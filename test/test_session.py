@@ -585,3 +585,59 @@ def test_the_fixation_as_row_and_col():
     cell = session.start()
     assert isinstance(cell, int) and cell == grid.center_index
     assert session.fixation_cell == (2, 3) == tuple(int(v) for v in grid.cell(cell))
+
+
+def _tracking_session(**changes):
+    """Return a count session on GRID with a walking target and the tracking settings."""
+    model = count_model(3)
+    settings = SearchSettings(confidence=0.95, absent_prior=0.2, motion_sigma_cells=0.2,
+                              motion_max_speed_cells=1.0, motion_speed_cells=0.5,
+                              motion_turn_prob=0.1, motion_leave_prob=0.05, **changes)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model), settings)
+    session.reset(seed=0)
+    return session, model
+
+
+def _strong_frame(model, fixation, target):
+    """Return counts that put the target at ``target``: each cell's most telling count."""
+    values = np.empty(GRID.n_cells)
+    fr, fc = GRID.cell(fixation)
+    for i in range(GRID.n_cells):
+        r, c = GRID.cell(i)
+        ratio = np.log(model.p_target[abs(r - fr), abs(c - fc)]) \
+            - np.log(model.p_null[abs(r - fr), abs(c - fc)])
+        values[i] = np.argmax(ratio) if i == target else np.argmin(ratio)
+    return Frame(values)
+
+
+def test_a_found_walking_target_is_looked_at_where_the_belief_predicts_it():
+    """motion.track_view peak: the next fixation is the peak of the belief lead_s ahead."""
+    session, model = _tracking_session(motion_track_view='peak', motion_lead_s=0.3)
+    cell = session.start()
+    target = GRID.index(1, 1)
+    for t in range(6):
+        result = session.update(_strong_frame(model, cell, target), dt_s=0.1 if t else 0.0)
+        cell = result.fixation
+    assert session.decision == 'found'
+    ahead = session.log_belief
+    session.motion.predict_over(ahead, 0.3, update=False)
+    assert cell == int(np.argmax(ahead[:GRID.n_cells]))
+
+
+def test_found_holds_down_to_keep_probability_and_is_lost_below_it():
+    session, model = _tracking_session(motion_keep_probability=0.6)
+    cell = session.start()
+    target = GRID.index(1, 2)
+    for t in range(5):
+        cell = session.update(_strong_frame(model, cell, target), dt_s=0.1).fixation
+    assert session.decision == 'found'
+    empty = Frame(np.full(GRID.n_cells, np.nan))          # unobserved: the belief spreads
+    decisions = []
+    for _ in range(30):
+        session.update(empty, dt_s=0.5)
+        decisions.append((session.decision, session.map_probability))
+    held = [p for d, p in decisions if d == 'found']
+    assert held and min(held) >= 0.6 and any(p < 0.95 for p in held)    # held under c
+    assert any(d != 'found' for d, _ in decisions)
+    first_lost = next(i for i, (d, _) in enumerate(decisions) if d != 'found')
+    assert decisions[first_lost][1] < 0.6 or decisions[first_lost][0] == 'absent'

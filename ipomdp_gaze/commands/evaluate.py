@@ -22,6 +22,8 @@ from ipomdp_gaze.drivers.scene_eval import evaluate_scenes
 from ipomdp_gaze.drivers.scene_report import (format_summary, paired_map_difference, results_json,
                                               summarise, write_json)
 from ipomdp_gaze.drivers.scene_tasks import task_spec, TASKS
+from ipomdp_gaze.drivers.tracking import (evaluate_walks, format_walks, summarise_walks,
+                                          walk_spec, walks_json)
 from ipomdp_gaze.files.observation_file import fingerprint
 from ipomdp_gaze.model.motion import Motion
 from ipomdp_gaze.model.observation import as_observation, GaussianObservation
@@ -33,6 +35,7 @@ from ipomdp_gaze.simulation.evaluation import (decision_summary, fixations_to_90
 from ipomdp_gaze.simulation.executor import InlineExecutor
 from ipomdp_gaze.simulation.simulate import draw_present, draw_targets
 from ipomdp_gaze.vision.pan_tilt import parse_faces
+from ipomdp_gaze.vision.walks import DURATION_S as WALK_DURATION_S
 import numpy as np
 
 from .common import add_task_args, nonneg_int, positive_int, task_from_args
@@ -73,6 +76,14 @@ def add_parser(sub):
                         'many-target session and scored by faces found, false faces, rooms '
                         'right and head time; --compare then takes many:parameter=value,... '
                         'and sweep-all-grouped3 / sweep-all-grouped5')
+    p.add_argument('--motion', choices=('still', 'walk'), default='still',
+                   help='--scenes pan-tilt: still faces (default) or faces that walk (the '
+                        'tracker of config/faces_camera_tracking.yaml against '
+                        'track-last-detection on the same walks, docs/design.md section 12)')
+    p.add_argument('--speed-deg-s', type=float, default=5.0, metavar='V',
+                   help='--motion walk: walking speed in degrees per second, 0-20 (default 5)')
+    p.add_argument('--walk-duration-s', type=float, default=WALK_DURATION_S, metavar='S',
+                   help=f'--motion walk: seconds per walk (default {WALK_DURATION_S:g})')
     p.add_argument('--scene-model', default='', metavar='FILE',
                    help='--scenes pan-tilt: another pan/tilt observation file (its camera is the '
                         "scene camera's)")
@@ -80,7 +91,8 @@ def add_parser(sub):
                    help='--scenes: another searcher on the same scenes and views (repeatable): '
                         'a policy name (sweep starts at its first pose) or a sweep answer rule '
                         '(sweep-tile, sweep-first-raw, sweep-first-grouped3, '
-                        'sweep-first-grouped5)')
+                        'sweep-first-grouped5); with --motion walk track-last-detection '
+                        '(default; :neighbors=N,lost_frames=M)')
     p.add_argument('--episodes-greedy', type=positive_int, default=2000,
                    help='episodes for the slow searchers, greedy and switching (policies '
                         'whose class sets costly; default 2000)')
@@ -317,6 +329,36 @@ def run_scenes(args) -> int:
     return 0
 
 
+def run_walks(args) -> int:
+    """``evaluate --scenes pan-tilt --motion walk``: the tracker and the baseline on walks."""
+    if args.policy or args.policy_file or args.empty_scenes or args.scene_model:
+        raise ValueError('--motion walk takes the tracking configuration: no --policy, '
+                         '--policy-file, --empty-scenes or --scene-model')
+    spec = walk_spec(args.speed_deg_s, args.split, args.seed, args.walk_duration_s,
+                     tuple(args.compare) or ('track-last-detection',))
+    changes = {key: value for key, value in (('confidence', args.confidence),
+                                             ('absent_prior', args.absent_prior))
+               if value is not None}
+    spec = replace(spec, settings=replace(spec.settings, **changes))
+    episodes = args.episodes or 100
+    with executor_from_args(args, episodes) as executor, \
+            progress_from_args(args, episodes, 'walks', 'walk') as bar:
+        results = evaluate_walks(spec, episodes, executor, progress=bar)
+    reference = spec.compare[0] if spec.compare else None
+    summary = {name: summarise_walks(group, results.get(reference))
+               for name, group in results.items()}
+    print(f'pan-tilt walks at {spec.speed_deg_s:g} deg/s, {spec.duration_s:g} s each, '
+          f'{args.split} scenes {args.seed}..{args.seed + episodes - 1}, tracker policy '
+          f'{spec.policy}, settings {spec.settings.to_parameters()}')
+    for name, s in summary.items():
+        for line in format_walks(name, s, reference if name != reference else ''):
+            print(line)
+    if args.json:
+        write_json(args.json, walks_json(spec, results, summary))
+        print(f'wrote {args.json}')
+    return 0
+
+
 def _report_rooms(args, spec, results: dict, episodes: int) -> int:
     """Print (and write) the room summaries of ``evaluate --scenes pan-tilt --faces``."""
     summary = {name: summarise_rooms(group) for name, group in results.items()}
@@ -352,6 +394,10 @@ def run(args) -> int:
     faces = parse_faces(args.faces)          # one line for a bad K or LO-HI, before any work
     if faces != (1, 1) and args.scenes != 'pan-tilt':
         raise ValueError('--faces is for --scenes pan-tilt')
+    if args.motion == 'walk':
+        if args.scenes != 'pan-tilt' or faces != (1, 1):
+            raise ValueError('--motion walk is for --scenes pan-tilt with one face')
+        return run_walks(args)
     if args.scenes:
         return run_scenes(args)
     args.episodes = args.episodes or 20000

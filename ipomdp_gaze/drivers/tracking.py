@@ -40,10 +40,11 @@ from ipomdp_gaze.policies.registry import build_policy
 from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
 from ipomdp_gaze.search.settings import check_parameters
 from ipomdp_gaze.simulation.evaluation import cells_apart, wilson_interval
+from ipomdp_gaze.simulation.executor import InlineExecutor, track
 from ipomdp_gaze.vision.detection import build_setup
 from ipomdp_gaze.vision.detector import as_detections
 from ipomdp_gaze.vision.pan_tilt import SceneGeometry
-from ipomdp_gaze.vision.walks import WalkSceneSet
+from ipomdp_gaze.vision.walks import check_speed, DURATION_S, WalkSceneSet
 import numpy as np
 
 # The detector's time per 320x240 view on the clock (s): a constant, so that where the face is
@@ -153,12 +154,10 @@ class WalkTask:
 
 
 class SessionTracker:
-    """The search session on the walk: ``found`` is having the face, its MAP cell the answer."""
+    """The search session on the walk: ``found`` is having the face, the peak cell the answer."""
 
-    def __init__(self, task: WalkTask, settings: SearchSettings, seed, view: str = 'map'):
-        if view not in ('map', 'policy'):
-            raise ValueError(f"view must be 'map' or 'policy', got {view!r}")
-        self.task, self.view = task, view
+    def __init__(self, task: WalkTask, settings: SearchSettings, seed):
+        self.task = task
         self.session = SearchSession(task.grid, task.model, task.policy, settings)
         self.session.reset(seed=seed)
         self.last_t = None
@@ -176,11 +175,9 @@ class SessionTracker:
         has = session.decision == 'found'
         event = '' if has == self.had else ('found' if has else 'lost')
         self.had = has
-        answer = tuple(int(v) for v in self.task.grid.cell(session.map_cell)) if has else None
-        if has and self.view == 'map':
-            session.fixate(session.map_cell)
-        return session._state().fixation if result.fixation is not None else \
-            session.map_cell, answer, event
+        peak = int(np.argmax(session.belief))       # the most likely cell, not its square's
+        answer = tuple(int(v) for v in self.task.grid.cell(peak)) if has else None
+        return result.fixation, answer, event
 
 
 class LastDetectionTracker:
@@ -299,27 +296,94 @@ class WalkSpec:
     duration_s: float
     settings: SearchSettings
     policy: str
-    view: str = 'map'
     compare: tuple = ('track-last-detection',)
 
 
+def walk_spec(speed_deg_s: float, split: str = 'test', seed: int = 0,
+              duration_s: float = DURATION_S, compare=('track-last-detection',),
+              settings: SearchSettings | None = None, config=None) -> WalkSpec:
+    """
+    Return a checked walk evaluation: ``config`` (default :data:`WALK_CONFIG`) and its policy.
+
+    ``compare`` names the other searchers, ``track-last-detection`` optionally with
+    ``:neighbors=N,lost_frames=M``.
+    """
+    check_speed(speed_deg_s)
+    if split not in ('train', 'test'):
+        raise ValueError(f"split must be 'train' or 'test', got {split!r}")
+    if not (math.isfinite(duration_s) and duration_s > 0):
+        raise ValueError(f'the walk duration must be > 0 s, got {duration_s!r}')
+    for name in compare:
+        _baseline_kwargs(name)
+    base, policy, _ = walk_settings(config)
+    return WalkSpec(split, int(seed), float(speed_deg_s), float(duration_s),
+                    settings or base, policy, tuple(compare))
+
+
+def _baseline_kwargs(name: str) -> dict:
+    """Return the baseline's keyword arguments of a searcher label, or raise ValueError."""
+    label, _, rest = name.partition(':')
+    if label not in TRACKERS:
+        raise ValueError(f"unknown walk searcher {name!r}; choose from {', '.join(TRACKERS)}")
+    kwargs = {}
+    for item in filter(None, rest.split(',')):
+        key, sep, value = item.partition('=')
+        if not sep or key not in ('neighbors', 'lost_frames') or not value.isdigit() \
+                or int(value) < 1:
+            raise ValueError(f'searcher {name!r}: expected neighbors=N or lost_frames=M with '
+                             f'N, M >= 1, got {item!r}')
+        kwargs[key] = int(value)
+    return kwargs
+
+
 def evaluate_walk(spec: WalkSpec, index: int) -> list:
-    """Run ``track`` and each of ``spec.compare`` on walk scene ``index``."""
+    """Run ``track`` and each of ``spec.compare`` on walk scene ``index`` (one piece of work)."""
     task = WalkTask.get(spec.settings, spec.policy)
     scene = WalkSceneSet(spec.split, task.geometry, spec.seed, spec.speed_deg_s,
                          spec.duration_s).scene(index)
-    out = []
-    tracker = SessionTracker(task, spec.settings, np.random.default_rng([spec.seed, index]),
-                             spec.view)
-    out.append(walk_result('track', index, scene, run_walk(task, scene, tracker)))
+    tracker = SessionTracker(task, spec.settings, np.random.default_rng([spec.seed, index]))
+    out = [walk_result('track', index, scene, run_walk(task, scene, tracker))]
     for name in spec.compare:
-        label, _, rest = name.partition(':')
-        if label != 'track-last-detection':
-            raise ValueError(f'unknown walk searcher {name!r}; choose from {TRACKERS}')
-        kwargs = {k: int(v) for k, v in (item.split('=') for item in rest.split(',') if item)}
-        out.append(walk_result(name, index, scene,
-                               run_walk(task, scene, LastDetectionTracker(task, **kwargs))))
+        baseline = LastDetectionTracker(task, **_baseline_kwargs(name))
+        out.append(walk_result(name, index, scene, run_walk(task, scene, baseline)))
     return out
+
+
+def evaluate_walks(spec: WalkSpec, episodes: int, executor=None, progress=None) -> dict:
+    """Run walk scenes ``0..episodes-1``; return ``{searcher: [WalkResult per scene]}``."""
+    executor = InlineExecutor() if executor is None else executor
+    futures = [executor.submit(evaluate_walk, spec, i) for i in range(episodes)]
+    for _ in track(futures, progress):
+        pass
+    out = {}
+    for future in futures:
+        for r in future.result():
+            out.setdefault(r.searcher, []).append(r)
+    return out
+
+
+def format_walks(name: str, s: dict, reference: str = '') -> list[str]:
+    """Return a searcher's summary lines (and its paired differences to ``reference``)."""
+    lines = [f"{name}: in view {s['in_view']:.3f}, in the centre cell {s['in_centre']:.3f} of "
+             f"the frames in reach; first find {s['first_find_s_mean']:.2f} s (found in "
+             f"{s['found']} of {s['scenes']}); reacquired {s['reacquired']} of {s['returns']} "
+             f"returns, {s['reacquire_s_mean']:.2f} s after the return; lost "
+             f"{s['lost_mean']:.2f} times per walk"]
+    for key in ('in_view', 'in_centre', 'reacquire_s'):
+        diff = s.get(f'{key}_minus_reference')
+        if diff:
+            lines.append(f'  {key} minus {reference} [paired 95%]: {diff[0]:+.3f} '
+                         f'[{diff[1]:+.3f}, {diff[2]:+.3f}]')
+    return lines
+
+
+def walks_json(spec: WalkSpec, results: dict, summary: dict) -> dict:
+    """Return the JSON record of a walk evaluation: configuration, summaries, every scene."""
+    return {'task': 'pan-tilt', 'motion': 'walk', 'speed_deg_s': spec.speed_deg_s,
+            'duration_s': spec.duration_s, 'split': spec.split, 'seed': spec.seed,
+            'policy': spec.policy, 'settings': spec.settings.to_parameters(),
+            'compare': list(spec.compare), 'summary': summary,
+            'scenes': {name: [r.to_dict() for r in group] for name, group in results.items()}}
 
 
 def summarise_walks(results: list, reference: list | None = None) -> dict:
@@ -333,7 +397,7 @@ def summarise_walks(results: list, reference: list | None = None) -> dict:
     s = {'scenes': len(results), 'in_view': mean([r.in_view for r in results]),
          'in_centre': mean([r.in_centre for r in results]),
          'first_find_s_mean': mean([r.first_find_s for r in results]),
-         'found': found, 'found_interval': wilson_interval(found, len(results)),
+         'found': found, 'found_interval': list(wilson_interval(found, len(results))),
          'reacquire_s_mean': mean([r.reacquire_s for r in back]),
          'reacquired': sum(bool(r.reacquired) for r in back), 'returns': len(back),
          'lost_mean': mean([r.lost for r in results])}

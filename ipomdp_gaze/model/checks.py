@@ -149,3 +149,15 @@ def check_targets(value, name: str = 'search.targets') -> str:
     if not (isinstance(value, str) and value in TARGETS):
         raise ValueError(f"{name} must be one of {', '.join(TARGETS)}, got {value!r}")
     return value
+
+
+# motion.track_view: where the head looks while a moving target is found: the search policy's
+# choice, or the peak of the belief predicted motion.lead_s ahead (docs/design.md section 12.4).
+TRACK_VIEWS = ('policy', 'peak')
+
+
+def check_track_view(value, name: str = 'motion.track_view') -> str:
+    """Return ``'policy'`` or ``'peak'``: how a found moving target is looked at."""
+    if not (isinstance(value, str) and value in TRACK_VIEWS):
+        raise ValueError(f"{name} must be one of {', '.join(TRACK_VIEWS)}, got {value!r}")
+    return value

@@ -186,6 +186,16 @@ class Motion:
             np.add(np.log(moved, out=moved), peak, out=log_belief[..., :n])
         return normalize_log(log_belief)
 
+    def predict_over(self, log_belief: np.ndarray, seconds: float,
+                     update: bool = True) -> np.ndarray:
+        """Predict a log belief over ``seconds`` in place (per-second parameters); return it."""
+        if self.active and seconds > 0:
+            self.over(seconds).predict_log(log_belief)
+        return log_belief
+
+    def reset(self) -> None:
+        """Forget what a search learned about the motion (nothing: a random walk has no state)."""
+
     # -- the target ----------------------------------------------------------------------
     @staticmethod
     def _step_cdf(matrix: np.ndarray) -> np.ndarray:
@@ -215,3 +225,141 @@ class Motion:
         jump_to = np.minimum((u[..., 3] * self.grid.n_cells).astype(np.int64),
                              self.grid.n_cells - 1)
         return np.where(u[..., 2] < self.jump_prob, jump_to, moved)
+
+
+def axis_drift(size: int, sigma_cells: float, shift_cells: float) -> np.ndarray:
+    """
+    One axis of a drifting step: move by ``shift_cells``, then the Gaussian step of ``sigma``.
+
+    The shift splits each position's mass between the two positions around ``x + shift``
+    (linear interpolation); mass shifted past either end leaves the axis (the row sums to less
+    than 1: the target walked out of the grid). :func:`axis_transition` then spreads it.
+    """
+    x = np.arange(size) + float(shift_cells)
+    low = np.floor(x).astype(np.int64)
+    frac = x - low
+    shift = np.zeros((size, size + 2))           # columns 0 and size + 1: past the ends
+    rows = np.arange(size)
+    np.add.at(shift, (rows, np.clip(low, -1, size) + 1), 1.0 - frac)
+    np.add.at(shift, (rows, np.clip(low + 1, -1, size) + 1), frac)
+    return shift[:, 1:size + 1] @ axis_transition(size, sigma_cells)
+
+
+class VelocityMotion(Motion):
+    """
+    A target that walks: a velocity per target, kept between turns (docs/design.md section 12.2).
+
+    The state is ``(cell, k)`` with ``k`` one of ``classes^2`` velocities ``(v_row, v_col)``,
+    each axis ``linspace(-max_speed, max_speed, classes)`` cells per second, drawn from the
+    prior ``pi(k)``, a Gaussian of standard deviation ``speed_cells`` per axis (uniform when 0).
+    Over ``dt`` seconds a target of velocity ``v`` moves by ``v dt`` and then by the random walk
+    of ``sigma_cells sqrt(dt)`` (:func:`axis_drift` per axis); one that walks past the grid's
+    edge has left (the absent hypothesis gains its mass). It jumps as :class:`Motion` says, turns
+    with probability ``1 - (1 - turn_prob)^dt`` (its velocity drawn anew from ``pi``), and an
+    absent target comes back with probability ``1 - (1 - leave_prob)^dt``, at a uniformly drawn
+    cell (as :class:`Motion`'s: entering at the border cells only drew the search policy to the
+    edges, where it missed faces that walked in and on, on training walks). The belief over
+    cells stays the session's; this object keeps ``P(k | cell)``, which the Bayes step leaves
+    alone (the detector sees where a target is, not how fast it goes), so predicting the joint
+    and summing over ``k`` is the exact filter. Without an absent hypothesis the mass that left is renormalised away.
+    """
+
+    def __init__(self, grid: Grid, sigma_cells: float = 0.0, jump_prob: float = 0.0,
+                 leave_prob: float = 0.0, max_speed_cells: float = 0.0, turn_prob: float = 0.0,
+                 speed_cells: float = 0.0, classes: int = 9):
+        super().__init__(grid, sigma_cells, jump_prob, leave_prob)
+        speed = float(max_speed_cells)
+        if not math.isfinite(speed) or speed <= 0:
+            raise ValueError(f'max_speed_cells must be > 0, got {max_speed_cells!r}')
+        self.max_speed_cells = speed
+        self.turn_prob = check_probability(turn_prob, 'turn_prob')
+        self.speed_cells = check_sigma_cells(speed_cells, 'speed_cells')
+        if isinstance(classes, bool) or int(classes) != classes or classes < 2:
+            raise ValueError(f'classes must be an int >= 2, got {classes!r}')
+        self.classes = int(classes)
+        self.speeds = np.linspace(-speed, speed, self.classes)
+        axis = np.ones(self.classes) if self.speed_cells == 0 else \
+            np.exp(-0.5 * (self.speeds / self.speed_cells) ** 2)
+        prior = np.outer(axis, axis)
+        self.prior = prior / prior.sum()
+        self.entry = np.full(grid.n_cells, 1.0 / grid.n_cells)
+        self.reset()
+
+    def __repr__(self):
+        return (f'VelocityMotion({self.grid!r}, sigma_cells={self.sigma_cells}, '
+                f'jump_prob={self.jump_prob}, leave_prob={self.leave_prob}, '
+                f'max_speed_cells={self.max_speed_cells}, turn_prob={self.turn_prob}, '
+                f'speed_cells={self.speed_cells}, classes={self.classes})')
+
+    @property
+    def active(self) -> bool:
+        """Return True: a target with a velocity moves."""
+        return True
+
+    def to_dict(self) -> dict:
+        """Return the parameters (:meth:`Motion.to_dict` and the velocity's)."""
+        return {**super().to_dict(), 'max_speed_cells': self.max_speed_cells,
+                'turn_prob': self.turn_prob, 'speed_cells': self.speed_cells,
+                'classes': self.classes}
+
+    def reset(self) -> None:
+        """Forget the velocities: ``P(k | cell)`` is the prior."""
+        self.velocity = np.repeat(self.prior[:, :, None], self.grid.n_cells, axis=2)
+
+    def velocity_mean(self, cells: np.ndarray) -> np.ndarray:
+        """Return the mean velocity ``(v_row, v_col)`` in cells/s, weighted by ``cells``."""
+        weights = self.velocity * np.asarray(cells, dtype=float)[None, None, :]
+        total = weights.sum()
+        if total <= 0:
+            return np.zeros(2)
+        per_class = weights.sum(axis=2) / total
+        return np.array([np.sum(per_class.sum(axis=1) * self.speeds),
+                         np.sum(per_class.sum(axis=0) * self.speeds)])
+
+    def predict_over(self, log_belief: np.ndarray, seconds: float,
+                     update: bool = True) -> np.ndarray:
+        """
+        Predict a normalised log belief over ``seconds`` in place (the class docstring).
+
+        ``update=False`` leaves ``P(k | cell)`` as it was (a look ahead, not a step of time).
+        Returns ``log_belief``.
+        """
+        dt = float(seconds)
+        if dt <= 0:
+            return log_belief
+        n, k = self.grid.n_cells, self.classes
+        rows, cols = self.grid.shape
+        peak = np.max(log_belief)
+        cells = np.exp(log_belief[:n] - peak)
+        sigma = self.sigma_cells * math.sqrt(dt)
+        row_steps = [axis_drift(rows, sigma, v * dt) for v in self.speeds]
+        col_steps = [axis_drift(cols, sigma, v * dt) for v in self.speeds]
+        joint = (self.velocity * cells[None, None, :]).reshape(k, k, rows, cols)
+        moved = np.empty_like(joint)
+        for a in range(k):
+            left = row_steps[a].T
+            for b in range(k):
+                moved[a, b] = left @ joint[a, b] @ col_steps[b]
+        moved = moved.reshape(k, k, n)
+        walked_out = float(joint.sum() - moved.sum())
+        jump = min(1.0 - (1.0 - self.jump_prob) ** dt, ALMOST_ONE)
+        if jump:
+            moved = (1.0 - jump) * moved + jump * moved.sum(axis=2, keepdims=True) / n
+        turn = min(1.0 - (1.0 - self.turn_prob) ** dt, ALMOST_ONE)
+        if turn:
+            moved = (1.0 - turn) * moved \
+                + turn * moved.sum(axis=(0, 1), keepdims=True) * self.prior[:, :, None]
+        if log_belief.shape[-1] > n:
+            back = min(1.0 - (1.0 - self.leave_prob) ** dt, ALMOST_ONE)
+            absent = math.exp(log_belief[n] - peak)
+            moved += back * absent * self.prior[:, :, None] * self.entry[None, None, :]
+            gone = (1.0 - back) * absent + max(walked_out, 0.0)
+            with np.errstate(divide='ignore'):
+                log_belief[n] = math.log(gone) + peak if gone > 0 else -np.inf
+        new_cells = moved.sum(axis=(0, 1))
+        if update:
+            with np.errstate(divide='ignore', invalid='ignore'):
+                self.velocity = np.where(new_cells > 0, moved / new_cells, self.prior[:, :, None])
+        with np.errstate(divide='ignore'):
+            log_belief[:n] = np.log(new_cells) + peak
+        return normalize_log(log_belief)

@@ -41,7 +41,7 @@ from ipomdp_gaze.model.belief import bayes_update, entropy, EvidenceError, map_c
 from ipomdp_gaze.model.false_alarms import FalseAlarmMixture
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.inhibition import policy_choice, unvisited_choice
-from ipomdp_gaze.model.motion import Motion
+from ipomdp_gaze.model.motion import Motion, VelocityMotion
 from ipomdp_gaze.model.observation import as_observation, check_evidence, CountObservation
 from ipomdp_gaze.model.still_evidence import cell_information, StillEvidence
 from ipomdp_gaze.model.stopping import ABSENT, decide, FOUND, initial_log_belief, with_absent
@@ -88,8 +88,19 @@ def _mixture_settings(settings: SearchSettings) -> tuple:
 
 def _motion(grid: Grid, settings: SearchSettings) -> Motion:
     """Return the target's motion of ``settings`` (per second in the nodes)."""
+    if settings.motion_max_speed_cells > 0:
+        return VelocityMotion(grid, settings.motion_sigma_cells, settings.motion_jump_prob,
+                              settings.motion_leave_prob, settings.motion_max_speed_cells,
+                              settings.motion_turn_prob, settings.motion_speed_cells)
     return Motion(grid, settings.motion_sigma_cells, settings.motion_jump_prob,
                   settings.motion_leave_prob)
+
+
+def _motion_settings(settings: SearchSettings) -> tuple:
+    """Return what the motion object is built from (a change rebuilds it)."""
+    return (settings.motion_sigma_cells, settings.motion_jump_prob, settings.motion_leave_prob,
+            settings.motion_max_speed_cells, settings.motion_turn_prob,
+            settings.motion_speed_cells)
 
 
 def _wants_mixture(settings: SearchSettings) -> bool:
@@ -265,7 +276,8 @@ class SearchSession:
         _check_mixture_model(settings, self.observation)
         old = self.settings
         self.settings = settings
-        self.motion = _motion(self.grid, settings)
+        if _motion_settings(settings) != _motion_settings(old):
+            self.motion = _motion(self.grid, settings)
         self._changed()                 # the answer's square follows found_radius and motion
         mixture_changed = _mixture_settings(settings) != _mixture_settings(old)
         if mixture_changed:
@@ -469,6 +481,7 @@ class SearchSession:
             self.rng = np.random.default_rng(seed)
         log_b = initial_log_belief(self.grid.n_cells, self.settings.absent_prior)
         self._still.reset()
+        self.motion.reset()
         if self._mixture is not None:
             self._mixture.reset()
         self._search = _Search(log_b, log_b.copy(), np.zeros(self.grid.n_cells, dtype=bool))
@@ -575,7 +588,7 @@ class SearchSession:
     def predict(self, dt_s: float) -> None:
         """Spread the belief over ``dt_s`` of the target's motion (nothing for a still target)."""
         if self.motion.active and dt_s > 0:
-            self.motion.over(dt_s).predict_log(self._state().log_belief)
+            self.motion.predict_over(self._state().log_belief, dt_s)
             self._changed()
 
     def update(self, frame: Frame, dt_s: float = 0.0) -> StepResult:
@@ -690,6 +703,12 @@ class SearchSession:
         search.decision, search.reason, search.ended = decision, reason, True
         return decision
 
+    def _predicted_peak(self) -> int:
+        """Return the most likely cell of the belief predicted ``motion.lead_s`` ahead."""
+        ahead = self.motion.predict_over(self._search.log_belief.copy(),
+                                         self.settings.motion_lead_s, update=False)
+        return int(np.argmax(ahead[:self.grid.n_cells]))
+
     def stop(self, reason: str) -> StepResult:
         """
         End the search now at a limit outside the session (a driver's pixel budget, a deadline).
@@ -715,6 +734,9 @@ class SearchSession:
         search, settings = self._search, self.settings
         if self.policy is None:
             return search.fixation
+        if self.motion.active and settings.motion_track_view == 'peak' \
+                and search.decision == 'found':
+            return self._predicted_peak()
         belief = self._cells()[None, :]
         if settings.inhibit_return and not self.motion.active:
             if search.visited.all():

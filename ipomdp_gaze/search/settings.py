@@ -26,7 +26,7 @@ from typing import Callable, Mapping
 
 from ipomdp_gaze.model.checks import (check_budget, check_confidence, check_flag,
                                       check_probability, check_radius, check_sigma_cells,
-                                      check_start_cell, check_targets)
+                                      check_start_cell, check_targets, check_track_view)
 from ipomdp_gaze.model.false_alarms import (check_false_alarm_scales, check_hotspot_prior,
                                             check_hotspot_scale, DEFAULT_HOTSPOT_SCALE)
 from ipomdp_gaze.model.still_evidence import check_repeat_weight
@@ -102,6 +102,28 @@ SCHEMA: tuple[Setting, ...] = (
             'with absent.prior: probability per second that the target leaves the grid, and '
             'that an absent one comes back (a person walking out of reach and in again)',
             bounds='in [0, 1)', metavar='P'),
+    Setting('motion_max_speed_cells', 'motion.max_speed_cells', 'float', 0.0,
+            check_sigma_cells,
+            'the target walks: it keeps a velocity (a belief over 9 x 9 velocities up to this '
+            'many cells per second on each axis) until it turns, leaves by walking past the '
+            "grid's edge and comes back at its border (motion.leave_prob per second); 0: a "
+            'random walk only',
+            bounds='>= 0', metavar='CELLS'),
+    Setting('motion_speed_cells', 'motion.speed_cells', 'float', 0.0, check_sigma_cells,
+            'with motion.max_speed_cells: how fast targets usually go, the standard deviation '
+            'per axis of the velocity prior in cells per second (0: every velocity alike)',
+            bounds='>= 0', metavar='CELLS'),
+    Setting('motion_turn_prob', 'motion.turn_prob', 'float', 0.0, check_probability,
+            'with motion.max_speed_cells: probability per second that the target turns (its '
+            'velocity drawn anew)', bounds='in [0, 1)', metavar='P'),
+    Setting('motion_track_view', 'motion.track_view', 'str', 'policy', check_track_view,
+            'moving target, once found: policy (the search policy chooses the view) or peak '
+            '(look at the most likely cell of the belief predicted motion.lead_s ahead)',
+            bounds='policy or peak', metavar='policy|peak'),
+    Setting('motion_lead_s', 'motion.lead_s', 'float', 0.0, check_sigma_cells,
+            'with motion.track_view peak: how far ahead the belief is predicted (the time from '
+            'a frame to the next: saccade, settling and the detector)', bounds='>= 0',
+            metavar='SECONDS'),
     Setting('motion_keep_probability', 'motion.keep_probability', 'float', 0.0,
             check_probability,
             'moving target: once found, it stays found while the answer holds at least this '
@@ -167,7 +189,7 @@ class SettingsBase:
     def moving(self) -> bool:
         """Whether the target is modelled as moving."""
         return self.motion_sigma_cells > 0 or self.motion_jump_prob > 0 \
-            or self.motion_leave_prob > 0
+            or self.motion_leave_prob > 0 or self.motion_max_speed_cells > 0
 
     def check_grid(self, grid) -> None:
         """Refuse a start cell outside ``grid`` (ValueError naming both)."""

@@ -8,7 +8,7 @@ the same split, background crop, face, size and start) with the face moving alon
 the panorama over ``duration_s`` seconds. The path (:class:`Walk`) is straight segments at a
 constant ``speed_deg_s`` between waypoints drawn uniformly in the grid's reach, with pauses
 (probability :data:`PAUSE_PROB` per leg, :data:`PAUSE_S` long) and, once per walk, an excursion
-out of the head's reach: the face walks past the nearer side edge of the panorama (no view can
+out of the head's reach: the face walks past the nearest edge of the panorama (no view can
 see it), stays out :data:`AWAY_S` seconds and walks back in to a new waypoint. Speed 0 is the
 still scene: the face never moves and never leaves.
 
@@ -34,10 +34,10 @@ import numpy as np
 PAUSE_PROB = 0.3
 PAUSE_S = (0.5, 2.0)
 AWAY_S = (2.0, 4.0)
-LEAVE_AT = (0.3, 0.5)
+LEAVE_AT = (0.15, 0.3)
 OUTSIDE_SIDES = 1.0
 MAX_SPEED_DEG_S = 20.0
-DURATION_S = 20.0
+DURATION_S = 30.0
 _STREAM_TAG = 0x3A1C
 _SPLIT_CODE = {'train': 0, 'test': 1}
 
@@ -80,17 +80,15 @@ def draw_walk(rng: np.random.Generator, geometry: SceneGeometry, start_px, side_
         return Walk(np.array([0.0, duration_s]), np.stack([start, start]))
     speed_px = speed * geometry.px_per_deg
     x_lo, x_hi, y_lo, y_hi = geometry.grid_area_px()
-    width = geometry.size_px[0]
+    width, height = geometry.size_px
     times, points = [0.0], [start]
     left = not leave
     while times[-1] < duration_s:
         here = points[-1]
         u_pause, u_len, u_x, u_y = rng.random(4)
         if not left and times[-1] >= leave_at:
-            side = -OUTSIDE_SIDES * side_px - side_px / 2 if here[0] < width / 2 \
-                else width + OUTSIDE_SIDES * side_px + side_px / 2
-            outside = np.array([side, here[1]])
-            times.append(times[-1] + abs(outside[0] - here[0]) / speed_px)
+            outside = _outside(here, width, height, side_px)
+            times.append(times[-1] + float(np.hypot(*(outside - here))) / speed_px)
             points.append(outside)
             times.append(times[-1] + away_s)
             points.append(outside)
@@ -104,6 +102,15 @@ def draw_walk(rng: np.random.Generator, geometry: SceneGeometry, start_px, side_
         times.append(times[-1] + max(float(np.hypot(*(target - here))) / speed_px, 1e-6))
         points.append(target)
     return Walk(np.array(times), np.stack(points))
+
+
+def _outside(here: np.ndarray, width: int, height: int, side_px: int) -> np.ndarray:
+    """Return the point past the panorama's nearest edge for a face leaving from ``here``."""
+    beyond = OUTSIDE_SIDES * side_px + side_px / 2
+    x, y = here
+    options = [(x, (-beyond, y)), (width - x, (width + beyond, y)), (y, (x, -beyond)),
+               (height - y, (x, height + beyond))]
+    return np.array(min(options, key=lambda option: option[0])[1], dtype=float)
 
 
 def check_speed(speed_deg_s) -> float:
@@ -224,40 +231,75 @@ class WalkSceneSet:
 
 def calibrate_motion(split: str = 'train', scenes: int = 200, speeds_deg_s=(0.0, 20.0),
                      dt_s: float = 0.13, seed: int = 0, duration_s: float = DURATION_S,
-                     step_s: float = 0.05) -> dict:
+                     step_s: float = 0.05, classes: int = 9) -> dict:
     """
     Fit the belief's motion to walks of ``split`` (docs/design.md section 12.3).
 
     Scene ``i`` walks at ``speeds_deg_s[0] + u (speeds_deg_s[1] - speeds_deg_s[0])``, ``u``
     uniform from the stream ``default_rng([tag, 2, seed])``: a tracker does not know how fast
-    people walk. ``sigma_cells`` is the random walk's maximum-likelihood step per second over
-    ``dt_s`` (the time between a tracker's frames), ``sqrt(mean(d_row^2 + d_col^2) / (2 dt))``
-    over the pairs of times ``dt_s`` apart that are both in the grid's reach; ``leave_prob`` is
-    ``1 - exp(-exits / seconds in reach)``, from the walks' positions every ``step_s``.
-    Returns ``{'sigma_cells', 'leave_prob', 'pairs', 'exits', 'seconds_in_reach'}``.
+    people walk. From the walks' positions every ``step_s`` while in the grid's reach:
+
+    - ``sigma_cells``: the random walk's maximum-likelihood step per second over ``dt_s`` (the
+      time between a tracker's frames), ``sqrt(mean(d_row^2 + d_col^2) / (2 dt))`` over pairs
+      of times ``dt_s`` apart, both in reach;
+    - ``leave_prob``: ``1 - exp(-exits / seconds in reach)``, and ``return_prob``,
+      ``1 - exp(-returns / seconds out of reach)``;
+    - for a target with a velocity (:class:`~ipomdp_gaze.model.motion.VelocityMotion`):
+      ``max_speed_cells``, the largest speed per axis seen; ``speed_cells``, the root mean
+      square of the velocity per axis (pauses included); ``turn_prob``,
+      ``1 - exp(-turns / seconds in reach)`` (a turn: the velocity changes between samples);
+      ``velocity_sigma_cells``, the random walk left once each pair's displacement is
+      predicted by its velocity rounded to the nearest of ``classes`` per axis.
     """
     lo, hi = (check_speed(v) for v in speeds_deg_s)
     draws = np.random.default_rng([_STREAM_TAG, 2, int(seed)]).random(int(scenes))
-    squares, pairs, exits, inside_s = 0.0, 0, 0, 0.0
+    walks, geometry = [], None
     for i, u in enumerate(draws):
         walk_set = WalkSceneSet(split, seed=seed, speed_deg_s=lo + u * (hi - lo),
                                 duration_s=duration_s)
-        walk = walk_set.scene(i).walk
+        walks.append(walk_set.scene(i).walk)
         geometry = walk_set.geometry
+    rows, cols = geometry.grid.shape
+
+    def grid_at(walk, times):
+        return np.stack(geometry.point_position(*walk.position_px(times).T), axis=-1)
+
+    samples = []
+    for walk in walks:
         times = np.arange(0.0, duration_s - dt_s, step_s)
-        a = np.stack(geometry.point_position(*walk.position_px(times).T), axis=-1)
-        b = np.stack(geometry.point_position(*walk.position_px(times + dt_s).T), axis=-1)
-        rows, cols = geometry.grid.shape
-        reach_a = _in_reach(a, rows, cols)
-        both = reach_a & _in_reach(b, rows, cols)
-        squares += float(np.sum((b[both] - a[both]) ** 2))
+        a, b = grid_at(walk, times), grid_at(walk, times + dt_s)
+        velocity = (grid_at(walk, times + 1e-4) - a) / 1e-4
+        samples.append((a, b, velocity, _in_reach(a, rows, cols),
+                        _in_reach(a, rows, cols) & _in_reach(b, rows, cols)))
+    speed = max(float(np.abs(v[r]).max()) if r.any() else 0.0 for _, _, v, r, _ in samples)
+    levels = np.linspace(-speed, speed, int(classes)) if speed > 0 else np.zeros(1)
+    squares = residual = moving = 0.0
+    pairs = exits = turns = returns = 0
+    inside_s = outside_s = 0.0
+    for a, b, velocity, reach, both in samples:
+        d = b[both] - a[both]
+        squares += float(np.sum(d ** 2))
+        nearest = levels[np.argmin(np.abs(velocity[both][..., None] - levels), axis=-1)]
+        residual += float(np.sum((d - nearest * dt_s) ** 2))
         pairs += int(both.sum())
-        exits += int(np.sum(reach_a[:-1] & ~reach_a[1:]))
-        inside_s += float(reach_a.sum()) * step_s
-    sigma = math.sqrt(squares / max(pairs, 1) / (2.0 * dt_s))
-    leave = 1.0 - math.exp(-exits / inside_s) if inside_s > 0 else 0.0
-    return {'sigma_cells': sigma, 'leave_prob': leave, 'pairs': pairs, 'exits': exits,
-            'seconds_in_reach': inside_s}
+        exits += int(np.sum(reach[:-1] & ~reach[1:]))
+        returns += int(np.sum(~reach[:-1] & reach[1:]))
+        outside_s += float((~reach).sum()) * step_s
+        moving += float(np.sum(velocity[reach] ** 2))
+        changed = np.any(np.abs(np.diff(velocity, axis=0)) > 1e-6, axis=1)
+        turns += int(np.sum(changed & reach[:-1] & reach[1:]))
+        inside_s += float(reach.sum()) * step_s
+    samples_in_reach = inside_s / step_s
+
+    def rate(count, seconds):
+        return 1.0 - math.exp(-count / seconds) if seconds > 0 else 0.0
+
+    return {'sigma_cells': math.sqrt(squares / max(pairs, 1) / (2.0 * dt_s)),
+            'leave_prob': rate(exits, inside_s), 'return_prob': rate(returns, outside_s),
+            'max_speed_cells': speed, 'turn_prob': rate(turns, inside_s),
+            'speed_cells': math.sqrt(moving / max(2 * samples_in_reach, 1)),
+            'velocity_sigma_cells': math.sqrt(residual / max(pairs, 1) / (2.0 * dt_s)),
+            'pairs': pairs, 'exits': exits, 'turns': turns, 'seconds_in_reach': inside_s}
 
 
 def _in_reach(position: np.ndarray, rows: int, cols: int) -> np.ndarray:
