@@ -11,10 +11,10 @@ searchers:
 
 - ``track`` (the shipped tracker): the search session with the walk configuration's motion
   (``motion.*``, calibrated on training walks, :func:`calibrate_motion`): the belief predicted
-  over the time between frames, updated with each view's counts. While it says ``found`` the
-  head looks at the most likely cell (``motion.track_view: map``; ``policy`` leaves the choice to
-  the search policy); otherwise the search policy chooses. ``lost`` when ``found`` ends,
-  ``reacquired`` when it comes back;
+  over the time between frames, updated with each view's counts; the session chooses every view
+  (while ``found``, ``motion.track_view``: the predicted peak; otherwise the search policy).
+  ``lost`` when ``found`` ends, ``found`` again after it a reacquisition; its answer is the most
+  likely cell while ``found``;
 - ``track-last-detection``, what a team would write: sweep the sweep policy's poses; centre the
   head on the last grouped detection (``min_neighbors`` :data:`BASELINE_NEIGHBORS`, the largest
   box); after :data:`BASELINE_LOST_FRAMES` views without one, lost: sweep again from the pose
@@ -51,8 +51,9 @@ import numpy as np
 # when a view is taken does not depend on the machine (the median measured here, bench/pan_tilt).
 DETECTOR_TIME_S = 0.03
 TRACKERS = ('track-last-detection',)
-# The baseline: grouped detections as OpenCV's default-ish min_neighbors 3, and the views without
-# one after which it sweeps again (both chosen on training walks, docs/pan_tilt.md).
+# The baseline: grouped detections with min_neighbors 3 (the pan/tilt sweep rules' best on the
+# still scenes, docs/pan_tilt.md) and the views without one after which it sweeps again (3: set
+# before any measurement; other values via track-last-detection:neighbors=N,lost_frames=M).
 BASELINE_NEIGHBORS = 3
 BASELINE_LOST_FRAMES = 3
 WALK_CONFIG = 'faces_camera_tracking.yaml'

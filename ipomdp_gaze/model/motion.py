@@ -332,15 +332,10 @@ class VelocityMotion(Motion):
         peak = np.max(log_belief)
         cells = np.exp(log_belief[:n] - peak)
         sigma = self.sigma_cells * math.sqrt(dt)
-        row_steps = [axis_drift(rows, sigma, v * dt) for v in self.speeds]
-        col_steps = [axis_drift(cols, sigma, v * dt) for v in self.speeds]
+        row_t = np.stack([axis_drift(rows, sigma, v * dt).T for v in self.speeds])
+        col = np.stack([axis_drift(cols, sigma, v * dt) for v in self.speeds])
         joint = (self.velocity * cells[None, None, :]).reshape(k, k, rows, cols)
-        moved = np.empty_like(joint)
-        for a in range(k):
-            left = row_steps[a].T
-            for b in range(k):
-                moved[a, b] = left @ joint[a, b] @ col_steps[b]
-        moved = moved.reshape(k, k, n)
+        moved = np.matmul(np.matmul(row_t[:, None], joint), col[None, :]).reshape(k, k, n)
         walked_out = float(joint.sum() - moved.sum())
         jump = min(1.0 - (1.0 - self.jump_prob) ** dt, ALMOST_ONE)
         if jump:
