@@ -4,7 +4,7 @@ VENV := .venv
 VPY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: venv demo test bench reproduce faces pan-tilt models soak clean
+.PHONY: venv demo test bench reproduce faces pan-tilt walks models soak clean
 
 venv: $(STAMP)
 
@@ -53,6 +53,11 @@ faces: $(STAMP)
 # writes docs/pan_tilt.md and docs/data/pan_tilt.json.gz (10-30 minutes, and 15 for the ROS demo).
 pan-tilt: $(STAMP)
 	$(VPY) bench/pan_tilt/pan_tilt.py --ros-seeds 50
+
+# People who move (issue 38): the tracker against track-last-detection on held-out walks at 5 and
+# 15 deg/s; writes docs/walks.md (bench/pan_tilt/walks.py; about 40 minutes on two idle cores).
+walks: $(STAMP)
+	$(VPY) bench/pan_tilt/walks.py --scenes 50 --speeds 5,15
 
 # Recalibrate every shipped Haar model and retrain faces-420-infomax from their recipes on training
 # scenes, print what moved and install the new files (bench/faces/models.py; about 70 minutes).

@@ -2,6 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The walk evaluation: one clock for every searcher, the baseline's rules, the command."""
 import json
+from pathlib import Path
 import subprocess
 import sys
 
@@ -11,6 +12,7 @@ from ipomdp_gaze.vision.walks import WalkSceneSet
 import numpy as np
 import pytest
 
+ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.fixture(scope='module')
 def task():
@@ -90,6 +92,17 @@ def test_evaluate_motion_walk_writes_the_summary_per_searcher(tmp_path):
             assert key in s
     assert len(record['scenes']['track']) == 2
     assert 'in_centre minus track-last-detection' in done.stdout
+    page = tmp_path / 'walks.md'
+    made = subprocess.run([sys.executable, str(ROOT / 'bench' / 'pan_tilt' / 'walks.py'),
+                           '--cli-json', str(out), '--json', str(tmp_path / 'record.json'),
+                           '--out', str(page)], capture_output=True, text=True, timeout=300)
+    assert made.returncode == 0, made.stderr
+    text = page.read_text()
+    assert '## 10 deg/s, 2 train walks of 3 s' in text
+    for name in ('track', 'track-last-detection'):
+        row = next(line for line in text.splitlines() if line.startswith(f'| `{name}` |'))
+        assert row.count('|') == 7
+    assert 'Paired differences, `track` minus `track-last-detection`' in text
 
 
 @pytest.mark.parametrize('args, message', [
