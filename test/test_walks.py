@@ -94,3 +94,15 @@ def test_motion_calibration_of_walks_at_one_speed_matches_the_path_geometry():
     assert fit['speed_cells'] < per_s
     assert fit['exits'] >= 10 and 0 < fit['leave_prob'] < 1 and 0 < fit['return_prob'] < 1
     assert fit['velocity_sigma_cells'] < fit['sigma_cells']
+
+
+def test_the_walk_plot_is_written(tmp_path):
+    from ipomdp_gaze.vision.walks import plot_walk
+    times = np.arange(0, 5, 0.25)
+    face = np.stack([np.linspace(1, 4, times.size), np.linspace(2, 9, times.size)], axis=1)
+    face[8:10] = np.nan
+    head = np.round(face)
+    head[8:10] = (4, 5)
+    out = tmp_path / 'walk.png'
+    plot_walk(times, face, head, out, 'a walk', events=[(1.0, 'found'), (2.0, 'lost')])
+    assert out.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n' and out.stat().st_size > 5000

@@ -307,3 +307,38 @@ def _in_reach(position: np.ndarray, rows: int, cols: int) -> np.ndarray:
     r = np.floor(position[:, 0] + 0.5)
     c = np.floor(position[:, 1] + 0.5)
     return (r >= 0) & (r < rows) & (c >= 0) & (c < cols)
+
+
+def plot_walk(times_s, face_rc, head_rc, path, title: str = '', events=()) -> None:
+    """
+    Draw a walk over time: the face's row and column (grid positions) and the head's.
+
+    ``times_s`` (T,), ``face_rc`` (T, 2) grid positions (NaN rows out of reach), ``head_rc``
+    (T, 2) the head's cell per frame; ``events`` ``(t_s, name)`` pairs marked as vertical lines
+    (found, lost, reacquired). Written with matplotlib (Agg) to ``path``.
+    """
+    import matplotlib
+    matplotlib.use('Agg')
+    from matplotlib import pyplot as plt
+    times = np.asarray(times_s, dtype=float)
+    face = np.asarray(face_rc, dtype=float).reshape(-1, 2)
+    head = np.asarray(head_rc, dtype=float).reshape(-1, 2)
+    fig, axes = plt.subplots(2, 1, figsize=(8, 5), sharex=True)
+    for axis, ax, label in ((1, axes[0], 'column'), (0, axes[1], 'row')):
+        ax.plot(times, face[:, axis], color='tab:orange', label='face')
+        ax.step(times, head[:, axis], where='post', color='tab:blue', label='gaze (head cell)')
+        out = np.isnan(face[:, axis])
+        if out.any():
+            ax.fill_between(times, 0, 1, where=out, transform=ax.get_xaxis_transform(),
+                            color='0.85', label='out of reach')
+        for t, name in events:
+            ax.axvline(t, color={'lost': 'tab:red'}.get(name, 'tab:green'), lw=0.8, ls=':')
+        ax.set_ylabel(label)
+        if axis == 0:
+            ax.invert_yaxis()
+    axes[0].legend(loc='upper right', fontsize=8)
+    axes[1].set_xlabel('time (s)')
+    fig.suptitle(title or 'the face and the gaze over time', fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
