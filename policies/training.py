@@ -45,7 +45,7 @@ from ipomdp_gaze.model.observation import as_observation, CountObservation
 from ipomdp_gaze.model.stopping import BatchBelief, check_absent_prior
 from ipomdp_gaze.simulation.evaluation import (fixations_to_90_ci, fixations_to_level,
                                                tracking_summary)
-from ipomdp_gaze.simulation.simulate import simulate
+from ipomdp_gaze.simulation.simulate import rollout, simulate
 import numpy as np
 
 from .conv import ConvPolicy, kernel_from_radial, radial_bins
@@ -250,19 +250,21 @@ def sample_episodes(theta: np.ndarray, model, reward: str, episodes: int,
     delta = np.empty((horizon, episodes, n))
     rewards = np.empty((horizon, episodes))
     fixations = np.empty((horizon, episodes), dtype=np.int64)
-    for t in range(horizon):
+
+    def choose(t):
         beliefs[t] = belief
         p = softmax(belief @ theta_t)
         a = sample_rows(p, rng)
         fixations[t] = a
         np.negative(p, out=delta[t])
         delta[t, rows, a] += 1.0
-        frames = model.sample(targets, a, rng, present=present)
-        infomax = batch.update(model.log_likelihood_ratio(frames, a, validate=False))
-        rewards[t] = infomax if reward == 'infomax' else belief[rows, a]
-        if moving:
-            targets = motion.move(targets, rng)
-            batch.predict(motion)
+        return a
+
+    def record(t, a, gain, where):
+        rewards[t] = gain if reward == 'infomax' else belief[rows, a]
+
+    rollout(model, batch, targets, present, horizon, choose, lambda t: rng, record,
+            motion=motion if moving else None, steps=lambda t: rng)
     return Episodes(beliefs, delta, rewards, fixations)
 
 

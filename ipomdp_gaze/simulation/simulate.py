@@ -144,6 +144,30 @@ def check_rows(rows, episodes: int) -> tuple[int, int]:
     return start, stop
 
 
+def rollout(model, beliefs: BatchBelief, where: np.ndarray, present, horizon: int, choose,
+            noise, record, motion: Motion | None = None, steps=None, predict: bool = True,
+            move_after_last: bool = True) -> None:
+    """
+    Run the batched episode loop of :func:`simulate` and policy-gradient training.
+
+    Each fixation ``t``: ``k = choose(t)``; a frame drawn at the targets ``where`` (``present``:
+    which scenes hold one, None for all) with ``noise(t)``; the Bayes step on ``beliefs``
+    (:class:`~ipomdp_gaze.model.stopping.BatchBelief`), whose information gain
+    ``record(t, k, gain, where)`` gets with the belief after the update; then, with a
+    ``motion``, the targets step (``steps(t)``) and the belief is predicted (``predict``). After
+    the last fixation the targets step only with ``move_after_last`` (training's draw order).
+    """
+    for t in range(horizon):
+        k = choose(t)
+        frames = model.sample(where, k, noise(t), present=present)
+        gain = beliefs.update(model.log_likelihood_ratio(frames, k, validate=False))
+        record(t, k, gain, where)
+        if motion is not None and (move_after_last or t + 1 < horizon):
+            where = motion.move(where, steps(t))
+            if predict:
+                beliefs.predict(motion)
+
+
 def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | None = None,
              seed: int = 0, targets: np.ndarray | None = None, progress=None,
              motion: Motion | None = None, predict: bool = True, absent_prior: float = 0.0,
@@ -242,12 +266,13 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
     if scan and getattr(model, 'has_scan', False):
         frames = model.sample_scan(where, scan_rng, present=None if all_present else present)
         beliefs.update(model.scan_log_likelihood_ratio(frames, validate=False))
-    for t in range(horizon):
-        k = np.asarray(policy.select(belief, t, rng), dtype=np.int64)
+
+    def choose(t):
+        return np.asarray(policy.select(belief, t, rng), dtype=np.int64)
+
+    def record(t, k, gain, where):
         fixations[:, t] = k
-        frames = model.sample(where, k, noise(t),
-                              present=None if all_present else present)
-        infomax[:, t] = beliefs.update(model.log_likelihood_ratio(frames, k, validate=False))
+        infomax[:, t] = gain
         truth = where if all_present else np.where(present, where, -1)
         path[:, t] = truth
         if with_absent:
@@ -260,11 +285,11 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
             correct[:, t] = np.where(present, ~says_absent & (guess == where), says_absent)
         else:
             correct[:, t] = guess == truth
-        if moving and t + 1 < horizon:
-            where = motion.move(where, steps(t))
-            if predict:
-                beliefs.predict(motion)
         if progress is not None:
             progress(t + 1)
+
+    rollout(model, beliefs, where, None if all_present else present, horizon, choose, noise,
+            record, motion=motion if moving else None, steps=steps, predict=predict,
+            move_after_last=False)
     return SearchResult(targets, fixations, correct, map_prob, infomax, guesses, path, present,
                         absent_prob)
