@@ -260,18 +260,20 @@ def test_a_drifting_axis_is_the_shift_then_the_step(shift, sigma):
 
 @pytest.mark.parametrize('absent', [True, False])
 def test_the_walking_target_is_the_exact_filter_of_the_joint_chain(absent):
-    """Cells x velocities (+ absent), built state by state: drift, jump, turn, return."""
+    """Cells x velocities, and absent x exit cell, built state by state: drift, jump, turn, back."""
     rows, cols, classes, dt = 4, 5, 3, 0.7
     grid = Grid(rows, cols)
     n, k = grid.n_cells, classes * classes
     motion = VelocityMotion(grid, 0.4, 0.05, 0.1, 1.5, 0.2, speed_cells=1.0, classes=classes)
     rng = np.random.default_rng(1)
     motion.velocity = rng.dirichlet(np.ones(k), size=n).T.reshape(classes, classes, n)
+    motion.entry = rng.dirichlet(np.ones(n))
     prior = motion.prior.reshape(-1)
     belief = rng.dirichlet(np.ones(n + 1)) if absent else rng.dirichlet(np.ones(n))
     sigma = 0.4 * math.sqrt(dt)
     jump, turn, back = (1 - (1 - p) ** dt for p in (0.05, 0.2, 0.1))
-    chain = np.zeros((n * k + 1, n * k + 1))
+    size = n * k + n                    # (velocity, cell) states, then (absent, exit cell)
+    chain = np.zeros((size, size))
     for a in range(classes):
         for b in range(classes):
             v = a * classes + b
@@ -282,23 +284,26 @@ def test_the_walking_target_is_the_exact_filter_of_the_joint_chain(absent):
             for w in range(k):
                 stay = (1 - turn) * (v == w) + turn * prior[w]
                 chain[v * n:(v + 1) * n, w * n:(w + 1) * n] = move * stay
-            chain[v * n:(v + 1) * n, -1] = out
-    chain[-1, :-1] = back * np.repeat(prior, n) / n
-    chain[-1, -1] = 1 - back
+            chain[v * n:(v + 1) * n, n * k:] = np.diag(out)       # left where it walked out
+    for exit_cell in range(n):
+        chain[n * k + exit_cell, exit_cell::n][:k] = back * prior
+        chain[n * k + exit_cell, n * k + exit_cell] = 1 - back
     np.testing.assert_allclose(chain.sum(axis=1), 1.0)
     joint = np.append((motion.velocity.reshape(k, n) * belief[:n]).reshape(-1),
-                      belief[n] if absent else 0.0)
+                      (belief[n] if absent else 0.0) * motion.entry)
     after = joint @ chain
     log_b = np.log(belief)
     motion.predict_over(log_b, dt)
-    cells = after[:-1].reshape(k, n).sum(axis=0)
+    moving = after[:n * k].reshape(k, n)
+    cells = moving.sum(axis=0)
     if not absent:                      # no absent hypothesis: what walked out is renormalised
-        cells, after = cells / cells.sum(), after / cells.sum()
+        cells = cells / cells.sum()
     else:
-        assert np.exp(log_b[n]) == pytest.approx(after[-1], rel=1e-10)
+        gone = after[n * k:]
+        assert np.exp(log_b[n]) == pytest.approx(gone.sum(), rel=1e-10)
+        np.testing.assert_allclose(motion.entry, gone / gone.sum(), rtol=1e-9)
     np.testing.assert_allclose(np.exp(log_b[:n]), cells, rtol=1e-10)
-    np.testing.assert_allclose(motion.velocity.reshape(k, n),
-                               after[:-1].reshape(k, n) / after[:-1].reshape(k, n).sum(axis=0),
+    np.testing.assert_allclose(motion.velocity.reshape(k, n), moving / moving.sum(axis=0),
                                rtol=1e-9)
 
 

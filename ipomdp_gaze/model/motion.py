@@ -256,12 +256,11 @@ class VelocityMotion(Motion):
     of ``sigma_cells sqrt(dt)`` (:func:`axis_drift` per axis); one that walks past the grid's
     edge has left (the absent hypothesis gains its mass). It jumps as :class:`Motion` says, turns
     with probability ``1 - (1 - turn_prob)^dt`` (its velocity drawn anew from ``pi``), and an
-    absent target comes back with probability ``1 - (1 - leave_prob)^dt``, at a uniformly drawn
-    cell (as :class:`Motion`'s: entering at the border cells only drew the search policy to the
-    edges, where it missed faces that walked in and on, on training walks). The belief over
-    cells stays the session's; this object keeps ``P(k | cell)``, which the Bayes step leaves
-    alone (the detector sees where a target is, not how fast it goes), so predicting the joint
-    and summing over ``k`` is the exact filter. Without an absent hypothesis the mass that left is renormalised away.
+    absent target comes back with probability ``1 - (1 - leave_prob)^dt`` where it left: at the
+    cell it walked out from (one absent from the start: at a uniformly drawn cell). The belief
+    over cells stays the session's; this object keeps ``P(k | cell)`` and ``P(exit | absent)``,
+    which the Bayes step leaves alone (the detector sees where a target is, not how fast it goes
+    nor where an absent one left), so predicting the joint and summing it is the exact filter. Without an absent hypothesis the mass that left is renormalised away.
     """
 
     def __init__(self, grid: Grid, sigma_cells: float = 0.0, jump_prob: float = 0.0,
@@ -282,7 +281,6 @@ class VelocityMotion(Motion):
             np.exp(-0.5 * (self.speeds / self.speed_cells) ** 2)
         prior = np.outer(axis, axis)
         self.prior = prior / prior.sum()
-        self.entry = np.full(grid.n_cells, 1.0 / grid.n_cells)
         self.reset()
 
     def __repr__(self):
@@ -303,8 +301,9 @@ class VelocityMotion(Motion):
                 'classes': self.classes}
 
     def reset(self) -> None:
-        """Forget the velocities: ``P(k | cell)`` is the prior."""
+        """Forget the velocities (``P(k | cell)`` is the prior) and where targets left."""
         self.velocity = np.repeat(self.prior[:, :, None], self.grid.n_cells, axis=2)
+        self.entry = np.full(self.grid.n_cells, 1.0 / self.grid.n_cells)
 
     def velocity_mean(self, cells: np.ndarray) -> np.ndarray:
         """Return the mean velocity ``(v_row, v_col)`` in cells/s, weighted by ``cells``."""
@@ -336,7 +335,8 @@ class VelocityMotion(Motion):
         col = np.stack([axis_drift(cols, sigma, v * dt) for v in self.speeds])
         joint = (self.velocity * cells[None, None, :]).reshape(k, k, rows, cols)
         moved = np.matmul(np.matmul(row_t[:, None], joint), col[None, :]).reshape(k, k, n)
-        walked_out = float(joint.sum() - moved.sum())
+        kept = row_t.sum(axis=1)[:, None, :, None] * col.sum(axis=2)[None, :, None, :]
+        walked_out = np.maximum((joint * (1.0 - kept)).sum(axis=(0, 1)).reshape(n), 0.0)
         jump = min(1.0 - (1.0 - self.jump_prob) ** dt, ALMOST_ONE)
         if jump:
             moved = (1.0 - jump) * moved + jump * moved.sum(axis=2, keepdims=True) / n
@@ -348,7 +348,10 @@ class VelocityMotion(Motion):
             back = min(1.0 - (1.0 - self.leave_prob) ** dt, ALMOST_ONE)
             absent = math.exp(log_belief[n] - peak)
             moved += back * absent * self.prior[:, :, None] * self.entry[None, None, :]
-            gone = (1.0 - back) * absent + max(walked_out, 0.0)
+            stays = (1.0 - back) * absent * self.entry + walked_out
+            gone = float(stays.sum())
+            if update and gone > 0:
+                self.entry = stays / gone
             with np.errstate(divide='ignore'):
                 log_belief[n] = math.log(gone) + peak if gone > 0 else -np.inf
         new_cells = moved.sum(axis=(0, 1))
