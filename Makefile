@@ -4,7 +4,7 @@ VENV := .venv
 VPY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: venv demo test bench reproduce faces pan-tilt walks models soak clean
+.PHONY: venv demo test bench reproduce faces pan-tilt walks figures models soak clean
 
 venv: $(STAMP)
 
@@ -61,6 +61,13 @@ walks: $(STAMP)
 
 # Recalibrate every shipped Haar model and retrain faces-420-infomax from their recipes on training
 # scenes, print what moved and install the new files (bench/faces/models.py; about 70 minutes).
+# The figures README.md shows, each by the command its caption names (test/test_readme_figures.py
+# checks that every caption's command still draws its figure).
+figures: $(STAMP)
+	$(VENV)/bin/ipomdp-gaze search --grid 11x11 --policy elm --seed 9 --plot docs/figures/search_example.png
+	$(VENV)/bin/ipomdp-gaze demo --scene faces --seed 0 --plot docs/figures/annotated_camera.png
+	$(VENV)/bin/ipomdp-gaze demo --scene faces --fovea --seed 0 --plot docs/figures/annotated_fovea.png
+
 models: $(STAMP)
 	$(VPY) bench/faces/models.py --install
 

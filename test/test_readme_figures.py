@@ -1,0 +1,70 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Every figure README.md shows is drawn by the command its caption names (issue 35, item 3).
+
+Each ``![...](docs/figures/NAME.png)`` of the README must have one caption command, a backticked
+``ipomdp-gaze ... --plot docs/figures/NAME.png``; ``make figures`` must run exactly those
+commands; and each command, run here with its plot sent to a temporary file, must still draw a
+PNG of the committed figure's size (the demos' over real DDS).
+"""
+import os
+from pathlib import Path
+import re
+import subprocess
+import sys
+
+import cv2
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+FIGURE = re.compile(r'!\[[^\]]*\]\((docs/figures/[\w.-]+\.png)\)')
+COMMAND = re.compile(r'`(ipomdp-gaze [^`]*?--plot\s+(docs/figures/[\w.-]+\.png))`')
+
+
+def readme_figures() -> dict:
+    """Return ``{figure path: caption command}`` (whitespace in a command made single)."""
+    text = (ROOT / 'README.md').read_text()
+    commands = {}
+    for match in COMMAND.finditer(text):
+        commands.setdefault(match.group(2), []).append(' '.join(match.group(1).split()))
+    return {figure: commands.get(figure, []) for figure in FIGURE.findall(text)}
+
+
+def make_figures_commands() -> list:
+    """Return the commands of the Makefile's ``figures`` target, as a user would type them."""
+    lines = (ROOT / 'Makefile').read_text().split('\nfigures:', 1)[1].split('\n\n', 1)[0]
+    return [line.strip().replace('$(VENV)/bin/ipomdp-gaze', 'ipomdp-gaze')
+            for line in lines.splitlines()[1:] if line.startswith('\t')]
+
+
+def test_every_readme_figure_has_one_command_and_make_figures_runs_them():
+    figures = readme_figures()
+    assert figures, 'README.md shows no figure'
+    for figure, commands in figures.items():
+        assert len(commands) == 1, f'{figure}: caption commands {commands}'
+    assert sorted(make_figures_commands()) == sorted(c[0] for c in figures.values())
+
+
+def _params():
+    out = []
+    for figure, commands in sorted(readme_figures().items()):
+        marks = [pytest.mark.ros] if commands and ' demo ' in f' {commands[0]} ' else []
+        out.append(pytest.param(figure, commands[0] if commands else '', marks=marks,
+                                id=Path(figure).stem))
+    return out
+
+
+@pytest.mark.parametrize('figure, command', _params())
+def test_a_readme_figure_command_still_draws_it(figure, command, tmp_path, request):
+    env = dict(os.environ)
+    if request.node.get_closest_marker('ros'):
+        env.update(request.getfixturevalue('ros_env'))
+    out = tmp_path / Path(figure).name
+    argv = command.replace(figure, str(out)).split()[1:]
+    done = subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', *argv], cwd=tmp_path,
+                          env=env, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stdout + done.stderr
+    drawn, shipped = cv2.imread(str(out)), cv2.imread(str(ROOT / figure))
+    assert drawn is not None, f'{command} drew nothing at {out}'
+    assert drawn.shape == shipped.shape
