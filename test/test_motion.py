@@ -260,7 +260,7 @@ def test_a_drifting_axis_is_the_shift_then_the_step(shift, sigma):
 
 @pytest.mark.parametrize('absent', [True, False])
 def test_the_walking_target_is_the_exact_filter_of_the_joint_chain(absent):
-    """Cells x velocities, and absent x exit cell, built state by state: drift, jump, turn, back."""
+    """Cells x velocities and absent x exit cell, state by state: drift, jump, turn, back."""
     rows, cols, classes, dt = 4, 5, 3, 0.7
     grid = Grid(rows, cols)
     n, k = grid.n_cells, classes * classes

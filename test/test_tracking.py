@@ -14,6 +14,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 
+
 @pytest.fixture(scope='module')
 def task():
     spec = tracking.walk_spec(10.0, 'train', 0, 4.0)

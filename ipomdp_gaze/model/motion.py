@@ -260,7 +260,8 @@ class VelocityMotion(Motion):
     cell it walked out from (one absent from the start: at a uniformly drawn cell). The belief
     over cells stays the session's; this object keeps ``P(k | cell)`` and ``P(exit | absent)``,
     which the Bayes step leaves alone (the detector sees where a target is, not how fast it goes
-    nor where an absent one left), so predicting the joint and summing it is the exact filter. Without an absent hypothesis the mass that left is renormalised away.
+    nor where an absent one left), so predicting the joint and summing it is the exact filter.
+    Without an absent hypothesis the mass that left is renormalised away.
     """
 
     def __init__(self, grid: Grid, sigma_cells: float = 0.0, jump_prob: float = 0.0,
