@@ -133,3 +133,22 @@ def test_a_periodic_recheck_searches_again_and_finds_nobody_new(rig, probe):
 def test_settings_the_many_target_mode_does_not_model_are_refused(rig, probe, params, words):
     result = probe.set_parameters(NODE, params)[0]
     assert not result.successful and words in result.reason, result.reason
+
+
+def test_search_targets_changes_at_run_time_and_starts_a_new_search(rig, probe):
+    """One target: the paper's search (its found event has the config's radius), no room."""
+    from diagnostic_msgs.msg import DiagnosticStatus
+    from ipomdp_gaze.msg_adapters import diagnostics
+    found = probe.record(DiagnosticStatus, 'found', 10)
+    last = _done(rig, 3)
+    assert wait_for(lambda: probe.matched('found') > 0, 20)
+    n, rooms = len(rig['cells']), len(rig['done'])
+    assert probe.set_parameters(NODE, {'search.targets': 'one'})[0].successful
+    assert wait_for(lambda: len(rig['cells']) > n, 20)
+    assert _people(rig) == []                              # the people forgotten
+    assert wait_for(lambda: any(diagnostics.parse_found(m)['radius'] == 1 for _, m in found),
+                    SEARCH_S), rig['controller'].output()[-3000:]
+    assert len(rig['done']) == rooms                       # one target: no room_done
+    assert probe.set_parameters(NODE, {'search.targets': 'many'})[0].successful
+    done = _done(rig, rooms + 1)
+    assert done['search_id'] > last['search_id'] and done['people'] == 2, done

@@ -163,10 +163,8 @@ class GazeControllerNode(Node):
         self._event_pubs = {name: self.create_publisher(DiagnosticStatus, name, 10)
                             for name in ('found', 'absent', 'gave_up')}
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
-        # Many targets: the people of the room (latched) and the room_done event.
-        self._targets_pub = self.create_publisher(PoseArray, '~/targets', STATE_QOS)
-        self._cells_pub = self.create_publisher(Float32MultiArray, '~/target_cells', STATE_QOS)
-        self._event_pubs['room_done'] = self.create_publisher(DiagnosticStatus, 'room_done', 10)
+        self._targets_pub = self._cells_pub = None
+        self._make_room_publishers()
         self._room = RoomWatch(cfg.grid)
         self._dwell_timer = self._recheck_timer = None
         self._forward_pub = self._trajectory_pub = None
@@ -325,6 +323,7 @@ class GazeControllerNode(Node):
         if (v['retry_period_s'], v['diagnostics_period_s']) != \
                 (ov['retry_period_s'], ov['diagnostics_period_s']):
             self._make_timers(v)
+        self._make_room_publishers()
         if v['absent.prior'] != ov['absent.prior'] or \
                 v['search.targets'] != ov['search.targets']:
             return f'policy {cfg.policy_label}; {self._restart()}'
@@ -335,6 +334,19 @@ class GazeControllerNode(Node):
         if cfg.head != old.head and core.enabled and not core.stopped:
             self._send_target()
         return f'policy {cfg.policy_label}'
+
+    def _make_room_publishers(self) -> None:
+        """
+        With many targets, advertise the people (latched) and room_done; once, kept after.
+
+        Created before the first search ends, so that a subscriber has matched the volatile
+        room_done by then; one target advertises none of them.
+        """
+        if not self._many or self._targets_pub is not None:
+            return
+        self._targets_pub = self.create_publisher(PoseArray, '~/targets', STATE_QOS)
+        self._cells_pub = self.create_publisher(Float32MultiArray, '~/target_cells', STATE_QOS)
+        self._event_pubs['room_done'] = self.create_publisher(DiagnosticStatus, 'room_done', 10)
 
     def _make_command_publishers(self, values: dict) -> None:
         for pub in (self._forward_pub, self._trajectory_pub):
@@ -603,7 +615,8 @@ class GazeControllerNode(Node):
             self._room.recheck()
         elif self._room.people or self._room.rooms_done:
             self._room.forget()
-            self._publish_people()
+            if self._targets_pub is not None:
+                self._publish_people()
         cell = self.core.reset(self._now_s())
         self._publish_belief()
         row, col = self._config.grid.cell(cell)
