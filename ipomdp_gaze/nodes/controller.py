@@ -28,6 +28,13 @@ target is sent until ``~/reset``. With ``motion.sigma_cells`` or ``motion.jump_p
 second), the belief is predicted over the time between frames and the controller keeps tracking
 after ``found`` (docs/design.md section 7).
 
+With ``search.targets: many`` (docs/design.md section 11.6) the core runs the occupancy belief
+and the node also publishes ``~/targets`` (``geometry_msgs/PoseArray``, the head direction of
+each person found) and ``~/target_cells`` (``Float32MultiArray``, ``[row, col, cell,
+probability]`` per person), both transient local, and the ``room_done`` event; then it keeps
+the people in view in turn, ``room.dwell_s`` each, until ``~/reset`` or the re-check every
+``room.recheck_period_s`` (:class:`ipomdp_gaze.search.room.RoomWatch`).
+
 Run with ``ros2 run ipomdp_gaze controller`` (or ``ipomdp-gaze controller``) and the usual
 ``--ros-args``.
 """
