@@ -3,7 +3,8 @@
 """
 Many-target mode over DDS: a room of two faces found, kept in view in turn, searched again.
 
-Three processes on the shipped pan/tilt face configuration (``config/faces_camera_*.yaml``): the
+Three processes on the shipped pan/tilt face configuration (``config/faces_camera_*.yaml``,
+the controller's with ``faces_camera_room_controller.yaml`` after it): the
 scene camera shows held-out room 0 of two faces (``scene.faces '2'``), the detector bins its
 detections to cells, and the controller runs ``search.targets many`` with the rooms' settings
 (docs/design.md section 11.5). The controller publishes both people on ``~/targets`` (their head
@@ -20,8 +21,6 @@ pytestmark = pytest.mark.ros
 
 NODE = 'gaze_controller'
 SEED = 0
-ROOM = ['-p', 'search.targets:=many', '-p', 'search.false_alarm_scales:=[1.0]',
-        '-p', 'search.hotspot_prior:=0.0', '-p', 'search.repeat_weight:=0.1']
 SEARCH_S = 240.0        # a generous limit for one search on a loaded machine, not a measure
 
 
@@ -44,7 +43,8 @@ def rig(probe, nodes):
            'done': probe.record(DiagnosticStatus, 'room_done', 10),
            'pan_tilt': probe.record(JointState, 'pan_tilt', LATCHED, distinct_stamps=True)}
     rec['controller'] = nodes.start('controller', [
-        '--params-file', config_path('faces_camera_controller.yaml'), *ROOM,
+        '--params-file', config_path('faces_camera_controller.yaml'),
+        '--params-file', config_path('faces_camera_room_controller.yaml'),
         '-p', 'room.dwell_s:=0.3', '-p', 'room.recheck_period_s:=0.0'])
     assert wait_for(lambda: rec['pan_tilt'], 60), rec['controller'].output()
     nodes.start('detector', ['--params-file', config_path('faces_camera_detector.yaml')])

@@ -4,8 +4,9 @@
 The controller in many-target mode over DDS on held-out rooms of 0-4 faces, against offline.
 
 For each seed: the scene camera's held-out room of that seed (``scene.faces '0-4'``), the
-detector and the controller (``config/faces_camera_*.yaml`` with ``search.targets many`` and the
-rooms' settings, docs/design.md section 11.5) as three fresh processes. Recorded: the people the
+detector and the controller (``config/faces_camera_*.yaml``, the controller's with
+``faces_camera_room_controller.yaml``: ``search.targets many`` and the rooms' settings,
+docs/design.md section 11.5) as three fresh processes. Recorded: the people the
 node publishes on ``~/target_cells`` with its ``room_done``, the seconds from starting the scene
 camera to ``room_done``, and whether the people are the offline many-target session's on the
 same room (``drivers.rooms.room_session``, ``many-cells``: one face per cluster, no boxes, as
@@ -27,8 +28,6 @@ import numpy as np
 TITLE = 'Many-target mode over DDS: rooms of 0-4 faces, the node against the offline session'
 ORDER = 63
 FACES = '0-4'
-ROOM = ['-p', 'search.targets:=many', '-p', 'search.false_alarm_scales:=[1.0]',
-        '-p', 'search.hotspot_prior:=0.0', '-p', 'search.repeat_weight:=0.1']
 TIMEOUT_S = 240.0
 
 
@@ -54,8 +53,9 @@ def run_room(seed: int) -> dict:
         with Watch(domain, 'bench_room', nodes) as watch:
             cells = watch.record(Float32MultiArray, '/gaze_controller/target_cells', LATCHED)
             done = watch.record(DiagnosticStatus, 'room_done', 10)
-            nodes.start('controller', ['--params-file',
-                                       str(config_file('faces_camera_controller.yaml')), *ROOM])
+            nodes.start('controller', [
+                '--params-file', str(config_file('faces_camera_controller.yaml')),
+                '--params-file', str(config_file('faces_camera_room_controller.yaml'))])
             if not watch.wait_until(lambda: watch.matched('room_done') > 0, 60):
                 raise RuntimeError('the controller did not come up')
             nodes.start('detector', ['--params-file',
