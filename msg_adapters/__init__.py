@@ -13,7 +13,9 @@ joints
 images
     The colour-mapped belief heatmap (``rgb8``) and ``32FC1`` evidence images.
 diagnostics
-    ``/diagnostics`` status and the ``found`` event.
+    ``/diagnostics`` status and the search events (``found``, ``room_done``, ...).
+people
+    The people of a room (many-target mode): ``PoseArray`` head directions and their cells.
 stamps
     ``builtin_interfaces/Time`` <-> seconds.
 

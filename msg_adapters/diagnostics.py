@@ -20,6 +20,7 @@ LEVELS = {'ok': DiagnosticStatus.OK, 'warn': DiagnosticStatus.WARN,
 FOUND_KEYS = ('row', 'col', 'cell', 'pan_rad', 'tilt_rad', 'probability', 'fixations')
 ABSENT_KEYS = ('probability', 'fixations')
 GAVE_UP_KEYS = ('fixations',)
+ROOM_DONE_KEYS = ('people', 'new_people', 'fixations', 'search_id')
 
 
 def _text(value) -> str:
@@ -101,6 +102,25 @@ def gave_up_status(name: str, fixations: int) -> DiagnosticStatus:
                   {'fixations': fixations})
 
 
+def room_done_status(name: str, people: int, new_people: int, fixations: int, search_id: int,
+                     recheck: bool, forced_by: str = '',
+                     confidence: float | None = None) -> DiagnosticStatus:
+    """
+    Build the ``room_done`` event of many-target mode: every cell decided, everyone found.
+
+    ``people`` found, ``new_people`` among them (not within a cell of anyone known before;
+    all of them after ``~/reset``), ``recheck`` whether the search was a periodic re-check;
+    ``ended`` and ``confidence`` as for ``found``.
+    """
+    clause, ending = _ending(forced_by, confidence)
+    kind = 're-check' if recheck else 'search'
+    message = (f'room done: {people} people found ({new_people} new) by {kind} {search_id} '
+               f'after {fixations} fixations{clause}')
+    return status(name, 'ok', message, {
+        'people': int(people), 'new_people': int(new_people), 'fixations': int(fixations),
+        'search_id': int(search_id), 'recheck': bool(recheck), **ending})
+
+
 def _parse(msg: DiagnosticStatus, event: str, keys, ints) -> dict:
     kv = values_of(msg)
     missing = [k for k in keys if k not in kv]
@@ -143,3 +163,10 @@ def parse_absent(msg: DiagnosticStatus) -> dict:
 def parse_gave_up(msg: DiagnosticStatus) -> dict:
     """Read a ``gave_up`` event (fixations as int); ValueError if bad."""
     return _parse(msg, 'gave_up', GAVE_UP_KEYS, ('fixations',))
+
+
+def parse_room_done(msg: DiagnosticStatus) -> dict:
+    """Read a ``room_done`` event (counts as int, ``recheck`` as bool); ValueError if bad."""
+    values = _with_ending(msg, _parse(msg, 'room_done', ROOM_DONE_KEYS, ROOM_DONE_KEYS))
+    values['recheck'] = values_of(msg).get('recheck') == 'true'
+    return values

@@ -36,6 +36,7 @@ def _flat(tree, prefix=''):
     ('camera.yaml', 'simulated_camera', 'camera', 'camera_params'),
     ('faces_camera_controller.yaml', 'gaze_controller', 'controller', 'controller_params'),
     ('faces_fovea_controller.yaml', 'gaze_controller', 'controller', 'controller_params'),
+    ('faces_camera_room_controller.yaml', 'gaze_controller', 'controller', 'controller_params'),
     ('faces_camera_detector.yaml', 'foveal_detector', 'detector', 'detector_params'),
     ('faces_fovea_detector.yaml', 'foveal_detector', 'detector', 'detector_params'),
     ('faces_camera_scene_camera.yaml', 'scene_camera', 'scene_camera', 'scene_camera_params'),

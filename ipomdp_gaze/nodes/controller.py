@@ -28,6 +28,13 @@ target is sent until ``~/reset``. With ``motion.sigma_cells`` or ``motion.jump_p
 second), the belief is predicted over the time between frames and the controller keeps tracking
 after ``found`` (docs/design.md section 7).
 
+With ``search.targets: many`` (docs/design.md section 11.6) the core runs the occupancy belief
+and the node also publishes ``~/targets`` (``geometry_msgs/PoseArray``, the head direction of
+each person found) and ``~/target_cells`` (``Float32MultiArray``, ``[row, col, cell,
+probability]`` per person), both transient local, and the ``room_done`` event; then it keeps
+the people in view in turn, ``room.dwell_s`` each, until ``~/reset`` or the re-check every
+``room.recheck_period_s`` (:class:`ipomdp_gaze.search.room.RoomWatch`).
+
 Run with ``ros2 run ipomdp_gaze controller`` (or ``ipomdp-gaze controller``) and the usual
 ``--ros-args``.
 """
@@ -36,9 +43,10 @@ from __future__ import annotations
 import sys
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from geometry_msgs.msg import PoseArray
 from ipomdp_gaze.model.belief import EvidenceError
 from ipomdp_gaze.model.head_time import SETTLE_TIME_S
-from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, stamps
+from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, people, stamps
 from ipomdp_gaze.policies.baselines import STRATEGIES
 from ipomdp_gaze.policies.conv import ACTIONS, check_kernel
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnavailable
@@ -47,6 +55,7 @@ from ipomdp_gaze.search.controller_config import (build_config, ControllerConfig
                                                   grid_from)
 from ipomdp_gaze.search.gaze import FrameSequence
 from ipomdp_gaze.search.health import HealthMonitor
+from ipomdp_gaze.search.room import MAX_PERIOD_S, RoomWatch
 from rclpy.exceptions import NameValidationException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -70,6 +79,8 @@ WARN_THROTTLE_S = 5.0
 # belief_image is at most this many pixels on a side (256x256 cells at 32 px would be 201 MB).
 MAX_IMAGE_SIDE_PX = 1024
 OBSERVATION_MODELS = ('gaussian', 'counts')
+# Many targets: occupied cells within this many cells (Chebyshev) are one person (the rooms').
+FACE_LINK = 2
 
 
 def controller_params() -> list[Param]:
@@ -98,6 +109,15 @@ def controller_params() -> list[Param]:
               'frames kept for the node per evidence topic; 1: the newest frame wins '
               '(read-only)', read_only=True, int_range=(1, 1000)),
     ] + search_params() + [
+        Param('room.dwell_s', 2.0, T.DOUBLE,
+              'search.targets many: seconds each person found is kept in view, in turn',
+              float_range=(0.01, MAX_PERIOD_S)),
+        Param('room.recheck_period_s', 60.0, T.DOUBLE,
+              'search.targets many: search the room again this often while keeping people in '
+              'view, at least room.dwell_s (0: never)', float_range=(0.0, MAX_PERIOD_S)),
+        Param('room.frame_id', 'pan_tilt_base', T.STRING,
+              'search.targets many: frame_id of ~/targets, the frame the head pans (z) and tilts '
+              '(y) in'),
         Param('policy.name', 'elm', T.STRING, 'fixation policy', choices=POLICY_NAMES),
         Param('policy.file', '', T.STRING,
               'policy YAML path or shipped kernel name; setting it selects learned'),
@@ -150,6 +170,10 @@ class GazeControllerNode(Node):
         self._event_pubs = {name: self.create_publisher(DiagnosticStatus, name, 10)
                             for name in ('found', 'absent', 'gave_up')}
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
+        self._targets_pub = self._cells_pub = None
+        self._make_room_publishers()
+        self._room = RoomWatch(cfg.grid)
+        self._dwell_timer = self._recheck_timer = None
         self._forward_pub = self._trajectory_pub = None
         self._make_command_publishers(v)
         evidence_qos = QoSProfile(history=HistoryPolicy.KEEP_LAST,
@@ -190,8 +214,18 @@ class GazeControllerNode(Node):
         ior = ', inhibition of return' if v['search.inhibit_return'] else ''
         if v['search.repeat_weight'] < 1.0:
             ior += f", repeated views weighted {v['search.repeat_weight']}"
+        if self._many:
+            recheck = v['room.recheck_period_s']
+            motion = ('many targets (an occupancy per cell), each kept in view '
+                      f"{v['room.dwell_s']} s in turn, re-checked "
+                      f"{f'every {recheck} s' if recheck else 'never'}")
         return (f"{motion}, absent prior {v['absent.prior']}, confidence {v['confidence']}, "
                 f'{budget} fixation budget{ior}')
+
+    @property
+    def _many(self) -> bool:
+        """Whether the controller searches for many targets (``search.targets: many``)."""
+        return self._config.values['search.targets'] == 'many'
 
     @property
     def _config(self) -> Config:
@@ -296,11 +330,30 @@ class GazeControllerNode(Node):
         if (v['retry_period_s'], v['diagnostics_period_s']) != \
                 (ov['retry_period_s'], ov['diagnostics_period_s']):
             self._make_timers(v)
-        if v['absent.prior'] != ov['absent.prior']:
+        self._make_room_publishers()
+        if v['absent.prior'] != ov['absent.prior'] or \
+                v['search.targets'] != ov['search.targets']:
             return f'policy {cfg.policy_label}; {self._restart()}'
+        if self._dwell_timer is not None and \
+                (v['room.dwell_s'], v['room.recheck_period_s']) != \
+                (ov['room.dwell_s'], ov['room.recheck_period_s']):
+            self._make_room_timers(v)
         if cfg.head != old.head and core.enabled and not core.stopped:
             self._send_target()
         return f'policy {cfg.policy_label}'
+
+    def _make_room_publishers(self) -> None:
+        """
+        With many targets, advertise the people (latched) and room_done; once, kept after.
+
+        Created before the first search ends, so that a subscriber has matched the volatile
+        room_done by then; one target advertises none of them.
+        """
+        if not self._many or self._targets_pub is not None:
+            return
+        self._targets_pub = self.create_publisher(PoseArray, '~/targets', STATE_QOS)
+        self._cells_pub = self.create_publisher(Float32MultiArray, '~/target_cells', STATE_QOS)
+        self._event_pubs['room_done'] = self.create_publisher(DiagnosticStatus, 'room_done', 10)
 
     def _make_command_publishers(self, values: dict) -> None:
         for pub in (self._forward_pub, self._trajectory_pub):
@@ -346,12 +399,14 @@ class GazeControllerNode(Node):
         self._pan_tilt_msg = joints.joint_state(head, cell, now.to_msg())
         self._publish_target()
 
-    def _publish_target(self) -> None:
-        head, cell = self._config.head, self.core.fixation
+    def _publish_target(self, person: int | None = None) -> None:
+        """Publish the head's target: the search's fixation, or a person in view (``person``)."""
+        head, cell = self._config.head, self.core.fixation if person is None else person
         self._pan_tilt_pub.publish(self._pan_tilt_msg)
         core = self.core
         self._fixation_pub.publish(grid_arrays.fixation(
-            self._config.grid, None if core.scanning else cell, core.search_id))
+            self._config.grid, None if core.scanning and person is None else cell,
+            core.search_id))
         if self._forward_pub is not None:
             self._forward_pub.publish(joints.forward_command(head, cell))
         if self._trajectory_pub is not None:
@@ -373,6 +428,14 @@ class GazeControllerNode(Node):
                 belief, grid, self.core.fixation, self._image_scale_px(),
                 self._now().to_msg()))
 
+    def _publish_people(self, found=()) -> None:
+        """Publish the people of the room on ``~/targets`` and ``~/target_cells``."""
+        cfg = self._config
+        self._targets_pub.publish(people.people_poses(
+            cfg.head, [p.cell for p in found], self._now().to_msg(), cfg.values['room.frame_id']))
+        self._cells_pub.publish(people.people_array(
+            cfg.grid, [(p.cell, p.probability) for p in found]))
+
     def _image_scale_px(self) -> int:
         """Pixels per cell of belief_image: as set, but the image fits MAX_IMAGE_SIDE_PX."""
         grid = self._config.grid
@@ -382,7 +445,8 @@ class GazeControllerNode(Node):
     def _publish_events(self, result) -> None:
         """Publish and log the events a frame fired (found, absent, gave_up)."""
         name = self.get_fully_qualified_name()
-        ending = '' if not self.core.stopped else '; the search has ended until ~/reset'
+        ending = '' if not self.core.stopped or self._many else \
+            '; the search has ended until ~/reset'
         confidence = self.core.settings.confidence
         if result.found is not None:
             found = result.found
@@ -391,7 +455,8 @@ class GazeControllerNode(Node):
             self._event_pubs['found'].publish(diagnostics.found_status(
                 f'{name}: found', row, col, found.cell, pan, tilt, found.probability,
                 found.fixations, found.forced_by, confidence,
-                0 if self.core.settings.moving else self.core.settings.found_radius))
+                0 if self.core.settings.moving or self._many else
+                self.core.settings.found_radius))
             clause = answer.confidence_clause('found', found.forced_by, found.probability,
                                               confidence)
             self.get_logger().info(
@@ -483,9 +548,82 @@ class GazeControllerNode(Node):
             self._send_target()         # first: the head can start moving while we report
         self._publish_belief()
         self._publish_events(result)
+        if self._many and self.core.stopped:
+            self._room_finished()
 
-    def _restart(self) -> str:
-        """Start a new search (``~/reset``); return what happened."""
+    # -- many targets: the room -------------------------------------------------------------
+    def _room_finished(self) -> None:
+        """
+        Publish the people and room_done of a finished many-target search; keep them in view.
+
+        ``room_done`` is published when every cell was decided (``found`` or ``absent``, also
+        when the fixation budget forced it with ``search.decide_at_budget``); after ``gave_up``
+        the people are those whose cells reached the confidence.
+        """
+        core, grid = self.core, self._config.grid
+        session = core.session
+        done = self._room.done(session.faces(link=FACE_LINK))
+        self._publish_people(done.people)
+        kind = 're-check' if done.recheck else 'search'
+        where = ', '.join(f'{grid.cell(p.cell)} p={p.probability:.3f}' for p in done.people)
+        if core.decision in ('found', 'absent'):
+            self._event_pubs['room_done'].publish(diagnostics.room_done_status(
+                f'{self.get_fully_qualified_name()}: room_done', len(done.people),
+                len(done.new), core.fixations, core.search_id, done.recheck,
+                session.gave_up_reason, core.settings.confidence))
+        self.get_logger().info(
+            f'room done ({kind} {core.search_id}, {core.decision}'
+            f"{f', forced by {session.gave_up_reason}' if session.gave_up_reason else ''}): "
+            f'{len(done.people)} people ({len(done.new)} new){": " + where if where else ""}')
+        self._make_room_timers(self._config.values)
+        self._on_dwell()
+
+    def _make_room_timers(self, values: dict) -> None:
+        """Start (again) the turn of the people in view and the periodic re-check."""
+        self._stop_room_timers()
+        self._dwell_timer = self.create_timer(values['room.dwell_s'],
+                                              self.guard.wrap(self._on_dwell))
+        if values['room.recheck_period_s'] > 0:
+            self._recheck_timer = self.create_timer(values['room.recheck_period_s'],
+                                                    self.guard.wrap(self._on_recheck))
+
+    def _stop_room_timers(self) -> None:
+        for timer in (self._dwell_timer, self._recheck_timer):
+            if timer is not None:
+                self.destroy_timer(timer)
+        self._dwell_timer = self._recheck_timer = None
+
+    def _on_dwell(self) -> None:
+        """Look at the next person found (nothing while disabled or with nobody found)."""
+        if not self.core.enabled:
+            return
+        person = self._room.next_person()
+        if person is None:
+            return
+        self._pan_tilt_msg = joints.joint_state(self._config.head, person.cell,
+                                                self._now().to_msg())
+        self._publish_target(person.cell)
+
+    def _on_recheck(self) -> None:
+        """Search the room again; its people replace the list (those not known are new)."""
+        if not self.core.enabled:
+            return
+        self.get_logger().info(f're-check of the room: {self._restart(recheck=True)}')
+
+    def _restart(self, recheck: bool = False) -> str:
+        """
+        Start a new search (``~/reset``, a re-check); return what happened.
+
+        Many targets: a re-check keeps the people known (to tell who is new) and their list on
+        ``~/targets`` until it ends; any other new search forgets them and publishes nobody.
+        """
+        self._stop_room_timers()
+        if recheck:
+            self._room.recheck()
+        elif self._room.people or self._room.rooms_done:
+            self._room.forget()
+            if self._targets_pub is not None:
+                self._publish_people()
         cell = self.core.reset(self._now_s())
         self._publish_belief()
         row, col = self._config.grid.cell(cell)

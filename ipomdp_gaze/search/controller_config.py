@@ -27,6 +27,8 @@ from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.model.observation import GaussianObservation
 from ipomdp_gaze.search.gaze import check_settle_time, GazeController
 from ipomdp_gaze.search.health import policy_label
+from ipomdp_gaze.search.many import check_many_settings
+from ipomdp_gaze.search.room import check_room_times
 from ipomdp_gaze.search.session import SearchSettings
 
 POLICY_KEYS = ('policy.name', 'policy.file', 'policy.kernel', 'policy.action')
@@ -175,6 +177,10 @@ def build_config(values: Mapping, build_policy: Callable, changed=None,
         head = head_from(values, grid)
         row_col_from(values, grid, 'start_row', 'start_col')
         settings = SearchSettings.from_parameters(values, grid=grid)
+        if settings.targets == 'many':
+            check_many_settings(settings)
+        if 'room.dwell_s' in values:
+            check_room_times(values['room.dwell_s'], values['room.recheck_period_s'])
         check_settle_time(values['settle_time_s'])
         warnings = []
         policy_changed = changed is None or any(k in changed for k in POLICY_KEYS) or any(

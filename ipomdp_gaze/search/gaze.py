@@ -43,8 +43,12 @@ from dataclasses import dataclass
 
 from ipomdp_gaze.model.belief import EvidenceError
 from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.search.many import OccupancySession
 from ipomdp_gaze.search.session import SearchSession, SearchSettings, session_view
 import numpy as np
+
+# Many targets: cells within this many cells of an occupied one are settled (the rooms' link).
+ROOM_LINK = 1
 
 
 def check_settle_time(settle_time_s: float) -> float:
@@ -117,6 +121,22 @@ class FrameResult:
         return self.status == 'applied'
 
 
+def make_session(grid: Grid, observation, policy, settings: SearchSettings):
+    """
+    Return a new search session of the belief ``settings.targets`` names.
+
+    ``one``: :class:`ipomdp_gaze.search.session.SearchSession` (the paper's belief); ``many``:
+    :class:`ipomdp_gaze.search.many.OccupancySession` with ``link`` :data:`ROOM_LINK`
+    (docs/design.md section 11.6), whose ``policy`` is kept but not used.
+    """
+    if settings.targets == 'many':
+        session = OccupancySession(grid, observation, settings, link=ROOM_LINK, log_size=1000)
+        session.set_policy(policy)
+    else:
+        session = SearchSession(grid, observation, policy, settings, log_size=1000)
+    return session
+
+
 class FrameSequence:
     """
     Frames lost on the way to the node, from the publisher's sequence numbers (1, 2, 3, ...).
@@ -173,8 +193,7 @@ class GazeController:
     def __init__(self, grid: Grid, observation, policy, settings: SearchSettings | None = None,
                  settle_time_s: float = 0.0, seed: int = 0):
         self.grid = grid
-        self.session = SearchSession(grid, observation, policy, settings or SearchSettings(),
-                                     log_size=1000)
+        self.session = make_session(grid, observation, policy, settings or SearchSettings())
         self.settle_time_s = check_settle_time(settle_time_s)
         self.session.reset(seed=seed)
         self.search_id = 0
@@ -198,10 +217,17 @@ class GazeController:
         """
         Use new settings from the next frame on; the search under way keeps its belief.
 
-        A new ``absent_prior`` or start cell applies from the next :meth:`reset`.
+        A new ``absent_prior`` or start cell applies from the next :meth:`reset`; a new
+        ``targets`` changes the belief, so a new search starts at once (:meth:`reset`).
         """
         if settle_time_s is not None:
             self.settle_time_s = check_settle_time(settle_time_s)
+        if settings.targets != self.settings.targets:
+            rng = self.session.rng
+            self.session = make_session(self.grid, self.observation, self.policy, settings)
+            self.session.reset(seed=rng)
+            self.reset(self.target_time_s)
+            return
         self.session.configure(settings)
 
     def set_observation(self, observation) -> None:

@@ -36,6 +36,7 @@ from __future__ import annotations
 from collections import deque
 
 from ipomdp_gaze.model.belief import argmax_ties_low, EvidenceError
+from ipomdp_gaze.model.motion import Motion
 from ipomdp_gaze.model.observation import as_observation, check_evidence, CountObservation
 from ipomdp_gaze.model.occupancy import (binary_entropy, cell_prior, count_faces, decided,
                                          information_table, log_nobody, occupancy,
@@ -110,6 +111,39 @@ class OccupancySession:
         self._log = deque(maxlen=int(log_size))
         self.rng = np.random.default_rng(0)
         self._state = None
+
+    # -- configuration -------------------------------------------------------------------
+    @property
+    def motion(self) -> Motion:
+        """Return the targets' motion: none (the occupancy belief models still targets)."""
+        return Motion(self.grid, 0.0, 0.0)
+
+    def configure(self, settings: SearchSettings) -> None:
+        """
+        Use new settings from the next frame on, keeping the belief of the search under way.
+
+        A new ``absent_prior`` applies from the next :meth:`reset`.
+
+        Raises
+        ------
+        ValueError
+            For settings the occupancy belief does not model (:func:`check_many_settings`).
+
+        """
+        settings.check_grid(self.grid)
+        check_many_settings(settings)
+        self.settings = settings
+
+    def set_observation(self, observation) -> None:
+        """Assume another observation model (or FPOC) from the next frame on."""
+        self.observation = as_observation(self.grid, observation)
+        self.table = information_table(self.observation)
+        self._view_info = self.table.view_information
+        self._counts = isinstance(self.observation, CountObservation)
+
+    def set_policy(self, policy) -> None:
+        """Keep ``policy`` for the record: the occupancy search chooses by its own infomax."""
+        self.policy = policy
 
     # -- read-only views -----------------------------------------------------------------
     def _s(self) -> dict:
@@ -198,6 +232,10 @@ class OccupancySession:
         if self._counts:
             self.observation.counts(obs)
         return obs
+
+    def checked_frame(self, values, kind: str = 'fixation') -> Frame:
+        """Return ``Frame(values, kind)`` checked once (:meth:`check_frame`; EvidenceError)."""
+        return Frame(self.check_frame(values), kind=kind)
 
     def scan(self, frame: Frame) -> StepResult:
         """Apply the one-time scan: ``L_j += log s_T(c_j) - log s_N(c_j)`` (once, first)."""

@@ -161,7 +161,8 @@ SCHEMA: tuple[Setting, ...] = (
             bounds='> 1', metavar='F'),
     Setting('targets', 'search.targets', 'str', 'one', check_targets,
             "the belief: one target or none (the paper's) or many (an occupancy per cell, "
-            'ipomdp_gaze.many; the gaze_controller node searches one)', bounds='one or many',
+            'ipomdp_gaze.many; the gaze_controller node then keeps the people found in view, '
+            'docs/design.md section 11.6)', bounds='one or many',
             metavar='one|many'),
 )
 

@@ -1,0 +1,115 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The room after a many-target search: who was found, who is new, and whom to look at next.
+
+The ``gaze_controller`` node in many-target mode (``search.targets: many``, docs/design.md
+section 11.6) runs a search of the room; when it ends, :meth:`RoomWatch.done` takes its faces
+(:meth:`ipomdp_gaze.search.many.OccupancySession.faces`) as the people in the room, and the node
+then keeps them in view in turn: :meth:`RoomWatch.next_person` names the next one each
+``room.dwell_s`` seconds. A periodic re-check (``room.recheck_period_s``) is a new search of the
+room; its people replace the list, and those farther than :data:`SAME_PERSON_CELLS` from every
+person known before are counted as new. ``~/reset`` forgets everyone (:meth:`RoomWatch.forget`).
+
+Pure: no ROS, no clock (the node owns the timers); times are seconds.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+import math
+
+# A person found again within this many cells (Chebyshev) of a known one is that person (the
+# rooms' scoring tolerance, docs/design.md section 11.5).
+SAME_PERSON_CELLS = 1
+# Longest dwell and re-check period accepted, in seconds (one day).
+MAX_PERIOD_S = 86400.0
+
+
+def check_room_times(dwell_s: float, recheck_period_s: float) -> tuple[float, float]:
+    """
+    Return ``(dwell_s, recheck_period_s)`` as floats.
+
+    Raises
+    ------
+    ValueError
+        Unless ``dwell_s`` is finite and in (0, 1 day] and ``recheck_period_s`` is 0 (never) or
+        at least ``dwell_s`` and at most a day.
+
+    """
+    dwell_s, recheck_period_s = float(dwell_s), float(recheck_period_s)
+    if not math.isfinite(dwell_s) or not 0 < dwell_s <= MAX_PERIOD_S:
+        raise ValueError(f'room.dwell_s must be in (0, {MAX_PERIOD_S:g}] seconds, got {dwell_s}')
+    if not math.isfinite(recheck_period_s) or not (
+            recheck_period_s == 0 or dwell_s <= recheck_period_s <= MAX_PERIOD_S):
+        raise ValueError(f'room.recheck_period_s must be 0 (never) or in [room.dwell_s, '
+                         f'{MAX_PERIOD_S:g}] seconds, got {recheck_period_s} with room.dwell_s '
+                         f'{dwell_s}')
+    return dwell_s, recheck_period_s
+
+
+@dataclass(frozen=True)
+class Person:
+    """One person found: the cell of the face and ``P(at least one of its cells is occupied)``."""
+
+    cell: int
+    probability: float
+
+
+@dataclass(frozen=True)
+class RoomDone:
+    """What a finished search of the room says: everyone found, and who of them is new."""
+
+    people: tuple
+    new: tuple
+    recheck: bool
+
+
+def people_from_faces(faces) -> tuple:
+    """Return :class:`Person` of each face dict (``cell``, ``probability``), in their order."""
+    return tuple(Person(int(f['cell']), float(f['probability'])) for f in faces)
+
+
+def new_people(known, found, grid, radius: int = SAME_PERSON_CELLS) -> tuple:
+    """Return the people of ``found`` farther than ``radius`` cells from every one of ``known``."""
+    out = []
+    for person in found:
+        row, col = grid.cell(person.cell)
+        if all(max(abs(row - r), abs(col - c)) > radius
+               for r, c in (grid.cell(k.cell) for k in known)):
+            out.append(person)
+    return tuple(out)
+
+
+class RoomWatch:
+    """The people of the room and the turn of looking at them (module docstring)."""
+
+    def __init__(self, grid):
+        self.grid = grid
+        self.people: tuple = ()
+        self.turn = -1
+        self.rechecking = False
+        self.rooms_done = 0
+
+    def recheck(self) -> None:
+        """Start a re-check: a new search whose people are compared with those known."""
+        self.rechecking = True
+
+    def forget(self) -> None:
+        """Forget everyone (``~/reset``): the next search's people are all new."""
+        self.people, self.turn, self.rechecking = (), -1, False
+
+    def done(self, faces) -> RoomDone:
+        """Take a finished search's faces as the people in the room; return who is new."""
+        found = people_from_faces(faces)
+        new = new_people(self.people, found, self.grid)
+        result = RoomDone(found, new, self.rechecking)
+        self.people, self.turn, self.rechecking = found, -1, False
+        self.rooms_done += 1
+        return result
+
+    def next_person(self) -> Person | None:
+        """Return the next person to keep in view (in the order found, round and round)."""
+        if not self.people:
+            return None
+        self.turn = (self.turn + 1) % len(self.people)
+        return self.people[self.turn]

@@ -1,0 +1,104 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""msg_adapters.people and the room_done event: the many-target messages (no DDS, no node)."""
+from __future__ import annotations
+
+import math
+
+from conftest import HAVE_ROS_MSGS
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head import PanTiltMap
+import numpy as np
+import pytest
+
+if HAVE_ROS_MSGS:
+    from builtin_interfaces.msg import Time
+    from ipomdp_gaze.msg_adapters import diagnostics, people
+    from std_msgs.msg import Float32MultiArray, MultiArrayDimension, MultiArrayLayout
+
+pytestmark = pytest.mark.ros
+
+GRID = Grid(11, 11, 5.0)
+
+
+def test_target_cells_layout_and_round_trip():
+    found = [(GRID.index(5, 9), 0.966), (GRID.index(7, 0), 0.934)]
+    msg = people.people_array(GRID, found)
+    dims = [(d.label, d.size, d.stride) for d in msg.layout.dim]
+    assert dims == [('people', 2, 8), ('row_col_cell_probability', 4, 4)]
+    assert msg.layout.data_offset == 0
+    np.testing.assert_allclose(list(msg.data), [5, 9, 64, 0.966, 7, 0, 77, 0.934], rtol=1e-6)
+    back = people.read_people_array(msg, GRID)
+    assert [c for c, _ in back] == [c for c, _ in found]
+    np.testing.assert_allclose([p for _, p in back], [p for _, p in found], rtol=1e-6)
+
+
+def test_nobody_is_an_empty_array():
+    msg = people.people_array(GRID, [])
+    assert [(d.label, d.size, d.stride) for d in msg.layout.dim] == [
+        ('people', 0, 0), ('row_col_cell_probability', 4, 4)]
+    assert len(msg.data) == 0 and people.read_people_array(msg, GRID) == []
+
+
+def _array(data, k, label='row_col_cell_probability', offset=0):
+    msg = Float32MultiArray(layout=MultiArrayLayout(dim=[
+        MultiArrayDimension(label='people', size=k, stride=4 * k),
+        MultiArrayDimension(label=label, size=4, stride=4)], data_offset=offset))
+    msg.data = [float(v) for v in data]
+    return msg
+
+
+@pytest.mark.parametrize('msg, words', [
+    (lambda: _array([5, 9, 64, 0.9], 1, label='xyz'), 'must have 2 dimensions'),
+    (lambda: _array([5, 9, 64, 0.9], 1, offset=1), 'data_offset 0'),
+    (lambda: _array([5, 9, 64], 1), 'says 1 people (4 values), has 3 values'),
+    (lambda: _array([5, 9, 63, 0.9], 1), 'is not a cell of the 11x11 grid'),
+    (lambda: _array([11, 0, 121, 0.9], 1), 'is not a cell of the 11x11 grid'),
+    (lambda: _array([5, 9, 64, 1.5], 1), 'probability 1.5 is not in [0, 1]'),
+    (lambda: Float32MultiArray(), 'must have 2 dimensions'),
+])
+def test_a_malformed_target_cells_message_is_refused_with_the_reason(msg, words):
+    with pytest.raises(people.PeopleLayoutError) as info:
+        people.read_people_array(msg(), GRID)
+    assert words in str(info.value)
+
+
+@pytest.mark.parametrize('signs', [(1, 1), (-1, 1), (1, -1)])
+def test_targets_poses_are_the_head_directions_of_the_cells(signs):
+    head = PanTiltMap(GRID, 'pan', 'tilt', *signs, 0.1, -0.05)
+    cells = [0, GRID.index(5, 9), GRID.index(7, 0), GRID.n_cells - 1]
+    msg = people.people_poses(head, cells, Time(sec=3, nanosec=4), 'base')
+    assert msg.header.frame_id == 'base' and msg.header.stamp.sec == 3
+    assert len(msg.poses) == 4
+    for pose, cell, (pan, tilt) in zip(msg.poses, cells, people.poses_angles(msg), strict=True):
+        assert (pan, tilt) == pytest.approx(head.angles(cell), abs=1e-12)
+        assert (pose.position.x, pose.position.y, pose.position.z) == (0.0, 0.0, 0.0)
+        q = pose.orientation
+        assert q.x ** 2 + q.y ** 2 + q.z ** 2 + q.w ** 2 == pytest.approx(1.0)
+
+
+def test_a_direction_points_the_camera_axis_where_rep_103_says():
+    """Pan left (+) turns x towards +y; tilt down (+) turns x towards -z."""
+    def axis(pan, tilt):
+        q = people.direction(pan, tilt)
+        x, y, z, w = q.x, q.y, q.z, q.w              # the rotated x axis: first column of R
+        return (1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y))
+    np.testing.assert_allclose(axis(math.pi / 2, 0.0), (0, 1, 0), atol=1e-12)
+    np.testing.assert_allclose(axis(0.0, math.pi / 2), (0, 0, -1), atol=1e-12)
+    pan, tilt = 0.3, 0.2
+    np.testing.assert_allclose(axis(pan, tilt), (math.cos(tilt) * math.cos(pan),
+                                                 math.cos(tilt) * math.sin(pan),
+                                                 -math.sin(tilt)), atol=1e-12)
+
+
+def test_room_done_event_round_trip():
+    msg = diagnostics.room_done_status('/gaze_controller: room_done', 2, 1, 20, 4, True,
+                                       'budget', 0.99)
+    assert msg.message == ('room done: 2 people found (1 new) by re-check 4 after 20 '
+                           'fixations, forced by the fixation budget below the confidence 0.99')
+    assert diagnostics.parse_room_done(msg) == {
+        'people': 2, 'new_people': 1, 'fixations': 20, 'search_id': 4, 'recheck': True,
+        'ended': 'forced:budget', 'confidence': 0.99}
+    msg = diagnostics.room_done_status('x', 0, 0, 7, 2, False, '', 0.95)
+    assert diagnostics.parse_room_done(msg)['ended'] == 'confidence'
+    assert 'room done: 0 people found (0 new) by search 2' in msg.message

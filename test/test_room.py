@@ -1,0 +1,116 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""Many-target mode without ROS: the controller core on the occupancy belief, and the room."""
+from __future__ import annotations
+
+from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.policies.registry import build_policy
+from ipomdp_gaze.search.gaze import GazeController
+from ipomdp_gaze.search.many import OccupancySession
+from ipomdp_gaze.search.room import check_room_times, Person, RoomWatch
+from ipomdp_gaze.search.session import SearchSession, SearchSettings
+import numpy as np
+import pytest
+
+GRID = Grid(11, 11, 5.0)
+CAMERA = make_fpoc('camera', half_width_deg=10.0, half_height_deg=10.0)
+FACES = [GRID.index(2, 3), GRID.index(8, 8)]
+MANY = SearchSettings(targets='many', confidence=0.95, absent_prior=0.5, max_fixations=40,
+                      inhibit_return=True, decide_at_budget=True)
+
+
+def controller(settings=MANY) -> GazeController:
+    core = GazeController(GRID, CAMERA, build_policy('elm', GRID, CAMERA), settings)
+    core.reset(0.0)
+    return core
+
+
+def search(core: GazeController, faces=FACES) -> list:
+    """Feed noise-free frames of a room with ``faces`` until the search ends; its results."""
+    d = dprime_matrix(GRID, CAMERA)
+    results, t = [], 0.0
+    while not core.stopped:
+        frame = np.zeros(GRID.n_cells)
+        frame[faces] = d[faces, core.fixation]
+        t += 1.0
+        results.append(core.offer(frame, t))
+    return results
+
+
+def test_many_targets_runs_the_occupancy_session_and_finds_every_face():
+    core = controller()
+    assert isinstance(core.session, OccupancySession)
+    results = search(core)
+    assert all(r.applied for r in results)
+    last = results[-1]
+    assert last.found is not None and last.found.forced_by == '' and last.fixation is None
+    assert core.decision == 'found' and core.session.gave_up_reason == ''
+    assert sorted(f['cell'] for f in core.session.faces(link=2)) == FACES
+    skipped = core.offer(np.zeros(GRID.n_cells), 100.0)            # the room is done
+    assert skipped.status == 'skipped' and 'the search has ended (found)' in skipped.reason
+
+
+def test_an_empty_room_is_absent():
+    core = controller()
+    search(core, faces=[])
+    assert core.decision == 'absent' and core.session.faces(link=2) == []
+
+
+def test_one_target_is_the_papers_session_and_switching_starts_a_new_search():
+    core = controller(SearchSettings())
+    assert isinstance(core.session, SearchSession)
+    first = core.search_id
+    core.configure(MANY)
+    assert isinstance(core.session, OccupancySession) and core.search_id == first + 1
+    assert core.fixation == GRID.center_index and not core.stopped
+    core.configure(SearchSettings())
+    assert isinstance(core.session, SearchSession) and core.search_id == first + 2
+
+
+@pytest.mark.parametrize('change, words', [
+    ({'hotspot_prior': 0.03}, 'does not model false-alarm scales or hotspots'),
+    ({'motion_sigma_cells': 1.0}, 'models still targets'),
+])
+def test_the_many_target_core_refuses_what_it_does_not_model(change, words):
+    from dataclasses import replace
+    core = controller()
+    with pytest.raises(ValueError, match=words):
+        core.configure(replace(MANY, **change))
+
+
+@pytest.mark.parametrize('dwell_s, recheck_s, words', [
+    (0.0, 0.0, 'room.dwell_s must be in (0, 86400] seconds, got 0.0'),
+    (float('nan'), 0.0, 'room.dwell_s must be in'),
+    (2.0, 1.0, 'room.recheck_period_s must be 0 (never) or in [room.dwell_s, 86400] seconds, '
+               'got 1.0 with room.dwell_s 2.0'),
+    (2.0, 1e6, 'room.recheck_period_s must be 0'),
+])
+def test_room_times_are_refused_with_the_reason(dwell_s, recheck_s, words):
+    with pytest.raises(ValueError) as info:
+        check_room_times(dwell_s, recheck_s)
+    assert words in str(info.value)
+
+
+def test_room_times_accepted():
+    assert check_room_times(2, 0) == (2.0, 0.0)
+    assert check_room_times(0.5, 0.5) == (0.5, 0.5)
+
+
+def test_the_room_keeps_its_people_in_view_in_turn_and_counts_who_is_new():
+    room = RoomWatch(GRID)
+    assert room.next_person() is None
+    a, b = GRID.index(2, 3), GRID.index(8, 8)
+    done = room.done([{'cell': a, 'probability': 0.9}, {'cell': b, 'probability': 0.8}])
+    assert done.people == done.new == (Person(a, 0.9), Person(b, 0.8)) and not done.recheck
+    assert [room.next_person().cell for _ in range(5)] == [a, b, a, b, a]
+    room.recheck()
+    moved, c = GRID.index(3, 4), GRID.index(5, 0)             # a within one cell; c new
+    done = room.done([{'cell': moved, 'probability': 0.9}, {'cell': b, 'probability': 0.7},
+                      {'cell': c, 'probability': 0.6}])
+    assert done.recheck and done.new == (Person(c, 0.6),) and len(done.people) == 3
+    assert room.next_person().cell == moved                    # a new list starts at its first
+    room.forget()
+    assert room.people == () and room.next_person() is None
+    done = room.done([{'cell': b, 'probability': 0.7}])
+    assert done.new == done.people and not done.recheck
