@@ -36,7 +36,7 @@ import argparse
 from dataclasses import replace
 import time
 
-from bench.find_photos import find_tasks
+from find_photos import find_tasks
 from ipomdp_gaze.commands.find import search_one
 from ipomdp_gaze.vision.fullframe import scan
 from ipomdp_gaze.vision.photos import (GROUP_BACKGROUNDS, group_photo,

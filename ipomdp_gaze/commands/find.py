@@ -68,6 +68,7 @@ from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
 from ipomdp_gaze.search import answer
 from ipomdp_gaze.vision.detectors import load_factory
 from ipomdp_gaze.vision.image_files import decode_quietly
+from ipomdp_gaze.vision.scales import SCALE_TABLES
 from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, FIND_SETTINGS,
                                        fovea_for_model, full_frame_reason, full_frame_search,
                                        search_all, search_image, search_many, size_distance)
@@ -506,6 +507,12 @@ def _in_given_pixels(result, scale: tuple, given: tuple):
                    detections=tuple((u * sx, v * sy) for u, v in result.detections), faces=faces)
 
 
+def scale_table(model):
+    """Return the coarse-pass table of the model's detector (None: the fovea's own scan)."""
+    kind = (model.meta.get('detector') or {}).get('kind', 'haar')
+    return SCALE_TABLES.get(kind)
+
+
 def search_one(image, task, settings, rng, find_all: bool) -> list:
     """Search one image: the fovea within one full scan's pixels, or the full frame (say why)."""
     width, height = image.shape[1], image.shape[0]
@@ -517,7 +524,8 @@ def search_one(image, task, settings, rng, find_all: bool) -> list:
         return results if find_all else results[:1]
     budget = width * height
     if settings.targets == 'many':
-        return [search_many(image, task.fovea, task.model, settings, pixel_budget=budget)]
+        return [search_many(image, task.fovea, task.model, settings, pixel_budget=budget,
+                            scales=scale_table(task.model))]
     if find_all:
         return search_all(image, task.fovea, task.model, task.policy, settings, rng=rng,
                           pixel_budget=budget)

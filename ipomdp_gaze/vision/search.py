@@ -46,6 +46,7 @@ import math
 import time
 
 from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.occupancy import cell_prior, prior_log_odds
 from ipomdp_gaze.search import answer
 from ipomdp_gaze.search.many import OccupancySession
 from ipomdp_gaze.search.sensors import run_search
@@ -54,6 +55,7 @@ from ipomdp_gaze.vision.detector import detector_window_px
 from ipomdp_gaze.vision.detectors import detector_from_settings  # noqa: F401 (its old home)
 from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea
 from ipomdp_gaze.vision.fovea_model import check_model, fovea_for_model  # noqa: F401
+from ipomdp_gaze.vision.scales import choose_scale, coarse_evidence, ScaleTable
 from ipomdp_gaze.vision.sensors import FoveaSensor
 import numpy as np
 
@@ -530,6 +532,51 @@ class _Recorder:
         return Frame(obs.counts, detector_pixels=obs.detector_pixels, seconds=obs.seconds)
 
 
+class _Coarse(_Recorder):
+    """
+    A fovea sensor whose one-time scan is the coarse full-frame pass (:mod:`.scales`).
+
+    The detector runs once on the whole image at the table's coarsest scale that sees faces
+    of the sizes that matter; its boxes become evidence per cell (a frame of kind
+    ``evidence``); fixations are the fovea's finer windows.
+    """
+
+    def __init__(self, fovea: Fovea, table, image_px: tuple[int, int], prior: np.ndarray):
+        super().__init__(fovea)
+        self.scans = True
+        self.table, self.image_px, self.prior = table, image_px, prior
+        self.scale = choose_scale(table, image_px)
+        self.image = None
+
+    def start(self, scene):
+        super().start(scene)
+        self.image = scene
+
+    def scan_cost(self):
+        width, height = self.image_px
+        return (int(np.floor(width * self.scale + 0.5))
+                * int(np.floor(height * self.scale + 0.5)))
+
+    def scan(self):
+        from ipomdp_gaze.vision.fullframe import scan
+        t0 = time.perf_counter()
+        found = scan(self.image, self.sensor.fovea.detector, self.grid, self.scale)
+        raw = found.boxes_px
+        scores = np.ones(len(raw)) if found.scores is None else np.asarray(found.scores)
+        if self.table.strong_score > 0:
+            strong = raw[scores >= self.table.strong_score]
+            weak = raw[scores < self.table.strong_score]
+        else:                                   # a grouping detector: grouped boxes are strong
+            strong, weak = found.grouped_px, raw
+        self.boxes.append(raw)
+        self.scores.append(scores)
+        self.strong = strong
+        term = coarse_evidence(self.table.row(self.scale), self.grid, self.image_px,
+                               found.detector_pixels, strong, weak, self.prior)
+        return Frame(term, kind='evidence', detector_pixels=found.detector_pixels,
+                     seconds=time.perf_counter() - t0)
+
+
 _COSTS = {}
 
 
@@ -556,7 +603,8 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
                 settings: SearchSettings | None = None, *,
                 pixel_budget: int | None = None, link: int = FACE_RADIUS,
                 settle: int = SETTLE_RADIUS,
-                empty_by_evidence: bool = EMPTY_BY_EVIDENCE) -> ImageSearch:
+                empty_by_evidence: bool = EMPTY_BY_EVIDENCE,
+                scales: ScaleTable | None = None) -> ImageSearch:
     """
     Search one image for every face at once: the many-target belief (``search.targets: many``).
 
@@ -569,6 +617,11 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     other are one cluster); cells within ``settle`` of an occupied cell need no decision of
     their own (:class:`~ipomdp_gaze.search.many.OccupancySession`, ``link``). ``decision`` is
     ``found`` when a face was reported, else ``absent`` (or ``gave_up``).
+
+    With ``scales`` (a detector's :class:`~ipomdp_gaze.vision.scales.ScaleTable`; ``find
+    --all``) the one-time scan is the coarse full-frame pass at the coarsest scale that sees
+    faces of the sizes that matter, and the fovea's finer windows are spent only on the cells
+    it leaves undecided (a weak detection); without, the fovea's own scan (as before).
 
     Raises
     ------
@@ -583,7 +636,12 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     session = OccupancySession(fovea.grid, model, settings,
                                costs=fixation_costs(fovea, image_px), link=settle,
                                empty_by_evidence=empty_by_evidence)
-    sensor = _Recorder(fovea)
+    if scales is None:
+        sensor = _Recorder(fovea)
+    else:
+        prior = prior_log_odds(fovea.grid.n_cells,
+                               cell_prior(fovea.grid.n_cells, settings.absent_prior))
+        sensor = _Coarse(fovea, scales, image_px, prior)
     outcome = run_search(session, sensor, image, pixel_budget=pixel_budget)
     boxes = np.concatenate(sensor.boxes) if sensor.boxes else np.zeros((0, 4))
     scores = np.concatenate(sensor.scores) if sensor.scores else np.zeros(0)
