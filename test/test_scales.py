@@ -10,8 +10,8 @@ from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.occupancy import cell_prior, prior_log_odds
 from ipomdp_gaze.vision.fovea_model import fovea_for_model
 from ipomdp_gaze.vision.photos import group_photo
-from ipomdp_gaze.vision.scales import (choose_scale, coarse_evidence, SCALE_TABLES, ScaleRow,
-                                       ScaleTable)
+from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evidence,
+                                       SCALE_TABLES, ScaleRow, ScaleTable)
 from ipomdp_gaze.vision.search import FIND_SETTINGS, search_many
 import numpy as np
 import pytest
@@ -79,3 +79,12 @@ def test_a_weak_coarse_detection_draws_finer_windows_there(yunet_420):
     row, col = result.path[0]                               # the first window: at the face
     assert abs(row - (y + h / 2) * 21 / 886) <= 2 and abs(col - (x + w / 2) * 21 / 1280) <= 2
     assert len(result.faces) == 1
+
+
+def test_the_coarse_pass_keeps_weaker_boxes_than_the_fine_windows(yunet_420):
+    _, fovea = yunet_420
+    coarse = coarse_detector(fovea.detector, 0.3)
+    assert coarse.settings()['score_threshold'] == 0.3
+    assert fovea.detector.settings()['score_threshold'] == 0.5     # the calibrated one kept
+    assert coarse_detector(fovea.detector, 0.3) is coarse               # built once
+    assert coarse_detector(fovea.detector, 0.0) is fovea.detector

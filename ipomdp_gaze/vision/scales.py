@@ -35,6 +35,9 @@ import numpy as np
 # The smallest face that matters, as a fraction of the image's shorter side: the smallest faces
 # of the training group pictures (48 px of 480, 90 of 886; ipomdp_gaze.vision.photos.GROUP_SIZES).
 MIN_FACE_FRACTION = 0.1
+# YuNet's coarse pass keeps boxes from this score (the fine windows' detector keeps 0.5, as
+# calibrated), so that a face the coarse scale sees only faintly still draws finer windows.
+WEAK_SCORE = 0.3
 # A false-detection chance per cell is never taken below this (the tables count few).
 MIN_FALSE = 1e-6
 
@@ -56,6 +59,7 @@ class ScaleTable:
     detector: str
     rows: tuple
     strong_score: float = 0.0
+    weak_score: float = 0.0
 
     def row(self, scale: float) -> ScaleRow:
         """Return the row of ``scale`` (ValueError for a scale not in the table)."""
@@ -65,9 +69,33 @@ class ScaleTable:
         raise ValueError(f'scale {scale} is not in the {self.detector} table')
 
 
-def _table(detector: str, rows: dict, strong_score: float = 0.0) -> ScaleTable:
+def _table(detector: str, rows: dict, strong_score: float = 0.0,
+           weak_score: float = 0.0) -> ScaleTable:
     return ScaleTable(detector, tuple(sorted((ScaleRow(s, *v) for s, v in rows.items()),
-                                             key=lambda r: r.scale)), strong_score)
+                                             key=lambda r: r.scale)), strong_score, weak_score)
+
+
+_COARSE = {}
+
+
+def coarse_detector(detector, weak_score: float):
+    """
+    Return the detector of the coarse pass: ``detector`` keeping boxes from ``weak_score``.
+
+    A detector with a ``score_threshold`` setting is rebuilt once with ``weak_score`` (so that
+    a face the coarse scale sees only faintly still leaves a weak box); any other, or
+    ``weak_score`` 0, is used as it is.
+    """
+    settings = getattr(detector, 'settings', None)
+    options = settings() if callable(settings) else {}
+    if not weak_score or 'score_threshold' not in options \
+            or options['score_threshold'] <= weak_score:
+        return detector
+    key = (id(detector), weak_score)
+    if key not in _COARSE:
+        _COARSE[key] = (detector, type(detector).from_settings(
+            {**options, 'score_threshold': weak_score}))
+    return _COARSE[key][1]
 
 
 # bench/faces/scales.py --scenes 4 (training photo groups: the training photo's face on the
@@ -80,7 +108,8 @@ def _table(detector: str, rows: dict, strong_score: float = 0.0) -> ScaleTable:
 # was seen).
 SCALE_TABLES = {
     'yunet': _table('yunet', {1.0: (12.0, 0.97, 0.05), 0.5: (16.0, 0.97, 0.05),
-                              0.3333: (20.0, 0.97, 0.05), 0.25: (20.0, 0.97, 0.05)}, 0.7),
+                              0.3333: (20.0, 0.97, 0.05), 0.25: (20.0, 0.97, 0.05)},
+                    strong_score=0.7, weak_score=WEAK_SCORE),
     'haar': _table('haar', {1.0: (12.0, 0.97, 0.2), 0.5: (20.0, 0.97, 0.05),
                             0.3333: (20.0, 0.97, 0.05), 0.25: (20.0, 0.97, 0.05)}),
 }

@@ -55,7 +55,8 @@ from ipomdp_gaze.vision.detector import detector_window_px
 from ipomdp_gaze.vision.detectors import detector_from_settings  # noqa: F401 (its old home)
 from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea
 from ipomdp_gaze.vision.fovea_model import check_model, fovea_for_model  # noqa: F401
-from ipomdp_gaze.vision.scales import choose_scale, coarse_evidence, ScaleTable
+from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evidence,
+                                       ScaleTable)
 from ipomdp_gaze.vision.sensors import FoveaSensor
 import numpy as np
 
@@ -546,6 +547,7 @@ class _Coarse(_Recorder):
         self.scans = True
         self.table, self.image_px, self.prior = table, image_px, prior
         self.scale = choose_scale(table, image_px)
+        self.detector = coarse_detector(fovea.detector, table.weak_score)
         self.image = None
 
     def start(self, scene):
@@ -560,7 +562,7 @@ class _Coarse(_Recorder):
     def scan(self):
         from ipomdp_gaze.vision.fullframe import scan
         t0 = time.perf_counter()
-        found = scan(self.image, self.sensor.fovea.detector, self.grid, self.scale)
+        found = scan(self.image, self.detector, self.grid, self.scale)
         raw = found.boxes_px
         scores = np.ones(len(raw)) if found.scores is None else np.asarray(found.scores)
         if self.table.strong_score > 0:
