@@ -60,6 +60,7 @@ class ScaleTable:
     rows: tuple
     strong_score: float = 0.0
     weak_score: float = 0.0
+    weak_neighbors: int = 1
 
     def row(self, scale: float) -> ScaleRow:
         """Return the row of ``scale`` (ValueError for a scale not in the table)."""

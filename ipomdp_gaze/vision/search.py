@@ -51,7 +51,7 @@ from ipomdp_gaze.search import answer
 from ipomdp_gaze.search.many import OccupancySession
 from ipomdp_gaze.search.sensors import run_search
 from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
-from ipomdp_gaze.vision.detector import detector_window_px
+from ipomdp_gaze.vision.detector import detector_window_px, group_boxes
 from ipomdp_gaze.vision.detectors import detector_from_settings  # noqa: F401 (its old home)
 from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea
 from ipomdp_gaze.vision.fovea_model import check_model, fovea_for_model  # noqa: F401
@@ -568,8 +568,9 @@ class _Coarse(_Recorder):
         if self.table.strong_score > 0:
             strong = raw[scores >= self.table.strong_score]
             weak = raw[scores < self.table.strong_score]
-        else:                                   # a grouping detector: grouped boxes are strong
-            strong, weak = found.grouped_px, raw
+        else:           # a grouping detector: its grouped boxes strong, looser groups weak
+            strong = found.grouped_px
+            weak = group_boxes(np.round(raw), self.table.weak_neighbors) if len(raw) else raw
         self.boxes.append(raw)
         self.scores.append(scores)
         self.strong = strong
