@@ -45,9 +45,11 @@ reproduce: $(STAMP)
 	$(VENV)/bin/ipomdp-gaze reproduce
 
 # Face search, Haar and YuNet, on 300 held-out scenes per task, the pan/tilt search and the
-# real-photo set: writes docs/faces.md and docs/data/faces.json (about 20 minutes).
+# real-photo set: writes docs/faces.md and docs/data/faces.json (about 20 minutes), then the
+# find --all group tables (faces-groups).
 faces: $(STAMP)
 	$(VPY) bench/faces/faces.py
+	$(MAKE) faces-groups
 
 # find --all on composed group pictures against the detector alone at 1, 1/2, 1/3, 1/4, training
 # (photo and lfw faces; YuNet, then Haar) then test groups, each table in one run: docs/faces.md's
