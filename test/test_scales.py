@@ -94,3 +94,48 @@ def test_the_coarse_pass_keeps_weaker_boxes_than_the_fine_windows(yunet_420):
     assert fovea.detector.settings()['score_threshold'] == 0.5     # the calibrated one kept
     assert coarse_detector(fovea.detector, 0.3) is coarse               # built once
     assert coarse_detector(fovea.detector, 0.0) is fovea.detector
+
+
+class _Blob:
+    """A stand-in detector: the bright square's box, weak (0.5) below 20 px, else strong."""
+
+    def __call__(self, gray):
+        ys, xs = np.nonzero(gray > 128)
+        if not len(xs):
+            return np.zeros((0, 5))
+        x0, y0, x1, y1 = xs.min(), ys.min(), xs.max() + 1, ys.max() + 1
+        score = 0.5 if min(x1 - x0, y1 - y0) < 20 else 0.9
+        return np.array([[x0, y0, x1 - x0, y1 - y0, score]], dtype=float)
+
+
+def _blob_sensor(fovea, side):
+    from ipomdp_gaze.vision.search import _Coarse
+    image = np.zeros((600, 800, 3), dtype=np.uint8)
+    image[300:300 + side, 500:500 + side] = 255
+    prior = prior_log_odds(fovea.grid.n_cells, cell_prior(fovea.grid.n_cells, 0.5))
+    sensor = _Coarse(fovea, TABLE, (800, 600), prior, 0.99, budget=800 * 600)
+    sensor.detector = _Blob()
+    sensor.start(image)
+    return sensor, prior, sensor.scan()
+
+
+def test_a_face_too_small_for_the_coarse_scale_gets_one_finer_look_only_there(yunet_420):
+    _, fovea = yunet_420
+    sensor, prior, frame = _blob_sensor(fovea, 24)          # 12 px at 1/2: weak
+    assert [scale for _, scale, _ in sensor.looks] == [0.5, 1.0]
+    (x0, y0, x1, y1), _, pixels = sensor.looks[1]
+    assert x0 <= 500 and 524 <= x1 and y0 <= 300 and 324 <= y1      # round the face
+    assert pixels < 800 * 600 / 10                          # 5x5 cells, not the frame
+    assert frame.detector_pixels == 400 * 300 + pixels < 800 * 600
+    posterior = prior + frame.values
+    face = fovea.grid.index(int(312 * 21 / 600), int(512 * 21 / 800))
+    assert posterior[face] > np.log(99)                              # occupied at 0.99
+    assert np.all(np.delete(posterior, face) < np.log(99))
+
+
+def test_a_face_the_coarse_scale_sees_needs_no_finer_look(yunet_420):
+    _, fovea = yunet_420
+    sensor, prior, frame = _blob_sensor(fovea, 60)          # 30 px at 1/2: strong
+    assert [scale for _, scale, _ in sensor.looks] == [0.5]
+    assert frame.detector_pixels == 400 * 300
+    assert np.sum(prior + frame.values > np.log(99)) == 1
