@@ -655,6 +655,20 @@ def fixation_costs(fovea: Fovea, image_px: tuple[int, int]) -> np.ndarray:
     return _COSTS[key]
 
 
+def prepare_many(fovea: Fovea, model, image_px: tuple[int, int],
+                 scales: ScaleTable | None = None) -> None:
+    """
+    Build what :func:`search_many` builds once, outside its seconds (as ``find`` sets up).
+
+    The belief's information table of the model, the fixation costs of the image size and,
+    with ``scales``, the coarse pass's detector; all cached, so a second call costs nothing.
+    """
+    OccupancySession(fovea.grid, model, replace(FIND_SETTINGS, targets='many'))
+    fixation_costs(fovea, image_px)
+    if scales is not None:
+        coarse_detector(fovea.detector, scales.weak_score)
+
+
 def search_many(image: np.ndarray, fovea: Fovea, model,
                 settings: SearchSettings | None = None, *,
                 pixel_budget: int | None = None, link: int = FACE_RADIUS,
