@@ -4,14 +4,19 @@
 Calibrate each detector per scale on training groups: which face sides a full-frame call sees.
 
 The table behind ``find --all``'s coarse pass (:mod:`ipomdp_gaze.vision.scales`). Training
-material only: :func:`many_faces.lfw_group` with the training thumbnails (faces 0-59) on the
-training backgrounds, grey, ``--scenes`` per width (faces 48-90 px scaled with the width, so
-24-180 px over the widths), each face counted at the side it has in the detector's input
-(``side * scale``). Per scale (1, 1/2, 1/3, 1/4): the smallest detector-input side from which
-the detector finds at least ``--recall`` of the faces in every 4 px bin above it, the recall of
-those faces, and the detections near no face per million detector pixels.
+material only, ``--scenes`` pictures per size from 320x240 to 1280x960: with ``--faces photos``
+(the default) :func:`ipomdp_gaze.vision.photos.group_photo` with ``split='train'`` (the
+training photo's face, ``count`` copies, on the training group backgrounds); with ``lfw`` (or
+``both``) also :func:`many_faces.lfw_group` (the training thumbnails, faces 0-59, upscaled and
+so blurred). Faces are 48-90 px at 640 wide, scaled with the width, and each is counted at the
+side it has in the detector's input (``side * scale``). Per scale (1, 1/2, 1/3, 1/4): the
+smallest detector-input side from which the detector finds at least ``--recall`` of the faces
+(of all above it, and of those up to 16 px larger), the recall of those faces, and the strong
+detections (YuNet: score 0.7 or more; Haar: its grouped boxes) near no face per million
+detector pixels.
 
-Usage: ``python bench/faces/scales.py [--detector yunet|haar] [--scenes 6]``; prints the
+Usage: ``python bench/faces/scales.py [--detector yunet|haar] [--scenes 6] [--recall 0.95]
+[--faces photos|lfw|both]``; prints the
 table as the Python literal :data:`ipomdp_gaze.vision.scales.SCALE_TABLES` holds.
 """
 import argparse
