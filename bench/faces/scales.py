@@ -89,6 +89,7 @@ def table(measured: dict, recall: float) -> dict:
                     if hits[sides >= i * BIN_PX].mean() >= recall
                     and (not w.size or w.mean() >= recall)),
                    math.inf)
+        low = max(low, float(np.floor(sides.min() / BIN_PX) * BIN_PX))  # none measured below
         seen = sides >= low
         rows[round(s, 4)] = (float(low), round(float(hits[seen].mean()), 3)
                              if seen.any() else 0.0,

@@ -101,12 +101,14 @@ def coarse_detector(detector, weak_score: float):
 
 # bench/faces/scales.py --scenes 4 (training photo groups: the training photo's face on the
 # training backgrounds, 320x240 to 1280x960): scale: (min side px in the detector input, recall
-# from it, strong false detections per Mpx). A coarser scale is never given a smaller side than
-# the finer one next to it (YuNet's measured minimum at 1/2 was the smallest face there, 14 px).
-# Strong: YuNet's score 0.7 or more, Haar's grouped boxes. No strong false detection was seen in
-# about 28 Mpx of detector input per detector (--faces both) but Haar's 0.2 per Mpx at full
-# resolution; a rate of 0 is taken as 0.05 per Mpx (one in 20 Mpx, of the order of one more than
-# was seen).
+# from it, strong false detections per Mpx). Measured from 4 px bins: at 1/4 every face from
+# 16 px was found, at 1/3 from 20, at 1/2 from 12 (but 15 of 18 at 16-20 px), at 1 every face
+# measured (24 px and up). Taken: 1/4 and 1/3 20 px, 1/2 16 px, 1 12 px (no face below 24 px
+# was measured there; 1/2 finds 12 px ones). Strong: YuNet's score 0.7 or more, Haar's grouped
+# boxes. No strong false detection was seen in about 28 Mpx of detector input per detector
+# (--faces both) but Haar's 0.2 per Mpx at full resolution; a rate of 0 is taken as 0.05 per
+# Mpx (one in 20 Mpx, of the order of one more than was seen). Haar: 12 px at 1, 20 at 1/2 to
+# 1/4 (every face from there found).
 SCALE_TABLES = {
     'yunet': _table('yunet', {1.0: (12.0, 0.97, 0.05), 0.5: (16.0, 0.97, 0.05),
                               0.3333: (20.0, 0.97, 0.05), 0.25: (20.0, 0.97, 0.05)},
