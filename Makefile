@@ -4,7 +4,7 @@ VENV := .venv
 VPY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: venv demo test bench reproduce faces pan-tilt walks figures models soak clean
+.PHONY: venv demo test bench reproduce faces faces-groups pan-tilt walks figures models soak clean
 
 venv: $(STAMP)
 
@@ -45,9 +45,23 @@ reproduce: $(STAMP)
 	$(VENV)/bin/ipomdp-gaze reproduce
 
 # Face search, Haar and YuNet, on 300 held-out scenes per task, the pan/tilt search and the
-# real-photo set: writes docs/faces.md and docs/data/faces.json (about 20 minutes).
+# real-photo set: writes docs/faces.md and docs/data/faces.json (about 20 minutes), then the
+# find --all group tables (faces-groups).
 faces: $(STAMP)
 	$(VPY) bench/faces/faces.py
+	$(MAKE) faces-groups
+
+# find --all on composed group pictures against the detector alone at 1, 1/2, 1/3, 1/4, training
+# (photo and lfw faces; YuNet, then Haar) then test groups, each table in one run: docs/faces.md's
+# section "find --all on groups: scale as an action" (about 3 minutes).
+GROUP_BENCH := $(VPY) bench/faces/many_faces.py --scenes 8 --sizes 640x480,1280x886 --write docs/faces.md
+
+faces-groups: $(STAMP)
+	$(GROUP_BENCH) --split train --section groups-train-photos
+	$(GROUP_BENCH) --split train --faces lfw --section groups-train-lfw
+	$(GROUP_BENCH) --split train --detector haar --section groups-train-photos-haar
+	$(GROUP_BENCH) --split test --section groups-test-photos
+	$(GROUP_BENCH) --split test --detector haar --section groups-test-photos-haar
 
 # The pan/tilt face search against a blind sweep on 400 + 200 held-out scenes and a second camera:
 # writes docs/pan_tilt.md and docs/data/pan_tilt.json.gz (10-30 minutes, and 15 for the ROS demo).

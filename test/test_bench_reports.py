@@ -155,3 +155,21 @@ def test_weak_faces_report_runs_on_a_few_scenes():
     rows = [line for line in run.stdout.splitlines() if line.startswith('| YuNet')]
     assert len(rows) == 9
     assert 'Weak faces no detector sees at its middle level' in run.stdout
+
+
+def test_many_faces_report_writes_its_section_and_keeps_the_rest(tmp_path):
+    """``bench/faces/many_faces.py --write`` fills its marked section of a page, once."""
+    page = tmp_path / 'faces.md'
+    page.write_text('# Faces\n\nbefore\n\n<!-- groups -->\nold\n<!-- /groups -->\n\nafter\n')
+    for _ in range(2):
+        run = subprocess.run([sys.executable, str(BENCH / 'faces' / 'many_faces.py'),
+                              '--scenes', '1', '--sizes', '640x480', '--write', str(page),
+                              '--section', 'groups'], capture_output=True, text=True,
+                             timeout=300)
+        assert run.returncode == 0, run.stderr
+    text = page.read_text()
+    assert text.count('<!-- groups -->') == 1 and 'old' not in text
+    assert text.startswith('# Faces\n\nbefore\n') and text.endswith('\n\nafter\n')
+    rows = [line for line in text.split('\n') if line.startswith('| 640x480 |')]
+    assert [r.split(' | ')[1] for r in rows] == ['find --all', 'detector at 1', 'detector at 0.5',
+                                                 'detector at 0.333', 'detector at 0.25']

@@ -814,6 +814,22 @@ FIND_TEXT = [
     'not), so photographs we never saw are the real check of this choice.', '']
 
 
+# The section bench/faces/many_faces.py fills (make faces-groups, which make faces runs after
+# this script): kept as it is when this script rewrites the file.
+GROUPS_HEADING = '## `find --all` on groups: scale as an action'
+
+
+def kept_section(path: Path, heading: str) -> list:
+    """Return the lines of the section of ``path`` that starts with ``heading`` (or none)."""
+    lines = path.read_text().split('\n') if path.exists() else []
+    start = next((i for i, line in enumerate(lines) if line.startswith(heading)), None)
+    if start is None:
+        return []
+    end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith('## ')),
+               len(lines))
+    return lines[start:end]
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description='Face search on held-out scenes.')
     parser.add_argument('--scenes', type=int, default=300,
@@ -933,6 +949,7 @@ def main(argv=None) -> int:
                                         '--groups --detector haar|yunet` prints these rows):',
                                         '']
         text += photo_detail(photos) + ['']
+    text += kept_section(args.out, GROUPS_HEADING)
     text += choices_text(trainings, photos, pan_tilt_train, args)
     text += IDEAS
     wall = time.perf_counter() - start

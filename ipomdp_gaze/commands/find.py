@@ -22,7 +22,10 @@ or cannot see (a small image, an image at most half the model's calibrated size,
 portrait: :func:`ipomdp_gaze.vision.search.full_frame_reason`) the whole frame is scanned once
 instead and stderr says why. ``--all`` finds every face in one search over the many-target
 belief (``--targets many``, its default: :func:`ipomdp_gaze.vision.search.search_many`;
-docs/design.md section 11): one line per face with its box, then the image's line;
+docs/design.md section 11): one line per face with its box, then the image's line. It
+starts with one detector call on the whole image at the coarsest scale its calibration says
+sees faces of 1/10 of the shorter side, and looks closer (a crop at a finer scale, then the
+fovea's windows) only where that call leaves cells undecided (:mod:`ipomdp_gaze.vision.scales`).
 ``--targets one`` keeps the old loop (:func:`ipomdp_gaze.vision.search.search_all`: find one
 face, rule its cells out, search again).
 
@@ -36,7 +39,9 @@ detector in the colour space it declares (RGB for YuNet, grey for Haar; a grey i
 into three channels for an RGB detector). ``seconds`` starts from the decoded
 array, so reading and decoding are not in it; nor is the one-time set-up of the detector, the
 fovea and the policy (the policy is run once on the uniform belief before the first image, so
-e.g. ELM's N x N weight matrix is built then).
+e.g. ELM's N x N weight matrix is built then), nor with ``--all`` that of the many-target
+belief (its information table, the fixation costs of an image size, the coarse pass's detector:
+:func:`ipomdp_gaze.vision.search.prepare_many`).
 
 **Model.** ``--observation`` names an ``ipomdp_gaze/observation-v1`` file (or a shipped model);
 the fovea, the grid and the detector are rebuilt from what the file records (each window is
@@ -68,9 +73,11 @@ from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
 from ipomdp_gaze.search import answer
 from ipomdp_gaze.vision.detectors import load_factory
 from ipomdp_gaze.vision.image_files import decode_quietly
+from ipomdp_gaze.vision.scales import SCALE_TABLES
 from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, FIND_SETTINGS,
                                        fovea_for_model, full_frame_reason, full_frame_search,
-                                       search_all, search_image, search_many, size_distance)
+                                       prepare_many, search_all, search_image, search_many,
+                                       size_distance)
 import numpy as np
 
 from .common import nonneg_int
@@ -506,6 +513,12 @@ def _in_given_pixels(result, scale: tuple, given: tuple):
                    detections=tuple((u * sx, v * sy) for u, v in result.detections), faces=faces)
 
 
+def scale_table(model):
+    """Return the coarse-pass table of the model's detector (None: the fovea's own scan)."""
+    kind = (model.meta.get('detector') or {}).get('kind', 'haar')
+    return SCALE_TABLES.get(kind)
+
+
 def search_one(image, task, settings, rng, find_all: bool) -> list:
     """Search one image: the fovea within one full scan's pixels, or the full frame (say why)."""
     width, height = image.shape[1], image.shape[0]
@@ -517,7 +530,10 @@ def search_one(image, task, settings, rng, find_all: bool) -> list:
         return results if find_all else results[:1]
     budget = width * height
     if settings.targets == 'many':
-        return [search_many(image, task.fovea, task.model, settings, pixel_budget=budget)]
+        scales = scale_table(task.model)
+        prepare_many(task.fovea, task.model, (width, height), scales)      # one-time set-up
+        return [search_many(image, task.fovea, task.model, settings, pixel_budget=budget,
+                            scales=scales)]
     if find_all:
         return search_all(image, task.fovea, task.model, task.policy, settings, rng=rng,
                           pixel_budget=budget)

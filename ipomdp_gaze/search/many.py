@@ -10,7 +10,8 @@ The same steps and results as :class:`ipomdp_gaze.search.session.SearchSession` 
 
 1. ``reset``: every cell's log odds ``log(q / (1 - q))`` with ``(1 - q)^N = absent_prior``
    (:func:`~ipomdp_gaze.model.occupancy.cell_prior`; ``q = 1/N`` without one);
-2. ``scan``: ``L_j += log s_T(c_j) - log s_N(c_j)``;
+2. ``scan``: ``L_j += log s_T(c_j) - log s_N(c_j)`` (or a sensor's own per-cell term, a frame
+   of kind ``evidence``);
 3. ``update``: ``L_j += l_j`` of the frame (the single-target belief's own term), with a still
    scene's repeated views weighted by ``repeat_weight`` (:mod:`ipomdp_gaze.model.still_evidence`:
    1 is naive Bayes);
@@ -238,15 +239,22 @@ class OccupancySession:
         return Frame(self.check_frame(values), kind=kind)
 
     def scan(self, frame: Frame) -> StepResult:
-        """Apply the one-time scan: ``L_j += log s_T(c_j) - log s_N(c_j)`` (once, first)."""
+        """
+        Apply the one-time scan: ``L_j += log s_T(c_j) - log s_N(c_j)`` (once, first).
+
+        A frame of kind ``'evidence'`` carries the log-likelihood ratios themselves (a sensor
+        with its own calibration: ``find --all``'s coarse pass, :mod:`ipomdp_gaze.vision.
+        scales`); they are added as they are.
+        """
         s = self._s()
         if s['fixation'] is not None or s['scanned']:
             raise OrderError('the one-time scan comes once, before the first fixation')
         if not self.settings.scan:
             return self._result('applied', reason='scan off')
         try:
-            term = self.observation.scan_log_likelihood_ratio(
-                check_evidence(frame.values, self.grid.n_cells))
+            values = check_evidence(frame.values, self.grid.n_cells)
+            term = (np.nan_to_num(values) if frame.kind == 'evidence' else
+                    self.observation.scan_log_likelihood_ratio(values))
         except EvidenceError as exc:
             return self._result('rejected', reason=str(exc))
         s['scanned'] = True

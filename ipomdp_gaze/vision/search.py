@@ -45,15 +45,19 @@ from dataclasses import dataclass, replace
 import math
 import time
 
+import cv2
 from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.occupancy import cell_prior, prior_log_odds
 from ipomdp_gaze.search import answer
 from ipomdp_gaze.search.many import OccupancySession
 from ipomdp_gaze.search.sensors import run_search
 from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
-from ipomdp_gaze.vision.detector import detector_window_px
+from ipomdp_gaze.vision.detector import detector_window_px, group_boxes
 from ipomdp_gaze.vision.detectors import detector_from_settings  # noqa: F401 (its old home)
 from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea
 from ipomdp_gaze.vision.fovea_model import check_model, fovea_for_model  # noqa: F401
+from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evidence,
+                                       ScaleTable)
 from ipomdp_gaze.vision.sensors import FoveaSensor
 import numpy as np
 
@@ -530,6 +534,105 @@ class _Recorder:
         return Frame(obs.counts, detector_pixels=obs.detector_pixels, seconds=obs.seconds)
 
 
+class _Coarse(_Recorder):
+    """
+    A fovea sensor whose one-time scan is the coarse full-frame pass (:mod:`.scales`).
+
+    The detector runs once on the whole image at the table's coarsest scale that sees faces
+    of the sizes that matter; its boxes become evidence per cell. Each group of cells a weak
+    box left undecided is then cropped (with a margin of two cells) and detected at the next
+    finer scale of the table, whose evidence replaces the coarser one for those cells (and
+    their neighbours), until no cell is undecided, the finest scale was used or the next crop
+    would pass ``budget`` pixels. All of it is one frame of kind ``evidence``; fixations are
+    the fovea's windows, for cells still undecided.
+    """
+
+    def __init__(self, fovea: Fovea, table, image_px: tuple[int, int], prior: np.ndarray,
+                 confidence: float, budget: float = math.inf):
+        super().__init__(fovea)
+        self.scans = True
+        self.table, self.image_px, self.prior = table, image_px, prior
+        self.scale = choose_scale(table, image_px)
+        self.detector = coarse_detector(fovea.detector, table.weak_score)
+        self.threshold = math.log(confidence / (1.0 - confidence))
+        self.budget = budget
+        self.image = None
+        self.looks = []
+
+    def start(self, scene):
+        super().start(scene)
+        self.image = scene
+
+    def scan_cost(self):
+        width, height = self.image_px
+        return (int(np.floor(width * self.scale + 0.5))
+                * int(np.floor(height * self.scale + 0.5)))
+
+    def _look(self, rect, scale):
+        """Detect in ``rect`` (x0, y0, x1, y1) at ``scale``: strong, weak boxes, pixels."""
+        from ipomdp_gaze.vision.fullframe import scan
+        x0, y0, x1, y1 = rect
+        found = scan(self.image[y0:y1, x0:x1], self.detector, (1, 1), scale)
+        raw = found.boxes_px + (x0, y0, 0, 0)
+        scores = np.ones(len(raw)) if found.scores is None else np.asarray(found.scores)
+        if self.table.strong_score > 0:
+            strong = raw[scores >= self.table.strong_score]
+            weak = raw[scores < self.table.strong_score]
+        else:           # a grouping detector: its grouped boxes strong, looser groups weak
+            strong = found.grouped_px + (x0, y0, 0, 0)
+            weak = (group_boxes(np.round(raw), self.table.weak_neighbors) if len(raw)
+                    else raw)
+        self.boxes.append(raw)
+        self.scores.append(scores)
+        self.looks.append((tuple(int(v) for v in rect), scale, found.detector_pixels))
+        return strong, weak, found.detector_pixels
+
+    def scan(self):
+        t0 = time.perf_counter()
+        width, height = self.image_px
+        strong, weak, pixels = self._look((0, 0, width, height), self.scale)
+        term = coarse_evidence(self.table.row(self.scale), self.grid, self.image_px, pixels,
+                               strong, weak, self.prior)
+        for row in (r for r in self.table.rows if r.scale > self.scale):
+            undecided = np.abs(self.prior + term) < self.threshold
+            if not undecided.any():
+                break
+            _, _, stats, _ = cv2.connectedComponentsWithStats(
+                undecided.reshape(self.grid.shape).astype(np.uint8), connectivity=8)
+            for col, row_, n_cols, n_rows, _ in stats[1:]:
+                box = (slice(row_, row_ + n_rows), slice(col, col + n_cols))
+                rect = _cell_rect(self.grid, box, 2, self.image_px)
+                cost = (int(np.floor((rect[2] - rect[0]) * row.scale + 0.5))
+                        * int(np.floor((rect[3] - rect[1]) * row.scale + 0.5)))
+                if pixels + cost > self.budget:
+                    break
+                strong, weak, spent = self._look(rect, row.scale)
+                pixels += spent
+                fine = coarse_evidence(row, self.grid, self.image_px, spent, strong, weak,
+                                       self.prior)
+                inner = np.zeros(self.grid.shape, dtype=bool)
+                inner[_grown(box, 1, self.grid.shape)] = True
+                term = np.where(inner.reshape(-1), fine, term)
+        return Frame(term, kind='evidence', detector_pixels=pixels,
+                     seconds=time.perf_counter() - t0)
+
+
+def _grown(box: tuple, margin: int, shape: tuple) -> tuple:
+    """Return a pair of row and column slices grown by ``margin`` cells within ``shape``."""
+    return tuple(slice(max(0, b.start - margin), min(n, b.stop + margin))
+                 for b, n in zip(box, shape))
+
+
+def _cell_rect(grid: Grid, box: tuple, margin: int, image_px: tuple) -> tuple:
+    """Return the pixel rectangle (x0, y0, x1, y1) of a box of cells grown by ``margin``."""
+    rows, cols = _grown(box, margin, grid.shape)
+    width, height = image_px
+    return (int(np.floor(cols.start * width / grid.cols)),
+            int(np.floor(rows.start * height / grid.rows)),
+            int(np.ceil(cols.stop * width / grid.cols)),
+            int(np.ceil(rows.stop * height / grid.rows)))
+
+
 _COSTS = {}
 
 
@@ -552,11 +655,26 @@ def fixation_costs(fovea: Fovea, image_px: tuple[int, int]) -> np.ndarray:
     return _COSTS[key]
 
 
+def prepare_many(fovea: Fovea, model, image_px: tuple[int, int],
+                 scales: ScaleTable | None = None) -> None:
+    """
+    Build what :func:`search_many` builds once, outside its seconds (as ``find`` sets up).
+
+    The belief's information table of the model, the fixation costs of the image size and,
+    with ``scales``, the coarse pass's detector; all cached, so a second call costs nothing.
+    """
+    OccupancySession(fovea.grid, model, replace(FIND_SETTINGS, targets='many'))
+    fixation_costs(fovea, image_px)
+    if scales is not None:
+        coarse_detector(fovea.detector, scales.weak_score)
+
+
 def search_many(image: np.ndarray, fovea: Fovea, model,
                 settings: SearchSettings | None = None, *,
                 pixel_budget: int | None = None, link: int = FACE_RADIUS,
                 settle: int = SETTLE_RADIUS,
-                empty_by_evidence: bool = EMPTY_BY_EVIDENCE) -> ImageSearch:
+                empty_by_evidence: bool = EMPTY_BY_EVIDENCE,
+                scales: ScaleTable | None = None) -> ImageSearch:
     """
     Search one image for every face at once: the many-target belief (``search.targets: many``).
 
@@ -569,6 +687,11 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     other are one cluster); cells within ``settle`` of an occupied cell need no decision of
     their own (:class:`~ipomdp_gaze.search.many.OccupancySession`, ``link``). ``decision`` is
     ``found`` when a face was reported, else ``absent`` (or ``gave_up``).
+
+    With ``scales`` (a detector's :class:`~ipomdp_gaze.vision.scales.ScaleTable`; ``find
+    --all``) the one-time scan is the coarse full-frame pass at the coarsest scale that sees
+    faces of the sizes that matter, and the fovea's finer windows are spent only on the cells
+    it leaves undecided (a weak detection); without, the fovea's own scan (as before).
 
     Raises
     ------
@@ -583,7 +706,13 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     session = OccupancySession(fovea.grid, model, settings,
                                costs=fixation_costs(fovea, image_px), link=settle,
                                empty_by_evidence=empty_by_evidence)
-    sensor = _Recorder(fovea)
+    if scales is None:
+        sensor = _Recorder(fovea)
+    else:
+        prior = prior_log_odds(fovea.grid.n_cells,
+                               cell_prior(fovea.grid.n_cells, settings.absent_prior))
+        sensor = _Coarse(fovea, scales, image_px, prior, settings.confidence,
+                         math.inf if pixel_budget is None else pixel_budget)
     outcome = run_search(session, sensor, image, pixel_budget=pixel_budget)
     boxes = np.concatenate(sensor.boxes) if sensor.boxes else np.zeros((0, 4))
     scores = np.concatenate(sensor.scores) if sensor.scores else np.zeros(0)

