@@ -10,27 +10,39 @@ from ipomdp_gaze.vision.pan_tilt import MAX_FACES, PanTiltSceneSet, parse_faces
 import numpy as np
 import pytest
 
-# sha256 of today's one-face scenes (before rooms existed), with their face.
-TODAY = {('train', 0, 0): ('598c1b225217d4858f877a206145568e0b599467f2f2694ecf36961bbd71b608',
-                           (9, 4), (403.5, 712.5), 67, 43),
-         ('test', 5, 2): ('0dd474f135c9e57e16d641e5ff81bc1cecbcd361b8f1cfbf3753f61112d6a50a',
-                          (9, 6), (519.5, 712.5), 43, 86)}
+# Today's one-face scenes (before rooms existed): their face (cell, centre, side, index) and the
+# image's mean and spread, over the whole scene and the face's square. Not a byte hash: the
+# sha256 taken when rooms came in (same code, same seeds) did not reproduce on another machine
+# (2026-12-03), where resizing and blending round a few pixels the other way; a crop, a face or
+# a position that changed moves these numbers by far more than the tolerance.
+TODAY = {('train', 0, 0): ((9, 4), (403.5, 712.5), 67, 43, (118.050, 38.407), (106.398, 37.091)),
+         ('test', 5, 2): ((9, 6), (519.5, 712.5), 43, 86, (126.774, 38.758), (134.663, 33.083))}
 
 
 def _sha(image) -> str:
     return hashlib.sha256(image.tobytes()).hexdigest()
 
 
+def _stats(image) -> tuple[float, float]:
+    pixels = np.asarray(image, dtype=float)
+    return float(pixels.mean()), float(pixels.std())
+
+
 @pytest.mark.parametrize('key', sorted(TODAY))
-def test_one_face_scenes_are_todays_bit_for_bit(key):
+def test_one_face_scenes_are_todays(key):
     split, seed, index = key
-    digest, cell, centre, side, face = TODAY[key]
+    cell, centre, side, face, whole, face_square = TODAY[key]
+    images = []
     for faces in (1, '1', (1, 1)):
         scene = PanTiltSceneSet(split, seed=seed, faces=faces).scene(index)
-        assert _sha(scene.image) == digest
+        images.append(scene.image.tobytes())
         assert (scene.cell, scene.face_centre_px, scene.face_px, scene.face_index) == \
             (cell, centre, side, face)
         assert [f.cell for f in scene.faces] == [cell]
+        x, y, half = int(centre[0] - side / 2), int(centre[1] - side / 2), side
+        assert _stats(scene.image) == pytest.approx(whole, abs=0.01)
+        assert _stats(scene.image[y:y + half, x:x + half]) == pytest.approx(face_square, abs=0.01)
+    assert len(set(images)) == 1           # one scene, however the count is spelled
 
 
 def _squares_apart(faces) -> bool:
