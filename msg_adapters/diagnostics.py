@@ -7,8 +7,12 @@ The ``found`` event is a ``diagnostic_msgs/DiagnosticStatus`` (level OK, a reada
 whose ``values`` carry the result as key/value strings: ``row``, ``col``, ``cell``, ``pan_rad``,
 ``tilt_rad``, ``probability`` and ``fixations``. The ``absent`` event carries ``probability``
 (``P(absent)``) and ``fixations``, the ``gave_up`` event ``fixations`` (level WARN: the search
-ended undecided). They read well in ``ros2 topic echo`` and need no custom interface package;
-:func:`parse_found`, :func:`parse_absent` and :func:`parse_gave_up` turn them back into numbers.
+ended undecided). With motion on, ``lost`` (the tracked target's belief fell below
+``motion.keep_probability``: ``row``, ``col``, ``cell`` where it was last found, ``probability``
+of the most likely cell now, ``absent_probability``, ``fixations``, ``seconds_tracked``) and
+``reacquired`` (found again after ``lost``: the ``found`` keys and ``seconds_lost``). They read
+well in ``ros2 topic echo`` and need no custom interface package; the ``parse_*`` functions turn
+them back into numbers.
 """
 from __future__ import annotations
 
@@ -20,6 +24,9 @@ LEVELS = {'ok': DiagnosticStatus.OK, 'warn': DiagnosticStatus.WARN,
 FOUND_KEYS = ('row', 'col', 'cell', 'pan_rad', 'tilt_rad', 'probability', 'fixations')
 ABSENT_KEYS = ('probability', 'fixations')
 GAVE_UP_KEYS = ('fixations',)
+LOST_KEYS = ('row', 'col', 'cell', 'probability', 'absent_probability', 'fixations',
+             'seconds_tracked')
+REACQUIRED_KEYS = FOUND_KEYS + ('seconds_lost',)
 ROOM_DONE_KEYS = ('people', 'new_people', 'fixations', 'search_id')
 
 
@@ -102,6 +109,32 @@ def gave_up_status(name: str, fixations: int) -> DiagnosticStatus:
                   {'fixations': fixations})
 
 
+def lost_status(name: str, row: int, col: int, cell: int, probability: float,
+                absent_probability: float, fixations: int,
+                seconds_tracked: float) -> DiagnosticStatus:
+    """Build the ``lost`` event (level WARN): the tracked target is no longer found."""
+    message = (f'target lost: last found at row {row}, col {col}, tracked '
+               f'{seconds_tracked:.2f} s; most likely cell now {probability:.4f}, nobody here '
+               f'{absent_probability:.4f} after {fixations} fixations')
+    return status(name, 'warn', message, {
+        'row': row, 'col': col, 'cell': cell, 'probability': float(probability),
+        'absent_probability': float(absent_probability), 'fixations': fixations,
+        'seconds_tracked': float(seconds_tracked)})
+
+
+def reacquired_status(name: str, row: int, col: int, cell: int, pan_rad: float,
+                      tilt_rad: float, probability: float, fixations: int,
+                      seconds_lost: float) -> DiagnosticStatus:
+    """Build the ``reacquired`` event: found again ``seconds_lost`` after ``lost``."""
+    message = (f'target reacquired at row {row}, col {col} (pan {pan_rad:+.4f} rad, tilt '
+               f'{tilt_rad:+.4f} rad) with probability {probability:.4f}, {seconds_lost:.2f} s '
+               f'after it was lost, after {fixations} fixations')
+    return status(name, 'ok', message, {
+        'row': row, 'col': col, 'cell': cell, 'pan_rad': float(pan_rad),
+        'tilt_rad': float(tilt_rad), 'probability': float(probability), 'fixations': fixations,
+        'seconds_lost': float(seconds_lost)})
+
+
 def room_done_status(name: str, people: int, new_people: int, fixations: int, search_id: int,
                      recheck: bool, forced_by: str = '',
                      confidence: float | None = None) -> DiagnosticStatus:
@@ -163,6 +196,16 @@ def parse_absent(msg: DiagnosticStatus) -> dict:
 def parse_gave_up(msg: DiagnosticStatus) -> dict:
     """Read a ``gave_up`` event (fixations as int); ValueError if bad."""
     return _parse(msg, 'gave_up', GAVE_UP_KEYS, ('fixations',))
+
+
+def parse_lost(msg: DiagnosticStatus) -> dict:
+    """Read a ``lost`` event (row, col, cell and fixations as int, the rest as float)."""
+    return _parse(msg, 'lost', LOST_KEYS, ('row', 'col', 'cell', 'fixations'))
+
+
+def parse_reacquired(msg: DiagnosticStatus) -> dict:
+    """Read a ``reacquired`` event (as :func:`parse_lost`); ValueError if bad."""
+    return _parse(msg, 'reacquired', REACQUIRED_KEYS, ('row', 'col', 'cell', 'fixations'))
 
 
 def parse_room_done(msg: DiagnosticStatus) -> dict:

@@ -1,9 +1,10 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """The log-domain belief update against a brute-force Bayes posterior, and its edge cases."""
-from ipomdp_gaze.model.belief import (argmax_ties_low, bayes_update, entropy, EvidenceError,
+from ipomdp_gaze.model.belief import (argmax_ties_low, bayes_update, entropy, entropy_of_log,
+                                      EvidenceError,
                                       fixate_target_reward, infomax_reward, map_cell,
-                                      uniform_log_belief)
+                                      normalize_log, uniform_log_belief)
 from ipomdp_gaze.model.observation import check_evidence
 from ipomdp_gaze.model.observation import gaussian_log_likelihood_ratio as llr
 import numpy as np
@@ -156,3 +157,16 @@ def test_entropy_and_the_tie_rule_of_one_belief_are_those_of_a_batch_bit_for_bit
     for row, belief in enumerate(beliefs):
         assert entropy(belief) == entropy(beliefs)[row]
         assert argmax_ties_low(belief) == batch[row]
+
+
+@pytest.mark.parametrize('n, impossible', [(1, 0), (7, 0), (121, 3), (16384, 100)])
+def test_entropy_of_a_log_belief_is_the_entropy_of_its_probabilities(n, impossible):
+    """The controller's entropy from the logs: the same value, cells at -inf counted 0."""
+    rng = np.random.default_rng(n)
+    log_b = rng.normal(size=n) * 4
+    log_b[rng.permutation(n)[:impossible]] = -np.inf
+    if n > impossible + 2:
+        log_b[np.isfinite(log_b).nonzero()[0][:2]] -= 800.0     # exp underflows to 0 there
+    log_b = normalize_log(log_b)
+    assert entropy_of_log(log_b) == pytest.approx(float(entropy(np.exp(log_b))), rel=1e-12,
+                                                  abs=1e-12)

@@ -138,9 +138,38 @@ def test_with_motion_found_reports_keeps_tracking_and_rearms():
     core.fixation = target
     lost = core.offer(frame_at(core, target, strength=-3.0), 2.1)
     assert lost.found is None and core.map_probability < 0.95 and core.decision == ''
+    assert lost.lost is not None and lost.lost.cell == target and lost.lost.fixations == 3
+    assert lost.lost.probability == pytest.approx(core.map_probability)
+    assert lost.lost.seconds_tracked == pytest.approx(1.1)
     core.fixation = target
     back = core.offer(frame_at(core, target, strength=10.0), 2.2)
-    assert back.found is not None and back.found.fixations == 4 and not core.stopped
+    assert back.found is None and not core.stopped       # a find after a loss: reacquired
+    assert back.reacquired is not None and back.reacquired.fixations == 4
+    assert back.reacquired.cell == target and back.reacquired.seconds_lost == pytest.approx(0.1)
+    assert (core.losses, core.reacquisitions) == (1, 1) and core.lost is None
+
+
+def test_a_still_search_never_loses_what_it_found():
+    """Without motion a decision ends the search: no lost, no reacquired."""
+    core = controller(confidence=0.95)
+    target = GRID.center_index
+    first = core.offer(frame_at(core, target, strength=10.0), 1.0)
+    assert first.found is not None and core.stopped and first.lost is None
+    after = core.offer(frame_at(core, target, strength=-3.0), 2.0)
+    assert after.status == 'skipped' and after.lost is None and core.losses == 0
+
+
+def test_a_reset_forgets_the_loss():
+    """After ~/reset the first find is found again, not reacquired."""
+    core = controller(motion_sigma_cells=0.2, confidence=0.95)
+    target = GRID.center_index
+    core.offer(frame_at(core, target, strength=10.0), 1.0)
+    core.fixation = target
+    assert core.offer(frame_at(core, target, strength=-3.0), 2.0).lost is not None
+    core.reset(3.0)
+    assert (core.losses, core.reacquisitions, core.lost) == (0, 0, None)
+    first = core.offer(frame_at(core, target, strength=10.0), 4.0)
+    assert first.found is not None and first.reacquired is None
 
 
 def test_absent_prior_changes_apply_from_the_next_reset():

@@ -27,7 +27,8 @@ VALUE_KEYS = ['policy', 'enabled', 'evidence_rate_hz', 'frames_received', 'frame
               'frames_rejected', 'frames_skipped', 'frames_dropped', 'seconds_without_evidence',
               'fixations', 'fixation_row', 'fixation_col', 'entropy_nats', 'most_likely_row',
               'most_likely_col', 'most_likely_probability', 'found', 'pan_tilt_resends',
-              'last_rejection', 'absent_probability', 'decision', 'search_ended']
+              'last_rejection', 'absent_probability', 'decision', 'search_ended', 'lost',
+              'reacquired']
 
 
 def health(enabled=True, stall_timeout_s=5.0, without_s=0.5, arrived=3, rejected=0,

@@ -18,6 +18,7 @@ import pytest
 # installed but broken package fails them (IPOMDP_GAZE_REQUIRE_ROS: a skip fails too).
 if HAVE_ROS_MSGS:
     from builtin_interfaces.msg import Time
+    from diagnostic_msgs.msg import DiagnosticStatus
     from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, stamps
     from ipomdp_gaze.msg_adapters.grid_arrays import LayoutError
     from sensor_msgs.msg import Image, JointState
@@ -184,6 +185,22 @@ def test_bad_evidence_images(kwargs, err, words):
 
 
 # -- diagnostics and stamps ---------------------------------------------------------------------
+def test_lost_and_reacquired_events_round_trip():
+    lost = diagnostics.lost_status('/gaze_controller: lost', 2, 9, 31, 0.41, 0.35, 17, 4.25)
+    assert lost.level == DiagnosticStatus.WARN and 'row 2, col 9' in lost.message
+    assert diagnostics.parse_lost(lost) == {
+        'row': 2, 'col': 9, 'cell': 31, 'probability': 0.41, 'absent_probability': 0.35,
+        'fixations': 17, 'seconds_tracked': 4.25}
+    again = diagnostics.reacquired_status('/gaze_controller: reacquired', 4, 1, 45, -0.3, 0.05,
+                                          0.97, 25, 1.5)
+    assert again.level == DiagnosticStatus.OK and '1.50 s after it was lost' in again.message
+    assert diagnostics.parse_reacquired(again) == {
+        'row': 4, 'col': 1, 'cell': 45, 'pan_rad': -0.3, 'tilt_rad': 0.05, 'probability': 0.97,
+        'fixations': 25, 'seconds_lost': 1.5}
+    with pytest.raises(ValueError, match='lacks'):
+        diagnostics.parse_lost(diagnostics.found_status('x', 1, 1, 12, 0.0, 0.0, 0.9, 3))
+
+
 def test_found_event_round_trip():
     msg = diagnostics.found_status('/gaze_controller: found', 3, 7, 40, 0.1, -0.2, 0.9734, 6)
     assert 'row 3, col 7' in msg.message

@@ -8,9 +8,10 @@ continuation lines) is run in a fresh folder, in order, with ``.venv/bin/python`
 ``.venv/bin/ipomdp-gaze`` standing for this interpreter and its CLI; what it prints (stdout and
 stderr, in order) must be the lines shown under it, numbers included, with times aside
 (``seconds=...``). A ``...`` line stands for any lines. Transcripts of commands that start ROS
-nodes (``demo``, ``record``, ``replay`` of a demo's bag) and those whose inputs the README does
-not create (``mine/``, ``photo.png``) are not run; the demo outputs the README shows are
-compared with ``ipomdp-gaze demo`` runs by a ROS test here.
+nodes (``demo``, ``record``, ``replay`` of a demo's bag) run in ROS tests here (the demo outputs
+the README shows, and the record and replay transcript in order, the bag's size aside); those
+whose inputs the README does not create (``mine/``, ``photo.png``) are not run. Every
+``ipomdp-gaze`` command in a fenced block must parse with the CLI's own parser.
 """
 from pathlib import Path
 import re
@@ -28,6 +29,12 @@ TIMES = (re.compile(r'seconds=\d+\.\d+'), 'seconds=<time>')
 
 def transcripts() -> list:
     """Return ``[(commands, outputs)]`` of the README's runnable transcripts."""
+    return [steps for steps in _all_transcripts()
+            if all(RUNNABLE.match(command) for command, _ in steps)]
+
+
+def _all_transcripts() -> list:
+    """Return ``[(commands, outputs)]`` of every transcript in the README."""
     found = []
     for block in FENCE.findall((ROOT / 'README.md').read_text()):
         lines = block.splitlines()
@@ -45,8 +52,7 @@ def transcripts() -> list:
                 shown.append(lines[i])
                 i += 1
             steps.append((command, shown))
-        if all(RUNNABLE.match(command) for command, _ in steps):
-            found.append(steps)
+        found.append(steps)
     return found
 
 
@@ -113,3 +119,67 @@ def test_the_readme_shows_what_the_demo_prints(ros_env, line, options):
     shown = _block_with(line)
     assert _contains(shown, run.stdout.splitlines()), \
         'README shows:\n' + '\n'.join(shown) + '\nprinted:\n' + run.stdout
+
+
+def readme_commands() -> list:
+    """Return every ``ipomdp-gaze`` command in the README's fenced blocks (its arguments)."""
+    commands = []
+    for block in FENCE.findall((ROOT / 'README.md').read_text()):
+        lines = block.splitlines()
+        i = 0
+        while i < len(lines):
+            line = lines[i]
+            while line.rstrip().endswith('\\') and i + 1 < len(lines):
+                i += 1
+                line = line.rstrip()[:-1] + ' ' + lines[i].strip()
+            i += 1
+            # A command, not an output line such as ``ipomdp-gaze find: shipped ...``.
+            match = re.match(r'^(?:\$ )?(?:\.venv/bin/)?ipomdp-gaze\s+([a-z_-]+(?:\s.*)?)$',
+                             line.strip())
+            if match:
+                commands.append(match.group(1))
+    return commands
+
+
+def test_every_readme_command_parses():
+    """A README command with a renamed or dropped flag fails here, without running it."""
+    import shlex
+    from ipomdp_gaze.cli import build_parser
+    parser, bad = build_parser(), []
+    assert len(readme_commands()) >= 20
+    for command in readme_commands():
+        words = shlex.split(command, comments=True)
+        words = words[:next((k for k, w in enumerate(words) if w in ('|', '>', '&&', ';')),
+                            len(words))]
+        try:
+            parser.parse_args(words)
+        except SystemExit as exc:
+            if exc.code:
+                bad.append(command)
+    assert not bad, bad
+
+
+# What varies between runs of the record and replay transcript: the bag's size, message count
+# and seconds (the images taken before the search began) and the search's seconds, not the
+# search.
+BAG_SIZE = (re.compile(r'\d+ messages, [\d.]+ MB, [\d.]+ s recorded; (\d+) frames over [\d.]+ s'
+                       r'(.*); [\d.]+ MB per minute of recording'),
+            r'N messages, M MB, S s recorded; \1 frames over T s\2; R MB per minute of recording')
+
+
+@pytest.mark.ros
+def test_the_readme_record_and_replay_transcript(ros_env, tmp_path):
+    """Issue 35: the README's demo --record, replay and replay --policy map, in order."""
+    steps = [step for steps in _all_transcripts() for step in steps
+             if steps[-1][0].endswith('replay faces-bag --policy map')]
+    assert [command.split('ipomdp-gaze ')[1] for command, _ in steps] == [
+        'demo --scene faces --seed 0 --record faces-bag', 'replay faces-bag',
+        'replay faces-bag --policy map']
+    for command, shown in steps:
+        run = subprocess.run(['bash', '-c', _shell(command) + ' 2>&1'], cwd=tmp_path,
+                             env=ros_env, capture_output=True, text=True, timeout=300)
+        assert run.returncode == 0, run.stdout
+        printed = [BAG_SIZE[0].sub(BAG_SIZE[1], line) for line in run.stdout.splitlines()]
+        expected = [BAG_SIZE[0].sub(BAG_SIZE[1], line) for line in shown]
+        assert _matches(expected, printed), (f'{command}\nREADME shows:\n' + '\n'.join(shown)
+                                             + '\nprinted:\n' + '\n'.join(printed))

@@ -19,14 +19,16 @@ remapping work:
   foveal detector serves), ``belief`` (``Float32MultiArray``) and ``belief_image`` (``rgb8``)
   after every update and reset (the N cell probabilities, summing to ``1 - P(absent)``), the
   search events ``found``, ``absent`` and ``gave_up`` (``diagnostic_msgs/DiagnosticStatus``,
-  reliable) and ``/diagnostics``; optionally
+  reliable; with motion on also ``lost`` and ``reacquired``) and ``/diagnostics``; optionally
   ``Float64MultiArray`` and ``JointTrajectory`` head commands on the topics their parameters name;
 - services ``~/reset`` (``std_srvs/Trigger``) and ``~/enable`` (``std_srvs/SetBool``).
 
 For a still target a decision (``found``, ``absent``) or ``gave_up`` ends the search: no new
 target is sent until ``~/reset``. With ``motion.sigma_cells`` or ``motion.jump_prob`` set (per
 second), the belief is predicted over the time between frames and the controller keeps tracking
-after ``found`` (docs/design.md section 7).
+after ``found`` (docs/design.md section 7): ``lost`` when the belief at the target falls below
+``motion.keep_probability``, ``reacquired`` (not a second ``found``) when it is found again
+(section 12.5).
 
 With ``search.targets: many`` (docs/design.md section 11.6) the core runs the occupancy belief
 and the node also publishes ``~/targets`` (``geometry_msgs/PoseArray``, the head direction of
@@ -168,7 +170,7 @@ class GazeControllerNode(Node):
         self._image_pub = self.create_publisher(Image, 'belief_image', 2)
         # Events: reliable, volatile, depth 10, so a default-QoS subscriber receives them.
         self._event_pubs = {name: self.create_publisher(DiagnosticStatus, name, 10)
-                            for name in ('found', 'absent', 'gave_up')}
+                            for name in ('found', 'absent', 'gave_up', 'lost', 'reacquired')}
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self._targets_pub = self._cells_pub = None
         self._make_room_publishers()
@@ -443,7 +445,7 @@ class GazeControllerNode(Node):
         return min(self._config.values['belief_image_scale_px'], fit)
 
     def _publish_events(self, result) -> None:
-        """Publish and log the events a frame fired (found, absent, gave_up)."""
+        """Publish and log the events a frame fired (found, absent, gave_up, lost, reacquired)."""
         name = self.get_fully_qualified_name()
         ending = '' if not self.core.stopped or self._many else \
             '; the search has ended until ~/reset'
@@ -474,6 +476,27 @@ class GazeControllerNode(Node):
                 f'{answer.heading("absent", absent.forced_by)}: nobody is here, probability '
                 f'{absent.probability:.4f} that nobody is here, after {absent.fixations} '
                 f'fixations{clause}{ending}')
+        if result.lost is not None:
+            lost = result.lost
+            row, col = self._config.grid.cell(lost.cell)
+            self._event_pubs['lost'].publish(diagnostics.lost_status(
+                f'{name}: lost', row, col, lost.cell, lost.probability, lost.absent_probability,
+                lost.fixations, lost.seconds_tracked))
+            self.get_logger().warning(
+                f'lost: the target last found at ({row}, {col}) after {lost.seconds_tracked:.2f} '
+                f's of tracking; most likely cell now {lost.probability:.4f}, nobody here '
+                f'{lost.absent_probability:.4f}; searching again')
+        if result.reacquired is not None:
+            again = result.reacquired
+            row, col = self._config.grid.cell(again.cell)
+            pan, tilt = self._config.head.angles(again.cell)
+            self._event_pubs['reacquired'].publish(diagnostics.reacquired_status(
+                f'{name}: reacquired', row, col, again.cell, pan, tilt, again.probability,
+                again.fixations, again.seconds_lost))
+            self.get_logger().info(
+                f'reacquired: the target is most likely at ({row}, {col}), pan {pan:+.4f} rad, '
+                f'tilt {tilt:+.4f} rad, probability {again.probability:.4f}, '
+                f'{again.seconds_lost:.2f} s after it was lost')
         if result.gave_up is not None:
             self._event_pubs['gave_up'].publish(diagnostics.gave_up_status(
                 f'{name}: gave_up', result.gave_up.fixations))

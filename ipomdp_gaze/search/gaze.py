@@ -91,6 +91,32 @@ class Absent:
 
 
 @dataclass(frozen=True)
+class Lost:
+    """
+    The lost event (motion on): the tracked target's belief fell below ``motion.keep_probability``.
+
+    ``cell`` is where it was last found; ``probability`` what the belief within ``found_radius``
+    of the most likely cell holds now, ``absent_probability`` the absent hypothesis's.
+    """
+
+    cell: int
+    probability: float
+    absent_probability: float
+    fixations: int
+    seconds_tracked: float
+
+
+@dataclass(frozen=True)
+class Reacquired:
+    """The reacquired event (motion on): ``found`` again after ``lost``, ``seconds_lost`` later."""
+
+    cell: int
+    probability: float
+    fixations: int
+    seconds_lost: float
+
+
+@dataclass(frozen=True)
 class GaveUp:
     """The gave-up event: the fixation budget ran out before any decision."""
 
@@ -104,8 +130,9 @@ class FrameResult:
 
     ``status`` is ``'applied'``, ``'skipped'`` or ``'rejected'``; ``reason`` says why a frame was
     not applied; ``fixation`` is the new target after an applied frame (None when the search has
-    ended: no new target); ``found``, ``absent`` and ``gave_up`` are set on the frame that fired
-    that event.
+    ended: no new target); ``found``, ``absent``, ``gave_up``, ``lost`` and ``reacquired`` are
+    set on the frame that fired that event (with motion on, a find after a loss is
+    ``reacquired``, not a second ``found``).
     """
 
     status: str
@@ -114,6 +141,8 @@ class FrameResult:
     found: Found | None = None
     absent: Absent | None = None
     gave_up: GaveUp | None = None
+    lost: Lost | None = None
+    reacquired: Reacquired | None = None
 
     @property
     def applied(self) -> bool:
@@ -312,7 +341,9 @@ class GazeController:
         self.search_id += 1
         if not self.wants_scan:
             self.session.start()
-        self.found = self.absent = self.gave_up = None
+        self.found = self.absent = self.gave_up = self.lost = None
+        self.losses = self.reacquisitions = 0
+        self.tracked_since_s = self.lost_since_s = 0.0
         self.target_time_s = self.usable_time_s = self.update_time_s = float(now_s)
         return self.fixation
 
@@ -422,6 +453,7 @@ class GazeController:
             self.skipped += 1
             return FrameResult('skipped', 'taken before the fixation settled')
         dt_s = float(stamp_s) - self.update_time_s
+        tracking = self.motion.active and self.session.decision == 'found'
         step = self.session.update(frame, dt_s=dt_s)
         if not step.applied:
             self.rejected += 1
@@ -429,13 +461,23 @@ class GazeController:
             return FrameResult('rejected', step.reason)
         self.update_time_s = max(self.update_time_s, float(stamp_s))
         self.applied += 1
-        events = self._events(step.fired)
+        events = self._events(step.fired, float(stamp_s))
+        if tracking and step.decision != 'found':
+            events['lost'] = self._lose(float(stamp_s))
         self.target_time_s = self.usable_time_s = float(stamp_s if now_s is None else now_s)
         return FrameResult('applied', fixation=step.fixation, **events)
 
-    def _events(self, fired: str) -> dict:
-        """Return the event objects of what a frame fired (found, absent or gave_up)."""
+    def _events(self, fired: str, stamp_s: float) -> dict:
+        """Return the events a frame fired: found (or reacquired), absent, gave_up."""
         forced_by = self.session.gave_up_reason if fired in ('found', 'absent') else ''
+        if fired == 'found' and self.motion.active:
+            self.tracked_since_s = stamp_s
+        if fired == 'found' and self.lost is not None:
+            self.reacquisitions += 1
+            seconds = max(0.0, stamp_s - self.lost_since_s)
+            self.lost = None
+            return {'reacquired': Reacquired(self.map_cell, self.map_probability, self.fixations,
+                                             seconds)}
         if fired == 'found':
             self.found = Found(self.map_cell, self.map_probability, self.fixations, forced_by)
             return {'found': self.found}
@@ -446,3 +488,12 @@ class GazeController:
             self.gave_up = GaveUp(self.fixations)
             return {'gave_up': self.gave_up}
         return {}
+
+    def _lose(self, stamp_s: float) -> Lost:
+        """Record that the tracked target was lost at ``stamp_s``; return the event."""
+        cell = self.found.cell if self.found is not None else self.map_cell
+        self.lost = Lost(cell, self.map_probability, self.absent_probability, self.fixations,
+                         max(0.0, stamp_s - self.tracked_since_s))
+        self.losses += 1
+        self.lost_since_s = stamp_s
+        return self.lost

@@ -187,5 +187,6 @@ class HealthMonitor:
             'found': core.found is not None, 'pan_tilt_resends': resends,
             'last_rejection': core.last_rejection,
             'absent_probability': core.absent_probability, 'decision': core.decision,
-            'search_ended': core.stopped}
+            'search_ended': core.stopped, 'lost': core.losses,
+            'reacquired': core.reacquisitions}
         return replace(health, values=values)

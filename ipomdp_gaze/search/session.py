@@ -37,7 +37,8 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass, field
 
-from ipomdp_gaze.model.belief import bayes_update, entropy, EvidenceError, map_cell, normalize_log
+from ipomdp_gaze.model.belief import (bayes_update, entropy_of_log, EvidenceError, map_cell,
+                                      normalize_log)
 from ipomdp_gaze.model.false_alarms import FalseAlarmMixture
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.inhibition import policy_choice, unvisited_choice
@@ -366,7 +367,7 @@ class SearchSession:
     def entropy_nats(self) -> float:
         """Entropy of the belief over all its hypotheses, in nats."""
         return self._view('entropy_nats',
-                          lambda: float(entropy(np.exp(self._search.log_belief))))
+                          lambda: entropy_of_log(self._search.log_belief))
 
     @property
     def fixation(self) -> int | None:
