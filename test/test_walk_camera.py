@@ -43,6 +43,13 @@ def test_the_walk_is_the_walk_scene_of_the_seed():
     assert _config(**{'scene.motion': 'still'}).walk is None
 
 
+def test_a_parameter_changed_at_run_time_keeps_the_walk():
+    from ipomdp_gaze.nodes.scene_camera import SceneCameraNode
+    cfg = _config()
+    values = dict(cfg.values, saccade_time_s=0.3)
+    assert SceneCameraNode._build(None, values, previous=cfg).walk is cfg.walk
+
+
 def test_at_speed_zero_every_frame_is_the_still_cameras_bit_for_bit():
     still = _config(**{'scene.motion': 'still'})
     walk = _config(**{'scene.speed_deg_s': 0.0})

@@ -255,10 +255,11 @@ class SceneCameraNode(SaccadeMixin, Node):
 
     # -- parameters ----------------------------------------------------------------------
     def _build(self, values: dict, changed=None, previous=None) -> SceneConfig:
-        """Keep the scene; follow the joint mapping and times (ValueError names the problem)."""
+        """Keep the scene and walk; follow the joint mapping and times (ValueError: why not)."""
         cfg = previous
         head = head_from(values, cfg.grid) if cfg.geometry is not None else None
-        return SceneConfig(dict(values), cfg.grid, cfg.camera, cfg.scene, cfg.geometry, head)
+        return SceneConfig(dict(values), cfg.grid, cfg.camera, cfg.scene, cfg.geometry, head,
+                           cfg.walk)
 
     def _apply_config(self, old: SceneConfig, cfg: SceneConfig) -> None:
         v, ov = cfg.values, old.values
