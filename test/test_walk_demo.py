@@ -119,3 +119,25 @@ def test_a_short_walk_demo_scores_frames_and_ends_with_the_score_line(ros_env, t
     assert scored and 0 < int(scored.group(1)) <= int(scored.group(2)), out
     assert 'stopped all 3 nodes' in out and 'NOT a clean shutdown' not in out
     assert plot.stat().st_size > 0
+
+
+def test_the_bench_says_per_seed_and_on_how_many_seeds_the_face_was_kept_in_view():
+    import importlib.util
+    from ipomdp_gaze.harness.walk_demo import WalkScore
+    spec = importlib.util.spec_from_file_location('bench_walk_demo',
+                                                  REPO / 'bench' / 'ros' / 'walk_demo.py')
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    results = [{'seed': 0, 'status': 0, 'score': WalkScore(100, 60, 0.75, 0.4, 1, 1),
+                'kept': True},
+               {'seed': 1, 'status': 0, 'score': WalkScore(90, 50, 0.3, 0.1, 2, 0),
+                'kept': False},
+               {'seed': 2, 'status': 1, 'score': None, 'kept': False}]
+    assert bench.seed_line(results[0]) == ('seed 0: status 0, 100 frames (60 in reach), in view '
+                                           '75.0%, centre cell 40.0%, lost 1, reacquired 1: '
+                                           'kept')
+    assert bench.seed_line(results[2]).endswith('no frame with the face in reach: not kept')
+    lines = bench.summary_lines(results)
+    assert lines[0].startswith('1 of 3 runs not scored; over the 2 scored: in view 52.5%')
+    assert lines[-1] == ('kept in view on 1 of 3 seeds (in view on >= 50% of the frames with '
+                         'the face in reach)')
