@@ -6,7 +6,8 @@ Conversions between numpy arrays and ROS 2 messages: the only place that touches
 Submodules
 ----------
 grid_arrays
-    Grid-shaped ``Float32MultiArray`` (belief, evidence) and the ``Int32MultiArray`` ground truth.
+    Grid-shaped ``Float32MultiArray`` (belief, evidence), the ``Int32MultiArray`` ground truth
+    and a walking face's ``walk_truth`` per frame.
 joints
     The head commands (``JointState``, ``Float64MultiArray``, ``JointTrajectory``) of the
     angles that :class:`ipomdp_gaze.model.head.PanTiltMap` gives a cell.

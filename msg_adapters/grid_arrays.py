@@ -8,15 +8,23 @@ The layout of a ``rows x cols`` grid is
 ``dim[1] = {label: 'cols', size: cols, stride: cols}``, ``data_offset = 0``, data row-major.
 Incoming arrays with an empty layout are read as row-major of the node's grid when their length
 fits; a layout that disagrees with the grid makes the frame invalid (:class:`LayoutError`).
+
+A walking face's truth per frame (``walk_truth``, a ``Float64MultiArray``, docs/design.md
+section 12.6) is ``[stamp_sec, stamp_nanosec, t_s, row, col, cell_row, cell_col]``: the frame's
+stamp, the walk's time, the face centre's grid position (not rounded) and its cell, ``-1, -1``
+out of the grid's reach.
 """
 from __future__ import annotations
 
 import array
+from dataclasses import dataclass
+import math
 
 from ipomdp_gaze.model.belief import EvidenceError
 from ipomdp_gaze.model.grid import Grid
 import numpy as np
-from std_msgs.msg import Float32MultiArray, Int32MultiArray, MultiArrayDimension, MultiArrayLayout
+from std_msgs.msg import (Float32MultiArray, Float64MultiArray, Int32MultiArray,
+                          MultiArrayDimension, MultiArrayLayout)
 
 
 class LayoutError(EvidenceError):
@@ -188,3 +196,56 @@ def cell_from_row_col(msg, grid: Grid, what: str = 'a cell',
 def cell_from_ground_truth(msg, grid: Grid) -> int | None:
     """Return the cell of a ground-truth ``[row, col]`` message, None for ``[-1, -1]`` (empty)."""
     return cell_from_row_col(msg, grid, 'ground truth', allow_empty=True)
+
+
+WALK_TRUTH_FIELDS = ('stamp_sec', 'stamp_nanosec', 't_s', 'row', 'col', 'cell_row', 'cell_col')
+
+
+@dataclass(frozen=True)
+class WalkTruth:
+    """One frame's walk truth: its stamp, the walk's time, the face's position and cell."""
+
+    stamp: tuple
+    t_s: float
+    position: tuple
+    cell: tuple | None
+
+
+def walk_truth(stamp, t_s: float, position, cell) -> Float64MultiArray:
+    """Build ``walk_truth`` of a frame (module docstring); ``cell`` None out of reach."""
+    row, col = (-1, -1) if cell is None else cell
+    msg = Float64MultiArray(layout=MultiArrayLayout(
+        dim=[MultiArrayDimension(label=','.join(WALK_TRUTH_FIELDS), size=7, stride=7)],
+        data_offset=0))
+    msg.data = [float(stamp.sec), float(stamp.nanosec), float(t_s), float(position[0]),
+                float(position[1]), float(row), float(col)]
+    return msg
+
+
+def read_walk_truth(msg, grid: Grid) -> WalkTruth:
+    """
+    Return the :class:`WalkTruth` of a ``walk_truth`` message.
+
+    Raises
+    ------
+    ValueError
+        If it is not 7 finite values whose stamp is whole and whose cell is in the grid or
+        ``-1, -1``.
+
+    """
+    data = [float(v) for v in msg.data]
+    if len(data) != len(WALK_TRUTH_FIELDS) or not all(math.isfinite(v) for v in data):
+        raise ValueError(f'walk_truth must be 7 finite values ({", ".join(WALK_TRUTH_FIELDS)}), '
+                         f'got {data}')
+    sec, nanosec, t_s, row, col, cell_row, cell_col = data
+    if sec != int(sec) or nanosec != int(nanosec) or not 0 <= nanosec < 1e9:
+        raise ValueError(f'walk_truth stamp must be whole seconds and nanoseconds, got '
+                         f'{sec}, {nanosec}')
+    cell = (int(cell_row), int(cell_col))
+    if cell == (-1, -1) and (cell_row, cell_col) == (-1.0, -1.0):
+        cell = None
+    elif cell != (cell_row, cell_col) or not (0 <= cell[0] < grid.rows
+                                              and 0 <= cell[1] < grid.cols):
+        raise ValueError(f'walk_truth cell ({cell_row:g}, {cell_col:g}) is outside the '
+                         f'{grid.rows}x{grid.cols} grid')
+    return WalkTruth((int(sec), int(nanosec)), t_s, (row, col), cell)

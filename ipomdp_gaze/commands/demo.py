@@ -8,7 +8,9 @@ prints each fixation until the ``found`` event, says where the target is and whe
 right, and shuts both nodes down (see :mod:`ipomdp_gaze.harness.demo`). With ``--scene faces``
 it finds a face in a held-out photograph instead: ``scene_camera``, ``foveal_detector`` and
 ``gaze_controller`` on a camera on the pan/tilt head, or with ``--fovea`` on a fixed camera
-and the digital fovea. The offline, ROS-free search is ``ipomdp-gaze search``.
+and the digital fovea; with ``--motion walk`` the face walks and the nodes track it, scored per
+frame (:mod:`ipomdp_gaze.harness.walk_demo`). The offline, ROS-free search is
+``ipomdp-gaze search``.
 """
 from __future__ import annotations
 
@@ -17,8 +19,12 @@ from pathlib import Path
 
 from ipomdp_gaze.harness.processes import MAX_DOMAIN_ID
 from ipomdp_gaze.vision.pan_tilt import parse_faces
+from ipomdp_gaze.vision.walks import DURATION_S as DEMO_DURATION_S
 
 from .common import nonneg_int, positive_float, positive_int
+
+# --motion walk: the walking speed unless --speed-deg-s says (the offline evaluation's default).
+DEMO_SPEED_DEG_S = 5.0
 
 
 def add_parser(sub):
@@ -44,6 +50,20 @@ def add_parser(sub):
                    help='with --scene faces: a held-out room of K faces (or LO-HI drawn from '
                         '--seed), 0-8, searched for every face by the many-target session '
                         'offline (not yet on ROS); default 1: the ROS demo of one face')
+    p.add_argument('--motion', choices=('still', 'walk'), default='still',
+                   help='with --scene faces on the pan/tilt camera: still (default) or walk: '
+                        'the face of --seed walks (the held-out walk scene), the controller '
+                        'tracks it with config/faces_camera_tracking.yaml for --duration-s of '
+                        'the camera clock; the last line scores the frames with the face in '
+                        'reach: kept in view P%% of frames, centre cell C%%, lost L, '
+                        'reacquired R')
+    p.add_argument('--speed-deg-s', type=float, default=None, metavar='V',
+                   help=f'--motion walk: walking speed in degrees per second, 0-20 (default '
+                        f'{DEMO_SPEED_DEG_S:g})')
+    p.add_argument('--duration-s', type=float, default=None, metavar='D',
+                   help=f'--motion walk: length of the walk and of the demo in seconds of the '
+                        f'camera clock, 1-3600 (default {DEMO_DURATION_S:g}, the offline '
+                        f"walks' length)")
     p.add_argument('--fpoc', choices=('camera', 'human'), default=None,
                    help='FPOC of both nodes (human: 0.42 deg/cell and ELM; default camera)')
     p.add_argument('--policy', default=None,
@@ -112,6 +132,11 @@ def run(args) -> int:
         if path is not None and path.suffix.lower() != suffix:
             raise ValueError(f'{flag} writes a {suffix} file, got {path}')
     faces = parse_faces(args.faces)
+    if args.motion == 'walk':
+        return _walk(args, faces, out)
+    for flag, value in (('--speed-deg-s', args.speed_deg_s), ('--duration-s', args.duration_s)):
+        if value is not None:
+            raise ValueError(f'{flag} goes with --motion walk')
     if faces != (1, 1):
         if args.scene != 'faces' or args.fovea or args.empty:
             raise ValueError('--faces goes with --scene faces on the pan/tilt camera, without '
@@ -154,3 +179,24 @@ def run(args) -> int:
             count = save_gif(pictures, args.animate)
             out(f'wrote {args.animate} ({count} pictures)')
     return status
+
+
+def _walk(args, faces: tuple, out) -> int:
+    """Run ``--motion walk``: the nodes track a walking face; the last line scores them."""
+    from ipomdp_gaze.harness.walk_demo import run_walk_demo, walk_setup
+    from ipomdp_gaze.vision.walks import check_speed
+    if args.scene != 'faces' or args.fovea or args.empty or faces != (1, 1):
+        raise ValueError('--motion walk goes with --scene faces on the pan/tilt camera and one '
+                         'face, without --fovea, --empty or --faces')
+    for flag, value in (('--animate', args.animate), ('--record', args.record),
+                        ('--target', args.target), ('--fpoc', args.fpoc),
+                        ('--max-fixations', args.max_fixations)):
+        if value is not None:
+            raise ValueError(f'{flag} is not available with --motion walk')
+    speed = check_speed(DEMO_SPEED_DEG_S if args.speed_deg_s is None else args.speed_deg_s)
+    duration = DEMO_DURATION_S if args.duration_s is None else args.duration_s
+    if not 1.0 <= duration <= 3600.0:
+        raise ValueError(f'--duration-s must be from 1 to 3600 s, got {duration:g}')
+    setup, camera = walk_setup(args.seed, speed, duration, args.policy)
+    return run_walk_demo(setup, camera, duration, args.timeout, args.domain_id, args.verbose,
+                         out, plot=args.plot)

@@ -144,14 +144,18 @@ class WalkTask:
 
     def in_view(self, truth, head: int) -> bool:
         """Whether the face centre is inside the camera's view with the head at ``head``."""
-        row, col = truth.position
-        r, c = self.grid.cell(int(head))
-        spacing = self.grid.spacing_deg
-        left, top = self.camera.angles_deg(-0.5, -0.5)
-        right, bottom = self.camera.angles_deg(self.camera.width - 0.5,
-                                               self.camera.height - 0.5)
-        dx, dy = (col - c) * spacing, (row - r) * spacing
-        return bool(left <= dx <= right and top <= dy <= bottom)
+        return face_in_view(self.camera, self.grid, truth.position, self.grid.cell(int(head)))
+
+
+def face_in_view(camera, grid, position, head_rc) -> bool:
+    """Whether grid position ``(row, col)`` is in ``camera``'s view, the head at ``head_rc``."""
+    row, col = position
+    r, c = head_rc
+    spacing = grid.spacing_deg
+    left, top = camera.angles_deg(-0.5, -0.5)
+    right, bottom = camera.angles_deg(camera.width - 0.5, camera.height - 0.5)
+    dx, dy = (col - c) * spacing, (row - r) * spacing
+    return bool(left <= dx <= right and top <= dy <= bottom)
 
 
 class SessionTracker:

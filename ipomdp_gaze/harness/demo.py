@@ -158,17 +158,21 @@ def demo_setup(fpoc: str = 'camera', policy: str | None = None, seed: int = 0,
 
 
 def faces_setup(fovea: bool = False, policy: str | None = None, seed: int = 0,
-                empty: bool = False) -> DemoSetup:
+                empty: bool = False, walk: dict | None = None) -> DemoSetup:
     """
     Build the face demo from ``config/faces_<mode>_*.yaml``: scene camera, detector, controller.
 
     ``fovea`` selects the fixed camera and the digital fovea (mode ``fovea``), else the camera
     on the pan/tilt head (mode ``camera``); ``seed`` picks the held-out test scene, ``empty``
-    shows it without its face (the pan/tilt camera's ``scene.empty``).
+    shows it without its face (the pan/tilt camera's ``scene.empty``). ``walk``: the scene
+    camera's ``scene.*`` parameters of a walking face, and the controller runs the tracker's
+    ``config/faces_camera_tracking.yaml`` (docs/design.md section 12.6).
     """
     mode = 'fovea' if fovea else 'camera'
     files = {node: config_file(f'faces_{mode}_{node}.yaml')
              for node in ('controller', 'detector', 'scene_camera')}
+    if walk is not None:
+        files['controller'] = config_file('faces_camera_tracking.yaml')
     controller = {'policy.name': policy} if policy else {}
     values = {p.name: p.default for p in joint_params(limits=True)}
     values.update(yaml_parameters(files['controller'], 'gaze_controller'))
@@ -183,6 +187,7 @@ def faces_setup(fovea: bool = False, policy: str | None = None, seed: int = 0,
     scan = bool(values.get('search.scan', True)) and \
         load_observation(values['observation.file']).has_scan
     camera = {'seed': seed, 'scene.empty': True} if empty else {'seed': seed}
+    camera.update(walk or {})
     return DemoSetup([('controller', _ros_args(files['controller'], controller)),
                       ('detector', _ros_args(files['detector'], {})),
                       ('scene_camera', _ros_args(files['scene_camera'], camera))],

@@ -23,6 +23,13 @@ with ``rate_hz > 0`` it streams frames like a video camera, also while moving. A
 with one stamp. ``ground_truth`` (``std_msgs/Int32MultiArray`` ``[row, col]`` of the face
 centre's cell in the grid of the view, transient local; ``[-1, -1]`` for nobody; a room of
 ``scene.faces`` faces: its first face) is published once when it is known.
+
+With ``scene.motion: walk`` (pan_tilt view, the one-face test scene) the face walks
+(:class:`ipomdp_gaze.vision.walks.WalkSceneSet`, scene of ``seed``, at ``scene.speed_deg_s``
+over ``scene.walk_duration_s``): every frame is drawn at ``t``, the seconds from the node's
+first frame to its stamp on the node's clock, and ``walk_truth`` (``std_msgs/Float64MultiArray``,
+layout in :mod:`ipomdp_gaze.msg_adapters.grid_arrays`) says where the face was in that frame,
+with the frame's stamp (docs/design.md section 12.6). ``ground_truth`` is the walk's start.
 Every callback runs under a :class:`ipomdp_gaze.nodes.guard.CallbackGuard` (its counts in the
 ``/diagnostics`` status ``<node>: callbacks``).
 """
@@ -38,7 +45,7 @@ from ipomdp_gaze.search.controller_config import head_from
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import CameraInfo, Image, JointState
-from std_msgs.msg import Int32MultiArray
+from std_msgs.msg import Float64MultiArray, Int32MultiArray
 
 from . import NODE_NAMES
 from .guard import CallbackGuard
@@ -48,6 +55,7 @@ from .spin import run_node
 
 NODE_NAME = NODE_NAMES['scene_camera']
 VIEWS = ('fixed', 'pan_tilt')
+MOTIONS = ('still', 'walk')
 # Defaults of each view: the grid, the scene's side (fixed) and the face sizes in pixels.
 VIEW_GRIDS = {'fixed': (21, 21, 1.0), 'pan_tilt': (11, 11, 5.0)}
 VIEW_FACES = {'fixed': (60, 140), 'pan_tilt': (30, 70)}
@@ -70,6 +78,14 @@ def scene_camera_params() -> list[Param]:
         Param('scene.faces', '1', T.STRING,
               'pan_tilt view: a room of K faces or LO-HI drawn per seed, 0-8 (1: the one-face '
               'test scene; ground_truth is its first face; read-only)', read_only=True),
+        Param('scene.motion', 'still', T.STRING,
+              'still: the face stays; walk: it walks (pan_tilt view, one-face test scene; '
+              'read-only)', read_only=True, choices=MOTIONS),
+        Param('scene.speed_deg_s', 5.0, T.DOUBLE, 'walk: walking speed in deg/s (read-only)',
+              read_only=True, float_range=(0.0, 20.0)),
+        Param('scene.walk_duration_s', 30.0, T.DOUBLE,
+              'walk: length of the walk in seconds; after it the face stays where it ended '
+              '(read-only)', read_only=True, float_range=(1.0, 3600.0)),
         Param('scene.file', '', T.STRING,
               "a user's image instead of a test scene (read-only)", read_only=True),
         Param('scene.face_x_px', -1.0, T.DOUBLE,
@@ -112,6 +128,7 @@ class SceneConfig:
     scene: object
     geometry: object = None
     head: object = None
+    walk: object = None
 
 
 def _scene_config(values: dict) -> SceneConfig:
@@ -134,6 +151,9 @@ def _scene_config(values: dict) -> SceneConfig:
         centre = (values['scene.face_x_px'], values['scene.face_y_px'])
     if view != 'pan_tilt' and parse_faces(values.get('scene.faces', '1')) != (1, 1):
         raise ValueError('scene.faces is for the pan_tilt view')
+    walking = values.get('scene.motion', 'still') == 'walk'
+    if walking:
+        _check_walk(values, faces)
     if view == 'pan_tilt':
         camera = PinholeCamera.from_fov(values['camera.width'], values['camera.height'],
                                         values['camera.hfov_deg'])
@@ -144,8 +164,13 @@ def _scene_config(values: dict) -> SceneConfig:
             scene = PanTiltSceneSet('test', geometry, faces, 'rgb', values['seed'],
                                     empty=values['scene.empty'],
                                     faces=values.get('scene.faces', '1')).scene(0)
+        walk = None
+        if walking:
+            from ipomdp_gaze.vision.walks import WalkSceneSet
+            walk = WalkSceneSet('test', geometry, values['seed'], values['scene.speed_deg_s'],
+                                values['scene.walk_duration_s']).scene(0)
         return SceneConfig(dict(values), grid, camera, scene, geometry,
-                           head_from(values, grid))
+                           head_from(values, grid), walk)
     if values['scene.file']:
         scene = user_scene(read_scene_file(values['scene.file']), centre, grid=grid.shape)
     else:
@@ -154,6 +179,24 @@ def _scene_config(values: dict) -> SceneConfig:
     height, width = scene.image.shape[:2]
     camera = PinholeCamera.from_fov(width, height, values['camera.hfov_deg'])
     return SceneConfig(dict(values), grid, camera, scene)
+
+
+def _check_walk(values: dict, faces: tuple) -> None:
+    """Refuse ``scene.motion: walk`` where no walk scene exists (ValueError names why)."""
+    from ipomdp_gaze.vision.pan_tilt import FACE_PX, parse_faces
+    why = None
+    if values['view'] != 'pan_tilt':
+        why = 'the pan_tilt view (a fixed camera sees no walk)'
+    elif values['scene.file']:
+        why = "a held-out test scene, not scene.file (a user's image has no walk)"
+    elif values['scene.empty']:
+        why = 'a face to walk, not scene.empty'
+    elif parse_faces(values.get('scene.faces', '1')) != (1, 1):
+        why = f"one face, not scene.faces {values['scene.faces']!r}"
+    elif tuple(faces) != FACE_PX:
+        why = f"the test scenes' face sizes, not scene.face_px {list(faces)}"
+    if why is not None:
+        raise ValueError(f'scene.motion walk needs {why}')
 
 
 class SceneCameraNode(SaccadeMixin, Node):
@@ -175,6 +218,9 @@ class SceneCameraNode(SaccadeMixin, Node):
         self._info_pub = self.create_publisher(CameraInfo, 'camera_info', IMAGE_QOS)
         self._joint_pub = self.create_publisher(JointState, 'joint_states', 10)
         self._truth_pub = self.create_publisher(Int32MultiArray, 'ground_truth', STATE_QOS)
+        self._walk_pub = self.create_publisher(Float64MultiArray, 'walk_truth', 10) \
+            if cfg.walk is not None else None
+        self._walk_start = None
         self.create_subscription(JointState, 'pan_tilt', self.guard.wrap(self._on_command),
                                  STATE_QOS)
         self._saccade_timer = self._frame_timer = None
@@ -194,6 +240,9 @@ class SceneCameraNode(SaccadeMixin, Node):
         if len(scene.faces) > 1:
             where = f'{len(scene.faces)} faces in cells ' + ', '.join(
                 str(f.cell) for f in scene.faces)
+        if cfg.walk is not None:
+            where += (f", walking at {cfg.values['scene.speed_deg_s']:g} deg/s for "
+                      f"{cfg.values['scene.walk_duration_s']:g} s from its first frame")
         self.get_logger().info(
             f"{cfg.values['view']} view of {scene.background} scene "
             f'{scene.image.shape[1]}x{scene.image.shape[0]} px ({where}); {width}x{height} px '
@@ -206,10 +255,11 @@ class SceneCameraNode(SaccadeMixin, Node):
 
     # -- parameters ----------------------------------------------------------------------
     def _build(self, values: dict, changed=None, previous=None) -> SceneConfig:
-        """Keep the scene; follow the joint mapping and times (ValueError names the problem)."""
+        """Keep the scene and walk; follow the joint mapping and times (ValueError: why not)."""
         cfg = previous
         head = head_from(values, cfg.grid) if cfg.geometry is not None else None
-        return SceneConfig(dict(values), cfg.grid, cfg.camera, cfg.scene, cfg.geometry, head)
+        return SceneConfig(dict(values), cfg.grid, cfg.camera, cfg.scene, cfg.geometry, head,
+                           cfg.walk)
 
     def _apply_config(self, old: SceneConfig, cfg: SceneConfig) -> None:
         v, ov = cfg.values, old.values
@@ -243,14 +293,27 @@ class SceneCameraNode(SaccadeMixin, Node):
                                                            cfg.grid.cell(cell))
         return view
 
+    def _walk_view(self, now):
+        """Return the view of the walk at ``now`` and publish where the face is in it."""
+        cfg = self._config
+        if self._walk_start is None:
+            self._walk_start = now
+        t_s = (now - self._walk_start).nanoseconds * 1e-9
+        truth = cfg.walk.truth_at(t_s)
+        self._walk_pub.publish(grid_arrays.walk_truth(now.to_msg(), t_s, truth.position,
+                                                      truth.cell))
+        return cfg.geometry.render(cfg.walk.image_at(t_s), cfg.grid.cell(self.pose))
+
     def _publish_frame(self) -> None:
         cfg = self._config
-        stamp = self.get_clock().now().to_msg()
+        now = self.get_clock().now()
+        stamp = now.to_msg()
         frame_id = cfg.values['frame_id']
         if cfg.head is not None:
             self._joint_pub.publish(joints.joint_state(cfg.head, self.pose, stamp))
         self._info_pub.publish(images.camera_info(cfg.camera, stamp, frame_id))
-        self._image_pub.publish(images.camera_image(self._view(self.pose), stamp, frame_id))
+        view = self._view(self.pose) if cfg.walk is None else self._walk_view(now)
+        self._image_pub.publish(images.camera_image(view, stamp, frame_id))
 
 
 def main(args=None) -> int:
