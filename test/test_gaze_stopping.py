@@ -149,6 +149,20 @@ def test_with_motion_found_reports_keeps_tracking_and_rearms():
     assert (core.losses, core.reacquisitions) == (1, 1) and core.lost is None
 
 
+def test_a_loss_names_the_cell_the_target_was_last_tracked_in():
+    """After a reacquisition elsewhere, the next loss is at the new cell, not the first find's."""
+    core = controller(motion_sigma_cells=0.2, confidence=0.95)
+    first, second = GRID.center_index, GRID.index(2, 3)
+    core.offer(frame_at(core, first, strength=10.0), 1.0)
+    core.fixation = first
+    assert core.offer(frame_at(core, first, strength=-3.0), 2.0).lost.cell == first
+    core.fixation = second
+    assert core.offer(frame_at(core, second, strength=10.0), 2.1).reacquired.cell == second
+    core.fixation = second
+    again = core.offer(frame_at(core, second, strength=-3.0), 3.1)
+    assert again.lost is not None and again.lost.cell == second
+
+
 def test_a_still_search_never_loses_what_it_found():
     """Without motion a decision ends the search: no lost, no reacquired."""
     core = controller(confidence=0.95)

@@ -479,24 +479,20 @@ class GazeControllerNode(Node):
         if result.lost is not None:
             lost = result.lost
             row, col = self._config.grid.cell(lost.cell)
-            self._event_pubs['lost'].publish(diagnostics.lost_status(
+            status = diagnostics.lost_status(
                 f'{name}: lost', row, col, lost.cell, lost.probability, lost.absent_probability,
-                lost.fixations, lost.seconds_tracked))
-            self.get_logger().warning(
-                f'lost: the target last found at ({row}, {col}) after {lost.seconds_tracked:.2f} '
-                f's of tracking; most likely cell now {lost.probability:.4f}, nobody here '
-                f'{lost.absent_probability:.4f}; searching again')
+                lost.fixations, lost.seconds_tracked)
+            self._event_pubs['lost'].publish(status)
+            self.get_logger().warning(f'{status.message}; searching again')
         if result.reacquired is not None:
             again = result.reacquired
             row, col = self._config.grid.cell(again.cell)
             pan, tilt = self._config.head.angles(again.cell)
-            self._event_pubs['reacquired'].publish(diagnostics.reacquired_status(
+            status = diagnostics.reacquired_status(
                 f'{name}: reacquired', row, col, again.cell, pan, tilt, again.probability,
-                again.fixations, again.seconds_lost))
-            self.get_logger().info(
-                f'reacquired: the target is most likely at ({row}, {col}), pan {pan:+.4f} rad, '
-                f'tilt {tilt:+.4f} rad, probability {again.probability:.4f}, '
-                f'{again.seconds_lost:.2f} s after it was lost')
+                again.fixations, again.seconds_lost)
+            self._event_pubs['reacquired'].publish(status)
+            self.get_logger().info(status.message)
         if result.gave_up is not None:
             self._event_pubs['gave_up'].publish(diagnostics.gave_up_status(
                 f'{name}: gave_up', result.gave_up.fixations))

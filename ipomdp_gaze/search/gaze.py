@@ -453,7 +453,9 @@ class GazeController:
             self.skipped += 1
             return FrameResult('skipped', 'taken before the fixation settled')
         dt_s = float(stamp_s) - self.update_time_s
-        tracking = self.motion.active and self.session.decision == 'found'
+        # While tracking, the cell the target was last found in: the answer before this frame.
+        tracked = self.map_cell if self.motion.active and self.session.decision == 'found' \
+            else None
         step = self.session.update(frame, dt_s=dt_s)
         if not step.applied:
             self.rejected += 1
@@ -462,8 +464,8 @@ class GazeController:
         self.update_time_s = max(self.update_time_s, float(stamp_s))
         self.applied += 1
         events = self._events(step.fired, float(stamp_s))
-        if tracking and step.decision != 'found':
-            events['lost'] = self._lose(float(stamp_s))
+        if tracked is not None and step.decision != 'found':
+            events['lost'] = self._lose(tracked, float(stamp_s))
         self.target_time_s = self.usable_time_s = float(stamp_s if now_s is None else now_s)
         return FrameResult('applied', fixation=step.fixation, **events)
 
@@ -489,9 +491,8 @@ class GazeController:
             return {'gave_up': self.gave_up}
         return {}
 
-    def _lose(self, stamp_s: float) -> Lost:
-        """Record that the tracked target was lost at ``stamp_s``; return the event."""
-        cell = self.found.cell if self.found is not None else self.map_cell
+    def _lose(self, cell: int, stamp_s: float) -> Lost:
+        """Record that the target tracked at ``cell`` was lost at ``stamp_s``; return the event."""
         self.lost = Lost(cell, self.map_probability, self.absent_probability, self.fixations,
                          max(0.0, stamp_s - self.tracked_since_s))
         self.losses += 1
