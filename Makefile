@@ -20,12 +20,16 @@ demo: $(STAMP)
 # Every extra is installed here, so every test must run: IPOMDP_GAZE_REQUIRE_ROS turns a skip for a
 # missing ROS (or cluster) package into a failure, and fails the run unless every collected ROS
 # test ran and at least this many did (test/conftest.py counts them). The layer contract first
-# (.importlinter, docs/design.md section 8), then the suite.
+# (.importlinter, docs/design.md section 8), then the suite, one pytest-xdist worker per core
+# (TEST_WORKERS=0 runs it in one process), a test file per worker at a time so that a module's
+# ROS nodes are shared by its tests; each worker reserves a ROS domain of its own.
 REQUIRED_ROS_TESTS := 200
+TEST_WORKERS ?= auto
 
 test: $(STAMP)
 	$(VENV)/bin/lint-imports
-	IPOMDP_GAZE_REQUIRE_ROS=$(REQUIRED_ROS_TESTS) $(VPY) -m pytest -q test
+	IPOMDP_GAZE_REQUIRE_ROS=$(REQUIRED_ROS_TESTS) $(VPY) -m pytest -q \
+		-n $(TEST_WORKERS) --dist loadfile test
 
 # The long robustness runs (minutes): 100,000 fuzzed frames, 10,080 hostile messages to the
 # detector per mode, a minute of load at 1 kHz (11x11) and 60 Hz (256x256), 50 start/SIGTERM

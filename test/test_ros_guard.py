@@ -5,7 +5,8 @@ The guard of the ROS tests (test/conftest.py), run on a small suite in a pytest 
 
 An rclpy that is installed but does not import fails the ROS tests instead of skipping them,
 and with IPOMDP_GAZE_REQUIRE_ROS=<n> (`make test`) the run fails unless every collected ROS test
-ran and at least n did.
+ran and at least n did, with or without pytest-xdist (`make test` runs ``-n auto``: there the
+controller process counts what its workers collected and ran).
 """
 import os
 from pathlib import Path
@@ -13,6 +14,8 @@ import re
 import shutil
 import subprocess
 import sys
+
+import pytest
 
 HERE = Path(__file__).resolve().parent
 SUITE = """
@@ -33,7 +36,7 @@ def test_maybe(skip):
 INI = '[pytest]\nmarkers =\n    ros: needs rclpy\n'
 
 
-def run_suite(tmp_path, skip=False, require=None, broken=False):
+def run_suite(tmp_path, skip=False, require=None, broken=False, workers=0):
     """Run the two (or three) ROS tests of SUITE with this conftest; return rc and output."""
     shutil.copy(HERE / 'conftest.py', tmp_path / 'conftest.py')
     (tmp_path / 'pytest.ini').write_text(INI)
@@ -49,8 +52,9 @@ def run_suite(tmp_path, skip=False, require=None, broken=False):
         (fake / '__init__.py').write_text("raise ImportError('librcl.so: cannot open')\n")
         paths.insert(0, str(fake.parent))
     env['PYTHONPATH'] = os.pathsep.join(paths + [env.get('PYTHONPATH', '')])
+    spread = ['-n', str(workers)] if workers else []
     out = subprocess.run([sys.executable, '-m', 'pytest', '-q', '-p', 'no:cacheprovider', '-rs',
-                          'test_suite.py'], cwd=tmp_path, env=env, capture_output=True,
+                          *spread, 'test_suite.py'], cwd=tmp_path, env=env, capture_output=True,
                          text=True, timeout=300)
     return out.returncode, out.stdout + out.stderr
 
@@ -62,22 +66,25 @@ def test_a_broken_rclpy_fails_the_ros_tests_instead_of_skipping_them(tmp_path):
     assert 'rclpy installed but broken: ImportError: librcl.so: cannot open' in out, out
 
 
-def test_with_rclpy_the_ros_tests_run_and_are_counted(tmp_path):
-    rc, out = run_suite(tmp_path, require=3)
+@pytest.mark.parametrize('workers', [0, 2])
+def test_with_rclpy_the_ros_tests_run_and_are_counted(tmp_path, workers):
+    rc, out = run_suite(tmp_path, require=3, workers=workers)
     assert rc == 0, out
     assert '3 passed' in out and 'ROS tests: 3 of 3 ran' in out, out
 
 
-def test_a_required_run_fails_when_a_ros_test_skipped(tmp_path):
-    rc, out = run_suite(tmp_path, skip=True, require=1)
+@pytest.mark.parametrize('workers', [0, 2])
+def test_a_required_run_fails_when_a_ros_test_skipped(tmp_path, workers):
+    rc, out = run_suite(tmp_path, skip=True, require=1, workers=workers)
     assert rc == 1, out
     assert '2 passed, 1 skipped' in out, out
     assert 'IPOMDP_GAZE_REQUIRE_ROS=1: 2 of 3 collected ROS tests ran' in out, out
-    rc, out = run_suite(tmp_path, skip=True)     # not required: a skip is a skip
+    rc, out = run_suite(tmp_path, skip=True, workers=workers)   # not required: a skip is a skip
     assert rc == 0 and '2 passed, 1 skipped' in out, out
 
 
-def test_a_required_run_fails_with_fewer_ros_tests_than_required(tmp_path):
-    rc, out = run_suite(tmp_path, require=4)
+@pytest.mark.parametrize('workers', [0, 2])
+def test_a_required_run_fails_with_fewer_ros_tests_than_required(tmp_path, workers):
+    rc, out = run_suite(tmp_path, require=4, workers=workers)
     assert rc == 1, out
     assert '3 passed' in out and 'IPOMDP_GAZE_REQUIRE_ROS=4: 3 of 3 collected' in out, out

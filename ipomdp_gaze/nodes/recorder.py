@@ -26,6 +26,7 @@ from __future__ import annotations
 import hashlib
 from pathlib import Path
 import sys
+import time
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import PoseArray
@@ -68,6 +69,8 @@ TOPICS = {
 }
 FILE_PARAMETERS = ('policy.file', 'observation.file')
 PARAMETER_RETRY_S = 0.5
+# A parameter request unanswered this long is sent again (s).
+PARAMETER_ANSWER_S = 3.0
 
 
 def recorder_params() -> list[Param]:
@@ -136,7 +139,7 @@ class RecorderNode(Node):
         self.create_timer(values['diagnostics_period_s'], self._publish_diagnostics)
         self.parameters: dict = {}
         self._pending = list(values['nodes'])
-        self._futures = {}
+        self._asked = {}
         self._parameter_clients = {}
         self._parameter_timer = self.create_timer(PARAMETER_RETRY_S, self._ask_parameters)
         self.get_logger().info(f"recording {', '.join(values['topics'])} to {values['path']}")
@@ -166,25 +169,36 @@ class RecorderNode(Node):
 
     # -- the other nodes' parameters ---------------------------------------------------------
     def _ask_parameters(self) -> None:
+        """
+        Ask each pending node for its parameters, once both its services are matched.
+
+        Both clients are made at first sight and kept: a request sent before its client has
+        matched the service is lost, and a service is discovered some time after the client
+        (late under load). A request unanswered after ``PARAMETER_ANSWER_S`` is asked again.
+        """
+        now = time.monotonic()
         for node in list(self._pending):
-            if node in self._futures:
+            asked = self._asked.get(node)
+            if asked is not None:
+                if now - asked < PARAMETER_ANSWER_S:
+                    continue
+                del self._asked[node]
+            clients = self._parameter_clients.get(node)
+            if clients is None:
+                clients = self._parameter_clients[node] = (
+                    self.create_client(ListParameters, f'/{node}/list_parameters'),
+                    self.create_client(GetParameters, f'/{node}/get_parameters'))
+            if not all(c.service_is_ready() for c in clients):
                 continue
-            client = self._parameter_clients.get(node)
-            if client is None:      # kept: a service is discovered some time after the client
-                client = self._parameter_clients[node] = self.create_client(
-                    ListParameters, f'/{node}/list_parameters')
-            if not client.service_is_ready():
-                continue
-            future = client.call_async(ListParameters.Request())
-            self._futures[node] = future
+            self._asked[node] = now
+            future = clients[0].call_async(ListParameters.Request())
             future.add_done_callback(lambda f, n=node: self._listed(n, f))
         if not self._pending:
             self.destroy_timer(self._parameter_timer)
 
     def _listed(self, node: str, future) -> None:
         names = list(future.result().result.names)
-        client = self.create_client(GetParameters, f'/{node}/get_parameters')
-        got = client.call_async(GetParameters.Request(names=names))
+        got = self._parameter_clients[node][1].call_async(GetParameters.Request(names=names))
         got.add_done_callback(lambda f: self._got(node, names, f))
 
     def _got(self, node: str, names: list, future) -> None:
