@@ -34,7 +34,7 @@ from ipomdp_gaze.drivers.sweep_rules import ROOM_SWEEPS, sweep_rule, SWEEP_RULES
 from ipomdp_gaze.search.sensors import run_search
 from ipomdp_gaze.search.session import SearchSession, SearchSettings
 from ipomdp_gaze.simulation.evaluation import answer_is_right
-from ipomdp_gaze.simulation.executor import InlineExecutor, track
+from ipomdp_gaze.simulation.executor import run_by_searcher
 import numpy as np
 
 
@@ -106,12 +106,4 @@ def evaluate_scenes(spec: TaskSpec, episodes: int, executor=None,
     Dask
     cluster give the same results); ``progress`` anything with ``update(n)``.
     """
-    executor = InlineExecutor() if executor is None else executor
-    futures = [executor.submit(evaluate_scene, spec, i) for i in range(episodes)]
-    for _ in track(futures, progress):
-        pass
-    out = {}
-    for future in futures:
-        for r in future.result():
-            out.setdefault(r.searcher, []).append(r)
-    return out
+    return run_by_searcher(evaluate_scene, spec, episodes, executor, progress)

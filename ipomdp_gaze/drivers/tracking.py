@@ -40,7 +40,7 @@ from ipomdp_gaze.policies.registry import build_policy
 from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
 from ipomdp_gaze.search.settings import check_parameters
 from ipomdp_gaze.simulation.evaluation import cells_apart, wilson_interval
-from ipomdp_gaze.simulation.executor import InlineExecutor, track
+from ipomdp_gaze.simulation.executor import run_by_searcher
 from ipomdp_gaze.vision.detection import build_setup
 from ipomdp_gaze.vision.detector import as_detections
 from ipomdp_gaze.vision.pan_tilt import SceneGeometry
@@ -356,15 +356,7 @@ def evaluate_walk(spec: WalkSpec, index: int) -> list:
 
 def evaluate_walks(spec: WalkSpec, episodes: int, executor=None, progress=None) -> dict:
     """Run walk scenes ``0..episodes-1``; return ``{searcher: [WalkResult per scene]}``."""
-    executor = InlineExecutor() if executor is None else executor
-    futures = [executor.submit(evaluate_walk, spec, i) for i in range(episodes)]
-    for _ in track(futures, progress):
-        pass
-    out = {}
-    for future in futures:
-        for r in future.result():
-            out.setdefault(r.searcher, []).append(r)
-    return out
+    return run_by_searcher(evaluate_walk, spec, episodes, executor, progress)
 
 
 def format_walks(name: str, s: dict, reference: str = '') -> list[str]:

@@ -345,3 +345,22 @@ def track(futures, progress=None, weights=None):
         if progress is not None:
             progress.update(weight[id(future)])
         yield future
+
+
+def run_by_searcher(piece, spec, episodes: int, executor=None, progress=None) -> dict:
+    """
+    Run ``piece(spec, i)`` for scenes ``i`` in ``0..episodes-1``; group its results by searcher.
+
+    Each piece returns a list of results with a ``searcher`` attribute; the answer is
+    ``{searcher: [result per scene, in scene order]}``, in the order the searchers first appear.
+    ``executor`` defaults to an :class:`InlineExecutor`; ``progress`` counts scenes as they end.
+    """
+    executor = InlineExecutor() if executor is None else executor
+    futures = [executor.submit(piece, spec, i) for i in range(episodes)]
+    for _ in track(futures, progress):
+        pass
+    out = {}
+    for future in futures:
+        for r in future.result():
+            out.setdefault(r.searcher, []).append(r)
+    return out
