@@ -79,12 +79,12 @@ def test_a_required_run_fails_when_a_ros_test_skipped(tmp_path, workers):
     assert rc == 1, out
     assert '2 passed, 1 skipped' in out, out
     assert 'IPOMDP_GAZE_REQUIRE_ROS=1: 2 of 3 collected ROS tests ran' in out, out
-    rc, out = run_suite(tmp_path, skip=True, workers=workers)   # not required: a skip is a skip
-    assert rc == 0 and '2 passed, 1 skipped' in out, out
+    if not workers:
+        rc, out = run_suite(tmp_path, skip=True)     # not required: a skip is a skip
+        assert rc == 0 and '2 passed, 1 skipped' in out, out
 
 
-@pytest.mark.parametrize('workers', [0, 2])
-def test_a_required_run_fails_with_fewer_ros_tests_than_required(tmp_path, workers):
-    rc, out = run_suite(tmp_path, require=4, workers=workers)
+def test_a_required_run_fails_with_fewer_ros_tests_than_required(tmp_path):
+    rc, out = run_suite(tmp_path, require=4)
     assert rc == 1, out
     assert '3 passed' in out and 'IPOMDP_GAZE_REQUIRE_ROS=4: 3 of 3 collected' in out, out
