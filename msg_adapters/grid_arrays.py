@@ -77,10 +77,10 @@ def check_layout(layout: MultiArrayLayout, grid: Grid) -> None:
     else:
         raise LayoutError(f'layout has {len(dims)} dimensions, expected 2 '
                           f'({grid.rows} rows x {grid.cols} cols)')
-    sizes = 'x'.join(str(d.size) for d in dims)
-    want = 'x'.join(str(size) for size, _ in expected)
     for dim, (size, stride) in zip(dims, expected):
         if dim.size != size:
+            sizes = 'x'.join(str(d.size) for d in dims)
+            want = 'x'.join(str(size) for size, _ in expected)
             raise LayoutError(f'layout is {sizes}, the grid is {want} '
                               f'({grid.rows} rows x {grid.cols} cols)')
         if dim.stride not in (0, stride):
@@ -128,10 +128,10 @@ def fixation(grid: Grid, cell: int | None, search_id: int) -> Int32MultiArray:
     the id tells the detector which search a request belongs to, so that a reset is seen and a
     frame is never paired with the wrong search.
     """
-    msg = row_col(grid, cell)
-    msg.layout.dim[0].label, msg.layout.dim[0].size, msg.layout.dim[0].stride = \
-        'row_col_search', 3, 3
-    msg.data = list(msg.data) + [int(search_id)]
+    row, col = (-1, -1) if cell is None else grid.cell(cell)
+    msg = Int32MultiArray(layout=MultiArrayLayout(
+        dim=[MultiArrayDimension(label='row_col_search', size=3, stride=3)], data_offset=0))
+    msg.data = [int(row), int(col), int(search_id)]
     return msg
 
 

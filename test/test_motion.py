@@ -328,3 +328,20 @@ def test_a_look_ahead_leaves_the_velocities_and_a_reset_forgets_them():
 def test_bad_velocity_settings_are_refused_with_a_reason(kwargs, message):
     with pytest.raises(ValueError, match=message):
         VelocityMotion(Grid(3, 3), **kwargs)
+
+
+@pytest.mark.parametrize('rows, cols, sigma', [(128, 128, 0.022), (128, 96, 0.3),
+                                               (256, 256, 0.5 * (1 / 60) ** 0.5)])
+def test_a_short_step_on_a_long_axis_predicts_as_the_matrix_product(rows, cols, sigma):
+    """The step's diagonals (or, for a step of a hundredth of a cell, the identity) added."""
+    motion = Motion(Grid(rows, cols, 1.0), sigma, 0.01)
+    assert motion._bands is not None
+    cells = np.random.default_rng(3).random((2, rows * cols))
+    cells[1, :rows * cols // 2] = 0.0                # cells the step leaves at exactly 0
+    grid_b = cells.reshape(2, rows, cols)
+    product = 0.99 * np.matmul(motion._row_t, np.matmul(grid_b, motion.col_matrix)).reshape(
+        cells.shape) + 0.01 * cells.sum(axis=-1, keepdims=True) / (rows * cols)
+    np.testing.assert_allclose(motion.predict(cells), product, rtol=1e-13, atol=0)
+    np.testing.assert_array_equal(motion.predict(cells) == 0, product == 0)
+    if motion._bands == ():
+        np.testing.assert_array_equal(motion.predict(cells), product)

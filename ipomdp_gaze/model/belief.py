@@ -78,15 +78,22 @@ def entropy(belief: np.ndarray) -> np.ndarray:
     return -np.sum(terms, axis=-1)
 
 
-def entropy_of_log(log_belief: np.ndarray) -> float:
+def entropy_of_log(log_belief: np.ndarray, cells: np.ndarray | None = None) -> float:
     """
     Shannon entropy in nats of one normalised log belief (N,): ``-sum_i B_i log B_i``.
 
     From the logs themselves, without taking the log of ``exp(log B)`` again (a third of the
     controller's per-frame cost on a 128x128 grid went there); cells at ``-inf`` count 0.
+    ``cells``: ``exp`` of the first entries of ``log_belief`` when the caller has them already
+    (a search session's cell probabilities), so they are not taken again.
     """
     log_b = np.asarray(log_belief, dtype=float)
-    b = np.exp(log_b)
+    if cells is None:
+        b = np.exp(log_b)
+    elif cells.size == log_b.size:
+        b = cells
+    else:
+        b = np.concatenate([cells, np.exp(log_b[cells.size:])])
     if not np.isfinite(log_b).all():
         keep = b > 0
         return float(-np.dot(b[keep], log_b[keep]))

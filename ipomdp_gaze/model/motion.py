@@ -43,6 +43,10 @@ from ipomdp_gaze.model.grid import Grid
 import numpy as np
 
 TRUNCATE_SIGMAS = 3.0
+# The prediction adds the step's diagonals one by one (instead of a matrix product) when an
+# axis is at least this many times longer than the step's 2R + 1 offsets: a few cells of a
+# short step (sigma_cells per second over a millisecond loop) on a long axis.
+BAND_RATIO = 32
 ALMOST_ONE = math.nextafter(1.0, 0.0)
 
 
@@ -67,6 +71,57 @@ def axis_transition(size: int, sigma_cells: float) -> np.ndarray:
     weights = np.ndarray((size, size), buffer=table, offset=(size - 1) * table.itemsize,
                          strides=(-table.itemsize, table.itemsize)).copy()
     return weights / weights.sum(axis=1, keepdims=True)
+
+
+def _diagonals(matrix: np.ndarray, reach: int) -> list:
+    """Return ``(k, M[x, x + k])`` for the offsets ``k`` in ``-reach..reach`` not all 0."""
+    bands = [(k, np.ascontiguousarray(np.diagonal(matrix, k))) for k in range(-reach, reach + 1)]
+    return [(k, diagonal) for k, diagonal in bands if diagonal.any()]
+
+
+def _axis_bands(row_matrix: np.ndarray, col_matrix: np.ndarray, sigma_cells: float):
+    """
+    Return the diagonals of both axes' steps when adding them beats a matrix product, else None.
+
+    The step reaches at most ``R = ceil(3 sigma)`` cells (:func:`axis_transition`); every entry
+    beyond is exactly 0, and so are the offsets whose ``g`` underflows, so the diagonals kept
+    hold the whole matrix. A step that is exactly the identity (``g(1)``, the largest entry off
+    the diagonal, underflows: a step of a hundredth of a cell) is ``()``: the product is then
+    the values themselves.
+    """
+    if sigma_cells <= 0:
+        return None
+    if all(m.shape[0] == 1 or m[0, 1] == 0.0 for m in (row_matrix, col_matrix)):
+        return ()
+    size = min(row_matrix.shape[0], col_matrix.shape[0])
+    reach = min(math.ceil(TRUNCATE_SIGMAS * sigma_cells), size - 1)
+    if (2 * reach + 1) * BAND_RATIO > size:
+        return None
+    row = _diagonals(row_matrix, reach)
+    return row, row if col_matrix is row_matrix else _diagonals(col_matrix, reach)
+
+
+def _banded_step(values: np.ndarray, bands: list, axis: int) -> np.ndarray:
+    """
+    Return ``values`` times a band matrix along ``axis`` (``y[d] = sum_s v[s] M[s, d]``, new).
+
+    ``axis`` is -1 (columns) or -2 (rows); ``bands`` are the matrix's ``(k, M[x, x + k])``
+    (:func:`_diagonals`): the same products as ``np.matmul``, summed offset by offset.
+    """
+    size = values.shape[axis]
+    out = np.zeros(values.shape)
+    scratch = np.empty(values.shape)
+    for k, diagonal in bands:
+        lo, hi = max(k, 0), size + min(k, 0)            # destinations d = s + k
+        if axis == -1:
+            src, dst, tmp = values[..., lo - k:hi - k], out[..., lo:hi], scratch[..., lo:hi]
+        else:
+            src, dst, tmp = values[..., lo - k:hi - k, :], out[..., lo:hi, :], \
+                scratch[..., lo:hi, :]
+            diagonal = diagonal[:, None]
+        np.multiply(src, diagonal, out=tmp)
+        dst += tmp
+    return out
 
 
 class Motion:
@@ -97,6 +152,7 @@ class Motion:
         self.col_matrix = self.row_matrix if grid.cols == grid.rows else \
             axis_transition(grid.cols, self.sigma_cells)
         self._row_t = np.ascontiguousarray(self.row_matrix.T)
+        self._bands = _axis_bands(self.row_matrix, self.col_matrix, self.sigma_cells)
         self._cdf = None                        # the step's CDFs, built on the first move
         self._over = None                       # the last (seconds, Motion) of over()
 
@@ -151,7 +207,14 @@ class Motion:
         b = np.asarray(cells, dtype=float)
         rows, cols = self.grid.shape
         grid_b = b.reshape(b.shape[:-1] + (rows, cols))
-        moved = np.matmul(self._row_t, np.matmul(grid_b, self.col_matrix)).reshape(b.shape)
+        if self._bands is None:
+            moved = np.matmul(self._row_t, np.matmul(grid_b, self.col_matrix)).reshape(b.shape)
+        elif not self._bands:                   # the identity: 1 times each value, exactly
+            moved = b.copy()
+        else:
+            row_bands, col_bands = self._bands
+            moved = _banded_step(_banded_step(grid_b, col_bands, -1), row_bands, -2)
+            moved = moved.reshape(b.shape)
         if self.jump_prob:
             mass = b.sum(axis=-1, keepdims=True)
             moved *= 1.0 - self.jump_prob

@@ -192,7 +192,7 @@ class GazeControllerNode(Node):
         self._single_publisher = dict.fromkeys(self._sequences, True)
         self.create_service(Trigger, '~/reset', self.guard.wrap(self._on_reset))
         self.create_service(SetBool, '~/enable', self.guard.wrap(self._on_enable))
-        self.guard.publish_status()
+        self.guard.publish_status(publisher=self._diag_pub)
         self._retry_timer = self._diag_timer = None
         self._make_timers(v)
         self._resends = 0

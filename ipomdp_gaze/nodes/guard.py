@@ -113,10 +113,18 @@ class CallbackGuard:
         out.update({f'callback_errors.{k}': v for k, v in sorted(self.by_callback.items())})
         return out
 
-    def publish_status(self, period_s: float = DIAGNOSTICS_PERIOD_S) -> None:
-        """Publish ``<node>: callbacks`` on ``/diagnostics`` every ``period_s`` from now on."""
-        from diagnostic_msgs.msg import DiagnosticArray
-        self._status_pub = self.node.create_publisher(DiagnosticArray, '/diagnostics', 10)
+    def publish_status(self, period_s: float = DIAGNOSTICS_PERIOD_S, publisher=None) -> None:
+        """
+        Publish ``<node>: callbacks`` on ``/diagnostics`` every ``period_s`` from now on.
+
+        ``publisher``: the node's own ``/diagnostics`` publisher (``DiagnosticArray``, depth 10)
+        to send it with; by default one is made. Every publisher costs each wait of the node's
+        executor the time of its QoS event handlers, so a node that has one passes it.
+        """
+        if publisher is None:
+            from diagnostic_msgs.msg import DiagnosticArray
+            publisher = self.node.create_publisher(DiagnosticArray, '/diagnostics', 10)
+        self._status_pub = publisher
         self.node.create_timer(period_s, self.wrap(self._publish, 'diagnostics'))
 
     def _publish(self) -> None:

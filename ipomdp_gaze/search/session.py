@@ -367,7 +367,7 @@ class SearchSession:
     def entropy_nats(self) -> float:
         """Entropy of the belief over all its hypotheses, in nats."""
         return self._view('entropy_nats',
-                          lambda: entropy_of_log(self._search.log_belief))
+                          lambda: entropy_of_log(self._search.log_belief, self._cells()))
 
     @property
     def fixation(self) -> int | None:
