@@ -5,6 +5,7 @@ import json
 from pathlib import Path
 import subprocess
 import sys
+from types import SimpleNamespace
 
 import cv2
 from ipomdp_gaze.cli import main
@@ -29,6 +30,22 @@ JSON_KEYS = ['path', 'cell', 'pixel', 'probability', 'fixations', 'detector_pixe
 def run_find(*args, cwd=None):
     return subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', 'find', *map(str, args)],
                           capture_output=True, text=True, timeout=300, cwd=cwd)
+
+
+@pytest.fixture
+def find_here(capsys, monkeypatch):
+    """Run ``find`` in this process: its lines and status without an interpreter per run."""
+    def run(*args, cwd=None):
+        if cwd is not None:
+            monkeypatch.chdir(cwd)
+        capsys.readouterr()
+        try:
+            code = main(['find', *map(str, args)])
+        except SystemExit as exc:
+            code = exc.code
+        out = capsys.readouterr()
+        return SimpleNamespace(returncode=code, stdout=out.out, stderr=out.err)
+    return run
 
 
 def calibrate(scenes, detector, config):
@@ -108,11 +125,11 @@ def test_find_locates_the_face_of_a_test_scene(task, tmp_path):
     assert 0 < entry['detector_pixels'] < 420 * 420 and entry['seconds'] > 0
 
 
-def test_json_has_one_entry_per_image_in_input_order(task):
+def test_json_has_one_entry_per_image_in_input_order(task, find_here):
     root = task['root']
     names = [path.name for path in reversed(task['images'])]
     out = root / 'two.json'
-    result = run_find(*names, '--observation', task['model'], '--json', 'two.json', cwd=root)
+    result = find_here(*names, '--observation', task['model'], '--json', 'two.json', cwd=root)
     assert result.returncode == 0, result.stderr
     data = json.loads(out.read_text())
     assert list(data) == ['grid', 'axes', 'images'] and data['grid'] == {'rows': 21, 'cols': 21}
@@ -214,9 +231,9 @@ def test_default_policy_is_the_shipped_kernel_of_the_model(task, tmp_path, monke
     (lambda d: _png(d / 'dot.png', np.zeros((1, 1), dtype=np.uint8)), 'too small'),
 ])
 def test_a_bad_image_is_one_error_line_and_the_others_are_searched(task, tmp_path, make,
-                                                                   message):
+                                                                   message, find_here):
     bad = make(tmp_path)
-    result = run_find(task['images'][0], bad, task['images'][1], '--observation', task['model'])
+    result = find_here(task['images'][0], bad, task['images'][1], '--observation', task['model'])
     assert result.returncode == 2                       # non-zero at the end
     out = result.stdout.strip().splitlines()
     searched = [line.split(':')[0] for line in out]
@@ -228,15 +245,15 @@ def test_a_bad_image_is_one_error_line_and_the_others_are_searched(task, tmp_pat
     assert errors[1] == 'ipomdp-gaze find: error: 1 of 3 inputs could not be searched'
 
 
-def test_a_malformed_observation_file_is_one_error_line(task, tmp_path):
+def test_a_malformed_observation_file_is_one_error_line(task, tmp_path, find_here):
     broken = _write(tmp_path / 'broken.yaml', b'format: ipomdp_gaze/observation-v1\nmodel: [\n')
-    result = run_find(task['images'][0], '--observation', broken)
+    result = find_here(task['images'][0], '--observation', broken)
     assert result.returncode == 2 and result.stdout == ''
     assert 'Traceback' not in result.stderr
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and str(broken) in lines[0] and 'not YAML' in lines[0]
     truncated = _write(tmp_path / 'short.yaml', Path(task['model']).read_bytes()[:2000])
-    result = run_find(task['images'][0], '--observation', truncated)
+    result = find_here(task['images'][0], '--observation', truncated)
     assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1
 
 

