@@ -6,9 +6,9 @@ Every figure README.md shows is drawn by the command its caption names (issue 35
 Each ``![...](docs/figures/NAME.png)`` of the README must have one caption command, a backticked
 ``ipomdp-gaze ... --plot docs/figures/NAME.png``; ``make figures`` must run exactly those
 commands; and each command, run here with its plot sent to a temporary file, must still draw a
-PNG of the committed figure's size (the demos' over real DDS).
+PNG of the committed figure's size. The demos' commands (over real DDS) run in
+test_ros_faces.py, whose tests check the same runs.
 """
-import os
 from pathlib import Path
 import re
 import subprocess
@@ -47,23 +47,24 @@ def test_every_readme_figure_has_one_command_and_make_figures_runs_them():
 
 
 def _params():
-    out = []
-    for figure, commands in sorted(readme_figures().items()):
-        marks = [pytest.mark.ros] if commands and ' demo ' in f' {commands[0]} ' else []
-        out.append(pytest.param(figure, commands[0] if commands else '', marks=marks,
-                                id=Path(figure).stem))
-    return out
+    """Return the figures whose commands run here: all but the demos' (test_ros_faces.py)."""
+    return [pytest.param(figure, commands[0] if commands else '', id=Path(figure).stem)
+            for figure, commands in sorted(readme_figures().items())
+            if not (commands and commands[0].split()[1:2] == ['demo'])]
+
+
+def test_every_demo_figure_command_is_checked_with_the_face_demos():
+    from test_ros_faces import DEMO_FIGURES
+    demos = {f for f, c in readme_figures().items() if c and c[0].split()[1:2] == ['demo']}
+    assert demos and sorted(demos) == sorted(DEMO_FIGURES.values())
 
 
 @pytest.mark.parametrize('figure, command', _params())
-def test_a_readme_figure_command_still_draws_it(figure, command, tmp_path, request):
-    env = dict(os.environ)
-    if request.node.get_closest_marker('ros'):
-        env.update(request.getfixturevalue('ros_env'))
+def test_a_readme_figure_command_still_draws_it(figure, command, tmp_path):
     out = tmp_path / Path(figure).name
     argv = command.replace(figure, str(out)).split()[1:]
     done = subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', *argv], cwd=tmp_path,
-                          env=env, capture_output=True, text=True, timeout=600)
+                          capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stdout + done.stderr
     drawn, shipped = cv2.imread(str(out)), cv2.imread(str(ROOT / figure))
     assert drawn is not None, f'{command} drew nothing at {out}'

@@ -18,7 +18,7 @@ stamped like its image. Afterwards every counter matches the prediction
 failed, the warnings were throttled, and the node is alive (it must exit 0 on SIGTERM at
 teardown).
 
-``make test`` sends 504 hostile messages per mode, every kind among them; ``make soak`` 10,080.
+``make test`` sends 252 hostile messages per mode, every kind among them; ``make soak`` 10,080.
 """
 from __future__ import annotations
 
@@ -371,11 +371,11 @@ def _fuzz(rig: Rig, hostile: int, seed: int) -> dict:
 
 
 @pytest.mark.parametrize('mode, hostile', [
-    # 504 messages per mode draw every kind (25 in fovea mode, 44 in camera mode; checked below)
-    # about 11 to 20 times each: what they test is each kind handled and counted exactly, and
+    # 252 messages per mode draw every kind (25 in fovea mode, 44 in camera mode; checked below)
+    # about 6 to 10 times each: what they test is each kind handled and counted exactly, and
     # the kinds interleaved with valid requests, not a rate, so more draws add no decision.
-    pytest.param('fovea', 504, id='fovea-504'),
-    pytest.param('camera', 504, id='camera-504'),
+    pytest.param('fovea', 252, id='fovea-252'),
+    pytest.param('camera', 252, id='camera-252'),
     pytest.param('fovea', 10080, id='fovea-10080', marks=pytest.mark.soak),
     pytest.param('camera', 10080, id='camera-10080', marks=pytest.mark.soak),
 ])

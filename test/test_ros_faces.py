@@ -5,16 +5,20 @@ The pixel loop end to end: scene camera, foveal detector and controller as three
 
 ``ipomdp-gaze demo --scene faces [--fovea]`` on held-out test scenes of fixed seeds: the face is
 found in the right place (within one cell of its centre's cell) and all three nodes stop
-cleanly, in both detector modes.
+cleanly, in both detector modes. The README's face demo outputs and figures are checked here
+too, on the same runs: each distinct demo command runs once per module.
 """
 from __future__ import annotations
 
+from pathlib import Path
 import re
 import subprocess
 import sys
 
 from conftest import REPO
 import pytest
+from test_readme import _block_with, _contains
+from test_readme_figures import readme_figures
 from test_ros_demo import node_processes
 
 pytestmark = pytest.mark.ros
@@ -28,6 +32,43 @@ FOUND = re.compile(r'^found(?:, forced by the fixation budget)?: the face is mos
                    r'\((?:reached|below) the confidence 0\.99\)$', re.M)
 VERDICT = re.compile(r'^the scene camera put the face centre in cell \((\d+), (\d+)\): that is '
                      r'(right|wrong)$', re.M)
+
+
+def _demo_figures() -> dict:
+    """Return ``{demo options: figure}`` of the README figures a face demo draws (``--plot``)."""
+    out = {}
+    for figure, commands in readme_figures().items():
+        argv = commands[0].split()[1:] if commands else []
+        if argv[:1] == ['demo']:
+            k = argv.index('--plot')
+            out[tuple(argv[1:k] + argv[k + 2:])] = figure
+    return out
+
+
+DEMO_FIGURES = _demo_figures()
+
+
+@pytest.fixture(scope='module')
+def demo(ros_env, tmp_path_factory):
+    """
+    Run ``ipomdp-gaze demo`` once per option list; the tests that check one command share it.
+
+    Options that are a README figure's command (without its ``--plot``) run with ``--plot`` to
+    a temporary file, so that the same run draws the figure.
+    """
+    plots, runs = tmp_path_factory.mktemp('plots'), {}
+
+    def run(*options):
+        if options not in runs:
+            plot = ['--plot', str(plots / Path(DEMO_FIGURES[options]).name)] \
+                if options in DEMO_FIGURES else []
+            runs[options] = subprocess.run(
+                [sys.executable, '-m', 'ipomdp_gaze.cli', 'demo', '--domain-id',
+                 ros_env['ROS_DOMAIN_ID'], *options, *plot], cwd=REPO, env=ros_env,
+                capture_output=True, text=True, timeout=180)
+        return runs[options], plots
+
+    return run
 
 
 def find_path(seed: int) -> tuple:
@@ -48,12 +89,9 @@ def find_path(seed: int) -> tuple:
     (['--seed', '0'], 'camera', r'pan +[-+]\d+\.\d\d deg +tilt +[-+]\d+\.\d\d deg'),
     (['--seed', '2'], 'camera', r'pan +[-+]\d+\.\d\d deg +tilt +[-+]\d+\.\d\d deg'),
 ])
-def test_three_nodes_find_the_face_and_stop(ros_env, options, mode, where):
+def test_three_nodes_find_the_face_and_stop(ros_env, demo, options, mode, where):
     domain = int(ros_env['ROS_DOMAIN_ID'])
-    run = subprocess.run(
-        [sys.executable, '-m', 'ipomdp_gaze.cli', 'demo', '--scene', 'faces', '--domain-id',
-         str(domain), *options], cwd=REPO, env=ros_env, capture_output=True, text=True,
-        timeout=180)
+    run, _ = demo('--scene', 'faces', *options)
     out = run.stdout
     assert run.returncode == 0, out + run.stderr
     grid = '21x21 grid' if mode == 'fovea' else '11x11 grid at 5.0 deg/cell'
@@ -85,12 +123,9 @@ def test_three_nodes_find_the_face_and_stop(ros_env, options, mode, where):
     assert node_processes(domain) == []
 
 
-def test_without_a_confident_cell_the_demo_answers_with_the_most_likely_one(ros_env):
+def test_without_a_confident_cell_the_demo_answers_with_the_most_likely_one(ros_env, demo):
     domain = int(ros_env['ROS_DOMAIN_ID'])
-    run = subprocess.run(
-        [sys.executable, '-m', 'ipomdp_gaze.cli', 'demo', '--scene', 'faces', '--fovea',
-         '--seed', '12', '--max-fixations', '4', '--domain-id', str(domain)], cwd=REPO,
-        env=ros_env, capture_output=True, text=True, timeout=180)
+    run, _ = demo('--scene', 'faces', '--fovea', '--seed', '12', '--max-fixations', '4')
     out = run.stdout
     assert run.returncode == 0, out + run.stderr
     assert len(FIXATION.findall(out)) == 4
@@ -102,12 +137,9 @@ def test_without_a_confident_cell_the_demo_answers_with_the_most_likely_one(ros_
     assert 'stopped all 3 nodes' in out and node_processes(domain) == []
 
 
-def test_on_a_scene_without_a_face_the_controller_says_absent(ros_env):
+def test_on_a_scene_without_a_face_the_controller_says_absent(ros_env, demo):
     domain = int(ros_env['ROS_DOMAIN_ID'])
-    run = subprocess.run(
-        [sys.executable, '-m', 'ipomdp_gaze.cli', 'demo', '--scene', 'faces', '--empty',
-         '--seed', '0', '--domain-id', str(domain)], cwd=REPO, env=ros_env,
-        capture_output=True, text=True, timeout=180)
+    run, _ = demo('--scene', 'faces', '--empty')           # seed 0, the default (README's)
     out = run.stdout
     assert run.returncode == 0, out + run.stderr
     absent = re.search(r'^absent: nobody is here, probability (\d\.\d+) that nobody is here, '
@@ -116,3 +148,34 @@ def test_on_a_scene_without_a_face_the_controller_says_absent(ros_env):
     assert int(absent.group(2)) == len(FIXATION.findall(out))
     assert 'the scene camera showed a scene with nobody in it: that is right' in out
     assert 'stopped all 3 nodes' in out and node_processes(domain) == []
+
+
+# The face demo outputs the README shows, by a line only that block holds, and the README's
+# options (each demo is deterministic for its seed: the scene and the detector).
+README_DEMOS = [('stopped all 3 nodes (scene_camera exit status 0', ('--scene', 'faces')),
+                ('the scene camera showed a scene with nobody in it',
+                 ('--scene', 'faces', '--empty'))]
+
+
+@pytest.mark.parametrize('line, options', README_DEMOS, ids=['faces', 'faces-empty'])
+def test_the_readme_shows_what_the_face_demo_prints(demo, line, options):
+    """Issue 35: the README showed a demo output the command no longer printed."""
+    run, _ = demo(*options)
+    assert run.returncode == 0, run.stdout + run.stderr
+    shown = _block_with(line)
+    assert _contains(shown, run.stdout.splitlines()), \
+        'README shows:\n' + '\n'.join(shown) + '\nprinted:\n' + run.stdout
+
+
+@pytest.mark.parametrize('options, figure', sorted(DEMO_FIGURES.items()),
+                         ids=[Path(f).stem for _, f in sorted(DEMO_FIGURES.items())])
+def test_a_readme_figure_demo_command_still_draws_it(demo, options, figure):
+    """Issue 35: a README figure's caption command draws a PNG of the committed figure's size."""
+    import cv2
+    run, plots = demo(*options)
+    assert run.returncode == 0, run.stdout + run.stderr
+    out = plots / Path(figure).name
+    assert f'wrote {out}' in run.stdout
+    drawn, shipped = cv2.imread(str(out)), cv2.imread(str(REPO / figure))
+    assert drawn is not None, f'{options} drew nothing at {out}'
+    assert drawn.shape == shipped.shape
