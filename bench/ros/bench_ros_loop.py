@@ -135,7 +135,8 @@ def bench(ctx=None) -> str:
               f"this process saw {s['sent']} camera frames (best effort, so a lower bound of "
               f"what was sent); the controller received {s['received']} "
               f"(lost to the keep-last queue: at least {lost}), applied {s['applied']} and "
-              f"skipped {s['skipped']} (stale: taken before the latest target settled, or superseded); "
+              f"skipped {s['skipped']} (stale: taken before the latest target settled, or "
+              f"superseded); "
               f"controller RSS {s['rss0']:.0f} MiB before, {s['rss1']:.0f} MiB after.",
               '', "Each loop includes two DDS hops, the controller's update and decision and the "
               "camera's frame generation; the camera stamps a frame when it sends it.", '']
