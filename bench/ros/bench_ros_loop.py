@@ -136,7 +136,7 @@ def bench(ctx=None) -> str:
               f"what was sent); the controller received {s['received']} "
               f"(lost to the keep-last queue: at least {lost}), applied {s['applied']} and "
               f"skipped {s['skipped']} (stale: taken before the latest target settled, or "
-              f"superseded); "
+              f'superseded); '
               f"controller RSS {s['rss0']:.0f} MiB before, {s['rss1']:.0f} MiB after.",
               '', "Each loop includes two DDS hops, the controller's update and decision and the "
               "camera's frame generation; the camera stamps a frame when it sends it.", '']
