@@ -17,6 +17,7 @@ import importlib.util
 import os
 from pathlib import Path
 import signal
+from types import SimpleNamespace
 
 from hypothesis import settings
 from ipomdp_gaze.harness.processes import wait_for  # noqa: F401 (the tests import it from here)
@@ -226,3 +227,27 @@ def config_path(name: str) -> str:
     """Find a shipped config file as the nodes do."""
     from ipomdp_gaze.files.share_files import config_file
     return str(config_file(name))
+
+
+@pytest.fixture
+def cli_here(capsys, monkeypatch):
+    """
+    Run ``ipomdp-gaze ARGS`` in this process; return its ``returncode``, ``stdout`` and ``stderr``.
+
+    The console script's own entry point (:func:`ipomdp_gaze.cli.main`) without an interpreter
+    start-up per run, for tests not about the process itself; a refusal while parsing is its
+    exit status. ``cwd`` runs it from that folder.
+    """
+    from ipomdp_gaze.cli import main
+
+    def run(*args, cwd=None):
+        if cwd is not None:
+            monkeypatch.chdir(cwd)
+        capsys.readouterr()
+        try:
+            code = main([str(a) for a in args])
+        except SystemExit as exc:
+            code = exc.code
+        out = capsys.readouterr()
+        return SimpleNamespace(returncode=code, stdout=out.out, stderr=out.err)
+    return run

@@ -4,7 +4,6 @@
 import subprocess
 import sys
 
-from ipomdp_gaze.cli import main
 from ipomdp_gaze.files.observation_file import load_observation
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.vision.calibrate import (count_model, hit_false_alarm, pool_target, Tallies,
@@ -15,16 +14,6 @@ import numpy as np
 import pytest
 
 GRID = Grid(5, 5, 1.0)
-
-
-def _calibrate(capsys, argv):
-    """Run ``calibrate`` in this process: its status and stderr, without an interpreter."""
-    capsys.readouterr()
-    try:
-        code = main(['calibrate', *argv])
-    except SystemExit as exc:
-        code = exc.code
-    return code, capsys.readouterr().err
 
 
 def test_tally_image_counts_every_fixation_at_its_offset():
@@ -82,7 +71,7 @@ def test_pooling_sums_offsets_at_similar_distances_and_widens_where_data_are_thi
     assert wide[2, 2].sum() >= 4
 
 
-def test_calibrate_command_on_scenes_and_on_a_labelled_folder(tmp_path, capsys):
+def test_calibrate_command_on_scenes_and_on_a_labelled_folder(tmp_path, cli_here):
     """Tiny runs: the hit rate at offset 0 beats the false-alarm rate (real detector)."""
     out = tmp_path / 'faces.yaml'
     done = subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', 'calibrate', '--scenes', '6',
@@ -99,11 +88,10 @@ def test_calibrate_command_on_scenes_and_on_a_labelled_folder(tmp_path, capsys):
     assert (tmp_path / 'faces.png').is_file() and 'hit' in done.stdout
     folder = tmp_path / 'labelled'
     write_scene_set([SceneSet('train', grid=(7, 7), seed=4)[i] for i in range(3)], folder)
-    code, err = _calibrate(capsys, ['--images', str(folder), '--labels',
-                                    str(folder / 'labels.csv'), '--grid', '7x7', '--windows',
-                                    '7,3', '--processes', '1', '--out',
-                                    str(tmp_path / 'mine.yaml'), '--quiet'])
-    assert code == 0, err
+    run = cli_here('calibrate', '--images', folder, '--labels', folder / 'labels.csv', '--grid',
+                   '7x7', '--windows', '7,3', '--processes', '1', '--out',
+                   tmp_path / 'mine.yaml', '--quiet')
+    assert run.returncode == 0, run.stderr
     assert load_observation(tmp_path / 'mine.yaml').meta['calibration']['images'] == 3
 
 
@@ -116,25 +104,25 @@ def test_calibrate_command_on_scenes_and_on_a_labelled_folder(tmp_path, capsys):
     (['--scenes', '2', '--scan-once', '--windows', '15,9,3'],
      'scan_once needs a whole-image window'),
 ])
-def test_bad_arguments_are_one_line(args, message, tmp_path, capsys):
+def test_bad_arguments_are_one_line(args, message, tmp_path, cli_here):
     argv = list(args)
     if '--out' not in args:
         argv += ['--out', str(tmp_path / 'o.yaml')]
-    code, err = _calibrate(capsys, argv)
-    assert code == 2 and 'Traceback' not in err
-    assert message in err.strip().splitlines()[-1]
+    run = cli_here('calibrate', *argv)
+    assert run.returncode == 2 and 'Traceback' not in run.stderr
+    assert message in run.stderr.strip().splitlines()[-1]
 
 
-def test_a_csv_naming_pixels_outside_the_image_is_refused(tmp_path, capsys):
+def test_a_csv_naming_pixels_outside_the_image_is_refused(tmp_path, cli_here):
     folder = tmp_path / 'labelled'
     write_scene_set([SceneSet('train', seed=5)[0]], folder)
     csv = folder / 'labels.csv'
     name = csv.read_text().splitlines()[1].split(',')[0]
     csv.write_text(f'path,x,y\n{name},999,5\n')
-    code, err = _calibrate(capsys, ['--images', str(folder), '--labels', str(csv), '--out',
-                                    str(tmp_path / 'o.yaml'), '--quiet'])
-    assert code == 2 and 'Traceback' not in err
-    assert 'outside' in err.strip().splitlines()[-1]
+    run = cli_here('calibrate', '--images', folder, '--labels', csv, '--out',
+                   tmp_path / 'o.yaml', '--quiet')
+    assert run.returncode == 2 and 'Traceback' not in run.stderr
+    assert 'outside' in run.stderr.strip().splitlines()[-1]
 
 
 def test_scan_tallies_are_offset_free_and_build_the_scan_tables():

@@ -5,7 +5,6 @@ import json
 from pathlib import Path
 import subprocess
 import sys
-from types import SimpleNamespace
 
 import cv2
 from ipomdp_gaze.cli import main
@@ -33,19 +32,9 @@ def run_find(*args, cwd=None):
 
 
 @pytest.fixture
-def find_here(capsys, monkeypatch):
+def find_here(cli_here):
     """Run ``find`` in this process: its lines and status without an interpreter per run."""
-    def run(*args, cwd=None):
-        if cwd is not None:
-            monkeypatch.chdir(cwd)
-        capsys.readouterr()
-        try:
-            code = main(['find', *map(str, args)])
-        except SystemExit as exc:
-            code = exc.code
-        out = capsys.readouterr()
-        return SimpleNamespace(returncode=code, stdout=out.out, stderr=out.err)
-    return run
+    return lambda *args, cwd=None: cli_here('find', *args, cwd=cwd)
 
 
 def calibrate(scenes, detector, config):

