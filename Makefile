@@ -22,12 +22,15 @@ demo: $(STAMP)
 # test ran and at least this many did (test/conftest.py counts them). The layer contract first
 # (.importlinter, docs/design.md section 8), then the suite, one pytest-xdist worker per core
 # (TEST_WORKERS=0 runs it in one process), a test file per worker at a time so that a module's
-# ROS nodes are shared by its tests; each worker reserves a ROS domain of its own.
+# ROS nodes are shared by its tests; each worker reserves a ROS domain of its own. The package is
+# compiled first: where PYTHONDONTWRITEBYTECODE is set (CI) an editable install is never compiled,
+# and each of the suite's hundreds of node and CLI processes would compile it again (~0.2 s each).
 REQUIRED_ROS_TESTS := 200
 TEST_WORKERS ?= auto
 
 test: $(STAMP)
 	$(VENV)/bin/lint-imports
+	$(VPY) -m compileall -q ipomdp_gaze
 	IPOMDP_GAZE_REQUIRE_ROS=$(REQUIRED_ROS_TESTS) $(VPY) -m pytest -q \
 		-n $(TEST_WORKERS) --dist loadfile test
 
