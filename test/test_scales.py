@@ -12,6 +12,7 @@ from ipomdp_gaze.vision.fovea_model import fovea_for_model
 from ipomdp_gaze.vision.photos import group_photo
 from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evidence,
                                        SCALE_TABLES, ScaleRow, ScaleTable)
+from ipomdp_gaze.vision import search
 from ipomdp_gaze.vision.search import FIND_SETTINGS, search_many
 import numpy as np
 import pytest
@@ -56,8 +57,8 @@ def test_find_all_reads_one_coarse_call_and_counts_each_face_once(yunet_420):
     result = search_many(image, fovea, model, MANY, pixel_budget=1280 * 886,
                          scales=scale_table(model))
     scale = choose_scale(SCALE_TABLES['yunet'], (1280, 886))
-    assert scale < 1.0
-    assert result.detector_pixels < 1280 * 886 / 4        # far below a full-resolution call
+    assert scale == 0.5                                     # 88.6 px faces: 44 px at 1/2
+    assert result.detector_pixels == 640 * 443             # that one call, a quarter of 1
     assert result.fixations <= 1                            # the pass decided (nearly) all
     centres = np.array([[x + w / 2, y + h / 2] for x, y, w, h in (f.box for f in result.faces)])
     inside = ((boxes[None, :, 0] <= centres[:, None, 0])
@@ -68,7 +69,7 @@ def test_find_all_reads_one_coarse_call_and_counts_each_face_once(yunet_420):
     assert np.all(inside.sum(axis=0) == 1) and np.all(inside.sum(axis=1) == 1)
 
 
-def test_a_weak_coarse_detection_draws_finer_looks_there(yunet_420):
+def test_a_weak_coarse_detection_draws_finer_looks_there(yunet_420, monkeypatch):
     model, fovea = yunet_420
     image, boxes = group_photo((1280, 886), seed=0, background='coffee', split='train',
                                copies=1)
@@ -77,12 +78,21 @@ def test_a_weak_coarse_detection_draws_finer_looks_there(yunet_420):
     coarse_px = round(1280 * coarse) * round(886 * coarse)
     plain = search_many(image, fovea, model, MANY, pixel_budget=1280 * 886, scales=table)
     assert plain.detector_pixels < 2 * coarse_px and plain.fixations == 0
-    strict = replace(table, strong_score=1.01)                  # every box weak
+    strict = replace(table, strong_score=1.01)                  # every coarse box weak
+    x, y, w, h = boxes[0]
+    # a finer crop round the face at scale 1, the table's finest: there a box the fovea's own
+    # detector keeps (score 0.5) is strong, so the face is found with no window
     result = search_many(image, fovea, model, MANY, pixel_budget=1280 * 886, scales=strict)
-    # finer crops round the face, then the fovea's windows: more pixels, within one full scan
+    assert plain.detector_pixels < result.detector_pixels < 1280 * 886 / 2
+    assert result.fixations == 0 and len(result.faces) == 1
+    bx, by, bw, bh = result.faces[0].box
+    assert x <= bx + bw / 2 <= x + w and y <= by + bh / 2 <= y + h
+    # every box weak at scale 1 too: the cells stay undecided after the crop, and the
+    # fovea's windows are spent there
+    monkeypatch.setattr(search, '_fine_score', lambda detector: 1.01)
+    result = search_many(image, fovea, model, MANY, pixel_budget=1280 * 886, scales=strict)
     assert plain.detector_pixels < result.detector_pixels <= 1280 * 886
     assert result.fixations >= 1
-    x, y, w, h = boxes[0]
     row, col = result.path[0]                               # the first window: at the face
     assert abs(row - (y + h / 2) * 21 / 886) <= 2 and abs(col - (x + w / 2) * 21 / 1280) <= 2
 
