@@ -156,7 +156,7 @@ def canvas_group(size, seed: int, split: str, copies: int, face_px=(15, 40),
 
 def scenes(split: str, count: int, size, copies: int, faces: str = 'photos',
            face_px=None):
-    """Yield the composed group scenes (or canvases) of a split: ``(name, image, boxes)``."""
+    """Yield the composed group pictures of a split, or its canvases: ``(name, image, boxes)``."""
     if face_px is not None:
         for i in range(count):
             name, image, boxes = canvas_group(size, i, split, copies, face_px)
