@@ -24,8 +24,11 @@ instead and stderr says why. ``--all`` finds every face in one search over the m
 belief (``--targets many``, its default: :func:`ipomdp_gaze.vision.search.search_many`;
 docs/design.md section 11): one line per face with its box, then the image's line. It
 starts with one detector call on the whole image at the coarsest scale its calibration says
-sees faces of 1/10 of the shorter side, and looks closer (a crop at a finer scale, then the
-fovea's windows) only where that call leaves cells undecided (:mod:`ipomdp_gaze.vision.scales`).
+sees faces of 1/10 of the shorter side (``--min-face PX``: of that side in the given image's
+pixels; full resolution when no coarser scale sees it), and looks closer (a crop at a finer
+scale, then the fovea's windows) only where that call leaves cells undecided
+(:mod:`ipomdp_gaze.vision.scales`). Faces far smaller than 1/10 on a large image also need
+``--max-side 0``: the default resize to 2048 px would shrink them below what the detector sees.
 ``--targets one`` keeps the old loop (:func:`ipomdp_gaze.vision.search.search_all`: find one
 face, rule its cells out, search again).
 
