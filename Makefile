@@ -59,7 +59,7 @@ faces: $(STAMP)
 # (photo and lfw faces; YuNet, then Haar) then test groups, each table in one run; then a small
 # group of 15-40 px faces in a 4000x3000 face-free canvas (training, then test; find --all as
 # shipped, --max-side 2048, and with --max-side 0 --min-face 15; about 1.7 GB resident for the
-# full-resolution calls): docs/faces.md's section "find --all on groups: scale as an action"
+# full-resolution calls on 12 MP): docs/faces.md's section "find --all on groups: scale as an action"
 # (about 6 minutes).
 GROUP_BENCH := $(VPY) bench/faces/many_faces.py --scenes 8 --sizes 640x480,1280x886 --write docs/faces.md
 CANVAS_BENCH := $(VPY) bench/faces/many_faces.py --canvas 15-40 --sizes 4000x3000 --scenes 4 \
