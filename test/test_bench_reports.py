@@ -173,3 +173,38 @@ def test_many_faces_report_writes_its_section_and_keeps_the_rest(tmp_path):
     rows = [line for line in text.split('\n') if line.startswith('| 640x480 |')]
     assert [r.split(' | ')[1] for r in rows] == ['find --all', 'detector at 1', 'detector at 0.5',
                                                  'detector at 0.333', 'detector at 0.25']
+
+
+def test_a_canvas_holds_a_small_group_of_small_faces_in_one_region_and_nothing_else():
+    """``many_faces.canvas_group``: 15-40 px faces, apart, in one region of a face-free canvas."""
+    sys.path.insert(0, str(BENCH / 'faces'))
+    from many_faces import canvas_group
+    import numpy as np
+    name, image, boxes = canvas_group((1600, 1200), 1, 'train', 6, (15, 40), (500, 400))
+    plain = canvas_group((1600, 1200), 1, 'train', 0, (15, 40), (500, 400))[1]
+    assert name == 'rocket' and image.shape == (1200, 1600, 3) and len(boxes) == 6
+    sides = boxes[:, 2:].max(axis=1)
+    assert np.all(sides <= 40.1) and np.all(sides >= 14.9)
+    assert np.ptp(boxes[:, 0]) < 500 and np.ptp(boxes[:, 1]) < 400
+    changed = np.argwhere(np.any(image != plain, axis=2))
+    assert len(changed) and np.ptp(changed[:, 1]) < 500 and np.ptp(changed[:, 0]) < 400
+    name = canvas_group((1600, 1200), 1, 'test', 1, (15, 40))[0]
+    assert name in ('stereo_motorcycle', 'gravel')                  # a test background
+
+
+def test_the_canvas_report_runs_find_as_shipped_and_at_full_resolution(tmp_path):
+    """``many_faces.py --canvas``: find resized by --max-side, and with --min-face at 1."""
+    run = subprocess.run([sys.executable, str(BENCH / 'faces' / 'many_faces.py'), '--canvas',
+                          '15-40', '--sizes', '1200x900', '--scenes', '1', '--max-side', '600',
+                          '--min-face', '15'], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    rows = {r.split(' | ')[1]: r.split(' | ') for r in run.stdout.split('\n')
+            if r.startswith('| 1200x900 |')}
+    assert list(rows) == ['find --all', 'find --all --max-side 0 --min-face 15',
+                          'detector at 1', 'detector at 0.5', 'detector at 0.333',
+                          'detector at 0.25']
+    pixels = {k: int(v[7].rstrip(' |').replace(',', '')) for k, v in rows.items()}
+    assert pixels['find --all'] <= 600 * 450                  # resized to 600x450 first
+    assert pixels['find --all --max-side 0 --min-face 15'] >= pixels['detector at 1'] == \
+        1200 * 900                                            # 15 px: full resolution
+    assert 'find --max-side 600' in run.stdout

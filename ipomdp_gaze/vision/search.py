@@ -548,12 +548,13 @@ class _Coarse(_Recorder):
     """
 
     def __init__(self, fovea: Fovea, table, image_px: tuple[int, int], prior: np.ndarray,
-                 confidence: float, budget: float = math.inf):
+                 confidence: float, budget: float = math.inf, min_face: float | None = None):
         super().__init__(fovea)
         self.scans = True
         self.table, self.image_px, self.prior = table, image_px, prior
-        self.scale = choose_scale(table, image_px)
+        self.scale = choose_scale(table, image_px, min_face)
         self.detector = coarse_detector(fovea.detector, table.weak_score)
+        self.fine_score = _fine_score(fovea.detector)
         self.threshold = math.log(confidence / (1.0 - confidence))
         self.budget = budget
         self.image = None
@@ -576,8 +577,13 @@ class _Coarse(_Recorder):
         raw = found.boxes_px + (x0, y0, 0, 0)
         scores = np.ones(len(raw)) if found.scores is None else np.asarray(found.scores)
         if self.table.strong_score > 0:
-            strong = raw[scores >= self.table.strong_score]
-            weak = raw[scores < self.table.strong_score]
+            # at the table's finest scale no finer look follows: a box the fovea's own
+            # detector keeps (its calibrated score threshold) is strong there
+            cut = self.table.strong_score
+            if scale >= self.table.rows[-1].scale:
+                cut = min(cut, self.fine_score)
+            strong = raw[scores >= cut]
+            weak = raw[scores < cut]
         else:           # a grouping detector: its grouped boxes strong, looser groups weak
             strong = found.grouped_px + (x0, y0, 0, 0)
             weak = (group_boxes(np.round(raw), self.table.weak_neighbors) if len(raw)
@@ -615,6 +621,12 @@ class _Coarse(_Recorder):
                 term = np.where(inner.reshape(-1), fine, term)
         return Frame(term, kind='evidence', detector_pixels=pixels,
                      seconds=time.perf_counter() - t0)
+
+
+def _fine_score(detector) -> float:
+    """Return the score from which the fovea's detector keeps a box (inf: it keeps no score)."""
+    settings = getattr(detector, 'settings', None)
+    return (settings() if callable(settings) else {}).get('score_threshold', math.inf)
 
 
 def _grown(box: tuple, margin: int, shape: tuple) -> tuple:
@@ -674,7 +686,8 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
                 pixel_budget: int | None = None, link: int = FACE_RADIUS,
                 settle: int = SETTLE_RADIUS,
                 empty_by_evidence: bool = EMPTY_BY_EVIDENCE,
-                scales: ScaleTable | None = None) -> ImageSearch:
+                scales: ScaleTable | None = None,
+                min_face: float | None = None) -> ImageSearch:
     """
     Search one image for every face at once: the many-target belief (``search.targets: many``).
 
@@ -692,6 +705,9 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     --all``) the one-time scan is the coarse full-frame pass at the coarsest scale that sees
     faces of the sizes that matter, and the fovea's finer windows are spent only on the cells
     it leaves undecided (a weak detection); without, the fovea's own scan (as before).
+    ``min_face``: the smallest face side that matters, in the image's pixels (default
+    :func:`~ipomdp_gaze.vision.scales.min_face_px`, 1/10 of the shorter side), which chooses
+    the coarse scale.
 
     Raises
     ------
@@ -712,7 +728,7 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
         prior = prior_log_odds(fovea.grid.n_cells,
                                cell_prior(fovea.grid.n_cells, settings.absent_prior))
         sensor = _Coarse(fovea, scales, image_px, prior, settings.confidence,
-                         math.inf if pixel_budget is None else pixel_budget)
+                         math.inf if pixel_budget is None else pixel_budget, min_face)
     outcome = run_search(session, sensor, image, pixel_budget=pixel_budget)
     boxes = np.concatenate(sensor.boxes) if sensor.boxes else np.zeros((0, 4))
     scores = np.concatenate(sensor.scores) if sensor.scores else np.zeros(0)
