@@ -239,11 +239,13 @@ def run(args) -> list[dict]:
 
 def _add(totals, method, counts, n_true, seconds, pixels):
     t = totals.setdefault(method, {'scenes': 0, 'faces': 0, 'found': 0, 'false': 0,
-                                   'duplicates': 0, 'seconds': 0.0, 'pixels': 0})
+                                   'false_most': 0, 'duplicates': 0, 'seconds': 0.0,
+                                   'pixels': 0})
     t['scenes'] += 1
     t['faces'] += n_true
     t['found'] += counts[0]
     t['false'] += counts[1]
+    t['false_most'] = max(t['false_most'], counts[1])
     t['duplicates'] += counts[2]
     t['seconds'] += seconds
     t['pixels'] += int(pixels)
@@ -302,12 +304,13 @@ def main(argv=None):
              f'{args.copies} copies (lfw: faces) per scene, detector {args.detector}, absent '
              f'prior {args.absent_prior}, confidence {args.confidence}, empty by evidence '
              f'{args.empty_by_evidence}, find --max-side {args.max_side}:', '',
-             '| size | method | faces | found | false | duplicates | s / scene | '
-             'detector px / scene |', '|---|---|---|---|---|---|---|---|']
+             '| size | method | faces | found | false | most false in a picture | duplicates | '
+             's / scene | detector px / scene |', '|---|---|---|---|---|---|---|---|---|']
     for r in rows:
         n = r['scenes']
         lines.append(f"| {r['size']} | {r['method']} | {r['faces']} | {r['found']} | "
-                     f"{r['false']} | {r['duplicates']} | {r['seconds'] / n:.4f} | "
+                     f"{r['false']} | {r['false_most']} | {r['duplicates']} | "
+                     f"{r['seconds'] / n:.4f} | "
                      f"{r['pixels'] / n:,.0f} |")
     print('\n'.join(lines))
     if args.write:
