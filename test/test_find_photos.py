@@ -64,7 +64,9 @@ def test_find_decides_on_each_real_photo_within_one_full_scan(photos, tmp_path, 
     assert len(entries) == 6 and f'{model} ' in result.stderr + ' '
     for name, entry in entries.items():
         boxes = labels[name][0]
-        assert entry['detector_pixels'] <= entry['full_scan_pixels'], name
+        # the default --scan coarse: full-frame calls from coarse to fine (1/4 + 1/3 + 1/2 + 1
+        # of a full scan at most, a confirming crop within them)
+        assert entry['detector_pixels'] <= 1.43 * entry['full_scan_pixels'], name
         if name == 'camera' and 'yunet' not in model:
             assert entry['decision'] in ('found', 'absent', 'gave_up')    # Haar misses him
         elif len(boxes):
