@@ -50,8 +50,8 @@ def test_a_face_free_photo_is_absent_after_every_rung(detector):
     start = ladder_start(task.model, table)
     rungs = [r.scale for r in table.rows if r.scale >= start * (1 - 1e-3)]
     assert rungs[-1] == 1.0
-    expected = sum(int(np.floor(image.shape[1] * s + 0.5)) * int(np.floor(image.shape[0] * s
-                                                                            + 0.5))
+    width, height = image.shape[1], image.shape[0]
+    expected = sum(int(np.floor(width * s + 0.5)) * int(np.floor(height * s + 0.5))
                    for s in rungs)
     assert result.detector_pixels == expected
 
@@ -104,3 +104,16 @@ def test_the_cli_switches_back_to_the_fovea(scene, tmp_path, cli_here):
     assert tuple(fovea['cell']) == today.cell and fovea['fixations'] == today.fixations
     assert fovea['detector_pixels'] == today.detector_pixels
     assert near(coarse['cell'], scene.cell) and coarse['decision'] == 'found'
+
+
+def test_the_default_line_says_it_ended_on_a_scan_without_a_probability(tmp_path, cli_here):
+    path = tmp_path / 'astronaut.png'
+    cv2.imwrite(str(path), cv2.cvtColor(load_photo('astronaut'), cv2.COLOR_RGB2BGR))
+    plot = tmp_path / 'plot.png'
+    result = cli_here('find', path, '--json', tmp_path / 'out.json', '--plot', plot)
+    assert result.returncode == 0, result.stderr
+    line = result.stdout.strip()
+    assert 'decision=found ended=scan' in line and 'p=n/a fixations=0' in line
+    assert 'method=scales' in line and plot.exists()
+    entry = json.loads((tmp_path / 'out.json').read_text())['images'][0]
+    assert entry['probability'] is None and entry['note'].startswith('full frame at')

@@ -55,7 +55,7 @@ def find_tasks(detector=None, observation=None) -> _Tasks:
 
 
 def photo_rows(tasks, split, settings, scan=SCAN_DEFAULT) -> list[dict]:
-    """``find --scan SCAN`` on each photo of ``split`` ('train', 'test' or 'all'): one dict each."""
+    """``find --scan SCAN`` on each photo of ``split`` ('train', 'test', 'all'): a dict each."""
     rows = []
     for i, photo in enumerate(real_photos(None if split == 'all' else split)):
         image = photo.image

@@ -121,11 +121,11 @@ def photo_table(split: str, detectors, scans) -> list[str]:
             empty = [r for r in rows if not r['face']]
             ratios = [r['pixels_ratio'] for r in rows]
             ms = [1e3 * r['seconds'] for r in rows]
-            lines.append(f"| {NAMES[detector]} | {mode} | "
+            lines.append(f'| {NAMES[detector]} | {mode} | '
                          f"{sum(r['right'] for r in faces)}/{len(faces)} | "
                          f"{sum(r['right'] for r in empty)}/{len(empty)} | "
-                         f"{np.mean(ratios):.2f}, {np.max(ratios):.2f} | "
-                         f"{np.median(ms):.0f} | {np.mean(ms):.0f} |")
+                         f'{np.mean(ratios):.2f}, {np.max(ratios):.2f} | '
+                         f'{np.median(ms):.0f} | {np.mean(ms):.0f} |')
             for r in rows:
                 if not r['right']:
                     lines.append(f"|  | (wrong: {r['photo']}: {r['decision']}) | | | | | |")

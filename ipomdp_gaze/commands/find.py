@@ -201,7 +201,7 @@ def add_parser(sub):
                         'runs at the coarsest scale whose calibration sees it, full resolution '
                         'when none does (faces far below 1/10 on a large image: pass '
                         '--max-side 0 too, or the resize makes them smaller still)')
-    p.add_argument('--scan', choices=SCAN_CHOICES, default=SCAN_DEFAULT,
+    p.add_argument('--scan', dest='scan_mode', choices=SCAN_CHOICES, default=SCAN_DEFAULT,
                    help='without --all: coarse (default) runs the detector on the whole image '
                         'from a coarse scale to finer ones until a strong box (looked at again '
                         'at the next finer scale) and answers it, up to 1.42 full scans of '
@@ -652,7 +652,7 @@ def run(args) -> int:
                   f'image, below the {table.rows[-1].min_side_px:.0f} px from which the '
                   f'{table.detector} table sees faces at full resolution: they may be missed')
         results = search_one(image, task, settings, np.random.default_rng([args.seed, i]),
-                             args.all, min_face, getattr(args, 'scan', SCAN_DEFAULT))
+                             args.all, min_face, getattr(args, 'scan_mode', SCAN_DEFAULT))
         searched = results                      # in the searched image's pixels (the plot)
         if scale != (1.0, 1.0):
             results = [_in_given_pixels(r, scale, given) for r in results]
