@@ -22,9 +22,10 @@ a strong box (YuNet: score 0.7; Haar: a merged box), looked at again round the b
 finer scale (a texture taken for a face at a coarse scale rarely survives); at full resolution
 any box the detector keeps answers. ``found`` at that box's centre, else ``absent``; no belief
 (``p`` n/a), method ``scales`` (:func:`ipomdp_gaze.vision.search.search_scales`). A face-free
-image pays every scale, up to 1.42 full scans of detector pixels. ``--scan many`` answers the
-most probable face of the many-target search of ``--all`` (below); ``--scan fovea`` is the
-paper's single-target search with the fovea (what ``find`` did before ``--scan``).
+image pays every scale, about 1.4 full scans of detector pixels (1/16 + 1/9 + 1/4 + 1 and any
+confirming crop). ``--scan many`` answers the most probable face of the many-target search of
+``--all`` (below); ``--scan fovea`` is the paper's single-target search with the fovea (what
+``find`` did before ``--scan``).
 
 **Pixels.** The fovea (:func:`ipomdp_gaze.vision.search.search_image`) never spends more
 detector pixels than one full-resolution scan of the image: it stops before a fixation that
@@ -204,14 +205,15 @@ def add_parser(sub):
     p.add_argument('--scan', dest='scan_mode', choices=SCAN_CHOICES, default=SCAN_DEFAULT,
                    help='without --all: coarse (default) runs the detector on the whole image '
                         'from a coarse scale to finer ones until a strong box (looked at again '
-                        'at the next finer scale) and answers it, up to 1.42 full scans of '
+                        'at the next finer scale) and answers it, about 1.4 full scans of '
                         'detector pixels on a face-free image; many: the most probable face of '
                         "--all's many-target search; fovea: the paper's single-target search "
                         'with the fovea within one full scan (find before --scan)')
     p.add_argument('--log', type=Path, default=None, metavar='OUT.jsonl',
                    help="write each image's search session event log (reset with the "
                         'settings, scan, start, one event per fixation with the frame and '
-                        'belief summaries and the decision) as one JSON line per image')
+                        'belief summaries and the decision) as one JSON line per image (no '
+                        'events with the default --scan coarse: it runs no search session)')
     p.add_argument('--seed', type=nonneg_int, default=0, metavar='S',
                    help='seed of a sampling policy (image i uses default_rng([S, i]))')
     p.set_defaults(run=run)
