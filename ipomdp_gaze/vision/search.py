@@ -791,20 +791,25 @@ def _ladder_answer(found, strong_score: float, last: bool):
 def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
                   start: float, confirm: bool = True) -> ImageSearch:
     """
-    Find the one face of ``find`` by full-frame calls from coarse to fine (``--scan ladder``).
+    Find the one face of ``find`` by full-frame calls from coarse to fine (``--scan coarse``).
 
     The detector runs on the whole image at ``start`` and then at each finer scale of the
     table, stopping at the first call with a strong box (YuNet: a score of at least the
     table's ``strong_score``; Haar: a merged box); at the finest scale any box the fovea's
-    detector keeps answers. ``found`` at the best box (the highest score; for a grouping
-    detector the merged box holding most raw detections), else ``absent``. No belief is
-    computed (``probability`` NaN).
+    detector keeps answers. With ``confirm`` a strong box of a coarser call answers only if a
+    crop round it (its side on each side) at the next finer scale keeps a box (strong unless
+    that scale is the finest); else the next scale's full-frame call follows. ``found`` at the
+    best box (the highest score; for a grouping detector the merged box holding most raw
+    detections), else ``absent``. No belief is computed (``probability`` NaN, method
+    ``scales``); ``detector_pixels`` counts every call and crop (a face-free image pays every
+    scale: 1/16 + 1/9 + 1/4 + 1 of a full scan from 1/4).
     """
     from ipomdp_gaze.vision.fullframe import cells_of_points, scan
     t0 = time.perf_counter()
     image_px = check_image(image, fovea)
     grid = fovea.grid
-    rungs = [row.scale for row in scales.rows if row.scale >= start * (1 - 1e-3)]
+    rungs = [row.scale for row in scales.rows if row.scale >= start * (1 - 1e-3)] \
+        or [scales.rows[-1].scale]
     pixels, box = 0, None
     for k, scale in enumerate(rungs):
         found = scan(image, fovea.detector, grid, scale)
