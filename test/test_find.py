@@ -99,7 +99,8 @@ def within_one_cell(cell, scene):
 
 def test_find_locates_the_face_of_a_test_scene(task, tmp_path):
     out = tmp_path / 'out.json'
-    result = run_find(task['images'][0], '--observation', task['model'], '--json', out)
+    result = run_find(task['images'][0], '--observation', task['model'], '--json', out,
+                      '--scan', 'fovea')
     assert result.returncode == 0, result.stderr
     lines = result.stdout.strip().splitlines()
     assert len(lines) == 1
@@ -118,7 +119,8 @@ def test_json_has_one_entry_per_image_in_input_order(task, find_here):
     root = task['root']
     names = [path.name for path in reversed(task['images'])]
     out = root / 'two.json'
-    result = find_here(*names, '--observation', task['model'], '--json', 'two.json', cwd=root)
+    result = find_here(*names, '--observation', task['model'], '--json', 'two.json',
+                       '--scan', 'fovea', cwd=root)
     assert result.returncode == 0, result.stderr
     data = json.loads(out.read_text())
     assert list(data) == ['grid', 'axes', 'images'] and data['grid'] == {'rows': 21, 'cols': 21}

@@ -7,8 +7,9 @@
 it with every default); the scene set's upscaled grey thumbnails are the Haar cascade's, so this
 names the scene task's ``faces-420`` count model (calibrated at the images' 420x420 px, with its
 one-time whole-image scan): ``find`` must use the shipped kernel trained on it, with every other
-setting left at its default (the absent hypothesis included), and find the face of held-out test
-scenes within one cell of its centre's cell. The scenes are
+setting left at its default (the absent hypothesis included) but ``--scan fovea`` (the default
+coarse scan has no policy: test/test_find_scan.py), and find the face of held-out test scenes
+within one cell of its centre's cell. The scenes are
 the first test scenes whose face OpenCV's full-frame scan finds (a choice that depends on the
 detector only, never on the model or on ``find``).
 """
@@ -54,7 +55,8 @@ def test_find_with_every_default_finds_the_faces(tmp_path):
         cv2.imwrite(str(paths[-1]), image)
     out = tmp_path / 'found.json'
     run = subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', 'find', *map(str, paths),
-                          '--json', str(out), '--observation', 'faces-420'],
+                          '--json', str(out), '--observation', 'faces-420', '--scan',
+                          'fovea'],
                          capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr
     assert 'observation model faces-420 (21x21 grid, calibrated at 420x420 px)' \

@@ -63,7 +63,9 @@ def test_the_words_of_an_ending():
 def test_each_line_says_how_the_search_ended_with_the_answers_probability(images, tmp_path,
                                                                           run_find):
     out = tmp_path / 'out.json'
-    result = run_find(*images.values(), '--json', out)
+    # the fovea's single-target belief (--scan fovea); the default coarse scan has no belief
+    # (ended=scan, p=n/a: test/test_find_scan.py)
+    result = run_find(*images.values(), '--json', out, '--scan', 'fovea')
     assert result.returncode == 0, result.stderr
     lines = {m['path']: m for m in LINE.finditer(result.stdout)}
     entries = {e['path']: e for e in json.loads(out.read_text())['images']}
@@ -91,7 +93,8 @@ def test_each_line_says_how_the_search_ended_with_the_answers_probability(images
 
 
 def test_a_limit_that_forces_found_says_so(images, run_find):
-    result = run_find(images['astronaut'], '--max-fixations', '1', '--confidence', '0.999999')
+    result = run_find(images['astronaut'], '--max-fixations', '1', '--confidence', '0.999999',
+                      '--scan', 'fovea')
     assert result.returncode == 0, result.stderr
     line = LINE.search(result.stdout)
     assert line['decision'] == 'found' and line['ended'] == 'forced:budget', result.stdout

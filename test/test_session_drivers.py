@@ -152,13 +152,15 @@ def test_find_with_an_absent_prior_says_absent_on_a_face_free_photo(tmp_path):
     cv2.imwrite(str(path), data.brick())
     # every view counting fully, the evidence decides before the pixel deadline
     out = cli('find', str(path), '--absent-prior', '0.5', '--json', str(tmp_path / 'o.json'),
-              '--observation', 'faces-420', '--repeat-weight', '1', '--policy', 'elm')
+              '--observation', 'faces-420', '--repeat-weight', '1', '--policy', 'elm',
+              '--scan', 'fovea')
     assert out.returncode == 0, out.stderr
     entry = json.loads((tmp_path / 'o.json').read_text())['images'][0]
     assert entry['decision'] == entry['stop'] == 'absent'       # the evidence decided
     assert entry['absent_probability'] >= 0.99 and 'decision=absent' in out.stdout
-    # by default (the absent hypothesis on): absent, by the evidence or at the pixel deadline
-    out = cli('find', str(path), '--json', str(tmp_path / 'o.json'))
+    # the fovea's defaults (the absent hypothesis on): absent, by the evidence or at the pixel
+    # deadline (the default --scan coarse has no belief: test/test_find_scan.py)
+    out = cli('find', str(path), '--json', str(tmp_path / 'o.json'), '--scan', 'fovea')
     entry = json.loads((tmp_path / 'o.json').read_text())['images'][0]
     assert out.returncode == 0 and entry['decision'] == 'absent', out.stderr
     assert entry['stop'] in ('absent', 'pixels') and entry['cell'] is None
@@ -171,7 +173,7 @@ def test_find_saves_each_images_event_log(tmp_path):
     path = tmp_path / 'astronaut.png'
     cv2.imwrite(str(path), cv2.cvtColor(data.astronaut(), cv2.COLOR_RGB2BGR))
     out = cli('find', str(path), '--log', str(tmp_path / 'log.jsonl'), '--json',
-              str(tmp_path / 'o.json'))
+              str(tmp_path / 'o.json'), '--scan', 'fovea')
     assert out.returncode == 0, out.stderr
     entry = json.loads((tmp_path / 'o.json').read_text())['images'][0]
     lines = (tmp_path / 'log.jsonl').read_text().splitlines()

@@ -817,6 +817,8 @@ FIND_TEXT = [
 # The section bench/faces/many_faces.py fills (make faces-groups, which make faces runs after
 # this script): kept as it is when this script rewrites the file.
 GROUPS_HEADING = '## `find --all` on groups: scale as an action'
+# bench/faces/find_scale.py's section (find without --all, every --scan), kept as written
+FIND_SCALE_HEADING = '## `find` without `--all`: scale first'
 
 
 def kept_section(path: Path, heading: str) -> list:
@@ -950,6 +952,7 @@ def main(argv=None) -> int:
                                         '']
         text += photo_detail(photos) + ['']
     text += kept_section(args.out, GROUPS_HEADING)
+    text += kept_section(args.out, FIND_SCALE_HEADING)
     text += choices_text(trainings, photos, pan_tilt_train, args)
     text += IDEAS
     wall = time.perf_counter() - start

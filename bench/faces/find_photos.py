@@ -27,7 +27,7 @@ from dataclasses import replace
 import time
 from types import SimpleNamespace
 
-from ipomdp_gaze.commands.find import _Tasks, FIND_DETECTORS, search_one
+from ipomdp_gaze.commands.find import _Tasks, FIND_DETECTORS, SCAN_DEFAULT, search_one
 from ipomdp_gaze.simulation.evaluation import answer_is_right
 from ipomdp_gaze.vision.fullframe import cells_of_points, scan
 from ipomdp_gaze.vision.photos import group_photo, real_photos, TRAIN_GROUP_BACKGROUNDS
@@ -54,14 +54,15 @@ def find_tasks(detector=None, observation=None) -> _Tasks:
                                   policy_file=None))
 
 
-def photo_rows(tasks, split, settings) -> list[dict]:
-    """``find`` on each photo of ``split`` ('train', 'test' or 'all'): one dict per photo."""
+def photo_rows(tasks, split, settings, scan=SCAN_DEFAULT) -> list[dict]:
+    """``find --scan SCAN`` on each photo of ``split`` ('train', 'test', 'all'): a dict each."""
     rows = []
     for i, photo in enumerate(real_photos(None if split == 'all' else split)):
         image = photo.image
         task = tasks.task((image.shape[1], image.shape[0]))
         t0 = time.perf_counter()
-        result = search_one(image, task, settings, np.random.default_rng([0, i]), False)[0]
+        result = search_one(image, task, settings, np.random.default_rng([0, i]), False,
+                            scan=scan)[0]
         seconds = time.perf_counter() - t0
         full = image.shape[0] * image.shape[1]
         face = bool(len(photo.boxes))

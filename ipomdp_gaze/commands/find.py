@@ -15,6 +15,18 @@ col)`` and ``pixel (x, y)`` (``none`` unless found), ``p``, the probability of *
 (the found cell's, or for ``absent`` that nobody is there), the fixations, the detector pixels
 against one full-resolution scan's, the seconds, why it stopped and the method.
 
+**Scale first** (``--scan``, without ``--all``). By default (``coarse``) the detector runs on
+the whole image at a coarse scale (1/2; Haar's ``faces-420``: 1/4) and then at each finer scale
+of its calibrated table (:mod:`ipomdp_gaze.vision.scales`: 1/4, 1/3, 1/2, 1) until one call has
+a strong box (YuNet: score 0.7; Haar: a merged box), looked at again round the box at the next
+finer scale (a texture taken for a face at a coarse scale rarely survives); at full resolution
+any box the detector keeps answers. ``found`` at that box's centre, else ``absent``; no belief
+(``p`` n/a), method ``scales`` (:func:`ipomdp_gaze.vision.search.search_scales`). A face-free
+image pays every scale, about 1.4 full scans of detector pixels (1/16 + 1/9 + 1/4 + 1 and any
+confirming crop). ``--scan many`` answers the most probable face of the many-target search of
+``--all`` (below); ``--scan fovea`` is the paper's single-target search with the fovea (what
+``find`` did before ``--scan``).
+
 **Pixels.** The fovea (:func:`ipomdp_gaze.vision.search.search_image`) never spends more
 detector pixels than one full-resolution scan of the image: it stops before a fixation that
 would, and decides then (``decide_at_budget``; stop ``pixels``). When the fovea would cost more
@@ -79,8 +91,8 @@ from ipomdp_gaze.vision.image_files import decode_quietly
 from ipomdp_gaze.vision.scales import SCALE_TABLES
 from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, FIND_SETTINGS,
                                        fovea_for_model, full_frame_reason, full_frame_search,
-                                       prepare_many, search_all, search_image, search_many,
-                                       size_distance)
+                                       prepare_many, search_all, search_first, search_image,
+                                       search_many, search_scales, size_distance)
 import numpy as np
 
 from .common import nonneg_int, positive_float
@@ -100,6 +112,24 @@ STDOUT = Path('-')
 # and 840 px, so a 2048 px image still holds every window at the resolution they were measured
 # at.
 MAX_SIDE_PX = 2048
+# find without --all: how the search starts (--scan). 'coarse' (the default): full-frame
+# detector calls from a coarse scale to finer ones until a strong box, confirmed by a look at
+# the next finer scale round it (search_scales); 'many': the many-target search of --all (its
+# coarse pass, the fovea only where cells stay undecided), answering its most probable face
+# (search_first); 'fovea': the paper's single-target belief after the fovea's own scan
+# (search_image, find before --scan). Chosen on training scenes and photos (docs/faces.md,
+# "find without --all: scale first"): on 60 training scenes of each task 'coarse' was as right
+# as each detector's best single-scale call in fewer seconds, 'many' lost at 840 and cost
+# Haar's full-resolution call at 420, 'fovea' lost with YuNet.
+SCAN_CHOICES = ('coarse', 'many', 'fovea')
+SCAN_DEFAULT = 'coarse'
+# --scan coarse: the scale of the first full-frame call, per detector and model size (the
+# shipped models' calibrated shorter side), chosen on 60 training scenes of each task (seed 1):
+# Haar from 1/4 at 420 (right 0.983 as from 1/3 and 1/2, in the fewest seconds) and from 1/2 at
+# 840 (0.950; from 1/4 and 1/3 a face-like texture of the backgrounds is answered at 0.917);
+# YuNet from 1/2 (0.967 at 420 and 0.850 at 840 from every start, from 1/2 in the fewest).
+LADDER_START = {('haar', 420): 0.25, ('haar', 840): 0.5, ('yunet', 420): 0.5,
+                ('yunet', 840): 0.5}
 
 
 def add_parser(sub):
@@ -172,10 +202,18 @@ def add_parser(sub):
                         'runs at the coarsest scale whose calibration sees it, full resolution '
                         'when none does (faces far below 1/10 on a large image: pass '
                         '--max-side 0 too, or the resize makes them smaller still)')
+    p.add_argument('--scan', dest='scan_mode', choices=SCAN_CHOICES, default=SCAN_DEFAULT,
+                   help='without --all: coarse (default) runs the detector on the whole image '
+                        'from a coarse scale to finer ones until a strong box (looked at again '
+                        'at the next finer scale) and answers it, about 1.4 full scans of '
+                        'detector pixels on a face-free image; many: the most probable face of '
+                        "--all's many-target search; fovea: the paper's single-target search "
+                        'with the fovea within one full scan (find before --scan)')
     p.add_argument('--log', type=Path, default=None, metavar='OUT.jsonl',
                    help="write each image's search session event log (reset with the "
                         'settings, scan, start, one event per fixation with the frame and '
-                        'belief summaries and the decision) as one JSON line per image')
+                        'belief summaries and the decision) as one JSON line per image (no '
+                        'events with the default --scan coarse: it runs no search session)')
     p.add_argument('--seed', type=nonneg_int, default=0, metavar='S',
                    help='seed of a sampling policy (image i uses default_rng([S, i]))')
     p.set_defaults(run=run)
@@ -422,7 +460,7 @@ def plot_title(path: str, result, confidence: float) -> str:
 
 
 def _reason(result) -> str:
-    return 'full_frame' if result.method == 'full_frame' else result.stop
+    return 'full_frame' if result.method in ('full_frame', 'scales') else result.stop
 
 
 def entry(path: str, result, grid, confidence: float | None = None) -> dict:
@@ -528,8 +566,18 @@ def scale_table(model):
     return SCALE_TABLES.get(kind)
 
 
+def ladder_start(model, scales) -> float:
+    """Return the first scale of ``--scan coarse`` for a model (:data:`LADDER_START`)."""
+    size = calibrated_size(model)
+    side = min(size) if size else 420
+    known = [key for key in LADDER_START if key[0] == scales.detector]
+    if not known:
+        return scales.rows[0].scale
+    return LADDER_START[min(known, key=lambda key: abs(math.log(side / key[1])))]
+
+
 def search_one(image, task, settings, rng, find_all: bool,
-               min_face: float | None = None) -> list:
+               min_face: float | None = None, scan: str = SCAN_DEFAULT) -> list:
     """
     Search one image: the fovea within one full scan's pixels, or the full frame (say why).
 
@@ -552,6 +600,14 @@ def search_one(image, task, settings, rng, find_all: bool,
     if find_all:
         return search_all(image, task.fovea, task.model, task.policy, settings, rng=rng,
                           pixel_budget=budget)
+    scales = scale_table(task.model) if scan != 'fovea' else None
+    if scales is not None and scan == 'coarse':
+        return [search_scales(image, task.fovea, task.model, scales,
+                              start=ladder_start(task.model, scales))]
+    if scales is not None:
+        prepare_many(task.fovea, task.model, (width, height), scales)      # one-time set-up
+        return [search_first(image, task.fovea, task.model, settings, pixel_budget=budget,
+                             scales=scales, min_face=min_face)]
     return [search_image(image, task.fovea, task.model, task.policy, settings, rng=rng,
                          pixel_budget=budget)]
 
@@ -598,7 +654,7 @@ def run(args) -> int:
                   f'image, below the {table.rows[-1].min_side_px:.0f} px from which the '
                   f'{table.detector} table sees faces at full resolution: they may be missed')
         results = search_one(image, task, settings, np.random.default_rng([args.seed, i]),
-                             args.all, min_face)
+                             args.all, min_face, getattr(args, 'scan_mode', SCAN_DEFAULT))
         searched = results                      # in the searched image's pixels (the plot)
         if scale != (1.0, 1.0):
             results = [_in_given_pixels(r, scale, given) for r in results]

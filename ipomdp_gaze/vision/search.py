@@ -52,7 +52,7 @@ from ipomdp_gaze.search import answer
 from ipomdp_gaze.search.many import OccupancySession
 from ipomdp_gaze.search.sensors import run_search
 from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
-from ipomdp_gaze.vision.detector import detector_window_px, group_boxes
+from ipomdp_gaze.vision.detector import box_centres_px, detector_window_px, group_boxes
 from ipomdp_gaze.vision.detectors import detector_from_settings  # noqa: F401 (its old home)
 from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea
 from ipomdp_gaze.vision.fovea_model import check_model, fovea_for_model  # noqa: F401
@@ -92,7 +92,7 @@ FIND_SETTINGS = SearchSettings(confidence=0.99, max_fixations=60, inhibit_return
 SCENE_SETTINGS = replace(FIND_SETTINGS, repeat_weight=1.0, absent_prior=0.0,
                          decide_at_budget=False)
 STOP_REASONS = ('found', 'absent', 'budget', 'repeat', 'pixels')
-METHODS = ('fovea', 'full_frame')
+METHODS = ('fovea', 'full_frame', 'scales')
 # find --all: a found face takes the cells within 2 (Chebyshev) of its answer out of the search.
 # One cell was too few on the composed group photos (docs/faces.md): a 48-90 px face spans 2-4
 # cells of a 640x480 picture and its spread-out detections were found again as a second face.
@@ -204,7 +204,7 @@ class ImageSearch:
     def ended(self) -> str:
         """How the search ended: ``confidence``, ``forced:<limit>``, ... (:mod:`..answer`)."""
         return answer.ended(self.decision,
-                            'full_frame' if self.method == 'full_frame' else self.stop)
+                            'full_frame' if self.method in ('full_frame', 'scales') else self.stop)
 
     @property
     def answer_probability(self) -> float:
@@ -741,3 +741,113 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     if decision in ('found', 'absent'):
         decision = 'found' if faces else 'absent'
     return _image_search(outcome, grid, image_px, calibrated_size(model), t0, decision, faces)
+
+
+def search_first(image: np.ndarray, fovea: Fovea, model,
+                 settings: SearchSettings | None = None, *,
+                 pixel_budget: int | None = None, scales: ScaleTable | None = None,
+                 min_face: float | None = None) -> ImageSearch:
+    """
+    Find the one face of ``find`` (without ``--all``) by the coarse pass first (``--scan coarse``).
+
+    The many-target search of :func:`search_many` with the detector's scale table (one
+    full-frame call at the coarsest scale that sees faces of ``min_face``, finer crops and the
+    fovea's windows only where cells stay undecided), answered as one target: ``found`` at the
+    most probable face (its cell, the centre of its box as the pixel, its probability), else
+    ``absent`` (every cell decided empty; ``absent_probability`` is ``P(nobody here)``) or
+    ``gave_up``. The paper's single-target belief is not used.
+    """
+    t0 = time.perf_counter()
+    many = search_many(image, fovea, model, settings, pixel_budget=pixel_budget,
+                       scales=scales, min_face=min_face)
+    if not many.faces:
+        nobody = float(np.prod(1.0 - np.asarray(many.belief, dtype=float)))
+        return replace(many, absent_probability=nobody, seconds=time.perf_counter() - t0)
+    face = many.faces[0]
+    x, y, w, h = face.box
+    return replace(many, cell=face.cell, pixel=(x + w / 2.0, y + h / 2.0),
+                   probability=face.probability, decision='found',
+                   seconds=time.perf_counter() - t0)
+
+
+def _ladder_answer(found, strong_score: float, last: bool):
+    """Return the answer box (x, y, w, h) of one rung of :func:`search_scales`, or None."""
+    if found.scores is not None and len(found.boxes_px) and strong_score > 0:
+        scores = np.asarray(found.scores, dtype=float)
+        best = int(np.argmax(scores))
+        if last or scores[best] >= strong_score:
+            return found.boxes_px[best]
+        return None
+    if not len(found.grouped_px):
+        return None
+    # a grouping detector: the merged box holding the most raw detection centres
+    centres = box_centres_px(found.boxes_px)
+    inside = [int(np.sum((centres[:, 0] >= x) & (centres[:, 0] < x + w)
+                         & (centres[:, 1] >= y) & (centres[:, 1] < y + h)))
+              for x, y, w, h in found.grouped_px]
+    return found.grouped_px[int(np.argmax(inside))]
+
+
+def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
+                  start: float, confirm: bool = True) -> ImageSearch:
+    """
+    Find the one face of ``find`` by full-frame calls from coarse to fine (``--scan coarse``).
+
+    The detector runs on the whole image at ``start`` and then at each finer scale of the
+    table, stopping at the first call with a strong box (YuNet: a score of at least the
+    table's ``strong_score``; Haar: a merged box); at the finest scale any box the fovea's
+    detector keeps answers. With ``confirm`` a strong box of a coarser call answers only if a
+    crop round it (its side on each side) at the next finer scale keeps a box (strong unless
+    that scale is the finest); else the next scale's full-frame call follows. ``found`` at the
+    best box (the highest score; for a grouping detector the merged box holding most raw
+    detections), else ``absent``. No belief is computed (``probability`` NaN, method
+    ``scales``); ``detector_pixels`` counts every call and crop (a face-free image pays every
+    scale: 1/16 + 1/9 + 1/4 + 1 of a full scan from 1/4).
+    """
+    from ipomdp_gaze.vision.fullframe import cells_of_points, scan
+    t0 = time.perf_counter()
+    image_px = check_image(image, fovea)
+    grid = fovea.grid
+    rungs = [row.scale for row in scales.rows if row.scale >= start * (1 - 1e-3)] \
+        or [scales.rows[-1].scale]
+    pixels, box = 0, None
+    for k, scale in enumerate(rungs):
+        found = scan(image, fovea.detector, grid, scale)
+        pixels += found.detector_pixels
+        last = k == len(rungs) - 1
+        box = _ladder_answer(found, scales.strong_score, last)
+        if box is not None and confirm and not last:
+            # look again round the box at the next finer scale: a texture the coarse call took
+            # for a face rarely survives
+            x, y, w, h = box
+            side = max(w, h)
+            x0, y0 = int(max(0, x - side)), int(max(0, y - side))
+            x1 = int(min(image_px[0], x + w + side))
+            y1 = int(min(image_px[1], y + h + side))
+            look = scan(image[y0:y1, x0:x1], fovea.detector, (1, 1), rungs[k + 1])
+            pixels += look.detector_pixels
+            box = _ladder_answer(look, scales.strong_score, k + 1 == len(rungs) - 1)
+            if box is not None:
+                box = np.asarray(box, dtype=float) + (x0, y0, 0, 0)
+        if box is not None:
+            break
+    common = {'fixations': 0, 'path': (), 'detector_pixels': pixels, 'image_px': image_px,
+              'calibrated_px': calibrated_size(model), 'method': 'scales',
+              'note': f'full frame at {", ".join(f"{s:.2g}" for s in rungs[:k + 1])}',
+              'probability': math.nan}
+    if box is None:
+        return ImageSearch(cell=(0, 0), pixel=(math.nan, math.nan), stop='absent',
+                           belief=np.zeros(grid.n_cells), decision='absent',
+                           absent_probability=math.nan, seconds=time.perf_counter() - t0,
+                           **common)
+    x, y, w, h = (float(v) for v in box)
+    centre = np.array([[x + w / 2.0, y + h / 2.0]])
+    cell = int(cells_of_points(centre, image.shape[:2], grid)[0])
+    belief = np.zeros(grid.n_cells)
+    belief[cell] = 1.0
+    return ImageSearch(cell=tuple(int(v) for v in grid.cell(cell)),
+                       pixel=(float(centre[0, 0]), float(centre[0, 1])), stop='found',
+                       belief=belief, decision='found', detections=((x + w / 2, y + h / 2),),
+                       faces=(Face(box=(x, y, w, h), cell=tuple(int(v) for v in grid.cell(cell)),
+                                   probability=math.nan),),
+                       seconds=time.perf_counter() - t0, **common)

@@ -52,7 +52,7 @@ def annotate_image_search(image: np.ndarray, result, fovea) -> np.ndarray:
     detections = None
     if getattr(result, 'detections', ()):
         detections = np.asarray(result.detections, dtype=np.float64) * factor
-    reason = 'full_frame' if result.method == 'full_frame' else result.stop
+    reason = 'full_frame' if result.method in ('full_frame', 'scales') else result.stop
     label = ''
     faces = getattr(result, 'faces', ())
     if result.decision == 'absent':

@@ -1,0 +1,119 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""``find`` without ``--all``: the coarse full-frame calls first (``--scan``), the fovea kept."""
+import json
+from types import SimpleNamespace
+
+import cv2
+from ipomdp_gaze.commands.find import _Tasks, ladder_start, scale_table, SCAN_DEFAULT, search_one
+from ipomdp_gaze.vision.photos import load_photo
+from ipomdp_gaze.vision.scenes import SceneSet
+from ipomdp_gaze.vision.search import FIND_SETTINGS, search_image, search_scales
+import numpy as np
+import pytest
+
+
+def tasks(detector):
+    return _Tasks(SimpleNamespace(observation=None, detector=detector, policy=None,
+                                  policy_file=None))
+
+
+@pytest.fixture(scope='module')
+def scene():
+    return SceneSet('test', size_px=420, face_px=(60, 140), grid=(21, 21), seed=0)[0]
+
+
+def near(cell, truth):
+    return max(abs(cell[0] - truth[0]), abs(cell[1] - truth[1])) <= 1
+
+
+@pytest.mark.parametrize('detector', ['haar', 'yunet'])
+def test_the_coarse_call_finds_the_face_with_no_fovea_window(scene, detector):
+    task = tasks(detector).task((420, 420))
+    [result] = search_one(scene.image, task, FIND_SETTINGS, np.random.default_rng(0), False)
+    assert SCAN_DEFAULT == 'coarse'
+    assert result.decision == 'found' and near(result.cell, scene.cell)
+    assert result.fixations == 0 and result.path == () and result.method == 'scales'
+    # fewer detector pixels than one full-resolution call: a coarser call saw the face
+    assert result.detector_pixels < 420 * 420
+    x, y = result.pixel
+    assert (int(y * 21 / 420), int(x * 21 / 420)) == result.cell
+
+
+@pytest.mark.parametrize('detector', ['haar', 'yunet'])
+def test_a_face_free_photo_is_absent_after_every_rung(detector):
+    image = load_photo('brick')
+    task = tasks(detector).task((image.shape[1], image.shape[0]))
+    [result] = search_one(image, task, FIND_SETTINGS, np.random.default_rng(0), False)
+    assert result.decision == 'absent' and result.stop == 'absent'
+    table = scale_table(task.model)
+    start = ladder_start(task.model, table)
+    rungs = [r.scale for r in table.rows if r.scale >= start * (1 - 1e-3)]
+    assert rungs[-1] == 1.0
+    width, height = image.shape[1], image.shape[0]
+    expected = sum(int(np.floor(width * s + 0.5)) * int(np.floor(height * s + 0.5))
+                   for s in rungs)
+    assert result.detector_pixels == expected
+
+
+def test_the_ladder_stops_at_the_first_strong_box(scene):
+    task = tasks('haar').task((420, 420))
+    table = scale_table(task.model)
+    full = search_scales(scene.image, task.fovea, task.model, table, start=1.0)
+    coarse = search_scales(scene.image, task.fovea, task.model, table, start=0.25)
+    assert full.detector_pixels == 420 * 420 and full.decision == 'found'
+    assert coarse.detector_pixels < full.detector_pixels and near(coarse.cell, full.cell)
+
+
+def test_scan_fovea_is_todays_find_bit_for_bit(scene):
+    task = tasks('haar').task((420, 420))
+    [old] = search_one(scene.image, task, FIND_SETTINGS, np.random.default_rng([0, 0]), False,
+                       scan='fovea')
+    today = search_image(scene.image, task.fovea, task.model, task.policy, FIND_SETTINGS,
+                         rng=np.random.default_rng([0, 0]), pixel_budget=420 * 420)
+    for name in ('cell', 'pixel', 'probability', 'fixations', 'path', 'stop', 'decision',
+                 'detector_pixels', 'absent_probability', 'method'):
+        assert getattr(old, name) == getattr(today, name), name
+    assert np.array_equal(old.belief, today.belief) and old.fixations > 0
+
+
+def test_scan_many_answers_the_most_probable_face(scene):
+    task = tasks('yunet').task((420, 420))
+    [result] = search_one(scene.image, task, FIND_SETTINGS, np.random.default_rng(0), False,
+                          scan='many')
+    assert result.decision == 'found' and near(result.cell, scene.cell)
+    assert result.cell == result.faces[0].cell
+    assert result.probability == result.faces[0].probability >= FIND_SETTINGS.confidence
+
+
+def test_the_cli_switches_back_to_the_fovea(scene, tmp_path, cli_here):
+    path = tmp_path / 'scene.png'
+    cv2.imwrite(str(path), scene.image)
+    out = {}
+    for scan in ('coarse', 'fovea'):
+        out[scan] = tmp_path / f'{scan}.json'
+        result = cli_here('find', path, '--detector', 'haar', '--scan', scan, '--json',
+                          out[scan])
+        assert result.returncode == 0, result.stderr
+    coarse, fovea = (json.loads(out[k].read_text())['images'][0] for k in ('coarse', 'fovea'))
+    assert coarse['method'] == 'scales' and coarse['fixations'] == 0
+    assert fovea['method'] == 'fovea' and fovea['fixations'] > 0
+    task = tasks('haar').task((420, 420))
+    today = search_image(scene.image, task.fovea, task.model, task.policy, FIND_SETTINGS,
+                         rng=np.random.default_rng([0, 0]), pixel_budget=420 * 420)
+    assert tuple(fovea['cell']) == today.cell and fovea['fixations'] == today.fixations
+    assert fovea['detector_pixels'] == today.detector_pixels
+    assert near(coarse['cell'], scene.cell) and coarse['decision'] == 'found'
+
+
+def test_the_default_line_says_it_ended_on_a_scan_without_a_probability(tmp_path, cli_here):
+    path = tmp_path / 'astronaut.png'
+    cv2.imwrite(str(path), cv2.cvtColor(load_photo('astronaut'), cv2.COLOR_RGB2BGR))
+    plot = tmp_path / 'plot.png'
+    result = cli_here('find', path, '--json', tmp_path / 'out.json', '--plot', plot)
+    assert result.returncode == 0, result.stderr
+    line = result.stdout.strip()
+    assert 'decision=found ended=scan' in line and 'p=n/a fixations=0' in line
+    assert 'method=scales' in line and plot.exists()
+    entry = json.loads((tmp_path / 'out.json').read_text())['images'][0]
+    assert entry['probability'] is None and entry['note'].startswith('full frame at')
