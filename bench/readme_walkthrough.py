@@ -13,11 +13,13 @@ is an error (make it a transcript). ``python`` and ``yaml`` blocks are not shell
 Every command runs with ``bash`` in one scratch folder, in README order (a command finds the
 files an earlier one wrote), ``.venv/bin/python`` and ``.venv/bin/ipomdp-gaze`` (or a bare
 ``ipomdp-gaze``) standing for this interpreter and this checkout's CLI. What varies between runs
-is masked on both sides (``MASKS``: wall times, a bag's size). Commands that cannot run here are
-listed as skipped with the reason (``SKIPS``: ROS 2's own CLI and colcon, your own files, a Dask
-scheduler, make targets that rewrite the repository's docs), never silently; a command that runs
-longer than ``--max-seconds`` is stopped and listed as too long. It prints a per-command diff for
-each difference and a summary, and exits 1 when a command failed or printed something else.
+is masked on both sides (``MASKS``: wall times, a bag's size, a demo's ROS domain). Commands that
+cannot run here are listed as skipped with the reason (``SKIPS``: ROS 2's own CLI and colcon, your
+own files, a Dask scheduler, commands and make targets that rewrite the repository's docs), never
+silently, and so is a command that needs a file only a command not run writes; a command that
+runs longer than ``--max-seconds`` is stopped and listed as too long. It prints a per-command
+diff for each difference and a summary, and exits 1 when a command failed or printed something
+else.
 
     python bench/readme_walkthrough.py [--readme README.md] [--max-seconds 600] [--only TEXT]
 """
@@ -76,6 +78,9 @@ SKIPS = [
     (re.compile(r'^make (?:reproduce|faces|faces-groups|models|bench|pan-tilt|walks|soak)\b'),
      "rewrites the repository's docs (minutes to an hour); the walkthrough runs in a scratch "
      'folder'),
+    (re.compile(r'ipomdp-gaze reproduce\b(?!.*--out\b)'),
+     "writes the checkout's docs/reproduction.md and docs/figures/ (as make reproduce does: "
+     'about 4-7 minutes on 2 cores); the walkthrough changes nothing in the repository'),
     (re.compile(r'^make demo\b'),
      'sets up .venv/, then runs .venv/bin/ipomdp-gaze demo: that command is run at its '
      'transcript'),

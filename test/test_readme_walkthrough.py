@@ -95,6 +95,7 @@ def test_a_command_without_ros_or_your_files_is_run_with_this_checkout():
     assert 'ROS 2 install' in walkthrough.skip_reason('ros2 topic echo /found')
     assert 'ROS 2 install' in walkthrough.skip_reason('CFG=$(ros2 pkg prefix ipomdp_gaze)/x')
     assert 'your own' in walkthrough.skip_reason("K=$(python3 -c \"open('my-policy.yaml')\")")
+    assert 'docs/reproduction.md' in walkthrough.skip_reason('ipomdp-gaze reproduce --jobs 2')
     assert walkthrough.skip_reason('.venv/bin/ipomdp-gaze find astronaut.png') == ''
     command = walkthrough.shell('.venv/bin/ipomdp-gaze search && ipomdp-gaze demo', 'py')
     assert command == 'py -m ipomdp_gaze.cli search && py -m ipomdp_gaze.cli demo'
