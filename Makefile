@@ -4,7 +4,7 @@ VENV := .venv
 VPY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: venv demo test bench reproduce faces faces-groups pan-tilt walks figures models soak clean
+.PHONY: venv demo test readme bench reproduce faces faces-groups pan-tilt walks figures models soak clean
 
 venv: $(STAMP)
 
@@ -33,6 +33,15 @@ test: $(STAMP)
 	$(VPY) -m compileall -q ipomdp_gaze
 	IPOMDP_GAZE_REQUIRE_ROS=$(REQUIRED_ROS_TESTS) $(VPY) -m pytest -q \
 		-n $(TEST_WORKERS) --dist loadfile test
+
+# README.md's walkthrough: every shell command of its fenced blocks, in order, in one scratch
+# folder; each transcript's shown lines compared with what its command prints (times and other
+# values that vary masked); commands that cannot run here listed as skipped with the reason
+# (bench/readme_walkthrough.py; README_MAX_SECONDS stops a command that runs longer).
+README_MAX_SECONDS ?= 600
+
+readme: $(STAMP)
+	$(VPY) bench/readme_walkthrough.py --max-seconds $(README_MAX_SECONDS)
 
 # The long robustness runs (minutes): 100,000 fuzzed frames, 10,080 hostile messages to the
 # detector per mode, a minute of load at 1 kHz (11x11) and 60 Hz (256x256), 50 start/SIGTERM
