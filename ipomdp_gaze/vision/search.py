@@ -56,6 +56,7 @@ from ipomdp_gaze.vision.detector import box_centres_px, detector_window_px, grou
 from ipomdp_gaze.vision.detectors import detector_from_settings  # noqa: F401 (its old home)
 from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea
 from ipomdp_gaze.vision.fovea_model import check_model, fovea_for_model  # noqa: F401
+from ipomdp_gaze.vision.fullframe import cells_of_points, scan
 from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evidence,
                                        ScaleTable)
 from ipomdp_gaze.vision.sensors import FoveaSensor
@@ -460,7 +461,6 @@ def full_frame_search(image: np.ndarray, fovea: Fovea, note: str = '',
     Returns one ``found`` result per grouped box (largest first), then one ``absent``; the
     probability is NaN (no belief is computed). Each result's ``faces`` holds every box.
     """
-    from ipomdp_gaze.vision.fullframe import cells_of_points, scan
     t0 = time.perf_counter()
     image_px = check_image(image, fovea)
     grid = fovea.grid
@@ -571,7 +571,6 @@ class _Coarse(_Recorder):
 
     def _look(self, rect, scale):
         """Detect in ``rect`` (x0, y0, x1, y1) at ``scale``: strong, weak boxes, pixels."""
-        from ipomdp_gaze.vision.fullframe import scan
         x0, y0, x1, y1 = rect
         found = scan(self.image[y0:y1, x0:x1], self.detector, (1, 1), scale)
         raw = found.boxes_px + (x0, y0, 0, 0)
@@ -804,7 +803,6 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
     ``scales``); ``detector_pixels`` counts every call and crop (a face-free image pays every
     scale: 1/16 + 1/9 + 1/4 + 1 of a full scan from 1/4).
     """
-    from ipomdp_gaze.vision.fullframe import cells_of_points, scan
     t0 = time.perf_counter()
     image_px = check_image(image, fovea)
     grid = fovea.grid
