@@ -5,7 +5,7 @@ import math
 
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.motion import (axis_drift, axis_transition, check_probability,
-                                      check_sigma_cells, Motion, VelocityMotion)
+                                      check_sigma_cells, LOG_UNDERFLOW, Motion, VelocityMotion)
 import numpy as np
 import pytest
 
@@ -154,6 +154,31 @@ def test_per_second_motion_scales_with_elapsed_time():
 def test_axis_matrix_rows_sum_to_one_and_zero_sigma_is_identity():
     np.testing.assert_allclose(axis_transition(8, 1.3).sum(axis=1), 1.0)
     np.testing.assert_array_equal(axis_transition(4, 0.0), np.eye(4))
+
+
+@pytest.mark.parametrize('sigma', [0.022, 0.025, 0.5 * (1 / 500) ** 0.5])
+def test_a_step_below_resolution_is_exactly_the_identity_and_predicts_nothing(sigma):
+    """``g(1)`` underflows: the general formula gives the identity, and so does the shortcut."""
+    np.testing.assert_array_equal(axis_transition(9, sigma), np.eye(9))
+    np.testing.assert_array_equal(axis_transition(9, sigma), _dense_axis(9, sigma))
+    grid = Grid(9, 9, 1.0)
+    log_b = np.log(np.random.default_rng(5).dirichlet(np.ones(82)))
+    still = Motion(grid, sigma, 0.0, 0.2)
+    assert still.is_identity() and not still.is_identity(with_absent=True)
+    before = log_b[:81].copy()
+    assert still.predict_log(log_b[:81]) is not None
+    np.testing.assert_array_equal(log_b[:81], before)         # bit for bit, no round trip
+    tiny = before.copy()
+    tiny[[3, 4, 5]] = tiny.max() + np.array([-745.0, LOG_UNDERFLOW, -2000.0])
+    round_trip = np.log(np.exp(tiny - tiny.max()))         # what a step of probabilities keeps
+    still.predict_log(tiny)
+    np.testing.assert_array_equal(np.isinf(tiny), np.isinf(round_trip))
+    assert np.isinf(tiny).sum() == 2 and np.isfinite(tiny[3])
+    moved = log_b.copy()
+    still.predict_log(moved)                                 # the absent column still leaves
+    assert not np.array_equal(moved, log_b)
+    assert not Motion(grid, sigma, 0.01).is_identity()
+    assert not Motion(grid, 0.05).is_identity()
 
 
 def _dense_axis(size, sigma):

@@ -48,6 +48,8 @@ TRUNCATE_SIGMAS = 3.0
 # short step (sigma_cells per second over a millisecond loop) on a long axis.
 BAND_RATIO = 32
 ALMOST_ONE = math.nextafter(1.0, 0.0)
+# exp(x) rounds to exactly 0 from this down (log of half the smallest subnormal, 2**-1075).
+LOG_UNDERFLOW = -1075 * math.log(2.0)
 
 
 def axis_transition(size: int, sigma_cells: float) -> np.ndarray:
@@ -61,8 +63,8 @@ def axis_transition(size: int, sigma_cells: float) -> np.ndarray:
     the same entries, row sums and quotients as evaluating it for every pair of positions.
     """
     sigma = check_sigma_cells(sigma_cells)
-    if sigma == 0:
-        return np.eye(size)
+    if sigma == 0 or math.exp(-0.5 / sigma ** 2) == 0.0:
+        return np.eye(size)                     # g(1) underflows: exactly the identity
     reach = min(math.ceil(TRUNCATE_SIGMAS * sigma), size - 1)
     offset = np.arange(-reach, reach + 1)
     table = np.zeros(2 * size - 1)              # entry size - 1 + k: g(k)
@@ -165,6 +167,17 @@ class Motion:
         """Whether the target moves at all (otherwise prediction is the identity)."""
         return self.sigma_cells > 0 or self.jump_prob > 0 or self.leave_prob > 0
 
+    def is_identity(self, with_absent: bool = False) -> bool:
+        """
+        Whether a step leaves every belief exactly as it is.
+
+        True when the Gaussian step is the identity (``g(1)`` underflows: a step of a hundredth of
+        a cell, a fast loop with slow motion) and nothing jumps, nor leaves (``with_absent``).
+        The prediction then skips its round trip through probabilities, which could only add
+        round-off.
+        """
+        return self._bands == () and not self.jump_prob and not (with_absent and self.leave_prob)
+
     def to_dict(self) -> dict:
         """``{'sigma_cells': ..., 'jump_prob': ..., 'leave_prob': ...}``."""
         return {'sigma_cells': self.sigma_cells, 'jump_prob': self.jump_prob,
@@ -231,10 +244,16 @@ class Motion:
         ``exp(-745)`` of it; cells that the step leaves at exactly 0 get ``-inf``. The result is
         renormalised (the step keeps the mass; this removes round-off). Returns ``log_belief``.
         """
+        n = self.grid.n_cells
         if not self.active:
             return log_belief
-        n = self.grid.n_cells
         peak = np.max(log_belief, axis=-1, keepdims=True)
+        if self.is_identity(log_belief.shape[-1] > n):
+            # The step moves nothing: of the round trip through probabilities only its underflow
+            # is kept (a cell below exp's range relative to the peak becomes exactly 0).
+            cells = log_belief[..., :n]
+            cells[cells - peak <= LOG_UNDERFLOW] = -np.inf
+            return log_belief
         cells = np.subtract(log_belief[..., :n], peak)
         moved = self.predict(np.exp(cells, out=cells))
         if self.leave_prob and log_belief.shape[-1] > n:
@@ -357,6 +376,17 @@ class VelocityMotion(Motion):
     def active(self) -> bool:
         """Return True: a target with a velocity moves."""
         return True
+
+    def is_identity(self, with_absent: bool = False) -> bool:
+        """
+        Whether a step leaves every belief exactly as it is.
+
+        True when the Gaussian step is the identity (``g(1)`` underflows: a step of a hundredth of
+        a cell, a fast loop with slow motion) and nothing jumps, nor leaves (``with_absent``).
+        The prediction then skips its round trip through probabilities, which could only add
+        round-off.
+        """
+        return self._bands == () and not self.jump_prob and not (with_absent and self.leave_prob)
 
     def to_dict(self) -> dict:
         """Return the parameters (:meth:`Motion.to_dict` and the velocity's)."""
