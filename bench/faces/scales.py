@@ -16,7 +16,7 @@ detections (YuNet: score 0.7 or more; Haar: its grouped boxes) near no face per 
 detector pixels, counted one more than were seen (none in 60 Mpx is taken as 1 in 60).
 
 Usage: ``python bench/faces/scales.py [--detector yunet|haar] [--scenes 6] [--recall 0.95]
-[--faces photos|lfw|both]``; prints the
+[--faces photos|lfw|both] [--weak]``; prints the
 table as the Python literal :data:`ipomdp_gaze.vision.scales.SCALE_TABLES` holds.
 """
 import argparse
@@ -26,6 +26,7 @@ import sys
 
 from ipomdp_gaze.vision.fullframe import scan
 from ipomdp_gaze.vision.photos import group_photo, TRAIN_GROUP_BACKGROUNDS
+from ipomdp_gaze.vision.scales import coarse_detector, SCALE_TABLES
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -53,14 +54,23 @@ def pictures(scenes: int, count: int, faces: str = 'photos'):
                                             copies=count))
 
 
-def measure(detector: str, scenes: int, count: int = 6, faces: str = 'photos') -> dict:
-    """Return per scale the faces' detector-input sides, hits and the false detections."""
+def measure(detector: str, scenes: int, count: int = 6, faces: str = 'photos',
+            weak: bool = False) -> dict:
+    """
+    Return per scale the faces' detector-input sides, hits and the false detections.
+
+    ``weak``: a hit is any box of the coarse pass's detector (YuNet keeping boxes from
+    :data:`~ipomdp_gaze.vision.scales.WEAK_SCORE`), the boxes that draw finer windows.
+    """
     tasks = find_tasks(detector=detector)
     out = {s: {'sides': [], 'hits': [], 'false': 0, 'pixels': 0} for s in SCALES}
     for size, seed, image, truth in pictures(scenes, count, faces):
         task = tasks.task(size)
+        fovea_detector = task.fovea.detector
+        if weak:
+            fovea_detector = coarse_detector(fovea_detector, SCALE_TABLES[detector].weak_score)
         for s in SCALES:
-            found = scan(image, task.fovea.detector, task.fovea.grid, s)
+            found = scan(image, fovea_detector, task.fovea.grid, s)
             boxes = found.grouped_px
             centres = boxes[:, :2] + boxes[:, 2:] / 2
             inside = ((truth[None, :, 0] <= centres[:, None, 0])
@@ -106,8 +116,11 @@ def main(argv=None):
     p.add_argument('--faces', choices=('photos', 'lfw', 'both'), default='photos',
                    help="the training photo's face (sharp), the lfw thumbnails (upscaled, "
                         'blurred: found only larger), or both')
+    p.add_argument('--weak', action='store_true',
+                   help="count a face as seen when the coarse pass's detector leaves any box "
+                        '(YuNet from the weak score): the sides that draw finer windows')
     args = p.parse_args(argv)
-    measured = measure(args.detector, args.scenes, faces=args.faces)
+    measured = measure(args.detector, args.scenes, faces=args.faces, weak=args.weak)
     rows = table(measured, args.recall)
     print(f'# {args.detector}: scale: (min side px in the detector input, recall from it, '
           f'false detections per Mpx), {args.scenes} training scenes per size')
