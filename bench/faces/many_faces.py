@@ -205,7 +205,8 @@ def run(args) -> list[dict]:
                 small, (sx, sy) = shrink(image, max_side)
                 task = tasks.task((small.shape[1], small.shape[0]))
                 [result] = search_one(small, task, settings, np.random.default_rng(0), True,
-                                      None if min_face is None else min_face / max(sx, sy))
+                                      None if min_face is None else min_face / max(sx, sy),
+                                      empty_by_evidence=args.empty_by_evidence)
                 seconds = time.perf_counter() - t0
                 boxes = (np.array([f.box for f in result.faces]).reshape(-1, 4)
                          * (sx, sy, sx, sy))
@@ -292,10 +293,6 @@ def main(argv=None):
                         '<!-- /SECTION --> (appended when they are not there)')
     p.add_argument('--section', default='many-faces')
     args = p.parse_args(argv)
-    if args.empty_by_evidence:
-        import functools
-        from ipomdp_gaze.commands import find
-        find.search_many = functools.partial(find.search_many, empty_by_evidence=True)
     args.face_px = args.canvas
     rows = run(args)
     kind = (f'canvases with {args.faces} faces of {args.canvas[0]:g}-{args.canvas[1]:g} px'

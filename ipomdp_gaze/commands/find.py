@@ -89,10 +89,11 @@ from ipomdp_gaze.search import answer
 from ipomdp_gaze.vision.detectors import load_factory
 from ipomdp_gaze.vision.image_files import decode_quietly
 from ipomdp_gaze.vision.scales import SCALE_TABLES
-from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, FIND_SETTINGS,
-                                       fovea_for_model, full_frame_reason, full_frame_search,
-                                       prepare_many, search_all, search_first, search_image,
-                                       search_many, search_scales, size_distance)
+from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, EMPTY_BY_EVIDENCE,
+                                       FIND_SETTINGS, fovea_for_model, full_frame_reason,
+                                       full_frame_search, prepare_many, search_all,
+                                       search_first, search_image, search_many, search_scales,
+                                       size_distance)
 import numpy as np
 
 from .common import nonneg_int, positive_float
@@ -577,12 +578,14 @@ def ladder_start(model, scales) -> float:
 
 
 def search_one(image, task, settings, rng, find_all: bool,
-               min_face: float | None = None, scan: str = SCAN_DEFAULT) -> list:
+               min_face: float | None = None, scan: str = SCAN_DEFAULT,
+               empty_by_evidence: bool = EMPTY_BY_EVIDENCE) -> list:
     """
     Search one image: the fovea within one full scan's pixels, or the full frame (say why).
 
     ``min_face`` (``--min-face``, in this image's pixels): the smallest face that matters to
-    the many-target search's coarse pass (default 1/10 of the shorter side).
+    the many-target search's coarse pass (default 1/10 of the shorter side);
+    ``empty_by_evidence``: its rule for cells nobody occupies (:func:`search_many`).
     """
     width, height = image.shape[1], image.shape[0]
     reason = full_frame_reason(task.fovea, (width, height), calibrated_size(task.model))
@@ -596,7 +599,8 @@ def search_one(image, task, settings, rng, find_all: bool,
         scales = scale_table(task.model)
         prepare_many(task.fovea, task.model, (width, height), scales)      # one-time set-up
         return [search_many(image, task.fovea, task.model, settings, pixel_budget=budget,
-                            scales=scales, min_face=min_face)]
+                            scales=scales, min_face=min_face,
+                            empty_by_evidence=empty_by_evidence)]
     if find_all:
         return search_all(image, task.fovea, task.model, task.policy, settings, rng=rng,
                           pixel_budget=budget)
@@ -654,7 +658,7 @@ def run(args) -> int:
                   f'image, below the {table.rows[-1].min_side_px:.0f} px from which the '
                   f'{table.detector} table sees faces at full resolution: they may be missed')
         results = search_one(image, task, settings, np.random.default_rng([args.seed, i]),
-                             args.all, min_face, getattr(args, 'scan_mode', SCAN_DEFAULT))
+                             args.all, min_face, args.scan_mode)
         searched = results                      # in the searched image's pixels (the plot)
         if scale != (1.0, 1.0):
             results = [_in_given_pixels(r, scale, given) for r in results]
