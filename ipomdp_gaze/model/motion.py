@@ -377,17 +377,6 @@ class VelocityMotion(Motion):
         """Return True: a target with a velocity moves."""
         return True
 
-    def is_identity(self, with_absent: bool = False) -> bool:
-        """
-        Whether a step leaves every belief exactly as it is.
-
-        True when the Gaussian step is the identity (``g(1)`` underflows: a step of a hundredth of
-        a cell, a fast loop with slow motion) and nothing jumps, nor leaves (``with_absent``).
-        The prediction then skips its round trip through probabilities, which could only add
-        round-off.
-        """
-        return self._bands == () and not self.jump_prob and not (with_absent and self.leave_prob)
-
     def to_dict(self) -> dict:
         """Return the parameters (:meth:`Motion.to_dict` and the velocity's)."""
         return {**super().to_dict(), 'max_speed_cells': self.max_speed_cells,
