@@ -517,12 +517,13 @@ def group_summary(rows: list[dict]) -> dict:
 def photo_tables(photos: dict) -> list[str]:
     """Per detector, method and split: faces found, wrong found, pixels, time; then groups."""
     lines = ['| split | detector | method | faces found (within one cell) | face-free photos: '
-             '`absent` / wrong `found` | fovea / full frame used | detector px / one full '
-             'scan (mean) | median ms |', '|---|---|---|---|---|---|---|---|']
+             '`absent` / wrong `found` | scales or fovea / full frame used | detector px / one '
+             'full scan (mean) | median ms |', '|---|---|---|---|---|---|---|---|']
     for split in ('train', 'test'):
         for kind, data in photos.items():
             for method, key, text in (
-                    ('find', 'find', f'`find --detector {kind}` (fovea, shipped models)'),
+                    ('find', 'find',
+                     f'`find --detector {kind}` (`--scan coarse`, shipped models)'),
                     ('full', 'full', 'full frame, full resolution (' + (
                         'grouped detections' if kind == 'haar' else "YuNet's boxes") + ')')):
                 s = photo_summary(data[key], split, method)
@@ -769,9 +770,14 @@ FIND_TEXT = [
     '`find` decides per image: `found` (cell and pixel), `absent` (no face: the absent '
     'hypothesis is on, prior 0.5) or `gave_up`; `cell`/`pixel` are null unless found, and the '
     'exit status is 0 whenever every image got a decision (2 only for inputs that could not be '
-    'read, after the others were searched). It never spends more detector pixels than one '
-    'full-resolution scan of the image (W x H): the fovea stops before a fixation that would '
-    'pass that, and the budget is a deadline (`decide_at_budget`: `absent` if P(absent) is at '
+    'read, after the others were searched). By default (`--scan coarse`, "`find` without '
+    '`--all`: scale first" below) it runs the detector on the whole image from a coarse scale '
+    'to finer ones until a strong box is confirmed, so a face-free image pays every scale '
+    '(1.25-1.42 full-resolution scans of detector pixels in the rows below). With `--scan '
+    "fovea` (the paper's search, the default until issue 36) it never spends more detector "
+    'pixels than one full-resolution scan of the image (W x H): the fovea stops before a '
+    'fixation that would pass that, and the budget is a deadline (`decide_at_budget`: '
+    '`absent` if P(absent) is at '
     "least the best cell's probability, else `found`; stop `pixels`). It scans the whole frame "
     "once instead, and says so, when the fovea's scan and first fixation would cost more than "
     "W x H, when its smallest window is resized below the detector's window, or when the image "
