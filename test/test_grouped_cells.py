@@ -132,7 +132,7 @@ def test_calibrate_refuses_grouped_settings_that_cannot_work(tmp_path, cli_here,
 
 @pytest.mark.parametrize('extra, kind_k', [
     ([], None),
-    (['--group-edges', '3,6,10', '--min-neighbors', '2'], 5),
+    (['--group-edges', '3,6,10', '--min-neighbors', '2'], 6),
 ])
 def test_calibrate_grouped_on_two_tiny_training_scenes_writes_a_valid_model(
         tmp_path, cli_here, extra, kind_k):
@@ -158,3 +158,21 @@ def test_calibrate_grouped_on_two_tiny_training_scenes_writes_a_valid_model(
     np.testing.assert_allclose(model.p_null.sum(axis=-1), 1.0)
     grouped = slice(rule.raw_levels + 1, None)
     assert model.p_target[0, 0, grouped].sum() > model.p_null[0, 0, grouped].sum()
+
+
+def test_the_detector_nodes_setup_observes_grouped_cells_from_the_file(tmp_path):
+    """``build_setup`` (the ROS detector node's) gives the view observer the file's rule."""
+    from ipomdp_gaze.vision.detection import build_setup
+    rule = CellObservation('grouped', 5, edges=(4.0, 9.0), min_neighbors=1, raw_levels=1)
+    model = load_observation('faces-pan-tilt')
+    doc = model_to_dict(model)
+    doc['target'] = np.full(model.grid.shape + (5,), 0.2).tolist()
+    doc['null'] = doc['target']
+    doc['cells'] = rule.to_dict()
+    save_observation(tmp_path / 'g.yaml', model_from_dict(doc))
+    setup = build_setup('camera', str(tmp_path / 'g.yaml'))
+    assert setup.observer.cells == rule
+    camera = setup.camera
+    image = np.zeros((camera.height, camera.width), dtype=np.uint8)
+    values = setup.observer.observe(image, camera, (5, 5)).counts
+    assert np.nanmax(values) == 0 and np.isnan(values).any()

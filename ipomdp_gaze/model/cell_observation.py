@@ -101,7 +101,7 @@ class CellObservation:
         object.__setattr__(self, 'threshold', threshold)
 
     def _check_grouping(self, k: int) -> None:
-        """Refuse grouping settings that do not fit the kind (``min_neighbors``, ``raw_levels``)."""
+        """Refuse grouping settings that do not fit the kind (min_neighbors, raw_levels)."""
         for name in ('min_neighbors', 'raw_levels'):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
