@@ -20,7 +20,10 @@ point or ``package.module:Factory``, whose code then runs) with ``--detector-opt
 for its own settings; the file records the detector's settings and fingerprint. ``--cells``
 says what a cell's observation is: ``counts`` (the default), ``score_bins`` (the cell's best
 score in K - 1 bins whose edges are chosen here, on the first ``--edge-images`` training images
-or scenes, and recorded) or ``threshold`` (detections scoring at least ``--threshold``).
+or scenes, and recorded), ``threshold`` (detections scoring at least ``--threshold``) or, with
+``--pan-tilt``, ``grouped`` (the support of the view's grouped boxes, ``--min-neighbors``, in
+bins of ``--group-edges`` or of quantiles chosen on the edge scenes; ``--raw-levels`` keeps the
+raw count of a cell without a group).
 """
 from __future__ import annotations
 
@@ -109,10 +112,21 @@ def add_parser(sub):
                         'or package.module:Factory (this imports and runs that module)')
     p.add_argument('--detector-option', action='append', default=[], metavar='NAME=VALUE',
                    help="one of the detector's own settings (repeat for more; YAML values)")
-    p.add_argument('--cells', choices=('counts', 'score_bins', 'threshold'), default='counts',
+    p.add_argument('--cells', choices=('counts', 'score_bins', 'threshold', 'grouped'),
+                   default='counts',
                    help="a cell's observation: the count of detections centred in it "
-                        '(default), its best score in K - 1 bins chosen on training data, or '
-                        'the count of detections scoring at least --threshold')
+                        '(default), its best score in K - 1 bins chosen on training data, '
+                        'the count of detections scoring at least --threshold, or (--pan-tilt) '
+                        'the support of its largest group of raw boxes grouped as OpenCV does')
+    p.add_argument('--min-neighbors', type=positive_int, default=None, metavar='N',
+                   help='--cells grouped: groups of at most N raw boxes are dropped (default 1)')
+    p.add_argument('--raw-levels', type=nonneg_int, default=None, metavar='R',
+                   help='--cells grouped: a cell without a group reads its raw count clipped '
+                        'to R (default 0: it reads 0)')
+    p.add_argument('--group-edges', type=_edges_arg, default=None, metavar='E1,E2,...',
+                   help='--cells grouped: fixed increasing edges on the support (K is then '
+                        'their number + R + 2); default: K - 1 - R bins at quantiles of the '
+                        'supports on the edge scenes')
     p.add_argument('--threshold', type=float, default=None,
                    help='--cells threshold: the lowest score counted')
     p.add_argument('--edge-images', type=positive_int, default=20, metavar='M',
@@ -223,8 +237,23 @@ IMAGE_DEFAULTS = {'windows': (21, 15, 9, 3), 'interpolation': 'area', 'absent_ra
                   'task': 'paper', 'scan_once': False, 'fixation_stride': 1}
 
 
+def _edges_arg(text: str) -> tuple:
+    """Parse ``E1,E2,...``: increasing numbers (checked by the cell observation rule)."""
+    try:
+        return tuple(float(v) for v in text.split(','))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'edges must be numbers separated by commas, got '
+                                         f'{text!r}') from None
+
+
 def _check_options(args) -> None:
     """Refuse options of the other task; fill in the defaults of this one."""
+    if args.cells == 'grouped' and not args.pan_tilt:
+        raise ValueError('--cells grouped needs --pan-tilt: the fovea sees a face at several '
+                         'scales and would group them apart')
+    for name in ('min_neighbors', 'raw_levels', 'group_edges'):
+        if args.cells != 'grouped' and getattr(args, name) is not None:
+            raise ValueError(f"--{name.replace('_', '-')} goes with --cells grouped")
     for name in PAN_TILT_ONLY if not args.pan_tilt else IMAGE_ONLY:
         value = getattr(args, name)
         if value is not None and value != IMAGE_DEFAULTS.get(name):
@@ -260,21 +289,34 @@ def _detector(args):
 def _cell_rule(args, pilot):
     """Return the cell observation rule of ``--cells``; ``pilot()`` tallies the edge images."""
     from ipomdp_gaze.model.cell_observation import CellObservation
-    from ipomdp_gaze.vision.calibrate import choose_edges
+    from ipomdp_gaze.vision.calibrate import choose_edges, choose_group_edges
     if args.cells == 'threshold':
         if args.threshold is None:
             raise ValueError('--cells threshold needs --threshold T')
         return CellObservation('threshold', args.max_count, threshold=args.threshold)
     if args.threshold is not None:
         raise ValueError('--threshold goes with --cells threshold')
-    return choose_edges(pilot(), args.max_count)
+    if args.cells == 'grouped':
+        neighbors = 1 if args.min_neighbors is None else args.min_neighbors
+        levels = args.raw_levels or 0
+        if args.group_edges is not None:
+            return CellObservation('grouped', len(args.group_edges) + levels + 2,
+                                   args.group_edges, min_neighbors=neighbors, raw_levels=levels)
+        if levels > args.max_count - 3:
+            raise ValueError(f'--raw-levels {levels} leaves no group bin below --max-count '
+                             f'{args.max_count} (at most {args.max_count - 3})')
+        provisional = CellObservation('grouped', levels + 2, min_neighbors=neighbors,
+                                      raw_levels=levels)
+        return choose_group_edges(pilot(provisional), args.max_count, neighbors, levels)
+    return choose_edges(pilot(None), args.max_count)
 
 
 def _record_cells(meta: dict, cells, args) -> None:
     """Record the cell observation rule (none for plain counts: older files stay the same)."""
     if cells is not None:
         meta['cells'] = cells.to_dict()
-        if cells.kind == 'score_bins':
+        if cells.kind == 'score_bins' or (cells.kind == 'grouped' and
+                                          args.group_edges is None):
             meta['calibration']['edges_from'] = args.edge_images
 
 
@@ -302,9 +344,10 @@ def run_pan_tilt(args) -> int:
     start = time.perf_counter()
     with executor_from_args(args) as executor:
         if args.cells != 'counts':
-            cells = _cell_rule(args, lambda: tally_pan_tilt_scenes(
+            cells = _cell_rule(args, lambda rule: tally_pan_tilt_scenes(
                 scenes, range(min(args.edge_images, args.scenes)), detector_kwargs,
-                args.max_count, None, executor=executor))
+                args.max_count if rule is None else rule.max_count, None, executor=executor,
+                cells=rule))
             max_count = cells.max_count
         with progress_from_args(args, args.scenes, 'calibrate', 'scene') as bar:
             tallies = tally_pan_tilt_scenes(scenes, range(args.scenes), detector_kwargs,
@@ -360,7 +403,7 @@ def run(args) -> int:
     cells = None
     with executor_from_args(args) as executor:
         if args.cells != 'counts':
-            cells = _cell_rule(args, lambda: tally_images(
+            cells = _cell_rule(args, lambda rule: tally_images(
                 items[:args.edge_images], detector_kwargs, grid, config, fixations=fixations,
                 executor=executor))
             config = dataclasses.replace(config, max_count=cells.max_count)

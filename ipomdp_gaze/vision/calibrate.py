@@ -209,6 +209,20 @@ def choose_edges(tallies: Tallies, max_count: int) -> CellObservation:
     return CellObservation('score_bins', len(edges) + 2, edges)
 
 
+def choose_group_edges(tallies: Tallies, max_count: int, min_neighbors: int,
+                       raw_levels: int = 0) -> CellObservation:
+    """
+    Return the ``grouped`` rule of K = ``max_count`` whose group bins share out training supports.
+
+    ``tallies.scores`` holds the largest group support of every observed cell holding a group
+    (tallied with a ``grouped`` rule); :func:`quantile_edges` cuts them into
+    ``K - 1 - raw_levels`` bins, fewer when supports repeat (a smaller K).
+    """
+    edges = quantile_edges(tallies.scores, max_count - 1 - raw_levels)
+    return CellObservation('grouped', len(edges) + raw_levels + 2, edges,
+                           min_neighbors=min_neighbors, raw_levels=raw_levels)
+
+
 def _resolve(item):
     """Return ``(image, target_cell)`` of an item, regenerating ``('scene', kwargs, i)``."""
     if len(item) == 3 and isinstance(item[0], str) and item[0] == 'scene':
@@ -299,6 +313,8 @@ def tally_views(observer, geometry, scene_image: np.ndarray, target_cell: int | 
     Each view is rendered by ``geometry`` (:class:`ipomdp_gaze.vision.pan_tilt.SceneGeometry`)
     and observed by ``observer`` (:class:`ipomdp_gaze.vision.pan_tilt.ViewObserver`), exactly as
     the ``scene_camera`` and ``foveal_detector`` nodes do; cells outside a view are not tallied.
+    ``scores`` keeps each observed cell's best score, or with ``grouped`` cells its best group
+    support (what :func:`choose_group_edges` bins).
     """
     grid = observer.grid
     fixations = np.arange(grid.n_cells) if fixations is None else np.asarray(fixations)
@@ -310,8 +326,12 @@ def tally_views(observer, geometry, scene_image: np.ndarray, target_cell: int | 
         frames[i] = observation.counts
         pixels += observation.detector_pixels
         seconds += observation.seconds
-        scores.append(best_scores(observation.cells, observation.scores,
-                                  ~np.isnan(observation.counts)))
+        if observation.group_support is None:
+            scores.append(best_scores(observation.cells, observation.scores,
+                                      ~np.isnan(observation.counts)))
+        else:
+            scores.append(best_scores(observation.group_cells, observation.group_support,
+                                      ~np.isnan(observation.counts)))
     tallies = tally_frames(grid, observer.max_count, frames, fixations, target_cell)
     tallies.detector_pixels, tallies.seconds = pixels, seconds
     tallies.scores = np.concatenate(scores)

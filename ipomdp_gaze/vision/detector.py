@@ -153,13 +153,25 @@ def group_boxes(boxes, min_neighbors: int = DEFAULT_MIN_NEIGHBORS,
         ``int64`` of shape ``(G, 4)``, rows ``x, y, w, h``.
 
     """
+    return group_support(boxes, min_neighbors, eps)[0]
+
+
+def group_support(boxes, min_neighbors: int = DEFAULT_MIN_NEIGHBORS,
+                  eps: float = GROUP_EPS) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Return :func:`group_boxes`' grouped boxes and the support of each, ``(G, 4)`` and ``(G,)``.
+
+    The support is OpenCV's group weight: the number of raw boxes the group merged (1 for every
+    box when ``min_neighbors`` is 0, which does not group).
+    """
     boxes = as_boxes(boxes)
     if min_neighbors < 0:
         raise ValueError(f'min_neighbors must be >= 0, got {min_neighbors!r}')
     if len(boxes) == 0 or min_neighbors == 0:
-        return boxes
-    grouped, _ = cv2.groupRectangles(boxes.tolist(), int(min_neighbors), float(eps))
-    return as_boxes(grouped)
+        return boxes, np.ones(len(boxes), dtype=np.int64)
+    grouped, weights = cv2.groupRectangles(boxes.tolist(), int(min_neighbors), float(eps))
+    grouped = as_boxes(grouped)
+    return grouped, np.asarray(weights, dtype=np.int64).reshape(len(grouped))
 
 
 def find_cascade(name: str = REFERENCE_CASCADE, path=None) -> Path:

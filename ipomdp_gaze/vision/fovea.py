@@ -340,6 +340,10 @@ class Fovea:
                 self.cells.max_count != self.config.max_count:
             raise ValueError(f'cells must be a CellObservation with K = max_count '
                              f'({self.config.max_count}), got {self.cells!r}')
+        if self.cells.kind == 'grouped':
+            raise ValueError('grouped cells are for one whole view (the pan/tilt head): the '
+                             "fovea's windows see one face at several scales and would group "
+                             'them apart')
         self._color = detector_color(detector)
         self._scales = np.asarray(self.config.scales)
         self._gray = None

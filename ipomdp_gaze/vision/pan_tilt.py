@@ -35,7 +35,8 @@ from ipomdp_gaze.model.cell_observation import CellObservation
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head_camera import bin_points, PinholeCamera
 from ipomdp_gaze.vision.detector import (as_detections, box_centres_px, detector_color,
-                                         detector_window_px, to_detector_image)
+                                         detector_window_px, group_support,
+                                         to_detector_image)
 from ipomdp_gaze.vision.scenes import _paste, load_background, load_faces, Scene, SceneFace, SPLITS
 import numpy as np
 
@@ -88,6 +89,10 @@ class ViewObservation:
         Wall time: grey conversion, detector and binning.
     scores : numpy.ndarray
         ``(M,)`` score of each detection (1 for a detector without scores).
+    group_cells : numpy.ndarray
+        ``grouped`` cells only: ``(G,)`` cell of each grouped box's centre, -1 off the grid.
+    group_support : numpy.ndarray
+        ``grouped`` cells only: ``(G,)`` raw boxes each group merged.
 
     """
 
@@ -99,6 +104,24 @@ class ViewObservation:
     detector_pixels: int
     seconds: float
     scores: np.ndarray = None
+    group_cells: np.ndarray = None
+    group_support: np.ndarray = None
+
+
+def view_groups(boxes, min_neighbors: int, camera: PinholeCamera, grid: Grid, head,
+                max_count: int) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Group a view's raw boxes as ``detectMultiScale`` does; return each group's cell and support.
+
+    :func:`ipomdp_gaze.vision.detector.group_support` on the boxes rounded to whole pixels (at
+    least 1 px wide and high; a cascade's boxes are already whole), the group's centre binned
+    as a detection's (-1 off the grid).
+    """
+    boxes = np.round(np.asarray(boxes, dtype=np.float64).reshape(-1, 4))
+    boxes[:, 2:] = np.maximum(boxes[:, 2:], 1.0)
+    grouped, support = group_support(boxes, min_neighbors)
+    _, _, cells = bin_points(box_centres_uv(grouped), camera, grid, head, max_count)
+    return cells, support
 
 
 class ViewObserver:
@@ -154,13 +177,20 @@ class ViewObserver:
         centres = box_centres_uv(boxes)
         head = (float(head_rc[0]), float(head_rc[1]))
         counts, raw, cells = bin_points(centres, camera, self.grid, head, self.max_count)
+        group_cells = group_support = groups = None
+        if self.cells.kind == 'grouped':
+            group_cells, group_support = view_groups(boxes, self.cells.min_neighbors, camera,
+                                                     self.grid, head, self.max_count)
+            kept = group_cells >= 0
+            groups = (group_cells[kept], group_support[kept])
         if self.cells.kind != 'counts':
             inside = cells >= 0
-            values = self.cells.values(cells[inside], scores[inside], self.grid.n_cells)
+            values = self.cells.values(cells[inside], scores[inside], self.grid.n_cells,
+                                       groups)
             counts = np.where(np.isnan(counts), np.nan, values)
         return ViewObservation(counts, raw, head, centres, cells,
                                int(pixels.shape[0] * pixels.shape[1]),
-                               time.perf_counter() - t0, scores)
+                               time.perf_counter() - t0, scores, group_cells, group_support)
 
 
 @dataclass(frozen=True)
