@@ -62,8 +62,8 @@ def events(launch, probe):
         'no lost event\n' + output()
     rec['back_at'] = move({'empty_scene': False, 'target_row': SECOND[0],
                            'target_col': SECOND[1]})
-    assert wait_for(lambda: _after(rec['reacquired'], rec['back_at']), EVENT_TIMEOUT_S), \
-        'no reacquired event\n' + output()
+    assert wait_for(lambda: _at_second(rec['reacquired'], rec['back_at']), EVENT_TIMEOUT_S), \
+        'no reacquired event at the second place\n' + output()
     return rec
 
 
@@ -72,12 +72,24 @@ def _after(events, t0):
     return [(t, msg) for t, msg in events if t > t0]
 
 
+def _at_second(events, t0):
+    """
+    Return the reacquired events after ``t0`` at :data:`SECOND`.
+
+    A frame the camera rendered before its scene change took effect can still show the face at
+    :data:`FIRST` after ``t0`` (a race of the test's two parameter calls, not of the tracker).
+    """
+    from ipomdp_gaze.msg_adapters import diagnostics
+    return [(t, msg) for t, msg in _after(events, t0)
+            if (lambda e: (e['row'], e['col']))(diagnostics.parse_reacquired(msg)) == SECOND]
+
+
 def test_a_target_that_leaves_and_returns_is_lost_then_reacquired(events):
     from ipomdp_gaze.msg_adapters import diagnostics
     found = diagnostics.parse_found(_after(events['found'], events['reset_at'])[0][1])
     t_lost, msg = _after(events['lost'], events['left_at'])[0]
     lost = diagnostics.parse_lost(msg)
-    t_back, msg = _after(events['reacquired'], events['back_at'])[0]
+    t_back, msg = _at_second(events['reacquired'], events['back_at'])[0]
     again = diagnostics.parse_reacquired(msg)
     assert (found['row'], found['col']) == FIRST
     assert (lost['row'], lost['col']) == FIRST                   # where it was last found
