@@ -80,8 +80,8 @@ def _at_second(events, t0):
     :data:`FIRST` after ``t0`` (a race of the test's two parameter calls, not of the tracker).
     """
     from ipomdp_gaze.msg_adapters import diagnostics
-    return [(t, msg) for t, msg in _after(events, t0)
-            if (lambda e: (e['row'], e['col']))(diagnostics.parse_reacquired(msg)) == SECOND]
+    at = [(t, msg, diagnostics.parse_reacquired(msg)) for t, msg in _after(events, t0)]
+    return [(t, msg) for t, msg, event in at if (event['row'], event['col']) == SECOND]
 
 
 def test_a_target_that_leaves_and_returns_is_lost_then_reacquired(events):

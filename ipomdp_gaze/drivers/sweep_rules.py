@@ -9,8 +9,7 @@ One pass of the sweep's poses (the views the ``sweep`` policy takes), answered w
 from __future__ import annotations
 
 from ipomdp_gaze.drivers.scene_report import scene_result, SceneResult
-from ipomdp_gaze.model.head_camera import bin_points
-from ipomdp_gaze.vision.detector import box_centres_px, group_boxes
+from ipomdp_gaze.vision.pan_tilt import view_groups
 import numpy as np
 
 # The sweep's answer rules, computed from one pass of its poses (the views the sweep policy takes):
@@ -85,14 +84,8 @@ def group_cells(detector, raw, camera, grid, head_rc, max_count: int,
 
     Grouped by the detector's own rule (YuNet's boxes are already suppressed), else as
     ``detectMultiScale`` does with ``min_neighbors`` (as ``fullframe.scan``); boxes whose centre
-    is off the grid are dropped.
+    is off the grid are dropped (:func:`ipomdp_gaze.vision.pan_tilt.view_groups`).
     """
-    group = getattr(detector, 'group', None)
-    boxes = np.asarray(group(raw, min_neighbors) if callable(group)
-                       else group_boxes(np.round(raw), min_neighbors)).reshape(-1, 4)
-    if not len(boxes):
-        return np.zeros(0, dtype=np.int64)
-    order = np.argsort(-(boxes[:, 2] * boxes[:, 3]), kind='stable')
-    centres = box_centres_px(boxes[order]) - 0.5
-    _, _, cells = bin_points(centres, camera, grid, head_rc, max_count)
+    cells, _ = view_groups(raw, min_neighbors, camera, grid, head_rc, max_count,
+                           getattr(detector, 'group', None))
     return cells[cells >= 0]

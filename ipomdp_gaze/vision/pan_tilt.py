@@ -109,19 +109,27 @@ class ViewObservation:
 
 
 def view_groups(boxes, min_neighbors: int, camera: PinholeCamera, grid: Grid, head,
-                max_count: int) -> tuple[np.ndarray, np.ndarray]:
+                max_count: int, group=None) -> tuple[np.ndarray, np.ndarray]:
     """
-    Group a view's raw boxes as ``detectMultiScale`` does; return each group's cell and support.
+    Group a view's raw boxes; return each group's cell and support, the largest box first.
 
-    :func:`ipomdp_gaze.vision.detector.group_support` on the boxes rounded to whole pixels (at
-    least 1 px wide and high; a cascade's boxes are already whole), the group's centre binned
-    as a detection's (-1 off the grid).
+    ``group``: a detector's own rule (``detector.group``, boxes only: support 1 each), else
+    :func:`ipomdp_gaze.vision.detector.group_support` as ``detectMultiScale`` groups, on the
+    boxes rounded to whole pixels (at least 1 px wide and high; a cascade's boxes are already
+    whole). A group's centre is binned as a detection's (-1 off the grid).
     """
-    boxes = np.round(np.asarray(boxes, dtype=np.float64).reshape(-1, 4))
-    boxes[:, 2:] = np.maximum(boxes[:, 2:], 1.0)
-    grouped, support = group_support(boxes, min_neighbors)
-    _, _, cells = bin_points(box_centres_uv(grouped), camera, grid, head, max_count)
-    return cells, support
+    if callable(group):
+        grouped = np.asarray(group(boxes, min_neighbors), dtype=np.float64).reshape(-1, 4)
+        support = np.ones(len(grouped), dtype=np.int64)
+    else:
+        boxes = np.round(np.asarray(boxes, dtype=np.float64).reshape(-1, 4))
+        boxes[:, 2:] = np.maximum(boxes[:, 2:], 1.0)
+        grouped, support = group_support(boxes, min_neighbors)
+    if not len(grouped):
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    order = np.argsort(-(grouped[:, 2] * grouped[:, 3]), kind='stable')
+    _, _, cells = bin_points(box_centres_uv(grouped[order]), camera, grid, head, max_count)
+    return cells, support[order]
 
 
 class ViewObserver:
