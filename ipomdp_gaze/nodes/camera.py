@@ -47,6 +47,7 @@ from std_srvs.srv import Trigger
 
 from . import NODE_NAMES
 from .guard import CallbackGuard
+from .outputs import QuietPublishers
 from .params import (cell_params, fpoc_params, grid_params, INT_MAX, joint_params, Param,
                      ParameterTransaction, T)
 from .saccade import saccade_params, SaccadeMixin
@@ -91,7 +92,7 @@ class CameraConfig:
     motion: Motion
 
 
-class SimulatedCameraNode(SaccadeMixin, Node):
+class SimulatedCameraNode(SaccadeMixin, QuietPublishers, Node):
     """A simulated pan/tilt head with a detector (see the module docstring)."""
 
     def __init__(self, **kwargs):

@@ -70,6 +70,7 @@ from trajectory_msgs.msg import JointTrajectory
 
 from . import NODE_NAMES
 from .guard import CallbackGuard
+from .outputs import QuietPublishers
 from .params import (cell_params, current_values, fpoc_params, grid_params, INT_MAX, joint_params,
                      Param, ParameterTransaction, search_params, T)
 from .spin import run_node
@@ -146,7 +147,7 @@ def controller_params() -> list[Param]:
     ]
 
 
-class GazeControllerNode(Node):
+class GazeControllerNode(QuietPublishers, Node):
     """ROS 2 wrapper of :class:`ipomdp_gaze.search.gaze.GazeController`."""
 
     def __init__(self, **kwargs):

@@ -40,6 +40,7 @@ from std_msgs.msg import Float32MultiArray, Int32MultiArray
 import yaml
 
 from . import NODE_NAMES
+from .outputs import QuietPublishers
 from .params import Param, ParameterTransaction, T
 from .spin import run_node
 
@@ -112,7 +113,7 @@ def file_hashes(parameters: dict) -> dict:
     return out
 
 
-class RecorderNode(Node):
+class RecorderNode(QuietPublishers, Node):
     """Subscribe to the search's topics (serialized) and write them to a rosbag2 MCAP bag."""
 
     def __init__(self, **kwargs):

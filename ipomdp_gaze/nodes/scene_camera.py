@@ -49,6 +49,7 @@ from std_msgs.msg import Float64MultiArray, Int32MultiArray
 
 from . import NODE_NAMES
 from .guard import CallbackGuard
+from .outputs import QuietPublishers
 from .params import INT_MAX, joint_params, MAX_CELLS_PER_SIDE, Param, ParameterTransaction, T
 from .saccade import saccade_params, SaccadeMixin
 from .spin import run_node
@@ -199,7 +200,7 @@ def _check_walk(values: dict, faces: tuple) -> None:
         raise ValueError(f'scene.motion walk needs {why}')
 
 
-class SceneCameraNode(SaccadeMixin, Node):
+class SceneCameraNode(SaccadeMixin, QuietPublishers, Node):
     """A simulated camera over a real photograph (see the module docstring)."""
 
     def __init__(self, **kwargs):

@@ -1,0 +1,59 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The nodes' publishers carry no QoS event handlers; incompatible pairs are still reported.
+
+Each event handler is rebuilt into the executor's wait set on every wake (docs/design.md section
+5.1), so only the subscriptions keep rclpy's defaults: an incompatible publisher on an input is
+logged by our node, an incompatible subscriber on an output by the subscriber's own node.
+"""
+from __future__ import annotations
+
+import time
+
+import pytest
+
+pytestmark = pytest.mark.ros
+
+
+@pytest.fixture
+def context(ros_env):
+    import rclpy
+    ctx = rclpy.Context()
+    rclpy.init(context=ctx, domain_id=int(ros_env['ROS_DOMAIN_ID']), args=[])
+    yield ctx
+    rclpy.try_shutdown(context=ctx)
+
+
+@pytest.mark.parametrize('module, cls', [('controller', 'GazeControllerNode'),
+                                         ('camera', 'SimulatedCameraNode')])
+def test_only_subscriptions_keep_event_handlers(context, module, cls):
+    import importlib
+
+    from rclpy.event_handler import EventHandler, QoSSubscriptionEventType
+    node = getattr(importlib.import_module(f'ipomdp_gaze.nodes.{module}'), cls)(context=context)
+    try:
+        handlers = [w for w in node.waitables if isinstance(w, EventHandler)]
+        assert len(list(node.publishers)) >= 4
+        assert len(list(node.subscriptions)) >= 1
+        kinds = {type(h.event_type) for h in handlers}
+        assert kinds == {QoSSubscriptionEventType}, kinds
+        assert len(handlers) <= 2 * len(list(node.subscriptions))
+    finally:
+        node.destroy_node()
+
+
+def test_an_incompatible_publisher_on_an_input_is_still_reported(launch, probe):
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float32MultiArray
+    cam = launch('camera', ['-p', 'rate_hz:=0.0'])
+    best_effort = QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT)
+    reliable = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
+    probe.publisher(JointState, 'pan_tilt', best_effort)      # the camera asks for reliable
+    probe.node.create_subscription(Float32MultiArray, 'evidence', lambda msg: None, reliable)
+    said = "New publisher discovered on topic 'pan_tilt', offering incompatible QoS"
+    assert probe.wait_until(lambda: said in cam.output(), 30, 0.1), cam.output()[-3000:]
+    time.sleep(1.0)
+    # The camera's evidence is best effort: this reliable subscriber is told in its own log.
+    assert 'requesting incompatible QoS' not in cam.output()
