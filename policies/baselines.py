@@ -219,16 +219,29 @@ class SweepPolicy:
         return np.full(np.shape(belief)[0], self.poses[t % self.poses.size], dtype=np.int64)
 
 
-def elm_policy(grid: Grid, model) -> ConvPolicy:
+class ELMPolicy(ConvPolicy):
     """
     ELM (Najemnik & Geisler 2009): ``argmax_k sum_i B_i 2 KL_ik``, a conv policy.
 
     ``2 KL`` per offset is the observation model's :meth:`elm_kernel` (``d^2`` for the Gaussian
-    model, so ``argmax_k sum_i B_i d_ik^2``).
+    model, so ``argmax_k sum_i B_i d_ik^2``). Its scores are an expected information (>= 0), so
+    a score per second of head time means something (:meth:`scores_per_second`).
     """
-    policy = ConvPolicy(grid, as_observation(grid, model).elm_kernel(), action='argmax')
-    policy.name = 'elm'
-    return policy
+
+    name = 'elm'
+
+    def __init__(self, grid: Grid, model):
+        super().__init__(grid, as_observation(grid, model).elm_kernel(), action='argmax')
+
+    def scores_per_second(self, belief, seconds: np.ndarray, detour_s=None) -> np.ndarray:
+        """Return ELM's scores over each view's seconds (``search.head_speed_deg_s``; no tour)."""
+        belief = np.atleast_2d(np.asarray(belief, dtype=float))
+        return np.array(self.scores(belief), dtype=float).reshape(belief.shape) / seconds
+
+
+def elm_policy(grid: Grid, model) -> ELMPolicy:
+    """Build ELM for ``model`` (:class:`ELMPolicy`)."""
+    return ELMPolicy(grid, model)
 
 
 class CoveragePolicy:
@@ -253,15 +266,39 @@ class CoveragePolicy:
         self.tile[poses] = 1.0
         self.peak = float(peak)
 
-    def scores(self, belief) -> np.ndarray:
-        """Return ELM's scores, those of the tile poses raised above the rest while diffuse."""
+    def scores(self, belief, seconds: np.ndarray | None = None,
+               tile_seconds: np.ndarray | None = None) -> np.ndarray:
+        """
+        Return ELM's scores, those of the tile poses raised above the rest while diffuse.
+
+        With ``seconds`` (each view's head time) ELM's scores are divided by them first, and
+        while diffuse by ``tile_seconds`` when given (the tour a tile commits to): the tiles
+        still come first, the best informative one per second first.
+        """
         belief = np.atleast_2d(np.asarray(belief, dtype=float))
         # Given a target is present: with the absent hypothesis the cells sum to 1 - P(absent).
         belief = belief / np.maximum(belief.sum(axis=1, keepdims=True), 1e-300)
         scores = np.array(self.elm.scores(belief), dtype=float).reshape(belief.shape)
         diffuse = belief.max(axis=1, keepdims=True) < self.peak
+        if seconds is not None:
+            spent = seconds if tile_seconds is None else np.where(diffuse, tile_seconds, seconds)
+            scores = scores / spent
         bonus = np.abs(scores).max(axis=1, keepdims=True) + 1.0
         return scores + diffuse * bonus * self.tile
+
+    def scores_per_second(self, belief, seconds: np.ndarray, detour_s=None) -> np.ndarray:
+        """
+        Return :meth:`scores` per second of each view (``search.head_speed_deg_s``).
+
+        ``detour_s(cells)``: the seconds a tour of the tiles left grows by when it starts at
+        each of ``cells`` (``search.head_tour``), added to the tiles' seconds while diffuse.
+        """
+        tile_seconds = None
+        if detour_s is not None:
+            tiles = np.flatnonzero(self.tile)
+            tile_seconds = np.array(seconds, dtype=float)
+            tile_seconds[tiles] += detour_s(tiles)
+        return self.scores(belief, seconds, tile_seconds)
 
     def select(self, belief, t, rng):
         return argmax_ties_low(self.scores(belief))

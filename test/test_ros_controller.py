@@ -207,6 +207,7 @@ def test_bad_kernel_is_rejected_and_the_old_one_stays(probe, cam, bad, words):
     ({'fpoc.dprime': -2.0}, 'dprime must be finite and > 0'),
     ({'policy.action': 'softmax'}, 'policy.action must be one of'),
     ({'trajectory_topic': 'bad topic'}, 'trajectory_topic'),
+    ({'search.view_time_s': 0.0}, 'search.view_time_s must be finite and > 0'),
 ])
 def test_invalid_parameters_are_rejected_with_a_reason(probe, cam, values, words):
     before = probe.get_parameters(NODE, list(values))

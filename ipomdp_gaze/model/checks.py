@@ -161,3 +161,8 @@ def check_track_view(value, name: str = 'motion.track_view') -> str:
     if not (isinstance(value, str) and value in TRACK_VIEWS):
         raise ValueError(f"{name} must be one of {', '.join(TRACK_VIEWS)}, got {value!r}")
     return value
+
+
+def check_seconds(value, name: str) -> float:
+    """Return a duration in seconds: a finite number > 0."""
+    return finite(name, value, positive=True)

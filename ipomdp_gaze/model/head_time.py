@@ -42,3 +42,50 @@ def head_travel_deg(grid: Grid, path) -> float:
         return 0.0
     rows, cols = grid.cell(np.asarray(path))
     return float(grid.spacing_deg * np.hypot(np.diff(rows), np.diff(cols)).sum())
+
+
+def view_seconds(grid: Grid, from_cell: int, view_time_s: float,
+                 head_speed_deg_s: float) -> np.ndarray:
+    """
+    Return the seconds of the next view at each cell, from the head at ``from_cell``: (N,).
+
+    ``view_time_s`` (the view's detector and settling time and the saccade's start) plus the
+    largest joint angle over ``head_speed_deg_s``, as :func:`head_time_s` counts a saccade. The
+    view at ``from_cell`` itself costs ``view_time_s``.
+    """
+    return view_time_s + _step_deg(grid, from_cell) / head_speed_deg_s
+
+
+def _step_deg(grid: Grid, from_cell: int) -> np.ndarray:
+    """Return the largest joint angle from ``from_cell`` to each cell (degrees), (N,)."""
+    rows, cols = grid.rows_cols()
+    r, c = divmod(int(from_cell), grid.cols)
+    return np.maximum(np.abs(rows - r), np.abs(cols - c)) * grid.spacing_deg
+
+
+def tour_detour_deg(grid: Grid, from_cell: int, cells) -> np.ndarray:
+    """
+    Return, for each of ``cells``, how much longer a tour of them all is when it starts there.
+
+    The tour from ``from_cell`` first to cell ``k`` and then on through the others, each time to
+    the nearest one left (largest joint angle, as a saccade is timed), against the shortest such
+    tour over the first choices: 0 for the best first cell, more for a near cell that leaves the
+    others scattered. Vectorised over the first choices; ``cells`` are flat indices, (K,).
+    """
+    cells = np.asarray(cells, dtype=np.int64).reshape(-1)
+    k = cells.size
+    if k == 0:
+        return np.zeros(0)
+    rows, cols = grid.cell(cells)
+    step = np.maximum(np.abs(rows[:, None] - rows[None, :]),
+                      np.abs(cols[:, None] - cols[None, :])) * grid.spacing_deg
+    length = _step_deg(grid, from_cell)[cells]
+    left = ~np.eye(k, dtype=bool)               # tour t (first cell t): cells not yet visited
+    at = np.arange(k)
+    for _ in range(k - 1):
+        reach = np.where(left, step[at], np.inf)
+        nxt = np.argmin(reach, axis=1)
+        length = length + reach[np.arange(k), nxt]
+        left[np.arange(k), nxt] = False
+        at = nxt
+    return length - length.min()

@@ -37,10 +37,11 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass, field
 
-from ipomdp_gaze.model.belief import (bayes_update, entropy_of_log, EvidenceError, map_cell,
-                                      normalize_log)
+from ipomdp_gaze.model.belief import (argmax_ties_low, bayes_update, entropy_of_log,
+                                      EvidenceError, map_cell, normalize_log)
 from ipomdp_gaze.model.false_alarms import FalseAlarmMixture
 from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head_time import tour_detour_deg, view_seconds
 from ipomdp_gaze.model.inhibition import policy_choice, unvisited_choice
 from ipomdp_gaze.model.motion import Motion, VelocityMotion
 from ipomdp_gaze.model.observation import as_observation, check_evidence, CountObservation
@@ -739,18 +740,47 @@ class SearchSession:
                 and search.decision == 'found':
             return self._predicted_peak()
         belief = self._cells()[None, :]
+        per_second = settings.head_speed_deg_s > 0 and not self.motion.active \
+            and callable(getattr(self.policy, 'scores_per_second', None))
         if settings.inhibit_return and not self.motion.active:
             if search.visited.all():
                 if settings.stop_on_repeat:
                     return None
                 search.visited[:] = False
+            if per_second:
+                scores = self._scores_per_second(belief)
+                scores[search.visited] = -np.inf
+                return int(argmax_ties_low(scores))
             return unvisited_choice(self.policy, belief, search.visited, search.fixations,
                                     self.rng, self.grid)
-        choice = policy_choice(self.policy.select(belief, search.fixations, self.rng),
-                               self.grid.n_cells)
+        if per_second:
+            choice = int(argmax_ties_low(self._scores_per_second(belief)))
+        else:
+            choice = policy_choice(self.policy.select(belief, search.fixations, self.rng),
+                                   self.grid.n_cells)
         if settings.stop_on_repeat and search.visited[choice]:
             return None
         return choice
+
+    def _scores_per_second(self, belief: np.ndarray) -> np.ndarray:
+        """Return the policy's scores per second of head time from the current fixation, (N,)."""
+        settings = self.settings
+        seconds = view_seconds(self.grid, self._search.fixation, settings.view_time_s,
+                               settings.head_speed_deg_s)
+        detour_s = self._tour_detour_s if settings.head_tour else None
+        return np.array(self.policy.scores_per_second(belief, seconds, detour_s),
+                        dtype=float).reshape(-1)
+
+    def _tour_detour_s(self, cells) -> np.ndarray:
+        """Return the seconds the tour of the unvisited ``cells`` grows by starting at each."""
+        search, settings = self._search, self.settings
+        cells = np.asarray(cells, dtype=np.int64)
+        left = ~search.visited[cells] if settings.inhibit_return \
+            else np.ones(cells.size, dtype=bool)
+        out = np.zeros(cells.size)
+        out[left] = tour_detour_deg(self.grid, search.fixation, cells[left]) \
+            / settings.head_speed_deg_s
+        return out
 
     def _rc(self, cell: int) -> list:
         return [int(v) for v in self.grid.cell(int(cell))]

@@ -25,8 +25,9 @@ from dataclasses import dataclass, field, make_dataclass, replace
 from typing import Callable, Mapping
 
 from ipomdp_gaze.model.checks import (check_budget, check_confidence, check_flag,
-                                      check_probability, check_radius, check_sigma_cells,
-                                      check_start_cell, check_targets, check_track_view)
+                                      check_probability, check_radius, check_seconds,
+                                      check_sigma_cells, check_start_cell, check_targets,
+                                      check_track_view)
 from ipomdp_gaze.model.false_alarms import (check_false_alarm_scales, check_hotspot_prior,
                                             check_hotspot_scale, DEFAULT_HOTSPOT_SCALE)
 from ipomdp_gaze.model.still_evidence import check_repeat_weight
@@ -89,6 +90,18 @@ SCHEMA: tuple[Setting, ...] = (
             'saw it at its most informative offset (1: every frame counts fully, naive Bayes; 0: '
             'the evidence of each cell once, for overlapping views of a still scene and a '
             'deterministic detector)', bounds='in [0, 1]', metavar='W'),
+    Setting('head_speed_deg_s', 'search.head_speed_deg_s', 'float', 0.0, check_sigma_cells,
+            'still target, policy elm or coverage (others choose as before): the view with the '
+            'best score per second of head time, the move at this joint speed plus '
+            "search.view_time_s (0: every view costs alike, the paper's choice)", bounds='>= 0',
+            metavar='DEG_S'),
+    Setting('view_time_s', 'search.view_time_s', 'float', 0.4, check_seconds,
+            'with search.head_speed_deg_s: the seconds of a view besides the move (detector, '
+            'settling and the start of the saccade)', bounds='> 0', metavar='SECONDS'),
+    Setting('head_tour', 'search.head_tour', 'bool', False, check_flag,
+            'with search.head_speed_deg_s and policy coverage: while the belief is diffuse, a '
+            'tile view also costs the longer tour of the tiles left that starting there '
+            'commits to (nearest-neighbour tours)'),
     Setting('absent_prior', 'absent.prior', 'float', 0.0, check_probability,
             'prior that no target is in the grid (0: always there); a change starts a new '
             'search', bounds='in [0, 1)', metavar='P'),
