@@ -194,6 +194,16 @@ def ros_env(tmp_path_factory):
             os.environ[k] = v
 
 
+@pytest.fixture
+def context(ros_env):
+    """Provide an rclpy context of its own on this run's domain, for in-process nodes."""
+    import rclpy
+    ctx = rclpy.Context()
+    rclpy.init(context=ctx, domain_id=int(ros_env['ROS_DOMAIN_ID']), args=[])
+    yield ctx
+    rclpy.try_shutdown(context=ctx)
+
+
 @pytest.fixture(scope='module')
 def probe(ros_env):
     """Provide the test's own node (a ``Watch``) on this run's domain, shared by a module."""

@@ -16,15 +16,6 @@ import pytest
 pytestmark = pytest.mark.ros
 
 
-@pytest.fixture
-def context(ros_env):
-    import rclpy
-    ctx = rclpy.Context()
-    rclpy.init(context=ctx, domain_id=int(ros_env['ROS_DOMAIN_ID']), args=[])
-    yield ctx
-    rclpy.try_shutdown(context=ctx)
-
-
 @pytest.mark.parametrize('module, cls', [('controller', 'GazeControllerNode'),
                                          ('camera', 'SimulatedCameraNode')])
 def test_only_subscriptions_keep_event_handlers(context, module, cls):

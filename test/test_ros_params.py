@@ -15,15 +15,6 @@ import pytest
 pytestmark = pytest.mark.ros
 
 
-@pytest.fixture
-def context(ros_env):
-    import rclpy
-    ctx = rclpy.Context()
-    rclpy.init(context=ctx, domain_id=int(ros_env['ROS_DOMAIN_ID']), args=[])
-    yield ctx
-    rclpy.try_shutdown(context=ctx)
-
-
 def _params():
     from ipomdp_gaze.nodes.params import Param, T
     return [Param('gain', 1, T.INTEGER, 'a gain', int_range=(0, 10)),

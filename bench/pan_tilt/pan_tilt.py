@@ -257,7 +257,7 @@ def _against_grouped_sweeps(results: dict) -> list[str]:
              f"- head time with a face {ours['face']['head_time_s_mean']:.2f} s against "
              f"{theirs['face']['head_time_s_mean']:.2f} s: {seconds[0]:+.2f} s "
              f'[{seconds[1]:+.2f}, {seconds[2]:+.2f}] '
-             f"({_met(seconds[0] <= 0)}: at most its)"]
+             f'({_met(seconds[0] <= 0)}: at most its)']
     if empty[SHIPPED] and empty[best]:
         absent = (ours['empty']['absent'], theirs['empty']['absent'])
         empty_s = _paired(empty[SHIPPED], empty[best], 'head_time_s')
