@@ -30,7 +30,8 @@ import sys
 import time
 
 from ipomdp_gaze.drivers.scene_eval import evaluate_scenes
-from ipomdp_gaze.drivers.scene_report import paired_map_difference, SceneResult, summarise
+from ipomdp_gaze.drivers.scene_report import (paired_difference, paired_map_difference,
+                                              SceneResult, summarise)
 from ipomdp_gaze.drivers.scene_tasks import task_spec
 from ipomdp_gaze.drivers.sweep_rules import SWEEP_RULES
 from ipomdp_gaze.model.head_time import HEAD_SPEED_DEG_S, SACCADE_TIME_S, SETTLE_TIME_S
@@ -227,15 +228,9 @@ def _checks(results: dict, passes: int, sweep_name: str) -> list[str]:
     return ok
 
 
-def _paired(a: list, b: list, key, resamples: int = 2000) -> tuple:
-    """Return mean(a - b) of ``key`` over the scenes both hold, with a bootstrap 95% interval."""
-    import numpy as np
-    first = {r.index: float(getattr(r, key)) for r in a}
-    pairs = [(first[r.index], float(getattr(r, key))) for r in b if r.index in first]
-    diff = np.array([x - y for x, y in pairs])
-    means = diff[np.random.default_rng(0).integers(0, diff.size, (resamples, diff.size))]
-    low, high = np.percentile(means.mean(axis=1), [2.5, 97.5])
-    return float(diff.mean()), float(low), float(high)
+def _paired(a: list, b: list, key: str) -> tuple:
+    """Return mean(a - b) of ``key`` over the same scenes and its bootstrap 95% interval."""
+    return tuple(float(v) for v in paired_difference(a, b, key))
 
 
 def _against_grouped_sweeps(results: dict) -> list[str]:

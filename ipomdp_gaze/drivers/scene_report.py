@@ -123,27 +123,38 @@ def summarise(results: list) -> dict:
     return out
 
 
+def paired_difference(a: list, b: list, key: str, n_boot: int = 2000, seed: int = 0) -> tuple:
+    """
+    Mean of ``key`` in ``a`` minus ``b`` over the scenes both hold, paired bootstrap 95%.
+
+    Scenes are matched by their index; ``key`` is a number or a fixed-length sequence per scene
+    (then every returned value is an array over its entries). Returns ``(difference, low,
+    high)``; the scenes are resampled together for every entry.
+    """
+    first = {r.index: getattr(r, key) for r in a}
+    pairs = [(first[r.index], getattr(r, key)) for r in b if r.index in first]
+    if not pairs:
+        raise ValueError('paired differences need scenes that both searchers ran')
+    diff = np.array([x for x, _ in pairs], dtype=float) - np.array([y for _, y in pairs],
+                                                                   dtype=float)
+    picks = np.random.default_rng(seed).integers(0, len(diff), size=(n_boot, len(diff)))
+    low, high = np.percentile(diff[picks].mean(axis=1), [2.5, 97.5], axis=0)
+    return diff.mean(axis=0), low, high
+
+
 def paired_map_difference(a: list, b: list, budgets=range(4, 13), n_boot: int = 2000,
                           seed: int = 0) -> dict:
     """
     MAP accuracy of ``a`` minus ``b`` (same scenes with a face) per budget, paired bootstrap 95%.
 
-    Returns ``{budget: (difference, low, high)}``; the scenes are resampled together for all
-    budgets.
+    Returns ``{budget: (difference, low, high)}`` (:func:`paired_difference` of ``map_right``).
     """
-    fa = np.array([r.map_right for r in a if r.has_face], dtype=float)
-    fb = np.array([r.map_right for r in b if r.has_face], dtype=float)
-    if fa.shape != fb.shape or not fa.size:
+    fa, fb = [r for r in a if r.has_face], [r for r in b if r.has_face]
+    if len(fa) != len(fb) or not fa:
         raise ValueError('paired differences need the same scenes with a face for both')
-    rng = np.random.default_rng(seed)
-    picks = rng.integers(0, len(fa), size=(n_boot, len(fa)))
-    diff = fa - fb
-    boot = diff[picks].mean(axis=1)
-    out = {}
-    for k in budgets:
-        low, high = np.percentile(boot[:, k - 1], [2.5, 97.5])
-        out[int(k)] = (float(diff[:, k - 1].mean()), float(low), float(high))
-    return out
+    diff, low, high = paired_difference(fa, fb, 'map_right', n_boot, seed)
+    return {int(k): (float(diff[k - 1]), float(low[k - 1]), float(high[k - 1]))
+            for k in budgets}
 
 
 def format_summary(spec, summary: dict, name: str = '') -> list[str]:

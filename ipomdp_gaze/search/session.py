@@ -226,6 +226,43 @@ class _Search:
     views: dict = field(default_factory=dict)
 
 
+class _PerSecond:
+    """
+    The session's policy seen per second of head time (``search.head_speed_deg_s``).
+
+    Its scores are the policy's ``scores_per_second`` from the current fixation, so inhibition
+    of return and the choice treat it as any policy with scores.
+    """
+
+    def __init__(self, session: 'SearchSession'):
+        self.session = session
+
+    def scores(self, belief: np.ndarray) -> np.ndarray:
+        """Return the policy's scores per second of each view from the current fixation."""
+        session = self.session
+        settings, here = session.settings, session._search.fixation
+        seconds = view_seconds(session.grid, here, settings.view_time_s,
+                               settings.head_speed_deg_s)
+        detour_s = self._detour_s if settings.head_tour else None
+        return np.asarray(session.policy.scores_per_second(belief, seconds, detour_s),
+                          dtype=float)
+
+    def select(self, belief, t, rng) -> np.ndarray:
+        return argmax_ties_low(self.scores(belief))
+
+    def _detour_s(self, cells) -> np.ndarray:
+        """Return the seconds the tour of the unvisited ``cells`` grows by starting at each."""
+        session = self.session
+        search, settings = session._search, session.settings
+        cells = np.asarray(cells, dtype=np.int64)
+        left = ~search.visited[cells] if settings.inhibit_return \
+            else np.ones(cells.size, dtype=bool)
+        out = np.zeros(cells.size)
+        out[left] = tour_detour_deg(session.grid, search.fixation, cells[left]) \
+            / settings.head_speed_deg_s
+        return out
+
+
 class SearchSession:
     """
     One search at a time on one grid, with an assumed observation model and a policy.
@@ -740,47 +777,22 @@ class SearchSession:
                 and search.decision == 'found':
             return self._predicted_peak()
         belief = self._cells()[None, :]
-        per_second = settings.head_speed_deg_s > 0 and not self.motion.active \
-            and callable(getattr(self.policy, 'scores_per_second', None))
+        policy = self.policy
+        if settings.head_speed_deg_s > 0 and not self.motion.active \
+                and callable(getattr(policy, 'scores_per_second', None)):
+            policy = _PerSecond(self)
         if settings.inhibit_return and not self.motion.active:
             if search.visited.all():
                 if settings.stop_on_repeat:
                     return None
                 search.visited[:] = False
-            if per_second:
-                scores = self._scores_per_second(belief)
-                scores[search.visited] = -np.inf
-                return int(argmax_ties_low(scores))
-            return unvisited_choice(self.policy, belief, search.visited, search.fixations,
+            return unvisited_choice(policy, belief, search.visited, search.fixations,
                                     self.rng, self.grid)
-        if per_second:
-            choice = int(argmax_ties_low(self._scores_per_second(belief)))
-        else:
-            choice = policy_choice(self.policy.select(belief, search.fixations, self.rng),
-                                   self.grid.n_cells)
+        choice = policy_choice(policy.select(belief, search.fixations, self.rng),
+                               self.grid.n_cells)
         if settings.stop_on_repeat and search.visited[choice]:
             return None
         return choice
-
-    def _scores_per_second(self, belief: np.ndarray) -> np.ndarray:
-        """Return the policy's scores per second of head time from the current fixation, (N,)."""
-        settings = self.settings
-        seconds = view_seconds(self.grid, self._search.fixation, settings.view_time_s,
-                               settings.head_speed_deg_s)
-        detour_s = self._tour_detour_s if settings.head_tour else None
-        return np.array(self.policy.scores_per_second(belief, seconds, detour_s),
-                        dtype=float).reshape(-1)
-
-    def _tour_detour_s(self, cells) -> np.ndarray:
-        """Return the seconds the tour of the unvisited ``cells`` grows by starting at each."""
-        search, settings = self._search, self.settings
-        cells = np.asarray(cells, dtype=np.int64)
-        left = ~search.visited[cells] if settings.inhibit_return \
-            else np.ones(cells.size, dtype=bool)
-        out = np.zeros(cells.size)
-        out[left] = tour_detour_deg(self.grid, search.fixation, cells[left]) \
-            / settings.head_speed_deg_s
-        return out
 
     def _rc(self, cell: int) -> list:
         return [int(v) for v in self.grid.cell(int(cell))]

@@ -1,0 +1,45 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""Paired differences of two searchers over the same scenes (``drivers.scene_report``)."""
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+from ipomdp_gaze.drivers.scene_report import paired_difference, paired_map_difference
+import numpy as np
+import pytest
+
+
+def _scenes(values, order=None, has_face=True):
+    order = range(len(values)) if order is None else order
+    return [SimpleNamespace(index=i, value=values[i], has_face=has_face,
+                            map_right=(values[i], 1.0 - values[i])) for i in order]
+
+
+def test_scenes_are_paired_by_index_and_resampled_together():
+    rng = np.random.default_rng(3)
+    a, b, order = rng.random(40), rng.random(40), rng.permutation(40)
+    diff, low, high = paired_difference(_scenes(a), _scenes(b, order=order), 'value',
+                                        n_boot=500, seed=7)
+    d = (a - b)[order]                  # the pairs in b's order, each scene with its own
+    assert diff == pytest.approx(d.mean())
+    picks = np.random.default_rng(7).integers(0, 40, size=(500, 40))
+    expected = np.percentile(d[picks].mean(axis=1), [2.5, 97.5])
+    assert (low, high) == pytest.approx(tuple(expected))
+    assert low <= diff <= high
+
+
+def test_sequences_give_an_interval_per_entry_and_map_budgets_read_them():
+    a, b = np.linspace(0, 1, 30), np.linspace(1, 0, 30)
+    diff, low, high = paired_difference(_scenes(a), _scenes(b), 'map_right')
+    assert diff.shape == low.shape == (2,) and diff[0] == pytest.approx(-diff[1])
+    by_budget = paired_map_difference(_scenes(a), _scenes(b), budgets=(1, 2))
+    assert by_budget[1] == pytest.approx((diff[0], low[0], high[0]))
+    assert by_budget[2] == pytest.approx((diff[1], low[1], high[1]))
+
+
+def test_no_common_scene_is_refused():
+    with pytest.raises(ValueError, match='both searchers ran'):
+        paired_difference(_scenes([1.0]), _scenes([1.0, 2.0], order=[1]), 'value')
+    with pytest.raises(ValueError, match='same scenes with a face'):
+        paired_map_difference(_scenes([1.0]), _scenes([1.0], has_face=False))
