@@ -270,8 +270,7 @@ class ConvPolicy:
         p, q = fft.shape
         b = np.asarray(belief, dtype=float)
         grid_b = b.reshape(b.shape[:-1] + (rows, cols))
-        spec = scipy.fft.rfft(grid_b, n=q, axis=-1)
-        spec = scipy.fft.fft(spec, n=p, axis=-2, overwrite_x=True)
+        spec = scipy.fft.rfft2(grid_b, s=(p, q))    # one call: half the padding copies
         spec *= fft.spectrum
         spec = scipy.fft.ifft(spec, axis=-2, overwrite_x=True)
         out = scipy.fft.irfft(spec[..., :rows, :], n=q, axis=-1)[..., :cols]

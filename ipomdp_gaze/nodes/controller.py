@@ -424,9 +424,15 @@ class GazeControllerNode(QuietPublishers, Node):
             self._publish_target()
 
     def _publish_belief(self) -> None:
+        """Publish the belief to its subscribers (none matched: a volatile topic loses nothing)."""
+        maps, images_wanted = (self._belief_pub.get_subscription_count(),
+                               self._image_pub.get_subscription_count())
+        if not (maps or images_wanted):
+            return
         grid, belief = self._config.grid, self.core.belief
-        self._belief_pub.publish(grid_arrays.to_multiarray(belief, grid))
-        if self._image_pub.get_subscription_count():
+        if maps:
+            self._belief_pub.publish(grid_arrays.to_multiarray(belief, grid))
+        if images_wanted:
             self._image_pub.publish(images.belief_image(
                 belief, grid, self.core.fixation, self._image_scale_px(),
                 self._now().to_msg()))
