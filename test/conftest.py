@@ -127,8 +127,8 @@ def pytest_runtest_logreport(report):
     """
     Count a `ros` test whose body ran, passed or failed (a skip is not a run).
 
-    Under pytest-xdist (`make test` runs ``-n auto``) this runs in the controller too, which
-    collects nothing: there the report's keywords say it is a `ros` test.
+    Under pytest-xdist (`make test` runs ``-n <cores + 1>``) this runs in the controller too,
+    which collects nothing: there the report's keywords say it is a `ros` test.
     """
     if report.when == 'call' and not report.skipped and (
             report.nodeid in _RosCount.collected or 'ros' in report.keywords):

@@ -5,8 +5,8 @@ The guard of the ROS tests (test/conftest.py), run on a small suite in a pytest 
 
 An rclpy that is installed but does not import fails the ROS tests instead of skipping them,
 and with IPOMDP_GAZE_REQUIRE_ROS=<n> (`make test`) the run fails unless every collected ROS test
-ran and at least n did, with or without pytest-xdist (`make test` runs ``-n auto``: there the
-controller process counts what its workers collected and ran).
+ran and at least n did, with or without pytest-xdist (`make test` runs ``-n <cores + 1>``: there
+the controller process counts what its workers collected and ran).
 """
 import os
 from pathlib import Path
