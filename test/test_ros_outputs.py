@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import time
 
+import numpy as np
 import pytest
 
 pytestmark = pytest.mark.ros
@@ -48,3 +49,41 @@ def test_an_incompatible_publisher_on_an_input_is_still_reported(launch, probe):
     time.sleep(1.0)
     # The camera's evidence is best effort: this reliable subscriber is told in its own log.
     assert 'requesting incompatible QoS' not in cam.output()
+
+
+def test_the_belief_map_is_built_only_for_subscribers(context, monkeypatch):
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from std_msgs.msg import Float32MultiArray
+
+    from ipomdp_gaze.msg_adapters import grid_arrays
+    from ipomdp_gaze.nodes.controller import GazeControllerNode
+    packed = []
+    pack = grid_arrays.to_multiarray
+    monkeypatch.setattr(grid_arrays, 'to_multiarray',
+                        lambda values, grid: packed.append(1) or pack(values, grid))
+    node = GazeControllerNode(context=context)
+    listener = rclpy.create_node('belief_listener', context=context)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    executor.add_node(listener)
+    try:
+        node._publish_belief()
+        assert packed == []                     # nobody subscribed: nothing built, nothing lost
+        received = []
+        listener.create_subscription(Float32MultiArray, 'belief',
+                                     received.append, 10)
+        deadline = time.monotonic() + 30
+        while not node._belief_pub.get_subscription_count() and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.05)
+        while not received and time.monotonic() < deadline:
+            node._publish_belief()
+            executor.spin_once(timeout_sec=0.1)
+        assert received and packed
+        grid = node._config.grid
+        values = grid_arrays.from_multiarray(received[-1], grid)
+        np.testing.assert_allclose(values, node.core.belief, rtol=1e-6)
+    finally:
+        executor.shutdown()
+        listener.destroy_node()
+        node.destroy_node()
