@@ -159,3 +159,60 @@ def test_a_moving_target_is_followed_as_before():
         session, _ = _session(head_speed_deg_s=speed, motion_sigma_cells=0.5)
         paths.append(_advance(session, 6).path)
     assert paths[0] == paths[1]
+
+
+def _room(**settings):
+    from ipomdp_gaze.search.many import OccupancySession
+    session = OccupancySession(GRID, MODEL, SearchSettings(
+        targets='many', repeat_weight=0.1, absent_prior=0.8, inhibit_return=True, **settings),
+        link=1)
+    session.reset(seed=0)
+    session.start()
+    return session
+
+
+def _room_frames(session, frames, rng):
+    """Apply frames of null counts; yield (view, the next choice, the gains it chose by)."""
+    for _ in range(frames):
+        counts = MODEL.sample(0, session.fixation, rng, present=False)
+        here = session.fixation
+        result = session.update(Frame(counts))
+        if session.ended:
+            break
+        yield here, result.fixation, session.gains()
+
+
+@pytest.mark.parametrize('seed', range(3))
+def test_many_targets_choose_the_most_information_per_second(seed):
+    speed, view_s = 120.0, 0.15
+    session = _room(head_speed_deg_s=speed, view_time_s=view_s)
+    rows, cols = GRID.rows_cols()
+    steps = 0
+    for here, choice, gains in _room_frames(session, 8, np.random.default_rng(seed)):
+        r, c = divmod(here, GRID.cols)
+        seconds = view_s + np.maximum(abs(rows - r), abs(cols - c)) * GRID.spacing_deg / speed
+        score = np.where(session.visited, -np.inf, gains / seconds)
+        assert choice == int(np.flatnonzero(score == score.max())[0])
+        steps += 1
+    assert steps >= 4
+
+
+def test_many_targets_without_head_speed_choose_by_information_alone():
+    rng = np.random.default_rng(5)
+    session = _room()
+    for here, choice, gains in _room_frames(session, 6, rng):
+        score = np.where(session.visited, -np.inf, gains)
+        assert choice == int(np.flatnonzero(score == score.max())[0])
+    paths = []
+    for speed in (0.0, 120.0):
+        room = _room(head_speed_deg_s=speed, view_time_s=0.15)
+        list(_room_frames(room, 8, np.random.default_rng(6)))
+        paths.append(room.path)
+    assert paths[0] != paths[1]                 # the head time moved the views
+
+
+def test_many_targets_refuse_the_tour():
+    from ipomdp_gaze.search.many import OccupancySession
+    with pytest.raises(ValueError, match='search.targets many has no tour'):
+        OccupancySession(GRID, MODEL, SearchSettings(targets='many', head_speed_deg_s=120.0,
+                                                     head_tour=True))

@@ -41,10 +41,9 @@ DEFAULT_BUDGET = 60
 # every grouped detection.
 ROOM_SEARCHERS = ('many', 'many-cells', 'many-posterior', 'every-view-many') + ROOM_SWEEPS
 # What rooms change in the pan/tilt configuration: the many-target setting, without what the
-# occupancy belief does not model (false-alarm scales, hotspots, the choice per second of head
-# time) ...
-ROOM_MODEL = {'targets': 'many', 'false_alarm_scales': (1.0,), 'hotspot_prior': 0.0,
-              'head_speed_deg_s': 0.0}
+# occupancy belief does not model (false-alarm scales, hotspots; the choice per second of head
+# time it keeps: docs/design.md section 11.5) ...
+ROOM_MODEL = {'targets': 'many', 'false_alarm_scales': (1.0,), 'hotspot_prior': 0.0}
 # ... and the settings chosen on training rooms (docs/design.md section 11.5): repeated views
 # of a cell weigh 0.1 (at 1, texture seen from several views became false faces), within the
 # configuration's budget of 20 fixations (40 found one more face of 50 in twice the head time).

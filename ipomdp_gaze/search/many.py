@@ -24,7 +24,8 @@ The same steps and results as :class:`ipomdp_gaze.search.session.SearchSession` 
    (:meth:`stop`), ``gave_up`` or, with ``decide_at_budget``, every cell by its likelier side;
    ``gave_up`` (reason ``repeat``) when no view left would tell anything new;
 5. otherwise the next fixation maximises the expected reduction of the summed cell entropies per
-   unit cost: ``argmax_k sum_j w_kj I(P(x_j); offset_jk) / cost_k`` over unvisited cells, with
+   unit cost: ``argmax_k sum_j w_kj I(P(x_j); offset_jk) / cost_k`` over unvisited cells (the
+   cost times the view's seconds of head time with ``search.head_speed_deg_s``), with
    ``w_kj = 1`` where view k sees cell j at a more informative offset (ELM kernel) than any view
    so far, ``repeat_weight`` otherwise, and 0 for a cell settled by ``link``.
 
@@ -37,6 +38,7 @@ from __future__ import annotations
 from collections import deque
 
 from ipomdp_gaze.model.belief import argmax_ties_low, EvidenceError
+from ipomdp_gaze.model.head_time import view_seconds
 from ipomdp_gaze.model.motion import Motion
 from ipomdp_gaze.model.observation import as_observation, check_evidence, CountObservation
 from ipomdp_gaze.model.occupancy import (binary_entropy, cell_prior, count_faces, decided,
@@ -59,6 +61,9 @@ def check_many_settings(settings: SearchSettings) -> None:
     if len(settings.false_alarm_scales) > 1 or settings.hotspot_prior > 0:
         raise ValueError('search.targets many does not model false-alarm scales or hotspots: '
                          'leave search.false_alarm_scales [1.0] and search.hotspot_prior 0')
+    if settings.head_tour:
+        raise ValueError('search.targets many has no tour of the tiles (that is policy '
+                         "coverage's): leave search.head_tour false")
 
 
 class OccupancySession:
@@ -357,12 +362,29 @@ class OccupancySession:
             weight = weight * ~settled[None, :]
         return np.einsum('kj,kj->k', info, weight)
 
+    def costs_from(self, cell: int | None) -> np.ndarray:
+        """
+        Return the cost of the next view at each cell (N,), with the head at ``cell``.
+
+        The fixation costs, times the view's seconds under the head model when
+        ``search.head_speed_deg_s`` > 0 (:func:`ipomdp_gaze.model.head_time.view_seconds`; the
+        head starts at the grid's centre): information per second of head time, as the
+        single-target session's per-second choice (docs/design.md section 6.14).
+        """
+        settings = self.settings
+        if settings.head_speed_deg_s <= 0:
+            return self.costs
+        at = self.grid.center_index if cell is None else int(cell)
+        return self.costs * view_seconds(self.grid, at, settings.view_time_s,
+                                         settings.head_speed_deg_s)
+
     def _choose(self) -> int | None:
         s = self._s()
-        score = self.gains() / self.costs
+        costs = self.costs_from(s['fixation'])
+        score = self.gains() / costs
         if self.settings.inhibit_return:
             score = np.where(s['visited'], -np.inf, score)
-        if not np.isfinite(score).any() or score.max() <= MIN_GAIN / self.costs.min():
+        if not np.isfinite(score).any() or score.max() <= MIN_GAIN / costs.min():
             return None
         return int(argmax_ties_low(score))
 

@@ -91,8 +91,9 @@ SCHEMA: tuple[Setting, ...] = (
             'the evidence of each cell once, for overlapping views of a still scene and a '
             'deterministic detector)', bounds='in [0, 1]', metavar='W'),
     Setting('head_speed_deg_s', 'search.head_speed_deg_s', 'float', 0.0, check_sigma_cells,
-            'still target, policy elm or coverage (others choose as before): the view with the '
-            'best score per second of head time, the move at this joint speed plus '
+            'still target, policy elm or coverage, or search.targets many (others choose as '
+            'before): the view with the best score per second of head time, the move at this '
+            'joint speed plus '
             "search.view_time_s (0: every view costs alike, the paper's choice)", bounds='>= 0',
             metavar='DEG_S'),
     Setting('view_time_s', 'search.view_time_s', 'float', 0.4, check_seconds,
