@@ -318,6 +318,18 @@ def test_two_faces_in_one_cell_when_the_boxes_say_so():
     assert {f['cell'] for f in faces} == {0}
 
 
+def test_a_box_centred_past_the_grids_edge_names_the_edge_cell():
+    """A wide view at the edge sees past the grid: its box still names a cell of the grid."""
+    grid = Grid(3, 3)
+    log_odds = np.full(9, -5.0)
+    log_odds[[0, 8]] = 5.0                              # corners (0, 0) and (2, 2)
+    occupied = log_odds > 0
+    past = np.array([[-80, -75, 20, 20], [150, 160, 20, 20]], dtype=float)  # above-left, below-right
+    for boxes in (past, past[:1], past[1:]):
+        faces = count_faces(log_odds, grid, occupied, boxes, image_px=(90, 90), link=1)
+        assert sorted(f['cell'] for f in faces) == [0, 8]
+
+
 def test_clusters_link_distance():
     grid = Grid(3, 6)
     cells = np.array([0, 7, 4, 17])                   # (0,0) (1,1) | (0,4) | (2,5)

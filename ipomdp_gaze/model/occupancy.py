@@ -301,6 +301,20 @@ def cell_boxes_px(grid, cells, image_px) -> np.ndarray:
     return np.stack([x0, y0, x1 - x0, y1 - y0], axis=1).astype(float)
 
 
+def _box_cells(boxes: np.ndarray, grid, image_px) -> np.ndarray:
+    """
+    Return the cell of each box centre (M,), a centre outside the image in the nearest edge cell.
+
+    A wide view at the grid's edge sees past it (the 40-degree lens), so a box may lie outside
+    the picture the grid tiles.
+    """
+    centres = boxes[:, :2] + boxes[:, 2:] / 2
+    width, height = image_px
+    row = np.clip(np.floor(centres[:, 1] * grid.rows / height), 0, grid.rows - 1)
+    col = np.clip(np.floor(centres[:, 0] * grid.cols / width), 0, grid.cols - 1)
+    return (row * grid.cols + col).astype(np.intp)
+
+
 def count_faces(log_odds: np.ndarray, grid, occupied: np.ndarray, boxes=None, scores=None,
                 image_px=None, link: int = 2, iou: float = 0.3,
                 support: float = 0.5) -> list[dict]:
@@ -345,11 +359,7 @@ def count_faces(log_odds: np.ndarray, grid, occupied: np.ndarray, boxes=None, sc
     merged = counts = centre_cells = None
     if boxes is not None and image_px is not None and len(boxes):
         merged, counts = merge_boxes(boxes, scores, iou)
-        centres = merged[:, :2] + merged[:, 2:] / 2
-        width, height = image_px
-        row = np.clip(np.floor(centres[:, 1] * grid.rows / height), 0, grid.rows - 1)
-        col = np.clip(np.floor(centres[:, 0] * grid.cols / width), 0, grid.cols - 1)
-        centre_cells = (row * grid.cols + col).astype(np.intp)
+        centre_cells = _box_cells(merged, grid, image_px)
     faces = []
     for label in range(labels.max() + 1 if labels.size else 0):
         cells = occupied_cells[labels == label]
@@ -384,10 +394,7 @@ def count_faces(log_odds: np.ndarray, grid, occupied: np.ndarray, boxes=None, sc
             w = occupancy(log_odds[part])
             best = int(np.rint(w @ r / w.sum()) * grid.cols + np.rint(w @ c / w.sum()))
             if box is not None and merged is not None and own.size:
-                centre = box[:2] + box[2:] / 2
-                width, height = image_px
-                best = int(min(int(centre[1] * grid.rows / height), grid.rows - 1) * grid.cols
-                           + min(int(centre[0] * grid.cols / width), grid.cols - 1))
+                best = int(_box_cells(box[None, :], grid, image_px)[0])
             faces.append({'cell': best, 'cells': part,
                           'probability': float(-np.expm1(log_empty[part].sum())),
                           'box': None if box is None else np.asarray(box, dtype=float)})
