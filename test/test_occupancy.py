@@ -324,7 +324,7 @@ def test_a_box_centred_past_the_grids_edge_names_the_edge_cell():
     log_odds = np.full(9, -5.0)
     log_odds[[0, 8]] = 5.0                              # corners (0, 0) and (2, 2)
     occupied = log_odds > 0
-    past = np.array([[-80, -75, 20, 20], [150, 160, 20, 20]], dtype=float)  # above-left, below-right
+    past = np.array([[-80, -75, 20, 20], [150, 160, 20, 20]], dtype=float)  # up-left, down-right
     for boxes in (past, past[:1], past[1:]):
         faces = count_faces(log_odds, grid, occupied, boxes, image_px=(90, 90), link=1)
         assert sorted(f['cell'] for f in faces) == [0, 8]
