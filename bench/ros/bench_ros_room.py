@@ -4,10 +4,10 @@
 The controller in many-target mode over DDS on held-out rooms of 0-4 faces, against offline.
 
 For each of 50 seeds (3 with ``--quick``): the scene camera's held-out room of that seed
-(``scene.faces '0-4'``), the detector and the controller (``config/faces_camera_*.yaml``, the controller's with
-``faces_camera_room_controller.yaml``: ``search.targets many`` and the rooms' settings,
-docs/design.md section 11.5) as three fresh processes. Recorded: the people the
-node publishes on ``~/target_cells`` with its ``room_done``, the seconds from starting the scene
+(``scene.faces '0-4'``), the detector and the controller (``config/faces_camera_*.yaml``, the
+controller's with ``faces_camera_room_controller.yaml``: ``search.targets many`` and the rooms'
+settings, docs/design.md section 11.5) as three fresh processes. Recorded: the people the node
+publishes on ``~/target_cells`` with its ``room_done``, the seconds from starting the scene
 camera to ``room_done``, and whether the people are the offline many-target session's on the
 same room (``drivers.rooms.room_session``, ``many-cells``: one face per cluster, no boxes, as
 the node answers) and the room's faces (each within one cell, ``match_faces``). Test rooms;
