@@ -182,6 +182,12 @@ def _room_frames(session, frames, rng):
         yield here, result.fixation, session.gains()
 
 
+def _first_best(score):
+    """Return the lowest cell within the project's tie tolerance (1e-9) of the best score."""
+    best = score.max()
+    return int(np.flatnonzero(score >= best - 1e-9 * abs(best))[0])
+
+
 @pytest.mark.parametrize('seed', range(3))
 def test_many_targets_choose_the_most_information_per_second(seed):
     speed, view_s = 120.0, 0.15
@@ -192,7 +198,7 @@ def test_many_targets_choose_the_most_information_per_second(seed):
         r, c = divmod(here, GRID.cols)
         seconds = view_s + np.maximum(abs(rows - r), abs(cols - c)) * GRID.spacing_deg / speed
         score = np.where(session.visited, -np.inf, gains / seconds)
-        assert choice == int(np.flatnonzero(score == score.max())[0])
+        assert choice == _first_best(score)
         steps += 1
     assert steps >= 4
 
@@ -202,7 +208,7 @@ def test_many_targets_without_head_speed_choose_by_information_alone():
     session = _room()
     for here, choice, gains in _room_frames(session, 6, rng):
         score = np.where(session.visited, -np.inf, gains)
-        assert choice == int(np.flatnonzero(score == score.max())[0])
+        assert choice == _first_best(score)
     paths = []
     for speed in (0.0, 120.0):
         room = _room(head_speed_deg_s=speed, view_time_s=0.15)
@@ -216,3 +222,5 @@ def test_many_targets_refuse_the_tour():
     with pytest.raises(ValueError, match='search.targets many has no tour'):
         OccupancySession(GRID, MODEL, SearchSettings(targets='many', head_speed_deg_s=120.0,
                                                      head_tour=True))
+    # Without head speed the tour does nothing, for one target as for many: accepted.
+    OccupancySession(GRID, MODEL, SearchSettings(targets='many', head_tour=True))

@@ -61,7 +61,7 @@ def check_many_settings(settings: SearchSettings) -> None:
     if len(settings.false_alarm_scales) > 1 or settings.hotspot_prior > 0:
         raise ValueError('search.targets many does not model false-alarm scales or hotspots: '
                          'leave search.false_alarm_scales [1.0] and search.hotspot_prior 0')
-    if settings.head_tour:
+    if settings.head_tour and settings.head_speed_deg_s > 0:
         raise ValueError('search.targets many has no tour of the tiles (that is policy '
                          "coverage's): leave search.head_tour false")
 
@@ -367,8 +367,9 @@ class OccupancySession:
         Return the cost of the next view at each cell (N,), with the head at ``cell``.
 
         The fixation costs, times the view's seconds under the head model when
-        ``search.head_speed_deg_s`` > 0 (:func:`ipomdp_gaze.model.head_time.view_seconds`; the
-        head starts at the grid's centre): information per second of head time, as the
+        ``search.head_speed_deg_s`` > 0 (:func:`ipomdp_gaze.model.head_time.view_seconds`; before
+        the first fixation the head is taken to be at the grid's centre, as the head-time model
+        counts): information per second of head time, as the
         single-target session's per-second choice (docs/design.md section 6.14).
         """
         settings = self.settings
