@@ -70,6 +70,12 @@ def test_a_near_cell_that_leaves_the_rest_behind_costs_its_detour():
     np.testing.assert_allclose(detour, [10.0, 0.0, 20.0])
 
 
+def _first_best(score):
+    """Return the lowest cell within the project's tie tolerance (1e-9) of the best score."""
+    best = score.max()
+    return int(np.flatnonzero(score >= best - 1e-9 * abs(best))[0])
+
+
 def _session(policy_name='coverage', **settings):
     policy = build_policy(policy_name, GRID, MODEL)
     return SearchSession(GRID, MODEL, policy, SearchSettings(**settings)), policy
@@ -114,8 +120,7 @@ def test_the_choice_is_the_best_score_per_second(policy_name, tour, views):
         bonus = np.abs(per).max() + 1.0
         expected = per + (given.max() < policy.peak) * bonus * policy.tile
     expected[visited] = -np.inf
-    best = np.flatnonzero(expected >= expected.max() - 1e-9 * abs(expected.max()))
-    assert result.fixation == best[0]
+    assert result.fixation == _first_best(expected)
 
 
 def test_without_head_speed_the_choice_is_unchanged():
@@ -180,12 +185,6 @@ def _room_frames(session, frames, rng):
         if session.ended:
             break
         yield here, result.fixation, session.gains()
-
-
-def _first_best(score):
-    """Return the lowest cell within the project's tie tolerance (1e-9) of the best score."""
-    best = score.max()
-    return int(np.flatnonzero(score >= best - 1e-9 * abs(best))[0])
 
 
 @pytest.mark.parametrize('seed', range(3))
