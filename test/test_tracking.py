@@ -7,6 +7,7 @@ import subprocess
 import sys
 
 from ipomdp_gaze.drivers import tracking
+from ipomdp_gaze.files.observation_file import load_observation
 from ipomdp_gaze.model.head_time import HEAD_SPEED_DEG_S, SACCADE_TIME_S, SETTLE_TIME_S
 from ipomdp_gaze.vision.walks import WalkSceneSet
 import numpy as np
@@ -76,6 +77,23 @@ def test_the_scores_of_a_walk_by_hand():
     assert r.first_find_s == 2.0 and r.found
     assert r.reacquire_s == pytest.approx(1.0, abs=0.011) and r.reacquired
     assert (r.lost, r.reacquired_events) == (1, 1)
+
+
+def test_the_tracker_reads_the_model_its_configuration_names(tmp_path):
+    """``observation.file`` of the tracking configuration, or the model asked for instead."""
+    config = tmp_path / 'tracking.yaml'
+    text = tracking.config_file(tracking.WALK_CONFIG).read_text()
+    assert 'file: faces-pan-tilt-profile' in text
+    config.write_text(text.replace('file: faces-pan-tilt-profile', 'file: faces-pan-tilt'))
+    assert tracking.walk_spec(5.0, 'train').model == 'faces-pan-tilt-profile'
+    spec = tracking.walk_spec(5.0, 'train', config=config)
+    assert spec.model == 'faces-pan-tilt'
+    assert tracking.walk_spec(5.0, 'train', config=config, model='faces-pan-tilt-profile').model \
+        == 'faces-pan-tilt-profile'
+    task = tracking.WalkTask.get(spec.settings, spec.policy, spec.model)
+    frontal = load_observation('faces-pan-tilt')
+    np.testing.assert_array_equal(task.model.p_target, frontal.p_target)
+    assert task.detector.cascade_names == ['haarcascade_frontalface_alt2.xml']
 
 
 def test_evaluate_motion_walk_writes_the_summary_per_searcher(tmp_path):

@@ -86,7 +86,8 @@ def add_parser(sub):
                    help=f'--motion walk: seconds per walk (default {WALK_DURATION_S:g})')
     p.add_argument('--scene-model', default='', metavar='FILE',
                    help='--scenes pan-tilt: another pan/tilt observation file (its camera is the '
-                        "scene camera's)")
+                        "scene camera's; with --motion walk, the tracker's instead of its "
+                        "configuration's observation.file)")
     p.add_argument('--compare', action='append', default=[], metavar='SEARCHER',
                    help='--scenes: another searcher on the same scenes and views (repeatable): '
                         'a policy name (sweep starts at its first pose) or a sweep answer rule '
@@ -331,11 +332,12 @@ def run_scenes(args) -> int:
 
 def run_walks(args) -> int:
     """``evaluate --scenes pan-tilt --motion walk``: the tracker and the baseline on walks."""
-    if args.policy or args.policy_file or args.empty_scenes or args.scene_model:
+    if args.policy or args.policy_file or args.empty_scenes:
         raise ValueError('--motion walk takes the tracking configuration: no --policy, '
-                         '--policy-file, --empty-scenes or --scene-model')
+                         '--policy-file or --empty-scenes')
     spec = walk_spec(args.speed_deg_s, args.split, args.seed, args.walk_duration_s,
-                     tuple(args.compare) or ('track-last-detection',))
+                     tuple(args.compare) or ('track-last-detection',),
+                     model=args.scene_model or None)
     changes = {key: value for key, value in (('confidence', args.confidence),
                                              ('absent_prior', args.absent_prior))
                if value is not None}

@@ -115,14 +115,14 @@ class WalkTask:
     _cache: dict = {}
 
     @classmethod
-    def get(cls, settings: SearchSettings, policy: str) -> WalkTask:
-        key = (settings, policy)
+    def get(cls, settings: SearchSettings, policy: str, model: str = '') -> WalkTask:
+        key = (settings, policy, model)
         if key not in cls._cache:
-            cls._cache = {key: cls(settings, policy)}
+            cls._cache = {key: cls(settings, policy, model)}
         return cls._cache[key]
 
-    def __init__(self, settings: SearchSettings, policy: str):
-        setup = build_setup('camera', '')
+    def __init__(self, settings: SearchSettings, policy: str, model: str = ''):
+        setup = build_setup('camera', model)
         self.model = setup.model
         self.grid = self.model.grid
         self.camera = setup.camera
@@ -302,16 +302,19 @@ class WalkSpec:
     settings: SearchSettings
     policy: str
     compare: tuple = ('track-last-detection',)
+    model: str = ''          # the pan/tilt observation file; '' for the camera mode's default
 
 
 def walk_spec(speed_deg_s: float, split: str = 'test', seed: int = 0,
               duration_s: float = DURATION_S, compare=('track-last-detection',),
-              settings: SearchSettings | None = None, config=None) -> WalkSpec:
+              settings: SearchSettings | None = None, config=None,
+              model: str | None = None) -> WalkSpec:
     """
     Return a checked walk evaluation: ``config`` (default :data:`WALK_CONFIG`) and its policy.
 
     ``compare`` names the other searchers, ``track-last-detection`` optionally with
-    ``:neighbors=N,lost_frames=M``.
+    ``:neighbors=N,lost_frames=M``. ``model``: a pan/tilt observation file (path or shipped
+    name) instead of the configuration's ``observation.file``.
     """
     check_speed(speed_deg_s)
     if split not in ('train', 'test'):
@@ -320,9 +323,10 @@ def walk_spec(speed_deg_s: float, split: str = 'test', seed: int = 0,
         raise ValueError(f'the walk duration must be > 0 s, got {duration_s!r}')
     for name in compare:
         _baseline_kwargs(name)
-    base, policy, _ = walk_settings(config)
+    base, policy, values = walk_settings(config)
+    model = values.get('observation.file', '') if model is None else str(model)
     return WalkSpec(split, int(seed), float(speed_deg_s), float(duration_s),
-                    settings or base, policy, tuple(compare))
+                    settings or base, policy, tuple(compare), model)
 
 
 def _baseline_kwargs(name: str) -> dict:
@@ -343,7 +347,7 @@ def _baseline_kwargs(name: str) -> dict:
 
 def evaluate_walk(spec: WalkSpec, index: int) -> list:
     """Run ``track`` and each of ``spec.compare`` on walk scene ``index`` (one piece of work)."""
-    task = WalkTask.get(spec.settings, spec.policy)
+    task = WalkTask.get(spec.settings, spec.policy, spec.model)
     scene = WalkSceneSet(spec.split, task.geometry, spec.seed, spec.speed_deg_s,
                          spec.duration_s).scene(index)
     tracker = SessionTracker(task, spec.settings, np.random.default_rng([spec.seed, index]))
@@ -378,7 +382,8 @@ def walks_json(spec: WalkSpec, results: dict, summary: dict) -> dict:
     """Return the JSON record of a walk evaluation: configuration, summaries, every scene."""
     return {'task': 'pan-tilt', 'motion': 'walk', 'speed_deg_s': spec.speed_deg_s,
             'duration_s': spec.duration_s, 'split': spec.split, 'seed': spec.seed,
-            'policy': spec.policy, 'settings': spec.settings.to_parameters(),
+            'policy': spec.policy, 'model': spec.model,
+            'settings': spec.settings.to_parameters(),
             'compare': list(spec.compare), 'summary': summary,
             'scenes': {name: [r.to_dict() for r in group] for name, group in results.items()}}
 
