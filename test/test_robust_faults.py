@@ -163,11 +163,14 @@ def test_camera_killed_mid_search_then_restarted(nodes, probe, watch):
                     graph.count_publishers('joint_states') > publishers[1] and
                     _matched(probe, 'evidence') and _matched(probe, 'joint_states'), 30), \
         camera.output()
-    n_frames, n_poses = len(watch.frames), len(watch.poses)
+    n_frames = len(watch.frames)
     assert len(watch.beliefs) == kept_beliefs
     assert probe.enable(True).success
-    assert wait_for(lambda: any(watch.cell(m) == target for _, m in watch.poses[n_poses:]), 30), \
-        (target, [watch.cell(m) for _, m in watch.poses[n_poses:]], camera.output())
+    # The new camera serves the re-sent target: the first update is the kept belief times a
+    # frame taken there (checked below). Its pose there is not required of the probe: on a
+    # loaded machine the killed camera's endpoint can leave the graph while the new one is being
+    # matched, so the counts above agree before the match and a pose sent in that gap is lost
+    # (a CI replica saw the camera's next poses, 24, 30, 40, without the target's).
     assert wait_for(lambda: len(watch.beliefs) > kept_beliefs, 30), controller.output()
     first = watch.belief(kept_beliefs)
     if not any(np.allclose(first, _posterior(kept, frame.data, target, watch.grid), rtol=1e-4,
