@@ -19,7 +19,7 @@ ROOT = Path(__file__).resolve().parents[1]
 @pytest.fixture(scope='module')
 def task():
     spec = tracking.walk_spec(10.0, 'train', 0, 4.0)
-    return spec, tracking.WalkTask.get(spec.settings, spec.policy)
+    return spec, tracking.WalkTask.get(spec.settings, spec.policy, spec.model)
 
 
 def _gaps_follow_the_head_model(frames, grid_spacing):
