@@ -43,6 +43,20 @@ def test_the_walk_is_the_walk_scene_of_the_seed():
     assert _config(**{'scene.motion': 'still'}).walk is None
 
 
+def test_scene_split_train_walks_the_training_scene_of_the_seed():
+    from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet
+    from ipomdp_gaze.vision.walks import WalkSceneSet
+    cfg = _config(**{'scene.split': 'train'})
+    want = WalkSceneSet('train', cfg.geometry, SEED, 5.0, 30.0).scene(0)
+    test = WalkSceneSet('test', cfg.geometry, SEED, 5.0, 30.0).scene(0)
+    np.testing.assert_array_equal(cfg.walk.walk.points_px, want.walk.points_px)
+    assert not np.array_equal(cfg.walk.image_at(0.0), test.image_at(0.0))
+    np.testing.assert_array_equal(cfg.walk.image_at(4.0), want.image_at(4.0))
+    still = _config(**{'scene.split': 'train', 'scene.motion': 'still'}).scene
+    np.testing.assert_array_equal(
+        still.image, PanTiltSceneSet('train', cfg.geometry, (30, 70), 'rgb', SEED).scene(0).image)
+
+
 def test_a_parameter_changed_at_run_time_keeps_the_walk():
     from ipomdp_gaze.nodes.scene_camera import SceneCameraNode
     cfg = _config()

@@ -72,9 +72,11 @@ def test_the_walk_demo_runs_the_tracker_on_the_walk_of_the_seed():
     assert setup.settings.moving
     camera_args = ' '.join(args['scene_camera'])
     for want in ('seed:=4', 'scene.motion:=walk', 'scene.speed_deg_s:=8.0',
-                 'scene.walk_duration_s:=12.0'):
+                 'scene.walk_duration_s:=12.0', 'scene.split:=test'):
         assert want in camera_args
     assert (camera.width, camera.height) == (320, 240)
+    train, _ = walk_setup(seed=4, split='train')
+    assert 'scene.split:=train' in ' '.join(dict(train.nodes)['scene_camera'])
 
 
 @pytest.mark.parametrize('args, message', [

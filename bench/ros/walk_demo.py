@@ -17,11 +17,14 @@ be. A head that ignored the face and visited the 121 poses alike would have it i
 5-degree grid), so 50% is far above chance and below what a tracker that keeps up reaches. A run
 that fails (a node did not start, the walk did not run its length) counts as not kept.
 
-Held-out walks only: seed S is the test split's walk scene S, the scene the offline evaluation
-(``ipomdp-gaze evaluate --scenes pan-tilt --motion walk``) calls index S. Each demo takes
-about ``D`` seconds plus 5-10 s to start and stop the nodes::
+Seed S is the test split's walk scene S, the scene the offline evaluation (``ipomdp-gaze
+evaluate --scenes pan-tilt --motion walk``) calls index S: the report's held-out walks.
+``--split train`` runs the training walks instead (the scene camera's ``scene.split``), for
+choosing settings over ROS on walks no report uses. Each demo takes about ``D`` seconds plus
+5-10 s to start and stop the nodes::
 
     .venv/bin/python bench/ros/walk_demo.py [--seeds 50] [--speed-deg-s 5] [--duration-s 30]
+        [--split test]
 """
 from __future__ import annotations
 
@@ -39,9 +42,10 @@ import numpy as np
 THRESHOLD = 0.5
 
 
-def run_seed(seed: int, speed: float, duration: float, timeout: float) -> dict:
+def run_seed(seed: int, speed: float, duration: float, timeout: float,
+             split: str = 'test') -> dict:
     """Run the walk demo of one seed; return its status and score."""
-    setup, camera = walk_setup(seed, speed, duration)
+    setup, camera = walk_setup(seed, speed, duration, split=split)
     stats = {}
     status = run_walk_demo(setup, camera, duration, timeout, domain_id_for(),
                            out=lambda line: None, stats=stats)
@@ -83,7 +87,7 @@ def summary_lines(results: list) -> list[str]:
 def main(argv=None) -> int:
     """Run the seeds and print a line each and the summary."""
     p = argparse.ArgumentParser(description=__doc__.split('\n\n')[0].strip())
-    p.add_argument('--seeds', type=int, default=50, help='held-out seeds 0..N-1 (default 50)')
+    p.add_argument('--seeds', type=int, default=50, help='seeds 0..N-1 (default 50)')
     p.add_argument('--first-seed', type=int, default=0, help='start at this seed (default 0)')
     p.add_argument('--speed-deg-s', type=float, default=5.0,
                    help='walking speed in deg/s, 0-20 (default 5)')
@@ -91,6 +95,9 @@ def main(argv=None) -> int:
                    help=f'seconds per walk (default {DURATION_S:g})')
     p.add_argument('--timeout', type=float, default=60.0,
                    help='seconds for the nodes to start (default 60)')
+    p.add_argument('--split', choices=('test', 'train'), default='test',
+                   help='held-out walks (test, the default: reports) or training walks (train: '
+                        'for choosing settings)')
     args = p.parse_args(argv)
     if args.seeds < 1 or args.first_seed < 0:
         p.error('--seeds must be >= 1 and --first-seed >= 0')
@@ -98,11 +105,11 @@ def main(argv=None) -> int:
         speed = check_speed(args.speed_deg_s)
     except ValueError as exc:
         p.error(str(exc))
-    print(f'walk demo over DDS: seeds {args.first_seed}-{args.first_seed + args.seeds - 1}, '
+    print(f'walk demo over DDS: {args.split} seeds {args.first_seed}-{args.first_seed + args.seeds - 1}, '
           f'{speed:g} deg/s, {args.duration_s:g} s each', flush=True)
     results = []
     for seed in range(args.first_seed, args.first_seed + args.seeds):
-        results.append(run_seed(seed, speed, args.duration_s, args.timeout))
+        results.append(run_seed(seed, speed, args.duration_s, args.timeout, args.split))
         print(seed_line(results[-1]), flush=True)
     for line in summary_lines(results):
         print(line, flush=True)

@@ -60,10 +60,15 @@ class WalkScore:
 
 
 def walk_setup(seed: int = 0, speed_deg_s: float = 5.0, duration_s: float = DURATION_S,
-               policy: str | None = None):
-    """Return the demo's nodes (:func:`faces_setup` with a walking face) and its camera."""
+               policy: str | None = None, split: str = 'test'):
+    """
+    Return the demo's nodes (:func:`faces_setup` with a walking face) and its camera.
+
+    ``split``: the held-out walks (``test``, for reports) or the training walks (``train``, for
+    choosing settings), the scene camera's ``scene.split``.
+    """
     walk = {'scene.motion': 'walk', 'scene.speed_deg_s': float(speed_deg_s),
-            'scene.walk_duration_s': float(duration_s)}
+            'scene.walk_duration_s': float(duration_s), 'scene.split': str(split)}
     setup = faces_setup(False, policy, seed, walk=walk)
     values = yaml_parameters(config_file('faces_camera_scene_camera.yaml'), 'scene_camera')
     camera = PinholeCamera.from_fov(values['camera.width'], values['camera.height'],

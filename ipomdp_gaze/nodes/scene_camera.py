@@ -5,7 +5,8 @@ The ``scene_camera`` node: a simulated camera over a real photograph, published 
 
 It stands in for camera hardware as ``simulated_camera`` stands in for a detector
 (docs/design.md section 6.6). The scene is a held-out test scene (a test background with one
-pasted test face, from ``seed``) or a user's image (``scene.file``, with the face centre as
+pasted test face, from ``seed``; ``scene.split: train`` takes the training scene of ``seed``
+instead, for choosing settings on scenes no report uses) or a user's image (``scene.file``, with the face centre as
 ``scene.face_x_px``/``scene.face_y_px``):
 
 - ``view: fixed``: a fixed camera that sees the whole scene (for the detector's ``fovea`` mode);
@@ -57,6 +58,7 @@ from .spin import run_node
 NODE_NAME = NODE_NAMES['scene_camera']
 VIEWS = ('fixed', 'pan_tilt')
 MOTIONS = ('still', 'walk')
+SPLITS = ('test', 'train')
 # Defaults of each view: the grid, the scene's side (fixed) and the face sizes in pixels.
 VIEW_GRIDS = {'fixed': (21, 21, 1.0), 'pan_tilt': (11, 11, 5.0)}
 VIEW_FACES = {'fixed': (60, 140), 'pan_tilt': (30, 70)}
@@ -71,8 +73,11 @@ def scene_camera_params() -> list[Param]:
         Param('view', 'pan_tilt', T.STRING,
               'fixed: the whole scene (fovea mode); pan_tilt: the field of view at the head '
               'pose (read-only)', read_only=True, choices=VIEWS),
-        Param('seed', 0, T.INTEGER, 'which held-out test scene (read-only)', read_only=True,
+        Param('seed', 0, T.INTEGER, 'which scene of scene.split (read-only)', read_only=True,
               int_range=(0, INT_MAX)),
+        Param('scene.split', 'test', T.STRING,
+              'test: the held-out scenes (reports); train: the training scenes, for choosing '
+              'settings on what no report uses (read-only)', read_only=True, choices=SPLITS),
         Param('scene.empty', False, T.BOOL,
               'pan_tilt view: the test scene of seed without its face, nobody here (read-only)',
               read_only=True),
@@ -153,6 +158,7 @@ def _scene_config(values: dict) -> SceneConfig:
     if view != 'pan_tilt' and parse_faces(values.get('scene.faces', '1')) != (1, 1):
         raise ValueError('scene.faces is for the pan_tilt view')
     walking = values.get('scene.motion', 'still') == 'walk'
+    split = values.get('scene.split', 'test')
     if walking:
         _check_walk(values, faces)
     if view == 'pan_tilt':
@@ -162,20 +168,20 @@ def _scene_config(values: dict) -> SceneConfig:
         if values['scene.file']:
             scene = user_scene(read_scene_file(values['scene.file']), centre, geometry)
         else:
-            scene = PanTiltSceneSet('test', geometry, faces, 'rgb', values['seed'],
+            scene = PanTiltSceneSet(split, geometry, faces, 'rgb', values['seed'],
                                     empty=values['scene.empty'],
                                     faces=values.get('scene.faces', '1')).scene(0)
         walk = None
         if walking:
             from ipomdp_gaze.vision.walks import WalkSceneSet
-            walk = WalkSceneSet('test', geometry, values['seed'], values['scene.speed_deg_s'],
+            walk = WalkSceneSet(split, geometry, values['seed'], values['scene.speed_deg_s'],
                                 values['scene.walk_duration_s']).scene(0)
         return SceneConfig(dict(values), grid, camera, scene, geometry,
                            head_from(values, grid), walk)
     if values['scene.file']:
         scene = user_scene(read_scene_file(values['scene.file']), centre, grid=grid.shape)
     else:
-        scene = SceneSet('test', values['scene.size_px'], faces, grid.shape,
+        scene = SceneSet(split, values['scene.size_px'], faces, grid.shape,
                          color='rgb', seed=values['seed']).scene(0)
     height, width = scene.image.shape[:2]
     camera = PinholeCamera.from_fov(width, height, values['camera.hfov_deg'])
