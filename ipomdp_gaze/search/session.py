@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 
 from ipomdp_gaze.model.belief import (argmax_ties_low, bayes_update, entropy_of_log,
                                       EvidenceError, map_cell, normalize_log)
+from ipomdp_gaze.model.clutter_map import ClutterMap
 from ipomdp_gaze.model.false_alarms import FalseAlarmMixture
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head_time import tour_detour_deg, view_seconds
@@ -300,6 +301,7 @@ class SearchSession:
         self._search = None
         self._counts = isinstance(self.observation, CountObservation)
         self._mixture = None
+        self._clutter = None
         _check_mixture_model(self.settings, self.observation)
 
     # -- configuration -------------------------------------------------------------------
@@ -319,8 +321,9 @@ class SearchSession:
             self.motion = _motion(self.grid, settings)
         self._changed()                 # the answer's square follows found_radius and motion
         mixture_changed = _mixture_settings(settings) != _mixture_settings(old)
-        if mixture_changed:
+        if mixture_changed or settings.moving != old.moving:
             self._mixture = None
+            self._clutter = None
         if self._search is not None and (settings.repeat_weight != old.repeat_weight
                                          or settings.moving != old.moving or mixture_changed):
             self._still.reset()
@@ -336,6 +339,7 @@ class SearchSession:
         self._counts = isinstance(self.observation, CountObservation)
         self._kernel = None
         self._mixture = None
+        self._clutter = None
 
     def set_policy(self, policy) -> None:
         """Choose with another policy from the next choice on."""
@@ -523,6 +527,8 @@ class SearchSession:
         self.motion.reset()
         if self._mixture is not None:
             self._mixture.reset()
+        if self._clutter is not None:
+            self._clutter.reset()
         self._search = _Search(log_b, log_b.copy(), np.zeros(self.grid.n_cells, dtype=bool))
         self._event('reset', settings=self.settings.to_parameters())
 
@@ -667,6 +673,12 @@ class SearchSession:
                          with_absent(self._still_term(obs, term), search.log_belief),
                          out=search.log_belief)
         else:
+            clutter = self._active_clutter()
+            if clutter is not None:
+                hot = clutter.hot_ratio(obs, search.fixation)
+                face = clutter.face_term(term, hot)
+                clutter.update(search.log_belief, term, hot, face)
+                term = face
             bayes_update(search.log_belief, with_absent(term, search.log_belief),
                          out=search.log_belief)
         self._changed()
@@ -704,6 +716,20 @@ class SearchSession:
         if self._mixture is None:
             self._mixture = FalseAlarmMixture(self.observation, *_mixture_settings(self.settings))
         return self._mixture
+
+    def _active_clutter(self) -> ClutterMap | None:
+        """Return the clutter map when hotspots are asked for and the target moves (§12.8)."""
+        if self.settings.hotspot_prior <= 0 or not self.motion.active or not self._counts:
+            return None
+        if self._clutter is None:
+            self._clutter = ClutterMap(self.observation, self.settings.hotspot_prior,
+                                       self.settings.hotspot_scale)
+        return self._clutter
+
+    @property
+    def hotspot_probability(self) -> np.ndarray | None:
+        """Each cell's probability of being a hotspot (the clutter map, §12.8); None without."""
+        return None if self._clutter is None else self._clutter.probability
 
     def _decide(self) -> str:
         """Run the stop rules after an applied frame; return the decision it fired ('')."""

@@ -166,12 +166,13 @@ SCHEMA: tuple[Setting, ...] = (
             "cell's counts during the search ([1.0]: the model's rates as calibrated)",
             metavar='F'),
     Setting('hotspot_prior', 'search.hotspot_prior', 'float', 0.0, check_hotspot_prior,
-            'still target, count model: prior that a cell without the target is a hotspot that '
-            'fires in every view (hotspot_scale times the false-alarm rate; 0: none)',
+            'count model: prior that a cell is a hotspot that fires in every view '
+            '(hotspot_scale times the false-alarm rate; a still target: kept over all views, '
+            'a moving one: a clutter map learned frame by frame; 0: none)',
             bounds='in [0, 0.5]', metavar='P'),
     Setting('hotspot_scale', 'search.hotspot_scale', 'float', DEFAULT_HOTSPOT_SCALE,
             check_hotspot_scale,
-            "still target, count model: a hotspot's factor of the model's false-alarm rate",
+            "count model: a hotspot's factor of the model's false-alarm rate",
             bounds='> 1', metavar='F'),
     Setting('targets', 'search.targets', 'str', 'one', check_targets,
             "the belief: one target or none (the paper's) or many (an occupancy per cell, "
