@@ -105,7 +105,8 @@ def main(argv=None) -> int:
         speed = check_speed(args.speed_deg_s)
     except ValueError as exc:
         p.error(str(exc))
-    print(f'walk demo over DDS: {args.split} seeds {args.first_seed}-{args.first_seed + args.seeds - 1}, '
+    last = args.first_seed + args.seeds - 1
+    print(f'walk demo over DDS: {args.split} seeds {args.first_seed}-{last}, '
           f'{speed:g} deg/s, {args.duration_s:g} s each', flush=True)
     results = []
     for seed in range(args.first_seed, args.first_seed + args.seeds):

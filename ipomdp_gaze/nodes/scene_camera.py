@@ -6,8 +6,8 @@ The ``scene_camera`` node: a simulated camera over a real photograph, published 
 It stands in for camera hardware as ``simulated_camera`` stands in for a detector
 (docs/design.md section 6.6). The scene is a held-out test scene (a test background with one
 pasted test face, from ``seed``; ``scene.split: train`` takes the training scene of ``seed``
-instead, for choosing settings on scenes no report uses) or a user's image (``scene.file``, with the face centre as
-``scene.face_x_px``/``scene.face_y_px``):
+instead, for choosing settings on scenes no report uses) or a user's image (``scene.file``,
+with the face centre as ``scene.face_x_px``/``scene.face_y_px``):
 
 - ``view: fixed``: a fixed camera that sees the whole scene (for the detector's ``fovea`` mode);
   the grid (21x21 by default) tiles the image;
