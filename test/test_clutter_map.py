@@ -66,9 +66,7 @@ def test_one_frame_gives_the_brute_force_marginals(seed):
     want_face, want_hot = _brute_force(model, scaled_null(model.p_target, model.p_null, 3.0),
                                        counts, fixation, log_belief, pi)
     ratio = model.log_likelihood_ratio(counts, fixation)
-    hot = clutter.hot_ratio(counts, fixation)
-    face = clutter.face_term(ratio, hot)
-    clutter.update(log_belief, ratio, hot, face)
+    face = clutter.step(log_belief, counts, fixation, ratio)
     posterior = np.exp(bayes_update(log_belief.copy(), with_absent(face, log_belief)))
     np.testing.assert_allclose(posterior, want_face, rtol=1e-10, atol=1e-14)
     np.testing.assert_allclose(clutter.probability, want_hot, rtol=1e-10, atol=1e-14)
@@ -84,9 +82,7 @@ def test_without_the_absent_hypothesis_too():
                                        counts, 1, np.append(log_belief, -np.inf),
                                        clutter.probability.copy())
     ratio = model.log_likelihood_ratio(counts, 1)
-    hot = clutter.hot_ratio(counts, 1)
-    face = clutter.face_term(ratio, hot)
-    clutter.update(log_belief, ratio, hot, face)
+    face = clutter.step(log_belief, counts, 1, ratio)
     np.testing.assert_allclose(np.exp(bayes_update(log_belief.copy(), face)), want_face[:-1],
                                rtol=1e-10)
     np.testing.assert_allclose(clutter.probability, want_hot, rtol=1e-10)
@@ -98,9 +94,7 @@ def test_an_unobserved_cell_learns_nothing_and_gives_no_term():
     clutter = ClutterMap(model, 0.05, 20.0)
     counts = np.array([1.0, np.nan, 2.0, 0.0])
     ratio = model.log_likelihood_ratio(counts, 0)
-    hot = clutter.hot_ratio(counts, 0)
-    face = clutter.face_term(ratio, hot)
-    clutter.update(normalize_log(np.zeros(5)), ratio, hot, face)
+    face = clutter.step(normalize_log(np.zeros(5)), counts, 0, ratio)
     assert face[1] == 0.0 and clutter.probability[1] == pytest.approx(0.05, rel=1e-12)
 
 

@@ -37,6 +37,7 @@ import math
 
 from ipomdp_gaze.model.false_alarms import check_hotspot_prior, check_hotspot_scale, scaled_null
 from ipomdp_gaze.model.observation import CountObservation
+from ipomdp_gaze.model.occupancy import occupancy
 import numpy as np
 
 
@@ -79,7 +80,22 @@ class ClutterMap:
     @property
     def probability(self) -> np.ndarray:
         """Each cell's probability of being a hotspot now, shape (N,)."""
-        return np.exp(_log_sigmoid(self.log_odds))
+        return occupancy(self.log_odds)
+
+    def step(self, log_belief: np.ndarray, observation: np.ndarray, fixation: int,
+             ratio: np.ndarray) -> np.ndarray:
+        """
+        Take one frame: return the face's term ``log T - log M`` and learn from the frame.
+
+        ``log_belief`` is the normalised belief predicted to the frame (N cells, or N + 1 with
+        the absent hypothesis last), ``observation`` the validated frame taken at ``fixation``
+        and ``ratio`` the model's ``log T - log N`` of it. The term uses the map as it was
+        before the frame, as the Bayes step of the belief must.
+        """
+        hot = self.hot_ratio(observation, fixation)
+        face = self.face_term(ratio, hot)
+        self.update(log_belief, ratio, hot, face)
+        return face
 
     def hot_ratio(self, observation: np.ndarray, fixation: int) -> np.ndarray:
         """Return ``log H_i - log N_i`` per cell for a validated frame (0 where unobserved)."""

@@ -675,10 +675,7 @@ class SearchSession:
         else:
             clutter = self._active_clutter()
             if clutter is not None:
-                hot = clutter.hot_ratio(obs, search.fixation)
-                face = clutter.face_term(term, hot)
-                clutter.update(search.log_belief, term, hot, face)
-                term = face
+                term = clutter.step(search.log_belief, obs, search.fixation, term)
             bayes_update(search.log_belief, with_absent(term, search.log_belief),
                          out=search.log_belief)
         self._changed()
