@@ -65,6 +65,39 @@ def test_the_ladder_stops_at_the_first_strong_box(scene):
     assert coarse.detector_pixels < full.detector_pixels and near(coarse.cell, full.cell)
 
 
+def test_a_weak_finest_scale_box_answers_only_if_an_enlarged_look_keeps_it():
+    """Training material: coffee upside down leaves a weak full-resolution box on texture."""
+    image = np.ascontiguousarray(np.rot90(load_photo('coffee'), 2))
+    task = tasks('yunet').task((image.shape[1], image.shape[0]))
+    table = scale_table(task.model)
+    start = ladder_start(task.model, table)
+    unlooked = search_scales(image, task.fovea, task.model, table, start=start,
+                             confirm_last=False)
+    looked = search_scales(image, task.fovea, task.model, table, start=start)
+    assert unlooked.decision == 'found' and looked.decision == 'absent'
+    # the look is one more call on the crop round the box, enlarged twice
+    x, y, w, h = unlooked.faces[0].box
+    side = max(w, h)
+    crop_w = min(image.shape[1], int(x + w + side)) - max(0, int(x - side))
+    crop_h = min(image.shape[0], int(y + h + side)) - max(0, int(y - side))
+    extra = looked.detector_pixels - unlooked.detector_pixels
+    assert abs(extra - 4 * crop_w * crop_h) <= 2 * (crop_w + crop_h) + 1
+
+
+def test_an_enlarged_look_keeps_a_weak_face():
+    """Training scene 5 (seed 1): the face's only box is weak at full resolution."""
+    scene = SceneSet('train', size_px=420, face_px=(60, 140), grid=(21, 21), seed=1)[5]
+    task = tasks('yunet').task((420, 420))
+    table = scale_table(task.model)
+    start = ladder_start(task.model, table)
+    unlooked = search_scales(scene.image, task.fovea, task.model, table, start=start,
+                             confirm_last=False)
+    looked = search_scales(scene.image, task.fovea, task.model, table, start=start)
+    assert looked.detector_pixels > unlooked.detector_pixels
+    assert looked.decision == unlooked.decision == 'found'
+    assert looked.cell == unlooked.cell and near(looked.cell, scene.cell)
+
+
 def test_scan_fovea_is_todays_find_bit_for_bit(scene):
     task = tasks('haar').task((420, 420))
     [old] = search_one(scene.image, task, FIND_SETTINGS, np.random.default_rng([0, 0]), False,

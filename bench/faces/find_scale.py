@@ -23,9 +23,11 @@ import sys
 import time
 from types import SimpleNamespace
 
-from ipomdp_gaze.commands.find import _Tasks, scale_table, SCAN_CHOICES, search_one
+import cv2
+from ipomdp_gaze.commands.find import _Tasks, ladder_start, scale_table, SCAN_CHOICES, search_one
 from ipomdp_gaze.simulation.evaluation import cells_apart, wilson_interval
 from ipomdp_gaze.vision.fullframe import scan
+from ipomdp_gaze.vision.photos import load_photo, read_labels
 from ipomdp_gaze.vision.scenes import SceneSet
 from ipomdp_gaze.vision.search import FIND_SETTINGS, search_scales
 import numpy as np
@@ -35,10 +37,23 @@ from faces import best_score_cell, TASKS  # noqa: E402, I100
 import find_photos  # noqa: E402, I100
 
 SCALES = (1.0, 0.75, 0.5, 1 / 3)
+# --looks: the enlarged look at a weak finest-scale box (search_scales), as (label, options):
+# without it, and at other enlargements and scores than the shipped 2x at 0.6
+LOOKS = (('no enlarged look', {'confirm_last': False}),
+         ('look 1.5x at 0.5', {'look_upscale': 1.5, 'look_score': 0.5}),
+         ('look 2x at 0.5', {'look_upscale': 2.0, 'look_score': 0.5}),
+         ('look 2x at 0.6 (shipped)', {'look_upscale': 2.0, 'look_score': 0.6}),
+         ('look 2x at 0.7', {'look_upscale': 2.0, 'look_score': 0.7}),
+         ('look 3x at 0.5', {'look_upscale': 3.0, 'look_score': 0.5}),
+         ('look 3x at 0.7', {'look_upscale': 3.0, 'look_score': 0.7}))
+# --augmented: face-free images to choose the look on (training only): the face-free training
+# photos and three photos of no split, each at these sizes, 4 rotations, and mirrored
+AUGMENT_PHOTOS = ('horse', 'logo', 'colorwheel')
+AUGMENT_SIZES = (0.5, 0.75, 1.0, 1.5, 2.0, 3.0)
 NAMES = {'haar': 'Haar', 'yunet': 'YuNet'}
 
 
-def run(task: str, detector: str, split: str, n: int, seed: int, starts=()) -> dict:
+def run(task: str, detector: str, split: str, n: int, seed: int, starts=(), looks=()) -> dict:
     """Return each method's rows on ``n`` scenes of ``split``: right, seconds, pixels."""
     _, size, faces = TASKS[task]
     tasks = _Tasks(SimpleNamespace(observation=None, detector=detector, policy=None,
@@ -74,6 +89,13 @@ def run(task: str, detector: str, split: str, n: int, seed: int, starts=()) -> d
             right = result.decision == 'found' and cells_apart(result.cell, scene.cell) <= 1
             add(f'find --scan coarse from x{start:.2g}', right, seconds,
                 result.detector_pixels)
+        for label, options in (looks if table.strong_score > 0 else ()):   # scores only
+            t0 = time.perf_counter()
+            result = search_scales(scene.image, find.fovea, find.model, table,
+                                   start=ladder_start(find.model, table), **options)
+            seconds = time.perf_counter() - t0
+            right = result.decision == 'found' and cells_apart(result.cell, scene.cell) <= 1
+            add(f'find --scan coarse, {label}', right, seconds, result.detector_pixels)
         for scale in SCALES:
             found = scan(scene.image, find.fovea.detector, grid, scale=scale)
             if detector == 'yunet':
@@ -132,6 +154,52 @@ def photo_table(split: str, detectors, scans) -> list[str]:
     return lines + ['']
 
 
+def augmented_images():
+    """Yield ``(label, image)``: the face-free training photos and AUGMENT_PHOTOS, augmented."""
+    import skimage.data
+    names = [name for name, (boxes, split) in read_labels().items()
+             if split == 'train' and not len(boxes)] + list(AUGMENT_PHOTOS)
+    for name in names:
+        image = load_photo(name) if name in read_labels() else getattr(skimage.data, name)()
+        if image.dtype == bool:
+            image = image.astype(np.uint8) * 255
+        image = image[..., :3] if image.ndim == 3 else image
+        for factor in AUGMENT_SIZES:
+            sized = cv2.resize(image, None, fx=factor, fy=factor,
+                               interpolation=cv2.INTER_AREA if factor < 1 else cv2.INTER_LINEAR)
+            for turns in range(4):
+                for mirror in (False, True):
+                    turned = np.rot90(sized, turns)
+                    yield (f'{name} x{factor:g} rot{90 * turns}{" mirrored" * mirror}',
+                           np.ascontiguousarray(turned[:, ::-1] if mirror else turned))
+
+
+def augmented_table(detector: str) -> list[str]:
+    """Return ``--scan coarse`` with each enlarged look (LOOKS) on the augmented face-free set."""
+    tasks = find_photos.find_tasks(detector)
+    answered = {label: [] for label, _ in (('shipped', {}),) + LOOKS}
+    pixels = {label: [] for label in answered}
+    n = 0
+    for name, image in augmented_images():
+        find = tasks.task((image.shape[1], image.shape[0]))
+        table = scale_table(find.model)
+        start = ladder_start(find.model, table)
+        n += 1
+        for label, options in (('shipped', {}),) + LOOKS:
+            result = search_scales(image, find.fovea, find.model, table, start=start, **options)
+            if result.decision == 'found':
+                answered[label].append(name)
+            pixels[label].append(result.detector_pixels / (image.shape[0] * image.shape[1]))
+    lines = [f'##### {NAMES[detector]}, face-free training photos augmented ({n} images: '
+             f'{len(AUGMENT_SIZES)} sizes, 4 rotations, mirrored)', '',
+             '| `--scan coarse` | face-free images answered `found` | px / full (mean) |',
+             '|---|---|---|']
+    for label in answered:
+        lines.append(f'| {label} | {len(answered[label])} of {n} | '
+                     f'{np.mean(pixels[label]):.3f} |')
+    return lines + ['']
+
+
 def main(argv=None) -> int:
     """Run the tasks and print (and optionally write) the tables."""
     parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
@@ -148,16 +216,25 @@ def main(argv=None) -> int:
     parser.add_argument('--starts', default='',
                         help='also --scan coarse from each of these first scales (e.g. '
                              '0.25,0.3333,0.5): the choice of its start')
+    parser.add_argument('--looks', action='store_true',
+                        help='also --scan coarse with each enlarged look of LOOKS')
+    parser.add_argument('--augmented', action='store_true',
+                        help='--scan coarse with each enlarged look on the face-free training '
+                             'photos augmented (training only)')
     args = parser.parse_args(argv)
     seed = args.seed if args.seed is not None else (1 if args.split == 'train' else 0)
     results = []
+    if args.augmented:
+        for detector in args.detectors.split(','):
+            print('\n'.join(augmented_table(detector)), flush=True)
     if args.photos:
         print('\n'.join(photo_table(args.split, args.detectors.split(','), SCAN_CHOICES)),
               flush=True)
     for task in ([] if args.no_scenes else args.tasks.split(',')):
         for detector in args.detectors.split(','):
             starts = [float(v) for v in args.starts.split(',') if v]
-            result = run(task, detector, args.split, args.scenes, seed, starts)
+            result = run(task, detector, args.split, args.scenes, seed, starts,
+                         LOOKS if args.looks else ())
             results.append(result)
             print('\n'.join(table(result)), flush=True)
     if args.json:

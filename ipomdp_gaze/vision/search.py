@@ -769,6 +769,20 @@ def search_first(image: np.ndarray, fovea: Fovea, model,
                    seconds=time.perf_counter() - t0)
 
 
+# find without --all (search_scales): a box that answers at the finest scale below the table's
+# strong score is looked at again, the crop round it enlarged LOOK_UPSCALE times, and answers
+# only if that look keeps a box of LOOK_SCORE. Chosen on training material only (YuNet, the
+# shipped ladders; docs/faces.md "find without --all: scale first"): the face-free training
+# photos and three photos of no split (horse, logo, colorwheel), each at 6 sizes (x0.5-x3),
+# 4 rotations and mirrored (432 images), and 120 training scenes and 20 training photos and
+# group pictures with faces. Rule: keep every face the ladder found without the look, then the
+# fewest face-free images answered. 2x at 0.6: 11 of 432 answered (18 without the look; 2x at
+# 0.5: 12; 1.5x at 0.5: 12), no face lost; 2x at 0.7 (7 answered) and 3x at 0.7 (6) lose a
+# face, a strong score at the finest scale instead of a look (5) loses 3.
+LOOK_UPSCALE = 2.0
+LOOK_SCORE = 0.6
+
+
 def _ladder_answer(found, strong_score: float, last: bool):
     """Return the answer box (x, y, w, h) of one rung of :func:`search_scales`, or None."""
     if found.scores is not None and len(found.boxes_px) and strong_score > 0:
@@ -787,8 +801,25 @@ def _ladder_answer(found, strong_score: float, last: bool):
     return found.grouped_px[int(np.argmax(inside))]
 
 
+def _crop_round(box, image_px) -> tuple[int, int, int, int]:
+    """Return the crop ``(x0, y0, x1, y1)`` round a box: its larger side on each side."""
+    x, y, w, h = box
+    side = max(w, h)
+    return (int(max(0, x - side)), int(max(0, y - side)),
+            int(min(image_px[0], x + w + side)), int(min(image_px[1], y + h + side)))
+
+
+def _best_score(found) -> float:
+    """Return the highest box score of a scan (NaN for a detector without scores or no box)."""
+    if found.scores is None or not len(found.scores):
+        return math.nan
+    return float(np.max(found.scores))
+
+
 def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
-                  start: float, confirm: bool = True) -> ImageSearch:
+                  start: float, confirm: bool = True, confirm_last: bool = True,
+                  look_upscale: float = LOOK_UPSCALE,
+                  look_score: float = LOOK_SCORE) -> ImageSearch:
     """
     Find the one face of ``find`` by full-frame calls from coarse to fine (``--scan coarse``).
 
@@ -797,7 +828,11 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
     table's ``strong_score``; Haar: a merged box); at the finest scale any box the fovea's
     detector keeps answers. With ``confirm`` a strong box of a coarser call answers only if a
     crop round it (its side on each side) at the next finer scale keeps a box (strong unless
-    that scale is the finest); else the next scale's full-frame call follows. ``found`` at the
+    that scale is the finest); else the next scale's full-frame call follows. With
+    ``confirm_last`` a box of a scoring detector that answers at the finest scale below the
+    table's strong score answers only if the same crop, enlarged ``look_upscale`` times, keeps
+    a box of at least ``look_score`` (a face grows clearer, a texture rarely does).
+    ``found`` at the
     best box (the highest score; for a grouping detector the merged box holding most raw
     detections), else ``absent``. No belief is computed (``probability`` NaN, method
     ``scales``); ``detector_pixels`` counts every call and crop (a face-free image pays every
@@ -814,19 +849,27 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
         pixels += found.detector_pixels
         last = k == len(rungs) - 1
         box = _ladder_answer(found, scales.strong_score, last)
+        score = _best_score(found) if last else math.nan
         if box is not None and confirm and not last:
             # look again round the box at the next finer scale: a texture the coarse call took
             # for a face rarely survives
-            x, y, w, h = box
-            side = max(w, h)
-            x0, y0 = int(max(0, x - side)), int(max(0, y - side))
-            x1 = int(min(image_px[0], x + w + side))
-            y1 = int(min(image_px[1], y + h + side))
+            x0, y0, x1, y1 = _crop_round(box, image_px)
             look = scan(image[y0:y1, x0:x1], fovea.detector, (1, 1), rungs[k + 1])
             pixels += look.detector_pixels
-            box = _ladder_answer(look, scales.strong_score, k + 1 == len(rungs) - 1)
+            finest = k + 1 == len(rungs) - 1
+            box = _ladder_answer(look, scales.strong_score, finest)
+            score = _best_score(look) if finest else math.nan
             if box is not None:
                 box = np.asarray(box, dtype=float) + (x0, y0, 0, 0)
+        if box is not None and confirm_last and score < scales.strong_score:
+            # a weak box at the finest scale: look at it enlarged
+            x0, y0, x1, y1 = _crop_round(box, image_px)
+            crop = cv2.resize(np.ascontiguousarray(image[y0:y1, x0:x1]), None,
+                              fx=look_upscale, fy=look_upscale, interpolation=cv2.INTER_LINEAR)
+            look = scan(crop, fovea.detector, (1, 1), 1.0)
+            pixels += look.detector_pixels
+            if not _best_score(look) >= look_score:
+                box = None
         if box is not None:
             break
     common = {'fixations': 0, 'path': (), 'detector_pixels': pixels, 'image_px': image_px,
