@@ -11,7 +11,7 @@ from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.occupancy import cell_prior, prior_log_odds
 from ipomdp_gaze.vision import search
 from ipomdp_gaze.vision.fovea_model import fovea_for_model
-from ipomdp_gaze.vision.photos import group_photo
+from ipomdp_gaze.vision.photos import group_photo, load_photo
 from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evidence,
                                        SCALE_TABLES, ScaleRow, ScaleTable)
 from ipomdp_gaze.vision.search import FIND_SETTINGS, search_many
@@ -82,8 +82,10 @@ def test_a_weak_coarse_detection_draws_finer_looks_there(yunet_420, monkeypatch)
     strict = replace(table, strong_score=1.01)                  # every coarse box weak
     x, y, w, h = boxes[0]
     # a finer crop round the face at scale 1, the table's finest: there a box the fovea's own
-    # detector keeps (score 0.5) is strong, so the face is found with no window
-    result = search_many(image, fovea, model, MANY, pixel_budget=1280 * 886, scales=strict)
+    # detector keeps (score 0.5) is strong (no enlarged look: every box is below 1.01), so the
+    # face is found with no window
+    result = search_many(image, fovea, model, MANY, pixel_budget=1280 * 886, scales=strict,
+                         look_upscale=0)
     assert plain.detector_pixels < result.detector_pixels < 1280 * 886 / 2
     assert result.fixations == 0 and len(result.faces) == 1
     bx, by, bw, bh = result.faces[0].box
@@ -91,11 +93,25 @@ def test_a_weak_coarse_detection_draws_finer_looks_there(yunet_420, monkeypatch)
     # every box weak at scale 1 too: the cells stay undecided after the crop, and the
     # fovea's windows are spent there
     monkeypatch.setattr(search, '_fine_score', lambda detector: 1.01)
-    result = search_many(image, fovea, model, MANY, pixel_budget=1280 * 886, scales=strict)
+    result = search_many(image, fovea, model, MANY, pixel_budget=1280 * 886, scales=strict,
+                         look_upscale=0)
     assert plain.detector_pixels < result.detector_pixels <= 1280 * 886
     assert result.fixations >= 1
     row, col = result.path[0]                               # the first window: at the face
     assert abs(row - (y + h / 2) * 21 / 886) <= 2 and abs(col - (x + w / 2) * 21 / 1280) <= 2
+
+
+def test_a_weak_full_resolution_box_is_strong_only_if_the_enlarged_look_keeps_it(yunet_420):
+    """Training photo coffee upside down: a weak full-resolution box on texture."""
+    model, fovea = yunet_420
+    image = np.ascontiguousarray(np.rot90(load_photo('coffee'), 2))
+    budget = image.shape[0] * image.shape[1]
+    table = scale_table(model)
+    unlooked = search_many(image, fovea, model, MANY, pixel_budget=budget, scales=table,
+                           look_upscale=0)
+    looked = search_many(image, fovea, model, MANY, pixel_budget=budget, scales=table)
+    assert len(unlooked.faces) == 1 and looked.faces == ()
+    assert looked.decision == 'absent' and looked.detector_pixels > unlooked.detector_pixels
 
 
 def test_the_coarse_pass_keeps_weaker_boxes_than_the_fine_windows(yunet_420):

@@ -62,6 +62,23 @@ from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evi
 from ipomdp_gaze.vision.sensors import FoveaSensor
 import numpy as np
 
+# The enlarged look (docs/design.md section 11.4). find without --all (search_scales): a box
+# that answers at the finest scale below the table's strong score answers only if the crop
+# round it, enlarged LOOK_UPSCALE times, keeps a box of LOOK_SCORE. Chosen on training material
+# only (YuNet, the shipped ladders): the face-free training photos and three photos of no split
+# (horse, logo, colorwheel), each at 6 sizes (x0.5-x3), 4 rotations and mirrored (432 images),
+# and the 129 faces the ladder finds without a look in 120 training scenes, the 8 training
+# group pictures and the astronaut at 6 sizes. Rule: keep every such face, then the fewest
+# face-free images answered, then the fewest pixels. 2x at 0.6: 11 of 432 answered (18 without
+# a look; 2x at 0.5 and 1.5x at 0.5: 12), no face lost; 2x at 0.7 (7) and 3x at 0.7 (6) lose a
+# face; YuNet's strong score at the finest scale instead of a look (5) loses 3.
+# find --all (_Coarse): the same look decides whether a full-resolution box of 0.5-0.7 is
+# strong (kept) or weak (not kept: the fovea's windows decide its cell). On the training groups
+# it keeps every face (lfw 43 and 47 of 48, photo faces 48 and 48, no false face added) and it
+# names 13 false faces instead of 16 on the 432 face-free images.
+LOOK_UPSCALE = 2.0
+LOOK_SCORE = 0.6
+
 # The settings of search_image unless given: NMPT's operating point (confidence 0.9, 25 fixations,
 # stop before fixating a cell a second time).
 DEFAULT_SETTINGS = SearchSettings(confidence=0.9, max_fixations=25, stop_on_repeat=True)
@@ -548,8 +565,10 @@ class _Coarse(_Recorder):
     """
 
     def __init__(self, fovea: Fovea, table, image_px: tuple[int, int], prior: np.ndarray,
-                 confidence: float, budget: float = math.inf, min_face: float | None = None):
+                 confidence: float, budget: float = math.inf, min_face: float | None = None,
+                 look_upscale: float = LOOK_UPSCALE, look_score: float = LOOK_SCORE):
         super().__init__(fovea)
+        self.look_upscale, self.look_score = look_upscale, look_score
         self.scans = True
         self.table, self.image_px, self.prior = table, image_px, prior
         self.scale = choose_scale(table, image_px, min_face)
@@ -575,22 +594,36 @@ class _Coarse(_Recorder):
         found = scan(self.image[y0:y1, x0:x1], self.detector, (1, 1), scale)
         raw = found.boxes_px + (x0, y0, 0, 0)
         scores = np.ones(len(raw)) if found.scores is None else np.asarray(found.scores)
+        pixels = found.detector_pixels
         if self.table.strong_score > 0:
             # at the table's finest scale no finer look follows: a box the fovea's own
-            # detector keeps (its calibrated score threshold) is strong there
+            # detector keeps (its calibrated score threshold) is strong there if the enlarged
+            # look keeps it too (without a look: at once)
             cut = self.table.strong_score
+            kept = np.zeros(len(raw), dtype=bool)
             if scale >= self.table.rows[-1].scale:
                 cut = min(cut, self.fine_score)
-            strong = raw[scores >= cut]
-            weak = raw[scores < cut]
+                if self.look_upscale:
+                    # a box below the strong score is strong only if the enlarged look keeps it
+                    for k in np.flatnonzero((scores >= cut) & (scores < self.table.strong_score)):
+                        x0c, y0c, x1c, y1c = _crop_round(raw[k], self.image_px)
+                        crop = cv2.resize(np.ascontiguousarray(self.image[y0c:y1c, x0c:x1c]),
+                                          None, fx=self.look_upscale, fy=self.look_upscale,
+                                          interpolation=cv2.INTER_LINEAR)
+                        look = scan(crop, self.sensor.fovea.detector, (1, 1), 1.0)
+                        pixels += look.detector_pixels
+                        kept[k] = _best_score(look) >= self.look_score
+                    cut = self.table.strong_score
+            strong = raw[(scores >= cut) | kept]
+            weak = raw[(scores < cut) & ~kept]
         else:           # a grouping detector: its grouped boxes strong, looser groups weak
             strong = found.grouped_px + (x0, y0, 0, 0)
             weak = (group_boxes(np.round(raw), self.table.weak_neighbors) if len(raw)
                     else raw)
         self.boxes.append(raw)
         self.scores.append(scores)
-        self.looks.append((tuple(int(v) for v in rect), scale, found.detector_pixels))
-        return strong, weak, found.detector_pixels
+        self.looks.append((tuple(int(v) for v in rect), scale, pixels))
+        return strong, weak, pixels
 
     def scan(self):
         t0 = time.perf_counter()
@@ -686,7 +719,8 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
                 settle: int = SETTLE_RADIUS,
                 empty_by_evidence: bool = EMPTY_BY_EVIDENCE,
                 scales: ScaleTable | None = None,
-                min_face: float | None = None) -> ImageSearch:
+                min_face: float | None = None, look_upscale: float = LOOK_UPSCALE,
+                look_score: float = LOOK_SCORE) -> ImageSearch:
     """
     Search one image for every face at once: the many-target belief (``search.targets: many``).
 
@@ -706,7 +740,9 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     it leaves undecided (a weak detection); without, the fovea's own scan (as before).
     ``min_face``: the smallest face side that matters, in the image's pixels (default
     :func:`~ipomdp_gaze.vision.scales.min_face_px`, 1/10 of the shorter side), which chooses
-    the coarse scale.
+    the coarse scale. A full-resolution box of the coarse pass below the table's strong score
+    is strong only if the crop round it, enlarged ``look_upscale`` times (0: no look), keeps a
+    box of ``look_score``; else it is weak.
 
     Raises
     ------
@@ -727,7 +763,8 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
         prior = prior_log_odds(fovea.grid.n_cells,
                                cell_prior(fovea.grid.n_cells, settings.absent_prior))
         sensor = _Coarse(fovea, scales, image_px, prior, settings.confidence,
-                         math.inf if pixel_budget is None else pixel_budget, min_face)
+                         math.inf if pixel_budget is None else pixel_budget, min_face,
+                         look_upscale, look_score)
     outcome = run_search(session, sensor, image, pixel_budget=pixel_budget)
     boxes = np.concatenate(sensor.boxes) if sensor.boxes else np.zeros((0, 4))
     scores = np.concatenate(sensor.scores) if sensor.scores else np.zeros(0)
@@ -767,20 +804,6 @@ def search_first(image: np.ndarray, fovea: Fovea, model,
     return replace(many, cell=face.cell, pixel=(x + w / 2.0, y + h / 2.0),
                    probability=face.probability, decision='found',
                    seconds=time.perf_counter() - t0)
-
-
-# find without --all (search_scales): a box that answers at the finest scale below the table's
-# strong score is looked at again, the crop round it enlarged LOOK_UPSCALE times, and answers
-# only if that look keeps a box of LOOK_SCORE. Chosen on training material only (YuNet, the
-# shipped ladders; docs/faces.md "find without --all: scale first"): the face-free training
-# photos and three photos of no split (horse, logo, colorwheel), each at 6 sizes (x0.5-x3),
-# 4 rotations and mirrored (432 images), and 120 training scenes and 20 training photos and
-# group pictures with faces. Rule: keep every face the ladder found without the look, then the
-# fewest face-free images answered. 2x at 0.6: 11 of 432 answered (18 without the look; 2x at
-# 0.5: 12; 1.5x at 0.5: 12), no face lost; 2x at 0.7 (7 answered) and 3x at 0.7 (6) lose a
-# face, a strong score at the finest scale instead of a look (5) loses 3.
-LOOK_UPSCALE = 2.0
-LOOK_SCORE = 0.6
 
 
 def _ladder_answer(found, strong_score: float, last: bool):
