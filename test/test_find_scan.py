@@ -72,7 +72,7 @@ def test_a_weak_finest_scale_box_answers_only_if_an_enlarged_look_keeps_it():
     table = scale_table(task.model)
     start = ladder_start(task.model, table)
     unlooked = search_scales(image, task.fovea, task.model, table, start=start,
-                             confirm_last=False)
+                             look_upscale=0)
     looked = search_scales(image, task.fovea, task.model, table, start=start)
     assert unlooked.decision == 'found' and looked.decision == 'absent'
     # the look is one more call on the crop round the box, enlarged twice
@@ -91,7 +91,7 @@ def test_an_enlarged_look_keeps_a_weak_face():
     table = scale_table(task.model)
     start = ladder_start(task.model, table)
     unlooked = search_scales(scene.image, task.fovea, task.model, table, start=start,
-                             confirm_last=False)
+                             look_upscale=0)
     looked = search_scales(scene.image, task.fovea, task.model, table, start=start)
     assert looked.detector_pixels > unlooked.detector_pixels
     assert looked.decision == unlooked.decision == 'found'

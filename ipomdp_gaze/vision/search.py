@@ -606,13 +606,11 @@ class _Coarse(_Recorder):
                 if self.look_upscale:
                     # a box below the strong score is strong only if the enlarged look keeps it
                     for k in np.flatnonzero((scores >= cut) & (scores < self.table.strong_score)):
-                        x0c, y0c, x1c, y1c = _crop_round(raw[k], self.image_px)
-                        crop = cv2.resize(np.ascontiguousarray(self.image[y0c:y1c, x0c:x1c]),
-                                          None, fx=self.look_upscale, fy=self.look_upscale,
-                                          interpolation=cv2.INTER_LINEAR)
-                        look = scan(crop, self.sensor.fovea.detector, (1, 1), 1.0)
-                        pixels += look.detector_pixels
-                        kept[k] = _best_score(look) >= self.look_score
+                        best, spent = _enlarged_look(self.image, raw[k], self.image_px,
+                                                     self.sensor.fovea.detector,
+                                                     self.look_upscale)
+                        pixels += spent
+                        kept[k] = best >= self.look_score
                     cut = self.table.strong_score
             strong = raw[(scores >= cut) | kept]
             weak = raw[(scores < cut) & ~kept]
@@ -839,9 +837,17 @@ def _best_score(found) -> float:
     return float(np.max(found.scores))
 
 
+def _enlarged_look(image: np.ndarray, box, image_px, detector, upscale: float):
+    """Return ``(best score, pixels)`` of the detector on the crop round ``box``, enlarged."""
+    x0, y0, x1, y1 = _crop_round(box, image_px)
+    crop = cv2.resize(np.ascontiguousarray(image[y0:y1, x0:x1]), None, fx=upscale, fy=upscale,
+                      interpolation=cv2.INTER_LINEAR)
+    look = scan(crop, detector, (1, 1), 1.0)
+    return _best_score(look), look.detector_pixels
+
+
 def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
-                  start: float, confirm: bool = True, confirm_last: bool = True,
-                  look_upscale: float = LOOK_UPSCALE,
+                  start: float, confirm: bool = True, look_upscale: float = LOOK_UPSCALE,
                   look_score: float = LOOK_SCORE) -> ImageSearch:
     """
     Find the one face of ``find`` by full-frame calls from coarse to fine (``--scan coarse``).
@@ -851,12 +857,11 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
     table's ``strong_score``; Haar: a merged box); at the finest scale any box the fovea's
     detector keeps answers. With ``confirm`` a strong box of a coarser call answers only if a
     crop round it (its side on each side) at the next finer scale keeps a box (strong unless
-    that scale is the finest); else the next scale's full-frame call follows. With
-    ``confirm_last`` a box of a scoring detector that answers at the finest scale below the
-    table's strong score answers only if the same crop, enlarged ``look_upscale`` times, keeps
-    a box of at least ``look_score`` (a face grows clearer, a texture rarely does).
-    ``found`` at the
-    best box (the highest score; for a grouping detector the merged box holding most raw
+    that scale is the finest); else the next scale's full-frame call follows. A box of a
+    scoring detector that answers at the finest scale below the table's strong score answers
+    only if the same crop, enlarged ``look_upscale`` times (0: no look), keeps a box of at
+    least ``look_score`` (a face grows clearer, a texture rarely does). ``found`` at the best
+    box (the highest score; for a grouping detector the merged box holding most raw
     detections), else ``absent``. No belief is computed (``probability`` NaN, method
     ``scales``); ``detector_pixels`` counts every call and crop (a face-free image pays every
     scale: 1/16 + 1/9 + 1/4 + 1 of a full scan from 1/4).
@@ -884,14 +889,11 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
             score = _best_score(look) if finest else math.nan
             if box is not None:
                 box = np.asarray(box, dtype=float) + (x0, y0, 0, 0)
-        if box is not None and confirm_last and score < scales.strong_score:
+        if box is not None and look_upscale and score < scales.strong_score:
             # a weak box at the finest scale: look at it enlarged
-            x0, y0, x1, y1 = _crop_round(box, image_px)
-            crop = cv2.resize(np.ascontiguousarray(image[y0:y1, x0:x1]), None,
-                              fx=look_upscale, fy=look_upscale, interpolation=cv2.INTER_LINEAR)
-            look = scan(crop, fovea.detector, (1, 1), 1.0)
-            pixels += look.detector_pixels
-            if not _best_score(look) >= look_score:
+            best, spent = _enlarged_look(image, box, image_px, fovea.detector, look_upscale)
+            pixels += spent
+            if not best >= look_score:
                 box = None
         if box is not None:
             break
