@@ -31,6 +31,7 @@ from ipomdp_gaze.vision.photos import load_photo, read_labels
 from ipomdp_gaze.vision.scenes import SceneSet
 from ipomdp_gaze.vision.search import FIND_SETTINGS, search_scales
 import numpy as np
+import skimage.data
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from faces import best_score_cell, TASKS  # noqa: E402, I100
@@ -156,11 +157,11 @@ def photo_table(split: str, detectors, scans) -> list[str]:
 
 def augmented_images():
     """Yield ``(label, image)``: the face-free training photos and AUGMENT_PHOTOS, augmented."""
-    import skimage.data
-    names = [name for name, (boxes, split) in read_labels().items()
+    labels = read_labels()
+    names = [name for name, (boxes, split) in labels.items()
              if split == 'train' and not len(boxes)] + list(AUGMENT_PHOTOS)
     for name in names:
-        image = load_photo(name) if name in read_labels() else getattr(skimage.data, name)()
+        image = load_photo(name) if name in labels else getattr(skimage.data, name)()
         if image.dtype == bool:
             image = image.astype(np.uint8) * 255
         image = image[..., :3] if image.ndim == 3 else image
@@ -177,7 +178,7 @@ def augmented_images():
 def augmented_table(detector: str) -> list[str]:
     """Return ``--scan coarse`` with each enlarged look (LOOKS) on the augmented face-free set."""
     tasks = find_photos.find_tasks(detector)
-    answered = {label: [] for label, _ in (('shipped', {}),) + LOOKS}
+    answered = {label: [] for label, _ in LOOKS}
     pixels = {label: [] for label in answered}
     n = 0
     for name, image in augmented_images():
@@ -185,7 +186,7 @@ def augmented_table(detector: str) -> list[str]:
         table = scale_table(find.model)
         start = ladder_start(find.model, table)
         n += 1
-        for label, options in (('shipped', {}),) + LOOKS:
+        for label, options in LOOKS:
             result = search_scales(image, find.fovea, find.model, table, start=start, **options)
             if result.decision == 'found':
                 answered[label].append(name)

@@ -596,24 +596,20 @@ class _Coarse(_Recorder):
         scores = np.ones(len(raw)) if found.scores is None else np.asarray(found.scores)
         pixels = found.detector_pixels
         if self.table.strong_score > 0:
-            # at the table's finest scale no finer look follows: a box the fovea's own
-            # detector keeps (its calibrated score threshold) is strong there if the enlarged
-            # look keeps it too (without a look: at once)
-            cut = self.table.strong_score
-            kept = np.zeros(len(raw), dtype=bool)
+            is_strong = scores >= self.table.strong_score
             if scale >= self.table.rows[-1].scale:
-                cut = min(cut, self.fine_score)
+                # at the table's finest scale no finer look follows: a box the fovea's own
+                # detector keeps (its calibrated score threshold) is strong there too, if the
+                # enlarged look keeps it (look_upscale 0: at once)
+                kept = np.flatnonzero((scores >= self.fine_score) & ~is_strong)
                 if self.look_upscale:
-                    # a box below the strong score is strong only if the enlarged look keeps it
-                    for k in np.flatnonzero((scores >= cut) & (scores < self.table.strong_score)):
-                        best, spent = _enlarged_look(self.image, raw[k], self.image_px,
-                                                     self.sensor.fovea.detector,
-                                                     self.look_upscale)
-                        pixels += spent
-                        kept[k] = best >= self.look_score
-                    cut = self.table.strong_score
-            strong = raw[(scores >= cut) | kept]
-            weak = raw[(scores < cut) & ~kept]
+                    looks = [_enlarged_look(self.image, raw[k], self.image_px,
+                                            self.sensor.fovea.detector, self.look_upscale)
+                             for k in kept]
+                    pixels += sum(spent for _, spent in looks)
+                    kept = kept[[best >= self.look_score for best, _ in looks]]
+                is_strong[kept] = True
+            strong, weak = raw[is_strong], raw[~is_strong]
         else:           # a grouping detector: its grouped boxes strong, looser groups weak
             strong = found.grouped_px + (x0, y0, 0, 0)
             weak = (group_boxes(np.round(raw), self.table.weak_neighbors) if len(raw)
