@@ -98,6 +98,32 @@ def test_an_enlarged_look_keeps_a_weak_face():
     assert looked.cell == unlooked.cell and near(looked.cell, scene.cell)
 
 
+def test_a_face_too_small_for_the_finest_scale_answers_from_its_faint_box():
+    """Training scene 4 (seed 1) of faces-840: a 34 px face leaves only a faint box at x1."""
+    scene = SceneSet('train', size_px=840, face_px=(24, 140), grid=(21, 21), seed=1)[4]
+    assert scene.face_px < 48                  # below the smallest face YuNet's x1 call sees
+    task = tasks('yunet').task((840, 840))
+    table = scale_table(task.model)
+    start = ladder_start(task.model, table)
+    unlooked = search_scales(scene.image, task.fovea, task.model, table, start=start,
+                             faint_score=0)
+    looked = search_scales(scene.image, task.fovea, task.model, table, start=start)
+    assert unlooked.decision == 'absent'
+    assert looked.decision == 'found' and near(looked.cell, scene.cell)
+    # the faint look is one call on the crop round the faint box, enlarged twice
+    x, y, w, h = looked.faces[0].box
+    assert max(w, h) <= 64
+    side = max(w, h)
+    crop_w = min(840, int(x + w + side)) - max(0, int(x - side))
+    crop_h = min(840, int(y + h + side)) - max(0, int(y - side))
+    extra = looked.detector_pixels - unlooked.detector_pixels
+    assert abs(extra - 4 * crop_w * crop_h) <= 2 * (crop_w + crop_h) + 1
+    # a look score the enlarged face does not reach keeps the answer absent, at the same cost
+    strict = search_scales(scene.image, task.fovea, task.model, table, start=start,
+                           faint_look_score=1.01)
+    assert strict.decision == 'absent' and strict.detector_pixels == looked.detector_pixels
+
+
 def test_scan_fovea_is_todays_find_bit_for_bit(scene):
     task = tasks('haar').task((420, 420))
     [old] = search_one(scene.image, task, FIND_SETTINGS, np.random.default_rng([0, 0]), False,

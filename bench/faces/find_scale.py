@@ -39,8 +39,13 @@ import find_photos  # noqa: E402, I100
 
 SCALES = (1.0, 0.75, 0.5, 1 / 3)
 # --looks: the enlarged look at a weak finest-scale box (search_scales), as (label, options):
-# without it, and at other enlargements and scores than the shipped 2x at 0.6
+# without it (nor the faint look), and at other enlargements and scores than the shipped 2x at
+# 0.6; the faint look at a faint small box when nothing answered: without it, and at other
+# look scores than the shipped 0.8
 LOOKS = (('no enlarged look', {'look_upscale': 0}),
+         ('no faint look', {'faint_score': 0}),
+         ('faint look at 0.6', {'faint_look_score': 0.6}),
+         ('faint look at 0.7', {'faint_look_score': 0.7}),
          ('look 1.5x at 0.5', {'look_upscale': 1.5, 'look_score': 0.5}),
          ('look 2x at 0.5', {'look_upscale': 2.0, 'look_score': 0.5}),
          ('look 2x at 0.6 (shipped)', {'look_upscale': 2.0, 'look_score': 0.6}),
