@@ -124,6 +124,43 @@ def test_a_face_too_small_for_the_finest_scale_answers_from_its_faint_box():
     assert strict.decision == 'absent' and strict.detector_pixels == looked.detector_pixels
 
 
+@pytest.mark.parametrize('finest, rungs', [(1.0, (0.5, 1.0)), (2.0, (0.5, 1.0, 2.0)),
+                                           (0.5, (0.5,)), (0.25, (0.25,))])
+def test_the_ladder_of_a_face_free_image_ends_at_its_finest_scale(finest, rungs):
+    """The face-free training photo brick pays every rung from the start (1/2) to finest."""
+    image = load_photo('brick')
+    task = tasks('yunet').task((image.shape[1], image.shape[0]))
+    table = scale_table(task.model)
+    assert ladder_start(task.model, table) == 0.5
+    result = search_scales(image, task.fovea, task.model, table, start=0.5, finest=finest,
+                           faint_score=0)
+    assert result.decision == 'absent'
+    width, height = image.shape[1], image.shape[0]
+    assert result.detector_pixels == sum(int(np.floor(width * s + 0.5))
+                                         * int(np.floor(height * s + 0.5)) for s in rungs)
+    assert result.note == f'full frame at {", ".join(f"{s:.2g}" for s in rungs)}'
+
+
+def test_min_face_below_full_resolution_enlarges_the_last_rung(tmp_path, cli_here):
+    """Training scene 23 (seed 1) of faces-840: a 37 px face, below YuNet's 48 px at x1."""
+    scene = SceneSet('train', size_px=840, face_px=(24, 140), grid=(21, 21), seed=1)[23]
+    path = tmp_path / 'scene.png'
+    cv2.imwrite(str(path), scene.image)
+    out = tmp_path / 'found.json'
+    answers = {}
+    for flags in ((), ('--min-face', 24)):
+        result = cli_here('find', path, '--json', out, *flags)
+        assert result.returncode == 0, result.stderr
+        [entry] = json.loads(out.read_text())['images']
+        answers[flags] = entry
+    assert answers[()]['decision'] == 'absent'
+    enlarged = answers[('--min-face', 24)]
+    assert enlarged['decision'] == 'found' and near(enlarged['cell'], scene.cell)
+    # the ladder from 1/2 to 1, then the frame enlarged 48 / 24 = 2x
+    assert enlarged['detector_pixels'] == (420 * 420 + 840 * 840 + 1680 * 1680)
+    assert 'the ladder ends on the image enlarged 2x' in result.stderr
+
+
 def test_scan_fovea_is_todays_find_bit_for_bit(scene):
     task = tasks('haar').task((420, 420))
     [old] = search_one(scene.image, task, FIND_SETTINGS, np.random.default_rng([0, 0]), False,

@@ -13,7 +13,7 @@ from ipomdp_gaze.vision import search
 from ipomdp_gaze.vision.fovea_model import fovea_for_model
 from ipomdp_gaze.vision.photos import group_photo, load_photo
 from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evidence,
-                                       SCALE_TABLES, ScaleRow, ScaleTable)
+                                       finest_scale, SCALE_TABLES, ScaleRow, ScaleTable)
 from ipomdp_gaze.vision.search import FIND_SETTINGS, search_many
 import numpy as np
 import pytest
@@ -31,6 +31,15 @@ def test_the_coarsest_scale_that_sees_the_smallest_face_that_matters_is_chosen()
     assert choose_scale(TABLE, (640, 480), min_face=20.0) == 1.0
     assert choose_scale(TABLE, (640, 480), min_face=5.0) == 1.0     # none sees it: the finest
     assert choose_scale(TABLE, (640, 480), min_face=200.0) == 0.25
+
+
+def test_the_ladder_ends_where_the_smallest_face_that_matters_is_seen():
+    assert finest_scale(TABLE) == 1.0                        # not given: full resolution
+    assert finest_scale(TABLE, 200.0) == 0.25                # 50 px at 1/4, which sees 20
+    assert finest_scale(TABLE, 32.0) == 0.5                  # 16 px at 1/2
+    assert finest_scale(TABLE, 12.0) == 1.0
+    assert finest_scale(TABLE, 6.0) == 2.0                   # enlarged until 12 px
+    assert finest_scale(TABLE, 1.0) == 4.0                   # at most MAX_SCALE
 
 
 def test_coarse_evidence_marks_strong_cells_occupied_weak_ones_undecided_others_empty():

@@ -258,6 +258,25 @@ def test_scan_downscales_and_maps_boxes_back_to_full_image_cells():
     assert result.seconds > 0
 
 
+def test_scan_enlarges_bilinearly_and_maps_boxes_back():
+    seen = []
+
+    class Recorder(FakeDetector):
+
+        def __call__(self, gray):
+            seen.append(gray.copy())
+            return super().__call__(gray)
+    fake = Recorder([[200, 120, 20, 20]])
+    image = np.zeros((420, 420), np.uint8)
+    image[100:110, 100:110] = 255
+    result = scan(image, fake, GRID, scale=2.0)
+    assert fake.shapes == [(840, 840)] and result.detector_pixels == 840 * 840
+    assert np.array_equal(seen[0], cv2.resize(image, (840, 840),
+                                              interpolation=cv2.INTER_LINEAR))
+    assert np.array_equal(result.boxes_px[0], [100, 60, 10, 10])
+    assert result.cell == GRID.index(65 // 20, 105 // 20)
+
+
 def test_scan_ties_go_to_the_lowest_cell_and_no_detection_gives_none():
     tie = FakeDetector([[300, 300, 10, 10], [10, 10, 10, 10]])
     assert scan(np.zeros((420, 420), np.uint8), tie).cell == GRID.index(0, 0)
@@ -274,7 +293,7 @@ def test_scan_groups_like_opencv_and_answers_with_the_largest_group():
     assert result.grouped_cell == GRID.index(340 // 20, 240 // 20)
     assert result.cell == GRID.index(340 // 20, 240 // 20)     # 5 raw centres there
     with pytest.raises(ValueError, match='scale'):
-        scan(np.zeros((420, 420), np.uint8), FakeDetector(), scale=1.5)
+        scan(np.zeros((420, 420), np.uint8), FakeDetector(), scale=4.5)
 
 
 def test_keep_boxes_is_the_scan_of_the_kept_boxes_alone():

@@ -8,7 +8,8 @@ process (sequential, so the wall times compare): ``find --scan coarse`` (the def
 full-frame call at the scale the detector's table chooses, then the fovea only where cells stay
 undecided, :func:`ipomdp_gaze.vision.search.search_first`), ``find --scan fovea`` (the paper's
 single-target belief after the fovea's scan, find before), both with ``find``'s own settings and
-models (``search_one``), and the detector alone on the full frame at 1, 0.75, 0.5 and 1/3 (Haar:
+models (``search_one``), the same with the task's smallest face given (``--min-face``), and the
+detector alone on the full frame at 1, 0.75, 0.5 and 1/3, YuNet also enlarged 2x and 1.5x (Haar:
 the cell with the most raw detections; YuNet: the best-scoring box, as docs/faces.md's tables).
 A find answer is right when it says ``found`` within one cell (Chebyshev) of the face.
 
@@ -38,6 +39,8 @@ from faces import best_score_cell, TASKS  # noqa: E402, I100
 import find_photos  # noqa: E402, I100
 
 SCALES = (1.0, 0.75, 0.5, 1 / 3)
+# YuNet sees faces from 48 px at full resolution (its scale table): the frame enlarged too
+UPSCALES = (2.0, 1.5)
 # --looks: the enlarged look at a weak finest-scale box (search_scales), as (label, options):
 # without it (nor the faint look), and at other enlargements and scores than the shipped 2x at
 # 0.6; the faint look at a faint small box when nothing answered: without it, and at other
@@ -88,6 +91,13 @@ def run(task: str, detector: str, split: str, n: int, seed: int, starts=(), look
             right = result.decision == 'found' and cells_apart(result.cell, scene.cell) <= 1
             add(f'find --scan {mode}', right, seconds, result.detector_pixels,
                 result.fixations)
+        # the task's smallest face given, as a user who knows it would (--min-face)
+        t0 = time.perf_counter()
+        result = search_one(scene.image, find, settings, np.random.default_rng([seed, i]), False,
+                            min_face=faces[0], scan='coarse')[0]
+        right = result.decision == 'found' and cells_apart(result.cell, scene.cell) <= 1
+        add(f'find --scan coarse --min-face {faces[0]}', right, time.perf_counter() - t0,
+            result.detector_pixels)
         for start in starts:
             t0 = time.perf_counter()
             result = search_scales(scene.image, find.fovea, find.model, table, start=start)
@@ -102,7 +112,7 @@ def run(task: str, detector: str, split: str, n: int, seed: int, starts=(), look
             seconds = time.perf_counter() - t0
             right = result.decision == 'found' and cells_apart(result.cell, scene.cell) <= 1
             add(f'find --scan coarse, {label}', right, seconds, result.detector_pixels)
-        for scale in SCALES:
+        for scale in SCALES + (UPSCALES if detector == 'yunet' else ()):
             found = scan(scene.image, find.fovea.detector, grid, scale=scale)
             if detector == 'yunet':
                 cell = best_score_cell(found, scene.image.shape[:2], grid)

@@ -88,7 +88,7 @@ from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
 from ipomdp_gaze.search import answer
 from ipomdp_gaze.vision.detectors import load_factory
 from ipomdp_gaze.vision.image_files import decode_quietly
-from ipomdp_gaze.vision.scales import SCALE_TABLES
+from ipomdp_gaze.vision.scales import finest_scale, SCALE_TABLES
 from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, EMPTY_BY_EVIDENCE,
                                        FIND_SETTINGS, fovea_for_model, full_frame_reason,
                                        full_frame_search, prepare_many, search_all,
@@ -198,11 +198,14 @@ def add_parser(sub):
                         'the detector node bounds its images (max_image_side_px); its pixels '
                         'are then given in the original image')
     p.add_argument('--min-face', type=positive_float, default=None, metavar='PX',
-                   help='with --all: the smallest face side that matters, in the given '
-                        "image's pixels (default 1/10 of its shorter side); the coarse pass "
-                        'runs at the coarsest scale whose calibration sees it, full resolution '
-                        'when none does (faces far below 1/10 on a large image: pass '
-                        '--max-side 0 too, or the resize makes them smaller still)')
+                   help="the smallest face side that matters, in the given image's pixels; "
+                        'with --all (default 1/10 of its shorter side) the coarse pass runs at '
+                        'the coarsest scale whose calibration sees it, full resolution when '
+                        'none does; without --all (--scan coarse; default: full resolution) '
+                        'the ladder ends at that scale, or on the image enlarged until the '
+                        'detector sees such faces (at most 4x) (faces far below 1/10 on a '
+                        'large image: pass --max-side 0 too, or the resize makes them smaller '
+                        'still)')
     p.add_argument('--scan', dest='scan_mode', choices=SCAN_CHOICES, default=SCAN_DEFAULT,
                    help='without --all: coarse (default) runs the detector on the whole image '
                         'from a coarse scale to finer ones until a strong box (looked at again '
@@ -584,7 +587,8 @@ def search_one(image, task, settings, rng, find_all: bool,
     Search one image: the fovea within one full scan's pixels, or the full frame (say why).
 
     ``min_face`` (``--min-face``, in this image's pixels): the smallest face that matters to
-    the many-target search's coarse pass (default 1/10 of the shorter side);
+    the many-target search's coarse pass (default 1/10 of the shorter side) and to the ladder
+    of ``--scan coarse`` (default: it ends at full resolution);
     ``empty_by_evidence``: its rule for cells nobody occupies (:func:`search_many`).
     """
     width, height = image.shape[1], image.shape[0]
@@ -607,7 +611,8 @@ def search_one(image, task, settings, rng, find_all: bool,
     scales = scale_table(task.model) if scan != 'fovea' else None
     if scales is not None and scan == 'coarse':
         return [search_scales(image, task.fovea, task.model, scales,
-                              start=ladder_start(task.model, scales))]
+                              start=ladder_start(task.model, scales),
+                              finest=finest_scale(scales, min_face))]
     if scales is not None:
         prepare_many(task.fovea, task.model, (width, height), scales)      # one-time set-up
         return [search_first(image, task.fovea, task.model, settings, pixel_budget=budget,
@@ -653,6 +658,14 @@ def run(args) -> int:
         grid = task.model.grid
         min_face = None if args.min_face is None else args.min_face / max(scale)
         table = scale_table(task.model) if settings.targets == 'many' else None
+        ladder = scale_table(task.model) if settings.targets != 'many' and not args.all \
+            and args.scan_mode == 'coarse' else None
+        if min_face is not None and ladder is not None \
+                and finest_scale(ladder, min_face) > ladder.rows[-1].scale:
+            _note(f'{path}: faces of {args.min_face:g} px are below the '
+                  f'{ladder.rows[-1].min_side_px:.0f} px from which the {ladder.detector} '
+                  f'table sees faces at full resolution: the ladder ends on the image '
+                  f'enlarged {finest_scale(ladder, min_face):.2g}x')
         if min_face is not None and table is not None and min_face < table.rows[-1].min_side_px:
             _note(f'{path}: faces of {args.min_face:g} px are {min_face:.0f} px in the searched '
                   f'image, below the {table.rows[-1].min_side_px:.0f} px from which the '

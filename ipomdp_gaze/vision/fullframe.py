@@ -27,6 +27,10 @@ from ipomdp_gaze.vision.detector import (as_detections, box_centres_px, DEFAULT_
                                          to_detector_image)
 import numpy as np
 
+# The largest factor a scan enlarges an image by (find's ladder for faces smaller than the
+# detector sees at full resolution, vision.scales.finest_scale).
+MAX_SCALE = 4.0
+
 
 @dataclass(frozen=True, eq=False)
 class ScanResult:
@@ -128,31 +132,32 @@ def scan(image: np.ndarray, detector, grid=(21, 21), scale: float = 1.0,
     grid : Grid or (int, int)
         The grid tiling the image.
     scale : float
-        Resize factor in ``(0, 1]``; the image is resized to ``round(W * scale) x
+        Resize factor in ``(0, MAX_SCALE]``; the image is resized to ``round(W * scale) x
         round(H * scale)`` with ``interpolation`` (default area averaging, the anti-aliased
-        decimation the fovea uses too).
+        decimation the fovea uses too) or, above 1, enlarged bilinearly.
     interpolation : int
-        ``cv2.INTER_*`` flag for the resize.
+        ``cv2.INTER_*`` flag for a reduction.
     min_neighbors : int
         Grouping threshold for OpenCV's answer (3, detectMultiScale's default).
 
     Raises
     ------
     ValueError
-        For a bad image (:func:`to_gray`) or a scale outside ``(0, 1]``.
+        For a bad image (:func:`to_gray`) or a scale outside ``(0, MAX_SCALE]``.
 
     """
     t0 = time.perf_counter()
     grid = grid if isinstance(grid, Grid) else Grid(*grid)
     scale = float(scale)
-    if not (np.isfinite(scale) and 0.0 < scale <= 1.0):
-        raise ValueError(f'scale must be in (0, 1], got {scale!r}')
+    if not (np.isfinite(scale) and 0.0 < scale <= MAX_SCALE):
+        raise ValueError(f'scale must be in (0, {MAX_SCALE:g}], got {scale!r}')
     gray = to_detector_image(image, detector_color(detector), detector_window_px(detector))
     height, width = gray.shape[:2]
     out_width = max(1, int(np.floor(width * scale + 0.5)))
     out_height = max(1, int(np.floor(height * scale + 0.5)))
     if (out_width, out_height) != (width, height):
-        gray = cv2.resize(gray, (out_width, out_height), interpolation=interpolation)
+        gray = cv2.resize(gray, (out_width, out_height),
+                          interpolation=interpolation if scale <= 1.0 else cv2.INTER_LINEAR)
     raw, scores = as_detections(detector(gray))
     group = getattr(detector, 'group', None)
     grouped = as_detections(group(raw, min_neighbors) if callable(group)

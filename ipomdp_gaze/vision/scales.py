@@ -29,7 +29,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 
-from ipomdp_gaze.vision.fullframe import cells_of_points
+from ipomdp_gaze.vision.fullframe import cells_of_points, MAX_SCALE
 import numpy as np
 
 # The smallest face that matters, as a fraction of the image's shorter side: the smallest faces
@@ -138,6 +138,22 @@ def choose_scale(table: ScaleTable, image_px: tuple[int, int],
         if side * row.scale >= row.min_side_px:
             return row.scale
     return table.rows[-1].scale
+
+
+def finest_scale(table: ScaleTable, min_face: float | None = None) -> float:
+    """
+    Return the scale ``find``'s ladder ends at: the table's finest unless ``min_face`` is given.
+
+    With ``min_face`` (px), the coarsest scale of the table that sees faces of that side; when
+    even the finest does not, the image enlarged so that it does (``min_side_px / min_face``
+    times, at most ``fullframe.MAX_SCALE``).
+    """
+    finest = table.rows[-1]
+    if min_face is None:
+        return finest.scale
+    if float(min_face) * finest.scale >= finest.min_side_px:
+        return choose_scale(table, (0, 0), min_face)
+    return min(MAX_SCALE, finest.min_side_px / float(min_face))
 
 
 def coarse_evidence(row: ScaleRow, grid, image_px: tuple[int, int], detector_pixels: int,

@@ -844,6 +844,14 @@ def _best_score(found) -> float:
     return float(np.max(found.scores))
 
 
+def _min_side_px(scales: ScaleTable, scale: float) -> float:
+    """Return the smallest face side (detector input px) a scale sees: its row's, or the finest."""
+    try:
+        return scales.row(scale).min_side_px
+    except ValueError:                          # an enlarged image: as at the finest scale
+        return scales.rows[-1].min_side_px
+
+
 def _split_faint(found, threshold: float, max_side_px: float, image_shape, grid):
     """
     Split a scan into the boxes scoring from ``threshold`` and the best faint one.
@@ -871,16 +879,19 @@ def _enlarged_look(image: np.ndarray, box, image_px, detector, upscale: float):
 def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
                   start: float, confirm: bool = True, look_upscale: float = LOOK_UPSCALE,
                   look_score: float = LOOK_SCORE, faint_score: float = FAINT_SCORE,
-                  faint_look_score: float = FAINT_LOOK_SCORE) -> ImageSearch:
+                  faint_look_score: float = FAINT_LOOK_SCORE,
+                  finest: float | None = None) -> ImageSearch:
     """
     Find the one face of ``find`` by full-frame calls from coarse to fine (``--scan coarse``).
 
     The detector runs on the whole image at ``start`` and then at each finer scale of the
-    table, stopping at the first call with a strong box (YuNet: a score of at least the
-    table's ``strong_score``; Haar: a merged box); at the finest scale any box the fovea's
-    detector keeps answers. With ``confirm`` a strong box of a coarser call answers only if a
-    crop round it (its side on each side) at the next finer scale keeps a box (strong unless
-    that scale is the finest); else the next scale's full-frame call follows. A box of a
+    table up to ``finest`` (default the table's finest; above it, one more call on the image
+    enlarged ``finest`` times: :func:`~ipomdp_gaze.vision.scales.finest_scale` for faces too
+    small for full resolution), stopping at the first call with a strong box (YuNet: a score
+    of at least the table's ``strong_score``; Haar: a merged box); at the finest scale any box
+    the fovea's detector keeps answers. With ``confirm`` a strong box of a coarser call answers
+    only if a crop round it (its side on each side) at the next finer scale keeps a box (strong
+    unless that scale is the finest); else the next scale's full-frame call follows. A box of a
     scoring detector that answers at the finest scale below the table's strong score answers
     only if the same crop, enlarged ``look_upscale`` times (0: no look), keeps a box of at
     least ``look_score`` (a face grows clearer, a texture rarely does). When no box has answered
@@ -895,8 +906,11 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
     t0 = time.perf_counter()
     image_px = check_image(image, fovea)
     grid = fovea.grid
-    rungs = [row.scale for row in scales.rows if row.scale >= start * (1 - 1e-3)] \
-        or [scales.rows[-1].scale]
+    finest = scales.rows[-1].scale if finest is None else float(finest)
+    rungs = [row.scale for row in scales.rows
+             if start * (1 - 1e-3) <= row.scale <= finest * (1 + 1e-3)]
+    if not rungs or finest > rungs[-1] * (1 + 1e-3):
+        rungs.append(finest)
     pixels, box, faint = 0, None, None
     for k, scale in enumerate(rungs):
         last = k == len(rungs) - 1
@@ -907,7 +921,7 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
         if faint_detector is not fovea.detector:
             # the same call keeps faint boxes too: set them aside, answer from the others
             found, faint = _split_faint(found, _fine_score(fovea.detector),
-                                        FAINT_SIDE * scales.rows[-1].min_side_px / scale,
+                                        FAINT_SIDE * _min_side_px(scales, scale) / scale,
                                         image.shape[:2], grid)
         box = _ladder_answer(found, scales.strong_score, last)
         score = _best_score(found) if last else math.nan
