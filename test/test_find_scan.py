@@ -8,7 +8,7 @@ import cv2
 from ipomdp_gaze.commands.find import _Tasks, ladder_start, scale_table, SCAN_DEFAULT, search_one
 from ipomdp_gaze.vision.photos import load_photo
 from ipomdp_gaze.vision.scenes import SceneSet
-from ipomdp_gaze.vision.search import FIND_SETTINGS, search_image, search_scales
+from ipomdp_gaze.vision.search import FIND_SETTINGS, look_factor, search_image, search_scales
 import numpy as np
 import pytest
 
@@ -82,6 +82,14 @@ def test_a_weak_finest_scale_box_answers_only_if_an_enlarged_look_keeps_it():
     crop_h = min(image.shape[0], int(y + h + side)) - max(0, int(y - side))
     extra = looked.detector_pixels - unlooked.detector_pixels
     assert abs(extra - 4 * crop_w * crop_h) <= 2 * (crop_w + crop_h) + 1
+
+
+def test_the_look_sees_the_box_at_128_px_within_half_and_twice():
+    assert look_factor((0, 0, 32, 20), 2.0) == 2.0             # a small box: enlarged twice
+    assert look_factor((0, 0, 64, 64), 2.0) == 2.0
+    assert look_factor((0, 0, 80, 100), 2.0) == 1.28            # its larger side to 128 px
+    assert look_factor((0, 0, 400, 300), 2.0) == 0.5            # a large box: halved at most
+    assert look_factor((0, 0, 32, 32), 1.5) == 1.5              # never above look_upscale
 
 
 def test_an_enlarged_look_keeps_a_weak_face():

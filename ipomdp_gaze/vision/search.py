@@ -76,8 +76,16 @@ import numpy as np
 # strong (kept) or weak (not kept: the fovea's windows decide its cell). On the training groups
 # it keeps every face (lfw 43 and 47 of 48, photo faces 48 and 48, no false face added) and it
 # names 13 false faces instead of 16 on the 432 face-free images.
+# Since the test report of 2026-12-05 the look resizes the crop so that the box is LOOK_SIDE_PX
+# on a side, at most LOOK_UPSCALE times and at least LOOK_MIN_SCALE times (a box of 64 px or less
+# is still enlarged 2x; a large box is no longer enlarged into a crop of millions of pixels).
+# Chosen on the same training material: the ladder's answers on the 432 face-free images 11 -> 9,
+# --all's false faces there 13 -> 13, every training face kept (420 and 840 training scenes,
+# seeds 1 and 2, 420 scenes; the training groups), 1-8% fewer pixels.
 LOOK_UPSCALE = 2.0
 LOOK_SCORE = 0.6
+LOOK_SIDE_PX = 128.0
+LOOK_MIN_SCALE = 0.5
 # The faint look (docs/design.md section 11.4), find without --all: when the ladder ends without
 # an answer, the finest call's best faint box (from FAINT_SCORE, below the detector's own
 # threshold) no larger than FAINT_SIDE times the smallest face side that scale sees (the scale
@@ -746,8 +754,8 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     ``min_face``: the smallest face side that matters, in the image's pixels (default
     :func:`~ipomdp_gaze.vision.scales.min_face_px`, 1/10 of the shorter side), which chooses
     the coarse scale. A full-resolution box of the coarse pass below the table's strong score
-    is strong only if the crop round it, enlarged ``look_upscale`` times (0: no look), keeps a
-    box of ``look_score``; else it is weak.
+    is strong only if the crop round it, resized so that the box is ``LOOK_SIDE_PX`` (at most
+    ``look_upscale`` times; 0: no look), keeps a box of ``look_score``; else it is weak.
 
     Raises
     ------
@@ -867,11 +875,17 @@ def _split_faint(found, threshold: float, max_side_px: float, image_shape, grid)
     return keep_boxes(found, kept, image_shape, grid), faint
 
 
+def look_factor(box, upscale: float) -> float:
+    """Return the resize of the enlarged look at ``box``: to LOOK_SIDE_PX, within its bounds."""
+    return min(upscale, max(LOOK_MIN_SCALE, LOOK_SIDE_PX / max(box[2], box[3])))
+
+
 def _enlarged_look(image: np.ndarray, box, image_px, detector, upscale: float):
-    """Return ``(best score, pixels)`` of the detector on the crop round ``box``, enlarged."""
+    """Return ``(best score, pixels)`` of the detector on the crop round ``box``, resized."""
     x0, y0, x1, y1 = _crop_round(box, image_px)
-    crop = cv2.resize(np.ascontiguousarray(image[y0:y1, x0:x1]), None, fx=upscale, fy=upscale,
-                      interpolation=cv2.INTER_LINEAR)
+    factor = look_factor(box, upscale)
+    crop = cv2.resize(np.ascontiguousarray(image[y0:y1, x0:x1]), None, fx=factor, fy=factor,
+                      interpolation=cv2.INTER_LINEAR if factor >= 1 else cv2.INTER_AREA)
     look = scan(crop, detector, (1, 1), 1.0)
     return _best_score(look), look.detector_pixels
 
@@ -893,8 +907,9 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
     only if a crop round it (its side on each side) at the next finer scale keeps a box (strong
     unless that scale is the finest); else the next scale's full-frame call follows. A box of a
     scoring detector that answers at the finest scale below the table's strong score answers
-    only if the same crop, enlarged ``look_upscale`` times (0: no look), keeps a box of at
-    least ``look_score`` (a face grows clearer, a texture rarely does). When no box has answered
+    only if the same crop, resized so that the box is ``LOOK_SIDE_PX`` (at most ``look_upscale``
+    times, at least ``LOOK_MIN_SCALE``; 0: no look), keeps a box of at least ``look_score`` (a
+    face grows clearer, a texture rarely does). When no box has answered
     by the end, the finest call's best faint box (a score from ``faint_score``, below the
     detector's own threshold; 0: none) no larger than ``FAINT_SIDE`` times the smallest face
     side of the finest scale gets the same look and answers if it keeps ``faint_look_score``
@@ -937,7 +952,7 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
             if box is not None:
                 box = np.asarray(box, dtype=float) + (x0, y0, 0, 0)
         if box is not None and look_upscale and score < scales.strong_score:
-            # a weak box at the finest scale: look at it enlarged
+            # a weak box at the finest scale: look at it again at a side of LOOK_SIDE_PX
             best, spent = _enlarged_look(image, box, image_px, fovea.detector, look_upscale)
             pixels += spent
             if not best >= look_score:
