@@ -42,19 +42,19 @@ SCALES = (1.0, 0.75, 0.5, 1 / 3)
 # YuNet sees faces from 48 px at full resolution (its scale table): the frame enlarged too
 UPSCALES = (2.0, 1.5)
 # --looks: the enlarged look at a weak finest-scale box (search_scales), as (label, options):
-# without it (nor the faint look), and at other enlargements and scores than the shipped 2x at
-# 0.6; the faint look at a faint small box when nothing answered: without it, and at other
-# look scores than the shipped 0.8
+# without it (nor the faint look), and at other bounds and scores than the shipped: the box at
+# 128 px, resized at most 2x (at least 1/2), a box of 0.6; the faint look at a faint small box
+# when nothing answered: without it, and at other look scores than the shipped 0.8
 LOOKS = (('no enlarged look', {'look_upscale': 0}),
          ('no faint look', {'faint_score': 0}),
          ('faint look at 0.6', {'faint_look_score': 0.6}),
          ('faint look at 0.7', {'faint_look_score': 0.7}),
-         ('look 1.5x at 0.5', {'look_upscale': 1.5, 'look_score': 0.5}),
-         ('look 2x at 0.5', {'look_upscale': 2.0, 'look_score': 0.5}),
-         ('look 2x at 0.6 (shipped)', {'look_upscale': 2.0, 'look_score': 0.6}),
-         ('look 2x at 0.7', {'look_upscale': 2.0, 'look_score': 0.7}),
-         ('look 3x at 0.5', {'look_upscale': 3.0, 'look_score': 0.5}),
-         ('look 3x at 0.7', {'look_upscale': 3.0, 'look_score': 0.7}))
+         ('look at most 1.5x, at 0.5', {'look_upscale': 1.5, 'look_score': 0.5}),
+         ('look at most 2x, at 0.5', {'look_upscale': 2.0, 'look_score': 0.5}),
+         ('look at most 2x, at 0.6 (shipped)', {'look_upscale': 2.0, 'look_score': 0.6}),
+         ('look at most 2x, at 0.7', {'look_upscale': 2.0, 'look_score': 0.7}),
+         ('look at most 3x, at 0.5', {'look_upscale': 3.0, 'look_score': 0.5}),
+         ('look at most 3x, at 0.7', {'look_upscale': 3.0, 'look_score': 0.7}))
 # --augmented: face-free images to choose the look on (training only): the face-free training
 # photos and three photos of no split, each at these sizes, 4 rotations, and mirrored
 AUGMENT_PHOTOS = ('horse', 'logo', 'colorwheel')
