@@ -84,12 +84,14 @@ def test_a_weak_finest_scale_box_answers_only_if_an_enlarged_look_keeps_it():
     assert abs(extra - 4 * crop_w * crop_h) <= 2 * (crop_w + crop_h) + 1
 
 
-def test_the_look_sees_the_box_at_128_px_within_half_and_twice():
+def test_the_look_sees_the_box_at_128_px_at_most_twice_and_never_below_its_call():
     assert look_factor((0, 0, 32, 20), 2.0) == 2.0             # a small box: enlarged twice
     assert look_factor((0, 0, 64, 64), 2.0) == 2.0
     assert look_factor((0, 0, 80, 100), 2.0) == 1.28            # its larger side to 128 px
-    assert look_factor((0, 0, 400, 300), 2.0) == 0.5            # a large box: halved at most
+    assert look_factor((0, 0, 400, 300), 2.0) == 1.0            # a large box: as its call saw it
     assert look_factor((0, 0, 32, 32), 1.5) == 1.5              # never above look_upscale
+    assert look_factor((0, 0, 82, 82), 2.0, scale=2.0) == 2.0   # found on the frame enlarged 2x
+    assert look_factor((0, 0, 82, 82), 2.0, scale=3.0) == 3.0
 
 
 def test_an_enlarged_look_keeps_a_weak_face():

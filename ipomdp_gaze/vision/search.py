@@ -77,15 +77,15 @@ import numpy as np
 # it keeps every face (lfw 43 and 47 of 48, photo faces 48 and 48, no false face added) and it
 # names 13 false faces instead of 16 on the 432 face-free images.
 # Since the test report of 2026-12-05 the look resizes the crop so that the box is LOOK_SIDE_PX
-# on a side, at most LOOK_UPSCALE times and at least LOOK_MIN_SCALE times (a box of 64 px or less
-# is still enlarged 2x; a large box is no longer enlarged into a crop of millions of pixels).
-# Chosen on the same training material: the ladder's answers on the 432 face-free images 11 -> 9,
-# --all's false faces there 13 -> 13, every training face kept (420 and 840 training scenes,
-# seeds 1 and 2, 420 scenes; the training groups), 1-8% fewer pixels.
+# on a side, at most LOOK_UPSCALE times and never below the scale of the call that found it (a
+# box of 64 px or less is still enlarged 2x; a large box is no longer enlarged into a crop of a
+# million pixels). Chosen on the same training material: the ladder's answers on the 432
+# face-free images 11 -> 10, --all's false faces there 13 -> 13, every training face kept (420
+# and 840 training scenes, seeds 1 and 2; the training groups; --min-face 24 at 840), 1-7% fewer
+# pixels. Bounded below by 1/2 instead it answers 9 but loses a 134 px face of --min-face 24.
 LOOK_UPSCALE = 2.0
 LOOK_SCORE = 0.6
 LOOK_SIDE_PX = 128.0
-LOOK_MIN_SCALE = 0.5
 # The faint look (docs/design.md section 11.4), find without --all: when the ladder ends without
 # an answer, the finest call's best faint box (from FAINT_SCORE, below the detector's own
 # threshold) no larger than FAINT_SIDE times the smallest face side that scale sees (the scale
@@ -623,8 +623,8 @@ class _Coarse(_Recorder):
                 kept = np.flatnonzero((scores >= self.fine_score) & ~is_strong)
                 if self.look_upscale:
                     looks = [_enlarged_look(self.image, raw[k], self.image_px,
-                                            self.sensor.fovea.detector, self.look_upscale)
-                             for k in kept]
+                                            self.sensor.fovea.detector, self.look_upscale,
+                                            scale) for k in kept]
                     pixels += sum(spent for _, spent in looks)
                     kept = kept[[best >= self.look_score for best, _ in looks]]
                 is_strong[kept] = True
@@ -875,15 +875,21 @@ def _split_faint(found, threshold: float, max_side_px: float, image_shape, grid)
     return keep_boxes(found, kept, image_shape, grid), faint
 
 
-def look_factor(box, upscale: float) -> float:
-    """Return the resize of the enlarged look at ``box``: to LOOK_SIDE_PX, within its bounds."""
-    return min(upscale, max(LOOK_MIN_SCALE, LOOK_SIDE_PX / max(box[2], box[3])))
+def look_factor(box, upscale: float, scale: float = 1.0) -> float:
+    """
+    Return the resize of the enlarged look at ``box``, found by a call at ``scale``.
+
+    The box's larger side to LOOK_SIDE_PX, at most ``upscale`` times and never below the
+    call's own scale (the look does not see the box smaller than the call that found it).
+    """
+    return min(max(upscale, scale), max(scale, LOOK_SIDE_PX / max(box[2], box[3])))
 
 
-def _enlarged_look(image: np.ndarray, box, image_px, detector, upscale: float):
+def _enlarged_look(image: np.ndarray, box, image_px, detector, upscale: float,
+                   scale: float = 1.0):
     """Return ``(best score, pixels)`` of the detector on the crop round ``box``, resized."""
     x0, y0, x1, y1 = _crop_round(box, image_px)
-    factor = look_factor(box, upscale)
+    factor = look_factor(box, upscale, scale)
     crop = cv2.resize(np.ascontiguousarray(image[y0:y1, x0:x1]), None, fx=factor, fy=factor,
                       interpolation=cv2.INTER_LINEAR if factor >= 1 else cv2.INTER_AREA)
     look = scan(crop, detector, (1, 1), 1.0)
@@ -908,7 +914,7 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
     unless that scale is the finest); else the next scale's full-frame call follows. A box of a
     scoring detector that answers at the finest scale below the table's strong score answers
     only if the same crop, resized so that the box is ``LOOK_SIDE_PX`` (at most ``look_upscale``
-    times, at least ``LOOK_MIN_SCALE``; 0: no look), keeps a box of at least ``look_score`` (a
+    times, never below the call's scale; 0: no look), keeps a box of at least ``look_score`` (a
     face grows clearer, a texture rarely does). When no box has answered
     by the end, the finest call's best faint box (a score from ``faint_score``, below the
     detector's own threshold; 0: none) no larger than ``FAINT_SIDE`` times the smallest face
@@ -953,7 +959,8 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
                 box = np.asarray(box, dtype=float) + (x0, y0, 0, 0)
         if box is not None and look_upscale and score < scales.strong_score:
             # a weak box at the finest scale: look at it again at a side of LOOK_SIDE_PX
-            best, spent = _enlarged_look(image, box, image_px, fovea.detector, look_upscale)
+            best, spent = _enlarged_look(image, box, image_px, fovea.detector, look_upscale,
+                                         scale)
             pixels += spent
             if not best >= look_score:
                 box = None
@@ -961,7 +968,8 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
             break
     if box is None and faint is not None:
         # a face too small for the finest scale: its faint small box, enlarged
-        best, spent = _enlarged_look(image, faint, image_px, fovea.detector, look_upscale)
+        best, spent = _enlarged_look(image, faint, image_px, fovea.detector, look_upscale,
+                                     rungs[-1])
         pixels += spent
         if best >= faint_look_score:
             box = faint
