@@ -27,6 +27,23 @@ def near(cell, truth):
     return max(abs(cell[0] - truth[0]), abs(cell[1] - truth[1])) <= 1
 
 
+def crop_size(box, shape):
+    """Return the (width, height) of the crop round a box: its larger side on each side."""
+    x, y, w, h = box
+    side = max(w, h)
+    return (min(shape[1], int(x + w + side)) - max(0, int(x - side)),
+            min(shape[0], int(y + h + side)) - max(0, int(y - side)))
+
+
+def with_and_without(image, **off):
+    """Return YuNet's ladder on ``image`` with ``off`` (a look switched off), then as shipped."""
+    task = tasks('yunet').task((image.shape[1], image.shape[0]))
+    table = scale_table(task.model)
+    start = ladder_start(task.model, table)
+    return (search_scales(image, task.fovea, task.model, table, start=start, **off),
+            search_scales(image, task.fovea, task.model, table, start=start))
+
+
 @pytest.mark.parametrize('detector', ['haar', 'yunet'])
 def test_the_coarse_call_finds_the_face_with_no_fovea_window(scene, detector):
     task = tasks(detector).task((420, 420))
@@ -68,20 +85,14 @@ def test_the_ladder_stops_at_the_first_strong_box(scene):
 def test_a_weak_finest_scale_box_answers_only_if_an_enlarged_look_keeps_it():
     """Training material: coffee upside down leaves a weak full-resolution box on texture."""
     image = np.ascontiguousarray(np.rot90(load_photo('coffee'), 2))
-    task = tasks('yunet').task((image.shape[1], image.shape[0]))
-    table = scale_table(task.model)
-    start = ladder_start(task.model, table)
-    unlooked = search_scales(image, task.fovea, task.model, table, start=start,
-                             look_upscale=0)
-    looked = search_scales(image, task.fovea, task.model, table, start=start)
+    unlooked, looked = with_and_without(image, look_upscale=0)
     assert unlooked.decision == 'found' and looked.decision == 'absent'
-    # the look is one more call on the crop round the box, enlarged twice
-    x, y, w, h = unlooked.faces[0].box
-    side = max(w, h)
-    crop_w = min(image.shape[1], int(x + w + side)) - max(0, int(x - side))
-    crop_h = min(image.shape[0], int(y + h + side)) - max(0, int(y - side))
+    # the look is one more call on the crop round the box, resized by look_factor
+    box = unlooked.faces[0].box
+    factor = look_factor(box, 2.0)
+    crop_w, crop_h = crop_size(box, image.shape)
     extra = looked.detector_pixels - unlooked.detector_pixels
-    assert abs(extra - 4 * crop_w * crop_h) <= 2 * (crop_w + crop_h) + 1
+    assert abs(extra - factor ** 2 * crop_w * crop_h) <= factor * (crop_w + crop_h) + 1
 
 
 def test_the_look_sees_the_box_at_128_px_at_most_twice_and_never_below_its_call():
@@ -97,12 +108,7 @@ def test_the_look_sees_the_box_at_128_px_at_most_twice_and_never_below_its_call(
 def test_an_enlarged_look_keeps_a_weak_face():
     """Training scene 5 (seed 1): the face's only box is weak at full resolution."""
     scene = SceneSet('train', size_px=420, face_px=(60, 140), grid=(21, 21), seed=1)[5]
-    task = tasks('yunet').task((420, 420))
-    table = scale_table(task.model)
-    start = ladder_start(task.model, table)
-    unlooked = search_scales(scene.image, task.fovea, task.model, table, start=start,
-                             look_upscale=0)
-    looked = search_scales(scene.image, task.fovea, task.model, table, start=start)
+    unlooked, looked = with_and_without(scene.image, look_upscale=0)
     assert looked.detector_pixels > unlooked.detector_pixels
     assert looked.decision == unlooked.decision == 'found'
     assert looked.cell == unlooked.cell and near(looked.cell, scene.cell)
@@ -112,25 +118,16 @@ def test_a_face_too_small_for_the_finest_scale_answers_from_its_faint_box():
     """Training scene 4 (seed 1) of faces-840: a 34 px face leaves only a faint box at x1."""
     scene = SceneSet('train', size_px=840, face_px=(24, 140), grid=(21, 21), seed=1)[4]
     assert scene.face_px < 48                  # below the smallest face YuNet's x1 call sees
-    task = tasks('yunet').task((840, 840))
-    table = scale_table(task.model)
-    start = ladder_start(task.model, table)
-    unlooked = search_scales(scene.image, task.fovea, task.model, table, start=start,
-                             faint_score=0)
-    looked = search_scales(scene.image, task.fovea, task.model, table, start=start)
+    unlooked, looked = with_and_without(scene.image, faint_score=0)
     assert unlooked.decision == 'absent'
     assert looked.decision == 'found' and near(looked.cell, scene.cell)
     # the faint look is one call on the crop round the faint box, enlarged twice
-    x, y, w, h = looked.faces[0].box
-    assert max(w, h) <= 64
-    side = max(w, h)
-    crop_w = min(840, int(x + w + side)) - max(0, int(x - side))
-    crop_h = min(840, int(y + h + side)) - max(0, int(y - side))
+    assert max(looked.faces[0].box[2:]) <= 64
+    crop_w, crop_h = crop_size(looked.faces[0].box, scene.image.shape)
     extra = looked.detector_pixels - unlooked.detector_pixels
     assert abs(extra - 4 * crop_w * crop_h) <= 2 * (crop_w + crop_h) + 1
     # a look score the enlarged face does not reach keeps the answer absent, at the same cost
-    strict = search_scales(scene.image, task.fovea, task.model, table, start=start,
-                           faint_look_score=1.01)
+    strict, _ = with_and_without(scene.image, faint_look_score=1.01)
     assert strict.decision == 'absent' and strict.detector_pixels == looked.detector_pixels
 
 
