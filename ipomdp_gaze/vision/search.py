@@ -946,21 +946,23 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
                                         image.shape[:2], grid)
         box = _ladder_answer(found, scales.strong_score, last)
         score = _best_score(found) if last else math.nan
+        seen_at = scale                         # the scale of the call that gave the box
         if box is not None and confirm and not last:
             # look again round the box at the next finer scale: a texture the coarse call took
             # for a face rarely survives
             x0, y0, x1, y1 = _crop_round(box, image_px)
-            look = scan(image[y0:y1, x0:x1], fovea.detector, (1, 1), rungs[k + 1])
+            seen_at = rungs[k + 1]
+            look = scan(image[y0:y1, x0:x1], fovea.detector, (1, 1), seen_at)
             pixels += look.detector_pixels
-            finest = k + 1 == len(rungs) - 1
-            box = _ladder_answer(look, scales.strong_score, finest)
-            score = _best_score(look) if finest else math.nan
+            at_finest = k + 1 == len(rungs) - 1
+            box = _ladder_answer(look, scales.strong_score, at_finest)
+            score = _best_score(look) if at_finest else math.nan
             if box is not None:
                 box = np.asarray(box, dtype=float) + (x0, y0, 0, 0)
         if box is not None and look_upscale and score < scales.strong_score:
             # a weak box at the finest scale: look at it again at a side of LOOK_SIDE_PX
             best, spent = _enlarged_look(image, box, image_px, fovea.detector, look_upscale,
-                                         scale)
+                                         seen_at)
             pixels += spent
             if not best >= look_score:
                 box = None
