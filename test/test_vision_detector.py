@@ -6,7 +6,7 @@ from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.vision import detector as detector_module
 from ipomdp_gaze.vision.detector import (as_boxes, find_cascade, group_boxes, HaarDetector,
                                          REFERENCE_CASCADE, to_gray)
-from ipomdp_gaze.vision.fullframe import cells_of_points, keep_boxes, scan
+from ipomdp_gaze.vision.fullframe import cells_of_points, scan
 import numpy as np
 import pytest
 from skimage import data
@@ -294,22 +294,6 @@ def test_scan_groups_like_opencv_and_answers_with_the_largest_group():
     assert result.cell == GRID.index(340 // 20, 240 // 20)     # 5 raw centres there
     with pytest.raises(ValueError, match='scale'):
         scan(np.zeros((420, 420), np.uint8), FakeDetector(), scale=4.5)
-
-
-def test_keep_boxes_is_the_scan_of_the_kept_boxes_alone():
-    small = [[20, 20, 40, 40]] * 4
-    large = [[200, 300, 80, 80]] * 5
-    image = np.zeros((420, 420), np.uint8)
-    both = scan(image, FakeDetector(small + large))
-    keep = np.array([True] * 4 + [False] * 5)
-    kept = keep_boxes(both, keep, image.shape, GRID)
-    alone = scan(image, FakeDetector(small))
-    for name in ('counts', 'boxes_px', 'grouped_px'):
-        assert np.array_equal(getattr(kept, name), getattr(alone, name)), name
-    assert kept.cell == alone.cell and kept.grouped_cell == alone.grouped_cell
-    assert kept.detector_pixels == both.detector_pixels
-    none = keep_boxes(both, np.zeros(9, bool), image.shape, GRID)
-    assert none.cell is None and none.grouped_cell is None and not none.counts.any()
 
 
 def test_full_frame_haar_scan_finds_the_astronaut(astronaut, haar):

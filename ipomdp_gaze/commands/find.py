@@ -660,12 +660,12 @@ def run(args) -> int:
         table = scale_table(task.model) if settings.targets == 'many' else None
         ladder = scale_table(task.model) if settings.targets != 'many' and not args.all \
             and args.scan_mode == 'coarse' else None
-        if min_face is not None and ladder is not None \
-                and finest_scale(ladder, min_face) > ladder.rows[-1].scale:
+        finest = None if min_face is None or ladder is None else finest_scale(ladder, min_face)
+        if finest is not None and finest > ladder.rows[-1].scale:
             _note(f'{path}: faces of {args.min_face:g} px are below the '
                   f'{ladder.rows[-1].min_side_px:.0f} px from which the {ladder.detector} '
                   f'table sees faces at full resolution: the ladder ends on the image '
-                  f'enlarged {finest_scale(ladder, min_face):.2g}x')
+                  f'enlarged {finest:.2g}x')
         if min_face is not None and table is not None and min_face < table.rows[-1].min_side_px:
             _note(f'{path}: faces of {args.min_face:g} px are {min_face:.0f} px in the searched '
                   f'image, below the {table.rows[-1].min_side_px:.0f} px from which the '

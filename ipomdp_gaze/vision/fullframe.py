@@ -17,7 +17,7 @@ Cells follow the fovea's convention: a point ``(x, y)`` of an ``H x W`` image li
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 import time
 
 import cv2
@@ -71,35 +71,6 @@ class ScanResult:
     detector_pixels: int
     seconds: float
     scores: np.ndarray = None
-
-
-def keep_boxes(found: ScanResult, keep: np.ndarray, image_shape: tuple[int, int],
-               grid: Grid) -> ScanResult:
-    """
-    Return ``found`` with only the raw boxes of mask ``keep`` (counts and cells recomputed).
-
-    A grouped box is kept with its raw box when the detector's grouping returned them one to one
-    (a detector that has suppressed overlaps itself), else when its centre lies in a kept box.
-    """
-    keep = np.asarray(keep, dtype=bool)
-    boxes = found.boxes_px[keep]
-    if len(found.grouped_px) == len(found.boxes_px):
-        grouped = found.grouped_px[keep]
-    else:
-        x, y = box_centres_px(found.grouped_px).reshape(-1, 2).T[:, :, None]
-        inside = (boxes[:, 0] <= x) & (x < boxes[:, 0] + boxes[:, 2]) \
-            & (boxes[:, 1] <= y) & (y < boxes[:, 1] + boxes[:, 3])
-        grouped = found.grouped_px[inside.any(axis=1)]
-    counts = np.bincount(cells_of_points(box_centres_px(boxes), image_shape, grid),
-                         minlength=grid.n_cells).astype(np.int64)
-    grouped_cell = None
-    if len(grouped):
-        largest = int(np.argmax(grouped[:, 2] * grouped[:, 3]))
-        grouped_cell = int(cells_of_points(box_centres_px(grouped[largest]), image_shape,
-                                           grid)[0])
-    return replace(found, counts=counts, cell=int(np.argmax(counts)) if counts.any() else None,
-                   boxes_px=boxes, grouped_px=grouped, grouped_cell=grouped_cell,
-                   scores=None if found.scores is None else found.scores[keep])
 
 
 def cells_of_points(points_px: np.ndarray, image_shape: tuple[int, int], grid: Grid) -> np.ndarray:

@@ -56,7 +56,7 @@ from ipomdp_gaze.vision.detector import box_centres_px, detector_window_px, grou
 from ipomdp_gaze.vision.detectors import detector_from_settings  # noqa: F401 (its old home)
 from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea
 from ipomdp_gaze.vision.fovea_model import check_model, fovea_for_model  # noqa: F401
-from ipomdp_gaze.vision.fullframe import cells_of_points, keep_boxes, scan
+from ipomdp_gaze.vision.fullframe import cells_of_points, scan
 from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evidence,
                                        ScaleTable)
 from ipomdp_gaze.vision.sensors import FoveaSensor
@@ -819,12 +819,17 @@ def search_first(image: np.ndarray, fovea: Fovea, model,
                    seconds=time.perf_counter() - t0)
 
 
-def _ladder_answer(found, strong_score: float, last: bool):
-    """Return the answer box (x, y, w, h) of one rung of :func:`search_scales`, or None."""
+def _ladder_answer(found, strong_score: float, last: bool, keep_from: float = -math.inf):
+    """
+    Return the answer box (x, y, w, h) of one rung of :func:`search_scales`, or None.
+
+    ``keep_from``: at the last rung a scoring detector's best box answers from this score
+    (the fovea's own threshold, when the call also kept faint boxes below it).
+    """
     if found.scores is not None and len(found.boxes_px) and strong_score > 0:
         scores = np.asarray(found.scores, dtype=float)
         best = int(np.argmax(scores))
-        if last or scores[best] >= strong_score:
+        if (last and scores[best] >= keep_from) or scores[best] >= strong_score:
             return found.boxes_px[best]
         return None
     if not len(found.grouped_px):
@@ -856,23 +861,16 @@ def _min_side_px(scales: ScaleTable, scale: float) -> float:
     """Return the smallest face side (detector input px) a scale sees: its row's, or the finest."""
     try:
         return scales.row(scale).min_side_px
-    except ValueError:                          # an enlarged image: as at the finest scale
+    except ValueError:                          # a scale off the table: as at the finest
         return scales.rows[-1].min_side_px
 
 
-def _split_faint(found, threshold: float, max_side_px: float, image_shape, grid):
-    """
-    Split a scan into the boxes scoring from ``threshold`` and the best faint one.
-
-    Return ``(found, faint)``: the scan without boxes scoring below ``threshold``, and the best
-    of those no larger than ``max_side_px`` (None if there is none).
-    """
+def _faint_box(found, threshold: float, max_side_px: float):
+    """Return the best box scoring below ``threshold`` no larger than ``max_side_px``, or None."""
     scores = np.asarray(found.scores, dtype=float)
     boxes = np.asarray(found.boxes_px, dtype=float).reshape(-1, 4)
-    kept = scores >= threshold
-    small = ~kept & (np.max(boxes[:, 2:], axis=1, initial=0) <= max_side_px)
-    faint = boxes[small][int(np.argmax(scores[small]))] if small.any() else None
-    return keep_boxes(found, kept, image_shape, grid), faint
+    small = (scores < threshold) & (np.max(boxes[:, 2:], axis=1, initial=0) <= max_side_px)
+    return boxes[small][int(np.argmax(scores[small]))] if small.any() else None
 
 
 def look_factor(box, upscale: float, scale: float = 1.0) -> float:
@@ -939,12 +937,13 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
             else fovea.detector
         found = scan(image, faint_detector, grid, scale)
         pixels += found.detector_pixels
+        keep_from = -math.inf
         if faint_detector is not fovea.detector:
-            # the same call keeps faint boxes too: set them aside, answer from the others
-            found, faint = _split_faint(found, _fine_score(fovea.detector),
-                                        FAINT_SIDE * _min_side_px(scales, scale) / scale,
-                                        image.shape[:2], grid)
-        box = _ladder_answer(found, scales.strong_score, last)
+            # the same call keeps faint boxes too: they answer only through the faint look
+            keep_from = _fine_score(fovea.detector)
+            faint = _faint_box(found, keep_from,
+                               FAINT_SIDE * _min_side_px(scales, scale) / scale)
+        box = _ladder_answer(found, scales.strong_score, last, keep_from)
         score = _best_score(found) if last else math.nan
         seen_at = scale                         # the scale of the call that gave the box
         if box is not None and confirm and not last:
