@@ -69,15 +69,27 @@ def rgb8_array(msg: Image) -> np.ndarray:
     return buf.reshape(msg.height, msg.step)[:, :3 * msg.width].reshape(msg.height, msg.width, 3)
 
 
-def evidence_image(values, grid: Grid, stamp, frame_id: str = '') -> Image:
-    """Per-cell evidence as a stamped ``32FC1`` image (height = rows, width = cols)."""
-    a = np.ascontiguousarray(values, dtype=np.float32)
+def evidence_image(values, grid: Grid, stamp, frame_id: str = '', offsets=None) -> Image:
+    """
+    Per-cell evidence as a stamped image (height = rows, width = cols).
+
+    ``32FC1``; with ``offsets`` ``(N, 2)``, ``32FC3``: per cell the evidence, then the mean
+    offset ``(row, col)`` in cells of the detections centred in it (NaN where none).
+    """
+    a = np.asarray(values, dtype=np.float32).reshape(-1)
     if a.size != grid.n_cells:
         raise ValueError(f'expected {grid.n_cells} values, got {a.size}')
+    channels = 1
+    if offsets is not None:
+        o = np.asarray(offsets, dtype=np.float32)
+        if o.shape != (grid.n_cells, 2):
+            raise ValueError(f'expected offsets of shape ({grid.n_cells}, 2), got {o.shape}')
+        a = np.concatenate([a[:, None], o], axis=1)
+        channels = 3
     msg = Image(header=Header(stamp=stamp, frame_id=frame_id), height=grid.rows,
-                width=grid.cols, encoding='32FC1', is_bigendian=int(not _LITTLE),
-                step=4 * grid.cols)
-    msg.data = a.tobytes()
+                width=grid.cols, encoding=f'32FC{channels}', is_bigendian=int(not _LITTLE),
+                step=4 * channels * grid.cols)
+    msg.data = np.ascontiguousarray(a).tobytes()
     return msg
 
 
@@ -100,28 +112,42 @@ def read_frame_tag(msg: Image) -> tuple[str, int | None]:
 
 def evidence_from_image(msg: Image, grid: Grid) -> np.ndarray:
     """
-    Read a ``32FC1`` evidence image as float64 values, shape (N,), row-major.
+    Read an evidence image's values as float64, shape (N,), row-major (offsets dropped).
+
+    Raises as :func:`evidence_and_offsets`.
+    """
+    return evidence_and_offsets(msg, grid)[0]
+
+
+def evidence_and_offsets(msg: Image, grid: Grid) -> tuple[np.ndarray, np.ndarray | None]:
+    """
+    Read a ``32FC1`` or ``32FC3`` evidence image: values (N,) and offsets (N, 2) or None.
 
     Raises
     ------
     LayoutError
-        If the encoding is not ``32FC1`` or the size is not ``rows x cols``.
+        If the encoding is neither ``32FC1`` nor ``32FC3`` or the size is not ``rows x cols``.
     EvidenceError
         If the data does not match the declared step and height.
 
     """
-    if msg.encoding.upper() != '32FC1':
-        raise LayoutError(f"evidence image encoding is {msg.encoding!r}, expected '32FC1'")
+    encoding = msg.encoding.upper()
+    if encoding not in ('32FC1', '32FC3'):
+        raise LayoutError(f"evidence image encoding is {msg.encoding!r}, expected '32FC1' "
+                          f"or '32FC3'")
     if (msg.height, msg.width) != grid.shape:
         raise LayoutError(f'evidence image is {msg.height}x{msg.width} (height x width), '
                           f'the grid is {grid.rows}x{grid.cols}')
+    channels = int(encoding[-1])
+    row_bytes = 4 * channels * msg.width
     buf = _uint8(msg.data)
-    if msg.step < 4 * msg.width or buf.size != msg.step * msg.height:
+    if msg.step < row_bytes or buf.size != msg.step * msg.height:
         raise EvidenceError(f'evidence image has {buf.size} bytes, expected step {msg.step} x '
-                            f'height {msg.height} with step >= {4 * msg.width}')
-    rows = buf.reshape(msg.height, msg.step)[:, :4 * msg.width]
+                            f'height {msg.height} with step >= {row_bytes}')
+    rows = buf.reshape(msg.height, msg.step)[:, :row_bytes]
     dtype = np.dtype('>f4' if msg.is_bigendian else '<f4')
-    return np.ascontiguousarray(rows).view(dtype).reshape(-1).astype(np.float64)
+    data = np.ascontiguousarray(rows).view(dtype).reshape(-1, channels).astype(np.float64)
+    return data[:, 0].copy(), (data[:, 1:].copy() if channels == 3 else None)
 
 
 def image_array(msg: Image, max_side_px: int = MAX_IMAGE_SIDE_PX) -> np.ndarray:

@@ -163,6 +163,29 @@ def test_evidence_image_round_trip(big_endian):
     np.testing.assert_array_equal(back, values.astype(np.float32))
 
 
+@pytest.mark.parametrize('big_endian', [False, True])
+def test_evidence_image_with_offsets_round_trip(big_endian):
+    rng = np.random.default_rng(2)
+    values = rng.integers(0, 10, 121).astype(float)
+    offsets = np.where(values[:, None] > 0, rng.uniform(-0.5, 0.5, (121, 2)), np.nan)
+    msg = images.evidence_image(values, GRID, Time(sec=3), 'fixation/4', offsets)
+    assert (msg.height, msg.width, msg.encoding, msg.step) == (11, 11, '32FC3', 132)
+    if big_endian:
+        raw = np.concatenate([values[:, None], offsets], axis=1).astype('>f4').tobytes()
+        msg = Image(height=11, width=11, encoding='32FC3', is_bigendian=1, step=132, data=raw)
+    back, back_offsets = images.evidence_and_offsets(msg, GRID)
+    np.testing.assert_array_equal(back, values.astype(np.float32))
+    np.testing.assert_array_equal(back_offsets, offsets.astype(np.float32))
+    np.testing.assert_array_equal(images.evidence_from_image(msg, GRID), back)
+    plain = images.evidence_and_offsets(images.evidence_image(values, GRID, Time(sec=3)), GRID)
+    assert plain[1] is None
+    with pytest.raises(EvidenceError, match='step'):
+        images.evidence_and_offsets(Image(height=11, width=11, encoding='32FC3', step=44,
+                                          data=np.zeros(121, '<f4').tobytes()), GRID)
+    with pytest.raises(ValueError, match='offsets of shape'):
+        images.evidence_image(values, GRID, Time(sec=3), '', offsets[:5])
+
+
 def test_evidence_image_with_row_padding():
     values = np.arange(121, dtype=np.float32).reshape(11, 11)
     padded = np.zeros((11, 12), dtype='<f4')

@@ -156,24 +156,27 @@ def _angles(msg, head: PanTiltMap) -> tuple[float, float]:
 
 def _frames(bag, grid: Grid) -> list:
     """
-    Return ``(stamp_s, arrival_s, values, kind)`` of every recorded frame, in arrival order.
+    Return ``(stamp_s, arrival_s, values, kind, offsets)`` of every frame, in arrival order.
 
     ``kind`` is ``'scan'`` for a one-time scan (``header.frame_id`` ``scan/<id>``, design §10.3),
-    else ``'fixation'``.
+    else ``'fixation'``; ``offsets`` ``(N, 2)`` from a ``32FC3`` evidence image (design §12.9),
+    else None.
     """
     frames = []
     for m in bag.topic('evidence_image'):
         msg = m.msg
+        channels = 3 if str(msg.encoding).upper() == '32FC3' else 1
         data = np.asarray(msg.data, dtype=np.uint8)
-        rows = data.reshape(msg.height, msg.step)[:, :4 * msg.width]
-        values = np.ascontiguousarray(rows).view('>f4' if msg.is_bigendian else '<f4')
+        rows = data.reshape(msg.height, msg.step)[:, :4 * channels * msg.width]
+        cells = np.ascontiguousarray(rows).view('>f4' if msg.is_bigendian else '<f4')
+        cells = cells.reshape(-1, channels).astype(np.float64)
         stamp = _seconds(msg.header.stamp)
         kind = 'scan' if str(msg.header.frame_id).startswith('scan/') else 'fixation'
-        frames.append((stamp or m.time_ns * 1e-9, m.time_ns * 1e-9,
-                       values.reshape(-1).astype(np.float64), kind))
+        frames.append((stamp or m.time_ns * 1e-9, m.time_ns * 1e-9, cells[:, 0].copy(), kind,
+                       cells[:, 1:].copy() if channels == 3 else None))
     for m in bag.topic('evidence'):
         frames.append((m.time_ns * 1e-9, m.time_ns * 1e-9,
-                       np.asarray(m.msg.data, dtype=np.float64), 'fixation'))
+                       np.asarray(m.msg.data, dtype=np.float64), 'fixation', None))
     frames.sort(key=lambda f: f[1])
     if not frames:
         raise ValueError(f'{bag.path} has no evidence_image or evidence frame to replay')
@@ -261,7 +264,7 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
     say = result.lines.append
     if core.fixation != recorded_cells[0]:
         result.first_difference = 1
-    for stamp, arrival, values, kind in frames:
+    for stamp, arrival, values, kind, offsets in frames:
         if result.first_difference is not None or core.stopped:
             break
         k = core.fixations
@@ -270,7 +273,7 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
         if kind == 'scan':          # the one-time scan of this (the only recorded) search
             step = core.offer_scan(values, core.search_id, now)
         else:
-            step = core.offer(values, stamp, now)
+            step = core.offer(values, stamp, now, offsets=offsets)
         if not step.applied:
             continue
         result.applied += 1

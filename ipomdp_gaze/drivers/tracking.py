@@ -176,7 +176,8 @@ class SessionTracker:
         session = self.session
         dt = 0.0 if self.last_t is None else t_s - self.last_t
         self.last_t = t_s
-        result = session.update(Frame(obs.counts, detector_pixels=obs.detector_pixels), dt_s=dt)
+        result = session.update(Frame(obs.counts, detector_pixels=obs.detector_pixels,
+                                      offsets=obs.offsets), dt_s=dt)
         has = session.decision == 'found'
         event = '' if has == self.had else ('found' if has else 'lost')
         self.had = has
@@ -420,3 +421,51 @@ def with_motion(settings: SearchSettings, sigma_cells: float, jump_prob: float =
     """Return ``settings`` with a moving target's motion (per second)."""
     return replace(settings, motion_sigma_cells=float(sigma_cells),
                    motion_jump_prob=float(jump_prob))
+
+
+def calibrate_position_sigma(split: str = 'train', scenes: int = 100, views: int = 4,
+                             speeds_deg_s=(0.0, 20.0), seed: int = 0,
+                             model: str | None = None) -> dict:
+    """
+    Fit ``motion.position_sigma_cells`` on walks of ``split`` (docs/design.md section 12.9).
+
+    Scene ``i`` walks at a speed drawn uniformly in ``speeds_deg_s`` (as
+    :func:`~ipomdp_gaze.vision.walks.calibrate_motion`); at ``views`` times drawn uniformly
+    while its face is in reach, the head looks at the face's cell (as while tracking), the
+    detector runs on the view, and the detections' mean position around that cell
+    (:func:`~ipomdp_gaze.model.position_filter.measured_position`) is compared with the face
+    centre. ``sigma_cells`` is the root mean square error per axis over the views with a
+    measurement within the gate, ``se_cells`` its standard error (delta method over the
+    squared errors: ``sd(e^2) / (2 sigma sqrt(n))``); also returned: the bias per axis, the
+    views measured and the views taken.
+    """
+    from ipomdp_gaze.model.position_filter import GATE_CELLS, measured_position
+    lo, hi = (check_speed(v) for v in speeds_deg_s)
+    base, policy, values = walk_settings()
+    task = WalkTask.get(base, policy, values.get('observation.file', '') if model is None
+                        else str(model))
+    grid = task.grid
+    rng = np.random.default_rng([7, int(seed)])
+    errors, taken = [], 0
+    for i in range(int(scenes)):
+        speed = lo + rng.random() * (hi - lo)
+        scene = WalkSceneSet(split, task.geometry, seed, speed).scene(i)
+        times = np.arange(0.0, scene.duration_s, 0.05)
+        reach = [t for t in times if scene.truth_at(t).cell is not None]
+        for t in rng.choice(reach, size=min(int(views), len(reach)), replace=False):
+            truth = scene.truth_at(float(t))
+            head = int(grid.index(*truth.cell))
+            obs, _ = task.view(scene, float(t), head)
+            taken += 1
+            z = measured_position(obs.counts, obs.offsets, grid, head)
+            if z is not None and np.max(np.abs(z - np.asarray(truth.cell))) <= GATE_CELLS:
+                errors.append(z - np.asarray(truth.position, dtype=np.float64))
+    e = np.asarray(errors, dtype=np.float64).reshape(-1, 2)
+    if not len(e):
+        raise ValueError('no view measured a position: no face detected on these walks')
+    sq = (e ** 2).reshape(-1)
+    sigma = float(np.sqrt(sq.mean()))
+    se = float(sq.std(ddof=1) / (2 * sigma * np.sqrt(sq.size))) if sq.size > 1 else math.inf
+    return {'sigma_cells': sigma, 'se_cells': se,
+            'bias_cells': [float(v) for v in e.mean(axis=0)],
+            'measured': int(len(e)), 'views': int(taken)}

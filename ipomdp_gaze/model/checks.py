@@ -153,14 +153,19 @@ def check_targets(value, name: str = 'search.targets') -> str:
 
 # motion.track_view: where the head looks while a moving target is found: the search policy's
 # choice, or the peak of the belief predicted motion.lead_s ahead (docs/design.md section 12.4).
-TRACK_VIEWS = ('policy', 'peak')
+TRACK_VIEWS = ('policy', 'peak', 'position')
 
 
 def check_track_view(value, name: str = 'motion.track_view') -> str:
-    """Return ``'policy'`` or ``'peak'``: how a found moving target is looked at."""
+    """Return ``'policy'``, ``'peak'`` or ``'position'``: how a found moving target is seen."""
     if not (isinstance(value, str) and value in TRACK_VIEWS):
         raise ValueError(f"{name} must be one of {', '.join(TRACK_VIEWS)}, got {value!r}")
     return value
+
+
+def check_positive_cells(value, name: str = 'position_sigma_cells') -> float:
+    """Return a length in cells that must be > 0 (a finite number)."""
+    return finite(name, value, positive=True)
 
 
 def check_seconds(value, name: str) -> float:

@@ -172,3 +172,29 @@ def bin_points(centres_uv: np.ndarray, camera: PinholeCamera, grid: Grid, head_r
     observed = observed_cells(camera, grid, head_rc)
     counts = np.where(observed, np.minimum(raw, max_count - 1), np.nan).astype(np.float64)
     return counts, raw, cells
+
+
+def point_offsets(centres_uv: np.ndarray, camera: PinholeCamera, grid: Grid,
+                  head_rc) -> np.ndarray:
+    """
+    Mean offset of a view's points from the centre of the cell they are binned to, per cell.
+
+    Returns ``(N, 2)`` float64 ``(row, col)`` offsets in cells, each within half a cell, NaN
+    for a cell without a point: where in its cell a detected face is (docs/design.md 12.9).
+    """
+    centres = np.asarray(centres_uv, dtype=float).reshape(-1, 2)
+    du, dv = camera.angles_deg(centres[:, 0], centres[:, 1])
+    pos = np.stack([head_rc[0] + dv / grid.spacing_deg, head_rc[1] + du / grid.spacing_deg],
+                   axis=1)
+    cell_rc = np.floor(pos + 0.5)
+    inside = (cell_rc[:, 0] >= 0) & (cell_rc[:, 0] < grid.rows) & (cell_rc[:, 1] >= 0) \
+        & (cell_rc[:, 1] < grid.cols)
+    cells = (cell_rc[inside, 0] * grid.cols + cell_rc[inside, 1]).astype(np.int64)
+    n = np.bincount(cells, minlength=grid.n_cells).astype(np.float64)
+    out = np.full((grid.n_cells, 2), np.nan)
+    has = n > 0
+    for axis in (0, 1):
+        total = np.bincount(cells, weights=pos[inside, axis] - cell_rc[inside, axis],
+                            minlength=grid.n_cells)
+        out[has, axis] = total[has] / n[has]
+    return out

@@ -10,7 +10,9 @@ remapping work:
 - subscribes ``evidence`` (``std_msgs/Float32MultiArray``, one standardised detector response
   per cell, or with ``observation.model: counts`` one detection count per cell; NaN = not
   observed; arrival time counts) and ``evidence_image``
-  (``sensor_msgs/Image`` 32FC1, rows x cols; its header stamp counts, or its arrival when unset),
+  (``sensor_msgs/Image`` 32FC1, rows x cols; its header stamp counts, or its arrival when unset;
+  32FC3 adds per cell the mean offset of its detections, which ``motion.track_view: position``
+  reads: the detector's ``publish_offsets``),
   both best effort and keep-last ``evidence_queue_depth`` (1: the newest frame wins; frames
   dropped on the way are counted from the publisher's sequence numbers);
 - publishes ``pan_tilt`` (``sensor_msgs/JointState``, transient local, depth 1, re-sent every
@@ -534,10 +536,10 @@ class GazeControllerNode(QuietPublishers, Node):
             self._sequences[topic].see(info.get('publication_sequence_number'))
 
     def _on_evidence(self, msg: Float32MultiArray, info) -> None:
-        self._take('evidence', info, grid_arrays.from_multiarray, msg)
+        self._take('evidence', info, _values_only, msg)
 
     def _on_evidence_image(self, msg: Image, info) -> None:
-        self._take('evidence_image', info, images.evidence_from_image, msg, msg.header.stamp,
+        self._take('evidence_image', info, images.evidence_and_offsets, msg, msg.header.stamp,
                    images.read_frame_tag(msg))
 
     def _take(self, topic: str, info, read, msg, stamp=None, tag=('fixation', None)) -> None:
@@ -551,7 +553,7 @@ class GazeControllerNode(QuietPublishers, Node):
         now = self._now_s()
         self._count_drops(topic, info)
         try:
-            values = read(msg, self._config.grid)
+            values, offsets = read(msg, self._config.grid)
         except EvidenceError as exc:
             self._handle(self.core.reject(str(exc)))
             return
@@ -560,7 +562,7 @@ class GazeControllerNode(QuietPublishers, Node):
             self._handle(self.core.offer_scan(values, search_id, now))
             return
         taken = now if stamp is None or stamps.is_zero(stamp) else stamps.to_seconds(stamp)
-        self._handle(self.core.offer(values, taken, now, search_id))
+        self._handle(self.core.offer(values, taken, now, search_id, offsets))
 
     def _handle(self, result) -> None:
         if result.status == 'rejected':
@@ -673,6 +675,11 @@ class GazeControllerNode(QuietPublishers, Node):
         response.message = state if changed else f'already {state}'
         self.get_logger().info(f'gaze control {response.message}')
         return response
+
+
+def _values_only(msg: Float32MultiArray, grid) -> tuple:
+    """Read an ``evidence`` array as ``(values, None)``: it carries no offsets."""
+    return grid_arrays.from_multiarray(msg, grid), None
 
 
 def main(args=None) -> int:

@@ -22,7 +22,10 @@ Relative topic names:
   ``camera`` mode) and ``fixation`` (``std_msgs/Int32MultiArray`` ``[row, col]``, transient
   local: the controller's);
 - publishes ``evidence_image`` (``32FC1``, stamped with the image's capture stamp; NaN = not
-  observed) or, with ``publish_image: false``, ``evidence``; and ``/diagnostics``.
+  observed; with ``publish_offsets`` in ``camera`` mode ``32FC3``: per cell the count and the
+  mean offset ``(row, col)`` of its detections from the cell's centre, in cells, which a
+  tracking controller with ``motion.track_view: position`` reads, docs/design.md section 12.9)
+  or, with ``publish_image: false``, ``evidence``; and ``/diagnostics``.
 
 A malformed image (another encoding, a step or data length that disagrees with the size, an
 empty or oversized image, a stamp that breaks the time sanity rule) is rejected with a throttled
@@ -120,6 +123,10 @@ def detector_params() -> list[Param]:
               'as stale (0: no limit)', float_range=(0.0, 1e6)),
         Param('publish_image', True, T.BOOL,
               'publish stamped 32FC1 evidence_image frames (false: evidence)'),
+        Param('publish_offsets', False, T.BOOL,
+              "camera mode: evidence_image is 32FC3, each cell's count followed by the mean "
+              'offset (row, col) of its detections from the cell centre in cells, NaN where none '
+              '(for motion.track_view: position; read-only)', read_only=True),
         Param('publish_annotated', False, T.BOOL,
               'publish annotated_image (the camera image with the belief, fixations, fovea '
               'windows, detections and the found cell drawn on it, rgb8) and the raw '
@@ -296,9 +303,10 @@ class FovealDetectorNode(QuietPublishers, Node):
         if outcome.status == 'published':
             frame, grid = outcome.frame, self._config.setup.grid
             if self._config.values['publish_image']:
+                offsets = frame.offsets if self._config.values['publish_offsets'] else None
                 self._image_pub.publish(images.evidence_image(
                     frame.counts, grid, frame.token,
-                    images.frame_tag(frame.kind, frame.search_id)))
+                    images.frame_tag(frame.kind, frame.search_id), offsets))
             else:
                 self._evidence_pub.publish(grid_arrays.to_multiarray(frame.counts, grid))
             if self._annotator is not None:

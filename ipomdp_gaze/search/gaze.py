@@ -413,7 +413,7 @@ class GazeController:
         return FrameResult('applied', fixation=cell)
 
     def offer(self, evidence, stamp_s: float, now_s: float | None = None,
-              search_id: int | None = None) -> FrameResult:
+              search_id: int | None = None, offsets=None) -> FrameResult:
         """
         Use, skip or reject one frame of evidence taken at ``stamp_s``.
 
@@ -428,10 +428,12 @@ class GazeController:
         search_id : int, optional
             The search the frame was taken for (a detector that says so); a frame of another
             search is skipped. None: unknown, judged by its time alone.
+        offsets : array (N, 2), optional
+            The mean offset of each cell's detections from its centre (``Frame.offsets``).
 
         """
         try:
-            frame = self.session.checked_frame(evidence)    # the one check of a frame's values
+            frame = self.session.checked_frame(evidence, offsets=offsets)   # checked once
         except EvidenceError as exc:
             return self.reject(str(exc))
         self.received += 1

@@ -46,6 +46,7 @@ from ipomdp_gaze.model.head_time import tour_detour_deg, view_seconds
 from ipomdp_gaze.model.inhibition import policy_choice, unvisited_choice
 from ipomdp_gaze.model.motion import Motion, VelocityMotion
 from ipomdp_gaze.model.observation import as_observation, check_evidence, CountObservation
+from ipomdp_gaze.model.position_filter import GATE_CELLS, measured_position, PositionFilter
 from ipomdp_gaze.model.still_evidence import cell_information, StillEvidence
 from ipomdp_gaze.model.stopping import ABSENT, decide, FOUND, initial_log_belief, with_absent
 from ipomdp_gaze.search.settings import parameter_names, settings_class
@@ -124,6 +125,48 @@ def _check_mixture_model(settings: SearchSettings, observation) -> None:
                      f'{getattr(observation, "name", type(observation).__name__)}')
 
 
+def check_offsets(offsets, n_cells: int) -> np.ndarray | None:
+    """
+    Return a frame's per-cell detection offsets as ``(N, 2)`` float64 (None stays None).
+
+    Raises
+    ------
+    EvidenceError
+        If the shape is not ``(N, 2)`` or an offset is not NaN and not within half a cell.
+
+    """
+    if offsets is None:
+        return None
+    values = np.asarray(offsets, dtype=np.float64)
+    if values.shape != (n_cells, 2):
+        raise EvidenceError(f'offsets must have shape ({n_cells}, 2), got {values.shape}')
+    seen = values[~np.isnan(values)]
+    if seen.size and not (np.isfinite(seen).all() and np.abs(seen).max() <= 0.5 + 1e-6):
+        raise EvidenceError('offsets must be NaN or within half a cell of the centre')
+    return values
+
+
+def _position_settings(settings: SearchSettings) -> tuple:
+    return (settings.motion_track_view, settings.motion_position_sigma_cells,
+            settings.motion_turn_prob, settings.motion_speed_cells, settings.motion_sigma_cells)
+
+
+def _position_filter(settings: SearchSettings) -> PositionFilter | None:
+    """
+    ``motion.track_view: position``'s filter (docs/design.md section 12.9), else None.
+
+    The velocity changes at ``motion.turn_prob`` per second to a new draw of the prior (per
+    axis standard deviation ``motion.speed_cells``), a change of variance ``2 speed^2`` on
+    average: the filter's velocity random walk is ``q = 2 turn_prob speed^2``.
+    """
+    if settings.motion_track_view != 'position':
+        return None
+    speed = settings.motion_speed_cells
+    return PositionFilter(settings.motion_position_sigma_cells,
+                          2.0 * settings.motion_turn_prob * speed ** 2,
+                          settings.motion_sigma_cells, speed)
+
+
 def start_index(grid: Grid, settings: SearchSettings) -> int | None:
     """Return the cell index of ``settings.start_cell`` on ``grid``, or None (the default rule)."""
     settings.check_grid(grid)
@@ -141,9 +184,11 @@ class Frame:
     Gaussian model, a detection count for a count model; NaN means not observed. ``kind`` is
     ``'fixation'`` (taken at the session's current fixation) or ``'scan'`` (the one-time scan).
     ``detector_pixels`` and ``seconds`` are what producing it cost; ``detections`` any boxes
-    the sensor wants drivers to draw or record. A frame built by
-    :meth:`SearchSession.checked_frame` carries the session and model that checked it, so that
-    session does not check it again.
+    the sensor wants drivers to draw or record. ``offsets`` ``(N, 2)``, optional: the mean
+    offset ``(row, col)`` in cells of the detections centred in each cell from its centre (NaN
+    where none), which ``motion.track_view: position`` reads (docs/design.md section 12.9).
+    A frame built by :meth:`SearchSession.checked_frame` carries the session and model that
+    checked it, so that session does not check it again.
     """
 
     values: np.ndarray
@@ -151,6 +196,7 @@ class Frame:
     detector_pixels: int = 0
     seconds: float = 0.0
     detections: tuple = ()
+    offsets: np.ndarray | None = None
     _checked_by: tuple = field(default=(), init=False, repr=False, compare=False)
 
     def summary(self) -> dict:
@@ -302,6 +348,7 @@ class SearchSession:
         self._counts = isinstance(self.observation, CountObservation)
         self._mixture = None
         self._clutter = None
+        self._position = _position_filter(self.settings)
         _check_mixture_model(self.settings, self.observation)
 
     # -- configuration -------------------------------------------------------------------
@@ -319,6 +366,8 @@ class SearchSession:
         self.settings = settings
         if _motion_settings(settings) != _motion_settings(old):
             self.motion = _motion(self.grid, settings)
+        if _position_settings(settings) != _position_settings(old):
+            self._position = _position_filter(settings)
         self._changed()                 # the answer's square follows found_radius and motion
         mixture_changed = _mixture_settings(settings) != _mixture_settings(old)
         if mixture_changed or settings.moving != old.moving:
@@ -481,9 +530,9 @@ class SearchSession:
             self.observation.counts(obs)
         return obs
 
-    def checked_frame(self, values, kind: str = 'fixation') -> Frame:
+    def checked_frame(self, values, kind: str = 'fixation', offsets=None) -> Frame:
         """
-        Return ``Frame(values, kind)`` checked here, once (:meth:`check_frame`).
+        Return ``Frame(values, kind, offsets=offsets)`` checked here, once (:meth:`check_frame`).
 
         :meth:`update` and :meth:`scan` take it without checking it again while the session
         assumes the same model. For a driver that must know whether a frame is usable before
@@ -497,7 +546,8 @@ class SearchSession:
             With the reason, as :meth:`check_frame`.
 
         """
-        frame = Frame(self.check_frame(values), kind=kind)
+        frame = Frame(self.check_frame(values), kind=kind,
+                      offsets=check_offsets(offsets, self.grid.n_cells))
         object.__setattr__(frame, '_checked_by', (self, self.observation))
         return frame
 
@@ -529,6 +579,7 @@ class SearchSession:
             self._mixture.reset()
         if self._clutter is not None:
             self._clutter.reset()
+        self._position = _position_filter(self.settings)
         self._search = _Search(log_b, log_b.copy(), np.zeros(self.grid.n_cells, dtype=bool))
         self._event('reset', settings=self.settings.to_parameters())
 
@@ -657,6 +708,7 @@ class SearchSession:
             raise OrderError(f'the search has ended ({search.decision}); reset starts a new one')
         try:
             obs = self._frame_values(frame)
+            offsets = check_offsets(frame.offsets, self.grid.n_cells)
             term = self.observation.log_likelihood_ratio(obs, search.fixation)
         except EvidenceError as exc:
             return self._result('rejected', reason=str(exc))
@@ -683,6 +735,7 @@ class SearchSession:
         search.path.append(search.fixation)
         search.visited[search.fixation] = True
         fired = self._decide()
+        self._follow(obs, offsets, dt_s)
         if not search.ended:
             following = self._choose()
             if following is None:
@@ -765,6 +818,35 @@ class SearchSession:
         search.decision, search.reason, search.ended = decision, reason, True
         return decision
 
+    def _follow(self, obs: np.ndarray, offsets, dt_s: float) -> None:
+        """
+        Move ``motion.track_view: position``'s filter on by a frame (docs/design.md 12.9).
+
+        It runs while the target is found: predicted over ``dt_s``, started or updated with the
+        detections' mean position around the belief's peak, and dropped when the target is not
+        found or it strays more than :data:`GATE_CELLS` from the peak (the cell belief decides
+        which cell; the filter only where in it).
+        """
+        position = self._position
+        if position is None:
+            return
+        if self._search.decision != 'found' or not self.motion.active:
+            position.reset()
+            return
+        peak = int(np.argmax(self._cells()))
+        peak_rc = np.asarray(self.grid.cell(peak), dtype=np.float64)
+        z = None if offsets is None else measured_position(obs, offsets, self.grid, peak)
+        if z is not None and np.max(np.abs(z - peak_rc)) > GATE_CELLS:
+            z = None
+        position.predict(dt_s)
+        if position.started and np.max(np.abs(position.x - peak_rc)) > GATE_CELLS:
+            position.reset()
+        if z is not None:
+            if position.started:
+                position.update(z)
+            else:
+                position.start(z)
+
     def _predicted_peak(self) -> int:
         """Return the most likely cell of the belief predicted ``motion.lead_s`` ahead."""
         ahead = self.motion.predict_over(self._search.log_belief.copy(),
@@ -796,8 +878,12 @@ class SearchSession:
         search, settings = self._search, self.settings
         if self.policy is None:
             return search.fixation
-        if self.motion.active and settings.motion_track_view == 'peak' \
+        if self.motion.active and settings.motion_track_view != 'policy' \
                 and search.decision == 'found':
+            if self._position is not None and self._position.started:
+                rc = np.round(self._position.ahead(settings.motion_lead_s))
+                rc = np.clip(rc, 0, [self.grid.rows - 1, self.grid.cols - 1]).astype(np.int64)
+                return int(self.grid.index(int(rc[0]), int(rc[1])))
             return self._predicted_peak()
         belief = self._cells()[None, :]
         policy = self.policy

@@ -25,9 +25,9 @@ from dataclasses import dataclass, field, make_dataclass, replace
 from typing import Callable, Mapping
 
 from ipomdp_gaze.model.checks import (check_budget, check_confidence, check_flag,
-                                      check_probability, check_radius, check_seconds,
-                                      check_sigma_cells, check_start_cell, check_targets,
-                                      check_track_view)
+                                      check_positive_cells, check_probability, check_radius,
+                                      check_seconds, check_sigma_cells, check_start_cell,
+                                      check_targets, check_track_view)
 from ipomdp_gaze.model.false_alarms import (check_false_alarm_scales, check_hotspot_prior,
                                             check_hotspot_scale, DEFAULT_HOTSPOT_SCALE)
 from ipomdp_gaze.model.still_evidence import check_repeat_weight
@@ -131,13 +131,20 @@ SCHEMA: tuple[Setting, ...] = (
             'with motion.max_speed_cells: probability per second that the target turns (its '
             'velocity drawn anew)', bounds='in [0, 1)', metavar='P'),
     Setting('motion_track_view', 'motion.track_view', 'str', 'policy', check_track_view,
-            'moving target, once found: policy (the search policy chooses the view) or peak '
-            '(look at the most likely cell of the belief predicted motion.lead_s ahead)',
-            bounds='policy or peak', metavar='policy|peak'),
+            'moving target, once found: policy (the search policy chooses the view), peak '
+            '(look at the most likely cell of the belief predicted motion.lead_s ahead) or '
+            "position (look at the cell of the position the detections' filter predicts "
+            'motion.lead_s ahead; docs/design.md section 12.9)',
+            bounds='policy, peak or position', metavar='policy|peak|position'),
     Setting('motion_lead_s', 'motion.lead_s', 'float', 0.0, check_sigma_cells,
-            'with motion.track_view peak: how far ahead the belief is predicted (the time from '
-            'a frame to the next: saccade, settling and the detector)', bounds='>= 0',
-            metavar='SECONDS'),
+            'with motion.track_view peak or position: how far ahead the target is predicted '
+            '(the time from a frame to the next: saccade, settling and the detector)',
+            bounds='>= 0', metavar='SECONDS'),
+    Setting('motion_position_sigma_cells', 'motion.position_sigma_cells', 'float', 0.1,
+            check_positive_cells,
+            "with motion.track_view position: the standard deviation of the detections' mean "
+            'position around the target, in cells (calibrated on training walks)',
+            bounds='> 0', metavar='CELLS'),
     Setting('motion_keep_probability', 'motion.keep_probability', 'float', 0.0,
             check_probability,
             'moving target: once found, it stays found while the answer holds at least this '

@@ -281,6 +281,8 @@ class Frame:
     ``search_id`` the search it was asked for (None: the request did not say). ``image``,
     ``detections_px`` (raw detection centres ``(M, 2)`` in its pixels), ``windows`` (fovea
     windows) and ``head_rc`` (camera mode) say how it was made, for pictures of the search.
+    ``offsets`` (camera mode): the mean offset ``(row, col)`` in cells of the detections
+    centred in each cell, NaN where none (``ViewObservation.offsets``).
     """
 
     fixation: int | None
@@ -295,6 +297,7 @@ class Frame:
     detections_px: np.ndarray | None = field(default=None, compare=False, repr=False)
     windows: tuple = field(default=(), compare=False, repr=False)
     head_rc: tuple | None = field(default=None, compare=False, repr=False)
+    offsets: np.ndarray | None = field(default=None, compare=False, repr=False)
 
 
 @dataclass(frozen=True)
@@ -543,6 +546,7 @@ class DetectorLoop:
         """Detect and count; the frame's ``seconds`` include the resize on arrival."""
         setup = self.setup
         t0 = time.perf_counter()
+        offsets = None
         try:
             if cell is None:
                 counts, pixels, centres, windows = self._scan(image)
@@ -556,6 +560,7 @@ class DetectorLoop:
                 observation = setup.observer.observe(image, camera, head_rc)
                 counts, pixels = observation.counts, observation.detector_pixels
                 centres, windows = observation.centres_uv, ()
+                offsets = observation.offsets
         except ValueError as exc:
             self._drop_through(stamp_s)
             return self._rejected(str(exc))
@@ -569,7 +574,7 @@ class DetectorLoop:
         return Outcome('published', frame=Frame(
             cell, stamp_s, token, counts, int(pixels), seconds,
             'scan' if cell is None else 'fixation', self.search_id, image, centres, windows,
-            head_rc))
+            head_rc, offsets))
 
     def _scan(self, image) -> tuple[np.ndarray, int, np.ndarray, tuple]:
         """

@@ -33,7 +33,7 @@ import time
 import cv2
 from ipomdp_gaze.model.cell_observation import CellObservation
 from ipomdp_gaze.model.grid import Grid
-from ipomdp_gaze.model.head_camera import bin_points, PinholeCamera
+from ipomdp_gaze.model.head_camera import bin_points, PinholeCamera, point_offsets
 from ipomdp_gaze.vision.detector import (as_detections, box_centres_px, detector_color,
                                          detector_window_px, group_support,
                                          to_detector_image)
@@ -93,6 +93,9 @@ class ViewObservation:
         ``grouped`` cells only: ``(G,)`` cell of each grouped box's centre, -1 off the grid.
     group_support : numpy.ndarray
         ``grouped`` cells only: ``(G,)`` raw boxes each group merged.
+    offsets : numpy.ndarray
+        ``(N, 2)`` mean offset ``(row, col)`` in cells of the detections centred in each cell
+        from its centre, NaN where none (:func:`ipomdp_gaze.model.head_camera.point_offsets`).
 
     """
 
@@ -106,6 +109,7 @@ class ViewObservation:
     scores: np.ndarray = None
     group_cells: np.ndarray = None
     group_support: np.ndarray = None
+    offsets: np.ndarray = None
 
 
 def view_groups(boxes, min_neighbors: int, camera: PinholeCamera, grid: Grid, head,
@@ -198,7 +202,8 @@ class ViewObserver:
             counts = np.where(np.isnan(counts), np.nan, values)
         return ViewObservation(counts, raw, head, centres, cells,
                                int(pixels.shape[0] * pixels.shape[1]),
-                               time.perf_counter() - t0, scores, group_cells, group_support)
+                               time.perf_counter() - t0, scores, group_cells, group_support,
+                               point_offsets(centres, camera, self.grid, head))
 
 
 @dataclass(frozen=True)
