@@ -25,7 +25,7 @@ NODE = 'foveal_detector'
 class Driver:
     """This test as the camera driver and the controller of one detector (in a namespace)."""
 
-    def __init__(self, probe, nodes, namespace: str, mode: str):
+    def __init__(self, probe, nodes, namespace: str, mode: str, extra=()):
         from diagnostic_msgs.msg import DiagnosticArray
         from ipomdp_gaze.harness.watch import LATCHED
         from rclpy.qos import QoSProfile, ReliabilityPolicy
@@ -50,7 +50,7 @@ class Driver:
         self.joint_states = probe.publisher(JointState, f'{namespace}/joint_states')
         self.fixation = probe.publisher(Int32MultiArray, f'{namespace}/fixation', LATCHED)
         self.proc = nodes.start('detector', ['-r', f'__ns:={namespace}', '-p', f'mode:={mode}',
-                                             '-p', 'diagnostics_period_s:=0.2'])
+                                             '-p', 'diagnostics_period_s:=0.2', *extra])
         assert wait_for(lambda: self.image.get_subscription_count() > 0 and self.status, 60), \
             self.proc.output()
 
@@ -97,7 +97,7 @@ def fovea(probe, nodes):
 @pytest.fixture(scope='module')
 def camera(probe, nodes):
     from ipomdp_gaze.vision.detection import build_setup
-    driver = Driver(probe, nodes, '/cam', 'camera')
+    driver = Driver(probe, nodes, '/cam', 'camera', ['-p', 'publish_offsets:=true'])
     driver.setup = build_setup('camera')
     driver.grid = driver.setup.grid
     return driver
@@ -233,6 +233,7 @@ def test_camera_mode_waits_for_camera_info_with_a_warning(camera):
 @pytest.mark.parametrize('seed, offset', [(5, (0, 0)), (6, (1, -1)), (9, (-1, 1))])
 def test_camera_mode_bins_a_face_to_its_cell_and_the_rest_is_nan(camera, seed, offset):
     from ipomdp_gaze.model.head_camera import observed_cells
+    from ipomdp_gaze.msg_adapters import images
     from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, SceneGeometry, shipped_camera
     grid = camera.grid
     scene = PanTiltSceneSet('test', SceneGeometry(grid, shipped_camera()), seed=seed).scene(0)
@@ -240,14 +241,20 @@ def test_camera_mode_bins_a_face_to_its_cell_and_the_rest_is_nan(camera, seed, o
     col = min(max(scene.cell[1] + offset[1], 0), 10)
     head = grid.index(row, col)
     camera.fixate(grid, head)
-    views = []
+    views, n = [], len(camera.frames)
     counts, _ = camera.frame_after(
         lambda: views.append(_pose_frame(camera, scene, head, camera.now())))
     seen = observed_cells(shipped_camera(), grid, (row, col))
     np.testing.assert_array_equal(~np.isnan(counts), seen)
     assert seen.sum() < grid.n_cells
-    want = camera.setup.observer.observe(views[0], shipped_camera(), (row, col)).counts
-    np.testing.assert_array_equal(counts, want)
+    want = camera.setup.observer.observe(views[0], shipped_camera(), (row, col))
+    np.testing.assert_array_equal(counts, want.counts)
+    # publish_offsets: a 32FC3 image whose channels 2-3 are the core's per-cell offsets
+    msg = camera.frames[n][1]
+    assert msg.encoding == '32FC3'
+    _, offsets = images.evidence_and_offsets(msg, grid)
+    np.testing.assert_array_equal(offsets, want.offsets.astype(np.float32))
+    assert np.isfinite(offsets[grid.index(*scene.cell)]).all()
     target = grid.index(*scene.cell)
     assert counts[target] > 0 and counts[target] == np.nanmax(counts)
 
