@@ -45,7 +45,8 @@ from ipomdp_gaze.model.occupancy import (binary_entropy, cell_prior, count_faces
                                          information_table, log_nobody, occupancy,
                                          prior_log_odds)
 from ipomdp_gaze.model.still_evidence import StillEvidence
-from ipomdp_gaze.search.session import Frame, OrderError, SearchSettings, start_index, StepResult
+from ipomdp_gaze.search.session import (check_offsets, Frame, OrderError, SearchSettings,
+                                        start_index, StepResult)
 import numpy as np
 from scipy.ndimage import maximum_filter
 
@@ -239,9 +240,16 @@ class OccupancySession:
             self.observation.counts(obs)
         return obs
 
-    def checked_frame(self, values, kind: str = 'fixation') -> Frame:
-        """Return ``Frame(values, kind)`` checked once (:meth:`check_frame`; EvidenceError)."""
-        return Frame(self.check_frame(values), kind=kind)
+    def checked_frame(self, values, kind: str = 'fixation', offsets=None) -> Frame:
+        """
+        Return ``Frame(values, kind, offsets=offsets)`` checked once (EvidenceError).
+
+        The values as :meth:`check_frame`, the detections' offsets as the single-target
+        session's (:func:`~ipomdp_gaze.search.session.check_offsets`); the many-target belief
+        does not read them.
+        """
+        return Frame(self.check_frame(values), kind=kind,
+                     offsets=check_offsets(offsets, self.grid.n_cells))
 
     def scan(self, frame: Frame) -> StepResult:
         """
