@@ -5,7 +5,8 @@ import json
 from types import SimpleNamespace
 
 import cv2
-from ipomdp_gaze.commands.find import _Tasks, ladder_start, scale_table, SCAN_DEFAULT, search_one
+from ipomdp_gaze.commands.find import (_Tasks, ladder_start, min_face_notes, scale_table,
+                                       SCAN_DEFAULT, search_one, search_route)
 from ipomdp_gaze.vision.photos import load_photo
 from ipomdp_gaze.vision.scenes import SceneSet
 from ipomdp_gaze.vision.search import FIND_SETTINGS, look_factor, search_image, search_scales
@@ -166,6 +167,78 @@ def test_min_face_below_full_resolution_enlarges_the_last_rung(tmp_path, cli_her
     # the ladder from 1/2 to 1, then the frame enlarged 48 / 24 = 2x
     assert enlarged['detector_pixels'] == (420 * 420 + 840 * 840 + 1680 * 1680)
     assert 'the ladder ends on the image enlarged 2x' in result.stderr
+
+
+def brick_png(path, side):
+    """Write the face-free training photo brick (512x512), resized to ``side``, as a PNG."""
+    image = cv2.resize(load_photo('brick'), (side, side), interpolation=cv2.INTER_AREA)
+    cv2.imwrite(str(path), cv2.cvtColor(image, cv2.COLOR_RGB2BGR))
+    return path
+
+
+def test_no_min_face_note_for_an_image_scanned_whole(tmp_path, cli_here):
+    """A small image goes down the full-frame path, which does not use --min-face."""
+    path = brick_png(tmp_path / 'small.png', 200)
+    task = tasks('yunet').task((200, 200))
+    assert search_route(task, (200, 200), FIND_SETTINGS, False)[0] == 'full_frame'
+    # on the ladder 24 px faces would end it on the frame enlarged 2x; with --all they are
+    # below the 48 px of YuNet's table: both notes would be said, were the image not whole
+    for flags in ((), ('--all',)):
+        result = cli_here('find', path, '--min-face', 24, *flags)
+        assert result.returncode == 0, result.stderr
+        assert 'scanned the whole frame once' in result.stderr
+        assert 'faces of 24 px' not in result.stderr
+        assert 'enlarged' not in result.stderr and 'may be missed' not in result.stderr
+
+
+@pytest.mark.parametrize('min_face, enlarged, capped', [(48, 2, False), (16, 4, True)])
+def test_the_min_face_note_quotes_the_searched_images_pixels(tmp_path, cli_here, min_face,
+                                                             enlarged, capped):
+    """Brick at 512 px, searched at 256 (--max-side): faces of N px are N / 2 px there."""
+    path = brick_png(tmp_path / 'brick.png', 512)
+    out = tmp_path / 'out.json'
+    result = cli_here('find', path, '--max-side', 256, '--min-face', min_face, '--json', out)
+    assert result.returncode == 0, result.stderr
+    [entry] = json.loads(out.read_text())['images']
+    # face-free: the ladder ran every rung, from 1/2 to the searched image enlarged
+    assert entry['decision'] == 'absent'
+    assert entry['note'] == f'full frame at 0.5, 1, {enlarged}'
+    assert (f'brick.png: faces of {min_face} px are {min_face // 2} px in the searched image, '
+            f'below the 48 px from which the yunet table sees faces at full resolution: the '
+            f'ladder ends on the image enlarged {enlarged}x') in result.stderr
+    # 8 px faces would need 6x: the ladder stops at the cap and says they may be missed
+    assert ('the most find enlarges an image (they would need 6x): faces of that size may '
+            'still be missed' in result.stderr) == capped
+
+
+def test_the_min_face_note_follows_the_ladders_own_rungs():
+    model = tasks('yunet').task((420, 420)).model
+    assert min_face_notes('a.png', 24, 24, 'ladder', model) == [
+        'a.png: faces of 24 px are below the 48 px from which the yunet table sees faces at full '
+        'resolution: the ladder ends on the image enlarged 2x']
+    # at the cap: 12 px faces are seen at 4x, 10 px ones would need 4.8x
+    [at_cap] = min_face_notes('a.png', 12, 12, 'ladder', model)
+    assert at_cap.endswith('enlarged 4x')
+    [capped] = min_face_notes('a.png', 10, 10, 'ladder', model)
+    assert capped.endswith('the ladder ends on the image enlarged 4x, the most find enlarges '
+                           'an image (they would need 4.8x): faces of that size may still be '
+                           'missed')
+    [slight] = min_face_notes('a.png', 46, 46, 'ladder', model)
+    assert slight.endswith('enlarged 1.04x')                  # not rounded to "1x"
+    # within the ladder's tolerance of full resolution there is no enlarged rung, so no note
+    assert min_face_notes('a.png', 47.99, 47.99, 'ladder', model) == []
+    assert min_face_notes('a.png', 60, 60, 'ladder', model) == []
+    # the coarse pass (--all, --scan many) notes faces below the table's finest side
+    for route in ('many', 'first'):
+        [note] = min_face_notes('a.png', 60, 30, route, model)
+        assert note == ('a.png: faces of 60 px are 30 px in the searched image, below the 48 px '
+                        'from which the yunet table sees faces at full resolution: they may be '
+                        'missed')
+        assert min_face_notes('a.png', 48, 48, route, model) == []
+    # routes that do not use --min-face say nothing
+    for route in ('full_frame', 'all', 'fovea'):
+        assert min_face_notes('a.png', 8, 8, route, model) == []
+    assert min_face_notes('a.png', None, None, 'ladder', model) == []
 
 
 def test_scan_fovea_is_todays_find_bit_for_bit(scene):

@@ -13,7 +13,8 @@ from ipomdp_gaze.vision import search
 from ipomdp_gaze.vision.fovea_model import fovea_for_model
 from ipomdp_gaze.vision.photos import group_photo, load_photo
 from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evidence,
-                                       finest_scale, SCALE_TABLES, ScaleRow, ScaleTable)
+                                       finest_scale, ladder_scales, SCALE_TABLES, ScaleRow,
+                                       ScaleTable)
 from ipomdp_gaze.vision.search import FIND_SETTINGS, search_many
 import numpy as np
 import pytest
@@ -40,6 +41,30 @@ def test_the_ladder_ends_where_the_smallest_face_that_matters_is_seen():
     assert finest_scale(TABLE, 12.0) == 1.0
     assert finest_scale(TABLE, 6.0) == 2.0                   # enlarged until 12 px
     assert finest_scale(TABLE, 1.0) == 4.0                   # at most MAX_SCALE
+
+
+def test_a_min_face_between_two_rows_ends_the_ladder_at_the_finer_row():
+    # 50 px: 12.5 px at 1/4 (which needs 20), 25 px at 1/2 (16): the 1/2 row, not 20 / 50 = 0.4
+    assert finest_scale(TABLE, 50.0) == 0.5
+    assert finest_scale(TABLE, 24.0) == 1.0                  # 12 px at 1/2 (16): full resolution
+    assert finest_scale(TABLE, 9.0) == pytest.approx(12 / 9)  # off the table only above it
+    yunet = SCALE_TABLES['yunet']
+    # 100 px: 25 px at 1/4 (44), 33 at 1/3 (40), 50 at 1/2 (36)
+    assert finest_scale(yunet, 100.0) == 0.5
+    assert finest_scale(yunet, 130.0) == 0.3333              # 43 px at 1/3 (40), 32.5 at 1/4
+
+
+def test_the_ladders_scales():
+    yunet = SCALE_TABLES['yunet']
+    assert ladder_scales(yunet, 0.5) == [0.5, 1.0]
+    assert ladder_scales(yunet, 0.25, 2.0) == [0.25, 0.3333, 0.5, 1.0, 2.0]
+    # finest below the start: the start is not run, the ladder is the one call at finest
+    assert ladder_scales(yunet, 0.5, finest_scale(yunet, 200.0)) == [0.25]
+    assert ladder_scales(yunet, 0.5, 0.5) == [0.5]
+    # an off-table finest between rows is one more call; one within the tolerance of a row is not
+    assert ladder_scales(yunet, 0.25, 0.4) == [0.25, 0.3333, 0.4]
+    assert ladder_scales(yunet, 0.5, 48 / 47.99) == [0.5, 1.0]
+    assert ladder_scales(yunet, 0.5, 48 / 47.9) == [0.5, 1.0, 48 / 47.9]
 
 
 def test_coarse_evidence_marks_strong_cells_occupied_weak_ones_undecided_others_empty():

@@ -23,9 +23,13 @@ finer scale (a texture taken for a face at a coarse scale rarely survives); at f
 any box the detector keeps answers. ``found`` at that box's centre, else ``absent``; no belief
 (``p`` n/a), method ``scales`` (:func:`ipomdp_gaze.vision.search.search_scales`). A face-free
 image pays every scale, about 1.4 full scans of detector pixels (1/16 + 1/9 + 1/4 + 1 and any
-confirming crop). ``--scan many`` answers the most probable face of the many-target search of
-``--all`` (below); ``--scan fovea`` is the paper's single-target search with the fovea (what
-``find`` did before ``--scan``).
+confirming crop). ``--min-face PX`` ends the ladder at the coarsest scale that sees faces of
+that side (one call whose strong box nothing confirms, when the first scale already sees them)
+or on the frame enlarged until the detector does, at most 4x (stderr says so, and when they
+would need more, that they may still be missed: :func:`min_face_notes`). ``--scan many``
+answers the most probable face of the many-target search of ``--all`` (below); ``--scan
+fovea`` is the paper's single-target search with the fovea (what ``find`` did before
+``--scan``).
 
 **Pixels.** The fovea (:func:`ipomdp_gaze.vision.search.search_image`) never spends more
 detector pixels than one full-resolution scan of the image: it stops before a fixation that
@@ -87,8 +91,9 @@ from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
 from ipomdp_gaze.search import answer
 from ipomdp_gaze.vision.detectors import load_factory
+from ipomdp_gaze.vision.fullframe import MAX_SCALE
 from ipomdp_gaze.vision.image_files import decode_quietly
-from ipomdp_gaze.vision.scales import finest_scale, SCALE_TABLES
+from ipomdp_gaze.vision.scales import finest_scale, ladder_scales, SCALE_TABLES
 from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, EMPTY_BY_EVIDENCE,
                                        FIND_SETTINGS, fovea_for_model, full_frame_reason,
                                        full_frame_search, prepare_many, search_all,
@@ -199,13 +204,19 @@ def add_parser(sub):
                         'are then given in the original image')
     p.add_argument('--min-face', type=positive_float, default=None, metavar='PX',
                    help="the smallest face side that matters, in the given image's pixels; "
-                        'with --all (default 1/10 of its shorter side) the coarse pass runs at '
-                        'the coarsest scale whose calibration sees it, full resolution when '
-                        'none does; without --all (--scan coarse; default: full resolution) '
-                        'the ladder ends at that scale, or on the image enlarged until the '
-                        'detector sees such faces (at most 4x) (faces far below 1/10 on a '
-                        'large image: pass --max-side 0 too, or the resize makes them smaller '
-                        'still)')
+                        'with --all or --scan many (default 1/10 of its shorter side) the '
+                        'coarse pass runs at the coarsest scale whose calibration sees it, '
+                        'full resolution when none does; with --scan coarse (default: full '
+                        'resolution) the ladder ends at that scale, or on the image enlarged '
+                        'until the detector sees such faces (at most 4x: smaller ones may '
+                        "still be missed); a side the ladder's first scale or a coarser one "
+                        'already sees (yunet: from 72 px in the searched image) leaves one '
+                        'call, whose strong box answers with no finer look to confirm it (at '
+                        "1/4 yunet's table counts 16x the false detections per Mpx of full "
+                        'resolution); unused by '
+                        '--scan fovea, --all --targets one and images scanned whole (faces '
+                        'far below 1/10 on a large image: pass --max-side 0 too, or the '
+                        'resize makes them smaller still)')
     p.add_argument('--scan', dest='scan_mode', choices=SCAN_CHOICES, default=SCAN_DEFAULT,
                    help='without --all: coarse (default) runs the detector on the whole image '
                         'from a coarse scale to finer ones until a strong box (looked at again '
@@ -580,6 +591,30 @@ def ladder_start(model, scales) -> float:
     return LADDER_START[min(known, key=lambda key: abs(math.log(side / key[1])))]
 
 
+def search_route(task, image_px: tuple[int, int], settings, find_all: bool,
+                 scan: str = SCAN_DEFAULT) -> tuple[str, str]:
+    """
+    Return which search :func:`search_one` runs on an image of ``image_px``, and why whole.
+
+    ``(route, reason)``: ``full_frame`` (a small image: :func:`full_frame_search`, ``reason``
+    its :func:`full_frame_reason`), ``many`` (:func:`search_many`, ``--all``), ``all`` (the old
+    loop, ``--all --targets one``), ``ladder`` (``--scan coarse``: :func:`search_scales`),
+    ``first`` (``--scan many``: :func:`search_first`) or ``fovea`` (``--scan fovea``, or a
+    detector without a scale table: :func:`search_image`); ``reason`` is '' but for
+    ``full_frame``.
+    """
+    reason = full_frame_reason(task.fovea, image_px, calibrated_size(task.model))
+    if reason:
+        return 'full_frame', reason
+    if settings.targets == 'many':
+        return 'many', ''
+    if find_all:
+        return 'all', ''
+    if scan == 'fovea' or scale_table(task.model) is None:
+        return 'fovea', ''
+    return ('ladder' if scan == 'coarse' else 'first'), ''
+
+
 def search_one(image, task, settings, rng, find_all: bool,
                min_face: float | None = None, scan: str = SCAN_DEFAULT,
                empty_by_evidence: bool = EMPTY_BY_EVIDENCE) -> list:
@@ -587,38 +622,75 @@ def search_one(image, task, settings, rng, find_all: bool,
     Search one image: the fovea within one full scan's pixels, or the full frame (say why).
 
     ``min_face`` (``--min-face``, in this image's pixels): the smallest face that matters to
-    the many-target search's coarse pass (default 1/10 of the shorter side) and to the ladder
-    of ``--scan coarse`` (default: it ends at full resolution);
+    the many-target search's coarse pass (``--all``, ``--scan many``; default 1/10 of the
+    shorter side) and to the ladder of ``--scan coarse`` (default: it ends at full
+    resolution); not to the full frame, the old loop or the fovea (:func:`search_route`);
     ``empty_by_evidence``: its rule for cells nobody occupies (:func:`search_many`).
     """
     width, height = image.shape[1], image.shape[0]
-    reason = full_frame_reason(task.fovea, (width, height), calibrated_size(task.model))
-    if reason:
+    route, reason = search_route(task, (width, height), settings, find_all, scan)
+    if route == 'full_frame':
         results = full_frame_search(image, task.fovea, reason, calibrated_size(task.model))
         if settings.targets == 'many':
             return [results[0]]
         return results if find_all else results[:1]
     budget = width * height
-    if settings.targets == 'many':
-        scales = scale_table(task.model)
+    scales = scale_table(task.model)
+    if route == 'many':
         prepare_many(task.fovea, task.model, (width, height), scales)      # one-time set-up
         return [search_many(image, task.fovea, task.model, settings, pixel_budget=budget,
                             scales=scales, min_face=min_face,
                             empty_by_evidence=empty_by_evidence)]
-    if find_all:
+    if route == 'all':
         return search_all(image, task.fovea, task.model, task.policy, settings, rng=rng,
                           pixel_budget=budget)
-    scales = scale_table(task.model) if scan != 'fovea' else None
-    if scales is not None and scan == 'coarse':
+    if route == 'ladder':
         return [search_scales(image, task.fovea, task.model, scales,
                               start=ladder_start(task.model, scales),
                               finest=finest_scale(scales, min_face))]
-    if scales is not None:
+    if route == 'first':
         prepare_many(task.fovea, task.model, (width, height), scales)      # one-time set-up
         return [search_first(image, task.fovea, task.model, settings, pixel_budget=budget,
                              scales=scales, min_face=min_face)]
     return [search_image(image, task.fovea, task.model, task.policy, settings, rng=rng,
                          pixel_budget=budget)]
+
+
+def min_face_notes(path: str, given: float | None, min_face: float | None, route: str,
+                   model) -> list[str]:
+    """
+    Return what stderr says about ``--min-face`` on one image (none: an empty list).
+
+    ``given``: ``--min-face`` in the given image's pixels; ``min_face``: the same side in the
+    searched image (after ``--max-side``), which the notes quote (and ``given`` beside it when
+    the image was resized); ``route``: :func:`search_route`'s. On the ladder (``ladder``),
+    when it ends on the frame enlarged beyond the table's finest row (its own rungs,
+    :func:`~ipomdp_gaze.vision.scales.ladder_scales`, decide), saying so, and at the cap
+    (:data:`~ipomdp_gaze.vision.fullframe.MAX_SCALE`) that such faces may still be missed; on
+    the coarse pass (``many``, ``first``), when the faces are below the side the table sees at
+    full resolution. Nothing on the other routes (a small image scanned whole, the old loop,
+    the fovea), which do not use ``--min-face``.
+    """
+    table = scale_table(model)
+    if min_face is None or table is None or route not in ('ladder', 'many', 'first'):
+        return []
+    finest = table.rows[-1]
+    faces = (f'faces of {given:g} px are' if math.isclose(given, min_face) else
+             f'faces of {given:g} px are {min_face:.3g} px in the searched image,')
+    below = (f'{faces} below the {finest.min_side_px:.0f} px from which the {table.detector} '
+             f'table sees faces at full resolution')
+    if route != 'ladder':
+        return ([f'{path}: {below}: they may be missed'] if min_face < finest.min_side_px
+                else [])
+    rungs = ladder_scales(table, ladder_start(model, table), finest_scale(table, min_face))
+    if not rungs[-1] > finest.scale:
+        return []
+    note = f'{path}: {below}: the ladder ends on the image enlarged {rungs[-1]:.3g}x'
+    need = finest.min_side_px / min_face
+    if need > MAX_SCALE:
+        note += (f', the most find enlarges an image (they would need {need:.3g}x): faces of '
+                 f'that size may still be missed')
+    return [note]
 
 
 def run(args) -> int:
@@ -657,19 +729,10 @@ def run(args) -> int:
             _note(note)
         grid = task.model.grid
         min_face = None if args.min_face is None else args.min_face / max(scale)
-        table = scale_table(task.model) if settings.targets == 'many' else None
-        ladder = scale_table(task.model) if settings.targets != 'many' and not args.all \
-            and args.scan_mode == 'coarse' else None
-        finest = None if min_face is None or ladder is None else finest_scale(ladder, min_face)
-        if finest is not None and finest > ladder.rows[-1].scale:
-            _note(f'{path}: faces of {args.min_face:g} px are below the '
-                  f'{ladder.rows[-1].min_side_px:.0f} px from which the {ladder.detector} '
-                  f'table sees faces at full resolution: the ladder ends on the image '
-                  f'enlarged {finest:.2g}x')
-        if min_face is not None and table is not None and min_face < table.rows[-1].min_side_px:
-            _note(f'{path}: faces of {args.min_face:g} px are {min_face:.0f} px in the searched '
-                  f'image, below the {table.rows[-1].min_side_px:.0f} px from which the '
-                  f'{table.detector} table sees faces at full resolution: they may be missed')
+        route, _ = search_route(task, (image.shape[1], image.shape[0]), settings, args.all,
+                                args.scan_mode)
+        for note in min_face_notes(path, args.min_face, min_face, route, task.model):
+            _note(note)
         results = search_one(image, task, settings, np.random.default_rng([args.seed, i]),
                              args.all, min_face, args.scan_mode)
         searched = results                      # in the searched image's pixels (the plot)

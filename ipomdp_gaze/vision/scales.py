@@ -40,6 +40,10 @@ MIN_FACE_FRACTION = 0.1
 WEAK_SCORE = 0.3
 # A false-detection chance per cell is never taken below this (the tables count few).
 MIN_FALSE = 1e-6
+# Two scales within this relative tolerance are one: a table's row (ScaleTable.row) and a rung
+# of find's ladder (ladder_scales, which also says whether the ladder ends on the enlarged frame,
+# for search_scales and for find's --min-face note alike).
+SCALE_RTOL = 1e-3
 
 
 @dataclass(frozen=True)
@@ -65,7 +69,7 @@ class ScaleTable:
     def row(self, scale: float) -> ScaleRow:
         """Return the row of ``scale`` (ValueError for a scale not in the table)."""
         for row in self.rows:
-            if math.isclose(row.scale, scale, rel_tol=1e-3):
+            if math.isclose(row.scale, scale, rel_tol=SCALE_RTOL):
                 return row
         raise ValueError(f'scale {scale} is not in the {self.detector} table')
 
@@ -146,7 +150,9 @@ def finest_scale(table: ScaleTable, min_face: float | None = None) -> float:
 
     With ``min_face`` (px), the coarsest scale of the table that sees faces of that side; when
     even the finest does not, the image enlarged so that it does (``min_side_px / min_face``
-    times, at most ``fullframe.MAX_SCALE``).
+    times, at most ``fullframe.MAX_SCALE``: below ``min_side_px / MAX_SCALE`` such faces may
+    still be missed). A coarse end is also the ladder's last call, whose strong box no finer
+    look confirms (:func:`ladder_scales`; docs/design.md section 11.4).
     """
     finest = table.rows[-1]
     if min_face is None:
@@ -154,6 +160,26 @@ def finest_scale(table: ScaleTable, min_face: float | None = None) -> float:
     if float(min_face) * finest.scale >= finest.min_side_px:
         return choose_scale(table, (0, 0), min_face)
     return min(MAX_SCALE, finest.min_side_px / float(min_face))
+
+
+def ladder_scales(table: ScaleTable, start: float, finest: float | None = None) -> list:
+    """
+    Return the scales of ``find``'s ladder (the full-frame calls of ``search_scales``).
+
+    The table's rows from ``start`` to ``finest`` (default the table's finest), coarse to fine,
+    each bound within :data:`SCALE_RTOL`; when ``finest`` is not among them (the frame enlarged
+    beyond the table's finest row by :func:`finest_scale`, or a scale between rows) one more
+    call at ``finest`` ends the ladder. With ``finest`` below ``start`` (a ``--min-face`` the
+    table sees at a coarser scale than the ladder's start) ``start`` is not run: the ladder is
+    the one call at ``finest``. The ladder ends on the enlarged frame exactly when its last
+    scale is above the table's finest row.
+    """
+    finest = table.rows[-1].scale if finest is None else float(finest)
+    rungs = [row.scale for row in table.rows
+             if start * (1 - SCALE_RTOL) <= row.scale <= finest * (1 + SCALE_RTOL)]
+    if not rungs or finest > rungs[-1] * (1 + SCALE_RTOL):
+        rungs.append(finest)
+    return rungs
 
 
 def coarse_evidence(row: ScaleRow, grid, image_px: tuple[int, int], detector_pixels: int,

@@ -58,7 +58,7 @@ from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea
 from ipomdp_gaze.vision.fovea_model import check_model, fovea_for_model  # noqa: F401
 from ipomdp_gaze.vision.fullframe import cells_of_points, scan
 from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evidence,
-                                       ScaleTable)
+                                       ladder_scales, ScaleTable)
 from ipomdp_gaze.vision.sensors import FoveaSensor
 import numpy as np
 
@@ -755,7 +755,9 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     :func:`~ipomdp_gaze.vision.scales.min_face_px`, 1/10 of the shorter side), which chooses
     the coarse scale. A full-resolution box of the coarse pass below the table's strong score
     is strong only if the crop round it, resized so that the box is ``LOOK_SIDE_PX`` (at most
-    ``look_upscale`` times; 0: no look), keeps a box of ``look_score``; else it is weak.
+    ``look_upscale`` times and never below the scale of the call that found the box, the
+    table's finest: :func:`look_factor`, 1 to 2x at full resolution; 0: no look), keeps a box
+    of ``look_score``; else it is weak.
 
     Raises
     ------
@@ -858,10 +860,19 @@ def _best_score(found) -> float:
 
 
 def _min_side_px(scales: ScaleTable, scale: float) -> float:
-    """Return the smallest face side (detector input px) a scale sees: its row's, or the finest."""
+    """
+    Return the smallest face side (detector input px) taken as seen at ``scale``.
+
+    A scale of the table (within ``SCALE_RTOL``): its row's. Any other takes the finest row's
+    side, measured only at that row's scale: for the frame enlarged beyond it (``finest`` above
+    the table, ``--min-face``) the side is assumed to hold in the enlarged detector input too;
+    for a ``finest`` between rows or below the coarsest (given to :func:`search_scales`, never
+    by ``find``) it is not its neighbouring rows' side (YuNet: 48 px at 1 against 36-44 px at
+    1/2-1/4).
+    """
     try:
         return scales.row(scale).min_side_px
-    except ValueError:                          # a scale off the table: as at the finest
+    except ValueError:                          # off the table: the finest row's (docstring)
         return scales.rows[-1].min_side_px
 
 
@@ -879,6 +890,10 @@ def look_factor(box, upscale: float, scale: float = 1.0) -> float:
 
     The box's larger side to LOOK_SIDE_PX, at most ``upscale`` times and never below the
     call's own scale (the look does not see the box smaller than the call that found it).
+    Both bounds are factors of the image given to the search, so above 1 (the frame enlarged
+    for ``--min-face``) the look enlarges the call's view at most ``upscale / scale`` times,
+    and from ``scale >= upscale`` (2x) not at all: it scores the box again at the call's own
+    scale, in the crop round it instead of the whole frame (other context, no more detail).
     """
     return min(max(upscale, scale), max(scale, LOOK_SIDE_PX / max(box[2], box[3])))
 
@@ -905,31 +920,37 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
     The detector runs on the whole image at ``start`` and then at each finer scale of the
     table up to ``finest`` (default the table's finest; above it, one more call on the image
     enlarged ``finest`` times: :func:`~ipomdp_gaze.vision.scales.finest_scale` for faces too
-    small for full resolution), stopping at the first call with a strong box (YuNet: a score
-    of at least the table's ``strong_score``; Haar: a merged box); at the finest scale any box
-    the fovea's detector keeps answers. With ``confirm`` a strong box of a coarser call answers
-    only if a crop round it (its side on each side) at the next finer scale keeps a box (strong
-    unless that scale is the finest); else the next scale's full-frame call follows. A box of a
-    scoring detector that answers at the finest scale below the table's strong score answers
-    only if the same crop, resized so that the box is ``LOOK_SIDE_PX`` (at most ``look_upscale``
-    times, never below the call's scale; 0: no look), keeps a box of at least ``look_score`` (a
-    face grows clearer, a texture rarely does). When no box has answered
-    by the end, the finest call's best faint box (a score from ``faint_score``, below the
+    small for full resolution; :func:`~ipomdp_gaze.vision.scales.ladder_scales`). A ``finest``
+    below ``start`` does not run ``start``: the ladder is the one call at ``finest``. The
+    ladder stops at the first call with a strong box (YuNet: a score of at least the table's
+    ``strong_score``; Haar: a merged box); at its last scale (``finest``) any box the fovea's
+    detector keeps answers. With ``confirm`` a strong box of a coarser call answers only if a
+    crop round it (its side on each side) at the next finer scale keeps a box (strong unless
+    that scale is the last); else the next scale's full-frame call follows. A strong box of
+    the last call is never confirmed, so a ``finest`` at or below ``start`` (a coarse end for
+    large faces) answers a strong box of that one coarse call as it is (YuNet's table: 16x the
+    strong false detections per Mpx at 1/4 as at 1). A box of a scoring detector that answers
+    at the last scale below the table's strong score answers only if the same crop, resized
+    so that the box is ``LOOK_SIDE_PX`` (at most ``look_upscale`` times, never below the
+    call's scale: :func:`look_factor`; 0: no look), keeps a box of at least ``look_score`` (a
+    face grows clearer, a texture rarely does). On the frame enlarged beyond the table
+    (``finest`` above 1) that look is no enlargement of what the call saw: at most
+    ``look_upscale / finest`` times its view, and from ``finest >= look_upscale`` (2x) the box
+    scored again at the call's own scale, in the crop round it instead of the whole frame
+    (other context, no more detail); the faint look below likewise. When no box has answered
+    by the end, the last call's best faint box (a score from ``faint_score``, below the
     detector's own threshold; 0: none) no larger than ``FAINT_SIDE`` times the smallest face
-    side of the finest scale gets the same look and answers if it keeps ``faint_look_score``
-    (a face too small for the scale). ``found`` at the best box (the highest score; for a
-    grouping detector the merged box holding most raw detections), else ``absent``. No belief
-    is computed (``probability`` NaN, method ``scales``); ``detector_pixels`` counts every call
-    and crop (a face-free image pays every scale: 1/16 + 1/9 + 1/4 + 1 of a full scan from 1/4).
+    side of the last scale (:func:`_min_side_px`) gets the same look and answers if it keeps
+    ``faint_look_score`` (a face too small for the scale). ``found`` at the best box (the
+    highest score; for a grouping detector the merged box holding most raw detections), else
+    ``absent``. No belief is computed (``probability`` NaN, method ``scales``);
+    ``detector_pixels`` counts every call and crop (a face-free image pays every scale: 1/16 +
+    1/9 + 1/4 + 1 of a full scan from 1/4).
     """
     t0 = time.perf_counter()
     image_px = check_image(image, fovea)
     grid = fovea.grid
-    finest = scales.rows[-1].scale if finest is None else float(finest)
-    rungs = [row.scale for row in scales.rows
-             if start * (1 - 1e-3) <= row.scale <= finest * (1 + 1e-3)]
-    if not rungs or finest > rungs[-1] * (1 + 1e-3):
-        rungs.append(finest)
+    rungs = ladder_scales(scales, start, finest)
     pixels, box, faint = 0, None, None
     for k, scale in enumerate(rungs):
         last = k == len(rungs) - 1
