@@ -128,10 +128,14 @@ def pixel_cells(u, v, camera: PinholeCamera, head_rc, spacing_deg: float):
 
     ``head_rc`` is the head's grid position ``(r_h, c_h)``, an integer cell or a real position.
     """
+    row, col = pixel_positions(u, v, camera, head_rc, spacing_deg)
+    return np.floor(row + 0.5).astype(np.int64), np.floor(col + 0.5).astype(np.int64)
+
+
+def pixel_positions(u, v, camera: PinholeCamera, head_rc, spacing_deg: float):
+    """Grid positions ``(row, col)`` (float arrays, cells) of pixels ``(u, v)``."""
     du, dv = camera.angles_deg(u, v)
-    col = np.floor(head_rc[1] + du / spacing_deg + 0.5).astype(np.int64)
-    row = np.floor(head_rc[0] + dv / spacing_deg + 0.5).astype(np.int64)
-    return row, col
+    return head_rc[0] + dv / spacing_deg, head_rc[1] + du / spacing_deg
 
 
 def view_extent(camera: PinholeCamera, grid: Grid, head_rc) -> tuple[int, int, int, int]:
@@ -183,9 +187,8 @@ def point_offsets(centres_uv: np.ndarray, camera: PinholeCamera, grid: Grid,
     for a cell without a point: where in its cell a detected face is (docs/design.md 12.9).
     """
     centres = np.asarray(centres_uv, dtype=float).reshape(-1, 2)
-    du, dv = camera.angles_deg(centres[:, 0], centres[:, 1])
-    pos = np.stack([head_rc[0] + dv / grid.spacing_deg, head_rc[1] + du / grid.spacing_deg],
-                   axis=1)
+    pos = np.stack(pixel_positions(centres[:, 0], centres[:, 1], camera, head_rc,
+                                   grid.spacing_deg), axis=1)
     cell_rc = np.floor(pos + 0.5)
     inside = (cell_rc[:, 0] >= 0) & (cell_rc[:, 0] < grid.rows) & (cell_rc[:, 1] >= 0) \
         & (cell_rc[:, 1] < grid.cols)

@@ -558,6 +558,13 @@ class SearchSession:
             return frame.values
         return self.check_frame(frame.values)
 
+    def _frame_offsets(self, frame: Frame) -> np.ndarray | None:
+        """Return a frame's checked offsets: checked here unless this session checked them."""
+        checked = frame._checked_by
+        if checked and checked[0] is self:
+            return frame.offsets
+        return check_offsets(frame.offsets, self.grid.n_cells)
+
     def reset(self, *, seed=None) -> None:
         """
         Start a new search from the prior.
@@ -708,7 +715,7 @@ class SearchSession:
             raise OrderError(f'the search has ended ({search.decision}); reset starts a new one')
         try:
             obs = self._frame_values(frame)
-            offsets = check_offsets(frame.offsets, self.grid.n_cells)
+            offsets = self._frame_offsets(frame)
             term = self.observation.log_likelihood_ratio(obs, search.fixation)
         except EvidenceError as exc:
             return self._result('rejected', reason=str(exc))
