@@ -270,9 +270,12 @@ def test_settings_refusals():
     assert SearchSettings().targets == 'one'
     assert SearchSettings.from_parameters({'search.targets': 'many'}).targets == 'many'
     grid = Grid(2, 2)
-    with pytest.raises(ValueError, match='still targets'):
-        OccupancySession(grid, _model(grid), SearchSettings(targets='many',
-                                                            motion_sigma_cells=0.5))
+    moving = OccupancySession(grid, _model(grid), SearchSettings(targets='many',
+                                                                 motion_sigma_cells=0.5))
+    assert moving.motion.active                     # section 12.10: people who move
+    with pytest.raises(ValueError, match='head_tour'):
+        OccupancySession(grid, _model(grid), SearchSettings(targets='many', head_tour=True,
+                                                            head_speed_deg_s=50.0))
     with pytest.raises(ValueError, match='excludes no cells'):
         session = OccupancySession(grid, _model(grid), SearchSettings(targets='many'))
         session.reset()

@@ -400,3 +400,41 @@ def count_faces(log_odds: np.ndarray, grid, occupied: np.ndarray, boxes=None, sc
                           'box': None if box is None else np.asarray(box, dtype=float)})
     faces.sort(key=lambda f: -f['probability'])
     return faces
+
+
+# Predicted log odds are kept at most this far from 0 (P within 1e-13 of 0 or 1).
+MAX_LOG_ODDS = 30.0
+
+
+def predict_occupancy(log_odds: np.ndarray, outside: float, motion, seconds: float,
+                      update: bool = True) -> tuple[np.ndarray, float]:
+    """
+    Predict the occupancy belief over ``seconds`` of the targets' motion: ``(L', outside')``.
+
+    The expected number of targets in each cell, ``m_j = P(x_j = 1)``, and ``outside``, the
+    expected number out of the grid's reach, move exactly as one target's belief and its absent
+    hypothesis do (:meth:`ipomdp_gaze.model.motion.Motion.predict_over`, per-second parameters:
+    walking out of the grid and ``leave_prob`` move mass between the grid and ``outside``): the
+    first moment of independently moving targets (the PHD filter's prediction, Mahler 2003).
+    The step conserves the total, so it runs on the normalised vector. The occupancy is then
+    ``P'_j = m'_j``, clipped below 1. For one target (every other cell empty) that is the exact
+    ``P'_j = P_i T_ij``; for several it is ``1 - prod_i (1 - P_i T_ij)`` (the exact occupancy when
+    cells hold independent targets) plus at most ``sum_{a < b} P_a T_aj P_b T_bj``, the chance that
+    two of them step into one cell (docs/design.md section 12.10). ``update=False``: a look
+    ahead that leaves a walking motion's velocities as they were.
+    """
+    log_odds = np.asarray(log_odds, dtype=float)
+    if not motion.active or seconds <= 0:
+        return log_odds.copy(), float(outside)
+    n = log_odds.shape[-1]
+    log_mass = -np.logaddexp(0.0, -log_odds)                   # log P(x_j = 1)
+    with np.errstate(divide='ignore'):
+        joint = np.append(log_mass, math.log(outside) if outside > 0 else -np.inf)
+    total = float(np.logaddexp.reduce(joint))
+    joint -= total
+    motion.predict_over(joint, seconds, update=update)
+    log_mass = np.minimum(joint[:n] + total, 0.0)
+    with np.errstate(divide='ignore'):
+        predicted = log_mass - np.log(-np.expm1(log_mass))
+    return (np.clip(predicted, -np.inf, MAX_LOG_ODDS),
+            float(np.exp(joint[n] + total)) if np.isfinite(joint[n]) else 0.0)

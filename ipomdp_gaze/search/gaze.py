@@ -117,6 +117,23 @@ class Reacquired:
 
 
 @dataclass(frozen=True)
+class PersonEvent:
+    """
+    A person's event of a moving many-target search: ``found``, ``lost`` or ``reacquired``.
+
+    ``person`` is its number (1, 2, ... in the order found; :mod:`ipomdp_gaze.search.tracks`);
+    ``seconds`` how long it was tracked before ``lost``, or lost before ``reacquired``.
+    """
+
+    kind: str
+    person: int
+    cell: int
+    probability: float
+    fixations: int
+    seconds: float = 0.0
+
+
+@dataclass(frozen=True)
 class GaveUp:
     """The gave-up event: the fixation budget ran out before any decision."""
 
@@ -132,7 +149,9 @@ class FrameResult:
     not applied; ``fixation`` is the new target after an applied frame (None when the search has
     ended: no new target); ``found``, ``absent``, ``gave_up``, ``lost`` and ``reacquired`` are
     set on the frame that fired that event (with motion on, a find after a loss is
-    ``reacquired``, not a second ``found``).
+    ``reacquired``, not a second ``found``). A moving many-target search reports its people's
+    events in ``people`` instead, and ``room_done`` on the frame after which every cell is
+    decided (again).
     """
 
     status: str
@@ -143,6 +162,8 @@ class FrameResult:
     gave_up: GaveUp | None = None
     lost: Lost | None = None
     reacquired: Reacquired | None = None
+    people: tuple = ()
+    room_done: bool = False
 
     @property
     def applied(self) -> bool:
@@ -455,6 +476,8 @@ class GazeController:
             self.skipped += 1
             return FrameResult('skipped', 'taken before the fixation settled')
         dt_s = float(stamp_s) - self.update_time_s
+        if self.follows_people:
+            return self._offer_people(frame, dt_s, stamp_s, now_s)
         # While tracking, the cell the target was last found in: the answer before this frame.
         tracked = self.map_cell if self.motion.active and self.session.decision == 'found' \
             else None
@@ -470,6 +493,32 @@ class GazeController:
             events['lost'] = self._lose(tracked, float(stamp_s))
         self.target_time_s = self.usable_time_s = float(stamp_s if now_s is None else now_s)
         return FrameResult('applied', fixation=step.fixation, **events)
+
+    @property
+    def follows_people(self) -> bool:
+        """Whether this is a moving many-target search (people followed one by one)."""
+        return isinstance(self.session, OccupancySession) and self.motion.active
+
+    def _offer_people(self, frame, dt_s: float, stamp_s: float, now_s) -> FrameResult:
+        """Apply a frame of a moving many-target search; its events are its people's."""
+        was_done = self.session.room_done
+        step = self.session.update(frame, dt_s=dt_s)
+        if not step.applied:
+            self.rejected += 1
+            self.last_rejection = step.reason
+            return FrameResult('rejected', step.reason)
+        self.update_time_s = max(self.update_time_s, float(stamp_s))
+        self.applied += 1
+        people = tuple(PersonEvent(e['event'], e['person'], e['cell'], e['probability'],
+                                   self.fixations, e['seconds'])
+                       for e in self.session.people_events)
+        self.losses += sum(e.kind == 'lost' for e in people)
+        self.reacquisitions += sum(e.kind == 'reacquired' for e in people)
+        gave_up = GaveUp(self.fixations) if step.fired == 'gave_up' else None
+        self.gave_up = gave_up or self.gave_up
+        self.target_time_s = self.usable_time_s = float(stamp_s if now_s is None else now_s)
+        return FrameResult('applied', fixation=step.fixation, gave_up=gave_up, people=people,
+                           room_done=self.session.room_done and not was_done)
 
     def _events(self, fired: str, stamp_s: float) -> dict:
         """Return the events a frame fired: found (or reacquired), absent, gave_up."""

@@ -29,6 +29,19 @@ The same steps and results as :class:`ipomdp_gaze.search.session.SearchSession` 
    ``w_kj = 1`` where view k sees cell j at a more informative offset (ELM kernel) than any view
    so far, ``repeat_weight`` otherwise, and 0 for a cell settled by ``link``.
 
+**Moving targets** (motion on: ``motion.*`` as for one target; docs/design.md section 12.10):
+before each frame the belief is predicted over ``dt_s``
+(:func:`ipomdp_gaze.model.occupancy.predict_occupancy`, people out of reach kept as an expected
+number ``outside``), the frame is added as it is (no still-scene weighting, no inhibition of
+return: a view of a moving scene repeats nothing), and :class:`ipomdp_gaze.search.tracks.Tracks`
+follows each person found (``found``, ``lost``, ``reacquired`` in :attr:`people_events`). The
+search does not end on a decision: ``found`` while anyone is followed, ``absent`` while every
+cell is decided empty; :attr:`room_done` says every cell is decided. The views: each person
+found ``motion.dwell_s`` in turn (``motion.track_view``: the cell of its position filter
+``motion.lead_s`` ahead, or of the occupancy predicted that far ahead), then one view of the
+infomax choice above with the cells around the people followed left out; with nobody found, or
+``motion.track_view: policy``, every view is that choice.
+
 The answer for drivers: :meth:`OccupancySession.faces` (one face per cluster of occupied cells,
 :func:`ipomdp_gaze.model.occupancy.count_faces`). The session imports no ROS, prints and writes
 nothing.
@@ -36,6 +49,7 @@ nothing.
 from __future__ import annotations
 
 from collections import deque
+import math
 
 from ipomdp_gaze.model.belief import argmax_ties_low, EvidenceError
 from ipomdp_gaze.model.head_time import view_seconds
@@ -43,10 +57,12 @@ from ipomdp_gaze.model.motion import Motion
 from ipomdp_gaze.model.observation import as_observation, check_evidence, CountObservation
 from ipomdp_gaze.model.occupancy import (binary_entropy, cell_prior, count_faces, decided,
                                          information_table, log_nobody, occupancy,
-                                         prior_log_odds)
+                                         predict_occupancy, prior_log_odds)
 from ipomdp_gaze.model.still_evidence import StillEvidence
-from ipomdp_gaze.search.session import (check_offsets, Frame, OrderError, SearchSettings,
-                                        start_index, StepResult)
+from ipomdp_gaze.search.session import (check_offsets, Frame, motion_settings, OrderError,
+                                        SearchSettings, start_index, StepResult, target_motion,
+                                        track_filter)
+from ipomdp_gaze.search.tracks import GLANCE, Tracks, Turns
 import numpy as np
 from scipy.ndimage import maximum_filter
 
@@ -56,9 +72,6 @@ MIN_GAIN = 1e-9
 
 def check_many_settings(settings: SearchSettings) -> None:
     """Refuse settings the many-target belief does not model (ValueError naming them)."""
-    if settings.moving:
-        raise ValueError('search.targets many models still targets: set motion.sigma_cells '
-                         'and motion.jump_prob to 0')
     if len(settings.false_alarm_scales) > 1 or settings.hotspot_prior > 0:
         raise ValueError('search.targets many does not model false-alarm scales or hotspots: '
                          'leave search.false_alarm_scales [1.0] and search.hotspot_prior 0')
@@ -115,6 +128,10 @@ class OccupancySession:
             raise ValueError('fixation costs must be finite and > 0')
         self._counts = isinstance(self.observation, CountObservation)
         self._still = StillEvidence(grid.n_cells)
+        self._motion = target_motion(grid, self.settings)
+        self.tracks = Tracks(grid, lambda: track_filter(self.settings))
+        self.turns = Turns(self.settings.motion_dwell_s)
+        self.people_events: tuple = ()
         self._log = deque(maxlen=int(log_size))
         self.rng = np.random.default_rng(0)
         self._state = None
@@ -122,8 +139,8 @@ class OccupancySession:
     # -- configuration -------------------------------------------------------------------
     @property
     def motion(self) -> Motion:
-        """Return the targets' motion: none (the occupancy belief models still targets)."""
-        return Motion(self.grid, 0.0, 0.0)
+        """Return how the targets move (``motion.*``; inactive for still targets)."""
+        return self._motion
 
     def configure(self, settings: SearchSettings) -> None:
         """
@@ -139,6 +156,10 @@ class OccupancySession:
         """
         settings.check_grid(self.grid)
         check_many_settings(settings)
+        if motion_settings(settings) != motion_settings(self.settings):
+            self._motion = target_motion(self.grid, settings)
+        if settings.motion_dwell_s != self.settings.motion_dwell_s:
+            self.turns = Turns(settings.motion_dwell_s)
         self.settings = settings
 
     def set_observation(self, observation) -> None:
@@ -162,6 +183,8 @@ class OccupancySession:
     def log_odds(self) -> np.ndarray:
         """``L_j`` (N,), a copy."""
         s = self._s()
+        if self._motion.active:
+            return s['base'].copy()
         return s['base'] + self._still.log_likelihood_ratio(self.settings.repeat_weight)
 
     @property
@@ -205,8 +228,21 @@ class OccupancySession:
     ended = property(lambda self: self._s()['ended'])
     log = property(lambda self: tuple(self._log))
 
+    @property
+    def room_done(self) -> bool:
+        """Whether every cell is decided (occupied, near a person found, or empty)."""
+        return self._s()['room_done']
+
     def faces(self, boxes=None, scores=None, image_px=None, link: int = 2) -> list[dict]:
-        """Return the faces, each counted once (``occupancy.count_faces``)."""
+        """
+        Return the faces, each counted once (``occupancy.count_faces``).
+
+        Moving targets: the people followed now (:attr:`tracks`), in the order of their
+        numbers, each ``{'cell', 'cells', 'probability', 'box': None, 'person'}``.
+        """
+        if self._motion.active:
+            return [{'cell': t.cell, 'cells': np.array([t.cell]), 'probability': t.probability,
+                     'box': None, 'person': t.person} for t in self.tracks.found]
         return count_faces(self.log_odds, self.grid, self.occupied(), boxes, scores, image_px,
                            link)
 
@@ -217,14 +253,23 @@ class OccupancySession:
             self.rng = seed
         elif seed is not None:
             self.rng = np.random.default_rng(seed)
-        q = cell_prior(self.grid.n_cells, self.settings.absent_prior)
+        n, absent = self.grid.n_cells, self.settings.absent_prior
+        q = cell_prior(n, absent)
         self._still.reset()
-        self._best = np.zeros(self.grid.n_cells)
-        prior = prior_log_odds(self.grid.n_cells, q)
+        self._motion.reset()
+        self.tracks.reset()
+        self.turns.reset()
+        self.people_events = ()
+        self._best = np.zeros(n)
+        prior = prior_log_odds(n, q)
+        # People out of reach: as many, against those in reach, as the absent hypothesis of one
+        # target holds against its cells (a / (1 - a)); an expected number, the grid's -N log(1-q).
+        outside = -n * math.log1p(-q) * absent / (1.0 - absent)
         self._state = {'base': prior, 'prior': prior, 'fixation': None,
                        'fixations': 0, 'path': [], 'scanned': False, 'decision': '',
-                       'reason': '', 'ended': False,
-                       'visited': np.zeros(self.grid.n_cells, dtype=bool)}
+                       'reason': '', 'ended': False, 'outside': outside, 'clock_s': 0.0,
+                       'room_done': False, 'decided_once': False,
+                       'visited': np.zeros(n, dtype=bool)}
         self._event('reset', settings=self.settings.to_parameters(), cell_prior=q)
 
     def exclude(self, cells) -> None:
@@ -305,6 +350,18 @@ class OccupancySession:
         self.grid.cell(int(cell))
         s['fixation'] = int(cell)
 
+    def predict(self, dt_s: float) -> None:
+        """Spread the belief over ``dt_s`` of the targets' motion (nothing for still targets)."""
+        s = self._s()
+        if self._motion.active and dt_s > 0:
+            s['base'], s['outside'] = predict_occupancy(s['base'], s['outside'], self._motion,
+                                                        dt_s)
+
+    @property
+    def outside(self) -> float:
+        """The expected number of people out of the grid's reach (moving targets)."""
+        return float(self._s()['outside'])
+
     def update(self, frame: Frame, dt_s: float = 0.0) -> StepResult:
         """Apply a frame taken at the current fixation; decide; choose the next fixation."""
         s = self._s()
@@ -315,25 +372,35 @@ class OccupancySession:
         k = s['fixation']
         try:
             obs = self.check_frame(frame.values)
+            offsets = check_offsets(frame.offsets, self.grid.n_cells)
             term = self.observation.log_likelihood_ratio(obs, k)
         except EvidenceError as exc:
             return self._result('rejected', reason=str(exc))
-        information = np.where(np.isnan(obs), 0.0, self._view_info[k])
-        self._still.add(term, information)
-        np.maximum(self._best, information, out=self._best)
+        dt_s = max(0.0, float(dt_s))
+        if self._motion.active:
+            self.predict(dt_s)
+            s['base'] = s['base'] + term
+            s['clock_s'] += dt_s
+        else:
+            information = np.where(np.isnan(obs), 0.0, self._view_info[k])
+            self._still.add(term, information)
+            np.maximum(self._best, information, out=self._best)
         s['fixations'] += 1
         s['path'].append(k)
         s['visited'][k] = True
-        fired = self._decide()
+        if self._motion.active:
+            fired = self._decide_moving(obs, offsets, dt_s)
+        else:
+            fired = self._decide()
         if not s['ended']:
-            following = self._choose()
+            following = self._choose_moving(dt_s) if self._motion.active else self._choose()
             if following is None:
                 fired = self._limit('repeat')
             else:
                 s['fixation'] = following
         self._event('frame', fixation=self._rc(k), frame=frame.summary(),
                     belief=self._summary(), decision=s['decision'], fired=fired,
-                    reason=s['reason'])
+                    reason=s['reason'], people=list(self.people_events))
         return self._result('applied', fired=fired)
 
     def stop(self, reason: str) -> StepResult:
@@ -363,6 +430,9 @@ class OccupancySession:
         """
         log_odds = self.log_odds if log_odds is None else log_odds
         info = self.table(log_odds)                                        # (N, N) [k, j]
+        if self._motion.active:
+            followed = self.tracks.followed()
+            return info @ (~followed).astype(float)
         weight = np.where(self._view_info > self._best[None, :], 1.0,
                           self.settings.repeat_weight)
         if self.link > 0:
@@ -397,10 +467,63 @@ class OccupancySession:
             return None
         return int(argmax_ties_low(score))
 
+    def _choose_moving(self, dt_s: float) -> int:
+        """
+        Return the next view with moving targets: a person's turn, else the infomax choice.
+
+        Never None: a moving scene always has something to look at (the current view at worst).
+        """
+        s, settings = self._s(), self.settings
+        found = self.tracks.found
+        if settings.motion_track_view != 'policy' and found:
+            person = self.turns.advance([t.person for t in found], dt_s)
+            if person is not GLANCE:
+                track = next(t for t in found if t.person == person)
+                ahead = None
+                if settings.motion_track_view == 'peak' and settings.motion_lead_s > 0:
+                    ahead, _ = predict_occupancy(s['base'], s['outside'], self._motion,
+                                                 settings.motion_lead_s, update=False)
+                elif settings.motion_track_view == 'peak':
+                    ahead = s['base']
+                return self.tracks.view(track, settings.motion_lead_s, ahead)
+        else:
+            self.turns.reset()
+        costs = self.costs_from(s['fixation'])
+        score = self.gains() / costs
+        if not np.isfinite(score).any() or score.max() <= MIN_GAIN / costs.min():
+            return s['fixation']
+        return int(argmax_ties_low(score))
+
+    def _decide_moving(self, values: np.ndarray, offsets, dt_s: float) -> str:
+        """
+        Follow the people through a frame; return the decision it fired (module docstring).
+
+        Cells are decided on the posterior (``P >= c`` or ``P <= 1 - c``): after a prediction the
+        evidence of a cell is no longer its own. The fixation budget ends a search that has
+        decided nothing yet, as for one moving target.
+        """
+        s, settings = self._s(), self.settings
+        log_odds = s['base']
+        occupied, empty = decided(log_odds, settings.confidence)
+        keep = settings.motion_keep_probability or settings.confidence
+        self.people_events = tuple(self.tracks.step(
+            occupancy(log_odds), occupied, keep, s['clock_s'], dt_s, values, offsets))
+        followed = self.tracks.followed(self.link) if self.link > 0 else \
+            np.zeros(self.grid.n_cells, dtype=bool)
+        s['room_done'] = bool(np.all(self.settled(occupied) | followed | empty))
+        decision = 'found' if self.tracks.found else ('absent' if s['room_done'] else '')
+        fired = decision if decision and decision != s['decision'] else ''
+        s['decision'] = decision
+        s['decided_once'] = s['decided_once'] or bool(decision)
+        if not s['decided_once'] and settings.max_fixations \
+                and s['fixations'] >= settings.max_fixations:
+            fired = self._limit('budget')
+        return fired
+
     def _decided(self, log_odds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Cells decided occupied and empty (N,) (``empty_by_evidence``: the evidence alone)."""
         occupied, empty = decided(log_odds, self.settings.confidence)
-        if self.empty_by_evidence:
+        if self.empty_by_evidence and not self._motion.active:
             empty = empty & decided(log_odds - self._s()['prior'], self.settings.confidence)[1]
         return occupied, empty
 
@@ -418,7 +541,7 @@ class OccupancySession:
     def _limit(self, reason: str) -> str:
         s = self._state
         decision = 'gave_up'
-        if self.settings.decide_at_budget:
+        if self.settings.decide_at_budget and not self._motion.active:
             decision = 'found' if np.any(self.log_odds > 0) else 'absent'
         s['decision'], s['reason'], s['ended'] = decision, reason, True
         return decision

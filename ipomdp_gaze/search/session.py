@@ -90,7 +90,7 @@ def _mixture_settings(settings: SearchSettings) -> tuple:
     return settings.false_alarm_scales, settings.hotspot_prior, settings.hotspot_scale
 
 
-def _motion(grid: Grid, settings: SearchSettings) -> Motion:
+def target_motion(grid: Grid, settings: SearchSettings) -> Motion:
     """Return the target's motion of ``settings`` (per second in the nodes)."""
     if settings.motion_max_speed_cells > 0:
         return VelocityMotion(grid, settings.motion_sigma_cells, settings.motion_jump_prob,
@@ -100,7 +100,7 @@ def _motion(grid: Grid, settings: SearchSettings) -> Motion:
                   settings.motion_leave_prob)
 
 
-def _motion_settings(settings: SearchSettings) -> tuple:
+def motion_settings(settings: SearchSettings) -> tuple:
     """Return what the motion object is built from (a change rebuilds it)."""
     return (settings.motion_sigma_cells, settings.motion_jump_prob, settings.motion_leave_prob,
             settings.motion_max_speed_cells, settings.motion_turn_prob,
@@ -151,7 +151,7 @@ def _position_settings(settings: SearchSettings) -> tuple:
             settings.motion_turn_prob, settings.motion_speed_cells, settings.motion_sigma_cells)
 
 
-def _position_filter(settings: SearchSettings) -> PositionFilter | None:
+def track_filter(settings: SearchSettings) -> PositionFilter | None:
     """
     ``motion.track_view: position``'s filter (docs/design.md section 12.9), else None.
 
@@ -339,7 +339,7 @@ class SearchSession:
         self.policy = policy
         self.settings = settings or SearchSettings()
         self.settings.check_grid(grid)
-        self.motion = _motion(grid, self.settings)
+        self.motion = target_motion(grid, self.settings)
         self._kernel = None
         self._still = StillEvidence(grid.n_cells)
         self._log = deque(maxlen=int(log_size))
@@ -348,7 +348,7 @@ class SearchSession:
         self._counts = isinstance(self.observation, CountObservation)
         self._mixture = None
         self._clutter = None
-        self._position = _position_filter(self.settings)
+        self._position = track_filter(self.settings)
         _check_mixture_model(self.settings, self.observation)
 
     # -- configuration -------------------------------------------------------------------
@@ -364,10 +364,10 @@ class SearchSession:
         _check_mixture_model(settings, self.observation)
         old = self.settings
         self.settings = settings
-        if _motion_settings(settings) != _motion_settings(old):
-            self.motion = _motion(self.grid, settings)
+        if motion_settings(settings) != motion_settings(old):
+            self.motion = target_motion(self.grid, settings)
         if _position_settings(settings) != _position_settings(old):
-            self._position = _position_filter(settings)
+            self._position = track_filter(settings)
         self._changed()                 # the answer's square follows found_radius and motion
         mixture_changed = _mixture_settings(settings) != _mixture_settings(old)
         if mixture_changed or settings.moving != old.moving:
@@ -586,7 +586,7 @@ class SearchSession:
             self._mixture.reset()
         if self._clutter is not None:
             self._clutter.reset()
-        self._position = _position_filter(self.settings)
+        self._position = track_filter(self.settings)
         self._search = _Search(log_b, log_b.copy(), np.zeros(self.grid.n_cells, dtype=bool))
         self._event('reset', settings=self.settings.to_parameters())
 

@@ -150,6 +150,10 @@ SCHEMA: tuple[Setting, ...] = (
             'moving target: once found, it stays found while the answer holds at least this '
             'probability, and is lost below it (0: the confidence)', bounds='in [0, 1)',
             metavar='P'),
+    Setting('motion_dwell_s', 'motion.dwell_s', 'float', 2.0, check_seconds,
+            'search.targets many, moving targets: seconds of views each person found gets in '
+            'turn before the next; after each round one view searches for people not found '
+            'yet (docs/design.md section 12.10)', bounds='> 0', metavar='SECONDS'),
     Setting('start_cell', 'start_cell', 'cell', None, check_start_cell,
             "the first fixation (default: the policy's choice after a scan, else the grid's "
             'centre)', flag='--start', metavar='ROW,COL'),

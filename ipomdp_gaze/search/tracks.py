@@ -1,0 +1,284 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The people a moving many-target search follows: one track each, and the head's time in turns.
+
+With ``search.targets: many`` and motion on (docs/design.md section 12.10) the occupancy belief
+(:mod:`ipomdp_gaze.model.occupancy`) is predicted between frames and updated cell by cell; it says
+where people are, not who is who. :class:`Tracks` keeps who: after each frame every person found
+is looked for within :data:`GATE_CELLS` of where it was (of where its position filter puts it):
+
+- it stays found at the likeliest cell there while that cell and its neighbours (within
+  :data:`SPILL_CELLS`) hold someone with at least the keep probability
+  (``motion.keep_probability``, the confidence when 0): ``1 - prod (1 - P_j)`` over them, so a face stepping from one cell to
+  the next, its probability split between both, is not lost. Those cells are its own (a face's
+  detections spill into its neighbours);
+- otherwise it is ``lost``;
+- an occupied cell (``P >= confidence``) that no found person owns is somebody: each cluster of
+  such cells (within ``link`` cells) is one person, at its likeliest cell. Faces are not told
+  apart, so while someone is lost the person found is taken to be the lost one nearest to it
+  (``reacquired``); with nobody lost it is new (``found``, the next person number).
+
+Each person found has its own ``motion.track_view: position`` filter
+(:class:`ipomdp_gaze.model.position_filter.PositionFilter`), fed with the detections around its
+cell. :class:`Turns` shares the head between them: each person is looked at for
+``motion.dwell_s`` seconds in the order found, and after each round one view (a glance) goes to
+the search for people not yet found.
+
+Pure: no ROS, no clock (times arrive as seconds).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+import math
+
+from ipomdp_gaze.model.occupancy import clusters
+from ipomdp_gaze.model.position_filter import GATE_CELLS as FILTER_GATE_CELLS
+from ipomdp_gaze.model.position_filter import measured_position, PositionFilter
+import numpy as np
+
+# A person found is looked for again within this many cells (Chebyshev) of where it was: a face
+# walking 20 deg/s crosses 2 cells of 10 degrees in the second between two looks at it.
+GATE_CELLS = 2
+# Cells within this many cells of a person's cell are its spill-over, not another person.
+SPILL_CELLS = 1
+# The view of a turn of Turns that looks for people not found yet.
+GLANCE = None
+
+
+@dataclass
+class Track:
+    """One person: its number, cell, probability, whether found, and since when (seconds)."""
+
+    person: int
+    cell: int
+    probability: float
+    found: bool = True
+    since_s: float = 0.0
+    position: PositionFilter | None = None
+
+    def to_dict(self, grid) -> dict:
+        """Plain types: person, cell, row, col, probability, found."""
+        row, col = grid.cell(self.cell)
+        return {'person': self.person, 'cell': int(self.cell), 'row': int(row),
+                'col': int(col), 'probability': float(self.probability), 'found': self.found}
+
+
+def near(grid, cell: int, radius: int) -> np.ndarray:
+    """Cells (N,) within ``radius`` cells (Chebyshev) of ``cell``."""
+    rows, cols = np.divmod(np.arange(grid.n_cells), grid.cols)
+    r, c = divmod(int(cell), grid.cols)
+    return (np.abs(rows - r) <= radius) & (np.abs(cols - c) <= radius)
+
+
+class Tracks:
+    """
+    The people of a moving many-target search (module docstring).
+
+    Parameters
+    ----------
+    grid : Grid
+        The visual array.
+    make_filter : callable
+        Returns a new position filter for a person found, or None (no ``motion.track_view:
+        position``).
+    link : int
+        Occupied cells within this many cells of each other are one person.
+
+    """
+
+    def __init__(self, grid, make_filter=lambda: None, link: int = 2):
+        self.grid = grid
+        self.make_filter = make_filter
+        self.link = int(link)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget everyone: the next person found is person 1."""
+        self.tracks: list[Track] = []
+        self.next_person = 1
+
+    @property
+    def found(self) -> list:
+        """The people found now, in the order of their numbers."""
+        return [t for t in self.tracks if t.found]
+
+    def followed(self, radius: int = GATE_CELLS) -> np.ndarray:
+        """Cells (N,) within ``radius`` cells of a person found."""
+        mask = np.zeros(self.grid.n_cells, dtype=bool)
+        for t in self.found:
+            mask |= near(self.grid, t.cell, radius)
+        return mask
+
+    def step(self, probability: np.ndarray, occupied: np.ndarray, keep: float, t_s: float,
+             dt_s: float = 0.0, values=None, offsets=None) -> list[dict]:
+        """
+        Follow everyone through one frame; return its events (module docstring).
+
+        Parameters
+        ----------
+        probability : array (N,)
+            ``P(x_j = 1)`` after the frame.
+        occupied : bool array (N,)
+            Cells decided occupied (``P >= confidence``).
+        keep : float
+            A person found stays found while its cell holds at least this probability.
+        t_s, dt_s : float
+            The search's clock at the frame, and the time since the frame before.
+        values, offsets : arrays (N,), (N, 2), optional
+            The frame and its detections' offsets, for the position filters.
+
+        Returns
+        -------
+        list of dict
+            ``{'event': 'found' | 'lost' | 'reacquired', 'person', 'cell', 'probability',
+            'seconds'}`` (``seconds``: tracked before ``lost``, lost before ``reacquired``).
+
+        """
+        grid, events = self.grid, []
+        taken = np.zeros(grid.n_cells, dtype=bool)
+        for track in self.found:
+            centre = self._centre(track, dt_s)
+            window = near(grid, centre, GATE_CELLS) & ~taken
+            best = int(np.argmax(np.where(window, probability, -1.0)))
+            held = self.held(probability, best, taken)
+            if window.any() and held >= keep:
+                track.cell, track.probability = best, held
+                taken |= near(grid, best, SPILL_CELLS)
+                self._measure(track, values, offsets)
+                continue
+            track.found = False
+            track.probability = self.held(probability, track.cell, taken)
+            events.append(self._event('lost', track, t_s - track.since_s))
+            track.since_s = float(t_s)
+            if track.position is not None:
+                track.position.reset()
+        cells = np.flatnonzero(occupied & ~taken)
+        labels = clusters(cells, grid, self.link)
+        for label in range(labels.max() + 1 if labels.size else 0):
+            members = cells[labels == label]
+            best = int(members[np.argmax(probability[members])])
+            track, kind = self._who(best)
+            seconds = t_s - track.since_s if kind == 'reacquired' else 0.0
+            track.cell, track.probability = best, self.held(probability, best, taken)
+            track.found, track.since_s = True, float(t_s)
+            if track.position is not None:
+                track.position.reset()
+            self._measure(track, values, offsets)
+            taken |= near(grid, best, SPILL_CELLS)
+            events.append(self._event(kind, track, seconds))
+        return events
+
+    def held(self, probability: np.ndarray, cell: int, taken: np.ndarray | None = None) -> float:
+        """``1 - prod (1 - P_j)`` over the cells within :data:`SPILL_CELLS` of ``cell`` not taken."""
+        cells = near(self.grid, cell, SPILL_CELLS)
+        if taken is not None:
+            cells &= ~taken
+        return float(-np.expm1(np.sum(np.log1p(-np.minimum(probability[cells], 1.0)))))
+
+    def _centre(self, track: Track, dt_s: float) -> int:
+        """The cell a person is looked for around: its filter's prediction, else its cell."""
+        position = track.position
+        if position is None or not position.started:
+            return track.cell
+        position.predict(dt_s)
+        rc = np.clip(np.round(position.x), 0, [self.grid.rows - 1, self.grid.cols - 1])
+        return int(self.grid.index(int(rc[0]), int(rc[1])))
+
+    def _measure(self, track: Track, values, offsets) -> None:
+        """Feed a person's filter the detections' mean position around its cell (gated)."""
+        position = track.position
+        if position is None or values is None or offsets is None:
+            return
+        cell_rc = np.asarray(self.grid.cell(track.cell), dtype=np.float64)
+        if position.started and np.max(np.abs(position.x - cell_rc)) > FILTER_GATE_CELLS:
+            position.reset()
+        z = measured_position(values, offsets, self.grid, track.cell)
+        if z is None or np.max(np.abs(z - cell_rc)) > FILTER_GATE_CELLS:
+            return
+        if position.started:
+            position.update(z)
+        else:
+            position.start(z)
+
+    def _who(self, cell: int) -> tuple[Track, str]:
+        """The lost person nearest ``cell`` (reacquired), else a new person (found)."""
+        lost = [t for t in self.tracks if not t.found]
+        if lost:
+            r, c = self.grid.cell(cell)
+            distance = [max(abs(r - tr), abs(c - tc))
+                        for tr, tc in (self.grid.cell(t.cell) for t in lost)]
+            return lost[int(np.argmin(distance))], 'reacquired'
+        track = Track(self.next_person, cell, 0.0, position=self.make_filter())
+        self.next_person += 1
+        self.tracks.append(track)
+        return track, 'found'
+
+    def view(self, track: Track, lead_s: float, ahead: np.ndarray | None = None) -> int:
+        """
+        Return the cell to look at for ``track``.
+
+        The cell of its filter's position ``lead_s`` ahead when it has one; else the likeliest
+        cell of ``ahead`` (the occupancy predicted ``lead_s`` ahead) within :data:`GATE_CELLS`
+        of it; else its cell.
+        """
+        grid = self.grid
+        if track.position is not None and track.position.started:
+            rc = np.clip(np.round(track.position.ahead(lead_s)), 0,
+                         [grid.rows - 1, grid.cols - 1]).astype(np.int64)
+            return int(grid.index(int(rc[0]), int(rc[1])))
+        if ahead is not None:
+            window = near(grid, track.cell, GATE_CELLS)
+            return int(np.argmax(np.where(window, ahead, -np.inf)))
+        return int(track.cell)
+
+    def _event(self, kind: str, track: Track, seconds: float) -> dict:
+        return {'event': kind, 'person': track.person, 'cell': int(track.cell),
+                'probability': float(track.probability), 'seconds': max(0.0, float(seconds))}
+
+
+class Turns:
+    """
+    The head's time shared between the people found (module docstring).
+
+    :meth:`advance` names whom the next view is for: each person ``dwell_s`` seconds in the
+    order of their numbers, then one :data:`GLANCE` for the search, round and round.
+    """
+
+    def __init__(self, dwell_s: float):
+        dwell_s = float(dwell_s)
+        if not math.isfinite(dwell_s) or dwell_s <= 0:
+            raise ValueError(f'dwell_s must be finite and > 0, got {dwell_s!r}')
+        self.dwell_s = dwell_s
+        self.reset()
+
+    def reset(self) -> None:
+        """No turn under way."""
+        self.current = GLANCE
+        self.last_person = 0
+        self.spent_s = 0.0
+
+    def advance(self, people, dt_s: float) -> int | None:
+        """
+        Return the person the next view is for, or :data:`GLANCE` (the search).
+
+        ``people`` are the numbers of the people found now (ascending), ``dt_s`` the time since
+        the last view. With nobody found every view is the search's.
+        """
+        people = sorted(int(p) for p in people)
+        if not people:
+            self.reset()
+            return GLANCE
+        self.spent_s += max(0.0, float(dt_s))
+        if self.current is not GLANCE and self.current in people \
+                and self.spent_s < self.dwell_s:
+            return self.current
+        after = self.last_person if self.current is GLANCE else self.current
+        later = [p for p in people if p > after]
+        if self.current is not GLANCE and not later:
+            self.current = GLANCE                  # a round is over: one view for the search
+        else:
+            self.current = later[0] if later else people[0]
+            self.last_person = self.current
+        self.spent_s = 0.0
+        return self.current

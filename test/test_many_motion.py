@@ -1,0 +1,252 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Many moving targets (docs/design.md section 12.10): the predicted occupancy, the people's
+tracks, the head's time in turns, and the moving many-target session end to end.
+"""
+from __future__ import annotations
+
+import itertools
+import math
+
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.motion import Motion, VelocityMotion
+from ipomdp_gaze.model.observation import CountObservation
+from ipomdp_gaze.model.occupancy import occupancy, predict_occupancy
+from ipomdp_gaze.search.gaze import GazeController
+from ipomdp_gaze.search.many import OccupancySession
+from ipomdp_gaze.search.session import Frame, SearchSettings
+from ipomdp_gaze.search.tracks import GLANCE, Tracks, Turns
+import numpy as np
+import pytest
+
+
+def _logit(p):
+    p = np.asarray(p, dtype=float)
+    return np.log(p) - np.log1p(-p)
+
+
+# -- the prediction ---------------------------------------------------------------------------
+@pytest.mark.parametrize('sigma, jump', [(0.7, 0.0), (1.3, 0.1)])
+def test_one_possible_target_is_predicted_exactly_as_the_chain_moves_it(sigma, jump):
+    """A single cell that may hold someone: ``P'_j = P_i T_ij``, the exact Bernoulli step."""
+    grid = Grid(4, 5)
+    motion = Motion(grid, sigma, jump)
+    p = np.full(grid.n_cells, 1e-300)
+    p[7] = 0.8
+    predicted, outside = predict_occupancy(_logit(p), 0.0, motion, 1.0)
+    exact = 0.8 * motion.transition_matrix()[7]
+    assert outside == 0.0
+    np.testing.assert_allclose(occupancy(predicted), exact, rtol=1e-9, atol=1e-12)
+
+
+def test_several_targets_are_within_the_bonferroni_bound_of_the_exact_occupancy():
+    """
+    Independent cells, each moving its target by the chain: the exact occupancy after the step
+    is ``1 - prod_i (1 - P_i T_ij)``, checked by enumerating every pattern of occupied cells;
+    the prediction is at least it and exceeds it by at most ``sum_{a<b} P_a T_aj P_b T_bj``.
+    """
+    grid = Grid(2, 3)
+    motion = Motion(grid, 0.9, 0.05)
+    t = motion.transition_matrix()
+    p = np.random.default_rng(4).uniform(0.05, 0.9, grid.n_cells)
+    exact = np.zeros(grid.n_cells)
+    for pattern in itertools.product((0, 1), repeat=grid.n_cells):        # brute force
+        x = np.array(pattern, dtype=bool)
+        weight = np.prod(np.where(x, p, 1 - p))
+        empty = np.prod(1 - t[x], axis=0) if x.any() else np.ones(grid.n_cells)
+        exact += weight * (1 - empty)
+    np.testing.assert_allclose(exact, 1 - np.prod(1 - p[:, None] * t, axis=0), atol=1e-12)
+    predicted = occupancy(predict_occupancy(_logit(p), 0.0, motion, 1.0)[0])
+    pair = p[:, None] * t                                                   # [a, j]
+    bound = 0.5 * (pair.sum(0) ** 2 - (pair ** 2).sum(0))
+    assert np.all(predicted >= exact - 1e-12)
+    assert np.all(predicted - exact <= bound + 1e-12)
+    assert np.any(predicted - exact > 1e-3)                                 # not trivially equal
+
+
+def test_walking_out_and_coming_back_keeps_the_expected_number_of_people():
+    """People walking out of reach are kept in ``outside`` and come back: the sum is kept."""
+    grid = Grid(5, 5)
+    motion = VelocityMotion(grid, 0.2, 0.0, 0.2, 2.0, 0.1, 1.0)
+    p = np.full(grid.n_cells, 0.01)
+    p[[0, 12]] = [0.99, 0.9]
+    log_odds, outside = _logit(p), 0.5
+    total = p.sum() + outside
+    for _ in range(6):
+        log_odds, outside = predict_occupancy(log_odds, outside, motion, 0.7)
+        assert occupancy(log_odds).sum() + outside == pytest.approx(total, rel=1e-9)
+    assert outside != 0.5
+
+
+def test_a_single_target_walks_as_the_single_target_belief_predicts():
+    """With one possible target the occupancy moves as one target's belief (walking out too)."""
+    grid = Grid(6, 7)
+    many, one = (VelocityMotion(grid, 0.3, 0.01, 0.0, 2.0, 0.2, 1.0) for _ in range(2))
+    p = np.full(grid.n_cells, 1e-300)
+    p[17] = 0.7
+    log_odds, outside = _logit(p), 0.0
+    belief = np.log(np.append(p / p.sum(), 1e-300))
+    for dt in (0.4, 0.3, 0.5):
+        log_odds, outside = predict_occupancy(log_odds, outside, many, dt)
+        one.predict_over(belief, dt)
+    single = np.exp(belief[:grid.n_cells])
+    np.testing.assert_allclose(occupancy(log_odds), 0.7 * single, rtol=1e-7,
+                               atol=1e-12)
+
+
+def test_no_motion_predicts_nothing():
+    grid = Grid(3, 3)
+    log_odds = _logit(np.linspace(0.1, 0.9, 9))
+    predicted, outside = predict_occupancy(log_odds, 0.3, Motion(grid), 5.0)
+    assert np.array_equal(predicted, log_odds) and outside == 0.3
+
+
+# -- the tracks and the turns -----------------------------------------------------------------
+def _field(grid, cells, p=0.999, rest=1e-4):
+    probability = np.full(grid.n_cells, rest)
+    probability[list(cells)] = p
+    return probability
+
+
+def test_people_are_found_followed_lost_and_reacquired_by_number():
+    grid = Grid(8, 8)
+    tracks = Tracks(grid)
+    a, b = grid.index(1, 1), grid.index(6, 5)
+
+    def step(cells, t, keep=0.5):
+        probability = _field(grid, cells)
+        return [(e['event'], e['person'], grid.cell(e['cell']))
+                for e in tracks.step(probability, probability >= 0.99, keep, t)]
+
+    assert step([a, b], 0.0) == [('found', 1, (1, 1)), ('found', 2, (6, 5))]
+    assert step([a + 1, b - 1], 1.0) == []                 # each moved a cell: same people
+    assert [(t.person, grid.cell(t.cell)) for t in tracks.found] == [(1, (1, 2)), (2, (6, 4))]
+    assert step([a + 1], 2.0) == [('lost', 2, (6, 4))]
+    assert step([a + 1, grid.index(7, 2)], 3.0) == [('reacquired', 2, (7, 2))]
+    events = tracks.step(_field(grid, [a + 1, grid.index(7, 2)]), _field(grid, []) > 1, 0.5, 4.0)
+    assert events == []
+    lost = tracks.step(_field(grid, [grid.index(7, 2)]), _field(grid, []) > 1, 0.5, 6.5)
+    assert [(e['event'], e['person'], e['seconds']) for e in lost] == [('lost', 1, 6.5)]
+
+
+def test_a_face_split_between_two_cells_is_not_lost_and_its_spill_over_is_no_new_person():
+    grid = Grid(6, 6)
+    tracks = Tracks(grid)
+    first = _field(grid, [grid.index(2, 2)])
+    assert len(tracks.step(first, first >= 0.99, 0.9, 0.0)) == 1
+    split = _field(grid, [grid.index(2, 2), grid.index(2, 3)], p=0.7)      # 1 - 0.3^2 = 0.91
+    assert tracks.step(split, split >= 0.99, 0.9, 0.5) == []
+    assert tracks.found[0].probability == pytest.approx(0.91, abs=1e-3)
+    spill = _field(grid, [grid.index(2, 3), grid.index(3, 3)])
+    assert tracks.step(spill, spill >= 0.99, 0.9, 1.0) == []               # one face, two cells
+    assert len(tracks.tracks) == 1
+
+
+def test_turns_share_the_head_between_people_with_a_glance_after_each_round():
+    turns = Turns(dwell_s=1.0)
+    seen = [turns.advance([1, 2], 0.4) for _ in range(9)]
+    assert seen == [1, 1, 1, 2, 2, 2, GLANCE, 1, 1]
+    assert turns.advance([1], 0.4) == 1 and turns.advance([2], 0.4) == 2   # 1 lost: next
+    assert turns.advance([], 0.4) is GLANCE
+    with pytest.raises(ValueError, match='dwell_s must be finite and > 0'):
+        Turns(0.0)
+
+
+# -- the session ------------------------------------------------------------------------------
+def _sensor(grid, radius=2):
+    """Counts 0..3: a face at offset <= 1 fires 2-3 times, clutter rarely; blind beyond radius."""
+    rows, cols = np.meshgrid(np.arange(grid.rows), np.arange(grid.cols), indexing='ij')
+    d = np.maximum(rows, cols)[..., None]
+    pt = np.where(d <= 1, [0.02, 0.08, 0.3, 0.6], [0.3, 0.3, 0.2, 0.2])
+    pn = np.broadcast_to([0.9, 0.08, 0.015, 0.005], pt.shape)
+    far = d[..., 0] > radius
+    pt = np.where(far[..., None], pn, pt)
+    return CountObservation(grid, pt / pt.sum(-1, keepdims=True), pn.copy())
+
+
+def _frame(model, rng, fixation, people, radius=2):
+    grid = model.grid
+    fr, fc = grid.cell(fixation)
+    values = np.full(grid.n_cells, np.nan)
+    occupied = set(int(c) for c in people)
+    for j in range(grid.n_cells):
+        r, c = grid.cell(j)
+        if max(abs(r - fr), abs(c - fc)) <= radius:
+            table = model.p_target if j in occupied else model.p_null
+            values[j] = rng.choice(4, p=table[abs(r - fr), abs(c - fc)])
+    return values
+
+
+MOVING = SearchSettings(targets='many', confidence=0.99, motion_sigma_cells=0.3,
+                        motion_jump_prob=0.001, motion_track_view='peak', motion_dwell_s=1.0,
+                        motion_keep_probability=0.5, absent_prior=0.5, motion_leave_prob=0.02)
+
+
+def test_two_walking_people_are_both_found_and_looked_at_in_turn():
+    grid = Grid(9, 9)
+    model = _sensor(grid)
+    session = OccupancySession(grid, model, MOVING, link=1)
+    session.reset(seed=0)
+    rng = np.random.default_rng(2)
+    fixation = session.start()
+    positions = np.array([[1.0, 1.0], [7.0, 6.0]])
+    velocity = np.array([[0.0, 0.4], [0.0, -0.4]])
+    looked, events = [], []
+    for _ in range(120):
+        positions = np.clip(positions + velocity * 0.3, 0, 8)
+        cells = [grid.index(*np.rint(p).astype(int)) for p in positions]
+        result = session.update(Frame(_frame(model, rng, fixation, cells)), dt_s=0.3)
+        events += list(session.people_events)
+        near = [max(np.abs(np.subtract(grid.cell(fixation), grid.cell(c)))) <= 1 for c in cells]
+        looked.append(near)
+        fixation = result.fixation
+        assert not result.ended
+    assert {e['person'] for e in events if e['event'] == 'found'} == {1, 2}
+    assert session.decision == 'found' and len(session.tracks.found) == 2
+    late = np.array(looked[60:])
+    assert late[:, 0].mean() > 0.25 and late[:, 1].mean() > 0.25, late.mean(0)   # both, in turn
+    assert [f['person'] for f in session.faces()] == [1, 2]
+
+
+def test_someone_who_leaves_is_lost_and_reacquired_when_back():
+    grid = Grid(7, 7)
+    model = _sensor(grid)
+    session = OccupancySession(grid, model, MOVING, link=1)
+    session.reset(seed=0)
+    rng = np.random.default_rng(5)
+    fixation = session.start()
+    kinds = []
+    for step in range(90):
+        people = [] if 30 <= step < 50 else [grid.index(3, 3 if step < 30 else 4)]
+        result = session.update(Frame(_frame(model, rng, fixation, people)), dt_s=0.3)
+        kinds += [(step, e['event'], e['person']) for e in session.people_events]
+        fixation = result.fixation
+    names = [k for _, k, _ in kinds]
+    assert names[:3] == ['found', 'lost', 'reacquired'], kinds
+    assert all(person == 1 for _, _, person in kinds)
+    assert kinds[1][0] >= 30 and kinds[2][0] >= 50
+
+
+def test_a_still_room_is_unchanged_and_the_controller_reports_each_persons_events():
+    still = OccupancySession(Grid(5, 5), _sensor(Grid(5, 5)), SearchSettings(targets='many'))
+    still.reset()
+    assert not still.motion.active and still.outside == 0.0
+    grid = Grid(7, 7)
+    core = GazeController(grid, _sensor(grid), None, MOVING)
+    assert core.follows_people
+    rng = np.random.default_rng(1)
+    kinds, t = [], 0.0
+    for step in range(60):
+        t += 0.3
+        result = core.offer(_frame(core.observation, rng, core.fixation, [grid.index(2, 4)]), t)
+        assert result.applied
+        kinds += [(e.kind, e.person, e.fixations) for e in result.people]
+    assert kinds[0][:2] == ('found', 1) and kinds[0][2] >= 1
+    assert not core.stopped
+
+
+def test_bad_dwell_is_refused_with_its_parameter_name():
+    with pytest.raises(ValueError, match='motion.dwell_s'):
+        SearchSettings(targets='many', motion_dwell_s=-1.0)
+    assert math.isclose(SearchSettings().motion_dwell_s, 2.0)
