@@ -10,8 +10,8 @@ is looked for within :data:`GATE_CELLS` of where it was (of where its position f
 
 - it stays found at the likeliest cell there while that cell and its neighbours (within
   :data:`SPILL_CELLS`) hold someone with at least the keep probability
-  (``motion.keep_probability``, the confidence when 0): ``1 - prod (1 - P_j)`` over them, so a face stepping from one cell to
-  the next, its probability split between both, is not lost. Those cells are its own (a face's
+  (``motion.keep_probability``, the confidence when 0): ``1 - prod (1 - P_j)`` over them, so
+  a face stepping from one cell to the next, its probability split between both, is not lost. Those cells are its own (a face's
   detections spill into its neighbours);
 - otherwise it is ``lost``;
 - an occupied cell (``P >= confidence``) that no found person owns is somebody: each cluster of
