@@ -11,8 +11,8 @@ is looked for within :data:`GATE_CELLS` of where it was (of where its position f
 - it stays found at the likeliest cell there while that cell and its neighbours (within
   :data:`SPILL_CELLS`) hold someone with at least the keep probability
   (``motion.keep_probability``, the confidence when 0): ``1 - prod (1 - P_j)`` over them, so
-  a face stepping from one cell to the next, its probability split between both, is not lost. Those cells are its own (a face's
-  detections spill into its neighbours);
+  a face stepping from one cell to the next, its probability split between both, is not lost.
+  Those cells are its own (a face's detections spill into its neighbours);
 - otherwise it is ``lost``;
 - an occupied cell (``P >= confidence``) that no found person owns is somebody: each cluster of
   such cells (within ``link`` cells) is one person, at its likeliest cell. Faces are not told
@@ -170,7 +170,7 @@ class Tracks:
         return events
 
     def held(self, probability: np.ndarray, cell: int, taken: np.ndarray | None = None) -> float:
-        """``1 - prod (1 - P_j)`` over the cells within :data:`SPILL_CELLS` of ``cell`` not taken."""
+        """Return whether someone is within SPILL_CELLS of ``cell``: ``1 - prod (1 - P_j)``."""
         cells = near(self.grid, cell, SPILL_CELLS)
         if taken is not None:
             cells &= ~taken
