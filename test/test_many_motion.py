@@ -1,8 +1,10 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-Many moving targets (docs/design.md section 12.10): the predicted occupancy, the people's
-tracks, the head's time in turns, and the moving many-target session end to end.
+Many moving targets (docs/design.md section 12.10).
+
+The predicted occupancy, the people's tracks, the head's time in turns, and the moving
+many-target session end to end.
 """
 from __future__ import annotations
 

@@ -177,7 +177,7 @@ class Tracks:
         return float(-np.expm1(np.sum(np.log1p(-np.minimum(probability[cells], 1.0)))))
 
     def _centre(self, track: Track, dt_s: float) -> int:
-        """The cell a person is looked for around: its filter's prediction, else its cell."""
+        """Return the cell a person is looked for around: its filter's prediction, else its cell."""
         position = track.position
         if position is None or not position.started:
             return track.cell
@@ -202,7 +202,7 @@ class Tracks:
             position.start(z)
 
     def _who(self, cell: int) -> tuple[Track, str]:
-        """The lost person nearest ``cell`` (reacquired), else a new person (found)."""
+        """Return the lost person nearest ``cell`` (reacquired), else a new person (found)."""
         lost = [t for t in self.tracks if not t.found]
         if lost:
             r, c = self.grid.cell(cell)
