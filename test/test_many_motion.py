@@ -44,9 +44,11 @@ def test_one_possible_target_is_predicted_exactly_as_the_chain_moves_it(sigma, j
 
 def test_several_targets_are_within_the_bonferroni_bound_of_the_exact_occupancy():
     """
-    Independent cells, each moving its target by the chain: the exact occupancy after the step
-    is ``1 - prod_i (1 - P_i T_ij)``, checked by enumerating every pattern of occupied cells;
-    the prediction is at least it and exceeds it by at most ``sum_{a<b} P_a T_aj P_b T_bj``.
+    Bound the prediction by the exact occupancy of independent cells.
+
+    Each cell moves its target by the chain: the exact occupancy after the step is
+    ``1 - prod_i (1 - P_i T_ij)``, checked by enumerating every pattern of occupied cells; the
+    prediction is at least it and exceeds it by at most ``sum_{a<b} P_a T_aj P_b T_bj``.
     """
     grid = Grid(2, 3)
     motion = Motion(grid, 0.9, 0.05)
@@ -157,7 +159,7 @@ def test_turns_share_the_head_between_people_with_a_glance_after_each_round():
 
 # -- the session ------------------------------------------------------------------------------
 def _sensor(grid, radius=2):
-    """Counts 0..3: a face at offset <= 1 fires 2-3 times, clutter rarely; blind beyond radius."""
+    """Return counts 0..3: a face at offset <= 1 fires 2-3 times, clutter rarely; blind beyond."""
     rows, cols = np.meshgrid(np.arange(grid.rows), np.arange(grid.cols), indexing='ij')
     d = np.maximum(rows, cols)[..., None]
     pt = np.where(d <= 1, [0.02, 0.08, 0.3, 0.6], [0.3, 0.3, 0.2, 0.2])
@@ -171,7 +173,7 @@ def _frame(model, rng, fixation, people, radius=2):
     grid = model.grid
     fr, fc = grid.cell(fixation)
     values = np.full(grid.n_cells, np.nan)
-    occupied = set(int(c) for c in people)
+    occupied = {int(c) for c in people}
     for j in range(grid.n_cells):
         r, c = grid.cell(j)
         if max(abs(r - fr), abs(c - fc)) <= radius:

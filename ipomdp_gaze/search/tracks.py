@@ -177,7 +177,7 @@ class Tracks:
         return float(-np.expm1(np.sum(np.log1p(-np.minimum(probability[cells], 1.0)))))
 
     def _centre(self, track: Track, dt_s: float) -> int:
-        """Return the cell a person is looked for around: its filter's prediction, else its cell."""
+        """Return the cell to look for a person around: its filter's prediction, else its cell."""
         position = track.position
         if position is None or not position.started:
             return track.cell
