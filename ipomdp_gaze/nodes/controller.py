@@ -59,7 +59,7 @@ from ipomdp_gaze.search.controller_config import (build_config, ControllerConfig
                                                   grid_from)
 from ipomdp_gaze.search.gaze import FrameSequence
 from ipomdp_gaze.search.health import HealthMonitor
-from ipomdp_gaze.search.room import MAX_PERIOD_S, RoomWatch
+from ipomdp_gaze.search.room import MAX_PERIOD_S, Person, RoomWatch
 from rclpy.exceptions import NameValidationException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -178,6 +178,7 @@ class GazeControllerNode(QuietPublishers, Node):
         self._targets_pub = self._cells_pub = None
         self._make_room_publishers()
         self._room = RoomWatch(cfg.grid)
+        self._new_people = 0
         self._dwell_timer = self._recheck_timer = None
         self._forward_pub = self._trajectory_pub = None
         self._make_command_publishers(v)
@@ -219,7 +220,10 @@ class GazeControllerNode(QuietPublishers, Node):
         ior = ', inhibition of return' if v['search.inhibit_return'] else ''
         if v['search.repeat_weight'] < 1.0:
             ior += f", repeated views weighted {v['search.repeat_weight']}"
-        if self._many:
+        if self._many and self.core.motion.active:
+            motion = ('many moving targets (an occupancy per cell), each person found followed '
+                      f"{v['motion.dwell_s']} s in turn, then a view for new people")
+        elif self._many:
             recheck = v['room.recheck_period_s']
             motion = ('many targets (an occupancy per cell), each kept in view '
                       f"{v['room.dwell_s']} s in turn, re-checked "
@@ -502,11 +506,36 @@ class GazeControllerNode(QuietPublishers, Node):
                 again.fixations, again.seconds_lost)
             self._event_pubs['reacquired'].publish(status)
             self.get_logger().info(status.message)
+        for event in result.people:
+            self._publish_person_event(event)
         if result.gave_up is not None:
             self._event_pubs['gave_up'].publish(diagnostics.gave_up_status(
                 f'{name}: gave_up', result.gave_up.fixations))
             self.get_logger().warning(f'gave up: no decision after {result.gave_up.fixations} '
                                       f'fixations (search.max_fixations){ending}')
+
+    def _publish_person_event(self, event) -> None:
+        """Publish a person's found, lost or reacquired (moving many-target search)."""
+        name = f'{self.get_fully_qualified_name()}: {event.kind}'
+        row, col = self._config.grid.cell(event.cell)
+        pan, tilt = self._config.head.angles(event.cell)
+        if event.kind == 'found':
+            msg = diagnostics.found_status(
+                name, row, col, event.cell, pan, tilt, event.probability, event.fixations, '',
+                self.core.settings.confidence, person=event.person)
+        elif event.kind == 'lost':
+            msg = diagnostics.lost_status(
+                name, row, col, event.cell, event.probability, self.core.absent_probability,
+                event.fixations, event.seconds, person=event.person)
+        else:
+            msg = diagnostics.reacquired_status(
+                name, row, col, event.cell, pan, tilt, event.probability, event.fixations,
+                event.seconds, person=event.person)
+        self._event_pubs[event.kind].publish(msg)
+        if event.kind == 'lost':
+            self.get_logger().warning(msg.message)
+        else:
+            self.get_logger().info(msg.message)
 
     def _publish_diagnostics(self) -> None:
         self._check_publishers()
@@ -576,7 +605,9 @@ class GazeControllerNode(QuietPublishers, Node):
             self._send_target()         # first: the head can start moving while we report
         self._publish_belief()
         self._publish_events(result)
-        if self._many and self.core.stopped:
+        if self.core.follows_people:
+            self._follow_people(result)
+        elif self._many and self.core.stopped:
             self._room_finished()
 
     # -- many targets: the room -------------------------------------------------------------
@@ -605,6 +636,25 @@ class GazeControllerNode(QuietPublishers, Node):
             f'{len(done.people)} people ({len(done.new)} new){": " + where if where else ""}')
         self._make_room_timers(self._config.values)
         self._on_dwell()
+
+    def _follow_people(self, result) -> None:
+        """
+        Publish the people a moving many-target search follows after each applied frame.
+
+        ``~/targets`` and ``~/target_cells`` hold the people found now, in the order of their
+        numbers (they move, so every frame); ``room_done`` is published each time every cell
+        becomes decided again, with the people found since the last one as new. The head's
+        time is shared by the search itself (``motion.dwell_s``), not by the dwell timer.
+        """
+        session, core = self.core.session, self.core
+        self._new_people += sum(e.kind == 'found' for e in result.people)
+        found = [Person(t.cell, t.probability) for t in session.tracks.found]
+        self._publish_people(found)
+        if result.room_done:
+            self._event_pubs['room_done'].publish(diagnostics.room_done_status(
+                f'{self.get_fully_qualified_name()}: room_done', len(found), self._new_people,
+                core.fixations, core.search_id, False, '', core.settings.confidence))
+            self._new_people = 0
 
     def _make_room_timers(self, values: dict) -> None:
         """Start (again) the turn of the people in view and the periodic re-check."""
@@ -648,10 +698,11 @@ class GazeControllerNode(QuietPublishers, Node):
         self._stop_room_timers()
         if recheck:
             self._room.recheck()
-        elif self._room.people or self._room.rooms_done:
+        elif self._room.people or self._room.rooms_done or self.core.follows_people:
             self._room.forget()
             if self._targets_pub is not None:
                 self._publish_people()
+        self._new_people = 0
         cell = self.core.reset(self._now_s())
         self._publish_belief()
         row, col = self._config.grid.cell(cell)
