@@ -72,19 +72,22 @@ def _ending(forced_by: str, confidence: float | None) -> tuple[str, dict]:
 
 def found_status(name: str, row: int, col: int, cell: int, pan_rad: float, tilt_rad: float,
                  probability: float, fixations: int, forced_by: str = '',
-                 confidence: float | None = None, radius: int = 0) -> DiagnosticStatus:
+                 confidence: float | None = None, radius: int = 0,
+                 person: int = 0) -> DiagnosticStatus:
     """
     Build the ``found`` event.
 
     ``ended`` (``confidence``, or ``forced:budget`` when the fixation budget forced it with
     ``search.decide_at_budget``) and ``confidence`` say how it was reached; ``radius`` (only
     when > 0) that the answer is the centre of the likeliest square of that radius
-    (``search.found_radius``), whose belief is ``probability``.
+    (``search.found_radius``), whose belief is ``probability``. ``person`` (only when > 0) is
+    the number of the person found by a moving many-target search (:func:`person_of`).
     """
     clause, ending = _ending(forced_by, confidence)
     if radius:
         ending['radius'] = int(radius)
-    message = (f'target found at row {row}, col {col} (pan {pan_rad:+.4f} rad, tilt '
+    ending.update(_person(person))
+    message = (f'{_who(person)} found at row {row}, col {col} (pan {pan_rad:+.4f} rad, tilt '
                f'{tilt_rad:+.4f} rad) with probability {probability:.4f} after {fixations} '
                f'fixations{clause}')
     return status(name, 'ok', message, {
@@ -111,28 +114,28 @@ def gave_up_status(name: str, fixations: int) -> DiagnosticStatus:
 
 def lost_status(name: str, row: int, col: int, cell: int, probability: float,
                 absent_probability: float, fixations: int,
-                seconds_tracked: float) -> DiagnosticStatus:
-    """Build the ``lost`` event (level WARN): the tracked target is no longer found."""
-    message = (f'target lost: last found at row {row}, col {col}, tracked '
+                seconds_tracked: float, person: int = 0) -> DiagnosticStatus:
+    """Build the ``lost`` event (level WARN): the tracked target (or ``person``) is not found."""
+    message = (f'{_who(person)} lost: last found at row {row}, col {col}, tracked '
                f'{seconds_tracked:.2f} s; most likely cell now {probability:.4f}, nobody here '
                f'{absent_probability:.4f} after {fixations} fixations')
     return status(name, 'warn', message, {
         'row': row, 'col': col, 'cell': cell, 'probability': float(probability),
         'absent_probability': float(absent_probability), 'fixations': fixations,
-        'seconds_tracked': float(seconds_tracked)})
+        'seconds_tracked': float(seconds_tracked), **_person(person)})
 
 
 def reacquired_status(name: str, row: int, col: int, cell: int, pan_rad: float,
                       tilt_rad: float, probability: float, fixations: int,
-                      seconds_lost: float) -> DiagnosticStatus:
+                      seconds_lost: float, person: int = 0) -> DiagnosticStatus:
     """Build the ``reacquired`` event: found again ``seconds_lost`` after ``lost``."""
-    message = (f'target reacquired at row {row}, col {col} (pan {pan_rad:+.4f} rad, tilt '
+    message = (f'{_who(person)} reacquired at row {row}, col {col} (pan {pan_rad:+.4f} rad, tilt '
                f'{tilt_rad:+.4f} rad) with probability {probability:.4f}, {seconds_lost:.2f} s '
                f'after it was lost, after {fixations} fixations')
     return status(name, 'ok', message, {
         'row': row, 'col': col, 'cell': cell, 'pan_rad': float(pan_rad),
         'tilt_rad': float(tilt_rad), 'probability': float(probability), 'fixations': fixations,
-        'seconds_lost': float(seconds_lost)})
+        'seconds_lost': float(seconds_lost), **_person(person)})
 
 
 def room_done_status(name: str, people: int, new_people: int, fixations: int, search_id: int,
@@ -152,6 +155,26 @@ def room_done_status(name: str, people: int, new_people: int, fixations: int, se
     return status(name, 'ok', message, {
         'people': int(people), 'new_people': int(new_people), 'fixations': int(fixations),
         'search_id': int(search_id), 'recheck': bool(recheck), **ending})
+
+
+def _person(person: int) -> dict:
+    """Return the ``person`` value of an event, only for a person's (> 0)."""
+    return {'person': int(person)} if person else {}
+
+
+def _who(person: int) -> str:
+    return f'person {int(person)}' if person else 'target'
+
+
+def person_of(msg: DiagnosticStatus) -> int:
+    """
+    Return the person number of a ``found``, ``lost`` or ``reacquired`` event (0: none).
+
+    A moving many-target search (``search.targets many`` with motion) numbers the people it
+    follows 1, 2, ... in the order found; the single-target events carry no number.
+    """
+    value = values_of(msg).get('person')
+    return int(value) if value is not None else 0
 
 
 def _parse(msg: DiagnosticStatus, event: str, keys, ints) -> dict:
