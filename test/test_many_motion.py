@@ -254,3 +254,35 @@ def test_bad_dwell_is_refused_with_its_parameter_name():
     with pytest.raises(ValueError, match='motion.dwell_s'):
         SearchSettings(targets='many', motion_dwell_s=-1.0)
     assert math.isclose(SearchSettings().motion_dwell_s, 2.0)
+
+
+def test_the_clutter_map_of_the_occupancy_belief_is_its_exact_hotspot_posterior():
+    """
+    Check the occupancy clutter map against enumeration.
+
+    One cell, face ``x`` and hotspot ``h`` independent a priori: the hotspot's posterior odds
+    after a frame, enumerated over ``(x, h)``, equal the map's; the face's term is the exact
+    ``P(o | x = 1) / P(o | x = 0)`` with the hotspot marginalised.
+    """
+    from ipomdp_gaze.model.clutter_map import ClutterMap
+    grid = Grid(3, 3)
+    model = _sensor(grid)
+    clutter = ClutterMap(model, 0.05, 20.0)
+    rng = np.random.default_rng(3)
+    b = rng.uniform(0.05, 0.9, grid.n_cells)
+    pi = occupancy(clutter.log_odds.copy())
+    obs = rng.integers(0, 4, grid.n_cells).astype(float)
+    fixation = 4
+    ratio = model.log_likelihood_ratio(obs, fixation)
+    face = clutter.occupancy_step(_logit(b), obs, fixation, ratio)
+    offsets = model.offsets(fixation)
+    c = obs.astype(int)
+    t = model.p_target.reshape(-1, 4)[offsets, c]
+    n = model.p_null.reshape(-1, 4)[offsets, c]
+    h = clutter._hot.p_target.reshape(-1, 4)[offsets, c]
+    joint = {(x, y): (b if x else 1 - b) * (pi if y else 1 - pi) * (t if x else (h if y else n))
+             for x in (0, 1) for y in (0, 1)}                                # brute force
+    hot_odds = (joint[0, 1] + joint[1, 1]) / (joint[0, 0] + joint[1, 0])
+    np.testing.assert_allclose(occupancy(clutter.log_odds), hot_odds / (1 + hot_odds),
+                               rtol=1e-10)
+    np.testing.assert_allclose(face, np.log(t) - np.log((1 - pi) * n + pi * h), rtol=1e-10)

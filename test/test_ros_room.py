@@ -126,10 +126,10 @@ def test_a_periodic_recheck_searches_again_and_finds_nobody_new(rig, probe):
 @pytest.mark.parametrize('params, words', [
     ({'room.recheck_period_s': 0.1}, 'room.recheck_period_s must be 0 (never) or in '
                                      '[room.dwell_s, 86400] seconds, got 0.1'),
-    ({'search.hotspot_prior': 0.03}, 'search.targets many does not model false-alarm scales '
-                                     'or hotspots'),
+    ({'search.hotspot_prior': 0.03}, 'search.targets many does not model false-alarm scales, '
+                                     'nor hotspots of a still scene'),
     ({'search.false_alarm_scales': [1.0, 3.0]}, 'search.targets many does not model '
-                                                'false-alarm scales or hotspots'),
+                                                'false-alarm scales'),
 ])
 def test_settings_the_many_target_mode_does_not_model_are_refused(rig, probe, params, words):
     result = probe.set_parameters(NODE, params)[0]

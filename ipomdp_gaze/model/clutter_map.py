@@ -27,6 +27,10 @@ taken independent of each other and of where the face is (an assumed-density fil
   give leave ``pi_i`` alone; counts nothing else explains raise it; a view of an empty spot
   lowers it.
 
+With many targets (the occupancy belief, one face or none per cell, :mod:`ipomdp_gaze.model.
+occupancy`) the cells are independent, so cell i's own occupancy ``b_i`` explains the rest:
+``S_i = 1 - b_i`` above (:meth:`ClutterMap.occupancy_step`), and the face's term is the same.
+
 Weak counts repeated at one spot then stop counting for a face after a view or two, while the
 counts a face gives near the view's centre (far more than a hotspot's) still do. With a prior of
 0 the face's term is the model's ratio exactly.
@@ -95,6 +99,22 @@ class ClutterMap:
         hot = self.hot_ratio(observation, fixation)
         face = self.face_term(ratio, hot)
         self.update(log_belief, ratio, hot, face)
+        return face
+
+    def occupancy_step(self, log_odds: np.ndarray, observation: np.ndarray, fixation: int,
+                       ratio: np.ndarray) -> np.ndarray:
+        """
+        Take one frame of the occupancy belief: return the face's term and learn from the frame.
+
+        ``log_odds`` is each cell's occupancy predicted to the frame (N,); otherwise as
+        :meth:`step`, with ``S_i = 1 - b_i`` (module docstring).
+        """
+        hot = self.hot_ratio(observation, fixation)
+        face = self.face_term(ratio, hot)
+        with np.errstate(invalid='ignore'):
+            log_x = np.asarray(log_odds, dtype=float) + ratio   # log b_i T_i / ((1 - b_i) N_i)
+        log_x = np.where(np.isnan(log_x), -np.inf, log_x)
+        self.log_odds += np.logaddexp(log_x, hot) - np.logaddexp(log_x, 0.0)
         return face
 
     def hot_ratio(self, observation: np.ndarray, fixation: int) -> np.ndarray:

@@ -52,6 +52,7 @@ from collections import deque
 import math
 
 from ipomdp_gaze.model.belief import argmax_ties_low, EvidenceError
+from ipomdp_gaze.model.clutter_map import ClutterMap
 from ipomdp_gaze.model.head_time import view_seconds
 from ipomdp_gaze.model.motion import Motion
 from ipomdp_gaze.model.observation import as_observation, check_evidence, CountObservation
@@ -72,9 +73,11 @@ MIN_GAIN = 1e-9
 
 def check_many_settings(settings: SearchSettings) -> None:
     """Refuse settings the many-target belief does not model (ValueError naming them)."""
-    if len(settings.false_alarm_scales) > 1 or settings.hotspot_prior > 0:
-        raise ValueError('search.targets many does not model false-alarm scales or hotspots: '
-                         'leave search.false_alarm_scales [1.0] and search.hotspot_prior 0')
+    still_hotspots = settings.hotspot_prior > 0 and not settings.moving
+    if len(settings.false_alarm_scales) > 1 or still_hotspots:
+        raise ValueError('search.targets many does not model false-alarm scales, nor hotspots '
+                         'of a still scene: leave search.false_alarm_scales [1.0], and '
+                         'search.hotspot_prior 0 unless the targets move')
     if settings.head_tour and settings.head_speed_deg_s > 0:
         raise ValueError('search.targets many has no tour of the tiles (that is policy '
                          "coverage's): leave search.head_tour false")
@@ -129,6 +132,7 @@ class OccupancySession:
         self._counts = isinstance(self.observation, CountObservation)
         self._still = StillEvidence(grid.n_cells)
         self._motion = target_motion(grid, self.settings)
+        self._clutter = None
         self.tracks = Tracks(grid, lambda: track_filter(self.settings))
         self.turns = Turns(self.settings.motion_dwell_s)
         self.people_events: tuple = ()
@@ -257,6 +261,7 @@ class OccupancySession:
         q = cell_prior(n, absent)
         self._still.reset()
         self._motion.reset()
+        self._clutter = None
         self.tracks.reset()
         self.turns.reset()
         self.people_events = ()
@@ -379,7 +384,10 @@ class OccupancySession:
         dt_s = max(0.0, float(dt_s))
         if self._motion.active:
             self.predict(dt_s)
-            s['base'] = s['base'] + term
+            clutter = self._active_clutter()
+            if clutter is not None:
+                term = clutter.occupancy_step(s['base'], obs, k, term)
+            s['base'] = s['base'] + np.nan_to_num(term)
             s['clock_s'] += dt_s
         else:
             information = np.where(np.isnan(obs), 0.0, self._view_info[k])
@@ -466,6 +474,21 @@ class OccupancySession:
         if not np.isfinite(score).any() or score.max() <= MIN_GAIN / costs.min():
             return None
         return int(argmax_ties_low(score))
+
+    def _active_clutter(self) -> ClutterMap | None:
+        """Return the clutter map of moving targets with ``search.hotspot_prior`` > 0 (counts only)."""
+        settings = self.settings
+        if settings.hotspot_prior <= 0 or not self._counts:
+            return None
+        key = (settings.hotspot_prior, settings.hotspot_scale)
+        if self._clutter is None or self._clutter[0] != key:
+            self._clutter = (key, ClutterMap(self.observation, *key))
+        return self._clutter[1]
+
+    @property
+    def hotspot_probability(self) -> np.ndarray | None:
+        """Each cell's probability of being a hotspot (moving targets' clutter map), or None."""
+        return None if self._clutter is None else self._clutter[1].probability
 
     def _choose_moving(self, dt_s: float) -> int:
         """

@@ -17,6 +17,11 @@ at its position at that time into the background (clipped at the panorama's edge
 :meth:`WalkScene.truth_at` says where it is (cell, or None out of reach). The draws of scene
 ``i`` come from their own stream ``default_rng([tag, split, seed, i])``, apart from the still
 scene's, so a still scene is bit for bit the one the still evaluation searches.
+
+**Several people** (``faces`` K >= 2, docs/design.md section 12.10): the still room of K faces
+of the same seed (:class:`PanTiltSceneSet` ``faces=K``, whose first face is the one-face
+scene's), each face walking its own path; face 0 draws from the one-face stream, face ``j``
+from ``default_rng([tag, split, seed, i, j])``. :meth:`WalkScene.truths_at` says where each is.
 """
 from __future__ import annotations
 
@@ -135,25 +140,49 @@ class Truth:
 
 
 class WalkScene:
-    """One walk scene: the background, the face (resized once), its :class:`Walk` and length."""
+    """
+    One walk scene: the background, the face (resized once), its :class:`Walk` and length.
+
+    ``others``: the ``(face, walk)`` of more people walking in the same scene (module
+    docstring); :attr:`walk` and :meth:`truth_at` are the first person's.
+    """
 
     def __init__(self, background: np.ndarray, face: np.ndarray, walk: Walk,
-                 geometry: SceneGeometry, index: int, duration_s: float | None = None):
+                 geometry: SceneGeometry, index: int, duration_s: float | None = None,
+                 others=()):
         self.background = background
         self.walk = walk
+        self.walks = (walk,) + tuple(w for _, w in others)
         self.duration_s = walk.duration_s if duration_s is None else float(duration_s)
         self.geometry = geometry
         self.index = index
         self.side_px = int(face.shape[0])
-        alpha = feather_mask(self.side_px, DEFAULT_FEATHER)
-        if background.ndim == 3:
+        self._faces = [self._sprite(f, background.ndim) for f in
+                       (face,) + tuple(f for f, _ in others)]
+
+    @staticmethod
+    def _sprite(face: np.ndarray, ndim: int) -> tuple:
+        """Return a face and its feathered alpha, as float32 (with a channel axis for colour)."""
+        alpha = feather_mask(int(face.shape[0]), DEFAULT_FEATHER)
+        if ndim == 3:
             face, alpha = face[:, :, None], alpha[:, :, None]
-        self._face = face.astype(np.float32)
-        self._alpha = alpha.astype(np.float32)
+        return face.astype(np.float32), alpha.astype(np.float32)
+
+    @property
+    def people(self) -> int:
+        """Return how many people walk in the scene."""
+        return len(self.walks)
 
     def truth_at(self, t_s: float) -> Truth:
-        """Return where the face is at ``t_s``: its cell is None out of the grid's reach."""
-        x, y = (float(v) for v in self.walk.position_px(t_s))
+        """Return where the (first) face is at ``t_s``: its cell is None out of the reach."""
+        return self._truth(self.walk, t_s)
+
+    def truths_at(self, t_s: float) -> tuple:
+        """Return where every face is at ``t_s`` (:class:`Truth` each, in the people's order)."""
+        return tuple(self._truth(walk, t_s) for walk in self.walks)
+
+    def _truth(self, walk: Walk, t_s: float) -> Truth:
+        x, y = (float(v) for v in walk.position_px(t_s))
         row, col = (float(v) for v in self.geometry.point_position(x, y))
         r, c = int(math.floor(row + 0.5)), int(math.floor(col + 0.5))
         g = self.geometry.grid
@@ -161,21 +190,22 @@ class WalkScene:
         return Truth((x, y), (row, col), cell)
 
     def image_at(self, t_s: float) -> np.ndarray:
-        """Return the panorama at ``t_s``: the face pasted where it is, clipped at the edges."""
+        """Return the panorama at ``t_s``: each face pasted where it is, clipped at the edges."""
         image = self.background.copy()
-        x, y = self.walk.position_px(t_s)
-        side = self.side_px
-        x0, y0 = int(round(x - side / 2.0)), int(round(y - side / 2.0))
-        h, w = image.shape[:2]
-        ax, ay = max(x0, 0), max(y0, 0)
-        bx, by = min(x0 + side, w), min(y0 + side, h)
-        if ax >= bx or ay >= by:
-            return image
-        face = self._face[ay - y0:by - y0, ax - x0:bx - x0]
-        alpha = self._alpha[ay - y0:by - y0, ax - x0:bx - x0]
-        region = image[ay:by, ax:bx]
-        bg = region.astype(np.float32)
-        region[...] = np.rint(bg + alpha * (face - bg)).astype(np.uint8)
+        for walk, (sprite, mask) in zip(self.walks, self._faces):
+            x, y = walk.position_px(t_s)
+            side = int(sprite.shape[0])
+            x0, y0 = int(round(x - side / 2.0)), int(round(y - side / 2.0))
+            h, w = image.shape[:2]
+            ax, ay = max(x0, 0), max(y0, 0)
+            bx, by = min(x0 + side, w), min(y0 + side, h)
+            if ax >= bx or ay >= by:
+                continue
+            face = sprite[ay - y0:by - y0, ax - x0:bx - x0]
+            alpha = mask[ay - y0:by - y0, ax - x0:bx - x0]
+            region = image[ay:by, ax:bx]
+            bg = region.astype(np.float32)
+            region[...] = np.rint(bg + alpha * (face - bg)).astype(np.uint8)
         return image
 
 
@@ -184,12 +214,15 @@ class WalkSceneSet:
     Walk scenes over the still pan/tilt scenes: scene ``i`` walks the face of seed ``seed + i``.
 
     ``speed_deg_s`` from 0 to 20; ``duration_s`` of each walk; ``leave`` adds the excursion out
-    of reach.
+    of reach; ``faces`` people per scene (module docstring; 1: the one-face walks, bit for bit).
     """
 
     def __init__(self, split: str = 'test', geometry: SceneGeometry | None = None,
                  seed: int = 0, speed_deg_s: float = 5.0, duration_s: float = DURATION_S,
-                 leave: bool = True, color: str = 'rgb'):
+                 leave: bool = True, color: str = 'rgb', faces: int = 1):
+        if isinstance(faces, bool) or int(faces) != faces or not 1 <= int(faces) <= 4:
+            raise ValueError(f'faces must be an integer from 1 to 4, got {faces!r}')
+        self.faces = int(faces)
         self.speed_deg_s = check_speed(speed_deg_s)
         self.duration_s = float(duration_s)
         if not (math.isfinite(self.duration_s) and self.duration_s > 0):
@@ -202,7 +235,7 @@ class WalkSceneSet:
         """Keyword arguments that rebuild this set (for worker processes)."""
         return {'split': self.split, 'geometry': self.geometry.to_dict(), 'seed': self.seed,
                 'speed_deg_s': self.speed_deg_s, 'duration_s': self.duration_s,
-                'leave': self.leave, 'color': self.color}
+                'leave': self.leave, 'color': self.color, 'faces': self.faces}
 
     @classmethod
     def from_kwargs(cls, kwargs: dict) -> WalkSceneSet:
@@ -218,15 +251,23 @@ class WalkSceneSet:
             raise IndexError(f'scene indices are non-negative, got {index}')
         kwargs = {'split': self.split, 'geometry': self.geometry, 'color': self.color,
                   'seed': self.seed + index}
-        still = PanTiltSceneSet(**kwargs).scene(0)
+        still = PanTiltSceneSet(**kwargs, faces=self.faces).scene(0)
         background = PanTiltSceneSet(**kwargs, empty=True).scene(0).image
-        side = int(still.face_px)
-        face = np.clip(cv2.resize(load_faces()[still.face_index], (side, side),
-                                  interpolation=cv2.INTER_CUBIC), 0.0, 255.0)
-        rng = np.random.default_rng([_STREAM_TAG, _SPLIT_CODE[self.split], self.seed + index])
-        walk = draw_walk(rng, self.geometry, still.face_centre_px, side, self.speed_deg_s,
-                         self.duration_s, self.leave)
-        return WalkScene(background, face, walk, self.geometry, index, self.duration_s)
+        people = []
+        for j, person in enumerate(still.faces if self.faces > 1 else
+                                   [(still.face_centre_px, still.face_px, None,
+                                     still.face_index)]):
+            centre, side, _, face_index = person
+            side = int(side)
+            face = np.clip(cv2.resize(load_faces()[face_index], (side, side),
+                                      interpolation=cv2.INTER_CUBIC), 0.0, 255.0)
+            stream = [_STREAM_TAG, _SPLIT_CODE[self.split], self.seed + index] + \
+                ([j] if j else [])
+            walk = draw_walk(np.random.default_rng(stream), self.geometry, centre, side,
+                             self.speed_deg_s, self.duration_s, self.leave)
+            people.append((face, walk))
+        (face, walk), others = people[0], people[1:]
+        return WalkScene(background, face, walk, self.geometry, index, self.duration_s, others)
 
 
 def calibrate_motion(split: str = 'train', scenes: int = 200, speeds_deg_s=(0.0, 20.0),

@@ -1,0 +1,256 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Several people who walk: find each, follow them in turn, find them again (design section 12.10).
+
+Walk scenes with K people (:class:`ipomdp_gaze.vision.walks.WalkSceneSet` ``faces=K``), every
+searcher on the same scenes and the same clock as the one-person walks
+(:func:`ipomdp_gaze.drivers.tracking.run_walk`'s: a view when the head has moved and settled,
+the detector's time after it). The searchers:
+
+- ``people`` (shipped): the moving many-target session of :data:`PEOPLE_CONFIG` over
+  :data:`~ipomdp_gaze.drivers.tracking.WALK_CONFIG` (``search.targets many``): one track per
+  person found, the head's time shared ``motion.dwell_s`` each with a view for new people after
+  each round; its answers are the people it follows;
+- ``track``: the one-target tracker of the walk configuration (what the product did before);
+- ``track-last-detection``: the baseline a team would write (centre the last grouped detection).
+
+Scores per scene, over each person's frames in the grid's reach, averaged over the people of the
+scene: ``in_view`` (the person inside the view), ``max_gap_s`` (the longest time the person was in
+reach without being in view, from a view to the next one that has it, or to the walk's end);
+``found`` (the share of the people that some answer named, within one cell, at some frame);
+``false_per_frame`` (answers within one cell of nobody in reach, per frame).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+import math
+
+from ipomdp_gaze.drivers.tracking import (_baseline_kwargs, LastDetectionTracker, SessionTracker,
+                                          WALK_CONFIG, WalkTask)
+from ipomdp_gaze.files.share_files import config_file
+from ipomdp_gaze.files.yaml_files import yaml_parameters
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head_time import HEAD_SPEED_DEG_S, SACCADE_TIME_S, SETTLE_TIME_S
+from ipomdp_gaze.search.many import OccupancySession
+from ipomdp_gaze.search.session import Frame, SearchSettings
+from ipomdp_gaze.search.settings import check_parameters
+from ipomdp_gaze.simulation.evaluation import cells_apart
+from ipomdp_gaze.simulation.executor import run_by_searcher
+from ipomdp_gaze.vision.walks import check_speed, DURATION_S, WalkSceneSet
+import numpy as np
+
+PEOPLE_CONFIG = 'faces_camera_people.yaml'
+# Occupied cells within this many cells are one person (the rooms' link, docs/design.md 11.5).
+PEOPLE_LINK = 1
+DETECTOR_TIME_S = 0.03
+
+
+def people_settings(paths=None) -> tuple[SearchSettings, str, dict]:
+    """Return the settings of the walk configuration with :data:`PEOPLE_CONFIG` over it."""
+    paths = [config_file(WALK_CONFIG), config_file(PEOPLE_CONFIG)] if paths is None else paths
+    values = {}
+    for path in paths:
+        values.update(yaml_parameters(path, 'gaze_controller'))
+    settings = check_parameters(values, grid=Grid(values['grid.rows'], values['grid.cols']),
+                                where=f'{paths[-1]}: ')
+    return settings, values.get('policy.name', 'coverage'), values
+
+
+class PeopleTracker:
+    """The moving many-target session: its answers are the people it follows."""
+
+    def __init__(self, task: WalkTask, settings: SearchSettings, seed):
+        self.task = task
+        self.session = OccupancySession(task.grid, task.model, settings, link=PEOPLE_LINK)
+        self.session.reset(seed=seed)
+        self.last_t = None
+
+    def first(self) -> int:
+        return self.session.start()
+
+    def step(self, t_s: float, obs, boxes) -> tuple:
+        """Apply the view taken at ``t_s``; return ``(next head, answers, events)``."""
+        dt = 0.0 if self.last_t is None else t_s - self.last_t
+        self.last_t = t_s
+        result = self.session.update(Frame(obs.counts, offsets=obs.offsets), dt_s=dt)
+        grid = self.task.grid
+        answers = [tuple(int(v) for v in grid.cell(t.cell)) for t in self.session.tracks.found]
+        return result.fixation, answers, [e['event'] for e in self.session.people_events]
+
+
+class OneTracker:
+    """A one-target searcher (``track`` or the baseline) answering at most one person."""
+
+    def __init__(self, tracker):
+        self.tracker = tracker
+
+    def first(self) -> int:
+        return self.tracker.first()
+
+    def step(self, t_s: float, obs, boxes) -> tuple:
+        nxt, answer, event = self.tracker.step(t_s, obs, boxes)
+        return nxt, [] if answer is None else [answer], [event] if event else []
+
+
+@dataclass(frozen=True)
+class PeopleFrame:
+    """One view: when, the head, each person's cell (None out of reach) and in-view, answers."""
+
+    t_s: float
+    head: tuple
+    cells: tuple
+    in_view: tuple
+    answers: tuple
+    events: tuple = ()
+
+
+@dataclass(frozen=True)
+class PeopleResult:
+    """One searcher on one scene of several people: the scores of the module docstring."""
+
+    searcher: str
+    index: int
+    people: int
+    in_view: float
+    max_gap_s: float
+    found: float
+    false_per_frame: float
+    frames: int
+
+    def to_dict(self) -> dict:
+        return {k: getattr(self, k) for k in ('searcher', 'index', 'people', 'in_view',
+                                              'max_gap_s', 'found', 'false_per_frame',
+                                              'frames')}
+
+
+def run_people(task: WalkTask, scene, tracker) -> list:
+    """Run one searcher over a scene of several walking people on the walks' clock."""
+    grid = task.grid
+    head = int(tracker.first())
+    previous = grid.center_index
+    t, frames = 0.0, []
+    while True:
+        if head != previous:
+            r0, c0 = grid.cell(previous)
+            r1, c1 = grid.cell(head)
+            step_deg = max(abs(r1 - r0), abs(c1 - c0)) * grid.spacing_deg
+            t += SACCADE_TIME_S + step_deg / HEAD_SPEED_DEG_S
+        t += SETTLE_TIME_S
+        if t > scene.duration_s:
+            break
+        obs, boxes = task.view(scene, t, head)
+        truths = scene.truths_at(t)
+        nxt, answers, events = tracker.step(t, obs, boxes)
+        frames.append(PeopleFrame(
+            t, tuple(int(v) for v in grid.cell(head)), tuple(tr.cell for tr in truths),
+            tuple(tr.cell is not None and task.in_view(tr, head) for tr in truths),
+            tuple(answers), tuple(events)))
+        t += DETECTOR_TIME_S
+        previous, head = head, int(nxt)
+    return frames
+
+
+def people_result(searcher: str, index: int, scene, frames: list) -> PeopleResult:
+    """Score a searcher's frames (module docstring)."""
+    people = scene.people
+    in_view, gaps, found = [], [], []
+    for p in range(people):
+        reach = [f for f in frames if f.cells[p] is not None]
+        if reach:
+            in_view.append(sum(f.in_view[p] for f in reach) / len(reach))
+        gap, since = 0.0, None
+        for f in frames:
+            if f.cells[p] is None:
+                since = None
+            elif f.in_view[p]:
+                if since is not None:
+                    gap = max(gap, f.t_s - since)
+                since = f.t_s
+            elif since is None:
+                since = f.t_s
+        if since is not None:
+            gap = max(gap, scene.duration_s - since)
+        gaps.append(gap)
+        found.append(any(f.cells[p] is not None and
+                         any(cells_apart(a, f.cells[p]) <= 1 for a in f.answers)
+                         for f in frames))
+    false = sum(sum(all(c is None or cells_apart(a, c) > 1 for c in f.cells) for a in f.answers)
+                for f in frames)
+    return PeopleResult(searcher, index, people,
+                        float(np.mean(in_view)) if in_view else math.nan,
+                        float(np.mean(gaps)), float(np.mean(found)),
+                        false / len(frames) if frames else math.nan, len(frames))
+
+
+@dataclass(frozen=True)
+class PeopleSpec:
+    """What a people-walk evaluation runs."""
+
+    split: str
+    seed: int
+    speed_deg_s: float
+    faces: int
+    duration_s: float
+    settings: SearchSettings
+    track_settings: SearchSettings
+    policy: str
+    model: str
+    compare: tuple = ('track', 'track-last-detection')
+
+
+def people_spec(speed_deg_s: float, faces: int = 2, split: str = 'test', seed: int = 0,
+                duration_s: float = DURATION_S, settings: SearchSettings | None = None,
+                compare=('track', 'track-last-detection')) -> PeopleSpec:
+    """Return a checked people-walk evaluation (module docstring)."""
+    from ipomdp_gaze.drivers.tracking import walk_settings
+    check_speed(speed_deg_s)
+    if split not in ('train', 'test'):
+        raise ValueError(f"split must be 'train' or 'test', got {split!r}")
+    for name in compare:
+        if name != 'track':
+            _baseline_kwargs(name)
+    base, policy, values = people_settings()
+    track, _, _ = walk_settings()
+    return PeopleSpec(split, int(seed), float(speed_deg_s), int(faces), float(duration_s),
+                      settings or base, track, policy, values.get('observation.file', ''),
+                      tuple(compare))
+
+
+def evaluate_people_walk(spec: PeopleSpec, index: int) -> list:
+    """Run ``people`` and each of ``spec.compare`` on scene ``index`` (one piece of work)."""
+    task = WalkTask.get(spec.track_settings, spec.policy, spec.model)
+    scene = WalkSceneSet(spec.split, task.geometry, spec.seed, spec.speed_deg_s,
+                         spec.duration_s, faces=spec.faces).scene(index)
+    seed = np.random.default_rng([spec.seed, index])
+    out = [people_result('people', index, scene,
+                         run_people(task, scene, PeopleTracker(task, spec.settings, seed)))]
+    for name in spec.compare:
+        if name == 'track':
+            rng = np.random.default_rng([spec.seed, index])
+            one = SessionTracker(task, spec.track_settings, rng)
+        else:
+            one = LastDetectionTracker(task, **_baseline_kwargs(name))
+        out.append(people_result(name, index, scene, run_people(task, scene, OneTracker(one))))
+    return out
+
+
+def evaluate_people_walks(spec: PeopleSpec, episodes: int, executor=None,
+                          progress=None) -> dict:
+    """Run scenes ``0..episodes-1``; return ``{searcher: [PeopleResult per scene]}``."""
+    return run_by_searcher(evaluate_people_walk, spec, episodes, executor, progress)
+
+
+def summarise_people(results: list, reference: list | None = None) -> dict:
+    """Return means over scenes, and paired 95% intervals of differences to ``reference``."""
+    s = {'scenes': len(results)}
+    for key in ('in_view', 'max_gap_s', 'found', 'false_per_frame'):
+        values = np.array([getattr(r, key) for r in results], dtype=float)
+        s[key] = float(np.nanmean(values)) if values.size else math.nan
+        if reference is not None and reference is not results and len(results) > 1:
+            d = values - np.array([getattr(r, key) for r in reference], dtype=float)
+            d = d[~np.isnan(d)]
+            half = 1.96 * d.std(ddof=1) / math.sqrt(d.size) if d.size > 1 else math.nan
+            s[f'{key}_minus_reference'] = [float(d.mean()), float(d.mean() - half),
+                                           float(d.mean() + half)]
+    return s
