@@ -476,7 +476,7 @@ class OccupancySession:
         return int(argmax_ties_low(score))
 
     def _active_clutter(self) -> ClutterMap | None:
-        """Return the clutter map of moving targets with ``search.hotspot_prior`` > 0 (counts only)."""
+        """Return the clutter map of moving targets with search.hotspot_prior > 0 (counts only)."""
         settings = self.settings
         if settings.hotspot_prior <= 0 or not self._counts:
             return None
