@@ -85,12 +85,22 @@ def test_at_speed_above_zero_the_face_moves():
     assert not np.array_equal(cfg.walk.image_at(0.0), cfg.walk.image_at(2.0))
 
 
+def test_two_people_walk_each_on_their_own_path():
+    cfg = _config(**{'scene.faces': '2'})
+    assert cfg.walk.people == 2
+    first = _config()
+    assert np.array_equal(first.walk.walk.points_px, cfg.walk.walk.points_px)
+    cells = [cfg.walk.truths_at(t) for t in (0.0, 5.0)]
+    assert cells[0][0].cell != cells[0][1].cell
+    assert [a.position != b.position for a, b in zip(*cells)] == [True, True]
+
+
 @pytest.mark.parametrize('changes, why', [
     ({'view': 'fixed'}, 'the pan_tilt view'),
     ({'scene.file': 'photo.jpg'}, 'not scene.file'),
     ({'scene.empty': True}, 'not scene.empty'),
-    ({'scene.faces': '2'}, "one face, not scene.faces '2'"),
-    ({'scene.faces': '0-3'}, "one face, not scene.faces '0-3'"),
+    ({'scene.faces': '5'}, "a number of faces from 1 to 4, not scene.faces '5'"),
+    ({'scene.faces': '0-3'}, "a number of faces from 1 to 4, not scene.faces '0-3'"),
     ({'scene.face_px': [40, 60]}, 'not scene.face_px [40, 60]'),
 ])
 def test_a_walk_where_there_is_none_is_refused_with_the_reason(changes, why):

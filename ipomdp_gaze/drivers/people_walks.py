@@ -18,6 +18,7 @@ the detector's time after it). The searchers:
 Scores per scene, over each person's frames in the grid's reach, averaged over the people of the
 scene: ``in_view`` (the person inside the view), ``max_gap_s`` (the longest time the person was in
 reach without being in view, from a view to the next one that has it, or to the walk's end);
+``tracked`` (the person named by an answer, within one cell: the searcher knows where it is);
 ``found`` (the share of the people that some answer named, within one cell, at some frame);
 ``false_per_frame`` (answers within one cell of nobody in reach, per frame).
 """
@@ -113,6 +114,7 @@ class PeopleResult:
     index: int
     people: int
     in_view: float
+    tracked: float
     max_gap_s: float
     found: float
     false_per_frame: float
@@ -120,8 +122,8 @@ class PeopleResult:
 
     def to_dict(self) -> dict:
         return {k: getattr(self, k) for k in ('searcher', 'index', 'people', 'in_view',
-                                              'max_gap_s', 'found', 'false_per_frame',
-                                              'frames')}
+                                              'tracked', 'max_gap_s', 'found',
+                                              'false_per_frame', 'frames')}
 
 
 def run_people(task: WalkTask, scene, tracker) -> list:
@@ -154,11 +156,13 @@ def run_people(task: WalkTask, scene, tracker) -> list:
 def people_result(searcher: str, index: int, scene, frames: list) -> PeopleResult:
     """Score a searcher's frames (module docstring)."""
     people = scene.people
-    in_view, gaps, found = [], [], []
+    in_view, tracked, gaps, found = [], [], [], []
     for p in range(people):
         reach = [f for f in frames if f.cells[p] is not None]
         if reach:
             in_view.append(sum(f.in_view[p] for f in reach) / len(reach))
+            tracked.append(sum(any(cells_apart(a, f.cells[p]) <= 1 for a in f.answers)
+                               for f in reach) / len(reach))
         gap, since = 0.0, None
         for f in frames:
             if f.cells[p] is None:
@@ -179,6 +183,7 @@ def people_result(searcher: str, index: int, scene, frames: list) -> PeopleResul
                 for f in frames)
     return PeopleResult(searcher, index, people,
                         float(np.mean(in_view)) if in_view else math.nan,
+                        float(np.mean(tracked)) if tracked else math.nan,
                         float(np.mean(gaps)), float(np.mean(found)),
                         false / len(frames) if frames else math.nan, len(frames))
 
@@ -244,7 +249,7 @@ def evaluate_people_walks(spec: PeopleSpec, episodes: int, executor=None,
 def summarise_people(results: list, reference: list | None = None) -> dict:
     """Return means over scenes, and paired 95% intervals of differences to ``reference``."""
     s = {'scenes': len(results)}
-    for key in ('in_view', 'max_gap_s', 'found', 'false_per_frame'):
+    for key in ('in_view', 'tracked', 'max_gap_s', 'found', 'false_per_frame'):
         values = np.array([getattr(r, key) for r in results], dtype=float)
         s[key] = float(np.nanmean(values)) if values.size else math.nan
         if reference is not None and reference is not results and len(results) > 1:

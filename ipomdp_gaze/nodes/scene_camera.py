@@ -25,12 +25,14 @@ with one stamp. ``ground_truth`` (``std_msgs/Int32MultiArray`` ``[row, col]`` of
 centre's cell in the grid of the view, transient local; ``[-1, -1]`` for nobody; a room of
 ``scene.faces`` faces: its first face) is published once when it is known.
 
-With ``scene.motion: walk`` (pan_tilt view, the one-face test scene) the face walks
+With ``scene.motion: walk`` (pan_tilt view, the test scene) the face walks
 (:class:`ipomdp_gaze.vision.walks.WalkSceneSet`, scene of ``seed``, at ``scene.speed_deg_s``
-over ``scene.walk_duration_s``): every frame is drawn at ``t``, the seconds from the node's
+over ``scene.walk_duration_s``; ``scene.faces`` K from 1 to 4: K people, each on its own walk,
+docs/design.md section 12.10): every frame is drawn at ``t``, the seconds from the node's
 first frame to its stamp on the node's clock, and ``walk_truth`` (``std_msgs/Float64MultiArray``,
-layout in :mod:`ipomdp_gaze.msg_adapters.grid_arrays`) says where the face was in that frame,
-with the frame's stamp (docs/design.md section 12.6). ``ground_truth`` is the walk's start.
+layout in :mod:`ipomdp_gaze.msg_adapters.grid_arrays`) says where the (first) face was in that
+frame, with the frame's stamp (docs/design.md section 12.6). ``ground_truth`` is the walk's
+start.
 Every callback runs under a :class:`ipomdp_gaze.nodes.guard.CallbackGuard` (its counts in the
 ``/diagnostics`` status ``<node>: callbacks``).
 """
@@ -85,8 +87,9 @@ def scene_camera_params() -> list[Param]:
               'pan_tilt view: a room of K faces or LO-HI drawn per seed, 0-8 (1: the one-face '
               'test scene; ground_truth is its first face; read-only)', read_only=True),
         Param('scene.motion', 'still', T.STRING,
-              'still: the face stays; walk: it walks (pan_tilt view, one-face test scene; '
-              'read-only)', read_only=True, choices=MOTIONS),
+              'still: the face stays; walk: it walks (pan_tilt view, the test scene; with '
+              'scene.faces K, 1-4, each face walks its own path; read-only)', read_only=True,
+              choices=MOTIONS),
         Param('scene.speed_deg_s', 5.0, T.DOUBLE, 'walk: walking speed in deg/s (read-only)',
               read_only=True, float_range=(0.0, 20.0)),
         Param('scene.walk_duration_s', 30.0, T.DOUBLE,
@@ -175,7 +178,8 @@ def _scene_config(values: dict) -> SceneConfig:
         if walking:
             from ipomdp_gaze.vision.walks import WalkSceneSet
             walk = WalkSceneSet(split, geometry, values['seed'], values['scene.speed_deg_s'],
-                                values['scene.walk_duration_s']).scene(0)
+                                values['scene.walk_duration_s'],
+                                faces=parse_faces(values.get('scene.faces', '1'))[0]).scene(0)
         return SceneConfig(dict(values), grid, camera, scene, geometry,
                            head_from(values, grid), walk)
     if values['scene.file']:
@@ -192,14 +196,15 @@ def _check_walk(values: dict, faces: tuple) -> None:
     """Refuse ``scene.motion: walk`` where no walk scene exists (ValueError names why)."""
     from ipomdp_gaze.vision.pan_tilt import FACE_PX, parse_faces
     why = None
+    lo, hi = parse_faces(values.get('scene.faces', '1'))
     if values['view'] != 'pan_tilt':
         why = 'the pan_tilt view (a fixed camera sees no walk)'
     elif values['scene.file']:
         why = "a held-out test scene, not scene.file (a user's image has no walk)"
     elif values['scene.empty']:
         why = 'a face to walk, not scene.empty'
-    elif parse_faces(values.get('scene.faces', '1')) != (1, 1):
-        why = f"one face, not scene.faces {values['scene.faces']!r}"
+    elif lo != hi or not 1 <= lo <= 4:
+        why = f"a number of faces from 1 to 4, not scene.faces {values['scene.faces']!r}"
     elif tuple(faces) != FACE_PX:
         why = f"the test scenes' face sizes, not scene.face_px {list(faces)}"
     if why is not None:
