@@ -286,3 +286,27 @@ def test_the_clutter_map_of_the_occupancy_belief_is_its_exact_hotspot_posterior(
     np.testing.assert_allclose(occupancy(clutter.log_odds), hot_odds / (1 + hot_odds),
                                rtol=1e-10)
     np.testing.assert_allclose(face, np.log(t) - np.log((1 - pi) * n + pi * h), rtol=1e-10)
+
+
+def test_the_search_keeps_its_turn_while_it_has_something_to_do():
+    turns = Turns(dwell_s=1.0)
+    seen = [turns.advance([1], 0.4, search=True) for _ in range(8)]
+    assert seen == [1, 1, 1, GLANCE, GLANCE, GLANCE, 1, 1]
+    turns.reset()
+    assert [turns.advance([1], 0.4, search=False) for _ in range(5)] == [1, 1, 1, GLANCE, 1]
+
+
+def test_a_person_not_looked_at_stays_found_and_is_lost_only_where_the_head_looked():
+    grid = Grid(8, 8)
+    tracks = Tracks(grid)
+    a = grid.index(4, 4)
+    first = _field(grid, [a])
+    tracks.step(first, first >= 0.99, 0.5, 0.0)
+    spread = _field(grid, [], rest=0.01)               # the person's occupancy spread out
+    blind = np.full(grid.n_cells, np.nan)
+    blind[grid.index(0, 0)] = 0.0                      # the frame looked elsewhere
+    assert tracks.step(spread, spread > 1, 0.5, 1.0, values=blind) == []
+    assert tracks.found[0].found
+    looked = np.full(grid.n_cells, 0.0)                # the frame saw every cell: nobody
+    events = tracks.step(spread, spread > 1, 0.5, 2.0, values=looked)
+    assert [(e['event'], e['person']) for e in events] == [('lost', 1)]

@@ -499,7 +499,7 @@ class OccupancySession:
         s, settings = self._s(), self.settings
         found = self.tracks.found
         if settings.motion_track_view != 'policy' and found:
-            person = self.turns.advance([t.person for t in found], dt_s)
+            person = self.turns.advance([t.person for t in found], dt_s, self._search_wanted())
             if person is not GLANCE:
                 track = next(t for t in found if t.person == person)
                 ahead = None
@@ -517,17 +517,30 @@ class OccupancySession:
             return s['fixation']
         return int(argmax_ties_low(score))
 
+    def _search_wanted(self) -> bool:
+        """
+        Whether the search has something to do: cells undecided, or someone likely unfollowed.
+
+        Likely: a cell not within 2 cells of anyone followed with ``P >= 1/2``.
+        """
+        s = self._s()
+        if not s['room_done']:
+            return True
+        unfollowed = ~self.tracks.followed()
+        return bool(np.any(s['base'][unfollowed] >= 0.0))
+
     def _decide_moving(self, values: np.ndarray, offsets, dt_s: float) -> str:
         """
         Follow the people through a frame; return the decision it fired (module docstring).
 
-        Cells are decided on the posterior (``P >= c`` or ``P <= 1 - c``): after a prediction the
-        evidence of a cell is no longer its own. The fixation budget ends a search that has
-        decided nothing yet, as for one moving target.
+        Cells are decided as still ones are (:meth:`_decided`); the evidence of a cell, its log
+        odds above the prior, flows with the motion like the rest, so a room decided empty
+        becomes undecided again as people could have walked in. The fixation budget ends a search
+        that has decided nothing yet, as for one moving target.
         """
         s, settings = self._s(), self.settings
         log_odds = s['base']
-        occupied, empty = decided(log_odds, settings.confidence)
+        occupied, empty = self._decided(log_odds)
         keep = settings.motion_keep_probability or settings.confidence
         self.people_events = tuple(self.tracks.step(
             occupancy(log_odds), occupied, keep, s['clock_s'], dt_s, values, offsets))
@@ -546,7 +559,7 @@ class OccupancySession:
     def _decided(self, log_odds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Cells decided occupied and empty (N,) (``empty_by_evidence``: the evidence alone)."""
         occupied, empty = decided(log_odds, self.settings.confidence)
-        if self.empty_by_evidence and not self._motion.active:
+        if self.empty_by_evidence:
             empty = empty & decided(log_odds - self._s()['prior'], self.settings.confidence)[1]
         return occupied, empty
 

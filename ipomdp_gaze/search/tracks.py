@@ -13,7 +13,10 @@ is looked for within :data:`GATE_CELLS` of where it was (of where its position f
   (``motion.keep_probability``, the confidence when 0): ``1 - prod (1 - P_j)`` over them, so
   a face stepping from one cell to the next, its probability split between both, is not lost.
   Those cells are its own (a face's detections spill into its neighbours);
-- otherwise it is ``lost``;
+- otherwise it is ``lost`` if the frame looked there (saw that likeliest cell): the head looked
+  and nobody was there. A person the frame did not look at stays found at
+  the likeliest cell of its predicted occupancy, however spread: while the head follows someone
+  else the others walk on unseen, and are looked for when their turn comes;
 - an occupied cell (``P >= confidence``) that no found person owns is somebody: each cluster of
   such cells (within ``link`` cells) is one person, at its likeliest cell. Faces are not told
   apart, so while someone is lost the person found is taken to be the lost one nearest to it
@@ -126,7 +129,8 @@ class Tracks:
         t_s, dt_s : float
             The search's clock at the frame, and the time since the frame before.
         values, offsets : arrays (N,), (N, 2), optional
-            The frame and its detections' offsets, for the position filters.
+            The frame (NaN where it did not look; None: it saw every cell) and its detections'
+            offsets, for the position filters.
 
         Returns
         -------
@@ -137,12 +141,14 @@ class Tracks:
         """
         grid, events = self.grid, []
         taken = np.zeros(grid.n_cells, dtype=bool)
+        seen = np.ones(grid.n_cells, dtype=bool) if values is None else \
+            ~np.isnan(np.asarray(values, dtype=float))
         for track in self.found:
             centre = self._centre(track, dt_s)
             window = near(grid, centre, GATE_CELLS) & ~taken
             best = int(np.argmax(np.where(window, probability, -1.0)))
             held = self.held(probability, best, taken)
-            if window.any() and held >= keep:
+            if window.any() and (held >= keep or not seen[best]):
                 track.cell, track.probability = best, held
                 taken |= near(grid, best, SPILL_CELLS)
                 self._measure(track, values, offsets)
@@ -242,7 +248,11 @@ class Turns:
     The head's time shared between the people found (module docstring).
 
     :meth:`advance` names whom the next view is for: each person ``dwell_s`` seconds in the
-    order of their numbers, then one :data:`GLANCE` for the search, round and round.
+    order of their numbers, then the search's turn (:data:`GLANCE`), round and round. The
+    search's turn is one view when the search has nothing to do; while it has (cells
+    undecided, or someone likely who is not followed yet) it goes on, up to ``dwell_s``: one
+    view of a new face is not enough to find it, and by the next round its evidence would have
+    spread with the motion.
     """
 
     def __init__(self, dwell_s: float):
@@ -255,15 +265,17 @@ class Turns:
     def reset(self) -> None:
         """No turn under way."""
         self.current = GLANCE
+        self.searching = False
         self.last_person = 0
         self.spent_s = 0.0
 
-    def advance(self, people, dt_s: float) -> int | None:
+    def advance(self, people, dt_s: float, search: bool = False) -> int | None:
         """
         Return the person the next view is for, or :data:`GLANCE` (the search).
 
         ``people`` are the numbers of the people found now (ascending), ``dt_s`` the time since
-        the last view. With nobody found every view is the search's.
+        the last view, ``search`` whether the search has something to do (class docstring).
+        With nobody found every view is the search's.
         """
         people = sorted(int(p) for p in people)
         if not people:
@@ -273,10 +285,15 @@ class Turns:
         if self.current is not GLANCE and self.current in people \
                 and self.spent_s < self.dwell_s:
             return self.current
+        if self.current is GLANCE and self.searching and search \
+                and self.spent_s < self.dwell_s:
+            return GLANCE
         after = self.last_person if self.current is GLANCE else self.current
         later = [p for p in people if p > after]
+        self.searching = False
         if self.current is not GLANCE and not later:
-            self.current = GLANCE                  # a round is over: one view for the search
+            self.current = GLANCE                  # a round is over: the search's turn
+            self.searching = True
         else:
             self.current = later[0] if later else people[0]
             self.last_person = self.current
