@@ -4,7 +4,7 @@ VENV := .venv
 VPY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: venv demo test readme bench reproduce faces faces-groups pan-tilt walks figures models soak clean
+.PHONY: venv demo test readme bench reproduce faces faces-groups pan-tilt walks people-walks figures models soak clean
 
 venv: $(STAMP)
 
@@ -98,6 +98,12 @@ pan-tilt: $(STAMP)
 # 15 deg/s; writes docs/walks.md (bench/pan_tilt/walks.py; about 40 minutes on two idle cores).
 walks: $(STAMP)
 	$(VPY) bench/pan_tilt/walks.py --scenes 50 --speeds 5,15
+
+# Several people who move (issue 38): the many-target tracker against the one-target tracker and
+# track-last-detection on held-out walks of two people at 5 and 15 deg/s; writes
+# docs/people_walks.md (bench/pan_tilt/people_walks.py; about 15 minutes on two idle cores).
+people-walks: $(STAMP)
+	$(VPY) bench/pan_tilt/people_walks.py --scenes 30 --speeds 5,15
 
 # Recalibrate every shipped Haar model and retrain faces-420-infomax from their recipes on training
 # scenes, print what moved and install the new files (bench/faces/models.py; about 70 minutes).

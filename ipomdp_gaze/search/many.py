@@ -542,8 +542,10 @@ class OccupancySession:
         log_odds = s['base']
         occupied, empty = self._decided(log_odds)
         keep = settings.motion_keep_probability or settings.confidence
+        # A round of turns: each person and the search dwell_s at most; one more for slack.
+        unseen_s = settings.motion_dwell_s * (len(self.tracks.found) + 2)
         self.people_events = tuple(self.tracks.step(
-            occupancy(log_odds), occupied, keep, s['clock_s'], dt_s, values, offsets))
+            occupancy(log_odds), occupied, keep, s['clock_s'], dt_s, values, offsets, unseen_s))
         followed = self.tracks.followed(self.link) if self.link > 0 else \
             np.zeros(self.grid.n_cells, dtype=bool)
         s['room_done'] = bool(np.all(self.settled(occupied) | followed | empty))

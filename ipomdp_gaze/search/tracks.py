@@ -14,9 +14,10 @@ is looked for within :data:`GATE_CELLS` of where it was (of where its position f
   a face stepping from one cell to the next, its probability split between both, is not lost.
   Those cells are its own (a face's detections spill into its neighbours);
 - otherwise it is ``lost`` if the frame looked there (saw that likeliest cell): the head looked
-  and nobody was there. A person the frame did not look at stays found at
-  the likeliest cell of its predicted occupancy, however spread: while the head follows someone
-  else the others walk on unseen, and are looked for when their turn comes;
+  and nobody was there. A person the frame did not look at stays found at the likeliest cell of
+  its predicted occupancy, however spread (its position filter dropped): while the head follows
+  someone else the others walk on unseen, and are looked for when their turn comes; unconfirmed
+  for longer than a round of turns (``unseen_s``), it is lost;
 - an occupied cell (``P >= confidence``) that no found person owns is somebody: each cluster of
   such cells (within ``link`` cells) is one person, at its likeliest cell. Faces are not told
   apart, so while someone is lost the person found is taken to be the lost one nearest to it
@@ -58,6 +59,7 @@ class Track:
     probability: float
     found: bool = True
     since_s: float = 0.0
+    confirmed_s: float = 0.0
     position: PositionFilter | None = None
 
     def to_dict(self, grid) -> dict:
@@ -114,7 +116,8 @@ class Tracks:
         return mask
 
     def step(self, probability: np.ndarray, occupied: np.ndarray, keep: float, t_s: float,
-             dt_s: float = 0.0, values=None, offsets=None) -> list[dict]:
+             dt_s: float = 0.0, values=None, offsets=None,
+             unseen_s: float = math.inf) -> list[dict]:
         """
         Follow everyone through one frame; return its events (module docstring).
 
@@ -131,6 +134,9 @@ class Tracks:
         values, offsets : arrays (N,), (N, 2), optional
             The frame (NaN where it did not look; None: it saw every cell) and its detections'
             offsets, for the position filters.
+        unseen_s : float
+            A person found not confirmed (held at the keep probability) for longer than this is
+            lost even where the head did not look: its turn came and went.
 
         Returns
         -------
@@ -148,10 +154,16 @@ class Tracks:
             window = near(grid, centre, GATE_CELLS) & ~taken
             best = int(np.argmax(np.where(window, probability, -1.0)))
             held = self.held(probability, best, taken)
-            if window.any() and (held >= keep or not seen[best]):
+            confirmed = window.any() and held >= keep
+            if confirmed or (window.any() and not seen[best]
+                             and t_s - track.confirmed_s <= unseen_s):
                 track.cell, track.probability = best, held
                 taken |= near(grid, best, SPILL_CELLS)
-                self._measure(track, values, offsets)
+                if confirmed:
+                    track.confirmed_s = float(t_s)
+                    self._measure(track, values, offsets)
+                elif track.position is not None:
+                    track.position.reset()          # unseen: the occupancy says where
                 continue
             track.found = False
             track.probability = self.held(probability, track.cell, taken)
@@ -167,7 +179,7 @@ class Tracks:
             track, kind = self._who(best)
             seconds = t_s - track.since_s if kind == 'reacquired' else 0.0
             track.cell, track.probability = best, self.held(probability, best, taken)
-            track.found, track.since_s = True, float(t_s)
+            track.found, track.since_s, track.confirmed_s = True, float(t_s), float(t_s)
             if track.position is not None:
                 track.position.reset()
             self._measure(track, values, offsets)
