@@ -27,12 +27,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 
-from ipomdp_gaze.drivers.tracking import (_baseline_kwargs, LastDetectionTracker, SessionTracker,
-                                          WALK_CONFIG, WalkTask)
+from ipomdp_gaze.drivers.tracking import (_baseline_kwargs, LastDetectionTracker, run_on_clock,
+                                          SessionTracker, WALK_CONFIG, WalkTask)
 from ipomdp_gaze.files.share_files import config_file
 from ipomdp_gaze.files.yaml_files import yaml_parameters
 from ipomdp_gaze.model.grid import Grid
-from ipomdp_gaze.model.head_time import HEAD_SPEED_DEG_S, SACCADE_TIME_S, SETTLE_TIME_S
 from ipomdp_gaze.search.many import OccupancySession
 from ipomdp_gaze.search.session import Frame, SearchSettings
 from ipomdp_gaze.search.settings import check_parameters
@@ -44,7 +43,6 @@ import numpy as np
 PEOPLE_CONFIG = 'faces_camera_people.yaml'
 # Occupied cells within this many cells are one person (the rooms' link, docs/design.md 11.5).
 PEOPLE_LINK = 1
-DETECTOR_TIME_S = 0.03
 
 
 def people_settings(paths=None) -> tuple[SearchSettings, str, dict]:
@@ -128,29 +126,14 @@ class PeopleResult:
 
 def run_people(task: WalkTask, scene, tracker) -> list:
     """Run one searcher over a scene of several walking people on the walks' clock."""
-    grid = task.grid
-    head = int(tracker.first())
-    previous = grid.center_index
-    t, frames = 0.0, []
-    while True:
-        if head != previous:
-            r0, c0 = grid.cell(previous)
-            r1, c1 = grid.cell(head)
-            step_deg = max(abs(r1 - r0), abs(c1 - c0)) * grid.spacing_deg
-            t += SACCADE_TIME_S + step_deg / HEAD_SPEED_DEG_S
-        t += SETTLE_TIME_S
-        if t > scene.duration_s:
-            break
-        obs, boxes = task.view(scene, t, head)
+    def record(t, head, stepped):
+        _, answers, events = stepped
         truths = scene.truths_at(t)
-        nxt, answers, events = tracker.step(t, obs, boxes)
-        frames.append(PeopleFrame(
-            t, tuple(int(v) for v in grid.cell(head)), tuple(tr.cell for tr in truths),
+        return PeopleFrame(
+            t, tuple(int(v) for v in task.grid.cell(head)), tuple(tr.cell for tr in truths),
             tuple(tr.cell is not None and task.in_view(tr, head) for tr in truths),
-            tuple(answers), tuple(events)))
-        t += DETECTOR_TIME_S
-        previous, head = head, int(nxt)
-    return frames
+            tuple(answers), tuple(events))
+    return run_on_clock(task, scene, tracker, record)
 
 
 def people_result(searcher: str, index: int, scene, frames: list) -> PeopleResult:

@@ -229,8 +229,13 @@ class LastDetectionTracker:
         return int(self.poses[self.pose]), None, event
 
 
-def run_walk(task: WalkTask, scene, tracker) -> list:
-    """Run one searcher over a walk scene on the clock of the module docstring."""
+def run_on_clock(task: WalkTask, scene, tracker, record) -> list:
+    """
+    Run one searcher over a walk scene on the clock of the module docstring.
+
+    ``record(t_s, head, stepped)`` makes the frame of each view from the tracker's
+    ``(next head, answer, event)``; returns the frames.
+    """
     grid = task.grid
     head = int(tracker.first())
     previous = grid.center_index
@@ -245,14 +250,22 @@ def run_walk(task: WalkTask, scene, tracker) -> list:
         if t > scene.duration_s:
             break
         obs, boxes = task.view(scene, t, head)
-        truth = scene.truth_at(t)
-        nxt, answer, event = tracker.step(t, obs, boxes)
-        head_rc = tuple(int(v) for v in grid.cell(head))
-        frames.append(WalkFrame(t, head_rc, truth.cell, task.in_view(truth, head) and
-                                truth.cell is not None, truth.cell == head_rc, answer, event))
+        stepped = tracker.step(t, obs, boxes)
+        frames.append(record(t, head, stepped))
         t += DETECTOR_TIME_S
-        previous, head = head, int(nxt)
+        previous, head = head, int(stepped[0])
     return frames
+
+
+def run_walk(task: WalkTask, scene, tracker) -> list:
+    """Run one searcher over a walk scene on the clock of the module docstring."""
+    def record(t, head, stepped):
+        _, answer, event = stepped
+        truth = scene.truth_at(t)
+        head_rc = tuple(int(v) for v in task.grid.cell(head))
+        return WalkFrame(t, head_rc, truth.cell, task.in_view(truth, head) and
+                         truth.cell is not None, truth.cell == head_rc, answer, event)
+    return run_on_clock(task, scene, tracker, record)
 
 
 def walk_result(searcher: str, index: int, scene, frames: list) -> WalkResult:

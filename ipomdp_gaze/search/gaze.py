@@ -481,18 +481,25 @@ class GazeController:
         # While tracking, the cell the target was last found in: the answer before this frame.
         tracked = self.map_cell if self.motion.active and self.session.decision == 'found' \
             else None
-        step = self.session.update(frame, dt_s=dt_s)
-        if not step.applied:
-            self.rejected += 1
-            self.last_rejection = step.reason
-            return FrameResult('rejected', step.reason)
-        self.update_time_s = max(self.update_time_s, float(stamp_s))
-        self.applied += 1
+        step, rejected = self._update(frame, dt_s, stamp_s)
+        if rejected is not None:
+            return rejected
         events = self._events(step.fired, float(stamp_s))
         if tracked is not None and step.decision != 'found':
             events['lost'] = self._lose(tracked, float(stamp_s))
         self.target_time_s = self.usable_time_s = float(stamp_s if now_s is None else now_s)
         return FrameResult('applied', fixation=step.fixation, **events)
+
+    def _update(self, frame, dt_s: float, stamp_s: float) -> tuple:
+        """Update the session; count the frame; return ``(step, the rejection or None)``."""
+        step = self.session.update(frame, dt_s=dt_s)
+        if not step.applied:
+            self.rejected += 1
+            self.last_rejection = step.reason
+            return step, FrameResult('rejected', step.reason)
+        self.update_time_s = max(self.update_time_s, float(stamp_s))
+        self.applied += 1
+        return step, None
 
     @property
     def follows_people(self) -> bool:
@@ -502,13 +509,9 @@ class GazeController:
     def _offer_people(self, frame, dt_s: float, stamp_s: float, now_s) -> FrameResult:
         """Apply a frame of a moving many-target search; its events are its people's."""
         was_done = self.session.room_done
-        step = self.session.update(frame, dt_s=dt_s)
-        if not step.applied:
-            self.rejected += 1
-            self.last_rejection = step.reason
-            return FrameResult('rejected', step.reason)
-        self.update_time_s = max(self.update_time_s, float(stamp_s))
-        self.applied += 1
+        step, rejected = self._update(frame, dt_s, stamp_s)
+        if rejected is not None:
+            return rejected
         people = tuple(PersonEvent(e['event'], e['person'], e['cell'], e['probability'],
                                    self.fixations, e['seconds'])
                        for e in self.session.people_events)

@@ -1,0 +1,43 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""The scores of several walking people (ipomdp_gaze.drivers.people_walks), worked by hand."""
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+from ipomdp_gaze.drivers.people_walks import people_result, people_settings, PeopleFrame
+import pytest
+
+
+def _frame(t, cells, in_view, answers):
+    return PeopleFrame(t, (5, 5), cells, in_view, answers)
+
+
+def test_scores_of_two_people_worked_by_hand():
+    scene = SimpleNamespace(people=2, duration_s=4.0)
+    frames = [
+        _frame(0.5, ((2, 2), (8, 8)), (True, False), ((2, 3),)),
+        _frame(1.5, ((2, 3), (8, 8)), (False, True), ((2, 3), (8, 7))),
+        _frame(2.5, ((2, 4), None), (True, False), ((2, 4), (5, 5))),
+        _frame(3.5, ((2, 5), (7, 8)), (False, False), ((6, 9),)),
+    ]
+    r = people_result('people', 3, scene, frames)
+    # Person 0: in view 2 of 4 frames, named on 3 (the last answer is far); person 1: in reach on
+    # 3 frames, in view on 1, named on 2 ((8, 7) at 1.5 and (6, 9) at 3.5, within a cell).
+    assert r.in_view == pytest.approx((2 / 4 + 1 / 3) / 2)
+    assert r.tracked == pytest.approx((3 / 4 + 2 / 3) / 2)
+    # Longest gaps in reach without a view: person 0 from its view at 0.5 to the next at 2.5
+    # (2.0 s; then 2.5 to the end, 1.5 s); person 1 from 0.5 (in reach, unseen) to its view at
+    # 1.5 (1.0 s); leaving at 2.5 ends a gap, and from its return at 3.5 to the end is 0.5 s.
+    assert r.max_gap_s == pytest.approx((2.0 + 1.0) / 2)
+    assert r.found == 1.0
+    assert r.false_per_frame == pytest.approx(1 / 4)          # (5, 5) names nobody
+    assert r.frames == 4 and r.people == 2
+
+
+def test_the_shipped_people_configuration_is_the_tracker_with_many_targets():
+    settings, policy, values = people_settings()
+    assert settings.targets == 'many' and settings.moving
+    assert settings.false_alarm_scales == (1.0,) and settings.hotspot_prior > 0
+    assert settings.motion_track_view == 'position' and settings.motion_dwell_s == 2.0
+    assert values['observation.file'] == 'faces-pan-tilt-profile' and policy == 'coverage'
