@@ -24,7 +24,6 @@ from __future__ import annotations
 import argparse
 from concurrent.futures import ProcessPoolExecutor
 import json
-import math
 from pathlib import Path
 import sys
 import time
@@ -32,6 +31,7 @@ import time
 from ipomdp_gaze.drivers.people_walks import (evaluate_people_walks, people_spec, PeopleResult,
                                               summarise_people)
 from ipomdp_gaze.simulation.progress import Progress
+from walks import _diff, _fmt                       # this folder's bench of one person
 
 ROOT = Path(__file__).resolve().parents[2]
 BASELINE = 'track-last-detection'
@@ -57,15 +57,6 @@ def run(args) -> dict:
 
 def _results(run: dict) -> dict:
     return {name: [PeopleResult(**r) for r in group] for name, group in run['scenes'].items()}
-
-
-def _fmt(value, digits=3) -> str:
-    return '-' if value is None or (isinstance(value, float) and math.isnan(value)) \
-        else f'{value:.{digits}f}'
-
-
-def _diff(value) -> str:
-    return '-' if not value else f'{value[0]:+.3f} [{value[1]:+.3f}, {value[2]:+.3f}]'
 
 
 def _table(run: dict) -> list[str]:
