@@ -291,7 +291,7 @@ def test_the_clutter_map_of_the_occupancy_belief_is_its_exact_hotspot_posterior(
 def test_the_search_keeps_its_turn_while_it_has_something_to_do():
     turns = Turns(dwell_s=1.0)
     seen = [turns.advance([1], 0.4, search=True) for _ in range(8)]
-    assert seen == [1, 1, 1, GLANCE, GLANCE, GLANCE, 1, 1]
+    assert seen == [1, 1, 1, GLANCE, GLANCE, 1, 1, 1]         # the search: half a dwell
     turns.reset()
     assert [turns.advance([1], 0.4, search=False) for _ in range(5)] == [1, 1, 1, GLANCE, 1]
 

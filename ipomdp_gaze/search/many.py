@@ -67,6 +67,8 @@ from ipomdp_gaze.search.tracks import GLANCE, Tracks, Turns
 import numpy as np
 from scipy.ndimage import maximum_filter
 
+# A person unconfirmed for a round of turns and this many more is lost (section 12.10).
+UNSEEN_SLACK_TURNS = 2
 # Gains below this (nats per unit cost, relative to the best) count as nothing left to learn.
 MIN_GAIN = 1e-9
 
@@ -543,7 +545,7 @@ class OccupancySession:
         occupied, empty = self._decided(log_odds)
         keep = settings.motion_keep_probability or settings.confidence
         # A round of turns: each person and the search dwell_s at most; one more for slack.
-        unseen_s = settings.motion_dwell_s * (len(self.tracks.found) + 2)
+        unseen_s = settings.motion_dwell_s * (len(self.tracks.found) + UNSEEN_SLACK_TURNS)
         self.people_events = tuple(self.tracks.step(
             occupancy(log_odds), occupied, keep, s['clock_s'], dt_s, values, offsets, unseen_s))
         followed = self.tracks.followed(self.link) if self.link > 0 else \

@@ -48,6 +48,9 @@ GATE_CELLS = 2
 SPILL_CELLS = 1
 # The view of a turn of Turns that looks for people not found yet.
 GLANCE = None
+# The search's turn lasts at most this share of a person's (``motion.dwell_s``): chosen on
+# training walks of two people (docs/design.md section 12.10).
+SEARCH_SHARE = 0.5
 
 
 @dataclass
@@ -262,7 +265,8 @@ class Turns:
     :meth:`advance` names whom the next view is for: each person ``dwell_s`` seconds in the
     order of their numbers, then the search's turn (:data:`GLANCE`), round and round. The
     search's turn is one view when the search has nothing to do; while it has (cells
-    undecided, or someone likely who is not followed yet) it goes on, up to ``dwell_s``: one
+    undecided, or someone likely who is not followed yet) it goes on, up to
+    :data:`SEARCH_SHARE` of ``dwell_s``: one
     view of a new face is not enough to find it, and by the next round its evidence would have
     spread with the motion.
     """
@@ -298,7 +302,7 @@ class Turns:
                 and self.spent_s < self.dwell_s:
             return self.current
         if self.current is GLANCE and self.searching and search \
-                and self.spent_s < self.dwell_s:
+                and self.spent_s < SEARCH_SHARE * self.dwell_s:
             return GLANCE
         after = self.last_person if self.current is GLANCE else self.current
         later = [p for p in people if p > after]
