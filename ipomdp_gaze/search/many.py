@@ -38,8 +38,9 @@ follows each person found (``found``, ``lost``, ``reacquired`` in :attr:`people_
 search does not end on a decision: ``found`` while anyone is followed, ``absent`` while every
 cell is decided empty; :attr:`room_done` says every cell is decided. The views: each person
 found ``motion.dwell_s`` in turn (``motion.track_view``: the cell of its position filter
-``motion.lead_s`` ahead, or of the occupancy predicted that far ahead), then one view of the
-infomax choice above with the cells around the people followed left out; with nobody found, or
+``motion.lead_s`` ahead, or of the occupancy predicted that far ahead), then the search's turn
+(:class:`~ipomdp_gaze.search.tracks.Turns`): the infomax choice above with the cells around the
+people followed left out; with nobody found, or
 ``motion.track_view: policy``, every view is that choice.
 
 The answer for drivers: :meth:`OccupancySession.faces` (one face per cluster of occupied cells,

@@ -152,8 +152,9 @@ SCHEMA: tuple[Setting, ...] = (
             metavar='P'),
     Setting('motion_dwell_s', 'motion.dwell_s', 'float', 2.0, check_seconds,
             'search.targets many, moving targets: seconds of views each person found gets in '
-            'turn before the next; after each round one view searches for people not found '
-            'yet (docs/design.md section 12.10)', bounds='> 0', metavar='SECONDS'),
+            'turn before the next; after each round the search looks for people not found yet '
+            '(one view, or up to half as long while the room is undecided; docs/design.md '
+            'section 12.10)', bounds='> 0', metavar='SECONDS'),
     Setting('start_cell', 'start_cell', 'cell', None, check_start_cell,
             "the first fixation (default: the policy's choice after a scan, else the grid's "
             'centre)', flag='--start', metavar='ROW,COL'),
