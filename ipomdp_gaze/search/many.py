@@ -367,7 +367,7 @@ class OccupancySession:
 
     @property
     def outside(self) -> float:
-        """The expected number of people out of the grid's reach (moving targets)."""
+        """Return the expected number of people out of the grid's reach (moving targets)."""
         return float(self._s()['outside'])
 
     def update(self, frame: Frame, dt_s: float = 0.0) -> StepResult:

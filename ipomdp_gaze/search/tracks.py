@@ -108,7 +108,7 @@ class Tracks:
 
     @property
     def found(self) -> list:
-        """The people found now, in the order of their numbers."""
+        """Return the people found now, in the order of their numbers."""
         return [t for t in self.tracks if t.found]
 
     def followed(self, radius: int = GATE_CELLS) -> np.ndarray:
