@@ -50,6 +50,8 @@ def events(launch, probe):
     rec['output'] = lambda: controller.output() + camera.output()           # noqa: E731
     assert wait_for(lambda: _after(rec['found'], rec['started_at']), EVENT_TIMEOUT_S), \
         'no found event\n' + rec['output']()
+    # ~/target_cells goes out just after the found event of the same frame.
+    assert wait_for(lambda: _people(rec), 10), rec['output']()
     rec['people_found'] = _people(rec)
 
     def move(params):
