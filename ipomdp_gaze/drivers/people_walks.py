@@ -27,14 +27,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 
-from ipomdp_gaze.drivers.tracking import (_baseline_kwargs, LastDetectionTracker, run_on_clock,
-                                          SessionTracker, WALK_CONFIG, WalkTask)
+from ipomdp_gaze.drivers.tracking import (_baseline_kwargs, LastDetectionTracker,
+                                          normal_interval, run_on_clock, SessionTracker,
+                                          walk_settings, WalkTask)
 from ipomdp_gaze.files.share_files import config_file
-from ipomdp_gaze.files.yaml_files import yaml_parameters
-from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.search.many import OccupancySession
 from ipomdp_gaze.search.session import Frame, SearchSettings
-from ipomdp_gaze.search.settings import check_parameters
 from ipomdp_gaze.simulation.evaluation import cells_apart
 from ipomdp_gaze.simulation.executor import run_by_searcher
 from ipomdp_gaze.vision.walks import check_speed, DURATION_S, WalkSceneSet
@@ -45,15 +43,9 @@ PEOPLE_CONFIG = 'faces_camera_people.yaml'
 PEOPLE_LINK = 1
 
 
-def people_settings(paths=None) -> tuple[SearchSettings, str, dict]:
+def people_settings() -> tuple[SearchSettings, str, dict]:
     """Return the settings of the walk configuration with :data:`PEOPLE_CONFIG` over it."""
-    paths = [config_file(WALK_CONFIG), config_file(PEOPLE_CONFIG)] if paths is None else paths
-    values = {}
-    for path in paths:
-        values.update(yaml_parameters(path, 'gaze_controller'))
-    settings = check_parameters(values, grid=Grid(values['grid.rows'], values['grid.cols']),
-                                where=f'{paths[-1]}: ')
-    return settings, values.get('policy.name', 'coverage'), values
+    return walk_settings(None, config_file(PEOPLE_CONFIG))
 
 
 class PeopleTracker:
@@ -191,7 +183,6 @@ def people_spec(speed_deg_s: float, faces: int = 2, split: str = 'test', seed: i
                 duration_s: float = DURATION_S, settings: SearchSettings | None = None,
                 compare=('track', 'track-last-detection')) -> PeopleSpec:
     """Return a checked people-walk evaluation (module docstring)."""
-    from ipomdp_gaze.drivers.tracking import walk_settings
     check_speed(speed_deg_s)
     if split not in ('train', 'test'):
         raise ValueError(f"split must be 'train' or 'test', got {split!r}")
@@ -237,8 +228,5 @@ def summarise_people(results: list, reference: list | None = None) -> dict:
         s[key] = float(np.nanmean(values)) if values.size else math.nan
         if reference is not None and reference is not results and len(results) > 1:
             d = values - np.array([getattr(r, key) for r in reference], dtype=float)
-            d = d[~np.isnan(d)]
-            half = 1.96 * d.std(ddof=1) / math.sqrt(d.size) if d.size > 1 else math.nan
-            s[f'{key}_minus_reference'] = [float(d.mean()), float(d.mean() - half),
-                                           float(d.mean() + half)]
+            s[f'{key}_minus_reference'] = normal_interval(d[~np.isnan(d)])
     return s

@@ -99,13 +99,20 @@ class WalkResult:
                 'reacquired_events': self.reacquired_events}
 
 
-def walk_settings(path=None) -> tuple[SearchSettings, str, dict]:
-    """Return the walk configuration's settings, policy name and parameters (``WALK_CONFIG``)."""
+def walk_settings(path=None, *more) -> tuple[SearchSettings, str, dict]:
+    """
+    Return the walk configuration's settings, policy name and parameters (``WALK_CONFIG``).
+
+    ``more`` parameter files are read after it, each over the ones before (as ``--params-file``
+    does on the node).
+    """
     from ipomdp_gaze.model.grid import Grid
-    path = config_file(WALK_CONFIG) if path is None else path
-    values = yaml_parameters(path, 'gaze_controller')
+    paths = [config_file(WALK_CONFIG) if path is None else path, *more]
+    values = {}
+    for p in paths:
+        values.update(yaml_parameters(p, 'gaze_controller'))
     settings = check_parameters(values, grid=Grid(values['grid.rows'], values['grid.cols']),
-                                where=f'{path}: ')
+                                where=f'{paths[-1]}: ')
     return settings, values.get('policy.name', 'coverage'), values
 
 
@@ -424,10 +431,14 @@ def summarise_walks(results: list, reference: list | None = None) -> dict:
                           if a.to_dict()[key] is not None and b.to_dict()[key] is not None])
             d = d[~np.isnan(d)]
             if d.size > 1:
-                half = 1.96 * d.std(ddof=1) / math.sqrt(d.size)
-                s[f'{key}_minus_reference'] = [float(d.mean()), float(d.mean() - half),
-                                               float(d.mean() + half)]
+                s[f'{key}_minus_reference'] = normal_interval(d)
     return s
+
+
+def normal_interval(d: np.ndarray) -> list:
+    """Return ``[mean, low, high]``: the mean of paired differences and its 95% normal interval."""
+    half = 1.96 * d.std(ddof=1) / math.sqrt(d.size) if d.size > 1 else math.nan
+    return [float(d.mean()), float(d.mean() - half), float(d.mean() + half)]
 
 
 def with_motion(settings: SearchSettings, sigma_cells: float, jump_prob: float = 0.0):
