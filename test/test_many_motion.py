@@ -310,3 +310,56 @@ def test_a_person_not_looked_at_stays_found_and_is_lost_only_where_the_head_look
     looked = np.full(grid.n_cells, 0.0)                # the frame saw every cell: nobody
     events = tracks.step(spread, spread > 1, 0.5, 2.0, values=looked)
     assert [(e['event'], e['person']) for e in events] == [('lost', 1)]
+
+
+def _tracked_session(settings, frames=15, cell=12, seed=0):
+    grid = Grid(5, 5)
+    model = _sensor(grid)
+    session = OccupancySession(grid, model, settings, link=1)
+    session.reset(seed=0)
+    rng = np.random.default_rng(seed)
+    fixation = session.start()
+    for _ in range(frames):
+        values = _frame(model, rng, fixation, [cell])
+        none = np.isnan(values) | (values == 0)                 # detections at cell centres
+        offsets = np.where(none[:, None], np.nan, np.zeros((grid.n_cells, 2)))
+        result = session.update(Frame(values, offsets=offsets), dt_s=0.3)
+        assert result.applied, result.reason
+        fixation = result.fixation
+    return session
+
+
+def test_motion_turned_on_mid_search_keeps_the_evidence_and_off_forgets_the_people():
+    from dataclasses import replace
+    still = replace(MOVING, motion_sigma_cells=0.0, motion_jump_prob=0.0, motion_leave_prob=0.0)
+    session = _tracked_session(still, frames=3)
+    before = session.log_odds
+    session.configure(MOVING)
+    np.testing.assert_allclose(session.log_odds, before)           # nothing forgotten
+    assert session.log_odds.max() > 0
+    moving = _tracked_session(MOVING)
+    assert moving.tracks.found
+    moving.configure(still)
+    assert not moving.tracks.tracks and not moving.people_events
+    assert all('person' not in f for f in moving.faces(link=1))    # the still room's faces
+
+
+def test_a_scan_does_not_end_a_moving_search():
+    grid = Grid(5, 5)
+    rng = np.random.default_rng(0)
+    model = CountObservation(grid, _sensor(grid).p_target, _sensor(grid).p_null,
+                             scan_target=rng.dirichlet(np.ones(4)),
+                             scan_null=rng.dirichlet(np.ones(4)))
+    session = OccupancySession(grid, model, MOVING, link=1)
+    session.reset(seed=0)
+    assert session.scan(Frame(np.full(25, -50.0), 'evidence')).applied
+    session.start()
+    assert not session.ended and session.decision == ''
+
+
+def test_new_filter_settings_reach_the_people_already_followed():
+    from dataclasses import replace
+    session = _tracked_session(replace(MOVING, motion_track_view='position'))
+    assert session.tracks.found and session.tracks.found[0].position is not None
+    session.configure(MOVING)                                       # track_view peak
+    assert all(t.position is None for t in session.tracks.tracks)

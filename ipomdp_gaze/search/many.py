@@ -62,8 +62,8 @@ from ipomdp_gaze.model.occupancy import (binary_entropy, cell_prior, count_faces
                                          predict_occupancy, prior_log_odds)
 from ipomdp_gaze.model.still_evidence import StillEvidence
 from ipomdp_gaze.search.session import (check_offsets, Frame, motion_settings, OrderError,
-                                        SearchSettings, start_index, StepResult, target_motion,
-                                        track_filter)
+                                        position_settings, SearchSettings, start_index,
+                                        StepResult, target_motion, track_filter)
 from ipomdp_gaze.search.tracks import GLANCE, Tracks, Turns
 import numpy as np
 from scipy.ndimage import maximum_filter
@@ -153,7 +153,10 @@ class OccupancySession:
         """
         Use new settings from the next frame on, keeping the belief of the search under way.
 
-        A new ``absent_prior`` applies from the next :meth:`reset`.
+        A new ``absent_prior`` applies from the next :meth:`reset`. Motion turned on keeps the
+        evidence so far (the still-scene weighting folded in); turned off, the people followed
+        are forgotten (a still room is searched, then decided). New position-filter settings
+        give the people followed new filters.
 
         Raises
         ------
@@ -163,11 +166,24 @@ class OccupancySession:
         """
         settings.check_grid(self.grid)
         check_many_settings(settings)
-        if motion_settings(settings) != motion_settings(self.settings):
+        old, s = self.settings, self._state
+        if motion_settings(settings) != motion_settings(old):
+            was_moving = self._motion.active
+            if s is not None and not was_moving:
+                s['base'] = self.log_odds          # the still evidence, weighted as it was
+                self._still.reset()
+                self._best = np.zeros(self.grid.n_cells)
             self._motion = target_motion(self.grid, settings)
-        if settings.motion_dwell_s != self.settings.motion_dwell_s:
+            if was_moving and not self._motion.active:
+                self.tracks.reset()                # still targets: the room's search decides
+                self.turns.reset()
+                self.people_events = ()
+        if settings.motion_dwell_s != old.motion_dwell_s:
             self.turns = Turns(settings.motion_dwell_s)
         self.settings = settings
+        if position_settings(settings) != position_settings(old):
+            for track in self.tracks.tracks:       # the people followed take the new filter
+                track.position = track_filter(settings)
 
     def set_observation(self, observation) -> None:
         """Assume another observation model (or FPOC) from the next frame on."""
@@ -346,7 +362,8 @@ class OccupancySession:
                 s['fixation'] = self.grid.center_index
         else:
             s['fixation'] = self.grid.center_index
-        fired = self._decide() if s['scanned'] else ''
+        # A moving search never ends on a decision: its first frame decides (_decide_moving).
+        fired = self._decide() if s['scanned'] and not self._motion.active else ''
         self._event('start', fixation=self._rc(s['fixation']), decision=fired)
         return s['fixation']
 

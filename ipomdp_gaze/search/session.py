@@ -146,7 +146,8 @@ def check_offsets(offsets, n_cells: int) -> np.ndarray | None:
     return values
 
 
-def _position_settings(settings: SearchSettings) -> tuple:
+def position_settings(settings: SearchSettings) -> tuple:
+    """Return what a position filter is built from (a change rebuilds it)."""
     return (settings.motion_track_view, settings.motion_position_sigma_cells,
             settings.motion_turn_prob, settings.motion_speed_cells, settings.motion_sigma_cells)
 
@@ -366,7 +367,7 @@ class SearchSession:
         self.settings = settings
         if motion_settings(settings) != motion_settings(old):
             self.motion = target_motion(self.grid, settings)
-        if _position_settings(settings) != _position_settings(old):
+        if position_settings(settings) != position_settings(old):
             self._position = track_filter(settings)
         self._changed()                 # the answer's square follows found_radius and motion
         mixture_changed = _mixture_settings(settings) != _mixture_settings(old)
