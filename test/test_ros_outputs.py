@@ -58,12 +58,13 @@ def test_the_belief_map_is_built_only_for_subscribers(context, monkeypatch):
 
     from ipomdp_gaze.msg_adapters import grid_arrays
     from ipomdp_gaze.nodes.controller import GazeControllerNode
-    packed = []
+    packed = []                                 # the belief as it was at each publish
     pack = grid_arrays.to_multiarray
     monkeypatch.setattr(grid_arrays, 'to_multiarray',
-                        lambda values, grid: packed.append(1) or pack(values, grid))
-    node = GazeControllerNode(context=context)
-    listener = rclpy.create_node('belief_listener', context=context)
+                        lambda values, grid: packed.append(np.array(values)) or pack(values, grid))
+    # A namespace of its own: no other test's node on this domain reaches its inputs.
+    node = GazeControllerNode(context=context, namespace='/belief_only')
+    listener = rclpy.create_node('belief_listener', context=context, namespace='/belief_only')
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(node)
     executor.add_node(listener)
@@ -82,6 +83,7 @@ def test_the_belief_map_is_built_only_for_subscribers(context, monkeypatch):
         assert received and packed
         grid = node._config.grid
         values = grid_arrays.from_multiarray(received[-1], grid)
+        assert any(np.allclose(values, sent, rtol=1e-6, atol=0) for sent in packed)
         np.testing.assert_allclose(values, node.core.belief, rtol=1e-6)
     finally:
         executor.shutdown()
