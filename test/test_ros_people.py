@@ -122,3 +122,21 @@ def test_the_search_goes_on_and_counts_each_persons_events(events):
     assert int(status['lost']) == len(_after(events['lost'], events['started_at'])) >= 1
     assert status['search_ended'] == 'false'
     assert wait_for(lambda: _people(events) not in (None, []), 20), events['output']()
+
+
+def test_motion_turned_off_mid_search_forgets_the_people_on_targets(events, probe):
+    # Runs last: the module's controller stops following people. The session forgets them,
+    # and ~/targets says so at once (a still search may name them again when it ends).
+    from ipomdp_gaze.model.grid import Grid
+    from ipomdp_gaze.msg_adapters import people
+    assert wait_for(lambda: _people(events) not in (None, []), 30), events['output']()
+    before = len(events['cells'])
+    result = probe.set_parameters_atomically(CONTROLLER, {'motion.sigma_cells': 0.0,
+                                                          'motion.leave_prob': 0.0})
+    assert result.successful, result.reason
+
+    def emptied():
+        grid = Grid(11, 11, 5.0)
+        return any(people.read_people_array(msg, grid) == []
+                   for _, msg in events['cells'][before:])
+    assert wait_for(emptied, 10), events['output']()

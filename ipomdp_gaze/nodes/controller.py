@@ -328,9 +328,14 @@ class GazeControllerNode(QuietPublishers, Node):
             self.get_logger().warning(cfg.warning)
         v, ov = cfg.values, old.values
         core = self.core
+        was_following = core.follows_people
         core.set_observation(cfg.observation)
         core.set_policy(cfg.policy)
         core.configure(cfg.settings, v['settle_time_s'])
+        if was_following and not core.follows_people and self._targets_pub is not None:
+            # Motion turned off: the session forgot the people it followed; so does ~/targets.
+            self._publish_people()
+            self._new_people = 0
         if v['seed'] != ov['seed']:
             core.reseed(v['seed'])
         if (v['forward_command_topic'], v['trajectory_topic']) != \
