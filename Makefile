@@ -4,7 +4,7 @@ VENV := .venv
 VPY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: venv demo test readme bench reproduce faces faces-groups pan-tilt walks people-walks figures models soak clean
+.PHONY: venv demo test readme bench reproduce faces faces-groups pan-tilt rooms walks people-walks figures models soak clean
 
 venv: $(STAMP)
 
@@ -93,6 +93,12 @@ faces-groups: $(STAMP)
 # writes docs/pan_tilt.md and docs/data/pan_tilt.json.gz (10-30 minutes, and 15 for the ROS demo).
 pan-tilt: $(STAMP)
 	$(VPY) bench/pan_tilt/pan_tilt.py --ros-seeds 50
+
+# Rooms of 0-4 faces (issue 37), both lenses: the many-target searches against one pass of the
+# grouped sweep, with the every-view bounds on the first 100 rooms; writes docs/rooms.md
+# (bench/pan_tilt/rooms.py; about 45 minutes on two idle cores).
+rooms: $(STAMP)
+	$(VPY) bench/pan_tilt/rooms.py --scenes 300 --bound 100
 
 # People who move (issue 38): the tracker against track-last-detection on held-out walks at 5 and
 # 15 deg/s; writes docs/walks.md (bench/pan_tilt/walks.py; about 40 minutes on two idle cores).

@@ -29,6 +29,29 @@ def test_pan_tilt_report_runs_on_a_few_scenes_and_writes_its_tables(tmp_path):
         assert sum(r['face_cell'] is None for r in group) == 2
 
 
+def test_rooms_report_runs_both_lenses_and_rewrites_from_its_record(tmp_path):
+    """``bench/pan_tilt/rooms.py`` (docs/rooms.md): every searcher on the same rooms."""
+    out, record = tmp_path / 'rooms.md', tmp_path / 'rooms.json'
+    script = [sys.executable, str(BENCH / 'pan_tilt' / 'rooms.py'), '--json', str(record),
+              '--out', str(out)]
+    run = subprocess.run(script + ['--scenes', '2', '--processes', '1'], capture_output=True,
+                         text=True, timeout=600)
+    assert run.returncode == 0, run.stderr[-2000:]
+    text = out.read_text()
+    assert '## 25 deg lens' in text and '## 40 deg lens' in text
+    assert text.count("Issue 37's rooms items") == 2 and 'not run (`--bound N`)' in text
+    data = json.loads(record.read_text())
+    for lens in data['runs'].values():
+        rooms = lens['rooms']
+        assert set(rooms) == {'many', 'pass-many', 'sweep-all-grouped5', 'sweep-all-grouped3'}
+        for ours, sweep in zip(rooms['pass-many'], rooms['sweep-all-grouped5']):
+            assert ours['index'] == sweep['index'] and ours['path'] == sweep['path']
+            assert ours['faces_found'] >= sweep['faces_found']
+    again = subprocess.run(script + ['--from-json'], capture_output=True, text=True, timeout=120)
+    assert again.returncode == 0, again.stderr[-2000:]
+    assert out.read_text() == text
+
+
 def test_models_script_refuses_an_unknown_model_with_one_line():
     """``bench/faces/models.py`` names the models it knows when given another."""
     run = subprocess.run([sys.executable, str(BENCH / 'faces' / 'models.py'), '--only',

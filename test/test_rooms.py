@@ -135,7 +135,8 @@ def test_room_specs_take_room_searchers_only():
     assert spec.settings.targets == 'many' and spec.settings.repeat_weight == 0.1
     assert spec.settings.max_fixations == 20 and spec.settings.hotspot_prior == 0
     for name in ('many-cells', 'many-posterior:absent.prior=0.13', 'every-view-many',
-                 'every-view-grouped3', 'sweep-all-grouped3'):
+                 'pass-many', 'pass-many:confidence=0.95', 'every-view-grouped3',
+                 'sweep-all-grouped3'):
         assert task_spec('pan-tilt', faces=2, compare=(name,)).compare == (name,)
     with pytest.raises(ValueError, match='unknown room searcher'):
         task_spec('pan-tilt', faces=2, compare=('sweep-all-grouped3:confidence=0.9',))
@@ -169,6 +170,37 @@ def test_evaluate_scores_a_small_room_run(tmp_path, capsys):
         assert len(scene['face_cells']) == 2
         assert scene['faces_found'] == match_faces(scene['answers'], scene['face_cells'])
     assert np.isfinite(record['summary']['many']['head_time_s_mean'])
+
+
+def test_pass_many_takes_the_sweeps_views_and_answers_its_belief_and_the_grouped(tmp_path):
+    import json
+
+    from ipomdp_gaze.drivers.rooms import room_session
+    from ipomdp_gaze.drivers.scene_tasks import SceneTask
+    from ipomdp_gaze.simulation.evaluation import cells_apart
+    out = tmp_path / 'rooms.json'
+    # Training room 1002 holds 4 faces; the grouped sweep finds 3 of them, the belief 4.
+    assert main(['evaluate', '--scenes', 'pan-tilt', '--faces', '0-4', '--split', 'train',
+                 '--episodes', '1', '--seed', '1002', '--compare', 'pass-many',
+                 '--compare', 'sweep-all-grouped5', '--jobs', '1', '--json', str(out)]) == 0
+    record = json.loads(out.read_text())
+    passed, swept = record['scenes']['pass-many'][0], record['scenes']['sweep-all-grouped5'][0]
+    assert passed['path'] == swept['path'] and passed['head_time_s'] == swept['head_time_s']
+    assert passed['done'] and passed['fixations'] == len(swept['path'])
+    # Every grouped detection is answered (the same face when within one cell) ...
+    assert all(min(cells_apart(tuple(g), tuple(a)) for a in passed['answers']) <= 1
+               for g in swept['answers'])
+    # ... besides the belief's faces after those views, each on its likelier side.
+    spec = task_spec('pan-tilt', faces='0-4', split='train', seed=1002)
+    task = SceneTask.get(spec)
+    task.sensor.start(task.scene(0).image)
+    session, outcome, _, faces = room_session(spec, task, 0, 'pass-many')
+    assert list(outcome.path) == swept['path']
+    assert all(session.log_odds[f['cell']] > 0 for f in faces)
+    belief = [list(task.model.grid.cell(f['cell'])) for f in faces]
+    assert passed['answers'][:len(belief)] == belief
+    assert passed['faces_found'] >= swept['faces_found']
+    assert passed['faces_found'] > swept['faces_found']     # this room: grouping misses one
 
 
 def test_the_room_demo_ends_with_one_verdict_line():

@@ -17,6 +17,13 @@ pan-tilt --faces K|LO-HI``). Its searchers, all on the same views of the task's
   face per cluster, boxes unused; ``many-posterior``: a cell is decided empty by its posterior
   (``P(x_j) <= 1 - c``, ``OccupancySession(empty_by_evidence=False)``) instead of its evidence
   alone;
+- ``pass-many`` (optionally ``pass-many:parameter=value,...``): the sweep's one pass (its poses,
+  in its order: the same views and head time) fed to the ``many`` session, which ends there
+  unless every cell was decided before; its answer is ``many``'s faces on their likelier side
+  (``P(x_j) > 1/2``, boxes split them) together with every detection grouped as
+  ``detectMultiScale`` does with ``min_neighbors`` :data:`PASS_MIN_NEIGHBORS` that is not within
+  one cell of one of them: grouping and the belief each see faces the other misses
+  (docs/design.md section 11.7);
 - ``sweep-all-grouped3`` / ``sweep-all-grouped5``: one pass of the sweep's poses answering every
   detection grouped as ``detectMultiScale`` does (``min_neighbors`` 3 / 5), each at the cell of
   its box centre; a detection within one cell of one already answered is the same face (the
@@ -52,6 +59,9 @@ SETTLE_LINK = 1
 FACE_LINK = 2
 # Pixels per cell of the room picture the searcher's boxes are drawn into (room_boxes).
 ROOM_CELL_PX = 100
+# The grouping whose detections pass-many answers besides its belief (the grouped sweep a team
+# keeps: no false face on the training rooms, where 3 named some; docs/design.md section 11.7).
+PASS_MIN_NEIGHBORS = 5
 
 
 def room_settings(settings, label: str = 'many'):
@@ -71,9 +81,13 @@ def room_session(spec, task, index: int, label: str = 'many'):
     settings = room_settings(spec.settings, label)
     name = label.split(':')[0]
     every = name == 'every-view-many'
+    order = range(grid.n_cells) if every else None
     if every:            # every view, then the budget's answer: a bound on the belief
         settings = replace(settings, max_fixations=grid.n_cells, decide_at_budget=False,
                            confidence=1 - 1e-12)
+    elif name == 'pass-many':       # the sweep's pass, then every cell on its likelier side
+        order = [int(p) for p in task.sweep.poses]
+        settings = replace(settings, max_fixations=len(order), decide_at_budget=True)
     session = OccupancySession(grid, task.model, settings, link=SETTLE_LINK,
                                empty_by_evidence=name != 'many-posterior')
     detector_s = []
@@ -81,7 +95,7 @@ def room_session(spec, task, index: int, label: str = 'many'):
                          seed=np.random.default_rng([spec.seed, index]),
                          limit=settings.max_fixations or 4 * grid.n_cells, restart=False,
                          on_frame=lambda frame, result: detector_s.append(frame.seconds),
-                         fixations=range(grid.n_cells) if every else None)
+                         fixations=order)
     if every:
         session = _Decided(session)
     boxes = None
@@ -153,8 +167,30 @@ def room_search(spec, task, scene, index: int, label: str) -> SceneResult:
     ended = bool(outcome.decision)
     decision = outcome.decision if ended else 'gave_up'
     reason = outcome.reason if ended else 'limit'
+    done = ended and not reason
+    if label.split(':')[0] == 'pass-many':
+        answers = with_grouped(task, outcome.path, answers, PASS_MIN_NEIGHBORS)
+        decision = 'found' if answers else 'absent'
+        done = ended                # the pass is its rule, as the sweep's
     return room_result(task, scene, index, label, answers, decision, reason, outcome.path,
-                       outcome.detector_pixels, detector_s, done=ended and not reason)
+                       outcome.detector_pixels, detector_s, done=done)
+
+
+def with_grouped(task, path, answers, min_neighbors: int) -> list:
+    """
+    ``answers`` and then each grouped detection of the views of ``path`` not within one cell.
+
+    The detections of each view grouped as ``detectMultiScale`` does with ``min_neighbors``,
+    views in the order taken, the largest box first (as the sweeps answer them).
+    """
+    grid = task.model.grid
+    out = list(answers)
+    for pose in dict.fromkeys(int(c) for c in path):
+        for cell in grouped_cells(task, pose, min_neighbors):
+            rc = tuple(int(v) for v in grid.cell(int(cell)))
+            if all(cells_apart(rc, seen) > 1 for seen in out):
+                out.append(rc)
+    return out
 
 
 def room_sweep(spec, task, scene, index: int, rule: str) -> SceneResult:
@@ -165,17 +201,14 @@ def room_sweep(spec, task, scene, index: int, rule: str) -> SceneResult:
     bound on what grouping sees.
     """
     grid = task.model.grid
-    answers, path, pixels, detector_s = [], [], 0, []
+    path, pixels, detector_s = [], 0, []
     poses = range(grid.n_cells) if rule.startswith('every-view') else task.sweep.poses
     for pose in poses:
         frame = task.sensor.observe(int(pose))
         path.append(int(pose))
         pixels += frame.detector_pixels
         detector_s.append(frame.seconds)
-        for cell in grouped_cells(task, int(pose), int(rule[-1])):
-            rc = tuple(int(v) for v in grid.cell(int(cell)))
-            if all(cells_apart(rc, seen) > 1 for seen in answers):
-                answers.append(rc)
+    answers = with_grouped(task, path, [], int(rule[-1]))
     return room_result(task, scene, index, rule, answers, 'found' if answers else 'absent', '',
                        path, pixels, detector_s, done=True)
 

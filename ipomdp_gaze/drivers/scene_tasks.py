@@ -37,9 +37,11 @@ TASKS = ('pan-tilt', 'faces-420', 'faces-840')
 DEFAULT_BUDGET = 60
 # The fixed-camera tasks: model, scene side (px), face sizes (px), as bench/faces/faces.py.
 # The searchers of rooms with several faces (drivers/rooms.py): the many-target session (its
-# faces split by the detector's boxes, or one per cluster of cells) and the sweeps answering
-# every grouped detection.
-ROOM_SEARCHERS = ('many', 'many-cells', 'many-posterior', 'every-view-many') + ROOM_SWEEPS
+# faces split by the detector's boxes, or one per cluster of cells), the sweep's one pass with
+# the session's belief and the grouped detections together, and the sweeps answering every
+# grouped detection.
+ROOM_SEARCHERS = ('many', 'many-cells', 'many-posterior', 'every-view-many',
+                  'pass-many') + ROOM_SWEEPS
 # What rooms change in the pan/tilt configuration: the many-target setting, without what the
 # occupancy belief does not model (false-alarm scales, hotspots; the choice per second of head
 # time it keeps: docs/design.md section 11.5) ...
