@@ -43,7 +43,8 @@ def test_rooms_report_runs_both_lenses_and_rewrites_from_its_record(tmp_path):
     data = json.loads(record.read_text())
     for lens in data['runs'].values():
         rooms = lens['rooms']
-        assert set(rooms) == {'many', 'pass-many', 'sweep-all-grouped5', 'sweep-all-grouped3'}
+        assert set(rooms) == {'many', 'pass-many', 'pass-many-cells', 'sweep-all-grouped5',
+                              'sweep-all-grouped3'}
         for ours, sweep in zip(rooms['pass-many'], rooms['sweep-all-grouped5']):
             assert ours['index'] == sweep['index'] and ours['path'] == sweep['path']
             assert ours['faces_found'] >= sweep['faces_found']

@@ -453,3 +453,104 @@ def test_simulated_searches_of_the_paper_task_find_the_target_or_nobody():
             assert max(abs(r - target // 7), abs(c - target % 7)) <= 1
         else:
             assert cells == []
+
+
+class _Sweep:
+    """A stand-in for the sweep policy: its name and its poses (what a pass reads)."""
+
+    name = 'sweep'
+
+    def __init__(self, poses):
+        self.poses = np.asarray(poses)
+
+
+def _pass_session(grid, model, poses, **settings):
+    session = OccupancySession(grid, model, SearchSettings(
+        targets='many', absent_prior=0.5, max_fixations=20, **settings), link=1)
+    session.set_policy(_Sweep(poses))
+    session.reset()
+    return session
+
+
+def test_a_pass_takes_the_sweeps_poses_in_order_and_ends_on_the_likelier_side():
+    grid = Grid(3, 3)
+    model = _model(grid, k=3, seed=4)
+    poses = [0, 2, 8, 6]
+    session = _pass_session(grid, model, poses)
+    assert session.passing
+    taken = [session.start()]
+    rng = np.random.default_rng(1)
+    result = None
+    while not session.ended:
+        result = session.update(Frame(rng.integers(0, 3, grid.n_cells).astype(float)))
+        if not session.ended:
+            taken.append(result.fixation)
+    assert taken == poses and session.path == tuple(poses)
+    assert result.reason == 'pass' and session.gave_up_reason == 'pass'
+    assert session.occupied().tolist() == (session.log_odds > 0).tolist()
+    assert result.decision == ('found' if session.faces() else 'absent')
+    # Any other policy: the infomax choice, as before.
+    other = OccupancySession(grid, model, SearchSettings(targets='many', absent_prior=0.5))
+    other.set_policy(object())
+    other.reset()
+    assert not other.passing
+
+
+def test_a_pass_names_grouped_detections_apart_from_the_beliefs_faces():
+    grid = Grid(5, 5)
+    pt = np.tile([0.5, 0.5], (5, 5, 1))              # counts that say nothing: the belief
+    model = CountObservation(grid, pt, pt.copy())     # names no face, the groups decide
+    session = _pass_session(grid, model, [6, 8, 18])
+    session.start()
+    groups = np.zeros((3, grid.n_cells))
+    groups[0, [0, 1, 12]] = 1                         # 1 is within one cell of 0: one face
+    groups[1, [13, 24]] = 1                           # 13 is next to 12 (seen before)
+    groups[2, [24]] = 2                               # the same face again
+    for frame_groups in groups:
+        session.update(Frame(np.zeros(grid.n_cells), groups=frame_groups))
+    assert session.ended and session.decision == 'found'
+    faces = session.faces()
+    assert [f['cell'] for f in faces] == [0, 12, 24]
+    assert all(f['grouped'] and f['box'] is None for f in faces)
+    assert [f['probability'] for f in faces] == pytest.approx(session.belief[[0, 12, 24]])
+
+
+def test_a_pass_names_the_beliefs_faces_first_and_groups_only_away_from_them():
+    grid = Grid(3, 3)
+    pt = np.tile([0.05, 0.95], (3, 3, 1))
+    pn = np.tile([0.95, 0.05], (3, 3, 1))
+    session = _pass_session(grid, CountObservation(grid, pt, pn), [4])
+    session.start()
+    values = np.zeros(grid.n_cells)
+    values[0] = 1.0                                  # the belief: cell 0 likelier occupied
+    groups = np.zeros(grid.n_cells)
+    groups[[1, 8]] = 1                               # 1 is within one cell of it, 8 is not
+    result = session.update(Frame(values, groups=groups))
+    assert result.ended and result.reason == 'pass'
+    assert [(f['cell'], f.get('grouped', False)) for f in session.faces()] == [(0, False),
+                                                                             (8, True)]
+
+
+@pytest.mark.parametrize('groups, match', [
+    (np.zeros(3), 'shape'), (np.full(4, -1.0), 'whole numbers'), (np.full(4, 0.5), 'whole'),
+    (np.array([0, 1, np.nan, 0]), 'whole'), (np.array([0, np.inf, 0, 0]), 'whole')])
+def test_bad_groups_are_refused_and_the_belief_is_unchanged(groups, match):
+    from ipomdp_gaze.model.belief import EvidenceError
+    grid = Grid(2, 2)
+    session = _pass_session(grid, _model(grid, k=2), [0, 3])
+    session.start()
+    before = session.log_odds.copy()
+    with pytest.raises(EvidenceError, match=match):
+        session.checked_frame(np.zeros(4), groups=groups)
+    result = session.update(Frame(np.zeros(4), groups=groups))
+    assert result.status == 'rejected' and match in result.reason
+    assert np.array_equal(session.log_odds, before) and session.fixations == 0
+
+
+def test_a_moving_search_makes_no_pass():
+    grid = Grid(3, 3)
+    session = OccupancySession(grid, _model(grid), SearchSettings(
+        targets='many', motion_sigma_cells=0.5))
+    session.set_policy(_Sweep([0, 8]))
+    session.reset()
+    assert not session.passing

@@ -176,7 +176,8 @@ def test_pass_many_takes_the_sweeps_views_and_answers_its_belief_and_the_grouped
     import json
 
     from ipomdp_gaze.drivers.rooms import room_session
-    from ipomdp_gaze.drivers.scene_tasks import SceneTask
+    from ipomdp_gaze.drivers.scene_tasks import ROOM_GROUP_MIN_NEIGHBORS, SceneTask
+    from ipomdp_gaze.drivers.sweep_rules import grouped_cells
     from ipomdp_gaze.simulation.evaluation import cells_apart
     out = tmp_path / 'rooms.json'
     # Training room 1002 holds 4 faces; the grouped sweep finds 3 of them, the belief 4.
@@ -195,10 +196,16 @@ def test_pass_many_takes_the_sweeps_views_and_answers_its_belief_and_the_grouped
     task = SceneTask.get(spec)
     task.sensor.start(task.scene(0).image)
     session, outcome, _, faces = room_session(spec, task, 0, 'pass-many')
-    assert list(outcome.path) == swept['path']
-    assert all(session.log_odds[f['cell']] > 0 for f in faces)
-    belief = [list(task.model.grid.cell(f['cell'])) for f in faces]
+    assert list(outcome.path) == swept['path'] and outcome.reason == 'pass'
+    # The views' groups are the grouped sweep's detections, per cell.
+    grid = task.model.grid
+    for pose in swept['path']:
+        cells = grouped_cells(task, pose, ROOM_GROUP_MIN_NEIGHBORS)
+        assert task.sensor.observe(pose).groups.tolist() == np.bincount(
+            cells, minlength=grid.n_cells).tolist()
+    belief = [list(grid.cell(f['cell'])) for f in faces if not f.get('grouped')]
     assert passed['answers'][:len(belief)] == belief
+    assert all(session.log_odds[f['cell']] > 0 for f in faces if not f.get('grouped'))
     assert passed['faces_found'] >= swept['faces_found']
     assert passed['faces_found'] > swept['faces_found']     # this room: grouping misses one
 

@@ -17,13 +17,15 @@ pan-tilt --faces K|LO-HI``). Its searchers, all on the same views of the task's
   face per cluster, boxes unused; ``many-posterior``: a cell is decided empty by its posterior
   (``P(x_j) <= 1 - c``, ``OccupancySession(empty_by_evidence=False)``) instead of its evidence
   alone;
-- ``pass-many`` (optionally ``pass-many:parameter=value,...``): the sweep's one pass (its poses,
-  in its order: the same views and head time) fed to the ``many`` session, which ends there
-  unless every cell was decided before; its answer is ``many``'s faces on their likelier side
-  (``P(x_j) > 1/2``, boxes split them) together with every detection grouped as
-  ``detectMultiScale`` does with ``min_neighbors`` :data:`PASS_MIN_NEIGHBORS` that is not within
-  one cell of one of them: grouping and the belief each see faces the other misses
-  (docs/design.md section 11.7);
+- ``pass-many`` (optionally ``pass-many:parameter=value,...``): the ``many`` session given the
+  sweep as its policy, so one pass of the sweep's poses (the same views and head time as the
+  sweeps; :class:`~ipomdp_gaze.search.many.OccupancySession`'s pass); its answer is the faces on
+  their likelier side (``P(x_j) > 1/2``, split by the boxes) together with every detection
+  grouped as ``detectMultiScale`` does with ``min_neighbors``
+  :data:`~ipomdp_gaze.drivers.scene_tasks.ROOM_GROUP_MIN_NEIGHBORS` (the views' ``groups``) more
+  than one cell from a face already named: grouping and the belief each see faces the other
+  misses (docs/design.md section 11.7); ``pass-many-cells``: the same without the boxes (one face
+  per cluster of cells, as the node answers);
 - ``sweep-all-grouped3`` / ``sweep-all-grouped5``: one pass of the sweep's poses answering every
   detection grouped as ``detectMultiScale`` does (``min_neighbors`` 3 / 5), each at the cell of
   its box centre; a detection within one cell of one already answered is the same face (the
@@ -59,9 +61,6 @@ SETTLE_LINK = 1
 FACE_LINK = 2
 # Pixels per cell of the room picture the searcher's boxes are drawn into (room_boxes).
 ROOM_CELL_PX = 100
-# The grouping whose detections pass-many answers besides its belief (the grouped sweep a team
-# keeps: no false face on the training rooms, where 3 named some; docs/design.md section 11.7).
-PASS_MIN_NEIGHBORS = 5
 
 
 def room_settings(settings, label: str = 'many'):
@@ -85,11 +84,10 @@ def room_session(spec, task, index: int, label: str = 'many'):
     if every:            # every view, then the budget's answer: a bound on the belief
         settings = replace(settings, max_fixations=grid.n_cells, decide_at_budget=False,
                            confidence=1 - 1e-12)
-    elif name == 'pass-many':       # the sweep's pass, then every cell on its likelier side
-        order = [int(p) for p in task.sweep.poses]
-        settings = replace(settings, max_fixations=len(order), decide_at_budget=True)
     session = OccupancySession(grid, task.model, settings, link=SETTLE_LINK,
                                empty_by_evidence=name != 'many-posterior')
+    if name.startswith('pass-many'):
+        session.set_policy(task.sweep)              # one pass of its poses
     detector_s = []
     outcome = run_search(session, task.sensor, None,
                          seed=np.random.default_rng([spec.seed, index]),
@@ -99,7 +97,7 @@ def room_session(spec, task, index: int, label: str = 'many'):
     if every:
         session = _Decided(session)
     boxes = None
-    if name != 'many-cells':
+    if name not in ('many-cells', 'pass-many-cells'):
         boxes = room_boxes(task, outcome.path)
     faces = session.faces(boxes, None, _room_px(grid), link=FACE_LINK) if boxes is not None \
         else session.faces(link=FACE_LINK)
@@ -167,11 +165,7 @@ def room_search(spec, task, scene, index: int, label: str) -> SceneResult:
     ended = bool(outcome.decision)
     decision = outcome.decision if ended else 'gave_up'
     reason = outcome.reason if ended else 'limit'
-    done = ended and not reason
-    if label.split(':')[0] == 'pass-many':
-        answers = with_grouped(task, outcome.path, answers, PASS_MIN_NEIGHBORS)
-        decision = 'found' if answers else 'absent'
-        done = ended                # the pass is its rule, as the sweep's
+    done = ended and reason in ('', 'pass')          # a pass ends by its own rule, as a sweep
     return room_result(task, scene, index, label, answers, decision, reason, outcome.path,
                        outcome.detector_pixels, detector_s, done=done)
 

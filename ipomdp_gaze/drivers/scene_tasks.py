@@ -41,7 +41,7 @@ DEFAULT_BUDGET = 60
 # the session's belief and the grouped detections together, and the sweeps answering every
 # grouped detection.
 ROOM_SEARCHERS = ('many', 'many-cells', 'many-posterior', 'every-view-many',
-                  'pass-many') + ROOM_SWEEPS
+                  'pass-many', 'pass-many-cells') + ROOM_SWEEPS
 # What rooms change in the pan/tilt configuration: the many-target setting, without what the
 # occupancy belief does not model (false-alarm scales, hotspots; the choice per second of head
 # time it keeps: docs/design.md section 11.5) ...
@@ -50,6 +50,9 @@ ROOM_MODEL = {'targets': 'many', 'false_alarm_scales': (1.0,), 'hotspot_prior': 
 # of a cell weigh 0.1 (at 1, texture seen from several views became false faces), within the
 # configuration's budget of 20 fixations (40 found one more face of 50 in twice the head time).
 ROOM_CHOICES = {'repeat_weight': 0.1}
+# The grouping a room's views also report (Frame.groups), which pass-many answers: the grouped
+# sweep a team keeps (no false face on the training rooms, where 3 named some; section 11.7).
+ROOM_GROUP_MIN_NEIGHBORS = 5
 ROOM_BUDGET = 20
 _FOVEA_TASKS = {'faces-420': ('faces-420', 420, (60, 140)),
                 'faces-840': ('faces-840', 840, (24, 140))}
@@ -235,6 +238,8 @@ class SceneTask:
             geometry = SceneGeometry(self.model.grid, setup.camera)
             recorder = Recording(setup.observer.detector)
             setup.observer.detector = recorder
+            if spec.rooms:
+                setup.observer.group_min_neighbors = ROOM_GROUP_MIN_NEIGHBORS
             self.sensor = ViewCache(PanTiltSensor(setup.observer, geometry), recorder)
             self.camera = setup.camera
             self.max_count = setup.observer.max_count

@@ -43,6 +43,12 @@ found ``motion.dwell_s`` in turn (``motion.track_view``: the cell of its positio
 people followed left out; with nobody found, or
 ``motion.track_view: policy``, every view is that choice.
 
+**One pass** (still targets, a policy with ``poses``, the sweep's: :meth:`set_policy`;
+docs/design.md section 11.7): the views are the pass's poses in order, once each; the search
+ends after the last (reason ``pass``; earlier if every cell was decided) with every cell on its
+likelier side, and its faces also name every grouped detection the frames carried
+(``Frame.groups``) more than one cell from a face already named.
+
 The answer for drivers: :meth:`OccupancySession.faces` (one face per cluster of occupied cells,
 :func:`ipomdp_gaze.model.occupancy.count_faces`). The session imports no ROS, prints and writes
 nothing.
@@ -61,7 +67,8 @@ from ipomdp_gaze.model.occupancy import (binary_entropy, cell_prior, count_faces
                                          information_table, log_nobody, occupancy,
                                          predict_occupancy, prior_log_odds)
 from ipomdp_gaze.model.still_evidence import StillEvidence
-from ipomdp_gaze.search.session import (check_offsets, Frame, motion_settings, OrderError,
+from ipomdp_gaze.search.session import (check_groups, check_offsets, Frame, motion_settings,
+                                        OrderError,
                                         position_settings, SearchSettings, start_index,
                                         StepResult, target_motion, track_filter)
 from ipomdp_gaze.search.tracks import GLANCE, Tracks, Turns
@@ -124,6 +131,7 @@ class OccupancySession:
         self.settings.check_grid(grid)
         check_many_settings(self.settings)
         self.policy = None
+        self._pass = None
         self.link = int(link)
         self.empty_by_evidence = bool(empty_by_evidence)
         self.table = information_table(self.observation)
@@ -193,8 +201,21 @@ class OccupancySession:
         self._counts = isinstance(self.observation, CountObservation)
 
     def set_policy(self, policy) -> None:
-        """Keep ``policy`` for the record: the occupancy search chooses by its own infomax."""
+        """
+        Keep ``policy``: a sweep (a policy with ``poses``) makes a still search one pass of them.
+
+        Any other policy is kept for the record: the occupancy search chooses by its own
+        infomax. Takes effect at the next :meth:`reset`.
+        """
         self.policy = policy
+        poses = getattr(policy, 'poses', None) if getattr(policy, 'name', '') == 'sweep' \
+            else None
+        self._pass = None if poses is None else np.asarray(poses, dtype=np.int64).copy()
+
+    @property
+    def passing(self) -> bool:
+        """Whether this search is one pass of the sweep's poses (still targets only)."""
+        return self._pass is not None and not self._motion.active
 
     # -- read-only views -----------------------------------------------------------------
     def _s(self) -> dict:
@@ -236,9 +257,13 @@ class OccupancySession:
         return float(binary_entropy(self.belief).sum())
 
     def occupied(self) -> np.ndarray:
-        """Return the occupied cells (N,): ``P >= confidence``; after a deadline ``P > 1/2``."""
+        """
+        Return the occupied cells (N,): ``P >= confidence``; after a deadline ``P > 1/2``.
+
+        After a pass (reason ``pass``) too: it ends with every cell on its likelier side.
+        """
         s, log_odds = self._s(), self.log_odds
-        if s['reason'] and self.settings.decide_at_budget:
+        if s['reason'] == 'pass' or (s['reason'] and self.settings.decide_at_budget):
             return log_odds > 0
         return self._decided(log_odds)[0]
 
@@ -266,8 +291,30 @@ class OccupancySession:
         if self._motion.active:
             return [{'cell': t.cell, 'cells': np.array([t.cell]), 'probability': t.probability,
                      'box': None, 'person': t.person} for t in self.tracks.found]
-        return count_faces(self.log_odds, self.grid, self.occupied(), boxes, scores, image_px,
-                           link)
+        faces = count_faces(self.log_odds, self.grid, self.occupied(), boxes, scores, image_px,
+                            link)
+        if self.passing:
+            faces += self._grouped_faces(faces)
+        return faces
+
+    def _grouped_faces(self, faces: list) -> list[dict]:
+        """
+        Return the pass's grouped detections more than one cell from every face named before.
+
+        In the order the views saw them (row-major within a view), each ``{'cell', 'cells',
+        'probability'`` (the belief's, which may doubt it), ``'box': None, 'grouped': True}``.
+        """
+        rows, cols = self.grid.rows_cols()
+        named = [int(f['cell']) for f in faces]
+        out = []
+        belief = self.belief
+        for cell in self._s()['groups']:
+            if all(max(abs(rows[cell] - rows[c]), abs(cols[cell] - cols[c])) > 1
+                   for c in named):
+                named.append(cell)
+                out.append({'cell': cell, 'cells': np.array([cell]),
+                            'probability': float(belief[cell]), 'box': None, 'grouped': True})
+        return out
 
     # -- the steps -----------------------------------------------------------------------
     def reset(self, *, seed=None) -> None:
@@ -293,7 +340,7 @@ class OccupancySession:
                        'fixations': 0, 'path': [], 'scanned': False, 'decision': '',
                        'reason': '', 'ended': False, 'outside': outside, 'clock_s': 0.0,
                        'room_done': False, 'decided_once': False,
-                       'visited': np.zeros(n, dtype=bool)}
+                       'visited': np.zeros(n, dtype=bool), 'groups': []}
         self._event('reset', settings=self.settings.to_parameters(), cell_prior=q)
 
     def exclude(self, cells) -> None:
@@ -309,16 +356,19 @@ class OccupancySession:
             self.observation.counts(obs)
         return obs
 
-    def checked_frame(self, values, kind: str = 'fixation', offsets=None) -> Frame:
+    def checked_frame(self, values, kind: str = 'fixation', offsets=None,
+                      groups=None) -> Frame:
         """
-        Return ``Frame(values, kind, offsets=offsets)`` checked once (EvidenceError).
+        Return ``Frame(values, kind, offsets=offsets, groups=groups)`` checked once.
 
-        The values as :meth:`check_frame`, the detections' offsets as the single-target
-        session's (:func:`~ipomdp_gaze.search.session.check_offsets`); the many-target belief
-        does not read them.
+        The values as :meth:`check_frame`, the detections' offsets and grouped detections as
+        :func:`~ipomdp_gaze.search.session.check_offsets` and
+        :func:`~ipomdp_gaze.search.session.check_groups` (EvidenceError); the belief reads
+        neither, a pass answers the groups.
         """
         return Frame(self.check_frame(values), kind=kind,
-                     offsets=check_offsets(offsets, self.grid.n_cells))
+                     offsets=check_offsets(offsets, self.grid.n_cells),
+                     groups=check_groups(groups, self.grid.n_cells))
 
     def scan(self, frame: Frame) -> StepResult:
         """
@@ -354,7 +404,9 @@ class OccupancySession:
         if s['fixation'] is not None:
             raise OrderError('the search has started already; reset starts a new one')
         fixed = start_index(self.grid, self.settings)
-        if fixed is not None:
+        if self.passing:
+            s['fixation'] = int(self._pass[0])
+        elif fixed is not None:
             s['fixation'] = fixed
         elif s['scanned'] or self.settings.start_cell == 'policy':
             s['fixation'] = self._choose()
@@ -398,6 +450,7 @@ class OccupancySession:
         try:
             obs = self.check_frame(frame.values)
             offsets = check_offsets(frame.offsets, self.grid.n_cells)
+            groups = check_groups(frame.groups, self.grid.n_cells)
             term = self.observation.log_likelihood_ratio(obs, k)
         except EvidenceError as exc:
             return self._result('rejected', reason=str(exc))
@@ -416,6 +469,8 @@ class OccupancySession:
         s['fixations'] += 1
         s['path'].append(k)
         s['visited'][k] = True
+        if groups is not None:
+            s['groups'].extend(int(c) for c in np.flatnonzero(groups > 0))
         if self._motion.active:
             fired = self._decide_moving(obs, offsets, dt_s)
         else:
@@ -423,7 +478,7 @@ class OccupancySession:
         if not s['ended']:
             following = self._choose_moving(dt_s) if self._motion.active else self._choose()
             if following is None:
-                fired = self._limit('repeat')
+                fired = self._end_pass() if self.passing else self._limit('repeat')
             else:
                 s['fixation'] = following
         self._event('frame', fixation=self._rc(k), frame=frame.summary(),
@@ -487,6 +542,9 @@ class OccupancySession:
 
     def _choose(self) -> int | None:
         s = self._s()
+        if self.passing:
+            left = self._pass[~s['visited'][self._pass]]
+            return int(left[0]) if left.size else None
         costs = self.costs_from(s['fixation'])
         score = self.gains() / costs
         if self.settings.inhibit_return:
@@ -592,9 +650,18 @@ class OccupancySession:
             s['decision'] = 'found' if occupied.any() else 'absent'
             s['ended'] = True
             return s['decision']
+        if self.passing and s['visited'][self._pass].all():
+            return self._end_pass()
         if settings.max_fixations and s['fixations'] >= settings.max_fixations:
             return self._limit('budget')
         return ''
+
+    def _end_pass(self) -> str:
+        """End a pass after its last pose: every cell on its likelier side, groups named."""
+        s = self._state
+        s['reason'], s['ended'] = 'pass', True
+        s['decision'] = 'found' if self.faces() else 'absent'
+        return s['decision']
 
     def _limit(self, reason: str) -> str:
         s = self._state

@@ -125,6 +125,27 @@ def _check_mixture_model(settings: SearchSettings, observation) -> None:
                      f'{getattr(observation, "name", type(observation).__name__)}')
 
 
+def check_groups(groups, n_cells: int) -> np.ndarray | None:
+    """
+    Return a frame's grouped detections per cell as ``(N,)`` float64 (None stays None).
+
+    Raises
+    ------
+    EvidenceError
+        If the shape is not ``(N,)`` or a value is not a whole number >= 0.
+
+    """
+    if groups is None:
+        return None
+    values = np.asarray(groups, dtype=np.float64)
+    if values.shape != (n_cells,):
+        raise EvidenceError(f'groups must have shape ({n_cells},), got {values.shape}')
+    if not (np.isfinite(values).all() and (values >= 0).all()
+            and (values == np.round(values)).all()):
+        raise EvidenceError('groups must be whole numbers >= 0 (grouped detections per cell)')
+    return values
+
+
 def check_offsets(offsets, n_cells: int) -> np.ndarray | None:
     """
     Return a frame's per-cell detection offsets as ``(N, 2)`` float64 (None stays None).
@@ -188,8 +209,11 @@ class Frame:
     the sensor wants drivers to draw or record. ``offsets`` ``(N, 2)``, optional: the mean
     offset ``(row, col)`` in cells of the detections centred in each cell from its centre (NaN
     where none), which ``motion.track_view: position`` reads (docs/design.md section 12.9).
-    A frame built by :meth:`SearchSession.checked_frame` carries the session and model that
-    checked it, so that session does not check it again.
+    ``groups`` ``(N,)``, optional: how many of the detector's grouped detections (as
+    ``detectMultiScale`` groups its raw boxes) are centred in each cell, which a many-target
+    pass answers (docs/design.md section 11.7). A frame built by
+    :meth:`SearchSession.checked_frame` carries the session and model that checked it, so that
+    session does not check it again.
     """
 
     values: np.ndarray
@@ -198,6 +222,7 @@ class Frame:
     seconds: float = 0.0
     detections: tuple = ()
     offsets: np.ndarray | None = None
+    groups: np.ndarray | None = None
     _checked_by: tuple = field(default=(), init=False, repr=False, compare=False)
 
     def summary(self) -> dict:
@@ -531,9 +556,13 @@ class SearchSession:
             self.observation.counts(obs)
         return obs
 
-    def checked_frame(self, values, kind: str = 'fixation', offsets=None) -> Frame:
+    def checked_frame(self, values, kind: str = 'fixation', offsets=None,
+                      groups=None) -> Frame:
         """
-        Return ``Frame(values, kind, offsets=offsets)`` checked here, once (:meth:`check_frame`).
+        Return ``Frame(values, kind, offsets=offsets, groups=groups)`` checked here, once.
+
+        The values as :meth:`check_frame`; ``groups`` are checked and kept (one target does not
+        read them).
 
         :meth:`update` and :meth:`scan` take it without checking it again while the session
         assumes the same model. For a driver that must know whether a frame is usable before
@@ -548,7 +577,8 @@ class SearchSession:
 
         """
         frame = Frame(self.check_frame(values), kind=kind,
-                      offsets=check_offsets(offsets, self.grid.n_cells))
+                      offsets=check_offsets(offsets, self.grid.n_cells),
+                      groups=check_groups(groups, self.grid.n_cells))
         object.__setattr__(frame, '_checked_by', (self, self.observation))
         return frame
 

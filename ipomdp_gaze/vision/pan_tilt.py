@@ -96,6 +96,9 @@ class ViewObservation:
     offsets : numpy.ndarray
         ``(N, 2)`` mean offset ``(row, col)`` in cells of the detections centred in each cell
         from its centre, NaN where none (:func:`ipomdp_gaze.model.head_camera.point_offsets`).
+    groups : numpy.ndarray or None
+        With the observer's ``group_min_neighbors`` > 0: ``(N,)`` how many detections grouped
+        as ``detectMultiScale`` groups (with that ``min_neighbors``) are centred in each cell.
 
     """
 
@@ -110,6 +113,7 @@ class ViewObservation:
     group_cells: np.ndarray = None
     group_support: np.ndarray = None
     offsets: np.ndarray = None
+    groups: np.ndarray = None
 
 
 def view_groups(boxes, min_neighbors: int, camera: PinholeCamera, grid: Grid, head,
@@ -151,11 +155,15 @@ class ViewObserver:
         K: counts are clipped to ``0..K-1``.
     cells : CellObservation, optional
         What a cell's observation is (default: the clipped count); its K must be ``max_count``.
+    group_min_neighbors : int
+        > 0: also count each view's detections grouped with this ``min_neighbors`` per cell
+        (``ViewObservation.groups``, what a many-target pass answers; docs/design.md section
+        11.7); 0: not.
 
     """
 
     def __init__(self, detector, grid: Grid, max_count: int = 10,
-                 cells: CellObservation | None = None):
+                 cells: CellObservation | None = None, group_min_neighbors: int = 0):
         if not callable(detector):
             raise ValueError(f'detector must be callable, got {type(detector).__name__}')
         if isinstance(max_count, bool) or int(max_count) != max_count or max_count < 2:
@@ -167,6 +175,11 @@ class ViewObserver:
         if not isinstance(self.cells, CellObservation) or self.cells.max_count != self.max_count:
             raise ValueError(f'cells must be a CellObservation with K = max_count '
                              f'({self.max_count}), got {self.cells!r}')
+        if isinstance(group_min_neighbors, bool) or int(group_min_neighbors) != \
+                group_min_neighbors or group_min_neighbors < 0:
+            raise ValueError(f'group_min_neighbors must be an int >= 0, got '
+                             f'{group_min_neighbors!r}')
+        self.group_min_neighbors = int(group_min_neighbors)
         self._color = detector_color(detector)
 
     def observe(self, image: np.ndarray, camera: PinholeCamera, head_rc) -> ViewObservation:
@@ -200,10 +213,15 @@ class ViewObserver:
             values = self.cells.values(cells[inside], scores[inside], self.grid.n_cells,
                                        groups)
             counts = np.where(np.isnan(counts), np.nan, values)
+        per_cell = None
+        if self.group_min_neighbors:
+            found, _ = view_groups(boxes, self.group_min_neighbors, camera, self.grid, head,
+                                   self.max_count, getattr(self.detector, 'group', None))
+            per_cell = np.bincount(found[found >= 0], minlength=self.grid.n_cells).astype(float)
         return ViewObservation(counts, raw, head, centres, cells,
                                int(pixels.shape[0] * pixels.shape[1]),
                                time.perf_counter() - t0, scores, group_cells, group_support,
-                               point_offsets(centres, camera, self.grid, head))
+                               point_offsets(centres, camera, self.grid, head), per_cell)
 
 
 @dataclass(frozen=True)
