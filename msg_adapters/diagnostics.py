@@ -61,7 +61,8 @@ def _ending(forced_by: str, confidence: float | None) -> tuple[str, dict]:
     values = {'ended': f'forced:{forced_by}' if forced_by else 'confidence'}
     if confidence is not None:
         values['confidence'] = float(confidence)
-    limit = {'budget': 'the fixation budget'}.get(forced_by, forced_by)
+    limit = {'budget': 'the fixation budget', 'pass': 'the end of its pass'}
+    limit = limit.get(forced_by, forced_by)
     if forced_by:
         below = f' below the confidence {confidence:g}' if confidence is not None else ''
         clause = f', forced by {limit}{below}'

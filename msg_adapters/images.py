@@ -69,16 +69,21 @@ def rgb8_array(msg: Image) -> np.ndarray:
     return buf.reshape(msg.height, msg.step)[:, :3 * msg.width].reshape(msg.height, msg.width, 3)
 
 
-def evidence_image(values, grid: Grid, stamp, frame_id: str = '', offsets=None) -> Image:
+def evidence_image(values, grid: Grid, stamp, frame_id: str = '', offsets=None,
+                   groups=None) -> Image:
     """
     Per-cell evidence as a stamped image (height = rows, width = cols).
 
     ``32FC1``; with ``offsets`` ``(N, 2)``, ``32FC3``: per cell the evidence, then the mean
-    offset ``(row, col)`` in cells of the detections centred in it (NaN where none).
+    offset ``(row, col)`` in cells of the detections centred in it (NaN where none); with
+    ``groups`` ``(N,)`` too, ``32FC4``: then the number of grouped detections centred in it
+    (``groups`` needs ``offsets``).
     """
     a = np.asarray(values, dtype=np.float32).reshape(-1)
     if a.size != grid.n_cells:
         raise ValueError(f'expected {grid.n_cells} values, got {a.size}')
+    if groups is not None and offsets is None:
+        raise ValueError('groups go in a 32FC4 image after the offsets: give both')
     channels = 1
     if offsets is not None:
         o = np.asarray(offsets, dtype=np.float32)
@@ -86,6 +91,12 @@ def evidence_image(values, grid: Grid, stamp, frame_id: str = '', offsets=None) 
             raise ValueError(f'expected offsets of shape ({grid.n_cells}, 2), got {o.shape}')
         a = np.concatenate([a[:, None], o], axis=1)
         channels = 3
+    if groups is not None:
+        g = np.asarray(groups, dtype=np.float32)
+        if g.shape != (grid.n_cells,):
+            raise ValueError(f'expected groups of shape ({grid.n_cells},), got {g.shape}')
+        a = np.concatenate([a, g[:, None]], axis=1)
+        channels = 4
     msg = Image(header=Header(stamp=stamp, frame_id=frame_id), height=grid.rows,
                 width=grid.cols, encoding=f'32FC{channels}', is_bigendian=int(not _LITTLE),
                 step=4 * channels * grid.cols)
@@ -121,20 +132,31 @@ def evidence_from_image(msg: Image, grid: Grid) -> np.ndarray:
 
 def evidence_and_offsets(msg: Image, grid: Grid) -> tuple[np.ndarray, np.ndarray | None]:
     """
-    Read a ``32FC1`` or ``32FC3`` evidence image: values (N,) and offsets (N, 2) or None.
+    Read an evidence image's values (N,) and offsets (N, 2) or None (groups dropped).
+
+    Raises as :func:`evidence_channels`.
+    """
+    return evidence_channels(msg, grid)[:2]
+
+
+def evidence_channels(msg: Image, grid: Grid) -> tuple:
+    """
+    Read a ``32FC1``, ``32FC3`` or ``32FC4`` evidence image (:func:`evidence_image`).
+
+    Returns ``(values (N,), offsets (N, 2) or None, groups (N,) or None)``.
 
     Raises
     ------
     LayoutError
-        If the encoding is neither ``32FC1`` nor ``32FC3`` or the size is not ``rows x cols``.
+        If the encoding is not one of those or the size is not ``rows x cols``.
     EvidenceError
         If the data does not match the declared step and height.
 
     """
     encoding = msg.encoding.upper()
-    if encoding not in ('32FC1', '32FC3'):
-        raise LayoutError(f"evidence image encoding is {msg.encoding!r}, expected '32FC1' "
-                          f"or '32FC3'")
+    if encoding not in ('32FC1', '32FC3', '32FC4'):
+        raise LayoutError(f"evidence image encoding is {msg.encoding!r}, expected '32FC1', "
+                          f"'32FC3' or '32FC4'")
     if (msg.height, msg.width) != grid.shape:
         raise LayoutError(f'evidence image is {msg.height}x{msg.width} (height x width), '
                           f'the grid is {grid.rows}x{grid.cols}')
@@ -147,7 +169,9 @@ def evidence_and_offsets(msg: Image, grid: Grid) -> tuple[np.ndarray, np.ndarray
     rows = buf.reshape(msg.height, msg.step)[:, :row_bytes]
     dtype = np.dtype('>f4' if msg.is_bigendian else '<f4')
     data = np.ascontiguousarray(rows).view(dtype).reshape(-1, channels).astype(np.float64)
-    return data[:, 0].copy(), (data[:, 1:].copy() if channels == 3 else None)
+    offsets = data[:, 1:3].copy() if channels >= 3 else None
+    groups = data[:, 3].copy() if channels == 4 else None
+    return data[:, 0].copy(), offsets, groups
 
 
 def image_array(msg: Image, max_side_px: int = MAX_IMAGE_SIDE_PX) -> np.ndarray:

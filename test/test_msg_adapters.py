@@ -186,6 +186,35 @@ def test_evidence_image_with_offsets_round_trip(big_endian):
         images.evidence_image(values, GRID, Time(sec=3), '', offsets[:5])
 
 
+@pytest.mark.parametrize('big_endian', [False, True])
+def test_evidence_image_with_groups_round_trip(big_endian):
+    rng = np.random.default_rng(3)
+    values = rng.integers(0, 10, 121).astype(float)
+    offsets = np.where(values[:, None] > 0, rng.uniform(-0.5, 0.5, (121, 2)), np.nan)
+    groups = np.where(values > 6, rng.integers(1, 3, 121), 0).astype(float)
+    msg = images.evidence_image(values, GRID, Time(sec=3), 'fixation/4', offsets, groups)
+    assert (msg.height, msg.width, msg.encoding, msg.step) == (11, 11, '32FC4', 176)
+    if big_endian:
+        raw = np.concatenate([values[:, None], offsets, groups[:, None]],
+                             axis=1).astype('>f4').tobytes()
+        msg = Image(height=11, width=11, encoding='32FC4', is_bigendian=1, step=176, data=raw)
+    back, back_offsets, back_groups = images.evidence_channels(msg, GRID)
+    np.testing.assert_array_equal(back, values.astype(np.float32))
+    np.testing.assert_array_equal(back_offsets, offsets.astype(np.float32))
+    np.testing.assert_array_equal(back_groups, groups)
+    two = images.evidence_and_offsets(msg, GRID)
+    assert len(two) == 2 and np.array_equal(two[1], back_offsets, equal_nan=True)
+    three = images.evidence_image(values, GRID, Time(sec=3), '', offsets)
+    assert images.evidence_channels(three, GRID)[2] is None
+    with pytest.raises(ValueError, match='give both'):
+        images.evidence_image(values, GRID, Time(sec=3), '', None, groups)
+    with pytest.raises(ValueError, match='groups of shape'):
+        images.evidence_image(values, GRID, Time(sec=3), '', offsets, groups[:5])
+    with pytest.raises(EvidenceError, match='step'):
+        images.evidence_channels(Image(height=11, width=11, encoding='32FC4', step=132,
+                                       data=np.zeros(363, '<f4').tobytes()), GRID)
+
+
 def test_evidence_image_with_row_padding():
     values = np.arange(121, dtype=np.float32).reshape(11, 11)
     padded = np.zeros((11, 12), dtype='<f4')

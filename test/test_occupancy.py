@@ -515,7 +515,7 @@ def test_a_pass_names_grouped_detections_apart_from_the_beliefs_faces():
     assert [f['probability'] for f in faces] == pytest.approx(session.belief[[0, 12, 24]])
 
 
-def test_a_pass_names_the_beliefs_faces_first_and_groups_only_away_from_them():
+def test_a_pass_names_the_better_placed_first_and_the_rest_only_away_from_them():
     grid = Grid(3, 3)
     pt = np.tile([0.05, 0.95], (3, 3, 1))
     pn = np.tile([0.95, 0.05], (3, 3, 1))
@@ -527,7 +527,12 @@ def test_a_pass_names_the_beliefs_faces_first_and_groups_only_away_from_them():
     groups[[1, 8]] = 1                               # 1 is within one cell of it, 8 is not
     result = session.update(Frame(values, groups=groups))
     assert result.ended and result.reason == 'pass'
-    assert [(f['cell'], f.get('grouped', False)) for f in session.faces()] == [(0, False),
+    # With the views' boxes the belief's face (at its box) first, the groups away from it ...
+    box = np.array([[1.0, 1.0, 8.0, 8.0]])            # centred in cell 0 of a 30x30 picture
+    with_boxes = session.faces(box, None, (30, 30))
+    assert [(f['cell'], f.get('grouped', False)) for f in with_boxes] == [(0, False), (8, True)]
+    # ... without them the groups (at their centres) first: cell 0 is taken for group 1's face.
+    assert [(f['cell'], f.get('grouped', False)) for f in session.faces()] == [(1, True),
                                                                              (8, True)]
 
 

@@ -57,6 +57,30 @@ def test_an_empty_room_is_absent():
     assert core.decision == 'absent' and core.session.faces(link=2) == []
 
 
+def test_the_core_with_the_sweep_makes_one_pass_and_takes_the_frames_groups():
+    sweep = build_policy('sweep', GRID, CAMERA)
+    core = GazeController(GRID, CAMERA, sweep, MANY)
+    core.reset(0.0)
+    assert core.session.passing and core.fixation == int(sweep.poses[0])
+    bad = core.offer(np.zeros(GRID.n_cells), 1.0, groups=np.full(GRID.n_cells, -1.0))
+    assert bad.status == 'rejected' and 'groups must be whole numbers' in bad.reason
+    assert core.session.fixations == 0
+    for values, reason in ((np.full(GRID.n_cells, np.nan), 'pass'),  # the views tell nothing
+                           (np.zeros(GRID.n_cells), '')):          # every cell decided
+        core.reset(0.0)
+        path, t = [], 1.0
+        while not core.stopped:
+            path.append(core.fixation)
+            groups = np.zeros(GRID.n_cells)
+            if len(path) == 1:
+                groups[FACES[1]] = 1                 # one view's grouped detection
+            t += 1.0
+            assert core.offer(values, t, groups=groups).applied
+        assert path == [int(p) for p in sweep.poses][:len(path)]
+        assert core.session.gave_up_reason == reason and core.decision == 'found'
+        assert [f['cell'] for f in core.session.faces(link=2)] == [FACES[1]]
+
+
 def test_one_target_is_the_papers_session_and_switching_starts_a_new_search():
     core = controller(SearchSettings())
     assert isinstance(core.session, SearchSession)

@@ -38,6 +38,7 @@ def _flat(tree, prefix=''):
     ('faces_fovea_controller.yaml', 'gaze_controller', 'controller', 'controller_params'),
     ('faces_camera_room_controller.yaml', 'gaze_controller', 'controller', 'controller_params'),
     ('faces_camera_detector.yaml', 'foveal_detector', 'detector', 'detector_params'),
+    ('faces_camera_room_detector.yaml', 'foveal_detector', 'detector', 'detector_params'),
     ('faces_fovea_detector.yaml', 'foveal_detector', 'detector', 'detector_params'),
     ('faces_camera_scene_camera.yaml', 'scene_camera', 'scene_camera', 'scene_camera_params'),
     ('faces_fovea_scene_camera.yaml', 'scene_camera', 'scene_camera', 'scene_camera_params'),

@@ -4,7 +4,8 @@
 Many-target mode over DDS: a room of two faces found, kept in view in turn, searched again.
 
 Three processes on the shipped pan/tilt face configuration (``config/faces_camera_*.yaml``,
-the controller's with ``faces_camera_room_controller.yaml`` after it): the
+the controller's with ``faces_camera_room_controller.yaml`` after it, the detector's with
+``faces_camera_room_detector.yaml``): the
 scene camera shows held-out room 0 of two faces (``scene.faces '2'``), the detector bins its
 detections to cells, and the controller runs ``search.targets many`` with the rooms' settings
 (docs/design.md section 11.5). The controller publishes both people on ``~/targets`` (their head
@@ -47,7 +48,8 @@ def rig(probe, nodes):
         '--params-file', config_path('faces_camera_room_controller.yaml'),
         '-p', 'room.dwell_s:=0.3', '-p', 'room.recheck_period_s:=0.0'])
     assert wait_for(lambda: rec['pan_tilt'], 60), rec['controller'].output()
-    nodes.start('detector', ['--params-file', config_path('faces_camera_detector.yaml')])
+    nodes.start('detector', ['--params-file', config_path('faces_camera_detector.yaml'),
+                             '--params-file', config_path('faces_camera_room_detector.yaml')])
     nodes.start('scene_camera', ['--params-file', config_path('faces_camera_scene_camera.yaml'),
                                  '-p', f'seed:={SEED}', '-p', "scene.faces:='2'"])
     return rec

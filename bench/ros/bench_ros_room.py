@@ -5,13 +5,14 @@ The controller in many-target mode over DDS on held-out rooms of 0-4 faces, agai
 
 For each of 50 seeds (3 with ``--quick``): the scene camera's held-out room of that seed
 (``scene.faces '0-4'``), the detector and the controller (``config/faces_camera_*.yaml``, the
-controller's with ``faces_camera_room_controller.yaml``: ``search.targets many`` and the rooms'
-settings, docs/design.md section 11.5) as three fresh processes. Recorded: the people the node
-publishes on ``~/target_cells`` with its ``room_done``, the seconds from starting the scene
-camera to ``room_done``, and whether the people are the offline many-target session's on the
-same room (``drivers.rooms.room_session``, ``many-cells``: one face per cluster, no boxes, as
-the node answers) and the room's faces (each within one cell, ``match_faces``). Test rooms;
-nothing was fitted to them.
+controller's with ``faces_camera_room_controller.yaml``: ``search.targets many``, the rooms'
+settings and the sweep's pass, docs/design.md sections 11.5 and 11.7; the detector's with
+``faces_camera_room_detector.yaml``: the grouped detections) as three fresh processes.
+Recorded: the people the node publishes on ``~/target_cells`` with its ``room_done``, the
+seconds from starting the scene camera to ``room_done``, and whether the people are the offline
+many-target session's on the same room (``drivers.rooms.room_session``, ``pass-many-cells``:
+no boxes, as the node answers) and the room's faces (each within one cell, ``match_faces``).
+Test rooms; nothing was fitted to them.
 """
 import time
 
@@ -38,7 +39,7 @@ def offline(seed: int) -> tuple[list, list]:
     scene = task.scene(0)
     task.sensor.start(scene.image)
     grid = task.model.grid
-    _, _, _, faces = room_session(spec, task, 0, 'many-cells')
+    _, _, _, faces = room_session(spec, task, 0, 'pass-many-cells')
     return ([tuple(int(v) for v in f.cell) for f in scene.faces],
             [tuple(int(v) for v in grid.cell(f['cell'])) for f in faces])
 
@@ -58,8 +59,9 @@ def run_room(seed: int) -> dict:
                 '--params-file', str(config_file('faces_camera_room_controller.yaml'))])
             if not watch.wait_until(lambda: watch.matched('room_done') > 0, 60):
                 raise RuntimeError('the controller did not come up')
-            nodes.start('detector', ['--params-file',
-                                     str(config_file('faces_camera_detector.yaml'))])
+            nodes.start('detector', [
+                '--params-file', str(config_file('faces_camera_detector.yaml')),
+                '--params-file', str(config_file('faces_camera_room_detector.yaml'))])
             t0 = time.monotonic()
             nodes.start('scene_camera', [
                 '--params-file', str(config_file('faces_camera_scene_camera.yaml')),

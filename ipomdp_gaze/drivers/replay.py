@@ -156,16 +156,16 @@ def _angles(msg, head: PanTiltMap) -> tuple[float, float]:
 
 def _frames(bag, grid: Grid) -> list:
     """
-    Return ``(stamp_s, arrival_s, values, kind, offsets)`` of every frame, in arrival order.
+    Return ``(stamp_s, arrival_s, values, kind, offsets, groups)`` of every frame, by arrival.
 
     ``kind`` is ``'scan'`` for a one-time scan (``header.frame_id`` ``scan/<id>``, design §10.3),
-    else ``'fixation'``; ``offsets`` ``(N, 2)`` from a ``32FC3`` evidence image (design §12.9),
-    else None.
+    else ``'fixation'``; ``offsets`` ``(N, 2)`` from a ``32FC3`` or ``32FC4`` evidence image
+    (design §12.9), ``groups`` ``(N,)`` from a ``32FC4`` one (design §11.7), else None.
     """
     frames = []
     for m in bag.topic('evidence_image'):
         msg = m.msg
-        channels = 3 if str(msg.encoding).upper() == '32FC3' else 1
+        channels = {'32FC3': 3, '32FC4': 4}.get(str(msg.encoding).upper(), 1)
         data = np.asarray(msg.data, dtype=np.uint8)
         rows = data.reshape(msg.height, msg.step)[:, :4 * channels * msg.width]
         cells = np.ascontiguousarray(rows).view('>f4' if msg.is_bigendian else '<f4')
@@ -173,10 +173,11 @@ def _frames(bag, grid: Grid) -> list:
         stamp = _seconds(msg.header.stamp)
         kind = 'scan' if str(msg.header.frame_id).startswith('scan/') else 'fixation'
         frames.append((stamp or m.time_ns * 1e-9, m.time_ns * 1e-9, cells[:, 0].copy(), kind,
-                       cells[:, 1:].copy() if channels == 3 else None))
+                       cells[:, 1:3].copy() if channels >= 3 else None,
+                       cells[:, 3].copy() if channels == 4 else None))
     for m in bag.topic('evidence'):
         frames.append((m.time_ns * 1e-9, m.time_ns * 1e-9,
-                       np.asarray(m.msg.data, dtype=np.float64), 'fixation', None))
+                       np.asarray(m.msg.data, dtype=np.float64), 'fixation', None, None))
     frames.sort(key=lambda f: f[1])
     if not frames:
         raise ValueError(f'{bag.path} has no evidence_image or evidence frame to replay')
@@ -264,7 +265,7 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
     say = result.lines.append
     if core.fixation != recorded_cells[0]:
         result.first_difference = 1
-    for stamp, arrival, values, kind, offsets in frames:
+    for stamp, arrival, values, kind, offsets, groups in frames:
         if result.first_difference is not None or core.stopped:
             break
         k = core.fixations
@@ -273,7 +274,7 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
         if kind == 'scan':          # the one-time scan of this (the only recorded) search
             step = core.offer_scan(values, core.search_id, now)
         else:
-            step = core.offer(values, stamp, now, offsets=offsets)
+            step = core.offer(values, stamp, now, offsets=offsets, groups=groups)
         if not step.applied:
             continue
         result.applied += 1

@@ -573,7 +573,7 @@ class GazeControllerNode(QuietPublishers, Node):
         self._take('evidence', info, _values_only, msg)
 
     def _on_evidence_image(self, msg: Image, info) -> None:
-        self._take('evidence_image', info, images.evidence_and_offsets, msg, msg.header.stamp,
+        self._take('evidence_image', info, images.evidence_channels, msg, msg.header.stamp,
                    images.read_frame_tag(msg))
 
     def _take(self, topic: str, info, read, msg, stamp=None, tag=('fixation', None)) -> None:
@@ -587,7 +587,7 @@ class GazeControllerNode(QuietPublishers, Node):
         now = self._now_s()
         self._count_drops(topic, info)
         try:
-            values, offsets = read(msg, self._config.grid)
+            values, offsets, groups = read(msg, self._config.grid)
         except EvidenceError as exc:
             self._handle(self.core.reject(str(exc)))
             return
@@ -596,7 +596,7 @@ class GazeControllerNode(QuietPublishers, Node):
             self._handle(self.core.offer_scan(values, search_id, now))
             return
         taken = now if stamp is None or stamps.is_zero(stamp) else stamps.to_seconds(stamp)
-        self._handle(self.core.offer(values, taken, now, search_id, offsets))
+        self._handle(self.core.offer(values, taken, now, search_id, offsets, groups))
 
     def _handle(self, result) -> None:
         if result.status == 'rejected':
@@ -734,8 +734,8 @@ class GazeControllerNode(QuietPublishers, Node):
 
 
 def _values_only(msg: Float32MultiArray, grid) -> tuple:
-    """Read an ``evidence`` array as ``(values, None)``: it carries no offsets."""
-    return grid_arrays.from_multiarray(msg, grid), None
+    """Read an ``evidence`` array as ``(values, None, None)``: no offsets, no groups."""
+    return grid_arrays.from_multiarray(msg, grid), None, None
 
 
 def main(args=None) -> int:

@@ -24,7 +24,9 @@ Relative topic names:
 - publishes ``evidence_image`` (``32FC1``, stamped with the image's capture stamp; NaN = not
   observed; with ``publish_offsets`` in ``camera`` mode ``32FC3``: per cell the count and the
   mean offset ``(row, col)`` of its detections from the cell's centre, in cells, which a
-  tracking controller with ``motion.track_view: position`` reads, docs/design.md section 12.9)
+  tracking controller with ``motion.track_view: position`` reads, docs/design.md section 12.9;
+  with ``publish_groups`` N > 0 ``32FC4``: those, then how many detections grouped with
+  ``min_neighbors`` N are centred in each cell, which a many-target pass names, section 11.7)
   or, with ``publish_image: false``, ``evidence``; and ``/diagnostics``.
 
 A malformed image (another encoding, a step or data length that disagrees with the size, an
@@ -127,6 +129,11 @@ def detector_params() -> list[Param]:
               "camera mode: evidence_image is 32FC3, each cell's count followed by the mean "
               'offset (row, col) of its detections from the cell centre in cells, NaN where none '
               '(for motion.track_view: position; read-only)', read_only=True),
+        Param('publish_groups', 0, T.INTEGER,
+              'camera mode, > 0: evidence_image is 32FC4, the 32FC3 channels then how many '
+              'detections grouped as detectMultiScale groups with this min_neighbors are centred '
+              'in each cell (what a many-target pass names, docs/design.md section 11.7; 0: '
+              'none; read-only)', int_range=(0, 1000), read_only=True),
         Param('publish_annotated', False, T.BOOL,
               'publish annotated_image (the camera image with the belief, fixations, fovea '
               'windows, detections and the found cell drawn on it, rgb8) and the raw '
@@ -223,6 +230,11 @@ class FovealDetectorNode(QuietPublishers, Node):
                 (values['grid.rows'], values['grid.cols'], values['grid.spacing_deg']),
                 _detector_settings(values), values['detector.cascade_dir'])
         head = head_from(values, setup.grid) if setup.mode == 'camera' else None
+        if values['publish_groups'] > 0:
+            if setup.mode != 'camera' or not values['publish_image']:
+                raise ValueError('publish_groups is for camera mode with publish_image: true '
+                                 '(the groups travel in the 32FC4 evidence_image)')
+            setup.observer.group_min_neighbors = int(values['publish_groups'])
         return DetectorConfig(dict(values), setup, head)
 
     def _apply_config(self, old: DetectorConfig, cfg: DetectorConfig) -> None:
@@ -302,11 +314,14 @@ class FovealDetectorNode(QuietPublishers, Node):
     def _handle(self, outcome) -> None:
         if outcome.status == 'published':
             frame, grid = outcome.frame, self._config.setup.grid
-            if self._config.values['publish_image']:
-                offsets = frame.offsets if self._config.values['publish_offsets'] else None
+            values = self._config.values
+            if values['publish_image']:
+                grouped = values['publish_groups'] > 0
+                offsets = frame.offsets if values['publish_offsets'] or grouped else None
                 self._image_pub.publish(images.evidence_image(
                     frame.counts, grid, frame.token,
-                    images.frame_tag(frame.kind, frame.search_id), offsets))
+                    images.frame_tag(frame.kind, frame.search_id), offsets,
+                    frame.groups if grouped else None))
             else:
                 self._evidence_pub.publish(grid_arrays.to_multiarray(frame.counts, grid))
             if self._annotator is not None:

@@ -434,7 +434,7 @@ class GazeController:
         return FrameResult('applied', fixation=cell)
 
     def offer(self, evidence, stamp_s: float, now_s: float | None = None,
-              search_id: int | None = None, offsets=None) -> FrameResult:
+              search_id: int | None = None, offsets=None, groups=None) -> FrameResult:
         """
         Use, skip or reject one frame of evidence taken at ``stamp_s``.
 
@@ -451,10 +451,13 @@ class GazeController:
             search is skipped. None: unknown, judged by its time alone.
         offsets : array (N, 2), optional
             The mean offset of each cell's detections from its centre (``Frame.offsets``).
+        groups : array (N,), optional
+            The grouped detections centred in each cell (``Frame.groups``).
 
         """
         try:
-            frame = self.session.checked_frame(evidence, offsets=offsets)   # checked once
+            frame = self.session.checked_frame(evidence, offsets=offsets,   # checked once
+                                               groups=groups)
         except EvidenceError as exc:
             return self.reject(str(exc))
         self.received += 1

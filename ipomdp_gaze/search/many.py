@@ -294,26 +294,38 @@ class OccupancySession:
         faces = count_faces(self.log_odds, self.grid, self.occupied(), boxes, scores, image_px,
                             link)
         if self.passing:
-            faces += self._grouped_faces(faces)
+            faces = self._with_groups(faces, boxes is not None)
         return faces
 
-    def _grouped_faces(self, faces: list) -> list[dict]:
+    def _with_groups(self, faces: list, boxes: bool) -> list[dict]:
         """
-        Return the pass's grouped detections more than one cell from every face named before.
+        Return a pass's faces: the belief's ``faces`` and its grouped detections, each once.
 
-        In the order the views saw them (row-major within a view), each ``{'cell', 'cells',
-        'probability'`` (the belief's, which may doubt it), ``'box': None, 'grouped': True}``.
+        The better placed come first, and a later one within one cell of an earlier is that
+        face: with the views' boxes, the belief's faces (each at its box), then the groups;
+        without them, the groups (each at its group's centre), then the belief's faces (a
+        cluster's likeliest cell, which may sit between two faces). Chosen on training rooms
+        (docs/design.md section 11.7). A grouped face is ``{'cell', 'cells', 'probability'``
+        (the belief's, which may doubt it), ``'box': None, 'grouped': True}``, in the order
+        the views saw them (row-major within a view).
         """
         rows, cols = self.grid.rows_cols()
-        named = [int(f['cell']) for f in faces]
-        out = []
         belief = self.belief
-        for cell in self._s()['groups']:
-            if all(max(abs(rows[cell] - rows[c]), abs(cols[cell] - cols[c])) > 1
-                   for c in named):
-                named.append(cell)
-                out.append({'cell': cell, 'cells': np.array([cell]),
-                            'probability': float(belief[cell]), 'box': None, 'grouped': True})
+        grouped = [{'cell': cell, 'cells': np.array([cell]), 'probability': float(belief[cell]),
+                    'box': None, 'grouped': True} for cell in self._s()['groups']]
+        out = []
+
+        def apart(cell, others):
+            return all(max(abs(rows[cell] - rows[int(f['cell'])]),
+                           abs(cols[cell] - cols[int(f['cell'])])) > 1 for f in others)
+        first, then = (faces, grouped) if boxes else (grouped, faces)
+        for face in first:                       # the belief's faces stay as counted (§11.3)
+            if not face.get('grouped') or apart(int(face['cell']), out):
+                out.append(face)
+        kept = list(out)
+        for face in then:
+            if apart(int(face['cell']), kept if not face.get('grouped') else out):
+                out.append(face)
         return out
 
     # -- the steps -----------------------------------------------------------------------
@@ -647,8 +659,9 @@ class OccupancySession:
         s, settings = self._state, self.settings
         occupied, empty = self._decided(self.log_odds)
         if np.all(self.settled(occupied) | empty):
-            s['decision'] = 'found' if occupied.any() else 'absent'
             s['ended'] = True
+            found = bool(self.faces()) if self.passing else occupied.any()   # and its groups
+            s['decision'] = 'found' if found else 'absent'
             return s['decision']
         if self.passing and s['visited'][self._pass].all():
             return self._end_pass()

@@ -282,7 +282,9 @@ class Frame:
     ``detections_px`` (raw detection centres ``(M, 2)`` in its pixels), ``windows`` (fovea
     windows) and ``head_rc`` (camera mode) say how it was made, for pictures of the search.
     ``offsets`` (camera mode): the mean offset ``(row, col)`` in cells of the detections
-    centred in each cell, NaN where none (``ViewObservation.offsets``).
+    centred in each cell, NaN where none (``ViewObservation.offsets``); ``groups`` (camera mode,
+    an observer with ``group_min_neighbors``): the grouped detections per cell
+    (``ViewObservation.groups``).
     """
 
     fixation: int | None
@@ -298,6 +300,7 @@ class Frame:
     windows: tuple = field(default=(), compare=False, repr=False)
     head_rc: tuple | None = field(default=None, compare=False, repr=False)
     offsets: np.ndarray | None = field(default=None, compare=False, repr=False)
+    groups: np.ndarray | None = field(default=None, compare=False, repr=False)
 
 
 @dataclass(frozen=True)
@@ -546,7 +549,7 @@ class DetectorLoop:
         """Detect and count; the frame's ``seconds`` include the resize on arrival."""
         setup = self.setup
         t0 = time.perf_counter()
-        offsets = None
+        offsets = groups = None
         try:
             if cell is None:
                 counts, pixels, centres, windows = self._scan(image)
@@ -560,7 +563,7 @@ class DetectorLoop:
                 observation = setup.observer.observe(image, camera, head_rc)
                 counts, pixels = observation.counts, observation.detector_pixels
                 centres, windows = observation.centres_uv, ()
-                offsets = observation.offsets
+                offsets, groups = observation.offsets, observation.groups
         except ValueError as exc:
             self._drop_through(stamp_s)
             return self._rejected(str(exc))
@@ -574,7 +577,7 @@ class DetectorLoop:
         return Outcome('published', frame=Frame(
             cell, stamp_s, token, counts, int(pixels), seconds,
             'scan' if cell is None else 'fixation', self.search_id, image, centres, windows,
-            head_rc, offsets))
+            head_rc, offsets, groups))
 
     def _scan(self, image) -> tuple[np.ndarray, int, np.ndarray, tuple]:
         """
