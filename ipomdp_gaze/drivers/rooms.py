@@ -277,8 +277,10 @@ def room_demo(faces, seed: int, out, max_fixations: int | None = None) -> int:
     ``demo --scene faces --faces K`` offline: the scene camera's room of ``seed``, searched.
 
     The held-out room the scene camera shows with ``seed`` and ``scene.faces`` (scene 0 of that
-    seed), the shipped pan/tilt model, camera and detector, and the many-target session
-    (``many``, the settings of ``evaluate --faces``; ``max_fixations`` replaces the budget).
+    seed), the shipped pan/tilt model, camera and detector, and the many-target session as the
+    rooms' configs run it on the node (``pass-many-cells``: one pass of the sweep, the grouped
+    detections and the belief's faces; the settings of ``evaluate --faces``; ``max_fixations``
+    replaces the budget).
     Prints every fixation, every face found and, last, ``found N of M faces: that is right``
     (every face found, nothing else named) or ``that is wrong``. Returns 0 when right, else 1.
     """
@@ -289,9 +291,9 @@ def room_demo(faces, seed: int, out, max_fixations: int | None = None) -> int:
     grid = task.model.grid
     task.sensor.start(scene.image)
     out(f'the scene camera shows held-out room {seed} ({scene.background}, '
-        f'{len(scene.faces)} faces); the many-target search runs offline on the detector '
+        f'{len(scene.faces)} faces); the many-target pass runs offline on the detector '
         f"node's views")
-    session, outcome, _, found = room_session(spec, task, 0)
+    session, outcome, _, found = room_session(spec, task, 0, 'pass-many-cells')
     for k, cell in enumerate(outcome.path, 1):
         pan, tilt = task.head.angles(int(cell))
         out(f'fixation {k}: cell {tuple(int(v) for v in grid.cell(int(cell)))} pan '
