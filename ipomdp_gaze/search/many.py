@@ -68,9 +68,8 @@ from ipomdp_gaze.model.occupancy import (binary_entropy, cell_prior, count_faces
                                          predict_occupancy, prior_log_odds)
 from ipomdp_gaze.model.still_evidence import StillEvidence
 from ipomdp_gaze.search.session import (check_groups, check_offsets, Frame, motion_settings,
-                                        OrderError,
-                                        position_settings, SearchSettings, start_index,
-                                        StepResult, target_motion, track_filter)
+                                        OrderError, position_settings, SearchSettings,
+                                        start_index, StepResult, target_motion, track_filter)
 from ipomdp_gaze.search.tracks import GLANCE, Tracks, Turns
 import numpy as np
 from scipy.ndimage import maximum_filter
@@ -205,7 +204,7 @@ class OccupancySession:
         Keep ``policy``: a sweep (a policy with ``poses``) makes a still search one pass of them.
 
         Any other policy is kept for the record: the occupancy search chooses by its own
-        infomax. Takes effect at the next :meth:`reset`.
+        infomax. Takes effect from the next choice of a fixation.
         """
         self.policy = policy
         poses = getattr(policy, 'poses', None) if getattr(policy, 'name', '') == 'sweep' \
