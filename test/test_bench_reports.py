@@ -39,7 +39,7 @@ def test_rooms_report_runs_both_lenses_and_rewrites_from_its_record(tmp_path):
     assert run.returncode == 0, run.stderr[-2000:]
     text = out.read_text()
     assert '## 25 deg lens' in text and '## 40 deg lens' in text
-    assert text.count("Issue 37's rooms items") == 2 and 'not run (`--bound N`)' in text
+    assert text.count("Issue 37's rooms items") == 4 and 'not run (`--bound N`)' in text
     data = json.loads(record.read_text())
     for lens in data['runs'].values():
         rooms = lens['rooms']
