@@ -532,8 +532,8 @@ def test_a_pass_names_the_better_placed_first_and_the_rest_only_away_from_them()
     with_boxes = session.faces(box, None, (30, 30))
     assert [(f['cell'], f.get('grouped', False)) for f in with_boxes] == [(0, False), (8, True)]
     # ... without them the groups (at their centres) first: cell 0 is taken for group 1's face.
-    assert [(f['cell'], f.get('grouped', False)) for f in session.faces()] == [(1, True),
-                                                                             (8, True)]
+    without = [(f['cell'], f.get('grouped', False)) for f in session.faces()]
+    assert without == [(1, True), (8, True)]
 
 
 @pytest.mark.parametrize('groups, match', [
@@ -559,3 +559,29 @@ def test_a_moving_search_makes_no_pass():
     session.set_policy(_Sweep([0, 8]))
     session.reset()
     assert not session.passing
+
+
+def test_a_pass_cut_by_its_budget_decides_with_its_groups_and_keeps_its_policy():
+    grid = Grid(5, 5)
+    pt = np.tile([0.5, 0.5], (5, 5, 1))              # the belief names nobody
+    model = CountObservation(grid, pt, pt.copy())
+    groups = np.zeros(grid.n_cells)
+    groups[12] = 1
+    session = OccupancySession(grid, model, SearchSettings(
+        targets='many', absent_prior=0.5, max_fixations=2, decide_at_budget=True), link=1)
+    session.set_policy(_Sweep([6, 8, 18]))
+    session.reset()
+    session.start()
+    session.update(Frame(np.zeros(grid.n_cells), groups=groups))
+    session.set_policy(object())                     # mid-search: the pass goes on
+    assert session.passing
+    result = session.update(Frame(np.zeros(grid.n_cells)))
+    assert result.reason == 'budget' and result.decision == 'found'
+    assert [f['cell'] for f in session.faces()] == [12]
+    session.reset()                                   # the next search: infomax, no groups
+    assert not session.passing
+    session.start()
+    session.update(Frame(np.zeros(grid.n_cells), groups=groups))
+    assert session.faces() == []
+    session.set_policy(_Sweep([6, 8, 18]))
+    assert not session.passing and session.faces() == []

@@ -167,6 +167,9 @@ def _frames(bag, grid: Grid) -> list:
         msg = m.msg
         channels = {'32FC3': 3, '32FC4': 4}.get(str(msg.encoding).upper(), 1)
         data = np.asarray(msg.data, dtype=np.uint8)
+        if msg.step < 4 * channels * msg.width or data.size != msg.step * msg.height:
+            raise ValueError(f'{bag.path}: an evidence_image has {data.size} bytes, not step '
+                             f'{msg.step} x height {msg.height} of {msg.encoding} rows')
         rows = data.reshape(msg.height, msg.step)[:, :4 * channels * msg.width]
         cells = np.ascontiguousarray(rows).view('>f4' if msg.is_bigendian else '<f4')
         cells = cells.reshape(-1, channels).astype(np.float64)

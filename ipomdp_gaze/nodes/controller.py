@@ -12,7 +12,8 @@ remapping work:
   observed; arrival time counts) and ``evidence_image``
   (``sensor_msgs/Image`` 32FC1, rows x cols; its header stamp counts, or its arrival when unset;
   32FC3 adds per cell the mean offset of its detections, which ``motion.track_view: position``
-  reads: the detector's ``publish_offsets``),
+  reads: the detector's ``publish_offsets``; 32FC4 then the grouped detections per cell, which
+  a many-target pass names: its ``publish_groups``),
   both best effort and keep-last ``evidence_queue_depth`` (1: the newest frame wins; frames
   dropped on the way are counted from the publisher's sequence numbers);
 - publishes ``pan_tilt`` (``sensor_msgs/JointState``, transient local, depth 1, re-sent every

@@ -177,7 +177,8 @@ def make_session(grid: Grid, observation, policy, settings: SearchSettings):
 
     ``one``: :class:`ipomdp_gaze.search.session.SearchSession` (the paper's belief); ``many``:
     :class:`ipomdp_gaze.search.many.OccupancySession` with ``link`` :data:`ROOM_LINK`
-    (docs/design.md section 11.6), whose ``policy`` is kept but not used.
+    (docs/design.md section 11.6), whose ``policy`` is kept but not used, except a sweep: each
+    search is then one pass of its poses (section 11.7).
     """
     if settings.targets == 'many':
         session = OccupancySession(grid, observation, settings, link=ROOM_LINK, log_size=1000)

@@ -204,7 +204,7 @@ class OccupancySession:
         Keep ``policy``: a sweep (a policy with ``poses``) makes a still search one pass of them.
 
         Any other policy is kept for the record: the occupancy search chooses by its own
-        infomax. Takes effect from the next choice of a fixation.
+        infomax. Takes effect at the next :meth:`reset`: a search is a pass or not throughout.
         """
         self.policy = policy
         poses = getattr(policy, 'poses', None) if getattr(policy, 'name', '') == 'sweep' \
@@ -213,8 +213,14 @@ class OccupancySession:
 
     @property
     def passing(self) -> bool:
-        """Whether this search is one pass of the sweep's poses (still targets only)."""
-        return self._pass is not None and not self._motion.active
+        """
+        Whether this search is one pass of the sweep's poses (still targets only).
+
+        Fixed when the search starts (:meth:`reset`: the policy then); motion turned on during
+        it ends the pass (a moving search names no groups).
+        """
+        passing = self._pass is not None if self._state is None else self._state['passing']
+        return passing and not self._motion.active
 
     # -- read-only views -----------------------------------------------------------------
     def _s(self) -> dict:
@@ -351,7 +357,8 @@ class OccupancySession:
                        'fixations': 0, 'path': [], 'scanned': False, 'decision': '',
                        'reason': '', 'ended': False, 'outside': outside, 'clock_s': 0.0,
                        'room_done': False, 'decided_once': False,
-                       'visited': np.zeros(n, dtype=bool), 'groups': []}
+                       'visited': np.zeros(n, dtype=bool), 'groups': [],
+                       'passing': self._pass is not None}
         self._event('reset', settings=self.settings.to_parameters(), cell_prior=q)
 
     def exclude(self, cells) -> None:
@@ -480,7 +487,7 @@ class OccupancySession:
         s['fixations'] += 1
         s['path'].append(k)
         s['visited'][k] = True
-        if groups is not None:
+        if groups is not None and self.passing:     # only a pass names them
             s['groups'].extend(int(c) for c in np.flatnonzero(groups > 0))
         if self._motion.active:
             fired = self._decide_moving(obs, offsets, dt_s)
@@ -677,10 +684,12 @@ class OccupancySession:
 
     def _limit(self, reason: str) -> str:
         s = self._state
+        s['reason'], s['ended'] = reason, True
         decision = 'gave_up'
         if self.settings.decide_at_budget and not self._motion.active:
-            decision = 'found' if np.any(self.log_odds > 0) else 'absent'
-        s['decision'], s['reason'], s['ended'] = decision, reason, True
+            found = bool(self.faces()) if self.passing else np.any(self.log_odds > 0)
+            decision = 'found' if found else 'absent'    # a pass: its groups too
+        s['decision'] = decision
         return decision
 
     def _rc(self, cell: int) -> list:
