@@ -5,7 +5,8 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
-from ipomdp_gaze.drivers.scene_report import paired_difference, paired_map_difference
+from ipomdp_gaze.drivers.scene_report import (paired_difference, paired_map_difference,
+                                              SceneResult)
 import numpy as np
 import pytest
 
@@ -43,3 +44,14 @@ def test_no_common_scene_is_refused():
         paired_difference(_scenes([1.0]), _scenes([1.0, 2.0], order=[1]), 'value')
     with pytest.raises(ValueError, match='same scenes with a face'):
         paired_map_difference(_scenes([1.0]), _scenes([1.0], has_face=False))
+
+
+def test_a_scene_result_comes_back_from_its_json_record():
+    import json
+    room = SceneResult('pass-many', 3, True, 'page', False, 'found', 'pass', (5, 9), (5, 9), 12,
+                       (12, 16), 9000, 1.5, 90.0, (True, False), 6.1, 1.2,
+                       ((5, 9), (7, 0)), ((5, 9),), 1, True)
+    one = SceneResult('coverage', 0, False, 'moon', True, 'absent', '', (5, 5), None, 3,
+                      (60, 61, 62), 300, 0.2, 10.0)
+    for result in (room, one):
+        assert SceneResult.from_record(json.loads(json.dumps(result.__dict__))) == result

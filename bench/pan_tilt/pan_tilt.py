@@ -136,11 +136,7 @@ def _sweep_poses(spec):
 
 
 def _results(run_record: dict) -> dict:
-    return {name: [SceneResult(**{**r, 'cell': tuple(r['cell']),
-                                  'face_cell': None if r['face_cell'] is None
-                                  else tuple(r['face_cell']),
-                                  'path': tuple(r['path']),
-                                  'map_right': tuple(r['map_right'])}) for r in group]
+    return {name: [SceneResult.from_record(r) for r in group]
             for name, group in run_record['results'].items()}
 
 

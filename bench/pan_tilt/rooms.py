@@ -79,17 +79,8 @@ def run(args) -> dict:
     return record
 
 
-def _scene(row: dict) -> SceneResult:
-    """Rebuild a :class:`SceneResult` from its JSON record (lists back to tuples)."""
-    def value(key, v):
-        if key in ('face_cells', 'answers'):
-            return tuple(map(tuple, v))
-        return tuple(v) if isinstance(v, list) else v
-    return SceneResult(**{k: value(k, v) for k, v in row.items()})
-
-
 def _results(group: dict) -> dict:
-    return {name: [_scene(r) for r in rows] for name, rows in group.items()}
+    return {name: [SceneResult.from_record(r) for r in rows] for name, rows in group.items()}
 
 
 def _diff(a, b, key) -> str:

@@ -170,23 +170,6 @@ def room_search(spec, task, scene, index: int, label: str) -> SceneResult:
                        outcome.detector_pixels, detector_s, done=done)
 
 
-def with_grouped(task, path, answers, min_neighbors: int) -> list:
-    """
-    ``answers`` and then each grouped detection of the views of ``path`` not within one cell.
-
-    The detections of each view grouped as ``detectMultiScale`` does with ``min_neighbors``,
-    views in the order taken, the largest box first (as the sweeps answer them).
-    """
-    grid = task.model.grid
-    out = list(answers)
-    for pose in dict.fromkeys(int(c) for c in path):
-        for cell in grouped_cells(task, pose, min_neighbors):
-            rc = tuple(int(v) for v in grid.cell(int(cell)))
-            if all(cells_apart(rc, seen) > 1 for seen in out):
-                out.append(rc)
-    return out
-
-
 def room_sweep(spec, task, scene, index: int, rule: str) -> SceneResult:
     """
     One pass of the sweep's poses answering every grouped detection (module docstring).
@@ -195,14 +178,17 @@ def room_sweep(spec, task, scene, index: int, rule: str) -> SceneResult:
     bound on what grouping sees.
     """
     grid = task.model.grid
-    path, pixels, detector_s = [], 0, []
+    answers, path, pixels, detector_s = [], [], 0, []
     poses = range(grid.n_cells) if rule.startswith('every-view') else task.sweep.poses
     for pose in poses:
         frame = task.sensor.observe(int(pose))
         path.append(int(pose))
         pixels += frame.detector_pixels
         detector_s.append(frame.seconds)
-    answers = with_grouped(task, path, [], int(rule[-1]))
+        for cell in grouped_cells(task, int(pose), int(rule[-1])):
+            rc = tuple(int(v) for v in grid.cell(int(cell)))
+            if all(cells_apart(rc, seen) > 1 for seen in answers):
+                answers.append(rc)
     return room_result(task, scene, index, rule, answers, 'found' if answers else 'absent', '',
                        path, pixels, detector_s, done=True)
 

@@ -58,6 +58,15 @@ class SceneResult:
     faces_found: int = 0
     done: bool = False
 
+    @classmethod
+    def from_record(cls, row: dict) -> SceneResult:
+        """Rebuild one from its JSON record (``__dict__``): its lists back to tuples."""
+        def value(key, v):
+            if key in ('face_cells', 'answers'):
+                return tuple(map(tuple, v))
+            return tuple(v) if isinstance(v, list) else v
+        return cls(**{k: value(k, v) for k, v in row.items()})
+
 
 def scene_result(task, scene, index, name, answer, face, decision, reason, path, pixels,
                  detector_s, map_right=()) -> SceneResult:
