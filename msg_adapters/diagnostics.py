@@ -63,7 +63,10 @@ def _ending(forced_by: str, confidence: float | None) -> tuple[str, dict]:
         values['confidence'] = float(confidence)
     limit = {'budget': 'the fixation budget', 'pass': 'the end of its pass'}
     limit = limit.get(forced_by, forced_by)
-    if forced_by:
+    if forced_by == 'group':            # search.group_stop: a stop rule, not a limit
+        values['ended'] = 'group'
+        clause = ' at a grouped detection of the detector'
+    elif forced_by:
         below = f' below the confidence {confidence:g}' if confidence is not None else ''
         clause = f', forced by {limit}{below}'
     else:
@@ -78,8 +81,9 @@ def found_status(name: str, row: int, col: int, cell: int, pan_rad: float, tilt_
     """
     Build the ``found`` event.
 
-    ``ended`` (``confidence``, or ``forced:budget`` when the fixation budget forced it with
-    ``search.decide_at_budget``) and ``confidence`` say how it was reached; ``radius`` (only
+    ``ended`` (``confidence``; ``forced:budget`` when the fixation budget forced it with
+    ``search.decide_at_budget``; ``group`` when a grouped detection ended the search,
+    ``search.group_stop``) and ``confidence`` say how it was reached; ``radius`` (only
     when > 0) that the answer is the centre of the likeliest square of that radius
     (``search.found_radius``), whose belief is ``probability``. ``person`` (only when > 0) is
     the number of the person found by a moving many-target search (:func:`person_of`).

@@ -79,6 +79,23 @@ def test_a_forced_found_and_an_absent_answer_say_so():
     assert stats['stop'] == 'absent' and stats['right']
 
 
+def test_a_found_at_a_grouped_detection_says_so():
+    from ipomdp_gaze.harness.demo import faces_setup
+    from ipomdp_gaze.msg_adapters import diagnostics
+    setup = faces_setup()
+    grid = setup.grid
+    belief = np.full(grid.n_cells, 0.3 / grid.n_cells)
+    grouped = diagnostics.found_status('c: found', 4, 2, grid.index(4, 2), 0.0, 0.0, 0.41, 1,
+                                       'group', 0.99)
+    assert grouped.message.endswith('after 1 fixations at a grouped detection of the detector')
+    assert diagnostics.parse_found(grouped)['ended'] == 'group'
+    lines, stats = _follow(setup, _record(setup, [belief], [60], found=grouped,
+                                          truth=grid.index(4, 2)))
+    assert lines[-2].startswith('found at a grouped detection: the face is at (4, 2), ')
+    assert lines[-2].endswith('probability 0.410, after 1 fixations (below the confidence 0.99)')
+    assert stats['stop'] == 'found' and stats['right']
+
+
 def test_the_gaussian_demo_shows_no_absent_probability():
     from ipomdp_gaze.harness.demo import demo_setup
     from ipomdp_gaze.msg_adapters import diagnostics

@@ -32,7 +32,8 @@ def test_detector_killed_mid_search_then_restarted_and_the_search_finishes(nodes
     diag = probe.search_status()
     controller = nodes.start('controller', _args(setup, 'controller', [
         '-p', f'retry_period_s:={RETRY_S}', '-p', 'diagnostics_period_s:=0.1',
-        '-p', 'confidence:=0.999']))
+        '-p', 'confidence:=0.999', '-p', 'search.group_stop:=false',
+        '-p', 'search.max_fixations:=20']))    # this search ends when the belief reaches 0.999
     detector = nodes.start('detector', _args(setup, 'detector'))
     assert wait_for(lambda: probe.node.count_subscribers('image') > 0, 60), detector.output()
     camera = nodes.start('scene_camera', _args(setup, 'scene_camera'))

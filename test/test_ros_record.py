@@ -52,9 +52,10 @@ def _rosbags_topics(bag: Path) -> dict:
 
 
 def _found(out: str) -> tuple:
-    found = re.search(r'^found(?:, forced by the fixation budget)?: the (?:target|face) is most '
-                      r'likely at \((\d+), (\d+)\).*after (\d+) fixations \((?:reached|below) '
-                      r'the confidence [\d.]+\)$', out, re.M)
+    found = re.search(r'^found(?:, forced by the fixation budget| at a grouped detection)?: '
+                      r'the (?:target|face) is (?:most likely )?at \((\d+), (\d+)\).*after '
+                      r'(\d+) fixations \((?:reached|below) the confidence [\d.]+\)$', out,
+                      re.M)
     assert found, out
     return int(found.group(1)), int(found.group(2)), int(found.group(3))
 

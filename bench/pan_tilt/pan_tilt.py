@@ -5,7 +5,8 @@ The pan/tilt face search against a blind sweep, on held-out test scenes: writes 
 
 One run, every searcher on the same scenes and the same views (a view is rendered and detected
 once per scene, :mod:`ipomdp_gaze.drivers.scene_eval`): the shipped configuration
-(``config/faces_camera_controller.yaml``, absent hypothesis on, head time in the choice), the same
+(``config/faces_camera_controller.yaml``, absent hypothesis on, head time in the choice, a
+grouped detection the belief does not veto ends the search), the same without that stop, the same
 with every view costing alike, the sweep policy with the same belief and stop rule for one pass,
 and the sweep's answer rules (best tile count after one pass; first view with a raw or a grouped
 detection). Scenes with a face and empty scenes (the
@@ -47,6 +48,12 @@ NO_HEAD_TIME = '{policy}:search.head_speed_deg_s=0'
 # The answer rules a team would write: a sweep that stops at its first grouped detection.
 GROUPED_SWEEPS = ('sweep-first-grouped3', 'sweep-first-grouped5')
 SECOND_MODEL = 'faces-pan-tilt-40-profile'
+# The grouping the second camera's detector reports for search.group_stop (its publish_groups):
+# min_neighbors 3, chosen on its training scenes (docs/design.md section 6.15); the shipped
+# camera's is config/faces_camera_detector.yaml's (5).
+SECOND_GROUPS = 3
+# The shipped search without the grouped detections' stop (the search before issue 37's).
+NO_GROUP_STOP = '{policy}:search.group_stop=false'
 
 # Ideas tried on TRAINING scenes: a hand-kept table (docs/data/pan_tilt_ideas.md).
 IDEAS = ROOT / 'docs' / 'data' / 'pan_tilt_ideas.md'
@@ -56,14 +63,16 @@ def run(args) -> dict:
     """Search the test scenes with every searcher; return the JSON record."""
     record = {'args': vars(args) | {'json': str(args.json), 'out': str(args.out)},
               'started': time.strftime('%Y-%m-%d %H:%M:%S UTC', time.gmtime()), 'runs': {}}
-    for label, model, faces, empty in (('main', '', args.faces, args.empty),
-                                       ('second', SECOND_MODEL, args.second_faces,
-                                        args.second_empty)):
+    for label, model, faces, empty, groups in (
+            ('main', '', args.faces, args.empty, None),
+            ('second', SECOND_MODEL, args.second_faces, args.second_empty, SECOND_GROUPS)):
         if not faces and not empty:
             continue
-        spec = task_spec('pan-tilt', seed=args.seed, split='test', model=model)
+        spec = task_spec('pan-tilt', seed=args.seed, split='test', model=model,
+                         group_min_neighbors=groups)
         passes = len(_sweep_poses(spec))
-        compare = (NO_HEAD_TIME.format(policy=spec.policy), SWEEP.format(passes=passes)) \
+        compare = (NO_GROUP_STOP.format(policy=spec.policy),
+                   NO_HEAD_TIME.format(policy=spec.policy), SWEEP.format(passes=passes)) \
             + SWEEP_RULES
         results = {}
         with ProcessPoolExecutor(max_workers=args.processes) as pool:
@@ -82,6 +91,7 @@ def run(args) -> dict:
         record['runs'][label] = {
             'model': model or DEFAULT_MODELS['camera'], 'policy': spec.policy,
             'settings': spec.settings.to_parameters(), 'sweep_poses': passes,
+            'group_min_neighbors': spec.group_min_neighbors,
             'results': {name: [r.__dict__ for r in group] for name, group in results.items()}}
     record['finished'] = time.strftime('%Y-%m-%d %H:%M:%S UTC', time.gmtime())
     return record
@@ -145,6 +155,8 @@ def _label(name: str, passes: int) -> str:
         return 'shipped infomax (`config/faces_camera_controller.yaml`)'
     if name.endswith(':search.head_speed_deg_s=0'):
         return 'the same, every view costing alike (no head time in the choice)'
+    if name.endswith(':search.group_stop=false'):
+        return 'the same without the grouped-detection stop (shipped before)'
     if name.startswith('sweep:'):
         return f'blind sweep, the same belief and stop rule, one pass ({passes} views)'
     return {'sweep-tile': 'blind sweep, one pass, the cell with most raw detections in its tile',
@@ -268,6 +280,13 @@ def _against_grouped_sweeps(results: dict) -> list[str]:
     return lines
 
 
+def _groups_note(label: str) -> str:
+    if label == 'main':
+        return " (the detector's `publish_groups` in `config/faces_camera_detector.yaml`)"
+    return (" (this camera's `publish_groups`, chosen on its training scenes: docs/design.md "
+            'section 6.15)')
+
+
 def _met(flag: bool) -> str:
     return 'met' if flag else 'not met'
 
@@ -304,7 +323,9 @@ def write_page(record: dict, out: Path) -> None:
         lines += [f'## {title}', '',
                   f"{n_face} scenes with a face, {n_empty} empty; the sweep's tiles: {passes} "
                   f"poses. Shipped settings: `{json.dumps(run_record['settings'])}`, policy "
-                  f"`{run_record['policy']}`.", '', '### Scenes with a face', '']
+                  f"`{run_record['policy']}`; the views' grouped detections (`search.group_stop`)"
+                  f" grouped with `min_neighbors` {run_record.get('group_min_neighbors', 0)}"
+                  f'{_groups_note(label)}.', '', '### Scenes with a face', '']
         lines += _table(results, passes, sweep_time)
         lines += ['', '### Empty scenes (nobody here), per background', '']
         lines += _empty_table(results, passes)

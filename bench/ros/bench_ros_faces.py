@@ -23,9 +23,10 @@ TITLE = 'Face search over DDS: scene camera, foveal detector and controller (thr
 ORDER = 61
 MODES = (('camera', False, 'a camera on the pan/tilt head (11x11 grid of 5 deg, '
                            '`faces-pan-tilt-profile`: the frontal and the profile cascade, '
-                           'coverage per second of head time, confidence 0.99 within one '
-                           'cell, inhibition of return, '
-                           'absent prior 0.8, false-alarm scales and hotspots, decided at 20 '
+                           'coverage per second of head time with the tour of the tiles, '
+                           'confidence 0.99 within one cell, inhibition of return, '
+                           'absent prior 0.8, false-alarm scales and hotspots, a grouped '
+                           'detection the belief does not veto ends the search, decided at 12 '
                            'fixations)'),
          ('fovea', True, 'a fixed camera and the digital fovea (21x21 grid over 420x420 '
                          'scenes, `faces-420` with its one-time scan and kernel '

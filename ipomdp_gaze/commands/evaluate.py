@@ -88,6 +88,11 @@ def add_parser(sub):
                    help='--scenes pan-tilt: another pan/tilt observation file (its camera is the '
                         "scene camera's; with --motion walk, the tracker's instead of its "
                         "configuration's observation.file)")
+    p.add_argument('--group-min-neighbors', type=nonneg_int, default=None, metavar='N',
+                   help="--scenes pan-tilt, one face: the grouping (detectMultiScale's "
+                        'min_neighbors) the views report for search.group_stop, as the '
+                        "detector node's publish_groups (default: config/"
+                        "faces_camera_detector.yaml's; 0: none)")
     p.add_argument('--compare', action='append', default=[], metavar='SEARCHER',
                    help='--scenes: another searcher on the same scenes and views (repeatable): '
                         'a policy name (sweep starts at its first pose) or a sweep answer rule '
@@ -287,7 +292,8 @@ def run_scenes(args) -> int:
     spec = task_spec(args.scenes, args.policy[0] if args.policy else None,
                      str(args.policy_file[0]) if args.policy_file else None, seed=args.seed,
                      max_fixations=args.max_fixations, split=args.split, model=args.scene_model,
-                     compare=tuple(args.compare), empty=False, faces=parse_faces(args.faces))
+                     compare=tuple(args.compare), empty=False, faces=parse_faces(args.faces),
+                     group_min_neighbors=args.group_min_neighbors)
     changes = {key: value for key, value in (('confidence', args.confidence),
                                              ('absent_prior', args.absent_prior))
                if value is not None}

@@ -236,7 +236,7 @@ def _recorded_decision(bag) -> Decision:
             values = {kv.key: kv.value for kv in events[-1].msg.values}
             cell = int(values['cell']) if 'cell' in values else None
             p = float(values['probability']) if 'probability' in values else None
-            forced = values.get('ended', '').partition('forced:')[2]
+            forced = answer.reason_of(values.get('ended', ''))
             return Decision(kind, cell, p, int(values['fixations']), forced)
     return Decision()
 

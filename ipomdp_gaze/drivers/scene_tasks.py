@@ -43,16 +43,20 @@ DEFAULT_BUDGET = 60
 ROOM_SEARCHERS = ('many', 'many-cells', 'many-posterior', 'every-view-many',
                   'pass-many', 'pass-many-cells') + ROOM_SWEEPS
 # What rooms change in the pan/tilt configuration: the many-target setting, without what the
-# occupancy belief does not model (false-alarm scales, hotspots; the choice per second of head
-# time it keeps: docs/design.md section 11.5) ...
-ROOM_MODEL = {'targets': 'many', 'false_alarm_scales': (1.0,), 'hotspot_prior': 0.0}
+# occupancy belief does not model (false-alarm scales, hotspots, coverage's tour; the choice per
+# second of head time it keeps: docs/design.md section 11.5) ...
+ROOM_MODEL = {'targets': 'many', 'false_alarm_scales': (1.0,), 'hotspot_prior': 0.0,
+              'head_tour': False}
 # ... and the settings chosen on training rooms (docs/design.md section 11.5): repeated views
 # of a cell weigh 0.1 (at 1, texture seen from several views became false faces), within the
-# configuration's budget of 20 fixations (40 found one more face of 50 in twice the head time).
+# budget of 20 fixations (40 found one more face of 50 in twice the head time).
 ROOM_CHOICES = {'repeat_weight': 0.1}
 # The grouping a room's views also report (Frame.groups), which pass-many answers: the grouped
 # sweep a team keeps (no false face on the training rooms, where 3 named some; section 11.7).
 ROOM_GROUP_MIN_NEIGHBORS = 5
+# The one-face scenes' views report the grouping of the shipped detector configuration
+# (config/faces_camera_detector.yaml, publish_groups), which search.group_stop stops at.
+DETECTOR_CONFIG = 'faces_camera_detector.yaml'
 ROOM_BUDGET = 20
 _FOVEA_TASKS = {'faces-420': ('faces-420', 420, (60, 140)),
                 'faces-840': ('faces-840', 840, (24, 140))}
@@ -72,6 +76,7 @@ class TaskSpec:
     model: str = ''
     compare: tuple = ()
     faces: tuple = (1, 1)
+    group_min_neighbors: int = 0
 
     @property
     def rooms(self) -> bool:
@@ -82,7 +87,8 @@ class TaskSpec:
 def task_spec(task: str, policy: str | None = None, policy_file: str | None = None,
               settings: SearchSettings | None = None, seed: int = 0,
               max_fixations: int | None = None, split: str = 'test', empty: bool = False,
-              model: str = '', compare=(), faces=1) -> TaskSpec:
+              model: str = '', compare=(), faces=1,
+              group_min_neighbors: int | None = None) -> TaskSpec:
     """
     Return the shipped configuration of ``task``, with any of its parts replaced.
 
@@ -101,6 +107,9 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
     compared with :data:`ROOM_SEARCHERS` only (drivers/rooms.py); the settings are then the
     configuration's with :data:`ROOM_MODEL` and :data:`ROOM_CHOICES`, and the budget
     :data:`ROOM_BUDGET` unless ``max_fixations`` is given.
+    ``group_min_neighbors`` (pan-tilt, one face): the grouping the views report for
+    ``search.group_stop`` (``Frame.groups``), by default the shipped detector configuration's
+    ``publish_groups`` (:func:`detector_groups`); rooms report :data:`ROOM_GROUP_MIN_NEIGHBORS`.
     """
     if task not in TASKS:
         raise ValueError(f"unknown scene task {task!r}; choose from {', '.join(TASKS)}")
@@ -146,8 +155,22 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
     if max_fixations is None:
         max_fixations = base.max_fixations or DEFAULT_BUDGET
     settings = settings or replace(base, max_fixations=max_fixations)
+    if task != 'pan-tilt':
+        groups = 0
+    elif faces != (1, 1):
+        groups = ROOM_GROUP_MIN_NEIGHBORS
+    else:
+        groups = detector_groups() if group_min_neighbors is None else int(group_min_neighbors)
+        if groups < 0:
+            raise ValueError(f'group_min_neighbors must be >= 0, got {groups}')
     return TaskSpec(task, name, file, settings, int(seed), split, bool(empty), model,
-                    tuple(compare), faces)
+                    tuple(compare), faces, groups)
+
+
+def detector_groups() -> int:
+    """Return the shipped detector configuration's ``publish_groups`` (0: none)."""
+    values = yaml_parameters(config_file(DETECTOR_CONFIG), 'foveal_detector')
+    return int(values.get('publish_groups', 0))
 
 
 def compare_settings(settings: SearchSettings, label: str) -> SearchSettings:
@@ -225,7 +248,7 @@ class SceneTask:
     @classmethod
     def get(cls, spec: TaskSpec) -> SceneTask:
         key = (spec.task, spec.policy, spec.policy_file, spec.seed, spec.split, spec.empty,
-               spec.model, spec.compare, spec.faces)
+               spec.model, spec.compare, spec.faces, spec.group_min_neighbors)
         if key not in cls._cache:
             cls._cache = {key: cls(spec)}
         return cls._cache[key]
@@ -238,8 +261,7 @@ class SceneTask:
             geometry = SceneGeometry(self.model.grid, setup.camera)
             recorder = Recording(setup.observer.detector)
             setup.observer.detector = recorder
-            if spec.rooms:
-                setup.observer.group_min_neighbors = ROOM_GROUP_MIN_NEIGHBORS
+            setup.observer.group_min_neighbors = spec.group_min_neighbors
             self.sensor = ViewCache(PanTiltSensor(setup.observer, geometry), recorder)
             self.camera = setup.camera
             self.max_count = setup.observer.max_count

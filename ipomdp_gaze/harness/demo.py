@@ -496,14 +496,15 @@ def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
     if record.found and printed >= last():
         found = diagnostics.parse_found(record.found[0][1])
         answer, stop = (found['row'], found['col'], found['cell']), 'found'
-        forced = found['ended'].partition('forced:')[2]
-        out(f'{words.heading("found", forced)}: the {what} is most likely at '
+        forced = words.reason_of(found['ended'])
+        where = 'at' if forced == 'group' else 'most likely at'     # the group's own cell
+        out(f'{words.heading("found", forced)}: the {what} is {where} '
             + _answer(setup, *answer, found['probability'], found['fixations'])
             + words.confidence_clause('found', forced, found['probability'], confidence))
     elif record.absent and printed >= last():
         found = diagnostics.parse_absent(record.absent[0][1])
         answer, stop = None, 'absent'
-        forced = found['ended'].partition('forced:')[2]
+        forced = words.reason_of(found['ended'])
         clause = words.confidence_clause('absent', forced, found['probability'], confidence)
         out(f"{words.heading('absent', forced)}: nobody is here, probability "
             f"{found['probability']:.3f} that nobody is here, after {found['fixations']} "

@@ -597,6 +597,10 @@ class GazeControllerNode(QuietPublishers, Node):
             self._handle(self.core.offer_scan(values, search_id, now))
             return
         taken = now if stamp is None or stamps.is_zero(stamp) else stamps.to_seconds(stamp)
+        if groups is None and self._config.settings.group_stop:
+            self.get_logger().warning(
+                'search.group_stop is on but the evidence carries no grouped detections: set '
+                "the detector's publish_groups (docs/design.md section 6.15)", once=True)
         self._handle(self.core.offer(values, taken, now, search_id, offsets, groups))
 
     def _handle(self, result) -> None:

@@ -8,7 +8,8 @@ evidence reached ``confidence`` (reason ``found`` / ``absent`` / ''), or a limit
 ``budget`` (the fixation budget), ``pixels`` (``find``'s cost cap: one full-resolution scan of
 detector pixels), ``repeat`` (every cell fixated once), ``timeout``. At a limit a search gives up,
 or, with ``decide_at_budget``, is **forced** to the likelier of ``found`` and ``absent``, whose
-probability is then below ``confidence``.
+probability is then below ``confidence``. With ``search.group_stop`` a grouped detection ends a
+search ``found`` at its cell (reason ``group``), whatever its probability.
 
 The probability of an answer is that of *that* answer: the found cell's (its square with
 ``found_radius``) for ``found``, ``P(absent)`` (nobody is there) for ``absent``, the most likely
@@ -33,17 +34,25 @@ def ended(decision: str, reason: str = '') -> str:
 
     ``confidence`` (the evidence reached the confidence), ``forced:<limit>`` (a limit forced a
     ``found`` or ``absent``), ``<limit>`` for ``gave_up``, ``scan`` for ``full_frame`` answers
-    (one detector scan, no belief), '' for no decision.
+    (one detector scan, no belief), ``group`` for a grouped detection's stop, '' for no
+    decision.
     """
     if not decision:
         return ''
     if reason == 'full_frame':
         return 'scan'
+    if reason == 'group':
+        return 'group'
     if decision == 'gave_up':
         return reason or 'limit'
     if reason in LIMITS:
         return f'forced:{reason}'
     return 'confidence'
+
+
+def reason_of(token: str) -> str:
+    """Return the reason an :func:`ended` token names (``forced:budget`` -> ``budget``)."""
+    return 'group' if token == 'group' else str(token).partition('forced:')[2]
 
 
 def forced(decision: str, reason: str = '') -> bool:
@@ -63,6 +72,8 @@ def heading(decision: str, reason: str = '') -> str:
         return 'gave up'
     if reason == 'full_frame':
         return f'{decision} by one full-frame detector scan'
+    if reason == 'group':
+        return f'{decision} at a grouped detection'
     if forced(decision, reason):
         return f'{decision}, forced by {LIMITS[reason]}'
     return decision

@@ -211,7 +211,8 @@ class Frame:
     where none), which ``motion.track_view: position`` reads (docs/design.md section 12.9).
     ``groups`` ``(N,)``, optional: how many of the detector's grouped detections (as
     ``detectMultiScale`` groups its raw boxes) are centred in each cell, which a many-target
-    pass answers (docs/design.md section 11.7). A frame built by
+    pass answers (docs/design.md section 11.7) and ``search.group_stop`` stops at (section
+    6.15). A frame built by
     :meth:`SearchSession.checked_frame` carries the session and model that checked it, so that
     session does not check it again.
     """
@@ -293,6 +294,7 @@ class _Search:
     reason: str = ''
     ended: bool = False
     decided_once: bool = False
+    group_cell: int | None = None
     path: list = field(default_factory=list)
     # What the read-only views derive from log_belief, each computed once: emptied whenever
     # log_belief (or a setting a view depends on) changes.
@@ -468,7 +470,11 @@ class SearchSession:
         Return the answer: the most likely cell (ties to the lowest index).
 
         With ``found_radius`` r > 0: the cell whose (2r + 1)-square holds the most belief.
+        After a grouped detection ended the search (``search.group_stop``): its cell.
         """
+        group_cell = self._state().group_cell
+        if group_cell is not None:
+            return group_cell
         return self._view('map_cell', lambda: int(map_cell(self._pooled())))
 
     def _pooled(self) -> np.ndarray:
@@ -561,8 +567,8 @@ class SearchSession:
         """
         Return ``Frame(values, kind, offsets=offsets, groups=groups)`` checked here, once.
 
-        The values as :meth:`check_frame`; ``groups`` are checked and kept (one target does not
-        read them).
+        The values as :meth:`check_frame`; ``groups`` are checked and kept (one target reads
+        them only with ``search.group_stop``).
 
         :meth:`update` and :meth:`scan` take it without checking it again while the session
         assumes the same model. For a driver that must know whether a frame is usable before
@@ -588,6 +594,13 @@ class SearchSession:
         if checked and checked[0] is self and checked[1] is self.observation:
             return frame.values
         return self.check_frame(frame.values)
+
+    def _frame_groups(self, frame: Frame) -> np.ndarray | None:
+        """Return a frame's checked groups: checked here unless this session checked them."""
+        checked = frame._checked_by
+        if checked and checked[0] is self:
+            return frame.groups
+        return check_groups(frame.groups, self.grid.n_cells)
 
     def _frame_offsets(self, frame: Frame) -> np.ndarray | None:
         """Return a frame's checked offsets: checked here unless this session checked them."""
@@ -747,6 +760,7 @@ class SearchSession:
         try:
             obs = self._frame_values(frame)
             offsets = self._frame_offsets(frame)
+            groups = self._frame_groups(frame)
             term = self.observation.log_likelihood_ratio(obs, search.fixation)
         except EvidenceError as exc:
             return self._result('rejected', reason=str(exc))
@@ -772,7 +786,7 @@ class SearchSession:
         search.fixations += 1
         search.path.append(search.fixation)
         search.visited[search.fixation] = True
-        fired = self._decide()
+        fired = self._decide(groups)
         self._follow(obs, offsets, dt_s)
         if not search.ended:
             following = self._choose()
@@ -819,8 +833,12 @@ class SearchSession:
         """Each cell's probability of being a hotspot (the clutter map, §12.8); None without."""
         return None if self._clutter is None else self._clutter.probability
 
-    def _decide(self) -> str:
-        """Run the stop rules after an applied frame; return the decision it fired ('')."""
+    def _decide(self, groups: np.ndarray | None = None) -> str:
+        """
+        Run the stop rules after an applied frame; return the decision it fired ('').
+
+        The confidence first, then a grouped detection (``search.group_stop``), then the budget.
+        """
         search, settings = self._search, self.settings
         peak, absent = float(self._pooled().max()), self.absent_probability
         code = int(decide(peak, absent, settings.confidence))
@@ -836,11 +854,25 @@ class SearchSession:
         elif decision:
             search.decision, search.ended, fired = decision, True, decision
         search.decided_once = search.decided_once or bool(fired)
+        if not search.ended and self._group_stops(groups):
+            cells = np.flatnonzero(groups > 0)
+            pooled = self._pooled()
+            cell = int(cells[np.argmax(pooled[cells])])
+            if pooled[cell] >= settings.group_probability:
+                search.group_cell = cell
+                search.decision, search.reason, search.ended = 'found', 'group', True
+                search.decided_once = True
+                return 'found'
         budget_applies = not search.decided_once or not settings.stop_on_decision
         if budget_applies and settings.max_fixations \
                 and search.fixations >= settings.max_fixations:
             fired = self._limit('budget')
         return fired
+
+    def _group_stops(self, groups: np.ndarray | None) -> bool:
+        """Whether a frame's grouped detections end the search (docs/design.md section 6.15)."""
+        return bool(self.settings.group_stop and self.settings.stop_on_decision
+                    and not self.motion.active and groups is not None and np.any(groups > 0))
 
     def _limit(self, reason: str) -> str:
         """

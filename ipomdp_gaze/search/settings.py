@@ -171,6 +171,16 @@ SCHEMA: tuple[Setting, ...] = (
     Setting('decide_at_budget', 'search.decide_at_budget', 'bool', False, check_flag,
             'still target: when the budget runs out undecided, say absent or found (whichever '
             'is more probable) instead of gave_up'),
+    Setting('group_stop', 'search.group_stop', 'bool', False, check_flag,
+            "still target, one target: a frame that carries the detector's grouped detections "
+            '(its publish_groups) with one in the grid ends the search found at the likeliest '
+            'cell holding one, as a sweep that stops at its first grouped detection does '
+            '(docs/design.md section 6.15)'),
+    Setting('group_probability', 'search.group_probability', 'float', 0.0, check_probability,
+            'with search.group_stop: a grouped detection ends the search only where the belief '
+            'gives its cell (its found_radius square) at least this probability after the frame '
+            "(0: every group; the belief's veto of texture the detector groups)",
+            bounds='in [0, 1)', metavar='P'),
     Setting('false_alarm_scales', 'search.false_alarm_scales', 'floats', (1.0,),
             check_false_alarm_scales,
             'still target, count model: the scene may fire the detector this many times as '
