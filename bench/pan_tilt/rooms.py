@@ -33,8 +33,11 @@ from ipomdp_gaze.drivers.rooms import summarise_rooms
 from ipomdp_gaze.drivers.scene_eval import evaluate_scenes
 from ipomdp_gaze.drivers.scene_report import paired_difference, SceneResult
 from ipomdp_gaze.drivers.scene_tasks import task_spec
+from ipomdp_gaze.model.head_camera import observed_cells
+from ipomdp_gaze.model.head_time import covering_poses, head_time_s, shortest_tour
 from ipomdp_gaze.simulation.progress import Progress
-from ipomdp_gaze.vision.detection import DEFAULT_MODELS
+from ipomdp_gaze.vision.detection import build_setup, DEFAULT_MODELS
+import numpy as np
 
 ROOT = Path(__file__).resolve().parents[2]
 LENSES = (('25 deg', ''), ('40 deg', 'faces-pan-tilt-40-profile'))
@@ -150,6 +153,42 @@ def _checks(results: dict, bounds: dict | None, name: str = OURS) -> list[str]:
     return lines
 
 
+def _moonshot(results: dict, model: str) -> list[str]:
+    """
+    Issue 37's moonshot, report only: head time to done against the sweep's and a perfect detector.
+
+    A perfect detector sees every face in any view that shows its cell and nothing else, so a
+    room is done once every cell has been shown: the fewest views that show every cell
+    (``covering_poses``), toured in the least saccade time (``shortest_tour``). Knowing where the
+    faces are, one view centred on each face, toured the same way, finds everyone (a bound on
+    finding, not on done). Both at the run's mean detector time per view.
+    """
+    setup = build_setup('camera', model)
+    grid = setup.model.grid
+    shown = np.array([observed_cells(setup.camera, grid, grid.cell(p))
+                      for p in range(grid.n_cells)])
+    cover = shortest_tour(grid, covering_poses(grid, shown))
+    views = [r for group in results.values() for r in group if r.fixations]
+    per_view = sum(r.detector_s for r in views) / sum(r.fixations for r in views)
+    done_s = head_time_s(grid, cover, np.full(cover.size, per_view))
+    oracle = [head_time_s(grid, tour, np.full(tour.size, per_view))
+              for tour in (shortest_tour(grid, [grid.index(*f) for f in set(r.face_cells)])
+                           for r in results[NODE])]
+    node = summarise_rooms(results[NODE])['head_time_s_mean']
+    sweep = summarise_rooms(results[SWEEP])['head_time_s_mean']
+    return ["The moonshot (issue 37, report only; the detector's mean time per view in this "
+            f'run, {per_view:.3f} s):', '',
+            f"- rooms done in 80% of the sweep's head time: the node's pass "
+            f'({LABELS[NODE].split(":")[0]}) takes {node:.2f} s, {node / sweep:.0%} of the '
+            f"sweep's {sweep:.2f} s ({'met' if node <= 0.8 * sweep else '**not met**'})",
+            f'- a perfect detector would call a room done after the fewest views that show '
+            f'every cell: {cover.size} views, toured in {done_s:.2f} s (the node: '
+            f'{node / done_s:.2f}x that)',
+            f'- knowing where the faces are, one view on each: {np.mean(oracle):.2f} s per room '
+            'on average (0 for an empty room; finding everyone, not knowing that the room is '
+            'done)']
+
+
 def _decided(group) -> int:
     return sum(r.reason == '' and r.decision in ('found', 'absent') for r in group)
 
@@ -176,6 +215,7 @@ def write_page(record: dict, out: Path) -> None:
                       *_table({k: v for k, v in bounds.items() if k in BOUNDS}), '']
         for name in (OURS, NODE):
             lines += [*_checks(results, bounds, name), '']
+        lines += [*_moonshot(results, run['model']), '']
     out.write_text('\n'.join(lines).rstrip() + '\n')
 
 

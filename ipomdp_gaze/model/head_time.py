@@ -89,3 +89,68 @@ def tour_detour_deg(grid: Grid, from_cell: int, cells) -> np.ndarray:
         left[np.arange(k), nxt] = False
         at = nxt
     return length - length.min()
+
+
+def covering_poses(grid: Grid, shown: np.ndarray) -> np.ndarray:
+    """
+    Return the fewest poses whose views together show every cell: an exact set cover.
+
+    ``shown[p, j]`` says whether the view from pose ``p`` (a cell of ``grid``) shows cell ``j``
+    (N, N). Solved as a 0-1 program (scipy's MILP, HiGHS); among the fewest, the poses nearest
+    the centre in all (a tie-break worth less than one pose). What a perfect detector would
+    need to call a room done: every cell seen once (the moonshot of issue 37).
+
+    Raises
+    ------
+    ValueError
+        When some cell is shown by no pose.
+
+    """
+    from scipy.optimize import Bounds, LinearConstraint, milp
+    shown = np.asarray(shown, dtype=bool)
+    if not shown.any(axis=0).all():
+        raise ValueError('no pose shows every cell: no cover')
+    p = shown.shape[0]
+    near = _step_deg(grid, grid.center_index)[:p]
+    cost = 1.0 + near / (2.0 * p * (near.max() + 1.0))
+    result = milp(cost, integrality=np.ones(p), bounds=Bounds(0, 1),
+                  constraints=LinearConstraint(shown.T.astype(float), lb=1, ub=np.inf))
+    return np.flatnonzero(np.round(result.x) > 0)
+
+
+def shortest_tour(grid: Grid, cells) -> np.ndarray:
+    """
+    Return ``cells`` in the order of least saccade time from the head at the grid's centre.
+
+    Exact (every order) for up to 7 cells, else nearest neighbour improved by 2-opt; the
+    saccade time is the head-time model's (:func:`head_time_s`: a move costs
+    :data:`SACCADE_TIME_S` plus the largest joint angle over :data:`HEAD_SPEED_DEG_S`).
+    """
+    from itertools import permutations
+    cells = np.asarray(cells, dtype=np.int64).reshape(-1)
+    if cells.size < 2:
+        return cells
+
+    def seconds(order):
+        rows, cols = grid.cell(np.concatenate([[grid.center_index], order]))
+        step = np.maximum(np.abs(np.diff(rows)), np.abs(np.diff(cols))) * grid.spacing_deg
+        return float(np.sum(np.where(step > 0, SACCADE_TIME_S + step / HEAD_SPEED_DEG_S, 0)))
+
+    if cells.size <= 7:
+        return np.asarray(min(permutations(cells.tolist()), key=seconds), dtype=np.int64)
+    order, left = [], set(cells.tolist())
+    at = grid.center_index
+    while left:
+        at = min(left, key=lambda c: (_step_deg(grid, at)[c], c))
+        order.append(at)
+        left.remove(at)
+    order = np.asarray(order, dtype=np.int64)
+    improved = True
+    while improved:
+        improved = False
+        for i in range(len(order) - 1):
+            for j in range(i + 2, len(order) + 1):
+                trial = np.concatenate([order[:i], order[i:j][::-1], order[j:]])
+                if seconds(trial) < seconds(order) - 1e-12:
+                    order, improved = trial, True
+    return order
