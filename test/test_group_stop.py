@@ -140,3 +140,41 @@ def test_the_settings_name_the_group_stop_as_the_node_and_yaml_do():
     assert (settings.group_stop, settings.group_probability) == (True, 0.05)
     with pytest.raises(ValueError, match='search.group_probability'):
         SearchSettings.from_parameters({'search.group_probability': 1.0})
+
+
+def test_a_group_in_an_excluded_cell_does_not_end_the_search():
+    _, session, _ = started(replace(SETTINGS, group_probability=0.0))
+    session.exclude([7])
+    groups = np.zeros(GRID.n_cells)
+    groups[7] = 1
+    result = session.update(Frame(np.zeros(GRID.n_cells), groups=groups))
+    assert not result.ended and result.reason == ''
+    groups[3] = 1                                   # an open cell with a group: that one
+    result = session.update(Frame(np.zeros(GRID.n_cells), groups=groups))
+    assert (result.reason, result.map_cell) == ('group', 3)
+
+
+def test_the_offline_views_report_each_models_grouping():
+    from ipomdp_gaze.drivers.scene_tasks import (MODEL_GROUPS, model_groups,
+                                                 ROOM_GROUP_MIN_NEIGHBORS, SceneTask, task_spec)
+    from ipomdp_gaze.files.share_files import config_file
+    from ipomdp_gaze.files.yaml_files import yaml_parameters
+    detector = yaml_parameters(config_file('faces_camera_detector.yaml'), 'foveal_detector')
+    controller = yaml_parameters(config_file('faces_camera_controller.yaml'), 'gaze_controller')
+    assert controller['search.group_stop'] and detector['publish_groups'] > 0
+    assert model_groups() == model_groups(detector['observation.file']) \
+        == detector['publish_groups']
+    assert model_groups('faces-pan-tilt-40-profile') == MODEL_GROUPS['faces-pan-tilt-40-profile']
+    assert model_groups('faces-pan-tilt-yunet') == 0          # YuNet does not group
+    spec = task_spec('pan-tilt', split='train', seed=1000)
+    assert spec.group_min_neighbors == detector['publish_groups'] and spec.settings.group_stop
+    assert task_spec('pan-tilt', group_min_neighbors=2).group_min_neighbors == 2
+    assert task_spec('pan-tilt', faces='0-4').group_min_neighbors == ROOM_GROUP_MIN_NEIGHBORS
+    assert task_spec('faces-420').group_min_neighbors == 0
+    with pytest.raises(ValueError, match='group_min_neighbors'):
+        task_spec('pan-tilt', group_min_neighbors=-1)
+    task = SceneTask.get(spec)
+    assert task.sensor.sensor.observer.group_min_neighbors == detector['publish_groups']
+    task.sensor.start(task.scene(0).image)
+    frame = task.sensor.observe(task.model.grid.center_index)
+    assert frame.groups is not None and frame.groups.shape == (task.model.grid.n_cells,)

@@ -4,8 +4,8 @@
 The moonshot's bounds (issue 37): the fewest covering views and the quickest tour, by brute force.
 
 ``covering_poses`` returns a cover of the fewest poses (checked against every subset on small
-grids), ``shortest_tour`` the order of least saccade time (against every order, and no worse
-than nearest neighbour where it uses 2-opt).
+grids), ``shortest_tour`` the order of least saccade time (against every order up to 7 cells;
+beyond, an order no reversal of a stretch improves).
 """
 from __future__ import annotations
 
@@ -65,15 +65,16 @@ def test_the_tour_is_the_quickest_order_from_the_centre():
         assert head_time_s(grid, tour, views) == pytest.approx(best)
 
 
-def test_a_long_tour_is_no_worse_than_nearest_neighbour():
+def test_a_long_tour_no_reversal_of_a_stretch_makes_quicker():
+    """Beyond 7 cells the tour is 2-opt optimal: reversing any stretch takes no less time."""
     grid = Grid(11, 11, 5.0)
-    cells = np.random.default_rng(5).choice(grid.n_cells, size=12, replace=False)
-    tour = shortest_tour(grid, cells)
-    assert sorted(tour.tolist()) == sorted(cells.tolist())
-    order, left, at = [], set(cells.tolist()), grid.center_index
-    while left:
-        at = min(left, key=lambda c: (max(abs(c // 11 - at // 11), abs(c % 11 - at % 11)), c))
-        order.append(at)
-        left.remove(at)
-    views = np.zeros(len(cells))
-    assert head_time_s(grid, tour, views) <= head_time_s(grid, order, views) + 1e-12
+    for seed in (5, 6):
+        cells = np.random.default_rng(seed).choice(grid.n_cells, size=12, replace=False)
+        tour = shortest_tour(grid, cells)
+        assert sorted(tour.tolist()) == sorted(cells.tolist())
+        views = np.zeros(len(cells))
+        seconds = head_time_s(grid, tour, views)
+        for i in range(len(tour) - 1):
+            for j in range(i + 2, len(tour) + 1):
+                trial = np.concatenate([tour[:i], tour[i:j][::-1], tour[j:]])
+                assert head_time_s(grid, trial, views) >= seconds - 1e-9

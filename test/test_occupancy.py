@@ -273,9 +273,26 @@ def test_settings_refusals():
     moving = OccupancySession(grid, _model(grid), SearchSettings(targets='many',
                                                                  motion_sigma_cells=0.5))
     assert moving.motion.active                     # section 12.10: people who move
-    with pytest.raises(ValueError, match='head_tour'):
-        OccupancySession(grid, _model(grid), SearchSettings(targets='many', head_tour=True,
-                                                            head_speed_deg_s=50.0))
+    # coverage's tour and the one-target group stop mean nothing to the occupancy belief: a
+    # configuration layered on the pan/tilt face config (which turns both on) searches as
+    # without them
+    big = Grid(4, 4)
+    paths = []
+    for extra in ({}, {'head_tour': True, 'group_stop': True}):
+        session = OccupancySession(big, _model(big), SearchSettings(
+            targets='many', head_speed_deg_s=50.0, absent_prior=0.5, max_fixations=5,
+            **extra))
+        session.reset(seed=0)
+        cell = session.start()
+        for _ in range(5):
+            groups = np.zeros(big.n_cells)
+            groups[cell] = 1
+            result = session.update(Frame(np.zeros(big.n_cells), groups=groups))
+            if result.ended:
+                break
+            cell = result.fixation
+        paths.append((session.path, session.decision))
+    assert paths[0] == paths[1]
     with pytest.raises(ValueError, match='excludes no cells'):
         session = OccupancySession(grid, _model(grid), SearchSettings(targets='many'))
         session.reset()

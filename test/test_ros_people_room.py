@@ -4,10 +4,10 @@
 Several people, followed in turn, on real pixels over DDS (docs/design.md section 12.10).
 
 Three processes on the shipped configurations: the scene camera shows held-out room 0 of two
-faces (``scene.faces '2'``, the room of ``test_ros_room``), the detector sends its 32FC3 frames
-(counts and the detections' offsets), and the controller runs
-``config/faces_camera_tracking.yaml`` with ``config/faces_camera_people.yaml`` after it: many
-targets that may move. Both people are found, each once, with its own number; ``~/target_cells``
+faces (``scene.faces '2'``, the room of ``test_ros_room``), the detector sends its 32FC4
+frames (counts, the detections' offsets and the grouped detections, which a tracker ignores),
+and the controller runs ``config/faces_camera_tracking.yaml`` with
+``config/faces_camera_people.yaml`` after it: many targets that may move. Both people are found, each once, with its own number; ``~/target_cells``
 lists both; then the head goes from one to the other (``motion.dwell_s`` each), with a view for
 new people after each round; the search never ends.
 """

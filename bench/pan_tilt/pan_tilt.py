@@ -48,11 +48,7 @@ NO_HEAD_TIME = '{policy}:search.head_speed_deg_s=0'
 # The answer rules a team would write: a sweep that stops at its first grouped detection.
 GROUPED_SWEEPS = ('sweep-first-grouped3', 'sweep-first-grouped5')
 SECOND_MODEL = 'faces-pan-tilt-40-profile'
-# The grouping the second camera's detector reports for search.group_stop (its publish_groups):
-# min_neighbors 3, chosen on its training scenes (docs/design.md section 6.15); the shipped
-# camera's is config/faces_camera_detector.yaml's (5).
-SECOND_GROUPS = 3
-# The shipped search without the grouped detections' stop (the search before issue 37's).
+# The shipped search without the grouped detections' stop (its tour and deadline kept).
 NO_GROUP_STOP = '{policy}:search.group_stop=false'
 
 # Ideas tried on TRAINING scenes: a hand-kept table (docs/data/pan_tilt_ideas.md).
@@ -63,13 +59,12 @@ def run(args) -> dict:
     """Search the test scenes with every searcher; return the JSON record."""
     record = {'args': vars(args) | {'json': str(args.json), 'out': str(args.out)},
               'started': time.strftime('%Y-%m-%d %H:%M:%S UTC', time.gmtime()), 'runs': {}}
-    for label, model, faces, empty, groups in (
-            ('main', '', args.faces, args.empty, None),
-            ('second', SECOND_MODEL, args.second_faces, args.second_empty, SECOND_GROUPS)):
+    for label, model, faces, empty in (('main', '', args.faces, args.empty),
+                                       ('second', SECOND_MODEL, args.second_faces,
+                                        args.second_empty)):
         if not faces and not empty:
             continue
-        spec = task_spec('pan-tilt', seed=args.seed, split='test', model=model,
-                         group_min_neighbors=groups)
+        spec = task_spec('pan-tilt', seed=args.seed, split='test', model=model)
         passes = len(_sweep_poses(spec))
         compare = (NO_GROUP_STOP.format(policy=spec.policy),
                    NO_HEAD_TIME.format(policy=spec.policy), SWEEP.format(passes=passes)) \
@@ -156,7 +151,7 @@ def _label(name: str, passes: int) -> str:
     if name.endswith(':search.head_speed_deg_s=0'):
         return 'the same, every view costing alike (no head time in the choice)'
     if name.endswith(':search.group_stop=false'):
-        return 'the same without the grouped-detection stop (shipped before)'
+        return 'the same without the grouped-detection stop (its tour and deadline kept)'
     if name.startswith('sweep:'):
         return f'blind sweep, the same belief and stop rule, one pass ({passes} views)'
     return {'sweep-tile': 'blind sweep, one pass, the cell with most raw detections in its tile',
@@ -283,8 +278,8 @@ def _against_grouped_sweeps(results: dict) -> list[str]:
 def _groups_note(label: str) -> str:
     if label == 'main':
         return " (the detector's `publish_groups` in `config/faces_camera_detector.yaml`)"
-    return (" (this camera's `publish_groups`, chosen on its training scenes: docs/design.md "
-            'section 6.15)')
+    return (" (this camera's `publish_groups`, chosen on its training scenes: "
+            '`scene_tasks.MODEL_GROUPS`, docs/design.md section 6.15)')
 
 
 def _met(flag: bool) -> str:

@@ -22,7 +22,7 @@ from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
 from ipomdp_gaze.search.session import PARAMETER_NAMES, SearchSettings
 from ipomdp_gaze.search.settings import check_parameters
-from ipomdp_gaze.vision.detection import build_setup
+from ipomdp_gaze.vision.detection import build_setup, DEFAULT_MODELS
 from ipomdp_gaze.vision.detector import as_detections
 from ipomdp_gaze.vision.fovea_model import fovea_for_model
 from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, parse_faces, SceneGeometry
@@ -54,9 +54,12 @@ ROOM_CHOICES = {'repeat_weight': 0.1}
 # The grouping a room's views also report (Frame.groups), which pass-many answers: the grouped
 # sweep a team keeps (no false face on the training rooms, where 3 named some; section 11.7).
 ROOM_GROUP_MIN_NEIGHBORS = 5
-# The one-face scenes' views report the grouping of the shipped detector configuration
-# (config/faces_camera_detector.yaml, publish_groups), which search.group_stop stops at.
+# The one-face scenes' views report the grouping search.group_stop stops at: for the shipped
+# camera model, the shipped detector configuration's (config/faces_camera_detector.yaml,
+# publish_groups); for another, the grouping chosen on its training scenes (docs/design.md
+# section 6.15); none for a model whose group stop was never measured (YuNet does not group).
 DETECTOR_CONFIG = 'faces_camera_detector.yaml'
+MODEL_GROUPS = {'faces-pan-tilt-40-profile': 3}
 ROOM_BUDGET = 20
 _FOVEA_TASKS = {'faces-420': ('faces-420', 420, (60, 140)),
                 'faces-840': ('faces-840', 840, (24, 140))}
@@ -108,8 +111,8 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
     configuration's with :data:`ROOM_MODEL` and :data:`ROOM_CHOICES`, and the budget
     :data:`ROOM_BUDGET` unless ``max_fixations`` is given.
     ``group_min_neighbors`` (pan-tilt, one face): the grouping the views report for
-    ``search.group_stop`` (``Frame.groups``), by default the shipped detector configuration's
-    ``publish_groups`` (:func:`detector_groups`); rooms report :data:`ROOM_GROUP_MIN_NEIGHBORS`.
+    ``search.group_stop`` (``Frame.groups``), by default the model's (:func:`model_groups`);
+    rooms report :data:`ROOM_GROUP_MIN_NEIGHBORS`.
     """
     if task not in TASKS:
         raise ValueError(f"unknown scene task {task!r}; choose from {', '.join(TASKS)}")
@@ -160,17 +163,25 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
     elif faces != (1, 1):
         groups = ROOM_GROUP_MIN_NEIGHBORS
     else:
-        groups = detector_groups() if group_min_neighbors is None else int(group_min_neighbors)
+        groups = model_groups(model) if group_min_neighbors is None \
+            else int(group_min_neighbors)
         if groups < 0:
             raise ValueError(f'group_min_neighbors must be >= 0, got {groups}')
     return TaskSpec(task, name, file, settings, int(seed), split, bool(empty), model,
                     tuple(compare), faces, groups)
 
 
-def detector_groups() -> int:
-    """Return the shipped detector configuration's ``publish_groups`` (0: none)."""
+def model_groups(model: str = '') -> int:
+    """
+    Return the grouping a pan/tilt model's views report for ``search.group_stop`` (0: none).
+
+    The shipped detector configuration's ``publish_groups`` for its own model (``model`` ''
+    is the shipped one), :data:`MODEL_GROUPS` for the others.
+    """
     values = yaml_parameters(config_file(DETECTOR_CONFIG), 'foveal_detector')
-    return int(values.get('publish_groups', 0))
+    if (model or DEFAULT_MODELS['camera']) == values.get('observation.file'):
+        return int(values.get('publish_groups', 0))
+    return MODEL_GROUPS.get(model, 0)
 
 
 def compare_settings(settings: SearchSettings, label: str) -> SearchSettings:

@@ -481,7 +481,8 @@ class GazeControllerNode(QuietPublishers, Node):
             clause = answer.confidence_clause('found', found.forced_by, found.probability,
                                               confidence)
             self.get_logger().info(
-                f'{answer.heading("found", found.forced_by)}: the target is most likely at '
+                f'{answer.heading("found", found.forced_by)}: the target is '
+                f"{'at' if found.forced_by == 'group' else 'most likely at'} "
                 f'({row}, {col}), pan {pan:+.4f} rad, tilt {tilt:+.4f} rad, probability '
                 f'{found.probability:.4f}, after {found.fixations} fixations{clause}{ending}')
         if result.absent is not None:
@@ -597,7 +598,9 @@ class GazeControllerNode(QuietPublishers, Node):
             self._handle(self.core.offer_scan(values, search_id, now))
             return
         taken = now if stamp is None or stamps.is_zero(stamp) else stamps.to_seconds(stamp)
-        if groups is None and self._config.settings.group_stop:
+        settings = self._config.settings
+        if groups is None and settings.group_stop and settings.targets == 'one' \
+                and not settings.moving:
             self.get_logger().warning(
                 'search.group_stop is on but the evidence carries no grouped detections: set '
                 "the detector's publish_groups (docs/design.md section 6.15)", once=True)

@@ -72,7 +72,9 @@ class Found:
     The found event: the most likely cell reached the confidence level.
 
     ``forced_by`` names the limit (``budget``) that forced it below the confidence
-    (``search.decide_at_budget``), '' when the evidence reached it.
+    (``search.decide_at_budget``), or ``group`` when a grouped detection ended the search
+    (``search.group_stop``; not a limit, its probability may be below the confidence), '' when
+    the evidence reached it.
     """
 
     cell: int

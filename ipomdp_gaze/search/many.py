@@ -87,9 +87,6 @@ def check_many_settings(settings: SearchSettings) -> None:
         raise ValueError('search.targets many does not model false-alarm scales, nor hotspots '
                          'of a still scene: leave search.false_alarm_scales [1.0], and '
                          'search.hotspot_prior 0 unless the targets move')
-    if settings.head_tour and settings.head_speed_deg_s > 0 and not settings.moving:
-        raise ValueError('search.targets many has no tour of the tiles (that is policy '
-                         "coverage's): leave search.head_tour false")
 
 
 class OccupancySession:

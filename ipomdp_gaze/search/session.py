@@ -242,7 +242,8 @@ class StepResult:
     What one frame did (as Gymnasium's ``step``: terminated and truncated kept apart).
 
     ``status`` is ``'applied'`` or ``'rejected'`` (``reason`` says why; the belief is then
-    unchanged). ``decision`` is ``found`` / ``absent`` (``terminated``: the evidence decided),
+    unchanged). ``decision`` is ``found`` / ``absent`` (``terminated``: the evidence decided,
+    or for ``found`` with reason ``group`` a grouped detection, ``search.group_stop``),
     ``gave_up`` (``truncated``: a limit, ``reason`` ``budget`` or ``repeat``) or ``''``;
     ``fired`` names the decision first reached by this frame ('' if none: with motion on a
     decision can be reported, lost and reached again). ``fixation`` is the next fixation, None
@@ -855,10 +856,11 @@ class SearchSession:
             search.decision, search.ended, fired = decision, True, decision
         search.decided_once = search.decided_once or bool(fired)
         if not search.ended and self._group_stops(groups):
-            cells = np.flatnonzero(groups > 0)
+            open_cells = np.isfinite(search.log_belief[:self.grid.n_cells])     # not excluded
+            cells = np.flatnonzero((groups > 0) & open_cells)
             pooled = self._pooled()
-            cell = int(cells[np.argmax(pooled[cells])])
-            if pooled[cell] >= settings.group_probability:
+            cell = int(cells[np.argmax(pooled[cells])]) if cells.size else -1
+            if cells.size and pooled[cell] >= settings.group_probability:
                 search.group_cell = cell
                 search.decision, search.reason, search.ended = 'found', 'group', True
                 search.decided_once = True
