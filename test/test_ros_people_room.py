@@ -7,9 +7,10 @@ Three processes on the shipped configurations: the scene camera shows held-out r
 faces (``scene.faces '2'``, the room of ``test_ros_room``), the detector sends its 32FC4
 frames (counts, the detections' offsets and the grouped detections, which a tracker ignores),
 and the controller runs ``config/faces_camera_tracking.yaml`` with
-``config/faces_camera_people.yaml`` after it: many targets that may move. Both people are found, each once, with its own number; ``~/target_cells``
-lists both; then the head goes from one to the other (``motion.dwell_s`` each), with a view for
-new people after each round; the search never ends.
+``config/faces_camera_people.yaml`` after it: many targets that may move. Both people are found,
+each once, with its own number; ``~/target_cells`` lists both; then the head goes from one to
+the other (``motion.dwell_s`` each), with a view for new people after each round; the search
+never ends.
 """
 from __future__ import annotations
 
