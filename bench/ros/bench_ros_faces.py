@@ -26,7 +26,7 @@ MODES = (('camera', False, 'a camera on the pan/tilt head (11x11 grid of 5 deg, 
                            'coverage per second of head time with the tour of the tiles, '
                            'confidence 0.99 within one cell, inhibition of return, '
                            'absent prior 0.8, false-alarm scales and hotspots, a grouped '
-                           'detection the belief does not veto ends the search, decided at 12 '
+                           'detection the belief does not veto ends the search, decided at 20 '
                            'fixations)'),
          ('fovea', True, 'a fixed camera and the digital fovea (21x21 grid over 420x420 '
                          'scenes, `faces-420` with its one-time scan and kernel '
