@@ -216,10 +216,19 @@ def test_many_targets_without_head_speed_choose_by_information_alone():
     assert paths[0] != paths[1]                 # the head time moved the views
 
 
-def test_many_targets_refuse_the_tour():
+def test_many_targets_ignore_the_tour():
+    """The tour is coverage's: the occupancy belief chooses per second without it (§6.15)."""
     from ipomdp_gaze.search.many import OccupancySession
-    with pytest.raises(ValueError, match='search.targets many has no tour'):
-        OccupancySession(GRID, MODEL, SearchSettings(targets='many', head_speed_deg_s=120.0,
-                                                     head_tour=True))
-    # Without head speed the tour does nothing, for one target as for many: accepted.
-    OccupancySession(GRID, MODEL, SearchSettings(targets='many', head_tour=True))
+    from ipomdp_gaze.search.session import Frame
+    paths = []
+    for tour in (False, True):
+        session = OccupancySession(GRID, MODEL, SearchSettings(
+            targets='many', head_speed_deg_s=120.0, head_tour=tour, absent_prior=0.5,
+            max_fixations=6))
+        session.reset(seed=0)
+        session.start()
+        for _ in range(6):
+            if session.update(Frame(np.zeros(GRID.n_cells))).ended:
+                break
+        paths.append(session.path)
+    assert paths[0] == paths[1] and len(paths[0]) > 1
