@@ -106,8 +106,12 @@ def test_figure_labels_of_a_dense_cluster_neither_overlap_nor_leave_the_axes():
 
 
 def _bench_module(name):
+    """Load a bench script as a module, its folder on the path as when it runs as a script."""
     import importlib.util
-    spec = importlib.util.spec_from_file_location(f'bench_{name}', next(BENCH.rglob(f'{name}.py')))
+    path = next(BENCH.rglob(f'{name}.py'))
+    if str(path.parent) not in sys.path:
+        sys.path.insert(0, str(path.parent))
+    spec = importlib.util.spec_from_file_location(f'bench_{name}', path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
