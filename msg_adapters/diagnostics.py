@@ -17,6 +17,7 @@ them back into numbers.
 from __future__ import annotations
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from ipomdp_gaze.search import answer
 from std_msgs.msg import Header
 
 LEVELS = {'ok': DiagnosticStatus.OK, 'warn': DiagnosticStatus.WARN,
@@ -61,8 +62,7 @@ def _ending(forced_by: str, confidence: float | None) -> tuple[str, dict]:
     values = {'ended': f'forced:{forced_by}' if forced_by else 'confidence'}
     if confidence is not None:
         values['confidence'] = float(confidence)
-    limit = {'budget': 'the fixation budget', 'pass': 'the end of its pass'}
-    limit = limit.get(forced_by, forced_by)
+    limit = answer.LIMITS.get(forced_by, forced_by)
     if forced_by == 'group':            # search.group_stop: a stop rule, not a limit
         values['ended'] = 'group'
         clause = ' at a grouped detection of the detector'

@@ -497,8 +497,7 @@ def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
         found = diagnostics.parse_found(record.found[0][1])
         answer, stop = (found['row'], found['col'], found['cell']), 'found'
         forced = words.reason_of(found['ended'])
-        where = 'at' if forced == 'group' else 'most likely at'     # the group's own cell
-        out(f'{words.heading("found", forced)}: the {what} is {where} '
+        out(f'{words.heading("found", forced)}: the {what} is {words.where(forced)} '
             + _answer(setup, *answer, found['probability'], found['fixations'])
             + words.confidence_clause('found', forced, found['probability'], confidence))
     elif record.absent and printed >= last():

@@ -124,7 +124,8 @@ def shortest_tour(grid: Grid, cells) -> np.ndarray:
 
     Exact (every order) for up to 7 cells, else nearest neighbour improved by 2-opt; the
     saccade time is the head-time model's (:func:`head_time_s`: a move costs
-    :data:`SACCADE_TIME_S` plus the largest joint angle over :data:`HEAD_SPEED_DEG_S`).
+    :data:`SACCADE_TIME_S` plus the largest joint angle over :data:`HEAD_SPEED_DEG_S`; the
+    views cost the same in every order).
     """
     from itertools import permutations
     cells = np.asarray(cells, dtype=np.int64).reshape(-1)
@@ -132,16 +133,15 @@ def shortest_tour(grid: Grid, cells) -> np.ndarray:
         return cells
 
     def seconds(order):
-        rows, cols = grid.cell(np.concatenate([[grid.center_index], order]))
-        step = np.maximum(np.abs(np.diff(rows)), np.abs(np.diff(cols))) * grid.spacing_deg
-        return float(np.sum(np.where(step > 0, SACCADE_TIME_S + step / HEAD_SPEED_DEG_S, 0)))
+        return head_time_s(grid, np.asarray(order), 0.0)
 
     if cells.size <= 7:
         return np.asarray(min(permutations(cells.tolist()), key=seconds), dtype=np.int64)
     order, left = [], set(cells.tolist())
     at = grid.center_index
     while left:
-        at = min(left, key=lambda c: (_step_deg(grid, at)[c], c))
+        step = _step_deg(grid, at)
+        at = min(left, key=lambda c: (step[c], c))
         order.append(at)
         left.remove(at)
     order = np.asarray(order, dtype=np.int64)

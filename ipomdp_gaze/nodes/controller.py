@@ -482,7 +482,7 @@ class GazeControllerNode(QuietPublishers, Node):
                                               confidence)
             self.get_logger().info(
                 f'{answer.heading("found", found.forced_by)}: the target is '
-                f"{'at' if found.forced_by == 'group' else 'most likely at'} "
+                f'{answer.where(found.forced_by)} '
                 f'({row}, {col}), pan {pan:+.4f} rad, tilt {tilt:+.4f} rad, probability '
                 f'{found.probability:.4f}, after {found.fixations} fixations{clause}{ending}')
         if result.absent is not None:

@@ -25,7 +25,8 @@ import math
 
 # The limits that can end a search, and their words.
 LIMITS = {'budget': 'the fixation budget', 'pixels': 'the pixel budget (one full scan)',
-          'repeat': 'every cell fixated once', 'timeout': 'the time limit'}
+          'repeat': 'every cell fixated once', 'timeout': 'the time limit',
+          'pass': 'the end of its pass'}
 
 
 def ended(decision: str, reason: str = '') -> str:
@@ -53,6 +54,11 @@ def ended(decision: str, reason: str = '') -> str:
 def reason_of(token: str) -> str:
     """Return the reason an :func:`ended` token names (``forced:budget`` -> ``budget``)."""
     return 'group' if token == 'group' else str(token).partition('forced:')[2]
+
+
+def where(reason: str = '') -> str:
+    """Return where a found answer is: ``at`` a grouped detection's, else ``most likely at``."""
+    return 'at' if reason == 'group' else 'most likely at'
 
 
 def forced(decision: str, reason: str = '') -> bool:

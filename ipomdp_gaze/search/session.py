@@ -596,19 +596,12 @@ class SearchSession:
             return frame.values
         return self.check_frame(frame.values)
 
-    def _frame_groups(self, frame: Frame) -> np.ndarray | None:
-        """Return a frame's checked groups: checked here unless this session checked them."""
+    def _frame_part(self, frame: Frame, name: str, check) -> np.ndarray | None:
+        """Return a frame's ``offsets`` or ``groups``: checked here unless this session did."""
         checked = frame._checked_by
         if checked and checked[0] is self:
-            return frame.groups
-        return check_groups(frame.groups, self.grid.n_cells)
-
-    def _frame_offsets(self, frame: Frame) -> np.ndarray | None:
-        """Return a frame's checked offsets: checked here unless this session checked them."""
-        checked = frame._checked_by
-        if checked and checked[0] is self:
-            return frame.offsets
-        return check_offsets(frame.offsets, self.grid.n_cells)
+            return getattr(frame, name)
+        return check(getattr(frame, name), self.grid.n_cells)
 
     def reset(self, *, seed=None) -> None:
         """
@@ -760,8 +753,8 @@ class SearchSession:
             raise OrderError(f'the search has ended ({search.decision}); reset starts a new one')
         try:
             obs = self._frame_values(frame)
-            offsets = self._frame_offsets(frame)
-            groups = self._frame_groups(frame)
+            offsets = self._frame_part(frame, 'offsets', check_offsets)
+            groups = self._frame_part(frame, 'groups', check_groups)
             term = self.observation.log_likelihood_ratio(obs, search.fixation)
         except EvidenceError as exc:
             return self._result('rejected', reason=str(exc))
@@ -859,9 +852,8 @@ class SearchSession:
             open_cells = np.isfinite(search.log_belief[:self.grid.n_cells])     # not excluded
             cells = np.flatnonzero((groups > 0) & open_cells)
             pooled = self._pooled()
-            cell = int(cells[np.argmax(pooled[cells])]) if cells.size else -1
-            if cells.size and pooled[cell] >= settings.group_probability:
-                search.group_cell = cell
+            if cells.size and pooled[cells].max() >= settings.group_probability:
+                search.group_cell = int(cells[np.argmax(pooled[cells])])
                 search.decision, search.reason, search.ended = 'found', 'group', True
                 search.decided_once = True
                 return 'found'
