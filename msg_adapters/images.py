@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import sys
 
+from ipomdp_gaze.files.evidence_bytes import data_bytes, decode_evidence, EVIDENCE_ENCODINGS
 from ipomdp_gaze.files.render import belief_heatmap
-from ipomdp_gaze.model.belief import EvidenceError
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head_camera import PinholeCamera
 import numpy as np
@@ -38,14 +38,6 @@ class ImageError(ValueError):
     """A camera image message that cannot be used; the message says why."""
 
 
-def _uint8(data) -> np.ndarray:
-    """View the bytes of an image's ``data`` field (bytes, array('B') or a list) as uint8."""
-    try:
-        return np.frombuffer(data, dtype=np.uint8)
-    except TypeError:
-        return np.asarray(data, dtype=np.uint8)
-
-
 def belief_image(belief, grid: Grid, fixation: int | None, scale_px: int, stamp,
                  frame_id: str = '') -> Image:
     """Build a stamped ``rgb8`` ``sensor_msgs/Image`` of the belief heatmap."""
@@ -62,7 +54,7 @@ def rgb8_array(msg: Image) -> np.ndarray:
     """Read an ``rgb8`` image as ``(height, width, 3)`` uint8 pixels (row padding dropped)."""
     if msg.encoding != 'rgb8':
         raise ValueError(f'expected an rgb8 image, got encoding {msg.encoding!r}')
-    buf = _uint8(msg.data)
+    buf = data_bytes(msg.data)
     if msg.step < 3 * msg.width or buf.size != msg.step * msg.height:
         raise ValueError(f'image data has {buf.size} bytes, expected step {msg.step} x height '
                          f'{msg.height} with step >= {3 * msg.width}')
@@ -153,25 +145,14 @@ def evidence_channels(msg: Image, grid: Grid) -> tuple:
         If the data does not match the declared step and height.
 
     """
-    encoding = msg.encoding.upper()
-    if encoding not in ('32FC1', '32FC3', '32FC4'):
+    if str(msg.encoding).upper() not in EVIDENCE_ENCODINGS:
         raise LayoutError(f"evidence image encoding is {msg.encoding!r}, expected '32FC1', "
                           f"'32FC3' or '32FC4'")
     if (msg.height, msg.width) != grid.shape:
         raise LayoutError(f'evidence image is {msg.height}x{msg.width} (height x width), '
                           f'the grid is {grid.rows}x{grid.cols}')
-    channels = int(encoding[-1])
-    row_bytes = 4 * channels * msg.width
-    buf = _uint8(msg.data)
-    if msg.step < row_bytes or buf.size != msg.step * msg.height:
-        raise EvidenceError(f'evidence image has {buf.size} bytes, expected step {msg.step} x '
-                            f'height {msg.height} with step >= {row_bytes}')
-    rows = buf.reshape(msg.height, msg.step)[:, :row_bytes]
-    dtype = np.dtype('>f4' if msg.is_bigendian else '<f4')
-    data = np.ascontiguousarray(rows).view(dtype).reshape(-1, channels).astype(np.float64)
-    offsets = data[:, 1:3].copy() if channels >= 3 else None
-    groups = data[:, 3].copy() if channels == 4 else None
-    return data[:, 0].copy(), offsets, groups
+    return decode_evidence(msg.encoding, msg.height, msg.width, msg.step, msg.is_bigendian,
+                           msg.data)
 
 
 def image_array(msg: Image, max_side_px: int = MAX_IMAGE_SIDE_PX) -> np.ndarray:
@@ -194,7 +175,7 @@ def image_array(msg: Image, max_side_px: int = MAX_IMAGE_SIDE_PX) -> np.ndarray:
         raise ImageError(f'unsupported image encoding {msg.encoding!r} (expected one of '
                          f"{', '.join(IMAGE_ENCODINGS)})")
     width, height, step = int(msg.width), int(msg.height), int(msg.step)
-    buf = _uint8(msg.data)
+    buf = data_bytes(msg.data)
     if width == 0 or height == 0 or buf.size == 0:
         raise ImageError(f'empty image ({width}x{height} px, {buf.size} bytes)')
     if width > max_side_px or height > max_side_px:

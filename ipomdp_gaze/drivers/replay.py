@@ -26,6 +26,8 @@ import dataclasses
 from dataclasses import dataclass, field
 import math
 
+from ipomdp_gaze.files.evidence_bytes import decode_evidence
+from ipomdp_gaze.model.belief import EvidenceError
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.policies.registry import build_policy
@@ -165,19 +167,15 @@ def _frames(bag, grid: Grid) -> list:
     frames = []
     for m in bag.topic('evidence_image'):
         msg = m.msg
-        channels = {'32FC3': 3, '32FC4': 4}.get(str(msg.encoding).upper(), 1)
-        data = np.asarray(msg.data, dtype=np.uint8)
-        if msg.step < 4 * channels * msg.width or data.size != msg.step * msg.height:
-            raise ValueError(f'{bag.path}: an evidence_image has {data.size} bytes, not step '
-                             f'{msg.step} x height {msg.height} of {msg.encoding} rows')
-        rows = data.reshape(msg.height, msg.step)[:, :4 * channels * msg.width]
-        cells = np.ascontiguousarray(rows).view('>f4' if msg.is_bigendian else '<f4')
-        cells = cells.reshape(-1, channels).astype(np.float64)
+        try:
+            values, offsets, groups = decode_evidence(msg.encoding, msg.height, msg.width,
+                                                      msg.step, msg.is_bigendian, msg.data)
+        except EvidenceError as exc:
+            raise ValueError(f'{bag.path}: an evidence_image cannot be read: {exc}') from None
         stamp = _seconds(msg.header.stamp)
         kind = 'scan' if str(msg.header.frame_id).startswith('scan/') else 'fixation'
-        frames.append((stamp or m.time_ns * 1e-9, m.time_ns * 1e-9, cells[:, 0].copy(), kind,
-                       cells[:, 1:3].copy() if channels >= 3 else None,
-                       cells[:, 3].copy() if channels == 4 else None))
+        frames.append((stamp or m.time_ns * 1e-9, m.time_ns * 1e-9, values, kind, offsets,
+                       groups))
     for m in bag.topic('evidence'):
         frames.append((m.time_ns * 1e-9, m.time_ns * 1e-9,
                        np.asarray(m.msg.data, dtype=np.float64), 'fixation', None, None))
