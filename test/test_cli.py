@@ -117,6 +117,11 @@ def test_search_prints_each_fixation(capsys):
      'motion.jump_prob must be a probability in [0, 1), got 2.0'),
     (['train', '--epochs', '1', '--out', 'x.yaml', '--motion-sigma-cells', '-1'],
      'motion.sigma_cells must be finite and >= 0, got -1.0'),
+    # Seeds go to the nodes as int64 parameters; a bag's folder is checked before any node runs.
+    (['demo', '--scene', 'faces', '--seed', str(2 ** 63)],
+     f"expected an integer from 0 to 2^63 - 1, got '{2 ** 63}'"),
+    (['demo', '--scene', 'faces', '--record', '/no_such_folder/bag'],
+     '--record /no_such_folder/bag: the folder /no_such_folder does not exist'),
 ])
 def test_bad_scene_arguments_exit_2_with_one_line(args, message):
     out = run_cli(*args)

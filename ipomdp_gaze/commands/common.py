@@ -60,13 +60,17 @@ def cell_index(value, grid, flag: str) -> int:
     return int(value)
 
 
-def _int_at_least(text: str, low: int, what: str) -> int:
-    """Parse an integer >= ``low`` for argparse; ``what`` names it in the error."""
+# The largest ROS integer parameter (int64): seeds go to the nodes as parameters.
+INT64_MAX = 2 ** 63 - 1
+
+
+def _int_at_least(text: str, low: int, what: str, high: int | None = None) -> int:
+    """Parse an integer from ``low`` to ``high`` for argparse; ``what`` names it in the error."""
     try:
         value = int(text)
     except ValueError:
         value = low - 1
-    if value < low:
+    if value < low or (high is not None and value > high):
         raise argparse.ArgumentTypeError(f'expected {what}, got {text!r}')
     return value
 
@@ -77,8 +81,8 @@ def positive_int(text: str) -> int:
 
 
 def nonneg_int(text: str) -> int:
-    """Parse an integer >= 0 (seeds) for argparse."""
-    return _int_at_least(text, 0, 'an integer >= 0')
+    """Parse an integer from 0 to 2^63 - 1 (seeds: a ROS integer parameter is int64)."""
+    return _int_at_least(text, 0, 'an integer from 0 to 2^63 - 1', INT64_MAX)
 
 
 def positive_float(text: str) -> float:

@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ipomdp_gaze.files.bag import check_new_bag
 from ipomdp_gaze.harness.processes import MAX_DOMAIN_ID
 from ipomdp_gaze.vision.pan_tilt import parse_faces
 from ipomdp_gaze.vision.walks import DURATION_S as DEMO_DURATION_S
@@ -126,8 +127,11 @@ def run(args) -> int:
     def out(line):
         print(line, flush=True)
 
-    if args.record is not None and args.record.exists():
-        raise ValueError(f'--record {args.record} exists; a bag needs a new directory')
+    if args.record is not None:
+        try:
+            check_new_bag(args.record)
+        except ValueError as exc:
+            raise ValueError(f'--record {exc}') from None
     for flag, path, suffix in (('--plot', args.plot, '.png'), ('--animate', args.animate, '.gif')):
         if path is not None and path.suffix.lower() != suffix:
             raise ValueError(f'{flag} writes a {suffix} file, got {path}')

@@ -13,6 +13,7 @@ package version, each node's parameters and the hashes of the files they name. N
 from __future__ import annotations
 
 from dataclasses import dataclass
+import os
 from pathlib import Path
 
 import yaml
@@ -26,6 +27,28 @@ def _typestore():
     return get_typestore(getattr(Stores, DISTRO_STORE))
 
 
+def check_new_bag(path) -> Path:
+    """
+    Return ``path`` as a Path if a bag can be created there: new, in a writable folder.
+
+    Raises
+    ------
+    ValueError
+        If ``path`` exists or its folder is missing or not writable (checked before any node
+        starts, so a demo does not run a search it cannot record).
+
+    """
+    path = Path(path)
+    if path.exists():
+        raise ValueError(f'{path} exists; a bag needs a new directory')
+    parent = path.parent
+    if not parent.is_dir():
+        raise ValueError(f'{path}: the folder {parent} does not exist')
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise ValueError(f'{path}: the folder {parent} is not writable')
+    return path
+
+
 def open_writer(path, compression: str = ''):
     """
     Create a bag at ``path`` (a new directory) and return the open ``rosbags`` writer.
@@ -33,16 +56,15 @@ def open_writer(path, compression: str = ''):
     Raises
     ------
     ValueError
-        If ``path`` exists or ``compression`` is not ``''`` or ``'zstd'``.
+        If ``path`` cannot be a new bag (:func:`check_new_bag`) or ``compression`` is not
+        ``''`` or ``'zstd'``.
 
     """
     from rosbags.rosbag2 import StoragePlugin, Writer
     from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
     if compression not in COMPRESSIONS:
         raise ValueError(f"compression must be '' or 'zstd', got {compression!r}")
-    path = Path(path)
-    if path.exists():
-        raise ValueError(f'{path} exists; a bag needs a new directory')
+    path = check_new_bag(path)
     writer = Writer(path, version=Writer.VERSION_LATEST, storage_plugin=StoragePlugin.MCAP)
     if compression:
         writer.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)

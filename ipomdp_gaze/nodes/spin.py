@@ -12,9 +12,13 @@ is killed (``exit status -9`` in the tests). A timer that does nothing bounds ev
 """
 from __future__ import annotations
 
+import difflib
+from pathlib import Path
+import re
 import sys
 
 import rclpy
+import yaml
 
 WAKE_PERIOD_S = 0.25
 
@@ -44,16 +48,24 @@ def run_node(make_node, node_name: str, args=None) -> int:
     """
     Run a node with the Jazzy idiom: init, spin until SIGINT/SIGTERM, destroy, try_shutdown.
 
-    An invalid start-up parameter (``ValueError`` or ``ParameterException`` from the node's
-    constructor) prints one line naming it and returns 1; a clean shutdown returns 0. Only the
-    constructor's errors are configuration errors: an exception that escapes a callback while
-    spinning (a callback not guarded by :class:`ipomdp_gaze.nodes.guard.CallbackGuard`) is a
-    bug, and is raised with its traceback.
+    ROS arguments rcl cannot parse (a missing or malformed ``--params-file``, a ``-p`` without
+    ``:=``, an unknown ``--ros-args`` flag) print one line and return 2. An invalid start-up
+    parameter (``ValueError`` or ``ParameterException`` from the node's constructor) prints one
+    line naming it and returns 1; a clean shutdown returns 0. Parameters given for the node that
+    it does not have (a typo) and a params file with no section for it are warned about
+    (:func:`warn_unused_parameters`), since rclpy ignores both silently. Only the constructor's
+    errors are configuration errors: an exception that escapes a callback while spinning (a
+    callback not guarded by :class:`ipomdp_gaze.nodes.guard.CallbackGuard`) is a bug, and is
+    raised with its traceback.
     """
     from rclpy.exceptions import ParameterException
     from rclpy.executors import ExternalShutdownException
     from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
-    rclpy.init(args=args)
+    try:
+        rclpy.init(args=args)
+    except (_rclpy.RCLError, _rclpy.UnknownROSArgsError) as exc:
+        print(f'{node_name}: error: {ros_args_error(exc)}', file=sys.stderr)
+        return 2
     node = None
     status = 0
     try:
@@ -63,6 +75,7 @@ def run_node(make_node, node_name: str, args=None) -> int:
             print(f'{node_name}: error: {exc}', file=sys.stderr)
             status = 1
         else:
+            warn_unused_parameters(node, sys.argv if args is None else args)
             spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
@@ -75,3 +88,86 @@ def run_node(make_node, node_name: str, args=None) -> int:
             node.destroy_node()
         rclpy.try_shutdown()
     return status
+
+
+def ros_args_error(exc) -> str:
+    """
+    Return rcl's complaint about the command line in one line, without its C source locations.
+
+    ``failed to initialize rcl: Couldn't parse params file: '--params-file x.yaml'. Error: Error
+    opening YAML file, at /project/src/parser.c:271, at ...`` becomes everything before the
+    first ``, at /``; an unknown flag (``UnknownROSArgsError``, a list) is named.
+    """
+    if type(exc).__name__ == 'UnknownROSArgsError':
+        flags = re.findall(r"'([^']*)'", str(exc)) or [str(exc)]
+        return f"unknown ROS arguments: {' '.join(flags)}"
+    text = ' '.join(str(exc).split())
+    return re.split(r',? at /', text, maxsplit=1)[0].strip()
+
+
+def params_file_sections(path) -> list[str]:
+    """
+    Return the node names a ROS params file has sections for (``/ns/node``, ``/**``, ...).
+
+    Nested namespaces (``ns: {node: {ros__parameters: ...}}``) are joined with ``/``. An
+    unreadable file gives an empty list (rcl has already read it, or refused it).
+    """
+    try:
+        data = yaml.safe_load(Path(path).read_text())
+    except (OSError, yaml.YAMLError, UnicodeDecodeError):
+        return []
+    out = []
+
+    def walk(node, prefix):
+        if not isinstance(node, dict):
+            return
+        for key, value in node.items():
+            name = f'{prefix}/{str(key).strip("/")}'
+            if isinstance(value, dict) and 'ros__parameters' in value:
+                out.append(name)
+            else:
+                walk(value, name)
+    walk(data, '')
+    return out
+
+
+def _params_files(argv) -> list[str]:
+    """Return the files given with ``--params-file`` in ``argv``."""
+    argv = [str(a) for a in argv or []]
+    return [argv[i + 1] for i, a in enumerate(argv[:-1]) if a == '--params-file']
+
+
+def warn_unused_parameters(node, argv) -> list[str]:
+    """
+    Warn (once each, on the node's logger) about parameters the node was given but does not have.
+
+    rclpy ignores an override for a parameter a node never declares, and a params file whose
+    sections name other nodes: a misspelt ``confidance`` or ``gaze_controler:`` would run on
+    defaults without a word. Returns the warnings.
+    """
+    declared = set(node._parameters)           # rclpy has no public view of either
+    given = set(getattr(node, '_parameter_overrides', {}))
+    warnings = []
+    for name in sorted(given - declared):
+        near = difflib.get_close_matches(name, sorted(declared), n=1)
+        warnings.append(f"parameter '{name}' is not a parameter of this node; ignored"
+                        + (f" (did you mean '{near[0]}'?)" if near else ''))
+    own = node.get_fully_qualified_name()
+    for path in _params_files(argv):
+        sections = params_file_sections(path)
+        if sections and not any(_matches(section, own) for section in sections):
+            warnings.append(f'params file {path} has no section for node {own} '
+                            f"(its sections: {', '.join(sections)}); none of it applies")
+    for text in warnings:
+        node.get_logger().warning(text)
+    return warnings
+
+
+def _matches(section: str, node_name: str) -> bool:
+    """Whether a params-file section applies to ``node_name`` (``/ns/node``; ``*`` wildcards)."""
+    pattern = re.escape(section).replace(r'/\*\*', '(/.*)?').replace(r'\*', '[^/]*')
+    if not section.startswith('/'):
+        pattern = '/' + pattern
+    if re.fullmatch(pattern, node_name):
+        return True
+    return '/' not in section.strip('/') and section.strip('/') == node_name.rsplit('/', 1)[-1]

@@ -1,0 +1,114 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+A node's command line: what rcl cannot parse, and what rclpy would ignore silently.
+
+The first is one line and exit 2; the second (a misspelt parameter, a params file for another
+node) is a warning.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+import select
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+pytestmark = pytest.mark.ros
+REPO = Path(__file__).resolve().parents[1]
+
+
+def _cli(ros_env, *args, timeout=60):
+    return subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', *args], cwd=REPO,
+                          env=ros_env, capture_output=True, text=True, timeout=timeout)
+
+
+@pytest.mark.parametrize('command', ['controller', 'detector', 'record'])
+@pytest.mark.parametrize('ros_args, message', [
+    (['--params-file', 'no_such_file.yaml'], "Couldn't parse params file"),
+    (['--params-file', 'setup.py'], "Couldn't parse params file"),
+    (['-p', 'confidence'], "Couldn't parse parameter override rule: '-p confidence'"),
+    (['--bogus'], 'unknown ROS arguments: --bogus'),
+])
+def test_unparsable_ros_args_exit_2_with_one_line(ros_env, tmp_path, command, ros_args,
+                                                  message):
+    first = [command] + ([str(tmp_path / 'bag')] if command == 'record' else [])
+    run = _cli(ros_env, *first, '--ros-args', *ros_args)
+    assert run.returncode == 2, run.stderr
+    assert 'Traceback' not in run.stderr
+    last = run.stderr.strip().splitlines()[-1]
+    assert ': error: ' in last and message in last
+    assert '/src/' not in last                          # rcl's C source locations are cut
+    assert not (tmp_path / 'bag').exists()
+
+
+def test_misspelt_parameters_are_warned_about(context, tmp_path):
+    from ipomdp_gaze.nodes.spin import warn_unused_parameters
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+    node = Node('gaze_controller', context=context, parameter_overrides=[
+        Parameter('confidance', value=0.9), Parameter('confidence', value=0.9)])
+    try:
+        node.declare_parameter('confidence', 0.99)
+        right = tmp_path / 'right.yaml'
+        right.write_text('/**:\n  ros__parameters:\n    confidence: 0.9\n')
+        other = tmp_path / 'other.yaml'
+        other.write_text('gaze_controler:\n  ros__parameters:\n    confidence: 0.9\n')
+        warned = warn_unused_parameters(node, ['x', '--ros-args', '--params-file', str(right)])
+        assert warned == ["parameter 'confidance' is not a parameter of this node; ignored "
+                          "(did you mean 'confidence'?)"]
+        warned = warn_unused_parameters(node, ['x', '--ros-args', '--params-file', str(other)])
+        assert warned[-1] == (f'params file {other} has no section for node /gaze_controller '
+                              '(its sections: /gaze_controler); none of it applies')
+    finally:
+        node.destroy_node()
+
+
+@pytest.mark.parametrize('section, node, applies', [
+    ('/gaze_controller', '/gaze_controller', True),
+    ('/**', '/robot/gaze_controller', True),
+    ('/**/gaze_controller', '/robot/gaze_controller', True),
+    ('/robot/*', '/robot/gaze_controller', True),
+    ('/robot/gaze_controller', '/gaze_controller', False),
+    ('/gaze_controler', '/gaze_controller', False),
+])
+def test_params_file_sections_match_as_rcl_does(tmp_path, section, node, applies):
+    from ipomdp_gaze.nodes.spin import _matches, params_file_sections
+    path = tmp_path / 'p.yaml'
+    path.write_text(f'{section}:\n  ros__parameters:\n    a: 1\n')
+    assert params_file_sections(path) == [section]
+    assert _matches(section, node) is applies
+
+
+def test_nested_namespaces_and_unreadable_files(tmp_path):
+    from ipomdp_gaze.nodes.spin import params_file_sections
+    nested = tmp_path / 'n.yaml'
+    nested.write_text('robot:\n  gaze_controller:\n    ros__parameters:\n      a: 1\n')
+    assert params_file_sections(nested) == ['/robot/gaze_controller']
+    assert params_file_sections(tmp_path / 'missing.yaml') == []
+
+
+def test_a_running_node_warns_about_a_typo(ros_env, tmp_path):
+    params = tmp_path / 'typo.yaml'
+    params.write_text('gaze_controller:\n  ros__parameters:\n    confidance: 0.95\n')
+    proc = subprocess.Popen([sys.executable, '-m', 'ipomdp_gaze.cli', 'controller',
+                             '--ros-args', '--params-file', str(params)], cwd=REPO,
+                            env=ros_env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            text=True)
+    seen, deadline = [], time.monotonic() + 60.0
+    try:
+        while time.monotonic() < deadline:        # the node logs while it starts up
+            ready, _, _ = select.select([proc.stderr], [], [], 1.0)
+            line = proc.stderr.readline() if ready else ''
+            seen.append(line)
+            if 'confidance' in line or proc.poll() is not None:
+                break
+    finally:
+        proc.send_signal(signal.SIGINT)
+        rest = proc.communicate(timeout=30)[1]
+    assert proc.returncode == 0, ''.join(seen) + rest
+    assert "parameter 'confidance' is not a parameter of this node; ignored (did you mean " \
+        "'confidence'?)" in ''.join(seen)
