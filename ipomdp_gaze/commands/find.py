@@ -13,7 +13,19 @@ evidence reached ``--confidence``; ``forced:pixels`` / ``forced:budget``: the pi
 fixation budget forced the likelier answer below it; :mod:`.search.answer`), ``cell (row,
 col)`` and ``pixel (x, y)`` (``none`` unless found), ``p``, the probability of *that* answer
 (the found cell's, or for ``absent`` that nobody is there), the fixations, the detector pixels
-against one full-resolution scan's, the seconds, why it stopped and the method.
+against one full-resolution scan's, the seconds, why it stopped and the method. On the
+many-target belief (``--all``, ``--scan many``) each cell is decided on its own: ``absent`` means
+every cell decided empty at ``--confidence`` (forced: every cell likelier empty than not), and
+its probability is written ``p_nobody``, P(nobody here), the product over the cells, which can
+be below the confidence or, when forced, below 0.5.
+
+**Outputs.** ``--json`` and ``--log`` take ``-`` for stdout (one of them; the lines then go to
+stderr); ``--json`` has an entry ``{path, error}`` for each input that could not be searched.
+Every output path (``--json``, ``--log``, each ``--plot`` file) is checked before any search: a
+folder, an input image, a path through a file or one written twice is refused in one line
+naming its option (exit status 2), as are a bad ``--policy`` or ``--policy-file`` (built once
+on each model first). ``--scan`` does not apply to ``--all`` or ``--targets many``: stderr says
+so once.
 
 **Scale first** (``--scan``, without ``--all``). By default (``coarse``) the detector runs on
 the whole image at a coarse scale (1/2; Haar's ``faces-420``: 1/4) and then at each finer scale
@@ -81,6 +93,7 @@ from __future__ import annotations
 from dataclasses import replace
 import json
 import math
+import os
 from pathlib import Path
 import sys
 
@@ -94,7 +107,8 @@ from ipomdp_gaze.vision.detectors import load_factory
 from ipomdp_gaze.vision.fullframe import MAX_SCALE
 from ipomdp_gaze.vision.image_files import decode_quietly
 from ipomdp_gaze.vision.scales import finest_scale, ladder_scales, SCALE_TABLES
-from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, EMPTY_BY_EVIDENCE,
+from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, clip_box,
+                                       EMPTY_BY_EVIDENCE,
                                        FIND_SETTINGS, fovea_for_model, full_frame_reason,
                                        full_frame_search, prepare_many, search_all,
                                        search_first, search_image, search_many, search_scales,
@@ -129,6 +143,9 @@ MAX_SIDE_PX = 2048
 # Haar's full-resolution call at 420, 'fovea' lost with YuNet.
 SCAN_CHOICES = ('coarse', 'many', 'fovea')
 SCAN_DEFAULT = 'coarse'
+# The routes of search_route whose belief is the many-target occupancy: there an absent answer
+# means every cell on its empty side, and its p is P(nobody here), the product over the cells.
+OCCUPANCY_ROUTES = ('many', 'first')
 # --scan coarse: the scale of the first full-frame call, per detector and model size (the
 # shipped models' calibrated shorter side), chosen on 60 training scenes of each task (seed 1):
 # Haar from 1/4 at 420 (right 0.983 as from 1/3 and 1/2, in the fewest seconds) and from 1/2 at
@@ -177,7 +194,11 @@ def add_parser(sub):
                         'occupancy per cell, infomax per detector pixel, within one full scan '
                         'of detector pixels); each face is printed with its box and '
                         'probability, counted once per cluster of occupied cells (split where '
-                        "the detector's boxes are distinct faces)")
+                        "the detector's boxes are distinct faces; boxes cut to the image); "
+                        '"absent" when every cell is decided empty at --confidence (or, forced '
+                        'by a limit, is likelier empty than not), and its line gives '
+                        'p_nobody=P(nobody here), the product over the cells of P(empty), which '
+                        'may be below --confidence or 0.5 (the --plot title says so)')
     add_search_args(p, None, ('targets',), task_default='many with --all, else one; --all '
                     '--targets one: find a face, rule the cells within 2 of it out, search '
                     'again')
@@ -189,14 +210,16 @@ def add_parser(sub):
     p.add_argument('--json', type=Path, default=None, metavar='OUT.json',
                    help='write {grid, axes, images: [{path, cell [row, col], pixel [x, y] '
                         '(null unless found), probability (of the answer: the cell found, or '
-                        'that nobody is there for absent), fixations, detector_pixels, '
+                        'that nobody is there for absent: with --all or --scan many '
+                        'P(nobody here), the product over cells), fixations, detector_pixels, '
                         'full_scan_pixels, seconds, decision, ended (confidence, '
                         'forced:pixels, forced:budget, repeat, ...), confidence, '
                         'map_probability, absent_probability, stop, method, note, '
                         'resized_from, grid, and with --targets many faces: [{box [x, y, w, h], '
                         'cell [row, col], probability}]}]} in input order (--all --targets one: '
-                        'one entry per face, with "face", then the last decision); "-" writes it '
-                        'to stdout (the lines then go to stderr)')
+                        'one entry per face, with "face", then the last decision; an input '
+                        'that could not be searched: {path, error}); "-" writes it to stdout '
+                        '(the lines then go to stderr)')
     p.add_argument('--max-side', type=nonneg_int, default=MAX_SIDE_PX, metavar='PX',
                    help='resize an image longer than this on a side before the search '
                         f'(default {MAX_SIDE_PX}; 0: never), a JPEG while it is decoded, as '
@@ -217,18 +240,20 @@ def add_parser(sub):
                         '--scan fovea, --all --targets one and images scanned whole (faces '
                         'far below 1/10 on a large image: pass --max-side 0 too, or the '
                         'resize makes them smaller still)')
-    p.add_argument('--scan', dest='scan_mode', choices=SCAN_CHOICES, default=SCAN_DEFAULT,
+    p.add_argument('--scan', dest='scan_mode', choices=SCAN_CHOICES, default=None,
                    help='without --all: coarse (default) runs the detector on the whole image '
                         'from a coarse scale to finer ones until a strong box (looked at again '
                         'at the next finer scale) and answers it, about 1.4 full scans of '
                         'detector pixels on a face-free image; many: the most probable face of '
                         "--all's many-target search; fovea: the paper's single-target search "
-                        'with the fovea within one full scan (find before --scan)')
+                        'with the fovea within one full scan (find before --scan); --all and '
+                        '--targets many do not use it (stderr says so when it is given)')
     p.add_argument('--log', type=Path, default=None, metavar='OUT.jsonl',
                    help="write each image's search session event log (reset with the "
                         'settings, scan, start, one event per fixation with the frame and '
                         'belief summaries and the decision) as one JSON line per image (no '
-                        'events with the default --scan coarse: it runs no search session)')
+                        'events with the default --scan coarse: it runs no search session); '
+                        '"-" writes it to stdout (the lines then go to stderr)')
     p.add_argument('--seed', type=nonneg_int, default=0, metavar='S',
                    help='seed of a sampling policy (image i uses default_rng([S, i]))')
     p.set_defaults(run=run)
@@ -380,10 +405,11 @@ class _Task:
                             f'{model.grid.cols} grid{at}), {policy}')
 
 
-def plot_image_search(image: np.ndarray, result, fovea, out_path: Path, title: str) -> None:
+def plot_image_search(image: np.ndarray, result, fovea, out_path: Path, title: str,
+                      occupancy: bool = False) -> None:
     """Draw the image, the final belief, the numbered scan path, the windows, the cell found."""
     from ipomdp_gaze.vision.search_plots import annotate_image_search, save_figure
-    save_figure(annotate_image_search(image, result, fovea), out_path, title)
+    save_figure(annotate_image_search(image, result, fovea, occupancy), out_path, title)
 
 
 def plot_paths(out: Path, count: int) -> list[Path]:
@@ -430,21 +456,25 @@ def _cell_text(result) -> str:
     return f'cell (row, col)=({r}, {c}) pixel (x, y)=({x:.1f}, {y:.1f})'
 
 
-def format_line(path: str, result, face: int | None = None) -> str:
+def format_line(path: str, result, face: int | None = None, occupancy: bool = False) -> str:
     """
     Format the one line printed per image (per face with ``--all``).
 
     ``ended`` says how the search ended (:func:`.search.answer.ended`: ``confidence``, or
     ``forced:pixels`` / ``forced:budget`` when a cost cap or the budget forced the decision
     below the confidence) and ``p`` is the probability of *that* answer: the found cell's, or
-    for ``absent`` the probability that nobody is there.
+    for ``absent`` the probability that nobody is there. On the many-target belief
+    (``occupancy``: ``--all``, ``--scan many``) ``absent`` means every cell on its empty side,
+    and its probability is written ``p_nobody``: P(nobody here), the product over the cells,
+    which can be below the confidence each cell reached (or below 0.5, when forced).
     """
     width, height = result.image_px
     p = result.answer_probability
     probability = 'n/a' if math.isnan(p) else f'{p:.3f}'
     which = '' if face is None else f' face={face}'
+    name = 'p_nobody' if occupancy and result.decision == 'absent' else 'p'
     line = (f'{path}:{which} decision={result.decision} ended={result.ended} '
-            f'{_cell_text(result)} p={probability} fixations={result.fixations} '
+            f'{_cell_text(result)} {name}={probability} fixations={result.fixations} '
             f'detector_pixels={result.detector_pixels} (full scan {width * height}) '
             f'seconds={result.seconds:.4f} stop={result.stop} method={result.method}')
     if not result.size_matches:
@@ -464,14 +494,43 @@ def face_line(path: str, result, face: int) -> str:
             f'cell (row, col)=({found.cell[0]}, {found.cell[1]}) p={probability}')
 
 
-def plot_title(path: str, result, confidence: float) -> str:
-    """Return a plot's title: the decision, how it ended, the answer and its probability."""
-    p = result.answer_probability
+def plot_title(path: str, result, confidence: float, occupancy: bool = False,
+               faces: int | None = None) -> str:
+    """
+    Return a plot's title: the decision, how it ended, the answer and its probability.
+
+    ``faces``: the many-target search's count of faces (``--all``), which leads the title;
+    ``occupancy``: the belief is the many-target one, where ``absent`` is said by its rule
+    (:func:`nobody_text`).
+    """
+    name, p = Path(path).name, result.answer_probability
+    tail = f'{result.fixations} fixations ({result.stop})'
+    nobody = occupancy and result.decision == 'absent' and not math.isnan(p)
+    if faces is not None:
+        found = f'{name}: {faces} face{"" if faces == 1 else "s"}'
+        return f'{found} ({nobody_text(result, confidence)}), {tail}' if nobody else \
+            f'{found}, {tail}'
+    if nobody:
+        return f'{name}: {nobody_text(result, confidence)}, {tail}'
     where = f', cell (row, col) {result.cell}' if result.decision == 'found' else ''
-    return (f'{Path(path).name}: {answer.heading(result.decision, _reason(result))}{where}, '
+    return (f'{name}: {answer.heading(result.decision, _reason(result))}{where}, '
             f'{answer.probability_text(result.decision, p)}'
             f'{answer.confidence_clause(result.decision, _reason(result), p, confidence)}, '
-            f'{result.fixations} fixations ({result.stop})')
+            f'{tail}')
+
+
+def nobody_text(result, confidence: float) -> str:
+    """
+    Say an ``absent`` of the many-target belief: its rule per cell, then ``P(nobody here)``.
+
+    Each cell is decided on its own, so the product over the cells can be below the confidence
+    each reached, or below 0.5 when a limit forced every cell to its likelier side.
+    """
+    reason = _reason(result)
+    rule = ('every cell likelier empty than occupied' if answer.forced('absent', reason) else
+            f'every cell decided empty at the confidence {confidence:g}')
+    return (f'{answer.heading("absent", reason)}: {rule}, P(nobody here) '
+            f'{result.answer_probability:.3f}')
 
 
 def _reason(result) -> str:
@@ -554,6 +613,13 @@ class _Tasks:
                     f'model.yaml')
             self.shipped = True
         self.tasks = {}
+        if args.policy or args.policy_file:     # a bad one: one line before any image
+            flag = '--policy-file' if args.policy_file else '--policy'
+            for model in self.models:
+                try:
+                    build_find_policy(args, model, lambda message: None)
+                except ValueError as exc:
+                    raise ValueError(f'{flag}: {exc}') from None
         if args.observation:                    # a bad model or policy: refused before any image
             self.task((0, 0))
 
@@ -566,11 +632,12 @@ class _Tasks:
 
 
 def _in_given_pixels(result, scale: tuple, given: tuple):
-    """Return a result on a resized image with its pixels in the given image's."""
+    """Return a result on a resized image with its pixels (boxes cut to it) in the given one's."""
     sx, sy = scale
     x, y = result.pixel
-    faces = tuple(replace(face, box=(face.box[0] * sx, face.box[1] * sy, face.box[2] * sx,
-                                     face.box[3] * sy)) for face in result.faces)
+    faces = tuple(replace(face, box=clip_box((face.box[0] * sx, face.box[1] * sy,
+                                              face.box[2] * sx, face.box[3] * sy), given))
+                  for face in result.faces)
     return replace(result, pixel=(x * sx, y * sy), resized_from=tuple(given),
                    detections=tuple((u * sx, v * sy) for u, v in result.detections), faces=faces)
 
@@ -693,6 +760,71 @@ def min_face_notes(path: str, given: float | None, min_face: float | None, route
     return [note]
 
 
+def check_outputs(args, images: list[str], plots: list[Path]) -> None:
+    """
+    Refuse, before any search, an output that cannot be written: one line naming its option.
+
+    ``--json``, ``--log`` (``-``: stdout, for one of them only) and each ``--plot`` file must
+    not be a folder, an input image or another output, and must sit in a folder that exists or
+    can be made (no file on the way).
+    """
+    outputs = [('--json', args.json), ('--log', args.log)] + [('--plot', plot) for plot in plots]
+    outputs = [(flag, path) for flag, path in outputs if path is not None]
+    if args.json == STDOUT and args.log == STDOUT:
+        raise ValueError('--json - and --log - would both write to stdout: give one of them a '
+                         'file')
+    inputs = {Path(image).resolve() for image in images}
+    seen = {}
+    for flag, path in outputs:
+        if path == STDOUT:
+            continue
+        if path.is_dir():
+            raise ValueError(f'{flag} {path}: is a directory')
+        resolved = path.resolve()
+        if resolved in inputs:
+            raise ValueError(f'{flag} {path}: is an input image (it would be overwritten)')
+        if resolved in seen:
+            raise ValueError(f'{flag} {path}: {seen[resolved]} writes the same file')
+        seen[resolved] = flag
+        folder = path.parent
+        while not folder.exists():               # made when the file is written
+            folder = folder.parent
+        if not folder.is_dir():
+            raise ValueError(f'{flag} {path}: {folder} is not a folder')
+        if not os.access(folder, os.W_OK | os.X_OK) or \
+                (path.exists() and not os.access(path, os.W_OK)):
+            raise ValueError(f'{flag} {path}: not writable')
+
+
+def _check_size(path: str, image: np.ndarray, given: tuple, fovea, max_side: int) -> None:
+    """Check the searched image's size; name ``--max-side`` when the resize made it too small."""
+    searched = (image.shape[1], image.shape[0])
+    try:
+        check_image_size(searched, fovea)
+    except ValueError as exc:
+        if searched == tuple(given):
+            raise
+        try:
+            check_image_size(given, fovea)
+        except ValueError:
+            raise exc from None                 # too small as given: not the resize's doing
+        need = str(exc).partition('too small: ')[2] or str(exc)
+        raise ValueError(f'{path}: --max-side {max_side} resized it from {given[0]}x{given[1]} '
+                         f'to {searched[0]}x{searched[1]} px, too small: {need} (give a larger '
+                         f'--max-side, or 0 not to resize)') from None
+
+
+def _write(text: str, out: Path) -> None:
+    """Write ``text`` to ``out`` (``-``: stdout), saying where."""
+    if out == STDOUT:
+        sys.stdout.write(text)
+        sys.stdout.flush()
+        return
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(text)
+    _note(f'wrote {out}')
+
+
 def run(args) -> int:
     settings_from_args(args, FIND_SETTINGS)             # bad settings: refused before any work
     if args.plot:
@@ -700,10 +832,15 @@ def run(args) -> int:
     images = expand_inputs(args.images)
     if not images:
         raise ValueError(f'no image files in {", ".join(args.images)}')
-    tasks = _Tasks(args)
     plots = plot_paths(args.plot, len(images)) if args.plot else []
+    check_outputs(args, images, plots)
+    tasks = _Tasks(args)
+    if args.scan_mode is not None and (args.all or args.targets == 'many'):
+        _note(f'warning: --scan {args.scan_mode} is ignored: it chooses how find looks for one '
+              f'face, and --all / --targets many search for every face')
+    scan = args.scan_mode or SCAN_DEFAULT
     entries, logs, failed, grid = [], [], 0, None
-    out = sys.stderr if args.json == STDOUT else sys.stdout
+    out = sys.stderr if STDOUT in (args.json, args.log) else sys.stdout
     for i, path in enumerate(images):
         notes = []
         try:
@@ -716,13 +853,15 @@ def run(args) -> int:
                              f'{image.shape[1]}x{image.shape[0]} px before the search '
                              f'(--max-side {args.max_side})')
             task = tasks.task((image.shape[1], image.shape[0]))
-            check_image_size((image.shape[1], image.shape[0]), task.fovea)
+            _check_size(path, image, given, task.fovea, args.max_side)
             settings = settings_from_args(args, FIND_SETTINGS, task.model.grid)
             if args.all and args.targets is TASK_DEFAULT:
                 settings = replace(settings, targets='many')
         except ValueError as exc:
             message = str(exc)
             _error(message if message.startswith(path) else f'{path}: {message}')
+            reason = message[len(path) + 2:] if message.startswith(f'{path}: ') else message
+            entries.append({'path': path, 'error': reason})
             failed += 1
             continue
         for note in notes:
@@ -730,49 +869,39 @@ def run(args) -> int:
         grid = task.model.grid
         min_face = None if args.min_face is None else args.min_face / max(scale)
         route, _ = search_route(task, (image.shape[1], image.shape[0]), settings, args.all,
-                                args.scan_mode)
+                                scan)
         for note in min_face_notes(path, args.min_face, min_face, route, task.model):
             _note(note)
         results = search_one(image, task, settings, np.random.default_rng([args.seed, i]),
-                             args.all, min_face, args.scan_mode)
+                             args.all, min_face, scan)
         searched = results                      # in the searched image's pixels (the plot)
         if scale != (1.0, 1.0):
             results = [_in_given_pixels(r, scale, given) for r in results]
         if results[0].method == 'full_frame':
             _note(f'{path}: scanned the whole frame once: {results[0].note}')
         many = settings.targets == 'many'
+        occupancy = route in OCCUPANCY_ROUTES
         for k, result in enumerate(results):
             for face in range(len(result.faces) if many else 0):
                 print(face_line(path, result, face), file=out, flush=True)
-            print(format_line(path, result, k if args.all and not many else None), file=out,
-                  flush=True)
+            print(format_line(path, result, k if args.all and not many else None, occupancy),
+                  file=out, flush=True)
             extra = ({'faces': [face.to_dict() for face in result.faces]} if many else
                      {'face': k} if args.all else {})
             entries.append({**entry(path, result, grid, settings.confidence), **extra})
         logs.append(json.dumps({'path': path, 'events': [e for r in results for e in r.log]}))
         if plots:
-            title = plot_title(path, results[0], settings.confidence)
-            if many:
-                title = (f'{Path(path).name}: {len(results[0].faces)} faces, '
-                         f'{results[0].fixations} fixations ({results[0].stop})')
-            plot_image_search(image, searched[0], task.fovea, plots[i], title)
+            title = plot_title(path, results[0], settings.confidence, occupancy,
+                               len(results[0].faces) if many else None)
+            plot_image_search(image, searched[0], task.fovea, plots[i], title, occupancy)
             _note(f'wrote {plots[i]}')
     if args.log:
-        args.log.parent.mkdir(parents=True, exist_ok=True)
-        args.log.write_text('\n'.join(logs) + '\n')
-        _note(f'wrote {args.log}')
+        _write('\n'.join(logs) + '\n' if logs else '', args.log)
     if args.json:
         rows, cols = grid.shape if grid is not None else (None, None)
-        text = json.dumps({'grid': {'rows': rows, 'cols': cols},
+        _write(json.dumps({'grid': {'rows': rows, 'cols': cols},
                            'axes': {'cell': ['row', 'col'], 'pixel': ['x', 'y']},
-                           'images': entries}, indent=1) + '\n'
-        if args.json == STDOUT:
-            sys.stdout.write(text)
-            sys.stdout.flush()
-        else:
-            args.json.parent.mkdir(parents=True, exist_ok=True)
-            args.json.write_text(text)
-            _note(f'wrote {args.json}')
+                           'images': entries}, indent=1) + '\n', args.json)
     if failed:
         _error(f'{failed} of {len(images)} inputs could not be searched')
         return 2

