@@ -68,6 +68,24 @@ def test_a_fixation_is_served_by_the_first_image_captured_after_it(fovea_setup):
     assert values['pixels_per_fixation_last'] == frame.detector_pixels > 0
 
 
+def test_a_resent_fixation_keeps_waiting_from_the_first_command(fovea_setup):
+    loop = DetectorLoop(fovea_setup)
+    image = SceneSet('test', **PAPER_TASK, color='rgb', seed=2).scene(0).image
+    cell = fovea_setup.grid.index(10, 10)
+    assert loop.fixate(cell, 2.0, search_id=4).status == 'waiting'
+    assert loop.fixate(cell, 3.0, search_id=4).status == 'waiting'       # re-sent at 3.0
+    out = loop.add_image(2.5, image)              # the slow head's image, taken before 3.0
+    assert out.status == 'published' and out.frame.stamp_s == 2.5
+    # Another cell, or a new search, starts a new wait.
+    assert loop.fixate(cell + 1, 4.0, search_id=4).status == 'waiting'
+    assert loop.fixate(cell + 1, 5.0, search_id=5).status == 'waiting'
+    assert loop.add_image(4.5, image).status == 'waiting'
+    assert loop.add_image(5.5, image).status == 'published'
+    # Served, the same command again wants a new image (the controller lost the frame).
+    assert loop.fixate(cell + 1, 6.0, search_id=5).status == 'waiting'
+    assert loop.values()['fixations_received'] == 5
+
+
 def test_the_newest_waiting_image_serves_a_fixation(fovea_setup):
     loop = DetectorLoop(fovea_setup)
     old = SceneSet('test', **PAPER_TASK, color='rgb', seed=2).scene(0).image

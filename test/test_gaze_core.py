@@ -103,6 +103,19 @@ def test_invalid_frames_are_rejected_and_change_nothing(frame, words):
     assert core.counters() == {'received': 1, 'applied': 0, 'rejected': 1, 'skipped': 0}
 
 
+def test_a_frame_that_observed_nothing_or_comes_from_the_future_is_rejected():
+    core = controller(settle_time_s=0.0)
+    before, fixation = core.belief, core.fixation
+    nothing = core.offer(np.full(121, np.nan), 5.0, now_s=5.0)
+    assert nothing.status == 'rejected' and 'observed nothing' in nothing.reason
+    ahead = core.offer(np.zeros(121), 5.6, now_s=5.0)          # its clock runs 0.6 s ahead
+    assert ahead.status == 'rejected' and '0.600 s ahead' in ahead.reason
+    np.testing.assert_array_equal(core.belief, before)
+    assert (core.fixation, core.fixations) == (fixation, 0)    # no fixation spent
+    assert core.offer(np.zeros(121), 5.4, now_s=5.0).status == 'applied'   # within 0.5 s
+    assert core.counters() == {'received': 3, 'applied': 1, 'rejected': 2, 'skipped': 0}
+
+
 def test_each_frame_is_checked_once_whatever_becomes_of_it(monkeypatch):
     core = controller(settle_time_s=0.5)
     checks = []

@@ -76,7 +76,7 @@ def test_stall_timeout_is_strict_and_zero_never_stalls():
     assert not health(stall_timeout_s=2.0, without_s=2.0).stalled
     assert health(stall_timeout_s=2.0, without_s=2.001).stalled
     h = health(stall_timeout_s=0.0, without_s=1e6, arrived=0)
-    assert (h.level, h.message, h.stalled) == ('warn', 'no evidence received', False)
+    assert (h.level, h.message, h.stalled) == ('ok', 'waiting for evidence', False)
 
 
 def test_target_found_is_ok_even_without_frames():
@@ -91,10 +91,12 @@ def test_a_stall_is_reported_before_the_found_target():
                                               'no frames arrive')
 
 
-def test_no_evidence_received_warns():
-    h = health(arrived=0)
-    assert (h.level, h.message, h.detail, h.stalled) == ('warn', 'no evidence received', '',
+def test_a_period_without_frames_is_ok_until_the_stall_timeout():
+    h = health(arrived=0, stall_timeout_s=5.0, without_s=1.5)
+    assert (h.level, h.message, h.detail, h.stalled) == ('ok', 'waiting for evidence', '',
                                                          False)
+    h = health(arrived=0, stall_timeout_s=5.0, without_s=5.5)
+    assert (h.level, h.stalled) == ('warn', True)
 
 
 @pytest.mark.parametrize('state', [{}, {'enabled': False}, {'found': True}])
@@ -105,8 +107,9 @@ def test_a_rejection_in_the_period_turns_an_ok_report_into_a_warning(state):
 
 
 def test_a_rejection_does_not_replace_another_warning_or_lack_a_reason():
-    h = health(arrived=0, rejected=1, last_rejection='bad layout')
-    assert (h.level, h.message) == ('warn', 'no evidence received')
+    h = health(arrived=0, rejected=1, last_rejection='bad layout', stall_timeout_s=1.0,
+               without_s=2.0)
+    assert (h.level, h.message) == ('warn', 'no usable evidence for 2.0 s')
     assert health(rejected=1, last_rejection='').message == 'searching'
 
 
@@ -160,7 +163,7 @@ def test_monitor_reports_each_period_with_values_in_order():
     assert v['entropy_nats'] == core.entropy_nats and v['last_rejection'] == ''
     # The next period saw no frame.
     h = monitor.report(core, 3.0, 5.0)
-    assert (h.level, h.message) == ('warn', 'no evidence received')
+    assert (h.level, h.message) == ('ok', 'waiting for evidence')
     assert h.values['evidence_rate_hz'] == 0.0
 
 
@@ -214,7 +217,7 @@ def test_monitor_starts_from_the_counters_it_is_given():
         core.offer(frame(i), float(i + 1))
     core.reject('bad layout')
     h = HealthMonitor(3.0, received=core.received, rejected=core.rejected).report(core, 4.0, 5.0)
-    assert (h.level, h.message) == ('warn', 'no evidence received')
+    assert (h.level, h.message) == ('ok', 'waiting for evidence')
     assert h.values['evidence_rate_hz'] == 0.0
 
 

@@ -6,10 +6,11 @@ Fuzz the live controller (its own process) with evidence and parameter requests.
 Frames go out in bursts no larger than the controller's queue (``evidence_queue_depth``), and
 the next burst waits until ``/diagnostics`` shows that every frame sent so far was received, so
 none is lost and every counter can be predicted exactly. The mix: valid frames (NaN cells,
-extreme finite values, empty and one-dimensional layouts, big-endian and padded images, future
-stamps), frames that must be skipped (old stamps, or sent while disabled) and frames that must
-be rejected (wrong lengths, +/-inf, empty, layouts that lie about the data, wrong encodings, and
-valid frames while the FPOC's d' is so large that the log-likelihood overflows). Between bursts
+extreme finite values, empty and one-dimensional layouts, big-endian and padded images),
+frames that must be skipped (old stamps, or sent while disabled) and frames that must be
+rejected (wrong lengths, +/-inf, empty, every cell NaN, stamps far in the future, layouts that
+lie about the data, wrong encodings, and valid frames while the FPOC's d' is so large that the
+log-likelihood overflows). Between bursts
 go parameter requests: wrong types and lengths, NaN kernels, read-only grid changes, bad policy
 files and valid changes. Afterwards the node is alive, answers its services, its belief is
 finite and normalised, and its counters match the prediction (received = applied + rejected +
@@ -119,7 +120,8 @@ class Frames:
             'valid': lambda: ('evidence', self.array(v), VALID),
             'valid-nan': lambda: ('evidence', self.array(np.where(
                 self.rng.random(N) < 0.5, np.nan, v)), VALID),
-            'valid-all-nan': lambda: ('evidence', self.array(np.full(N, np.nan)), VALID),
+            # every cell NaN: observed nothing, and no fixation is spent on it
+            'all-nan': lambda: ('evidence', self.array(np.full(N, np.nan)), REJECT),
             'valid-extreme': lambda: ('evidence', self.array(np.where(
                 self.rng.random(N) < 0.1, self.rng.choice(
                     [3.4e38, -3.4e38, 1e30, -1e30, 1e-45, -0.0], N), v)), VALID),
@@ -156,9 +158,10 @@ class Frames:
             'image-padded': lambda: ('evidence_image', self.image(v, pad=8), VALID),
             'image-lowercase': lambda: ('evidence_image', self.image(v, encoding='32fc1'),
                                         VALID),
+            # beyond the stamp tolerance ahead of the controller's clock: its clock runs ahead
             'image-future-stamp': lambda: ('evidence_image', self.image(v, stamp=far_future),
-                                           VALID),
-            'image-all-nan': lambda: ('evidence_image', self.image(np.full(N, np.nan)), VALID),
+                                           REJECT),
+            'image-all-nan': lambda: ('evidence_image', self.image(np.full(N, np.nan)), REJECT),
             'image-old-stamp': lambda: ('evidence_image', self.image(v, stamp=(1, 0)), SKIP),
             'image-mono8': lambda: ('evidence_image', self.image(
                 v, encoding='mono8', data=bytes(N)), REJECT),

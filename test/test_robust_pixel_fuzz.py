@@ -248,6 +248,7 @@ class Messages:
             'js-no-position': (lambda: joint(0.0, 0.0, positions=[0.0]), js_rej),
             'js-future': (lambda: joint(0.0, 0.0, stamp=self._ahead(3600.0)), js_rej),
             'js-other-joints': (lambda: JointState(name=['wheel'], position=[1e308]), {}),
+            'js-pan-alone': (lambda: joint(0.0, 0.0, names=[head.pan_joint, 'wheel']), js_rej),
             'js-valid': (lambda: joint(0.0, 0.0), {'joint_states_received': 1}),
         }
         return kinds

@@ -284,8 +284,15 @@ class FovealDetectorNode(QuietPublishers, Node):
 
     def _on_joint_states(self, msg: JointState) -> None:
         head = self._config.head
-        if head is None or head.pan_joint not in msg.name or head.tilt_joint not in msg.name:
+        named = [j for j in (head.pan_joint, head.tilt_joint) if j in msg.name] if head else []
+        if not named:
             return              # a joint state of other joints: not the head's
+        if len(named) == 1:     # a driver that publishes each joint alone: refused, and said
+            other = head.tilt_joint if named[0] == head.pan_joint else head.pan_joint
+            self._handle(self.loop.refuse(
+                'joint_states', f'it names {named[0]!r} but not {other!r}: both head joints '
+                                'must be in one JointState (the pose of one instant)'))
+            return
         try:
             pan, tilt = joints.angles_from_joint_state(msg, head)
         except ValueError as exc:

@@ -55,8 +55,18 @@ class SaccadeMixin:
             return None
 
     def _saccade_to(self, goal: int) -> None:
-        """Start a saccade to ``goal`` (a re-sent goal does not restart one under way)."""
+        """
+        Start a saccade to ``goal``; a re-sent goal does not restart one.
+
+        Under way, the saccade goes on; at the goal already, the head does not move and the
+        camera arrives at once (a frame now, with ``rate_hz`` 0): a real head commanded to where
+        it stands stays put, and a re-send means the frame is wanted.
+        """
         if goal == self.goal and self.moving:
+            return
+        if goal == self.pose and not self.moving:
+            self.goal = goal
+            self._arrive()
             return
         self.goal, self.moving = goal, True
         if self._saccade_timer is None:

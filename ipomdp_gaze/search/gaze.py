@@ -49,6 +49,10 @@ import numpy as np
 
 # Many targets: cells within this many cells of an occupied one are settled (the rooms' link).
 ROOM_LINK = 1
+# A frame stamped further ahead of the controller's clock is refused: that clock and the
+# camera's disagree, and the settle rule (a frame taken after the head arrived) cannot hold. The
+# detector node refuses images by the same tolerance (its stamp_tolerance_s default).
+STAMP_TOLERANCE_S = 0.5
 
 
 def check_settle_time(settle_time_s: float) -> float:
@@ -463,6 +467,12 @@ class GazeController:
                                                groups=groups)
         except EvidenceError as exc:
             return self.reject(str(exc))
+        if now_s is not None and stamp_s - now_s > STAMP_TOLERANCE_S:
+            return self.reject(f"stamped {stamp_s - now_s:.3f} s ahead of this node's clock "
+                               f'(more than {STAMP_TOLERANCE_S:g} s): its clock runs ahead')
+        if np.isnan(frame.values).all():
+            return self.reject('every cell is NaN: the frame observed nothing, and a fixation '
+                               'is not spent on it')
         self.received += 1
         if not self.enabled:
             self.skipped += 1

@@ -18,7 +18,8 @@ period:
 - ``ok``, ``target absent`` / ``gave up after N fixations``: the search decided that the grid is
   empty, or spent its fixation budget (docs/design.md section 7). A search that has ended is
   never reported as stalled: it waits for ``~/reset`` and expects no frames;
-- ``warn``, ``no evidence received``: no frame arrived in the period;
+- ``ok``, ``waiting for evidence``: no frame arrived in the period, not yet for the stall
+  timeout (a head that takes longer than a period per view is healthy: only the stall warns);
 - ``warn``, ``evidence rejected: <reason>``: a frame was rejected in the period (replaces any
   ``ok`` report).
 
@@ -103,7 +104,7 @@ def classify(enabled: bool, stall_timeout_s: float, seconds_without_evidence: fl
     elif decision == 'absent':
         message = ended['absent']
     elif arrived == 0:
-        level, message = 'warn', 'no evidence received'
+        message = 'waiting for evidence'
     if rejected and last_rejection and level == 'ok':
         level, message = 'warn', f'evidence rejected: {last_rejection}'
     return Health(level, message, detail)

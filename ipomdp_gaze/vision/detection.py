@@ -56,6 +56,7 @@ from ipomdp_gaze.files.observation_file import load_observation
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.model.head_camera import PinholeCamera
+from ipomdp_gaze.search.gaze import STAMP_TOLERANCE_S
 import numpy as np
 
 MODES = ('fovea', 'camera')
@@ -73,8 +74,8 @@ MAX_JOINT_RAD = 2 * math.pi
 FOV_RANGE_DEG = (0.5, 175.0)
 # Images more than this many times the model's image width or height are resized (far larger).
 RESIZE_ABOVE = 2.0
-# Defaults of the time sanity rule (seconds).
-STAMP_TOLERANCE_S = 0.5
+# Defaults of the time sanity rule (seconds): images stamped ahead by more than
+# STAMP_TOLERANCE_S (the controller's tolerance too) or older than MAX_AGE_S are refused.
 MAX_AGE_S = 10.0
 
 
@@ -382,13 +383,20 @@ class DetectorLoop:
         Take a fixation commanded at ``now_s``: wait for an image captured from then on.
 
         ``search_id`` (the controller's, when it says) comes back with the frame; a new id is a
-        new search, and whatever the previous one still waited for is dropped.
+        new search, and whatever the previous one still waited for is dropped. The same fixation
+        of the same search re-sent while it still waits (the controller's ``retry_period_s``)
+        keeps waiting from the first command: restarting the wait would throw away the image a
+        slow head takes on arrival, and every re-send would do it again.
         """
+        cell = int(cell)
         self.setup.grid.cell(cell)
         self.fixations += 1
         self.inputs['fixation'][0] += 1
+        resent = self.pending is not None and self.pending[0] == cell \
+            and search_id == self.search_id
         self.search_id = search_id
-        self.pending = (int(cell), float(now_s))
+        if not resent:
+            self.pending = (cell, float(now_s))
         return self.serve()
 
     def request_scan(self, search_id: int, now_s: float) -> Outcome:

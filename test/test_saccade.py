@@ -1,0 +1,47 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""The simulated head's saccades: a re-sent goal neither restarts a saccade nor moves the head."""
+from __future__ import annotations
+
+import pytest
+
+pytestmark = pytest.mark.ros
+
+
+class _Timer:
+    def __init__(self):
+        self.resets = 0
+
+    def reset(self):
+        self.resets += 1
+
+    def cancel(self):
+        pass
+
+
+def _head():
+    from ipomdp_gaze.nodes.saccade import SaccadeMixin
+
+    class Head(SaccadeMixin):
+        def __init__(self):
+            self.pose, self.goal, self.moving = 0, 0, False
+            self._saccade_timer, self.frames = _Timer(), []
+
+        def _arrived(self):
+            self.frames.append(self.pose)
+    return Head()
+
+
+def test_a_goal_resent_under_way_or_at_it_does_not_restart_the_saccade():
+    head = _head()
+    head._saccade_to(5)
+    assert (head.moving, head._saccade_timer.resets, head.frames) == (True, 1, [])
+    head._saccade_to(5)                                  # re-sent under way: goes on
+    assert head._saccade_timer.resets == 1
+    head._on_arrival()
+    assert (head.pose, head.moving, head.frames) == (5, False, [5])
+    head._saccade_to(5)                                  # re-sent at the goal: a frame now
+    assert (head.pose, head.moving, head._saccade_timer.resets, head.frames) == \
+        (5, False, 1, [5, 5])
+    head._saccade_to(7)                                  # a new goal: a saccade
+    assert (head.moving, head._saccade_timer.resets, head.frames) == (True, 2, [5, 5])
