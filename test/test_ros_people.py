@@ -125,12 +125,13 @@ def test_the_search_goes_on_and_counts_each_persons_events(events):
 
 
 def test_motion_turned_off_mid_search_forgets_the_people_on_targets(events, probe):
-    # Runs last: the module's controller stops following people. The session forgets them,
-    # and ~/targets says so at once (a still search may name them again when it ends).
+    # Runs last: the module's controller stops following people. A new, still search starts:
+    # ~/targets says at once that nobody is known (the pass may name them again when it ends).
     from ipomdp_gaze.model.grid import Grid
     from ipomdp_gaze.msg_adapters import people
     assert wait_for(lambda: _people(events) not in (None, []), 30), events['output']()
     before = len(events['cells'])
+    assert int(events['status'].values['lost']) >= 1        # the moving search's own count
     result = probe.set_parameters_atomically(CONTROLLER, {'motion.sigma_cells': 0.0,
                                                           'motion.leave_prob': 0.0})
     assert result.successful, result.reason
@@ -140,3 +141,6 @@ def test_motion_turned_off_mid_search_forgets_the_people_on_targets(events, prob
         return any(people.read_people_array(msg, grid) == []
                    for _, msg in events['cells'][before:])
     assert wait_for(emptied, 10), events['output']()
+    # Still and moving people are two searches: the switch starts a new one (and no dwell on
+    # the people the moving search followed goes on).
+    assert wait_for(lambda: events['status'].values.get('lost') == '0', 10), events['output']()

@@ -329,14 +329,9 @@ class GazeControllerNode(QuietPublishers, Node):
             self.get_logger().warning(cfg.warning)
         v, ov = cfg.values, old.values
         core = self.core
-        was_following = core.follows_people
         core.set_observation(cfg.observation)
         core.set_policy(cfg.policy)
         core.configure(cfg.settings, v['settle_time_s'])
-        if was_following and not core.follows_people and self._targets_pub is not None:
-            # Motion turned off: the session forgot the people it followed; so does ~/targets.
-            self._publish_people()
-            self._new_people = 0
         if v['seed'] != ov['seed']:
             core.reseed(v['seed'])
         if (v['forward_command_topic'], v['trajectory_topic']) != \
@@ -346,9 +341,12 @@ class GazeControllerNode(QuietPublishers, Node):
                 (ov['retry_period_s'], ov['diagnostics_period_s']):
             self._make_timers(v)
         self._make_room_publishers()
+        # Many targets still or moving are two searches (the people of a pass, or followed):
+        # switching between them starts a new one, and ~/targets forgets whom the other knew.
+        switched = self._many and cfg.settings.moving != old.settings.moving
         if v['absent.prior'] != ov['absent.prior'] or \
-                v['search.targets'] != ov['search.targets']:
-            return f'policy {cfg.policy_label}; {self._restart()}'
+                v['search.targets'] != ov['search.targets'] or switched:
+            return f'policy {cfg.policy_label}; {self._restart(forget=switched)}'
         if self._dwell_timer is not None and \
                 (v['room.dwell_s'], v['room.recheck_period_s']) != \
                 (ov['room.dwell_s'], ov['room.recheck_period_s']):
@@ -701,17 +699,18 @@ class GazeControllerNode(QuietPublishers, Node):
             return
         self.get_logger().info(f're-check of the room: {self._restart(recheck=True)}')
 
-    def _restart(self, recheck: bool = False) -> str:
+    def _restart(self, recheck: bool = False, forget: bool = False) -> str:
         """
         Start a new search (``~/reset``, a re-check); return what happened.
 
         Many targets: a re-check keeps the people known (to tell who is new) and their list on
-        ``~/targets`` until it ends; any other new search forgets them and publishes nobody.
+        ``~/targets`` until it ends; any other new search forgets them and publishes nobody
+        (``forget``: also the people a moving search followed, when motion was just switched).
         """
         self._stop_room_timers()
         if recheck:
             self._room.recheck()
-        elif self._room.people or self._room.rooms_done or self.core.follows_people:
+        elif forget or self._room.people or self._room.rooms_done or self.core.follows_people:
             self._room.forget()
             if self._targets_pub is not None:
                 self._publish_people()

@@ -87,9 +87,17 @@ def heading(decision: str, reason: str = '') -> str:
 
 def confidence_clause(decision: str, reason: str, probability: float,
                       confidence: float | None) -> str:
-    """Return ``(reached the confidence C)``, ``(below the confidence C)`` or ''."""
+    """
+    Return ``(reached the confidence C)``, ``(below the confidence C)`` or ''.
+
+    A forced answer whose own probability is at the confidence anyway (a room's pass ends
+    forced while the face it names is sure; the rest of the room is not) says ``(forced before
+    the search reached the confidence C)``: never "below" of a probability that is not.
+    """
     if confidence is None or not decision or math.isnan(probability):
         return ''
+    if forced(decision, reason) and probability >= confidence:
+        return f' (forced before the search reached the confidence {confidence:g})'
     word = 'reached' if probability >= confidence and not forced(decision, reason) \
         else 'below'
     return f' ({word} the confidence {confidence:g})'
