@@ -90,7 +90,9 @@ def test_the_absent_hypothesis_follows_bayes_over_n_plus_one_states():
 
 def test_gave_up_at_the_budget_is_undecided_and_ends_the_search():
     core = controller(max_fixations=3)
-    results = [core.offer(np.full(GRID.n_cells, np.nan), float(t)) for t in (1, 2, 3)]
+    little = np.full(GRID.n_cells, np.nan)
+    little[0] = 0.0                                   # one cell seen: nothing decided
+    results = [core.offer(little, float(t)) for t in (1, 2, 3)]
     assert [r.gave_up for r in results[:2]] == [None, None]
     assert results[2].gave_up is not None and results[2].gave_up.fixations == 3
     assert results[2].found is None and results[2].absent is None

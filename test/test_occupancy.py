@@ -532,6 +532,33 @@ def test_a_pass_names_grouped_detections_apart_from_the_beliefs_faces():
     assert [f['probability'] for f in faces] == pytest.approx(session.belief[[0, 12, 24]])
 
 
+def test_a_pass_tells_neighbouring_groups_apart_by_where_their_detections_lie():
+    from ipomdp_gaze.search.many import GROUP_SAME_FACE_CELLS
+    grid = Grid(5, 5)
+    pt = np.tile([0.5, 0.5], (5, 5, 1))
+    model = CountObservation(grid, pt, pt.copy())
+    session = _pass_session(grid, model, [6, 8, 18])
+    session.start()
+    frames = []
+    for cells, shifts in (([11, 12], [(0.0, -0.3), (0.0, 0.3)]),    # two people, 1.6 apart
+                          ([17], [(-0.45, 0.0)]),     # the first one's neighbour below, 0.55
+                          ([2, 3], [(0.0, 0.45), (0.0, -0.45)])):   # one face, 0.1 apart
+        groups, offsets = np.zeros(grid.n_cells), np.full((grid.n_cells, 2), np.nan)
+        groups[cells] = 1
+        offsets[cells] = shifts
+        frames.append(Frame(np.zeros(grid.n_cells), groups=groups, offsets=offsets))
+    for frame in frames:
+        session.update(frame)
+    faces = session.faces()
+    # 12 is 1.6 from 11 (two faces, where the cells alone made one); 17 lies 0.55 from 12's
+    # detections (row 3 - 0.45 against row 2, col 2 against 2.3): within 0.75, the same face;
+    # 3 lies 0.1 from 2.
+    assert GROUP_SAME_FACE_CELLS == 0.75
+    assert [f['cell'] for f in faces] == [11, 12, 2]
+    assert faces[0]['at'] == pytest.approx((2.0, 0.7)) and faces[1]['at'] == \
+        pytest.approx((2.0, 2.3))
+
+
 def test_a_pass_names_the_better_placed_first_and_the_rest_only_away_from_them():
     grid = Grid(3, 3)
     pt = np.tile([0.05, 0.95], (3, 3, 1))

@@ -65,7 +65,9 @@ def test_the_core_with_the_sweep_makes_one_pass_and_takes_the_frames_groups():
     bad = core.offer(np.zeros(GRID.n_cells), 1.0, groups=np.full(GRID.n_cells, -1.0))
     assert bad.status == 'rejected' and 'groups must be whole numbers' in bad.reason
     assert core.session.fixations == 0
-    for values, reason in ((np.full(GRID.n_cells, np.nan), 'pass'),  # the views tell nothing
+    nearly_nothing = np.full(GRID.n_cells, np.nan)
+    nearly_nothing[0] = 0.0                          # (a frame that observes nothing is refused)
+    for values, reason in ((nearly_nothing, 'pass'),               # the views tell little
                            (np.zeros(GRID.n_cells), '')):          # every cell decided
         core.reset(0.0)
         path, t = [], 1.0

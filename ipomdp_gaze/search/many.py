@@ -89,6 +89,14 @@ def check_many_settings(settings: SearchSettings) -> None:
                          'search.hotspot_prior 0 unless the targets move')
 
 
+# A pass's two grouped detections lying within this many cells of each other (Chebyshev, at
+# their cells plus the detections' mean offset, Frame.offsets) are one face; farther apart, two
+# people. The cells alone (within one cell: one face) merged neighbours. Training rooms, without
+# boxes: 184 of 201 faces against 179 (25 deg, seed 5000), 279 of 318 against 267 (seed 6000),
+# 283 of 318 against 278 (40 deg, seed 6000), false faces the same (docs/design.md 11.7).
+GROUP_SAME_FACE_CELLS = 0.75
+
+
 class OccupancySession:
     """
     One many-target search at a time on one grid (module docstring).
@@ -306,27 +314,39 @@ class OccupancySession:
         The better placed come first, and a later one within one cell of an earlier is that
         face: with the views' boxes, the belief's faces (each at its box), then the groups;
         without them, the groups (each at its group's centre), then the belief's faces (a
-        cluster's likeliest cell, which may sit between two faces). Chosen on training rooms
-        (docs/design.md section 11.7). A grouped face is ``{'cell', 'cells', 'probability'``
-        (the belief's, which may doubt it), ``'box': None, 'grouped': True}``, in the order
-        the views saw them (row-major within a view).
+        cluster's likeliest cell, which may sit between two faces). Two groups whose frames
+        said where their detections lie (``Frame.offsets``) are one face when within
+        :data:`GROUP_SAME_FACE_CELLS` of each other (each at its cell plus the mean offset of
+        the detections there), so two people in neighbouring cells stay two; without offsets,
+        within one cell. Chosen on training rooms (docs/design.md section 11.7). A grouped face
+        is ``{'cell', 'cells', 'probability'`` (the belief's, which may doubt it), ``'box':
+        None, 'grouped': True, 'at': (row, col)`` in fractional cells or None``}``, in the
+        order the views saw them (row-major within a view).
         """
         rows, cols = self.grid.rows_cols()
         belief = self.belief
         grouped = [{'cell': cell, 'cells': np.array([cell]), 'probability': float(belief[cell]),
-                    'box': None, 'grouped': True} for cell in self._s()['groups']]
+                    'box': None, 'grouped': True, 'at': None if math.isnan(r) else (r, c)}
+                   for cell, r, c in self._s()['groups']]
         out = []
 
-        def apart(cell, others):
-            return all(max(abs(rows[cell] - rows[int(f['cell'])]),
-                           abs(cols[cell] - cols[int(f['cell'])])) > 1 for f in others)
+        def apart(face, others):
+            for f in others:
+                if face.get('at') and f.get('at'):      # two groups: where they lie
+                    if max(abs(face['at'][0] - f['at'][0]),
+                           abs(face['at'][1] - f['at'][1])) <= GROUP_SAME_FACE_CELLS:
+                        return False
+                elif max(abs(rows[int(face['cell'])] - rows[int(f['cell'])]),
+                         abs(cols[int(face['cell'])] - cols[int(f['cell'])])) <= 1:
+                    return False
+            return True
         first, then = (faces, grouped) if boxes else (grouped, faces)
         for face in first:                       # the belief's faces stay as counted (§11.3)
-            if not face.get('grouped') or apart(int(face['cell']), out):
+            if not face.get('grouped') or apart(face, out):
                 out.append(face)
         kept = list(out)
         for face in then:
-            if apart(int(face['cell']), kept if not face.get('grouped') else out):
+            if apart(face, kept if not face.get('grouped') else out):
                 out.append(face)
         return out
 
@@ -484,8 +504,12 @@ class OccupancySession:
         s['fixations'] += 1
         s['path'].append(k)
         s['visited'][k] = True
-        if groups is not None and self.passing:     # only a pass names them
-            s['groups'].extend(int(c) for c in np.flatnonzero(groups > 0))
+        if groups is not None and self.passing:     # only a pass names them, where they lie
+            at = np.flatnonzero(groups > 0)
+            rows, cols = self.grid.rows_cols()
+            shift = np.full((at.size, 2), np.nan) if offsets is None else offsets[at]
+            s['groups'].extend((int(c), float(rows[c] + dr), float(cols[c] + dc))
+                               for c, (dr, dc) in zip(at, shift))
         if self._motion.active:
             fired = self._decide_moving(obs, offsets, dt_s)
         else:

@@ -85,4 +85,5 @@ class PanTiltSensor:
         head = self.grid.cell(int(cell))
         obs = self.observer.observe(self.view(cell), self.camera, head)
         return Frame(obs.counts, detector_pixels=obs.detector_pixels, seconds=obs.seconds,
-                     detections=tuple(map(tuple, obs.centres_uv)), groups=obs.groups)
+                     detections=tuple(map(tuple, obs.centres_uv)), groups=obs.groups,
+                     offsets=None if obs.groups is None else obs.offsets)
