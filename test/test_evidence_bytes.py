@@ -49,7 +49,7 @@ def test_decode_refuses_what_it_cannot_read():
         decode_evidence('32FC4', 2, cols, step, False, data)   # 3 channels' rows read as 4
 
 
-def test_node_and_replay_read_the_same_frame():
+def test_the_adapter_reads_the_message_through_the_decoder():
     from ipomdp_gaze.model.grid import Grid
     images = pytest.importorskip('ipomdp_gaze.msg_adapters.images')
     grid = Grid(3, 4, 5.0)

@@ -541,7 +541,7 @@ def test_a_pass_tells_neighbouring_groups_apart_by_where_their_detections_lie():
     session.start()
     frames = []
     for cells, shifts in (([11, 12], [(0.0, -0.3), (0.0, 0.3)]),    # two people, 1.6 apart
-                          ([17], [(-0.45, 0.0)]),     # the first one's neighbour below, 0.55
+                          ([17], [(-0.45, 0.0)]),     # below the second, 0.55 from it
                           ([2, 3], [(0.0, 0.45), (0.0, -0.45)])):   # one face, 0.1 apart
         groups, offsets = np.zeros(grid.n_cells), np.full((grid.n_cells, 2), np.nan)
         groups[cells] = 1

@@ -38,6 +38,8 @@ QUEUE = 64
 BURST = 48
 KERNEL_SIZE = (2 * ROWS - 1) * (2 * COLS - 1)
 VALID, REJECT, SKIP = 'valid', 'rejected', 'skipped'
+# Read fine but refused where it would be used: skipped first while disabled.
+REFUSED_IN_USE = 'refused in use'
 
 
 @pytest.fixture(scope='module')
@@ -121,7 +123,7 @@ class Frames:
             'valid-nan': lambda: ('evidence', self.array(np.where(
                 self.rng.random(N) < 0.5, np.nan, v)), VALID),
             # every cell NaN: observed nothing, and no fixation is spent on it
-            'all-nan': lambda: ('evidence', self.array(np.full(N, np.nan)), REJECT),
+            'all-nan': lambda: ('evidence', self.array(np.full(N, np.nan)), REFUSED_IN_USE),
             'valid-extreme': lambda: ('evidence', self.array(np.where(
                 self.rng.random(N) < 0.1, self.rng.choice(
                     [3.4e38, -3.4e38, 1e30, -1e30, 1e-45, -0.0], N), v)), VALID),
@@ -160,8 +162,9 @@ class Frames:
                                         VALID),
             # beyond the stamp tolerance ahead of the controller's clock: its clock runs ahead
             'image-future-stamp': lambda: ('evidence_image', self.image(v, stamp=far_future),
-                                           REJECT),
-            'image-all-nan': lambda: ('evidence_image', self.image(np.full(N, np.nan)), REJECT),
+                                           REFUSED_IN_USE),
+            'image-all-nan': lambda: ('evidence_image', self.image(np.full(N, np.nan)),
+                                      REFUSED_IN_USE),
             'image-old-stamp': lambda: ('evidence_image', self.image(v, stamp=(1, 0)), SKIP),
             'image-mono8': lambda: ('evidence_image', self.image(
                 v, encoding='mono8', data=bytes(N)), REJECT),
@@ -336,8 +339,10 @@ def _run_fuzz(rig, messages: int, param_requests: int, seed: int) -> dict:
             _publish(rig, topic, msg)
             if hostile:
                 outcome = REJECT
-            elif outcome == VALID and disabled:
+            elif outcome in (VALID, REFUSED_IN_USE) and disabled:
                 outcome = SKIP
+            elif outcome == REFUSED_IN_USE:
+                outcome = REJECT
             want[outcome] += 1
             want['applied'] += outcome == VALID
         sent += n

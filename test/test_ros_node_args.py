@@ -73,6 +73,7 @@ def test_misspelt_parameters_are_warned_about(context, tmp_path):
     ('/**/gaze_controller', '/robot/gaze_controller', True),
     ('/robot/*', '/robot/gaze_controller', True),
     ('/robot/gaze_controller', '/gaze_controller', False),
+    ('/gaze_controller', '/head1/gaze_controller', False),      # a bare key: the root only
     ('/gaze_controler', '/gaze_controller', False),
 ])
 def test_params_file_sections_match_as_rcl_does(tmp_path, section, node, applies):

@@ -1,6 +1,6 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""The simulated head's saccades: a re-sent goal neither restarts a saccade nor moves the head."""
+"""The simulated head's saccades: a re-sent command neither restarts a saccade nor waits."""
 from __future__ import annotations
 
 import pytest
@@ -32,16 +32,20 @@ def _head():
     return Head()
 
 
-def test_a_goal_resent_under_way_or_at_it_does_not_restart_the_saccade():
+def test_a_resent_goal_neither_restarts_the_saccade_nor_waits_again():
     head = _head()
-    head._saccade_to(5)
+    head._saccade_to(5, (1, 0))
     assert (head.moving, head._saccade_timer.resets, head.frames) == (True, 1, [])
-    head._saccade_to(5)                                  # re-sent under way: goes on
+    head._saccade_to(5, (1, 0))                          # re-sent under way: goes on
     assert head._saccade_timer.resets == 1
     head._on_arrival()
     assert (head.pose, head.moving, head.frames) == (5, False, [5])
-    head._saccade_to(5)                                  # re-sent at the goal: a frame now
+    head._saccade_to(5, (1, 0))                          # re-sent at the goal: a frame now
     assert (head.pose, head.moving, head._saccade_timer.resets, head.frames) == \
         (5, False, 1, [5, 5])
-    head._saccade_to(7)                                  # a new goal: a saccade
+    head._saccade_to(5, (2, 0))                          # a new command to where it stands:
     assert (head.moving, head._saccade_timer.resets, head.frames) == (True, 2, [5, 5])
+    head._on_arrival()                                   # it settles again first
+    assert head.frames == [5, 5, 5]
+    head._saccade_to(7, (3, 0))                          # a new goal: a saccade
+    assert (head.moving, head._saccade_timer.resets, head.frames) == (True, 3, [5, 5, 5])

@@ -57,8 +57,8 @@ def add_parser(sub):
 
 def run_record(args) -> int:
     from ipomdp_gaze.nodes.recorder import main, TOPICS
-    if args.path.exists():
-        raise ValueError(f'{args.path} exists; a bag needs a new directory')
+    from ipomdp_gaze.files.bag import check_new_bag
+    check_new_bag(args.path)
     ros = ['-p', f'path:={args.path.resolve()}']
     if args.topics:
         topics = [t.strip() for t in args.topics.split(',') if t.strip()]

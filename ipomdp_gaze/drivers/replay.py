@@ -167,6 +167,9 @@ def _frames(bag, grid: Grid) -> list:
     frames = []
     for m in bag.topic('evidence_image'):
         msg = m.msg
+        if (msg.height, msg.width) != grid.shape:
+            raise ValueError(f'{bag.path}: an evidence_image is {msg.height}x{msg.width} '
+                             f'(height x width), the recorded grid {grid.rows}x{grid.cols}')
         try:
             values, offsets, groups = decode_evidence(msg.encoding, msg.height, msg.width,
                                                       msg.step, msg.is_bigendian, msg.data)

@@ -29,23 +29,28 @@ def _typestore():
 
 def check_new_bag(path) -> Path:
     """
-    Return ``path`` as a Path if a bag can be created there: new, in a writable folder.
+    Return ``path`` as a Path if a bag can be created there: new, its folders creatable.
+
+    Missing folders on the way are made with the bag (as ``rosbags`` does); the nearest one
+    that exists must be a writable folder.
 
     Raises
     ------
     ValueError
-        If ``path`` exists or its folder is missing or not writable (checked before any node
-        starts, so a demo does not run a search it cannot record).
+        If ``path`` exists, or a file or an unwritable folder is in the way (checked before
+        any node starts, so a demo does not run a search it cannot record).
 
     """
     path = Path(path)
     if path.exists():
         raise ValueError(f'{path} exists; a bag needs a new directory')
-    parent = path.parent
-    if not parent.is_dir():
-        raise ValueError(f'{path}: the folder {parent} does not exist')
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise ValueError(f'{path}: the folder {parent} is not writable')
+    folder = path.parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    if not folder.is_dir():
+        raise ValueError(f'{path}: {folder} is not a folder')
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise ValueError(f'{path}: the folder {folder} is not writable')
     return path
 
 

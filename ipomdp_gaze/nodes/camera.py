@@ -161,7 +161,7 @@ class SimulatedCameraNode(SaccadeMixin, QuietPublishers, Node):
     def _on_command(self, msg: JointState) -> None:
         cell = self._commanded_cell(msg, self._config.head)
         if cell is not None:
-            self._saccade_to(cell)
+            self._saccade_to(cell, self._command_stamp_of(msg))
 
     def _arrived(self) -> None:
         if self._config.values['rate_hz'] == 0:

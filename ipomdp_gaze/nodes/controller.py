@@ -58,7 +58,7 @@ from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnav
 from ipomdp_gaze.search import answer
 from ipomdp_gaze.search.controller_config import (build_config, ControllerConfig as Config,
                                                   grid_from)
-from ipomdp_gaze.search.gaze import FrameSequence
+from ipomdp_gaze.search.gaze import FrameSequence, STAMP_TOLERANCE_S
 from ipomdp_gaze.search.health import HealthMonitor
 from ipomdp_gaze.search.room import MAX_PERIOD_S, Person, RoomWatch
 from rclpy.exceptions import NameValidationException
@@ -105,6 +105,10 @@ def controller_params() -> list[Param]:
         Param('settle_time_s', SETTLE_TIME_S, T.DOUBLE,
               'frames taken earlier than this after a target was sent are skipped',
               float_range=(0.0, 60.0)),
+        Param('stamp_tolerance_s', STAMP_TOLERANCE_S, T.DOUBLE,
+              "evidence stamped more than this ahead of this node's clock is rejected (its "
+              "clock runs ahead); keep it as the detector's stamp_tolerance_s",
+              float_range=(0.0, 3600.0)),
         Param('retry_period_s', 1.0, T.DOUBLE,
               're-send the current target this often until a usable frame arrives (0: never)',
               float_range=(0.0, 3600.0)),
@@ -329,9 +333,11 @@ class GazeControllerNode(QuietPublishers, Node):
             self.get_logger().warning(cfg.warning)
         v, ov = cfg.values, old.values
         core = self.core
+        was_following = core.follows_people
         core.set_observation(cfg.observation)
         core.set_policy(cfg.policy)
         core.configure(cfg.settings, v['settle_time_s'])
+        core.stamp_tolerance_s = v['stamp_tolerance_s']
         if v['seed'] != ov['seed']:
             core.reseed(v['seed'])
         if (v['forward_command_topic'], v['trajectory_topic']) != \
@@ -346,7 +352,8 @@ class GazeControllerNode(QuietPublishers, Node):
         switched = self._many and cfg.settings.moving != old.settings.moving
         if v['absent.prior'] != ov['absent.prior'] or \
                 v['search.targets'] != ov['search.targets'] or switched:
-            return f'policy {cfg.policy_label}; {self._restart(forget=switched)}'
+            forget = switched or (was_following and not core.follows_people)
+            return f'policy {cfg.policy_label}; {self._restart(forget=forget)}'
         if self._dwell_timer is not None and \
                 (v['room.dwell_s'], v['room.recheck_period_s']) != \
                 (ov['room.dwell_s'], ov['room.recheck_period_s']):

@@ -45,6 +45,11 @@ class SaccadeMixin:
             self._frame_timer = self.create_timer(1.0 / values['rate_hz'],
                                                   self.guard.wrap(self._publish_frame))
 
+    @staticmethod
+    def _command_stamp_of(msg) -> tuple:
+        """Return a command's header stamp as ``(sec, nanosec)``: a re-send repeats it."""
+        return int(msg.header.stamp.sec), int(msg.header.stamp.nanosec)
+
     def _commanded_cell(self, msg, head):
         """Return the cell nearest a ``pan_tilt`` command, or None (warned, throttled)."""
         try:
@@ -54,18 +59,21 @@ class SaccadeMixin:
                                       throttle_duration_sec=5.0)
             return None
 
-    def _saccade_to(self, goal: int) -> None:
+    def _saccade_to(self, goal: int, stamp=None) -> None:
         """
-        Start a saccade to ``goal``; a re-sent goal does not restart one.
+        Start a saccade to ``goal``, commanded by a message stamped ``stamp`` (``(sec, nsec)``).
 
-        Under way, the saccade goes on; at the goal already, the head does not move and the
-        camera arrives at once (a frame now, with ``rate_hz`` 0): a real head commanded to where
-        it stands stays put, and a re-send means the frame is wanted.
+        A re-sent command (the same stamp: the controller's ``retry_period_s``) does not restart
+        a saccade: under way, it goes on; at the goal already, the head does not move and the
+        camera arrives at once (a frame now, with ``rate_hz`` 0), since the controller is still
+        waiting for it. A new command to where the head stands settles again for
+        ``saccade_time_s`` (the controller skips frames taken before its settle time).
         """
+        resent = stamp is not None and stamp == getattr(self, '_command_stamp', None)
+        self._command_stamp = stamp
         if goal == self.goal and self.moving:
             return
-        if goal == self.pose and not self.moving:
-            self.goal = goal
+        if resent and goal == self.pose and not self.moving:
             self._arrive()
             return
         self.goal, self.moving = goal, True

@@ -287,7 +287,7 @@ class SceneCameraNode(SaccadeMixin, QuietPublishers, Node):
         # a fixed camera: the command triggers a frame
         goal = self.pose if cfg.head is None else self._commanded_cell(msg, cfg.head)
         if goal is not None:
-            self._saccade_to(goal)
+            self._saccade_to(goal, self._command_stamp_of(msg))
 
     def _arrived(self) -> None:
         if self._config.values['rate_hz'] == 0:

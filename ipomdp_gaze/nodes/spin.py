@@ -168,6 +168,4 @@ def _matches(section: str, node_name: str) -> bool:
     pattern = re.escape(section).replace(r'/\*\*', '(/.*)?').replace(r'\*', '[^/]*')
     if not section.startswith('/'):
         pattern = '/' + pattern
-    if re.fullmatch(pattern, node_name):
-        return True
-    return '/' not in section.strip('/') and section.strip('/') == node_name.rsplit('/', 1)[-1]
+    return re.fullmatch(pattern, node_name) is not None

@@ -25,7 +25,7 @@ from ipomdp_gaze.model.fpoc import make_fpoc, parameter_names
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.model.observation import GaussianObservation
-from ipomdp_gaze.search.gaze import check_settle_time, GazeController
+from ipomdp_gaze.search.gaze import check_settle_time, GazeController, STAMP_TOLERANCE_S
 from ipomdp_gaze.search.health import policy_label
 from ipomdp_gaze.search.many import check_many_settings
 from ipomdp_gaze.search.room import check_room_times
@@ -148,7 +148,8 @@ class ControllerConfig:
         """Return a new :class:`ipomdp_gaze.search.gaze.GazeController` with this configuration."""
         v = self.values
         return GazeController(self.grid, self.observation, self.policy, self.settings,
-                              v['settle_time_s'], v['seed'])
+                              v['settle_time_s'], v['seed'],
+                              v.get('stamp_tolerance_s', STAMP_TOLERANCE_S))
 
 
 def build_config(values: Mapping, build_policy: Callable, changed=None,

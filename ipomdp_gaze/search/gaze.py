@@ -248,8 +248,10 @@ class GazeController:
     """
 
     def __init__(self, grid: Grid, observation, policy, settings: SearchSettings | None = None,
-                 settle_time_s: float = 0.0, seed: int = 0):
+                 settle_time_s: float = 0.0, seed: int = 0,
+                 stamp_tolerance_s: float = STAMP_TOLERANCE_S):
         self.grid = grid
+        self.stamp_tolerance_s = float(stamp_tolerance_s)
         self.session = make_session(grid, observation, policy, settings or SearchSettings())
         self.settle_time_s = check_settle_time(settle_time_s)
         self.session.reset(seed=seed)
@@ -403,6 +405,10 @@ class GazeController:
     def reject(self, reason: str) -> FrameResult:
         """Count a frame that could not even be read (for example a bad message layout)."""
         self.received += 1
+        return self._refuse(reason)
+
+    def _refuse(self, reason: str) -> FrameResult:
+        """Count a received frame as rejected for ``reason``."""
         self.rejected += 1
         self.last_rejection = str(reason)
         return FrameResult('rejected', str(reason))
@@ -467,12 +473,6 @@ class GazeController:
                                                groups=groups)
         except EvidenceError as exc:
             return self.reject(str(exc))
-        if now_s is not None and stamp_s - now_s > STAMP_TOLERANCE_S:
-            return self.reject(f"stamped {stamp_s - now_s:.3f} s ahead of this node's clock "
-                               f'(more than {STAMP_TOLERANCE_S:g} s): its clock runs ahead')
-        if np.isnan(frame.values).all():
-            return self.reject('every cell is NaN: the frame observed nothing, and a fixation '
-                               'is not spent on it')
         self.received += 1
         if not self.enabled:
             self.skipped += 1
@@ -488,6 +488,13 @@ class GazeController:
             self.skipped += 1
             return FrameResult('skipped', f'the search has ended ({self.decision}); ~/reset '
                                           f'starts a new one')
+        if now_s is not None and stamp_s - now_s > self.stamp_tolerance_s:
+            return self._refuse(f"stamped {stamp_s - now_s:.3f} s ahead of this node's clock "
+                                f'(more than stamp_tolerance_s {self.stamp_tolerance_s:g} s): '
+                                'its clock runs ahead')
+        if np.isnan(frame.values).all():
+            return self._refuse('every cell is NaN: the frame observed nothing, and a fixation '
+                                'is not spent on it')
         if stamp_s < self.target_time_s + self.settle_time_s:
             self.skipped += 1
             return FrameResult('skipped', 'taken before the fixation settled')

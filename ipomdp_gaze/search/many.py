@@ -47,7 +47,8 @@ people followed left out; with nobody found, or
 docs/design.md section 11.7): the views are the pass's poses in order, once each; the search
 ends after the last (reason ``pass``; earlier if every cell was decided) with every cell on its
 likelier side, and its faces also name every grouped detection the frames carried
-(``Frame.groups``) more than one cell from a face already named.
+(``Frame.groups``) that is not a face already named: more than one cell from it, or, for two
+groups whose frames gave offsets, more than :data:`GROUP_SAME_FACE_CELLS` from where it lies.
 
 The answer for drivers: :meth:`OccupancySession.faces` (one face per cluster of occupied cells,
 :func:`ipomdp_gaze.model.occupancy.count_faces`). The session imports no ROS, prints and writes
