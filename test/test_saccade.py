@@ -9,6 +9,7 @@ pytestmark = pytest.mark.ros
 
 
 class _Timer:
+
     def __init__(self):
         self.resets = 0
 
@@ -23,6 +24,7 @@ def _head():
     from ipomdp_gaze.nodes.saccade import SaccadeMixin
 
     class Head(SaccadeMixin):
+
         def __init__(self):
             self.pose, self.goal, self.moving = 0, 0, False
             self._saccade_timer, self.frames = _Timer(), []
