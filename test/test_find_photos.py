@@ -21,12 +21,6 @@ def run_cli(*args):
                           capture_output=True, text=True, timeout=600)
 
 
-@pytest.fixture
-def run_find(cli_here):
-    """Run ``find`` in this process: its lines and status without an interpreter per run."""
-    return lambda *args: cli_here('find', *args)
-
-
 def write(path, rgb):
     cv2.imwrite(str(path), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
     return path

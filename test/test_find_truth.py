@@ -27,12 +27,6 @@ LINE = re.compile(r'^(?P<path>\S+): decision=(?P<decision>\w+) ended=(?P<ended>\
 CONFIDENCE = 0.99
 
 
-@pytest.fixture
-def run_find(cli_here):
-    """Run ``find`` in this process: its lines and status without an interpreter per run."""
-    return lambda *args, cwd=None: cli_here('find', *args, cwd=cwd)
-
-
 @pytest.fixture(scope='module')
 def images(tmp_path_factory):
     """Write the astronaut (a face), noise and a solid colour (nobody) as 8-bit PNGs."""

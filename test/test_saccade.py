@@ -51,3 +51,32 @@ def test_a_resent_goal_neither_restarts_the_saccade_nor_waits_again():
     assert head.frames == [5, 5, 5]
     head._saccade_to(7, (3, 0))                          # a new goal: a saccade
     assert (head.moving, head._saccade_timer.resets, head.frames) == (True, 3, [5, 5, 5])
+
+
+class _Logger:
+
+    def __init__(self):
+        self.warnings = []
+
+    def warning(self, text, **_):
+        self.warnings.append(text)
+
+
+def test_a_command_beyond_the_grid_is_clipped_to_its_edge_and_warned():
+    from ipomdp_gaze.model.grid import Grid
+    from ipomdp_gaze.model.head import PanTiltMap
+    from ipomdp_gaze.msg_adapters import joints
+    from builtin_interfaces.msg import Time
+    from sensor_msgs.msg import JointState
+    head_map = PanTiltMap(Grid(5, 7, spacing_deg=5.0))
+    head, logger = _head(), _Logger()
+    head.get_logger = lambda: logger
+    inside = joints.joint_state(head_map, head_map.grid.index(4, 6), Time())
+    assert head._commanded_cell(inside, head_map) == head_map.grid.index(4, 6)
+    assert logger.warnings == []
+    far = JointState(name=['pan_joint', 'tilt_joint'], position=[-100.0, 0.0])
+    assert head._commanded_cell(far, head_map) == head_map.grid.index(2, 6)    # pan's edge
+    assert len(logger.warnings) == 1 and 'beyond the 5x7 grid' in logger.warnings[0]
+    nan = JointState(name=['pan_joint', 'tilt_joint'], position=[float('nan'), 0.0])
+    assert head._commanded_cell(nan, head_map) is None
+    assert 'ignored a pan_tilt command' in logger.warnings[1]

@@ -29,6 +29,8 @@ class SaccadeMixin:
     :meth:`_arrived` (the head reached its goal) and ``_publish_frame``.
     """
 
+    _command_stamp: tuple | None = None     # the last pan/tilt command's header stamp
+
     def _make_saccade_timers(self, values: dict) -> None:
         """Rebuild the saccade timer (None: instantaneous) and the frame timer (``rate_hz``)."""
         for timer in (self._saccade_timer, self._frame_timer):
@@ -51,13 +53,26 @@ class SaccadeMixin:
         return int(msg.header.stamp.sec), int(msg.header.stamp.nanosec)
 
     def _commanded_cell(self, msg, head):
-        """Return the cell nearest a ``pan_tilt`` command, or None (warned, throttled)."""
+        """
+        Return the cell nearest a ``pan_tilt`` command, or None (warned, throttled).
+
+        A command more than a cell beyond the grid is warned about (throttled) and clipped to
+        the edge, as a head stops at its joint limits.
+        """
         try:
-            return head.nearest_cell(*joints.angles_from_joint_state(msg, head))
+            pan_rad, tilt_rad = joints.angles_from_joint_state(msg, head)
+            row, col = head.position(pan_rad, tilt_rad)
         except ValueError as exc:
             self.get_logger().warning(f'ignored a pan_tilt command: {exc}',
                                       throttle_duration_sec=5.0)
             return None
+        rows, cols = head.grid.rows, head.grid.cols
+        if not (-1.0 <= row <= rows and -1.0 <= col <= cols):
+            self.get_logger().warning(
+                f'a pan_tilt command ({pan_rad:.4f}, {tilt_rad:.4f}) rad points at row '
+                f'{row:.1f}, col {col:.1f}, beyond the {rows}x{cols} grid: the head stops at '
+                'the nearest edge cell', throttle_duration_sec=5.0)
+        return head.nearest_cell(pan_rad, tilt_rad)
 
     def _saccade_to(self, goal: int, stamp=None) -> None:
         """
@@ -69,7 +84,7 @@ class SaccadeMixin:
         waiting for it. A new command to where the head stands settles again for
         ``saccade_time_s`` (the controller skips frames taken before its settle time).
         """
-        resent = stamp is not None and stamp == getattr(self, '_command_stamp', None)
+        resent = stamp is not None and stamp == self._command_stamp
         self._command_stamp = stamp
         if goal == self.goal and self.moving:
             return
