@@ -73,11 +73,15 @@ faces: $(STAMP)
 # (photo and lfw faces; YuNet, then Haar) then test groups, each table in one run; then a small
 # group of 15-40 px faces in a 4000x3000 face-free canvas (training, then test; find --all as
 # shipped, --max-side 2048, and with --max-side 0 --min-face 15; about 1.7 GB resident for the
-# full-resolution calls on 12 MP): docs/faces.md's section "find --all on groups: scale as an action"
-# (about 6 minutes).
+# full-resolution calls on 12 MP); then crowds: the split's photo faces 29 (25) times anywhere in
+# 3000x2171 and 2048x1536 pictures at 50-100 px (25-50 px), find --all against the same without
+# its crowd step (crowd ratio 0): docs/faces.md's section "find --all on groups: scale as an
+# action" (about 8 minutes).
 GROUP_BENCH := $(VPY) bench/faces/many_faces.py --scenes 8 --sizes 640x480,1280x886 --write docs/faces.md
 CANVAS_BENCH := $(VPY) bench/faces/many_faces.py --canvas 15-40 --sizes 4000x3000 --scenes 4 \
 	--min-face 15 --write docs/faces.md
+CROWD_BENCH := $(VPY) bench/faces/many_faces.py --sizes 3000x2171,2048x1536 --scenes 4 \
+	--crowd-ratios 0 --write docs/faces.md
 
 faces-groups: $(STAMP)
 	$(GROUP_BENCH) --split train --section groups-train-photos
@@ -88,6 +92,10 @@ faces-groups: $(STAMP)
 	$(GROUP_BENCH) --split test --section groups-test-photos
 	$(GROUP_BENCH) --split test --detector haar --section groups-test-photos-haar
 	$(CANVAS_BENCH) --split test --section canvas-test
+	$(CROWD_BENCH) --split train --crowd 50-100 --copies 29 --section crowd-train
+	$(CROWD_BENCH) --split train --crowd 25-50 --copies 25 --section crowd-train-small
+	$(CROWD_BENCH) --split test --crowd 50-100 --copies 15 --section crowd-test
+	$(CROWD_BENCH) --split test --crowd 25-50 --copies 13 --section crowd-test-small
 
 # The pan/tilt face search against a blind sweep on 400 + 200 held-out scenes and a second camera:
 # writes docs/pan_tilt.md and docs/data/pan_tilt.json.gz (10-30 minutes, and 15 for the ROS demo).

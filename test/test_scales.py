@@ -240,3 +240,123 @@ def test_the_calibration_counts_one_false_detection_more_than_it_saw():
                  0.95)
     assert rows[1.0] == (16.0, 1.0, 0.5)      # from the bin of 16-20 px up; none in 2 Mpx: 1 in 2
     assert rows[0.5] == (16.0, 1.0, 4.0)                   # 3 seen in 1 Mpx: 4
+
+
+class _Blobs:
+    """A stand-in detector: each bright square's box, strong from 20 px, weak from 12."""
+
+    def __call__(self, gray):
+        import cv2
+        n, _, stats, _ = cv2.connectedComponentsWithStats((gray > 128).astype(np.uint8))
+        out = [[x, y, w, h, 0.9 if min(w, h) >= 20 else 0.5]
+               for x, y, w, h, _ in stats[1:n] if min(w, h) >= 12]
+        return np.array(out, dtype=float).reshape(-1, 5)
+
+
+CROWD = {(200, 200): 80, (200, 800): 80, (600, 500): 60, (600, 1200): 60, (960, 240): 40,
+         (960, 1000): 40}                                   # (y, x): side in px, 1600x1200
+
+
+def _crowd_sensor(fovea, crowd_ratio=search.CROWD_RATIO):
+    image = np.zeros((1200, 1600, 3), dtype=np.uint8)
+    for (y, x), side in CROWD.items():
+        image[y:y + side, x:x + side] = 255
+    prior = prior_log_odds(fovea.grid.n_cells, cell_prior(fovea.grid.n_cells, 0.5))
+    sensor = search._Coarse(fovea, TABLE, (1600, 1200), prior, 0.99, budget=1600 * 1200,
+                            crowd_ratio=crowd_ratio)
+    sensor.detector = _Blobs()
+    sensor.start(image)
+    return sensor, prior, sensor.scan()
+
+
+def _cells(fovea):
+    return {fovea.grid.index(int((y + side / 2) * 21 / 1200), int((x + side / 2) * 21 / 1600))
+            for (y, x), side in CROWD.items()}
+
+
+def test_faces_smaller_than_assumed_send_the_whole_image_to_a_finer_call(yunet_420):
+    _, fovea = yunet_420
+    # faces that matter: 120 px (1/10 of 1200), seen at 1/4; there the 80 px squares are
+    # strong (20 px), the 60 px weak and the 40 px unseen. A face below 0.7 x 120 px was found:
+    # the image holds smaller faces than assumed, and the whole image is read at the row at or
+    # above 0.25 / 0.7 (1/2), where every square is strong. The next step (its 40 px squares
+    # are below 0.7 x 80) would be the full-resolution call, past the budget of one full scan
+    sensor, prior, frame = _crowd_sensor(fovea)
+    whole = (0, 0, 1600, 1200)
+    assert [(rect, scale) for rect, scale, _ in sensor.looks] == [(whole, 0.25), (whole, 0.5)]
+    assert frame.detector_pixels == 400 * 300 + 800 * 600
+    posterior = prior + frame.values
+    faces = sorted(_cells(fovea))
+    assert np.all(posterior[faces] > np.log(99))                         # each occupied
+    assert np.all(np.delete(posterior, faces) < -np.log(99))             # every other empty
+    # without the step the 60 px squares draw crops at 1/2 and the 40 px ones are never seen
+    sensor, prior, frame = _crowd_sensor(fovea, crowd_ratio=0.0)
+    assert sensor.looks[0][:2] == (whole, 0.25)
+    assert all(rect != whole for rect, _, _ in sensor.looks[1:])
+    occupied = set(np.flatnonzero(prior + frame.values > np.log(99)))
+    assert occupied < set(faces) and len(occupied) == 4
+
+
+def test_the_crowds_prior_is_the_fraction_of_cells_holding_a_strong_box(yunet_420):
+    _, fovea = yunet_420
+    sensor, prior, _ = _crowd_sensor(fovea)
+    n = fovea.grid.n_cells
+    boxes = np.array([[x, y, side, side] for (y, x), side in CROWD.items()], dtype=float)
+    shift = sensor._crowd_shift(boxes)
+    assert np.allclose(prior + shift, np.log(6 / (n - 6)))               # 6 faces in 6 cells
+    assert np.allclose(prior + sensor._crowd_shift(boxes[:1]), np.log(1 / (n - 1)))
+    sensor.prior = np.full(n, np.log(0.1 / 0.9))            # a prior above the crowd's: kept
+    assert np.all(sensor._crowd_shift(boxes) == 0.0)
+    assert np.all(sensor._crowd_shift(np.zeros((0, 4))) == 0.0)
+
+
+def _crowd(size, sides, count, seed=0):
+    """Paste the training face ``count`` times (mirrored alternately) on a training photo."""
+    from ipomdp_gaze.vision.photos import face_crops
+    import cv2
+    width, height = size
+    rng = np.random.default_rng(seed)
+    back = cv2.resize(load_photo('coffee'), size, interpolation=cv2.INTER_CUBIC)
+    image = np.ascontiguousarray(back)
+    [(crop, (x, y, w, h))] = face_crops('train')
+    taken, boxes = [], []
+    for k in range(count):
+        face, fx = (crop[:, ::-1], crop.shape[1] - x - w) if k % 2 else (crop, x)
+        while True:
+            f = rng.uniform(*sides) / max(w, h)
+            ow, oh = round(crop.shape[1] * f), round(crop.shape[0] * f)
+            px, py = int(rng.integers(0, width - ow)), int(rng.integers(0, height - oh))
+            if all(px + ow <= a or a + b <= px or py + oh <= c or c + d <= py
+                   for a, c, b, d in taken):
+                break
+        taken.append((px, py, ow, oh))
+        image[py:py + oh, px:px + ow] = cv2.resize(face, (ow, oh), interpolation=cv2.INTER_AREA)
+        boxes.append((px + fx * f, py + y * f, w * f, h * f))
+    return image, np.array(boxes)
+
+
+def test_find_all_finds_a_crowd_of_faces_far_smaller_than_a_tenth_of_the_image(yunet_420):
+    """29 faces of 41-61 px in 2048x1482 (the issue's crowd photo after find's resize)."""
+    from ipomdp_gaze.commands.find import _Tasks
+    from types import SimpleNamespace
+    image, truth = _crowd((2048, 1482), (41, 61), 29)
+    task = _Tasks(SimpleNamespace(observation=None, detector='yunet', policy=None,
+                                  policy_file=None)).task((2048, 1482))
+    table = scale_table(task.model)
+
+    def found(crowd_ratio):
+        result = search_many(image, task.fovea, task.model, MANY, pixel_budget=2048 * 1482,
+                             scales=table, crowd_ratio=crowd_ratio)
+        centres = np.array([[x + w / 2, y + h / 2] for x, y, w, h in
+                            (f.box for f in result.faces)]).reshape(-1, 2)
+        inside = ((truth[None, :, 0] <= centres[:, None, 0])
+                  & (centres[:, None, 0] <= truth[None, :, 0] + truth[None, :, 2])
+                  & (truth[None, :, 1] <= centres[:, None, 1])
+                  & (centres[:, None, 1] <= truth[None, :, 1] + truth[None, :, 3]))
+        assert np.all(inside.sum(axis=1) == 1)              # no false face
+        assert np.all(inside.sum(axis=0) <= 1)              # none twice
+        return int(inside.any(axis=0).sum()), result.detector_pixels
+    crowd, crowd_px = found(search.CROWD_RATIO)
+    plain, _ = found(0.0)
+    assert crowd >= 26 and crowd >= plain + 5, (crowd, plain)
+    assert crowd_px < 2048 * 1482 * 0.75                    # less than a full call

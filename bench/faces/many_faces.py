@@ -48,7 +48,7 @@ from ipomdp_gaze.vision.photos import (_paste_rgb, face_crops, GROUP_BACKGROUNDS
                                        load_photo, TRAIN_GROUP_BACKGROUNDS)
 from ipomdp_gaze.vision.scenes import (_paste as paste, DEFAULT_FEATHER, load_background,
                                        load_faces, SPLITS)
-from ipomdp_gaze.vision.search import FIND_SETTINGS
+from ipomdp_gaze.vision.search import CROWD_RATIO, FIND_SETTINGS
 import numpy as np
 
 SCALES = (1.0, 1 / 2, 1 / 3, 1 / 4)
@@ -155,12 +155,17 @@ def canvas_group(size, seed: int, split: str, copies: int, face_px=(15, 40),
 
 
 def scenes(split: str, count: int, size, copies: int, faces: str = 'photos',
-           face_px=None):
-    """Yield the composed group pictures of a split, or its canvases: ``(name, image, boxes)``."""
+           face_px=None, crowd: bool = False):
+    """
+    Yield the composed group pictures of a split, or its canvases: ``(name, image, boxes)``.
+
+    ``crowd``: the canvases' faces anywhere in the picture (a crowd), not in one region.
+    """
     if face_px is not None:
         for i in range(count):
-            name, image, boxes = canvas_group(size, i, split, copies, face_px)
-            yield f'canvas-{name}-{i}', image, boxes
+            name, image, boxes = canvas_group(size, i, split, copies, face_px,
+                                              region=size if crowd else (1000, 750))
+            yield f'{"crowd" if crowd else "canvas"}-{name}-{i}', image, boxes
         return
     if faces == 'lfw':
         for i in range(count):
@@ -180,25 +185,27 @@ def run(args) -> list[dict]:
     tasks = find_tasks(detector=args.detector)
     settings = replace(FIND_SETTINGS, targets='many', absent_prior=args.absent_prior,
                        confidence=args.confidence)
-    finds = [('find --all', args.max_side, None)]
+    finds = [('find --all', args.max_side, None, CROWD_RATIO)]
     if args.min_face:
         finds.append((f'find --all --max-side 0 --min-face {args.min_face:g}', 0,
-                      args.min_face))
+                      args.min_face, CROWD_RATIO))
+    finds += [(f'find --all, crowd ratio {ratio:g}', args.max_side, None, ratio)
+              for ratio in args.crowd_ratios]
     rows = []
     for size in args.sizes:
         totals = {}
         # find's one-time set-up (the belief's information table, the fixation costs of the
         # size) is not in its seconds (ipomdp_gaze.commands.find): built on a first scene here
         _, image, _ = next(iter(scenes(args.split, 1, size, args.copies, args.faces,
-                                       args.face_px)))
-        for _, max_side, min_face in finds:
+                                       args.face_px, args.crowd is not None)))
+        for _, max_side, min_face, _ in finds:
             small, _ = shrink(image, max_side)
             search_one(small, tasks.task((small.shape[1], small.shape[0])), settings,
                        np.random.default_rng(0), True)
         del image, small
         for name, image, truth in scenes(args.split, args.scenes, size, args.copies,
-                                         args.faces, args.face_px):
-            for method, max_side, min_face in finds:
+                                         args.faces, args.face_px, args.crowd is not None):
+            for method, max_side, min_face, ratio in finds:
                 # as find does: an image longer than --max-side is resized first (INTER_AREA;
                 # in its seconds), the faces' boxes given back in the image's pixels
                 t0 = time.perf_counter()
@@ -206,7 +213,8 @@ def run(args) -> list[dict]:
                 task = tasks.task((small.shape[1], small.shape[0]))
                 [result] = search_one(small, task, settings, np.random.default_rng(0), True,
                                       None if min_face is None else min_face / max(sx, sy),
-                                      empty_by_evidence=args.empty_by_evidence)
+                                      empty_by_evidence=args.empty_by_evidence,
+                                      crowd_ratio=ratio)
                 seconds = time.perf_counter() - t0
                 boxes = (np.array([f.box for f in result.faces]).reshape(-1, 4)
                          * (sx, sy, sx, sy))
@@ -280,6 +288,14 @@ def main(argv=None):
                    help='large canvases instead of group pictures: each of --sizes (e.g. '
                         '4000x3000) a background of the split with its photo faces, --copies '
                         'times, of LO-HI px in one 1000x750 region (canvas_group)')
+    p.add_argument('--crowd', type=_range, default=None, metavar='LO-HI',
+                   help='crowds instead of group pictures: each of --sizes a background of '
+                        'the split with its photo faces, --copies times, of LO-HI px anywhere '
+                        'in the picture (canvas_group over the whole picture)')
+    p.add_argument('--crowd-ratios', type=lambda t: [float(v) for v in t.split(',')],
+                   default=[], metavar='R,R',
+                   help='also run find --all with these crowd ratios (0: no crowd step; '
+                        'the shipped: ipomdp_gaze.vision.search.CROWD_RATIO)')
     p.add_argument('--max-side', type=int, default=MAX_SIDE_PX,
                    help="find --all's --max-side (default find's; the detector alone always "
                         'reads the whole image)')
@@ -293,10 +309,13 @@ def main(argv=None):
                         '<!-- /SECTION --> (appended when they are not there)')
     p.add_argument('--section', default='many-faces')
     args = p.parse_args(argv)
-    args.face_px = args.canvas
+    if args.canvas and args.crowd:
+        p.error('--canvas and --crowd are two kinds of picture: give one')
+    args.face_px = args.canvas or args.crowd
     rows = run(args)
-    kind = (f'canvases with {args.faces} faces of {args.canvas[0]:g}-{args.canvas[1]:g} px'
-            if args.canvas else f'{args.faces} faces')
+    kind = (f'{"crowds" if args.crowd else "canvases"} with {args.faces} faces of '
+            f'{args.face_px[0]:g}-{args.face_px[1]:g} px' if args.face_px
+            else f'{args.faces} faces')
     lines = [f'split {args.split}, {kind}, {args.scenes} scenes per size, '
              f'{args.copies} copies (lfw: faces) per scene, detector {args.detector}, absent '
              f'prior {args.absent_prior}, confidence {args.confidence}, empty by evidence '

@@ -55,7 +55,9 @@ starts with one detector call on the whole image at the coarsest scale its calib
 sees faces of 1/10 of the shorter side (``--min-face PX``: of that side in the given image's
 pixels; full resolution when no coarser scale sees it), and looks closer (a crop at a finer
 scale, then the fovea's windows) only where that call leaves cells undecided
-(:mod:`ipomdp_gaze.vision.scales`). Faces far smaller than 1/10 on a large image also need
+(:mod:`ipomdp_gaze.vision.scales`); a face found far smaller than assumed (a crowd) sends the
+whole image to a finer call (:data:`ipomdp_gaze.vision.search.CROWD_RATIO`). Faces far smaller
+than 1/10 on a large image also need
 ``--max-side 0``: the default resize to 2048 px would shrink them below what the detector sees.
 ``--targets one`` keeps the old loop (:func:`ipomdp_gaze.vision.search.search_all`: find one
 face, rule its cells out, search again).
@@ -108,7 +110,7 @@ from ipomdp_gaze.vision.fullframe import MAX_SCALE
 from ipomdp_gaze.vision.image_files import decode_quietly
 from ipomdp_gaze.vision.scales import finest_scale, ladder_scales, SCALE_TABLES
 from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, clip_box,
-                                       EMPTY_BY_EVIDENCE,
+                                       CROWD_RATIO, EMPTY_BY_EVIDENCE,
                                        FIND_SETTINGS, fovea_for_model, full_frame_reason,
                                        full_frame_search, prepare_many, search_all,
                                        search_first, search_image, search_many, search_scales,
@@ -684,7 +686,8 @@ def search_route(task, image_px: tuple[int, int], settings, find_all: bool,
 
 def search_one(image, task, settings, rng, find_all: bool,
                min_face: float | None = None, scan: str = SCAN_DEFAULT,
-               empty_by_evidence: bool = EMPTY_BY_EVIDENCE) -> list:
+               empty_by_evidence: bool = EMPTY_BY_EVIDENCE,
+               crowd_ratio: float = CROWD_RATIO) -> list:
     """
     Search one image: the fovea within one full scan's pixels, or the full frame (say why).
 
@@ -692,7 +695,8 @@ def search_one(image, task, settings, rng, find_all: bool,
     the many-target search's coarse pass (``--all``, ``--scan many``; default 1/10 of the
     shorter side) and to the ladder of ``--scan coarse`` (default: it ends at full
     resolution); not to the full frame, the old loop or the fovea (:func:`search_route`);
-    ``empty_by_evidence``: its rule for cells nobody occupies (:func:`search_many`).
+    ``empty_by_evidence``: its rule for cells nobody occupies, ``crowd_ratio`` its step to a
+    finer call for a crowd (:func:`search_many`).
     """
     width, height = image.shape[1], image.shape[0]
     route, reason = search_route(task, (width, height), settings, find_all, scan)
@@ -707,7 +711,7 @@ def search_one(image, task, settings, rng, find_all: bool,
         prepare_many(task.fovea, task.model, (width, height), scales)      # one-time set-up
         return [search_many(image, task.fovea, task.model, settings, pixel_budget=budget,
                             scales=scales, min_face=min_face,
-                            empty_by_evidence=empty_by_evidence)]
+                            empty_by_evidence=empty_by_evidence, crowd_ratio=crowd_ratio)]
     if route == 'all':
         return search_all(image, task.fovea, task.model, task.policy, settings, rng=rng,
                           pixel_budget=budget)

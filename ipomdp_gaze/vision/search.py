@@ -58,7 +58,7 @@ from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea
 from ipomdp_gaze.vision.fovea_model import check_model, fovea_for_model  # noqa: F401
 from ipomdp_gaze.vision.fullframe import cells_of_points, scan
 from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evidence,
-                                       ladder_scales, ScaleTable)
+                                       ladder_scales, min_face_px, SCALE_RTOL, ScaleTable)
 from ipomdp_gaze.vision.sensors import FoveaSensor
 import numpy as np
 
@@ -97,6 +97,12 @@ LOOK_SIDE_PX = 128.0
 FAINT_SCORE = 0.2
 FAINT_SIDE = 4 / 3
 FAINT_LOOK_SCORE = 0.8
+# A crowd (find --all, docs/design.md section 11.4): when the coarse pass finds a face smaller
+# than CROWD_RATIO times the faces assumed to matter (1/10 of the shorter side), the image holds
+# smaller faces than assumed, and the whole image is detected again at the table's row at or
+# above 1 / CROWD_RATIO times the scale (faces CROWD_RATIO times smaller seen at the input size
+# of the smallest found), and so on while the smallest face found keeps shrinking by that ratio.
+CROWD_RATIO = 0.7
 
 # The settings of search_image unless given: NMPT's operating point (confidence 0.9, 25 fixations,
 # stop before fixating a cell a second time).
@@ -600,12 +606,15 @@ class _Coarse(_Recorder):
 
     def __init__(self, fovea: Fovea, table, image_px: tuple[int, int], prior: np.ndarray,
                  confidence: float, budget: float = math.inf, min_face: float | None = None,
-                 look_upscale: float = LOOK_UPSCALE, look_score: float = LOOK_SCORE):
+                 look_upscale: float = LOOK_UPSCALE, look_score: float = LOOK_SCORE,
+                 crowd_ratio: float = CROWD_RATIO):
         super().__init__(fovea)
         self.look_upscale, self.look_score = look_upscale, look_score
         self.scans = True
         self.table, self.image_px, self.prior = table, image_px, prior
-        self.scale = choose_scale(table, image_px, min_face)
+        self.min_face = min_face_px(image_px) if min_face is None else float(min_face)
+        self.scale = choose_scale(table, image_px, self.min_face)
+        self.crowd_ratio = crowd_ratio
         self.detector = coarse_detector(fovea.detector, table.weak_score)
         self.fine_score = _fine_score(fovea.detector)
         self.threshold = math.log(confidence / (1.0 - confidence))
@@ -653,13 +662,65 @@ class _Coarse(_Recorder):
         self.looks.append((tuple(int(v) for v in rect), scale, pixels))
         return strong, weak, pixels
 
+    def _finer_for_smaller_faces(self, strong, scale: float, side: float):
+        """
+        Return the next full call's scale when the faces found are smaller than ``side``.
+
+        A strong box whose larger side is below ``crowd_ratio`` times the faces assumed to
+        matter (``side``) says the image holds smaller faces than assumed (a crowd): faces
+        ``crowd_ratio`` times smaller still would be seen, at the size in the detector's input
+        at which this call saw its smallest, by a call ``1 / crowd_ratio`` times finer (the
+        table's row at or above it). None when no box is that small, no finer row exists or
+        ``crowd_ratio`` is 0.
+        """
+        if not self.crowd_ratio or not len(strong):
+            return None
+        smallest = float(np.min(np.max(np.asarray(strong, dtype=float)[:, 2:], axis=1)))
+        if smallest >= self.crowd_ratio * side:
+            return None
+        want = scale / self.crowd_ratio
+        finer = [r.scale for r in self.table.rows if r.scale > scale * (1 + SCALE_RTOL)]
+        if not finer:
+            return None
+        return next((f for f in finer if f >= want * (1 - SCALE_RTOL)), finer[-1]), smallest
+
+    def _crowd_shift(self, strong) -> np.ndarray:
+        """
+        Return the log odds that raise the prior to the crowd's own density (0 where it is more).
+
+        In a crowd the prior's expected number of faces (under one, from ``absent.prior``) is
+        contradicted by the faces found: the per-cell prior becomes the fraction of cells
+        holding a strong box's centre (an empirical Bayes estimate), so that a strong box
+        decides its cell and a cell without any box is decided empty without a finer look.
+        """
+        boxes = np.asarray(strong, dtype=float).reshape(-1, 4)
+        width, height = self.image_px
+        k = len(np.unique(cells_of_points(boxes[:, :2] + boxes[:, 2:] / 2, (height, width),
+                                          self.grid)))
+        n = self.grid.n_cells
+        if not k or k >= n:
+            return np.zeros(n)
+        return np.maximum(0.0, math.log(k / (n - k)) - self.prior)
+
     def scan(self):
         t0 = time.perf_counter()
         width, height = self.image_px
-        strong, weak, pixels = self._look((0, 0, width, height), self.scale)
-        term = coarse_evidence(self.table.row(self.scale), self.grid, self.image_px, pixels,
-                               strong, weak, self.prior)
-        for row in (r for r in self.table.rows if r.scale > self.scale):
+        whole = (0, 0, width, height)
+        strong, weak, pixels = self._look(whole, self.scale)
+        scale, side = self.scale, self.min_face
+        while (step := self._finer_for_smaller_faces(strong, scale, side)) is not None:
+            finer, side = step
+            if pixels + round(width * finer) * round(height * finer) > self.budget:
+                break
+            # the whole image again at the finer scale: its boxes and evidence replace the
+            # coarser call's, whose strong boxes stay strong
+            found, weak, spent = self._look(whole, finer)
+            strong = np.concatenate([strong, found])
+            pixels, scale = pixels + spent, finer
+        shift = self._crowd_shift(strong) if scale != self.scale else 0.0
+        term = coarse_evidence(self.table.row(scale), self.grid, self.image_px, pixels,
+                               strong, weak, self.prior + shift) + shift
+        for row in (r for r in self.table.rows if r.scale > scale):
             undecided = np.abs(self.prior + term) < self.threshold
             if not undecided.any():
                 break
@@ -675,7 +736,7 @@ class _Coarse(_Recorder):
                 strong, weak, spent = self._look(rect, row.scale)
                 pixels += spent
                 fine = coarse_evidence(row, self.grid, self.image_px, spent, strong, weak,
-                                       self.prior)
+                                       self.prior + shift) + shift
                 inner = np.zeros(self.grid.shape, dtype=bool)
                 inner[_grown(box, 1, self.grid.shape)] = True
                 term = np.where(inner.reshape(-1), fine, term)
@@ -748,7 +809,7 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
                 empty_by_evidence: bool = EMPTY_BY_EVIDENCE,
                 scales: ScaleTable | None = None,
                 min_face: float | None = None, look_upscale: float = LOOK_UPSCALE,
-                look_score: float = LOOK_SCORE) -> ImageSearch:
+                look_score: float = LOOK_SCORE, crowd_ratio: float = CROWD_RATIO) -> ImageSearch:
     """
     Search one image for every face at once: the many-target belief (``search.targets: many``).
 
@@ -772,7 +833,9 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     is strong only if the crop round it, resized so that the box is ``LOOK_SIDE_PX`` (at most
     ``look_upscale`` times and never below the scale of the call that found the box, the
     table's finest: :func:`look_factor`, 1 to 2x at full resolution; 0: no look), keeps a box
-    of ``look_score``; else it is weak.
+    of ``look_score``; else it is weak. A face found smaller than ``crowd_ratio`` times
+    ``min_face`` (a crowd) sends the whole image to a finer call, and the faces found set the
+    prior's density (:data:`CROWD_RATIO`; 0: neither).
 
     Raises
     ------
@@ -794,7 +857,7 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
                                cell_prior(fovea.grid.n_cells, settings.absent_prior))
         sensor = _Coarse(fovea, scales, image_px, prior, settings.confidence,
                          math.inf if pixel_budget is None else pixel_budget, min_face,
-                         look_upscale, look_score)
+                         look_upscale, look_score, crowd_ratio)
     outcome = run_search(session, sensor, image, pixel_budget=pixel_budget)
     boxes = np.concatenate(sensor.boxes) if sensor.boxes else np.zeros((0, 4))
     scores = np.concatenate(sensor.scores) if sensor.scores else np.zeros(0)
