@@ -141,3 +141,18 @@ def test_bad_walk_arguments_are_one_line(args, message, cli_here):
     err = run.stderr
     assert run.returncode != 0 and 'Traceback' not in err
     assert message in err.strip().splitlines()[-1]
+
+
+def test_a_paired_difference_of_fractions_is_cut_to_minus_one_one():
+    from ipomdp_gaze.drivers.tracking import normal_interval
+    mean, low, high = normal_interval(np.array([1.0, -0.03]), 1.0)       # +-1.43 wide
+    assert mean == pytest.approx(0.485) and high == 1.0 and low == pytest.approx(0.485 - 1.0094)
+    assert normal_interval(np.array([1.0, -1.0]), 1.0)[1:] == [-1.0, 1.0]
+    assert normal_interval(np.array([3.0, -1.0]))[1] < -1.0        # seconds: no bound
+
+
+def test_walk_options_without_motion_walk_are_refused(cli_here):
+    for flag in ('--speed-deg-s', '--walk-duration-s'):
+        result = cli_here('evaluate', '--scenes', 'pan-tilt', flag, '5', '--episodes', '1')
+        assert result.returncode == 2
+        assert result.stderr.strip().endswith(f'{flag} goes with --motion walk')

@@ -36,6 +36,7 @@ from ipomdp_gaze.simulation.executor import InlineExecutor
 from ipomdp_gaze.simulation.simulate import draw_present, draw_targets
 from ipomdp_gaze.vision.pan_tilt import parse_faces
 from ipomdp_gaze.vision.walks import DURATION_S as WALK_DURATION_S
+from ipomdp_gaze.vision.walks import SPEED_DEG_S as WALK_SPEED_DEG_S
 import numpy as np
 
 from .common import add_task_args, nonneg_int, positive_int, task_from_args
@@ -80,9 +81,10 @@ def add_parser(sub):
                    help='--scenes pan-tilt: still faces (default) or faces that walk (the '
                         'tracker of config/faces_camera_tracking.yaml against '
                         'track-last-detection on the same walks, docs/design.md section 12)')
-    p.add_argument('--speed-deg-s', type=float, default=5.0, metavar='V',
-                   help='--motion walk: walking speed in degrees per second, 0-20 (default 5)')
-    p.add_argument('--walk-duration-s', type=float, default=WALK_DURATION_S, metavar='S',
+    p.add_argument('--speed-deg-s', type=float, default=None, metavar='V',
+                   help='--motion walk: walking speed in degrees per second, 0-20 (default '
+                        f'{WALK_SPEED_DEG_S:g})')
+    p.add_argument('--walk-duration-s', type=float, default=None, metavar='S',
                    help=f'--motion walk: seconds per walk (default {WALK_DURATION_S:g})')
     p.add_argument('--scene-model', default='', metavar='FILE',
                    help='--scenes pan-tilt: another pan/tilt observation file (its camera is the '
@@ -341,7 +343,9 @@ def run_walks(args) -> int:
     if args.policy or args.policy_file or args.empty_scenes:
         raise ValueError('--motion walk takes the tracking configuration: no --policy, '
                          '--policy-file or --empty-scenes')
-    spec = walk_spec(args.speed_deg_s, args.split, args.seed, args.walk_duration_s,
+    spec = walk_spec(WALK_SPEED_DEG_S if args.speed_deg_s is None else args.speed_deg_s,
+                     args.split, args.seed,
+                     WALK_DURATION_S if args.walk_duration_s is None else args.walk_duration_s,
                      tuple(args.compare) or ('track-last-detection',),
                      model=args.scene_model or None)
     changes = {key: value for key, value in (('confidence', args.confidence),
@@ -406,6 +410,10 @@ def run(args) -> int:
         if args.scenes != 'pan-tilt' or faces != (1, 1):
             raise ValueError('--motion walk is for --scenes pan-tilt with one face')
         return run_walks(args)
+    for flag, value in (('--speed-deg-s', args.speed_deg_s),
+                        ('--walk-duration-s', args.walk_duration_s)):
+        if value is not None:
+            raise ValueError(f'{flag} goes with --motion walk')
     if args.scenes:
         return run_scenes(args)
     args.episodes = args.episodes or 20000

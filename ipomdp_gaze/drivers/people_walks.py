@@ -228,5 +228,6 @@ def summarise_people(results: list, reference: list | None = None) -> dict:
         s[key] = float(np.nanmean(values)) if values.size else math.nan
         if reference is not None and reference is not results and len(results) > 1:
             d = values - np.array([getattr(r, key) for r in reference], dtype=float)
-            s[f'{key}_minus_reference'] = normal_interval(d[~np.isnan(d)])
+            bound = 1.0 if key in ('in_view', 'tracked') else math.inf     # fractions
+            s[f'{key}_minus_reference'] = normal_interval(d[~np.isnan(d)], bound)
     return s

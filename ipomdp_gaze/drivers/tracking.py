@@ -386,16 +386,19 @@ def evaluate_walks(spec: WalkSpec, episodes: int, executor=None, progress=None) 
 
 def format_walks(name: str, s: dict, reference: str = '') -> list[str]:
     """Return a searcher's summary lines (and its paired differences to ``reference``)."""
+    censored = ', a walk without a find charged to its end' if s['found'] < s['scenes'] else ''
+    returns = (f"reacquired {s['reacquired']} of {s['returns']} returns, "
+               f"{s['reacquire_s_mean']:.2f} s after the return" if s['returns']
+               else 'no walk left and came back')
     lines = [f"{name}: in view {s['in_view']:.3f}, in the centre cell {s['in_centre']:.3f} of "
              f"the frames in reach; first find {s['first_find_s_mean']:.2f} s (found in "
-             f"{s['found']} of {s['scenes']}); reacquired {s['reacquired']} of {s['returns']} "
-             f"returns, {s['reacquire_s_mean']:.2f} s after the return; lost "
+             f"{s['found']} of {s['scenes']}{censored}); {returns}; lost "
              f"{s['lost_mean']:.2f} times per walk"]
     for key in ('in_view', 'in_centre', 'reacquire_s'):
         diff = s.get(f'{key}_minus_reference')
         if diff:
-            lines.append(f'  {key} minus {reference} [paired 95%]: {diff[0]:+.3f} '
-                         f'[{diff[1]:+.3f}, {diff[2]:+.3f}]')
+            lines.append(f'  {key} minus {reference} [paired 95%, {diff[3]} walks]: '
+                         f'{diff[0]:+.3f} [{diff[1]:+.3f}, {diff[2]:+.3f}]')
     return lines
 
 
@@ -431,14 +434,21 @@ def summarise_walks(results: list, reference: list | None = None) -> dict:
                           if a.to_dict()[key] is not None and b.to_dict()[key] is not None])
             d = d[~np.isnan(d)]
             if d.size > 1:
-                s[f'{key}_minus_reference'] = normal_interval(d)
+                # a difference of two fractions lies in [-1, 1]; of seconds, anywhere
+                bound = 1.0 if key != 'reacquire_s' else math.inf
+                s[f'{key}_minus_reference'] = normal_interval(d, bound) + [int(d.size)]
     return s
 
 
-def normal_interval(d: np.ndarray) -> list:
-    """Return ``[mean, low, high]``: the mean of paired differences and its 95% normal interval."""
+def normal_interval(d: np.ndarray, bound: float = math.inf) -> list:
+    """
+    Return ``[mean, low, high]``: the mean of paired differences and its 95% normal interval.
+
+    The interval is cut to ``[-bound, bound]``, where the differences can lie (1 for fractions).
+    """
     half = 1.96 * d.std(ddof=1) / math.sqrt(d.size) if d.size > 1 else math.nan
-    return [float(d.mean()), float(d.mean() - half), float(d.mean() + half)]
+    return [float(d.mean()), float(max(d.mean() - half, -bound)),
+            float(min(d.mean() + half, bound))]
 
 
 def with_motion(settings: SearchSettings, sigma_cells: float, jump_prob: float = 0.0):

@@ -42,6 +42,8 @@ AWAY_S = (2.0, 4.0)
 LEAVE_AT = (0.15, 0.3)
 OUTSIDE_SIDES = 1.0
 MAX_SPEED_DEG_S = 20.0
+# the walking speed of evaluate --motion walk when none is given
+SPEED_DEG_S = 5.0
 DURATION_S = 30.0
 _STREAM_TAG = 0x3A1C
 _SPLIT_CODE = {'train': 0, 'test': 1}
@@ -218,7 +220,7 @@ class WalkSceneSet:
     """
 
     def __init__(self, split: str = 'test', geometry: SceneGeometry | None = None,
-                 seed: int = 0, speed_deg_s: float = 5.0, duration_s: float = DURATION_S,
+                 seed: int = 0, speed_deg_s: float = SPEED_DEG_S, duration_s: float = DURATION_S,
                  leave: bool = True, color: str = 'rgb', faces: int = 1):
         if isinstance(faces, bool) or int(faces) != faces or not 1 <= int(faces) <= 4:
             raise ValueError(f'faces must be an integer from 1 to 4, got {faces!r}')
