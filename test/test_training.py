@@ -313,3 +313,10 @@ def test_a_run_shorter_than_eval_every_still_ends_with_an_evaluation(tmp_path, c
     assert rows[0]['fixations_to_90'] is not None and rows[0]['episodes'] == 3 * 150
     trainer = Trainer(Grid(3, 3), FPOC, TrainConfig(eval_every=2, eval_episodes=50, seed=1))
     assert [r['epoch'] for r in trainer.run(5)] == [2, 4, 5]
+
+
+def test_zero_epochs_without_an_initial_kernel_is_refused(tmp_path, capsys):
+    out = tmp_path / 'k.yaml'
+    assert main(['train', '--grid', '5x5', '--epochs', '0', '--out', str(out), '--quiet']) == 2
+    assert not out.exists()
+    assert '--epochs 0 trains nothing' in capsys.readouterr().err

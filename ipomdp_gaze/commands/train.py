@@ -175,6 +175,9 @@ def run(args) -> int:
                     'reward_scale': REWARD_SCALE, 'baseline': True}
         defaults.update({k: v for k, v in overrides.items() if v is not None})
         config = TrainConfig(**defaults)
+        if args.epochs == 0 and args.init_elm is None:
+            raise ValueError('--epochs 0 trains nothing: give a positive count (or --init-elm '
+                             'SCALE to write the initial ELM kernel)')
         params, init = None, 'zeros'
         if args.init_elm is not None:
             if config.family != 'conv':
