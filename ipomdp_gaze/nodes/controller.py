@@ -353,7 +353,9 @@ class GazeControllerNode(QuietPublishers, Node):
         if v['absent.prior'] != ov['absent.prior'] or \
                 v['search.targets'] != ov['search.targets'] or switched:
             forget = switched or (was_following and not core.follows_people)
-            return f'policy {cfg.policy_label}; {self._restart(forget=forget)}'
+            # a new search.targets has started the core's new search already (configure)
+            begun = v['search.targets'] != ov['search.targets']
+            return f'policy {cfg.policy_label}; {self._restart(forget=forget, begun=begun)}'
         if self._dwell_timer is not None and \
                 (v['room.dwell_s'], v['room.recheck_period_s']) != \
                 (ov['room.dwell_s'], ov['room.recheck_period_s']):
@@ -706,13 +708,14 @@ class GazeControllerNode(QuietPublishers, Node):
             return
         self.get_logger().info(f're-check of the room: {self._restart(recheck=True)}')
 
-    def _restart(self, recheck: bool = False, forget: bool = False) -> str:
+    def _restart(self, recheck: bool = False, forget: bool = False, begun: bool = False) -> str:
         """
         Start a new search (``~/reset``, a re-check); return what happened.
 
         Many targets: a re-check keeps the people known (to tell who is new) and their list on
         ``~/targets`` until it ends; any other new search forgets them and publishes nobody
         (``forget``: also the people a moving search followed, when motion was just switched).
+        ``begun``: the core has started the new search already (one search id per search).
         """
         self._stop_room_timers()
         if recheck:
@@ -722,7 +725,7 @@ class GazeControllerNode(QuietPublishers, Node):
             if self._targets_pub is not None:
                 self._publish_people()
         self._new_people = 0
-        cell = self.core.reset(self._now_s())
+        cell = self.core.reset(self._now_s(), new_search=not begun)
         self._publish_belief()
         row, col = self._config.grid.cell(cell)
         if self.core.enabled:

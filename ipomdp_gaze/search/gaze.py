@@ -361,14 +361,15 @@ class GazeController:
                 'rejected': self.rejected, 'skipped': self.skipped}
 
     # -- events ----------------------------------------------------------------------------
-    def reset(self, now_s: float) -> int:
+    def reset(self, now_s: float, new_search: bool = True) -> int:
         """
         Start a new search from the prior at the start cell; return it (sent at ``now_s``).
 
         The prior is uniform over the cells, with ``absent_prior`` on the absent hypothesis.
+        ``new_search`` False restarts the search just begun (:meth:`configure`) under its id.
         """
         self.session.reset()
-        self.search_id += 1
+        self.search_id += bool(new_search)
         if not self.wants_scan:
             self.session.start()
         self.found = self.absent = self.gave_up = self.lost = None
