@@ -264,3 +264,47 @@ def test_ipomdp_gaze_record_records_another_run_until_sigint(ros_env, tmp_path, 
     meta = yaml.safe_load((tmp_path / 'bag' / 'metadata.yaml').read_text())
     custom = meta['rosbag2_bagfile_information']['custom_data']
     assert 'ipomdp_gaze/version' in custom
+
+
+@pytest.mark.parametrize('args, message', [
+    (['--policy', 'bogus'], "ipomdp-gaze replay: error: --policy: unknown policy 'bogus'"),
+    (['--confidence', '2'], 'ipomdp-gaze replay: error: --confidence: '),
+    (['--policy-file', 'no-such-kernel.yaml'], 'ipomdp-gaze replay: error: --policy-file: '),
+    (['--new-search'], 'ipomdp-gaze replay: error: a new search needs a recording of a fixed '
+                       'camera (the detector in fovea mode): this one has no parameters of '
+                       'foveal_detector and no camera image'),
+])
+def test_a_bad_option_is_named_and_the_recording_blamed_only_for_itself(simulated, cli_here,
+                                                                        args, message):
+    """QA: ``--policy bogus`` said 'the recording: ...'; --new-search spoke of another bag."""
+    tmp, _ = simulated
+    run = cli_here('replay', tmp / 'bag', *args)
+    assert run.returncode == 2, run.stdout + run.stderr
+    last = run.stderr.strip().splitlines()[-1]
+    assert last.startswith(message), last
+    assert 'the recording' not in last and 'a camera on the head' not in last
+
+
+def test_the_recorder_records_every_topic_of_the_controller_in_many_target_mode(context):
+    """QA: lost, reacquired, room_done, ~/targets and ~/target_cells were not recordable."""
+    from ipomdp_gaze.files.yaml_files import yaml_parameters
+    from ipomdp_gaze.nodes.controller import GazeControllerNode
+    from ipomdp_gaze.nodes.recorder import TOPICS
+    from rclpy.parameter import Parameter
+    from std_msgs.msg import Float64MultiArray
+    values = {}
+    for name in ('faces_camera_controller.yaml', 'faces_camera_tracking.yaml',
+                 'faces_camera_people.yaml'):
+        values.update(yaml_parameters(REPO / 'config' / name, 'gaze_controller'))
+    node = GazeControllerNode(context=context, parameter_overrides=[
+        Parameter(k, value=v) for k, v in values.items()])
+    try:
+        published = {p.topic_name: p.msg_type for p in node.publishers}
+    finally:
+        node.destroy_node()
+    recorded = {'/' + t.lstrip('/'): msg_type for t, (msg_type, _, _) in TOPICS.items()}
+    wanted = {t: m for t, m in published.items() if t not in ('/belief_image', '/rosout')}
+    assert {'/lost', '/reacquired', '/room_done', '/gaze_controller/targets',
+            '/gaze_controller/target_cells', '/parameter_events'} <= set(wanted)
+    assert {t: recorded.get(t) for t in wanted} == wanted
+    assert TOPICS['walk_truth'][0] is Float64MultiArray          # the scene camera's walk

@@ -37,8 +37,9 @@ def add_parser(sub):
         'replay', help='re-run a recorded search through the controller; print differences',
         description='Read a bag written by `ipomdp-gaze record` or `demo --record`, rebuild '
                     'the controller from the recorded parameters (or with the options below '
-                    'changed), offer it the recorded frames as the node did and print where '
-                    'its fixations and decision differ from the recording. The frames were '
+                    'changed; parameters set while recording are set at their time), offer it '
+                    'the recorded frames as the node did and print where its fixations, events '
+                    'and last decision differ from the recording. The frames were '
                     'taken where the recorded search looked, so the replay stops at the first '
                     'fixation that differs.')
     p.add_argument('path', type=Path, metavar='PATH', help='the bag directory')
@@ -96,7 +97,7 @@ def describe_written(path: Path) -> str:
 
 
 def run_replay(args) -> int:
-    from ipomdp_gaze.drivers.replay import describe_size, replay
+    from ipomdp_gaze.drivers.replay import describe_settings, describe_size, replay
     from ipomdp_gaze.files.bag import read_bag
     if not args.path.is_dir():
         raise ValueError(f'{args.path} is not a bag directory')
@@ -106,9 +107,7 @@ def run_replay(args) -> int:
     overrides = {'observation': args.observation, 'policy': args.policy,
                  'policy_file': args.policy_file, 'confidence': args.confidence,
                  'max_fixations': args.max_fixations}
-    changed = [f'{k}={v}' for k, v in overrides.items() if v is not None]
-    print('settings: ' + ('recorded' if not changed else
-                          'recorded, with ' + ', '.join(changed)))
+    print(describe_settings(bag, overrides, args.new_search))
     if args.new_search:
         from ipomdp_gaze.drivers.replay import new_search
         new_search(bag, overrides)

@@ -4,14 +4,17 @@
 Replay a recorded search: its frames through the controller's core, with its settings or others.
 
 A bag written by the ``recorder`` node (:mod:`ipomdp_gaze.files.bag`) holds the frames of evidence
-the
-controller was offered (``evidence_image``, stamped, or ``evidence``), the targets it sent
-(``pan_tilt``, one stamp per target), its events (``found``, ``absent``, ``gave_up``) and its
-parameters. :func:`replay` builds a :class:`ipomdp_gaze.search.gaze.GazeController` from those
-parameters, with any of them replaced (``overrides``: another observation model, policy,
-confidence ...), drives it with ``reset`` and ``offer(evidence, stamp_s, now_s)`` exactly as the
-node did (``now_s``: when the node sent the next target) and compares each decision with the
-recording: every next fixation and the final event.
+the controller was offered (``evidence_image``, stamped, or ``evidence``), the targets it sent
+(``pan_tilt``, one stamp per target), its events (``found``, ``absent``, ``gave_up``, ``lost``,
+``reacquired``; a person's with a ``person`` value), its parameters at the start and the
+changes of them (``/parameter_events``). :func:`replay` builds a
+:class:`ipomdp_gaze.search.gaze.GazeController` from those parameters as they were when the
+replayed search began, with any of them replaced (``overrides``: another observation model,
+policy, confidence ...), sets each later change at its recorded time as the node does, drives
+it with ``reset`` and ``offer(evidence, stamp_s, now_s)`` exactly as the node did (``now_s``:
+when the node sent the next target) and compares it with the recording: every next fixation,
+the events in order and the last decision (a tracker may find, lose and decide absent in one
+search), or, following many moving people, each person's events.
 
 The frames were taken where the *recorded* search looked. A replay that chooses another fixation
 would need a frame from a view nobody took, so it stops at the first fixation that differs and
@@ -32,7 +35,7 @@ from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.policies.registry import build_policy
 from ipomdp_gaze.search import answer
-from ipomdp_gaze.search.controller_config import build_config
+from ipomdp_gaze.search.controller_config import build_config, ControllerConfig
 from ipomdp_gaze.search.gaze import GazeController
 import numpy as np
 
@@ -52,6 +55,16 @@ OVERRIDES = {'observation': 'observation.file', 'policy': 'policy.name',
              'policy_file': 'policy.file', 'confidence': 'confidence',
              'max_fixations': 'search.max_fixations', 'repeat_weight': 'search.repeat_weight',
              'inhibit_return': 'search.inhibit_return'}
+# The command-line option of each override, which a refusal of its value names.
+OPTIONS = {key: '--' + key.replace('_', '-') for key in OVERRIDES}
+# The controller's event topics, in the order a frame that fires several fires them.
+EVENTS = ('found', 'reacquired', 'lost', 'absent', 'gave_up')
+# The events that decide (``lost`` only ends a ``found``).
+DECISIONS = ('found', 'reacquired', 'absent', 'gave_up')
+# rcl_interfaces/msg/ParameterValue: the field of each type (0, not set, has none).
+VALUE_FIELDS = {1: 'bool_value', 2: 'integer_value', 3: 'double_value', 4: 'string_value',
+                5: 'byte_array_value', 6: 'bool_array_value', 7: 'integer_array_value',
+                8: 'double_array_value', 9: 'string_array_value'}
 
 
 @dataclass
@@ -85,6 +98,60 @@ class Decision:
         return (self.kind, self.cell, self.fixations) == (other.kind, other.cell, other.fixations)
 
 
+@dataclass(frozen=True)
+class Event:
+    """
+    One event of the controller: ``kind`` (:data:`EVENTS`), cell, fixations, probability.
+
+    ``person`` is the person's number in a moving many-target search, 0 for the search's own.
+    """
+
+    kind: str
+    cell: int | None
+    fixations: int
+    probability: float | None = None
+    person: int = 0
+    forced_by: str = ''
+
+    @property
+    def key(self) -> tuple:
+        """Return what two events must share to be the same: kind, person, cell, fixations."""
+        return self.kind, self.person, self.cell, self.fixations
+
+    def decision(self) -> Decision:
+        """Return it as a :class:`Decision`."""
+        return Decision(self.kind, self.cell, self.probability, self.fixations, self.forced_by)
+
+    def describe(self, grid: Grid) -> str:
+        """Say it briefly: ``person 2 lost at (3, 4) after 17 fixations``."""
+        who = f'person {self.person} ' if self.person else ''
+        where = f' at {tuple(int(v) for v in grid.cell(self.cell))}' \
+            if self.cell is not None else ''
+        return f'{who}{self.kind}{where} after {self.fixations} fixations'
+
+
+def in_firing_order(events: list) -> list:
+    """
+    Return ``events`` (in arrival order) with those of one frame in the order a frame fires them.
+
+    Events of one frame share their fixations; the recorder takes each topic in its own order.
+    """
+    out, group = [], []
+    for event in list(events) + [None]:
+        if group and (event is None or event.fixations != group[0].fixations):
+            out += sorted(group, key=lambda e: (EVENTS.index(e.kind), e.person, e.cell or 0))
+            group = []
+        if event is not None:
+            group.append(event)
+    return out
+
+
+def last_decision(events: list) -> Decision:
+    """Return the last of ``events`` that decides (:data:`DECISIONS`), or no decision."""
+    decided = [e for e in events if e.kind in DECISIONS]
+    return decided[-1].decision() if decided else Decision()
+
+
 @dataclass
 class ReplayResult:
     """What the replay did, next to what the recording says."""
@@ -99,11 +166,26 @@ class ReplayResult:
     first_difference: int | None = None
     stopped_early: bool = False
     lines: list = field(default_factory=list)
+    recorded_events: list = field(default_factory=list)
+    replay_events: list = field(default_factory=list)
+    recorded_people: list = field(default_factory=list)
+    replay_people: list = field(default_factory=list)
+    changes_applied: int = 0
 
     @property
     def same(self) -> bool:
-        """Whether every compared fixation and the final decision agree."""
-        return self.first_difference is None and self.recorded.same(self.replayed)
+        """Whether every compared fixation, the events, the last decision and the people agree."""
+        return (self.first_difference is None and self.recorded.same(self.replayed)
+                and first_other(self.recorded_events, self.replay_events) is None
+                and first_other(self.recorded_people, self.replay_people) is None)
+
+
+def first_other(recorded: list, replayed: list) -> int | None:
+    """Return the index of the first event that differs between two lists (None: the same)."""
+    for i in range(max(len(recorded), len(replayed))):
+        if i >= len(recorded) or i >= len(replayed) or recorded[i].key != replayed[i].key:
+            return i
+    return None
 
 
 def settings_from(parameters: dict, overrides: dict | None = None) -> dict:
@@ -124,27 +206,136 @@ def settings_from(parameters: dict, overrides: dict | None = None) -> dict:
     return values
 
 
-def build_controller(values: dict) -> tuple[GazeController, PanTiltMap]:
+def _with_defaults(values: dict) -> dict:
+    return {'policy.kernel': None, 'policy.file': '', 'policy.action': 'argmax', **values}
+
+
+def _config(values: dict, blame: str) -> ControllerConfig:
+    """Build the node's configuration; a refusal is said as ``<blame>: <why>``."""
+    try:
+        return build_config(_with_defaults(values), build_policy)
+    except ValueError as exc:
+        raise ValueError(f'{blame}: {exc}') from None
+
+
+def checked_config(parameters: dict, overrides: dict | None = None) -> ControllerConfig:
     """
-    Build the core and the head mapping from the ``gaze_controller`` parameters, as the node does.
+    Build the configuration from recorded ``parameters`` with ``overrides``, as the node does.
 
     The node's own builder (:func:`ipomdp_gaze.search.controller_config.build_config`), so a
-    recording
-    replays with every check the node makes (a count model's grid and pan/tilt spacing among
-    them).
+    recording replays with every check the node makes (a count model's grid and pan/tilt
+    spacing among them). The recorded parameters are checked alone first, then with each
+    override in turn, so a refusal blames what it comes from: ``the recording: ...`` or the
+    option (``--policy: unknown policy 'bogus'``).
 
     Raises
     ------
     ValueError
-        If a parameter is missing or refused (the message names it).
+        If a parameter is missing or refused (the message names it and who gave it).
 
     """
-    values = {'policy.kernel': None, 'policy.file': '', 'policy.action': 'argmax', **values}
-    try:
-        config = build_config(values, build_policy)
-    except ValueError as exc:
-        raise ValueError(f'the recording: {exc}') from None
+    config = _config(settings_from(parameters), 'the recording')
+    given = {}
+    for key, value in (overrides or {}).items():
+        if value is None:
+            continue
+        given[key] = value
+        config = _config(settings_from(parameters, given), OPTIONS[key])
+    return config
+
+
+def build_controller(values: dict) -> tuple[GazeController, PanTiltMap]:
+    """Build the core and the head mapping from the ``gaze_controller`` parameters ``values``."""
+    config = _config(values, 'the recording')
     return config.controller(), config.head
+
+
+def _parameter_value(value):
+    """Return an ``rcl_interfaces/ParameterValue`` as Python (None when not set)."""
+    name = VALUE_FIELDS.get(int(value.type))
+    if name is None:
+        return None
+    got = getattr(value, name)
+    if name == 'string_array_value':
+        return [str(v) for v in got]
+    return np.asarray(got).tolist() if int(value.type) >= 5 else got
+
+
+@dataclass(frozen=True)
+class ParameterChange:
+    """Parameters of a node set while recording: when (bag time, ns), new and old values."""
+
+    time_ns: int
+    values: dict
+    before: dict
+
+
+def parameter_changes(bag, node: str = CONTROLLER) -> list:
+    """
+    Return the :class:`ParameterChange` of ``node`` recorded on ``/parameter_events``.
+
+    Only those after the recorder asked for the parameters it keeps in the metadata (a value
+    set again to what it was is no change), so folding them into those gives the parameters
+    at any time of the recording.
+    """
+    since = int(bag.custom_data.get(f'ipomdp_gaze/parameters_time/{node}') or 0)
+    values = dict(bag.parameters(node))
+    out = []
+    for m in bag.topic('/parameter_events'):
+        if m.time_ns < since or str(m.msg.node).rstrip('/').rsplit('/', 1)[-1] != node:
+            continue
+        new = {}
+        for p in list(m.msg.new_parameters) + list(m.msg.changed_parameters):
+            value = _parameter_value(p.value)
+            if value is not None and (p.name not in values or values[p.name] != value):
+                new[p.name] = value
+        if new:
+            out.append(ParameterChange(m.time_ns, new, {k: values.get(k) for k in new}))
+            values.update(new)
+    return out
+
+
+def values_at(parameters: dict, changes: list, time_ns: int | None) -> dict:
+    """Return ``parameters`` with the ``changes`` up to ``time_ns`` set (None: all of them)."""
+    values = dict(parameters)
+    for change in changes:
+        if time_ns is None or change.time_ns <= time_ns:
+            values.update(change.values)
+    return values
+
+
+def _short(value) -> str:
+    return f'[{len(value)} values]' if isinstance(value, list) and len(value) > 4 else \
+        str(value)
+
+
+def describe_settings(bag, overrides: dict | None = None, new_search: bool = False) -> str:
+    """
+    Say in one line which settings a replay uses: the recorded, the options, the changes.
+
+    A controller whose parameters were set while recording (``/parameter_events``) is not
+    replayed with the recorded start values alone: the line names each change and its time
+    (seconds into the recording), which the replay sets at that time (``new_search``: the
+    new search on the last image uses the last values).
+    """
+    given = {k: v for k, v in (overrides or {}).items() if v is not None}
+    text = 'settings: recorded' + (', with ' + ', '.join(f'{k}={v}' for k, v in given.items())
+                                   if given else '')
+    changes = parameter_changes(bag)
+    if not changes:
+        return text
+    start = bag.messages[0].time_ns if bag.messages else 0
+    kept = {OVERRIDES[k] for k in given}
+    at = {}                 # changes said at the same tenth of a second go together
+    for c in changes:
+        at.setdefault(f'{(c.time_ns - start) * 1e-9:.1f}', []).extend(
+            f'{k} {_short(c.before[k])} -> {_short(v)}' for k, v in sorted(c.values.items()))
+    said = '; '.join(f"at {t} s {', '.join(parts)}" for t, parts in at.items())
+    ignored = sorted(kept & {k for c in changes for k in c.values})
+    how = 'the new search uses the last values' if new_search else \
+        'each applied by the replay at its time'
+    return (f'{text}; {CONTROLLER} parameters set while recording, {how}: {said}' +
+            (f" (not {', '.join(ignored)}: the options' values hold)" if ignored else ''))
 
 
 def _seconds(stamp) -> float:
@@ -204,8 +395,16 @@ def _targets(bag, head: PanTiltMap) -> list:
 
 
 def last_search(bag, head: PanTiltMap, start: int):
+    """Return the bag from the controller's last reset on (:func:`search_start`), if any."""
+    cut = search_start(bag, head, start)
+    if cut is None:
+        return bag
+    return dataclasses.replace(bag, messages=[m for m in bag.messages if m.time_ns >= cut])
+
+
+def search_start(bag, head: PanTiltMap, start: int) -> int | None:
     """
-    Return the bag from the controller's last reset on (its uniform ``belief``), if any.
+    Return when (bag time, ns) the controller's last reset (its uniform ``belief``) began.
 
     A bag may hold several searches (``~/reset`` starts a new one; the demo resets once the
     recorder hears every node): a replay follows the last one. The recorder takes the topics
@@ -218,7 +417,7 @@ def last_search(bag, head: PanTiltMap, start: int):
     resets = [m.time_ns for m in bag.topic('belief')
               if np.size(m.msg.data) == grid.n_cells and np.ptp(np.asarray(m.msg.data)) == 0]
     if not resets:
-        return bag
+        return None
     cut = resets[-1]
     sent = [m for m in bag.topic('pan_tilt')
             if cut - RESET_WINDOW_S * 1e9 <= _seconds(m.msg.header.stamp) * 1e9
@@ -227,51 +426,124 @@ def last_search(bag, head: PanTiltMap, start: int):
         first = max(sent, key=lambda m: _seconds(m.msg.header.stamp))
         stamp = first.msg.header.stamp
         cut = min(cut, min(m.time_ns for m in sent if m.msg.header.stamp == stamp))
-    return dataclasses.replace(bag, messages=[m for m in bag.messages if m.time_ns >= cut])
+    return cut
 
 
-def _recorded_decision(bag) -> Decision:
-    for kind in ('found', 'absent', 'gave_up'):
-        events = bag.topic(kind)
-        if events:                  # the last: one of an earlier search may arrive late
-            values = {kv.key: kv.value for kv in events[-1].msg.values}
-            cell = int(values['cell']) if 'cell' in values else None
-            p = float(values['probability']) if 'probability' in values else None
-            forced = answer.reason_of(values.get('ended', ''))
-            return Decision(kind, cell, p, int(values['fixations']), forced)
-    return Decision()
+def recorded_events(bag) -> tuple[list, list]:
+    """
+    Return the recorded ``(search events, people's events)``, each in firing order.
+
+    A person's event (a moving many-target search) carries its ``person`` number; the others
+    are the search's own. Arrival order (an event of an earlier search may arrive late, after
+    the cut of :func:`last_search`, and must not count as this one's last).
+    """
+    timed = []
+    for kind in EVENTS:
+        for m in bag.topic(kind):
+            values = {kv.key: kv.value for kv in m.msg.values}
+            timed.append((m.time_ns, Event(
+                kind, int(values['cell']) if 'cell' in values else None,
+                int(values['fixations']),
+                float(values['probability']) if 'probability' in values else None,
+                int(values.get('person', 0)), answer.reason_of(values.get('ended', '')))))
+    events = [e for _, e in sorted(timed, key=lambda te: te[0])]
+    return (in_firing_order([e for e in events if not e.person]),
+            in_firing_order([e for e in events if e.person]))
+
+
+def _step_events(step) -> list:
+    """Return the events of an applied frame, in firing order (:data:`EVENTS`)."""
+    out = []
+    for kind in EVENTS:
+        event = getattr(step, kind, None)
+        if event is not None:
+            out.append(Event(kind, getattr(event, 'cell', None), event.fixations,
+                             getattr(event, 'probability', None), 0,
+                             getattr(event, 'forced_by', '')))
+    return out
+
+
+def _apply_change(core, config: ControllerConfig, parameters: dict, overrides) -> tuple:
+    """
+    Make the core follow changed parameters as the node does (``_apply_config``).
+
+    The node's builder with what changed and the configuration before, then the observation,
+    the policy, the settings, the stamp tolerance and the seed.
+    """
+    values = _with_defaults(settings_from(parameters, overrides))
+    changed = {k for k, v in values.items() if config.values.get(k) != v}
+    new = build_config(values, build_policy, changed, config)
+    core.set_observation(new.observation)
+    core.set_policy(new.policy)
+    core.configure(new.settings, values['settle_time_s'])
+    if 'stamp_tolerance_s' in values:
+        core.stamp_tolerance_s = values['stamp_tolerance_s']
+    if values.get('seed') != config.values.get('seed'):
+        core.reseed(values['seed'])
+    return new
+
+
+def _events_text(events: list, grid: Grid) -> str:
+    return ', '.join(e.describe(grid) for e in events) or 'none'
+
+
+def _people_text(events: list) -> str:
+    if not events:
+        return "no person's event"
+    counts = ', '.join(f'{k} {sum(e.kind == k for e in events)}' for k in EVENTS
+                       if any(e.kind == k for e in events))
+    people = len({e.person for e in events})
+    return f'{len(events)} events of {people} people ({counts})'
 
 
 def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
     """
-    Re-run the recorded frames through the controller; print and return where decisions differ.
+    Re-run the recorded frames through the controller; print and return where it differs.
 
     ``bag`` is an :class:`ipomdp_gaze.files.bag.Bag`; ``overrides`` replace recorded settings
-    (:data:`OVERRIDES`).
+    (:data:`OVERRIDES`). Parameters the controller was given while recording
+    (:func:`parameter_changes`) are in force from their time: those before the replayed
+    search from its start, the later ones from the first frame that arrived after them.
     """
     recorded_values = bag.parameters(CONTROLLER)
     if not recorded_values:
         raise ValueError(f'{bag.path} has no parameters of {CONTROLLER} in its metadata: was '
                          f'it recorded by the recorder node with the controller running?')
-    core, head = build_controller(settings_from(recorded_values, overrides))
+    changes = parameter_changes(bag)
+    config = checked_config(values_at(recorded_values, changes, None), overrides)
+    head = config.head
+    cut = search_start(bag, head, config.controller().reset(0.0))
+    if cut is not None:
+        bag = dataclasses.replace(bag, messages=[m for m in bag.messages if m.time_ns >= cut])
+    else:                   # one search: it began with the recording
+        cut = bag.messages[0].time_ns if bag.messages else 0
+    parameters = values_at(recorded_values, changes, cut)
+    pending = [c for c in changes if c.time_ns > cut]
+    config = _config(settings_from(parameters, overrides), 'the recording')
+    core = config.controller()
     grid = core.grid
-    bag = last_search(bag, head, core.reset(0.0))
     frames = _frames(bag, grid)
     targets = _targets(bag, head)
     if not targets:
         raise ValueError(f'{bag.path} has no pan_tilt target of the controller')
-    recorded = _recorded_decision(bag)
+    recorded_events_, recorded_people = recorded_events(bag)
+    recorded = last_decision(recorded_events_)
     recorded_cells = [cell for _, cell in targets]
     core.reset(targets[0][0])
     replayed_cells = [core.fixation]
     result = ReplayResult(grid, recorded_cells, replayed_cells, recorded, Decision(),
-                          len(frames), 0)
+                          len(frames), 0, recorded_events=recorded_events_,
+                          recorded_people=recorded_people)
     say = result.lines.append
     if core.fixation != recorded_cells[0]:
         result.first_difference = 1
     for stamp, arrival, values, kind, offsets, groups in frames:
         if result.first_difference is not None or core.stopped:
             break
+        while pending and pending[0].time_ns * 1e-9 <= arrival:
+            parameters.update(pending.pop(0).values)
+            config = _apply_change(core, config, parameters, overrides)
+            result.changes_applied += 1
         k = core.fixations
         # The node sent its next target when it took the frame: the recorded send time.
         now = targets[k + 1][0] if k + 1 < len(targets) else arrival
@@ -282,32 +554,71 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
         if not step.applied:
             continue
         result.applied += 1
-        event = step.found or step.absent or step.gave_up
-        if event is not None:
-            kind = 'found' if step.found else 'absent' if step.absent else 'gave_up'
-            result.replayed = Decision(kind, getattr(event, 'cell', None),
-                                       getattr(event, 'probability', None), event.fixations,
-                                       getattr(event, 'forced_by', ''))
+        result.replay_events += _step_events(step)
+        result.replay_people += in_firing_order([
+            Event(e.kind, e.cell, e.fixations, e.probability, e.person)
+            for e in step.people])
         if step.fixation is None:
             continue
         replayed_cells.append(step.fixation)
         n = len(replayed_cells)
         if n <= len(recorded_cells) and step.fixation != recorded_cells[n - 1]:
             result.first_difference = n
+    result.replayed = last_decision(result.replay_events)
     if result.first_difference is not None:
         n = result.first_difference
         rec = grid.cell(recorded_cells[n - 1]) if n <= len(recorded_cells) else None
         say(f'fixation {n} differs: recorded {rec}, replay {grid.cell(replayed_cells[n - 1])}; '
             f'the recorded frames after it were taken elsewhere, so the replay stops here')
         result.stopped_early = True
-    say(f'recorded: {recorded.describe(grid)}')
-    say(f'replay:   {result.replayed.describe(grid)}')
-    if result.first_difference is None:
-        say('the same fixations and the same decision' if result.same else
-            'the same fixations, another decision')
+    if core.follows_people or recorded_people:
+        _say_people(result, say)
+    else:
+        _say_decisions(result, say)
     for line in result.lines:
         out(line)
     return result
+
+
+def _say_decisions(result: ReplayResult, say) -> None:
+    """Say the events (when a search had more than one) and the last decisions, compared."""
+    grid = result.grid
+    several = max(len(result.recorded_events), len(result.replay_events)) > 1
+    last = 'the last decision ' if several else ''
+    if several:
+        say(f'recorded events: {_events_text(result.recorded_events, grid)}')
+        say(f'replay events:   {_events_text(result.replay_events, grid)}')
+    say(f'recorded: {last}{result.recorded.describe(grid)}')
+    say(f'replay:   {last}{result.replayed.describe(grid)}')
+    if result.first_difference is not None:
+        return
+    if not result.recorded.same(result.replayed):
+        say(f'the same fixations, another {last}decision')
+    elif first_other(result.recorded_events, result.replay_events) is not None:
+        say('the same fixations and the same last decision, other events before it')
+    else:
+        say('the same fixations, the same events and the same last decision' if several else
+            'the same fixations and the same decision')
+
+
+def _say_people(result: ReplayResult, say) -> None:
+    """Say the people's events of a moving many-target search, compared person by person."""
+    grid = result.grid
+    say('following many people: the replay compares their events (found, lost, reacquired '
+        'per person), not one decision')
+    say(f'recorded: {_people_text(result.recorded_people)}')
+    say(f'replay:   {_people_text(result.replay_people)}')
+    if result.first_difference is not None:
+        return
+    i = first_other(result.recorded_people, result.replay_people)
+    if i is None:
+        say("the same fixations and the same people's events")
+        return
+    rec = result.recorded_people[i].describe(grid) if i < len(result.recorded_people) \
+        else 'none'
+    rep = result.replay_people[i].describe(grid) if i < len(result.replay_people) else 'none'
+    say(f"the same fixations, other people's events: event {i + 1} is {rec} recorded, "
+        f'{rep} in the replay')
 
 
 def _search_frames(bag) -> list:
@@ -374,6 +685,16 @@ def _last_image(bag) -> np.ndarray:
     return np.ascontiguousarray(pixels[:, :, 0] if channels == 1 else pixels)
 
 
+def _why_no_scene(bag, detector: dict) -> str:
+    """Say why a recording that is not of a fixed camera holds no whole scene to search."""
+    if detector.get('mode'):
+        return (f"this one's detector was in {detector['mode']} mode: a camera on the head "
+                'only recorded the views it took')
+    images = 'no camera image' if not bag.topic('image') else 'camera images'
+    return (f'this one has no parameters of {DETECTOR} and {images}: its evidence came '
+            'without a detector node (a simulated camera, say), so it holds no scene to search')
+
+
 def new_search(bag, overrides: dict | None = None, out=print):
     """
     Run a whole new search on the last recorded image of a fixed camera (``fovea`` mode).
@@ -393,9 +714,10 @@ def new_search(bag, overrides: dict | None = None, out=print):
     detector = bag.parameters(DETECTOR)
     if detector.get('mode') != 'fovea':
         raise ValueError('a new search needs a recording of a fixed camera (the detector in '
-                         'fovea mode): a camera on the head only recorded the views it took')
-    values = settings_from(bag.parameters(CONTROLLER), overrides)
-    core, _ = build_controller(values)
+                         f'fovea mode): {_why_no_scene(bag, detector)}')
+    parameters = values_at(bag.parameters(CONTROLLER), parameter_changes(bag), None)
+    config = checked_config(parameters, overrides)
+    core, values = config.controller(), config.values
     given = {k: v for k, v in (('cascade', detector.get('detector.cascade')),
                                ('scale_factor', detector.get('detector.scale_factor', 0) or None),
                                ('min_neighbors', detector.get('detector.min_neighbors', -1)))

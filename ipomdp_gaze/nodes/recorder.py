@@ -9,15 +9,21 @@ Python): a directory ``path`` with ``metadata.yaml`` and one ``.mcap`` file in r
 as they arrive, timestamped with the time the middleware received them. ``topics`` lists the
 relative topic names to record (:data:`TOPICS` gives each one's type and QoS; the default
 is every one of them: camera images, ``camera_info``, ``joint_states``, ``fixation``,
-``pan_tilt``, ``evidence``, ``evidence_image``, ``belief``, ``found``, ``absent``, ``gave_up``,
-``/diagnostics``, ``ground_truth`` and the detector's ``annotated_image`` and raw
-``detections``).
+``pan_tilt``, ``evidence``, ``evidence_image``, ``belief``, the controller's events ``found``,
+``absent``, ``gave_up``, ``lost``, ``reacquired`` and ``room_done``, its people
+``gaze_controller/targets`` and ``gaze_controller/target_cells`` (its ``~/targets`` and
+``~/target_cells``, many targets), ``/diagnostics``, ``/parameter_events`` (the parameters set
+while recording), ``ground_truth``, the scene camera's ``walk_truth`` and the detector's
+``annotated_image`` and raw ``detections``). A topic no node publishes in the mode running is
+subscribed to and stays empty.
 
 The bag's ``custom_data`` (in ``metadata.yaml``) holds ``ipomdp_gaze/version`` (the package),
 ``ipomdp_gaze/parameters/<node>`` (every parameter of each node in ``nodes``, as YAML, fetched
-once they answer) and ``ipomdp_gaze/files`` (the sha256 of each policy and observation file
-those parameters name): what ``ipomdp-gaze replay`` needs to re-run the search. ``compression``
-``zstd`` compresses the MCAP chunks (as rosbag2's ``zstd`` storage presets do; every MCAP
+once they answer; ``ipomdp_gaze/parameters_time/<node>`` the recorder's time in ns when it
+asked for them, so a replay applies the ``/parameter_events`` after it) and
+``ipomdp_gaze/files`` (the sha256 of each policy and observation file those parameters
+name): what ``ipomdp-gaze replay`` needs to re-run the search. ``compression`` ``zstd``
+compresses the MCAP chunks (as rosbag2's ``zstd`` storage presets do; every MCAP
 reader decompresses them). ``/diagnostics`` carries ``<node>: recording`` with the messages
 written and the publishers matched per topic.
 """
@@ -31,12 +37,14 @@ import time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import PoseArray
 from ipomdp_gaze.msg_adapters import diagnostics
+from rcl_interfaces.msg import ParameterEvent
 from rcl_interfaces.srv import GetParameters, ListParameters
 from rclpy.node import Node
 from rclpy.parameter import parameter_value_to_python
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.qos import DurabilityPolicy, qos_profile_parameter_events, QoSProfile, \
+    ReliabilityPolicy
 from sensor_msgs.msg import CameraInfo, Image, JointState
-from std_msgs.msg import Float32MultiArray, Int32MultiArray
+from std_msgs.msg import Float32MultiArray, Float64MultiArray, Int32MultiArray
 import yaml
 
 from . import NODE_NAMES
@@ -49,6 +57,9 @@ LATCHED = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
 BEST_EFFORT = QoSProfile(depth=50, reliability=ReliabilityPolicy.BEST_EFFORT)
 RELIABLE = QoSProfile(depth=50, reliability=ReliabilityPolicy.RELIABLE)
+EVENT = (DiagnosticStatus, 'diagnostic_msgs/msg/DiagnosticStatus', RELIABLE)
+# The controller's private ~/targets and ~/target_cells, relative to the recorder's namespace.
+CONTROLLER_TOPIC = NODE_NAMES['controller'] + '/'
 # Relative topic -> (message type, ROS type name, QoS of the subscription).
 TOPICS = {
     # Images reliable: over best effort a large image is lost whole when one fragment is.
@@ -60,11 +71,20 @@ TOPICS = {
     'evidence': (Float32MultiArray, 'std_msgs/msg/Float32MultiArray', BEST_EFFORT),
     'evidence_image': (Image, 'sensor_msgs/msg/Image', BEST_EFFORT),
     'belief': (Float32MultiArray, 'std_msgs/msg/Float32MultiArray', RELIABLE),
-    'found': (DiagnosticStatus, 'diagnostic_msgs/msg/DiagnosticStatus', RELIABLE),
-    'absent': (DiagnosticStatus, 'diagnostic_msgs/msg/DiagnosticStatus', RELIABLE),
-    'gave_up': (DiagnosticStatus, 'diagnostic_msgs/msg/DiagnosticStatus', RELIABLE),
+    'found': EVENT,
+    'absent': EVENT,
+    'gave_up': EVENT,
+    'lost': EVENT,
+    'reacquired': EVENT,
+    'room_done': EVENT,
+    CONTROLLER_TOPIC + 'targets': (PoseArray, 'geometry_msgs/msg/PoseArray', LATCHED),
+    CONTROLLER_TOPIC + 'target_cells': (Float32MultiArray, 'std_msgs/msg/Float32MultiArray',
+                                        LATCHED),
     '/diagnostics': (DiagnosticArray, 'diagnostic_msgs/msg/DiagnosticArray', RELIABLE),
+    '/parameter_events': (ParameterEvent, 'rcl_interfaces/msg/ParameterEvent',
+                          qos_profile_parameter_events),
     'ground_truth': (Int32MultiArray, 'std_msgs/msg/Int32MultiArray', LATCHED),
+    'walk_truth': (Float64MultiArray, 'std_msgs/msg/Float64MultiArray', RELIABLE),
     'annotated_image': (Image, 'sensor_msgs/msg/Image', RELIABLE),
     'detections': (PoseArray, 'geometry_msgs/msg/PoseArray', RELIABLE),
 }
@@ -192,17 +212,24 @@ class RecorderNode(QuietPublishers, Node):
             if not all(c.service_is_ready() for c in clients):
                 continue
             self._asked[node] = now
+            asked_ns = self.get_clock().now().nanoseconds
             future = clients[0].call_async(ListParameters.Request())
-            future.add_done_callback(lambda f, n=node: self._listed(n, f))
+            future.add_done_callback(lambda f, n=node, t=asked_ns: self._listed(n, f, t))
         if not self._pending:
             self.destroy_timer(self._parameter_timer)
 
-    def _listed(self, node: str, future) -> None:
+    def _listed(self, node: str, future, asked_ns: int) -> None:
         names = list(future.result().result.names)
         got = self._parameter_clients[node][1].call_async(GetParameters.Request(names=names))
-        got.add_done_callback(lambda f: self._got(node, names, f))
+        got.add_done_callback(lambda f: self._got(node, names, f, asked_ns))
 
-    def _got(self, node: str, names: list, future) -> None:
+    def _got(self, node: str, names: list, future, asked_ns: int) -> None:
+        """
+        Keep the parameters of ``node`` and when they were asked for (``asked_ns``).
+
+        A parameter set after that time is on ``/parameter_events``; one set between the
+        request and the answer is in both, which a replay may apply twice harmlessly.
+        """
         values = {n: parameter_value_to_python(v) for n, v in zip(names, future.result().values)}
         values = {k: (list(v) if isinstance(v, (list, tuple)) or hasattr(v, 'tolist') else v)
                   for k, v in values.items()}
@@ -211,6 +238,7 @@ class RecorderNode(QuietPublishers, Node):
         self.parameters[node] = values
         self.writer.set_custom_data(f'ipomdp_gaze/parameters/{node}',
                                     yaml.safe_dump(values, sort_keys=True))
+        self.writer.set_custom_data(f'ipomdp_gaze/parameters_time/{node}', str(asked_ns))
         self.writer.set_custom_data('ipomdp_gaze/files',
                                     yaml.safe_dump(file_hashes(self.parameters), sort_keys=True))
         if node in self._pending:

@@ -1,0 +1,243 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+What ``replay`` compares on a tracker's or many people's search, and which settings it uses.
+
+The bags are built here: the controller's core (with the shipped tracking parameters) searches
+a scene of detection counts as the node would, and its targets, frames, events and parameter
+changes are written as the recorder writes them. A tracker may find, lose and then decide
+``absent`` in one search (the replay compares the last decision, not the first kind found); a
+moving many-target search has people's events, not a decision; a parameter set while recording
+is in force from its time.
+"""
+from pathlib import Path
+from types import SimpleNamespace
+
+from ipomdp_gaze.drivers.replay import build_controller, describe_settings, replay, \
+    settings_from
+from ipomdp_gaze.files.bag import Bag, BagMessage
+from ipomdp_gaze.files.yaml_files import yaml_parameters
+from ipomdp_gaze.search.controller_config import build_config
+import numpy as np
+import pytest
+import yaml
+
+REPO = Path(__file__).resolve().parents[1]
+FRAME_S = 0.3
+EVENT_KEYS = ('found', 'reacquired', 'lost', 'absent', 'gave_up')
+
+
+def _parameters(*files, **changed) -> dict:
+    """Return the controller's parameters: its defaults, then the config files (as the node)."""
+    from ipomdp_gaze.nodes.controller import controller_params
+    values = {p.name: p.default for p in controller_params()}
+    for name in files:
+        values.update(yaml_parameters(REPO / 'config' / name, 'gaze_controller'))
+    values.update({k.replace('__', '.'): v for k, v in changed.items()})
+    return values
+
+
+TRACKING = ('faces_camera_controller.yaml', 'faces_camera_tracking.yaml')
+PEOPLE = TRACKING + ('faces_camera_people.yaml',)
+
+
+def _stamp(t: float):
+    sec = int(t)
+    return SimpleNamespace(sec=sec, nanosec=int(round((t - sec) * 1e9)))
+
+
+def _status(values: dict):
+    return SimpleNamespace(values=[SimpleNamespace(key=k, value=str(v))
+                                   for k, v in values.items()])
+
+
+def _event(kind: str, event, person: int = 0) -> dict:
+    values = {'fixations': event.fixations}
+    if getattr(event, 'cell', None) is not None:
+        values['cell'] = event.cell
+    if getattr(event, 'probability', None) is not None:
+        values['probability'] = event.probability
+    if person:
+        values['person'] = person
+    return {'kind': kind, 'values': values}
+
+
+def _parameter_event(t_s: float, values: dict) -> BagMessage:
+    """Return a ``/parameter_events`` message of the controller (doubles and strings here)."""
+    params = []
+    for name, value in values.items():
+        if isinstance(value, str):
+            v = SimpleNamespace(type=4, string_value=value)
+        else:
+            v = SimpleNamespace(type=3, double_value=float(value))
+        params.append(SimpleNamespace(name=name, value=v))
+    msg = SimpleNamespace(node='/gaze_controller', new_parameters=[], changed_parameters=params,
+                          deleted_parameters=[])
+    return BagMessage('/parameter_events', int(t_s * 1e9), msg, 0)
+
+
+def _record(values: dict, faces, frames: int, changes=()) -> Bag:
+    """
+    Search with the core as the node does and return the bag a recorder would have written.
+
+    ``faces(i, fixation)`` gives the cells with a face at frame ``i``; a view counts 9
+    detections on a face in its 5x5 cells and 0 elsewhere, NaN out of view. ``changes`` are
+    ``(frame, {parameter: value})`` set (as the node sets them) just before that frame.
+    """
+    core, head = build_controller(values)
+    grid, config, live = core.grid, build_config(values, _build_policy()), dict(values)
+    messages, t = [], 1000.0
+    core.reset(t)
+
+    def target(now: float) -> None:
+        pan, tilt = head.angles(core.fixation)
+        msg = SimpleNamespace(header=SimpleNamespace(stamp=_stamp(now)),
+                              name=[head.pan_joint, head.tilt_joint], position=[pan, tilt])
+        messages.append(BagMessage('/pan_tilt', int((now + 0.001) * 1e9), msg, 0))
+    target(t)
+    changes = dict(changes)
+    for i in range(frames):
+        t += FRAME_S
+        if i in changes:
+            live.update(changes[i])
+            config = build_config(live, _build_policy(), set(changes[i]), config)
+            core.set_policy(config.policy)
+            core.configure(config.settings, live['settle_time_s'])
+            messages.append(_parameter_event(t - 0.1, changes[i]))
+        row, col = grid.cell(core.fixation)
+        evidence = np.full(grid.n_cells, np.nan, dtype=np.float32)
+        for r in range(max(0, row - 2), min(grid.rows, row + 3)):
+            for c in range(max(0, col - 2), min(grid.cols, col + 3)):
+                evidence[grid.index(r, c)] = 9.0 if grid.index(r, c) in faces(i) else 0.0
+        messages.append(BagMessage('/evidence', int(t * 1e9),
+                                   SimpleNamespace(data=evidence), evidence.nbytes))
+        step = core.offer(evidence.astype(np.float64), t, t + 0.01)
+        assert step.applied, step.reason
+        # The recorder takes each event topic in its own order: here the reverse of firing.
+        fired = [_event(k, getattr(step, k)) for k in EVENT_KEYS if getattr(step, k)]
+        fired += [_event(e.kind, e, e.person) for e in step.people]
+        for j, event in enumerate(reversed(fired)):
+            messages.append(BagMessage('/' + event['kind'], int((t + 0.005 + 1e-4 * j) * 1e9),
+                                       _status(event['values']), 0))
+        if step.fixation is not None:
+            target(t + 0.01)
+        if core.stopped:
+            break
+    custom = {'ipomdp_gaze/parameters/gaze_controller': yaml.safe_dump(values),
+              'ipomdp_gaze/parameters_time/gaze_controller': str(int(999.0 * 1e9))}
+    return Bag(Path('bag'), sorted(messages, key=lambda m: m.time_ns), custom, 0, t - 1000.0)
+
+
+def _build_policy():
+    from ipomdp_gaze.policies.registry import build_policy
+    return build_policy
+
+
+def _walk_out(face: int, until: int):
+    """Put a face at ``face`` for the first ``until`` frames, then nobody (it walked away)."""
+    return lambda i: {face} if i < until else set()
+
+
+def test_a_tracker_that_found_lost_and_decided_absent_is_compared_by_its_last_decision():
+    """QA: found -> lost -> absent replayed as 'the same fixations, another decision'."""
+    values = _parameters(*TRACKING, confidence=0.85)
+    bag = _record(values, _walk_out(5 * 11 + 8, 20), 60)
+    kinds = [m.topic for m in bag.messages if m.topic in ('/found', '/lost', '/absent')]
+    assert kinds == ['/found', '/lost', '/absent'], kinds
+    lines = []
+    result = replay(bag, out=lines.append)
+    assert [e.kind for e in result.recorded_events] == ['found', 'lost', 'absent']
+    assert result.recorded.kind == 'absent' and result.replayed.kind == 'absent'
+    assert result.same, lines
+    assert lines[-3].startswith('recorded: the last decision absent p='), lines
+    assert lines[-2].startswith('replay:   the last decision absent p='), lines
+    assert lines[-1] == 'the same fixations, the same events and the same last decision'
+    assert 'another decision' not in '\n'.join(lines)
+
+
+def test_a_parameter_set_while_recording_is_set_by_the_replay_at_its_time():
+    """QA: confidence set at run time was ignored while replay said 'settings: recorded'."""
+    values = _parameters(*TRACKING, confidence=0.95)
+    # Lowered once the face has gone: with 0.95 the tracker never says absent here.
+    bag = _record(values, _walk_out(5 * 11 + 8, 20), 60, changes=[(25, {'confidence': 0.85})])
+    assert bag.topic('absent'), 'the recorded search should have ended absent'
+    text = describe_settings(bag)
+    assert text.startswith('settings: recorded; gaze_controller parameters set while '
+                           'recording, each applied by the replay at its time: at '), text
+    assert 'confidence 0.95 -> 0.85' in text and '\n' not in text
+    lines = []
+    result = replay(bag, out=lines.append)
+    assert result.changes_applied == 1
+    assert result.same, lines
+    # An option holds over a recorded change of the same parameter, and the line says so.
+    text = describe_settings(bag, {'confidence': 0.9})
+    assert text.startswith('settings: recorded, with confidence=0.9; ') and \
+        text.endswith("(not confidence: the options' values hold)"), text
+    assert not replay(bag, {'confidence': 0.9}, out=lambda line: None).same
+
+
+def test_a_change_before_the_replayed_search_is_its_setting_from_the_start():
+    """A parameter set, then ~/reset: the search replayed began with the new value."""
+    values = _parameters(*TRACKING, confidence=0.85)
+    bag = _record(values, _walk_out(5 * 11 + 8, 20), 60)
+    # The same search recorded by a controller started at 0.5 and set to 0.85 before it.
+    start = dict(values, confidence=0.5)
+    early = _parameter_event(999.5, {'confidence': 0.85})
+    reset = BagMessage('/belief', int(999.9 * 1e9),
+                       SimpleNamespace(data=np.full(121, 1 / 121)), 0)
+    bag = Bag(bag.path, sorted(bag.messages + [early, reset], key=lambda m: m.time_ns),
+              dict(bag.custom_data, **{'ipomdp_gaze/parameters/gaze_controller':
+                                       yaml.safe_dump(start)}), 0, bag.duration_s)
+    assert 'confidence 0.5 -> 0.85' in describe_settings(bag)
+    result = replay(bag, out=lambda line: None)
+    assert result.changes_applied == 0 and result.same
+
+
+def test_many_moving_people_are_compared_by_their_events_not_a_decision():
+    """QA: a many-target walking bag said 'no decision / the same fixations, another decision'."""
+    values = _parameters(*PEOPLE)
+    bag = _record(values, _walk_out(5 * 11 + 8, 15), 40)
+    assert any('person' in {kv.key for kv in m.msg.values} for m in bag.topic('found'))
+    lines = []
+    result = replay(bag, out=lines.append)
+    assert result.recorded_people
+    assert [e.key for e in result.recorded_people] == [e.key for e in result.replay_people]
+    assert result.same, lines
+    assert lines[0] == ('following many people: the replay compares their events (found, '
+                        'lost, reacquired per person), not one decision')
+    assert lines[-1] == "the same fixations and the same people's events"
+    assert 'decision' not in '\n'.join(lines[1:])
+
+
+def test_other_people_events_are_said_person_by_person():
+    values = _parameters(*PEOPLE)
+    bag = _record(values, _walk_out(5 * 11 + 8, 15), 40)
+    # Drop the recorded lost event(s): the replay's then differ from the recording's.
+    bag = Bag(bag.path, [m for m in bag.messages if m.topic != '/lost'], bag.custom_data, 0,
+              bag.duration_s)
+    lines = []
+    result = replay(bag, out=lines.append)
+    if not any(e.kind == 'lost' for e in result.replay_people):
+        pytest.skip('this walk has no lost person to drop')
+    assert not result.same
+    assert lines[-1].startswith("the same fixations, other people's events: event "), lines
+    assert 'person 1 lost at' in lines[-1]
+
+
+@pytest.mark.parametrize('option, value, message', [
+    ('policy', 'bogus', "--policy: unknown policy 'bogus'"),
+    ('confidence', 2.0, '--confidence: '),
+    ('policy_file', 'no-such-kernel', '--policy-file: '),
+    ('observation', 'no-such-model', '--observation: '),
+])
+def test_a_bad_option_is_named_as_the_option_not_the_recording(option, value, message):
+    from ipomdp_gaze.drivers.replay import checked_config
+    values = _parameters(*TRACKING)
+    with pytest.raises(ValueError) as err:
+        checked_config(values, {option: value})
+    assert str(err.value).startswith(message), str(err.value)
+    assert 'the recording' not in str(err.value)
+    broken = dict(values, confidence=7.0)
+    with pytest.raises(ValueError, match='^the recording: '):
+        checked_config(broken, {})
+    assert settings_from(values, {option: None}) == values
