@@ -629,3 +629,16 @@ def test_a_pass_cut_by_its_budget_decides_with_its_groups_and_keeps_its_policy()
     assert session.faces() == []
     session.set_policy(_Sweep([6, 8, 18]))
     assert not session.passing and session.faces() == []
+
+
+def test_a_stray_large_box_does_not_become_the_box_of_the_faces_it_covers():
+    """Haar's raw boxes (no scores): the box most others overlap is kept, not the largest."""
+    from ipomdp_gaze.model.occupancy import merge_boxes
+    face = [[100, 100, 40, 40], [102, 99, 40, 41], [98, 101, 42, 40]]
+    other = [[160, 105, 30, 30], [161, 104, 31, 31]]
+    stray = [[60, 60, 160, 160]]                            # round both, a texture's scale
+    kept, support = merge_boxes(stray + face + other)
+    assert len(kept) == 2 and kept[0].tolist() in face and kept[1].tolist() in other
+    assert support.tolist() == [4, 2]                       # the stray joined the face it holds
+    kept, _ = merge_boxes(stray + face, scores=[0.9, 0.8, 0.7, 0.6])    # scores still rule
+    assert kept.tolist()[0] == stray[0]

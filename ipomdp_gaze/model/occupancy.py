@@ -270,17 +270,21 @@ def merge_boxes(boxes, scores=None, iou: float = 0.3,
     """
     Greedy non-maximum suppression: the distinct boxes ``(F, 4)`` and their support ``(F,)``.
 
-    Boxes in decreasing score (then area) order; a box overlapping a kept one by more than
-    ``iou`` (of the union), or lying in it by more than ``inside`` (of the smaller box), joins
-    it. One face seen by several windows and scales is one box; its support is the sum of the
-    scores of the raw boxes it took (1 each for a detector without scores).
+    Boxes in decreasing score order; a box overlapping a kept one by more than ``iou`` (of the
+    union), or lying in it by more than ``inside`` (of the smaller box), joins it. One face
+    seen by several windows and scales is one box; its support is the sum of the scores of the
+    raw boxes it took (1 each for a detector without scores). Ties (every box of a detector
+    without scores) go to the box that most others overlap by ``iou``, the middle of a cluster
+    of raw detections (then the larger): a stray large box round a face and its neighbour
+    does not become the face's box.
     """
     boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
     if boxes.shape[0] == 0:
         return boxes, np.zeros(0, dtype=np.intp)
     scores = np.ones(len(boxes)) if scores is None else np.asarray(scores, dtype=float)
-    order = np.lexsort((-boxes[:, 2] * boxes[:, 3], -scores))
-    overlap = (box_iou(boxes, boxes) > iou) | (box_iou(boxes, boxes, 'smaller') > inside)
+    similar = box_iou(boxes, boxes) > iou
+    order = np.lexsort((-boxes[:, 2] * boxes[:, 3], -similar.sum(axis=1), -scores))
+    overlap = similar | (box_iou(boxes, boxes, 'smaller') > inside)
     owner = np.full(len(boxes), -1)
     kept = []
     for i in order:                       # over detections (a handful per face), not cells
