@@ -360,3 +360,29 @@ def test_find_all_finds_a_crowd_of_faces_far_smaller_than_a_tenth_of_the_image(y
     plain, _ = found(0.0)
     assert crowd >= 26 and crowd >= plain + 5, (crowd, plain)
     assert crowd_px < 2048 * 1482 * 0.75                    # less than a full call
+
+
+def test_the_enlarged_looks_stay_within_the_pixel_budget(yunet_420, monkeypatch):
+    _, fovea = yunet_420
+    image = np.zeros((300, 400, 3), dtype=np.uint8)
+    for x in (40, 140, 240, 340):
+        image[100:115, x:x + 15] = 255                      # 15 px: a box of 0.5, weak
+    looks = []
+
+    def look(image, box, image_px, detector, upscale, scale=1.0):
+        looks.append(box)
+        return 0.9, search._look_cost(box, image_px, upscale, scale)
+    monkeypatch.setattr(search, '_enlarged_look', look)
+    monkeypatch.setattr(search, '_fine_score', lambda detector: 0.4)
+    cost = search._look_cost(np.array([40, 100, 15, 15]), (400, 300), search.LOOK_UPSCALE)
+    prior = prior_log_odds(fovea.grid.n_cells, cell_prior(fovea.grid.n_cells, 0.5))
+    allowed = 400 * 300 + 2 * cost + cost // 2              # the call and two looks fit
+    budget = allowed / (1 + search.LOOK_ALLOWANCE)
+    sensor = search._Coarse(fovea, TABLE, (400, 300), prior, 0.99, budget=budget)
+    sensor.detector = _Blobs()
+    sensor.start(image)
+    frame = sensor.scan()
+    assert [scale for _, scale, _ in sensor.looks] == [1.0] and len(looks) == 2
+    assert frame.detector_pixels == 400 * 300 + 2 * cost <= allowed
+    posterior = prior + frame.values        # the two looked at strong, the other two weak
+    assert np.sum(posterior > 4) == 2 and np.sum(np.abs(posterior) < 1e-9) == 2

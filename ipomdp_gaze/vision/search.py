@@ -86,6 +86,11 @@ import numpy as np
 LOOK_UPSCALE = 2.0
 LOOK_SCORE = 0.6
 LOOK_SIDE_PX = 128.0
+# find --all's enlarged looks at weak full-resolution boxes may add at most this fraction of its
+# pixel budget (one full scan) beyond it, a bound on a photo full of face-like texture: the
+# training groups at 640x480 spend 13% (the full call is the budget there), one look at a 60 px
+# box of a 400x600 photo 50%, and a 48 Mpx photo of textures spent 22% before this bound.
+LOOK_ALLOWANCE = 1.0
 # The faint look (docs/design.md section 11.4), find without --all: when the ladder ends without
 # an answer, the finest call's best faint box (from FAINT_SCORE, below the detector's own
 # threshold) no larger than FAINT_SIDE times the smallest face side that scale sees (the scale
@@ -631,8 +636,14 @@ class _Coarse(_Recorder):
         return (int(np.floor(width * self.scale + 0.5))
                 * int(np.floor(height * self.scale + 0.5)))
 
-    def _look(self, rect, scale):
-        """Detect in ``rect`` (x0, y0, x1, y1) at ``scale``: strong, weak boxes, pixels."""
+    def _look(self, rect, scale, spent: int = 0):
+        """
+        Detect in ``rect`` (x0, y0, x1, y1) at ``scale``: strong, weak boxes, pixels.
+
+        ``spent``: the pixels the pass has read before; an enlarged look that would take the
+        pass past its budget and :data:`LOOK_ALLOWANCE` is not taken (the best-scoring boxes
+        are looked at first), and its box stays weak.
+        """
         x0, y0, x1, y1 = rect
         found = scan(self.image[y0:y1, x0:x1], self.detector, (1, 1), scale)
         raw = found.boxes_px + (x0, y0, 0, 0)
@@ -646,11 +657,18 @@ class _Coarse(_Recorder):
                 # enlarged look keeps it (look_upscale 0: at once)
                 kept = np.flatnonzero((scores >= self.fine_score) & ~is_strong)
                 if self.look_upscale:
-                    looks = [_enlarged_look(self.image, raw[k], self.image_px,
-                                            self.sensor.fovea.detector, self.look_upscale,
-                                            scale) for k in kept]
-                    pixels += sum(spent for _, spent in looks)
-                    kept = kept[[best >= self.look_score for best, _ in looks]]
+                    confirmed = []
+                    for k in kept[np.argsort(-scores[kept], kind='stable')]:
+                        cost = _look_cost(raw[k], self.image_px, self.look_upscale, scale)
+                        if spent + pixels + cost > self.budget * (1 + LOOK_ALLOWANCE):
+                            continue
+                        best, used = _enlarged_look(self.image, raw[k], self.image_px,
+                                                    self.sensor.fovea.detector,
+                                                    self.look_upscale, scale)
+                        pixels += used
+                        if best >= self.look_score:
+                            confirmed.append(k)
+                    kept = np.array(confirmed, dtype=np.intp)
                 is_strong[kept] = True
             strong, weak = raw[is_strong], raw[~is_strong]
         else:           # a grouping detector: its grouped boxes strong, looser groups weak
@@ -714,7 +732,7 @@ class _Coarse(_Recorder):
                 break
             # the whole image again at the finer scale: its boxes and evidence replace the
             # coarser call's, whose strong boxes stay strong
-            found, weak, spent = self._look(whole, finer)
+            found, weak, spent = self._look(whole, finer, pixels)
             strong = np.concatenate([strong, found])
             pixels, scale = pixels + spent, finer
         shift = self._crowd_shift(strong) if scale != self.scale else 0.0
@@ -733,7 +751,7 @@ class _Coarse(_Recorder):
                         * int(np.floor((rect[3] - rect[1]) * row.scale + 0.5)))
                 if pixels + cost > self.budget:
                     break
-                strong, weak, spent = self._look(rect, row.scale)
+                strong, weak, spent = self._look(rect, row.scale, pixels)
                 pixels += spent
                 fine = coarse_evidence(row, self.grid, self.image_px, spent, strong, weak,
                                        self.prior + shift) + shift
@@ -869,7 +887,13 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     decision = outcome.decision
     if decision in ('found', 'absent'):
         decision = 'found' if faces else 'absent'
-    return _image_search(outcome, grid, image_px, calibrated_size(model), t0, decision, faces)
+    result = _image_search(outcome, grid, image_px, calibrated_size(model), t0, decision, faces)
+    if not faces:
+        return result
+    # the image's answer is its most probable face, at its box's centre (as search_first)
+    x, y, w, h = faces[0].box
+    return replace(result, cell=faces[0].cell, pixel=(x + w / 2.0, y + h / 2.0),
+                   probability=faces[0].probability)
 
 
 def search_first(image: np.ndarray, fovea: Fovea, model,
@@ -892,11 +916,7 @@ def search_first(image: np.ndarray, fovea: Fovea, model,
     if not many.faces:
         nobody = float(np.prod(1.0 - np.asarray(many.belief, dtype=float)))
         return replace(many, absent_probability=nobody, seconds=time.perf_counter() - t0)
-    face = many.faces[0]
-    x, y, w, h = face.box
-    return replace(many, cell=face.cell, pixel=(x + w / 2.0, y + h / 2.0),
-                   probability=face.probability, decision='found',
-                   seconds=time.perf_counter() - t0)
+    return replace(many, decision='found', seconds=time.perf_counter() - t0)
 
 
 def _ladder_answer(found, strong_score: float, last: bool, keep_from: float = -math.inf):
@@ -974,6 +994,13 @@ def look_factor(box, upscale: float, scale: float = 1.0) -> float:
     scale, in the crop round it instead of the whole frame (other context, no more detail).
     """
     return min(max(upscale, scale), max(scale, LOOK_SIDE_PX / max(box[2], box[3])))
+
+
+def _look_cost(box, image_px, upscale: float, scale: float = 1.0) -> int:
+    """Return the detector pixels of :func:`_enlarged_look` at ``box`` (before it runs)."""
+    x0, y0, x1, y1 = _crop_round(box, image_px)
+    factor = look_factor(box, upscale, scale)
+    return round((x1 - x0) * factor) * round((y1 - y0) * factor)
 
 
 def _enlarged_look(image: np.ndarray, box, image_px, detector, upscale: float,
