@@ -3,6 +3,8 @@
 """How a search ended, in words: the confidence clause never says "below" of a sure answer."""
 from __future__ import annotations
 
+import math
+
 from ipomdp_gaze.search import answer
 import pytest
 
@@ -19,3 +21,17 @@ import pytest
 ])
 def test_the_confidence_clause(decision, reason, p, want):
     assert answer.confidence_clause(decision, reason, p, 0.99) == want
+
+
+def test_a_title_says_how_the_calls_from_coarse_to_fine_and_a_forced_count_ended():
+    from types import SimpleNamespace
+    from ipomdp_gaze.commands.find import plot_title
+    ladder = SimpleNamespace(answer_probability=math.nan, fixations=0, stop='found',
+                             decision='found', cell=(5, 9), method='scales')
+    title = plot_title('a.png', ladder, 0.99)
+    assert 'found by full-frame detector calls, coarse to fine' in title
+    assert 'one full-frame detector scan' not in title
+    forced = SimpleNamespace(answer_probability=0.9, fixations=0, stop='pixels',
+                             decision='found', cell=(5, 9), method='fovea')
+    assert plot_title('a.png', forced, 0.99, occupancy=True, faces=3).startswith(
+        'a.png: 3 faces (forced by the pixel budget (one full scan)), 0 fixations')

@@ -97,6 +97,9 @@ def test_find_all_one_target_loop_finds_the_faces_of_a_group_photo_then_no_more(
     assert result.returncode == 0, result.stderr
     entries = json.loads(out.read_text())['images']
     assert [e['face'] for e in entries] == list(range(len(entries)))
+    lines = result.stdout.strip().splitlines()
+    assert all(f'face={k} decision=found' in line for k, line in enumerate(lines[:-1]))
+    assert f'search={len(lines) - 1} decision=' in lines[-1] and 'face=' not in lines[-1]
     assert entries[-1]['decision'] in ('absent', 'gave_up') and entries[-1]['cell'] is None
     found = [e['cell'] for e in entries[:-1]]
     assert all(e['decision'] == 'found' for e in entries[:-1])

@@ -204,7 +204,8 @@ def add_parser(sub):
                         'may be below --confidence or 0.5 (the --plot title says so)')
     add_search_args(p, None, ('targets',), task_default='many with --all, else one; --all '
                     '--targets one: find a face, rule the cells within 2 of it out, search '
-                    'again')
+                    'again: a line per search (face=K for a face, at a point without a box; '
+                    'search=K for the last, which found none)')
     p.add_argument('--plot', type=Path, default=None, metavar='OUT.png',
                    help='draw the image, the numbered fixations and the windows of the last '
                         'one, in the format the extension names (.png, .pdf, .svg, .jpg, ...; '
@@ -474,7 +475,8 @@ def format_line(path: str, result, face: int | None = None, occupancy: bool = Fa
     width, height = result.image_px
     p = result.answer_probability
     probability = 'n/a' if math.isnan(p) else f'{p:.3f}'
-    which = '' if face is None else f' face={face}'
+    which = ('' if face is None else f' face={face}' if result.decision == 'found' else
+             f' search={face}')
     name = 'p_nobody' if occupancy and result.decision == 'absent' else 'p'
     line = (f'{path}:{which} decision={result.decision} ended={result.ended} '
             f'{_cell_text(result)} {name}={probability} fixations={result.fixations} '
@@ -511,6 +513,8 @@ def plot_title(path: str, result, confidence: float, occupancy: bool = False,
     nobody = occupancy and result.decision == 'absent' and not math.isnan(p)
     if faces is not None:
         found = f'{name}: {faces} face{"" if faces == 1 else "s"}'
+        if faces and answer.forced(result.decision, result.stop):
+            found += f' (forced by {answer.LIMITS[result.stop]})'
         return f'{found} ({nobody_text(result, confidence)}), {tail}' if nobody else \
             f'{found}, {tail}'
     if nobody:
@@ -537,7 +541,7 @@ def nobody_text(result, confidence: float) -> str:
 
 
 def _reason(result) -> str:
-    return 'full_frame' if result.method in ('full_frame', 'scales') else result.stop
+    return result.method if result.method in ('full_frame', 'scales') else result.stop
 
 
 def entry(path: str, result, grid, confidence: float | None = None) -> dict:

@@ -35,12 +35,13 @@ def ended(decision: str, reason: str = '') -> str:
 
     ``confidence`` (the evidence reached the confidence), ``forced:<limit>`` (a limit forced a
     ``found`` or ``absent``), ``<limit>`` for ``gave_up``, ``scan`` for ``full_frame`` answers
-    (one detector scan, no belief), ``group`` for a grouped detection's stop, '' for no
+    (one detector scan, no belief; also for ``scales``, the calls from coarse to fine),
+    ``group`` for a grouped detection's stop, '' for no
     decision.
     """
     if not decision:
         return ''
-    if reason == 'full_frame':
+    if reason in ('full_frame', 'scales'):
         return 'scan'
     if reason == 'group':
         return 'group'
@@ -78,6 +79,8 @@ def heading(decision: str, reason: str = '') -> str:
         return 'gave up'
     if reason == 'full_frame':
         return f'{decision} by one full-frame detector scan'
+    if reason == 'scales':
+        return f'{decision} by full-frame detector calls, coarse to fine'
     if reason == 'group':
         return f'{decision} at a grouped detection'
     if forced(decision, reason):
