@@ -132,6 +132,7 @@ def test_a_periodic_recheck_searches_again_and_finds_nobody_new(rig, probe):
                                      'nor hotspots of a still scene'),
     ({'search.false_alarm_scales': [1.0, 3.0]}, 'search.targets many does not model '
                                                 'false-alarm scales'),
+    ({'room.frame_id': ' '}, 'room.frame_id must name the frame of ~/targets'),
 ])
 def test_settings_the_many_target_mode_does_not_model_are_refused(rig, probe, params, words):
     result = probe.set_parameters(NODE, params)[0]

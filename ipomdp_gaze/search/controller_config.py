@@ -182,6 +182,9 @@ def build_config(values: Mapping, build_policy: Callable, changed=None,
             check_many_settings(settings)
         if 'room.dwell_s' in values:
             check_room_times(values['room.dwell_s'], values['room.recheck_period_s'])
+        if not str(values.get('room.frame_id', 'unset')).strip():
+            raise ValueError('room.frame_id must name the frame of ~/targets (a TF frame), '
+                             'got an empty string')
         check_settle_time(values['settle_time_s'])
         warnings = []
         policy_changed = changed is None or any(k in changed for k in POLICY_KEYS) or any(
