@@ -129,3 +129,24 @@ def test_a_failing_service_answers_false_and_a_failing_timer_keeps_ticking(ros_e
         assert node.guard.by_callback['failing_tick'] == len(ticks)
     finally:
         rig.close()
+
+
+def test_a_callback_failing_after_shutdown_is_neither_counted_nor_warned():
+    """Ctrl-C while a callback publishes: its 'publisher's context is invalid' is no fault."""
+    from types import SimpleNamespace
+    from ipomdp_gaze.nodes.guard import CallbackGuard
+    warnings = []
+    context = SimpleNamespace(up=True)
+    context.ok = lambda: context.up
+    node = SimpleNamespace(context=context, get_logger=lambda: SimpleNamespace(
+        warning=lambda text, **_: warnings.append(text)))
+    guard = CallbackGuard(node)
+
+    def publish(_msg):
+        raise RuntimeError("Failed to publish: publisher's context is invalid")
+    guarded = guard.wrap(publish, 'on_evidence_image')
+    guarded(None)
+    assert guard.errors == 1 and len(warnings) == 1             # running: a fault
+    context.up = False
+    guarded(None)
+    assert guard.errors == 1 and len(warnings) == 1             # shut down: quiet

@@ -49,6 +49,14 @@ class CallbackGuard:
         self._pass_through = _shutdown_exceptions()
         self._status_pub = None
 
+    def _shutting_down(self) -> bool:
+        """Return whether the node's context is shut down (nothing can be published)."""
+        context = getattr(self.node, 'context', None)
+        try:
+            return context is not None and not context.ok()
+        except Exception:  # noqa: B902 (a context torn down under us is shut down too)
+            return True
+
     def record(self, name: str, exc: BaseException) -> str:
         """Count an exception raised in callback ``name``; return its one-line reason."""
         reason = f'{type(exc).__name__}: {exc}'.replace('\n', ' ')[:300]
@@ -77,6 +85,8 @@ class CallbackGuard:
             except pass_through:
                 raise
             except Exception as exc:  # noqa: B902 (that is the point of the guard)
+                if self._shutting_down():
+                    return None         # Ctrl-C while a callback ran: its publish has no context
                 reason = self.record(name, exc)
                 if len(args) == 2:                      # a service: (request, response)
                     response = args[1]
