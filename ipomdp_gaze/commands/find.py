@@ -108,7 +108,7 @@ from ipomdp_gaze.search import answer
 from ipomdp_gaze.vision.detectors import load_factory
 from ipomdp_gaze.vision.fullframe import MAX_SCALE
 from ipomdp_gaze.vision.image_files import decode_quietly
-from ipomdp_gaze.vision.scales import finest_scale, ladder_scales, SCALE_TABLES
+from ipomdp_gaze.vision.scales import finest_scale, ladder_scales, min_face_px, SCALE_TABLES
 from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, clip_box,
                                        CROWD_RATIO, EMPTY_BY_EVIDENCE,
                                        FIND_SETTINGS, fovea_for_model, full_frame_reason,
@@ -880,7 +880,12 @@ def run(args) -> int:
         route, _ = search_route(task, (image.shape[1], image.shape[0]), settings, args.all,
                                 scan)
         for note in min_face_notes(path, args.min_face, min_face, route, task.model):
-            _note(note)
+            _note(note + (' (--max-side 0 searches the image at its own size)'
+                          if scale != (1.0, 1.0) else ''))
+        if route == 'many' and args.min_face is None and scale != (1.0, 1.0):
+            _note(f'{path}: --all looks for faces of {min_face_px(given):.0f} px or more '
+                  '(1/10 of the shorter side; a face found smaller sends it finer): '
+                  '--min-face PX --max-side 0 looks for smaller faces')
         results = search_one(image, task, settings, np.random.default_rng([args.seed, i]),
                              args.all, min_face, scan)
         searched = results                      # in the searched image's pixels (the plot)
