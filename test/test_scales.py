@@ -362,6 +362,15 @@ def test_find_all_finds_a_crowd_of_faces_far_smaller_than_a_tenth_of_the_image(y
     assert crowd_px < 2048 * 1482 * 0.75                    # less than a full call
 
 
+class _Ranked(_Blobs):
+    """The squares' boxes, each scoring more the further right it lies (0.45-0.6)."""
+
+    def __call__(self, gray):
+        boxes = super().__call__(gray)
+        boxes[:, 4] = 0.45 + boxes[:, 0] / 2000
+        return boxes
+
+
 def test_the_enlarged_looks_stay_within_the_pixel_budget(yunet_420, monkeypatch):
     _, fovea = yunet_420
     image = np.zeros((300, 400, 3), dtype=np.uint8)
@@ -379,10 +388,11 @@ def test_the_enlarged_looks_stay_within_the_pixel_budget(yunet_420, monkeypatch)
     allowed = 400 * 300 + 2 * cost + cost // 2              # the call and two looks fit
     budget = allowed / (1 + search.LOOK_ALLOWANCE)
     sensor = search._Coarse(fovea, TABLE, (400, 300), prior, 0.99, budget=budget)
-    sensor.detector = _Blobs()
+    sensor.detector = _Ranked()
     sensor.start(image)
     frame = sensor.scan()
     assert [scale for _, scale, _ in sensor.looks] == [1.0] and len(looks) == 2
+    assert sorted(box[0] for box in looks) == [240, 340]    # the two best-scoring first
     assert frame.detector_pixels == 400 * 300 + 2 * cost <= allowed
     posterior = prior + frame.values        # the two looked at strong, the other two weak
     assert np.sum(posterior > 4) == 2 and np.sum(np.abs(posterior) < 1e-9) == 2
