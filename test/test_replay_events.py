@@ -13,8 +13,8 @@ is in force from its time.
 from pathlib import Path
 from types import SimpleNamespace
 
-from ipomdp_gaze.drivers.replay import build_controller, describe_settings, replay, \
-    settings_from
+from ipomdp_gaze.drivers.replay import build_controller, Decision, describe_settings, Event, \
+    parameter_changes, replay, ReplayResult, settings_from
 from ipomdp_gaze.files.bag import Bag, BagMessage
 from ipomdp_gaze.files.yaml_files import yaml_parameters
 from ipomdp_gaze.search.controller_config import build_config
@@ -62,16 +62,18 @@ def _event(kind: str, event, person: int = 0) -> dict:
     return {'kind': kind, 'values': values}
 
 
-def _parameter_event(t_s: float, values: dict) -> BagMessage:
-    """Return a ``/parameter_events`` message of the controller (doubles and strings here)."""
+def _parameter_event(t_s: float, values: dict, node: str = '/gaze_controller') -> BagMessage:
+    """Return a ``/parameter_events`` message of ``node`` (doubles, strings, double arrays)."""
     params = []
     for name, value in values.items():
         if isinstance(value, str):
             v = SimpleNamespace(type=4, string_value=value)
+        elif isinstance(value, list):
+            v = SimpleNamespace(type=8, double_array_value=[float(x) for x in value])
         else:
             v = SimpleNamespace(type=3, double_value=float(value))
         params.append(SimpleNamespace(name=name, value=v))
-    msg = SimpleNamespace(node='/gaze_controller', new_parameters=[], changed_parameters=params,
+    msg = SimpleNamespace(node=node, new_parameters=[], changed_parameters=params,
                           deleted_parameters=[])
     return BagMessage('/parameter_events', int(t_s * 1e9), msg, 0)
 
@@ -84,12 +86,13 @@ def _record(values: dict, faces, frames: int, changes=()) -> Bag:
     detections on a face in its 5x5 cells and 0 elsewhere, NaN out of view. ``changes`` are
     ``(frame, {parameter: value})`` set (as the node sets them) just before that frame.
     """
-    core, head = build_controller(values)
+    core, _ = build_controller(values)
     grid, config, live = core.grid, build_config(values, _build_policy()), dict(values)
     messages, t = [], 1000.0
     core.reset(t)
 
     def target(now: float) -> None:
+        head = config.head          # a changed pan_offset_rad moves the targets sent after it
         pan, tilt = head.angles(core.fixation)
         msg = SimpleNamespace(header=SimpleNamespace(stamp=_stamp(now)),
                               name=[head.pan_joint, head.tilt_joint], position=[pan, tilt])
@@ -163,12 +166,15 @@ def test_a_parameter_set_while_recording_is_set_by_the_replay_at_its_time():
     assert bag.topic('absent'), 'the recorded search should have ended absent'
     text = describe_settings(bag)
     assert text.startswith('settings: recorded; gaze_controller parameters set while '
-                           'recording, each applied by the replay at its time: at '), text
+                           'recording, each in force from its time: at '), text
     assert 'confidence 0.95 -> 0.85' in text and '\n' not in text
     lines = []
     result = replay(bag, out=lines.append)
     assert result.changes_applied == 1
     assert result.same, lines
+    text = describe_settings(bag, result=result)
+    assert text.startswith('settings: recorded; gaze_controller parameters set while '
+                           'recording: applied by the replay at its time: at '), text
     # An option holds over a recorded change of the same parameter, and the line says so.
     text = describe_settings(bag, {'confidence': 0.9})
     assert text.startswith('settings: recorded, with confidence=0.9; ') and \
@@ -241,3 +247,132 @@ def test_a_bad_option_is_named_as_the_option_not_the_recording(option, value, me
     with pytest.raises(ValueError, match='^the recording: '):
         checked_config(broken, {})
     assert settings_from(values, {option: None}) == values
+
+
+def _with(bag: Bag, messages=(), **custom) -> Bag:
+    """Return ``bag`` with more ``messages`` and ``custom_data`` entries."""
+    return Bag(bag.path, sorted(list(bag.messages) + list(messages), key=lambda m: m.time_ns),
+               dict(bag.custom_data, **custom), 0, bag.duration_s)
+
+
+def _tracked_bag(**changed) -> Bag:
+    return _record(_parameters(*TRACKING, confidence=0.85, **changed),
+                   _walk_out(5 * 11 + 8, 20), 60)
+
+
+def test_a_change_of_a_controller_in_another_namespace_is_not_the_recorded_ones():
+    """Review: /parameter_events is global; /robot2/gaze_controller's change was applied."""
+    bag = _tracked_bag()
+    other = _parameter_event(1000.05, {'confidence': 0.5}, node='/robot2/gaze_controller')
+    mixed = _with(bag, [other])
+    assert parameter_changes(mixed) == []
+    assert describe_settings(mixed) == 'settings: recorded'
+    assert replay(mixed, out=lambda line: None).same
+    # The recorder names the node it asked; that node's changes are the controller's.
+    named = _with(bag, [other, _parameter_event(1000.06, {'confidence': 0.6})],
+                  **{'ipomdp_gaze/parameters_node/gaze_controller': '/robot2/gaze_controller'})
+    assert [c.values for c in parameter_changes(named)] == [{'confidence': 0.5}]
+
+
+def test_a_head_change_after_the_search_does_not_move_its_targets():
+    """Review: pan_offset_rad set 1 s after the search made every fixation 'differ'."""
+    bag = _tracked_bag()
+    end = bag.messages[-1].time_ns * 1e-9
+    late = _with(bag, [_parameter_event(end + 1.0, {'pan_offset_rad': 0.3})])
+    lines = []
+    result = replay(late, out=lines.append)
+    assert result.same and result.changes_applied == 0, lines
+    text = describe_settings(late, result=result)
+    assert 'applied by the replay' not in text and '\n' not in text, text
+    assert text.startswith('settings: recorded; gaze_controller parameters set while '
+                           "recording: after the replay's last frame (not applied): at "), text
+    assert text.endswith(' s pan_offset_rad 0.0 -> 0.3'), text
+
+
+def test_a_head_change_during_the_search_maps_the_targets_sent_after_it():
+    bag = _record(_parameters(*TRACKING, confidence=0.85), _walk_out(5 * 11 + 8, 20), 60,
+                  changes=[(6, {'pan_offset_rad': 0.05})])
+    lines = []
+    result = replay(bag, out=lines.append)
+    assert result.changes_applied == 1 and result.same, lines
+    text = describe_settings(bag, result=result)
+    assert 'applied by the replay at its time: at ' in text and 'after' not in text, text
+
+
+def test_a_late_event_of_an_earlier_search_is_not_this_ones():
+    """Review: a /found of the search before, arriving before this one's first frame."""
+    bag = _tracked_bag()
+    first = min(m.time_ns for m in bag.topic('evidence'))
+    late = BagMessage('/found', first - int(0.05e9),
+                      _status({'fixations': 7, 'cell': 3, 'probability': 0.99}), 0)
+    lines = []
+    result = replay(_with(bag, [late]), out=lines.append)
+    assert result.same, lines
+    assert [e.kind for e in result.recorded_events] == ['found', 'lost', 'absent']
+
+
+def test_a_search_event_of_a_many_people_search_is_compared_and_said():
+    """Review: only gave_up differed; the last line said 'the same ... people's events'."""
+    bag = _record(_parameters(*PEOPLE), _walk_out(5 * 11 + 8, 15), 40)
+    assert not bag.topic('gave_up')
+    extra = BagMessage('/gave_up', bag.messages[-1].time_ns + int(0.01e9),
+                       _status({'fixations': 40}), 0)
+    lines = []
+    result = replay(_with(bag, [extra]), out=lines.append)
+    assert not result.same
+    assert lines[-1] == ("the same fixations and the same people's events, other search "
+                         'events: event 1 is gave_up after 40 fixations recorded, none in the '
+                         'replay'), lines
+    assert lines[-3] == 'recorded search events: gave_up after 40 fixations', lines
+    assert lines[-2] == 'replay search events:   none', lines
+
+
+IDENTITY = [0.0] * 220 + [1.0] + [0.0] * 220        # 21x21: the belief itself
+
+
+def test_a_recorded_change_refused_with_an_option_names_the_option_and_its_time():
+    """Review: a plain ValueError, or the option blamed for a change after the search."""
+    bag = _tracked_bag(policy__kernel=IDENTITY)
+    # policy.kernel emptied before the first frame: --policy learned then has no kernel.
+    during = _with(bag, [_parameter_event(1000.2, {'policy.kernel': []})])
+    with pytest.raises(ValueError) as err:
+        replay(during, {'policy': 'learned'}, out=lambda line: None)
+    assert str(err.value).startswith("--policy: policy 'learned' needs policy.kernel or "
+                                     'policy.file (with the parameters set at '), str(err.value)
+    assert '\n' not in str(err.value)
+    # The same change after the search is never used: no error.
+    end = bag.messages[-1].time_ns * 1e-9
+    after = _with(bag, [_parameter_event(end + 1.0, {'policy.kernel': []})])
+    replay(after, {'policy': 'learned'}, out=lambda line: None)
+    # A recorded change refused alone is the recording's.
+    bad = _with(bag, [_parameter_event(1000.2, {'confidence': 7.0})])
+    with pytest.raises(ValueError, match='^the recording: .*confidence.*'
+                                         r'\(with the parameters set at 0\.2 s'):
+        replay(bad, out=lambda line: None)
+
+
+def test_no_decision_is_said_as_such():
+    """Review: 'replay:   the last decision no decision'."""
+    from ipomdp_gaze.model.grid import Grid
+    grid = Grid(11, 11, 5.0)
+    recorded = [Event('found', 3, 4, 0.9), Event('lost', None, 6), Event('absent', None, 9, 0.9)]
+    result = ReplayResult(grid, [], [], recorded[-1].decision(), Decision(), 9, 3,
+                          first_difference=3, recorded_events=recorded)
+    from ipomdp_gaze.drivers.replay import _say_decisions
+    lines = []
+    _say_decisions(result, lines.append)
+    assert lines[-1] == 'replay:   no decision', lines
+    assert lines[-2].startswith('recorded: the last decision absent'), lines
+
+
+@pytest.mark.parametrize('option, value, recorded, named', [
+    ('observation', 'faces-pan-tilt-profile', {'observation.model': 'gaussian'},
+     'observation.model'),
+    ('policy_file', 'some-kernel', {'policy.name': 'map'}, 'policy.name'),
+    ('policy', 'map', {'policy.kernel': IDENTITY}, 'policy.kernel'),
+])
+def test_the_options_note_names_the_parameters_an_option_also_sets(option, value, recorded,
+                                                                   named):
+    bag = _with(_tracked_bag(), [_parameter_event(1000.2, recorded)])
+    text = describe_settings(bag, {option: value})
+    assert text.endswith(f"(not {named}: the options' values hold)"), text

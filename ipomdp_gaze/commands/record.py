@@ -107,12 +107,16 @@ def run_replay(args) -> int:
     overrides = {'observation': args.observation, 'policy': args.policy,
                  'policy_file': args.policy_file, 'confidence': args.confidence,
                  'max_fixations': args.max_fixations}
-    print(describe_settings(bag, overrides, args.new_search))
     if args.new_search:
         from ipomdp_gaze.drivers.replay import new_search
+        print(describe_settings(bag, overrides, args.new_search))
         new_search(bag, overrides)
         return 0
-    result = replay(bag, overrides)
+    # The replay first: the settings line says which recorded changes it applied.
+    result = replay(bag, overrides, out=lambda line: None)
+    print(describe_settings(bag, overrides, result=result))
+    for line in result.lines:
+        print(line)
     print(f'{result.frames} frames recorded, {result.applied} applied by the replay')
     if result.stopped_early and bag.parameters('foveal_detector').get('mode') == 'fovea':
         print('the recording is of a fixed camera: --new-search runs a whole new search on '

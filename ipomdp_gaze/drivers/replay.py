@@ -35,7 +35,8 @@ from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.policies.registry import build_policy
 from ipomdp_gaze.search import answer
-from ipomdp_gaze.search.controller_config import build_config, ControllerConfig
+from ipomdp_gaze.search.controller_config import build_config, ControllerConfig, grid_from, \
+    head_from
 from ipomdp_gaze.search.gaze import GazeController
 import numpy as np
 
@@ -171,6 +172,10 @@ class ReplayResult:
     recorded_people: list = field(default_factory=list)
     replay_people: list = field(default_factory=list)
     changes_applied: int = 0
+    # Each recorded change of the controller's parameters with what the replay did with it:
+    # 'start' (set before the replayed search: its setting from the start), 'applied' (at its
+    # time) or 'after' (after the replay's last frame: not applied).
+    changes: list = field(default_factory=list)
 
     @property
     def same(self) -> bool:
@@ -270,19 +275,33 @@ class ParameterChange:
     before: dict
 
 
+def node_name(bag, node: str = CONTROLLER) -> str:
+    """
+    Return the fully qualified name of the ``node`` whose parameters the recorder kept.
+
+    The recorder stores it (``ipomdp_gaze/parameters_node/<node>``); a bag written before it
+    did asked ``/<node>`` (the recorder's ``nodes`` are relative to the root namespace).
+    """
+    name = bag.custom_data.get(f'ipomdp_gaze/parameters_node/{node}')
+    return str(name) if name else '/' + node.strip('/')
+
+
 def parameter_changes(bag, node: str = CONTROLLER) -> list:
     """
     Return the :class:`ParameterChange` of ``node`` recorded on ``/parameter_events``.
 
-    Only those after the recorder asked for the parameters it keeps in the metadata (a value
-    set again to what it was is no change), so folding them into those gives the parameters
-    at any time of the recording.
+    ``/parameter_events`` is global: only the events of the very node the recorder asked for
+    its parameters (:func:`node_name`; a ``gaze_controller`` of another namespace is another
+    robot's) and only those after it asked (a value set again to what it was is no change), so
+    folding them into those gives the parameters at any time of the recording. A change set
+    while the recorder asked is already in the parameters it kept: it holds from the start.
     """
     since = int(bag.custom_data.get(f'ipomdp_gaze/parameters_time/{node}') or 0)
+    name = node_name(bag, node)
     values = dict(bag.parameters(node))
     out = []
     for m in bag.topic('/parameter_events'):
-        if m.time_ns < since or str(m.msg.node).rstrip('/').rsplit('/', 1)[-1] != node:
+        if m.time_ns < since or str(m.msg.node) != name:
             continue
         new = {}
         for p in list(m.msg.new_parameters) + list(m.msg.changed_parameters):
@@ -309,14 +328,33 @@ def _short(value) -> str:
         str(value)
 
 
-def describe_settings(bag, overrides: dict | None = None, new_search: bool = False) -> str:
+# What a replay did with a recorded change (ReplayResult.changes), as the settings line says it.
+CHANGE_FATES = {'start': 'before the replayed search (its setting from the start)',
+                'applied': 'applied by the replay at its time',
+                'after': "after the replay's last frame (not applied)"}
+
+
+def _changes_text(changes: list, start: int) -> str:
+    """Say ``changes`` with their times (s into the recording); one time's go together."""
+    at = {}
+    for c in changes:
+        at.setdefault(f'{(c.time_ns - start) * 1e-9:.1f}', []).extend(
+            f'{k} {_short(c.before[k])} -> {_short(v)}' for k, v in sorted(c.values.items()))
+    return '; '.join(f"at {t} s {', '.join(parts)}" for t, parts in at.items())
+
+
+def describe_settings(bag, overrides: dict | None = None, new_search: bool = False,
+                      result: ReplayResult | None = None) -> str:
     """
     Say in one line which settings a replay uses: the recorded, the options, the changes.
 
     A controller whose parameters were set while recording (``/parameter_events``) is not
     replayed with the recorded start values alone: the line names each change and its time
-    (seconds into the recording), which the replay sets at that time (``new_search``: the
-    new search on the last image uses the last values).
+    (seconds into the recording). Given the replay's ``result`` it says what the replay did
+    with each: in force from the replayed search's start, applied at its time, or after the
+    replay's last frame and not applied (``new_search``: the new search on the last image uses
+    the last values). An option holds over a recorded change of a parameter it sets, those it
+    sets besides its own among them (``--observation`` sets ``observation.model``).
     """
     given = {k: v for k, v in (overrides or {}).items() if v is not None}
     text = 'settings: recorded' + (', with ' + ', '.join(f'{k}={v}' for k, v in given.items())
@@ -325,17 +363,19 @@ def describe_settings(bag, overrides: dict | None = None, new_search: bool = Fal
     if not changes:
         return text
     start = bag.messages[0].time_ns if bag.messages else 0
-    kept = {OVERRIDES[k] for k in given}
-    at = {}                 # changes said at the same tenth of a second go together
-    for c in changes:
-        at.setdefault(f'{(c.time_ns - start) * 1e-9:.1f}', []).extend(
-            f'{k} {_short(c.before[k])} -> {_short(v)}' for k, v in sorted(c.values.items()))
-    said = '; '.join(f"at {t} s {', '.join(parts)}" for t, parts in at.items())
+    kept = set(settings_from({}, given))
     ignored = sorted(kept & {k for c in changes for k in c.values})
-    how = 'the new search uses the last values' if new_search else \
-        'each applied by the replay at its time'
-    return (f'{text}; {CONTROLLER} parameters set while recording, {how}: {said}' +
-            (f" (not {', '.join(ignored)}: the options' values hold)" if ignored else ''))
+    head = f'{text}; {CONTROLLER} parameters set while recording'
+    if new_search:
+        said = f', the new search uses the last values: {_changes_text(changes, start)}'
+    elif result is None:
+        said = f', each in force from its time: {_changes_text(changes, start)}'
+    else:
+        said = ': ' + '; '.join(
+            f'{words}: ' + _changes_text([c for c, f in result.changes if f == fate], start)
+            for fate, words in CHANGE_FATES.items() if any(f == fate for _, f in result.changes))
+    return head + said + (f" (not {', '.join(ignored)}: the options' values hold)"
+                          if ignored else '')
 
 
 def _seconds(stamp) -> float:
@@ -382,15 +422,25 @@ def _frames(bag, grid: Grid) -> list:
     return frames
 
 
-def _targets(bag, head: PanTiltMap) -> list:
-    """Return ``(sent_s, cell)`` of each target the controller sent (re-sends dropped)."""
+def _targets(bag, head: PanTiltMap, heads: tuple = ()) -> list:
+    """
+    Return ``(sent_s, cell)`` of each target the controller sent (re-sends dropped).
+
+    ``heads`` are ``(time_ns, PanTiltMap)`` of the head's later settings in time order: a
+    target recorded after one is mapped with it (a changed ``pan_offset_rad`` moves the angles
+    of the targets sent after it, not of those before).
+    """
     seen, out = set(), []
     for m in bag.topic('pan_tilt'):
         key = (m.msg.header.stamp.sec, m.msg.header.stamp.nanosec)
         if key in seen:
             continue
         seen.add(key)
-        out.append((_seconds(m.msg.header.stamp), head.nearest_cell(*_angles(m.msg, head))))
+        mapping = head
+        for time_ns, later in heads:
+            if time_ns <= m.time_ns:
+                mapping = later
+        out.append((_seconds(m.msg.header.stamp), mapping.nearest_cell(*_angles(m.msg, mapping))))
     return out
 
 
@@ -414,11 +464,9 @@ def search_start(bag, head: PanTiltMap, start: int) -> int | None:
     controller sends no target; the search's first target is then the next one.
     """
     grid = head.grid
-    resets = [m.time_ns for m in bag.topic('belief')
-              if np.size(m.msg.data) == grid.n_cells and np.ptp(np.asarray(m.msg.data)) == 0]
-    if not resets:
+    cut = _last_reset(bag, grid)
+    if cut is None:
         return None
-    cut = resets[-1]
     sent = [m for m in bag.topic('pan_tilt')
             if cut - RESET_WINDOW_S * 1e9 <= _seconds(m.msg.header.stamp) * 1e9
             <= cut + RESET_TARGET_S * 1e9 and head.nearest_cell(*_angles(m.msg, head)) == start]
@@ -429,17 +477,27 @@ def search_start(bag, head: PanTiltMap, start: int) -> int | None:
     return cut
 
 
-def recorded_events(bag) -> tuple[list, list]:
+def _last_reset(bag, grid: Grid) -> int | None:
+    """Return when (bag time, ns) the controller's last uniform ``belief`` arrived, if any."""
+    resets = [m.time_ns for m in bag.topic('belief')
+              if np.size(m.msg.data) == grid.n_cells and np.ptp(np.asarray(m.msg.data)) == 0]
+    return resets[-1] if resets else None
+
+
+def recorded_events(bag, since_s: float | None = None) -> tuple[list, list]:
     """
     Return the recorded ``(search events, people's events)``, each in firing order.
 
     A person's event (a moving many-target search) carries its ``person`` number; the others
-    are the search's own. Arrival order (an event of an earlier search may arrive late, after
-    the cut of :func:`last_search`, and must not count as this one's last).
+    are the search's own. Arrival order; ``since_s`` (bag time, s: the arrival of the search's
+    first applied frame) drops the events that arrived before it, an earlier search's that
+    arrived late, after the cut of :func:`last_search` (they must not count as this one's).
     """
     timed = []
     for kind in EVENTS:
         for m in bag.topic(kind):
+            if since_s is not None and m.time_ns * 1e-9 < since_s:
+                continue
             values = {kv.key: kv.value for kv in m.msg.values}
             timed.append((m.time_ns, Event(
                 kind, int(values['cell']) if 'cell' in values else None,
@@ -463,16 +521,27 @@ def _step_events(step) -> list:
     return out
 
 
-def _apply_change(core, config: ControllerConfig, parameters: dict, overrides) -> tuple:
+def _apply_change(core, config: ControllerConfig, parameters: dict, overrides,
+                  when: str) -> ControllerConfig:
     """
     Make the core follow changed parameters as the node does (``_apply_config``).
 
     The node's builder with what changed and the configuration before, then the observation,
-    the policy, the settings, the stamp tolerance and the seed.
+    the policy, the settings, the stamp tolerance and the seed. A refusal names its culprit,
+    the recording or an option, and ``when`` the change was set (``at 12.3 s``).
     """
     values = _with_defaults(settings_from(parameters, overrides))
     changed = {k for k, v in values.items() if config.values.get(k) != v}
-    new = build_config(values, build_policy, changed, config)
+    try:
+        new = build_config(values, build_policy, changed, config)
+    except ValueError as exc:
+        said = f'the recording: {exc}'
+        try:
+            checked_config(parameters, overrides)
+        except ValueError as named:
+            said = str(named)
+        raise ValueError(f'{said} (with the parameters set at {when} of the recording)') \
+            from None
     core.set_observation(new.observation)
     core.set_policy(new.policy)
     core.configure(new.settings, values['settle_time_s'])
@@ -510,40 +579,50 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
         raise ValueError(f'{bag.path} has no parameters of {CONTROLLER} in its metadata: was '
                          f'it recorded by the recorder node with the controller running?')
     changes = parameter_changes(bag)
-    config = checked_config(values_at(recorded_values, changes, None), overrides)
-    head = config.head
-    cut = search_start(bag, head, config.controller().reset(0.0))
+    origin = bag.messages[0].time_ns if bag.messages else 0
+    grid = grid_from(recorded_values)               # read-only: never set while recording
+    # The settings of the replayed search are those in force at its start (its reset), not
+    # the last ones: a change after it must not move its start cell or its head.
+    reset = _last_reset(bag, grid)
+    at = values_at(recorded_values, changes, origin if reset is None else reset)
+    config = checked_config(at, overrides)
+    cut = search_start(bag, config.head, config.controller().reset(0.0))
     if cut is not None:
         bag = dataclasses.replace(bag, messages=[m for m in bag.messages if m.time_ns >= cut])
     else:                   # one search: it began with the recording
-        cut = bag.messages[0].time_ns if bag.messages else 0
+        cut = origin
     parameters = values_at(recorded_values, changes, cut)
+    if parameters != at:
+        config = checked_config(parameters, overrides)
     pending = [c for c in changes if c.time_ns > cut]
-    config = _config(settings_from(parameters, overrides), 'the recording')
     core = config.controller()
     grid = core.grid
     frames = _frames(bag, grid)
-    targets = _targets(bag, head)
+    heads = tuple((c.time_ns, head_from(values_at(recorded_values, changes, c.time_ns), grid))
+                  for c in pending)
+    targets = _targets(bag, config.head, heads)
     if not targets:
         raise ValueError(f'{bag.path} has no pan_tilt target of the controller')
-    recorded_events_, recorded_people = recorded_events(bag)
-    recorded = last_decision(recorded_events_)
     recorded_cells = [cell for _, cell in targets]
     core.reset(targets[0][0])
     replayed_cells = [core.fixation]
-    result = ReplayResult(grid, recorded_cells, replayed_cells, recorded, Decision(),
-                          len(frames), 0, recorded_events=recorded_events_,
-                          recorded_people=recorded_people)
+    result = ReplayResult(grid, recorded_cells, replayed_cells, Decision(), Decision(),
+                          len(frames), 0)
+    result.changes = [(c, 'start') for c in changes if c.time_ns <= cut]
     say = result.lines.append
     if core.fixation != recorded_cells[0]:
         result.first_difference = 1
+    first_applied = None
     for stamp, arrival, values, kind, offsets, groups in frames:
         if result.first_difference is not None or core.stopped:
             break
         while pending and pending[0].time_ns * 1e-9 <= arrival:
-            parameters.update(pending.pop(0).values)
-            config = _apply_change(core, config, parameters, overrides)
+            change = pending.pop(0)
+            parameters.update(change.values)
+            config = _apply_change(core, config, parameters, overrides,
+                                   f'{(change.time_ns - origin) * 1e-9:.1f} s')
             result.changes_applied += 1
+            result.changes.append((change, 'applied'))
         k = core.fixations
         # The node sent its next target when it took the frame: the recorded send time.
         now = targets[k + 1][0] if k + 1 < len(targets) else arrival
@@ -553,6 +632,8 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
             step = core.offer(values, stamp, now, offsets=offsets, groups=groups)
         if not step.applied:
             continue
+        if first_applied is None:
+            first_applied = arrival
         result.applied += 1
         result.replay_events += _step_events(step)
         result.replay_people += in_firing_order([
@@ -564,6 +645,12 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
         n = len(replayed_cells)
         if n <= len(recorded_cells) and step.fixation != recorded_cells[n - 1]:
             result.first_difference = n
+    result.changes += [(c, 'after') for c in pending]
+    # The recorded events from this search's first applied frame on (a late one of the search
+    # before arrives after the cut but before that frame).
+    since = first_applied if first_applied is not None else frames[0][1]
+    result.recorded_events, result.recorded_people = recorded_events(bag, since)
+    result.recorded = last_decision(result.recorded_events)
     result.replayed = last_decision(result.replay_events)
     if result.first_difference is not None:
         n = result.first_difference
@@ -571,13 +658,25 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
         say(f'fixation {n} differs: recorded {rec}, replay {grid.cell(replayed_cells[n - 1])}; '
             f'the recorded frames after it were taken elsewhere, so the replay stops here')
         result.stopped_early = True
-    if core.follows_people or recorded_people:
+    if core.follows_people or result.recorded_people:
         _say_people(result, say)
     else:
         _say_decisions(result, say)
     for line in result.lines:
         out(line)
     return result
+
+
+def _decision_text(decision: Decision, last: str, grid: Grid) -> str:
+    """Say a decision after ``last`` ('the last decision '), or 'no decision' alone."""
+    return f'{last}{decision.describe(grid)}' if decision.kind else decision.describe(grid)
+
+
+def _difference_text(i: int, recorded: list, replayed: list, grid: Grid) -> str:
+    """Say the ``i``-th events of both lists: ``event 2 is X recorded, Y in the replay``."""
+    rec = recorded[i].describe(grid) if i < len(recorded) else 'none'
+    rep = replayed[i].describe(grid) if i < len(replayed) else 'none'
+    return f'event {i + 1} is {rec} recorded, {rep} in the replay'
 
 
 def _say_decisions(result: ReplayResult, say) -> None:
@@ -588,8 +687,8 @@ def _say_decisions(result: ReplayResult, say) -> None:
     if several:
         say(f'recorded events: {_events_text(result.recorded_events, grid)}')
         say(f'replay events:   {_events_text(result.replay_events, grid)}')
-    say(f'recorded: {last}{result.recorded.describe(grid)}')
-    say(f'replay:   {last}{result.replayed.describe(grid)}')
+    say(f'recorded: {_decision_text(result.recorded, last, grid)}')
+    say(f'replay:   {_decision_text(result.replayed, last, grid)}')
     if result.first_difference is not None:
         return
     if not result.recorded.same(result.replayed):
@@ -608,17 +707,25 @@ def _say_people(result: ReplayResult, say) -> None:
         'per person), not one decision')
     say(f'recorded: {_people_text(result.recorded_people)}')
     say(f'replay:   {_people_text(result.replay_people)}')
+    search = result.recorded_events or result.replay_events
+    if search:              # the search's own events (gave_up, say) are compared too
+        say(f'recorded search events: {_events_text(result.recorded_events, grid)}')
+        say(f'replay search events:   {_events_text(result.replay_events, grid)}')
     if result.first_difference is not None:
         return
     i = first_other(result.recorded_people, result.replay_people)
+    j = first_other(result.recorded_events, result.replay_events)
     if i is None:
-        say("the same fixations and the same people's events")
-        return
-    rec = result.recorded_people[i].describe(grid) if i < len(result.recorded_people) \
-        else 'none'
-    rep = result.replay_people[i].describe(grid) if i < len(result.replay_people) else 'none'
-    say(f"the same fixations, other people's events: event {i + 1} is {rec} recorded, "
-        f'{rep} in the replay')
+        text = "the same fixations and the same people's events"
+    else:
+        text = ("the same fixations, other people's events: "
+                + _difference_text(i, result.recorded_people, result.replay_people, grid))
+    if j is not None:
+        text += (', other search events: ' if i is None else '; other search events: ') + \
+            _difference_text(j, result.recorded_events, result.replay_events, grid)
+    elif search and i is None:
+        text += ' and search events'
+    say(text)
 
 
 def _search_frames(bag) -> list:
