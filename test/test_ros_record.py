@@ -308,3 +308,55 @@ def test_the_recorder_records_every_topic_of_the_controller_in_many_target_mode(
             '/gaze_controller/target_cells', '/parameter_events'} <= set(wanted)
     assert {t: recorded.get(t) for t in wanted} == wanted
     assert TOPICS['walk_truth'][0] is Float64MultiArray          # the scene camera's walk
+
+
+def test_the_recorder_keeps_the_full_name_and_times_the_ask_by_the_messages_clock(context,
+                                                                                  tmp_path):
+    """
+    Review: under use_sim_time the ask was timed by the simulated clock, the messages by wall time.
+
+    The recorder also names the node that answered, so a replay takes its /parameter_events
+    (a global topic) and not a namesake's.
+    """
+    import time
+    from builtin_interfaces.msg import Time as TimeMsg
+    from ipomdp_gaze.files.bag import read_bag
+    from ipomdp_gaze.nodes.recorder import RecorderNode
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+    from rosgraph_msgs.msg import Clock
+    source = Node('recorded_source', context=context)
+    source.declare_parameter('confidence', 0.9)
+    recorder = RecorderNode(context=context, parameter_overrides=[
+        Parameter('path', value=str(tmp_path / 'bag')),
+        Parameter('topics', value=['/parameter_events']),
+        Parameter('nodes', value=['recorded_source']),
+        Parameter('use_sim_time', value=True)])
+    clock = source.create_publisher(Clock, '/clock', 10)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(source)
+    executor.add_node(recorder)
+    before = time.time_ns()
+    try:
+        deadline = time.monotonic() + 30.0
+        while 'recorded_source' not in recorder.parameters and time.monotonic() < deadline:
+            # A simulation's clock, seconds from 100: far from the system time.
+            sim = 100.0 + time.monotonic() - deadline + 30.0
+            clock.publish(Clock(clock=TimeMsg(sec=int(sim), nanosec=int(sim % 1 * 1e9))))
+            executor.spin_once(timeout_sec=0.05)
+        assert 'recorded_source' in recorder.parameters
+        source.set_parameters([Parameter('confidence', value=0.8)])
+        deadline = time.monotonic() + 10.0
+        while not recorder.counts['/parameter_events'] and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.1)
+    finally:
+        executor.shutdown()
+        recorder.destroy_node()
+        source.destroy_node()
+    bag = read_bag(tmp_path / 'bag')
+    asked = int(bag.custom_data['ipomdp_gaze/parameters_time/recorded_source'])
+    assert before - 1e9 <= asked <= time.time_ns(), (before, asked)
+    assert bag.custom_data['ipomdp_gaze/parameters_node/recorded_source'] == '/recorded_source'
+    events = [m for m in bag.topic('/parameter_events') if m.msg.node == '/recorded_source']
+    assert events and all(m.time_ns >= asked for m in events)

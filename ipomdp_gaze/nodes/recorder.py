@@ -19,8 +19,11 @@ subscribed to and stays empty.
 
 The bag's ``custom_data`` (in ``metadata.yaml``) holds ``ipomdp_gaze/version`` (the package),
 ``ipomdp_gaze/parameters/<node>`` (every parameter of each node in ``nodes``, as YAML, fetched
-once they answer; ``ipomdp_gaze/parameters_time/<node>`` the recorder's time in ns when it
-asked for them, so a replay applies the ``/parameter_events`` after it) and
+once they answer; ``ipomdp_gaze/parameters_node/<node>`` the fully qualified name of the node
+that answered, ``/<node>``, so a replay takes that node's ``/parameter_events``, a global topic,
+and not a namesake's in another namespace; ``ipomdp_gaze/parameters_time/<node>`` when the
+recorder asked for them, in ns of the clock the messages are stamped with, so a replay applies
+the ``/parameter_events`` after it) and
 ``ipomdp_gaze/files`` (the sha256 of each policy and observation file those parameters
 name): what ``ipomdp-gaze replay`` needs to re-run the search. ``compression`` ``zstd``
 compresses the MCAP chunks (as rosbag2's ``zstd`` storage presets do; every MCAP
@@ -114,6 +117,11 @@ def recorder_params() -> list[Param]:
     ]
 
 
+def node_name(node: str) -> str:
+    """Return the fully qualified name of a node of ``nodes`` (relative to the root: ``/``)."""
+    return '/' + node.strip('/')
+
+
 def file_hashes(parameters: dict) -> dict:
     """``{name or path: sha256}`` of the policy and observation files named by parameters."""
     from ipomdp_gaze.files.observation_file import resolve_source as observation_source
@@ -181,9 +189,10 @@ class RecorderNode(QuietPublishers, Node):
 
         def write(data: bytes, info=None) -> None:
             # When the middleware received it (as ros2 bag), not when this callback ran: a
-            # busy executor takes the topics in its own order, later.
+            # busy executor takes the topics in its own order, later. That is the system
+            # clock's time, never the simulated one (use_sim_time), and so is the fallback.
             received = info.get('received_timestamp') if isinstance(info, dict) else None
-            stamp = int(received) if received else self.get_clock().now().nanoseconds
+            stamp = int(received) if received else time.time_ns()
             self.writer.write(connection, stamp, data)
             self.counts[topic] += 1
         return write
@@ -207,12 +216,14 @@ class RecorderNode(QuietPublishers, Node):
             clients = self._parameter_clients.get(node)
             if clients is None:
                 clients = self._parameter_clients[node] = (
-                    self.create_client(ListParameters, f'/{node}/list_parameters'),
-                    self.create_client(GetParameters, f'/{node}/get_parameters'))
+                    self.create_client(ListParameters, f'{node_name(node)}/list_parameters'),
+                    self.create_client(GetParameters, f'{node_name(node)}/get_parameters'))
             if not all(c.service_is_ready() for c in clients):
                 continue
             self._asked[node] = now
-            asked_ns = self.get_clock().now().nanoseconds
+            # The messages' clock (the middleware's receipt: system time), not the node's,
+            # which is the simulated time under use_sim_time.
+            asked_ns = time.time_ns()
             future = clients[0].call_async(ListParameters.Request())
             future.add_done_callback(lambda f, n=node, t=asked_ns: self._listed(n, f, t))
         if not self._pending:
@@ -225,10 +236,13 @@ class RecorderNode(QuietPublishers, Node):
 
     def _got(self, node: str, names: list, future, asked_ns: int) -> None:
         """
-        Keep the parameters of ``node`` and when they were asked for (``asked_ns``).
+        Keep the parameters of ``node``, its full name and when they were asked (``asked_ns``).
 
-        A parameter set after that time is on ``/parameter_events``; one set between the
-        request and the answer is in both, which a replay may apply twice harmlessly.
+        A parameter set after that time is on ``/parameter_events``. One set between the
+        request and the answer is already in the answer: its event carries the value kept, so
+        a replay sees no change there and takes that value from the start of the recording
+        (``/parameter_events`` does not carry the value before; nor does anything hold a change
+        made before the recorder asked).
         """
         values = {n: parameter_value_to_python(v) for n, v in zip(names, future.result().values)}
         values = {k: (list(v) if isinstance(v, (list, tuple)) or hasattr(v, 'tolist') else v)
@@ -238,6 +252,7 @@ class RecorderNode(QuietPublishers, Node):
         self.parameters[node] = values
         self.writer.set_custom_data(f'ipomdp_gaze/parameters/{node}',
                                     yaml.safe_dump(values, sort_keys=True))
+        self.writer.set_custom_data(f'ipomdp_gaze/parameters_node/{node}', node_name(node))
         self.writer.set_custom_data(f'ipomdp_gaze/parameters_time/{node}', str(asked_ns))
         self.writer.set_custom_data('ipomdp_gaze/files',
                                     yaml.safe_dump(file_hashes(self.parameters), sort_keys=True))
