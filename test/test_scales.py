@@ -257,9 +257,9 @@ CROWD = {(200, 200): 80, (200, 800): 80, (600, 500): 60, (600, 1200): 60, (960, 
          (960, 1000): 40}                                   # (y, x): side in px, 1600x1200
 
 
-def _crowd_sensor(fovea, crowd_ratio=search.CROWD_RATIO):
+def _crowd_sensor(fovea, crowd_ratio=search.CROWD_RATIO, crowd=None):
     image = np.zeros((1200, 1600, 3), dtype=np.uint8)
-    for (y, x), side in CROWD.items():
+    for (y, x), side in (CROWD if crowd is None else crowd).items():
         image[y:y + side, x:x + side] = 255
     prior = prior_log_odds(fovea.grid.n_cells, cell_prior(fovea.grid.n_cells, 0.5))
     sensor = search._Coarse(fovea, TABLE, (1600, 1200), prior, 0.99, budget=1600 * 1200,
@@ -396,3 +396,17 @@ def test_the_enlarged_looks_stay_within_the_pixel_budget(yunet_420, monkeypatch)
     assert frame.detector_pixels == 400 * 300 + 2 * cost <= allowed
     posterior = prior + frame.values        # the two looked at strong, the other two weak
     assert np.sum(posterior > 4) == 2 and np.sum(np.abs(posterior) < 1e-9) == 2
+
+
+def test_weak_boxes_of_small_faces_send_the_image_finer_only_when_there_are_enough(yunet_420):
+    _, fovea = yunet_420
+    whole = (0, 0, 1600, 1200)
+    faint = {(200, 200): 60, (200, 800): 60, (600, 500): 60, (900, 1200): 60}   # weak at 1/4
+    sensor, prior, frame = _crowd_sensor(fovea, crowd=faint)
+    assert [(rect, scale) for rect, scale, _ in sensor.looks] == [(whole, 0.25), (whole, 0.5)]
+    assert np.sum(prior + frame.values > np.log(99)) == 4
+    two = dict(list(faint.items())[:2])                         # fewer than CROWD_WEAK_BOXES
+    sensor, _, _ = _crowd_sensor(fovea, crowd=two)
+    assert search.CROWD_WEAK_BOXES == 3
+    assert sensor.looks[0][:2] == (whole, 0.25)
+    assert all(rect != whole for rect, _, _ in sensor.looks[1:])   # crops round each only
