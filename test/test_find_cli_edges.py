@@ -217,3 +217,11 @@ def test_scan_with_all_says_once_that_it_is_ignored(images, run_find):
     for flags in (('--all',), ('--scan', 'fovea')):
         result = run_find(images['astronaut'], *flags)
         assert result.returncode == 0 and 'ignored' not in result.stderr, result.stderr
+
+
+def test_a_panorama_is_not_enlarged_beyond_a_few_megapixels():
+    from ipomdp_gaze.vision.search_plots import enlarged, MAX_ENLARGED_SIDE_PX
+    pano, factor = enlarged(np.zeros((137, 2048, 3), np.uint8))
+    assert factor == 2 and pano.shape[1] <= MAX_ENLARGED_SIDE_PX      # 5x before: 10240 px
+    small, factor = enlarged(np.zeros((60, 80, 3), np.uint8))
+    assert factor == 11 and small.shape[:2] == (660, 880)             # small images as before

@@ -18,12 +18,22 @@ import numpy as np
 
 from .annotate import annotate, fovea_cell_map, LOG_RANGE
 
+# A picture's short side is enlarged to at least MIN_SIDE_PX (whole factors, nearest), its long
+# side staying within MAX_ENLARGED_SIDE_PX (a panorama stays a few Mpx)
 MIN_SIDE_PX = 640
+MAX_ENLARGED_SIDE_PX = 4096
 
 
-def enlarged(image: np.ndarray, min_side: int = MIN_SIDE_PX) -> tuple[np.ndarray, int]:
-    """Return the image scaled by a whole factor (nearest) so its short side >= min_side."""
+def enlarged(image: np.ndarray, min_side: int = MIN_SIDE_PX,
+             max_side: int = MAX_ENLARGED_SIDE_PX) -> tuple[np.ndarray, int]:
+    """
+    Return the image scaled by a whole factor (nearest) so its short side >= min_side.
+
+    The long side stays within ``max_side`` (a panorama is not blown up to megapixels that
+    the figure shrinks again).
+    """
     factor = max(1, int(np.ceil(min_side / max(1, min(image.shape[:2])))))
+    factor = max(1, min(factor, max_side // max(1, max(image.shape[:2]))))
     if factor == 1:
         return image, 1
     return cv2.resize(image, (image.shape[1] * factor, image.shape[0] * factor),
