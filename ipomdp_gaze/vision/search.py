@@ -694,8 +694,8 @@ class _Coarse(_Recorder):
         holds smaller faces than assumed (a crowd): faces ``crowd_ratio`` times smaller still
         would be seen, at the size in the detector's input at which this call saw its
         smallest, by a call ``1 / crowd_ratio`` times finer (the table's row at or above it,
-        else the finest). None when no box is that small, no finer row exists or
-        ``crowd_ratio`` is 0.
+        else the finest). None when no strong box and fewer than :data:`CROWD_WEAK_BOXES`
+        weak ones are that small, no finer row exists or ``crowd_ratio`` is 0.
         """
         if not self.crowd_ratio:
             return None
