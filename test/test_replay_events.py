@@ -365,6 +365,21 @@ def test_no_decision_is_said_as_such():
     assert lines[-2].startswith('recorded: the last decision absent'), lines
 
 
+def test_another_last_decision_is_said_in_plain_words():
+    """Review: 'the same fixations, another the last decision decision'."""
+    lines = []
+    result = replay(_tracked_bag(), {'confidence': 0.95}, out=lines.append)
+    assert result.first_difference is None and not result.same, lines
+    assert lines[-1] == 'the same fixations, another last decision', lines
+    from ipomdp_gaze.drivers.replay import _say_decisions
+    from ipomdp_gaze.model.grid import Grid
+    one = ReplayResult(Grid(11, 11, 5.0), [], [], Decision('absent', None, 0.9, 9),
+                       Decision(), 9, 9)
+    lines = []
+    _say_decisions(one, lines.append)
+    assert lines[-1] == 'the same fixations, another decision', lines
+
+
 @pytest.mark.parametrize('option, value, recorded, named', [
     ('observation', 'faces-pan-tilt-profile', {'observation.model': 'gaussian'},
      'observation.model'),

@@ -692,7 +692,8 @@ def _say_decisions(result: ReplayResult, say) -> None:
     if result.first_difference is not None:
         return
     if not result.recorded.same(result.replayed):
-        say(f'the same fixations, another {last}decision')
+        say('the same fixations, another last decision' if several else
+            'the same fixations, another decision')
     elif first_other(result.recorded_events, result.replay_events) is not None:
         say('the same fixations and the same last decision, other events before it')
     else:
