@@ -84,7 +84,9 @@ def _record(values: dict, faces, frames: int, changes=()) -> Bag:
 
     ``faces(i, fixation)`` gives the cells with a face at frame ``i``; a view counts 9
     detections on a face in its 5x5 cells and 0 elsewhere, NaN out of view. ``changes`` are
-    ``(frame, {parameter: value})`` set (as the node sets them) just before that frame.
+    ``(frame, {parameter: value})`` set (as the node sets them) just before that frame: one that
+    moves the head sends the current target again, stamped anew, and frames settle from then on
+    (the node's ``_send_target``); a frame taken sooner is skipped.
     """
     core, _ = build_controller(values)
     grid, config, live = core.grid, build_config(values, _build_policy()), dict(values)
@@ -92,6 +94,7 @@ def _record(values: dict, faces, frames: int, changes=()) -> Bag:
     core.reset(t)
 
     def target(now: float) -> None:
+        core.retarget(now)
         head = config.head          # a changed pan_offset_rad moves the targets sent after it
         pan, tilt = head.angles(core.fixation)
         msg = SimpleNamespace(header=SimpleNamespace(stamp=_stamp(now)),
@@ -103,10 +106,13 @@ def _record(values: dict, faces, frames: int, changes=()) -> Bag:
         t += FRAME_S
         if i in changes:
             live.update(changes[i])
-            config = build_config(live, _build_policy(), set(changes[i]), config)
+            old, config = config, build_config(live, _build_policy(), set(changes[i]), config)
+            core.set_observation(config.observation)
             core.set_policy(config.policy)
             core.configure(config.settings, live['settle_time_s'])
             messages.append(_parameter_event(t - 0.1, changes[i]))
+            if config.head != old.head and not core.stopped:
+                target(t - 0.1 + 0.001)
         row, col = grid.cell(core.fixation)
         evidence = np.full(grid.n_cells, np.nan, dtype=np.float32)
         for r in range(max(0, row - 2), min(grid.rows, row + 3)):
@@ -115,6 +121,8 @@ def _record(values: dict, faces, frames: int, changes=()) -> Bag:
         messages.append(BagMessage('/evidence', int(t * 1e9),
                                    SimpleNamespace(data=evidence), evidence.nbytes))
         step = core.offer(evidence.astype(np.float64), t, t + 0.01)
+        if step.status == 'skipped':
+            continue
         assert step.applied, step.reason
         # The recorder takes each event topic in its own order: here the reverse of firing.
         fired = [_event(k, getattr(step, k)) for k in EVENT_KEYS if getattr(step, k)]
@@ -391,3 +399,19 @@ def test_the_options_note_names_the_parameters_an_option_also_sets(option, value
     bag = _with(_tracked_bag(), [_parameter_event(1000.2, recorded)])
     text = describe_settings(bag, {option: value})
     assert text.endswith(f"(not {named}: the options' values hold)"), text
+
+
+def test_a_head_change_mid_search_resends_the_target_and_the_replay_settles_anew():
+    """Review: the node's re-send counted as a fixation, the replay never settled again."""
+    bag = _record(_parameters(*TRACKING, confidence=0.85), _walk_out(5 * 11 + 8, 20), 60,
+                  changes=[(6, {'pan_offset_rad': 0.05})])
+    change = bag.topic('parameter_events')[0].time_ns
+    after = [m for m in bag.topic('pan_tilt') if m.time_ns > change]
+    before = [m for m in bag.topic('pan_tilt') if m.time_ns < change][-1]
+    assert after[0].msg.position[1] == before.msg.position[1], 'the re-send of the same cell'
+    lines = []
+    result = replay(bag, out=lines.append)
+    assert result.changes_applied == 1 and result.same, lines
+    # The frame inside the re-sent target's settle window was skipped, by the node and replay.
+    assert result.applied == result.frames - 1, (result.applied, result.frames)
+    assert len(result.recorded_fixations) == len(bag.topic('pan_tilt')) - 1

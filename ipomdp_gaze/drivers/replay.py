@@ -389,7 +389,7 @@ def _angles(msg, head: PanTiltMap) -> tuple[float, float]:
 
 def _frames(bag, grid: Grid) -> list:
     """
-    Return ``(stamp_s, arrival_s, values, kind, offsets, groups)`` of every frame, by arrival.
+    Return ``(stamp_s, arrival_ns, values, kind, offsets, groups)`` of every frame, by arrival.
 
     ``kind`` is ``'scan'`` for a one-time scan (``header.frame_id`` ``scan/<id>``, design §10.3),
     else ``'fixation'``; ``offsets`` ``(N, 2)`` from a ``32FC3`` or ``32FC4`` evidence image
@@ -408,10 +408,9 @@ def _frames(bag, grid: Grid) -> list:
             raise ValueError(f'{bag.path}: an evidence_image cannot be read: {exc}') from None
         stamp = _seconds(msg.header.stamp)
         kind = 'scan' if str(msg.header.frame_id).startswith('scan/') else 'fixation'
-        frames.append((stamp or m.time_ns * 1e-9, m.time_ns * 1e-9, values, kind, offsets,
-                       groups))
+        frames.append((stamp or m.time_ns * 1e-9, m.time_ns, values, kind, offsets, groups))
     for m in bag.topic('evidence'):
-        frames.append((m.time_ns * 1e-9, m.time_ns * 1e-9,
+        frames.append((m.time_ns * 1e-9, m.time_ns,
                        np.asarray(m.msg.data, dtype=np.float64), 'fixation', None, None))
     frames.sort(key=lambda f: f[1])
     if not frames:
@@ -422,26 +421,47 @@ def _frames(bag, grid: Grid) -> list:
     return frames
 
 
-def _targets(bag, head: PanTiltMap, heads: tuple = ()) -> list:
+def _targets(bag, head: PanTiltMap, heads: tuple = (), frames_ns: tuple = ()) -> tuple:
     """
-    Return ``(sent_s, cell)`` of each target the controller sent (re-sends dropped).
+    Return ``(sent_s, cell)`` of each target the controller sent (re-sends dropped), re-sends.
 
     ``heads`` are ``(time_ns, PanTiltMap)`` of the head's later settings in time order: a
     target recorded after one is mapped with it (a changed ``pan_offset_rad`` moves the angles
-    of the targets sent after it, not of those before).
+    of the targets sent after it, not of those before). A change that moves the head makes the
+    node send its current target again, stamped anew (``_send_target``: frames settle from
+    then on); that is no new fixation. The first newly stamped target recorded after such a
+    change (from :data:`RESET_TARGET_S` before it: the topics arrive in their own order) and
+    before the next frame (``frames_ns``, arrival times), at the cell of the target before, is
+    that re-send: dropped, its stamp returned in ``{change time_ns: sent_s}``.
     """
-    seen, out = set(), []
+    moved, before = [], head
+    for time_ns, later in heads:
+        if later != before:
+            moved.append((time_ns, later))
+        before = later
+    frames_ns = sorted(frames_ns)
+    seen, out, resent = set(), [], {}
     for m in bag.topic('pan_tilt'):
         key = (m.msg.header.stamp.sec, m.msg.header.stamp.nanosec)
         if key in seen:
             continue
         seen.add(key)
+        sent = _seconds(m.msg.header.stamp)
+        change = next(((t, later) for t, later in moved if t not in resent
+                       and t - RESET_TARGET_S * 1e9 <= m.time_ns
+                       and not any(t <= f < m.time_ns for f in frames_ns)), None)
+        if change is not None and out:
+            resent[change[0]] = sent            # the re-send or the first target after it
+            if change[1].nearest_cell(*_angles(m.msg, change[1])) == out[-1][1]:
+                continue
+            del resent[change[0]]
+            moved.remove(change)                # a new target: the change made no re-send
         mapping = head
         for time_ns, later in heads:
             if time_ns <= m.time_ns:
                 mapping = later
-        out.append((_seconds(m.msg.header.stamp), mapping.nearest_cell(*_angles(m.msg, mapping))))
-    return out
+        out.append((sent, mapping.nearest_cell(*_angles(m.msg, mapping))))
+    return out, resent
 
 
 def last_search(bag, head: PanTiltMap, start: int):
@@ -484,19 +504,19 @@ def _last_reset(bag, grid: Grid) -> int | None:
     return resets[-1] if resets else None
 
 
-def recorded_events(bag, since_s: float | None = None) -> tuple[list, list]:
+def recorded_events(bag, since_ns: int | None = None) -> tuple[list, list]:
     """
     Return the recorded ``(search events, people's events)``, each in firing order.
 
     A person's event (a moving many-target search) carries its ``person`` number; the others
-    are the search's own. Arrival order; ``since_s`` (bag time, s: the arrival of the search's
+    are the search's own. Arrival order; ``since_ns`` (bag time: the arrival of the search's
     first applied frame) drops the events that arrived before it, an earlier search's that
     arrived late, after the cut of :func:`last_search` (they must not count as this one's).
     """
     timed = []
     for kind in EVENTS:
         for m in bag.topic(kind):
-            if since_s is not None and m.time_ns * 1e-9 < since_s:
+            if since_ns is not None and m.time_ns < since_ns:
                 continue
             values = {kv.key: kv.value for kv in m.msg.values}
             timed.append((m.time_ns, Event(
@@ -600,7 +620,7 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
     frames = _frames(bag, grid)
     heads = tuple((c.time_ns, head_from(values_at(recorded_values, changes, c.time_ns), grid))
                   for c in pending)
-    targets = _targets(bag, config.head, heads)
+    targets, resent = _targets(bag, config.head, heads, tuple(f[1] for f in frames))
     if not targets:
         raise ValueError(f'{bag.path} has no pan_tilt target of the controller')
     recorded_cells = [cell for _, cell in targets]
@@ -616,16 +636,18 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
     for stamp, arrival, values, kind, offsets, groups in frames:
         if result.first_difference is not None or core.stopped:
             break
-        while pending and pending[0].time_ns * 1e-9 <= arrival:
+        while pending and pending[0].time_ns <= arrival:
             change = pending.pop(0)
             parameters.update(change.values)
             config = _apply_change(core, config, parameters, overrides,
                                    f'{(change.time_ns - origin) * 1e-9:.1f} s')
+            if change.time_ns in resent:     # the node sent its target again: settle anew
+                core.retarget(resent[change.time_ns])
             result.changes_applied += 1
             result.changes.append((change, 'applied'))
         k = core.fixations
         # The node sent its next target when it took the frame: the recorded send time.
-        now = targets[k + 1][0] if k + 1 < len(targets) else arrival
+        now = targets[k + 1][0] if k + 1 < len(targets) else arrival * 1e-9
         if kind == 'scan':          # the one-time scan of this (the only recorded) search
             step = core.offer_scan(values, core.search_id, now)
         else:
