@@ -415,3 +415,36 @@ def test_a_head_change_mid_search_resends_the_target_and_the_replay_settles_anew
     # The frame inside the re-sent target's settle window was skipped, by the node and replay.
     assert result.applied == result.frames - 1, (result.applied, result.frames)
     assert len(result.recorded_fixations) == len(bag.topic('pan_tilt')) - 1
+
+
+@pytest.mark.parametrize('files', [TRACKING, PEOPLE])
+def test_a_recording_under_sim_time_replays_its_frames_on_the_stamps_clock(files):
+    """Review: bag times (system clock) against sim-time stamps: 0 frames, 'the same ...'."""
+    import dataclasses
+    bag = _record(_parameters(*files, confidence=0.85), _walk_out(5 * 11 + 8, 20), 60)
+    reset = BagMessage('/belief', int(999.9995e9), SimpleNamespace(data=np.full(121, 1 / 121)),
+                       0)
+    shift = int(1.7e18)     # received on the system clock; the headers on the simulated one
+    moved = Bag(bag.path, [dataclasses.replace(m, time_ns=m.time_ns + shift) for m in
+                           sorted(bag.messages + [reset], key=lambda m: m.time_ns)],
+                dict(bag.custom_data, **{'ipomdp_gaze/parameters_time/gaze_controller':
+                                         str(int(999e9) + shift)}), 0, bag.duration_s)
+    lines = []
+    result = replay(moved, out=lines.append)
+    assert result.applied == result.frames and result.same, lines
+
+
+def test_no_frame_applied_is_said_as_nothing_compared():
+    """Review: 0 frames applied, and the replay said 'the same fixations'."""
+    bag = _tracked_bag()
+    nan = SimpleNamespace(data=np.full(121, np.nan, dtype=np.float32))
+    blind = Bag(bag.path, [BagMessage(m.topic, m.time_ns, nan, 0) if m.topic == '/evidence'
+                           else m for m in bag.messages if m.topic not in
+                           ('/found', '/lost', '/absent')], bag.custom_data, 0, bag.duration_s)
+    lines = []
+    result = replay(blind, out=lines.append)
+    assert result.applied == 0 and not result.same, lines
+    assert lines[-1].startswith('nothing compared: the replay applied none of the '
+                                f'{result.frames} recorded frames ('), lines
+    assert 'every cell is NaN' in lines[-1], lines
+    assert not any(line.startswith('the same') for line in lines), lines

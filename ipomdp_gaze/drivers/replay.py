@@ -48,6 +48,9 @@ IMAGE_CHANNELS = {'mono8': 1, 'rgb8': 3, 'bgr8': 3}
 # comes when it is enabled, after the reset belief).
 RESET_TARGET_S = 0.005
 RESET_WINDOW_S = 0.25
+# Header stamps this much or more away from the messages' arrival are of another clock (the
+# simulated one under use_sim_time; the recorder writes the system clock's receipt).
+CLOCKS_APART_S = 1.0
 # The bag's growth per minute of search is extrapolated from at least this many seconds and
 # frames (a face demo's search: 3-10 frames over 2.5-10 s).
 MIN_RATE_S, MIN_RATE_FRAMES = 2.0, 3
@@ -176,11 +179,14 @@ class ReplayResult:
     # 'start' (set before the replayed search: its setting from the start), 'applied' (at its
     # time) or 'after' (after the replay's last frame: not applied).
     changes: list = field(default_factory=list)
+    # Why no frame was applied (the most frequent reason, with its count), when none was.
+    unused: str = ''
 
     @property
     def same(self) -> bool:
-        """Whether every compared fixation, the events, the last decision and the people agree."""
-        return (self.first_difference is None and self.recorded.same(self.replayed)
+        """Whether frames were applied and the fixations, events, decisions and people agree."""
+        return (self.applied > 0 and self.first_difference is None
+                and self.recorded.same(self.replayed)
                 and first_other(self.recorded_events, self.replay_events) is None
                 and first_other(self.recorded_people, self.replay_people) is None)
 
@@ -387,14 +393,51 @@ def _angles(msg, head: PanTiltMap) -> tuple[float, float]:
     return tuple(float(msg.position[names.index(j)]) for j in (head.pan_joint, head.tilt_joint))
 
 
-def _frames(bag, grid: Grid) -> list:
+class StampClock:
+    """
+    Bag time (the system clock's receipt) on the header stamps' clock.
+
+    Under use_sim_time the nodes stamp with the simulated clock while the recorder writes when
+    the middleware received each message (system time). The controller's targets carry both:
+    a time of the bag is moved by the difference of the last target received before it (or the
+    first), so a header-less frame, a zero stamp and the reset's arrival are on the clock of the
+    stamps. Clocks less than :data:`CLOCKS_APART_S` apart are one: the time is kept as it is.
+    """
+
+    def __init__(self, bag):
+        pairs = sorted((m.time_ns, m.time_ns - int(m.msg.header.stamp.sec) * 10**9
+                        - int(m.msg.header.stamp.nanosec)) for m in bag.topic('pan_tilt'))
+        apart = pairs and abs(sorted(d for _, d in pairs)[len(pairs) // 2]) >= CLOCKS_APART_S * 1e9
+        self.pairs = pairs if apart else []
+
+    @property
+    def apart(self) -> bool:
+        """Whether the stamps are of another clock than the bag's times."""
+        return bool(self.pairs)
+
+    def stamp_ns(self, time_ns: int) -> int:
+        """Return bag time ``time_ns`` on the stamps' clock (ns)."""
+        if not self.pairs:
+            return int(time_ns)
+        before = [d for t, d in self.pairs if t <= time_ns]
+        return int(time_ns) - (before[-1] if before else self.pairs[0][1])
+
+    def stamp_s(self, time_ns: int) -> float:
+        """Return bag time ``time_ns`` on the stamps' clock (s)."""
+        return self.stamp_ns(time_ns) * 1e-9
+
+
+def _frames(bag, grid: Grid, clock: StampClock | None = None) -> list:
     """
     Return ``(stamp_s, arrival_ns, values, kind, offsets, groups)`` of every frame, by arrival.
 
+    A frame without a header (``evidence``) or with a zero stamp is stamped when it arrived,
+    on the stamps' clock (``clock``, :class:`StampClock`), as the node stamps it when it takes it.
     ``kind`` is ``'scan'`` for a one-time scan (``header.frame_id`` ``scan/<id>``, design §10.3),
     else ``'fixation'``; ``offsets`` ``(N, 2)`` from a ``32FC3`` or ``32FC4`` evidence image
     (design §12.9), ``groups`` ``(N,)`` from a ``32FC4`` one (design §11.7), else None.
     """
+    clock = clock or StampClock(bag)
     frames = []
     for m in bag.topic('evidence_image'):
         msg = m.msg
@@ -408,9 +451,10 @@ def _frames(bag, grid: Grid) -> list:
             raise ValueError(f'{bag.path}: an evidence_image cannot be read: {exc}') from None
         stamp = _seconds(msg.header.stamp)
         kind = 'scan' if str(msg.header.frame_id).startswith('scan/') else 'fixation'
-        frames.append((stamp or m.time_ns * 1e-9, m.time_ns, values, kind, offsets, groups))
+        frames.append((stamp or clock.stamp_s(m.time_ns), m.time_ns, values, kind, offsets,
+                       groups))
     for m in bag.topic('evidence'):
-        frames.append((m.time_ns * 1e-9, m.time_ns,
+        frames.append((clock.stamp_s(m.time_ns), m.time_ns,
                        np.asarray(m.msg.data, dtype=np.float64), 'fixation', None, None))
     frames.sort(key=lambda f: f[1])
     if not frames:
@@ -487,9 +531,10 @@ def search_start(bag, head: PanTiltMap, start: int) -> int | None:
     cut = _last_reset(bag, grid)
     if cut is None:
         return None
+    at = StampClock(bag).stamp_ns(cut)         # the reset's arrival on the stamps' clock
     sent = [m for m in bag.topic('pan_tilt')
-            if cut - RESET_WINDOW_S * 1e9 <= _seconds(m.msg.header.stamp) * 1e9
-            <= cut + RESET_TARGET_S * 1e9 and head.nearest_cell(*_angles(m.msg, head)) == start]
+            if at - RESET_WINDOW_S * 1e9 <= _seconds(m.msg.header.stamp) * 1e9
+            <= at + RESET_TARGET_S * 1e9 and head.nearest_cell(*_angles(m.msg, head)) == start]
     if sent:
         first = max(sent, key=lambda m: _seconds(m.msg.header.stamp))
         stamp = first.msg.header.stamp
@@ -617,7 +662,8 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
     pending = [c for c in changes if c.time_ns > cut]
     core = config.controller()
     grid = core.grid
-    frames = _frames(bag, grid)
+    clock = StampClock(bag)
+    frames = _frames(bag, grid, clock)
     heads = tuple((c.time_ns, head_from(values_at(recorded_values, changes, c.time_ns), grid))
                   for c in pending)
     targets, resent = _targets(bag, config.head, heads, tuple(f[1] for f in frames))
@@ -632,7 +678,7 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
     say = result.lines.append
     if core.fixation != recorded_cells[0]:
         result.first_difference = 1
-    first_applied = None
+    first_applied, unused = None, {}
     for stamp, arrival, values, kind, offsets, groups in frames:
         if result.first_difference is not None or core.stopped:
             break
@@ -647,12 +693,13 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
             result.changes.append((change, 'applied'))
         k = core.fixations
         # The node sent its next target when it took the frame: the recorded send time.
-        now = targets[k + 1][0] if k + 1 < len(targets) else arrival * 1e-9
+        now = targets[k + 1][0] if k + 1 < len(targets) else clock.stamp_s(arrival)
         if kind == 'scan':          # the one-time scan of this (the only recorded) search
             step = core.offer_scan(values, core.search_id, now)
         else:
             step = core.offer(values, stamp, now, offsets=offsets, groups=groups)
         if not step.applied:
+            unused[step.reason or step.status] = unused.get(step.reason or step.status, 0) + 1
             continue
         if first_applied is None:
             first_applied = arrival
@@ -668,6 +715,10 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
         if n <= len(recorded_cells) and step.fixation != recorded_cells[n - 1]:
             result.first_difference = n
     result.changes += [(c, 'after') for c in pending]
+    if not result.applied and unused:
+        why, n = max(unused.items(), key=lambda kv: kv[1])
+        result.unused = f'{n} {why}' + (' (the clocks of the stamps and of the recording differ)'
+                                        if clock.apart else '')
     # The recorded events from this search's first applied frame on (a late one of the search
     # before arrives after the cut but before that frame).
     since = first_applied if first_applied is not None else frames[0][1]
@@ -711,7 +762,7 @@ def _say_decisions(result: ReplayResult, say) -> None:
         say(f'replay events:   {_events_text(result.replay_events, grid)}')
     say(f'recorded: {_decision_text(result.recorded, last, grid)}')
     say(f'replay:   {_decision_text(result.replayed, last, grid)}')
-    if result.first_difference is not None:
+    if result.first_difference is not None or _said_none_applied(result, say):
         return
     if not result.recorded.same(result.replayed):
         say('the same fixations, another last decision' if several else
@@ -721,6 +772,15 @@ def _say_decisions(result: ReplayResult, say) -> None:
     else:
         say('the same fixations, the same events and the same last decision' if several else
             'the same fixations and the same decision')
+
+
+def _said_none_applied(result: ReplayResult, say) -> bool:
+    """Say that nothing was compared when the replay applied no frame, and why; whether so."""
+    if result.applied:
+        return False
+    say(f'nothing compared: the replay applied none of the {result.frames} recorded frames'
+        + (f' ({result.unused})' if result.unused else ''))
+    return True
 
 
 def _say_people(result: ReplayResult, say) -> None:
@@ -734,7 +794,7 @@ def _say_people(result: ReplayResult, say) -> None:
     if search:              # the search's own events (gave_up, say) are compared too
         say(f'recorded search events: {_events_text(result.recorded_events, grid)}')
         say(f'replay search events:   {_events_text(result.replay_events, grid)}')
-    if result.first_difference is not None:
+    if result.first_difference is not None or _said_none_applied(result, say):
         return
     i = first_other(result.recorded_people, result.replay_people)
     j = first_other(result.recorded_events, result.replay_events)
