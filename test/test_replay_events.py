@@ -448,3 +448,24 @@ def test_no_frame_applied_is_said_as_nothing_compared():
                                 f'{result.frames} recorded frames ('), lines
     assert 'every cell is NaN' in lines[-1], lines
     assert not any(line.startswith('the same') for line in lines), lines
+
+
+def test_a_bag_recorded_in_a_namespace_replays_its_topics_and_its_controllers_changes():
+    """Review: '-r __ns:=/head1' wrote /head1/pan_tilt; the replay looked for /pan_tilt."""
+    import dataclasses
+    bag = _record(_parameters(*TRACKING, confidence=0.95), _walk_out(5 * 11 + 8, 20), 60,
+                  changes=[(25, {'confidence': 0.85})])
+    moved = [m if m.topic == '/parameter_events' else
+             dataclasses.replace(m, topic='/head1' + m.topic) for m in bag.messages]
+    for m in moved:
+        if m.topic == '/parameter_events':
+            m.msg.node = '/head1/gaze_controller'
+    spaced = Bag(bag.path, moved, dict(bag.custom_data, **{
+        'ipomdp_gaze/namespace': '/head1',
+        'ipomdp_gaze/parameters_node/gaze_controller': '/head1/gaze_controller'}), 0,
+        bag.duration_s)
+    assert spaced.topic('pan_tilt') and spaced.topic('/parameter_events')
+    lines = []
+    result = replay(spaced, out=lines.append)
+    assert result.changes_applied == 1 and result.same, lines
+    assert result.applied == result.frames

@@ -310,6 +310,21 @@ def test_the_recorder_records_every_topic_of_the_controller_in_many_target_mode(
     assert TOPICS['walk_truth'][0] is Float64MultiArray          # the scene camera's walk
 
 
+def _events_written(recorder) -> list:
+    """Return the list the recorder's written ``/parameter_events`` nodes will be added to."""
+    from rcl_interfaces.msg import ParameterEvent
+    from rclpy.serialization import deserialize_message
+    written, write = [], recorder.writer.write
+    connection = recorder.connections['/parameter_events']
+
+    def spy(conn, stamp, data):
+        write(conn, stamp, data)
+        if conn is connection:
+            written.append(str(deserialize_message(data, ParameterEvent).node))
+    recorder.writer.write = spy
+    return written
+
+
 def test_the_recorder_keeps_the_full_name_and_times_the_ask_by_the_messages_clock(context,
                                                                                   tmp_path):
     """
@@ -346,9 +361,10 @@ def test_the_recorder_keeps_the_full_name_and_times_the_ask_by_the_messages_cloc
             clock.publish(Clock(clock=TimeMsg(sec=int(sim), nanosec=int(sim % 1 * 1e9))))
             executor.spin_once(timeout_sec=0.05)
         assert 'recorded_source' in recorder.parameters
+        written = _events_written(recorder)
         source.set_parameters([Parameter('confidence', value=0.8)])
         deadline = time.monotonic() + 10.0
-        while not recorder.counts['/parameter_events'] and time.monotonic() < deadline:
+        while '/recorded_source' not in written and time.monotonic() < deadline:
             executor.spin_once(timeout_sec=0.1)
     finally:
         executor.shutdown()
@@ -360,3 +376,50 @@ def test_the_recorder_keeps_the_full_name_and_times_the_ask_by_the_messages_cloc
     assert bag.custom_data['ipomdp_gaze/parameters_node/recorded_source'] == '/recorded_source'
     events = [m for m in bag.topic('/parameter_events') if m.msg.node == '/recorded_source']
     assert events and all(m.time_ns >= asked for m in events)
+
+
+def test_a_recorder_in_a_namespace_asks_its_node_there_and_the_replay_reads_it(context,
+                                                                               tmp_path):
+    """Review: under -r __ns:=/head1 the topics were /head1/..., the parameters asked of /."""
+    import time
+    from ipomdp_gaze.files.bag import read_bag
+    from ipomdp_gaze.nodes.recorder import RecorderNode, TOPICS
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+    from sensor_msgs.msg import JointState
+    source = Node('recorded_source', namespace='/head1', context=context)
+    source.declare_parameter('confidence', 0.9)
+    recorder = RecorderNode(context=context, namespace='/head1', parameter_overrides=[
+        Parameter('path', value=str(tmp_path / 'bag')),
+        Parameter('topics', value=['pan_tilt', '/parameter_events']),
+        Parameter('nodes', value=['recorded_source'])])
+    target = source.create_publisher(JointState, 'pan_tilt', TOPICS['pan_tilt'][2])
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(source)
+    executor.add_node(recorder)
+    try:
+        written = _events_written(recorder)
+        deadline = time.monotonic() + 30.0
+        while 'recorded_source' not in recorder.parameters and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.05)
+        assert 'recorded_source' in recorder.parameters
+        target.publish(JointState(name=['pan', 'tilt'], position=[0.0, 0.0]))
+        source.set_parameters([Parameter('confidence', value=0.8)])
+        deadline = time.monotonic() + 10.0
+        while (not recorder.counts['pan_tilt'] or '/head1/recorded_source' not in written) \
+                and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.1)
+    finally:
+        executor.shutdown()
+        recorder.destroy_node()
+        source.destroy_node()
+    bag = read_bag(tmp_path / 'bag')
+    assert bag.custom_data['ipomdp_gaze/namespace'] == '/head1'
+    assert bag.custom_data['ipomdp_gaze/parameters_node/recorded_source'] == \
+        '/head1/recorded_source'
+    assert bag.parameters('recorded_source')['confidence'] == 0.9
+    assert [m.topic for m in bag.topic('pan_tilt')] == ['/head1/pan_tilt']
+    from ipomdp_gaze.drivers.replay import parameter_changes
+    assert [c.values for c in parameter_changes(bag, 'recorded_source')] == \
+        [{'confidence': 0.8}]

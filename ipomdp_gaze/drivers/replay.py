@@ -285,8 +285,8 @@ def node_name(bag, node: str = CONTROLLER) -> str:
     """
     Return the fully qualified name of the ``node`` whose parameters the recorder kept.
 
-    The recorder stores it (``ipomdp_gaze/parameters_node/<node>``); a bag written before it
-    did asked ``/<node>`` (the recorder's ``nodes`` are relative to the root namespace).
+    The recorder stores it (``ipomdp_gaze/parameters_node/<node>``: ``/head1/gaze_controller``
+    when it recorded in ``/head1``); a bag written before it did asked ``/<node>``.
     """
     name = bag.custom_data.get(f'ipomdp_gaze/parameters_node/{node}')
     return str(name) if name else '/' + node.strip('/')

@@ -20,6 +20,8 @@ import yaml
 
 DISTRO_STORE = 'ROS2_JAZZY'
 COMPRESSIONS = ('', 'zstd')
+# The recorder's absolute topics (the others are relative: resolved in its namespace).
+ABSOLUTE_TOPICS = ('diagnostics', 'parameter_events')
 
 
 def _typestore():
@@ -103,9 +105,21 @@ class Bag:
     size_bytes: int
     duration_s: float
 
+    @property
+    def namespace(self) -> str:
+        """Return where the recorder resolved its relative topics (``/`` when not kept)."""
+        return str(self.custom_data.get('ipomdp_gaze/namespace') or '/')
+
     def topic(self, name: str) -> list:
-        """Return the messages of the topic ``name`` (with or without its leading slash)."""
-        name = name.lstrip('/')
+        """
+        Return the messages of the topic ``name``, resolved in the recorder's namespace.
+
+        ``pan_tilt`` of a bag recorded in ``/head1`` is ``/head1/pan_tilt``; ``/parameter_events``
+        is absolute, as is any name in the root namespace (with or without its leading slash).
+        """
+        name = name.strip('/')
+        if self.namespace.strip('/') and name not in ABSOLUTE_TOPICS:
+            name = self.namespace.strip('/') + '/' + name
         return [m for m in self.messages if m.topic.lstrip('/') == name]
 
     def parameters(self, node: str) -> dict:

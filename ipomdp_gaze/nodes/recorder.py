@@ -20,10 +20,12 @@ subscribed to and stays empty.
 The bag's ``custom_data`` (in ``metadata.yaml``) holds ``ipomdp_gaze/version`` (the package),
 ``ipomdp_gaze/parameters/<node>`` (every parameter of each node in ``nodes``, as YAML, fetched
 once they answer; ``ipomdp_gaze/parameters_node/<node>`` the fully qualified name of the node
-that answered, ``/<node>``, so a replay takes that node's ``/parameter_events``, a global topic,
-and not a namesake's in another namespace; ``ipomdp_gaze/parameters_time/<node>`` when the
-recorder asked for them, in ns of the clock the messages are stamped with, so a replay applies
-the ``/parameter_events`` after it) and
+that answered, ``<namespace>/<node>``, so a replay takes that node's ``/parameter_events``, a
+global topic, and not a namesake's in another namespace;
+``ipomdp_gaze/parameters_time/<node>`` when the recorder asked for them, in ns of the clock the
+messages are stamped with, so a replay applies the ``/parameter_events`` after it),
+``ipomdp_gaze/namespace`` (the recorder's: its relative topics and nodes are resolved in it,
+``/head1/pan_tilt`` under ``-r __ns:=/head1``) and
 ``ipomdp_gaze/files`` (the sha256 of each policy and observation file those parameters
 name): what ``ipomdp-gaze replay`` needs to re-run the search. ``compression`` ``zstd``
 compresses the MCAP chunks (as rosbag2's ``zstd`` storage presets do; every MCAP
@@ -117,9 +119,16 @@ def recorder_params() -> list[Param]:
     ]
 
 
-def node_name(node: str) -> str:
-    """Return the fully qualified name of a node of ``nodes`` (relative to the root: ``/``)."""
-    return '/' + node.strip('/')
+def node_name(node: str, namespace: str = '/') -> str:
+    """
+    Return the fully qualified name of a node of ``nodes``, resolved as a topic is.
+
+    A relative name is in the recorder's ``namespace`` (``--ros-args -r __ns:=/head1`` records
+    ``/head1/pan_tilt`` and asks ``/head1/gaze_controller``); ``/name`` is absolute.
+    """
+    if node.startswith('/'):
+        return '/' + node.strip('/')
+    return namespace.rstrip('/') + '/' + node.strip('/')
 
 
 def file_hashes(parameters: dict) -> dict:
@@ -155,6 +164,8 @@ class RecorderNode(QuietPublishers, Node):
         from ipomdp_gaze.files.share_files import package_version
         self.writer = open_writer(values['path'], values['compression'])
         self.writer.set_custom_data('ipomdp_gaze/version', package_version())
+        # The namespace the relative topics and nodes were resolved in: a replay's too.
+        self.writer.set_custom_data('ipomdp_gaze/namespace', self.get_namespace())
         self.connections = {}
         self.counts = dict.fromkeys(values['topics'], 0)
         self.subscriptions_ = {}
@@ -215,9 +226,10 @@ class RecorderNode(QuietPublishers, Node):
                 del self._asked[node]
             clients = self._parameter_clients.get(node)
             if clients is None:
+                name = node_name(node, self.get_namespace())
                 clients = self._parameter_clients[node] = (
-                    self.create_client(ListParameters, f'{node_name(node)}/list_parameters'),
-                    self.create_client(GetParameters, f'{node_name(node)}/get_parameters'))
+                    self.create_client(ListParameters, f'{name}/list_parameters'),
+                    self.create_client(GetParameters, f'{name}/get_parameters'))
             if not all(c.service_is_ready() for c in clients):
                 continue
             self._asked[node] = now
@@ -252,7 +264,8 @@ class RecorderNode(QuietPublishers, Node):
         self.parameters[node] = values
         self.writer.set_custom_data(f'ipomdp_gaze/parameters/{node}',
                                     yaml.safe_dump(values, sort_keys=True))
-        self.writer.set_custom_data(f'ipomdp_gaze/parameters_node/{node}', node_name(node))
+        self.writer.set_custom_data(f'ipomdp_gaze/parameters_node/{node}',
+                                    node_name(node, self.get_namespace()))
         self.writer.set_custom_data(f'ipomdp_gaze/parameters_time/{node}', str(asked_ns))
         self.writer.set_custom_data('ipomdp_gaze/files',
                                     yaml.safe_dump(file_hashes(self.parameters), sort_keys=True))
