@@ -469,3 +469,15 @@ def test_a_bag_recorded_in_a_namespace_replays_its_topics_and_its_controllers_ch
     result = replay(spaced, out=lines.append)
     assert result.changes_applied == 1 and result.same, lines
     assert result.applied == result.frames
+
+
+def test_a_refused_replay_still_says_its_settings(cli_here, monkeypatch, tmp_path):
+    """Review: the settings line was printed only after a replay that did not raise."""
+    bag = _with(_tracked_bag(policy__kernel=IDENTITY),
+                [_parameter_event(1000.2, {'policy.kernel': []})])
+    monkeypatch.setattr('ipomdp_gaze.files.bag.read_bag', lambda path: bag)
+    run = cli_here('replay', tmp_path, '--policy', 'learned')
+    assert run.returncode == 2, run
+    assert 'settings: recorded, with policy=learned; gaze_controller parameters set while ' \
+        'recording, each in force from its time: at ' in run.stdout, run.stdout
+    assert "--policy: policy 'learned' needs policy.kernel" in run.stderr, run.stderr

@@ -112,8 +112,13 @@ def run_replay(args) -> int:
         print(describe_settings(bag, overrides, args.new_search))
         new_search(bag, overrides)
         return 0
-    # The replay first: the settings line says which recorded changes it applied.
-    result = replay(bag, overrides, out=lambda line: None)
+    # The replay first: the settings line says which recorded changes it applied. A replay
+    # refused (a recorded change an option breaks, say) still says the settings it was given.
+    try:
+        result = replay(bag, overrides, out=lambda line: None)
+    except ValueError:
+        print(describe_settings(bag, overrides), flush=True)
+        raise
     print(describe_settings(bag, overrides, result=result))
     for line in result.lines:
         print(line)
