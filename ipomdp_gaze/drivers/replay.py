@@ -25,6 +25,7 @@ controller settings. No rclpy here: messages come from ``rosbags``.
 """
 from __future__ import annotations
 
+import bisect
 import dataclasses
 from dataclasses import dataclass, field
 import math
@@ -409,6 +410,7 @@ class StampClock:
                         - int(m.msg.header.stamp.nanosec)) for m in bag.topic('pan_tilt'))
         apart = pairs and abs(sorted(d for _, d in pairs)[len(pairs) // 2]) >= CLOCKS_APART_S * 1e9
         self.pairs = pairs if apart else []
+        self.times = [t for t, _ in self.pairs]
 
     @property
     def apart(self) -> bool:
@@ -419,8 +421,8 @@ class StampClock:
         """Return bag time ``time_ns`` on the stamps' clock (ns)."""
         if not self.pairs:
             return int(time_ns)
-        before = [d for t, d in self.pairs if t <= time_ns]
-        return int(time_ns) - (before[-1] if before else self.pairs[0][1])
+        k = bisect.bisect_right(self.times, int(time_ns))     # targets received by then
+        return int(time_ns) - self.pairs[max(k - 1, 0)][1]
 
     def stamp_s(self, time_ns: int) -> float:
         """Return bag time ``time_ns`` on the stamps' clock (s)."""
