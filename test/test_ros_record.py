@@ -310,6 +310,14 @@ def test_the_recorder_records_every_topic_of_the_controller_in_many_target_mode(
     assert TOPICS['walk_truth'][0] is Float64MultiArray          # the scene camera's walk
 
 
+def _spin_until(executor, done, timeout_s: float, step_s: float = 0.1) -> None:
+    """Spin ``executor`` until ``done()`` or ``timeout_s`` (the caller asserts what it needs)."""
+    import time
+    deadline = time.monotonic() + timeout_s
+    while not done() and time.monotonic() < deadline:
+        executor.spin_once(timeout_sec=step_s)
+
+
 def _events_written(recorder) -> list:
     """Return the list the recorder's written ``/parameter_events`` nodes will be added to."""
     from rcl_interfaces.msg import ParameterEvent
@@ -363,9 +371,7 @@ def test_the_recorder_keeps_the_full_name_and_times_the_ask_by_the_messages_cloc
         assert 'recorded_source' in recorder.parameters
         written = _events_written(recorder)
         source.set_parameters([Parameter('confidence', value=0.8)])
-        deadline = time.monotonic() + 10.0
-        while '/recorded_source' not in written and time.monotonic() < deadline:
-            executor.spin_once(timeout_sec=0.1)
+        _spin_until(executor, lambda: '/recorded_source' in written, 10.0)
     finally:
         executor.shutdown()
         recorder.destroy_node()
@@ -381,7 +387,6 @@ def test_the_recorder_keeps_the_full_name_and_times_the_ask_by_the_messages_cloc
 def test_a_recorder_in_a_namespace_asks_its_node_there_and_the_replay_reads_it(context,
                                                                                tmp_path):
     """Review: under -r __ns:=/head1 the topics were /head1/..., the parameters asked of /."""
-    import time
     from ipomdp_gaze.files.bag import read_bag
     from ipomdp_gaze.nodes.recorder import RecorderNode, TOPICS
     from rclpy.executors import SingleThreadedExecutor
@@ -400,16 +405,12 @@ def test_a_recorder_in_a_namespace_asks_its_node_there_and_the_replay_reads_it(c
     executor.add_node(recorder)
     try:
         written = _events_written(recorder)
-        deadline = time.monotonic() + 30.0
-        while 'recorded_source' not in recorder.parameters and time.monotonic() < deadline:
-            executor.spin_once(timeout_sec=0.05)
+        _spin_until(executor, lambda: 'recorded_source' in recorder.parameters, 30.0, 0.05)
         assert 'recorded_source' in recorder.parameters
         target.publish(JointState(name=['pan', 'tilt'], position=[0.0, 0.0]))
         source.set_parameters([Parameter('confidence', value=0.8)])
-        deadline = time.monotonic() + 10.0
-        while (not recorder.counts['pan_tilt'] or '/head1/recorded_source' not in written) \
-                and time.monotonic() < deadline:
-            executor.spin_once(timeout_sec=0.1)
+        _spin_until(executor, lambda: recorder.counts['pan_tilt']
+                    and '/head1/recorded_source' in written, 10.0)
     finally:
         executor.shutdown()
         recorder.destroy_node()
