@@ -36,8 +36,8 @@ from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.policies.registry import build_policy
 from ipomdp_gaze.search import answer
-from ipomdp_gaze.search.controller_config import build_config, ControllerConfig, grid_from, \
-    head_from
+from ipomdp_gaze.search.controller_config import build_config, ControllerConfig, \
+    follow_config, grid_from, head_from
 from ipomdp_gaze.search.gaze import GazeController
 import numpy as np
 
@@ -593,9 +593,9 @@ def _apply_change(core, config: ControllerConfig, parameters: dict, overrides,
     """
     Make the core follow changed parameters as the node does (``_apply_config``).
 
-    The node's builder with what changed and the configuration before, then the observation,
-    the policy, the settings, the stamp tolerance and the seed. A refusal names its culprit,
-    the recording or an option, and ``when`` the change was set (``at 12.3 s``).
+    The node's builder with what changed and the configuration before, followed as the node
+    follows it (:func:`~ipomdp_gaze.search.controller_config.follow_config`). A refusal names
+    its culprit, the recording or an option, and ``when`` the change was set (``at 12.3 s``).
     """
     values = _with_defaults(settings_from(parameters, overrides))
     changed = {k for k, v in values.items() if config.values.get(k) != v}
@@ -609,13 +609,7 @@ def _apply_change(core, config: ControllerConfig, parameters: dict, overrides,
             said = str(named)
         raise ValueError(f'{said} (with the parameters set at {when} of the recording)') \
             from None
-    core.set_observation(new.observation)
-    core.set_policy(new.policy)
-    core.configure(new.settings, values['settle_time_s'])
-    if 'stamp_tolerance_s' in values:
-        core.stamp_tolerance_s = values['stamp_tolerance_s']
-    if values.get('seed') != config.values.get('seed'):
-        core.reseed(values['seed'])
+    follow_config(core, new, config.values)
     return new
 
 

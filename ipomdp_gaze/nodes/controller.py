@@ -57,7 +57,7 @@ from ipomdp_gaze.policies.conv import ACTIONS, check_kernel
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnavailable
 from ipomdp_gaze.search import answer
 from ipomdp_gaze.search.controller_config import (build_config, ControllerConfig as Config,
-                                                  grid_from)
+                                                  follow_config, grid_from)
 from ipomdp_gaze.search.gaze import FrameSequence, STAMP_TOLERANCE_S
 from ipomdp_gaze.search.health import HealthMonitor
 from ipomdp_gaze.search.room import MAX_PERIOD_S, Person, RoomWatch
@@ -334,12 +334,7 @@ class GazeControllerNode(QuietPublishers, Node):
         v, ov = cfg.values, old.values
         core = self.core
         was_following = core.follows_people
-        core.set_observation(cfg.observation)
-        core.set_policy(cfg.policy)
-        core.configure(cfg.settings, v['settle_time_s'])
-        core.stamp_tolerance_s = v['stamp_tolerance_s']
-        if v['seed'] != ov['seed']:
-            core.reseed(v['seed'])
+        follow_config(core, cfg, ov)
         if (v['forward_command_topic'], v['trajectory_topic']) != \
                 (ov['forward_command_topic'], ov['trajectory_topic']):
             self._make_command_publishers(v)

@@ -199,3 +199,20 @@ def build_config(values: Mapping, build_policy: Callable, changed=None,
         raise ValueError(f'no controller parameter {exc}') from None
     return ControllerConfig(dict(values), grid, fpoc, observation, policy, head, settings,
                             '; '.join(warnings))
+
+
+def follow_config(core: GazeController, new: ControllerConfig, old_values: Mapping) -> None:
+    """
+    Make a controller core follow a new configuration: the node's and the replay's one way.
+
+    The observation, the policy, the settings (a new ``search.targets`` starts a new search:
+    :meth:`GazeController.configure`), the stamp tolerance, and the seed when it changed.
+    """
+    v = new.values
+    core.set_observation(new.observation)
+    core.set_policy(new.policy)
+    core.configure(new.settings, v['settle_time_s'])
+    if 'stamp_tolerance_s' in v:
+        core.stamp_tolerance_s = v['stamp_tolerance_s']
+    if v.get('seed') != old_values.get('seed'):
+        core.reseed(v['seed'])
