@@ -87,6 +87,12 @@ def cells_of_points(points_px: np.ndarray, image_shape: tuple[int, int], grid: G
     return row.astype(np.int64) * grid.cols + col.astype(np.int64)
 
 
+def scaled_size(width: int, height: int, scale: float) -> tuple[int, int]:
+    """Return the ``(width, height)`` a full-frame call at ``scale`` gives the detector."""
+    return (max(1, int(np.floor(width * scale + 0.5))),
+            max(1, int(np.floor(height * scale + 0.5))))
+
+
 def scan(image: np.ndarray, detector, grid=(21, 21), scale: float = 1.0,
          interpolation: int = cv2.INTER_AREA,
          min_neighbors: int = DEFAULT_MIN_NEIGHBORS) -> ScanResult:
@@ -124,8 +130,7 @@ def scan(image: np.ndarray, detector, grid=(21, 21), scale: float = 1.0,
         raise ValueError(f'scale must be in (0, {MAX_SCALE:g}], got {scale!r}')
     gray = to_detector_image(image, detector_color(detector), detector_window_px(detector))
     height, width = gray.shape[:2]
-    out_width = max(1, int(np.floor(width * scale + 0.5)))
-    out_height = max(1, int(np.floor(height * scale + 0.5)))
+    out_width, out_height = scaled_size(width, height, scale)
     if (out_width, out_height) != (width, height):
         gray = cv2.resize(gray, (out_width, out_height),
                           interpolation=interpolation if scale <= 1.0 else cv2.INTER_LINEAR)

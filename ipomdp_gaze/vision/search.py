@@ -56,7 +56,7 @@ from ipomdp_gaze.vision.detector import box_centres_px, detector_window_px, grou
 from ipomdp_gaze.vision.detectors import detector_from_settings  # noqa: F401 (its old home)
 from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea
 from ipomdp_gaze.vision.fovea_model import check_model, fovea_for_model  # noqa: F401
-from ipomdp_gaze.vision.fullframe import cells_of_points, scan
+from ipomdp_gaze.vision.fullframe import cells_of_points, scaled_size, scan
 from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evidence,
                                        ladder_scales, min_face_px, SCALE_RTOL, ScaleTable)
 from ipomdp_gaze.vision.sensors import FoveaSensor
@@ -638,8 +638,7 @@ class _Coarse(_Recorder):
 
     def scan_cost(self):
         width, height = self.image_px
-        return (int(np.floor(width * self.scale + 0.5))
-                * int(np.floor(height * self.scale + 0.5)))
+        return math.prod(scaled_size(width, height, self.scale))
 
     def _look(self, rect, scale, spent: int = 0):
         """
@@ -740,7 +739,7 @@ class _Coarse(_Recorder):
         scale, side = self.scale, self.min_face
         while (step := self._finer_for_smaller_faces(strong, scale, side, weak)) is not None:
             finer, side = step
-            if pixels + round(width * finer) * round(height * finer) > self.budget:
+            if pixels + math.prod(scaled_size(width, height, finer)) > self.budget:
                 break
             # the whole image again at the finer scale: its boxes and evidence replace the
             # coarser call's, whose strong boxes stay strong
@@ -759,8 +758,7 @@ class _Coarse(_Recorder):
             for col, row_, n_cols, n_rows, _ in stats[1:]:
                 box = (slice(row_, row_ + n_rows), slice(col, col + n_cols))
                 rect = _cell_rect(self.grid, box, 2, self.image_px)
-                cost = (int(np.floor((rect[2] - rect[0]) * row.scale + 0.5))
-                        * int(np.floor((rect[3] - rect[1]) * row.scale + 0.5)))
+                cost = math.prod(scaled_size(rect[2] - rect[0], rect[3] - rect[1], row.scale))
                 if pixels + cost > self.budget:
                     break
                 strong, weak, spent = self._look(rect, row.scale, pixels)
