@@ -123,6 +123,26 @@ def test_the_choice_is_the_best_score_per_second(policy_name, tour, views):
     assert result.fixation == _first_best(expected)
 
 
+@pytest.mark.parametrize('tour', [False, True])
+def test_a_first_view_chosen_by_the_policy_is_timed_from_the_centre(tour):
+    """``start_cell: policy``: before any view the head is where the head model starts it."""
+    speed, view_s = 120.0, 0.15
+    session, policy = _session(inhibit_return=True, head_speed_deg_s=speed, view_time_s=view_s,
+                               head_tour=tour, start_cell='policy')
+    session.reset()
+    first = session.start()
+    centre = GRID.center_index
+    belief = session.belief[None, :GRID.n_cells]
+    seconds = view_seconds(GRID, centre, view_s, speed)
+    detour = None
+    if tour:
+        def detour(cells):
+            return tour_detour_deg(GRID, centre, cells) / speed
+    expected = np.asarray(policy.scores_per_second(belief, seconds, detour)).reshape(-1)
+    assert first == _first_best(expected)
+    assert policy.tile[first] == 1.0           # a diffuse belief: a tile, not the centre
+
+
 def test_without_head_speed_the_choice_is_unchanged():
     a, _ = _session(inhibit_return=True)
     b, _ = _session(inhibit_return=True, view_time_s=0.05, head_tour=True)

@@ -306,17 +306,23 @@ class _PerSecond:
     """
     The session's policy seen per second of head time (``search.head_speed_deg_s``).
 
-    Its scores are the policy's ``scores_per_second`` from the current fixation, so inhibition
-    of return and the choice treat it as any policy with scores.
+    Its scores are the policy's ``scores_per_second`` from the current fixation (before the
+    first, the grid's centre, where the head model starts: ``start_cell: policy``), so
+    inhibition of return and the choice treat it as any policy with scores.
     """
 
     def __init__(self, session: 'SearchSession'):
         self.session = session
 
+    def _here(self) -> int:
+        """Return the head's cell: the current fixation, else the grid's centre."""
+        fixation = self.session._search.fixation
+        return self.session.grid.center_index if fixation is None else fixation
+
     def scores(self, belief: np.ndarray) -> np.ndarray:
         """Return the policy's scores per second of each view from the current fixation."""
         session = self.session
-        settings, here = session.settings, session._search.fixation
+        settings, here = session.settings, self._here()
         seconds = view_seconds(session.grid, here, settings.view_time_s,
                                settings.head_speed_deg_s)
         detour_s = self._detour_s if settings.head_tour else None
@@ -334,7 +340,7 @@ class _PerSecond:
         left = ~search.visited[cells] if settings.inhibit_return \
             else np.ones(cells.size, dtype=bool)
         out = np.zeros(cells.size)
-        out[left] = tour_detour_deg(session.grid, search.fixation, cells[left]) \
+        out[left] = tour_detour_deg(session.grid, self._here(), cells[left]) \
             / settings.head_speed_deg_s
         return out
 
