@@ -134,10 +134,7 @@ def test_a_first_view_chosen_by_the_policy_is_timed_from_the_centre(tour):
     centre = GRID.center_index
     belief = session.belief[None, :GRID.n_cells]
     seconds = view_seconds(GRID, centre, view_s, speed)
-    detour = None
-    if tour:
-        def detour(cells):
-            return tour_detour_deg(GRID, centre, cells) / speed
+    detour = (lambda cells: tour_detour_deg(GRID, centre, cells) / speed) if tour else None
     expected = np.asarray(policy.scores_per_second(belief, seconds, detour)).reshape(-1)
     assert first == _first_best(expected)
     assert policy.tile[first] == 1.0           # a diffuse belief: a tile, not the centre
