@@ -10,11 +10,10 @@ from the ``rng`` passed at each call.
 """
 from __future__ import annotations
 
-import math
-
 from ipomdp_gaze.model.belief import argmax_ties_low
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.observation import as_observation
+from ipomdp_gaze.model.view_reach import axis_covered, axis_reach, view_cells
 import numpy as np
 
 from .conv import ConvPolicy
@@ -26,8 +25,6 @@ COVERAGE_PEAK = 0.3
 # A model without a camera's field of view (the Gaussian FPOCs, the fovea): the sweep's raster
 # looks at every SWEEP_STEP-th cell in each direction.
 SWEEP_STEP = 3
-# A cell is seen well from a view when its outer edge lies this far (in cells) inside the image.
-TILE_MARGIN_CELLS = 0.25
 
 _NEEDS_FPOC = {'greedy': 'the ideal searcher', 'tempered': 'tempered ELM',
                'switching': 'tempered ELM, then the ideal searcher'}
@@ -103,17 +100,6 @@ class SpiralPolicy:
         return np.full(np.shape(belief)[0], self.order[t % self.order.size], dtype=np.int64)
 
 
-def _view_cells(grid: Grid, model) -> tuple[float, float] | None:
-    """Return the camera's field of view in cells ``(rows, cols)`` (None without one)."""
-    image = (getattr(model, 'meta', None) or {}).get('image') or {}
-    camera = image.get('camera') if image.get('view') == 'pan_tilt' else None
-    if not camera:
-        return None
-    from ipomdp_gaze.model.head_camera import PinholeCamera
-    hfov, vfov = PinholeCamera.from_k(camera['width'], camera['height'], camera['K']).fov_deg
-    return vfov / grid.spacing_deg, hfov / grid.spacing_deg
-
-
 def sweep_tile_cells(grid: Grid, model) -> tuple[int, int]:
     """
     Return ``(rows, cols)`` of cells one view covers: the camera's field of view over the spacing.
@@ -121,7 +107,7 @@ def sweep_tile_cells(grid: Grid, model) -> tuple[int, int]:
     The camera is the one a pan/tilt count model was calibrated with (its ``meta``); a model
     without one (Gaussian FPOCs, the fovea) gets the raster's :data:`SWEEP_STEP`.
     """
-    view = _view_cells(grid, model)
+    view = view_cells(grid, model)
     if view is None:
         return SWEEP_STEP, SWEEP_STEP
     return (max(1, min(grid.rows, int(view[0]))), max(1, min(grid.cols, int(view[1]))))
@@ -141,13 +127,8 @@ def _tile_centres(n_cells: int, side: int) -> np.ndarray:
 
 def _covers(poses: np.ndarray, n_cells: int, seen: int, well: int) -> bool:
     """Whether every cell is well seen from a pose, or seen from poses on both of its sides."""
-    cells = np.arange(n_cells).reshape(-1, 1)
-    offset = cells - poses.reshape(1, -1)
-    near = np.abs(offset)
-    well_seen = (near <= well).any(axis=1)
-    left = ((offset >= 0) & (near <= seen)).any(axis=1)
-    right = ((offset <= 0) & (near <= seen)).any(axis=1)
-    return bool(np.all(well_seen | (left & right)))
+    offset = np.arange(n_cells).reshape(-1, 1) - poses.reshape(1, -1)
+    return bool(np.all(axis_covered(offset, seen, well)))
 
 
 def axis_poses(n_cells: int, view_cells: float) -> np.ndarray:
@@ -155,16 +136,13 @@ def axis_poses(n_cells: int, view_cells: float) -> np.ndarray:
     Return the fewest view centres along an axis of ``n_cells`` that see every cell.
 
     A view ``view_cells`` wide (its field of view over the spacing) sees the cells at offsets up
-    to ``seen = floor(view_cells / 2 - 1/2)`` from its centre, and sees them *well* up to
-    ``well``, the offsets whose cell's outer edge lies :data:`TILE_MARGIN_CELLS` or more inside
-    the image: a target near the outer edge of a cell at the border is cut by the image, and a
-    detector misses a cut face. Every cell must be well seen from some view, or seen from views
-    on both of its sides (each sees the half the other cuts). Of the evenly spread layouts with
-    the fewest views (no uneven layout needs fewer: test_sweep checks every one), the one whose
-    outer views sit furthest in from the edges (at most ``well``).
+    to ``seen`` from its centre and sees them *well* up to ``well``
+    (:func:`ipomdp_gaze.model.view_reach.axis_reach`). Every cell must be well seen from some
+    view, or seen from views on both of its sides (each sees the half the other cuts). Of the
+    evenly spread layouts with the fewest views (no uneven layout needs fewer: test_sweep checks
+    every one), the one whose outer views sit furthest in from the edges (at most ``well``).
     """
-    seen = max(0, math.floor(view_cells / 2 - 0.5 + 1e-9))
-    well = min(seen, max(0, math.floor(view_cells / 2 - 0.5 - TILE_MARGIN_CELLS + 1e-9)))
+    seen, well = axis_reach(view_cells)
     for n_poses in range(1, n_cells + 1):
         for margin in range(min(well, (n_cells - 1) // 2), -1, -1):
             poses = _spread(n_cells, n_poses, margin)
@@ -184,7 +162,7 @@ def sweep_tiles(grid: Grid, model) -> tuple[np.ndarray, np.ndarray]:
     ``k`` belongs to (the nearest pose in units of :func:`sweep_tile_cells`).
     """
     tile_rows, tile_cols = sweep_tile_cells(grid, model)
-    view = _view_cells(grid, model)
+    view = view_cells(grid, model)
     if view is None:
         rows, cols = _tile_centres(grid.rows, tile_rows), _tile_centres(grid.cols, tile_cols)
     else:

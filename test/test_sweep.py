@@ -8,8 +8,8 @@ from ipomdp_gaze.drivers.scene_tasks import task_spec
 from ipomdp_gaze.files.observation_file import load_observation
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head_time import head_time_s, SACCADE_TIME_S, SETTLE_TIME_S
-from ipomdp_gaze.policies.baselines import (axis_poses, SWEEP_STEP, sweep_tile_cells,
-                                            TILE_MARGIN_CELLS)
+from ipomdp_gaze.model.view_reach import TILE_MARGIN_CELLS
+from ipomdp_gaze.policies.baselines import axis_poses, SWEEP_STEP, sweep_tile_cells
 from ipomdp_gaze.policies.registry import build_policy
 import numpy as np
 import pytest

@@ -49,6 +49,7 @@ from ipomdp_gaze.model.observation import as_observation, check_evidence, CountO
 from ipomdp_gaze.model.position_filter import GATE_CELLS, measured_position, PositionFilter
 from ipomdp_gaze.model.still_evidence import cell_information, StillEvidence
 from ipomdp_gaze.model.stopping import ABSENT, decide, FOUND, initial_log_belief, with_absent
+from ipomdp_gaze.model.view_reach import ViewReach
 from ipomdp_gaze.search.settings import parameter_names, settings_class
 import numpy as np
 
@@ -384,6 +385,7 @@ class SearchSession:
         self._mixture = None
         self._clutter = None
         self._position = track_filter(self.settings)
+        self._reach = ViewReach.of(grid, self.observation)
         _check_mixture_model(self.settings, self.observation)
 
     # -- configuration -------------------------------------------------------------------
@@ -421,6 +423,7 @@ class SearchSession:
         _check_mixture_model(self.settings, observation)
         self.observation = observation
         self._counts = isinstance(self.observation, CountObservation)
+        self._reach = ViewReach.of(self.grid, observation)
         self._kernel = None
         self._mixture = None
         self._clutter = None
@@ -843,6 +846,8 @@ class SearchSession:
         peak, absent = float(self._pooled().max()), self.absent_probability
         code = int(decide(peak, absent, settings.confidence))
         decision = {FOUND: 'found', ABSENT: 'absent'}.get(code, '')
+        if decision == 'absent' and self._uncovered().size:
+            decision = ''                   # search.absent_needs_coverage: not yet (§6.16)
         keep = settings.motion_keep_probability
         if self.motion.active and not decision and search.decision == 'found' and keep \
                 and peak >= keep and peak >= absent:
@@ -868,6 +873,19 @@ class SearchSession:
                 and search.fixations >= settings.max_fixations:
             fired = self._limit('budget')
         return fired
+
+    def _uncovered(self) -> np.ndarray:
+        """
+        Return the cells the search's views have not covered, with ``absent_needs_coverage``.
+
+        Empty without the setting, for a moving target or without a pan/tilt camera
+        (:mod:`ipomdp_gaze.model.view_reach`, docs/design.md section 6.16).
+        """
+        search = self._search
+        if not self.settings.absent_needs_coverage or self.motion.active \
+                or self._reach is None:
+            return np.zeros(0, dtype=np.int64)
+        return np.flatnonzero(~self._reach.covered(self.grid, search.path))
 
     def _group_stops(self, groups: np.ndarray | None) -> bool:
         """Whether a frame's grouped detections end the search (docs/design.md section 6.15)."""
@@ -960,6 +978,15 @@ class SearchSession:
         if settings.head_speed_deg_s > 0 and not self.motion.active \
                 and callable(getattr(policy, 'scores_per_second', None)):
             policy = _PerSecond(self)
+        uncovered = self._uncovered()
+        if uncovered.size and self.absent_probability >= settings.confidence:
+            # absent is held back (search.absent_needs_coverage): a view that covers a cell left
+            barred = ~self._reach.sees_well(self.grid, uncovered)
+            if settings.inhibit_return:
+                barred |= search.visited
+            if not barred.all():
+                return unvisited_choice(policy, belief, barred, search.fixations, self.rng,
+                                        self.grid)
         if settings.inhibit_return and not self.motion.active:
             if search.visited.all():
                 if settings.stop_on_repeat:

@@ -181,6 +181,12 @@ SCHEMA: tuple[Setting, ...] = (
             'gives its cell (its found_radius square) at least this probability after the frame '
             "(0: every group; the belief's veto of texture the detector groups)",
             bounds='in [0, 1)', metavar='P'),
+    Setting('absent_needs_coverage', 'search.absent_needs_coverage', 'bool', False, check_flag,
+            "still target, one target, a pan/tilt count model: absent only once the search's "
+            'views have covered every cell (seen it well inside the image, or from both sides, '
+            "as the sweep's tiles do); until then the next view is one that covers a cell left "
+            '(the budget still decides; no effect without a camera; docs/design.md section '
+            '6.16)'),
     Setting('false_alarm_scales', 'search.false_alarm_scales', 'floats', (1.0,),
             check_false_alarm_scales,
             'still target, count model: the scene may fire the detector this many times as '

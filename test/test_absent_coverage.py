@@ -1,0 +1,158 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+``search.absent_needs_coverage``: no ``absent`` before the views have covered every cell (§6.16).
+
+The views' reach against a brute-force walk over cells and views, the sweep's tiles covering the
+grid, and the session: absent held back until the path covers every cell, the views in between
+each covering a cell left, the belief the same Bayes posterior as without the setting, and
+nothing changed for a model without a camera or a moving target.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+from ipomdp_gaze.files.observation_file import load_observation
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.view_reach import ViewReach
+from ipomdp_gaze.policies.baselines import sweep_tiles
+from ipomdp_gaze.policies.registry import build_policy
+from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
+import numpy as np
+import pytest
+
+LENSES = ('faces-pan-tilt-profile', 'faces-pan-tilt-40-profile')
+SETTINGS = SearchSettings(confidence=0.99, absent_prior=0.8, inhibit_return=True,
+                          max_fixations=40, decide_at_budget=True, head_speed_deg_s=120.0,
+                          view_time_s=0.15, head_tour=True)
+
+
+def _brute_covered(grid, reach, views):
+    """Walk every cell and view with plain Python."""
+    out = []
+    for cell in range(grid.n_cells):
+        r, c = divmod(cell, grid.cols)
+        ok = []
+        for axis, here in ((0, r), (1, c)):
+            offsets = []
+            for v in views:
+                vr, vc = divmod(int(v), grid.cols)
+                if abs(r - vr) <= reach.seen[0] and abs(c - vc) <= reach.seen[1]:
+                    offsets.append(here - (vr, vc)[axis])
+            well = any(abs(o) <= reach.well[axis] for o in offsets)
+            sides = any(o >= 0 for o in offsets) and any(o <= 0 for o in offsets)
+            ok.append(well or sides)
+        out.append(all(ok))
+    return np.array(out)
+
+
+@pytest.mark.parametrize('seed', range(8))
+def test_the_cells_views_cover_against_a_walk_by_hand(seed):
+    rng = np.random.default_rng(seed)
+    grid = Grid(int(rng.integers(3, 10)), int(rng.integers(3, 10)), 5.0)
+    seen = tuple(int(v) for v in rng.integers(0, 4, size=2))
+    well = tuple(int(rng.integers(0, s + 1)) for s in seen)
+    reach = ViewReach(seen, well)
+    views = rng.choice(grid.n_cells, size=int(rng.integers(0, 6)), replace=False)
+    np.testing.assert_array_equal(reach.covered(grid, views), _brute_covered(grid, reach, views))
+    sees_well = reach.sees_well(grid, [0, grid.n_cells - 1])
+    for v in range(grid.n_cells):
+        vr, vc = divmod(v, grid.cols)
+        expected = any(abs(vr - r) <= well[0] and abs(vc - c) <= well[1]
+                       for r, c in ((0, 0), (grid.rows - 1, grid.cols - 1)))
+        assert sees_well[v] == expected
+
+
+@pytest.mark.parametrize('name', LENSES)
+def test_the_sweeps_tiles_cover_every_cell_and_none_is_spare(name):
+    model = load_observation(name)
+    grid, reach = model.grid, ViewReach.of(model.grid, model)
+    poses, _ = sweep_tiles(grid, model)
+    assert reach.covered(grid, poses).all()
+    for k in range(poses.size):
+        assert not reach.covered(grid, np.delete(poses, k)).all()
+    assert not reach.covered(grid, [grid.center_index]).all()
+    assert ViewReach.of(grid, load_observation('faces-420')) is None
+
+
+def _empty_room(name, settings, views=40):
+    """Zero counts in every view until the search ends; return the session."""
+    model = load_observation(name)
+    grid = model.grid
+    session = SearchSession(grid, model, build_policy('coverage', grid, model), settings)
+    session.reset(seed=0)
+    session.start()
+    for _ in range(views):
+        result = session.update(Frame(np.zeros(grid.n_cells, dtype=np.int64)))
+        if result.ended:
+            break
+    return session, result
+
+
+@pytest.mark.parametrize('name', LENSES)
+def test_absent_waits_until_the_views_cover_every_cell(name):
+    without, plain = _empty_room(name, SETTINGS)
+    held, result = _empty_room(name, replace(SETTINGS, absent_needs_coverage=True))
+    grid, reach = held.grid, held._reach
+    assert result.decision == plain.decision == 'absent'
+    assert reach.covered(grid, held.path).all()
+    assert not reach.covered(grid, held.path[:-1]).all()      # it ends at the first chance
+    assert len(held.path) >= len(without.path)
+    # Up to the view where the search without the setting said absent, the paths agree; each
+    # later view covered a cell the views before it had left.
+    n = len(without.path)
+    assert held.path[:n] == without.path
+    if not reach.covered(grid, without.path).all():
+        assert len(held.path) > n
+    for k in range(n, len(held.path)):
+        left = np.flatnonzero(~reach.covered(grid, held.path[:k]))
+        assert reach.sees_well(grid, left)[held.path[k]]
+
+
+def test_the_belief_is_the_same_posterior_and_found_is_not_held():
+    name = 'faces-pan-tilt-40-profile'
+    model = load_observation(name)
+    grid = model.grid
+    sessions = []
+    for needs in (False, True):
+        session = SearchSession(grid, model, build_policy('coverage', grid, model),
+                                replace(SETTINGS, absent_needs_coverage=needs))
+        session.reset(seed=0)
+        session.start()
+        sessions.append(session)
+    counts = np.zeros(grid.n_cells, dtype=np.int64)
+    for k in range(3):
+        for session in sessions:
+            session.fixate(grid.center_index + k)
+            session.update(Frame(counts))
+    np.testing.assert_allclose(sessions[0].log_belief, sessions[1].log_belief)
+    strong = counts.copy()
+    strong[grid.center_index] = 8
+    decisions = [[], []]
+    for _ in range(6):
+        for session, out in zip(sessions, decisions):
+            if not session.ended:
+                session.fixate(grid.center_index)
+                out.append(session.update(Frame(strong)).decision)
+    assert decisions[0] == decisions[1] and decisions[0][-1] == 'found'
+    assert not sessions[1]._reach.covered(grid, sessions[1].path).all()
+
+
+def test_no_effect_for_a_model_without_a_camera_or_a_moving_target():
+    model = load_observation('faces-420')
+    grid = model.grid
+    paths = []
+    for needs in (False, True):
+        settings = SearchSettings(confidence=0.99, absent_prior=0.8, inhibit_return=True,
+                                  max_fixations=30, absent_needs_coverage=needs)
+        session = SearchSession(grid, model, build_policy('elm', grid, model), settings)
+        session.reset(seed=0)
+        session.start()
+        for _ in range(30):
+            if session.update(Frame(np.zeros(grid.n_cells, dtype=np.int64))).ended:
+                break
+        paths.append((session.path, session.decision))
+    assert paths[0] == paths[1]
+    moving, _ = _empty_room(LENSES[1], replace(SETTINGS, absent_needs_coverage=True,
+                                               motion_sigma_cells=0.5), views=3)
+    assert moving._uncovered().size == 0
