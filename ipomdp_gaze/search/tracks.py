@@ -195,7 +195,8 @@ class Tracks:
         cells = near(self.grid, cell, SPILL_CELLS)
         if taken is not None:
             cells &= ~taken
-        return float(-np.expm1(np.sum(np.log1p(-np.minimum(probability[cells], 1.0)))))
+        with np.errstate(divide='ignore'):         # a cell at 1: log1p(-1) = -inf, held 1
+            return float(-np.expm1(np.sum(np.log1p(-np.minimum(probability[cells], 1.0)))))
 
     def _centre(self, track: Track, dt_s: float) -> int:
         """Return the cell to look for a person around: its filter's prediction, else its cell."""
