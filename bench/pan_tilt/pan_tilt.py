@@ -97,40 +97,49 @@ def run_ros(record: dict, seeds: int) -> None:
     Run the three-process ROS demo on test scenes ``0..seeds-1``; add its answers to the record.
 
     Each is ``ipomdp-gaze demo --scene faces --seed S`` (scene camera, detector, controller with
-    the shipped configuration); the offline evaluation's scene S is the same scene.
+    the shipped configuration), then the same scenes empty (``--empty``); the offline
+    evaluation's scene S is the same scene, with and without its face.
     """
     sys.path.insert(0, str(ROOT / 'bench' / 'ros'))
     from bench_ros_faces import run_mode
-    rows = run_mode(False, range(seeds), lambda line: print(line, file=sys.stderr))
-    record['ros'] = [{k: (list(v) if isinstance(v, tuple) else v) for k, v in row.items()}
-                     for row in rows]
+    for key, empty in (('ros', False), ('ros_empty', True)):
+        rows = run_mode(False, range(seeds), lambda line: print(line, file=sys.stderr),
+                        empty=empty)
+        record[key] = [{k: (list(v) if isinstance(v, tuple) else v) for k, v in row.items()}
+                       for row in rows]
 
 
 def _ros_lines(record: dict) -> list[str]:
-    rows = record.get('ros')
-    if not rows:
-        return []
-    offline = {r['index']: r for r in record['runs']['main']['results'][SHIPPED]
-               if r['has_face']}
-    same, lines = 0, []
-    for row in rows:
-        off = offline.get(row['seed'])
-        if off is None:
+    lines = []
+    for key, has_face, kind in (('ros', True, 'scenes with a face'),
+                                ('ros_empty', False, 'empty scenes')):
+        rows = record.get(key)
+        if not rows:
             continue
-        ros_answer = 'absent' if row.get('stop') == 'absent' else \
-            (row.get('row'), row.get('col'))
-        off_answer = 'absent' if off['decision'] == 'absent' else tuple(off['cell'])
-        agree = ros_answer == off_answer and row.get('fixations') == off['fixations']
-        same += agree
-        if not agree:
-            lines.append(f"| {row['seed']} | {off_answer} after {off['fixations']} | "
-                         f"{ros_answer} after {row.get('fixations')} ({row.get('stop')}, "
-                         f"status {row.get('status')}) |")
-    head = [f'{same} of {len(rows)} seeds give the same answer and fixation count over ROS '
-            '(three processes, `ipomdp-gaze demo --scene faces --seed S`) as offline.']
-    if lines:
-        head += ['', '| seed | offline | ROS |', '|---|---|---|'] + lines
-    return head
+        offline = {r['index']: r for r in record['runs']['main']['results'][SHIPPED]
+                   if r['has_face'] == has_face}
+        same, differ = 0, []
+        for row in rows:
+            off = offline.get(row['seed'])
+            if off is None:
+                continue
+            ros_answer = 'absent' if row.get('stop') == 'absent' else \
+                (row.get('row'), row.get('col'))
+            off_answer = 'absent' if off['decision'] == 'absent' else tuple(off['cell'])
+            agree = ros_answer == off_answer and row.get('fixations') == off['fixations']
+            same += agree
+            if not agree:
+                differ.append(f"| {row['seed']} | {off_answer} after {off['fixations']} | "
+                              f"{ros_answer} after {row.get('fixations')} ({row.get('stop')}, "
+                              f"status {row.get('status')}) |")
+        if lines:
+            lines.append('')
+        lines.append(f'{kind.capitalize()}: {same} of {len(rows)} seeds give the same answer '
+                     'and fixation count over ROS (three processes, `ipomdp-gaze demo --scene '
+                     f"faces{'' if has_face else ' --empty'} --seed S`) as offline.")
+        if differ:
+            lines += ['', '| seed | offline | ROS |', '|---|---|---|'] + differ
+    return lines
 
 
 def _sweep_poses(spec):

@@ -34,12 +34,16 @@ MODES = (('camera', False, 'a camera on the pan/tilt head (11x11 grid of 5 deg, 
                          '`find` searches)'))
 
 
-def run_mode(fovea: bool, seeds, log) -> list:
-    """One demo per seed; a dict of its results each (``right`` False when it failed)."""
+def run_mode(fovea: bool, seeds, log, empty: bool = False) -> list:
+    """
+    One demo per seed; a dict of its results each (``right`` False when it failed).
+
+    ``empty``: the scene without its face (``demo --empty``), right when the answer is absent.
+    """
     out = []
     for seed in seeds:
         stats = {}
-        status = run_demo(faces_setup(fovea, seed=seed), 60.0, domain_id_for(),
+        status = run_demo(faces_setup(fovea, seed=seed, empty=empty), 60.0, domain_id_for(),
                           out=lambda line: None, stats=stats)
         stats.update(seed=seed, status=status)
         stats.setdefault('right', False)
