@@ -14,8 +14,8 @@ same photo crops without the face) are reported apart, empty ones per background
 camera (a 40-degree lens, model ``faces-pan-tilt-40-profile``: its recipe in
 ``bench/faces/models.py``, training scenes) checks that nothing is tuned to one camera.
 
-Regenerate with ``make pan-tilt`` (about 25 minutes on two idle cores, and 20 more for the ROS demo
-on 50 seeds), or ``python bench/pan_tilt/pan_tilt.py [--faces 400] [--empty 200] [--ros-seeds
+Regenerate with ``make pan-tilt`` (about 25 minutes on two idle cores, and about 35 more for the ROS
+demo on 50 seeds with a face and the same 50 empty), or ``python bench/pan_tilt/pan_tilt.py [--faces 400] [--empty 200] [--ros-seeds
 50]``;
 ``--from-json`` rewrites the page from the last run's record without searching (with
 ``--ros-seeds`` it adds the ROS comparison to it).
@@ -379,8 +379,9 @@ def main(argv=None) -> int:
     p.add_argument('--from-json', action='store_true',
                    help='write the page from --json without searching')
     p.add_argument('--ros-seeds', type=int, default=0, metavar='N',
-                   help='also run the three-process ROS demo on test scenes 0..N-1 and compare '
-                        'it per seed with the offline searches (about 22 s per seed)')
+                   help='also run the three-process ROS demo on test scenes 0..N-1, with their '
+                        'face and empty, and compare it per seed with the offline searches '
+                        '(about 20 s per seed and kind)')
     args = p.parse_args(argv)
     if args.from_json:
         record = _read(args.json)
