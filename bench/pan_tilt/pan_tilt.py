@@ -14,10 +14,10 @@ same photo crops without the face) are reported apart, empty ones per background
 camera (a 40-degree lens, model ``faces-pan-tilt-40-profile``: its recipe in
 ``bench/faces/models.py``, training scenes) checks that nothing is tuned to one camera.
 
-Regenerate with ``make pan-tilt`` (about 25 minutes on two idle cores, and about 35 more for the ROS
-demo on 50 seeds with a face and the same 50 empty), or ``python bench/pan_tilt/pan_tilt.py [--faces 400] [--empty 200] [--ros-seeds
-50]``;
-``--from-json`` rewrites the page from the last run's record without searching (with
+Regenerate with ``make pan-tilt`` (about 25 minutes on two idle cores, and about 35 more for the
+ROS demo on 50 seeds with a face and the same 50 empty), or ``python bench/pan_tilt/pan_tilt.py
+[--faces 400] [--empty 200] [--ros-seeds 50]``; ``--from-json`` rewrites the page from the last
+run's record without searching (with
 ``--ros-seeds`` it adds the ROS comparison to it).
 """
 from __future__ import annotations
