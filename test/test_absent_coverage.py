@@ -10,6 +10,7 @@ nothing changed for a model without a camera or a moving target.
 """
 from __future__ import annotations
 
+import copy
 from dataclasses import replace
 
 from ipomdp_gaze.files.observation_file import load_observation
@@ -28,21 +29,21 @@ SETTINGS = SearchSettings(confidence=0.99, absent_prior=0.8, inhibit_return=True
 
 
 def _brute_covered(grid, reach, views):
-    """Walk every cell and view with plain Python."""
+    """Walk every cell, quarter and view with plain Python."""
     out = []
     for cell in range(grid.n_cells):
         r, c = divmod(cell, grid.cols)
-        ok = []
-        for axis, here in ((0, r), (1, c)):
-            offsets = []
-            for v in views:
-                vr, vc = divmod(int(v), grid.cols)
-                if abs(r - vr) <= reach.seen[0] and abs(c - vc) <= reach.seen[1]:
-                    offsets.append(here - (vr, vc)[axis])
-            well = any(abs(o) <= reach.well[axis] for o in offsets)
-            sides = any(o >= 0 for o in offsets) and any(o <= 0 for o in offsets)
-            ok.append(well or sides)
-        out.append(all(ok))
+        quarters = {(a, b): False for a in (-1, 1) for b in (-1, 1)}
+        for v in {int(v) for v in views}:
+            dr, dc = r - v // grid.cols, c - v % grid.cols
+            if abs(dr) > reach.seen[0] or abs(dc) > reach.seen[1]:
+                continue
+            for a, b in quarters:
+                # whole along an axis when seen well, else only the half towards the view
+                row_ok = abs(dr) <= reach.well[0] or (a < 0) == (dr > 0)
+                col_ok = abs(dc) <= reach.well[1] or (b < 0) == (dc > 0)
+                quarters[a, b] |= row_ok and col_ok
+        out.append(all(quarters.values()))
     return np.array(out)
 
 
@@ -61,6 +62,32 @@ def test_the_cells_views_cover_against_a_walk_by_hand(seed):
         expected = any(abs(vr - r) <= well[0] and abs(vc - c) <= well[1]
                        for r, c in ((0, 0), (grid.rows - 1, grid.cols - 1)))
         assert sees_well[v] == expected
+
+
+def test_a_quarter_cut_in_every_view_is_not_covered():
+    """Two views that cut a cell along different axes both miss its far corner."""
+    grid, reach = Grid(9, 9, 5.0), ViewReach((2, 2), (1, 1))
+    cell = grid.index(5, 5)
+    views = [grid.index(5, 3), grid.index(3, 7)]
+    assert not reach.covered(grid, views)[cell]
+    assert reach.covered(grid, views + [grid.index(7, 7)])[cell]
+    assert reach.covered(grid, [grid.index(5, 4)])[cell]
+
+
+def test_a_camera_record_it_cannot_read_is_refused_in_one_line():
+    model = load_observation('faces-pan-tilt-40-profile')
+    broken = copy.deepcopy(model)
+    del broken.meta['image']['camera']['K']
+    grid = model.grid
+    policy = build_policy('elm', grid, model)
+    SearchSession(grid, broken, policy, SETTINGS)          # the setting off: not read
+    with pytest.raises(ValueError, match='a camera record must be') as e:
+        SearchSession(grid, broken, policy, replace(SETTINGS, absent_needs_coverage=True))
+    assert '\n' not in str(e.value)
+    session = SearchSession(grid, broken, policy, SETTINGS)
+    with pytest.raises(ValueError, match='a camera record must be'):
+        session.configure(replace(SETTINGS, absent_needs_coverage=True))
+    assert not session.settings.absent_needs_coverage      # refused: the settings before
 
 
 @pytest.mark.parametrize('name', LENSES)
@@ -153,6 +180,9 @@ def test_no_effect_for_a_model_without_a_camera_or_a_moving_target():
                 break
         paths.append((session.path, session.decision))
     assert paths[0] == paths[1]
-    moving, _ = _empty_room(LENSES[1], replace(SETTINGS, absent_needs_coverage=True,
-                                               motion_sigma_cells=0.5), views=3)
-    assert moving._uncovered().size == 0
+    moving = []
+    for needs in (False, True):
+        session, result = _empty_room(LENSES[1], replace(SETTINGS, absent_needs_coverage=needs,
+                                                         motion_sigma_cells=0.5), views=12)
+        moving.append((session.path, result.decision, session.absent_probability))
+    assert moving[0] == moving[1]

@@ -7,11 +7,12 @@ A view ``view_cells`` wide (the camera's field of view over the grid's spacing) 
 at offsets up to ``seen = floor(view_cells / 2 - 1/2)`` from its centre, and sees them *well*
 up to ``well``, the offsets whose cell's outer edge lies :data:`TILE_MARGIN_CELLS` or more inside
 the image: a face near the outer edge of a cell at the border is cut by the image, and a
-detector misses a cut face. A cell is *covered* by a set of views when, along each axis, one of
-the views that see it sees it well, or views on both of its sides see it (each sees the half
-the other cuts). The sweep's tiles (``policies.baselines.sweep_tiles``) are the fewest views that
-cover every cell; ``search.absent_needs_coverage`` holds ``absent`` back until the views of a
-search have.
+detector misses a cut face. Along an axis a view sees a cell whole when it sees it well, and
+otherwise only the cell's half nearer the view's centre. A cell is *covered* by a set of views
+when each of its four quarters is seen whole by one of them (views on both sides of a cell each
+see the half the other cuts). The sweep's tiles (``policies.baselines.sweep_tiles``) are the
+fewest views that cover every cell; ``search.absent_needs_coverage`` holds ``absent`` back until
+the views of a search have.
 """
 from __future__ import annotations
 
@@ -32,7 +33,7 @@ def view_cells(grid: Grid, model) -> tuple[float, float] | None:
     if not camera:
         return None
     from ipomdp_gaze.model.head_camera import PinholeCamera
-    hfov, vfov = PinholeCamera.from_k(camera['width'], camera['height'], camera['K']).fov_deg
+    hfov, vfov = PinholeCamera.from_dict(camera).fov_deg
     return vfov / grid.spacing_deg, hfov / grid.spacing_deg
 
 
@@ -73,19 +74,23 @@ class ViewReach(NamedTuple):
 
     def covered(self, grid: Grid, views) -> np.ndarray:
         """Return which cells the views at cells ``views`` cover, (N,) bool."""
-        views = np.asarray(views, dtype=np.int64).reshape(-1)
+        views = np.unique(np.asarray(views, dtype=np.int64).reshape(-1))
         if not views.size:
             return np.zeros(grid.n_cells, dtype=bool)
         rows, cols = grid.rows_cols()
         vr, vc = np.divmod(views, grid.cols)
-        dr = rows.reshape(-1, 1) - vr.reshape(1, -1)
-        dc = cols.reshape(-1, 1) - vc.reshape(1, -1)
-        sees = (np.abs(dr) <= self.seen[0]) & (np.abs(dc) <= self.seen[1])
-        # Offsets of views that do not see the cell at all are pushed out of reach.
-        far = max(self.seen) + grid.rows + grid.cols
-        dr, dc = np.where(sees, dr, far), np.where(sees, dc, far)
-        return (axis_covered(dr, self.seen[0], self.well[0])
-                & axis_covered(dc, self.seen[1], self.well[1]))
+        halves = []                       # per axis: (low half seen, high half seen), (N, V)
+        for axis, (here, there) in enumerate(((rows, vr), (cols, vc))):
+            offset = here.reshape(-1, 1) - there.reshape(1, -1)
+            whole = np.abs(offset) <= self.well[axis]
+            halves.append((whole | (offset > 0), whole | (offset < 0)))
+        sees = ((np.abs(rows.reshape(-1, 1) - vr) <= self.seen[0])
+                & (np.abs(cols.reshape(-1, 1) - vc) <= self.seen[1]))
+        covered = np.ones(grid.n_cells, dtype=bool)
+        for row_half in halves[0]:        # each quarter: a row half and a column half
+            for col_half in halves[1]:
+                covered &= (sees & row_half & col_half).any(axis=1)
+        return covered
 
     def sees_well(self, grid: Grid, cells) -> np.ndarray:
         """Return which views (every cell as a view centre) see one of ``cells`` well, (N,)."""

@@ -63,7 +63,7 @@ def where(reason: str = '') -> str:
 
 
 def forced(decision: str, reason: str = '') -> bool:
-    """Whether a limit forced a ``found`` or ``absent`` (its probability below confidence)."""
+    """Whether a limit forced a ``found`` or ``absent`` (the search's own rules had not)."""
     return ended(decision, reason).startswith('forced:')
 
 

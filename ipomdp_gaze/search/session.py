@@ -303,6 +303,18 @@ class _Search:
     views: dict = field(default_factory=dict)
 
 
+def _view_reach(settings: SearchSettings, grid: Grid, observation) -> ViewReach | None:
+    """
+    Return the camera's reach when ``search.absent_needs_coverage`` needs it, else None.
+
+    Raises ``ValueError`` (one line) for a camera record it cannot read, so that the settings
+    or the model are refused before a search uses them.
+    """
+    if not settings.absent_needs_coverage:
+        return None
+    return ViewReach.of(grid, observation)
+
+
 class _PerSecond:
     """
     The session's policy seen per second of head time (``search.head_speed_deg_s``).
@@ -385,7 +397,7 @@ class SearchSession:
         self._mixture = None
         self._clutter = None
         self._position = track_filter(self.settings)
-        self._reach = ViewReach.of(grid, self.observation)
+        self._reach = _view_reach(self.settings, grid, self.observation)
         _check_mixture_model(self.settings, self.observation)
 
     # -- configuration -------------------------------------------------------------------
@@ -399,8 +411,10 @@ class SearchSession:
         """
         settings.check_grid(self.grid)
         _check_mixture_model(settings, self.observation)
+        reach = _view_reach(settings, self.grid, self.observation)
         old = self.settings
         self.settings = settings
+        self._reach = reach
         if motion_settings(settings) != motion_settings(old):
             self.motion = target_motion(self.grid, settings)
         if position_settings(settings) != position_settings(old):
@@ -421,9 +435,10 @@ class SearchSession:
         """Assume another observation model (or FPOC) from the next frame on."""
         observation = as_observation(self.grid, observation)
         _check_mixture_model(self.settings, observation)
+        reach = _view_reach(self.settings, self.grid, observation)
         self.observation = observation
         self._counts = isinstance(self.observation, CountObservation)
-        self._reach = ViewReach.of(self.grid, observation)
+        self._reach = reach
         self._kernel = None
         self._mixture = None
         self._clutter = None
@@ -840,7 +855,9 @@ class SearchSession:
         """
         Run the stop rules after an applied frame; return the decision it fired ('').
 
-        The confidence first, then a grouped detection (``search.group_stop``), then the budget.
+        The confidence first (``absent`` held back while ``search.absent_needs_coverage`` finds
+        a cell the views have not covered), then a grouped detection (``search.group_stop``),
+        then the budget.
         """
         search, settings = self._search, self.settings
         peak, absent = float(self._pooled().max()), self.absent_probability
@@ -881,11 +898,10 @@ class SearchSession:
         Empty without the setting, for a moving target or without a pan/tilt camera
         (:mod:`ipomdp_gaze.model.view_reach`, docs/design.md section 6.16).
         """
-        search = self._search
         if not self.settings.absent_needs_coverage or self.motion.active \
                 or self._reach is None:
             return np.zeros(0, dtype=np.int64)
-        return np.flatnonzero(~self._reach.covered(self.grid, search.path))
+        return np.flatnonzero(~self._reach.covered(self.grid, self._search.path))
 
     def _group_stops(self, groups: np.ndarray | None) -> bool:
         """Whether a frame's grouped detections end the search (docs/design.md section 6.15)."""
@@ -978,12 +994,11 @@ class SearchSession:
         if settings.head_speed_deg_s > 0 and not self.motion.active \
                 and callable(getattr(policy, 'scores_per_second', None)):
             policy = _PerSecond(self)
-        uncovered = self._uncovered()
-        if uncovered.size and self.absent_probability >= settings.confidence:
-            # absent is held back (search.absent_needs_coverage): a view that covers a cell left
+        if self.absent_probability >= settings.confidence \
+                and (uncovered := self._uncovered()).size:
+            # absent is held back (search.absent_needs_coverage): a view that covers a cell
+            # left (none taken yet: a view that saw one well would have covered it)
             barred = ~self._reach.sees_well(self.grid, uncovered)
-            if settings.inhibit_return:
-                barred |= search.visited
             if not barred.all():
                 return unvisited_choice(policy, belief, barred, search.fixations, self.rng,
                                         self.grid)

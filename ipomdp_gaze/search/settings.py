@@ -183,10 +183,10 @@ SCHEMA: tuple[Setting, ...] = (
             bounds='in [0, 1)', metavar='P'),
     Setting('absent_needs_coverage', 'search.absent_needs_coverage', 'bool', False, check_flag,
             "still target, one target, a pan/tilt count model: absent only once the search's "
-            'views have covered every cell (seen it well inside the image, or from both sides, '
-            "as the sweep's tiles do); until then the next view is one that covers a cell left "
-            '(the budget still decides; no effect without a camera; docs/design.md section '
-            '6.16)'),
+            'views have covered every cell (each quarter of it seen whole by some view, as the '
+            "sweep's tiles see them); while P(absent) is at the confidence and a cell is left, "
+            'the next view is one that covers it (the budget still decides; no effect without a '
+            'camera; docs/design.md section 6.16)'),
     Setting('false_alarm_scales', 'search.false_alarm_scales', 'floats', (1.0,),
             check_false_alarm_scales,
             'still target, count model: the scene may fire the detector this many times as '
