@@ -165,21 +165,21 @@ def test_the_belief_is_the_same_posterior_and_found_is_not_held():
     assert not sessions[1]._reach.covered(grid, sessions[1].path).all()
 
 
-def test_no_effect_for_a_model_without_a_camera_or_a_moving_target():
+def test_a_model_without_a_camera_is_refused_and_a_moving_target_unchanged():
     model = load_observation('faces-420')
     grid = model.grid
-    paths = []
-    for needs in (False, True):
-        settings = SearchSettings(confidence=0.99, absent_prior=0.8, inhibit_return=True,
-                                  max_fixations=30, absent_needs_coverage=needs)
-        session = SearchSession(grid, model, build_policy('elm', grid, model), settings)
-        session.reset(seed=0)
-        session.start()
-        for _ in range(30):
-            if session.update(Frame(np.zeros(grid.n_cells, dtype=np.int64))).ended:
-                break
-        paths.append((session.path, session.decision))
-    assert paths[0] == paths[1]
+    settings = SearchSettings(confidence=0.99, absent_prior=0.8, absent_needs_coverage=True)
+    with pytest.raises(ValueError, match='needs a pan/tilt count model') as e:
+        SearchSession(grid, model, build_policy('elm', grid, model), settings)
+    assert '\n' not in str(e.value)
+    camera = load_observation(LENSES[1])
+    session = SearchSession(camera.grid, camera, build_policy('elm', camera.grid, camera),
+                            settings)
+    blind = copy.deepcopy(camera)
+    del blind.meta['image']
+    with pytest.raises(ValueError, match='needs a pan/tilt count model'):
+        session.set_observation(blind)
+    assert session.observation is not blind                # refused: the model before
     moving = []
     for needs in (False, True):
         session, result = _empty_room(LENSES[1], replace(SETTINGS, absent_needs_coverage=needs,

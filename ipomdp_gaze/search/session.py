@@ -307,12 +307,16 @@ def _view_reach(settings: SearchSettings, grid: Grid, observation) -> ViewReach 
     """
     Return the camera's reach when ``search.absent_needs_coverage`` needs it, else None.
 
-    Raises ``ValueError`` (one line) for a camera record it cannot read, so that the settings
-    or the model are refused before a search uses them.
+    Raises ``ValueError`` (one line) for a model without a pan/tilt camera or a camera record
+    it cannot read, so that the settings or the model are refused before a search uses them.
     """
     if not settings.absent_needs_coverage:
         return None
-    return ViewReach.of(grid, observation)
+    reach = ViewReach.of(grid, observation)
+    if reach is None:
+        raise ValueError('search.absent_needs_coverage needs a pan/tilt count model (its '
+                         'camera says which cells a view sees well); this model has no camera')
+    return reach
 
 
 class _PerSecond:

@@ -185,8 +185,8 @@ SCHEMA: tuple[Setting, ...] = (
             "still target, one target, a pan/tilt count model: absent only once the search's "
             'views have covered every cell (each quarter of it seen whole by some view, as the '
             "sweep's tiles see them); while P(absent) is at the confidence and a cell is left, "
-            'the next view is one that covers it (the budget still decides; no effect without a '
-            'camera; docs/design.md section 6.16)'),
+            'the next view is one that covers it (the budget still decides; refused for a model '
+            'without a camera, no effect on a moving target; docs/design.md section 6.16)'),
     Setting('false_alarm_scales', 'search.false_alarm_scales', 'floats', (1.0,),
             check_false_alarm_scales,
             'still target, count model: the scene may fire the detector this many times as '
