@@ -208,6 +208,9 @@ def test_bad_kernel_is_rejected_and_the_old_one_stays(probe, cam, bad, words):
     ({'policy.action': 'softmax'}, 'policy.action must be one of'),
     ({'trajectory_topic': 'bad topic'}, 'trajectory_topic'),
     ({'search.view_time_s': 0.0}, 'search.view_time_s must be finite and > 0'),
+    # settings the model cannot serve are refused before any of them applies
+    ({'search.false_alarm_scales': [1.0, 2.0]}, 'needs a count model'),
+    ({'search.absent_needs_coverage': True}, 'needs a pan/tilt count model'),
 ])
 def test_invalid_parameters_are_rejected_with_a_reason(probe, cam, values, words):
     before = probe.get_parameters(NODE, list(values))

@@ -29,7 +29,7 @@ from ipomdp_gaze.search.gaze import check_settle_time, GazeController, STAMP_TOL
 from ipomdp_gaze.search.health import policy_label
 from ipomdp_gaze.search.many import check_many_settings
 from ipomdp_gaze.search.room import check_room_times
-from ipomdp_gaze.search.session import SearchSettings
+from ipomdp_gaze.search.session import check_model_settings, SearchSettings
 
 POLICY_KEYS = ('policy.name', 'policy.file', 'policy.kernel', 'policy.action')
 OBSERVATION_KEYS = ('observation.model', 'observation.file')
@@ -180,6 +180,8 @@ def build_config(values: Mapping, build_policy: Callable, changed=None,
         settings = SearchSettings.from_parameters(values, grid=grid)
         if settings.targets == 'many':
             check_many_settings(settings)
+        else:
+            check_model_settings(settings, grid, observation)
         if 'room.dwell_s' in values:
             check_room_times(values['room.dwell_s'], values['room.recheck_period_s'])
         if not str(values.get('room.frame_id', 'unset')).strip():

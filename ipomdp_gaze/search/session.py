@@ -126,6 +126,20 @@ def _check_mixture_model(settings: SearchSettings, observation) -> None:
                      f'{getattr(observation, "name", type(observation).__name__)}')
 
 
+def check_model_settings(settings: SearchSettings, grid: Grid, observation) -> None:
+    """
+    Refuse one-target settings that ``observation`` cannot serve (``ValueError``, one line).
+
+    What :class:`SearchSession` checks when it is built, configured or given a model: the
+    false-alarm scales and hotspots need count tables, ``search.absent_needs_coverage`` a
+    pan/tilt camera. The node's parameter check calls it, so a change is refused before any of
+    it applies.
+    """
+    observation = as_observation(grid, observation)
+    _check_mixture_model(settings, observation)
+    _view_reach(settings, grid, observation)
+
+
 def check_groups(groups, n_cells: int) -> np.ndarray | None:
     """
     Return a frame's grouped detections per cell as ``(N,)`` float64 (None stays None).
