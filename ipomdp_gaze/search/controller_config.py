@@ -211,7 +211,7 @@ def follow_config(core: GazeController, new: ControllerConfig, old_values: Mappi
     :meth:`GazeController.configure`), the stamp tolerance, and the seed when it changed.
     """
     v = new.values
-    core.set_observation(new.observation)
+    core.set_observation(new.observation, new.settings)
     core.set_policy(new.policy)
     core.configure(new.settings, v['settle_time_s'])
     if 'stamp_tolerance_s' in v:

@@ -289,9 +289,13 @@ class GazeController:
             return
         self.session.configure(settings)
 
-    def set_observation(self, observation) -> None:
-        """Use another observation model (or FPOC) for the following updates; keep the belief."""
-        self.session.set_observation(observation)
+    def set_observation(self, observation, settings: SearchSettings | None = None) -> None:
+        """
+        Use another observation model (or FPOC) for the following updates; keep the belief.
+
+        ``settings``: those :meth:`configure` gets next, which the model is checked against.
+        """
+        self.session.set_observation(observation, settings)
 
     def set_policy(self, policy) -> None:
         """Use another policy from the next choice on."""

@@ -198,8 +198,8 @@ class OccupancySession:
             for track in self.tracks.tracks:       # the people followed take the new filter
                 track.position = track_filter(settings)
 
-    def set_observation(self, observation) -> None:
-        """Assume another observation model (or FPOC) from the next frame on."""
+    def set_observation(self, observation, settings: SearchSettings | None = None) -> None:
+        """Assume another observation model (or FPOC) from the next frame; ``settings`` unused."""
         self.observation = as_observation(self.grid, observation)
         self.table = information_table(self.observation)
         self._view_info = self.table.view_information
@@ -210,7 +210,8 @@ class OccupancySession:
         Keep ``policy``: a sweep (a policy with ``poses``) makes a still search one pass of them.
 
         Any other policy is kept for the record: the occupancy search chooses by its own
-        infomax. Takes effect at the next :meth:`reset`: a search is a pass or not throughout.
+        infomax. Takes effect at the next :meth:`reset`: a search is a pass or not throughout,
+        of the poses it started with.
         """
         self.policy = policy
         poses = getattr(policy, 'poses', None) if getattr(policy, 'name', '') == 'sweep' \
@@ -376,7 +377,7 @@ class OccupancySession:
                        'reason': '', 'ended': False, 'outside': outside, 'clock_s': 0.0,
                        'room_done': False, 'decided_once': False,
                        'visited': np.zeros(n, dtype=bool), 'groups': [],
-                       'passing': self._pass is not None}
+                       'passing': self._pass is not None, 'pass': self._pass}
         self._event('reset', settings=self.settings.to_parameters(), cell_prior=q)
 
     def exclude(self, cells) -> None:
@@ -441,7 +442,7 @@ class OccupancySession:
             raise OrderError('the search has started already; reset starts a new one')
         fixed = start_index(self.grid, self.settings)
         if self.passing:
-            s['fixation'] = int(self._pass[0])
+            s['fixation'] = int(s['pass'][0])
         elif fixed is not None:
             s['fixation'] = fixed
         elif s['scanned'] or self.settings.start_cell == 'policy':
@@ -583,7 +584,7 @@ class OccupancySession:
     def _choose(self) -> int | None:
         s = self._s()
         if self.passing:
-            left = self._pass[~s['visited'][self._pass]]
+            left = s['pass'][~s['visited'][s['pass']]]
             return int(left[0]) if left.size else None
         costs = self.costs_from(s['fixation'])
         score = self.gains() / costs
@@ -691,7 +692,7 @@ class OccupancySession:
             found = bool(self.faces()) if self.passing else occupied.any()   # and its groups
             s['decision'] = 'found' if found else 'absent'
             return s['decision']
-        if self.passing and s['visited'][self._pass].all():
+        if self.passing and s['visited'][s['pass']].all():
             return self._end_pass()
         if settings.max_fixations and s['fixations'] >= settings.max_fixations:
             return self._limit('budget')

@@ -449,11 +449,19 @@ class SearchSession:
                 self._mixture.reset()
             self._search.still_base = self._search.log_belief.copy()
 
-    def set_observation(self, observation) -> None:
-        """Assume another observation model (or FPOC) from the next frame on."""
+    def set_observation(self, observation, settings: SearchSettings | None = None) -> None:
+        """
+        Assume another observation model (or FPOC) from the next frame on.
+
+        ``settings``: the ones :meth:`configure` is about to be given (a driver changing both
+        at once); the model is checked against them instead of those in force.
+        """
         observation = as_observation(self.grid, observation)
-        _check_mixture_model(self.settings, observation)
-        reach = _view_reach(self.settings, self.grid, observation)
+        settings = settings or self.settings
+        reach = None                    # many targets: this session is replaced (configure)
+        if settings.targets == 'one':
+            _check_mixture_model(settings, observation)
+            reach = _view_reach(settings, self.grid, observation)
         self.observation = observation
         self._counts = isinstance(self.observation, CountObservation)
         self._reach = reach

@@ -1,0 +1,119 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+A run-time parameter change the controller's check accepts is one it can apply.
+
+The node checks a change by building the whole configuration (``build_config``, in its set
+callback) and applies it afterwards (``follow_config``, post-set); an error while applying
+leaves the node half changed with the change already reported as taken. Each example starts
+the controller core from a shipped parameter file, searches a few frames, draws a change of
+several parameters (the model, the policy, the search settings, many targets), and either the
+check refuses it in one line or it applies and the search goes on. ``search.false_alarm_scales``
+on a Gaussian model was accepted and then raised while being applied, before this test.
+"""
+from __future__ import annotations
+
+import os
+
+from hypothesis import given, HealthCheck, settings
+from hypothesis import strategies as st
+from ipomdp_gaze.files.share_files import config_file
+from ipomdp_gaze.files.yaml_files import yaml_parameters
+from ipomdp_gaze.nodes.controller import controller_params
+from ipomdp_gaze.policies.registry import build_policy
+from ipomdp_gaze.search.controller_config import build_config, follow_config
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.ros                # controller_params declares rclpy parameter types
+
+EXAMPLES = 4 * int(os.environ.get('PROPERTY_EXAMPLES', '40'))
+BASES = {
+    'defaults': (),
+    'faces camera': ('faces_camera_controller.yaml',),
+    'rooms': ('faces_camera_controller.yaml', 'faces_camera_room_controller.yaml'),
+    'tracking': ('faces_camera_tracking.yaml',),
+}
+CHANGES = {
+    'observation.model': ['gaussian', 'counts'],
+    'observation.file': ['', 'faces-pan-tilt-profile', 'faces-pan-tilt-40-profile'],
+    'fpoc.model': ['camera', 'human'],
+    'policy.name': ['elm', 'coverage', 'sweep', 'map', 'greedy', 'nmpt'],
+    'confidence': [0.9, 0.99], 'search.max_fixations': [0, 5, 20],
+    'search.inhibit_return': [False, True], 'search.repeat_weight': [1.0, 0.1],
+    'search.head_speed_deg_s': [0.0, 120.0], 'search.head_tour': [False, True],
+    'absent.prior': [0.0, 0.8], 'motion.sigma_cells': [0.0, 0.5],
+    'motion.track_view': ['policy', 'peak', 'position'], 'start_row': [-1, 0],
+    'start_col': [-1, 3], 'search.found_radius': [0, 1], 'search.decide_at_budget': [False, True],
+    'search.group_stop': [False, True], 'search.absent_needs_coverage': [False, True],
+    'search.false_alarm_scales': [[1.0], [0.5, 1.0, 4.0]], 'search.hotspot_prior': [0.0, 0.03],
+    'search.targets': ['one', 'many'], 'search.stop_on_decision': [True, False],
+}
+DEFAULTS = {p.name: p.default for p in controller_params()}
+
+
+def _values(base: str) -> dict:
+    values = dict(DEFAULTS)
+    for name in BASES[base]:
+        values.update(yaml_parameters(config_file(name), 'gaze_controller'))
+    return values
+
+
+def _frames(core, rng, count: int, t_s: float, counts: bool) -> float:
+    for _ in range(count):
+        t_s += 1.0
+        n = core.grid.n_cells
+        evidence = rng.poisson(0.3, n).astype(float) if counts else rng.standard_normal(n)
+        core.offer(evidence, t_s, t_s)
+    return t_s
+
+
+@settings(deadline=None, max_examples=EXAMPLES, suppress_health_check=[HealthCheck.too_slow])
+@given(base=st.sampled_from(sorted(BASES)), data=st.data(), seed=st.integers(0, 2**31 - 1))
+def test_a_change_the_check_accepts_applies(base, data, seed):
+    values = _values(base)
+    old = build_config(values, build_policy)
+    core = old.controller()
+    rng = np.random.default_rng(seed)
+    core.reset(0.0)
+    t_s = _frames(core, rng, 3, 0.0, values['observation.model'] == 'counts')
+    change = {k: data.draw(st.sampled_from(v)) for k, v in CHANGES.items()
+              if data.draw(st.booleans())}
+    new_values = dict(values, **change)
+    try:
+        new = build_config(new_values, build_policy, set(change), old)
+    except ValueError as e:
+        assert str(e) and '\n' not in str(e)
+        return
+    follow_config(core, new, old.values)
+    _frames(core, rng, 4, t_s, new_values['observation.model'] == 'counts')
+    assert 0 <= core.fixation < core.grid.n_cells
+
+
+def test_a_policy_change_during_a_rooms_pass_keeps_the_pass():
+    """The pass is the search's own: a new policy applies from the next search."""
+    values = _values('rooms')
+    old = build_config(values, build_policy)
+    core = old.controller()
+    rng = np.random.default_rng(0)
+    core.reset(0.0)
+    poses = list(core.session._s()['pass'])
+    t_s = _frames(core, rng, 3, 0.0, True)
+    new = build_config(dict(values, **{'policy.name': 'elm'}), build_policy, {'policy.name'}, old)
+    follow_config(core, new, old.values)
+    _frames(core, rng, len(poses) - 3, t_s, True)
+    assert list(core.session.path) == poses and core.session.ended
+
+
+def test_counts_with_scales_to_a_gaussian_model_applies_in_one_change():
+    """The model is checked against the settings that come with it, not those in force."""
+    values = _values('faces camera')
+    assert len(values['search.false_alarm_scales']) > 1
+    old = build_config(values, build_policy)
+    core = old.controller()
+    change = {'observation.model': 'gaussian', 'observation.file': '',
+              'search.false_alarm_scales': [1.0], 'search.hotspot_prior': 0.0}
+    new = build_config(dict(values, **change), build_policy, set(change), old)
+    follow_config(core, new, old.values)
+    assert core.settings.false_alarm_scales == (1.0,)
+    assert type(core.observation).__name__ == 'GaussianObservation'
