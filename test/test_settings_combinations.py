@@ -7,8 +7,8 @@ A user can set every parameter of the node or the YAML at once, and change one w
 runs. Each example draws a model (both pan/tilt lenses and the fovea), a policy and a value for
 each of a random subset of the settings; the settings object either refuses them with a
 ``ValueError`` (its one line) or the session (one target or many) starts, applies frames of
-random counts, unobserved cells and grouped detections, takes a run-time change, and keeps a
-normalised belief whose answer is a cell. ``start_cell: policy`` with head time in the choice
+random counts, unobserved cells, grouped detections and detection offsets, takes a run-time
+change, and keeps a normalised belief whose answer is a cell. ``start_cell: policy`` with head time in the choice
 raised ``TypeError`` before this test (the first view was timed from no fixation).
 """
 from __future__ import annotations
@@ -86,8 +86,13 @@ def test_accepted_settings_run_a_search_and_take_a_change(data, seed):
             counts = rng.poisson(rng.choice([0.05, 0.5, 3.0]), grid.n_cells).astype(float)
             counts[rng.random(grid.n_cells) < 0.2 * rng.random()] = np.nan
             groups = (rng.random(grid.n_cells) < 0.02).astype(float) if k % 2 else None
+            offsets = None
+            if k % 3 == 1:                    # where in its cell each cell's detections lie
+                offsets = rng.uniform(-0.5, 0.5, (grid.n_cells, 2))
+                offsets[rng.random(grid.n_cells) < 0.5] = np.nan
             try:
-                result = session.update(Frame(counts, groups=groups, seconds=0.1))
+                result = session.update(Frame(counts, groups=groups, seconds=0.1,
+                                              offsets=offsets))
             except OrderError:                # the search ended: nothing more to apply
                 break
             if k == change_at:
