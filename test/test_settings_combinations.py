@@ -8,8 +8,9 @@ runs. Each example draws a model (both pan/tilt lenses and the fovea), a policy 
 each of a random subset of the settings; the settings object either refuses them with a
 ``ValueError`` (its one line) or the session (one target or many) starts, applies frames of
 random counts, unobserved cells, grouped detections and detection offsets, takes a run-time
-change, and keeps a normalised belief whose answer is a cell. ``start_cell: policy`` with head time in the choice
-raised ``TypeError`` before this test (the first view was timed from no fixation).
+change, and keeps a normalised belief whose answer is a cell. ``start_cell: policy`` with
+head time in the choice raised ``TypeError`` before this test (the first view was timed from no
+fixation).
 """
 from __future__ import annotations
 
