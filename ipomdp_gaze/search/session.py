@@ -126,18 +126,25 @@ def _check_mixture_model(settings: SearchSettings, observation) -> None:
                      f'{getattr(observation, "name", type(observation).__name__)}')
 
 
-def check_model_settings(settings: SearchSettings, grid: Grid, observation) -> None:
+def check_model_settings(settings: SearchSettings, grid: Grid,
+                         observation) -> ViewReach | None:
     """
     Refuse one-target settings that ``observation`` cannot serve (``ValueError``, one line).
 
     What :class:`SearchSession` checks when it is built, configured or given a model: the
     false-alarm scales and hotspots need count tables, ``search.absent_needs_coverage`` a
-    pan/tilt camera. The node's parameter check calls it, so a change is refused before any of
-    it applies.
+    pan/tilt camera (whose reach it returns; None without the setting). The node's parameter
+    check calls it, so a change is refused before any of it applies.
     """
     observation = as_observation(grid, observation)
     _check_mixture_model(settings, observation)
-    _view_reach(settings, grid, observation)
+    if not settings.absent_needs_coverage:
+        return None
+    reach = ViewReach.of(grid, observation)        # a camera record it cannot read: refused
+    if reach is None:
+        raise ValueError('search.absent_needs_coverage needs a pan/tilt count model (its '
+                         'camera says which cells a view sees well); this model has no camera')
+    return reach
 
 
 def check_groups(groups, n_cells: int) -> np.ndarray | None:
@@ -317,22 +324,6 @@ class _Search:
     views: dict = field(default_factory=dict)
 
 
-def _view_reach(settings: SearchSettings, grid: Grid, observation) -> ViewReach | None:
-    """
-    Return the camera's reach when ``search.absent_needs_coverage`` needs it, else None.
-
-    Raises ``ValueError`` (one line) for a model without a pan/tilt camera or a camera record
-    it cannot read, so that the settings or the model are refused before a search uses them.
-    """
-    if not settings.absent_needs_coverage:
-        return None
-    reach = ViewReach.of(grid, observation)
-    if reach is None:
-        raise ValueError('search.absent_needs_coverage needs a pan/tilt count model (its '
-                         'camera says which cells a view sees well); this model has no camera')
-    return reach
-
-
 class _PerSecond:
     """
     The session's policy seen per second of head time (``search.head_speed_deg_s``).
@@ -415,8 +406,7 @@ class SearchSession:
         self._mixture = None
         self._clutter = None
         self._position = track_filter(self.settings)
-        self._reach = _view_reach(self.settings, grid, self.observation)
-        _check_mixture_model(self.settings, self.observation)
+        self._reach = check_model_settings(self.settings, grid, self.observation)
 
     # -- configuration -------------------------------------------------------------------
     def configure(self, settings: SearchSettings) -> None:
@@ -428,8 +418,7 @@ class SearchSession:
         belief now.
         """
         settings.check_grid(self.grid)
-        _check_mixture_model(settings, self.observation)
-        reach = _view_reach(settings, self.grid, self.observation)
+        reach = check_model_settings(settings, self.grid, self.observation)
         old = self.settings
         self.settings = settings
         self._reach = reach
@@ -458,10 +447,9 @@ class SearchSession:
         """
         observation = as_observation(self.grid, observation)
         settings = settings or self.settings
-        reach = None                    # many targets: this session is replaced (configure)
-        if settings.targets == 'one':
-            _check_mixture_model(settings, observation)
-            reach = _view_reach(settings, self.grid, observation)
+        # many targets: this session is replaced (configure), nothing to check against
+        reach = check_model_settings(settings, self.grid, observation) \
+            if settings.targets == 'one' else None
         self.observation = observation
         self._counts = isinstance(self.observation, CountObservation)
         self._reach = reach
