@@ -226,8 +226,8 @@ class OccupancySession:
         Fixed when the search starts (:meth:`reset`: the policy then); motion turned on during
         it ends the pass (a moving search names no groups).
         """
-        passing = self._pass is not None if self._state is None else self._state['passing']
-        return passing and not self._motion.active
+        poses = self._pass if self._state is None else self._state['pass']
+        return poses is not None and not self._motion.active
 
     # -- read-only views -----------------------------------------------------------------
     def _s(self) -> dict:
@@ -377,7 +377,7 @@ class OccupancySession:
                        'reason': '', 'ended': False, 'outside': outside, 'clock_s': 0.0,
                        'room_done': False, 'decided_once': False,
                        'visited': np.zeros(n, dtype=bool), 'groups': [],
-                       'passing': self._pass is not None, 'pass': self._pass}
+                       'pass': self._pass}
         self._event('reset', settings=self.settings.to_parameters(), cell_prior=q)
 
     def exclude(self, cells) -> None:
