@@ -236,9 +236,10 @@ def checked_config(parameters: dict, overrides: dict | None = None) -> Controlle
 
     The node's own builder (:func:`ipomdp_gaze.search.controller_config.build_config`), so a
     recording replays with every check the node makes (a count model's grid and pan/tilt
-    spacing among them). The recorded parameters are checked alone first, then with each
-    override in turn, so a refusal blames what it comes from: ``the recording: ...`` or the
-    option (``--policy: unknown policy 'bogus'``).
+    spacing among them), built once with every override. Only when that is refused are the
+    recorded parameters built alone, then with each override in turn, so that the refusal
+    blames what it comes from: ``the recording: ...`` or the option (``--policy: unknown
+    policy 'bogus'``).
 
     Raises
     ------
@@ -246,11 +247,14 @@ def checked_config(parameters: dict, overrides: dict | None = None) -> Controlle
         If a parameter is missing or refused (the message names it and who gave it).
 
     """
+    options = {k: v for k, v in (overrides or {}).items() if v is not None}
+    try:
+        return build_config(_with_defaults(settings_from(parameters, options)), build_policy)
+    except ValueError:
+        pass                                    # refused: find what to blame
     config = _config(settings_from(parameters), 'the recording')
     given = {}
-    for key, value in (overrides or {}).items():
-        if value is None:
-            continue
+    for key, value in options.items():
         given[key] = value
         config = _config(settings_from(parameters, given), OPTIONS[key])
     return config
@@ -493,9 +497,10 @@ def _targets(bag, head: PanTiltMap, heads: tuple = (), frames_ns: tuple = ()) ->
             continue
         seen.add(key)
         sent = _seconds(m.msg.header.stamp)
+        arrived = bisect.bisect_left(frames_ns, m.time_ns)      # frames before this target
         change = next(((t, later) for t, later in moved if t not in resent
                        and t - RESET_TARGET_S * 1e9 <= m.time_ns
-                       and not any(t <= f < m.time_ns for f in frames_ns)), None)
+                       and bisect.bisect_left(frames_ns, t) >= arrived), None)  # none since t
         if change is not None and out:
             resent[change[0]] = sent            # the re-send or the first target after it
             if change[1].nearest_cell(*_angles(m.msg, change[1])) == out[-1][1]:
