@@ -75,13 +75,16 @@ faces: $(STAMP)
 # shipped, --max-side 2048, and with --max-side 0 --min-face 15; about 1.7 GB resident for the
 # full-resolution calls on 12 MP); then crowds: the split's photo faces 29 (25) times anywhere in
 # 3000x2171 and 2048x1536 pictures at 50-100 px (25-50 px), find --all against the same without
-# its crowd step (crowd ratio 0): docs/faces.md's section "find --all on groups: scale as an
-# action" (about 8 minutes).
+# its crowd step (crowd ratio 0); then hard crowds (the faces grey, flat and blurred, 3000x2171):
+# docs/faces.md's section "find --all on groups: scale as an action" (about 11 minutes).
 GROUP_BENCH := $(VPY) bench/faces/many_faces.py --scenes 8 --sizes 640x480,1280x886 --write docs/faces.md
 CANVAS_BENCH := $(VPY) bench/faces/many_faces.py --canvas 15-40 --sizes 4000x3000 --scenes 4 \
 	--min-face 15 --write docs/faces.md
 CROWD_BENCH := $(VPY) bench/faces/many_faces.py --sizes 3000x2171,2048x1536 --scenes 4 \
 	--crowd-ratios 0 --write docs/faces.md
+# hard crowds: the faces grey, at 0.6 of their contrast, blurred (1 or 2 px of a 75 px face)
+HARD_CROWD_BENCH := $(VPY) bench/faces/many_faces.py --sizes 3000x2171 --scenes 4 --crowd 50-100 \
+	--write docs/faces.md
 
 faces-groups: $(STAMP)
 	$(GROUP_BENCH) --split train --section groups-train-photos
@@ -96,6 +99,10 @@ faces-groups: $(STAMP)
 	$(CROWD_BENCH) --split train --crowd 25-50 --copies 25 --section crowd-train-small
 	$(CROWD_BENCH) --split test --crowd 50-100 --copies 15 --section crowd-test
 	$(CROWD_BENCH) --split test --crowd 25-50 --copies 13 --section crowd-test-small
+	$(HARD_CROWD_BENCH) --split train --degrade 1 --copies 29 --section crowd-train-hard1
+	$(HARD_CROWD_BENCH) --split train --degrade 2 --copies 29 --section crowd-train-hard2
+	$(HARD_CROWD_BENCH) --split test --degrade 1 --copies 15 --section crowd-test-hard1
+	$(HARD_CROWD_BENCH) --split test --degrade 2 --copies 15 --section crowd-test-hard2
 
 # The pan/tilt face search against a blind sweep on 400 + 200 held-out scenes and a second camera:
 # writes docs/pan_tilt.md and docs/data/pan_tilt.json.gz (10-30 minutes, and 15 for the ROS demo).

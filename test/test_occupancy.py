@@ -338,6 +338,33 @@ def test_two_faces_in_one_cell_when_the_boxes_say_so():
     assert {f['cell'] for f in faces} == {0}
 
 
+def test_in_a_crowd_a_strong_box_seen_once_is_a_face_beside_one_seen_often():
+    """A crowd of find --all: one cluster of occupied cells, faces seen by one call or three."""
+    grid = Grid(1, 6)
+    log_odds = np.array([5.0, 5.0, 5.0, 5.0, -5.0, -5.0])
+    occupied = log_odds > 0
+    often = [[0, 0, 20, 20], [1, 0, 20, 20], [0, 1, 19, 20]]      # three calls, 0.9 each
+    once = [[42, 0, 18, 18]]                                       # one call, 0.8
+    stray = [[18, 2, 14, 14]]                                      # beside the first, 0.6
+    boxes = np.array(often + once + stray, dtype=float)
+    scores = np.array([0.9, 0.9, 0.9, 0.8, 0.6])
+    # without a strong score the cluster's best support (2.7) decides: one face
+    faces = count_faces(log_odds, grid, occupied, boxes, scores, image_px=(120, 20))
+    assert len(faces) == 1
+    faces = count_faces(log_odds, grid, occupied, boxes, scores, image_px=(120, 20),
+                        strong=0.7)
+    assert sorted(f['box'][0] for f in faces) == [0, 42]        # the stray is no face
+    # a strong box touching a face seen more often is still that face
+    touching = np.array(often + [[12, 0, 20, 20]], dtype=float)
+    faces = count_faces(log_odds, grid, occupied, touching, np.array([0.9, 0.9, 0.9, 0.8]),
+                        image_px=(120, 20), strong=0.7)
+    assert len(faces) == 1
+    # below the strong score, a box seen once beside no other still waits for the best's share
+    faces = count_faces(log_odds, grid, occupied, boxes, np.array([0.9, 0.9, 0.9, 0.6, 0.6]),
+                        image_px=(120, 20), strong=0.7)
+    assert len(faces) == 1
+
+
 def test_a_box_centred_past_the_grids_edge_names_the_edge_cell():
     """A wide view at the edge sees past the grid: its box still names a cell of the grid."""
     grid = Grid(3, 3)

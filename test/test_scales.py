@@ -257,12 +257,13 @@ CROWD = {(200, 200): 80, (200, 800): 80, (600, 500): 60, (600, 1200): 60, (960, 
          (960, 1000): 40}                                   # (y, x): side in px, 1600x1200
 
 
-def _crowd_sensor(fovea, crowd_ratio=search.CROWD_RATIO, crowd=None):
+def _crowd_sensor(fovea, crowd_ratio=search.CROWD_RATIO, crowd=None, table=TABLE,
+                  budget=1600 * 1200):
     image = np.zeros((1200, 1600, 3), dtype=np.uint8)
     for (y, x), side in (CROWD if crowd is None else crowd).items():
         image[y:y + side, x:x + side] = 255
     prior = prior_log_odds(fovea.grid.n_cells, cell_prior(fovea.grid.n_cells, 0.5))
-    sensor = search._Coarse(fovea, TABLE, (1600, 1200), prior, 0.99, budget=1600 * 1200,
+    sensor = search._Coarse(fovea, table, (1600, 1200), prior, 0.99, budget=budget,
                             crowd_ratio=crowd_ratio)
     sensor.detector = _Blobs()
     sensor.start(image)
@@ -295,6 +296,52 @@ def test_faces_smaller_than_assumed_send_the_whole_image_to_a_finer_call(yunet_4
     assert all(rect != whole for rect, _, _ in sensor.looks[1:])
     occupied = set(np.flatnonzero(prior + frame.values > np.log(99)))
     assert occupied < set(faces) and len(occupied) == 4
+
+
+def test_a_pass_that_sees_nothing_looks_again_finer_where_few_false_boxes_are_expected(
+        yunet_420):
+    _, fovea = yunet_420
+    whole = (0, 0, 1600, 1200)
+    small = {(200, 200): 40, (960, 1000): 40}               # 10 px at 1/4: no box at all
+    # nothing seen: faces 0.7 times the 120 px assumed may be there (84 px: 21 px at 1/4, which
+    # this table's 1/4 row does not see, needing 24), so the whole image is read at 1/2 (42 px)
+    table = ScaleTable('test', (ScaleRow(0.25, 24.0, 0.97, 0.05), *TABLE.rows[1:]), 0.7)
+    sensor, prior, frame = _crowd_sensor(fovea, crowd=small, table=table)
+    assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 0.5]
+    posterior = prior + frame.values
+    cells = [fovea.grid.index(int((y + s / 2) * 21 / 1200), int((x + s / 2) * 21 / 1600))
+             for (y, x), s in small.items()]
+    assert np.all(posterior[cells] > np.log(99))
+    # an empty image pays the same two calls and is decided empty everywhere
+    sensor, prior, frame = _crowd_sensor(fovea, crowd={}, table=table)
+    assert [scale for _, scale, _ in sensor.looks] == [0.25, 0.5]
+    assert np.all(prior + frame.values < -np.log(99))
+    # a row expecting a false box in one image of 30 or more is not read on no sign of a face
+    noisy = ScaleTable('test', (table.rows[0], ScaleRow(0.5, 16.0, 0.97, 0.0625),
+                                table.rows[2]), 0.7)
+    assert 0.0625 * 800 * 600 / 1e6 == search.STEP_FALSE
+    sensor, _, _ = _crowd_sensor(fovea, crowd=small, table=noisy)
+    assert [scale for _, scale, _ in sensor.looks] == [0.25]
+    # faces assumed to matter that the coarse call sees well: nothing seen is nothing there
+    sensor, _, _ = _crowd_sensor(fovea, crowd=small)
+    assert [scale for _, scale, _ in sensor.looks] == [0.25]
+
+
+def test_the_crowd_step_reads_at_most_the_budget_it_is_given(yunet_420):
+    _, fovea = yunet_420
+    # the 80 px squares send the pass to 1/2 (above); three 30 px squares, unseen at 1/4, are
+    # weak there (15 px), and faces 0.7 x 30 px may be there too (10.5 px at 1/2, below its
+    # 16): the full-resolution call is next, which one full call's
+    # budget does not allow after 1/4 and 1/2, and four (an image find resized to half its
+    # sides, budgeted by the image as given) do
+    crowd = {(200, 200): 80, (200, 800): 80, (600, 500): 60, (960, 240): 30,
+             (960, 1000): 30, (600, 1200): 30}
+    whole = (0, 0, 1600, 1200)
+    sensor, _, _ = _crowd_sensor(fovea, crowd=crowd)
+    assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 0.5]
+    sensor, prior, frame = _crowd_sensor(fovea, crowd=crowd, budget=4 * 1600 * 1200)
+    assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 0.5, 1.0]
+    assert frame.detector_pixels == 400 * 300 + 800 * 600 + 1600 * 1200
 
 
 def test_the_crowds_prior_is_the_fraction_of_cells_holding_a_strong_box(yunet_420):

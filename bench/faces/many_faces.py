@@ -53,6 +53,9 @@ import numpy as np
 
 SCALES = (1.0, 1 / 2, 1 / 3, 1 / 4)
 SPLITS_CODE = {'train': 0, 'test': 1}
+# --degrade: faces grey at this fraction of their contrast, blurred as a face of this side
+DEGRADE_CONTRAST = 0.6
+DEGRADE_FACE_PX = 75.0
 
 
 def score(boxes, truth) -> tuple[int, int, int]:
@@ -105,8 +108,22 @@ def lfw_group(size, seed: int, split: str, count: int):
     return name, np.repeat(image[:, :, None], 3, axis=2), np.array(boxes, dtype=float)
 
 
+def degraded(crop: np.ndarray, blur_px: float) -> np.ndarray:
+    """
+    Return a face crop grey, at :data:`DEGRADE_CONTRAST` of its contrast and blurred.
+
+    ``blur_px``: the Gaussian's sigma in the pixels of a face of :data:`DEGRADE_FACE_PX` (the
+    crop is blurred at its own size, the sigma scaled to it): a hard face such as a grey crowd
+    photograph's, out of focus and in flat light.
+    """
+    grey = cv2.cvtColor(np.ascontiguousarray(crop), cv2.COLOR_RGB2GRAY).astype(float)
+    grey = cv2.GaussianBlur(grey, (0, 0), blur_px * max(crop.shape[:2]) / DEGRADE_FACE_PX)
+    grey = np.clip(128.0 + DEGRADE_CONTRAST * (grey - 128.0), 0, 255).astype(np.uint8)
+    return np.repeat(grey[:, :, None], 3, axis=2)
+
+
 def canvas_group(size, seed: int, split: str, copies: int, face_px=(15, 40),
-                 region=(1000, 750)):
+                 region=(1000, 750), degrade: float = 0.0):
     """
     Paste a small group of the split's photo faces into a large face-free canvas.
 
@@ -115,8 +132,8 @@ def canvas_group(size, seed: int, split: str, copies: int, face_px=(15, 40),
     centre-cropped; every labelled face of the split is pasted ``copies`` times (every other one
     mirrored, as :func:`~ipomdp_gaze.vision.photos.group_photo` does) with its larger side
     uniform in ``face_px``, at places that do not overlap inside one ``region`` of the canvas
-    placed at random. Returns the background's name, the RGB image ``(H, W, 3)`` and the face
-    boxes ``(F, 4)``.
+    placed at random. ``degrade``: each face :func:`degraded` with that blur (0: as it is).
+    Returns the background's name, the RGB image ``(H, W, 3)`` and the face boxes ``(F, 4)``.
     """
     width, height = size
     rng = np.random.default_rng([0xCA57, width, height, seed, SPLITS_CODE[split]])
@@ -133,6 +150,8 @@ def canvas_group(size, seed: int, split: str, copies: int, face_px=(15, 40),
     rx = int(rng.integers(0, width - region_w + 1))
     ry = int(rng.integers(0, height - region_h + 1))
     crops = face_crops(split)
+    if degrade:
+        crops = [(degraded(crop, degrade), box) for crop, box in crops]
     mirrored = [(crop[:, ::-1], np.array([crop.shape[1] - x - w, y, w, h]))
                 for crop, (x, y, w, h) in crops]
     taken, boxes = [], []
@@ -155,7 +174,7 @@ def canvas_group(size, seed: int, split: str, copies: int, face_px=(15, 40),
 
 
 def scenes(split: str, count: int, size, copies: int, faces: str = 'photos',
-           face_px=None, crowd: bool = False):
+           face_px=None, crowd: bool = False, degrade: float = 0.0):
     """
     Yield the composed group pictures of a split, or its canvases: ``(name, image, boxes)``.
 
@@ -164,7 +183,8 @@ def scenes(split: str, count: int, size, copies: int, faces: str = 'photos',
     if face_px is not None:
         for i in range(count):
             name, image, boxes = canvas_group(size, i, split, copies, face_px,
-                                              region=size if crowd else (1000, 750))
+                                              region=size if crowd else (1000, 750),
+                                              degrade=degrade)
             yield f'{"crowd" if crowd else "canvas"}-{name}-{i}', image, boxes
         return
     if faces == 'lfw':
@@ -197,14 +217,15 @@ def run(args) -> list[dict]:
         # find's one-time set-up (the belief's information table, the fixation costs of the
         # size) is not in its seconds (ipomdp_gaze.commands.find): built on a first scene here
         _, image, _ = next(iter(scenes(args.split, 1, size, args.copies, args.faces,
-                                       args.face_px, args.crowd is not None)))
+                                       args.face_px, args.crowd is not None, args.degrade)))
         for _, max_side, min_face, _ in finds:
             small, _ = shrink(image, max_side)
             search_one(small, tasks.task((small.shape[1], small.shape[0])), settings,
                        np.random.default_rng(0), True)
         del image, small
         for name, image, truth in scenes(args.split, args.scenes, size, args.copies,
-                                         args.faces, args.face_px, args.crowd is not None):
+                                         args.faces, args.face_px, args.crowd is not None,
+                                         args.degrade):
             for method, max_side, min_face, ratio in finds:
                 # as find does: an image longer than --max-side is resized first (INTER_AREA;
                 # in its seconds), the faces' boxes given back in the image's pixels
@@ -214,7 +235,7 @@ def run(args) -> list[dict]:
                 [result] = search_one(small, task, settings, np.random.default_rng(0), True,
                                       None if min_face is None else min_face / max(sx, sy),
                                       empty_by_evidence=args.empty_by_evidence,
-                                      crowd_ratio=ratio)
+                                      crowd_ratio=ratio, given_px=image.shape[0] * image.shape[1])
                 seconds = time.perf_counter() - t0
                 boxes = (np.array([f.box for f in result.faces]).reshape(-1, 4)
                          * (sx, sy, sx, sy))
@@ -292,6 +313,9 @@ def main(argv=None):
                    help='crowds instead of group pictures: each of --sizes a background of '
                         'the split with its photo faces, --copies times, of LO-HI px anywhere '
                         'in the picture (canvas_group over the whole picture)')
+    p.add_argument('--degrade', type=float, default=0.0, metavar='SIGMA',
+                   help='canvases and crowds: every face grey, at 0.6 of its contrast and '
+                        'blurred by SIGMA px of a 75 px face (a hard crowd; 0: as it is)')
     p.add_argument('--crowd-ratios', type=lambda t: [float(v) for v in t.split(',')],
                    default=[], metavar='R,R',
                    help='also run find --all with these crowd ratios (0: no crowd step; '
@@ -316,6 +340,8 @@ def main(argv=None):
     kind = (f'{"crowds" if args.crowd else "canvases"} with {args.faces} faces of '
             f'{args.face_px[0]:g}-{args.face_px[1]:g} px' if args.face_px
             else f'{args.faces} faces')
+    if args.degrade:
+        kind += f' (grey, contrast {DEGRADE_CONTRAST:g}, blur {args.degrade:g} px)'
     lines = [f'split {args.split}, {kind}, {args.scenes} scenes per size, '
              f'{args.copies} copies (lfw: faces) per scene, detector {args.detector}, absent '
              f'prior {args.absent_prior}, confidence {args.confidence}, empty by evidence '

@@ -692,7 +692,7 @@ def search_route(task, image_px: tuple[int, int], settings, find_all: bool,
 def search_one(image, task, settings, rng, find_all: bool,
                min_face: float | None = None, scan: str = SCAN_DEFAULT,
                empty_by_evidence: bool = EMPTY_BY_EVIDENCE,
-               crowd_ratio: float = CROWD_RATIO) -> list:
+               crowd_ratio: float = CROWD_RATIO, given_px: int | None = None) -> list:
     """
     Search one image: the fovea within one full scan's pixels, or the full frame (say why).
 
@@ -701,7 +701,9 @@ def search_one(image, task, settings, rng, find_all: bool,
     shorter side) and to the ladder of ``--scan coarse`` (default: it ends at full
     resolution); not to the full frame, the old loop or the fovea (:func:`search_route`);
     ``empty_by_evidence``: its rule for cells nobody occupies, ``crowd_ratio`` its step to a
-    finer call for a crowd (:func:`search_many`).
+    finer call for a crowd (:func:`search_many`). ``given_px``: the pixels of the image as
+    given, before ``--max-side`` resized it (default this image's): the many-target search
+    reads at most one full-resolution call of that image, the other searches of this one.
     """
     width, height = image.shape[1], image.shape[0]
     route, reason = search_route(task, (width, height), settings, find_all, scan)
@@ -714,6 +716,7 @@ def search_one(image, task, settings, rng, find_all: bool,
     scales = scale_table(task.model)
     if route == 'many':
         prepare_many(task.fovea, task.model, (width, height), scales)      # one-time set-up
+        budget = max(budget, given_px or 0)
         return [search_many(image, task.fovea, task.model, settings, pixel_budget=budget,
                             scales=scales, min_face=min_face,
                             empty_by_evidence=empty_by_evidence, crowd_ratio=crowd_ratio)]
@@ -884,10 +887,11 @@ def run(args) -> int:
                           if scale != (1.0, 1.0) else ''))
         if route == 'many' and args.min_face is None and scale != (1.0, 1.0):
             _note(f'{path}: --all looks for faces of {min_face_px(given):.0f} px or more '
-                  '(1/10 of the shorter side; a face found smaller sends it finer): '
+                  '(1/10 of the shorter side; a smaller face found, or none, sends it '
+                  'finer): '
                   '--min-face PX --max-side 0 looks for smaller faces')
         results = search_one(image, task, settings, np.random.default_rng([args.seed, i]),
-                             args.all, min_face, scan)
+                             args.all, min_face, scan, given_px=given[0] * given[1])
         searched = results                      # in the searched image's pixels (the plot)
         if scale != (1.0, 1.0):
             results = [_in_given_pixels(r, scale, given) for r in results]

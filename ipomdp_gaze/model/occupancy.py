@@ -265,8 +265,8 @@ def box_iou(a: np.ndarray, b: np.ndarray, over: str = 'union') -> np.ndarray:
     return np.where(union > 0, inter / np.where(union > 0, union, 1.0), 0.0)
 
 
-def merge_boxes(boxes, scores=None, iou: float = 0.3,
-                inside: float = 0.6) -> tuple[np.ndarray, np.ndarray]:
+def merge_boxes(boxes, scores=None, iou: float = 0.3, inside: float = 0.6,
+                best: bool = False) -> tuple:
     """
     Greedy non-maximum suppression: the distinct boxes ``(F, 4)`` and their support ``(F,)``.
 
@@ -276,11 +276,11 @@ def merge_boxes(boxes, scores=None, iou: float = 0.3,
     raw boxes it took (1 each for a detector without scores). Ties (every box of a detector
     without scores) go to the box that most others overlap by ``iou``, the middle of a cluster
     of raw detections (then the larger): a stray large box round a face and its neighbour
-    does not become the face's box.
+    does not become the face's box. ``best``: also return each box's best raw score ``(F,)``.
     """
     boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
     if boxes.shape[0] == 0:
-        return boxes, np.zeros(0, dtype=np.intp)
+        return (boxes, np.zeros(0, dtype=np.intp)) + ((np.zeros(0),) if best else ())
     scores = np.ones(len(boxes)) if scores is None else np.asarray(scores, dtype=float)
     similar = box_iou(boxes, boxes) > iou
     order = np.lexsort((-boxes[:, 2] * boxes[:, 3], -similar.sum(axis=1), -scores))
@@ -293,7 +293,33 @@ def merge_boxes(boxes, scores=None, iou: float = 0.3,
         owner[i] = len(kept)
         owner[(owner < 0) & overlap[i]] = len(kept)
         kept.append(i)
-    return boxes[kept], np.bincount(owner, weights=scores, minlength=len(kept))
+    support = np.bincount(owner, weights=scores, minlength=len(kept))
+    if not best:
+        return boxes[kept], support
+    top = np.full(len(kept), -np.inf)
+    np.maximum.at(top, owner, scores)
+    return boxes[kept], support, top
+
+
+def _supported(boxes: np.ndarray, counts: np.ndarray, support: float, top=None,
+               strong: float | None = None) -> np.ndarray:
+    """
+    Return which of a cluster's merged boxes ``(K, 4)`` are faces of their own (bool, (K,)).
+
+    A box is one when its support is at least ``support`` times the cluster's best. With
+    ``strong``, a box whose best raw score ``top`` reaches it needs that only of the boxes
+    beside it (centres closer than the larger of the two on both axes): a stray box beside a
+    face is still not a second face.
+    """
+    if strong is None:
+        return counts >= support * counts.max()
+    centres = boxes[:, :2] + boxes[:, 2:] / 2
+    near = ((np.abs(centres[:, None, 0] - centres[None, :, 0])
+             < np.maximum(boxes[:, None, 2], boxes[None, :, 2]))
+            & (np.abs(centres[:, None, 1] - centres[None, :, 1])
+               < np.maximum(boxes[:, None, 3], boxes[None, :, 3])))
+    local = counts >= support * np.where(near, counts[None, :], 0.0).max(axis=1)
+    return local & ((counts >= support * counts.max()) | (top >= strong))
 
 
 def cell_boxes_px(grid, cells, image_px) -> np.ndarray:
@@ -321,7 +347,7 @@ def _box_cells(boxes: np.ndarray, grid, image_px) -> np.ndarray:
 
 def count_faces(log_odds: np.ndarray, grid, occupied: np.ndarray, boxes=None, scores=None,
                 image_px=None, link: int = 2, iou: float = 0.3,
-                support: float = 0.5) -> list[dict]:
+                support: float = 0.5, strong: float | None = None) -> list[dict]:
     """
     Return one face per cluster of occupied cells, split where the detector's boxes differ.
 
@@ -344,6 +370,10 @@ def count_faces(log_odds: np.ndarray, grid, occupied: np.ndarray, boxes=None, sc
     support : float
         A cluster is split only by merged boxes with at least this share of the support of its
         best-supported box (a stray raw box beside a face does not make a second face).
+    strong : float, optional
+        A detector's strong score (``find --all``'s coarse pass): a merged box holding a raw box
+        of that score needs the share of ``support`` only of the boxes beside it, so that in a
+        crowd a face one call saw stays a face beside faces that several calls saw.
 
     Returns
     -------
@@ -362,7 +392,7 @@ def count_faces(log_odds: np.ndarray, grid, occupied: np.ndarray, boxes=None, sc
     log_empty = -np.logaddexp(0.0, log_odds)                  # log(1 - P(x_j = 1))
     merged = counts = centre_cells = None
     if boxes is not None and image_px is not None and len(boxes):
-        merged, counts = merge_boxes(boxes, scores, iou)
+        merged, counts, top = merge_boxes(boxes, scores, iou, best=True)
         centre_cells = _box_cells(merged, grid, image_px)
     faces = []
     for label in range(labels.max() + 1 if labels.size else 0):
@@ -374,7 +404,7 @@ def count_faces(log_odds: np.ndarray, grid, occupied: np.ndarray, boxes=None, sc
             dist = np.maximum(np.abs(br[:, None] - r[None, :]), np.abs(bc[:, None] - c[None, :]))
             own = np.flatnonzero(dist.min(axis=1) <= 1)
             if own.size:
-                own = own[counts[own] >= support * counts[own].max()]
+                own = own[_supported(merged[own], counts[own], support, top[own], strong)]
         if own.size >= 2:
             r, c = np.divmod(cells, grid.cols)
             br, bc = np.divmod(centre_cells[own], grid.cols)

@@ -293,9 +293,10 @@ class OccupancySession:
         """Whether every cell is decided (occupied, near a person found, or empty)."""
         return self._s()['room_done']
 
-    def faces(self, boxes=None, scores=None, image_px=None, link: int = 2) -> list[dict]:
+    def faces(self, boxes=None, scores=None, image_px=None, link: int = 2,
+              strong: float | None = None) -> list[dict]:
         """
-        Return the faces, each counted once (``occupancy.count_faces``).
+        Return the faces, each counted once (``occupancy.count_faces``; ``strong``: its).
 
         Moving targets: the people followed now (:attr:`tracks`), in the order of their
         numbers, each ``{'cell', 'cells', 'probability', 'box': None, 'person'}``.
@@ -304,7 +305,7 @@ class OccupancySession:
             return [{'cell': t.cell, 'cells': np.array([t.cell]), 'probability': t.probability,
                      'box': None, 'person': t.person} for t in self.tracks.found]
         faces = count_faces(self.log_odds, self.grid, self.occupied(), boxes, scores, image_px,
-                            link)
+                            link, strong=strong)
         if self.passing:
             faces = self._with_groups(faces, boxes is not None)
         return faces

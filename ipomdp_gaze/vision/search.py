@@ -102,16 +102,21 @@ LOOK_ALLOWANCE = 1.0
 FAINT_SCORE = 0.2
 FAINT_SIDE = 4 / 3
 FAINT_LOOK_SCORE = 0.8
-# A crowd (find --all, docs/design.md section 11.4): when the coarse pass finds a face smaller
-# than CROWD_RATIO times the faces assumed to matter (1/10 of the shorter side), the image holds
-# smaller faces than assumed, and the whole image is detected again at the table's row at or
-# above 1 / CROWD_RATIO times the scale (faces CROWD_RATIO times smaller seen at the input size
-# of the smallest found), and so on while the smallest face found keeps shrinking by that ratio.
+# A crowd (find --all, docs/design.md section 11.4): faces down to CROWD_RATIO times the smallest
+# the coarse pass found (or, when it found nothing, than the faces assumed to matter) may be
+# there; when the call's scale does not see faces that small by its table, the whole image is
+# detected again at the coarsest finer row that does (the finest affordable one when none is),
+# and so on, within the pixel budget.
 CROWD_RATIO = 0.7
+# With no box at all, a finer call is taken only if its table row expects fewer false detections
+# than this in the whole image (rate times its pixels): YuNet's rows do on every image find
+# resizes, Haar's (0.18-0.37 per Mpx) only on small ones. Chosen on the 432 face-free training
+# images (bench/faces/find_scale.py's augmented set): without it Haar's find --all named a face
+# on 50 of them instead of 41, YuNet's on 11 with it or without.
+STEP_FALSE = 0.03
 # Faces too small for the coarse scale to see strongly can still leave weak boxes: this many
-# weak boxes below CROWD_RATIO times the faces assumed to matter send the image finer too
-# (training crowds of 25-50 px: 23 -> 43 of 100 faces at 3000x2171, 74 -> 82 at 2048x1536;
-# the training groups, the 50-100 px crowds and the 432 face-free images unchanged).
+# weak boxes (and no strong one) give the smallest face found; fewer, beside no strong box, say
+# nothing of the faces' size and take no step.
 CROWD_WEAK_BOXES = 3
 
 # The settings of search_image unless given: NMPT's operating point (confidence 0.9, 25 fixations,
@@ -684,34 +689,47 @@ class _Coarse(_Recorder):
         self.looks.append((tuple(int(v) for v in rect), scale, pixels))
         return strong, weak, pixels
 
-    def _finer_for_smaller_faces(self, strong, scale: float, side: float, weak=()):
+    def _finer_for_smaller_faces(self, strong, scale: float, side: float, weak=(),
+                                 spent: int = 0):
         """
-        Return the next full call's scale and side when faces are smaller than ``side``.
+        Return the next whole-image call's scale and face side, when faces may be smaller.
 
-        A strong box whose larger side is below ``crowd_ratio`` times the faces assumed to
-        matter (``side``), or :data:`CROWD_WEAK_BOXES` weak ones that small, say the image
-        holds smaller faces than assumed (a crowd): faces ``crowd_ratio`` times smaller still
-        would be seen, at the size in the detector's input at which this call saw its
-        smallest, by a call ``1 / crowd_ratio`` times finer (the table's row at or above it,
-        else the finest). None when no strong box and fewer than :data:`CROWD_WEAK_BOXES`
-        weak ones are that small, no finer row exists or ``crowd_ratio`` is 0.
+        A strong box below ``crowd_ratio`` times the faces assumed to matter (``side``), or
+        :data:`CROWD_WEAK_BOXES` weak ones that small, say the image holds smaller faces than
+        assumed (a crowd), and the smallest of them that faces ``crowd_ratio`` times smaller
+        still may be there; with no box at all, faces ``crowd_ratio`` times smaller than
+        ``side`` may be. When this call's scale does not see faces that small by its table
+        row, the next call is the coarsest finer row that does, else the finest one within the
+        budget (``spent``: the pixels read so far); with no box at all, only rows that expect
+        fewer false detections than :data:`STEP_FALSE`. None otherwise, when no finer
+        row fits or ``crowd_ratio`` is 0.
         """
         if not self.crowd_ratio:
             return None
         sides = [np.max(np.asarray(boxes, dtype=float).reshape(-1, 4)[:, 2:], axis=1)
                  for boxes in (strong, weak)]
         small = [s[s < self.crowd_ratio * side] for s in sides]
+        blind = False
         if len(small[0]):
             smallest = float(np.min(small[0]))
         elif len(small[1]) >= CROWD_WEAK_BOXES:
             smallest = float(np.min(small[1]))
+        elif not len(sides[0]) and not len(sides[1]):
+            smallest, blind = side, True
         else:
             return None
-        want = scale / self.crowd_ratio
-        finer = [r.scale for r in self.table.rows if r.scale > scale * (1 + SCALE_RTOL)]
+        want = smallest * self.crowd_ratio
+        row = self.table.row(scale)
+        if want * scale >= row.min_side_px:
+            return None
+        width, height = self.image_px
+        finer = [r for r in self.table.rows if r.scale > scale * (1 + SCALE_RTOL)
+                 and spent + math.prod(scaled_size(width, height, r.scale)) <= self.budget
+                 and not (blind and r.false_per_mpx * math.prod(
+                     scaled_size(width, height, r.scale)) / 1e6 >= STEP_FALSE)]
         if not finer:
             return None
-        return next((f for f in finer if f >= want * (1 - SCALE_RTOL)), finer[-1]), smallest
+        return next((r for r in finer if want * r.scale >= r.min_side_px), finer[-1]).scale, want
 
     def _crowd_shift(self, strong) -> np.ndarray:
         """
@@ -737,10 +755,9 @@ class _Coarse(_Recorder):
         whole = (0, 0, width, height)
         strong, weak, pixels = self._look(whole, self.scale)
         scale, side = self.scale, self.min_face
-        while (step := self._finer_for_smaller_faces(strong, scale, side, weak)) is not None:
+        while (step := self._finer_for_smaller_faces(strong, scale, side, weak,
+                                                     pixels)) is not None:
             finer, side = step
-            if pixels + math.prod(scaled_size(width, height, finer)) > self.budget:
-                break
             # the whole image again at the finer scale: its boxes and evidence replace the
             # coarser call's, whose strong boxes stay strong
             found, weak, spent = self._look(whole, finer, pixels)
@@ -890,7 +907,9 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     boxes = np.concatenate(sensor.boxes) if sensor.boxes else np.zeros((0, 4))
     scores = np.concatenate(sensor.scores) if sensor.scores else np.zeros(0)
     grid = fovea.grid
-    found = session.faces(boxes, scores, image_px, link)
+    found = session.faces(boxes, scores, image_px, link,
+                          strong=scales.strong_score if scales is not None
+                          and scales.strong_score > 0 else None)
     faces = tuple(Face(box=clip_box(f['box'], image_px),
                        cell=tuple(int(v) for v in grid.cell(f['cell'])),
                        probability=f['probability']) for f in found)
