@@ -405,7 +405,7 @@ def test_a_head_change_mid_search_resends_the_target_and_the_replay_settles_anew
     """Review: the node's re-send counted as a fixation, the replay never settled again."""
     bag = _record(_parameters(*TRACKING, confidence=0.85), _walk_out(5 * 11 + 8, 20), 60,
                   changes=[(6, {'pan_offset_rad': 0.05})])
-    change = bag.topic('parameter_events')[0].time_ns
+    change = bag.topic('/parameter_events')[0].time_ns
     after = [m for m in bag.topic('pan_tilt') if m.time_ns > change]
     before = [m for m in bag.topic('pan_tilt') if m.time_ns < change][-1]
     assert after[0].msg.position[1] == before.msg.position[1], 'the re-send of the same cell'

@@ -421,6 +421,9 @@ def test_a_recorder_in_a_namespace_asks_its_node_there_and_the_replay_reads_it(c
         '/head1/recorded_source'
     assert bag.parameters('recorded_source')['confidence'] == 0.9
     assert [m.topic for m in bag.topic('pan_tilt')] == ['/head1/pan_tilt']
+    # a leading slash is absolute, as the recorder resolved its topics; without, relative
+    assert {m.topic for m in bag.topic('/parameter_events')} == {'/parameter_events'}
+    assert bag.topic('/pan_tilt') == [] and bag.topic('parameter_events') == []
     from ipomdp_gaze.drivers.replay import parameter_changes
     assert [c.values for c in parameter_changes(bag, 'recorded_source')] == \
         [{'confidence': 0.8}]

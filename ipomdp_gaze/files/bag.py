@@ -20,8 +20,6 @@ import yaml
 
 DISTRO_STORE = 'ROS2_JAZZY'
 COMPRESSIONS = ('', 'zstd')
-# The recorder's absolute topics (the others are relative: resolved in its namespace).
-ABSOLUTE_TOPICS = ('diagnostics', 'parameter_events')
 
 
 def _typestore():
@@ -114,12 +112,13 @@ class Bag:
         """
         Return the messages of the topic ``name``, resolved in the recorder's namespace.
 
-        ``pan_tilt`` of a bag recorded in ``/head1`` is ``/head1/pan_tilt``; ``/parameter_events``
-        is absolute, as is any name in the root namespace (with or without its leading slash).
+        ``pan_tilt`` of a bag recorded in ``/head1`` is ``/head1/pan_tilt``; a name with a
+        leading slash (``/parameter_events``) is absolute, by the rule the recorder resolved its
+        topics with (in the root namespace both are the same).
         """
-        name = name.strip('/')
-        if self.namespace.strip('/') and name not in ABSOLUTE_TOPICS:
+        if not name.startswith('/') and self.namespace.strip('/'):
             name = self.namespace.strip('/') + '/' + name
+        name = name.strip('/')
         return [m for m in self.messages if m.topic.lstrip('/') == name]
 
     def parameters(self, node: str) -> dict:

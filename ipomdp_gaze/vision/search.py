@@ -1025,18 +1025,22 @@ def look_factor(box, upscale: float, scale: float = 1.0) -> float:
     return min(max(upscale, scale), max(scale, LOOK_SIDE_PX / max(box[2], box[3])))
 
 
-def _look_cost(box, image_px, upscale: float, scale: float = 1.0) -> int:
-    """Return the detector pixels of :func:`_enlarged_look` at ``box`` (before it runs)."""
+def _look_geometry(box, image_px, upscale: float, scale: float = 1.0):
+    """Return the enlarged look's crop ``(x0, y0, x1, y1)``, its resize and its size ``(w, h)``."""
     x0, y0, x1, y1 = _crop_round(box, image_px)
     factor = look_factor(box, upscale, scale)
-    return round((x1 - x0) * factor) * round((y1 - y0) * factor)
+    return (x0, y0, x1, y1), factor, (round((x1 - x0) * factor), round((y1 - y0) * factor))
+
+
+def _look_cost(box, image_px, upscale: float, scale: float = 1.0) -> int:
+    """Return the detector pixels of :func:`_enlarged_look` at ``box`` (before it runs)."""
+    return math.prod(_look_geometry(box, image_px, upscale, scale)[2])
 
 
 def _enlarged_look(image: np.ndarray, box, image_px, detector, upscale: float,
                    scale: float = 1.0):
     """Return ``(best score, pixels)`` of the detector on the crop round ``box``, resized."""
-    x0, y0, x1, y1 = _crop_round(box, image_px)
-    factor = look_factor(box, upscale, scale)
+    (x0, y0, x1, y1), factor, _ = _look_geometry(box, image_px, upscale, scale)
     crop = cv2.resize(np.ascontiguousarray(image[y0:y1, x0:x1]), None, fx=factor, fy=factor,
                       interpolation=cv2.INTER_LINEAR if factor >= 1 else cv2.INTER_AREA)
     look = scan(crop, detector, (1, 1), 1.0)
