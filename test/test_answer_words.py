@@ -14,7 +14,9 @@ import pytest
     ('found', 'budget', 0.62, ' (below the confidence 0.99)'),
     ('absent', 'pixels', 0.493, ' (below the confidence 0.99)'),
     # a room's pass ends forced while the face it names is sure
-    ('found', 'pass', 0.9995, ' (forced before the search reached the confidence 0.99)'),
+    ('found', 'pass', 0.9995, ' (at the confidence 0.99, forced before the search was done)'),
+    # absent held back until every cell was seen well (absent_needs_coverage), then forced
+    ('absent', 'budget', 0.995, ' (at the confidence 0.99, forced before the search was done)'),
     ('found', 'group', 0.68, ' (below the confidence 0.99)'),
     ('gave_up', 'budget', 0.4, ' (below the confidence 0.99)'),
     ('', '', 0.5, ''),

@@ -94,13 +94,15 @@ def confidence_clause(decision: str, reason: str, probability: float,
     Return ``(reached the confidence C)``, ``(below the confidence C)`` or ''.
 
     A forced answer whose own probability is at the confidence anyway (a room's pass ends
-    forced while the face it names is sure; the rest of the room is not) says ``(forced before
-    the search reached the confidence C)``: never "below" of a probability that is not.
+    forced while the face it names is sure and the rest of the room is not; ``absent`` held
+    back by ``search.absent_needs_coverage`` until a budget forced it) says ``(at the
+    confidence C, forced before the search was done)``: never "below" of a probability that is
+    not, nor "reached" of a search that did not end by it.
     """
     if confidence is None or not decision or math.isnan(probability):
         return ''
     if forced(decision, reason) and probability >= confidence:
-        return f' (forced before the search reached the confidence {confidence:g})'
+        return f' (at the confidence {confidence:g}, forced before the search was done)'
     word = 'reached' if probability >= confidence and not forced(decision, reason) \
         else 'below'
     return f' ({word} the confidence {confidence:g})'
