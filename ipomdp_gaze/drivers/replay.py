@@ -652,6 +652,8 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
     reset = _last_reset(bag, grid)
     at = values_at(recorded_values, changes, origin if reset is None else reset)
     config = checked_config(at, overrides)
+    # the start cell from a core of its own: a policy's first choice may draw on its random
+    # stream, which the replayed core must begin fresh, as the node's did
     cut = search_start(bag, config.head, config.controller().reset(0.0))
     if cut is not None:
         bag = dataclasses.replace(bag, messages=[m for m in bag.messages if m.time_ns >= cut])
