@@ -249,3 +249,34 @@ def test_conv_policy_with_any_finite_kernel_chooses_a_valid_cell(grid, action, s
     assert_cells(policy.select(belief, 0, rng), belief, grid)
     visited = np.zeros(grid.n_cells, dtype=bool)
     assert 0 <= unvisited_choice(policy, belief[:1], visited, 0, rng, grid) < grid.n_cells
+
+
+@st.composite
+def crowds(draw):
+    """Draw occupied cells on a 4x6 grid of 20 px cells and raw boxes with scores."""
+    log_odds = np.array(draw(st.lists(st.sampled_from([-5.0, 5.0]), min_size=24, max_size=24)))
+    n = draw(st.integers(0, 12))
+    boxes = np.array([[draw(st.integers(-5, 115)), draw(st.integers(-5, 75)),
+                       draw(st.integers(4, 40)), draw(st.integers(4, 40))] for _ in range(n)],
+                     dtype=float).reshape(-1, 4)
+    scores = np.array([draw(st.floats(0.3, 1.0)) for _ in range(n)])
+    return Grid(4, 6), log_odds, boxes, scores
+
+
+@PROPERTY
+@given(crowds(), st.floats(0.3, 1.0))
+def test_a_strong_score_only_ever_splits_a_cluster_into_more_faces(crowd, strong):
+    from ipomdp_gaze.model.occupancy import count_faces
+    grid, log_odds, boxes, scores = crowd
+    occupied = log_odds > 0
+    plain = count_faces(log_odds, grid, occupied, boxes, scores, (120, 80))
+    more = count_faces(log_odds, grid, occupied, boxes, scores, (120, 80), strong=strong)
+    assert len(more) >= len(plain)
+
+    def cells(faces):
+        return set(np.concatenate([f['cells'] for f in faces]).tolist()) if faces else set()
+    assert cells(more) == cells(plain) == set(np.flatnonzero(occupied).tolist())
+    # a strong score above every raw score changes nothing
+    above = count_faces(log_odds, grid, occupied, boxes, scores, (120, 80), strong=1.5)
+    assert [(f['cell'], f['probability']) for f in above] == \
+        [(f['cell'], f['probability']) for f in plain]
