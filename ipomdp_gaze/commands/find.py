@@ -193,9 +193,10 @@ def add_parser(sub):
                                        'repeat_weight', 'start_cell'))
     p.add_argument('--all', action='store_true',
                    help='find every face in one search over the many-target belief (an '
-                        'occupancy per cell, infomax per detector pixel, within one full scan '
-                        'of detector pixels, and at most one more for the looks that confirm '
-                        'weak boxes); each face is printed with its box and '
+                        'occupancy per cell, infomax per detector pixel, within one '
+                        'full-resolution scan of the image as given (before --max-side), and '
+                        'at most one more for the looks that confirm weak boxes); each face is '
+                        'printed with its box and '
                         'probability, counted once per cluster of occupied cells (split where '
                         "the detector's boxes are distinct faces; boxes cut to the image); "
                         '"absent" when every cell is decided empty at --confidence (or, forced '
