@@ -82,7 +82,7 @@ CANVAS_BENCH := $(VPY) bench/faces/many_faces.py --canvas 15-40 --sizes 4000x300
 	--min-face 15 --write docs/faces.md
 CROWD_BENCH := $(VPY) bench/faces/many_faces.py --sizes 3000x2171,2048x1536 --scenes 4 \
 	--crowd-ratios 0 --write docs/faces.md
-# hard crowds: the faces grey, at 0.6 of their contrast, blurred (1 or 2 px of a 75 px face)
+# hard crowds: the faces grey, at 0.6 of their contrast, blurred (1 or 3 px of a 75 px face)
 HARD_CROWD_BENCH := $(VPY) bench/faces/many_faces.py --sizes 3000x2171 --scenes 4 --crowd 50-100 \
 	--write docs/faces.md
 
@@ -100,9 +100,9 @@ faces-groups: $(STAMP)
 	$(CROWD_BENCH) --split test --crowd 50-100 --copies 15 --section crowd-test
 	$(CROWD_BENCH) --split test --crowd 25-50 --copies 13 --section crowd-test-small
 	$(HARD_CROWD_BENCH) --split train --degrade 1 --copies 29 --section crowd-train-hard1
-	$(HARD_CROWD_BENCH) --split train --degrade 2 --copies 29 --section crowd-train-hard2
+	$(HARD_CROWD_BENCH) --split train --degrade 3 --copies 29 --section crowd-train-hard3
 	$(HARD_CROWD_BENCH) --split test --degrade 1 --copies 15 --section crowd-test-hard1
-	$(HARD_CROWD_BENCH) --split test --degrade 2 --copies 15 --section crowd-test-hard2
+	$(HARD_CROWD_BENCH) --split test --degrade 3 --copies 15 --section crowd-test-hard3
 
 # The pan/tilt face search against a blind sweep on 400 + 200 held-out scenes and a second camera:
 # writes docs/pan_tilt.md and docs/data/pan_tilt.json.gz (10-30 minutes, and 15 for the ROS demo).

@@ -354,6 +354,10 @@ def test_in_a_crowd_a_strong_box_seen_once_is_a_face_beside_one_seen_often():
     faces = count_faces(log_odds, grid, occupied, boxes, scores, image_px=(120, 20),
                         strong=0.7)
     assert sorted(f['box'][0] for f in faces) == [0, 42]        # the stray is no face
+    # a detector that keeps no scores has no strong score: its raw counts decide as before
+    assert len(count_faces(log_odds, grid, occupied, boxes, image_px=(120, 20),
+                           strong=0.7)) == len(count_faces(log_odds, grid, occupied, boxes,
+                                                           image_px=(120, 20)))
     # a strong box touching a face seen more often is still that face
     touching = np.array(often + [[12, 0, 20, 20]], dtype=float)
     faces = count_faces(log_odds, grid, occupied, touching, np.array([0.9, 0.9, 0.9, 0.8]),

@@ -344,6 +344,38 @@ def test_the_crowd_step_reads_at_most_the_budget_it_is_given(yunet_420):
     assert frame.detector_pixels == 400 * 300 + 800 * 600 + 1600 * 1200
 
 
+def test_faces_smaller_than_every_row_sees_go_to_the_finest_row_the_budget_allows(yunet_420):
+    _, fovea = yunet_420
+    # faces 0.7 x 80 px (56 px) may be there, which no row of this table sees (1/2 needs 40 px
+    # in its input, 1 needs 60): the finest row within the budget is read
+    table = ScaleTable('test', (TABLE.rows[0], ScaleRow(0.5, 40.0, 0.97, 0.05),
+                                ScaleRow(1.0, 60.0, 0.97, 0.05)), 0.7)
+    whole = (0, 0, 1600, 1200)
+    sensor, _, _ = _crowd_sensor(fovea, table=table, budget=4 * 1600 * 1200)
+    assert [scale for rect, scale, _ in sensor.looks if rect == whole][:2] == [0.25, 1.0]
+    sensor, _, _ = _crowd_sensor(fovea, table=table)         # one full call: 1 does not fit
+    assert [scale for rect, scale, _ in sensor.looks if rect == whole][:2] == [0.25, 0.5]
+
+
+def test_search_many_counts_faces_with_the_tables_strong_score(yunet_420, monkeypatch):
+    """The coarse pass's strong score reaches count_faces (a scoreless table's does not)."""
+    from ipomdp_gaze.search.many import OccupancySession
+    model, fovea = yunet_420
+    seen = []
+    faces = OccupancySession.faces
+
+    def spy(self, *args, **kwargs):
+        seen.append(kwargs.get('strong'))
+        return faces(self, *args, **kwargs)
+    monkeypatch.setattr(OccupancySession, 'faces', spy)
+    image, _ = group_photo((640, 480), seed=0, background='coffee', split='train', copies=1)
+    search_many(image, fovea, model, MANY, pixel_budget=640 * 480, scales=TABLE)
+    scoreless = ScaleTable('haar-like', TABLE.rows)
+    search_many(image, fovea, model, MANY, pixel_budget=640 * 480, scales=scoreless)
+    search_many(image, fovea, model, MANY, pixel_budget=640 * 480)
+    assert seen == [TABLE.strong_score, None, None]
+
+
 def test_the_crowds_prior_is_the_fraction_of_cells_holding_a_strong_box(yunet_420):
     _, fovea = yunet_420
     sensor, prior, _ = _crowd_sensor(fovea)
@@ -433,7 +465,7 @@ def test_the_enlarged_looks_stay_within_the_pixel_budget(yunet_420, monkeypatch)
     cost = search._look_cost(np.array([40, 100, 15, 15]), (400, 300), search.LOOK_UPSCALE)
     prior = prior_log_odds(fovea.grid.n_cells, cell_prior(fovea.grid.n_cells, 0.5))
     allowed = 400 * 300 + 2 * cost + cost // 2              # the call and two looks fit
-    budget = allowed / (1 + search.LOOK_ALLOWANCE)
+    budget = allowed - search.LOOK_ALLOWANCE * 400 * 300    # beyond it: of one full scan
     sensor = search._Coarse(fovea, TABLE, (400, 300), prior, 0.99, budget=budget)
     sensor.detector = _Ranked()
     sensor.start(image)

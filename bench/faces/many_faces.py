@@ -108,16 +108,16 @@ def lfw_group(size, seed: int, split: str, count: int):
     return name, np.repeat(image[:, :, None], 3, axis=2), np.array(boxes, dtype=float)
 
 
-def degraded(crop: np.ndarray, blur_px: float) -> np.ndarray:
+def degraded(crop: np.ndarray, box, blur_px: float) -> np.ndarray:
     """
     Return a face crop grey, at :data:`DEGRADE_CONTRAST` of its contrast and blurred.
 
     ``blur_px``: the Gaussian's sigma in the pixels of a face of :data:`DEGRADE_FACE_PX` (the
-    crop is blurred at its own size, the sigma scaled to it): a hard face such as a grey crowd
-    photograph's, out of focus and in flat light.
+    crop is blurred at its own size, the sigma scaled by its face ``box``'s larger side): a
+    hard face such as a grey crowd photograph's, out of focus and in flat light.
     """
     grey = cv2.cvtColor(np.ascontiguousarray(crop), cv2.COLOR_RGB2GRAY).astype(float)
-    grey = cv2.GaussianBlur(grey, (0, 0), blur_px * max(crop.shape[:2]) / DEGRADE_FACE_PX)
+    grey = cv2.GaussianBlur(grey, (0, 0), blur_px * max(box[2], box[3]) / DEGRADE_FACE_PX)
     grey = np.clip(128.0 + DEGRADE_CONTRAST * (grey - 128.0), 0, 255).astype(np.uint8)
     return np.repeat(grey[:, :, None], 3, axis=2)
 
@@ -151,7 +151,7 @@ def canvas_group(size, seed: int, split: str, copies: int, face_px=(15, 40),
     ry = int(rng.integers(0, height - region_h + 1))
     crops = face_crops(split)
     if degrade:
-        crops = [(degraded(crop, degrade), box) for crop, box in crops]
+        crops = [(degraded(crop, box, degrade), box) for crop, box in crops]
     mirrored = [(crop[:, ::-1], np.array([crop.shape[1] - x - w, y, w, h]))
                 for crop, (x, y, w, h) in crops]
     taken, boxes = [], []
@@ -335,6 +335,8 @@ def main(argv=None):
     args = p.parse_args(argv)
     if args.canvas and args.crowd:
         p.error('--canvas and --crowd are two kinds of picture: give one')
+    if args.degrade and not (args.canvas or args.crowd):
+        p.error('--degrade changes the faces of --canvas or --crowd pictures: give one')
     args.face_px = args.canvas or args.crowd
     rows = run(args)
     kind = (f'{"crowds" if args.crowd else "canvases"} with {args.faces} faces of '

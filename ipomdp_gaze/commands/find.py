@@ -55,9 +55,10 @@ starts with one detector call on the whole image at the coarsest scale its calib
 sees faces of 1/10 of the shorter side (``--min-face PX``: of that side in the given image's
 pixels; full resolution when no coarser scale sees it), and looks closer (a crop at a finer
 scale, then the fovea's windows) only where that call leaves cells undecided
-(:mod:`ipomdp_gaze.vision.scales`); a face found far smaller than assumed (a crowd) sends the
-whole image to a finer call (:data:`ipomdp_gaze.vision.search.CROWD_RATIO`). Faces far smaller
-than 1/10 on a large image also need
+(:mod:`ipomdp_gaze.vision.scales`); a face found far smaller than assumed (a crowd), or none at
+all, sends the whole image to a finer call (:data:`ipomdp_gaze.vision.search.CROWD_RATIO`),
+within one full-resolution scan of the image as given. Faces far smaller than 1/10 on a large
+image also need
 ``--max-side 0``: the default resize to 2048 px would shrink them below what the detector sees.
 ``--targets one`` keeps the old loop (:func:`ipomdp_gaze.vision.search.search_all`: find one
 face, rule its cells out, search again).

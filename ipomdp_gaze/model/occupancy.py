@@ -373,7 +373,8 @@ def count_faces(log_odds: np.ndarray, grid, occupied: np.ndarray, boxes=None, sc
     strong : float, optional
         A detector's strong score (``find --all``'s coarse pass): a merged box holding a raw box
         of that score needs the share of ``support`` only of the boxes beside it, so that in a
-        crowd a face one call saw stays a face beside faces that several calls saw.
+        crowd a face one call saw stays a face beside faces that several calls saw. Ignored
+        without ``scores`` (a detector that keeps none has no strong score).
 
     Returns
     -------
@@ -393,6 +394,8 @@ def count_faces(log_odds: np.ndarray, grid, occupied: np.ndarray, boxes=None, sc
     merged = counts = centre_cells = None
     if boxes is not None and image_px is not None and len(boxes):
         merged, counts, top = merge_boxes(boxes, scores, iou, best=True)
+        if scores is None:
+            strong = None
         centre_cells = _box_cells(merged, grid, image_px)
     faces = []
     for label in range(labels.max() + 1 if labels.size else 0):

@@ -86,10 +86,11 @@ import numpy as np
 LOOK_UPSCALE = 2.0
 LOOK_SCORE = 0.6
 LOOK_SIDE_PX = 128.0
-# find --all's enlarged looks at weak full-resolution boxes may add at most this fraction of its
-# pixel budget (one full scan) beyond it, a bound on a photo full of face-like texture: the
-# training groups at 640x480 spend 13% (the full call is the budget there), one look at a 60 px
-# box of a 400x600 photo 50%, and a 48 Mpx photo of textures spent 22% before this bound.
+# find --all's enlarged looks at weak full-resolution boxes may add at most this fraction of one
+# full scan of the searched image beyond its pixel budget, a bound on a photo full of face-like
+# texture: the training groups at 640x480 spend 13% (the full call is the budget there), one
+# look at a 60 px box of a 400x600 photo 50%, and a 48 Mpx photo of textures spent 22% before
+# this bound.
 LOOK_ALLOWANCE = 1.0
 # The faint look (docs/design.md section 11.4), find without --all: when the ladder ends without
 # an answer, the finest call's best faint box (from FAINT_SCORE, below the detector's own
@@ -112,11 +113,11 @@ CROWD_RATIO = 0.7
 # than this in the whole image (rate times its pixels): YuNet's rows do on every image find
 # resizes, Haar's (0.18-0.37 per Mpx) only on small ones. Chosen on the 432 face-free training
 # images (bench/faces/find_scale.py's augmented set): without it Haar's find --all named a face
-# on 50 of them instead of 41, YuNet's on 11 with it or without.
+# on 46 of them instead of 41, YuNet's on 11 with it or without.
 STEP_FALSE = 0.03
 # Faces too small for the coarse scale to see strongly can still leave weak boxes: this many
-# weak boxes (and no strong one) give the smallest face found; fewer, beside no strong box, say
-# nothing of the faces' size and take no step.
+# weak boxes that small (and no strong one that small) give the smallest face found; one or two
+# say nothing of the faces' size and take no step (no box at all: STEP_FALSE).
 CROWD_WEAK_BOXES = 3
 
 # The settings of search_image unless given: NMPT's operating point (confidence 0.9, 25 fixations,
@@ -650,8 +651,8 @@ class _Coarse(_Recorder):
         Detect in ``rect`` (x0, y0, x1, y1) at ``scale``: strong, weak boxes, pixels.
 
         ``spent``: the pixels the pass has read before; an enlarged look that would take the
-        pass past its budget and :data:`LOOK_ALLOWANCE` is not taken (the best-scoring boxes
-        are looked at first), and its box stays weak.
+        pass past its budget and :data:`LOOK_ALLOWANCE` of one full scan of the image is not
+        taken (the best-scoring boxes are looked at first), and its box stays weak.
         """
         x0, y0, x1, y1 = rect
         found = scan(self.image[y0:y1, x0:x1], self.detector, (1, 1), scale)
@@ -669,7 +670,8 @@ class _Coarse(_Recorder):
                     confirmed = []
                     for k in kept[np.argsort(-scores[kept], kind='stable')]:
                         cost = _look_cost(raw[k], self.image_px, self.look_upscale, scale)
-                        if spent + pixels + cost > self.budget * (1 + LOOK_ALLOWANCE):
+                        if spent + pixels + cost > self.budget + LOOK_ALLOWANCE * math.prod(
+                                self.image_px):
                             continue
                         best, used = _enlarged_look(self.image, raw[k], self.image_px,
                                                     self.sensor.fovea.detector,
@@ -701,8 +703,10 @@ class _Coarse(_Recorder):
         ``side`` may be. When this call's scale does not see faces that small by its table
         row, the next call is the coarsest finer row that does, else the finest one within the
         budget (``spent``: the pixels read so far); with no box at all, only rows that expect
-        fewer false detections than :data:`STEP_FALSE`. None otherwise, when no finer
-        row fits or ``crowd_ratio`` is 0.
+        fewer false detections than :data:`STEP_FALSE`. The side returned is the next call's
+        ``side``: the smallest face found (a face 0.7 times smaller still steps again), or
+        with no box the smaller faces now assumed. None otherwise, when no finer row fits or
+        ``crowd_ratio`` is 0.
         """
         if not self.crowd_ratio:
             return None
@@ -729,7 +733,8 @@ class _Coarse(_Recorder):
                      scaled_size(width, height, r.scale)) / 1e6 >= STEP_FALSE)]
         if not finer:
             return None
-        return next((r for r in finer if want * r.scale >= r.min_side_px), finer[-1]).scale, want
+        step = next((r for r in finer if want * r.scale >= r.min_side_px), finer[-1]).scale
+        return step, (want if blind else smallest)
 
     def _crowd_shift(self, strong) -> np.ndarray:
         """
@@ -861,7 +866,9 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     One search session over the occupancy of every cell (:class:`ipomdp_gaze.search.many.
     OccupancySession`): the scan, then the fixation with the largest expected drop of the
     summed cell entropies per detector pixel, until every cell is decided at the confidence
-    (or the budget, or ``pixel_budget``: one full scan for ``find``). The faces are the clusters
+    (or the budget, or ``pixel_budget``: for ``find``, one full-resolution scan of the image
+    as given, before ``--max-side``; beyond it only the looks' :data:`LOOK_ALLOWANCE`). The
+    faces are the clusters
     of occupied cells, each counted once and split where the detector's merged boxes are
     distinct faces (:func:`ipomdp_gaze.model.occupancy.count_faces`, cells within ``link`` of each
     other are one cluster); cells within ``settle`` of an occupied cell need no decision of
@@ -879,8 +886,11 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     ``look_upscale`` times and never below the scale of the call that found the box, the
     table's finest: :func:`look_factor`, 1 to 2x at full resolution; 0: no look), keeps a box
     of ``look_score``; else it is weak. A face found smaller than ``crowd_ratio`` times
-    ``min_face`` (a crowd) sends the whole image to a finer call, and the faces found set the
-    prior's density (:data:`CROWD_RATIO`; 0: neither).
+    ``min_face`` (a crowd), or no box at all, sends the whole image to a finer call where the
+    table says smaller faces are seen (:meth:`_Coarse._finer_for_smaller_faces`), and the
+    faces found set the prior's density (:data:`CROWD_RATIO`; 0: neither). With the
+    detector's strong score, a face one call saw strongly is a face beside faces that several
+    calls saw (``count_faces(strong=)``).
 
     Raises
     ------
