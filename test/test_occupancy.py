@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """The many-target occupancy belief against brute-force Bayes over every occupancy pattern."""
+from dataclasses import replace
 import itertools
 import math
 
@@ -403,6 +404,40 @@ def test_run_search_on_simulated_scenes_ends_after_a_decisive_scan():
     one = run_search(session, ModelSensor(grid, model, np.random.default_rng(0)), 4)
     assert one.decision == 'found' and one.fixations == 0
     assert [f['cell'] for f in session.faces()] == [4]
+
+
+def test_the_fixations_after_the_scan_keep_to_their_own_budget():
+    """A budget of the whole search and one of the fixations after the scan: both are kept."""
+    from ipomdp_gaze.search.sensors import ModelSensor, run_search
+    grid = Grid(3, 3)
+    model = CountObservation(grid, np.tile([0.5, 0.5], (3, 3, 1)),
+                             np.tile([0.55, 0.45], (3, 3, 1)), scan_target=[0.5, 0.5],
+                             scan_null=[0.55, 0.45])
+
+    class Costed(ModelSensor):
+        def scan(self):
+            return replace(super().scan(), detector_pixels=1000)
+
+        def scan_cost(self):
+            return 1000
+
+        def fixation_cost(self, cell):
+            return 100
+
+        def observe(self, cell):
+            return replace(super().observe(cell), detector_pixels=100)
+    settings = SearchSettings(targets='many', confidence=0.999, absent_prior=0.5,
+                              max_fixations=30, inhibit_return=False)
+    session = OccupancySession(grid, model, settings)
+
+    def run(**budgets):
+        return run_search(session, Costed(grid, model, np.random.default_rng(0)), 4, **budgets)
+    assert run(pixel_budget=1650).fixations == 6                     # 1000 + 6 x 100
+    assert run(pixel_budget=10 ** 6, fixation_budget=350).fixations == 3
+    capped = run(pixel_budget=1650, fixation_budget=10 ** 6)
+    assert capped.fixations == 6 and capped.detector_pixels == 1600
+    assert capped.reason == 'pixels'
+    assert run(fixation_budget=350).fixations == 3                   # no total budget
 
 
 def test_the_single_target_session_refuses_many_targets():

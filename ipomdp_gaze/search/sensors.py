@@ -102,7 +102,8 @@ class SearchOutcome:
 
 def run_search(session: SearchSession, sensor: Sensor, scene, *, seed=None,
                limit: int | None = None, pixel_budget: int | None = None, exclude=(),
-               restart: bool = True, fixations=None, on_frame=None) -> SearchOutcome:
+               restart: bool = True, fixations=None, on_frame=None,
+               fixation_budget: int | None = None) -> SearchOutcome:
     """
     Search one scene: reset, scan once (if the sensor and model have one), fixate until the end.
 
@@ -110,7 +111,8 @@ def run_search(session: SearchSession, sensor: Sensor, scene, *, seed=None,
     run it. ``limit`` caps the frames when the settings have no budget (an offline search must
     end). ``pixel_budget`` caps the detector pixels: before a scan or a fixation that would pass
     it (the sensor's ``scan_cost()`` / ``fixation_cost(cell)``) the search stops there
-    (:meth:`SearchSession.stop`, reason ``pixels``). ``exclude`` rules cells out after the scan
+    (:meth:`SearchSession.stop`, reason ``pixels``); ``fixation_budget`` caps those of the
+    fixations after the scan alone, the same way. ``exclude`` rules cells out after the scan
     (:meth:`SearchSession.exclude`, ``find --all``); ``restart=False`` keeps the scene the sensor
     already holds (a second search of the same image reuses its detections). ``fixations``, a
     sequence of cells, is fixated in that order instead of the policy's choices (every view of a
@@ -137,6 +139,7 @@ def run_search(session: SearchSession, sensor: Sensor, scene, *, seed=None,
     t0 = time.perf_counter()
     budget = math.inf if pixel_budget is None else int(pixel_budget)
     pixels, over = 0, False
+    after_scan = math.inf if fixation_budget is None else int(fixation_budget)
     order = None if fixations is None else iter([int(c) for c in fixations])
     if restart:
         sensor.start(scene)
@@ -149,6 +152,7 @@ def run_search(session: SearchSession, sensor: Sensor, scene, *, seed=None,
             _check(session.scan(frame))
     if len(exclude):
         session.exclude(exclude)
+    budget = min(budget, pixels + after_scan)
     cell = session.start()
     while not over and not session.ended and (limit is None or session.fixations < limit):
         if order is not None:
@@ -156,7 +160,7 @@ def run_search(session: SearchSession, sensor: Sensor, scene, *, seed=None,
             if cell is None:
                 break
             session.fixate(cell)
-        if pixel_budget is not None and pixels + sensor.fixation_cost(cell) > budget:
+        if budget < math.inf and pixels + sensor.fixation_cost(cell) > budget:
             over = True
             break
         frame = sensor.observe(cell)

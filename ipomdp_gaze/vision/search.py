@@ -913,7 +913,10 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
         sensor = _Coarse(fovea, scales, image_px, prior, settings.confidence,
                          math.inf if pixel_budget is None else pixel_budget, min_face,
                          look_upscale, look_score, crowd_ratio)
-    outcome = run_search(session, sensor, image, pixel_budget=pixel_budget)
+    # the fovea's windows after the pass: at most one full scan of this image, also when the
+    # budget is one of the (larger) image as given
+    outcome = run_search(session, sensor, image, pixel_budget=pixel_budget,
+                         fixation_budget=None if pixel_budget is None else math.prod(image_px))
     boxes = np.concatenate(sensor.boxes) if sensor.boxes else np.zeros((0, 4))
     scores = np.concatenate(sensor.scores) if sensor.scores else np.zeros(0)
     grid = fovea.grid
