@@ -415,6 +415,7 @@ def test_the_fixations_after_the_scan_keep_to_their_own_budget():
                              scan_null=[0.55, 0.45])
 
     class Costed(ModelSensor):
+
         def scan(self):
             return replace(super().scan(), detector_pixels=1000)
 
