@@ -85,6 +85,9 @@ CROWD_BENCH := $(VPY) bench/faces/many_faces.py --sizes 3000x2171,2048x1536 --sc
 # hard crowds: the faces grey, at 0.6 of their contrast, blurred (1 or 3 px of a 75 px face)
 HARD_CROWD_BENCH := $(VPY) bench/faces/many_faces.py --sizes 3000x2171 --scenes 4 --crowd 50-100 \
 	--write docs/faces.md
+# a few people in a large photo: the split's photo faces 2-3 times at 100-200 px anywhere
+SPARSE_BENCH := $(VPY) bench/faces/many_faces.py --sizes 4000x3000,3000x2171 --scenes 8 \
+	--crowd 100-200 --write docs/faces.md
 
 faces-groups: $(STAMP)
 	$(GROUP_BENCH) --split train --section groups-train-photos
@@ -103,6 +106,8 @@ faces-groups: $(STAMP)
 	$(HARD_CROWD_BENCH) --split train --degrade 3 --copies 29 --section crowd-train-hard3
 	$(HARD_CROWD_BENCH) --split test --degrade 1 --copies 15 --section crowd-test-hard1
 	$(HARD_CROWD_BENCH) --split test --degrade 3 --copies 15 --section crowd-test-hard3
+	$(SPARSE_BENCH) --split train --copies 3 --section sparse-train
+	$(SPARSE_BENCH) --split test --copies 2 --section sparse-test
 
 # The pan/tilt face search against a blind sweep on 400 + 200 held-out scenes and a second camera:
 # writes docs/pan_tilt.md and docs/data/pan_tilt.json.gz (10-30 minutes, and 15 for the ROS demo).

@@ -346,15 +346,23 @@ def test_the_crowd_step_reads_at_most_the_budget_it_is_given(yunet_420):
 
 def test_faces_smaller_than_every_row_sees_go_to_the_finest_row_the_budget_allows(yunet_420):
     _, fovea = yunet_420
-    # faces 0.7 x 80 px (56 px) may be there, which no row of this table sees (1/2 needs 40 px
-    # in its input, 1 needs 60): the finest row within the budget is read
+    # an 80 px face strong at 1/4 and three 60 px ones weak there (faces seen faintly): faces
+    # 0.7 x 80 px (56 px) may be there, which no row of this table sees (1/2 needs 40 px in its
+    # input, 1 needs 60): the finest row within the budget is read
     table = ScaleTable('test', (TABLE.rows[0], ScaleRow(0.5, 40.0, 0.97, 0.05),
                                 ScaleRow(1.0, 60.0, 0.97, 0.05)), 0.7)
+    faint = {(200, 200): 80, (600, 500): 60, (600, 1200): 60, (960, 240): 60}
     whole = (0, 0, 1600, 1200)
-    sensor, _, _ = _crowd_sensor(fovea, table=table, budget=4 * 1600 * 1200)
-    assert [scale for rect, scale, _ in sensor.looks if rect == whole][:2] == [0.25, 1.0]
-    sensor, _, _ = _crowd_sensor(fovea, table=table)         # one full call: 1 does not fit
-    assert [scale for rect, scale, _ in sensor.looks if rect == whole][:2] == [0.25, 0.5]
+
+    def calls(crowd, budget):
+        sensor, _, _ = _crowd_sensor(fovea, crowd=crowd, table=table, budget=budget)
+        return [scale for rect, scale, _ in sensor.looks if rect == whole][:2]
+    assert calls(faint, 4 * 1600 * 1200) == [0.25, 1.0]
+    assert calls(faint, 1600 * 1200) == [0.25, 0.5]          # one full call: 1 does not fit
+    # small faces seen well (strong, one weak box): the call 1/0.7 times finer, 1/2, whatever
+    # the table says of 56 px faces there (this call saw 80 px ones at 20 px)
+    seen_well = {(200, 200): 80, (600, 500): 60}
+    assert calls(seen_well, 4 * 1600 * 1200) == [0.25, 0.5]
 
 
 def test_search_many_counts_faces_with_the_tables_strong_score(yunet_420, monkeypatch):

@@ -105,9 +105,10 @@ FAINT_SIDE = 4 / 3
 FAINT_LOOK_SCORE = 0.8
 # A crowd (find --all, docs/design.md section 11.4): faces down to CROWD_RATIO times the smallest
 # the coarse pass found (or, when it found nothing, than the faces assumed to matter) may be
-# there; when the call's scale does not see faces that small by its table, the whole image is
-# detected again at the coarsest finer row that does (the finest affordable one when none is),
-# and so on, within the pixel budget.
+# there. Seen well, they are seen that much smaller by a call 1 / CROWD_RATIO times finer; seen
+# faintly (many weak boxes) or not at all, the whole image is detected again at the coarsest
+# finer row whose table sees them (the finest affordable one when none does); and so on, within
+# the pixel budget.
 CROWD_RATIO = 0.7
 # With no box at all, a finer call is taken only if its table row expects fewer false detections
 # than this in the whole image (rate times its pixels): YuNet's rows do on every image find
@@ -700,10 +701,15 @@ class _Coarse(_Recorder):
         :data:`CROWD_WEAK_BOXES` weak ones that small, say the image holds smaller faces than
         assumed (a crowd), and the smallest of them that faces ``crowd_ratio`` times smaller
         still may be there; with no box at all, faces ``crowd_ratio`` times smaller than
-        ``side`` may be. When this call's scale does not see faces that small by its table
-        row, the next call is the coarsest finer row that does, else the finest one within the
-        budget (``spent``: the pixels read so far); with no box at all, only rows that expect
-        fewer false detections than :data:`STEP_FALSE`. The side returned is the next call's
+        ``side`` may be. Small faces this call saw well (strong, with fewer than
+        :data:`CROWD_WEAK_BOXES` weak boxes that small) are seen ``crowd_ratio`` times smaller
+        by a call ``1 / crowd_ratio`` times finer (the finer row at or above it within the
+        budget, ``spent``: the pixels read so far, else the finest that fits). Faces it saw
+        only faintly (that many weak boxes), or none at all, are looked for where the table
+        says: when this call's scale does not see faces that small by its table row, at the
+        coarsest finer row that does, else the finest one within the budget; with no box at
+        all, only rows that expect fewer false detections than :data:`STEP_FALSE`. The side
+        returned is the next call's
         ``side``: the smallest face found (a face 0.7 times smaller still steps again), or
         with no box the smaller faces now assumed. None otherwise, when no finer row fits or
         ``crowd_ratio`` is 0.
@@ -723,14 +729,23 @@ class _Coarse(_Recorder):
         else:
             return None
         want = smallest * self.crowd_ratio
-        row = self.table.row(scale)
-        if want * scale >= row.min_side_px:
-            return None
         width, height = self.image_px
         finer = [r for r in self.table.rows if r.scale > scale * (1 + SCALE_RTOL)
                  and spent + math.prod(scaled_size(width, height, r.scale)) <= self.budget
                  and not (blind and r.false_per_mpx * math.prod(
                      scaled_size(width, height, r.scale)) / 1e6 >= STEP_FALSE)]
+        if not blind and len(small[1]) < CROWD_WEAK_BOXES:
+            # small faces seen well (few weak boxes that small): faces crowd_ratio times
+            # smaller are seen at the input size this call saw its smallest at, by a call
+            # 1 / crowd_ratio times finer
+            if not finer:
+                return None
+            target = scale / self.crowd_ratio
+            return next((r for r in finer if r.scale >= target * (1 - SCALE_RTOL)),
+                        finer[-1]).scale, smallest
+        row = self.table.row(scale)
+        if want * scale >= row.min_side_px:
+            return None
         if not finer:
             return None
         step = next((r for r in finer if want * r.scale >= r.min_side_px), finer[-1]).scale
