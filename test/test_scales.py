@@ -363,6 +363,13 @@ def test_faces_smaller_than_every_row_sees_go_to_the_finest_row_the_budget_allow
     # the table says of 56 px faces there (this call saw 80 px ones at 20 px)
     seen_well = {(200, 200): 80, (600, 500): 60}
     assert calls(seen_well, 4 * 1600 * 1200) == [0.25, 0.5]
+    # ... the row at or above 1/4 / 0.7, not the next finer one (1/3 here) ...
+    table = ScaleTable('test', (TABLE.rows[0], ScaleRow(0.3, 20.0, 0.97, 0.05),
+                                *TABLE.rows[1:]), 0.7)
+    assert calls(seen_well, 4 * 1600 * 1200) == [0.25, 0.5]
+    # ... and even where the table says the call sees 56 px faces already
+    table = ScaleTable('test', (ScaleRow(0.25, 10.0, 0.97, 0.05), *TABLE.rows[1:]), 0.7)
+    assert calls(seen_well, 4 * 1600 * 1200) == [0.25, 0.5]
 
 
 def test_search_many_counts_faces_with_the_tables_strong_score(yunet_420, monkeypatch):
@@ -382,6 +389,22 @@ def test_search_many_counts_faces_with_the_tables_strong_score(yunet_420, monkey
     search_many(image, fovea, model, MANY, pixel_budget=640 * 480, scales=scoreless)
     search_many(image, fovea, model, MANY, pixel_budget=640 * 480)
     assert seen == [TABLE.strong_score, None, None]
+
+
+def test_search_many_bounds_the_fixations_after_the_pass_by_one_full_scan(yunet_420,
+                                                                       monkeypatch):
+    model, fovea = yunet_420
+    seen = []
+    run = search.run_search
+
+    def spy(*args, **kwargs):
+        seen.append((kwargs.get('pixel_budget'), kwargs.get('fixation_budget')))
+        return run(*args, **kwargs)
+    monkeypatch.setattr(search, 'run_search', spy)
+    image, _ = group_photo((640, 480), seed=0, background='coffee', split='train', copies=1)
+    search_many(image, fovea, model, MANY, pixel_budget=4 * 640 * 480, scales=TABLE)
+    search_many(image, fovea, model, MANY, scales=TABLE)
+    assert seen == [(4 * 640 * 480, 640 * 480), (None, None)]
 
 
 def test_the_crowds_prior_is_the_fraction_of_cells_holding_a_strong_box(yunet_420):

@@ -709,10 +709,9 @@ class _Coarse(_Recorder):
         says: when this call's scale does not see faces that small by its table row, at the
         coarsest finer row that does, else the finest one within the budget; with no box at
         all, only rows that expect fewer false detections than :data:`STEP_FALSE`. The side
-        returned is the next call's
-        ``side``: the smallest face found (a face 0.7 times smaller still steps again), or
-        with no box the smaller faces now assumed. None otherwise, when no finer row fits or
-        ``crowd_ratio`` is 0.
+        returned is the next call's ``side``: the smallest face found (a face 0.7 times smaller
+        still steps again), or with no box the smaller faces now assumed. None otherwise, when
+        no finer row fits or ``crowd_ratio`` is 0.
         """
         if not self.crowd_ratio:
             return None
@@ -882,11 +881,12 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     OccupancySession`): the scan, then the fixation with the largest expected drop of the
     summed cell entropies per detector pixel, until every cell is decided at the confidence
     (or the budget, or ``pixel_budget``: for ``find``, one full-resolution scan of the image
-    as given, before ``--max-side``; beyond it only the looks' :data:`LOOK_ALLOWANCE`). The
-    faces are the clusters
-    of occupied cells, each counted once and split where the detector's merged boxes are
-    distinct faces (:func:`ipomdp_gaze.model.occupancy.count_faces`, cells within ``link`` of each
-    other are one cluster); cells within ``settle`` of an occupied cell need no decision of
+    as given, before ``--max-side``; beyond it only the looks' :data:`LOOK_ALLOWANCE`; with a
+    ``pixel_budget`` the fixations after the scan also read at most one full scan of this
+    image). The faces are the clusters of occupied cells, each counted once and split where
+    the detector's merged boxes are distinct faces
+    (:func:`ipomdp_gaze.model.occupancy.count_faces`, cells within ``link`` of each other are
+    one cluster); cells within ``settle`` of an occupied cell need no decision of
     their own (:class:`~ipomdp_gaze.search.many.OccupancySession`, ``link``). ``decision`` is
     ``found`` when a face was reported, else ``absent`` (or ``gave_up``).
 
@@ -901,9 +901,10 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     ``look_upscale`` times and never below the scale of the call that found the box, the
     table's finest: :func:`look_factor`, 1 to 2x at full resolution; 0: no look), keeps a box
     of ``look_score``; else it is weak. A face found smaller than ``crowd_ratio`` times
-    ``min_face`` (a crowd), or no box at all, sends the whole image to a finer call where the
-    table says smaller faces are seen (:meth:`_Coarse._finer_for_smaller_faces`), and the
-    faces found set the prior's density (:data:`CROWD_RATIO`; 0: neither). With the
+    ``min_face`` (a crowd), or no box at all, sends the whole image to a finer call: 1 /
+    ``crowd_ratio`` times finer for faces seen well, where the table says smaller faces are
+    seen for faces seen faintly or not at all (:meth:`_Coarse._finer_for_smaller_faces`), and
+    the faces found set the prior's density (:data:`CROWD_RATIO`; 0: neither). With the
     detector's strong score, a face one call saw strongly is a face beside faces that several
     calls saw (``count_faces(strong=)``).
 
