@@ -391,8 +391,8 @@ def test_search_many_counts_faces_with_the_tables_strong_score(yunet_420, monkey
     assert seen == [TABLE.strong_score, None, None]
 
 
-def test_search_many_bounds_the_fixations_after_the_pass_by_one_full_scan(yunet_420,
-                                                                       monkeypatch):
+def test_search_many_bounds_the_fixations_after_the_pass_by_one_full_scan(
+        yunet_420, monkeypatch):
     model, fovea = yunet_420
     seen = []
     run = search.run_search
