@@ -727,25 +727,22 @@ class _Coarse(_Recorder):
             smallest, blind = side, True
         else:
             return None
-        want = smallest * self.crowd_ratio
         width, height = self.image_px
         finer = [r for r in self.table.rows if r.scale > scale * (1 + SCALE_RTOL)
                  and spent + math.prod(scaled_size(width, height, r.scale)) <= self.budget
                  and not (blind and r.false_per_mpx * math.prod(
                      scaled_size(width, height, r.scale)) / 1e6 >= STEP_FALSE)]
+        if not finer:
+            return None
         if not blind and len(small[1]) < CROWD_WEAK_BOXES:
             # small faces seen well (few weak boxes that small): faces crowd_ratio times
             # smaller are seen at the input size this call saw its smallest at, by a call
             # 1 / crowd_ratio times finer
-            if not finer:
-                return None
             target = scale / self.crowd_ratio
             return next((r for r in finer if r.scale >= target * (1 - SCALE_RTOL)),
                         finer[-1]).scale, smallest
-        row = self.table.row(scale)
-        if want * scale >= row.min_side_px:
-            return None
-        if not finer:
+        want = smallest * self.crowd_ratio
+        if want * scale >= self.table.row(scale).min_side_px:
             return None
         step = next((r for r in finer if want * r.scale >= r.min_side_px), finer[-1]).scale
         return step, (want if blind else smallest)
