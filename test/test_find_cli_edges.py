@@ -159,6 +159,15 @@ def test_log_dash_writes_the_log_to_stdout(images, tmp_path, run_find):
         'of them a file']
 
 
+def test_an_output_in_a_folder_that_takes_no_file_is_refused_before_any_search(
+        images, run_find):
+    # /proc refuses a new file to root as well, whose permission checks all pass
+    result = run_find(images['astronaut'], '--json', '/proc/find.json')
+    assert result.returncode == 2 and result.stdout == ''
+    assert result.stderr.strip().splitlines() == [
+        'ipomdp-gaze find: error: --json /proc/find.json: not writable']
+
+
 @pytest.mark.parametrize('option, target, says', [
     ('--json', 'adir', '--json adir: is a directory'),
     ('--log', 'adir', '--log adir: is a directory'),
@@ -199,6 +208,16 @@ def test_a_bad_policy_is_one_line_for_all_images(images, run_find, flags, says):
     assert result.returncode == 2 and result.stdout == ''
     [line] = result.stderr.strip().splitlines()
     assert line.startswith('ipomdp-gaze find: error: --policy') and says in line, line
+
+
+@pytest.mark.parametrize('flags', [('--all',), ('--targets', 'many')])
+def test_a_confidence_the_many_target_belief_cannot_decide_at_is_one_line(
+        images, run_find, flags):
+    result = run_find(images['astronaut'], images['noise'], *flags, '--confidence', '0.3')
+    assert result.returncode == 2 and result.stdout == ''
+    [line] = result.stderr.strip().splitlines()
+    assert line == ('ipomdp-gaze find: error: search.targets many decides each cell at the '
+                    'confidence either way, so it must be above 0.5 (got 0.3)')
 
 
 def test_an_image_max_side_makes_too_small_names_the_option(images, run_find):

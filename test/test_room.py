@@ -97,6 +97,8 @@ def test_one_target_is_the_papers_session_and_switching_starts_a_new_search():
 @pytest.mark.parametrize('change, words', [
     ({'hotspot_prior': 0.03}, 'nor hotspots of a still scene'),
     ({'false_alarm_scales': (1.0, 3.0)}, 'does not model false-alarm scales'),
+    ({'confidence': 0.5}, r'decides each cell at the confidence either way, so it must be above '
+                          r'0\.5 \(got 0\.5\)'),
 ])
 def test_the_many_target_core_refuses_what_it_does_not_model(change, words):
     from dataclasses import replace

@@ -13,7 +13,6 @@ the prediction step and the paired difference).
 from __future__ import annotations
 
 from dataclasses import replace
-import json
 from pathlib import Path
 
 from ipomdp_gaze.drivers.pieces import concat_results, COSTLY_CHUNK, PLANNER_CHUNK, simulate_pieces
@@ -24,6 +23,7 @@ from ipomdp_gaze.drivers.scene_report import (format_summary, paired_map_differe
 from ipomdp_gaze.drivers.scene_tasks import task_spec, TASKS
 from ipomdp_gaze.drivers.tracking import (evaluate_walks, format_walks, summarise_walks,
                                           walk_spec, walks_json)
+from ipomdp_gaze.files import json_files
 from ipomdp_gaze.files.observation_file import fingerprint
 from ipomdp_gaze.model.motion import Motion
 from ipomdp_gaze.model.observation import as_observation, GaussianObservation
@@ -450,6 +450,6 @@ def run(args) -> int:
               f"{gain['difference']:+.4f}" + (f' [{ci[0]:+.4f}, {ci[1]:+.4f}]' if ci else ''))
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(json.dumps(result, indent=1) + '\n')
+        args.json.write_text(json_files.dumps(result) + '\n')
         print(f'wrote {args.json}')
     return 0

@@ -102,10 +102,12 @@ import sys
 
 import cv2
 from ipomdp_gaze.files.observation_file import load_observation, shipped_image_models
+from ipomdp_gaze.files.writable import folder_writable
 from ipomdp_gaze.model.belief import uniform_log_belief
 from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
 from ipomdp_gaze.search import answer
+from ipomdp_gaze.search.many import check_many_settings
 from ipomdp_gaze.vision.detectors import load_factory
 from ipomdp_gaze.vision.fullframe import MAX_SCALE
 from ipomdp_gaze.vision.image_files import decode_quietly
@@ -805,8 +807,7 @@ def check_outputs(args, images: list[str], plots: list[Path]) -> None:
             folder = folder.parent
         if not folder.is_dir():
             raise ValueError(f'{flag} {path}: {folder} is not a folder')
-        if not os.access(folder, os.W_OK | os.X_OK) or \
-                (path.exists() and not os.access(path, os.W_OK)):
+        if not folder_writable(folder) or (path.exists() and not os.access(path, os.W_OK)):
             raise ValueError(f'{flag} {path}: not writable')
 
 
@@ -840,7 +841,9 @@ def _write(text: str, out: Path) -> None:
 
 
 def run(args) -> int:
-    settings_from_args(args, FIND_SETTINGS)             # bad settings: refused before any work
+    settings = settings_from_args(args, FIND_SETTINGS)  # bad settings: refused before any work
+    if (args.all and args.targets is TASK_DEFAULT) or args.targets == 'many':
+        check_many_settings(replace(settings, targets='many'))
     if args.plot:
         plot_format(args.plot)
     images = expand_inputs(args.images)

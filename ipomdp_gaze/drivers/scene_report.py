@@ -12,10 +12,10 @@ lines and files (docs/design.md section 10.4).
 from __future__ import annotations
 
 from dataclasses import dataclass
-import json
 import math
 from pathlib import Path
 
+from ipomdp_gaze.files import json_files
 from ipomdp_gaze.model.head_time import head_time_s, head_travel_deg
 from ipomdp_gaze.simulation.evaluation import answer_is_right, wilson_interval
 import numpy as np
@@ -224,4 +224,4 @@ def results_json(spec, results, summary: dict) -> dict:
 def write_json(path: Path, record: dict) -> None:
     """Write a JSON record (parents created)."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(record, indent=1) + '\n')
+    path.write_text(json_files.dumps(record) + '\n')

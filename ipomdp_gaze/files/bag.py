@@ -13,9 +13,9 @@ package version, each node's parameters and the hashes of the files they name. N
 from __future__ import annotations
 
 from dataclasses import dataclass
-import os
 from pathlib import Path
 
+from ipomdp_gaze.files.writable import folder_writable
 import yaml
 
 DISTRO_STORE = 'ROS2_JAZZY'
@@ -49,7 +49,7 @@ def check_new_bag(path) -> Path:
         folder = folder.parent
     if not folder.is_dir():
         raise ValueError(f'{path}: {folder} is not a folder')
-    if not os.access(folder, os.W_OK | os.X_OK):
+    if not folder_writable(folder):
         raise ValueError(f'{path}: the folder {folder} is not writable')
     return path
 

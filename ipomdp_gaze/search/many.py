@@ -83,6 +83,9 @@ MIN_GAIN = 1e-9
 
 def check_many_settings(settings: SearchSettings) -> None:
     """Refuse settings the many-target belief does not model (ValueError naming them)."""
+    if settings.confidence <= 0.5:
+        raise ValueError(f'search.targets many decides each cell at the confidence either way, '
+                         f'so it must be above 0.5 (got {settings.confidence:g})')
     still_hotspots = settings.hotspot_prior > 0 and not settings.moving
     if len(settings.false_alarm_scales) > 1 or still_hotspots:
         raise ValueError('search.targets many does not model false-alarm scales, nor hotspots '

@@ -1,0 +1,45 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""The CLI's JSON records are strict JSON: no bare NaN or Infinity."""
+import json
+import math
+
+from ipomdp_gaze.files import json_files
+import pytest
+
+
+def _strict(text):
+    def refuse(constant):
+        raise ValueError(f'not JSON: {constant}')
+    return json.loads(text, parse_constant=refuse)
+
+
+def test_a_number_that_is_not_finite_is_null_at_any_depth():
+    record = {'mean': math.nan, 'rows': [1.5, math.inf, {'low': -math.inf, 'n': 3}],
+              'pair': (math.nan, 2.0), 'name': 'walk', 'ok': True, 'none': None}
+    assert _strict(json_files.dumps(record)) == {
+        'mean': None, 'rows': [1.5, None, {'low': None, 'n': 3}], 'pair': [None, 2.0],
+        'name': 'walk', 'ok': True, 'none': None}
+
+
+def test_plain_json_would_have_written_nan():
+    with pytest.raises(ValueError, match='NaN'):
+        _strict(json.dumps({'mean': math.nan}))
+
+
+def test_the_evaluation_of_walks_writes_strict_json(tmp_path):
+    from ipomdp_gaze.cli import main
+    out = tmp_path / 'walk.json'
+    assert main(['evaluate', '--scenes', 'pan-tilt', '--motion', 'walk', '--episodes', '1',
+                 '--walk-duration-s', '2', '--json', str(out), '--quiet']) == 0
+    text = out.read_text()
+    assert 'NaN' not in text and 'Infinity' not in text
+    summary = _strict(text)
+    assert summary
+
+
+def test_a_folder_is_writable_when_a_file_can_be_made_there(tmp_path):
+    from ipomdp_gaze.files.writable import folder_writable
+    assert folder_writable(tmp_path)
+    assert list(tmp_path.iterdir()) == []           # the probe leaves nothing behind
+    assert not folder_writable('/proc')             # a virtual file system, even for root
