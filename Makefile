@@ -88,6 +88,11 @@ HARD_CROWD_BENCH := $(VPY) bench/faces/many_faces.py --sizes 3000x2171 --scenes 
 # a few people in a large photo: the split's photo faces 2-3 times at 100-200 px anywhere
 SPARSE_BENCH := $(VPY) bench/faces/many_faces.py --sizes 4000x3000,3000x2171 --scenes 8 \
 	--crowd 100-200 --write docs/faces.md
+# ... smaller (60-120 px), and grey, faint and blurred (1 px of a 75 px face)
+SPARSE_SMALL_BENCH := $(VPY) bench/faces/many_faces.py --sizes 4000x3000,3000x2171 --scenes 8 \
+	--crowd 60-120 --write docs/faces.md
+SPARSE_HARD_BENCH := $(VPY) bench/faces/many_faces.py --sizes 4000x3000 --scenes 8 \
+	--crowd 100-200 --degrade 1 --write docs/faces.md
 
 faces-groups: $(STAMP)
 	$(GROUP_BENCH) --split train --section groups-train-photos
@@ -108,6 +113,10 @@ faces-groups: $(STAMP)
 	$(HARD_CROWD_BENCH) --split test --degrade 3 --copies 15 --section crowd-test-hard3
 	$(SPARSE_BENCH) --split train --copies 3 --section sparse-train
 	$(SPARSE_BENCH) --split test --copies 2 --section sparse-test
+	$(SPARSE_SMALL_BENCH) --split train --copies 3 --section sparse-small-train
+	$(SPARSE_HARD_BENCH) --split train --copies 3 --section sparse-hard1-train
+	$(SPARSE_SMALL_BENCH) --split test --copies 2 --section sparse-small-test
+	$(SPARSE_HARD_BENCH) --split test --copies 2 --section sparse-hard1-test
 
 # The pan/tilt face search against a blind sweep on 400 + 200 held-out scenes and a second camera:
 # writes docs/pan_tilt.md and docs/data/pan_tilt.json.gz (10-30 minutes, and 15 for the ROS demo).

@@ -298,6 +298,32 @@ def test_faces_smaller_than_assumed_send_the_whole_image_to_a_finer_call(yunet_4
     assert occupied < set(faces) and len(occupied) == 4
 
 
+def test_a_face_a_crop_finds_smaller_than_assumed_sends_the_whole_image_to_that_scale(
+        yunet_420):
+    _, fovea = yunet_420
+    whole = (0, 0, 1600, 1200)
+    # faces that matter: 120 px, seen at 1/4. The 60 px square is weak there (15 px) and no
+    # crowd (one weak box); the crop round it at 1/2 finds it strong (30 px), a face below
+    # 0.7 x 120 that the 1/4 call assumed away: the 44 px squares, unseen at 1/4 (11 px), are
+    # found when the whole image is read at 1/2 (22 px)
+    few = {(200, 200): 60, (600, 900): 44, (960, 1300): 44}
+    sensor, prior, frame = _crowd_sensor(fovea, crowd=few)
+    looks = [(rect, scale) for rect, scale, _ in sensor.looks]
+    assert looks[0] == (whole, 0.25) and looks[1][0] != whole and looks[1][1] == 0.5
+    assert looks[2] == (whole, 0.5)
+    cells = [fovea.grid.index(int((y + s / 2) * 21 / 1200), int((x + s / 2) * 21 / 1600))
+             for (y, x), s in few.items()]
+    assert np.all(prior[cells] + frame.values[cells] > np.log(99))
+    # without the crowd rule the crop's face is taken for itself, and the others are missed
+    sensor, prior, frame = _crowd_sensor(fovea, crowd=few, crowd_ratio=0.0)
+    assert all(rect != whole for rect, _, _ in sensor.looks[1:])
+    assert np.all(prior[cells[1:]] + frame.values[cells[1:]] < 0)
+    # a face of the assumed size the whole image's call found itself (100 px: 25 px at 1/4)
+    # says that call saw faces, so a smaller one in a crop sends nothing further
+    sensor, prior, frame = _crowd_sensor(fovea, crowd={**few, (800, 200): 100})
+    assert all(rect != whole for rect, _, _ in sensor.looks[1:])
+
+
 def test_a_pass_that_sees_nothing_looks_again_finer_where_few_false_boxes_are_expected(
         yunet_420):
     _, fovea = yunet_420
@@ -518,5 +544,8 @@ def test_weak_boxes_of_small_faces_send_the_image_finer_only_when_there_are_enou
     two = dict(list(faint.items())[:2])                         # fewer than CROWD_WEAK_BOXES
     sensor, _, _ = _crowd_sensor(fovea, crowd=two)
     assert search.CROWD_WEAK_BOXES == 3
-    assert sensor.looks[0][:2] == (whole, 0.25)
-    assert all(rect != whole for rect, _, _ in sensor.looks[1:])   # crops round each only
+    looks = [(rect, scale) for rect, scale, _ in sensor.looks]
+    # no crowd step: crops round each at 1/2 first; the whole image follows at 1/2 only since
+    # those crops found faces smaller than the 1/4 call assumed, which found none itself
+    assert looks[0] == (whole, 0.25) and looks[3] == (whole, 0.5)
+    assert all(rect != whole and scale == 0.5 for rect, scale in looks[1:3])

@@ -617,8 +617,12 @@ class _Coarse(_Recorder):
     box left undecided is then cropped (with a margin of two cells) and detected at the next
     finer scale of the table, whose evidence replaces the coarser one for those cells (and
     their neighbours), until no cell is undecided, the finest scale was used or the next crop
-    would pass ``budget`` pixels. All of it is one frame of kind ``evidence``; fixations are
-    the fovea's windows, for cells still undecided.
+    would pass ``budget`` pixels. Faces smaller than assumed send the whole image to a finer
+    call first (:meth:`_finer_for_smaller_faces`); and when the whole image's calls found no
+    strong box of their own while a crop did, one smaller than ``crowd_ratio`` times the faces
+    they assumed, the cells they decided empty were decided for larger faces: the whole image
+    is read again at that crop's scale, and the steps go on from there. All of it is one frame
+    of kind ``evidence``; fixations are the fovea's windows, for cells still undecided.
     """
 
     def __init__(self, fovea: Fovea, table, image_px: tuple[int, int], prior: np.ndarray,
@@ -771,17 +775,42 @@ class _Coarse(_Recorder):
         whole = (0, 0, width, height)
         strong, weak, pixels = self._look(whole, self.scale)
         scale, side = self.scale, self.min_face
-        while (step := self._finer_for_smaller_faces(strong, scale, side, weak,
-                                                     pixels)) is not None:
-            finer, side = step
-            # the whole image again at the finer scale: its boxes and evidence replace the
-            # coarser call's, whose strong boxes stay strong
-            found, weak, spent = self._look(whole, finer, pixels)
-            strong = np.concatenate([strong, found])
-            pixels, scale = pixels + spent, finer
-        shift = self._crowd_shift(strong) if scale != self.scale else 0.0
-        term = coarse_evidence(self.table.row(scale), self.grid, self.image_px, pixels,
-                               strong, weak, self.prior + shift) + shift
+        while True:
+            while (step := self._finer_for_smaller_faces(strong, scale, side, weak,
+                                                         pixels)) is not None:
+                finer, side = step
+                # the whole image again at the finer scale: its boxes and evidence replace the
+                # coarser call's, whose strong boxes stay strong
+                found, weak, spent = self._look(whole, finer, pixels)
+                strong = np.concatenate([strong, found])
+                pixels, scale = pixels + spent, finer
+            shift = self._crowd_shift(strong) if scale != self.scale else 0.0
+            term = coarse_evidence(self.table.row(scale), self.grid, self.image_px, pixels,
+                                   strong, weak, self.prior + shift) + shift
+            term, pixels, small, at = self._finer_looks(term, scale, side, shift, pixels)
+            # the whole image's calls found no face of their own, and a crop found one smaller
+            # than they assumed: the cells they decided empty may hold more like it, so the
+            # whole image at the crop's scale (not past the budget), and the steps from there
+            if len(strong) or not len(small) or at <= scale * (1 + SCALE_RTOL) \
+                    or pixels + math.prod(scaled_size(width, height, at)) > self.budget:
+                break
+            found, weak, spent = self._look(whole, at, pixels)
+            strong = np.concatenate([strong, small, found])
+            pixels, scale = pixels + spent, at
+            side = float(np.min(np.max(small[:, 2:], axis=1)))
+        return Frame(term, kind='evidence', detector_pixels=pixels,
+                     seconds=time.perf_counter() - t0)
+
+    def _finer_looks(self, term, scale: float, side: float, shift, pixels: int):
+        """
+        Look again at each group of undecided cells, at each finer row in turn (class docstring).
+
+        Returns ``(term, pixels, small, at)``: the evidence with each look's replacing the
+        coarser one round its cells, the pixels read in all, the strong boxes of the looks
+        smaller than ``crowd_ratio`` times ``side`` (the faces the whole image's calls assumed)
+        and the finest scale of a look that found one (0 without).
+        """
+        small, at = [], 0.0
         for row in (r for r in self.table.rows if r.scale > scale):
             undecided = np.abs(self.prior + term) < self.threshold
             if not undecided.any():
@@ -801,8 +830,13 @@ class _Coarse(_Recorder):
                 inner = np.zeros(self.grid.shape, dtype=bool)
                 inner[_grown(box, 1, self.grid.shape)] = True
                 term = np.where(inner.reshape(-1), fine, term)
-        return Frame(term, kind='evidence', detector_pixels=pixels,
-                     seconds=time.perf_counter() - t0)
+                strong = np.asarray(strong, dtype=float).reshape(-1, 4)
+                smaller = strong[np.max(strong[:, 2:], axis=1) < self.crowd_ratio * side]
+                if len(smaller):
+                    small.append(smaller)
+                    at = max(at, row.scale)
+        small = np.concatenate(small) if small else np.zeros((0, 4))
+        return term, pixels, small, at
 
 
 def _fine_score(detector) -> float:
@@ -901,9 +935,10 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     ``min_face`` (a crowd), or no box at all, sends the whole image to a finer call: 1 /
     ``crowd_ratio`` times finer for faces seen well, where the table says smaller faces are
     seen for faces seen faintly or not at all (:meth:`_Coarse._finer_for_smaller_faces`), and
-    the faces found set the prior's density (:data:`CROWD_RATIO`; 0: neither). With the
-    detector's strong score, a face one call saw strongly is a face beside faces that several
-    calls saw (``count_faces(strong=)``).
+    the faces found set the prior's density (:data:`CROWD_RATIO`; 0: neither); a smaller face
+    that only a finer crop found, when the whole image's calls found none, sends the whole
+    image to the crop's scale (:class:`_Coarse`). With the detector's strong score, a face one
+    call saw strongly is a face beside faces that several calls saw (``count_faces(strong=)``).
 
     Raises
     ------
