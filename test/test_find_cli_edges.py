@@ -210,7 +210,7 @@ def test_a_bad_policy_is_one_line_for_all_images(images, run_find, flags, says):
     assert line.startswith('ipomdp-gaze find: error: --policy') and says in line, line
 
 
-@pytest.mark.parametrize('flags', [('--all',), ('--targets', 'many')])
+@pytest.mark.parametrize('flags', [('--all',), ('--targets', 'many'), ('--scan', 'many')])
 def test_a_confidence_the_many_target_belief_cannot_decide_at_is_one_line(
         images, run_find, flags):
     result = run_find(images['astronaut'], images['noise'], *flags, '--confidence', '0.3')

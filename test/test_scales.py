@@ -318,6 +318,10 @@ def test_a_face_a_crop_finds_smaller_than_assumed_sends_the_whole_image_to_that_
     sensor, prior, frame = _crowd_sensor(fovea, crowd=few, crowd_ratio=0.0)
     assert all(rect != whole for rect, _, _ in sensor.looks[1:])
     assert np.all(prior[cells[1:]] + frame.values[cells[1:]] < 0)
+    # after that call the faces assumed are the crop's (60 px): the 44 px ones are not 0.7
+    # times smaller, so no further step even where the budget would allow the full resolution
+    sensor, _, _ = _crowd_sensor(fovea, crowd=few, budget=4 * 1600 * 1200)
+    assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 0.5]
     # a face of the assumed size the whole image's call found itself (100 px: 25 px at 1/4)
     # says that call saw faces, so a smaller one in a crop sends nothing further
     sensor, prior, frame = _crowd_sensor(fovea, crowd={**few, (800, 200): 100})
@@ -534,7 +538,7 @@ def test_the_enlarged_looks_stay_within_the_pixel_budget(yunet_420, monkeypatch)
     assert np.sum(posterior > 4) == 2 and np.sum(np.abs(posterior) < 1e-9) == 2
 
 
-def test_weak_boxes_of_small_faces_send_the_image_finer_only_when_there_are_enough(yunet_420):
+def test_weak_boxes_of_small_faces_are_a_crowd_only_when_there_are_enough(yunet_420):
     _, fovea = yunet_420
     whole = (0, 0, 1600, 1200)
     faint = {(200, 200): 60, (200, 800): 60, (600, 500): 60, (900, 1200): 60}   # weak at 1/4

@@ -842,7 +842,8 @@ def _write(text: str, out: Path) -> None:
 
 def run(args) -> int:
     settings = settings_from_args(args, FIND_SETTINGS)  # bad settings: refused before any work
-    if (args.all and args.targets is TASK_DEFAULT) or args.targets == 'many':
+    if (args.all and args.targets is TASK_DEFAULT) or args.targets == 'many' \
+            or (not args.all and args.scan_mode == 'many'):     # --scan many: the same belief
         check_many_settings(replace(settings, targets='many'))
     if args.plot:
         plot_format(args.plot)

@@ -118,7 +118,8 @@ CROWD_RATIO = 0.7
 STEP_FALSE = 0.03
 # Faces too small for the coarse scale to see strongly can still leave weak boxes: this many
 # weak boxes that small (and no strong one that small) give the smallest face found; one or two
-# say nothing of the faces' size and take no step (no box at all: STEP_FALSE).
+# say nothing of the faces' size and take no step (no box at all: STEP_FALSE), though a crop
+# round one that finds a small strong face may still send the whole image finer (_Coarse).
 CROWD_WEAK_BOXES = 3
 
 # The settings of search_image unless given: NMPT's operating point (confidence 0.9, 25 fixations,
@@ -621,8 +622,10 @@ class _Coarse(_Recorder):
     call first (:meth:`_finer_for_smaller_faces`); and when the whole image's calls found no
     strong box of their own while a crop did, one smaller than ``crowd_ratio`` times the faces
     they assumed, the cells they decided empty were decided for larger faces: the whole image
-    is read again at that crop's scale, and the steps go on from there. All of it is one frame
-    of kind ``evidence``; fixations are the fovea's windows, for cells still undecided.
+    is read again at the finest scale of a crop that found one (within the budget), with the
+    smallest of them as the faces assumed, and the steps go on from there (``crowd_ratio`` 0:
+    neither). All of it is one frame of kind ``evidence``; fixations are the fovea's windows,
+    for cells still undecided.
     """
 
     def __init__(self, fovea: Fovea, table, image_px: tuple[int, int], prior: np.ndarray,
