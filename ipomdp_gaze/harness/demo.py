@@ -18,6 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 import math
 from pathlib import Path
+import sys
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray
@@ -379,8 +380,8 @@ def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = 
                                      time.monotonic() - annotated[-1][0] > PICTURE_QUIET_S,
                                      PICTURE_WAIT_S)
                 pictures.extend(_pictures(setup, record_, annotated, stats))
-        except RuntimeError as exc:
-            out(f'ipomdp-gaze demo: error: {exc}')
+        except RuntimeError as exc:        # the error on stderr; the nodes' output follows
+            print(f'ipomdp-gaze demo: error: {exc}', file=sys.stderr, flush=True)
         finally:
             alive = {p.node: p.running for p in procs}
             codes = {p.node: code for p, code in nodes.stop(procs[::-1])}
