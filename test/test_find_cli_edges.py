@@ -84,6 +84,20 @@ def test_find_all_writes_p_nobody_for_absent(images, run_find):
     assert re.search(r' p_nobody=0\.\d{3} ', absent), absent
 
 
+def test_a_search_without_a_belief_writes_no_probability_either_way(
+        images, tmp_path, run_find):
+    # the scale ladder and the full frame compute no belief: neither P(answer) nor P(absent)
+    small = tmp_path / 'small.png'
+    cv2.imwrite(str(small), cv2.resize(cv2.imread(str(images['astronaut'])), (64, 64)))
+    out = tmp_path / 'plain.json'
+    result = run_find(images['astronaut'], images['noise'], small, '--json', out)
+    assert result.returncode == 0, result.stderr
+    entries = json.loads(out.read_text())['images']
+    assert [(e['decision'], e['method']) for e in entries] == [
+        ('found', 'scales'), ('absent', 'scales'), ('found', 'full_frame')]
+    assert all(e['probability'] is None and e['absent_probability'] is None for e in entries)
+
+
 def test_scan_many_absent_is_p_nobody_but_the_fovea_keeps_p(images, run_find):
     many = run_find(images['noise'], '--scan', 'many')
     fovea = run_find(images['noise'], '--scan', 'fovea')

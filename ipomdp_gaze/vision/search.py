@@ -239,7 +239,8 @@ class ImageSearch:
     decision : str
         ``found``, ``absent`` or ``gave_up`` (the session's decision; ``stop`` says why).
     absent_probability : float
-        ``P(absent)`` at stop (0 without the absent hypothesis).
+        ``P(absent)`` at stop (0 without the absent hypothesis; NaN where no belief was
+        computed: the full frame and the scale ladder).
     log : tuple
         The session's event log of this search.
     method : str
@@ -561,7 +562,7 @@ def full_frame_search(image: np.ndarray, fovea: Fovea, note: str = '',
         results.append(ImageSearch(cell=tuple(int(v) for v in grid.cell(cell)),
                                    pixel=(float(centre[0, 0]), float(centre[0, 1])),
                                    probability=math.nan, stop='found', belief=belief,
-                                   decision='found', **common))
+                                   decision='found', absent_probability=math.nan, **common))
     results.append(ImageSearch(cell=(0, 0), pixel=(math.nan, math.nan), probability=math.nan,
                                stop='absent', belief=np.zeros(grid.n_cells), decision='absent',
                                absent_probability=math.nan, **common))
@@ -1214,6 +1215,7 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
     return ImageSearch(cell=tuple(int(v) for v in grid.cell(cell)),
                        pixel=(float(centre[0, 0]), float(centre[0, 1])), stop='found',
                        belief=belief, decision='found', detections=((x + w / 2, y + h / 2),),
+                       absent_probability=math.nan,
                        faces=(Face(box=(x, y, w, h), cell=tuple(int(v) for v in grid.cell(cell)),
                                    probability=math.nan),),
                        seconds=time.perf_counter() - t0, **common)
