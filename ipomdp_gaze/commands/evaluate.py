@@ -23,7 +23,6 @@ from ipomdp_gaze.drivers.scene_report import (format_summary, paired_map_differe
 from ipomdp_gaze.drivers.scene_tasks import task_spec, TASKS
 from ipomdp_gaze.drivers.tracking import (evaluate_walks, format_walks, summarise_walks,
                                           walk_spec, walks_json)
-from ipomdp_gaze.files import json_files
 from ipomdp_gaze.files.observation_file import fingerprint
 from ipomdp_gaze.model.motion import Motion
 from ipomdp_gaze.model.observation import as_observation, GaussianObservation
@@ -449,7 +448,6 @@ def run(args) -> int:
         print(f'{name}: tracking accuracy with minus without prediction '
               f"{gain['difference']:+.4f}" + (f' [{ci[0]:+.4f}, {ci[1]:+.4f}]' if ci else ''))
     if args.json:
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(json_files.dumps(result) + '\n')
+        write_json(args.json, result)
         print(f'wrote {args.json}')
     return 0

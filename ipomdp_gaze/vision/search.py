@@ -794,7 +794,8 @@ class _Coarse(_Recorder):
             term, pixels, small, at = self._finer_looks(term, scale, side, shift, pixels)
             # the whole image's calls found no face of their own, and a crop found one smaller
             # than they assumed: the cells they decided empty may hold more like it, so the
-            # whole image at the crop's scale (not past the budget), and the steps from there
+            # whole image at the crop's scale (not past the budget), and the steps from there;
+            # at most once, since its strong boxes then hold the crop's faces
             if len(strong) or not len(small) or at <= scale * (1 + SCALE_RTOL) \
                     or pixels + math.prod(scaled_size(width, height, at)) > self.budget:
                 break
