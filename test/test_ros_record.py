@@ -173,7 +173,11 @@ def test_the_face_demo_records_the_annotated_image_and_replays(ros_env, tmp_path
     detections = messages['/detections']                   # the raw detections, per frame
     assert len(detections) >= fixations                    # (and of the search before the reset)
     stamps = {(m.header.stamp.sec, m.header.stamp.nanosec) for m in messages['/evidence_image']}
-    assert {(m.header.stamp.sec, m.header.stamp.nanosec) for m in detections} <= stamps
+    framed = {(m.header.stamp.sec, m.header.stamp.nanosec) for m in detections}
+    # every frame's detections beside its evidence image; the recorder may stop between the
+    # two of the one frame in flight at shutdown (seen once in CI), never of an earlier one
+    late = {stamp for stamp in framed if stamp > max(stamps)}
+    assert framed - late <= stamps and len(late) <= 1, (sorted(framed - stamps), max(stamps))
     points = np.array([[p.position.x, p.position.y] for m in detections for p in m.poses])
     assert len(points) and (points >= -0.5).all()
     assert (points[:, 0] < last.shape[1]).all() and (points[:, 1] < last.shape[0]).all()
