@@ -93,6 +93,12 @@ SPARSE_SMALL_BENCH := $(VPY) bench/faces/many_faces.py --sizes 4000x3000,3000x21
 	--crowd 60-120 --write docs/faces.md
 SPARSE_HARD_BENCH := $(VPY) bench/faces/many_faces.py --sizes 4000x3000 --scenes 8 \
 	--crowd 100-200 --degrade 1 --write docs/faces.md
+# a few small faces (25-50 px, 1/30 to 1/60 of the shorter side) anywhere in a photo of at most
+# 2048 px, and a dozen of 30-60 px, grey, faint and blurred (1 px of a 75 px face)
+FEW_SMALL_BENCH := $(VPY) bench/faces/many_faces.py --sizes 2048x1536,1600x1200 --scenes 8 \
+	--crowd 25-50 --write docs/faces.md
+FEW_HARD_BENCH := $(VPY) bench/faces/many_faces.py --sizes 1600x1200 --scenes 8 \
+	--crowd 30-60 --degrade 1 --write docs/faces.md
 
 faces-groups: $(STAMP)
 	$(GROUP_BENCH) --split train --section groups-train-photos
@@ -117,6 +123,10 @@ faces-groups: $(STAMP)
 	$(SPARSE_HARD_BENCH) --split train --copies 3 --section sparse-hard1-train
 	$(SPARSE_SMALL_BENCH) --split test --copies 2 --section sparse-small-test
 	$(SPARSE_HARD_BENCH) --split test --copies 2 --section sparse-hard1-test
+	$(FEW_SMALL_BENCH) --split train --copies 5 --section few-small-train
+	$(FEW_HARD_BENCH) --split train --copies 12 --section few-hard1-train
+	$(FEW_SMALL_BENCH) --split test --copies 3 --section few-small-test
+	$(FEW_HARD_BENCH) --split test --copies 6 --section few-hard1-test
 
 # The pan/tilt face search against a blind sweep on 400 + 200 held-out scenes and a second camera:
 # writes docs/pan_tilt.md and docs/data/pan_tilt.json.gz (10-30 minutes, and 15 for the ROS demo).

@@ -169,12 +169,13 @@ class _Blob:
         return np.array([[x0, y0, x1 - x0, y1 - y0, score]], dtype=float)
 
 
-def _blob_sensor(fovea, side):
+def _blob_sensor(fovea, side, crowd_ratio=search.CROWD_RATIO):
     from ipomdp_gaze.vision.search import _Coarse
     image = np.zeros((600, 800, 3), dtype=np.uint8)
     image[300:300 + side, 500:500 + side] = 255
     prior = prior_log_odds(fovea.grid.n_cells, cell_prior(fovea.grid.n_cells, 0.5))
-    sensor = _Coarse(fovea, TABLE, (800, 600), prior, 0.99, budget=800 * 600)
+    sensor = _Coarse(fovea, TABLE, (800, 600), prior, 0.99, budget=800 * 600,
+                     crowd_ratio=crowd_ratio)
     sensor.detector = _Blob()
     sensor.start(image)
     return sensor, prior, sensor.scan()
@@ -182,7 +183,8 @@ def _blob_sensor(fovea, side):
 
 def test_a_face_too_small_for_the_coarse_scale_gets_one_finer_look_only_there(yunet_420):
     _, fovea = yunet_420
-    sensor, prior, frame = _blob_sensor(fovea, 24)          # 12 px at 1/2: weak
+    # 12 px at 1/2: weak. Without the crowd rules the crop round it is the one finer look
+    sensor, prior, frame = _blob_sensor(fovea, 24, crowd_ratio=0.0)
     assert [scale for _, scale, _ in sensor.looks] == [0.5, 1.0]
     (x0, y0, x1, y1), _, pixels = sensor.looks[1]
     assert x0 <= 500 and 524 <= x1 and y0 <= 300 and 324 <= y1      # round the face
@@ -192,6 +194,15 @@ def test_a_face_too_small_for_the_coarse_scale_gets_one_finer_look_only_there(yu
     face = fovea.grid.index(int(312 * 21 / 600), int(512 * 21 / 800))
     assert posterior[face] > np.log(99)                              # occupied at 0.99
     assert np.all(np.delete(posterior, face) < np.log(99))
+    # with them, the crop's face (24 px) is below 0.7 times the faces the 1/2 call assumed
+    # (60 px), so the cells it decided empty may hold more like it: the whole image is read at
+    # 1, once, past the budget of one full call by the 1/2 call and the crop
+    sensor, prior, frame = _blob_sensor(fovea, 24)
+    assert [(rect, scale) for rect, scale, _ in sensor.looks][2] == ((0, 0, 800, 600), 1.0)
+    assert len(sensor.looks) == 3
+    assert frame.detector_pixels == 400 * 300 + pixels + 800 * 600
+    posterior = prior + frame.values              # the face the likeliest cell; its fixations
+    assert np.argmax(posterior) == face and posterior[face] > 0     # decide it at 0.99
 
 
 def test_a_face_the_coarse_scale_sees_needs_no_finer_look(yunet_420):
@@ -357,20 +368,23 @@ def test_a_pass_that_sees_nothing_looks_again_finer_where_few_false_boxes_are_ex
     assert [scale for _, scale, _ in sensor.looks] == [0.25]
 
 
-def test_the_crowd_step_reads_at_most_the_budget_it_is_given(yunet_420):
+def test_the_crowd_step_reads_past_its_budget_only_by_one_call_that_fits_it(yunet_420):
     _, fovea = yunet_420
     # the 80 px squares send the pass to 1/2 (above); three 30 px squares, unseen at 1/4, are
     # weak there (15 px), and faces 0.7 x 30 px may be there too (10.5 px at 1/2, below its
-    # 16): the full-resolution call is next, which one full call's
-    # budget does not allow after 1/4 and 1/2, and four (an image find resized to half its
-    # sides, budgeted by the image as given) do
+    # 16): the full-resolution call is next. Four full calls' budget (an image find resized to
+    # half its sides, budgeted by the image as given) holds it; one full call's does not after
+    # 1/4 and 1/2, yet the call alone fits it (the detector alone at 1), so it is read, once
     crowd = {(200, 200): 80, (200, 800): 80, (600, 500): 60, (960, 240): 30,
              (960, 1000): 30, (600, 1200): 30}
     whole = (0, 0, 1600, 1200)
-    sensor, _, _ = _crowd_sensor(fovea, crowd=crowd)
+    for budget in (4 * 1600 * 1200, 1600 * 1200):
+        sensor, prior, frame = _crowd_sensor(fovea, crowd=crowd, budget=budget)
+        assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 0.5, 1.0]
+        assert frame.detector_pixels == 400 * 300 + 800 * 600 + 1600 * 1200
+    # a budget the call alone passes: not read
+    sensor, _, _ = _crowd_sensor(fovea, crowd=crowd, budget=1600 * 1200 - 1)
     assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 0.5]
-    sensor, prior, frame = _crowd_sensor(fovea, crowd=crowd, budget=4 * 1600 * 1200)
-    assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 0.5, 1.0]
     assert frame.detector_pixels == 400 * 300 + 800 * 600 + 1600 * 1200
 
 
@@ -400,6 +414,49 @@ def test_faces_smaller_than_every_row_sees_go_to_the_finest_row_the_budget_allow
     # ... and even where the table says the call sees 56 px faces already
     table = ScaleTable('test', (ScaleRow(0.25, 10.0, 0.97, 0.05), *TABLE.rows[1:]), 0.7)
     assert calls(seen_well, 4 * 1600 * 1200) == [0.25, 0.5]
+
+
+def test_a_crowd_seen_faintly_sends_the_whole_image_past_the_budget_once(yunet_420):
+    _, fovea = yunet_420
+    whole = (0, 0, 1600, 1200)
+    # an 80 px square (strong at 1/4: a face below 0.7 x the 120 px assumed, a crowd) sends
+    # the pass to 1/2. There six 28 px squares are weak (14 px), below what the 1/2 row sees
+    # (32 px of the image), and three 20 px ones leave no box (10 px). No finer row fits the
+    # budget of one full call after 1/4 and 1/2, yet the faint boxes say the crowd's faces are
+    # at the edge of what 1/2 sees: the full-resolution call is read once, past the budget
+    crowd = {(100, 100): 80, **{(400, 100 + 250 * k): 28 for k in range(6)},
+             **{(800, 300 + 400 * k): 20 for k in range(3)}}
+    sensor, prior, frame = _crowd_sensor(fovea, crowd=crowd)
+    assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 0.5, 1.0]
+    assert frame.detector_pixels == 400 * 300 + 800 * 600 + 1600 * 1200
+    cells = [fovea.grid.index(int((y + s / 2) * 21 / 1200), int((x + s / 2) * 21 / 1600))
+             for (y, x), s in crowd.items()]
+    posterior = prior + frame.values
+    assert np.all(posterior[cells] > np.log(49))            # 1.3 full calls' false rate
+    assert np.all(np.delete(posterior, cells) < -np.log(99))
+    # without the crowd rules (crowd_ratio 0) the 20 px squares are never seen
+    sensor, prior, frame = _crowd_sensor(fovea, crowd=crowd, crowd_ratio=0.0)
+    assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25]
+    assert np.all(prior[cells[-3:]] + frame.values[cells[-3:]] < 0)
+
+    # the rule itself, after a 1/2 call of a crowd whose faces seemed 40 px or more (so that
+    # the 28 px boxes are not 0.7 times smaller than the faces assumed)
+    def step(weak_sides, strong_side=80.0, budget=1600 * 1200, crowd_ratio=search.CROWD_RATIO):
+        sensor = search._Coarse(fovea, TABLE, (1600, 1200), prior, 0.99, budget=budget,
+                                crowd_ratio=crowd_ratio)
+        weak = np.array([[0, 0, w, w] for w in weak_sides], dtype=float).reshape(-1, 4)
+        return sensor, sensor._finer_for_faint_faces(
+            np.array([[0, 0, strong_side, strong_side]]), weak, 0.5)
+    sensor, scale = step([28.0] * 6)
+    assert scale == 1.0 and sensor.overrun
+    assert sensor._finer_for_faint_faces(np.array([[0, 0, 80, 80]]),
+                                         np.array([[0, 0, 28, 28]] * 6), 0.5) is None   # once
+    assert step([28.0] * 5)[1] is None                      # five faint boxes: no
+    assert step([28.0] * 3 + [40.0] * 3)[1] is None         # 40 px: seen by the 1/2 row
+    assert step([28.0] * 6, strong_side=90.0)[1] is None    # no face below 0.7 x 120 px
+    assert step([28.0] * 6, crowd_ratio=0.0)[1] is None
+    assert step([28.0] * 6, budget=1600 * 1200 - 1)[1] is None     # the call alone passes it
+    assert step([28.0] * 6, budget=4 * 1600 * 1200)[1] == 1.0
 
 
 def test_search_many_counts_faces_with_the_tables_strong_score(yunet_420, monkeypatch):
