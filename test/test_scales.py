@@ -203,6 +203,7 @@ def test_a_face_too_small_for_the_coarse_scale_gets_one_finer_look_only_there(yu
     assert frame.detector_pixels == 400 * 300 + pixels + 800 * 600
     posterior = prior + frame.values              # the face the likeliest cell; its fixations
     assert np.argmax(posterior) == face and posterior[face] > 0     # decide it at 0.99
+    assert np.all(np.delete(posterior, face) < np.log(99))
 
 
 def test_a_face_the_coarse_scale_sees_needs_no_finer_look(yunet_420):
@@ -382,10 +383,10 @@ def test_the_crowd_step_reads_past_its_budget_only_by_one_call_that_fits_it(yune
         sensor, prior, frame = _crowd_sensor(fovea, crowd=crowd, budget=budget)
         assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 0.5, 1.0]
         assert frame.detector_pixels == 400 * 300 + 800 * 600 + 1600 * 1200
-    # a budget the call alone passes: not read
-    sensor, _, _ = _crowd_sensor(fovea, crowd=crowd, budget=1600 * 1200 - 1)
+    # a budget the call alone passes: not read, and no crop passes the budget
+    sensor, _, frame = _crowd_sensor(fovea, crowd=crowd, budget=1600 * 1200 - 1)
     assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 0.5]
-    assert frame.detector_pixels == 400 * 300 + 800 * 600 + 1600 * 1200
+    assert frame.detector_pixels <= 1600 * 1200 - 1 and not sensor.overrun
 
 
 def test_faces_smaller_than_every_row_sees_go_to_the_finest_row_the_budget_allows(yunet_420):
@@ -416,47 +417,73 @@ def test_faces_smaller_than_every_row_sees_go_to_the_finest_row_the_budget_allow
     assert calls(seen_well, 4 * 1600 * 1200) == [0.25, 0.5]
 
 
+class _Shaded(_Blobs):
+    """The squares' boxes from 12 px, strong (0.9) where bright, weak (0.5) where dim."""
+
+    def __call__(self, gray):
+        import cv2
+        n, labels, stats, _ = cv2.connectedComponentsWithStats((gray > 64).astype(np.uint8))
+        out = [[x, y, w, h, 0.9 if gray[labels == k].mean() > 192 else 0.5]
+               for k, (x, y, w, h, _) in enumerate(stats[1:n], start=1) if min(w, h) >= 12]
+        return np.array(out, dtype=float).reshape(-1, 5)
+
+
 def test_a_crowd_seen_faintly_sends_the_whole_image_past_the_budget_once(yunet_420):
     _, fovea = yunet_420
     whole = (0, 0, 1600, 1200)
-    # an 80 px square (strong at 1/4: a face below 0.7 x the 120 px assumed, a crowd) sends
-    # the pass to 1/2. There six 28 px squares are weak (14 px), below what the 1/2 row sees
-    # (32 px of the image), and three 20 px ones leave no box (10 px). No finer row fits the
-    # budget of one full call after 1/4 and 1/2, yet the faint boxes say the crowd's faces are
-    # at the edge of what 1/2 sees: the full-resolution call is read once, past the budget
-    crowd = {(100, 100): 80, **{(400, 100 + 250 * k): 28 for k in range(6)},
-             **{(800, 300 + 400 * k): 20 for k in range(3)}}
-    sensor, prior, frame = _crowd_sensor(fovea, crowd=crowd)
-    assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 0.5, 1.0]
-    assert frame.detector_pixels == 400 * 300 + 800 * 600 + 1600 * 1200
-    cells = [fovea.grid.index(int((y + s / 2) * 21 / 1200), int((x + s / 2) * 21 / 1600))
-             for (y, x), s in crowd.items()]
-    posterior = prior + frame.values
-    assert np.all(posterior[cells] > np.log(49))            # 1.3 full calls' false rate
-    assert np.all(np.delete(posterior, cells) < -np.log(99))
-    # without the crowd rules (crowd_ratio 0) the 20 px squares are never seen
-    sensor, prior, frame = _crowd_sensor(fovea, crowd=crowd, crowd_ratio=0.0)
-    assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25]
-    assert np.all(prior[cells[-3:]] + frame.values[cells[-3:]] < 0)
+    # a table whose 1/2 row sees faces from 40 px of its input (80 px of the image). A bright
+    # 80 px square (strong at 1/4: a face below 0.7 x the 120 px assumed, a crowd) and six dim
+    # 60 px ones (weak) send the pass to 1/2, the finest call within one full call's budget.
+    # There the dim squares are weak again, not 0.7 times smaller than the 80 px face, yet
+    # below what the 1/2 row sees: the crowd's faces are at the edge of what 1/2 sees, and the
+    # full-resolution call is read, past the budget, where three bright 20 px squares (unseen
+    # at 1/4 and 1/2) are found
+    table = ScaleTable('test', (TABLE.rows[0], ScaleRow(0.5, 40.0, 0.97, 0.05), TABLE.rows[2]),
+                       0.7)
+    dim = {(400, 100 + 250 * k): 60 for k in range(6)}
+    bright = {(100, 100): 80, **{(900, 300 + 400 * k): 20 for k in range(3)}}
 
-    # the rule itself, after a 1/2 call of a crowd whose faces seemed 40 px or more (so that
-    # the 28 px boxes are not 0.7 times smaller than the faces assumed)
-    def step(weak_sides, strong_side=80.0, budget=1600 * 1200, crowd_ratio=search.CROWD_RATIO):
-        sensor = search._Coarse(fovea, TABLE, (1600, 1200), prior, 0.99, budget=budget,
-                                crowd_ratio=crowd_ratio)
+    def run(dim):
+        image = np.zeros((1200, 1600, 3), dtype=np.uint8)
+        for squares, level in ((dim, 160), (bright, 255)):
+            for (y, x), side in squares.items():
+                image[y:y + side, x:x + side] = level
+        prior = prior_log_odds(fovea.grid.n_cells, cell_prior(fovea.grid.n_cells, 0.5))
+        sensor = search._Coarse(fovea, table, (1600, 1200), prior, 0.99, budget=1600 * 1200)
+        sensor.detector = _Shaded()
+        sensor.start(image)
+        frame = sensor.scan()
+        return sensor, prior + frame.values, frame
+    sensor, posterior, frame = run(dim)
+    assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 0.5, 1.0]
+    calls = 400 * 300 + 800 * 600 + 1600 * 1200             # and the enlarged looks at the dim
+    assert calls < frame.detector_pixels <= calls + search.LOOK_ALLOWANCE * 1600 * 1200
+    assert sensor.overrun                                   # squares' weak boxes at 1
+    cells = [fovea.grid.index(int((y + s / 2) * 21 / 1200), int((x + s / 2) * 21 / 1600))
+             for (y, x), s in bright.items()]
+    assert np.all(posterior[cells] > 0)                     # the 20 px squares: found
+    # five dim squares are not a crowd seen faintly: the 20 px squares are never seen
+    sensor, posterior, _ = run(dict(list(dim.items())[:5]))
+    assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 0.5]
+    assert np.all(posterior[cells[1:]] < 0)
+
+    # the rule itself, after a 1/2 call of the shipped test table (its row sees 32 px)
+    def step(weak_sides, strong_side=80.0, budget=1600 * 1200, spent=400 * 300 + 800 * 600,
+             overrun=False, crowd_ratio=search.CROWD_RATIO):
+        sensor = search._Coarse(fovea, TABLE, (1600, 1200), np.zeros(fovea.grid.n_cells),
+                                0.99, budget=budget, crowd_ratio=crowd_ratio)
+        sensor.overrun = overrun
         weak = np.array([[0, 0, w, w] for w in weak_sides], dtype=float).reshape(-1, 4)
-        return sensor, sensor._finer_for_faint_faces(
-            np.array([[0, 0, strong_side, strong_side]]), weak, 0.5)
-    sensor, scale = step([28.0] * 6)
-    assert scale == 1.0 and sensor.overrun
-    assert sensor._finer_for_faint_faces(np.array([[0, 0, 80, 80]]),
-                                         np.array([[0, 0, 28, 28]] * 6), 0.5) is None   # once
-    assert step([28.0] * 5)[1] is None                      # five faint boxes: no
-    assert step([28.0] * 3 + [40.0] * 3)[1] is None         # 40 px: seen by the 1/2 row
-    assert step([28.0] * 6, strong_side=90.0)[1] is None    # no face below 0.7 x 120 px
-    assert step([28.0] * 6, crowd_ratio=0.0)[1] is None
-    assert step([28.0] * 6, budget=1600 * 1200 - 1)[1] is None     # the call alone passes it
-    assert step([28.0] * 6, budget=4 * 1600 * 1200)[1] == 1.0
+        return sensor._finer_for_faint_faces(np.array([[0, 0, strong_side, strong_side]]),
+                                             weak, 0.5, spent)
+    assert step([28.0] * 6) == 1.0
+    assert step([28.0] * 5) is None                         # five faint boxes: no
+    assert step([28.0] * 3 + [40.0] * 3) is None            # 40 px: seen by the 1/2 row
+    assert step([28.0] * 6, strong_side=90.0) is None       # no face below 0.7 x 120 px
+    assert step([28.0] * 6, crowd_ratio=0.0) is None
+    assert step([28.0] * 6, budget=1600 * 1200 - 1) is None        # the call alone passes it
+    assert step([28.0] * 6, overrun=True) is None           # a call passed the budget already
+    assert step([28.0] * 6, overrun=True, spent=0) == 1.0   # within the budget: always
 
 
 def test_search_many_counts_faces_with_the_tables_strong_score(yunet_420, monkeypatch):

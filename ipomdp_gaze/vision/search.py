@@ -627,13 +627,15 @@ class _Coarse(_Recorder):
     finer scale of the table, whose evidence replaces the coarser one for those cells (and
     their neighbours), until no cell is undecided, the finest scale was used or the next crop
     would pass ``budget`` pixels. Faces smaller than assumed send the whole image to a finer
-    call first (:meth:`_finer_for_smaller_faces`); and when the whole image's calls found no
-    strong box of their own while a crop did, one smaller than ``crowd_ratio`` times the faces
-    they assumed, the cells they decided empty were decided for larger faces: the whole image
-    is read again at the finest scale of a crop that found one (within the budget), with the
-    smallest of them as the faces assumed, and the steps go on from there (``crowd_ratio`` 0:
-    neither). All of it is one frame of kind ``evidence``; fixations are the fovea's windows,
-    for cells still undecided.
+    call first (:meth:`_finer_for_smaller_faces`, :meth:`_finer_for_faint_faces`); and when the
+    whole image's calls found no strong box of their own while a crop did, one smaller than
+    ``crowd_ratio`` times the faces they assumed, the cells they decided empty were decided for
+    larger faces: the whole image is read again at the finest scale of a crop that found one,
+    with the smallest of them as the faces assumed, and the steps go on from there
+    (``crowd_ratio`` 0: neither). Once per image one of these whole-image calls may pass the
+    budget, if the call alone costs no more than it (the detector alone at that scale; no
+    crop, and no fixation, follows then). All of it is one frame of kind ``evidence``;
+    fixations are the fovea's windows, for cells still undecided.
     """
 
     def __init__(self, fovea: Fovea, table, image_px: tuple[int, int], prior: np.ndarray,
@@ -653,7 +655,7 @@ class _Coarse(_Recorder):
         self.budget = budget
         self.image = None
         self.looks = []
-        self.overrun = False
+        self.overrun = False                # a whole-image call went past the budget
 
     def start(self, scene):
         super().start(scene)
@@ -721,14 +723,19 @@ class _Coarse(_Recorder):
         ``side`` may be. Small faces this call saw well (strong, with fewer than
         :data:`CROWD_WEAK_BOXES` weak boxes that small) are seen ``crowd_ratio`` times smaller
         by a call ``1 / crowd_ratio`` times finer (the finer row at or above it within the
-        budget, ``spent``: the pixels read so far, else the finest that fits). Faces it saw
+        budget, ``spent``: the pixels read so far, else the finest that fits; see below when
+        none fits). Faces it saw
         only faintly (that many weak boxes), or none at all, are looked for where the table
         says: when this call's scale does not see faces that small by its table row, at the
         coarsest finer row that does, else the finest one within the budget; with no box at
         all, only rows that expect fewer false detections than :data:`STEP_FALSE`. The side
         returned is the next call's ``side``: the smallest face found (a face 0.7 times smaller
-        still steps again), or with no box the smaller faces now assumed. None otherwise, when
-        no finer row fits or ``crowd_ratio`` is 0.
+        still steps again), or with no box the smaller faces now assumed. When no finer row fits
+        the budget, the rows whose call alone fits it are taken instead, unless a call passed the
+        budget already, no box was seen, or the faces were seen well and the smallest of them is
+        one this call's row sees (the next call would only look for faces 0.7 times smaller
+        still: not worth a full call). None otherwise, when no finer row fits or
+        ``crowd_ratio`` is 0.
         """
         if not self.crowd_ratio:
             return None
@@ -754,10 +761,9 @@ class _Coarse(_Recorder):
                 seen_well and smallest * scale >= self.table.row(scale).min_side_px):
             # a crowd's step the budget refuses, for faces this call saw only faintly or
             # smaller than its table row sees (so it missed more of them): taken once past the
-            # budget, by a call that alone costs no more (the detector alone at that scale)
+            # budget (scan), by a call that alone costs no more (the detector alone there)
             finer = [r for r in self.table.rows if r.scale > scale * (1 + SCALE_RTOL)
                      and cost[r.scale] <= self.budget]
-            self.overrun = bool(finer)
         if not finer:
             return None
         if seen_well:
@@ -773,7 +779,7 @@ class _Coarse(_Recorder):
         step = next((r for r in finer if want * r.scale >= r.min_side_px), finer[-1]).scale
         return step, (want if blind else smallest)
 
-    def _finer_for_faint_faces(self, strong, weak, scale: float):
+    def _finer_for_faint_faces(self, strong, weak, scale: float, spent: int = 0):
         """
         Return the scale of one more whole-image call for a crowd this call saw faintly.
 
@@ -781,10 +787,11 @@ class _Coarse(_Recorder):
         call leaving :data:`CROWD_FAINT_BOXES` weak boxes smaller than its table row sees says
         the crowd's faces are at the edge of what it sees, and more are missed: the whole
         image is read once more at the coarsest finer row that sees the smallest of them
-        (else the finest), even past the budget, as long as that call alone costs no more than
-        the budget (the detector alone at that scale). Once per image; None otherwise.
+        (else the finest), within the budget (``spent``: the pixels read so far), else past it
+        if no call has passed it yet and the call alone costs no more than the budget (the
+        detector alone at that scale). None otherwise.
         """
-        if self.overrun or not self.crowd_ratio:
+        if not self.crowd_ratio:
             return None
 
         def sides(boxes):
@@ -795,11 +802,12 @@ class _Coarse(_Recorder):
                 sides(strong) < self.crowd_ratio * self.min_face):
             return None
         width, height = self.image_px
+        cost = {r.scale: math.prod(scaled_size(width, height, r.scale)) for r in self.table.rows}
         finer = [r for r in self.table.rows if r.scale > scale * (1 + SCALE_RTOL)
-                 and math.prod(scaled_size(width, height, r.scale)) <= self.budget]
+                 and cost[r.scale] <= self.budget
+                 and (spent + cost[r.scale] <= self.budget or not self.overrun)]
         if not finer:
             return None
-        self.overrun = True
         smallest = float(np.min(faint))
         return next((r for r in finer if smallest * r.scale >= r.min_side_px), finer[-1]).scale
 
@@ -829,8 +837,10 @@ class _Coarse(_Recorder):
         scale, side = self.scale, self.min_face
         while True:
             while (step := self._finer_for_smaller_faces(strong, scale, side, weak, pixels)
-                   or self._finer_for_faint_faces(strong, weak, scale)) is not None:
+                   or self._finer_for_faint_faces(strong, weak, scale, pixels)) is not None:
                 finer, side = step if isinstance(step, tuple) else (step, side)
+                self.overrun |= pixels + math.prod(scaled_size(width, height, finer)) \
+                    > self.budget
                 # the whole image again at the finer scale: its boxes and evidence replace the
                 # coarser call's, whose strong boxes stay strong
                 found, weak, spent = self._look(whole, finer, pixels)
@@ -970,10 +980,11 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     OccupancySession`): the scan, then the fixation with the largest expected drop of the
     summed cell entropies per detector pixel, until every cell is decided at the confidence
     (or the budget, or ``pixel_budget``: for ``find``, one full-resolution scan of the image
-    as given, before ``--max-side``; beyond it only the looks' :data:`LOOK_ALLOWANCE`; with a
-    ``pixel_budget`` the fixations after the scan also read at most one full scan of this
-    image). The faces are the clusters of occupied cells, each counted once and split where
-    the detector's merged boxes are distinct faces
+    as given, before ``--max-side``; beyond it only the looks' :data:`LOOK_ALLOWANCE` and, once,
+    a crowd's whole-image call that alone fits it (:class:`_Coarse`); with a ``pixel_budget``
+    the fixations after the scan also read at most one full scan of this image). The faces
+    are the clusters of occupied cells, each counted once and split where the detector's
+    merged boxes are distinct faces
     (:func:`ipomdp_gaze.model.occupancy.count_faces`, cells within ``link`` of each other are
     one cluster); cells within ``settle`` of an occupied cell need no decision of
     their own (:class:`~ipomdp_gaze.search.many.OccupancySession`, ``link``). ``decision`` is
