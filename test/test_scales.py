@@ -200,7 +200,7 @@ def test_a_face_too_small_for_the_coarse_scale_gets_one_finer_look_only_there(yu
     sensor, prior, frame = _blob_sensor(fovea, 24)
     assert [(rect, scale) for rect, scale, _ in sensor.looks][2] == ((0, 0, 800, 600), 1.0)
     assert len(sensor.looks) == 3
-    assert frame.detector_pixels == 400 * 300 + pixels + 800 * 600
+    assert frame.detector_pixels == 400 * 300 + pixels + 800 * 600 and sensor.overrun
     posterior = prior + frame.values              # the face the likeliest cell; its fixations
     assert np.argmax(posterior) == face and posterior[face] > 0     # decide it at 0.99
     assert np.all(np.delete(posterior, face) < np.log(99))
@@ -383,6 +383,17 @@ def test_the_crowd_step_reads_past_its_budget_only_by_one_call_that_fits_it(yune
         sensor, prior, frame = _crowd_sensor(fovea, crowd=crowd, budget=budget)
         assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 0.5, 1.0]
         assert frame.detector_pixels == 400 * 300 + 800 * 600 + 1600 * 1200
+    # past the budget once: with a call past it already, the step is refused (within the
+    # budget it is not), and the next image starts afresh
+    sensor, _, _ = _crowd_sensor(fovea, crowd=crowd)
+    assert sensor.overrun
+    strong = np.array([[0, 0, 80, 80]], dtype=float)
+    weak = np.array([[0, 0, 30, 30]] * 3, dtype=float)
+    assert sensor._finer_for_smaller_faces(strong, 0.5, 80.0, weak, 600_000) is None
+    assert sensor._finer_for_smaller_faces(strong, 0.5, 80.0, weak, 0) == (1.0, 30.0)
+    sensor.start(np.zeros((1200, 1600, 3), dtype=np.uint8))
+    assert not sensor.overrun
+    assert sensor._finer_for_smaller_faces(strong, 0.5, 80.0, weak, 600_000) == (1.0, 30.0)
     # a budget the call alone passes: not read, and no crop passes the budget
     sensor, _, frame = _crowd_sensor(fovea, crowd=crowd, budget=1600 * 1200 - 1)
     assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 0.5]

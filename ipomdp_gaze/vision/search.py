@@ -108,7 +108,7 @@ FAINT_LOOK_SCORE = 0.8
 # there. Seen well, they are seen that much smaller by a call 1 / CROWD_RATIO times finer; seen
 # faintly (many weak boxes) or not at all, the whole image is detected again at the coarsest
 # finer row whose table sees them (the finest affordable one when none does); and so on, within
-# the pixel budget.
+# the pixel budget, but for one whole-image call per image past it that alone fits it (_Coarse).
 CROWD_RATIO = 0.7
 # With no box at all, a finer call is taken only if its table row expects fewer false detections
 # than this in the whole image (rate times its pixels): YuNet's rows do on every image find
@@ -123,10 +123,11 @@ STEP_FALSE = 0.03
 CROWD_WEAK_BOXES = 3
 # A crowd seen faintly: this many weak boxes smaller than the call's table row sees, in a picture
 # where a face below CROWD_RATIO times the faces assumed was found, send the whole image to one
-# more call at the scale that sees them, even past the pixel budget (_Coarse's
-# _finer_for_faint_faces). Chosen on training crowds: 25-50 px faces in 2048x1536 left 7-12 such
-# boxes at 1/2 (found 86 of 100 faces without the call, 100 with it), three 60-120 px faces in
-# 4000x3000 left 3 (the call found nothing more and its texture boxes drew 2 false faces).
+# more call at the scale that sees them, past the pixel budget if need be (once per image, if the
+# call alone fits it: _Coarse's _finer_for_faint_faces). Chosen on training crowds: 25-50 px
+# faces in 2048x1536 left 7-12 such boxes at 1/2 (found 86 of 100 faces without the call, 100
+# with it), three 60-120 px faces in 4000x3000 left 3 (the call found nothing more and its
+# texture boxes drew 2 false faces).
 CROWD_FAINT_BOXES = 6
 
 # The settings of search_image unless given: NMPT's operating point (confidence 0.9, 25 fixations,
@@ -787,9 +788,10 @@ class _Coarse(_Recorder):
         call leaving :data:`CROWD_FAINT_BOXES` weak boxes smaller than its table row sees says
         the crowd's faces are at the edge of what it sees, and more are missed: the whole
         image is read once more at the coarsest finer row that sees the smallest of them
-        (else the finest), within the budget (``spent``: the pixels read so far), else past it
-        if no call has passed it yet and the call alone costs no more than the budget (the
-        detector alone at that scale). None otherwise.
+        (else the finest). That row is taken even when a coarser one would fit what is left of
+        the budget (``spent``: the pixels read so far), since a coarser call would again see
+        these faces at its edge: past the budget if no call has passed it yet and the call
+        alone costs no more than the budget (the detector alone at that scale). None otherwise.
         """
         if not self.crowd_ratio:
             return None
@@ -981,7 +983,8 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     summed cell entropies per detector pixel, until every cell is decided at the confidence
     (or the budget, or ``pixel_budget``: for ``find``, one full-resolution scan of the image
     as given, before ``--max-side``; beyond it only the looks' :data:`LOOK_ALLOWANCE` and, once,
-    a crowd's whole-image call that alone fits it (:class:`_Coarse`); with a ``pixel_budget``
+    a crowd's whole-image call that alone fits it (:class:`_Coarse`: the crowd's steps, the crop
+    rule and the faint rule); with a ``pixel_budget``
     the fixations after the scan also read at most one full scan of this image). The faces
     are the clusters of occupied cells, each counted once and split where the detector's
     merged boxes are distinct faces
