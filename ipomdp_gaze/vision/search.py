@@ -664,8 +664,20 @@ class _Coarse(_Recorder):
         self.overrun = False
 
     def scan_cost(self):
-        width, height = self.image_px
-        return math.prod(scaled_size(width, height, self.scale))
+        return self._whole_px(self.scale)
+
+    def _whole_px(self, scale: float) -> int:
+        """Return the detector pixels of a whole-image call at ``scale``."""
+        return math.prod(scaled_size(*self.image_px, scale))
+
+    def _may_read(self, cost: int, spent: int) -> bool:
+        """
+        Say whether a whole-image call of ``cost`` pixels may follow ``spent`` ones.
+
+        Within the budget, always; past it once per image, if the call alone fits the budget
+        (the detector alone at that scale; :attr:`overrun` says a call has passed it).
+        """
+        return spent + cost <= self.budget or (not self.overrun and cost <= self.budget)
 
     def _look(self, rect, scale, spent: int = 0):
         """
@@ -740,8 +752,7 @@ class _Coarse(_Recorder):
         """
         if not self.crowd_ratio:
             return None
-        sides = [np.max(np.asarray(boxes, dtype=float).reshape(-1, 4)[:, 2:], axis=1)
-                 for boxes in (strong, weak)]
+        sides = [_box_sides(boxes) for boxes in (strong, weak)]
         small = [s[s < self.crowd_ratio * side] for s in sides]
         blind = False
         if len(small[0]):
@@ -752,19 +763,15 @@ class _Coarse(_Recorder):
             smallest, blind = side, True
         else:
             return None
-        width, height = self.image_px
-        cost = {r.scale: math.prod(scaled_size(width, height, r.scale)) for r in self.table.rows}
-        finer = [r for r in self.table.rows if r.scale > scale * (1 + SCALE_RTOL)
-                 and spent + cost[r.scale] <= self.budget
-                 and not (blind and r.false_per_mpx * cost[r.scale] / 1e6 >= STEP_FALSE)]
+        rows = [r for r in self.table.rows if r.scale > scale * (1 + SCALE_RTOL)
+                and not (blind and r.false_per_mpx * self._whole_px(r.scale) / 1e6 >= STEP_FALSE)]
+        finer = [r for r in rows if spent + self._whole_px(r.scale) <= self.budget]
         seen_well = not blind and len(small[1]) < CROWD_WEAK_BOXES
-        if not finer and not blind and not self.overrun and not (
+        if not finer and not blind and not (
                 seen_well and smallest * scale >= self.table.row(scale).min_side_px):
             # a crowd's step the budget refuses, for faces this call saw only faintly or
-            # smaller than its table row sees (so it missed more of them): taken once past the
-            # budget (scan), by a call that alone costs no more (the detector alone there)
-            finer = [r for r in self.table.rows if r.scale > scale * (1 + SCALE_RTOL)
-                     and cost[r.scale] <= self.budget]
+            # smaller than its table row sees (so it missed more of them): past the budget once
+            finer = [r for r in rows if self._may_read(self._whole_px(r.scale), spent)]
         if not finer:
             return None
         if seen_well:
@@ -796,18 +803,13 @@ class _Coarse(_Recorder):
         if not self.crowd_ratio:
             return None
 
-        def sides(boxes):
-            return np.max(np.asarray(boxes, dtype=float).reshape(-1, 4)[:, 2:], axis=1)
-        faint = sides(weak)
+        faint = _box_sides(weak)
         faint = faint[faint < self.table.row(scale).min_side_px / scale]
         if len(faint) < CROWD_FAINT_BOXES or not np.any(
-                sides(strong) < self.crowd_ratio * self.min_face):
+                _box_sides(strong) < self.crowd_ratio * self.min_face):
             return None
-        width, height = self.image_px
-        cost = {r.scale: math.prod(scaled_size(width, height, r.scale)) for r in self.table.rows}
         finer = [r for r in self.table.rows if r.scale > scale * (1 + SCALE_RTOL)
-                 and cost[r.scale] <= self.budget
-                 and (spent + cost[r.scale] <= self.budget or not self.overrun)]
+                 and self._may_read(self._whole_px(r.scale), spent)]
         if not finer:
             return None
         smallest = float(np.min(faint))
@@ -841,8 +843,7 @@ class _Coarse(_Recorder):
             while (step := self._finer_for_smaller_faces(strong, scale, side, weak, pixels)
                    or self._finer_for_faint_faces(strong, weak, scale, pixels)) is not None:
                 finer, side = step if isinstance(step, tuple) else (step, side)
-                self.overrun |= pixels + math.prod(scaled_size(width, height, finer)) \
-                    > self.budget
+                self.overrun |= pixels + self._whole_px(finer) > self.budget
                 # the whole image again at the finer scale: its boxes and evidence replace the
                 # coarser call's, whose strong boxes stay strong
                 found, weak, spent = self._look(whole, finer, pixels)
@@ -857,17 +858,14 @@ class _Coarse(_Recorder):
             # whole image at the crop's scale (past the budget only as a crowd's step may be),
             # and the steps from there; at most once, since its strong boxes then hold the
             # crop's faces
-            if len(strong) or not len(small) or at <= scale * (1 + SCALE_RTOL):
+            if len(strong) or not len(small) or at <= scale * (1 + SCALE_RTOL) \
+                    or not self._may_read(self._whole_px(at), pixels):
                 break
-            cost = math.prod(scaled_size(width, height, at))
-            if pixels + cost > self.budget:
-                if self.overrun or cost > self.budget:
-                    break
-                self.overrun = True
+            self.overrun |= pixels + self._whole_px(at) > self.budget
             found, weak, spent = self._look(whole, at, pixels)
             strong = np.concatenate([strong, small, found])
             pixels, scale = pixels + spent, at
-            side = float(np.min(np.max(small[:, 2:], axis=1)))
+            side = float(np.min(_box_sides(small)))
         return Frame(term, kind='evidence', detector_pixels=pixels,
                      seconds=time.perf_counter() - t0)
 
@@ -901,12 +899,17 @@ class _Coarse(_Recorder):
                 inner[_grown(box, 1, self.grid.shape)] = True
                 term = np.where(inner.reshape(-1), fine, term)
                 strong = np.asarray(strong, dtype=float).reshape(-1, 4)
-                smaller = strong[np.max(strong[:, 2:], axis=1) < self.crowd_ratio * side]
+                smaller = strong[_box_sides(strong) < self.crowd_ratio * side]
                 if len(smaller):
                     small.append(smaller)
                     at = max(at, row.scale)
         small = np.concatenate(small) if small else np.zeros((0, 4))
         return term, pixels, small, at
+
+
+def _box_sides(boxes) -> np.ndarray:
+    """Return the larger side of each box ``(x, y, w, h)`` of ``boxes`` (M,)."""
+    return np.max(np.asarray(boxes, dtype=float).reshape(-1, 4)[:, 2:], axis=1)
 
 
 def _fine_score(detector) -> float:
@@ -984,10 +987,9 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     (or the budget, or ``pixel_budget``: for ``find``, one full-resolution scan of the image
     as given, before ``--max-side``; beyond it only the looks' :data:`LOOK_ALLOWANCE` and, once,
     a crowd's whole-image call that alone fits it (:class:`_Coarse`: the crowd's steps, the crop
-    rule and the faint rule); with a ``pixel_budget``
-    the fixations after the scan also read at most one full scan of this image). The faces
-    are the clusters of occupied cells, each counted once and split where the detector's
-    merged boxes are distinct faces
+    rule and the faint rule); with a ``pixel_budget`` the fixations after the scan also read
+    at most one full scan of this image). The faces are the clusters of occupied cells, each
+    counted once and split where the detector's merged boxes are distinct faces
     (:func:`ipomdp_gaze.model.occupancy.count_faces`, cells within ``link`` of each other are
     one cluster); cells within ``settle`` of an occupied cell need no decision of
     their own (:class:`~ipomdp_gaze.search.many.OccupancySession`, ``link``). ``decision`` is
