@@ -7,7 +7,7 @@ from types import SimpleNamespace
 import cv2
 from ipomdp_gaze.commands.find import (_Tasks, ladder_start, min_face_notes, scale_table,
                                        SCAN_DEFAULT, search_one, search_route)
-from ipomdp_gaze.vision.photos import load_photo
+from ipomdp_gaze.vision.photos import load_photo, read_labels
 from ipomdp_gaze.vision.scenes import SceneSet
 from ipomdp_gaze.vision.search import FIND_SETTINGS, look_factor, search_image, search_scales
 import numpy as np
@@ -164,8 +164,9 @@ def test_min_face_below_full_resolution_enlarges_the_last_rung(tmp_path, cli_her
     assert answers[()]['decision'] == 'absent'
     enlarged = answers[('--min-face', 24)]
     assert enlarged['decision'] == 'found' and near(enlarged['cell'], scene.cell)
-    # the ladder from 1/2 to 1, then the frame enlarged 48 / 24 = 2x
-    assert enlarged['detector_pixels'] == (420 * 420 + 840 * 840 + 1680 * 1680)
+    # the first call for a face of 840 px (300 px, YuNet's largest side), the ladder from 1/2
+    # to 1, then the frame enlarged 48 / 24 = 2x
+    assert enlarged['detector_pixels'] == (300 * 300 + 420 * 420 + 840 * 840 + 1680 * 1680)
     assert 'the ladder ends on the image enlarged 2x' in result.stderr
 
 
@@ -293,3 +294,32 @@ def test_the_default_line_says_it_ended_on_a_scan_without_a_probability(tmp_path
     assert 'method=scales' in line and plot.exists()
     entry = json.loads((tmp_path / 'out.json').read_text())['images'][0]
     assert entry['probability'] is None and entry['note'].startswith('full frame at')
+
+
+def close_up(face_px: int):
+    """Return a close-up (the astronaut's head enlarged, its face ``face_px`` tall) and the box."""
+    photo = load_photo('astronaut')
+    x, y, w, h = (int(v) for v in read_labels()['astronaut'][0][0])
+    head = photo[max(0, y - h // 2):y + h + h // 2, max(0, x - w // 2):x + w + w // 2]
+    factor = face_px / h
+    image = cv2.resize(np.ascontiguousarray(head), None, fx=factor, fy=factor,
+                       interpolation=cv2.INTER_LINEAR)
+    box = np.array([x - max(0, x - w // 2), y - max(0, y - h // 2), w, h]) * factor
+    return image, box
+
+
+def inside(pixel, box):
+    x, y, w, h = box
+    return x <= pixel[0] <= x + w and y <= pixel[1] <= y + h
+
+
+def test_a_face_as_large_as_the_image_is_found_by_a_coarse_first_call():
+    # YuNet finds no strong box for a face of 1000 px at 1/2 or 1 (at 1 a weak one on its chin):
+    # the first call, coarse enough for a face of the image's side, finds it, and the crop
+    # round it is confirmed where the face is at most 300 px, not at full resolution
+    image, box = close_up(1000)
+    task = tasks('yunet').task((image.shape[1], image.shape[0]))
+    [result] = search_one(image, task, FIND_SETTINGS, np.random.default_rng(0), False)
+    assert result.decision == 'found' and inside(result.pixel, box)
+    assert result.note.startswith(f'full frame at {300 / min(image.shape[:2]):.2g}')
+    assert result.detector_pixels < 0.25 * image.shape[0] * image.shape[1]

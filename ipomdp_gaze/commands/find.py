@@ -162,18 +162,19 @@ LADDER_START = {('haar', 420): 0.25, ('haar', 840): 0.5, ('yunet', 420): 0.5,
 
 def add_parser(sub):
     p = sub.add_parser(
-        'find', help='find the face in images with the digital fovea and a count model',
-        description='Search each image with the digital fovea: scan the whole image once '
-                    "(when the model has scan tables) and fixate the policy's choice on the "
-                    'scanned belief (without a scan: the grid centre), update the belief with '
-                    'the count model, stop when a cell reaches --confidence (found), when '
-                    '"no face" reaches it (absent), at --max-fixations or once every cell was '
-                    'fixated (gave_up), and before spending more detector pixels than one '
-                    'full-resolution scan (deciding then); small images are scanned whole '
-                    'instead. Print one line per image (path, decision, cell (row, col) and '
-                    'pixel (x, y) found, probability, fixations, detector pixels, seconds). '
-                    'Images are read with OpenCV (BGR converted to RGB; grey for a grey '
-                    'detector such as Haar); 8 bits per channel.')
+        'find', help='find faces in images: the detector scale first, or the digital fovea',
+        description='Find a face in each image (--all: every face). By default (--scan '
+                    'coarse) the detector runs on the whole image from a coarse scale to finer '
+                    'ones until a strong box, looked at again round the box at the next finer '
+                    "scale, answers (found), else absent; --scan fovea is the paper's search: "
+                    "scan the whole image once, fixate the policy's choice on the belief, "
+                    'update it with the count model, stop when a cell (or "no face") reaches '
+                    '--confidence, at --max-fixations, once every cell was fixated (gave_up) '
+                    'or before spending more detector pixels than one full-resolution scan. '
+                    'Small images are scanned whole instead. Print one line per image (path, '
+                    'decision, cell (row, col) and pixel (x, y) found, probability, fixations, '
+                    'detector pixels, seconds). Images are read with OpenCV (BGR converted to '
+                    'RGB; grey for a grey detector such as Haar); 8 bits per channel.')
     p.add_argument('images', nargs='+', metavar='IMAGE',
                    help='image files (PNG, JPEG, ...) or folders (their image files, by name)')
     p.add_argument('--observation', default=None, metavar='FILE',

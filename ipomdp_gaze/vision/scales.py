@@ -44,6 +44,10 @@ MIN_FALSE = 1e-6
 # of find's ladder (ladder_scales, which also says whether the ladder ends on the enlarged frame,
 # for search_scales and for find's --min-face note alike).
 SCALE_RTOL = 1e-3
+# The largest face find's ladder must see: one as large as the image's shorter side (a close-up
+# portrait); a detector with a largest side (ScaleTable.max_side_px) gets a first call coarse
+# enough for it (ladder_scales).
+MAX_FACE_FRACTION = 1.0
 
 
 @dataclass(frozen=True)
@@ -58,13 +62,19 @@ class ScaleRow:
 
 @dataclass(frozen=True)
 class ScaleTable:
-    """A detector's calibrated scales (coarse to fine in :meth:`rows`) and its strong score."""
+    """
+    A detector's calibrated scales (coarse to fine in :meth:`rows`) and its strong score.
+
+    ``max_side_px``: the largest face side (detector input px) the detector still finds
+    strongly (YuNet's largest anchors; a sliding-window cascade such as Haar has none: inf).
+    """
 
     detector: str
     rows: tuple
     strong_score: float = 0.0
     weak_score: float = 0.0
     weak_neighbors: int = 1
+    max_side_px: float = math.inf
 
     def row(self, scale: float) -> ScaleRow:
         """Return the row of ``scale`` (ValueError for a scale not in the table)."""
@@ -75,9 +85,10 @@ class ScaleTable:
 
 
 def _table(detector: str, rows: dict, strong_score: float = 0.0,
-           weak_score: float = 0.0) -> ScaleTable:
+           weak_score: float = 0.0, max_side_px: float = math.inf) -> ScaleTable:
     return ScaleTable(detector, tuple(sorted((ScaleRow(s, *v) for s, v in rows.items()),
-                                             key=lambda r: r.scale)), strong_score, weak_score)
+                                             key=lambda r: r.scale)), strong_score, weak_score,
+                      max_side_px=max_side_px)
 
 
 _COARSE = {}
@@ -115,10 +126,14 @@ def coarse_detector(detector, weak_score: float):
 # and chose scales too coarse for other faces). Strong: YuNet's score 0.7 or more, Haar's
 # grouped boxes. False detections are counted one more than were seen (YuNet: 1, 0, 0, 1 in
 # 252, 63, 28, 16 Mpx at 1, 1/2, 1/3, 1/4; Haar: 85, 22, 4, 1).
+# YuNet's largest side, bench/faces/large_faces.py --sides (training faces 0-59 and the
+# astronaut's head, one face a picture on three training backgrounds, at scale 1): the largest
+# 50 px step at which it finds at least 0.95 of them strongly: 300 px (0.967; 350: 0.918, 500:
+# 0.672; a face of 930 px got one box, of 0.59, on its chin).
 SCALE_TABLES = {
     'yunet': _table('yunet', {1.0: (48.0, 0.981, 0.008), 0.5: (36.0, 0.97, 0.016),
                               0.3333: (40.0, 0.967, 0.036), 0.25: (44.0, 0.953, 0.127)},
-                    strong_score=0.7, weak_score=WEAK_SCORE),
+                    strong_score=0.7, weak_score=WEAK_SCORE, max_side_px=300.0),
     'haar': _table('haar', {1.0: (24.0, 0.971, 0.342), 0.5: (36.0, 0.979, 0.366),
                             0.3333: (40.0, 0.972, 0.179), 0.25: (32.0, 0.959, 0.127)}),
 }
@@ -162,7 +177,20 @@ def finest_scale(table: ScaleTable, min_face: float | None = None) -> float:
     return min(MAX_SCALE, finest.min_side_px / float(min_face))
 
 
-def ladder_scales(table: ScaleTable, start: float, finest: float | None = None) -> list:
+def largest_face_scale(table: ScaleTable, image_px: tuple[int, int]) -> float:
+    """
+    Return the scale at which a face of :data:`MAX_FACE_FRACTION` of the shorter side is seen.
+
+    That face's side at this scale is the table's ``max_side_px`` (inf for a detector without
+    a largest side, which sees it at any scale: 0 is returned then).
+    """
+    if not math.isfinite(table.max_side_px):
+        return 0.0
+    return table.max_side_px / (MAX_FACE_FRACTION * min(image_px))
+
+
+def ladder_scales(table: ScaleTable, start: float, finest: float | None = None,
+                  image_px: tuple[int, int] | None = None) -> list:
     """
     Return the scales of ``find``'s ladder (the full-frame calls of ``search_scales``).
 
@@ -172,14 +200,36 @@ def ladder_scales(table: ScaleTable, start: float, finest: float | None = None) 
     call at ``finest`` ends the ladder. With ``finest`` below ``start`` (a ``--min-face`` the
     table sees at a coarser scale than the ladder's start) ``start`` is not run: the ladder is
     the one call at ``finest``. The ladder ends on the enlarged frame exactly when its last
-    scale is above the table's finest row.
+    scale is above the table's finest row. Given the image's ``(width, height)``, a first call
+    at :func:`largest_face_scale` comes before the others when it is coarser than all of them:
+    a face as large as the image is beyond the detector's largest side at every rung (YuNet
+    scores a 930 px face 0.59, on its chin), and that call costs little (a 2048 px square:
+    2% of a full scan).
     """
     finest = table.rows[-1].scale if finest is None else float(finest)
     rungs = [row.scale for row in table.rows
              if start * (1 - SCALE_RTOL) <= row.scale <= finest * (1 + SCALE_RTOL)]
     if not rungs or finest > rungs[-1] * (1 + SCALE_RTOL):
         rungs.append(finest)
+    if image_px is not None:
+        largest = largest_face_scale(table, image_px)
+        if 0 < largest < rungs[0] * (1 - SCALE_RTOL):
+            rungs.insert(0, largest)
     return rungs
+
+
+def confirm_scale(table: ScaleTable, box_side_px: float, scale: float, finer: float) -> float:
+    """
+    Return the scale at which ``find``'s ladder confirms a box found by a call at ``scale``.
+
+    The next rung ``finer``, unless the box (``box_side_px`` in image px) would be beyond the
+    table's ``max_side_px`` there: then the scale at which it is that side, never below
+    ``scale`` (a face filling the frame is confirmed in the crop round it at the call's own
+    scale).
+    """
+    if box_side_px * finer <= table.max_side_px:
+        return finer
+    return max(scale, table.max_side_px / box_side_px)
 
 
 def coarse_evidence(row: ScaleRow, grid, image_px: tuple[int, int], detector_pixels: int,

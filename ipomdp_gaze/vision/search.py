@@ -58,7 +58,8 @@ from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea
 from ipomdp_gaze.vision.fovea_model import check_model, fovea_for_model  # noqa: F401
 from ipomdp_gaze.vision.fullframe import cells_of_points, scaled_size, scan
 from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evidence,
-                                       ladder_scales, min_face_px, SCALE_RTOL, ScaleTable)
+                                       confirm_scale, ladder_scales, min_face_px, SCALE_RTOL,
+                                       ScaleTable)
 from ipomdp_gaze.vision.sensors import FoveaSensor
 import numpy as np
 
@@ -852,7 +853,8 @@ class _Coarse(_Recorder):
             shift = self._crowd_shift(strong) if scale != self.scale else 0.0
             term = coarse_evidence(self.table.row(scale), self.grid, self.image_px, pixels,
                                    strong, weak, self.prior + shift) + shift
-            term, pixels, small, at = self._finer_looks(term, scale, side, shift, pixels)
+            term, pixels, small, at = self._finer_looks(term, scale, side, shift, pixels,
+                                                        strong)
             # the whole image's calls found no face of their own, and a crop found one smaller
             # than they assumed: the cells they decided empty may hold more like it, so the
             # whole image at the crop's scale (past the budget only as a crowd's step may be),
@@ -866,20 +868,35 @@ class _Coarse(_Recorder):
             strong = np.concatenate([strong, small, found])
             pixels, scale = pixels + spent, at
             side = float(np.min(_box_sides(small)))
+        # a strong box beyond the detector's largest side even at the finest row: no finer look
+        # or fixation can see that face, so the calls that saw it decide its cell
+        large = strong[_box_sides(strong) * self.table.rows[-1].scale > self.table.max_side_px]
+        cells = cells_of_points(large[:, :2] + large[:, 2:] / 2, (height, width), self.grid)
+        prior = np.broadcast_to(self.prior, term.shape)
+        term[cells] = np.maximum(term[cells], self.threshold - prior[cells])
         return Frame(term, kind='evidence', detector_pixels=pixels,
                      seconds=time.perf_counter() - t0)
 
-    def _finer_looks(self, term, scale: float, side: float, shift, pixels: int):
+    def _finer_looks(self, term, scale: float, side: float, shift, pixels: int,
+                     seen=np.zeros((0, 4))):
         """
         Look again at each group of undecided cells, at each finer row in turn (class docstring).
 
         Returns ``(term, pixels, small, at)``: the evidence with each look's replacing the
         coarser one round its cells, the pixels read in all, the strong boxes of the looks
         smaller than ``crowd_ratio`` times ``side`` (the faces the whole image's calls assumed)
-        and the finest scale of a look that found one (0 without).
+        and the finest scale of a look that found one (0 without). A cell holding the centre of
+        a strong box of the whole image's calls (``seen``) beyond the detector's largest side
+        at the look's scale (``ScaleTable.max_side_px``) keeps its evidence: a look that cannot
+        see that face does not say it is not there (YuNet finds no face of 720 px at 1).
         """
         small, at = [], 0.0
+        seen = np.asarray(seen, dtype=float).reshape(-1, 4)
         for row in (r for r in self.table.rows if r.scale > scale):
+            too_large = seen[_box_sides(seen) * row.scale > self.table.max_side_px]
+            unseen = np.zeros(self.grid.n_cells, dtype=bool)
+            unseen[cells_of_points(too_large[:, :2] + too_large[:, 2:] / 2,
+                                   self.image_px[::-1], self.grid)] = True
             undecided = np.abs(self.prior + term) < self.threshold
             if not undecided.any():
                 break
@@ -897,7 +914,7 @@ class _Coarse(_Recorder):
                                        self.prior + shift) + shift
                 inner = np.zeros(self.grid.shape, dtype=bool)
                 inner[_grown(box, 1, self.grid.shape)] = True
-                term = np.where(inner.reshape(-1), fine, term)
+                term = np.where(inner.reshape(-1) & ~unseen, fine, term)
                 strong = np.asarray(strong, dtype=float).reshape(-1, 4)
                 smaller = strong[_box_sides(strong) < self.crowd_ratio * side]
                 if len(smaller):
@@ -1194,12 +1211,17 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
     table up to ``finest`` (default the table's finest; above it, one more call on the image
     enlarged ``finest`` times: :func:`~ipomdp_gaze.vision.scales.finest_scale` for faces too
     small for full resolution; :func:`~ipomdp_gaze.vision.scales.ladder_scales`). A ``finest``
-    below ``start`` does not run ``start``: the ladder is the one call at ``finest``. The
-    ladder stops at the first call with a strong box (YuNet: a score of at least the table's
-    ``strong_score``; Haar: a merged box); at its last scale (``finest``) any box the fovea's
-    detector keeps answers. With ``confirm`` a strong box of a coarser call answers only if a
-    crop round it (its side on each side) at the next finer scale keeps a box (strong unless
-    that scale is the last); else the next scale's full-frame call follows. A strong box of
+    below ``start`` does not run ``start``: the ladder is the one call at ``finest``. For a
+    detector with a largest side (YuNet: 300 px) a first call coarse enough for a face as
+    large as the image's shorter side comes before ``start`` when ``start`` is finer (a
+    close-up portrait). The ladder stops at the first call with a strong box (YuNet: a score
+    of at least the table's ``strong_score``; Haar: a merged box); at its last scale
+    (``finest``) any box the fovea's detector keeps answers. With ``confirm`` a strong box of a
+    coarser call answers only if a crop round it (its side on each side) at the next finer
+    scale keeps a box (strong unless that scale is the last), or, for a box beyond the
+    detector's largest side there, at the scale where it is that side (never below its own
+    call's: :func:`~ipomdp_gaze.vision.scales.confirm_scale`); else the next scale's
+    full-frame call follows. A strong box of
     the last call is never confirmed, so a ``finest`` at or below ``start`` (a coarse end for
     large faces) answers a strong box of that one coarse call as it is (YuNet's table: 16x the
     strong false detections per Mpx at 1/4 as at 1). A box of a scoring detector that answers
@@ -1223,7 +1245,7 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
     t0 = time.perf_counter()
     image_px = check_image(image, fovea)
     grid = fovea.grid
-    rungs = ladder_scales(scales, start, finest)
+    rungs = ladder_scales(scales, start, finest, image_px)
     pixels, box, faint = 0, None, None
     for k, scale in enumerate(rungs):
         last = k == len(rungs) - 1
@@ -1244,10 +1266,10 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
             # look again round the box at the next finer scale: a texture the coarse call took
             # for a face rarely survives
             x0, y0, x1, y1 = _crop_round(box, image_px)
-            seen_at = rungs[k + 1]
+            seen_at = confirm_scale(scales, float(np.max(box[2:])), scale, rungs[k + 1])
             look = scan(image[y0:y1, x0:x1], fovea.detector, (1, 1), seen_at)
             pixels += look.detector_pixels
-            at_finest = k + 1 == len(rungs) - 1
+            at_finest = seen_at == rungs[-1]
             box = _ladder_answer(look, scales.strong_score, at_finest)
             score = _best_score(look) if at_finest else math.nan
             if box is not None:
