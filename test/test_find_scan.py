@@ -314,12 +314,13 @@ def inside(pixel, box):
 
 
 def test_a_face_as_large_as_the_image_is_found_by_a_coarse_first_call():
-    # YuNet finds no strong box for a face of 1000 px at 1/2 or 1 (at 1 a weak one on its chin):
-    # the first call, coarse enough for a face of the image's side, finds it, and the crop
-    # round it is confirmed where the face is at most 300 px, not at full resolution
-    image, box = close_up(1000)
+    # a face of 1,300 px: YuNet scores it 0.72 at 1/2, and its crop at 1 holds only boxes of
+    # 0.5-0.6 on parts of it, so before the ladder went on to 1 and said absent after 3.5 full
+    # scans; the first call, coarse enough for a face of the image's side, finds it, and the
+    # crop round it is confirmed where the face is at most 300 px, not at full resolution
+    image, box = close_up(1300)
     task = tasks('yunet').task((image.shape[1], image.shape[0]))
     [result] = search_one(image, task, FIND_SETTINGS, np.random.default_rng(0), False)
     assert result.decision == 'found' and inside(result.pixel, box)
-    assert result.note.startswith(f'full frame at {300 / min(image.shape[:2]):.2g}')
-    assert result.detector_pixels < 0.25 * image.shape[0] * image.shape[1]
+    assert result.note == f'full frame at {300 / min(image.shape[:2]):.2g}'
+    assert result.detector_pixels < 0.1 * image.shape[0] * image.shape[1]

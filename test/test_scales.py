@@ -674,22 +674,57 @@ def test_weak_boxes_of_small_faces_are_a_crowd_only_when_there_are_enough(yunet_
     assert all(rect != whole and scale == 0.5 for rect, scale in looks[1:3])
 
 
-def test_find_all_keeps_a_face_too_large_for_its_finer_looks():
-    """A training lfw face of 720 px in 1600x1200: strong at 1/2, beyond YuNet's 300 px at 1."""
+def lfw_close_up(size, side: int, face: int, corner):
+    """Compose a training lfw face of ``side`` px at ``corner`` on coffee (``size``)."""
+    image = cv2.resize(load_background('coffee', 'rgb'), size)
+    x0, y0 = corner
+    pasted = cv2.resize(np.dstack([load_faces()[face]] * 3), (side, side),
+                        interpolation=cv2.INTER_CUBIC)
+    image[y0:y0 + side, x0:x0 + side] = np.clip(pasted, 0, 255).astype(np.uint8)
+    return image
+
+
+def find_all_yunet(image, settings=MANY):
     from ipomdp_gaze.commands.find import _Tasks
     from types import SimpleNamespace
-    image = cv2.resize(load_background('coffee', 'rgb'), (1600, 1200))
-    face = cv2.resize(np.dstack([load_faces()[5]] * 3), (720, 720),
-                      interpolation=cv2.INTER_CUBIC)
-    image[240:960, 293:1013] = np.clip(face, 0, 255).astype(np.uint8)
+    size = (image.shape[1], image.shape[0])
     task = _Tasks(SimpleNamespace(observation=None, detector='yunet', policy=None,
-                                  policy_file=None)).task((1600, 1200))
-    result = search_many(image, task.fovea, task.model, MANY, pixel_budget=1600 * 1200,
-                         scales=scale_table(task.model))
+                                  policy_file=None)).task(size)
+    return search_many(image, task.fovea, task.model, settings,
+                       pixel_budget=size[0] * size[1], scales=scale_table(task.model))
+
+
+@pytest.mark.parametrize('confidence', [0.99, 0.995, 0.95])
+def test_find_all_keeps_a_face_too_large_for_its_finer_looks(confidence):
+    """A training lfw face of 720 px in 1600x1200: strong at 1/2, beyond YuNet's 300 px at 1."""
+    result = find_all_yunet(lfw_close_up((1600, 1200), 720, 5, (293, 240)),
+                            replace(MANY, confidence=confidence))
     # before, a look at 1 round its cells (382 px wide, inside the face) found nothing and
     # said the cell was empty; now the cell keeps the coarse call's evidence and is decided
+    # (at 0.995 too, where prior + (threshold - prior) rounds a step below the threshold)
     assert result.decision == 'found' and len(result.faces) == 1
     x, y, w, h = result.faces[0].box
     assert 293 <= x + w / 2 <= 1013 and 240 <= y + h / 2 <= 960
     assert result.fixations == 0
     assert result.detector_pixels < 1600 * 1200 / 2
+
+
+def test_find_all_looks_again_where_a_weak_box_too_large_for_its_scale_is_300_px(monkeypatch):
+    """A training lfw face of 1382 px in 2048x1536: at 1/3 one weak box (0.69) of 1593 px."""
+    calls = []
+    look = search._Coarse._look
+
+    def spy(self, rect, scale, spent=0):
+        out = look(self, rect, scale, spent)
+        calls.append((rect, scale, len(out[0]), len(out[1])))
+        return out
+    monkeypatch.setattr(search._Coarse, '_look', spy)
+    result = find_all_yunet(lfw_close_up((2048, 1536), 1382, 20, (222, 77)))
+    whole = (0, 0, 2048, 1536)
+    assert calls[0][0] == whole and calls[0][1] == pytest.approx(1 / 3, rel=1e-3)
+    assert calls[0][2:] == (0, 1)                           # one weak box, no strong one
+    # the whole image again where that box is 300 px: there the face is strong
+    assert calls[1][0] == whole and 0.15 < calls[1][1] < 0.2 and calls[1][2] == 1
+    assert result.decision == 'found' and len(result.faces) == 1
+    x, y, w, h = result.faces[0].box
+    assert 222 <= x + w / 2 <= 222 + 1382 and 77 <= y + h / 2 <= 77 + 1382

@@ -18,7 +18,7 @@ Two tables, on one split's faces and backgrounds (``--split train`` informs the 
   detector pixels over one full scan.
 
 Usage: ``python bench/faces/large_faces.py [--split train|test] [--sides] [--pictures 8]
-[--seed 11]``.
+[--seed 11] [--fractions 0.3,0.45,0.6,0.75,0.9]``.
 """
 import argparse
 from dataclasses import replace
@@ -91,20 +91,20 @@ def sides_table(split: str) -> list[str]:
     return lines
 
 
-def close_ups(split: str, pictures: int, seed: int) -> list[str]:
+def close_ups(split: str, pictures: int, seed: int, fractions=FRACTIONS) -> list[str]:
     rng = np.random.default_rng(seed)
     faces = split_faces(split)
     names = SPLITS[split][1]
     tasks = _Tasks(SimpleNamespace(observation=None, detector='yunet', policy=None,
                                    policy_file=None))
     runs = {'find': (False, 'one'), 'find --all': (True, 'many')}
-    right = {run: {f: [] for f in FRACTIONS} for run in runs}
+    right = {run: {f: [] for f in fractions} for run in runs}
     others = dict.fromkeys(runs, 0)
     ratios = {run: [] for run in runs}
     for k in range(pictures):
         face = faces[0] if k == 0 else faces[rng.integers(len(faces))]
         for width, height in SIZES:
-            for fraction in FRACTIONS:
+            for fraction in fractions:
                 background = cv2.resize(load_background(names[rng.integers(len(names))], 'rgb'),
                                         (width, height))
                 side = fraction * min(width, height)
@@ -122,11 +122,11 @@ def close_ups(split: str, pictures: int, seed: int) -> list[str]:
                     others[run] += len(hits) - sum(hits)
                     ratios[run].append(result.detector_pixels / (width * height))
     n = pictures * len(SIZES)
-    lines = ['| search | ' + ' | '.join(f'face {f:g} of the side' for f in FRACTIONS)
+    lines = ['| search | ' + ' | '.join(f'face {f:g} of the side' for f in fractions)
              + ' | other faces named | px / full |',
-             '|---|' + '---|' * (len(FRACTIONS) + 2)]
+             '|---|' + '---|' * (len(fractions) + 2)]
     for run in runs:
-        cells = ' | '.join(f'{sum(right[run][f])}/{n}' for f in FRACTIONS)
+        cells = ' | '.join(f'{sum(right[run][f])}/{n}' for f in fractions)
         lines.append(f'| `{run}` | {cells} | {others[run]} | {np.mean(ratios[run]):.3f} |')
     return lines
 
@@ -137,9 +137,11 @@ def main(argv=None) -> int:
     parser.add_argument('--sides', action='store_true')
     parser.add_argument('--pictures', type=int, default=8)
     parser.add_argument('--seed', type=int, default=11)
+    parser.add_argument('--fractions', type=lambda text: [float(v) for v in text.split(',')],
+                        default=FRACTIONS, help='face sides, as fractions of the shorter side')
     args = parser.parse_args(argv)
     lines = (sides_table(args.split) if args.sides
-             else close_ups(args.split, args.pictures, args.seed))
+             else close_ups(args.split, args.pictures, args.seed, args.fractions))
     print('\n'.join(lines))
     return 0
 

@@ -93,6 +93,9 @@ LOOK_SIDE_PX = 128.0
 # look at a 60 px box of a 400x600 photo 50%, and a 48 Mpx photo of textures spent 22% before
 # this bound.
 LOOK_ALLOWANCE = 1.0
+# find --all: a cell the pass decides by a face too large for any finer look gets its log odds
+# this far (nats) past the threshold of confidence, so that rounding cannot leave it a step below
+DECIDED_MARGIN = 1e-9
 # The faint look (docs/design.md section 11.4), find without --all: when the ladder ends without
 # an answer, the finest call's best faint box (from FAINT_SCORE, below the detector's own
 # threshold) no larger than FAINT_SIDE times the smallest face side that scale sees (the scale
@@ -839,6 +842,17 @@ class _Coarse(_Recorder):
         width, height = self.image_px
         whole = (0, 0, width, height)
         strong, weak, pixels = self._look(whole, self.scale)
+        too_large = weak[_box_sides(weak) * self.scale > self.table.max_side_px]
+        if len(too_large):
+            # a weak box too large for the pass's scale (a close-up): the whole image again
+            # where it is the detector's largest side; its strong boxes too large for the
+            # pass's scale join the pass's
+            at = self.table.max_side_px / float(np.max(_box_sides(too_large)))
+            if pixels + self._whole_px(at) <= self.budget:
+                large, _, spent = self._look(whole, at, pixels)
+                pixels += spent
+                strong = np.concatenate(
+                    [strong, large[_box_sides(large) * self.scale > self.table.max_side_px]])
         scale, side = self.scale, self.min_face
         while True:
             while (step := self._finer_for_smaller_faces(strong, scale, side, weak, pixels)
@@ -868,12 +882,15 @@ class _Coarse(_Recorder):
             strong = np.concatenate([strong, small, found])
             pixels, scale = pixels + spent, at
             side = float(np.min(_box_sides(small)))
-        # a strong box beyond the detector's largest side even at the finest row: no finer look
-        # or fixation can see that face, so the calls that saw it decide its cell
-        large = strong[_box_sides(strong) * self.table.rows[-1].scale > self.table.max_side_px]
+        # a strong box beyond the detector's largest side at every row finer than the pass's
+        # (at the pass's own scale when none is finer): no finer look can see that face, nor a
+        # fixation (windows of a few cells), so the calls that saw it decide its cell (a hair
+        # past the threshold, so that prior + term does not round to a step below it)
+        finer = [row.scale for row in self.table.rows if row.scale > scale * (1 + SCALE_RTOL)]
+        large = strong[_box_sides(strong) * min(finer, default=scale) > self.table.max_side_px]
         cells = cells_of_points(large[:, :2] + large[:, 2:] / 2, (height, width), self.grid)
         prior = np.broadcast_to(self.prior, term.shape)
-        term[cells] = np.maximum(term[cells], self.threshold - prior[cells])
+        term[cells] = np.maximum(term[cells], self.threshold - prior[cells] + DECIDED_MARGIN)
         return Frame(term, kind='evidence', detector_pixels=pixels,
                      seconds=time.perf_counter() - t0)
 
@@ -1211,24 +1228,25 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
     table up to ``finest`` (default the table's finest; above it, one more call on the image
     enlarged ``finest`` times: :func:`~ipomdp_gaze.vision.scales.finest_scale` for faces too
     small for full resolution; :func:`~ipomdp_gaze.vision.scales.ladder_scales`). A ``finest``
-    below ``start`` does not run ``start``: the ladder is the one call at ``finest``. For a
-    detector with a largest side (YuNet: 300 px) a first call coarse enough for a face as
-    large as the image's shorter side comes before ``start`` when ``start`` is finer (a
-    close-up portrait). The ladder stops at the first call with a strong box (YuNet: a score
-    of at least the table's ``strong_score``; Haar: a merged box); at its last scale
+    below ``start`` does not run ``start``. For a detector with a largest side (YuNet: 300
+    px) a first call coarse enough for a face as large as the image's shorter side comes
+    first when every other rung is finer (a close-up portrait; pictures of a shorter side
+    above 600 px from 1/2). The ladder stops at the first call with a strong box (YuNet: a
+    score of at least the table's ``strong_score``; Haar: a merged box); at its last scale
     (``finest``) any box the fovea's detector keeps answers. With ``confirm`` a strong box of a
     coarser call answers only if a crop round it (its side on each side) at the next finer
     scale keeps a box (strong unless that scale is the last), or, for a box beyond the
     detector's largest side there, at the scale where it is that side (never below its own
-    call's: :func:`~ipomdp_gaze.vision.scales.confirm_scale`); else the next scale's
-    full-frame call follows. A strong box of
-    the last call is never confirmed, so a ``finest`` at or below ``start`` (a coarse end for
-    large faces) answers a strong box of that one coarse call as it is (YuNet's table: 16x the
-    strong false detections per Mpx at 1/4 as at 1). A box of a scoring detector that answers
-    at the last scale below the table's strong score answers only if the same crop, resized
-    so that the box is ``LOOK_SIDE_PX`` (at most ``look_upscale`` times, never below the
-    call's scale: :func:`look_factor`; 0: no look), keeps a box of at least ``look_score`` (a
-    face grows clearer, a texture rarely does). On the frame enlarged beyond the table
+    call's, where the look mostly finds the box again; the box confirmed there must be strong
+    even when the next rung is the last: :func:`~ipomdp_gaze.vision.scales.confirm_scale`);
+    else the next scale's full-frame call follows. A strong box of the last call is never
+    confirmed, so a ``finest`` at or below ``start`` (a coarse end for large faces) answers a
+    strong box of its coarse call as it is (YuNet's table: 16x the strong false detections
+    per Mpx at 1/4 as at 1). A box of a scoring detector that answers at the last scale below
+    the table's strong score answers only if the same crop, resized so that the box is
+    ``LOOK_SIDE_PX`` (at most ``look_upscale`` times, never below the call's scale:
+    :func:`look_factor`; 0: no look), keeps a box of at least ``look_score`` (a face grows
+    clearer, a texture rarely does). On the frame enlarged beyond the table
     (``finest`` above 1) that look is no enlargement of what the call saw: at most
     ``look_upscale / finest`` times its view, and from ``finest >= look_upscale`` (2x) the box
     scored again at the call's own scale, in the crop round it instead of the whole frame
@@ -1240,7 +1258,7 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
     highest score; for a grouping detector the merged box holding most raw detections), else
     ``absent``. No belief is computed (``probability`` NaN, method ``scales``);
     ``detector_pixels`` counts every call and crop (a face-free image pays every scale: 1/16 +
-    1/9 + 1/4 + 1 of a full scan from 1/4).
+    1/9 + 1/4 + 1 of a full scan from 1/4, and the first call for the largest face if any).
     """
     t0 = time.perf_counter()
     image_px = check_image(image, fovea)
