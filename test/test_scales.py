@@ -15,8 +15,7 @@ from ipomdp_gaze.vision.fovea_model import fovea_for_model
 from ipomdp_gaze.vision.photos import group_photo, load_photo
 from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evidence,
                                        confirm_scale, finest_scale, ladder_scales,
-                                       largest_face_scale, SCALE_TABLES, ScaleRow,
-                                       ScaleTable)
+                                       SCALE_TABLES, ScaleRow, ScaleTable)
 from ipomdp_gaze.vision.scenes import load_background, load_faces
 from ipomdp_gaze.vision.search import FIND_SETTINGS, search_many
 import numpy as np
@@ -68,19 +67,6 @@ def test_the_ladders_scales():
     assert ladder_scales(yunet, 0.25, 0.4) == [0.25, 0.3333, 0.4]
     assert ladder_scales(yunet, 0.5, 48 / 47.99) == [0.5, 1.0]
     assert ladder_scales(yunet, 0.5, 48 / 47.9) == [0.5, 1.0, 48 / 47.9]
-
-
-def test_a_large_image_gets_a_first_call_for_a_face_as_large_as_it():
-    yunet, haar = SCALE_TABLES['yunet'], SCALE_TABLES['haar']
-    # a face of the shorter side is YuNet's largest side (300 px) at 300 / 1536
-    assert ladder_scales(yunet, 0.5, None, (2048, 1536)) == [300 / 1536, 0.5, 1.0]
-    assert largest_face_scale(yunet, (1536, 2048)) == pytest.approx(300 / 1536)
-    # the start already sees it (a 512 px face at 1/2 is 256 px), and so does a cascade
-    assert ladder_scales(yunet, 0.5, None, (512, 512)) == [0.5, 1.0]
-    assert ladder_scales(haar, 0.25, None, (4000, 3000)) == [0.25, 0.3333, 0.5, 1.0]
-    assert largest_face_scale(haar, (4000, 3000)) == 0.0
-    # below a coarse --min-face end too
-    assert ladder_scales(yunet, 0.5, 0.25, (4000, 3000)) == [0.1, 0.25]
 
 
 def test_a_box_is_confirmed_where_it_is_at_most_the_detectors_largest_side():

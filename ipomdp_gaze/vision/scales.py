@@ -44,10 +44,6 @@ MIN_FALSE = 1e-6
 # of find's ladder (ladder_scales, which also says whether the ladder ends on the enlarged frame,
 # for search_scales and for find's --min-face note alike).
 SCALE_RTOL = 1e-3
-# The largest face find's ladder must see: one as large as the image's shorter side (a close-up
-# portrait); a detector with a largest side (ScaleTable.max_side_px) gets a first call coarse
-# enough for it (ladder_scales).
-MAX_FACE_FRACTION = 1.0
 
 
 @dataclass(frozen=True)
@@ -177,20 +173,7 @@ def finest_scale(table: ScaleTable, min_face: float | None = None) -> float:
     return min(MAX_SCALE, finest.min_side_px / float(min_face))
 
 
-def largest_face_scale(table: ScaleTable, image_px: tuple[int, int]) -> float:
-    """
-    Return the scale at which a face of :data:`MAX_FACE_FRACTION` of the shorter side is seen.
-
-    That face's side at this scale is the table's ``max_side_px`` (inf for a detector without
-    a largest side, which sees it at any scale: 0 is returned then).
-    """
-    if not math.isfinite(table.max_side_px):
-        return 0.0
-    return table.max_side_px / (MAX_FACE_FRACTION * min(image_px))
-
-
-def ladder_scales(table: ScaleTable, start: float, finest: float | None = None,
-                  image_px: tuple[int, int] | None = None) -> list:
+def ladder_scales(table: ScaleTable, start: float, finest: float | None = None) -> list:
     """
     Return the scales of ``find``'s ladder (the full-frame calls of ``search_scales``).
 
@@ -200,21 +183,14 @@ def ladder_scales(table: ScaleTable, start: float, finest: float | None = None,
     call at ``finest`` ends the ladder. With ``finest`` below ``start`` (a ``--min-face`` the
     table sees at a coarser scale than the ladder's start) ``start`` is not run: the ladder is
     the one call at ``finest``. The ladder ends on the enlarged frame exactly when its last
-    scale is above the table's finest row. Given the image's ``(width, height)``, a first call
-    at :func:`largest_face_scale` comes before the others when it is coarser than all of them:
-    a face as large as the image is beyond the detector's largest side at every rung (YuNet
-    scores a 930 px face 0.59, on its chin), and that call costs little (a 2048 px square:
-    2% of a full scan).
+    scale is above the table's finest row. (``search_scales`` may add one call, coarser, for
+    a box too large for its rung: a close-up.)
     """
     finest = table.rows[-1].scale if finest is None else float(finest)
     rungs = [row.scale for row in table.rows
              if start * (1 - SCALE_RTOL) <= row.scale <= finest * (1 + SCALE_RTOL)]
     if not rungs or finest > rungs[-1] * (1 + SCALE_RTOL):
         rungs.append(finest)
-    if image_px is not None:
-        largest = largest_face_scale(table, image_px)
-        if 0 < largest < rungs[0] * (1 - SCALE_RTOL):
-            rungs.insert(0, largest)
     return rungs
 
 

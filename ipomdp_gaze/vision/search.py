@@ -1229,9 +1229,10 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
     enlarged ``finest`` times: :func:`~ipomdp_gaze.vision.scales.finest_scale` for faces too
     small for full resolution; :func:`~ipomdp_gaze.vision.scales.ladder_scales`). A ``finest``
     below ``start`` does not run ``start``. For a detector with a largest side (YuNet: 300
-    px) a first call coarse enough for a face as large as the image's shorter side comes
-    first when every other rung is finer (a close-up portrait; pictures of a shorter side
-    above 600 px from 1/2). The ladder stops at the first call with a strong box (YuNet: a
+    px, ``ScaleTable.max_side_px``) a call before the last that leaves a box (from the
+    table's weak score) too large for its scale and answers nothing sends the whole image,
+    next and once, to the scale where that box is the largest side (a close-up portrait).
+    The ladder stops at the first call with a strong box (YuNet: a
     score of at least the table's ``strong_score``; Haar: a merged box); at its last scale
     (``finest``) any box the fovea's detector keeps answers. With ``confirm`` a strong box of a
     coarser call answers only if a crop round it (its side on each side) at the next finer
@@ -1258,21 +1259,27 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
     highest score; for a grouping detector the merged box holding most raw detections), else
     ``absent``. No belief is computed (``probability`` NaN, method ``scales``);
     ``detector_pixels`` counts every call and crop (a face-free image pays every scale: 1/16 +
-    1/9 + 1/4 + 1 of a full scan from 1/4, and the first call for the largest face if any).
+    1/9 + 1/4 + 1 of a full scan from 1/4, and the call for a box too large if any).
     """
     t0 = time.perf_counter()
     image_px = check_image(image, fovea)
     grid = fovea.grid
-    rungs = ladder_scales(scales, start, finest, image_px)
-    pixels, box, faint = 0, None, None
-    for k, scale in enumerate(rungs):
+    rungs = ladder_scales(scales, start, finest)
+    pixels, box, faint, larger = 0, None, None, False
+    k = -1
+    while k + 1 < len(rungs):
+        k += 1
+        scale = rungs[k]
         last = k == len(rungs) - 1
-        faint_detector = coarse_detector(fovea.detector, faint_score) if last and look_upscale \
-            else fovea.detector
-        found = scan(image, faint_detector, grid, scale)
+        # the last call keeps faint boxes (for the faint look), the others weak ones (for a face
+        # too large for their scale); neither answers as such
+        weak_from = faint_score if last and look_upscale else (
+            scales.weak_score if math.isfinite(scales.max_side_px) else 0.0)
+        detector = coarse_detector(fovea.detector, weak_from)
+        found = scan(image, detector, grid, scale)
         pixels += found.detector_pixels
         keep_from = -math.inf
-        if faint_detector is not fovea.detector:
+        if last and detector is not fovea.detector:
             # the same call keeps faint boxes too: they answer only through the faint look
             keep_from = _fine_score(fovea.detector)
             faint = _faint_box(found, keep_from,
@@ -1301,6 +1308,12 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
                 box = None
         if box is not None:
             break
+        sides = _box_sides(found.boxes_px)
+        if not last and not larger and np.any(sides * scale > scales.max_side_px):
+            # a box too large for this scale (a close-up): the whole image next where it is the
+            # detector's largest side, once
+            rungs.insert(k + 1, scales.max_side_px / float(np.max(sides)))
+            larger = True
     if box is None and faint is not None:
         # a face too small for the finest scale: its faint small box, enlarged
         best, spent = _enlarged_look(image, faint, image_px, fovea.detector, look_upscale,
