@@ -132,6 +132,15 @@ def test_a_face_too_small_for_the_finest_scale_answers_from_its_faint_box():
     assert strict.decision == 'absent' and strict.detector_pixels == looked.detector_pixels
 
 
+def test_without_looks_the_ladder_reads_only_its_rungs():
+    """Training scene 7 (seed 1) of faces-840: a faint box of 0.3-0.5 at x1."""
+    scene = SceneSet('train', size_px=840, face_px=(24, 140), grid=(21, 21), seed=1)[7]
+    unlooked, _ = with_and_without(scene.image, look_upscale=0)
+    # no enlarged look and no faint look: the calls at 1/2 and 1, nothing else
+    assert unlooked.decision == 'absent'
+    assert unlooked.detector_pixels == 420 * 420 + 840 * 840
+
+
 @pytest.mark.parametrize('finest, rungs', [(1.0, (0.5, 1.0)), (2.0, (0.5, 1.0, 2.0)),
                                            (0.5, (0.5,)), (0.25, (0.25,))])
 def test_the_ladder_of_a_face_free_image_ends_at_its_finest_scale(finest, rungs):

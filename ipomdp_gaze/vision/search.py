@@ -1273,8 +1273,10 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
         last = k == len(rungs) - 1
         # the last call keeps faint boxes (for the faint look), the others weak ones (for a face
         # too large for their scale); neither answers as such
-        weak_from = faint_score if last and look_upscale else (
-            scales.weak_score if math.isfinite(scales.max_side_px) else 0.0)
+        if last:
+            weak_from = faint_score if look_upscale else 0.0
+        else:
+            weak_from = scales.weak_score if math.isfinite(scales.max_side_px) else 0.0
         detector = coarse_detector(fovea.detector, weak_from)
         found = scan(image, detector, grid, scale)
         pixels += found.detector_pixels
