@@ -639,7 +639,12 @@ class _Coarse(_Recorder):
     with the smallest of them as the faces assumed, and the steps go on from there
     (``crowd_ratio`` 0: neither). Once per image one of these whole-image calls may pass the
     budget, if the call alone costs no more than it (the detector alone at that scale; no
-    crop, and no fixation, follows then). All of it is one frame of kind ``evidence``;
+    crop, and no fixation, follows then). Faces too large for a scale (a close-up; the
+    table's ``max_side_px``): a weak box of the first call too large for its scale sends the
+    whole image, within the budget, to the scale where that box is the largest side, whose
+    strong boxes too large for the first call's scale join its own; a finer look keeps the
+    evidence of a cell whose strong box is too large for the look; and a strong box too large
+    for every finer row decides its cell. All of it is one frame of kind ``evidence``;
     fixations are the fovea's windows, for cells still undecided.
     """
 
