@@ -187,6 +187,18 @@ def test_face_boxes_are_drawn_where_the_json_says():
     assert green[40:120, 80].all() and not green[60:100, 30:70].any()
 
 
+def test_face_boxes_stay_visible_on_a_large_picture():
+    from ipomdp_gaze.vision.search import Face
+    from ipomdp_gaze.vision.search_plots import draw_faces
+    picture = np.zeros((1536, 2048, 3), dtype=np.uint8)
+    face = Face(box=(100.0, 200.0, 800.0, 900.0), cell=(2, 1), probability=0.9)
+    green = np.all(draw_faces(picture, [face]) == (0, 255, 0), axis=2)
+    # a figure shows about 570 of the 2048 columns: a line of 2 px could fall between them,
+    # so the line is 2048 / 300 -> 7 px (rows 197-203 round the top edge at 200)
+    assert green[197:204, 300:800].all() and not green[210:1000, 300:800].any()
+    assert green[300:1000, 97:104].all()
+
+
 def test_plot_refuses_a_format_it_cannot_write_and_writes_the_one_named(photos, tmp_path,
                                                                         run_find):
     folder, _ = photos

@@ -335,3 +335,18 @@ def test_a_face_too_large_for_a_rung_is_looked_at_where_it_is_300_px(face_px, no
     assert result.decision == 'found' and inside(result.pixel, box)
     assert result.note == note
     assert result.detector_pixels < 0.6 * image.shape[0] * image.shape[1]
+    # the box answered is cut to the image (YuNet's box of a face at an edge reaches past it)
+    x, y, w, h = result.faces[0].box
+    assert 0 <= x and 0 <= y and x + w <= image.shape[1] and y + h <= image.shape[0]
+
+
+def test_the_ladders_box_is_cut_to_the_image():
+    """The astronaut cropped inside her face: YuNet's box reaches 8 px past the left edge."""
+    image = np.ascontiguousarray(load_photo('astronaut')[83:, 198:])
+    task = tasks('yunet').task((image.shape[1], image.shape[0]))
+    [result] = search_one(image, task, FIND_SETTINGS, np.random.default_rng(0), False)
+    assert result.decision == 'found' and result.method == 'scales'
+    x, y, w, h = result.faces[0].box
+    assert x == 0.0 and y == 0.0 and 0 < w < 80 and 0 < h <= image.shape[0]
+    # the answer's pixel is still the detector's box centre, as before
+    assert result.pixel[0] == pytest.approx(31.8, abs=0.1)

@@ -1346,6 +1346,7 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
                        pixel=(float(centre[0, 0]), float(centre[0, 1])), stop='found',
                        belief=belief, decision='found', detections=((x + w / 2, y + h / 2),),
                        absent_probability=math.nan,
-                       faces=(Face(box=(x, y, w, h), cell=tuple(int(v) for v in grid.cell(cell)),
+                       faces=(Face(box=clip_box((x, y, w, h), image_px),
+                                   cell=tuple(int(v) for v in grid.cell(cell)),
                                    probability=math.nan),),
                        seconds=time.perf_counter() - t0, **common)

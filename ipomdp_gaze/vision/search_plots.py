@@ -18,6 +18,8 @@ import numpy as np
 
 from .annotate import annotate, fovea_cell_map, LOG_RANGE
 
+# draw_faces: one pixel of line per this many pixels of the picture's width
+DRAW_WIDTH_PX = 300
 # A picture's short side is enlarged to at least MIN_SIDE_PX (whole factors, nearest), its long
 # side staying within MAX_ENLARGED_SIDE_PX (a panorama stays a few Mpx)
 MIN_SIDE_PX = 640
@@ -88,14 +90,21 @@ def annotate_image_search(image: np.ndarray, result, fovea,
 
 
 def draw_faces(picture: np.ndarray, faces, factor: int = 1) -> np.ndarray:
-    """Draw each face's box (image pixels times ``factor``) and its number on an RGB picture."""
+    """
+    Draw each face's box (image pixels times ``factor``) and its number on an RGB picture.
+
+    Lines and numbers grow with the picture (one line pixel per ``DRAW_WIDTH_PX`` of its
+    width): a saved figure shows about 570 px of it, so a 2 px line on a 2048 px picture could
+    fall between the pixels shown.
+    """
     out = np.ascontiguousarray(picture)
-    thickness = max(2, factor)
+    grow = max(1, factor, int(np.ceil(out.shape[1] / DRAW_WIDTH_PX)))
+    thickness = max(2, grow)
     for i, face in enumerate(faces):
         x, y, w, h = (int(round(v * factor)) for v in face.box)
         cv2.rectangle(out, (x, y), (x + w, y + h), (0, 255, 0), thickness)
-        cv2.putText(out, str(i), (x + 2, max(12, y - 4)), cv2.FONT_HERSHEY_SIMPLEX,
-                    0.5 * max(1, factor), (0, 255, 0), max(1, factor // 2 + 1))
+        cv2.putText(out, str(i), (x + 2 * grow, max(12 * grow, y - 4 * grow)),
+                    cv2.FONT_HERSHEY_SIMPLEX, 0.5 * grow, (0, 255, 0), max(1, grow // 2 + 1))
     return out
 
 
