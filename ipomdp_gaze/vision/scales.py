@@ -194,6 +194,34 @@ def ladder_scales(table: ScaleTable, start: float, finest: float | None = None) 
     return rungs
 
 
+def box_sides(boxes) -> np.ndarray:
+    """Return the larger side of each box ``(x, y, w, h)`` of ``boxes`` (M,)."""
+    return np.max(np.asarray(boxes, dtype=float).reshape(-1, 4)[:, 2:], axis=1)
+
+
+def box_cells(boxes, image_px: tuple[int, int], grid) -> np.ndarray:
+    """Return the cell holding each box's centre (M,), in an image of ``(width, height)``."""
+    boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
+    return cells_of_points(boxes[:, :2] + boxes[:, 2:] / 2, image_px[::-1], grid)
+
+
+def too_large(table: ScaleTable, boxes, scale: float) -> np.ndarray:
+    """Return the boxes (image px) beyond the detector's largest side at ``scale``, (K, 4)."""
+    boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
+    return boxes[box_sides(boxes) * scale > table.max_side_px]
+
+
+def larger_face_scale(table: ScaleTable, boxes, scale: float) -> float | None:
+    """
+    Return the scale at which the largest box too large for ``scale`` is the largest side.
+
+    The whole image is read again there when a call's box is too large for it (a close-up:
+    ``find``'s ladder and ``--all``'s pass); None when no box is.
+    """
+    large = too_large(table, boxes, scale)
+    return table.max_side_px / float(np.max(box_sides(large))) if len(large) else None
+
+
 def confirm_scale(table: ScaleTable, box_side_px: float, scale: float, finer: float) -> float:
     """
     Return the scale at which ``find``'s ladder confirms a box found by a call at ``scale``.
@@ -218,17 +246,12 @@ def coarse_evidence(row: ScaleRow, grid, image_px: tuple[int, int], detector_pix
     box's cell gets ``-prior_log_odds`` (even odds after the prior) unless a strong box is
     centred there too.
     """
-    width, height = image_px
     n = grid.n_cells
     false = max(MIN_FALSE, row.false_per_mpx * detector_pixels / 1e6 / n)
     recall = min(max(row.recall, false), 1.0 - 1e-6)
     term = np.full(n, math.log((1.0 - recall) / (1.0 - false)))
-
-    def cells(boxes):
-        boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
-        return cells_of_points(boxes[:, :2] + boxes[:, 2:] / 2, (height, width), grid)
     prior = np.broadcast_to(np.asarray(prior_log_odds, dtype=float), (n,))
-    weak = cells(weak_px)
+    weak = box_cells(weak_px, image_px, grid)
     term[weak] = -prior[weak]
-    term[cells(strong_px)] = math.log(recall / false)
+    term[box_cells(strong_px, image_px, grid)] = math.log(recall / false)
     return term

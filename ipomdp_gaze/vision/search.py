@@ -57,9 +57,10 @@ from ipomdp_gaze.vision.detectors import detector_from_settings  # noqa: F401 (i
 from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea
 from ipomdp_gaze.vision.fovea_model import check_model, fovea_for_model  # noqa: F401
 from ipomdp_gaze.vision.fullframe import cells_of_points, scaled_size, scan
-from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evidence,
-                                       confirm_scale, ladder_scales, min_face_px, SCALE_RTOL,
-                                       ScaleTable)
+from ipomdp_gaze.vision.scales import (box_cells, box_sides, choose_scale, coarse_detector,
+                                       coarse_evidence, confirm_scale, ladder_scales,
+                                       larger_face_scale, min_face_px, SCALE_RTOL, ScaleTable,
+                                       too_large)
 from ipomdp_gaze.vision.sensors import FoveaSensor
 import numpy as np
 
@@ -761,7 +762,7 @@ class _Coarse(_Recorder):
         """
         if not self.crowd_ratio:
             return None
-        sides = [_box_sides(boxes) for boxes in (strong, weak)]
+        sides = [box_sides(boxes) for boxes in (strong, weak)]
         small = [s[s < self.crowd_ratio * side] for s in sides]
         blind = False
         if len(small[0]):
@@ -812,10 +813,10 @@ class _Coarse(_Recorder):
         if not self.crowd_ratio:
             return None
 
-        faint = _box_sides(weak)
+        faint = box_sides(weak)
         faint = faint[faint < self.table.row(scale).min_side_px / scale]
         if len(faint) < CROWD_FAINT_BOXES or not np.any(
-                _box_sides(strong) < self.crowd_ratio * self.min_face):
+                box_sides(strong) < self.crowd_ratio * self.min_face):
             return None
         finer = [r for r in self.table.rows if r.scale > scale * (1 + SCALE_RTOL)
                  and self._may_read(self._whole_px(r.scale), spent)]
@@ -833,10 +834,7 @@ class _Coarse(_Recorder):
         holding a strong box's centre (an empirical Bayes estimate), so that a strong box
         decides its cell and a cell without any box is decided empty without a finer look.
         """
-        boxes = np.asarray(strong, dtype=float).reshape(-1, 4)
-        width, height = self.image_px
-        k = len(np.unique(cells_of_points(boxes[:, :2] + boxes[:, 2:] / 2, (height, width),
-                                          self.grid)))
+        k = len(np.unique(box_cells(strong, self.image_px, self.grid)))
         n = self.grid.n_cells
         if not k or k >= n:
             return np.zeros(n)
@@ -847,17 +845,14 @@ class _Coarse(_Recorder):
         width, height = self.image_px
         whole = (0, 0, width, height)
         strong, weak, pixels = self._look(whole, self.scale)
-        too_large = weak[_box_sides(weak) * self.scale > self.table.max_side_px]
-        if len(too_large):
+        at = larger_face_scale(self.table, weak, self.scale)
+        if at is not None and pixels + self._whole_px(at) <= self.budget:
             # a weak box too large for the pass's scale (a close-up): the whole image again
             # where it is the detector's largest side; its strong boxes too large for the
             # pass's scale join the pass's
-            at = self.table.max_side_px / float(np.max(_box_sides(too_large)))
-            if pixels + self._whole_px(at) <= self.budget:
-                large, _, spent = self._look(whole, at, pixels)
-                pixels += spent
-                strong = np.concatenate(
-                    [strong, large[_box_sides(large) * self.scale > self.table.max_side_px]])
+            large, _, spent = self._look(whole, at, pixels)
+            pixels += spent
+            strong = np.concatenate([strong, too_large(self.table, large, self.scale)])
         scale, side = self.scale, self.min_face
         while True:
             while (step := self._finer_for_smaller_faces(strong, scale, side, weak, pixels)
@@ -886,21 +881,20 @@ class _Coarse(_Recorder):
             found, weak, spent = self._look(whole, at, pixels)
             strong = np.concatenate([strong, small, found])
             pixels, scale = pixels + spent, at
-            side = float(np.min(_box_sides(small)))
+            side = float(np.min(box_sides(small)))
         # a strong box beyond the detector's largest side at every row finer than the pass's
         # (at the pass's own scale when none is finer): no finer look can see that face, nor a
         # fixation (windows of a few cells), so the calls that saw it decide its cell (a hair
         # past the threshold, so that prior + term does not round to a step below it)
         finer = [row.scale for row in self.table.rows if row.scale > scale * (1 + SCALE_RTOL)]
-        large = strong[_box_sides(strong) * min(finer, default=scale) > self.table.max_side_px]
-        cells = cells_of_points(large[:, :2] + large[:, 2:] / 2, (height, width), self.grid)
+        cells = box_cells(too_large(self.table, strong, min(finer, default=scale)),
+                          self.image_px, self.grid)
         prior = np.broadcast_to(self.prior, term.shape)
         term[cells] = np.maximum(term[cells], self.threshold - prior[cells] + DECIDED_MARGIN)
         return Frame(term, kind='evidence', detector_pixels=pixels,
                      seconds=time.perf_counter() - t0)
 
-    def _finer_looks(self, term, scale: float, side: float, shift, pixels: int,
-                     seen=np.zeros((0, 4))):
+    def _finer_looks(self, term, scale: float, side: float, shift, pixels: int, seen):
         """
         Look again at each group of undecided cells, at each finer row in turn (class docstring).
 
@@ -913,12 +907,10 @@ class _Coarse(_Recorder):
         see that face does not say it is not there (YuNet finds no face of 720 px at 1).
         """
         small, at = [], 0.0
-        seen = np.asarray(seen, dtype=float).reshape(-1, 4)
         for row in (r for r in self.table.rows if r.scale > scale):
-            too_large = seen[_box_sides(seen) * row.scale > self.table.max_side_px]
             unseen = np.zeros(self.grid.n_cells, dtype=bool)
-            unseen[cells_of_points(too_large[:, :2] + too_large[:, 2:] / 2,
-                                   self.image_px[::-1], self.grid)] = True
+            unseen[box_cells(too_large(self.table, seen, row.scale), self.image_px,
+                             self.grid)] = True
             undecided = np.abs(self.prior + term) < self.threshold
             if not undecided.any():
                 break
@@ -938,17 +930,12 @@ class _Coarse(_Recorder):
                 inner[_grown(box, 1, self.grid.shape)] = True
                 term = np.where(inner.reshape(-1) & ~unseen, fine, term)
                 strong = np.asarray(strong, dtype=float).reshape(-1, 4)
-                smaller = strong[_box_sides(strong) < self.crowd_ratio * side]
+                smaller = strong[box_sides(strong) < self.crowd_ratio * side]
                 if len(smaller):
                     small.append(smaller)
                     at = max(at, row.scale)
         small = np.concatenate(small) if small else np.zeros((0, 4))
         return term, pixels, small, at
-
-
-def _box_sides(boxes) -> np.ndarray:
-    """Return the larger side of each box ``(x, y, w, h)`` of ``boxes`` (M,)."""
-    return np.max(np.asarray(boxes, dtype=float).reshape(-1, 4)[:, 2:], axis=1)
 
 
 def _fine_score(detector) -> float:
@@ -1315,11 +1302,11 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
                 box = None
         if box is not None:
             break
-        sides = _box_sides(found.boxes_px)
-        if not last and not larger and np.any(sides * scale > scales.max_side_px):
+        at = None if last or larger else larger_face_scale(scales, found.boxes_px, scale)
+        if at is not None:
             # a box too large for this scale (a close-up): the whole image next where it is the
             # detector's largest side, once
-            rungs.insert(k + 1, scales.max_side_px / float(np.max(sides)))
+            rungs.insert(k + 1, at)
             larger = True
     if box is None and faint is not None:
         # a face too small for the finest scale: its faint small box, enlarged
