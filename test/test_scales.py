@@ -454,11 +454,11 @@ def test_a_crowd_seen_faintly_sends_the_whole_image_past_the_budget_once(yunet_4
     whole = (0, 0, 1600, 1200)
     # a table whose 1/2 row sees faces from 40 px of its input (80 px of the image). A bright
     # 80 px square (strong at 1/4: a face below 0.7 x the 120 px assumed, a crowd) and six dim
-    # 60 px ones (weak) send the pass to 1/2, the finest call within one full call's budget.
-    # There the dim squares are weak again, not 0.7 times smaller than the 80 px face, yet
-    # below what the 1/2 row sees: the crowd's faces are at the edge of what 1/2 sees, and the
-    # full-resolution call is read, past the budget, where three bright 20 px squares (unseen
-    # at 1/4 and 1/2) are found
+    # 60 px ones (weak: the crowd seen faintly) say faces of 0.7 x 80 px may be there. The 1/2
+    # row, the finest within one full call's budget, does not see them (28 px of its input);
+    # the full-resolution row does: it is read at once, past the budget, where three bright
+    # 20 px squares (unseen at 1/4 and 1/2) are found. (Before, 1/2 was read first, the
+    # finest row the budget allowed, and only its faint boxes sent the image to 1.)
     table = ScaleTable('test', (TABLE.rows[0], ScaleRow(0.5, 40.0, 0.97, 0.05), TABLE.rows[2]),
                        0.7)
     dim = {(400, 100 + 250 * k): 60 for k in range(6)}
@@ -476,17 +476,26 @@ def test_a_crowd_seen_faintly_sends_the_whole_image_past_the_budget_once(yunet_4
         frame = sensor.scan()
         return sensor, prior + frame.values, frame
     sensor, posterior, frame = run(dim)
-    assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 0.5, 1.0]
-    calls = 400 * 300 + 800 * 600 + 1600 * 1200             # and the enlarged looks at the dim
+    assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 1.0]
+    calls = 400 * 300 + 1600 * 1200                         # and the enlarged looks at the dim
     assert calls < frame.detector_pixels <= calls + search.LOOK_ALLOWANCE * 1600 * 1200
     assert sensor.overrun                                   # squares' weak boxes at 1
     cells = [fovea.grid.index(int((y + s / 2) * 21 / 1200), int((x + s / 2) * 21 / 1600))
              for (y, x), s in bright.items()]
     assert np.all(posterior[cells] > 0)                     # the 20 px squares: found
-    # five dim squares are not a crowd seen faintly: the 20 px squares are never seen
-    sensor, posterior, _ = run(dict(list(dim.items())[:5]))
+    # two dim squares are not a crowd seen faintly (CROWD_WEAK_BOXES): the 80 px face was
+    # seen well, faces 0.7 times smaller are seen 1 / 0.7 times finer, at 1/2, and the 20 px
+    # squares are never seen
+    sensor, posterior, _ = run(dict(list(dim.items())[:2]))
     assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 0.5]
     assert np.all(posterior[cells[1:]] < 0)
+    # past the budget once: after a call past it, the finest row within it
+    strong = np.array([[0, 0, 80, 80]], dtype=float)
+    weak = np.array([[0, 0, 60, 60]] * 6, dtype=float)
+    sensor.start(np.zeros((1200, 1600, 3), dtype=np.uint8))
+    assert sensor._finer_for_smaller_faces(strong, 0.25, 120.0, weak, 400 * 300) == (1.0, 80.0)
+    sensor.overrun = True
+    assert sensor._finer_for_smaller_faces(strong, 0.25, 120.0, weak, 400 * 300) == (0.5, 80.0)
 
     # the rule itself, after a 1/2 call of the shipped test table (its row sees 32 px)
     def step(weak_sides, strong_side=80.0, budget=1600 * 1200, spent=400 * 300 + 800 * 600,

@@ -112,8 +112,9 @@ FAINT_LOOK_SCORE = 0.8
 # the coarse pass found (or, when it found nothing, than the faces assumed to matter) may be
 # there. Seen well, they are seen that much smaller by a call 1 / CROWD_RATIO times finer; seen
 # faintly (many weak boxes) or not at all, the whole image is detected again at the coarsest
-# finer row whose table sees them (the finest affordable one when none does); and so on, within
-# the pixel budget, but for one whole-image call per image past it that alone fits it (_Coarse).
+# finer row whose table sees them (seen faintly, past the budget if need be; the finest
+# affordable one when none does); and so on, within the pixel budget, but for one whole-image
+# call per image past it that alone fits it (_Coarse).
 CROWD_RATIO = 0.7
 # With no box at all, a finer call is taken only if its table row expects fewer false detections
 # than this in the whole image (rate times its pixels): YuNet's rows do on every image find
@@ -750,8 +751,11 @@ class _Coarse(_Recorder):
         none fits). Faces it saw
         only faintly (that many weak boxes), or none at all, are looked for where the table
         says: when this call's scale does not see faces that small by its table row, at the
-        coarsest finer row that does, else the finest one within the budget; with no box at
-        all, only rows that expect fewer false detections than :data:`STEP_FALSE`. The side
+        coarsest finer row within the budget that does; for faces seen faintly, else the
+        coarsest that does whose call alone fits the budget, past it once (a row the budget
+        allows that does not see them would decide their cells empty: hard crowds); else the
+        finest one within the budget; with no box at all, only rows that expect fewer false
+        detections than :data:`STEP_FALSE`. The side
         returned is the next call's ``side``: the smallest face found (a face 0.7 times smaller
         still steps again), or with no box the smaller faces now assumed. When no finer row fits
         the budget, the rows whose call alone fits it are taken instead, unless a call passed the
@@ -794,8 +798,14 @@ class _Coarse(_Recorder):
         want = smallest * self.crowd_ratio
         if want * scale >= self.table.row(scale).min_side_px:
             return None
-        step = next((r for r in finer if want * r.scale >= r.min_side_px), finer[-1]).scale
-        return step, (want if blind else smallest)
+        step = next((r for r in finer if want * r.scale >= r.min_side_px), None)
+        if step is None and not blind:
+            # no row within the budget sees faces that small: the coarsest that does, past the
+            # budget once (a finer row the budget allows would leave them unseen and decided
+            # empty)
+            step = next((r for r in rows if want * r.scale >= r.min_side_px
+                         and self._may_read(self._whole_px(r.scale), spent)), None)
+        return (step or finer[-1]).scale, (want if blind else smallest)
 
     def _finer_for_faint_faces(self, strong, weak, scale: float, spent: int = 0):
         """
