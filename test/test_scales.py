@@ -516,6 +516,45 @@ def test_a_crowd_seen_faintly_sends_the_whole_image_past_the_budget_once(yunet_4
     assert step([28.0] * 6, overrun=True, spent=0) == 1.0   # within the budget: always
 
 
+def test_a_crowd_seen_faintly_after_a_step_within_the_budget_reads_the_row_that_sees_it(
+        yunet_420):
+    """A crowd seen faintly at a row the budget allowed: the faint rule, through the pass."""
+    _, fovea = yunet_420
+    whole = (0, 0, 1600, 1200)
+    # a bright 60 px square (strong at 1/4, below 0.7 x 120 px; no weak box: seen well) sends
+    # the pass to 1/2 (1 / 0.7 finer), within the budget. Six dim 44 px squares (unseen at 1/4,
+    # 11 px; weak at 1/2) are not 0.7 times smaller than 60 px (42 px), so the weak-box
+    # branch says nothing, but they are below what the 1/2 row sees (80 px): CROWD_FAINT_BOXES
+    # of them send the whole image to 1, past the budget, where three bright 20 px squares are
+    # found. Five do not.
+    table = ScaleTable('test', (TABLE.rows[0], ScaleRow(0.5, 40.0, 0.97, 0.05), TABLE.rows[2]),
+                       0.7)
+    dim = {(400, 100 + 250 * k): 44 for k in range(6)}
+    bright = {(100, 100): 60, **{(900, 300 + 400 * k): 20 for k in range(3)}}
+
+    def run(dim):
+        image = np.zeros((1200, 1600, 3), dtype=np.uint8)
+        for squares, level in ((dim, 160), (bright, 255)):
+            for (y, x), side in squares.items():
+                image[y:y + side, x:x + side] = level
+        prior = prior_log_odds(fovea.grid.n_cells, cell_prior(fovea.grid.n_cells, 0.5))
+        sensor = search._Coarse(fovea, table, (1600, 1200), prior, 0.99, budget=1600 * 1200)
+        sensor.detector = _Shaded()
+        sensor.start(image)
+        frame = sensor.scan()
+        return sensor, prior + frame.values, frame
+    cells = [fovea.grid.index(int((y + s / 2) * 21 / 1200), int((x + s / 2) * 21 / 1600))
+             for (y, x), s in bright.items()]
+    sensor, posterior, _ = run(dim)
+    assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 0.5, 1.0]
+    assert sensor.overrun
+    assert np.all(posterior[cells] > 0)
+    sensor, posterior, _ = run(dict(list(dim.items())[:5]))
+    assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 0.5]
+    assert not sensor.overrun
+    assert np.all(posterior[cells[1:]] < 0)
+
+
 def test_search_many_counts_faces_with_the_tables_strong_score(yunet_420, monkeypatch):
     """The coarse pass's strong score reaches count_faces (a scoreless table's does not)."""
     from ipomdp_gaze.search.many import OccupancySession

@@ -805,7 +805,7 @@ class _Coarse(_Recorder):
             # empty)
             step = next((r for r in rows if want * r.scale >= r.min_side_px
                          and self._may_read(self._whole_px(r.scale), spent)), None)
-        return (step or finer[-1]).scale, (want if blind else smallest)
+        return (step if step is not None else finer[-1]).scale, (want if blind else smallest)
 
     def _finer_for_faint_faces(self, strong, weak, scale: float, spent: int = 0):
         """
