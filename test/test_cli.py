@@ -46,6 +46,8 @@ def test_node_subcommands_run_their_node(command, node, capsys):
     (['evaluate', '--fpoc-param', 'foveal_dprime=-2'], 'foveal_dprime must be finite and > 0'),
     (['evaluate', '--fpoc-param', 'foveal_dprime'], 'expected name=value'),
     (['evaluate', '--episodes', '0'], 'expected a positive integer'),
+    (['evaluate', '--bootstrap', '1'], 'expected at least 10 resamples'),
+    (['reproduce', '--bootstrap', '9'], 'expected at least 10 resamples'),
     (['evaluate', '--spacing-deg', 'nan'], 'expected a positive number'),
     (['evaluate', '--fpoc', 'laser'], "invalid choice: 'laser'"),
     (['search', '--target', '99'], 'outside the 49-cell grid'),

@@ -80,6 +80,17 @@ def positive_int(text: str) -> int:
     return _int_at_least(text, 1, 'a positive integer')
 
 
+# A 95% percentile interval from fewer bootstrap resamples has no 2.5% tail to speak of (one
+# resample gives the estimate twice).
+MIN_BOOTSTRAP = 10
+
+
+def bootstrap_count(text: str) -> int:
+    """Parse ``--bootstrap``: resamples for a 95% interval, at least :data:`MIN_BOOTSTRAP`."""
+    return _int_at_least(text, MIN_BOOTSTRAP, f'at least {MIN_BOOTSTRAP} resamples (a 95% '
+                         'interval from fewer is degenerate)')
+
+
 def nonneg_int(text: str) -> int:
     """Parse an integer from 0 to 2^63 - 1 (seeds: a ROS integer parameter is int64)."""
     return _int_at_least(text, 0, 'an integer from 0 to 2^63 - 1', INT64_MAX)

@@ -38,7 +38,7 @@ from ipomdp_gaze.vision.walks import DURATION_S as WALK_DURATION_S
 from ipomdp_gaze.vision.walks import SPEED_DEG_S as WALK_SPEED_DEG_S
 import numpy as np
 
-from .common import add_task_args, nonneg_int, positive_int, task_from_args
+from .common import add_task_args, bootstrap_count, nonneg_int, positive_int, task_from_args
 from .running import add_run_args, executor_from_args, progress_from_args
 from .search_args import add_scene_args, add_search_args, settings_from_args
 
@@ -106,7 +106,7 @@ def add_parser(sub):
     p.add_argument('--horizon', type=positive_int, default=None,
                    help="fixations per episode (default N, the paper's T)")
     p.add_argument('--seed', type=nonneg_int, default=0)
-    p.add_argument('--bootstrap', type=positive_int, default=1000,
+    p.add_argument('--bootstrap', type=bootstrap_count, default=1000,
                    help='bootstrap resamples for the 95%% interval (default 1000)')
     p.add_argument('--paired', action='store_true',
                    help='also give each policy minus the first, on the same episodes, with a '

@@ -23,7 +23,7 @@ from ipomdp_gaze.policies.conv import radial_bins
 from ipomdp_gaze.policies.planner import make_planner, TemperedELM
 import numpy as np
 
-from .common import nonneg_int, positive_int
+from .common import bootstrap_count, nonneg_int, positive_int
 from .running import add_run_args, executor_from_args, progress_from_args
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -49,7 +49,7 @@ def add_parser(sub):
     p.add_argument('--episodes-greedy', type=positive_int, default=2000)
     p.add_argument('--episodes-planner', type=positive_int, default=2000)
     p.add_argument('--seed', type=nonneg_int, default=0)
-    p.add_argument('--bootstrap', type=positive_int, default=1000)
+    p.add_argument('--bootstrap', type=bootstrap_count, default=1000)
     p.add_argument('--retrain', action='store_true', help='retrain every shipped kernel first')
     p.add_argument('--cache', type=Path, default=ROOT / '.cache' / 'reproduce', metavar='DIR',
                    help='keep every simulated piece here and reuse it while its inputs and the '
