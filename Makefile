@@ -75,7 +75,8 @@ faces: $(STAMP)
 # shipped, --max-side 2048, and with --max-side 0 --min-face 15; about 1.7 GB resident for the
 # full-resolution calls on 12 MP); then crowds: the split's photo faces 29 (25) times anywhere in
 # 3000x2171 and 2048x1536 pictures at 50-100 px (25-50 px), find --all against the same without
-# its crowd step (crowd ratio 0); then hard crowds (the faces grey, flat and blurred, 3000x2171):
+# its crowd step (crowd ratio 0); then hard crowds (the faces grey, flat and blurred, 3000x2171
+# and 2048x1536):
 # docs/faces.md's section "find --all on groups: scale as an action" (about 11 minutes).
 GROUP_BENCH := $(VPY) bench/faces/many_faces.py --scenes 8 --sizes 640x480,1280x886 --write docs/faces.md
 CANVAS_BENCH := $(VPY) bench/faces/many_faces.py --canvas 15-40 --sizes 4000x3000 --scenes 4 \
@@ -83,8 +84,8 @@ CANVAS_BENCH := $(VPY) bench/faces/many_faces.py --canvas 15-40 --sizes 4000x300
 CROWD_BENCH := $(VPY) bench/faces/many_faces.py --sizes 3000x2171,2048x1536 --scenes 4 \
 	--crowd-ratios 0 --write docs/faces.md
 # hard crowds: the faces grey, at 0.6 of their contrast, blurred (1 or 3 px of a 75 px face)
-HARD_CROWD_BENCH := $(VPY) bench/faces/many_faces.py --sizes 3000x2171 --scenes 4 --crowd 50-100 \
-	--write docs/faces.md
+HARD_CROWD_BENCH := $(VPY) bench/faces/many_faces.py --sizes 3000x2171,2048x1536 --scenes 4 \
+	--crowd 50-100 --write docs/faces.md
 # a few people in a large photo: the split's photo faces 2-3 times at 100-200 px anywhere
 SPARSE_BENCH := $(VPY) bench/faces/many_faces.py --sizes 4000x3000,3000x2171 --scenes 8 \
 	--crowd 100-200 --write docs/faces.md
