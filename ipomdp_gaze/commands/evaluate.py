@@ -107,7 +107,7 @@ def add_parser(sub):
                    help="fixations per episode (default N, the paper's T)")
     p.add_argument('--seed', type=nonneg_int, default=0)
     p.add_argument('--bootstrap', type=bootstrap_count, default=1000,
-                   help='bootstrap resamples for the 95%% interval (default 1000)')
+                   help='bootstrap resamples for the 95%% interval (at least 10; default 1000)')
     p.add_argument('--paired', action='store_true',
                    help='also give each policy minus the first, on the same episodes, with a '
                         'paired bootstrap 95%% interval')
