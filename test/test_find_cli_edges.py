@@ -8,6 +8,7 @@ failed inputs missing from ``--json``, ``--log -``, output paths refused only af
 bad policy once per image, ``--max-side`` unnamed, ``--scan`` silently ignored, "1 faces".
 """
 import json
+from pathlib import Path
 import re
 
 import cv2
@@ -241,6 +242,16 @@ def test_an_image_max_side_makes_too_small_names_the_option(images, run_find):
             'too small: the detector and the 21x21 grid need at least 21x21') in result.stderr
 
 
+def test_an_image_too_small_as_given_names_its_own_size(tmp_path, run_find):
+    strip = tmp_path / 'strip.png'          # 10 px high: too small before --max-side shrinks it
+    cv2.imwrite(str(strip), np.zeros((10, 5000), dtype=np.uint8))
+    result = run_find(strip)
+    assert result.returncode == 2
+    assert (f'error: {strip}: image of 5000x10 pixels (WxH) is too small: the detector and '
+            'the 21x21 grid need at least 21x21') in result.stderr, result.stderr
+    assert '--max-side' not in result.stderr
+
+
 def test_scan_with_all_says_once_that_it_is_ignored(images, run_find):
     warning = 'warning: --scan fovea is ignored'
     for flags in (('--all',), ('--targets', 'many')):
@@ -250,6 +261,24 @@ def test_scan_with_all_says_once_that_it_is_ignored(images, run_find):
     for flags in (('--all',), ('--scan', 'fovea')):
         result = run_find(images['astronaut'], *flags)
         assert result.returncode == 0 and 'ignored' not in result.stderr, result.stderr
+
+
+def test_a_folder_searches_its_images_and_names_the_files_it_skips(images, tmp_path, run_find):
+    from PIL import Image
+    folder = tmp_path / 'photos'
+    folder.mkdir()
+    astronaut = cv2.imread(str(images['astronaut']))
+    Image.fromarray(astronaut[:, :, ::-1]).save(folder / 'astronaut.gif')   # a GIF: by suffix
+    cv2.imwrite(str(folder / 'noise.jpe'), cv2.imread(str(images['noise'])))
+    (folder / 'notes.txt').write_text('not an image')
+    (folder / 'boxes.json').write_text('{}')
+    result = run_find(folder)
+    assert result.returncode == 0, result.stderr
+    searched = re.findall(r'^(\S+): decision=(\w+)', result.stdout, re.M)
+    assert [(Path(p).name, d) for p, d in searched] == [('astronaut.gif', 'found'),
+                                                        ('noise.jpe', 'absent')]
+    assert f'{folder}: 2 files not named as an image skipped (boxes.json, notes.txt; name one ' \
+        'to search it)' in ' '.join(result.stderr.split())
 
 
 def test_a_panorama_is_not_enlarged_beyond_a_few_megapixels():

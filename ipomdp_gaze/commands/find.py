@@ -428,18 +428,27 @@ def plot_paths(out: Path, count: int) -> list[Path]:
     return [out.with_name(f'{out.stem}-{i}{out.suffix or ".png"}') for i in range(count)]
 
 
-IMAGE_SUFFIXES = ('.png', '.jpg', '.jpeg', '.bmp', '.tif', '.tiff', '.webp', '.pgm', '.ppm',
-                  '.pbm', '.jp2')
+# A folder's files that find reads (by suffix; a file named directly is decoded whatever its
+# name: OpenCV tells formats by their content, a GIF by its first frame).
+IMAGE_SUFFIXES = ('.png', '.jpg', '.jpeg', '.jpe', '.jfif', '.bmp', '.dib', '.tif', '.tiff',
+                  '.webp', '.gif', '.pgm', '.ppm', '.pbm', '.pnm', '.jp2')
 
 
-def expand_inputs(paths: list[str]) -> list[str]:
-    """Each path as given; a folder becomes its image files (by suffix), sorted by name."""
+def expand_inputs(paths: list[str], skipped: list | None = None) -> list[str]:
+    """
+    Each path as given; a folder becomes its image files (by suffix), sorted by name.
+
+    ``skipped``, when given, gets ``(folder, names)`` for each folder with other files.
+    """
     out = []
     for path in paths:
         folder = Path(path)
         if folder.is_dir():
-            out.extend(str(f) for f in sorted(folder.iterdir())
-                       if f.is_file() and f.suffix.lower() in IMAGE_SUFFIXES)
+            files = sorted(f for f in folder.iterdir() if f.is_file())
+            out.extend(str(f) for f in files if f.suffix.lower() in IMAGE_SUFFIXES)
+            others = [f.name for f in files if f.suffix.lower() not in IMAGE_SUFFIXES]
+            if others and skipped is not None:
+                skipped.append((path, others))
         else:
             out.append(path)
     return out
@@ -822,8 +831,8 @@ def _check_size(path: str, image: np.ndarray, given: tuple, fovea, max_side: int
             raise
         try:
             check_image_size(given, fovea)
-        except ValueError:
-            raise exc from None                 # too small as given: not the resize's doing
+        except ValueError as small:             # too small as given: not the resize's doing
+            raise ValueError(f'{path}: {small}') from None
         need = str(exc).partition('too small: ')[2] or str(exc)
         raise ValueError(f'{path}: --max-side {max_side} resized it from {given[0]}x{given[1]} '
                          f'to {searched[0]}x{searched[1]} px, too small: {need} (give a larger '
@@ -848,7 +857,12 @@ def run(args) -> int:
         check_many_settings(replace(settings, targets='many'))
     if args.plot:
         plot_format(args.plot)
-    images = expand_inputs(args.images)
+    skipped = []
+    images = expand_inputs(args.images, skipped)
+    for folder, names in skipped:
+        _note(f'{folder}: {len(names)} file{"s" * (len(names) > 1)} not named as an image '
+              f'skipped ({", ".join(names[:3])}{", ..." * (len(names) > 3)}; name one to '
+              f'search it)')
     if not images:
         raise ValueError(f'no image files in {", ".join(args.images)}')
     plots = plot_paths(args.plot, len(images)) if args.plot else []
