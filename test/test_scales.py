@@ -473,6 +473,20 @@ class _Shaded(_Blobs):
         return np.array(out, dtype=float).reshape(-1, 5)
 
 
+def _shaded_pass(fovea, table, dim, bright):
+    """Run the pass over 1600x1200 with dim (weak) and bright (strong) squares, (y, x): side."""
+    image = np.zeros((1200, 1600, 3), dtype=np.uint8)
+    for squares, level in ((dim, 160), (bright, 255)):
+        for (y, x), side in squares.items():
+            image[y:y + side, x:x + side] = level
+    prior = prior_log_odds(fovea.grid.n_cells, cell_prior(fovea.grid.n_cells, 0.5))
+    sensor = search._Coarse(fovea, table, (1600, 1200), prior, 0.99, budget=1600 * 1200)
+    sensor.detector = _Shaded()
+    sensor.start(image)
+    frame = sensor.scan()
+    return sensor, prior + frame.values, frame
+
+
 def test_a_crowd_seen_faintly_sends_the_whole_image_past_the_budget_once(yunet_420):
     _, fovea = yunet_420
     whole = (0, 0, 1600, 1200)
@@ -489,16 +503,7 @@ def test_a_crowd_seen_faintly_sends_the_whole_image_past_the_budget_once(yunet_4
     bright = {(100, 100): 80, **{(900, 300 + 400 * k): 20 for k in range(3)}}
 
     def run(dim):
-        image = np.zeros((1200, 1600, 3), dtype=np.uint8)
-        for squares, level in ((dim, 160), (bright, 255)):
-            for (y, x), side in squares.items():
-                image[y:y + side, x:x + side] = level
-        prior = prior_log_odds(fovea.grid.n_cells, cell_prior(fovea.grid.n_cells, 0.5))
-        sensor = search._Coarse(fovea, table, (1600, 1200), prior, 0.99, budget=1600 * 1200)
-        sensor.detector = _Shaded()
-        sensor.start(image)
-        frame = sensor.scan()
-        return sensor, prior + frame.values, frame
+        return _shaded_pass(fovea, table, dim, bright)
     sensor, posterior, frame = run(dim)
     assert [scale for rect, scale, _ in sensor.looks if rect == whole] == [0.25, 1.0]
     calls = 400 * 300 + 1600 * 1200                         # and the enlarged looks at the dim
@@ -557,16 +562,7 @@ def test_a_crowd_seen_faintly_after_a_step_within_the_budget_reads_the_row_that_
     bright = {(100, 100): 60, **{(900, 300 + 400 * k): 20 for k in range(3)}}
 
     def run(dim):
-        image = np.zeros((1200, 1600, 3), dtype=np.uint8)
-        for squares, level in ((dim, 160), (bright, 255)):
-            for (y, x), side in squares.items():
-                image[y:y + side, x:x + side] = level
-        prior = prior_log_odds(fovea.grid.n_cells, cell_prior(fovea.grid.n_cells, 0.5))
-        sensor = search._Coarse(fovea, table, (1600, 1200), prior, 0.99, budget=1600 * 1200)
-        sensor.detector = _Shaded()
-        sensor.start(image)
-        frame = sensor.scan()
-        return sensor, prior + frame.values, frame
+        return _shaded_pass(fovea, table, dim, bright)
     cells = [fovea.grid.index(int((y + s / 2) * 21 / 1200), int((x + s / 2) * 21 / 1600))
              for (y, x), s in bright.items()]
     sensor, posterior, _ = run(dim)
