@@ -682,13 +682,14 @@ class _Coarse(_Recorder):
         """Return the detector pixels of a whole-image call at ``scale``."""
         return math.prod(scaled_size(*self.image_px, scale))
 
-    def _may_read(self, cost: int, spent: int) -> bool:
+    def _may_read(self, scale: float, spent: int) -> bool:
         """
-        Say whether a whole-image call of ``cost`` pixels may follow ``spent`` ones.
+        Say whether a whole-image call at ``scale`` may follow ``spent`` pixels.
 
         Within the budget, always; past it once per image, if the call alone fits the budget
         (the detector alone at that scale; :attr:`overrun` says a call has passed it).
         """
+        cost = self._whole_px(scale)
         return spent + cost <= self.budget or (not self.overrun and cost <= self.budget)
 
     def _look(self, rect, scale, spent: int = 0):
@@ -786,7 +787,7 @@ class _Coarse(_Recorder):
                 seen_well and smallest * scale >= self.table.row(scale).min_side_px):
             # a crowd's step the budget refuses, for faces this call saw only faintly or
             # smaller than its table row sees (so it missed more of them): past the budget once
-            finer = [r for r in rows if self._may_read(self._whole_px(r.scale), spent)]
+            finer = [r for r in rows if self._may_read(r.scale, spent)]
         if not finer:
             return None
         if seen_well:
@@ -805,7 +806,7 @@ class _Coarse(_Recorder):
             # budget once (a finer row the budget allows would leave them unseen and decided
             # empty)
             step = next((r for r in rows if want * r.scale >= r.min_side_px
-                         and self._may_read(self._whole_px(r.scale), spent)), None)
+                         and self._may_read(r.scale, spent)), None)
         return (step if step is not None else finer[-1]).scale, (want if blind else smallest)
 
     def _finer_for_faint_faces(self, strong, weak, scale: float, spent: int = 0):
@@ -830,7 +831,7 @@ class _Coarse(_Recorder):
                 box_sides(strong) < self.crowd_ratio * self.min_face):
             return None
         finer = [r for r in self.table.rows if r.scale > scale * (1 + SCALE_RTOL)
-                 and self._may_read(self._whole_px(r.scale), spent)]
+                 and self._may_read(r.scale, spent)]
         if not finer:
             return None
         smallest = float(np.min(faint))
@@ -886,7 +887,7 @@ class _Coarse(_Recorder):
             # and the steps from there; at most once, since its strong boxes then hold the
             # crop's faces
             if len(strong) or not len(small) or at <= scale * (1 + SCALE_RTOL) \
-                    or not self._may_read(self._whole_px(at), pixels):
+                    or not self._may_read(at, pixels):
                 break
             self.overrun |= pixels + self._whole_px(at) > self.budget
             found, weak, spent = self._look(whole, at, pixels)
