@@ -96,7 +96,8 @@ def test_find_all_one_target_loop_finds_the_faces_of_a_group_photo_then_no_more(
                       '--json', out)
     assert result.returncode == 0, result.stderr
     entries = json.loads(out.read_text())['images']
-    assert [e['face'] for e in entries] == list(range(len(entries)))
+    assert [e['face'] for e in entries[:-1]] == list(range(len(entries) - 1))
+    assert entries[-1]['search'] == len(entries) - 1 and 'face' not in entries[-1]
     lines = result.stdout.strip().splitlines()
     assert all(f'face={k} decision=found' in line for k, line in enumerate(lines[:-1]))
     assert f'search={len(lines) - 1} decision=' in lines[-1] and 'face=' not in lines[-1]

@@ -226,8 +226,9 @@ def add_parser(sub):
                         'map_probability, absent_probability, stop, method, note, '
                         'resized_from, grid, and with --targets many faces: [{box [x, y, w, h], '
                         'cell [row, col], probability}]}]} in input order (--all --targets one: '
-                        'one entry per face, with "face", then the last decision; an input '
-                        'that could not be searched: {path, error}); "-" writes it to stdout '
+                        'one entry per face, with "face": K, then the last search, with '
+                        '"search": K, as the lines; an input that could not be searched: '
+                        '{path, error}); "-" writes it to stdout '
                         '(the lines then go to stderr)')
     p.add_argument('--max-side', type=nonneg_int, default=MAX_SIDE_PX, metavar='PX',
                    help='resize an image longer than this on a side before the search '
@@ -926,7 +927,8 @@ def run(args) -> int:
             print(format_line(path, result, k if args.all and not many else None, occupancy),
                   file=out, flush=True)
             extra = ({'faces': [face.to_dict() for face in result.faces]} if many else
-                     {'face': k} if args.all else {})
+                     {} if not args.all else
+                     {'face': k} if result.decision == 'found' else {'search': k})
             entries.append({**entry(path, result, grid, settings.confidence), **extra})
         logs.append(json.dumps({'path': path, 'events': [e for r in results for e in r.log]}))
         if plots:
