@@ -244,3 +244,32 @@ def test_a_count_the_null_rules_out_is_still_a_frame_with_scales():
     counts[4] = 2.0
     assert session.update(Frame(counts)).applied
     assert np.all(np.isfinite(session.belief)) and session.map_cell == 4
+
+
+@pytest.mark.parametrize('seed', range(2))
+def test_one_factor_scales_the_false_alarm_rates_as_the_brute_force_posterior(seed):
+    rng = np.random.default_rng(20 + seed)
+    grid, model = _model(rng)
+    settings = SearchSettings(confidence=0.999999, absent_prior=0.3, false_alarm_scales=[1.5])
+    session = SearchSession(grid, model, None, settings)
+    session.reset(seed=0)
+    session.start()
+    frames = []
+    for _ in range(4):
+        counts = rng.integers(0, 3, size=grid.n_cells).astype(float)
+        frames.append((session.fixation, counts))
+        assert session.update(Frame(counts)).applied
+        session.fixate(int(rng.integers(grid.n_cells)))
+    expected = _brute_posterior(model, frames, (1.5,), 0.3)
+    assert session.belief == pytest.approx(expected[:-1], rel=1e-9, abs=1e-12)
+    assert not np.allclose(expected, _brute_posterior(model, frames, (1.0,), 0.3))
+
+
+def test_one_factor_other_than_one_is_refused_where_scales_are():
+    from ipomdp_gaze.model.fpoc import make_fpoc
+    from ipomdp_gaze.search.many import check_many_settings
+    with pytest.raises(ValueError, match='does not model false-alarm scales'):
+        check_many_settings(SearchSettings(targets='many', false_alarm_scales=[2.0]))
+    with pytest.raises(ValueError, match='search.false_alarm_scales needs a count model'):
+        SearchSession(Grid(5, 5, 1.0), make_fpoc('human'), None,
+                      SearchSettings(false_alarm_scales=[2.0]))

@@ -207,6 +207,10 @@ def test_bad_kernel_is_rejected_and_the_old_one_stays(probe, cam, bad, words):
     ({'fpoc.dprime': -2.0}, 'dprime must be finite and > 0'),
     ({'policy.action': 'softmax'}, 'policy.action must be one of'),
     ({'trajectory_topic': 'bad topic'}, 'trajectory_topic'),
+    # a substitution rcl does not know is refused, not half-applied
+    ({'forward_command_topic': '/x{y}'}, 'forward_command_topic: topic name'),
+    ({'trajectory_topic': '~/cmd{x}'}, 'unknown substitution: {x}'),
+    ({'search.false_alarm_scales': [2.0]}, 'needs a count model'),
     ({'search.view_time_s': 0.0}, 'search.view_time_s must be finite and > 0'),
     # settings the model cannot serve are refused before any of them applies
     ({'search.false_alarm_scales': [1.0, 2.0]}, 'needs a count model'),

@@ -62,10 +62,11 @@ from ipomdp_gaze.search.gaze import FrameSequence, STAMP_TOLERANCE_S
 from ipomdp_gaze.search.health import HealthMonitor
 from ipomdp_gaze.search.room import MAX_PERIOD_S, Person, RoomWatch
 from rclpy.exceptions import NameValidationException
+from rclpy.expand_topic_name import expand_topic_name
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
-from rclpy.validate_topic_name import validate_topic_name
+from rclpy.validate_full_topic_name import validate_full_topic_name
 from sensor_msgs.msg import Image, JointState
 from std_msgs.msg import Float32MultiArray, Float64MultiArray, Int32MultiArray
 from std_srvs.srv import SetBool, Trigger
@@ -252,10 +253,14 @@ class GazeControllerNode(QuietPublishers, Node):
         cfg = build_config(values, build_policy, changed, previous)
         for name in ('forward_command_topic', 'trajectory_topic'):
             if values[name]:
+                # expanded as the publisher will be ({node}, ~), so that an unknown
+                # substitution is refused here and not when the old publisher is gone
                 try:
-                    validate_topic_name(values[name])
-                except NameValidationException as exc:
-                    raise ValueError(f'{name}: {exc}') from None
+                    validate_full_topic_name(expand_topic_name(
+                        values[name], self.get_name(), self.get_namespace()))
+                except (NameValidationException, ValueError) as exc:
+                    reason = str(exc).split(', at ')[0]
+                    raise ValueError(f'{name}: {reason}') from None
         return cfg
 
     def _startup_config(self) -> Config:

@@ -69,8 +69,9 @@ from ipomdp_gaze.model.occupancy import (binary_entropy, cell_prior, count_faces
                                          predict_occupancy, prior_log_odds)
 from ipomdp_gaze.model.still_evidence import StillEvidence
 from ipomdp_gaze.search.session import (check_groups, check_offsets, Frame, motion_settings,
-                                        OrderError, position_settings, SearchSettings,
-                                        start_index, StepResult, target_motion, track_filter)
+                                        OrderError, position_settings, scales_false_alarms,
+                                        SearchSettings, start_index, StepResult, target_motion,
+                                        track_filter)
 from ipomdp_gaze.search.tracks import GLANCE, Tracks, Turns
 import numpy as np
 from scipy.ndimage import maximum_filter
@@ -87,7 +88,7 @@ def check_many_settings(settings: SearchSettings) -> None:
         raise ValueError(f'search.targets many decides each cell at the confidence either way, '
                          f'so it must be above 0.5 (got {settings.confidence:g})')
     still_hotspots = settings.hotspot_prior > 0 and not settings.moving
-    if len(settings.false_alarm_scales) > 1 or still_hotspots:
+    if scales_false_alarms(settings) or still_hotspots:
         raise ValueError('search.targets many does not model false-alarm scales, nor hotspots '
                          'of a still scene: leave search.false_alarm_scales [1.0], and '
                          'search.hotspot_prior 0 unless the targets move')

@@ -109,7 +109,12 @@ def motion_settings(settings: SearchSettings) -> tuple:
 
 
 def _wants_mixture(settings: SearchSettings) -> bool:
-    return len(settings.false_alarm_scales) > 1 or settings.hotspot_prior > 0
+    return scales_false_alarms(settings) or settings.hotspot_prior > 0
+
+
+def scales_false_alarms(settings: SearchSettings) -> bool:
+    """Say whether the settings scale the model's false-alarm rates (any factors but [1.0])."""
+    return settings.false_alarm_scales != (1.0,)
 
 
 def _check_mixture_model(settings: SearchSettings, observation) -> None:
@@ -120,7 +125,7 @@ def _check_mixture_model(settings: SearchSettings, observation) -> None:
                          f'target')
     if not _wants_mixture(settings) or isinstance(observation, CountObservation):
         return
-    name = 'false_alarm_scales' if len(settings.false_alarm_scales) > 1 else 'hotspot_prior'
+    name = 'false_alarm_scales' if scales_false_alarms(settings) else 'hotspot_prior'
     raise ValueError(f'{PARAMETER_NAMES[name]} needs a count model '
                      f'(observation.model: counts); this search uses '
                      f'{getattr(observation, "name", type(observation).__name__)}')
