@@ -14,6 +14,7 @@ import argparse
 import importlib
 import os
 import sys
+import warnings
 
 from ipomdp_gaze.files.share_files import package_version
 
@@ -49,6 +50,16 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _one_line_warnings(command: str, default):
+    """Return a ``warnings.showwarning`` that prints the package's own warnings in one line."""
+    def show(message, category, filename, lineno, file=None, line=None):
+        if category.__module__.startswith('ipomdp_gaze'):
+            print(f'ipomdp-gaze {command}: warning: {message}', file=sys.stderr)
+        else:
+            default(message, category, filename, lineno, file, line)
+    return show
+
+
 def main(argv=None) -> int:
     """Entry point of the console script."""
     parser = build_parser()
@@ -57,6 +68,7 @@ def main(argv=None) -> int:
         parser.print_help(sys.stderr)       # a bare command: what there is to run
         return 2
     args = parser.parse_args(argv)
+    warnings.showwarning = _one_line_warnings(args.command, warnings.showwarning)
     try:
         return int(args.run(args) or 0)
     except BrokenPipeError:

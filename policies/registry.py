@@ -21,7 +21,7 @@ class PolicyUnavailable(ValueError):
     """A policy that cannot be built here: a policy file or module that does not exist."""
 
 
-def build_policy(name: str, grid, model, kernel=None, file: str = '', action: str = 'argmax',
+def build_policy(name: str, grid, model, kernel=None, file: str = '', action: str | None = None,
                  warn=None):
     """
     Build the policy called ``name`` (one of :data:`POLICY_NAMES`).
@@ -30,8 +30,9 @@ def build_policy(name: str, grid, model, kernel=None, file: str = '', action: st
     NMPT's fixed policy (:class:`ipomdp_gaze.policies.nmpt.NMPTPolicy`; it always samples).
     ``learned`` uses ``kernel`` (a convolutional kernel, 2-D or row-major) when it is non-empty,
     else the policy ``file`` (a policy YAML path or a shipped kernel name); ``action``
-    (``argmax`` or ``sample``) applies to it. A file trained on another FPOC is accepted and
-    ``warn(message)`` is called; one for another grid is refused.
+    (``argmax`` or ``sample``) applies to it (None: the file's own rule; a kernel: argmax). A
+    file trained on another FPOC is accepted and ``warn(message)`` is called; one for another
+    grid is refused.
 
     Raises
     ------
@@ -43,7 +44,8 @@ def build_policy(name: str, grid, model, kernel=None, file: str = '', action: st
         grid (:class:`ipomdp_gaze.policies.policy_file.PolicyFileError` is a ValueError).
 
     """
-    check_action(action)
+    if action is not None:
+        check_action(action)
     if name in STRATEGIES:
         try:
             return make_baseline(name, grid, model)
@@ -56,7 +58,7 @@ def build_policy(name: str, grid, model, kernel=None, file: str = '', action: st
     if name != 'learned':
         raise ValueError(f"unknown policy {name!r}; valid policies: {', '.join(POLICY_NAMES)}")
     if kernel is not None and len(kernel):
-        return ConvPolicy(grid, kernel, action=action, what='policy.kernel')
+        return ConvPolicy(grid, kernel, action=action or 'argmax', what='policy.kernel')
     if not file:
         raise ValueError("policy 'learned' needs policy.kernel or policy.file")
     try:

@@ -203,7 +203,12 @@ def elm_init(grid: Grid, model, scale: float) -> np.ndarray:
     kernel = as_observation(grid, model).elm_kernel()
     weight = np.bincount(bins.ravel(), weights=kernel.ravel(), minlength=values.size) \
         / np.bincount(bins.ravel(), minlength=values.size)
-    return scale * weight
+    with np.errstate(over='ignore'):
+        params = scale * weight
+    if not np.all(np.isfinite(params)):
+        raise ValueError(f'the ELM initialisation scale {scale:g} makes the kernel overflow: '
+                         'give a smaller one')
+    return params
 
 
 def sample_episodes(theta: np.ndarray, model, reward: str, episodes: int,

@@ -200,3 +200,80 @@ def test_search_plot_title_says_how_the_search_ended(monkeypatch, tmp_path):
                  str(tmp_path / 's.png')]) == 0
     assert re.fullmatch(r'7x7, human FPOC, elm\ngave up at the fixation budget, p=0\.\d{3}, 2 '
                         r'fixations \(star = target\)', titles[0]), titles
+
+
+def _kernel_file(path, action='argmax'):
+    """Write the shipped 7x7 kernel to ``path`` with its action rule set to ``action``."""
+    import yaml
+    from ipomdp_gaze.policies.policy_file import resolve_source
+    spec = yaml.safe_load(resolve_source('human-7x7-infomax').read_text())
+    spec['action'] = action
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(yaml.safe_dump(spec))
+    return path
+
+
+def test_two_policy_rows_of_one_name_are_refused_before_any_episode(tmp_path):
+    first = _kernel_file(tmp_path / 'a' / 'pol.yaml')
+    second = _kernel_file(tmp_path / 'b' / 'pol.yaml')
+    elm = _kernel_file(tmp_path / 'elm.yaml')
+    for args, words in ((['--policy-file', first, '--policy-file', second],
+                         f"--policy-file {second}: its row would be named 'pol', as "
+                         f"--policy-file {first}'s"),
+                        (['--policy', 'elm', '--policy-file', elm],
+                         "named 'elm', as --policy elm's")):
+        out = run_cli('evaluate', '--episodes', '50', *map(str, args))
+        assert out.returncode == 2 and words in out.stderr and not out.stdout
+        assert 'Traceback' not in out.stderr
+
+
+def test_a_policy_file_that_samples_is_sampled_by_search_and_evaluate(tmp_path):
+    argmax = _kernel_file(tmp_path / 'argmax.yaml')
+    sample = _kernel_file(tmp_path / 'sample.yaml', 'sample')
+    searches = [run_cli('search', '--policy-file', str(path), '--seed', '2').stdout
+                for path in (argmax, sample, argmax)]
+    assert searches[0] == searches[2] != searches[1]
+    from ipomdp_gaze.model.grid import Grid
+    from ipomdp_gaze.model.fpoc import make_fpoc
+    from ipomdp_gaze.policies.registry import build_policy
+    grid = Grid(7, 7, 0.42)
+    assert build_policy('learned', grid, make_fpoc('human'), file=str(sample)).action == 'sample'
+    assert build_policy('learned', grid, make_fpoc('human'), file=str(sample),
+                        action='argmax').action == 'argmax'
+
+
+@pytest.mark.parametrize('args, words', [
+    (['evaluate', '--grid', '7x7', '--policy', 'greedy', '--json', '{dir}'],
+     '--json {dir}: is a directory'),
+    (['evaluate', '--json', '-'], '--json -: evaluate prints its table to stdout'),
+    (['search', '--plot', '{dir}/a.txt'], '--plot {dir}/a.txt: the extension names no format'),
+    (['search', '--plot', '{dir}/noext'], 'the extension names no format'),
+    (['calibrate', '--scenes', '3', '--out', '{dir}/good.yaml', '--plot', '{dir}/x.txt'],
+     '--plot {dir}/x.txt: the extension names no format'),
+    (['train', '--out', '{dir}/f.csv/x.yaml', '--epochs', '1'],
+     '--out {dir}/f.csv/x.yaml: {dir}/f.csv is not a folder'),
+    (['train', '--resume', 'human-7x7-infomax', '--epochs', '1600'],
+     '--resume human-7x7-infomax: give --out PATH.yaml'),
+    (['train', '--seeds', '1,1', '--out', '{dir}/t.yaml', '--epochs', '1'], 'each value once'),
+    (['reproduce', '--out', '{dir}/rep', '--cache', '{dir}/f.csv', '--episodes', '50'],
+     '--cache {dir}/f.csv: {dir}/f.csv is not a folder'),
+    (['evaluate', '--scenes', 'pan-tilt', '--faces', '2', '--episodes', '1', '--policy', 'map'],
+     '--faces rooms are searched by the many-target session'),
+])
+def test_an_output_or_option_that_cannot_serve_is_refused_before_any_work(tmp_path, args,
+                                                                          words):
+    (tmp_path / 'f.csv').write_text('epoch\n')
+    out = run_cli(*[a.format(dir=tmp_path) for a in args])
+    assert out.returncode == 2, out.stderr
+    assert words.format(dir=tmp_path) in out.stderr.strip().splitlines()[-1]
+    assert 'Traceback' not in out.stderr and not out.stdout
+    assert sorted(p.name for p in tmp_path.iterdir()) == ['f.csv']      # nothing written
+
+
+def test_a_search_without_a_budget_that_reaches_its_cap_says_it_gave_up():
+    out = run_cli('search', '--grid', '3x3', '--fpoc-param', 'foveal_dprime=0.01', '--seed', '1',
+                  '--max-fixations', '0')
+    assert out.returncode == 0, out.stderr
+    last = out.stdout.strip().splitlines()[-1]
+    assert last.startswith('gave up: no cell reached the confidence 0.95 after 900 fixations, '
+                           'the cap of an offline search without a budget (100 per cell)')

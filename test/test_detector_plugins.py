@@ -129,7 +129,8 @@ def test_the_factory_builds_shipped_and_outside_detectors_by_name(on_path):
         make_detector('no_such_module:Thing')
     with pytest.raises(ValueError, match="module 'blobdet' has no 'Nothing'"):
         make_detector('blobdet:Nothing')
-    with pytest.raises(ValueError, match='bad options'):
+    with pytest.raises(ValueError, match="detector 'blob' has no option 'colour' "
+                                         r'\(its options: min_red\)'):
         make_detector('blob', colour='red')
     with pytest.raises(ValueError, match='min_red 120 but the detector has 150'):
         from ipomdp_gaze.vision.detectors import compare_settings

@@ -35,7 +35,7 @@ import time
 from ipomdp_gaze.model.grid import Grid
 import numpy as np
 
-from .common import grid_arg, nonneg_int, positive_float, positive_int
+from .common import check_output_file, grid_arg, nonneg_int, positive_float, positive_int
 from .running import add_run_args, executor_from_args, progress_from_args
 
 # The two tasks of the face issue: image side and face sizes in pixels.
@@ -387,6 +387,11 @@ def run(args) -> int:
     from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig
     if args.out.suffix != '.yaml':
         raise ValueError(f'--out must end in .yaml, got {args.out}')
+    check_output_file('--out', args.out)
+    if args.plot is not None:
+        check_output_file('--plot', args.plot, plot=True)
+    else:
+        check_output_file('--out', args.out.with_suffix('.png'))
     _check_options(args)
     if args.pan_tilt:
         return run_pan_tilt(args)

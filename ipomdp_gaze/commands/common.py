@@ -1,11 +1,14 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""Argument helpers shared by the subcommands: grid, FPOC and policy selection."""
+"""Argument helpers shared by the subcommands: grid, FPOC, policy selection and outputs."""
 from __future__ import annotations
 
 import argparse
 import math
+import os
+from pathlib import Path
 
+from ipomdp_gaze.files.writable import folder_writable
 from ipomdp_gaze.model.fpoc import make_fpoc, MODELS, parameter_names
 from ipomdp_gaze.model.grid import Grid, parse_grid
 from ipomdp_gaze.model.observation import MATRIX_MAX_CELLS
@@ -203,3 +206,52 @@ def task_from_args(args) -> tuple[Grid, object]:
             raise ValueError(f'unknown FPOC parameter {name!r} for {args.fpoc!r}; valid: '
                              f"{', '.join(names)}")
     return grid, make_fpoc(args.fpoc, **params)
+
+
+def check_output_file(flag: str, path: Path, plot: bool = False) -> Path:
+    """
+    Refuse, before any work, an output file that cannot be written: one line naming ``flag``.
+
+    The path must not be a folder, and must sit in a folder that exists or can be made (no
+    file on the way) and takes a new file; an existing file must be writable. ``plot``: the
+    extension must name a format matplotlib writes (:func:`plot_format`).
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise ValueError(f'{flag} {path}: is a directory')
+    if plot:
+        plot_format(path, flag)
+    check_output_folder(flag, path.parent, path)
+    if path.exists() and not os.access(path, os.W_OK):
+        raise ValueError(f'{flag} {path}: not writable')
+    return path
+
+
+def check_output_folder(flag: str, folder: Path, named: Path | None = None) -> Path:
+    """
+    Refuse, before any work, a folder to write in that cannot be: one line naming ``flag``.
+
+    Its first existing ancestor (the rest is made when written) must be a folder that takes a
+    new file. ``named``: the path the message names (default ``folder``).
+    """
+    named = Path(folder) if named is None else named
+    existing = Path(folder)
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if not existing.is_dir():
+        raise ValueError(f'{flag} {named}: {existing} is not a folder')
+    if not folder_writable(existing):
+        raise ValueError(f'{flag} {named}: not writable')
+    return Path(folder)
+
+
+def plot_format(path: Path, flag: str = '--plot') -> Path:
+    """Check that matplotlib writes the format ``path``'s extension names (ValueError if not)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    formats = FigureCanvasAgg(Figure()).get_supported_filetypes()
+    suffix = path.suffix.lower().lstrip('.')
+    if suffix not in formats:
+        raise ValueError(f'{flag} {path}: the extension names no format matplotlib writes '
+                         f'(use one of {", ".join("." + k for k in sorted(formats))})')
+    return path

@@ -38,7 +38,8 @@ from ipomdp_gaze.vision.walks import DURATION_S as WALK_DURATION_S
 from ipomdp_gaze.vision.walks import SPEED_DEG_S as WALK_SPEED_DEG_S
 import numpy as np
 
-from .common import add_task_args, bootstrap_count, nonneg_int, positive_int, task_from_args
+from .common import (add_task_args, bootstrap_count, check_output_file, nonneg_int,
+                     positive_int, task_from_args)
 from .running import add_run_args, executor_from_args, progress_from_args
 from .search_args import add_scene_args, add_search_args, settings_from_args
 
@@ -125,8 +126,20 @@ def add_parser(sub):
 
 
 def load_policies(args, grid, fpoc) -> dict:
-    """Name -> policy for every ``--policy`` and ``--policy-file``."""
-    policies = {}
+    """
+    Name -> policy for every ``--policy`` and ``--policy-file`` (a file's row: its stem).
+
+    Two rows of one name are refused (ValueError naming both), so that no row replaces another.
+    """
+    policies, given = {}, {}
+    sources = [(name, f'--policy {name}') for name in
+               args.policy or ([] if args.policy_file else ['map'])]
+    sources += [(path.stem, f'--policy-file {path}') for path in args.policy_file]
+    for name, source in sources:
+        if name in given:
+            raise ValueError(f"{source}: its row would be named {name!r}, as {given[name]}'s "
+                             "(a file's row is named by its stem): give them different names")
+        given[name] = source
     for name in args.policy or ([] if args.policy_file else ['map']):
         policies[name] = build_policy(name, grid, fpoc)
     for path in args.policy_file:
@@ -299,6 +312,10 @@ def run_scenes(args) -> int:
                                              ('absent_prior', args.absent_prior))
                if value is not None}
     spec = replace(spec, settings=replace(spec.settings, **changes))
+    if spec.rooms and (args.policy or args.policy_file):
+        raise ValueError('--faces rooms are searched by the many-target session, which chooses '
+                         'its views by its own infomax: no --policy or --policy-file (other '
+                         'searchers: --compare)')
     episodes = args.episodes or 200
     if args.empty_scenes and args.scenes != 'pan-tilt':
         raise ValueError('--empty-scenes is for --scenes pan-tilt')
@@ -402,6 +419,10 @@ def _pieces(args, policies) -> int:
 
 def run(args) -> int:
     check_settings(args)
+    if args.json is not None:
+        if str(args.json) == '-':
+            raise ValueError('--json -: evaluate prints its table to stdout; give --json a file')
+        check_output_file('--json', args.json)
     faces = parse_faces(args.faces)          # one line for a bad K or LO-HI, before any work
     if faces != (1, 1) and args.scenes != 'pan-tilt':
         raise ValueError('--faces is for --scenes pan-tilt')

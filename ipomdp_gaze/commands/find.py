@@ -96,13 +96,11 @@ from __future__ import annotations
 from dataclasses import replace
 import json
 import math
-import os
 from pathlib import Path
 import sys
 
 import cv2
 from ipomdp_gaze.files.observation_file import load_observation, shipped_image_models
-from ipomdp_gaze.files.writable import folder_writable
 from ipomdp_gaze.model.belief import uniform_log_belief
 from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
@@ -120,7 +118,7 @@ from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, clip_b
                                        size_distance)
 import numpy as np
 
-from .common import nonneg_int, positive_float
+from .common import check_output_file, nonneg_int, plot_format, positive_float
 from .search_args import add_search_args, settings_from_args, TASK_DEFAULT
 
 POLICY_CHOICES = tuple(name for name in POLICY_NAMES if name != 'learned')
@@ -453,18 +451,6 @@ def expand_inputs(paths: list[str], skipped: list | None = None) -> list[str]:
         else:
             out.append(path)
     return out
-
-
-def plot_format(path: Path) -> Path:
-    """Check that matplotlib writes the format ``path``'s extension names (ValueError if not)."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-    formats = FigureCanvasAgg(Figure()).get_supported_filetypes()
-    suffix = path.suffix.lower().lstrip('.')
-    if suffix not in formats:
-        raise ValueError(f'--plot {path}: the extension names no format matplotlib writes '
-                         f'(use one of {", ".join("." + k for k in sorted(formats))})')
-    return path
 
 
 def _cell_text(result) -> str:
@@ -813,13 +799,7 @@ def check_outputs(args, images: list[str], plots: list[Path]) -> None:
         if resolved in seen:
             raise ValueError(f'{flag} {path}: {seen[resolved]} writes the same file')
         seen[resolved] = flag
-        folder = path.parent
-        while not folder.exists():               # made when the file is written
-            folder = folder.parent
-        if not folder.is_dir():
-            raise ValueError(f'{flag} {path}: {folder} is not a folder')
-        if not folder_writable(folder) or (path.exists() and not os.access(path, os.W_OK)):
-            raise ValueError(f'{flag} {path}: not writable')
+        check_output_file(flag, path)
 
 
 def _check_size(path: str, image: np.ndarray, given: tuple, fovea, max_side: int) -> None:

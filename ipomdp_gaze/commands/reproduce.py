@@ -23,10 +23,14 @@ from ipomdp_gaze.policies.conv import radial_bins
 from ipomdp_gaze.policies.planner import make_planner, TemperedELM
 import numpy as np
 
-from .common import bootstrap_count, nonneg_int, positive_int
+from .common import bootstrap_count, check_output_folder, nonneg_int, positive_int
 from .running import add_run_args, executor_from_args, progress_from_args
 
 ROOT = Path(__file__).resolve().parents[2]
+# The shipped run's options (docs/reproduction.md); the notes quote numbers of this run.
+DEFAULTS = {'episodes': 20000, 'episodes_greedy': 2000, 'episodes_planner': 2000, 'seed': 0,
+            'bootstrap': 1000}
+SHIPPED_RUN = ('episodes', 'episodes_greedy', 'episodes_planner', 'seed')
 KERNELS = ('human-7x7-infomax', 'human-11x11-infomax', 'human-11x11-fixate_target',
            'exponential-11x11-infomax', 'camera-11x11-infomax')
 PAPER_7X7 = {'learned infomax': 7.86, 'greedy': 8.96, 'map': 9.25, 'random': 11.33}
@@ -45,11 +49,11 @@ def add_parser(sub):
                        description='Reproduce Table I and Figs. 3-6 of Butko & Movellan (2008) '
                                    'from the shipped kernels with fixed seeds.')
     p.add_argument('--out', type=Path, default=ROOT / 'docs', help='output folder (default docs/)')
-    p.add_argument('--episodes', type=positive_int, default=20000)
-    p.add_argument('--episodes-greedy', type=positive_int, default=2000)
-    p.add_argument('--episodes-planner', type=positive_int, default=2000)
-    p.add_argument('--seed', type=nonneg_int, default=0)
-    p.add_argument('--bootstrap', type=bootstrap_count, default=1000)
+    p.add_argument('--episodes', type=positive_int, default=DEFAULTS['episodes'])
+    p.add_argument('--episodes-greedy', type=positive_int, default=DEFAULTS['episodes_greedy'])
+    p.add_argument('--episodes-planner', type=positive_int, default=DEFAULTS['episodes_planner'])
+    p.add_argument('--seed', type=nonneg_int, default=DEFAULTS['seed'])
+    p.add_argument('--bootstrap', type=bootstrap_count, default=DEFAULTS['bootstrap'])
     p.add_argument('--retrain', action='store_true', help='retrain every shipped kernel first')
     p.add_argument('--cache', type=Path, default=ROOT / '.cache' / 'reproduce', metavar='DIR',
                    help='keep every simulated piece here and reuse it while its inputs and the '
@@ -264,6 +268,9 @@ def _simulate_all(args, specs, pool, cache, log, progress=None):
 
 
 def run(args) -> int:
+    check_output_folder('--out', args.out)
+    if args.cache is not None:
+        check_output_folder('--cache', args.cache)
     out, figures = args.out, args.out / 'figures'
     figures.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
@@ -477,5 +484,14 @@ def _report(args, r7, r11, others, specs, planner_ms, curves):
               '![Fig. 3](figures/fig3_learning_curves.png)', '']
     notes = ROOT / 'docs' / 'reproduction_notes.md'
     if notes.exists():
+        shipped = {name: DEFAULTS[name] for name in SHIPPED_RUN}
+        given = {name: getattr(args, name) for name in SHIPPED_RUN}
+        if given != shipped:
+            lines += ['*The notes below quote the shipped run (' + ', '.join(
+                f'`--{name.replace("_", "-")} {value}`' for name, value in shipped.items())
+                + '); this run used ' + ', '.join(
+                f'`--{name.replace("_", "-")} {value}`' for name, value in given.items()
+                if value != shipped[name])
+                + ', and its own numbers are the tables and figures above.*', '']
         lines += [notes.read_text().rstrip(), '']
     return lines

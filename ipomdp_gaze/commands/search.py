@@ -13,11 +13,14 @@ from ipomdp_gaze.search.sensors import run_search as run_offline
 from ipomdp_gaze.search.session import SearchSession, SearchSettings
 import numpy as np
 
-from .common import add_task_args, cell_arg, cell_index, nonneg_int, task_from_args
+from .common import (add_task_args, cell_arg, cell_index, check_output_file, nonneg_int,
+                     task_from_args)
 from .search_args import add_search_args, settings_from_args
 
 # The paper's convention: the policy picks every fixation, the first included (design 4.1).
 SEARCH_SETTINGS = SearchSettings(confidence=0.95, start_cell='policy')
+# With no budget (--max-fixations 0) an offline search still ends: after this many frames per cell.
+NO_BUDGET_FRAMES_PER_CELL = 100
 
 
 def add_parser(sub):
@@ -34,15 +37,12 @@ def add_parser(sub):
     add_search_args(p, SEARCH_SETTINGS, ('confidence',))
     p.add_argument('--max-fixations', type=nonneg_int, default=None, metavar='N',
                    help='fixation budget: gave up when it runs out undecided (default 4 N; 0 = '
-                        'no budget)')
+                        f'no budget, but an offline search still gives up after '
+                        f'{NO_BUDGET_FRAMES_PER_CELL} N)')
     p.add_argument('--seed', type=nonneg_int, default=0)
     p.add_argument('--plot', type=Path, default=None, metavar='PNG',
                    help='save the final belief with the scan path as a picture')
     p.set_defaults(run=run)
-
-
-# With no budget (--max-fixations 0) an offline search still ends: after this many frames per cell.
-NO_BUDGET_FRAMES_PER_CELL = 100
 
 
 def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=print):
@@ -77,7 +77,12 @@ def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=
     verdict = 'right' if guess == target else 'wrong'
     clause = answer.confidence_clause(result.decision, result.reason, result.map_probability,
                                       settings.confidence)
-    if result.decision == 'gave_up':
+    if not result.decision:
+        out(f'gave up: no cell reached the confidence {settings.confidence:g} after '
+            f'{result.fixations} fixations, the cap of an offline search without a budget '
+            f'({NO_BUDGET_FRAMES_PER_CELL} per cell); the target is most likely at ({gr}, {gc}), '
+            f'probability {result.map_probability:.3f}, which is {verdict}')
+    elif result.decision == 'gave_up':
         out(f'gave up: no cell reached the confidence {settings.confidence:g} at '
             f'{answer.LIMITS.get(result.reason, result.reason)}; the target is most likely at '
             f'({gr}, {gc}), probability {result.map_probability:.3f}, after '
@@ -115,6 +120,8 @@ def plot_search(grid, belief, path, target, title, out_path):
 
 
 def run(args) -> int:
+    if args.plot:
+        check_output_file('--plot', args.plot, plot=True)
     grid, fpoc = task_from_args(args)
     if args.policy_file:
         policy = build_policy('learned', grid, fpoc, file=args.policy_file)

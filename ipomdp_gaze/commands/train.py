@@ -14,7 +14,8 @@ from pathlib import Path
 
 from ipomdp_gaze.search.session import SearchSettings
 
-from .common import add_task_args, nonneg_int, positive_float, positive_int, task_from_args
+from .common import (add_task_args, check_output_file, nonneg_int, positive_float, positive_int,
+                     task_from_args)
 from .running import add_run_args, executor_from_args, progress_from_args
 from .search_args import add_scene_args, settings_from_args
 
@@ -88,6 +89,8 @@ def _list(kind):
         values = [kind(item) for item in text.split(',') if item.strip()]
         if not values:
             raise argparse.ArgumentTypeError(f'expected a comma-separated list, got {text!r}')
+        if len(set(values)) != len(values):
+            raise argparse.ArgumentTypeError(f'each value once (one training each), got {text!r}')
         return values
     return parse
 
@@ -155,7 +158,12 @@ def run(args) -> int:
     if out is None:
         raise ValueError('--out PATH.yaml is required (or --resume PATH.yaml)')
     if out.suffix != '.yaml':
+        if args.out is None:
+            raise ValueError(f'--resume {args.resume}: give --out PATH.yaml for the resumed '
+                             'policy (it is written there, with its learning curve)')
         raise ValueError(f'--out must end in .yaml, got {out}')
+    check_output_file('--out', out)
+    check_output_file('--out', out.with_suffix('.csv'))
     grid, fpoc = _task(args, spec)
     overrides = {
         'learning_rate': args.learning_rate, 'anneal_epochs': args.anneal_epochs,
@@ -183,7 +191,11 @@ def run(args) -> int:
             if config.family != 'conv':
                 raise ValueError('--init-elm starts a conv kernel: use it with --family conv')
             from ipomdp_gaze.policies.training import elm_init
-            params, init = elm_init(grid, fpoc, args.init_elm), f'elm x {args.init_elm:g}'
+            try:
+                params = elm_init(grid, fpoc, args.init_elm)
+            except ValueError as exc:
+                raise ValueError(f'--init-elm {args.init_elm:g}: {exc}') from None
+            init = f'elm x {args.init_elm:g}'
         if sweep:
             return run_sweep(args, grid, fpoc, config, params, init, out)
         trainer = Trainer(grid, fpoc, config, params=params, init=init)

@@ -123,6 +123,18 @@ def _checked(detector, kind: str):
     return detector
 
 
+def _option_names(factory) -> set | None:
+    """Return the keyword options a factory takes (None: any, or its signature is unknown)."""
+    try:
+        parameters = inspect.signature(factory).parameters.values()
+    except (TypeError, ValueError):
+        return None
+    if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in parameters):
+        return None
+    return {p.name for p in parameters
+            if p.kind in (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)}
+
+
 def make_detector(kind: str = DEFAULT_KIND, **options):
     """
     Build a detector by kind with its own options, ``Factory(**options)``.
@@ -135,6 +147,11 @@ def make_detector(kind: str = DEFAULT_KIND, **options):
 
     """
     factory = load_factory(kind)
+    known = _option_names(factory)
+    unknown = sorted(set(options) - known) if known is not None else []
+    if unknown:
+        raise ValueError(f'detector {kind!r} has no option {", ".join(map(repr, unknown))} '
+                         f'(its options: {", ".join(sorted(known)) or "none"})')
     try:
         detector = factory(**options)
     except TypeError as exc:
