@@ -68,7 +68,13 @@ def main(argv=None) -> int:
         parser.print_help(sys.stderr)       # a bare command: what there is to run
         return 2
     args = parser.parse_args(argv)
-    warnings.showwarning = _one_line_warnings(args.command, warnings.showwarning)
+    with warnings.catch_warnings():
+        warnings.showwarning = _one_line_warnings(args.command, warnings.showwarning)
+        return _run(args)
+
+
+def _run(args) -> int:
+    """Run the parsed command; its errors as one line (exit 2)."""
     try:
         return int(args.run(args) or 0)
     except BrokenPipeError:

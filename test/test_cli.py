@@ -200,6 +200,10 @@ def test_search_plot_title_says_how_the_search_ended(monkeypatch, tmp_path):
                  str(tmp_path / 's.png')]) == 0
     assert re.fullmatch(r'7x7, human FPOC, elm\ngave up at the fixation budget, p=0\.\d{3}, 2 '
                         r'fixations \(star = target\)', titles[0]), titles
+    assert main(['search', '--grid', '3x3', '--fpoc-param', 'foveal_dprime=0.01', '--seed', '1',
+                 '--max-fixations', '0', '--plot', str(tmp_path / 's.png')]) == 0
+    assert titles[1].endswith('\ngave up at the cap of an offline search (100 per cell), '
+                              'p=0.118, 900 fixations (star = target)'), titles
 
 
 def _kernel_file(path, action='argmax'):
@@ -240,6 +244,27 @@ def test_a_policy_file_that_samples_is_sampled_by_search_and_evaluate(tmp_path):
     assert build_policy('learned', grid, make_fpoc('human'), file=str(sample)).action == 'sample'
     assert build_policy('learned', grid, make_fpoc('human'), file=str(sample),
                         action='argmax').action == 'argmax'
+    rows = run_cli('evaluate', '--policy-file', str(argmax), '--policy-file', str(sample),
+                   '--episodes', '400', '--seed', '1').stdout.splitlines()
+    argmax_row, sample_row = ([line.split()[2:] for line in rows if line.startswith(name)][0]
+                              for name in ('argmax ', 'sample '))
+    assert argmax_row != sample_row
+
+
+def test_the_packages_own_warnings_are_one_line_each():
+    out = run_cli('evaluate', '--grid', '7x7', '--spacing-deg', '1.0', '--policy-file',
+                  'human-7x7-infomax', '--episodes', '50')
+    assert out.returncode == 0, out.stderr
+    warned = [line for line in out.stderr.splitlines() if 'warning' in line.lower()]
+    assert len(warned) == 1 and warned[0].startswith('ipomdp-gaze evaluate: warning: ')
+    assert 'policy was trained at spacing_deg 0.42 but is used at 1.0' in warned[0]
+    assert 'PolicyFileWarning' not in out.stderr and 'check_task' not in out.stderr
+
+
+def test_a_plot_extension_in_capitals_is_written(tmp_path):
+    out = run_cli('search', '--grid', '5x5', '--seed', '1', '--plot', str(tmp_path / 'S.PNG'))
+    assert out.returncode == 0, out.stderr
+    assert (tmp_path / 'S.PNG').read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
 
 
 @pytest.mark.parametrize('args, words', [
@@ -255,6 +280,10 @@ def test_a_policy_file_that_samples_is_sampled_by_search_and_evaluate(tmp_path):
     (['train', '--resume', 'human-7x7-infomax', '--epochs', '1600'],
      '--resume human-7x7-infomax: give --out PATH.yaml'),
     (['train', '--seeds', '1,1', '--out', '{dir}/t.yaml', '--epochs', '1'], 'each value once'),
+    (['train', '--init-elm', '1e308', '--family', 'conv', '--epochs', '1', '--out',
+      '{dir}/x.yaml'], '--init-elm 1e+308: the ELM initialisation scale 1e+308 makes the '
+                       'kernel overflow: give a smaller one'),
+    (['evaluate', '--policy', 'map', '--policy', 'map'], '--policy map is given twice'),
     (['reproduce', '--out', '{dir}/rep', '--cache', '{dir}/f.csv', '--episodes', '50'],
      '--cache {dir}/f.csv: {dir}/f.csv is not a folder'),
     (['evaluate', '--scenes', 'pan-tilt', '--faces', '2', '--episodes', '1', '--policy', 'map'],

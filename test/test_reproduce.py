@@ -175,6 +175,12 @@ def test_the_report_is_the_same_on_one_or_two_processes_and_from_the_cache(tmp_p
     report = _tables(tmp_path / 'a' / 'reproduction.md')
     assert report == _tables(tmp_path / 'b' / 'reproduction.md')
     assert report == _tables(tmp_path / 'c' / 'reproduction.md')
+    # the notes quote the shipped run's numbers: a run of other options says so before them
+    text = (tmp_path / 'a' / 'reproduction.md').read_text()
+    assert ('*The notes below quote the shipped run (`--episodes 20000`, `--episodes-greedy '
+            '2000`, `--episodes-planner 2000`, `--seed 0`); this run used `--episodes 300`, '
+            '`--episodes-greedy 12`, `--episodes-planner 12`, and its own numbers are the '
+            'tables and figures above.*') in text
     assert sum(line.startswith('| rollout planner') for line in report) == 1
     for figure in ('fig3_learning_curves', 'fig4a_percent_correct', 'fig6_kernels_by_fpoc'):
         assert (tmp_path / 'a' / 'figures' / f'{figure}.png').stat().st_size > 0

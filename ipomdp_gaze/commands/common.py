@@ -221,9 +221,12 @@ def check_output_file(flag: str, path: Path, plot: bool = False) -> Path:
         raise ValueError(f'{flag} {path}: is a directory')
     if plot:
         plot_format(path, flag)
+    if path.exists():
+        # written in place (/dev/null in a folder nobody writes to, a file of one's own)
+        if not os.access(path, os.W_OK):
+            raise ValueError(f'{flag} {path}: not writable')
+        return path
     check_output_folder(flag, path.parent, path)
-    if path.exists() and not os.access(path, os.W_OK):
-        raise ValueError(f'{flag} {path}: not writable')
     return path
 
 

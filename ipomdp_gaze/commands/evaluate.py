@@ -52,7 +52,8 @@ def add_parser(sub):
                                    'policies; print a table and optionally write JSON.')
     add_task_args(p)
     p.add_argument('--policy', action='append', default=[], choices=NAMED_POLICIES,
-                   help='a baseline by name (repeatable)')
+                   help='a baseline by name (repeatable; default map when no --policy-file is '
+                        'given)')
     p.add_argument('--policy-file', action='append', default=[], type=Path, metavar='PATH',
                    help='a policy YAML file, keyed by its file stem (repeatable)')
     p.add_argument('--episodes', type=positive_int, default=None,
@@ -136,6 +137,8 @@ def load_policies(args, grid, fpoc) -> dict:
                args.policy or ([] if args.policy_file else ['map'])]
     sources += [(path.stem, f'--policy-file {path}') for path in args.policy_file]
     for name, source in sources:
+        if source == given.get(name):
+            raise ValueError(f'{source} is given twice: each row once')
         if name in given:
             raise ValueError(f"{source}: its row would be named {name!r}, as {given[name]}'s "
                              "(a file's row is named by its stem): give them different names")

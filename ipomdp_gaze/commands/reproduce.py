@@ -29,8 +29,8 @@ from .running import add_run_args, executor_from_args, progress_from_args
 ROOT = Path(__file__).resolve().parents[2]
 # The shipped run's options (docs/reproduction.md); the notes quote numbers of this run.
 DEFAULTS = {'episodes': 20000, 'episodes_greedy': 2000, 'episodes_planner': 2000, 'seed': 0,
-            'bootstrap': 1000}
-SHIPPED_RUN = ('episodes', 'episodes_greedy', 'episodes_planner', 'seed')
+            'bootstrap': 1000, 'retrain': False}
+SHIPPED_RUN = ('episodes', 'episodes_greedy', 'episodes_planner', 'seed', 'retrain')
 KERNELS = ('human-7x7-infomax', 'human-11x11-infomax', 'human-11x11-fixate_target',
            'exponential-11x11-infomax', 'camera-11x11-infomax')
 PAPER_7X7 = {'learned infomax': 7.86, 'greedy': 8.96, 'map': 9.25, 'random': 11.33}
@@ -487,11 +487,12 @@ def _report(args, r7, r11, others, specs, planner_ms, curves):
         shipped = {name: DEFAULTS[name] for name in SHIPPED_RUN}
         given = {name: getattr(args, name) for name in SHIPPED_RUN}
         if given != shipped:
-            lines += ['*The notes below quote the shipped run (' + ', '.join(
-                f'`--{name.replace("_", "-")} {value}`' for name, value in shipped.items())
-                + '); this run used ' + ', '.join(
-                f'`--{name.replace("_", "-")} {value}`' for name, value in given.items()
-                if value != shipped[name])
-                + ', and its own numbers are the tables and figures above.*', '']
+            def flags(values):
+                return ', '.join(f'`--{name.replace("_", "-")}`' if value is True else
+                                 f'`--{name.replace("_", "-")} {value}`'
+                                 for name, value in values.items() if value is not False)
+            lines += [f'*The notes below quote the shipped run ({flags(shipped)}); this run '
+                      f'used {flags({k: v for k, v in given.items() if v != shipped[k]})}, and '
+                      'its own numbers are the tables and figures above.*', '']
         lines += [notes.read_text().rstrip(), '']
     return lines

@@ -29,7 +29,8 @@ def add_parser(sub):
                                    'the policy looked, the belief at the most likely cell and '
                                    'whether that guess is right.')
     add_task_args(p)
-    p.add_argument('--policy', default='elm', choices=NAMED_POLICIES)
+    p.add_argument('--policy', default='elm', choices=NAMED_POLICIES,
+                   help='the policy by name (default elm)')
     p.add_argument('--policy-file', default=None, metavar='PATH',
                    help='a policy YAML file or a shipped kernel name (overrides --policy)')
     p.add_argument('--target', type=cell_arg, default=None, metavar='ROW,COL',
@@ -65,8 +66,9 @@ def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=
         steps.append(result)
         kr, kc = grid.cell(session.path[-1])
         gr, gc = grid.cell(result.map_cell)
+        entropy = max(session.entropy_nats, 0.0)          # never -0.00 of a decided 1x1 grid
         out(f'fixation {result.fixations:3d}: looked at ({kr}, {kc})  ->  most likely ({gr}, '
-            f'{gc}) p={result.map_probability:.3f}  entropy {session.entropy_nats:.2f} nats  '
+            f'{gc}) p={result.map_probability:.3f}  entropy {entropy:.2f} nats  '
             f"{'right' if result.map_cell == target else 'wrong'}")
 
     limit = None if settings.max_fixations else NO_BUDGET_FRAMES_PER_CELL * grid.n_cells
@@ -78,12 +80,12 @@ def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=
     clause = answer.confidence_clause(result.decision, result.reason, result.map_probability,
                                       settings.confidence)
     if not result.decision:
-        out(f'gave up: no cell reached the confidence {settings.confidence:g} after '
+        out(f'gave up: no cell reached the confidence {settings.confidence:.12g} after '
             f'{result.fixations} fixations, the cap of an offline search without a budget '
             f'({NO_BUDGET_FRAMES_PER_CELL} per cell); the target is most likely at ({gr}, {gc}), '
             f'probability {result.map_probability:.3f}, which is {verdict}')
     elif result.decision == 'gave_up':
-        out(f'gave up: no cell reached the confidence {settings.confidence:g} at '
+        out(f'gave up: no cell reached the confidence {settings.confidence:.12g} at '
             f'{answer.LIMITS.get(result.reason, result.reason)}; the target is most likely at '
             f'({gr}, {gc}), probability {result.map_probability:.3f}, after '
             f'{result.fixations} fixations, which is {verdict}')
@@ -139,7 +141,10 @@ def run(args) -> int:
         name = args.policy_file or args.policy
         task = f'{fpoc.model} FPOC' if args.observation is None else args.observation
         ending = answer.heading(result.decision, result.reason)
-        if result.decision == 'gave_up':
+        if not result.decision:
+            ending = (f'gave up at the cap of an offline search ({NO_BUDGET_FRAMES_PER_CELL} per '
+                      'cell)')
+        elif result.decision == 'gave_up':
             ending += f' at {answer.LIMITS.get(result.reason, result.reason)}'
         # Two lines: one would run past the figure's edges and under the colour bar.
         title = (f'{grid.rows}x{grid.cols}, {task}, {name}\n{ending}, '

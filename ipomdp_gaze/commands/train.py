@@ -162,8 +162,9 @@ def run(args) -> int:
             raise ValueError(f'--resume {args.resume}: give --out PATH.yaml for the resumed '
                              'policy (it is written there, with its learning curve)')
         raise ValueError(f'--out must end in .yaml, got {out}')
-    check_output_file('--out', out)
-    check_output_file('--out', out.with_suffix('.csv'))
+    flag = '--out' if args.out is not None else '--resume'        # --resume writes over itself
+    check_output_file(flag, out)
+    check_output_file(flag, out.with_suffix('.csv'))
     grid, fpoc = _task(args, spec)
     overrides = {
         'learning_rate': args.learning_rate, 'anneal_epochs': args.anneal_epochs,

@@ -102,10 +102,10 @@ def confidence_clause(decision: str, reason: str, probability: float,
     if confidence is None or not decision or math.isnan(probability):
         return ''
     if forced(decision, reason) and probability >= confidence:
-        return f' (at the confidence {confidence:g}, forced before the search was done)'
+        return f' (at the confidence {confidence:.12g}, forced before the search was done)'
     word = 'reached' if probability >= confidence and not forced(decision, reason) \
         else 'below'
-    return f' ({word} the confidence {confidence:g})'
+    return f' ({word} the confidence {confidence:.12g})'
 
 
 def probability_text(decision: str, probability: float) -> str:
