@@ -5,7 +5,8 @@ Publish evidence frames at a fixed rate (or as fast as possible) for the load te
 
 A camera that is faster than the controller: ``--rate-hz`` frames per second of a
 ``--rows`` x ``--cols`` grid on ``evidence`` (best effort, keep last 1, like the simulated
-camera), for ``--seconds``, then optionally a ``--burst`` of frames as fast as possible. It
+camera), for ``--seconds`` (with ``--stop-file``: at least that long, then until the file
+exists, at most ``--max-seconds``), then optionally a ``--burst`` of frames as fast as possible. It
 waits until the controller subscribes and sends one frame alone first (the controller counts
 dropped frames from the first sequence number it sees), and finally, with ``--marker``, sends
 one frame one value short that the controller must reject: being the newest frame, it is never
@@ -21,6 +22,7 @@ from __future__ import annotations
 import argparse
 import array
 import json
+from pathlib import Path
 import sys
 import time
 
@@ -33,6 +35,11 @@ def main(argv=None) -> int:
     parser.add_argument('--rate-hz', type=float, default=1000.0, help='0: as fast as possible')
     parser.add_argument('--seconds', type=float, default=5.0)
     parser.add_argument('--frames', type=int, default=0, help='stop after this many (0: none)')
+    parser.add_argument('--stop-file', default='', metavar='PATH',
+                        help='after --seconds, go on until this file exists (a test that needs '
+                             'the controller to have taken some frames, on any machine)')
+    parser.add_argument('--max-seconds', type=float, default=60.0,
+                        help='with --stop-file: stop after this long in any case')
     parser.add_argument('--burst', type=int, default=0,
                         help='then this many frames as fast as possible')
     parser.add_argument('--marker', action='store_true', help='end with one invalid frame')
@@ -75,9 +82,12 @@ def main(argv=None) -> int:
     late = 0
     t0 = time.monotonic()
     end = t0 + args.seconds
+    stop = Path(args.stop_file) if args.stop_file else None
     while True:
         now = time.monotonic()
-        if now >= end or (args.frames and sent >= args.frames):
+        if now >= end and (stop is None or now >= t0 + args.max_seconds or stop.exists()):
+            break
+        if args.frames and sent >= args.frames:
             break
         if period:
             due = t0 + (sent - 1) * period
