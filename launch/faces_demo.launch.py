@@ -6,7 +6,10 @@ Launch the face search: gaze controller, foveal detector and, for bench testing,
 ``ros2 launch ipomdp_gaze faces_demo.launch.py`` runs the pan/tilt version (``mode:=camera``)
 with ``config/faces_camera_*.yaml``; ``mode:=fovea`` the fixed camera with the digital fovea
 (``config/faces_fovea_*.yaml``). ``scene_camera:=false`` leaves the camera to a real driver:
-remap its topics, e.g. ``image:=/camera/image_raw camera_info:=/camera/camera_info``.
+remap its topics, e.g. ``image:=/camera/image_raw camera_info:=/camera/camera_info``, and a
+real head's (``joint_states:=...``, its joint names ``pan_joint:=... tilt_joint:=...`` and
+``joint_state_tolerance_s:=0.02`` when its joint states are not stamped like the images; the
+defaults are the config files' values, which the scene camera's joint states meet).
 """
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument
@@ -24,6 +27,8 @@ def generate_launch_description():
     def params(node):
         return PathJoinSubstitution([config, ['faces_', mode, f'_{node}.yaml']])
 
+    joints = {name: LaunchConfiguration(name) for name in ('pan_joint', 'tilt_joint')}
+
     return LaunchDescription([
         DeclareLaunchArgument('mode', default_value='camera',
                               description='camera (pan/tilt head) or fovea (fixed camera)'),
@@ -35,12 +40,25 @@ def generate_launch_description():
                               description='the camera image topic the detector reads'),
         DeclareLaunchArgument('camera_info', default_value='camera_info',
                               description='the camera_info topic the detector reads'),
+        DeclareLaunchArgument('joint_states', default_value='joint_states',
+                              description="the head's joint_states topic the detector reads"),
+        DeclareLaunchArgument('pan_joint', default_value='pan_joint',
+                              description="the head's pan joint (controller and detector)"),
+        DeclareLaunchArgument('tilt_joint', default_value='tilt_joint',
+                              description="the head's tilt joint (controller and detector)"),
+        DeclareLaunchArgument('joint_state_tolerance_s', default_value='0.0',
+                              description='camera mode: how far apart the stamps of an image '
+                                          'and its joint state may be (a real head: e.g. 0.02)'),
         Node(package='ipomdp_gaze', executable='controller', name='gaze_controller',
-             parameters=[params('controller')], output='screen'),
+             parameters=[params('controller'), joints], output='screen'),
         Node(package='ipomdp_gaze', executable='detector', name='foveal_detector',
-             parameters=[params('detector')], output='screen',
+             parameters=[params('detector'), {
+                 **joints,
+                 'joint_state_tolerance_s': LaunchConfiguration('joint_state_tolerance_s')}],
+             output='screen',
              remappings=[('image', LaunchConfiguration('image')),
-                         ('camera_info', LaunchConfiguration('camera_info'))]),
+                         ('camera_info', LaunchConfiguration('camera_info')),
+                         ('joint_states', LaunchConfiguration('joint_states'))]),
         Node(package='ipomdp_gaze', executable='scene_camera', name='scene_camera',
              parameters=[params('scene_camera'), {'seed': LaunchConfiguration('seed')}],
              output='screen', condition=IfCondition(LaunchConfiguration('scene_camera'))),

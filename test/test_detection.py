@@ -340,3 +340,66 @@ def test_the_detector_logic_does_not_import_finds_driver():
                          timeout=120)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == 'False'
+
+
+def test_a_fast_joint_state_stream_pairs_with_an_image_half_a_second_late(camera_setup):
+    # a 500 Hz joint_state_broadcaster and a camera whose images arrive 0.5 s after they were
+    # taken: the joint states of the image's time are 250 messages back (a count of 200 lost them)
+    loop = DetectorLoop(camera_setup, HEAD, tolerance_s=0.002)
+    loop.set_camera(shipped_camera())
+    scene, _ = _view(1, 0)
+    target = GRID.index(*scene.cell)
+    _, view = _view(1, target)
+    loop.fixate(target, 10.0)
+    for k in range(1001):                                         # 10.0 .. 12.0 s at 500 Hz
+        loop.add_pose(10.0 + k / 500, *HEAD.angles(target))
+    out = loop.add_image(11.5, view)                              # taken at 11.5, arrives at 12
+    assert out.status == 'published', out.reason
+
+
+def test_a_joint_state_the_image_cannot_pair_with_says_how_far_the_nearest_is(camera_setup):
+    loop = DetectorLoop(camera_setup, HEAD, tolerance_s=0.0)
+    loop.set_camera(shipped_camera())
+    scene, _ = _view(1, 0)
+    target = GRID.index(*scene.cell)
+    _, view = _view(1, target)
+    loop.fixate(target, 0.0)
+    assert loop.add_image(1.0, view).reason == (
+        'no joint state with the stamp of the newest image (no joint state received; '
+        'joint_state_tolerance_s 0 s)')
+    assert loop.add_pose(1.004, *HEAD.angles(target)).reason == (
+        'no joint state with the stamp of the newest image (the nearest is 0.004 s from it; '
+        'joint_state_tolerance_s 0 s)')
+    assert loop.waited_s(3.5) == 3.5 and DetectorLoop(camera_setup, HEAD).waited_s(3.5) == 0
+
+
+def test_the_pose_history_is_the_nearest_stamp_of_a_plain_search():
+    from ipomdp_gaze.vision.detection import PoseHistory
+    rng = np.random.default_rng(4)
+    history, added = PoseHistory(span_s=0.5), {}
+    for i in range(3000):
+        stamp = float(np.round(i * 0.001 + rng.normal(0, 0.002), 4))   # mostly in order
+        history.add(stamp, float(i), 0.0)
+        added[float(i)] = stamp
+        if i % 37:
+            continue
+        newest = max(added.values())
+        for query, tolerance in ((stamp - 0.1, 0.001), (stamp, 0.0), (stamp - 0.3, 0.01)):
+            near = sorted((abs(s - query), s, p) for p, s in added.items()
+                          if s >= newest - 0.5 and abs(s - query) <= tolerance + 1e-9)
+            got = history.nearest(query, tolerance)
+            if not near:
+                assert got is None
+            else:
+                assert got is not None and abs(added[got[0]] - query) == near[0][0]
+    assert history.stamps == sorted(history.stamps)
+    assert min(history.stamps) >= max(added.values()) - 1.0        # the old ones trimmed
+
+
+def test_the_pose_history_keeps_at_most_about_its_cap_and_the_newest():
+    from ipomdp_gaze.vision.detection import PoseHistory
+    history = PoseHistory(span_s=100.0, cap=300)
+    for i in range(5000):
+        history.add(i * 0.001, float(i), 0.0)
+    assert len(history) <= 600 and history.nearest(4.999, 0.0) == (4999.0, 0.0)
+    assert history.nearest(4.7, 0.0) == (4700.0, 0.0)

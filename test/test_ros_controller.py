@@ -380,3 +380,27 @@ def test_ros2_control_outputs_follow_their_topic_parameters(probe, cam):
     n = len(forward)
     cam.step(_frames(50, 1)[0])
     assert len(forward) == n
+
+
+def test_a_frame_taken_before_the_head_settled_is_asked_for_again_once_it_has(probe, cam):
+    import time
+    from std_msgs.msg import Int32MultiArray
+    fixations = probe.record(Int32MultiArray, 'fixation', 20)
+    assert all(r.successful for r in _set(probe, settle_time_s=0.8, retry_period_s=60.0))
+    try:
+        _fresh_search(probe, cam)
+        assert wait_for(lambda: fixations, 10)
+        n_fix, n_targets, nb = len(fixations), len(cam.targets), len(cam.beliefs)
+        skipped = int(cam.counters().get('frames_skipped', 0))
+        sent = time.monotonic()
+        cam.send(_frames(60, 1)[0])            # a detector's image of a head that came fast
+        # asked again for the fixation alone once it settled: not after retry_period_s (60 s),
+        # and no new target for the head
+        assert wait_for(lambda: len(fixations) > n_fix, 10)
+        assert 0.3 < time.monotonic() - sent < 5.0
+        assert len(cam.targets) == n_targets and len(cam.beliefs) == nb
+        assert list(fixations[-1][1].data) == list(fixations[n_fix - 1][1].data)
+        assert int(cam.wait_counters()['frames_skipped']) == skipped + 1
+        cam.step(_frames(61, 1)[0])            # the image taken after it: applied
+    finally:
+        assert all(r.successful for r in _set(probe, settle_time_s=0.0, retry_period_s=1.0))

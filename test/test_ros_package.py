@@ -139,6 +139,18 @@ def test_face_launch_file_starts_the_three_nodes_with_the_files_of_its_mode():
     for mode in ('camera', 'fovea'):
         for node in ('controller', 'detector', 'scene_camera'):
             assert (REPO / 'config' / f'faces_{mode}_{node}.yaml').is_file()
+    # the arguments for a real head default to the config files' values (the demo unchanged)
+    defaults = {c.args[0].value: kw.value.value for c in ast.walk(tree)
+                if isinstance(c, ast.Call) and getattr(c.func, 'id', '') == 'DeclareLaunchArgument'
+                for kw in c.keywords if kw.arg == 'default_value'}
+    for mode in ('camera', 'fovea'):
+        for node in ('controller', 'detector'):
+            values = yaml.safe_load((REPO / 'config' / f'faces_{mode}_{node}.yaml').read_text())
+            values = next(iter(values.values()))['ros__parameters']
+            for name in ('pan_joint', 'tilt_joint', 'joint_state_tolerance_s'):
+                if name in values:
+                    assert yaml.safe_load(defaults[name]) == values[name], (mode, node, name)
+    assert defaults['joint_states'] == 'joint_states'
     setup = (REPO / 'setup.py').read_text()
     assert "'detector = ipomdp_gaze.nodes.detector:main'" in setup
     assert "'scene_camera = ipomdp_gaze.nodes.scene_camera:main'" in setup

@@ -58,7 +58,7 @@ from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnav
 from ipomdp_gaze.search import answer
 from ipomdp_gaze.search.controller_config import (build_config, ControllerConfig as Config,
                                                   follow_config, grid_from)
-from ipomdp_gaze.search.gaze import FrameSequence, STAMP_TOLERANCE_S
+from ipomdp_gaze.search.gaze import FrameSequence, SETTLING, STAMP_TOLERANCE_S
 from ipomdp_gaze.search.health import HealthMonitor
 from ipomdp_gaze.search.room import MAX_PERIOD_S, Person, RoomWatch
 from rclpy.exceptions import NameValidationException
@@ -83,6 +83,9 @@ NODE_NAME = NODE_NAMES['controller']
 STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                        durability=DurabilityPolicy.TRANSIENT_LOCAL)
 WARN_THROTTLE_S = 5.0
+# The fixation is asked for again this long after its settle time has passed (a frame taken
+# then is not skipped on a clock read a hair earlier).
+SETTLED_MARGIN_S = 0.01
 # belief_image is at most this many pixels on a side (256x256 cells at 32 px would be 201 MB).
 MAX_IMAGE_SIDE_PX = 1024
 OBSERVATION_MODELS = ('gaussian', 'counts')
@@ -204,6 +207,8 @@ class GazeControllerNode(QuietPublishers, Node):
         self.create_service(SetBool, '~/enable', self.guard.wrap(self._on_enable))
         self.guard.publish_status(publisher=self._diag_pub)
         self._retry_timer = self._diag_timer = None
+        self._settled_timer = None          # asks for the fixation again once it has settled
+        self._fixation_msg = None           # the fixation last published
         self._make_timers(v)
         self._resends = 0
         self._health = HealthMonitor(self._now_s())
@@ -426,9 +431,10 @@ class GazeControllerNode(QuietPublishers, Node):
         head, cell = self._config.head, self.core.fixation if person is None else person
         self._pan_tilt_pub.publish(self._pan_tilt_msg)
         core = self.core
-        self._fixation_pub.publish(grid_arrays.fixation(
+        self._fixation_msg = grid_arrays.fixation(
             self._config.grid, None if core.scanning and person is None else cell,
-            core.search_id))
+            core.search_id)
+        self._fixation_pub.publish(self._fixation_msg)
         if self._forward_pub is not None:
             self._forward_pub.publish(joints.forward_command(head, cell))
         if self._trajectory_pub is not None:
@@ -436,6 +442,28 @@ class GazeControllerNode(QuietPublishers, Node):
                 head, cell, self._config.values['trajectory_duration_s']))
         if self._retry_timer is not None:
             self._retry_timer.reset()
+
+    def _ask_when_settled(self) -> None:
+        """
+        After a frame taken before the head settled, ask for the fixation again once it has.
+
+        A detector serves a fixation with the first image taken after it was commanded; from a
+        head that arrives sooner than ``settle_time_s`` that image is skipped, and the next
+        would come only with the re-send of ``retry_period_s``. The fixation alone is published
+        again (the head's target and its settle time stand), when the settle time has passed.
+        """
+        if self._settled_timer is not None or self._fixation_msg is None:
+            return
+        wait_s = self.core.target_time_s + self.core.settle_time_s - self._now_s()
+        self._settled_timer = self.create_timer(max(wait_s, 0.0) + SETTLED_MARGIN_S,
+                                                self.guard.wrap(self._on_settled))
+
+    def _on_settled(self) -> None:
+        """Publish the waiting fixation again (:meth:`_ask_when_settled`), once."""
+        self.destroy_timer(self._settled_timer)
+        self._settled_timer = None
+        if self.core.enabled and not self.core.stopped and self._fixation_msg is not None:
+            self._fixation_pub.publish(self._fixation_msg)
 
     def _on_retry(self) -> None:
         if self.core.enabled and not self.core.stopped and self._pan_tilt_msg is not None:
@@ -614,6 +642,9 @@ class GazeControllerNode(QuietPublishers, Node):
         self._handle(self.core.offer(values, taken, now, search_id, offsets, groups))
 
     def _handle(self, result) -> None:
+        if result.status == 'skipped' and result.reason == SETTLING:
+            self._ask_when_settled()
+            return
         if result.status == 'rejected':
             self.get_logger().warning(
                 f'rejected an evidence frame ({self.core.rejected} so far): {result.reason}',

@@ -70,6 +70,9 @@ FRAME_QOS = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
 STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                        durability=DurabilityPolicy.TRANSIENT_LOCAL)
 WARN_THROTTLE_S = 5.0
+# A fixation that waits longer than this for a usable image is stuck, not starting up: the log
+# says why (camera_info, joint states), and /diagnostics warns.
+STUCK_S = 2.0
 SETUP_KEYS = ('observation.file', 'grid.rows', 'grid.cols', 'grid.spacing_deg',
               'detector.kind', 'detector.options', 'detector.cascade', 'detector.scale_factor',
               'detector.min_neighbors', 'detector.cascade_dir')
@@ -113,6 +116,7 @@ def detector_params() -> list[Param]:
         Param('joint_state_tolerance_s', 0.0, T.DOUBLE,
               'camera mode: pair an image with a joint state stamped at most this far from it '
               '(0: the same stamp)', float_range=(0.0, 1.0)),
+
         Param('image_best_effort', False, T.BOOL,
               'subscribe image best effort, for a driver that publishes it so (default '
               'reliable: large images lose fragments over best effort; read-only)',
@@ -243,7 +247,7 @@ class FovealDetectorNode(QuietPublishers, Node):
         self.loop.head = cfg.head
         self.loop.tolerance_s = cfg.values['joint_state_tolerance_s']
         self.loop.stamp_tolerance_s = cfg.values['stamp_tolerance_s']
-        self.loop.max_age_s = cfg.values['max_image_age_s']
+        self.loop.set_max_age(cfg.values['max_image_age_s'])
         if cfg.values['diagnostics_period_s'] != old.values['diagnostics_period_s']:
             self.destroy_timer(self._diag_timer)
             self._diag_timer = self.create_timer(cfg.values['diagnostics_period_s'],
@@ -342,13 +346,34 @@ class FovealDetectorNode(QuietPublishers, Node):
             self.get_logger().warning(
                 f'ignored a message ({refused} so far): {outcome.reason}',
                 throttle_duration_sec=WARN_THROTTLE_S)
-        elif outcome.status == 'waiting' and outcome.reason.startswith('no camera_info'):
-            self.get_logger().warning(
-                f"a fixation waits: {outcome.reason}; is the camera driver's camera_info "
-                f"remapped to {self.resolve_topic_name('camera_info')}?",
-                throttle_duration_sec=WARN_THROTTLE_S)
+
+    def _warn_if_stuck(self) -> None:
+        """
+        Say why a fixation waits, once it has waited past the start-up's (:data:`STUCK_S`).
+
+        camera_info or a joint state to pair with the image: the first fixation may come before
+        either, so only a wait that lasts is warned about.
+        """
+        reason = self.loop.waiting
+        if not self._stuck():
+            return
+        if reason.startswith('no camera_info'):
+            hint = (f"; is the camera driver's camera_info remapped to "
+                    f"{self.resolve_topic_name('camera_info')}?")
+        elif reason.startswith('no joint state'):
+            hint = (f'; are {self.resolve_topic_name("joint_states")} stamped like the images '
+                    '(raise joint_state_tolerance_s to how far apart they are)?')
+        else:
+            return
+        self.get_logger().warning(f'a fixation waits: {reason}{hint}',
+                                  throttle_duration_sec=WARN_THROTTLE_S)
+
+    def _stuck(self) -> bool:
+        """Whether the waiting fixation has waited longer than :data:`STUCK_S`."""
+        return self.loop.waited_s(self._now_s()) > STUCK_S
 
     def _publish_diagnostics(self) -> None:
+        self._warn_if_stuck()
         values = {**self.loop.values(), **self.guard.values()}
         level, message = 'ok', 'serving fixations'
         now = (self.loop.rejected, sum(c[1] for c in self.loop.inputs.values()),
@@ -356,6 +381,9 @@ class FovealDetectorNode(QuietPublishers, Node):
         new = [b - a for a, b in zip(self._reported, now)]
         if values['waiting_for_image'] and self.loop.waiting.startswith('no camera_info'):
             level, message = 'warn', 'no camera_info received'
+        elif values['waiting_for_image'] and self.loop.waiting.startswith('no joint state') \
+                and self._stuck():
+            level, message = 'warn', 'no joint state pairs with the images'
         elif any(new):
             level = 'warn'
             message = ', '.join(f'{n} {what}' for n, what in zip(

@@ -55,6 +55,10 @@ ROOM_LINK = 1
 STAMP_TOLERANCE_S = 0.5
 
 
+# A frame's skip reason when it was taken before the current target's settle time.
+SETTLING = 'taken before the fixation settled'
+
+
 def check_settle_time(settle_time_s: float) -> float:
     """
     Return the settle time in seconds as a float.
@@ -502,7 +506,7 @@ class GazeController:
                                 'is not spent on it')
         if stamp_s < self.target_time_s + self.settle_time_s:
             self.skipped += 1
-            return FrameResult('skipped', 'taken before the fixation settled')
+            return FrameResult('skipped', SETTLING)
         dt_s = float(stamp_s) - self.update_time_s
         if self.follows_people:
             return self._offer_people(frame, dt_s, stamp_s, now_s)

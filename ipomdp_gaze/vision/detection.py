@@ -47,6 +47,7 @@ ones the counts mean anything with, so settings given next to it may only repeat
 """
 from __future__ import annotations
 
+import bisect
 from collections import deque
 from dataclasses import dataclass, field
 import math
@@ -77,6 +78,55 @@ RESIZE_ABOVE = 2.0
 # Defaults of the time sanity rule (seconds): images stamped ahead by more than
 # STAMP_TOLERANCE_S (the controller's tolerance too) or older than MAX_AGE_S are refused.
 MAX_AGE_S = 10.0
+# Joint states are kept for as long as an image may be old (max_age_s; this long without a
+# limit), at most this many: a 1 kHz joint_state_broadcaster and a camera 0.5 s late still pair.
+POSE_SPAN_S = 10.0
+MAX_POSES = 100_000
+
+
+class PoseHistory:
+    """
+    The head's joint angles by stamp over the last ``span_s`` seconds, looked up by bisection.
+
+    Kept by time, not by count: at 500 Hz a count of 200 held 0.4 s, and an image 0.5 s late
+    found no joint state to pair with. At most ``cap`` are kept (the oldest go first).
+    """
+
+    def __init__(self, span_s: float = POSE_SPAN_S, cap: int = MAX_POSES):
+        self.span_s, self.cap = float(span_s), int(cap)
+        self.stamps: list[float] = []
+        self.poses: list[tuple[float, float]] = []
+
+    def __len__(self) -> int:
+        return len(self.stamps)
+
+    def add(self, stamp_s: float, pan: float, tilt: float) -> None:
+        """Keep a joint state (in stamp order; equal stamps after the earlier ones)."""
+        i = bisect.bisect_right(self.stamps, stamp_s)
+        self.stamps.insert(i, stamp_s)
+        self.poses.insert(i, (pan, tilt))
+        old = max(bisect.bisect_left(self.stamps, self.stamps[-1] - self.span_s),
+                  len(self.stamps) - self.cap)
+        if old > 0 and (old >= 1024 or 2 * old > len(self.stamps)):     # amortised
+            del self.stamps[:old]
+            del self.poses[:old]
+
+    def nearest(self, stamp_s: float, tolerance_s: float):
+        """Return the angles stamped closest to ``stamp_s`` within the tolerance, or None."""
+        i = bisect.bisect_left(self.stamps, stamp_s)
+        best = None
+        for j in (i - 1, i):
+            if 0 <= j < len(self.stamps):
+                gap = abs(self.stamps[j] - stamp_s)
+                if gap <= tolerance_s + 1e-9 and (best is None or gap < best[0]):
+                    best = (gap, *self.poses[j])
+        return None if best is None else best[1:]
+
+    def gap(self, stamp_s: float) -> float:
+        """Return how far the joint state stamped closest to ``stamp_s`` is from it (inf: none)."""
+        i = bisect.bisect_left(self.stamps, stamp_s)
+        return min((abs(self.stamps[j] - stamp_s) for j in (i - 1, i)
+                    if 0 <= j < len(self.stamps)), default=math.inf)
 
 
 def model_view(model) -> str:
@@ -326,8 +376,9 @@ class DetectorLoop:
     tolerance_s : float
         ``camera`` mode: a joint state pairs with an image stamped at most this far apart.
     keep : int
-        Images kept while a fixation waits (the newest; none while no fixation waits), and
-        ``50 * keep`` joint states.
+        Images kept while a fixation waits (the newest; none while no fixation waits); joint
+        states are kept by time (:class:`PoseHistory`, as long as ``max_age_s``).
+
     stamp_tolerance_s : float
         Inputs stamped more than this ahead of the clock on arrival are rejected.
     max_age_s : float
@@ -350,7 +401,7 @@ class DetectorLoop:
         self.search_id: int | None = None
         self.scans = 0
         self._images = deque(maxlen=keep)
-        self._poses = deque(maxlen=50 * keep)
+        self._poses = PoseHistory(self.max_age_s if self.max_age_s > 0 else POSE_SPAN_S)
         self.received = self.processed = self.rejected = self.fixations = 0
         self.future = self.stale = self.resized = 0
         # Other inputs: received and refused (joint_states, camera_info, fixation).
@@ -467,7 +518,7 @@ class DetectorLoop:
         if problem:
             return self.refuse('joint_states', problem)
         self.inputs['joint_states'][0] += 1
-        self._poses.append((float(stamp_s), pan, tilt))
+        self._poses.add(float(stamp_s), pan, tilt)
         return self.serve()
 
     def set_camera(self, camera: PinholeCamera, max_side_px: int | None = None) -> Outcome:
@@ -488,6 +539,15 @@ class DetectorLoop:
             self.mismatch = camera_mismatch(self.setup.camera, camera)
         return self.serve()
 
+    def set_max_age(self, max_age_s: float) -> None:
+        """Refuse inputs older than ``max_age_s`` (0: no limit); keep joint states that long."""
+        self.max_age_s = float(max_age_s)
+        self._poses.span_s = self.max_age_s if self.max_age_s > 0 else POSE_SPAN_S
+
+    def waited_s(self, now_s: float) -> float:
+        """Return how long the waiting fixation has waited for a usable image (0: none waits)."""
+        return 0.0 if self.pending is None else max(0.0, float(now_s) - self.pending[1])
+
     def set_setup(self, setup: DetectorSetup) -> None:
         """Use another model and detector from the next image on."""
         self.setup = setup
@@ -500,12 +560,7 @@ class DetectorLoop:
 
     def _pose_at(self, stamp_s: float):
         """Return the joint angles stamped closest to ``stamp_s`` within the tolerance, or None."""
-        best = None
-        for stamp, pan, tilt in self._poses:
-            gap = abs(stamp - stamp_s)
-            if gap <= self.tolerance_s + 1e-9 and (best is None or gap < best[0]):
-                best = (gap, pan, tilt)
-        return None if best is None else best[1:]
+        return self._poses.nearest(stamp_s, self.tolerance_s)
 
     def serve(self) -> Outcome:
         """Serve the waiting fixation with the newest usable image, if there is one."""
@@ -528,7 +583,12 @@ class DetectorLoop:
                                       'intrinsics K to map pixels to cells')
         pose = self._pose_at(stamp)
         if pose is None:
-            return Outcome('waiting', 'no joint state with the stamp of the newest image')
+            gap = self._poses.gap(stamp)
+            nearest = ('no joint state received' if not math.isfinite(gap) else
+                       f'the nearest is {gap:.3f} s from it')
+            return Outcome('waiting', f'no joint state with the stamp of the newest image '
+                                      f'({nearest}; joint_state_tolerance_s '
+                                      f'{self.tolerance_s:g} s)')
         head_rc = self.head.position(*pose)
         at = self.head.nearest_cell(*pose)
         if at != cell:
