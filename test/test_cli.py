@@ -284,6 +284,11 @@ def test_a_plot_extension_in_capitals_is_written(tmp_path):
       '{dir}/x.yaml'], '--init-elm 1e+308: the ELM initialisation scale 1e+308 makes the '
                        'kernel overflow: give a smaller one'),
     (['evaluate', '--policy', 'map', '--policy', 'map'], '--policy map is given twice'),
+    (['evaluate', '--scenes', 'pan-tilt', '--motion', 'walk', '--max-fixations', '3'],
+     '--max-fixations: not used here: --motion walk runs the tracking configuration'),
+    (['evaluate', '--scenes', 'pan-tilt', '--grid', '3x3', '--horizon', '5',
+      '--motion-sigma-cells', '1'],
+     '--grid, --horizon, --motion-sigma-cells: not used here: --scenes pan-tilt runs the real'),
     (['reproduce', '--out', '{dir}/rep', '--cache', '{dir}/f.csv', '--episodes', '50'],
      '--cache {dir}/f.csv: {dir}/f.csv is not a folder'),
     (['evaluate', '--scenes', 'pan-tilt', '--faces', '2', '--episodes', '1', '--policy', 'map'],

@@ -159,6 +159,39 @@ def test_an_unreachable_scheduler_is_one_line(capsys):
         assert reason in err and err.count('\n') == 1, err
 
 
+@pytest.mark.parametrize('answer, reason', [
+    (None, 'no Dask scheduler answered at'),                 # a port that listens, says nothing
+    (b'SSH-2.0-OpenSSH_9.6\r\n' * 64, 'it answered what no Dask scheduler sends'),
+])
+def test_a_port_that_is_no_scheduler_is_one_line_within_the_timeout(answer, reason):
+    server = socket.socket()
+    server.bind(('127.0.0.1', 0))
+    server.listen(4)
+    held = []
+
+    def serve():
+        while True:
+            try:
+                conn, _ = server.accept()
+            except OSError:
+                return
+            held.append(conn)
+            if answer:
+                conn.sendall(answer)
+
+    threading.Thread(target=serve, daemon=True).start()
+    try:
+        with pytest.raises(ClusterError) as raised:
+            DaskExecutor(f'tcp://127.0.0.1:{server.getsockname()[1]}', timeout_s=1.0)
+        assert reason in str(raised.value) and '\n' not in str(raised.value)
+        with pytest.raises(ClusterError, match='TLS expects'):
+            DaskExecutor(f'tls://127.0.0.1:{server.getsockname()[1]}', timeout_s=1.0)
+    finally:
+        server.close()
+        for conn in held:
+            conn.close()
+
+
 def test_the_scheduler_comes_from_the_environment(monkeypatch, capsys):
     monkeypatch.setenv('DASK_SCHEDULER_ADDRESS', 'not-an-address')
     assert cli_main(['evaluate', '--grid', '4x4', '--episodes', '10']) == 2

@@ -160,3 +160,28 @@ def test_example_drives_the_env_with_a_shipped_kernel_and_baselines(capsys):
 def test_bad_motion_and_absent_options_are_named(kwargs, words):
     with pytest.raises(ValueError, match=words):
         VisualSearchEnv(**kwargs)
+
+
+@pytest.mark.parametrize('options, words', [
+    ({'target': 99}, r"options\['target'\] must be a cell index in \[0, 25\), got 99"),
+    ({'target': -1}, r'got -1'),
+    ({'target': 2.5}, r'got 2.5'),
+    ({'present': False}, r'needs absent_prior > 0'),
+    ({'present': 'no'}, r"options\['present'\] must be True or False"),
+    ({'targte': 3}, r"unknown reset option\(s\) 'targte'; valid: present, target"),
+])
+def test_bad_reset_options_are_named_before_the_episode(options, words):
+    env = VisualSearchEnv(rows=5, cols=5)
+    with pytest.raises(ValueError, match=words):
+        env.reset(seed=0, options=options)
+
+
+def test_a_truncated_episode_needs_a_reset_as_a_terminated_one():
+    env = VisualSearchEnv(rows=5, cols=5, max_steps=2, confidence=0.999999)
+    env.reset(seed=0, options={'target': 3})
+    truncated = [env.step(0)[3] for _ in range(2)]
+    assert truncated == [False, True]
+    with pytest.raises(gymnasium.error.ResetNeeded, match='terminated or truncated'):
+        env.step(0)
+    env.reset(seed=1)
+    env.step(0)

@@ -15,6 +15,7 @@ from ipomdp_gaze.files.bag import Bag, BagMessage
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head import PanTiltMap
 import numpy as np
+import pytest
 
 GRID = Grid(11, 11, 5.0)
 HEAD = PanTiltMap(GRID)
@@ -108,3 +109,19 @@ def test_record_says_what_it_wrote(tmp_path):
                                      f'found 1, pan_tilt 2)')
     assert describe_written(tmp_path / 'none').startswith(
         'ipomdp-gaze record: nothing readable was written')
+
+
+def test_a_damaged_message_in_a_bag_is_one_line_naming_it(tmp_path):
+    from ipomdp_gaze.files.bag import open_writer, read_bag
+    writer = open_writer(tmp_path / 'bag')
+    conn = writer.add_connection('/note', 'std_msgs/msg/String')
+    good = bytes([0, 1, 0, 0]) + (3).to_bytes(4, 'little') + b'hi\x00'
+    writer.write(conn, 1_000, good)
+    writer.write(conn, 2_000, bytes([0, 1, 0, 0]) + (10 ** 9).to_bytes(4, 'little') + b'hi\x00')
+    writer.close()
+    with pytest.raises(ValueError) as raised:
+        read_bag(tmp_path / 'bag')
+    message = str(raised.value)
+    assert message.startswith(f'{tmp_path / "bag"}: a std_msgs/msg/String message on /note at '
+                              '2000 ns cannot be read (a damaged bag?): ')
+    assert '\n' not in message

@@ -407,6 +407,24 @@ def _report_rooms(args, spec, results: dict, episodes: int) -> int:
     return 0
 
 
+# Options of the simulated task, which --scenes does not read: (flag, attribute).
+SIMULATION_ONLY = (('--grid', 'grid'), ('--spacing-deg', 'spacing_deg'), ('--fpoc', 'fpoc'),
+                   ('--fpoc-param', 'fpoc_param'), ('--observation', 'observation'),
+                   ('--horizon', 'horizon'), ('--motion-sigma-cells', 'motion_sigma_cells'),
+                   ('--jump-prob', 'motion_jump_prob'), ('--absent-rate', 'absent_rate'),
+                   ('--compare-prediction', 'compare_prediction'))
+# Options of the still pan/tilt scenes, which --motion walk does not read.
+STILL_SCENES_ONLY = (('--max-fixations', 'max_fixations'),
+                     ('--group-min-neighbors', 'group_min_neighbors'))
+
+
+def _refuse_unused(args, options, why: str) -> None:
+    """Refuse any of ``options`` given on the command line (ValueError naming them and why)."""
+    given = [flag for flag, name in options if getattr(args, name) not in (None, False, [])]
+    if given:
+        raise ValueError(f'{", ".join(given)}: not used here: {why}')
+
+
 def _pieces(args, policies) -> int:
     """Return how many pieces :func:`evaluate` submits for these arguments."""
     count = 0
@@ -429,9 +447,14 @@ def run(args) -> int:
     faces = parse_faces(args.faces)          # one line for a bad K or LO-HI, before any work
     if faces != (1, 1) and args.scenes != 'pan-tilt':
         raise ValueError('--faces is for --scenes pan-tilt')
+    if args.scenes:
+        _refuse_unused(args, SIMULATION_ONLY, f'--scenes {args.scenes} runs the real detector on '
+                       'scenes, not the simulated task (its model: --scene-model)')
     if args.motion == 'walk':
         if args.scenes != 'pan-tilt' or faces != (1, 1):
             raise ValueError('--motion walk is for --scenes pan-tilt with one face')
+        _refuse_unused(args, STILL_SCENES_ONLY, '--motion walk runs the tracking '
+                       "configuration for the walk's duration")
         return run_walks(args)
     for flag, value in (('--speed-deg-s', args.speed_deg_s),
                         ('--walk-duration-s', args.walk_duration_s)):

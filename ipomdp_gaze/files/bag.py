@@ -165,7 +165,12 @@ def read_bag(path, topics=None) -> Bag:
             connections = [c for c in reader.connections
                            if wanted is None or c.topic.lstrip('/') in wanted]
             for connection, stamp, raw in reader.messages(connections=connections):
-                msg = store.deserialize_cdr(raw, connection.msgtype)
+                try:
+                    msg = store.deserialize_cdr(raw, connection.msgtype)
+                except Exception as exc:        # noqa: B902 (rosbags' serde errors vary)
+                    raise ValueError(f'{path}: a {connection.msgtype} message on '
+                                     f'{connection.topic} at {int(stamp)} ns cannot be read '
+                                     f'(a damaged bag?): {exc}') from None
                 messages.append(BagMessage(connection.topic, int(stamp), msg, len(raw)))
             duration = reader.duration * 1e-9
     except ReaderError as exc:

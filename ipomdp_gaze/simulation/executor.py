@@ -57,10 +57,14 @@ import os
 from pathlib import Path
 import signal
 import socket
+import sys
+import threading
 
 SCHEDULER_ENV = 'DASK_SCHEDULER_ADDRESS'
 # Seconds to wait for a Dask scheduler before giving up with one line.
 CONNECT_TIMEOUT_S = 10.0
+# Beyond the connect timeout, how long a client that never finished connecting is waited for.
+CONNECT_GRACE_S = 5.0
 
 
 class ClusterError(OSError):
@@ -204,11 +208,7 @@ class DaskExecutor(_Executor):
                                '(dask[distributed])') from None
         self.address = address
         _probe(address, timeout_s)
-        try:
-            self.client = Client(address, timeout=timeout_s, set_as_default=False)
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise ClusterError(f'cannot reach the Dask scheduler at {address} within '
-                               f'{timeout_s:g} s ({type(exc).__name__})') from None
+        self.client = _connect(Client, address, timeout_s)
         try:
             if check:
                 self.check()
@@ -271,6 +271,52 @@ class DaskExecutor(_Executor):
 def _same(value):
     """Return ``value`` (a task that holds a shared array on the cluster)."""
     return value
+
+
+def _connect(client_class, address: str, timeout_s: float):
+    """
+    Return a ``Client`` of the scheduler at ``address``, or raise ClusterError in one line.
+
+    A port that accepts the connection but is no Dask scheduler (the dashboard's 8787, a web
+    server) never answers Dask's handshake, and ``Client``'s own timeout does not cover it; one
+    that answers with other bytes makes Dask read garbage (a MemoryError, a TypeError for
+    ``tls://`` without certificates). So the client is made in a daemon thread, waited for at
+    most ``timeout_s`` and a little more, and any failure is the scheduler's, said in one line;
+    the half-made client's own complaints when it is collected are silenced.
+    """
+    made = {}
+
+    def connect():
+        try:
+            made['client'] = client_class(address, timeout=timeout_s, set_as_default=False)
+        except BaseException as exc:            # noqa: B902 (any failure is the scheduler's)
+            made['error'] = exc
+
+    thread = threading.Thread(target=connect, name='dask-connect', daemon=True)
+    thread.start()
+    thread.join(timeout_s + CONNECT_GRACE_S)
+    if 'client' in made:
+        return made['client']
+    _quiet_client_collection()
+    if thread.is_alive():
+        raise ClusterError(f'no Dask scheduler answered at {address} within {timeout_s:g} s '
+                           '(something listens there: is it the dashboard? a scheduler listens '
+                           'on 8786 by default, its dashboard on 8787)')
+    exc = made['error']
+    detail = 'it answered what no Dask scheduler sends' if isinstance(exc, MemoryError) else \
+        (str(exc).strip().splitlines() or [type(exc).__name__])[-1]
+    raise ClusterError(f'cannot reach the Dask scheduler at {address} within {timeout_s:g} s '
+                       f'({type(exc).__name__}: {detail})')
+
+
+def _quiet_client_collection() -> None:
+    """Silence the 'Exception ignored in Client.__del__' of a client that failed to connect."""
+    previous = sys.unraisablehook
+
+    def hook(unraisable):
+        if 'Client.__del__' not in repr(getattr(unraisable, 'object', None)):
+            previous(unraisable)
+    sys.unraisablehook = hook
 
 
 def _probe(address: str, timeout_s: float) -> None:

@@ -46,6 +46,8 @@ from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings, ses
 import numpy as np
 
 ENV_ID = 'ipomdp_gaze/VisualSearch-v0'
+# What reset(options=...) takes: the target's cell, and whether it is there at all.
+RESET_OPTIONS = frozenset({'target', 'present'})
 REWARDS = ('infomax', 'fixate_target')
 OBSERVE = ('belief', 'evidence')
 
@@ -139,9 +141,23 @@ class VisualSearchEnv(gymnasium.Env):
         super().reset(seed=seed)
         n = self.grid.n_cells
         options = options or {}
+        unknown = sorted(set(options) - RESET_OPTIONS)
+        if unknown:
+            raise ValueError(f'unknown reset option(s) {", ".join(map(repr, unknown))}; valid: '
+                             f'{", ".join(sorted(RESET_OPTIONS))}')
         target = options.get('target')
+        if target is not None and (isinstance(target, bool) or not isinstance(
+                target, (int, np.integer)) or not 0 <= target < n):
+            raise ValueError(f"options['target'] must be a cell index in [0, {n}), got "
+                             f'{target!r}')
         self._target = int(self.np_random.integers(n)) if target is None else int(target)
         if 'present' in options:
+            if not isinstance(options['present'], (bool, np.bool_)):
+                raise ValueError(f"options['present'] must be True or False, got "
+                                 f"{options['present']!r}")
+            if not options['present'] and self.absent_prior <= 0:
+                raise ValueError("options['present'] False needs absent_prior > 0: without it "
+                                 'the belief has no "nobody here" to find')
             self._present = bool(options['present'])
         else:
             self._present = self.absent_rate == 0 or \
@@ -158,9 +174,9 @@ class VisualSearchEnv(gymnasium.Env):
         if not self.action_space.contains(k):
             raise ValueError(
                 f'action must be a cell index in [0, {self.grid.n_cells}), got {action!r}')
-        if self.session.ended:
-            raise gymnasium.error.ResetNeeded('the episode has terminated: call reset() before '
-                                              'step()')
+        if self.session.ended or self._steps >= self.max_steps:
+            raise gymnasium.error.ResetNeeded('the episode has ended (terminated or truncated): '
+                                              'call reset() before step()')
         obs = self.model.sample(self._target, k, self.np_random, present=self._present)
         self.session.fixate(k)
         result = self.session.update(Frame(obs))
