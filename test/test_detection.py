@@ -403,3 +403,17 @@ def test_the_pose_history_keeps_at_most_about_its_cap_and_the_newest():
         history.add(i * 0.001, float(i), 0.0)
     assert len(history) <= 600 and history.nearest(4.999, 0.0) == (4999.0, 0.0)
     assert history.nearest(4.7, 0.0) == (4700.0, 0.0)
+
+
+def test_a_larger_camera_of_the_models_field_of_view_is_the_models_camera(camera_setup):
+    from ipomdp_gaze.model.head_camera import PinholeCamera
+    model = shipped_camera()
+    loop = DetectorLoop(camera_setup, HEAD)
+    big = PinholeCamera(4 * model.width, 4 * model.height, 4 * model.fx, 4 * model.fy,
+                        (model.cx + 0.5) * 4 - 0.5, (model.cy + 0.5) * 4 - 0.5)
+    loop.set_camera(big)                     # resized on arrival to exactly the model's camera
+    assert loop.mismatch == ''
+    wide = PinholeCamera(4 * model.width, 3 * model.height, 4 * model.fx, 4 * model.fy,
+                         (model.cx + 0.5) * 4 - 0.5, (model.cy + 0.5) * 3 - 0.5)
+    loop.set_camera(wide)                    # another aspect: another vertical field of view
+    assert 'calibrated with 320x240' in loop.mismatch

@@ -259,8 +259,17 @@ def _one_line(exc: BaseException) -> str:
 
 
 def camera_mismatch(model_camera_: PinholeCamera | None, camera: PinholeCamera) -> str:
-    """Say how ``camera`` differs from the camera a model was calibrated with ('' if not)."""
-    if model_camera_ is None or model_camera_.matches(camera):
+    """
+    Say how ``camera`` differs from the camera a model was calibrated with ('' if not).
+
+    As the detector sees it: an image that :func:`resized_size` shrinks is compared at the size
+    it is shrunk to (a 1280x960 camera of the model's field of view is the model's camera).
+    """
+    if model_camera_ is None:
+        return ''
+    model_size = (model_camera_.width, model_camera_.height)
+    size = resized_size((camera.width, camera.height), model_size)
+    if model_camera_.matches(camera if size is None else scaled_camera(camera, *size)):
         return ''
     hfov, vfov = camera.fov_deg
     mh, mv = model_camera_.fov_deg
