@@ -16,6 +16,7 @@ from launch.actions import DeclareLaunchArgument
 from launch.conditions import IfCondition
 from launch.substitutions import LaunchConfiguration, PathJoinSubstitution
 from launch_ros.actions import Node
+from launch_ros.parameter_descriptions import ParameterValue
 from launch_ros.substitutions import FindPackageShare
 
 
@@ -27,7 +28,9 @@ def generate_launch_description():
     def params(node):
         return PathJoinSubstitution([config, ['faces_', mode, f'_{node}.yaml']])
 
-    joints = {name: LaunchConfiguration(name) for name in ('pan_joint', 'tilt_joint')}
+    # typed: 0 or 1 would otherwise reach the DOUBLE parameter as an integer, and be refused
+    joints = {name: ParameterValue(LaunchConfiguration(name), value_type=str)
+              for name in ('pan_joint', 'tilt_joint')}
 
     return LaunchDescription([
         DeclareLaunchArgument('mode', default_value='camera',
@@ -54,12 +57,14 @@ def generate_launch_description():
         Node(package='ipomdp_gaze', executable='detector', name='foveal_detector',
              parameters=[params('detector'), {
                  **joints,
-                 'joint_state_tolerance_s': LaunchConfiguration('joint_state_tolerance_s')}],
+                 'joint_state_tolerance_s': ParameterValue(
+                     LaunchConfiguration('joint_state_tolerance_s'), value_type=float)}],
              output='screen',
              remappings=[('image', LaunchConfiguration('image')),
                          ('camera_info', LaunchConfiguration('camera_info')),
                          ('joint_states', LaunchConfiguration('joint_states'))]),
         Node(package='ipomdp_gaze', executable='scene_camera', name='scene_camera',
-             parameters=[params('scene_camera'), {'seed': LaunchConfiguration('seed')}],
+             parameters=[params('scene_camera'), {'seed': LaunchConfiguration('seed'),
+                                                  **joints}],
              output='screen', condition=IfCondition(LaunchConfiguration('scene_camera'))),
     ])

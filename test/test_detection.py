@@ -417,3 +417,14 @@ def test_a_larger_camera_of_the_models_field_of_view_is_the_models_camera(camera
                          (model.cx + 0.5) * 4 - 0.5, (model.cy + 0.5) * 3 - 0.5)
     loop.set_camera(wide)                    # another aspect: another vertical field of view
     assert 'calibrated with 320x240' in loop.mismatch
+
+
+def test_the_pose_history_starts_again_when_the_clock_goes_back():
+    from ipomdp_gaze.vision.detection import PoseHistory
+    history = PoseHistory(span_s=10.0)
+    for k in range(3001):                          # 100-130 s at pose A
+        history.add(100.0 + k / 100, 1.0, 0.0)
+    for k in range(12001):                         # a simulation reset: 0-120 s at pose B
+        history.add(k / 100, 2.0, 0.0)
+    assert history.nearest(119.99, 0.0) == (2.0, 0.0)
+    assert history.nearest(105.0, 0.0) == (2.0, 0.0)

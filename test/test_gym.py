@@ -185,3 +185,8 @@ def test_a_truncated_episode_needs_a_reset_as_a_terminated_one():
         env.step(0)
     env.reset(seed=1)
     env.step(0)
+
+
+def test_max_steps_below_one_is_refused():
+    with pytest.raises(ValueError, match='max_steps must be at least 1, got 0'):
+        VisualSearchEnv(rows=5, cols=5, max_steps=0)

@@ -125,3 +125,21 @@ def test_a_damaged_message_in_a_bag_is_one_line_naming_it(tmp_path):
     assert message.startswith(f'{tmp_path / "bag"}: a std_msgs/msg/String message on /note at '
                               '2000 ns cannot be read (a damaged bag?): ')
     assert '\n' not in message
+
+
+def test_a_message_type_the_reader_does_not_know_is_named(tmp_path):
+    from ipomdp_gaze.files.bag import open_writer, read_bag
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    writer = Writer(tmp_path / 'bag', version=Writer.VERSION_LATEST,
+                    storage_plugin=StoragePlugin.MCAP)
+    writer.open()
+    from rosbags.typesys import get_types_from_msg, get_typestore, Stores
+    store = get_typestore(Stores.EMPTY)
+    store.register(get_types_from_msg('int32 x', 'my_robot/msg/Thing'))
+    conn = writer.add_connection('/thing', 'my_robot/msg/Thing', typestore=store)
+    writer.write(conn, 1_000, bytes([0, 1, 0, 0]) + (7).to_bytes(4, 'little'))
+    writer.close()
+    with pytest.raises(ValueError, match='/thing holds my_robot/msg/Thing, a message type this '
+                                         'reader does not know'):
+        read_bag(tmp_path / 'bag')
+    assert open_writer                              # the writer of the package's own bags

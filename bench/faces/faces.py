@@ -432,7 +432,7 @@ def run_pan_tilt(detectors, n: int, empty: int, split: str, progress=None) -> di
     """
     Run the pan/tilt search of each detector on ``n`` scenes (+ ``empty``) of ``split``.
 
-    ``evaluate --scenes pan-tilt [--observation faces-pan-tilt-yunet]``: the shipped controller
+    ``evaluate --scenes pan-tilt [--scene-model faces-pan-tilt-yunet]``: the shipped controller
     configuration (policy, settings) with each detector's own pan/tilt model and camera.
     """
     from ipomdp_gaze.drivers.scene_eval import evaluate_scenes

@@ -412,7 +412,7 @@ SIMULATION_ONLY = (('--grid', 'grid'), ('--spacing-deg', 'spacing_deg'), ('--fpo
                    ('--fpoc-param', 'fpoc_param'), ('--observation', 'observation'),
                    ('--horizon', 'horizon'), ('--motion-sigma-cells', 'motion_sigma_cells'),
                    ('--jump-prob', 'motion_jump_prob'), ('--absent-rate', 'absent_rate'),
-                   ('--compare-prediction', 'compare_prediction'))
+                   ('--compare-prediction', 'compare_prediction'), ('--paired', 'paired'))
 # Options of the still pan/tilt scenes, which --motion walk does not read.
 STILL_SCENES_ONLY = (('--max-fixations', 'max_fixations'),
                      ('--group-min-neighbors', 'group_min_neighbors'))
@@ -420,7 +420,9 @@ STILL_SCENES_ONLY = (('--max-fixations', 'max_fixations'),
 
 def _refuse_unused(args, options, why: str) -> None:
     """Refuse any of ``options`` given on the command line (ValueError naming them and why)."""
-    given = [flag for flag, name in options if getattr(args, name) not in (None, False, [])]
+    given = [flag for flag, name in options
+             if not any(getattr(args, name) is unset for unset in (None, False))
+             and getattr(args, name) != []]
     if given:
         raise ValueError(f'{", ".join(given)}: not used here: {why}')
 

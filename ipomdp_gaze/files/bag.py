@@ -165,6 +165,10 @@ def read_bag(path, topics=None) -> Bag:
             connections = [c for c in reader.connections
                            if wanted is None or c.topic.lstrip('/') in wanted]
             for connection, stamp, raw in reader.messages(connections=connections):
+                if connection.msgtype not in store.types:
+                    raise ValueError(f'{path}: {connection.topic} holds {connection.msgtype}, '
+                                     'a message type this reader does not know (record only '
+                                     "the search's topics)")
                 try:
                     msg = store.deserialize_cdr(raw, connection.msgtype)
                 except Exception as exc:        # noqa: B902 (rosbags' serde errors vary)

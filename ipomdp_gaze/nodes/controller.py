@@ -423,6 +423,9 @@ class GazeControllerNode(QuietPublishers, Node):
         head, cell = self._config.head, self.core.fixation
         now = self._now()
         self.core.retarget(now.nanoseconds * 1e-9)
+        if self._settled_timer is not None:     # a new target settles from now
+            self.destroy_timer(self._settled_timer)
+            self._settled_timer = None
         self._pan_tilt_msg = joints.joint_state(head, cell, now.to_msg())
         self._publish_target()
 

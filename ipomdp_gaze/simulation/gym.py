@@ -9,7 +9,7 @@ observation is a ``Dict`` with the belief grid (or, with ``observe='evidence'``,
 of the last frame) and the current fixation. The reward is the infomax reward ``sum_i B_i log B_i``
 of the new belief (``reward='fixate_target'``: the belief at the fixated cell). An episode
 terminates when the most likely cell reaches ``confidence`` (in (0, 1), as everywhere) and is
-truncated after ``max_steps`` fixations; stepping on after it terminated needs a reset. The
+truncated after ``max_steps`` fixations; stepping on after either needs a reset. The
 belief, the Bayes step and the stop rules are the search session's
 (:mod:`ipomdp_gaze.search.session`,
 with the agent choosing every fixation). The hidden target is in ``info['target']`` for oracle
@@ -97,6 +97,8 @@ class VisualSearchEnv(gymnasium.Env):
         self.reward_name, self.observe = reward, observe
         self.confidence = self.settings.confidence
         self.max_steps = n if max_steps is None else int(max_steps)
+        if self.max_steps < 1:
+            raise ValueError(f'max_steps must be at least 1, got {max_steps!r}')
         self.start_cell = self.grid.center_index if start_cell is None else int(start_cell)
         if not 0 <= self.start_cell < n:
             raise ValueError(f'start_cell must be a cell index below {n}, got {start_cell!r}')

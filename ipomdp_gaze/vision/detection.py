@@ -101,7 +101,16 @@ class PoseHistory:
         return len(self.stamps)
 
     def add(self, stamp_s: float, pan: float, tilt: float) -> None:
-        """Keep a joint state (in stamp order; equal stamps after the earlier ones)."""
+        """
+        Keep a joint state (in stamp order; equal stamps after the earlier ones).
+
+        One stamped more than ``span_s`` before the newest kept says the clock went back (a
+        simulation reset, a bag played in a loop; a live node refuses joint states that old):
+        the history starts again from it, so that no pose of before the jump answers.
+        """
+        if self.stamps and stamp_s < self.stamps[-1] - self.span_s:
+            self.stamps.clear()
+            self.poses.clear()
         i = bisect.bisect_right(self.stamps, stamp_s)
         self.stamps.insert(i, stamp_s)
         self.poses.insert(i, (pan, tilt))
