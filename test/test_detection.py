@@ -342,14 +342,19 @@ def test_the_detector_logic_does_not_import_finds_driver():
     assert out.stdout.strip() == 'False'
 
 
-def test_a_fast_joint_state_stream_pairs_with_an_image_half_a_second_late(camera_setup):
-    # a 500 Hz joint_state_broadcaster and a camera whose images arrive 0.5 s after they were
-    # taken: the joint states of the image's time are 250 messages back (a count of 200 lost them)
-    loop = DetectorLoop(camera_setup, HEAD, tolerance_s=0.002)
+def _on_the_face(camera_setup, tolerance_s: float):
+    """Return a camera-mode loop with the shipped camera, a scene's face cell, the view on it."""
+    loop = DetectorLoop(camera_setup, HEAD, tolerance_s=tolerance_s)
     loop.set_camera(shipped_camera())
     scene, _ = _view(1, 0)
     target = GRID.index(*scene.cell)
-    _, view = _view(1, target)
+    return loop, target, _view(1, target)[1]
+
+
+def test_a_fast_joint_state_stream_pairs_with_an_image_half_a_second_late(camera_setup):
+    # a 500 Hz joint_state_broadcaster and a camera whose images arrive 0.5 s after they were
+    # taken: the joint states of the image's time are 250 messages back (a count of 200 lost them)
+    loop, target, view = _on_the_face(camera_setup, 0.002)
     loop.fixate(target, 10.0)
     for k in range(1001):                                         # 10.0 .. 12.0 s at 500 Hz
         loop.add_pose(10.0 + k / 500, *HEAD.angles(target))
@@ -358,11 +363,7 @@ def test_a_fast_joint_state_stream_pairs_with_an_image_half_a_second_late(camera
 
 
 def test_a_joint_state_the_image_cannot_pair_with_says_how_far_the_nearest_is(camera_setup):
-    loop = DetectorLoop(camera_setup, HEAD, tolerance_s=0.0)
-    loop.set_camera(shipped_camera())
-    scene, _ = _view(1, 0)
-    target = GRID.index(*scene.cell)
-    _, view = _view(1, target)
+    loop, target, view = _on_the_face(camera_setup, 0.0)
     loop.fixate(target, 0.0)
     assert loop.add_image(1.0, view).reason == (
         'no joint state with the stamp of the newest image (no joint state received; '

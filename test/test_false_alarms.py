@@ -62,23 +62,31 @@ def _brute_posterior(model, frames, scales, absent_prior, hotspot_prior=0.0, hot
     return post / post.sum()
 
 
+def _searched(model, settings, rng, n_frames: int, first_at_random: bool = False):
+    """Search on random count frames (a fifth of the cells unobserved); the session, the frames."""
+    grid = model.grid
+    session = SearchSession(grid, model, None, settings)
+    session.reset(seed=0)
+    session.start()
+    if first_at_random:
+        session.fixate(int(rng.integers(grid.n_cells)))
+    frames = []
+    for _ in range(n_frames):
+        counts = rng.integers(0, 3, size=grid.n_cells).astype(float)
+        counts[rng.random(grid.n_cells) < 0.2] = np.nan          # some cells not observed
+        frames.append((session.fixation, counts))
+        assert session.update(Frame(counts)).applied
+        session.fixate(int(rng.integers(grid.n_cells)))
+    return session, frames
+
+
 @pytest.mark.parametrize('seed', range(4))
 def test_the_belief_is_the_brute_force_posterior_marginal_over_the_scales(seed):
     rng = np.random.default_rng(seed)
     grid, model = _model(rng)
     scales = (0.5, 1.0, 2.5)
     settings = SearchSettings(confidence=0.999999, absent_prior=0.3, false_alarm_scales=scales)
-    session = SearchSession(grid, model, None, settings)
-    session.reset(seed=0)
-    session.start()
-    session.fixate(int(rng.integers(grid.n_cells)))
-    frames = []
-    for _ in range(5):
-        counts = rng.integers(0, 3, size=grid.n_cells).astype(float)
-        counts[rng.random(grid.n_cells) < 0.2] = np.nan          # some cells not observed
-        frames.append((session.fixation, counts))
-        assert session.update(Frame(counts)).applied
-        session.fixate(int(rng.integers(grid.n_cells)))
+    session, frames = _searched(model, settings, rng, 5, first_at_random=True)
     expected = _brute_posterior(model, frames, scales, 0.3)
     assert session.belief == pytest.approx(expected[:-1], rel=1e-9, abs=1e-12)
     assert session.absent_probability == pytest.approx(expected[-1], rel=1e-9)
@@ -91,16 +99,7 @@ def test_with_hotspots_the_belief_is_the_brute_force_posterior(seed):
     scales, rho, hot = (1.0, 1.5), 0.2, 2.5
     settings = SearchSettings(confidence=0.999999, absent_prior=0.3, false_alarm_scales=scales,
                               hotspot_prior=rho, hotspot_scale=hot)
-    session = SearchSession(grid, model, None, settings)
-    session.reset(seed=0)
-    session.start()
-    frames = []
-    for _ in range(4):
-        counts = rng.integers(0, 3, size=grid.n_cells).astype(float)
-        counts[rng.random(grid.n_cells) < 0.2] = np.nan
-        frames.append((session.fixation, counts))
-        assert session.update(Frame(counts)).applied
-        session.fixate(int(rng.integers(grid.n_cells)))
+    session, frames = _searched(model, settings, rng, 4)
     expected = _brute_posterior(model, frames, scales, 0.3, rho, hot)
     assert session.belief == pytest.approx(expected[:-1], rel=1e-9, abs=1e-12)
     assert session.absent_probability == pytest.approx(expected[-1], rel=1e-9)
@@ -251,15 +250,7 @@ def test_one_factor_scales_the_false_alarm_rates_as_the_brute_force_posterior(se
     rng = np.random.default_rng(20 + seed)
     grid, model = _model(rng)
     settings = SearchSettings(confidence=0.999999, absent_prior=0.3, false_alarm_scales=[1.5])
-    session = SearchSession(grid, model, None, settings)
-    session.reset(seed=0)
-    session.start()
-    frames = []
-    for _ in range(4):
-        counts = rng.integers(0, 3, size=grid.n_cells).astype(float)
-        frames.append((session.fixation, counts))
-        assert session.update(Frame(counts)).applied
-        session.fixate(int(rng.integers(grid.n_cells)))
+    session, frames = _searched(model, settings, rng, 4)
     expected = _brute_posterior(model, frames, (1.5,), 0.3)
     assert session.belief == pytest.approx(expected[:-1], rel=1e-9, abs=1e-12)
     assert not np.allclose(expected, _brute_posterior(model, frames, (1.0,), 0.3))
