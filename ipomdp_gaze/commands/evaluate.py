@@ -132,22 +132,20 @@ def load_policies(args, grid, fpoc) -> dict:
 
     Two rows of one name are refused (ValueError naming both), so that no row replaces another.
     """
-    policies, given = {}, {}
-    sources = [(name, f'--policy {name}') for name in
-               args.policy or ([] if args.policy_file else ['map'])]
-    sources += [(path.stem, f'--policy-file {path}') for path in args.policy_file]
-    for name, source in sources:
+    names = args.policy or ([] if args.policy_file else ['map'])
+    rows = [(name, f'--policy {name}', {}) for name in names]
+    rows += [(path.stem, f'--policy-file {path}', {'file': str(path)})
+             for path in args.policy_file]
+    given = {}
+    for name, source, _ in rows:
         if source == given.get(name):
             raise ValueError(f'{source} is given twice: each row once')
         if name in given:
             raise ValueError(f"{source}: its row would be named {name!r}, as {given[name]}'s "
                              "(a file's row is named by its stem): give them different names")
         given[name] = source
-    for name in args.policy or ([] if args.policy_file else ['map']):
-        policies[name] = build_policy(name, grid, fpoc)
-    for path in args.policy_file:
-        policies[path.stem] = build_policy('learned', grid, fpoc, file=str(path))
-    return policies
+    return {name: build_policy('learned' if file else name, grid, fpoc, **file)
+            for name, _, file in rows}
 
 
 def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
@@ -421,8 +419,8 @@ STILL_SCENES_ONLY = (('--max-fixations', 'max_fixations'),
 def _refuse_unused(args, options, why: str) -> None:
     """Refuse any of ``options`` given on the command line (ValueError naming them and why)."""
     given = [flag for flag, name in options
-             if not any(getattr(args, name) is unset for unset in (None, False))
-             and getattr(args, name) != []]
+             if getattr(args, name) not in (None, [])
+             and getattr(args, name) is not False]       # a 0 is given
     if given:
         raise ValueError(f'{", ".join(given)}: not used here: {why}')
 

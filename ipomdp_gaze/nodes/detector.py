@@ -116,7 +116,6 @@ def detector_params() -> list[Param]:
         Param('joint_state_tolerance_s', 0.0, T.DOUBLE,
               'camera mode: pair an image with a joint state stamped at most this far from it '
               '(0: the same stamp)', float_range=(0.0, 1.0)),
-
         Param('image_best_effort', False, T.BOOL,
               'subscribe image best effort, for a driver that publishes it so (default '
               'reliable: large images lose fragments over best effort; read-only)',

@@ -293,14 +293,14 @@ def _connect(client_class, address: str, timeout_s: float):
             made['error'] = exc
 
     thread = threading.Thread(target=connect, name='dask-connect', daemon=True)
+    deadline_s = timeout_s + min(CONNECT_GRACE_S, timeout_s)
     thread.start()
-    thread.join(timeout_s + min(CONNECT_GRACE_S, timeout_s))
+    thread.join(deadline_s)
     if 'client' in made:
         return made['client']
     _quiet_client_collection()
     if thread.is_alive():
-        raise ClusterError(f'no Dask scheduler answered at {address} within '
-                           f'{timeout_s + min(CONNECT_GRACE_S, timeout_s):g} s '
+        raise ClusterError(f'no Dask scheduler answered at {address} within {deadline_s:g} s '
                            '(something listens there: is it the dashboard? a scheduler listens '
                            'on 8786 by default, its dashboard on 8787)')
     exc = made['error']
