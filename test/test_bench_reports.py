@@ -246,3 +246,19 @@ def test_the_group_tables_keep_the_most_false_faces_in_one_picture():
         many._add(totals, 'find --all', counts, 6, 0.01, 1000)
     t = totals['find --all']
     assert (t['found'], t['false'], t['false_most'], t['duplicates']) == (17, 3, 2, 1)
+
+
+
+def test_walk_reports_refuse_bad_options_with_one_line_before_any_walk(tmp_path, capsys):
+    """``bench/pan_tilt/walks.py`` and ``people_walks.py``: a bad option is named, no traceback."""
+    import pytest
+    for script, args, named in (
+            ('walks', ['--speeds', '5,a'], 'argument --speeds'),
+            ('walks', ['--speeds', '50'], 'from 0 to 20'),
+            ('people_walks', ['--faces', '7'], 'argument --faces'),
+            ('people_walks', ['--scenes', '0'], 'argument --scenes'),
+            ('people_walks', ['--json', str(tmp_path)], f'--json {tmp_path}: is a directory')):
+        with pytest.raises(SystemExit) as stop:
+            _bench_module(script).main(args)
+        assert stop.value.code == 2, (script, args)
+        assert named in capsys.readouterr().err

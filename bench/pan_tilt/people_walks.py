@@ -30,8 +30,9 @@ import time
 
 from ipomdp_gaze.drivers.people_walks import (evaluate_people_walks, people_spec, PeopleResult,
                                               summarise_people)
+from ipomdp_gaze.commands.common import check_output_file, nonneg_int, positive_float, positive_int
 from ipomdp_gaze.simulation.progress import Progress
-from walks import _diff, _fmt                       # this folder's bench of one person
+from walks import _diff, _fmt, speeds_arg       # this folder's bench of one person
 
 ROOT = Path(__file__).resolve().parents[2]
 BASELINE = 'track-last-detection'
@@ -102,18 +103,26 @@ def write_page(record: dict, out: Path) -> None:
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    p.add_argument('--scenes', type=int, default=30, help='test scenes per speed')
-    p.add_argument('--speeds', default='5,15', help='walking speeds, deg/s (comma-separated)')
-    p.add_argument('--faces', type=int, default=2, help='people per scene, 2-4')
-    p.add_argument('--duration-s', type=float, default=30.0)
-    p.add_argument('--seed', type=int, default=0)
-    p.add_argument('--processes', type=int, default=2)
+    p.add_argument('--scenes', type=positive_int, default=30, help='test scenes per speed')
+    p.add_argument('--speeds', type=speeds_arg, default='5,15', help='walking speeds, deg/s (comma-separated)')
+    p.add_argument('--faces', type=int, choices=range(2, 5), default=2,
+                   help='people per scene, 2-4')
+    p.add_argument('--duration-s', type=positive_float, default=30.0)
+    p.add_argument('--seed', type=nonneg_int, default=0)
+    p.add_argument('--processes', type=positive_int, default=2)
     p.add_argument('--json', type=Path, default=ROOT / 'docs' / 'data' / 'people_walks.json')
     p.add_argument('--out', type=Path, default=ROOT / 'docs' / 'people_walks.md')
     p.add_argument('--from-json', action='store_true',
                    help='write the page from --json without searching')
     args = p.parse_args(argv)
-    args.speeds = [float(v) for v in args.speeds.split(',')]
+    try:
+        for speed in args.speeds:
+            people_spec(speed, args.faces, 'test', args.seed, args.duration_s)
+        check_output_file('--out', args.out)
+        if not args.from_json:
+            check_output_file('--json', args.json)
+    except ValueError as exc:
+        p.error(str(exc))
     if args.from_json:
         record = json.loads(args.json.read_text())
     else:

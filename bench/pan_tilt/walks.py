@@ -28,11 +28,21 @@ import time
 
 from ipomdp_gaze.drivers.tracking import (evaluate_walks, summarise_walks, walk_spec,
                                           WalkResult, walks_json)
+from ipomdp_gaze.commands.common import check_output_file, nonneg_int, positive_float, positive_int
 from ipomdp_gaze.simulation.progress import Progress
-from ipomdp_gaze.vision.walks import calibrate_motion
+from ipomdp_gaze.vision.walks import calibrate_motion, check_speed
 
 ROOT = Path(__file__).resolve().parents[2]
 BASELINE = 'track-last-detection'
+
+
+def speeds_arg(text: str) -> list[float]:
+    """Parse ``--speeds``: comma-separated walking speeds in deg/s."""
+    try:
+        return [check_speed(float(v)) for v in text.split(',')]
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(f'expected walking speeds in deg/s such as 5,15 '
+                                         f'({exc})') from None
 
 
 def run(args) -> dict:
@@ -115,11 +125,11 @@ def write_page(record: dict, out: Path, calibration: dict) -> None:
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    p.add_argument('--scenes', type=int, default=50, help='test walks per speed')
-    p.add_argument('--speeds', default='5,15', help='walking speeds, deg/s (comma-separated)')
-    p.add_argument('--duration-s', type=float, default=30.0)
-    p.add_argument('--seed', type=int, default=0)
-    p.add_argument('--processes', type=int, default=2)
+    p.add_argument('--scenes', type=positive_int, default=50, help='test walks per speed')
+    p.add_argument('--speeds', type=speeds_arg, default='5,15', help='walking speeds, deg/s (comma-separated)')
+    p.add_argument('--duration-s', type=positive_float, default=30.0)
+    p.add_argument('--seed', type=nonneg_int, default=0)
+    p.add_argument('--processes', type=positive_int, default=2)
     p.add_argument('--json', type=Path, default=ROOT / 'docs' / 'data' / 'walks.json')
     p.add_argument('--out', type=Path, default=ROOT / 'docs' / 'walks.md')
     p.add_argument('--from-json', action='store_true',
@@ -127,7 +137,14 @@ def main(argv=None) -> int:
     p.add_argument('--cli-json', nargs='+', type=Path, default=None, metavar='JSON',
                    help='build the record from evaluate --motion walk --json files')
     args = p.parse_args(argv)
-    args.speeds = [float(v) for v in args.speeds.split(',')]
+    try:
+        for speed in args.speeds:
+            walk_spec(speed, 'test', args.seed, args.duration_s)
+        check_output_file('--out', args.out)
+        if not args.from_json:
+            check_output_file('--json', args.json)
+    except ValueError as exc:
+        p.error(str(exc))
     if args.from_json:
         record = json.loads(args.json.read_text())
     else:
