@@ -248,7 +248,6 @@ def test_the_group_tables_keep_the_most_false_faces_in_one_picture():
     assert (t['found'], t['false'], t['false_most'], t['duplicates']) == (17, 3, 2, 1)
 
 
-
 def test_walk_reports_refuse_bad_options_with_one_line_before_any_walk(tmp_path, capsys):
     """``bench/pan_tilt/walks.py`` and ``people_walks.py``: a bad option is named, no traceback."""
     import pytest

@@ -28,9 +28,10 @@ from pathlib import Path
 import sys
 import time
 
+from ipomdp_gaze.commands.common import (check_output_file, nonneg_int, positive_float,
+                                         positive_int)
 from ipomdp_gaze.drivers.people_walks import (evaluate_people_walks, people_spec, PeopleResult,
                                               summarise_people)
-from ipomdp_gaze.commands.common import check_output_file, nonneg_int, positive_float, positive_int
 from ipomdp_gaze.simulation.progress import Progress
 from walks import _diff, _fmt, speeds_arg       # this folder's bench of one person
 
@@ -104,7 +105,8 @@ def write_page(record: dict, out: Path) -> None:
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     p.add_argument('--scenes', type=positive_int, default=30, help='test scenes per speed')
-    p.add_argument('--speeds', type=speeds_arg, default='5,15', help='walking speeds, deg/s (comma-separated)')
+    p.add_argument('--speeds', type=speeds_arg, default='5,15',
+                   help='walking speeds, deg/s (comma-separated)')
     p.add_argument('--faces', type=int, choices=range(2, 5), default=2,
                    help='people per scene, 2-4')
     p.add_argument('--duration-s', type=positive_float, default=30.0)

@@ -26,9 +26,10 @@ from pathlib import Path
 import sys
 import time
 
+from ipomdp_gaze.commands.common import (check_output_file, nonneg_int, positive_float,
+                                         positive_int)
 from ipomdp_gaze.drivers.tracking import (evaluate_walks, summarise_walks, walk_spec,
                                           WalkResult, walks_json)
-from ipomdp_gaze.commands.common import check_output_file, nonneg_int, positive_float, positive_int
 from ipomdp_gaze.simulation.progress import Progress
 from ipomdp_gaze.vision.walks import calibrate_motion, check_speed
 
@@ -126,7 +127,8 @@ def write_page(record: dict, out: Path, calibration: dict) -> None:
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     p.add_argument('--scenes', type=positive_int, default=50, help='test walks per speed')
-    p.add_argument('--speeds', type=speeds_arg, default='5,15', help='walking speeds, deg/s (comma-separated)')
+    p.add_argument('--speeds', type=speeds_arg, default='5,15',
+                   help='walking speeds, deg/s (comma-separated)')
     p.add_argument('--duration-s', type=positive_float, default=30.0)
     p.add_argument('--seed', type=nonneg_int, default=0)
     p.add_argument('--processes', type=positive_int, default=2)
