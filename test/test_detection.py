@@ -181,6 +181,15 @@ def test_settings_that_repeat_the_observation_file_are_accepted():
                          'cascade': 'haarcascade_frontalface_alt2.xml'})
     assert setup.grid.shape == (21, 21) and setup.fovea is not None
     assert build_setup('camera', grid=(11, 11, 5.0)).observer is not None
+    # an ensemble's members as calibrate was given them (the file fills in defaults and
+    # fingerprints): the same detector, accepted; one member fewer is not
+    members = [{'kind': 'haar', 'cascade': ['haarcascade_frontalface_alt2.xml',
+                                            'haarcascade_profileface.xml'],
+                'mirror': [False, True]}, {'kind': 'yunet', 'upscale': 2, 'weight': 5}]
+    assert build_setup('camera', 'faces-pan-tilt-ensemble',
+                       detector={'kind': 'ensemble', 'members': members}).observer is not None
+    with pytest.raises(ValueError, match='detector.members .* contradicts'):
+        build_setup('camera', 'faces-pan-tilt-ensemble', detector={'members': members[:1]})
 
 
 def test_an_image_from_the_future_or_the_past_is_rejected_and_counted(fovea_setup):

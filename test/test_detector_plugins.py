@@ -49,6 +49,30 @@ class BlobDetector:
     def settings(self):
         return {'kind': 'ignored: the factory records the name it built this by',
                 'min_red': self.min_red}
+
+
+class Fussy(BlobDetector):
+    """Raises on an image with a white pixel (a plug-in's bug on some images)."""
+
+    def __call__(self, rgb):
+        if (rgb.min(axis=2) == 255).any():
+            raise RuntimeError('cannot handle this one')
+        return super().__call__(rgb)
+
+
+class Forgetful(BlobDetector):
+    """Its settings() leave out the option it was built with."""
+
+    def settings(self):
+        return {}
+
+
+class Astray:
+    """Three boxes wholly outside any image it is given (corners taken for sizes) and one in."""
+
+    def __call__(self, gray):
+        h, w = gray.shape[:2]
+        return np.array([[-20, -20, 10, 10], [w + 5, 2, 8, 8], [2, h, 4, 4], [1, 1, 4, 4]])
 '''
 SIZE, CELLS, SQUARE = 84, 7, 14
 KINDS = {'module': 'blobdet:BlobDetector', 'entry point': 'blob'}
@@ -263,3 +287,46 @@ def test_a_threshold_model_counts_only_boxes_scoring_above_it(on_path, tmp_path)
         fovea.start(image)
         assert len(fovea.detector(image)) == 1
         assert fovea.observe(cell).counts[cell] == expected
+
+
+def test_options_a_plugin_leaves_out_of_its_settings_are_recorded_and_rebuilt(on_path):
+    from ipomdp_gaze.vision.detector import detector_settings
+    from ipomdp_gaze.vision.detectors import detector_from_settings, make_detector
+    settings = detector_settings(make_detector('blobdet:Forgetful', min_red=120))
+    assert settings == {'kind': 'blobdet:Forgetful', 'min_red': 120}
+    assert detector_from_settings(settings).min_red == 120
+    # a shipped detector (rebuilt by its from_settings) records only its own settings
+    haar = detector_settings(make_detector('haar', scale_factor=1.2))
+    assert 'cascade_dir' not in haar and haar['scale_factor'] == 1.2
+
+
+def test_boxes_that_miss_the_image_are_not_counted_at_its_edge(on_path):
+    from ipomdp_gaze.vision.detector import detect
+    from ipomdp_gaze.vision.detectors import make_detector
+    astray = make_detector('blobdet:Astray')
+    boxes, scores = detect(astray, np.zeros((30, 40), np.uint8))
+    np.testing.assert_array_equal(boxes, [[1, 1, 4, 4]])
+    np.testing.assert_array_equal(scores, [1.0])
+    # an image smaller than the detector's window_px is not given to it
+    astray.window_px = (41, 10)
+    boxes, scores = detect(astray, np.zeros((30, 40), np.uint8))
+    assert boxes.shape == (0, 4) and scores.shape == (0,)
+
+
+def test_a_detector_that_fails_on_one_image_is_reported_against_it(on_path, tmp_path, capsys):
+    """The other images are still searched and written (the README's promise for bad files)."""
+    model = calibrate(tmp_path, 'blobdet:Fussy')
+    good, bad = tmp_path / 'good.png', tmp_path / 'bad.png'
+    image = blob_image(np.random.default_rng(7), (2, 4))
+    cv2.imwrite(str(good), image[:, :, ::-1])
+    cv2.imwrite(str(bad), np.full_like(image, 255))
+    capsys.readouterr()
+    out = tmp_path / 'found.json'
+    assert cli(['find', str(bad), str(good), '--observation', str(model), '--json',
+                str(out)]) == 2
+    err = capsys.readouterr().err
+    assert (f'ipomdp-gaze find: error: {bad}: the detector blobdet:Fussy raised RuntimeError: '
+            'cannot handle this one') in err and 'Traceback' not in err
+    bad_entry, good_entry = json.loads(out.read_text())['images']
+    assert bad_entry['error'].startswith('the detector blobdet:Fussy raised')
+    assert good_entry['cell'] == [2, 4]

@@ -77,3 +77,24 @@ def test_slow_searchers_say_so_and_evaluate_runs_them_on_fewer_episodes():
     first = simulate(grid, fpoc, make_baseline('greedy', grid, fpoc), 40, 5, 0)
     np.testing.assert_allclose(result['policies']['greedy']['percent_correct'],
                                first.percent_correct, atol=1e-6)
+
+
+def test_a_horizon_that_cuts_resamples_widens_the_interval_or_leaves_it_undefined():
+    """A resample not at 90% within the horizon is "more than T", never dropped (QA: narrower)."""
+    from ipomdp_gaze.simulation.evaluation import fixations_to_90_ci, paired_difference_ci
+    rng = np.random.default_rng(4)
+    # each episode becomes right for good at a geometric time: 90% is crossed near t = 8
+    turns = rng.geometric(0.25, size=(2, 400))
+    full = [np.arange(1, 31)[None, :] >= t[:, None] for t in turns]
+    counts = np.random.default_rng(5).multinomial(400, np.full(400, 1 / 400), size=1000)
+    for horizon in (8, 9, 10, 30):
+        cut = [c[:, :horizon] for c in full]
+        point, ci = fixations_to_90_ci(cut[0], 49, None, counts=counts)
+        point_full, ci_full = fixations_to_90_ci(full[0], 49, None, counts=counts)
+        if point is not None:
+            assert point == point_full
+            assert ci is None or ci == ci_full, (horizon, ci, ci_full)
+        diff, paired = paired_difference_ci(cut[0], cut[1], 49, None, counts=counts)
+        _, paired_full = paired_difference_ci(full[0], full[1], 49, None, counts=counts)
+        assert paired is None or paired == paired_full, (horizon, paired, paired_full)
+    assert ci == ci_full and paired == paired_full          # horizon 30: nothing cut

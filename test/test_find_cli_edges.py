@@ -215,8 +215,6 @@ def test_json_and_log_to_one_file_are_refused(images, tmp_path, run_find):
                                                "'no-such-policy.yaml' not found"),
     (('--policy-file', 'human-7x7-infomax'), 'policy is for a 7x7 grid but the task grid is '
                                              '21x21'),
-    (('--policy', 'greedy'), '--policy: policy greedy (the ideal searcher) needs the Gaussian '
-                             'model'),
 ])
 def test_a_bad_policy_is_one_line_for_all_images(images, run_find, flags, says):
     result = run_find(images['astronaut'], images['noise'], images['right'], *flags)
@@ -272,13 +270,37 @@ def test_a_folder_searches_its_images_and_names_the_files_it_skips(images, tmp_p
     cv2.imwrite(str(folder / 'noise.jpe'), cv2.imread(str(images['noise'])))
     (folder / 'notes.txt').write_text('not an image')
     (folder / 'boxes.json').write_text('{}')
+    (folder / 'more').mkdir()                           # not walked down, but said
     result = run_find(folder)
     assert result.returncode == 0, result.stderr
     searched = re.findall(r'^(\S+): decision=(\w+)', result.stdout, re.M)
     assert [(Path(p).name, d) for p, d in searched] == [('astronaut.gif', 'found'),
                                                         ('noise.jpe', 'absent')]
-    assert f'{folder}: 2 files not named as an image skipped (boxes.json, notes.txt; name one ' \
-        'to search it)' in ' '.join(result.stderr.split())
+    assert f'{folder}: 2 files not named as an image and 1 folder skipped (boxes.json, more/, ' \
+        'notes.txt; name one to search it)' in ' '.join(result.stderr.split())
+    empty = run_find('')                                # an unset shell variable: not "."
+    assert empty.returncode == 2 and empty.stderr.strip().splitlines() == [
+        "ipomdp-gaze find: error: an empty image path ('': an unset shell variable?)"]
+
+
+@pytest.mark.parametrize('flags, warning', [
+    ((), None),
+    (('--policy', 'elm', '--seed', '3'), '--policy, --seed are ignored: the default scan '
+                                         '(--scan coarse) calls the detector'),
+    (('--confidence', '0.9'), '--confidence is ignored: the default scan'),
+    (('--all', '--policy', 'elm'), '--policy is ignored: the many-target search chooses its '
+                                   'looks by infomax (--all --targets one uses it)'),
+    (('--scan', 'fovea', '--policy', 'elm', '--seed', '3'), None),
+    (('--all', '--targets', 'one', '--policy', 'elm'), None),
+])
+def test_options_a_search_does_not_use_are_named_once(images, run_find, flags, warning):
+    result = run_find(images['astronaut'], images['noise'], *flags)
+    assert result.returncode == 0, result.stderr
+    said = [line for line in result.stderr.splitlines() if 'ignored' in line]
+    if warning is None:
+        assert said == []
+    else:
+        assert len(said) == 1 and warning in said[0], said
 
 
 def test_a_panorama_is_not_enlarged_beyond_a_few_megapixels():
@@ -287,3 +309,27 @@ def test_a_panorama_is_not_enlarged_beyond_a_few_megapixels():
     assert factor == 2 and pano.shape[1] <= MAX_ENLARGED_SIDE_PX      # 5x before: 10240 px
     small, factor = enlarged(np.zeros((60, 80, 3), np.uint8))
     assert factor == 11 and small.shape[:2] == (660, 880)             # small images as before
+
+
+def test_an_image_the_search_runs_out_of_memory_on_is_one_line_and_the_rest_is_searched(
+        images, run_find, monkeypatch, tmp_path):
+    import ipomdp_gaze.commands.find as find
+    searched = find.search_one
+
+    def search_one(image, *args, **kwargs):
+        if image.mean() < 1:                            # the black picture: "too large"
+            raise cv2.error('OpenCV(4.x) alloc.cpp:73: error: (-4:Insufficient memory) '
+                            'Failed to allocate 2304000000 bytes in function OutOfMemoryError')
+        return searched(image, *args, **kwargs)
+
+    monkeypatch.setattr(find, 'search_one', search_one)
+    black = tmp_path / 'black.png'
+    cv2.imwrite(str(black), np.zeros((300, 400, 3), np.uint8))
+    out = tmp_path / 'out.json'
+    result = run_find(black, images['astronaut'], '--json', out)
+    assert result.returncode == 2
+    assert (f'ipomdp-gaze find: error: {black}: out of memory searching it at 400x300 px (a '
+            'smaller --max-side, or a larger --min-face, reads fewer pixels)') in result.stderr
+    assert 'Traceback' not in result.stderr
+    entries = json.loads(out.read_text())['images']
+    assert entries[0]['error'].startswith('out of memory') and entries[1]['decision'] == 'found'

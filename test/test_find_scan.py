@@ -216,8 +216,8 @@ def test_the_min_face_note_quotes_the_searched_images_pixels(tmp_path, cli_here,
             f'below the 48 px from which the yunet table sees faces at full resolution: the '
             f'ladder ends on the image enlarged {enlarged}x') in result.stderr
     # 8 px faces would need 6x: the ladder stops at the cap and says they may be missed
-    assert ('the most find enlarges an image (they would need 6x): faces of that size may '
-            'still be missed' in result.stderr) == capped
+    assert ('the most find enlarges an image of this size (they would need 6x): faces of that '
+            'size may still be missed' in result.stderr) == capped
 
 
 def test_the_min_face_note_follows_the_ladders_own_rungs():
@@ -230,8 +230,17 @@ def test_the_min_face_note_follows_the_ladders_own_rungs():
     assert at_cap.endswith('enlarged 4x')
     [capped] = min_face_notes('a.png', 10, 10, 'ladder', model)
     assert capped.endswith('the ladder ends on the image enlarged 4x, the most find enlarges '
-                           'an image (they would need 4.8x): faces of that size may still be '
-                           'missed')
+                           'an image of this size (they would need 4.8x): faces of that size '
+                           'may still be missed')
+    # a large image is enlarged only to MAX_ENLARGED_PX (its memory), a huge one not at all
+    [large] = min_face_notes('a.png', 12, 12, 'ladder', model, (4000, 3000))
+    assert large.endswith('the ladder ends on the image enlarged 1.41x, the most find enlarges '
+                          'an image of this size (they would need 4x): faces of that size may '
+                          'still be missed')
+    assert min_face_notes('a.png', 12, 12, 'ladder', model, (8000, 6000)) == [
+        'a.png: faces of 12 px are below the 48 px from which the yunet table sees faces at '
+        'full resolution: an image of this size is not enlarged (it would read more than 24 '
+        'Mpx): faces of that size may be missed']
     [slight] = min_face_notes('a.png', 46, 46, 'ladder', model)
     assert slight.endswith('enlarged 1.04x')                  # not rounded to "1x"
     # within the ladder's tolerance of full resolution there is no enlarged rung, so no note

@@ -233,12 +233,28 @@ def test_calibrate_reads_a_corrupt_image_without_libpngs_lines(images, tmp_path,
 def test_all_on_a_resized_image_says_which_faces_it_looks_for(images, run_find):
     result = run_find(images['astronaut'], '--all', '--max-side', '400')
     assert result.returncode == 0, result.stderr
-    assert ('--all looks for faces of 51 px or more (1/10 of the shorter side; a smaller face '
-            'found, or none, sends it finer): --min-face PX --max-side 0 looks for smaller '
-            'faces') \
+    assert ('--all looks for faces of 51 px or more (1/10 of the shorter side; a face found '
+            'below 0.7 times that, or none, sends it finer): --min-face PX --max-side 0 looks '
+            'for smaller faces') \
         in result.stderr
     small = run_find(images['astronaut'], '--all', '--max-side', '400', '--min-face', '40')
     assert 'looks for faces of' not in small.stderr
     assert '(--max-side 0 searches the image at its own size)' in small.stderr
     whole = run_find(images['astronaut'], '--all')
     assert 'looks for faces of' not in whole.stderr     # not resized: nothing to say
+
+
+def test_a_16_bit_image_of_a_10_bit_camera_is_read_from_its_own_range(tmp_path):
+    """Values up to 1020 are a 10-bit sensor's: scaled by 255 / 1023, not divided into black."""
+    from ipomdp_gaze.commands.find import read_image
+    path = tmp_path / 'ten.png'
+    raw = np.array([[0, 512, 1020], [1023, 4, 100]], np.uint16).repeat(40, 0).repeat(40, 1)
+    cv2.imwrite(str(path), raw)
+    notes = []
+    image = read_image(str(path), notes)
+    assert image.dtype == np.uint8
+    np.testing.assert_array_equal(image, np.round(raw * (255 / 1023)).astype(np.uint8))
+    assert notes == [f"{path}: 16-bit image with values up to 1023, read as 10-bit (a camera's "
+                     'raw range), converted to 8 bits per channel (divided by 4.012)']
+    cv2.imwrite(str(path), raw // 5)                    # 8-bit values stored in 16 bits
+    np.testing.assert_array_equal(read_image(str(path)), (raw // 5).astype(np.uint8))

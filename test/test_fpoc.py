@@ -26,6 +26,16 @@ def test_human_foveal_dprime_parameter():
     assert make_fpoc('human', noise_contrast=0.4).of_eccentricity(1.0) > HumanFPOC()(1.0, 0)
 
 
+def test_human_foveal_dprime_is_met_up_to_the_top_of_its_range():
+    """Past d0 = 11.9, 2 - 2 Phi(d0 / sqrt 2) rounded to 0: a math domain error (QA)."""
+    for d0 in (5.9, 6.1, 8.0, 11.5, 11.95, 12.0):
+        assert make_fpoc('human', foveal_dprime=d0)(0, 0) == pytest.approx(d0, rel=1e-9)
+    # the formula's own shape, documented: above threshold d' peaks off the fixation
+    ecc = np.linspace(0, 2, 2001)
+    values = make_fpoc('human', foveal_dprime=3.0).of_eccentricity(ecc)
+    assert values.max() == pytest.approx(3.53, abs=0.01) and ecc[values.argmax()] > 0.3
+
+
 def test_exponential():
     f = make_fpoc('exponential')
     assert f(1.5, 0) == pytest.approx(2.0 * np.exp(-1))

@@ -8,6 +8,7 @@ many-target session end to end.
 """
 from __future__ import annotations
 
+from dataclasses import replace
 import itertools
 import math
 
@@ -363,3 +364,16 @@ def test_new_filter_settings_reach_the_people_already_followed():
     assert session.tracks.found and session.tracks.found[0].position is not None
     session.configure(MOVING)                                       # track_view peak
     assert all(t.position is None for t in session.tracks.tracks)
+
+
+def test_a_moving_room_without_an_entry_model_or_a_dwell_view_is_warned_about():
+    """Moving people: nobody enters without leave/jump, nobody is kept in view under 'policy'."""
+    from ipomdp_gaze.search.controller_config import moving_room_warnings
+    moving = SearchSettings(targets='many', motion_sigma_cells=0.5)
+    no_entry, no_dwell = moving_room_warnings(moving)
+    assert 'a person who comes in after the start is never found' in no_entry
+    assert 'motion.dwell_s is not used' in no_dwell
+    entering = replace(moving, motion_leave_prob=0.1, motion_track_view='peak')
+    assert moving_room_warnings(entering) == []
+    assert moving_room_warnings(replace(moving, motion_sigma_cells=0.0)) == []      # still
+    assert moving_room_warnings(replace(moving, targets='one')) == []

@@ -218,3 +218,24 @@ def test_rao_blackwellised_runs_keep_the_searches_and_the_curve_with_less_varian
     again.collect()
     assert cache.hits == 3
     np.testing.assert_array_equal(again.map_prob['greedy'], rb)
+
+
+def test_retraining_writes_into_the_output_folder_and_fig3_reads_its_curve(
+        tmp_path, monkeypatch):
+    """``--retrain`` never writes into the installed package (QA); Fig. 3 then shows its curve."""
+    import ipomdp_gaze.cli
+    seen = []
+    monkeypatch.setattr(ipomdp_gaze.cli, 'main', lambda argv: seen.append(argv) or 0)
+    paths = reproduce._retrain(lambda message: None, tmp_path / 'out' / 'kernels')
+    assert set(paths) == set(reproduce.KERNELS)
+    outs = [argv[argv.index('--out') + 1] for argv in seen]
+    assert outs == [str(tmp_path / 'out' / 'kernels' / f'{name}.yaml')
+                    for name in reproduce.KERNELS]
+    shipped = reproduce._curves({})
+    assert [p.name for p in shipped.values()] == ['human-7x7-infomax.csv',
+                                                  'human-7x7-logistic.csv']
+    paths['human-7x7-infomax'].with_suffix('.csv').write_text('epoch\n')
+    conv = reproduce._curves(paths)['weight sharing (conv, 27 weights)']
+    assert conv == tmp_path / 'out' / 'kernels' / 'human-7x7-infomax.csv'
+    monkeypatch.setattr(reproduce, 'ROOT', tmp_path)        # an installed package: no docs/
+    assert reproduce._curves({}) is None

@@ -44,6 +44,11 @@ def test_the_ladder_ends_where_the_smallest_face_that_matters_is_seen():
     assert finest_scale(TABLE, 12.0) == 1.0
     assert finest_scale(TABLE, 6.0) == 2.0                   # enlarged until 12 px
     assert finest_scale(TABLE, 1.0) == 4.0                   # at most MAX_SCALE
+    # ... and at most MAX_ENLARGED_PX read: 24 Mpx of a 12 Mpx image is sqrt(2) times its side
+    assert finest_scale(TABLE, 1.0, (4000, 3000)) == pytest.approx(2 ** 0.5)
+    assert finest_scale(TABLE, 6.0, (1000, 1000)) == 2.0     # 4 Mpx enlarged: within the cap
+    assert finest_scale(TABLE, 1.0, (8000, 6000)) == 1.0     # never below the image's own size
+    assert finest_scale(TABLE, 32.0, (8000, 6000)) == 0.5    # the table's own rows unchanged
 
 
 def test_a_min_face_between_two_rows_ends_the_ladder_at_the_finer_row():

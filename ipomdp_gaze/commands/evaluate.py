@@ -448,8 +448,14 @@ def run(args) -> int:
     if faces != (1, 1) and args.scenes != 'pan-tilt':
         raise ValueError('--faces is for --scenes pan-tilt')
     if args.scenes:
+        model = ('its model: --scene-model' if args.scenes == 'pan-tilt' else
+                 'with its shipped model; another model is tried with find, or on the pan-tilt '
+                 'scenes with --scene-model')
         _refuse_unused(args, SIMULATION_ONLY, f'--scenes {args.scenes} runs the real detector on '
-                       'scenes, not the simulated task (its model: --scene-model)')
+                       f'scenes, not the simulated task ({model})')
+        if args.scene_model and args.scenes != 'pan-tilt':
+            raise ValueError(f'--scene-model is for --scenes pan-tilt; --scenes {args.scenes} '
+                             'runs its shipped model')
     if args.motion == 'walk':
         if args.scenes != 'pan-tilt' or faces != (1, 1):
             raise ValueError('--motion walk is for --scenes pan-tilt with one face')

@@ -65,7 +65,8 @@ face, rule its cells out, search again).
 
 **Images** are read with OpenCV (``IMREAD_ANYDEPTH | IMREAD_ANYCOLOR``: EXIF orientation applied,
 an alpha channel dropped; OpenCV's and libpng's own messages silenced, our one line says it). A
-16-bit image is converted to 8 bits (divided by 257) with a note; one longer than ``--max-side``
+16-bit image is converted to 8 bits (divided by 257, or from the 8-14 bits its values fit) with
+a note; one longer than ``--max-side``
 (2048) on a side is resized before the search (a JPEG decoded at 1/2, 1/4 or 1/8 first, so an
 8000x6000 photo peaks at about 180 MB) and its answer given in its own pixels. Colour arrays
 arrive in OpenCV's BGR order and are converted to RGB; the fovea gives each window to the
@@ -107,9 +108,10 @@ from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
 from ipomdp_gaze.search import answer
 from ipomdp_gaze.search.many import check_many_settings
 from ipomdp_gaze.vision.detectors import load_factory
-from ipomdp_gaze.vision.fullframe import MAX_SCALE
+from ipomdp_gaze.vision.fullframe import MAX_ENLARGED_PX
 from ipomdp_gaze.vision.image_files import decode_quietly
-from ipomdp_gaze.vision.scales import finest_scale, ladder_scales, min_face_px, SCALE_TABLES
+from ipomdp_gaze.vision.scales import (finest_scale, ladder_scales, max_enlargement,
+                                       min_face_px, SCALE_TABLES)
 from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, clip_box,
                                        CROWD_RATIO, EMPTY_BY_EVIDENCE,
                                        FIND_SETTINGS, fovea_for_model, full_frame_reason,
@@ -121,7 +123,8 @@ import numpy as np
 from .common import check_output_file, nonneg_int, plot_format, positive_float
 from .search_args import add_search_args, settings_from_args, TASK_DEFAULT
 
-POLICY_CHOICES = tuple(name for name in POLICY_NAMES if name != 'learned')
+# greedy (the ideal searcher) needs a Gaussian FPOC; find's models count detections
+POLICY_CHOICES = tuple(name for name in POLICY_NAMES if name not in ('learned', 'greedy'))
 # The detectors with shipped find models; the first is the default, chosen on the training
 # photos and training group pictures (docs/faces.md, "find on real photographs").
 FIND_DETECTORS = ('yunet', 'haar')
@@ -295,13 +298,20 @@ def _read_flags(file: Path, max_side: int) -> tuple[int, tuple | None]:
     return READ_FLAGS, None
 
 
+# The bit depths a 16-bit file may hold (a 10-, 12- or 14-bit camera's raw values, 8-bit data
+# stored in 16): a file is read as the smallest its largest value fits, so that a 10-bit frame
+# is not divided by 257 into a nearly black picture.
+SENSOR_BITS = (8, 10, 12, 14, 16)
+
+
 def read_image(path: str, notes: list | None = None, max_side: int = 0,
                size: list | None = None) -> np.ndarray:
     """
     Read an image file as ``uint8`` grey ``(H, W)`` or RGB ``(H, W, 3)``.
 
-    A 16-bit image is converted to 8 bits (``round(v / 257)``, 65535 -> 255), and ``notes``,
-    when given, gets a line saying so; ``size``, when given, gets the decoded ``(width,
+    A 16-bit image is converted to 8 bits (``round(v / 257)``, 65535 -> 255; values that fit
+    fewer bits, :data:`SENSOR_BITS`, scaled from that range instead), and ``notes``, when
+    given, gets a line saying so; ``size``, when given, gets the decoded ``(width,
     height)``. With ``max_side``, an image longer than that on a side
     is resized (:func:`shrink`) before its colours are converted, so that no second full-size
     copy is made (an 8000x6000 photo peaks at about 270 MB resident, most of it the decoded
@@ -328,10 +338,15 @@ def read_image(path: str, notes: list | None = None, max_side: int = 0,
     if image is None:
         raise ValueError(f'{path}: not an image OpenCV can decode')
     if image.dtype == np.uint16:
-        image = cv2.convertScaleAbs(image, alpha=1.0 / 257.0)
+        high = int(image.max())
+        bits = next(b for b in SENSOR_BITS if high < 2 ** b)
+        image = cv2.convertScaleAbs(image, alpha=255.0 / (2 ** bits - 1))
         if notes is not None:
             notes.append(f'{path}: 16-bit image converted to 8 bits per channel (divided by '
-                         f'257)')
+                         f'257)' if bits == 16 else
+                         f'{path}: 16-bit image with values up to {high}, read as {bits}-bit '
+                         "(a camera's raw range), converted to 8 bits per channel (divided "
+                         f'by {(2 ** bits - 1) / 255:.4g})')
     if image.dtype != np.uint8:
         bits = 8 * image.dtype.itemsize
         raise ValueError(f'{path}: {bits}-bit {image.dtype} image; find needs 8 or 16 bits '
@@ -437,15 +452,26 @@ def expand_inputs(paths: list[str], skipped: list | None = None) -> list[str]:
     """
     Each path as given; a folder becomes its image files (by suffix), sorted by name.
 
-    ``skipped``, when given, gets ``(folder, names)`` for each folder with other files.
+    ``skipped``, when given, gets ``(folder, names)`` for each folder with other files or
+    folders (not searched: a folder is not walked down).
+
+    Raises
+    ------
+    ValueError
+        For an empty path (an unset shell variable), which would name the current folder.
+
     """
     out = []
     for path in paths:
+        if not path.strip():
+            raise ValueError(f'an empty image path ({path!r}: an unset shell variable?)')
         folder = Path(path)
         if folder.is_dir():
-            files = sorted(f for f in folder.iterdir() if f.is_file())
+            entries = sorted(folder.iterdir())
+            files = [f for f in entries if f.is_file()]
             out.extend(str(f) for f in files if f.suffix.lower() in IMAGE_SUFFIXES)
-            others = [f.name for f in files if f.suffix.lower() not in IMAGE_SUFFIXES]
+            others = [f.name + '/' * f.is_dir() for f in entries
+                      if not (f.is_file() and f.suffix.lower() in IMAGE_SUFFIXES)]
             if others and skipped is not None:
                 skipped.append((path, others))
         else:
@@ -727,7 +753,7 @@ def search_one(image, task, settings, rng, find_all: bool,
     if route == 'ladder':
         return [search_scales(image, task.fovea, task.model, scales,
                               start=ladder_start(task.model, scales),
-                              finest=finest_scale(scales, min_face))]
+                              finest=finest_scale(scales, min_face, (width, height)))]
     if route == 'first':
         prepare_many(task.fovea, task.model, (width, height), scales)      # one-time set-up
         return [search_first(image, task.fovea, task.model, settings, pixel_budget=budget,
@@ -737,7 +763,7 @@ def search_one(image, task, settings, rng, find_all: bool,
 
 
 def min_face_notes(path: str, given: float | None, min_face: float | None, route: str,
-                   model) -> list[str]:
+                   model, image_px: tuple[int, int] | None = None) -> list[str]:
     """
     Return what stderr says about ``--min-face`` on one image (none: an empty list).
 
@@ -746,7 +772,8 @@ def min_face_notes(path: str, given: float | None, min_face: float | None, route
     the image was resized); ``route``: :func:`search_route`'s. On the ladder (``ladder``),
     when it ends on the frame enlarged beyond the table's finest row (its own rungs,
     :func:`~ipomdp_gaze.vision.scales.ladder_scales`, decide), saying so, and at the cap
-    (:data:`~ipomdp_gaze.vision.fullframe.MAX_SCALE`) that such faces may still be missed; on
+    (:func:`~ipomdp_gaze.vision.scales.max_enlargement` of the searched image of ``image_px``)
+    that such faces may still be missed; on
     the coarse pass (``many``, ``first``), when the faces are below the side the table sees at
     full resolution. Nothing on the other routes (a small image scanned whole, the old loop,
     the fovea), which do not use ``--min-face``.
@@ -762,15 +789,61 @@ def min_face_notes(path: str, given: float | None, min_face: float | None, route
     if route != 'ladder':
         return ([f'{path}: {below}: they may be missed'] if min_face < finest.min_side_px
                 else [])
-    rungs = ladder_scales(table, ladder_start(model, table), finest_scale(table, min_face))
+    rungs = ladder_scales(table, ladder_start(model, table),
+                          finest_scale(table, min_face, image_px))
+    need = finest.min_side_px / min_face
+    cap = max_enlargement(image_px)
+    if need > cap and cap <= finest.scale:
+        return [f'{path}: {below}: an image of this size is not enlarged (it would read more '
+                f'than {MAX_ENLARGED_PX / 1e6:g} Mpx): faces of that size may be missed']
     if not rungs[-1] > finest.scale:
         return []
     note = f'{path}: {below}: the ladder ends on the image enlarged {rungs[-1]:.3g}x'
-    need = finest.min_side_px / min_face
-    if need > MAX_SCALE:
-        note += (f', the most find enlarges an image (they would need {need:.3g}x): faces of '
-                 f'that size may still be missed')
+    if need > cap:
+        note += (f', the most find enlarges an image of this size (they would need '
+                 f'{need:.3g}x): faces of that size may still be missed')
     return [note]
+
+
+# What each route leaves unused of the options given (search_route): the ladder takes no
+# setting at all; the many-target searches keep their settings but choose by infomax.
+FOVEA_OPTIONS = (('policy', '--policy'), ('policy_file', '--policy-file'),
+                 ('confidence', '--confidence'), ('max_fixations', '--max-fixations'),
+                 ('start_cell', '--start'), ('absent_prior', '--absent-prior'),
+                 ('repeat_weight', '--repeat-weight'), ('seed', '--seed'))
+UNUSED_BY_ROUTE = {'ladder': tuple(flag for _, flag in FOVEA_OPTIONS),
+                   'many': ('--policy', '--policy-file', '--seed'),
+                   'first': ('--policy', '--policy-file', '--seed')}
+
+
+def unused_options(args, route: str, model) -> str | None:
+    """
+    Return the warning for options given that ``route`` does not use, or None.
+
+    An option counts as given when it differs from find's default. A detector without a scale
+    table searches with the fovea whatever ``--scan`` says: a note says so.
+    """
+    defaults = {'policy': None, 'policy_file': None, 'seed': 0, 'start_cell': None,
+                **{key: getattr(FIND_SETTINGS, key) for key, _ in FOVEA_OPTIONS
+                   if hasattr(FIND_SETTINGS, key)}}
+    if route == 'fovea' and scale_table(model) is None and args.scan_mode != 'fovea':
+        kind = model.meta.get('detector', {}).get('kind', 'its detector')
+        return (f'note: --scan {args.scan_mode or SCAN_DEFAULT} needs a scale table, which '
+                f'only the shipped detectors ({", ".join(FIND_DETECTORS)}) have: the model of '
+                f'{kind} searches with the fovea (--scan fovea)'
+                + (', without --min-face' if args.min_face is not None else ''))
+    given = [flag for key, flag in FOVEA_OPTIONS
+             if flag in UNUSED_BY_ROUTE.get(route, ())
+             and getattr(args, key, defaults[key]) not in (defaults[key], TASK_DEFAULT)]
+    if not given:
+        return None
+    how = {'ladder': 'the default scan (--scan coarse) calls the detector on the whole image '
+                     'from coarse to fine and takes no fovea setting (--scan fovea',
+           'many': 'the many-target search chooses its looks by infomax (--all --targets one',
+           'first': '--scan many chooses its looks by infomax (--scan fovea'}[route]
+    one = len(given) == 1
+    return (f'warning: {", ".join(given)} {"is" if one else "are"} ignored: {how} uses '
+            f'{"it" if one else "them"})')
 
 
 def check_outputs(args, images: list[str], plots: list[Path]) -> None:
@@ -841,9 +914,13 @@ def run(args) -> int:
     skipped = []
     images = expand_inputs(args.images, skipped)
     for folder, names in skipped:
-        _note(f'{folder}: {len(names)} file{"s" * (len(names) > 1)} not named as an image '
-              f'skipped ({", ".join(names[:3])}{", ..." * (len(names) > 3)}; name one to '
-              f'search it)')
+        files = sum(not name.endswith('/') for name in names)
+        folders = len(names) - files
+        what = ' and '.join(
+            ([f'{files} file{"s" * (files > 1)} not named as an image'] if files else [])
+            + ([f'{folders} folder{"s" * (folders > 1)}'] if folders else []))
+        _note(f'{folder}: {what} skipped ({", ".join(names[:3])}{", ..." * (len(names) > 3)}; '
+              f'name one to search it)')
     if not images:
         raise ValueError(f'no image files in {", ".join(args.images)}')
     plots = plot_paths(args.plot, len(images)) if args.plot else []
@@ -853,7 +930,7 @@ def run(args) -> int:
         _note(f'warning: --scan {args.scan_mode} is ignored: it chooses how find looks for one '
               f'face, and --all / --targets many search for every face')
     scan = args.scan_mode or SCAN_DEFAULT
-    entries, logs, failed, grid = [], [], 0, None
+    entries, logs, failed, grid, warned = [], [], 0, None, set()
     out = sys.stderr if STDOUT in (args.json, args.log) else sys.stdout
     for i, path in enumerate(images):
         notes = []
@@ -884,16 +961,34 @@ def run(args) -> int:
         min_face = None if args.min_face is None else args.min_face / max(scale)
         route, _ = search_route(task, (image.shape[1], image.shape[0]), settings, args.all,
                                 scan)
-        for note in min_face_notes(path, args.min_face, min_face, route, task.model):
+        warning = unused_options(args, route, task.model)
+        if warning is not None and warning not in warned:
+            warned.add(warning)
+            _note(warning)
+        for note in min_face_notes(path, args.min_face, min_face, route, task.model,
+                                   (image.shape[1], image.shape[0])):
             _note(note + (' (--max-side 0 searches the image at its own size)'
                           if scale != (1.0, 1.0) else ''))
         if route == 'many' and args.min_face is None and scale != (1.0, 1.0):
             _note(f'{path}: --all looks for faces of {min_face_px(given):.0f} px or more '
-                  '(1/10 of the shorter side; a smaller face found, or none, sends it '
-                  'finer): '
+                  f'(1/10 of the shorter side; a face found below {CROWD_RATIO:g} times '
+                  'that, or none, sends it finer): '
                   '--min-face PX --max-side 0 looks for smaller faces')
-        results = search_one(image, task, settings, np.random.default_rng([args.seed, i]),
-                             args.all, min_face, scan, given_px=given[0] * given[1])
+        try:
+            results = search_one(image, task, settings, np.random.default_rng([args.seed, i]),
+                                 args.all, min_face, scan, given_px=given[0] * given[1])
+        except (ValueError, MemoryError, cv2.error) as exc:
+            # a detector that fails on this image (DetectorFailed, a box it should not give)
+            # or runs out of memory: reported against the image, the others still searched
+            if isinstance(exc, cv2.error) and 'Insufficient memory' not in str(exc):
+                raise
+            reason = (str(exc) if isinstance(exc, ValueError) else
+                      f'out of memory searching it at {image.shape[1]}x{image.shape[0]} px '
+                      f'(a smaller --max-side, or a larger --min-face, reads fewer pixels)')
+            _error(f'{path}: {reason}')
+            entries.append({'path': path, 'error': reason})
+            failed += 1
+            continue
         searched = results                      # in the searched image's pixels (the plot)
         if scale != (1.0, 1.0):
             results = [_in_given_pixels(r, scale, given) for r in results]

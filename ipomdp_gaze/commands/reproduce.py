@@ -27,6 +27,11 @@ from .common import bootstrap_count, check_output_folder, nonneg_int, positive_i
 from .running import add_run_args, executor_from_args, progress_from_args
 
 ROOT = Path(__file__).resolve().parents[2]
+# A source checkout has docs/ (the report, the learning curves of Fig. 3); an installed package
+# does not, and writes beside the working directory instead.
+CHECKOUT = (ROOT / 'docs' / 'data').is_dir()
+CURVES = {'weight sharing (conv, 27 weights)': 'human-7x7-infomax.csv',
+          'no weight sharing (logistic, 2401 weights)': 'human-7x7-logistic.csv'}
 # The shipped run's options (docs/reproduction.md); the notes quote numbers of this run.
 DEFAULTS = {'episodes': 20000, 'episodes_greedy': 2000, 'episodes_planner': 2000, 'seed': 0,
             'bootstrap': 1000, 'retrain': False}
@@ -48,14 +53,18 @@ def add_parser(sub):
     p = sub.add_parser('reproduce', help="regenerate docs/reproduction.md and the paper's figures",
                        description='Reproduce Table I and Figs. 3-6 of Butko & Movellan (2008) '
                                    'from the shipped kernels with fixed seeds.')
-    p.add_argument('--out', type=Path, default=ROOT / 'docs', help='output folder (default docs/)')
+    p.add_argument('--out', type=Path, default=ROOT / 'docs' if CHECKOUT else Path('reproduction'),
+                   help='output folder (default docs/ of a source checkout, else ./reproduction)')
     p.add_argument('--episodes', type=positive_int, default=DEFAULTS['episodes'])
     p.add_argument('--episodes-greedy', type=positive_int, default=DEFAULTS['episodes_greedy'])
     p.add_argument('--episodes-planner', type=positive_int, default=DEFAULTS['episodes_planner'])
     p.add_argument('--seed', type=nonneg_int, default=DEFAULTS['seed'])
     p.add_argument('--bootstrap', type=bootstrap_count, default=DEFAULTS['bootstrap'])
-    p.add_argument('--retrain', action='store_true', help='retrain every shipped kernel first')
-    p.add_argument('--cache', type=Path, default=ROOT / '.cache' / 'reproduce', metavar='DIR',
+    p.add_argument('--retrain', action='store_true',
+                   help='retrain every shipped kernel first, into OUT/kernels (with its learning '
+                        'curve), and report on those')
+    p.add_argument('--cache', type=Path, default=(ROOT if CHECKOUT else Path('.')) / '.cache' /
+                   'reproduce', metavar='DIR',
                    help='keep every simulated piece here and reuse it while its inputs and the '
                         'package source are unchanged (default .cache/reproduce)')
     p.add_argument('--no-cache', dest='cache', action='store_const', const=None,
@@ -93,14 +102,34 @@ def retrain_argv(spec, out) -> list[str]:
     return argv
 
 
-def _retrain(log):
+def _retrain(log, folder: Path) -> dict:
+    """Retrain every shipped kernel into ``folder`` (never the installed package); their paths."""
     from ipomdp_gaze.cli import main as cli_main
-    from ipomdp_gaze.policies.policy_file import resolve_source
+    folder.mkdir(parents=True, exist_ok=True)
+    paths = {}
     for name in KERNELS:
-        argv = retrain_argv(_load(name), resolve_source(name))
+        paths[name] = folder / f'{name}.yaml'
+        argv = retrain_argv(_load(name), paths[name])
         log(f'retraining {name}: ipomdp-gaze {" ".join(argv)}')
         if cli_main(argv) != 0:
             raise RuntimeError(f'retraining {name} failed')
+    return paths
+
+
+def _curves(retrained: dict) -> dict | None:
+    """
+    Return Fig. 3's learning curves by label, or None where they are not at hand.
+
+    The conv curve is the retrained kernel's when ``--retrain`` made one, else the shipped
+    record's in docs/data; the logistic curve is always the shipped record's (made by ``train
+    --family logistic``, docs/reproduction_notes.md). Only a source checkout has docs/data.
+    """
+    data = ROOT / 'docs' / 'data'
+    curves = {label: data / name for label, name in CURVES.items()}
+    if 'human-7x7-infomax' in retrained:
+        curves['weight sharing (conv, 27 weights)'] = \
+            retrained['human-7x7-infomax'].with_suffix('.csv')
+    return curves if all(path.is_file() for path in curves.values()) else None
 
 
 def _where(executor) -> str:
@@ -114,6 +143,59 @@ def _fmt(point, ci):
     if point is None:
         return 'not reached'
     return f'{point:.2f}' + (f' [{ci[0]:.2f}, {ci[1]:.2f}]' if ci else '')
+
+
+def _plot_curves(plt, curves: dict, path: Path) -> None:
+    """Draw Fig. 3: mean return and fixations to 90% per epoch, each curve of ``curves``."""
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    for label, path_csv in curves.items():
+        c = _read_curve(path_csv)
+        axes[0].plot(c['epoch'], c['mean_return'], label=label)
+        ok = ~np.isnan(c['fixations_to_90'])
+        axes[1].plot(c['epoch'][ok], c['fixations_to_90'][ok], 'o-', ms=3, label=label)
+    axes[0].set_xlabel('epoch (150 episodes each)')
+    axes[0].set_ylabel('mean return (infomax)')
+    axes[1].set_xlabel('epoch (150 episodes each)')
+    axes[1].set_ylabel('fixations to 90% correct')
+    axes[1].axhline(PAPER_7X7['learned infomax'], color='0.5', ls='--', lw=0.8)
+    for ax in axes:
+        ax.set_xscale('log')
+        ax.legend()
+    fig.suptitle('7x7, human FPOC: learning with and without weight sharing')
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _curve_lines(curves: dict) -> list[str]:
+    """Fig. 3's section: when each curve first reaches the paper's level, and the speed-up."""
+    lines = []
+    for label, path in curves.items():
+        c = _read_curve(path)
+        ok = np.where(c['fixations_to_90'] <= PAPER_7X7['learned infomax'])[0]
+        if ok.size:
+            lines.append(f'- {label}: first reaches {PAPER_7X7["learned infomax"]} fixations to '
+                         f'90% at epoch {c["epoch"][ok[0]]:.0f} '
+                         f'({c["wall_seconds"][ok[0]]:.0f} s wall).')
+        else:
+            best = np.nanmin(c['fixations_to_90'])
+            lines.append(f'- {label}: does not reach {PAPER_7X7["learned infomax"]} within '
+                         f'{c["epoch"][-1]:.0f} epochs (best {best:.2f}, '
+                         f'{c["wall_seconds"][-1]:.0f} s wall).')
+    loaded = {label: _read_curve(path) for label, path in curves.items()}
+    level = max(np.nanmin(c['fixations_to_90']) for c in loaded.values())
+    reach = {}
+    for label, c in loaded.items():
+        hit = np.where(c['fixations_to_90'] <= level)[0]
+        reach[label] = (c['epoch'][hit[0]], c['wall_seconds'][hit[0]])
+    (la, (ea, wa)), (lb, (eb, wb)) = reach.items()
+    lines += ['', f"Common level (the worse curve's best): {level:.2f} fixations to 90% on the "
+              f'training-time evaluation set. {la} first reaches it at epoch {ea:.0f} '
+              f'({wa:.0f} s), {lb} at epoch {eb:.0f} ({wb:.0f} s): weight sharing is '
+              f'{eb / ea:.0f}x faster in epochs and {wb / max(wa, 1e-9):.0f}x in wall time '
+              '(the paper: about 20x).', '',
+              '![Fig. 3](figures/fig3_learning_curves.png)', '']
+    return lines
 
 
 def _pyplot():
@@ -279,9 +361,12 @@ def run(args) -> int:
     def log(message):
         print(f'[{time.perf_counter() - started:6.0f} s] {message}', flush=True)
 
-    if args.retrain:
-        _retrain(log)
-    specs = {name: _load(name) for name in KERNELS}
+    retrained = _retrain(log, out / 'kernels') if args.retrain else {}
+    specs = {name: _load(str(retrained.get(name, name))) for name in KERNELS}
+    curves = _curves(retrained)
+    if curves is None:
+        log('Fig. 3 is not drawn: its learning curves (docs/data/human-7x7-*.csv) are in a '
+            'source checkout of ipomdp_gaze, not in an installed package')
     plt = _pyplot()
     lines = []
     cache = PieceCache(args.cache)
@@ -319,29 +404,8 @@ def run(args) -> int:
                   figures / 'fig6_kernels_by_fpoc.png', fpoc_panel=True)
 
     # Figure 3: learning curves with and without weight sharing.
-    data = ROOT / 'docs' / 'data'
-    curves = {'weight sharing (conv, 27 weights)': data / 'human-7x7-infomax.csv',
-              'no weight sharing (logistic, 2401 weights)': data / 'human-7x7-logistic.csv'}
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
-    for label, path in curves.items():
-        if not path.exists():
-            raise FileNotFoundError(f'learning curve {path} is missing (train with --family)')
-        c = _read_curve(path)
-        axes[0].plot(c['epoch'], c['mean_return'], label=label)
-        ok = ~np.isnan(c['fixations_to_90'])
-        axes[1].plot(c['epoch'][ok], c['fixations_to_90'][ok], 'o-', ms=3, label=label)
-    axes[0].set_xlabel('epoch (150 episodes each)')
-    axes[0].set_ylabel('mean return (infomax)')
-    axes[1].set_xlabel('epoch (150 episodes each)')
-    axes[1].set_ylabel('fixations to 90% correct')
-    axes[1].axhline(PAPER_7X7['learned infomax'], color='0.5', ls='--', lw=0.8)
-    for ax in axes:
-        ax.set_xscale('log')
-        ax.legend()
-    fig.suptitle('7x7, human FPOC: learning with and without weight sharing')
-    fig.tight_layout()
-    fig.savefig(figures / 'fig3_learning_curves.png', dpi=110)
-    plt.close(fig)
+    if curves is not None:
+        _plot_curves(plt, curves, figures / 'fig3_learning_curves.png')
 
     lines += _report(args, r7, r11, others, specs, planner_ms, curves)
     cpu = sum(getattr(resource.getrusage(who), field) for field in ('ru_utime', 'ru_stime')
@@ -455,33 +519,9 @@ def _report(args, r7, r11, others, specs, planner_ms, curves):
               '![Fig. 6](figures/fig6_kernels_by_fpoc.png)', '']
 
     lines += ['## Fig. 3: learning with and without weight sharing', '']
-    speed = []
-    for label, path in curves.items():
-        c = _read_curve(path)
-        ok = np.where(c['fixations_to_90'] <= PAPER_7X7['learned infomax'])[0]
-        if ok.size:
-            speed.append((label, c['epoch'][ok[0]], c['wall_seconds'][ok[0]]))
-            lines.append(f'- {label}: first reaches {PAPER_7X7["learned infomax"]} fixations to '
-                         f'90% at epoch {c["epoch"][ok[0]]:.0f} '
-                         f'({c["wall_seconds"][ok[0]]:.0f} s wall).')
-        else:
-            best = np.nanmin(c['fixations_to_90'])
-            lines.append(f'- {label}: does not reach {PAPER_7X7["learned infomax"]} within '
-                         f'{c["epoch"][-1]:.0f} epochs (best {best:.2f}, '
-                         f'{c["wall_seconds"][-1]:.0f} s wall).')
-    loaded = {label: _read_curve(path) for label, path in curves.items()}
-    level = max(np.nanmin(c['fixations_to_90']) for c in loaded.values())
-    reach = {}
-    for label, c in loaded.items():
-        hit = np.where(c['fixations_to_90'] <= level)[0]
-        reach[label] = (c['epoch'][hit[0]], c['wall_seconds'][hit[0]])
-    (la, (ea, wa)), (lb, (eb, wb)) = reach.items()
-    lines += ['', f"Common level (the worse curve's best): {level:.2f} fixations to 90% on the "
-              f'training-time evaluation set. {la} first reaches it at epoch {ea:.0f} '
-              f'({wa:.0f} s), {lb} at epoch {eb:.0f} ({wb:.0f} s): weight sharing is '
-              f'{eb / ea:.0f}x faster in epochs and {wb / max(wa, 1e-9):.0f}x in wall time '
-              '(the paper: about 20x).', '',
-              '![Fig. 3](figures/fig3_learning_curves.png)', '']
+    lines += _curve_lines(curves) if curves is not None else [
+        'Not drawn: its learning curves (docs/data/human-7x7-*.csv) are in a source checkout of '
+        'ipomdp_gaze, not in an installed package.', '']
     notes = ROOT / 'docs' / 'reproduction_notes.md'
     if notes.exists():
         shipped = {name: DEFAULTS[name] for name in SHIPPED_RUN}

@@ -18,7 +18,7 @@ from typing import Callable
 
 from ipomdp_gaze.model.grid import Grid
 import numpy as np
-from scipy.special import ndtr, ndtri
+from scipy.special import log_ndtr, ndtr, ndtri
 
 EDGE_TOL_DEG = 1e-9
 
@@ -69,6 +69,9 @@ class HumanFPOC(FPOC):
     ``c_T(e)^2 = 0.002130 exp(0.9790 e) + 0.6712 exp(0.4905 e) n^2``,
     ``s(e) = 2.8 e / (e + 0.8) + 2``, ``f(c, e) = 0.5 + 0.5 (1 - exp(-(c / c_T(e))^s(e)))``,
     ``d'(e) = sqrt(2) Phi^-1(f(c, e))``, with the contrast c chosen so that ``d'(0) = d0``.
+    The steepness s grows with e, so once c is above the foveal threshold (d0 above about 1.7) d'
+    peaks off the centre, as the formula does (d0 = 3: 3.53 at 0.42 degrees; the default d0 = 2
+    peaks at 2.056 at 0.15 degrees); docs/design.md section 2.
     """
 
     model = 'human'
@@ -79,9 +82,13 @@ class HumanFPOC(FPOC):
         self.foveal_dprime = _positive('foveal_dprime', foveal_dprime)
         if self.foveal_dprime > 12:
             raise ValueError(f'foveal_dprime must be <= 12 (Phi saturates), got {foveal_dprime!r}')
-        f0 = ndtr(self.foveal_dprime / math.sqrt(2.0))
-        # At e = 0 the steepness is 2: (c / c_T)^2 = -ln(2 - 2 f0).
-        self.contrast = math.sqrt(self._threshold_sq(0.0) * -math.log(2.0 - 2.0 * f0))
+        # At e = 0 the steepness is 2: (c / c_T)^2 = -ln(2 - 2 f0), f0 = Phi(d0 / sqrt 2). Past
+        # d0 = 6, 2 - 2 f0 loses digits (and rounds to 0 from 11.9): there in logs, as
+        # -ln 2 - ln Phi(-d0 / sqrt 2); below, as written (the shipped models, bit for bit).
+        d0 = self.foveal_dprime / math.sqrt(2.0)
+        ratio_sq = (-math.log(2.0 - 2.0 * ndtr(d0)) if self.foveal_dprime <= 6 else
+                    -(math.log(2.0) + float(log_ndtr(-d0))))
+        self.contrast = math.sqrt(self._threshold_sq(0.0) * ratio_sq)
 
     def _threshold_sq(self, ecc):
         n2 = self.noise_contrast ** 2

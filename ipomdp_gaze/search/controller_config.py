@@ -188,7 +188,7 @@ def build_config(values: Mapping, build_policy: Callable, changed=None,
             raise ValueError('room.frame_id must name the frame of ~/targets (a TF frame), '
                              'got an empty string')
         check_settle_time(values['settle_time_s'])
-        warnings = []
+        warnings = moving_room_warnings(settings)
         policy_changed = changed is None or any(k in changed for k in POLICY_KEYS) or any(
             k.startswith('fpoc.') for k in changed) or observation_changed
         if previous is not None and not policy_changed:
@@ -201,6 +201,31 @@ def build_config(values: Mapping, build_policy: Callable, changed=None,
         raise ValueError(f'no controller parameter {exc}') from None
     return ControllerConfig(dict(values), grid, fpoc, observation, policy, head, settings,
                             '; '.join(warnings))
+
+
+def moving_room_warnings(settings: SearchSettings) -> list[str]:
+    """
+    Say what a many-target search of moving people will not do with ``settings`` (warnings).
+
+    With motion the room is never done: nobody enters the belief but through its entry model
+    (``motion.leave_prob``: people walk in from out of reach; ``motion.jump_prob``), so without
+    one a person who comes in later is never found; and only ``motion.track_view`` peak or
+    position keeps a person found in view for ``motion.dwell_s``.
+    """
+    moving = (settings.motion_sigma_cells > 0 or settings.motion_jump_prob > 0
+              or settings.motion_leave_prob > 0 or settings.motion_speed_cells > 0)
+    if settings.targets != 'many' or not moving:
+        return []
+    out = []
+    if settings.motion_leave_prob == 0 and settings.motion_jump_prob == 0:
+        out.append('search.targets many with motion and no entry model: a person who comes in '
+                   'after the start is never found (give motion.leave_prob, with absent.prior '
+                   'for the people out of reach, or motion.jump_prob; room.recheck_period_s is '
+                   'for a still room only)')
+    if settings.motion_track_view == 'policy':
+        out.append('motion.track_view policy: the people found are not kept in view in turn '
+                   '(motion.dwell_s is not used); give motion.track_view peak or position')
+    return out
 
 
 def follow_config(core: GazeController, new: ControllerConfig, old_values: Mapping) -> None:

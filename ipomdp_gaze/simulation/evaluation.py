@@ -78,10 +78,21 @@ def fixations_to_90_ci(correct: np.ndarray, n_cells: int, rng: np.random.Generat
         counts = bootstrap_counts(episodes, resamples, rng)
     curves = (counts.astype(np.float32) @ correct.astype(np.float32)) / episodes
     values = fixations_to_level(curves, n_cells)
-    if np.mean(np.isnan(values)) > 0.025:
-        return point, None
-    low, high = np.nanpercentile(values, [2.5, 97.5])
-    return point, (float(low), float(high))
+    beyond = np.where(np.isnan(values), np.inf, values)     # not reached within the horizon
+    return point, _interval(beyond, beyond)
+
+
+def _interval(low_values: np.ndarray, high_values: np.ndarray):
+    """
+    Return the 95% percentile interval, or None when a bound lies beyond the horizon.
+
+    A resample that never reaches 90% within the horizon is "more than T" (+inf), not dropped:
+    dropping it would narrow the interval exactly where the horizon cuts it.
+    """
+    with np.errstate(invalid='ignore'):         # inf - inf between two resamples beyond it
+        low = float(np.percentile(low_values, 2.5))
+        high = float(np.percentile(high_values, 97.5))
+    return (low, high) if np.isfinite(low) and np.isfinite(high) else None
 
 
 def paired_difference_ci(correct_a: np.ndarray, correct_b: np.ndarray, n_cells: int,
@@ -104,9 +115,12 @@ def paired_difference_ci(correct_a: np.ndarray, correct_b: np.ndarray, n_cells: 
     counts = counts.astype(np.float32)
     va = fixations_to_level(counts @ a.astype(np.float32) / n, n_cells)
     vb = fixations_to_level(counts @ b.astype(np.float32) / n, n_cells)
-    diff = va - vb
-    low, high = np.nanpercentile(diff, [2.5, 97.5])
-    return pa - pb, (float(low), float(high))
+    # beyond the horizon: +inf on that side; both beyond, the difference could be anything
+    with np.errstate(invalid='ignore'):
+        diff = np.where(np.isnan(va), np.inf, va) - np.where(np.isnan(vb), np.inf, vb)
+    unknown = np.isnan(diff)
+    return pa - pb, _interval(np.where(unknown, -np.inf, diff),
+                              np.where(unknown, np.inf, diff))
 
 
 # -- moving and absent targets, stopping (docs/design.md section 7) -----------------------------

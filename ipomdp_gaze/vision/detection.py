@@ -239,9 +239,11 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
             raise ValueError(f'detector.{key}: the detector {recorded.get("kind")!r} of '
                              f'observation.file {name!r} has no setting {key!r} (it has '
                              f'{", ".join(sorted(recorded))})')
-        if asked != recorded.get(key):
-            raise ValueError(f'detector.{key} {asked!r} contradicts observation.file {name!r}, '
-                             f'measured with {recorded.get(key)!r} (leave it unset to take it)')
+    differs = sorted(key for key, asked in (detector or {}).items() if asked != recorded[key])
+    if differs and not _builds_the_same(recorded, detector, cascade_dir):
+        key = differs[0]
+        raise ValueError(f'detector.{key} {detector[key]!r} contradicts observation.file '
+                         f'{name!r}, measured with {recorded[key]!r} (leave it unset to take it)')
     notes = []
     try:
         built = detector_from_settings(recorded, cascade_dir or None, notes.append)
@@ -260,6 +262,30 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
         # A record of the file with the wrong types (a fuzzed or hand-edited file).
         raise ValueError(f'observation.file {name!r}: its detector or fovea record is unusable '
                          f'({type(exc).__name__}: {_one_line(exc)})') from None
+
+
+def _builds_the_same(recorded: dict, asked: dict, cascade_dir) -> bool:
+    """
+    Whether the settings ``asked`` over ``recorded`` build the recorded detector.
+
+    Options written as given (an ensemble's members without the defaults and fingerprints the
+    file fills in) repeat the file when the detector they build records what it does.
+    """
+    from ipomdp_gaze.vision.detector import detector_settings
+    from ipomdp_gaze.vision.detectors import (compare_settings, info_keys_of, load_factory,
+                                              make_detector, option_names)
+    try:
+        kind = asked.get('kind', recorded['kind'])
+        takes = option_names(load_factory(kind))
+        options = {key: value for key, value in {**recorded, **asked}.items()
+                   if key != 'kind' and (takes is None or key in takes)}
+        if cascade_dir and (takes is None or 'cascade_dir' in takes):
+            options['cascade_dir'] = cascade_dir
+        built = make_detector(kind, **options)
+        compare_settings(recorded, detector_settings(built), info_keys_of(built))
+    except (ValueError, TypeError, KeyError, OSError):
+        return False
+    return True
 
 
 def _one_line(exc: BaseException) -> str:

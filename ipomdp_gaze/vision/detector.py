@@ -53,6 +53,8 @@ COLORS = ('gray', 'rgb')
 INFO_KEYS = ('opencv', 'window_px')
 # Set by the factory (ipomdp_gaze.vision.detectors) on what it builds: the kind it built it by.
 KIND_ATTRIBUTE = '_ipomdp_gaze_kind'
+# ... and the options it was built with, recorded where its own settings() leaves them out.
+OPTIONS_ATTRIBUTE = '_ipomdp_gaze_options'
 
 
 @runtime_checkable
@@ -81,7 +83,12 @@ def as_detections(result) -> tuple[np.ndarray, np.ndarray]:
         positive width and height.
 
     """
-    array = np.asarray(result, dtype=np.float64) if np.size(result) else np.empty((0, 5))
+    try:
+        array = np.asarray(result, dtype=np.float64) if np.size(result) else np.empty((0, 5))
+    except (TypeError, ValueError):
+        raise ValueError(f'a detector must return one array of boxes, (M, 5) x, y, w, h, score '
+                         f'or (M, 4), got a {type(result).__name__} that is not one (boxes '
+                         f'and scores apart?)') from None
     if array.ndim != 2 or array.shape[1] not in (4, 5):
         raise ValueError(f'a detector must return boxes of shape (M, 5) x, y, w, h, score or '
                          f'(M, 4), got {array.shape}')
@@ -91,6 +98,44 @@ def as_detections(result) -> tuple[np.ndarray, np.ndarray]:
         raise ValueError('every box must have a positive width and height')
     scores = array[:, 4].copy() if array.shape[1] == 5 else np.ones(len(array))
     return np.ascontiguousarray(array[:, :4]), scores
+
+
+class DetectorFailed(ValueError):
+    """A detector raised on an image: its own error, named as the detector's (:func:`detect`)."""
+
+
+def detect(detector, image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Call ``detector`` on ``image`` and read its answer (:func:`as_detections`).
+
+    An image smaller than the detector's ``window_px`` (a window of the fovea) is not given to
+    it: it sees nothing there. Boxes that do not overlap the image are dropped (a plug-in's
+    bug, or boxes given as corners: they must not be counted in the cells at the image's
+    edge). An exception the
+    detector raises (a plug-in's bug, a missing weight file) becomes :class:`DetectorFailed`
+    naming the detector, so that a driver reports it against the image and goes on; running
+    out of memory stays what it is.
+    """
+    height, width = image.shape[:2]
+    window = detector_window_px(detector)
+    if width < window[0] or height < window[1]:
+        return np.empty((0, 4)), np.empty(0)
+    try:
+        result = detector(image)
+    except MemoryError:
+        raise
+    except Exception as exc:                    # noqa: B902 (any error of a user's detector)
+        if type(exc).__name__ == 'error' and 'Insufficient memory' in str(exc):
+            raise                               # OpenCV out of memory: the image's size
+        kind = getattr(detector, KIND_ATTRIBUTE, None) or type(detector).__name__
+        raise DetectorFailed(f'the detector {kind} raised {type(exc).__name__}: '
+                             f'{exc}') from exc
+    boxes, scores = as_detections(result)
+    overlap = ((boxes[:, 0] < width) & (boxes[:, 1] < height)
+               & (boxes[:, 0] + boxes[:, 2] > 0) & (boxes[:, 1] + boxes[:, 3] > 0))
+    if overlap.all():
+        return boxes, scores
+    return boxes[overlap], scores[overlap]
 
 
 def detector_color(detector) -> str:
@@ -429,10 +474,15 @@ def detector_settings(detector) -> dict:
 
     ``kind`` is the name the factory (:func:`ipomdp_gaze.vision.detectors.make_detector`) built
     the detector by; for a detector built otherwise, the kind its settings give, else its class
-    as ``module:Class``, so that the factory can rebuild it when it takes no options.
+    as ``module:Class``, so that the factory can rebuild it when it takes no options. A
+    detector its factory rebuilds as ``factory(**options)`` (no ``from_settings``) has the
+    options it was built with recorded too where ``settings()`` does not give them (a plug-in
+    without ``settings()``, or one that forgets an option), so that a model file rebuilds the
+    detector it was calibrated with.
     """
     settings = getattr(detector, 'settings', None)
-    out = dict(settings()) if callable(settings) else {}
+    out = {**getattr(detector, OPTIONS_ATTRIBUTE, {}),
+           **(dict(settings()) if callable(settings) else {})}
     kind = getattr(detector, KIND_ATTRIBUTE, None)
     if kind is None and 'kind' not in out:
         kind = f'{type(detector).__module__}:{type(detector).__qualname__}'

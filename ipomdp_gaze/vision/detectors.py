@@ -36,7 +36,8 @@ from importlib import metadata
 import inspect
 import re
 
-from ipomdp_gaze.vision.detector import COLORS, detector_settings, INFO_KEYS, KIND_ATTRIBUTE
+from ipomdp_gaze.vision.detector import (COLORS, detector_settings, INFO_KEYS, KIND_ATTRIBUTE,
+                                         OPTIONS_ATTRIBUTE)
 
 ENTRY_POINT_GROUP = 'ipomdp_gaze.detectors'
 # The shipped detectors: declared as entry points in setup.py, and found here without them.
@@ -107,8 +108,8 @@ def load_factory(kind: str):
     return factory
 
 
-def _checked(detector, kind: str):
-    """Check what a factory returned against the interface; return it."""
+def _checked(detector, kind: str, options: dict):
+    """Check what a factory returned against the interface; record its kind and options."""
     if not callable(detector):
         raise ValueError(f'detector {kind!r}: the factory returned {type(detector).__name__}, '
                          f'which is not callable')
@@ -118,12 +119,13 @@ def _checked(detector, kind: str):
                          f'{color!r}')
     try:
         setattr(detector, KIND_ATTRIBUTE, kind)
+        setattr(detector, OPTIONS_ATTRIBUTE, dict(options))
     except AttributeError:
-        pass                    # a detector with __slots__ records its own kind
+        pass                    # a detector with __slots__ records its own kind and options
     return detector
 
 
-def _option_names(factory) -> set | None:
+def option_names(factory) -> set | None:
     """Return the keyword options a factory takes (None: any, or its signature is unknown)."""
     try:
         parameters = inspect.signature(factory).parameters.values()
@@ -147,7 +149,7 @@ def make_detector(kind: str = DEFAULT_KIND, **options):
 
     """
     factory = load_factory(kind)
-    known = _option_names(factory)
+    known = option_names(factory)
     unknown = sorted(set(options) - known) if known is not None else []
     if unknown:
         raise ValueError(f'detector {kind!r} has no option {", ".join(map(repr, unknown))} '
@@ -156,7 +158,9 @@ def make_detector(kind: str = DEFAULT_KIND, **options):
         detector = factory(**options)
     except TypeError as exc:
         raise ValueError(f'detector {kind!r}: bad options {sorted(options)} ({exc})') from None
-    return _checked(detector, kind)
+    # A factory rebuilt by from_settings records itself whole; one rebuilt as factory(**options)
+    # from its record needs its options there (detector_settings keeps those settings() omits).
+    return _checked(detector, kind, {} if hasattr(factory, 'from_settings') else options)
 
 
 def detector_from_spec(spec: dict | None):
@@ -230,6 +234,7 @@ def detector_from_settings(settings: dict, cascade_dir=None, on_note=None):
         takes = 'cascade_dir' in params or any(p.kind == p.VAR_KEYWORD for p in params.values())
         context = {'cascade_dir': cascade_dir} if cascade_dir is not None and takes else {}
         detector = from_settings(dict(settings), **context)
+        options = {}                            # its settings() gives what it was built with
     else:
         options = {k: v for k, v in settings.items() if k != 'kind' and k not in info}
         try:
@@ -237,7 +242,7 @@ def detector_from_settings(settings: dict, cascade_dir=None, on_note=None):
         except TypeError as exc:
             raise ValueError(f'detector {kind!r} cannot be rebuilt from {sorted(options)} '
                              f'({exc})') from None
-    detector = _checked(detector, kind)
+    detector = _checked(detector, kind, options)
     for note in compare_settings(settings, detector_settings(detector), info_keys_of(detector)):
         if on_note is not None:
             on_note(note)

@@ -20,8 +20,9 @@ is rebuilt.
 from __future__ import annotations
 
 import cv2
-from ipomdp_gaze.vision.detector import (as_detections, detector_settings, detector_window_px,
-                                         group_boxes, INFO_KEYS, to_detector_image)
+from ipomdp_gaze.vision.detector import (as_detections, detect, detector_settings,
+                                         detector_window_px, group_boxes, INFO_KEYS,
+                                         to_detector_image)
 import numpy as np
 
 # Largest weight of a member: a box counted more often than this says nothing a count can keep.
@@ -119,7 +120,7 @@ class EnsembleDetector:
         parts = []
         for member, weight in zip(self.members, self.weights):
             own = to_detector_image(image, getattr(member, 'color', 'gray'))
-            boxes, scores = as_detections(member(own))
+            boxes, scores = detect(member, own)
             parts.append(np.repeat(np.column_stack([boxes, scores]), weight, axis=0))
         return np.concatenate(parts, axis=0) if parts else np.empty((0, 5))
 

@@ -60,7 +60,7 @@ import cv2
 from ipomdp_gaze.model.cell_observation import CellObservation
 from ipomdp_gaze.model.checks import positive_int as _positive_int
 from ipomdp_gaze.model.grid import Grid
-from ipomdp_gaze.vision.detector import (as_detections, box_centres_px, detector_color,
+from ipomdp_gaze.vision.detector import (box_centres_px, detect, detector_color,
                                          detector_settings, detector_window_px, to_detector_image)
 import numpy as np
 
@@ -547,7 +547,7 @@ class Fovea:
         else:
             view = cv2.resize(crop, (out_width, out_height),
                               interpolation=self.config.cv2_interpolation)
-        boxes, scores = as_detections(self.detector(view))
+        boxes, scores = detect(self.detector, view)
         back = np.array([width_px / out_width, height_px / out_height])
         centres = box_centres_px(boxes) * back + (x, y)
         boxes_px = np.concatenate([boxes[:, :2] * back + (x, y), boxes[:, 2:4] * back], axis=1)

@@ -23,13 +23,16 @@ import time
 import cv2
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.vision.detector import (as_detections, box_centres_px, DEFAULT_MIN_NEIGHBORS,
-                                         detector_color, detector_window_px, group_boxes,
-                                         to_detector_image)
+                                         detect, detector_color, detector_window_px,
+                                         group_boxes, to_detector_image)
 import numpy as np
 
 # The largest factor a scan enlarges an image by (find's ladder for faces smaller than the
 # detector sees at full resolution, vision.scales.finest_scale).
 MAX_SCALE = 4.0
+# The most pixels an enlarged call reads (OpenCV's detectors need about 75 bytes a pixel: 24 Mpx
+# is about 1.8 GB); an image enlarged for small faces stops there, never below its own size.
+MAX_ENLARGED_PX = 24_000_000
 
 
 @dataclass(frozen=True, eq=False)
@@ -134,7 +137,7 @@ def scan(image: np.ndarray, detector, grid=(21, 21), scale: float = 1.0,
     if (out_width, out_height) != (width, height):
         gray = cv2.resize(gray, (out_width, out_height),
                           interpolation=interpolation if scale <= 1.0 else cv2.INTER_LINEAR)
-    raw, scores = as_detections(detector(gray))
+    raw, scores = detect(detector, gray)
     group = getattr(detector, 'group', None)
     grouped = as_detections(group(raw, min_neighbors) if callable(group)
                             else group_boxes(np.round(raw), min_neighbors))[0]

@@ -34,7 +34,7 @@ import cv2
 from ipomdp_gaze.model.cell_observation import CellObservation
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head_camera import bin_points, PinholeCamera, point_offsets
-from ipomdp_gaze.vision.detector import (as_detections, box_centres_px, detector_color,
+from ipomdp_gaze.vision.detector import (box_centres_px, detect, detector_color,
                                          detector_window_px, group_support,
                                          to_detector_image)
 from ipomdp_gaze.vision.scenes import _paste, load_background, load_faces, Scene, SceneFace, SPLITS
@@ -198,7 +198,7 @@ class ViewObserver:
         if pixels.shape[:2] != (camera.height, camera.width):
             raise ValueError(f'the image is {pixels.shape[1]}x{pixels.shape[0]} px but '
                              f'camera_info says {camera.width}x{camera.height}')
-        boxes, scores = as_detections(self.detector(pixels))
+        boxes, scores = detect(self.detector, pixels)
         centres = box_centres_uv(boxes)
         head = (float(head_rc[0]), float(head_rc[1]))
         counts, raw, cells = bin_points(centres, camera, self.grid, head, self.max_count)

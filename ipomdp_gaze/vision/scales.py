@@ -29,7 +29,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 
-from ipomdp_gaze.vision.fullframe import cells_of_points, MAX_SCALE
+from ipomdp_gaze.vision.fullframe import cells_of_points, MAX_ENLARGED_PX, MAX_SCALE
 import numpy as np
 
 # The smallest face that matters, as a fraction of the image's shorter side: the smallest faces
@@ -155,13 +155,27 @@ def choose_scale(table: ScaleTable, image_px: tuple[int, int],
     return table.rows[-1].scale
 
 
-def finest_scale(table: ScaleTable, min_face: float | None = None) -> float:
+def max_enlargement(image_px: tuple[int, int] | None) -> float:
+    """
+    Return the most an image of ``(width, height)`` px is enlarged for small faces.
+
+    ``fullframe.MAX_SCALE``, less where the enlarged image would read more than
+    ``fullframe.MAX_ENLARGED_PX`` (its memory), but never below 1 (the image at its own size).
+    """
+    if image_px is None:
+        return MAX_SCALE
+    area = float(image_px[0]) * float(image_px[1])
+    return max(1.0, min(MAX_SCALE, math.sqrt(MAX_ENLARGED_PX / area) if area else MAX_SCALE))
+
+
+def finest_scale(table: ScaleTable, min_face: float | None = None,
+                 image_px: tuple[int, int] | None = None) -> float:
     """
     Return the scale ``find``'s ladder ends at: the table's finest unless ``min_face`` is given.
 
     With ``min_face`` (px), the coarsest scale of the table that sees faces of that side; when
     even the finest does not, the image enlarged so that it does (``min_side_px / min_face``
-    times, at most ``fullframe.MAX_SCALE``: below ``min_side_px / MAX_SCALE`` such faces may
+    times, at most :func:`max_enlargement` of an image of ``image_px``: smaller faces may
     still be missed). A coarse end is also the ladder's last call, whose strong box no finer
     look confirms (:func:`ladder_scales`; docs/design.md section 11.4).
     """
@@ -170,7 +184,8 @@ def finest_scale(table: ScaleTable, min_face: float | None = None) -> float:
         return finest.scale
     if float(min_face) * finest.scale >= finest.min_side_px:
         return choose_scale(table, (0, 0), min_face)
-    return min(MAX_SCALE, finest.min_side_px / float(min_face))
+    return max(finest.scale,
+               min(max_enlargement(image_px), finest.min_side_px / float(min_face)))
 
 
 def ladder_scales(table: ScaleTable, start: float, finest: float | None = None) -> list:
