@@ -142,3 +142,17 @@ def test_the_room_keeps_its_people_in_view_in_turn_and_counts_who_is_new():
     assert room.people == () and room.next_person() is None
     done = room.done([{'cell': b, 'probability': 0.7}])
     assert done.new == done.people and not done.recheck
+
+
+def test_people_two_cells_apart_are_two_under_the_gaussian_model():
+    """QA: the node linked occupied cells within 2 under every model, so two people became one."""
+    from ipomdp_gaze.search.room import PERSON_LINK
+    faces = [GRID.index(4, 4), GRID.index(4, 6), GRID.index(6, 6)]
+    core = controller()
+    search(core, faces=faces)
+    assert core.decision == 'found'
+    found = core.session.faces(link=PERSON_LINK['gaussian'])
+    assert sorted(f['cell'] for f in found) == faces
+    # the counts' link (a face's spill-over) makes them one, at a cell where nobody stands
+    [merged] = core.session.faces(link=PERSON_LINK['counts'])
+    assert merged['cell'] not in faces

@@ -60,7 +60,7 @@ from ipomdp_gaze.search.controller_config import (build_config, ControllerConfig
                                                   follow_config, grid_from)
 from ipomdp_gaze.search.gaze import FrameSequence, SETTLING, STAMP_TOLERANCE_S
 from ipomdp_gaze.search.health import HealthMonitor
-from ipomdp_gaze.search.room import MAX_PERIOD_S, Person, RoomWatch
+from ipomdp_gaze.search.room import MAX_PERIOD_S, Person, PERSON_LINK, RoomWatch
 from rclpy.exceptions import NameValidationException
 from rclpy.expand_topic_name import expand_topic_name
 from rclpy.node import Node
@@ -89,8 +89,6 @@ SETTLED_MARGIN_S = 0.01
 # belief_image is at most this many pixels on a side (256x256 cells at 32 px would be 201 MB).
 MAX_IMAGE_SIDE_PX = 1024
 OBSERVATION_MODELS = ('gaussian', 'counts')
-# Many targets: occupied cells within this many cells (Chebyshev) are one person (the rooms').
-FACE_LINK = 2
 
 
 def controller_params() -> list[Param]:
@@ -675,7 +673,8 @@ class GazeControllerNode(QuietPublishers, Node):
         """
         core, grid = self.core, self._config.grid
         session = core.session
-        done = self._room.done(session.faces(link=FACE_LINK))
+        link = PERSON_LINK[self._config.values['observation.model']]
+        done = self._room.done(session.faces(link=link))
         self._publish_people(done.people)
         kind = 're-check' if done.recheck else 'search'
         where = ', '.join(f'{grid.cell(p.cell)} p={p.probability:.3f}' for p in done.people)

@@ -21,6 +21,11 @@ import math
 # A person found again within this many cells (Chebyshev) of a known one is that person (the
 # rooms' scoring tolerance, docs/design.md section 11.5).
 SAME_PERSON_CELLS = 1
+# Occupied cells within this many cells (Chebyshev) are one person, by the node's
+# observation.model: a face's detection counts spill into the cells round it (the rooms' link,
+# docs/design.md section 11.3), while the Gaussian model's evidence of a target lies in its own
+# cell only, so there each occupied cell is one person.
+PERSON_LINK = {'counts': 2, 'gaussian': 0}
 # Longest dwell and re-check period accepted, in seconds (one day).
 MAX_PERIOD_S = 86400.0
 
