@@ -67,6 +67,16 @@ class Forgetful(BlobDetector):
         return {}
 
 
+class Picky:
+    """An option its factory converts (and refuses with numpy's or Python's own message)."""
+
+    def __init__(self, temperature=1.0):
+        self.temperature = float(temperature)
+
+    def __call__(self, gray):
+        return np.empty((0, 4))
+
+
 class Astray:
     """Three boxes wholly outside any image it is given (corners taken for sizes) and one in."""
 
@@ -83,6 +93,8 @@ def plugin_dir(tmp_path_factory):
     """Write the plug-in module and a dist-info declaring its entry point to a folder."""
     folder = tmp_path_factory.mktemp('plugin')
     (folder / 'blobdet.py').write_text(textwrap.dedent(BLOB))
+    (folder / 'brokendet.py').write_text(          # a plug-in whose weights are not installed
+        "raise FileNotFoundError(2, 'No such file or directory', '/nowhere/weights.onnx')\n")
     info = folder / 'blobdet_plugin-0.1.dist-info'
     info.mkdir()
     (info / 'METADATA').write_text('Metadata-Version: 2.1\nName: blobdet-plugin\nVersion: 0.1\n')
@@ -330,3 +342,16 @@ def test_a_detector_that_fails_on_one_image_is_reported_against_it(on_path, tmp_
     bad_entry, good_entry = json.loads(out.read_text())['images']
     assert bad_entry['error'].startswith('the detector blobdet:Fussy raised')
     assert good_entry['cell'] == [2, 4]
+
+
+def test_a_plugin_that_fails_to_load_or_refuses_an_option_is_named(on_path):
+    from ipomdp_gaze.vision.detectors import make_detector
+    with pytest.raises(ValueError, match=r"^detector 'brokendet:Thing': importing module "
+                                         r"'brokendet' failed: FileNotFoundError: .*weights"):
+        make_detector('brokendet:Thing')
+    with pytest.raises(ValueError, match=r"^detector 'blobdet:Picky': bad options "
+                                         r"\['temperature'\] \(could not convert"):
+        make_detector('blobdet:Picky', temperature='abc')
+    with pytest.raises(ValueError, match='is its package installed, or its folder on '
+                                         'PYTHONPATH'):
+        make_detector('not_installed_anywhere:Thing')

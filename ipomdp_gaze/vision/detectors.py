@@ -65,8 +65,11 @@ def _import_target(target: str, kind: str):
     try:
         obj = importlib.import_module(module_name)
     except ImportError as exc:
-        raise ValueError(f'detector {kind!r}: cannot import module {module_name!r} ({exc})') \
-            from None
+        raise ValueError(f'detector {kind!r}: cannot import module {module_name!r} ({exc}; '
+                         f'is its package installed, or its folder on PYTHONPATH?)') from None
+    except Exception as exc:                    # noqa: B902 (a plug-in failing as it loads)
+        raise ValueError(f'detector {kind!r}: importing module {module_name!r} failed: '
+                         f'{type(exc).__name__}: {exc}') from None
     for part in attribute.split('.'):
         try:
             obj = getattr(obj, part)
@@ -156,8 +159,12 @@ def make_detector(kind: str = DEFAULT_KIND, **options):
                          f'(its options: {", ".join(sorted(known)) or "none"})')
     try:
         detector = factory(**options)
-    except TypeError as exc:
-        raise ValueError(f'detector {kind!r}: bad options {sorted(options)} ({exc})') from None
+    except (TypeError, ValueError) as exc:
+        message = str(exc)
+        if message.startswith(f'detector {kind!r}'):
+            raise
+        raise ValueError(f'detector {kind!r}: bad options {sorted(options)} ({message})') \
+            from None
     # A factory rebuilt by from_settings records itself whole; one rebuilt as factory(**options)
     # from its record needs its options there (detector_settings keeps those settings() omits).
     return _checked(detector, kind, {} if hasattr(factory, 'from_settings') else options)
