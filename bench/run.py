@@ -117,11 +117,11 @@ PENDING = {
 
 HEADER = """# Benchmarks
 
-Written by `make bench` (`bench/run.py`): one section per `bench/bench_*.py`. The machine is
-small and shared (other engineers' jobs run at the same time), so absolute times move by 2x or
-more from run to run; every timing is therefore shown beside a reference measured in the same
-run, and the ratios are the numbers to compare. Benchmarks are not tests: nothing in `make test`
-depends on timing.
+Written by `make bench` (`bench/run.py`): one section per `bench/<group>/bench_*.py`. The
+machine is small and shared (other engineers' jobs run at the same time), so absolute times move
+by 2x or more from run to run; every timing is therefore shown beside a reference measured in
+the same run, and the ratios are the numbers to compare. Benchmarks are not tests: nothing in
+`make test` depends on timing.
 
 """
 

@@ -359,3 +359,19 @@ def test_the_ladders_box_is_cut_to_the_image():
     assert x == 0.0 and y == 0.0 and 0 < w < 80 and 0 < h <= image.shape[0]
     # the answer's pixel is still the detector's box centre, as before
     assert result.pixel[0] == pytest.approx(31.8, abs=0.1)
+
+
+def test_search_all_runs_with_its_default_budget():
+    """QA: pixel_budget=None became inf, which run_search took as int(inf)."""
+    from ipomdp_gaze.files.observation_file import load_observation
+    from ipomdp_gaze.policies.registry import build_policy
+    from ipomdp_gaze.search.session import SearchSettings
+    from ipomdp_gaze.vision.fovea_model import fovea_for_model
+    from ipomdp_gaze.vision.search import search_all
+    from skimage import data
+    model = load_observation('faces-420-yunet')
+    settings = SearchSettings(confidence=0.99, max_fixations=20, inhibit_return=True,
+                              absent_prior=0.5, repeat_weight=0.3)
+    searches = search_all(data.astronaut(), fovea_for_model(model), model,
+                          build_policy('elm', model.grid, model), settings)
+    assert searches[0].decision == 'found' and searches[0].cell == (4, 9)

@@ -641,3 +641,61 @@ def test_found_holds_down_to_keep_probability_and_is_lost_below_it():
     assert any(d != 'found' for d, _ in decisions)
     first_lost = next(i for i, (d, _) in enumerate(decisions) if d != 'found')
     assert decisions[first_lost][1] < 0.6 or decisions[first_lost][0] == 'absent'
+
+
+def test_api_misuse_is_refused_with_the_reason_not_a_numpy_error():
+    """QA of the Python API: grids, times, generators, cells and policy scores are checked."""
+    from ipomdp_gaze.model.inhibition import unvisited_choice
+    from ipomdp_gaze.search.many import OccupancySession
+    fpoc = make_fpoc('human')
+    other = Grid(3, 3, 1.0)
+    with pytest.raises(ValueError, match='the observation model is for a 3x3 grid, the search '
+                                         'is on a 3x4 grid'):
+        SearchSession(GRID, _count_model_of(other), build_policy('elm', GRID, fpoc))
+    with pytest.raises(ValueError, match='the policy is for a 3x3 grid, the search is on a 3x4'):
+        SearchSession(GRID, fpoc, build_policy('elm', other, fpoc))
+    session = SearchSession(GRID, fpoc, build_policy('elm', GRID, fpoc),
+                            SearchSettings(max_fixations=5))
+    session.reset(seed=0)
+    session.start()
+    for bad in (-1.0, math.nan, math.inf, 'soon'):
+        with pytest.raises(ValueError, match='dt_s must be a finite number of seconds >= 0'):
+            session.update(Frame(np.zeros(GRID.n_cells)), dt_s=bad)
+        with pytest.raises(ValueError, match='dt_s must be'):
+            session.predict(bad)
+    assert session.fixations == 0                           # nothing was applied
+    many = OccupancySession(GRID, fpoc, SearchSettings(targets='many', max_fixations=5))
+    many.reset(seed=0)
+    many.start()
+    with pytest.raises(ValueError, match='dt_s must be'):
+        many.update(Frame(np.zeros(GRID.n_cells)), dt_s=-0.5)
+    with pytest.raises(TypeError, match='rng must be a numpy.random.Generator'):
+        ModelSensor(GRID, fpoc, np.random)
+    with pytest.raises(ValueError, match=r'cell \(3, 0\) is outside a 3x4 grid'):
+        GRID.index(3, 0)
+    with pytest.raises(ValueError, match=r'cell \(-1, 2\) is outside'):
+        GRID.index(-1, 2)
+
+    class NaNPolicy:
+        name = 'nan'
+
+        def scores(self, belief):
+            return np.full(belief.shape, np.nan)
+
+    belief = np.full((1, GRID.n_cells), 1 / GRID.n_cells)
+    visited = np.zeros(GRID.n_cells, bool)
+    visited[0] = True
+    with pytest.raises(ValueError, match='the policy scored a cell NaN'):
+        unvisited_choice(NaNPolicy(), belief, visited, 0, None, GRID)
+    NaNPolicy.scores = lambda self, belief: np.full(belief.shape, -np.inf)
+    assert unvisited_choice(NaNPolicy(), belief, visited, 0, None, GRID) == 1   # not cell 0
+    core = GazeController(GRID, fpoc, build_policy('elm', GRID, fpoc), SearchSettings())
+    core.reset(0.0)
+    result = core.offer(np.zeros(GRID.n_cells), math.nan)
+    assert result.status == 'rejected' and 'stamped nan, not a time' in result.reason
+
+
+def _count_model_of(grid):
+    """Return a count model of ``grid`` (flat tables: the grid is all that matters here)."""
+    table = np.full((grid.rows, grid.cols, 3), 1 / 3)
+    return CountObservation(grid, table, table.copy())

@@ -77,9 +77,12 @@ class Grid:
         return self.index((self.rows - 1) // 2, (self.cols - 1) // 2)
 
     def index(self, row, col):
-        """Row-major cell index ``row * cols + col`` (scalars or arrays)."""
-        return np.asarray(row) * self.cols + np.asarray(col) if np.ndim(row) or np.ndim(col) \
-            else int(row) * self.cols + int(col)
+        """Row-major cell index ``row * cols + col`` (scalars checked in the grid, or arrays)."""
+        if np.ndim(row) or np.ndim(col):
+            return np.asarray(row) * self.cols + np.asarray(col)
+        if not (0 <= int(row) < self.rows and 0 <= int(col) < self.cols):
+            raise ValueError(f'cell ({row}, {col}) is outside a {self.rows}x{self.cols} grid')
+        return int(row) * self.cols + int(col)
 
     def cell(self, index):
         """``(row, col)`` of a cell index (scalars or arrays)."""

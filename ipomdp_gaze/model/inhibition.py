@@ -42,7 +42,13 @@ def unvisited_choice(policy, belief: np.ndarray, visited: np.ndarray, t: int, rn
     if callable(scorer) or getattr(policy, 'name', '') == 'map':
         scores = np.array(scorer(belief) if callable(scorer) else belief,
                           dtype=float).reshape(-1)
+        if scores.size != n:
+            raise ValueError(f'the policy scored {scores.size} cells of the {n}-cell grid')
+        if np.isnan(scores).any():
+            raise ValueError('the policy scored a cell NaN')
         scores[visited] = -np.inf
+        if not np.isfinite(scores).any():       # every unvisited score -inf: the first of them
+            return int(np.argmin(visited))
         return int(argmax_ties_low(scores))
     choice = policy_choice(policy.select(belief, t, rng), n)
     if not visited[choice]:

@@ -53,7 +53,7 @@ def check_evidence(observation, n_cells: int) -> np.ndarray:
     obs = np.asarray(observation, dtype=float)
     if obs.ndim != 1 or obs.size != n_cells:
         raise EvidenceError(f'evidence has {obs.size} values in shape {obs.shape}, '
-                            f'expected {n_cells}')
+                            f'expected {n_cells}: shape ({n_cells},), one per cell, row-major')
     if np.any(np.isinf(obs)):
         raise EvidenceError('evidence contains +/-inf')
     return obs
@@ -575,9 +575,17 @@ class CountObservation:
 
 
 def as_observation(grid: Grid, model):
-    """Return ``model`` if it is an observation model, or the Gaussian model of an FPOC."""
+    """
+    Return the observation model of a search on ``grid``: ``model``, or an FPOC's Gaussian model.
+
+    A model of another grid's shape is refused (ValueError): its tables would not fit the belief.
+    """
     if isinstance(model, FPOC):
         return GaussianObservation(grid, model)
     if not hasattr(model, 'log_likelihood_ratio'):
         raise TypeError(f'expected an observation model or an FPOC, got {type(model).__name__}')
+    own = getattr(model, 'grid', None)
+    if own is not None and tuple(own.shape) != tuple(grid.shape):
+        raise ValueError(f'the observation model is for a {own.rows}x{own.cols} grid, the '
+                         f'search is on a {grid.rows}x{grid.cols} grid')
     return model

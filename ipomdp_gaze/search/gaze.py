@@ -40,6 +40,7 @@ camera needs: times, settling, enable, counters and the events of a frame. Its s
 from __future__ import annotations
 
 from dataclasses import dataclass
+import math
 
 from ipomdp_gaze.model.belief import EvidenceError
 from ipomdp_gaze.model.grid import Grid
@@ -477,6 +478,8 @@ class GazeController:
             The grouped detections centred in each cell (``Frame.groups``).
 
         """
+        if not math.isfinite(stamp_s):
+            return self.reject(f'the frame is stamped {stamp_s!r}, not a time')
         try:
             frame = self.session.checked_frame(evidence, offsets=offsets,   # checked once
                                                groups=groups)
@@ -507,7 +510,7 @@ class GazeController:
         if stamp_s < self.target_time_s + self.settle_time_s:
             self.skipped += 1
             return FrameResult('skipped', SETTLING)
-        dt_s = float(stamp_s) - self.update_time_s
+        dt_s = max(0.0, float(stamp_s) - self.update_time_s)     # a stamp before the last
         if self.follows_people:
             return self._offer_people(frame, dt_s, stamp_s, now_s)
         # While tracking, the cell the target was last found in: the answer before this frame.

@@ -68,10 +68,10 @@ from ipomdp_gaze.model.occupancy import (binary_entropy, cell_prior, count_faces
                                          information_table, log_nobody, occupancy,
                                          predict_occupancy, prior_log_odds)
 from ipomdp_gaze.model.still_evidence import StillEvidence
-from ipomdp_gaze.search.session import (check_groups, check_offsets, Frame, motion_settings,
-                                        OrderError, position_settings, scales_false_alarms,
-                                        SearchSettings, start_index, StepResult, target_motion,
-                                        track_filter)
+from ipomdp_gaze.search.session import (check_groups, check_offsets, check_seconds_elapsed,
+                                        Frame, motion_settings, OrderError, position_settings,
+                                        scales_false_alarms, SearchSettings, start_index,
+                                        StepResult, target_motion, track_filter)
 from ipomdp_gaze.search.tracks import GLANCE, Tracks, Turns
 import numpy as np
 from scipy.ndimage import maximum_filter
@@ -472,6 +472,7 @@ class OccupancySession:
     def predict(self, dt_s: float) -> None:
         """Spread the belief over ``dt_s`` of the targets' motion (nothing for still targets)."""
         s = self._s()
+        dt_s = check_seconds_elapsed(dt_s)
         if self._motion.active and dt_s > 0:
             s['base'], s['outside'] = predict_occupancy(s['base'], s['outside'], self._motion,
                                                         dt_s)
@@ -489,6 +490,7 @@ class OccupancySession:
         if s['ended']:
             raise OrderError(f'the search has ended ({s["decision"]}); reset starts a new one')
         k = s['fixation']
+        dt_s = check_seconds_elapsed(dt_s)
         try:
             obs = self.check_frame(frame.values)
             offsets = check_offsets(frame.offsets, self.grid.n_cells)
@@ -496,7 +498,6 @@ class OccupancySession:
             term = self.observation.log_likelihood_ratio(obs, k)
         except EvidenceError as exc:
             return self._result('rejected', reason=str(exc))
-        dt_s = max(0.0, float(dt_s))
         if self._motion.active:
             self.predict(dt_s)
             clutter = self._active_clutter()

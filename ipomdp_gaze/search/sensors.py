@@ -51,6 +51,9 @@ class ModelSensor:
     """
 
     def __init__(self, grid: Grid, model, rng: np.random.Generator):
+        if not isinstance(rng, np.random.Generator):
+            raise TypeError(f'rng must be a numpy.random.Generator (np.random.default_rng(seed)), '
+                            f'got {type(rng).__name__}')
         self.grid = grid
         self.model = as_observation(grid, model)
         self.rng = rng
@@ -137,9 +140,10 @@ def run_search(session: SearchSession, sensor: Sensor, scene, *, seed=None,
         raise ValueError(f'the sensor observes a {sensor.grid.rows}x{sensor.grid.cols} grid, '
                          f'the session searches {session.grid.rows}x{session.grid.cols}')
     t0 = time.perf_counter()
-    budget = math.inf if pixel_budget is None else int(pixel_budget)
+    budget = math.inf if pixel_budget is None or pixel_budget == math.inf else int(pixel_budget)
     pixels, over = 0, False
-    after_scan = math.inf if fixation_budget is None else int(fixation_budget)
+    after_scan = (math.inf if fixation_budget is None or fixation_budget == math.inf
+                  else int(fixation_budget))
     order = None if fixations is None else iter([int(c) for c in fixations])
     if restart:
         sensor.start(scene)

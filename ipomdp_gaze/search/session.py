@@ -36,6 +36,7 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass, field
+import math
 
 from ipomdp_gaze.model.belief import (argmax_ties_low, bayes_update, entropy_of_log,
                                       EvidenceError, map_cell, normalize_log)
@@ -372,6 +373,25 @@ class _PerSecond:
         return out
 
 
+def check_seconds_elapsed(dt_s) -> float:
+    """Return ``dt_s`` as float seconds, or raise ValueError unless it is finite and >= 0."""
+    try:
+        value = float(dt_s)
+    except (TypeError, ValueError):
+        value = math.nan
+    if not (math.isfinite(value) and value >= 0):
+        raise ValueError(f'dt_s must be a finite number of seconds >= 0, got {dt_s!r}')
+    return value
+
+
+def check_policy_grid(policy, grid) -> None:
+    """Refuse a policy built for another grid's shape (ValueError): its scores would not fit."""
+    own = getattr(policy, 'grid', None)
+    if own is not None and tuple(own.shape) != tuple(grid.shape):
+        raise ValueError(f'the policy is for a {own.rows}x{own.cols} grid, the search is on a '
+                         f'{grid.rows}x{grid.cols} grid')
+
+
 class SearchSession:
     """
     One search at a time on one grid, with an assumed observation model and a policy.
@@ -398,6 +418,7 @@ class SearchSession:
                  log_size: int = 10_000):
         self.grid = grid
         self.observation = as_observation(grid, observation)
+        check_policy_grid(policy, grid)
         self.policy = policy
         self.settings = settings or SearchSettings()
         self.settings.check_grid(grid)
@@ -463,7 +484,8 @@ class SearchSession:
         self._clutter = None
 
     def set_policy(self, policy) -> None:
-        """Choose with another policy from the next choice on."""
+        """Choose with another policy from the next choice on (one of this grid's shape)."""
+        check_policy_grid(policy, self.grid)
         self.policy = policy
 
     # -- read-only views -----------------------------------------------------------------
@@ -771,6 +793,7 @@ class SearchSession:
 
     def predict(self, dt_s: float) -> None:
         """Spread the belief over ``dt_s`` of the target's motion (nothing for a still target)."""
+        dt_s = check_seconds_elapsed(dt_s)
         if self.motion.active and dt_s > 0:
             self.motion.predict_over(self._state().log_belief, dt_s)
             self._changed()
@@ -787,6 +810,8 @@ class SearchSession:
         ------
         OrderError
             Before :meth:`start`, or after the search has ended.
+        ValueError
+            For a ``dt_s`` that is negative or not finite.
 
         """
         search = self._state()
@@ -794,6 +819,7 @@ class SearchSession:
             raise OrderError('start the search (the first fixation) before updating it')
         if search.ended:
             raise OrderError(f'the search has ended ({search.decision}); reset starts a new one')
+        dt_s = check_seconds_elapsed(dt_s)
         try:
             obs = self._frame_values(frame)
             offsets = self._frame_part(frame, 'offsets', check_offsets)
