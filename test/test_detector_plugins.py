@@ -355,3 +355,30 @@ def test_a_plugin_that_fails_to_load_or_refuses_an_option_is_named(on_path):
     with pytest.raises(ValueError, match='is its package installed, or its folder on '
                                          'PYTHONPATH'):
         make_detector('not_installed_anywhere:Thing')
+
+
+def test_an_ensemble_calls_each_member_that_sees_the_image_and_our_bugs_stay_bugs(on_path):
+    """Review: the ensemble's window_px is its largest member's; the package's errors propagate."""
+    from ipomdp_gaze.vision.detector import detect
+    from ipomdp_gaze.vision.detectors import make_detector
+    ensemble = make_detector('ensemble', members=[{'kind': 'haar'},
+                                                  {'kind': 'blobdet:Astray'}])
+    assert ensemble.window_px[0] > 12                 # Haar's 20: larger than the image below
+    boxes, _ = detect(ensemble, np.zeros((12, 12), np.uint8))
+    np.testing.assert_array_equal(boxes, [[1, 1, 4, 4]])     # Astray's box inside: it was asked
+
+    def broken(self, image):
+        raise IndexError('a bug of ours')
+
+    ours = type('Ours', (), {'__module__': 'ipomdp_gaze.vision.detector', '__call__': broken})
+    with pytest.raises(IndexError, match='a bug of ours'):      # a traceback, not one line
+        detect(ours(), np.zeros((40, 40), np.uint8))
+
+
+def test_a_fingerprint_or_an_impossible_value_in_the_nodes_options_is_refused_in_one_line():
+    """Review: only options the factory takes were rebuilt; the others passed unchecked."""
+    from ipomdp_gaze.vision.detection import build_setup
+    for asked in ({'model_sha256': 'bogus'}, {'top_k': float('inf')},
+                  {'window_px': [99, 99]}, {'opencv': '3.0'}):
+        with pytest.raises(ValueError, match=f'detector.{next(iter(asked))} .* contradicts'):
+            build_setup('camera', 'faces-pan-tilt-yunet', detector=asked)

@@ -98,3 +98,12 @@ def test_a_horizon_that_cuts_resamples_widens_the_interval_or_leaves_it_undefine
         _, paired_full = paired_difference_ci(full[0], full[1], 49, None, counts=counts)
         assert paired is None or paired == paired_full, (horizon, paired, paired_full)
     assert ci == ci_full and paired == paired_full          # horizon 30: nothing cut
+
+
+def test_a_percentile_on_a_finite_resample_next_to_those_beyond_is_that_resample():
+    """QA review: with inf, numpy's interpolation gave inf * 0 = NaN at an exact position."""
+    from ipomdp_gaze.simulation.evaluation import _interval
+    values = np.r_[np.arange(976.0), np.full(25, np.inf)]       # 1001 resamples, 25 beyond
+    assert _interval(values, values) == (25.0, 975.0)
+    values = np.r_[np.arange(970.0), np.full(31, np.inf)]       # the 97.5% one is beyond
+    assert _interval(values, values) is None

@@ -258,3 +258,12 @@ def test_a_16_bit_image_of_a_10_bit_camera_is_read_from_its_own_range(tmp_path):
                      'raw range), converted to 8 bits per channel (divided by 4.012)']
     cv2.imwrite(str(path), raw // 5)                    # 8-bit values stored in 16 bits
     np.testing.assert_array_equal(read_image(str(path)), (raw // 5).astype(np.uint8))
+
+
+def test_images_decode_without_opencvs_logging_binding(monkeypatch):
+    """QA: the 4.11-4.12 wheels and Ubuntu's OpenCV have no cv2.utils.logging (a traceback)."""
+    from ipomdp_gaze.vision.image_files import decode_quietly
+    monkeypatch.delattr(cv2.utils, 'logging')
+    _, png = cv2.imencode('.png', np.full((4, 6), 7, np.uint8))
+    assert decode_quietly(png, cv2.IMREAD_UNCHANGED).shape == (4, 6)
+    assert decode_quietly(np.frombuffer(b'not an image', np.uint8)) is None

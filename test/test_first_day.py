@@ -90,7 +90,8 @@ def test_bad_cells_exit_with_one_line(args, message):
     (['--policy', 'nonsense'], '--policy must be one of learned, map'),
     (['--target', '99,99'], '--target 99,99 is outside the 11x11 grid'),
     (['--scene', 'faces', '--policy', 'greedy'], 'needs the Gaussian model of an FPOC'),
-    (['--domain-id', '300'], 'expected a ROS domain id in 0..101'),
+    (['--domain-id', '300'], 'expected a ROS domain id in 0..101 or 215..232'),
+    (['--domain-id', '150'], 'expected a ROS domain id in 0..101 or 215..232, got'),
     (['--plot', 'x.gif'], '--plot writes a .png file'),
 ])
 def test_demo_refuses_bad_arguments_before_starting_any_node(args, message):
@@ -131,3 +132,9 @@ def test_the_human_fpoc_far_out_is_zero_without_a_numpy_warning():
         warnings.simplefilter('error')
         d = make_fpoc('human')(np.array([0.0, 800.0]), np.array([0.0, 0.0]))
     assert d[0] == pytest.approx(2.0) and d[1] == 0.0
+
+
+def test_the_linux_only_domain_ids_are_accepted():
+    """QA: 215..232 are valid ROS domain ids on Linux; the demo refused them."""
+    from ipomdp_gaze.commands.demo import domain_arg
+    assert [domain_arg(str(d)) for d in (0, 101, 215, 232)] == [0, 101, 215, 232]

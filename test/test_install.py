@@ -441,3 +441,22 @@ def test_installed_scene_camera_and_detector_serve_a_fixation(install, ros_env, 
         codes = {node.name: node.stop() for node in nodes}
     assert codes == {'detector': 0, 'scene_camera': 0}, f'exit status {codes}:\n' + \
         '\n'.join(f'--- {n.name}\n{n.output()}' for n in nodes)
+
+
+def test_a_user_or_prefix_install_finds_its_shared_files(tmp_path, monkeypatch):
+    """QA: pip install --user or --prefix put share/ipomdp_gaze where nothing looked."""
+    import importlib.metadata as metadata
+    from ipomdp_gaze.files import share_files
+    site = tmp_path / 'pfx' / 'lib' / 'python3.11' / 'site-packages'
+    info = site / 'ipomdp_gaze-0.2.0.dist-info'
+    info.mkdir(parents=True)
+    (info / 'METADATA').write_text('Metadata-Version: 2.1\nName: ipomdp_gaze\nVersion: 0.2.0\n')
+    share = tmp_path / 'pfx' / 'share' / 'ipomdp_gaze'
+    (share / 'config').mkdir(parents=True)
+    (share / 'package.xml').write_text('<package/>\n')
+    (share / 'config' / 'only_here.yaml').write_text('a: 1\n')
+    (info / 'RECORD').write_text('../../../share/ipomdp_gaze/package.xml,,\n'
+                                 '../../../share/ipomdp_gaze/config/only_here.yaml,,\n')
+    monkeypatch.setattr(metadata, 'distribution', lambda name: metadata.PathDistribution(info))
+    monkeypatch.setenv('AMENT_PREFIX_PATH', '')
+    assert share_files.config_file('only_here.yaml') == share / 'config' / 'only_here.yaml'

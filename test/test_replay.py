@@ -143,3 +143,13 @@ def test_a_message_type_the_reader_does_not_know_is_named(tmp_path):
                                          'reader does not know'):
         read_bag(tmp_path / 'bag')
     assert open_writer                              # the writer of the package's own bags
+
+
+def test_bags_without_rosbags_installed_are_one_line(tmp_path, monkeypatch):
+    """QA: a rosdep/colcon install has no rosbags; the recorder died with a 16-line traceback."""
+    import sys
+    from ipomdp_gaze.files import bag
+    monkeypatch.setitem(sys.modules, 'rosbags', None)          # import rosbags: ImportError
+    for call in (lambda: bag.open_writer(tmp_path / 'new'), lambda: bag.read_bag(tmp_path)):
+        with pytest.raises(ValueError, match=r'needs the rosbags package \(pip install '):
+            call()

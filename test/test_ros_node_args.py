@@ -113,3 +113,19 @@ def test_a_running_node_warns_about_a_typo(ros_env, tmp_path):
     assert proc.returncode == 0, ''.join(seen) + rest
     assert "parameter 'confidance' is not a parameter of this node; ignored (did you mean " \
         "'confidence'?)" in ''.join(seen)
+
+
+@pytest.mark.parametrize('module', ['controller', 'camera', 'detector', 'scene_camera'])
+def test_a_node_executable_answers_help_and_refuses_a_stray_argument(ros_env, module):
+    """QA: `lib/ipomdp_gaze/controller --help` started a live node that moved the head."""
+    def run(*args):
+        return subprocess.run([sys.executable, '-m', f'ipomdp_gaze.nodes.{module}', *args],
+                              cwd=REPO, env=ros_env, capture_output=True, text=True, timeout=60)
+    helped = run('--help')
+    assert helped.returncode == 0 and helped.stdout.startswith(
+        f'usage: ros2 run ipomdp_gaze {module} [--ros-args'), helped.stdout + helped.stderr
+    assert '[INFO]' not in helped.stdout + helped.stderr               # no node started
+    stray = run('--seed', '3')
+    assert stray.returncode == 2
+    assert stray.stderr.strip().splitlines()[-1].endswith(
+        'unexpected arguments --seed 3 (ROS arguments go after --ros-args; --help for usage)')

@@ -90,6 +90,9 @@ def tempered_vs_elm(grid, fpoc, d, seeds, episodes, horizon, resamples):
               f"expected {fmt(entry['expected'])}", flush=True)
     pooled = {}
     for key in ('indicator', 'expected'):
+        if any(r[key]['ci95'] is None for r in rows):       # a bound beyond the horizon
+            pooled[key] = {'difference': None, 'ci95': None}
+            continue
         diffs = np.array([r[key]['difference'] for r in rows])
         ses = np.array([(r[key]['ci95'][1] - r[key]['ci95'][0]) / 3.92 for r in rows])
         mean, se = diffs.mean(), np.sqrt(np.sum(ses ** 2)) / len(rows)

@@ -84,8 +84,8 @@ def smoothed(curve, window=3):
 
 def describe(name, r):
     """Describe a result in one line: fixations to 90%, its interval, the difference to ELM."""
-    low, high = r['ci95']
-    dlow, dhigh = r['minus_elm_ci95']
+    low, high = r['ci95'] or (np.nan, np.nan)                   # None: beyond the horizon
+    dlow, dhigh = r['minus_elm_ci95'] or (np.nan, np.nan)
     return (f'{name}: {r["epochs"]} epochs, {r["train_seconds"]:.1f} s of training; '
             f'fixations to 90% {r["fixations_to_90"]:.3f} [{low:.3f}, {high:.3f}], '
             f'minus ELM {r["minus_elm"]:+.3f} [{dlow:+.3f}, {dhigh:+.3f}]')

@@ -87,6 +87,11 @@ def planner_options(text):
     return options
 
 
+def _ci(ci, sign: str) -> str:
+    """Format a 95% interval, or say that a bound lies beyond the horizon (no interval)."""
+    return '[beyond the horizon]' if ci is None else f'[{ci[0]:{sign}.3f}, {ci[1]:{sign}.3f}]'
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
     parser.add_argument('--episodes', type=int, default=4000)
@@ -139,13 +144,13 @@ def main():
             point, ci = fixations_to_90_ci(results[name][i], GRID.n_cells,
                                            np.random.default_rng([args.seed, 7]), RESAMPLES)
             out['policies'][name][label] = {'fixations_to_90': point, 'ci95': ci}
-            print(f'{name:9s} {label:9s} {point:.3f} [{ci[0]:.3f}, {ci[1]:.3f}]')
+            print(f'{name:9s} {label:9s} {point:.3f} {_ci(ci, "")}')
     for a, b in itertools.combinations(names[::-1], 2):
         for i, label in enumerate(measures):
             diff, ci = paired_difference_ci(results[a][i], results[b][i], GRID.n_cells,
                                             np.random.default_rng([args.seed, 8]), RESAMPLES)
             out['paired'].setdefault(f'{a} - {b}', {})[label] = {'difference': diff, 'ci95': ci}
-            print(f'{a} - {b} ({label}, {n} paired): {diff:+.3f} [{ci[0]:+.3f}, {ci[1]:+.3f}]')
+            print(f'{a} - {b} ({label}, {n} paired): {diff:+.3f} {_ci(ci, "+")}')
     if args.json is not None:
         args.json.write_text(json.dumps(out, indent=1) + '\n')
 

@@ -81,7 +81,7 @@ def add_parser(sub):
     p.add_argument('--timeout', type=positive_float, default=60.0,
                    help='give up after this many seconds (default 60)')
     p.add_argument('--domain-id', type=domain_arg, default=None,
-                   help='ROS domain id, 0..101 (default: derived from the process id)')
+                   help='ROS domain id, 0..101 or 215..232 (default: derived from the process id)')
     p.add_argument('--verbose', action='store_true', help="print the nodes' own output")
     p.add_argument('--plot', type=Path, default=None, metavar='PNG',
                    help='write the final picture of the search: the belief over the camera '
@@ -109,15 +109,20 @@ def parse_target(text):
     return row, col
 
 
+# Fast DDS maps domain ids to UDP ports: on Linux 0..101 and 215..232 are valid (ROS 2's
+# "ROS_DOMAIN_ID" concept page); the demo picks its own in 1..101.
+LINUX_EXTRA_DOMAINS = range(215, 233)
+
+
 def domain_arg(text: str) -> int:
-    """Parse a ROS domain id in 0..101 for argparse."""
+    """Parse a ROS domain id (0..101 or 215..232) for argparse."""
     try:
         value = int(text)
     except ValueError:
         value = -1
-    if not 0 <= value <= MAX_DOMAIN_ID:
-        raise argparse.ArgumentTypeError(f'expected a ROS domain id in 0..{MAX_DOMAIN_ID}, got '
-                                         f'{text!r}')
+    if not (0 <= value <= MAX_DOMAIN_ID or value in LINUX_EXTRA_DOMAINS):
+        raise argparse.ArgumentTypeError(f'expected a ROS domain id in 0..{MAX_DOMAIN_ID} or '
+                                         f'215..232, got {text!r}')
     return value
 
 

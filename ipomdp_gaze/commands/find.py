@@ -982,7 +982,7 @@ def run(args) -> int:
             # or runs out of memory: reported against the image, the others still searched
             if isinstance(exc, cv2.error) and 'Insufficient memory' not in str(exc):
                 raise
-            reason = (str(exc) if isinstance(exc, ValueError) else
+            reason = (str(exc).removeprefix(f'{path}: ') if isinstance(exc, ValueError) else
                       f'out of memory searching it at {image.shape[1]}x{image.shape[0]} px '
                       f'(a smaller --max-side, or a larger --min-face, reads fewer pixels)')
             _error(f'{path}: {reason}')

@@ -22,7 +22,18 @@ DISTRO_STORE = 'ROS2_JAZZY'
 COMPRESSIONS = ('', 'zstd')
 
 
+def _need_rosbags() -> None:
+    """Raise ValueError (one line) unless ``rosbags``, which reads and writes bags, is there."""
+    try:
+        import rosbags  # noqa: F401
+    except ImportError:
+        raise ValueError('recording and replaying bags needs the rosbags package (pip install '
+                         "'rosbags>=0.10'; a rosdep or colcon install does not bring it)") \
+            from None
+
+
 def _typestore():
+    _need_rosbags()
     from rosbags.typesys import get_typestore, Stores
     return get_typestore(getattr(Stores, DISTRO_STORE))
 
@@ -65,6 +76,7 @@ def open_writer(path, compression: str = ''):
         ``''`` or ``'zstd'``.
 
     """
+    _need_rosbags()
     from rosbags.rosbag2 import StoragePlugin, Writer
     from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
     if compression not in COMPRESSIONS:
@@ -153,6 +165,7 @@ def read_bag(path, topics=None) -> Bag:
         If ``path`` is not a readable rosbag2 bag.
 
     """
+    _need_rosbags()
     from rosbags.rosbag2 import Reader
     from rosbags.rosbag2.errors import ReaderError
     path = Path(path)

@@ -20,7 +20,28 @@ def share_dirs() -> list[Path]:
     """Candidate ``share/ipomdp_gaze`` directories, most specific first."""
     prefixes = [Path(p) for p in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep) if p]
     dirs = [p / 'share' / PACKAGE for p in prefixes + [Path(sys.prefix)]]
-    return dirs + [SOURCE_ROOT]
+    installed = installed_share()
+    return dirs + ([installed] if installed is not None else []) + [SOURCE_ROOT]
+
+
+def installed_share() -> Path | None:
+    """
+    Return the ``share/ipomdp_gaze`` folder the installed distribution recorded, or None.
+
+    ``pip install --user`` or ``--prefix`` puts it under that scheme's data folder, which is
+    neither ``sys.prefix`` nor on ``AMENT_PREFIX_PATH``; the distribution's RECORD names it
+    (relative to site-packages). An editable install records none.
+    """
+    from importlib.metadata import distribution, PackageNotFoundError
+    try:
+        dist = distribution(PACKAGE)
+    except PackageNotFoundError:
+        return None
+    for file in dist.files or ():
+        if file.name == 'package.xml' and file.parent.name == PACKAGE \
+                and file.parent.parent.name == 'share':
+            return Path(dist.locate_file(file)).resolve().parent
+    return None
 
 
 def config_file(name: str) -> Path:

@@ -61,6 +61,24 @@ def run_node(make_node, node_name: str, args=None) -> int:
     from rclpy.exceptions import ParameterException
     from rclpy.executors import ExternalShutdownException
     from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+    from rclpy.utilities import remove_ros_args
+    argv = list(sys.argv if args is None else args)
+    try:
+        own = remove_ros_args(args=argv)[1:]    # what is not for ROS: the node takes nothing
+    except Exception:                           # noqa: B902 (rcl's own parse error, below)
+        own = []
+    if own:
+        executable = Path(argv[0]).stem if argv else node_name
+        if set(own) & {'-h', '--help'}:
+            print(f'usage: ros2 run ipomdp_gaze {executable} [--ros-args --params-file FILE '
+                  f'-p NAME:=VALUE -r FROM:=TO ...]\n\nRun the {node_name} node until Ctrl-C '
+                  'or SIGTERM. Its topics, services and parameters: README.md (the "For robot '
+                  'users" sections); its shipped parameter files: share/ipomdp_gaze/config/.')
+            return 0
+        print(f'{node_name}: error: unexpected argument{"s" * (len(own) > 1)} '
+              f'{" ".join(own)} (ROS arguments go after --ros-args; --help for usage)',
+              file=sys.stderr)
+        return 2
     try:
         rclpy.init(args=args)
     except (_rclpy.RCLError, _rclpy.UnknownROSArgsError) as exc:

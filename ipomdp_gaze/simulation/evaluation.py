@@ -82,17 +82,23 @@ def fixations_to_90_ci(correct: np.ndarray, n_cells: int, rng: np.random.Generat
     return point, _interval(beyond, beyond)
 
 
+# Stands for "beyond the horizon" in a bootstrap interval (_interval): finite, so interpolating
+# towards it stays a number, and far above any number of fixations.
+BEYOND = 1e300
+
+
 def _interval(low_values: np.ndarray, high_values: np.ndarray):
     """
     Return the 95% percentile interval, or None when a bound lies beyond the horizon.
 
     A resample that never reaches 90% within the horizon is "more than T" (+inf), not dropped:
-    dropping it would narrow the interval exactly where the horizon cuts it.
+    dropping it would narrow the interval exactly where the horizon cuts it. Infinities become
+    +/-:data:`BEYOND` for the interpolation (``inf * 0`` would be NaN where a percentile falls
+    on a finite resample), and a bound that lands beyond the horizon is no bound.
     """
-    with np.errstate(invalid='ignore'):         # inf - inf between two resamples beyond it
-        low = float(np.percentile(low_values, 2.5))
-        high = float(np.percentile(high_values, 97.5))
-    return (low, high) if np.isfinite(low) and np.isfinite(high) else None
+    low = float(np.percentile(np.clip(low_values, -BEYOND, BEYOND), 2.5))
+    high = float(np.percentile(np.clip(high_values, -BEYOND, BEYOND), 97.5))
+    return (low, high) if abs(low) < BEYOND / 2 and abs(high) < BEYOND / 2 else None
 
 
 def paired_difference_ci(correct_a: np.ndarray, correct_b: np.ndarray, n_cells: int,

@@ -18,8 +18,9 @@ It turns camera images into count frames for the controller, one frame per fixat
   (:class:`ipomdp_gaze.vision.fovea.Fovea`).
 
 Every image is counted: ``received = processed + rejected + unused`` (unused: no fixation was
-waiting for it, or a newer image served it). An image the detector cannot take (too small, or
-not the size ``camera_info`` says) is rejected with the reason and the fixation keeps waiting.
+waiting for it, or a newer image served it). An image the detector cannot take (too small, not
+the size ``camera_info`` says, or one a plug-in detector fails on: ``DetectorFailed``) is
+rejected with the reason and the fixation keeps waiting.
 
 **Time sanity.** Each input is checked against the node's clock when it arrives: an image or
 joint state stamped more than ``stamp_tolerance_s`` ahead of it is rejected (``images_future``;
@@ -277,13 +278,16 @@ def _builds_the_same(recorded: dict, asked: dict, cascade_dir) -> bool:
     try:
         kind = asked.get('kind', recorded['kind'])
         takes = option_names(load_factory(kind))
+        if takes is not None and any(asked[key] != recorded.get(key)
+                                     for key in asked if key != 'kind' and key not in takes):
+            return False                # a fingerprint or record-only key: only the file's
         options = {key: value for key, value in {**recorded, **asked}.items()
                    if key != 'kind' and (takes is None or key in takes)}
         if cascade_dir and (takes is None or 'cascade_dir' in takes):
             options['cascade_dir'] = cascade_dir
         built = make_detector(kind, **options)
         compare_settings(recorded, detector_settings(built), info_keys_of(built))
-    except (ValueError, TypeError, KeyError, OSError):
+    except Exception:                           # noqa: B902 (whatever fails: not the same)
         return False
     return True
 

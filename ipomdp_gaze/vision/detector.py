@@ -112,21 +112,24 @@ def detect(detector, image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     it: it sees nothing there. Boxes that do not overlap the image are dropped (a plug-in's
     bug, or boxes given as corners: they must not be counted in the cells at the image's
     edge). An exception the
-    detector raises (a plug-in's bug, a missing weight file) becomes :class:`DetectorFailed`
-    naming the detector, so that a driver reports it against the image and goes on; running
-    out of memory stays what it is.
+    detector from outside the package raises (a plug-in's bug, a missing weight file) becomes
+    :class:`DetectorFailed` naming the detector, so that a driver reports it against the image
+    and goes on; the package's own detectors' errors, and running out of memory, stay what they
+    are.
     """
     height, width = image.shape[:2]
-    window = detector_window_px(detector)
+    # an ensemble's window_px is its largest member's; each member checks its own
+    window = (0, 0) if hasattr(detector, 'members') else detector_window_px(detector)
     if width < window[0] or height < window[1]:
         return np.empty((0, 4)), np.empty(0)
+    own = type(detector).__module__.split('.')[0] == 'ipomdp_gaze'
     try:
         result = detector(image)
     except MemoryError:
         raise
     except Exception as exc:                    # noqa: B902 (any error of a user's detector)
-        if type(exc).__name__ == 'error' and 'Insufficient memory' in str(exc):
-            raise                               # OpenCV out of memory: the image's size
+        if own or (type(exc).__name__ == 'error' and 'Insufficient memory' in str(exc)):
+            raise                               # our bug (a traceback), or OpenCV's memory
         kind = getattr(detector, KIND_ATTRIBUTE, None) or type(detector).__name__
         raise DetectorFailed(f'the detector {kind} raised {type(exc).__name__}: '
                              f'{exc}') from exc

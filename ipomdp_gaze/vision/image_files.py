@@ -38,12 +38,17 @@ def decode_quietly(data: np.ndarray, flags: int = READ_FLAGS):
     A corrupt file makes libpng and OpenCV print their own lines (``libpng error: PNG input
     buffer is incomplete``, ``[ERROR:0@...] global grfmt_png.cpp ...``) on stderr before our
     one-line message says the same; libpng writes to the file descriptor itself, so that is
-    redirected for the call.
+    redirected for the call (OpenCV's own log level too, where its Python binding has
+    ``cv2.utils.logging``: not in the 4.11-4.12 wheels, nor Ubuntu's 4.6, whose messages the
+    redirection silences alone).
     """
-    level = cv2.utils.logging.getLogLevel()
-    cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_SILENT)
+    logging = getattr(getattr(cv2, 'utils', None), 'logging', None)
+    level = logging.getLogLevel() if logging is not None else None
+    if logging is not None:
+        logging.setLogLevel(logging.LOG_LEVEL_SILENT)
     try:
         with _quiet_fd(2):
             return cv2.imdecode(data, flags)
     finally:
-        cv2.utils.logging.setLogLevel(level)
+        if logging is not None:
+            logging.setLogLevel(level)
