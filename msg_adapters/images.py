@@ -224,17 +224,34 @@ def camera_info(camera: PinholeCamera, stamp, frame_id: str = '') -> CameraInfo:
 
 def camera_from_info(msg: CameraInfo) -> PinholeCamera:
     """
-    Read a ``camera_info``: image size and K (distortion is not used).
+    Read a ``camera_info``: the camera of the images it goes with (distortion is not used).
+
+    ``width``, ``height`` and K describe the full sensor; a driver that bins or crops says so
+    with ``binning_x/y`` and ``roi`` (REP 104: the region in full-resolution pixels, then
+    binned), and the images are that region, binned: K is shifted by the region's offset and
+    divided by the binning, and the size is the region's (the whole sensor without one).
 
     Raises
     ------
     ImageError
-        For a zero size or a K that is not a pinhole camera's.
+        For a zero size, a region outside the sensor or a K that is not a pinhole camera's.
 
     """
     if msg.width == 0 or msg.height == 0:
         raise ImageError(f'camera_info has no image size ({msg.width}x{msg.height})')
+    bx, by = max(1, int(msg.binning_x)), max(1, int(msg.binning_y))
+    roi = msg.roi
+    x0, y0 = int(roi.x_offset), int(roi.y_offset)
+    width = int(roi.width) or int(msg.width) - x0
+    height = int(roi.height) or int(msg.height) - y0
+    if width <= 0 or height <= 0 or x0 + width > msg.width or y0 + height > msg.height:
+        raise ImageError(f'camera_info: its roi ({x0}, {y0}, {roi.width}x{roi.height}) is not '
+                         f'inside the {msg.width}x{msg.height} sensor')
+    k = [float(v) for v in msg.k]
+    if (bx, by, x0, y0, width, height) != (1, 1, 0, 0, msg.width, msg.height):
+        k[0], k[2] = k[0] / bx, (k[2] - x0) / bx
+        k[4], k[5] = k[4] / by, (k[5] - y0) / by
     try:
-        return PinholeCamera.from_k(msg.width, msg.height, list(msg.k))
+        return PinholeCamera.from_k(width // bx, height // by, k)
     except ValueError as exc:
         raise ImageError(f'camera_info: {exc}') from None

@@ -284,7 +284,7 @@ def test_a_large_fovea_image_is_resized_to_the_model_image(fovea_setup):
     cell = fovea_setup.grid.index(10, 10)
     loop.fixate(cell, 0.0)
     out = loop.add_image(1.0, big, now_s=1.0)
-    small = cv2.resize(big, (420, 321), interpolation=cv2.INTER_AREA)
+    small = cv2.resize(big, (549, 420), interpolation=cv2.INTER_AREA)   # its short side 420
     fovea = fovea_for_model(fovea_setup.model, reuse_windows=False)
     fovea.start(small)
     want = fovea.observe(cell)
@@ -438,3 +438,32 @@ def test_the_pose_history_starts_again_when_the_clock_goes_back():
         history.add(k / 100, 2.0, 0.0)
     assert history.nearest(119.99, 0.0) == (2.0, 0.0)
     assert history.nearest(105.0, 0.0) == (2.0, 0.0)
+
+
+def test_a_wide_frame_keeps_its_height_in_fovea_mode_and_a_camera_fits_its_model():
+    """QA: a 16:9 frame fitted into 420x420 halved its faces; fovea mode scales its short side."""
+    from ipomdp_gaze.vision.detection import resized_size
+    model = (420, 420)
+    assert resized_size((1280, 720), model, 'fovea') is None          # 720 <= 2 x 420: as is
+    assert resized_size((1920, 1080), model, 'fovea') == (747, 420)
+    assert resized_size((4000, 3000), model, 'fovea') == (560, 420)
+    assert resized_size((1080, 1080), model, 'fovea') == (420, 420)   # square: as before
+    assert resized_size((1280, 960), (320, 240), 'camera') == (320, 240)
+    assert resized_size((1280, 640), (320, 240), 'camera') == (320, 160)   # pixels per degree
+
+
+def test_the_face_of_a_letterboxed_hd_frame_gets_the_most_detections(fovea_setup):
+    import cv2
+    from skimage import data
+    photo = data.astronaut()
+    frame = np.zeros((1080, 1920, 3), np.uint8)
+    photo_px = cv2.resize(photo, (1080, 1080), interpolation=cv2.INTER_AREA)
+    frame[:, 420:1500] = photo_px
+    face_x, face_y = 420 + 223 * 1080 / 512, 122 * 1080 / 512          # the astronaut's face
+    face = (int(face_y * 21 / 1080), int(face_x * 21 / 1920))
+    loop = DetectorLoop(fovea_setup)
+    loop.request_scan(1, 0.0)
+    out = loop.add_image(1.0, frame)
+    counts = np.nan_to_num(out.frame.counts).reshape(21, 21)
+    peak = np.unravel_index(np.argmax(counts), counts.shape)
+    assert max(abs(peak[0] - face[0]), abs(peak[1] - face[1])) <= 1, (peak, face, counts.max())

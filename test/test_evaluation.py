@@ -107,3 +107,7 @@ def test_a_percentile_on_a_finite_resample_next_to_those_beyond_is_that_resample
     assert _interval(values, values) == (25.0, 975.0)
     values = np.r_[np.arange(970.0), np.full(31, np.inf)]       # the 97.5% one is beyond
     assert _interval(values, values) is None
+    # part of the way towards one beyond (1000 resamples, 25 beyond) is beyond too (review)
+    values = np.r_[np.arange(975.0), np.full(25, np.inf)]
+    assert _interval(values, values) is None
+    assert _interval(-values, -values) is None

@@ -137,4 +137,9 @@ def test_the_human_fpoc_far_out_is_zero_without_a_numpy_warning():
 def test_the_linux_only_domain_ids_are_accepted():
     """QA: 215..232 are valid ROS domain ids on Linux; the demo refused them."""
     from ipomdp_gaze.commands.demo import domain_arg
+    from ipomdp_gaze.harness.processes import ros_environment
     assert [domain_arg(str(d)) for d in (0, 101, 215, 232)] == [0, 101, 215, 232]
+    # ... and the run's environment takes them too (review: the demo still refused 220)
+    assert ros_environment(220, '/tmp', base={})['ROS_DOMAIN_ID'] == '220'
+    with pytest.raises(ValueError, match='domain id must be in 0..101 or 215..232, got 150'):
+        ros_environment(150, '/tmp', base={})

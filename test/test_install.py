@@ -457,6 +457,15 @@ def test_a_user_or_prefix_install_finds_its_shared_files(tmp_path, monkeypatch):
     (share / 'config' / 'only_here.yaml').write_text('a: 1\n')
     (info / 'RECORD').write_text('../../../share/ipomdp_gaze/package.xml,,\n'
                                  '../../../share/ipomdp_gaze/config/only_here.yaml,,\n')
+    package = site / 'ipomdp_gaze'
+    package.mkdir()
+    (package / '__init__.py').write_text('')
+    (package / 'files').mkdir()
     monkeypatch.setattr(metadata, 'distribution', lambda name: metadata.PathDistribution(info))
+    monkeypatch.setattr(share_files, '__file__', str(package / 'files' / 'share_files.py'))
     monkeypatch.setenv('AMENT_PREFIX_PATH', '')
     assert share_files.config_file('only_here.yaml') == share / 'config' / 'only_here.yaml'
+    # a record of another copy (this code runs from elsewhere) is not used
+    monkeypatch.setattr(share_files, '__file__', str(tmp_path / 'checkout' / 'ipomdp_gaze' /
+                                                     'files' / 'share_files.py'))
+    assert share_files.installed_share() is None

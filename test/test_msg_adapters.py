@@ -368,3 +368,20 @@ def test_fixation_messages_are_row_col():
     msg.data = [3, 11]
     with pytest.raises(ValueError, match=r'fixation \(3, 11\) is outside'):
         grid_arrays.cell_from_row_col(msg, GRID, 'fixation')
+
+
+def test_a_binned_or_cropped_camera_info_describes_the_images_it_goes_with():
+    """QA: REP 104's binning and roi were ignored, so every binned image was 'the wrong size'."""
+    from ipomdp_gaze.model.head_camera import PinholeCamera
+    from sensor_msgs.msg import CameraInfo, RegionOfInterest
+    k = [800.0, 0.0, 320.0, 0.0, 800.0, 240.0, 0.0, 0.0, 1.0]
+    binned = images.camera_from_info(CameraInfo(width=640, height=480, k=k, binning_x=2,
+                                                binning_y=2))
+    assert binned == PinholeCamera.from_k(320, 240, [400.0, 0, 160.0, 0, 400.0, 120.0, 0, 0, 1])
+    roi = RegionOfInterest(x_offset=100, y_offset=40, width=320, height=240)
+    cropped = images.camera_from_info(CameraInfo(width=640, height=480, k=k, roi=roi))
+    assert cropped == PinholeCamera.from_k(320, 240, [800.0, 0, 220.0, 0, 800.0, 200.0, 0, 0, 1])
+    assert cropped.fov_deg[0] < 0.55 * binned.fov_deg[0]             # about half the view
+    roi = RegionOfInterest(x_offset=400, y_offset=0, width=320, height=240)
+    with pytest.raises(images.ImageError, match=r'its roi \(400, 0, 320x240\) is not inside'):
+        images.camera_from_info(CameraInfo(width=640, height=480, k=k, roi=roi))

@@ -230,6 +230,28 @@ def test_camera_mode_waits_for_camera_info_with_a_warning(camera):
                     20)
 
 
+def test_camera_mode_warns_about_lens_distortion_it_does_not_model(camera):
+    """QA: equidistant and rational_polynomial camera_info were taken silently."""
+    from ipomdp_gaze.msg_adapters import images
+    from ipomdp_gaze.vision.pan_tilt import shipped_camera
+    info = images.camera_info(shipped_camera(), camera.now())
+    info.distortion_model, info.d = 'equidistant', [-0.25, 0.05, 0.0, 0.0]
+    camera.camera_info.publish(info)
+    assert wait_for(lambda: 'camera_info has lens distortion (equidistant)' in
+                    camera.proc.output(), 20), camera.proc.output()[-2000:]
+    assert camera.proc.running
+
+
+def test_a_fixation_without_images_is_warned_about_with_the_qos_hint(fovea):
+    """QA: the detector stayed 'serving fixations' while a best-effort camera sent nothing."""
+    fovea.fixate(fovea.setup.grid, fovea.setup.grid.index(2, 2))
+    assert wait_for(lambda: fovea.status and fovea.status[-1][1] == 'no image arrives', 30), \
+        fovea.status[-1:]
+    assert wait_for(lambda: 'a fixation waits: no image captured since the fixation was '
+                            'commanded' in fovea.proc.output(), 20)
+    assert 'a best-effort camera needs image_best_effort: true' in fovea.proc.output()
+
+
 @pytest.mark.parametrize('seed, offset', [(5, (0, 0)), (6, (1, -1)), (9, (-1, 1))])
 def test_camera_mode_bins_a_face_to_its_cell_and_the_rest_is_nan(camera, seed, offset):
     from ipomdp_gaze.model.head_camera import observed_cells

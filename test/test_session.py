@@ -689,6 +689,10 @@ def test_api_misuse_is_refused_with_the_reason_not_a_numpy_error():
         unvisited_choice(NaNPolicy(), belief, visited, 0, None, GRID)
     NaNPolicy.scores = lambda self, belief: np.full(belief.shape, -np.inf)
     assert unvisited_choice(NaNPolicy(), belief, visited, 0, None, GRID) == 1   # not cell 0
+    mixed = np.zeros(GRID.n_cells)
+    mixed[[1, 2]] = -np.inf, np.inf
+    NaNPolicy.scores = lambda self, belief: mixed.copy()
+    assert unvisited_choice(NaNPolicy(), belief, visited, 0, None, GRID) == 2   # the +inf one
     core = GazeController(GRID, fpoc, build_policy('elm', GRID, fpoc), SearchSettings())
     core.reset(0.0)
     result = core.offer(np.zeros(GRID.n_cells), math.nan)

@@ -18,7 +18,7 @@ import argparse
 from pathlib import Path
 
 from ipomdp_gaze.files.bag import check_new_bag
-from ipomdp_gaze.harness.processes import MAX_DOMAIN_ID
+from ipomdp_gaze.harness.processes import MAX_DOMAIN_ID, valid_domain_id
 from ipomdp_gaze.vision.pan_tilt import parse_faces
 from ipomdp_gaze.vision.walks import DURATION_S as DEMO_DURATION_S
 
@@ -109,18 +109,13 @@ def parse_target(text):
     return row, col
 
 
-# Fast DDS maps domain ids to UDP ports: on Linux 0..101 and 215..232 are valid (ROS 2's
-# "ROS_DOMAIN_ID" concept page); the demo picks its own in 1..101.
-LINUX_EXTRA_DOMAINS = range(215, 233)
-
-
 def domain_arg(text: str) -> int:
     """Parse a ROS domain id (0..101 or 215..232) for argparse."""
     try:
         value = int(text)
     except ValueError:
         value = -1
-    if not (0 <= value <= MAX_DOMAIN_ID or value in LINUX_EXTRA_DOMAINS):
+    if not valid_domain_id(value):
         raise argparse.ArgumentTypeError(f'expected a ROS domain id in 0..{MAX_DOMAIN_ID} or '
                                          f'215..232, got {text!r}')
     return value

@@ -30,13 +30,17 @@ def installed_share() -> Path | None:
 
     ``pip install --user`` or ``--prefix`` puts it under that scheme's data folder, which is
     neither ``sys.prefix`` nor on ``AMENT_PREFIX_PATH``; the distribution's RECORD names it
-    (relative to site-packages). An editable install records none.
+    (relative to site-packages). An editable install records none, and a distribution that is
+    not this code (an old ``--user`` copy beside a checkout run from source) is not used.
     """
     from importlib.metadata import distribution, PackageNotFoundError
     try:
         dist = distribution(PACKAGE)
     except PackageNotFoundError:
         return None
+    own = Path(__file__).resolve().parents[1] / '__init__.py'
+    if Path(dist.locate_file(f'{PACKAGE}/__init__.py')).resolve() != own:
+        return None                             # another copy's record, not this code's
     for file in dist.files or ():
         if file.name == 'package.xml' and file.parent.name == PACKAGE \
                 and file.parent.parent.name == 'share':

@@ -23,6 +23,16 @@ import time
 from ipomdp_gaze.nodes import NODE_NAMES
 
 MAX_DOMAIN_ID = 101
+# Fast DDS maps domain ids to UDP ports: on Linux 0..101 and 215..232 are valid (ROS 2's
+# "ROS_DOMAIN_ID" concept page); runs pick their own in 1..101 (reserve_domain_id).
+LINUX_EXTRA_DOMAINS = range(215, 233)
+
+
+def valid_domain_id(domain_id) -> bool:
+    """Whether ``domain_id`` is a ROS domain id Fast DDS takes on Linux (0..101, 215..232)."""
+    return 0 <= int(domain_id) <= MAX_DOMAIN_ID or int(domain_id) in LINUX_EXTRA_DOMAINS
+
+
 # Run a node with a faulthandler: SIGUSR1 prints every thread's stack to its log.
 STACK_DUMP_MAIN = ('import faulthandler, signal, sys; '
                    'faulthandler.register(signal.SIGUSR1, all_threads=True); '
@@ -72,8 +82,8 @@ def domain_id_for(pid: int | None = None) -> int:
 
 def ros_environment(domain_id: int, log_dir, base: dict | None = None) -> dict:
     """Copy ``base`` (default ``os.environ``) and set it up for an isolated run."""
-    if not 0 <= int(domain_id) <= MAX_DOMAIN_ID:
-        raise ValueError(f'domain id must be in 0..{MAX_DOMAIN_ID}, got {domain_id}')
+    if not valid_domain_id(domain_id):
+        raise ValueError(f'domain id must be in 0..{MAX_DOMAIN_ID} or 215..232, got {domain_id}')
     env = dict(os.environ if base is None else base)
     env.update({'ROS_DOMAIN_ID': str(int(domain_id)),
                 'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST',

@@ -46,9 +46,12 @@ def unvisited_choice(policy, belief: np.ndarray, visited: np.ndarray, t: int, rn
             raise ValueError(f'the policy scored {scores.size} cells of the {n}-cell grid')
         if np.isnan(scores).any():
             raise ValueError('the policy scored a cell NaN')
-        scores[visited] = -np.inf
-        if not np.isfinite(scores).any():       # every unvisited score -inf: the first of them
+        if np.all(scores[~visited] == -np.inf):  # every unvisited score -inf: the first of them
             return int(np.argmin(visited))
+        infinite = np.flatnonzero((scores == np.inf) & ~visited)
+        if infinite.size:                       # the tie rule's tolerance is NaN at +inf
+            return int(infinite[0])
+        scores[visited] = -np.inf
         return int(argmax_ties_low(scores))
     choice = policy_choice(policy.select(belief, t, rng), n)
     if not visited[choice]:

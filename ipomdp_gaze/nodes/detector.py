@@ -62,6 +62,8 @@ from .spin import run_node
 
 NODE_NAME = NODE_NAMES['detector']
 SENSOR_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT)
+# camera_info comes with every frame: its lens distortion is warned about this seldom.
+DISTORTION_WARN_S = 3600.0
 # Images are large: over best effort, Fast DDS drops a whole image when one fragment is lost,
 # so the subscription is reliable unless the driver only publishes best effort.
 IMAGE_QOS = {False: QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE),
@@ -283,6 +285,12 @@ class FovealDetectorNode(QuietPublishers, Node):
         if self.loop.mismatch:
             self.get_logger().warning(self.loop.mismatch)
             self.loop.mismatch = ''
+        if any(float(d) != 0.0 for d in msg.d):
+            self.get_logger().warning(
+                f'camera_info has lens distortion ({msg.distortion_model or "unnamed model"}): '
+                'the detector maps pixels to cells with K alone, so detections near the edge '
+                'may land a cell off; give it rectified images (image_proc) and their '
+                'camera_info', throttle_duration_sec=DISTORTION_WARN_S)
         self._handle(outcome)
 
     def _on_joint_states(self, msg: JointState) -> None:
@@ -362,6 +370,11 @@ class FovealDetectorNode(QuietPublishers, Node):
         elif reason.startswith('no joint state'):
             hint = (f'; are {self.resolve_topic_name("joint_states")} stamped like the images '
                     '(raise joint_state_tolerance_s to how far apart they are)?')
+        elif reason.startswith('no image captured'):
+            hint = (f' ({self.loop.received} images received in all); is the camera publishing '
+                    f'on {self.resolve_topic_name("image")}'
+                    + ('' if self.get_parameter('image_best_effort').value else
+                       ' (a best-effort camera needs image_best_effort: true)') + '?')
         else:
             return
         self.get_logger().warning(f'a fixation waits: {reason}{hint}',
@@ -383,6 +396,9 @@ class FovealDetectorNode(QuietPublishers, Node):
         elif values['waiting_for_image'] and self.loop.waiting.startswith('no joint state') \
                 and self._stuck():
             level, message = 'warn', 'no joint state pairs with the images'
+        elif values['waiting_for_image'] and self.loop.waiting.startswith('no image captured') \
+                and self._stuck():
+            level, message = 'warn', 'no image arrives'
         elif any(new):
             level = 'warn'
             message = ', '.join(f'{n} {what}' for n, what in zip(

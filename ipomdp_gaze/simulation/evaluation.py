@@ -96,9 +96,16 @@ def _interval(low_values: np.ndarray, high_values: np.ndarray):
     +/-:data:`BEYOND` for the interpolation (``inf * 0`` would be NaN where a percentile falls
     on a finite resample), and a bound that lands beyond the horizon is no bound.
     """
-    low = float(np.percentile(np.clip(low_values, -BEYOND, BEYOND), 2.5))
-    high = float(np.percentile(np.clip(high_values, -BEYOND, BEYOND), 97.5))
-    return (low, high) if abs(low) < BEYOND / 2 and abs(high) < BEYOND / 2 else None
+    low_values = np.clip(np.asarray(low_values, dtype=float), -BEYOND, BEYOND)
+    high_values = np.clip(np.asarray(high_values, dtype=float), -BEYOND, BEYOND)
+    low = float(np.percentile(low_values, 2.5))
+    high = float(np.percentile(high_values, 97.5))
+    # a bound interpolated part of the way towards BEYOND is beyond the finite resamples too
+    finite = np.concatenate([low_values, high_values])
+    finite = finite[np.abs(finite) < BEYOND]
+    if not finite.size or not finite.min() <= low <= high <= finite.max():
+        return None
+    return low, high
 
 
 def paired_difference_ci(correct_a: np.ndarray, correct_b: np.ndarray, n_cells: int,

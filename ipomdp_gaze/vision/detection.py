@@ -315,7 +315,10 @@ def camera_mismatch(model_camera_: PinholeCamera | None, camera: PinholeCamera) 
     return (f'camera_info describes a {camera.width}x{camera.height} camera with a '
             f'{hfov:.1f}x{vfov:.1f} deg field of view, but the model was calibrated with '
             f'{model_camera_.width}x{model_camera_.height} and {mh:.1f}x{mv:.1f} deg: its '
-            f'counts may not follow the model')
+            f'counts may not follow the model, and cells it does not see may be answered '
+            f'absent (calibrate a model for this camera: ipomdp-gaze calibrate --pan-tilt '
+            f'--camera {camera.width}x{camera.height} --hfov-deg {hfov:.1f}, with the '
+            f'detector options of the model you use; bench/faces/models.py has their recipes)')
 
 
 def check_camera(camera: PinholeCamera, max_side_px: int | None = None) -> None:
@@ -349,19 +352,32 @@ def scaled_camera(camera: PinholeCamera, width: int, height: int) -> PinholeCame
                          (camera.cx + 0.5) * sx - 0.5, (camera.cy + 0.5) * sy - 0.5)
 
 
-def resized_size(size: tuple[int, int],
-                 model_size: tuple[int, int] | None) -> tuple[int, int] | None:
+def resized_size(size: tuple[int, int], model_size: tuple[int, int] | None,
+                 mode: str = 'camera') -> tuple[int, int] | None:
     """
     Return the ``(width, height)`` an image of ``size`` is resized to, or None to keep it.
 
-    An image more than :data:`RESIZE_ABOVE` times the model's image width or height is scaled
-    (aspect kept) to fit within the model's image size.
+    ``camera`` mode: an image more than :data:`RESIZE_ABOVE` times the model's image width or
+    height is scaled (aspect kept) to fit within the model's image size: a camera of the
+    model's field of view then has the model's pixels per degree. ``fovea`` mode (a fixed
+    camera, no field of view to match): the image's shorter side stands for the model's
+    (square) side, so an image whose shorter side is more than :data:`RESIZE_ABOVE` times the
+    model's shorter side is scaled to it; a wide frame (16:9) keeps its height's worth of
+    pixels instead of shrinking to fit the model's width (a 1280x720 frame fitted into 420x420
+    halved its faces, and the search answered a false alarm).
     """
     width, height = size
-    if model_size is None or (width <= RESIZE_ABOVE * model_size[0] and
-                              height <= RESIZE_ABOVE * model_size[1]):
+    if model_size is None:
         return None
-    scale = min(model_size[0] / width, model_size[1] / height)
+    if mode == 'fovea':
+        side, model_side = min(width, height), min(model_size)
+        if side <= RESIZE_ABOVE * model_side:
+            return None
+        scale = model_side / side
+    elif width <= RESIZE_ABOVE * model_size[0] and height <= RESIZE_ABOVE * model_size[1]:
+        return None
+    else:
+        scale = min(model_size[0] / width, model_size[1] / height)
     return max(1, round(width * scale)), max(1, round(height * scale))
 
 
@@ -535,7 +551,7 @@ class DetectorLoop:
         size = (image.shape[1], image.shape[0])
         t0 = time.perf_counter()
         if image.ndim in (2, 3):
-            target = resized_size(size, self.setup.image_size)
+            target = resized_size(size, self.setup.image_size, self.setup.mode)
             if target is not None:
                 image = resize_view(image, target)
                 self.resized += 1
@@ -633,7 +649,7 @@ class DetectorLoop:
         if pose is None:
             gap = self._poses.gap(stamp)
             nearest = ('no joint state received' if not math.isfinite(gap) else
-                       f'the nearest is {gap:.3f} s from it')
+                       f'the nearest is {gap:.3g} s from it')
             return Outcome('waiting', f'no joint state with the stamp of the newest image '
                                       f'({nearest}; joint_state_tolerance_s '
                                       f'{self.tolerance_s:g} s)')
