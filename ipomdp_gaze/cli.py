@@ -13,7 +13,9 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import signal
 import sys
+import threading
 import warnings
 
 from ipomdp_gaze.files.share_files import package_version
@@ -73,8 +75,25 @@ def main(argv=None) -> int:
         return _run(args)
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (``kill``, a script's ``terminate()``): stopped as Ctrl-C stops, exit 143."""
+
+
+def _terminate(signum, frame):
+    raise Terminated()
+
+
+# The commands that run pieces of work in this process or a pool: SIGTERM stops them as Ctrl-C
+# does (the pool's pieces cancelled, no half-written file). The node commands keep rclpy's own
+# handling; demo and record keep theirs.
+WORK_COMMANDS = ('evaluate', 'train', 'reproduce', 'calibrate', 'find', 'search')
+
+
 def _run(args) -> int:
     """Run the parsed command; its errors as one line (exit 2)."""
+    handles = args.command in WORK_COMMANDS and \
+        threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _terminate) if handles else None
     try:
         return int(args.run(args) or 0)
     except BrokenPipeError:
@@ -88,8 +107,13 @@ def _run(args) -> int:
         print(f'ipomdp-gaze {args.command}: error: out of memory: the task is too large for '
               f'this machine (a smaller --grid or fewer --episodes)', file=sys.stderr)
         return 2
+    except Terminated:
+        return 143
     except KeyboardInterrupt:
         return 130
+    finally:
+        if handles:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == '__main__':

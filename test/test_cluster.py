@@ -16,6 +16,7 @@ import socket
 import subprocess
 import sys
 import threading
+import time
 
 from conftest import require_extra, wait_for
 from ipomdp_gaze.cli import main as cli_main
@@ -300,3 +301,43 @@ def test_a_worker_killed_mid_run_changes_nothing(cluster, monkeypatch):
     np.testing.assert_array_equal(runner.correct['greedy'], here.correct['greedy'])
     np.testing.assert_array_equal(runner.map_prob['greedy'], here.map_prob['greedy'])
     assert runner.decisions['greedy'] == here.decisions['greedy']
+
+
+def _children(pid: int) -> list[int]:
+    """Return the child processes of ``pid`` (Linux /proc)."""
+    try:
+        text = Path(f'/proc/{pid}/task/{pid}/children').read_text()
+    except OSError:
+        return []
+    return [int(p) for p in text.split()]
+
+
+def _running(pid: int) -> bool:
+    """Whether ``pid`` runs (a zombie nobody reaped has ended)."""
+    try:
+        status = Path(f'/proc/{pid}/status').read_text()
+    except OSError:
+        return False
+    return '\nState:\tZ' not in status
+
+
+@pytest.mark.parametrize('how, code', [(signal.SIGTERM, 143), (signal.SIGKILL, -9)])
+def test_a_killed_run_leaves_no_pool_worker_behind(tmp_path, how, code):
+    """QA: kill or a script's timeout left the --jobs workers running, holding its pipes."""
+    proc = subprocess.Popen(
+        [sys.executable, '-m', 'ipomdp_gaze.cli', 'evaluate', '--grid', '9x9', '--policy',
+         'greedy', '--episodes', '20000', '--episodes-greedy', '20000', '--jobs', '2',
+         '--quiet', '--json', str(tmp_path / 'out.json')], cwd=ROOT,
+        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    try:
+        assert wait_for(lambda: len(_children(proc.pid)) >= 2 or proc.poll() is not None, 120)
+        workers = _children(proc.pid)
+        time.sleep(1.0)                                 # the pieces are running
+        proc.send_signal(how)
+        proc.wait(timeout=60)
+        assert proc.returncode == code, proc.stderr.read()
+        assert wait_for(lambda: not any(_running(w) for w in workers), 30), workers
+        assert not (tmp_path / 'out.json').exists()
+    finally:
+        if proc.poll() is None:
+            proc.kill()

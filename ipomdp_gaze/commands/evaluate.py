@@ -66,7 +66,7 @@ def add_parser(sub):
                         "or faces-840 (find's settings); --policy, --policy-file, "
                         '--confidence, --max-fixations (default: the configuration budget, '
                         'else 60) and --absent-prior change the shipped configuration')
-    p.add_argument('--split', choices=('train', 'test'), default='test',
+    p.add_argument('--split', choices=('train', 'test'), default=None,
                    help='--scenes: training scenes (for every choice) or held-out test scenes '
                         '(default)')
     p.add_argument('--empty-scenes', type=nonneg_int, default=0, metavar='M',
@@ -447,6 +447,15 @@ def run(args) -> int:
     faces = parse_faces(args.faces)          # one line for a bad K or LO-HI, before any work
     if faces != (1, 1) and args.scenes != 'pan-tilt':
         raise ValueError('--faces is for --scenes pan-tilt')
+    if not args.scenes:
+        scene_only = [flag for flag, given in (
+            ('--compare', bool(args.compare)), ('--empty-scenes', bool(args.empty_scenes)),
+            ('--split', args.split is not None), ('--scene-model', bool(args.scene_model)),
+            ('--group-min-neighbors', args.group_min_neighbors is not None)) if given]
+        if scene_only:
+            raise ValueError(f'{", ".join(scene_only)}: not used here: only --scenes reads '
+                             'it (the simulated task draws its own targets)')
+    args.split = args.split or 'test'
     if args.scenes:
         model = ('its model: --scene-model' if args.scenes == 'pan-tilt' else
                  'with its shipped model; another model is tried with find, or on the pan-tilt '
@@ -472,6 +481,9 @@ def run(args) -> int:
     args.max_fixations = args.max_fixations or None           # 0: no budget, the horizon
     grid, fpoc = task_from_args(args)
     policies = load_policies(args, grid, fpoc)
+    if args.paired and len(policies) < 2:
+        raise ValueError('--paired compares each policy after the first with the first: give '
+                         'two or more (--policy, --policy-file)')
     with executor_from_args(args, _pieces(args, policies)) as executor, \
             progress_from_args(args, 0, 'evaluate', 'episode') as bar:
         result = evaluate(grid, fpoc, policies, args.episodes, args.horizon, args.seed,
