@@ -320,3 +320,20 @@ def test_zero_epochs_without_an_initial_kernel_is_refused(tmp_path, capsys):
     assert main(['train', '--grid', '5x5', '--epochs', '0', '--out', str(out), '--quiet']) == 2
     assert not out.exists()
     assert '--epochs 0 trains nothing' in capsys.readouterr().err
+
+
+def test_a_resumed_training_refuses_settings_other_than_its_own(tmp_path, capsys):
+    """QA: --resume took a new seed and learning rate and recorded them for every epoch."""
+    from ipomdp_gaze.cli import main as cli
+    first = tmp_path / 'r.yaml'
+    assert cli(['train', '--grid', '5x5', '--epochs', '2', '--out', str(first), '--quiet',
+                '--final-episodes', '50']) == 0
+    capsys.readouterr()
+    assert cli(['train', '--resume', str(first), '--epochs', '3', '--out',
+                str(tmp_path / 'x.yaml'), '--seed', '5', '--horizon', '7', '--quiet']) == 2
+    [line] = capsys.readouterr().err.strip().splitlines()
+    assert '--seed 5 (recorded: 0)' in line and '--horizon 7 (recorded: the default)' in line
+    assert not (tmp_path / 'x.yaml').exists()
+    assert cli(['train', '--resume', str(first), '--epochs', '3', '--out',
+                str(tmp_path / 'same.yaml'), '--seed', '0', '--quiet',
+                '--final-episodes', '50']) == 0              # the recorded value: fine

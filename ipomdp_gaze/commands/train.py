@@ -148,6 +148,38 @@ def _count_task(args, spec):
     return model.grid, model
 
 
+# The flag of each training setting a resumed training keeps (_refuse_changed_training).
+RESUME_FLAGS = {'learning_rate': '--learning-rate', 'anneal_epochs': '--anneal-epochs',
+                'reward_scale': '--reward-scale', 'beta': '--beta',
+                'baseline': '--baseline/--no-baseline', 'seed': '--seed',
+                'episodes_per_epoch': '--episodes-per-epoch', 'horizon': '--horizon',
+                'eval_every': '--eval-every', 'eval_episodes': '--eval-episodes',
+                'motion_sigma_cells': '--motion-sigma-cells', 'jump_prob': '--jump-prob',
+                'absent_prior': '--absent-prior', 'absent_rate': '--absent-rate'}
+
+
+def _refuse_changed_training(args, spec, overrides: dict) -> None:
+    """
+    Refuse training settings given with ``--resume`` that differ from the file's (ValueError).
+
+    A resumed training continues exactly like an uninterrupted one (docs/design.md section
+    3.4): with other settings its record would describe every epoch by the last ones.
+    """
+    from ipomdp_gaze.policies.training import config_from_spec
+    recorded = config_from_spec(spec)
+
+    def shown(value):
+        return 'the default' if value is None else repr(value)
+
+    changed = [f'{RESUME_FLAGS[key]} {value!r} (recorded: {shown(getattr(recorded, key))})'
+               for key, value in overrides.items()
+               if value is not None and value != getattr(recorded, key)]
+    if changed:
+        raise ValueError(f'--resume {args.resume} continues the training as the file records '
+                         f'it, but {"; ".join(changed)}: leave them out, or start a new '
+                         'training with --out')
+
+
 def run(args) -> int:
     from ipomdp_gaze.policies.policy_file import load_policy_spec, save_policy
     from ipomdp_gaze.policies.training import (evaluation_block, read_curve, TrainConfig, Trainer,
@@ -203,6 +235,7 @@ def run(args) -> int:
     else:
         if args.init_elm is not None:
             raise ValueError('--init-elm starts a new training; a resumed one keeps its kernel')
+        _refuse_changed_training(args, spec, overrides)
         trainer = trainer_from_spec(spec, model=fpoc, **overrides)
     curve_path = out.with_suffix('.csv')
     rows = []
