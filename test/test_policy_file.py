@@ -337,3 +337,24 @@ def test_save_refuses_an_invalid_spec(tmp_path):
 def test_kernel_dir_is_the_package_data_next_to_the_module():
     assert pf.KERNEL_DIR.resolve() == (Path(pf.__file__).parent / 'kernels').resolve()
     assert 'human-7x7-infomax' in pf.shipped_kernels()
+
+
+def test_a_key_given_twice_is_refused_not_taken_last_wins(tmp_path):
+    """QA: `action: sample` appended by hand made the shipped kernel sample, silently."""
+    shipped = pf.resolve_source('human-7x7-infomax')
+    path = tmp_path / 'edited.yaml'
+    path.write_text(Path(shipped).read_text() + 'action: sample\n')
+    lines = path.read_text().splitlines()
+    with pytest.raises(pf.PolicyFileError,
+                       match=rf"the key 'action' appears twice \(line {len(lines)}\)"):
+        pf.load_policy_spec(str(path))
+    # the observation files are read the same way; a nested mapping too
+    from ipomdp_gaze.files.observation_file import ObservationFileError
+    from ipomdp_gaze.files.yaml_files import read_yaml
+    nested = tmp_path / 'nested.yaml'
+    nested.write_text('a:\n  b: 1\n  c: 2\n  b: 3\n')
+    with pytest.raises(ObservationFileError, match=r"the key 'b' appears twice \(line 4\)"):
+        read_yaml(nested, ObservationFileError)
+    ok = tmp_path / 'ok.yaml'
+    ok.write_text('base: &b {x: 1}\nderived:\n  <<: *b\n  y: 2\n')           # a merge key is fine
+    assert read_yaml(ok, ValueError) == {'base': {'x': 1}, 'derived': {'x': 1, 'y': 2}}

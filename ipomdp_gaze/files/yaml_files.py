@@ -16,14 +16,46 @@ import numpy as np
 import yaml
 
 
+class DuplicateKeyError(yaml.YAMLError):
+    """A mapping gives one key twice (PyYAML would keep the last silently)."""
+
+    def __init__(self, key, mark):
+        super().__init__(f'the key {key!r} appears twice')
+        self.key, self.problem_mark = key, mark
+
+
+class UniqueKeyLoader(yaml.SafeLoader):
+    """The safe loader, refusing a key given twice in one mapping (a hand edit appended)."""
+
+
+def _unique_mapping(loader, node, deep=False):
+    seen = set()
+    for key_node, _ in node.value:
+        if key_node.tag == 'tag:yaml.org,2002:merge':
+            continue
+        key = loader.construct_object(key_node, deep=True)
+        try:
+            duplicate = key in seen
+        except TypeError:
+            continue                            # unhashable: construct_mapping says so
+        if duplicate:
+            raise DuplicateKeyError(key, key_node.start_mark)
+        seen.add(key)
+    return loader.construct_mapping(node, deep=deep)
+
+
+UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _unique_mapping)
+
+
 def read_yaml(path: Path, error: type[ValueError]):
     """
-    Parse a YAML file with the safe loader.
+    Parse a YAML file with the safe loader (a key given twice in one mapping refused).
 
     Raises
     ------
     error
-        ``<path>: cannot read``, ``<path>: not YAML at line N`` or nested too deeply.
+        ``<path>: cannot read``, ``<path>: not YAML at line N``, ``<path>: the key 'k'
+        appears twice (line N)`` or nested too deeply.
 
     """
     try:
@@ -31,7 +63,10 @@ def read_yaml(path: Path, error: type[ValueError]):
     except (OSError, UnicodeDecodeError) as exc:
         raise error(f'{path}: cannot read: {exc}') from None
     try:
-        return yaml.safe_load(text)
+        return yaml.load(text, Loader=UniqueKeyLoader)      # noqa: S506 (a safe loader)
+    except DuplicateKeyError as exc:
+        raise error(f'{path}: {exc} (line {exc.problem_mark.line + 1}): which one is meant? '
+                    'keep one') from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, 'problem_mark', None)
         where = f' at line {mark.line + 1}' if mark is not None else ''
