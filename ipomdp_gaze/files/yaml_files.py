@@ -63,7 +63,11 @@ def read_yaml(path: Path, error: type[ValueError]):
     except (OSError, UnicodeDecodeError) as exc:
         raise error(f'{path}: cannot read: {exc}') from None
     try:
-        return yaml.load(text, Loader=UniqueKeyLoader)      # noqa: S506 (a safe loader)
+        loader = UniqueKeyLoader(text)          # what yaml.safe_load does, with the key check
+        try:
+            return loader.get_single_data()
+        finally:
+            loader.dispose()
     except DuplicateKeyError as exc:
         raise error(f'{path}: {exc} (line {exc.problem_mark.line + 1}): which one is meant? '
                     'keep one') from None
