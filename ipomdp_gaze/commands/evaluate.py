@@ -69,7 +69,7 @@ def add_parser(sub):
     p.add_argument('--split', choices=('train', 'test'), default=None,
                    help='--scenes: training scenes (for every choice) or held-out test scenes '
                         '(default)')
-    p.add_argument('--empty-scenes', type=nonneg_int, default=0, metavar='M',
+    p.add_argument('--empty-scenes', type=nonneg_int, default=None, metavar='M',
                    help='--scenes pan-tilt: also M scenes without a face (the same photo crops), '
                         'reported apart per background')
     p.add_argument('--faces', default='1', metavar='K|LO-HI',
@@ -411,6 +411,9 @@ SIMULATION_ONLY = (('--grid', 'grid'), ('--spacing-deg', 'spacing_deg'), ('--fpo
                    ('--horizon', 'horizon'), ('--motion-sigma-cells', 'motion_sigma_cells'),
                    ('--jump-prob', 'motion_jump_prob'), ('--absent-rate', 'absent_rate'),
                    ('--compare-prediction', 'compare_prediction'), ('--paired', 'paired'))
+# Options of the scene tasks, which the simulated task does not read.
+SCENES_ONLY = (('--compare', 'compare'), ('--empty-scenes', 'empty_scenes'), ('--split', 'split'),
+               ('--scene-model', 'scene_model'), ('--group-min-neighbors', 'group_min_neighbors'))
 # Options of the still pan/tilt scenes, which --motion walk does not read.
 STILL_SCENES_ONLY = (('--max-fixations', 'max_fixations'),
                      ('--group-min-neighbors', 'group_min_neighbors'))
@@ -419,7 +422,7 @@ STILL_SCENES_ONLY = (('--max-fixations', 'max_fixations'),
 def _refuse_unused(args, options, why: str) -> None:
     """Refuse any of ``options`` given on the command line (ValueError naming them and why)."""
     given = [flag for flag, name in options
-             if getattr(args, name) not in (None, [])
+             if getattr(args, name) not in (None, [], '')
              and getattr(args, name) is not False]       # a 0 is given
     if given:
         raise ValueError(f'{", ".join(given)}: not used here: {why}')
@@ -448,13 +451,8 @@ def run(args) -> int:
     if faces != (1, 1) and args.scenes != 'pan-tilt':
         raise ValueError('--faces is for --scenes pan-tilt')
     if not args.scenes:
-        scene_only = [flag for flag, given in (
-            ('--compare', bool(args.compare)), ('--empty-scenes', bool(args.empty_scenes)),
-            ('--split', args.split is not None), ('--scene-model', bool(args.scene_model)),
-            ('--group-min-neighbors', args.group_min_neighbors is not None)) if given]
-        if scene_only:
-            raise ValueError(f'{", ".join(scene_only)}: not used here: only --scenes reads '
-                             'it (the simulated task draws its own targets)')
+        _refuse_unused(args, SCENES_ONLY, 'only --scenes reads it (the simulated task draws its '
+                       'own targets)')
     args.split = args.split or 'test'
     if args.scenes:
         model = ('its model: --scene-model' if args.scenes == 'pan-tilt' else
