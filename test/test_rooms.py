@@ -225,7 +225,10 @@ def test_the_room_demo_ends_with_one_verdict_line():
                                                      '--fovea'],
                                   ['--scene', 'faces', '--faces', '0-3', '--empty'],
                                   ['--scene', 'faces', '--faces', '2', '--plot', 'x.png'],
-                                  ['--scene', 'faces', '--faces', '2-1']])
+                                  ['--scene', 'faces', '--faces', '2-1'],
+                                  ['--scene', 'faces', '--faces', '2', '--timeout', '5'],
+                                  ['--scene', 'faces', '--faces', '2', '--domain-id', '220'],
+                                  ['--scene', 'faces', '--faces', '0-2', '--verbose']])
 def test_the_demo_refuses_faces_where_they_do_not_apply_in_one_line(args, capsys):
     assert main(['demo', *args]) == 2
     err = capsys.readouterr().err.strip().splitlines()

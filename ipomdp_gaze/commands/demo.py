@@ -26,6 +26,8 @@ from .common import nonneg_int, positive_float, positive_int
 
 # --motion walk: the walking speed unless --speed-deg-s says (the offline evaluation's default).
 DEMO_SPEED_DEG_S = 5.0
+# The nodes' demos give up after this many seconds unless --timeout says.
+DEMO_TIMEOUT_S = 60.0
 
 
 def add_parser(sub):
@@ -78,8 +80,8 @@ def add_parser(sub):
     p.add_argument('--max-fixations', type=positive_int, default=None, metavar='N',
                    help='without a found event after N fixations, answer with the most likely '
                         'cell (default 60; with --faces the budget of evaluate --faces)')
-    p.add_argument('--timeout', type=positive_float, default=60.0,
-                   help='give up after this many seconds (default 60)')
+    p.add_argument('--timeout', type=positive_float, default=None,
+                   help=f'give up after this many seconds (default {DEMO_TIMEOUT_S:g})')
     p.add_argument('--domain-id', type=domain_arg, default=None,
                    help='ROS domain id, 0..101 or 215..232 (default: derived from the process id)')
     p.add_argument('--verbose', action='store_true', help="print the nodes' own output")
@@ -147,7 +149,9 @@ def run(args) -> int:
                              '--fovea or --empty (--faces 0 is nobody here)')
         for flag, value in (('--plot', args.plot), ('--animate', args.animate),
                             ('--record', args.record), ('--policy', args.policy),
-                            ('--target', args.target), ('--fpoc', args.fpoc)):
+                            ('--target', args.target), ('--fpoc', args.fpoc),
+                            ('--timeout', args.timeout), ('--domain-id', args.domain_id),
+                            ('--verbose', args.verbose or None)):
             if value is not None:
                 raise ValueError(f'{flag} is not available with --faces (an offline search)')
         from ipomdp_gaze.drivers.rooms import room_demo
@@ -167,7 +171,7 @@ def run(args) -> int:
         setup = demo_setup(args.fpoc or 'camera', args.policy, args.seed,
                            parse_target(args.target))
     pictures = [] if args.plot or args.animate else None
-    status = run_demo(setup, args.timeout, args.domain_id, args.verbose, out,
+    status = run_demo(setup, args.timeout or DEMO_TIMEOUT_S, args.domain_id, args.verbose, out,
                       max_fixations=args.max_fixations or 60, record=args.record,
                       compression='' if args.compression == 'none' else args.compression,
                       pictures=pictures)
@@ -202,5 +206,5 @@ def _walk(args, faces: tuple, out) -> int:
     if not 1.0 <= duration <= 3600.0:
         raise ValueError(f'--duration-s must be from 1 to 3600 s, got {duration:g}')
     setup, camera = walk_setup(args.seed, speed, duration, args.policy)
-    return run_walk_demo(setup, camera, duration, args.timeout, args.domain_id, args.verbose,
-                         out, plot=args.plot)
+    return run_walk_demo(setup, camera, duration, args.timeout or DEMO_TIMEOUT_S,
+                         args.domain_id, args.verbose, out, plot=args.plot)
