@@ -227,11 +227,11 @@ def model_to_dict(model: CountObservation) -> dict:
     for key in RECORDS[:4]:
         if key in model.meta:
             doc[key] = plain(model.meta[key])
-    doc['target'] = np.round(model.p_target, 12).tolist()
-    doc['null'] = np.round(model.p_null, 12).tolist()
+    doc['target'] = model.p_target.tolist()
+    doc['null'] = model.p_null.tolist()
     if model.has_scan:
-        doc['scan'] = {'target': np.round(model.scan_target, 12).tolist(),
-                       'null': np.round(model.scan_null, 12).tolist()}
+        doc['scan'] = {'target': model.scan_target.tolist(),
+                       'null': model.scan_null.tolist()}
     if 'calibration' in model.meta:
         doc['calibration'] = plain(model.meta['calibration'])
     return doc

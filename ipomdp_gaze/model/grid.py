@@ -80,16 +80,17 @@ class Grid:
         """Row-major cell index ``row * cols + col`` (scalars checked in the grid, or arrays)."""
         if np.ndim(row) or np.ndim(col):
             return np.asarray(row) * self.cols + np.asarray(col)
-        if not (0 <= int(row) < self.rows and 0 <= int(col) < self.cols):
+        row, col = _whole(row, 'row'), _whole(col, 'column')
+        if not (0 <= row < self.rows and 0 <= col < self.cols):
             raise ValueError(f'cell ({row}, {col}) is outside a {self.rows}x{self.cols} grid')
-        return int(row) * self.cols + int(col)
+        return row * self.cols + col
 
     def cell(self, index):
         """``(row, col)`` of a cell index (scalars or arrays)."""
         if np.ndim(index):
             index = np.asarray(index)
             return index // self.cols, index % self.cols
-        index = int(index)
+        index = _whole(index, 'cell index')
         if not 0 <= index < self.n_cells:
             raise ValueError(f'cell index {index} is outside a {self.rows}x{self.cols} grid')
         return divmod(index, self.cols)
@@ -142,3 +143,15 @@ class Grid:
     def to_dict(self) -> dict:
         """``{'rows', 'cols', 'spacing_deg'}`` as written to JSON and policy files."""
         return {'rows': self.rows, 'cols': self.cols, 'spacing_deg': self.spacing_deg}
+
+
+def _whole(value, what: str) -> int:
+    """Return a scalar cell coordinate as an int; a fraction (1.5) is refused, not truncated."""
+    try:
+        whole = int(value)
+        exact = whole == value
+    except (TypeError, ValueError, OverflowError):
+        exact = False
+    if not exact:
+        raise ValueError(f'a {what} must be a whole number, got {value!r}')
+    return whole

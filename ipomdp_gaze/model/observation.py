@@ -50,12 +50,36 @@ def check_evidence(observation, n_cells: int) -> np.ndarray:
         With the reason, when the frame cannot be used.
 
     """
-    obs = np.asarray(observation, dtype=float)
+    try:
+        obs = np.asarray(observation, dtype=float)
+    except (TypeError, ValueError):
+        raise EvidenceError('evidence must be numbers') from None
     if obs.ndim != 1 or obs.size != n_cells:
         raise EvidenceError(f'evidence has {obs.size} values in shape {obs.shape}, '
                             f'expected {n_cells}: shape ({n_cells},), one per cell, row-major')
     if np.any(np.isinf(obs)):
         raise EvidenceError('evidence contains +/-inf')
+    return obs
+
+
+def check_frames_shape(observation, n_cells: int) -> np.ndarray:
+    """
+    Return frames as float64 of shape ``(N,)`` or ``(E, N)``: one value per cell, row-major.
+
+    Raises
+    ------
+    EvidenceError
+        For any other shape (a frame of another grid would otherwise broadcast against this
+        one's cells).
+
+    """
+    try:
+        obs = np.asarray(observation, dtype=float)
+    except (TypeError, ValueError):
+        raise EvidenceError('evidence must be numbers') from None
+    if obs.ndim not in (1, 2) or obs.shape[-1] != n_cells:
+        raise EvidenceError(f'evidence has shape {obs.shape}, expected ({n_cells},) or '
+                            f'(episodes, {n_cells}): one value per cell, row-major')
     return obs
 
 
@@ -207,6 +231,8 @@ class GaussianObservation:
             For a frame that cannot be used (nothing is changed anywhere).
 
         """
+        if validate:
+            observation = check_frames_shape(observation, self.grid.n_cells)
         return gaussian_log_likelihood_ratio(observation, self.dprime(fixation), validate)
 
     def sample(self, targets, fixations, rng: np.random.Generator,
@@ -447,7 +473,8 @@ class CountObservation:
             For a negative, non-integer or non-finite (other than NaN) count.
 
         """
-        obs = np.asarray(observation, dtype=float)
+        obs = check_frames_shape(observation, self.grid.n_cells) if validate else \
+            np.asarray(observation, dtype=float)
         missing = np.isnan(obs)
         if validate:
             bad = ~missing & (~np.isfinite(obs) | (obs < 0) | (obs != np.floor(obs)))

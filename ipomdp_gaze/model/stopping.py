@@ -103,7 +103,7 @@ def first_decisions(map_probability: np.ndarray, absent_probability, confidence:
     confidence : float
         The level ``c``.
     max_fixations : int, optional
-        The budget (default T): decisions after it do not count.
+        The budget (default T; 0 is no budget, as everywhere): decisions after it do not count.
 
     Returns
     -------
@@ -114,7 +114,10 @@ def first_decisions(map_probability: np.ndarray, absent_probability, confidence:
 
     """
     p = np.asarray(map_probability, dtype=float)
-    budget = p.shape[1] if max_fixations is None else min(int(max_fixations), p.shape[1])
+    max_fixations = check_max_fixations(max_fixations)
+    budget = p.shape[1] if max_fixations is None else min(max_fixations, p.shape[1])
+    if budget == 0:                             # no fixation recorded: nothing decided
+        return np.full(p.shape[0], GAVE_UP), np.zeros(p.shape[0], dtype=int)
     absent = np.zeros_like(p) if absent_probability is None else np.asarray(absent_probability)
     codes = decide(p[:, :budget], absent[:, :budget], check_confidence(confidence))
     decided = codes != UNDECIDED

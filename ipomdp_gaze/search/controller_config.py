@@ -179,7 +179,7 @@ def build_config(values: Mapping, build_policy: Callable, changed=None,
         row_col_from(values, grid, 'start_row', 'start_col')
         settings = SearchSettings.from_parameters(values, grid=grid)
         if settings.targets == 'many':
-            check_many_settings(settings)
+            check_many_settings(settings, grid)
         else:
             check_model_settings(settings, grid, observation)
         if 'room.dwell_s' in values:

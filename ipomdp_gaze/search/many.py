@@ -82,8 +82,17 @@ UNSEEN_SLACK_TURNS = 2
 MIN_GAIN = 1e-9
 
 
-def check_many_settings(settings: SearchSettings) -> None:
-    """Refuse settings the many-target belief does not model (ValueError naming them)."""
+def check_many_settings(settings: SearchSettings, grid=None) -> None:
+    """
+    Refuse settings the many-target belief does not model (ValueError naming them).
+
+    With ``grid``, also a cell prior of certainty: one cell and no ``absent.prior`` (or one so
+    small that the prior of each cell rounds to 1), where nothing could be learnt.
+    """
+    if grid is not None and cell_prior(grid.n_cells, settings.absent_prior) >= 1.0:
+        raise ValueError(f'search.targets many on a grid of one cell needs '
+                         f'search.absent.prior > 0 (got {settings.absent_prior:g}; below 1e-16 it '
+                         f'rounds to 0): without it its cell is occupied for certain')
     if settings.confidence <= 0.5:
         raise ValueError(f'search.targets many decides each cell at the confidence either way, '
                          f'so it must be above 0.5 (got {settings.confidence:g})')
@@ -138,7 +147,7 @@ class OccupancySession:
         self.observation = as_observation(grid, observation)
         self.settings = settings or SearchSettings(targets='many')
         self.settings.check_grid(grid)
-        check_many_settings(self.settings)
+        check_many_settings(self.settings, grid)
         self.policy = None
         self._pass = None
         self.link = int(link)
@@ -170,8 +179,10 @@ class OccupancySession:
         """
         Use new settings from the next frame on, keeping the belief of the search under way.
 
-        A new ``absent_prior`` applies from the next :meth:`reset`. Motion turned on keeps the
-        evidence so far (the still-scene weighting folded in); turned off, the people followed
+        A new ``absent_prior`` applies from the next :meth:`reset`. Motion turned on, or a new
+        ``repeat_weight``, keeps the evidence so far (the still-scene weighting folded in, as
+        it was) and counts the still scene's evidence afresh from the next frame (as
+        :meth:`SearchSession.configure`); motion turned off, the people followed
         are forgotten (a still room is searched, then decided). New position-filter settings
         give the people followed new filters.
 
@@ -182,14 +193,16 @@ class OccupancySession:
 
         """
         settings.check_grid(self.grid)
-        check_many_settings(settings)
+        check_many_settings(settings, self.grid)
         old, s = self.settings, self._state
-        if motion_settings(settings) != motion_settings(old):
+        moves = motion_settings(settings) != motion_settings(old)
+        if s is not None and not self._motion.active and (
+                moves or settings.repeat_weight != old.repeat_weight):
+            s['base'] = self.log_odds              # the still evidence, weighted as it was
+            self._still.reset()
+            self._best = np.zeros(self.grid.n_cells)
+        if moves:
             was_moving = self._motion.active
-            if s is not None and not was_moving:
-                s['base'] = self.log_odds          # the still evidence, weighted as it was
-                self._still.reset()
-                self._best = np.zeros(self.grid.n_cells)
             self._motion = target_motion(self.grid, settings)
             if was_moving and not self._motion.active:
                 self.tracks.reset()                # still targets: the room's search decides

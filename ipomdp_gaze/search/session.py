@@ -764,7 +764,7 @@ class SearchSession:
 
         ``settings.start_cell`` if it is a cell; the policy's choice (its best unvisited cell
         with inhibition of return) on the belief if it is ``'policy'`` or after a scan;
-        otherwise the grid's centre.
+        otherwise, and without a policy (the driver chooses: :meth:`fixate`), the grid's centre.
         """
         search = self._state()
         if search.fixation is not None:
@@ -772,7 +772,7 @@ class SearchSession:
         fixed = start_index(self.grid, self.settings)
         if fixed is not None:
             search.fixation = fixed
-        elif search.scanned or self.settings.start_cell == 'policy':
+        elif self.policy is not None and (search.scanned or self.settings.start_cell == 'policy'):
             search.fixation = self._choose()
         else:
             search.fixation = self.grid.center_index

@@ -304,13 +304,22 @@ def tracking_arrays(result, cols: int) -> tuple[np.ndarray, np.ndarray, np.ndarr
 
 
 def _ratio_bootstrap(numerators, denominators, rng: np.random.Generator, resamples: int):
-    """Percentile bootstrap over searches of ``sum(num_i) / sum(den_i)`` for each pair given."""
+    """
+    Percentile bootstrap over searches of ``sum(num_i) / sum(den_i)`` for each pair given.
+
+    A resample whose denominator is 0 (no search in it has any fixation to count) has no ratio:
+    NaN, which the callers leave out of their percentiles, rather than a ratio of 0.
+    """
     e = numerators[0].size
     values = []
     for start in range(0, resamples, CHUNK):
         counts = bootstrap_counts(e, min(CHUNK, resamples - start), rng).astype(float)
-        values.append(np.stack([(counts @ num) / np.maximum(counts @ den, 1)
-                                for num, den in zip(numerators, denominators)]))
+        ratios = []
+        for num, den in zip(numerators, denominators):
+            top, bottom = counts @ num, counts @ den
+            ratios.append(np.divide(top, bottom, out=np.full(top.shape, np.nan),
+                                    where=bottom > 0))
+        values.append(np.stack(ratios))
     return np.concatenate(values, axis=1)
 
 
@@ -331,7 +340,7 @@ def tracking_summary(result, cols: int, rng: np.random.Generator, resamples: int
     ci = None
     if total:
         boot = _ratio_bootstrap([hits.astype(float)], [after.astype(float)], rng, resamples)[0]
-        ci = [float(x) for x in np.percentile(boot, [2.5, 97.5])]
+        ci = [float(x) for x in np.nanpercentile(boot, [2.5, 97.5])]
     return {'locked': rate(first[present] > 0), 'first_lock': mean_ci(first[first > 0]),
             'tracking_accuracy': {'value': accuracy, 'ci95': ci,
                                   'fixations_after_lock': total}}
@@ -354,5 +363,5 @@ def paired_tracking_difference(result_a, result_b, cols: int, rng: np.random.Gen
     point = hits_a.sum() / after_a.sum() - hits_b.sum() / after_b.sum()
     boot = _ratio_bootstrap([hits_a.astype(float), hits_b.astype(float)],
                             [after_a.astype(float), after_b.astype(float)], rng, resamples)
-    low, high = np.percentile(boot[0] - boot[1], [2.5, 97.5])
+    low, high = np.nanpercentile(boot[0] - boot[1], [2.5, 97.5])
     return {'difference': float(point), 'ci95': [float(low), float(high)]}
