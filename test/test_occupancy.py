@@ -709,3 +709,44 @@ def test_a_stray_large_box_does_not_become_the_box_of_the_faces_it_covers():
     assert support.tolist() == [4, 2]                       # the stray joined the face it holds
     kept, _ = merge_boxes(stray + face, scores=[0.9, 0.8, 0.7, 0.6])    # scores still rule
     assert kept.tolist()[0] == stray[0]
+
+
+@pytest.mark.parametrize('link', [0, 1])
+def test_the_still_gains_kept_between_frames_are_those_computed_afresh(link):
+    """The gains' (N, N) terms are updated per changed column; every call equals a fresh one."""
+    grid = Grid(12, 12)                    # a frame changes at most 25 of 144 cells' terms
+    model = _model(grid, k=3, seed=7, radius=2)
+    session = OccupancySession(grid, model, SearchSettings(
+        targets='many', absent_prior=0.5, repeat_weight=0.5, confidence=0.99), link=link)
+    session.reset()
+    session.start()
+    rng = np.random.default_rng(3)
+
+    def fresh(log_odds=None):
+        kept, session._gain_cache = session._gain_cache, None
+        try:
+            return session.gains(log_odds)
+        finally:
+            session._gain_cache = kept
+
+    for step in range(40):
+        if step == 20:
+            session.configure(replace(session.settings, repeat_weight=0.2))
+        want = fresh()
+        np.testing.assert_array_equal(session.gains(), want)
+        other = session.log_odds + rng.normal(0, 0.01, grid.n_cells) * \
+            (rng.random(grid.n_cells) < 0.1)
+        np.testing.assert_array_equal(session.gains(other), fresh(other))
+        if session.ended:
+            break
+        fixation = grid.index(*rng.integers(3, 8, 2))
+        session.fixate(fixation)
+        # Each cell's likeliest count for a face at (5, 5), none elsewhere: cells get decided
+        # (and with link, their neighbours settled) while the search goes on.
+        terms = np.stack([model.log_likelihood_ratio(np.full(grid.n_cells, c), fixation)
+                          for c in range(3)])
+        face = np.zeros(grid.n_cells, bool)
+        face[grid.index(5, 5)] = True
+        frame = np.where(face, terms.argmax(axis=0), terms.argmin(axis=0)).astype(float)
+        frame[rng.random(grid.n_cells) < 0.3] = np.nan
+        session.update(Frame(frame))

@@ -358,3 +358,21 @@ def test_a_key_given_twice_is_refused_not_taken_last_wins(tmp_path):
     ok = tmp_path / 'ok.yaml'
     ok.write_text('base: &b {x: 1}\nderived:\n  <<: *b\n  y: 2\n')           # a merge key is fine
     assert read_yaml(ok, ValueError) == {'base': {'x': 1}, 'derived': {'x': 1, 'y': 2}}
+
+
+def test_the_fast_yaml_parser_reads_every_shipped_file_as_the_python_one():
+    """read_yaml parses with libyaml when PyYAML has it; its documents must be the same."""
+    import yaml
+    from ipomdp_gaze.files import yaml_files
+    if yaml_files.UniqueKeyCLoader is None:
+        assert not getattr(yaml, '__with_libyaml__', False)
+        pytest.skip('PyYAML without libyaml: only the Python loader reads')
+    root = Path(__file__).resolve().parents[1]
+    files = sorted((root / 'config').glob('*.yaml')) + \
+        sorted((root / 'ipomdp_gaze' / 'models').glob('*.yaml')) + \
+        sorted(Path(pf.KERNEL_DIR).glob('*.yaml'))
+    assert len(files) >= 20
+    for path in files:
+        text = path.read_text(encoding='utf-8')
+        assert yaml_files._load(text, yaml_files.UniqueKeyCLoader) == \
+            yaml_files._load(text, yaml_files.UniqueKeyLoader), path

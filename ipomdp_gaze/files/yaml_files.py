@@ -46,6 +46,43 @@ def _unique_mapping(loader, node, deep=False):
 
 UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _unique_mapping)
 
+if getattr(yaml, '__with_libyaml__', False):
+    class UniqueKeyCLoader(yaml.CSafeLoader):
+        """:class:`UniqueKeyLoader` on libyaml's parser (the same constructors, 5-10x faster)."""
+
+    UniqueKeyCLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG,
+                                     _unique_mapping)
+else:                                           # pragma: no cover - PyYAML without libyaml
+    UniqueKeyCLoader = None
+
+# Deeper documents are read again by the pure-Python loader, so that its limits (a
+# RecursionError beyond a few hundred levels) decide as before; libyaml stops at 1000.
+FAST_MAX_DEPTH = 100
+
+
+def _depth_exceeds(doc, limit: int) -> bool:
+    """Whether lists and dicts nest more than ``limit`` deep in ``doc`` (aliases visited once)."""
+    stack, seen = [(doc, 0)], set()
+    while stack:
+        value, depth = stack.pop()
+        if isinstance(value, (list, dict)):
+            if depth >= limit:
+                return True
+            if id(value) in seen:
+                continue
+            seen.add(id(value))
+            items = value.values() if isinstance(value, dict) else value
+            stack.extend((v, depth + 1) for v in items if isinstance(v, (list, dict)))
+    return False
+
+
+def _load(text: str, loader_class):
+    loader = loader_class(text)                 # what yaml.safe_load does, with the key check
+    try:
+        return loader.get_single_data()
+    finally:
+        loader.dispose()
+
 
 def read_yaml(path: Path, error: type[ValueError]):
     """
@@ -62,12 +99,18 @@ def read_yaml(path: Path, error: type[ValueError]):
         text = Path(path).read_text(encoding='utf-8')
     except (OSError, UnicodeDecodeError) as exc:
         raise error(f'{path}: cannot read: {exc}') from None
-    try:
-        loader = UniqueKeyLoader(text)          # what yaml.safe_load does, with the key check
+    if UniqueKeyCLoader is not None:
+        # The fast parser for files that read; any problem, or a deep document, is read again
+        # by the pure-Python loader, so every message (and its line) is what it always was.
         try:
-            return loader.get_single_data()
-        finally:
-            loader.dispose()
+            doc = _load(text, UniqueKeyCLoader)
+        except (yaml.YAMLError, RecursionError):
+            pass
+        else:
+            if not _depth_exceeds(doc, FAST_MAX_DEPTH):
+                return doc
+    try:
+        return _load(text, UniqueKeyLoader)
     except DuplicateKeyError as exc:
         raise error(f'{path}: {exc} (line {exc.problem_mark.line + 1}): which one is meant? '
                     'keep one') from None

@@ -192,7 +192,12 @@ class InformationTable:
         self.table = channel_information(p[None, :], pt[first][:, None, :],
                                          pn[first][:, None, :])             # (M, B)
         ri, ci = self.grid.pair_offset_index()
-        self.pair = np.ascontiguousarray(self.offset_id[ri, ci])          # [k, j] channel
+        # [k, j] -> the flat index of (channel of offset k - j, cell j) in by_channel's (M, N):
+        # one 1-D take per call (a gather with two broadcast index arrays costs 4x more).
+        flat = np.array(self.offset_id[ri, ci], dtype=np.intp, order='C')
+        flat *= flat.shape[1]
+        flat += np.arange(flat.shape[1])
+        self.flat_pair = flat
         kernel = np.asarray(model.elm_kernel(), dtype=float)
         self.view_information = np.ascontiguousarray(kernel[ri, ci])     # [k, j] ELM kernel
 
@@ -205,8 +210,9 @@ class InformationTable:
 
     def __call__(self, log_odds: np.ndarray, candidates=None) -> np.ndarray:
         """``I[k, j]`` of cell j seen from candidate k: (K, N), K = all cells by default."""
-        pair = self.pair if candidates is None else self.pair[np.asarray(candidates)]
-        return self.by_channel(log_odds)[pair, np.arange(pair.shape[1])[None, :]]
+        flat = self.flat_pair if candidates is None else \
+            self.flat_pair[np.asarray(candidates)]
+        return np.take(self.by_channel(log_odds).ravel(), flat)
 
 
 _TABLES = {}

@@ -168,6 +168,7 @@ class OccupancySession:
         self._log = deque(maxlen=int(log_size))
         self.rng = np.random.default_rng(0)
         self._state = None
+        self._gain_cache = None         # the still gains' (N, N) terms (:meth:`_still_terms`)
 
     # -- configuration -------------------------------------------------------------------
     @property
@@ -572,16 +573,55 @@ class OccupancySession:
         so far (ELM kernel), else ``repeat_weight`` (module docstring).
         """
         log_odds = self.log_odds if log_odds is None else log_odds
-        info = self.table(log_odds)                                        # (N, N) [k, j]
         if self._motion.active:
+            info = self.table(log_odds)                                    # (N, N) [k, j]
             followed = self.tracks.followed()
             return info @ (~followed).astype(float)
-        weight = np.where(self._view_info > self._best[None, :], 1.0,
-                          self.settings.repeat_weight)
-        if self.link > 0:
-            settled = self.settled(self._decided(log_odds)[0])
-            weight = weight * ~settled[None, :]
+        settled = self.settled(self._decided(log_odds)[0]) if self.link > 0 else None
+        info, weight = self._still_terms(np.asarray(log_odds, dtype=float), settled)
         return np.einsum('kj,kj->k', info, weight)
+
+    def _still_terms(self, log_odds: np.ndarray, settled) -> tuple[np.ndarray, np.ndarray]:
+        """
+        ``I[k, j]`` and ``w[k, j]`` (N, N) of the still gains, kept from the last call.
+
+        Column j depends only on cell j (its log odds, best view so far, settled or not), and a
+        still frame changes the cells it saw: only the columns whose inputs changed are
+        recomputed, with the same operations, so the arrays (and the sum) are the ones a full
+        computation gives.
+        """
+        table, rw = self.table, self.settings.repeat_weight
+        best = self._best
+        key = (table, rw, self.link > 0)
+        c = self._gain_cache
+        if c is not None and c['key'][0] is table and c['key'][1:] == key[1:] \
+                and c['log_odds'].shape == log_odds.shape:
+            changed = (c['log_odds'] != log_odds) | (c['best'] != best)
+            if settled is not None:
+                changed |= c['settled'] != settled
+            cols = np.flatnonzero(changed)
+            # NaN never equals itself: such a column is recomputed on every call, as before.
+            if cols.size <= log_odds.size // 4:
+                if cols.size:
+                    info, weight = c['info'], c['weight']
+                    by_channel = table.by_channel(log_odds).ravel()
+                    info[:, cols] = np.take(by_channel, table.flat_pair[:, cols])
+                    w = np.where(self._view_info[:, cols] > best[None, cols], 1.0, rw)
+                    if settled is not None:
+                        w = w * ~settled[None, cols]
+                    weight[:, cols] = w
+                    c['log_odds'][cols], c['best'][cols] = log_odds[cols], best[cols]
+                    if settled is not None:
+                        c['settled'] = settled.copy()
+                return c['info'], c['weight']
+        info = table(log_odds)                                             # (N, N) [k, j]
+        weight = np.where(self._view_info > best[None, :], 1.0, rw)
+        if settled is not None:
+            weight = weight * ~settled[None, :]
+        self._gain_cache = {'key': key, 'info': info, 'weight': weight,
+                            'log_odds': log_odds.copy(), 'best': best.copy(),
+                            'settled': None if settled is None else settled.copy()}
+        return info, weight
 
     def costs_from(self, cell: int | None) -> np.ndarray:
         """
