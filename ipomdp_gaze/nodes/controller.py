@@ -61,6 +61,8 @@ from ipomdp_gaze.search.controller_config import (build_config, ControllerConfig
 from ipomdp_gaze.search.gaze import FrameSequence, SETTLING, STAMP_TOLERANCE_S
 from ipomdp_gaze.search.health import HealthMonitor
 from ipomdp_gaze.search.room import MAX_PERIOD_S, Person, PERSON_LINK, RoomWatch
+from rclpy.clock import JumpThreshold
+from rclpy.duration import Duration
 from rclpy.exceptions import NameValidationException
 from rclpy.expand_topic_name import expand_topic_name
 from rclpy.node import Node
@@ -86,6 +88,9 @@ WARN_THROTTLE_S = 5.0
 # The fixation is asked for again this long after its settle time has passed (a frame taken
 # then is not skipped on a clock read a hair earlier).
 SETTLED_MARGIN_S = 0.01
+# A jump of the node's clock (use_sim_time: /clock set back, or its first tick far from 0) moves
+# the times the search keeps; forward, only jumps this long (a /clock ticks far more often).
+CLOCK_JUMP_FORWARD_S = 5.0
 # belief_image is at most this many pixels on a side (256x256 cells at 32 px would be 201 MB).
 MAX_IMAGE_SIDE_PX = 1024
 OBSERVATION_MODELS = ('gaussian', 'counts')
@@ -212,6 +217,10 @@ class GazeControllerNode(QuietPublishers, Node):
         self._health = HealthMonitor(self._now_s())
         self._pan_tilt_msg = None
         self.core.reset(self._now_s())
+        self._clock_jumps = self.get_clock().create_jump_callback(
+            JumpThreshold(min_forward=Duration(seconds=CLOCK_JUMP_FORWARD_S),
+                          min_backward=Duration(nanoseconds=-1), on_clock_change=True),
+            post_callback=self.guard.wrap(self._on_clock_jump))
         self._publish_belief()
         self._send_target()
         self.get_logger().info(
@@ -409,6 +418,20 @@ class GazeControllerNode(QuietPublishers, Node):
 
     def _now_s(self) -> float:
         return self._now().nanoseconds * 1e-9
+
+    def _on_clock_jump(self, jump) -> None:
+        """
+        Move the search's times with a jump of the clock (sim time set back or started).
+
+        Without this, a /clock set back (a simulator's reset, ``ros2 bag play --loop``) leaves
+        the target stamped in the future, and every frame is skipped as taken before the head
+        settled; a first /clock far from 0 reads as a long stall.
+        """
+        delta_s = jump.delta.nanoseconds * 1e-9
+        self.core.shift_clock(delta_s)
+        self._health = HealthMonitor(self._now_s(), self.core.received, self.core.rejected)
+        self.get_logger().info(f'the clock jumped {delta_s:+.3f} s: the search keeps its '
+                               f'belief and counts its times from the new clock')
 
     # -- outputs -------------------------------------------------------------------------
     def _send_target(self) -> None:

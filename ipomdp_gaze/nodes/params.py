@@ -15,6 +15,7 @@ with the reason.
 """
 from __future__ import annotations
 
+import array
 from dataclasses import dataclass
 import math
 
@@ -74,7 +75,8 @@ class Param:
             return (f"{self.name} must be one of {', '.join(repr(c) for c in self.choices)}, "
                     f'got {value!r}')
         if self.dynamic and self.name == 'fpoc.dprime':
-            items = value if isinstance(value, (list, tuple)) else [value]
+            # A list set at run time arrives from rclpy as an array.array('d').
+            items = list(value) if isinstance(value, (list, tuple, array.array)) else [value]
             if not items or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
                                     for v in items):
                 return f'fpoc.dprime must be a number or a list of numbers, got {value!r}'

@@ -18,6 +18,7 @@ import re
 import sys
 
 import rclpy
+from rclpy.clock import Clock, ClockType
 import yaml
 
 WAKE_PERIOD_S = 0.25
@@ -37,7 +38,9 @@ def spin(node, wake_period_s: float = WAKE_PERIOD_S) -> None:
         When a signal shut the context down (as :func:`rclpy.spin` does).
 
     """
-    timer = node.create_timer(wake_period_s, _wake)
+    # On the steady clock: a node's own clock is the simulated one under use_sim_time, and a
+    # paused /clock would stop the wake-up, so a signal could wait for the next tick.
+    timer = node.create_timer(wake_period_s, _wake, clock=Clock(clock_type=ClockType.STEADY_TIME))
     try:
         rclpy.spin(node)
     finally:

@@ -17,6 +17,7 @@ The core does not import the policies (docs/design.md section 8): the caller pas
 """
 from __future__ import annotations
 
+import array
 from dataclasses import dataclass
 from typing import Callable, Mapping
 
@@ -46,7 +47,8 @@ def fpoc_from(values: Mapping):
     kwargs = {}
     for name in parameter_names(model):
         value = values[f'fpoc.{name}']
-        kwargs[name] = list(value) if isinstance(value, (list, tuple)) else value
+        # lists: from YAML a list, set at run time an array.array('d') (rclpy's)
+        kwargs[name] = list(value) if isinstance(value, (list, tuple, array.array)) else value
     if model == 'table' and not isinstance(kwargs['dprime'], list):
         raise ValueError('the table FPOC needs fpoc.dprime as a list matching fpoc.ecc_deg')
     return make_fpoc(model, **kwargs)

@@ -392,6 +392,22 @@ class GazeController:
         self.target_time_s = float(now_s)
         return self.fixation
 
+    def shift_clock(self, delta_s: float) -> None:
+        """
+        Move every time kept by ``delta_s``: the node's clock jumped (sim time set back).
+
+        A ``/clock`` that restarts (a simulator's reset, a bag played in a loop) would otherwise
+        leave the target's stamp in the future, and every frame would wait for it to settle.
+        """
+        delta_s = float(delta_s)
+        if not math.isfinite(delta_s):
+            raise ValueError(f'a clock jump must be finite, got {delta_s!r}')
+        self.target_time_s += delta_s
+        self.usable_time_s += delta_s
+        self.update_time_s += delta_s
+        self.tracked_since_s += delta_s
+        self.lost_since_s += delta_s
+
     def set_enabled(self, enabled: bool, now_s: float) -> bool:
         """
         Enable or disable; returns whether that changed anything.
