@@ -322,3 +322,22 @@ def test_a_search_without_a_budget_that_reaches_its_cap_says_it_gave_up():
     last = out.stdout.strip().splitlines()[-1]
     assert last.startswith('gave up: no cell reached the confidence 0.95 after 900 fixations, '
                            'the cap of an offline search without a budget (100 per cell)')
+
+
+def test_blas_runs_on_one_thread_unless_the_environment_says(monkeypatch):
+    """QA: the logistic curve regenerated only with OPENBLAS_NUM_THREADS=1 (training's gemm)."""
+    import os
+    import subprocess
+    from ipomdp_gaze.cli import BLAS_THREAD_VARIABLES
+    # The pin works only if numpy is not loaded before main() runs.
+    run = subprocess.run([sys.executable, '-c', 'import sys, ipomdp_gaze.cli; '
+                          "print('numpy' in sys.modules)"], capture_output=True, text=True,
+                         check=True)
+    assert run.stdout.strip() == 'False'
+    for name in BLAS_THREAD_VARIABLES:
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv('MKL_NUM_THREADS', '4')
+    with pytest.raises(SystemExit):
+        main(['--version'])
+    assert os.environ['OPENBLAS_NUM_THREADS'] == os.environ['OMP_NUM_THREADS'] == '1'
+    assert os.environ['MKL_NUM_THREADS'] == '4'

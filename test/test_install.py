@@ -371,7 +371,7 @@ def test_installed_controller_and_camera_talk_over_dds(install, ros_env, probe, 
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float32MultiArray
     params = yaml.safe_load((install.share / 'config' / 'controller.yaml').read_text())
-    grid = params['gaze_controller']['ros__parameters']['grid']
+    grid = params['/**/gaze_controller']['ros__parameters']['grid']
     n_cells = grid['rows'] * grid['cols']
     latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                          durability=DurabilityPolicy.TRANSIENT_LOCAL)

@@ -129,3 +129,36 @@ def test_a_node_executable_answers_help_and_refuses_a_stray_argument(ros_env, mo
     assert stray.returncode == 2
     assert stray.stderr.strip().splitlines()[-1].endswith(
         'unexpected arguments --seed 3 (ROS arguments go after --ros-args; --help for usage)')
+
+
+@pytest.mark.parametrize('path', sorted((REPO / 'config').glob('*.yaml')), ids=lambda p: p.name)
+def test_every_shipped_params_file_applies_in_any_namespace(path):
+    """QA: bare ``gaze_controller:`` sections applied only at the root, so under -r __ns:=/r1."""
+    from ipomdp_gaze.nodes import NODE_NAMES
+    from ipomdp_gaze.nodes.spin import _matches, params_file_sections
+    sections = params_file_sections(path)
+    assert len(sections) == 1 and sections[0].startswith('/**/'), sections
+    assert sections[0][len('/**/'):] in NODE_NAMES.values()
+    for namespace in ('', '/robot1', '/robot1/head'):
+        assert _matches(sections[0], f'{namespace}/{sections[0][len("/**/"):]}')
+
+
+@pytest.mark.parametrize('name, node_class', [('controller', 'GazeControllerNode'),
+                                              ('camera', 'SimulatedCameraNode')])
+def test_a_namespaced_node_takes_the_shipped_values(context, name, node_class):
+    import importlib
+    from ipomdp_gaze.files.yaml_files import yaml_parameters
+    from ipomdp_gaze.nodes import NODE_NAMES
+    path = REPO / 'config' / f'{name}.yaml'
+    shipped = yaml_parameters(path, NODE_NAMES[name])
+    make = getattr(importlib.import_module(f'ipomdp_gaze.nodes.{name}'), node_class)
+    node = make(context=context, namespace='/robot1/head',
+                cli_args=['--ros-args', '--params-file', str(path)])
+    try:
+        assert node.get_fully_qualified_name() == f'/robot1/head/{NODE_NAMES[name]}'
+        for key, value in shipped.items():
+            got = node.get_parameter(key).value
+            assert (list(got) if hasattr(got, 'tolist') or hasattr(got, 'typecode') else got) \
+                == value, key
+    finally:
+        node.destroy_node()

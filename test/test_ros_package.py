@@ -50,8 +50,8 @@ def test_yaml_names_declared_parameters_with_their_types(file, node, module, par
     module = importlib.import_module(f'ipomdp_gaze.nodes.{module}')
     declared = {p.name: p for p in getattr(module, params)()}
     doc = _yaml(file)
-    assert list(doc) == [node]
-    values = _flat(doc[node]['ros__parameters'])
+    assert list(doc) == [f'/**/{node}']           # applies in any namespace
+    values = _flat(doc[f'/**/{node}']['ros__parameters'])
     unknown = sorted(set(values) - set(declared))
     assert not unknown, f'{file}: undeclared parameters {unknown}'
     for name, value in values.items():
@@ -67,8 +67,8 @@ def test_yaml_names_declared_parameters_with_their_types(file, node, module, par
 
 
 def test_the_two_yaml_files_describe_the_same_task():
-    controller = _flat(_yaml('controller.yaml')['gaze_controller']['ros__parameters'])
-    camera = _flat(_yaml('camera.yaml')['simulated_camera']['ros__parameters'])
+    controller = _flat(_yaml('controller.yaml')['/**/gaze_controller']['ros__parameters'])
+    camera = _flat(_yaml('camera.yaml')['/**/simulated_camera']['ros__parameters'])
     task = [k for k in controller if k.startswith(('grid.', 'fpoc.')) or k.endswith(
         ('_joint', '_sign', '_offset_rad'))]
     assert {k: controller[k] for k in task} == {k: camera.get(k) for k in task}
@@ -83,10 +83,11 @@ def test_the_two_yaml_files_describe_the_same_task():
 @pytest.mark.parametrize('mode, view', [('camera', 'pan_tilt'), ('fovea', 'fixed')])
 def test_the_three_face_yaml_files_of_a_mode_describe_the_same_task(mode, view):
     from ipomdp_gaze.files.observation_file import load_observation
-    controller = _flat(_yaml(f'faces_{mode}_controller.yaml')['gaze_controller']
+    controller = _flat(_yaml(f'faces_{mode}_controller.yaml')['/**/gaze_controller']
                        ['ros__parameters'])
-    detector = _flat(_yaml(f'faces_{mode}_detector.yaml')['foveal_detector']['ros__parameters'])
-    camera = _flat(_yaml(f'faces_{mode}_scene_camera.yaml')['scene_camera']['ros__parameters'])
+    detector = _flat(_yaml(f'faces_{mode}_detector.yaml')['/**/foveal_detector']
+                     ['ros__parameters'])
+    camera = _flat(_yaml(f'faces_{mode}_scene_camera.yaml')['/**/scene_camera']['ros__parameters'])
     assert detector['mode'] == mode and camera['view'] == view
     assert controller['observation.model'] == 'counts'
     assert controller['observation.file'] == detector['observation.file']

@@ -180,9 +180,16 @@ def flatten(tree: dict, prefix: str = '') -> dict:
 
 
 def yaml_parameters(path, node_name: str) -> dict:
-    """Read the ``ros__parameters`` of ``node_name`` from a parameter file, dotted names."""
+    """
+    Read the ``ros__parameters`` of ``node_name`` from a parameter file, dotted names.
+
+    The node's section is ``/**/node_name:`` (the shipped files: it applies in any namespace),
+    ``/node_name:`` or ``node_name:``.
+    """
     tree = yaml.safe_load(Path(path).read_text())
-    try:
-        return flatten(tree[node_name]['ros__parameters'])
-    except (KeyError, TypeError):
-        raise ValueError(f'{path} has no {node_name}: ros__parameters block') from None
+    for key in (f'/**/{node_name}', f'/{node_name}', node_name):
+        try:
+            return flatten(tree[key]['ros__parameters'])
+        except (KeyError, TypeError):
+            continue
+    raise ValueError(f'{path} has no /**/{node_name}: ros__parameters block')
