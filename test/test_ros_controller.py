@@ -210,6 +210,8 @@ def test_bad_kernel_is_rejected_and_the_old_one_stays(probe, cam, bad, words):
     # a substitution rcl does not know is refused, not half-applied
     ({'forward_command_topic': '/x{y}'}, 'forward_command_topic: topic name'),
     ({'trajectory_topic': '~/cmd{x}'}, 'unknown substitution: {x}'),
+    # rcl's caret picture under the fault would span three lines (QA)
+    ({'forward_command_topic': 'a//b'}, "must not contain repeated '/' ('a//b')"),
     ({'search.false_alarm_scales': [2.0]}, 'needs a count model'),
     ({'search.view_time_s': 0.0}, 'search.view_time_s must be finite and > 0'),
     # settings the model cannot serve are refused before any of them applies
@@ -221,6 +223,7 @@ def test_invalid_parameters_are_rejected_with_a_reason(probe, cam, values, words
     result = probe.set_parameters(NODE, values)[0]
     assert not result.successful
     assert words in result.reason, result.reason
+    assert '\n' not in result.reason, result.reason
     assert probe.get_parameters(NODE, list(values)) == before
 
 

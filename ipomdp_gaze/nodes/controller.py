@@ -271,8 +271,9 @@ class GazeControllerNode(QuietPublishers, Node):
                     validate_full_topic_name(expand_topic_name(
                         values[name], self.get_name(), self.get_namespace()))
                 except (NameValidationException, ValueError) as exc:
-                    reason = str(exc).split(', at ')[0]
-                    raise ValueError(f'{name}: {reason}') from None
+                    # rcl adds the name again with a caret under the fault: one line instead
+                    reason = ' '.join(str(exc).split(', at ')[0].split('\n')[:1]).rstrip(':')
+                    raise ValueError(f'{name}: {reason} ({values[name]!r})') from None
         return cfg
 
     def _startup_config(self) -> Config:
