@@ -282,7 +282,8 @@ def _distributions(name: str, table, shape_problem, atol: float) -> np.ndarray:
         where = f'offset ({offset[0]}, {offset[1]}) ' if offset else ''
         raise ValueError(f'{name} table must be finite and >= 0: {where}count {c} is '
                          f'{a[tuple(bad[0])]}')
-    total = a.sum(axis=-1)
+    with np.errstate(over='ignore'):            # entries near the float limit: inf, refused
+        total = a.sum(axis=-1)
     off = np.argwhere(np.abs(np.atleast_1d(total) - 1.0) > atol)
     if off.size:
         if a.ndim == 1:
