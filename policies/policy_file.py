@@ -37,7 +37,7 @@ from typing import Callable
 import warnings
 
 from ipomdp_gaze.files.observation_file import fingerprint
-from ipomdp_gaze.files.yaml_files import check_header, plain, read_yaml, write_yaml
+from ipomdp_gaze.files.yaml_files import check_header, in_folder, plain, read_yaml, write_yaml
 from ipomdp_gaze.model.fpoc import FPOC, fpoc_from_dict
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.observation import CountObservation, GaussianObservation
@@ -378,7 +378,7 @@ def load_policy_spec(source) -> PolicySpec:
 
     """
     path = resolve_source(source)
-    doc = read_yaml(path, PolicyFileError)
+    doc = read_yaml(path, PolicyFileError, shipped=in_folder(path, KERNEL_DIR))
     try:
         return spec_from_dict(doc, path=path)
     except PolicyFileError as exc:

@@ -376,3 +376,28 @@ def test_the_fast_yaml_parser_reads_every_shipped_file_as_the_python_one():
         text = path.read_text(encoding='utf-8')
         assert yaml_files._load(text, yaml_files.UniqueKeyCLoader) == \
             yaml_files._load(text, yaml_files.UniqueKeyLoader), path
+
+
+@pytest.mark.parametrize('text, outcome', [
+    ('a: b\t\n', 'not YAML at line 1'),                  # libyaml reads {'a': 'b'}
+    ('a: !\n', {'a': None}),                              # libyaml reads ''
+    ('a:\n\ufeff  b: 1\n', {'a': None, '\ufeff  b': 1}),  # libyaml drops the mark: {'a': {'b': 1}}
+])
+def test_a_users_yaml_is_read_by_pythons_parser_as_always(tmp_path, monkeypatch, text, outcome):
+    """QA: libyaml reads a few odd inputs otherwise; only the package's own files take it."""
+    from ipomdp_gaze.files import yaml_files
+    path = tmp_path / 'mine.yaml'
+    path.write_text(text, encoding='utf-8')
+    fast = []
+    real = yaml_files._load
+    monkeypatch.setattr(yaml_files, '_load', lambda t, cls: fast.append(cls) or real(t, cls))
+    if isinstance(outcome, str):
+        with pytest.raises(ValueError, match=outcome):
+            yaml_files.read_yaml(path, ValueError)
+    else:
+        assert yaml_files.read_yaml(path, ValueError) == outcome
+    assert fast == [yaml_files.UniqueKeyLoader]
+    # a shipped kernel is read by libyaml where PyYAML has it
+    fast.clear()
+    pf.load_policy_spec('human-7x7-infomax')
+    assert fast == [yaml_files.UniqueKeyCLoader or yaml_files.UniqueKeyLoader]

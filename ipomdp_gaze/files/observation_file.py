@@ -32,7 +32,7 @@ import math
 from pathlib import Path
 import re
 
-from ipomdp_gaze.files.yaml_files import check_header, plain, read_yaml, write_yaml
+from ipomdp_gaze.files.yaml_files import check_header, in_folder, plain, read_yaml, write_yaml
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.observation import CountObservation
 import numpy as np
@@ -207,7 +207,7 @@ def load_observation(source) -> CountObservation:
 
     """
     path = resolve_source(source)
-    doc = read_yaml(path, ObservationFileError)
+    doc = read_yaml(path, ObservationFileError, shipped=in_folder(path, MODEL_DIR))
     if isinstance(doc, dict) and doc.get('format') == POLICY_FORMAT:
         raise ObservationFileError(f'{path} is a policy file ({POLICY_FORMAT}), not an '
                                    f'observation model ({FORMAT}): pass it as --policy-file '
