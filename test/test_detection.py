@@ -86,6 +86,19 @@ def test_a_resent_fixation_keeps_waiting_from_the_first_command(fovea_setup):
     assert loop.values()['fixations_received'] == 5
 
 
+def test_a_fixation_resent_on_a_clock_set_back_waits_from_the_new_time(fovea_setup):
+    """Review: after /clock jumped back the wait kept the old time, and no image served it."""
+    loop = DetectorLoop(fovea_setup)
+    image = SceneSet('test', **PAPER_TASK, color='rgb', seed=2).scene(0).image
+    cell = fovea_setup.grid.index(10, 10)
+    assert loop.fixate(cell, 2002.0, search_id=1).status == 'waiting'
+    assert loop.add_image(2001.0, image, now_s=2002.0).status == 'waiting'   # before the command
+    # The clock set back to 100: the controller re-sends the same fixation of the same search.
+    assert loop.fixate(cell, 101.0, search_id=1).status == 'waiting'
+    out = loop.add_image(101.5, image, now_s=101.5)
+    assert out.status == 'published' and out.frame.stamp_s == 101.5
+
+
 def test_the_newest_waiting_image_serves_a_fixation(fovea_setup):
     loop = DetectorLoop(fovea_setup)
     old = SceneSet('test', **PAPER_TASK, color='rgb', seed=2).scene(0).image

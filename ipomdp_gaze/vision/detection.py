@@ -501,17 +501,23 @@ class DetectorLoop:
         new search, and whatever the previous one still waited for is dropped. The same fixation
         of the same search re-sent while it still waits (the controller's ``retry_period_s``)
         keeps waiting from the first command: restarting the wait would throw away the image a
-        slow head takes on arrival, and every re-send would do it again.
+        slow head takes on arrival, and every re-send would do it again. A re-send before the
+        first command's time is a clock set back (sim time: a simulator's reset, a looped bag):
+        the wait starts again from it, and the images kept, stamped on the old clock, go.
         """
         cell = int(cell)
         self.setup.grid.cell(cell)
         self.fixations += 1
         self.inputs['fixation'][0] += 1
+        now_s = float(now_s)
+        if self.pending is not None and now_s < self.pending[1]:
+            self._images.clear()
+            self.pending = None
         resent = self.pending is not None and self.pending[0] == cell \
             and search_id == self.search_id
         self.search_id = search_id
         if not resent:
-            self.pending = (cell, float(now_s))
+            self.pending = (cell, now_s)
         return self.serve()
 
     def request_scan(self, search_id: int, now_s: float) -> Outcome:
