@@ -68,6 +68,49 @@ def test_a_clock_set_back_keeps_the_search_going_and_a_late_clock_is_no_stall(co
         assert frame_applied(), node.core.counters()
         assert tick(102.0) and frame_applied()
         assert node.core.seconds_without_evidence(node._now_s()) < 1.0
+        # A clock that runs ahead fast (a simulation faster than real time): time that passed.
+        assert tick(112.0)
+        assert node.core.seconds_without_evidence(node._now_s()) == pytest.approx(10.0)
+        assert frame_applied()
+    finally:
+        executor.shutdown()
+        source.destroy_node()
+        node.destroy_node()
+
+
+def test_use_sim_time_turned_on_at_run_time_moves_the_search_to_the_new_clock(context):
+    """Review: rcl reports the switch as a jump of 0, so the target stayed at system time."""
+    from builtin_interfaces.msg import Time as TimeMsg
+    from ipomdp_gaze.nodes.controller import GazeControllerNode
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+    from rosgraph_msgs.msg import Clock
+    from std_msgs.msg import Float32MultiArray
+    namespace = '/sim_time_switch'
+    node = GazeControllerNode(context=context, namespace=namespace, parameter_overrides=[
+        Parameter('settle_time_s', value=0.2), Parameter('policy.name', value='elm'),
+        Parameter('evidence_queue_depth', value=10)])
+    source = Node('sim_time_switch_source', namespace=namespace, context=context)
+    clock = source.create_publisher(Clock, '/clock', 10)
+    evidence = source.create_publisher(Float32MultiArray, 'evidence', 10)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    executor.add_node(source)
+    n = node._config.grid.n_cells
+    try:
+        assert node._now_s() > 1e9                     # system time
+        assert node.set_parameters([Parameter('use_sim_time', value=True)])[0].successful
+        assert _spin_until(executor, lambda: clock.get_subscription_count() > 0
+                           and evidence.get_subscription_count() > 0, 30.0)
+        for seconds in (50.0, 51.0):
+            clock.publish(Clock(clock=TimeMsg(sec=int(seconds))))
+            assert _spin_until(executor, lambda: node._now_s() == seconds, 10.0)
+        assert node.core.target_time_s <= 51.0
+        before = node.core.counters()['applied']
+        evidence.publish(Float32MultiArray(data=np.zeros(n, np.float32).tolist()))
+        assert _spin_until(executor, lambda: node.core.counters()['applied'] > before, 10.0), \
+            node.core.counters()
     finally:
         executor.shutdown()
         source.destroy_node()

@@ -61,7 +61,7 @@ from ipomdp_gaze.search.controller_config import (build_config, ControllerConfig
 from ipomdp_gaze.search.gaze import FrameSequence, SETTLING, STAMP_TOLERANCE_S
 from ipomdp_gaze.search.health import HealthMonitor
 from ipomdp_gaze.search.room import MAX_PERIOD_S, Person, PERSON_LINK, RoomWatch
-from rclpy.clock import JumpThreshold
+from rclpy.clock import ClockChange, JumpThreshold
 from rclpy.duration import Duration
 from rclpy.exceptions import NameValidationException
 from rclpy.expand_topic_name import expand_topic_name
@@ -88,8 +88,8 @@ WARN_THROTTLE_S = 5.0
 # The fixation is asked for again this long after its settle time has passed (a frame taken
 # then is not skipped on a clock read a hair earlier).
 SETTLED_MARGIN_S = 0.01
-# A jump of the node's clock (use_sim_time: /clock set back, or its first tick far from 0) moves
-# the times the search keeps; forward, only jumps this long (a /clock ticks far more often).
+# A jump of the node's clock (use_sim_time: /clock set back, its first tick far from 0, or the
+# clock switched) moves the times the search keeps; forward jumps are looked at from this long.
 CLOCK_JUMP_FORWARD_S = 5.0
 # belief_image is at most this many pixels on a side (256x256 cells at 32 px would be 201 MB).
 MAX_IMAGE_SIDE_PX = 1024
@@ -217,9 +217,11 @@ class GazeControllerNode(QuietPublishers, Node):
         self._health = HealthMonitor(self._now_s())
         self._pan_tilt_msg = None
         self.core.reset(self._now_s())
+        self._clock_before_s = None         # the clock's reading before a jump (pre_callback)
         self._clock_jumps = self.get_clock().create_jump_callback(
             JumpThreshold(min_forward=Duration(seconds=CLOCK_JUMP_FORWARD_S),
                           min_backward=Duration(nanoseconds=-1), on_clock_change=True),
+            pre_callback=self.guard.wrap(self._before_clock_jump),
             post_callback=self.guard.wrap(self._on_clock_jump))
         self._publish_belief()
         self._send_target()
@@ -420,19 +422,32 @@ class GazeControllerNode(QuietPublishers, Node):
     def _now_s(self) -> float:
         return self._now().nanoseconds * 1e-9
 
+    def _before_clock_jump(self) -> None:
+        self._clock_before_s = self._now_s()
+
     def _on_clock_jump(self, jump) -> None:
         """
-        Move the search's times with a jump of the clock (sim time set back or started).
+        Move the search's times with a jump of the clock (sim time set back, started or on).
 
         Without this, a /clock set back (a simulator's reset, ``ros2 bag play --loop``) leaves
         the target stamped in the future, and every frame is skipped as taken before the head
-        settled; a first /clock far from 0 reads as a long stall.
+        settled; a first /clock far from 0 reads as a long stall, and so does use_sim_time
+        turned on at run time. A /clock that runs ahead fast (a simulation faster than real
+        time) is time that passed: only a first tick, from 0, moves the times forward.
         """
-        delta_s = jump.delta.nanoseconds * 1e-9
+        before_s, self._clock_before_s = self._clock_before_s, None
+        now_s = self._now_s()
+        # rcl reports a switch of clock (use_sim_time) as a jump of 0: measure it
+        delta_s = now_s - before_s if before_s is not None else jump.delta.nanoseconds * 1e-9
+        switched = jump.clock_change in (ClockChange.ROS_TIME_ACTIVATED,
+                                         ClockChange.ROS_TIME_DEACTIVATED)
+        if not (switched or delta_s < 0 or before_s == 0.0):
+            return
         self.core.shift_clock(delta_s)
-        self._health = HealthMonitor(self._now_s(), self.core.received, self.core.rejected)
+        self._health = HealthMonitor(now_s, self.core.received, self.core.rejected)
         self.get_logger().info(f'the clock jumped {delta_s:+.3f} s: the search keeps its '
-                               f'belief and counts its times from the new clock')
+                               f'belief and counts its times from the new clock',
+                               throttle_duration_sec=WARN_THROTTLE_S)
 
     # -- outputs -------------------------------------------------------------------------
     def _send_target(self) -> None:
