@@ -94,8 +94,11 @@ def test_a_budget_of_zero_is_no_budget_in_first_decisions():
 
 def test_many_targets_on_one_cell_need_an_absent_prior():
     grid = Grid(1, 1)
-    with pytest.raises(ValueError, match='absent.prior > 0'):
+    with pytest.raises(ValueError, match='on 1 cell needs a larger search.absent.prior'):
         OccupancySession(grid, _gaussian(grid), SearchSettings(targets='many'))
+    four = Grid(2, 2)
+    with pytest.raises(ValueError, match=r'on 4 cells needs .* \(got 1e-70\)'):
+        OccupancySession(four, _gaussian(four), SearchSettings(targets='many', absent_prior=1e-70))
     session = OccupancySession(grid, _gaussian(grid),
                                SearchSettings(targets='many', absent_prior=0.5))
     session.reset()

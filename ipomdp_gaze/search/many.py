@@ -90,9 +90,10 @@ def check_many_settings(settings: SearchSettings, grid=None) -> None:
     small that the prior of each cell rounds to 1), where nothing could be learnt.
     """
     if grid is not None and cell_prior(grid.n_cells, settings.absent_prior) >= 1.0:
-        raise ValueError(f'search.targets many on a grid of one cell needs '
-                         f'search.absent.prior > 0 (got {settings.absent_prior:g}; below 1e-16 it '
-                         f'rounds to 0): without it its cell is occupied for certain')
+        raise ValueError(f'search.targets many on {grid.n_cells} cell'
+                         f"{'s' * (grid.n_cells > 1)} needs a larger search.absent.prior (got "
+                         f'{settings.absent_prior:g}): with it the prior of each cell rounds to '
+                         f'1, occupied for certain')
     if settings.confidence <= 0.5:
         raise ValueError(f'search.targets many decides each cell at the confidence either way, '
                          f'so it must be above 0.5 (got {settings.confidence:g})')
@@ -588,7 +589,8 @@ class OccupancySession:
         Column j depends only on cell j (its log odds, best view so far, settled or not), and a
         still frame changes the cells it saw: only the columns whose inputs changed are
         recomputed, with the same operations, so the arrays (and the sum) are the ones a full
-        computation gives.
+        computation gives. They stay allocated with the session: 16 N^2 bytes (2 MB on 21x21,
+        45 MB on 41x41, 270 MB on 64x64), which a full computation allocated anew each call.
         """
         table, rw = self.table, self.settings.repeat_weight
         best = self._best
