@@ -190,3 +190,66 @@ def test_a_truncated_episode_needs_a_reset_as_a_terminated_one():
 def test_max_steps_below_one_is_refused():
     with pytest.raises(ValueError, match='max_steps must be at least 1, got 0'):
         VisualSearchEnv(rows=5, cols=5, max_steps=0)
+
+
+@pytest.mark.parametrize('kwargs, words', [
+    ({'max_steps': 2.5}, 'max_steps must be an integer, got 2.5'),
+    ({'max_steps': '10'}, "max_steps must be an integer, got '10'"),
+    ({'max_steps': True}, 'max_steps must be an integer, got True'),
+    ({'max_steps': float('inf')}, 'max_steps must be an integer, got inf'),
+    ({'start_cell': 2.5}, 'start_cell must be an integer'),
+    ({'start_cell': True}, 'start_cell must be an integer'),
+    ({'scan': 'yes'}, 'scan must be True or False'),
+])
+def test_integer_arguments_are_refused_not_truncated(kwargs, words):
+    """QA: max_steps=2.5 ran 2 steps, start_cell=True started at cell 1."""
+    with pytest.raises(ValueError, match=words):
+        VisualSearchEnv(rows=5, cols=5, **kwargs)
+
+
+@pytest.mark.parametrize('action', [2.7, '3', True, np.float64(1.0), None])
+def test_an_action_outside_the_space_is_refused(action):
+    """QA: step(2.7) fixated cell 2 although Discrete(N).contains(2.7) is False."""
+    env = VisualSearchEnv(rows=5, cols=5)
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match='action must be a cell index'):
+        env.step(action)
+    assert env.step(np.int64(3))[4]['steps'] == 1          # a numpy integer is an index
+
+
+@pytest.mark.parametrize('kwargs', [{'fpoc': 'camera'}, {'spacing_deg': 5.0},
+                                    {'fpoc_params': {'dprime': 2.0}}])
+def test_fpoc_and_spacing_cannot_go_with_an_observation_model(kwargs):
+    """QA: they were ignored silently beside observation=."""
+    from ipomdp_gaze.model.fpoc import make_fpoc
+    from ipomdp_gaze.model.grid import Grid
+    from ipomdp_gaze.model.observation import GaussianObservation
+    grid = Grid(3, 3)
+    with pytest.raises(ValueError, match='cannot go with observation='):
+        VisualSearchEnv(observation=GaussianObservation(grid, make_fpoc('human')), **kwargs)
+
+
+def test_a_count_model_with_scan_tables_starts_from_the_scanned_belief():
+    """QA: the env started from the uniform prior where simulate, training and find scan."""
+    from gymnasium.utils.seeding import np_random
+    from ipomdp_gaze.model.grid import Grid
+    from ipomdp_gaze.model.observation import CountObservation
+    from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
+    grid = Grid(3, 3)
+    rng = np.random.default_rng(0)
+    model = CountObservation(grid, rng.dirichlet(np.ones(3), size=(3, 3)),
+                             rng.dirichlet(np.ones(3), size=(3, 3)),
+                             scan_target=np.array([0.1, 0.3, 0.6]),
+                             scan_null=np.array([0.7, 0.2, 0.1]))
+    env = VisualSearchEnv(observation=model)
+    obs, info = env.reset(seed=5, options={'target': 4})
+    # The scan is the reset's first draw from np_random (the target was given).
+    counts = model.sample_scan(4, np_random(5)[0], present=True)
+    session = SearchSession(grid, model, None, SearchSettings(confidence=0.95))
+    session.reset()
+    session.scan(Frame(counts, kind='scan'))
+    np.testing.assert_allclose(obs['belief'].ravel(), session.belief, rtol=1e-12)
+    assert info['entropy'] < np.log(9) - 1e-6
+    plain = VisualSearchEnv(observation=model, scan=False)
+    obs, info = plain.reset(seed=5, options={'target': 4})
+    np.testing.assert_allclose(obs['belief'].ravel(), np.full(9, 1 / 9))

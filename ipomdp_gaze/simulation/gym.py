@@ -29,9 +29,15 @@ the absent hypothesis: the observation gains ``'absent'`` (``P(absent)``, shape 
 N + 1 hypotheses, and an episode also terminates when ``P(absent)`` reaches ``confidence``.
 ``absent_rate`` is the fraction of episodes whose scene is empty (drawn at reset from
 ``np_random``; ``options={'present': False}`` forces one).
+
+A count model with scan tables (``faces-420`` and the other calibrated face models) starts each
+episode with its one-time whole-image scan, drawn at reset (``scan=False``: from the uniform
+prior), as the simulation, training and ``find`` start (docs/design.md section 6.8): the first
+observation is the scanned belief.
 """
 from __future__ import annotations
 
+import operator
 from pathlib import Path
 
 import gymnasium
@@ -50,6 +56,8 @@ ENV_ID = 'ipomdp_gaze/VisualSearch-v0'
 RESET_OPTIONS = frozenset({'target', 'present'})
 REWARDS = ('infomax', 'fixate_target')
 OBSERVE = ('belief', 'evidence')
+# The grid's spacing when neither it nor an observation model says (the paper's 7x7 task).
+DEFAULT_SPACING_DEG = 0.42
 
 
 class VisualSearchEnv(gymnasium.Env):
@@ -58,14 +66,19 @@ class VisualSearchEnv(gymnasium.Env):
     metadata = {'render_modes': ['rgb_array', 'ansi'], 'render_fps': 4}
 
     def __init__(self, rows: int | None = None, cols: int | None = None,
-                 spacing_deg: float = 0.42, fpoc: str | FPOC = 'human',
+                 spacing_deg: float | None = None, fpoc: str | FPOC | None = None,
                  fpoc_params: dict | None = None, reward: str = 'infomax',
                  observe: str = 'belief', confidence: float = 0.95,
                  max_steps: int | None = None, start_cell: int | None = None,
                  render_mode: str | None = None, observation=None,
                  motion_sigma_cells: float = 0.0, jump_prob: float = 0.0,
-                 absent_prior: float = 0.0, absent_rate: float = 0.0):
+                 absent_prior: float = 0.0, absent_rate: float = 0.0, scan: bool = True):
         if observation is not None:
+            given = [name for name, value in (('spacing_deg', spacing_deg), ('fpoc', fpoc),
+                                              ('fpoc_params', fpoc_params)) if value is not None]
+            if given:
+                raise ValueError(f"{', '.join(given)} cannot go with observation=: the "
+                                 f'observation model brings its own grid and evidence')
             if isinstance(observation, (str, Path)):
                 from ipomdp_gaze.files.observation_file import load_observation
                 observation = load_observation(observation)
@@ -76,9 +89,13 @@ class VisualSearchEnv(gymnasium.Env):
                                  f"model's {self.grid.rows}x{self.grid.cols} grid")
         else:
             self.grid = Grid(7 if rows is None else rows, 7 if cols is None else cols,
-                             spacing_deg)
+                             DEFAULT_SPACING_DEG if spacing_deg is None else spacing_deg)
+            fpoc = 'human' if fpoc is None else fpoc
             self.fpoc = fpoc if isinstance(fpoc, FPOC) else make_fpoc(fpoc, **(fpoc_params or {}))
             self.model = GaussianObservation(self.grid, self.fpoc)
+        if not isinstance(scan, (bool, np.bool_)):
+            raise ValueError(f'scan must be True or False, got {scan!r}')
+        self.scan = bool(scan) and getattr(self.model, 'has_scan', False)
         if reward not in REWARDS:
             raise ValueError(f"unknown reward {reward!r}; valid rewards: {', '.join(REWARDS)}")
         if observe not in OBSERVE:
@@ -96,10 +113,11 @@ class VisualSearchEnv(gymnasium.Env):
         self.absent_rate = check_probability(absent_rate, 'absent_rate')
         self.reward_name, self.observe = reward, observe
         self.confidence = self.settings.confidence
-        self.max_steps = n if max_steps is None else int(max_steps)
+        self.max_steps = n if max_steps is None else _whole(max_steps, 'max_steps')
         if self.max_steps < 1:
             raise ValueError(f'max_steps must be at least 1, got {max_steps!r}')
-        self.start_cell = self.grid.center_index if start_cell is None else int(start_cell)
+        self.start_cell = self.grid.center_index if start_cell is None else \
+            _whole(start_cell, 'start_cell')
         if not 0 <= self.start_cell < n:
             raise ValueError(f'start_cell must be a cell index below {n}, got {start_cell!r}')
         self.render_mode = render_mode
@@ -165,6 +183,9 @@ class VisualSearchEnv(gymnasium.Env):
             self._present = self.absent_rate == 0 or \
                 bool(self.np_random.random() >= self.absent_rate)
         self.session.reset()
+        if self.scan:
+            counts = self.model.sample_scan(self._target, self.np_random, present=self._present)
+            self.session.scan(Frame(counts, kind='scan'))
         self.session.start()
         self._evidence = np.zeros(n)
         self._fixation = self.start_cell
@@ -172,7 +193,10 @@ class VisualSearchEnv(gymnasium.Env):
         return self._obs(), self._info()
 
     def step(self, action):
-        k = int(action)
+        try:
+            k = _whole(action, 'action')
+        except ValueError:
+            k = -1
         if not self.action_space.contains(k):
             raise ValueError(
                 f'action must be a cell index in [0, {self.grid.n_cells}), got {action!r}')
@@ -202,6 +226,16 @@ class VisualSearchEnv(gymnasium.Env):
         if self.render_mode == 'ansi':
             return belief_text(self.belief, *self.grid.shape, self._fixation)
         return None
+
+
+def _whole(value, name: str) -> int:
+    """Return an integer argument as an int; a float, a string or a bool is refused."""
+    if isinstance(value, (bool, np.bool_)):
+        raise ValueError(f'{name} must be an integer, got {value!r}')
+    try:
+        return operator.index(value)
+    except TypeError:
+        raise ValueError(f'{name} must be an integer, got {value!r}') from None
 
 
 def register_env() -> None:
