@@ -253,3 +253,12 @@ def test_a_count_model_with_scan_tables_starts_from_the_scanned_belief():
     plain = VisualSearchEnv(observation=model, scan=False)
     obs, info = plain.reset(seed=5, options={'target': 4})
     np.testing.assert_allclose(obs['belief'].ravel(), np.full(9, 1 / 9))
+
+
+def test_a_step_before_the_first_reset_asks_for_a_reset():
+    """QA: the raw env raised the session's OrderError, not Gymnasium's ResetNeeded."""
+    env = VisualSearchEnv(rows=5, cols=5)
+    with pytest.raises(gymnasium.error.ResetNeeded, match='reset'):
+        env.step(0)
+    env.reset(seed=0)
+    env.step(0)

@@ -136,6 +136,7 @@ class VisualSearchEnv(gymnasium.Env):
         self._target = 0
         self._present = True
         self._steps = 0
+        self._started = False
 
     belief = session_view(
         'belief', 'Return the cell probabilities, shape (N,) (summing to ``1 - P(absent)``).')
@@ -187,6 +188,7 @@ class VisualSearchEnv(gymnasium.Env):
             counts = self.model.sample_scan(self._target, self.np_random, present=self._present)
             self.session.scan(Frame(counts, kind='scan'))
         self.session.start()
+        self._started = True
         self._evidence = np.zeros(n)
         self._fixation = self.start_cell
         self._steps = 0
@@ -200,6 +202,8 @@ class VisualSearchEnv(gymnasium.Env):
         if not self.action_space.contains(k):
             raise ValueError(
                 f'action must be a cell index in [0, {self.grid.n_cells}), got {action!r}')
+        if not self._started:
+            raise gymnasium.error.ResetNeeded('call reset() before step()')
         if self.session.ended or self._steps >= self.max_steps:
             raise gymnasium.error.ResetNeeded('the episode has ended (terminated or truncated): '
                                               'call reset() before step()')
