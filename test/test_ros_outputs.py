@@ -89,3 +89,42 @@ def test_the_belief_map_is_built_only_for_subscribers(context, monkeypatch):
         executor.shutdown()
         listener.destroy_node()
         node.destroy_node()
+
+
+def test_a_new_room_frame_republishes_the_people_in_it(context):
+    """Known gap: ~/targets kept the old frame_id until the next search of the room ended."""
+    import rclpy
+    from geometry_msgs.msg import PoseArray
+    from ipomdp_gaze.nodes.controller import GazeControllerNode, STATE_QOS
+    from ipomdp_gaze.search.room import Person
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.parameter import Parameter
+    node = GazeControllerNode(context=context, namespace='/room_frame', parameter_overrides=[
+        Parameter('search.targets', value='many')])
+    listener = rclpy.create_node('room_frame_listener', context=context, namespace='/room_frame')
+    received = []
+    listener.create_subscription(PoseArray, 'gaze_controller/targets', received.append,
+                                 STATE_QOS)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    executor.add_node(listener)
+    grid = node._config.grid
+
+    def spin_until(condition):
+        deadline = time.monotonic() + 30
+        while not condition() and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.05)
+        return condition()
+
+    try:
+        node._publish_people([Person(grid.index(2, 3), 0.99), Person(grid.index(8, 8), 0.97)])
+        assert spin_until(lambda: received and len(received[-1].poses) == 2)
+        assert received[-1].header.frame_id == 'pan_tilt_base'
+        first = [(p.orientation.z, p.orientation.w) for p in received[-1].poses]
+        assert node.set_parameters([Parameter('room.frame_id', value='head_base')])[0].successful
+        assert spin_until(lambda: received[-1].header.frame_id == 'head_base')
+        assert [(p.orientation.z, p.orientation.w) for p in received[-1].poses] == first
+    finally:
+        executor.shutdown()
+        listener.destroy_node()
+        node.destroy_node()

@@ -188,6 +188,7 @@ class GazeControllerNode(QuietPublishers, Node):
                             for name in ('found', 'absent', 'gave_up', 'lost', 'reacquired')}
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self._targets_pub = self._cells_pub = None
+        self._people_published = None       # what ~/targets said last (None: nothing yet)
         self._make_room_publishers()
         self._room = RoomWatch(cfg.grid)
         self._new_people = 0
@@ -362,6 +363,9 @@ class GazeControllerNode(QuietPublishers, Node):
                 (ov['retry_period_s'], ov['diagnostics_period_s']):
             self._make_timers(v)
         self._make_room_publishers()
+        if self._people_published is not None and (
+                v['room.frame_id'] != ov['room.frame_id'] or cfg.head != old.head):
+            self._publish_people(self._people_published)      # the same people, new poses
         # Many targets still or moving are two searches (the people of a pass, or followed):
         # switching between them starts a new one, and ~/targets forgets whom the other knew.
         switched = self._many and cfg.settings.moving != old.settings.moving
@@ -526,6 +530,7 @@ class GazeControllerNode(QuietPublishers, Node):
 
     def _publish_people(self, found=()) -> None:
         """Publish the people of the room on ``~/targets`` and ``~/target_cells``."""
+        self._people_published = tuple(found)
         cfg = self._config
         self._targets_pub.publish(people.people_poses(
             cfg.head, [p.cell for p in found], self._now().to_msg(), cfg.values['room.frame_id']))
