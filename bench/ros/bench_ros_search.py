@@ -3,15 +3,18 @@
 """
 Live searches over DDS with the shipped YAML files, beside the same task simulated offline.
 
-Run: ``.venv/bin/python bench/ros/bench_ros_search.py [searches]`` (default 30). Starts
+Run: ``.venv/bin/python bench/ros/bench_ros_search.py [searches] [--quick]`` (default 30 live
+searches; ``--quick``: 5 live and 200 offline). Starts
 ``gaze_controller`` and ``simulated_camera`` as processes on a private domain, then repeats:
 disable, camera reset (a new random target), controller reset, enable, wait for ``found``.
 Prints fixations to ``found`` (median, 90th percentile), the fraction found at the right cell and
-the wall time per search, and the same numbers from the numpy core on 2,000 simulated searches.
+the wall time per search, and the same numbers from the numpy core on 2,000 simulated searches
+(the controller's core, :class:`GazeController`, with the shipped confidence 0.95).
 """
-import sys
+import argparse
 import time
 
+from ipomdp_gaze.commands.common import positive_int
 from ipomdp_gaze.files.share_files import config_file
 from ipomdp_gaze.harness.processes import domain_id_for, isolated_nodes
 from ipomdp_gaze.harness.watch import CAMERA, SearchRecord, Watch
@@ -20,6 +23,7 @@ from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays
 from ipomdp_gaze.policies.registry import build_policy
 from ipomdp_gaze.search.gaze import GazeController
+from ipomdp_gaze.search.session import SearchSettings
 import numpy as np
 
 GRID = Grid(11, 11, 5.0)
@@ -32,7 +36,7 @@ def offline(policy_name, searches=2000, seed=0, confidence=0.95):
     d = dprime_matrix(GRID, FPOC)
     file = 'camera-11x11-infomax' if policy_name == 'learned' else ''
     core = GazeController(GRID, FPOC, build_policy(policy_name, GRID, FPOC, file=file),
-                          confidence=confidence)
+                          SearchSettings(confidence=confidence))
     fixations, right = [], []
     for _ in range(searches):
         target = int(rng.integers(GRID.n_cells))
@@ -83,8 +87,16 @@ def live(searches, domain):
         return np.array(out), policy, codes
 
 
-def main():
-    searches = int(sys.argv[1]) if len(sys.argv) > 1 else 30
+def main(argv=None):
+    """Run the live searches, then the offline ones, and print both lines."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
+    parser.add_argument('searches', nargs='?', type=positive_int, default=None,
+                        help='live searches (default 30; 5 with --quick)')
+    parser.add_argument('--quick', action='store_true',
+                        help='a smoke run: 5 live searches and 200 offline')
+    args = parser.parse_args(argv)
+    searches = args.searches or (5 if args.quick else 30)
+    offline_searches = 200 if args.quick else 2000
     results, policy, codes = live(searches, domain_id_for())
     fix, right, secs = results[:, 0], results[:, 1], results[:, 2]
     print(f'live over DDS ({policy}, {searches} searches, node exit codes {codes}): '
@@ -92,8 +104,8 @@ def main():
           f'mean {fix.mean():.2f}; right {right.mean():.3f}; seconds per search median '
           f'{np.median(secs):.2f}, p90 {np.percentile(secs, 90):.2f}; '
           f'seconds per fixation {secs.sum() / fix.sum():.3f}')
-    fix, right = offline(policy)
-    print(f'offline core ({policy}, 2000 searches): fixations to found median '
+    fix, right = offline(policy, offline_searches)
+    print(f'offline core ({policy}, {offline_searches} searches): fixations to found median '
           f'{np.median(fix):.0f}, p90 {np.percentile(fix, 90):.1f}, mean {fix.mean():.2f}; '
           f'right {right.mean():.3f}')
 
