@@ -15,7 +15,9 @@ one of two ways:
 - otherwise it is run as a script (``python bench/bench_x.py``) and its output is quoted.
 
 Sections are delimited by ``<!-- bench:NAME order=N -->`` markers, so ``--only NAME`` re-runs one
-benchmark and keeps the others' last results in the file. Timings are not tests: nothing in
+benchmark and keeps the others' last results in the file. A benchmark that fails (an exception,
+a script's non-zero exit status) gets its error as its section; the others are still written,
+then the run exits with status 1 and names the failed ones. Timings are not tests: nothing in
 ``make test`` depends on them.
 
 Usage: ``.venv/bin/python bench/run.py [--only latency,simulate] [--quick] [--out FILE]``.
@@ -30,6 +32,7 @@ import re
 import subprocess
 import sys
 import time
+import traceback
 
 # One BLAS thread, set before any benchmark imports numpy: on a small shared machine a
 # multi-threaded matrix-vector product waits for a busy core and becomes 10-100x slower; the
@@ -77,23 +80,29 @@ def load(path: Path):
     return module
 
 
-def run_one(name: str, path: Path, ctx: Context) -> tuple[float, str, str]:
-    """Run one benchmark; return ``(order, title, markdown body)``."""
+def run_one(name: str, path: Path, ctx: Context) -> tuple[float, str, str, bool]:
+    """Run one benchmark; return ``(order, title, markdown body, whether it succeeded)``."""
     module = load(path)
     title = getattr(module, 'TITLE', name.replace('_', ' ').capitalize())
     order = float(getattr(module, 'ORDER', 50))
     t0 = time.perf_counter()
     if hasattr(module, 'bench'):
-        body = module.bench(ctx).rstrip() + '\n'
+        try:
+            body, ok = module.bench(ctx).rstrip() + '\n', True
+        except Exception:                # the section shows it; the run goes on, then fails
+            error = traceback.format_exc().strip()
+            ctx.log(error)
+            body, ok = f'Failed:\n\n```\n{error}\n```\n', False
     else:
         done = subprocess.run([sys.executable, str(path)], cwd=ROOT, capture_output=True,
                               text=True, timeout=SCRIPT_TIMEOUT_S)
-        status = '' if done.returncode == 0 else f' (exit status {done.returncode})'
+        ok = done.returncode == 0
+        status = '' if ok else f' (exit status {done.returncode})'
         body = (f'Output of `python bench/{path.name}`{status}:\n\n```\n'
                 f'{(done.stdout + done.stderr).strip()}\n```\n')
     wall = time.perf_counter() - t0
     body += f'\n*Measured {machine()}; this section took {wall:.0f} s.*\n'
-    return order, title, body
+    return order, title, body, ok
 
 
 def machine() -> str:
@@ -155,7 +164,7 @@ def previous(path: Path) -> tuple[dict, dict, dict]:
 
 
 def main(argv=None) -> int:
-    """Run the selected benchmarks and write the report."""
+    """Run the selected benchmarks and write the report; 1 if a benchmark failed."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
     parser.add_argument('--only', default='', help='comma-separated names (bench_NAME.py)')
     parser.add_argument('--quick', action='store_true', help='few calls: a smoke run')
@@ -168,13 +177,19 @@ def main(argv=None) -> int:
         parser.error(f"unknown benchmark {unknown[0]!r}; available: {', '.join(found)}")
     ctx = Context(args.quick, FIGURES)
     sections, titles, order = previous(args.out) if args.only else ({}, {}, {})
+    failed = []
     for name in names:
         ctx.log(f'== bench_{name}')
-        position, title, body = run_one(name, found[name], ctx)
+        position, title, body, ok = run_one(name, found[name], ctx)
         sections[name], titles[name], order[name] = body, title, position
+        if not ok:
+            failed.append(name)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(compose(sections, order, titles))
     ctx.log(f'wrote {args.out}')
+    if failed:
+        ctx.log(f"failed: {', '.join(failed)} (each section shows its error)")
+        return 1
     return 0
 
 
