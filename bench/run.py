@@ -12,7 +12,9 @@ one of two ways:
   :class:`Context` (``ctx.quick``, ``ctx.figure(name)`` for a path under ``docs/figures/``,
   ``ctx.log(text)``). Optional module attributes: ``TITLE`` (the section heading) and ``ORDER``
   (position; lower first, default 50);
-- otherwise it is run as a script (``python bench/bench_x.py``) and its output is quoted.
+- otherwise it is run as a script (``python bench/<group>/bench_x.py``) and its standard output
+  is quoted; its standard error (progress lines) goes to the console, and into the section only
+  when the script fails.
 
 Sections are delimited by ``<!-- bench:NAME order=N -->`` markers, so ``--only NAME`` re-runs one
 benchmark and keeps the others' last results in the file. A benchmark that fails (an exception,
@@ -31,6 +33,7 @@ import platform
 import re
 import subprocess
 import sys
+import threading
 import time
 import traceback
 
@@ -45,6 +48,8 @@ ROOT = BENCH_DIR.parent
 DEFAULT_OUT = ROOT / 'docs' / 'benchmarks.md'
 FIGURES = ROOT / 'docs' / 'figures'
 SCRIPT_TIMEOUT_S = 3600
+# Last lines of a failed script's standard error quoted in its section.
+ERROR_LINES = 40
 MARK = re.compile(r'<!-- bench:(\w+) order=([-\d.]+) -->\n(.*?)<!-- /bench:\1 -->\n', re.S)
 
 
@@ -80,6 +85,41 @@ def load(path: Path):
     return module
 
 
+def run_script(path: Path) -> tuple[int, str, str]:
+    """
+    Run a script benchmark; return ``(exit status, stdout, stderr)``.
+
+    Its standard error is echoed to ours as it comes (progress lines); a script that runs past
+    :data:`SCRIPT_TIMEOUT_S` is killed.
+    """
+    proc = subprocess.Popen([sys.executable, str(path)], cwd=ROOT, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    out, err = [], []
+
+    def read_out():
+        out.append(proc.stdout.read())
+
+    def read_err():
+        for line in proc.stderr:
+            err.append(line)
+            sys.stderr.write(line)
+            sys.stderr.flush()
+
+    readers = [threading.Thread(target=read_out, daemon=True),
+               threading.Thread(target=read_err, daemon=True)]
+    for reader in readers:
+        reader.start()
+    try:
+        status = proc.wait(timeout=SCRIPT_TIMEOUT_S)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        status = proc.wait()
+        err.append(f'killed after {SCRIPT_TIMEOUT_S} s\n')
+    for reader in readers:
+        reader.join()
+    return status, ''.join(out), ''.join(err)
+
+
 def run_one(name: str, path: Path, ctx: Context) -> tuple[float, str, str, bool]:
     """Run one benchmark; return ``(order, title, markdown body, whether it succeeded)``."""
     module = load(path)
@@ -94,12 +134,14 @@ def run_one(name: str, path: Path, ctx: Context) -> tuple[float, str, str, bool]
             ctx.log(error)
             body, ok = f'Failed:\n\n```\n{error}\n```\n', False
     else:
-        done = subprocess.run([sys.executable, str(path)], cwd=ROOT, capture_output=True,
-                              text=True, timeout=SCRIPT_TIMEOUT_S)
-        ok = done.returncode == 0
-        status = '' if ok else f' (exit status {done.returncode})'
-        body = (f'Output of `python bench/{path.name}`{status}:\n\n```\n'
-                f'{(done.stdout + done.stderr).strip()}\n```\n')
+        status, out, err = run_script(path)
+        ok = status == 0
+        text = out.strip()
+        if not ok:                       # progress lines stay out unless they tell why
+            text = '\n'.join([text] + err.strip().splitlines()[-ERROR_LINES:]).strip()
+        note = '' if ok else f' (exit status {status})'
+        shown = path.relative_to(ROOT) if path.is_relative_to(ROOT) else path
+        body = f'Output of `python {shown.as_posix()}`{note}:\n\n```\n{text}\n```\n'
     wall = time.perf_counter() - t0
     body += f'\n*Measured {machine()}; this section took {wall:.0f} s.*\n'
     return order, title, body, ok
