@@ -12,9 +12,10 @@ one of two ways:
   :class:`Context` (``ctx.quick``, ``ctx.figure(name)`` for a path under ``docs/figures/``,
   ``ctx.log(text)``). Optional module attributes: ``TITLE`` (the section heading) and ``ORDER``
   (position; lower first, default 50);
-- otherwise it is run as a script (``python bench/<group>/bench_x.py``) and its standard output
-  is quoted; its standard error (progress lines) goes to the console, and into the section only
-  when the script fails.
+- otherwise it is run as a script (``python bench/<group>/bench_x.py``, and ``--quick`` when the
+  run is quick: a script benchmark must accept it) and its standard output is quoted; its
+  standard error (progress lines) goes to the console, and into the section only when the
+  script fails.
 
 Sections are delimited by ``<!-- bench:NAME order=N -->`` markers, so ``--only NAME`` re-runs one
 benchmark and keeps the others' last results in the file. A benchmark that fails (an exception,
@@ -85,15 +86,16 @@ def load(path: Path):
     return module
 
 
-def run_script(path: Path) -> tuple[int, str, str]:
+def run_script(path: Path, quick: bool) -> tuple[int, str, str]:
     """
     Run a script benchmark; return ``(exit status, stdout, stderr)``.
 
-    Its standard error is echoed to ours as it comes (progress lines); a script that runs past
-    :data:`SCRIPT_TIMEOUT_S` is killed.
+    ``quick``: the script gets ``--quick``. Its standard error is echoed to ours as it comes
+    (progress lines); a script that runs past :data:`SCRIPT_TIMEOUT_S` is killed.
     """
-    proc = subprocess.Popen([sys.executable, str(path)], cwd=ROOT, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+    command = [sys.executable, str(path)] + (['--quick'] if quick else [])
+    proc = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
     out, err = [], []
 
     def read_out():
@@ -134,14 +136,15 @@ def run_one(name: str, path: Path, ctx: Context) -> tuple[float, str, str, bool]
             ctx.log(error)
             body, ok = f'Failed:\n\n```\n{error}\n```\n', False
     else:
-        status, out, err = run_script(path)
+        status, out, err = run_script(path, ctx.quick)
         ok = status == 0
         text = out.strip()
         if not ok:                       # progress lines stay out unless they tell why
             text = '\n'.join([text] + err.strip().splitlines()[-ERROR_LINES:]).strip()
         note = '' if ok else f' (exit status {status})'
         shown = path.relative_to(ROOT) if path.is_relative_to(ROOT) else path
-        body = f'Output of `python {shown.as_posix()}`{note}:\n\n```\n{text}\n```\n'
+        command = f"python {shown.as_posix()}{' --quick' if ctx.quick else ''}"
+        body = f'Output of `{command}`{note}:\n\n```\n{text}\n```\n'
     wall = time.perf_counter() - t0
     body += f'\n*Measured {machine()}; this section took {wall:.0f} s.*\n'
     return order, title, body, ok
@@ -209,7 +212,8 @@ def main(argv=None) -> int:
     """Run the selected benchmarks and write the report; 1 if a benchmark failed."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
     parser.add_argument('--only', default='', help='comma-separated names (bench_NAME.py)')
-    parser.add_argument('--quick', action='store_true', help='few calls: a smoke run')
+    parser.add_argument('--quick', action='store_true',
+                        help='few calls: a smoke run (script benchmarks get --quick)')
     parser.add_argument('--out', type=Path, default=DEFAULT_OUT, help='report path')
     args = parser.parse_args(argv)
     found = discover()

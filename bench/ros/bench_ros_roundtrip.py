@@ -3,17 +3,16 @@
 """
 Round trip through the gaze_controller process: evidence frame in, belief and next target out.
 
-Run: ``.venv/bin/python bench/ros/bench_ros_roundtrip.py [policy ...]`` (default ``elm map``). For
-each
-policy it starts the controller (shipped YAML, ``settle_time_s`` 0, no retries) on a private
-domain; this process plays the camera: on every new ``pan_tilt`` it publishes one 11x11 evidence
-frame and times until the next ``pan_tilt`` (and the ``belief``) arrive; the controller tracks
-(``motion.sigma_cells`` 0.5, docs/design.md section 7), so its search never ends and each frame
-includes the prediction step. 20 warm-up and 200 timed
-round trips per policy; prints median and 90th percentile in ms. It also times the controller's
-work for one frame in-process (message in, update, choice, messages out) without DDS.
+Run: ``.venv/bin/python bench/ros/bench_ros_roundtrip.py [policy ...] [--quick]`` (default ``elm
+map``). For each policy it starts the controller (shipped YAML, ``settle_time_s`` 0, no retries)
+on a private domain; this process plays the camera: on every new ``pan_tilt`` it publishes one
+11x11 evidence frame and times until the next ``pan_tilt`` (and the ``belief``) arrive; the
+controller tracks (``motion.sigma_cells`` 0.5, docs/design.md section 7), so its search never ends
+and each frame includes the prediction step. 20 warm-up and 200 timed round trips per policy
+(``--quick``: 50); prints median and 90th percentile in ms. It also times the controller's work
+for one frame in-process (message in, update, choice, messages out) without DDS.
 """
-import sys
+import argparse
 import threading
 import time
 
@@ -25,7 +24,7 @@ from ipomdp_gaze.model.fpoc import make_fpoc
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
-from ipomdp_gaze.policies.registry import build_policy
+from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
 from ipomdp_gaze.search.gaze import GazeController
 import numpy as np
 from sensor_msgs.msg import JointState
@@ -38,7 +37,9 @@ WARMUP, TIMED = 20, 200
 def in_process(policy_name, repeats=2000):
     """Median microseconds of the controller's per-frame work without DDS."""
     fpoc = make_fpoc('camera', half_width_deg=10.0, half_height_deg=10.0)
-    core = GazeController(GRID, fpoc, build_policy(policy_name, GRID, fpoc), settle_time_s=0.0)
+    file = 'camera-11x11-infomax' if policy_name == 'learned' else ''   # the shipped YAML's
+    core = GazeController(GRID, fpoc, build_policy(policy_name, GRID, fpoc, file=file),
+                          settle_time_s=0.0)
     head = PanTiltMap(GRID)
     rng = np.random.default_rng(0)
     frames = [grid_arrays.to_multiarray(rng.standard_normal(121), GRID) for _ in range(50)]
@@ -58,7 +59,7 @@ def in_process(policy_name, repeats=2000):
     return t[0], t[1]
 
 
-def round_trips(policy_name, domain):
+def round_trips(policy_name, domain, timed=TIMED):
     """Median and p90 milliseconds of frame -> next pan_tilt, and frame -> belief."""
     with isolated_nodes(domain) as nodes:
         # Motion on: a tracker never ends its search, so every frame gets a next target.
@@ -73,7 +74,7 @@ def round_trips(policy_name, domain):
             pub = watch.publisher(Float32MultiArray, 'evidence', 10)
 
             def send():
-                if len(state['target']) >= WARMUP + TIMED:
+                if len(state['target']) >= WARMUP + timed:
                     done.set()
                     return
                 msg = grid_arrays.to_multiarray(rng.standard_normal(121), GRID)
@@ -105,21 +106,37 @@ def round_trips(policy_name, domain):
             watch.wait_until(done.is_set, 120)
         target = np.array(state['target'][WARMUP:]) * 1e3
         belief = np.array(state['belief'][WARMUP:]) * 1e3
-        if target.size < TIMED:
+        if target.size < timed:
             raise RuntimeError(f'only {target.size} round trips timed:\n{proc.output()}')
     return (np.median(target), np.percentile(target, 90), np.median(belief),
             np.percentile(belief, 90))
 
 
-def main():
-    policies = sys.argv[1:] or ['elm', 'map']
+def policy_name(text: str) -> str:
+    """Parse a policy name of the registry for argparse."""
+    if text not in POLICY_NAMES:
+        raise argparse.ArgumentTypeError(
+            f"unknown policy {text!r}; valid policies: {', '.join(POLICY_NAMES)}")
+    return text
+
+
+def main(argv=None):
+    """Time each policy in process and over DDS; print one line per policy."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
+    parser.add_argument('policies', nargs='*', metavar='policy', type=policy_name,
+                        help=f"controller policies (default elm map): {', '.join(POLICY_NAMES)}")
+    parser.add_argument('--quick', action='store_true',
+                        help='a smoke run: 50 timed round trips and 200 in-process frames')
+    args = parser.parse_args(argv)
+    policies = args.policies or ['elm', 'map']
+    timed, repeats = (50, 200) if args.quick else (TIMED, 2000)
     domain = domain_id_for()
     for name in policies:
-        work, image = in_process(name)
-        t50, t90, b50, b90 = round_trips(name, domain)
+        work, image = in_process(name, repeats)
+        t50, t90, b50, b90 = round_trips(name, domain, timed)
         print(f'{name:8s} frame -> next pan_tilt: median {t50:.2f} ms, p90 {t90:.2f} ms; '
               f'frame -> belief: median {b50:.2f} ms, p90 {b90:.2f} ms '
-              f'({TIMED} round trips); in-process work per frame {work:.0f} us '
+              f'({timed} round trips); in-process work per frame {work:.0f} us '
               f'+ belief_image {image:.0f} us')
 
 

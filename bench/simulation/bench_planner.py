@@ -4,7 +4,7 @@
 Look-ahead planner vs the baselines on paired episodes (7x7, human FPOC, calibrated default).
 
 Run: ``.venv/bin/python bench/simulation/bench_planner.py [--episodes 2000] [--episodes-fast
-20000]``.
+20000] [--quick]`` (``--quick``: 200 and 2,000 episodes, 200 bootstrap resamples, unless given).
 
 Every policy sees the same targets and observation noise (common random numbers; a run of n
 episodes is the first n episodes of a longer one). Printed for each policy: fixations to 90%
@@ -115,14 +115,18 @@ def fmt(block):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    parser.add_argument('--episodes', type=int, default=2000, help='planner episodes')
+    parser.add_argument('--quick', action='store_true',
+                        help='a smoke run: the defaults 200, 2000 and 200 resamples')
+    parser.add_argument('--episodes', type=int, default=None,
+                        help='planner (and greedy) episodes (default 2000)')
     parser.add_argument('--episodes-elm-planner', type=int, default=0,
                         help='episodes of the planner with plain ELM as base (0: skip)')
-    parser.add_argument('--episodes-fast', type=int, default=20000,
-                        help='episodes of MAP, ELM and tempered ELM')
+    parser.add_argument('--episodes-fast', type=int, default=None,
+                        help='episodes of MAP, ELM and tempered ELM (default 20000)')
     parser.add_argument('--horizon', type=int, default=12, help='fixations per episode')
     parser.add_argument('--seed', type=int, default=0)
-    parser.add_argument('--bootstrap', type=int, default=1000)
+    parser.add_argument('--bootstrap', type=int, default=None,
+                        help='bootstrap resamples (default 1000)')
     parser.add_argument('--tempered-seeds', type=int, default=0,
                         help='also compare tempered ELM with ELM on this many fresh seeds '
                              '(100, 101, ...) of --episodes-fast episodes each')
@@ -130,6 +134,10 @@ def main():
                         help='only the fast policies (and --tempered-seeds)')
     parser.add_argument('--json', type=Path, default=None)
     args = parser.parse_args()
+    for name, full, quick in (('episodes', 2000, 200), ('episodes_fast', 20000, 2000),
+                              ('bootstrap', 1000, 200)):
+        if getattr(args, name) is None:
+            setattr(args, name, quick if args.quick else full)
 
     grid, fpoc = Grid(7, 7, 0.42), make_fpoc('human')
     n = grid.n_cells

@@ -22,6 +22,9 @@ curves are written as CSV (``--curves DIR``) for the report's Fig. 3.
 OpenBLAS threads spin-wait badly on a shared 2-core machine (a 18150 x 121 gradient product
 took 0.76 s threaded under load against 0.04 s on one thread), so this script runs with
 ``OPENBLAS_NUM_THREADS=1`` unless the variable is set.
+
+``--quick`` (a smoke run): 100 epochs (1,000 with ``--logistic``), 1,000 validation and 2,000
+final episodes, unless given.
 """
 import os  # noqa: I100
 
@@ -116,21 +119,27 @@ def speedups(conv_curve, logistic_curve):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument('--epochs', type=int, default=1000)
+    parser.add_argument('--quick', action='store_true',
+                        help='a smoke run: fewer epochs and episodes (the defaults in brackets)')
+    parser.add_argument('--epochs', type=int, default=None, help='default 1000 [100]')
     parser.add_argument('--logistic', action='store_true')
-    parser.add_argument('--logistic-epochs', type=int, default=10000)
+    parser.add_argument('--logistic-epochs', type=int, default=None, help='default 10000 [1000]')
     parser.add_argument('--learning-rate', type=float, default=5.0)
     parser.add_argument('--logistic-learning-rate', type=float, default=5.0)
     parser.add_argument('--logistic-eval-every', type=int, default=250)
     parser.add_argument('--no-baseline', action='store_true')
     parser.add_argument('--seed', type=int, default=0)
     parser.add_argument('--eval-every', type=int, default=25)
-    parser.add_argument('--eval-episodes', type=int, default=5000)
-    parser.add_argument('--final-episodes', type=int, default=20000)
+    parser.add_argument('--eval-episodes', type=int, default=None, help='default 5000 [1000]')
+    parser.add_argument('--final-episodes', type=int, default=None, help='default 20000 [2000]')
     parser.add_argument('--curves', type=Path, default=None, metavar='DIR',
                         help='write conv/logistic learning-curve CSVs here')
     parser.add_argument('--json', type=Path, default=None)
     args = parser.parse_args()
+    for name, full, quick in (('epochs', 1000, 100), ('logistic_epochs', 10000, 1000),
+                              ('eval_episodes', 5000, 1000), ('final_episodes', 20000, 2000)):
+        if getattr(args, name) is None:
+            setattr(args, name, quick if args.quick else full)
     grid, fpoc = Grid(7, 7, 0.42), make_fpoc('human')
     elm = simulate(grid, fpoc, make_baseline('elm', grid, fpoc), args.final_episodes, seed=0)
     report = {'grid': '7x7', 'fpoc': fpoc.to_dict(), 'seed': args.seed,
