@@ -9,9 +9,9 @@ benchmark (for example ``ros/bench_ros_loop.py``) only has to be dropped into a 
 one of two ways:
 
 - it defines ``bench(ctx) -> str``: markdown of its section, without the title. ``ctx`` is a
-  :class:`Context` (``ctx.quick``, ``ctx.figure(name)`` for a path under ``docs/figures/``,
-  ``ctx.log(text)``). Optional module attributes: ``TITLE`` (the section heading) and ``ORDER``
-  (position; lower first, default 50);
+  :class:`Context` (``ctx.quick``, ``ctx.figure(name)`` for a path in the report's ``figures/``
+  folder, ``ctx.log(text)``). Optional module attributes: ``TITLE`` (the section heading) and
+  ``ORDER`` (position; lower first, default 50);
 - otherwise it is run as a script (``python bench/<group>/bench_x.py``, and ``--quick`` when the
   run is quick: a script benchmark must accept it) and its standard output is quoted; its
   standard error (progress lines) goes to the console, and into the section only when the
@@ -22,6 +22,9 @@ benchmark and keeps the others' last results in the file. A benchmark that fails
 a script's non-zero exit status) gets its error as its section; the others are still written,
 then the run exits with status 1 and names the failed ones. Timings are not tests: nothing in
 ``make test`` depends on them.
+
+Figures go to ``docs/figures/`` when the report is ``docs/benchmarks.md``, otherwise to
+``figures/`` beside the ``--out`` file (the report links them as ``figures/NAME``).
 
 Usage: ``.venv/bin/python bench/run.py [--only latency,simulate] [--quick] [--out FILE]``.
 """
@@ -62,7 +65,7 @@ class Context:
         self.figures = figures
 
     def figure(self, name: str) -> Path:
-        """Path of a figure file ``docs/figures/<name>`` (the directory is created)."""
+        """Path of a figure file ``<figures>/<name>`` (the directory is created)."""
         self.figures.mkdir(parents=True, exist_ok=True)
         return self.figures / name
 
@@ -208,20 +211,32 @@ def previous(path: Path) -> tuple[dict, dict, dict]:
     return sections, titles, order
 
 
+def figures_for(out: Path) -> Path:
+    """Where a report's figures go: ``docs/figures`` for ``docs/benchmarks.md``, else beside it."""
+    out = out.resolve()
+    return FIGURES if out == DEFAULT_OUT else out.parent / 'figures'
+
+
 def main(argv=None) -> int:
     """Run the selected benchmarks and write the report; 1 if a benchmark failed."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
     parser.add_argument('--only', default='', help='comma-separated names (bench_NAME.py)')
     parser.add_argument('--quick', action='store_true',
                         help='few calls: a smoke run (script benchmarks get --quick)')
-    parser.add_argument('--out', type=Path, default=DEFAULT_OUT, help='report path')
+    parser.add_argument('--out', type=Path, default=DEFAULT_OUT,
+                        help='report path (default docs/benchmarks.md); its figures go to '
+                             'figures/ beside it')
     args = parser.parse_args(argv)
     found = discover()
     names = [n for n in args.only.split(',') if n] or list(found)
     unknown = [n for n in names if n not in found]
     if unknown:
         parser.error(f"unknown benchmark {unknown[0]!r}; available: {', '.join(found)}")
-    ctx = Context(args.quick, FIGURES)
+    figures = figures_for(args.out)
+    if figures == FIGURES and args.out.resolve() != DEFAULT_OUT:
+        parser.error(f'--out {args.out}: its figures would replace those of '
+                     f'{DEFAULT_OUT.relative_to(ROOT)} in docs/figures; write it elsewhere')
+    ctx = Context(args.quick, figures)
     sections, titles, order = previous(args.out) if args.only else ({}, {}, {})
     failed = []
     for name in names:

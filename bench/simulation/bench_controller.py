@@ -19,7 +19,7 @@ bench/simulation/bench_controller.py [--quick]`` prints the markdown section. Po
 ``PYTHONPATH`` at
 another checkout measures that code with the same script (a before/after comparison).
 """
-import sys
+import argparse
 import time
 
 from ipomdp_gaze.model.fpoc import make_fpoc
@@ -97,6 +97,12 @@ def bench(ctx=None) -> str:
     return '\n'.join(lines)
 
 
+def main(argv=None) -> None:
+    """Run alone: print the section."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
+    parser.add_argument('--quick', action='store_true', help='few frames: a smoke run')
+    print(bench(parser.parse_args(argv)))
+
+
 if __name__ == '__main__':
-    print(bench(type('Ctx', (), {'quick': '--quick' in sys.argv[1:]})()))
-    sys.exit(0)
+    main()

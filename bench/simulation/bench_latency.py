@@ -16,9 +16,11 @@ library path (N x N matrices, as before issue 5) and a per-cell Python loop. Als
 direct/FFT break-even, peak memory (tracemalloc) and the effect of kernel truncation.
 
 Run through ``bench/run.py`` (``make bench``), or alone: ``python bench/simulation/bench_latency.py
-[--quick]`` prints the markdown section.
+[--quick] [--figures DIR]`` prints the markdown section (and draws its figures in ``DIR``).
 """
+import argparse
 import math
+from pathlib import Path
 import sys
 import time
 import tracemalloc
@@ -579,11 +581,23 @@ def bench(ctx) -> str:
     scan = break_even(ctx, fpoc)
     trunc = truncation(ctx)
     greedy = greedy_cost(ctx)
-    plot(ctx, rows, scan)
+    if ctx.figures is not None:
+        plot(ctx, rows, scan)
     return report(rows, scan, trunc, greedy)
 
 
+def main(argv=None) -> None:
+    """Run alone: print the section; draw its figures only where ``--figures`` says."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
+    parser.add_argument('--quick', action='store_true', help='few calls: a smoke run')
+    parser.add_argument('--figures', type=Path, default=None, metavar='DIR',
+                        help="write the section's figures into DIR (default: not drawn; "
+                             'make bench writes those of docs/benchmarks.md)')
+    args = parser.parse_args(argv)
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from run import Context
+    print(bench(Context(args.quick, args.figures)))
+
+
 if __name__ == '__main__':
-    sys.path.insert(0, str(__import__('pathlib').Path(__file__).resolve().parents[1]))
-    from run import Context, FIGURES
-    print(bench(Context('--quick' in sys.argv, FIGURES)))
+    main()

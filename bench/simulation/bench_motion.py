@@ -12,7 +12,7 @@ training) and for one belief (the controller), it times
 median microseconds per call. The dense matrix is only tried up to 4,096 cells (N^2 doubles).
 ``bench/run.py`` calls :func:`bench` for a markdown table.
 """
-import sys
+import argparse
 import time
 
 from ipomdp_gaze.model.grid import Grid
@@ -82,5 +82,12 @@ def bench(ctx) -> str:
             "controller's grids go up to 256x256.\n")
 
 
+def main(argv=None) -> None:
+    """Run alone: print the table."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
+    parser.add_argument('--quick', action='store_true', help='few calls: a smoke run')
+    print(table(measure(parser.parse_args(argv).quick)))
+
+
 if __name__ == '__main__':
-    print(table(measure('--quick' in sys.argv)))
+    main()

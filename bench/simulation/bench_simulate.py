@@ -8,6 +8,7 @@ episode-fixations per
 second, beside a naive per-episode Python loop on a subsample (the reference ratio).
 ``bench/run.py`` calls :func:`bench` instead, which also times 11x11 and writes a markdown table.
 """
+import argparse
 import time
 
 from ipomdp_gaze.model.belief import bayes_update, map_cell, uniform_log_belief
@@ -69,7 +70,10 @@ def bench(ctx) -> str:
         f'(MAP, 7x7) is {batched[(7, "map")] / naive_rate:.0f}x faster in this run.'])
 
 
-def main():
+def main(argv=None):
+    """Run alone: the 7x7 throughput of each baseline and the naive loop's ratio."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
+    parser.parse_args(argv)
     grid, fpoc = Grid(7, 7, 0.42), make_fpoc('human')
     episodes = 20000
     for name in ('map', 'random', 'elm'):
