@@ -18,7 +18,10 @@ one of two ways:
   script fails.
 
 Sections are delimited by ``<!-- bench:NAME order=N -->`` markers, so ``--only NAME`` re-runs one
-benchmark and keeps the others' last results in the file. A benchmark that fails (an exception,
+benchmark and keeps the others' last results in the file. The soak of the face loop
+(``bench/ros/soak_face_loop.py``, section ``soak_face_loop``) is not one of these benchmarks: it
+runs for minutes, under ``make soak`` only, which writes its section; a full run keeps that
+section as it was. A benchmark that fails (an exception,
 a script's non-zero exit status) gets its error as its section; the others are still written,
 then the run exits with status 1 and names the failed ones. Timings are not tests: nothing in
 ``make test`` depends on them.
@@ -54,6 +57,8 @@ FIGURES = ROOT / 'docs' / 'figures'
 SCRIPT_TIMEOUT_S = 3600
 # Last lines of a failed script's standard error quoted in its section.
 ERROR_LINES = 40
+# Sections another command writes (not bench_*.py): a full run keeps them as they are.
+OTHER_SECTIONS = {'soak_face_loop': '`make soak` (bench/ros/soak_face_loop.py)'}
 MARK = re.compile(r'<!-- bench:(\w+) order=([-\d.]+) -->\n(.*?)<!-- /bench:\1 -->\n', re.S)
 
 
@@ -174,10 +179,11 @@ PENDING = {
 
 HEADER = """# Benchmarks
 
-Written by `make bench` (`bench/run.py`): one section per `bench/<group>/bench_*.py`. The
-machine is small and shared (other engineers' jobs run at the same time), so absolute times move
-by 2x or more from run to run; every timing is therefore shown beside a reference measured in
-the same run, and the ratios are the numbers to compare. Benchmarks are not tests: nothing in
+Written by `make bench` (`bench/run.py`): one section per `bench/<group>/bench_*.py`, and the
+soak of the face loop, which only `make soak` runs and writes (`make bench` keeps its section).
+The machine is small and shared (other engineers' jobs run at the same time), so absolute times
+move by 2x or more from run to run; every timing is therefore shown beside a reference measured
+in the same run, and the ratios are the numbers to compare. Benchmarks are not tests: nothing in
 `make test` depends on timing.
 
 """
@@ -219,7 +225,11 @@ def figures_for(out: Path) -> Path:
 
 def main(argv=None) -> int:
     """Run the selected benchmarks and write the report; 1 if a benchmark failed."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
+    parser = argparse.ArgumentParser(
+        description=__doc__.splitlines()[1],
+        epilog='The soak of the face loop (section soak_face_loop) runs under make soak only; a '
+               'full run keeps its section. A benchmark that fails is written as its section '
+               'and the run exits with status 1.')
     parser.add_argument('--only', default='', help='comma-separated names (bench_NAME.py)')
     parser.add_argument('--quick', action='store_true',
                         help='few calls: a smoke run (script benchmarks get --quick)')
@@ -231,13 +241,20 @@ def main(argv=None) -> int:
     names = [n for n in args.only.split(',') if n] or list(found)
     unknown = [n for n in names if n not in found]
     if unknown:
+        if unknown[0] in OTHER_SECTIONS:
+            parser.error(f'{unknown[0]!r} is not a benchmark of this runner: '
+                         f'{OTHER_SECTIONS[unknown[0]]} writes its section')
         parser.error(f"unknown benchmark {unknown[0]!r}; available: {', '.join(found)}")
     figures = figures_for(args.out)
     if figures == FIGURES and args.out.resolve() != DEFAULT_OUT:
         parser.error(f'--out {args.out}: its figures would replace those of '
                      f'{DEFAULT_OUT.relative_to(ROOT)} in docs/figures; write it elsewhere')
     ctx = Context(args.quick, figures)
-    sections, titles, order = previous(args.out) if args.only else ({}, {}, {})
+    sections, titles, order = previous(args.out)
+    if not args.only:                    # a full run writes every section anew but the soak's
+        for kept in (sections, titles, order):
+            for name in set(kept) - set(OTHER_SECTIONS):
+                del kept[name]
     failed = []
     for name in names:
         ctx.log(f'== bench_{name}')
