@@ -29,21 +29,25 @@ import time
 
 def main(argv=None) -> int:
     """Flood ``evidence``; print the counts as JSON."""
+    from ipomdp_gaze.commands.common import (nonneg_float, nonneg_int, positive_float,
+                                             positive_int)
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
-    parser.add_argument('--rows', type=int, default=11)
-    parser.add_argument('--cols', type=int, default=11)
-    parser.add_argument('--rate-hz', type=float, default=1000.0, help='0: as fast as possible')
-    parser.add_argument('--seconds', type=float, default=5.0)
-    parser.add_argument('--frames', type=int, default=0, help='stop after this many (0: none)')
+    parser.add_argument('--rows', type=positive_int, default=11)
+    parser.add_argument('--cols', type=positive_int, default=11)
+    parser.add_argument('--rate-hz', type=nonneg_float, default=1000.0,
+                        help='0: as fast as possible')
+    parser.add_argument('--seconds', type=nonneg_float, default=5.0)
+    parser.add_argument('--frames', type=nonneg_int, default=0,
+                        help='stop after this many (0: none)')
     parser.add_argument('--stop-file', default='', metavar='PATH',
                         help='after --seconds, go on until this file exists (a test that needs '
                              'the controller to have taken some frames, on any machine)')
-    parser.add_argument('--max-seconds', type=float, default=60.0,
+    parser.add_argument('--max-seconds', type=positive_float, default=60.0,
                         help='with --stop-file: stop after this long in any case')
-    parser.add_argument('--burst', type=int, default=0,
+    parser.add_argument('--burst', type=nonneg_int, default=0,
                         help='then this many frames as fast as possible')
     parser.add_argument('--marker', action='store_true', help='end with one invalid frame')
-    parser.add_argument('--seed', type=int, default=0)
+    parser.add_argument('--seed', type=nonneg_int, default=0)
     args = parser.parse_args(argv)
 
     from ipomdp_gaze.harness.processes import wait_for

@@ -26,6 +26,7 @@ import time
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO))
 
+from ipomdp_gaze.commands.common import positive_float, positive_int  # noqa: E402
 from ipomdp_gaze.files.share_files import config_file  # noqa: E402
 from ipomdp_gaze.harness.processes import domain_id_for, NodeGroup, ros_environment  # noqa: E402
 
@@ -33,10 +34,10 @@ from ipomdp_gaze.harness.processes import domain_id_for, NodeGroup, ros_environm
 def main(argv=None) -> int:
     """Run the cycles and print one JSON line per cycle and a summary."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
-    parser.add_argument('--cycles', type=int, default=50)
-    parser.add_argument('--frames', type=int, default=3,
+    parser.add_argument('--cycles', type=positive_int, default=50)
+    parser.add_argument('--frames', type=positive_int, default=3,
                         help='applied frames to wait for before stopping')
-    parser.add_argument('--timeout-s', type=float, default=10.0)
+    parser.add_argument('--timeout-s', type=positive_float, default=10.0)
     parser.add_argument('--keep', default='', help='folder for the logs of hung nodes')
     args = parser.parse_args(argv)
 

@@ -35,6 +35,8 @@ import time
 BENCH = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(BENCH.parent), str(BENCH), str(BENCH / 'ros')]
 
+from ipomdp_gaze.commands.common import (check_output_file, nonneg_int,  # noqa: E402
+                                         positive_float)
 import numpy as np  # noqa: E402
 
 NAME, ORDER = 'soak_face_loop', 90
@@ -262,11 +264,16 @@ def write_section(body: str, out: Path) -> None:
 def main(argv=None) -> int:
     """Run the soak and write its section."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
-    parser.add_argument('--minutes', type=float, default=10.0)
-    parser.add_argument('--seed', type=int, default=0, help='test scene and start cells')
+    parser.add_argument('--minutes', type=positive_float, default=10.0)
+    parser.add_argument('--seed', type=nonneg_int, default=0, help='test scene and start cells')
     parser.add_argument('--out', type=Path, default=BENCH.parent / 'docs' / 'benchmarks.md')
     parser.add_argument('--no-write', action='store_true', help='print only')
     args = parser.parse_args(argv)
+    if not args.no_write:
+        try:
+            check_output_file('--out', args.out)
+        except ValueError as exc:
+            parser.error(str(exc))
     result = soak(args.minutes, args.seed)
     body, ok = report(result)
     print(body)

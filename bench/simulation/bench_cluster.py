@@ -25,6 +25,7 @@ import sys
 import tempfile
 import time
 
+from ipomdp_gaze.commands.common import positive_int
 from ipomdp_gaze.commands.evaluate import evaluate
 from ipomdp_gaze.drivers.pieces import COSTLY_CHUNK
 from ipomdp_gaze.model.fpoc import make_fpoc
@@ -170,13 +171,23 @@ def bench(ctx) -> str:
     return table(measure(n, log=ctx.log), n)
 
 
-def main():
+def worker_counts(text: str) -> list:
+    """Parse ``--workers``: comma-separated Dask worker counts, each a positive integer."""
+    try:
+        return [positive_int(count) for count in text.split(',')]
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(
+            f'expected positive integers separated by commas, got {text!r}') from None
+
+
+def main(argv=None):
+    """Run every way and print the log, then the table."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
-    parser.add_argument('--episodes-greedy', type=int, default=1000)
-    parser.add_argument('--workers', default='1,2')
-    args = parser.parse_args()
-    workers = [int(w) for w in args.workers.split(',')]
-    rows = measure(args.episodes_greedy, workers, lambda text: print(text, flush=True))
+    parser.add_argument('--episodes-greedy', type=positive_int, default=1000)
+    parser.add_argument('--workers', type=worker_counts, default='1,2',
+                        help='Dask worker counts to run, comma-separated (default 1,2)')
+    args = parser.parse_args(argv)
+    rows = measure(args.episodes_greedy, args.workers, lambda text: print(text, flush=True))
     print()
     print(table(rows, args.episodes_greedy))
 

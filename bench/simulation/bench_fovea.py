@@ -26,6 +26,7 @@ from pathlib import Path
 import time
 
 import cv2
+from ipomdp_gaze.commands.common import check_output_file, nonneg_int
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.vision.detectors import make_detector
 from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig
@@ -87,14 +88,32 @@ def bench_fovea(gray, detector, face, interpolation, repeats, rng):
                         'raw_detections_per_window': per_window.tolist()}}
 
 
+def image_side(text: str) -> int:
+    """Parse ``--size``: at least a pixel per cell of the grid (the detector needs 20x20)."""
+    try:
+        side = int(text)
+    except ValueError:
+        side = 0
+    if side < GRID.cols:
+        raise argparse.ArgumentTypeError(f'expected an integer >= {GRID.cols} (a pixel per cell '
+                                         f'of the {GRID.rows}x{GRID.cols} grid), got {text!r}')
+    return side
+
+
 def main(argv=None):
     """Run the benchmark and print (and optionally save) the numbers."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
     parser.add_argument('--quick', action='store_true', help='fewer repetitions')
-    parser.add_argument('--size', type=int, default=420, help='image side in pixels')
-    parser.add_argument('--threads', type=int, default=None, help='cv2.setNumThreads(N)')
+    parser.add_argument('--size', type=image_side, default=420, help='image side in pixels')
+    parser.add_argument('--threads', type=nonneg_int, default=None,
+                        help='cv2.setNumThreads(N) (0: no threads)')
     parser.add_argument('--json', type=Path, default=None, metavar='OUT')
     args = parser.parse_args(argv)
+    try:
+        if args.json:
+            check_output_file('--json', args.json)
+    except ValueError as exc:
+        parser.error(str(exc))
     if args.threads is not None:
         cv2.setNumThreads(args.threads)
     repeats = 5 if args.quick else 30

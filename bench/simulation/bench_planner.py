@@ -26,6 +26,8 @@ import json
 from pathlib import Path
 import time
 
+from ipomdp_gaze.commands.common import (bootstrap_count, check_output_file, nonneg_int,
+                                         positive_int)
 from ipomdp_gaze.model.belief import bayes_update
 from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
 from ipomdp_gaze.model.grid import Grid
@@ -113,27 +115,32 @@ def fmt(block):
     return f'{value:{sign}7.3f} {interval:>16}'
 
 
-def main():
+def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--quick', action='store_true',
                         help='a smoke run: the defaults 200, 2000 and 200 resamples')
-    parser.add_argument('--episodes', type=int, default=None,
+    parser.add_argument('--episodes', type=positive_int, default=None,
                         help='planner (and greedy) episodes (default 2000)')
-    parser.add_argument('--episodes-elm-planner', type=int, default=0,
+    parser.add_argument('--episodes-elm-planner', type=nonneg_int, default=0,
                         help='episodes of the planner with plain ELM as base (0: skip)')
-    parser.add_argument('--episodes-fast', type=int, default=None,
+    parser.add_argument('--episodes-fast', type=positive_int, default=None,
                         help='episodes of MAP, ELM and tempered ELM (default 20000)')
-    parser.add_argument('--horizon', type=int, default=12, help='fixations per episode')
-    parser.add_argument('--seed', type=int, default=0)
-    parser.add_argument('--bootstrap', type=int, default=None,
+    parser.add_argument('--horizon', type=positive_int, default=12, help='fixations per episode')
+    parser.add_argument('--seed', type=nonneg_int, default=0)
+    parser.add_argument('--bootstrap', type=bootstrap_count, default=None,
                         help='bootstrap resamples (default 1000)')
-    parser.add_argument('--tempered-seeds', type=int, default=0,
+    parser.add_argument('--tempered-seeds', type=nonneg_int, default=0,
                         help='also compare tempered ELM with ELM on this many fresh seeds '
                              '(100, 101, ...) of --episodes-fast episodes each')
     parser.add_argument('--skip-planner', action='store_true',
                         help='only the fast policies (and --tempered-seeds)')
     parser.add_argument('--json', type=Path, default=None)
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
+    try:
+        if args.json:
+            check_output_file('--json', args.json)
+    except ValueError as exc:
+        parser.error(str(exc))
     for name, full, quick in (('episodes', 2000, 200), ('episodes_fast', 20000, 2000),
                               ('bootstrap', 1000, 200)):
         if getattr(args, name) is None:

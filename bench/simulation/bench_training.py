@@ -34,6 +34,9 @@ import argparse  # noqa: E402, I100
 import json  # noqa: E402
 from pathlib import Path  # noqa: E402
 
+from ipomdp_gaze.commands.common import (check_output_file,  # noqa: E402
+                                         check_output_folder, nonneg_int, positive_float,
+                                         positive_int)
 from ipomdp_gaze.model.fpoc import make_fpoc  # noqa: E402
 from ipomdp_gaze.model.grid import Grid  # noqa: E402
 from ipomdp_gaze.policies.baselines import make_baseline  # noqa: E402
@@ -117,25 +120,35 @@ def speedups(conv_curve, logistic_curve):
     return levels
 
 
-def main():
+def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--quick', action='store_true',
                         help='a smoke run: fewer epochs and episodes (the defaults in brackets)')
-    parser.add_argument('--epochs', type=int, default=None, help='default 1000 [100]')
+    parser.add_argument('--epochs', type=positive_int, default=None, help='default 1000 [100]')
     parser.add_argument('--logistic', action='store_true')
-    parser.add_argument('--logistic-epochs', type=int, default=None, help='default 10000 [1000]')
-    parser.add_argument('--learning-rate', type=float, default=5.0)
-    parser.add_argument('--logistic-learning-rate', type=float, default=5.0)
-    parser.add_argument('--logistic-eval-every', type=int, default=250)
+    parser.add_argument('--logistic-epochs', type=positive_int, default=None,
+                        help='default 10000 [1000]')
+    parser.add_argument('--learning-rate', type=positive_float, default=5.0)
+    parser.add_argument('--logistic-learning-rate', type=positive_float, default=5.0)
+    parser.add_argument('--logistic-eval-every', type=positive_int, default=250)
     parser.add_argument('--no-baseline', action='store_true')
-    parser.add_argument('--seed', type=int, default=0)
-    parser.add_argument('--eval-every', type=int, default=25)
-    parser.add_argument('--eval-episodes', type=int, default=None, help='default 5000 [1000]')
-    parser.add_argument('--final-episodes', type=int, default=None, help='default 20000 [2000]')
+    parser.add_argument('--seed', type=nonneg_int, default=0)
+    parser.add_argument('--eval-every', type=positive_int, default=25)
+    parser.add_argument('--eval-episodes', type=positive_int, default=None,
+                        help='default 5000 [1000]')
+    parser.add_argument('--final-episodes', type=positive_int, default=None,
+                        help='default 20000 [2000]')
     parser.add_argument('--curves', type=Path, default=None, metavar='DIR',
                         help='write conv/logistic learning-curve CSVs here')
     parser.add_argument('--json', type=Path, default=None)
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
+    try:
+        if args.json:
+            check_output_file('--json', args.json)
+        if args.curves:
+            check_output_folder('--curves', args.curves)
+    except ValueError as exc:
+        parser.error(str(exc))
     for name, full, quick in (('epochs', 1000, 100), ('logistic_epochs', 10000, 1000),
                               ('eval_episodes', 5000, 1000), ('final_episodes', 20000, 2000)):
         if getattr(args, name) is None:
