@@ -229,6 +229,11 @@ def _fmt_us(us):
     return f'{us:.1f} µs'
 
 
+def _fmt_ratio(ratio):
+    """Return a reference / ours ratio: 2 significant digits below 10 (0.18x, 1.0x), else whole."""
+    return f'{ratio:#.2g}x' if ratio < 9.95 else f'{ratio:,.0f}x'
+
+
 def _fmt_bytes(b):
     if b is None:
         return '-'
@@ -520,7 +525,7 @@ def report(rows, scan, trunc, greedy) -> str:
         cells = []
         for kind in REFERENCE_CALLS:
             v = r.get(kind + ' cpu')
-            cells.append(f'{_fmt_us(v[0])} ({v[0] / ours:,.0f}x)' if v else 'not run')
+            cells.append(f'{_fmt_us(v[0])} ({_fmt_ratio(v[0] / ours)})' if v else 'not run')
         text.append(f"| {r['side']}x{r['side']} | " + ' | '.join(cells) + ' |')
     text += ['', 'correlate2d is O(N^2) per frame (about 5 s at 256x256), so it is run up to '
              '128x128 only; the per-cell loop only at 7x7 and 11x11.', '',
