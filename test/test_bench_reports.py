@@ -261,3 +261,124 @@ def test_walk_reports_refuse_bad_options_with_one_line_before_any_walk(tmp_path,
             _bench_module(script).main(args)
         assert stop.value.code == 2, (script, args)
         assert named in capsys.readouterr().err
+
+
+def test_benchmarks_refuse_bad_options_with_one_line_before_any_work(tmp_path, capsys):
+    """The script benchmarks name a bad option (exit status 2) before they measure anything."""
+    import pytest
+    for script, args, named in (
+            ('bench_fovea', ['--size', '0'], 'argument --size: expected an integer >= 21'),
+            ('bench_fovea', ['--json', str(tmp_path)], f'--json {tmp_path}: is a directory'),
+            ('bench_planner', ['--episodes', '0'], 'argument --episodes'),
+            ('bench_planner', ['--bootstrap', '3'], 'argument --bootstrap'),
+            ('bench_cluster', ['--workers', 'abc'], 'argument --workers'),
+            ('bench_cluster', ['--episodes-greedy', '0'], 'argument --episodes-greedy'),
+            ('bench_training', ['--epochs', '-1'], 'argument --epochs'),
+            ('bench_latency', ['--bogus'], 'unrecognized arguments: --bogus'),
+            ('bench_motion', ['--quick', '1'], 'unrecognized arguments: 1'),
+            ('bench_controller', ['--bogus'], 'unrecognized arguments'),
+            ('bench_simulate', ['--quick'], 'unrecognized arguments'),
+            ('soak_face_loop', ['--minutes', '-1', '--no-write'], 'argument --minutes'),
+            ('shutdown_cycles', ['--cycles', '-1'], 'argument --cycles'),
+            ('evidence_flood', ['--rate-hz', '-5'], 'argument --rate-hz')):
+        with pytest.raises(SystemExit) as stop:
+            _bench_module(script).main(args)
+        err = capsys.readouterr().err
+        assert stop.value.code == 2, (script, args)
+        lines = err.strip().splitlines()             # argparse's usage, then one error line
+        assert 'Traceback' not in err and named in lines[-1], (script, args, err)
+        assert [line for line in lines if 'error' in line] == lines[-1:], (script, args, err)
+
+
+def test_a_benchmark_run_alone_prints_its_usage_for_help(tmp_path, capsys, monkeypatch):
+    """``--help`` prints the usage and does nothing else (bench_latency ran, drew its figures)."""
+    import pytest
+    monkeypatch.chdir(tmp_path)
+    for script in ('bench_latency', 'bench_motion', 'bench_controller', 'bench_simulate',
+                   'bench_fovea', 'bench_planner', 'bench_training'):
+        with pytest.raises(SystemExit) as stop:
+            _bench_module(script).main(['--help'])
+        assert stop.value.code == 0, script
+        assert capsys.readouterr().out.startswith('usage:'), script
+    assert not any(tmp_path.iterdir())
+
+
+def test_ros_benchmarks_refuse_bad_options_with_one_line(capsys):
+    """The ROS benchmarks parse their options: --help was a policy name or a search count."""
+    import pytest
+    pytest.importorskip('rclpy')
+    for script, args, named in (
+            ('bench_ros_search', ['--help'], None),
+            ('bench_ros_search', ['0'], 'argument searches: expected a positive integer'),
+            ('bench_ros_roundtrip', ['--help'], None),
+            ('bench_ros_roundtrip', ['elm', 'nope'], "argument policy: unknown policy 'nope'")):
+        with pytest.raises(SystemExit) as stop:
+            _bench_module(script).main(args)
+        out, err = capsys.readouterr()
+        if named is None:
+            assert stop.value.code == 0 and out.startswith('usage:'), script
+        else:
+            assert stop.value.code == 2 and named in err.strip().splitlines()[-1], (script, err)
+
+
+def _runner(monkeypatch, folder, benches):
+    """``bench/run.py`` as a module, finding only the given benchmark files (name: source)."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location('bench_runner', BENCH / 'run.py')
+    run = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(run)
+    folder.mkdir()
+    for name, source in benches.items():
+        (folder / f'bench_{name}.py').write_text(source)
+    monkeypatch.setattr(run, 'discover', lambda: {
+        p.stem[len('bench_'):]: p for p in sorted(folder.glob('bench_*.py'))})
+    return run
+
+
+SCRIPT = """import sys
+if __name__ == '__main__':
+    print('table', sys.argv[1:])
+    print('progress 1/2', file=sys.stderr)
+    sys.exit({status})
+"""
+
+
+def test_run_writes_every_section_then_fails_naming_the_failed_benchmarks(tmp_path, monkeypatch,
+                                                                          capsys):
+    """A failed benchmark is its section's error; the others are written; the exit status is 1."""
+    run = _runner(monkeypatch, tmp_path / 'benches', {
+        'good': "def bench(ctx):\n    ctx.figure('f.png').write_text('png')\n    return 'fine'\n",
+        'raises': "def bench(ctx):\n    raise RuntimeError('kaput')\n",
+        'script': SCRIPT.format(status=0),
+        'broken': SCRIPT.format(status=3)})
+    out = tmp_path / 'report' / 'bench.md'
+    assert run.main(['--quick', '--out', str(out)]) == 1
+    assert 'failed: broken, raises' in capsys.readouterr().err
+    sections, _, _ = run.previous(out)
+    assert set(sections) == {'good', 'raises', 'script', 'broken'}
+    assert sections['good'].startswith('fine')
+    assert 'RuntimeError: kaput' in sections['raises']
+    # a script gets --quick; its progress lines stay out of its section unless it failed
+    assert f'Output of `python {tmp_path}/benches/bench_script.py --quick`:' in sections['script']
+    assert "table ['--quick']" in sections['script'] and 'progress' not in sections['script']
+    assert '(exit status 3)' in sections['broken'] and 'progress 1/2' in sections['broken']
+    assert (tmp_path / 'report' / 'figures' / 'f.png').read_text() == 'png'   # beside --out
+
+
+def test_run_keeps_the_soak_section_and_refuses_what_it_cannot_write(tmp_path, monkeypatch,
+                                                                     capsys):
+    """A full run keeps ``make soak``'s section; --only soak_face_loop and --out in docs/ fail."""
+    import pytest
+    run = _runner(monkeypatch, tmp_path / 'benches',
+                  {'good': "def bench(ctx):\n    return 'ok'\n"})
+    out = tmp_path / 'bench.md'
+    out.write_text(run.compose({'soak_face_loop': 'soaked\n', 'gone': 'stale\n'},
+                               {'soak_face_loop': 90.0}, {'soak_face_loop': 'Soak', 'gone': 'G'}))
+    assert run.main(['--out', str(out)]) == 0
+    sections, _, _ = run.previous(out)
+    assert sections == {'good': sections['good'], 'soak_face_loop': 'soaked\n'}
+    for args, named in ((['--only', 'soak_face_loop'], '`make soak`'),
+                        (['--out', str(run.ROOT / 'docs' / 'other.md')], 'docs/figures')):
+        with pytest.raises(SystemExit) as stop:
+            run.main(args)
+        assert stop.value.code == 2 and named in capsys.readouterr().err.strip().splitlines()[-1]
