@@ -147,6 +147,8 @@ class Grid:
 
 def _whole(value, what: str) -> int:
     """Return a scalar cell coordinate as an int; a fraction (1.5) is refused, not truncated."""
+    if type(value) is int:                      # the controller's every frame: no more work
+        return value
     try:
         whole = int(value)
         exact = whole == value

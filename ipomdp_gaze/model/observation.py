@@ -73,6 +73,9 @@ def check_frames_shape(observation, n_cells: int) -> np.ndarray:
         one's cells).
 
     """
+    if type(observation) is np.ndarray and observation.dtype == np.float64 \
+            and observation.shape == (n_cells,):
+        return observation                      # a checked frame (the sessions'): as it is
     try:
         obs = np.asarray(observation, dtype=float)
     except (TypeError, ValueError):
