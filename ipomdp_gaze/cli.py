@@ -65,17 +65,17 @@ def _one_line_warnings(command: str, default):
 # BLAS libraries' thread counts, pinned to one unless the environment sets them: a long matrix
 # product (training's gradient) sums in pieces per thread and rounds differently with their
 # number, and training compounds it over epochs, so a curve regenerates exactly only on the
-# same count (docs/reproduction.md). Set before numpy is first imported (build_parser), and only
-# when none of the variables the BLAS libraries read is set: a user's OMP_NUM_THREADS stands.
-BLAS_THREAD_VARIABLES = ('OPENBLAS_NUM_THREADS', 'OMP_NUM_THREADS', 'MKL_NUM_THREADS',
-                         'GOTO_NUM_THREADS', 'BLIS_NUM_THREADS', 'VECLIB_MAXIMUM_THREADS')
+# same count (docs/reproduction.md). Set before numpy is first imported (build_parser), unless a
+# variable the bundled OpenBLAS reads is set: a user's OMP_NUM_THREADS stands (an MKL or BLIS
+# variable does not reach numpy's OpenBLAS, so it does not stop the pin).
+OPENBLAS_THREAD_VARIABLES = ('OPENBLAS_NUM_THREADS', 'GOTO_NUM_THREADS', 'OMP_NUM_THREADS')
 
 
 def main(argv=None) -> int:
     """Entry point of the console script."""
-    if not any(os.environ.get(name) for name in BLAS_THREAD_VARIABLES):
-        for name in BLAS_THREAD_VARIABLES[:3]:
-            os.environ[name] = '1'
+    if not any(os.environ.get(name) for name in OPENBLAS_THREAD_VARIABLES):
+        os.environ['OPENBLAS_NUM_THREADS'] = os.environ['OMP_NUM_THREADS'] = '1'
+        os.environ.setdefault('MKL_NUM_THREADS', '1')
     parser = build_parser()
     argv = sys.argv[1:] if argv is None else list(argv)
     if not argv:

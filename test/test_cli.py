@@ -328,19 +328,22 @@ def test_blas_runs_on_one_thread_unless_the_environment_says(monkeypatch):
     """QA: the logistic curve regenerated only with OPENBLAS_NUM_THREADS=1 (training's gemm)."""
     import os
     import subprocess
-    from ipomdp_gaze.cli import BLAS_THREAD_VARIABLES
+    from ipomdp_gaze.cli import OPENBLAS_THREAD_VARIABLES
     # The pin works only if numpy is not loaded before main() runs.
     run = subprocess.run([sys.executable, '-c', 'import sys, ipomdp_gaze.cli; '
                           "print('numpy' in sys.modules)"], capture_output=True, text=True,
                          check=True)
     assert run.stdout.strip() == 'False'
-    for name in BLAS_THREAD_VARIABLES:
+    names = (*OPENBLAS_THREAD_VARIABLES, 'MKL_NUM_THREADS')
+    for name in names:
         monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv('MKL_NUM_THREADS', '4')      # not read by numpy's OpenBLAS: pinned still
     with pytest.raises(SystemExit):
         main(['--version'])
     assert os.environ['OPENBLAS_NUM_THREADS'] == os.environ['OMP_NUM_THREADS'] == '1'
-    # A user's own setting stands, whichever variable it is (OpenBLAS reads its own first).
-    for name in BLAS_THREAD_VARIABLES:
+    assert os.environ['MKL_NUM_THREADS'] == '4'
+    # A user's own setting that OpenBLAS reads stands.
+    for name in names:
         monkeypatch.delenv(name, raising=False)
     monkeypatch.setenv('OMP_NUM_THREADS', '2')
     with pytest.raises(SystemExit):

@@ -99,6 +99,18 @@ def test_a_fixation_resent_on_a_clock_set_back_waits_from_the_new_time(fovea_set
     assert out.status == 'published' and out.frame.stamp_s == 101.5
 
 
+def test_a_scan_asked_again_on_a_clock_set_back_is_not_served_an_old_image(fovea_setup):
+    """Review: the set-back rule of fixate was missing from request_scan."""
+    loop = DetectorLoop(fovea_setup)
+    image = SceneSet('test', **PAPER_TASK, color='rgb', seed=2).scene(0).image
+    assert loop.fixate(fovea_setup.grid.index(10, 10), 2002.0, search_id=1).status == 'waiting'
+    assert loop.add_image(2001.9, image, token='old', now_s=2002.0).status == 'waiting'
+    waiting = loop.request_scan(2, 101.0)
+    assert waiting.status == 'waiting', waiting
+    out = loop.add_image(101.5, image, token='new', now_s=101.5)
+    assert out.status == 'published' and out.frame.token == 'new'
+
+
 def test_the_newest_waiting_image_serves_a_fixation(fovea_setup):
     loop = DetectorLoop(fovea_setup)
     old = SceneSet('test', **PAPER_TASK, color='rgb', seed=2).scene(0).image

@@ -250,6 +250,9 @@ def test_a_count_model_with_scan_tables_starts_from_the_scanned_belief():
     session.scan(Frame(counts, kind='scan'))
     np.testing.assert_allclose(obs['belief'].ravel(), session.belief, rtol=1e-12)
     assert info['entropy'] < np.log(9) - 1e-6
+    evidence = VisualSearchEnv(observation=model, observe='evidence')
+    obs, _ = evidence.reset(seed=5, options={'target': 4})
+    np.testing.assert_array_equal(obs['evidence'].ravel(), counts)     # the scan's counts
     plain = VisualSearchEnv(observation=model, scan=False)
     obs, info = plain.reset(seed=5, options={'target': 4})
     np.testing.assert_allclose(obs['belief'].ravel(), np.full(9, 1 / 9))

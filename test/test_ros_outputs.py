@@ -124,6 +124,20 @@ def test_a_new_room_frame_republishes_the_people_in_it(context):
         assert node.set_parameters([Parameter('room.frame_id', value='head_base')])[0].successful
         assert spin_until(lambda: received[-1].header.frame_id == 'head_base')
         assert [(p.orientation.z, p.orientation.w) for p in received[-1].poses] == first
+        # A new head mapping: the same people, their poses turned the other way.
+        count = len(received)
+        assert node.set_parameters([Parameter('pan_sign', value=-1)])[0].successful
+        assert spin_until(lambda: len(received) > count)
+        assert [(p.orientation.z, p.orientation.w) for p in received[-1].poses] != first
+        # One target: ~/targets says nothing more, whatever the frame.
+        assert node.set_parameters([Parameter('search.targets', value='one')])[0].successful
+        executor.spin_once(timeout_sec=0.2)
+        count = len(received)
+        assert node.set_parameters([Parameter('room.frame_id', value='other')])[0].successful
+        deadline = time.monotonic() + 1.0
+        while time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.05)
+        assert all(m.header.frame_id != 'other' for m in received[count:])
     finally:
         executor.shutdown()
         listener.destroy_node()

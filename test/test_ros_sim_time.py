@@ -35,8 +35,13 @@ def test_a_clock_set_back_keeps_the_search_going_and_a_late_clock_is_no_stall(co
     namespace = '/sim_time_jump'
     node = GazeControllerNode(context=context, namespace=namespace, parameter_overrides=[
         Parameter('use_sim_time', value=True), Parameter('settle_time_s', value=0.2),
-        Parameter('policy.name', value='elm'), Parameter('evidence_queue_depth', value=10)])
+        Parameter('policy.name', value='elm'), Parameter('evidence_queue_depth', value=10),
+        Parameter('retry_period_s', value=0.0)])
     source = Node('sim_time_source', namespace=namespace, context=context)
+    from ipomdp_gaze.nodes.controller import STATE_QOS
+    from sensor_msgs.msg import JointState
+    targets = []
+    source.create_subscription(JointState, 'pan_tilt', targets.append, STATE_QOS)
     clock = source.create_publisher(Clock, '/clock', 10)
     evidence = source.create_publisher(Float32MultiArray, 'evidence', 10)
     executor = SingleThreadedExecutor(context=context)
@@ -65,6 +70,10 @@ def test_a_clock_set_back_keeps_the_search_going_and_a_late_clock_is_no_stall(co
         assert tick(2001.0) and frame_applied()
         assert tick(2002.0) and frame_applied()
         assert tick(100.0) and tick(101.0)            # set back, as a looped bag does
+        # The target goes out again on the new clock (retries are off: the detector would
+        # otherwise wait from the old one for good).
+        assert _spin_until(executor, lambda: targets and targets[-1].header.stamp.sec in
+                           (100, 101), 10.0), [t.header.stamp.sec for t in targets]
         assert frame_applied(), node.core.counters()
         assert tick(102.0) and frame_applied()
         assert node.core.seconds_without_evidence(node._now_s()) < 1.0

@@ -471,9 +471,9 @@ def _report(args, r7, r11, others, specs, planner_ms, curves):
               f'{PLANNER_CHUNK} episodes) divided by its decisions (this machine). Its '
               "rollouts run in float32, whose last bits depend on the CPU's vector "
               "instructions and on BLAS's thread count (`ipomdp-gaze` runs BLAS on one thread "
-              'unless OPENBLAS_NUM_THREADS is set; on two, this row read 7.64), so on another '
-              'machine a few of its choices, and the last digit of its rows, may differ (every '
-              'other row is computed in float64).',
+              'unless OPENBLAS_NUM_THREADS or OMP_NUM_THREADS is set; on two, this row read '
+              '7.64), so on another machine a few of its choices, and the last digit of its '
+              'rows, may differ (every other row is computed in float64).',
               '', '![Fig. 4a](figures/fig4a_percent_correct.png)', '']
 
     lines += ['## 11x11 (121-AFC), human FPOC: infomax-trained vs fixate-target-trained', '',

@@ -363,7 +363,7 @@ class GazeControllerNode(QuietPublishers, Node):
                 (ov['retry_period_s'], ov['diagnostics_period_s']):
             self._make_timers(v)
         self._make_room_publishers()
-        if self._people_published is not None and (
+        if self._many and self._people_published is not None and (
                 v['room.frame_id'] != ov['room.frame_id'] or cfg.head != old.head):
             self._publish_people(self._people_published)      # the same people, new poses
         # Many targets still or moving are two searches (the people of a pass, or followed):
@@ -449,6 +449,8 @@ class GazeControllerNode(QuietPublishers, Node):
             return
         self.core.shift_clock(delta_s)
         self._health = HealthMonitor(now_s, self.core.received, self.core.rejected)
+        if self.core.enabled and not self.core.stopped and self._pan_tilt_msg is not None:
+            self._send_target()     # stamped on the new clock (retry_period_s may be 0: never)
         self.get_logger().info(f'the clock jumped {delta_s:+.3f} s: the search keeps its '
                                f'belief and counts its times from the new clock',
                                throttle_duration_sec=WARN_THROTTLE_S)

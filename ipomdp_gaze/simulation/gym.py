@@ -33,7 +33,7 @@ N + 1 hypotheses, and an episode also terminates when ``P(absent)`` reaches ``co
 A count model with scan tables (``faces-420`` and the other calibrated face models) starts each
 episode with its one-time whole-image scan, drawn at reset (``scan=False``: from the uniform
 prior), as the simulation, training and ``find`` start (docs/design.md section 6.8): the first
-observation is the scanned belief.
+observation is the scanned belief (``observe='evidence'``: the scan's counts).
 """
 from __future__ import annotations
 
@@ -184,12 +184,13 @@ class VisualSearchEnv(gymnasium.Env):
             self._present = self.absent_rate == 0 or \
                 bool(self.np_random.random() >= self.absent_rate)
         self.session.reset()
+        self._evidence = np.zeros(n)
         if self.scan:
             counts = self.model.sample_scan(self._target, self.np_random, present=self._present)
             self.session.scan(Frame(counts, kind='scan'))
+            self._evidence = counts
         self.session.start()
         self._started = True
-        self._evidence = np.zeros(n)
         self._fixation = self.start_cell
         self._steps = 0
         return self._obs(), self._info()

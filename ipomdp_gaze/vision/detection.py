@@ -510,9 +510,7 @@ class DetectorLoop:
         self.fixations += 1
         self.inputs['fixation'][0] += 1
         now_s = float(now_s)
-        if self.pending is not None and now_s < self.pending[1]:
-            self._images.clear()
-            self.pending = None
+        self._clock_went_back(now_s)
         resent = self.pending is not None and self.pending[0] == cell \
             and search_id == self.search_id
         self.search_id = search_id
@@ -531,9 +529,16 @@ class DetectorLoop:
         """
         self.fixations += 1
         self.inputs['fixation'][0] += 1
+        self._clock_went_back(float(now_s))
         self.search_id = int(search_id)
         self.pending = (None, float(now_s))
         return self.serve()
+
+    def _clock_went_back(self, now_s: float) -> None:
+        """Before a command stamped earlier than the one waiting: the images kept go."""
+        if self.pending is not None and now_s < self.pending[1]:
+            self._images.clear()
+            self.pending = None
 
     def add_image(self, stamp_s: float, image: np.ndarray, token=None,
                   now_s: float | None = None) -> Outcome:
