@@ -592,12 +592,19 @@ class OccupancySession:
         computation gives. They stay allocated with the session: 16 N^2 bytes (2 MB on 21x21,
         45 MB on 41x41, 270 MB on 64x64), which a full computation allocated anew each call.
         """
-        table, rw = self.table, self.settings.repeat_weight
-        best = self._best
-        key = (table, rw, self.link > 0)
+        table, rw, best = self.table, self.settings.repeat_weight, self._best
+
+        def columns(cols):
+            """Return the terms of the columns ``cols`` (a slice or indices), as :attr:`table`."""
+            weight = np.where(self._view_info[:, cols] > best[None, cols], 1.0, rw)
+            if settled is not None:
+                weight = weight * ~settled[None, cols]
+            info = np.take(table.by_channel(log_odds).ravel(), table.flat_pair[:, cols])
+            return info, weight
+
         c = self._gain_cache
-        if c is not None and c['key'][0] is table and c['key'][1:] == key[1:] \
-                and c['log_odds'].shape == log_odds.shape:
+        if c is not None and c['table'] is table and c['rw'] == rw \
+                and (c['settled'] is None) == (settled is None):
             changed = (c['log_odds'] != log_odds) | (c['best'] != best)
             if settled is not None:
                 changed |= c['settled'] != settled
@@ -605,22 +612,12 @@ class OccupancySession:
             # NaN never equals itself: such a column is recomputed on every call, as before.
             if cols.size <= log_odds.size // 4:
                 if cols.size:
-                    info, weight = c['info'], c['weight']
-                    by_channel = table.by_channel(log_odds).ravel()
-                    info[:, cols] = np.take(by_channel, table.flat_pair[:, cols])
-                    w = np.where(self._view_info[:, cols] > best[None, cols], 1.0, rw)
-                    if settled is not None:
-                        w = w * ~settled[None, cols]
-                    weight[:, cols] = w
+                    c['info'][:, cols], c['weight'][:, cols] = columns(cols)
                     c['log_odds'][cols], c['best'][cols] = log_odds[cols], best[cols]
-                    if settled is not None:
-                        c['settled'] = settled.copy()
+                    c['settled'] = None if settled is None else settled.copy()
                 return c['info'], c['weight']
-        info = table(log_odds)                                             # (N, N) [k, j]
-        weight = np.where(self._view_info > best[None, :], 1.0, rw)
-        if settled is not None:
-            weight = weight * ~settled[None, :]
-        self._gain_cache = {'key': key, 'info': info, 'weight': weight,
+        info, weight = columns(slice(None))
+        self._gain_cache = {'table': table, 'rw': rw, 'info': info, 'weight': weight,
                             'log_odds': log_odds.copy(), 'best': best.copy(),
                             'settled': None if settled is None else settled.copy()}
         return info, weight
