@@ -193,12 +193,12 @@ def test_max_steps_below_one_is_refused():
 
 
 @pytest.mark.parametrize('kwargs, words', [
-    ({'max_steps': 2.5}, 'max_steps must be an integer, got 2.5'),
-    ({'max_steps': '10'}, "max_steps must be an integer, got '10'"),
-    ({'max_steps': True}, 'max_steps must be an integer, got True'),
-    ({'max_steps': float('inf')}, 'max_steps must be an integer, got inf'),
-    ({'start_cell': 2.5}, 'start_cell must be an integer'),
-    ({'start_cell': True}, 'start_cell must be an integer'),
+    ({'max_steps': 2.5}, 'max_steps must be a non-negative integer, got 2.5'),
+    ({'max_steps': '10'}, "max_steps must be a non-negative integer, got '10'"),
+    ({'max_steps': True}, 'max_steps must be a non-negative integer, got True'),
+    ({'max_steps': float('inf')}, 'max_steps must be a non-negative integer, got inf'),
+    ({'start_cell': 2.5}, 'start_cell must be a non-negative integer'),
+    ({'start_cell': True}, 'start_cell must be a non-negative integer'),
     ({'scan': 'yes'}, 'scan must be True or False'),
 ])
 def test_integer_arguments_are_refused_not_truncated(kwargs, words):

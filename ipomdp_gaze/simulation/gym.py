@@ -37,13 +37,13 @@ observation is the scanned belief (``observe='evidence'``: the scan's counts).
 """
 from __future__ import annotations
 
-import operator
 from pathlib import Path
 
 import gymnasium
 from gymnasium import spaces
 from ipomdp_gaze.files.render import belief_heatmap, belief_text
 from ipomdp_gaze.model.belief import map_cell
+from ipomdp_gaze.model.checks import positive_int
 from ipomdp_gaze.model.fpoc import FPOC, make_fpoc
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.motion import check_probability
@@ -113,11 +113,12 @@ class VisualSearchEnv(gymnasium.Env):
         self.absent_rate = check_probability(absent_rate, 'absent_rate')
         self.reward_name, self.observe = reward, observe
         self.confidence = self.settings.confidence
-        self.max_steps = n if max_steps is None else _whole(max_steps, 'max_steps')
+        self.max_steps = n if max_steps is None else \
+            positive_int('max_steps', max_steps, allow_zero=True)
         if self.max_steps < 1:
             raise ValueError(f'max_steps must be at least 1, got {max_steps!r}')
         self.start_cell = self.grid.center_index if start_cell is None else \
-            _whole(start_cell, 'start_cell')
+            positive_int('start_cell', start_cell, allow_zero=True)
         if not 0 <= self.start_cell < n:
             raise ValueError(f'start_cell must be a cell index below {n}, got {start_cell!r}')
         self.render_mode = render_mode
@@ -196,13 +197,11 @@ class VisualSearchEnv(gymnasium.Env):
         return self._obs(), self._info()
 
     def step(self, action):
-        try:
-            k = _whole(action, 'action')
-        except ValueError:
-            k = -1
-        if not self.action_space.contains(k):
+        # The space's own test, which also takes numpy integers; a bool it would take as 0 or 1
+        if isinstance(action, (bool, np.bool_)) or not self.action_space.contains(action):
             raise ValueError(
                 f'action must be a cell index in [0, {self.grid.n_cells}), got {action!r}')
+        k = int(action)
         if not self._started:
             raise gymnasium.error.ResetNeeded('call reset() before step()')
         if self.session.ended or self._steps >= self.max_steps:
@@ -231,16 +230,6 @@ class VisualSearchEnv(gymnasium.Env):
         if self.render_mode == 'ansi':
             return belief_text(self.belief, *self.grid.shape, self._fixation)
         return None
-
-
-def _whole(value, name: str) -> int:
-    """Return an integer argument as an int; a float, a string or a bool is refused."""
-    if isinstance(value, (bool, np.bool_)):
-        raise ValueError(f'{name} must be an integer, got {value!r}')
-    try:
-        return operator.index(value)
-    except TypeError:
-        raise ValueError(f'{name} must be an integer, got {value!r}') from None
 
 
 def register_env() -> None:
