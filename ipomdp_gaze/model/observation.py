@@ -37,6 +37,14 @@ MATRIX_MAX_CELLS = 4096
 MAX_LOG_RATIO = 50.0
 
 
+def _numbers(observation) -> np.ndarray:
+    """Return evidence as a float64 array; strings or objects are an :class:`EvidenceError`."""
+    try:
+        return np.asarray(observation, dtype=float)
+    except (TypeError, ValueError):
+        raise EvidenceError('evidence must be numbers') from None
+
+
 def check_evidence(observation, n_cells: int) -> np.ndarray:
     """
     Validate one frame of evidence and return it as a float64 array of shape (N,).
@@ -50,10 +58,7 @@ def check_evidence(observation, n_cells: int) -> np.ndarray:
         With the reason, when the frame cannot be used.
 
     """
-    try:
-        obs = np.asarray(observation, dtype=float)
-    except (TypeError, ValueError):
-        raise EvidenceError('evidence must be numbers') from None
+    obs = _numbers(observation)
     if obs.ndim != 1 or obs.size != n_cells:
         raise EvidenceError(f'evidence has {obs.size} values in shape {obs.shape}, '
                             f'expected {n_cells}: shape ({n_cells},), one per cell, row-major')
@@ -76,10 +81,7 @@ def check_frames_shape(observation, n_cells: int) -> np.ndarray:
     if type(observation) is np.ndarray and observation.dtype == np.float64 \
             and observation.shape == (n_cells,):
         return observation                      # a checked frame (the sessions'): as it is
-    try:
-        obs = np.asarray(observation, dtype=float)
-    except (TypeError, ValueError):
-        raise EvidenceError('evidence must be numbers') from None
+    obs = _numbers(observation)
     if obs.ndim not in (1, 2) or obs.shape[-1] != n_cells:
         raise EvidenceError(f'evidence has shape {obs.shape}, expected ({n_cells},) or '
                             f'(episodes, {n_cells}): one value per cell, row-major')
