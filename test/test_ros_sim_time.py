@@ -23,107 +23,104 @@ def _spin_until(executor, condition, timeout_s: float) -> bool:
     return condition()
 
 
+class SimClockRig:
+    """An in-process controller and a node of this test that drives /clock and the evidence."""
+
+    def __init__(self, context, namespace: str, **parameters):
+        from ipomdp_gaze.nodes.controller import GazeControllerNode, STATE_QOS
+        from rclpy.executors import SingleThreadedExecutor
+        from rclpy.node import Node
+        from rclpy.parameter import Parameter
+        from rosgraph_msgs.msg import Clock
+        from sensor_msgs.msg import JointState
+        from std_msgs.msg import Float32MultiArray
+        parameters = {'settle_time_s': 0.2, 'policy.name': 'elm', 'evidence_queue_depth': 10,
+                      **parameters}
+        self.node = GazeControllerNode(context=context, namespace=namespace, parameter_overrides=[
+            Parameter(name, value=value) for name, value in parameters.items()])
+        self.source = Node(f'{namespace.strip("/")}_source', namespace=namespace,
+                           context=context)
+        self.targets = []
+        self.source.create_subscription(JointState, 'pan_tilt', self.targets.append, STATE_QOS)
+        self.clock = self.source.create_publisher(Clock, '/clock', 10)
+        self.evidence = self.source.create_publisher(Float32MultiArray, 'evidence', 10)
+        self.executor = SingleThreadedExecutor(context=context)
+        self.executor.add_node(self.node)
+        self.executor.add_node(self.source)
+
+    def spin_until(self, condition, timeout_s: float = 10.0) -> bool:
+        return _spin_until(self.executor, condition, timeout_s)
+
+    def connected(self) -> bool:
+        return self.spin_until(lambda: self.clock.get_subscription_count() > 0
+                               and self.evidence.get_subscription_count() > 0, 30.0)
+
+    def tick(self, seconds: float) -> bool:
+        """Publish /clock at ``seconds``; whether the controller's clock reads it."""
+        from builtin_interfaces.msg import Time as TimeMsg
+        from rosgraph_msgs.msg import Clock
+        self.clock.publish(Clock(clock=TimeMsg(sec=int(seconds),
+                                               nanosec=int(seconds % 1 * 1e9))))
+        return self.spin_until(lambda: abs(self.node._now_s() - seconds) < 1e-6)
+
+    def frame_applied(self) -> bool:
+        """Send a frame of zeros; whether the controller applied it (not skipped)."""
+        from std_msgs.msg import Float32MultiArray
+        core = self.node.core
+        before = core.counters()
+        n = self.node._config.grid.n_cells
+        self.evidence.publish(Float32MultiArray(data=np.zeros(n, np.float32).tolist()))
+        assert self.spin_until(lambda: core.counters()['received'] > before['received'])
+        return core.counters()['applied'] > before['applied']
+
+    def close(self) -> None:
+        self.executor.shutdown()
+        self.source.destroy_node()
+        self.node.destroy_node()
+
+
 def test_a_clock_set_back_keeps_the_search_going_and_a_late_clock_is_no_stall(context):
     """QA: after /clock jumped back every frame was skipped as taken before the head settled."""
-    from builtin_interfaces.msg import Time as TimeMsg
-    from ipomdp_gaze.nodes.controller import GazeControllerNode
-    from rclpy.executors import SingleThreadedExecutor
-    from rclpy.node import Node
-    from rclpy.parameter import Parameter
-    from rosgraph_msgs.msg import Clock
-    from std_msgs.msg import Float32MultiArray
-    namespace = '/sim_time_jump'
-    node = GazeControllerNode(context=context, namespace=namespace, parameter_overrides=[
-        Parameter('use_sim_time', value=True), Parameter('settle_time_s', value=0.2),
-        Parameter('policy.name', value='elm'), Parameter('evidence_queue_depth', value=10),
-        Parameter('retry_period_s', value=0.0)])
-    source = Node('sim_time_source', namespace=namespace, context=context)
-    from ipomdp_gaze.nodes.controller import STATE_QOS
-    from sensor_msgs.msg import JointState
-    targets = []
-    source.create_subscription(JointState, 'pan_tilt', targets.append, STATE_QOS)
-    clock = source.create_publisher(Clock, '/clock', 10)
-    evidence = source.create_publisher(Float32MultiArray, 'evidence', 10)
-    executor = SingleThreadedExecutor(context=context)
-    executor.add_node(node)
-    executor.add_node(source)
-    n = node._config.grid.n_cells
-
-    def tick(seconds: float) -> bool:
-        clock.publish(Clock(clock=TimeMsg(sec=int(seconds), nanosec=int(seconds % 1 * 1e9))))
-        return _spin_until(executor, lambda: abs(node._now_s() - seconds) < 1e-6, 10.0)
-
-    def frame_applied() -> bool:
-        before = node.core.counters()
-        evidence.publish(Float32MultiArray(data=np.zeros(n, np.float32).tolist()))
-        assert _spin_until(executor, lambda: node.core.counters()['received']
-                           > before['received'], 10.0)
-        return node.core.counters()['applied'] > before['applied']
-
+    rig = SimClockRig(context, '/sim_time_jump', use_sim_time=True, retry_period_s=0.0)
+    node = rig.node
     try:
-        assert _spin_until(executor, lambda: clock.get_subscription_count() > 0
-                           and evidence.get_subscription_count() > 0, 30.0)
+        assert rig.connected()
         assert node._now_s() == 0.0                   # no /clock yet: sim time 0
-        assert tick(2000.0)
+        assert rig.tick(2000.0)
         # The first tick is a jump of 2000 s: not 2000 s without evidence.
         assert node.core.seconds_without_evidence(node._now_s()) < 1.0
-        assert tick(2001.0) and frame_applied()
-        assert tick(2002.0) and frame_applied()
-        assert tick(100.0) and tick(101.0)            # set back, as a looped bag does
+        assert rig.tick(2001.0) and rig.frame_applied()
+        assert rig.tick(2002.0) and rig.frame_applied()
+        assert rig.tick(100.0) and rig.tick(101.0)    # set back, as a looped bag does
         # The target goes out again on the new clock (retries are off: the detector would
         # otherwise wait from the old one for good).
-        assert _spin_until(executor, lambda: targets and targets[-1].header.stamp.sec in
-                           (100, 101), 10.0), [t.header.stamp.sec for t in targets]
-        assert frame_applied(), node.core.counters()
-        assert tick(102.0) and frame_applied()
+        assert rig.spin_until(lambda: rig.targets and rig.targets[-1].header.stamp.sec in
+                              (100, 101)), [t.header.stamp.sec for t in rig.targets]
+        assert rig.frame_applied(), node.core.counters()
+        assert rig.tick(102.0) and rig.frame_applied()
         assert node.core.seconds_without_evidence(node._now_s()) < 1.0
         # A clock that runs ahead fast (a simulation faster than real time): time that passed.
-        assert tick(112.0)
+        assert rig.tick(112.0)
         assert node.core.seconds_without_evidence(node._now_s()) == pytest.approx(10.0)
-        assert frame_applied()
+        assert rig.frame_applied()
     finally:
-        executor.shutdown()
-        source.destroy_node()
-        node.destroy_node()
+        rig.close()
 
 
 def test_use_sim_time_turned_on_at_run_time_moves_the_search_to_the_new_clock(context):
     """Review: rcl reports the switch as a jump of 0, so the target stayed at system time."""
-    from builtin_interfaces.msg import Time as TimeMsg
-    from ipomdp_gaze.nodes.controller import GazeControllerNode
-    from rclpy.executors import SingleThreadedExecutor
-    from rclpy.node import Node
     from rclpy.parameter import Parameter
-    from rosgraph_msgs.msg import Clock
-    from std_msgs.msg import Float32MultiArray
-    namespace = '/sim_time_switch'
-    node = GazeControllerNode(context=context, namespace=namespace, parameter_overrides=[
-        Parameter('settle_time_s', value=0.2), Parameter('policy.name', value='elm'),
-        Parameter('evidence_queue_depth', value=10)])
-    source = Node('sim_time_switch_source', namespace=namespace, context=context)
-    clock = source.create_publisher(Clock, '/clock', 10)
-    evidence = source.create_publisher(Float32MultiArray, 'evidence', 10)
-    executor = SingleThreadedExecutor(context=context)
-    executor.add_node(node)
-    executor.add_node(source)
-    n = node._config.grid.n_cells
+    rig = SimClockRig(context, '/sim_time_switch')
+    node = rig.node
     try:
         assert node._now_s() > 1e9                     # system time
         assert node.set_parameters([Parameter('use_sim_time', value=True)])[0].successful
-        assert _spin_until(executor, lambda: clock.get_subscription_count() > 0
-                           and evidence.get_subscription_count() > 0, 30.0)
-        for seconds in (50.0, 51.0):
-            clock.publish(Clock(clock=TimeMsg(sec=int(seconds))))
-            assert _spin_until(executor, lambda: node._now_s() == seconds, 10.0)
+        assert rig.connected()
+        assert rig.tick(50.0) and rig.tick(51.0)
         assert node.core.target_time_s <= 51.0
-        before = node.core.counters()['applied']
-        evidence.publish(Float32MultiArray(data=np.zeros(n, np.float32).tolist()))
-        assert _spin_until(executor, lambda: node.core.counters()['applied'] > before, 10.0), \
-            node.core.counters()
+        assert rig.frame_applied(), node.core.counters()
     finally:
-        executor.shutdown()
-        source.destroy_node()
-        node.destroy_node()
+        rig.close()
 
 
 @pytest.mark.parametrize('which', ['controller', 'camera'])
