@@ -64,6 +64,24 @@ def test_settled_frame_updates_the_belief_and_the_policy_picks_the_next_fixation
     assert core.target_time_s == 0.7 and core.fixations == 1
 
 
+def test_the_event_log_is_kept_only_when_asked_and_changes_no_search():
+    """No log by default (the node's topics are its record); ``log_size`` keeps one."""
+    frames = np.random.default_rng(5).standard_normal((6, 121))
+    runs = []
+    for log_size in (0, 100):
+        policy = build_policy('elm', GRID, CAMERA)
+        core = GazeController(GRID, CAMERA, policy, SearchSettings(), 0.0, log_size=log_size)
+        core.reset(0.0)
+        runs.append([(core.offer(f, stamp_s=1.0 + i).fixation, core.belief.tobytes())
+                     for i, f in enumerate(frames)])
+        kinds = [event['event'] for event in core.session.log]
+        assert kinds.count('frame') == (6 if log_size else 0)
+        assert ('reset' in kinds) == bool(log_size)
+        core.configure(SearchSettings(targets='many'))      # a new session keeps the size
+        assert bool(core.session.log) == bool(log_size)
+    assert runs[0] == runs[1]
+
+
 def test_one_frame_per_fixation():
     core = controller(settle_time_s=0.5)
     rng = np.random.default_rng(2)

@@ -48,6 +48,25 @@ def test_batched_ratio_equals_one_frame_at_a_time():
         MODEL.log_likelihood_ratio(frames, fixations, validate=False), batch)
 
 
+@pytest.mark.parametrize('side', [3, 15, 16])
+def test_one_fixation_reads_the_same_dprime_on_small_and_large_grids(side):
+    """A small grid's rows of the (fixation, cell) matrix equal the offset table's window."""
+    grid = Grid(side, side + 1)                 # 240 cells read rows, 272 the window
+    model = GaussianObservation(grid, make_fpoc('human'))
+    for k in (0, grid.n_cells // 2, grid.n_cells - 1):
+        one = model.dprime(k)
+        window = model.dprime_window(k).reshape(-1)
+        np.testing.assert_array_equal(one, window)
+        if one.flags.writeable:                 # a copy: writing it changes nothing
+            one[:] = -1.0
+        else:
+            with pytest.raises(ValueError):
+                one[0] = 1.0                    # a shared row: read-only
+        np.testing.assert_array_equal(model.dprime(k), window)
+    with pytest.raises(ValueError, match='outside'):
+        model.dprime(grid.n_cells)
+
+
 def test_a_frame_that_overflows_is_refused():
     frame = np.zeros(GRID.n_cells)
     frame[3] = 1e308

@@ -7,7 +7,8 @@ from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.motion import Motion
 from ipomdp_gaze.model.observation import CountObservation, GaussianObservation
 from ipomdp_gaze.model.stopping import (ABSENT, check_absent_prior, check_confidence,
-                                        check_max_fixations, decide, first_decisions, FOUND,
+                                        check_max_fixations, decide, decide_one,
+                                        first_decisions, FOUND,
                                         GAVE_UP, initial_log_belief, UNDECIDED)
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.simulation.evaluation import (decision_summary, paired_tracking_difference,
@@ -173,6 +174,15 @@ def test_decide_found_absent_and_undecided():
     assert decide(0.45, 0.45, 0.4) == FOUND
     np.testing.assert_array_equal(decide([0.99, 0.1, 0.3], [0.0, 0.9, 0.3], 0.9),
                                   [FOUND, ABSENT, UNDECIDED])
+
+
+def test_decide_one_is_decide_for_every_pair():
+    """The session's scalar rule gives the array rule's code, at ties, the level and NaN."""
+    values = [0.0, 0.2, 0.45, 0.5, 0.9, 0.95, 0.99, 1.0, float('nan')]
+    for confidence in (0.4, 0.5, 0.95, 0.99):
+        for cell in values:
+            for absent in values:
+                assert decide_one(cell, absent, confidence) == decide(cell, absent, confidence)
 
 
 def test_first_decision_of_each_sequence():

@@ -33,6 +33,9 @@ import numpy as np
 OVERFLOW_REASON = 'evidence too large: d * (o - d/2) overflows float64'
 # Largest grid whose (fixation, cell) d' matrix is kept for batched look-ups (8 * N^2 bytes).
 MATRIX_MAX_CELLS = 4096
+# Largest grid whose single-fixation look-ups read that matrix's rows too (contiguous, no copy;
+# 512 KiB at most), built on the first frame: a frame's d' was a strided window copied each time.
+ROW_MAX_CELLS = 256
 # Log-likelihood ratio of a count one hypothesis forbids: decisive, but finite.
 MAX_LOG_RATIO = 50.0
 
@@ -200,11 +203,14 @@ class GaussianObservation:
                                  f'{MATRIX_MAX_CELLS} cells')
             ri, ci = self.grid.pair_offset_index()
             self._by_fixation = np.ascontiguousarray(self.table[ri, ci])
+            self._by_fixation.flags.writeable = False      # its rows are handed out
         return self._by_fixation
 
     def dprime(self, fixation) -> np.ndarray:
         """``d_jk`` of every cell j: shape (N,) for one fixation, (E, N) for E fixations."""
         if np.ndim(fixation) == 0:
+            if self.grid.n_cells <= ROW_MAX_CELLS:
+                return self.dprime_by_fixation()[_fixation_index(self.grid, fixation)]
             return self.dprime_window(fixation).reshape(-1)
         return self.dprime_by_fixation()[np.asarray(fixation, dtype=np.intp)]
 

@@ -89,6 +89,20 @@ def decide(map_probability, absent_probability, confidence: float) -> np.ndarray
     return np.where(found, FOUND, np.where(gone, ABSENT, UNDECIDED))
 
 
+def decide_one(map_probability: float, absent_probability: float, confidence: float) -> int:
+    """
+    Return :func:`decide`'s code for one search, in Python floats.
+
+    The same rule and the same code for every value, NaN included (a search session decides
+    once per frame, where numpy's scalar overhead was most of the rule's cost).
+    """
+    if map_probability >= confidence and map_probability >= absent_probability:
+        return FOUND
+    if absent_probability >= confidence and absent_probability > map_probability:
+        return ABSENT
+    return UNDECIDED
+
+
 def first_decisions(map_probability: np.ndarray, absent_probability, confidence: float,
                     max_fixations: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """

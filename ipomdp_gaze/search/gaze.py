@@ -182,9 +182,13 @@ class FrameResult:
         return self.status == 'applied'
 
 
-def make_session(grid: Grid, observation, policy, settings: SearchSettings):
+def make_session(grid: Grid, observation, policy, settings: SearchSettings, log_size: int = 0):
     """
     Return a new search session of the belief ``settings.targets`` names.
+
+    It keeps the newest ``log_size`` events of :attr:`SearchSession.log`; the controller keeps
+    none by default (its frame results and the node's topics say what happened, and building
+    an event per frame was a fifth of the 11x11 controller's per-frame time).
 
     ``one``: :class:`ipomdp_gaze.search.session.SearchSession` (the paper's belief); ``many``:
     :class:`ipomdp_gaze.search.many.OccupancySession` with ``link`` :data:`ROOM_LINK`
@@ -192,10 +196,11 @@ def make_session(grid: Grid, observation, policy, settings: SearchSettings):
     search is then one pass of its poses (section 11.7).
     """
     if settings.targets == 'many':
-        session = OccupancySession(grid, observation, settings, link=ROOM_LINK, log_size=1000)
+        session = OccupancySession(grid, observation, settings, link=ROOM_LINK,
+                                   log_size=log_size)
         session.set_policy(policy)
     else:
-        session = SearchSession(grid, observation, policy, settings, log_size=1000)
+        session = SearchSession(grid, observation, policy, settings, log_size=log_size)
     return session
 
 
@@ -249,15 +254,20 @@ class GazeController:
         Frames stamped earlier than this after the target was sent are skipped.
     seed
         Seed of the generator handed to the policy (``random``, ``sample``).
+    log_size
+        Events the session keeps in its log (:attr:`SearchSession.log`); 0, the default, keeps
+        none.
 
     """
 
     def __init__(self, grid: Grid, observation, policy, settings: SearchSettings | None = None,
                  settle_time_s: float = 0.0, seed: int = 0,
-                 stamp_tolerance_s: float = STAMP_TOLERANCE_S):
+                 stamp_tolerance_s: float = STAMP_TOLERANCE_S, log_size: int = 0):
         self.grid = grid
         self.stamp_tolerance_s = float(stamp_tolerance_s)
-        self.session = make_session(grid, observation, policy, settings or SearchSettings())
+        self.log_size = int(log_size)
+        self.session = make_session(grid, observation, policy, settings or SearchSettings(),
+                                    self.log_size)
         self.settle_time_s = check_settle_time(settle_time_s)
         self.session.reset(seed=seed)
         self.search_id = 0
@@ -288,7 +298,8 @@ class GazeController:
             self.settle_time_s = check_settle_time(settle_time_s)
         if settings.targets != self.settings.targets:
             rng = self.session.rng
-            self.session = make_session(self.grid, self.observation, self.policy, settings)
+            self.session = make_session(self.grid, self.observation, self.policy, settings,
+                                        self.log_size)
             self.session.reset(seed=rng)
             self.reset(self.target_time_s)
             return

@@ -137,7 +137,7 @@ class OccupancySession:
         ``(1 - c) / c``). Off: the posterior ``P <= 1 - c`` decides, and a sparse prior
         decides every cell nobody looked at (``find`` chooses that, for its cost).
     log_size : int
-        Events kept in :attr:`log`.
+        Events kept in :attr:`log`; 0 keeps none, and the per-frame events are not built.
 
     """
 
@@ -543,9 +543,10 @@ class OccupancySession:
                 fired = self._end_pass() if self.passing else self._limit('repeat')
             else:
                 s['fixation'] = following
-        self._event('frame', fixation=self._rc(k), frame=frame.summary(),
-                    belief=self._summary(), decision=s['decision'], fired=fired,
-                    reason=s['reason'], people=list(self.people_events))
+        if self._log.maxlen:
+            self._event('frame', fixation=self._rc(k), frame=frame.summary(),
+                        belief=self._summary(), decision=s['decision'], fired=fired,
+                        reason=s['reason'], people=list(self.people_events))
         return self._result('applied', fired=fired)
 
     def stop(self, reason: str) -> StepResult:

@@ -49,7 +49,7 @@ from ipomdp_gaze.model.motion import Motion, VelocityMotion
 from ipomdp_gaze.model.observation import as_observation, check_evidence, CountObservation
 from ipomdp_gaze.model.position_filter import GATE_CELLS, measured_position, PositionFilter
 from ipomdp_gaze.model.still_evidence import cell_information, StillEvidence
-from ipomdp_gaze.model.stopping import ABSENT, decide, FOUND, initial_log_belief, with_absent
+from ipomdp_gaze.model.stopping import ABSENT, decide_one, FOUND, initial_log_belief, with_absent
 from ipomdp_gaze.model.view_reach import ViewReach
 from ipomdp_gaze.search.settings import parameter_names, settings_class
 import numpy as np
@@ -411,7 +411,9 @@ class SearchSession:
     settings : SearchSettings
         Checked already; the start cell is checked against ``grid`` here.
     log_size : int
-        Events kept in :attr:`log` (the newest); a tracking search never ends.
+        Events kept in :attr:`log` (the newest); a tracking search never ends. 0 keeps none,
+        and the per-frame events are not even built (the gaze controller's: its results and
+        the node's topics say what happened).
 
     """
 
@@ -859,9 +861,10 @@ class SearchSession:
                 fired = 'gave_up'
             else:
                 search.fixation = following
-        self._event('frame', fixation=self._rc(search.path[-1]), frame=frame.summary(),
-                    belief=self._belief_summary(), decision=search.decision,
-                    fired=fired, reason=search.reason)
+        if self._log.maxlen:
+            self._event('frame', fixation=self._rc(search.path[-1]), frame=frame.summary(),
+                        belief=self._belief_summary(), decision=search.decision,
+                        fired=fired, reason=search.reason)
         return self._result('applied', fired=fired)
 
     # -- inside ------------------------------------------------------------------------------
@@ -907,7 +910,7 @@ class SearchSession:
         """
         search, settings = self._search, self.settings
         peak, absent = float(self._pooled().max()), self.absent_probability
-        code = int(decide(peak, absent, settings.confidence))
+        code = decide_one(peak, absent, settings.confidence)
         decision = {FOUND: 'found', ABSENT: 'absent'}.get(code, '')
         if decision == 'absent' and self._uncovered().size:
             decision = ''                   # search.absent_needs_coverage: not yet (§6.16)
