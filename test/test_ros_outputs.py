@@ -142,3 +142,41 @@ def test_a_new_room_frame_republishes_the_people_in_it(context):
         executor.shutdown()
         listener.destroy_node()
         node.destroy_node()
+
+
+@pytest.mark.parametrize('durability, moves', [('volatile', True), (None, False)])
+def test_a_volatile_teleop_drives_the_camera_with_its_qos_overridden(context, durability, moves):
+    """The command subscription takes ROS's QoS overrides: volatile matches any publisher."""
+    import rclpy
+    from ipomdp_gaze.msg_adapters import joints
+    from ipomdp_gaze.nodes.camera import SimulatedCameraNode
+    from ipomdp_gaze.nodes.qos import STATE_QOS
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.parameter import Parameter
+    from rclpy.qos import DurabilityPolicy
+    from sensor_msgs.msg import JointState
+    name = 'qos_overrides./teleop/pan_tilt.subscription.durability'
+    overrides = [Parameter('rate_hz', value=0.0)]
+    if durability:
+        overrides.append(Parameter(name, value=durability))
+    camera = SimulatedCameraNode(context=context, namespace='/teleop',
+                                 parameter_overrides=overrides)
+    teleop = rclpy.create_node('teleop', context=context, namespace='/teleop')
+    command = teleop.create_publisher(JointState, 'pan_tilt', 10)     # volatile, reliable
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(camera)
+    executor.add_node(teleop)
+    head = camera._config.head
+    corner = camera._config.grid.index(0, 0)
+    try:
+        assert camera.get_parameter(name).value == (durability or 'transient_local')
+        deadline = time.monotonic() + (20.0 if moves else 2.0)
+        while camera.goal != corner and time.monotonic() < deadline:
+            command.publish(joints.joint_state(head, corner, camera.get_clock().now().to_msg()))
+            executor.spin_once(timeout_sec=0.1)
+        assert (camera.goal == corner) is moves
+        assert STATE_QOS.durability == DurabilityPolicy.TRANSIENT_LOCAL     # the shared one
+    finally:
+        executor.shutdown()
+        teleop.destroy_node()
+        camera.destroy_node()

@@ -40,7 +40,6 @@ from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
 from ipomdp_gaze.search.controller_config import fpoc_from, grid_from, head_from, row_col_from
 import numpy as np
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import Image, JointState
 from std_msgs.msg import Float32MultiArray, Int32MultiArray
 from std_srvs.srv import Trigger
@@ -50,13 +49,11 @@ from .guard import CallbackGuard
 from .outputs import QuietPublishers
 from .params import (cell_params, fpoc_params, grid_params, INT_MAX, joint_params, Param,
                      ParameterTransaction, T)
+from .qos import command_subscription, FRAME_QOS, STATE_QOS
 from .saccade import saccade_params, SaccadeMixin
 from .spin import run_node
 
 NODE_NAME = NODE_NAMES['camera']
-FRAME_QOS = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
-STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
-                       durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
 
 def camera_params() -> list[Param]:
@@ -112,8 +109,7 @@ class SimulatedCameraNode(SaccadeMixin, QuietPublishers, Node):
         self._image_pub = self.create_publisher(Image, 'evidence_image', FRAME_QOS)
         self._joint_pub = self.create_publisher(JointState, 'joint_states', 10)
         self._truth_pub = self.create_publisher(Int32MultiArray, 'ground_truth', STATE_QOS)
-        self.create_subscription(JointState, 'pan_tilt', self.guard.wrap(self._on_command),
-                                 STATE_QOS)
+        command_subscription(self, JointState, 'pan_tilt', self.guard.wrap(self._on_command))
         self.create_service(Trigger, '~/reset', self.guard.wrap(self._on_reset))
         self.guard.publish_status()
         self._saccade_timer = self._frame_timer = self._walk_timer = None

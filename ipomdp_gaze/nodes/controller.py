@@ -67,7 +67,7 @@ from rclpy.exceptions import NameValidationException
 from rclpy.expand_topic_name import expand_topic_name
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.validate_full_topic_name import validate_full_topic_name
 from sensor_msgs.msg import Image, JointState
 from std_msgs.msg import Float32MultiArray, Float64MultiArray, Int32MultiArray
@@ -79,11 +79,10 @@ from .guard import CallbackGuard
 from .outputs import QuietPublishers
 from .params import (cell_params, current_values, fpoc_params, grid_params, INT_MAX, joint_params,
                      Param, ParameterTransaction, search_params, T)
+from .qos import STATE_QOS
 from .spin import run_node
 
 NODE_NAME = NODE_NAMES['controller']
-STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
-                       durability=DurabilityPolicy.TRANSIENT_LOCAL)
 WARN_THROTTLE_S = 5.0
 # The fixation is asked for again this long after its settle time has passed (a frame taken
 # then is not skipped on a clock read a hair earlier).

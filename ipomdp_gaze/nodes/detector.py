@@ -49,7 +49,7 @@ from ipomdp_gaze.search.controller_config import head_from
 from ipomdp_gaze.vision.detection import (build_setup, DetectorLoop, DetectorSetup, MAX_AGE_S,
                                           MODES, STAMP_TOLERANCE_S)
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import CameraInfo, Image, JointState
 from std_msgs.msg import Float32MultiArray, Int32MultiArray
 
@@ -58,6 +58,7 @@ from .annotation import Annotator
 from .guard import CallbackGuard
 from .outputs import QuietPublishers
 from .params import joint_params, MAX_CELLS_PER_SIDE, Param, ParameterTransaction, T
+from .qos import command_subscription, FRAME_QOS
 from .spin import run_node
 
 NODE_NAME = NODE_NAMES['detector']
@@ -68,9 +69,6 @@ DISTORTION_WARN_S = 3600.0
 # so the subscription is reliable unless the driver only publishes best effort.
 IMAGE_QOS = {False: QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE),
              True: SENSOR_QOS}
-FRAME_QOS = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
-STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
-                       durability=DurabilityPolicy.TRANSIENT_LOCAL)
 WARN_THROTTLE_S = 5.0
 # A fixation that waits longer than this for a usable image is stuck, not starting up: the log
 # says why (camera_info, joint states), and /diagnostics warns.
@@ -198,8 +196,7 @@ class FovealDetectorNode(QuietPublishers, Node):
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self.create_subscription(Image, 'image', guard.wrap(self._on_image),
                                  IMAGE_QOS[v['image_best_effort']])
-        self.create_subscription(Int32MultiArray, 'fixation', guard.wrap(self._on_fixation),
-                                 STATE_QOS)
+        command_subscription(self, Int32MultiArray, 'fixation', guard.wrap(self._on_fixation))
         if cfg.setup.mode == 'camera':
             self.create_subscription(CameraInfo, 'camera_info', guard.wrap(self._on_camera_info),
                                      SENSOR_QOS)

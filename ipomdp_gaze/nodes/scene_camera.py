@@ -46,7 +46,7 @@ from ipomdp_gaze.model.head_camera import PinholeCamera
 from ipomdp_gaze.msg_adapters import grid_arrays, images, joints
 from ipomdp_gaze.search.controller_config import head_from
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import CameraInfo, Image, JointState
 from std_msgs.msg import Float64MultiArray, Int32MultiArray
 
@@ -54,6 +54,7 @@ from . import NODE_NAMES
 from .guard import CallbackGuard
 from .outputs import QuietPublishers
 from .params import INT_MAX, joint_params, MAX_CELLS_PER_SIDE, Param, ParameterTransaction, T
+from .qos import command_subscription, STATE_QOS
 from .saccade import saccade_params, SaccadeMixin
 from .spin import run_node
 
@@ -65,8 +66,6 @@ SPLITS = ('test', 'train')
 VIEW_GRIDS = {'fixed': (21, 21, 1.0), 'pan_tilt': (11, 11, 5.0)}
 VIEW_FACES = {'fixed': (60, 140), 'pan_tilt': (30, 70)}
 IMAGE_QOS = QoSProfile(depth=2, reliability=ReliabilityPolicy.RELIABLE)
-STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
-                       durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
 
 def scene_camera_params() -> list[Param]:
@@ -233,8 +232,7 @@ class SceneCameraNode(SaccadeMixin, QuietPublishers, Node):
         self._walk_pub = self.create_publisher(Float64MultiArray, 'walk_truth', 10) \
             if cfg.walk is not None else None
         self._walk_start = None
-        self.create_subscription(JointState, 'pan_tilt', self.guard.wrap(self._on_command),
-                                 STATE_QOS)
+        command_subscription(self, JointState, 'pan_tilt', self.guard.wrap(self._on_command))
         self._saccade_timer = self._frame_timer = None
         self._make_timers(cfg.values)
         scene = cfg.scene

@@ -1,0 +1,40 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The QoS profiles the nodes share, and the command subscriptions a user may re-profile.
+
+A target (``pan_tilt``, ``fixation``) is state: reliable, depth 1, transient local, so a node
+that starts later still gets the current one. A subscription that asks for transient local
+matches no volatile publisher (a teleop tool, a driver of one's own): such a publisher is
+reported as incompatible and its commands never arrive. The command subscriptions therefore
+take ROS's start-up QoS overrides, e.g. ``--ros-args -p
+qos_overrides./pan_tilt.subscription.durability:=volatile`` (the topic as resolved, namespace
+included), which matches every publisher; the controller re-sends its target every
+``retry_period_s``, so a volatile subscription still gets it.
+"""
+from __future__ import annotations
+
+from rclpy.qos import DurabilityPolicy, QoSPolicyKind, QoSProfile, ReliabilityPolicy
+from rclpy.qos_overriding_options import QoSOverridingOptions
+
+STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                       durability=DurabilityPolicy.TRANSIENT_LOCAL)
+FRAME_QOS = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
+PROFILE_FIELDS = ('history', 'depth', 'reliability', 'durability', 'lifespan', 'deadline',
+                  'liveliness', 'liveliness_lease_duration',
+                  'avoid_ros_namespace_conventions')
+COMMAND_POLICIES = (QoSPolicyKind.DURABILITY, QoSPolicyKind.RELIABILITY, QoSPolicyKind.DEPTH,
+                    QoSPolicyKind.HISTORY)
+
+
+def command_subscription(node, msg_type, topic: str, callback):
+    """
+    Subscribe a command topic with :data:`STATE_QOS`, overridable at start-up.
+
+    rclpy writes the overrides into the profile it is given, so each subscription gets a copy
+    of its own: the shared profile, which the node's publishers use too, stays as it is.
+    """
+    profile = QoSProfile(**{name: getattr(STATE_QOS, name) for name in PROFILE_FIELDS})
+    return node.create_subscription(
+        msg_type, topic, callback, profile,
+        qos_overriding_options=QoSOverridingOptions(policy_kinds=COMMAND_POLICIES))
