@@ -111,3 +111,34 @@ def test_pieces_of_a_count_model_run_are_its_rows():
 def test_bad_rows_are_refused(rows):
     with pytest.raises(ValueError, match='rows must'):
         simulate(GRID, HUMAN, make_baseline('elm', GRID, HUMAN), 10, 3, seed=0, rows=rows)
+
+
+@pytest.mark.parametrize('targets, message', [
+    ([0, 4, -1], 'cells in 0..8, got -1'),
+    ([0, 4, 9], 'cells in 0..8, got 9'),
+    ([0, 4], r'shape \(3,\)'),
+    ([0.5, 4, 1], 'whole cell indices'),
+])
+def test_given_targets_outside_the_grid_are_refused(targets, message):
+    # A target of -1 used to be accepted: the frames put the signal on the last cell (numpy's
+    # wrap-round) while the score compared the guess with -1, so that episode was never right.
+    grid = Grid(3, 3, 1.0)
+    with pytest.raises(ValueError, match=message):
+        simulate(grid, HUMAN, make_baseline('elm', grid, HUMAN), 3, 4, seed=0, targets=targets)
+
+
+def test_given_targets_are_the_searched_cells():
+    # With a d' so large that one look decides, every episode is right after one fixation at
+    # exactly the targets it was given, whole floats included.
+    grid = Grid(3, 3, 1.0)
+    sure = make_fpoc('table', ecc_deg=[0.0, 5.0], dprime=[40.0, 40.0])
+    targets = np.array([8.0, 0.0, 4.0, 8.0])
+    res = simulate(grid, sure, make_baseline('elm', grid, sure), 4, 1, seed=1, targets=targets)
+    np.testing.assert_array_equal(res.guess[:, 0], [8, 0, 4, 8])
+    assert res.correct.all()
+
+
+def test_present_of_the_wrong_length_is_refused():
+    grid = Grid(3, 3, 1.0)
+    with pytest.raises(ValueError, match='one flag per episode'):
+        simulate(grid, HUMAN, make_baseline('elm', grid, HUMAN), 3, 2, present=[True, False])

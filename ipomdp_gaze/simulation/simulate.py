@@ -168,6 +168,41 @@ def rollout(model, beliefs: BatchBelief, where: np.ndarray, present, horizon: in
                 beliefs.predict(motion)
 
 
+def check_targets(targets, n_cells: int, episodes: int) -> np.ndarray:
+    """
+    Return given target cells as an int64 array of shape ``(episodes,)``.
+
+    A ValueError names what is wrong: a cell outside ``0..N-1`` (a negative one would wrap
+    round to the last cells when the frames are drawn, while the scoring compares the guess with
+    the negative number, so the search could never be right), a fraction or a wrong length.
+    """
+    values = np.asarray(targets)
+    if values.shape != (episodes,):
+        raise ValueError(f'targets must hold one cell per episode, shape ({episodes},), got '
+                         f'shape {values.shape}')
+    if values.dtype.kind not in 'iu':
+        if values.dtype.kind != 'f' or not np.all(np.isfinite(values)) or \
+                np.any(values != np.round(values)):
+            raise ValueError(f'targets must be whole cell indices, got dtype {values.dtype}')
+    values = values.astype(np.int64)
+    bad = (values < 0) | (values >= n_cells)
+    if bad.any():
+        raise ValueError(f'targets must be cells in 0..{n_cells - 1}, got {int(values[bad][0])} '
+                         f'(episode {int(np.flatnonzero(bad)[0])})')
+    return values
+
+
+def check_present(present, episodes: int) -> np.ndarray:
+    """Return ``present`` as a bool array of shape ``(episodes,)`` (ValueError otherwise)."""
+    values = np.asarray(present)
+    if values.shape != (episodes,):
+        raise ValueError(f'present must hold one flag per episode, shape ({episodes},), got '
+                         f'shape {values.shape}')
+    if values.dtype.kind != 'b' and not np.all(np.isin(values, (0, 1))):
+        raise ValueError('present must hold True/False (or 1/0) per episode')
+    return values.astype(bool)
+
+
 def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | None = None,
              seed: int = 0, targets: np.ndarray | None = None, progress=None,
              motion: Motion | None = None, predict: bool = True, absent_prior: float = 0.0,
@@ -225,11 +260,12 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
     if horizon < 1 or episodes < 1:
         raise ValueError('episodes and horizon must be >= 1')
     model = as_observation(grid, model)
-    targets = draw_targets(n, episodes, seed) if targets is None else np.asarray(targets)
+    targets = (draw_targets(n, episodes, seed) if targets is None
+               else check_targets(targets, n, episodes))
     absent_prior = check_absent_prior(absent_prior)
     if present is None:
         present = draw_present(episodes, absent_rate, seed)
-    present = np.asarray(present, dtype=bool)
+    present = check_present(present, episodes)
     total = episodes
     if rows is not None:
         start, stop = check_rows(rows, episodes)
