@@ -142,3 +142,55 @@ def test_present_of_the_wrong_length_is_refused():
     grid = Grid(3, 3, 1.0)
     with pytest.raises(ValueError, match='one flag per episode'):
         simulate(grid, HUMAN, make_baseline('elm', grid, HUMAN), 3, 2, present=[True, False])
+
+
+def test_a_prior_is_where_the_belief_starts_and_the_targets_are_drawn():
+    # The sequential Bayes posterior from the prior (the first test's loop, started at log
+    # prior instead of uniform) gives every fixation, guess and MAP probability of the batch.
+    grid, fpoc = Grid(3, 4, 0.42), make_fpoc('human')
+    prior = np.random.default_rng(4).dirichlet(np.ones(grid.n_cells))
+    policy = make_baseline('elm', grid, fpoc)
+    res = simulate(grid, fpoc, policy, episodes=6, horizon=5, seed=12, prior=prior)
+    d = dprime_matrix(grid, fpoc)
+    for e in range(6):
+        log_b = np.log(prior)
+        for t in range(5):
+            k = int(policy.select(np.exp(log_b)[None], t, None)[0])
+            assert k == res.fixations[e, t]
+            obs = noise_stream(12, t).standard_normal((6, grid.n_cells))[e]
+            obs[res.targets[e]] += d[res.targets[e], k]
+            log_b = bayes_update(log_b, llr(obs, d[:, k]))
+            assert map_cell(np.exp(log_b)) == res.guess[e, t]
+            assert np.exp(log_b).max() == pytest.approx(res.map_prob[e, t], rel=1e-12)
+
+
+def test_with_a_blind_fpoc_the_belief_stays_at_the_prior():
+    grid = Grid(3, 5, 1.0)
+    blind = make_fpoc('table', ecc_deg=[0.0, 5.0], dprime=[0.0, 0.0])
+    prior = np.arange(1.0, 16.0)
+    prior[[0, 7]] = 0.0
+    prior /= prior.sum()
+    res = simulate(grid, blind, make_baseline('elm', grid, blind), 4000, 3, seed=2, prior=prior)
+    assert (res.guess == 14).all()
+    np.testing.assert_allclose(res.map_prob, prior[14], rtol=1e-12)
+    # The infomax reward is the prior's negative entropy (0 log 0 = 0), not NaN.
+    kept = prior[prior > 0]
+    np.testing.assert_allclose(res.infomax, np.sum(kept * np.log(kept)), rtol=1e-12)
+    counts = np.bincount(res.targets, minlength=grid.n_cells)
+    assert counts[[0, 7]].sum() == 0
+    # Targets follow the prior: a chi-square test at a generous level.
+    expected = 4000 * prior[prior > 0]
+    chi2 = np.sum((counts[prior > 0] - expected) ** 2 / expected)
+    assert chi2 < 40.0                                      # 12 dof: p < 1e-4 beyond
+
+
+@pytest.mark.parametrize('prior, message', [
+    (np.full(8, 1 / 8), 'one probability per cell, 9 values'),
+    (np.full(9, 0.1), 'sum to 1, got 0.9'),
+    (np.r_[-0.1, np.full(8, 1.1 / 8)], 'finite and >= 0'),
+    (np.r_[np.nan, np.full(8, 1 / 8)], 'finite and >= 0'),
+])
+def test_bad_priors_are_refused(prior, message):
+    grid = Grid(3, 3, 1.0)
+    with pytest.raises(ValueError, match=message):
+        simulate(grid, HUMAN, make_baseline('elm', grid, HUMAN), 3, 2, prior=prior)

@@ -195,7 +195,8 @@ class BatchBelief:
             self.belief[...] = full[:, :n]
             if self.has_absent:
                 self.absent_probability = full[:, n]
-            return np.sum(full * log_b, axis=1, where=full > 0)
+            with np.errstate(invalid='ignore'):     # 0 * -inf where a cell is 0: not summed
+                return np.sum(full * log_b, axis=1, where=full > 0)
         np.exp(log_b, out=self.belief)
         return np.sum(self.belief * log_b, axis=1)
 

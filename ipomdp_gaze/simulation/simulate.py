@@ -203,11 +203,35 @@ def check_present(present, episodes: int) -> np.ndarray:
     return values.astype(bool)
 
 
+def check_prior(prior, n_cells: int) -> np.ndarray:
+    """
+    Return a prior over the target's cell as a float array (N,) summing to 1.
+
+    A ValueError names what is wrong: the length, a value that is negative or not finite, or a
+    sum other than 1 (within 1e-6; a prior is not renormalised silently). Cells may be 0: the
+    target is never there and the belief keeps them at 0.
+    """
+    values = np.asarray(prior, dtype=float) if not isinstance(prior, np.ndarray) else prior
+    if values.dtype.kind not in 'iuf':
+        raise ValueError(f'prior must be numbers, got dtype {values.dtype}')
+    values = values.astype(float).reshape(-1) if values.ndim == 2 else values.astype(float)
+    if values.shape != (n_cells,):
+        raise ValueError(f'prior must hold one probability per cell, {n_cells} values (rows x '
+                         f'cols, row-major), got shape {np.shape(prior)}')
+    if not np.all(np.isfinite(values)) or np.any(values < 0):
+        raise ValueError('prior must be finite and >= 0 in every cell')
+    total = float(values.sum())
+    if abs(total - 1.0) > 1e-6:
+        raise ValueError(f'prior must sum to 1, got {total:.6g}')
+    return values / total
+
+
 def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | None = None,
              seed: int = 0, targets: np.ndarray | None = None, progress=None,
              motion: Motion | None = None, predict: bool = True, absent_prior: float = 0.0,
              absent_rate: float = 0.0, present: np.ndarray | None = None,
-             rows: tuple[int, int] | None = None, scan: bool = True) -> SearchResult:
+             rows: tuple[int, int] | None = None, scan: bool = True,
+             prior: np.ndarray | None = None) -> SearchResult:
     """
     Run ``episodes`` searches of ``horizon`` fixations (default N) from the prior.
 
@@ -253,6 +277,10 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
         With a count model that has scan tables, first apply the one-time scan (drawn from the
         scan tables, its own stream ``[seed, 5]``), as ``find`` and the fovea do; the first
         fixation is then the policy's choice on the scanned belief.
+    prior : array (N,) or (rows, cols), optional
+        Where the target is a priori (default uniform): every belief starts at it (times
+        ``1 - absent_prior``) and, unless ``targets`` is given, the targets are drawn from it
+        on the seed's target stream (:func:`check_prior`: one value per cell, >= 0, summing to 1).
 
     """
     n = grid.n_cells
@@ -260,8 +288,14 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
     if horizon < 1 or episodes < 1:
         raise ValueError('episodes and horizon must be >= 1')
     model = as_observation(grid, model)
-    targets = (draw_targets(n, episodes, seed) if targets is None
-               else check_targets(targets, n, episodes))
+    if prior is not None:
+        prior = check_prior(prior, n)
+    if targets is not None:
+        targets = check_targets(targets, n, episodes)
+    elif prior is None:
+        targets = draw_targets(n, episodes, seed)
+    else:
+        targets = np.random.default_rng([seed, _TARGET]).choice(n, size=episodes, p=prior)
     absent_prior = check_absent_prior(absent_prior)
     if present is None:
         present = draw_present(episodes, absent_rate, seed)
@@ -289,7 +323,14 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
     all_present = bool(present.all())
     moving = motion is not None and motion.active
     index = np.arange(episodes)
-    beliefs = BatchBelief(n, absent_prior, episodes, moving)
+    # A prior with empty cells holds zeros from the start, as a motion step may leave them: the
+    # belief then takes the reward's 0 log 0 = 0 path (BatchBelief's ``moving``).
+    zeros = prior is not None and not prior.all()
+    beliefs = BatchBelief(n, absent_prior, episodes, moving or zeros)
+    if prior is not None:
+        with np.errstate(divide='ignore'):
+            beliefs.log_belief[:, :n] += np.log(prior * n)
+        beliefs.belief[...] = np.exp(beliefs.log_belief[:, :n])
     with_absent, belief = beliefs.has_absent, beliefs.belief
     fixations = np.empty((episodes, horizon), dtype=np.int64)
     correct = np.empty((episodes, horizon), dtype=bool)
