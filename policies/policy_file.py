@@ -189,6 +189,9 @@ def _check_nesting(value, key: str, shape: tuple[int, int], what: str) -> None:
 
 def _array(doc: dict, key: str, shape: tuple[int, int], what: str) -> np.ndarray:
     value = doc[key]
+    if value is None:
+        raise PolicyFileError(f'{key} has no value: {what} needs a {shape[0]} x {shape[1]} list '
+                              f'of lists of numbers')
     _check_nesting(value, key, shape, what)
     try:
         array = np.asarray(value, dtype=float)
@@ -303,6 +306,13 @@ def _record(doc: dict, key: str) -> dict:
         return {}
     if not isinstance(block, dict):
         raise PolicyFileError(f'{key} must be a mapping')
+    if key == 'training':
+        for name, kind in (('epochs', 'a whole number'), ('wall_seconds', 'a number')):
+            value = block.get(name)             # what train --resume goes on from
+            number = isinstance(value, (int, float)) and not isinstance(value, bool)
+            if value is not None and not (number and math.isfinite(value) and value >= 0
+                                          and (name != 'epochs' or value == int(value))):
+                raise PolicyFileError(f'training.{name} must be {kind} >= 0, got {value!r}')
     if key == 'evaluation':
         f90 = block.get('fixations_to_90')
         if f90 is not None and (isinstance(f90, bool) or not isinstance(f90, (int, float))):
