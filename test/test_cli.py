@@ -101,6 +101,29 @@ def test_search_prints_each_fixation(capsys):
                            'budget; the target is most likely at (')
 
 
+def test_search_runs_a_target_absent_trial(capsys):
+    """QA (a researcher): one target-absent trial from the CLI, with the absent hypothesis."""
+    assert main(['search', '--grid', '7x7', '--seed', '3', '--empty', '--absent-prior',
+                 '0.5']) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert lines[0] == 'no target: an empty 7x7 grid (a target-absent trial)'
+    assert all('P(absent)=' in line for line in lines[1:-1])
+    assert re.fullmatch(r'absent: no target, P\(absent\) 0\.9\d\d, after \d+ fixations '
+                        r'\(reached the confidence 0\.95\), which is right', lines[-1]), lines[-1]
+    # With a target the same prior answers found (the seed's target), each line with P(absent).
+    assert main(['search', '--grid', '7x7', '--seed', '3', '--absent-prior', '0.5']) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert lines[-1].startswith('found: the target is most likely at (6, 5)')
+    assert lines[-1].endswith('which is right') and 'P(absent)=' in lines[-2]
+    # Without the absent hypothesis an empty scene can only end wrong, at the budget.
+    assert main(['search', '--grid', '7x7', '--seed', '3', '--empty', '--max-fixations',
+                 '5']) == 0
+    assert capsys.readouterr().out.strip().endswith('which is wrong')
+    assert main(['search', '--grid', '7x7', '--empty', '--target', '1,1']) == 2
+    assert capsys.readouterr().err.strip().splitlines()[-1].endswith(
+        '--empty is a scene without a target: leave out --target')
+
+
 @pytest.mark.parametrize('args, message', [
     # The search settings: the message of SearchSettings, as the node's (one schema).
     (['evaluate', '--motion-sigma-cells', '-0.5'],

@@ -35,7 +35,10 @@ def add_parser(sub):
                    help='a policy YAML file or a shipped kernel name (overrides --policy)')
     p.add_argument('--target', type=cell_arg, default=None, metavar='ROW,COL',
                    help='target cell as ROW,COL or a flat index (default random)')
-    add_search_args(p, SEARCH_SETTINGS, ('confidence',))
+    p.add_argument('--empty', action='store_true',
+                   help='a target-absent trial: the scene holds no target (the frames are '
+                        'noise); with --absent-prior the search can answer absent')
+    add_search_args(p, SEARCH_SETTINGS, ('confidence', 'absent_prior'))
     p.add_argument('--max-fixations', type=nonneg_int, default=None, metavar='N',
                    help='fixation budget: gave up when it runs out undecided (default 4 N; 0 = '
                         f'no budget, but an offline search still gives up after '
@@ -58,25 +61,44 @@ def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=
     rng = np.random.default_rng(seed)
     session = SearchSession(grid, model, policy, settings)
     sensor = ModelSensor(grid, model, rng)
-    tr, tc = grid.cell(target)
-    out(f'target hidden at cell {target} ({tr}, {tc}) of a {grid.rows}x{grid.cols} grid')
+    with_absent = settings.absent_prior > 0
+    if target is None:
+        out(f'no target: an empty {grid.rows}x{grid.cols} grid (a target-absent trial)')
+    else:
+        tr, tc = grid.cell(target)
+        out(f'target hidden at cell {target} ({tr}, {tc}) of a {grid.rows}x{grid.cols} grid')
     steps = []
+
+    def right(result, answer_absent: bool) -> str:
+        if target is None:
+            return 'right' if answer_absent else 'wrong'
+        return 'right' if result.map_cell == target and not answer_absent else 'wrong'
 
     def show(frame, result):
         steps.append(result)
         kr, kc = grid.cell(session.path[-1])
         gr, gc = grid.cell(result.map_cell)
         entropy = max(session.entropy_nats, 0.0)          # never -0.00 of a decided 1x1 grid
+        # With the absent hypothesis the answer so far is absent while it is the likeliest.
+        absent = f'  P(absent)={result.absent_probability:.3f}' if with_absent else ''
+        likelier = with_absent and result.absent_probability >= result.map_probability
         out(f'fixation {result.fixations:3d}: looked at ({kr}, {kc})  ->  most likely ({gr}, '
-            f'{gc}) p={result.map_probability:.3f}  entropy {entropy:.2f} nats  '
-            f"{'right' if result.map_cell == target else 'wrong'}")
+            f'{gc}) p={result.map_probability:.3f}{absent}  entropy {entropy:.2f} nats  '
+            f'{right(result, likelier)}')
 
     limit = None if settings.max_fixations else NO_BUDGET_FRAMES_PER_CELL * grid.n_cells
     run_offline(session, sensor, target, seed=rng, limit=limit, on_frame=show)
     result = steps[-1]
     guess = result.map_cell
     gr, gc = grid.cell(guess)
-    verdict = 'right' if guess == target else 'wrong'
+    if result.decision == 'absent':
+        clause = answer.confidence_clause(result.decision, result.reason,
+                                          result.absent_probability, settings.confidence)
+        out(f'{answer.heading(result.decision, result.reason)}: no target, P(absent) '
+            f'{result.absent_probability:.3f}, after {result.fixations} fixations{clause}, '
+            f'which is {right(result, True)}')
+        return None, session.path, session.belief, result
+    verdict = right(result, False)
     clause = answer.confidence_clause(result.decision, result.reason, result.map_probability,
                                       settings.confidence)
     if not result.decision:
@@ -110,8 +132,9 @@ def plot_search(grid, belief, path, target, title, out_path):
     for i, (r, c) in enumerate(zip(rows, cols)):
         ax.text(c, r, str(i + 1), color='black', ha='center', va='center', fontsize=8,
                 bbox={'boxstyle': 'circle,pad=0.2', 'fc': 'cyan', 'ec': 'none'})
-    tr, tc = grid.cell(target)
-    ax.plot(tc, tr, marker='*', ms=16, mfc='none', mec='lime', mew=2)
+    if target is not None:
+        tr, tc = grid.cell(target)
+        ax.plot(tc, tr, marker='*', ms=16, mfc='none', mec='lime', mew=2)
     ax.set_title(title, fontsize=10)
     ax.set_xlabel('column')
     ax.set_ylabel('row')
@@ -133,8 +156,12 @@ def run(args) -> int:
         args.max_fixations = 4 * grid.n_cells
     settings = settings_from_args(args, SEARCH_SETTINGS, grid)
     rng = np.random.default_rng([args.seed, 1])
+    if args.empty and args.target is not None:
+        raise ValueError('--empty is a scene without a target: leave out --target')
     target = int(rng.integers(grid.n_cells)) if args.target is None else \
         cell_index(args.target, grid, '--target')
+    if args.empty:
+        target = None
     guess, path, belief, result = run_search(grid, as_observation(grid, fpoc), policy, target,
                                              settings, args.seed)
     if args.plot:
@@ -148,7 +175,8 @@ def run(args) -> int:
             ending += f' at {answer.LIMITS.get(result.reason, result.reason)}'
         # Two lines: one would run past the figure's edges and under the colour bar.
         title = (f'{grid.rows}x{grid.cols}, {task}, {name}\n{ending}, '
-                 f'p={result.map_probability:.3f}, {len(path)} fixations (star = target)')
+                 f'p={result.map_probability:.3f}, {len(path)} fixations '
+                 f"{'(no target)' if target is None else '(star = target)'}")
         plot_search(grid, belief, path, target, title, args.plot)
         print(f'wrote {args.plot}')
     return 0
