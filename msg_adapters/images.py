@@ -105,10 +105,12 @@ def read_frame_tag(msg: Image) -> tuple[str, int | None]:
     """
     Return ``(kind, search_id)`` of an evidence image, from ``header.frame_id`` (``frame_tag``).
 
-    Any other frame id (a detector that does not tag its frames) gives ``('fixation', None)``.
+    Any other frame id (a detector that does not tag its frames) gives ``('fixation', None)``,
+    so does a number that is not ASCII digits (``str.isdigit`` also takes ``'²'``, which ``int``
+    refuses).
     """
     kind, _, number = msg.header.frame_id.partition('/')
-    if kind in ('scan', 'fixation') and number.isdigit():
+    if kind in ('scan', 'fixation') and number.isascii() and number.isdigit():
         return kind, int(number)
     return 'fixation', None
 

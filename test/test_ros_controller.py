@@ -276,6 +276,28 @@ def test_stamped_evidence_image_is_used(probe, cam):
                                rtol=1e-4, atol=1e-7)
 
 
+def test_evidence_image_with_a_non_ascii_digit_tag_is_read_as_untagged(probe, cam):
+    # 'fixation/²' passed str.isdigit() and then failed int(): the frame was lost as a callback
+    # error, outside frames_received. Any frame_id that is not a tag reads as untagged.
+    from ipomdp_gaze.msg_adapters import images
+    callbacks = probe.status_values('gaze_controller: callbacks')
+    before = cam.wait_counters()
+    belief, fixation = cam.belief().astype(np.float64), cam.fixation()
+    frame = _frames(9, 1)[0]
+    msg = images.evidence_image(frame, cam.grid, cam.probe.node.get_clock().now().to_msg())
+    msg.header.frame_id = 'fixation/\u00b2'
+    nb = len(cam.beliefs)
+    cam.evidence_image.publish(msg)
+    assert wait_for(lambda: len(cam.beliefs) > nb, 20)
+    np.testing.assert_allclose(cam.belief(), cam.expected(belief, frame, fixation),
+                               rtol=1e-4, atol=1e-7)
+    after = cam.wait_counters(frames_applied=int(before['frames_applied']) + 1)
+    assert int(after['frames_received']) == int(before['frames_received']) + 1
+    n = len(callbacks)
+    assert wait_for(lambda: len(callbacks) > n, 20)
+    assert callbacks[-1]['callback_errors'] == '0', callbacks[-1]
+
+
 def test_disable_skips_frames_enable_resends_reset_restarts(probe, cam):
     before = cam.wait_counters()            # fresh: /diagnostics comes once a second
     fixation, nb, nt = cam.fixation(), len(cam.beliefs), len(cam.targets)
