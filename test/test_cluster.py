@@ -153,7 +153,8 @@ def test_an_unreachable_scheduler_is_one_line(capsys):
         sock.bind(('127.0.0.1', 0))
         port = sock.getsockname()[1]
     for address, reason in ((f'tcp://127.0.0.1:{port}', 'cannot reach the Dask scheduler'),
-                            ('tcp://127.0.0.1', 'wants [tcp://]HOST:PORT')):
+                            ('tcp://127.0.0.1', 'wants [tcp://]HOST:PORT'),
+                            ('tcp://127.0.0.1:8\u00b2', 'wants [tcp://]HOST:PORT')):   # int('²')
         assert cli_main(['evaluate', '--grid', '4x4', '--episodes', '10', '--scheduler',
                          address]) == 2
         err = capsys.readouterr().err

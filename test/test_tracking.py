@@ -131,6 +131,7 @@ def test_evaluate_motion_walk_writes_the_summary_per_searcher(tmp_path):
     (['--speed-deg-s', '25'], 'speed_deg_s must be a number from 0 to 20'),
     (['--compare', 'sweep'], "unknown walk searcher 'sweep'"),
     (['--compare', 'track-last-detection:neighbors=0'], 'expected neighbors=N'),
+    (['--compare', 'track-last-detection:neighbors=\u00b2'], 'expected neighbors=N'),
     (['--walk-duration-s', '0'], 'the walk duration must be > 0 s'),
     (['--faces', '2'], '--motion walk is for --scenes pan-tilt with one face'),
 ])

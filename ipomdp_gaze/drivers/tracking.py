@@ -358,8 +358,8 @@ def _baseline_kwargs(name: str) -> dict:
     kwargs = {}
     for item in filter(None, rest.split(',')):
         key, sep, value = item.partition('=')
-        if not sep or key not in ('neighbors', 'lost_frames') or not value.isdigit() \
-                or int(value) < 1:
+        whole = value.isascii() and value.isdigit()         # int() refuses '²', isdigit not
+        if not sep or key not in ('neighbors', 'lost_frames') or not whole or int(value) < 1:
             raise ValueError(f'searcher {name!r}: expected neighbors=N or lost_frames=M with '
                              f'N, M >= 1, got {item!r}')
         kwargs[key] = int(value)

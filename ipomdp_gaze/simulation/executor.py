@@ -352,7 +352,8 @@ def _probe(address: str, timeout_s: float) -> None:
     if sep and scheme not in ('tcp', 'tls'):
         return
     host, colon, port = rest.rpartition(':')
-    if not colon or not host or not port.isdigit() or not 0 < int(port) < 65536:
+    whole = port.isascii() and port.isdigit()               # int() refuses '²', isdigit not
+    if not colon or not host or not whole or not 0 < int(port) < 65536:
         raise ClusterError(f'--scheduler wants [tcp://]HOST:PORT, e.g. tcp://10.0.0.5:8786, '
                            f'got {address!r}')
     try:
