@@ -7,6 +7,7 @@ import subprocess
 import sys
 
 from ipomdp_gaze.cli import main
+import numpy as np
 import pytest
 
 
@@ -99,6 +100,53 @@ def test_search_prints_each_fixation(capsys):
     last = capsys.readouterr().out.strip().splitlines()[-1]
     assert last.startswith('gave up: no cell reached the confidence 0.95 at the fixation '
                            'budget; the target is most likely at (')
+
+
+def test_evaluate_draws_targets_from_a_prior_file(tmp_path, capsys):
+    """QA (a researcher): a centre-biased task; the prior is the targets' and the belief's."""
+    point = tmp_path / 'point.txt'
+    point.write_text('# all mass on (1, 2)\n0 0 0\n0, 0, 5\n0 0 0\n')
+    out = tmp_path / 'out.json'
+    assert main(['evaluate', '--grid', '3x3', '--policy', 'map', '--policy', 'random',
+                 '--episodes', '200', '--prior', str(point), '--quiet', '--json',
+                 str(out)]) == 0
+    assert capsys.readouterr().out.splitlines()[0].endswith(f', prior {point}')
+    data = json.loads(out.read_text())
+    assert data['prior'] == [[0, 0, 0], [0, 0, 1], [0, 0, 0]]
+    for name in ('map', 'random'):              # the belief starts sure: right from the start
+        assert data['policies'][name]['percent_correct'] == [1.0] * 9
+    # Targets follow the prior: weights 1 and 3 on two cells, the belief split 1:3 as well.
+    two = tmp_path / 'two.txt'
+    two.write_text('1 0 0\n0 0 0\n0 0 3\n')
+    assert main(['evaluate', '--grid', '3x3', '--policy', 'center', '--episodes', '4000',
+                 '--fpoc', 'table', '--fpoc-param', 'dprime=[0,0]', '--fpoc-param',
+                 'ecc_deg=[0,1]', '--prior', str(two), '--quiet', '--json', str(out)]) == 0
+    capsys.readouterr()
+    from ipomdp_gaze.simulation.simulate import draw_targets
+    prior = np.asarray(json.loads(out.read_text())['prior']).ravel()
+    targets = draw_targets(9, 4000, 0, prior)
+    assert set(targets) == {0, 8}
+    share = np.mean(targets == 8)               # binomial sd 0.007 at 4000 draws
+    assert abs(share - 0.75) < 0.03
+    # With d' = 0 no frame moves the belief: its MAP is the likelier cell, right on its share.
+    correct = json.loads(out.read_text())['policies']['center']['percent_correct']
+    assert correct == [pytest.approx(share, abs=1e-6)] * 9
+
+
+@pytest.mark.parametrize('text, message', [
+    ('1 1\n1 1\n', 'a 3x3 grid needs 3 lines of 3 weights, got 2 lines of 2'),
+    ('1 1 1\n1 x 1\n1 1 1\n', "not a number in '1 x 1'"),
+    ('1 1 1\n1 -1 1\n1 1 1\n', 'weights must be finite, >= 0 and not all 0'),
+    ('0 0 0\n0 0 0\n0 0 0\n', 'weights must be finite, >= 0 and not all 0'),
+])
+def test_a_bad_prior_file_is_one_line(tmp_path, capsys, text, message):
+    path = tmp_path / 'prior.txt'
+    path.write_text(text)
+    assert main(['evaluate', '--grid', '3x3', '--episodes', '10', '--prior', str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.strip().splitlines()[-1].endswith(message) and err.count('\n') == 1, err
+    assert main(['evaluate', '--scenes', 'faces-420', '--prior', str(path)]) == 2
+    assert '--prior' in capsys.readouterr().err
 
 
 def test_search_runs_a_target_absent_trial(capsys):

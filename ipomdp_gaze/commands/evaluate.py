@@ -32,7 +32,7 @@ from ipomdp_gaze.simulation.evaluation import (decision_summary, fixations_to_90
                                                paired_difference_ci, paired_tracking_difference,
                                                tracking_summary)
 from ipomdp_gaze.simulation.executor import InlineExecutor
-from ipomdp_gaze.simulation.simulate import draw_present, draw_targets
+from ipomdp_gaze.simulation.simulate import check_prior, draw_present, draw_targets
 from ipomdp_gaze.vision.pan_tilt import parse_faces
 from ipomdp_gaze.vision.walks import DURATION_S as WALK_DURATION_S
 from ipomdp_gaze.vision.walks import SPEED_DEG_S as WALK_SPEED_DEG_S
@@ -102,6 +102,11 @@ def add_parser(sub):
                         '(sweep-tile, sweep-first-raw, sweep-first-grouped3, '
                         'sweep-first-grouped5); with --motion walk track-last-detection '
                         '(default; :neighbors=N,lost_frames=M)')
+    p.add_argument('--prior', type=Path, default=None, metavar='FILE',
+                   help='where the target is a priori: a text file of ROWS lines of COLS '
+                        'non-negative weights (spaces or commas; # comments), scaled to sum '
+                        '1; the targets are drawn from it and every belief starts at it '
+                        '(default uniform)')
     p.add_argument('--episodes-greedy', type=positive_int, default=2000,
                    help='episodes for the slow searchers, greedy and switching (policies '
                         'whose class sets costly; default 2000)')
@@ -154,7 +159,7 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
              absent_prior: float | None = None, absent_rate: float | None = None,
              confidence: float | None = None, max_fixations: int | None = None,
              compare_prediction: bool = False, paired: bool = False, executor=None,
-             bar=None) -> dict:
+             bar=None, prior=None) -> dict:
     """
     Run every policy on the same targets, noise, target paths and empty scenes.
 
@@ -175,7 +180,9 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
     (``PLANNER_CHUNK`` for the planner), with the same numbers wherever they run; ``bar``
     (:class:`ipomdp_gaze.simulation.progress.Progress`) counts episodes, ``progress(name, entry)``
     is
-    called as each policy's entry is ready.
+    called as each policy's entry is ready. ``prior`` (N,), summing to 1: where the targets
+    are a priori (drawn from it, and every belief starts at it; default uniform), recorded in
+    the result as ``prior``, rows of cells.
     """
     scene = (motion_sigma_cells, jump_prob, absent_prior, absent_rate, confidence,
              max_fixations)
@@ -189,12 +196,16 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
         raise ValueError(f'--max-fixations {max_fixations} is beyond the horizon {horizon}')
     model = as_observation(grid, fpoc)
     motion = Motion(grid, motion_sigma_cells, jump_prob)
-    targets = draw_targets(grid.n_cells, episodes, seed)
+    if prior is not None:
+        prior = check_prior(prior, grid.n_cells)
+    targets = draw_targets(grid.n_cells, episodes, seed, prior)
     present = draw_present(episodes, absent_rate, seed)
     task = ({'fpoc': model.fpoc.to_dict()} if isinstance(model, GaussianObservation)
             else {'observation': {**model.to_dict(), 'sha256': fingerprint(model)}})
     out = {'grid': grid.to_dict(), **task, 'episodes': episodes,
            'horizon': horizon, 'seed': seed}
+    if prior is not None:
+        out['prior'] = prior.reshape(grid.shape).tolist()
     if extended:
         out.update({'motion_sigma_cells': motion.sigma_cells, 'jump_prob': motion.jump_prob,
                     'absent_prior': float(absent_prior), 'absent_rate': float(absent_rate),
@@ -215,7 +226,7 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
         futures = simulate_pieces(executor, grid, model, policy, n, horizon, seed, chunk,
                                   targets=targets[:n], motion=motion, predict=predict,
                                   absent_prior=absent_prior, present=present[:n],
-                                  progress=bar)
+                                  prior=prior, progress=bar)
         submitted.append((name, n, futures))
     results = {}
     for name, n, futures in submitted:
@@ -410,13 +421,44 @@ SIMULATION_ONLY = (('--grid', 'grid'), ('--spacing-deg', 'spacing_deg'), ('--fpo
                    ('--fpoc-param', 'fpoc_param'), ('--observation', 'observation'),
                    ('--horizon', 'horizon'), ('--motion-sigma-cells', 'motion_sigma_cells'),
                    ('--jump-prob', 'motion_jump_prob'), ('--absent-rate', 'absent_rate'),
-                   ('--compare-prediction', 'compare_prediction'), ('--paired', 'paired'))
+                   ('--compare-prediction', 'compare_prediction'), ('--paired', 'paired'),
+                   ('--prior', 'prior'))
 # Options of the scene tasks, which the simulated task does not read.
 SCENES_ONLY = (('--compare', 'compare'), ('--empty-scenes', 'empty_scenes'), ('--split', 'split'),
                ('--scene-model', 'scene_model'), ('--group-min-neighbors', 'group_min_neighbors'))
 # Options of the still pan/tilt scenes, which --motion walk does not read.
 STILL_SCENES_ONLY = (('--max-fixations', 'max_fixations'),
                      ('--group-min-neighbors', 'group_min_neighbors'))
+
+
+def read_prior(path: Path, grid) -> np.ndarray:
+    """
+    Read a prior over the target's cell: ``grid.rows`` lines of ``grid.cols`` weights >= 0.
+
+    Spaces or commas between numbers, ``#`` comments; scaled to sum 1. ValueError (one line)
+    for a file that cannot be read, the wrong shape, or weights that are not numbers >= 0 with
+    a positive sum.
+    """
+    try:
+        text = Path(path).read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f'--prior {path}: cannot read it ({exc.__class__.__name__})') from None
+    rows = []
+    for line in text.splitlines():
+        line = line.split('#', 1)[0].replace(',', ' ').split()
+        if line:
+            try:
+                rows.append([float(v) for v in line])
+            except ValueError:
+                raise ValueError(f'--prior {path}: not a number in {" ".join(line)!r}') from None
+    if len(rows) != grid.rows or any(len(r) != grid.cols for r in rows):
+        shape = f'{len(rows)} lines of ' + '/'.join(sorted({str(len(r)) for r in rows}) or '0')
+        raise ValueError(f'--prior {path}: a {grid.rows}x{grid.cols} grid needs {grid.rows} '
+                         f'lines of {grid.cols} weights, got {shape}')
+    weights = np.asarray(rows, dtype=float).reshape(-1)
+    if not np.all(np.isfinite(weights)) or np.any(weights < 0) or not weights.sum() > 0:
+        raise ValueError(f'--prior {path}: weights must be finite, >= 0 and not all 0')
+    return weights / weights.sum()
 
 
 def _refuse_unused(args, options, why: str) -> None:
@@ -478,6 +520,7 @@ def run(args) -> int:
     args.episodes = args.episodes or 20000
     args.max_fixations = args.max_fixations or None           # 0: no budget, the horizon
     grid, fpoc = task_from_args(args)
+    prior = None if args.prior is None else read_prior(args.prior, grid)
     policies = load_policies(args, grid, fpoc)
     if args.paired and len(policies) < 2:
         raise ValueError('--paired compares each policy after the first with the first: give '
@@ -491,10 +534,11 @@ def run(args) -> int:
                           absent_prior=args.absent_prior, absent_rate=args.absent_rate,
                           confidence=args.confidence, max_fixations=args.max_fixations,
                           compare_prediction=args.compare_prediction, paired=args.paired,
-                          executor=executor, bar=bar)
+                          executor=executor, bar=bar, prior=prior)
     task = (f'count model {args.observation}' if args.observation else
             f'{grid.spacing_deg} deg/cell, FPOC {fpoc.to_dict()}')
-    print(f"{grid.rows}x{grid.cols} grid, {task}, horizon {result['horizon']}, seed {args.seed}")
+    print(f"{grid.rows}x{grid.cols} grid, {task}, horizon {result['horizon']}, seed {args.seed}"
+          + ('' if prior is None else f', prior {args.prior}'))
     print(format_table(result))
     if 'confidence' in result:
         print(f"motion sigma {result['motion_sigma_cells']} cells, jump {result['jump_prob']} "

@@ -70,10 +70,16 @@ class SearchResult:
         return self.correct.mean(axis=0)
 
 
-def draw_targets(n_cells: int, episodes: int, seed: int) -> np.ndarray:
-    """Uniformly random target cells from the seed's target stream."""
+def draw_targets(n_cells: int, episodes: int, seed: int, prior=None) -> np.ndarray:
+    """
+    Random target cells from the seed's target stream: uniform, or drawn from ``prior``.
+
+    ``prior`` (N,) sums to 1 (:func:`check_prior`); both draws are prefix-stable.
+    """
     rng = np.random.default_rng([seed, _TARGET])
-    return rng.integers(0, n_cells, size=episodes)
+    if prior is None:
+        return rng.integers(0, n_cells, size=episodes)
+    return rng.choice(n_cells, size=episodes, p=check_prior(prior, n_cells))
 
 
 def draw_present(episodes: int, absent_rate: float, seed: int) -> np.ndarray:
@@ -292,10 +298,8 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
         prior = check_prior(prior, n)
     if targets is not None:
         targets = check_targets(targets, n, episodes)
-    elif prior is None:
-        targets = draw_targets(n, episodes, seed)
     else:
-        targets = np.random.default_rng([seed, _TARGET]).choice(n, size=episodes, p=prior)
+        targets = draw_targets(n, episodes, seed, prior)
     absent_prior = check_absent_prior(absent_prior)
     if present is None:
         present = draw_present(episodes, absent_rate, seed)
