@@ -430,6 +430,25 @@ def check_task(spec: PolicySpec, grid: Grid | None = None, fpoc=None,
         warn(f'{where}policy was trained for {trained} but is used with FPOC {fpoc.to_dict()}')
 
 
+SCENE_KEYS = ('motion_sigma_cells', 'jump_prob', 'absent_prior', 'absent_rate')
+
+
+def check_scene(spec: PolicySpec, scene: dict, warn: Callable[[str], None] | None = None) -> None:
+    """
+    Report (through ``warn``) each setting of docs/design.md section 7 that differs from training.
+
+    ``scene`` maps :data:`SCENE_KEYS` to the values used now (missing or None: 0, the paper's
+    task); a policy file records the non-zero ones under ``training``.
+    """
+    warn = _warn if warn is None else warn
+    where = f'{spec.path}: ' if spec.path is not None else ''
+    for key in SCENE_KEYS:
+        trained = float(spec.training.get(key) or 0.0)
+        used = float(scene.get(key) or 0.0)
+        if not math.isclose(trained, used, rel_tol=1e-9, abs_tol=1e-12):
+            warn(f'{where}policy was trained with {key} {trained:g} but is used with {used:g}')
+
+
 def load_policy(source, grid: Grid | None = None, fpoc: FPOC | None = None,
                 action: str | None = None, warn: Callable[[str], None] | None = None):
     """

@@ -126,6 +126,26 @@ def test_fpoc_or_spacing_mismatch_warns(tmp_path):
         load_policy(path, fpoc=make_fpoc('exponential'))
 
 
+def test_a_policy_used_off_its_training_scenes_warns(tmp_path, capsys):
+    """QA: a policy trained with an absent prior, evaluated without it, said nothing."""
+    from dataclasses import replace
+    from ipomdp_gaze.cli import main
+    spec = replace(conv_spec(), training={'epochs': 3, 'absent_prior': 0.2})
+    path = save_policy(tmp_path / 'k.yaml', spec)
+    messages = []
+    pf.check_scene(load_policy_spec(path), {'absent_prior': 0.2}, messages.append)
+    assert messages == []
+    pf.check_scene(load_policy_spec(path), {'jump_prob': 0.1}, messages.append)
+    assert messages == [f'{path}: policy was trained with jump_prob 0 but is used with 0.1',
+                        f'{path}: policy was trained with absent_prior 0.2 but is used with 0']
+    args = ['evaluate', '--grid', '3x4', '--policy-file', str(path), '--episodes', '20',
+            '--quiet']
+    assert main(args) == 0
+    assert 'policy was trained with absent_prior 0.2 but is used with 0' in capsys.readouterr().err
+    assert main(args + ['--absent-prior', '0.2']) == 0
+    assert 'warning' not in capsys.readouterr().err
+
+
 def _break(doc, change):
     doc = dict(doc)
     change(doc)
