@@ -73,6 +73,8 @@ def test_table_interpolates_and_is_constant_beyond():
     ('human', {'bogus': 1}, "unknown parameter 'bogus'"),
     ('camera', {'shape': 'hexagon'}, 'shape must be one of'),
     ('table', {'ecc_deg': [0, 1], 'dprime': [1]}, 'equal length'),
+    ('table', {'dprime': [2, 1, 0]}, r'got 2 ecc_deg \[0.0, 1.0\] and 3 dprime \[2.0, 1.0, 0.0\] '
+     r'\(a value not given is its default: ecc_deg \[0.0, 1.0\]'),
     ('table', {'ecc_deg': [1, 0], 'dprime': [1, 1]}, 'increasing'),
     ('table', {'ecc_deg': [0, 1], 'dprime': [1, -1]}, '>= 0'),
     ('nope', {}, 'valid models: human, exponential, camera, table'),

@@ -179,8 +179,10 @@ class TableFPOC(FPOC):
         except (TypeError, ValueError):
             raise ValueError('ecc_deg and dprime must be lists of numbers') from None
         if ecc.size < 1 or ecc.size != dp.size:
-            raise ValueError(f'ecc_deg and dprime must be non-empty and of equal length, '
-                             f'got {ecc.size} and {dp.size}')
+            raise ValueError(f'ecc_deg and dprime must be non-empty and of equal length, got '
+                             f'{ecc.size} ecc_deg {ecc.tolist()} and {dp.size} dprime '
+                             f'{dp.tolist()} (a value not given is its default: ecc_deg '
+                             f"{self.defaults['ecc_deg']}, dprime {self.defaults['dprime']})")
         if not (np.all(np.isfinite(ecc)) and np.all(np.isfinite(dp))):
             raise ValueError('ecc_deg and dprime must be finite')
         if np.any(ecc < 0) or np.any(np.diff(ecc) <= 0):
