@@ -719,7 +719,10 @@ class OccupancySession:
         s, settings = self._s(), self.settings
         log_odds = s['base']
         occupied, empty = self._decided(log_odds)
-        keep = settings.motion_keep_probability or settings.confidence
+        # A person at an occupied cell (P >= confidence) is held, as one target's found holds
+        # at the confidence whatever motion.keep_probability says: a keep above the confidence
+        # would lose and reacquire the person in the same frame.
+        keep = min(settings.motion_keep_probability or settings.confidence, settings.confidence)
         # A round of turns: each person and the search dwell_s at most; one more for slack.
         unseen_s = settings.motion_dwell_s * (len(self.tracks.found) + UNSEEN_SLACK_TURNS)
         self.people_events = tuple(self.tracks.step(
