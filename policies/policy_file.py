@@ -308,10 +308,12 @@ def _record(doc: dict, key: str) -> dict:
         raise PolicyFileError(f'{key} must be a mapping')
     if key == 'training':
         for name, kind in (('epochs', 'a whole number'), ('wall_seconds', 'a number')):
-            value = block.get(name)             # what train --resume goes on from
-            number = isinstance(value, (int, float)) and not isinstance(value, bool)
-            if value is not None and not (number and math.isfinite(value) and value >= 0
-                                          and (name != 'epochs' or value == int(value))):
+            if name not in block:
+                continue                        # left out: train --resume starts from 0
+            value = block[name]                 # what train --resume goes on from; null is
+            number = isinstance(value, (int, float)) and not isinstance(value, bool)  # refused
+            if not (number and math.isfinite(value) and value >= 0
+                    and (name != 'epochs' or value == int(value))):
                 raise PolicyFileError(f'training.{name} must be {kind} >= 0, got {value!r}')
     if key == 'evaluation':
         f90 = block.get('fixations_to_90')

@@ -337,3 +337,20 @@ def test_a_resumed_training_refuses_settings_other_than_its_own(tmp_path, capsys
     assert cli(['train', '--resume', str(first), '--epochs', '3', '--out',
                 str(tmp_path / 'same.yaml'), '--seed', '0', '--quiet',
                 '--final-episodes', '50']) == 0              # the recorded value: fine
+
+
+@pytest.mark.parametrize('key', ['epochs', 'wall_seconds'])
+def test_resume_from_a_file_whose_count_is_null_is_one_line(tmp_path, capsys, key):
+    # QA: training.epochs: null loaded, then train --resume raised int(None)'s TypeError.
+    import yaml
+    out = tmp_path / 'p.yaml'
+    common = ['--eval-every', '2', '--eval-episodes', '50', '--final-episodes', '100', '--quiet']
+    assert main(['train', '--grid', '3x3', '--epochs', '2', '--out', str(out)] + common) == 0
+    capsys.readouterr()
+    doc = yaml.safe_load(out.read_text())
+    doc['training'][key] = None
+    out.write_text(yaml.safe_dump(doc))
+    assert main(['train', '--resume', str(out), '--epochs', '4'] + common) == 2
+    err = capsys.readouterr().err
+    kind = 'a whole number' if key == 'epochs' else 'a number'
+    assert err.strip().splitlines()[-1].endswith(f'training.{key} must be {kind} >= 0, got None')
