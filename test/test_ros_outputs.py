@@ -9,6 +9,7 @@ logged by our node, an incompatible subscriber on an output by the subscriber's 
 """
 from __future__ import annotations
 
+import re
 import time
 
 import numpy as np
@@ -180,3 +181,16 @@ def test_a_volatile_teleop_drives_the_camera_with_its_qos_overridden(context, du
         executor.shutdown()
         teleop.destroy_node()
         camera.destroy_node()
+
+
+@pytest.mark.parametrize('policy, value, message', [
+    ('durability', 'bogus', 'Unexpected QoS override for policy `durability`: `bogus`'),
+    ('depth', -1, 'qos_overrides./pan_tilt.subscription.depth must be >= 1, got -1'),
+])
+def test_a_bad_qos_override_is_a_value_error_naming_it(context, policy, value, message):
+    """QA: rclpy's bare RuntimeError (or rcl's 'invalid allocator') was a start-up traceback."""
+    from ipomdp_gaze.nodes.camera import SimulatedCameraNode
+    from rclpy.parameter import Parameter
+    name = f'qos_overrides./pan_tilt.subscription.{policy}'
+    with pytest.raises(ValueError, match=re.escape(message)):
+        SimulatedCameraNode(context=context, parameter_overrides=[Parameter(name, value=value)])

@@ -14,8 +14,10 @@ included), which matches every publisher; the controller re-sends its target eve
 """
 from __future__ import annotations
 
-from rclpy.qos import DurabilityPolicy, QoSPolicyKind, QoSProfile, ReliabilityPolicy
-from rclpy.qos_overriding_options import QoSOverridingOptions
+from rcl_interfaces.msg import SetParametersResult
+from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSPolicyKind, QoSProfile,
+                       ReliabilityPolicy)
+from rclpy.qos_overriding_options import InvalidQosOverridesError, QoSOverridingOptions
 
 STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                        durability=DurabilityPolicy.TRANSIENT_LOCAL)
@@ -27,14 +29,37 @@ COMMAND_POLICIES = (QoSPolicyKind.DURABILITY, QoSPolicyKind.RELIABILITY, QoSPoli
                     QoSPolicyKind.HISTORY)
 
 
+def _depth_check(name: str):
+    """Return the overrides' check: a depth rcl can take (>= 1 to keep the last; >= 0)."""
+    def check(profile: QoSProfile) -> SetParametersResult:
+        least = 1 if profile.history == HistoryPolicy.KEEP_LAST else 0
+        if profile.depth < least:           # rcl: 'invalid allocator' when negative
+            return SetParametersResult(successful=False,
+                                       reason=f'{name}.depth must be >= {least}, got '
+                                              f'{profile.depth}')
+        return SetParametersResult(successful=True)
+    return check
+
+
 def command_subscription(node, msg_type, topic: str, callback):
     """
     Subscribe a command topic with :data:`STATE_QOS`, overridable at start-up.
 
     rclpy writes the overrides into the profile it is given, so each subscription gets a copy
-    of its own: the shared profile, which the node's publishers use too, stays as it is.
+    of its own: the shared profile, which the node's publishers use too, stays as it is. An
+    override rclpy cannot take (``durability:=bogus``, ``depth:=-1``) raises ``ValueError``
+    naming it, which the node's start-up prints as one line (rclpy raised a bare
+    ``RuntimeError``, or rcl's 'invalid allocator').
     """
-    profile = QoSProfile(**{name: getattr(STATE_QOS, name) for name in PROFILE_FIELDS})
-    return node.create_subscription(
-        msg_type, topic, callback, profile,
-        qos_overriding_options=QoSOverridingOptions(policy_kinds=COMMAND_POLICIES))
+    profile = QoSProfile(**{field: getattr(STATE_QOS, field) for field in PROFILE_FIELDS})
+    name = f'qos_overrides.{node.resolve_topic_name(topic)}.subscription'
+    options = QoSOverridingOptions(policy_kinds=COMMAND_POLICIES, callback=_depth_check(name))
+    try:
+        return node.create_subscription(msg_type, topic, callback, profile,
+                                        qos_overriding_options=options)
+    except InvalidQosOverridesError as exc:
+        raise ValueError(str(exc).rpartition('are not valid: ')[2]) from None
+    except RuntimeError as exc:
+        if type(exc) is not RuntimeError:       # rcl's RCLError and the like: not an override
+            raise
+        raise ValueError(f'{name}: {exc}') from None
