@@ -172,6 +172,24 @@ def test_search_runs_a_target_absent_trial(capsys):
         '--empty is a scene without a target: leave out --target')
 
 
+def test_a_target_absent_trial_that_gives_up_answers_as_its_lines_do(capsys, monkeypatch):
+    """QA: the last line named the MAP cell 'wrong' after lines saying absent, 'right'."""
+    assert main(['search', '--grid', '7x7', '--seed', '3', '--empty', '--absent-prior', '0.5',
+                 '--max-fixations', '4']) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert lines[-2].endswith('P(absent)=0.464  entropy 1.68 nats  right'), lines[-2]
+    assert lines[-1] == ('gave up: no cell reached the confidence 0.95 at the fixation budget; '
+                         'most likely no target, P(absent) 0.464, after 4 fixations, which is '
+                         'right')
+    # The figure of an absent answer gives P(absent), not the MAP cell's p (0.018 here).
+    from ipomdp_gaze.commands import search
+    titles = []
+    monkeypatch.setattr(search, 'plot_search', lambda *a: titles.append(a[4]))
+    assert main(['search', '--grid', '7x7', '--seed', '3', '--empty', '--absent-prior', '0.5',
+                 '--plot', 'unused.png']) == 0
+    assert 'absent, P(absent)=0.974, 13 fixations (no target)' in titles[0], titles
+
+
 @pytest.mark.parametrize('args, message', [
     # The search settings: the message of SearchSettings, as the node's (one schema).
     (['evaluate', '--motion-sigma-cells', '-0.5'],

@@ -69,6 +69,10 @@ def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=
         out(f'target hidden at cell {target} ({tr}, {tc}) of a {grid.rows}x{grid.cols} grid')
     steps = []
 
+    def says_absent(result) -> bool:
+        # The simulator's and the stop rule's answer: absent while strictly the likelier.
+        return with_absent and result.absent_probability > result.map_probability
+
     def right(result, answer_absent: bool) -> str:
         if target is None:
             return 'right' if answer_absent else 'wrong'
@@ -81,7 +85,7 @@ def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=
         entropy = max(session.entropy_nats, 0.0)          # never -0.00 of a decided 1x1 grid
         # With the absent hypothesis the answer so far is absent while it is the likeliest.
         absent = f'  P(absent)={result.absent_probability:.3f}' if with_absent else ''
-        likelier = with_absent and result.absent_probability >= result.map_probability
+        likelier = says_absent(result)
         out(f'fixation {result.fixations:3d}: looked at ({kr}, {kc})  ->  most likely ({gr}, '
             f'{gc}) p={result.map_probability:.3f}{absent}  entropy {entropy:.2f} nats  '
             f'{right(result, likelier)}')
@@ -99,17 +103,20 @@ def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=
             f'which is {right(result, True)}')
         return None, session.path, session.belief, result
     verdict = right(result, False)
+    likeliest = f'the target is most likely at ({gr}, {gc}), probability ' \
+                f'{result.map_probability:.3f}'
+    if says_absent(result):             # undecided, but the answer so far is absent
+        verdict = right(result, True)
+        likeliest = f'most likely no target, P(absent) {result.absent_probability:.3f}'
     clause = answer.confidence_clause(result.decision, result.reason, result.map_probability,
                                       settings.confidence)
     if not result.decision:
         out(f'gave up: no cell reached the confidence {settings.confidence:.12g} after '
             f'{result.fixations} fixations, the cap of an offline search without a budget '
-            f'({NO_BUDGET_FRAMES_PER_CELL} per cell); the target is most likely at ({gr}, {gc}), '
-            f'probability {result.map_probability:.3f}, which is {verdict}')
+            f'({NO_BUDGET_FRAMES_PER_CELL} per cell); {likeliest}, which is {verdict}')
     elif result.decision == 'gave_up':
         out(f'gave up: no cell reached the confidence {settings.confidence:.12g} at '
-            f'{answer.LIMITS.get(result.reason, result.reason)}; the target is most likely at '
-            f'({gr}, {gc}), probability {result.map_probability:.3f}, after '
+            f'{answer.LIMITS.get(result.reason, result.reason)}; {likeliest}, after '
             f'{result.fixations} fixations, which is {verdict}')
     else:
         out(f'{answer.heading(result.decision, result.reason)}: the target is most likely at '
@@ -174,8 +181,10 @@ def run(args) -> int:
         elif result.decision == 'gave_up':
             ending += f' at {answer.LIMITS.get(result.reason, result.reason)}'
         # Two lines: one would run past the figure's edges and under the colour bar.
+        p = (f'P(absent)={result.absent_probability:.3f}' if result.decision == 'absent'
+             else f'p={result.map_probability:.3f}')
         title = (f'{grid.rows}x{grid.cols}, {task}, {name}\n{ending}, '
-                 f'p={result.map_probability:.3f}, {len(path)} fixations '
+                 f'{p}, {len(path)} fixations '
                  f"{'(no target)' if target is None else '(star = target)'}")
         plot_search(grid, belief, path, target, title, args.plot)
         print(f'wrote {args.plot}')
