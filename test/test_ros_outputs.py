@@ -194,3 +194,26 @@ def test_a_bad_qos_override_is_a_value_error_naming_it(context, policy, value, m
     name = f'qos_overrides./pan_tilt.subscription.{policy}'
     with pytest.raises(ValueError, match=re.escape(message)):
         SimulatedCameraNode(context=context, parameter_overrides=[Parameter(name, value=value)])
+
+
+def test_the_qos_override_parameters_rebuild_and_log_nothing(context):
+    # QA: each of rclpy's qos_overrides.* declarations rebuilt the node's configuration, then
+    # logged 'parameters set: qos_overrides./pan_tilt.subscription.durability=...' at start-up.
+    from ipomdp_gaze.nodes.camera import SimulatedCameraNode
+    from rclpy.parameter import Parameter
+
+    class Counting(SimulatedCameraNode):
+        builds = 0
+
+        def _build(self, *args, **kwargs):
+            Counting.builds += 1
+            return super()._build(*args, **kwargs)
+
+    node = Counting(context=context, parameter_overrides=[Parameter('rate_hz', value=0.0)])
+    try:
+        assert Counting.builds == 1                         # the start, nothing more
+        assert node.get_parameter('qos_overrides./pan_tilt.subscription.depth').value == 1
+        assert node.set_parameters([Parameter('seed', value=3)])[0].successful
+        assert Counting.builds == 2                         # its own parameters still build
+    finally:
+        node.destroy_node()

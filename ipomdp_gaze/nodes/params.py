@@ -203,6 +203,10 @@ def short_repr(value, limit: int = 6) -> str:
     return repr(value)
 
 
+# rclpy declares these itself for an overridable subscription, read-only, while it is made.
+QOS_OVERRIDES = 'qos_overrides.'
+
+
 class ParameterTransaction:
     """
     Declare a node's parameters and take every change whole or not at all.
@@ -261,6 +265,9 @@ class ParameterTransaction:
         self.ready = True
 
     def _on_set(self, params: list[Parameter]) -> SetParametersResult:
+        if all(p.name.startswith(QOS_OVERRIDES) for p in params):
+            self._pending = None    # rclpy's read-only QoS overrides (nodes/qos.py): not ours
+            return SetParametersResult(successful=True)
         for p in params:
             spec = self._by_name.get(p.name)
             reason = spec.check(p.value) if spec is not None else None
