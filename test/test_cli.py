@@ -113,6 +113,11 @@ def test_evaluate_draws_targets_from_a_prior_file(tmp_path, capsys):
     assert capsys.readouterr().out.splitlines()[0].endswith(f', prior {point}')
     data = json.loads(out.read_text())
     assert data['prior'] == [[0, 0, 0], [0, 0, 1], [0, 0, 0]]
+    huge = tmp_path / 'huge.txt'                # weights near the float limit: their sum is inf
+    huge.write_text('1e308 1e308 1e308\n' * 3)
+    assert main(['evaluate', '--grid', '3x3', '--episodes', '10', '--prior', str(huge),
+                 '--quiet', '--json', str(out)]) == 0
+    assert json.loads(out.read_text())['prior'] == [[1 / 9] * 3] * 3
     for name in ('map', 'random'):              # the belief starts sure: right from the start
         assert data['policies'][name]['percent_correct'] == [1.0] * 9
     # Targets follow the prior: weights 1 and 3 on two cells, the belief split 1:3 as well.
@@ -138,6 +143,7 @@ def test_evaluate_draws_targets_from_a_prior_file(tmp_path, capsys):
     ('1 1 1\n1 x 1\n1 1 1\n', "not a number in '1 x 1'"),
     ('1 1 1\n1 -1 1\n1 1 1\n', 'weights must be finite, >= 0 and not all 0'),
     ('0 0 0\n0 0 0\n0 0 0\n', 'weights must be finite, >= 0 and not all 0'),
+    ('1e308 1e308 1e308\n1e308 1e308 1e308\n1e308 1e308 x\n', "not a number in '1e308 1e308 x'"),
 ])
 def test_a_bad_prior_file_is_one_line(tmp_path, capsys, text, message):
     path = tmp_path / 'prior.txt'

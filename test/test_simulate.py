@@ -189,6 +189,7 @@ def test_with_a_blind_fpoc_the_belief_stays_at_the_prior():
     (np.full(9, 0.1), 'sum to 1, got 0.9'),
     (np.r_[-0.1, np.full(8, 1.1 / 8)], 'finite and >= 0'),
     (np.r_[np.nan, np.full(8, 1 / 8)], 'finite and >= 0'),
+    (np.full((9, 1), 1 / 9), r'\(rows, cols\) = \(3, 3\) or \(9,\), got shape \(9, 1\)'),
 ])
 def test_bad_priors_are_refused(prior, message):
     grid = Grid(3, 3, 1.0)

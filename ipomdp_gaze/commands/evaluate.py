@@ -462,8 +462,9 @@ def read_prior(path: Path, grid) -> np.ndarray:
         raise ValueError(f'--prior {path}: a {grid.rows}x{grid.cols} grid needs {grid.rows} '
                          f'lines of {grid.cols} weights, got {shape}')
     weights = np.asarray(rows, dtype=float).reshape(-1)
-    if not np.all(np.isfinite(weights)) or np.any(weights < 0) or not weights.sum() > 0:
+    if not np.all(np.isfinite(weights)) or np.any(weights < 0) or not weights.max() > 0:
         raise ValueError(f'--prior {path}: weights must be finite, >= 0 and not all 0')
+    weights = weights / weights.max()           # the sum of weights near 1e308 stays finite
     return weights / weights.sum()
 
 

@@ -1,7 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-The QoS profiles the nodes share, and the command subscriptions a user may re-profile.
+The state and frame QoS profiles several nodes share; the command subscriptions, re-profilable.
 
 A target (``pan_tilt``, ``fixation``) is state: reliable, depth 1, transient local, so a node
 that starts later still gets the current one. A subscription that asks for transient local

@@ -209,7 +209,7 @@ def check_present(present, episodes: int) -> np.ndarray:
     return values.astype(bool)
 
 
-def check_prior(prior, n_cells: int) -> np.ndarray:
+def check_prior(prior, n_cells: int, shape: tuple[int, int] | None = None) -> np.ndarray:
     """
     Return a prior over the target's cell as a float array (N,) summing to 1.
 
@@ -220,6 +220,9 @@ def check_prior(prior, n_cells: int) -> np.ndarray:
     values = np.asarray(prior, dtype=float) if not isinstance(prior, np.ndarray) else prior
     if values.dtype.kind not in 'iuf':
         raise ValueError(f'prior must be numbers, got dtype {values.dtype}')
+    if values.ndim == 2 and shape is not None and values.shape != tuple(shape):
+        raise ValueError(f'prior must be (rows, cols) = {tuple(shape)} or ({n_cells},), got shape '
+                         f'{values.shape}')
     values = values.astype(float).reshape(-1) if values.ndim == 2 else values.astype(float)
     if values.shape != (n_cells,):
         raise ValueError(f'prior must hold one probability per cell, {n_cells} values (rows x '
@@ -295,7 +298,7 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
         raise ValueError('episodes and horizon must be >= 1')
     model = as_observation(grid, model)
     if prior is not None:
-        prior = check_prior(prior, n)
+        prior = check_prior(prior, n, grid.shape)
     if targets is not None:
         targets = check_targets(targets, n, episodes)
     else:
