@@ -128,3 +128,17 @@ def test_every_shipped_controller_file_passes_the_yaml_check(name):
             got = getattr(settings, s.key)
             assert (list(got) if isinstance(got, tuple) else got) == \
                 (sorted(expected) if s.kind == 'floats' else expected), s.parameter
+
+
+@pytest.mark.parametrize('key, value, message', [
+    ('motion_lead_s', 1e6, r'motion.lead_s must be at most 60 s'),
+    ('motion_lead_s', -0.1, r'motion.lead_s must be finite and >= 0'),
+    ('motion_dwell_s', 1e6, r'motion.dwell_s must be at most 86400 s \(a day\)'),
+    ('motion_dwell_s', 0.0, r'motion.dwell_s must be finite and > 0'),
+])
+def test_motion_durations_have_an_upper_bound(key, value, message):
+    """QA: a lead of 1e6 s sent the head to the grid's corner; a dwell of 1e6 s was taken."""
+    with pytest.raises(ValueError, match=message):
+        SearchSettings(**{key: value})
+    assert getattr(SearchSettings(**{key: 60.0 if key == 'motion_lead_s' else 86400.0}),
+                   key) in (60.0, 86400.0)

@@ -32,6 +32,30 @@ from ipomdp_gaze.model.false_alarms import (check_false_alarm_scales, check_hots
                                             check_hotspot_scale, DEFAULT_HOTSPOT_SCALE)
 from ipomdp_gaze.model.still_evidence import check_repeat_weight
 
+# Upper bounds of two motion durations: a prediction further ahead than a minute says nothing
+# about where a walking person is (the head would chase the grid's corner), and a dwell of
+# more than a day is a re-check that never comes (room.dwell_s has the same bound).
+MAX_LEAD_S = 60.0
+MAX_DWELL_S = 86400.0
+
+
+def check_lead_s(value, name: str) -> float:
+    """Return ``motion.lead_s``: seconds in [0, :data:`MAX_LEAD_S`]."""
+    seconds = check_sigma_cells(value, name)
+    if seconds > MAX_LEAD_S:
+        raise ValueError(f'{name} must be at most {MAX_LEAD_S:g} s (a prediction that far ahead '
+                         f'says nothing of where the target is), got {value!r}')
+    return seconds
+
+
+def check_dwell_s(value, name: str) -> float:
+    """Return ``motion.dwell_s``: seconds in (0, :data:`MAX_DWELL_S`]."""
+    seconds = check_seconds(value, name)
+    if seconds > MAX_DWELL_S:
+        raise ValueError(f'{name} must be at most {MAX_DWELL_S:g} s (a day), got {value!r}')
+    return seconds
+
+
 # What a setting's values are: the node declares them with the matching parameter type and a
 # CLI flag parses them so (a cell is ``ROW,COL``; the node declares it as two integers).
 KINDS = ('float', 'int', 'bool', 'floats', 'cell', 'str')
@@ -136,10 +160,10 @@ SCHEMA: tuple[Setting, ...] = (
             "position (look at the cell of the position the detections' filter predicts "
             'motion.lead_s ahead; docs/design.md section 12.9)',
             bounds='policy, peak or position', metavar='policy|peak|position'),
-    Setting('motion_lead_s', 'motion.lead_s', 'float', 0.0, check_sigma_cells,
+    Setting('motion_lead_s', 'motion.lead_s', 'float', 0.0, check_lead_s,
             'with motion.track_view peak or position: how far ahead the target is predicted '
             '(the time from a frame to the next: saccade, settling and the detector)',
-            bounds='>= 0', metavar='SECONDS'),
+            bounds='in [0, 60]', metavar='SECONDS'),
     Setting('motion_position_sigma_cells', 'motion.position_sigma_cells', 'float', 0.1,
             check_positive_cells,
             "with motion.track_view position: the standard deviation of the detections' mean "
@@ -150,11 +174,11 @@ SCHEMA: tuple[Setting, ...] = (
             'moving target: once found, it stays found while the answer holds at least this '
             'probability, and is lost below it (0: the confidence)', bounds='in [0, 1)',
             metavar='P'),
-    Setting('motion_dwell_s', 'motion.dwell_s', 'float', 2.0, check_seconds,
+    Setting('motion_dwell_s', 'motion.dwell_s', 'float', 2.0, check_dwell_s,
             'search.targets many, moving targets: seconds of views each person found gets in '
             'turn before the next; after each round the search looks for people not found yet '
             '(one view, or up to half as long while the room is undecided; docs/design.md '
-            'section 12.10)', bounds='> 0', metavar='SECONDS'),
+            'section 12.10)', bounds='in (0, 86400]', metavar='SECONDS'),
     Setting('start_cell', 'start_cell', 'cell', None, check_start_cell,
             "the first fixation (default: the policy's choice after a scan, else the grid's "
             'centre)', flag='--start', metavar='ROW,COL'),
