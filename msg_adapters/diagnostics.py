@@ -121,9 +121,10 @@ def lost_status(name: str, row: int, col: int, cell: int, probability: float,
                 absent_probability: float, fixations: int,
                 seconds_tracked: float, person: int = 0) -> DiagnosticStatus:
     """Build the ``lost`` event (level WARN): the tracked target (or ``person``) is not found."""
+    shown, nobody = max(0.0, probability), max(0.0, absent_probability)   # never '-0.0000'
     message = (f'{_who(person)} lost: last found at row {row}, col {col}, tracked '
-               f'{seconds_tracked:.2f} s; most likely cell now {probability:.4f}, nobody here '
-               f'{absent_probability:.4f} after {fixations} fixations')
+               f'{seconds_tracked:.2f} s; most likely cell now {shown:.4f}, nobody here '
+               f'{nobody:.4f} after {fixations} fixations')
     return status(name, 'warn', message, {
         'row': row, 'col': col, 'cell': cell, 'probability': float(probability),
         'absent_probability': float(absent_probability), 'fixations': fixations,

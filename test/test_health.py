@@ -211,6 +211,26 @@ def test_monitor_reports_the_found_target():
     assert monitor.report(core, t + 1.5, 60.0).message == 'target found'
 
 
+def test_found_in_diagnostics_is_the_decision_now():
+    """QA: 'found' stayed true after a moving target was lost (decision absent, not found)."""
+    core = controller(confidence=0.6, absent_prior=0.3, motion_sigma_cells=0.3,
+                      motion_leave_prob=0.1)
+    monitor = HealthMonitor(0.0)
+    target, t = GRID.center_index, 0.0
+    while core.decision != 'found':
+        t += 1.0
+        obs = np.random.default_rng(int(t)).standard_normal(GRID.n_cells)
+        obs[target] += 4.0
+        core.offer(obs, t)
+    assert monitor.report(core, t + 0.5, 60.0).values['found'] is True
+    while core.decision == 'found':                # the target has left: only noise now
+        t += 1.0
+        core.offer(np.random.default_rng(int(t)).standard_normal(GRID.n_cells), t)
+    assert core.found is not None                   # the event fired in this search ...
+    values = monitor.report(core, t + 0.5, 60.0).values
+    assert values['found'] is False and values['decision'] == core.decision   # ... not now
+
+
 def test_monitor_starts_from_the_counters_it_is_given():
     core = controller()
     for i in range(3):

@@ -237,6 +237,12 @@ def test_bad_evidence_images(kwargs, err, words):
 
 
 # -- diagnostics and stamps ---------------------------------------------------------------------
+def test_a_lost_event_never_says_minus_zero():
+    from ipomdp_gaze.msg_adapters.diagnostics import lost_status
+    message = lost_status('x', 1, 2, 3, -1e-17, -0.0, 4, 1.0).message
+    assert 'most likely cell now 0.0000, nobody here 0.0000' in message and '-0' not in message
+
+
 def test_lost_and_reacquired_events_round_trip():
     lost = diagnostics.lost_status('/gaze_controller: lost', 2, 9, 31, 0.41, 0.35, 17, 4.25)
     assert lost.level == DiagnosticStatus.WARN and 'row 2, col 9' in lost.message

@@ -40,8 +40,7 @@ def rig(probe, nodes):
            'cells': probe.record(Float32MultiArray, f'/{NODE}/target_cells', LATCHED),
            'pan_tilt': probe.record(JointState, 'pan_tilt', LATCHED, distinct_stamps=True),
            'status': probe.search_status(NODE)}
-    rec['controller'] = nodes.start('controller', [
-        '--params-file', config_path('faces_camera_controller.yaml'),
+    rec['controller'] = nodes.start('controller', [      # README's chain, the bench's settings
         '--params-file', config_path('faces_camera_tracking.yaml'),
         '--params-file', config_path('faces_camera_people.yaml'),
         '-p', 'motion.dwell_s:=1.0', '-p', 'diagnostics_period_s:=0.2'])

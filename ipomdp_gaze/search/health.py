@@ -185,7 +185,7 @@ class HealthMonitor:
             'fixations': core.fixations, 'fixation_row': fix_row, 'fixation_col': fix_col,
             'entropy_nats': core.entropy_nats, 'most_likely_row': map_row,
             'most_likely_col': map_col, 'most_likely_probability': core.map_probability,
-            'found': core.found is not None, 'pan_tilt_resends': resends,
+            'found': core.decision == 'found', 'pan_tilt_resends': resends,
             'last_rejection': core.last_rejection,
             'absent_probability': core.absent_probability, 'decision': core.decision,
             'search_ended': core.stopped, 'lost': core.losses,
