@@ -170,3 +170,32 @@ def test_entropy_of_a_log_belief_is_the_entropy_of_its_probabilities(n, impossib
     log_b = normalize_log(log_b)
     assert entropy_of_log(log_b) == pytest.approx(float(entropy(np.exp(log_b))), rel=1e-12,
                                                   abs=1e-12)
+
+
+def test_a_batch_renormalises_terms_far_beyond_the_range_of_exp_as_one_belief_does():
+    """The batch path shifts each row by its peak before exp, as the one-belief path does."""
+    log_b = uniform_log_belief(5, episodes=3)
+    term = np.zeros((3, 5))
+    term[0, 2] = 1e6                                    # exp(1e6) overflows unless shifted
+    term[1, 4] = -1e6
+    term[2] = 800.0 + np.arange(5)
+    batch = bayes_update(log_b, term)
+    assert np.isfinite(batch).all()
+    np.testing.assert_allclose(np.exp(batch).sum(axis=1), 1.0)
+    for e in range(3):
+        np.testing.assert_allclose(batch[e], bayes_update(log_b[e], term[e]), rtol=1e-12)
+    assert batch[0, 2] == 0.0 and batch[0, 0] == -1e6
+
+
+@pytest.mark.parametrize('scores, expected', [
+    ([-3.0, -1.0 - 1e-12, -1.0], 1),       # a negative peak: a near tie within rtol |peak|
+    ([-3.0, -1.0 - 1e-6, -1.0], 2),        # a negative peak, not within the tolerance
+    ([-1.0, 0.0, 0.0], 1),                 # a peak of 0: the first cell at it
+    ([0.0, -1.0, -0.0], 0),
+])
+def test_the_tie_rule_holds_for_negative_and_zero_peaks_in_one_belief_and_a_batch(
+        scores, expected):
+    """Infomax rewards and log scores are negative: the rule must not depend on the sign."""
+    assert argmax_ties_low(np.array(scores)) == expected
+    np.testing.assert_array_equal(argmax_ties_low(np.array([scores, scores])),
+                                  [expected, expected])
