@@ -6,7 +6,7 @@ from ipomdp_gaze.files.observation_file import (fingerprint, load_observation, m
                                                 save_observation)
 from ipomdp_gaze.model.belief import bayes_update, EvidenceError, uniform_log_belief
 from ipomdp_gaze.model.grid import Grid
-from ipomdp_gaze.model.observation import CountObservation
+from ipomdp_gaze.model.observation import CountObservation, MAX_LOG_RATIO
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.simulation.simulate import simulate
 import numpy as np
@@ -243,3 +243,63 @@ def test_scan_tables_round_trip_through_the_file_and_the_fingerprint(tmp_path):
     doc['scan'] = {'target': [0.5, 0.5], 'null': [0.5, 0.5]}
     with pytest.raises(ObservationFileError, match='K = 4 entries'):
         model_from_dict(doc)
+
+
+@pytest.mark.parametrize('scale', [0.5, 2.0])
+def test_tables_that_do_not_sum_to_one_are_refused_below_as_above(scale):
+    target, null = tables(0)
+    null[1, 2] *= scale
+    with pytest.raises(ValueError, match=r'null table must sum to 1 over counts at every '
+                                         r'offset: offset \(1, 2\)'):
+        CountObservation(GRID, target, null)
+    with pytest.raises(ValueError, match='scan target table must sum to 1'):
+        CountObservation(GRID, *tables(0), scan_target=SCAN_TARGET * scale,
+                         scan_null=SCAN_NULL)
+
+
+def test_tables_of_a_single_count_are_refused():
+    one = np.ones(GRID.shape + (1,))
+    with pytest.raises(ValueError, match='K >= 2'):
+        CountObservation(GRID, one, one)
+
+
+def test_a_count_one_hypothesis_rules_out_gives_the_clipped_ratio_on_either_side():
+    target, null = tables(2)
+    target[0, 0] = [0.0, 0.0, 0.5, 0.5]
+    null[0, 0] = [0.5, 0.5, 0.0, 0.0]
+    model = CountObservation(GRID, target, null)
+    frame = np.full(GRID.n_cells, np.nan)
+    frame[0] = 3                                   # impossible without the target
+    assert model.log_likelihood_ratio(frame, 0)[0] == MAX_LOG_RATIO
+    frame[0] = 0                                   # impossible with the target
+    assert model.log_likelihood_ratio(frame, 0)[0] == -MAX_LOG_RATIO
+
+
+def test_cells_at_offsets_whose_tables_agree_are_not_observed_and_learn_nothing():
+    target, null = tables(4)
+    target[2:] = null[2:]                          # offsets |dr| >= 2 say nothing
+    model = CountObservation(GRID, target, null)
+    rows, _ = GRID.rows_cols()
+    for k, row in ((GRID.index(0, 0), 0), (GRID.index(3, 4), 3)):
+        np.testing.assert_array_equal(model.observed(k), np.abs(rows - row) < 2)
+        term = model.log_likelihood_ratio(np.full(GRID.n_cells, 2.0), k)
+        assert np.all(term[np.abs(rows - row) >= 2] == 0.0)
+
+
+def test_the_elm_kernel_is_twice_the_kl_by_hand_with_zero_probabilities():
+    """0 log 0 = 0 where p_target is 0; where p_null is 0 and p_target is not, 2 * the cap."""
+    target, null = tables(5)
+    target[0, 1] = [0.0, 0.2, 0.3, 0.5]            # a count the target never gives
+    target[2, 3], null[2, 3] = [0.25] * 4, [0.5, 0.5, 0.0, 0.0]
+    model = CountObservation(GRID, target, null)
+    kernel = model.elm_kernel()
+    assert kernel.shape == GRID.kernel_shape and np.isfinite(kernel).all()
+    rows, cols = GRID.shape
+    for dr in range(-(rows - 1), rows):
+        for dc in range(-(cols - 1), cols):
+            pt, pn = target[abs(dr), abs(dc)], null[abs(dr), abs(dc)]
+            if np.any((pt > 0) & (pn == 0)):
+                expected = 2 * MAX_LOG_RATIO
+            else:
+                expected = 2 * sum(p * np.log(p / q) for p, q in zip(pt, pn) if p > 0)
+            assert kernel[dr + rows - 1, dc + cols - 1] == pytest.approx(expected, rel=1e-12)
