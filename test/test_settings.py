@@ -20,6 +20,7 @@ from ipomdp_gaze.files.yaml_files import yaml_parameters
 from ipomdp_gaze.model.checks import check_sigma_cells
 from ipomdp_gaze.search.session import PARAMETER_NAMES, SearchSettings
 from ipomdp_gaze.search.settings import check_parameters, SCHEMA, Setting, settings_class
+import numpy as np
 import pytest
 
 NEW = Setting('dwell_s', 'search.dwell_s', 'float', 1.5, check_sigma_cells,
@@ -142,3 +143,21 @@ def test_motion_durations_have_an_upper_bound(key, value, message):
         SearchSettings(**{key: value})
     assert getattr(SearchSettings(**{key: 60.0 if key == 'motion_lead_s' else 86400.0}),
                    key) in (60.0, 86400.0)
+
+
+@pytest.mark.parametrize('changes, message', [
+    ({'found_radius': 6}, 'search.found_radius must be an integer from 0 to 5'),
+    ({'found_radius': -1}, 'search.found_radius must be an integer from 0 to 5'),
+    ({'start_cell': (0, -1)}, r'start_cell must be \(row, col\) with row, col >= 0'),
+    ({'start_cell': (-1, 0)}, r'start_cell must be \(row, col\) with row, col >= 0'),
+])
+def test_the_bounds_of_cell_settings_are_refused_on_both_sides(changes, message):
+    with pytest.raises(ValueError, match=message):
+        SearchSettings(**changes)
+
+
+def test_the_edges_of_cell_settings_and_numpy_booleans_are_accepted():
+    settings = SearchSettings(found_radius=5, start_cell=(0, 0), inhibit_return=np.True_,
+                              stop_on_repeat=np.False_)
+    assert settings.found_radius == 5 and settings.start_cell == (0, 0)
+    assert settings.inhibit_return is True and settings.stop_on_repeat is False
