@@ -6,10 +6,10 @@ from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.motion import Motion
 from ipomdp_gaze.model.observation import CountObservation, GaussianObservation
-from ipomdp_gaze.model.stopping import (ABSENT, check_absent_prior, check_confidence,
-                                        check_max_fixations, decide, decide_one,
-                                        first_decisions, FOUND,
-                                        GAVE_UP, initial_log_belief, UNDECIDED)
+from ipomdp_gaze.model.stopping import (ABSENT, BatchBelief, check_absent_prior,
+                                        check_confidence, check_max_fixations, decide,
+                                        decide_one, first_decisions, FOUND, GAVE_UP,
+                                        initial_log_belief, UNDECIDED)
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.simulation.evaluation import (decision_summary, paired_tracking_difference,
                                                search_outcomes, tracking_arrays, tracking_summary,
@@ -291,3 +291,18 @@ def test_bad_settings_are_refused_with_a_reason(check, value, message):
 def test_budget_zero_means_none():
     assert check_max_fixations(0) is None and check_max_fixations(None) is None
     assert check_max_fixations(7) == 7
+
+
+def test_a_batch_reward_counts_a_cell_at_probability_zero_as_0_log_0():
+    """Infomax reward over every hypothesis: a cell at -inf (a motion step) adds 0, not NaN."""
+    batch = BatchBelief(4, 0.2, episodes=2, moving=True)
+    batch.log_belief[0, 1] = -np.inf
+    batch.log_belief[:] = bayes_update(batch.log_belief, np.zeros((2, 5)))
+    llr = np.array([[0.5, 0.0, -1.0, 2.0], [0.0, 1.0, 0.0, 0.0]])
+    reward = batch.update(llr)
+    for e in range(2):
+        log_b = bayes_update(batch.log_belief[e], np.zeros(5))      # already the posterior
+        p = np.exp(log_b)
+        expected = sum(x * np.log(x) for x in p if x > 0)
+        assert reward[e] == pytest.approx(expected, rel=1e-12)
+    assert np.isfinite(reward).all() and batch.belief[0, 1] == 0.0
