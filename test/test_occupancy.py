@@ -7,11 +7,13 @@ import math
 
 from ipomdp_gaze.model.fpoc import make_fpoc
 from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.motion import Motion
 from ipomdp_gaze.model.observation import CountObservation, GaussianObservation
-from ipomdp_gaze.model.occupancy import (binary_entropy, cell_prior, channel_information, clusters,
-                                         count_faces, decided, InformationTable, log_nobody,
-                                         occupancy, one_target_belief, prior_log_odds,
-                                         update_log_odds)
+from ipomdp_gaze.model.occupancy import (_TABLES, binary_entropy, cell_prior, channel_information,
+                                         clusters, count_faces, decided, information_table,
+                                         InformationTable, log_nobody, MAX_LOG_ODDS, occupancy,
+                                         one_target_belief, predict_occupancy, prior_log_odds,
+                                         TABLE_LOG_ODDS, update_log_odds)
 from ipomdp_gaze.search.many import OccupancySession
 from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
 import numpy as np
@@ -750,3 +752,69 @@ def test_the_still_gains_kept_between_frames_are_those_computed_afresh(link):
         frame = np.where(face, terms.argmax(axis=0), terms.argmin(axis=0)).astype(float)
         frame[rng.random(grid.n_cells) < 0.3] = np.nan
         session.update(Frame(frame))
+
+
+def test_the_information_table_interpolates_between_its_points_and_clamps_beyond_them():
+    """Off its 0.1 grid the table interpolates; decided cells (|L| >= 30) read its ends, ~0."""
+    grid = Grid(3, 4)
+    model = _model(grid, k=3, seed=8)
+    table = InformationTable(model)
+    offsets = model.offsets(np.arange(grid.n_cells))
+    k = model.max_count + 1
+    rng = np.random.default_rng(8)
+    log_odds = rng.uniform(-8.0, 8.0, grid.n_cells)
+    log_odds[:4] = [0.05, -2.95, 1.234, 3.3333]              # between the table's points
+    exact = channel_information(occupancy(log_odds)[None, :],
+                                model.p_target.reshape(-1, k)[offsets],
+                                model.p_null.reshape(-1, k)[offsets])
+    np.testing.assert_allclose(table(log_odds), exact, atol=5e-4)
+    decided_cells = np.array([TABLE_LOG_ODDS, TABLE_LOG_ODDS + 15.0, -TABLE_LOG_ODDS, -1e6,
+                              np.inf, -np.inf] + [0.0] * (grid.n_cells - 6))
+    info = table(decided_cells)
+    assert np.isfinite(info).all()
+    assert np.all(info[:, :6] < 1e-9)
+    session = OccupancySession(grid, model, SearchSettings(targets='many'))
+    session.reset()
+    assert np.isfinite(session.gains(decided_cells)).all()
+
+
+def test_a_cell_is_decided_at_exactly_the_confidence_either_way():
+    confidence = 0.9
+    threshold = math.log(confidence) - math.log1p(-confidence)
+    occupied, empty = decided(np.array([threshold, -threshold, np.nextafter(threshold, 0),
+                                        np.nextafter(-threshold, 0)]), confidence)
+    np.testing.assert_array_equal(occupied, [True, False, False, False])
+    np.testing.assert_array_equal(empty, [False, True, False, False])
+
+
+def test_a_predicted_expected_count_above_one_is_a_cell_occupied_for_certain_not_nan():
+    """People walking in from outside can make m_j exceed 1: P'_j is clipped below 1."""
+    grid = Grid(1, 2)
+    motion = Motion(grid, 0.0, 0.0, 0.5)                  # half of those out of reach come in
+    log_odds, outside = predict_occupancy(np.array([2.0, -1.0]), 5.0, motion, 1.0)
+    assert np.all(np.isfinite(log_odds)) and np.all(log_odds <= MAX_LOG_ODDS)
+    np.testing.assert_array_equal(log_odds, [MAX_LOG_ODDS, MAX_LOG_ODDS])
+    assert 0.0 < outside < 5.0
+
+
+@pytest.mark.parametrize('seconds', [0.0, -1.0])
+def test_no_time_predicts_nothing_even_for_decided_cells(seconds):
+    log_odds = np.array([45.0, -60.0, 0.3, 2.0])
+    predicted, outside = predict_occupancy(log_odds, 0.7, Motion(Grid(2, 2), 0.8, 0.1, 0.2),
+                                           seconds)
+    np.testing.assert_array_equal(predicted, log_odds)
+    assert outside == 0.7 and predicted is not log_odds
+
+
+def test_the_information_table_of_a_model_is_never_another_models_by_a_reused_id():
+    """The cache is keyed by id(model); an id reused after a model is freed must not match."""
+    grid = Grid(2, 3)
+    first, second = _model(grid, seed=1), _model(grid, seed=2)
+    stale = information_table(first)
+    _TABLES[id(second)] = (first, stale)          # as if `second` reused a freed model's id
+    try:
+        table = information_table(second)
+        assert table is not stale
+        np.testing.assert_array_equal(table.table, InformationTable(second).table)
+    finally:
+        _TABLES.pop(id(second), None)
