@@ -703,3 +703,64 @@ def _count_model_of(grid):
     """Return a count model of ``grid`` (flat tables: the grid is all that matters here)."""
     table = np.full((grid.rows, grid.cols, 3), 1 / 3)
     return CountObservation(grid, table, table.copy())
+
+
+def test_the_one_time_scan_is_refused_a_second_time_and_the_belief_kept():
+    model = count_model(3)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model), SearchSettings())
+    session.reset()
+    scan = Frame(np.array([3.0] + [0.0] * (GRID.n_cells - 1)), kind='scan')
+    assert session.scan(scan).applied
+    before = session.log_belief
+    with pytest.raises(OrderError, match='once'):
+        session.scan(scan)
+    np.testing.assert_array_equal(session.log_belief, before)
+
+
+@pytest.mark.parametrize('how', ['budget', 'stop'])
+def test_at_a_limit_a_tie_between_absent_and_the_answer_decides_absent(how):
+    """decide_at_budget: absent when P(absent) is at least the answer's probability."""
+    grid = Grid(1, 1)
+    settings = SearchSettings(absent_prior=0.5, decide_at_budget=True,
+                              max_fixations=1 if how == 'budget' else 0)
+    session = SearchSession(grid, make_fpoc('human'), None, settings)
+    session.reset()
+    session.start()
+    result = session.update(Frame(np.array([np.nan])))     # unobserved: the prior stays
+    if how == 'stop':
+        assert not result.ended
+        result = session.stop('pixels')
+    assert session.absent_probability == session.map_probability == 0.5
+    reason = 'budget' if how == 'budget' else 'pixels'
+    assert (result.decision, result.reason, result.ended) == ('absent', reason, True)
+
+
+def test_with_motion_the_budget_ends_only_a_search_that_has_not_decided_yet():
+    session, model = _tracking_session(max_fixations=6)
+    cell = session.start()
+    target = GRID.index(1, 2)
+    fired = []
+    for t in range(12):
+        result = session.update(_strong_frame(model, cell, target), dt_s=0.1)
+        fired.append(result.fired)
+        assert not result.ended, (t, result)
+        cell = result.fixation
+    assert 'found' in fired[:5] and session.fixations == 12
+
+
+def test_an_excluded_cell_stays_ruled_out_when_repeated_views_are_weighted():
+    model = count_model(2)
+    settings = SearchSettings(confidence=1 - 1e-12, repeat_weight=0.5, max_fixations=8)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model), settings)
+    sensor = ModelSensor(GRID, model, np.random.default_rng(3))
+    sensor.start(5)                                      # the target sits in the excluded cell
+    session.reset(seed=0)
+    session.exclude([5])
+    cell = session.start()
+    for _ in range(8):
+        result = session.update(sensor.observe(cell))
+        assert session.belief[5] == 0.0
+        assert session.belief.sum() == pytest.approx(1.0)
+        if result.ended:
+            break
+        cell = result.fixation
