@@ -111,3 +111,50 @@ def test_a_percentile_on_a_finite_resample_next_to_those_beyond_is_that_resample
     values = np.r_[np.arange(975.0), np.full(25, np.inf)]
     assert _interval(values, values) is None
     assert _interval(-values, -values) is None
+
+
+def test_the_prior_is_the_chance_level_when_90_percent_is_crossed_at_the_first_fixation():
+    """Percent correct at t = 0 is 1/N: the first segment runs from (0, 1/N) to (1, pc[0])."""
+    assert fixations_to_level(np.array([0.95, 1.0]), 4) == pytest.approx(0.65 / 0.7)
+    assert fixations_to_level(np.array([[0.95], [0.2]]), 4)[0] == pytest.approx(0.65 / 0.7)
+
+
+def test_a_curve_that_reaches_90_percent_exactly_has_reached_it():
+    assert fixations_to_level(np.array([0.5, 0.9]), 10) == pytest.approx(2.0)
+    assert fixations_to_level(np.array([0.5, 0.9, 0.9, 1.0]), 10) == pytest.approx(2.0)
+
+
+def _never_right_in_one_resample():
+    """Return 9 episodes right from fixation 1 and one never; resamples: the sample, 1 beyond."""
+    correct = np.zeros((10, 3), dtype=bool)
+    correct[:9] = True
+    counts = np.ones((1000, 10), dtype=np.int64)
+    counts[-1] = 0
+    counts[-1, 9] = 10
+    return correct, counts
+
+
+def test_a_resample_that_never_reaches_90_percent_is_beyond_the_horizon_not_undefined():
+    correct, counts = _never_right_in_one_resample()
+    point, ci = fixations_to_90_ci(correct, 10, None, counts=counts)
+    assert point == pytest.approx((0.9 - 0.1) / (0.9 - 0.1))
+    assert ci == (pytest.approx(point), pytest.approx(point))     # 1 of 1000: inside 97.5%
+
+
+def test_a_paired_resample_beyond_the_horizon_on_both_sides_widens_nothing_it_cannot_know():
+    correct, counts = _never_right_in_one_resample()
+    diff, ci = paired_difference_ci(correct, correct, 10, None, counts=counts)
+    assert diff == 0 and ci == (0.0, 0.0)
+
+
+def test_a_resample_identical_to_the_sample_reaches_90_percent_where_the_sample_does():
+    """Bug: the bootstrap divided its curves in float32, 9/10 = 0.89999998 < 0.9: never."""
+    correct = np.zeros((10, 3), dtype=bool)
+    correct[:9] = True                                     # exactly 90% right from fixation 1
+    same = np.ones((1000, 10), dtype=np.int64)             # every resample is the sample
+    point, ci = fixations_to_90_ci(correct, 10, None, counts=same)
+    assert point == 1.0 and ci == (1.0, 1.0)
+    other = np.zeros((10, 3), dtype=bool)
+    other[:9, 1:] = True                                   # the same, one fixation later
+    diff, paired = paired_difference_ci(correct, other, 10, None, counts=same)
+    assert diff == pytest.approx(-1.0) and paired == (pytest.approx(-1.0), pytest.approx(-1.0))

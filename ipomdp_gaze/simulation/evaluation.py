@@ -76,7 +76,10 @@ def fixations_to_90_ci(correct: np.ndarray, n_cells: int, rng: np.random.Generat
         return None, None
     if counts is None:
         counts = bootstrap_counts(episodes, resamples, rng)
-    curves = (counts.astype(np.float32) @ correct.astype(np.float32)) / episodes
+    # Whole counts, exact in float32 (below 2^24); divided in float64 as the point estimate's
+    # mean is, so a resample at exactly 90% reaches it as the sample does (not 0.89999998).
+    curves = (counts.astype(np.float32) @ correct.astype(np.float32)).astype(np.float64) \
+        / episodes
     values = fixations_to_level(curves, n_cells)
     beyond = np.where(np.isnan(values), np.inf, values)     # not reached within the horizon
     return point, _interval(beyond, beyond)
@@ -126,8 +129,8 @@ def paired_difference_ci(correct_a: np.ndarray, correct_b: np.ndarray, n_cells: 
     if counts is None:
         counts = bootstrap_counts(n, resamples, rng)
     counts = counts.astype(np.float32)
-    va = fixations_to_level(counts @ a.astype(np.float32) / n, n_cells)
-    vb = fixations_to_level(counts @ b.astype(np.float32) / n, n_cells)
+    va = fixations_to_level((counts @ a.astype(np.float32)).astype(np.float64) / n, n_cells)
+    vb = fixations_to_level((counts @ b.astype(np.float32)).astype(np.float64) / n, n_cells)
     # beyond the horizon: +inf on that side; both beyond, the difference could be anything
     with np.errstate(invalid='ignore'):
         diff = np.where(np.isnan(va), np.inf, va) - np.where(np.isnan(vb), np.inf, vb)
