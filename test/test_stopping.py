@@ -11,9 +11,9 @@ from ipomdp_gaze.model.stopping import (ABSENT, BatchBelief, check_absent_prior,
                                         decide_one, first_decisions, FOUND, GAVE_UP,
                                         initial_log_belief, UNDECIDED)
 from ipomdp_gaze.policies.baselines import make_baseline
-from ipomdp_gaze.simulation.evaluation import (decision_summary, paired_tracking_difference,
-                                               search_outcomes, tracking_arrays, tracking_summary,
-                                               wilson_interval)
+from ipomdp_gaze.simulation.evaluation import (decision_summary, mean_ci,
+                                               paired_tracking_difference, search_outcomes,
+                                               tracking_arrays, tracking_summary, wilson_interval)
 from ipomdp_gaze.simulation.simulate import (draw_present, motion_stream, noise_stream,
                                              SearchResult, simulate)
 import numpy as np
@@ -306,3 +306,22 @@ def test_a_batch_reward_counts_a_cell_at_probability_zero_as_0_log_0():
         expected = sum(x * np.log(x) for x in p if x > 0)
         assert reward[e] == pytest.approx(expected, rel=1e-12)
     assert np.isfinite(reward).all() and batch.belief[0, 1] == 0.0
+
+
+def test_the_mean_and_its_normal_interval_use_the_sample_standard_deviation():
+    values = np.array([1.0, 2.0, 3.0, 7.0])
+    half = 1.959963984540054 * np.sqrt(np.sum((values - 3.25) ** 2) / 3) / 2
+    out = mean_ci(values)
+    assert out['mean'] == 3.25 and out['ci95'] == pytest.approx([3.25 - half, 3.25 + half])
+    assert mean_ci(np.array([2.0])) == {'mean': 2.0, 'ci95': None}
+    assert mean_ci(np.array([])) == {'mean': None, 'ci95': None}
+
+
+def test_wrong_decisions_count_a_wrong_absent_as_well_as_a_wrong_found():
+    res = hand_made_result()
+    res.absent_prob[1] = 0.97                 # search 1 (a target present) now says absent
+    outcome, _ = search_outcomes(res, 0.95)
+    np.testing.assert_array_equal(outcome, [0, 2, 1, 1, 0])
+    s = decision_summary(res, 0.95)
+    assert s['decided']['searches'] == 5 and s['decided']['wrong']['count'] == 3
+    assert s['decided']['wrong_absent']['count'] == 1
