@@ -818,3 +818,34 @@ def test_the_information_table_of_a_model_is_never_another_models_by_a_reused_id
         np.testing.assert_array_equal(table.table, InformationTable(second).table)
     finally:
         _TABLES.pop(id(second), None)
+
+
+@pytest.mark.parametrize('weight', [0.0, 0.3])
+def test_a_view_seen_already_gains_repeat_weight_of_its_information_and_unseen_cells_full(weight):
+    """w_kj is repeat_weight where view k repeats an equally good view; NaN cells were unseen."""
+    grid = Grid(3, 3)
+    model = _model(grid, k=3, seed=8, radius=1)
+    session = OccupancySession(grid, model, SearchSettings(
+        targets='many', scan=False, repeat_weight=weight, confidence=0.999))
+    session.reset()
+    k = session.start()
+    frame = np.zeros(grid.n_cells)
+    frame[0] = np.nan                                        # cell 0 not observed
+    session.update(Frame(frame))
+    info = InformationTable(model)(session.log_odds)        # [view, cell]
+    seen = model.observed(k) & ~np.isnan(frame)
+    expected = np.where(seen, weight, 1.0) * info[k]
+    assert session.gains()[k] == pytest.approx(expected.sum(), rel=1e-12)
+
+
+def test_inhibition_of_return_keeps_a_many_target_search_off_the_views_it_took():
+    grid = Grid(3, 3)
+    model = _model(grid, k=3, seed=8, radius=1)
+    weak = CountObservation(grid, 0.95 * model.p_null + 0.05 * model.p_target, model.p_null)
+    session = OccupancySession(grid, weak, SearchSettings(
+        targets='many', scan=False, inhibit_return=True, max_fixations=9, confidence=0.999))
+    session.reset()
+    session.start()
+    while not session.ended:
+        session.update(Frame(np.zeros(grid.n_cells)))
+    assert len(session.path) >= 3 and len(set(session.path)) == len(session.path)
