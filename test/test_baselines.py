@@ -78,3 +78,20 @@ def test_spiral_visits_every_cell_once():
 def test_center_policy_from_uniform():
     k = make_baseline('center', Grid(7, 7), HUMAN).select(np.full((2, 49), 1 / 49), 0, None)
     assert list(k) == [24, 24]
+
+
+@pytest.mark.parametrize('peak, diffuse',
+                         [(0.25, True), (0.29, True), (0.31, False), (0.4, False)])
+def test_coverage_raises_the_tiles_only_while_no_cell_given_a_target_reaches_its_peak(
+        peak, diffuse):
+    """Below 0.3 only, on the cells given a target (they sum to 1 - P(absent))."""
+    coverage, elm = make_baseline('coverage', GRID, HUMAN), make_baseline('elm', GRID, HUMAN)
+    belief = np.full(GRID.n_cells, (1 - peak) / (GRID.n_cells - 1))
+    belief[7] = peak
+    elm_scores = np.asarray(elm.scores(belief[None, :]), dtype=float).reshape(-1)
+    for scale in (1.0, 0.5):                  # the same belief with P(absent) = 0.5
+        scores = coverage.scores(scale * belief[None, :]).reshape(-1)
+        raised = scores - elm_scores
+        np.testing.assert_allclose(raised[coverage.tile == 0], 0.0, atol=1e-12)
+        assert np.all(raised[coverage.tile == 1] > elm_scores.max()) == diffuse
+        assert np.all(np.abs(raised[coverage.tile == 1]) < 1e-12) == (not diffuse)
