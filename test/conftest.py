@@ -239,6 +239,15 @@ def config_path(name: str) -> str:
     return str(config_file(name))
 
 
+def people_controller_args(keep_probability: float, *extra: str) -> list[str]:
+    """Return the arguments of a controller following moving people (``extra``: more ``-p``)."""
+    return ['--params-file', config_path('controller.yaml'), '-p', 'search.targets:=many',
+            '-p', 'absent.prior:=0.3', '-p', 'motion.sigma_cells:=0.3',
+            '-p', 'motion.leave_prob:=0.05', '-p', 'motion.track_view:=peak',
+            '-p', f'motion.keep_probability:={keep_probability}', '-p', 'motion.dwell_s:=1.0',
+            '-p', 'diagnostics_period_s:=0.2', *extra]
+
+
 @pytest.fixture
 def cli_here(capsys, monkeypatch):
     """

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import time
 
-from conftest import config_path, wait_for
+from conftest import config_path, people_controller_args, wait_for
 import pytest
 
 pytestmark = pytest.mark.ros
@@ -35,12 +35,7 @@ def events(launch, probe):
            'reacquired': probe.record(DiagnosticStatus, 'reacquired', 10),
            'cells': probe.record(Float32MultiArray, f'/{CONTROLLER}/target_cells', LATCHED),
            'status': probe.search_status(CONTROLLER)}
-    controller = launch('controller', [
-        '--params-file', config_path('controller.yaml'), '-p', 'search.targets:=many',
-        '-p', 'absent.prior:=0.3', '-p', 'motion.sigma_cells:=0.3',
-        '-p', 'motion.leave_prob:=0.05', '-p', 'motion.track_view:=peak',
-        '-p', 'motion.keep_probability:=0.5', '-p', 'motion.dwell_s:=1.0',
-        '-p', 'diagnostics_period_s:=0.2'])
+    controller = launch('controller', people_controller_args(0.5))
     assert wait_for(lambda: all(probe.matched(t) for t in ('found', 'lost', 'reacquired')),
                     30), controller.output()
     rec['started_at'] = time.monotonic()

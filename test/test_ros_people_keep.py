@@ -12,7 +12,7 @@ hovers near the confidence) and the simulated camera, a still person, run as pro
 """
 from __future__ import annotations
 
-from conftest import config_path, wait_for
+from conftest import config_path, people_controller_args, wait_for
 import pytest
 
 pytestmark = pytest.mark.ros
@@ -33,13 +33,8 @@ def test_a_keep_probability_above_the_confidence_loses_nobody_held_at_the_confid
     lost = probe.record(DiagnosticStatus, 'lost', 1000)
     again = probe.record(DiagnosticStatus, 'reacquired', 1000)
     status = probe.search_status(CONTROLLER)
-    controller = launch('controller', [
-        '--params-file', config_path('controller.yaml'), '-p', 'search.targets:=many',
-        '-p', f'confidence:={CONFIDENCE}', '-p', f'fpoc.dprime:={DPRIME}',
-        '-p', 'absent.prior:=0.3', '-p', 'motion.sigma_cells:=0.3',
-        '-p', 'motion.leave_prob:=0.05', '-p', 'motion.track_view:=peak',
-        '-p', 'motion.keep_probability:=0.999', '-p', 'motion.dwell_s:=1.0',
-        '-p', 'diagnostics_period_s:=0.2'])
+    controller = launch('controller', people_controller_args(
+        0.999, '-p', f'confidence:={CONFIDENCE}', '-p', f'fpoc.dprime:={DPRIME}'))
     assert wait_for(lambda: all(probe.matched(t) for t in ('found', 'lost', 'reacquired')),
                     30), controller.output()
     camera = launch('camera', ['--params-file', config_path('camera.yaml'),
