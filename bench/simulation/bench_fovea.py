@@ -26,7 +26,7 @@ from pathlib import Path
 import time
 
 import cv2
-from ipomdp_gaze.commands.common import check_output_file, nonneg_int
+from ipomdp_gaze.commands.common import nonneg_int, parse_with_outputs
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.vision.detectors import make_detector
 from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig
@@ -108,12 +108,7 @@ def main(argv=None):
     parser.add_argument('--threads', type=nonneg_int, default=None,
                         help='cv2.setNumThreads(N) (0: no threads)')
     parser.add_argument('--json', type=Path, default=None, metavar='OUT')
-    args = parser.parse_args(argv)
-    try:
-        if args.json:
-            check_output_file('--json', args.json)
-    except ValueError as exc:
-        parser.error(str(exc))
+    args = parse_with_outputs(parser, argv, json='--json')
     if args.threads is not None:
         cv2.setNumThreads(args.threads)
     repeats = 5 if args.quick else 30

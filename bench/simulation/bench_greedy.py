@@ -19,7 +19,7 @@ import json
 from pathlib import Path
 import time
 
-from ipomdp_gaze.commands.common import check_output_file
+from ipomdp_gaze.commands.common import parse_with_outputs
 from ipomdp_gaze.model.belief import argmax_ties_low
 from ipomdp_gaze.model.fpoc import make_fpoc
 from ipomdp_gaze.model.grid import Grid
@@ -177,12 +177,7 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
     parser.add_argument('--quick', action='store_true', help='fewer episodes and calls')
     parser.add_argument('--json', type=Path, default=None, metavar='OUT')
-    args = parser.parse_args(argv)
-    try:
-        if args.json:
-            check_output_file('--json', args.json)
-    except ValueError as exc:
-        parser.error(str(exc))
+    args = parse_with_outputs(parser, argv, json='--json')
     scale = 0.25 if args.quick else 1.0
     results = [
         bench_grid((7, 7), 'greedy', int(120 * scale), 49, int(600 * scale), (512,)),

@@ -26,7 +26,7 @@ import json
 from pathlib import Path
 import time
 
-from ipomdp_gaze.commands.common import (bootstrap_count, check_output_file, nonneg_int,
+from ipomdp_gaze.commands.common import (bootstrap_count, nonneg_int, parse_with_outputs,
                                          positive_int)
 from ipomdp_gaze.model.belief import bayes_update
 from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
@@ -135,12 +135,7 @@ def main(argv=None):
     parser.add_argument('--skip-planner', action='store_true',
                         help='only the fast policies (and --tempered-seeds)')
     parser.add_argument('--json', type=Path, default=None)
-    args = parser.parse_args(argv)
-    try:
-        if args.json:
-            check_output_file('--json', args.json)
-    except ValueError as exc:
-        parser.error(str(exc))
+    args = parse_with_outputs(parser, argv, json='--json')
     for name, full, quick in (('episodes', 2000, 200), ('episodes_fast', 20000, 2000),
                               ('bootstrap', 1000, 200)):
         if getattr(args, name) is None:

@@ -230,6 +230,24 @@ def check_output_file(flag: str, path: Path, plot: bool = False) -> Path:
     return path
 
 
+def parse_with_outputs(parser, argv, **outputs: str):
+    """
+    Parse ``argv``; refuse each output file given that cannot be written, as a usage error.
+
+    ``outputs`` maps an attribute of the parsed arguments to its flag (``json='--json'``): a
+    file that :func:`check_output_file` refuses ends the program with ``parser.error``'s one
+    line and status 2, before any work.
+    """
+    args = parser.parse_args(argv)
+    try:
+        for name, flag in outputs.items():
+            if getattr(args, name):
+                check_output_file(flag, getattr(args, name))
+    except ValueError as exc:
+        parser.error(str(exc))
+    return args
+
+
 def check_output_folder(flag: str, folder: Path, named: Path | None = None) -> Path:
     """
     Refuse, before any work, a folder to write in that cannot be: one line naming ``flag``.
