@@ -452,7 +452,8 @@ def check_scene(spec: PolicySpec, scene: dict, warn: Callable[[str], None] | Non
 
 
 def load_policy(source, grid: Grid | None = None, fpoc: FPOC | None = None,
-                action: str | None = None, warn: Callable[[str], None] | None = None):
+                action: str | None = None, warn: Callable[[str], None] | None = None,
+                scene: dict | None = None):
     """
     Load a policy file (path or shipped name) as a policy object with ``select``.
 
@@ -466,10 +467,14 @@ def load_policy(source, grid: Grid | None = None, fpoc: FPOC | None = None,
         Overrides the file's action rule.
     warn : callable, optional
         Receives a message when the policy is used off its training task.
+    scene : dict, optional
+        The scenes it will be used on: see :func:`check_scene` (None: not checked).
 
     """
     spec = load_policy_spec(source)
     check_task(spec, grid, fpoc, warn)
+    if scene is not None:
+        check_scene(spec, scene, warn)
     if action is not None and action not in ACTIONS:
         raise PolicyFileError(f"unknown action {action!r}; valid: {', '.join(ACTIONS)}")
     return spec.make_policy(action)

@@ -22,7 +22,7 @@ class PolicyUnavailable(ValueError):
 
 
 def build_policy(name: str, grid, model, kernel=None, file: str = '', action: str | None = None,
-                 warn=None):
+                 warn=None, scene: dict | None = None):
     """
     Build the policy called ``name`` (one of :data:`POLICY_NAMES`).
 
@@ -31,8 +31,8 @@ def build_policy(name: str, grid, model, kernel=None, file: str = '', action: st
     ``learned`` uses ``kernel`` (a convolutional kernel, 2-D or row-major) when it is non-empty,
     else the policy ``file`` (a policy YAML path or a shipped kernel name); ``action``
     (``argmax`` or ``sample``) applies to it (None: the file's own rule; a kernel: argmax). A
-    file trained on another FPOC is accepted and ``warn(message)`` is called; one for another
-    grid is refused.
+    file trained on another FPOC, or (given ``scene``, :func:`.policy_file.check_scene`) on
+    other scenes, is accepted and ``warn(message)`` is called; one for another grid is refused.
 
     Raises
     ------
@@ -70,4 +70,4 @@ def build_policy(name: str, grid, model, kernel=None, file: str = '', action: st
         resolve_source(file)
     except PolicyFileError as exc:
         raise PolicyUnavailable(str(exc)) from None
-    return load_policy(file, grid=grid, fpoc=model, action=action, warn=warn)
+    return load_policy(file, grid=grid, fpoc=model, action=action, warn=warn, scene=scene)

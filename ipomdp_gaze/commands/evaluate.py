@@ -26,7 +26,6 @@ from ipomdp_gaze.drivers.tracking import (evaluate_walks, format_walks, summaris
 from ipomdp_gaze.files.observation_file import fingerprint
 from ipomdp_gaze.model.motion import Motion
 from ipomdp_gaze.model.observation import as_observation, GaussianObservation
-from ipomdp_gaze.policies.policy_file import check_scene, load_policy_spec
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
 from ipomdp_gaze.search.session import SearchSettings
 from ipomdp_gaze.simulation.evaluation import (decision_summary, fixations_to_90_ci,
@@ -150,13 +149,11 @@ def load_policies(args, grid, fpoc) -> dict:
             raise ValueError(f"{source}: its row would be named {name!r}, as {given[name]}'s "
                              "(a file's row is named by its stem): give them different names")
         given[name] = source
-    policies = {name: build_policy('learned' if file else name, grid, fpoc, **file)
-                for name, _, file in rows}
+    # A policy file used off its training scenes is said, as off its FPOC or spacing.
     scene = {'motion_sigma_cells': args.motion_sigma_cells, 'jump_prob': args.motion_jump_prob,
              'absent_prior': args.absent_prior, 'absent_rate': args.absent_rate}
-    for path in args.policy_file:               # a policy used off its training scenes: said
-        check_scene(load_policy_spec(str(path)), scene)
-    return policies
+    return {name: build_policy('learned', grid, fpoc, **file, scene=scene) if file
+            else build_policy(name, grid, fpoc) for name, _, file in rows}
 
 
 def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
