@@ -14,6 +14,8 @@ included), which matches every publisher; the controller re-sends its target eve
 """
 from __future__ import annotations
 
+import copy
+
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSPolicyKind, QoSProfile,
                        ReliabilityPolicy)
@@ -22,9 +24,6 @@ from rclpy.qos_overriding_options import InvalidQosOverridesError, QoSOverriding
 STATE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                        durability=DurabilityPolicy.TRANSIENT_LOCAL)
 FRAME_QOS = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
-PROFILE_FIELDS = ('history', 'depth', 'reliability', 'durability', 'lifespan', 'deadline',
-                  'liveliness', 'liveliness_lease_duration',
-                  'avoid_ros_namespace_conventions')
 COMMAND_POLICIES = (QoSPolicyKind.DURABILITY, QoSPolicyKind.RELIABILITY, QoSPolicyKind.DEPTH,
                     QoSPolicyKind.HISTORY)
 
@@ -51,7 +50,7 @@ def command_subscription(node, msg_type, topic: str, callback):
     naming it, which the node's start-up prints as one line (rclpy raised a bare
     ``RuntimeError``, or rcl's 'invalid allocator').
     """
-    profile = QoSProfile(**{field: getattr(STATE_QOS, field) for field in PROFILE_FIELDS})
+    profile = copy.copy(STATE_QOS)
     name = f'qos_overrides.{node.resolve_topic_name(topic)}.subscription'
     options = QoSOverridingOptions(policy_kinds=COMMAND_POLICIES, callback=_depth_check(name))
     try:
