@@ -31,12 +31,11 @@ from ipomdp_gaze.model.checks import (check_budget, check_confidence, check_flag
 from ipomdp_gaze.model.false_alarms import (check_false_alarm_scales, check_hotspot_prior,
                                             check_hotspot_scale, DEFAULT_HOTSPOT_SCALE)
 from ipomdp_gaze.model.still_evidence import check_repeat_weight
+from ipomdp_gaze.search.room import MAX_PERIOD_S
 
-# Upper bounds of two motion durations: a prediction further ahead than a minute says nothing
-# about where a walking person is (the head would chase the grid's corner), and a dwell of
-# more than a day is a re-check that never comes (room.dwell_s has the same bound).
+# A prediction further ahead than a minute says nothing about where a walking person is (the
+# head would chase the grid's corner); a dwell is bounded as room.dwell_s is (MAX_PERIOD_S).
 MAX_LEAD_S = 60.0
-MAX_DWELL_S = 86400.0
 
 
 def check_lead_s(value, name: str) -> float:
@@ -49,10 +48,10 @@ def check_lead_s(value, name: str) -> float:
 
 
 def check_dwell_s(value, name: str) -> float:
-    """Return ``motion.dwell_s``: seconds in (0, :data:`MAX_DWELL_S`]."""
+    """Return ``motion.dwell_s``: seconds in (0, ``room.MAX_PERIOD_S``] (a day)."""
     seconds = check_seconds(value, name)
-    if seconds > MAX_DWELL_S:
-        raise ValueError(f'{name} must be at most {MAX_DWELL_S:g} s (a day), got {value!r}')
+    if seconds > MAX_PERIOD_S:
+        raise ValueError(f'{name} must be at most {MAX_PERIOD_S:g} s (a day), got {value!r}')
     return seconds
 
 
