@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import json
 import os
 from pathlib import Path
+import re
 import signal
 import socket
 import subprocess
@@ -163,7 +164,10 @@ def test_an_unreachable_scheduler_is_one_line(capsys):
 
 @pytest.mark.parametrize('answer, reason', [
     (None, 'no Dask scheduler answered at'),                 # a port that listens, says nothing
-    (b'SSH-2.0-OpenSSH_9.6\r\n' * 64, 'it answered what no Dask scheduler sends'),
+    # What Dask makes of the babble (MemoryError: 'it answered ...') may come after the
+    # deadline on a loaded machine (CI, once): then the refusal is the silent port's, one line.
+    (b'SSH-2.0-OpenSSH_9.6\r\n' * 64,
+     '(it answered what no Dask scheduler sends|no Dask scheduler answered at)'),
 ])
 def test_a_port_that_is_no_scheduler_is_one_line_within_the_timeout(answer, reason):
     server = socket.socket()
@@ -189,7 +193,7 @@ def test_a_port_that_is_no_scheduler_is_one_line_within_the_timeout(answer, reas
             DaskExecutor(f'tls://127.0.0.1:{server.getsockname()[1]}', timeout_s=5.0)
         with pytest.raises(ClusterError) as raised:
             DaskExecutor(f'tcp://127.0.0.1:{server.getsockname()[1]}', timeout_s=1.0)
-        assert reason in str(raised.value) and '\n' not in str(raised.value)
+        assert re.search(reason, str(raised.value)) and '\n' not in str(raised.value)
     finally:
         server.close()
         for conn in held:
