@@ -41,6 +41,7 @@ from ipomdp_gaze.files.yaml_files import check_header, in_folder, plain, read_ya
 from ipomdp_gaze.model.fpoc import FPOC, fpoc_from_dict
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.observation import CountObservation, GaussianObservation
+from ipomdp_gaze.simulation.simulate import check_prior
 import numpy as np
 
 from .conv import ACTIONS, ConvPolicy, radial_bins
@@ -372,10 +373,28 @@ def spec_from_dict(doc, path: Path | None = None) -> PolicySpec:
     else:
         n = grid.n_cells
         theta = _array(doc, 'theta', (n, n), f'a {grid.rows}x{grid.cols} grid')
+    training, evaluation = _record(doc, 'training'), _record(doc, 'evaluation')
+    for key, block in (('training', training), ('evaluation', evaluation)):
+        if block.get('prior') is not None:
+            _check_prior(block['prior'], grid, f'{key}.prior')
     return PolicySpec(grid=grid, fpoc=fpoc, reward=reward, family=family, action=action,
                       observation=observation, kernel=kernel, theta=theta,
-                      training=_record(doc, 'training'), evaluation=_record(doc, 'evaluation'),
-                      path=path)
+                      training=training, evaluation=evaluation, path=path)
+
+
+def _check_prior(value, grid: Grid, name: str) -> None:
+    """Refuse a recorded prior that is not rows x cols probabilities summing to 1."""
+    try:
+        values = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise PolicyFileError(f'{name} must be rows of numbers') from None
+    if values.shape != grid.shape:
+        raise PolicyFileError(f'{name}: a {grid.rows}x{grid.cols} grid needs {grid.rows} rows of '
+                              f'{grid.cols} numbers, got shape {values.shape}')
+    try:
+        check_prior(values, grid.n_cells, grid.shape)
+    except ValueError as exc:
+        raise PolicyFileError(f'{name}: {exc}') from None
 
 
 def load_policy_spec(source) -> PolicySpec:
@@ -440,7 +459,8 @@ def check_scene(spec: PolicySpec, scene: dict, warn: Callable[[str], None] | Non
     Report (through ``warn``) each setting of docs/design.md section 7 that differs from training.
 
     ``scene`` maps :data:`SCENE_KEYS` to the values used now (missing or None: 0, the paper's
-    task); a policy file records the non-zero ones under ``training``.
+    task), and ``prior`` to rows of cells (missing or None: uniform); a policy file records the
+    non-zero ones, and a prior that is not uniform, under ``training``.
     """
     warn = _warn if warn is None else warn
     where = f'{spec.path}: ' if spec.path is not None else ''
@@ -449,6 +469,17 @@ def check_scene(spec: PolicySpec, scene: dict, warn: Callable[[str], None] | Non
         used = float(scene.get(key) or 0.0)
         if not math.isclose(trained, used, rel_tol=1e-9, abs_tol=1e-12):
             warn(f'{where}policy was trained with {key} {trained:g} but is used with {used:g}')
+    trained, used = spec.training.get('prior'), scene.get('prior')
+    if trained is None and used is not None:
+        warn(f'{where}policy was trained with a uniform prior but is used with another')
+    elif trained is not None and used is None:
+        warn(f'{where}policy was trained with a prior that is not uniform but is used with '
+             'the uniform one')
+    elif trained is not None and not np.allclose(np.array(trained, dtype=float),
+                                                 np.array(used, dtype=float).reshape(
+                                                     np.shape(trained)),
+                                                 rtol=1e-9, atol=1e-12):
+        warn(f'{where}policy was trained with another prior than the one it is used with')
 
 
 def load_policy(source, grid: Grid | None = None, fpoc: FPOC | None = None,

@@ -45,7 +45,7 @@ from ipomdp_gaze.model.observation import as_observation, CountObservation
 from ipomdp_gaze.model.stopping import BatchBelief, check_absent_prior
 from ipomdp_gaze.simulation.evaluation import (fixations_to_90_ci, fixations_to_level,
                                                tracking_summary)
-from ipomdp_gaze.simulation.simulate import rollout, simulate
+from ipomdp_gaze.simulation.simulate import check_prior, rollout, simulate
 import numpy as np
 
 from .conv import ConvPolicy, kernel_from_radial, radial_bins
@@ -66,7 +66,8 @@ class TrainConfig:
     subtracts a per-time-step reward baseline (the mean reward of the other episodes of the
     epoch at the same step, which keeps the estimate unbiased). ``motion_sigma_cells``,
     ``jump_prob``, ``absent_prior`` and ``absent_rate`` set the task of docs/design.md section 7
-    (per fixation).
+    (per fixation); ``prior``, rows of cells summing to 1, is where the target is a priori
+    (drawn from it, and every belief starts at it; None: uniform, the paper's task).
     """
 
     reward: str = 'infomax'
@@ -86,6 +87,7 @@ class TrainConfig:
     jump_prob: float = 0.0
     absent_prior: float = 0.0
     absent_rate: float = 0.0
+    prior: tuple[tuple[float, ...], ...] | None = None
 
     def __post_init__(self):
         if self.reward not in REWARDS:
@@ -113,11 +115,34 @@ class TrainConfig:
         check_probability(self.jump_prob, 'jump_prob')
         check_absent_prior(self.absent_prior)
         check_probability(self.absent_rate, 'absent_rate')
+        if self.prior is not None:
+            object.__setattr__(self, 'prior', prior_rows(self.prior))
 
     def scene(self) -> dict:
         """Return the settings of docs/design.md section 7 that are not 0 (the paper's task)."""
         names = ('motion_sigma_cells', 'jump_prob', 'absent_prior', 'absent_rate')
-        return {k: getattr(self, k) for k in names if getattr(self, k)}
+        scene = {k: getattr(self, k) for k in names if getattr(self, k)}
+        if self.prior is not None:
+            scene['prior'] = [list(row) for row in self.prior]
+        return scene
+
+
+def prior_rows(prior) -> tuple[tuple[float, ...], ...]:
+    """
+    Return a prior over the cells as rows of floats (hashable, as a policy file records it).
+
+    ``prior`` is rows of cells (a nested sequence or a 2-D array); each value >= 0, summing to
+    1 (:func:`ipomdp_gaze.simulation.simulate.check_prior`). ValueError (one line) otherwise.
+    """
+    try:
+        values = np.array(prior, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError('prior must be rows of numbers, one per cell') from None
+    if values.ndim != 2 or values.size == 0:
+        raise ValueError(f'prior must be rows of cells (rows x cols numbers), got shape '
+                         f'{values.shape}')
+    check_prior(values, values.size, values.shape)
+    return tuple(tuple(float(v) for v in row) for row in values)
 
 
 @dataclass
@@ -214,7 +239,7 @@ def elm_init(grid: Grid, model, scale: float) -> np.ndarray:
 def sample_episodes(theta: np.ndarray, model, reward: str, episodes: int,
                     horizon: int, rng: np.random.Generator, motion: Motion | None = None,
                     absent_prior: float = 0.0, absent_rate: float = 0.0,
-                    scan: bool = True) -> Episodes:
+                    scan: bool = True, prior: np.ndarray | None = None) -> Episodes:
     """
     Run a batch of episodes with the softmax policy ``p(k | B) ∝ exp(theta[k] . B)``.
 
@@ -238,15 +263,22 @@ def sample_episodes(theta: np.ndarray, model, reward: str, episodes: int,
     scan : bool
         With a count model that has scan tables, first apply the one-time scan (drawn from the
         scan tables), as ``find`` does: the policy learns from the beliefs it will see.
+    prior : array (N,), optional
+        Where the target is a priori, summing to 1 (:func:`check_prior`): the targets are drawn
+        from it and every belief starts at it (default uniform, drawn as before it existed).
 
     """
     n = theta.shape[0]
     rows = np.arange(episodes)
     theta_t = np.ascontiguousarray(theta.T)
-    targets = rng.integers(0, n, size=episodes)
+    if prior is None:
+        targets = rng.integers(0, n, size=episodes)
+    else:
+        prior = check_prior(prior, n)
+        targets = rng.choice(n, size=episodes, p=prior)
     present = rng.random(episodes) >= absent_rate if absent_rate > 0 else None
     moving = motion is not None and motion.active
-    batch = BatchBelief(n, absent_prior, episodes, moving)
+    batch = BatchBelief(n, absent_prior, episodes, moving, prior)
     belief = batch.belief
     if scan and getattr(model, 'has_scan', False):
         frames = model.sample_scan(targets, rng, present=present)
@@ -361,6 +393,9 @@ class Trainer:
         self.wall_seconds = float(wall_seconds)
         self.horizon = grid.n_cells if config.horizon is None else int(config.horizon)
         self.motion = Motion(grid, config.motion_sigma_cells, config.jump_prob)
+        self.prior = None
+        if config.prior is not None:
+            self.prior = check_prior(np.array(config.prior), grid.n_cells, grid.shape)
         self.curve: list[dict] = []
 
     def epoch_rng(self, epoch: int) -> np.random.Generator:
@@ -379,7 +414,8 @@ class Trainer:
         cfg = self.config
         batch = sample_episodes(self.family.theta(self.params), self.model, cfg.reward,
                                 cfg.episodes_per_epoch, self.horizon, self.epoch_rng(self.epoch),
-                                self.motion, cfg.absent_prior, cfg.absent_rate)
+                                self.motion, cfg.absent_prior, cfg.absent_rate,
+                                prior=self.prior)
         grad = self.family.project(theta_gradient(batch, cfg.beta, cfg.reward_scale,
                                                   cfg.baseline))
         self.params += self.learning_rate(self.epoch) * grad
@@ -392,7 +428,8 @@ class Trainer:
         result = simulate(self.grid, self.model, self.family.policy(self.params, 'argmax'),
                           cfg.eval_episodes if episodes is None else episodes, self.horizon,
                           cfg.eval_seed if seed is None else seed, motion=self.motion,
-                          absent_prior=cfg.absent_prior, absent_rate=cfg.absent_rate)
+                          absent_prior=cfg.absent_prior, absent_rate=cfg.absent_rate,
+                          prior=self.prior)
         return fixations_to_level(result.percent_correct, self.grid.n_cells)
 
     def run(self, epochs: int, progress=False,
@@ -552,6 +589,7 @@ def evaluation_block(grid: Grid, fpoc: FPOC, policy, episodes: int = 20000, seed
     result = simulate(grid, fpoc, policy, episodes, horizon, seed, motion=motion,
                       absent_prior=scene.get('absent_prior', 0.0),
                       absent_rate=scene.get('absent_rate', 0.0),
+                      prior=None if scene.get('prior') is None else np.array(scene['prior']),
                       progress=None if progress is None else lambda t: progress.update(1))
     point, ci = fixations_to_90_ci(result.correct, grid.n_cells,
                                    np.random.default_rng([seed, 99]), bootstrap)

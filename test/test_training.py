@@ -354,3 +354,120 @@ def test_resume_from_a_file_whose_count_is_null_is_one_line(tmp_path, capsys, ke
     err = capsys.readouterr().err
     kind = 'a whole number' if key == 'epochs' else 'a number'
     assert err.strip().splitlines()[-1].endswith(f'training.{key} must be {kind} >= 0, got None')
+
+
+def test_training_episodes_start_at_the_prior_and_draw_targets_from_it():
+    """A prior replays as its draws: targets from it, the belief at it, then Bayes steps."""
+    from ipomdp_gaze.model.belief import bayes_update
+    grid = Grid(3, 3)
+    model = GaussianObservation(grid, FPOC)
+    prior = np.array([0, 1, 0, 0, 6, 0, 0, 0, 3], dtype=float) / 10
+    theta = np.random.default_rng(1).normal(size=(9, 9))
+    batch = sample_episodes(theta, model, 'infomax', 8, 4, np.random.default_rng(4),
+                            prior=prior)
+    rng = np.random.default_rng(4)
+    targets = rng.choice(9, size=8, p=prior)
+    with np.errstate(divide='ignore'):
+        log_b = np.tile(np.log(prior), (8, 1))
+    for t in range(4):
+        np.testing.assert_allclose(batch.belief[t], np.exp(log_b), rtol=1e-9, atol=1e-300)
+        rng.random((8, 1))                      # the softmax policy's own draw
+        a = batch.fixations[t]
+        frames = model.sample(targets, a, rng)
+        log_b = bayes_update(log_b, model.log_likelihood_ratio(frames, a))
+        full = np.exp(log_b)
+        with np.errstate(invalid='ignore'):     # 0 log 0 = 0 in the cells the prior rules out
+            expected = np.sum(full * log_b, axis=1, where=full > 0)
+        np.testing.assert_allclose(batch.reward[t], expected, rtol=1e-9)
+
+
+def test_a_prior_is_recorded_resumed_and_checked(tmp_path):
+    grid = Grid(3, 3)
+    rows = ((0.0, 0.1, 0.0), (0.0, 0.6, 0.0), (0.0, 0.0, 0.3))
+    config = TrainConfig(seed=2, eval_every=2, eval_episodes=40, prior=np.array(rows))
+    assert config.prior == rows and config.scene() == {'prior': [list(r) for r in rows]}
+    trainer = Trainer(grid, FPOC, config)
+    trainer.run(2)
+    path = save_policy(tmp_path / 'prior.yaml', trainer.spec())
+    spec = load_policy_spec(path)
+    assert spec.training['prior'] == [list(r) for r in rows]
+    assert trainer_from_spec(spec).config == config
+    warnings = []
+    load_policy(path, grid, FPOC, warn=warnings.append, scene={'prior': np.array(rows)})
+    assert warnings == []
+    load_policy(path, grid, FPOC, warn=warnings.append, scene={})
+    assert warnings == [f'{path}: policy was trained with a prior that is not uniform but is '
+                        'used with the uniform one']
+    other = np.full((3, 3), 1 / 9)
+    load_policy(path, grid, FPOC, warn=warnings.append, scene={'prior': other})
+    assert warnings[-1] == f'{path}: policy was trained with another prior than the one it is ' \
+                           'used with'
+    plain = save_policy(tmp_path / 'plain.yaml', Trainer(grid, FPOC, TrainConfig()).spec())
+    load_policy(plain, grid, FPOC, warn=warnings.append, scene={'prior': other})
+    assert warnings[-1] == f'{plain}: policy was trained with a uniform prior but is used ' \
+                           'with another'
+    with pytest.raises(ValueError, match=r'prior must be \(rows, cols\) = \(3, 4\) or \(12,\), '
+                                         r'got shape \(3, 3\)'):
+        Trainer(Grid(3, 4), FPOC, config)
+    with pytest.raises(ValueError, match='prior must sum to 1'):
+        TrainConfig(prior=[[0.5, 0.6]])
+    with pytest.raises(ValueError, match='prior must be rows of cells'):
+        TrainConfig(prior=[0.5, 0.5])
+
+
+@pytest.mark.parametrize('value, message', [
+    ([[0.5, 0.5]], r'training.prior: a 2x2 grid needs 2 rows of 2 numbers, got shape \(1, 2\)'),
+    ([[0.5, 'x'], [0, 0]], 'training.prior must be rows of numbers'),
+    ([[0.5, 0.5], [0.5, 0.5]], 'training.prior: prior must sum to 1, got 2'),
+    ([[-0.5, 0.5], [0.5, 0.5]], 'training.prior: prior must be finite and >= 0 in every cell'),
+])
+def test_a_bad_recorded_prior_is_one_line(tmp_path, capsys, value, message):
+    import yaml
+    path = save_policy(tmp_path / 'k.yaml', Trainer(Grid(2, 2), FPOC, TrainConfig()).spec())
+    doc = yaml.safe_load(path.read_text())
+    doc['training']['prior'] = value
+    path.write_text(yaml.safe_dump(doc))
+    with pytest.raises(ValueError, match=message):
+        load_policy_spec(path)
+    assert main(['evaluate', '--grid', '2x2', '--policy-file', str(path), '--episodes',
+                 '10']) == 2
+    [line] = capsys.readouterr().err.strip().splitlines()
+    assert line.endswith(message.replace('\\', '')), line
+
+
+def test_train_cli_takes_a_prior_and_evaluate_agrees(tmp_path, capsys):
+    """QA (a researcher): a centre-biased task, trained and evaluated on the same prior."""
+    prior = tmp_path / 'centre.txt'
+    prior.write_text('1 1 1\n1 6 1\n1 1 1\n')
+    out = tmp_path / 'c.yaml'
+    assert main(['train', '--grid', '3x3', '--epochs', '4', '--eval-every', '2',
+                 '--eval-episodes', '50', '--final-episodes', '500', '--prior', str(prior),
+                 '--out', str(out), '--quiet']) == 0
+    text = capsys.readouterr().out
+    assert 'a prior that is not uniform' in text
+    spec = load_policy_spec(out)
+    expected = [[1 / 14, 1 / 14, 1 / 14], [1 / 14, 6 / 14, 1 / 14], [1 / 14, 1 / 14, 1 / 14]]
+    np.testing.assert_allclose(spec.training['prior'], expected)
+    np.testing.assert_allclose(spec.evaluation['prior'], expected)
+    json_out = tmp_path / 'e.json'
+    assert main(['evaluate', '--grid', '3x3', '--policy-file', str(out), '--episodes', '500',
+                 '--prior', str(prior), '--quiet', '--json', str(json_out)]) == 0
+    captured = capsys.readouterr()
+    assert 'warning' not in captured.err
+    import json
+    row = json.loads(json_out.read_text())['policies']['c']
+    assert row['fixations_to_90'] == spec.evaluation['fixations_to_90']
+    # Resumed without --prior it keeps its own; with another it is refused, in one line.
+    assert main(['train', '--resume', str(out), '--epochs', '6', '--out',
+                 str(tmp_path / 'r.yaml'), '--final-episodes', '0', '--quiet']) == 0
+    assert load_policy_spec(tmp_path / 'r.yaml').training['prior'] == spec.training['prior']
+    other = tmp_path / 'other.txt'
+    other.write_text('1 1 1\n1 1 1\n1 1 2\n')
+    capsys.readouterr()
+    assert main(['train', '--resume', str(out), '--epochs', '6', '--out',
+                 str(tmp_path / 'x.yaml'), '--prior', str(other), '--quiet']) == 2
+    [line] = capsys.readouterr().err.strip().splitlines()
+    assert f'--prior {other} (recorded: another prior)' in line
+    assert main(['train', '--grid', '3x3', '--epochs', '1', '--out', str(tmp_path / 'y.yaml'),
+                 '--prior', str(tmp_path / 'none.txt')]) == 2
+    assert '--prior' in capsys.readouterr().err

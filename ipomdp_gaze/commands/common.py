@@ -12,6 +12,7 @@ from ipomdp_gaze.files.writable import folder_writable
 from ipomdp_gaze.model.fpoc import make_fpoc, MODELS, parameter_names
 from ipomdp_gaze.model.grid import Grid, parse_grid
 from ipomdp_gaze.model.observation import MATRIX_MAX_CELLS
+import numpy as np
 import yaml
 
 
@@ -276,3 +277,42 @@ def plot_format(path: Path, flag: str = '--plot') -> Path:
         raise ValueError(f'{flag} {path}: the extension names no format matplotlib writes '
                          f'(use one of {", ".join("." + k for k in sorted(formats))})')
     return path
+
+
+def add_prior_arg(parser: argparse.ArgumentParser, use: str) -> None:
+    """Add ``--prior FILE``, where the target is a priori (:func:`read_prior`); ``use``: how."""
+    parser.add_argument('--prior', type=Path, default=None, metavar='FILE',
+                        help='where the target is a priori: a text file of ROWS lines of COLS '
+                             'non-negative weights (spaces or commas; # comments), scaled to '
+                             f'sum 1; {use} (default uniform)')
+
+
+def read_prior(path: Path, grid) -> np.ndarray:
+    """
+    Read a prior over the target's cell: ``grid.rows`` lines of ``grid.cols`` weights >= 0.
+
+    Spaces or commas between numbers, ``#`` comments; scaled to sum 1. ValueError (one line)
+    for a file that cannot be read, the wrong shape, or weights that are not numbers >= 0 with
+    a positive sum.
+    """
+    try:
+        text = Path(path).read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f'--prior {path}: cannot read it ({exc.__class__.__name__})') from None
+    rows = []
+    for line in text.splitlines():
+        line = line.split('#', 1)[0].replace(',', ' ').split()
+        if line:
+            try:
+                rows.append([float(v) for v in line])
+            except ValueError:
+                raise ValueError(f'--prior {path}: not a number in {" ".join(line)!r}') from None
+    if len(rows) != grid.rows or any(len(r) != grid.cols for r in rows):
+        shape = f'{len(rows)} lines of ' + '/'.join(sorted({str(len(r)) for r in rows}) or '0')
+        raise ValueError(f'--prior {path}: a {grid.rows}x{grid.cols} grid needs {grid.rows} '
+                         f'lines of {grid.cols} weights, got {shape}')
+    weights = np.asarray(rows, dtype=float).reshape(-1)
+    if not np.all(np.isfinite(weights)) or np.any(weights < 0) or not weights.max() > 0:
+        raise ValueError(f'--prior {path}: weights must be finite, >= 0 and not all 0')
+    weights = weights / weights.max()           # the sum of weights near 1e308 stays finite
+    return weights / weights.sum()

@@ -38,8 +38,8 @@ from ipomdp_gaze.vision.walks import DURATION_S as WALK_DURATION_S
 from ipomdp_gaze.vision.walks import SPEED_DEG_S as WALK_SPEED_DEG_S
 import numpy as np
 
-from .common import (add_task_args, bootstrap_count, check_output_file, nonneg_int,
-                     positive_int, task_from_args)
+from .common import (add_prior_arg, add_task_args, bootstrap_count, check_output_file,
+                     nonneg_int, positive_int, read_prior, task_from_args)
 from .running import add_run_args, executor_from_args, progress_from_args
 from .search_args import add_scene_args, add_search_args, settings_from_args
 
@@ -102,11 +102,7 @@ def add_parser(sub):
                         '(sweep-tile, sweep-first-raw, sweep-first-grouped3, '
                         'sweep-first-grouped5); with --motion walk track-last-detection '
                         '(default; :neighbors=N,lost_frames=M)')
-    p.add_argument('--prior', type=Path, default=None, metavar='FILE',
-                   help='where the target is a priori: a text file of ROWS lines of COLS '
-                        'non-negative weights (spaces or commas; # comments), scaled to sum '
-                        '1; the targets are drawn from it and every belief starts at it '
-                        '(default uniform)')
+    add_prior_arg(p, 'the targets are drawn from it and every belief starts at it')
     p.add_argument('--episodes-greedy', type=positive_int, default=2000,
                    help='episodes for the slow searchers, greedy and switching (policies '
                         'whose class sets costly; default 2000)')
@@ -131,11 +127,12 @@ def add_parser(sub):
     p.set_defaults(run=run)
 
 
-def load_policies(args, grid, fpoc) -> dict:
+def load_policies(args, grid, fpoc, prior=None) -> dict:
     """
     Name -> policy for every ``--policy`` and ``--policy-file`` (a file's row: its stem).
 
     Two rows of one name are refused (ValueError naming both), so that no row replaces another.
+    ``prior`` (N,), the ``--prior`` read: a policy file trained on another prior is said.
     """
     names = args.policy or ([] if args.policy_file else ['map'])
     rows = [(name, f'--policy {name}', {}) for name in names]
@@ -151,7 +148,8 @@ def load_policies(args, grid, fpoc) -> dict:
         given[name] = source
     # A policy file used off its training scenes is said, as off its FPOC or spacing.
     scene = {'motion_sigma_cells': args.motion_sigma_cells, 'jump_prob': args.motion_jump_prob,
-             'absent_prior': args.absent_prior, 'absent_rate': args.absent_rate}
+             'absent_prior': args.absent_prior, 'absent_rate': args.absent_rate,
+             'prior': None if prior is None else prior.reshape(grid.shape)}
     return {name: build_policy('learned', grid, fpoc, **file, scene=scene) if file
             else build_policy(name, grid, fpoc) for name, _, file in rows}
 
@@ -434,37 +432,6 @@ STILL_SCENES_ONLY = (('--max-fixations', 'max_fixations'),
                      ('--group-min-neighbors', 'group_min_neighbors'))
 
 
-def read_prior(path: Path, grid) -> np.ndarray:
-    """
-    Read a prior over the target's cell: ``grid.rows`` lines of ``grid.cols`` weights >= 0.
-
-    Spaces or commas between numbers, ``#`` comments; scaled to sum 1. ValueError (one line)
-    for a file that cannot be read, the wrong shape, or weights that are not numbers >= 0 with
-    a positive sum.
-    """
-    try:
-        text = Path(path).read_text()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ValueError(f'--prior {path}: cannot read it ({exc.__class__.__name__})') from None
-    rows = []
-    for line in text.splitlines():
-        line = line.split('#', 1)[0].replace(',', ' ').split()
-        if line:
-            try:
-                rows.append([float(v) for v in line])
-            except ValueError:
-                raise ValueError(f'--prior {path}: not a number in {" ".join(line)!r}') from None
-    if len(rows) != grid.rows or any(len(r) != grid.cols for r in rows):
-        shape = f'{len(rows)} lines of ' + '/'.join(sorted({str(len(r)) for r in rows}) or '0')
-        raise ValueError(f'--prior {path}: a {grid.rows}x{grid.cols} grid needs {grid.rows} '
-                         f'lines of {grid.cols} weights, got {shape}')
-    weights = np.asarray(rows, dtype=float).reshape(-1)
-    if not np.all(np.isfinite(weights)) or np.any(weights < 0) or not weights.max() > 0:
-        raise ValueError(f'--prior {path}: weights must be finite, >= 0 and not all 0')
-    weights = weights / weights.max()           # the sum of weights near 1e308 stays finite
-    return weights / weights.sum()
-
-
 def _refuse_unused(args, options, why: str) -> None:
     """Refuse any of ``options`` given on the command line (ValueError naming them and why)."""
     given = [flag for flag, name in options
@@ -525,7 +492,7 @@ def run(args) -> int:
     args.max_fixations = args.max_fixations or None           # 0: no budget, the horizon
     grid, fpoc = task_from_args(args)
     prior = None if args.prior is None else read_prior(args.prior, grid)
-    policies = load_policies(args, grid, fpoc)
+    policies = load_policies(args, grid, fpoc, prior)
     if args.paired and len(policies) < 2:
         raise ValueError('--paired compares each policy after the first with the first: give '
                          'two or more (--policy, --policy-file)')

@@ -14,8 +14,8 @@ from pathlib import Path
 
 from ipomdp_gaze.search.session import SearchSettings
 
-from .common import (add_task_args, check_output_file, nonneg_int, positive_float, positive_int,
-                     task_from_args)
+from .common import (add_prior_arg, add_task_args, check_output_file, nonneg_int, positive_float,
+                     positive_int, read_prior, task_from_args)
 from .running import add_run_args, executor_from_args, progress_from_args
 from .search_args import add_scene_args, settings_from_args
 
@@ -72,6 +72,8 @@ def add_parser(sub):
     p.add_argument('--final-seed', type=nonneg_int, default=0,
                    help='seed of the final evaluation (default 0, as ipomdp-gaze evaluate)')
     add_scene_args(p, 'training')
+    add_prior_arg(p, 'the training targets are drawn from it, every belief starts at it, and '
+                     'the policy file records it')
     p.add_argument('--seeds', type=_list(nonneg_int), default=None, metavar='S,...',
                    help='a sweep: train one policy per seed (and per --learning-rates value) '
                         'on the workers of --jobs / --scheduler, write PATH-seedS.yaml each and '
@@ -155,7 +157,8 @@ RESUME_FLAGS = {'learning_rate': '--learning-rate', 'anneal_epochs': '--anneal-e
                 'episodes_per_epoch': '--episodes-per-epoch', 'horizon': '--horizon',
                 'eval_every': '--eval-every', 'eval_episodes': '--eval-episodes',
                 'motion_sigma_cells': '--motion-sigma-cells', 'jump_prob': '--jump-prob',
-                'absent_prior': '--absent-prior', 'absent_rate': '--absent-rate'}
+                'absent_prior': '--absent-prior', 'absent_rate': '--absent-rate',
+                'prior': '--prior'}
 
 
 def _refuse_changed_training(args, spec, overrides: dict) -> None:
@@ -171,8 +174,13 @@ def _refuse_changed_training(args, spec, overrides: dict) -> None:
     def shown(value):
         return 'the default' if value is None else repr(value)
 
-    changed = [f'{RESUME_FLAGS[key]} {value!r} (recorded: {shown(getattr(recorded, key))})'
-               for key, value in overrides.items()
+    def given(key, value):
+        if key == 'prior':                  # rows of numbers: the file, and which was recorded
+            return (f'--prior {args.prior} (recorded: '
+                    f'{"uniform" if recorded.prior is None else "another prior"})')
+        return f'{RESUME_FLAGS[key]} {value!r} (recorded: {shown(getattr(recorded, key))})'
+
+    changed = [given(key, value) for key, value in overrides.items()
                if value is not None and value != getattr(recorded, key)]
     if changed:
         raise ValueError(f'--resume {args.resume} continues the training as the file records '
@@ -198,6 +206,10 @@ def run(args) -> int:
     check_output_file(flag, out)
     check_output_file(flag, out.with_suffix('.csv'))
     grid, fpoc = _task(args, spec)
+    prior = None
+    if args.prior is not None:
+        from ipomdp_gaze.policies.training import prior_rows
+        prior = prior_rows(read_prior(args.prior, grid).reshape(grid.shape))
     overrides = {
         'learning_rate': args.learning_rate, 'anneal_epochs': args.anneal_epochs,
         'reward_scale': args.reward_scale,
@@ -206,7 +218,7 @@ def run(args) -> int:
         'eval_every': args.eval_every,
         'eval_episodes': args.eval_episodes, 'motion_sigma_cells': args.motion_sigma_cells,
         'jump_prob': args.motion_jump_prob, 'absent_prior': args.absent_prior,
-        'absent_rate': args.absent_rate}
+        'absent_rate': args.absent_rate, 'prior': prior}
     sweep = args.seeds is not None or args.learning_rates is not None
     if sweep and spec is not None:
         raise ValueError('--seeds / --learning-rates start new trainings: drop --resume')
@@ -268,7 +280,8 @@ def run(args) -> int:
     task = fpoc.model if hasattr(fpoc, 'model') else f'count model {args.observation}'
     print(f'trained {cfg.family} {cfg.reward} policy on {grid.rows}x{grid.cols} '
           f'{task}: {trainer.epoch} epochs, lr {cfg.learning_rate}, '
-          f'{trainer.wall_seconds:.1f} s of training')
+          f'{trainer.wall_seconds:.1f} s of training'
+          + ('' if cfg.prior is None else ', a prior that is not uniform'))
     if evaluation:
         f90, ci = evaluation['fixations_to_90'], evaluation['ci95']
         text = 'never' if f90 is None else f'{f90:.2f}'

@@ -163,7 +163,8 @@ class BatchBelief:
     (:func:`ipomdp_gaze.policies.training.sample_episodes`): the prior, the step
     ``log B += llr`` with the absent hypothesis's 0 (:func:`with_absent`) and renormalisation,
     the infomax reward ``sum_h B_h log B_h`` over every hypothesis (0 log 0 = 0 where a motion
-    step left a cell at 0), and the motion prediction.
+    step left a cell at 0), and the motion prediction. ``prior`` (N,), summing to 1: where the
+    target is a priori (default uniform), the cells' share of the mass that is not absent.
 
     Attributes
     ----------
@@ -174,11 +175,17 @@ class BatchBelief:
 
     """
 
-    def __init__(self, n_cells: int, absent_prior: float, episodes: int, moving: bool = False):
+    def __init__(self, n_cells: int, absent_prior: float, episodes: int, moving: bool = False,
+                 prior: np.ndarray | None = None):
         self.n = n_cells
         self.log_belief = initial_log_belief(n_cells, absent_prior, episodes)
         self.has_absent = self.log_belief.shape[1] > n_cells
-        self.moving = bool(moving)
+        # A prior with empty cells holds zeros from the start, as a motion step may leave them:
+        # the reward then takes the 0 log 0 = 0 path of ``moving``.
+        self.moving = bool(moving) or (prior is not None and not np.all(prior))
+        if prior is not None:               # (N,) summing to 1, checked by the caller
+            with np.errstate(divide='ignore'):
+                self.log_belief[:, :n_cells] += np.log(prior * n_cells)
         self._terms = np.zeros((episodes, n_cells + 1)) if self.has_absent else None
         self.belief = np.exp(self.log_belief[:, :n_cells])
         self.absent_probability = None

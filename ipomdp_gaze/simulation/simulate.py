@@ -330,14 +330,7 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
     all_present = bool(present.all())
     moving = motion is not None and motion.active
     index = np.arange(episodes)
-    # A prior with empty cells holds zeros from the start, as a motion step may leave them: the
-    # belief then takes the reward's 0 log 0 = 0 path (BatchBelief's ``moving``).
-    zeros = prior is not None and not prior.all()
-    beliefs = BatchBelief(n, absent_prior, episodes, moving or zeros)
-    if prior is not None:
-        with np.errstate(divide='ignore'):
-            beliefs.log_belief[:, :n] += np.log(prior * n)
-        beliefs.belief[...] = np.exp(beliefs.log_belief[:, :n])
+    beliefs = BatchBelief(n, absent_prior, episodes, moving, prior)
     with_absent, belief = beliefs.has_absent, beliefs.belief
     fixations = np.empty((episodes, horizon), dtype=np.int64)
     correct = np.empty((episodes, horizon), dtype=bool)
