@@ -38,10 +38,10 @@ import warnings
 
 from ipomdp_gaze.files.observation_file import fingerprint
 from ipomdp_gaze.files.yaml_files import check_header, in_folder, plain, read_yaml, write_yaml
+from ipomdp_gaze.model.belief import check_prior
 from ipomdp_gaze.model.fpoc import FPOC, fpoc_from_dict
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.observation import CountObservation, GaussianObservation
-from ipomdp_gaze.simulation.simulate import check_prior
 import numpy as np
 
 from .conv import ACTIONS, ConvPolicy, radial_bins

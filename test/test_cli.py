@@ -155,6 +155,35 @@ def test_a_bad_prior_file_is_one_line(tmp_path, capsys, text, message):
     assert '--prior' in capsys.readouterr().err
 
 
+def test_search_draws_its_target_from_a_prior_and_starts_there(tmp_path, capsys):
+    """QA (a researcher): one trial of a centre-biased task; a cell it rules out is refused."""
+    prior = tmp_path / 'prior.txt'
+    prior.write_text('0 0 0\n0 0 1\n0 0 0\n')
+    assert main(['search', '--grid', '3x3', '--prior', str(prior), '--seed', '4']) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert lines[0] == 'target hidden at cell 5 (1, 2) of a 3x3 grid'
+    # The belief starts sure: p 1 after the first frame, entropy 0.00 (never -0.00).
+    assert re.search(r'most likely \(1, 2\) p=1\.000  entropy 0\.00 nats  right$', lines[1])
+    assert main(['search', '--grid', '3x3', '--prior', str(prior), '--target', '0,0']) == 2
+    [line] = capsys.readouterr().err.strip().splitlines()
+    assert line.endswith(f'--target (0, 0) is a cell --prior {prior} rules out (weight 0): '
+                         'the search could never find it there')
+    wide = tmp_path / 'wide.txt'
+    wide.write_text('1 1 1\n1 1 1\n')
+    assert main(['search', '--grid', '3x3', '--prior', str(wide)]) == 2
+    assert capsys.readouterr().err.strip().endswith('a 3x3 grid needs 3 lines of 3 weights, '
+                                                    'got 2 lines of 3')
+    # Seeds draw their targets from the prior: only the two cells it allows.
+    two = tmp_path / 'two.txt'
+    two.write_text('1 0 0\n0 0 0\n0 0 1\n')
+    seen = set()
+    for seed in range(12):
+        assert main(['search', '--grid', '3x3', '--prior', str(two), '--seed', str(seed)]) == 0
+        seen.add(capsys.readouterr().out.splitlines()[0])
+    assert seen == {'target hidden at cell 0 (0, 0) of a 3x3 grid',
+                    'target hidden at cell 8 (2, 2) of a 3x3 grid'}
+
+
 def test_search_runs_a_target_absent_trial(capsys):
     """QA (a researcher): one target-absent trial from the CLI, with the absent hypothesis."""
     assert main(['search', '--grid', '7x7', '--seed', '3', '--empty', '--absent-prior',

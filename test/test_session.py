@@ -46,13 +46,17 @@ def count_model(seed=0, scan=True) -> CountObservation:
                             **scan_tables)
 
 
-def brute_force_log_posterior(model, scan, frames, absent_prior):
+def brute_force_log_posterior(model, scan, frames, absent_prior, cell_prior=None):
     """Return log P(h | scan, frames) for each cell h, then absent: likelihoods multiplied out."""
     n = GRID.n_cells
     hypotheses = list(range(n)) + ([None] if absent_prior > 0 else [])
+    cell_prior = np.full(n, 1 / n) if cell_prior is None else cell_prior
     out = []
     for h in hypotheses:
-        prior = absent_prior if h is None else (1 - absent_prior) / n
+        prior = absent_prior if h is None else (1 - absent_prior) * cell_prior[h]
+        if prior == 0:
+            out.append(-math.inf)
+            continue
         log_p = math.log(prior)
         for i in range(n):
             if scan is not None:
@@ -126,6 +130,65 @@ def test_the_belief_is_the_brute_force_posterior(absent_prior, with_scan):
             break
         cell = result.fixation
     assert result.ended and result.decision == 'gave_up' and result.truncated
+
+
+@pytest.mark.parametrize('absent_prior', [0.0, 0.3])
+def test_a_session_prior_is_where_the_belief_starts_and_bayes_goes_on_from(absent_prior):
+    """The brute-force posterior under a prior over the cells, one of them ruled out."""
+    model = count_model(2)
+    prior = np.arange(GRID.n_cells, dtype=float)         # cell 0 at 0: never the target
+    prior /= prior.sum()
+    settings = SearchSettings(confidence=1 - 1e-12, absent_prior=absent_prior,
+                              max_fixations=6)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model), settings,
+                            prior=prior.reshape(GRID.shape))
+    sensor = ModelSensor(GRID, model, np.random.default_rng(5))
+    sensor.start(7)
+    session.reset(seed=0)
+    np.testing.assert_allclose(session.belief, (1 - absent_prior) * prior, atol=1e-15)
+    frame = sensor.scan()
+    scan = frame.values
+    session.scan(frame)
+    cell, frames = session.start(), []
+    for _ in range(6):
+        frame = sensor.observe(cell)
+        frames.append((cell, frame.values))
+        result = session.update(frame)
+        np.testing.assert_allclose(
+            session.log_belief, brute_force_log_posterior(model, scan, frames, absent_prior,
+                                                          prior), atol=1e-10)
+        assert session.belief[0] == 0 and np.isfinite(session.entropy_nats)
+        if result.ended:
+            break
+        cell = result.fixation
+    session.reset()                                     # every search starts at it again
+    np.testing.assert_allclose(session.belief, (1 - absent_prior) * prior, atol=1e-15)
+    for bad, message in (([1.0], r'prior must hold one probability per cell, 12 values'),
+                         (np.full(GRID.n_cells, 0.5), 'prior must sum to 1, got 6'),
+                         (np.full((4, 3), 1 / 12), r'prior must be \(rows, cols\) = \(3, 4\)')):
+        with pytest.raises(ValueError, match=message):
+            SearchSession(GRID, model, None, settings, prior=bad)
+
+
+def test_a_prior_with_empty_cells_keeps_a_moving_belief_finite():
+    """A walking target from a prior with zeros: the motion step fills them, nothing is NaN."""
+    model = count_model(3, scan=False)
+    prior = np.zeros(GRID.n_cells)
+    prior[[5, 6]] = 0.5
+    settings = SearchSettings(confidence=0.999, motion_sigma_cells=0.7, max_fixations=0)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model), settings,
+                            prior=prior)
+    sensor = ModelSensor(GRID, model, np.random.default_rng(6))
+    sensor.start(5)
+    session.reset(seed=1)
+    cell = session.start()
+    for _ in range(5):
+        result = session.update(sensor.observe(cell), dt_s=1.0)
+        cell = result.fixation if result.fixation is not None else cell
+        belief = session.belief
+        assert np.all(np.isfinite(belief)) and belief.sum() == pytest.approx(1.0)
+        assert np.all(belief > 0)                       # the walk reaches every cell of 3x4
+        assert np.isfinite(session.entropy_nats)
 
 
 @pytest.mark.parametrize('weight', [0.0, 0.25])

@@ -13,8 +13,8 @@ from ipomdp_gaze.search.sensors import run_search as run_offline
 from ipomdp_gaze.search.session import SearchSession, SearchSettings
 import numpy as np
 
-from .common import (add_task_args, cell_arg, cell_index, check_output_file, nonneg_int,
-                     task_from_args)
+from .common import (add_prior_arg, add_task_args, cell_arg, cell_index, check_output_file,
+                     nonneg_int, read_prior, task_from_args)
 from .search_args import add_search_args, settings_from_args
 
 # The paper's convention: the policy picks every fixation, the first included (design 4.1).
@@ -43,23 +43,27 @@ def add_parser(sub):
                    help='fixation budget: gave up when it runs out undecided (default 4 N; 0 = '
                         f'no budget, but an offline search still gives up after '
                         f'{NO_BUDGET_FRAMES_PER_CELL} N)')
+    add_prior_arg(p, 'the hidden target is drawn from it (unless --target) and the belief starts '
+                     'at it')
     p.add_argument('--seed', type=nonneg_int, default=0)
     p.add_argument('--plot', type=Path, default=None, metavar='PNG',
                    help='save the final belief with the scan path as a picture')
     p.set_defaults(run=run)
 
 
-def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=print):
+def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=print,
+               prior=None):
     """
     Run one simulated search on the search session, printing each fixation.
 
-    The model's own sampler is the world (:class:`ipomdp_gaze.search.sensors.ModelSensor`); one
+    ``prior`` (N,), optional: where the belief starts (the session's prior). The model's own
+    sampler is the world (:class:`ipomdp_gaze.search.sensors.ModelSensor`); one
     generator, ``default_rng(seed)``, serves the policy and the noise; the loop is
     :func:`ipomdp_gaze.search.sensors.run_search`. Returns ``(guess, path, belief, result)``
     (``result``: the last :class:`ipomdp_gaze.search.session.StepResult`).
     """
     rng = np.random.default_rng(seed)
-    session = SearchSession(grid, model, policy, settings)
+    session = SearchSession(grid, model, policy, settings, prior=prior)
     sensor = ModelSensor(grid, model, rng)
     with_absent = settings.absent_prior > 0
     if target is None:
@@ -82,7 +86,7 @@ def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=
         steps.append(result)
         kr, kc = grid.cell(session.path[-1])
         gr, gc = grid.cell(result.map_cell)
-        entropy = max(session.entropy_nats, 0.0)          # never -0.00 of a decided 1x1 grid
+        entropy = max(session.entropy_nats, 0.0) + 0.0    # never -0.00 of a decided belief
         # With the absent hypothesis the answer so far is absent while it is the likeliest.
         absent = f'  P(absent)={result.absent_probability:.3f}' if with_absent else ''
         likelier = says_absent(result)
@@ -162,15 +166,23 @@ def run(args) -> int:
     if args.max_fixations is None:
         args.max_fixations = 4 * grid.n_cells
     settings = settings_from_args(args, SEARCH_SETTINGS, grid)
+    prior = None if args.prior is None else read_prior(args.prior, grid)
     rng = np.random.default_rng([args.seed, 1])
     if args.empty and args.target is not None:
         raise ValueError('--empty is a scene without a target: leave out --target')
-    target = int(rng.integers(grid.n_cells)) if args.target is None else \
-        cell_index(args.target, grid, '--target')
+    if args.target is not None:
+        target = cell_index(args.target, grid, '--target')
+        if prior is not None and prior[target] == 0:
+            raise ValueError(f'--target {grid.cell(target)} is a cell --prior {args.prior} rules '
+                             'out (weight 0): the search could never find it there')
+    elif prior is None:
+        target = int(rng.integers(grid.n_cells))
+    else:
+        target = int(rng.choice(grid.n_cells, p=prior))
     if args.empty:
         target = None
     guess, path, belief, result = run_search(grid, as_observation(grid, fpoc), policy, target,
-                                             settings, args.seed)
+                                             settings, args.seed, prior=prior)
     if args.plot:
         name = args.policy_file or args.policy
         task = f'{fpoc.model} FPOC' if args.observation is None else args.observation

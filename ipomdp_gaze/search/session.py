@@ -6,9 +6,9 @@ The one search engine: a search session that every driver runs (docs/design.md s
 A search is a short sequence of pure steps on one belief over the N cells (plus, with
 ``absent_prior > 0``, the hypothesis "no target in the grid"):
 
-1. :meth:`SearchSession.reset` -- the prior: ``(1 - absent_prior) / N`` per cell and
-   ``absent_prior`` on the absent hypothesis
-   (:func:`ipomdp_gaze.model.stopping.initial_log_belief`);
+1. :meth:`SearchSession.reset` -- the prior: ``(1 - absent_prior) / N`` per cell (or
+   ``(1 - absent_prior) P_i`` with a session ``prior`` P) and ``absent_prior`` on the absent
+   hypothesis (:func:`ipomdp_gaze.model.stopping.initial_log_belief`);
 2. :meth:`SearchSession.scan` -- optional, once, before the first fixation: the one-time scan of
    a model with scan tables, ``log B_i += log s_T(c_i) - log s_N(c_i)``;
 3. :meth:`SearchSession.start` -- the first fixation: ``settings.start_cell``, or by default
@@ -38,7 +38,7 @@ from collections import deque
 from dataclasses import dataclass, field
 import math
 
-from ipomdp_gaze.model.belief import (argmax_ties_low, bayes_update, entropy_of_log,
+from ipomdp_gaze.model.belief import (argmax_ties_low, bayes_update, check_prior, entropy_of_log,
                                       EvidenceError, map_cell, normalize_log)
 from ipomdp_gaze.model.clutter_map import ClutterMap
 from ipomdp_gaze.model.false_alarms import FalseAlarmMixture
@@ -410,6 +410,9 @@ class SearchSession:
         (:meth:`fixate`, as a Gymnasium agent does); the session then never chooses.
     settings : SearchSettings
         Checked already; the start cell is checked against ``grid`` here.
+    prior : array (N,) or (rows, cols), optional
+        Where the target is a priori, summing to 1 (:func:`ipomdp_gaze.model.belief.check_prior`):
+        every search starts at it (default uniform, the paper's task); cells at 0 stay at 0.
     log_size : int
         Events kept in :attr:`log` (the newest); a tracking search never ends. 0 keeps none,
         and the per-frame events are not even built (the gaze controller's: its results and
@@ -418,8 +421,12 @@ class SearchSession:
     """
 
     def __init__(self, grid: Grid, observation, policy, settings: SearchSettings | None = None,
-                 log_size: int = 10_000):
+                 log_size: int = 10_000, prior=None):
         self.grid = grid
+        self.prior = None
+        if prior is not None:
+            self.prior = check_prior(prior, grid.n_cells, grid.shape)
+            self.prior.flags.writeable = False
         self.observation = as_observation(grid, observation)
         check_policy_grid(policy, grid)
         self.policy = policy
@@ -678,14 +685,17 @@ class SearchSession:
         A ``seed`` (an int, or a Generator to use as it is) restarts the policy's random
         stream, which otherwise runs on.
 
-        The prior is ``(1 - absent_prior) / N`` per cell and ``absent_prior`` on the absent
-        hypothesis (none when it is 0).
+        The prior is ``(1 - absent_prior) / N`` per cell (``(1 - absent_prior) P_i`` with the
+        session's ``prior`` P) and ``absent_prior`` on the absent hypothesis (none when it is 0).
         """
         if isinstance(seed, np.random.Generator):
             self.rng = seed
         elif seed is not None:
             self.rng = np.random.default_rng(seed)
         log_b = initial_log_belief(self.grid.n_cells, self.settings.absent_prior)
+        if self.prior is not None:
+            with np.errstate(divide='ignore'):          # a cell at 0: log 0 = -inf, kept so
+                log_b[:self.grid.n_cells] += np.log(self.prior * self.grid.n_cells)
         self._still.reset()
         self.motion.reset()
         if self._mixture is not None:

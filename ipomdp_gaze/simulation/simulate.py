@@ -21,7 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Protocol
 
-from ipomdp_gaze.model.belief import map_cell
+from ipomdp_gaze.model.belief import check_prior, map_cell
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.motion import check_probability, Motion
 from ipomdp_gaze.model.observation import as_observation
@@ -207,32 +207,6 @@ def check_present(present, episodes: int) -> np.ndarray:
     if values.dtype.kind != 'b' and not np.all(np.isin(values, (0, 1))):
         raise ValueError('present must hold True/False (or 1/0) per episode')
     return values.astype(bool)
-
-
-def check_prior(prior, n_cells: int, shape: tuple[int, int] | None = None) -> np.ndarray:
-    """
-    Return a prior over the target's cell as a float array (N,) summing to 1.
-
-    A ValueError names what is wrong: the length, a value that is negative or not finite, or a
-    sum other than 1 (within 1e-6; a prior is not renormalised silently). Cells may be 0: the
-    target is never there and the belief keeps them at 0.
-    """
-    values = np.asarray(prior, dtype=float) if not isinstance(prior, np.ndarray) else prior
-    if values.dtype.kind not in 'iuf':
-        raise ValueError(f'prior must be numbers, got dtype {values.dtype}')
-    if values.ndim == 2 and shape is not None and values.shape != tuple(shape):
-        raise ValueError(f'prior must be (rows, cols) = {tuple(shape)} or ({n_cells},), got shape '
-                         f'{values.shape}')
-    values = values.astype(float).reshape(-1) if values.ndim == 2 else values.astype(float)
-    if values.shape != (n_cells,):
-        raise ValueError(f'prior must hold one probability per cell, {n_cells} values (rows x '
-                         f'cols, row-major), got shape {np.shape(prior)}')
-    if not np.all(np.isfinite(values)) or np.any(values < 0):
-        raise ValueError('prior must be finite and >= 0 in every cell')
-    total = float(values.sum())
-    if abs(total - 1.0) > 1e-6:
-        raise ValueError(f'prior must sum to 1, got {total:.6g}')
-    return values / total
 
 
 def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | None = None,
