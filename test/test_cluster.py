@@ -8,6 +8,7 @@ mid-run loses nothing; an unreachable scheduler or a worker with other code is o
 Ctrl-C stops a run at once and keeps its finished pieces.
 """
 from dataclasses import dataclass
+import gc
 import json
 import os
 from pathlib import Path
@@ -187,8 +188,6 @@ def test_a_port_that_is_no_scheduler_is_one_line_within_the_timeout(answer, reas
 
     threading.Thread(target=serve, daemon=True).start()
     try:
-        # tls:// first: a client that read the babbler's garbage can hold Dask's event loop for
-        # a while, and the TLS refusal (at once, before any connection) would then wait on it
         with pytest.raises(ClusterError, match='TLS expects'):
             DaskExecutor(f'tls://127.0.0.1:{server.getsockname()[1]}', timeout_s=5.0)
         with pytest.raises(ClusterError) as raised:
@@ -198,6 +197,29 @@ def test_a_port_that_is_no_scheduler_is_one_line_within_the_timeout(answer, reas
         server.close()
         for conn in held:
             conn.close()
+
+
+def test_a_client_that_failed_to_connect_is_closed_at_once():
+    """
+    Not left to the garbage collector, whose ``Client.__del__`` could deadlock the next start.
+
+    The collector is off, so a failed client left open is still there to be seen.
+    """
+    from distributed import Client
+    server = socket.socket()
+    server.bind(('127.0.0.1', 0))
+    server.listen(4)
+    before = {id(o) for o in gc.get_objects() if isinstance(o, Client)}
+    gc.disable()
+    try:
+        with pytest.raises(ClusterError, match='TLS expects'):
+            DaskExecutor(f'tls://127.0.0.1:{server.getsockname()[1]}', timeout_s=5.0)
+        made = [o for o in gc.get_objects() if isinstance(o, Client) and id(o) not in before]
+        assert made and wait_for(lambda: all(c.status == 'closed' for c in made), 10.0), \
+            [c.status for c in made]
+    finally:
+        gc.enable()
+        server.close()
 
 
 def test_the_scheduler_comes_from_the_environment(monkeypatch, capsys):

@@ -302,25 +302,44 @@ def _connect(client_class, address: str, timeout_s: float):
     server) never answers Dask's handshake, and ``Client``'s own timeout does not cover it; one
     that answers with other bytes makes Dask read garbage (a MemoryError, a TypeError for
     ``tls://`` without certificates). So the client is made in a daemon thread, waited for at
-    most ``timeout_s`` and a little more, and any failure is the scheduler's, said in one line;
-    the half-made client's own complaints when it is collected are silenced.
+    most ``timeout_s`` and a little more, and any failure is the scheduler's, said in one line.
+    A client that fails, or connects only after the wait, is closed by that thread: left to the
+    garbage collector, its ``Client.__del__`` could run inside Dask's loop lock while the next
+    client starts, and wait for that lock for ever; its complaints when collected are silenced.
     """
     made = {}
+    lock = threading.Lock()
+    finished = threading.Event()
+
+    class HeldClient(client_class):
+        """A client held from its first step, so that one which fails can be closed."""
+
+        def start(self, **kwargs):
+            made['half'] = self
+            return super().start(**kwargs)
 
     def connect():
         try:
-            made['client'] = client_class(address, timeout=timeout_s, set_as_default=False)
+            made['client'] = HeldClient(address, timeout=timeout_s, set_as_default=False)
         except BaseException as exc:            # noqa: B902 (any failure is the scheduler's)
             made['error'] = exc
+        with lock:
+            finished.set()
+            kept = 'client' in made and not made['late']
+        if not kept and 'half' in made:
+            _close_quietly(made['half'])
 
+    made['late'] = False
     thread = threading.Thread(target=connect, name='dask-connect', daemon=True)
     deadline_s = timeout_s + min(CONNECT_GRACE_S, timeout_s)
     thread.start()
-    thread.join(deadline_s)
-    if 'client' in made:
+    finished.wait(deadline_s)
+    with lock:
+        made['late'] = not finished.is_set()
+    if 'client' in made and not made['late']:
         return made['client']
     _quiet_client_collection()
-    if thread.is_alive():
+    if made['late']:
         raise ClusterError(f'no Dask scheduler answered at {address} within {deadline_s:g} s '
                            '(something listens there: is it the dashboard? a scheduler listens '
                            'on 8786 by default, its dashboard on 8787)')
@@ -329,6 +348,14 @@ def _connect(client_class, address: str, timeout_s: float):
         (str(exc).strip().splitlines() or [type(exc).__name__])[-1]
     raise ClusterError(f'cannot reach the Dask scheduler at {address} within {timeout_s:g} s '
                        f'({type(exc).__name__}: {detail})')
+
+
+def _close_quietly(client) -> None:
+    """Close a client that failed to connect; an error in closing is not the one to report."""
+    try:
+        client.close()
+    except Exception:                           # noqa: B902 (the connect failure came first)
+        pass
 
 
 def _quiet_client_collection() -> None:
