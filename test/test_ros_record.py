@@ -431,3 +431,43 @@ def test_a_recorder_in_a_namespace_asks_its_node_there_and_the_replay_reads_it(c
     from ipomdp_gaze.drivers.replay import parameter_changes
     assert [c.values for c in parameter_changes(bag, 'recorded_source')] == \
         [{'confidence': 0.8}]
+
+
+@pytest.mark.parametrize('durability, recorded', [('volatile', True), (None, False)])
+def test_a_volatile_teleop_is_recorded_with_the_recorders_qos_overridden(context, tmp_path,
+                                                                         durability, recorded):
+    """QA: the recorder's pan_tilt and fixation took no QoS overrides, as the cameras' do."""
+    import time
+    from ipomdp_gaze.nodes.recorder import RecorderNode
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Int32MultiArray
+    names = [f'qos_overrides./teleop/{t}.subscription.durability'
+             for t in ('pan_tilt', 'fixation')]
+    overrides = [Parameter('path', value=str(tmp_path / 'bag')),
+                 Parameter('topics', value=['pan_tilt', 'fixation'])]
+    if durability:
+        overrides += [Parameter(name, value=durability) for name in names]
+    recorder = RecorderNode(context=context, namespace='/teleop', parameter_overrides=overrides)
+    teleop = Node('teleop', namespace='/teleop', context=context)
+    pan_tilt = teleop.create_publisher(JointState, 'pan_tilt', 10)     # volatile, reliable
+    fixation = teleop.create_publisher(Int32MultiArray, 'fixation', 10)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(recorder)
+    executor.add_node(teleop)
+    try:
+        assert [recorder.get_parameter(n).value for n in names] == \
+            [durability or 'transient_local'] * 2
+        deadline = time.monotonic() + (20.0 if recorded else 2.0)
+        while not all(recorder.counts.values()) and time.monotonic() < deadline:
+            pan_tilt.publish(JointState(name=['pan', 'tilt'], position=[0.0, 0.0]))
+            fixation.publish(Int32MultiArray(data=[0, 0]))
+            executor.spin_once(timeout_sec=0.1)
+        assert {t: bool(n) for t, n in recorder.counts.items()} == \
+            {'pan_tilt': recorded, 'fixation': recorded}
+    finally:
+        executor.shutdown()
+        teleop.destroy_node()
+        recorder.destroy_node()

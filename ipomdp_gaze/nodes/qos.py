@@ -40,22 +40,24 @@ def _depth_check(name: str):
     return check
 
 
-def command_subscription(node, msg_type, topic: str, callback):
+def command_subscription(node, msg_type, topic: str, callback, qos: QoSProfile = STATE_QOS,
+                         raw: bool = False):
     """
-    Subscribe a command topic with :data:`STATE_QOS`, overridable at start-up.
+    Subscribe a command topic with ``qos`` (:data:`STATE_QOS`), overridable at start-up.
 
     rclpy writes the overrides into the profile it is given, so each subscription gets a copy
-    of its own: the shared profile, which the node's publishers use too, stays as it is. An
+    of its own: the shared profile, which the node's publishers use too, stays as it is. ``raw``
+    hands the callback the serialized message (the recorder). An
     override rclpy cannot take (``durability:=bogus``, ``depth:=-1``) raises ``ValueError``
     naming it, which the node's start-up prints as one line (rclpy raised a bare
     ``RuntimeError``, or rcl's 'invalid allocator').
     """
-    profile = copy.copy(STATE_QOS)
+    profile = copy.copy(qos)
     name = f'qos_overrides.{node.resolve_topic_name(topic)}.subscription'
     options = QoSOverridingOptions(policy_kinds=COMMAND_POLICIES, callback=_depth_check(name))
     try:
         return node.create_subscription(msg_type, topic, callback, profile,
-                                        qos_overriding_options=options)
+                                        qos_overriding_options=options, raw=raw)
     except InvalidQosOverridesError as exc:
         raise ValueError(str(exc).rpartition('are not valid: ')[2]) from None
     except RuntimeError as exc:

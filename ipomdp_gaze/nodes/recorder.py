@@ -15,7 +15,9 @@ is every one of them: camera images, ``camera_info``, ``joint_states``, ``fixati
 ``~/target_cells``, many targets), ``/diagnostics``, ``/parameter_events`` (the parameters set
 while recording), ``ground_truth``, the scene camera's ``walk_truth`` and the detector's
 ``annotated_image`` and raw ``detections``). A topic no node publishes in the mode running is
-subscribed to and stays empty.
+subscribed to and stays empty. The ``pan_tilt`` and ``fixation`` subscriptions (transient local)
+take ROS's start-up QoS overrides, as the cameras' and the detector's do: ``-p
+qos_overrides./pan_tilt.subscription.durability:=volatile`` records a volatile teleop publisher.
 
 The bag's ``custom_data`` (in ``metadata.yaml``) holds ``ipomdp_gaze/version`` (the package),
 ``ipomdp_gaze/parameters/<node>`` (every parameter of each node in ``nodes``, as YAML, fetched
@@ -55,6 +57,7 @@ import yaml
 from . import NODE_NAMES
 from .outputs import QuietPublishers
 from .params import Param, ParameterTransaction, T
+from .qos import command_subscription
 from .spin import run_node
 
 NODE_NAME = NODE_NAMES['recorder']
@@ -93,6 +96,9 @@ TOPICS = {
     'annotated_image': (Image, 'sensor_msgs/msg/Image', RELIABLE),
     'detections': (PoseArray, 'geometry_msgs/msg/PoseArray', RELIABLE),
 }
+# The commands, which a volatile publisher (a teleop tool) may send: their subscriptions take
+# ROS's start-up QoS overrides, as the cameras' and the detector's do (nodes/qos.py).
+COMMAND_TOPICS = ('pan_tilt', 'fixation')
 FILE_PARAMETERS = ('policy.file', 'observation.file')
 PARAMETER_RETRY_S = 0.5
 # A parameter request unanswered this long is sent again (s).
@@ -173,8 +179,12 @@ class RecorderNode(QuietPublishers, Node):
             msg_type, type_name, qos = TOPICS[topic]
             self.connections[topic] = self.writer.add_connection(
                 self.resolve_topic_name(topic), type_name)
-            self.subscriptions_[topic] = self.create_subscription(
-                msg_type, topic, self._writer_for(topic), qos, raw=True)
+            if topic in COMMAND_TOPICS:
+                self.subscriptions_[topic] = command_subscription(
+                    self, msg_type, topic, self._writer_for(topic), qos, raw=True)
+            else:
+                self.subscriptions_[topic] = self.create_subscription(
+                    msg_type, topic, self._writer_for(topic), qos, raw=True)
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self.create_timer(values['diagnostics_period_s'], self._publish_diagnostics)
         self.parameters: dict = {}
