@@ -37,9 +37,11 @@ def test_empty_scene_terminates_absent_and_the_reward_counts_every_hypothesis():
                           absent_prior=0.5, confidence=0.99)
     obs, info = env.reset(seed=2, options={'present': False})
     assert obs['absent'][0] == pytest.approx(0.5) and info['present'] is False
+    assert info['target'] is None                       # no target to name (it was a cell)
     assert obs['belief'].sum() == pytest.approx(0.5)
     for _ in range(30):
         obs, reward, terminated, truncated, info = env.step(4)
+        assert info['target'] is None
         full = np.append(env.belief, env.absent_probability)
         assert reward == pytest.approx(np.sum(full * np.log(full)))
         assert obs['belief'].sum() + obs['absent'][0] == pytest.approx(1.0)
@@ -52,6 +54,8 @@ def test_absent_rate_draws_empty_scenes_from_the_env_generator():
     env = VisualSearchEnv(absent_prior=0.5, absent_rate=0.5)
     present = [env.reset(seed=s)[1]['present'] for s in range(200)]
     assert 60 < sum(present) < 140
+    infos = [env.reset(seed=s)[1] for s in range(200)]
+    assert all((i['target'] is None) is (not i['present']) for i in infos)
     assert [env.reset(seed=s)[1]['present'] for s in range(200)] == present
 
 

@@ -13,7 +13,7 @@ truncated after ``max_steps`` fixations; stepping on after either needs a reset.
 belief, the Bayes step and the stop rules are the search session's
 (:mod:`ipomdp_gaze.search.session`,
 with the agent choosing every fixation). The hidden target is in ``info['target']`` for oracle
-baselines.
+baselines (``None`` in an empty scene: there is no target to name).
 
 By default the observation model is the Gaussian model of ``fpoc`` on a ``rows x cols`` grid
 (7x7); ``observation=`` takes any observation model instead, for example a count model or the
@@ -154,7 +154,8 @@ class VisualSearchEnv(gymnasium.Env):
     def _info(self, decision: str = ''):
         b = self.belief
         guess = int(map_cell(b))
-        return {'target': self._target, 'map_cell': guess, 'map_probability': float(b[guess]),
+        target = self._target if self._present else None
+        return {'target': target, 'map_cell': guess, 'map_probability': float(b[guess]),
                 'entropy': self.session.entropy_nats, 'steps': self._steps,
                 'present': self._present, 'absent_probability': self.absent_probability,
                 'decision': decision}
