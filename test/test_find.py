@@ -220,6 +220,8 @@ def test_default_policy_is_the_shipped_kernel_of_the_model(task, tmp_path, monke
     (lambda d: _png(d / 'deep.tiff', np.zeros((420, 420), dtype=np.float32)),
      '32-bit float32 image; find needs 8 or 16 bits per channel'),
     (lambda d: _png(d / 'dot.png', np.zeros((1, 1), dtype=np.uint8)), 'too small'),
+    # a link to itself: was a RuntimeError traceback (Path.resolve) before any image
+    (lambda d: _link(d / 'loop.png', 'loop.png'), 'a symbolic link loop'),
 ])
 def test_a_bad_image_is_one_error_line_and_the_others_are_searched(task, tmp_path, make,
                                                                    message, find_here):
@@ -255,4 +257,9 @@ def _write(path, data: bytes):
 
 def _png(path, image):
     assert cv2.imwrite(str(path), image)
+    return path
+
+
+def _link(path, target):
+    path.symlink_to(target)
     return path

@@ -192,10 +192,12 @@ def test_an_output_in_a_folder_that_takes_no_file_is_refused_before_any_search(
                                            'not a folder'),
     ('--plot', 'astronaut.png', '--plot astronaut.png: is an input image (it would be '
                                 'overwritten)'),
+    ('--json', 'loop.json', '--json loop.json: a symbolic link loop'),   # was a traceback
 ])
 def test_a_bad_output_path_is_refused_before_any_search(images, tmp_path, run_find, option,
                                                         target, says):
     (tmp_path / 'adir').mkdir()
+    (tmp_path / 'loop.json').symlink_to('loop.json')
     (tmp_path / 'astronaut.png').write_bytes(images['astronaut'].read_bytes())
     result = run_find('astronaut.png', option, target, cwd=tmp_path)
     assert result.returncode == 2 and result.stdout == ''

@@ -22,10 +22,10 @@ be below the confidence or, when forced, below 0.5.
 **Outputs.** ``--json`` and ``--log`` take ``-`` for stdout (one of them; the lines then go to
 stderr); ``--json`` has an entry ``{path, error}`` for each input that could not be searched.
 Every output path (``--json``, ``--log``, each ``--plot`` file) is checked before any search: a
-folder, an input image, a path through a file or one written twice is refused in one line
-naming its option (exit status 2), as are a bad ``--policy`` or ``--policy-file`` (built once
-on each model first). ``--scan`` does not apply to ``--all`` or ``--targets many``: stderr says
-so once.
+folder, an input image, a path through a file, a symbolic link loop or one written twice is
+refused in one line naming its option (exit status 2), as are a bad ``--policy`` or
+``--policy-file`` (built once on each model first). ``--scan`` does not apply to ``--all`` or
+``--targets many``: stderr says so once.
 
 **Scale first** (``--scan``, without ``--all``). By default (``coarse``) the detector runs on
 the whole image at a coarse scale (1/2; Haar's ``faces-420``: 1/4) and then at each finer scale
@@ -95,8 +95,10 @@ whose ``observation.name`` is the model's name), else ELM on the model, acting b
 from __future__ import annotations
 
 from dataclasses import replace
+import errno
 import json
 import math
+import os
 from pathlib import Path
 import sys
 
@@ -324,6 +326,8 @@ def read_image(path: str, notes: list | None = None, max_side: int = 0,
 
     """
     file = Path(path)
+    if file.is_symlink() and _loops(file):
+        raise ValueError(f'{path}: a symbolic link loop')
     if not file.exists():
         raise ValueError(f'{path}: no such file')
     if not file.is_file():
@@ -362,6 +366,15 @@ def read_image(path: str, notes: list | None = None, max_side: int = 0,
     if image.ndim == 3:
         image = cv2.cvtColor(image, cv2.COLOR_BGR2RGB)
     return image
+
+
+def _loops(path: Path) -> bool:
+    """Whether following ``path``'s links never ends (ELOOP: ``exists()`` just says False)."""
+    try:
+        os.stat(path)
+    except OSError as exc:
+        return exc.errno == errno.ELOOP
+    return False
 
 
 def shrink(image: np.ndarray, max_side: int) -> tuple[np.ndarray, tuple]:
@@ -859,14 +872,17 @@ def check_outputs(args, images: list[str], plots: list[Path]) -> None:
     if args.json == STDOUT and args.log == STDOUT:
         raise ValueError('--json - and --log - would both write to stdout: give one of them a '
                          'file')
-    inputs = {Path(image).resolve() for image in images}
+    # realpath, not Path.resolve: a symbolic link loop is the input's own error, not a traceback
+    inputs = {Path(os.path.realpath(image)) for image in images}
     seen = {}
     for flag, path in outputs:
         if path == STDOUT:
             continue
         if path.is_dir():
             raise ValueError(f'{flag} {path}: is a directory')
-        resolved = path.resolve()
+        if _loops(path):
+            raise ValueError(f'{flag} {path}: a symbolic link loop')
+        resolved = Path(os.path.realpath(path))
         if resolved in inputs:
             raise ValueError(f'{flag} {path}: is an input image (it would be overwritten)')
         if resolved in seen:
