@@ -1,7 +1,9 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """``ipomdp-gaze find`` on generated scenes, with a count model calibrated on train scenes."""
+import errno
 import json
+import os
 from pathlib import Path
 import subprocess
 import sys
@@ -263,3 +265,38 @@ def _png(path, image):
 def _link(path, target):
     path.symlink_to(target)
     return path
+
+
+def test_a_folder_or_file_find_may_not_look_at_is_one_line_each(task, tmp_path, monkeypatch,
+                                                                find_here):
+    """
+    A folder without read permission, or a file in one without search permission: one line each.
+
+    Was ``error: [Errno 13] Permission denied`` for the whole run, no image searched. Root reads
+    them all, so the refusals are those of a user's own process, made here by os.stat,
+    os.listdir and os.scandir (as the system would) for these paths only.
+    """
+    locked, noexec = tmp_path / 'locked', tmp_path / 'noexec'
+    for folder in (locked, noexec):
+        folder.mkdir()
+        (folder / 'a.png').write_bytes(Path(task['images'][0]).read_bytes())
+    stat, listdir, scandir = os.stat, os.listdir, os.scandir
+
+    def refuse(call, refused):
+        def wrapped(path='.', *args, **kwargs):
+            if Path(os.fsdecode(path)) in refused:
+                raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), str(path))
+            return call(path, *args, **kwargs)
+        return wrapped
+    monkeypatch.setattr(os, 'stat', refuse(stat, {noexec / 'a.png'}))
+    monkeypatch.setattr(os, 'listdir', refuse(listdir, {locked}))
+    monkeypatch.setattr(os, 'scandir', refuse(scandir, {locked}))
+    result = find_here(locked, noexec, task['images'][1], '--observation', task['model'])
+    assert result.returncode == 2 and 'Traceback' not in result.stderr
+    assert [line.split(':')[0] for line in result.stdout.splitlines()] == [
+        str(task['images'][1])]
+    errors = [line for line in result.stderr.splitlines() if 'error:' in line]
+    assert errors == [
+        f'ipomdp-gaze find: error: {locked}: a folder find cannot list: Permission denied',
+        f'ipomdp-gaze find: error: {noexec / "a.png"}: cannot read: Permission denied',
+        'ipomdp-gaze find: error: 2 of 3 inputs could not be searched']

@@ -100,6 +100,7 @@ import json
 import math
 import os
 from pathlib import Path
+import stat
 import sys
 
 import cv2
@@ -326,11 +327,18 @@ def read_image(path: str, notes: list | None = None, max_side: int = 0,
 
     """
     file = Path(path)
-    if file.is_symlink() and _loops(file):
-        raise ValueError(f'{path}: a symbolic link loop')
-    if not file.exists():
-        raise ValueError(f'{path}: no such file')
-    if not file.is_file():
+    try:
+        mode = os.stat(file).st_mode
+    except OSError as exc:      # one stat: a folder on the way may refuse it (EACCES)
+        raise ValueError(f'{path}: {_stat_error(exc)}') from None
+    if stat.S_ISDIR(mode):      # a folder expand_inputs could not list
+        try:
+            os.scandir(file).close()
+        except OSError as exc:
+            raise ValueError(f'{path}: a folder find cannot list: {exc.strerror or exc}') \
+                from None
+        raise ValueError(f'{path}: not a file')
+    if not stat.S_ISREG(mode):
         raise ValueError(f'{path}: not a file')
     try:
         data = np.fromfile(file, dtype=np.uint8)
@@ -366,6 +374,15 @@ def read_image(path: str, notes: list | None = None, max_side: int = 0,
     if image.ndim == 3:
         image = cv2.cvtColor(image, cv2.COLOR_BGR2RGB)
     return image
+
+
+def _stat_error(exc: OSError) -> str:
+    """Say why a path cannot be stat-ed: missing, a link loop, or the system's reason."""
+    if exc.errno in (errno.ENOENT, errno.ENOTDIR):
+        return 'no such file'
+    if exc.errno == errno.ELOOP:
+        return 'a symbolic link loop'
+    return f'cannot read: {exc.strerror or exc}'
 
 
 def _loops(path: Path) -> bool:
@@ -466,7 +483,9 @@ def expand_inputs(paths: list[str], skipped: list | None = None) -> list[str]:
     Each path as given; a folder becomes its image files (by suffix), sorted by name.
 
     ``skipped``, when given, gets ``(folder, names)`` for each folder with other files or
-    folders (not searched: a folder is not walked down).
+    folders (not searched: a folder is not walked down). A folder that cannot be listed stays
+    as given, and :func:`read_image` reports it, as it does an entry that cannot be stat-ed:
+    one line each, the other images still searched.
 
     Raises
     ------
@@ -478,18 +497,35 @@ def expand_inputs(paths: list[str], skipped: list | None = None) -> list[str]:
     for path in paths:
         if not path.strip():
             raise ValueError(f'an empty image path ({path!r}: an unset shell variable?)')
-        folder = Path(path)
-        if folder.is_dir():
-            entries = sorted(folder.iterdir())
-            files = [f for f in entries if f.is_file()]
-            out.extend(str(f) for f in files if f.suffix.lower() in IMAGE_SUFFIXES)
-            others = [f.name + '/' * f.is_dir() for f in entries
-                      if not (f.is_file() and f.suffix.lower() in IMAGE_SUFFIXES)]
-            if others and skipped is not None:
-                skipped.append((path, others))
-        else:
+        try:
+            entries = sorted(Path(path).iterdir()) if os.path.isdir(path) else None
+        except OSError:         # a folder that cannot be listed: read_image says why, alone
+            entries = None
+        if entries is None:
             out.append(path)
+            continue
+        kinds = {f: _kind(f) for f in entries}
+        out.extend(str(f) for f in entries
+                   if kinds[f] == 'file' and f.suffix.lower() in IMAGE_SUFFIXES)
+        others = [f.name + '/' * (kinds[f] == 'folder') for f in entries
+                  if not (kinds[f] == 'file' and f.suffix.lower() in IMAGE_SUFFIXES)]
+        if others and skipped is not None:
+            skipped.append((path, others))
     return out
+
+
+def _kind(entry: Path) -> str:
+    """
+    ``'file'``, ``'folder'``, or ``'other'`` for a folder's entry.
+
+    An entry that cannot be stat-ed (a link loop, a folder without search permission) is a file
+    of its suffix, so that read_image reports it rather than the folder skip it unsaid.
+    """
+    try:
+        mode = os.stat(entry).st_mode
+    except OSError:
+        return 'file'
+    return 'folder' if stat.S_ISDIR(mode) else 'file' if stat.S_ISREG(mode) else 'other'
 
 
 def _cell_text(result) -> str:
