@@ -13,6 +13,7 @@ import json
 import re
 import subprocess
 import sys
+import warnings
 
 import cv2
 from ipomdp_gaze.search.answer import answer_probability, ended, heading
@@ -174,6 +175,27 @@ def test_a_large_jpeg_is_decoded_reduced(tmp_path):
     size = []
     image = read_image(str(path), [], 300, size)
     assert size == [(1600, 1200)] and image.shape == (225, 300, 3)
+
+
+@pytest.mark.parametrize('limit', [1_000_000, 500_000], ids=['warned', 'refused'])
+def test_a_jpeg_over_pillows_bomb_limit_is_decoded_reduced_without_its_warning(
+        tmp_path, monkeypatch, limit):
+    """
+    Pillow warns (two lines) over MAX_IMAGE_PIXELS and refuses over twice that (179 Mpx).
+
+    A 16000x12000 photo was decoded whole (1.3 GB resident instead of a quarter-size decode),
+    a 12000x9000 one printed DecompressionBombWarning; the limit is lowered here to reach them.
+    """
+    from ipomdp_gaze.commands.find import _read_flags
+    from PIL import Image
+    monkeypatch.setattr(Image, 'MAX_IMAGE_PIXELS', limit)
+    path = tmp_path / 'large.jpg'
+    cv2.imwrite(str(path), np.full((900, 1200, 3), 90, np.uint8))     # 1.08 Mpx
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        flags, size = _read_flags(path, 300)
+    assert (flags, size) == (cv2.IMREAD_REDUCED_COLOR_4, (1200, 900))
+    assert Image.MAX_IMAGE_PIXELS == limit                  # the check is back for others
 
 
 def test_a_corrupt_png_is_our_one_line_only(images, tmp_path):

@@ -282,14 +282,20 @@ def _read_flags(file: Path, max_side: int) -> tuple[int, tuple | None]:
     the largest k of 8, 4, 2 that keeps the longer side at least ``max_side``. Other formats
     are decoded whole (and a 16-bit one converted with its note), then resized. The size comes
     from the file's header (Pillow, which reads no pixels) and is returned with the flags
-    (None when the decode is not reduced); a file Pillow cannot read is decoded whole.
+    (None when the decode is not reduced); a file Pillow cannot read is decoded whole. Pillow's
+    decompression-bomb check is off for the header: it would warn in two lines over 89 Mpx
+    and refuse over 179 Mpx, so that the photos the reduced decode is for were decoded whole.
     """
     if not max_side:
         return READ_FLAGS, None
     try:
         from PIL import Image
-        with Image.open(file) as header:
-            size, kind = tuple(int(v) for v in header.size), header.format
+        bomb, Image.MAX_IMAGE_PIXELS = Image.MAX_IMAGE_PIXELS, None
+        try:
+            with Image.open(file) as header:
+                size, kind = tuple(int(v) for v in header.size), header.format
+        finally:
+            Image.MAX_IMAGE_PIXELS = bomb
     except Exception:           # noqa: B902 (any failure: OpenCV decodes it, or says why)
         return READ_FLAGS, None
     if kind != 'JPEG':          # only libjpeg scales while decoding; 16-bit PNGs keep depth
