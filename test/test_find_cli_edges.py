@@ -335,3 +335,26 @@ def test_an_image_the_search_runs_out_of_memory_on_is_one_line_and_the_rest_is_s
     assert 'Traceback' not in result.stderr
     entries = json.loads(out.read_text())['images']
     assert entries[0]['error'].startswith('out of memory') and entries[1]['decision'] == 'found'
+
+
+@pytest.mark.skipif(not Path('/dev/full').exists(), reason='needs /dev/full (Linux)')
+def test_a_plot_the_disk_refuses_is_one_line_and_the_rest_is_searched(images, tmp_path,
+                                                                      run_find):
+    """A disk that fills during the run (a link to /dev/full): was one unnamed line, all lost."""
+    (tmp_path / 'p-0.png').symlink_to('/dev/full')
+    out = tmp_path / 'found.json'
+    result = run_find(images['astronaut'], images['noise'], '--plot', tmp_path / 'p.png',
+                      '--json', out)
+    assert result.returncode == 2 and 'Traceback' not in result.stderr
+    assert [line.split(':')[0] for line in result.stdout.splitlines()] == [
+        str(images['astronaut']), str(images['noise'])]
+    assert [line for line in result.stderr.splitlines() if 'error:' in line] == [
+        f'ipomdp-gaze find: error: --plot {tmp_path / "p-0.png"}: cannot write: No space left '
+        'on device']
+    assert (tmp_path / 'p-1.png').stat().st_size > 0
+    assert [e['path'] for e in json.loads(out.read_text())['images']] == [
+        str(images['astronaut']), str(images['noise'])]
+    result = run_find(images['astronaut'], '--json', '/dev/full')
+    assert result.returncode == 2 and result.stdout.startswith(f'{images["astronaut"]}: ')
+    assert result.stderr.splitlines()[-1] == ('ipomdp-gaze find: error: --json /dev/full: '
+                                              'cannot write: No space left on device')

@@ -24,8 +24,9 @@ stderr); ``--json`` has an entry ``{path, error}`` for each input that could not
 Every output path (``--json``, ``--log``, each ``--plot`` file) is checked before any search: a
 folder, an input image, a path through a file, a symbolic link loop or one written twice is
 refused in one line naming its option (exit status 2), as are a bad ``--policy`` or
-``--policy-file`` (built once on each model first). ``--scan`` does not apply to ``--all`` or
-``--targets many``: stderr says so once.
+``--policy-file`` (built once on each model first); one that fails while written (a disk
+that fills) is one line naming it, the other images and outputs still done (exit status 2).
+``--scan`` does not apply to ``--all`` or ``--targets many``: stderr says so once.
 
 **Scale first** (``--scan``, without ``--all``). By default (``coarse``) the detector runs on
 the whole image at a coarse scale (1/2; Haar's ``faces-420``: 1/4) and then at each finer scale
@@ -951,15 +952,35 @@ def _check_size(path: str, image: np.ndarray, given: tuple, fovea, max_side: int
                          f'--max-side, or 0 not to resize)') from None
 
 
-def _write(text: str, out: Path) -> None:
-    """Write ``text`` to ``out`` (``-``: stdout), saying where."""
+def _write(text: str, out: Path, flag: str) -> bool:
+    """
+    Write ``text`` to ``out`` (``-``: stdout), saying where; False after one line if it fails.
+
+    A disk that fills during the run (checked writable before it) costs this output only.
+    """
     if out == STDOUT:
         sys.stdout.write(text)
         sys.stdout.flush()
-        return
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(text)
+        return True
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(text)
+    except OSError as exc:
+        _error(f'{flag} {out}: cannot write: {exc.strerror or exc}')
+        return False
     _note(f'wrote {out}')
+    return True
+
+
+def _plot(image, result, task, out: Path, title: str, occupancy: bool) -> bool:
+    """Draw one image's plot to ``out``; False after one line naming it if it cannot be written."""
+    try:
+        plot_image_search(image, result, task.fovea, out, title, occupancy)
+    except OSError as exc:      # a full disk: this plot is lost, not the other images' search
+        _error(f'--plot {out}: cannot write: {exc.strerror or exc}')
+        return False
+    _note(f'wrote {out}')
+    return True
 
 
 def run(args) -> int:
@@ -988,7 +1009,7 @@ def run(args) -> int:
         _note(f'warning: --scan {args.scan_mode} is ignored: it chooses how find looks for one '
               f'face, and --all / --targets many search for every face')
     scan = args.scan_mode or SCAN_DEFAULT
-    entries, logs, failed, grid, warned = [], [], 0, None, set()
+    entries, logs, failed, grid, warned, unwritten = [], [], 0, None, set(), 0
     out = sys.stderr if STDOUT in (args.json, args.log) else sys.stdout
     for i, path in enumerate(images):
         notes = []
@@ -1067,16 +1088,16 @@ def run(args) -> int:
         if plots:
             title = plot_title(path, results[0], settings.confidence, occupancy,
                                len(results[0].faces) if many else None)
-            plot_image_search(image, searched[0], task.fovea, plots[i], title, occupancy)
-            _note(f'wrote {plots[i]}')
+            unwritten += not _plot(image, searched[0], task, plots[i], title, occupancy)
     if args.log:
-        _write('\n'.join(logs) + '\n' if logs else '', args.log)
+        unwritten += not _write('\n'.join(logs) + '\n' if logs else '', args.log, '--log')
     if args.json:
         rows, cols = grid.shape if grid is not None else (None, None)
-        _write(json.dumps({'grid': {'rows': rows, 'cols': cols},
-                           'axes': {'cell': ['row', 'col'], 'pixel': ['x', 'y']},
-                           'images': entries}, indent=1) + '\n', args.json)
+        unwritten += not _write(json.dumps({'grid': {'rows': rows, 'cols': cols},
+                                            'axes': {'cell': ['row', 'col'],
+                                                     'pixel': ['x', 'y']},
+                                            'images': entries}, indent=1) + '\n',
+                                args.json, '--json')
     if failed:
         _error(f'{failed} of {len(images)} inputs could not be searched')
-        return 2
-    return 0
+    return 2 if failed or unwritten else 0
