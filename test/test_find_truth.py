@@ -10,6 +10,7 @@ found on an absent answer; ``--json -``; 16-bit images; large images resized; a 
 our one line only; ``--detector`` takes any detector kind.
 """
 import json
+import os
 import re
 import subprocess
 import sys
@@ -250,6 +251,50 @@ def test_calibrate_reads_a_corrupt_image_without_libpngs_lines(images, tmp_path,
     with pytest.raises(ValueError, match=f'labels.csv:2: cannot decode {path} as an image'):
         _read_image(path, 'labels.csv:2')
     assert capfd.readouterr().err == ''
+
+
+def test_an_image_over_opencvs_pixel_limit_is_one_line_and_the_rest_is_searched(images,
+                                                                                tmp_path):
+    """
+    An image over OpenCV's 2^30 pixels (a 40000x40000 PNG, 1.6 MB of zeros): was a cv2.error.
+
+    The traceback ended the run, the other images unsearched. The limit, read from the
+    environment, is lowered here below the astronaut's 512x512 and above the 300x300 crop.
+    """
+    crop = tmp_path / 'crop.png'
+    cv2.imwrite(str(crop), cv2.imread(str(images['astronaut']))[:300, 100:400])
+    result = subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', 'find',
+                             str(images['astronaut']), str(crop)], capture_output=True,
+                            text=True, timeout=300,
+                            env={**os.environ, 'OPENCV_IO_MAX_IMAGE_PIXELS': '100000'})
+    assert result.returncode == 2 and 'Traceback' not in result.stderr
+    assert result.stdout.startswith(f'{crop}: decision=found')
+    assert [line for line in result.stderr.splitlines() if 'error:' in line] == [
+        f'ipomdp-gaze find: error: {images["astronaut"]}: more pixels than OpenCV decodes '
+        '(OPENCV_IO_MAX_IMAGE_PIXELS: 2^30 unless that environment variable is set)',
+        'ipomdp-gaze find: error: 1 of 2 inputs could not be searched']
+
+
+def test_an_image_too_large_for_memory_is_one_line_for_find_and_calibrate(images, tmp_path,
+                                                                          monkeypatch,
+                                                                          run_find):
+    """A 20000x20000 PNG under a 1.5 GB ulimit: cv2.imdecode's Insufficient memory."""
+    from ipomdp_gaze.vision import image_files
+    from ipomdp_gaze.vision.scenes import _read_image
+    decode = image_files.cv2.imdecode
+
+    def imdecode(data, flags):
+        if data.size == images['noise'].stat().st_size:
+            raise cv2.error('OpenCV(4.14.0) alloc.cpp:73: error: (-4:Insufficient memory) '
+                            'Failed to allocate 1200000000 bytes')
+        return decode(data, flags)
+    monkeypatch.setattr(image_files.cv2, 'imdecode', imdecode)
+    result = run_find(images['noise'], images['astronaut'])
+    assert result.returncode == 2
+    assert result.stdout.startswith(f'{images["astronaut"]}: decision=found')
+    assert f'error: {images["noise"]}: out of memory decoding it\n' in result.stderr
+    with pytest.raises(ValueError, match=f'labels.csv:2: {images["noise"]}: out of memory'):
+        _read_image(images['noise'], 'labels.csv:2')
 
 
 def test_all_on_a_resized_image_says_which_faces_it_looks_for(images, run_find):

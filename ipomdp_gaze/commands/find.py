@@ -330,7 +330,8 @@ def read_image(path: str, notes: list | None = None, max_side: int = 0,
     Raises
     ------
     ValueError
-        Naming the file: missing, unreadable, not decodable, or of another depth (float).
+        Naming the file: missing, unreadable, not decodable (over OpenCV's pixel limit, out of
+        memory), or of another depth (float).
 
     """
     file = Path(path)
@@ -352,7 +353,10 @@ def read_image(path: str, notes: list | None = None, max_side: int = 0,
     except OSError as exc:
         raise ValueError(f'{path}: cannot read: {exc.strerror or exc}') from None
     flags, header = _read_flags(file, max_side) if data.size else (READ_FLAGS, None)
-    image = decode_quietly(data, flags) if data.size else None
+    try:
+        image = decode_quietly(data, flags) if data.size else None
+    except ValueError as exc:   # over OpenCV's pixel limit, or out of memory
+        raise ValueError(f'{path}: {exc}') from None
     del data
     if image is None:
         raise ValueError(f'{path}: not an image OpenCV can decode')
@@ -1027,8 +1031,12 @@ def run(args) -> int:
             settings = settings_from_args(args, FIND_SETTINGS, task.model.grid)
             if args.all and args.targets is TASK_DEFAULT:
                 settings = replace(settings, targets='many')
-        except ValueError as exc:
-            message = str(exc)
+        except (ValueError, MemoryError, cv2.error) as exc:
+            # out of memory converting or resizing a decoded image: this image's error too
+            if isinstance(exc, cv2.error) and 'Insufficient memory' not in str(exc):
+                raise
+            message = str(exc) if isinstance(exc, ValueError) else \
+                f'{path}: out of memory reading it (a smaller image file)'
             _error(message if message.startswith(path) else f'{path}: {message}')
             reason = message[len(path) + 2:] if message.startswith(f'{path}: ') else message
             entries.append({'path': path, 'error': reason})

@@ -13,6 +13,20 @@ import numpy as np
 READ_FLAGS = cv2.IMREAD_ANYDEPTH | cv2.IMREAD_ANYCOLOR
 
 
+OUT_OF_MEMORY = 'out of memory decoding it'
+
+
+def decode_error(exc: cv2.error) -> str:
+    """Say in one line why ``cv2.imdecode`` raised: the pixel limit, memory, or its message."""
+    text = str(exc)
+    if 'CV_IO_MAX_IMAGE_PIXELS' in text:
+        return ('more pixels than OpenCV decodes (OPENCV_IO_MAX_IMAGE_PIXELS: 2^30 unless '
+                'that environment variable is set)')
+    if 'Insufficient memory' in text:
+        return OUT_OF_MEMORY
+    return f'OpenCV cannot decode it: {exc.err or text.strip().splitlines()[-1]}'
+
+
 @contextmanager
 def _quiet_fd(fd: int = 2):
     """Send what C code writes to file descriptor ``fd`` (stderr) to /dev/null meanwhile."""
@@ -35,6 +49,10 @@ def decode_quietly(data: np.ndarray, flags: int = READ_FLAGS):
     """
     ``cv2.imdecode`` with OpenCV's and libpng's own messages silenced (None if it fails).
 
+    An image OpenCV refuses to decode (over ``OPENCV_IO_MAX_IMAGE_PIXELS``, 2^30 by default) or
+    has no memory for raises ValueError saying so in one line (the caller names the file): it
+    raised ``cv2.error``, a traceback that ended the other files' work too.
+
     A corrupt file makes libpng and OpenCV print their own lines (``libpng error: PNG input
     buffer is incomplete``, ``[ERROR:0@...] global grfmt_png.cpp ...``) on stderr before our
     one-line message says the same; libpng writes to the file descriptor itself, so that is
@@ -49,6 +67,10 @@ def decode_quietly(data: np.ndarray, flags: int = READ_FLAGS):
     try:
         with _quiet_fd(2):
             return cv2.imdecode(data, flags)
+    except cv2.error as exc:
+        raise ValueError(decode_error(exc)) from None
+    except MemoryError:
+        raise ValueError(OUT_OF_MEMORY) from None
     finally:
         if logging is not None:
             logging.setLogLevel(level)

@@ -525,7 +525,10 @@ def _read_image(path: Path, where: str) -> np.ndarray:
         raise FileNotFoundError(f'{where}: image {path} does not exist')
     from .image_files import decode_quietly
     data = np.fromfile(path, dtype=np.uint8)
-    image = decode_quietly(data, cv2.IMREAD_UNCHANGED) if data.size else None
+    try:
+        image = decode_quietly(data, cv2.IMREAD_UNCHANGED) if data.size else None
+    except ValueError as exc:   # over OpenCV's pixel limit, or out of memory
+        raise ValueError(f'{where}: {path}: {exc}') from None
     if image is None:
         raise ValueError(f'{where}: cannot decode {path} as an image')
     if image.dtype != np.uint8:
