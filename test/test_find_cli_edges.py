@@ -7,7 +7,9 @@ QA's report on ``find``: boxes past the image, a ``p`` that read as contradictin
 failed inputs missing from ``--json``, ``--log -``, output paths refused only after the search, a
 bad policy once per image, ``--max-side`` unnamed, ``--scan`` silently ignored, "1 faces".
 """
+import errno
 import json
+import os
 from pathlib import Path
 import re
 
@@ -358,3 +360,19 @@ def test_a_plot_the_disk_refuses_is_one_line_and_the_rest_is_searched(images, tm
     assert result.returncode == 2 and result.stdout.startswith(f'{images["astronaut"]}: ')
     assert result.stderr.splitlines()[-1] == ('ipomdp-gaze find: error: --json /dev/full: '
                                               'cannot write: No space left on device')
+
+
+def test_an_output_in_a_folder_that_refuses_a_look_is_named(images, tmp_path, monkeypatch,
+                                                            run_find):
+    """A folder without search permission (EACCES): was "[Errno 13] Permission denied: ..."."""
+    out, stat = tmp_path / 'closed' / 'found.json', os.stat
+
+    def refuse(path, *args, **kwargs):
+        if Path(os.fsdecode(path)) == out:
+            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), str(path))
+        return stat(path, *args, **kwargs)
+    monkeypatch.setattr(os, 'stat', refuse)
+    result = run_find(images['astronaut'], '--json', out)
+    assert result.returncode == 2 and result.stdout == ''
+    assert result.stderr.strip().splitlines() == [
+        f'ipomdp-gaze find: error: --json {out}: Permission denied']

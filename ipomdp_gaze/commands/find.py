@@ -925,6 +925,11 @@ def check_outputs(args, images: list[str], plots: list[Path]) -> None:
     for flag, path in outputs:
         if path == STDOUT:
             continue
+        try:
+            os.stat(path)
+        except OSError as exc:  # a folder on the way that refuses a look (EACCES) is named too
+            if exc.errno not in (errno.ENOENT, errno.ENOTDIR, errno.ELOOP):
+                raise ValueError(f'{flag} {path}: {exc.strerror or exc}') from None
         if path.is_dir():
             raise ValueError(f'{flag} {path}: is a directory')
         if _loops(path):
