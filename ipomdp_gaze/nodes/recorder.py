@@ -39,6 +39,7 @@ from __future__ import annotations
 import hashlib
 from pathlib import Path
 import sys
+import threading
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
@@ -160,6 +161,10 @@ class RecorderNode(QuietPublishers, Node):
     """Subscribe to the search's topics (serialized) and write them to a rosbag2 MCAP bag."""
 
     def __init__(self, **kwargs):
+        # The bag is written by the subscriptions and the parameter answers (executor tasks,
+        # in no callback group) and closed by destroy_node: in a multi-threaded executor these
+        # run at once, so each holds this lock.
+        self._bag_lock = threading.Lock()
         super().__init__(NODE_NAME, **kwargs)
         self._transaction = ParameterTransaction(self, recorder_params(), self._build,
                                                  lambda old, new: None)
@@ -214,8 +219,11 @@ class RecorderNode(QuietPublishers, Node):
             # clock's time, never the simulated one (use_sim_time), and so is the fallback.
             received = info.get('received_timestamp') if isinstance(info, dict) else None
             stamp = int(received) if received else time.time_ns()
-            self.writer.write(connection, stamp, data)
-            self.counts[topic] += 1
+            with self._bag_lock:
+                if self.writer is None:     # taken before destroy_node closed the bag
+                    return
+                self.writer.write(connection, stamp, data)
+                self.counts[topic] += 1
         return write
 
     # -- the other nodes' parameters ---------------------------------------------------------
@@ -271,16 +279,19 @@ class RecorderNode(QuietPublishers, Node):
                   for k, v in values.items()}
         values = {k: ([float(x) if isinstance(x, float) else x for x in v]
                       if isinstance(v, list) else v) for k, v in values.items()}
-        self.parameters[node] = values
-        self.writer.set_custom_data(f'ipomdp_gaze/parameters/{node}',
-                                    yaml.safe_dump(values, sort_keys=True))
-        self.writer.set_custom_data(f'ipomdp_gaze/parameters_node/{node}',
-                                    node_name(node, self.get_namespace()))
-        self.writer.set_custom_data(f'ipomdp_gaze/parameters_time/{node}', str(asked_ns))
-        self.writer.set_custom_data('ipomdp_gaze/files',
-                                    yaml.safe_dump(file_hashes(self.parameters), sort_keys=True))
-        if node in self._pending:
-            self._pending.remove(node)
+        with self._bag_lock:
+            if self.writer is None:         # answered after destroy_node closed the bag
+                return
+            self.parameters[node] = values
+            self.writer.set_custom_data(f'ipomdp_gaze/parameters/{node}',
+                                        yaml.safe_dump(values, sort_keys=True))
+            self.writer.set_custom_data(f'ipomdp_gaze/parameters_node/{node}',
+                                        node_name(node, self.get_namespace()))
+            self.writer.set_custom_data(f'ipomdp_gaze/parameters_time/{node}', str(asked_ns))
+            self.writer.set_custom_data('ipomdp_gaze/files', yaml.safe_dump(
+                file_hashes(self.parameters), sort_keys=True))
+            if node in self._pending:
+                self._pending.remove(node)
         self.get_logger().info(f'recorded the parameters of {node}')
 
     def _publish_diagnostics(self) -> None:
@@ -297,10 +308,17 @@ class RecorderNode(QuietPublishers, Node):
             self.get_clock().now().to_msg()))
 
     def destroy_node(self):
-        """Close the bag (writes metadata.yaml), then destroy the node."""
-        writer, self.writer = getattr(self, 'writer', None), None
-        if writer is not None:
-            writer.close()
+        """
+        Close the bag (writes metadata.yaml), then destroy the node.
+
+        A write under way (another executor thread) ends first; one that starts later is
+        dropped: a node unloaded while its executor spins (composed nodes) neither writes to a
+        closed bag nor raises out of the executor's spin.
+        """
+        with self._bag_lock:
+            writer, self.writer = getattr(self, 'writer', None), None
+            if writer is not None:
+                writer.close()
         return super().destroy_node()
 
 

@@ -1,0 +1,92 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+Nodes composed in one process and spun by a ``MultiThreadedExecutor`` (QA, composition).
+
+A team (or a component container) runs our nodes with other nodes in one process, on several
+threads: another node's callback then runs beside ours, a done-callback of a service answer runs
+in no callback group, and a node may be unloaded (``remove_node``, ``destroy_node``) while one of
+its callbacks is under way. Each test holds a callback where the race happens (an event, never a
+sleep), so that the outcome does not depend on the machine's speed.
+"""
+import threading
+
+import pytest
+
+pytestmark = pytest.mark.ros
+
+WAIT_S = 30.0
+
+
+class _Spinner:
+    """Spin a ``MultiThreadedExecutor`` in a thread; keep what its spin raised."""
+
+    def __init__(self, context, nodes, threads: int = 4):
+        from rclpy.executors import MultiThreadedExecutor
+        self.executor = MultiThreadedExecutor(num_threads=threads, context=context)
+        for node in nodes:
+            self.executor.add_node(node)
+        self.errors = []
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._spin, daemon=True)
+        self._thread.start()
+
+    def _spin(self):
+        while not self._stop.is_set():
+            try:
+                self.executor.spin_once(timeout_sec=0.05)
+            except Exception as exc:  # noqa: B902 (what a team's spin would have raised)
+                self.errors.append(exc)
+
+    def close(self):
+        self._stop.set()
+        self._thread.join(WAIT_S)
+        self.executor.shutdown(timeout_sec=WAIT_S)
+
+
+def test_a_recorder_unloaded_during_a_write_closes_its_bag_after_the_write(context, tmp_path):
+    """
+    QA: destroy_node closed the bag under a write on another thread; the write then raised.
+
+    (``WriterError: Bag was not opened``, or ``AttributeError`` on the writer set to None,
+    raised out of the team's ``spin``; a write during the close could corrupt the bag.)
+    """
+    from ipomdp_gaze.files.bag import read_bag
+    from ipomdp_gaze.nodes.recorder import RecorderNode, TOPICS
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+    from sensor_msgs.msg import JointState
+    recorder = RecorderNode(context=context, namespace='/unload', parameter_overrides=[
+        Parameter('path', value=str(tmp_path / 'bag')), Parameter('topics', value=['pan_tilt']),
+        Parameter('nodes', value=['nobody'])])
+    source = Node('unload_source', namespace='/unload', context=context)
+    target = source.create_publisher(JointState, 'pan_tilt', TOPICS['pan_tilt'][2])
+    entered, release, failures = threading.Event(), threading.Event(), []
+    write = recorder.writer.write
+
+    def held_write(*args):
+        entered.set()
+        release.wait(WAIT_S)
+        try:
+            write(*args)
+        except Exception as exc:  # noqa: B902
+            failures.append(exc)
+            raise
+    recorder.writer.write = held_write
+    spinner = _Spinner(context, [recorder, source])
+    unloading = threading.Thread(target=recorder.destroy_node)
+    try:
+        target.publish(JointState(name=['pan', 'tilt'], position=[0.1, 0.2]))
+        assert entered.wait(WAIT_S), 'the recorder never received the message'
+        spinner.executor.remove_node(recorder)
+        unloading.start()
+        unloading.join(1.0)     # the unfixed destroy_node has closed the bag by now
+        release.set()
+        unloading.join(WAIT_S)
+        assert not unloading.is_alive()
+    finally:
+        release.set()
+        spinner.close()
+        source.destroy_node()
+    assert failures == [] and spinner.errors == []
+    assert len(read_bag(tmp_path / 'bag').topic('/unload/pan_tilt')) == 1
