@@ -90,3 +90,95 @@ def test_a_recorder_unloaded_during_a_write_closes_its_bag_after_the_write(conte
         source.destroy_node()
     assert failures == [] and spinner.errors == []
     assert len(read_bag(tmp_path / 'bag').topic('/unload/pan_tilt')) == 1
+
+
+class _HeldOffer:
+    """Hold the controller's next ``core.offer`` until released; note the confidence after."""
+
+    def __init__(self, node):
+        self.node, self.offer = node, node.core.offer
+        self.entered, self.release, self.returned = (threading.Event(), threading.Event(),
+                                                     threading.Event())
+        self.confidence = None
+        node.core.offer = self
+
+    def __call__(self, *args, **kwargs):
+        self.entered.set()
+        self.release.wait(WAIT_S)
+        try:
+            return self.offer(*args, **kwargs)
+        finally:
+            self.confidence = self.node._config.values['confidence']
+            self.node.core.offer = self.offer
+            self.returned.set()
+
+
+def _held_controller(context, namespace):
+    """Return a controller, a source node, its held ``core.offer`` and a frame publisher."""
+    import numpy as np
+    from ipomdp_gaze.msg_adapters import grid_arrays
+    from ipomdp_gaze.nodes.controller import GazeControllerNode
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+    from std_msgs.msg import Float32MultiArray
+    node = GazeControllerNode(context=context, namespace=namespace, parameter_overrides=[
+        Parameter('settle_time_s', value=0.0), Parameter('retry_period_s', value=0.0)])
+    source = Node('evidence_source', namespace=namespace, context=context)
+    held = _HeldOffer(node)
+    frame = grid_arrays.to_multiarray(np.zeros(node._config.grid.n_cells, np.float32),
+                                      node._config.grid)
+    evidence = source.create_publisher(Float32MultiArray, 'evidence', 10)
+    return node, source, held, lambda: evidence.publish(frame)
+
+
+def test_set_parameters_from_another_thread_waits_for_the_callback_under_way(context):
+    """
+    QA: a node's ``set_parameters`` called beside its evidence callback rebuilt it mid-frame.
+
+    (Another node's callback on a ``MultiThreadedExecutor``; with ``search.targets`` switched
+    under a frame, ``AttributeError: 'SearchSession' object has no attribute 'faces'``.)
+    """
+    from rclpy.parameter import Parameter
+    node, source, held, publish = _held_controller(context, '/set_beside')
+    spinner = _Spinner(context, [node, source])
+    setter = threading.Thread(target=node.set_parameters,
+                              args=([Parameter('confidence', value=0.9)],))
+    try:
+        while not held.entered.wait(0.1):       # best effort: resent until the node hears it
+            publish()
+        setter.start()
+        setter.join(1.0)    # the unfixed set has rebuilt the configuration by now
+        held.release.set()
+        setter.join(WAIT_S)
+        assert held.returned.wait(WAIT_S) and not setter.is_alive()
+    finally:
+        held.release.set()
+        spinner.close()
+        node.destroy_node()
+        source.destroy_node()
+    assert held.confidence == 0.95                      # the frame ran on one configuration
+    assert node._config.values['confidence'] == 0.9     # and the set came after it
+    assert node.guard.errors == 0 and spinner.errors == []
+
+
+def test_a_controller_destroyed_during_a_callback_destroys_after_it(context):
+    """QA: destroy_node under an evidence callback made it publish on destroyed publishers."""
+    node, source, held, publish = _held_controller(context, '/destroy_beside')
+    spinner = _Spinner(context, [node, source])
+    unloading = threading.Thread(target=node.destroy_node)
+    try:
+        while not held.entered.wait(0.1):
+            publish()
+        spinner.executor.remove_node(node)
+        unloading.start()
+        unloading.join(1.0)     # the unfixed destroy_node has destroyed the publishers by now
+        held.release.set()
+        unloading.join(WAIT_S)
+        assert held.returned.wait(WAIT_S) and not unloading.is_alive()
+    finally:
+        held.release.set()
+        spinner.close()
+        source.destroy_node()
+    assert node.core.fixations == 1      # the frame was applied, its fixation published
+    assert node.guard.errors == 0, node.guard.last_error
+    assert spinner.errors == []

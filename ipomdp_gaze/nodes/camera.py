@@ -45,7 +45,7 @@ from std_msgs.msg import Float32MultiArray, Int32MultiArray
 from std_srvs.srv import Trigger
 
 from . import NODE_NAMES
-from .guard import CallbackGuard
+from .guard import CallbackGuard, GuardedNode
 from .outputs import QuietPublishers
 from .params import (cell_params, fpoc_params, grid_params, INT_MAX, joint_params, Param,
                      ParameterTransaction, T)
@@ -89,7 +89,7 @@ class CameraConfig:
     motion: Motion
 
 
-class SimulatedCameraNode(SaccadeMixin, QuietPublishers, Node):
+class SimulatedCameraNode(SaccadeMixin, GuardedNode, QuietPublishers, Node):
     """A simulated pan/tilt head with a detector (see the module docstring)."""
 
     def __init__(self, **kwargs):

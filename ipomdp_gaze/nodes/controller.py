@@ -75,7 +75,7 @@ from std_srvs.srv import SetBool, Trigger
 from trajectory_msgs.msg import JointTrajectory
 
 from . import NODE_NAMES
-from .guard import CallbackGuard
+from .guard import CallbackGuard, GuardedNode
 from .outputs import QuietPublishers
 from .params import (cell_params, current_values, fpoc_params, grid_params, INT_MAX, joint_params,
                      Param, ParameterTransaction, search_params, T)
@@ -160,7 +160,7 @@ def controller_params() -> list[Param]:
     ]
 
 
-class GazeControllerNode(QuietPublishers, Node):
+class GazeControllerNode(GuardedNode, QuietPublishers, Node):
     """ROS 2 wrapper of :class:`ipomdp_gaze.search.gaze.GazeController`."""
 
     def __init__(self, **kwargs):

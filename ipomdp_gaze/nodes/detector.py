@@ -55,7 +55,7 @@ from std_msgs.msg import Float32MultiArray, Int32MultiArray
 
 from . import NODE_NAMES
 from .annotation import Annotator
-from .guard import CallbackGuard
+from .guard import CallbackGuard, GuardedNode
 from .outputs import QuietPublishers
 from .params import joint_params, MAX_CELLS_PER_SIDE, Param, ParameterTransaction, T
 from .qos import command_subscription, FRAME_QOS
@@ -174,7 +174,7 @@ def _detector_settings(values: dict) -> dict:
     return given
 
 
-class FovealDetectorNode(QuietPublishers, Node):
+class FovealDetectorNode(GuardedNode, QuietPublishers, Node):
     """ROS 2 wrapper of :class:`ipomdp_gaze.vision.detection.DetectorLoop`."""
 
     def __init__(self, **kwargs):

@@ -13,11 +13,19 @@ errors end a node.
 The counts are in ``/diagnostics``: merged into the node's own status (:meth:`values`), or, for
 a node without one, in a status of their own, ``<node>: callbacks`` (:meth:`publish_status`):
 OK while ``callback_errors`` is 0, WARN after an error.
+
+The guarded callbacks of a node also run one at a time under the guard's lock, and so do its
+parameter sets and ``destroy_node`` (:class:`GuardedNode`). In its own process a node is spun
+by one thread; composed in one process and spun by a ``MultiThreadedExecutor``, its callbacks
+are still one mutually exclusive group, but another node's callback may call ``set_parameters``
+on it, or unload it, while one of them is under way.
 """
 from __future__ import annotations
 
 from collections import Counter
+import contextlib
 import functools
+import threading
 
 WARN_THROTTLE_S = 5.0
 DIAGNOSTICS_PERIOD_S = 1.0
@@ -48,6 +56,8 @@ class CallbackGuard:
         self.last_error = ''
         self._pass_through = _shutdown_exceptions()
         self._status_pub = None
+        self.lock = threading.RLock()   # one guarded callback, parameter set or destroy at a time
+        self.closed = False             # destroy_node has run: later callbacks do nothing
 
     def _shutting_down(self) -> bool:
         """Return whether the node's context is shut down (nothing can be published)."""
@@ -74,29 +84,37 @@ class CallbackGuard:
 
         A service callback (called with ``request, response``) returns the response it was
         given, with ``success = False`` and the reason as ``message`` when it has those fields.
+        It runs under :attr:`lock`; once the node is destroyed it does nothing (a message taken
+        before ``destroy_node`` would be published on destroyed publishers).
         """
         name = name or getattr(callback, '__name__', 'callback').lstrip('_')
-        pass_through = self._pass_through
 
         @functools.wraps(callback)
         def guarded(*args):
-            try:
-                return callback(*args)
-            except pass_through:
-                raise
-            except Exception as exc:  # noqa: B902 (that is the point of the guard)
-                if self._shutting_down():
-                    return None         # Ctrl-C while a callback ran: its publish has no context
-                reason = self.record(name, exc)
-                if len(args) == 2:                      # a service: (request, response)
-                    response = args[1]
-                    if hasattr(response, 'success'):
-                        response.success = False
-                    if hasattr(response, 'message'):
-                        response.message = f'internal error: {reason}'
-                    return response
-                return None
+            with self.lock:
+                if self.closed:
+                    return args[1] if len(args) == 2 else None
+                return self._call(callback, name, args)
         return guarded
+
+    def _call(self, callback, name: str, args: tuple):
+        """Call ``callback(*args)``: what it raises is counted (see :meth:`wrap`)."""
+        try:
+            return callback(*args)
+        except self._pass_through:
+            raise
+        except Exception as exc:  # noqa: B902 (that is the point of the guard)
+            if self._shutting_down():
+                return None         # Ctrl-C while a callback ran: its publish has no context
+            reason = self.record(name, exc)
+            if len(args) == 2:                      # a service: (request, response)
+                response = args[1]
+                if hasattr(response, 'success'):
+                    response.success = False
+                if hasattr(response, 'message'):
+                    response.message = f'internal error: {reason}'
+                return response
+            return None
 
     def refusing(self, build, name: str = 'parameters'):
         """
@@ -145,3 +163,36 @@ class CallbackGuard:
             [diagnostics.status(f'{self.node.get_fully_qualified_name()}: callbacks', level,
                                 message, self.values())],
             self.node.get_clock().now().to_msg()))
+
+
+class GuardedNode:
+    """
+    Mixin before ``rclpy.node.Node``: parameter sets and ``destroy_node`` take the guard's lock.
+
+    A ``set_parameters`` called by another node's callback (composed nodes, a multi-threaded
+    executor) would otherwise rebuild the search under an evidence callback, and a
+    ``destroy_node`` would destroy the publishers a callback is about to use. Both wait for
+    the callback under way; callbacks taken before ``destroy_node`` then do nothing.
+    """
+
+    def _guard_lock(self):
+        guard = getattr(self, 'guard', None)   # None while Node.__init__ runs (one thread)
+        return contextlib.nullcontext() if guard is None else guard.lock
+
+    def set_parameters(self, parameter_list):
+        """Set parameters as ``Node.set_parameters`` does, between two callbacks."""
+        with self._guard_lock():
+            return super().set_parameters(parameter_list)
+
+    def set_parameters_atomically(self, parameter_list):
+        """Set parameters as ``Node.set_parameters_atomically`` does, between two callbacks."""
+        with self._guard_lock():
+            return super().set_parameters_atomically(parameter_list)
+
+    def destroy_node(self):
+        """Destroy the node once the callback under way has returned; later ones do nothing."""
+        with self._guard_lock():
+            guard = getattr(self, 'guard', None)
+            if guard is not None:
+                guard.closed = True
+            return super().destroy_node()

@@ -51,7 +51,7 @@ from sensor_msgs.msg import CameraInfo, Image, JointState
 from std_msgs.msg import Float64MultiArray, Int32MultiArray
 
 from . import NODE_NAMES
-from .guard import CallbackGuard
+from .guard import CallbackGuard, GuardedNode
 from .outputs import QuietPublishers
 from .params import INT_MAX, joint_params, MAX_CELLS_PER_SIDE, Param, ParameterTransaction, T
 from .qos import command_subscription, STATE_QOS
@@ -210,7 +210,7 @@ def _check_walk(values: dict, faces: tuple) -> None:
         raise ValueError(f'scene.motion walk needs {why}')
 
 
-class SceneCameraNode(SaccadeMixin, QuietPublishers, Node):
+class SceneCameraNode(SaccadeMixin, GuardedNode, QuietPublishers, Node):
     """A simulated camera over a real photograph (see the module docstring)."""
 
     def __init__(self, **kwargs):
