@@ -117,7 +117,8 @@ def test_the_detectors_picture_labels_a_forced_answer():
     from ipomdp_gaze.msg_adapters import diagnostics
     from ipomdp_gaze.nodes.annotation import Annotator
     node = SimpleNamespace(create_publisher=lambda *a: None,
-                           create_subscription=lambda *a: None)
+                           create_subscription=lambda *a: None,
+                           guard=SimpleNamespace(wrap=lambda callback: callback))
     annotator = Annotator(node)
     annotator._publish = lambda: None
     annotator._on_found(diagnostics.found_status('c: found', 1, 2, 13, 0.0, 0.0, 0.6, 20,
@@ -126,3 +127,26 @@ def test_the_detectors_picture_labels_a_forced_answer():
     annotator._on_found(diagnostics.found_status('c: found', 1, 2, 13, 0.0, 0.0, 0.999, 4,
                                                  radius=1))
     assert annotator.found_label == 'found' and annotator.found_radius == 1
+
+
+def test_the_annotators_subscriptions_run_under_the_nodes_guard():
+    """QA (composed nodes): a failure drawing a belief or found message is counted, not fatal."""
+    from ipomdp_gaze.nodes.annotation import Annotator
+    from ipomdp_gaze.nodes.guard import CallbackGuard
+    subscribed = {}
+    warnings = []
+    logger = SimpleNamespace(warning=lambda text, **kw: warnings.append(text))
+    node = SimpleNamespace(create_publisher=lambda *a: None, get_logger=lambda: logger,
+                           create_subscription=lambda kind, topic, callback, depth:
+                           subscribed.__setitem__(topic, callback))
+    node.guard = CallbackGuard(node)
+    annotator = Annotator(node)
+
+    def fail():
+        raise IndexError('a cell outside the grid')
+    annotator._publish = fail
+    annotator.node.loop = SimpleNamespace(setup=SimpleNamespace(grid=None))
+    from ipomdp_gaze.msg_adapters import diagnostics
+    subscribed['found'](diagnostics.found_status('c: found', 1, 2, 13, 0.0, 0.0, 0.6, 20))
+    assert node.guard.errors == 1 and node.guard.by_callback == {'on_found': 1}
+    assert 'IndexError: a cell outside the grid' in warnings[0]

@@ -36,8 +36,10 @@ class Annotator:
         self.node = node
         self.publisher = node.create_publisher(Image, TOPIC, 2)
         self.detections = node.create_publisher(PoseArray, 'detections', 10)
-        node.create_subscription(Float32MultiArray, 'belief', self._on_belief, 10)
-        node.create_subscription(DiagnosticStatus, 'found', self._on_found, 10)
+        # under the node's guard, as its other callbacks: counted if they fail, one at a time
+        node.create_subscription(Float32MultiArray, 'belief', node.guard.wrap(self._on_belief),
+                                 10)
+        node.create_subscription(DiagnosticStatus, 'found', node.guard.wrap(self._on_found), 10)
         self.fixations: list[int] = []
         self.belief = None
         self.found = None
