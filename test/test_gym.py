@@ -269,3 +269,30 @@ def test_a_step_before_the_first_reset_asks_for_a_reset():
         env.step(0)
     env.reset(seed=0)
     env.step(0)
+
+
+def test_a_prior_is_where_targets_are_drawn_and_the_belief_starts():
+    """QA (an RL researcher): a centre-biased task in the environment, as in evaluate --prior."""
+    prior = np.zeros((4, 4))
+    prior[1, 1], prior[2, 3] = 0.25, 0.75
+    env = VisualSearchEnv(rows=4, cols=4, observe='evidence', prior=prior, confidence=1 - 1e-9)
+    check_env(env, skip_render_check=True)
+    targets = [env.reset(seed=s)[1]['target'] for s in range(40)]
+    assert set(targets) == {5, 11}
+    assert 0.5 < targets.count(11) / 40 < 0.95         # 0.75 of 40: sd 0.07
+    obs, info = env.reset(seed=2)
+    np.testing.assert_allclose(env.belief, prior.ravel())
+    d = dprime_matrix(env.grid, env.fpoc)
+    with np.errstate(divide='ignore'):
+        log_b = np.log(prior.ravel())
+    for action in (0, 6):
+        obs, reward, *_ = env.step(action)
+        log_b = bayes_update(log_b, llr(obs['evidence'].ravel(), d[:, action]))
+        b = np.exp(log_b)
+        np.testing.assert_allclose(env.belief, b, atol=1e-12)
+        assert reward == pytest.approx(np.sum(b[b > 0] * np.log(b[b > 0])))
+    assert env.reset(options={'target': 5})[1]['target'] == 5
+    with pytest.raises(ValueError, match=r"options\['target'\] 0 is a cell the prior rules out"):
+        env.reset(options={'target': 0})
+    with pytest.raises(ValueError, match='prior must sum to 1'):
+        VisualSearchEnv(rows=4, cols=4, prior=np.ones((4, 4)))

@@ -28,7 +28,9 @@ the absent hypothesis: the observation gains ``'absent'`` (``P(absent)``, shape 
 ``belief`` grid holds the cells (summing to ``1 - P(absent)``), the infomax reward is over all
 N + 1 hypotheses, and an episode also terminates when ``P(absent)`` reaches ``confidence``.
 ``absent_rate`` is the fraction of episodes whose scene is empty (drawn at reset from
-``np_random``; ``options={'present': False}`` forces one).
+``np_random``; ``options={'present': False}`` forces one). ``prior`` ((N,) or (rows, cols),
+summing to 1) is where the target is a priori: reset draws it from the prior and the belief
+starts there (default uniform; ``options={'target': cell}`` must be a cell it allows).
 
 A count model with scan tables (``faces-420`` and the other calibrated face models) starts each
 episode with its one-time whole-image scan, drawn at reset (``scan=False``: from the uniform
@@ -72,7 +74,8 @@ class VisualSearchEnv(gymnasium.Env):
                  max_steps: int | None = None, start_cell: int | None = None,
                  render_mode: str | None = None, observation=None,
                  motion_sigma_cells: float = 0.0, jump_prob: float = 0.0,
-                 absent_prior: float = 0.0, absent_rate: float = 0.0, scan: bool = True):
+                 absent_prior: float = 0.0, absent_rate: float = 0.0, scan: bool = True,
+                 prior=None):
         if observation is not None:
             given = [name for name, value in (('spacing_deg', spacing_deg), ('fpoc', fpoc),
                                               ('fpoc_params', fpoc_params)) if value is not None]
@@ -107,7 +110,8 @@ class VisualSearchEnv(gymnasium.Env):
         self.settings = SearchSettings(confidence=confidence, absent_prior=absent_prior,
                                        motion_sigma_cells=motion_sigma_cells,
                                        motion_jump_prob=jump_prob)
-        self.session = SearchSession(self.grid, self.model, None, self.settings)
+        self.session = SearchSession(self.grid, self.model, None, self.settings, prior=prior)
+        self.prior = self.session.prior
         self.motion = self.session.motion
         self.absent_prior = self.settings.absent_prior
         self.absent_rate = check_probability(absent_rate, 'absent_rate')
@@ -173,7 +177,15 @@ class VisualSearchEnv(gymnasium.Env):
                 target, (int, np.integer)) or not 0 <= target < n):
             raise ValueError(f"options['target'] must be a cell index in [0, {n}), got "
                              f'{target!r}')
-        self._target = int(self.np_random.integers(n)) if target is None else int(target)
+        if target is not None and self.prior is not None and self.prior[target] == 0:
+            raise ValueError(f"options['target'] {target} is a cell the prior rules out "
+                             '(probability 0)')
+        if target is not None:
+            self._target = int(target)
+        elif self.prior is None:
+            self._target = int(self.np_random.integers(n))
+        else:
+            self._target = int(self.np_random.choice(n, p=self.prior))
         if 'present' in options:
             if not isinstance(options['present'], (bool, np.bool_)):
                 raise ValueError(f"options['present'] must be True or False, got "
