@@ -271,6 +271,7 @@ def test_a_step_before_the_first_reset_asks_for_a_reset():
     env.step(0)
 
 
+@pytest.mark.filterwarnings('ignore:.*Box observation space m.* value is:UserWarning')
 def test_a_prior_is_where_targets_are_drawn_and_the_belief_starts():
     """QA (an RL researcher): a centre-biased task in the environment, as in evaluate --prior."""
     prior = np.zeros((4, 4))
