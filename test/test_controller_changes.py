@@ -48,6 +48,7 @@ CHANGES = {
     'search.group_stop': [False, True], 'search.absent_needs_coverage': [False, True],
     'search.false_alarm_scales': [[1.0], [0.5, 1.0, 4.0]], 'search.hotspot_prior': [0.0, 0.03],
     'search.targets': ['one', 'many'], 'search.stop_on_decision': [True, False],
+    'belief.prior': [[], [1.0] * 60 + [0.0] + [2.0] * 60],
 }
 DEFAULTS = {p.name: p.default for p in controller_params()}
 
@@ -117,3 +118,35 @@ def test_counts_with_scales_to_a_gaussian_model_applies_in_one_change():
     follow_config(core, new, old.values)
     assert core.settings.false_alarm_scales == (1.0,)
     assert type(core.observation).__name__ == 'GaussianObservation'
+
+
+def test_a_prior_follows_into_the_next_search_and_out_of_many_targets():
+    """belief.prior: the next reset starts there; a switch to many targets drops it first."""
+    values = _values('defaults')
+    weights = np.arange(121, dtype=float)
+    old = build_config(values, build_policy)
+    core = old.controller()
+    core.reset(0.0)
+    _frames(core, np.random.default_rng(1), 2, 0.0, False)
+    under_way = core.belief
+    prior = build_config(dict(values, **{'belief.prior': list(weights)}), build_policy,
+                         {'belief.prior'}, old)
+    np.testing.assert_allclose(prior.prior, weights / weights.sum())
+    follow_config(core, prior, old.values)
+    np.testing.assert_array_equal(core.belief, under_way)          # from the next reset on
+    core.reset(3.0)
+    absent = values['absent.prior']
+    np.testing.assert_allclose(core.belief, (1 - absent) * weights / weights.sum(), atol=1e-15)
+    many = dict(prior.values, **{'search.targets': 'many', 'belief.prior': []})
+    follow_config(core, build_config(many, build_policy, {'search.targets', 'belief.prior'},
+                                     prior), prior.values)
+    assert core.settings.targets == 'many' and core.prior is None
+    with pytest.raises(ValueError, match=r"a prior over one target's cell \(belief.prior\) "
+                                         'does not go with search.targets many'):
+        build_config(dict(many, **{'belief.prior': list(weights)}), build_policy,
+                     {'belief.prior'}, prior)
+    for bad, message in (([1.0] * 120, 'belief.prior must hold one weight per cell, 121 values '
+                                       'for a 11x11 grid'),
+                         ([0.0] * 121, 'belief.prior weights must be finite, >= 0 and not all 0')):
+        with pytest.raises(ValueError, match=message):
+            build_config(dict(values, **{'belief.prior': bad}), build_policy)

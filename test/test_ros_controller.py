@@ -217,6 +217,8 @@ def test_bad_kernel_is_rejected_and_the_old_one_stays(probe, cam, bad, words):
     # settings the model cannot serve are refused before any of them applies
     ({'search.false_alarm_scales': [1.0, 2.0]}, 'needs a count model'),
     ({'search.absent_needs_coverage': True}, 'needs a pan/tilt count model'),
+    ({'belief.prior': [1.0] * 120}, 'belief.prior must hold one weight per cell, 121 values'),
+    ({'belief.prior': [-1.0] + [1.0] * 120}, 'belief.prior weights must be finite, >= 0'),
 ])
 def test_invalid_parameters_are_rejected_with_a_reason(probe, cam, values, words):
     before = probe.get_parameters(NODE, list(values))
@@ -225,6 +227,28 @@ def test_invalid_parameters_are_rejected_with_a_reason(probe, cam, values, words
     assert words in result.reason, result.reason
     assert '\n' not in result.reason, result.reason
     assert probe.get_parameters(NODE, list(values)) == before
+
+
+def test_a_prior_set_remotely_is_where_the_next_search_starts(probe, cam):
+    """belief.prior: the reset's belief is the prior, then Bayes' rule goes on from it."""
+    weights = np.ones(121)
+    weights[:11] = 0.0                           # the top row ruled out
+    weights[60] = 20.0
+    try:
+        results = _set(probe, belief__prior=weights.tolist())
+        assert results[0].successful, results[0].reason
+        nb, nt = len(cam.beliefs), len(cam.targets)
+        assert _reset(probe).success
+        assert wait_for(lambda: len(cam.beliefs) > nb and len(cam.targets) > nt, 20)
+        np.testing.assert_allclose(cam.belief(), weights / weights.sum(), rtol=1e-6)
+        for frame in _frames(3, 2):
+            got_belief, _ = cam.step_by_bayes(frame)
+            assert np.all(got_belief[:11] == 0)
+    finally:                                     # an empty array: the uniform prior again
+        from rclpy.parameter import Parameter
+        empty = Parameter('belief.prior', Parameter.Type.DOUBLE_ARRAY, [])
+        assert _set(probe, belief__prior=empty)[0].successful
+    _fresh_search(probe, cam)
 
 
 def test_malformed_evidence_is_rejected_counted_and_throttled(probe, cam):

@@ -106,6 +106,10 @@ def controller_params() -> list[Param]:
               'count model: an ipomdp_gaze/observation-v1 path or shipped name (with counts)'),
     ] + cell_params(
         'start', 'the first fixation after a reset', 'the centre {}') + [
+        Param('belief.prior', None, T.DOUBLE_ARRAY,
+              'where the one target is a priori: a weight >= 0 per cell, rows x cols values '
+              'row-major, scaled to sum 1 (empty: uniform, the paper); from the next reset; '
+              'not with search.targets many'),
         Param('seed', 0, T.INTEGER, 'seed of the random and sample policies',
               int_range=(0, INT_MAX)),
         Param('settle_time_s', SETTLE_TIME_S, T.DOUBLE,

@@ -31,6 +31,7 @@ from ipomdp_gaze.search.health import policy_label
 from ipomdp_gaze.search.many import check_many_settings
 from ipomdp_gaze.search.room import check_room_times
 from ipomdp_gaze.search.session import check_model_settings, SearchSettings
+import numpy as np
 
 POLICY_KEYS = ('policy.name', 'policy.file', 'policy.kernel', 'policy.action')
 OBSERVATION_KEYS = ('observation.model', 'observation.file')
@@ -87,6 +88,34 @@ def row_col_from(values: Mapping, grid: Grid, row_name: str, col_name: str) -> t
     return tuple(out)
 
 
+def prior_from(values: Mapping, grid: Grid):
+    """
+    Return ``belief.prior`` as probabilities (N,), or None for the uniform prior (no values).
+
+    Raises
+    ------
+    ValueError
+        Unless it holds one weight >= 0 per cell (rows x cols, row-major) with a positive sum;
+        or with ``search.targets`` many, whose belief is not over one target's cell.
+
+    """
+    weights = values.get('belief.prior')
+    if weights is None or len(weights) == 0:
+        return None
+    weights = np.asarray(list(weights), dtype=float)
+    if weights.size != grid.n_cells:
+        raise ValueError(f'belief.prior must hold one weight per cell, {grid.n_cells} values '
+                         f'for a {grid.rows}x{grid.cols} grid (row-major; none: uniform), got '
+                         f'{weights.size}')
+    if not np.all(np.isfinite(weights)) or np.any(weights < 0) or not weights.max() > 0:
+        raise ValueError('belief.prior weights must be finite, >= 0 and not all 0')
+    if values.get('search.targets', 'one') == 'many':
+        raise ValueError("a prior over one target's cell (belief.prior) does not go with "
+                         'search.targets many')
+    weights = weights / weights.max()           # the sum of weights near 1e308 stays finite
+    return weights / weights.sum()
+
+
 def observation_from(values: Mapping, grid: Grid, fpoc):
     """
     Build the observation model the parameters select: Gaussian with the FPOC, or a count model.
@@ -129,6 +158,7 @@ class ControllerConfig:
     head: PanTiltMap
     settings: SearchSettings
     warning: str = ''
+    prior: np.ndarray | None = None
 
     @property
     def observation_label(self) -> str:
@@ -151,7 +181,7 @@ class ControllerConfig:
         v = self.values
         return GazeController(self.grid, self.observation, self.policy, self.settings,
                               v['settle_time_s'], v['seed'],
-                              v.get('stamp_tolerance_s', STAMP_TOLERANCE_S))
+                              v.get('stamp_tolerance_s', STAMP_TOLERANCE_S), prior=self.prior)
 
 
 def build_config(values: Mapping, build_policy: Callable, changed=None,
@@ -180,6 +210,7 @@ def build_config(values: Mapping, build_policy: Callable, changed=None,
         head = head_from(values, grid)
         row_col_from(values, grid, 'start_row', 'start_col')
         settings = SearchSettings.from_parameters(values, grid=grid)
+        prior = prior_from(values, grid)
         if settings.targets == 'many':
             check_many_settings(settings, grid)
         else:
@@ -202,7 +233,7 @@ def build_config(values: Mapping, build_policy: Callable, changed=None,
     except KeyError as exc:
         raise ValueError(f'no controller parameter {exc}') from None
     return ControllerConfig(dict(values), grid, fpoc, observation, policy, head, settings,
-                            '; '.join(warnings))
+                            '; '.join(warnings), prior)
 
 
 def moving_room_warnings(settings: SearchSettings) -> list[str]:
@@ -235,12 +266,16 @@ def follow_config(core: GazeController, new: ControllerConfig, old_values: Mappi
     Make a controller core follow a new configuration: the node's and the replay's one way.
 
     The observation, the policy, the settings (a new ``search.targets`` starts a new search:
-    :meth:`GazeController.configure`), the stamp tolerance, and the seed when it changed.
+    :meth:`GazeController.configure`), the prior (from the next reset), the stamp tolerance,
+    and the seed when it changed.
     """
     v = new.values
     core.set_observation(new.observation, new.settings)
     core.set_policy(new.policy)
+    if new.prior is None:               # before a switch to many targets, which takes none
+        core.set_prior(None)
     core.configure(new.settings, v['settle_time_s'])
+    core.set_prior(new.prior)
     if 'stamp_tolerance_s' in v:
         core.stamp_tolerance_s = v['stamp_tolerance_s']
     if v.get('seed') != old_values.get('seed'):

@@ -182,7 +182,8 @@ class FrameResult:
         return self.status == 'applied'
 
 
-def make_session(grid: Grid, observation, policy, settings: SearchSettings, log_size: int = 0):
+def make_session(grid: Grid, observation, policy, settings: SearchSettings, log_size: int = 0,
+                 prior=None):
     """
     Return a new search session of the belief ``settings.targets`` names.
 
@@ -193,14 +194,19 @@ def make_session(grid: Grid, observation, policy, settings: SearchSettings, log_
     ``one``: :class:`ipomdp_gaze.search.session.SearchSession` (the paper's belief); ``many``:
     :class:`ipomdp_gaze.search.many.OccupancySession` with ``link`` :data:`ROOM_LINK`
     (docs/design.md section 11.6), whose ``policy`` is kept but not used, except a sweep: each
-    search is then one pass of its poses (section 11.7).
+    search is then one pass of its poses (section 11.7). ``prior`` (N,): where the one target is
+    a priori (:class:`SearchSession`'s); the many-target belief takes none (ValueError).
     """
     if settings.targets == 'many':
+        if prior is not None:
+            raise ValueError("a prior over one target's cell (belief.prior) does not go with "
+                             'search.targets many')
         session = OccupancySession(grid, observation, settings, link=ROOM_LINK,
                                    log_size=log_size)
         session.set_policy(policy)
     else:
-        session = SearchSession(grid, observation, policy, settings, log_size=log_size)
+        session = SearchSession(grid, observation, policy, settings, log_size=log_size,
+                                prior=prior)
     return session
 
 
@@ -257,17 +263,20 @@ class GazeController:
     log_size
         Events the session keeps in its log (:attr:`SearchSession.log`); 0, the default, keeps
         none.
+    prior
+        Where the one target is a priori, (N,) or (rows, cols) summing to 1 (None: uniform;
+        the node's ``belief.prior``); not with ``search.targets`` many.
 
     """
 
     def __init__(self, grid: Grid, observation, policy, settings: SearchSettings | None = None,
                  settle_time_s: float = 0.0, seed: int = 0,
-                 stamp_tolerance_s: float = STAMP_TOLERANCE_S, log_size: int = 0):
+                 stamp_tolerance_s: float = STAMP_TOLERANCE_S, log_size: int = 0, prior=None):
         self.grid = grid
         self.stamp_tolerance_s = float(stamp_tolerance_s)
         self.log_size = int(log_size)
         self.session = make_session(grid, observation, policy, settings or SearchSettings(),
-                                    self.log_size)
+                                    self.log_size, prior)
         self.settle_time_s = check_settle_time(settle_time_s)
         self.session.reset(seed=seed)
         self.search_id = 0
@@ -299,7 +308,7 @@ class GazeController:
         if settings.targets != self.settings.targets:
             rng = self.session.rng
             self.session = make_session(self.grid, self.observation, self.policy, settings,
-                                        self.log_size)
+                                        self.log_size, self.prior)
             self.session.reset(seed=rng)
             self.reset(self.target_time_s)
             return
@@ -316,6 +325,19 @@ class GazeController:
     def set_policy(self, policy) -> None:
         """Use another policy from the next choice on."""
         self.session.set_policy(policy)
+
+    @property
+    def prior(self):
+        """Where the one target is a priori, (N,) (None: uniform, or many targets)."""
+        return getattr(self.session, 'prior', None)
+
+    def set_prior(self, prior) -> None:
+        """Start the searches at ``prior`` (None: uniform) from the next :meth:`reset` on."""
+        if prior is not None and self.settings.targets == 'many':
+            raise ValueError("a prior over one target's cell (belief.prior) does not go with "
+                             'search.targets many')
+        if self.settings.targets == 'one':
+            self.session.set_prior(prior)
 
     def reseed(self, seed: int) -> None:
         """Restart the policy's random stream."""

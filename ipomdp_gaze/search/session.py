@@ -424,9 +424,7 @@ class SearchSession:
                  log_size: int = 10_000, prior=None):
         self.grid = grid
         self.prior = None
-        if prior is not None:
-            self.prior = check_prior(prior, grid.n_cells, grid.shape)
-            self.prior.flags.writeable = False
+        self.set_prior(prior)
         self.observation = as_observation(grid, observation)
         check_policy_grid(policy, grid)
         self.policy = policy
@@ -497,6 +495,13 @@ class SearchSession:
         """Choose with another policy from the next choice on (one of this grid's shape)."""
         check_policy_grid(policy, self.grid)
         self.policy = policy
+
+    def set_prior(self, prior) -> None:
+        """From the next reset, start every search at ``prior`` (N,) (None: uniform)."""
+        if prior is not None:
+            prior = check_prior(prior, self.grid.n_cells, self.grid.shape)
+            prior.flags.writeable = False
+        self.prior = prior
 
     # -- read-only views -----------------------------------------------------------------
     def _state(self) -> _Search:
