@@ -155,6 +155,16 @@ def test_a_bad_prior_file_is_one_line(tmp_path, capsys, text, message):
     assert '--prior' in capsys.readouterr().err
 
 
+def test_a_prior_file_from_a_spreadsheet_is_read(tmp_path, capsys):
+    """QA: a UTF-8 byte-order mark, Windows line ends, tabs and trailing commas are read."""
+    path = tmp_path / 'prior.csv'
+    path.write_bytes(b'\xef\xbb\xbf0,0,0,\r\n0\t0\t5\t\r\n0,0,0,\r\n')
+    out = tmp_path / 'out.json'
+    assert main(['evaluate', '--grid', '3x3', '--episodes', '10', '--prior', str(path),
+                 '--quiet', '--json', str(out)]) == 0, capsys.readouterr().err
+    assert json.loads(out.read_text())['prior'] == [[0, 0, 0], [0, 0, 1], [0, 0, 0]]
+
+
 def test_search_draws_its_target_from_a_prior_and_starts_there(tmp_path, capsys):
     """QA (a researcher): one trial of a centre-biased task; a cell it rules out is refused."""
     prior = tmp_path / 'prior.txt'

@@ -291,12 +291,13 @@ def read_prior(path: Path, grid) -> np.ndarray:
     """
     Read a prior over the target's cell: ``grid.rows`` lines of ``grid.cols`` weights >= 0.
 
-    Spaces or commas between numbers, ``#`` comments; scaled to sum 1. ValueError (one line)
-    for a file that cannot be read, the wrong shape, or weights that are not numbers >= 0 with
-    a positive sum.
+    Spaces or commas between numbers, ``#`` comments; scaled to sum 1. UTF-8, with or without
+    the byte-order mark a spreadsheet or Notepad writes first. ValueError (one line) for a file
+    that cannot be read, the wrong shape, or weights that are not numbers >= 0 with a positive
+    sum.
     """
     try:
-        text = Path(path).read_text()
+        text = Path(path).read_text(encoding='utf-8-sig')
     except (OSError, UnicodeDecodeError) as exc:
         raise ValueError(f'--prior {path}: cannot read it ({exc.__class__.__name__})') from None
     rows = []
