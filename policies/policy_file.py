@@ -38,7 +38,7 @@ import warnings
 
 from ipomdp_gaze.files.observation_file import fingerprint
 from ipomdp_gaze.files.yaml_files import check_header, in_folder, plain, read_yaml, write_yaml
-from ipomdp_gaze.model.belief import check_prior
+from ipomdp_gaze.model.belief import check_prior, prior_is_uniform
 from ipomdp_gaze.model.fpoc import FPOC, fpoc_from_dict
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.observation import CountObservation, GaussianObservation
@@ -459,8 +459,8 @@ def check_scene(spec: PolicySpec, scene: dict, warn: Callable[[str], None] | Non
     Report (through ``warn``) each setting of docs/design.md section 7 that differs from training.
 
     ``scene`` maps :data:`SCENE_KEYS` to the values used now (missing or None: 0, the paper's
-    task), and ``prior`` to rows of cells (missing or None: uniform); a policy file records the
-    non-zero ones, and a prior that is not uniform, under ``training``.
+    task), and ``prior`` to rows of cells (missing, None or equal cells: uniform); a policy file
+    records the non-zero ones, and a prior given to training, under ``training``.
     """
     warn = _warn if warn is None else warn
     where = f'{spec.path}: ' if spec.path is not None else ''
@@ -470,6 +470,9 @@ def check_scene(spec: PolicySpec, scene: dict, warn: Callable[[str], None] | Non
         if not math.isclose(trained, used, rel_tol=1e-9, abs_tol=1e-12):
             warn(f'{where}policy was trained with {key} {trained:g} but is used with {used:g}')
     trained, used = spec.training.get('prior'), scene.get('prior')
+    # A uniform prior given as rows of cells (train --prior of a uniform file) is the default.
+    trained = None if prior_is_uniform(trained) else trained
+    used = None if prior_is_uniform(used) else used
     if trained is None and used is not None:
         warn(f'{where}policy was trained with a uniform prior but is used with another')
     elif trained is not None and used is None:

@@ -398,7 +398,8 @@ def test_a_prior_is_recorded_resumed_and_checked(tmp_path):
     load_policy(path, grid, FPOC, warn=warnings.append, scene={})
     assert warnings == [f'{path}: policy was trained with a prior that is not uniform but is '
                         'used with the uniform one']
-    other = np.full((3, 3), 1 / 9)
+    other = np.full((3, 3), 1 / 10)
+    other[1, 1] = 0.2
     load_policy(path, grid, FPOC, warn=warnings.append, scene={'prior': other})
     assert warnings[-1] == f'{path}: policy was trained with another prior than the one it is ' \
                            'used with'
@@ -406,6 +407,14 @@ def test_a_prior_is_recorded_resumed_and_checked(tmp_path):
     load_policy(plain, grid, FPOC, warn=warnings.append, scene={'prior': other})
     assert warnings[-1] == f'{plain}: policy was trained with a uniform prior but is used ' \
                            'with another'
+    # A uniform prior given as rows of cells is the uniform prior: no warning against None.
+    uniform = np.full((3, 3), 1 / 9)
+    warnings.clear()
+    load_policy(plain, grid, FPOC, warn=warnings.append, scene={'prior': uniform})
+    assert warnings == []
+    load_policy(path, grid, FPOC, warn=warnings.append, scene={'prior': uniform})
+    assert warnings == [f'{path}: policy was trained with a prior that is not uniform but is '
+                        'used with the uniform one']
     with pytest.raises(ValueError, match=r'prior must be \(rows, cols\) = \(3, 4\) or \(12,\), '
                                          r'got shape \(3, 3\)'):
         Trainer(Grid(3, 4), FPOC, config)
@@ -471,3 +480,21 @@ def test_train_cli_takes_a_prior_and_evaluate_agrees(tmp_path, capsys):
     assert main(['train', '--grid', '3x3', '--epochs', '1', '--out', str(tmp_path / 'y.yaml'),
                  '--prior', str(tmp_path / 'none.txt')]) == 2
     assert '--prior' in capsys.readouterr().err
+
+
+def test_a_policy_trained_on_a_uniform_prior_file_is_a_uniform_one(tmp_path, capsys):
+    """QA: train --prior of equal weights says no 'not uniform', and evaluate warns of nothing."""
+    flat = tmp_path / 'flat.txt'
+    flat.write_text('2 2 2\n2 2 2\n2 2 2\n')
+    out = tmp_path / 'u.yaml'
+    assert main(['train', '--grid', '3x3', '--epochs', '2', '--eval-every', '2',
+                 '--eval-episodes', '20', '--final-episodes', '50', '--prior', str(flat),
+                 '--out', str(out), '--quiet']) == 0
+    assert 'not uniform' not in capsys.readouterr().out
+    assert main(['evaluate', '--grid', '3x3', '--policy-file', str(out), '--episodes', '20',
+                 '--quiet']) == 0
+    assert 'warning' not in capsys.readouterr().err
+    (tmp_path / 'f7.txt').write_text('1 1 1 1 1 1 1\n' * 7)
+    assert main(['evaluate', '--grid', '7x7', '--policy-file', 'human-7x7-infomax',
+                 '--episodes', '20', '--quiet', '--prior', str(tmp_path / 'f7.txt')]) == 0
+    assert 'warning' not in capsys.readouterr().err

@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ipomdp_gaze.model.belief import prior_is_uniform
 from ipomdp_gaze.search.session import SearchSettings
 
 from .common import (add_prior_arg, add_task_args, check_output_file, nonneg_int, positive_float,
@@ -281,7 +282,7 @@ def run(args) -> int:
     print(f'trained {cfg.family} {cfg.reward} policy on {grid.rows}x{grid.cols} '
           f'{task}: {trainer.epoch} epochs, lr {cfg.learning_rate}, '
           f'{trainer.wall_seconds:.1f} s of training'
-          + ('' if cfg.prior is None else ', a prior that is not uniform'))
+          + ('' if prior_is_uniform(cfg.prior) else ', a prior that is not uniform'))
     if evaluation:
         f90, ci = evaluation['fixations_to_90'], evaluation['ci95']
         text = 'never' if f90 is None else f'{f90:.2f}'

@@ -157,3 +157,11 @@ def check_prior(prior, n_cells: int, shape: tuple[int, int] | None = None) -> np
     if abs(total - 1.0) > 1e-6:
         raise ValueError(f'prior must sum to 1, got {total:.6g}')
     return values / total
+
+
+def prior_is_uniform(prior) -> bool:
+    """Return whether a prior over the cells is None or uniform (a uniform file is the default)."""
+    if prior is None:
+        return True
+    values = np.asarray(prior, dtype=float).reshape(-1)
+    return bool(np.allclose(values, 1.0 / values.size, rtol=1e-9, atol=0.0))
