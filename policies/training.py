@@ -430,7 +430,8 @@ class Trainer:
                           cfg.eval_seed if seed is None else seed, motion=self.motion,
                           absent_prior=cfg.absent_prior, absent_rate=cfg.absent_rate,
                           prior=self.prior)
-        return fixations_to_level(result.percent_correct, self.grid.n_cells)
+        return fixations_to_level(result.percent_correct, self.grid.n_cells,
+                                  chance=None if self.prior is None else float(self.prior.max()))
 
     def run(self, epochs: int, progress=False,
             callback: Callable[[dict], None] | None = None) -> list[dict]:
@@ -586,13 +587,16 @@ def evaluation_block(grid: Grid, fpoc: FPOC, policy, episodes: int = 20000, seed
     scene = dict(scene or {})
     horizon = grid.n_cells if horizon is None else int(horizon)
     motion = Motion(grid, scene.get('motion_sigma_cells', 0.0), scene.get('jump_prob', 0.0))
+    prior = scene.get('prior')
+    if prior is not None:
+        prior = check_prior(np.array(prior), grid.n_cells, grid.shape)
     result = simulate(grid, fpoc, policy, episodes, horizon, seed, motion=motion,
                       absent_prior=scene.get('absent_prior', 0.0),
-                      absent_rate=scene.get('absent_rate', 0.0),
-                      prior=None if scene.get('prior') is None else np.array(scene['prior']),
+                      absent_rate=scene.get('absent_rate', 0.0), prior=prior,
                       progress=None if progress is None else lambda t: progress.update(1))
     point, ci = fixations_to_90_ci(result.correct, grid.n_cells,
-                                   np.random.default_rng([seed, 99]), bootstrap)
+                                   np.random.default_rng([seed, 99]), bootstrap,
+                                   chance=None if prior is None else float(prior.max()))
     block = {'episodes': int(episodes), 'seed': int(seed), 'action': policy.action,
              'horizon': horizon, 'fixations_to_90': point, 'ci95': list(ci) if ci else None}
     block.update(scene)

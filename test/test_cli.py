@@ -155,6 +155,28 @@ def test_a_bad_prior_file_is_one_line(tmp_path, capsys, text, message):
     assert '--prior' in capsys.readouterr().err
 
 
+def test_fixations_to_90_start_at_the_prior_s_chance(tmp_path, capsys):
+    """QA: before any fixation the prior's MAP cell is right with its probability, not 1/N."""
+    point, sure = tmp_path / 'point.txt', tmp_path / 'sure.txt'
+    point.write_text('0 0 0\n0 1 0\n0 0 0\n')
+    sure.write_text('92 1 1\n1 1 1\n1 1 1\n')          # 0.92 on (0, 0)
+    out = tmp_path / 'out.json'
+    assert main(['evaluate', '--grid', '3x3', '--policy', 'map', '--policy', 'random',
+                 '--paired', '--episodes', '200', '--prior', str(point), '--quiet', '--json',
+                 str(out)]) == 0
+    data = json.loads(out.read_text())
+    for name in ('map', 'random'):              # right at 0 fixations already (was 0.90)
+        assert data['policies'][name]['fixations_to_90'] == 0.0
+        assert data['policies'][name]['ci95'] == [0.0, 0.0]
+    assert data['paired']['random - map']['difference'] == 0.0
+    # d' = 0: no frame moves the belief, percent correct stays at 0.92 from t = 0 on.
+    assert main(['evaluate', '--grid', '3x3', '--episodes', '2000', '--fpoc', 'table',
+                 '--fpoc-param', 'dprime=[0,0]', '--fpoc-param', 'ecc_deg=[0,1]', '--prior',
+                 str(sure), '--quiet', '--json', str(out)]) == 0
+    capsys.readouterr()
+    assert json.loads(out.read_text())['policies']['map']['fixations_to_90'] == 0.0
+
+
 def test_a_prior_file_from_a_spreadsheet_is_read(tmp_path, capsys):
     """QA: a UTF-8 byte-order mark, Windows line ends, tabs and trailing commas are read."""
     path = tmp_path / 'prior.csv'

@@ -158,3 +158,13 @@ def test_a_resample_identical_to_the_sample_reaches_90_percent_where_the_sample_
     other[:9, 1:] = True                                   # the same, one fixation later
     diff, paired = paired_difference_ci(correct, other, 10, None, counts=same)
     assert diff == pytest.approx(-1.0) and paired == (pytest.approx(-1.0), pytest.approx(-1.0))
+
+
+def test_chance_is_percent_correct_before_the_first_fixation():
+    """A prior's MAP cell is right with its probability at t = 0: the curve starts there."""
+    assert fixations_to_level(np.array([0.95, 1.0]), 10, chance=0.92) == 0.0
+    assert fixations_to_level(np.array([0.95, 1.0]), 10, chance=0.5) == pytest.approx(0.4 / 0.45)
+    assert fixations_to_level(np.array([0.95, 1.0]), 10) == pytest.approx(0.8 / 0.85)
+    correct = np.ones((20, 3), dtype=bool)
+    assert fixations_to_90_ci(correct, 10, np.random.default_rng(0), 50,
+                              chance=1.0) == (0.0, (0.0, 0.0))

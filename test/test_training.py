@@ -498,3 +498,24 @@ def test_a_policy_trained_on_a_uniform_prior_file_is_a_uniform_one(tmp_path, cap
     assert main(['evaluate', '--grid', '7x7', '--policy-file', 'human-7x7-infomax',
                  '--episodes', '20', '--quiet', '--prior', str(tmp_path / 'f7.txt')]) == 0
     assert 'warning' not in capsys.readouterr().err
+
+
+def test_a_sure_prior_needs_no_fixation_in_training_and_evaluate(tmp_path, capsys):
+    """QA: with all mass on one cell the target is known at t = 0: 0 fixations to 90%."""
+    point = tmp_path / 'point.txt'
+    point.write_text('0 0 0\n0 0 1\n0 0 0\n')
+    out = tmp_path / 'p.yaml'
+    assert main(['train', '--grid', '3x3', '--epochs', '2', '--eval-every', '1',
+                 '--eval-episodes', '20', '--final-episodes', '100', '--prior', str(point),
+                 '--out', str(out), '--quiet']) == 0
+    capsys.readouterr()
+    spec = load_policy_spec(out)
+    assert spec.evaluation['fixations_to_90'] == 0.0 and spec.evaluation['ci95'] == [0.0, 0.0]
+    curve = (tmp_path / 'p.csv').read_text().splitlines()
+    assert curve[0].split(',')[3] == 'fixations_to_90'
+    assert all(float(row.split(',')[3]) == 0 for row in curve[1:]), curve   # its evaluations
+    json_out = tmp_path / 'e.json'
+    assert main(['evaluate', '--grid', '3x3', '--policy-file', str(out), '--episodes', '100',
+                 '--prior', str(point), '--quiet', '--json', str(json_out)]) == 0
+    import json
+    assert json.loads(json_out.read_text())['policies']['p']['fixations_to_90'] == 0.0

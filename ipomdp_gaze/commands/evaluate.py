@@ -205,8 +205,10 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
             else {'observation': {**model.to_dict(), 'sha256': fingerprint(model)}})
     out = {'grid': grid.to_dict(), **task, 'episodes': episodes,
            'horizon': horizon, 'seed': seed}
+    chance = None                   # percent correct at t = 0: 1/N, or the prior's MAP cell's
     if prior is not None:
         out['prior'] = prior.reshape(grid.shape).tolist()
+        chance = float(prior.max())
     if extended:
         out.update({'motion_sigma_cells': motion.sigma_cells, 'jump_prob': motion.jump_prob,
                     'absent_prior': float(absent_prior), 'absent_rate': float(absent_rate),
@@ -234,7 +236,8 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
         result = concat_results(f.result() for f in futures)
         results[name] = result
         point, ci = fixations_to_90_ci(result.correct, grid.n_cells,
-                                       np.random.default_rng([seed, 99]), bootstrap)
+                                       np.random.default_rng([seed, 99]), bootstrap,
+                                       chance=chance)
         entry = out['policies'][name] = {
             'episodes': n, 'fixations_to_90': point, 'ci95': list(ci) if ci else None,
             'percent_correct': [round(float(x), 6) for x in result.percent_correct]}
@@ -251,7 +254,8 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
         for name in names[1:]:
             a, z = results[name].correct, results[names[0]].correct
             diff, ci = paired_difference_ci(a, z, grid.n_cells,
-                                            np.random.default_rng([seed, 95]), bootstrap)
+                                            np.random.default_rng([seed, 95]), bootstrap,
+                                            chance=chance)
             out['paired'][f'{name} - {names[0]}'] = {
                 'episodes': int(min(a.shape[0], z.shape[0])),
                 'difference': diff, 'ci95': list(ci) if ci else None}

@@ -4,7 +4,8 @@
 Honest evaluation: percent correct vs fixations, fixations to 90% correct, bootstrap intervals.
 
 Fixations to 90% correct is the first t where percent correct reaches 0.90, interpolated linearly
-between t-1 and t (percent correct at t = 0 is the uniform guess, 1/N); ``None`` if never reached.
+between t-1 and t (percent correct at t = 0 is the uniform guess, 1/N, or with a prior over the
+cells its largest probability, ``chance``); ``None`` if never reached.
 Intervals are percentile bootstraps over episodes.
 
 For moving and absent targets and the stopping rules (docs/design.md section 7.4): the rates of
@@ -20,14 +21,19 @@ import numpy as np
 LEVEL = 0.90
 
 
-def fixations_to_level(percent_correct: np.ndarray, n_cells: int, level: float = LEVEL):
+def fixations_to_level(percent_correct: np.ndarray, n_cells: int, level: float = LEVEL,
+                       chance: float | None = None):
     """
     First t (interpolated) at which ``percent_correct[t-1] >= level``; ``None`` if never.
 
     Works on a curve (T,) or a stack of curves (B, T), returning a float array with NaN for never.
+    ``chance`` is percent correct at t = 0, before any fixation (default ``1/n_cells``; with a
+    prior P over the cells, ``max P``: the MAP guess of the prior, 0 fixations when it reaches
+    ``level``).
     """
     pc = np.atleast_2d(np.asarray(percent_correct, dtype=float))
-    curve = np.concatenate([np.full((pc.shape[0], 1), 1.0 / n_cells), pc], axis=1)
+    start = 1.0 / n_cells if chance is None else float(chance)
+    curve = np.concatenate([np.full((pc.shape[0], 1), start), pc], axis=1)
     reached = curve >= level
     hit = reached.any(axis=1)
     t = np.argmax(reached, axis=1)                    # first index in curve (0 = prior)
@@ -48,7 +54,8 @@ def bootstrap_counts(episodes: int, resamples: int, rng: np.random.Generator) ->
 
 
 def fixations_to_90_ci(correct: np.ndarray, n_cells: int, rng: np.random.Generator,
-                       resamples: int = 1000, counts: np.ndarray | None = None):
+                       resamples: int = 1000, counts: np.ndarray | None = None,
+                       chance: float | None = None):
     """
     Point estimate and 95% percentile-bootstrap interval of fixations to 90% correct.
 
@@ -64,6 +71,8 @@ def fixations_to_90_ci(correct: np.ndarray, n_cells: int, rng: np.random.Generat
         Number of bootstrap resamples.
     counts : array (resamples, episodes), optional
         Shared resampling weights, so paired comparisons resample the same episodes.
+    chance : float, optional
+        Percent correct at t = 0 in place of 1/N (a prior's largest probability).
 
     Returns
     -------
@@ -71,7 +80,7 @@ def fixations_to_90_ci(correct: np.ndarray, n_cells: int, rng: np.random.Generat
 
     """
     episodes = correct.shape[0]
-    point = fixations_to_level(correct.mean(axis=0), n_cells)
+    point = fixations_to_level(correct.mean(axis=0), n_cells, chance=chance)
     if point is None:
         return None, None
     if counts is None:
@@ -80,7 +89,7 @@ def fixations_to_90_ci(correct: np.ndarray, n_cells: int, rng: np.random.Generat
     # mean is, so a resample at exactly 90% reaches it as the sample does (not 0.89999998).
     curves = (counts.astype(np.float32) @ correct.astype(np.float32)).astype(np.float64) \
         / episodes
-    values = fixations_to_level(curves, n_cells)
+    values = fixations_to_level(curves, n_cells, chance=chance)
     beyond = np.where(np.isnan(values), np.inf, values)     # not reached within the horizon
     return point, _interval(beyond, beyond)
 
@@ -113,24 +122,27 @@ def _interval(low_values: np.ndarray, high_values: np.ndarray):
 
 def paired_difference_ci(correct_a: np.ndarray, correct_b: np.ndarray, n_cells: int,
                          rng: np.random.Generator, resamples: int = 1000,
-                         counts: np.ndarray | None = None):
+                         counts: np.ndarray | None = None, chance: float | None = None):
     """
     Difference ``a - b`` of fixations to 90% on the same episodes, with a paired 95% CI.
 
     Both are measured on the first ``n = min`` episodes; each bootstrap resample weights the same
     episodes of a and b (``counts``, shape (resamples, n), drawn from ``rng`` when omitted).
+    ``chance``: percent correct at t = 0 (:func:`fixations_to_level`).
     """
     n = min(correct_a.shape[0], correct_b.shape[0])
     a, b = correct_a[:n], correct_b[:n]
-    pa = fixations_to_level(a.mean(axis=0), n_cells)
-    pb = fixations_to_level(b.mean(axis=0), n_cells)
+    pa = fixations_to_level(a.mean(axis=0), n_cells, chance=chance)
+    pb = fixations_to_level(b.mean(axis=0), n_cells, chance=chance)
     if pa is None or pb is None:
         return None, None
     if counts is None:
         counts = bootstrap_counts(n, resamples, rng)
     counts = counts.astype(np.float32)
-    va = fixations_to_level((counts @ a.astype(np.float32)).astype(np.float64) / n, n_cells)
-    vb = fixations_to_level((counts @ b.astype(np.float32)).astype(np.float64) / n, n_cells)
+    va = fixations_to_level((counts @ a.astype(np.float32)).astype(np.float64) / n, n_cells,
+                            chance=chance)
+    vb = fixations_to_level((counts @ b.astype(np.float32)).astype(np.float64) / n, n_cells,
+                            chance=chance)
     # beyond the horizon: +inf on that side; both beyond, the difference could be anything
     with np.errstate(invalid='ignore'):
         diff = np.where(np.isnan(va), np.inf, va) - np.where(np.isnan(vb), np.inf, vb)
