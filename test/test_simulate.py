@@ -190,6 +190,10 @@ def test_with_a_blind_fpoc_the_belief_stays_at_the_prior():
     (np.r_[-0.1, np.full(8, 1.1 / 8)], 'finite and >= 0'),
     (np.r_[np.nan, np.full(8, 1 / 8)], 'finite and >= 0'),
     (np.full((9, 1), 1 / 9), r'\(rows, cols\) = \(3, 3\) or \(9,\), got shape \(9, 1\)'),
+    ('centre', "prior must be numbers, one per cell, got str 'centre'"),       # QA: no numpy
+    ({'centre': 1.0}, 'prior must be numbers, one per cell, got dict'),      # message, no
+    ([[0.5, 0.5], [0.0]], 'prior must be numbers, one per cell, got list'),  # TypeError
+    ([0.1j] * 9, 'prior must be numbers, one per cell, got list'),
 ])
 def test_bad_priors_are_refused(prior, message):
     grid = Grid(3, 3, 1.0)

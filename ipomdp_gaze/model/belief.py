@@ -133,6 +133,12 @@ def map_cell(belief: np.ndarray) -> np.ndarray:
     return argmax_ties_low(belief)
 
 
+def _short(value, limit: int = 40) -> str:
+    """Return ``repr(value)`` cut to ``limit`` characters, for a one-line message."""
+    text = repr(value)
+    return text if len(text) <= limit else text[:limit - 3] + '...'
+
+
 def check_prior(prior, n_cells: int, shape: tuple[int, int] | None = None) -> np.ndarray:
     """
     Return a prior over the target's cell as a float array (N,) summing to 1.
@@ -141,7 +147,11 @@ def check_prior(prior, n_cells: int, shape: tuple[int, int] | None = None) -> np
     sum other than 1 (within 1e-6; a prior is not renormalised silently). Cells may be 0: the
     target is never there and the belief keeps them at 0.
     """
-    values = np.asarray(prior, dtype=float) if not isinstance(prior, np.ndarray) else prior
+    try:                                    # a string, a mapping or ragged rows: one line
+        values = np.asarray(prior, dtype=float) if not isinstance(prior, np.ndarray) else prior
+    except (TypeError, ValueError):
+        raise ValueError(f'prior must be numbers, one per cell, got {type(prior).__name__} '
+                         f'{_short(prior)}') from None
     if values.dtype.kind not in 'iuf':
         raise ValueError(f'prior must be numbers, got dtype {values.dtype}')
     if values.ndim == 2 and shape is not None and values.shape != tuple(shape):
