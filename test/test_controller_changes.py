@@ -150,3 +150,19 @@ def test_a_prior_follows_into_the_next_search_and_out_of_many_targets():
                          ([0.0] * 121, 'belief.prior weights must be finite, >= 0 and not all 0')):
         with pytest.raises(ValueError, match=message):
             build_config(dict(values, **{'belief.prior': bad}), build_policy)
+
+
+def test_a_prior_given_with_a_switch_to_one_target_starts_the_new_search():
+    """Many targets to one with belief.prior in one set: the search begun at once is at it."""
+    values = _values('rooms')
+    old = build_config(values, build_policy)
+    core = old.controller()
+    core.reset(0.0)
+    _frames(core, np.random.default_rng(2), 2, 0.0, True)
+    weights = np.arange(121, dtype=float)
+    change = {'search.targets': 'one', 'belief.prior': list(weights)}
+    new = build_config(dict(values, **change), build_policy, set(change), old)
+    follow_config(core, new, old.values)
+    assert core.settings.targets == 'one'
+    absent = values['absent.prior']
+    np.testing.assert_allclose(core.belief, (1 - absent) * weights / weights.sum(), atol=1e-15)

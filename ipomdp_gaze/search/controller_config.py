@@ -266,15 +266,15 @@ def follow_config(core: GazeController, new: ControllerConfig, old_values: Mappi
     Make a controller core follow a new configuration: the node's and the replay's one way.
 
     The observation, the policy, the settings (a new ``search.targets`` starts a new search:
-    :meth:`GazeController.configure`), the prior (from the next reset), the stamp tolerance,
-    and the seed when it changed.
+    :meth:`GazeController.configure`), the prior (from the next reset, or the search a switch to
+    one target starts at once), the stamp tolerance, and the seed when it changed.
     """
     v = new.values
     core.set_observation(new.observation, new.settings)
     core.set_policy(new.policy)
     if new.prior is None:               # before a switch to many targets, which takes none
         core.set_prior(None)
-    core.configure(new.settings, v['settle_time_s'])
+    core.configure(new.settings, v['settle_time_s'], new.prior)   # a switch to one: at the prior
     core.set_prior(new.prior)
     if 'stamp_tolerance_s' in v:
         core.stamp_tolerance_s = v['stamp_tolerance_s']

@@ -296,19 +296,21 @@ class GazeController:
         'motion',
         "Return the target's motion per second (:class:`ipomdp_gaze.model.motion.Motion`).")
 
-    def configure(self, settings: SearchSettings, settle_time_s: float | None = None) -> None:
+    def configure(self, settings: SearchSettings, settle_time_s: float | None = None,
+                  prior=None) -> None:
         """
         Use new settings from the next frame on; the search under way keeps its belief.
 
         A new ``absent_prior`` or start cell applies from the next :meth:`reset`; a new
-        ``targets`` changes the belief, so a new search starts at once (:meth:`reset`).
+        ``targets`` changes the belief, so a new search starts at once (:meth:`reset`), at
+        ``prior`` with one target (None: the prior in force, :meth:`set_prior`).
         """
         if settle_time_s is not None:
             self.settle_time_s = check_settle_time(settle_time_s)
         if settings.targets != self.settings.targets:
             rng = self.session.rng
             self.session = make_session(self.grid, self.observation, self.policy, settings,
-                                        self.log_size, self.prior)
+                                        self.log_size, self.prior if prior is None else prior)
             self.session.reset(seed=rng)
             self.reset(self.target_time_s)
             return
