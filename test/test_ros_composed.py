@@ -182,3 +182,28 @@ def test_a_controller_destroyed_during_a_callback_destroys_after_it(context):
     assert node.core.fixations == 1      # the frame was applied, its fixation published
     assert node.guard.errors == 0, node.guard.last_error
     assert spinner.errors == []
+
+
+def test_a_parameter_answer_after_the_recorder_is_unloaded_does_nothing(context, tmp_path):
+    """
+    An answer or a timer taken before ``destroy_node`` that runs after it does nothing.
+
+    (``_listed`` sent its GetParameters on the destroyed client, the timers' ``_ask_parameters``
+    and ``_publish_diagnostics`` used the destroyed clients, subscriptions and publisher:
+    ``InvalidHandle`` out of the team's spin.)
+    """
+    from ipomdp_gaze.nodes.recorder import RecorderNode
+    from rcl_interfaces.srv import ListParameters
+    from rclpy.parameter import Parameter
+    from rclpy.task import Future
+    recorder = RecorderNode(context=context, namespace='/late_answer', parameter_overrides=[
+        Parameter('path', value=str(tmp_path / 'bag')), Parameter('topics', value=['pan_tilt']),
+        Parameter('nodes', value=['nobody'])])
+    recorder._ask_parameters()              # its clients made: the services are not there
+    answer = Future()
+    answer.set_result(ListParameters.Response())
+    recorder.destroy_node()
+    recorder._listed('nobody', answer, 0)   # a done-callback already queued
+    recorder._ask_parameters()              # a timer callback already taken
+    recorder._publish_diagnostics()         # and the other timer's
+    assert recorder.parameters == {}

@@ -162,8 +162,9 @@ class RecorderNode(QuietPublishers, Node):
 
     def __init__(self, **kwargs):
         # The bag is written by the subscriptions and the parameter answers (executor tasks,
-        # in no callback group) and closed by destroy_node: in a multi-threaded executor these
-        # run at once, so each holds this lock.
+        # in no callback group) and closed by destroy_node, which also destroys the parameter
+        # clients and the publisher that the timers and the answers use: in a multi-threaded
+        # executor these run at once, so each holds this lock (a writer of None: destroyed).
         self._bag_lock = threading.Lock()
         super().__init__(NODE_NAME, **kwargs)
         self._transaction = ParameterTransaction(self, recorder_params(), self._build,
@@ -235,7 +236,12 @@ class RecorderNode(QuietPublishers, Node):
         matched the service is lost, and a service is discovered some time after the client
         (late under load). A request unanswered after ``PARAMETER_ANSWER_S`` is asked again.
         """
-        now = time.monotonic()
+        with self._bag_lock:
+            if self.writer is not None:     # else taken before destroy_node: no clients left
+                self._ask_pending(time.monotonic())
+
+    def _ask_pending(self, now: float) -> None:
+        """Ask the pending nodes (:meth:`_ask_parameters`, under the lock)."""
         for node in list(self._pending):
             asked = self._asked.get(node)
             if asked is not None:
@@ -260,8 +266,13 @@ class RecorderNode(QuietPublishers, Node):
             self.destroy_timer(self._parameter_timer)
 
     def _listed(self, node: str, future, asked_ns: int) -> None:
+        """Ask ``node`` for the values of the parameters it listed (not once destroyed)."""
         names = list(future.result().result.names)
-        got = self._parameter_clients[node][1].call_async(GetParameters.Request(names=names))
+        with self._bag_lock:
+            if self.writer is None:         # answered after destroy_node: no client left
+                return
+            got = self._parameter_clients[node][1].call_async(
+                GetParameters.Request(names=names))
         got.add_done_callback(lambda f: self._got(node, names, f, asked_ns))
 
     def _got(self, node: str, names: list, future, asked_ns: int) -> None:
@@ -296,16 +307,19 @@ class RecorderNode(QuietPublishers, Node):
 
     def _publish_diagnostics(self) -> None:
         """Publish ``<node>: recording``: messages and matched publishers of each topic."""
-        values = {}
-        for topic, sub in self.subscriptions_.items():
-            name = topic.lstrip('/')
-            values[f'messages_{name}'] = self.counts[topic]
-            values[f'publishers_{name}'] = sub.get_publisher_count()
-        values['parameters_of'] = ','.join(sorted(self.parameters))
-        self._diag_pub.publish(diagnostics.diagnostic_array(
-            [diagnostics.status(f'{self.get_fully_qualified_name()}: recording', 'ok',
-                                f'{sum(self.counts.values())} messages', values)],
-            self.get_clock().now().to_msg()))
+        with self._bag_lock:
+            if self.writer is None:         # taken before destroy_node: nothing to publish on
+                return
+            values = {}
+            for topic, sub in self.subscriptions_.items():
+                name = topic.lstrip('/')
+                values[f'messages_{name}'] = self.counts[topic]
+                values[f'publishers_{name}'] = sub.get_publisher_count()
+            values['parameters_of'] = ','.join(sorted(self.parameters))
+            self._diag_pub.publish(diagnostics.diagnostic_array(
+                [diagnostics.status(f'{self.get_fully_qualified_name()}: recording', 'ok',
+                                    f'{sum(self.counts.values())} messages', values)],
+                self.get_clock().now().to_msg()))
 
     def destroy_node(self):
         """
