@@ -9,6 +9,7 @@ import os
 from pathlib import Path
 
 from ipomdp_gaze.files.writable import folder_writable
+from ipomdp_gaze.model.belief import prior_from_weights
 from ipomdp_gaze.model.fpoc import make_fpoc, MODELS, parameter_names
 from ipomdp_gaze.model.grid import Grid, parse_grid
 from ipomdp_gaze.model.observation import MATRIX_MAX_CELLS
@@ -312,8 +313,7 @@ def read_prior(path: Path, grid) -> np.ndarray:
         shape = f'{len(rows)} lines of ' + '/'.join(sorted({str(len(r)) for r in rows}) or '0')
         raise ValueError(f'--prior {path}: a {grid.rows}x{grid.cols} grid needs {grid.rows} '
                          f'lines of {grid.cols} weights, got {shape}')
-    weights = np.asarray(rows, dtype=float).reshape(-1)
-    if not np.all(np.isfinite(weights)) or np.any(weights < 0) or not weights.max() > 0:
-        raise ValueError(f'--prior {path}: weights must be finite, >= 0 and not all 0')
-    weights = weights / weights.max()           # the sum of weights near 1e308 stays finite
-    return weights / weights.sum()
+    try:
+        return prior_from_weights(rows)
+    except ValueError as exc:
+        raise ValueError(f'--prior {path}: {exc}') from None

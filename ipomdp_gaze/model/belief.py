@@ -169,6 +169,19 @@ def check_prior(prior, n_cells: int, shape: tuple[int, int] | None = None) -> np
     return values / total
 
 
+def prior_from_weights(weights) -> np.ndarray:
+    """
+    Scale weights >= 0 (one per cell) to a prior summing to 1: a prior file's, ``belief.prior``.
+
+    ValueError ('weights must be finite, >= 0 and not all 0') otherwise; the caller names them.
+    """
+    weights = np.asarray(weights, dtype=float).reshape(-1)
+    if not np.all(np.isfinite(weights)) or np.any(weights < 0) or not weights.max() > 0:
+        raise ValueError('weights must be finite, >= 0 and not all 0')
+    weights = weights / weights.max()           # the sum of weights near 1e308 stays finite
+    return weights / weights.sum()
+
+
 def prior_is_uniform(prior) -> bool:
     """Return whether a prior over the cells is None or uniform (a uniform file is the default)."""
     if prior is None:

@@ -50,21 +50,26 @@ def check_absent_prior(value, name: str = 'absent_prior') -> float:
 
 
 def initial_log_belief(n_cells: int, absent_prior: float = 0.0,
-                       episodes: int | None = None) -> np.ndarray:
+                       episodes: int | None = None, prior: np.ndarray | None = None) -> np.ndarray:
     """
     Return the prior's log probabilities: N cells, plus the absent hypothesis when it is used.
 
     With ``absent_prior = 0`` this is :func:`ipomdp_gaze.model.belief.uniform_log_belief` (N
     columns).
     Otherwise the last of N + 1 columns is ``log(absent_prior)`` and each cell has
-    ``log((1 - absent_prior) / N)``.
+    ``log((1 - absent_prior) / N)``. With ``prior`` P over the cells ((N,), summing to 1,
+    checked by the caller) each cell has ``log((1 - absent_prior) P_i)``: -inf where P_i = 0.
     """
-    prior = check_absent_prior(absent_prior)
-    if prior == 0:
-        return uniform_log_belief(n_cells, episodes)
-    shape = (n_cells + 1,) if episodes is None else (episodes, n_cells + 1)
-    log_b = np.full(shape, math.log1p(-prior) - math.log(n_cells))
-    log_b[..., n_cells] = math.log(prior)
+    absent = check_absent_prior(absent_prior)
+    if absent == 0:
+        log_b = uniform_log_belief(n_cells, episodes)
+    else:
+        shape = (n_cells + 1,) if episodes is None else (episodes, n_cells + 1)
+        log_b = np.full(shape, math.log1p(-absent) - math.log(n_cells))
+        log_b[..., n_cells] = math.log(absent)
+    if prior is not None:
+        with np.errstate(divide='ignore'):
+            log_b[..., :n_cells] += np.log(prior * n_cells)
     return log_b
 
 
@@ -178,14 +183,11 @@ class BatchBelief:
     def __init__(self, n_cells: int, absent_prior: float, episodes: int, moving: bool = False,
                  prior: np.ndarray | None = None):
         self.n = n_cells
-        self.log_belief = initial_log_belief(n_cells, absent_prior, episodes)
+        self.log_belief = initial_log_belief(n_cells, absent_prior, episodes, prior)
         self.has_absent = self.log_belief.shape[1] > n_cells
         # A prior with empty cells holds zeros from the start, as a motion step may leave them:
         # the reward then takes the 0 log 0 = 0 path of ``moving``.
         self.moving = bool(moving) or (prior is not None and not np.all(prior))
-        if prior is not None:               # (N,) summing to 1, checked by the caller
-            with np.errstate(divide='ignore'):
-                self.log_belief[:, :n_cells] += np.log(prior * n_cells)
         self._terms = np.zeros((episodes, n_cells + 1)) if self.has_absent else None
         self.belief = np.exp(self.log_belief[:, :n_cells])
         self.absent_probability = None

@@ -22,11 +22,13 @@ from dataclasses import dataclass
 from typing import Callable, Mapping
 
 from ipomdp_gaze.files.observation_file import load_observation
+from ipomdp_gaze.model.belief import prior_from_weights
 from ipomdp_gaze.model.fpoc import make_fpoc, parameter_names
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.model.observation import GaussianObservation
-from ipomdp_gaze.search.gaze import check_settle_time, GazeController, STAMP_TOLERANCE_S
+from ipomdp_gaze.search.gaze import (check_settle_time, GazeController, NO_PRIOR_WITH_MANY,
+                                     STAMP_TOLERANCE_S)
 from ipomdp_gaze.search.health import policy_label
 from ipomdp_gaze.search.many import check_many_settings
 from ipomdp_gaze.search.room import check_room_times
@@ -107,13 +109,13 @@ def prior_from(values: Mapping, grid: Grid):
         raise ValueError(f'belief.prior must hold one weight per cell, {grid.n_cells} values '
                          f'for a {grid.rows}x{grid.cols} grid (row-major; none: uniform), got '
                          f'{weights.size}')
-    if not np.all(np.isfinite(weights)) or np.any(weights < 0) or not weights.max() > 0:
-        raise ValueError('belief.prior weights must be finite, >= 0 and not all 0')
+    try:
+        prior = prior_from_weights(weights)
+    except ValueError as exc:
+        raise ValueError(f'belief.prior {exc}') from None
     if values.get('search.targets', 'one') == 'many':
-        raise ValueError("a prior over one target's cell (belief.prior) does not go with "
-                         'search.targets many')
-    weights = weights / weights.max()           # the sum of weights near 1e308 stays finite
-    return weights / weights.sum()
+        raise ValueError(NO_PRIOR_WITH_MANY)
+    return prior
 
 
 def observation_from(values: Mapping, grid: Grid, fpoc):

@@ -182,6 +182,11 @@ class FrameResult:
         return self.status == 'applied'
 
 
+# The many-target belief is an occupancy per cell, each starting from absent.prior (section 11.6).
+NO_PRIOR_WITH_MANY = ("a prior over one target's cell (belief.prior) does not go with "
+                      'search.targets many')
+
+
 def make_session(grid: Grid, observation, policy, settings: SearchSettings, log_size: int = 0,
                  prior=None):
     """
@@ -199,8 +204,7 @@ def make_session(grid: Grid, observation, policy, settings: SearchSettings, log_
     """
     if settings.targets == 'many':
         if prior is not None:
-            raise ValueError("a prior over one target's cell (belief.prior) does not go with "
-                             'search.targets many')
+            raise ValueError(NO_PRIOR_WITH_MANY)
         session = OccupancySession(grid, observation, settings, link=ROOM_LINK,
                                    log_size=log_size)
         session.set_policy(policy)
@@ -336,8 +340,7 @@ class GazeController:
     def set_prior(self, prior) -> None:
         """Start the searches at ``prior`` (None: uniform) from the next :meth:`reset` on."""
         if prior is not None and self.settings.targets == 'many':
-            raise ValueError("a prior over one target's cell (belief.prior) does not go with "
-                             'search.targets many')
+            raise ValueError(NO_PRIOR_WITH_MANY)
         if self.settings.targets == 'one':
             self.session.set_prior(prior)
 

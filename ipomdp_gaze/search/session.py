@@ -697,10 +697,8 @@ class SearchSession:
             self.rng = seed
         elif seed is not None:
             self.rng = np.random.default_rng(seed)
-        log_b = initial_log_belief(self.grid.n_cells, self.settings.absent_prior)
-        if self.prior is not None:
-            with np.errstate(divide='ignore'):          # a cell at 0: log 0 = -inf, kept so
-                log_b[:self.grid.n_cells] += np.log(self.prior * self.grid.n_cells)
+        log_b = initial_log_belief(self.grid.n_cells, self.settings.absent_prior,
+                                   prior=self.prior)    # a cell at 0: log 0 = -inf, kept so
         self._still.reset()
         self.motion.reset()
         if self._mixture is not None:
