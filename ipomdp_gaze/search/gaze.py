@@ -412,7 +412,8 @@ class GazeController:
         """
         Start a new search from the prior at the start cell; return it (sent at ``now_s``).
 
-        The prior is uniform over the cells, with ``absent_prior`` on the absent hypothesis.
+        The prior is :attr:`prior` (uniform without one) over the cells, with ``absent_prior``
+        on the absent hypothesis.
         ``new_search`` False restarts the search just begun (:meth:`configure`) under its id.
         """
         self.session.reset()

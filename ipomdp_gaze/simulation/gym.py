@@ -33,8 +33,8 @@ summing to 1) is where the target is a priori: reset draws it from the prior and
 starts there (default uniform; ``options={'target': cell}`` must be a cell it allows).
 
 A count model with scan tables (``faces-420`` and the other calibrated face models) starts each
-episode with its one-time whole-image scan, drawn at reset (``scan=False``: from the uniform
-prior), as the simulation, training and ``find`` start (docs/design.md section 6.8): the first
+episode with its one-time whole-image scan, drawn at reset (``scan=False``: from the prior),
+as the simulation, training and ``find`` start (docs/design.md section 6.8): the first
 observation is the scanned belief (``observe='evidence'``: the scan's counts).
 """
 from __future__ import annotations
