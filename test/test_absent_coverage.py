@@ -186,3 +186,28 @@ def test_a_model_without_a_camera_is_refused_and_a_moving_target_unchanged():
                                                          motion_sigma_cells=0.5), views=12)
         moving.append((session.path, result.decision, session.absent_probability))
     assert moving[0] == moving[1]
+
+
+@pytest.mark.parametrize('name', LENSES)
+def test_absent_waits_only_for_the_cells_a_prior_allows(name):
+    """A cell at prior 0 never holds the target: no view is spent covering it."""
+    model = load_observation(name)
+    grid = model.grid
+    prior = np.ones(grid.shape)
+    prior[:grid.rows // 2] = 0.0                    # the upper half ruled out
+    prior = (prior / prior.sum()).ravel()
+    allowed = np.flatnonzero(prior > 0)
+    session = SearchSession(grid, model, build_policy('coverage', grid, model),
+                            replace(SETTINGS, absent_needs_coverage=True, scan=False),
+                            prior=prior)
+    session.reset(seed=0)
+    session.start()
+    for _ in range(SETTINGS.max_fixations):
+        result = session.update(Frame(np.zeros(grid.n_cells, dtype=np.int64)))
+        if result.ended:
+            break
+    reach = session._reach
+    assert result.decision == 'absent' and session.gave_up_reason == ''
+    assert reach.covered(grid, session.path)[allowed].all()
+    assert not reach.covered(grid, session.path[:-1])[allowed].all()  # at the first chance
+    assert not reach.covered(grid, session.path).all()      # the ruled-out half left alone

@@ -957,13 +957,16 @@ class SearchSession:
         """
         Return the cells the search's views have not covered, with ``absent_needs_coverage``.
 
-        Empty without the setting, for a moving target or without a pan/tilt camera
-        (:mod:`ipomdp_gaze.model.view_reach`, docs/design.md section 6.16).
+        Only the cells that may hold the target: not one the prior rules out (or
+        :meth:`exclude` took out), whose belief is 0 for good. Empty without the setting, for
+        a moving target or without a pan/tilt camera (:mod:`ipomdp_gaze.model.view_reach`,
+        docs/design.md section 6.16).
         """
         if not self.settings.absent_needs_coverage or self.motion.active \
                 or self._reach is None:
             return np.zeros(0, dtype=np.int64)
-        return np.flatnonzero(~self._reach.covered(self.grid, self._search.path))
+        open_cells = np.isfinite(self._search.log_belief[:self.grid.n_cells])
+        return np.flatnonzero(~self._reach.covered(self.grid, self._search.path) & open_cells)
 
     def _group_stops(self, groups: np.ndarray | None) -> bool:
         """Whether a frame's grouped detections end the search (docs/design.md section 6.15)."""
