@@ -519,3 +519,32 @@ def test_a_sure_prior_needs_no_fixation_in_training_and_evaluate(tmp_path, capsy
                  '--prior', str(point), '--quiet', '--json', str(json_out)]) == 0
     import json
     assert json.loads(json_out.read_text())['policies']['p']['fixations_to_90'] == 0.0
+
+
+def test_resume_with_a_uniform_prior_file_continues_the_recorded_training(tmp_path, capsys):
+    """QA (upgrade): --resume of a file with no prior (0.3.1's) and --prior of equal weights."""
+    flat = tmp_path / 'flat.txt'
+    flat.write_text('1 1 1\n1 1 1\n1 1 1\n')
+    first = tmp_path / 'k.yaml'
+    common = ['--eval-every', '2', '--eval-episodes', '20', '--final-episodes', '0', '--quiet']
+    assert main(['train', '--grid', '3x3', '--epochs', '2', '--out', str(first)] + common) == 0
+    assert main(['train', '--resume', str(first), '--epochs', '4', '--out',
+                 str(tmp_path / 'a.yaml')] + common) == 0
+    # Refused before as '--prior flat.txt (recorded: uniform)': the same prior, continued as is.
+    assert main(['train', '--resume', str(first), '--epochs', '4', '--out',
+                 str(tmp_path / 'b.yaml'), '--prior', str(flat)] + common) == 0, \
+        capsys.readouterr().err
+    a, b = load_policy_spec(tmp_path / 'a.yaml'), load_policy_spec(tmp_path / 'b.yaml')
+    np.testing.assert_array_equal(a.kernel, b.kernel)
+    assert 'prior' not in b.training
+    # A file that records a uniform prior (train --prior of equal weights) is uniform too.
+    uniform = tmp_path / 'u.yaml'
+    assert main(['train', '--grid', '3x3', '--epochs', '2', '--out', str(uniform),
+                 '--prior', str(flat)] + common) == 0
+    centre = tmp_path / 'centre.txt'
+    centre.write_text('1 1 1\n1 6 1\n1 1 1\n')
+    capsys.readouterr()
+    assert main(['train', '--resume', str(uniform), '--epochs', '4', '--out',
+                 str(tmp_path / 'c.yaml'), '--prior', str(centre)] + common) == 2
+    [line] = capsys.readouterr().err.strip().splitlines()
+    assert f'--prior {centre} (recorded: uniform)' in line, line

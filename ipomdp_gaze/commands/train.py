@@ -162,6 +162,19 @@ RESUME_FLAGS = {'learning_rate': '--learning-rate', 'anneal_epochs': '--anneal-e
                 'prior': '--prior'}
 
 
+def config_prior(spec):
+    """Return the prior a policy file's training records (rows), or None (uniform)."""
+    from ipomdp_gaze.policies.training import config_from_spec
+    return config_from_spec(spec).prior
+
+
+def _same_prior(given, recorded) -> bool:
+    """Whether ``--prior``'s rows are the recorded prior; a uniform file is the uniform prior."""
+    if prior_is_uniform(given) and prior_is_uniform(recorded):
+        return True
+    return given == recorded
+
+
 def _refuse_changed_training(args, spec, overrides: dict) -> None:
     """
     Refuse training settings given with ``--resume`` that differ from the file's (ValueError).
@@ -178,7 +191,7 @@ def _refuse_changed_training(args, spec, overrides: dict) -> None:
     def given(key, value):
         if key == 'prior':                  # rows of numbers: the file, and which was recorded
             return (f'--prior {args.prior} (recorded: '
-                    f'{"uniform" if recorded.prior is None else "another prior"})')
+                    f'{"uniform" if prior_is_uniform(recorded.prior) else "another prior"})')
         return f'{RESUME_FLAGS[key]} {value!r} (recorded: {shown(getattr(recorded, key))})'
 
     changed = [given(key, value) for key, value in overrides.items()
@@ -248,6 +261,8 @@ def run(args) -> int:
     else:
         if args.init_elm is not None:
             raise ValueError('--init-elm starts a new training; a resumed one keeps its kernel')
+        if prior is not None and _same_prior(prior, config_prior(spec)):
+            overrides['prior'] = None       # the recorded one, kept as it is (bit for bit)
         _refuse_changed_training(args, spec, overrides)
         trainer = trainer_from_spec(spec, model=fpoc, **overrides)
     curve_path = out.with_suffix('.csv')
