@@ -453,3 +453,20 @@ def test_a_frame_taken_before_the_head_settled_is_asked_for_again_once_it_has(pr
         cam.step(_frames(61, 1)[0])            # the image taken after it: applied
     finally:
         assert all(r.successful for r in _set(probe, settle_time_s=0.0, retry_period_s=1.0))
+
+
+def test_a_prior_given_at_start_up_is_said_and_a_bad_one_ends_the_node(nodes):
+    """QA (upgrading): the start-up line says belief.prior places the target; a bad one: a line."""
+    weights = ', '.join(['1.0'] * 120 + ['5.0'])
+    good = nodes.start('controller', ['-r', '__ns:=/prior', '-p', f'belief.prior:=[{weights}]'])
+    assert wait_for(lambda: 'first fixation' in good.output(), 60), good.output()
+    assert 'a still target placed by belief.prior (not uniform over the cells)' in good.output()
+    assert good.stop() == 0
+    nodes.killed.append(good)
+    short = ', '.join(['1.0'] * 120)
+    bad = nodes.start('controller', ['-r', '__ns:=/prior_bad', '-p', f'belief.prior:=[{short}]'])
+    assert wait_for(lambda: not bad.running, 60)
+    nodes.killed.append(bad)                                   # exited on purpose
+    assert bad.proc.returncode == 1
+    assert 'belief.prior must hold one weight per cell, 121 values' in bad.output()
+    assert 'Traceback' not in bad.output(), bad.output()

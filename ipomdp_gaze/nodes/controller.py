@@ -49,7 +49,7 @@ import sys
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import PoseArray
-from ipomdp_gaze.model.belief import EvidenceError
+from ipomdp_gaze.model.belief import EvidenceError, prior_is_uniform
 from ipomdp_gaze.model.head_time import SETTLE_TIME_S
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, people, stamps
 from ipomdp_gaze.policies.baselines import STRATEGIES
@@ -252,6 +252,8 @@ class GazeControllerNode(GuardedNode, QuietPublishers, Node):
             motion = ('many targets (an occupancy per cell), each kept in view '
                       f"{v['room.dwell_s']} s in turn, re-checked "
                       f"{f'every {recheck} s' if recheck else 'never'}")
+        if not prior_is_uniform(self._config.prior):
+            motion += ' placed by belief.prior (not uniform over the cells)'
         return (f"{motion}, absent prior {v['absent.prior']}, confidence {v['confidence']}, "
                 f'{budget} fixation budget{ior}')
 
