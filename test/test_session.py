@@ -827,3 +827,24 @@ def test_an_excluded_cell_stays_ruled_out_when_repeated_views_are_weighted():
         if result.ended:
             break
         cell = result.fixation
+
+
+@pytest.mark.parametrize('radius', [0, 1])
+def test_the_answer_after_a_frame_is_the_tie_rules_cell_of_the_pooled_belief(radius):
+    """The stop rule's peak gives the answer (no second max): ties within 1e-9 to the lowest."""
+    from ipomdp_gaze.model.belief import argmax_ties_low
+    from ipomdp_gaze.search.session import pooled_belief
+    model = count_model(4, scan=False)
+    settings = SearchSettings(confidence=1 - 1e-12, found_radius=radius, max_fixations=0)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model), settings)
+    session.reset(seed=0)
+    cell = session.start()
+    zeros = np.zeros(GRID.n_cells)                   # a frame of 0 counts: cells stay tied
+    for frame in [zeros] + [np.random.default_rng(i).integers(0, K, GRID.n_cells)
+                            for i in range(6)]:
+        result = session.update(Frame(frame.astype(float)))
+        pooled = pooled_belief(session.belief, GRID, radius)
+        assert result.map_cell == session.map_cell == int(argmax_ties_low(pooled))
+        assert result.map_probability == pytest.approx(pooled[result.map_cell], abs=1e-15)
+        cell = result.fixation
+    assert cell is not None

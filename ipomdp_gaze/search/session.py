@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 import math
 
 from ipomdp_gaze.model.belief import (argmax_ties_low, bayes_update, check_prior, entropy_of_log,
-                                      EvidenceError, map_cell, normalize_log)
+                                      EvidenceError, map_cell, normalize_log, TIE_RTOL)
 from ipomdp_gaze.model.clutter_map import ClutterMap
 from ipomdp_gaze.model.false_alarms import FalseAlarmMixture
 from ipomdp_gaze.model.grid import Grid
@@ -75,6 +75,10 @@ def session_view(name: str, doc: str) -> property:
     unchanged.
     """
     return property(lambda self: getattr(self.session, name), doc=doc)
+
+
+# A stop rule's decision code as the search reports it.
+_DECISIONS = {FOUND: 'found', ABSENT: 'absent'}
 
 
 def pooled_belief(belief: np.ndarray, grid: Grid, radius: int) -> np.ndarray:
@@ -922,9 +926,13 @@ class SearchSession:
         then the budget.
         """
         search, settings = self._search, self.settings
-        peak, absent = float(self._pooled().max()), self.absent_probability
+        pooled = self._pooled()
+        peak, absent = float(pooled.max()), self.absent_probability
+        views = search.views
+        if 'map_cell' not in views:         # the answer from this peak: argmax_ties_low's rule
+            views['map_cell'] = int(np.argmax(pooled >= peak - TIE_RTOL * abs(peak)))
         code = decide_one(peak, absent, settings.confidence)
-        decision = {FOUND: 'found', ABSENT: 'absent'}.get(code, '')
+        decision = _DECISIONS.get(code, '')
         if decision == 'absent' and self._uncovered().size:
             decision = ''                   # search.absent_needs_coverage: not yet (§6.16)
         keep = settings.motion_keep_probability
@@ -947,6 +955,8 @@ class SearchSession:
                 search.decision, search.reason, search.ended = 'found', 'group', True
                 search.decided_once = True
                 return 'found'
+        if search.group_cell is None and 'map_probability' not in views:
+            views['map_probability'] = float(pooled[views['map_cell']])
         budget_applies = not search.decided_once or not settings.stop_on_decision
         if budget_applies and settings.max_fixations \
                 and search.fixations >= settings.max_fixations:
