@@ -78,7 +78,8 @@ def _parameter_event(t_s: float, values: dict, node: str = '/gaze_controller') -
     return BagMessage('/parameter_events', int(t_s * 1e9), msg, 0)
 
 
-def _record(values: dict, faces, frames: int, changes=()) -> Bag:
+def _record(values: dict, faces, frames: int, changes=(), start: float = 1000.0,
+            belief: bool = False) -> Bag:
     """
     Search with the core as the node does and return the bag a recorder would have written.
 
@@ -86,12 +87,16 @@ def _record(values: dict, faces, frames: int, changes=()) -> Bag:
     detections on a face in its 5x5 cells and 0 elsewhere, NaN out of view. ``changes`` are
     ``(frame, {parameter: value})`` set (as the node sets them) just before that frame: one that
     moves the head sends the current target again, stamped anew, and frames settle from then on
-    (the node's ``_send_target``); a frame taken sooner is skipped.
+    (the node's ``_send_target``); a frame taken sooner is skipped. ``start``: when the search
+    begins (s); ``belief``: also record the reset's ``belief`` (the prior), as the node sends it.
     """
     core, _ = build_controller(values)
     grid, config, live = core.grid, build_config(values, _build_policy()), dict(values)
-    messages, t = [], 1000.0
+    messages, t = [], start
     core.reset(t)
+    if belief:
+        messages.append(BagMessage('/belief', int((t + 0.002) * 1e9),
+                                   SimpleNamespace(data=core.belief.astype(np.float32)), 0))
 
     def target(now: float) -> None:
         core.retarget(now)
@@ -205,6 +210,26 @@ def test_a_change_before_the_replayed_search_is_its_setting_from_the_start():
     assert 'confidence 0.5 -> 0.85' in describe_settings(bag)
     result = replay(bag, out=lambda line: None)
     assert result.changes_applied == 0 and result.same
+
+
+def test_the_last_search_is_replayed_when_it_began_at_a_prior():
+    """QA: a reset at belief.prior (not uniform) was not seen: the first search was replayed."""
+    face = 5 * 11 + 8
+    values = _parameters('faces_camera_controller.yaml')
+    first = _record(values, lambda i: {face}, 20, belief=True)
+    weights = np.ones(121)
+    weights[:11] = 0.0                          # the top row ruled out
+    weights[face] = 10.0
+    second = _record(dict(values, **{'belief.prior': weights.tolist()}), lambda i: {face}, 20,
+                     start=1100.0, belief=True)
+    assert second.topic('found') and len(second.topic('evidence')) != len(first.topic('evidence'))
+    change = _parameter_event(1099.0, {'belief.prior': weights.tolist()})
+    bag = _with(first, list(second.messages) + [change])
+    lines = []
+    result = replay(bag, out=lines.append)
+    assert [fate for _, fate in result.changes] == ['start'], lines
+    assert result.applied == len(second.topic('evidence')) and result.same, lines
+    assert len(result.recorded_events) == len(second.topic('found')), lines
 
 
 def test_many_moving_people_are_compared_by_their_events_not_a_decision():

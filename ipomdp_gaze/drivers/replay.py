@@ -37,7 +37,7 @@ from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.policies.registry import build_policy
 from ipomdp_gaze.search import answer
 from ipomdp_gaze.search.controller_config import build_config, ControllerConfig, \
-    follow_config, grid_from, head_from
+    follow_config, grid_from, head_from, prior_from
 from ipomdp_gaze.search.gaze import GazeController
 import numpy as np
 
@@ -525,7 +525,7 @@ def last_search(bag, head: PanTiltMap, start: int):
 
 def search_start(bag, head: PanTiltMap, start: int) -> int | None:
     """
-    Return when (bag time, ns) the controller's last reset (its uniform ``belief``) began.
+    Return when (bag time, ns) the controller's last reset (its ``belief`` at the prior) began.
 
     A bag may hold several searches (``~/reset`` starts a new one; the demo resets once the
     recorder hears every node): a replay follows the last one. The recorder takes the topics
@@ -549,10 +549,43 @@ def search_start(bag, head: PanTiltMap, start: int) -> int | None:
     return cut
 
 
+def _recorded_priors(bag, grid: Grid) -> list:
+    """Return each ``belief.prior`` the recording had (recorded or set), as probabilities (N,)."""
+    values = [bag.parameters(CONTROLLER)] + [c.values for c in parameter_changes(bag)]
+    priors = []
+    for v in values:
+        try:
+            prior = prior_from({'belief.prior': v.get('belief.prior')}, grid)
+        except ValueError:
+            continue                            # refused by the node: never in force
+        if prior is not None:
+            priors.append(prior)
+    return priors
+
+
+def _reset_times(bag, grid: Grid | None = None) -> list:
+    """
+    Return when (bag time, ns) each reset's ``belief`` arrived: uniform, or at a recorded prior.
+
+    A search starts at ``belief.prior`` (times ``1 - absent.prior``) when one is in force, so a
+    reset is a belief proportional to a prior of the recording, not only a uniform one.
+    """
+    priors = [] if grid is None else _recorded_priors(bag, grid)
+    out = []
+    for m in bag.topic('belief'):
+        data = np.asarray(m.msg.data, dtype=float)
+        if grid is not None and data.size != grid.n_cells:
+            continue
+        total = data.sum()
+        if np.ptp(data) == 0 or (total > 0 and any(
+                np.allclose(data / total, p, rtol=1e-5, atol=1e-9) for p in priors)):
+            out.append(m.time_ns)
+    return out
+
+
 def _last_reset(bag, grid: Grid) -> int | None:
-    """Return when (bag time, ns) the controller's last uniform ``belief`` arrived, if any."""
-    resets = [m.time_ns for m in bag.topic('belief')
-              if np.size(m.msg.data) == grid.n_cells and np.ptp(np.asarray(m.msg.data)) == 0]
+    """Return when (bag time, ns) the controller's last reset ``belief`` arrived, if any."""
+    resets = _reset_times(bag, grid)
     return resets[-1] if resets else None
 
 
@@ -816,7 +849,8 @@ def _say_people(result: ReplayResult, say) -> None:
 
 def _search_frames(bag) -> list:
     """Return the arrival times (ns) of the last search's frames, sorted."""
-    resets = [m.time_ns for m in bag.topic('belief') if np.ptp(np.asarray(m.msg.data)) == 0]
+    parameters = bag.parameters(CONTROLLER)
+    resets = _reset_times(bag, grid_from(parameters) if 'grid.rows' in parameters else None)
     since = resets[-1] if resets else 0          # the last search (see last_search)
     return sorted(m.time_ns for topic in ('evidence_image', 'evidence')
                   for m in bag.topic(topic) if m.time_ns >= since)
