@@ -506,3 +506,22 @@ def test_a_refused_replay_still_says_its_settings(cli_here, monkeypatch, tmp_pat
     assert 'settings: recorded, with policy=learned; gaze_controller parameters set while ' \
         'recording, each in force from its time: at ' in run.stdout, run.stdout
     assert "--policy: policy 'learned' needs policy.kernel" in run.stderr, run.stderr
+
+
+def test_a_new_search_on_the_recorded_image_starts_at_the_recorded_prior():
+    """QA: replay --new-search searched from the uniform prior, not the recorded belief.prior."""
+    from ipomdp_gaze.drivers.replay import new_search
+    controller = _parameters('faces_fovea_controller.yaml')
+    weights = np.zeros(21 * 21)
+    weights[3 * 21 + 4] = 1.0                   # the face is known to be at (3, 4)
+    controller['belief.prior'] = weights.tolist()
+    detector = yaml_parameters(REPO / 'config' / 'faces_fovea_detector.yaml', 'foveal_detector')
+    side = 420
+    image = SimpleNamespace(encoding='mono8', height=side, width=side, step=side,
+                            data=np.full(side * side, 128, dtype=np.uint8))
+    custom = {'ipomdp_gaze/parameters/gaze_controller': yaml.safe_dump(controller),
+              'ipomdp_gaze/parameters/foveal_detector': yaml.safe_dump(detector)}
+    bag = Bag(Path('bag'), [BagMessage('/image', int(1e9), image, side * side)], custom, 0, 1.0)
+    lines = []
+    result = new_search(bag, out=lines.append)
+    assert result.cell == (3, 4) and result.decision == 'found', lines

@@ -957,7 +957,8 @@ def new_search(bag, overrides: dict | None = None, out=print):
     if not settings.max_fixations:        # the demo's budget: a still image needs an end
         settings = dataclasses.replace(settings, max_fixations=4 * core.grid.n_cells)
     result = search_image(_last_image(bag), setup.fovea, core.observation, core.policy,
-                          settings, rng=np.random.default_rng(int(values.get('seed', 0))))
+                          settings, rng=np.random.default_rng(int(values.get('seed', 0))),
+                          prior=config.prior)       # belief.prior: as the recorded search
     cell = setup.fovea.grid.index(*result.cell) if result.decision != 'absent' else None
     decision = Decision(result.decision, cell, result.answer_probability, result.fixations,
                         result.stop if answer.forced(result.decision, result.stop) else '')

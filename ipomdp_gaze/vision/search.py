@@ -393,7 +393,7 @@ def cell_centre_px(grid: Grid, cell: int, image_px: tuple[int, int]) -> tuple[fl
 def search_image(image: np.ndarray, fovea: Fovea, model, policy,
                  settings: SearchSettings | None = None, *,
                  rng: np.random.Generator | None = None, pixel_budget: int | None = None,
-                 excluded=(), restart: bool = True) -> ImageSearch:
+                 excluded=(), restart: bool = True, prior=None) -> ImageSearch:
     """
     Search one decoded image with the fovea, the count model and a policy (module docstring).
 
@@ -426,6 +426,9 @@ def search_image(image: np.ndarray, fovea: Fovea, model, policy,
     restart : bool
         Start the fovea on ``image`` (False: the fovea already holds it, and its cached windows
         are reused at no detector cost, as in a second search of the same image).
+    prior : array (N,), optional
+        Where the face is a priori, summing to 1 (None: uniform; the controller's
+        ``belief.prior``, so ``replay --new-search`` repeats a search that had one).
 
     Raises
     ------
@@ -439,7 +442,8 @@ def search_image(image: np.ndarray, fovea: Fovea, model, policy,
     settings = DEFAULT_SETTINGS if settings is None else settings
     calibrated = calibrated_size(model)
     image_px = check_image(image, fovea)
-    outcome = run_search(SearchSession(fovea.grid, model, policy, settings), FoveaSensor(fovea),
+    outcome = run_search(SearchSession(fovea.grid, model, policy, settings, prior=prior),
+                         FoveaSensor(fovea),
                          image, seed=np.random.default_rng(0) if rng is None else rng,
                          pixel_budget=pixel_budget, exclude=excluded, restart=restart)
     return _image_search(outcome, fovea.grid, image_px, calibrated, t0, outcome.decision)
