@@ -28,7 +28,7 @@ VALUE_KEYS = ['policy', 'enabled', 'evidence_rate_hz', 'frames_received', 'frame
               'fixations', 'fixation_row', 'fixation_col', 'entropy_nats', 'most_likely_row',
               'most_likely_col', 'most_likely_probability', 'found', 'pan_tilt_resends',
               'last_rejection', 'absent_probability', 'decision', 'search_ended', 'lost',
-              'reacquired']
+              'reacquired', 'prior']
 
 
 def health(enabled=True, stall_timeout_s=5.0, without_s=0.5, arrived=3, rejected=0,

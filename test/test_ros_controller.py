@@ -237,6 +237,9 @@ def test_a_prior_set_remotely_is_where_the_next_search_starts(probe, cam):
     try:
         results = _set(probe, belief__prior=weights.tolist())
         assert results[0].successful, results[0].reason
+        assert wait_for(lambda: 'belief.prior placing the target from the next search '
+                        '(~/reset)' in cam.proc.output(), 20), cam.proc.output()[-2000:]
+        cam.wait_counters(prior='belief.prior')
         nb, nt = len(cam.beliefs), len(cam.targets)
         assert _reset(probe).success
         assert wait_for(lambda: len(cam.beliefs) > nb and len(cam.targets) > nt, 20)
@@ -248,6 +251,7 @@ def test_a_prior_set_remotely_is_where_the_next_search_starts(probe, cam):
         from rclpy.parameter import Parameter
         empty = Parameter('belief.prior', Parameter.Type.DOUBLE_ARRAY, [])
         assert _set(probe, belief__prior=empty)[0].successful
+    cam.wait_counters(prior='uniform')
     _fresh_search(probe, cam)
 
 

@@ -61,6 +61,7 @@ from ipomdp_gaze.search.controller_config import (build_config, ControllerConfig
 from ipomdp_gaze.search.gaze import FrameSequence, SETTLING, STAMP_TOLERANCE_S
 from ipomdp_gaze.search.health import HealthMonitor
 from ipomdp_gaze.search.room import MAX_PERIOD_S, Person, PERSON_LINK, RoomWatch
+import numpy as np
 from rclpy.clock import ClockChange, JumpThreshold
 from rclpy.duration import Duration
 from rclpy.exceptions import NameValidationException
@@ -93,6 +94,13 @@ CLOCK_JUMP_FORWARD_S = 5.0
 # belief_image is at most this many pixels on a side (256x256 cells at 32 px would be 201 MB).
 MAX_IMAGE_SIDE_PX = 1024
 OBSERVATION_MODELS = ('gaussian', 'counts')
+
+
+def _same_prior(a, b) -> bool:
+    """Whether two ``belief.prior`` probabilities (None: uniform) are the same."""
+    if a is None or b is None:
+        return a is b
+    return bool(np.array_equal(a, b))
 
 
 def controller_params() -> list[Param]:
@@ -386,6 +394,10 @@ class GazeControllerNode(GuardedNode, QuietPublishers, Node):
             self._make_room_timers(v)
         if cfg.head != old.head and core.enabled and not core.stopped:
             self._send_target()
+        if not _same_prior(old.prior, cfg.prior):
+            return (f'policy {cfg.policy_label}; belief.prior '
+                    f"{'uniform' if prior_is_uniform(cfg.prior) else 'placing the target'} "
+                    'from the next search (~/reset)')
         return f'policy {cfg.policy_label}'
 
     def _make_room_publishers(self) -> None:

@@ -29,6 +29,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 
+from ipomdp_gaze.model.belief import prior_is_uniform
+
 MIN_PERIOD_S = 1e-9
 
 
@@ -189,5 +191,7 @@ class HealthMonitor:
             'last_rejection': core.last_rejection,
             'absent_probability': core.absent_probability, 'decision': core.decision,
             'search_ended': core.stopped, 'lost': core.losses,
-            'reacquired': core.reacquisitions}
+            'reacquired': core.reacquisitions,
+            'prior': 'uniform' if prior_is_uniform(getattr(core, 'prior', None))
+            else 'belief.prior'}
         return replace(health, values=values)
