@@ -38,14 +38,15 @@ import time
 from typing import Callable
 
 from ipomdp_gaze.files.observation_file import fingerprint
+from ipomdp_gaze.model.belief import check_prior, draw_cells
 from ipomdp_gaze.model.fpoc import FPOC
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.motion import check_probability, check_sigma_cells, Motion
 from ipomdp_gaze.model.observation import as_observation, CountObservation
 from ipomdp_gaze.model.stopping import BatchBelief, check_absent_prior
 from ipomdp_gaze.simulation.evaluation import (fixations_to_90_ci, fixations_to_level,
-                                               tracking_summary)
-from ipomdp_gaze.simulation.simulate import check_prior, rollout, simulate
+                                               prior_chance, tracking_summary)
+from ipomdp_gaze.simulation.simulate import rollout, simulate
 import numpy as np
 
 from .conv import ConvPolicy, kernel_from_radial, radial_bins
@@ -271,11 +272,9 @@ def sample_episodes(theta: np.ndarray, model, reward: str, episodes: int,
     n = theta.shape[0]
     rows = np.arange(episodes)
     theta_t = np.ascontiguousarray(theta.T)
-    if prior is None:
-        targets = rng.integers(0, n, size=episodes)
-    else:
+    if prior is not None:
         prior = check_prior(prior, n)
-        targets = rng.choice(n, size=episodes, p=prior)
+    targets = draw_cells(rng, n, prior, episodes)
     present = rng.random(episodes) >= absent_rate if absent_rate > 0 else None
     moving = motion is not None and motion.active
     batch = BatchBelief(n, absent_prior, episodes, moving, prior)
@@ -431,7 +430,7 @@ class Trainer:
                           absent_prior=cfg.absent_prior, absent_rate=cfg.absent_rate,
                           prior=self.prior)
         return fixations_to_level(result.percent_correct, self.grid.n_cells,
-                                  chance=None if self.prior is None else float(self.prior.max()))
+                                  chance=prior_chance(self.prior))
 
     def run(self, epochs: int, progress=False,
             callback: Callable[[dict], None] | None = None) -> list[dict]:
@@ -596,7 +595,7 @@ def evaluation_block(grid: Grid, fpoc: FPOC, policy, episodes: int = 20000, seed
                       progress=None if progress is None else lambda t: progress.update(1))
     point, ci = fixations_to_90_ci(result.correct, grid.n_cells,
                                    np.random.default_rng([seed, 99]), bootstrap,
-                                   chance=None if prior is None else float(prior.max()))
+                                   chance=prior_chance(prior))
     block = {'episodes': int(episodes), 'seed': int(seed), 'action': policy.action,
              'horizon': horizon, 'fixations_to_90': point, 'ci95': list(ci) if ci else None}
     block.update(scene)

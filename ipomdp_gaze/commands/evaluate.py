@@ -30,7 +30,7 @@ from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
 from ipomdp_gaze.search.session import SearchSettings
 from ipomdp_gaze.simulation.evaluation import (decision_summary, fixations_to_90_ci,
                                                paired_difference_ci, paired_tracking_difference,
-                                               tracking_summary)
+                                               prior_chance, tracking_summary)
 from ipomdp_gaze.simulation.executor import InlineExecutor
 from ipomdp_gaze.simulation.simulate import check_prior, draw_present, draw_targets
 from ipomdp_gaze.vision.pan_tilt import parse_faces
@@ -205,10 +205,9 @@ def evaluate(grid, fpoc, policies: dict, episodes: int, horizon, seed: int,
             else {'observation': {**model.to_dict(), 'sha256': fingerprint(model)}})
     out = {'grid': grid.to_dict(), **task, 'episodes': episodes,
            'horizon': horizon, 'seed': seed}
-    chance = None                   # percent correct at t = 0: 1/N, or the prior's MAP cell's
+    chance = prior_chance(prior)    # percent correct at t = 0: 1/N, or the prior's MAP cell's
     if prior is not None:
         out['prior'] = prior.reshape(grid.shape).tolist()
-        chance = float(prior.max())
     if extended:
         out.update({'motion_sigma_cells': motion.sigma_cells, 'jump_prob': motion.jump_prob,
                     'absent_prior': float(absent_prior), 'absent_rate': float(absent_rate),

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ipomdp_gaze.model.belief import draw_cells
 from ipomdp_gaze.model.observation import as_observation
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
 from ipomdp_gaze.search import answer
@@ -175,10 +176,8 @@ def run(args) -> int:
         if prior is not None and prior[target] == 0:
             raise ValueError(f'--target {grid.cell(target)} is a cell --prior {args.prior} rules '
                              'out (weight 0): the search could never find it there')
-    elif prior is None:
-        target = int(rng.integers(grid.n_cells))
     else:
-        target = int(rng.choice(grid.n_cells, p=prior))
+        target = int(draw_cells(rng, grid.n_cells, prior))
     if args.empty:
         target = None
     guess, path, belief, result = run_search(grid, as_observation(grid, fpoc), policy, target,

@@ -169,6 +169,19 @@ def check_prior(prior, n_cells: int, shape: tuple[int, int] | None = None) -> np
     return values / total
 
 
+def draw_cells(rng: np.random.Generator, n_cells: int, prior: np.ndarray | None = None,
+               size=None):
+    """
+    Draw random cells from ``rng``: uniform, or from ``prior`` (N,), checked, summing to 1.
+
+    The uniform draw is ``integers(0, N)``, the draw before priors existed, so a seed gives
+    the targets it gave then; a prior draws with ``choice``.
+    """
+    if prior is None:
+        return rng.integers(0, n_cells, size=size)
+    return rng.choice(n_cells, size=size, p=prior)
+
+
 def prior_from_weights(weights) -> np.ndarray:
     """
     Scale weights >= 0 (one per cell) to a prior summing to 1: a prior file's, ``belief.prior``.

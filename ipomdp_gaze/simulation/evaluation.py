@@ -21,6 +21,11 @@ import numpy as np
 LEVEL = 0.90
 
 
+def prior_chance(prior) -> float | None:
+    """Percent correct at t = 0 under ``prior`` (N,): its MAP cell's, ``max P`` (None: 1/N)."""
+    return None if prior is None else float(np.max(prior))
+
+
 def fixations_to_level(percent_correct: np.ndarray, n_cells: int, level: float = LEVEL,
                        chance: float | None = None):
     """

@@ -44,7 +44,7 @@ from pathlib import Path
 import gymnasium
 from gymnasium import spaces
 from ipomdp_gaze.files.render import belief_heatmap, belief_text
-from ipomdp_gaze.model.belief import map_cell
+from ipomdp_gaze.model.belief import draw_cells, map_cell
 from ipomdp_gaze.model.checks import positive_int
 from ipomdp_gaze.model.fpoc import FPOC, make_fpoc
 from ipomdp_gaze.model.grid import Grid
@@ -180,12 +180,8 @@ class VisualSearchEnv(gymnasium.Env):
         if target is not None and self.prior is not None and self.prior[target] == 0:
             raise ValueError(f"options['target'] {target} is a cell the prior rules out "
                              '(probability 0)')
-        if target is not None:
-            self._target = int(target)
-        elif self.prior is None:
-            self._target = int(self.np_random.integers(n))
-        else:
-            self._target = int(self.np_random.choice(n, p=self.prior))
+        self._target = int(draw_cells(self.np_random, n, self.prior)) if target is None \
+            else int(target)
         if 'present' in options:
             if not isinstance(options['present'], (bool, np.bool_)):
                 raise ValueError(f"options['present'] must be True or False, got "

@@ -21,7 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Protocol
 
-from ipomdp_gaze.model.belief import check_prior, map_cell
+from ipomdp_gaze.model.belief import check_prior, draw_cells, map_cell
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.motion import check_probability, Motion
 from ipomdp_gaze.model.observation import as_observation
@@ -77,9 +77,8 @@ def draw_targets(n_cells: int, episodes: int, seed: int, prior=None) -> np.ndarr
     ``prior`` (N,) sums to 1 (:func:`check_prior`); both draws are prefix-stable.
     """
     rng = np.random.default_rng([seed, _TARGET])
-    if prior is None:
-        return rng.integers(0, n_cells, size=episodes)
-    return rng.choice(n_cells, size=episodes, p=check_prior(prior, n_cells))
+    return draw_cells(rng, n_cells, None if prior is None else check_prior(prior, n_cells),
+                      episodes)
 
 
 def draw_present(episodes: int, absent_rate: float, seed: int) -> np.ndarray:
