@@ -170,3 +170,102 @@ def test_lattice_fixations_keep_the_edges_and_calibration_can_use_them():
     tallies = tally_images(items, {}, grid, config, processes=1, fixations=cells)
     assert tallies.images == 2 and tallies.fixations == 2 * 9
     assert tallies.null.sum() + tallies.target.sum() == 2 * 9 * 25     # 5-cell window: all seen
+
+
+def _resized_copy(folder, scale: float, names) -> None:
+    """Resize the named images of a labelled folder in place, and their labels."""
+    import cv2
+    rows = (folder / 'labels.csv').read_text().splitlines()
+    out = [rows[0]]
+    for row in rows[1:]:
+        name, x, y = row.split(',')
+        if name in names:
+            image = cv2.imread(str(folder / name), cv2.IMREAD_UNCHANGED)
+            cv2.imwrite(str(folder / name), cv2.resize(image, None, fx=scale, fy=scale,
+                                                       interpolation=cv2.INTER_LINEAR))
+            x, y = (f'{float(v) * scale:g}' if v else v for v in (x, y))
+        out.append(f'{name},{x},{y}')
+    (folder / 'labels.csv').write_text('\n'.join(out) + '\n')
+
+
+def test_resize_calibrates_a_folder_of_several_sizes_as_the_images_resized_first(
+        tmp_path, cli_here):
+    """--resize: images and labels resized to one size give the model of that folder resized."""
+    import cv2
+    scenes = [SceneSet('train', grid=(7, 7), seed=4)[i] for i in range(3)]
+    mixed, resized = tmp_path / 'mixed', tmp_path / 'resized'
+    write_scene_set(scenes, mixed)
+    names = [row.split(',')[0] for row in (mixed / 'labels.csv').read_text().splitlines()[1:]]
+    _resized_copy(mixed, 1.5, names[1:])                      # 630x630 and 420x420 images
+    common = ['--labels', mixed / 'labels.csv', '--grid', '7x7', '--windows', '7,3',
+              '--processes', '1', '--quiet']
+    run = cli_here('calibrate', '--images', mixed, *common, '--out', tmp_path / 'no.yaml')
+    assert run.returncode == 2 and 'Traceback' not in run.stderr
+    last = run.stderr.strip().splitlines()[-1]
+    assert 'share one size' in last and '420x420, 630x630' in last and '--resize' in last
+    run = cli_here('calibrate', '--images', mixed, *common, '--resize', '420x420', '--out',
+                   tmp_path / 'mixed.yaml')
+    assert run.returncode == 0, run.stderr
+    # the same images resized by hand (area down to 420, as --resize does) and their labels
+    write_scene_set(scenes, resized)
+    rows = []
+    for row in (mixed / 'labels.csv').read_text().splitlines()[1:]:
+        name, x, y = row.split(',')
+        image = cv2.imread(str(mixed / name), cv2.IMREAD_UNCHANGED)
+        if image.shape[0] != 420:
+            image = cv2.resize(image, (420, 420), interpolation=cv2.INTER_AREA)
+            x, y = (f'{float(v) * 420 / 630!r}' if v else v for v in (x, y))
+        cv2.imwrite(str(resized / name), image)
+        rows.append(f'{name},{x},{y}')
+    (resized / 'labels.csv').write_text('path,x,y\n' + '\n'.join(rows) + '\n')
+    run = cli_here('calibrate', '--images', resized, '--labels', resized / 'labels.csv',
+                   *common[2:], '--out', tmp_path / 'resized.yaml')
+    assert run.returncode == 0, run.stderr
+    mine, theirs = load_observation(tmp_path / 'mixed.yaml'), load_observation(
+        tmp_path / 'resized.yaml')
+    np.testing.assert_array_equal(mine.p_target, theirs.p_target)
+    np.testing.assert_array_equal(mine.p_null, theirs.p_null)
+    assert mine.meta['image'] == {'width': 420, 'height': 420}
+    assert mine.meta['calibration']['source']['resize'] == [420, 420]
+    assert 'resize' not in theirs.meta['calibration']['source']
+
+
+def test_resize_refuses_another_aspect_ratio_naming_the_image(tmp_path, cli_here):
+    import cv2
+    folder = tmp_path / 'labelled'
+    write_scene_set([SceneSet('train', grid=(7, 7), seed=4)[i] for i in range(2)], folder)
+    name = (folder / 'labels.csv').read_text().splitlines()[2].split(',')[0]
+    image = cv2.imread(str(folder / name), cv2.IMREAD_UNCHANGED)
+    cv2.imwrite(str(folder / name), image[:300])                 # 420x300: 7:5, not 1:1
+    rows = (folder / 'labels.csv').read_text().splitlines()
+    rows[2] = f'{name},,'
+    (folder / 'labels.csv').write_text('\n'.join(rows) + '\n')
+    run = cli_here('calibrate', '--images', folder, '--labels', folder / 'labels.csv',
+                   '--resize', '210x210', '--out', tmp_path / 'o.yaml', '--quiet')
+    assert run.returncode == 2 and 'Traceback' not in run.stderr
+    last = run.stderr.strip().splitlines()[-1]
+    assert 'image 2 of --labels is 420x300 px, another aspect ratio' in last
+
+
+def test_resize_labelled_scales_each_centre_with_its_image():
+    from ipomdp_gaze.commands.calibrate import resize_labelled
+    from ipomdp_gaze.vision.scenes import LabelledImage
+    items = [LabelledImage(np.zeros((100, 150), np.uint8), (30.0, 90.0)),
+             LabelledImage(np.zeros((200, 301), np.uint8), None),    # 3:2 within 0.5%
+             LabelledImage(np.zeros((60, 90, 3), np.uint8), (0.0, 59.5))]
+    out = resize_labelled(items, (300, 200))
+    assert [item.image.shape for item in out] == [(200, 300), (200, 300), (200, 300, 3)]
+    assert out[0].centre_px == (60.0, 180.0) and out[1].centre_px is None
+    assert out[2].centre_px == pytest.approx((0.0, 59.5 * 200 / 60))
+
+
+@pytest.mark.parametrize('args, message', [
+    (['--pan-tilt', '--scenes', '2', '--camera', '320'], 'WIDTHxHEIGHT'),
+    (['--images', '.', '--labels', 'x.csv', '--resize', '0x10'], 'WIDTHxHEIGHT'),
+    (['--pan-tilt', '--scenes', '2', '--resize', '320x240'],
+     '--resize is for the image task'),
+])
+def test_bad_sizes_are_one_line(args, message, tmp_path, cli_here):
+    run = cli_here('calibrate', *args, '--out', tmp_path / 'o.yaml')
+    assert run.returncode == 2 and 'Traceback' not in run.stderr
+    assert message in run.stderr.strip().splitlines()[-1]

@@ -35,7 +35,8 @@ import time
 from ipomdp_gaze.model.grid import Grid
 import numpy as np
 
-from .common import check_output_file, grid_arg, nonneg_int, positive_float, positive_int
+from .common import check_output_file, grid_arg, nonneg_int, positive_float, positive_int, \
+    size_arg
 from .running import add_run_args, executor_from_args, progress_from_args
 
 # The two tasks of the face issue: image side and face sizes in pixels.
@@ -58,6 +59,11 @@ def eval_fraction(text: str) -> float:
     return float(num) / float(den) if sep else float(num)
 
 
+# calibrate --resize: the relative difference of aspect ratios taken as the same (a 1000x667
+# photo is 3:2 within 0.05%, a 1024x768 frame 4:3 exactly); beyond it faces would be squashed.
+RESIZE_ASPECT_TOL = 0.02
+
+
 def add_parser(sub):
     p = sub.add_parser('calibrate', help='measure a count model of a detector behind the fovea',
                        description='Fixate every cell of labelled images, tally the detector '
@@ -73,6 +79,10 @@ def add_parser(sub):
                         help='a folder of images, labelled by --labels')
     p.add_argument('--labels', type=Path, metavar='CSV',
                    help='CSV "path,x,y" of face-centre pixels (empty x,y: no face)')
+    p.add_argument('--resize', type=size_arg, default=None, metavar='WIDTHxHEIGHT',
+                   help='--images: resize every image (and its label) to this size, for a '
+                        'folder of several sizes of one aspect ratio (within 2%%); the model is '
+                        'calibrated at it')
     p.add_argument('--task', choices=tuple(TASKS), default=None,
                    help='scene size and face sizes of --scenes: paper (420 px, faces 60-140) '
                         'or small (840 px, faces 24-140); default paper')
@@ -84,7 +94,7 @@ def add_parser(sub):
                         '(default 11x11)')
     p.add_argument('--spacing-deg', type=positive_float, default=None,
                    help='--pan-tilt: degrees between neighbouring cells (default 5)')
-    p.add_argument('--camera', type=grid_arg, default=None, metavar='WIDTHxHEIGHT',
+    p.add_argument('--camera', type=size_arg, default=None, metavar='WIDTHxHEIGHT',
                    help='--pan-tilt: camera image size in pixels (default 320x240)')
     p.add_argument('--hfov-deg', type=positive_float, default=None,
                    help='--pan-tilt: horizontal field of view, edge to edge (default 25)')
@@ -168,10 +178,13 @@ def _items(args, grid: Grid):
     labelled = read_labelled_folder(args.images, args.labels)
     if not labelled:
         raise ValueError(f'{args.labels} lists no images')
+    if args.resize is not None:
+        labelled = resize_labelled(labelled, args.resize)
     shapes = {item.image.shape[:2] for item in labelled}
     if len(shapes) > 1:
         raise ValueError(f'images must share one size to calibrate one model, got '
-                         f'{sorted(shapes)}')
+                         f'{", ".join(f"{w}x{h}" for h, w in sorted(shapes))} px (--resize '
+                         f'WIDTHxHEIGHT resizes them and their labels)')
     shape = shapes.pop()
     items = []
     for item in labelled:
@@ -180,7 +193,38 @@ def _items(args, grid: Grid):
             r, c = cell_of_point(item.centre_px[0], item.centre_px[1], shape, grid.shape)
             cell = r * grid.cols + c
         items.append((item.image, cell))
-    return items, shape, {'images': str(args.images), 'labels': str(args.labels)}
+    source = {'images': str(args.images), 'labels': str(args.labels)}
+    if args.resize is not None:
+        source['resize'] = list(args.resize)
+    return items, shape, source
+
+
+def resize_labelled(labelled, size_px: tuple[int, int], tolerance: float = RESIZE_ASPECT_TOL):
+    """
+    Return labelled images resized to ``size_px`` ``(width, height)``, their face centres too.
+
+    Each image keeps its content (no crop, no padding), so an aspect ratio more than
+    ``tolerance`` (relative) from the size's would squash the faces the model is calibrated
+    on: refused, naming the image.
+    """
+    import cv2
+    from ipomdp_gaze.vision.scenes import LabelledImage
+    width, height = size_px
+    out = []
+    for index, item in enumerate(labelled):
+        h, w = item.image.shape[:2]
+        if abs((w / h) / (width / height) - 1.0) > tolerance:
+            raise ValueError(f'--resize {width}x{height}: image {index + 1} of --labels is '
+                             f'{w}x{h} px, another aspect ratio (crop it to {width}:{height} '
+                             f'first, and move its label)')
+        shrink = width * height < w * h
+        image = item.image if (w, h) == (width, height) else cv2.resize(
+            item.image, (width, height),
+            interpolation=cv2.INTER_AREA if shrink else cv2.INTER_LINEAR)
+        centre = None if item.centre_px is None else \
+            (item.centre_px[0] * width / w, item.centre_px[1] * height / h)
+        out.append(LabelledImage(image, centre))
+    return out
 
 
 def rate_table(model, size: int = 6) -> str:
@@ -230,8 +274,8 @@ def plot_fpoc(model, path: Path, title: str) -> None:
 
 
 # Options of the image task that mean nothing for --pan-tilt, and the reverse.
-IMAGE_ONLY = ('images', 'labels', 'windows', 'scales', 'interpolation', 'absent_rate', 'task',
-              'scan_once', 'fixation_stride')
+IMAGE_ONLY = ('images', 'labels', 'resize', 'windows', 'scales', 'interpolation', 'absent_rate',
+              'task', 'scan_once', 'fixation_stride')
 PAN_TILT_ONLY = ('spacing_deg', 'camera', 'hfov_deg', 'face_px', 'null_scenes')
 IMAGE_DEFAULTS = {'windows': (21, 15, 9, 3), 'interpolation': 'area', 'absent_rate': 0.0,
                   'task': 'paper', 'scan_once': False, 'fixation_stride': 1}

@@ -7,6 +7,7 @@ import argparse
 import math
 import os
 from pathlib import Path
+import re
 
 from ipomdp_gaze.files.writable import folder_writable
 from ipomdp_gaze.model.belief import prior_from_weights
@@ -23,6 +24,15 @@ def grid_arg(text: str) -> tuple[int, int]:
         return parse_grid(text)
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def size_arg(text: str) -> tuple[int, int]:
+    """Parse an image size ``WIDTHxHEIGHT`` in pixels for argparse (two positive integers)."""
+    match = re.fullmatch(r'\s*(\d+)\s*[xX]\s*(\d+)\s*', str(text))
+    if not match or min(int(match.group(1)), int(match.group(2))) < 1:
+        raise argparse.ArgumentTypeError(f'a size must look like WIDTHxHEIGHT in pixels, e.g. '
+                                         f'640x480, got {text!r}')
+    return int(match.group(1)), int(match.group(2))
 
 
 def cell_arg(text: str):
