@@ -4,6 +4,8 @@
 from dataclasses import replace
 import itertools
 import math
+import threading
+import time
 
 from ipomdp_gaze.model.fpoc import make_fpoc
 from ipomdp_gaze.model.grid import Grid
@@ -849,3 +851,65 @@ def test_inhibition_of_return_keeps_a_many_target_search_off_the_views_it_took()
     while not session.ended:
         session.update(Frame(np.zeros(grid.n_cells)))
     assert len(session.path) >= 3 and len(set(session.path)) == len(session.path)
+
+
+CACHE_SIZE = 8          # the models information_table keeps (TABLE_CACHE_SIZE)
+
+
+def test_the_information_table_cache_is_safe_from_many_threads(monkeypatch):
+    """
+    Composed nodes on a MultiThreadedExecutor fill the cache at once (QA): no thread fails.
+
+    More models than the cache keeps, so the threads evict and insert together, and every
+    look at the cache and every build lets the other threads run (as a large grid's build
+    does): no error, every table the one built alone, never more than the cache's size.
+    """
+    grid = Grid(2, 3)
+    models = [_model(grid, seed=seed) for seed in range(3 * CACHE_SIZE // 2)]
+    alone = [InformationTable(model) for model in models]
+    sizes = []
+
+    class Cache(dict):
+        """The cache, with a thread switch between reading its oldest key and evicting it."""
+
+        def __iter__(self):
+            keys = list(super().__iter__())
+            time.sleep(0.0005)
+            return iter(keys)
+
+        def __setitem__(self, key, value):
+            super().__setitem__(key, value)
+            sizes.append(len(self))
+
+    class Build(InformationTable):
+        """A build that lets the other threads run first."""
+
+        def __init__(self, model):
+            time.sleep(0.001)
+            super().__init__(model)
+
+    monkeypatch.setattr('ipomdp_gaze.model.occupancy._TABLES', Cache())
+    monkeypatch.setattr('ipomdp_gaze.model.occupancy.InformationTable', Build)
+    threads, calls = 8, 100
+    start, errors, got = threading.Barrier(threads), [], [[] for _ in range(threads)]
+
+    def hammer(i):
+        try:
+            start.wait()
+            for n in range(calls):
+                j = (i * 5 + n) % len(models)
+                got[i].append((j, information_table(models[j])))
+        except Exception as exc:                      # noqa: B902 (any failure is the finding)
+            errors.append(exc)
+
+    workers = [threading.Thread(target=hammer, args=(i,)) for i in range(threads)]
+    for worker in workers:
+        worker.start()
+    for worker in workers:
+        worker.join()
+    assert errors == []
+    assert sum(map(len, got)) == threads * calls
+    assert max(sizes) <= CACHE_SIZE
+    for j, table in itertools.chain.from_iterable(got):
+        for name in ('table', 'offset_id', 'flat_pair', 'view_information'):
+            np.testing.assert_array_equal(getattr(table, name), getattr(alone[j], name))

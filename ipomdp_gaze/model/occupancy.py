@@ -36,6 +36,7 @@ Pure numpy (and scipy's connected components); no ROS, no policies.
 from __future__ import annotations
 
 import math
+import threading
 
 import numpy as np
 from scipy.sparse import coo_matrix
@@ -215,17 +216,34 @@ class InformationTable:
         return np.take(self.by_channel(log_odds).ravel(), flat)
 
 
+# id(model) -> (model, table) of the last TABLE_CACHE_SIZE models, oldest first; read and
+# written under _TABLES_LOCK only (composed nodes on a MultiThreadedExecutor share it).
+TABLE_CACHE_SIZE = 8
 _TABLES = {}
+_TABLES_LOCK = threading.Lock()
 
 
 def information_table(model) -> InformationTable:
-    """Return the :class:`InformationTable` of a model, built once per model (a small cache)."""
+    """
+    Return the :class:`InformationTable` of a model, built once per model (a small cache).
+
+    Safe from many threads: a table is built outside the lock (another model's caller does not
+    wait for it) and published under it; of two threads that built one model's table at once,
+    both return the one published first.
+    """
     key = id(model)
-    cached = _TABLES.get(key)
-    if cached is None or cached[0] is not model:
-        if len(_TABLES) >= 8:
-            _TABLES.pop(next(iter(_TABLES)))
-        cached = _TABLES[key] = (model, InformationTable(model))
+    with _TABLES_LOCK:
+        cached = _TABLES.get(key)
+    if cached is not None and cached[0] is model:
+        return cached[1]
+    table = InformationTable(model)
+    with _TABLES_LOCK:
+        cached = _TABLES.get(key)
+        if cached is None or cached[0] is not model:      # not published meanwhile
+            _TABLES.pop(key, None)                         # a freed model's reused id
+            while len(_TABLES) >= TABLE_CACHE_SIZE:
+                _TABLES.pop(next(iter(_TABLES)))
+            cached = _TABLES[key] = (model, table)
     return cached[1]
 
 
