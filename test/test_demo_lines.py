@@ -150,3 +150,39 @@ def test_the_annotators_subscriptions_run_under_the_nodes_guard():
     subscribed['found'](diagnostics.found_status('c: found', 1, 2, 13, 0.0, 0.0, 0.6, 20))
     assert node.guard.errors == 1 and node.guard.by_callback == {'on_found': 1}
     assert 'IndexError: a cell outside the grid' in warnings[0]
+
+
+def test_a_reset_at_a_prior_is_a_reset_for_the_watch_and_the_demo():
+    """QA: a search started at belief.prior was counted as a fixation's update (not uniform)."""
+    from ipomdp_gaze.harness.watch import is_update, SearchRecord
+    from ipomdp_gaze.model.belief import bayes_update
+    from ipomdp_gaze.model.grid import Grid
+    from ipomdp_gaze.msg_adapters import grid_arrays
+    from std_msgs.msg import Float32MultiArray
+    grid = Grid(3, 3)
+    prior = np.array([0.0, 1.0, 0.0, 1.0, 4.0, 1.0, 0.0, 1.0, 0.0]) / 8.0
+    other = np.roll(prior, 1)
+    with np.errstate(divide='ignore'):
+        after = np.exp(bayes_update(np.log(prior), np.linspace(-1.0, 1.0, 9)))
+
+    def msg(belief):
+        return grid_arrays.to_multiarray(belief, grid)            # float32, as the node sends
+
+    assert not is_update(msg(np.full(9, 1 / 9)))
+    for reset in (prior, 0.7 * prior):                             # 0.7: with absent.prior 0.3
+        assert not is_update(msg(reset), [prior])
+        assert not is_update(msg(reset), [other, prior])
+        assert is_update(msg(reset))                               # an unknown prior: as before
+        assert is_update(msg(reset), [other])
+    assert is_update(msg(after), [prior])
+    assert is_update(Float32MultiArray(data=[0.1, 0.2, 0.3, 0.4]), [prior])   # another size
+
+    kept = {}
+
+    def record(msg_type, topic, qos=10, distinct_stamps=False, keep=None):
+        kept[topic] = keep
+        return []
+
+    SearchRecord(SimpleNamespace(record=record), updates_only=True, n_cells=9, priors=[prior])
+    assert not kept['belief'](msg(prior)) and not kept['belief'](msg(np.full(9, 1 / 9)))
+    assert kept['belief'](msg(after))

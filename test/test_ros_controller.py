@@ -231,6 +231,7 @@ def test_invalid_parameters_are_rejected_with_a_reason(probe, cam, values, words
 
 def test_a_prior_set_remotely_is_where_the_next_search_starts(probe, cam):
     """belief.prior: the reset's belief is the prior, then Bayes' rule goes on from it."""
+    from ipomdp_gaze.harness.watch import is_update
     weights = np.ones(121)
     weights[:11] = 0.0                           # the top row ruled out
     weights[60] = 20.0
@@ -243,10 +244,14 @@ def test_a_prior_set_remotely_is_where_the_next_search_starts(probe, cam):
         nb, nt = len(cam.beliefs), len(cam.targets)
         assert _reset(probe).success
         assert wait_for(lambda: len(cam.beliefs) > nb and len(cam.targets) > nt, 20)
-        np.testing.assert_allclose(cam.belief(), weights / weights.sum(), rtol=1e-6)
+        prior = weights / weights.sum()
+        np.testing.assert_allclose(cam.belief(), prior, rtol=1e-6)
+        # The watch, the demo and the soak tell this reset from a fixation's update (QA).
+        assert not is_update(cam.beliefs[-1][1], [prior]) and is_update(cam.beliefs[-1][1])
         for frame in _frames(3, 2):
             got_belief, _ = cam.step_by_bayes(frame)
             assert np.all(got_belief[:11] == 0)
+            assert is_update(cam.beliefs[-1][1], [prior])
     finally:                                     # an empty array: the uniform prior again
         from rclpy.parameter import Parameter
         empty = Parameter('belief.prior', Parameter.Type.DOUBLE_ARRAY, [])

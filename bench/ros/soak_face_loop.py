@@ -74,9 +74,14 @@ class Sampler(threading.Thread):
 
 
 class Events:
-    """Fixations sent and beliefs applied, as ``(time, kind, value)``; search ends; statuses."""
+    """
+    Fixations sent and beliefs applied, as ``(time, kind, value)``; search ends; statuses.
 
-    def __init__(self, watch):
+    A reset's belief (uniform, or at one of ``priors``: the controller's ``belief.prior``) is
+    not a belief applied.
+    """
+
+    def __init__(self, watch, priors=()):
         from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
         from ipomdp_gaze.harness.watch import is_update, LATCHED
         from ipomdp_gaze.msg_adapters import diagnostics
@@ -88,7 +93,7 @@ class Events:
             self.log.append((time.monotonic(), 'fixation', tuple(msg.data)))
 
         def on_belief(msg):
-            if is_update(msg):
+            if is_update(msg, priors):
                 self.log.append((time.monotonic(), 'belief', int(np.argmax(msg.data))))
 
         def on_end(kind):
@@ -162,7 +167,7 @@ def soak(minutes: float, seed: int) -> dict:
         procs = {name: nodes.start(name, args[name])
                  for name in ('controller', 'detector', 'scene_camera')}
         with Watch(domain, 'soak', nodes) as watch:
-            events = Events(watch)
+            events = Events(watch, setup.priors)
             if not watch.wait_until(lambda: events.ends or len(events.log) > 3, 120):
                 raise RuntimeError('the loop did not start')
             sampler = Sampler({n: p.proc.pid for n, p in procs.items()})

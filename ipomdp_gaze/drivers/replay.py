@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import math
 
 from ipomdp_gaze.files.evidence_bytes import decode_evidence
-from ipomdp_gaze.model.belief import EvidenceError
+from ipomdp_gaze.model.belief import EvidenceError, is_reset_belief
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.policies.registry import build_policy
@@ -576,9 +576,7 @@ def _reset_times(bag, grid: Grid | None = None) -> list:
         data = np.asarray(m.msg.data, dtype=float)
         if grid is not None and data.size != grid.n_cells:
             continue
-        total = data.sum()
-        if np.ptp(data) == 0 or (total > 0 and any(
-                np.allclose(data / total, p, rtol=1e-5, atol=1e-9) for p in priors)):
+        if is_reset_belief(data, priors):
             out.append(m.time_ns)
     return out
 

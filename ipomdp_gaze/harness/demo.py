@@ -32,7 +32,8 @@ from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, joints
 from ipomdp_gaze.nodes import NODE_NAMES
 from ipomdp_gaze.nodes.params import joint_params
 from ipomdp_gaze.search import answer as words
-from ipomdp_gaze.search.controller_config import fpoc_from, grid_from, head_from, observation_from
+from ipomdp_gaze.search.controller_config import (fpoc_from, grid_from, head_from,
+                                                  observation_from, prior_from)
 from ipomdp_gaze.search.session import pooled_belief, SearchSettings
 from ipomdp_gaze.simulation.evaluation import answer_is_right, RIGHT_RADIUS_CELLS
 import numpy as np
@@ -67,7 +68,8 @@ class DemoSetup:
     ``image_px`` the ``(width, height)`` of the fixed scene (fovea mode, for pixel answers);
     ``scan`` whether each search starts with the one-time scan (its belief comes first);
     ``settings`` the controller's search settings (its confidence, absent prior and found
-    radius: the progress lines name the answer as the controller decides it).
+    radius: the progress lines name the answer as the controller decides it); ``prior`` its
+    ``belief.prior`` as probabilities (N,), None when uniform (a reset's belief is at it).
     """
 
     nodes: list
@@ -79,6 +81,12 @@ class DemoSetup:
     image_px: tuple | None = None
     scan: bool = False
     settings: SearchSettings = field(default_factory=SearchSettings)
+    prior: np.ndarray | None = None
+
+    @property
+    def priors(self) -> tuple:
+        """Return the priors a reset's belief may be at besides the uniform one (``is_update``)."""
+        return () if self.prior is None else (self.prior,)
 
     @property
     def tolerance_cells(self) -> int:
@@ -155,7 +163,8 @@ def demo_setup(fpoc: str = 'camera', policy: str | None = None, seed: int = 0,
     return DemoSetup([('controller', _ros_args(controller_yaml, controller)),
                       ('camera', _ros_args(camera_yaml, camera))], grid,
                      head_from(values, grid), controller,
-                     settings=SearchSettings.from_parameters(values, grid=grid))
+                     settings=SearchSettings.from_parameters(values, grid=grid),
+                     prior=prior_from(values, grid))
 
 
 def faces_setup(fovea: bool = False, policy: str | None = None, seed: int = 0,
@@ -193,7 +202,7 @@ def faces_setup(fovea: bool = False, policy: str | None = None, seed: int = 0,
                       ('detector', _ros_args(files['detector'], {})),
                       ('scene_camera', _ros_args(files['scene_camera'], camera))],
                      grid, head_from(values, grid), controller, 'faces', mode, image_px, scan,
-                     SearchSettings.from_parameters(values, grid=grid))
+                     SearchSettings.from_parameters(values, grid=grid), prior_from(values, grid))
 
 
 def _started(watch, record, node: str):
@@ -338,7 +347,7 @@ def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = 
                  for node, args in _with_recorder(setup, record, compression, pictures)]
         watch = Watch(domain, 'gaze_demo', nodes)
         record_ = SearchRecord(watch, depth=200, updates_only=True,
-                               n_cells=setup.grid.n_cells)
+                               n_cells=setup.grid.n_cells, priors=setup.priors)
         annotated = watch.record(Image, 'annotated_image', 50) if pictures is not None \
             else []
         recorder = RecorderStatus(watch) if record else None

@@ -17,6 +17,7 @@ import time
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from ipomdp_gaze.harness.processes import wait_for
+from ipomdp_gaze.model.belief import is_reset_belief
 from ipomdp_gaze.msg_adapters import diagnostics
 from ipomdp_gaze.nodes import NODE_NAMES
 import numpy as np
@@ -319,26 +320,33 @@ def _parameter_msgs(params) -> list:
     return [p.to_parameter_msg() for p in params]
 
 
-def is_update(msg: Float32MultiArray) -> bool:
-    """Whether a ``belief`` is not uniform: the result of a fixation, not a reset."""
-    return bool(np.ptp(np.asarray(msg.data)) > 0)
+def is_update(msg: Float32MultiArray, priors=()) -> bool:
+    """
+    Whether a ``belief`` is the result of a fixation, not a reset.
+
+    A reset's belief is uniform, or at the prior in force: ``priors`` are the controller's
+    ``belief.prior`` values as probabilities (N,), as replay takes the recorded ones.
+    """
+    return not is_reset_belief(msg.data, priors)
 
 
 class SearchRecord:
     """
     What the controller and the camera publish during searches, as ``(t, msg)`` lists.
 
-    ``beliefs`` (``belief``, keep-last ``depth``; with ``updates_only`` not the uniform belief of
-    a reset; with ``n_cells`` only beliefs of that many cells, not a previous run's grid),
-    ``targets`` (``pan_tilt``, latched, each sent target once), ``found``, ``absent`` and
-    ``truth`` (the camera's ``ground_truth``, latched).
+    ``beliefs`` (``belief``, keep-last ``depth``; with ``updates_only`` not the belief of a
+    reset, uniform or at one of ``priors``: :func:`is_update`; with ``n_cells`` only beliefs of
+    that many cells, not a previous run's grid), ``targets`` (``pan_tilt``, latched, each sent
+    target once), ``found``, ``absent`` and ``truth`` (the camera's ``ground_truth``, latched).
     """
 
     def __init__(self, watch: Watch, depth: int = 200, updates_only: bool = False,
-                 n_cells: int | None = None):
+                 n_cells: int | None = None, priors=()):
+        priors = tuple(priors)
+
         def keep(msg) -> bool:
             fits = n_cells is None or len(msg.data) == n_cells    # not another run's grid
-            return fits and (not updates_only or is_update(msg))
+            return fits and (not updates_only or is_update(msg, priors))
         self.beliefs = watch.record(Float32MultiArray, 'belief', depth, keep=keep)
         self.targets = watch.record(JointState, 'pan_tilt', LATCHED, distinct_stamps=True)
         self.found = watch.record(DiagnosticStatus, 'found', 10)

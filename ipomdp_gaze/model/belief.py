@@ -201,3 +201,22 @@ def prior_is_uniform(prior) -> bool:
         return True
     values = np.asarray(prior, dtype=float).reshape(-1)
     return bool(np.allclose(values, 1.0 / values.size, rtol=1e-9, atol=0.0))
+
+
+def is_reset_belief(belief, priors=()) -> bool:
+    """
+    Return whether a published belief is a reset's: uniform, or proportional to one of ``priors``.
+
+    A search starts at the prior in force (``belief.prior``, else uniform) times ``1 - absent
+    prior``, so a reset is told from a fixation's update by its shape, not its sum; ``priors``
+    are probabilities (N,) (another size never matches; float32 messages: rtol 1e-5).
+    """
+    data = np.asarray(belief, dtype=float).reshape(-1)
+    if data.size == 0:
+        return False
+    if np.ptp(data) == 0:
+        return True
+    total = data.sum()
+    return bool(total > 0 and any(
+        np.size(p) == data.size and np.allclose(data / total, np.reshape(p, -1), rtol=1e-5,
+                                                atol=1e-9) for p in priors))
