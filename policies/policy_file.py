@@ -108,7 +108,7 @@ class PolicySpec:
                 'weight': [float(w) for w in weight]}
 
     def make_policy(self, action: str | None = None):
-        """Build the policy object (:class:`ConvPolicy` or :class:`LogisticPolicy`)."""
+        """Build the policy object (:class:`ConvPolicy` or :class:`LogisticPolicy`; ``.spec``)."""
         action = self.action if action is None else action
         if self.family == 'conv':
             policy = ConvPolicy(self.grid, self.kernel, action=action)
@@ -116,6 +116,7 @@ class PolicySpec:
             policy = LogisticPolicy(self.grid, self.theta, action=action)
         if self.path is not None:
             policy.name = self.path.stem
+        policy.spec = self          # checked again against a later prior without a second read
         return policy
 
     def to_dict(self) -> dict:
@@ -469,7 +470,22 @@ def check_scene(spec: PolicySpec, scene: dict, warn: Callable[[str], None] | Non
         used = float(scene.get(key) or 0.0)
         if not math.isclose(trained, used, rel_tol=1e-9, abs_tol=1e-12):
             warn(f'{where}policy was trained with {key} {trained:g} but is used with {used:g}')
-    trained, used = spec.training.get('prior'), scene.get('prior')
+    check_training_prior(spec, scene.get('prior'), warn)
+
+
+def check_training_prior(spec: PolicySpec, prior,
+                         warn: Callable[[str], None] | None = None) -> None:
+    """
+    Report (through ``warn``) a policy used with another prior than its training's.
+
+    ``prior`` is the one it is used with: rows of cells or probabilities (N,); None or equal
+    cells is the uniform prior, as is a file without ``training.prior``. :func:`check_scene`
+    says it with the other settings; ``evaluate --scenes`` (uniform) and the gaze controller
+    (``belief.prior``) say it alone.
+    """
+    warn = _warn if warn is None else warn
+    where = f'{spec.path}: ' if spec.path is not None else ''
+    trained, used = spec.training.get('prior'), prior
     # A uniform prior given as rows of cells (train --prior of a uniform file) is the default.
     trained = None if prior_is_uniform(trained) else trained
     used = None if prior_is_uniform(used) else used

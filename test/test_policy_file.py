@@ -146,6 +146,27 @@ def test_a_policy_used_off_its_training_scenes_warns(tmp_path, capsys):
     assert 'warning' not in capsys.readouterr().err
 
 
+def test_a_policy_trained_on_a_prior_is_said_on_the_scenes_too(tmp_path, capsys):
+    """QA: evaluate --scenes (every search uniform) used a file trained on a prior silently."""
+    from dataclasses import replace
+    spec = load_policy_spec('faces-420-infomax')
+    rows = np.ones(spec.grid.shape)
+    rows[0] = 3.0                                   # the top row: 3 times any other cell
+    trained = save_policy(tmp_path / 'trained.yaml', replace(
+        spec, path=None, training={**spec.training, 'prior': (rows / rows.sum()).tolist()}))
+    plain = save_policy(tmp_path / 'plain.yaml', replace(spec, path=None))
+    said = []                                       # the words of evaluate without --scenes
+    pf.check_scene(load_policy_spec(trained), {}, said.append)
+    assert said == [f'{trained}: policy was trained with a prior that is not uniform but is '
+                    'used with the uniform one']
+    args = ['evaluate', '--scenes', 'faces-420', '--episodes', '1', '--quiet', '--policy-file']
+    assert main(args + [str(trained)]) == 0
+    err = capsys.readouterr().err
+    assert err.splitlines().count(f'ipomdp-gaze evaluate: warning: {said[0]}') == 1, err
+    assert main(args + [str(plain)]) == 0
+    assert 'warning' not in capsys.readouterr().err
+
+
 def _break(doc, change):
     doc = dict(doc)
     change(doc)

@@ -26,6 +26,7 @@ from ipomdp_gaze.drivers.tracking import (evaluate_walks, format_walks, summaris
 from ipomdp_gaze.files.observation_file import fingerprint
 from ipomdp_gaze.model.motion import Motion
 from ipomdp_gaze.model.observation import as_observation, GaussianObservation
+from ipomdp_gaze.policies.policy_file import check_training_prior, load_policy_spec
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
 from ipomdp_gaze.search.session import SearchSettings
 from ipomdp_gaze.simulation.evaluation import (decision_summary, fixations_to_90_ci,
@@ -332,6 +333,9 @@ def run_scenes(args) -> int:
         raise ValueError('--faces rooms are searched by the many-target session, which chooses '
                          'its views by its own infomax: no --policy or --policy-file (other '
                          'searchers: --compare)')
+    if spec.policy_file and not spec.rooms:
+        # Every scene starts uniform: a file trained on a prior is said, as without --scenes.
+        check_training_prior(load_policy_spec(spec.policy_file), None)
     episodes = args.episodes or 200
     if args.empty_scenes and args.scenes != 'pan-tilt':
         raise ValueError('--empty-scenes is for --scenes pan-tilt')

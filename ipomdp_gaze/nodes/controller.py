@@ -54,6 +54,7 @@ from ipomdp_gaze.model.head_time import SETTLE_TIME_S
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, people, stamps
 from ipomdp_gaze.policies.baselines import STRATEGIES
 from ipomdp_gaze.policies.conv import ACTIONS, check_kernel
+from ipomdp_gaze.policies.policy_file import check_training_prior
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnavailable
 from ipomdp_gaze.search import answer
 from ipomdp_gaze.search.controller_config import (build_config, ControllerConfig as Config,
@@ -101,6 +102,21 @@ def _same_prior(a, b) -> bool:
     if a is None or b is None:
         return a is b
     return bool(np.array_equal(a, b))
+
+
+def _say_training_prior(cfg: Config) -> None:
+    """
+    Add to ``cfg.warning`` that its policy file is used with another prior than its training's.
+
+    As ``evaluate`` says it (a policy file records ``training.prior``; without one it was
+    trained on the uniform prior); a kernel or a baseline has no training prior to compare.
+    """
+    spec = getattr(cfg.policy, 'spec', None)
+    if spec is None:
+        return
+    said = [cfg.warning] if cfg.warning else []
+    check_training_prior(spec, cfg.prior, said.append)
+    cfg.warning = '; '.join(said)
 
 
 def controller_params() -> list[Param]:
@@ -279,6 +295,9 @@ class GazeControllerNode(GuardedNode, QuietPublishers, Node):
     def _build(self, values: dict, changed=None, previous: Config | None = None) -> Config:
         """Derive a :class:`Config` from parameter values (ValueError names the problem)."""
         cfg = build_config(values, build_policy, changed, previous)
+        if previous is None or cfg.policy is not previous.policy or \
+                not _same_prior(cfg.prior, previous.prior):
+            _say_training_prior(cfg)        # once, when the policy or the prior changes
         for name in ('forward_command_topic', 'trajectory_topic'):
             if values[name]:
                 # expanded as the publisher will be ({node}, ~), so that an unknown

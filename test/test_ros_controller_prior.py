@@ -1,0 +1,89 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+The controller's ``belief.prior`` on an in-process node, against a policy file's training prior.
+
+A policy file trained on another prior than the one in force is said once, as ``evaluate``
+says it.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.ros
+WEIGHTS = [1] * 121
+WEIGHTS[60] = 11                                # the centre cell, 11 times any other
+
+
+def _node(context, **kwargs):
+    from ipomdp_gaze.nodes.controller import GazeControllerNode
+    return GazeControllerNode(context=context, **kwargs)
+
+
+def _set(node, **values):
+    from rclpy.parameter import Parameter
+    return node.set_parameters_atomically(
+        [v if isinstance(v, Parameter) else Parameter(k.replace('__', '.'), value=v)
+         for k, v in values.items()])
+
+
+def _log_until(capfd, words, timeout_s=5.0) -> str:
+    """Return this process's stderr (rcutils logs there) up to and with ``words``."""
+    import time
+    deadline, seen = time.monotonic() + timeout_s, ''
+    while words not in seen and time.monotonic() < deadline:
+        seen += capfd.readouterr().err
+        time.sleep(0.02)
+    assert words in seen, seen
+    return seen
+
+
+def test_a_policy_file_used_with_another_prior_is_said_at_start_and_on_each_change(
+        context, capfd, tmp_path):
+    """QA: evaluate warned on a policy file used off its training prior; the controller not."""
+    from ipomdp_gaze.policies.policy_file import load_policy_spec, save_policy
+    from rclpy.parameter import Parameter
+    spec = load_policy_spec('camera-11x11-infomax')
+    weights = [float(w) for w in WEIGHTS]
+    prior = np.array(weights) / sum(weights)
+    trained = save_policy(tmp_path / 'trained.yaml', replace(
+        spec, path=None, training={**spec.training, 'prior': prior.reshape(11, 11).tolist()}))
+    plain = save_policy(tmp_path / 'plain.yaml', replace(spec, path=None))
+    said = {'uniform': f'{trained}: policy was trained with a prior that is not uniform but is '
+                       'used with the uniform one',
+            'another': f'{trained}: policy was trained with another prior than the one it is '
+                       'used with',
+            'plain': f'{plain}: policy was trained with a uniform prior but is used with '
+                     'another'}
+    capfd.readouterr()
+    node = _node(context, parameter_overrides=[Parameter('policy.file', value=str(trained))])
+    try:
+        log = _log_until(capfd, 'first fixation')
+        assert log.count(said['uniform']) == 1 and 'policy learned' in log
+        # At the policy's own prior: nothing to say.
+        assert _set(node, belief__prior=weights).successful
+        log = _log_until(capfd, 'parameters set: belief.prior=')
+        assert 'policy was trained with' not in log
+        other = list(weights)
+        other[0] = 11.0
+        assert _set(node, belief__prior=other).successful
+        log = _log_until(capfd, 'parameters set: belief.prior=')
+        assert log.count(said['another']) == 1
+        # Neither the policy nor the prior changed: not said again.
+        assert _set(node, confidence=0.9).successful
+        assert 'policy was trained with' not in _log_until(capfd, 'parameters set: confidence=')
+        # A policy trained on the uniform prior, used at belief.prior.
+        assert _set(node, policy__file=str(plain)).successful
+        log = _log_until(capfd, 'parameters set: policy.file=')
+        assert log.count(said['plain']) == 1 and said['another'] not in log
+        empty = Parameter('belief.prior', Parameter.Type.DOUBLE_ARRAY, [])
+        assert _set(node, belief__prior=empty).successful
+        assert 'policy was trained with' not in _log_until(capfd, 'parameters set: belief.prior=')
+        # Back to the file trained on the prior, now used with the uniform one.
+        assert _set(node, policy__file=str(trained)).successful
+        assert _log_until(capfd, 'parameters set: policy.file=').count(said['uniform']) == 1
+    finally:
+        node.destroy_node()
