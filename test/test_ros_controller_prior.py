@@ -1,10 +1,11 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """
-The controller's ``belief.prior`` on an in-process node, against a policy file's training prior.
+The controller's ``belief.prior`` on an in-process node: as written, and against a policy file.
 
-A policy file trained on another prior than the one in force is said once, as ``evaluate``
-says it.
+Whole numbers (``-p belief.prior:=[1,2,1,...]``, YAML ``[1, 2, 1]``, a set of integers) reach
+rclpy as an integer array; the controller takes them as doubles. A policy file trained on
+another prior than the one in force is said once, as ``evaluate`` says it.
 """
 from __future__ import annotations
 
@@ -39,6 +40,49 @@ def _log_until(capfd, words, timeout_s=5.0) -> str:
         time.sleep(0.02)
     assert words in seen, seen
     return seen
+
+
+@pytest.mark.parametrize('given', ['parameter_overrides', '-p', 'params file'])
+def test_whole_numbers_for_belief_prior_are_taken_as_doubles(context, tmp_path, given):
+    """QA: -p belief.prior:=[1,2,1,...] was refused by rclpy's type check (INTEGER_ARRAY)."""
+    from rclpy.parameter import Parameter
+    text = f"[{', '.join(map(str, WEIGHTS))}]"
+    if given == 'parameter_overrides':
+        kwargs = {'parameter_overrides': [Parameter('belief.prior', value=WEIGHTS)]}
+        assert kwargs['parameter_overrides'][0].type_ == Parameter.Type.INTEGER_ARRAY
+    elif given == '-p':
+        kwargs = {'cli_args': ['--ros-args', '-p', f'belief.prior:={text.replace(" ", "")}']}
+    else:
+        path = tmp_path / 'prior.yaml'
+        path.write_text(f'/**:\n  ros__parameters:\n    belief.prior: {text}\n')
+        kwargs = {'cli_args': ['--ros-args', '--params-file', str(path)]}
+    node = _node(context, **kwargs)
+    try:
+        got = node.get_parameter('belief.prior')
+        assert got.type_ == Parameter.Type.DOUBLE_ARRAY
+        assert list(got.value) == [float(w) for w in WEIGHTS]
+        np.testing.assert_allclose(node._config.prior, np.array(WEIGHTS) / sum(WEIGHTS))
+        # At run time (a set, as ros2 param set and the parameter service make one).
+        again = WEIGHTS[::-1]
+        again[0] = 3
+        assert Parameter('belief.prior', value=again).type_ == Parameter.Type.INTEGER_ARRAY
+        result = _set(node, belief__prior=again)
+        assert result.successful, result.reason
+        assert node.get_parameter('belief.prior').type_ == Parameter.Type.DOUBLE_ARRAY
+        np.testing.assert_allclose(node._config.prior, np.array(again) / sum(again))
+        # Whole numbers go through the same checks as any weights.
+        result = _set(node, belief__prior=[-1] + WEIGHTS[1:])
+        assert not result.successful
+        assert 'belief.prior weights must be finite, >= 0' in result.reason, result.reason
+        result = _set(node, belief__prior=WEIGHTS[1:])
+        assert not result.successful and 'belief.prior must hold one weight per cell, 121 ' \
+            'values' in result.reason, result.reason
+        # A kernel of whole numbers is still refused for its type (policy.kernel: doubles).
+        result = _set(node, policy__kernel=[1] * 441)
+        assert not result.successful and 'Wrong parameter type' in result.reason
+        np.testing.assert_allclose(node._config.prior, np.array(again) / sum(again))
+    finally:
+        node.destroy_node()
 
 
 def test_a_policy_file_used_with_another_prior_is_said_at_start_and_on_each_change(

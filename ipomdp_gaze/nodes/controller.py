@@ -132,8 +132,9 @@ def controller_params() -> list[Param]:
         'start', 'the first fixation after a reset', 'the centre {}') + [
         Param('belief.prior', None, T.DOUBLE_ARRAY,
               'where the one target is a priori: a weight >= 0 per cell, rows x cols values '
-              'row-major, scaled to sum 1 (empty: uniform, the paper); from the next reset; '
-              'not with search.targets many'),
+              'row-major, scaled to sum 1 (empty: uniform, the paper; whole numbers such as '
+              '[1, 2, 1] are taken as doubles); from the next reset; not with search.targets '
+              'many', whole_numbers=True),
         Param('seed', 0, T.INTEGER, 'seed of the random and sample policies',
               int_range=(0, INT_MAX)),
         Param('settle_time_s', SETTLE_TIME_S, T.DOUBLE,
@@ -194,12 +195,12 @@ class GazeControllerNode(GuardedNode, QuietPublishers, Node):
     def __init__(self, **kwargs):
         super().__init__(NODE_NAME, **kwargs)
         self.guard = CallbackGuard(self)
-        self.add_pre_set_parameters_callback(self._pre_set)
         # At run time an unexpected error while building or applying a parameter set is
         # counted and refuses the set; at start-up (_startup_config) it ends the node.
         self._transaction = ParameterTransaction(
             self, controller_params(), self.guard.refusing(self._build),
-            self.guard.wrap(self._apply_config), self._check_while_declaring)
+            self.guard.wrap(self._apply_config), self._check_while_declaring,
+            pre_set=self._pre_set)
         self._transaction.declare()
         self._transaction.start(self._startup_config())
         cfg = self._config

@@ -39,6 +39,8 @@ class Param:
     ``ptype`` is the parameter type; ``default=None`` declares the type only and then sets an
     empty array (array parameters).
     ``choices`` restricts strings; ``float_range``/``int_range`` are enforced by rclpy itself.
+    ``whole_numbers`` (a double array): an integer array, as rcl reads ``-p name:=[1,2,1]`` or
+    YAML's ``[1, 2, 1]``, is taken as those doubles instead of refused for its type.
     """
 
     name: str
@@ -50,6 +52,13 @@ class Param:
     float_range: tuple | None = None
     int_range: tuple | None = None
     choices: tuple | None = None
+    whole_numbers: bool = False
+
+    def taken(self, parameter: Parameter) -> Parameter:
+        """Return ``parameter`` as it is declared: with ``whole_numbers``, integers as doubles."""
+        if self.whole_numbers and parameter.type_ == T.INTEGER_ARRAY:
+            return Parameter(parameter.name, T.DOUBLE_ARRAY, [float(v) for v in parameter.value])
+        return parameter
 
     def descriptor(self) -> ParameterDescriptor:
         """Build the ``ParameterDescriptor`` to declare with."""
@@ -235,24 +244,35 @@ class ParameterTransaction:
     while_declaring : callable, optional
         ``while_declaring(params)``, raising ``ValueError`` for an override that the parameters
         declared so far already rule out (until :attr:`ready`, nothing is built).
+    pre_set : callable, optional
+        The node's own pre-set step, ``pre_set(params) -> params`` (rclpy would join the lists
+        of two pre-set callbacks), run after whole numbers become doubles (:meth:`Param.taken`).
 
     """
 
-    def __init__(self, node, params: list[Param], build, apply, while_declaring=None):
+    def __init__(self, node, params: list[Param], build, apply, while_declaring=None,
+                 pre_set=None):
         self.node = node
         self.params = params
         self._by_name = {p.name: p for p in params}
         self._build = build
         self._apply = apply
         self._while_declaring = while_declaring
+        self._node_pre_set = pre_set
         self.ready = False
         self.config = None
         self._pending = None
+        node.add_pre_set_parameters_callback(self._pre_set)
         node.add_on_set_parameters_callback(self._on_set)
         node.add_post_set_parameters_callback(self._post_set)
 
     def declare(self) -> None:
         """Declare every parameter (YAML and ``-p`` overrides go through the callbacks)."""
+        # rclpy checks an override's type before any callback (no pre-set while declaring).
+        overrides = self.node._parameter_overrides
+        for name, given in list(overrides.items()):
+            if name in self._by_name:
+                overrides[name] = self._by_name[name].taken(given)
         declare(self.node, self.params)
 
     def values(self) -> dict:
@@ -263,6 +283,11 @@ class ParameterTransaction:
         """Take ``config`` as the one in force and build every later change."""
         self.config = config
         self.ready = True
+
+    def _pre_set(self, params: list[Parameter]) -> list[Parameter]:
+        params = [self._by_name[p.name].taken(p) if p.name in self._by_name else p
+                  for p in params]
+        return params if self._node_pre_set is None else self._node_pre_set(params)
 
     def _on_set(self, params: list[Parameter]) -> SetParametersResult:
         if all(p.name.startswith(QOS_OVERRIDES) for p in params):
