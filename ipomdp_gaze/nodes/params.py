@@ -268,8 +268,9 @@ class ParameterTransaction:
 
     def declare(self) -> None:
         """Declare every parameter (YAML and ``-p`` overrides go through the callbacks)."""
-        # rclpy checks an override's type before any callback (no pre-set while declaring).
-        overrides = self.node._parameter_overrides
+        # rclpy checks an override's type before any callback (no pre-set while declaring);
+        # its overrides are a private dict (rclpy 7): without it, whole numbers stay refused.
+        overrides = getattr(self.node, '_parameter_overrides', None) or {}
         for name, given in list(overrides.items()):
             if name in self._by_name:
                 overrides[name] = self._by_name[name].taken(given)
