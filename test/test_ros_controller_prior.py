@@ -77,9 +77,16 @@ def test_whole_numbers_for_belief_prior_are_taken_as_doubles(context, tmp_path, 
         result = _set(node, belief__prior=WEIGHTS[1:])
         assert not result.successful and 'belief.prior must hold one weight per cell, 121 ' \
             'values' in result.reason, result.reason
-        # A kernel of whole numbers is still refused for its type (policy.kernel: doubles).
-        result = _set(node, policy__kernel=[1] * 441)
-        assert not result.successful and 'Wrong parameter type' in result.reason
+        # Every double array takes whole numbers: a kernel, the false-alarm scales.
+        kernel = [0] * 441
+        kernel[220] = 1
+        result = _set(node, policy__kernel=kernel)
+        assert result.successful, result.reason
+        got = node.get_parameter('policy.kernel')
+        assert got.type_ == Parameter.Type.DOUBLE_ARRAY and list(got.value) == kernel
+        # (the scales reach the settings check, past rclpy's type check: counts only)
+        result = _set(node, search__false_alarm_scales=[1, 2, 4])
+        assert not result.successful and 'needs a count model' in result.reason, result.reason
         np.testing.assert_allclose(node._config.prior, np.array(again) / sum(again))
     finally:
         node.destroy_node()

@@ -134,7 +134,7 @@ def controller_params() -> list[Param]:
               'where the one target is a priori: a weight >= 0 per cell, rows x cols values '
               'row-major, scaled to sum 1 (empty: uniform, the paper; whole numbers such as '
               '[1, 2, 1] are taken as doubles); from the next reset; not with search.targets '
-              'many', whole_numbers=True),
+              'many'),
         Param('seed', 0, T.INTEGER, 'seed of the random and sample policies',
               int_range=(0, INT_MAX)),
         Param('settle_time_s', SETTLE_TIME_S, T.DOUBLE,

@@ -39,8 +39,8 @@ class Param:
     ``ptype`` is the parameter type; ``default=None`` declares the type only and then sets an
     empty array (array parameters).
     ``choices`` restricts strings; ``float_range``/``int_range`` are enforced by rclpy itself.
-    ``whole_numbers`` (a double array): an integer array, as rcl reads ``-p name:=[1,2,1]`` or
-    YAML's ``[1, 2, 1]``, is taken as those doubles instead of refused for its type.
+    A double array takes an integer array, as rcl reads ``-p name:=[1,2,1]`` or YAML's
+    ``[1, 2, 1]``, as those doubles instead of refusing it for its type (:meth:`taken`).
     """
 
     name: str
@@ -52,11 +52,10 @@ class Param:
     float_range: tuple | None = None
     int_range: tuple | None = None
     choices: tuple | None = None
-    whole_numbers: bool = False
 
     def taken(self, parameter: Parameter) -> Parameter:
-        """Return ``parameter`` as it is declared: with ``whole_numbers``, integers as doubles."""
-        if self.whole_numbers and parameter.type_ == T.INTEGER_ARRAY:
+        """Return ``parameter`` as it is declared: for a double array, whole numbers as doubles."""
+        if self.ptype == T.DOUBLE_ARRAY and parameter.type_ == T.INTEGER_ARRAY:
             return Parameter(parameter.name, T.DOUBLE_ARRAY, [float(v) for v in parameter.value])
         return parameter
 
