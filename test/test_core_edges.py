@@ -152,3 +152,21 @@ def test_whole_floats_and_numpy_integers_still_name_cells():
     assert grid.cell(np.float64(4.0)) == (1, 1)
     with pytest.raises(ValueError, match='whole number'):
         grid.cell(1.7)
+
+
+def test_a_simulation_refuses_a_dprime_whose_drawn_frames_overflow():
+    # The simulator applies its own frames unchecked: past about 1.9e154, d (o - d/2) is +/-inf
+    # and the belief NaN, and every search was scored wrong without a word (evaluate printed
+    # "never" for a camera that sees perfectly); from about 1e153 the reward was NaN.
+    from ipomdp_gaze.policies.baselines import MapPolicy
+    from ipomdp_gaze.simulation.simulate import simulate
+    grid = Grid(3, 3, 1.0)
+
+    def camera(dprime):
+        return make_fpoc('camera', dprime=dprime, half_width_deg=1, half_height_deg=1)
+    for dprime in (1e154, 1e155):
+        with pytest.raises(ValueError, match="d' up to 1e\\+150 can be simulated"):
+            simulate(grid, camera(dprime), MapPolicy(), episodes=20, seed=0)
+    result = simulate(grid, camera(1e150), MapPolicy(), episodes=20, seed=0)
+    assert result.correct[:, -1].all()          # a perfect camera: every search ends right
+    assert np.isfinite(result.infomax).all()

@@ -38,6 +38,10 @@ MATRIX_MAX_CELLS = 4096
 ROW_MAX_CELLS = 256
 # Log-likelihood ratio of a count one hypothesis forbids: decisive, but finite.
 MAX_LOG_RATIO = 50.0
+# Largest d' the simulator draws frames for: a frame's term d (o - d/2) overflows from about
+# d' = 1.9e154, and from about 1e153 a few frames push the log belief to -inf, where the reward
+# sum B log B is NaN (0 * -inf); at 1e150 that takes ~1e8 frames.
+SAMPLE_MAX_DPRIME = 1e150
 
 
 def _numbers(observation) -> np.ndarray:
@@ -213,6 +217,20 @@ class GaussianObservation:
                 return self.dprime_by_fixation()[_fixation_index(self.grid, fixation)]
             return self.dprime_window(fixation).reshape(-1)
         return self.dprime_by_fixation()[np.asarray(fixation, dtype=np.intp)]
+
+    def check_sampling(self) -> None:
+        """
+        Refuse (ValueError) a d' so large that a frame drawn by :meth:`sample` overflows.
+
+        The simulator and training apply drawn frames unchecked (``validate=False``): far above
+        :data:`SAMPLE_MAX_DPRIME` the term ``d (o - d/2)`` of such a frame is +/-inf, the log
+        belief turns to NaN (inf - inf) and every guess is scored wrong without a word.
+        """
+        d_max = float(self.table.max())
+        if d_max > SAMPLE_MAX_DPRIME:
+            raise ValueError(f"d' up to {SAMPLE_MAX_DPRIME:g} can be simulated, the FPOC gives "
+                             f"{d_max:.6g}: the drawn frames' terms d (o - d/2) would overflow "
+                             'float64 (or push the log belief to -inf)')
 
     def observed(self, fixation: int) -> np.ndarray:
         """Cells a frame from ``fixation`` says anything about (``d' > 0``), shape (N,)."""

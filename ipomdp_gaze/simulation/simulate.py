@@ -161,7 +161,12 @@ def rollout(model, beliefs: BatchBelief, where: np.ndarray, present, horizon: in
     ``record(t, k, gain, where)`` gets with the belief after the update; then, with a
     ``motion``, the targets step (``steps(t)``) and the belief is predicted (``predict``). After
     the last fixation the targets step only with ``move_after_last`` (training's draw order).
+    A Gaussian model whose drawn frames would overflow is refused first (ValueError): the
+    frames are applied unchecked.
     """
+    check = getattr(model, 'check_sampling', None)
+    if check is not None:
+        check()
     for t in range(horizon):
         k = choose(t)
         frames = model.sample(where, k, noise(t), present=present)
