@@ -36,6 +36,23 @@ def test_human_foveal_dprime_is_met_up_to_the_top_of_its_range():
     assert values.max() == pytest.approx(3.53, abs=0.01) and ecc[values.argmax()] > 0.3
 
 
+@pytest.mark.filterwarnings('error')
+def test_human_is_zero_at_any_far_eccentricity():
+    """
+    From about 6e307 degrees 2.8 e overflowed: d' was NaN, with a warning (QA).
+
+    ``search --spacing-deg 1e308`` then failed on an ELM "kernel" of NaN, and evaluate scored
+    every search wrong without a word; an offset past the largest double is infinitely far.
+    """
+    far = np.array([1e3, 6e307, 1e308, np.finfo(float).max, np.inf])
+    np.testing.assert_array_equal(HumanFPOC().of_eccentricity(far), 0.0)
+    grid = Grid(3, 3, 1e308)
+    table = dprime_table(grid, HumanFPOC())
+    assert table[2, 2] == pytest.approx(2.0)
+    np.testing.assert_array_equal(np.delete(table.ravel(), 12), 0.0)
+    assert grid.offsets_deg(0)[0][2] == np.inf         # two columns of 1e308 degrees
+
+
 def test_exponential():
     f = make_fpoc('exponential')
     assert f(1.5, 0) == pytest.approx(2.0 * np.exp(-1))

@@ -98,7 +98,10 @@ class HumanFPOC(FPOC):
     def of_eccentricity(self, ecc_deg) -> np.ndarray:
         """Evaluate d' as a function of eccentricity in degrees."""
         ecc = np.asarray(ecc_deg, dtype=float)
-        steep = 2.8 * ecc / (ecc + 0.8) + 2.0
+        with np.errstate(over='ignore', invalid='ignore'):
+            steep = 2.8 * ecc / (ecc + 0.8) + 2.0
+        # Past about 6e307 degrees 2.8 e overflows (inf / inf at e = inf): the limit, 4.8 (d' 0).
+        steep = np.where(np.isfinite(steep), steep, 4.8)
         ratio_sq = self.contrast ** 2 / self._threshold_sq(ecc)
         miss = np.exp(-ratio_sq ** (steep / 2.0))
         # f = 0.5 + 0.5 (1 - miss) = 1 - miss / 2; Phi^-1(1 - x) = -Phi^-1(x) keeps precision.

@@ -104,7 +104,8 @@ class Grid:
         """Offsets ``(dx, dy)`` in degrees of every cell seen from ``fixation``, shape (N,)."""
         rf, cf = self.cell(fixation)
         r, c = self.rows_cols()
-        return self.spacing_deg * (c - cf), self.spacing_deg * (r - rf)
+        with np.errstate(over='ignore'):        # past the largest double: infinitely far, d' 0
+            return self.spacing_deg * (c - cf), self.spacing_deg * (r - rf)
 
     def fixation_window(self, table: np.ndarray, row: int, col: int) -> np.ndarray:
         """
@@ -126,7 +127,8 @@ class Grid:
         """
         dr = np.arange(-(self.rows - 1), self.rows)
         dc = np.arange(-(self.cols - 1), self.cols)
-        dy, dx = np.meshgrid(self.spacing_deg * dr, self.spacing_deg * dc, indexing='ij')
+        with np.errstate(over='ignore'):        # past the largest double: infinitely far, d' 0
+            dy, dx = np.meshgrid(self.spacing_deg * dr, self.spacing_deg * dc, indexing='ij')
         return dx, dy
 
     def pair_offset_index(self) -> tuple[np.ndarray, np.ndarray]:
