@@ -170,3 +170,15 @@ def test_a_simulation_refuses_a_dprime_whose_drawn_frames_overflow():
     result = simulate(grid, camera(1e150), MapPolicy(), episodes=20, seed=0)
     assert result.correct[:, -1].all()          # a perfect camera: every search ends right
     assert np.isfinite(result.infomax).all()
+
+
+@pytest.mark.filterwarnings('error')
+def test_elm_refuses_a_dprime_whose_square_overflows_in_one_line():
+    # search --fpoc camera --fpoc-param dprime=1e300 printed numpy's two lines ("overflow
+    # encountered in square", "return self.table ** 2") before its error.
+    from ipomdp_gaze.policies.baselines import ELMPolicy
+    grid = Grid(3, 3, 1.0)
+    fpoc = make_fpoc('camera', dprime=1e300, half_width_deg=1, half_height_deg=1)
+    assert np.isinf(GaussianObservation(grid, fpoc).elm_kernel()).any()
+    with pytest.raises(ValueError, match='kernel must be finite'):
+        ELMPolicy(grid, fpoc)

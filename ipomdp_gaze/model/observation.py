@@ -237,8 +237,14 @@ class GaussianObservation:
         return self.dprime(fixation) > 0
 
     def elm_kernel(self) -> np.ndarray:
-        """Return ELM's kernel on the offset table: ``2 KL(N(d, 1) || N(0, 1)) = d^2``."""
-        return self.table ** 2
+        """
+        Return ELM's kernel on the offset table: ``2 KL(N(d, 1) || N(0, 1)) = d^2``.
+
+        A d' above about 1.3e154 squares to inf, which the policy refuses (``kernel must be
+        finite``), without a numpy warning.
+        """
+        with np.errstate(over='ignore'):
+            return self.table ** 2
 
     # -- the model -----------------------------------------------------------------------
     def log_likelihood_ratio(self, observation, fixation, validate: bool = True) -> np.ndarray:
