@@ -220,7 +220,9 @@ class ParameterFuzz:
             ('kernel-nan', [p('policy.kernel', [nan] + kernel[1:])], False, 'must be finite'),
             ('kernel-inf', [p('policy.kernel', kernel[:-1] + [-inf])], False, 'finite'),
             ('kernel-all-nan', [p('policy.kernel', [nan] * KERNEL_SIZE)], False, 'finite'),
-            ('kernel-ints', [p('policy.kernel', [1] * KERNEL_SIZE)], False, 'Wrong parameter'),
+            ('kernel-ints', [p('policy.kernel', [int(v) for v in rng.integers(-3, 4,
+                                                                              KERNEL_SIZE)])],
+             True, ''),                                 # whole numbers: taken as doubles
             ('kernel-string', [p('policy.kernel', 'zeros')], False, 'Wrong parameter'),
             ('kernel-bools', [p('policy.kernel', [True] * KERNEL_SIZE)], False, 'Wrong'),
             ('grid-rows', [p('grid.rows', int(rng.integers(1, 300)))], False, 'read-only'),
