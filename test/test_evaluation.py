@@ -168,3 +168,27 @@ def test_chance_is_percent_correct_before_the_first_fixation():
     correct = np.ones((20, 3), dtype=bool)
     assert fixations_to_90_ci(correct, 10, np.random.default_rng(0), 50,
                               chance=1.0) == (0.0, (0.0, 0.0))
+
+
+def test_one_episode_gives_no_interval_rather_than_one_of_no_width():
+    """Every resample of one episode is that episode: [x, x] would be no 95% interval."""
+    correct = np.arange(1, 13)[None, :] >= np.array([[4]])
+    point, ci = fixations_to_90_ci(correct, 100, np.random.default_rng(0), 200)
+    assert point == pytest.approx(3.9) and ci is None       # between fixations 3 (0) and 4 (1)
+    other = np.arange(1, 13)[None, :] >= np.array([[6]])
+    diff, ci = paired_difference_ci(other, correct, 100, np.random.default_rng(0), 200)
+    assert diff == pytest.approx(2.0) and ci is None
+    two = np.concatenate([correct, other])
+    assert fixations_to_90_ci(two, 100, np.random.default_rng(0), 200)[1] is not None
+
+
+def test_one_search_gives_no_tracking_interval():
+    from types import SimpleNamespace
+    from ipomdp_gaze.simulation.evaluation import paired_tracking_difference, tracking_summary
+    one = SimpleNamespace(target_path=np.array([[0] * 4]), guess=np.array([[0, 0, 20, 0]]),
+                          present=None)
+    other = SimpleNamespace(target_path=one.target_path, guess=np.array([[0] * 4]), present=None)
+    summary = tracking_summary(one, 5, np.random.default_rng(0))['tracking_accuracy']
+    assert summary['value'] == pytest.approx(2 / 3) and summary['ci95'] is None
+    paired = paired_tracking_difference(one, other, 5, np.random.default_rng(0))
+    assert paired['difference'] == pytest.approx(-1 / 3) and paired['ci95'] is None

@@ -81,13 +81,16 @@ def fixations_to_90_ci(correct: np.ndarray, n_cells: int, rng: np.random.Generat
 
     Returns
     -------
-    (estimate, (low, high)) with ``None`` where 90% is not reached.
+    (estimate, (low, high)) with ``None`` where 90% is not reached, and no interval (None) from
+    fewer than :data:`MIN_EPISODES` episodes.
 
     """
     episodes = correct.shape[0]
     point = fixations_to_level(correct.mean(axis=0), n_cells, chance=chance)
     if point is None:
         return None, None
+    if episodes < MIN_EPISODES:
+        return point, None
     if counts is None:
         counts = bootstrap_counts(episodes, resamples, rng)
     # Whole counts, exact in float32 (below 2^24); divided in float64 as the point estimate's
@@ -102,6 +105,9 @@ def fixations_to_90_ci(correct: np.ndarray, n_cells: int, rng: np.random.Generat
 # Stands for "beyond the horizon" in a bootstrap interval (_interval): finite, so interpolating
 # towards it stays a number, and far above any number of fixations.
 BEYOND = 1e300
+# Every resample of one episode is that episode: its bootstrap "interval" has no width, which is
+# no 95% interval. Fewer episodes (searches) than this give none (None), as mean_ci does.
+MIN_EPISODES = 2
 
 
 def _interval(low_values: np.ndarray, high_values: np.ndarray):
@@ -133,7 +139,8 @@ def paired_difference_ci(correct_a: np.ndarray, correct_b: np.ndarray, n_cells: 
 
     Both are measured on the first ``n = min`` episodes; each bootstrap resample weights the same
     episodes of a and b (``counts``, shape (resamples, n), drawn from ``rng`` when omitted).
-    ``chance``: percent correct at t = 0 (:func:`fixations_to_level`).
+    ``chance``: percent correct at t = 0 (:func:`fixations_to_level`). No interval (None) from
+    fewer than :data:`MIN_EPISODES` episodes.
     """
     n = min(correct_a.shape[0], correct_b.shape[0])
     a, b = correct_a[:n], correct_b[:n]
@@ -141,6 +148,8 @@ def paired_difference_ci(correct_a: np.ndarray, correct_b: np.ndarray, n_cells: 
     pb = fixations_to_level(b.mean(axis=0), n_cells, chance=chance)
     if pa is None or pb is None:
         return None, None
+    if n < MIN_EPISODES:
+        return pa - pb, None
     if counts is None:
         counts = bootstrap_counts(n, resamples, rng)
     counts = counts.astype(np.float32)
@@ -358,7 +367,7 @@ def tracking_summary(result, cols: int, rng: np.random.Generator, resamples: int
     total = int(after.sum())
     accuracy = float(hits.sum() / total) if total else None
     ci = None
-    if total:
+    if total and first.size >= MIN_EPISODES:
         boot = _ratio_bootstrap([hits.astype(float)], [after.astype(float)], rng, resamples)[0]
         ci = [float(x) for x in np.nanpercentile(boot, [2.5, 97.5])]
     return {'locked': rate(first[present] > 0), 'first_lock': mean_ci(first[first > 0]),
@@ -381,6 +390,8 @@ def paired_tracking_difference(result_a, result_b, cols: int, rng: np.random.Gen
     if not after_a.sum() or not after_b.sum():
         return {'difference': None, 'ci95': None}
     point = hits_a.sum() / after_a.sum() - hits_b.sum() / after_b.sum()
+    if n < MIN_EPISODES:
+        return {'difference': float(point), 'ci95': None}
     boot = _ratio_bootstrap([hits_a.astype(float), hits_b.astype(float)],
                             [after_a.astype(float), after_b.astype(float)], rng, resamples)
     low, high = np.nanpercentile(boot[0] - boot[1], [2.5, 97.5])
