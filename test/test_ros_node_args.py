@@ -162,3 +162,25 @@ def test_a_namespaced_node_takes_the_shipped_values(context, name, node_class):
                 == value, key
     finally:
         node.destroy_node()
+
+
+@pytest.mark.parametrize('nodes, fault', [
+    ('[gaze controller]', "'gaze controller' is not a node name"),
+    ('[gaze_controller, 9x]', "'9x' is not a node name"),
+])
+def test_a_recorder_node_name_it_cannot_ask_ends_it_with_one_line(
+        ros_env, tmp_path, nodes, fault):
+    """
+    QA: a name in ``nodes`` the recorder cannot make a parameter client for.
+
+    It was taken at start-up; half a second later the first ask raised out of the spin
+    (InvalidServiceNameException, a traceback) and left a bag begun.
+    """
+    run = _cli(ros_env, 'record', str(tmp_path / 'bag'), '--ros-args', '-p', f'nodes:={nodes}',
+               '-p', 'topics:=[belief]', timeout=30)
+    assert run.returncode == 1, run.stdout + run.stderr
+    assert 'Traceback' not in run.stderr, run.stderr
+    lines = run.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith('recorder: error: nodes: '), lines
+    assert fault in lines[0]
+    assert not (tmp_path / 'bag').exists()

@@ -47,10 +47,14 @@ from geometry_msgs.msg import PoseArray
 from ipomdp_gaze.msg_adapters import diagnostics
 from rcl_interfaces.msg import ParameterEvent
 from rcl_interfaces.srv import GetParameters, ListParameters
+from rclpy.exceptions import NameValidationException
+from rclpy.expand_topic_name import expand_topic_name
 from rclpy.node import Node
 from rclpy.parameter import parameter_value_to_python
 from rclpy.qos import DurabilityPolicy, qos_profile_parameter_events, QoSProfile, \
     ReliabilityPolicy
+from rclpy.validate_full_topic_name import validate_full_topic_name
+from rclpy.validate_topic_name import validate_topic_name
 from sensor_msgs.msg import CameraInfo, Image, JointState
 from std_msgs.msg import Float32MultiArray, Float64MultiArray, Int32MultiArray
 import yaml
@@ -209,7 +213,26 @@ class RecorderNode(QuietPublishers, Node):
         if unknown:
             raise ValueError(f"topics: unknown {', '.join(unknown)}; known: "
                              f"{', '.join(TOPICS)}")
+        for node in values['nodes']:
+            self._check_node_name(node)
         return dict(values)
+
+    def _check_node_name(self, node: str) -> None:
+        """
+        Refuse a name of ``nodes`` whose parameter services cannot be named (ValueError).
+
+        Checked as ``create_client`` checks it, which the first ask would otherwise do in a
+        timer: an exception out of the spin, with a traceback and the bag begun.
+        """
+        service = f'{node_name(node, self.get_namespace())}/list_parameters'
+        try:
+            validate_topic_name(service, is_service=True)
+            validate_full_topic_name(expand_topic_name(
+                service, self.get_name(), self.get_namespace()), is_service=True)
+        except (NameValidationException, ValueError) as exc:
+            # rclpy adds the name again with a caret under the fault: its first line only
+            reason = str(exc).split('\n')[0].rstrip(':')
+            raise ValueError(f'nodes: {node!r} is not a node name ({reason})') from None
 
     def _writer_for(self, topic: str):
         connection = self.connections[topic]
