@@ -471,3 +471,52 @@ def test_a_volatile_teleop_is_recorded_with_the_recorders_qos_overridden(context
         executor.shutdown()
         teleop.destroy_node()
         recorder.destroy_node()
+
+
+def test_a_write_that_fails_is_counted_and_survived_and_so_is_the_close(context, tmp_path):
+    """
+    QA: the recorder's callbacks were not guarded.
+
+    On a full disk (``OSError: [Errno 27] File too large`` under ``ulimit -f``) the write raised
+    out of the spin and ended the node with a traceback, and closing the bag raised a second.
+    """
+    from ipomdp_gaze.nodes.recorder import RecorderNode
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+    from std_msgs.msg import Float32MultiArray
+    source = Node('full_disk_source', context=context)
+    recorder = RecorderNode(context=context, parameter_overrides=[
+        Parameter('path', value=str(tmp_path / 'bag')), Parameter('topics', value=['belief']),
+        Parameter('nodes', value=['full_disk_source'])])
+    belief = source.create_publisher(Float32MultiArray, 'belief', 10)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(source)
+    executor.add_node(recorder)
+    write, failed = recorder.writer.write, []
+
+    def full(*args):
+        failed.append(args)
+        raise OSError(27, 'File too large')
+    try:
+        _spin_until(executor, lambda: belief.get_subscription_count() > 0, 20.0)
+        recorder.writer.write = full
+        belief.publish(Float32MultiArray(data=[1.0]))
+        _spin_until(executor, lambda: failed, 10.0)
+        assert failed and recorder.guard.errors == 1
+        assert recorder.guard.by_callback['write'] == 1
+        assert 'File too large' in recorder.guard.last_error
+        recorder.writer.write = write                   # space again: the node goes on
+        belief.publish(Float32MultiArray(data=[2.0]))
+        _spin_until(executor, lambda: recorder.counts['belief'] == 1, 10.0)
+        assert recorder.counts['belief'] == 1
+    finally:
+        executor.shutdown()
+        writer = recorder.writer
+
+        def close():
+            raise OSError(27, 'File too large')
+        if writer is not None:
+            writer.close = close
+        recorder.destroy_node()                         # logs, does not raise
+        source.destroy_node()

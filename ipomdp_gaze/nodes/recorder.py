@@ -60,6 +60,7 @@ from std_msgs.msg import Float32MultiArray, Float64MultiArray, Int32MultiArray
 import yaml
 
 from . import NODE_NAMES
+from .guard import CallbackGuard
 from .outputs import QuietPublishers
 from .params import Param, ParameterTransaction, T
 from .qos import command_subscription
@@ -171,6 +172,9 @@ class RecorderNode(QuietPublishers, Node):
         # executor these run at once, so each holds this lock (a writer of None: destroyed).
         self._bag_lock = threading.Lock()
         super().__init__(NODE_NAME, **kwargs)
+        # A write that fails (the disk is full) is counted, logged and survived, as every
+        # node's callbacks are; the count is in the recording status.
+        self.guard = guard = CallbackGuard(self)
         self._transaction = ParameterTransaction(self, recorder_params(), self._build,
                                                  lambda old, new: None)
         self._transaction.declare()
@@ -191,17 +195,19 @@ class RecorderNode(QuietPublishers, Node):
                 self.resolve_topic_name(topic), type_name)
             if topic in COMMAND_TOPICS:
                 self.subscriptions_[topic] = command_subscription(
-                    self, msg_type, topic, self._writer_for(topic), qos, raw=True)
+                    self, msg_type, topic, guard.wrap(self._writer_for(topic), 'write'), qos,
+                    raw=True)
             else:
                 self.subscriptions_[topic] = self.create_subscription(
-                    msg_type, topic, self._writer_for(topic), qos, raw=True)
+                    msg_type, topic, guard.wrap(self._writer_for(topic), 'write'), qos, raw=True)
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
-        self.create_timer(values['diagnostics_period_s'], self._publish_diagnostics)
+        self.create_timer(values['diagnostics_period_s'], guard.wrap(self._publish_diagnostics))
         self.parameters: dict = {}
         self._pending = list(values['nodes'])
         self._asked = {}
         self._parameter_clients = {}
-        self._parameter_timer = self.create_timer(PARAMETER_RETRY_S, self._ask_parameters)
+        self._parameter_timer = self.create_timer(PARAMETER_RETRY_S,
+                                                  guard.wrap(self._ask_parameters))
         self.get_logger().info(f"recording {', '.join(values['topics'])} to {values['path']}")
 
     def _build(self, values: dict, changed=None, previous=None) -> dict:
@@ -339,9 +345,13 @@ class RecorderNode(QuietPublishers, Node):
                 values[f'messages_{name}'] = self.counts[topic]
                 values[f'publishers_{name}'] = sub.get_publisher_count()
             values['parameters_of'] = ','.join(sorted(self.parameters))
+            values.update(self.guard.values())
+            message = f'{sum(self.counts.values())} messages'
+            if self.guard.errors:
+                message += f'; {self.guard.errors} callback errors: {self.guard.last_error}'
             self._diag_pub.publish(diagnostics.diagnostic_array(
-                [diagnostics.status(f'{self.get_fully_qualified_name()}: recording', 'ok',
-                                    f'{sum(self.counts.values())} messages', values)],
+                [diagnostics.status(f'{self.get_fully_qualified_name()}: recording',
+                                    'warn' if self.guard.errors else 'ok', message, values)],
                 self.get_clock().now().to_msg()))
 
     def destroy_node(self):
@@ -355,7 +365,10 @@ class RecorderNode(QuietPublishers, Node):
         with self._bag_lock:
             writer, self.writer = getattr(self, 'writer', None), None
             if writer is not None:
-                writer.close()
+                try:
+                    writer.close()
+                except OSError as exc:      # the disk is full: the node still goes down
+                    self.get_logger().error(f'could not close the bag: {exc}')
         return super().destroy_node()
 
 
