@@ -118,3 +118,41 @@ def wait_log(capfd, words, timeout_s=5.0) -> bool:
         if words in seen or time.monotonic() > deadline:
             return words in seen
         time.sleep(0.05)
+
+
+def _declared_with(ros_env, ros_args):
+    """Declare two arrays with defaults on a node given ``ros_args``; return node and values."""
+    import rclpy
+    from ipomdp_gaze.nodes.params import Param, ParameterTransaction, T
+    from rclpy.node import Node
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=int(ros_env['ROS_DOMAIN_ID']),
+               args=['node', '--ros-args', *ros_args])
+    node = Node('empty_arrays', context=context)
+    params = [Param('scales', [1.0], T.DOUBLE_ARRAY, 'factors'),
+              Param('names', ['a'], T.STRING_ARRAY, 'names (read-only)', read_only=True)]
+    try:
+        tx = ParameterTransaction(node, params, lambda values, *_: values, lambda *_: None)
+        tx.declare()
+        return {p.name: node.get_parameter(p.name) for p in params}
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)
+
+
+def test_an_empty_list_for_an_array_with_a_default_is_its_empty_array(ros_env):
+    """
+    QA: ``-p name:=[]`` (or YAML's ``[]``) reaches rclpy as NOT_SET, without a type.
+
+    An array declared with a default then ended the node on 'The parameter ... is not
+    initialized' (``-p search.false_alarm_scales:=[]``, the recorder's ``-p nodes:=[]``),
+    instead of the node judging the empty array; a read-only one cannot be set after it is
+    declared, and says so.
+    """
+    from rclpy.parameter import Parameter
+    got = _declared_with(ros_env, ['-p', 'scales:=[]'])
+    assert got['scales'].type_ == Parameter.Type.DOUBLE_ARRAY and list(got['scales'].value) == []
+    assert list(got['names'].value) == ['a']
+    with pytest.raises(ValueError, match='names is given as an empty list.*read-only array '
+                                         'needs at least one value'):
+        _declared_with(ros_env, ['-p', 'names:=[]'])

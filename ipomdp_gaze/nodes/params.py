@@ -26,6 +26,7 @@ from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescr
 from rclpy.parameter import Parameter
 
 T = Parameter.Type
+ARRAY_TYPES = (T.BYTE_ARRAY, T.BOOL_ARRAY, T.INTEGER_ARRAY, T.DOUBLE_ARRAY, T.STRING_ARRAY)
 INT_MAX = 2 ** 31 - 1
 # Rows or columns of a grid: 256x256 (65,536 cells) is the largest grid tested under load.
 MAX_CELLS_PER_SIDE = 1024
@@ -186,12 +187,27 @@ def search_params(schema=SCHEMA) -> list[Param]:
 
 
 def declare(node, params: list[Param]) -> None:
-    """Declare every parameter (YAML and ``-p`` overrides go through the node's callbacks)."""
+    """
+    Declare every parameter (YAML and ``-p`` overrides go through the node's callbacks).
+
+    An array given as an empty list (``-p name:=[]``, YAML's ``[]``) has no type for rcl, and
+    rclpy hands it over as NOT_SET: declared with a default it was refused as 'not
+    initialized'. It is set as the declared type's empty array (the node then judges it), or,
+    for a read-only array, which can only take its override, refused with that reason.
+    """
+    overrides = getattr(node, '_parameter_overrides', None) or {}
     for p in params:
-        if p.default is None:
+        given = overrides.get(p.name)
+        empty = p.ptype in ARRAY_TYPES and given is not None and given.type_ == T.NOT_SET
+        if empty and p.default is not None and p.read_only:
+            raise ValueError(f'{p.name} is given as an empty list, which ROS cannot type: a '
+                             'read-only array needs at least one value')
+        if p.default is None or empty:
             node.declare_parameter(p.name, p.ptype, p.descriptor())
             if node.get_parameter_or(p.name).type_ == T.NOT_SET:
-                node.set_parameters([Parameter(p.name, p.ptype, [])])
+                result = node.set_parameters([Parameter(p.name, p.ptype, [])])[0]
+                if empty and not result.successful:
+                    raise ValueError(f'{p.name} []: {result.reason}')
         else:
             node.declare_parameter(p.name, p.default, p.descriptor())
 
