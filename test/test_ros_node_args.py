@@ -184,3 +184,15 @@ def test_a_recorder_node_name_it_cannot_ask_ends_it_with_one_line(
     assert len(lines) == 1 and lines[0].startswith('recorder: error: nodes: '), lines
     assert fault in lines[0]
     assert not (tmp_path / 'bag').exists()
+
+
+def test_a_scene_file_that_is_not_there_ends_the_scene_camera_with_one_line(ros_env, tmp_path):
+    """QA: OpenCV's imread printed its own 'can't open/read file' warning before our line."""
+    missing = tmp_path / 'no_such_scene.png'
+    run = subprocess.run([sys.executable, '-m', 'ipomdp_gaze.nodes.scene_camera', '--ros-args',
+                          '-p', f'scene.file:={missing}'], cwd=REPO, env=ros_env,
+                         capture_output=True, text=True, timeout=60)
+    assert run.returncode == 1, run.stdout + run.stderr
+    assert run.stderr.strip().splitlines() == [
+        f"scene_camera: error: scene.file '{missing}' is missing or not an image OpenCV can "
+        'read'], run.stderr

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 import math
+import os
 import time
 
 import cv2
@@ -538,7 +539,10 @@ def read_scene_file(path) -> np.ndarray:
         If the file is missing, cannot be decoded or is not 8 bits per channel.
 
     """
-    image = cv2.imread(str(path), cv2.IMREAD_ANYDEPTH | cv2.IMREAD_ANYCOLOR)
+    # Not a file: said here, because OpenCV's imread also prints a warning of its own on stderr
+    # for a path it cannot open, a second line after a start-up error's one.
+    image = cv2.imread(str(path), cv2.IMREAD_ANYDEPTH | cv2.IMREAD_ANYCOLOR) \
+        if os.path.isfile(path) else None
     if image is None:
         raise ValueError(f'scene.file {str(path)!r} is missing or not an image OpenCV can read')
     if image.dtype != np.uint8:
