@@ -22,7 +22,8 @@ The same steps and results as :class:`ipomdp_gaze.search.session.SearchSession` 
    cannot be another face): ``found``
    if a cell is occupied, else ``absent``; at the fixation budget or a driver's cost cap
    (:meth:`stop`), ``gave_up`` or, with ``decide_at_budget``, every cell by its likelier side;
-   ``gave_up`` (reason ``repeat``) when no view left would tell anything new;
+   ``gave_up`` (reason ``repeat``) when no view left would tell anything new, or, with
+   ``stop_on_repeat``, when the best view is one already taken;
 5. otherwise the next fixation maximises the expected reduction of the summed cell entropies per
    unit cost: ``argmax_k sum_j w_kj I(P(x_j); offset_jk) / cost_k`` over unvisited cells (the
    cost times the view's seconds of head time with ``search.head_speed_deg_s``), with
@@ -651,7 +652,10 @@ class OccupancySession:
             score = np.where(s['visited'], -np.inf, score)
         if not np.isfinite(score).any() or score.max() <= MIN_GAIN / costs.min():
             return None
-        return int(argmax_ties_low(score))
+        choice = int(argmax_ties_low(score))
+        if self.settings.stop_on_repeat and s['visited'][choice]:
+            return None                 # give up (repeat) rather than look at a cell again
+        return choice
 
     def _active_clutter(self) -> ClutterMap | None:
         """Return the clutter map of moving targets with search.hotspot_prior > 0 (counts only)."""

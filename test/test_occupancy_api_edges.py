@@ -1,0 +1,44 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""The many-target session's Python API at its edges (a researcher's QA run)."""
+from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import CountObservation
+from ipomdp_gaze.search.many import OccupancySession
+from ipomdp_gaze.search.sensors import run_search
+from ipomdp_gaze.search.session import Frame, SearchSettings
+import numpy as np
+
+
+def _model(grid):
+    pt = np.tile([0.1, 0.2, 0.7], grid.shape + (1,))
+    pn = np.tile([0.8, 0.15, 0.05], grid.shape + (1,))
+    return CountObservation(grid, pt, pn)
+
+
+class _Blind:
+    """A camera whose detector returns nothing: every cell NaN, so nothing is ever learnt."""
+
+    scans = False
+
+    def __init__(self, grid):
+        self.grid, self.frames = grid, 0
+
+    def start(self, scene):
+        pass
+
+    def observe(self, cell):
+        self.frames += 1
+        if self.frames > 50:
+            raise RuntimeError('the search did not end')
+        return Frame(np.full(self.grid.n_cells, np.nan))
+
+
+def test_stop_on_repeat_gives_up_before_a_second_look_at_a_cell():
+    """run_search ends a search by stop_on_repeat alone; the many-target session ignored it."""
+    grid = Grid(3, 3)
+    session = OccupancySession(grid, _model(grid),
+                               SearchSettings(targets='many', stop_on_repeat=True))
+    out = run_search(session, _Blind(grid), None)
+    # every view is alike (the same tables at every offset): the centre, then cell 0, whose
+    # view is again the best
+    assert (out.decision, out.reason, out.path) == ('gave_up', 'repeat', (4, 0))
