@@ -5,8 +5,9 @@ from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.observation import CountObservation
 from ipomdp_gaze.search.many import OccupancySession
 from ipomdp_gaze.search.sensors import run_search
-from ipomdp_gaze.search.session import Frame, SearchSettings
+from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
 import numpy as np
+import pytest
 
 
 def _model(grid):
@@ -42,3 +43,22 @@ def test_stop_on_repeat_gives_up_before_a_second_look_at_a_cell():
     # every view is alike (the same tables at every offset): the centre, then cell 0, whose
     # view is again the best
     assert (out.decision, out.reason, out.path) == ('gave_up', 'repeat', (4, 0))
+
+
+@pytest.mark.parametrize('many', [False, True])
+@pytest.mark.parametrize('cell', [1.5, '3', -1, 9, None])
+def test_fixate_refuses_a_cell_that_is_not_a_whole_index_in_the_grid(many, cell):
+    """fixate(1.5) looked at cell 1 (int() truncated), though the API refuses fractional cells."""
+    grid = Grid(3, 3)
+    model = _model(grid)
+    if many:
+        session = OccupancySession(grid, model, SearchSettings(targets='many'))
+    else:
+        session = SearchSession(grid, model, None, SearchSettings())
+    session.reset()
+    session.start()
+    with pytest.raises(ValueError):
+        session.fixate(cell)
+    assert session.fixation == 4
+    session.fixate(np.int64(2))
+    assert session.fixation == 2 and type(session.fixation) is int

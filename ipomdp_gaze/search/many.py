@@ -482,8 +482,8 @@ class OccupancySession:
         s = self._s()
         if s['fixation'] is None:
             raise OrderError('start the search before fixating')
-        self.grid.cell(int(cell))
-        s['fixation'] = int(cell)
+        row, col = self.grid.cell(cell)         # a whole index in the grid, else ValueError
+        s['fixation'] = row * self.grid.cols + col
 
     def predict(self, dt_s: float) -> None:
         """Spread the belief over ``dt_s`` of the targets' motion (nothing for still targets)."""

@@ -808,8 +808,8 @@ class SearchSession:
         search = self._state()
         if search.fixation is None:
             raise OrderError('start the search before fixating')
-        self.grid.cell(int(cell))
-        search.fixation = int(cell)
+        row, col = self.grid.cell(cell)         # a whole index in the grid, else ValueError
+        search.fixation = row * self.grid.cols + col
 
     def predict(self, dt_s: float) -> None:
         """Spread the belief over ``dt_s`` of the target's motion (nothing for a still target)."""
