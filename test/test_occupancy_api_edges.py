@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """The many-target session's Python API at its edges (a researcher's QA run)."""
+from ipomdp_gaze.model.fpoc import make_fpoc
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.observation import CountObservation
 from ipomdp_gaze.search.many import OccupancySession
@@ -62,3 +63,43 @@ def test_fixate_refuses_a_cell_that_is_not_a_whole_index_in_the_grid(many, cell)
     assert session.fixation == 4
     session.fixate(np.int64(2))
     assert session.fixation == 2 and type(session.fixation) is int
+
+
+@pytest.mark.parametrize('kwargs, match', [
+    ({'costs': [1.0, 2.0, 3.0]}, r'costs must be one number or 9 \(one per cell'),
+    ({'costs': np.ones((3, 3))}, r'costs must be one number or 9 \(one per cell'),
+    ({'costs': ['a'] * 9}, 'costs must be numbers'),
+    ({'link': -1}, 'link must be a whole number of cells >= 0'),
+    ({'link': 1.5}, 'link must be a whole number of cells >= 0'),
+    ({'link': 'a'}, 'link must be a whole number of cells >= 0'),
+])
+def test_bad_costs_and_link_are_one_clear_value_error(kwargs, match):
+    """A wrong-length costs array raised numpy's broadcast error; link -1 or 1.5 was taken."""
+    grid = Grid(3, 3)
+    with pytest.raises(ValueError, match=match):
+        OccupancySession(grid, _model(grid), SearchSettings(targets='many'), **kwargs)
+
+
+def test_gains_of_a_belief_of_another_length_is_a_value_error():
+    grid = Grid(3, 3)
+    session = OccupancySession(grid, _model(grid), SearchSettings(targets='many'))
+    session.reset()
+    with pytest.raises(ValueError, match=r'log odds must have shape \(9,\)'):
+        session.gains(np.zeros(4))
+    np.testing.assert_array_equal(session.gains(np.zeros(9)), session.gains(np.zeros((3, 3))))
+
+
+@pytest.mark.parametrize('many', [False, True])
+def test_a_scan_with_a_model_without_scan_tables_is_a_value_error(many):
+    """A model without scan tables: an AttributeError where SearchSession.scan says ValueError."""
+    grid = Grid(3, 3)
+    fpoc = make_fpoc('human')
+    if many:
+        session = OccupancySession(grid, fpoc, SearchSettings(targets='many'))
+    else:
+        session = SearchSession(grid, fpoc, None, SearchSettings())
+    session.reset()
+    with pytest.raises(ValueError, match='no scan tables'):
+        session.scan(Frame(np.zeros(9), kind='scan'))
+    if many:                        # a sensor's own log-likelihood ratios need no tables
+        assert session.scan(Frame(np.full(9, -1.0), kind='evidence')).applied

@@ -69,10 +69,11 @@ from ipomdp_gaze.model.occupancy import (binary_entropy, cell_prior, count_faces
                                          information_table, log_nobody, occupancy,
                                          predict_occupancy, prior_log_odds)
 from ipomdp_gaze.model.still_evidence import StillEvidence
-from ipomdp_gaze.search.session import (check_groups, check_offsets, check_seconds_elapsed,
-                                        Frame, motion_settings, OrderError, position_settings,
-                                        scales_false_alarms, SearchSettings, start_index,
-                                        StepResult, target_motion, track_filter)
+from ipomdp_gaze.search.session import (check_groups, check_offsets, check_scan_model,
+                                        check_seconds_elapsed, Frame, motion_settings,
+                                        OrderError, position_settings, scales_false_alarms,
+                                        SearchSettings, start_index, StepResult, target_motion,
+                                        track_filter)
 from ipomdp_gaze.search.tracks import GLANCE, Tracks, Turns
 import numpy as np
 from scipy.ndimage import maximum_filter
@@ -105,6 +106,29 @@ def check_many_settings(settings: SearchSettings, grid=None) -> None:
                          'search.hotspot_prior 0 unless the targets move')
 
 
+def check_link(link) -> int:
+    """Return ``link`` as an int: a whole number of cells >= 0 (ValueError otherwise)."""
+    try:
+        ok = not isinstance(link, bool) and int(link) == link and link >= 0
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise ValueError(f'link must be a whole number of cells >= 0, got {link!r}')
+    return int(link)
+
+
+def check_costs(costs, n_cells: int) -> np.ndarray:
+    """Return fixation costs as (N,) floats: one number for all, or one per cell (ValueError)."""
+    try:
+        values = np.asarray(costs, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f'fixation costs must be numbers, got {costs!r}') from None
+    if values.ndim > 1 or values.size not in (1, n_cells):
+        raise ValueError(f'fixation costs must be one number or {n_cells} (one per cell, '
+                         f'row-major), got shape {values.shape}')
+    return np.broadcast_to(values.reshape(-1), (n_cells,)).copy()
+
+
 # A pass's two grouped detections lying within this many cells of each other (Chebyshev, at
 # their cells plus the detections' mean offset, Frame.offsets) are one face; farther apart, two
 # people. The cells alone (within one cell: one face) merged neighbours. Training rooms, without
@@ -126,8 +150,9 @@ class OccupancySession:
     settings : SearchSettings
         ``confidence``, ``max_fixations``, ``inhibit_return``, ``stop_on_repeat``,
         ``repeat_weight``, ``absent_prior``, ``start_cell``, ``scan``, ``decide_at_budget``.
-    costs : array (N,), optional
-        Cost of a fixation at each cell (detector pixels for the fovea); 1 each by default.
+    costs : array (N,) or float, optional
+        Cost of a fixation at each cell, row-major (detector pixels for the fovea), finite and
+        > 0; one number for every cell; 1 each by default.
     link : int
         Cells within this many cells (Chebyshev) of a cell decided occupied are settled
         (module docstring); 0: every cell is decided on its own.
@@ -152,12 +177,12 @@ class OccupancySession:
         check_many_settings(self.settings, grid)
         self.policy = None
         self._pass = None
-        self.link = int(link)
+        self.link = check_link(link)
         self.empty_by_evidence = bool(empty_by_evidence)
         self.table = information_table(self.observation)
         self._view_info = self.table.view_information                     # [k, j]
         self.costs = np.ones(grid.n_cells) if costs is None else \
-            np.broadcast_to(np.asarray(costs, dtype=float), (grid.n_cells,)).copy()
+            check_costs(costs, grid.n_cells)
         if np.any(~np.isfinite(self.costs) | (self.costs <= 0)):
             raise ValueError('fixation costs must be finite and > 0')
         self._counts = isinstance(self.observation, CountObservation)
@@ -441,6 +466,8 @@ class OccupancySession:
             raise OrderError('the one-time scan comes once, before the first fixation')
         if not self.settings.scan:
             return self._result('applied', reason='scan off')
+        if frame.kind != 'evidence':
+            check_scan_model(self.observation)
         try:
             values = check_evidence(frame.values, self.grid.n_cells)
             term = (np.nan_to_num(values) if frame.kind == 'evidence' else
@@ -575,7 +602,14 @@ class OccupancySession:
         ``sum_j w_kj I(P(x_j); offset_jk)``, ``w_kj`` 1 for a view more informative than any
         so far (ELM kernel), else ``repeat_weight`` (module docstring).
         """
-        log_odds = self.log_odds if log_odds is None else log_odds
+        if log_odds is None:
+            log_odds = self.log_odds
+        else:
+            log_odds = np.asarray(log_odds, dtype=float)
+            if log_odds.size != self.grid.n_cells:
+                raise ValueError(f'log odds must have shape ({self.grid.n_cells},) or '
+                                 f'{self.grid.shape}, got {log_odds.shape}')
+            log_odds = log_odds.reshape(-1)
         if self._motion.active:
             info = self.table(log_odds)                                    # (N, N) [k, j]
             followed = self.tracks.followed()

@@ -157,6 +157,14 @@ def check_model_settings(settings: SearchSettings, grid: Grid,
     return reach
 
 
+def check_scan_model(observation) -> None:
+    """Refuse a one-time scan of a model without scan tables (ValueError, as a count model's)."""
+    if not getattr(observation, 'has_scan', False):
+        name = getattr(observation, 'name', type(observation).__name__)
+        raise ValueError(f'this {name} model has no scan tables: a one-time scan needs a count '
+                         f'model measured with one (scan_target, scan_null)')
+
+
 def check_groups(groups, n_cells: int) -> np.ndarray | None:
     """
     Return a frame's grouped detections per cell as ``(N,)`` float64 (None stays None).
@@ -764,6 +772,7 @@ class SearchSession:
             raise OrderError('the one-time scan comes once, before the first fixation')
         if not self.settings.scan:
             return self._result('applied', reason='scan off')
+        check_scan_model(self.observation)
         try:
             obs = self._frame_values(frame)
             term = self.observation.scan_log_likelihood_ratio(obs)
