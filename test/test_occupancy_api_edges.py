@@ -4,6 +4,7 @@
 from ipomdp_gaze.model.fpoc import make_fpoc
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.observation import CountObservation
+from ipomdp_gaze.model.occupancy import one_target_belief
 from ipomdp_gaze.search.many import OccupancySession
 from ipomdp_gaze.search.sensors import run_search
 from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
@@ -103,3 +104,14 @@ def test_a_scan_with_a_model_without_scan_tables_is_a_value_error(many):
         session.scan(Frame(np.zeros(9), kind='scan'))
     if many:                        # a sensor's own log-likelihood ratios need no tables
         assert session.scan(Frame(np.full(9, -1.0), kind='evidence')).applied
+
+
+@pytest.mark.parametrize('absent', [False, True])
+def test_one_target_belief_of_a_batch_is_each_rows_own(absent):
+    """(E, N) log odds were normalised over the whole batch (and flattened with absent=True)."""
+    log_odds = np.random.default_rng(0).normal(size=(4, 6)) * 3
+    batch = one_target_belief(log_odds, absent)
+    assert batch.shape == (4, 7 if absent else 6)
+    np.testing.assert_allclose(batch, [one_target_belief(row, absent) for row in log_odds],
+                               rtol=1e-12)
+    np.testing.assert_allclose(batch.sum(axis=-1), 1.0)

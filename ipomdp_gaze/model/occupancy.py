@@ -103,16 +103,17 @@ def log_nobody(log_odds: np.ndarray) -> np.ndarray:
 
 def one_target_belief(log_odds: np.ndarray, absent: bool = False) -> np.ndarray:
     """
-    Return the posterior conditioned on exactly one occupied cell: ``softmax(L)`` (N,).
+    Return the posterior conditioned on exactly one occupied cell: ``softmax(L)`` (..., N).
 
-    ``absent=True`` conditions on at most one: ``softmax([L, 0])`` (N + 1,), "nobody" last.
+    ``absent=True`` conditions on at most one: ``softmax([L, 0])`` (..., N + 1), "nobody" last.
+    A batch (E, N) gives each row's own.
     """
     log_odds = np.asarray(log_odds, dtype=float)
     if absent:
-        log_odds = np.append(log_odds, 0.0)
-    z = log_odds - log_odds.max()
+        log_odds = np.concatenate([log_odds, np.zeros(log_odds.shape[:-1] + (1,))], axis=-1)
+    z = log_odds - log_odds.max(axis=-1, keepdims=True)
     e = np.exp(z)
-    return e / e.sum()
+    return e / e.sum(axis=-1, keepdims=True)
 
 
 def binary_entropy(p: np.ndarray) -> np.ndarray:
