@@ -115,3 +115,24 @@ def test_one_target_belief_of_a_batch_is_each_rows_own(absent):
     np.testing.assert_allclose(batch, [one_target_belief(row, absent) for row in log_odds],
                                rtol=1e-12)
     np.testing.assert_allclose(batch.sum(axis=-1), 1.0)
+
+
+def test_room_done_once_a_still_search_decided_every_cell():
+    """room_done says every cell is decided; for a still search it stayed False."""
+    grid = Grid(1, 3)
+    session = OccupancySession(grid, _model(grid), SearchSettings(
+        targets='many', absent_prior=0.5, confidence=0.9))
+    session.reset()
+    session.start()
+    assert not session.room_done
+    result = session.update(Frame(np.array([2.0, 0.0, 0.0])))
+    while not result.ended:
+        assert not session.room_done
+        result = session.update(Frame(np.array([2.0, 0.0, 0.0])))
+    assert result.decision == 'found' and session.room_done
+    budget = OccupancySession(grid, _model(grid), SearchSettings(
+        targets='many', absent_prior=0.5, confidence=0.999, max_fixations=1))
+    budget.reset()
+    budget.start()
+    assert budget.update(Frame(np.array([2.0, 0.0, 0.0]))).truncated
+    assert not budget.room_done                       # the budget decides nothing

@@ -788,7 +788,7 @@ class OccupancySession:
         s, settings = self._state, self.settings
         occupied, empty = self._decided(self.log_odds)
         if np.all(self.settled(occupied) | empty):
-            s['ended'] = True
+            s['ended'] = s['room_done'] = True
             found = bool(self.faces()) if self.passing else occupied.any()   # and its groups
             s['decision'] = 'found' if found else 'absent'
             return s['decision']
