@@ -25,7 +25,8 @@ The same steps and results as :class:`ipomdp_gaze.search.session.SearchSession` 
    ``gave_up`` (reason ``repeat``) when no view left would tell anything new, or, with
    ``stop_on_repeat``, when the best view is one already taken;
 5. otherwise the next fixation maximises the expected reduction of the summed cell entropies per
-   unit cost: ``argmax_k sum_j w_kj I(P(x_j); offset_jk) / cost_k`` over unvisited cells (the
+   unit cost: ``argmax_k sum_j w_kj I(P(x_j); offset_jk) / cost_k`` over every cell, the
+   unvisited ones with ``inhibit_return`` (the
    cost times the view's seconds of head time with ``search.head_speed_deg_s``), with
    ``w_kj = 1`` where view k sees cell j at a more informative offset (ELM kernel) than any view
    so far, ``repeat_weight`` otherwise, and 0 for a cell settled by ``link``.
@@ -80,7 +81,8 @@ from scipy.ndimage import maximum_filter
 
 # A person unconfirmed for a round of turns and this many more is lost (section 12.10).
 UNSEEN_SLACK_TURNS = 2
-# Gains below this (nats per unit cost, relative to the best) count as nothing left to learn.
+# A best score at most this over the cheapest cost (nats of a view at that cost) is nothing
+# left to learn.
 MIN_GAIN = 1e-9
 
 
