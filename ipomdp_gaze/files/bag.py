@@ -28,7 +28,7 @@ def _need_rosbags() -> None:
         import rosbags  # noqa: F401
     except ImportError:
         raise ValueError('recording and replaying bags needs the rosbags package (pip install '
-                         "'rosbags>=0.10'; a rosdep or colcon install does not bring it)") \
+                         "'rosbags>=0.11.6'; a rosdep or colcon install does not bring it)") \
             from None
 
 
