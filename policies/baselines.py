@@ -110,7 +110,10 @@ def sweep_tile_cells(grid: Grid, model) -> tuple[int, int]:
     view = view_cells(grid, model)
     if view is None:
         return SWEEP_STEP, SWEEP_STEP
-    return (max(1, min(grid.rows, int(view[0]))), max(1, min(grid.cols, int(view[1]))))
+    # Whole cells, with axis_reach's 1e-9: a 25-degree view over 5-degree cells is 5 cells, but
+    # numpy 1.x's arctan gave 24.999999999999996 degrees, which int() cut to 4.
+    return (max(1, min(grid.rows, int(view[0] + 1e-9))),
+            max(1, min(grid.cols, int(view[1] + 1e-9))))
 
 
 def _spread(n_cells: int, n_poses: int, margin: float) -> np.ndarray:

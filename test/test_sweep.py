@@ -33,6 +33,15 @@ def test_sweep_tiles_the_pan_tilt_grid_by_the_cameras_field_of_view():
     assert sweep.select(belief, 13, None)[0] == sweep.poses[1]
 
 
+def test_a_view_a_rounding_short_of_whole_cells_tiles_by_those_cells(monkeypatch):
+    """QA: numpy 1.x's arctan made the 25-degree view 24.999999999999996 degrees, 4 cells."""
+    from ipomdp_gaze.policies import baselines
+    model = load_observation('faces-pan-tilt')
+    monkeypatch.setattr(baselines, 'view_cells',
+                        lambda grid, m: (3.776105319578252, 4.999999999999999))
+    assert sweep_tile_cells(model.grid, model) == (3, 5)
+
+
 def test_a_wider_lens_gets_fewer_poses_that_keep_the_edges_inside_the_image():
     model = load_observation('faces-pan-tilt-40')       # 40 x 30.5 degrees: 8 x 6.1 cells
     poses = build_policy('sweep', model.grid, model).poses
