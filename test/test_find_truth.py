@@ -327,10 +327,27 @@ def test_a_16_bit_image_of_a_10_bit_camera_is_read_from_its_own_range(tmp_path):
     np.testing.assert_array_equal(read_image(str(path)), (raw // 5).astype(np.uint8))
 
 
+def test_a_gif_decodes_where_opencv_cannot(monkeypatch, tmp_path):
+    """QA: OpenCV decodes GIF from 4.12 on; 4.11 (numpy<2, the README's ROS line) could not."""
+    from ipomdp_gaze.commands.find import read_image
+    from PIL import Image
+    photo = load_photo('astronaut')
+    Image.fromarray(photo).save(tmp_path / 'a.gif')
+    Image.fromarray(photo).save(tmp_path / 'a.png')
+    shipped = np.asarray(Image.open(tmp_path / 'a.gif').convert('RGB'))   # the palette's colours
+    monkeypatch.setattr(cv2, 'imdecode', lambda data, flags: None)       # an OpenCV without GIF
+    np.testing.assert_array_equal(read_image(str(tmp_path / 'a.gif')), shipped)
+    with pytest.raises(ValueError, match='not an image OpenCV can decode'):
+        read_image(str(tmp_path / 'a.png'))                # only a GIF goes to Pillow
+    (tmp_path / 'bad.gif').write_bytes(b'GIF89a' + bytes(20))
+    with pytest.raises(ValueError, match='not an image OpenCV can decode'):
+        read_image(str(tmp_path / 'bad.gif'))
+
+
 def test_images_decode_without_opencvs_logging_binding(monkeypatch):
     """QA: the 4.11-4.12 wheels and Ubuntu's OpenCV have no cv2.utils.logging (a traceback)."""
     from ipomdp_gaze.vision.image_files import decode_quietly
-    monkeypatch.delattr(cv2.utils, 'logging')
+    monkeypatch.delattr(cv2.utils, 'logging', raising=False)    # 4.8-4.12 have none anyway
     _, png = cv2.imencode('.png', np.full((4, 6), 7, np.uint8))
     assert decode_quietly(png, cv2.IMREAD_UNCHANGED).shape == (4, 6)
     assert decode_quietly(np.frombuffer(b'not an image', np.uint8)) is None

@@ -49,6 +49,8 @@ def decode_quietly(data: np.ndarray, flags: int = READ_FLAGS):
     """
     ``cv2.imdecode`` with OpenCV's and libpng's own messages silenced (None if it fails).
 
+    A GIF that OpenCV before 4.12 cannot decode is decoded by Pillow (:func:`_decode_gif`).
+
     An image OpenCV refuses to decode (over ``OPENCV_IO_MAX_IMAGE_PIXELS``, 2^30 by default) or
     has no memory for raises ValueError saying so in one line (the caller names the file): it
     raised ``cv2.error``, a traceback that ended the other files' work too.
@@ -66,7 +68,8 @@ def decode_quietly(data: np.ndarray, flags: int = READ_FLAGS):
         logging.setLogLevel(logging.LOG_LEVEL_SILENT)
     try:
         with _quiet_fd(2):
-            return cv2.imdecode(data, flags)
+            image = cv2.imdecode(data, flags)
+        return _decode_gif(data) if image is None else image
     except cv2.error as exc:
         raise ValueError(decode_error(exc)) from None
     except MemoryError:
@@ -74,3 +77,22 @@ def decode_quietly(data: np.ndarray, flags: int = READ_FLAGS):
     finally:
         if logging is not None:
             logging.setLogLevel(level)
+
+
+def _decode_gif(data: np.ndarray):
+    """
+    Decode a GIF's first frame by Pillow as OpenCV 4.12+ does (BGR, 3 channels); else None.
+
+    OpenCV decodes GIF from 4.12 on, and the opencv-python-headless wheels of 4.12+ need numpy
+    2: with ``numpy<2`` (the README's ROS install, which gets 4.11) or Ubuntu's OpenCV a GIF was
+    "not an image OpenCV can decode". Pillow comes with matplotlib.
+    """
+    if bytes(data[:4]) != b'GIF8':
+        return None
+    try:
+        from io import BytesIO
+        from PIL import Image
+        with Image.open(BytesIO(data.tobytes())) as gif:
+            return np.ascontiguousarray(np.asarray(gif.convert('RGB'))[:, :, ::-1])
+    except Exception:           # noqa: B902 (a damaged GIF: the caller says it is not an image)
+        return None
