@@ -465,7 +465,8 @@ def test_gaussian_information_equals_the_integral_of_the_entropy_drop():
         phi1 = np.exp(-0.5 * (o - d) ** 2) / math.sqrt(2 * math.pi)
         m = p_j * phi1 + (1 - p_j) * phi0
         after = binary_entropy(np.divide(p_j * phi1, m, out=np.zeros_like(m), where=m > 0))
-        return binary_entropy(p_j) - np.trapezoid(m * after, o)
+        trapezoid = getattr(np, 'trapezoid', None) or np.trapz     # numpy 1.x: trapz only
+        return binary_entropy(p_j) - trapezoid(m * after, o)
 
     d = model.dprime(np.arange(9))                                      # [k, j]
     brute = np.array([[drop(p[j], d[k, j]) for j in range(9)] for k in range(9)])

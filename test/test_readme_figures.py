@@ -6,7 +6,7 @@ Every figure README.md shows is drawn by the command its caption names (issue 35
 Each ``![...](docs/figures/NAME.png)`` of the README must have one caption command, a backticked
 ``ipomdp-gaze ... --plot docs/figures/NAME.png``; ``make figures`` must run exactly those
 commands; and each command, run here with its plot sent to a temporary file, must still draw a
-PNG of the committed figure's size. The demos' commands (over real DDS) run in
+PNG of the committed figure's size (within 2 px). The demos' commands (over real DDS) run in
 test_ros_faces.py, whose tests check the same runs.
 """
 from pathlib import Path
@@ -68,4 +68,7 @@ def test_a_readme_figure_command_still_draws_it(figure, command, tmp_path):
     assert done.returncode == 0, done.stdout + done.stderr
     drawn, shipped = cv2.imread(str(out)), cv2.imread(str(ROOT / figure))
     assert drawn is not None, f'{command} drew nothing at {out}'
-    assert drawn.shape == shipped.shape
+    # matplotlib 3.7's tight bounding box is a pixel smaller (505 rows, not 506)
+    assert drawn.shape[2:] == shipped.shape[2:] and \
+        all(abs(a - b) <= 2 for a, b in zip(drawn.shape[:2], shipped.shape[:2])), \
+        (drawn.shape, shipped.shape)
