@@ -48,9 +48,14 @@ def test_stop_on_repeat_gives_up_before_a_second_look_at_a_cell():
 
 
 @pytest.mark.parametrize('many', [False, True])
-@pytest.mark.parametrize('cell', [1.5, '3', -1, 9, None])
+@pytest.mark.parametrize('cell', [1.5, '3', -1, 9, None, (1, 2), [4], np.array([4])])
 def test_fixate_refuses_a_cell_that_is_not_a_whole_index_in_the_grid(many, cell):
-    """fixate(1.5) looked at cell 1 (int() truncated), though the API refuses fractional cells."""
+    """
+    fixate(1.5) looked at cell 1 (int() truncated), though the API refuses fractional cells.
+
+    A sequence or an array is no cell either: Grid.cell takes it as many cells, and the
+    fixation became an array.
+    """
     grid = Grid(3, 3)
     model = _model(grid)
     if many:

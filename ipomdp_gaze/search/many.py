@@ -71,10 +71,10 @@ from ipomdp_gaze.model.occupancy import (binary_entropy, cell_prior, count_faces
                                          predict_occupancy, prior_log_odds)
 from ipomdp_gaze.model.still_evidence import StillEvidence
 from ipomdp_gaze.search.session import (check_groups, check_offsets, check_scan_model,
-                                        check_seconds_elapsed, Frame, motion_settings,
-                                        OrderError, position_settings, scales_false_alarms,
-                                        SearchSettings, start_index, StepResult, target_motion,
-                                        track_filter)
+                                        check_seconds_elapsed, fixation_index, Frame,
+                                        motion_settings, OrderError, position_settings,
+                                        scales_false_alarms, SearchSettings, start_index,
+                                        StepResult, target_motion, track_filter)
 from ipomdp_gaze.search.tracks import GLANCE, Tracks, Turns
 import numpy as np
 from scipy.ndimage import maximum_filter
@@ -511,8 +511,7 @@ class OccupancySession:
         s = self._s()
         if s['fixation'] is None:
             raise OrderError('start the search before fixating')
-        row, col = self.grid.cell(cell)         # a whole index in the grid, else ValueError
-        s['fixation'] = row * self.grid.cols + col
+        s['fixation'] = fixation_index(self.grid, cell)
 
     def predict(self, dt_s: float) -> None:
         """Spread the belief over ``dt_s`` of the targets' motion (nothing for still targets)."""

@@ -229,6 +229,19 @@ def track_filter(settings: SearchSettings) -> PositionFilter | None:
                           settings.motion_sigma_cells, speed)
 
 
+def fixation_index(grid: Grid, cell) -> int:
+    """
+    Return the cell a driver fixates (``fixate``) as a row-major index (ValueError otherwise).
+
+    One whole number in the grid: a fraction is refused, not truncated, and so is a sequence
+    or an array, which :meth:`Grid.cell` would take as many cells.
+    """
+    if np.ndim(cell):
+        raise ValueError(f'a cell index must be one whole number, got {cell!r}')
+    row, col = grid.cell(cell)
+    return row * grid.cols + col
+
+
 def start_index(grid: Grid, settings: SearchSettings) -> int | None:
     """Return the cell index of ``settings.start_cell`` on ``grid``, or None (the default rule)."""
     settings.check_grid(grid)
@@ -817,8 +830,7 @@ class SearchSession:
         search = self._state()
         if search.fixation is None:
             raise OrderError('start the search before fixating')
-        row, col = self.grid.cell(cell)         # a whole index in the grid, else ValueError
-        search.fixation = row * self.grid.cols + col
+        search.fixation = fixation_index(self.grid, cell)
 
     def predict(self, dt_s: float) -> None:
         """Spread the belief over ``dt_s`` of the target's motion (nothing for a still target)."""
