@@ -78,6 +78,7 @@ def test_fixate_refuses_a_cell_that_is_not_a_whole_index_in_the_grid(many, cell)
     ({'link': -1}, 'link must be a whole number of cells >= 0'),
     ({'link': 1.5}, 'link must be a whole number of cells >= 0'),
     ({'link': 'a'}, 'link must be a whole number of cells >= 0'),
+    ({'link': float('inf')}, 'link must be a whole number of cells >= 0'),
 ])
 def test_bad_costs_and_link_are_one_clear_value_error(kwargs, match):
     """A wrong-length costs array raised numpy's broadcast error; link -1 or 1.5 was taken."""

@@ -112,7 +112,7 @@ def check_link(link) -> int:
     """Return ``link`` as an int: a whole number of cells >= 0 (ValueError otherwise)."""
     try:
         ok = not isinstance(link, bool) and int(link) == link and link >= 0
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):     # OverflowError: int(inf)
         ok = False
     if not ok:
         raise ValueError(f'link must be a whole number of cells >= 0, got {link!r}')
