@@ -39,6 +39,15 @@ def test_sequences_give_an_interval_per_entry_and_map_budgets_read_them():
     assert by_budget[2] == pytest.approx((diff[1], low[1], high[1]))
 
 
+def test_one_common_scene_gives_no_interval_rather_than_one_of_no_width():
+    """QA: evaluate --scenes --episodes 1 --compare sweep printed [+0.000, +0.000] per budget."""
+    diff, low, high = paired_difference(_scenes([0.75]), _scenes([0.5]), 'value')
+    assert diff == pytest.approx(0.25) and low is None and high is None
+    by_budget = paired_map_difference(_scenes([1.0]), _scenes([0.0]), budgets=(1, 2))
+    assert by_budget == {1: (1.0, None, None), 2: (-1.0, None, None)}
+    assert None not in paired_difference(_scenes([0.75, 0.5]), _scenes([0.5, 0.5]), 'value')
+
+
 def test_no_common_scene_is_refused():
     with pytest.raises(ValueError, match='both searchers ran'):
         paired_difference(_scenes([1.0]), _scenes([1.0, 2.0], order=[1]), 'value')

@@ -365,9 +365,13 @@ def run_scenes(args) -> int:
     main = next(iter(results))
     if 'sweep' in results and main != 'sweep':
         diff = paired_map_difference(results[main], results['sweep'])
-        print(f'MAP right, {main} minus sweep [paired bootstrap 95%]: '
-              + '; '.join(f'{k}: {d:+.3f} [{lo:+.3f}, {hi:+.3f}]'
-                          for k, (d, lo, hi) in diff.items()))
+        if any(lo is None for _, lo, _ in diff.values()):      # one scene: no interval
+            print(f'MAP right, {main} minus sweep (one scene with a face: no interval): '
+                  + '; '.join(f'{k}: {d:+.3f}' for k, (d, _, _) in diff.items()))
+        else:
+            print(f'MAP right, {main} minus sweep [paired bootstrap 95%]: '
+                  + '; '.join(f'{k}: {d:+.3f} [{lo:+.3f}, {hi:+.3f}]'
+                              for k, (d, lo, hi) in diff.items()))
     if args.json:
         write_json(args.json, results_json(spec, results, summary))
         print(f'wrote {args.json}')

@@ -17,7 +17,7 @@ from pathlib import Path
 
 from ipomdp_gaze.files import json_files
 from ipomdp_gaze.model.head_time import head_time_s, head_travel_deg
-from ipomdp_gaze.simulation.evaluation import answer_is_right, wilson_interval
+from ipomdp_gaze.simulation.evaluation import answer_is_right, MIN_EPISODES, wilson_interval
 import numpy as np
 
 # The MAP's accuracy is reported after every fixation count 1..MAP_BUDGETS.
@@ -138,7 +138,9 @@ def paired_difference(a: list, b: list, key: str, n_boot: int = 2000, seed: int 
 
     Scenes are matched by their index; ``key`` is a number or a fixed-length sequence per scene
     (then every returned value is an array over its entries). Returns ``(difference, low,
-    high)``; the scenes are resampled together for every entry.
+    high)``; the scenes are resampled together for every entry. From fewer than
+    :data:`~ipomdp_gaze.simulation.evaluation.MIN_EPISODES` scenes ``low`` and ``high`` are None:
+    every resample of one scene is that scene, an interval of no width.
     """
     first = {r.index: getattr(r, key) for r in a}
     pairs = [(first[r.index], getattr(r, key)) for r in b if r.index in first]
@@ -146,6 +148,8 @@ def paired_difference(a: list, b: list, key: str, n_boot: int = 2000, seed: int 
         raise ValueError('paired differences need scenes that both searchers ran')
     diff = np.array([x for x, _ in pairs], dtype=float) - np.array([y for _, y in pairs],
                                                                    dtype=float)
+    if len(diff) < MIN_EPISODES:
+        return diff.mean(axis=0), None, None
     picks = np.random.default_rng(seed).integers(0, len(diff), size=(n_boot, len(diff)))
     low, high = np.percentile(diff[picks].mean(axis=1), [2.5, 97.5], axis=0)
     return diff.mean(axis=0), low, high
@@ -156,14 +160,15 @@ def paired_map_difference(a: list, b: list, budgets=range(4, 13), n_boot: int = 
     """
     MAP accuracy of ``a`` minus ``b`` (same scenes with a face) per budget, paired bootstrap 95%.
 
-    Returns ``{budget: (difference, low, high)}`` (:func:`paired_difference` of ``map_right``).
+    Returns ``{budget: (difference, low, high)}`` (:func:`paired_difference` of ``map_right``;
+    ``low`` and ``high`` None from one scene).
     """
     fa, fb = [r for r in a if r.has_face], [r for r in b if r.has_face]
     if len(fa) != len(fb) or not fa:
         raise ValueError('paired differences need the same scenes with a face for both')
     diff, low, high = paired_difference(fa, fb, 'map_right', n_boot, seed)
-    return {int(k): (float(diff[k - 1]), float(low[k - 1]), float(high[k - 1]))
-            for k in budgets}
+    return {int(k): (float(diff[k - 1]), None if low is None else float(low[k - 1]),
+                     None if high is None else float(high[k - 1])) for k in budgets}
 
 
 def format_summary(spec, summary: dict, name: str = '') -> list[str]:
