@@ -84,6 +84,10 @@ def test_whole_numbers_for_belief_prior_are_taken_as_doubles(context, tmp_path, 
         assert result.successful, result.reason
         got = node.get_parameter('policy.kernel')
         assert got.type_ == Parameter.Type.DOUBLE_ARRAY and list(got.value) == kernel
+        result = _set(node, fpoc__ecc_deg=[0, 20])          # the table FPOC's eccentricities
+        assert result.successful, result.reason
+        got = node.get_parameter('fpoc.ecc_deg')
+        assert got.type_ == Parameter.Type.DOUBLE_ARRAY and list(got.value) == [0.0, 20.0]
         # (the scales reach the settings check, past rclpy's type check: counts only)
         result = _set(node, search__false_alarm_scales=[1, 2, 4])
         assert not result.successful and 'needs a count model' in result.reason, result.reason
