@@ -13,7 +13,7 @@ from __future__ import annotations
 from ipomdp_gaze.model.belief import argmax_ties_low
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.observation import as_observation
-from ipomdp_gaze.model.view_reach import axis_covered, axis_reach, view_cells
+from ipomdp_gaze.model.view_reach import axis_covered, axis_reach, view_cells, WHOLE_CELL_TOL
 import numpy as np
 
 from .conv import ConvPolicy
@@ -110,10 +110,10 @@ def sweep_tile_cells(grid: Grid, model) -> tuple[int, int]:
     view = view_cells(grid, model)
     if view is None:
         return SWEEP_STEP, SWEEP_STEP
-    # Whole cells, with axis_reach's 1e-9: a 25-degree view over 5-degree cells is 5 cells, but
-    # numpy 1.x's arctan gave 24.999999999999996 degrees, which int() cut to 4.
-    return (max(1, min(grid.rows, int(view[0] + 1e-9))),
-            max(1, min(grid.cols, int(view[1] + 1e-9))))
+    # Whole cells as axis_reach counts them: a 25-degree view over 5-degree cells is 5 cells,
+    # though numpy 1.x's arctan gave 24.999999999999996 degrees, which int() alone cut to 4.
+    return (max(1, min(grid.rows, int(view[0] + WHOLE_CELL_TOL))),
+            max(1, min(grid.cols, int(view[1] + WHOLE_CELL_TOL))))
 
 
 def _spread(n_cells: int, n_poses: int, margin: float) -> np.ndarray:

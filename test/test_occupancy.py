@@ -15,7 +15,7 @@ from ipomdp_gaze.model.occupancy import (_TABLES, binary_entropy, cell_prior, ch
                                          clusters, count_faces, decided, information_table,
                                          InformationTable, log_nobody, MAX_LOG_ODDS, occupancy,
                                          one_target_belief, predict_occupancy, prior_log_odds,
-                                         TABLE_LOG_ODDS, update_log_odds)
+                                         TABLE_CACHE_SIZE, TABLE_LOG_ODDS, update_log_odds)
 from ipomdp_gaze.search.many import OccupancySession
 from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
 import numpy as np
@@ -854,9 +854,6 @@ def test_inhibition_of_return_keeps_a_many_target_search_off_the_views_it_took()
     assert len(session.path) >= 3 and len(set(session.path)) == len(session.path)
 
 
-CACHE_SIZE = 8          # the models information_table keeps (TABLE_CACHE_SIZE)
-
-
 def test_the_information_table_cache_is_safe_from_many_threads(monkeypatch):
     """
     Composed nodes on a MultiThreadedExecutor fill the cache at once (QA): no thread fails.
@@ -866,7 +863,7 @@ def test_the_information_table_cache_is_safe_from_many_threads(monkeypatch):
     does): no error, every table the one built alone, never more than the cache's size.
     """
     grid = Grid(2, 3)
-    models = [_model(grid, seed=seed) for seed in range(3 * CACHE_SIZE // 2)]
+    models = [_model(grid, seed=seed) for seed in range(3 * TABLE_CACHE_SIZE // 2)]
     alone = [InformationTable(model) for model in models]
     sizes = []
 
@@ -910,7 +907,7 @@ def test_the_information_table_cache_is_safe_from_many_threads(monkeypatch):
         worker.join()
     assert errors == []
     assert sum(map(len, got)) == threads * calls
-    assert max(sizes) <= CACHE_SIZE
+    assert max(sizes) <= TABLE_CACHE_SIZE
     for j, table in itertools.chain.from_iterable(got):
         for name in ('table', 'offset_id', 'flat_pair', 'view_information'):
             np.testing.assert_array_equal(getattr(table, name), getattr(alone[j], name))

@@ -24,6 +24,9 @@ import numpy as np
 
 # A cell is seen well from a view when its outer edge lies this far (in cells) inside the image.
 TILE_MARGIN_CELLS = 0.25
+# A view's width in cells is rounded down to whole cells after adding this: arctan's last bits
+# (numpy 1.x gave a 25-degree view as 24.999999999999996 degrees) must not cost a cell.
+WHOLE_CELL_TOL = 1e-9
 
 
 def view_cells(grid: Grid, model) -> tuple[float, float] | None:
@@ -39,8 +42,8 @@ def view_cells(grid: Grid, model) -> tuple[float, float] | None:
 
 def axis_reach(cells: float) -> tuple[int, int]:
     """Return ``(seen, well)``: the offsets a view ``cells`` wide sees, and sees well."""
-    seen = max(0, math.floor(cells / 2 - 0.5 + 1e-9))
-    well = min(seen, max(0, math.floor(cells / 2 - 0.5 - TILE_MARGIN_CELLS + 1e-9)))
+    seen = max(0, math.floor(cells / 2 - 0.5 + WHOLE_CELL_TOL))
+    well = min(seen, max(0, math.floor(cells / 2 - 0.5 - TILE_MARGIN_CELLS + WHOLE_CELL_TOL)))
     return seen, well
 
 
