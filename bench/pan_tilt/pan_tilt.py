@@ -26,6 +26,7 @@ import argparse
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import replace
 import json
+import math
 from pathlib import Path
 import sys
 import time
@@ -217,7 +218,9 @@ def _checks(results: dict, passes: int, sweep_name: str) -> list[str]:
     face = summarise(results[SHIPPED]).get('face')
     empty = summarise(results[SHIPPED]).get('empty')
     sweep_time = summarise(results['sweep-tile'])['face']['head_time_s_mean']
-    diff = paired_map_difference(results[SHIPPED], results[sweep_name])
+    diff = {budget: tuple(math.nan if v is None else v for v in row)   # one scene: NaN
+            for budget, row in paired_map_difference(results[SHIPPED],
+                                                     results[sweep_name]).items()}
     ok = []
     if face:
         ok.append(f"- right >= 0.98: {face['right']:.3f} ({_met(face['right'] >= 0.98)})")
@@ -241,8 +244,13 @@ def _checks(results: dict, passes: int, sweep_name: str) -> list[str]:
 
 
 def _paired(a: list, b: list, key: str) -> tuple:
-    """Return mean(a - b) of ``key`` over the same scenes and its bootstrap 95% interval."""
-    return tuple(float(v) for v in paired_difference(a, b, key))
+    """
+    Return mean(a - b) of ``key`` over the same scenes and its bootstrap 95% interval.
+
+    From fewer scenes than an interval needs (one) its bounds are NaN: printed as such, and
+    no target is met on them.
+    """
+    return tuple(math.nan if v is None else float(v) for v in paired_difference(a, b, key))
 
 
 def _against_grouped_sweeps(results: dict) -> list[str]:

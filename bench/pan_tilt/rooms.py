@@ -91,6 +91,8 @@ def _diff(a, b, key) -> str:
         a, b = ([SimpleNamespace(index=r.index, false_faces=len(r.answers) - r.faces_found)
                  for r in group] for group in (a, b))
     d, low, high = paired_difference(a, b, key)
+    if low is None:                                # one room: no interval
+        return f'{d:+.3f} (one room: no interval)'
     return f'{d:+.3f} [{low:+.3f}, {high:+.3f}]'
 
 
