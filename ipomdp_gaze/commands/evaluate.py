@@ -20,7 +20,8 @@ from ipomdp_gaze.drivers.rooms import format_rooms, room_settings, summarise_roo
 from ipomdp_gaze.drivers.scene_eval import evaluate_scenes
 from ipomdp_gaze.drivers.scene_report import (format_summary, paired_map_difference, results_json,
                                               summarise, write_json)
-from ipomdp_gaze.drivers.scene_tasks import task_spec, TASKS
+from ipomdp_gaze.drivers.scene_tasks import (DEFAULT_BUDGET, MODEL_GROUPS, ROOM_BUDGET,
+                                             task_spec, TASKS)
 from ipomdp_gaze.drivers.tracking import (evaluate_walks, format_walks, summarise_walks,
                                           walk_spec, walks_json)
 from ipomdp_gaze.files.observation_file import fingerprint
@@ -45,6 +46,8 @@ from .running import add_run_args, executor_from_args, progress_from_args
 from .search_args import add_scene_args, add_search_args, settings_from_args
 
 NO_PREDICTION = ' (no prediction)'
+# --episodes when not given: simulated episodes, scenes of --scenes, walks of --motion walk.
+EPISODES, SCENE_EPISODES, WALK_EPISODES = 20000, 200, 100
 
 
 def add_parser(sub):
@@ -58,15 +61,16 @@ def add_parser(sub):
     p.add_argument('--policy-file', action='append', default=[], type=Path, metavar='PATH',
                    help='a policy YAML file, keyed by its file stem (repeatable)')
     p.add_argument('--episodes', type=positive_int, default=None,
-                   help='simulated episodes (default 20000), or scenes with --scenes (default '
-                        '200)')
+                   help=f'simulated episodes (default {EPISODES}), or scenes with --scenes '
+                        f'(default {SCENE_EPISODES}; walks with --motion walk: {WALK_EPISODES})')
     p.add_argument('--scenes', default=None, choices=TASKS,
                    help='evaluate an image task on held-out scenes through the real detector '
                         'and sensor (the search session of the nodes and find) instead of '
                         'simulating: pan-tilt (config/faces_camera_controller.yaml), faces-420 '
                         "or faces-840 (find's settings); --policy, --policy-file, "
                         '--confidence, --max-fixations (default: the configuration budget, '
-                        'else 60) and --absent-prior change the shipped configuration')
+                        f'else {DEFAULT_BUDGET}; rooms of --faces: {ROOM_BUDGET}) and '
+                        '--absent-prior change the shipped configuration')
     p.add_argument('--split', choices=('train', 'test'), default=None,
                    help='--scenes: training scenes (for every choice) or held-out test scenes '
                         '(default)')
@@ -95,8 +99,10 @@ def add_parser(sub):
     p.add_argument('--group-min-neighbors', type=nonneg_int, default=None, metavar='N',
                    help="--scenes pan-tilt, one face: the grouping (detectMultiScale's "
                         'min_neighbors) the views report for search.group_stop, as the '
-                        "detector node's publish_groups (default: config/"
-                        "faces_camera_detector.yaml's; 0: none)")
+                        "detector node's publish_groups (default: the model's, config/"
+                        "faces_camera_detector.yaml's for the shipped one, "
+                        + ''.join(f'{n} for {m}, ' for m, n in MODEL_GROUPS.items())
+                        + 'else none; 0: none)')
     p.add_argument('--compare', action='append', default=[], metavar='SEARCHER',
                    help='--scenes: another searcher on the same scenes and views (repeatable): '
                         'a policy name (sweep starts at its first pose) or a sweep answer rule '
@@ -336,7 +342,7 @@ def run_scenes(args) -> int:
     if spec.policy_file and not spec.rooms:
         # Every scene starts uniform: a file trained on a prior is said, as without --scenes.
         check_training_prior(load_policy_spec(spec.policy_file), None)
-    episodes = args.episodes or 200
+    episodes = args.episodes or SCENE_EPISODES
     if args.empty_scenes and args.scenes != 'pan-tilt':
         raise ValueError('--empty-scenes is for --scenes pan-tilt')
     if args.empty_scenes and spec.rooms:
@@ -392,7 +398,7 @@ def run_walks(args) -> int:
                                              ('absent_prior', args.absent_prior))
                if value is not None}
     spec = replace(spec, settings=replace(spec.settings, **changes))
-    episodes = args.episodes or 100
+    episodes = args.episodes or WALK_EPISODES
     with executor_from_args(args, episodes) as executor, \
             progress_from_args(args, episodes, 'walks', 'walk') as bar:
         results = evaluate_walks(spec, episodes, executor, progress=bar)
@@ -499,7 +505,7 @@ def run(args) -> int:
             raise ValueError(f'{flag} goes with --motion walk')
     if args.scenes:
         return run_scenes(args)
-    args.episodes = args.episodes or 20000
+    args.episodes = args.episodes or EPISODES
     args.max_fixations = args.max_fixations or None           # 0: no budget, the horizon
     grid, fpoc = task_from_args(args)
     prior = None if args.prior is None else read_prior(args.prior, grid)
