@@ -156,3 +156,16 @@ def test_an_empty_list_for_an_array_with_a_default_is_its_empty_array(ros_env):
     with pytest.raises(ValueError, match='names is given as an empty list.*read-only array '
                                          'needs at least one value'):
         _declared_with(ros_env, ['-p', 'names:=[]'])
+
+
+def test_every_description_says_read_only_exactly_when_it_is():
+    """``ros2 param describe`` shows the text: a read-only parameter says so, and no other."""
+    from ipomdp_gaze.nodes.camera import camera_params
+    from ipomdp_gaze.nodes.controller import controller_params
+    from ipomdp_gaze.nodes.detector import detector_params
+    from ipomdp_gaze.nodes.recorder import recorder_params
+    from ipomdp_gaze.nodes.scene_camera import scene_camera_params
+    wrong = [p.name for params in (camera_params(), controller_params(), detector_params(),
+                                   recorder_params(), scene_camera_params())
+             for p in params if p.read_only != ('read-only' in p.description)]
+    assert wrong == []

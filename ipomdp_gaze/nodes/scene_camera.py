@@ -108,9 +108,11 @@ def scene_camera_params() -> list[Param]:
         Param('scene.face_px', [0, 0], T.INTEGER_ARRAY,
               'smallest and largest face side in scene pixels ([0, 0]: 60-140 fixed, 30-70 '
               'pan_tilt; read-only)', read_only=True),
-        Param('grid.rows', 0, T.INTEGER, "rows (0: the view's, 21 fixed, 11 pan_tilt)",
+        Param('grid.rows', 0, T.INTEGER,
+              "rows (0: the view's, 21 fixed, 11 pan_tilt; read-only)",
               read_only=True, int_range=(0, MAX_CELLS_PER_SIDE)),
-        Param('grid.cols', 0, T.INTEGER, "columns (0: the view's, 21 fixed, 11 pan_tilt)",
+        Param('grid.cols', 0, T.INTEGER,
+              "columns (0: the view's, 21 fixed, 11 pan_tilt; read-only)",
               read_only=True, int_range=(0, MAX_CELLS_PER_SIDE)),
         Param('grid.spacing_deg', 5.0, T.DOUBLE, 'pan_tilt: degrees per cell (read-only)',
               read_only=True, float_range=(1e-6, 90.0)),
@@ -121,7 +123,7 @@ def scene_camera_params() -> list[Param]:
         Param('camera.hfov_deg', 25.0, T.DOUBLE,
               'horizontal field of view, edge to edge, of camera_info.K (read-only)',
               read_only=True, float_range=(1.0, 170.0)),
-        Param('frame_id', 'camera', T.STRING, 'frame_id of image and camera_info',
+        Param('frame_id', 'camera', T.STRING, 'frame_id of image and camera_info (read-only)',
               read_only=True),
     ] + joint_params(limits=False) + saccade_params(max_rate_hz=100.0)
 
