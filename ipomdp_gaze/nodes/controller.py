@@ -129,7 +129,8 @@ def controller_params() -> list[Param]:
         Param('observation.file', '', T.STRING,
               'count model: an ipomdp_gaze/observation-v1 path or shipped name (with counts)'),
     ] + cell_params(
-        'start', 'the first fixation after a reset', 'the centre {}') + [
+        'start', 'the first fixation after a reset',
+        "the centre {}; both -1: the policy's choice after a scan, else the centre") + [
         Param('belief.prior', None, T.DOUBLE_ARRAY,
               'where the one target is a priori: a weight >= 0 per cell, rows x cols values '
               'row-major, scaled to sum 1 (empty: uniform, the paper; whole numbers such as '
