@@ -848,3 +848,28 @@ def test_the_answer_after_a_frame_is_the_tie_rules_cell_of_the_pooled_belief(rad
         assert result.map_probability == pytest.approx(pooled[result.map_cell], abs=1e-15)
         cell = result.fixation
     assert cell is not None
+
+
+def test_a_search_that_never_ends_keeps_only_the_newest_fixations_in_its_path(monkeypatch):
+    # A tracking search (motion on) never ends: its path grew by one entry per frame for as
+    # long as the controller ran (about 12 bytes a frame, 30 MB a day at 30 Hz on 11x11).
+    import ipomdp_gaze.search.many as many
+    import ipomdp_gaze.search.session as session_module
+    monkeypatch.setattr(session_module, 'PATH_SIZE', 20, raising=False)
+    monkeypatch.setattr(many, 'PATH_SIZE', 20, raising=False)
+    model = count_model(3)
+    settings = SearchSettings(confidence=1 - 1e-9, motion_sigma_cells=0.5)
+    sessions = [SearchSession(GRID, model, build_policy('elm', GRID, model), settings,
+                              log_size=0),
+                many.OccupancySession(GRID, model, replace(settings, targets='many'),
+                                      log_size=0)]
+    for session in sessions:
+        session.reset(seed=0)
+        cell, looked = session.start(), []
+        for _ in range(200):
+            looked.append(cell)
+            result = session.update(Frame(np.zeros(GRID.n_cells)), dt_s=0.1)
+            assert result.applied and not result.ended
+            cell = result.fixation
+        assert session.fixations == 200
+        assert session.path == tuple(looked[-20:])

@@ -72,7 +72,7 @@ from ipomdp_gaze.model.occupancy import (binary_entropy, cell_prior, count_faces
 from ipomdp_gaze.model.still_evidence import StillEvidence
 from ipomdp_gaze.search.session import (check_groups, check_offsets, check_scan_model,
                                         check_seconds_elapsed, fixation_index, Frame,
-                                        motion_settings, OrderError, position_settings,
+                                        motion_settings, OrderError, PATH_SIZE, position_settings,
                                         scales_false_alarms, SearchSettings, start_index,
                                         StepResult, target_motion, track_filter)
 from ipomdp_gaze.search.tracks import GLANCE, Tracks, Turns
@@ -420,8 +420,8 @@ class OccupancySession:
         # People out of reach: as many, against those in reach, as the absent hypothesis of one
         # target holds against its cells (a / (1 - a)); an expected number, the grid's -N log(1-q).
         outside = -n * math.log1p(-q) * absent / (1.0 - absent)
-        self._state = {'base': prior, 'prior': prior, 'fixation': None,
-                       'fixations': 0, 'path': [], 'scanned': False, 'decision': '',
+        self._state = {'base': prior, 'prior': prior, 'fixation': None, 'fixations': 0,
+                       'path': deque(maxlen=PATH_SIZE), 'scanned': False, 'decision': '',
                        'reason': '', 'ended': False, 'outside': outside, 'clock_s': 0.0,
                        'room_done': False, 'decided_once': False,
                        'visited': np.zeros(n, dtype=bool), 'groups': [],

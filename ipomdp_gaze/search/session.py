@@ -59,6 +59,10 @@ DECISIONS = ('found', 'absent', 'gave_up')
 # Why a search gave up: the fixation budget, or (stop_on_repeat) the next fixation would repeat
 # a cell (NMPT's rule; with inhibition of return: every cell has been fixated).
 GAVE_UP_REASONS = ('budget', 'repeat')
+# Fixations kept in a search's :attr:`SearchSession.path` (the newest): a tracking search, or a
+# still one without a budget that never decides, never ends, and its path would grow by one
+# entry per frame for as long as the node runs.
+PATH_SIZE = 10_000
 # The parameter (node, YAML) name of each setting: the name every refusal message uses.
 PARAMETER_NAMES = parameter_names()
 # The settings object, generated from the schema (ipomdp_gaze.search.settings.SCHEMA): one checked
@@ -350,7 +354,10 @@ class _Search:
     ended: bool = False
     decided_once: bool = False
     group_cell: int | None = None
-    path: list = field(default_factory=list)
+    path: deque = field(default_factory=lambda: deque(maxlen=PATH_SIZE))
+    # Every cell fixated in this search (the views :meth:`SearchSession._uncovered` counts; the
+    # path keeps only the newest PATH_SIZE, and ``visited`` is cleared by inhibition of return).
+    viewed: np.ndarray | None = None
     # What the read-only views derive from log_belief, each computed once: emptied whenever
     # log_belief (or a setting a view depends on) changes.
     views: dict = field(default_factory=dict)
@@ -632,7 +639,7 @@ class SearchSession:
 
     @property
     def path(self) -> tuple:
-        """Return the fixations whose frames were applied, in order."""
+        """Return the fixations whose frames were applied, in order: the newest PATH_SIZE."""
         return tuple(self._state().path)
 
     @property
@@ -731,7 +738,8 @@ class SearchSession:
         if self._clutter is not None:
             self._clutter.reset()
         self._position = track_filter(self.settings)
-        self._search = _Search(log_b, log_b.copy(), np.zeros(self.grid.n_cells, dtype=bool))
+        self._search = _Search(log_b, log_b.copy(), np.zeros(self.grid.n_cells, dtype=bool),
+                               viewed=np.zeros(self.grid.n_cells, dtype=bool))
         self._event('reset', settings=self.settings.to_parameters())
 
     def exclude(self, cells) -> None:
@@ -890,6 +898,7 @@ class SearchSession:
         search.fixations += 1
         search.path.append(search.fixation)
         search.visited[search.fixation] = True
+        search.viewed[search.fixation] = True
         fired = self._decide(groups)
         self._follow(obs, offsets, dt_s)
         if not search.ended:
@@ -997,7 +1006,8 @@ class SearchSession:
                 or self._reach is None:
             return np.zeros(0, dtype=np.int64)
         open_cells = np.isfinite(self._search.log_belief[:self.grid.n_cells])
-        return np.flatnonzero(~self._reach.covered(self.grid, self._search.path) & open_cells)
+        views = np.flatnonzero(self._search.viewed)
+        return np.flatnonzero(~self._reach.covered(self.grid, views) & open_cells)
 
     def _group_stops(self, groups: np.ndarray | None) -> bool:
         """Whether a frame's grouped detections end the search (docs/design.md section 6.15)."""
