@@ -129,6 +129,33 @@ def test_the_detectors_picture_labels_a_forced_answer():
     assert annotator.found_label == 'found' and annotator.found_radius == 1
 
 
+def test_the_annotator_keeps_a_bounded_path_and_starts_one_per_search():
+    """
+    Soak QA: the fixations drawn grew with every fixation until a uniform belief came.
+
+    A tracking search never sends one and a reset at a non-uniform ``belief.prior`` neither, so
+    the list grew for as long as the detector ran, and each frame drew all of it. A scan frame
+    (no fixation) raised TypeError.
+    """
+    from ipomdp_gaze.nodes.annotation import Annotator, MAX_DRAWN
+    publisher = SimpleNamespace(get_subscription_count=lambda: 0)
+    node = SimpleNamespace(create_publisher=lambda *a: publisher,
+                           create_subscription=lambda *a: None,
+                           guard=SimpleNamespace(wrap=lambda callback: callback))
+    annotator = Annotator(node)
+
+    def frame(fixation, search_id):
+        return SimpleNamespace(fixation=fixation, search_id=search_id, detections_px=None,
+                               image=None)
+    annotator.on_frame(frame(None, 1))                      # the scan of search 1
+    for k in range(5 * MAX_DRAWN):
+        annotator.on_frame(frame(k % 7, 1))
+    assert annotator.count == 5 * MAX_DRAWN
+    assert list(annotator.fixations) == [k % 7 for k in range(4 * MAX_DRAWN, 5 * MAX_DRAWN)]
+    annotator.on_frame(frame(3, 2))                         # search 2, no uniform belief
+    assert list(annotator.fixations) == [3] and annotator.count == 1
+
+
 def test_the_annotators_subscriptions_run_under_the_nodes_guard():
     """QA (composed nodes): a failure drawing a belief or found message is counted, not fatal."""
     from ipomdp_gaze.nodes.annotation import Annotator

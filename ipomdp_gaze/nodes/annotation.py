@@ -18,6 +18,8 @@ nobody subscribes to.
 """
 from __future__ import annotations
 
+from collections import deque
+
 from diagnostic_msgs.msg import DiagnosticStatus
 from geometry_msgs.msg import Point, Pose, PoseArray
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images
@@ -27,6 +29,9 @@ from sensor_msgs.msg import Image
 from std_msgs.msg import Float32MultiArray, Header
 
 TOPIC = 'annotated_image'
+# Fixations drawn: the newest of the search (a tracking search never ends, and each frame
+# draws every fixation kept).
+MAX_DRAWN = 100
 
 
 class Annotator:
@@ -40,7 +45,9 @@ class Annotator:
         node.create_subscription(Float32MultiArray, 'belief', node.guard.wrap(self._on_belief),
                                  10)
         node.create_subscription(DiagnosticStatus, 'found', node.guard.wrap(self._on_found), 10)
-        self.fixations: list[int] = []
+        self.fixations: deque = deque(maxlen=MAX_DRAWN)
+        self.count = 0                  # fixations of this search, MAX_DRAWN of them kept
+        self.search_id = None
         self.belief = None
         self.found = None
         self.found_label = 'found'
@@ -55,8 +62,14 @@ class Annotator:
     def on_frame(self, frame) -> None:
         """Take a frame the detector just published and draw it."""
         self.frame = frame
-        if not self.fixations or self.fixations[-1] != frame.fixation:
+        if frame.search_id is not None and frame.search_id != self.search_id:
+            # a new search: a reset at a prior that is not uniform sends no uniform belief
+            self.search_id = frame.search_id
+            self._new_search()
+        if frame.fixation is not None and (not self.fixations
+                                           or self.fixations[-1] != frame.fixation):
             self.fixations.append(int(frame.fixation))
+            self.count += 1
         if frame.detections_px is not None and self.detections.get_subscription_count() > 0:
             msg = PoseArray(header=Header(stamp=frame.token))
             msg.poses = [Pose(position=Point(x=float(x), y=float(y)))
@@ -71,9 +84,14 @@ class Annotator:
         except ValueError:
             return
         if np.ptp(belief) == 0:                    # a reset: a new search
-            self.fixations, self.found, self.frame = [], None, None
+            self._new_search()
+            self.frame = None
         self.belief = np.asarray(belief, dtype=np.float64)
         self._publish()
+
+    def _new_search(self) -> None:
+        self.fixations.clear()
+        self.count, self.found = 0, None
 
     def _on_found(self, msg: DiagnosticStatus) -> None:
         try:
@@ -99,7 +117,7 @@ class Annotator:
         windows = [(*w.rect_px, w.whole_image) for w in frame.windows]
         picture = annotate(frame.image, cell_map, self.belief, self.fixations, windows,
                            frame.detections_px, self.found,
-                           label=f'fixation {len(self.fixations)}',
+                           label=f'fixation {self.count}',
                            found_label=self.found_label, found_radius=self.found_radius)
         self.publisher.publish(images.camera_image(picture, frame.token))
         self.published += 1
