@@ -244,7 +244,7 @@ def test_resize_refuses_another_aspect_ratio_naming_the_image(tmp_path, cli_here
                    '--resize', '210x210', '--out', tmp_path / 'o.yaml', '--quiet')
     assert run.returncode == 2 and 'Traceback' not in run.stderr
     last = run.stderr.strip().splitlines()[-1]
-    assert 'image 2 of --labels is 420x300 px, another aspect ratio' in last
+    assert f'--resize 210x210: {name} is 420x300 px, another aspect ratio' in last
 
 
 def test_resize_labelled_scales_each_centre_with_its_image():

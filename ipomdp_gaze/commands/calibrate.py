@@ -174,12 +174,13 @@ def _items(args, grid: Grid):
         return [('scene', kwargs, i) for i in range(args.scenes)], (size, size), kwargs
     if args.labels is None:
         raise ValueError('--images needs --labels CSV')
-    from ipomdp_gaze.vision.scenes import cell_of_point, read_labelled_folder
+    from ipomdp_gaze.vision.scenes import cell_of_point, labelled_names, read_labelled_folder
     labelled = read_labelled_folder(args.images, args.labels)
     if not labelled:
         raise ValueError(f'{args.labels} lists no images')
     if args.resize is not None:
-        labelled = resize_labelled(labelled, args.resize)
+        labelled = resize_labelled(labelled, args.resize,
+                                   names=labelled_names(args.images, args.labels))
     shapes = {item.image.shape[:2] for item in labelled}
     if len(shapes) > 1:
         raise ValueError(f'images must share one size to calibrate one model, got '
@@ -199,13 +200,14 @@ def _items(args, grid: Grid):
     return items, shape, source
 
 
-def resize_labelled(labelled, size_px: tuple[int, int], tolerance: float = RESIZE_ASPECT_TOL):
+def resize_labelled(labelled, size_px: tuple[int, int], tolerance: float = RESIZE_ASPECT_TOL,
+                    names=None):
     """
     Return labelled images resized to ``size_px`` ``(width, height)``, their face centres too.
 
     Each image keeps its content (no crop, no padding), so an aspect ratio more than
     ``tolerance`` (relative) from the size's would squash the faces the model is calibrated
-    on: refused, naming the image.
+    on: refused, naming the image (by ``names[i]``, its label CSV entry, when given).
     """
     import cv2
     from ipomdp_gaze.vision.scenes import LabelledImage
@@ -214,9 +216,9 @@ def resize_labelled(labelled, size_px: tuple[int, int], tolerance: float = RESIZ
     for index, item in enumerate(labelled):
         h, w = item.image.shape[:2]
         if abs((w / h) / (width / height) - 1.0) > tolerance:
-            raise ValueError(f'--resize {width}x{height}: image {index + 1} of --labels is '
-                             f'{w}x{h} px, another aspect ratio (crop it to {width}:{height} '
-                             f'first, and move its label)')
+            name = names[index] if names is not None else f'image {index + 1} of --labels'
+            raise ValueError(f'--resize {width}x{height}: {name} is {w}x{h} px, another aspect '
+                             f'ratio (crop it to {width}:{height} first, and move its label)')
         shrink = width * height < w * h
         image = item.image if (w, h) == (width, height) else cv2.resize(
             item.image, (width, height),

@@ -456,6 +456,26 @@ def write_scene_set(scenes, folder, csv_name: str = 'labels.csv') -> Path:
     return csv_path
 
 
+def labels_path(folder, csv_path) -> Path:
+    """
+    Return the label CSV of a labelled folder: ``csv_path``, or, relative and missing, inside it.
+
+    FileNotFoundError if neither is a file.
+    """
+    csv_path = Path(csv_path)
+    if not csv_path.exists() and not csv_path.is_absolute() and (Path(folder) / csv_path).exists():
+        csv_path = Path(folder) / csv_path
+    if not csv_path.is_file():
+        raise FileNotFoundError(f'label CSV {csv_path} does not exist')
+    return csv_path
+
+
+def labelled_names(folder, csv_path) -> list[str]:
+    """Return the ``path`` entries of a label CSV, in order (as :func:`read_labelled_folder`)."""
+    with open(labels_path(folder, csv_path), newline='', encoding='utf-8') as stream:
+        return [(row.get('path') or '').strip() for row in csv.DictReader(stream)]
+
+
 def read_labelled_folder(folder, csv_path) -> list[LabelledImage]:
     """
     Read a folder of images and a CSV ``path,x,y`` of face-centre pixels.
@@ -489,11 +509,7 @@ def read_labelled_folder(folder, csv_path) -> list[LabelledImage]:
     folder = Path(folder)
     if not folder.is_dir():
         raise FileNotFoundError(f'image folder {folder} does not exist')
-    csv_path = Path(csv_path)
-    if not csv_path.exists() and not csv_path.is_absolute() and (folder / csv_path).exists():
-        csv_path = folder / csv_path
-    if not csv_path.is_file():
-        raise FileNotFoundError(f'label CSV {csv_path} does not exist')
+    csv_path = labels_path(folder, csv_path)
     out = []
     with open(csv_path, newline='', encoding='utf-8') as stream:
         reader = csv.DictReader(stream)
