@@ -190,14 +190,19 @@ def declare(node, params: list[Param]) -> None:
     """
     Declare every parameter (YAML and ``-p`` overrides go through the node's callbacks).
 
-    An array given as an empty list (``-p name:=[]``, YAML's ``[]``) has no type for rcl, and
-    rclpy hands it over as NOT_SET: declared with a default it was refused as 'not
-    initialized'. It is set as the declared type's empty array (the node then judges it), or,
-    for a read-only array, which can only take its override, refused with that reason.
+    rclpy checks an override's type before any callback (no pre-set while declaring), so the
+    overrides, a private dict of rclpy 7 (without it nothing is rewritten), are rewritten
+    first: whole numbers for a double array become doubles (:meth:`Param.taken`). An array
+    given as an empty list (``-p name:=[]``, YAML's ``[]``) has no type for rcl, and rclpy
+    hands it over as NOT_SET: declared with a default it was refused as 'not initialized'. It
+    is set as the declared type's empty array (the node then judges it), or, for a read-only
+    array, which can only take its override, refused with that reason.
     """
     overrides = getattr(node, '_parameter_overrides', None) or {}
     for p in params:
         given = overrides.get(p.name)
+        if given is not None:
+            overrides[p.name] = given = p.taken(given)
         empty = p.ptype in ARRAY_TYPES and given is not None and given.type_ == T.NOT_SET
         if empty and p.default is not None and p.read_only:
             raise ValueError(f'{p.name} is given as an empty list, which ROS cannot type: a '
@@ -283,12 +288,6 @@ class ParameterTransaction:
 
     def declare(self) -> None:
         """Declare every parameter (YAML and ``-p`` overrides go through the callbacks)."""
-        # rclpy checks an override's type before any callback (no pre-set while declaring);
-        # its overrides are a private dict (rclpy 7): without it, whole numbers stay refused.
-        overrides = getattr(self.node, '_parameter_overrides', None) or {}
-        for name, given in list(overrides.items()):
-            if name in self._by_name:
-                overrides[name] = self._by_name[name].taken(given)
         declare(self.node, self.params)
 
     def values(self) -> dict:
