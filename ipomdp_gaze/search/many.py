@@ -120,7 +120,13 @@ def check_link(link) -> int:
 
 
 def check_costs(costs, n_cells: int) -> np.ndarray:
-    """Return fixation costs as (N,) floats: one number for all, or one per cell (ValueError)."""
+    """
+    Return fixation costs as (N,) floats: one number for all, or one per cell, finite and > 0.
+
+    ValueError otherwise; None is 1 for every cell.
+    """
+    if costs is None:
+        return np.ones(n_cells)
     try:
         values = np.asarray(costs, dtype=float)
     except (TypeError, ValueError):
@@ -128,6 +134,8 @@ def check_costs(costs, n_cells: int) -> np.ndarray:
     if values.ndim > 1 or values.size not in (1, n_cells):
         raise ValueError(f'fixation costs must be one number or {n_cells} (one per cell, '
                          f'row-major), got shape {values.shape}')
+    if np.any(~np.isfinite(values) | (values <= 0)):
+        raise ValueError('fixation costs must be finite and > 0')
     return np.broadcast_to(values.reshape(-1), (n_cells,)).copy()
 
 
@@ -183,10 +191,7 @@ class OccupancySession:
         self.empty_by_evidence = bool(empty_by_evidence)
         self.table = information_table(self.observation)
         self._view_info = self.table.view_information                     # [k, j]
-        self.costs = np.ones(grid.n_cells) if costs is None else \
-            check_costs(costs, grid.n_cells)
-        if np.any(~np.isfinite(self.costs) | (self.costs <= 0)):
-            raise ValueError('fixation costs must be finite and > 0')
+        self.costs = check_costs(costs, grid.n_cells)
         self._counts = isinstance(self.observation, CountObservation)
         self._still = StillEvidence(grid.n_cells)
         self._motion = target_motion(grid, self.settings)
