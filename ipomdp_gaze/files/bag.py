@@ -4,11 +4,14 @@
 rosbag2 bags of a search (MCAP storage), written and read in pure Python with ``rosbags``.
 
 A bag is a directory with ``metadata.yaml`` and one ``.mcap`` file, as ``ros2 bag record -s
-mcap`` writes it. :func:`open_writer` starts one (``compression='zstd'`` compresses the MCAP
-chunks, as rosbag2's ``zstd`` storage presets do, so ``mcap`` readers and Foxglove still read
-it); :func:`read_bag` returns every message deserialized (``rosbags`` message classes, with
-the fields of the ROS messages) and the bag's ``custom_data``, where the recorder keeps the
-package version, each node's parameters and the hashes of the files they name. No rclpy here.
+mcap`` writes it, or several (``<name>_0.mcap``, ``<name>_1.mcap``, ...) when split by size or
+duration as ``ros2 bag record --max-bag-size/--max-bag-duration`` splits it
+(:class:`SplitWriter`). :func:`open_writer` starts one (``compression='zstd'`` compresses the
+MCAP chunks, as rosbag2's ``zstd`` storage presets do, so ``mcap`` readers and Foxglove still
+read it); :func:`read_bag` returns every message of every file in time order, deserialized
+(``rosbags`` message classes, with the fields of the ROS messages) and the bag's
+``custom_data``, where the recorder keeps the package version, each node's parameters and the
+hashes of the files they name. No rclpy here.
 """
 from __future__ import annotations
 
@@ -20,6 +23,13 @@ import yaml
 
 DISTRO_STORE = 'ROS2_JAZZY'
 COMPRESSIONS = ('', 'zstd')
+# After a split the file before stays open for the messages received before the split and
+# written after it, until one received this long after the split is written (ns).
+LATE_NS = 2_000_000_000
+NO_MESSAGE_NS = 2 ** 63 - 1     # rosbag2's starting time of a file without messages
+# The largest split limits of the recorder: 10 TB and a year (0 is no split).
+MAX_BAG_SIZE_MB = 1.0e7
+MAX_BAG_DURATION_S = 3.2e7
 
 
 def _need_rosbags() -> None:
@@ -65,26 +75,34 @@ def check_new_bag(path) -> Path:
     return path
 
 
-def open_writer(path, compression: str = ''):
+def open_writer(path, compression: str = '', max_file_bytes: int = 0,
+                max_file_duration_ns: int = 0):
     """
-    Create a bag at ``path`` (a new directory) and return the open ``rosbags`` writer.
+    Create a bag at ``path`` (a new directory) and return its open writer.
+
+    With ``max_file_bytes`` and ``max_file_duration_ns`` 0 it is the ``rosbags`` writer of one
+    ``<name>.mcap``; with either, a :class:`SplitWriter` (the same calls) that splits the bag.
 
     Raises
     ------
     ValueError
-        If ``path`` cannot be a new bag (:func:`check_new_bag`) or ``compression`` is not
-        ``''`` or ``'zstd'``.
+        If ``path`` cannot be a new bag (:func:`check_new_bag`), ``compression`` is not ``''``
+        or ``'zstd'`` or a limit is negative.
 
     """
     _need_rosbags()
     from rosbags.rosbag2 import StoragePlugin, Writer
-    from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
     if compression not in COMPRESSIONS:
         raise ValueError(f"compression must be '' or 'zstd', got {compression!r}")
+    for name, value in (('max_file_bytes', max_file_bytes),
+                        ('max_file_duration_ns', max_file_duration_ns)):
+        if value < 0:
+            raise ValueError(f'{name} must be 0 (no split) or more, got {value}')
     path = check_new_bag(path)
+    if max_file_bytes or max_file_duration_ns:
+        return SplitWriter(path, compression, int(max_file_bytes), int(max_file_duration_ns))
     writer = Writer(path, version=Writer.VERSION_LATEST, storage_plugin=StoragePlugin.MCAP)
-    if compression:
-        writer.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)
+    _compress(writer, compression)
     writer.open()
     store = _typestore()
     add = writer.add_connection
@@ -93,6 +111,179 @@ def open_writer(path, compression: str = ''):
         return add(topic, msgtype, typestore=store, **kw)
     writer.add_connection = add_connection
     return writer
+
+
+def _compress(writer, compression: str) -> None:
+    """Set ``zstd`` chunk compression on a ``rosbags`` writer not yet open (``''``: none)."""
+    if compression:
+        from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
+        writer.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)
+
+
+@dataclass(frozen=True)
+class SplitConnection:
+    """A topic of a :class:`SplitWriter`, what :meth:`SplitWriter.add_connection` returns."""
+
+    index: int
+    topic: str
+    msgtype: str
+
+
+@dataclass
+class _Part:
+    """One file of a split bag while it is written: its ``rosbags`` writer and what it holds."""
+
+    index: int
+    writer: object
+    file: Path
+    connections: list
+    first_ns: int = NO_MESSAGE_NS
+    last_ns: int = 0
+    count: int = 0
+
+
+class SplitWriter:
+    """
+    Write a bag split into files ``<name>_0.mcap``, ``<name>_1.mcap``, ... as rosbag2 does.
+
+    A message starts a new file when the file being written holds ``max_file_bytes`` on disk
+    (MCAP is written in chunks of about 1 MiB, so a file ends at the first chunk that reaches
+    it) or the message is more than ``max_file_duration_ns`` after the file's first; every file
+    has every topic. :meth:`close` writes ``metadata.yaml``: ``relative_file_paths`` and
+    ``files`` (each file's ``path``, ``starting_time``, ``duration`` and ``message_count``), the
+    topics with their counts over all files and ``custom_data``, so ``rosbags``' reader and
+    ``ros2 bag play`` read the files in order as one bag.
+
+    Messages arrive a little out of time order (the recorder's callbacks take the topics in
+    their own order): one received before a split but written after it goes to the file before,
+    which stays open until a message received ``LATE_NS`` after the split, so each file's
+    messages come before the next file's. Each file is written by a ``rosbags`` writer of its
+    own in a folder ``<name>_<i>`` of the bag, whose name it takes, and is moved up when closed.
+    """
+
+    def __init__(self, path, compression: str, max_file_bytes: int, max_file_duration_ns: int):
+        self.path = Path(path)
+        self.compression = compression
+        self.max_file_bytes = max_file_bytes
+        self.max_file_duration_ns = max_file_duration_ns
+        self.custom_data: dict = {}
+        self.files: list = []           # the closed files' entries of metadata.yaml's files
+        self._store = _typestore()
+        self._topics: list = []
+        self._counts: list = []
+        self._boundary_ns = 0
+        self._template: dict = {}       # metadata.yaml of a closed file, its rosbags writer's
+        self.path.mkdir(parents=True)
+        self._parts = [self._open_part(0)]
+
+    def _open_part(self, index: int) -> _Part:
+        from rosbags.rosbag2 import StoragePlugin, Writer
+        folder = self.path / f'{self.path.name}_{index}'
+        writer = Writer(folder, version=Writer.VERSION_LATEST, storage_plugin=StoragePlugin.MCAP)
+        _compress(writer, self.compression)
+        writer.open()
+        for key, value in self.custom_data.items():
+            writer.set_custom_data(key, value)
+        connections = [writer.add_connection(c.topic, c.msgtype, typestore=self._store)
+                       for c in self._topics]
+        return _Part(index, writer, next(folder.glob('*.mcap')), connections)
+
+    def add_connection(self, topic: str, msgtype: str) -> SplitConnection:
+        """Add a topic to every file (those written later too); return it for :meth:`write`."""
+        connection = SplitConnection(len(self._topics), topic, msgtype)
+        for part in self._parts:
+            part.connections.append(part.writer.add_connection(topic, msgtype,
+                                                               typestore=self._store))
+        self._topics.append(connection)
+        self._counts.append(0)
+        return connection
+
+    def set_custom_data(self, key: str, value: str) -> None:
+        """Set ``custom_data[key]`` of the bag (also in each file's own MCAP metadata)."""
+        for part in self._parts:
+            part.writer.set_custom_data(key, value)
+        self.custom_data[key] = value
+
+    def write(self, connection: SplitConnection, time_ns: int, data: bytes) -> None:
+        """Write a serialized message received at ``time_ns``, starting a new file if due."""
+        if not self._parts:
+            raise ValueError(f'{self.path}: the bag is closed')
+        if len(self._parts) == 2:
+            if time_ns < self._boundary_ns:
+                self._put(self._parts[0], connection, time_ns, data)
+                return
+            if time_ns >= self._boundary_ns + LATE_NS:
+                self._finish(self._parts[0])
+        current = self._parts[-1]
+        if current.count and self._full(current, time_ns):
+            # Every message of the file before comes before the boundary, every later one after.
+            self._boundary_ns = max(time_ns, current.last_ns + 1)
+            self._parts.append(self._open_part(current.index + 1))
+            if len(self._parts) == 3:
+                self._finish(self._parts[0])
+            if time_ns < self._boundary_ns:
+                self._put(current, connection, time_ns, data)
+                return
+        self._put(self._parts[-1], connection, time_ns, data)
+
+    def _full(self, part: _Part, time_ns: int) -> bool:
+        """Whether ``part`` is done before a message at ``time_ns``: its size or duration."""
+        if self.max_file_bytes and part.file.stat().st_size >= self.max_file_bytes:
+            return True
+        return bool(self.max_file_duration_ns) and \
+            time_ns - part.first_ns > self.max_file_duration_ns
+
+    def _put(self, part: _Part, connection: SplitConnection, time_ns: int, data: bytes) -> None:
+        part.writer.write(part.connections[connection.index], time_ns, data)
+        part.first_ns = min(part.first_ns, time_ns)
+        part.last_ns = max(part.last_ns, time_ns)
+        part.count += 1
+        self._counts[connection.index] += 1
+
+    def _finish(self, part: _Part) -> None:
+        """Close ``part``, move its file into the bag and keep its ``files`` entry."""
+        self._parts.remove(part)            # never closed twice, also when closing fails
+        part.writer.close()
+        folder = part.file.parent
+        name = f'{self.path.name}_{part.index}{part.file.suffix}'
+        part.file.replace(self.path / name)
+        meta = folder / 'metadata.yaml'
+        self._template = yaml.safe_load(meta.read_text())['rosbag2_bagfile_information']
+        meta.unlink()
+        folder.rmdir()
+        self.files.append({
+            'path': name,
+            'starting_time': {'nanoseconds_since_epoch': part.first_ns},
+            'duration': {'nanoseconds': max(0, part.last_ns - part.first_ns)},
+            'message_count': part.count})
+
+    def close(self) -> None:
+        """Close the open files and write ``metadata.yaml`` of the whole bag."""
+        if not self._parts:
+            raise ValueError(f'{self.path}: the bag is closed')
+        while self._parts:
+            self._finish(self._parts[0])
+        info = dict(self._template)
+        counts = {(c.topic, c.msgtype): n for c, n in zip(self._topics, self._counts)}
+        info['topics_with_message_count'] = [
+            dict(entry, message_count=counts.get((entry['topic_metadata']['name'],
+                                                  entry['topic_metadata']['type']), 0))
+            for entry in info.get('topics_with_message_count') or []]
+        starts = [f['starting_time']['nanoseconds_since_epoch'] for f in self.files
+                  if f['message_count']]
+        ends = [f['starting_time']['nanoseconds_since_epoch'] + f['duration']['nanoseconds']
+                for f in self.files if f['message_count']]
+        info['relative_file_paths'] = [f['path'] for f in self.files]
+        info['files'] = self.files
+        info['message_count'] = sum(f['message_count'] for f in self.files)
+        info['starting_time'] = {'nanoseconds_since_epoch': min(starts, default=NO_MESSAGE_NS)}
+        info['duration'] = {'nanoseconds': max(ends) - min(starts) if starts else 0}
+        info['custom_data'] = dict(self.custom_data) or None
+        meta = self.path / 'metadata.yaml'
+        written = meta.with_suffix('.yaml.tmp')
+        written.write_text(yaml.safe_dump({'rosbag2_bagfile_information': info},
+                                          default_flow_style=False, sort_keys=False))
+        written.replace(meta)
 
 
 @dataclass
@@ -159,6 +350,8 @@ def read_bag(path, topics=None) -> Bag:
     """
     Read a bag: every message (of ``topics``, relative names, if given), deserialized.
 
+    A split bag's files are read as one bag: its messages in time order.
+
     Raises
     ------
     ValueError
@@ -192,5 +385,8 @@ def read_bag(path, topics=None) -> Bag:
             duration = reader.duration * 1e-9
     except ReaderError as exc:
         raise ValueError(f'{path}: {exc}') from None
+    # The files of a split bag one after the other, each in time order: one bag's order (a
+    # stable sort keeps the order of messages received at the same time).
+    messages.sort(key=lambda m: m.time_ns)
     size = sum(f.stat().st_size for f in path.iterdir() if f.is_file())
     return Bag(path, messages, dict(info.get('custom_data') or {}), size, duration)
