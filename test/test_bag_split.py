@@ -145,6 +145,38 @@ def test_a_negative_split_limit_is_refused(tmp_path, limits, message):
     assert not (tmp_path / 'bag').exists()
 
 
+def test_record_says_how_many_files_it_wrote(tmp_path):
+    from ipomdp_gaze.commands.record import describe_written
+    _write(tmp_path / 'bag', ARRIVALS, max_file_duration_ns=1_000_000_000)
+    size = sum(p.stat().st_size for p in (tmp_path / 'bag').iterdir()) / 1e6
+    assert describe_written(tmp_path / 'bag') == (
+        f"wrote {tmp_path / 'bag'}: 10 messages over 3.3 s, {size:.2f} MB in 3 files (a 5, b 5)")
+
+
+@pytest.mark.parametrize('flag, value, message', [
+    ('--max-bag-size-mb', '-1',
+     "argument --max-bag-size-mb: expected 0 (no split) to 1e+07 MB, got '-1'"),
+    ('--max-bag-duration-s', 'nan',
+     "argument --max-bag-duration-s: expected 0 (no split) to 3.2e+07 s, got 'nan'"),
+    ('--max-bag-duration-s', 'soon',
+     "argument --max-bag-duration-s: expected 0 (no split) to 3.2e+07 s, got 'soon'"),
+])
+def test_record_and_demo_refuse_a_bad_split_limit_with_one_line(cli_here, tmp_path, flag,
+                                                                value, message):
+    for command in (['record', tmp_path / 'bag'], ['demo', '--record', tmp_path / 'bag']):
+        run = cli_here(*command, flag, value)
+        assert run.returncode == 2
+        assert run.stderr.strip().splitlines()[-1].endswith(message), run.stderr
+        assert not (tmp_path / 'bag').exists()
+
+
+def test_the_demo_refuses_a_split_without_a_bag(cli_here):
+    run = cli_here('demo', '--max-bag-size-mb', '100')
+    assert run.returncode == 2
+    assert run.stderr.strip().splitlines()[-1].endswith(
+        '--max-bag-size-mb splits the bag of --record, which is not given'), run.stderr
+
+
 def test_a_message_later_than_the_file_before_stays_open_for_is_still_read_in_time_order(
         tmp_path, monkeypatch):
     """Received at 1.0 s but written after one at 1.7 s: the first file was closed by then."""

@@ -189,6 +189,90 @@ def test_the_face_demo_records_the_annotated_image_and_replays(ros_env, tmp_path
     assert 'a new search needs a recording of a fixed camera' in refused.stderr
 
 
+def _unsplit_copy(bag: Path, path: Path) -> None:
+    """Write every message of ``bag`` (files read one after the other) into one MCAP file."""
+    from ipomdp_gaze.files.bag import open_writer, read_metadata
+    from rosbags.rosbag2 import Reader
+    writer = open_writer(path)
+    for key, value in read_metadata(bag)['custom_data'].items():
+        writer.set_custom_data(key, value)
+    with Reader(bag) as reader:
+        connections = {c.id: writer.add_connection(c.topic, c.msgtype)
+                       for c in reader.connections}
+        for connection, stamp, data in reader.messages():
+            writer.write(connections[connection.id], stamp, data)
+    writer.close()
+
+
+def test_a_recording_split_by_size_is_read_and_replayed_as_one_bag(ros_env, tmp_path,
+                                                                   cli_here):
+    """
+    The recorder's max_bag_size_mb: files ``bag_0.mcap`` ... as ``ros2 bag record`` splits.
+
+    The fixed camera streams its 420x420 images: about 1 MB a second. rosbags reads the files
+    one after the other (as ``ros2 bag play``): every message, in time order; the replay of the
+    split bag is the replay of the same messages in one file.
+    """
+    from rosbags.rosbag2 import Reader
+    bag = tmp_path / 'bag'
+    run = _cli(ros_env, 'demo', '--scene', 'faces', '--fovea', '--domain-id',
+               ros_env['ROS_DOMAIN_ID'], '--seed', '0', '--record', str(bag),
+               '--max-bag-size-mb', '1')
+    assert run.returncode == 0, run.stdout + run.stderr
+    meta = yaml.safe_load((bag / 'metadata.yaml').read_text())['rosbag2_bagfile_information']
+    names = meta['relative_file_paths']
+    assert len(names) >= 3, names
+    assert names == [f'bag_{i}.mcap' for i in range(len(names))]
+    assert [f['path'] for f in meta['files']] == names
+    assert sorted(p.name for p in bag.iterdir()) == sorted(names + ['metadata.yaml'])
+    sizes = [(bag / name).stat().st_size for name in names]
+    assert all(size >= 1e6 for size in sizes[:-1]), sizes
+    assert sum(f['message_count'] for f in meta['files']) == meta['message_count']
+    custom = meta['custom_data']
+    assert {'ipomdp_gaze/version', 'ipomdp_gaze/namespace', 'ipomdp_gaze/files',
+            'ipomdp_gaze/parameters/gaze_controller'} <= set(custom)
+    assert custom['ipomdp_gaze/namespace'] == '/'
+    assert yaml.safe_load(custom['ipomdp_gaze/parameters/foveal_detector'])['mode'] == 'fovea'
+    with Reader(bag) as reader:
+        stamps = [stamp for _, stamp, _ in reader.messages()]
+        assert len(stamps) == reader.message_count == meta['message_count']
+    assert stamps == sorted(stamps)
+    ends = [f['starting_time']['nanoseconds_since_epoch'] + f['duration']['nanoseconds']
+            for f in meta['files']]
+    starts = [f['starting_time']['nanoseconds_since_epoch'] for f in meta['files']]
+    assert all(end < start for end, start in zip(ends, starts[1:])), (starts, ends)
+    _unsplit_copy(bag, tmp_path / 'one')
+    assert [p.name for p in (tmp_path / 'one').glob('*.mcap')] == ['one.mcap']
+    split, one = cli_here('replay', bag), cli_here('replay', tmp_path / 'one')
+    assert split.returncode == one.returncode == 0, split.stdout + split.stderr
+    assert re.search(r'^\d+ frames recorded, \d+ applied by the replay$', split.stdout, re.M), \
+        split.stdout
+    # The first line names the bag and its size; the rest is the replay (of a fixed camera,
+    # which may stop at a frame the recorded search did not wait for: the same in both).
+    assert split.stdout.splitlines()[1:] == one.stdout.splitlines()[1:]
+    assert split.stdout.splitlines()[0].split(':', 1)[1].split(',')[0] == \
+        one.stdout.splitlines()[0].split(':', 1)[1].split(',')[0]        # the message count
+
+
+@pytest.mark.parametrize('override, reason', [
+    ('max_bag_size_mb:=-1.0', 'Parameter max_bag_size_mb out of range Min: 0.0, Max: '
+                              '10000000.0, value: -1.0'),
+    ('max_bag_duration_s:=.nan', 'Parameter max_bag_duration_s out of range'),
+    ('max_bag_duration_s:=60', "Trying to set parameter 'max_bag_duration_s' to '60' of type "
+                               "'INTEGER', expecting type 'DOUBLE'"),
+])
+def test_a_split_limit_the_recorder_cannot_take_ends_it_with_one_line(ros_env, tmp_path,
+                                                                      override, reason):
+    run = _cli(ros_env, 'record', str(tmp_path / 'bag'), '--ros-args', '-p', override,
+               timeout=60)
+    assert run.returncode == 1, run.stdout + run.stderr
+    assert 'Traceback' not in run.stderr
+    lines = run.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith('recorder: error: '), lines
+    assert reason in lines[0]
+    assert not (tmp_path / 'bag').exists()
+
+
 def test_a_fixed_camera_recording_can_be_searched_anew(ros_env, tmp_path):
     run = _cli(ros_env, 'demo', '--scene', 'faces', '--fovea', '--domain-id',
                ros_env['ROS_DOMAIN_ID'], '--seed', '0', '--record', str(tmp_path / 'bag'))

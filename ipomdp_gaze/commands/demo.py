@@ -23,6 +23,7 @@ from ipomdp_gaze.vision.pan_tilt import parse_faces
 from ipomdp_gaze.vision.walks import DURATION_S as DEMO_DURATION_S
 
 from .common import nonneg_int, positive_float, positive_int
+from .record import add_split_args
 
 # --motion walk: the walking speed unless --speed-deg-s says (the offline evaluation's default).
 DEMO_SPEED_DEG_S = 5.0
@@ -95,6 +96,7 @@ def add_parser(sub):
                         'and MCAP) with the recorder node; replay it with ipomdp-gaze replay')
     p.add_argument('--compression', choices=('none', 'zstd'), default='none',
                    help='with --record: zstd-compress the MCAP chunks (default none)')
+    add_split_args(p, 'with --record: ')
     p.set_defaults(run=run)
 
 
@@ -134,6 +136,10 @@ def run(args) -> int:
             check_new_bag(args.record)
         except ValueError as exc:
             raise ValueError(f'--record {exc}') from None
+    for flag, value in (('--max-bag-size-mb', args.max_bag_size_mb),
+                        ('--max-bag-duration-s', args.max_bag_duration_s)):
+        if value and args.record is None:
+            raise ValueError(f'{flag} splits the bag of --record, which is not given')
     for flag, path, suffix in (('--plot', args.plot, '.png'), ('--animate', args.animate, '.gif')):
         if path is not None and path.suffix.lower() != suffix:
             raise ValueError(f'{flag} writes a {suffix} file, got {path}')
@@ -174,6 +180,8 @@ def run(args) -> int:
     status = run_demo(setup, args.timeout or DEMO_TIMEOUT_S, args.domain_id, args.verbose, out,
                       max_fixations=args.max_fixations or 60, record=args.record,
                       compression='' if args.compression == 'none' else args.compression,
+                      max_bag_size_mb=args.max_bag_size_mb,
+                      max_bag_duration_s=args.max_bag_duration_s,
                       pictures=pictures)
     if pictures is not None:
         from ipomdp_gaze.vision.search_plots import save_gif, save_png

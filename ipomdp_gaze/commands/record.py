@@ -11,6 +11,7 @@ prints where the decisions differ.
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 from .search_args import add_search_args
@@ -29,6 +30,7 @@ def add_parser(sub):
                    help='relative topics to record (default: every search topic)')
     p.add_argument('--compression', choices=('none', 'zstd'), default='none',
                    help='zstd-compress the MCAP chunks (default none)')
+    add_split_args(p)
     p.add_argument('--ros-args', dest='ros_args', nargs=argparse.REMAINDER, default=None,
                    metavar='ARG', help='ROS arguments (remapping, namespace, -p nodes:=[...])')
     p.set_defaults(run=run_record)
@@ -56,6 +58,33 @@ def add_parser(sub):
     p.set_defaults(run=run_replay)
 
 
+def add_split_args(p, when: str = '') -> None:
+    """Add ``--max-bag-size-mb`` and ``--max-bag-duration-s``, the recorder's split limits."""
+    from ipomdp_gaze.files.bag import MAX_BAG_DURATION_S, MAX_BAG_SIZE_MB
+    p.add_argument('--max-bag-size-mb', type=split_limit(MAX_BAG_SIZE_MB, 'MB'), default=0.0,
+                   metavar='MB',
+                   help=f'{when}split the bag into MCAP files of about MB megabytes (as ros2 bag '
+                        'record --max-bag-size; default 0: one file)')
+    p.add_argument('--max-bag-duration-s', type=split_limit(MAX_BAG_DURATION_S, 's'),
+                   default=0.0, metavar='S',
+                   help=f'{when}split the bag into MCAP files of S seconds (as ros2 bag record '
+                        '--max-bag-duration; default 0: one file)')
+
+
+def split_limit(maximum: float, unit: str):
+    """Parse a split limit for argparse: 0 (no split) to ``maximum``."""
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not 0.0 <= value <= maximum:             # NaN too
+            raise argparse.ArgumentTypeError(f'expected 0 (no split) to {maximum:g} {unit}, '
+                                             f'got {text!r}')
+        return value
+    return parse
+
+
 def run_record(args) -> int:
     from ipomdp_gaze.nodes.recorder import main, TOPICS
     from ipomdp_gaze.files.bag import check_new_bag
@@ -70,6 +99,8 @@ def run_record(args) -> int:
         ros += ['-p', f"topics:=[{','.join(topics)}]"]
     if args.compression != 'none':
         ros += ['-p', f'compression:={args.compression}']
+    from ipomdp_gaze.nodes.recorder import split_overrides
+    ros += split_overrides(args.max_bag_size_mb, args.max_bag_duration_s)
     status = main(['ipomdp-gaze-record', '--ros-args', *ros, *(args.ros_args or [])])
     print(describe_written(args.path), flush=True)
     return status
@@ -92,8 +123,10 @@ def describe_written(path: Path) -> str:
     seconds = int((info.get('duration') or {}).get('nanoseconds', 0)) * 1e-9
     size = sum(f.stat().st_size for f in Path(path).iterdir() if f.is_file())
     topics = ', '.join(f'{topic} {n}' for topic, n in sorted(counts.items()) if n)
+    files = len(info.get('relative_file_paths') or [])
     return (f'wrote {path}: {int(info.get("message_count", 0))} messages over {seconds:.1f} s, '
-            f'{size / 1e6:.2f} MB' + (f' ({topics})' if topics else ''))
+            f'{size / 1e6:.2f} MB' + (f' in {files} files' if files > 1 else '')
+            + (f' ({topics})' if topics else ''))
 
 
 def run_replay(args) -> int:

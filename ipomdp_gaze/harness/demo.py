@@ -216,8 +216,13 @@ def _started(watch, record, node: str):
     return None
 
 
-def _with_recorder(setup: DemoSetup, record, compression: str, pictures) -> list:
-    """Return the nodes to start: a recorder first (``record``), the detector drawing."""
+def _with_recorder(setup: DemoSetup, record, compression: str, pictures,
+                   split: tuple = (0.0, 0.0)) -> list:
+    """
+    Return the nodes to start: a recorder first (``record``), the detector drawing.
+
+    ``split`` is the recorder's ``max_bag_size_mb`` and ``max_bag_duration_s``.
+    """
     nodes = list(setup.nodes)
     if (pictures is not None or record) and setup.scene == 'faces':
         # The detector's annotated_image (pictures) and its raw detections (recorded).
@@ -230,6 +235,8 @@ def _with_recorder(setup: DemoSetup, record, compression: str, pictures) -> list
             args += ['-p', f"topics:=[{','.join(t for t in TOPICS if t != 'annotated_image')}]"]
         if compression:
             args += ['-p', f'compression:={compression}']
+        from ipomdp_gaze.nodes.recorder import split_overrides
+        args += split_overrides(*split)
         if setup.scene != 'faces':
             args += ['-p', f"nodes:=[{NODE_NAMES['controller']}]"]
         args += ['-p', 'diagnostics_period_s:=0.1']
@@ -326,7 +333,8 @@ def _pictures(setup: DemoSetup, record: SearchRecord, annotated: list, stats: di
 def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = None,
              verbose: bool = False, out=print, stats: dict | None = None,
              max_fixations: int = 60, record=None, compression: str = '',
-             pictures: list | None = None) -> int:
+             pictures: list | None = None, max_bag_size_mb: float = 0.0,
+             max_bag_duration_s: float = 0.0) -> int:
     """
     Run the demo; 0 when an answer was judged in time and every node stopped cleanly.
 
@@ -336,7 +344,8 @@ def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = 
     ``fixations``), ``stop`` (``found``, ``budget`` or ``timeout``), ``truth`` (the ground
     truth's ``(row, col)``), ``right`` and ``search_s``: seconds from starting the last node to
     the belief of the answer's last fixation. ``record``: a ``recorder`` node writes the
-    search to this new bag directory (``compression``: ``''`` or ``zstd``). ``pictures``, when
+    search to this new bag directory (``compression``: ``''`` or ``zstd``; ``max_bag_size_mb``
+    and ``max_bag_duration_s`` split it, 0: one file). ``pictures``, when
     given, is filled with an RGB picture of the search per belief (the last one shows the
     answer).
     """
@@ -344,7 +353,8 @@ def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = 
     stats = {} if stats is None else stats
     with isolated_nodes(domain, prefix='ipomdp-gaze-demo-') as nodes:
         procs = [nodes.add(node, args)
-                 for node, args in _with_recorder(setup, record, compression, pictures)]
+                 for node, args in _with_recorder(setup, record, compression, pictures,
+                                                  (max_bag_size_mb, max_bag_duration_s))]
         watch = Watch(domain, 'gaze_demo', nodes)
         record_ = SearchRecord(watch, depth=200, updates_only=True,
                                n_cells=setup.grid.n_cells, priors=setup.priors)

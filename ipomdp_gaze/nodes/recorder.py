@@ -5,7 +5,16 @@ The ``recorder`` node: write a search to a rosbag2 bag (MCAP), as ``ros2 bag rec
 
 No ``ros2 bag`` is installable here, so the node writes the bag itself with ``rosbags`` (pure
 Python): a directory ``path`` with ``metadata.yaml`` and one ``.mcap`` file in rosbag2's layout
-(read here with the ``mcap`` and ``rosbags`` readers). Messages are recorded serialized (CDR)
+(read here with the ``mcap`` and ``rosbags`` readers). ``max_bag_size_mb`` and
+``max_bag_duration_s`` (0: no split, the default) split it as ``ros2 bag record
+--max-bag-size/--max-bag-duration`` does, for a long session with a camera: files
+``<name>_0.mcap``, ``<name>_1.mcap``, ..., a new one once the file being written holds that many
+MB (1e6 bytes on disk; MCAP is written in chunks of about 1 MiB, so a file ends at the first
+chunk that reaches it) or a message comes more than that many seconds after the file's first.
+``metadata.yaml`` lists every file in ``relative_file_paths`` and ``files`` (path, start,
+duration, message count), and each file's messages come before the next one's
+(:class:`ipomdp_gaze.files.bag.SplitWriter`), so ``ros2 bag play``, ``rosbags`` and
+``ipomdp-gaze replay`` read the files in order as one bag. Messages are recorded serialized (CDR)
 as they arrive, timestamped with the time the middleware received them. ``topics`` lists the
 relative topic names to record (:data:`TOPICS` gives each one's type and QoS; the default
 is every one of them: camera images, ``camera_info``, ``joint_states``, ``fixation``,
@@ -44,6 +53,7 @@ import time
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import PoseArray
+from ipomdp_gaze.files.bag import MAX_BAG_DURATION_S, MAX_BAG_SIZE_MB
 from ipomdp_gaze.msg_adapters import diagnostics
 from rcl_interfaces.msg import ParameterEvent
 from rcl_interfaces.srv import GetParameters, ListParameters
@@ -124,11 +134,29 @@ def recorder_params() -> list[Param]:
         Param('compression', '', T.STRING,
               "'' (none) or 'zstd' (the MCAP chunks; read-only)", read_only=True,
               choices=('', 'zstd')),
+        Param('max_bag_size_mb', 0.0, T.DOUBLE,
+              'split the bag: a new MCAP file once the one being written holds this many MB '
+              '(1e6 bytes on disk; 0: no split; read-only)', read_only=True,
+              float_range=(0.0, MAX_BAG_SIZE_MB)),
+        Param('max_bag_duration_s', 0.0, T.DOUBLE,
+              'split the bag: a new MCAP file for a message more than this many seconds after '
+              "the file's first (0: no split; read-only)", read_only=True,
+              float_range=(0.0, MAX_BAG_DURATION_S)),
         Param('diagnostics_period_s', 1.0, T.DOUBLE,
               'period of the recorder: recording status on /diagnostics (messages and '
               'matched publishers per topic; read-only)', read_only=True,
               float_range=(0.01, 3600.0)),
     ]
+
+
+def split_overrides(max_bag_size_mb: float = 0.0, max_bag_duration_s: float = 0.0) -> list:
+    """Return the recorder's ``-p`` arguments of these split limits (none for 0: no split)."""
+    out = []
+    for name, value in (('max_bag_size_mb', max_bag_size_mb),
+                        ('max_bag_duration_s', max_bag_duration_s)):
+        if value:
+            out += ['-p', f'{name}:={float(value)!r}']
+    return out
 
 
 def node_name(node: str, namespace: str = '/') -> str:
@@ -182,7 +210,9 @@ class RecorderNode(QuietPublishers, Node):
         self._transaction.start(self._build(values))
         from ipomdp_gaze.files.bag import open_writer
         from ipomdp_gaze.files.share_files import package_version
-        self.writer = open_writer(values['path'], values['compression'])
+        self.writer = open_writer(values['path'], values['compression'],
+                                  max_file_bytes=int(values['max_bag_size_mb'] * 1e6),
+                                  max_file_duration_ns=int(values['max_bag_duration_s'] * 1e9))
         self.writer.set_custom_data('ipomdp_gaze/version', package_version())
         # The namespace the relative topics and nodes were resolved in: a replay's too.
         self.writer.set_custom_data('ipomdp_gaze/namespace', self.get_namespace())
