@@ -161,3 +161,46 @@ def test_the_edges_of_cell_settings_and_numpy_booleans_are_accepted():
                               stop_on_repeat=np.False_)
     assert settings.found_radius == 5 and settings.start_cell == (0, 0)
     assert settings.inhibit_return is True and settings.stop_on_repeat is False
+
+
+def test_each_interval_is_what_its_settings_check_takes():
+    """The interval (help, the node's descriptor range) and the check must not drift apart."""
+    import math
+    ranged = [s for s in SCHEMA if s.interval is not None]
+    assert {s.parameter for s in ranged} >= {'confidence', 'search.found_radius',
+                                             'search.max_fixations', 'motion.dwell_s'}
+    for s in ranged:
+        iv, whole = s.interval, s.kind == 'int'
+        for end, is_open, outward in ((iv.low, iv.low_open, -math.inf),
+                                      (iv.high, iv.high_open, math.inf)):
+            if end is None:                      # no bound: any finite number, not infinity
+                s.check(10 ** 12 if whole else math.copysign(1e12, outward), s.parameter)
+                if not whole:
+                    with pytest.raises(ValueError, match=s.parameter):
+                        s.check(outward, s.parameter)
+                continue
+            if is_open:
+                with pytest.raises(ValueError, match=s.parameter):
+                    s.check(float(end), s.parameter)
+                s.check(math.nextafter(end, -outward), s.parameter)
+            else:
+                s.check(int(end) if whole else float(end), s.parameter)
+            beyond = int(end) + int(math.copysign(1, outward)) if whole else \
+                math.nextafter(end, outward)
+            with pytest.raises(ValueError, match=s.parameter):
+                s.check(beyond, s.parameter)
+        with pytest.raises(ValueError, match=s.parameter):
+            s.check(math.nan, s.parameter)
+    assert SCHEMA[0].help_text.endswith(', in (0, 1)')
+    assert next(s for s in SCHEMA if s.key == 'max_fixations').help_text.endswith(
+        ', >= 0 (0: none)')
+    assert next(s for s in SCHEMA if s.key == 'found_radius').help_text.endswith(', 0 to 5')
+
+
+def test_an_interval_is_for_numbers_with_closed_integer_ends():
+    from ipomdp_gaze.search.settings import Interval
+    with pytest.raises(ValueError, match='an interval is for a float or an int with closed'):
+        Setting('x', 'search.x', 'int', 1, check_sigma_cells, 'x',
+                interval=Interval(0, low_open=True))
+    with pytest.raises(ValueError, match='an interval is for a float or an int'):
+        Setting('x', 'search.x', 'str', 'a', check_sigma_cells, 'x', interval=Interval(0))

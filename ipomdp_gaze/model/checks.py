@@ -118,10 +118,16 @@ def check_factor_above_one(value, name: str, what: str) -> float:
     return float(value)
 
 
+# The largest search.found_radius in cells: an 11 x 11 square of cells around the answer.
+MAX_FOUND_RADIUS = 5
+
+
 def check_radius(value, name: str) -> int:
-    """Return a radius in cells, an integer from 0 to 5."""
-    if _is_bool(value) or not isinstance(value, (int, np.integer)) or not 0 <= value <= 5:
-        raise ValueError(f'{name} must be an integer from 0 to 5 (cells), got {value!r}')
+    """Return a radius in cells, an integer from 0 to :data:`MAX_FOUND_RADIUS`."""
+    if _is_bool(value) or not isinstance(value, (int, np.integer)) \
+            or not 0 <= value <= MAX_FOUND_RADIUS:
+        raise ValueError(f'{name} must be an integer from 0 to {MAX_FOUND_RADIUS} (cells), got '
+                         f'{value!r}')
     return int(value)
 
 

@@ -47,6 +47,8 @@ import numpy as np
 MAX_SCALES = 8
 # A hotspot fires this many times as often as the model's null tables by default.
 DEFAULT_HOTSPOT_SCALE = 20.0
+# The largest prior that a cell is a hotspot (check_hotspot_prior).
+MAX_HOTSPOT_PRIOR = 0.5
 # A scaled null table never gives a cell a detection with more than this probability.
 MAX_DETECTION_PROBABILITY = 0.95
 
@@ -67,7 +69,7 @@ def check_false_alarm_scales(value, name: str = 'false_alarm_scales') -> tuple:
 
 def check_hotspot_prior(value, name: str = 'hotspot_prior') -> float:
     """Return the prior that a cell is a hotspot as a float in [0, 0.5], or raise ValueError."""
-    return check_in_range(value, name, 0.0, 0.5, ' (0: no hotspots)')
+    return check_in_range(value, name, 0.0, MAX_HOTSPOT_PRIOR, ' (0: no hotspots)')
 
 
 def check_hotspot_scale(value, name: str = 'hotspot_scale') -> float:

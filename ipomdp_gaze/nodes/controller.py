@@ -80,7 +80,7 @@ from . import NODE_NAMES
 from .guard import CallbackGuard, GuardedNode
 from .outputs import QuietPublishers
 from .params import (cell_params, current_values, fpoc_params, grid_params, INT_MAX, joint_params,
-                     Param, ParameterTransaction, search_params, T)
+                     Param, ParameterTransaction, RangeReasons, search_params, T)
 from .qos import STATE_QOS
 from .spin import run_node
 
@@ -190,7 +190,7 @@ def controller_params() -> list[Param]:
     ]
 
 
-class GazeControllerNode(GuardedNode, QuietPublishers, Node):
+class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
     """ROS 2 wrapper of :class:`ipomdp_gaze.search.gaze.GazeController`."""
 
     def __init__(self, **kwargs):

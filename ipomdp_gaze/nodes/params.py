@@ -16,8 +16,9 @@ with the reason.
 from __future__ import annotations
 
 import array
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 import math
+from typing import Callable
 
 from ipomdp_gaze.model.fpoc import CameraFPOC, MODELS
 from ipomdp_gaze.search.settings import SCHEMA
@@ -28,6 +29,8 @@ from rclpy.parameter import Parameter
 T = Parameter.Type
 ARRAY_TYPES = (T.BYTE_ARRAY, T.BOOL_ARRAY, T.INTEGER_ARRAY, T.DOUBLE_ARRAY, T.STRING_ARRAY)
 INT_MAX = 2 ** 31 - 1
+# The largest int64, the largest integer parameter: where a range with no upper bound ends.
+INT64_MAX = 2 ** 63 - 1
 # Rows or columns of a grid: 256x256 (65,536 cells) is the largest grid tested under load.
 MAX_CELLS_PER_SIDE = 1024
 
@@ -40,6 +43,10 @@ class Param:
     ``ptype`` is the parameter type; ``default=None`` declares the type only and then sets an
     empty array (array parameters).
     ``choices`` restricts strings; ``float_range``/``int_range`` are enforced by rclpy itself.
+    ``range_check`` is the settings schema's ``check(value, name)`` of a search setting whose
+    range the descriptor carries (its closed hull; ``constraints`` names what the hull takes that
+    the check refuses): a value it refuses is refused with its reason before rclpy's range check
+    (:meth:`ParameterTransaction.refusal`, :func:`declare`).
     A double array takes an integer array, as rcl reads ``-p name:=[1,2,1]`` or YAML's
     ``[1, 2, 1]``, as those doubles instead of refusing it for its type (:meth:`taken`).
     """
@@ -53,6 +60,8 @@ class Param:
     float_range: tuple | None = None
     int_range: tuple | None = None
     choices: tuple | None = None
+    range_check: Callable | None = None
+    constraints: str = ''
 
     def taken(self, parameter: Parameter) -> Parameter:
         """Return ``parameter`` as it is declared: for a double array, whole numbers as doubles."""
@@ -76,10 +85,23 @@ class Param:
             d.integer_range = [IntegerRange(from_value=low, to_value=high, step=step)]
         if self.choices is not None:
             d.additional_constraints = 'one of: ' + ', '.join(repr(c) for c in self.choices)
+        elif self.constraints:
+            d.additional_constraints = self.constraints
         return d
 
+    def range_refusal(self, parameter: Parameter) -> str | None:
+        """Return why ``range_check`` refuses ``parameter`` of the declared type, or None."""
+        if self.range_check is None or self.read_only or parameter.type_ != self.ptype:
+            return None
+        return self.check(parameter.value)
+
     def check(self, value) -> str | None:
-        """Return why ``value`` is invalid, or None (ranges and types are rclpy's job)."""
+        """Return why ``value`` is invalid, or None (types and other ranges are rclpy's job)."""
+        if self.range_check is not None:
+            try:
+                self.range_check(value, self.name)
+            except ValueError as exc:
+                return str(exc)
         if self.choices is not None and value not in self.choices:
             return (f"{self.name} must be one of {', '.join(repr(c) for c in self.choices)}, "
                     f'got {value!r}')
@@ -179,11 +201,33 @@ def search_params(schema=SCHEMA) -> list[Param]:
     """
     Return the search settings as parameters, generated from :mod:`ipomdp_gaze.search.settings`.
 
-    The start cell is declared as ``start_row`` / ``start_col`` (:func:`cell_params`).
+    The start cell is declared as ``start_row`` / ``start_col`` (:func:`cell_params`). A
+    setting's interval becomes the descriptor's range (:func:`_ranged`).
     """
-    return [Param(s.parameter, list(s.default) if s.kind == 'floats' else s.default,
-                  _PARAMETER_TYPES[s.kind], s.help_text, int_range=s.int_range)
+    return [_ranged(Param(s.parameter, list(s.default) if s.kind == 'floats' else s.default,
+                          _PARAMETER_TYPES[s.kind], s.help_text), s)
             for s in schema if s.kind != 'cell']
+
+
+def _ranged(param: Param, setting) -> Param:
+    """
+    Give ``param`` the range of ``setting``'s interval, if it has one.
+
+    A ROS range is closed, so an open end is included and a missing bound is infinite (an
+    integer's: int64's); what the hull takes that the setting refuses is named in the
+    descriptor's constraints, and the setting's check stays the authority (``range_check``).
+    """
+    interval = setting.interval
+    if interval is None:
+        return param
+    low, high = interval.closed_hull()
+    if setting.kind == 'int':
+        return replace(param, range_check=setting.check, int_range=(
+            -INT64_MAX - 1 if low == -math.inf else int(low),
+            INT64_MAX if high == math.inf else int(high)))
+    wider = interval.open_ends()
+    return replace(param, range_check=setting.check, float_range=(low, high),
+                   constraints=f'{interval.text()}: {wider}' if wider else '')
 
 
 def declare(node, params: list[Param]) -> None:
@@ -196,13 +240,18 @@ def declare(node, params: list[Param]) -> None:
     given as an empty list (``-p name:=[]``, YAML's ``[]``) has no type for rcl, and rclpy
     hands it over as NOT_SET: declared with a default it was refused as 'not initialized'. It
     is set as the declared type's empty array (the node then judges it), or, for a read-only
-    array, which can only take its override, refused with that reason.
+    array, which can only take its override, refused with that reason. An override that a
+    parameter's ``range_check`` refuses is refused with its reason (a ``ValueError``), before
+    rclpy's range check would refuse it with its own.
     """
     overrides = getattr(node, '_parameter_overrides', None) or {}
     for p in params:
         given = overrides.get(p.name)
         if given is not None:
             overrides[p.name] = given = p.taken(given)
+            reason = p.range_refusal(given)
+            if reason:
+                raise ValueError(reason)
         empty = p.ptype in ARRAY_TYPES and given is not None and given.type_ == T.NOT_SET
         if empty and p.default is not None and p.read_only:
             raise ValueError(f'{p.name} is given as an empty list, which ROS cannot type: a '
@@ -299,6 +348,21 @@ class ParameterTransaction:
         self.config = config
         self.ready = True
 
+    def refusal(self, params: list[Parameter]) -> SetParametersResult | None:
+        """
+        Return the refusal of a set by a parameter's ``range_check``, or None.
+
+        rclpy checks a descriptor's range before any callback and refuses with its own text
+        ('Parameter confidence out of range Min: 0.0, Max: 1.0, value: 1.5'): a node asks this
+        first (:class:`RangeReasons`), so such a value gets the settings' reason instead.
+        """
+        for p in params:
+            spec = self._by_name.get(p.name)
+            reason = spec.range_refusal(spec.taken(p)) if spec is not None else None
+            if reason:
+                return SetParametersResult(successful=False, reason=reason)
+        return None
+
     def _pre_set(self, params: list[Parameter]) -> list[Parameter]:
         params = [self._by_name[p.name].taken(p) if p.name in self._by_name else p
                   for p in params]
@@ -334,3 +398,31 @@ class ParameterTransaction:
         extra = self._apply(old, self.config)
         changed = ', '.join(f'{p.name}={short_repr(p.value)}' for p in params)
         self.node.get_logger().info(f'parameters set: {changed}' + (f'; {extra}' if extra else ''))
+
+
+class RangeReasons:
+    """
+    Mixin before ``rclpy.node.Node``: a set a ``range_check`` refuses gets the check's reason.
+
+    Every set (``ros2 param set``, the parameter services, the node's own) is first asked of
+    the node's ``_transaction`` (:meth:`ParameterTransaction.refusal`); a set it does not refuse
+    goes on as ``Node``'s, with rclpy's descriptor checks and the callbacks.
+    """
+
+    def _range_refusal(self, parameter_list):
+        transaction = getattr(self, '_transaction', None)
+        return None if transaction is None else transaction.refusal(parameter_list)
+
+    def set_parameters(self, parameter_list):
+        """Set parameters one by one as ``Node.set_parameters`` does; return the results."""
+        results = []
+        for p in parameter_list:
+            refused = self._range_refusal([p])
+            results.append(refused if refused is not None else super().set_parameters([p])[0])
+        return results
+
+    def set_parameters_atomically(self, parameter_list):
+        """Set parameters all or none as ``Node.set_parameters_atomically`` does."""
+        refused = self._range_refusal(parameter_list)
+        return refused if refused is not None else \
+            super().set_parameters_atomically(parameter_list)

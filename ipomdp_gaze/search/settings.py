@@ -22,14 +22,16 @@ other edit. The module is pure: no rclpy, no argparse.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, make_dataclass, replace
+import math
 from typing import Callable, Mapping
 
 from ipomdp_gaze.model.checks import (check_budget, check_confidence, check_flag,
                                       check_positive_cells, check_probability, check_radius,
                                       check_seconds, check_sigma_cells, check_start_cell,
-                                      check_targets, check_track_view)
+                                      check_targets, check_track_view, MAX_FOUND_RADIUS)
 from ipomdp_gaze.model.false_alarms import (check_false_alarm_scales, check_hotspot_prior,
-                                            check_hotspot_scale, DEFAULT_HOTSPOT_SCALE)
+                                            check_hotspot_scale, DEFAULT_HOTSPOT_SCALE,
+                                            MAX_HOTSPOT_PRIOR)
 from ipomdp_gaze.model.still_evidence import check_repeat_weight
 from ipomdp_gaze.search.room import MAX_PERIOD_S
 
@@ -61,14 +63,57 @@ KINDS = ('float', 'int', 'bool', 'floats', 'cell', 'str')
 
 
 @dataclass(frozen=True)
+class Interval:
+    """
+    The numbers a setting allows: from ``low`` to ``high`` (None: no bound), each end open or not.
+
+    The help's range text and the node's descriptor range come from it; the setting's check
+    stays the authority (it also refuses NaN and, with a missing bound, infinity).
+    """
+
+    low: float | None = None
+    high: float | None = None
+    low_open: bool = False
+    high_open: bool = False
+
+    def text(self, kind: str = 'float') -> str:
+        """Return the range as help shows it: ``in (0, 1)``, ``>= 0``, ``0 to 5`` (integers)."""
+        low, high = self.low, self.high
+        if low is not None and high is not None:
+            if kind == 'int':
+                return f'{low:g} to {high:g}'
+            return (f"in {'(' if self.low_open else '['}{low:g}, {high:g}"
+                    f"{')' if self.high_open else ']'}")
+        if low is not None:
+            return f"{'>' if self.low_open else '>='} {low:g}"
+        if high is not None:
+            return f"{'<' if self.high_open else '<='} {high:g}"
+        return ''
+
+    def closed_hull(self) -> tuple[float, float]:
+        """Return ``(low, high)`` with the open ends included and a missing bound infinite."""
+        return (-math.inf if self.low is None else self.low,
+                math.inf if self.high is None else self.high)
+
+    def open_ends(self) -> str:
+        """Return what the closed hull takes that the setting does not (a ROS range is closed)."""
+        ends = ((self.low, self.low_open), (self.high, self.high_open))
+        out = [f'{end:g} excluded' for end, is_open in ends if is_open and end is not None]
+        if self.low is None or self.high is None:
+            out.append('finite')
+        return ', '.join(out)
+
+
+@dataclass(frozen=True)
 class Setting:
     """
     One search setting: everything every driver needs to know about it.
 
     ``key`` is the field of the settings object, ``parameter`` the node / YAML name,
     ``kind`` one of :data:`KINDS`, ``check(value, parameter)`` returns the value in its plain
-    type or raises ``ValueError`` with one line. ``bounds`` is the allowed range as text for
-    help and descriptors; ``int_range`` (inclusive) is also enforced by rclpy when declared.
+    type or raises ``ValueError`` with one line. ``interval`` is the range of a number
+    (:class:`Interval`): the help shows it and the node declares it in the parameter's
+    descriptor; ``bounds`` is other text on the allowed values (after the range, in brackets).
     ``flag`` is the CLI flag (default ``--key-with-dashes``) and ``metavar`` its placeholder.
     """
 
@@ -79,29 +124,41 @@ class Setting:
     check: Callable
     help: str  # noqa: A003 (the schema's word, as argparse's)
     bounds: str = ''
-    int_range: tuple | None = None
+    interval: Interval | None = None
     flag: str = ''
     metavar: str = ''
 
     def __post_init__(self):
         if self.kind not in KINDS:
             raise ValueError(f'setting {self.key}: kind must be one of {KINDS}, got {self.kind!r}')
+        if self.interval is not None and (self.kind not in ('float', 'int') or (
+                self.kind == 'int' and (self.interval.low_open or self.interval.high_open))):
+            raise ValueError(f'setting {self.key}: an interval is for a float or an int with '
+                             'closed ends')
         if not self.flag:
             object.__setattr__(self, 'flag', '--' + self.key.replace('_', '-'))
 
     @property
+    def bounds_text(self) -> str:
+        """Return the allowed values as text: the interval, then ``bounds``."""
+        if self.interval is None:
+            return self.bounds
+        text = self.interval.text(self.kind)
+        return f'{text} ({self.bounds})' if self.bounds else text
+
+    @property
     def help_text(self) -> str:
         """Return the help with the allowed range, as the descriptor and ``--help`` show it."""
-        return f'{self.help}, {self.bounds}' if self.bounds else self.help
+        return f'{self.help}, {self.bounds_text}' if self.bounds_text else self.help
 
 
 SCHEMA: tuple[Setting, ...] = (
     Setting('confidence', 'confidence', 'float', 0.95, check_confidence,
             'found (absent) fires when the most likely cell (no target) reaches this probability',
-            bounds='in (0, 1)', metavar='P'),
+            interval=Interval(0, 1, low_open=True, high_open=True), metavar='P'),
     Setting('max_fixations', 'search.max_fixations', 'int', 0, check_budget,
-            'fixation budget of a search: gave_up when it runs out undecided', bounds='0: none',
-            metavar='N'),
+            'fixation budget of a search: gave_up when it runs out undecided',
+            interval=Interval(0), bounds='0: none', metavar='N'),
     Setting('inhibit_return', 'search.inhibit_return', 'bool', False, check_flag,
             'still target: never fixate a cell twice in a search (a deterministic detector on a '
             'still scene repeats its counts; the Bayes step would count them twice)'),
@@ -112,47 +169,51 @@ SCHEMA: tuple[Setting, ...] = (
             'still target: weight of the evidence a cell gets from views other than the one that '
             'saw it at its most informative offset (1: every frame counts fully, naive Bayes; 0: '
             'the evidence of each cell once, for overlapping views of a still scene and a '
-            'deterministic detector)', bounds='in [0, 1]', metavar='W'),
+            'deterministic detector)', interval=Interval(0, 1), metavar='W'),
     Setting('head_speed_deg_s', 'search.head_speed_deg_s', 'float', 0.0, check_sigma_cells,
             'still target, policy elm or coverage, or search.targets many (others choose as '
             'before): the view with the best score per second of head time, the move at this '
             'joint speed plus '
-            "search.view_time_s (0: every view costs alike, the paper's choice)", bounds='>= 0',
+            "search.view_time_s (0: every view costs alike, the paper's choice)",
+            interval=Interval(0),
             metavar='DEG_S'),
     Setting('view_time_s', 'search.view_time_s', 'float', 0.4, check_seconds,
             'with search.head_speed_deg_s: the seconds of a view besides the move (detector, '
-            'settling and the start of the saccade)', bounds='> 0', metavar='SECONDS'),
+            'settling and the start of the saccade)', interval=Interval(0, low_open=True),
+            metavar='SECONDS'),
     Setting('head_tour', 'search.head_tour', 'bool', False, check_flag,
             'with search.head_speed_deg_s and policy coverage: while the belief is diffuse, a '
             'tile view also costs the longer tour of the tiles left that starting there '
             'commits to (nearest-neighbour tours)'),
     Setting('absent_prior', 'absent.prior', 'float', 0.0, check_probability,
             'prior that no target is in the grid (0: always there); a change starts a new '
-            'search', bounds='in [0, 1)', metavar='P'),
+            'search', interval=Interval(0, 1, high_open=True), metavar='P'),
     Setting('motion_sigma_cells', 'motion.sigma_cells', 'float', 0.0, check_sigma_cells,
             'the target moves: standard deviation of its random walk in cells per second (per '
-            'fixation in simulation; 0: a still target)', bounds='>= 0', metavar='CELLS'),
+            'fixation in simulation; 0: a still target)', interval=Interval(0),
+            metavar='CELLS'),
     Setting('motion_jump_prob', 'motion.jump_prob', 'float', 0.0, check_probability,
             'probability per second (per fixation in simulation) that the target jumps to a '
-            'random cell', bounds='in [0, 1)', flag='--jump-prob', metavar='P'),
+            'random cell', interval=Interval(0, 1, high_open=True), flag='--jump-prob',
+            metavar='P'),
     Setting('motion_leave_prob', 'motion.leave_prob', 'float', 0.0, check_probability,
             'with absent.prior: probability per second that the target leaves the grid, and '
             'that an absent one comes back (a person walking out of reach and in again)',
-            bounds='in [0, 1)', metavar='P'),
+            interval=Interval(0, 1, high_open=True), metavar='P'),
     Setting('motion_max_speed_cells', 'motion.max_speed_cells', 'float', 0.0,
             check_sigma_cells,
             'the target walks: it keeps a velocity (a belief over 9 x 9 velocities up to this '
             'many cells per second on each axis) until it turns, leaves by walking past the '
             "grid's edge and comes back at its border (motion.leave_prob per second); 0: a "
             'random walk only',
-            bounds='>= 0', metavar='CELLS'),
+            interval=Interval(0), metavar='CELLS'),
     Setting('motion_speed_cells', 'motion.speed_cells', 'float', 0.0, check_sigma_cells,
             'with motion.max_speed_cells: how fast targets usually go, the standard deviation '
             'per axis of the velocity prior in cells per second (0: every velocity alike)',
-            bounds='>= 0', metavar='CELLS'),
+            interval=Interval(0), metavar='CELLS'),
     Setting('motion_turn_prob', 'motion.turn_prob', 'float', 0.0, check_probability,
             'with motion.max_speed_cells: probability per second that the target turns (its '
-            'velocity drawn anew)', bounds='in [0, 1)', metavar='P'),
+            'velocity drawn anew)', interval=Interval(0, 1, high_open=True), metavar='P'),
     Setting('motion_track_view', 'motion.track_view', 'str', 'policy', check_track_view,
             'moving target, once found: policy (the search policy chooses the view), peak '
             '(look at the most likely cell of the belief predicted motion.lead_s ahead) or '
@@ -162,22 +223,23 @@ SCHEMA: tuple[Setting, ...] = (
     Setting('motion_lead_s', 'motion.lead_s', 'float', 0.0, check_lead_s,
             'with motion.track_view peak or position: how far ahead the target is predicted '
             '(the time from a frame to the next: saccade, settling and the detector)',
-            bounds='in [0, 60]', metavar='SECONDS'),
+            interval=Interval(0, MAX_LEAD_S), metavar='SECONDS'),
     Setting('motion_position_sigma_cells', 'motion.position_sigma_cells', 'float', 0.1,
             check_positive_cells,
             "with motion.track_view position: the standard deviation of the detections' mean "
             'position around the target, in cells (calibrated on training walks)',
-            bounds='> 0', metavar='CELLS'),
+            interval=Interval(0, low_open=True), metavar='CELLS'),
     Setting('motion_keep_probability', 'motion.keep_probability', 'float', 0.0,
             check_probability,
             'moving target: once found, it stays found while the answer holds at least this '
-            'probability, and is lost below it (0: the confidence)', bounds='in [0, 1)',
-            metavar='P'),
+            'probability, and is lost below it (0: the confidence)',
+            interval=Interval(0, 1, high_open=True), metavar='P'),
     Setting('motion_dwell_s', 'motion.dwell_s', 'float', 2.0, check_dwell_s,
             'search.targets many, moving targets: seconds of views each person found gets in '
             'turn before the next; after each round the search looks for people not found yet '
             '(one view, or up to half as long while the room is undecided; docs/design.md '
-            'section 12.10)', bounds='in (0, 86400]', metavar='SECONDS'),
+            'section 12.10)', interval=Interval(0, MAX_PERIOD_S, low_open=True),
+            metavar='SECONDS'),
     Setting('start_cell', 'start_cell', 'cell', None, check_start_cell,
             "the first fixation (default: the policy's choice after a scan, else the grid's "
             'centre)', flag='--start', metavar='ROW,COL'),
@@ -186,8 +248,8 @@ SCHEMA: tuple[Setting, ...] = (
             'whole-image scan (asked of the detector as fixation [-1, -1, search_id])'),
     Setting('found_radius', 'search.found_radius', 'int', 0, check_radius,
             'found when the belief within this many cells of a cell reaches the '
-            'confidence, and that cell is the answer (0: the cell alone)', bounds='0 to 5',
-            int_range=(0, 5), metavar='CELLS'),
+            'confidence, and that cell is the answer (0: the cell alone)',
+            interval=Interval(0, MAX_FOUND_RADIUS), metavar='CELLS'),
     Setting('stop_on_decision', 'search.stop_on_decision', 'bool', True, check_flag,
             'found and absent end a search (off: they are only reported, as for a moving target, '
             'and the search goes on to its budget: to measure what every view would give)'),
@@ -203,7 +265,7 @@ SCHEMA: tuple[Setting, ...] = (
             'with search.group_stop: a grouped detection ends the search only where the belief '
             'gives its cell (its found_radius square) at least this probability after the frame '
             "(0: every group; the belief's veto of texture the detector groups)",
-            bounds='in [0, 1)', metavar='P'),
+            interval=Interval(0, 1, high_open=True), metavar='P'),
     Setting('absent_needs_coverage', 'search.absent_needs_coverage', 'bool', False, check_flag,
             "still target, one target, a pan/tilt count model: absent only once the search's "
             'views have covered every cell (each quarter of it seen whole by some view, as the '
@@ -220,11 +282,11 @@ SCHEMA: tuple[Setting, ...] = (
             'count model: prior that a cell is a hotspot that fires in every view '
             '(hotspot_scale times the false-alarm rate; a still target: kept over all views, '
             'a moving one: a clutter map learned frame by frame; 0: none)',
-            bounds='in [0, 0.5]', metavar='P'),
+            interval=Interval(0, MAX_HOTSPOT_PRIOR), metavar='P'),
     Setting('hotspot_scale', 'search.hotspot_scale', 'float', DEFAULT_HOTSPOT_SCALE,
             check_hotspot_scale,
             "count model: a hotspot's factor of the model's false-alarm rate",
-            bounds='> 1', metavar='F'),
+            interval=Interval(1, low_open=True), metavar='F'),
     Setting('targets', 'search.targets', 'str', 'one', check_targets,
             "the belief: one target or none (the paper's) or many (an occupancy per cell, "
             'ipomdp_gaze.many; the gaze_controller node then keeps the people found in view, '
