@@ -132,15 +132,17 @@ def summarise(results: list) -> dict:
     return out
 
 
-def paired_difference(a: list, b: list, key: str, n_boot: int = 2000, seed: int = 0) -> tuple:
+def paired_difference(a: list, b: list, key: str, rng: np.random.Generator,
+                      n_boot: int = 2000) -> tuple:
     """
     Mean of ``key`` in ``a`` minus ``b`` over the scenes both hold, paired bootstrap 95%.
 
     Scenes are matched by their index; ``key`` is a number or a fixed-length sequence per scene
     (then every returned value is an array over its entries). Returns ``(difference, low,
-    high)``; the scenes are resampled together for every entry. From fewer than
+    high)``; the scenes are resampled together for every entry, drawn from ``rng`` (the
+    published reports pass a fresh ``default_rng(0)`` to each call). From fewer than
     :data:`~ipomdp_gaze.simulation.evaluation.MIN_EPISODES` scenes ``low`` and ``high`` are None:
-    every resample of one scene is that scene, an interval of no width.
+    every resample of one scene is that scene, an interval of no width (nothing is drawn).
     """
     first = {r.index: getattr(r, key) for r in a}
     pairs = [(first[r.index], getattr(r, key)) for r in b if r.index in first]
@@ -150,23 +152,23 @@ def paired_difference(a: list, b: list, key: str, n_boot: int = 2000, seed: int 
                                                                    dtype=float)
     if len(diff) < MIN_EPISODES:
         return diff.mean(axis=0), None, None
-    picks = np.random.default_rng(seed).integers(0, len(diff), size=(n_boot, len(diff)))
+    picks = rng.integers(0, len(diff), size=(n_boot, len(diff)))
     low, high = np.percentile(diff[picks].mean(axis=1), [2.5, 97.5], axis=0)
     return diff.mean(axis=0), low, high
 
 
-def paired_map_difference(a: list, b: list, budgets=range(4, 13), n_boot: int = 2000,
-                          seed: int = 0) -> dict:
+def paired_map_difference(a: list, b: list, rng: np.random.Generator, budgets=range(4, 13),
+                          n_boot: int = 2000) -> dict:
     """
     MAP accuracy of ``a`` minus ``b`` (same scenes with a face) per budget, paired bootstrap 95%.
 
-    Returns ``{budget: (difference, low, high)}`` (:func:`paired_difference` of ``map_right``;
-    ``low`` and ``high`` None from one scene).
+    Returns ``{budget: (difference, low, high)}`` (:func:`paired_difference` of ``map_right``,
+    resampled from ``rng``; ``low`` and ``high`` None from one scene).
     """
     fa, fb = [r for r in a if r.has_face], [r for r in b if r.has_face]
     if len(fa) != len(fb) or not fa:
         raise ValueError('paired differences need the same scenes with a face for both')
-    diff, low, high = paired_difference(fa, fb, 'map_right', n_boot, seed)
+    diff, low, high = paired_difference(fa, fb, 'map_right', rng, n_boot)
     return {int(k): (float(diff[k - 1]), None if low is None else float(low[k - 1]),
                      None if high is None else float(high[k - 1])) for k in budgets}
 
