@@ -26,7 +26,6 @@ import argparse
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import replace
 import json
-import math
 from pathlib import Path
 import sys
 import time
@@ -37,6 +36,7 @@ from ipomdp_gaze.drivers.scene_report import (paired_difference, paired_map_diff
 from ipomdp_gaze.drivers.scene_tasks import task_spec
 from ipomdp_gaze.drivers.sweep_rules import SWEEP_RULES
 from ipomdp_gaze.model.head_time import HEAD_SPEED_DEG_S, SACCADE_TIME_S, SETTLE_TIME_S
+from ipomdp_gaze.simulation.evaluation import format_interval
 from ipomdp_gaze.simulation.progress import Progress
 from ipomdp_gaze.vision.detection import DEFAULT_MODELS
 import numpy as np
@@ -223,8 +223,8 @@ def _checks(results: dict, passes: int, sweep_name: str) -> list[str]:
     face = summarise(results[SHIPPED]).get('face')
     empty = summarise(results[SHIPPED]).get('empty')
     sweep_time = summarise(results['sweep-tile'])['face']['head_time_s_mean']
-    diff = {budget: tuple(math.nan if v is None else v for v in row)   # one scene: NaN
-            for budget, row in paired_map_difference(
+    diff = {budget: (d, None if low is None else (low, high))   # too few scenes: no interval
+            for budget, (d, low, high) in paired_map_difference(
                 results[SHIPPED], results[sweep_name],
                 np.random.default_rng(BOOTSTRAP_SEED)).items()}
     ok = []
@@ -233,12 +233,13 @@ def _checks(results: dict, passes: int, sweep_name: str) -> list[str]:
         ok.append(f"- fixations mean <= 8: {face['fixations_mean']:.2f} "
                   f"({_met(face['fixations_mean'] <= 8)}); p90 <= 12: "
                   f"{face['fixations_p90']:.0f} ({_met(face['fixations_p90'] <= 12)})")
-    worst = min(low for _, low, _ in diff.values())
-    met = all(d >= 0 and low > -0.02 for d, low, _ in diff.values())
+    lows = [ci[0] for _, ci in diff.values() if ci is not None]
+    worst = f'{min(lows):+.3f}' if lows else '-'
+    met = all(d >= 0 and ci is not None and ci[0] > -0.02 for d, ci in diff.values())
     ok.append("- MAP right minus the sweep's (same belief, one pass), paired bootstrap 95%: "
-              + '; '.join(f'{k}: {d:+.3f} [{lo:+.3f}, {hi:+.3f}]' for k, (d, lo, hi)
+              + '; '.join(f'{k}: {d:+.3f} {format_interval(ci, "+.3f")}' for k, (d, ci)
                           in diff.items())
-              + f' ({_met(met)}; lowest bound {worst:+.3f})')
+              + f' ({_met(met)}; lowest bound {worst})')
     ratio = face['head_time_s_mean'] / sweep_time
     ok.append(f"- head time {face['head_time_s_mean']:.2f} s = {ratio:.0%} of the one-pass "
               f"sweep's {sweep_time:.2f} s ({_met(ratio <= 0.75)}: <= 75%)")
@@ -253,11 +254,11 @@ def _paired(a: list, b: list, key: str) -> tuple:
     """
     Return mean(a - b) of ``key`` over the same scenes and its bootstrap 95% interval.
 
-    From fewer scenes than an interval needs (one) its bounds are NaN: printed as such, and
-    no target is met on them.
+    From fewer scenes than an interval needs (MIN_EPISODES) the interval is None: printed as
+    ``-``, and no target is met on it.
     """
-    return tuple(math.nan if v is None else float(v)
-                 for v in paired_difference(a, b, key, np.random.default_rng(BOOTSTRAP_SEED)))
+    d, low, high = paired_difference(a, b, key, np.random.default_rng(BOOTSTRAP_SEED))
+    return float(d), None if low is None else (float(low), float(high))
 
 
 def _against_grouped_sweeps(results: dict) -> list[str]:
@@ -270,15 +271,16 @@ def _against_grouped_sweeps(results: dict) -> list[str]:
     ours, theirs = summarise(results[SHIPPED]), summarise(results[best])
     right = _paired(face[SHIPPED], face[best], 'right')
     seconds = _paired(face[SHIPPED], face[best], 'head_time_s')
+    right_met = ours['face']['right'] >= theirs['face']['right'] and right[1] is not None \
+        and right[1][0] > -0.02
     lines = [f'The best grouped sweep here (right most often with a face, then `absent` most '
              f'often): {_label(best, 0)}. Paired over the same scenes, bootstrap 95%:', '',
              f"- right {ours['face']['right']:.3f} against {theirs['face']['right']:.3f}: "
-             f'{right[0]:+.3f} [{right[1]:+.3f}, {right[2]:+.3f}] '
-             f"({_met(ours['face']['right'] >= theirs['face']['right'] and right[1] > -0.02)}: "
-             'at least its, interval above -0.02)',
+             f'{right[0]:+.3f} {format_interval(right[1], "+.3f")} '
+             f'({_met(right_met)}: at least its, interval above -0.02)',
              f"- head time with a face {ours['face']['head_time_s_mean']:.2f} s against "
              f"{theirs['face']['head_time_s_mean']:.2f} s: {seconds[0]:+.2f} s "
-             f'[{seconds[1]:+.2f}, {seconds[2]:+.2f}] '
+             f'{format_interval(seconds[1], "+.2f")} '
              f'({_met(seconds[0] <= 0)}: at most its)']
     if empty[SHIPPED] and empty[best]:
         absent = (ours['empty']['absent'], theirs['empty']['absent'])
@@ -293,7 +295,7 @@ def _against_grouped_sweeps(results: dict) -> list[str]:
                   f'({_met(absent[0] >= absent[1])}: at least its); head time '
                   f"{ours['empty']['head_time_s_mean']:.2f} s against "
                   f"{theirs['empty']['head_time_s_mean']:.2f} s: {empty_s[0]:+.2f} s "
-                  f'[{empty_s[1]:+.2f}, {empty_s[2]:+.2f}]',
+                  f'{format_interval(empty_s[1], "+.2f")}',
                   f'- mean head time over every scene, with a face or empty: {both:.2f} s against '
                   f'{both_theirs:.2f} s ({_met(both <= both_theirs)}: at most its)']
     return lines

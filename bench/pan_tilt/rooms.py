@@ -35,6 +35,7 @@ from ipomdp_gaze.drivers.scene_report import paired_difference, SceneResult
 from ipomdp_gaze.drivers.scene_tasks import task_spec
 from ipomdp_gaze.model.head_camera import observed_cells
 from ipomdp_gaze.model.head_time import covering_poses, head_time_s, shortest_tour
+from ipomdp_gaze.simulation.evaluation import format_interval
 from ipomdp_gaze.simulation.progress import Progress
 from ipomdp_gaze.vision.detection import build_setup, DEFAULT_MODELS
 import numpy as np
@@ -94,9 +95,7 @@ def _diff(a, b, key) -> str:
         a, b = ([SimpleNamespace(index=r.index, false_faces=len(r.answers) - r.faces_found)
                  for r in group] for group in (a, b))
     d, low, high = paired_difference(a, b, key, np.random.default_rng(BOOTSTRAP_SEED))
-    if low is None:                                # one room: no interval
-        return f'{d:+.3f} (one room: no interval)'
-    return f'{d:+.3f} [{low:+.3f}, {high:+.3f}]'
+    return f'{d:+.3f} {format_interval(None if low is None else (low, high), "+.3f")}'
 
 
 def _table(results: dict) -> list[str]:

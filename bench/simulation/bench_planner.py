@@ -34,7 +34,8 @@ from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.observation import GaussianObservation
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.policies.planner import make_planner, TemperedELM
-from ipomdp_gaze.simulation.evaluation import fixations_to_90_ci, paired_difference_ci
+from ipomdp_gaze.simulation.evaluation import (fixations_to_90_ci, format_interval,
+                                               paired_difference_ci)
 from ipomdp_gaze.simulation.simulate import draw_targets, simulate
 import numpy as np
 
@@ -88,31 +89,37 @@ def tempered_vs_elm(grid, fpoc, d, seeds, episodes, horizon, resamples):
         b = simulate(grid, fpoc, make_baseline('elm', grid, fpoc), episodes, horizon, seed=seed)
         entry = paired(a, b, grid.n_cells, seed, resamples)
         rows.append(entry)
-        print(f"  seed {seed:>4}: indicator {fmt(entry['indicator'])}   "
-              f"expected {fmt(entry['expected'])}", flush=True)
+        print(f"  seed {seed:>4}: indicator {fmt(entry['indicator'], episodes)}   "
+              f"expected {fmt(entry['expected'], episodes)}", flush=True)
     pooled = {}
     for key in ('indicator', 'expected'):
-        if any(r[key]['ci95'] is None for r in rows):       # a bound beyond the horizon
+        if any(r[key]['difference'] is None for r in rows):     # a policy never reaches 90%
             pooled[key] = {'difference': None, 'ci95': None}
             continue
         diffs = np.array([r[key]['difference'] for r in rows])
+        if any(r[key]['ci95'] is None for r in rows):   # too few episodes, or beyond the horizon
+            pooled[key] = {'difference': float(diffs.mean()), 'ci95': None}
+            continue
         ses = np.array([(r[key]['ci95'][1] - r[key]['ci95'][0]) / 3.92 for r in rows])
         mean, se = diffs.mean(), np.sqrt(np.sum(ses ** 2)) / len(rows)
         pooled[key] = {'difference': float(mean), 'ci95': [mean - 1.96 * se, mean + 1.96 * se]}
-    print(f"  pooled ({len(seeds)} x {episodes}): indicator {fmt(pooled['indicator'])}   "
-          f"expected {fmt(pooled['expected'])}")
+    print(f'  pooled ({len(seeds)} x {episodes}): indicator '
+          f"{fmt(pooled['indicator'], episodes)}   expected {fmt(pooled['expected'], episodes)}")
     return {'seeds': list(seeds), 'episodes_per_seed': episodes, 'per_seed': rows,
             'pooled': pooled}
 
 
-def fmt(block):
+def fmt(block, episodes):
+    """
+    Format a value and its 95% interval (``-``: none from fewer than MIN_EPISODES episodes).
+
+    ``episodes`` is how many the interval was drawn from.
+    """
     value, ci = block.get('fixations_to_90', block.get('difference')), block['ci95']
     if value is None:
         return f"{'never':>23}"
-    interval = f'[{ci[0]:+.2f}, {ci[1]:+.2f}]' if 'difference' in block and ci else (
-        f'[{ci[0]:.2f}, {ci[1]:.2f}]' if ci else '[   -  ]')
     sign = '+' if 'difference' in block else ''
-    return f'{value:{sign}7.3f} {interval:>16}'
+    return f'{value:{sign}7.3f} {format_interval(ci, sign + ".2f", episodes):>16}'
 
 
 def main(argv=None):
@@ -180,8 +187,8 @@ def main(argv=None):
         entry.update(episodes=episodes, wall_seconds=wall,
                      decisions_per_second=episodes * args.horizon / wall)
         report['policies'][name] = entry
-        print(f"{name:<18} {episodes:>8} {fmt(entry['indicator']):>27} "
-              f"{fmt(entry['expected']):>27} {wall:8.1f}", flush=True)
+        print(f"{name:<18} {episodes:>8} {fmt(entry['indicator'], episodes):>27} "
+              f"{fmt(entry['expected'], episodes):>27} {wall:8.1f}", flush=True)
 
     pairs = [('planner', other) for other in results if 'planner' in results and
              other != 'planner']
@@ -195,8 +202,8 @@ def main(argv=None):
         entry = paired(results[a], results[b], n, args.seed, args.bootstrap)
         entry['episodes'] = common
         report['paired'][f'{a} - {b}'] = entry
-        print(f"{a + ' - ' + b:<34} {common:>8} {fmt(entry['indicator']):>25} "
-              f"{fmt(entry['expected']):>25}", flush=True)
+        print(f"{a + ' - ' + b:<34} {common:>8} {fmt(entry['indicator'], common):>25} "
+              f"{fmt(entry['expected'], common):>25}", flush=True)
 
     if args.tempered_seeds:
         print(f'\ntempered_elm - elm on {args.tempered_seeds} fresh seeds:')

@@ -42,7 +42,7 @@ from ipomdp_gaze.model.grid import Grid  # noqa: E402
 from ipomdp_gaze.policies.baselines import make_baseline  # noqa: E402
 from ipomdp_gaze.policies.training import TrainConfig, Trainer, write_curve  # noqa: E402
 from ipomdp_gaze.simulation.evaluation import (  # noqa: E402
-    fixations_to_90_ci, fixations_to_level, paired_difference_ci)
+    fixations_to_90_ci, fixations_to_level, format_interval, paired_difference_ci)
 from ipomdp_gaze.simulation.simulate import simulate  # noqa: E402
 import numpy as np  # noqa: E402
 
@@ -100,13 +100,19 @@ def beside_target(value, target=TARGET_FIXATIONS, digits=3):
     return f'{value:.{digits}f}'
 
 
-def describe(name, r):
-    """Describe a result in one line: fixations to 90%, its interval, the difference to ELM."""
-    low, high = r['ci95'] or (np.nan, np.nan)                   # None: beyond the horizon
-    dlow, dhigh = r['minus_elm_ci95'] or (np.nan, np.nan)
+def describe(name, r, episodes):
+    """
+    Describe a result in one line: fixations to 90%, its interval, the difference to ELM.
+
+    ``episodes``: the evaluation's (no interval, ``-``, from fewer than MIN_EPISODES).
+    """
+    point, diff = r['fixations_to_90'], r['minus_elm']
+    reached = 'never' if point is None else \
+        f"{beside_target(point)} {format_interval(r['ci95'], '.3f', episodes)}"
+    minus = 'not defined (90% never reached)' if diff is None else \
+        f"{diff:+.3f} {format_interval(r['minus_elm_ci95'], '+.3f', episodes)}"
     return (f'{name}: {r["epochs"]} epochs, {r["train_seconds"]:.1f} s of training; '
-            f'fixations to 90% {beside_target(r["fixations_to_90"])} [{low:.3f}, {high:.3f}], '
-            f'minus ELM {r["minus_elm"]:+.3f} [{dlow:+.3f}, {dhigh:+.3f}]')
+            f'fixations to 90% {reached}, minus ELM {minus}')
 
 
 def speedups(conv_curve, logistic_curve):
@@ -171,17 +177,19 @@ def main(argv=None):
               'learning_rate': args.learning_rate, 'baseline': not args.no_baseline,
               'elm_fixations_to_90': fixations_to_level(elm.percent_correct, grid.n_cells),
               'load_average_before': os.getloadavg()[0], 'cpus': os.cpu_count()}
-    print(f'ELM on the evaluation set: {report["elm_fixations_to_90"]:.3f}; load average '
-          f'{report["load_average_before"]:.2f} on {report["cpus"]} CPUs')
+    elm_90 = report['elm_fixations_to_90']
+    print(f'ELM on the evaluation set: {"never" if elm_90 is None else format(elm_90, ".3f")}; '
+          f'load average {report["load_average_before"]:.2f} on {report["cpus"]} CPUs')
     conv, conv_curve = train('conv', args, grid, fpoc)
     c = report['conv'] = {'epochs': conv.epoch, 'train_seconds': conv.wall_seconds,
                           **final(conv, grid, fpoc, args.final_episodes, elm)}
     report['load_average_after'] = os.getloadavg()[0]
-    print(describe('conv', c) + f'; load average now {report["load_average_after"]:.2f}')
-    fix_ok = c['fixations_to_90'] <= TARGET_FIXATIONS
+    print(describe('conv', c, args.final_episodes)
+          + f'; load average now {report["load_average_after"]:.2f}')
+    fix_ok = c['fixations_to_90'] is not None and c['fixations_to_90'] <= TARGET_FIXATIONS
     time_ok = c['train_seconds'] < TARGET_SECONDS
     print(f'targets: <= {TARGET_FIXATIONS} fixations {"met" if fix_ok else "MISSED"} '
-          f'({beside_target(c["fixations_to_90"])}); '
+          f'({"never" if c["fixations_to_90"] is None else beside_target(c["fixations_to_90"])}); '
           f'< {TARGET_SECONDS:.0f} s {"met" if time_ok else "MISSED"} '
           f'({c["train_seconds"]:.1f} s)')
     if args.curves:
@@ -191,7 +199,7 @@ def main(argv=None):
         logistic, logistic_curve = train('logistic', args, grid, fpoc)
         report['logistic'] = {'epochs': logistic.epoch, 'train_seconds': logistic.wall_seconds,
                               **final(logistic, grid, fpoc, args.final_episodes, elm)}
-        print(describe('logistic', report['logistic']))
+        print(describe('logistic', report['logistic'], args.final_episodes))
         if args.curves:
             write_curve(args.curves / 'human-7x7-infomax-logistic.csv', logistic_curve)
         report['levels'] = speedups(conv_curve, logistic_curve)

@@ -42,7 +42,8 @@ from ipomdp_gaze.model.fpoc import make_fpoc
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.policies.planner import make_planner
-from ipomdp_gaze.simulation.evaluation import fixations_to_90_ci, paired_difference_ci
+from ipomdp_gaze.simulation.evaluation import (fixations_to_90_ci, format_interval,
+                                               paired_difference_ci)
 from ipomdp_gaze.simulation.executor import make_executor
 from ipomdp_gaze.simulation.progress import Progress
 import numpy as np
@@ -87,12 +88,19 @@ def planner_options(text):
     return options
 
 
-def _ci(ci, sign: str) -> str:
-    """Format a 95% interval, or say that a bound lies beyond the horizon (no interval)."""
-    return '[beyond the horizon]' if ci is None else f'[{ci[0]:{sign}.3f}, {ci[1]:{sign}.3f}]'
+def _value(value, ci, sign: str, episodes: int) -> str:
+    """
+    Format a value and its 95% interval from ``episodes`` episodes.
+
+    No interval is ``-`` from fewer than MIN_EPISODES episodes, else a bound lies beyond the
+    horizon; no value: 90% is never reached (by one of the pair).
+    """
+    if value is None:
+        return 'never' if sign == '' else 'not defined (a policy never reaches 90%)'
+    return f'{value:{sign}.3f} {format_interval(ci, sign + ".3f", episodes)}'
 
 
-def main():
+def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
     parser.add_argument('--episodes', type=int, default=4000)
     parser.add_argument('--seed', type=int, default=1)
@@ -113,7 +121,7 @@ def main():
     parser.add_argument('--scheduler', default=None, metavar='ADDRESS',
                         help='a Dask scheduler to run the pieces on (docs/cluster.md)')
     parser.add_argument('--quiet', action='store_true', help='no progress on stderr')
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     n, names = args.episodes, args.policies
     policies = {name: build(name, args.planner_options) for name in names}
     cache = PieceCache(args.cache)
@@ -144,13 +152,13 @@ def main():
             point, ci = fixations_to_90_ci(results[name][i], GRID.n_cells,
                                            np.random.default_rng([args.seed, 7]), RESAMPLES)
             out['policies'][name][label] = {'fixations_to_90': point, 'ci95': ci}
-            print(f'{name:9s} {label:9s} {point:.3f} {_ci(ci, "")}')
+            print(f'{name:9s} {label:9s} {_value(point, ci, "", n)}')
     for a, b in itertools.combinations(names[::-1], 2):
         for i, label in enumerate(measures):
             diff, ci = paired_difference_ci(results[a][i], results[b][i], GRID.n_cells,
                                             np.random.default_rng([args.seed, 8]), RESAMPLES)
             out['paired'].setdefault(f'{a} - {b}', {})[label] = {'difference': diff, 'ci95': ci}
-            print(f'{a} - {b} ({label}, {n} paired): {diff:+.3f} {_ci(ci, "+")}')
+            print(f'{a} - {b} ({label}, {n} paired): {_value(diff, ci, "+", n)}')
     if args.json is not None:
         args.json.write_text(json.dumps(out, indent=1) + '\n')
 

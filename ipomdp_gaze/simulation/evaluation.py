@@ -110,6 +110,21 @@ BEYOND = 1e300
 MIN_EPISODES = 2
 
 
+def format_interval(ci, spec: str = '.3f', episodes: int | None = None) -> str:
+    """
+    Format a 95% interval as ``[low, high]`` (each with ``spec``), or ``-`` when there is none.
+
+    A bootstrap interval is None from fewer than :data:`MIN_EPISODES` searches; given
+    ``episodes`` (the searches it was drawn from), a missing interval of more says its other
+    reason, a bound beyond the horizon (:func:`_interval`).
+    """
+    if ci is not None:
+        return f'[{ci[0]:{spec}}, {ci[1]:{spec}}]'
+    if episodes is not None and episodes >= MIN_EPISODES:
+        return '[beyond the horizon]'
+    return '-'
+
+
 def _interval(low_values: np.ndarray, high_values: np.ndarray):
     """
     Return the 95% percentile interval, or None when a bound lies beyond the horizon.
