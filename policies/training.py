@@ -38,6 +38,7 @@ import time
 from typing import Callable
 
 from ipomdp_gaze.files.observation_file import fingerprint
+from ipomdp_gaze.files.writable import write_file
 from ipomdp_gaze.model.belief import check_prior, draw_cells
 from ipomdp_gaze.model.fpoc import FPOC
 from ipomdp_gaze.model.grid import Grid
@@ -550,12 +551,19 @@ def write_curve(path, rows: list[dict], append: bool = False) -> Path:
     """Write (or append to) a learning-curve CSV with columns :data:`CSV_FIELDS`."""
     path = Path(path)
     exists = append and path.is_file()
-    with path.open('a' if exists else 'w', newline='') as fh:
-        writer = csv.DictWriter(fh, fieldnames=CSV_FIELDS)
-        if not exists:
-            writer.writeheader()
-        for row in rows:
-            writer.writerow({k: ('' if row.get(k) is None else row[k]) for k in CSV_FIELDS})
+
+    def write(out: Path) -> None:
+        with out.open('a' if exists else 'w', newline='') as fh:
+            writer = csv.DictWriter(fh, fieldnames=CSV_FIELDS)
+            if not exists:
+                writer.writeheader()
+            for row in rows:
+                writer.writerow({k: ('' if row.get(k) is None else row[k]) for k in CSV_FIELDS})
+
+    if exists:
+        write(path)
+    else:
+        write_file(path, write)     # whole or not at all: a resumed training reads it back
     return path
 
 

@@ -32,6 +32,7 @@ import dataclasses
 from pathlib import Path
 import time
 
+from ipomdp_gaze.files.writable import write_figure
 from ipomdp_gaze.model.grid import Grid
 import numpy as np
 
@@ -270,8 +271,7 @@ def plot_fpoc(model, path: Path, title: str) -> None:
     axes[2].grid(True, alpha=0.3)
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=100)
+    write_figure(fig, path, dpi=100)
     plt.close(fig)
 
 

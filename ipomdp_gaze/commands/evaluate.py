@@ -380,9 +380,17 @@ def run_scenes(args) -> int:
                   + '; '.join(f'{k}: {d:+.3f} [{lo:+.3f}, {hi:+.3f}]'
                               for k, (d, lo, hi) in diff.items()))
     if args.json:
-        write_json(args.json, results_json(spec, results, summary))
-        print(f'wrote {args.json}')
+        _write_json(args.json, results_json(spec, results, summary))
     return 0
+
+
+def _write_json(path: Path, record: dict) -> None:
+    """Write ``--json`` whole or not at all; a failure names the option."""
+    try:
+        write_json(path, record)
+    except OSError as exc:
+        raise ValueError(f'--json {path}: cannot write: {exc.strerror or exc}') from None
+    print(f'wrote {path}')
 
 
 def run_walks(args) -> int:
@@ -413,8 +421,7 @@ def run_walks(args) -> int:
         for line in format_walks(name, s, reference if name != reference else ''):
             print(line)
     if args.json:
-        write_json(args.json, walks_json(spec, results, summary))
-        print(f'wrote {args.json}')
+        _write_json(args.json, walks_json(spec, results, summary))
     return 0
 
 
@@ -430,8 +437,7 @@ def _report_rooms(args, spec, results: dict, episodes: int) -> int:
         for line in format_rooms(name, s):
             print(line)
     if args.json:
-        write_json(args.json, results_json(spec, results, summary))
-        print(f'wrote {args.json}')
+        _write_json(args.json, results_json(spec, results, summary))
     return 0
 
 
@@ -544,6 +550,5 @@ def run(args) -> int:
         print(f'{name}: tracking accuracy with minus without prediction '
               f"{gain['difference']:+.4f}" + (f' [{ci[0]:+.4f}, {ci[1]:+.4f}]' if ci else ''))
     if args.json:
-        write_json(args.json, result)
-        print(f'wrote {args.json}')
+        _write_json(args.json, result)
     return 0

@@ -106,6 +106,7 @@ import sys
 
 import cv2
 from ipomdp_gaze.files.observation_file import load_observation, shipped_image_models
+from ipomdp_gaze.files.writable import write_text
 from ipomdp_gaze.model.belief import uniform_log_belief
 from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
@@ -965,15 +966,15 @@ def _write(text: str, out: Path, flag: str) -> bool:
     """
     Write ``text`` to ``out`` (``-``: stdout), saying where; False after one line if it fails.
 
-    A disk that fills during the run (checked writable before it) costs this output only.
+    A disk that fills during the run (checked writable before it) costs this output only, and
+    leaves the file that was there, or none, not half of one.
     """
     if out == STDOUT:
         sys.stdout.write(text)
         sys.stdout.flush()
         return True
     try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        out.write_text(text)
+        write_text(out, text)
     except OSError as exc:
         _error(f'{flag} {out}: cannot write: {exc.strerror or exc}')
         return False

@@ -17,6 +17,7 @@ import resource
 import time
 
 from ipomdp_gaze.drivers.pieces import COSTLY_CHUNK, PieceCache, PLANNER_CHUNK, Runner
+from ipomdp_gaze.files.writable import write_text
 from ipomdp_gaze.model.fpoc import dprime_table
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.policies.conv import radial_bins
@@ -418,7 +419,7 @@ def run(args) -> int:
               f'({cache.hits} of the pieces from the cache), load average '
               f'{load_start:.1f} at the start and {load_end:.1f} at the end (this machine: '
               f'{os.cpu_count()} cores).', '']
-    (out / 'reproduction.md').write_text('\n'.join(lines) + '\n')
+    write_text(out / 'reproduction.md', '\n'.join(lines) + '\n')
     log(f'wrote {out / "reproduction.md"} and {figures}/ ({wall:.0f} s wall, {cpu:.0f} s CPU)')
     return 0
 

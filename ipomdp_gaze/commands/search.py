@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ipomdp_gaze.files.writable import write_figure
 from ipomdp_gaze.model.belief import draw_cells
 from ipomdp_gaze.model.observation import as_observation
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
@@ -151,8 +152,7 @@ def plot_search(grid, belief, path, target, title, out_path):
     ax.set_xlabel('column')
     ax.set_ylabel('row')
     fig.tight_layout()
-    out_path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out_path, dpi=110)
+    write_figure(fig, out_path, dpi=110)
     plt.close(fig)
 
 

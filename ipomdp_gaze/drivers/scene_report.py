@@ -16,6 +16,7 @@ import math
 from pathlib import Path
 
 from ipomdp_gaze.files import json_files
+from ipomdp_gaze.files.writable import write_text
 from ipomdp_gaze.model.head_time import head_time_s, head_travel_deg
 from ipomdp_gaze.simulation.evaluation import answer_is_right, MIN_EPISODES, wilson_interval
 import numpy as np
@@ -229,6 +230,5 @@ def results_json(spec, results, summary: dict) -> dict:
 
 
 def write_json(path: Path, record: dict) -> None:
-    """Write a JSON record (parents created)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json_files.dumps(record) + '\n')
+    """Write a JSON record (parents created), whole or not at all."""
+    write_text(path, json_files.dumps(record) + '\n')

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ipomdp_gaze.files.writable import write_text
 import numpy as np
 import yaml
 
@@ -147,12 +148,9 @@ def plain(value):
 
 
 def write_yaml(path, doc: dict) -> Path:
-    """Write ``doc`` (plain types) as block YAML, keys in order; create the folder."""
+    """Write ``doc`` (plain types) as block YAML, keys in order, whole or not at all."""
     path = Path(path)
-    if path.parent != Path(''):
-        path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=100),
-                    encoding='utf-8')
+    write_text(path, yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=100))
     return path
 
 

@@ -14,6 +14,7 @@ from pathlib import Path
 import textwrap
 
 import cv2
+from ipomdp_gaze.files.writable import write_figure, write_file
 import numpy as np
 
 from .annotate import annotate, fovea_cell_map, LOG_RANGE
@@ -125,18 +126,16 @@ def save_figure(picture: np.ndarray, out_path: Path, title: str) -> None:
                        fraction=0.04, pad=0.02)
     bar.set_label('log10 belief / most likely cell (overlay)', fontsize=8)
     fig.tight_layout()
-    out_path = Path(out_path)
-    out_path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out_path, dpi=100, format=out_path.suffix.lstrip('.').lower() or 'png')
+    write_figure(fig, out_path, dpi=100)
     plt.close(fig)
 
 
 def save_png(picture: np.ndarray, out_path: Path) -> None:
     """Save an RGB picture as it is (no title, no scale)."""
-    out_path = Path(out_path)
-    out_path.parent.mkdir(parents=True, exist_ok=True)
-    if not cv2.imwrite(str(out_path), np.ascontiguousarray(picture[:, :, ::-1])):
-        raise OSError(f'cannot write {out_path}')
+    ok, data = cv2.imencode('.png', np.ascontiguousarray(picture[:, :, ::-1]))
+    if not ok:
+        raise OSError(f'cannot encode a PNG of {out_path}')
+    write_file(out_path, lambda temporary: temporary.write_bytes(data.tobytes()))
 
 
 def save_gif(frames, out_path: Path, seconds_per_frame: float = 0.6,
@@ -158,8 +157,7 @@ def save_gif(frames, out_path: Path, seconds_per_frame: float = 0.6,
         raise ValueError('no frame to animate: the search published no picture')
     images = [Image.fromarray(f) for f in frames]
     durations = [int(seconds_per_frame * 1000)] * (len(images) - 1) + [int(last_seconds * 1000)]
-    out_path = Path(out_path)
-    out_path.parent.mkdir(parents=True, exist_ok=True)
-    images[0].save(out_path, format='GIF', save_all=True, append_images=images[1:],
-                   duration=durations, loop=0, optimize=True)
+    write_file(out_path, lambda temporary: images[0].save(
+        temporary, format='GIF', save_all=True, append_images=images[1:], duration=durations,
+        loop=0, optimize=True))
     return len(images)

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import math
 
 import cv2
+from ipomdp_gaze.files.writable import write_figure
 from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, SceneGeometry
 from ipomdp_gaze.vision.scenes import DEFAULT_FEATHER, feather_mask, load_faces
 import numpy as np
@@ -383,5 +384,5 @@ def plot_walk(times_s, face_rc, head_rc, path, title: str = '', events=()) -> No
     axes[1].set_xlabel('time (s)')
     fig.suptitle(title or 'the face and the gaze over time', fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    write_figure(fig, path, dpi=100)
     plt.close(fig)

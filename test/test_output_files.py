@@ -1,0 +1,104 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""The files the commands write: whole or not at all."""
+import os
+from pathlib import Path
+import resource
+import signal
+import subprocess
+import sys
+
+from ipomdp_gaze.files.writable import write_file, write_text
+from ipomdp_gaze.policies.policy_file import load_policy_spec
+from ipomdp_gaze.policies.training import read_curve
+import pytest
+import skimage.data
+
+ASTRONAUT = Path(skimage.data.__file__).parent / 'astronaut.png'
+
+
+def _small_files(limit_bytes: int):
+    """Return a ``preexec_fn`` that lets the child write no file past ``limit_bytes``."""
+    def limit():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)        # EFBIG, as a full disk's ENOSPC
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit_bytes, limit_bytes))
+    return limit
+
+
+def run_cli(*args, limit_bytes=None, cwd=None):
+    return subprocess.run([sys.executable, '-m', 'ipomdp_gaze.cli', *map(str, args)],
+                          capture_output=True, text=True, timeout=300, cwd=cwd,
+                          preexec_fn=None if limit_bytes is None else _small_files(limit_bytes))
+
+
+def _leftovers(folder: Path) -> list:
+    return sorted(p.name for p in folder.iterdir() if p.name.startswith('.'))
+
+
+def test_evaluate_json_the_disk_refuses_keeps_the_old_file_and_names_json(tmp_path):
+    """A write that fails part way left half a JSON record ('[Errno 27] File too large')."""
+    out = tmp_path / 'out.json'
+    out.write_text('{"old": 1}\n')
+    run = run_cli('evaluate', '--grid', '3x3', '--episodes', '20', '--json', out,
+                  limit_bytes=200)
+    assert run.returncode == 2
+    assert run.stderr.strip().splitlines()[-1] == \
+        f'ipomdp-gaze evaluate: error: --json {out}: cannot write: File too large'
+    assert out.read_text() == '{"old": 1}\n'
+    assert _leftovers(tmp_path) == []
+
+
+def test_find_outputs_the_disk_refuses_keep_the_old_files(tmp_path):
+    outputs = {name: tmp_path / name for name in ('found.json', 'found.log', 'found.png')}
+    for path in outputs.values():
+        path.write_text('old\n')
+    run = run_cli('find', ASTRONAUT, '--json', outputs['found.json'], '--log',
+                  outputs['found.log'], '--plot', outputs['found.png'], limit_bytes=100)
+    assert run.returncode == 2 and 'Traceback' not in run.stderr
+    for flag, name in (('--json', 'found.json'), ('--log', 'found.log'), ('--plot', 'found.png')):
+        assert f'{flag} {outputs[name]}: cannot write: File too large' in run.stderr
+        assert outputs[name].read_text() == 'old\n'
+    assert _leftovers(tmp_path) == []
+
+
+def test_a_resumed_training_the_disk_refuses_keeps_the_policy_it_resumes(tmp_path):
+    """``train --resume P`` writes over P: a failed write must not leave half a policy."""
+    policy = tmp_path / 'p.yaml'
+    assert run_cli('train', '--grid', '3x3', '--epochs', '2', '--eval-every', '1',
+                   '--episodes-per-epoch', '4', '--eval-episodes', '20', '--final-episodes',
+                   '0', '--out', policy).returncode == 0
+    before = policy.read_bytes(), policy.with_suffix('.csv').read_bytes()
+    run = run_cli('train', '--resume', policy, '--epochs', '4', '--final-episodes', '0',
+                  limit_bytes=300)
+    assert run.returncode == 2 and 'Traceback' not in run.stderr
+    assert (policy.read_bytes(), policy.with_suffix('.csv').read_bytes()) == before
+    assert load_policy_spec(policy).training['epochs'] == 2
+    assert [row['epoch'] for row in read_curve(policy.with_suffix('.csv'))] == [1, 2]
+    assert _leftovers(tmp_path) == []
+
+
+def test_write_file_keeps_the_mode_a_new_file_gets_and_writes_devices_in_place(tmp_path):
+    umask = os.umask(0o022)
+    try:
+        path = write_text(tmp_path / 'sub' / 'new.json', '{}\n')
+        assert path.stat().st_mode & 0o777 == 0o644
+        old = tmp_path / 'old.json'
+        old.write_text('x')
+        old.chmod(0o640)
+        write_text(old, 'y')
+        assert old.read_text() == 'y' and old.stat().st_mode & 0o777 == 0o640
+    finally:
+        os.umask(umask)
+    link = tmp_path / 'link.json'
+    link.symlink_to(old)
+    write_text(link, 'z')
+    assert link.is_symlink() and old.read_text() == 'z'
+    assert write_text(Path(os.devnull), 'nothing') == Path(os.devnull)     # not replaced
+    assert Path(os.devnull).is_char_device()
+
+    def stopped(temporary):
+        temporary.write_text('half')
+        raise KeyboardInterrupt
+    with pytest.raises(KeyboardInterrupt):
+        write_file(old, stopped)
+    assert old.read_text() == 'z' and _leftovers(tmp_path) == []
