@@ -1,6 +1,6 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""The files the commands write: whole or not at all."""
+"""The files the commands write: whole or not at all, refused before the work."""
 import os
 from pathlib import Path
 import resource
@@ -8,6 +8,7 @@ import signal
 import subprocess
 import sys
 
+from ipomdp_gaze.cli import main
 from ipomdp_gaze.files.writable import write_file, write_text
 from ipomdp_gaze.policies.policy_file import load_policy_spec
 from ipomdp_gaze.policies.training import read_curve
@@ -102,3 +103,14 @@ def test_write_file_keeps_the_mode_a_new_file_gets_and_writes_devices_in_place(t
     with pytest.raises(KeyboardInterrupt):
         write_file(old, stopped)
     assert old.read_text() == 'z' and _leftovers(tmp_path) == []
+
+
+def test_a_sweep_refuses_a_file_it_would_write_before_any_training(tmp_path, capsys):
+    """``PATH-seedS.yaml`` was found unwritable only after every training had run."""
+    (tmp_path / 't-seed2.yaml').mkdir()
+    assert main(['train', '--grid', '3x3', '--seeds', '1,2', '--epochs', '1',
+                 '--episodes-per-epoch', '2', '--final-episodes', '0', '--jobs', '1',
+                 '--quiet', '--out', str(tmp_path / 't.yaml')]) == 2
+    err = capsys.readouterr().err
+    assert err == f'ipomdp-gaze train: error: --out {tmp_path}/t-seed2.yaml: is a directory\n'
+    assert sorted(p.name for p in tmp_path.iterdir()) == ['t-seed2.yaml']

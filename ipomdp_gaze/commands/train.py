@@ -331,6 +331,12 @@ def run_sweep(args, grid, model, config, params, init, out) -> int:
     seeds = args.seeds if args.seeds is not None else [config.seed]
     rates = args.learning_rates
     runs = [(seed, rate) for rate in (rates or [config.learning_rate]) for seed in seeds]
+    paths = {(seed, rate): out.with_name(f'{out.stem}-seed{seed}'
+                                         + (f'-lr{rate:g}' if rates else '') + '.yaml')
+             for seed, rate in runs}
+    for path in paths.values():         # refused before any training, as --out itself
+        check_output_file('--out', path)
+        check_output_file('--out', path.with_suffix('.csv'))
     epochs = args.epochs
     with executor_from_args(args, len(runs)) as executor, \
             progress_from_args(args, len(runs), 'train sweep', 'training') as bar:
@@ -343,8 +349,7 @@ def run_sweep(args, grid, model, config, params, init, out) -> int:
         for future in track(list(futures), bar):
             seed, rate = futures[future]
             spec, rows, evaluation = future.result()
-            tag = f'-seed{seed}' + (f'-lr{rate:g}' if rates else '')
-            path = out.with_name(f'{out.stem}{tag}.yaml')
+            path = paths[seed, rate]
             save_policy(path, spec)
             write_curve(path.with_suffix('.csv'), rows)
             results[seed, rate] = (path, rows, evaluation)
