@@ -114,3 +114,24 @@ def test_a_sweep_refuses_a_file_it_would_write_before_any_training(tmp_path, cap
     err = capsys.readouterr().err
     assert err == f'ipomdp-gaze train: error: --out {tmp_path}/t-seed2.yaml: is a directory\n'
     assert sorted(p.name for p in tmp_path.iterdir()) == ['t-seed2.yaml']
+
+
+@pytest.mark.parametrize('args', [['--plot', '{dir}/d.png'], ['--animate', '{dir}/d.gif'],
+                                  ['--scene', 'faces', '--motion', 'walk', '--plot',
+                                   '{dir}/d.png']])
+def test_demo_refuses_its_picture_files_before_the_nodes_run(tmp_path, monkeypatch, capsys,
+                                                             args):
+    """An unwritable --plot or --animate was found after the whole demo had run."""
+    import ipomdp_gaze.harness.demo as demo
+    import ipomdp_gaze.harness.walk_demo as walk_demo
+
+    def run(*args, **kwargs):
+        raise AssertionError('the nodes ran')
+    monkeypatch.setattr(demo, 'run_demo', run)
+    monkeypatch.setattr(walk_demo, 'run_walk_demo', run)
+    (tmp_path / 'd.png').mkdir()
+    (tmp_path / 'd.gif').mkdir()
+    args = [a.format(dir=tmp_path) for a in args]
+    assert main(['demo', *args]) == 2
+    assert capsys.readouterr().err == \
+        f'ipomdp-gaze demo: error: {args[-2]} {args[-1]}: is a directory\n'

@@ -22,7 +22,7 @@ from ipomdp_gaze.harness.processes import MAX_DOMAIN_ID, valid_domain_id
 from ipomdp_gaze.vision.pan_tilt import parse_faces
 from ipomdp_gaze.vision.walks import DURATION_S as DEMO_DURATION_S
 
-from .common import nonneg_int, positive_float, positive_int
+from .common import check_output_file, nonneg_int, positive_float, positive_int
 from .record import add_split_args
 
 # --motion walk: the walking speed unless --speed-deg-s says (the offline evaluation's default).
@@ -143,6 +143,8 @@ def run(args) -> int:
     for flag, path, suffix in (('--plot', args.plot, '.png'), ('--animate', args.animate, '.gif')):
         if path is not None and path.suffix.lower() != suffix:
             raise ValueError(f'{flag} writes a {suffix} file, got {path}')
+        if path is not None:
+            check_output_file(flag, path)   # before the nodes run, not after
     faces = parse_faces(args.faces)
     if args.motion == 'walk':
         return _walk(args, faces, out)
