@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
-"""The files the commands write: whole or not at all, refused before the work."""
+"""The files the commands write: whole or not at all, refused before the work, noted on stderr."""
+import json
 import os
 from pathlib import Path
 import resource
@@ -135,3 +136,18 @@ def test_demo_refuses_its_picture_files_before_the_nodes_run(tmp_path, monkeypat
     assert main(['demo', *args]) == 2
     assert capsys.readouterr().err == \
         f'ipomdp-gaze demo: error: {args[-2]} {args[-1]}: is a directory\n'
+
+
+@pytest.mark.parametrize('command', [
+    ['evaluate', '--grid', '3x3', '--episodes', '20', '--json', '{dir}/e.json'],
+    ['search', '--grid', '3x3', '--seed', '1', '--plot', '{dir}/s.png'],
+])
+def test_the_note_of_a_file_written_goes_to_stderr(tmp_path, command):
+    """``evaluate ... --json F > table.txt`` put 'wrote F' among the table's lines."""
+    run = run_cli(*[a.format(dir=tmp_path) for a in command])
+    assert run.returncode == 0, run.stderr
+    written = command[-1].format(dir=tmp_path)
+    assert 'wrote' not in run.stdout
+    assert f'ipomdp-gaze {command[0]}: wrote {written}\n' in run.stderr
+    if written.endswith('.json'):
+        assert json.loads(Path(written).read_text())['grid']['rows'] == 3

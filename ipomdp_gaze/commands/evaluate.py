@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
+import sys
 
 from ipomdp_gaze.drivers.pieces import concat_results, COSTLY_CHUNK, PLANNER_CHUNK, simulate_pieces
 from ipomdp_gaze.drivers.rooms import format_rooms, room_settings, summarise_rooms
@@ -385,12 +386,12 @@ def run_scenes(args) -> int:
 
 
 def _write_json(path: Path, record: dict) -> None:
-    """Write ``--json`` whole or not at all; a failure names the option."""
+    """Write ``--json`` whole or not at all; say so on stderr (stdout holds the results only)."""
     try:
         write_json(path, record)
     except OSError as exc:
         raise ValueError(f'--json {path}: cannot write: {exc.strerror or exc}') from None
-    print(f'wrote {path}')
+    print(f'ipomdp-gaze evaluate: wrote {path}', file=sys.stderr)
 
 
 def run_walks(args) -> int:

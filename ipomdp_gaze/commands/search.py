@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+import sys
 
 from ipomdp_gaze.files.writable import write_figure
 from ipomdp_gaze.model.belief import draw_cells
@@ -198,5 +199,5 @@ def run(args) -> int:
                  f'{p}, {len(path)} fixations '
                  f"{'(no target)' if target is None else '(star = target)'}")
         plot_search(grid, belief, path, target, title, args.plot)
-        print(f'wrote {args.plot}')
+        print(f'ipomdp-gaze search: wrote {args.plot}', file=sys.stderr)
     return 0
