@@ -97,7 +97,6 @@ from __future__ import annotations
 
 from dataclasses import replace
 import errno
-import json
 import math
 import os
 from pathlib import Path
@@ -105,6 +104,7 @@ import stat
 import sys
 
 import cv2
+from ipomdp_gaze.files import json_files
 from ipomdp_gaze.files.observation_file import load_observation, shipped_image_models
 from ipomdp_gaze.files.writable import write_text
 from ipomdp_gaze.model.belief import uniform_log_belief
@@ -1098,7 +1098,9 @@ def run(args) -> int:
                      {} if not args.all else
                      {'face': k} if result.decision == 'found' else {'search': k})
             entries.append({**entry(path, result, grid, settings.confidence), **extra})
-        logs.append(json.dumps({'path': path, 'events': [e for r in results for e in r.log]}))
+        logs.append(json_files.dumps({'path': path,
+                                      'events': [e for r in results for e in r.log]},
+                                     indent=None))
         if plots:
             title = plot_title(path, results[0], settings.confidence, occupancy,
                                len(results[0].faces) if many else None)
@@ -1107,10 +1109,10 @@ def run(args) -> int:
         unwritten += not _write('\n'.join(logs) + '\n' if logs else '', args.log, '--log')
     if args.json:
         rows, cols = grid.shape if grid is not None else (None, None)
-        unwritten += not _write(json.dumps({'grid': {'rows': rows, 'cols': cols},
-                                            'axes': {'cell': ['row', 'col'],
-                                                     'pixel': ['x', 'y']},
-                                            'images': entries}, indent=1) + '\n',
+        unwritten += not _write(json_files.dumps({'grid': {'rows': rows, 'cols': cols},
+                                                  'axes': {'cell': ['row', 'col'],
+                                                           'pixel': ['x', 'y']},
+                                                  'images': entries}) + '\n',
                                 args.json, '--json')
     if failed:
         _error(f'{failed} of {len(images)} inputs could not be searched')

@@ -6,9 +6,18 @@ from __future__ import annotations
 import json
 import math
 
+import numpy as np
+
 
 def finite(value):
-    """Return ``value`` with every NaN or infinite float (nested in dicts, lists) as None."""
+    """
+    Return ``value`` with every NaN or infinite float (nested in dicts, lists) as None.
+
+    numpy scalars and arrays become Python numbers and lists first (``json`` refuses a
+    ``float32`` or an ``int64``, with a traceback after the work).
+    """
+    if isinstance(value, (np.ndarray, np.generic)):
+        value = value.tolist()
     if isinstance(value, float):
         return value if math.isfinite(value) else None
     if isinstance(value, dict):
