@@ -151,3 +151,18 @@ def test_the_note_of_a_file_written_goes_to_stderr(tmp_path, command):
     assert f'ipomdp-gaze {command[0]}: wrote {written}\n' in run.stderr
     if written.endswith('.json'):
         assert json.loads(Path(written).read_text())['grid']['rows'] == 3
+
+
+def test_a_writable_file_in_a_folder_that_takes_no_new_file_is_written_in_place(
+        tmp_path, monkeypatch):
+    """``check_output_file`` accepts such a file: the write must not then need a new one."""
+    import ipomdp_gaze.files.writable as writable
+
+    def refused(target):
+        raise PermissionError(13, 'Permission denied')
+    monkeypatch.setattr(writable, '_new_file', refused)
+    own = tmp_path / 'own.json'
+    own.write_text('old')
+    assert write_text(own, 'new').read_text() == 'new'
+    with pytest.raises(PermissionError, match=str(tmp_path / 'other.json')):
+        write_text(tmp_path / 'other.json', 'new')

@@ -34,9 +34,10 @@ def write_file(path, write) -> Path:
     A write stopped part way (a full disk, Ctrl-C) leaves the file that was there, or none,
     never half of one: a reader of a policy, a model or a JSON record sees it whole or not at
     all. The temporary file takes the mode a new file gets (the umask), or the replaced file's.
-    A path that is there and not a regular file (``/dev/null``, a pipe) is written in place; a
-    symbolic link's target is the file replaced. The folder is made if missing. An OSError is
-    raised again naming ``path``, not the temporary file.
+    A path that is there and not a regular file (``/dev/null``, a pipe) is written in place, as
+    is a file of one's own in a folder that takes no new file; a symbolic link's target is the
+    file replaced. The folder is made if missing. An OSError is raised again naming ``path``,
+    not the temporary file.
     """
     path = Path(path)
     target = Path(os.path.realpath(path))
@@ -47,6 +48,9 @@ def write_file(path, write) -> Path:
         target.parent.mkdir(parents=True, exist_ok=True)
         temporary = _new_file(target)
     except OSError as exc:
+        if target.is_file() and os.access(target, os.W_OK):
+            write(target)                       # the folder refuses a new file; this one is ours
+            return path
         raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
     try:
         if target.exists():
