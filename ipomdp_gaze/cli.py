@@ -100,12 +100,60 @@ def _terminate(signum, frame):
 # handling; demo and record keep theirs.
 WORK_COMMANDS = ('evaluate', 'train', 'reproduce', 'calibrate', 'find', 'search')
 
+# The options that name a file a work command or the demo writes (``-`` is stdout, no file).
+OUTPUT_OPTIONS = ('json', 'log', 'plot', 'out', 'resume', 'animate', 'record')
+
+
+def writes_files(args) -> bool:
+    """Whether the parsed command writes a file of its own besides stdout and stderr."""
+    return args.command in WORK_COMMANDS + ('demo',) and any(
+        getattr(args, name, None) is not None and str(getattr(args, name)) != '-'
+        for name in OUTPUT_OPTIONS)
+
+
+class _ReaderGone:
+    """
+    A stdout or stderr that, once its reader has gone (``| head -1``), discards what is written.
+
+    Installed for a command that writes files: a pipe closed early must cost the lines it
+    no longer wants, not ``--json`` and the other files, which are written at the end.
+    """
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def write(self, text):
+        try:
+            return self._stream.write(text)
+        except BrokenPipeError:
+            self._discard()
+            return len(text)
+
+    def flush(self):
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            self._discard()
+
+    def _discard(self):
+        try:                                    # nothing still buffered reaches the pipe
+            os.dup2(os.open(os.devnull, os.O_WRONLY), self._stream.fileno())
+        except (OSError, ValueError, AttributeError):
+            pass                                # not a file descriptor (a test's capture)
+        self._stream = open(os.devnull, 'w')
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
 
 def _run(args) -> int:
     """Run the parsed command; its errors as one line (exit 2)."""
     handles = args.command in WORK_COMMANDS and \
         threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGTERM, _terminate) if handles else None
+    streams = sys.stdout, sys.stderr
+    if writes_files(args):
+        sys.stdout, sys.stderr = _ReaderGone(sys.stdout), _ReaderGone(sys.stderr)
     try:
         return int(args.run(args) or 0)
     except BrokenPipeError:
@@ -124,6 +172,7 @@ def _run(args) -> int:
     except KeyboardInterrupt:
         return 130
     finally:
+        sys.stdout, sys.stderr = streams
         if handles:
             signal.signal(signal.SIGTERM, previous)
 

@@ -166,3 +166,44 @@ def test_a_writable_file_in_a_folder_that_takes_no_new_file_is_written_in_place(
     assert write_text(own, 'new').read_text() == 'new'
     with pytest.raises(PermissionError, match=str(tmp_path / 'other.json')):
         write_text(tmp_path / 'other.json', 'new')
+
+
+def _reader_gone(args, stderr):
+    """Run the CLI with its stdout a pipe closed before anything is read (``| head -0``)."""
+    with subprocess.Popen([sys.executable, '-m', 'ipomdp_gaze.cli', *map(str, args)],
+                          stdout=subprocess.PIPE, stderr=stderr) as child:
+        child.stdout.close()
+        return child.wait(timeout=300)
+
+
+COMMAND_FILES = [
+    (['evaluate', '--grid', '3x3', '--episodes', '20', '--json', '{dir}/e.json'], ['e.json']),
+    (['find', ASTRONAUT, Path(skimage.data.__file__).parent / 'coffee.png', '--json',
+      '{dir}/f.json', '--log', '{dir}/f.log', '--plot', '{dir}/f.png'],
+     ['f-0.png', 'f-1.png', 'f.json', 'f.log']),
+    (['search', '--grid', '5x5', '--plot', '{dir}/s.png'], ['s.png']),
+]
+
+
+@pytest.mark.parametrize('command, files', COMMAND_FILES)
+@pytest.mark.parametrize('stderr_too', [False, True])
+def test_a_reader_that_goes_away_costs_no_output_file(tmp_path, command, files, stderr_too):
+    """``find ... --json F | head -1`` ended quietly at the closed pipe, F never written."""
+    errors = tmp_path / 'stderr.txt'
+    with errors.open('w') as stderr:
+        status = _reader_gone([str(a).format(dir=tmp_path) for a in command],
+                              subprocess.STDOUT if stderr_too else stderr)
+    assert status == 0
+    assert 'Traceback' not in errors.read_text()
+    assert sorted(p.name for p in tmp_path.iterdir() if p != errors) == files
+    for name in files:
+        if name.endswith('.json'):
+            record = json.loads((tmp_path / name).read_text())
+            assert len(record.get('images', [0, 0])) == 2       # find: both images searched
+
+
+def test_a_reader_that_goes_away_still_stops_a_command_without_files(tmp_path):
+    errors = tmp_path / 'stderr.txt'
+    with errors.open('w') as stderr:
+        assert _reader_gone(['search', '--grid', '5x5'], stderr) == 0
+    assert errors.read_text() == ''
