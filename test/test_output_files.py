@@ -207,3 +207,24 @@ def test_a_reader_that_goes_away_still_stops_a_command_without_files(tmp_path):
     with errors.open('w') as stderr:
         assert _reader_gone(['search', '--grid', '5x5'], stderr) == 0
     assert errors.read_text() == ''
+
+
+@pytest.mark.parametrize('args', [
+    ['evaluate', '--json', '{dir}/results/'],
+    ['find', ASTRONAUT, '--json', '{dir}/results/'],
+    ['find', ASTRONAUT, '--log', '{dir}/results/'],
+    ['find', ASTRONAUT, '--plot', '{dir}/found.png/'],
+    ['search', '--plot', '{dir}/s.png/'],
+    ['train', '--epochs', '1', '--out', '{dir}/t.yaml/'],
+    ['calibrate', '--scenes', '1', '--out', '{dir}/m.yaml/'],
+    ['demo', '--plot', '{dir}/d.png/'],
+])
+def test_an_output_file_that_ends_in_a_slash_is_refused(tmp_path, args):
+    """``--json results/`` wrote a file named ``results``: the slash names a folder."""
+    args = [str(a).format(dir=tmp_path) for a in args]
+    run = run_cli(*args)
+    assert run.returncode == 2
+    assert run.stderr.splitlines()[-1] == (
+        f'ipomdp-gaze {args[0]}: error: argument {args[-2]}: {args[-1]!r} ends in / and names '
+        'a folder: give the name of a file to write in it')
+    assert list(tmp_path.iterdir()) == []

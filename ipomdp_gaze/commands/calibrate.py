@@ -36,8 +36,8 @@ from ipomdp_gaze.files.writable import write_figure
 from ipomdp_gaze.model.grid import Grid
 import numpy as np
 
-from .common import check_output_file, grid_arg, nonneg_int, positive_float, positive_int, \
-    size_arg
+from .common import check_output_file, grid_arg, nonneg_int, output_file, positive_float, \
+    positive_int, size_arg
 from .running import add_run_args, executor_from_args, progress_from_args
 
 # The two tasks of the face issue: image side and face sizes in pixels.
@@ -155,8 +155,8 @@ def add_parser(sub):
                    help='fixate the cells whose row and column are multiples of S (and the '
                         'last row and column) instead of every cell (default 1: every cell)')
     p.add_argument('--processes', dest='jobs', type=positive_int, help=argparse.SUPPRESS)
-    p.add_argument('--out', type=Path, required=True, metavar='FILE.yaml')
-    p.add_argument('--plot', type=Path, default=None, metavar='PNG',
+    p.add_argument('--out', type=output_file, required=True, metavar='FILE.yaml')
+    p.add_argument('--plot', type=output_file, default=None, metavar='PNG',
                    help='figure of the learned FPOC (default: beside --out)')
     add_run_args(p)
     p.set_defaults(run=run)

@@ -220,6 +220,19 @@ def task_from_args(args) -> tuple[Grid, object]:
     return grid, make_fpoc(args.fpoc, **params)
 
 
+def output_file(text: str) -> Path:
+    """
+    Parse the path of a file to write for argparse; refuse one that ends in ``/``.
+
+    ``--json results/`` names a folder, but a ``Path`` drops the slash: a file ``results``
+    was written where the user meant a folder.
+    """
+    if text.endswith(('/', os.sep)) and text.strip('/' + os.sep):
+        raise argparse.ArgumentTypeError(f'{text!r} ends in / and names a folder: give the '
+                                         f'name of a file to write in it')
+    return Path(text)
+
+
 def check_output_file(flag: str, path: Path, plot: bool = False) -> Path:
     """
     Refuse, before any work, an output file that cannot be written: one line naming ``flag``.

@@ -22,7 +22,7 @@ from ipomdp_gaze.harness.processes import MAX_DOMAIN_ID, valid_domain_id
 from ipomdp_gaze.vision.pan_tilt import parse_faces
 from ipomdp_gaze.vision.walks import DURATION_S as DEMO_DURATION_S
 
-from .common import check_output_file, nonneg_int, positive_float, positive_int
+from .common import check_output_file, nonneg_int, output_file, positive_float, positive_int
 from .record import add_split_args
 
 # --motion walk: the walking speed unless --speed-deg-s says (the offline evaluation's default).
@@ -86,10 +86,10 @@ def add_parser(sub):
     p.add_argument('--domain-id', type=domain_arg, default=None,
                    help='ROS domain id, 0..101 or 215..232 (default: derived from the process id)')
     p.add_argument('--verbose', action='store_true', help="print the nodes' own output")
-    p.add_argument('--plot', type=Path, default=None, metavar='PNG',
+    p.add_argument('--plot', type=output_file, default=None, metavar='PNG',
                    help='write the final picture of the search: the belief over the camera '
                         "image (faces: the detector's annotated_image) with the fixations")
-    p.add_argument('--animate', type=Path, default=None, metavar='GIF',
+    p.add_argument('--animate', type=output_file, default=None, metavar='GIF',
                    help='write an animated GIF of the search, one picture per belief')
     p.add_argument('--record', type=Path, default=None, metavar='PATH',
                    help='record the search to a rosbag2 bag (a new directory: metadata.yaml '

@@ -42,7 +42,7 @@ from ipomdp_gaze.vision.walks import SPEED_DEG_S as WALK_SPEED_DEG_S
 import numpy as np
 
 from .common import (add_prior_arg, add_task_args, bootstrap_count, check_output_file,
-                     nonneg_int, positive_int, read_prior, task_from_args)
+                     nonneg_int, output_file, positive_int, read_prior, task_from_args)
 from .running import add_run_args, executor_from_args, progress_from_args
 from .search_args import add_scene_args, add_search_args, settings_from_args
 
@@ -130,7 +130,8 @@ def add_parser(sub):
     p.add_argument('--compare-prediction', action='store_true',
                    help='moving target: also run each policy without the prediction step and '
                         'report the paired difference in tracking accuracy')
-    p.add_argument('--json', type=Path, default=None, metavar='OUT', help='write results here')
+    p.add_argument('--json', type=output_file, default=None, metavar='OUT',
+                   help='write results here')
     add_run_args(p)
     p.set_defaults(run=run)
 

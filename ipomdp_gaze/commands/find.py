@@ -125,7 +125,7 @@ from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, clip_b
                                        size_distance)
 import numpy as np
 
-from .common import check_output_file, nonneg_int, plot_format, positive_float
+from .common import check_output_file, nonneg_int, output_file, plot_format, positive_float
 from .search_args import add_search_args, settings_from_args, TASK_DEFAULT
 
 # greedy (the ideal searcher) needs a Gaussian FPOC; find's models count detections
@@ -217,12 +217,12 @@ def add_parser(sub):
                     '--targets one: find a face, rule the cells within 2 of it out, search '
                     'again: a line per search (face=K for a face, at a point without a box; '
                     'search=K for the last, which found none)')
-    p.add_argument('--plot', type=Path, default=None, metavar='OUT.png',
+    p.add_argument('--plot', type=output_file, default=None, metavar='OUT.png',
                    help='draw the image, the numbered fixations and the windows of the last '
                         'one, in the format the extension names (.png, .pdf, .svg, .jpg, ...; '
                         'others refused); with several images, OUT-<i>.ext for image i '
                         '(0-based)')
-    p.add_argument('--json', type=Path, default=None, metavar='OUT.json',
+    p.add_argument('--json', type=output_file, default=None, metavar='OUT.json',
                    help='write {grid, axes, images: [{path, cell [row, col], pixel [x, y] '
                         '(null unless found), probability (of the answer: the cell found, or '
                         'that nobody is there for absent: with --all or --scan many '
@@ -264,7 +264,7 @@ def add_parser(sub):
                         "--all's many-target search; fovea: the paper's single-target search "
                         'with the fovea within one full scan (find before --scan); --all and '
                         '--targets many do not use it (stderr says so when it is given)')
-    p.add_argument('--log', type=Path, default=None, metavar='OUT.jsonl',
+    p.add_argument('--log', type=output_file, default=None, metavar='OUT.jsonl',
                    help="write each image's search session event log (reset with the "
                         'settings, scan, start, one event per fixation with the frame and '
                         'belief summaries and the decision) as one JSON line per image (no '

@@ -3,7 +3,6 @@
 """``ipomdp-gaze search``: one offline search, printed fixation by fixation."""
 from __future__ import annotations
 
-from pathlib import Path
 import sys
 
 from ipomdp_gaze.files.writable import write_figure
@@ -17,7 +16,7 @@ from ipomdp_gaze.search.session import SearchSession, SearchSettings
 import numpy as np
 
 from .common import (add_prior_arg, add_task_args, cell_arg, cell_index, check_output_file,
-                     nonneg_int, read_prior, task_from_args)
+                     nonneg_int, output_file, read_prior, task_from_args)
 from .search_args import add_search_args, settings_from_args
 
 # The paper's convention: the policy picks every fixation, the first included (design 4.1).
@@ -49,7 +48,7 @@ def add_parser(sub):
     add_prior_arg(p, 'the hidden target is drawn from it (unless --target) and the belief starts '
                      'at it')
     p.add_argument('--seed', type=nonneg_int, default=0)
-    p.add_argument('--plot', type=Path, default=None, metavar='PNG',
+    p.add_argument('--plot', type=output_file, default=None, metavar='PNG',
                    help='save the final belief with the scan path as a picture')
     p.set_defaults(run=run)
 

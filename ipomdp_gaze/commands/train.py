@@ -15,8 +15,8 @@ from pathlib import Path
 from ipomdp_gaze.model.belief import prior_is_uniform
 from ipomdp_gaze.search.session import SearchSettings
 
-from .common import (add_prior_arg, add_task_args, check_output_file, nonneg_int, positive_float,
-                     positive_int, read_prior, task_from_args)
+from .common import (add_prior_arg, add_task_args, check_output_file, nonneg_int, output_file,
+                     positive_float, positive_int, read_prior, task_from_args)
 from .running import add_run_args, executor_from_args, progress_from_args
 from .search_args import add_scene_args, settings_from_args
 
@@ -40,7 +40,7 @@ def add_parser(sub):
     p.add_argument('--epochs', type=nonneg_int, required=True,
                    help='total epochs; with --resume, training continues up to this count')
     p.add_argument('--seed', type=nonneg_int, default=None, help='training seed (default 0)')
-    p.add_argument('--out', type=Path, default=None, metavar='PATH.yaml',
+    p.add_argument('--out', type=output_file, default=None, metavar='PATH.yaml',
                    help='policy file to write (default: the --resume file)')
     p.add_argument('--resume', type=Path, default=None, metavar='PATH.yaml',
                    help='continue training the policy in this file with its recorded settings')
