@@ -51,11 +51,12 @@ def test_evaluate_json_the_disk_refuses_keeps_the_old_file_and_names_json(tmp_pa
 
 
 def test_find_outputs_the_disk_refuses_keep_the_old_files(tmp_path):
+    # The log is the shortest output: '{"path": "<the image>", "events": []}', over 40 bytes.
     outputs = {name: tmp_path / name for name in ('found.json', 'found.log', 'found.png')}
     for path in outputs.values():
         path.write_text('old\n')
     run = run_cli('find', ASTRONAUT, '--json', outputs['found.json'], '--log',
-                  outputs['found.log'], '--plot', outputs['found.png'], limit_bytes=100)
+                  outputs['found.log'], '--plot', outputs['found.png'], limit_bytes=40)
     assert run.returncode == 2 and 'Traceback' not in run.stderr
     for flag, name in (('--json', 'found.json'), ('--log', 'found.log'), ('--plot', 'found.png')):
         assert f'{flag} {outputs[name]}: cannot write: File too large' in run.stderr
