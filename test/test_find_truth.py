@@ -178,6 +178,31 @@ def test_a_large_jpeg_is_decoded_reduced(tmp_path):
     assert size == [(1600, 1200)] and image.shape == (225, 300, 3)
 
 
+@pytest.mark.parametrize('stored, orientation, shown', [
+    ((400, 399), None, (400, 399)), ((400, 399), 6, (399, 400)), ((400, 399), 8, (399, 400)),
+    ((400, 399), 3, (400, 399)), ((400, 300), 6, (300, 400))])
+def test_a_reduced_jpeg_gives_its_size_as_displayed(tmp_path, stored, orientation, shown):
+    """
+    A JPEG decoded at 1/4 is given in the size a viewer shows, EXIF's quarter turns applied.
+
+    400x399 decodes to 100x100 at 1/4, which says nothing of a turn: it was said to be 399x400
+    (the answer's x scaled by 399/100, and 'resized from 399x400'), and a 4096x4095 photo
+    'resized from 4095x4096'.
+    """
+    from ipomdp_gaze.commands.find import read_image
+    from PIL import Image
+    path = tmp_path / 'reduced.jpg'
+    picture = Image.fromarray(np.full((stored[1], stored[0], 3), 90, np.uint8))
+    exif = Image.Exif()
+    if orientation is not None:
+        exif[0x0112] = orientation
+    picture.save(path, exif=exif.tobytes())
+    size = []
+    image = read_image(str(path), [], 100, size)
+    assert size == [shown]
+    assert image.shape[:2] == tuple(round(100 * side / max(shown)) for side in shown[::-1])
+
+
 @pytest.mark.parametrize('limit', [1_000_000, 500_000], ids=['warned', 'refused'])
 def test_a_jpeg_over_pillows_bomb_limit_is_decoded_reduced_without_its_warning(
         tmp_path, monkeypatch, limit):

@@ -284,7 +284,9 @@ def _read_flags(file: Path, max_side: int) -> tuple[int, tuple | None]:
     the largest k of 8, 4, 2 that keeps the longer side at least ``max_side``. Other formats
     are decoded whole (and a 16-bit one converted with its note), then resized. The size comes
     from the file's header (Pillow, which reads no pixels) and is returned with the flags
-    (None when the decode is not reduced); a file Pillow cannot read is decoded whole. Pillow's
+    (None when the decode is not reduced), as displayed: width and height swapped when its
+    EXIF orientation turns it a quarter (5-8), as OpenCV's decode does; a file Pillow cannot
+    read is decoded whole. Pillow's
     decompression-bomb check is off for the header: it would warn in two lines over 89 Mpx
     and refuse over 179 Mpx, so that the photos the reduced decode is for were decoded whole.
     """
@@ -296,6 +298,8 @@ def _read_flags(file: Path, max_side: int) -> tuple[int, tuple | None]:
         try:
             with Image.open(file) as header:
                 size, kind = tuple(int(v) for v in header.size), header.format
+                if header.getexif().get(EXIF_ORIENTATION) in QUARTER_TURNS:
+                    size = size[::-1]
         finally:
             Image.MAX_IMAGE_PIXELS = bomb
     except Exception:           # noqa: B902 (any failure: OpenCV decodes it, or says why)
@@ -308,6 +312,11 @@ def _read_flags(file: Path, max_side: int) -> tuple[int, tuple | None]:
             return flag, size
     return READ_FLAGS, None
 
+
+# The EXIF orientation tag, and its values that turn the picture a quarter (width and height
+# swap when it is displayed, and when OpenCV decodes it).
+EXIF_ORIENTATION = 0x0112
+QUARTER_TURNS = (5, 6, 7, 8)
 
 # The bit depths a 16-bit file may hold (a 10-, 12- or 14-bit camera's raw values, 8-bit data
 # stored in 16): a file is read as the smallest its largest value fits, so that a 10-bit frame
@@ -379,8 +388,9 @@ def read_image(path: str, notes: list | None = None, max_side: int = 0,
         image = image[:, :, 0]
     if size is not None:
         decoded = (image.shape[1], image.shape[0])
-        if header is not None and (header[0] > header[1]) != (decoded[0] > decoded[1]):
-            header = header[::-1]               # the decode applied an EXIF rotation
+        if header is not None and decoded[0] != decoded[1] and \
+                (header[0] > header[1]) != (decoded[0] > decoded[1]):
+            header = header[::-1]               # the decode turned it, and the header did not
         size.append(decoded if header is None else header)
     image, _ = shrink(image, max_side)
     if image.ndim == 3:
