@@ -292,6 +292,27 @@ def test_reader_accepts_user_images(tmp_path):
     assert second.shape == (10, 10) and none is None
 
 
+def test_reader_turns_an_image_as_its_exif_orientation_says(tmp_path):
+    """
+    A phone's photo stored sideways (EXIF orientation 6) is labelled as a viewer shows it.
+
+    find searches it turned; the reader took the stored pixels (IMREAD_UNCHANGED ignores EXIF),
+    so that a centre inside the picture was 'outside the 40x30 image', or at another place.
+    """
+    from PIL import Image
+    shown = np.zeros((40, 30, 3), dtype=np.uint8)           # 30 wide, 40 high, as displayed
+    shown[30:40, 0:10] = 255                                # the "face": bottom-left corner
+    stored = np.rot90(shown, k=1)                           # turned back a quarter: 40x30
+    exif = Image.Exif()
+    exif[0x0112] = 6                                        # display: turn 90 degrees clockwise
+    Image.fromarray(np.ascontiguousarray(stored)).save(tmp_path / 'a.jpg', quality=95,
+                                                       exif=exif.tobytes())
+    (tmp_path / 'labels.csv').write_text('path,x,y\na.jpg,5,35\n')
+    ((image, centre),) = read_labelled_folder(tmp_path, tmp_path / 'labels.csv')
+    assert image.shape == (40, 30, 3) and centre == (5.0, 35.0)
+    assert image[35, 5].min() > 200 and image[5, 25].max() < 50
+
+
 @pytest.mark.parametrize('rows,error,match', [
     ('a.png,60,10\n', ValueError, 'outside the 60x40'),
     ('a.png,10,-0.5\n', ValueError, 'outside'),

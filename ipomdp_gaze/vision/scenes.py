@@ -494,7 +494,8 @@ def read_labelled_folder(folder, csv_path) -> list[LabelledImage]:
     -------
     list of LabelledImage
         ``(image, centre_px)`` pairs in CSV order. Images are ``uint8``, grey ``(H, W)`` or RGB
-        ``(H, W, 3)`` (OpenCV reads BGR; it is converted, and an alpha channel is dropped).
+        ``(H, W, 3)`` (OpenCV reads BGR; it is converted, and an alpha channel is dropped), turned
+        as their EXIF orientation says, as a viewer and ``find`` show them.
 
     Raises
     ------
@@ -537,12 +538,19 @@ def read_labelled_folder(folder, csv_path) -> list[LabelledImage]:
 
 
 def _read_image(path: Path, where: str) -> np.ndarray:
+    """
+    Decode a labelled image as ``find`` does: EXIF orientation applied, an alpha channel dropped.
+
+    Labels are pixels of the picture as a viewer shows it (and as ``find`` searches it): read
+    with ``IMREAD_UNCHANGED``, a phone's photo stored sideways with an EXIF turn was calibrated
+    sideways, its face centre at another place.
+    """
     if not path.is_file():
         raise FileNotFoundError(f'{where}: image {path} does not exist')
-    from .image_files import decode_quietly
+    from .image_files import decode_quietly, READ_FLAGS
     data = np.fromfile(path, dtype=np.uint8)
     try:
-        image = decode_quietly(data, cv2.IMREAD_UNCHANGED) if data.size else None
+        image = decode_quietly(data, READ_FLAGS) if data.size else None
     except ValueError as exc:   # over OpenCV's pixel limit, or out of memory
         raise ValueError(f'{where}: {path}: {exc}') from None
     if image is None:
@@ -552,12 +560,7 @@ def _read_image(path: Path, where: str) -> np.ndarray:
     if image.ndim == 3 and image.shape[2] == 1:
         image = image[:, :, 0]
     if image.ndim == 3:
-        if image.shape[2] == 4:
-            image = cv2.cvtColor(image, cv2.COLOR_BGRA2RGB)
-        elif image.shape[2] == 3:
-            image = cv2.cvtColor(image, cv2.COLOR_BGR2RGB)
-        else:
-            raise ValueError(f'{where}: {path} has {image.shape[2]} channels; expected 1, 3 or 4')
+        image = cv2.cvtColor(image, cv2.COLOR_BGR2RGB)
     return image
 
 
