@@ -50,6 +50,50 @@ def test_yunet_boxes_are_floats_with_scores_and_small_images_hold_nothing(yunet)
         yunet(np.zeros((40, 40), np.uint8))
 
 
+class _UnwrittenBelow33:
+    """FaceDetectorYN as OpenCV 4.14 answers: a box read from unwritten memory below 33 px."""
+
+    def __init__(self):
+        self.size, self.given = None, []
+
+    def setInputSize(self, size):  # noqa: N802 (OpenCV's name)
+        self.size = size
+
+    def detect(self, bgr):
+        height, width = bgr.shape[:2]
+        assert (width, height) == self.size
+        self.given.append((width, height))
+        if min(width, height) <= 32:                # what it read: a face box, score 0.93
+            return 1, np.array([[2.0, 1.0, 12.0, 14.0] + [0.0] * 10 + [0.93]], np.float32)
+        return 1, None
+
+
+def test_yunet_never_gives_the_network_an_input_of_32_px_or_less_on_a_side():
+    """
+    The network answers such an input from memory it never wrote, other boxes each call.
+
+    Measured on OpenCV 4.14: 59 of 600 flat grey images of 16-32 px on a side got a box (score
+    up to 0.95, or at 1e16 or inf); a fovea window of 171x17 px (a 1200x120 strip) or a 500x30
+    full frame is such an input, and find once answered 'found' at pixel (179.5, -14.7) of a
+    grey strip. Padded with black to 33 px, none did (0 of 600), and faces of 24-32 px are
+    still seen (below).
+    """
+    detector = make_detector('yunet')
+    detector._net = net = _UnwrittenBelow33()
+    for width, height in ((500, 30), (171, 17), (16, 16), (20, 398), (33, 33)):
+        assert detector(np.full((height, width, 3), 90, np.uint8)).shape == (0, 5)
+    assert net.given == [(500, 33), (171, 33), (33, 33), (33, 398), (33, 33)]
+
+
+def test_yunet_finds_a_face_that_fills_a_small_image(yunet):
+    """A face of 24-32 px with no margin is still seen where the input is padded."""
+    x, y, w, h = read_labels()['astronaut'][0][0]
+    face = load_photo('astronaut')[round(y):round(y + h), round(x):round(x + w)]
+    seen = [len(yunet(cv2.resize(face, (side, side), interpolation=cv2.INTER_AREA))) > 0
+            for side in range(24, 33)]
+    assert sum(seen) >= 5
+
+
 def test_the_photo_labels_name_every_photo_and_their_faces():
     labels = read_labels()
     faces = {name: boxes for name, (boxes, _) in labels.items() if len(boxes)}

