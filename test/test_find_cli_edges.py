@@ -376,3 +376,30 @@ def test_an_output_in_a_folder_that_refuses_a_look_is_named(images, tmp_path, mo
     assert result.returncode == 2 and result.stdout == ''
     assert result.stderr.strip().splitlines() == [
         f'ipomdp-gaze find: error: --json {out}: Permission denied']
+
+
+def test_find_all_keeps_a_large_face_that_a_finer_looks_crop_cuts(tmp_path, run_find):
+    """
+    A face wider than the crop a finer look reads round its cell is not ruled out by that look.
+
+    Haar's --all: the astronaut's face enlarged to about 250 px in a 900x2048 picture is a
+    strong box at 1/2, its cell undecided; the look at 1 reads that cell and two more round it,
+    214 px wide, sees no face in the half it holds, and its evidence replaced the strong box's:
+    'absent', p_nobody=0.985 (a 901x2048 photo of a face of 302 px, the same).
+    """
+    from ipomdp_gaze.vision.photos import read_labels
+    x, y, w, h = (int(v) for v in read_labels()['astronaut'][0][0])
+    face = load_photo('astronaut')[y - 40:y + h + 40, x - 40:x + w + 40]
+    face = cv2.resize(face, None, fx=480 / face.shape[1], fy=480 / face.shape[1],
+                      interpolation=cv2.INTER_CUBIC)
+    canvas = np.full((2048, 900, 3), 120, np.uint8)
+    left = (900 - face.shape[1]) // 2
+    canvas[100:100 + face.shape[0], left:left + face.shape[1]] = face
+    path = tmp_path / 'tall.png'
+    cv2.imwrite(str(path), cv2.cvtColor(canvas, cv2.COLOR_RGB2BGR))
+    result = run_find(path, '--all', '--detector', 'haar', '--json', tmp_path / 'out.json')
+    assert result.returncode == 0, result.stderr
+    entry = json.loads((tmp_path / 'out.json').read_text())['images'][0]
+    assert entry['decision'] == 'found' and len(entry['faces']) == 1
+    bx, by, bw, bh = entry['faces'][0]['box']
+    assert left < bx + bw / 2 < left + face.shape[1] and 100 < by + bh / 2 < 100 + face.shape[0]

@@ -920,7 +920,10 @@ class _Coarse(_Recorder):
         and the finest scale of a look that found one (0 without). A cell holding the centre of
         a strong box of the whole image's calls (``seen``) beyond the detector's largest side
         at the look's scale (``ScaleTable.max_side_px``) keeps its evidence: a look that cannot
-        see that face does not say it is not there (YuNet finds no face of 720 px at 1). A
+        see that face does not say it is not there (YuNet finds no face of 720 px at 1), nor
+        does a look whose crop (the cells and two more round them) cuts the box and that does
+        not see it strong again (Haar's 302 px face at 1/2 in a 901x2048 photo, looked at in a
+        crop 215 px wide, was 'absent'). A
         cell whose evidence is a strong box's and that the look sees strong again adds the
         look's evidence to it: two calls at different scales agree, as the ladder's confirming
         look (on a 6400x4800 photo each call's false-detection chance per cell, many pixels
@@ -952,10 +955,15 @@ class _Coarse(_Recorder):
                                        self.prior + shift) + shift
                 inner = np.zeros(self.grid.shape, dtype=bool)
                 inner[_grown(box, 1, self.grid.shape)] = True
-                inner = inner.reshape(-1) & ~unseen
                 strong = np.asarray(strong, dtype=float).reshape(-1, 4)
                 again = np.zeros(self.grid.n_cells, dtype=bool)
                 again[box_cells(strong, self.image_px, self.grid)] = True
+                # a strong box the look's crop cuts: a look that does not see it again cannot
+                # say that face is not there either
+                cut = np.zeros(self.grid.n_cells, dtype=bool)
+                cut[box_cells(_cut_by(seen, rect, self.image_px), self.image_px,
+                              self.grid)] = True
+                inner = inner.reshape(-1) & ~unseen & ~(cut & ~again)
                 # a strong box seen again by a call at another scale: both calls' evidence (the
                 # crowd's shift once), as the ladder's confirming look; otherwise the look's
                 term = np.where(inner, np.where(held & again, term + fine - shift, fine), term)
@@ -972,6 +980,17 @@ def _fine_score(detector) -> float:
     """Return the score from which the fovea's detector keeps a box (inf: it keeps no score)."""
     settings = getattr(detector, 'settings', None)
     return (settings() if callable(settings) else {}).get('score_threshold', math.inf)
+
+
+def _cut_by(boxes, rect: tuple, image_px: tuple) -> np.ndarray:
+    """Return the boxes (K, 4) that the crop ``rect`` (x0, y0, x1, y1) cuts, within the image."""
+    boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
+    width, height = image_px
+    x0, y0 = np.maximum(boxes[:, 0], 0.0), np.maximum(boxes[:, 1], 0.0)
+    x1 = np.minimum(boxes[:, 0] + boxes[:, 2], width)
+    y1 = np.minimum(boxes[:, 1] + boxes[:, 3], height)
+    inside = (x0 >= rect[0]) & (y0 >= rect[1]) & (x1 <= rect[2]) & (y1 <= rect[3])
+    return boxes[~inside]
 
 
 def _grown(box: tuple, margin: int, shape: tuple) -> tuple:
