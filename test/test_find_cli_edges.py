@@ -403,3 +403,21 @@ def test_find_all_keeps_a_large_face_that_a_finer_looks_crop_cuts(tmp_path, run_
     assert entry['decision'] == 'found' and len(entry['faces']) == 1
     bx, by, bw, bh = entry['faces'][0]['box']
     assert left < bx + bw / 2 < left + face.shape[1] and 100 < by + bh / 2 < 100 + face.shape[0]
+
+
+def test_a_frame_scanned_whole_because_max_side_shrank_it_says_so(tmp_path, run_find):
+    """
+    A picture scanned whole only because --max-side shrank it says so, and how not to.
+
+    An 8000x300 panorama is 2048x77 after --max-side: 'the image is far below the size the
+    model was calibrated at' blamed the picture, and --max-side 0 found both faces it missed.
+    """
+    path = tmp_path / 'strip.png'
+    cv2.imwrite(str(path), np.full((60, 1000, 3), 90, np.uint8))
+    result = run_find(path, '--max-side', '500')
+    assert result.returncode == 0, result.stderr
+    assert (f'{path}: scanned the whole frame once: ' in result.stderr and
+            ' (500x30 px as --max-side 500 resized it; --max-side 0 searches it at its own '
+            'size)\n' in result.stderr)
+    whole = run_find(path, '--max-side', '0')
+    assert 'scanned the whole frame once' in whole.stderr and 'resized it' not in whole.stderr

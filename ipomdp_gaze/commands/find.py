@@ -1096,7 +1096,10 @@ def run(args) -> int:
         if scale != (1.0, 1.0):
             results = [_in_given_pixels(r, scale, given) for r in results]
         if results[0].method == 'full_frame':
-            _note(f'{path}: scanned the whole frame once: {results[0].note}')
+            _note(f'{path}: scanned the whole frame once: {results[0].note}' +
+                  (f' ({image.shape[1]}x{image.shape[0]} px as --max-side {args.max_side} '
+                   f'resized it; --max-side 0 searches it at its own size)'
+                   if scale != (1.0, 1.0) else ''))
         many = settings.targets == 'many'
         occupancy = route in OCCUPANCY_ROUTES
         for k, result in enumerate(results):
