@@ -155,7 +155,9 @@ IDEAS = [
     'fixations, seed 1 0.980 in 8.52, **seed 2 0.980 in 8.47**, seed 3 0.973 in 8.63; ELM '
     '0.980 in 8.53 (ELM spends fewer detector pixels: 62,184 per search against 82,864). '
     'Simulation: fixations to 90% ELM 3.50 [3.35, 3.63], seed 2 3.49 [3.33, 3.63], kernel '
-    'minus ELM -0.01 [-0.08, +0.07]: a tie again; shipped as `faces-420-infomax` |',
+    'minus ELM -0.01 [-0.08, +0.07]: a tie again (reruns on simulation seeds 2 and 3: '
+    '-0.08 [-0.16, -0.01] and -0.03 [-0.10, +0.05]: level with ELM or slightly ahead, never '
+    'behind); shipped as `faces-420-infomax` |',
     '',
     'Where the fovea still falls short: a face of 60-140 px covers 3-7 cells of the 21x21 '
     'grid and raw detections land in several of them, while the count model treats cells as '
