@@ -17,6 +17,7 @@ import importlib.util
 import os
 from pathlib import Path
 import signal
+import sys
 from types import SimpleNamespace
 
 from hypothesis import settings
@@ -231,6 +232,17 @@ def nodes(ros_env, tmp_path_factory):
 def launch(nodes):
     """Provide ``nodes.start``, which starts a node process (``controller`` or ``camera``)."""
     return nodes.start
+
+
+def bench_module(name: str):
+    """Load a bench script as a module, its folder on the path as when it runs as a script."""
+    path = next((Path(__file__).resolve().parents[1] / 'bench').rglob(f'{name}.py'))
+    if str(path.parent) not in sys.path:
+        sys.path.insert(0, str(path.parent))
+    spec = importlib.util.spec_from_file_location(f'bench_{name}', path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 def config_path(name: str) -> str:

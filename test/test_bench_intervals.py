@@ -12,24 +12,12 @@ from __future__ import annotations
 import gzip
 import json
 from pathlib import Path
-import sys
 
+from conftest import bench_module
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 BENCH = ROOT / 'bench'
-
-
-def _bench_module(name):
-    """Load a bench script as a module, its folder on the path as when it runs as a script."""
-    import importlib.util
-    path = next(BENCH.rglob(f'{name}.py'))
-    if str(path.parent) not in sys.path:
-        sys.path.insert(0, str(path.parent))
-    spec = importlib.util.spec_from_file_location(f'bench_{name}', path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 @pytest.fixture(params=[(1, None), (2, 3)], ids=['one', 'two-below-three'])
@@ -59,8 +47,8 @@ def test_format_interval():
 
 
 def test_planner_vs_greedy(few, capsys):
-    _bench_module('planner_vs_greedy').main(['--episodes', str(few), '--policies',
-                                             'elm,tempered', '--jobs', '1', '--quiet'])
+    bench_module('planner_vs_greedy').main(['--episodes', str(few), '--policies',
+                                            'elm,tempered', '--jobs', '1', '--quiet'])
     out = capsys.readouterr().out
     _no_bad_words(out)
     lines = [line for line in out.splitlines() if 'indicator' in line or 'expected' in line]
@@ -71,9 +59,9 @@ def test_planner_vs_greedy(few, capsys):
 
 
 def test_bench_planner(few, capsys):
-    _bench_module('bench_planner').main(['--episodes', str(few), '--episodes-fast', str(few),
-                                         '--bootstrap', '50', '--skip-planner',
-                                         '--tempered-seeds', '2'])
+    bench_module('bench_planner').main(['--episodes', str(few), '--episodes-fast', str(few),
+                                        '--bootstrap', '50', '--skip-planner',
+                                        '--tempered-seeds', '2'])
     out = capsys.readouterr().out
     _no_bad_words(out)
     rows = [line for line in out.splitlines() if line.startswith(('elm ', 'tempered_elm '))]
@@ -84,8 +72,8 @@ def test_bench_planner(few, capsys):
 
 
 def test_bench_training(few, capsys, tmp_path):
-    _bench_module('bench_training').main(['--epochs', '1', '--eval-every', '1',
-                                          '--eval-episodes', '1', '--final-episodes', str(few)])
+    bench_module('bench_training').main(['--epochs', '1', '--eval-every', '1',
+                                         '--eval-episodes', '1', '--final-episodes', str(few)])
     out = capsys.readouterr().out
     _no_bad_words(out)
     conv = next(line for line in out.splitlines() if line.startswith('conv:'))
@@ -104,7 +92,7 @@ def _cut(record: dict, keep) -> dict:
 
 
 def test_pan_tilt_page(few, tmp_path):
-    pan_tilt = _bench_module('pan_tilt')
+    pan_tilt = bench_module('pan_tilt')
     record = json.loads(gzip.decompress((ROOT / 'docs' / 'data' / 'pan_tilt.json.gz')
                                         .read_bytes()))
     record.pop('ros', None)
@@ -127,7 +115,7 @@ def test_pan_tilt_page(few, tmp_path):
 
 
 def test_rooms_page(few, tmp_path):
-    rooms = _bench_module('rooms')
+    rooms = bench_module('rooms')
     record = json.loads(gzip.decompress((ROOT / 'docs' / 'data' / 'rooms.json.gz')
                                         .read_bytes()))
     # rooms with faces, among the first the every-view bounds ran on too

@@ -7,6 +7,8 @@ from pathlib import Path
 import subprocess
 import sys
 
+from conftest import bench_module
+
 BENCH = Path(__file__).resolve().parents[1] / 'bench'
 
 
@@ -105,22 +107,10 @@ def test_figure_labels_of_a_dense_cluster_neither_overlap_nor_leave_the_axes():
     plt.close(fig)
 
 
-def _bench_module(name):
-    """Load a bench script as a module, its folder on the path as when it runs as a script."""
-    import importlib.util
-    path = next(BENCH.rglob(f'{name}.py'))
-    if str(path.parent) not in sys.path:
-        sys.path.insert(0, str(path.parent))
-    spec = importlib.util.spec_from_file_location(f'bench_{name}', path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def test_bound_statistics_skip_the_cells_a_view_does_not_see():
     """``pan_tilt_bound.statistics``: the centred count, the largest and the sum over views."""
     import numpy as np
-    bound = _bench_module('pan_tilt_bound')
+    bound = bench_module('pan_tilt_bound')
     nan = np.nan
     counts = np.array([[3.0, 1.0, nan],       # view centred on cell 0
                        [0.0, 2.0, 5.0],       # on cell 1
@@ -134,7 +124,7 @@ def test_bound_statistics_skip_the_cells_a_view_does_not_see():
 def test_bound_tables_score_answers_against_the_empty_scenes():
     """The trade-off rows: right within one cell, a face named on empty scenes, thresholds."""
     import numpy as np
-    bound = _bench_module('pan_tilt_bound')
+    bound = bench_module('pan_tilt_bound')
 
     def row(face, absent, answer, peak_cell, peak):
         values = np.zeros(121)
@@ -240,7 +230,7 @@ def test_the_canvas_report_runs_find_as_shipped_and_at_full_resolution(tmp_path)
 
 def test_the_group_tables_keep_the_most_false_faces_in_one_picture():
     """Issue 36 asks for at most one false face per photo: a total alone cannot say it."""
-    many = _bench_module('many_faces')
+    many = bench_module('many_faces')
     totals = {}
     for counts in ((6, 1, 0), (5, 2, 0), (6, 0, 1)):       # (found, false, duplicates)
         many._add(totals, 'find --all', counts, 6, 0.01, 1000)
@@ -258,7 +248,7 @@ def test_walk_reports_refuse_bad_options_with_one_line_before_any_walk(tmp_path,
             ('people_walks', ['--scenes', '0'], 'argument --scenes'),
             ('people_walks', ['--json', str(tmp_path)], f'--json {tmp_path}: is a directory')):
         with pytest.raises(SystemExit) as stop:
-            _bench_module(script).main(args)
+            bench_module(script).main(args)
         assert stop.value.code == 2, (script, args)
         assert named in capsys.readouterr().err
 
@@ -282,7 +272,7 @@ def test_benchmarks_refuse_bad_options_with_one_line_before_any_work(tmp_path, c
             ('shutdown_cycles', ['--cycles', '-1'], 'argument --cycles'),
             ('evidence_flood', ['--rate-hz', '-5'], 'argument --rate-hz')):
         with pytest.raises(SystemExit) as stop:
-            _bench_module(script).main(args)
+            bench_module(script).main(args)
         err = capsys.readouterr().err
         assert stop.value.code == 2, (script, args)
         lines = err.strip().splitlines()             # argparse's usage, then one error line
@@ -297,7 +287,7 @@ def test_a_benchmark_run_alone_prints_its_usage_for_help(tmp_path, capsys, monke
     for script in ('bench_latency', 'bench_motion', 'bench_controller', 'bench_simulate',
                    'bench_fovea', 'bench_planner', 'bench_training'):
         with pytest.raises(SystemExit) as stop:
-            _bench_module(script).main(['--help'])
+            bench_module(script).main(['--help'])
         assert stop.value.code == 0, script
         assert capsys.readouterr().out.startswith('usage:'), script
     assert not any(tmp_path.iterdir())
@@ -313,7 +303,7 @@ def test_ros_benchmarks_refuse_bad_options_with_one_line(capsys):
             ('bench_ros_roundtrip', ['--help'], None),
             ('bench_ros_roundtrip', ['elm', 'nope'], "argument policy: unknown policy 'nope'")):
         with pytest.raises(SystemExit) as stop:
-            _bench_module(script).main(args)
+            bench_module(script).main(args)
         out, err = capsys.readouterr()
         if named is None:
             assert stop.value.code == 0 and out.startswith('usage:'), script
