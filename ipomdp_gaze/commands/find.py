@@ -10,14 +10,17 @@ line and the others are still searched; the exit status is then 2 at the end, el
 image got a decision). One line is printed per image, in input order: the path as given, the
 **decision** (``found``, ``absent`` or ``gave_up``), how it **ended** (``confidence``: the
 evidence reached ``--confidence``; ``forced:pixels`` / ``forced:budget``: the pixel cap or the
-fixation budget forced the likelier answer below it; :mod:`.search.answer`), ``cell (row,
+fixation budget forced the likelier answer below it, or on the many-target belief ended the
+search with cells still undecided; :mod:`.search.answer`), ``cell (row,
 col)`` and ``pixel (x, y)`` (``none`` unless found), ``p``, the probability of *that* answer
 (the found cell's, or for ``absent`` that nobody is there), the fixations, the detector pixels
 against one full-resolution scan's, the seconds, why it stopped and the method. On the
 many-target belief (``--all``, ``--scan many``) each cell is decided on its own: ``absent`` means
 every cell decided empty at ``--confidence`` (forced: every cell likelier empty than not), and
 its probability is written ``p_nobody``, P(nobody here), the product over the cells, which can
-be below the confidence or, when forced, below 0.5.
+be below the confidence or, when forced, below 0.5. There a forced end is the search's as a
+whole: the limit put the cells still undecided on their likelier side, and a face whose
+probability reached the confidence was decided by the evidence all the same.
 
 **Outputs.** ``--json`` and ``--log`` take ``-`` for stdout (one of them; the lines then go to
 stderr); ``--json`` has an entry ``{path, error}`` for each input that could not be searched.
@@ -212,7 +215,11 @@ def add_parser(sub):
                         '"absent" when every cell is decided empty at --confidence (or, forced '
                         'by a limit, is likelier empty than not), and its line gives '
                         'p_nobody=P(nobody here), the product over the cells of P(empty), which '
-                        'may be below --confidence or 0.5 (the --plot title says so)')
+                        'may be below --confidence or 0.5 (the --plot title says so); '
+                        'ended=forced:pixels (forced:budget) says the limit ended the search '
+                        'while cells were still undecided and put them on their likelier '
+                        'side: a face whose p reached --confidence was decided by the '
+                        'evidence all the same, one below it was forced')
     add_search_args(p, None, ('targets',), task_default='many with --all, else one; --all '
                     '--targets one: find a face, rule the cells within 2 of it out, search '
                     'again: a line per search (face=K for a face, at a point without a box; '
@@ -568,7 +575,9 @@ def format_line(path: str, result, face: int | None = None, occupancy: bool = Fa
     for ``absent`` the probability that nobody is there. On the many-target belief
     (``occupancy``: ``--all``, ``--scan many``) ``absent`` means every cell on its empty side,
     and its probability is written ``p_nobody``: P(nobody here), the product over the cells,
-    which can be below the confidence each cell reached (or below 0.5, when forced).
+    which can be below the confidence each cell reached (or below 0.5, when forced); a forced
+    end there is the search's (cells still undecided put on their likelier side), and a face
+    whose ``p`` reached the confidence was decided by the evidence all the same.
     """
     width, height = result.image_px
     p = result.answer_probability
@@ -612,7 +621,7 @@ def plot_title(path: str, result, confidence: float, occupancy: bool = False,
     if faces is not None:
         found = f'{name}: {faces} face{"" if faces == 1 else "s"}'
         if faces and answer.forced(result.decision, result.stop):
-            found += f' (forced by {answer.LIMITS[result.stop]})'
+            found += f' ({forced_faces_text(result, confidence)})'
         return f'{found} ({nobody_text(result, confidence)}), {tail}' if nobody else \
             f'{found}, {tail}'
     if nobody:
@@ -622,6 +631,24 @@ def plot_title(path: str, result, confidence: float, occupancy: bool = False,
             f'{answer.probability_text(result.decision, p)}'
             f'{answer.confidence_clause(result.decision, _reason(result), p, confidence)}, '
             f'{tail}')
+
+
+def forced_faces_text(result, confidence: float) -> str:
+    """
+    Say a many-target search a limit ended with faces: what was forced and what was not.
+
+    The limit ends the search as a whole while some cells are still undecided, and puts those
+    on their likelier side; a face whose probability reached the confidence was decided by the
+    evidence all the same (a full-resolution pass that read the whole pixel budget, leaving a
+    weak box's cell at even odds, names its sure faces at 0.991), one below it was forced.
+    """
+    probabilities = [face.probability for face in getattr(result, 'faces', ())]
+    sure = sum(p >= confidence for p in probabilities if not math.isnan(p))
+    which = (f'every face at the confidence {confidence:g}' if sure == len(probabilities) else
+             f'no face at the confidence {confidence:g}' if not sure else
+             f'{sure} of the faces at the confidence {confidence:g}, the others forced')
+    return (f'search forced by {answer.LIMITS[result.stop]}: cells still undecided on their '
+            f'likelier side; {which}')
 
 
 def nobody_text(result, confidence: float) -> str:
