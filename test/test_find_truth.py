@@ -376,3 +376,57 @@ def test_images_decode_without_opencvs_logging_binding(monkeypatch):
     _, png = cv2.imencode('.png', np.full((4, 6), 7, np.uint8))
     assert decode_quietly(png, cv2.IMREAD_UNCHANGED).shape == (4, 6)
     assert decode_quietly(np.frombuffer(b'not an image', np.uint8)) is None
+
+
+def test_a_fully_transparent_png_is_searched_with_a_note(tmp_path):
+    """QA: an image all of alpha 0 is searched in colours a viewer does not show: say so."""
+    from ipomdp_gaze.commands.find import read_image
+    from PIL import Image
+    rgba = np.random.default_rng(3).integers(0, 256, (48, 64, 4), dtype=np.uint8)
+    rgba[:, :, 3] = 0
+    Image.fromarray(rgba, 'RGBA').save(tmp_path / 'hidden.png')
+    notes = []
+    image = read_image(str(tmp_path / 'hidden.png'), notes)
+    np.testing.assert_array_equal(image, rgba[:, :, :3])     # the stored colours, as before
+    assert notes == [f'{tmp_path / "hidden.png"}: every pixel is fully transparent (alpha 0); '
+                     'searched in the colours stored under it, which a viewer does not show']
+    rgba[0, 0, 3] = 255                                         # one pixel shows: nothing to say
+    Image.fromarray(rgba, 'RGBA').save(tmp_path / 'shown.png')
+    Image.fromarray(rgba[:, :, [0, 3]], 'LA').save(tmp_path / 'grey.png')
+    notes = []
+    np.testing.assert_array_equal(read_image(str(tmp_path / 'shown.png'), notes), rgba[:, :, :3])
+    grey = read_image(str(tmp_path / 'grey.png'), notes)
+    assert grey.shape == (48, 64, 3) and np.array_equal(grey[:, :, 0], rgba[:, :, 0])
+    assert notes == []
+
+
+def test_only_the_first_page_or_frame_is_searched_and_find_says_so(tmp_path):
+    """QA: a multi-page TIFF and an animated GIF were searched on their first page alone."""
+    from ipomdp_gaze.commands.find import read_image
+    from PIL import Image
+    rng = np.random.default_rng(4)
+    pages = [Image.fromarray(rng.integers(0, 256, (40, 60, 3), dtype=np.uint8)) for _ in range(3)]
+    pages[0].save(tmp_path / 'pages.tif', save_all=True, append_images=pages[1:])
+    pages[0].save(tmp_path / 'frames.gif', save_all=True, append_images=pages[1:])
+    pages[0].save(tmp_path / 'one.gif')
+    pages[0].save(tmp_path / 'one.tif')
+    notes = []
+    np.testing.assert_array_equal(read_image(str(tmp_path / 'pages.tif'), notes),
+                                  np.asarray(pages[0]))
+    read_image(str(tmp_path / 'frames.gif'), notes)
+    read_image(str(tmp_path / 'one.gif'), notes)
+    read_image(str(tmp_path / 'one.tif'), notes)
+    assert notes == [f'{tmp_path / "pages.tif"}: 3 pages in the file (TIFF); only the first is '
+                     'searched',
+                     f'{tmp_path / "frames.gif"}: 3 frames in the file (an animated GIF); only '
+                     'the first is searched']
+
+
+def test_the_notes_of_a_file_reach_finds_stderr(tmp_path, run_find):
+    from PIL import Image
+    frames = [Image.fromarray(np.full((120, 160, 3), v, np.uint8)) for v in (40, 200)]
+    frames[0].save(tmp_path / 'two.gif', save_all=True, append_images=frames[1:])
+    result = run_find(tmp_path / 'two.gif')
+    assert result.returncode == 0, result.stderr
+    assert (f'ipomdp-gaze find: {tmp_path / "two.gif"}: 2 frames in the file (an animated GIF); '
+            'only the first is searched') in result.stderr

@@ -320,6 +320,35 @@ def _read_flags(file: Path, max_side: int) -> tuple[int, tuple | None]:
     return READ_FLAGS, None
 
 
+def _layers(file: Path) -> tuple[str, int, bool]:
+    """
+    Return the file's format, its pages or frames and whether it has an alpha channel.
+
+    From the header by Pillow, which decodes no pixels (a GIF's frames are counted by skipping
+    their blocks); ``('', 1, False)`` for a file Pillow cannot read. OpenCV decodes the first
+    page of a multi-page TIFF and the first frame of an animated GIF, and drops the alpha channel:
+    :func:`read_image` says so when it matters.
+    """
+    try:
+        from PIL import Image
+        bomb, Image.MAX_IMAGE_PIXELS = Image.MAX_IMAGE_PIXELS, None
+        try:
+            with Image.open(file) as header:
+                alpha = 'A' in header.mode or 'transparency' in header.info
+                return str(header.format or ''), int(getattr(header, 'n_frames', 1)), alpha
+        finally:
+            Image.MAX_IMAGE_PIXELS = bomb
+    except Exception:           # noqa: B902 (any failure: OpenCV decodes it, or says why)
+        return '', 1, False
+
+
+def _pages_note(path: str, kind: str, pages: int) -> str:
+    """Say that only the first page (TIFF) or frame (GIF, ...) of a file of several is searched."""
+    what = 'pages' if kind == 'TIFF' else 'frames'
+    return (f'{path}: {pages} {what} in the file ({"an animated " * (kind == "GIF")}{kind}); '
+            f'only the first is searched')
+
+
 # The EXIF orientation tag, and its values that turn the picture a quarter (width and height
 # swap when it is displayed, and when OpenCV decodes it).
 EXIF_ORIENTATION = 0x0112
@@ -370,6 +399,9 @@ def read_image(path: str, notes: list | None = None, max_side: int = 0,
     except OSError as exc:
         raise ValueError(f'{path}: cannot read: {exc.strerror or exc}') from None
     flags, header = _read_flags(file, max_side) if data.size else (READ_FLAGS, None)
+    kind, pages, alpha = _layers(file) if data.size else ('', 1, False)
+    if alpha and flags == READ_FLAGS:
+        flags = cv2.IMREAD_UNCHANGED    # the same colours, and the alpha channel beside them
     try:
         image = decode_quietly(data, flags) if data.size else None
     except ValueError as exc:   # over OpenCV's pixel limit, or out of memory
@@ -377,6 +409,15 @@ def read_image(path: str, notes: list | None = None, max_side: int = 0,
     del data
     if image is None:
         raise ValueError(f'{path}: not an image OpenCV can decode')
+    if pages > 1 and notes is not None:
+        notes.append(_pages_note(path, kind, pages))
+    if image.ndim == 3 and image.shape[2] in (2, 4):
+        # the colours as READ_FLAGS decodes them (alpha dropped, nothing composited)
+        hidden = not image[:, :, -1].any()
+        image = np.ascontiguousarray(image[:, :, :-1])
+        if hidden and notes is not None:
+            notes.append(f'{path}: every pixel is fully transparent (alpha 0); searched in the '
+                         'colours stored under it, which a viewer does not show')
     if image.dtype == np.uint16:
         high = int(image.max())
         bits = next(b for b in SENSOR_BITS if high < 2 ** b)
