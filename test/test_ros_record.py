@@ -271,6 +271,7 @@ def test_a_split_limit_the_recorder_cannot_take_ends_it_with_one_line(ros_env, t
     assert len(lines) == 1 and lines[0].startswith('recorder: error: '), lines
     assert reason in lines[0]
     assert not (tmp_path / 'bag').exists()
+    assert run.stdout == ''         # QA: then 'nothing readable was written (...)', noise
 
 
 def test_a_fixed_camera_recording_can_be_searched_anew(ros_env, tmp_path):
