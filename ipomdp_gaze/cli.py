@@ -21,7 +21,7 @@ import warnings
 from ipomdp_gaze.files.share_files import package_version
 
 # Modules under ipomdp_gaze.commands, in the order --help lists their subcommands: evaluate,
-# search, find, train, calibrate, reproduce, demo, record and replay, then the nodes:
+# search, find, train, calibrate, reproduce, demo, record, reindex and replay, then the nodes:
 # controller, camera, detector, scene_camera and recorder.
 COMMANDS = ('evaluate', 'search', 'find', 'train', 'calibrate', 'reproduce', 'demo', 'record',
             'nodes')

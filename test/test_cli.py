@@ -23,7 +23,7 @@ def test_help_lists_subcommands():
         assert name in out.stdout
     assert re.findall(r'^    (\w+)', out.stdout, re.M) == [
         'evaluate', 'search', 'find', 'train', 'calibrate', 'reproduce', 'demo', 'record',
-        'replay', 'controller', 'camera', 'detector', 'scene_camera', 'recorder']
+        'reindex', 'replay', 'controller', 'camera', 'detector', 'scene_camera', 'recorder']
 
 
 @pytest.mark.parametrize('command, node', [('controller', 'gaze_controller'),

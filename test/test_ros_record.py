@@ -605,3 +605,99 @@ def test_a_write_that_fails_is_counted_and_survived_and_so_is_the_close(context,
             writer.close = close
         recorder.destroy_node()                         # logs, does not raise
         source.destroy_node()
+
+
+def test_a_recorder_killed_mid_recording_is_reindexed_and_read_back(ros_env, tmp_path, probe):
+    """
+    The power lost or SIGKILL while recording: no metadata.yaml, the MCAP file unfinished.
+
+    ``ipomdp-gaze reindex`` rebuilds it: every image written before the last complete chunk
+    (chunks of about 1 MiB; here 100 kB images, at most 10 in the chunk not yet written) is read
+    back, in the order published, with the custom data the recorder had set.
+    """
+    import signal
+    from ipomdp_gaze.files.bag import read_bag
+    from ipomdp_gaze.files.share_files import package_version
+    from ipomdp_gaze.harness.processes import wait_for
+    from ipomdp_gaze.nodes.recorder import TOPICS
+    from sensor_msgs.msg import Image
+    from std_msgs.msg import Header
+    count, size = 40, 100_000
+    bag = tmp_path / 'bag'
+    status = probe.status_values('recorder: recording')
+    images = probe.publisher(Image, 'image', TOPICS['image'][2])
+    log = tmp_path / 'recorder.log'
+    with open(log, 'wb') as out:
+        recorder = subprocess.Popen(
+            [sys.executable, '-m', 'ipomdp_gaze.cli', 'record', str(bag), '--topics', 'image',
+             '--ros-args', '-p', 'nodes:=[test_probe]', '-p', 'diagnostics_period_s:=0.2'],
+            cwd=REPO, env=ros_env, stdout=out, stderr=subprocess.STDOUT)
+    try:
+        assert wait_for(lambda: b'recorded the parameters of test_probe' in log.read_bytes()
+                        and images.get_subscription_count() > 0, 60), log.read_text()
+        for i in range(count):      # reliable, a history of 50: every one is delivered
+            images.publish(Image(height=1, width=size, encoding='mono8', step=size,
+                                 data=bytes([i]) * size, header=Header(frame_id=str(i))))
+        assert wait_for(lambda: status and int(status[-1]['messages_image']) == count, 60), \
+            log.read_text()
+    finally:
+        recorder.send_signal(signal.SIGKILL)
+        assert recorder.wait(30) == -signal.SIGKILL
+    assert not (bag / 'metadata.yaml').exists()
+    refused = _cli(ros_env, 'replay', str(bag))
+    assert refused.returncode == 2
+    assert refused.stderr.strip().splitlines() == [
+        f'ipomdp-gaze replay: error: {bag} is not a rosbag2 bag: no metadata.yaml (a recording '
+        f'cut off? `ipomdp-gaze reindex {bag}` rebuilds it from the MCAP files)']
+    run = _cli(ros_env, 'reindex', str(bag))
+    assert run.returncode == 0, run.stdout + run.stderr
+    read = read_bag(bag)
+    recovered = [m.msg.header.frame_id for m in read.messages]
+    assert count - 10 <= len(recovered) < count
+    assert recovered == [str(i) for i in range(len(recovered))]
+    assert all(bytes(m.msg.data) == bytes([i]) * size for i, m in enumerate(read.messages))
+    assert f'bag.mcap: unfinished, {len(recovered)} messages recovered' in run.stdout
+    assert read.custom_data['ipomdp_gaze/version'] == package_version()
+    assert read.namespace == '/'
+    assert read.parameters('test_probe')['use_sim_time'] is False
+    # replay reads it whole (no controller was recorded here: nothing to re-run)
+    replayed = _cli(ros_env, 'replay', str(bag))
+    assert replayed.stdout.startswith(f'{bag}: {len(recovered)} messages, '), \
+        replayed.stdout + replayed.stderr
+    assert replayed.stderr.strip().splitlines() == [
+        f'ipomdp-gaze replay: error: {bag} has no parameters of gaze_controller in its metadata: '
+        'was it recorded by the recorder node with the controller running?']
+
+
+def _cut_before_the_summary(file: Path) -> None:
+    """Cut a closed MCAP file after its last chunk, in a record: as a writer killed then."""
+    from mcap.reader import make_reader
+    with open(file, 'rb') as f:
+        last = max(make_reader(f).get_summary().chunk_indexes,
+                   key=lambda c: c.chunk_start_offset)
+    end = last.chunk_start_offset + last.chunk_length + last.message_index_length
+    with open(file, 'r+b') as f:
+        f.truncate(end + 20)
+
+
+def test_a_demo_recording_cut_off_is_reindexed_and_replays_to_the_recorded_decision(
+        simulated, ros_env, tmp_path):
+    """Only the recorder's custom data records say the parameters: its close never came."""
+    import shutil
+    tmp, out = simulated
+    bag = tmp_path / 'bag'
+    shutil.copytree(tmp / 'bag', bag)
+    (bag / 'metadata.yaml').unlink()
+    _cut_before_the_summary(bag / 'bag.mcap')
+    run = _cli(ros_env, 'reindex', str(bag))
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert 'parameters of foveal_detector, gaze_controller' in run.stdout \
+        or 'parameters of gaze_controller' in run.stdout, run.stdout
+    closed = yaml.safe_load((tmp / 'bag' / 'metadata.yaml').read_text())
+    rebuilt = yaml.safe_load((bag / 'metadata.yaml').read_text())
+    assert rebuilt == closed
+    row, col, fixations = _found(out)
+    replayed = _cli(ros_env, 'replay', str(bag))
+    assert replayed.returncode == 0, replayed.stdout + replayed.stderr
+    assert f'replay:   found at ({row}, {col}) p=' in replayed.stdout
+    assert 'the same fixations and the same decision' in replayed.stdout

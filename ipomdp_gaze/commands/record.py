@@ -3,6 +3,9 @@
 """
 ``ipomdp-gaze record PATH`` and ``ipomdp-gaze replay PATH``: a search to a bag, and back.
 
+``reindex PATH`` rebuilds the ``metadata.yaml`` of a recording cut off (power lost, SIGKILL)
+from its MCAP files (:func:`ipomdp_gaze.files.bag.reindex`), as ``ros2 bag reindex`` does.
+
 ``record`` runs the ``recorder`` node (:mod:`ipomdp_gaze.nodes.recorder`) until Ctrl-C or SIGTERM,
 writing a rosbag2 bag with MCAP storage at PATH; ``replay`` re-runs a bag's frames through the
 controller's core with the recorded settings or others (:mod:`ipomdp_gaze.drivers.replay`) and
@@ -34,6 +37,21 @@ def add_parser(sub):
     p.add_argument('--ros-args', dest='ros_args', nargs=argparse.REMAINDER, default=None,
                    metavar='ARG', help='ROS arguments (remapping, namespace, -p nodes:=[...])')
     p.set_defaults(run=run_record)
+
+    p = sub.add_parser(
+        'reindex', help="rebuild a cut-off recording's metadata.yaml from its MCAP files",
+        description='Rebuild metadata.yaml of a bag whose recording was cut off (the power '
+                    'lost, the recorder killed with SIGKILL), as ros2 bag reindex does: from '
+                    "the MCAP files in PATH, a split bag's file being written moved up from "
+                    'its folder <name>_<i>/. An unfinished file (no summary) is rewritten with '
+                    'every message of its complete chunks (MCAP is written in chunks of about '
+                    '1 MiB: the messages of the last one, not yet written, are lost); the '
+                    "recorder's custom data (package version, parameters, file hashes, "
+                    'namespace) is taken from the files. Then replay and read_bag read it.')
+    p.add_argument('path', type=Path, metavar='PATH', help='the bag directory')
+    p.add_argument('--force', action='store_true',
+                   help='rebuild metadata.yaml also when the bag has one')
+    p.set_defaults(run=run_reindex)
 
     p = sub.add_parser(
         'replay', help='re-run a recorded search through the controller; print differences',
@@ -107,7 +125,20 @@ def run_record(args) -> int:
     return status
 
 
-def describe_written(path: Path) -> str:
+def run_reindex(args) -> int:
+    from ipomdp_gaze.files.bag import reindex
+    done = reindex(args.path, force=args.force)
+    print(describe_written(args.path, 'rebuilt'))
+    for name, count in done.recovered.items():
+        print(f'{name}: unfinished, {count} messages recovered')
+    custom = done.info.get('custom_data') or {}
+    nodes = sorted(k.split('/', 2)[2] for k in custom if k.startswith('ipomdp_gaze/parameters/'))
+    print(f"package {custom.get('ipomdp_gaze/version', 'unknown')}; parameters of "
+          f"{', '.join(nodes) or 'no node'}")
+    return 0
+
+
+def describe_written(path: Path, verb: str = 'wrote') -> str:
     """
     Say what a stopped recording wrote: messages per topic, seconds and megabytes.
 
@@ -125,7 +156,7 @@ def describe_written(path: Path) -> str:
     size = sum(f.stat().st_size for f in Path(path).iterdir() if f.is_file())
     topics = ', '.join(f'{topic} {n}' for topic, n in sorted(counts.items()) if n)
     files = len(info.get('relative_file_paths') or [])
-    return (f'wrote {path}: {int(info.get("message_count", 0))} messages over {seconds:.1f} s, '
+    return (f'{verb} {path}: {int(info.get("message_count", 0))} messages over {seconds:.1f} s, '
             f'{size / 1e6:.2f} MB' + (f' in {files} files' if files > 1 else '')
             + (f' ({topics})' if topics else ''))
 

@@ -11,12 +11,20 @@ MCAP chunks, as rosbag2's ``zstd`` storage presets do, so ``mcap`` readers and F
 read it); :func:`read_bag` returns every message of every file in time order, deserialized
 (``rosbags`` message classes, with the fields of the ROS messages) and the bag's
 ``custom_data``, where the recorder keeps the package version, each node's parameters and the
-hashes of the files they name. No rclpy here.
+hashes of the files they name. The custom data also goes into the MCAP file being written, as a
+metadata record (:data:`CUSTOM_DATA_RECORD`) flushed as soon as it is set, and every chunk is
+flushed once written, so a recording cut off (power lost, SIGKILL) keeps them: :func:`reindex`
+rebuilds ``metadata.yaml`` of such a bag from its MCAP files, as ``ros2 bag reindex`` does.
+No rclpy here.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
+import io
+import os
 from pathlib import Path
+import re
+import shutil
 
 from ipomdp_gaze.files.writable import folder_writable
 import yaml
@@ -30,6 +38,10 @@ NO_MESSAGE_NS = 2 ** 63 - 1     # rosbag2's starting time of a file without mess
 # The largest split limits of the recorder: 10 TB and a year (0 is no split).
 MAX_BAG_SIZE_MB = 1.0e7
 MAX_BAG_DURATION_S = 3.2e7
+# The MCAP metadata record of custom data written while recording (a map of key -> value).
+CUSTOM_DATA_RECORD = 'ipomdp_gaze/custom_data'
+ROSBAG2_RECORD = 'rosbag2'          # the metadata record rosbags writes at close
+MCAP_MAGIC = b'\x89MCAP0\r\n'
 
 
 def _need_rosbags() -> None:
@@ -91,7 +103,6 @@ def open_writer(path, compression: str = '', max_file_bytes: int = 0,
 
     """
     _need_rosbags()
-    from rosbags.rosbag2 import StoragePlugin, Writer
     if compression not in COMPRESSIONS:
         raise ValueError(f"compression must be '' or 'zstd', got {compression!r}")
     for name, value in (('max_file_bytes', max_file_bytes),
@@ -101,16 +112,63 @@ def open_writer(path, compression: str = '', max_file_bytes: int = 0,
     path = check_new_bag(path)
     if max_file_bytes or max_file_duration_ns:
         return SplitWriter(path, compression, int(max_file_bytes), int(max_file_duration_ns))
-    writer = Writer(path, version=Writer.VERSION_LATEST, storage_plugin=StoragePlugin.MCAP)
-    _compress(writer, compression)
-    writer.open()
+    writer = _open_rosbags(path, compression)
     store = _typestore()
     add = writer.add_connection
 
     def add_connection(topic, msgtype, **kw):
         return add(topic, msgtype, typestore=store, **kw)
     writer.add_connection = add_connection
+    writer.set_custom_data = lambda key, value: _keep_custom_data(writer, {key: value})
     return writer
+
+
+def _open_rosbags(path: Path, compression: str):
+    """
+    Open a ``rosbags`` MCAP writer at ``path`` whose chunks reach the file once written.
+
+    ``rosbags`` writes each chunk (about 1 MiB of messages) through a buffered file: flushed
+    after it, a chunk is in the file even if the process is killed right after.
+    """
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    writer = Writer(path, version=Writer.VERSION_LATEST, storage_plugin=StoragePlugin.MCAP)
+    _compress(writer, compression)
+    writer.open()
+    storage = writer.storage
+    close_chunk = storage.close_chunk
+
+    def flushed_close_chunk():
+        close_chunk()
+        storage.bio.flush()
+    storage.close_chunk = flushed_close_chunk
+    return writer
+
+
+def _keep_custom_data(writer, items: dict) -> None:
+    """
+    Set ``items`` in a ``rosbags`` writer's custom data and write them into its MCAP file now.
+
+    One metadata record :data:`CUSTOM_DATA_RECORD` of ``items``, flushed and synced to the
+    disk: ``rosbags`` writes custom data only when it closes the file, which a recording cut
+    off never does; :func:`reindex` reads it back.
+    """
+    from rosbags.rosbag2.storage_mcap import write_record, write_string, write_uint32
+    for key, value in items.items():
+        type(writer).set_custom_data(writer, key, value)     # the class's: not this wrapper
+    if not items:
+        return
+    entries = io.BytesIO()
+    for key, value in items.items():
+        write_string(entries, key)
+        write_string(entries, value)
+    record = io.BytesIO()
+    write_string(record, CUSTOM_DATA_RECORD)
+    write_uint32(record, entries.tell())
+    record.write(entries.getbuffer())
+    bio = writer.storage.bio
+    write_record(bio, 0x0C, record)
+    bio.flush()
+    os.fsync(bio.fileno())
 
 
 def _compress(writer, compression: str) -> None:
@@ -177,13 +235,9 @@ class SplitWriter:
         self._parts = [self._open_part(0)]
 
     def _open_part(self, index: int) -> _Part:
-        from rosbags.rosbag2 import StoragePlugin, Writer
         folder = self.path / f'{self.path.name}_{index}'
-        writer = Writer(folder, version=Writer.VERSION_LATEST, storage_plugin=StoragePlugin.MCAP)
-        _compress(writer, self.compression)
-        writer.open()
-        for key, value in self.custom_data.items():
-            writer.set_custom_data(key, value)
+        writer = _open_rosbags(folder, self.compression)
+        _keep_custom_data(writer, self.custom_data)
         connections = [writer.add_connection(c.topic, c.msgtype, typestore=self._store)
                        for c in self._topics]
         return _Part(index, writer, next(folder.glob('*.mcap')), connections)
@@ -201,7 +255,7 @@ class SplitWriter:
     def set_custom_data(self, key: str, value: str) -> None:
         """Set ``custom_data[key]`` of the bag (also in each file's own MCAP metadata)."""
         for part in self._parts:
-            part.writer.set_custom_data(key, value)
+            _keep_custom_data(part.writer, {key: value})
         self.custom_data[key] = value
 
     def write(self, connection: SplitConnection, time_ns: int, data: bytes) -> None:
@@ -339,11 +393,21 @@ def read_metadata(path) -> dict:
     """Return ``rosbag2_bagfile_information`` of a bag's ``metadata.yaml``."""
     meta = Path(path) / 'metadata.yaml'
     if not meta.is_file():
-        raise ValueError(f'{path} is not a rosbag2 bag: no metadata.yaml')
+        raise ValueError(f'{path} is not a rosbag2 bag: no metadata.yaml' + (
+            f' (a recording cut off? `ipomdp-gaze reindex {path}` rebuilds it from the MCAP '
+            'files)' if _has_mcap_files(Path(path)) else ''))
     try:
         return yaml.safe_load(meta.read_text())['rosbag2_bagfile_information']
     except (yaml.YAMLError, KeyError, TypeError):
         raise ValueError(f'{meta} is not rosbag2 metadata') from None
+
+
+def _has_mcap_files(path: Path) -> bool:
+    """Whether ``path`` is a folder with MCAP files a :func:`reindex` would read."""
+    try:
+        return path.is_dir() and bool(_bag_files(path))
+    except (OSError, ValueError):
+        return False
 
 
 def read_bag(path, topics=None) -> Bag:
@@ -384,9 +448,223 @@ def read_bag(path, topics=None) -> Bag:
                 messages.append(BagMessage(connection.topic, int(stamp), msg, len(raw)))
             duration = reader.duration * 1e-9
     except ReaderError as exc:
-        raise ValueError(f'{path}: {exc}') from None
+        # A file cut off under a metadata.yaml (copied before the recording ended, say).
+        cut = 'magic' in str(exc) or 'footer' in str(exc).lower()
+        raise ValueError(f'{path}: {exc}' + (
+            f' (an unfinished MCAP file? `ipomdp-gaze reindex --force {path}` recovers it)'
+            if cut else '')) from None
     # The files of a split bag one after the other, each in time order: one bag's order (a
     # stable sort keeps the order of messages received at the same time).
     messages.sort(key=lambda m: m.time_ns)
     size = sum(f.stat().st_size for f in path.iterdir() if f.is_file())
     return Bag(path, messages, dict(info.get('custom_data') or {}), size, duration)
+
+
+@dataclass
+class Reindexed:
+    """What :func:`reindex` did: the bag's new metadata and the files it recovered."""
+
+    info: dict                      # metadata.yaml's rosbag2_bagfile_information
+    recovered: dict                 # file name -> messages recovered of an unfinished file
+
+
+def _bag_files(path: Path) -> list:
+    """
+    Return the bag's MCAP files in order, each ``(file, name in the bag)``.
+
+    Those in the bag and those of a split bag still in a folder ``<name>_<i>/`` (a file being
+    written: ``<name>_<i>/<name>_<i>.mcap``), in the order of their index ``_<i>``.
+    """
+    found = [(f, f.name) for f in path.glob('*.mcap') if f.is_file()]
+    for folder in path.iterdir():
+        file = folder / f'{folder.name}.mcap'
+        if folder.is_dir() and file.is_file():
+            found.append((file, file.name))
+    names = [name for _, name in found]
+    twice = sorted({name for name in names if names.count(name) > 1})
+    if twice:
+        raise ValueError(f'{path}: {twice[0]} is there twice (in the bag and in a folder); '
+                         'keep one')
+
+    def order(entry):
+        index = re.fullmatch(r'.*_(\d+)\.mcap', entry[1])
+        return (int(index.group(1)) if index else -1, entry[1])
+    return sorted(found, key=order)
+
+
+def _closed_metadata(file: Path):
+    """Return the ``rosbag2`` metadata a closed MCAP file carries, or None if not closed."""
+    from mcap.reader import make_reader
+    with open(file, 'rb') as f:
+        f.seek(0, os.SEEK_END)
+        if f.tell() < 2 * len(MCAP_MAGIC):
+            return None
+        f.seek(-len(MCAP_MAGIC), os.SEEK_END)
+        if f.read() != MCAP_MAGIC:
+            return None
+        f.seek(0)
+        try:
+            for record in make_reader(f).iter_metadata():
+                if record.name == ROSBAG2_RECORD:
+                    return yaml.safe_load(record.metadata['serialized_metadata'])
+        except Exception:           # noqa: B902 (a damaged summary: rewritten as unfinished)
+            return None
+    return None
+
+
+def _recover(file: Path, folder: Path) -> tuple:
+    """
+    Rewrite the complete records of an unfinished MCAP ``file`` into ``folder`` (a new bag).
+
+    The ``mcap`` stream reader reads records in order up to the first incomplete one (the
+    truncation); every message of a complete chunk is written again by a ``rosbags`` writer,
+    which closes the file with its summary. Return the new file's metadata (as ``rosbags``
+    writes it), the custom data its :data:`CUSTOM_DATA_RECORD` records held and the messages.
+    """
+    from mcap.records import Channel, Chunk, Footer, Message, Metadata, Schema
+    from mcap.stream_reader import breakup_chunk, StreamReader
+    store = _typestore()
+    schemas, connections, custom = {}, {}, {}
+    state = {'writer': None, 'count': 0}
+
+    def writer(compression: str):
+        if state['writer'] is None:
+            state['writer'] = _open_rosbags(folder, compression)
+        return state['writer']
+
+    def take(record, compression: str) -> None:
+        if isinstance(record, Schema):
+            schemas[record.id] = record
+        elif isinstance(record, Channel):
+            # every topic, in the order recorded, those without a message too
+            msgtype = schemas[record.schema_id].name
+            if msgtype not in store.types:
+                raise ValueError(f'{file}: {record.topic} holds {msgtype}, a message type '
+                                 'this reader does not know')
+            connections[record.id] = writer(compression).add_connection(
+                record.topic, msgtype, typestore=store)
+        elif isinstance(record, Message):
+            writer(compression).write(connections[record.channel_id], record.log_time,
+                                      record.data)
+            state['count'] += 1
+        elif isinstance(record, Metadata) and record.name == CUSTOM_DATA_RECORD:
+            custom.update(record.metadata)
+
+    with open(file, 'rb') as f:
+        reader = StreamReader(f, emit_chunks=True,
+                              record_size_limit=max(file.stat().st_size, 1))
+        try:
+            for record in reader.records:
+                if isinstance(record, Footer):
+                    break
+                if isinstance(record, Chunk):
+                    compression = 'zstd' if record.compression == 'zstd' else ''
+                    for inner in breakup_chunk(record):
+                        take(inner, compression)
+                else:
+                    take(record, '')
+        except ValueError as exc:
+            if str(exc).startswith(f'{file}:'):
+                raise
+        except Exception:           # noqa: B902 (the truncation: any record cut anywhere)
+            pass
+    bag_writer = writer('')
+    for key, value in custom.items():
+        bag_writer.set_custom_data(key, value)
+    bag_writer.close()
+    info = yaml.safe_load((folder / 'metadata.yaml').read_text())['rosbag2_bagfile_information']
+    return info, custom, state['count']
+
+
+def _merge(infos: list, custom_data: dict) -> dict:
+    """Return the metadata of a bag of these files (each one's metadata, in order)."""
+    info = dict(infos[-1])
+    topics, counts = {}, {}
+    for one in infos:
+        for entry in one.get('topics_with_message_count') or []:
+            key = (entry['topic_metadata']['name'], entry['topic_metadata']['type'])
+            topics.setdefault(key, entry['topic_metadata'])
+            counts[key] = counts.get(key, 0) + int(entry['message_count'])
+    info['topics_with_message_count'] = [{'topic_metadata': topics[key],
+                                          'message_count': counts[key]} for key in topics]
+    files = [entry for one in infos for entry in one['files']]
+    starts = [f['starting_time']['nanoseconds_since_epoch'] for f in files if f['message_count']]
+    ends = [f['starting_time']['nanoseconds_since_epoch'] + f['duration']['nanoseconds']
+            for f in files if f['message_count']]
+    info['relative_file_paths'] = [f['path'] for f in files]
+    info['files'] = files
+    info['message_count'] = sum(f['message_count'] for f in files)
+    info['starting_time'] = {'nanoseconds_since_epoch': min(starts, default=NO_MESSAGE_NS)}
+    info['duration'] = {'nanoseconds': max(ends) - min(starts) if starts else 0}
+    info['custom_data'] = dict(custom_data) or None
+    return info
+
+
+def reindex(path, force: bool = False) -> Reindexed:
+    """
+    Rebuild ``metadata.yaml`` of a bag from its MCAP files, as ``ros2 bag reindex`` does.
+
+    For a recording cut off (power lost, the recorder killed): no ``metadata.yaml``, and the
+    file being written (a split bag's in its folder ``<name>_<i>/``) has no summary. A closed
+    file keeps its own metadata; an unfinished one is rewritten with every message of its
+    complete chunks (those written before the last chunk was begun) and moved into the bag.
+    The custom data (package version, parameters, file hashes, namespace) is what the files
+    carry, later files' over earlier ones'.
+
+    Raises
+    ------
+    ValueError
+        If ``path`` is not a folder, holds no MCAP file or already has ``metadata.yaml``
+        (unless ``force``).
+
+    """
+    _need_rosbags()
+    path = Path(path)
+    if not path.is_dir():
+        raise ValueError(f'{path} is not a bag directory')
+    meta = path / 'metadata.yaml'
+    if meta.exists() and not force:
+        raise ValueError(f'{path} has a metadata.yaml already; --force rebuilds it from the '
+                         'MCAP files')
+    files = _bag_files(path)
+    if not files:
+        raise ValueError(f'{path}: no MCAP files to reindex (<name>.mcap, or <name>_<i>.mcap '
+                         'of a split bag)')
+    if not folder_writable(path):
+        raise ValueError(f'{path}: the folder is not writable')
+    infos, custom, recovered = [], {}, {}
+    for file, name in files:
+        info = _closed_metadata(file)
+        if info is not None:
+            custom.update(info.get('custom_data') or {})
+            if file.parent != path:         # closed, not yet moved up (killed in between)
+                file.replace(path / name)
+        else:
+            scratch = path / f'.reindex_{Path(name).stem}'
+            if scratch.exists():
+                raise ValueError(f'{scratch} exists (an earlier reindex stopped?); remove it')
+            try:
+                info, found, count = _recover(file, scratch / Path(name).stem)
+            except BaseException:
+                shutil.rmtree(scratch, ignore_errors=True)
+                raise
+            custom.update(found)
+            (scratch / Path(name).stem / name).replace(path / name)
+            (scratch / Path(name).stem / 'metadata.yaml').unlink()
+            (scratch / Path(name).stem).rmdir()
+            scratch.rmdir()
+            recovered[name] = count
+        if file.parent != path:
+            # the folder a split bag's file was written in: nothing else of it is kept
+            for leftover in (file, file.parent / 'metadata.yaml'):
+                if leftover.exists():
+                    leftover.unlink()
+            file.parent.rmdir()
+        info = dict(info, files=[dict(entry, path=name) for entry in info['files']])
+        infos.append(info)
+    merged = _merge(infos, custom)
+    written = meta.with_suffix('.yaml.tmp')
+    written.write_text(yaml.safe_dump({'rosbag2_bagfile_information': merged},
+                                      default_flow_style=False, sort_keys=False))
+    written.replace(meta)
+    return Reindexed(merged, recovered)

@@ -38,7 +38,10 @@ messages are stamped with, so a replay applies the ``/parameter_events`` after i
 ``ipomdp_gaze/namespace`` (the recorder's: its relative topics and nodes are resolved in it,
 ``/head1/pan_tilt`` under ``-r __ns:=/head1``) and
 ``ipomdp_gaze/files`` (the sha256 of each policy and observation file those parameters
-name): what ``ipomdp-gaze replay`` needs to re-run the search. ``compression`` ``zstd``
+name): what ``ipomdp-gaze replay`` needs to re-run the search. Each is also written into the
+MCAP file being written as soon as it is known (a metadata record, synced to the disk), so a
+recording cut off (power lost, SIGKILL) keeps it: ``ipomdp-gaze reindex`` rebuilds such a bag's
+``metadata.yaml`` from its MCAP files. ``compression`` ``zstd``
 compresses the MCAP chunks (as rosbag2's ``zstd`` storage presets do; every MCAP
 reader decompresses them). ``/diagnostics`` carries ``<node>: recording`` with the messages
 written and the publishers matched per topic.
