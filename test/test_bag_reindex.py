@@ -151,3 +151,25 @@ def test_reindex_refuses_a_folder_without_mcap_files_with_one_line(tmp_path, cli
     assert run.returncode == 2
     assert run.stderr.strip().splitlines() == [
         'ipomdp-gaze reindex: error: ' + message.format(p=path)]
+
+
+def test_a_write_failing_while_recovering_is_raised_and_leaves_the_bag_as_it_was(
+        tmp_path, monkeypatch):
+    """Review: a full disk while rewriting was taken for the cut: a shorter file replaced it."""
+    from ipomdp_gaze.files.bag import reindex
+    from rosbags.rosbag2 import Writer
+    bag = tmp_path / 'bag'
+    _killed(bag, 40)
+    before = (bag / 'bag.mcap').read_bytes()
+    write, written = Writer.write, []
+
+    def full(self, *args):
+        if len(written) == 5:
+            raise OSError(28, 'No space left on device')
+        written.append(args)
+        write(self, *args)
+    monkeypatch.setattr(Writer, 'write', full)
+    with pytest.raises(OSError, match='No space left'):
+        reindex(bag)
+    assert sorted(p.name for p in bag.iterdir()) == ['bag.mcap']
+    assert (bag / 'bag.mcap').read_bytes() == before

@@ -512,68 +512,94 @@ def _closed_metadata(file: Path):
     return None
 
 
+def _complete_records(file: Path):
+    """
+    Yield the records of an MCAP ``file`` in order (a chunk's with its compression).
+
+    Up to the footer, or to the first record cut off (the truncation) or damaged: the ``mcap``
+    stream reader reads a record only when it is whole, and a chunk is broken up only then.
+    """
+    from mcap.records import Chunk, Footer
+    from mcap.stream_reader import breakup_chunk, StreamReader
+    with open(file, 'rb') as f:
+        records = StreamReader(f, emit_chunks=True,
+                               record_size_limit=max(file.stat().st_size, 1)).records
+        while True:
+            try:
+                record = next(records)
+                if isinstance(record, Chunk):
+                    compression = 'zstd' if record.compression == 'zstd' else ''
+                    inner = [(r, compression) for r in breakup_chunk(record)]
+                else:
+                    inner = [(record, '')]
+            except StopIteration:
+                return
+            except Exception:       # noqa: B902 (the cut: any record cut anywhere)
+                return
+            if isinstance(record, Footer):
+                return
+            yield from inner
+
+
+class _Recovery:
+    """The ``rosbags`` writer of a file recovered (opened with the first chunk's compression)."""
+
+    def __init__(self, file: Path, folder: Path):
+        self.file, self.folder = file, folder
+        self.store = _typestore()
+        self.writer = None
+        self.schemas, self.connections, self.custom = {}, {}, {}
+        self.count = 0
+
+    def _writer(self, compression: str):
+        if self.writer is None:
+            self.writer = _open_rosbags(self.folder, compression)
+        return self.writer
+
+    def take(self, record, compression: str) -> None:
+        """Write a record read: a message, its topic, its type, or keep custom data."""
+        from mcap.records import Channel, Message, Metadata, Schema
+        if isinstance(record, Schema):
+            self.schemas[record.id] = record
+        elif isinstance(record, Channel):
+            # every topic, in the order recorded, those without a message too
+            msgtype = self.schemas[record.schema_id].name
+            if msgtype not in self.store.types:
+                raise ValueError(f'{self.file}: {record.topic} holds {msgtype}, a message type '
+                                 'this reader does not know')
+            self.connections[record.id] = self._writer(compression).add_connection(
+                record.topic, msgtype, typestore=self.store)
+        elif isinstance(record, Message):
+            self._writer(compression).write(self.connections[record.channel_id],
+                                            record.log_time, record.data)
+            self.count += 1
+        elif isinstance(record, Metadata) and record.name == CUSTOM_DATA_RECORD:
+            self.custom.update(record.metadata)
+
+    def close(self) -> dict:
+        """Close the new file (with the custom data) and return its metadata."""
+        writer = self._writer('')
+        for key, value in self.custom.items():
+            writer.set_custom_data(key, value)
+        writer.close()
+        return yaml.safe_load((self.folder / 'metadata.yaml').read_text())[
+            'rosbag2_bagfile_information']
+
+
 def _recover(file: Path, folder: Path) -> tuple:
     """
     Rewrite the complete records of an unfinished MCAP ``file`` into ``folder`` (a new bag).
 
-    The ``mcap`` stream reader reads records in order up to the first incomplete one (the
-    truncation); every message of a complete chunk is written again by a ``rosbags`` writer,
-    which closes the file with its summary. Return the new file's metadata (as ``rosbags``
-    writes it), the custom data its :data:`CUSTOM_DATA_RECORD` records held and the messages.
+    Every message of a complete chunk (:func:`_complete_records`) is written again by a
+    ``rosbags`` writer, which closes the file with its summary. Return the new file's metadata
+    (as ``rosbags`` writes it), the custom data its :data:`CUSTOM_DATA_RECORD` records held
+    and the number of messages. A failure to write (a full disk) is raised, not taken for the
+    end of what was recorded.
     """
-    from mcap.records import Channel, Chunk, Footer, Message, Metadata, Schema
-    from mcap.stream_reader import breakup_chunk, StreamReader
-    store = _typestore()
-    schemas, connections, custom = {}, {}, {}
-    state = {'writer': None, 'count': 0}
-
-    def writer(compression: str):
-        if state['writer'] is None:
-            state['writer'] = _open_rosbags(folder, compression)
-        return state['writer']
-
-    def take(record, compression: str) -> None:
-        if isinstance(record, Schema):
-            schemas[record.id] = record
-        elif isinstance(record, Channel):
-            # every topic, in the order recorded, those without a message too
-            msgtype = schemas[record.schema_id].name
-            if msgtype not in store.types:
-                raise ValueError(f'{file}: {record.topic} holds {msgtype}, a message type '
-                                 'this reader does not know')
-            connections[record.id] = writer(compression).add_connection(
-                record.topic, msgtype, typestore=store)
-        elif isinstance(record, Message):
-            writer(compression).write(connections[record.channel_id], record.log_time,
-                                      record.data)
-            state['count'] += 1
-        elif isinstance(record, Metadata) and record.name == CUSTOM_DATA_RECORD:
-            custom.update(record.metadata)
-
-    with open(file, 'rb') as f:
-        reader = StreamReader(f, emit_chunks=True,
-                              record_size_limit=max(file.stat().st_size, 1))
-        try:
-            for record in reader.records:
-                if isinstance(record, Footer):
-                    break
-                if isinstance(record, Chunk):
-                    compression = 'zstd' if record.compression == 'zstd' else ''
-                    for inner in breakup_chunk(record):
-                        take(inner, compression)
-                else:
-                    take(record, '')
-        except ValueError as exc:
-            if str(exc).startswith(f'{file}:'):
-                raise
-        except Exception:           # noqa: B902 (the truncation: any record cut anywhere)
-            pass
-    bag_writer = writer('')
-    for key, value in custom.items():
-        bag_writer.set_custom_data(key, value)
-    bag_writer.close()
-    info = yaml.safe_load((folder / 'metadata.yaml').read_text())['rosbag2_bagfile_information']
-    return info, custom, state['count']
+    recovery = _Recovery(file, folder)
+    for record, compression in _complete_records(file):
+        recovery.take(record, compression)
+    return recovery.close(), recovery.custom, recovery.count
 
 
 def _merge(infos: list, custom_data: dict) -> dict:
