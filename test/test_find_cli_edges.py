@@ -414,10 +414,10 @@ def test_a_frame_scanned_whole_because_max_side_shrank_it_says_so(tmp_path, run_
     """
     path = tmp_path / 'strip.png'
     cv2.imwrite(str(path), np.full((60, 1000, 3), 90, np.uint8))
-    result = run_find(path, '--max-side', '500')
+    result = run_find(path, '--max-side', '100')
     assert result.returncode == 0, result.stderr
     assert (f'{path}: scanned the whole frame once: ' in result.stderr and
-            ' (500x30 px as --max-side 500 resized it; --max-side 0 searches it at its own '
+            ' (353x21 px as --max-side 100 resized it; --max-side 0 searches it at its own '
             'size)\n' in result.stderr)
     whole = run_find(path, '--max-side', '0')
     assert 'scanned the whole frame once' in whole.stderr and 'resized it' not in whole.stderr

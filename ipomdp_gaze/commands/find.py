@@ -70,9 +70,11 @@ face, rule its cells out, search again).
 **Images** are read with OpenCV (``IMREAD_ANYDEPTH | IMREAD_ANYCOLOR``: EXIF orientation applied,
 an alpha channel dropped; OpenCV's and libpng's own messages silenced, our one line says it). A
 16-bit image is converted to 8 bits (divided by 257, or from the 8-14 bits its values fit) with
-a note; one longer than ``--max-side``
-(2048) on a side is resized before the search (a JPEG decoded at 1/2, 1/4 or 1/8 first, so an
-8000x6000 photo peaks at about 180 MB) and its answer given in its own pixels. Colour arrays
+a note; one larger than ``--max-side`` (2048) allows is resized before the search (a JPEG
+decoded at 1/2, 1/4 or 1/8 first, so an 8000x6000 photo peaks at about 180 MB) and its answer
+given in its own pixels: up to 2:1 its longer side to ``--max-side``, a panorama beyond 2:1 to
+at most the pixels of a ``--max-side`` x 3/4 ``--max-side`` picture (:func:`resized_size`), so
+that an 8000x300 panorama's faces are not shrunk to 11 px high. Colour arrays
 arrive in OpenCV's BGR order and are converted to RGB; the fovea gives each window to the
 detector in the colour space it declares (RGB for YuNet, grey for Haar; a grey image is repeated
 into three channels for an RGB detector). ``seconds`` starts from the decoded
@@ -146,6 +148,14 @@ STDOUT = Path('-')
 # and 840 px, so a 2048 px image still holds every window at the resolution they were measured
 # at.
 MAX_SIDE_PX = 2048
+# A picture at most this many times as long as it is high (or high as wide) is resized to
+# --max-side on its longer side, as before 0.3.4: every published picture (640x480 to 4000x3000
+# and 8000x6000, 1536x2048 portraits) and a 360 camera's 2:1 equirectangular frame. A wider one
+# (a stitched pan sweep, 4:1 to 10:1) keeps at most the pixels of a --max-side x 3/4 --max-side
+# picture (3.1 Mpx at 2048, the 4:3 size whose memory is measured above) instead: its longer
+# side resized to --max-side made an 8000x300 panorama 2048x77 px, below the faces' size.
+PANORAMA_RATIO = 2.0
+PANORAMA_AREA_FRACTION = 0.75
 # find without --all: how the search starts (--scan). 'coarse' (the default): full-frame
 # detector calls from a coarse scale to finer ones until a strong box, confirmed by a look at
 # the next finer scale round it (search_scales); 'many': the many-target search of --all (its
@@ -247,7 +257,9 @@ def add_parser(sub):
                    help='resize an image longer than this on a side before the search '
                         f'(default {MAX_SIDE_PX}; 0: never), a JPEG while it is decoded, as '
                         'the detector node bounds its images (max_image_side_px); its pixels '
-                        'are then given in the original image')
+                        'are then given in the original image. A panorama beyond 2:1 keeps '
+                        'at most the pixels of a PX x 3/4 PX picture instead, at its own '
+                        'aspect ratio (an 8000x300 one is searched as given)')
     p.add_argument('--min-face', type=positive_float, default=None, metavar='PX',
                    help="the smallest face side that matters, in the given image's pixels; "
                         'with --all or --scan many (default 1/10 of its shorter side) the '
@@ -288,7 +300,8 @@ def _read_flags(file: Path, max_side: int) -> tuple[int, tuple | None]:
 
     OpenCV decodes a colour JPEG through a second full-size buffer (an 8000x6000 photo: 280 MB);
     ``IMREAD_REDUCED_COLOR_<k>`` decodes it at 1/k instead (libjpeg scales while decoding), for
-    the largest k of 8, 4, 2 that keeps the longer side at least ``max_side``. Other formats
+    the largest k of 8, 4, 2 that keeps the longer side at least that of the resized picture
+    (:func:`resized_size`: ``max_side`` up to 2:1). Other formats
     are decoded whole (and a 16-bit one converted with its note), then resized. The size comes
     from the file's header (Pillow, which reads no pixels) and is returned with the flags
     (None when the decode is not reduced), as displayed: width and height swapped when its
@@ -315,7 +328,7 @@ def _read_flags(file: Path, max_side: int) -> tuple[int, tuple | None]:
         return READ_FLAGS, None
     for k, flag in ((8, cv2.IMREAD_REDUCED_COLOR_8), (4, cv2.IMREAD_REDUCED_COLOR_4),
                     (2, cv2.IMREAD_REDUCED_COLOR_2)):
-        if max(size) // k >= max_side:
+        if max(size) // k >= max(resized_size(*size, max_side)):
             return flag, size
     return READ_FLAGS, None
 
@@ -368,7 +381,7 @@ def read_image(path: str, notes: list | None = None, max_side: int = 0,
     A 16-bit image is converted to 8 bits (``round(v / 257)``, 65535 -> 255; values that fit
     fewer bits, :data:`SENSOR_BITS`, scaled from that range instead), and ``notes``, when
     given, gets a line saying so; ``size``, when given, gets the decoded ``(width,
-    height)``. With ``max_side``, an image longer than that on a side
+    height)``. With ``max_side``, an image over its size (:func:`resized_size`)
     is resized (:func:`shrink`) before its colours are converted, so that no second full-size
     copy is made (an 8000x6000 photo peaks at about 270 MB resident, most of it the decoded
     array).
@@ -464,19 +477,42 @@ def _loops(path: Path) -> bool:
     return False
 
 
+def resized_size(width: int, height: int, max_side: int) -> tuple[int, int]:
+    """
+    Return the ``(width, height)`` :func:`shrink` resizes a picture of that size to.
+
+    Up to :data:`PANORAMA_RATIO` (2:1) the longer side is at most ``max_side``; a wider or
+    taller picture keeps at most ``max_side`` x 3/4 ``max_side`` pixels
+    (:data:`PANORAMA_AREA_FRACTION`) at its own aspect ratio, so that a panorama's faces are
+    not shrunk to a few pixels high while its memory stays that of a 4:3 picture at
+    ``max_side``. 0: never resized.
+    """
+    if not max_side:
+        return width, height
+    if max(width, height) <= PANORAMA_RATIO * min(width, height):
+        if max(width, height) <= max_side:
+            return width, height
+        scale = max_side / max(width, height)
+        return max(1, round(width * scale)), max(1, round(height * scale))
+    area = max_side * max_side * PANORAMA_AREA_FRACTION
+    if width * height <= area:
+        return width, height
+    scale = math.sqrt(area / (width * height))
+    return max(1, math.floor(width * scale)), max(1, math.floor(height * scale))
+
+
 def shrink(image: np.ndarray, max_side: int) -> tuple[np.ndarray, tuple]:
     """
-    Resize ``image`` so its longer side is at most ``max_side`` (``INTER_AREA``); 0: never.
+    Resize ``image`` to :func:`resized_size` (``INTER_AREA``); ``max_side`` 0: never.
 
     Returns the image and the factors ``(sx, sy)`` from its pixels to the given image's.
     As the detector node does with ``max_image_side_px``, but resizing instead of refusing: a
     search over an 8000x6000 image would otherwise take seconds and gigabytes.
     """
     height, width = image.shape[:2]
-    if not max_side or max(width, height) <= max_side:
+    size = resized_size(width, height, max_side)
+    if size == (width, height):
         return image, (1.0, 1.0)
-    scale = max_side / max(width, height)
-    size = (max(1, round(width * scale)), max(1, round(height * scale)))
     small = cv2.resize(image, size, interpolation=cv2.INTER_AREA)
     return small, (width / size[0], height / size[1])
 
