@@ -143,8 +143,9 @@ def test_reproduce_through_the_scheduler_gives_the_local_report(cluster, tmp_pat
     small = ['--episodes', '300', '--episodes-greedy', '12', '--episodes-planner', '12',
              '--bootstrap', '50', '--no-cache', '--quiet']
     _run(['reproduce', '--out', str(tmp_path / 'here'), '--jobs', '1', *small], capsys)
-    log = _run(['reproduce', '--out', str(tmp_path / 'dask'), '--scheduler', cluster.address,
-                *small], capsys)
+    assert cli_main(['reproduce', '--out', str(tmp_path / 'dask'), '--scheduler',
+                     cluster.address, *small]) == 0
+    log = capsys.readouterr().err               # the progress log goes to stderr
     assert '2 Dask workers' in log
     assert _tables(tmp_path / 'here' / 'reproduction.md') == \
         _tables(tmp_path / 'dask' / 'reproduction.md')

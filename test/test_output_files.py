@@ -142,14 +142,23 @@ def test_demo_refuses_its_picture_files_before_the_nodes_run(tmp_path, monkeypat
 @pytest.mark.parametrize('command', [
     ['evaluate', '--grid', '3x3', '--episodes', '20', '--json', '{dir}/e.json'],
     ['search', '--grid', '3x3', '--seed', '1', '--plot', '{dir}/s.png'],
+    ['train', '--grid', '3x3', '--epochs', '2', '--quiet', '--out', '{dir}/p.yaml'],
+    ['calibrate', '--scenes', '2', '--grid', '7x7', '--windows', '7,3', '--scales', '1/2,1',
+     '--processes', '1', '--quiet', '--out', '{dir}/c.yaml'],
 ])
 def test_the_note_of_a_file_written_goes_to_stderr(tmp_path, command):
-    """``evaluate ... --json F > table.txt`` put 'wrote F' among the table's lines."""
+    """
+    ``evaluate ... --json F > table.txt`` put 'wrote F' among the table's lines.
+
+    ``train`` and ``calibrate`` said 'wrote X and Y' on stdout too, after their results.
+    """
     run = run_cli(*[a.format(dir=tmp_path) for a in command])
     assert run.returncode == 0, run.stderr
     written = command[-1].format(dir=tmp_path)
     assert 'wrote' not in run.stdout
-    assert f'ipomdp-gaze {command[0]}: wrote {written}\n' in run.stderr
+    also = {'train': f" and {tmp_path / 'p.csv'}", 'calibrate': f" and {tmp_path / 'c.png'}"}
+    assert f'ipomdp-gaze {command[0]}: wrote {written}{also.get(command[0], "")}\n' \
+        in run.stderr
     if written.endswith('.json'):
         assert json.loads(Path(written).read_text())['grid']['rows'] == 3
 

@@ -169,7 +169,7 @@ def test_the_report_is_the_same_on_one_or_two_processes_and_from_the_cache(tmp_p
                      str(cache), *small]) == 0
     assert cli_main(['reproduce', '--out', str(tmp_path / 'c'), '--jobs', '1', '--no-cache',
                      *small]) == 0
-    log = capsys.readouterr().out
+    log = capsys.readouterr().err
     pieces = len(list(cache.glob('*.bin')))
     assert pieces > 0 and f'{pieces} pieces from the cache' in log
     report = _tables(tmp_path / 'a' / 'reproduction.md')

@@ -30,6 +30,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 from pathlib import Path
+import sys
 import time
 
 from ipomdp_gaze.files.writable import write_figure
@@ -421,8 +422,8 @@ def run_pan_tilt(args) -> int:
     plot_fpoc(model, plot, f'{args.out.stem}: {tallies.images} pan/tilt scenes, '
                            f'{grid.rows}x{grid.cols} grid of {grid.spacing_deg:g} deg, '
                            f'{width}x{height} camera, {hfov:.1f}x{vfov:.1f} deg view')
-    print(f'calibrated on {tallies.images} scenes ({tallies.fixations} views) in {wall:.1f} s; '
-          f'wrote {args.out} and {plot}')
+    print(f'calibrated on {tallies.images} scenes ({tallies.fixations} views) in {wall:.1f} s')
+    print(f'ipomdp-gaze calibrate: wrote {args.out} and {plot}', file=sys.stderr)
     return 0
 
 
@@ -482,5 +483,6 @@ def run(args) -> int:
     plot_fpoc(model, plot, f'{args.out.stem}: {tallies.images} images of {width}x{height} px, '
                            f'{grid.rows}x{grid.cols} grid, windows {list(config.windows_cells)}')
     print(f'calibrated on {tallies.images} images ({tallies.fixations} fixations) in '
-          f'{wall:.1f} s; wrote {args.out} and {plot}')
+          f'{wall:.1f} s')
+    print(f'ipomdp-gaze calibrate: wrote {args.out} and {plot}', file=sys.stderr)
     return 0

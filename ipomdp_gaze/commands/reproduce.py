@@ -14,6 +14,7 @@ import hashlib
 import os
 from pathlib import Path
 import resource
+import sys
 import time
 
 from ipomdp_gaze.drivers.pieces import COSTLY_CHUNK, PieceCache, PLANNER_CHUNK, Runner
@@ -360,7 +361,8 @@ def run(args) -> int:
     load_start = os.getloadavg()[0]
 
     def log(message):
-        print(f'[{time.perf_counter() - started:6.0f} s] {message}', flush=True)
+        print(f'[{time.perf_counter() - started:6.0f} s] {message}', file=sys.stderr,
+              flush=True)
 
     retrained = _retrain(log, out / 'kernels') if args.retrain else {}
     specs = {name: _load(str(retrained.get(name, name))) for name in KERNELS}

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+import sys
 
 from ipomdp_gaze.model.belief import prior_is_uniform
 from ipomdp_gaze.search.session import SearchSettings
@@ -309,7 +310,7 @@ def run(args) -> int:
             ci = evaluation['tracking_accuracy_ci95']
             print(f"tracking accuracy {evaluation['tracking_accuracy']:.4f} "
                   f'[{ci[0]:.4f}, {ci[1]:.4f}]')
-    print(f'wrote {out} and {curve_path}')
+    print(f'ipomdp-gaze train: wrote {out} and {curve_path}', file=sys.stderr)
     return 0
 
 
