@@ -66,8 +66,8 @@ def test_find_all_finds_both_faces_of_a_panorama(tmp_path, run_find, tall):
                    for x, y, w, h in (face['box'] for face in entry['faces'])) == 1
     searched = '126x3794' if tall else '3794x126'
     given = '160x4800' if tall else '4800x160'
-    assert f'resized from {given} to {searched} px before the search (--max-side 800)' \
-        in result.stderr
+    assert (f'resized from {given} to {searched} px before the search (--max-side 800: a '
+            'panorama beyond 2:1 keeps 0.48 Mpx)\n') in result.stderr
 
 
 @pytest.mark.parametrize('size, max_side, resized', [

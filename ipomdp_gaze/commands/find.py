@@ -1143,9 +1143,13 @@ def run(args) -> int:
             given = sizes[0]
             scale = (given[0] / image.shape[1], given[1] / image.shape[0])
             if scale != (1.0, 1.0):
+                wide = max(image.shape[:2]) > args.max_side     # a panorama's pixel bound
                 notes.append(f'{path}: resized from {given[0]}x{given[1]} to '
                              f'{image.shape[1]}x{image.shape[0]} px before the search '
-                             f'(--max-side {args.max_side})')
+                             f'(--max-side {args.max_side}' +
+                             (f': a panorama beyond {PANORAMA_RATIO:g}:1 keeps '
+                              f'{PANORAMA_AREA_FRACTION * args.max_side ** 2 / 1e6:.2g} Mpx)'
+                              if wide else ')'))
             task = tasks.task((image.shape[1], image.shape[0]))
             _check_size(path, image, given, task.fovea, args.max_side)
             settings = settings_from_args(args, FIND_SETTINGS, task.model.grid)
