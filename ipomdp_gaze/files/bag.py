@@ -26,7 +26,7 @@ from pathlib import Path
 import re
 import shutil
 
-from ipomdp_gaze.files.writable import folder_writable
+from ipomdp_gaze.files.writable import folder_writable, write_text
 import yaml
 
 DISTRO_STORE = 'ROS2_JAZZY'
@@ -323,21 +323,7 @@ class SplitWriter:
             dict(entry, message_count=counts.get((entry['topic_metadata']['name'],
                                                   entry['topic_metadata']['type']), 0))
             for entry in info.get('topics_with_message_count') or []]
-        starts = [f['starting_time']['nanoseconds_since_epoch'] for f in self.files
-                  if f['message_count']]
-        ends = [f['starting_time']['nanoseconds_since_epoch'] + f['duration']['nanoseconds']
-                for f in self.files if f['message_count']]
-        info['relative_file_paths'] = [f['path'] for f in self.files]
-        info['files'] = self.files
-        info['message_count'] = sum(f['message_count'] for f in self.files)
-        info['starting_time'] = {'nanoseconds_since_epoch': min(starts, default=NO_MESSAGE_NS)}
-        info['duration'] = {'nanoseconds': max(ends) - min(starts) if starts else 0}
-        info['custom_data'] = dict(self.custom_data) or None
-        meta = self.path / 'metadata.yaml'
-        written = meta.with_suffix('.yaml.tmp')
-        written.write_text(yaml.safe_dump({'rosbag2_bagfile_information': info},
-                                          default_flow_style=False, sort_keys=False))
-        written.replace(meta)
+        _write_metadata(self.path, _with_files(info, self.files, self.custom_data))
 
 
 @dataclass
@@ -613,17 +599,30 @@ def _merge(infos: list, custom_data: dict) -> dict:
             counts[key] = counts.get(key, 0) + int(entry['message_count'])
     info['topics_with_message_count'] = [{'topic_metadata': topics[key],
                                           'message_count': counts[key]} for key in topics]
-    files = [entry for one in infos for entry in one['files']]
+    return _with_files(info, [entry for one in infos for entry in one['files']], custom_data)
+
+
+def _with_files(info: dict, files: list, custom_data: dict) -> dict:
+    """
+    Return ``info`` with a bag's files (metadata.yaml's ``files`` entries, in order).
+
+    Their paths, total message count, starting time and duration, and ``custom_data``.
+    """
     starts = [f['starting_time']['nanoseconds_since_epoch'] for f in files if f['message_count']]
     ends = [f['starting_time']['nanoseconds_since_epoch'] + f['duration']['nanoseconds']
             for f in files if f['message_count']]
-    info['relative_file_paths'] = [f['path'] for f in files]
-    info['files'] = files
-    info['message_count'] = sum(f['message_count'] for f in files)
-    info['starting_time'] = {'nanoseconds_since_epoch': min(starts, default=NO_MESSAGE_NS)}
-    info['duration'] = {'nanoseconds': max(ends) - min(starts) if starts else 0}
-    info['custom_data'] = dict(custom_data) or None
-    return info
+    return dict(info, relative_file_paths=[f['path'] for f in files], files=files,
+                message_count=sum(f['message_count'] for f in files),
+                starting_time={'nanoseconds_since_epoch': min(starts, default=NO_MESSAGE_NS)},
+                duration={'nanoseconds': max(ends) - min(starts) if starts else 0},
+                custom_data=dict(custom_data) or None)
+
+
+def _write_metadata(path: Path, info: dict) -> None:
+    """Write a bag's ``metadata.yaml`` whole or not at all."""
+    write_text(path / 'metadata.yaml', yaml.safe_dump({'rosbag2_bagfile_information': info},
+                                                      default_flow_style=False,
+                                                      sort_keys=False))
 
 
 def reindex(path, force: bool = False) -> Reindexed:
@@ -689,8 +688,5 @@ def reindex(path, force: bool = False) -> Reindexed:
         info = dict(info, files=[dict(entry, path=name) for entry in info['files']])
         infos.append(info)
     merged = _merge(infos, custom)
-    written = meta.with_suffix('.yaml.tmp')
-    written.write_text(yaml.safe_dump({'rosbag2_bagfile_information': merged},
-                                      default_flow_style=False, sort_keys=False))
-    written.replace(meta)
+    _write_metadata(path, merged)
     return Reindexed(merged, recovered)
