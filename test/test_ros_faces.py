@@ -178,7 +178,8 @@ def test_a_readme_figure_demo_command_still_draws_it(demo, options, figure):
     run, plots = demo(*options)
     assert run.returncode == 0, run.stdout + run.stderr
     out = plots / Path(figure).name
-    assert f'wrote {out}' in run.stdout
+    # the note goes to stderr: stdout is the demo's transcript, the same with --plot or without
+    assert f'ipomdp-gaze demo: wrote {out}\n' in run.stderr and 'wrote' not in run.stdout
     drawn, shipped = cv2.imread(str(out)), cv2.imread(str(REPO / figure))
     assert drawn is not None, f'{options} drew nothing at {out}'
     assert drawn.shape == shipped.shape

@@ -121,6 +121,7 @@ def test_a_short_walk_demo_scores_frames_and_ends_with_the_score_line(ros_env, t
     assert scored and 0 < int(scored.group(1)) <= int(scored.group(2)), out
     assert 'stopped all 3 nodes' in out and 'NOT a clean shutdown' not in out
     assert plot.stat().st_size > 0
+    assert f'ipomdp-gaze demo: wrote {plot}\n' in run.stderr and 'wrote' not in out
 
 
 def test_the_bench_says_per_seed_and_on_how_many_seeds_the_face_was_kept_in_view():

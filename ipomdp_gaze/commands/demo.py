@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+import sys
 
 from ipomdp_gaze.files.bag import check_new_bag
 from ipomdp_gaze.harness.processes import MAX_DOMAIN_ID, valid_domain_id
@@ -125,6 +126,11 @@ def domain_arg(text: str) -> int:
     return value
 
 
+def _note(line: str) -> None:
+    """Say what was written, on stderr: stdout ends with the demo's verdict."""
+    print(f'ipomdp-gaze demo: {line}', file=sys.stderr, flush=True)
+
+
 def run(args) -> int:
     from ipomdp_gaze.harness.demo import demo_setup, faces_setup, run_demo
 
@@ -188,14 +194,14 @@ def run(args) -> int:
     if pictures is not None:
         from ipomdp_gaze.vision.search_plots import save_gif, save_png
         if not pictures:
-            out('ipomdp-gaze demo: no picture of the search to write')
+            _note('no picture of the search to write')
             return status or 1
         if args.plot:
             save_png(pictures[-1], args.plot)
-            out(f'wrote {args.plot}')
+            _note(f'wrote {args.plot}')
         if args.animate:
             count = save_gif(pictures, args.animate)
-            out(f'wrote {args.animate} ({count} pictures)')
+            _note(f'wrote {args.animate} ({count} pictures)')
     return status
 
 
@@ -217,4 +223,4 @@ def _walk(args, faces: tuple, out) -> int:
         raise ValueError(f'--duration-s must be from 1 to 3600 s, got {duration:g}')
     setup, camera = walk_setup(args.seed, speed, duration, args.policy)
     return run_walk_demo(setup, camera, duration, args.timeout or DEMO_TIMEOUT_S,
-                         args.domain_id, args.verbose, out, plot=args.plot)
+                         args.domain_id, args.verbose, out, plot=args.plot, note=_note)

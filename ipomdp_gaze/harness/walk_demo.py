@@ -125,14 +125,15 @@ def _walk_time(truths: list, grid, at: float) -> float:
 
 def run_walk_demo(setup, camera, duration_s: float = DURATION_S, timeout_s: float = 60.0,
                   domain_id: int | None = None, verbose: bool = False, out=print,
-                  plot=None, stats: dict | None = None) -> int:
+                  plot=None, stats: dict | None = None, note=None) -> int:
     """
     Run the walk demo; 0 when the walk ran its length, frames were scored and all stopped cleanly.
 
     ``timeout_s`` bounds the start (the nodes up and the camera's first frame); then the demo
     follows the walk until a frame at ``duration_s`` of the camera's clock (or ``timeout_s``
     more without one). ``plot``: write the face's path and the gaze over time there (PNG).
-    ``stats``, when given, gets ``score`` (:class:`WalkScore`) and ``frames``.
+    ``stats``, when given, gets ``score`` (:class:`WalkScore`) and ``frames``. ``note`` says
+    what was written (default ``out``; the CLI's goes to stderr).
     """
     domain = domain_id_for() if domain_id is None else domain_id
     stats = {} if stats is None else stats
@@ -194,7 +195,7 @@ def run_walk_demo(setup, camera, duration_s: float = DURATION_S, timeout_s: floa
             ('' if clean else ': NOT a clean shutdown'))
         if plot is not None and frames:
             _plot(frames, events, truths, grid, plot, setup)
-            out(f'wrote {plot}')
+            (out if note is None else note)(f'wrote {plot}')
         out(f'scored {score.in_reach} frames with the face in reach, of {score.frames} frames '
             f'({len(truths)} sent, {len(events["found"])} found events)')
         if walked and score.in_reach and clean:
