@@ -18,12 +18,13 @@ remapping work:
   dropped on the way are counted from the publisher's sequence numbers);
 - publishes ``pan_tilt`` (``sensor_msgs/JointState``, transient local, depth 1, re-sent every
   ``retry_period_s`` until a usable frame arrives) and, with every target sent or re-sent,
-  ``fixation`` (``std_msgs/Int32MultiArray`` ``[row, col]``, transient local, depth 1: what a
-  foveal detector serves), ``belief`` (``Float32MultiArray``) and ``belief_image`` (``rgb8``)
-  after every update and reset (the N cell probabilities, summing to ``1 - P(absent)``), the
-  search events ``found``, ``absent`` and ``gave_up`` (``diagnostic_msgs/DiagnosticStatus``,
-  reliable; with motion on also ``lost`` and ``reacquired``) and ``/diagnostics``; optionally
-  ``Float64MultiArray`` and ``JointTrajectory`` head commands on the topics their parameters name;
+  ``fixation`` (``std_msgs/Int32MultiArray`` ``[row, col, search_id]``, transient local,
+  depth 1: what a foveal detector serves), ``belief`` (``Float32MultiArray``) and
+  ``belief_image`` (``rgb8``) after every update and reset (the N cell probabilities, summing
+  to ``1 - P(absent)``), the search events ``found``, ``absent`` and ``gave_up``
+  (``diagnostic_msgs/DiagnosticStatus``, reliable; with motion on also ``lost`` and
+  ``reacquired``) and ``/diagnostics``; optionally ``Float64MultiArray`` and
+  ``JointTrajectory`` head commands on the topics their parameters name;
 - services ``~/reset`` (``std_srvs/Trigger``) and ``~/enable`` (``std_srvs/SetBool``).
 
 For a still target a decision (``found``, ``absent``) or ``gave_up`` ends the search: no new
