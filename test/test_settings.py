@@ -118,10 +118,27 @@ def test_a_typo_in_a_settings_namespace_is_refused_other_parameters_pass():
     assert settings.confidence == 0.9
 
 
-@pytest.mark.parametrize('name', ['controller.yaml', 'faces_camera_controller.yaml',
-                                  'faces_fovea_controller.yaml'])
+# A controller file given after another (a second --params-file, as its header says).
+OVERLAYS = {'faces_camera_room_controller.yaml': 'faces_camera_controller.yaml',
+            'faces_camera_people.yaml': 'faces_camera_tracking.yaml'}
+CONTROLLER_FILES = sorted(path.name for path in (REPO / 'config').glob('*.yaml')
+                          if '/**/gaze_controller:' in path.read_text())
+
+
+def test_the_yaml_check_covers_every_shipped_controller_file():
+    assert {'controller.yaml', 'faces_camera_controller.yaml', 'faces_camera_tracking.yaml',
+            'faces_fovea_controller.yaml', *OVERLAYS} <= set(CONTROLLER_FILES)
+    for overlay, base in OVERLAYS.items():
+        assert base in CONTROLLER_FILES and base not in OVERLAYS
+        assert base in (REPO / 'config' / overlay).read_text().split('/**/')[0], overlay
+
+
+@pytest.mark.parametrize('name', CONTROLLER_FILES)
 def test_every_shipped_controller_file_passes_the_yaml_check(name):
     values = yaml_parameters(REPO / 'config' / name, 'gaze_controller')
+    if name in OVERLAYS:
+        base = yaml_parameters(REPO / 'config' / OVERLAYS[name], 'gaze_controller')
+        values = {**base, **values}
     settings = check_parameters(values, where=f'{name}: ')
     for s in SCHEMA:
         if s.parameter in values:
