@@ -19,8 +19,9 @@ Relative topic names:
 - subscribes ``image`` (``sensor_msgs/Image``: ``mono8``, ``rgb8`` or ``bgr8``; reliable, or
   best effort with ``image_best_effort``; depth 1: the newest wins), ``camera_info``
   (``sensor_msgs/CameraInfo``, ``camera`` mode), ``joint_states`` (``sensor_msgs/JointState``,
-  ``camera`` mode) and ``fixation`` (``std_msgs/Int32MultiArray`` ``[row, col]``, transient
-  local: the controller's);
+  ``camera`` mode) and ``fixation`` (``std_msgs/Int32MultiArray`` ``[row, col, search_id]``,
+  ``[-1, -1, search_id]`` for the one-time scan, or an older controller's ``[row, col]``;
+  transient local: the controller's);
 - publishes ``evidence_image`` (``32FC1``, stamped with the image's capture stamp; NaN = not
   observed; with ``publish_offsets`` in ``camera`` mode ``32FC3``: per cell the count and the
   mean offset ``(row, col)`` of its detections from the cell's centre, in cells, which a
