@@ -10,6 +10,7 @@ from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.vision.detector import HaarDetector
 from ipomdp_gaze.vision.fovea import (cell_edges_px, Fovea, FoveaConfig, REFERENCE_WINDOWS_CELLS,
                                       window_cells)
+from ipomdp_gaze.vision.search import _Recorder, fresh_counts
 import numpy as np
 import pytest
 from skimage import data
@@ -276,6 +277,34 @@ def test_reuse_windows_makes_repeated_windows_free_without_changing_counts():
         assert np.array_equal(a.counts, b.counts, equal_nan=True)
     assert reusing.image_detector_pixels == 3600 * (4 + 1)
     assert plain.image_detector_pixels == 3600 * (4 + 3 + 3)
+
+
+def test_a_fixation_counts_again_only_cells_a_window_read_afresh_saw():
+    """A window served from the cache is the same pixels: ``find --all`` counts it once."""
+    def boxes(call, gray):
+        return [centred_box(30, 30)]
+
+    fovea = Fovea(FakeDetector(boxes), GRID, FoveaConfig(windows_cells=(15, 9, 3)),
+                  reuse_windows=True)
+    fovea.start(image())
+    first = fovea.observe(GRID.index(0, 0))
+    assert first.from_cache == (False, False, False)
+    assert np.array_equal(fresh_counts(first, GRID), first.counts, equal_nan=True)
+    # (2, 2) shares the corner's 15- and 9-cell windows; only its 3-cell window is new.
+    second = fovea.observe(GRID.index(2, 2))
+    assert second.from_cache == (True, True, False)
+    counts = fresh_counts(second, GRID).reshape(21, 21)
+    expected = np.zeros((21, 21), bool)
+    expected[1:4, 1:4] = True
+    assert np.array_equal(~np.isnan(counts), expected)
+    assert np.array_equal(counts[1:4, 1:4], second.counts.reshape(21, 21)[1:4, 1:4])
+    assert np.nansum(counts) >= 1                          # the new window's box is kept
+    # every window cached: nothing new is seen
+    again = fovea.observe(GRID.index(2, 2))
+    assert again.detector_pixels == 0 and np.isnan(fresh_counts(again, GRID)).all()
+    recorder = _Recorder(fovea)
+    assert np.isnan(recorder.observe(GRID.index(2, 2)).values).all()
+    assert not np.isnan(recorder.observe(GRID.index(10, 10)).values).all()
 
 
 def test_observe_validates_its_state_and_fixation():

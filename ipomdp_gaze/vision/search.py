@@ -625,7 +625,26 @@ class _Recorder:
     def observe(self, cell):
         obs = self.sensor.fovea.observe(int(cell))
         self._keep(obs)
-        return Frame(obs.counts, detector_pixels=obs.detector_pixels, seconds=obs.seconds)
+        return Frame(fresh_counts(obs, self.grid), detector_pixels=obs.detector_pixels,
+                     seconds=obs.seconds)
+
+
+def fresh_counts(observation, grid) -> np.ndarray:
+    """
+    Return a fixation's counts with the cells only its cached windows saw left unobserved (NaN).
+
+    A window served from the image's cache is the same pixels given to the same deterministic
+    detector, so what it says was said when it was first read: counted again it is no new
+    evidence (a clamped corner window, one weak box, counted once per fixation; docs/design.md
+    section 11.4). A cell inside any window read afresh keeps its whole count, the sum over
+    every window as the tables were calibrated.
+    """
+    fresh = np.zeros(grid.shape, dtype=bool)
+    for window, cached in zip(observation.windows, observation.from_cache):
+        if not cached:
+            row, col, n_rows, n_cols = window.cells
+            fresh[row:row + n_rows, col:col + n_cols] = True
+    return np.where(fresh.ravel(), observation.counts, np.nan)
 
 
 class _Coarse(_Recorder):
