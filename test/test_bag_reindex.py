@@ -16,12 +16,13 @@ import pytest
 import yaml
 
 # The writer's process: its messages (std_msgs/String, ``message <i>`` padded to ``size``
-# bytes, at i ms), each chunk's message times printed once the chunk is written, then SIGKILL.
+# bytes, at i ms), each chunk's message times printed once the chunk is written (with
+# ``flush_every`` > 0 the writer's flush() after every that many messages), then SIGKILL.
 WRITER = textwrap.dedent("""
     import os, signal, sys
     from rosbags.rosbag2.storage_mcap import McapWriter
     from ipomdp_gaze.files.bag import open_writer
-    path, count, size, max_bytes, close_after = sys.argv[1], *map(int, sys.argv[2:])
+    path, count, size, max_bytes, close_after, flush_every = sys.argv[1], *map(int, sys.argv[2:])
     write, close_chunk = McapWriter.write, McapWriter.close_chunk
 
     def pending_write(self, connection, stamp, data):
@@ -35,12 +36,16 @@ WRITER = textwrap.dedent("""
     writer = open_writer(path, max_file_bytes=max_bytes)
     writer.set_custom_data('ipomdp_gaze/version', '9.9.9')
     connection = writer.add_connection('/note', 'std_msgs/msg/String')
+    if flush_every:
+        writer.flush()                          # the topic, before any message
     for i in range(count):
         if i == 3:
             writer.set_custom_data('ipomdp_gaze/parameters/source', 'confidence: 0.9\\n')
         text = f'message {i}'.encode().ljust(size, b'.') + b'\\0'
         writer.write(connection, 1_000_000 * (i + 1), bytes([0, 1, 0, 0])
                      + len(text).to_bytes(4, 'little') + text)
+        if flush_every and (i + 1) % flush_every == 0:
+            writer.flush()
     if close_after:
         writer.close()
     os.kill(os.getpid(), signal.SIGKILL)
@@ -48,11 +53,11 @@ WRITER = textwrap.dedent("""
 
 
 def _killed(path: Path, count: int, size: int = 100_000, max_bytes: int = 0,
-            close: bool = False) -> list:
+            close: bool = False, flush_every: int = 0) -> list:
     """Write ``count`` messages to a bag at ``path``, SIGKILL; return the times written out."""
     run = subprocess.run([sys.executable, '-c', WRITER, str(path), str(count), str(size),
-                          str(max_bytes), str(int(close))], capture_output=True, text=True,
-                         timeout=120)
+                          str(max_bytes), str(int(close)), str(flush_every)],
+                         capture_output=True, text=True, timeout=120)
     assert run.returncode == -9, run.stdout + run.stderr
     return sorted(int(stamp) for stamp in run.stdout.split())
 
@@ -92,6 +97,29 @@ def test_a_killed_recording_is_unreadable_until_reindexed_then_keeps_every_writt
     assert [(t['topic_metadata']['name'], t['message_count'])
             for t in meta['topics_with_message_count']] == [('/note', len(written))]
     assert sorted(p.name for p in bag.iterdir()) == ['bag.mcap', 'metadata.yaml']
+
+
+@pytest.mark.parametrize('max_bytes', [0, 10**6], ids=['one file', 'split'])
+def test_a_flushed_chunk_of_a_few_small_messages_survives_the_kill(tmp_path, max_bytes):
+    """
+    A low-rate topic fills a 1 MiB chunk in minutes: flush() writes the chunk begun.
+
+    Before it, a recording cut off before its first MiB kept nothing, not even its topics.
+    """
+    from ipomdp_gaze.files.bag import read_bag, reindex
+    bag = tmp_path / 'bag'
+    written = _killed(bag, 7, size=10, max_bytes=max_bytes, flush_every=5)
+    assert written == [1_000_000 * (i + 1) for i in range(5)]
+    done = reindex(bag)
+    assert sum(done.recovered.values()) == 5
+    read = read_bag(bag)
+    assert [m.time_ns for m in read.messages] == written
+    assert _texts(read) == [f'message {i}' for i in range(5)]
+    assert read.custom_data['ipomdp_gaze/parameters/source'] == 'confidence: 0.9\n'
+    nothing = tmp_path / 'nothing'                 # flushed before any message: the topic
+    assert _killed(nothing, 0, size=10, max_bytes=max_bytes, flush_every=5) == []
+    assert [(t['topic_metadata']['name'], t['message_count']) for t in
+            reindex(nothing).info['topics_with_message_count']] == [('/note', 0)]
 
 
 def test_an_unfinished_split_bag_moves_its_open_file_up_and_lists_every_file(tmp_path):

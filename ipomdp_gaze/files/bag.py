@@ -13,7 +13,8 @@ read it); :func:`read_bag` returns every message of every file in time order, de
 ``custom_data``, where the recorder keeps the package version, each node's parameters and the
 hashes of the files they name. The custom data also goes into the MCAP file being written, as a
 metadata record (:data:`CUSTOM_DATA_RECORD`) flushed as soon as it is set, and every chunk is
-flushed once written, so a recording cut off (power lost, SIGKILL) keeps them: :func:`reindex`
+flushed once written, so a recording cut off (power lost, SIGKILL) keeps them; the writer's
+``flush()`` also writes the chunk begun, synced (the recorder: every second). :func:`reindex`
 rebuilds ``metadata.yaml`` of such a bag from its MCAP files, as ``ros2 bag reindex`` does.
 No rclpy here.
 """
@@ -94,6 +95,7 @@ def open_writer(path, compression: str = '', max_file_bytes: int = 0,
 
     With ``max_file_bytes`` and ``max_file_duration_ns`` 0 it is the ``rosbags`` writer of one
     ``<name>.mcap``; with either, a :class:`SplitWriter` (the same calls) that splits the bag.
+    Both have ``flush()``: the chunk begun is written and synced now (a smaller chunk).
 
     Raises
     ------
@@ -120,7 +122,23 @@ def open_writer(path, compression: str = '', max_file_bytes: int = 0,
         return add(topic, msgtype, typestore=store, **kw)
     writer.add_connection = add_connection
     writer.set_custom_data = lambda key, value: _keep_custom_data(writer, {key: value})
+    writer.flush = lambda: _flush(writer)
     return writer
+
+
+def _flush(writer) -> None:
+    """
+    Write a ``rosbags`` MCAP writer's chunk begun to the disk now (if it holds anything), synced.
+
+    ``rosbags`` writes a chunk when it holds about 1 MiB: minutes of a low-rate topic, and the
+    topics themselves (their channel records) go into the first. A recording cut off then
+    loses all of it; closed early (a smaller chunk) it is a complete chunk that
+    :func:`reindex` recovers.
+    """
+    storage = writer.storage
+    if storage.chunk.bio.tell():
+        storage.close_chunk()
+        os.fsync(storage.bio.fileno())
 
 
 def _open_rosbags(path: Path, compression: str):
@@ -279,6 +297,11 @@ class SplitWriter:
                 self._put(current, connection, time_ns, data)
                 return
         self._put(self._parts[-1], connection, time_ns, data)
+
+    def flush(self) -> None:
+        """Write the open files' chunks begun to the disk now, synced (as the single file's)."""
+        for part in self._parts:
+            _flush(part.writer)
 
     def _full(self, part: _Part, time_ns: int) -> bool:
         """Whether ``part`` is done before a message at ``time_ns``: its size or duration."""

@@ -27,6 +27,8 @@ while recording), ``ground_truth``, the scene camera's ``walk_truth`` and the de
 subscribed to and stays empty. The ``pan_tilt`` and ``fixation`` subscriptions (transient local)
 take ROS's start-up QoS overrides, as the cameras' and the detector's do: ``-p
 qos_overrides./pan_tilt.subscription.durability:=volatile`` records a volatile teleop publisher.
+The chunk begun is written and synced every :data:`FLUSH_PERIOD_S`, so a recording cut off
+loses about a second at most: ``ipomdp-gaze reindex`` recovers the rest.
 
 The bag's ``custom_data`` (in ``metadata.yaml``) holds ``ipomdp_gaze/version`` (the package),
 ``ipomdp_gaze/parameters/<node>`` (every parameter of each node in ``nodes``, as YAML, fetched
@@ -120,6 +122,10 @@ TOPICS = {
 COMMAND_TOPICS = ('pan_tilt', 'fixation')
 FILE_PARAMETERS = ('policy.file', 'observation.file')
 PARAMETER_RETRY_S = 0.5
+# The bag's chunk begun is written to the disk (synced) this often (s): a recording cut off
+# (power lost, SIGKILL) loses at most about this much, not a chunk of up to 1 MiB (minutes of
+# evidence without images, and the topics themselves until the first chunk).
+FLUSH_PERIOD_S = 1.0
 # A parameter request unanswered this long is sent again (s).
 PARAMETER_ANSWER_S = 3.0
 
@@ -233,6 +239,7 @@ class RecorderNode(QuietPublishers, Node):
             else:
                 self.subscriptions_[topic] = self.create_subscription(
                     msg_type, topic, guard.wrap(self._writer_for(topic), 'write'), qos, raw=True)
+        self.create_timer(FLUSH_PERIOD_S, guard.wrap(self._flush, 'flush'))
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self.create_timer(values['diagnostics_period_s'], guard.wrap(self._publish_diagnostics))
         self.parameters: dict = {}
@@ -288,6 +295,12 @@ class RecorderNode(QuietPublishers, Node):
                 self.writer.write(connection, stamp, data)
                 self.counts[topic] += 1
         return write
+
+    def _flush(self) -> None:
+        """Write the bag's chunk begun to the disk (:data:`FLUSH_PERIOD_S`)."""
+        with self._bag_lock:
+            if self.writer is not None:
+                self.writer.flush()
 
     # -- the other nodes' parameters ---------------------------------------------------------
     def _ask_parameters(self) -> None:
