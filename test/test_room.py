@@ -144,6 +144,17 @@ def test_the_room_keeps_its_people_in_view_in_turn_and_counts_who_is_new():
     assert done.new == done.people and not done.recheck
 
 
+def test_the_people_are_most_probable_first_as_targets_documents():
+    """QA: a pass lists its grouped detections first, and the node published them so."""
+    room = RoomWatch(GRID)
+    a, b, c, d = (GRID.index(*rc) for rc in ((0, 0), (2, 1), (3, 9), (10, 10)))
+    done = room.done([{'cell': a, 'probability': 0.63}, {'cell': b, 'probability': 0.61},
+                      {'cell': c, 'probability': 0.64}, {'cell': d, 'probability': 0.2}])
+    assert done.people == (Person(c, 0.64), Person(a, 0.63), Person(b, 0.61), Person(d, 0.2))
+    assert done.new == done.people
+    assert [room.next_person().cell for _ in range(4)] == [c, a, b, d]
+
+
 def test_people_two_cells_apart_are_two_under_the_gaussian_model():
     """QA: the node linked occupied cells within 2 under every model, so two people became one."""
     from ipomdp_gaze.search.room import PERSON_LINK

@@ -104,8 +104,13 @@ class RoomWatch:
         self.people, self.turn, self.rechecking = (), -1, False
 
     def done(self, faces) -> RoomDone:
-        """Take a finished search's faces as the people in the room; return who is new."""
-        found = people_from_faces(faces)
+        """
+        Take a finished search's faces as the people in the room; return who is new.
+
+        The people are most probable first (ties in the search's order), as ``~/targets``
+        documents: a pass lists its grouped detections before the belief's faces.
+        """
+        found = tuple(sorted(people_from_faces(faces), key=lambda p: -p.probability))
         new = new_people(self.people, found, self.grid)
         result = RoomDone(found, new, self.rechecking)
         self.people, self.turn, self.rechecking = found, -1, False

@@ -1,0 +1,89 @@
+# Copyright 2026 ipomdp_gaze developers
+# SPDX-License-Identifier: Apache-2.0
+"""
+A room of four over DDS, two of them in the corners of the pan/tilt range: the order published.
+
+Three processes on the shipped pan/tilt face configuration with the rooms' (as
+``test_ros_room_pass.py``): the scene camera shows held-out room 4 of four faces, at cells
+(3, 9), (0, 0), (10, 10) and (2, 1). The node's people are those of the offline pass on the
+same room, published most probable first as README's "Everyone in the room" says (the pass
+lists its grouped detections first, and the node published that order), the corners at the
+ends of the head's range, and the head keeps them in view in that order.
+"""
+from __future__ import annotations
+
+import math
+
+from conftest import config_path, wait_for
+import pytest
+
+pytestmark = pytest.mark.ros
+
+NODE = 'gaze_controller'
+SEED = 4
+SEARCH_S = 240.0        # a generous limit for one search on a loaded machine, not a measure
+
+
+@pytest.fixture(scope='module')
+def offline():
+    """Run the offline pass on the room the scene camera shows: its people's cells."""
+    from ipomdp_gaze.drivers.rooms import room_session
+    from ipomdp_gaze.drivers.scene_tasks import SceneTask, task_spec
+    spec = task_spec('pan-tilt', seed=SEED, faces=4)
+    task = SceneTask.get(spec)
+    task.sensor.start(task.scene(0).image)
+    _, _, _, faces = room_session(spec, task, 0, 'pass-many-cells')
+    truth = [tuple(int(v) for v in f.cell) for f in task.scene(0).faces]
+    return {'people': sorted(f['cell'] for f in faces), 'truth': truth}
+
+
+@pytest.fixture(scope='module')
+def rig(probe, nodes):
+    from diagnostic_msgs.msg import DiagnosticStatus
+    from geometry_msgs.msg import PoseArray
+    from ipomdp_gaze.harness.watch import LATCHED
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float32MultiArray
+    rec = {'targets': probe.record(PoseArray, f'/{NODE}/targets', LATCHED),
+           'cells': probe.record(Float32MultiArray, f'/{NODE}/target_cells', LATCHED),
+           'done': probe.record(DiagnosticStatus, 'room_done', 10),
+           'pan_tilt': probe.record(JointState, 'pan_tilt', LATCHED, distinct_stamps=True)}
+    rec['controller'] = nodes.start('controller', [
+        '--params-file', config_path('faces_camera_controller.yaml'),
+        '--params-file', config_path('faces_camera_room_controller.yaml'),
+        '-p', 'room.dwell_s:=0.3', '-p', 'room.recheck_period_s:=0.0'])
+    assert wait_for(lambda: rec['pan_tilt'], 60), rec['controller'].output()
+    nodes.start('detector', ['--params-file', config_path('faces_camera_detector.yaml'),
+                             '--params-file', config_path('faces_camera_room_detector.yaml')])
+    nodes.start('scene_camera', ['--params-file', config_path('faces_camera_scene_camera.yaml'),
+                                 '-p', f'seed:={SEED}', '-p', "scene.faces:='4'"])
+    return rec
+
+
+def test_four_people_corners_included_are_published_most_probable_first(rig, offline):
+    from ipomdp_gaze.model.grid import Grid
+    from ipomdp_gaze.model.head import PanTiltMap
+    from ipomdp_gaze.msg_adapters import diagnostics, joints, people
+    assert wait_for(lambda: rig['done'], SEARCH_S), rig['controller'].output()[-3000:]
+    done = diagnostics.parse_room_done(rig['done'][0][1])
+    grid = Grid(11, 11, 5.0)
+    found = people.read_people_array(rig['cells'][-1][1], grid)
+    cells = [cell for cell, _ in found]
+    assert sorted(cells) == offline['people'] and done['people'] == len(cells) == 4, found
+    assert sorted(grid.cell(c) for c in cells) == sorted(offline['truth'])
+    probabilities = [p for _, p in found]
+    assert probabilities == sorted(probabilities, reverse=True), found
+    # ~/targets in the same order; the corners at the ends of the +-25 degree range
+    head = PanTiltMap(grid, 'pan_joint', 'tilt_joint')
+    angles = people.poses_angles(rig['targets'][-1][1])
+    for (pan, tilt), cell in zip(angles, cells, strict=True):
+        assert (pan, tilt) == pytest.approx(head.angles(cell), abs=1e-9)
+    edge = math.radians(25.0)
+    corners = {grid.index(0, 0), grid.index(10, 10)}
+    assert sorted(abs(a) for c, pair in zip(cells, angles) if c in corners for a in pair) == \
+        pytest.approx([edge] * 4, abs=1e-9)
+    # the head goes to them in that order, round and round
+    assert wait_for(lambda: len(rig['pan_tilt']) >= 12 + 5, 60)
+    sent = [head.nearest_cell(*joints.angles_from_joint_state(msg, head))
+            for _, msg in rig['pan_tilt'][12:12 + 5]]
+    assert sent == cells + cells[:1], (sent, cells)
