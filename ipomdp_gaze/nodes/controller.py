@@ -160,8 +160,9 @@ def controller_params() -> list[Param]:
               'search.targets many: seconds each person found is kept in view, in turn',
               float_range=(0.01, MAX_PERIOD_S)),
         Param('room.recheck_period_s', 60.0, T.DOUBLE,
-              'search.targets many: search the room again this often while keeping people in '
-              'view, at least room.dwell_s (0: never)', float_range=(0.0, MAX_PERIOD_S)),
+              'search.targets many: search the room again this many seconds after a search of it '
+              'ended, while keeping its people in view; at least room.dwell_s (0: never)',
+              float_range=(0.0, MAX_PERIOD_S)),
         Param('room.frame_id', 'pan_tilt_base', T.STRING,
               'search.targets many: frame_id of ~/targets, the frame the head pans (z) and tilts '
               '(y) in'),
