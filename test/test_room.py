@@ -167,3 +167,12 @@ def test_people_two_cells_apart_are_two_under_the_gaussian_model():
     # the counts' link (a face's spill-over) makes them one, at a cell where nobody stands
     [merged] = core.session.faces(link=PERSON_LINK['counts'])
     assert merged['cell'] not in faces
+
+
+@pytest.mark.parametrize('frame_id', ['/pan_tilt_base', ' head', 'head ', '', ' '])
+def test_a_frame_id_tf2_cannot_look_up_is_refused(frame_id):
+    """QA: '/pan_tilt_base' was taken, and ~/targets named a frame every tf2 lookup refuses."""
+    from ipomdp_gaze.search.room import check_frame_id
+    with pytest.raises(ValueError, match='room.frame_id must name the frame of ~/targets'):
+        check_frame_id(frame_id)
+    assert check_frame_id('pan_tilt_base') == 'pan_tilt_base'

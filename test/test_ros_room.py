@@ -133,6 +133,11 @@ def test_a_periodic_recheck_searches_again_and_finds_nobody_new(rig, probe):
     ({'search.false_alarm_scales': [1.0, 3.0]}, 'search.targets many does not model '
                                                 'false-alarm scales'),
     ({'room.frame_id': ' '}, 'room.frame_id must name the frame of ~/targets'),
+    # QA: accepted, then ~/targets named a frame tf2 refuses to look up
+    ({'room.frame_id': '/pan_tilt_base'}, 'room.frame_id must name the frame of ~/targets (a TF '
+                                          "frame), got '/pan_tilt_base': tf2 frame ids have no "
+                                          "leading '/'"),
+    ({'room.frame_id': 'pan_tilt_base '}, "got 'pan_tilt_base '"),
 ])
 def test_settings_the_many_target_mode_does_not_model_are_refused(rig, probe, params, words):
     result = probe.set_parameters(NODE, params)[0]

@@ -31,7 +31,7 @@ from ipomdp_gaze.search.gaze import (check_settle_time, GazeController, NO_PRIOR
                                      STAMP_TOLERANCE_S)
 from ipomdp_gaze.search.health import policy_label
 from ipomdp_gaze.search.many import check_many_settings
-from ipomdp_gaze.search.room import check_room_times
+from ipomdp_gaze.search.room import check_frame_id, check_room_times
 from ipomdp_gaze.search.session import check_model_settings, SearchSettings
 import numpy as np
 
@@ -219,9 +219,7 @@ def build_config(values: Mapping, build_policy: Callable, changed=None,
             check_model_settings(settings, grid, observation)
         if 'room.dwell_s' in values:
             check_room_times(values['room.dwell_s'], values['room.recheck_period_s'])
-        if not str(values.get('room.frame_id', 'unset')).strip():
-            raise ValueError('room.frame_id must name the frame of ~/targets (a TF frame), '
-                             'got an empty string')
+        check_frame_id(str(values.get('room.frame_id', 'unset')))
         check_settle_time(values['settle_time_s'])
         warnings = moving_room_warnings(settings)
         policy_changed = changed is None or any(k in changed for k in POLICY_KEYS) or any(

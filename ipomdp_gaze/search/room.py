@@ -52,6 +52,27 @@ def check_room_times(dwell_s: float, recheck_period_s: float) -> tuple[float, fl
     return dwell_s, recheck_period_s
 
 
+def check_frame_id(frame_id: str) -> str:
+    """
+    Return ``room.frame_id``, a frame tf2 can look up.
+
+    Raises
+    ------
+    ValueError
+        If it is empty, has spaces round it (then it names no frame) or starts with ``/`` (tf2
+        refuses such a frame id in every lookup).
+
+    """
+    if not frame_id.strip():
+        raise ValueError('room.frame_id must name the frame of ~/targets (a TF frame), '
+                         'got an empty string')
+    if frame_id != frame_id.strip() or frame_id.startswith('/'):
+        raise ValueError(f'room.frame_id must name the frame of ~/targets (a TF frame), got '
+                         f"{frame_id!r}: tf2 frame ids have no leading '/' and no spaces round "
+                         'them')
+    return frame_id
+
+
 @dataclass(frozen=True)
 class Person:
     """One person found: the cell of the face and ``P(at least one of its cells is occupied)``."""
