@@ -99,7 +99,8 @@ def plugin_dir(tmp_path_factory):
     info.mkdir()
     (info / 'METADATA').write_text('Metadata-Version: 2.1\nName: blobdet-plugin\nVersion: 0.1\n')
     (info / 'entry_points.txt').write_text('[ipomdp_gaze.detectors]\n'
-                                           'blob = blobdet:BlobDetector\n')
+                                           'blob = blobdet:BlobDetector\n'
+                                           'blob_broken = brokendet:Thing\n')
     return folder
 
 
@@ -355,6 +356,11 @@ def test_a_plugin_that_fails_to_load_or_refuses_an_option_is_named(on_path):
     with pytest.raises(ValueError, match='is its package installed, or its folder on '
                                          'PYTHONPATH'):
         make_detector('not_installed_anywhere:Thing')
+    # the same module by its entry point (a traceback before: only ImportError was caught)
+    with pytest.raises(ValueError, match=r"^detector 'blob_broken': loading its entry point "
+                                         r"'brokendet:Thing' failed: FileNotFoundError: "
+                                         r'.*weights'):
+        make_detector('blob_broken')
 
 
 def test_an_ensemble_calls_each_member_that_sees_the_image_and_our_bugs_stay_bugs(on_path):
@@ -382,3 +388,14 @@ def test_a_fingerprint_or_an_impossible_value_in_the_nodes_options_is_refused_in
                   {'window_px': [99, 99]}, {'opencv': '3.0'}):
         with pytest.raises(ValueError, match=f'detector.{next(iter(asked))} .* contradicts'):
             build_setup('camera', 'faces-pan-tilt-yunet', detector=asked)
+
+
+def test_a_plugin_entry_point_that_raises_as_it_loads_is_one_line_in_find(on_path, tmp_path,
+                                                                          capsys):
+    """A plug-in's module failing with other than ImportError gave find a traceback."""
+    path = tmp_path / 'test.png'
+    cv2.imwrite(str(path), blob_image(np.random.default_rng(7), (2, 4)))
+    capsys.readouterr()
+    assert cli(['find', str(path), '--detector', 'blob_broken']) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "detector 'blob_broken': loading its entry point" in err[0], err

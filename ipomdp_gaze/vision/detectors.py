@@ -106,6 +106,9 @@ def load_factory(kind: str):
         except (ImportError, AttributeError) as exc:
             raise ValueError(f'detector {kind!r}: its entry point {found.value!r} does not '
                              f'load ({exc})') from None
+        except Exception as exc:                # noqa: B902 (a plug-in failing as it loads)
+            raise ValueError(f'detector {kind!r}: loading its entry point {found.value!r} '
+                             f'failed: {type(exc).__name__}: {exc}') from None
     if not callable(factory):
         raise ValueError(f'detector {kind!r} is not callable: {factory!r}')
     return factory
