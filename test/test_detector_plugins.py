@@ -83,6 +83,19 @@ class Astray:
     def __call__(self, gray):
         h, w = gray.shape[:2]
         return np.array([[-20, -20, 10, 10], [w + 5, 2, 8, 8], [2, h, 4, 4], [1, 1, 4, 4]])
+
+
+class Misshapen:
+    """Answers in a way given by its option: rows of 3, NaN, a negative width, complex."""
+
+    def __init__(self, mode='short'):
+        self.mode = mode
+
+    def __call__(self, gray):
+        return {'short': np.array([[1.0, 2.0, 3.0]]),
+                'nan': np.array([[np.nan, 1, 5, 5, 0.5]]),
+                'negative': np.array([[10, 10, -5, 5, 0.5]]),
+                'complex': np.array([[1, 1, 5, 5]], complex)}[self.mode]
 '''
 SIZE, CELLS, SQUARE = 84, 7, 14
 KINDS = {'module': 'blobdet:BlobDetector', 'entry point': 'blob'}
@@ -399,3 +412,25 @@ def test_a_plugin_entry_point_that_raises_as_it_loads_is_one_line_in_find(on_pat
     assert cli(['find', str(path), '--detector', 'blob_broken']) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "detector 'blob_broken': loading its entry point" in err[0], err
+
+
+@pytest.mark.parametrize('mode, words', [
+    ('short', 'boxes of shape (M, 5) x, y, w, h, score or (M, 4), got (1, 3)'),
+    ('nan', 'a box or score that is not a finite number'),
+    ('negative', 'every box must have a positive width and height'),
+    ('complex', 'a detector must return real numbers, got complex ones'),
+])
+def test_a_plugins_malformed_answer_is_named_against_the_detector(on_path, mode, words):
+    """A complex answer lost its imaginary part with a warning; the others named no detector."""
+    import warnings
+
+    from ipomdp_gaze.vision.detector import detect, DetectorFailed
+    from ipomdp_gaze.vision.detectors import make_detector
+    detector = make_detector('blobdet:Misshapen', mode=mode)
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        with pytest.raises(DetectorFailed) as caught:
+            detect(detector, np.zeros((30, 40), np.uint8))
+    message = str(caught.value)
+    assert message.startswith('the detector blobdet:Misshapen returned bad boxes: ')
+    assert words in message and '\n' not in message

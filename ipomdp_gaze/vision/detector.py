@@ -79,10 +79,12 @@ def as_detections(result) -> tuple[np.ndarray, np.ndarray]:
     Raises
     ------
     ValueError
-        If the shape is not ``(M, 4)`` or ``(M, 5)``, a number is not finite, or a box has no
-        positive width and height.
+        If the shape is not ``(M, 4)`` or ``(M, 5)``, a number is not finite or real, or a box
+        has no positive width and height.
 
     """
+    if np.iscomplexobj(result):
+        raise ValueError('a detector must return real numbers, got complex ones')
     try:
         array = np.asarray(result, dtype=np.float64) if np.size(result) else np.empty((0, 5))
     except (TypeError, ValueError):
@@ -111,8 +113,8 @@ def detect(detector, image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     An image smaller than the detector's ``window_px`` (a window of the fovea) is not given to
     it: it sees nothing there. Boxes that do not overlap the image are dropped (a plug-in's
     bug, or boxes given as corners: they must not be counted in the cells at the image's
-    edge). An exception the
-    detector from outside the package raises (a plug-in's bug, a missing weight file) becomes
+    edge). An exception the detector from outside the package raises (a plug-in's bug, a
+    missing weight file), and an answer of it that :func:`as_detections` refuses, become
     :class:`DetectorFailed` naming the detector, so that a driver reports it against the image
     and goes on; the package's own detectors' errors, and running out of memory, stay what they
     are.
@@ -123,6 +125,7 @@ def detect(detector, image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     if width < window[0] or height < window[1]:
         return np.empty((0, 4)), np.empty(0)
     own = type(detector).__module__.split('.')[0] == 'ipomdp_gaze'
+    kind = getattr(detector, KIND_ATTRIBUTE, None) or type(detector).__name__
     try:
         result = detector(image)
     except MemoryError:
@@ -130,10 +133,14 @@ def detect(detector, image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     except Exception as exc:                    # noqa: B902 (any error of a user's detector)
         if own or (type(exc).__name__ == 'error' and 'Insufficient memory' in str(exc)):
             raise                               # our bug (a traceback), or OpenCV's memory
-        kind = getattr(detector, KIND_ATTRIBUTE, None) or type(detector).__name__
         raise DetectorFailed(f'the detector {kind} raised {type(exc).__name__}: '
                              f'{exc}') from exc
-    boxes, scores = as_detections(result)
+    try:
+        boxes, scores = as_detections(result)
+    except ValueError as exc:
+        if own:
+            raise
+        raise DetectorFailed(f'the detector {kind} returned bad boxes: {exc}') from None
     overlap = ((boxes[:, 0] < width) & (boxes[:, 1] < height)
                & (boxes[:, 0] + boxes[:, 2] > 0) & (boxes[:, 1] + boxes[:, 3] > 0))
     if overlap.all():
