@@ -273,6 +273,8 @@ def test_the_detector_node_serves_an_outside_detector(ros_env, probe, plugin_dir
         expected = setup.fovea.observe(cell).counts
         np.testing.assert_array_equal(counts, expected)
         assert counts[cell] > 0                   # the square's score bin, not "nothing"
+        # its start-up line names it by kind and options, not <blobdet.BlobDetector object at>
+        assert f'detector {KINDS[how]}(min_red=150); waiting' in proc.output(), proc.output()
     finally:
         bad = group.close()
     assert not bad, bad
@@ -434,3 +436,15 @@ def test_a_plugins_malformed_answer_is_named_against_the_detector(on_path, mode,
     message = str(caught.value)
     assert message.startswith('the detector blobdet:Misshapen returned bad boxes: ')
     assert words in message and '\n' not in message
+
+
+def test_a_plugin_without_a_repr_is_described_by_its_kind_and_options(on_path):
+    """The node's start-up line and an ensemble's repr showed <blobdet.Forgetful object at>."""
+    from ipomdp_gaze.vision.detector import describe_detector
+    from ipomdp_gaze.vision.detectors import make_detector
+    assert describe_detector(make_detector('blobdet:Forgetful', min_red=120)) == \
+        'blobdet:Forgetful(min_red=120)'
+    ensemble = make_detector('ensemble', members=[{'kind': 'blob', 'min_red': 99, 'weight': 2}])
+    assert repr(ensemble) == 'EnsembleDetector([blob(min_red=99) x2])'
+    haar = make_detector('haar')
+    assert describe_detector(haar) == repr(haar)

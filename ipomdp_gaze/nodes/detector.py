@@ -49,6 +49,7 @@ from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, s
 from ipomdp_gaze.search.controller_config import head_from
 from ipomdp_gaze.vision.detection import (build_setup, DetectorLoop, DetectorSetup, MAX_AGE_S,
                                           MODES, STAMP_TOLERANCE_S)
+from ipomdp_gaze.vision.detector import describe_detector
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import CameraInfo, Image, JointState
@@ -211,8 +212,8 @@ class FovealDetectorNode(GuardedNode, QuietPublishers, Node):
         g = cfg.setup.grid
         self.get_logger().info(
             f'{cfg.setup.mode} mode, count model {cfg.setup.name!r} ({g.rows}x{g.cols} grid, '
-            f'K = {cfg.setup.model.max_count + 1}), detector {cfg.setup.detector!r}; waiting '
-            f'for fixation and image')
+            f'K = {cfg.setup.model.max_count + 1}), detector '
+            f'{describe_detector(cfg.setup.detector)}; waiting for fixation and image')
         for note in cfg.setup.notes:
             self.get_logger().warning(note)
 

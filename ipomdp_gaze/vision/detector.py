@@ -501,6 +501,20 @@ def detector_settings(detector) -> dict:
     return {'kind': out.pop('kind'), **out}
 
 
+def describe_detector(detector) -> str:
+    """
+    Name a detector for a log line: its own ``repr``, else its kind and settings.
+
+    A plug-in without a ``__repr__`` of its own would show as ``<module.Class object at 0x...>``,
+    which says neither the name it was built by nor its options.
+    """
+    if type(detector).__repr__ is not object.__repr__:
+        return repr(detector)
+    settings = detector_settings(detector)
+    kind = settings.pop('kind')
+    return f'{kind}({", ".join(f"{key}={value!r}" for key, value in settings.items())})'
+
+
 def detector_window_px(detector) -> tuple[int, int]:
     """Smallest ``(width, height)`` the detector can see anything in (at least 2x2 pixels)."""
     window = getattr(detector, 'window_px', None)

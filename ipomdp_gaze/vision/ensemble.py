@@ -20,9 +20,9 @@ is rebuilt.
 from __future__ import annotations
 
 import cv2
-from ipomdp_gaze.vision.detector import (as_detections, detect, detector_settings,
-                                         detector_window_px, group_boxes, INFO_KEYS,
-                                         to_detector_image)
+from ipomdp_gaze.vision.detector import (as_detections, describe_detector, detect,
+                                         detector_settings, detector_window_px, group_boxes,
+                                         INFO_KEYS, to_detector_image)
 import numpy as np
 
 # Largest weight of a member: a box counted more often than this says nothing a count can keep.
@@ -144,6 +144,6 @@ class EnsembleDetector:
 
     def __repr__(self) -> str:
         """Show the members and their weights."""
-        inner = ', '.join(f'{member!r} x{weight}'
+        inner = ', '.join(f'{describe_detector(member)} x{weight}'
                           for member, weight in zip(self.members, self.weights))
         return f'EnsembleDetector([{inner}])'
