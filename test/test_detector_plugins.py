@@ -448,3 +448,19 @@ def test_a_plugin_without_a_repr_is_described_by_its_kind_and_options(on_path):
     assert repr(ensemble) == 'EnsembleDetector([blob(min_red=99) x2])'
     haar = make_detector('haar')
     assert describe_detector(haar) == repr(haar)
+
+
+def test_a_name_two_installed_packages_declare_is_refused(on_path, tmp_path, monkeypatch):
+    """The one later on sys.path was loaded silently (a dict kept the last entry point)."""
+    from ipomdp_gaze.vision.detectors import make_detector
+    for dist, target in (('twin_a', 'blobdet:BlobDetector'), ('twin_b', 'blobdet:Fussy')):
+        info = tmp_path / f'{dist}-0.1.dist-info'
+        info.mkdir()
+        (info / 'METADATA').write_text(f'Metadata-Version: 2.1\nName: {dist}\nVersion: 0.1\n')
+        (info / 'entry_points.txt').write_text(f'[ipomdp_gaze.detectors]\ntwin = {target}\n')
+    monkeypatch.syspath_prepend(str(tmp_path))
+    with pytest.raises(ValueError, match=r"^detector 'twin' is declared by more than one "
+                                         r'installed package \(twin_a 0.1: blobdet:BlobDetector; '
+                                         r'twin_b 0.1: blobdet:Fussy\); uninstall one'):
+        make_detector('twin')
+    assert type(make_detector('blob')).__name__ == 'BlobDetector'   # one declaration: fine

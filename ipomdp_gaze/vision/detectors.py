@@ -13,7 +13,8 @@ A detector **kind** is one of:
   This package declares ``haar`` (:class:`ipomdp_gaze.vision.detector.HaarDetector`),
   ``yunet`` (:class:`ipomdp_gaze.vision.yunet.YuNetDetector`) and ``ensemble`` (several of
   them as one, :class:`ipomdp_gaze.vision.ensemble.EnsembleDetector`); these are also found in a
-  source checkout whose metadata is not installed, and an entry point cannot replace them;
+  source checkout whose metadata is not installed, and an entry point cannot replace them; a
+  name two installed distributions declare with different targets is refused;
 - ``package.module:Factory``: the module is imported and ``Factory`` called. **Importing a
   module runs its code**: a kind read from an observation file or a parameter runs whatever that
   module does, so only use files and modules you trust.
@@ -53,6 +54,33 @@ _TARGET = re.compile(r'[A-Za-z_][\w.]*:[A-Za-z_][\w.]*')
 def entry_point_kinds() -> dict:
     """Detector names declared in :data:`ENTRY_POINT_GROUP` by installed distributions."""
     return {ep.name: ep for ep in metadata.entry_points(group=ENTRY_POINT_GROUP)}
+
+
+def _entry_point(kind: str):
+    """
+    Return the one entry point declaring ``kind``, or None.
+
+    Raises
+    ------
+    ValueError
+        If installed distributions declare the name with different targets: which one loaded
+        would depend on the order of ``sys.path``, and a model would be applied with a detector
+        it was not calibrated with.
+
+    """
+    found = [ep for ep in metadata.entry_points(group=ENTRY_POINT_GROUP) if ep.name == kind]
+    targets = sorted({ep.value for ep in found})
+    if len(targets) > 1:
+        owners = '; '.join(sorted(f'{_owner(ep)}: {ep.value}' for ep in found))
+        raise ValueError(f'detector {kind!r} is declared by more than one installed package '
+                         f'({owners}); uninstall one, or give package.module:Factory')
+    return found[0] if found else None
+
+
+def _owner(ep) -> str:
+    """Name the distribution that declares an entry point (as far as it is known)."""
+    dist = getattr(ep, 'dist', None)
+    return 'a package' if dist is None else f'{dist.metadata["Name"]} {dist.version}'
 
 
 def detector_kinds() -> list[str]:
@@ -97,7 +125,7 @@ def load_factory(kind: str):
     elif _TARGET.fullmatch(kind):
         factory = _import_target(kind, kind)
     else:
-        found = entry_point_kinds().get(kind)
+        found = _entry_point(kind)
         if found is None:
             raise ValueError(f'unknown detector {kind!r}; known: {", ".join(detector_kinds())} '
                              f'(or give package.module:Factory)')
