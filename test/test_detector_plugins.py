@@ -85,6 +85,40 @@ class Astray:
         return np.array([[-20, -20, 10, 10], [w + 5, 2, 8, 8], [2, h, 4, 4], [1, 1, 4, 4]])
 
 
+class Lopsided(Astray):
+    """A window_px of one side."""
+
+    window_px = (20,)
+
+
+class Secretive(Astray):
+    """Its settings() raise."""
+
+    def settings(self):
+        raise RuntimeError('settings are secret')
+
+
+class Listy(Astray):
+    """Its settings() are not a mapping."""
+
+    def settings(self):
+        return [('size', 3)]
+
+
+class Needy(Astray):
+    """Raises as it is built, with an error that is not about its options."""
+
+    def __init__(self, device='gpu'):
+        raise RuntimeError('no GPU found')
+
+
+class Boastful(BlobDetector):
+    """Its settings() name an option its factory does not take."""
+
+    def settings(self):
+        return {'min_red': self.min_red, 'max_red': 255}
+
+
 class Misshapen:
     """Answers in a way given by its option: rows of 3, NaN, a negative width, complex."""
 
@@ -464,3 +498,27 @@ def test_a_name_two_installed_packages_declare_is_refused(on_path, tmp_path, mon
                                          r'twin_b 0.1: blobdet:Fussy\); uninstall one'):
         make_detector('twin')
     assert type(make_detector('blob')).__name__ == 'BlobDetector'   # one declaration: fine
+
+
+@pytest.mark.parametrize('kind, words', [
+    ('blobdet:Lopsided', 'window_px must be (width, height) in pixels, got (20,)'),
+    ('blobdet:Secretive', 'its settings() raised RuntimeError: settings are secret'),
+    ('blobdet:Listy', 'its settings() must return a dict of its options, got list'),
+    ('blobdet:Needy', 'building it failed: RuntimeError: no GPU found'),
+])
+def test_a_plugin_that_breaks_as_it_is_built_is_one_line(on_path, tmp_path, capsys, kind,
+                                                         words):
+    """These were tracebacks in calibrate, find and the node (IndexError, RuntimeError)."""
+    from ipomdp_gaze.vision.detectors import detector_from_settings, make_detector
+    with pytest.raises(ValueError) as caught:
+        make_detector(kind)
+    assert str(caught.value) == f'detector {kind!r}: {words}'
+    with pytest.raises(ValueError) as caught:            # a model file naming it
+        detector_from_settings({'kind': kind})
+    assert str(caught.value) == f'detector {kind!r}: {words}'
+    labels = labelled_folder(tmp_path / 'images', n=2)
+    capsys.readouterr()
+    rc = cli(['calibrate', '--images', str(tmp_path / 'images'), '--labels', str(labels),
+              '--detector', kind, '--out', str(tmp_path / 'x.yaml'), '--quiet'])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and err == [f'ipomdp-gaze calibrate: error: detector {kind!r}: {words}']

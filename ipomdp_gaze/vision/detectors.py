@@ -32,9 +32,12 @@ when they differ.
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
+import contextlib
 import importlib
 from importlib import metadata
 import inspect
+import math
 import re
 
 from ipomdp_gaze.vision.detector import (COLORS, detector_settings, INFO_KEYS, KIND_ATTRIBUTE,
@@ -151,12 +154,37 @@ def _checked(detector, kind: str, options: dict):
     if color not in COLORS:
         raise ValueError(f'detector {kind!r}: color must be one of {", ".join(COLORS)}, got '
                          f'{color!r}')
+    window = getattr(detector, 'window_px', None)
+    if window is not None and not _is_window(window):
+        raise ValueError(f'detector {kind!r}: window_px must be (width, height) in pixels, '
+                         f'got {window!r}')
+    settings = getattr(detector, 'settings', None)
+    if settings is not None:
+        if not callable(settings):
+            raise ValueError(f'detector {kind!r}: settings must be a method, got {settings!r}')
+        if type(detector).__module__.split('.')[0] != 'ipomdp_gaze':
+            try:
+                answer = settings()
+            except Exception as exc:            # noqa: B902 (a plug-in's bug, named)
+                raise ValueError(f'detector {kind!r}: its settings() raised '
+                                 f'{type(exc).__name__}: {exc}') from None
+            if not isinstance(answer, Mapping):
+                raise ValueError(f'detector {kind!r}: its settings() must return a dict of '
+                                 f'its options, got {type(answer).__name__}')
     try:
         setattr(detector, KIND_ATTRIBUTE, kind)
         setattr(detector, OPTIONS_ATTRIBUTE, dict(options))
     except AttributeError:
         pass                    # a detector with __slots__ records its own kind and options
     return detector
+
+
+def _is_window(window) -> bool:
+    """Whether ``window`` is two finite numbers, a ``window_px`` (width, height)."""
+    try:
+        return len(window) == 2 and all(math.isfinite(float(side)) for side in window)
+    except (TypeError, ValueError):
+        return False
 
 
 def option_names(factory) -> set | None:
@@ -169,6 +197,30 @@ def option_names(factory) -> set | None:
         return None
     return {p.name for p in parameters
             if p.kind in (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)}
+
+
+class _BuildFailed(ValueError):
+    """A plug-in raised as it was built: the message names it already."""
+
+
+@contextlib.contextmanager
+def _named_errors(kind: str):
+    """
+    Turn a plug-in's unexpected error as it is built into one line naming it.
+
+    Its TypeError and ValueError are left to the caller, which names the options; the shipped
+    detectors' errors (a missing cascade: FileNotFoundError) and running out of memory stay
+    what they are.
+    """
+    try:
+        yield
+    except (MemoryError, TypeError, ValueError):
+        raise
+    except Exception as exc:                    # noqa: B902 (whatever a plug-in raises)
+        if kind in BUILTIN:
+            raise
+        raise _BuildFailed(f'detector {kind!r}: building it failed: {type(exc).__name__}: '
+                           f'{exc}') from None
 
 
 def make_detector(kind: str = DEFAULT_KIND, **options):
@@ -189,10 +241,11 @@ def make_detector(kind: str = DEFAULT_KIND, **options):
         raise ValueError(f'detector {kind!r} has no option {", ".join(map(repr, unknown))} '
                          f'(its options: {", ".join(sorted(known)) or "none"})')
     try:
-        detector = factory(**options)
+        with _named_errors(kind):
+            detector = factory(**options)
     except (TypeError, ValueError) as exc:
         # the shipped factories name the option they refuse; a plug-in's error may not
-        if isinstance(exc, ValueError) and kind in BUILTIN:
+        if isinstance(exc, _BuildFailed) or (isinstance(exc, ValueError) and kind in BUILTIN):
             raise
         raise ValueError(f'detector {kind!r}: bad options {sorted(options)} ({exc})') from None
     # A factory rebuilt by from_settings records itself whole; one rebuilt as factory(**options)
@@ -270,12 +323,14 @@ def detector_from_settings(settings: dict, cascade_dir=None, on_note=None):
         params = inspect.signature(from_settings).parameters
         takes = 'cascade_dir' in params or any(p.kind == p.VAR_KEYWORD for p in params.values())
         context = {'cascade_dir': cascade_dir} if cascade_dir is not None and takes else {}
-        detector = from_settings(dict(settings), **context)
+        with _named_errors(kind):
+            detector = from_settings(dict(settings), **context)
         options = {}                            # its settings() gives what it was built with
     else:
         options = {k: v for k, v in settings.items() if k != 'kind' and k not in info}
         try:
-            detector = factory(**options)
+            with _named_errors(kind):
+                detector = factory(**options)
         except TypeError as exc:
             raise ValueError(f'detector {kind!r} cannot be rebuilt from {sorted(options)} '
                              f'({exc})') from None
