@@ -522,3 +522,17 @@ def test_a_plugin_that_breaks_as_it_is_built_is_one_line(on_path, tmp_path, caps
               '--detector', kind, '--out', str(tmp_path / 'x.yaml'), '--quiet'])
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and err == [f'ipomdp-gaze calibrate: error: detector {kind!r}: {words}']
+
+
+def test_calibrate_refuses_a_plugin_its_recorded_settings_cannot_rebuild(on_path, tmp_path,
+                                                                         capsys):
+    """The model was written, and find and the node refused it: now checked before the work."""
+    labels = labelled_folder(tmp_path / 'images', n=2)
+    out = tmp_path / 'x.yaml'
+    capsys.readouterr()
+    rc = cli(['calibrate', '--images', str(tmp_path / 'images'), '--labels', str(labels),
+              '--detector', 'blobdet:Boastful', '--out', str(out), '--quiet'])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and not out.exists(), err
+    assert 'the detector cannot be rebuilt from the settings its model would record' in err[0]
+    assert "unexpected keyword argument 'max_red'" in err[0]

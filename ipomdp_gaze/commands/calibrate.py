@@ -324,13 +324,23 @@ def _check_options(args) -> None:
 
 def _detector(args):
     """Return the detector's plain settings for the workers, and the detector built from them."""
-    from ipomdp_gaze.vision.detectors import detector_from_spec, parse_options
+    from ipomdp_gaze.vision.detector import detector_settings
+    from ipomdp_gaze.vision.detectors import (detector_from_settings, detector_from_spec,
+                                              parse_options)
     spec = {'kind': args.detector, **parse_options(args.detector_option)}
     if args.detector == 'haar':
         spec.setdefault('scale_factor', args.scale_factor)
     elif args.scale_factor != 1.1:
         raise ValueError('--scale-factor is a haar setting; use --detector-option')
-    return spec, detector_from_spec(spec)
+    detector = detector_from_spec(spec)
+    # find and the node rebuild it from what the model records: check that now, not after
+    try:
+        detector_from_settings(detector_settings(detector))
+    except ValueError as exc:
+        raise ValueError(f'the detector cannot be rebuilt from the settings its model would '
+                         f'record, so the model could not be used (is its settings() right?): '
+                         f'{exc}') from None
+    return spec, detector
 
 
 def _cell_rule(args, pilot):
