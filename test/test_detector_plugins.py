@@ -129,7 +129,7 @@ class Misshapen:
         return {'short': np.array([[1.0, 2.0, 3.0]]),
                 'nan': np.array([[np.nan, 1, 5, 5, 0.5]]),
                 'negative': np.array([[10, 10, -5, 5, 0.5]]),
-                'complex': np.array([[1, 1, 5, 5]], complex)}[self.mode]
+                'complex': np.array([[1, 1, 5, 5]], complex), 'none': None}[self.mode]
 '''
 SIZE, CELLS, SQUARE = 84, 7, 14
 KINDS = {'module': 'blobdet:BlobDetector', 'entry point': 'blob'}
@@ -455,9 +455,10 @@ def test_a_plugin_entry_point_that_raises_as_it_loads_is_one_line_in_find(on_pat
     ('nan', 'a box or score that is not a finite number'),
     ('negative', 'every box must have a positive width and height'),
     ('complex', 'a detector must return real numbers, got complex ones'),
+    ('none', 'got None (no return statement?)'),
 ])
 def test_a_plugins_malformed_answer_is_named_against_the_detector(on_path, mode, words):
-    """A complex answer lost its imaginary part with a warning; the others named no detector."""
+    """Complex lost its imaginary part with a warning, None was "got ()"; none named it."""
     import warnings
 
     from ipomdp_gaze.vision.detector import detect, DetectorFailed

@@ -83,6 +83,9 @@ def as_detections(result) -> tuple[np.ndarray, np.ndarray]:
         has no positive width and height.
 
     """
+    if result is None:
+        raise ValueError('a detector must return boxes, (M, 5) x, y, w, h, score or (M, 4), '
+                         'got None (no return statement?)')
     if np.iscomplexobj(result):
         raise ValueError('a detector must return real numbers, got complex ones')
     try:
