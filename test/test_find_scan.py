@@ -88,7 +88,10 @@ def test_a_weak_finest_scale_box_answers_only_if_an_enlarged_look_keeps_it():
     image = np.ascontiguousarray(np.rot90(load_photo('coffee'), 2))
     unlooked, looked = with_and_without(image, look_upscale=0)
     assert unlooked.decision == 'found' and looked.decision == 'absent'
-    # the look is one more call on the crop round the box, resized by look_factor
+    # the look is one more call on the crop round the box, resized by look_factor (Haar's
+    # second opinion then looks at the faint boxes: left out here)
+    looked, _ = with_and_without(image, second_score=0)
+    assert looked.decision == 'absent'
     box = unlooked.faces[0].box
     factor = look_factor(box, 2.0)
     crop_w, crop_h = crop_size(box, image.shape)
@@ -128,8 +131,45 @@ def test_a_face_too_small_for_the_finest_scale_answers_from_its_faint_box():
     extra = looked.detector_pixels - unlooked.detector_pixels
     assert abs(extra - 4 * crop_w * crop_h) <= 2 * (crop_w + crop_h) + 1
     # a look score the enlarged face does not reach keeps the answer absent, at the same cost
-    strict, _ = with_and_without(scene.image, faint_look_score=1.01)
+    strict, _ = with_and_without(scene.image, faint_look_score=1.01, second_score=0)
     assert strict.decision == 'absent' and strict.detector_pixels == looked.detector_pixels
+    # where Haar sees this 34 px face in the crop round the same faint box (its second opinion)
+    seconded, _ = with_and_without(scene.image, faint_look_score=1.01)
+    assert seconded.decision == 'found' and near(seconded.cell, scene.cell)
+
+
+def test_haar_answers_where_yunet_left_a_faint_box_on_a_face_it_missed():
+    """Training scene 175 (seed 3): YuNet's best box on the face, 60 px, scores 0.14."""
+    scene = SceneSet('train', size_px=420, face_px=(60, 140), grid=(21, 21), seed=3)[175]
+    alone, seconded = with_and_without(scene.image, second_score=0)
+    assert alone.decision == 'absent'
+    assert seconded.decision == 'found' and near(seconded.cell, scene.cell)
+    # the answer is Haar's box, centred in YuNet's faint one; its crop (half the faint box's
+    # side round it) is the only extra call, at the crop's own scale
+    x, y, w, h = seconded.faces[0].box
+    assert np.isnan(seconded.probability) and w >= 24 and h >= 24
+    extra = seconded.detector_pixels - alone.detector_pixels
+    assert 0 < extra <= (2 * 60) ** 2
+    # Haar asked for more neighbours than it finds there leaves the answer absent
+    strict, _ = with_and_without(scene.image, second_neighbors=200)
+    assert strict.decision == 'absent'
+
+
+def test_haar_is_asked_only_about_a_scoring_detectors_faint_boxes_of_a_bounded_size():
+    from ipomdp_gaze.vision.search import _second_opinion
+    from skimage import data
+    image = data.astronaut()
+    face = np.array([[170.0, 60.0, 110.0, 110.0]])            # the astronaut's face
+    wall = np.array([[360.0, 300.0, 100.0, 100.0]])           # her suit, no face
+    found = SimpleNamespace(boxes_px=np.vstack([wall, face]), scores=np.array([0.3, 0.1]))
+    box, pixels = _second_opinion(image, found, (512, 512), 0.05, 2, 0.5, 8)
+    assert box is not None
+    assert 170 <= box[0] + box[2] / 2 <= 280 and 60 <= box[1] + box[3] / 2 <= 170
+    assert pixels == 200 * 200 + 220 * 220                    # both crops, the suit's first
+    assert _second_opinion(image, found, (512, 512), 0.05, 1, 0.5, 8) == (None, 200 * 200)
+    assert _second_opinion(image, found, (512, 512), 0.2, 2, 0.5, 8)[0] is None     # too faint
+    assert _second_opinion(image, found, (512, 512), 0.05, 2, 0.2, 8) == (None, 200 * 200)
+    assert _second_opinion(image, found, (512, 512), 0.05, 2, 0.15, 8) == (None, 0)
 
 
 def test_without_looks_the_ladder_reads_only_its_rungs():

@@ -108,6 +108,25 @@ DECIDED_MARGIN = 1e-9
 FAINT_SCORE = 0.2
 FAINT_SIDE = 4 / 3
 FAINT_LOOK_SCORE = 0.8
+# Haar's second opinion (docs/design.md section 11.4), find without --all with a scoring
+# detector (YuNet): when neither the ladder nor the faint look answered, the finest call's
+# SECOND_BOXES best boxes from SECOND_SCORE (below the detector's threshold), each at most
+# SECOND_SIDE of the image's shorter side, are shown to OpenCV's Haar face cascade in the crop
+# round each (half the box's side on each side, at the crop's own scale): a grouped Haar box of
+# SECOND_NEIGHBORS neighbours centred in the faint box answers there. YuNet, trained on camera
+# faces, leaves blurred or enlarged thumbnails a faint box that Haar's grey pattern sees.
+# Chosen on training material only (300 training scenes per task, seed 3, the 432 face-free
+# augmented images and the training photos), by the rule "no face-free image answered more,
+# every training photo within the ladder's 1.5 full scans, then the most faces, then the
+# fewest pixels" over scores 0.05-0.3, 1-5 boxes, sides 1/4-1 and 3, 5 or 8 neighbours:
+# 285 -> 287 right at 420 and 264 -> 270 at 840, still 10 of the 432 face-free images
+# answered, for 0.01 more full scans on them (1.27 -> 1.28). Sides to 1/2 found 288 and 271 but read 1.67
+# full scans on the training photo coins (1.25 without); 3 neighbours found 291 and 278 but
+# answered 12 more face-free images.
+SECOND_SCORE = 0.05
+SECOND_BOXES = 2
+SECOND_SIDE = 0.25
+SECOND_NEIGHBORS = 8
 # A crowd (find --all, docs/design.md section 11.4): faces down to CROWD_RATIO times the smallest
 # the coarse pass found (or, when it found nothing, than the faces assumed to matter) may be
 # there. Seen well, they are seen that much smaller by a call 1 / CROWD_RATIO times finer; seen
@@ -1232,12 +1251,57 @@ def _min_side_px(scales: ScaleTable, scale: float) -> float:
         return scales.rows[-1].min_side_px
 
 
-def _faint_box(found, threshold: float, max_side_px: float):
-    """Return the best box scoring below ``threshold`` no larger than ``max_side_px``, or None."""
+def _faint_box(found, threshold: float, max_side_px: float, floor: float = -math.inf):
+    """Return the best box scoring in ``[floor, threshold)`` no larger than ``max_side_px``."""
     scores = np.asarray(found.scores, dtype=float)
     boxes = np.asarray(found.boxes_px, dtype=float).reshape(-1, 4)
-    small = (scores < threshold) & (np.max(boxes[:, 2:], axis=1, initial=0) <= max_side_px)
+    small = (scores < threshold) & (scores >= floor) \
+        & (np.max(boxes[:, 2:], axis=1, initial=0) <= max_side_px)
     return boxes[small][int(np.argmax(scores[small]))] if small.any() else None
+
+
+_HAAR = []
+
+
+def second_opinion_detector():
+    """Return OpenCV's Haar face cascade (the package's ``haar`` kind), built once."""
+    if not _HAAR:
+        from ipomdp_gaze.vision.detectors import make_detector
+        _HAAR.append(make_detector('haar'))
+    return _HAAR[0]
+
+
+def _second_opinion(image: np.ndarray, found, image_px: tuple[int, int], score: float,
+                    n_boxes: int, side: float, neighbors: int):
+    """
+    Return Haar's answer in the crops round ``found``'s best faint boxes, or None; and its pixels.
+
+    The ``n_boxes`` best boxes from ``score``, each at most ``side`` of the shorter side, in
+    order: a grouped Haar box of ``neighbors`` neighbours centred in the box answers (that Haar
+    box). Crops smaller than the cascade's window are skipped.
+    """
+    width, height = image_px
+    scores = np.asarray(found.scores, dtype=float)
+    boxes = np.asarray(found.boxes_px, dtype=float).reshape(-1, 4)
+    largest = np.max(boxes[:, 2:], axis=1, initial=0)
+    keep = np.flatnonzero((scores >= score) & (largest <= side * min(width, height)))
+    haar = second_opinion_detector()
+    window = min(detector_window_px(haar))
+    pixels = 0
+    for k in keep[np.argsort(-scores[keep], kind='stable')][:n_boxes]:
+        x, y, w, h = boxes[k]
+        margin = max(w, h) / 2.0
+        x0, y0 = int(max(0.0, x - margin)), int(max(0.0, y - margin))
+        x1, y1 = int(min(width, x + w + margin)), int(min(height, y + h + margin))
+        if min(x1 - x0, y1 - y0) < window:
+            continue
+        look = scan(image[y0:y1, x0:x1], haar, (1, 1), 1.0, min_neighbors=neighbors)
+        pixels += look.detector_pixels
+        for gx, gy, gw, gh in look.grouped_px:
+            cx, cy = x0 + gx + gw / 2.0, y0 + gy + gh / 2.0
+            if x <= cx <= x + w and y <= cy <= y + h:
+                return np.array([x0 + gx, y0 + gy, gw, gh], dtype=float), pixels
+    return None, pixels
 
 
 def look_factor(box, upscale: float, scale: float = 1.0) -> float:
@@ -1280,7 +1344,9 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
                   start: float, confirm: bool = True, look_upscale: float = LOOK_UPSCALE,
                   look_score: float = LOOK_SCORE, faint_score: float = FAINT_SCORE,
                   faint_look_score: float = FAINT_LOOK_SCORE,
-                  finest: float | None = None) -> ImageSearch:
+                  finest: float | None = None, second_score: float = SECOND_SCORE,
+                  second_boxes: int = SECOND_BOXES, second_side: float = SECOND_SIDE,
+                  second_neighbors: int = SECOND_NEIGHBORS) -> ImageSearch:
     """
     Find the one face of ``find`` by full-frame calls from coarse to fine (``--scan coarse``).
 
@@ -1315,7 +1381,12 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
     by the end, the last call's best faint box (a score from ``faint_score``, below the
     detector's own threshold; 0: none) no larger than ``FAINT_SIDE`` times the smallest face
     side of the last scale (:func:`_min_side_px`) gets the same look and answers if it keeps
-    ``faint_look_score`` (a face too small for the scale). ``found`` at the best box (the
+    ``faint_look_score`` (a face too small for the scale). Then, for a scoring detector, Haar's
+    second opinion: the last call's ``second_boxes`` best boxes from ``second_score`` (0: no
+    second opinion), each at most ``second_side`` of the image's shorter side, answer where
+    OpenCV's Haar face cascade, in the crop round the box at the crop's own scale, finds a
+    grouped box of ``second_neighbors`` neighbours centred in it (:func:`_second_opinion`;
+    that box is the answer). ``found`` at the best box (the
     highest score; for a grouping detector the merged box holding most raw detections), else
     ``absent``. No belief is computed (``probability`` NaN, method ``scales``);
     ``detector_pixels`` counts every call and crop (a face-free image pays every scale: 1/16 +
@@ -1326,6 +1397,8 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
     grid = fovea.grid
     rungs = ladder_scales(scales, start, finest)
     pixels, box, faint, larger = 0, None, None, False
+    second = second_score > 0 and second_boxes > 0 and scales.strong_score > 0 \
+        and bool(look_upscale)
     k = -1
     while k + 1 < len(rungs):
         k += 1
@@ -1335,6 +1408,8 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
         # too large for their scale); neither answers as such
         if last:
             weak_from = faint_score if look_upscale else 0.0
+            if second:
+                weak_from = min(weak_from, second_score)
         else:
             weak_from = scales.weak_score if math.isfinite(scales.max_side_px) else 0.0
         detector = coarse_detector(fovea.detector, weak_from)
@@ -1345,7 +1420,7 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
             # the same call keeps faint boxes too: they answer only through the faint look
             keep_from = _fine_score(fovea.detector)
             faint = _faint_box(found, keep_from,
-                               FAINT_SIDE * _min_side_px(scales, scale) / scale)
+                               FAINT_SIDE * _min_side_px(scales, scale) / scale, faint_score)
         box = _ladder_answer(found, scales.strong_score, last, keep_from)
         score = _best_score(found) if last else math.nan
         seen_at = scale                         # the scale of the call that gave the box
@@ -1383,6 +1458,10 @@ def search_scales(image: np.ndarray, fovea: Fovea, model, scales: ScaleTable, *,
         pixels += spent
         if best >= faint_look_score:
             box = faint
+    if box is None and second and len(found.boxes_px):
+        box, spent = _second_opinion(image, found, image_px, second_score, second_boxes,
+                                     second_side, second_neighbors)
+        pixels += spent
     common = {'fixations': 0, 'path': (), 'detector_pixels': pixels, 'image_px': image_px,
               'calibrated_px': calibrated_size(model), 'method': 'scales',
               'note': f'full frame at {", ".join(f"{s:.2g}" for s in rungs[:k + 1])}',
