@@ -120,9 +120,9 @@ FAINT_LOOK_SCORE = 0.8
 # every training photo within the ladder's 1.5 full scans, then the most faces, then the
 # fewest pixels" over scores 0.05-0.3, 1-5 boxes, sides 1/4-1 and 3, 5 or 8 neighbours:
 # 285 -> 287 right at 420 and 264 -> 270 at 840, still 10 of the 432 face-free images
-# answered, for 0.01 more full scans on them (1.27 -> 1.28). Sides to 1/2 found 288 and 271 but read 1.67
-# full scans on the training photo coins (1.25 without); 3 neighbours found 291 and 278 but
-# answered 12 more face-free images.
+# answered, for 0.01 more full scans on them (1.27 -> 1.28). Sides to 1/2 found 288 and 271
+# but read 1.67 full scans on the training photo coins (1.25 without); 3 neighbours found 291
+# and 278 but answered 12 more face-free images.
 SECOND_SCORE = 0.05
 SECOND_BOXES = 2
 SECOND_SIDE = 0.25
