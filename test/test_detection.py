@@ -111,6 +111,25 @@ def test_a_scan_asked_again_on_a_clock_set_back_is_not_served_an_old_image(fovea
     assert out.status == 'published' and out.frame.token == 'new'
 
 
+def test_a_resent_scan_request_keeps_waiting_from_the_first_request(fovea_setup):
+    """QA: a re-send restarted the scan's wait, so images slower than re-sends never served."""
+    loop = DetectorLoop(fovea_setup)
+    image = SceneSet('test', **PAPER_TASK, color='rgb', seed=2).scene(0).image
+    assert loop.request_scan(7, 2.0).status == 'waiting'
+    assert loop.request_scan(7, 3.0).status == 'waiting'         # re-sent after retry_period_s
+    assert loop.waited_s(4.5) == 2.5                             # what the stuck warning reads
+    out = loop.add_image(2.5, image, token='late', now_s=3.6)    # taken after the request
+    assert out.status == 'published', out
+    assert (out.frame.kind, out.frame.token, out.frame.search_id) == ('scan', 'late', 7)
+    # Served, the same request again (its frame lost) wants a new image; so does a new search.
+    assert loop.request_scan(7, 5.0).status == 'waiting'
+    assert loop.add_image(4.8, image, now_s=5.1).status == 'waiting'
+    assert loop.request_scan(8, 6.0).status == 'waiting'
+    assert loop.add_image(5.5, image, now_s=6.1).status == 'waiting'
+    out = loop.add_image(6.2, image, token='new', now_s=6.3)
+    assert out.status == 'published' and (out.frame.token, out.frame.search_id) == ('new', 8)
+
+
 def test_the_newest_waiting_image_serves_a_fixation(fovea_setup):
     loop = DetectorLoop(fovea_setup)
     old = SceneSet('test', **PAPER_TASK, color='rgb', seed=2).scene(0).image

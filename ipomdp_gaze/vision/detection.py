@@ -525,13 +525,20 @@ class DetectorLoop:
         Served with the next image captured from ``now_s`` on: the fovea's whole-image windows
         (``fovea`` mode with a scanning fovea); a sensor without a scan (``camera`` mode, or a
         fovea that does not scan) answers with a frame of NaN (nothing observed), so the
-        controller can start its search all the same.
+        controller can start its search all the same. A re-send of the request waiting (the
+        same search) keeps waiting from the first, as a re-sent fixation does: restarting the
+        wait at every ``retry_period_s`` starved the scan of a camera whose images take longer
+        than that to arrive, and hid the wait from the stuck warning.
         """
         self.fixations += 1
         self.inputs['fixation'][0] += 1
-        self._clock_went_back(float(now_s))
+        now_s = float(now_s)
+        self._clock_went_back(now_s)
+        resent = self.pending is not None and self.pending[0] is None \
+            and int(search_id) == self.search_id
         self.search_id = int(search_id)
-        self.pending = (None, float(now_s))
+        if not resent:
+            self.pending = (None, now_s)
         return self.serve()
 
     def _clock_went_back(self, now_s: float) -> None:
