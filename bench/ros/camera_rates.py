@@ -4,11 +4,12 @@
 The pixel loop fed like a real camera: ``foveal_detector`` and ``gaze_controller`` at 15-30 Hz.
 
 Starts the controller and the detector with the shipped fovea-mode files
-(``config/faces_fovea_*.yaml``, each in its own process) and a camera process (this script with
-``--publish``) that streams ``sensor_msgs/Image`` on ``image`` at ``--rate-hz``, reliable, depth
-10 (a typical driver's default QoS): a held-out test scene with one face, scaled to
-``--size``, ``mono8``, ``rgb8`` or ``bgr8``, stamped when it is sent. Each time a search ends this
-process resets the controller, so the loop runs for the whole ``--seconds``. Reported:
+(``config/faces_fovea_*.yaml``, each in its own process; ``--mode camera``: below) and a
+camera process (this script with ``--publish``) that streams ``sensor_msgs/Image`` on
+``image`` at ``--rate-hz``, reliable, depth 10 (a typical driver's default QoS): a held-out
+test scene with one face, scaled to ``--size``, ``mono8``, ``rgb8`` or ``bgr8``, stamped when it
+is sent. Each time a search ends this process resets the controller, so the loop runs for the
+whole ``--seconds``. Reported:
 
 - **latency**: image stamp to its ``evidence_image`` arriving here (median, p90, max; the
   evidence carries the image's stamp);
@@ -21,7 +22,10 @@ process resets the controller, so the loop runs for the whole ``--seconds``. Rep
   process); with ``--switch WxH``, it changes to that size halfway; with ``--bad-every N``,
   every N-th image is sent as ``rgba8`` (an encoding the node refuses); with ``--stamp-lag S``
   each image is stamped S seconds before it is sent (a camera whose images arrive S late);
-  ``--detector-args`` adds to the detector's ``--ros-args`` (``'-p image_best_effort:=true'``).
+  ``--detector-args`` adds to the detector's ``--ros-args`` (``'-p image_best_effort:=true'``);
+  ``--mode camera`` runs the camera-mode files (``config/faces_camera_*.yaml``) with a head in
+  the camera process that is at once where ``pan_tilt`` says, and ``joint_states`` and
+  ``camera_info`` (25 degrees wide, the model camera's field of view) stamped like each image.
 
 The machine's other load moves every time here; the numbers describe one run. Example::
 
@@ -77,6 +81,7 @@ def publish(args) -> None:
     node = Node('camera_rates_camera')
     pub = node.create_publisher(Image, 'image',
                                 QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE))
+    head = Head(node) if args.mode == 'camera' else None
     sizes = [size_arg(args.size)] + ([size_arg(args.switch)] if args.switch else [])
     frames = [(scene_pixels(s, args.encoding), s) for s in sizes]
     channels = 1 if args.encoding == 'mono8' else 3
@@ -97,6 +102,8 @@ def publish(args) -> None:
                         step=(4 if bad else channels) * w)
             msg.data = (np.zeros((h, w, 4), np.uint8) if bad else pixels).tobytes()
             pub.publish(msg)
+            if head is not None:
+                head.publish(stamp.to_msg(), w, h)
             if log:
                 log.write(f'{stamp.nanoseconds} {int(bool(bad))} {w} {h}\n')
             n += 1
@@ -105,8 +112,56 @@ def publish(args) -> None:
     finally:
         if log:
             log.close()
+        rclpy.try_shutdown()            # ends the head's spin thread first
+        if head is not None:
+            head.thread.join(5)
         node.destroy_node()
-        rclpy.try_shutdown()
+
+
+class Head:
+    """
+    Camera mode: a head that is where ``pan_tilt`` says at once, and a camera of 25 degrees.
+
+    With each image it publishes ``joint_states`` and ``camera_info`` under the image's stamp
+    (the field of view of the model's camera, any size); it spins in a thread of its own.
+    """
+
+    def __init__(self, node):
+        from ipomdp_gaze.nodes.qos import STATE_QOS
+        from rclpy.executors import SingleThreadedExecutor
+        from sensor_msgs.msg import CameraInfo, JointState
+        self.node, self.position = node, [0.0, 0.0]
+        self.CameraInfo, self.JointState = CameraInfo, JointState
+        self.joints = node.create_publisher(JointState, 'joint_states', 10)
+        self.info = node.create_publisher(CameraInfo, 'camera_info', 10)
+        node.create_subscription(JointState, 'pan_tilt', self._on_target, STATE_QOS)
+        self.executor = SingleThreadedExecutor(context=node.context)
+        self.executor.add_node(node)
+        self.thread = threading.Thread(target=self._spin, daemon=True)
+        self.thread.start()
+
+    def _spin(self) -> None:
+        from rclpy.executors import ExternalShutdownException
+        try:
+            self.executor.spin()
+        except ExternalShutdownException:
+            pass
+
+    def _on_target(self, msg) -> None:
+        self.position = [float(msg.position[0]), float(msg.position[1])]
+
+    def publish(self, stamp, width: int, height: int) -> None:
+        """Publish the head's pose and the camera's intrinsics stamped like an image."""
+        import math
+        from ipomdp_gaze.model.head_camera import PinholeCamera
+        from ipomdp_gaze.msg_adapters import images
+        from std_msgs.msg import Header
+        fx = (width / 2) / math.tan(math.radians(12.5))
+        camera = PinholeCamera(width, height, fx, fx, (width - 1) / 2, (height - 1) / 2)
+        self.info.publish(images.camera_info(camera, stamp))
+        self.joints.publish(self.JointState(header=Header(stamp=stamp),
+                                            name=['pan_joint', 'tilt_joint'],
+                                            position=list(self.position)))
 
 
 class Sampler(threading.Thread):
@@ -150,7 +205,7 @@ def camera_process(args, seconds: float, log: str, env: dict) -> subprocess.Pope
     cmd = [sys.executable, __file__, '--publish', '--size', args.size, '--encoding',
            args.encoding, '--rate-hz', str(args.rate_hz), '--seconds', str(seconds),
            '--log', log, '--bad-every', str(args.bad_every),
-           '--stamp-lag', str(args.stamp_lag)]
+           '--stamp-lag', str(args.stamp_lag), '--mode', args.mode]
     if args.switch:
         cmd += ['--switch', args.switch]
     return subprocess.Popen(cmd, env=env, stdin=subprocess.DEVNULL)
@@ -166,14 +221,16 @@ def run(args) -> dict:
     from sensor_msgs.msg import Image
     from std_msgs.msg import Int32MultiArray
     cfg = ROOT / 'config'
+    mode = args.mode
     tmp = tempfile.mkdtemp(prefix='camera-rates-')
     log = os.path.join(tmp, 'camera.log')
     with isolated_nodes(args.domain, prefix='camera-rates-') as nodes:
         procs = {
             'controller': nodes.start('controller', [
-                '--params-file', cfg / 'faces_fovea_controller.yaml']),
+                '--params-file', cfg / f'faces_{mode}_controller.yaml']),
             'detector': nodes.start('detector', [
-                '--params-file', cfg / 'faces_fovea_detector.yaml', *args.detector_args.split()]),
+                '--params-file', cfg / f'faces_{mode}_detector.yaml',
+                *args.detector_args.split()]),
         }
         cameras = []
         with Watch(args.domain, 'camera_rates', nodes) as watch:
@@ -326,6 +383,9 @@ def main() -> int:
     parser.add_argument('--switch', default='')
     parser.add_argument('--stall', type=float, default=0.0)
     parser.add_argument('--bad-every', type=int, default=0)
+    parser.add_argument('--mode', default='fovea', choices=('fovea', 'camera'),
+                        help='camera: the head follows pan_tilt at once, with joint_states and '
+                             'camera_info stamped like each image')
     parser.add_argument('--stamp-lag', type=float, default=0.0,
                         help='stamp each image this many seconds before it is sent')
     parser.add_argument('--detector-args', default='',
