@@ -137,7 +137,8 @@ def test_the_room_keeps_its_people_in_view_in_turn_and_counts_who_is_new():
     done = room.done([{'cell': moved, 'probability': 0.9}, {'cell': b, 'probability': 0.7},
                       {'cell': c, 'probability': 0.6}])
     assert done.recheck and done.new == (Person(c, 0.6),) and len(done.people) == 3
-    assert room.next_person().cell == moved                    # a new list starts at its first
+    # the round goes on: a (moved) had its turn in it, so b, then c (new), then a new round
+    assert [room.next_person().cell for _ in range(4)] == [b, c, moved, b]
     room.forget()
     assert room.people == () and room.next_person() is None
     done = room.done([{'cell': b, 'probability': 0.7}])
@@ -176,3 +177,51 @@ def test_a_frame_id_tf2_cannot_look_up_is_refused(frame_id):
     with pytest.raises(ValueError, match='room.frame_id must name the frame of ~/targets'):
         check_frame_id(frame_id)
     assert check_frame_id('pan_tilt_base') == 'pan_tilt_base'
+
+
+FOUR = [GRID.index(*rc) for rc in ((1, 1), (1, 9), (9, 1), (9, 9))]
+
+
+def _faces(cells, probabilities=(0.9, 0.8, 0.7, 0.6)) -> list:
+    return [{'cell': c, 'probability': p} for c, p in zip(cells, probabilities)]
+
+
+def test_a_recheck_shorter_than_a_round_starves_nobody():
+    """QA: the turn restarted at the first person after each re-check; (9, 9) was never seen."""
+    room = RoomWatch(GRID)
+    room.done(_faces(FOUR))
+    looked = []
+    for _ in range(4):       # 2 s dwell, 5 s period: turns at 0, 2 and 4 s, then the re-check
+        looked += [room.next_person().cell for _ in range(3)]
+        room.recheck()
+        done = room.done(_faces(FOUR))                    # nobody new
+        assert done.recheck and done.new == ()
+    assert looked == FOUR * 3
+    # a new round; after a re-check that reorders the list, the rest of it in the new order
+    assert room.next_person().cell == FOUR[0]
+    room.recheck()
+    room.done(_faces(FOUR[::-1]))                         # (9, 9) most probable now
+    assert [room.next_person().cell for _ in range(4)] == [FOUR[3], FOUR[2], FOUR[1], FOUR[3]]
+
+
+def test_after_a_recheck_the_new_people_get_their_turn_in_the_round():
+    room = RoomWatch(GRID)
+    room.done(_faces(FOUR[:2]))
+    assert room.next_person().cell == FOUR[0]
+    room.recheck()
+    gone = [GRID.index(1, 2), FOUR[2]]           # the first moved by a cell, one more came in
+    room.done(_faces(gone))                       # and the second left
+    assert [room.next_person().cell for _ in range(3)] == [FOUR[2], gone[0], FOUR[2]]
+    room.recheck()
+    room.done([])                                 # nobody: nothing to look at
+    assert room.looked == frozenset() and room.next_person() is None
+
+
+def test_two_people_side_by_side_found_again_are_each_matched_once():
+    """One known person found again is one of the new list, even with two within a cell."""
+    from ipomdp_gaze.search.room import found_again
+    side = [Person(GRID.index(5, 5), 0.9), Person(GRID.index(5, 6), 0.8)]
+    assert found_again(side[:1], side, GRID) == {0}
+    assert found_again(side[1:], side, GRID) == {1}
+    assert found_again(side, side[::-1], GRID) == {0, 1}
+    assert found_again([Person(GRID.index(0, 0), 0.9)], side, GRID) == frozenset()

@@ -7,9 +7,12 @@ The ``gaze_controller`` node in many-target mode (``search.targets: many``, docs
 section 11.6) runs a search of the room; when it ends, :meth:`RoomWatch.done` takes its faces
 (:meth:`ipomdp_gaze.search.many.OccupancySession.faces`) as the people in the room, and the node
 then keeps them in view in turn: :meth:`RoomWatch.next_person` names the next one each
-``room.dwell_s`` seconds. A periodic re-check (``room.recheck_period_s``) is a new search of the
-room; its people replace the list, and those farther than :data:`SAME_PERSON_CELLS` from every
-person known before are counted as new. ``~/reset`` forgets everyone (:meth:`RoomWatch.forget`).
+``room.dwell_s`` seconds, in rounds in which each person gets one turn. A periodic re-check
+(``room.recheck_period_s``) is a new search of the room; its people replace the list, and those
+farther than :data:`SAME_PERSON_CELLS` from every person known before are counted as new. The
+round goes on across a re-check: the people found again who had their turn in it wait for the
+others (new people included), so a re-check period shorter than a round starves nobody.
+``~/reset`` forgets everyone (:meth:`RoomWatch.forget`).
 
 Pure: no ROS, no clock (the node owns the timers); times are seconds.
 """
@@ -106,13 +109,33 @@ def new_people(known, found, grid, radius: int = SAME_PERSON_CELLS) -> tuple:
     return tuple(out)
 
 
+def found_again(known, found, grid, radius: int = SAME_PERSON_CELLS) -> frozenset:
+    """
+    Return the indices in ``found`` of the people of ``known`` found again.
+
+    Each of ``known``, in its order, is the nearest (Chebyshev; ties: the first) of ``found``
+    within ``radius`` cells not taken by one before it: one person found again per known one,
+    even when two people stand within ``radius`` of each other.
+    """
+    taken = set()
+    for person in known:
+        row, col = grid.cell(person.cell)
+        near = [(max(abs(row - r), abs(col - c)), j)
+                for j, (r, c) in enumerate(grid.cell(p.cell) for p in found)
+                if j not in taken]
+        near = [(d, j) for d, j in near if d <= radius]
+        if near:
+            taken.add(min(near)[1])
+    return frozenset(taken)
+
+
 class RoomWatch:
     """The people of the room and the turn of looking at them (module docstring)."""
 
     def __init__(self, grid):
         self.grid = grid
         self.people: tuple = ()
-        self.turn = -1
+        self.looked = frozenset()           # indices of the people who had their turn this round
         self.rechecking = False
         self.rooms_done = 0
 
@@ -122,25 +145,37 @@ class RoomWatch:
 
     def forget(self) -> None:
         """Forget everyone (``~/reset``): the next search's people are all new."""
-        self.people, self.turn, self.rechecking = (), -1, False
+        self.people, self.looked, self.rechecking = (), frozenset(), False
 
     def done(self, faces) -> RoomDone:
         """
         Take a finished search's faces as the people in the room; return who is new.
 
         The people are most probable first (ties in the search's order), as ``~/targets``
-        documents: a pass lists its grouped detections before the belief's faces.
+        documents: a pass lists its grouped detections before the belief's faces. After a
+        re-check the round goes on: those found again who had their turn in it wait for the rest.
         """
         found = tuple(sorted(people_from_faces(faces), key=lambda p: -p.probability))
         new = new_people(self.people, found, self.grid)
         result = RoomDone(found, new, self.rechecking)
-        self.people, self.turn, self.rechecking = found, -1, False
+        looked = frozenset()
+        if self.rechecking:
+            looked = found_again([self.people[i] for i in sorted(self.looked)], found, self.grid)
+        self.people, self.looked, self.rechecking = found, looked, False
         self.rooms_done += 1
         return result
 
     def next_person(self) -> Person | None:
-        """Return the next person to keep in view (in the order found, round and round)."""
+        """
+        Return the next person to keep in view: the first in the list without a turn this round.
+
+        When everyone has had a turn a new round begins, with the first; so without re-checks
+        the people come in the order found, round and round.
+        """
         if not self.people:
             return None
-        self.turn = (self.turn + 1) % len(self.people)
-        return self.people[self.turn]
+        waiting = [i for i in range(len(self.people)) if i not in self.looked]
+        if not waiting:
+            self.looked, waiting = frozenset(), [0]
+        self.looked |= {waiting[0]}
+        return self.people[waiting[0]]
