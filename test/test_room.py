@@ -225,3 +225,34 @@ def test_two_people_side_by_side_found_again_are_each_matched_once():
     assert found_again(side[1:], side, GRID) == {1}
     assert found_again(side, side[::-1], GRID) == {0, 1}
     assert found_again([Person(GRID.index(0, 0), 0.9)], side, GRID) == frozenset()
+
+
+def _tick_s(start_s: float, k: int, period_s: float) -> float:
+    """Return the k-th tick of an rclpy timer of ``period_s`` started at ``start_s`` (whole ns)."""
+    return start_s + k * int(period_s * 1e9) * 1e-9
+
+
+@pytest.mark.parametrize('dwell_s, period_s, turns', [
+    (2.0, 2.0, [False, False, False]),            # each tick is a re-check's too
+    (2.0, 4.0, [True, False, True, False]),
+    (2.0, 5.0, [True, True, True, True, False]),  # 10 s: the second re-check (while disabled)
+    (0.7, 2.1, [True, True, False]),              # 3 * 0.7 is 2.0999999999999996
+    (1 / 3, 1.0, [True, True, False]),            # the timer's third tick comes 1 ns early
+    (2.0, 0.0, [True, True, True]),               # no re-check
+])
+@pytest.mark.parametrize('start_s', [0.0, 1765115000.25])           # sim time; epoch seconds
+def test_a_dwell_tick_at_the_moment_of_the_recheck_is_no_turn(start_s, dwell_s, period_s, turns):
+    """QA: at 2 s / 2 s the head was sent to a person and to the pass's first pose at once."""
+    room = RoomWatch(GRID)
+    room.start_turns(start_s, dwell_s, period_s)
+    late_s = 0.003                                # callbacks run a little after their tick
+    assert [room.dwell_tick(_tick_s(start_s, k, dwell_s) + late_s)
+            for k in range(1, len(turns) + 1)] == turns
+
+
+def test_a_late_dwell_tick_is_the_timers_last_tick():
+    """A timer called late skips the ticks it missed: the call is for the last one."""
+    room = RoomWatch(GRID)
+    room.start_turns(50.0, 2.0, 5.0)
+    assert room.dwell_tick(50.0 + 9.5)             # the tick at 8 s
+    assert not room.dwell_tick(50.0 + 11.9)        # the tick at 10 s, the re-check's

@@ -774,7 +774,7 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
             f"{f', forced by {session.gave_up_reason}' if session.gave_up_reason else ''}): "
             f'{len(done.people)} people ({len(done.new)} new){": " + where if where else ""}')
         self._make_room_timers(self._config.values)
-        self._on_dwell()
+        self._look_at_next()
 
     def _follow_people(self, result) -> None:
         """
@@ -798,6 +798,8 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
     def _make_room_timers(self, values: dict) -> None:
         """Start (again) the turn of the people in view and the periodic re-check."""
         self._stop_room_timers()
+        self._room.start_turns(self._now_s(), values['room.dwell_s'],
+                               values['room.recheck_period_s'])
         self._dwell_timer = self.create_timer(values['room.dwell_s'],
                                               self.guard.wrap(self._on_dwell))
         if values['room.recheck_period_s'] > 0:
@@ -811,6 +813,11 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
         self._dwell_timer = self._recheck_timer = None
 
     def _on_dwell(self) -> None:
+        """Look at the next person, unless the re-check starts now (it sends the head)."""
+        if self._room.dwell_tick(self._now_s()):
+            self._look_at_next()
+
+    def _look_at_next(self) -> None:
         """Look at the next person found (nothing while disabled or with nobody found)."""
         if not self.core.enabled:
             return

@@ -11,8 +11,10 @@ then keeps them in view in turn: :meth:`RoomWatch.next_person` names the next on
 (``room.recheck_period_s``) is a new search of the room; its people replace the list, and those
 farther than :data:`SAME_PERSON_CELLS` from every person known before are counted as new. The
 round goes on across a re-check: the people found again who had their turn in it wait for the
-others (new people included), so a re-check period shorter than a round starves nobody.
-``~/reset`` forgets everyone (:meth:`RoomWatch.forget`).
+others (new people included), so a re-check period shorter than a round starves nobody. A tick
+of the dwell timer at the moment the re-check starts is no turn (:meth:`RoomWatch.dwell_tick`):
+the head then gets one command, the search's. ``~/reset`` forgets everyone
+(:meth:`RoomWatch.forget`).
 
 Pure: no ROS, no clock (the node owns the timers); times are seconds.
 """
@@ -31,6 +33,9 @@ SAME_PERSON_CELLS = 1
 PERSON_LINK = {'counts': 2, 'gaussian': 0}
 # Longest dwell and re-check period accepted, in seconds (one day).
 MAX_PERIOD_S = 86400.0
+# Timer ticks this close are one moment (rclpy timers count whole nanoseconds: three ticks of
+# 1/3 s end 1 ns before one of 1 s).
+SAME_MOMENT_S = 1e-6
 
 
 def check_room_times(dwell_s: float, recheck_period_s: float) -> tuple[float, float]:
@@ -138,6 +143,7 @@ class RoomWatch:
         self.looked = frozenset()           # indices of the people who had their turn this round
         self.rechecking = False
         self.rooms_done = 0
+        self._start_s, self._dwell_s, self._recheck_period_s = 0.0, 1.0, 0.0
 
     def recheck(self) -> None:
         """Start a re-check: a new search whose people are compared with those known."""
@@ -179,3 +185,24 @@ class RoomWatch:
             self.looked, waiting = frozenset(), [0]
         self.looked |= {waiting[0]}
         return self.people[waiting[0]]
+
+    def start_turns(self, now_s: float, dwell_s: float, recheck_period_s: float) -> None:
+        """Start counting the dwell and re-check timers' ticks from ``now_s`` (period 0: none)."""
+        self._start_s, self._dwell_s, self._recheck_period_s = now_s, dwell_s, recheck_period_s
+
+    def dwell_tick(self, now_s: float) -> bool:
+        """
+        Return whether the dwell timer's call at ``now_s`` is a person's turn.
+
+        The tick is the last of the timer's (``k * dwell_s`` after the start; a timer called
+        late skips the ticks it missed). It is no turn when the re-check timer ticks at that
+        moment (``k * dwell_s`` a multiple of ``recheck_period_s``): the re-check takes
+        precedence, so the head gets one command, the search's first pose, not a person's and
+        that pose at once.
+        """
+        k = math.floor((now_s - self._start_s + SAME_MOMENT_S) / self._dwell_s)
+        at_s, period_s = k * self._dwell_s, self._recheck_period_s
+        if period_s <= 0:
+            return True
+        rechecks = round(at_s / period_s)
+        return rechecks < 1 or abs(at_s - rechecks * period_s) > SAME_MOMENT_S
