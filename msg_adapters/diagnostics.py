@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from ipomdp_gaze.search import answer
+from ipomdp_gaze.search.room import people_text
 from std_msgs.msg import Header
 
 LEVELS = {'ok': DiagnosticStatus.OK, 'warn': DiagnosticStatus.WARN,
@@ -156,7 +157,7 @@ def room_done_status(name: str, people: int, new_people: int, fixations: int, se
     """
     clause, ending = _ending(forced_by, confidence)
     kind = 're-check' if recheck else 'search'
-    message = (f'room done: {people} people found ({new_people} new) by {kind} {search_id} '
+    message = (f'room done: {people_text(people)} found ({new_people} new) by {kind} {search_id} '
                f'after {fixations} fixations{clause}')
     return status(name, 'ok', message, {
         'people': int(people), 'new_people': int(new_people), 'fixations': int(fixations),

@@ -25,6 +25,7 @@ from geometry_msgs.msg import Pose, PoseArray, Quaternion
 from ipomdp_gaze.model.belief import EvidenceError
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head import PanTiltMap
+from ipomdp_gaze.search.room import people_text
 import numpy as np
 from std_msgs.msg import Float32MultiArray, Header, MultiArrayDimension, MultiArrayLayout
 
@@ -93,7 +94,7 @@ def read_people_array(msg, grid: Grid) -> list[tuple[int, float]]:
     k = dims[0].size
     data = np.asarray(msg.data, dtype=np.float64)
     if data.size != k * n:
-        raise PeopleLayoutError(f'target_cells says {k} people ({k * n} values), has '
+        raise PeopleLayoutError(f'target_cells says {people_text(k)} ({k * n} values), has '
                                 f'{data.size} values')
     out = []
     for row, col, cell, p in data.reshape(k, n):

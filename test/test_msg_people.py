@@ -51,7 +51,7 @@ def _array(data, k, label='row_col_cell_probability', offset=0):
 @pytest.mark.parametrize('msg, words', [
     (lambda: _array([5, 9, 64, 0.9], 1, label='xyz'), 'must have 2 dimensions'),
     (lambda: _array([5, 9, 64, 0.9], 1, offset=1), 'data_offset 0'),
-    (lambda: _array([5, 9, 64], 1), 'says 1 people (4 values), has 3 values'),
+    (lambda: _array([5, 9, 64], 1), 'says 1 person (4 values), has 3 values'),
     (lambda: _array([5, 9, 63, 0.9], 1), 'is not a cell of the 11x11 grid'),
     (lambda: _array([11, 0, 121, 0.9], 1), 'is not a cell of the 11x11 grid'),
     (lambda: _array([5, 9, 64, 1.5], 1), 'probability 1.5 is not in [0, 1]'),
@@ -102,3 +102,5 @@ def test_room_done_event_round_trip():
     msg = diagnostics.room_done_status('x', 0, 0, 7, 2, False, '', 0.95)
     assert diagnostics.parse_room_done(msg)['ended'] == 'confidence'
     assert 'room done: 0 people found (0 new) by search 2' in msg.message
+    msg = diagnostics.room_done_status('x', 1, 1, 12, 2, False, 'pass', 0.99)
+    assert msg.message.startswith('room done: 1 person found (1 new) by search 2'), msg.message

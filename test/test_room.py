@@ -256,3 +256,9 @@ def test_a_late_dwell_tick_is_the_timers_last_tick():
     room.start_turns(50.0, 2.0, 5.0)
     assert room.dwell_tick(50.0 + 9.5)             # the tick at 8 s
     assert not room.dwell_tick(50.0 + 11.9)        # the tick at 10 s, the re-check's
+
+
+def test_one_person_is_one_person_in_words():
+    """QA: the log and room_done said '1 people found'."""
+    from ipomdp_gaze.search.room import people_text
+    assert [people_text(n) for n in (0, 1, 2)] == ['0 people', '1 person', '2 people']

@@ -62,7 +62,7 @@ from ipomdp_gaze.search.controller_config import (build_config, ControllerConfig
                                                   follow_config, grid_from)
 from ipomdp_gaze.search.gaze import FrameSequence, SETTLING, STAMP_TOLERANCE_S
 from ipomdp_gaze.search.health import HealthMonitor
-from ipomdp_gaze.search.room import MAX_PERIOD_S, Person, PERSON_LINK, RoomWatch
+from ipomdp_gaze.search.room import MAX_PERIOD_S, people_text, Person, PERSON_LINK, RoomWatch
 import numpy as np
 from rclpy.clock import ClockChange, JumpThreshold
 from rclpy.duration import Duration
@@ -772,7 +772,8 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
         self.get_logger().info(
             f'room done ({kind} {core.search_id}, {core.decision}'
             f"{f', forced by {session.gave_up_reason}' if session.gave_up_reason else ''}): "
-            f'{len(done.people)} people ({len(done.new)} new){": " + where if where else ""}')
+            f'{people_text(len(done.people))} ({len(done.new)} new)'
+            f'{": " + where if where else ""}')
         self._make_room_timers(self._config.values)
         self._look_at_next()
 

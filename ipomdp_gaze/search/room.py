@@ -38,6 +38,11 @@ MAX_PERIOD_S = 86400.0
 SAME_MOMENT_S = 1e-6
 
 
+def people_text(count: int) -> str:
+    """Return ``'1 person'`` or ``'<count> people'``, for logs and events."""
+    return f'{count} person' if count == 1 else f'{count} people'
+
+
 def check_room_times(dwell_s: float, recheck_period_s: float) -> tuple[float, float]:
     """
     Return ``(dwell_s, recheck_period_s)`` as floats.
