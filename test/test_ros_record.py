@@ -476,6 +476,42 @@ def test_the_recorder_keeps_the_full_name_and_times_the_ask_by_the_messages_cloc
     assert events and all(m.time_ns >= asked for m in events)
 
 
+def test_the_recorder_flushes_by_the_system_clock_under_use_sim_time(context, tmp_path):
+    """
+    Review: the flush timer ran on the node's clock, the simulated one under use_sim_time.
+
+    With /clock stopped (a paused simulation, or none yet) the chunk begun was never written, so
+    a recording cut off lost everything, not about a second.
+    """
+    from ipomdp_gaze.nodes.recorder import RecorderNode, TOPICS
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+    from sensor_msgs.msg import Image
+    source = Node('flushed_source', context=context)
+    images = source.create_publisher(Image, 'image', TOPICS['image'][2])
+    recorder = RecorderNode(context=context, parameter_overrides=[
+        Parameter('path', value=str(tmp_path / 'bag')), Parameter('topics', value=['image']),
+        Parameter('use_sim_time', value=True)])
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(source)
+    executor.add_node(recorder)
+    file = tmp_path / 'bag' / 'bag.mcap'
+    pixels = bytes([201]) * 8
+    try:
+        _spin_until(executor, lambda: images.get_subscription_count() > 0, 30.0)
+        images.publish(Image(height=1, width=8, encoding='mono8', step=8, data=pixels))
+        _spin_until(executor, lambda: recorder.counts['image'] == 1, 30.0)
+        assert recorder.counts['image'] == 1
+        # no /clock: the simulated time stands still, the system's goes on
+        _spin_until(executor, lambda: pixels in file.read_bytes(), 15.0)
+        assert pixels in file.read_bytes()
+    finally:
+        executor.shutdown()
+        recorder.destroy_node()
+        source.destroy_node()
+
+
 def test_a_recorder_in_a_namespace_asks_its_node_there_and_the_replay_reads_it(context,
                                                                                tmp_path):
     """Review: under -r __ns:=/head1 the topics were /head1/..., the parameters asked of /."""

@@ -27,8 +27,9 @@ while recording), ``ground_truth``, the scene camera's ``walk_truth`` and the de
 subscribed to and stays empty. The ``pan_tilt`` and ``fixation`` subscriptions (transient local)
 take ROS's start-up QoS overrides, as the cameras' and the detector's do: ``-p
 qos_overrides./pan_tilt.subscription.durability:=volatile`` records a volatile teleop publisher.
-The chunk begun is written and synced every :data:`FLUSH_PERIOD_S`, so a recording cut off
-loses about a second at most: ``ipomdp-gaze reindex`` recovers the rest.
+The chunk begun is written and synced every :data:`FLUSH_PERIOD_S` (of the system's clock, also
+under ``use_sim_time``), so a recording cut off loses about a second at most: ``ipomdp-gaze
+reindex`` recovers the rest.
 
 The bag's ``custom_data`` (in ``metadata.yaml``) holds ``ipomdp_gaze/version`` (the package),
 ``ipomdp_gaze/parameters/<node>`` (every parameter of each node in ``nodes``, as YAML, fetched
@@ -62,6 +63,7 @@ from ipomdp_gaze.files.bag import MAX_BAG_DURATION_S, MAX_BAG_SIZE_MB
 from ipomdp_gaze.msg_adapters import diagnostics
 from rcl_interfaces.msg import ParameterEvent
 from rcl_interfaces.srv import GetParameters, ListParameters
+from rclpy.clock import Clock, ClockType
 from rclpy.exceptions import NameValidationException
 from rclpy.expand_topic_name import expand_topic_name
 from rclpy.node import Node
@@ -239,7 +241,10 @@ class RecorderNode(QuietPublishers, Node):
             else:
                 self.subscriptions_[topic] = self.create_subscription(
                     msg_type, topic, guard.wrap(self._writer_for(topic), 'write'), qos, raw=True)
-        self.create_timer(FLUSH_PERIOD_S, guard.wrap(self._flush, 'flush'))
+        # By the system's clock, as the messages' times: under use_sim_time a paused or slow
+        # simulation's clock would hold the chunk back.
+        self.create_timer(FLUSH_PERIOD_S, guard.wrap(self._flush, 'flush'),
+                          clock=Clock(clock_type=ClockType.STEADY_TIME))
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self.create_timer(values['diagnostics_period_s'], guard.wrap(self._publish_diagnostics))
         self.parameters: dict = {}
