@@ -187,3 +187,17 @@ def test_a_message_later_than_the_file_before_stays_open_for_is_still_read_in_ti
     assert [f['message_count'] for f in _meta(tmp_path / 'bag')['files']] == [1, 3]
     assert [(m.topic, m.time_ns) for m in bag.read_bag(tmp_path / 'bag').messages] == \
         sorted(late, key=lambda m: m[1])
+
+
+@pytest.mark.parametrize('limits', [{}, {'max_file_duration_ns': 1_000_000_000}],
+                         ids=['one file', 'split'])
+def test_a_flush_of_a_closed_bag_is_refused_as_a_write_is(tmp_path, limits):
+    """Review: one file's flush() raised AttributeError, a split bag's did nothing silently."""
+    from ipomdp_gaze.files.bag import open_writer
+    writer = open_writer(tmp_path / 'bag', **limits)
+    connection = writer.add_connection('/a', 'std_msgs/msg/Int32')
+    writer.write(connection, 0, _int32(0))
+    writer.flush()
+    writer.close()
+    with pytest.raises(ValueError, match='the bag is closed'):
+        writer.flush()

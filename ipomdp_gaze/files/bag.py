@@ -122,20 +122,22 @@ def open_writer(path, compression: str = '', max_file_bytes: int = 0,
         return add(topic, msgtype, typestore=store, **kw)
     writer.add_connection = add_connection
     writer.set_custom_data = lambda key, value: _keep_custom_data(writer, {key: value})
-    writer.flush = lambda: _flush(writer)
+    writer.flush = lambda: _flush(writer, path)
     return writer
 
 
-def _flush(writer) -> None:
+def _flush(writer, path) -> None:
     """
     Write a ``rosbags`` MCAP writer's chunk begun to the disk now (if it holds anything), synced.
 
     ``rosbags`` writes a chunk when it holds about 1 MiB: minutes of a low-rate topic, and the
     topics themselves (their channel records) go into the first. A recording cut off then
     loses all of it; closed early (a smaller chunk) it is a complete chunk that
-    :func:`reindex` recovers.
+    :func:`reindex` recovers. A closed writer (of the bag at ``path``) is refused (ValueError).
     """
     storage = writer.storage
+    if storage is None:
+        raise ValueError(f'{path}: the bag is closed')
     if storage.chunk.bio.tell():
         storage.close_chunk()
         os.fsync(storage.bio.fileno())
@@ -300,8 +302,10 @@ class SplitWriter:
 
     def flush(self) -> None:
         """Write the open files' chunks begun to the disk now, synced (as the single file's)."""
+        if not self._parts:
+            raise ValueError(f'{self.path}: the bag is closed')
         for part in self._parts:
-            _flush(part.writer)
+            _flush(part.writer, part.file)
 
     def _full(self, part: _Part, time_ns: int) -> bool:
         """Whether ``part`` is done before a message at ``time_ns``: its size or duration."""
