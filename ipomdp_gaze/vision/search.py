@@ -110,10 +110,11 @@ FAINT_SIDE = 4 / 3
 FAINT_LOOK_SCORE = 0.8
 # Haar's second opinion (docs/design.md section 11.4), find without --all with a scoring
 # detector (YuNet): when neither the ladder nor the faint look answered, the finest call's
-# SECOND_BOXES best boxes from SECOND_SCORE (below the detector's threshold), each at most
-# SECOND_SIDE of the image's shorter side, are shown to OpenCV's Haar face cascade in the crop
-# round each (half the box's side on each side, at the crop's own scale): a grouped Haar box of
-# SECOND_NEIGHBORS neighbours centred in the faint box answers there. YuNet, trained on camera
+# SECOND_BOXES best boxes from SECOND_SCORE (faint ones below the detector's threshold, and a
+# weak one from it that the enlarged look turned down), each at most SECOND_SIDE of the image's
+# shorter side, are shown to OpenCV's Haar face cascade in the crop round each (half the box's
+# side on each side, at the crop's own scale): a grouped Haar box of SECOND_NEIGHBORS
+# neighbours centred in the box answers there. YuNet, trained on camera
 # faces, leaves blurred or enlarged thumbnails a faint box that Haar's grey pattern sees.
 # Chosen on training material only (300 training scenes per task, seed 3, the 432 face-free
 # augmented images and the training photos), by the rule "no face-free image answered more,
