@@ -305,6 +305,9 @@ def test_a_fixation_counts_again_only_cells_a_window_read_afresh_saw():
     recorder = _Recorder(fovea)
     assert np.isnan(recorder.observe(GRID.index(2, 2)).values).all()
     assert not np.isnan(recorder.observe(GRID.index(10, 10)).values).all()
+    # nor are its boxes kept again for counting the faces (their support when boxes merge)
+    assert len(recorder.boxes[0]) == len(recorder.scores[0]) == 0
+    assert len(recorder.boxes[1]) == len(recorder.scores[1]) == 3     # one box per window
 
 
 def test_observe_validates_its_state_and_fixation():

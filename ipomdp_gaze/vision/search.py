@@ -631,8 +631,14 @@ class _Recorder:
         return self.sensor.fixation_cost(cell)
 
     def _keep(self, observation):
-        self.boxes.append(observation.boxes_px)
-        self.scores.append(observation.scores)
+        """Keep the boxes of the windows read afresh (a cached window's were kept when read)."""
+        boxes, scores = observation.boxes_px, observation.scores
+        cached = getattr(observation, 'from_cache', ())
+        if any(cached) and len(boxes):
+            fresh = ~np.asarray(cached, dtype=bool)[observation.window_index]
+            boxes, scores = boxes[fresh], scores[fresh]
+        self.boxes.append(boxes)
+        self.scores.append(scores)
 
     def scan(self):
         scan = self.sensor.fovea.scan()
