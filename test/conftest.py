@@ -251,6 +251,36 @@ def config_path(name: str) -> str:
     return str(config_file(name))
 
 
+def start_room(probe, nodes, seed: int, faces: int, node: str = 'gaze_controller') -> dict:
+    """
+    Start the rooms' three nodes (shipped pan/tilt configs, the rooms' overlays) on one room.
+
+    The controller first (dwell 0.3 s, no re-check), then the detector and the scene camera on
+    room 0 of ``seed`` with ``faces`` faces. Return the probe's records (``targets``,
+    ``cells``, ``done``, ``pan_tilt``) and the ``controller`` and ``detector`` processes.
+    """
+    from diagnostic_msgs.msg import DiagnosticStatus
+    from geometry_msgs.msg import PoseArray
+    from ipomdp_gaze.harness.watch import LATCHED
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float32MultiArray
+    rec = {'targets': probe.record(PoseArray, f'/{node}/targets', LATCHED),
+           'cells': probe.record(Float32MultiArray, f'/{node}/target_cells', LATCHED),
+           'done': probe.record(DiagnosticStatus, 'room_done', 10),
+           'pan_tilt': probe.record(JointState, 'pan_tilt', LATCHED, distinct_stamps=True)}
+    rec['controller'] = nodes.start('controller', [
+        '--params-file', config_path('faces_camera_controller.yaml'),
+        '--params-file', config_path('faces_camera_room_controller.yaml'),
+        '-p', 'room.dwell_s:=0.3', '-p', 'room.recheck_period_s:=0.0'])
+    assert wait_for(lambda: rec['pan_tilt'], 60), rec['controller'].output()
+    rec['detector'] = nodes.start('detector', [
+        '--params-file', config_path('faces_camera_detector.yaml'),
+        '--params-file', config_path('faces_camera_room_detector.yaml')])
+    nodes.start('scene_camera', ['--params-file', config_path('faces_camera_scene_camera.yaml'),
+                                 '-p', f'seed:={seed}', '-p', f"scene.faces:='{faces}'"])
+    return rec
+
+
 def people_controller_args(keep_probability: float, *extra: str) -> list[str]:
     """Return the arguments of a controller following moving people (``extra``: more ``-p``)."""
     return ['--params-file', config_path('controller.yaml'), '-p', 'search.targets:=many',

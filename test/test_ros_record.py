@@ -646,6 +646,34 @@ def test_a_write_that_fails_is_counted_and_survived_and_so_is_the_close(context,
         source.destroy_node()
 
 
+def _image_recorder(bag: Path, ros_env, probe):
+    """
+    Start ``ipomdp-gaze record BAG --topics image`` and the probe's image publisher.
+
+    Return the recorder's status values, the publisher, the process and its log, once it has
+    recorded the probe's parameters and subscribed to the images.
+    """
+    from ipomdp_gaze.harness.processes import wait_for
+    from ipomdp_gaze.nodes.recorder import TOPICS
+    from sensor_msgs.msg import Image
+    status = probe.status_values('recorder: recording')
+    images = probe.publisher(Image, 'image', TOPICS['image'][2])
+    log = bag.parent / 'recorder.log'
+    with open(log, 'wb') as out:
+        recorder = subprocess.Popen(
+            [sys.executable, '-m', 'ipomdp_gaze.cli', 'record', str(bag), '--topics', 'image',
+             '--ros-args', '-p', 'nodes:=[test_probe]', '-p', 'diagnostics_period_s:=0.2'],
+            cwd=REPO, env=ros_env, stdout=out, stderr=subprocess.STDOUT)
+    try:
+        assert wait_for(lambda: b'recorded the parameters of test_probe' in log.read_bytes()
+                        and images.get_subscription_count() > 0, 60), log.read_text()
+    except BaseException:
+        recorder.kill()
+        recorder.wait(30)
+        raise
+    return status, images, recorder, log
+
+
 def test_a_recorder_killed_mid_recording_is_reindexed_and_read_back(ros_env, tmp_path, probe):
     """
     The power lost or SIGKILL while recording: no metadata.yaml, the MCAP file unfinished.
@@ -658,22 +686,12 @@ def test_a_recorder_killed_mid_recording_is_reindexed_and_read_back(ros_env, tmp
     from ipomdp_gaze.files.bag import read_bag
     from ipomdp_gaze.files.share_files import package_version
     from ipomdp_gaze.harness.processes import wait_for
-    from ipomdp_gaze.nodes.recorder import TOPICS
     from sensor_msgs.msg import Image
     from std_msgs.msg import Header
     count, size = 40, 100_000
     bag = tmp_path / 'bag'
-    status = probe.status_values('recorder: recording')
-    images = probe.publisher(Image, 'image', TOPICS['image'][2])
-    log = tmp_path / 'recorder.log'
-    with open(log, 'wb') as out:
-        recorder = subprocess.Popen(
-            [sys.executable, '-m', 'ipomdp_gaze.cli', 'record', str(bag), '--topics', 'image',
-             '--ros-args', '-p', 'nodes:=[test_probe]', '-p', 'diagnostics_period_s:=0.2'],
-            cwd=REPO, env=ros_env, stdout=out, stderr=subprocess.STDOUT)
+    status, images, recorder, log = _image_recorder(bag, ros_env, probe)
     try:
-        assert wait_for(lambda: b'recorded the parameters of test_probe' in log.read_bytes()
-                        and images.get_subscription_count() > 0, 60), log.read_text()
         for i in range(count):      # reliable, a history of 50: every one is delivered
             images.publish(Image(height=1, width=size, encoding='mono8', step=size,
                                  data=bytes([i]) * size, header=Header(frame_id=str(i))))
@@ -719,21 +737,11 @@ def test_a_recorder_killed_a_few_seconds_in_keeps_its_few_small_messages(ros_env
     import signal
     from ipomdp_gaze.files.bag import read_bag
     from ipomdp_gaze.harness.processes import wait_for
-    from ipomdp_gaze.nodes.recorder import TOPICS
     from sensor_msgs.msg import Image
     from std_msgs.msg import Header
     bag = tmp_path / 'bag'
-    status = probe.status_values('recorder: recording')
-    images = probe.publisher(Image, 'image', TOPICS['image'][2])
-    log = tmp_path / 'recorder.log'
-    with open(log, 'wb') as out:
-        recorder = subprocess.Popen(
-            [sys.executable, '-m', 'ipomdp_gaze.cli', 'record', str(bag), '--topics', 'image',
-             '--ros-args', '-p', 'nodes:=[test_probe]', '-p', 'diagnostics_period_s:=0.2'],
-            cwd=REPO, env=ros_env, stdout=out, stderr=subprocess.STDOUT)
+    status, images, recorder, log = _image_recorder(bag, ros_env, probe)
     try:
-        assert wait_for(lambda: b'recorded the parameters of test_probe' in log.read_bytes()
-                        and images.get_subscription_count() > 0, 60), log.read_text()
         for i in range(5):
             images.publish(Image(height=1, width=8, encoding='mono8', step=8,
                                  data=bytes([200 + i]) * 8, header=Header(frame_id=str(i))))

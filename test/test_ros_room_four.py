@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 
-from conftest import config_path, wait_for
+from conftest import start_room, wait_for
 import pytest
 
 pytestmark = pytest.mark.ros
@@ -39,25 +39,7 @@ def offline():
 
 @pytest.fixture(scope='module')
 def rig(probe, nodes):
-    from diagnostic_msgs.msg import DiagnosticStatus
-    from geometry_msgs.msg import PoseArray
-    from ipomdp_gaze.harness.watch import LATCHED
-    from sensor_msgs.msg import JointState
-    from std_msgs.msg import Float32MultiArray
-    rec = {'targets': probe.record(PoseArray, f'/{NODE}/targets', LATCHED),
-           'cells': probe.record(Float32MultiArray, f'/{NODE}/target_cells', LATCHED),
-           'done': probe.record(DiagnosticStatus, 'room_done', 10),
-           'pan_tilt': probe.record(JointState, 'pan_tilt', LATCHED, distinct_stamps=True)}
-    rec['controller'] = nodes.start('controller', [
-        '--params-file', config_path('faces_camera_controller.yaml'),
-        '--params-file', config_path('faces_camera_room_controller.yaml'),
-        '-p', 'room.dwell_s:=0.3', '-p', 'room.recheck_period_s:=0.0'])
-    assert wait_for(lambda: rec['pan_tilt'], 60), rec['controller'].output()
-    nodes.start('detector', ['--params-file', config_path('faces_camera_detector.yaml'),
-                             '--params-file', config_path('faces_camera_room_detector.yaml')])
-    nodes.start('scene_camera', ['--params-file', config_path('faces_camera_scene_camera.yaml'),
-                                 '-p', f'seed:={SEED}', '-p', "scene.faces:='4'"])
-    return rec
+    return start_room(probe, nodes, SEED, 4)
 
 
 def test_four_people_corners_included_are_published_most_probable_first(rig, offline):

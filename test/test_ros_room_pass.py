@@ -12,7 +12,7 @@ those of the offline session on the same room and views (``drivers.rooms.room_se
 """
 from __future__ import annotations
 
-from conftest import config_path, wait_for
+from conftest import config_path, start_room, wait_for
 import pytest
 
 pytestmark = pytest.mark.ros
@@ -37,25 +37,7 @@ def offline():
 
 @pytest.fixture(scope='module')
 def rig(probe, nodes):
-    from diagnostic_msgs.msg import DiagnosticStatus
-    from ipomdp_gaze.harness.watch import LATCHED
-    from sensor_msgs.msg import JointState
-    from std_msgs.msg import Float32MultiArray
-    rec = {'cells': probe.record(Float32MultiArray, f'/{NODE}/target_cells', LATCHED),
-           'done': probe.record(DiagnosticStatus, 'room_done', 10),
-           'pan_tilt': probe.record(JointState, 'pan_tilt', LATCHED, distinct_stamps=True)}
-    rec['controller'] = nodes.start('controller', [
-        '--params-file', config_path('faces_camera_controller.yaml'),
-        '--params-file', config_path('faces_camera_room_controller.yaml'),
-        '-p', 'room.dwell_s:=0.3',
-        '-p', 'room.recheck_period_s:=0.0'])
-    assert wait_for(lambda: rec['pan_tilt'], 60), rec['controller'].output()
-    rec['detector'] = nodes.start('detector', [
-        '--params-file', config_path('faces_camera_detector.yaml'),
-        '--params-file', config_path('faces_camera_room_detector.yaml')])
-    nodes.start('scene_camera', ['--params-file', config_path('faces_camera_scene_camera.yaml'),
-                                 '-p', f'seed:={SEED}', '-p', "scene.faces:='2'"])
-    return rec
+    return start_room(probe, nodes, SEED, 2)
 
 
 def test_the_node_makes_one_pass_and_names_the_offline_sessions_people(rig, offline):
