@@ -129,7 +129,8 @@ class Misshapen:
         return {'short': np.array([[1.0, 2.0, 3.0]]),
                 'nan': np.array([[np.nan, 1, 5, 5, 0.5]]),
                 'negative': np.array([[10, 10, -5, 5, 0.5]]),
-                'complex': np.array([[1, 1, 5, 5]], complex), 'none': None}[self.mode]
+                'complex': np.array([[1, 1, 5, 5]], complex), 'none': None,
+                'empty short': np.empty((0, 3))}[self.mode]
 '''
 SIZE, CELLS, SQUARE = 84, 7, 14
 KINDS = {'module': 'blobdet:BlobDetector', 'entry point': 'blob'}
@@ -456,6 +457,7 @@ def test_a_plugin_entry_point_that_raises_as_it_loads_is_one_line_in_find(on_pat
     ('negative', 'every box must have a positive width and height'),
     ('complex', 'a detector must return real numbers, got complex ones'),
     ('none', 'got None (no return statement?)'),
+    ('empty short', 'boxes of shape (M, 5) x, y, w, h, score or (M, 4), got (0, 3)'),
 ])
 def test_a_plugins_malformed_answer_is_named_against_the_detector(on_path, mode, words):
     """Complex lost its imaginary part with a warning, None was "got ()"; none named it."""

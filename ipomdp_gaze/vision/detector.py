@@ -90,10 +90,13 @@ def as_detections(result) -> tuple[np.ndarray, np.ndarray]:
         raise ValueError('a detector must return real numbers, got complex ones')
     try:
         array = np.asarray(result, dtype=np.float64) if np.size(result) else np.empty((0, 5))
+        shape = np.shape(result)
     except (TypeError, ValueError):
         raise ValueError(f'a detector must return one array of boxes, (M, 5) x, y, w, h, score '
                          f'or (M, 4), got a {type(result).__name__} that is not one (boxes '
                          f'and scores apart?)') from None
+    if len(shape) == 2 and not array.size:
+        array = np.empty(shape)             # no box, but of the width it answers with
     if array.ndim != 2 or array.shape[1] not in (4, 5):
         raise ValueError(f'a detector must return boxes of shape (M, 5) x, y, w, h, score or '
                          f'(M, 4), got {array.shape}')
