@@ -42,6 +42,7 @@ Part of the core: numpy and OpenCV only; the policy is any object with ``select`
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+import functools
 import math
 import time
 
@@ -1226,10 +1227,10 @@ def _ladder_answer(found, strong_score: float, last: bool, keep_from: float = -m
     return found.grouped_px[int(np.argmax(inside))]
 
 
-def _crop_round(box, image_px) -> tuple[int, int, int, int]:
-    """Return the crop ``(x0, y0, x1, y1)`` round a box: its larger side on each side."""
+def _crop_round(box, image_px, reach: float = 1.0) -> tuple[int, int, int, int]:
+    """Return the crop ``(x0, y0, x1, y1)`` round a box: ``reach`` of its larger side each side."""
     x, y, w, h = box
-    side = max(w, h)
+    side = reach * max(w, h)
     return (int(max(0, x - side)), int(max(0, y - side)),
             int(min(image_px[0], x + w + side)), int(min(image_px[1], y + h + side)))
 
@@ -1267,15 +1268,11 @@ def _faint_box(found, threshold: float, max_side_px: float, floor: float = -math
     return boxes[small][int(np.argmax(scores[small]))] if small.any() else None
 
 
-_HAAR = []
-
-
+@functools.lru_cache(maxsize=1)
 def second_opinion_detector():
     """Return OpenCV's Haar face cascade (the package's ``haar`` kind), built once."""
-    if not _HAAR:
-        from ipomdp_gaze.vision.detectors import make_detector
-        _HAAR.append(make_detector('haar'))
-    return _HAAR[0]
+    from ipomdp_gaze.vision.detectors import make_detector
+    return make_detector('haar')
 
 
 def _second_opinion(image: np.ndarray, found, image_px: tuple[int, int], score: float,
@@ -1297,9 +1294,7 @@ def _second_opinion(image: np.ndarray, found, image_px: tuple[int, int], score: 
     pixels = 0
     for k in keep[np.argsort(-scores[keep], kind='stable')][:n_boxes]:
         x, y, w, h = boxes[k]
-        margin = max(w, h) / 2.0
-        x0, y0 = int(max(0.0, x - margin)), int(max(0.0, y - margin))
-        x1, y1 = int(min(width, x + w + margin)), int(min(height, y + h + margin))
+        x0, y0, x1, y1 = _crop_round(boxes[k], image_px, reach=0.5)
         if min(x1 - x0, y1 - y0) < window:
             continue
         look = scan(image[y0:y1, x0:x1], haar, (1, 1), 1.0, min_neighbors=neighbors)
