@@ -251,6 +251,21 @@ def config_path(name: str) -> str:
     return str(config_file(name))
 
 
+def offline_room(seed: int, faces: int):
+    """
+    Run the offline pass on room 0 of ``seed`` with ``faces`` faces, as the scene camera shows it.
+
+    Return the task, the session's outcome and its people (``drivers.rooms.room_session``).
+    """
+    from ipomdp_gaze.drivers.rooms import room_session
+    from ipomdp_gaze.drivers.scene_tasks import SceneTask, task_spec
+    spec = task_spec('pan-tilt', seed=seed, faces=faces)
+    task = SceneTask.get(spec)
+    task.sensor.start(task.scene(0).image)
+    _, outcome, _, people = room_session(spec, task, 0, 'pass-many-cells')
+    return task, outcome, people
+
+
 def start_room(probe, nodes, seed: int, faces: int, node: str = 'gaze_controller') -> dict:
     """
     Start the rooms' three nodes (shipped pan/tilt configs, the rooms' overlays) on one room.

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 
-from conftest import start_room, wait_for
+from conftest import offline_room, start_room, wait_for
 import pytest
 
 pytestmark = pytest.mark.ros
@@ -27,12 +27,7 @@ SEARCH_S = 240.0        # a generous limit for one search on a loaded machine, n
 @pytest.fixture(scope='module')
 def offline():
     """Run the offline pass on the room the scene camera shows: its people's cells."""
-    from ipomdp_gaze.drivers.rooms import room_session
-    from ipomdp_gaze.drivers.scene_tasks import SceneTask, task_spec
-    spec = task_spec('pan-tilt', seed=SEED, faces=4)
-    task = SceneTask.get(spec)
-    task.sensor.start(task.scene(0).image)
-    _, _, _, faces = room_session(spec, task, 0, 'pass-many-cells')
+    task, _, faces = offline_room(SEED, 4)
     truth = [tuple(int(v) for v in f.cell) for f in task.scene(0).faces]
     return {'people': sorted(f['cell'] for f in faces), 'truth': truth}
 

@@ -12,7 +12,7 @@ those of the offline session on the same room and views (``drivers.rooms.room_se
 """
 from __future__ import annotations
 
-from conftest import config_path, start_room, wait_for
+from conftest import config_path, offline_room, start_room, wait_for
 import pytest
 
 pytestmark = pytest.mark.ros
@@ -25,12 +25,7 @@ SEARCH_S = 240.0        # a generous limit for one search on a loaded machine, n
 @pytest.fixture(scope='module')
 def offline():
     """Run the offline pass on the room the scene camera shows: its path, its people's cells."""
-    from ipomdp_gaze.drivers.rooms import room_session
-    from ipomdp_gaze.drivers.scene_tasks import SceneTask, task_spec
-    spec = task_spec('pan-tilt', seed=SEED, faces=2)
-    task = SceneTask.get(spec)
-    task.sensor.start(task.scene(0).image)
-    session, outcome, _, faces = room_session(spec, task, 0, 'pass-many-cells')
+    task, outcome, faces = offline_room(SEED, 2)
     return {'path': [int(c) for c in outcome.path], 'people': sorted(f['cell'] for f in faces),
             'grouped': sum(bool(f.get('grouped')) for f in faces), 'poses': task.sweep.poses}
 
