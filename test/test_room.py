@@ -258,6 +258,16 @@ def test_a_late_dwell_tick_is_the_timers_last_tick():
     assert not room.dwell_tick(50.0 + 11.9)        # the tick at 10 s, the re-check's
 
 
+def test_a_clock_set_back_restarts_the_turns_and_the_recheck_at_the_new_now():
+    """QA: after /clock went back from 101 s to 50 s every tick was a turn, the re-check's too."""
+    room = RoomWatch(GRID)
+    room.start_turns(100.0, 1.0, 3.0)
+    assert room.dwell_tick(101.003)
+    room.restart_turns(50.0)                       # the node restarts both timers at 50 s
+    assert [room.dwell_tick(50.0 + k + 0.003) for k in (1, 2, 3, 4, 5, 6)] == \
+        [True, True, False, True, True, False]     # 53 s and 56 s: the re-check's
+
+
 def test_one_person_is_one_person_in_words():
     """QA: the log and room_done said '1 people found'."""
     from ipomdp_gaze.search.room import people_text

@@ -491,9 +491,30 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
         self._health = HealthMonitor(now_s, self.core.received, self.core.rejected)
         if self.core.enabled and not self.core.stopped and self._pan_tilt_msg is not None:
             self._send_target()     # stamped on the new clock (retry_period_s may be 0: never)
-        self.get_logger().info(f'the clock jumped {delta_s:+.3f} s: the search keeps its '
-                               f'belief and counts its times from the new clock',
-                               throttle_duration_sec=WARN_THROTTLE_S)
+        said = f'the clock jumped {delta_s:+.3f} s: the search keeps its belief and counts its ' \
+            'times from the new clock'
+        if delta_s < 0 and not switched and self._dwell_timer is not None:
+            self._restart_room_timers(now_s)
+            # a line of its own, throttled apart from the first tick's (a call site each)
+            self.get_logger().info(f"{said}; the room's turns and re-check start again now",
+                                   throttle_duration_sec=WARN_THROTTLE_S)
+        else:
+            self.get_logger().info(said, throttle_duration_sec=WARN_THROTTLE_S)
+
+    def _restart_room_timers(self, now_s: float) -> None:
+        """
+        Restart the dwell and re-check timers at ``now_s``, after the clock was set back.
+
+        rcl restarts a timer at the jump only if the clock went back past the timer's last
+        tick, and otherwise keeps its ticks (they come the jump's length late): the two timers
+        could tick out of step, and out of step with the turns' origin, which stayed in the
+        future (then every tick was a turn, the re-check's too). Here both timers and the origin
+        restart together; a timer restarts a whole period from now (``Timer.reset``).
+        """
+        self._room.restart_turns(now_s)
+        for timer in (self._dwell_timer, self._recheck_timer):
+            if timer is not None:
+                timer.reset()
 
     # -- outputs -------------------------------------------------------------------------
     def _send_target(self) -> None:

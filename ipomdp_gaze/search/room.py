@@ -13,7 +13,8 @@ farther than :data:`SAME_PERSON_CELLS` from every person known before are counte
 round goes on across a re-check: the people found again who had their turn in it wait for the
 others (new people included), so a re-check period shorter than a round starves nobody. A tick
 of the dwell timer at the moment the re-check starts is no turn (:meth:`RoomWatch.dwell_tick`):
-the head then gets one command, the search's. ``~/reset`` forgets everyone
+the head then gets one command, the search's. A clock set back restarts the turns and the
+re-check at the new now (:meth:`RoomWatch.restart_turns`). ``~/reset`` forgets everyone
 (:meth:`RoomWatch.forget`).
 
 Pure: no ROS, no clock (the node owns the timers); times are seconds.
@@ -194,6 +195,16 @@ class RoomWatch:
     def start_turns(self, now_s: float, dwell_s: float, recheck_period_s: float) -> None:
         """Start counting the dwell and re-check timers' ticks from ``now_s`` (period 0: none)."""
         self._start_s, self._dwell_s, self._recheck_period_s = now_s, dwell_s, recheck_period_s
+
+    def restart_turns(self, now_s: float) -> None:
+        """
+        Count the dwell and re-check timers' ticks from ``now_s`` (their periods unchanged).
+
+        For a clock set back (a simulator's reset, ``ros2 bag play --loop``): the node restarts
+        both timers at the new now, and their ticks are then counted from there, not from an
+        origin in the future (before it every tick was a turn, a re-check's moment too).
+        """
+        self._start_s = now_s
 
     def dwell_tick(self, now_s: float) -> bool:
         """
