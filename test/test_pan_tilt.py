@@ -96,6 +96,23 @@ def test_a_users_image_is_resized_to_the_scene_and_its_face_centre_scaled():
         user_scene(image, (500.0, 10.0), GEOMETRY)
 
 
+@pytest.mark.parametrize('width, height', [(400, 300), (200, 400)])
+def test_a_users_image_of_another_shape_is_fitted_to_the_scene_not_stretched(width, height):
+    """QA: a 4:3 photo was stretched to the 945x868 scene: its faces a fifth narrower."""
+    image = np.zeros((height, width, 3), np.uint8)
+    image[100:140, 150:190] = 255                         # a 40 px square, centre (170, 120)
+    scene = user_scene(image, (170.0, 120.0), GEOMETRY)
+    assert scene.image.shape == (868, 945, 3)
+    rows, cols = np.nonzero(scene.image[:, :, 0] > 200)
+    side_x, side_y = np.ptp(cols) + 1, np.ptp(rows) + 1
+    assert abs(side_x - side_y) <= 1                      # square, as in the photo
+    x, y = scene.face_centre_px
+    assert abs(x - (cols.min() + cols.max() + 1) / 2) <= 1
+    assert abs(y - (rows.min() + rows.max() + 1) / 2) <= 1
+    assert scene.cell == GEOMETRY.cell_of_point(x, y)
+    assert np.all(scene.image[0, 0] == 128)               # a band beside the photo
+
+
 class Boxes:
     """A detector that returns fixed boxes, whatever the image."""
 

@@ -529,6 +529,13 @@ def _pick(u: float, n: int) -> int:
     return min(int(u * n), n - 1)
 
 
+# A user's image whose aspect ratio is within this (relative) of the pan/tilt scene's is resized
+# to fill it (faces at most 2% narrower or wider, as calibrate --resize takes); another is fitted
+# inside, its aspect kept, on this grey.
+SCENE_ASPECT_TOL = 0.02
+SCENE_PAD_GREY = 128
+
+
 def read_scene_file(path) -> np.ndarray:
     """
     Read a user's scene image as ``uint8`` RGB ``(H, W, 3)`` (grey files are replicated).
@@ -554,13 +561,40 @@ def read_scene_file(path) -> np.ndarray:
     return cv2.cvtColor(image, cv2.COLOR_BGR2RGB)
 
 
+def _fit_scene(image: np.ndarray, centre, size: tuple[int, int]) -> tuple:
+    """Return ``image`` fitted to ``size`` (:func:`user_scene`) and ``centre`` mapped with it."""
+    height, width = image.shape[:2]
+    if (width, height) == size:
+        return image, centre
+    sx, sy = size[0] / width, size[1] / height
+    if abs(sx / sy - 1.0) <= SCENE_ASPECT_TOL:
+        fitted, (x0, y0) = cv2.resize(image, size, interpolation=cv2.INTER_AREA), (0, 0)
+    else:
+        scale = min(sx, sy)
+        inner = (max(1, round(width * scale)), max(1, round(height * scale)))
+        sx, sy = inner[0] / width, inner[1] / height
+        x0, y0 = (size[0] - inner[0]) // 2, (size[1] - inner[1]) // 2
+        fitted = np.full((size[1], size[0]) + image.shape[2:], SCENE_PAD_GREY, image.dtype)
+        fitted[y0:y0 + inner[1], x0:x0 + inner[0]] = cv2.resize(
+            image, inner, interpolation=cv2.INTER_AREA).reshape(
+                (inner[1], inner[0]) + image.shape[2:])
+    if centre is not None:
+        centre = (x0 + centre[0] * sx, y0 + centre[1] * sy)
+    return fitted, centre
+
+
 def user_scene(image: np.ndarray, face_centre_px, geometry: SceneGeometry | None = None,
                grid=None) -> Scene:
     """
-    Make a user's image a scene: for a pan/tilt ``geometry`` resized to its size, else as is.
+    Make a user's image a scene: for a pan/tilt ``geometry`` fitted to its size, else as is.
 
     ``face_centre_px`` ``(x, y)`` in the image's pixels (or None) gives the scene's ``cell``: on
     the pan/tilt grid of ``geometry``, or on ``grid`` ``(rows, cols)`` tiling the image.
+
+    An image of the scene's shape (within :data:`SCENE_ASPECT_TOL`) is resized to fill it; one
+    of another shape is scaled to fit inside it, its aspect kept, and centred on grey
+    (:data:`SCENE_PAD_GREY`): stretched to fill it, a 4:3 photo's faces came out a fifth
+    narrower than they are, and the detector's counts are for faces as they are.
 
     Raises
     ------
@@ -573,11 +607,7 @@ def user_scene(image: np.ndarray, face_centre_px, geometry: SceneGeometry | None
     if centre is not None and not (0 <= centre[0] < width and 0 <= centre[1] < height):
         raise ValueError(f'the face centre {centre} is outside the {width}x{height} image')
     if geometry is not None:
-        size = geometry.size_px
-        if (width, height) != size:
-            image = cv2.resize(image, size, interpolation=cv2.INTER_AREA)
-            if centre is not None:
-                centre = (centre[0] * size[0] / width, centre[1] * size[1] / height)
+        image, centre = _fit_scene(image, centre, geometry.size_px)
         cell = None if centre is None else geometry.cell_of_point(*centre)
     else:
         from ipomdp_gaze.vision.scenes import cell_of_point
