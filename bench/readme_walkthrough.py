@@ -50,15 +50,16 @@ COMMAND = re.compile(r'^(?:\$ |make\b|ipomdp-gaze\b|\.venv/bin/|ros2\b|colcon\b|
 # replay transcript's bag size, message count and seconds, and its growth rate (or, from a search
 # under 2 s of frames, the note that it is too short to extrapolate: which one depends on the
 # machine's speed); the frames a replay finds recorded (a frame that arrives after the decision is
-# recorded but not applied: the frames applied, the search's, are checked).
+# recorded but not applied: the frames applied, the search's, are checked). A count of one reads
+# '1 message', '1 frame' (ipomdp_gaze.model.wording): the masks take both forms.
 MASKS = [
     (re.compile(r'seconds=\d+\.\d+'), 'seconds=<time>'),
     (re.compile(r'head time \d+\.\d+ s \(detector \d+\.\d+ s per view\)'),
      'head time <time> s (detector <time> s per view)'),
     (re.compile(r'ROS domain \d+;'), 'ROS domain <N>;'),
-    (re.compile(r'\d+ messages, [\d.]+ MB, [\d.]+ s recorded; .*?; (package [\d.]+)$'),
+    (re.compile(r'\d+ messages?, [\d.]+ MB, [\d.]+ s recorded; .*?; (package [\d.]+)$'),
      r'N messages, M MB, S s recorded; RATE; \1'),
-    (re.compile(r'^\d+ frames recorded, (\d+) applied by the replay$'),
+    (re.compile(r'^\d+ frames? recorded, (\d+) applied by the replay$'),
      r'N frames recorded, \1 applied by the replay'),
 ]
 

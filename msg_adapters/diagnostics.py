@@ -17,6 +17,7 @@ them back into numbers.
 from __future__ import annotations
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.search import answer
 from ipomdp_gaze.search.room import people_text
 from std_msgs.msg import Header
@@ -94,8 +95,8 @@ def found_status(name: str, row: int, col: int, cell: int, pan_rad: float, tilt_
         ending['radius'] = int(radius)
     ending.update(_person(person))
     message = (f'{_who(person)} found at row {row}, col {col} (pan {pan_rad:+.4f} rad, tilt '
-               f'{tilt_rad:+.4f} rad) with probability {probability:.4f} after {fixations} '
-               f'fixations{clause}')
+               f'{tilt_rad:+.4f} rad) with probability {probability:.4f} after '
+               f'{counted(fixations, "fixation")}{clause}')
     return status(name, 'ok', message, {
         'row': row, 'col': col, 'cell': cell, 'pan_rad': float(pan_rad),
         'tilt_rad': float(tilt_rad), 'probability': float(probability), 'fixations': fixations,
@@ -107,14 +108,15 @@ def absent_status(name: str, probability: float, fixations: int, forced_by: str 
     """Build the ``absent`` event: ``P(absent)`` reached the confidence (or was forced)."""
     clause, ending = _ending(forced_by, confidence)
     message = (f'no target in the grid: probability {probability:.4f} that nobody is there '
-               f'after {fixations} fixations{clause}')
+               f'after {counted(fixations, "fixation")}{clause}')
     return status(name, 'ok', message, {'probability': float(probability),
                                         'fixations': fixations, **ending})
 
 
 def gave_up_status(name: str, fixations: int) -> DiagnosticStatus:
     """Build the ``gave_up`` event: the fixation budget ran out undecided (level WARN)."""
-    return status(name, 'warn', f'gave up undecided after {fixations} fixations (the budget)',
+    return status(name, 'warn',
+                  f'gave up undecided after {counted(fixations, "fixation")} (the budget)',
                   {'fixations': fixations})
 
 
@@ -125,7 +127,7 @@ def lost_status(name: str, row: int, col: int, cell: int, probability: float,
     shown, nobody = max(0.0, probability), max(0.0, absent_probability)   # never '-0.0000'
     message = (f'{_who(person)} lost: last found at row {row}, col {col}, tracked '
                f'{seconds_tracked:.2f} s; most likely cell now {shown:.4f}, nobody here '
-               f'{nobody:.4f} after {fixations} fixations')
+               f'{nobody:.4f} after {counted(fixations, "fixation")}')
     return status(name, 'warn', message, {
         'row': row, 'col': col, 'cell': cell, 'probability': float(probability),
         'absent_probability': float(absent_probability), 'fixations': fixations,
@@ -138,7 +140,7 @@ def reacquired_status(name: str, row: int, col: int, cell: int, pan_rad: float,
     """Build the ``reacquired`` event: found again ``seconds_lost`` after ``lost``."""
     message = (f'{_who(person)} reacquired at row {row}, col {col} (pan {pan_rad:+.4f} rad, tilt '
                f'{tilt_rad:+.4f} rad) with probability {probability:.4f}, {seconds_lost:.2f} s '
-               f'after it was lost, after {fixations} fixations')
+               f'after it was lost, after {counted(fixations, "fixation")}')
     return status(name, 'ok', message, {
         'row': row, 'col': col, 'cell': cell, 'pan_rad': float(pan_rad),
         'tilt_rad': float(tilt_rad), 'probability': float(probability), 'fixations': fixations,
@@ -158,7 +160,7 @@ def room_done_status(name: str, people: int, new_people: int, fixations: int, se
     clause, ending = _ending(forced_by, confidence)
     kind = 're-check' if recheck else 'search'
     message = (f'room done: {people_text(people)} found ({new_people} new) by {kind} {search_id} '
-               f'after {fixations} fixations{clause}')
+               f'after {counted(fixations, "fixation")}{clause}')
     return status(name, 'ok', message, {
         'people': int(people), 'new_people': int(new_people), 'fixations': int(fixations),
         'search_id': int(search_id), 'recheck': bool(recheck), **ending})

@@ -94,7 +94,7 @@ def test_search_prints_each_fixation(capsys):
     assert re.search(r'^fixation   1: looked at \(\d+, \d+\)  ->  most likely \(\d+, \d+\) p=',
                      out, re.M), out
     assert re.search(r'^found: the target is most likely at \(\d+, \d+\), probability '
-                     r'\d\.\d+, after \d+ fixations \(reached the confidence 0\.95\), which '
+                     r'\d\.\d+, after \d+ fixations? \(reached the confidence 0\.95\), which '
                      r'is (right|wrong)$', out, re.M), out
     assert main(['search', '--grid', '7x7', '--seed', '3', '--max-fixations', '2']) == 0
     last = capsys.readouterr().out.strip().splitlines()[-1]
@@ -223,7 +223,7 @@ def test_search_runs_a_target_absent_trial(capsys):
     lines = capsys.readouterr().out.strip().splitlines()
     assert lines[0] == 'no target: an empty 7x7 grid (a target-absent trial)'
     assert all('P(absent)=' in line for line in lines[1:-1])
-    assert re.fullmatch(r'absent: no target, P\(absent\) 0\.9\d\d, after \d+ fixations '
+    assert re.fullmatch(r'absent: no target, P\(absent\) 0\.9\d\d, after \d+ fixations? '
                         r'\(reached the confidence 0\.95\), which is right', lines[-1]), lines[-1]
     # With a target the same prior answers found (the seed's target), each line with P(absent).
     assert main(['search', '--grid', '7x7', '--seed', '3', '--absent-prior', '0.5']) == 0

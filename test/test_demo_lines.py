@@ -70,12 +70,12 @@ def test_a_forced_found_and_an_absent_answer_say_so():
     lines, _ = _follow(setup, _record(setup, [belief], [60], found=forced, truth=0))
     assert lines[-2].startswith('found, forced by the fixation budget: the face is most likely '
                                 'at (0, 0), ')
-    assert lines[-2].endswith('probability 0.620, after 1 fixations (below the confidence 0.99)')
+    assert lines[-2].endswith('probability 0.620, after 1 fixation (below the confidence 0.99)')
     absent = diagnostics.absent_status('c: absent', 0.7, 1, '', 0.99)
     lines, stats = _follow(setup, _record(setup, [belief], [60], absent=absent))
     assert '->  most likely' in lines[0] and 'nobody p=0.700' in lines[0]   # today: p=0.002 only
     assert lines[1] == ('absent: nobody is here, probability 0.700 that nobody is here, after 1 '
-                        'fixations (below the confidence 0.99)')
+                        'fixation (below the confidence 0.99)')
     assert stats['stop'] == 'absent' and stats['right']
 
 
@@ -87,12 +87,12 @@ def test_a_found_at_a_grouped_detection_says_so():
     belief = np.full(grid.n_cells, 0.3 / grid.n_cells)
     grouped = diagnostics.found_status('c: found', 4, 2, grid.index(4, 2), 0.0, 0.0, 0.41, 1,
                                        'group', 0.99)
-    assert grouped.message.endswith('after 1 fixations at a grouped detection of the detector')
+    assert grouped.message.endswith('after 1 fixation at a grouped detection of the detector')
     assert diagnostics.parse_found(grouped)['ended'] == 'group'
     lines, stats = _follow(setup, _record(setup, [belief], [60], found=grouped,
                                           truth=grid.index(4, 2)))
     assert lines[-2].startswith('found at a grouped detection: the face is at (4, 2), ')
-    assert lines[-2].endswith('probability 0.410, after 1 fixations (below the confidence 0.99)')
+    assert lines[-2].endswith('probability 0.410, after 1 fixation (below the confidence 0.99)')
     assert stats['stop'] == 'found' and stats['right']
 
 

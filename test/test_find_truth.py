@@ -232,7 +232,7 @@ def test_a_corrupt_png_is_our_one_line_only(images, tmp_path):
     assert result.returncode == 2
     assert result.stderr.splitlines() == [
         f'ipomdp-gaze find: error: {path}: not an image OpenCV can decode',
-        'ipomdp-gaze find: error: 1 of 1 inputs could not be searched']
+        'ipomdp-gaze find: error: 1 of 1 input could not be searched']
 
 
 @pytest.mark.parametrize('kind, message', [

@@ -295,7 +295,7 @@ def test_the_image_tasks_run_from_the_install(install, tmp_path):
     out = install.run(cli, 'evaluate', '--scenes', 'pan-tilt', '--episodes', '1',
                       '--max-fixations', '3', '--jobs', '1', '--quiet', cwd=tmp_path)
     assert out.returncode == 0, out.stdout + out.stderr
-    assert 'pan-tilt (1 scenes with a face): right' in out.stdout
+    assert 'pan-tilt (1 scene with a face): right' in out.stdout
     # The ensemble detector by its entry point, and its model (two cascades and YuNet) installed.
     out = install.run(install.python, '-c', 'from importlib.metadata import entry_points; '
                       "print(sorted(e.name for e in entry_points(group='ipomdp_gaze.detectors')));"
@@ -308,7 +308,7 @@ def test_the_image_tasks_run_from_the_install(install, tmp_path):
                       'faces-pan-tilt-ensemble', '--episodes', '1', '--max-fixations', '3',
                       '--jobs', '1', '--quiet', cwd=tmp_path)
     assert out.returncode == 0, out.stdout + out.stderr
-    assert 'pan-tilt (1 scenes with a face): right' in out.stdout
+    assert 'pan-tilt (1 scene with a face): right' in out.stdout
 
 
 def test_every_module_imports_from_the_install_and_bare_names_do_not(install, tmp_path):

@@ -91,6 +91,16 @@ def test_what_varies_is_masked_and_dots_stand_for_any_lines():
     assert walkthrough.contains(['b', '...', 'd'], ['a', 'b', 'c', 'd', 'e'])
 
 
+def test_the_masked_counts_match_a_count_of_one_in_the_singular():
+    shown = ['bag: 194 messages, 2.01 MB, 8.9 s recorded; 8 frames over 1.4 s; package 0.3.5',
+             '8 frames recorded, 1 applied by the replay']
+    printed = ['bag: 1 message, 0.01 MB, 0.2 s recorded; 1 frame over 0.0 s; package 0.3.5',
+               '1 frame recorded, 1 applied by the replay']
+    assert walkthrough.matches(shown, printed)
+    assert not walkthrough.matches(shown, printed[:1] + ['1 frame recorded, 0 applied by the '
+                                                         'replay'])
+
+
 def test_a_command_without_ros_or_your_files_is_run_with_this_checkout():
     assert 'ROS 2 install' in walkthrough.skip_reason('ros2 topic echo /found')
     assert 'ROS 2 install' in walkthrough.skip_reason('CFG=$(ros2 pkg prefix ipomdp_gaze)/x')

@@ -46,7 +46,7 @@ def test_demo_finds_the_target_and_stops_both_nodes(ros_env, options, grid_line)
                            r' +tilt +([-+]\d+\.\d+) deg +-> +most likely \((\d+), (\d+)\) '
                            r'p=(\d\.\d+) +entropy (\d+\.\d+) nats$', out, re.M)
     found = re.search(r'^found: the target is most likely at \((\d+), (\d+)\).* probability '
-                      r'(\d\.\d+), after (\d+) fixations \(reached the confidence 0\.95\)$',
+                      r'(\d\.\d+), after (\d+) fixations? \(reached the confidence 0\.95\)$',
                       out, re.M)
     assert fixations and found, out
     assert [int(f[0]) for f in fixations] == list(range(1, len(fixations) + 1))

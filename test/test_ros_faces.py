@@ -30,7 +30,7 @@ FIXATION = re.compile(r'^fixation +(\d+): looked at \((\d+), (\d+)\)  (.*)  ->  
 # detection with search.group_stop) and how it ended.
 FOUND = re.compile(r'^found(?:, forced by the fixation budget| at a grouped detection)?: the '
                    r'face is (?:most likely )?at '
-                   r'\((\d+), (\d+)\), (.*), probability (\d\.\d+), after (\d+) fixations '
+                   r'\((\d+), (\d+)\), (.*), probability (\d\.\d+), after (\d+) fixations? '
                    r'\((?:reached|below) the confidence 0\.99\)$', re.M)
 VERDICT = re.compile(r'^the scene camera put the face centre in cell \((\d+), (\d+)\): that is '
                      r'(right|wrong)$', re.M)
@@ -146,7 +146,7 @@ def test_on_a_scene_without_a_face_the_controller_says_absent(ros_env, demo):
     out = run.stdout
     assert run.returncode == 0, out + run.stderr
     absent = re.search(r'^absent(?:, forced by the fixation budget)?: nobody is here, '
-                       r'probability (\d\.\d+) that nobody is here, after (\d+) fixations '
+                       r'probability (\d\.\d+) that nobody is here, after (\d+) fixations? '
                        r'\((?:reached|below) the confidence 0\.99\)$', out, re.M)
     assert absent and 'found:' not in out, out
     assert int(absent.group(2)) == len(FIXATION.findall(out))

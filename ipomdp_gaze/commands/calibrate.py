@@ -35,6 +35,7 @@ import time
 
 from ipomdp_gaze.files.writable import write_figure
 from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.wording import counted
 import numpy as np
 
 from .common import check_output_file, grid_arg, nonneg_int, output_file, positive_float, \
@@ -432,7 +433,8 @@ def run_pan_tilt(args) -> int:
     plot_fpoc(model, plot, f'{args.out.stem}: {tallies.images} pan/tilt scenes, '
                            f'{grid.rows}x{grid.cols} grid of {grid.spacing_deg:g} deg, '
                            f'{width}x{height} camera, {hfov:.1f}x{vfov:.1f} deg view')
-    print(f'calibrated on {tallies.images} scenes ({tallies.fixations} views) in {wall:.1f} s')
+    print(f'calibrated on {counted(tallies.images, "scene")} '
+          f'({counted(tallies.fixations, "view")}) in {wall:.1f} s')
     print(f'ipomdp-gaze calibrate: wrote {args.out} and {plot}', file=sys.stderr)
     return 0
 
@@ -490,9 +492,10 @@ def run(args) -> int:
     save_observation(args.out, model)
     print(rate_table(model))
     plot = args.plot if args.plot is not None else args.out.with_suffix('.png')
-    plot_fpoc(model, plot, f'{args.out.stem}: {tallies.images} images of {width}x{height} px, '
+    plot_fpoc(model, plot, f'{args.out.stem}: {counted(tallies.images, "image")} of '
+                           f'{width}x{height} px, '
                            f'{grid.rows}x{grid.cols} grid, windows {list(config.windows_cells)}')
-    print(f'calibrated on {tallies.images} images ({tallies.fixations} fixations) in '
-          f'{wall:.1f} s')
+    print(f'calibrated on {counted(tallies.images, "image")} '
+          f'({counted(tallies.fixations, "fixation")}) in {wall:.1f} s')
     print(f'ipomdp-gaze calibrate: wrote {args.out} and {plot}', file=sys.stderr)
     return 0

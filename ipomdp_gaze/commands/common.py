@@ -14,6 +14,7 @@ from ipomdp_gaze.model.belief import prior_from_weights
 from ipomdp_gaze.model.fpoc import make_fpoc, MODELS, parameter_names
 from ipomdp_gaze.model.grid import Grid, parse_grid
 from ipomdp_gaze.model.observation import MATRIX_MAX_CELLS
+from ipomdp_gaze.model.wording import counted
 import numpy as np
 import yaml
 
@@ -333,7 +334,8 @@ def read_prior(path: Path, grid) -> np.ndarray:
             except ValueError:
                 raise ValueError(f'--prior {path}: not a number in {" ".join(line)!r}') from None
     if len(rows) != grid.rows or any(len(r) != grid.cols for r in rows):
-        shape = f'{len(rows)} lines of ' + '/'.join(sorted({str(len(r)) for r in rows}) or '0')
+        widths = '/'.join(sorted({str(len(r)) for r in rows}) or '0')
+        shape = f'{counted(len(rows), "line")} of {widths}'
         raise ValueError(f'--prior {path}: a {grid.rows}x{grid.cols} grid needs {grid.rows} '
                          f'lines of {grid.cols} weights, got {shape}')
     try:

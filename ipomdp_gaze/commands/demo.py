@@ -20,6 +20,7 @@ import sys
 
 from ipomdp_gaze.files.bag import check_new_bag
 from ipomdp_gaze.harness.processes import MAX_DOMAIN_ID, valid_domain_id
+from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.vision.pan_tilt import parse_faces
 from ipomdp_gaze.vision.walks import DURATION_S as DEMO_DURATION_S
 
@@ -201,7 +202,7 @@ def run(args) -> int:
             _note(f'wrote {args.plot}')
         if args.animate:
             count = save_gif(pictures, args.animate)
-            _note(f'wrote {args.animate} ({count} pictures)')
+            _note(f'wrote {args.animate} ({counted(count, "picture")})')
     return status
 
 

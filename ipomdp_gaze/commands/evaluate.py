@@ -28,6 +28,7 @@ from ipomdp_gaze.drivers.tracking import (evaluate_walks, format_walks, summaris
 from ipomdp_gaze.files.observation_file import fingerprint
 from ipomdp_gaze.model.motion import Motion
 from ipomdp_gaze.model.observation import as_observation, GaussianObservation
+from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.policies.policy_file import check_training_prior, load_policy_spec
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
 from ipomdp_gaze.search.session import SearchSettings
@@ -432,7 +433,7 @@ def _report_rooms(args, spec, results: dict, episodes: int) -> int:
     summary = {name: summarise_rooms(group) for name, group in results.items()}
     lo, hi = spec.faces
     count = f'{lo}' if lo == hi else f'{lo}-{hi}'
-    print(f'{args.scenes}: rooms of {count} faces, {args.split} scenes {args.seed}..'
+    print(f'{args.scenes}: rooms of {counted(count, "face")}, {args.split} scenes {args.seed}..'
           f'{args.seed + episodes - 1}, many-target settings '
           f'{room_settings(spec.settings).to_parameters()}')
     for name, s in summary.items():

@@ -113,6 +113,7 @@ from ipomdp_gaze.files import json_files
 from ipomdp_gaze.files.observation_file import load_observation, shipped_image_models
 from ipomdp_gaze.files.writable import write_text
 from ipomdp_gaze.model.belief import uniform_log_belief
+from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.policies.policy_file import default_policy_file
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES
 from ipomdp_gaze.search import answer
@@ -693,10 +694,10 @@ def plot_title(path: str, result, confidence: float, occupancy: bool = False,
     (:func:`nobody_text`).
     """
     name, p = Path(path).name, result.answer_probability
-    tail = f'{result.fixations} fixations ({result.stop})'
+    tail = f'{counted(result.fixations, "fixation")} ({result.stop})'
     nobody = occupancy and result.decision == 'absent' and not math.isnan(p)
     if faces is not None:
-        found = f'{name}: {faces} face{"" if faces == 1 else "s"}'
+        found = f'{name}: {counted(faces, "face")}'
         if faces and answer.forced(result.decision, result.stop):
             found += f' ({forced_faces_text(result, confidence)})'
         return f'{found} ({nobody_text(result, confidence)}), {tail}' if nobody else \
@@ -1236,5 +1237,5 @@ def run(args) -> int:
                                                   'images': entries}) + '\n',
                                 args.json, '--json')
     if failed:
-        _error(f'{failed} of {len(images)} inputs could not be searched')
+        _error(f'{failed} of {counted(len(images), "input")} could not be searched')
     return 2 if failed or unwritten else 0

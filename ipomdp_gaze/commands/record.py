@@ -17,6 +17,8 @@ import argparse
 import math
 from pathlib import Path
 
+from ipomdp_gaze.model.wording import counted
+
 from .search_args import add_search_args
 
 
@@ -130,7 +132,7 @@ def run_reindex(args) -> int:
     done = reindex(args.path, force=args.force)
     print(describe_written(args.path, 'rebuilt'))
     for name, count in done.recovered.items():
-        print(f'{name}: unfinished, {count} messages recovered')
+        print(f'{name}: unfinished, {counted(count, "message")} recovered')
     custom = done.info.get('custom_data') or {}
     nodes = sorted(k.split('/', 2)[2] for k in custom if k.startswith('ipomdp_gaze/parameters/'))
     print(f"package {custom.get('ipomdp_gaze/version', 'unknown')}; parameters of "
@@ -156,7 +158,8 @@ def describe_written(path: Path, verb: str = 'wrote') -> str:
     size = sum(f.stat().st_size for f in Path(path).iterdir() if f.is_file())
     topics = ', '.join(f'{topic} {n}' for topic, n in sorted(counts.items()) if n)
     files = len(info.get('relative_file_paths') or [])
-    return (f'{verb} {path}: {int(info.get("message_count", 0))} messages over {seconds:.1f} s, '
+    messages = counted(int(info.get('message_count', 0)), 'message')
+    return (f'{verb} {path}: {messages} over {seconds:.1f} s, '
             f'{size / 1e6:.2f} MB' + (f' in {files} files' if files > 1 else '')
             + (f' ({topics})' if topics else ''))
 
@@ -167,7 +170,7 @@ def run_replay(args) -> int:
     if not args.path.is_dir():
         raise ValueError(f'{args.path} is not a bag directory')
     bag = read_bag(args.path)
-    print(f'{args.path}: {len(bag.messages)} messages, {describe_size(bag)}; package '
+    print(f'{args.path}: {counted(len(bag.messages), "message")}, {describe_size(bag)}; package '
           f"{bag.custom_data.get('ipomdp_gaze/version', 'unknown')}")
     overrides = {'observation': args.observation, 'policy': args.policy,
                  'policy_file': args.policy_file, 'confidence': args.confidence,
@@ -187,7 +190,7 @@ def run_replay(args) -> int:
     print(describe_settings(bag, overrides, result=result))
     for line in result.lines:
         print(line)
-    print(f'{result.frames} frames recorded, {result.applied} applied by the replay')
+    print(f'{counted(result.frames, "frame")} recorded, {result.applied} applied by the replay')
     if result.stopped_early and bag.parameters('foveal_detector').get('mode') == 'fovea':
         print('the recording is of a fixed camera: --new-search runs a whole new search on '
               'its last image with these settings')

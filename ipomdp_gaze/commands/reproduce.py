@@ -20,6 +20,7 @@ import time
 from ipomdp_gaze.drivers.pieces import COSTLY_CHUNK, PieceCache, PLANNER_CHUNK, Runner
 from ipomdp_gaze.files.writable import write_text
 from ipomdp_gaze.model.fpoc import dprime_table
+from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.policies.baselines import make_baseline
 from ipomdp_gaze.policies.conv import radial_bins
 from ipomdp_gaze.policies.planner import make_planner, TemperedELM
@@ -137,8 +138,8 @@ def _curves(retrained: dict) -> dict | None:
 def _where(executor) -> str:
     """Where the pieces ran, for the log and the report: ``2 processes``, ``3 Dask workers``."""
     if hasattr(executor, 'client'):
-        return f'{executor.workers} Dask workers'
-    return f"{executor.workers} process{'es' if executor.workers > 1 else ''}"
+        return counted(executor.workers, 'Dask worker')
+    return counted(executor.workers, 'process', 'processes')
 
 
 def _fmt(point, ci):

@@ -8,6 +8,7 @@ import sys
 from ipomdp_gaze.files.writable import write_figure
 from ipomdp_gaze.model.belief import draw_cells
 from ipomdp_gaze.model.observation import as_observation
+from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.policies.registry import build_policy, NAMED_POLICIES
 from ipomdp_gaze.search import answer
 from ipomdp_gaze.search.sensors import ModelSensor
@@ -105,8 +106,8 @@ def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=
         clause = answer.confidence_clause(result.decision, result.reason,
                                           result.absent_probability, settings.confidence)
         out(f'{answer.heading(result.decision, result.reason)}: no target, P(absent) '
-            f'{result.absent_probability:.3f}, after {result.fixations} fixations{clause}, '
-            f'which is {right(result, True)}')
+            f'{result.absent_probability:.3f}, after {counted(result.fixations, "fixation")}'
+            f'{clause}, which is {right(result, True)}')
         return None, session.path, session.belief, result
     verdict = right(result, False)
     likeliest = f'the target is most likely at ({gr}, {gc}), probability ' \
@@ -118,16 +119,16 @@ def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=
                                       settings.confidence)
     if not result.decision:
         out(f'gave up: no cell reached the confidence {settings.confidence:.12g} after '
-            f'{result.fixations} fixations, the cap of an offline search without a budget '
-            f'({NO_BUDGET_FRAMES_PER_CELL} per cell); {likeliest}, which is {verdict}')
+            f'{counted(result.fixations, "fixation")}, the cap of an offline search without a '
+            f'budget ({NO_BUDGET_FRAMES_PER_CELL} per cell); {likeliest}, which is {verdict}')
     elif result.decision == 'gave_up':
         out(f'gave up: no cell reached the confidence {settings.confidence:.12g} at '
             f'{answer.LIMITS.get(result.reason, result.reason)}; {likeliest}, after '
-            f'{result.fixations} fixations, which is {verdict}')
+            f'{counted(result.fixations, "fixation")}, which is {verdict}')
     else:
         out(f'{answer.heading(result.decision, result.reason)}: the target is most likely at '
             f'({gr}, {gc}), probability {result.map_probability:.3f}, after '
-            f'{result.fixations} fixations{clause}, which is {verdict}')
+            f'{counted(result.fixations, "fixation")}{clause}, which is {verdict}')
     return guess, session.path, session.belief, result
 
 
@@ -195,7 +196,7 @@ def run(args) -> int:
         p = (f'P(absent)={result.absent_probability:.3f}' if result.decision == 'absent'
              else f'p={result.map_probability:.3f}')
         title = (f'{grid.rows}x{grid.cols}, {task}, {name}\n{ending}, '
-                 f'{p}, {len(path)} fixations '
+                 f'{p}, {counted(len(path), "fixation")} '
                  f"{'(no target)' if target is None else '(star = target)'}")
         plot_search(grid, belief, path, target, title, args.plot)
         print(f'ipomdp-gaze search: wrote {args.plot}', file=sys.stderr)

@@ -14,6 +14,7 @@ from pathlib import Path
 import sys
 
 from ipomdp_gaze.model.belief import prior_is_uniform
+from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.search.session import SearchSettings
 
 from .common import (add_prior_arg, add_task_args, check_output_file, nonneg_int, output_file,
@@ -304,7 +305,7 @@ def run(args) -> int:
         text = 'never' if f90 is None else f'{f90:.2f}'
         if ci:
             text += f' [{ci[0]:.2f}, {ci[1]:.2f}]'
-        print(f'fixations to 90% correct (argmax, {args.final_episodes} episodes, seed '
+        print(f'fixations to 90% correct (argmax, {counted(args.final_episodes, "episode")}, seed '
               f'{args.final_seed}): {text}')
         if evaluation.get('tracking_accuracy') is not None:
             ci = evaluation['tracking_accuracy_ci95']
@@ -369,11 +370,12 @@ def run_sweep(args, grid, model, config, params, init, out) -> int:
         value = f90 if evaluation else last
         if value is not None:
             spread.setdefault(rate, []).append(value)
-    measure = (f'final evaluation ({args.final_episodes} episodes, seed {args.final_seed})'
+    measure = (f'final evaluation ({counted(args.final_episodes, "episode")}, seed '
+               f'{args.final_seed})'
                if args.final_episodes else 'last learning-curve point')
     for rate, values in spread.items():
         v = np.asarray(values, dtype=float)
         sd = f'{v.std(ddof=1):.2f}' if v.size > 1 else '-'
-        print(f'lr {rate:g}: fixations to 90% by {measure} over {v.size} seeds: mean '
+        print(f'lr {rate:g}: fixations to 90% by {measure} over {counted(v.size, "seed")}: mean '
               f'{v.mean():.2f}, sd {sd}, range {v.min():.2f} to {v.max():.2f}')
     return 0

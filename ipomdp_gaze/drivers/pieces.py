@@ -25,6 +25,7 @@ import time
 
 from ipomdp_gaze.model.fpoc import dprime_matrix
 from ipomdp_gaze.model.observation import GaussianObservation
+from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.policies.greedy import expected_percent_correct_at
 from ipomdp_gaze.simulation.evaluation import (bootstrap_counts, fixations_to_90_ci,
                                                paired_difference_ci)
@@ -299,8 +300,9 @@ def _check_reached(name, correct):
     """
     final = float(correct[:, -1].mean())
     if final < REACHED:
-        raise RuntimeError(f'{name}: only {final:.1%} correct after {correct.shape[1]} fixations; '
-                           f'raise the horizon of this run')
+        raise RuntimeError(f'{name}: only {final:.1%} correct after '
+                           f'{counted(correct.shape[1], "fixation")}; raise the horizon of this '
+                           'run')
 
 
 def _simulate_piece(grid, model, policy, episodes, horizon, seed, rows, options):

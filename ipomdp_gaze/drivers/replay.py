@@ -34,6 +34,7 @@ from ipomdp_gaze.files.evidence_bytes import decode_evidence
 from ipomdp_gaze.model.belief import EvidenceError, is_reset_belief
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head import PanTiltMap
+from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.policies.registry import build_policy
 from ipomdp_gaze.search import answer
 from ipomdp_gaze.search.controller_config import build_config, ControllerConfig, \
@@ -96,7 +97,7 @@ class Decision:
         nobody = ' that nobody is here' if self.kind == 'absent' else ''
         p = f' p={self.probability:.3f}{nobody}' if self.probability is not None else ''
         return (f'{answer.heading(self.kind, self.forced_by)}{where}{p} after '
-                f'{self.fixations} fixations')
+                f'{counted(self.fixations, "fixation")}')
 
     def same(self, other: Decision) -> bool:
         """Whether both are the same decision (kind, cell and fixations)."""
@@ -132,7 +133,7 @@ class Event:
         who = f'person {self.person} ' if self.person else ''
         where = f' at {tuple(int(v) for v in grid.cell(self.cell))}' \
             if self.cell is not None else ''
-        return f'{who}{self.kind}{where} after {self.fixations} fixations'
+        return f'{who}{self.kind}{where} after {counted(self.fixations, "fixation")}'
 
 
 def in_firing_order(events: list) -> list:
@@ -659,7 +660,7 @@ def _people_text(events: list) -> str:
     counts = ', '.join(f'{k} {sum(e.kind == k for e in events)}' for k in EVENTS
                        if any(e.kind == k for e in events))
     people = len({e.person for e in events})
-    return f'{len(events)} events of {people} people ({counts})'
+    return f'{counted(len(events), "event")} of {counted(people, "person", "people")} ({counts})'
 
 
 def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
@@ -885,7 +886,7 @@ def describe_size(bag) -> str:
     if len(frames) < 2:
         rate = 'fewer than two frames'
     elif seconds < MIN_RATE_S or len(frames) < MIN_RATE_FRAMES:
-        rate = (f'{len(frames)} frames over {seconds:.1f} s: too short a search to '
+        rate = (f'{counted(len(frames), "frame")} over {seconds:.1f} s: too short a search to '
                 f'extrapolate MB per minute of search (at least {MIN_RATE_FRAMES} frames over '
                 f'{MIN_RATE_S:g} s); {bag.megabytes_per_minute:.1f} MB per minute of '
                 f'recording')
@@ -963,7 +964,7 @@ def new_search(bag, overrides: dict | None = None, out=print):
     if result.decision == 'gave_up':
         out(f'new search on the recorded image: gave up at '
             f'{answer.LIMITS.get(result.stop, result.stop)}; most likely {result.cell} '
-            f'p={result.probability:.3f} after {result.fixations} fixations')
+            f'p={result.probability:.3f} after {counted(result.fixations, "fixation")}')
     else:
         out(f'new search on the recorded image: {decision.describe(setup.fovea.grid)}')
     return result

@@ -50,6 +50,7 @@ from ipomdp_gaze.drivers.scene_report import scene_result, SceneResult
 from ipomdp_gaze.drivers.scene_tasks import compare_settings, ROOM_MODEL
 from ipomdp_gaze.drivers.sweep_rules import grouped_cells
 from ipomdp_gaze.model.occupancy import count_faces
+from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.search.many import OccupancySession
 from ipomdp_gaze.search.sensors import run_search
 from ipomdp_gaze.simulation.evaluation import cells_apart, match_faces, wilson_interval
@@ -247,14 +248,15 @@ def format_rooms(name: str, s: dict) -> list[str]:
     """Lines of the printed room report for one searcher."""
     recall = 'n/a' if s['recall'] is None else f"{s['recall']:.3f}"
     low, high = s['rooms_right_ci95']
-    lines = [f"{name} ({s['scenes']} rooms, {s['faces']} faces): recall {recall}, false faces "
+    lines = [f"{name} ({counted(s['scenes'], 'room')}, {counted(s['faces'], 'face')}): recall "
+             f'{recall}, false faces '
              f"{s['false_per_scene']:.3f} per room, rooms right {s['rooms_right']:.3f} "
              f"[{low:.3f}, {high:.3f}], done {s['rooms_done']:.3f} (done and right "
              f"{s['rooms_done_right']:.3f}), head time {s['head_time_s_mean']:.2f} s, fixations "
              f"mean {s['fixations_mean']:.2f} / p90 {s['fixations_p90']:.1f}"]
     lines.append('  per face count: ' + '; '.join(
-        f"{k}: {row['scenes']} rooms, right {row['right']}, found {row['found']}, false "
-        f"{row['false']}" for k, row in s['per_face_count'].items()))
+        f"{k}: {counted(row['scenes'], 'room')}, right {row['right']}, found {row['found']}, "
+        f"false {row['false']}" for k, row in s['per_face_count'].items()))
     return lines
 
 
@@ -277,7 +279,7 @@ def room_demo(faces, seed: int, out, max_fixations: int | None = None) -> int:
     grid = task.model.grid
     task.sensor.start(scene.image)
     out(f'the scene camera shows held-out room {seed} ({scene.background}, '
-        f'{len(scene.faces)} faces); the many-target pass runs offline on the detector '
+        f'{counted(len(scene.faces), "face")}); the many-target pass runs offline on the detector '
         f"node's views")
     session, outcome, _, found = room_session(spec, task, 0, 'pass-many-cells')
     for k, cell in enumerate(outcome.path, 1):
@@ -286,7 +288,7 @@ def room_demo(faces, seed: int, out, max_fixations: int | None = None) -> int:
             f'{math.degrees(pan):+.1f} deg tilt {math.degrees(tilt):+.1f} deg')
     how = outcome.decision or 'gave_up'
     out(f"{how}{f' ({outcome.reason})' if outcome.reason else ''} after "
-        f'{outcome.fixations} fixations: {len(found)} faces')
+        f'{counted(outcome.fixations, "fixation")}: {counted(len(found), "face")}')
     for i, face in enumerate(found, 1):
         out(f"face {i}: cell {tuple(int(v) for v in grid.cell(face['cell']))} p="
             f"{face['probability']:.3f}")
@@ -296,5 +298,5 @@ def room_demo(faces, seed: int, out, max_fixations: int | None = None) -> int:
     answers = [tuple(int(v) for v in grid.cell(f['cell'])) for f in found]
     n = match_faces(answers, truths)
     right = n == len(truths) and n == len(answers)
-    out(f"found {n} of {len(truths)} faces: that is {'right' if right else 'wrong'}")
+    out(f"found {n} of {counted(len(truths), 'face')}: that is {'right' if right else 'wrong'}")
     return 0 if right else 1

@@ -18,6 +18,7 @@ from pathlib import Path
 from ipomdp_gaze.files import json_files
 from ipomdp_gaze.files.writable import write_text
 from ipomdp_gaze.model.head_time import head_time_s, head_travel_deg
+from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.simulation.evaluation import answer_is_right, MIN_EPISODES, wilson_interval
 import numpy as np
 
@@ -181,7 +182,8 @@ def format_summary(spec, summary: dict, name: str = '') -> list[str]:
         low, high = s['right_ci95']
         what = 'with a face' if label == 'face' else 'empty'
         decisions = ', '.join(f'{k} {v}' for k, v in s['decisions'].items())
-        line = (f"{name or spec.task} ({s['scenes']} scenes {what}): right {s['right']:.3f} "
+        line = (f"{name or spec.task} ({counted(s['scenes'], 'scene')} {what}): right "
+                f"{s['right']:.3f} "
                 f"[{low:.3f}, {high:.3f}], fixations mean {s['fixations_mean']:.2f} / median "
                 f"{s['fixations_median']:.1f} / p90 {s['fixations_p90']:.1f}; {decisions}; "
                 f"detector pixels {s['detector_pixels_mean']:.0f} per search")
@@ -195,8 +197,8 @@ def format_summary(spec, summary: dict, name: str = '') -> list[str]:
             lines.append('  MAP right after 1..20 fixations: '
                          + ' '.join(f'{v:.2f}' for v in acc))
         for bg, row in s.get('per_background', {}).items():
-            lines.append(f"  {bg}: {row['scenes']} scenes, absent {row['absent']}, wrong found "
-                         f"{row['wrong_found']}")
+            lines.append(f"  {bg}: {counted(row['scenes'], 'scene')}, absent {row['absent']}, "
+                         f"wrong found {row['wrong_found']}")
     return lines
 
 

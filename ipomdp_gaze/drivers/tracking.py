@@ -36,6 +36,7 @@ from ipomdp_gaze.drivers.sweep_rules import group_cells
 from ipomdp_gaze.files.share_files import config_file
 from ipomdp_gaze.files.yaml_files import yaml_parameters
 from ipomdp_gaze.model.head_time import HEAD_SPEED_DEG_S, SACCADE_TIME_S, SETTLE_TIME_S
+from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.policies.registry import build_policy
 from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
 from ipomdp_gaze.search.settings import check_parameters
@@ -397,7 +398,7 @@ def format_walks(name: str, s: dict, reference: str = '') -> list[str]:
     for key in ('in_view', 'in_centre', 'reacquire_s'):
         diff = s.get(f'{key}_minus_reference')
         if diff:
-            lines.append(f'  {key} minus {reference} [paired 95%, {diff[3]} walks]: '
+            lines.append(f'  {key} minus {reference} [paired 95%, {counted(diff[3], "walk")}]: '
                          f'{diff[0]:+.3f} [{diff[1]:+.3f}, {diff[2]:+.3f}]')
     return lines
 

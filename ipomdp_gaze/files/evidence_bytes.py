@@ -13,6 +13,7 @@ the node read it live. No ROS types: only the message's fields.
 from __future__ import annotations
 
 from ipomdp_gaze.model.belief import EvidenceError
+from ipomdp_gaze.model.wording import counted
 import numpy as np
 
 # Evidence image encodings and their channels.
@@ -64,8 +65,8 @@ def decode_evidence(encoding: str, height: int, width: int, step: int, is_bigend
     row_bytes = 4 * channels * int(width)
     buf = data_bytes(data)
     if step < row_bytes or buf.size != step * height:
-        raise EvidenceError(f'evidence image has {buf.size} bytes, expected step {step} x '
-                            f'height {height} with step >= {row_bytes}')
+        raise EvidenceError(f'evidence image has {counted(buf.size, "byte")}, expected step '
+                            f'{step} x height {height} with step >= {row_bytes}')
     rows = buf.reshape(height, step)[:, :row_bytes]
     dtype = np.dtype('>f4' if is_bigendian else '<f4')
     cells = np.ascontiguousarray(rows).view(dtype).reshape(-1, channels).astype(np.float64)

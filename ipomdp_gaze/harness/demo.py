@@ -28,6 +28,7 @@ from ipomdp_gaze.harness.processes import domain_id_for, isolated_nodes
 from ipomdp_gaze.harness.watch import quiet_condition, SearchRecord, Watch
 from ipomdp_gaze.model.belief import entropy
 from ipomdp_gaze.model.head import PanTiltMap
+from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, joints
 from ipomdp_gaze.nodes import NODE_NAMES
 from ipomdp_gaze.nodes.params import joint_params
@@ -466,8 +467,8 @@ def _answer(setup: DemoSetup, row: int, col: int, cell: int, probability: float,
     else:
         pan, tilt = setup.head.angles(cell)
         place = f'pan {math.degrees(pan):+.2f} deg, tilt {math.degrees(tilt):+.2f} deg'
-    return (f'({row}, {col}), {place}, probability {probability:.3f}, after {fixations} '
-            f'fixations')
+    return (f'({row}, {col}), {place}, probability {probability:.3f}, after '
+            f'{counted(fixations, "fixation")}')
 
 
 def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
@@ -526,8 +527,8 @@ def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
         forced = words.reason_of(found['ended'])
         clause = words.confidence_clause('absent', forced, found['probability'], confidence)
         out(f"{words.heading('absent', forced)}: nobody is here, probability "
-            f"{found['probability']:.3f} that nobody is here, after {found['fixations']} "
-            f'fixations{clause}')
+            f"{found['probability']:.3f} that nobody is here, after "
+            f"{counted(found['fixations'], 'fixation')}{clause}")
     elif printed == 0:
         out(f'ipomdp-gaze demo: the {what} was not found within {timeout_s:g} s')
         return 1
@@ -538,7 +539,7 @@ def _follow(setup: DemoSetup, record: SearchRecord, wait, timeout_s: float, out,
         found = {'row': answer[0], 'col': answer[1], 'cell': cell, 'fixations': printed,
                  'probability': probability}
         stop = 'budget' if in_time else 'timeout'
-        why = f'after {max_fixations} fixations' if in_time else \
+        why = f'after {counted(max_fixations, "fixation")}' if in_time else \
             f'within {timeout_s:g} s'
         out(f'gave up: no cell reached the confidence {confidence:g} {why}; the {what} is '
             f'most likely at ' + _answer(setup, *answer, probability, printed))

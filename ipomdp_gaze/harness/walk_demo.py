@@ -26,6 +26,7 @@ from ipomdp_gaze.harness.demo import faces_setup
 from ipomdp_gaze.harness.processes import domain_id_for, isolated_nodes, NodeExited
 from ipomdp_gaze.harness.watch import LATCHED, Watch
 from ipomdp_gaze.model.head_camera import PinholeCamera
+from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.msg_adapters import grid_arrays, joints
 from ipomdp_gaze.vision.walks import DURATION_S
 from sensor_msgs.msg import JointState
@@ -196,7 +197,8 @@ def run_walk_demo(setup, camera, duration_s: float = DURATION_S, timeout_s: floa
         if plot is not None and frames:
             _plot(frames, events, truths, grid, plot, setup)
             (out if note is None else note)(f'wrote {plot}')
-        out(f'scored {score.in_reach} frames with the face in reach, of {score.frames} frames '
+        out(f'scored {counted(score.in_reach, "frame")} with the face in reach, of '
+            f'{counted(score.frames, "frame")} '
             f'({len(truths)} sent, {len(events["found"])} found events)')
         if walked and score.in_reach and clean:
             status = 0

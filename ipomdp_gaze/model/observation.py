@@ -28,6 +28,7 @@ import operator
 from ipomdp_gaze.model.belief import EvidenceError
 from ipomdp_gaze.model.fpoc import dprime_table, FPOC
 from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.wording import counted
 import numpy as np
 
 OVERFLOW_REASON = 'evidence too large: d * (o - d/2) overflows float64'
@@ -67,7 +68,7 @@ def check_evidence(observation, n_cells: int) -> np.ndarray:
     """
     obs = _numbers(observation)
     if obs.ndim != 1 or obs.size != n_cells:
-        raise EvidenceError(f'evidence has {obs.size} values in shape {obs.shape}, '
+        raise EvidenceError(f'evidence has {counted(obs.size, "value")} in shape {obs.shape}, '
                             f'expected {n_cells}: shape ({n_cells},), one per cell, row-major')
     if np.any(np.isinf(obs)):
         raise EvidenceError('evidence contains +/-inf')

@@ -52,6 +52,7 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import PoseArray
 from ipomdp_gaze.model.belief import EvidenceError, prior_is_uniform
 from ipomdp_gaze.model.head_time import SETTLE_TIME_S
+from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, people, stamps
 from ipomdp_gaze.policies.baselines import STRATEGIES
 from ipomdp_gaze.policies.conv import ACTIONS, check_kernel
@@ -627,7 +628,8 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
                 f'{answer.heading("found", found.forced_by)}: the target is '
                 f'{answer.where(found.forced_by)} '
                 f'({row}, {col}), pan {pan:+.4f} rad, tilt {tilt:+.4f} rad, probability '
-                f'{found.probability:.4f}, after {found.fixations} fixations{clause}{ending}')
+                f'{found.probability:.4f}, after {counted(found.fixations, "fixation")}'
+                f'{clause}{ending}')
         if result.absent is not None:
             absent = result.absent
             self._event_pubs['absent'].publish(diagnostics.absent_status(
@@ -637,8 +639,8 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
                                               confidence)
             self.get_logger().info(
                 f'{answer.heading("absent", absent.forced_by)}: nobody is here, probability '
-                f'{absent.probability:.4f} that nobody is here, after {absent.fixations} '
-                f'fixations{clause}{ending}')
+                f'{absent.probability:.4f} that nobody is here, after '
+                f'{counted(absent.fixations, "fixation")}{clause}{ending}')
         if result.lost is not None:
             lost = result.lost
             row, col = self._config.grid.cell(lost.cell)
@@ -661,8 +663,9 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
         if result.gave_up is not None:
             self._event_pubs['gave_up'].publish(diagnostics.gave_up_status(
                 f'{name}: gave_up', result.gave_up.fixations))
-            self.get_logger().warning(f'gave up: no decision after {result.gave_up.fixations} '
-                                      f'fixations (search.max_fixations){ending}')
+            self.get_logger().warning(f'gave up: no decision after '
+                                      f'{counted(result.gave_up.fixations, "fixation")} '
+                                      f'(search.max_fixations){ending}')
 
     def _publish_person_event(self, event) -> None:
         """Publish a person's found, lost or reacquired (moving many-target search)."""

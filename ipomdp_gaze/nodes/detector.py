@@ -45,6 +45,7 @@ import sys
 
 from diagnostic_msgs.msg import DiagnosticArray
 from ipomdp_gaze.model.head import PanTiltMap
+from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays, images, joints, stamps
 from ipomdp_gaze.search.controller_config import head_from
 from ipomdp_gaze.vision.detection import (build_setup, DetectorLoop, DetectorSetup, MAX_AGE_S,
@@ -370,8 +371,8 @@ class FovealDetectorNode(GuardedNode, QuietPublishers, Node):
             hint = (f'; are {self.resolve_topic_name("joint_states")} stamped like the images '
                     '(raise joint_state_tolerance_s to how far apart they are)?')
         elif reason.startswith('no image captured'):
-            hint = (f' ({self.loop.received} images received in all); is the camera publishing '
-                    f'on {self.resolve_topic_name("image")}'
+            hint = (f' ({counted(self.loop.received, "image")} received in all); is the camera '
+                    f'publishing on {self.resolve_topic_name("image")}'
                     + ('' if self.get_parameter('image_best_effort').value else
                        ' (a best-effort camera needs image_best_effort: true)') + '?')
         else:

@@ -60,6 +60,7 @@ import time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import PoseArray
 from ipomdp_gaze.files.bag import MAX_BAG_DURATION_S, MAX_BAG_SIZE_MB
+from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.msg_adapters import diagnostics
 from rcl_interfaces.msg import ParameterEvent
 from rcl_interfaces.srv import GetParameters, ListParameters
@@ -397,7 +398,7 @@ class RecorderNode(QuietPublishers, Node):
                 values[f'publishers_{name}'] = sub.get_publisher_count()
             values['parameters_of'] = ','.join(sorted(self.parameters))
             values.update(self.guard.values())
-            message = f'{sum(self.counts.values())} messages'
+            message = counted(sum(self.counts.values()), 'message')
             if self.guard.errors:
                 message += f'; {self.guard.errors} callback errors: {self.guard.last_error}'
             self._diag_pub.publish(diagnostics.diagnostic_array(

@@ -30,6 +30,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 from ipomdp_gaze.model.belief import prior_is_uniform
+from ipomdp_gaze.model.wording import counted
 
 MIN_PERIOD_S = 1e-9
 
@@ -88,7 +89,7 @@ def classify(enabled: bool, stall_timeout_s: float, seconds_without_evidence: fl
     """
     level, message, detail = 'ok', 'searching', ''
     ended = {'found': 'target found', 'absent': 'target absent',
-             'gave_up': f'gave up after {fixations} fixations'}
+             'gave_up': f'gave up after {counted(fixations, "fixation")}'}
     if not enabled:
         message = 'disabled'
     elif stopped:
@@ -98,7 +99,7 @@ def classify(enabled: bool, stall_timeout_s: float, seconds_without_evidence: fl
         if arrived == 0:
             detail = 'no frames arrive'
         else:
-            detail = f'{arrived} frames arrived, none usable'
+            detail = f'{counted(arrived, "frame")} arrived, none usable'
             if rejected:
                 detail += f'; last rejection: {last_rejection}'
     elif found:

@@ -24,6 +24,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 
+from ipomdp_gaze.model.wording import counted
+
 # A person found again within this many cells (Chebyshev) of a known one is that person (the
 # rooms' scoring tolerance, docs/design.md section 11.5).
 SAME_PERSON_CELLS = 1
@@ -41,7 +43,7 @@ SAME_MOMENT_S = 1e-6
 
 def people_text(count: int) -> str:
     """Return ``'1 person'`` or ``'<count> people'``, for logs and events."""
-    return f'{count} person' if count == 1 else f'{count} people'
+    return counted(count, 'person', 'people')
 
 
 def check_room_times(dwell_s: float, recheck_period_s: float) -> tuple[float, float]:
