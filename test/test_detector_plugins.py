@@ -60,6 +60,13 @@ class Fussy(BlobDetector):
         return super().__call__(rgb)
 
 
+class Grumpy(BlobDetector):
+    """Raises on every image."""
+
+    def __call__(self, rgb):
+        raise RuntimeError('not today')
+
+
 class Forgetful(BlobDetector):
     """Its settings() leave out the option it was built with."""
 
@@ -393,6 +400,40 @@ def test_a_detector_that_fails_on_one_image_is_reported_against_it(on_path, tmp_
     bad_entry, good_entry = json.loads(out.read_text())['images']
     assert bad_entry['error'].startswith('the detector blobdet:Fussy raised')
     assert good_entry['cell'] == [2, 4]
+
+
+@pytest.mark.parametrize('processes', ['1', '2'])
+def test_calibrate_names_the_image_a_plugin_fails_on(on_path, tmp_path, capsys, processes):
+    """QA: the one error line named the detector but not which of the images it failed on."""
+    labels = labelled_folder(tmp_path / 'images', n=4)
+    bad = tmp_path / 'images' / '2.png'
+    image = cv2.imread(str(bad))
+    image[0, 0] = 255                                   # Fussy raises on a white pixel
+    cv2.imwrite(str(bad), image)
+    out = tmp_path / 'x.yaml'
+    capsys.readouterr()
+    rc = cli(['calibrate', '--images', str(tmp_path / 'images'), '--labels', str(labels),
+              '--grid', f'{CELLS}x{CELLS}', '--windows', f'{CELLS},3', '--max-count', '4',
+              '--detector', 'blobdet:Fussy', '--processes', processes, '--quiet', '--out',
+              str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and not out.exists()
+    assert err == [f'ipomdp-gaze calibrate: error: {bad}: the detector blobdet:Fussy raised '
+                   'RuntimeError: cannot handle this one']
+
+
+@pytest.mark.parametrize('task, where', [
+    ([], 'training scene 0 (seed 3)'),
+    (['--pan-tilt'], 'pan/tilt training scene 0 (seed 3): the view at cell (0, 0)')])
+def test_calibrate_names_the_scene_a_plugin_fails_on(on_path, tmp_path, capsys, task, where):
+    out = tmp_path / 'x.yaml'
+    capsys.readouterr()
+    rc = cli(['calibrate', *task, '--scenes', '2', '--seed', '3', '--detector', 'blobdet:Grumpy',
+              '--processes', '1', '--quiet', '--out', str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and not out.exists()
+    assert err == [f'ipomdp-gaze calibrate: error: {where}: the detector blobdet:Grumpy raised '
+                   'RuntimeError: not today']
 
 
 def test_a_plugin_that_fails_to_load_or_refuses_an_option_is_named(on_path):

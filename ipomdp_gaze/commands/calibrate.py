@@ -165,7 +165,13 @@ def add_parser(sub):
 
 
 def _items(args, grid: Grid):
-    """Labelled items for the workers and the image size they share."""
+    """
+    Labelled items for the workers, the image size they share, their source and their names.
+
+    The names (each image's file as the label CSV gives it, under ``--images``; None for
+    ``--scenes``, whose scenes are named by index and seed) are what a failure is reported
+    against.
+    """
     if args.scenes is not None:
         if args.labels is not None:
             raise ValueError('--labels goes with --images, not --scenes')
@@ -174,16 +180,16 @@ def _items(args, grid: Grid):
                   'absent_rate': args.absent_rate, 'seed': args.seed}
         from ipomdp_gaze.vision.scenes import SceneSet
         SceneSet(**kwargs)                                   # validate before the workers
-        return [('scene', kwargs, i) for i in range(args.scenes)], (size, size), kwargs
+        return [('scene', kwargs, i) for i in range(args.scenes)], (size, size), kwargs, None
     if args.labels is None:
         raise ValueError('--images needs --labels CSV')
     from ipomdp_gaze.vision.scenes import cell_of_point, labelled_names, read_labelled_folder
     labelled = read_labelled_folder(args.images, args.labels)
     if not labelled:
         raise ValueError(f'{args.labels} lists no images')
+    entries = labelled_names(args.images, args.labels)
     if args.resize is not None:
-        labelled = resize_labelled(labelled, args.resize,
-                                   names=labelled_names(args.images, args.labels))
+        labelled = resize_labelled(labelled, args.resize, names=entries)
     shapes = {item.image.shape[:2] for item in labelled}
     if len(shapes) > 1:
         raise ValueError(f'images must share one size to calibrate one model, got '
@@ -200,7 +206,7 @@ def _items(args, grid: Grid):
     source = {'images': str(args.images), 'labels': str(args.labels)}
     if args.resize is not None:
         source['resize'] = list(args.resize)
-    return items, shape, source
+    return items, shape, source, [str(Path(args.images) / entry) for entry in entries]
 
 
 def resize_labelled(labelled, size_px: tuple[int, int], tolerance: float = RESIZE_ASPECT_TOL,
@@ -460,7 +466,7 @@ def run(args) -> int:
                          scan_once=args.scan_once)
     detector_kwargs, detector = _detector(args)
     Fovea(detector, grid, config)        # refuses a bad configuration before any work
-    items, (height, width), source = _items(args, grid)
+    items, (height, width), source, names = _items(args, grid)
     start = time.perf_counter()
     fixations = None if args.fixation_stride == 1 else \
         lattice_fixations(grid, args.fixation_stride)
@@ -469,11 +475,12 @@ def run(args) -> int:
         if args.cells != 'counts':
             cells = _cell_rule(args, lambda rule: tally_images(
                 items[:args.edge_images], detector_kwargs, grid, config, fixations=fixations,
-                executor=executor))
+                executor=executor, names=None if names is None else names[:args.edge_images]))
             config = dataclasses.replace(config, max_count=cells.max_count)
         with progress_from_args(args, len(items), 'calibrate', 'image') as bar:
             tallies = tally_images(items, detector_kwargs, grid, config, progress=bar.update,
-                                   fixations=fixations, executor=executor, cells=cells)
+                                   fixations=fixations, executor=executor, cells=cells,
+                                   names=names)
     wall = time.perf_counter() - start
     meta = {'image': {'width': int(width), 'height': int(height)}, 'fovea': config.to_dict(),
             'detector': detector_settings(detector),

@@ -33,11 +33,13 @@ which :func:`choose_edges` picks the bins of a ``score_bins`` rule on training d
 """
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 from ipomdp_gaze.model.cell_observation import CellObservation, quantile_edges
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.observation import CountObservation
+from ipomdp_gaze.vision.detector import DetectorFailed
 from ipomdp_gaze.vision.detectors import detector_from_spec
 from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig
 import numpy as np
@@ -166,15 +168,32 @@ def _worker_tally(job) -> Tallies:
     """Tally a chunk of images in a worker process (its own detector and fovea)."""
     import cv2
     cv2.setNumThreads(1)
-    detector_spec, grid_shape, config, items, fixations, cells = job
+    detector_spec, grid_shape, config, items, fixations, cells, names = job
     config = FoveaConfig.from_dict(config)
     fovea = Fovea(detector_from_spec(detector_spec), grid_shape, config, reuse_windows=True,
                   cells=_cells(cells, config.max_count))
     total = Tallies.empty(fovea.grid, fovea.config.max_count)
-    for item in items:
+    for item, name in zip(items, names):
         image, target = _resolve(item)
-        total += tally_image(fovea, image, target, fixations)
+        with _failing_on(name):
+            total += tally_image(fovea, image, target, fixations)
     return total
+
+
+@contextmanager
+def _failing_on(name: str):
+    """Name the image or scene a plug-in detector failed on (its error named only itself)."""
+    try:
+        yield
+    except DetectorFailed as exc:
+        raise DetectorFailed(f'{name}: {exc}') from None
+
+
+def item_name(item, index: int) -> str:
+    """Name item ``index`` of :func:`tally_images` when no name is given: its scene or number."""
+    if _is_scene(item):
+        return f"training scene {item[2]} (seed {item[1]['seed']})"
+    return f'image {index + 1}'
 
 
 def lattice_fixations(grid: Grid, stride: int) -> np.ndarray:
@@ -223,9 +242,13 @@ def choose_group_edges(tallies: Tallies, max_count: int, min_neighbors: int,
                            min_neighbors=min_neighbors, raw_levels=raw_levels)
 
 
+def _is_scene(item) -> bool:
+    return len(item) == 3 and isinstance(item[0], str) and item[0] == 'scene'
+
+
 def _resolve(item):
     """Return ``(image, target_cell)`` of an item, regenerating ``('scene', kwargs, i)``."""
-    if len(item) == 3 and isinstance(item[0], str) and item[0] == 'scene':
+    if _is_scene(item):
         from ipomdp_gaze.vision.scenes import SceneSet
         scene = SceneSet(**item[1]).scene(item[2])
         if scene.cell is None:
@@ -268,7 +291,7 @@ def _run_jobs(worker, jobs: list, total: Tallies, processes: int, progress,
 
 def tally_images(items, detector_kwargs: dict, grid: Grid, config: FoveaConfig,
                  processes: int = 2, progress=None, fixations=None, executor=None,
-                 cells: CellObservation | None = None) -> Tallies:
+                 cells: CellObservation | None = None, names=None) -> Tallies:
     """
     Tally many labelled images, spread over ``processes`` worker processes.
 
@@ -294,14 +317,21 @@ def tally_images(items, detector_kwargs: dict, grid: Grid, config: FoveaConfig,
         depend on it.
     cells : CellObservation, optional
         What a cell's observation is (default: the clipped count); its K is the fovea's.
+    names : list of str, optional
+        Each item's name (its file) for the one error line of a plug-in detector that fails on
+        it (:class:`~ipomdp_gaze.vision.detector.DetectorFailed`); default :func:`item_name`.
 
     """
+    if names is None:
+        names = [item_name(item, i) for i, item in enumerate(items)]
+    if len(names) != len(items):
+        raise ValueError(f'{len(names)} names for {len(items)} items')
     total = Tallies.empty(grid, config.max_count)
     workers = processes if executor is None else executor.workers
     chunk = max(1, min(8, len(items) // max(1, 4 * workers)))
     rule = None if cells is None else cells.to_dict()
     jobs = [(dict(detector_kwargs), grid.shape, config.to_dict(), items[i:i + chunk], fixations,
-             rule) for i in range(0, len(items), chunk)]
+             rule, list(names[i:i + chunk])) for i in range(0, len(items), chunk)]
     return _run_jobs(_worker_tally, jobs, total, processes, progress, executor)
 
 
@@ -322,7 +352,8 @@ def tally_views(observer, geometry, scene_image: np.ndarray, target_cell: int | 
     pixels, seconds, scores = 0, 0.0, [np.empty(0)]
     for i, k in enumerate(fixations):
         view = geometry.render(scene_image, grid.cell(int(k)))
-        observation = observer.observe(view, geometry.camera, grid.cell(int(k)))
+        with _failing_on(f'the view at cell {tuple(int(v) for v in grid.cell(int(k)))}'):
+            observation = observer.observe(view, geometry.camera, grid.cell(int(k)))
         frames[i] = observation.counts
         pixels += observation.detector_pixels
         seconds += observation.seconds
@@ -355,12 +386,13 @@ def _worker_tally_views(job) -> Tallies:
     for index in indices:
         scene = scenes.scene(index)
         target = grid.index(*scene.cell)
-        if index < null_scenes:
-            total += tally_views(observer, geometry, scene.image, target)
-            continue
-        sees = [k for k in poses
-                if observed_cells(geometry.camera, grid, grid.cell(int(k)))[target]]
-        part = tally_views(observer, geometry, scene.image, target, sees)
+        with _failing_on(f'pan/tilt training scene {index} (seed {scenes.seed})'):
+            if index < null_scenes:
+                total += tally_views(observer, geometry, scene.image, target)
+                continue
+            sees = [k for k in poses
+                    if observed_cells(geometry.camera, grid, grid.cell(int(k)))[target]]
+            part = tally_views(observer, geometry, scene.image, target, sees)
         part.null[...] = 0
         total += part
     return total
