@@ -201,3 +201,60 @@ def test_a_flush_of_a_closed_bag_is_refused_as_a_write_is(tmp_path, limits):
     writer.close()
     with pytest.raises(ValueError, match='the bag is closed'):
         writer.flush()
+
+
+@pytest.mark.parametrize('limits, name', [({}, 'bag.mcap'),
+                                          ({'max_file_duration_ns': 1_000_000_000}, 'bag_0.mcap')],
+                         ids=['one file', 'split'])
+def test_a_hand_off_is_synced_without_the_writer_even_once_it_is_closed(tmp_path, monkeypatch,
+                                                                        limits, name):
+    """
+    The recorder syncs outside its lock what hand_off() gave the system (its flush held the lock).
+
+    The bytes are in the file at the hand-off; the sync, after the writer closed (the file
+    moved, for a split bag), syncs that file through a duplicate descriptor, then closes it.
+    """
+    import os
+    from ipomdp_gaze.files.bag import open_writer, read_bag
+    writer = open_writer(tmp_path / 'bag', **limits)
+    connection = writer.add_connection('/a', 'std_msgs/msg/Int32')
+    writer.write(connection, 5, _int32(1234567))
+    pending = writer.hand_off()
+    file = next((tmp_path / 'bag').rglob('*.mcap'))
+    assert _int32(1234567) in file.read_bytes()             # the system has it already
+    writer.close()
+    synced, real_fsync = [], os.fsync
+
+    def fsync(fd):
+        synced.append(os.fstat(fd).st_ino)
+        real_fsync(fd)
+    monkeypatch.setattr(os, 'fsync', fsync)
+    pending.sync()
+    assert synced == [(tmp_path / 'bag' / name).stat().st_ino]
+    pending.sync()                                          # done: nothing left to sync
+    assert len(synced) == 1
+    assert [m.time_ns for m in read_bag(tmp_path / 'bag').messages] == [5]
+    with pytest.raises(ValueError, match='the bag is closed'):
+        writer.hand_off()
+
+
+def test_a_hand_off_closes_its_duplicates_also_when_fsync_fails(tmp_path, monkeypatch):
+    import os
+    from ipomdp_gaze.files.bag import open_writer
+    writer = open_writer(tmp_path / 'bag')
+    connection = writer.add_connection('/a', 'std_msgs/msg/Int32')
+    writer.hand_off().sync()                                # the topic's records
+    assert writer.hand_off()._fds == []                    # nothing begun: nothing to sync
+    writer.write(connection, 5, _int32(1))
+    pending = writer.hand_off()
+    fds = list(pending._fds)
+    assert len(fds) == 1 and fds[0] != writer.storage.bio.fileno()
+
+    def failing_fsync(fd):
+        raise OSError(5, 'Input/output error')
+    monkeypatch.setattr(os, 'fsync', failing_fsync)
+    with pytest.raises(OSError, match='Input/output error'):
+        pending.sync()
+    with pytest.raises(OSError):                            # closed although fsync failed
+        os.fstat(fds[0])
+    writer.close()

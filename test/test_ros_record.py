@@ -513,6 +513,63 @@ def test_the_recorder_flushes_by_the_system_clock_under_use_sim_time(context, tm
         source.destroy_node()
 
 
+def test_a_message_is_written_while_the_flush_waits_for_the_disk(context, tmp_path,
+                                                                 monkeypatch):
+    """
+    Review: the flush held the bag's lock through fsync, so on slow storage every write waited.
+
+    fsync is made to wait for the test: a message written meanwhile from another thread must
+    go in before it is released (the timeouts are a safety net only, nothing is timed).
+    """
+    import os
+    import threading
+    from ipomdp_gaze.files.bag import read_bag
+    from ipomdp_gaze.nodes.recorder import RecorderNode
+    from rclpy.parameter import Parameter
+    from rclpy.serialization import serialize_message
+    from sensor_msgs.msg import Image
+    recorder = RecorderNode(context=context, parameter_overrides=[
+        Parameter('path', value=str(tmp_path / 'bag')), Parameter('topics', value=['image'])])
+    write = recorder._writer_for('image')
+    first, second = bytes([201]) * 8, bytes([202]) * 8
+    entered, release, wrote = threading.Event(), threading.Event(), threading.Event()
+    in_file, real_fsync = [], os.fsync
+
+    def waiting_fsync(fd):
+        in_file.append(first in (tmp_path / 'bag' / 'bag.mcap').read_bytes())
+        entered.set()
+        assert release.wait(60), 'the test never released fsync'
+        real_fsync(fd)
+
+    def image(pixels):
+        return serialize_message(Image(height=1, width=8, encoding='mono8', step=8, data=pixels))
+
+    def write_second():
+        write(image(second))
+        wrote.set()
+    try:
+        write(image(first))
+        monkeypatch.setattr(os, 'fsync', waiting_fsync)
+        flusher = threading.Thread(target=recorder._flush)
+        flusher.start()
+        assert entered.wait(30)
+        assert in_file == [True]            # handed to the system before fsync began
+        writer = threading.Thread(target=write_second)
+        writer.start()
+        assert wrote.wait(20), 'the write waited for fsync'
+        assert flusher.is_alive() and not release.is_set()      # fsync still under way
+        release.set()
+        flusher.join(30)
+        writer.join(30)
+        assert not flusher.is_alive() and recorder.counts['image'] == 2
+    finally:
+        release.set()
+        monkeypatch.undo()
+        recorder.destroy_node()
+    assert [bytes(m.msg.data) for m in read_bag(tmp_path / 'bag').topic('image')] == \
+        [first, second]
+
+
 def test_a_recorder_in_a_namespace_asks_its_node_there_and_the_replay_reads_it(context,
                                                                                tmp_path):
     """Review: under -r __ns:=/head1 the topics were /head1/..., the parameters asked of /."""

@@ -14,7 +14,9 @@ read it); :func:`read_bag` returns every message of every file in time order, de
 hashes of the files they name. The custom data also goes into the MCAP file being written, as a
 metadata record (:data:`CUSTOM_DATA_RECORD`) flushed as soon as it is set, and every chunk is
 flushed once written, so a recording cut off (power lost, SIGKILL) keeps them; the writer's
-``flush()`` also writes the chunk begun, synced (the recorder: every second). :func:`reindex`
+``flush()`` also writes the chunk begun, synced (the recorder: every second), in two steps a
+writer under a lock can take apart: ``hand_off()`` gives the bytes to the operating system and
+returns a :class:`PendingSync`, whose ``sync()`` runs ``fsync`` without the writer. :func:`reindex`
 rebuilds ``metadata.yaml`` of such a bag from its MCAP files, as ``ros2 bag reindex`` does.
 No rclpy here.
 """
@@ -95,7 +97,9 @@ def open_writer(path, compression: str = '', max_file_bytes: int = 0,
 
     With ``max_file_bytes`` and ``max_file_duration_ns`` 0 it is the ``rosbags`` writer of one
     ``<name>.mcap``; with either, a :class:`SplitWriter` (the same calls) that splits the bag.
-    Both have ``flush()``: the chunk begun is written and synced now (a smaller chunk).
+    Both have ``flush()``: the chunk begun is written and synced now (a smaller chunk); and
+    ``hand_off()``, its first half: the chunk written to the file, a :class:`PendingSync` of it
+    returned to be synced later, outside whatever lock guards the writer.
 
     Raises
     ------
@@ -122,25 +126,55 @@ def open_writer(path, compression: str = '', max_file_bytes: int = 0,
         return add(topic, msgtype, typestore=store, **kw)
     writer.add_connection = add_connection
     writer.set_custom_data = lambda key, value: _keep_custom_data(writer, {key: value})
-    writer.flush = lambda: _flush(writer, path)
+    writer.hand_off = lambda: PendingSync(_hand_off(writer, path))
+    writer.flush = lambda: writer.hand_off().sync()
     return writer
 
 
-def _flush(writer, path) -> None:
+class PendingSync:
     """
-    Write a ``rosbags`` MCAP writer's chunk begun to the disk now (if it holds anything), synced.
+    Files whose bytes the operating system has, to ``fsync`` later: duplicates of their fds.
+
+    :meth:`sync` needs nothing of the writer, so a recorder calls it after its lock is released
+    (a message written meanwhile does not wait for the disk), and a file closed or split off
+    meanwhile is still synced: the duplicate keeps the open file, never a closed fd's number.
+    """
+
+    def __init__(self, fds=()):
+        self._fds = list(fds)
+
+    def sync(self) -> None:
+        """``fsync`` each file, then close the duplicates (all of them, also when one fails)."""
+        try:
+            for fd in self._fds:
+                os.fsync(fd)
+        finally:
+            self.close()
+
+    def close(self) -> None:
+        """Close the duplicates unsynced (a hand-off that failed half way); again: nothing."""
+        fds, self._fds = self._fds, []
+        for fd in fds:
+            os.close(fd)
+
+
+def _hand_off(writer, path) -> list:
+    """
+    Write a ``rosbags`` MCAP writer's chunk begun to its file now; return a dup of its fd.
 
     ``rosbags`` writes a chunk when it holds about 1 MiB: minutes of a low-rate topic, and the
     topics themselves (their channel records) go into the first. A recording cut off then
     loses all of it; closed early (a smaller chunk) it is a complete chunk that
-    :func:`reindex` recovers. A closed writer (of the bag at ``path``) is refused (ValueError).
+    :func:`reindex` recovers once synced (:class:`PendingSync`). Nothing begun: nothing to
+    sync (``[]``). A closed writer (of the bag at ``path``) is refused (ValueError).
     """
     storage = writer.storage
     if storage is None:
         raise ValueError(f'{path}: the bag is closed')
-    if storage.chunk.bio.tell():
-        storage.close_chunk()
-        os.fsync(storage.bio.fileno())
+    if not storage.chunk.bio.tell():
+        return []
+    storage.close_chunk()                   # written and flushed (_open_rosbags)
+    return [os.dup(storage.bio.fileno())]
 
 
 def _open_rosbags(path: Path, compression: str):
@@ -302,10 +336,20 @@ class SplitWriter:
 
     def flush(self) -> None:
         """Write the open files' chunks begun to the disk now, synced (as the single file's)."""
+        self.hand_off().sync()
+
+    def hand_off(self) -> PendingSync:
+        """Write the open files' chunks begun to their files; return them to sync later."""
         if not self._parts:
             raise ValueError(f'{self.path}: the bag is closed')
-        for part in self._parts:
-            _flush(part.writer, part.file)
+        fds = []
+        try:
+            for part in self._parts:
+                fds += _hand_off(part.writer, part.file)
+        except BaseException:
+            PendingSync(fds).close()
+            raise
+        return PendingSync(fds)
 
     def _full(self, part: _Part, time_ns: int) -> bool:
         """Whether ``part`` is done before a message at ``time_ns``: its size or duration."""

@@ -29,7 +29,8 @@ take ROS's start-up QoS overrides, as the cameras' and the detector's do: ``-p
 qos_overrides./pan_tilt.subscription.durability:=volatile`` records a volatile teleop publisher.
 The chunk begun is written and synced every :data:`FLUSH_PERIOD_S` (of the system's clock, also
 under ``use_sim_time``), so a recording cut off loses about a second at most: ``ipomdp-gaze
-reindex`` recovers the rest.
+reindex`` recovers the rest. Only the hand-off of the bytes to the system holds the bag's lock;
+the ``fsync`` runs after it, so on slow storage the subscriptions' writes do not wait for it.
 
 The bag's ``custom_data`` (in ``metadata.yaml``) holds ``ipomdp_gaze/version`` (the package),
 ``ipomdp_gaze/parameters/<node>`` (every parameter of each node in ``nodes``, as YAML, fetched
@@ -303,10 +304,17 @@ class RecorderNode(QuietPublishers, Node):
         return write
 
     def _flush(self) -> None:
-        """Write the bag's chunk begun to the disk (:data:`FLUSH_PERIOD_S`)."""
+        """
+        Write the bag's chunk begun to the disk (:data:`FLUSH_PERIOD_S`).
+
+        Under the lock only the hand-off of the bytes to the operating system; ``fsync`` (slow
+        storage: long) runs after it, so a message written meanwhile does not wait for it.
+        """
         with self._bag_lock:
-            if self.writer is not None:
-                self.writer.flush()
+            if self.writer is None:
+                return
+            pending = self.writer.hand_off()
+        pending.sync()
 
     # -- the other nodes' parameters ---------------------------------------------------------
     def _ask_parameters(self) -> None:
