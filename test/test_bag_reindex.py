@@ -201,3 +201,35 @@ def test_a_write_failing_while_recovering_is_raised_and_leaves_the_bag_as_it_was
         reindex(bag)
     assert sorted(p.name for p in bag.iterdir()) == ['bag.mcap']
     assert (bag / 'bag.mcap').read_bytes() == before
+
+
+@pytest.mark.parametrize('name', ['run', 'run_1'])
+def test_reindex_of_the_folder_holding_a_bag_leaves_that_bag_alone(tmp_path, name):
+    """
+    QA: ``reindex recordings/`` took ``recordings/run/run.mcap`` for a split bag's open file.
+
+    It moved the MCAP file up into ``recordings/``, deleted the bag's metadata.yaml and its
+    folder: the recording was no longer a bag.
+    """
+    from ipomdp_gaze.files.bag import read_bag, reindex
+    folder = tmp_path / 'recordings'
+    bag = folder / name
+    _killed(bag, 5, size=1000, close=True)
+    before = {p.name: p.read_bytes() for p in bag.iterdir()}
+    with pytest.raises(ValueError, match='no MCAP files to reindex'):
+        reindex(folder)
+    assert sorted(p.name for p in folder.iterdir()) == [name]
+    assert {p.name: p.read_bytes() for p in bag.iterdir()} == before
+    assert len(read_bag(bag).messages) == 5
+
+
+def test_a_split_bag_renamed_after_the_kill_still_finds_its_open_file(tmp_path):
+    """Its open file's folder is named after the files (``bag_<i>/``), not the new folder."""
+    from ipomdp_gaze.files.bag import read_bag, reindex
+    written = _killed(tmp_path / 'bag', 70, max_bytes=2_000_000)
+    renamed = tmp_path / 'renamed'
+    (tmp_path / 'bag').rename(renamed)
+    assert any(p.is_dir() for p in renamed.iterdir())
+    done = reindex(renamed)
+    assert done.recovered
+    assert [m.time_ns for m in read_bag(renamed).messages] == written

@@ -530,12 +530,18 @@ def _bag_files(path: Path) -> list:
     Return the bag's MCAP files in order, each ``(file, name in the bag)``.
 
     Those in the bag and those of a split bag still in a folder ``<name>_<i>/`` (a file being
-    written: ``<name>_<i>/<name>_<i>.mcap``), in the order of their index ``_<i>``.
+    written: ``<name>_<i>/<name>_<i>.mcap``), in the order of their index ``_<i>``. ``<name>``
+    is the bag's folder name or that of its split files (a bag renamed after the recording):
+    another bag kept in a subfolder (``reindex`` of the folder holding it) is not one of its
+    files, and is left alone (it was moved up, its metadata.yaml deleted).
     """
     found = [(f, f.name) for f in path.glob('*.mcap') if f.is_file()]
+    prefixes = {path.resolve().name} | {
+        m.group(1) for m in (re.fullmatch(r'(.+)_\d+\.mcap', name) for _, name in found) if m}
     for folder in path.iterdir():
         file = folder / f'{folder.name}.mcap'
-        if folder.is_dir() and file.is_file():
+        split = re.fullmatch(r'(.+)_\d+', folder.name)
+        if split and split.group(1) in prefixes and folder.is_dir() and file.is_file():
             found.append((file, file.name))
     names = [name for _, name in found]
     twice = sorted({name for name in names if names.count(name) > 1})
