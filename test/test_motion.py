@@ -371,3 +371,26 @@ def test_a_short_step_on_a_long_axis_predicts_as_the_matrix_product(rows, cols, 
     np.testing.assert_array_equal(motion.predict(cells) == 0, product == 0)
     if motion._bands == ():
         np.testing.assert_array_equal(motion.predict(cells), product)
+
+
+@pytest.mark.parametrize('sigma', [2.0 ** 40, 1e200, 1e308])
+def test_a_step_far_wider_than_the_grid_spreads_evenly_without_overflowing(sigma):
+    """
+    QA: ``motion.sigma_cells`` 1e200 passed its check, then ``sigma ** 2`` overflowed.
+
+    The node took the value and failed to apply it (an OverflowError counted as a callback
+    error, the parameter set but the search not following it); ``evaluate`` printed a
+    traceback. Every g(k) on the axis is 1.0: the step is the uniform one, over any time.
+    """
+    assert np.array_equal(axis_transition(11, sigma), np.full((11, 11), 1 / 11))
+    grid = Grid(3, 4, 5.0)
+    motion = Motion(grid, sigma).over(4.0)
+    belief = np.log(np.arange(1.0, 13.0) / 78.0)
+    assert np.allclose(np.exp(motion.predict_log(belief.copy())), 1 / 12)
+
+
+def test_evaluate_with_a_huge_motion_sigma_runs(cli_here):
+    run = cli_here('evaluate', '--grid', '3x3', '--policy', 'map', '--episodes', 4,
+                   '--motion-sigma-cells', '1e200', '--seed', 0, '--quiet')
+    assert run.returncode == 0, run.stderr
+    assert 'Traceback' not in run.stderr

@@ -36,6 +36,7 @@ variance ``sigma_cells^2 dt`` (``sigma = sigma_cells sqrt(dt)``) and jumps with 
 from __future__ import annotations
 
 import math
+import sys
 
 from ipomdp_gaze.model.belief import normalize_log
 from ipomdp_gaze.model.checks import check_probability, check_sigma_cells  # noqa: F401
@@ -50,6 +51,15 @@ BAND_RATIO = 32
 ALMOST_ONE = math.nextafter(1.0, 0.0)
 # exp(x) rounds to exactly 0 from this down (log of half the smallest subnormal, 2**-1075).
 LOG_UNDERFLOW = -1075 * math.log(2.0)
+# A step this many times an axis's length has g(k) exactly 1.0 at every offset on it
+# (k^2 / (2 sigma^2) < 2**-61): a larger sigma gives the same matrix, computed without
+# sigma ** 2 overflowing (motion.sigma_cells 1e200 was an OverflowError).
+FLAT_STEP_AXES = 2.0 ** 30
+
+
+def step_sigma(sigma_cells: float, seconds: float) -> float:
+    """Return ``sigma_cells * sqrt(seconds)``, at most the largest float (never inf)."""
+    return min(sigma_cells * math.sqrt(seconds), sys.float_info.max)
 
 
 def axis_transition(size: int, sigma_cells: float) -> np.ndarray:
@@ -62,7 +72,7 @@ def axis_transition(size: int, sigma_cells: float) -> np.ndarray:
     ``-R..R`` and laid out along the diagonals (row x is the table ``g(x' - x)`` seen from x):
     the same entries, row sums and quotients as evaluating it for every pair of positions.
     """
-    sigma = check_sigma_cells(sigma_cells)
+    sigma = min(check_sigma_cells(sigma_cells), size * FLAT_STEP_AXES)
     if sigma == 0 or math.exp(-0.5 / sigma ** 2) == 0.0:
         return np.eye(size)                     # g(1) underflows: exactly the identity
     reach = min(math.ceil(TRUNCATE_SIGMAS * sigma), size - 1)
@@ -96,7 +106,7 @@ def _axis_bands(row_matrix: np.ndarray, col_matrix: np.ndarray, sigma_cells: flo
     if all(m.shape[0] == 1 or m[0, 1] == 0.0 for m in (row_matrix, col_matrix)):
         return ()
     size = min(row_matrix.shape[0], col_matrix.shape[0])
-    reach = min(math.ceil(TRUNCATE_SIGMAS * sigma_cells), size - 1)
+    reach = min(math.ceil(TRUNCATE_SIGMAS * min(sigma_cells, size)), size - 1)
     if (2 * reach + 1) * BAND_RATIO > size:
         return None
     row = _diagonals(row_matrix, reach)
@@ -196,7 +206,7 @@ class Motion:
             return self._over[1]
         jump = min(1.0 - (1.0 - self.jump_prob) ** dt, ALMOST_ONE)
         leave = min(1.0 - (1.0 - self.leave_prob) ** dt, ALMOST_ONE)
-        motion = Motion(self.grid, self.sigma_cells * math.sqrt(dt), jump, leave)
+        motion = Motion(self.grid, step_sigma(self.sigma_cells, dt), jump, leave)
         self._over = (dt, motion)
         return motion
 
@@ -413,7 +423,7 @@ class VelocityMotion(Motion):
         rows, cols = self.grid.shape
         peak = np.max(log_belief)
         cells = np.exp(log_belief[:n] - peak)
-        sigma = self.sigma_cells * math.sqrt(dt)
+        sigma = step_sigma(self.sigma_cells, dt)
         row_t = np.stack([axis_drift(rows, sigma, v * dt).T for v in self.speeds])
         col = np.stack([axis_drift(cols, sigma, v * dt) for v in self.speeds])
         joint = (self.velocity * cells[None, None, :]).reshape(k, k, rows, cols)
