@@ -150,3 +150,26 @@ def test_a_callback_failing_after_shutdown_is_neither_counted_nor_warned():
     context.up = False
     guarded(None)
     assert guard.errors == 1 and len(warnings) == 1             # shut down: quiet
+
+
+def test_a_failing_callback_of_two_arguments_that_is_no_service_returns_none():
+    """
+    QA: a parameter set's ``apply(old, new)`` failing returned ``new``, taken for a service.
+
+    The controller then logged ``parameters set: ...; ControllerConfig(values={...`` (the whole
+    configuration, as if it were what the set did). A service still answers its response.
+    """
+    from types import SimpleNamespace
+    from ipomdp_gaze.nodes.guard import CallbackGuard
+    from std_srvs.srv import Trigger
+    node = SimpleNamespace(context=SimpleNamespace(ok=lambda: True), get_logger=lambda: (
+        SimpleNamespace(warning=lambda text, **_: None)))
+    guard = CallbackGuard(node)
+
+    def apply(old, new):
+        raise OverflowError(34, 'Numerical result out of range')
+    assert guard.wrap(apply)(object(), {'confidence': 0.9}) is None
+    assert guard.by_callback['apply'] == 1
+    reply = guard.wrap(apply, 'on_reset')(Trigger.Request(), Trigger.Response(success=True))
+    assert isinstance(reply, Trigger.Response) and not reply.success
+    assert reply.message == "internal error: OverflowError: (34, 'Numerical result out of range')"

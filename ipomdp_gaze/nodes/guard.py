@@ -33,6 +33,19 @@ DIAGNOSTICS_PERIOD_S = 1.0
 _PASS_THROUGH = (KeyboardInterrupt, SystemExit)
 
 
+def _service_response(args: tuple):
+    """
+    Return the response of a service callback's ``(request, response)``, else None.
+
+    A response is a ROS message; another callback of two arguments (a parameter transaction's
+    ``apply(old, new)``) is not a service: its failure returned ``new`` as if it were one, and
+    the node logged the whole configuration after ``parameters set:``.
+    """
+    if len(args) == 2 and hasattr(type(args[1]), 'get_fields_and_field_types'):
+        return args[1]
+    return None
+
+
 def _shutdown_exceptions() -> tuple:
     from rclpy.executors import ExternalShutdownException
     return _PASS_THROUGH + (ExternalShutdownException,)
@@ -93,7 +106,7 @@ class CallbackGuard:
         def guarded(*args):
             with self.lock:
                 if self.closed:
-                    return args[1] if len(args) == 2 else None
+                    return _service_response(args)
                 return self._call(callback, name, args)
         return guarded
 
@@ -107,8 +120,8 @@ class CallbackGuard:
             if self._shutting_down():
                 return None         # Ctrl-C while a callback ran: its publish has no context
             reason = self.record(name, exc)
-            if len(args) == 2:                      # a service: (request, response)
-                response = args[1]
+            response = _service_response(args)
+            if response is not None:                # a service: (request, response)
                 if hasattr(response, 'success'):
                     response.success = False
                 if hasattr(response, 'message'):
