@@ -346,6 +346,31 @@ def test_reader_rejects_bad_files(tmp_path):
         read_labelled_folder(folder, csv_path)
 
 
+def test_reader_takes_excel_csv_and_names_a_label_file_that_is_no_csv(tmp_path, cli_here):
+    """
+    QA: Excel's "CSV UTF-8" (a byte order mark first) was "missing ['path']" of its own header.
+
+    An image given as ``--labels`` was refused by the codec alone ('utf-8' codec can't
+    decode byte 0x89), naming no file; a folder "did not exist".
+    """
+    from ipomdp_gaze.vision.scenes import labelled_names
+    folder, csv_path = _folder(tmp_path, 'a.png,1,1\n')
+    csv_path.write_bytes(b'\xef\xbb\xbf' + csv_path.read_bytes())
+    ((image, centre),) = read_labelled_folder(folder, csv_path)
+    assert centre == (1.0, 1.0) and labelled_names(folder, csv_path) == ['a.png']
+    image_path = tmp_path / 'a.png'
+    for read in (read_labelled_folder, labelled_names):
+        with pytest.raises(ValueError) as refused:
+            read(folder, image_path)
+        assert str(refused.value) == \
+            f"{image_path}: not a UTF-8 text CSV (path,x,y): byte 0 is b'\\x89'"
+    run = cli_here('calibrate', '--images', folder, '--labels', tmp_path, '--out',
+                   tmp_path / 'out.yaml')
+    assert run.returncode == 2
+    assert run.stderr.strip().splitlines() == [
+        f'ipomdp-gaze calibrate: error: label CSV {tmp_path} is a folder, not a CSV file']
+
+
 def test_opencv_cascade_finds_the_pasted_faces():
     """
     The real detector finds most pasted faces: the scenes are usable for calibration.

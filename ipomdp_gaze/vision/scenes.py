@@ -465,15 +465,31 @@ def labels_path(folder, csv_path) -> Path:
     csv_path = Path(csv_path)
     if not csv_path.exists() and not csv_path.is_absolute() and (Path(folder) / csv_path).exists():
         csv_path = Path(folder) / csv_path
+    if csv_path.is_dir():
+        raise FileNotFoundError(f'label CSV {csv_path} is a folder, not a CSV file')
     if not csv_path.is_file():
         raise FileNotFoundError(f'label CSV {csv_path} does not exist')
     return csv_path
 
 
+# Excel's "CSV UTF-8" starts with a byte order mark, which utf-8 read as part of 'path'.
+LABELS_ENCODING = 'utf-8-sig'
+
+
+def _not_text(csv_path: Path, exc: UnicodeDecodeError) -> ValueError:
+    """Return the one-line refusal of a label CSV not in UTF-8 text (an image given instead)."""
+    return ValueError(f'{csv_path}: not a UTF-8 text CSV (path,x,y): byte {exc.start} is '
+                      f'{exc.object[exc.start:exc.start + 1]!r}')
+
+
 def labelled_names(folder, csv_path) -> list[str]:
     """Return the ``path`` entries of a label CSV, in order (as :func:`read_labelled_folder`)."""
-    with open(labels_path(folder, csv_path), newline='', encoding='utf-8') as stream:
-        return [(row.get('path') or '').strip() for row in csv.DictReader(stream)]
+    csv_path = labels_path(folder, csv_path)
+    try:
+        with open(csv_path, newline='', encoding=LABELS_ENCODING) as stream:
+            return [(row.get('path') or '').strip() for row in csv.DictReader(stream)]
+    except UnicodeDecodeError as exc:
+        raise _not_text(csv_path, exc) from None
 
 
 def read_labelled_folder(folder, csv_path) -> list[LabelledImage]:
@@ -511,8 +527,16 @@ def read_labelled_folder(folder, csv_path) -> list[LabelledImage]:
     if not folder.is_dir():
         raise FileNotFoundError(f'image folder {folder} does not exist')
     csv_path = labels_path(folder, csv_path)
+    try:
+        return _read_labels(folder, csv_path)
+    except UnicodeDecodeError as exc:
+        raise _not_text(csv_path, exc) from None
+
+
+def _read_labels(folder: Path, csv_path: Path) -> list[LabelledImage]:
+    """Read a label CSV's images and centres (:func:`read_labelled_folder`)."""
     out = []
-    with open(csv_path, newline='', encoding='utf-8') as stream:
+    with open(csv_path, newline='', encoding=LABELS_ENCODING) as stream:
         reader = csv.DictReader(stream)
         missing = {'path', 'x', 'y'} - set(reader.fieldnames or ())
         if missing:
