@@ -310,6 +310,37 @@ def test_a_fixation_counts_again_only_cells_a_window_read_afresh_saw():
     assert len(recorder.boxes[1]) == len(recorder.scores[1]) == 3     # one box per window
 
 
+def _replayed(config, reuse, fixations, img):
+    fovea = Fovea(lambda gray: np.zeros((0, 4)), Grid(9, 9), config, reuse_windows=reuse)
+    fovea.start(img)
+    fovea.scan()
+    for k in fixations:
+        fovea.observe(k)
+    return fovea
+
+
+@pytest.mark.parametrize('config, reuse', [
+    (FoveaConfig(windows_cells=(9, 5, 3)), True),
+    (FoveaConfig(windows_cells=(9, 5, 3), scan_once=True), True),
+    (FoveaConfig(windows_cells=(9, 5, 3)), False),
+    # two windows larger than the grid at one scale: the second is the first, from the cache
+    (FoveaConfig(windows_cells=(12, 10, 3), scales=(0.5, 0.5, 1.0)), True)])
+def test_fresh_views_are_the_pixels_and_cells_a_fixation_would_read_afresh(config, reuse):
+    """For every fixation: observe's pixels, and the cells fresh_counts keeps of its frame."""
+    img = image(90, 117)
+    history = (0, 20, 80, 10)                 # (0, 0), (2, 2), (8, 8), (1, 1)
+    for done in range(len(history) + 1):
+        costs, cover = _replayed(config, reuse, history[:done], img).fresh_views()
+        for k in range(81):
+            after = _replayed(config, reuse, history[:done], img).observe(k)
+            assert costs[k] == after.detector_pixels
+            np.testing.assert_array_equal(cover[k], ~np.isnan(fresh_counts(after, Grid(9, 9))))
+        if reuse and done == 1:       # (1, 1) places (0, 0)'s windows: every one cached
+            assert costs[10] == 0 and not cover[10].any() and costs[40] > 0
+    with pytest.raises(RuntimeError, match='start'):
+        Fovea(lambda gray: np.zeros((0, 4)), Grid(9, 9), config).fresh_views()
+
+
 def test_observe_validates_its_state_and_fixation():
     fovea = Fovea(FakeDetector(), GRID)
     with pytest.raises(RuntimeError, match='start'):

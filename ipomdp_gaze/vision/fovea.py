@@ -349,6 +349,7 @@ class Fovea:
         self._gray = None
         self._row_edges_px = self._col_edges_px = None
         self._cache = {}
+        self._fresh = None              # fresh_views' windows of every fixation on this image
         self.image_detector_pixels = 0
         self.image_seconds = 0.0
         self.n_fixations = 0
@@ -387,6 +388,7 @@ class Fovea:
         self._row_edges_px = cell_edges_px(height, self.grid.rows)
         self._col_edges_px = cell_edges_px(width, self.grid.cols)
         self._cache = {}
+        self._fresh = None
         self.image_detector_pixels = 0
         self.n_fixations = 0
         self.image_seconds = time.perf_counter() - t0
@@ -430,6 +432,83 @@ class Fovea:
         return int(sum(w.resized_px[0] * w.resized_px[1] for w in windows
                        if not (self.config.scan_once and w.whole_image)
                        and (w.cells, w.resized_px) not in self._cache))
+
+    def fresh_views(self) -> tuple[np.ndarray, np.ndarray]:
+        """
+        Return what a fixation at each cell would read afresh now: pixels (N,), cells (N, N).
+
+        ``costs[k]`` is :meth:`fixation_cost` ``(k)``: the detector pixels of fixation k's
+        windows not in the image's cache (nor a copy of an earlier window of the same
+        fixation, which :meth:`observe` serves from the cache); ``cover[k, j]`` says cell j
+        lies in one of those windows: the cells
+        :func:`ipomdp_gaze.vision.search.fresh_counts` keeps of that fixation. A fixation
+        whose every window is cached reads nothing (0, no cell). With ``scan_once`` the
+        whole-image windows are left out, as :meth:`observe` leaves them. The windows of every
+        fixation are placed once per image; the cover is recomputed when the cache grows.
+
+        Raises
+        ------
+        RuntimeError
+            Before :meth:`start`.
+
+        """
+        if self._gray is None:
+            raise RuntimeError('no image: call start(image) first')
+        f = self._fresh
+        if f is None:
+            f = self._fresh = self._fixation_windows()
+        if f['seen'] != len(self._cache) or f['cover'] is None:
+            keys = list(self._cache)[f['seen']:]
+            for (cells, resized) in keys:
+                f['cached'] |= np.all(f['keys'] == (*cells, *resized), axis=-1)
+            f['seen'] = len(self._cache)
+            fresh = f['read'] & ~f['cached']
+            f['costs'] = np.sum(np.where(fresh, f['pixels'], 0), axis=1).astype(float)
+            rows, cols = self.grid.shape
+            cover = np.zeros((self.grid.n_cells, rows, cols), dtype=bool)
+            for i in range(fresh.shape[1]):
+                cover |= (fresh[:, i, None, None] & f['in_rows'][:, i, :, None]
+                          & f['in_cols'][:, i, None, :])
+            f['cover'] = cover.reshape(self.grid.n_cells, -1)
+        return f['costs'].copy(), f['cover'].copy()
+
+    def _fixation_windows(self) -> dict:
+        """
+        Place the windows of every fixation on the current image (vectorised :meth:`window_rects`).
+
+        ``keys`` (N, K, 6): each window's cache key ``row, col, n_rows, n_cols, width, height``;
+        ``pixels`` (N, K); ``read`` (N, K): the windows :meth:`observe` reads, less a copy of an
+        earlier window of its fixation that it would serve from the cache; ``in_rows`` (N, K,
+        rows) and ``in_cols`` (N, K, cols): the cells each covers.
+        """
+        grid, config = self.grid, self.config
+        sizes = np.asarray(config.windows_cells, dtype=np.int64)
+        rows_of, cols_of = grid.rows_cols()
+        placed = []
+        for axis_cells, p, edges in ((grid.rows, rows_of, self._row_edges_px),
+                                     (grid.cols, cols_of, self._col_edges_px)):
+            n = np.minimum(sizes, axis_cells)
+            first = np.clip(p[:, None] - sizes // 2, 0, axis_cells - n)          # (N, K)
+            placed.append((first, np.broadcast_to(n, first.shape),
+                           edges[first + n] - edges[first]))
+        (row, n_rows, height_px), (col, n_cols, width_px) = placed
+        scales = np.asarray(config.scales)
+        width = np.maximum(1, np.floor(width_px * scales + 0.5).astype(np.int64))
+        height = np.maximum(1, np.floor(height_px * scales + 0.5).astype(np.int64))
+        keys = np.stack([row, col, n_rows, n_cols, width, height], axis=-1)
+        whole = (n_rows == grid.rows) & (n_cols == grid.cols)
+        read = ~whole if config.scan_once else np.ones(whole.shape, dtype=bool)
+        kept = whole | self.reuse_windows
+        for i in range(1, keys.shape[1]):
+            for j in range(i):
+                read[:, i] &= ~(kept[:, j] & read[:, j]
+                                & np.all(keys[:, i] == keys[:, j], axis=-1))
+        return {'keys': keys, 'pixels': width * height, 'read': read,
+                'cached': np.zeros(read.shape, dtype=bool), 'seen': 0, 'cover': None,
+                'in_rows': (np.arange(grid.rows) >= row[..., None])
+                & (np.arange(grid.rows) < (row + n_rows)[..., None]),
+                'in_cols': (np.arange(grid.cols) >= col[..., None])
+                & (np.arange(grid.cols) < (col + n_cols)[..., None])}
 
     def scan_cost(self) -> int:
         """Detector pixels :meth:`scan` would spend now (0 without a scan or once done)."""
