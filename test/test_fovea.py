@@ -1,16 +1,18 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """The digital fovea: window geometry, per-window resolution, binning, counts, NaN and caching."""
+from dataclasses import replace
 import json
 import subprocess
 import sys
 
 import cv2
 from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.observation import CountObservation
 from ipomdp_gaze.vision.detector import HaarDetector
 from ipomdp_gaze.vision.fovea import (cell_edges_px, Fovea, FoveaConfig, REFERENCE_WINDOWS_CELLS,
                                       window_cells)
-from ipomdp_gaze.vision.search import _Recorder, fresh_counts
+from ipomdp_gaze.vision.search import _Recorder, FIND_SETTINGS, fresh_counts, search_many
 import numpy as np
 import pytest
 from skimage import data
@@ -339,6 +341,56 @@ def test_fresh_views_are_the_pixels_and_cells_a_fixation_would_read_afresh(confi
             assert costs[10] == 0 and not cover[10].any() and costs[40] > 0
     with pytest.raises(RuntimeError, match='start'):
         Fovea(lambda gray: np.zeros((0, 4)), Grid(9, 9), config).fresh_views()
+
+
+class _Spending(Fovea):
+    """A fovea keeping each fixation's detector pixels."""
+
+    def start(self, image):
+        super().start(image)
+        self.spent = []
+
+    def observe(self, fixation):
+        observation = super().observe(fixation)
+        self.spent.append(observation.detector_pixels)
+        return observation
+
+
+def _bright_box(gray):
+    """Detect the box of the bright pixels."""
+    ys, xs = np.nonzero(gray > 128)
+    if not len(xs):
+        return np.zeros((0, 4))
+    return np.array([[xs.min(), ys.min(), np.ptp(xs) + 1, np.ptp(ys) + 1]], dtype=float)
+
+
+def test_find_all_spends_no_fixation_on_windows_read_already():
+    """
+    The many-target choice counts only what a fixation reads afresh (search_many).
+
+    A bright patch in cell (1, 1) of a 9x9 grid: fixations near the corner all place the
+    7-cell window there. Before, the search chose 7 of its 30 fixations whose windows were all
+    read already (0 detector pixels, no evidence); now none.
+    """
+    grid = Grid(9, 9)
+    hit = {0: 0.9, 1: 0.7, 2: 0.5}
+    pt, pn = np.empty((9, 9, 2)), np.empty((9, 9, 2))
+    for dr in range(9):
+        for dc in range(9):
+            p = hit.get(max(dr, dc), 0.3)
+            pt[dr, dc], pn[dr, dc] = (1 - p, p), (0.95, 0.05)
+    model = CountObservation(grid, pt, pn)
+    img = np.zeros((90, 90), np.uint8)
+    img[10:14, 10:14] = 255
+    fovea = _Spending(_bright_box, grid, FoveaConfig(windows_cells=(7, 3), scales=(1.0, 1.0),
+                                                     max_count=2), reuse_windows=True)
+    result = search_many(img, fovea, model, replace(FIND_SETTINGS, targets='many',
+                                                    max_fixations=30))
+    assert [face.cell for face in result.faces] == [(1, 1)]
+    assert result.fixations == len(fovea.spent) == 30
+    assert 0 not in fovea.spent
+    assert 900 in fovea.spent                  # a fixation whose 7-cell window was cached
+    assert result.detector_pixels == sum(fovea.spent)
 
 
 def test_observe_validates_its_state_and_fixation():

@@ -207,6 +207,94 @@ def test_infomax_gain_equals_brute_force_expected_entropy():
     assert session.gains(log_odds).argmax() == brute.argmax()
 
 
+def _brute_fresh_entropy_drop(model, log_odds, fixation, cells):
+    """H(before) - E[H(after)] when the frame observes only ``cells`` (others NaN)."""
+    k = model.max_count + 1
+    p = occupancy(log_odds)
+    at = np.flatnonzero(cells)
+    offsets = model.offsets(fixation)[at]
+    pt = model.p_target.reshape(-1, k)[offsets]
+    pn = model.p_null.reshape(-1, k)[offsets]
+    expected = 0.0
+    for counts in itertools.product(range(k), repeat=at.size):
+        c = np.array(counts, dtype=np.int64)
+        prob = np.prod(p[at] * pt[np.arange(at.size), c]
+                       + (1 - p[at]) * pn[np.arange(at.size), c])
+        frame = np.full(log_odds.size, np.nan)
+        frame[at] = c
+        after = update_log_odds(log_odds, model.log_likelihood_ratio(frame, fixation))
+        expected += prob * binary_entropy(occupancy(after)).sum()
+    return binary_entropy(p).sum() - expected
+
+
+def test_a_partly_cached_view_gains_only_what_the_cells_it_reads_afresh_tell():
+    """gains(cover=): the expected entropy drop of the frame fresh_counts leaves (others NaN)."""
+    grid = Grid(2, 3)
+    model = _model(grid, k=3, seed=4)
+    log_odds = np.array([-2.0, 0.3, 1.5, -0.2, 0.8, -1.1])
+    cover = np.ones((6, 6), dtype=bool)
+    cover[1] = [True, True, False, False, False, True]    # its other windows cached
+    cover[4] = [False, False, False, True, True, False]
+    cover[5] = False                                     # every window cached: nothing read
+    session = OccupancySession(grid, model, SearchSettings(targets='many'))
+    session.reset()
+    whole, fresh = session.gains(log_odds), session.gains(log_odds, cover=cover)
+    for view in range(6):
+        brute = _brute_fresh_entropy_drop(model, log_odds, view, cover[view])
+        assert fresh[view] == pytest.approx(brute, rel=2e-3, abs=1e-12)
+    assert whole[1] > fresh[1] > 0 and whole[4] > fresh[4] > 0 and fresh[5] == 0
+    np.testing.assert_array_equal(fresh[[0, 2, 3]], whole[[0, 2, 3]])    # read whole
+
+
+def _fresh_choice(session, costs, cover):
+    session.set_fresh(lambda: (costs, cover))
+    session.reset()
+    return session.start()
+
+
+def test_a_view_served_whole_from_the_cache_is_never_chosen_while_another_gains():
+    grid = Grid(3, 3)
+    model = _model(grid, k=3, seed=8, radius=1)
+    settings = SearchSettings(targets='many', scan=False, start_cell='policy',
+                              max_fixations=20)
+    session = OccupancySession(grid, model, settings)
+    session.reset()
+    best = session.start()                      # the choice without a cache
+    costs, cover = np.ones(9), np.ones((9, 9), dtype=bool)
+    assert _fresh_choice(session, costs, cover) == best
+    costs[best], cover[best] = 0.0, False        # served whole from the cache
+    choice = _fresh_choice(session, costs, cover)
+    assert choice != best
+    gains = session.gains(cover=cover)
+    assert gains[choice] == gains[costs > 0].max() > 0
+    # a partly cached view is scored per the pixels it reads afresh
+    costs, cover = np.ones(9), np.ones((9, 9), dtype=bool)
+    other = (best + 1) % 9
+    cover[other] = np.arange(9) == other
+    costs[other] = 1e-6
+    assert _fresh_choice(session, costs, cover) == other
+    # every view cached: nothing is worth a fixation, the search gives up as it does today
+    session.set_fresh(lambda: (np.zeros(9), np.zeros((9, 9), dtype=bool)))
+    session.reset()
+    session.start()
+    result = session.update(Frame(np.zeros(9)))
+    assert result.ended and result.reason == 'repeat' and session.fixations == 1
+
+
+def test_fresh_views_are_checked():
+    grid = Grid(2, 2)
+    session = OccupancySession(grid, _model(grid), SearchSettings(targets='many', scan=False,
+                                                                  start_cell='policy'))
+    with pytest.raises(ValueError, match='callable'):
+        session.set_fresh(np.ones(4))
+    for costs, cover, match in ((np.ones(3), np.ones((4, 4)), r'costs \(4,\)'),
+                                (-np.ones(4), np.ones((4, 4)), '>= 0')):
+        session.set_fresh(lambda: (costs, cover))
+        session.reset()
+        with pytest.raises(ValueError, match=match):
+            session.start()
+
+
 def test_infomax_choice_per_cost_with_spread_views():
     grid = Grid(3, 3)
     model = _model(grid, k=3, seed=8, radius=1)

@@ -29,7 +29,10 @@ The same steps and results as :class:`ipomdp_gaze.search.session.SearchSession` 
    unvisited ones with ``inhibit_return`` (the
    cost times the view's seconds of head time with ``search.head_speed_deg_s``), with
    ``w_kj = 1`` where view k sees cell j at a more informative offset (ELM kernel) than any view
-   so far, ``repeat_weight`` otherwise, and 0 for a cell settled by ``link``.
+   so far, ``repeat_weight`` otherwise, and 0 for a cell settled by ``link``. With a sensor's
+   fresh views (:meth:`OccupancySession.set_fresh`: the fovea's windows cached on the image)
+   only the cells view k would read afresh count, ``cost_k`` is what it reads afresh, and a
+   view with nothing to read is never taken.
 
 **Moving targets** (motion on: ``motion.*`` as for one target; docs/design.md section 12.10):
 before each frame the belief is predicted over ``dt_s``
@@ -203,6 +206,7 @@ class OccupancySession:
         self.rng = np.random.default_rng(0)
         self._state = None
         self._gain_cache = None         # the still gains' (N, N) terms (:meth:`_still_terms`)
+        self._fresh = None              # what each view would read afresh (:meth:`set_fresh`)
 
     # -- configuration -------------------------------------------------------------------
     @property
@@ -269,6 +273,36 @@ class OccupancySession:
         poses = getattr(policy, 'poses', None) if getattr(policy, 'name', '') == 'sweep' \
             else None
         self._pass = None if poses is None else np.asarray(poses, dtype=np.int64).copy()
+
+    def set_fresh(self, fresh) -> None:
+        """
+        Choose still views by what each would read afresh: ``fresh() -> (costs, cover)``, or None.
+
+        A sensor that serves part of a view from a cache of what it read already (the fovea's
+        windows on one image: no new evidence, so its frame leaves the cells only those parts
+        saw unobserved) gives, before each choice, each view's cost of what it would read
+        afresh, ``costs`` (N,) >= 0 in the unit of the fixation costs, and the cells it would
+        observe, ``cover`` (N, N) bool ``[k, j]``. The still infomax choice then counts only
+        those cells' information (:meth:`gains` ``cover``) per that cost, and never takes a
+        view of cost 0 (nothing new to read); with no view left that tells anything, the search
+        gives up (``repeat``). None (the default): every view is read whole, at the fixation
+        costs. Moving targets and a pass choose as before.
+        """
+        if fresh is not None and not callable(fresh):
+            raise ValueError(f'fresh must be callable or None, got {type(fresh).__name__}')
+        self._fresh = fresh
+
+    def _fresh_views(self) -> tuple[np.ndarray, np.ndarray]:
+        """Return :meth:`set_fresh`'s costs (N,) and cover (N, N), checked (ValueError)."""
+        n = self.grid.n_cells
+        costs, cover = self._fresh()
+        costs, cover = np.asarray(costs, dtype=float), np.asarray(cover, dtype=bool)
+        if costs.shape != (n,) or cover.shape != (n, n):
+            raise ValueError(f'fresh views must be costs ({n},) and cover ({n}, {n}), got '
+                             f'{costs.shape} and {cover.shape}')
+        if np.any(~np.isfinite(costs) | (costs < 0)):
+            raise ValueError('fresh view costs must be finite and >= 0')
+        return costs, cover
 
     @property
     def passing(self) -> bool:
@@ -601,12 +635,14 @@ class OccupancySession:
         grid = occupied.reshape(self.grid.shape)
         return maximum_filter(grid, size=side, mode='constant', cval=False).reshape(-1)
 
-    def gains(self, log_odds: np.ndarray | None = None) -> np.ndarray:
+    def gains(self, log_odds: np.ndarray | None = None, cover=None) -> np.ndarray:
         """
         Return the expected drop of the summed cell entropies per fixation cell (N,), nats.
 
         ``sum_j w_kj I(P(x_j); offset_jk)``, ``w_kj`` 1 for a view more informative than any
-        so far (ELM kernel), else ``repeat_weight`` (module docstring).
+        so far (ELM kernel), else ``repeat_weight`` (module docstring). With ``cover`` (N, N)
+        bool ``[k, j]`` (still targets), only the cells view k would observe count
+        (:meth:`set_fresh`); a view covering every cell gains as without.
         """
         if log_odds is None:
             log_odds = self.log_odds
@@ -622,7 +658,13 @@ class OccupancySession:
             return info @ (~followed).astype(float)
         settled = self.settled(self._decided(log_odds)[0]) if self.link > 0 else None
         info, weight = self._still_terms(np.asarray(log_odds, dtype=float), settled)
-        return np.einsum('kj,kj->k', info, weight)
+        gains = np.einsum('kj,kj->k', info, weight)
+        if cover is not None:
+            cover = np.asarray(cover, dtype=bool)
+            part = np.flatnonzero(~cover.all(axis=1))          # views not read whole
+            if part.size:
+                gains[part] = np.einsum('kj,kj->k', info[part], weight[part] * cover[part])
+        return gains
 
     def _still_terms(self, log_odds: np.ndarray, settled) -> tuple[np.ndarray, np.ndarray]:
         """
@@ -664,30 +706,42 @@ class OccupancySession:
                             'settled': None if settled is None else settled.copy()}
         return info, weight
 
-    def costs_from(self, cell: int | None) -> np.ndarray:
+    def costs_from(self, cell: int | None, costs=None) -> np.ndarray:
         """
         Return the cost of the next view at each cell (N,), with the head at ``cell``.
 
-        The fixation costs, times the view's seconds under the head model when
-        ``search.head_speed_deg_s`` > 0 (:func:`ipomdp_gaze.model.head_time.view_seconds`; before
-        the first fixation the head is taken to be at the grid's centre, as the head-time model
-        counts): information per second of head time, as the
-        single-target session's per-second choice (docs/design.md section 6.14).
+        The fixation costs (or ``costs`` (N,): :meth:`set_fresh`'s), times the view's seconds
+        under the head model when ``search.head_speed_deg_s`` > 0
+        (:func:`ipomdp_gaze.model.head_time.view_seconds`; before the first fixation the head
+        is taken to be at the grid's centre, as the head-time model counts): information per
+        second of head time, as the single-target session's per-second choice (docs/design.md
+        section 6.14).
         """
         settings = self.settings
+        costs = self.costs if costs is None else costs
         if settings.head_speed_deg_s <= 0:
-            return self.costs
+            return costs
         at = self.grid.center_index if cell is None else int(cell)
-        return self.costs * view_seconds(self.grid, at, settings.view_time_s,
-                                         settings.head_speed_deg_s)
+        return costs * view_seconds(self.grid, at, settings.view_time_s,
+                                    settings.head_speed_deg_s)
 
     def _choose(self) -> int | None:
         s = self._s()
         if self.passing:
             left = s['pass'][~s['visited'][s['pass']]]
             return int(left[0]) if left.size else None
-        costs = self.costs_from(s['fixation'])
-        score = self.gains() / costs
+        if self._fresh is None:
+            costs = self.costs_from(s['fixation'])
+            score = self.gains() / costs
+        else:
+            fresh, cover = self._fresh_views()
+            costs = self.costs_from(s['fixation'], fresh)
+            reads = costs > 0
+            if not reads.any():
+                return None             # every view served from the cache: nothing new
+            score = np.full(costs.shape, -np.inf)
+            score[reads] = self.gains(cover=cover)[reads] / costs[reads]
+            costs = costs[reads]
         if self.settings.inhibit_return:
             score = np.where(s['visited'], -np.inf, score)
         if not np.isfinite(score).any() or score.max() <= MIN_GAIN / costs.min():

@@ -1148,6 +1148,9 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     session = OccupancySession(fovea.grid, model, settings,
                                costs=fixation_costs(fovea, image_px), link=settle,
                                empty_by_evidence=empty_by_evidence)
+    # a window read already on this image is no new evidence (fresh_counts): the choice
+    # counts only what each fixation would read afresh, and its pixels
+    session.set_fresh(fovea.fresh_views)
     if scales is None:
         sensor = _Recorder(fovea)
     else:
