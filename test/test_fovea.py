@@ -331,8 +331,11 @@ def test_fresh_views_are_the_pixels_and_cells_a_fixation_would_read_afresh(confi
     """For every fixation: observe's pixels, and the cells fresh_counts keeps of its frame."""
     img = image(90, 117)
     history = (0, 20, 80, 10)                 # (0, 0), (2, 2), (8, 8), (1, 1)
+    live = _replayed(config, reuse, (), img)   # fresh_views kept up to date as the cache grows
     for done in range(len(history) + 1):
-        costs, cover = _replayed(config, reuse, history[:done], img).fresh_views()
+        costs, cover = live.fresh_views()
+        if done < len(history):
+            live.observe(history[done])
         for k in range(81):
             after = _replayed(config, reuse, history[:done], img).observe(k)
             assert costs[k] == after.detector_pixels

@@ -658,12 +658,16 @@ class OccupancySession:
             return info @ (~followed).astype(float)
         settled = self.settled(self._decided(log_odds)[0]) if self.link > 0 else None
         info, weight = self._still_terms(np.asarray(log_odds, dtype=float), settled)
+        if cover is None:
+            return np.einsum('kj,kj->k', info, weight)
+        cover = np.asarray(cover, dtype=bool)
+        part = np.flatnonzero(~cover.all(axis=1))              # views not read whole
+        if part.size == cover.shape[0]:
+            return np.einsum('kj,kj->k', info, np.where(cover, weight, 0.0))
         gains = np.einsum('kj,kj->k', info, weight)
-        if cover is not None:
-            cover = np.asarray(cover, dtype=bool)
-            part = np.flatnonzero(~cover.all(axis=1))          # views not read whole
-            if part.size:
-                gains[part] = np.einsum('kj,kj->k', info[part], weight[part] * cover[part])
+        if part.size:
+            gains[part] = np.einsum('kj,kj->k', info[part], np.where(cover[part], weight[part],
+                                                                     0.0))
         return gains
 
     def _still_terms(self, log_odds: np.ndarray, settled) -> tuple[np.ndarray, np.ndarray]:

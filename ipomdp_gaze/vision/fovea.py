@@ -284,6 +284,14 @@ def window_cells(grid_shape: tuple[int, int], windows_cells, fixation_rc) -> np.
     return np.stack([row, col, n_rows, n_cols], axis=1)
 
 
+def _cover(fresh: np.ndarray, in_rows: np.ndarray, in_cols: np.ndarray) -> np.ndarray:
+    """Return the cells (M, rows * cols) of each fixation's windows marked in ``fresh`` (M, K)."""
+    cover = np.zeros((fresh.shape[0], in_rows.shape[2], in_cols.shape[2]), dtype=bool)
+    for i in range(fresh.shape[1]):
+        cover |= fresh[:, i, None, None] & in_rows[:, i, :, None] & in_cols[:, i, None, :]
+    return cover.reshape(fresh.shape[0], cover.shape[1] * cover.shape[2])
+
+
 def _resized(size_px: int, scale: float) -> int:
     """``round(size_px * scale)`` (halves up), at least 1."""
     return max(1, int(np.floor(size_px * scale + 0.5)))
@@ -457,19 +465,16 @@ class Fovea:
         f = self._fresh
         if f is None:
             f = self._fresh = self._fixation_windows()
-        if f['seen'] != len(self._cache) or f['cover'] is None:
-            keys = list(self._cache)[f['seen']:]
-            for (cells, resized) in keys:
+        if f['seen'] != len(self._cache):
+            for cells, resized in list(self._cache)[f['seen']:]:
                 f['cached'] |= np.all(f['keys'] == (*cells, *resized), axis=-1)
             f['seen'] = len(self._cache)
             fresh = f['read'] & ~f['cached']
+            changed = np.flatnonzero(np.any(fresh != f['fresh'], axis=1))   # their cover
+            f['fresh'] = fresh
             f['costs'] = np.sum(np.where(fresh, f['pixels'], 0), axis=1).astype(float)
-            rows, cols = self.grid.shape
-            cover = np.zeros((self.grid.n_cells, rows, cols), dtype=bool)
-            for i in range(fresh.shape[1]):
-                cover |= (fresh[:, i, None, None] & f['in_rows'][:, i, :, None]
-                          & f['in_cols'][:, i, None, :])
-            f['cover'] = cover.reshape(self.grid.n_cells, -1)
+            f['cover'][changed] = _cover(fresh[changed], f['in_rows'][changed],
+                                         f['in_cols'][changed])
         return f['costs'].copy(), f['cover'].copy()
 
     def _fixation_windows(self) -> dict:
@@ -479,7 +484,9 @@ class Fovea:
         ``keys`` (N, K, 6): each window's cache key ``row, col, n_rows, n_cols, width, height``;
         ``pixels`` (N, K); ``read`` (N, K): the windows :meth:`observe` reads, less a copy of an
         earlier window of its fixation that it would serve from the cache; ``in_rows`` (N, K,
-        rows) and ``in_cols`` (N, K, cols): the cells each covers.
+        rows) and ``in_cols`` (N, K, cols): the cells each covers; and :meth:`fresh_views`'
+        state with nothing cached: ``cached``, ``seen`` (cache entries taken into account),
+        ``fresh``, ``cover`` and ``costs``.
         """
         grid, config = self.grid, self.config
         sizes = np.asarray(config.windows_cells, dtype=np.int64)
@@ -503,12 +510,15 @@ class Fovea:
             for j in range(i):
                 read[:, i] &= ~(kept[:, j] & read[:, j]
                                 & np.all(keys[:, i] == keys[:, j], axis=-1))
-        return {'keys': keys, 'pixels': width * height, 'read': read,
-                'cached': np.zeros(read.shape, dtype=bool), 'seen': 0, 'cover': None,
-                'in_rows': (np.arange(grid.rows) >= row[..., None])
-                & (np.arange(grid.rows) < (row + n_rows)[..., None]),
-                'in_cols': (np.arange(grid.cols) >= col[..., None])
-                & (np.arange(grid.cols) < (col + n_cols)[..., None])}
+        in_rows = (np.arange(grid.rows) >= row[..., None]) \
+            & (np.arange(grid.rows) < (row + n_rows)[..., None])
+        in_cols = (np.arange(grid.cols) >= col[..., None]) \
+            & (np.arange(grid.cols) < (col + n_cols)[..., None])
+        pixels = width * height
+        return {'keys': keys, 'pixels': pixels, 'read': read, 'in_rows': in_rows,
+                'in_cols': in_cols, 'cached': np.zeros(read.shape, dtype=bool), 'seen': 0,
+                'fresh': read, 'cover': _cover(read, in_rows, in_cols),
+                'costs': np.sum(np.where(read, pixels, 0), axis=1).astype(float)}
 
     def scan_cost(self) -> int:
         """Detector pixels :meth:`scan` would spend now (0 without a scan or once done)."""
