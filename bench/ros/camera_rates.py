@@ -15,6 +15,10 @@ whole ``--seconds``. Reported:
   evidence carries the image's stamp);
 - **which image answers a fixation**: images the camera sent between the fixation reaching this
   process and the image that answered it (0: the first one sent after it);
+- **each fixation's wait**: from the fixation reaching this process to the next
+  ``evidence_image``, for fixations commanded while the camera streamed (the first one, commanded
+  before the camera's first image, waits for the camera process to start), and the waits over
+  0.5 s;
 - the loop's rate (fixations answered per second) and the detector's own ``detector_ms``;
 - each process's CPU (share of one core) and resident memory, sampled every second (growth:
   the largest of the last third against the largest of the first third);
@@ -297,6 +301,43 @@ def run(args) -> dict:
             'wall_to_mono': time.time() - time.monotonic()}
 
 
+def streaming_spans(sent_s: np.ndarray, stall) -> list[tuple[float, float]]:
+    """
+    Return the spans (first image sent, last image sent) of each camera process.
+
+    ``sent_s`` are the send times of the images in the bench's monotonic clock; with a stall
+    (``stall`` is its (from, to), else (None, None)) the first camera sent before it and the
+    second after it.
+    """
+    if not sent_s.size:
+        return []
+    if stall[0] is None:
+        return [(float(sent_s[0]), float(sent_s[-1]))]
+    parts = (sent_s[sent_s <= stall[0]], sent_s[sent_s >= stall[1]])
+    return [(float(p[0]), float(p[-1])) for p in parts if p.size]
+
+
+def fixation_waits(fixations, evidence_s, spans) -> tuple[np.ndarray, int]:
+    """
+    Return the wait of each fixation for its evidence, and how many were left out.
+
+    A fixation counts once (not its re-sends) and only if it was commanded while a camera
+    streamed (within one of ``spans``): one commanded before the camera's first image, or in a
+    stall, waits for the camera process to start, not for the transport.
+    """
+    waits, left_out = [], 0
+    for i, (t, data) in enumerate(fixations):
+        if i and data == fixations[i - 1][1]:
+            continue                                # a re-send of the same fixation
+        if not any(first <= t <= last for first, last in spans):
+            left_out += 1
+            continue
+        j = int(np.searchsorted(evidence_s, t, side='right'))
+        if j < len(evidence_s):
+            waits.append(evidence_s[j] - t)
+    return np.asarray(waits, dtype=float), left_out
+
+
 def report(r: dict, args) -> str:
     """Text summary of a run."""
     off = r['wall_to_mono']
@@ -332,18 +373,17 @@ def report(r: dict, args) -> str:
         lines.append(f'evidence frames {lat.size} ({lat.size / span:.1f}/s); latency image stamp '
                      f'-> evidence here: median {1e3 * np.median(lat):.1f} ms, p90 '
                      f'{1e3 * np.percentile(lat, 90):.1f} ms, max {1e3 * lat.max():.1f} ms')
-    waits = []
-    for i, (t, data) in enumerate(r['fixations']):
-        if i and data == r['fixations'][i - 1][1]:
-            continue                                # a re-send of the same fixation
-        after = [te for te, _, _ in r['evidence'] if te > t]
-        if after:
-            waits.append(after[0] - t)
-    if waits:
-        w = np.asarray(waits)
-        lines.append(f'fixation -> its evidence here: median {1e3 * np.median(w):.1f} ms, p90 '
-                     f'{1e3 * np.percentile(w, 90):.1f} ms, max {1e3 * w.max():.0f} ms; over '
-                     f'0.5 s: {int(np.sum(w > 0.5))} of {w.size}')
+    sent_s = sent[:, 0] * 1e-9 - off if sent.size else np.zeros(0)
+    waits, before = fixation_waits(r['fixations'], [te for te, _, _ in r['evidence']],
+                                   streaming_spans(sent_s, r['stall']))
+    if waits.size:
+        slow = np.sort(waits[waits > 0.5])[::-1]
+        lines.append(f'fixation -> its evidence here ({before} commanded while the camera was '
+                     f'not streaming left out): median '
+                     f'{1e3 * np.median(waits):.1f} ms, p90 {1e3 * np.percentile(waits, 90):.1f} '
+                     f'ms, max {1e3 * waits.max():.0f} ms; over 0.5 s: {slow.size} of '
+                     f'{waits.size}' + (f' ({", ".join(f"{w:.2f}" for w in slow[:8])} s)'
+                                        if slow.size else ''))
     if skipped:
         s = np.asarray(skipped)
         lines.append(f'images sent between the fixation and the one that answered it: '
