@@ -246,9 +246,11 @@ def test_install_has_executables_index_marker_and_share_files(install):
     assert marker.is_file(), marker
     shipped = ['package.xml'] + [p.relative_to(install.copy).as_posix() for p in
                                  (*sorted(install.copy.glob('config/*.yaml')),
+                                  *sorted(install.copy.glob('config/*.xml')),
                                   *sorted(install.copy.glob('launch/*.launch.py')))]
     assert {'config/controller.yaml', 'config/camera.yaml', 'config/faces_fovea_detector.yaml',
-            'config/faces_camera_scene_camera.yaml', 'launch/faces_demo.launch.py'} <= \
+            'config/faces_camera_scene_camera.yaml', 'config/fastdds_large_images.xml',
+            'launch/faces_demo.launch.py'} <= \
         set(shipped)
     for name in shipped:
         assert (install.share / name).is_file(), install.share / name

@@ -67,9 +67,10 @@ def test_setup_installs_marker_package_xml_config_launch_and_kernels(monkeypatch
     installed = {dest: {Path(f).as_posix() for f in files} for dest, files in dist.data_files}
     assert 'resource/ipomdp_gaze' in installed['share/ament_index/resource_index/packages']
     assert 'package.xml' in installed['share/ipomdp_gaze']
-    for dest, folder, pattern in (('config', 'config', '*.yaml'),
-                                  ('launch', 'launch', '*.launch.py')):
-        expected = {p.relative_to(ROOT).as_posix() for p in (ROOT / folder).glob(pattern)}
+    for dest, folder, patterns in (('config', 'config', ('*.yaml', '*.xml')),
+                                   ('launch', 'launch', ('*.launch.py',))):
+        expected = {p.relative_to(ROOT).as_posix() for pattern in patterns
+                    for p in (ROOT / folder).glob(pattern)}
         assert expected == installed.get(f'share/ipomdp_gaze/{dest}', set()), dest
     # Kernels are package data of ipomdp_gaze.policies (importlib.resources), not share/ files.
     assert 'share/ipomdp_gaze/kernels' not in installed
