@@ -166,3 +166,26 @@ def test_a_prior_given_with_a_switch_to_one_target_starts_the_new_search():
     assert core.settings.targets == 'one'
     absent = values['absent.prior']
     np.testing.assert_allclose(core.belief, (1 - absent) * weights / weights.sum(), atol=1e-15)
+
+
+@pytest.mark.parametrize('change', [
+    {'motion.position_sigma_cells': 1e308}, {'motion.sigma_cells': 1e200},
+    {'motion.speed_cells': 1e200}, {'motion.max_speed_cells': 1e308}])
+def test_a_huge_motion_length_is_applied_not_an_overflow(change):
+    """
+    QA: ``motion.position_sigma_cells`` 1e308 passed the check, then applying it overflowed.
+
+    The position filter squared it (an OverflowError after the change was reported taken);
+    ``motion.max_speed_cells`` 1e308 made a NaN belief. Every finite length applies.
+    """
+    values = dict(_values('tracking'), **{'motion.track_view': 'position'})
+    old = build_config(values, build_policy)
+    core = old.controller()
+    rng = np.random.default_rng(0)
+    core.reset(0.0)
+    t_s = _frames(core, rng, 3, 0.0, True)
+    new = build_config(dict(values, **change), build_policy, set(change), old)
+    follow_config(core, new, old.values)
+    _frames(core, rng, 4, t_s, True)
+    assert 0 <= core.fixation < core.grid.n_cells
+    assert not np.isnan(core.session.log_belief).any()

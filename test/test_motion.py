@@ -394,3 +394,19 @@ def test_evaluate_with_a_huge_motion_sigma_runs(cli_here):
                    '--motion-sigma-cells', '1e200', '--seed', 0, '--quiet')
     assert run.returncode == 0, run.stderr
     assert 'Traceback' not in run.stderr
+
+
+@pytest.mark.parametrize('speed', [1e200, 1e308])
+def test_a_walk_far_faster_than_the_grid_leaves_it_without_a_nan(speed):
+    """
+    QA: ``motion.max_speed_cells`` 1e308 made a NaN belief (``linspace(-speed, speed)``).
+
+    Every moving velocity walks off the grid in any step, as one of a few grid lengths does:
+    the prediction is that of a speed the grid's size.
+    """
+    grid = Grid(3, 4, 5.0)
+    belief = np.log(np.arange(1.0, 13.0) / 78.0)
+    fast, slow = (VelocityMotion(grid, 0.5, 0.0, 0.0, s, 0.2, 0.0) for s in (speed, 40.0))
+    assert np.isfinite(fast.speeds).all()
+    np.testing.assert_allclose(fast.predict_over(belief.copy(), 2.0),
+                               slow.predict_over(belief.copy(), 2.0), rtol=1e-12)

@@ -5,7 +5,7 @@ from ipomdp_gaze.model.belief import EvidenceError
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head_camera import bin_points, PinholeCamera, point_offsets
 from ipomdp_gaze.model.observation import CountObservation
-from ipomdp_gaze.model.position_filter import measured_position, PositionFilter
+from ipomdp_gaze.model.position_filter import measured_position, PositionFilter, walk_filter
 from ipomdp_gaze.search.session import Frame, SearchSession, SearchSettings
 import numpy as np
 import pytest
@@ -173,3 +173,29 @@ def test_bad_offsets_are_rejected_and_the_belief_kept(offsets, words):
     np.testing.assert_array_equal(session.belief, before)
     with pytest.raises(EvidenceError, match=words):
         session.checked_frame(np.zeros(grid.n_cells), offsets=offsets)
+
+
+@pytest.mark.parametrize('scale', [1e100, 1e300])
+def test_huge_lengths_filter_as_the_same_lengths_scaled_down(scale):
+    """
+    QA: a measurement sigma of 1e308 cells was an OverflowError in ``sigma ** 2``.
+
+    The filter's estimates depend only on ratios of its variances: lengths scaled up together
+    give the same positions and velocities, and any finite lengths build a filter.
+    """
+    rng = np.random.default_rng(5)
+    z = rng.normal(size=(6, 2)) + np.arange(6)[:, None] * 0.3
+    filters = [walk_filter(0.14 * f, 0.3, 0.15 * f, 1.49 * f) for f in (1.0, scale)]
+    for kf in filters:
+        kf.start(z[0])
+        for zi in z[1:]:
+            kf.predict(0.2)
+            kf.update(zi)
+    np.testing.assert_allclose(filters[1].x, filters[0].x, rtol=1e-12)
+    np.testing.assert_allclose(filters[1].v, filters[0].v, rtol=1e-12)
+    for lengths in [(1e308, 0.0, 0.0), (0.1, 1e308, 1e308), (1e-300, 1e308, 0.0)]:
+        kf = walk_filter(lengths[0], 0.3, *lengths[1:])
+        kf.start(z[0])
+        kf.predict(0.2)
+        kf.update(z[1])
+        assert np.isfinite(kf.ahead(0.3)).all()

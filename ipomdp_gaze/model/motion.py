@@ -327,7 +327,9 @@ def axis_drift(size: int, sigma_cells: float, shift_cells: float) -> np.ndarray:
     (linear interpolation); mass shifted past either end leaves the axis (the row sums to less
     than 1: the target walked out of the grid). :func:`axis_transition` then spreads it.
     """
-    x = np.arange(size) + float(shift_cells)
+    # a shift past size + 1 cells takes every position off the axis, as a larger one does (and
+    # keeps floor() within int64: max_speed_cells 1e308 made it a NaN belief)
+    x = np.arange(size) + min(max(float(shift_cells), -(size + 1.0)), size + 1.0)
     low = np.floor(x).astype(np.int64)
     frac = x - low
     shift = np.zeros((size, size + 2))           # columns 0 and size + 1: past the ends
@@ -369,9 +371,11 @@ class VelocityMotion(Motion):
         if isinstance(classes, bool) or int(classes) != classes or classes < 2:
             raise ValueError(f'classes must be an int >= 2, got {classes!r}')
         self.classes = int(classes)
-        self.speeds = np.linspace(-speed, speed, self.classes)
-        axis = np.ones(self.classes) if self.speed_cells == 0 else \
-            np.exp(-0.5 * (self.speeds / self.speed_cells) ** 2)
+        # speed times the unit steps: linspace(-speed, speed) overflows its step past 9e307
+        self.speeds = speed * np.linspace(-1.0, 1.0, self.classes)
+        with np.errstate(over='ignore'):              # a speed far beyond speed_cells: weight 0
+            axis = np.ones(self.classes) if self.speed_cells == 0 else \
+                np.exp(-0.5 * (self.speeds / self.speed_cells) ** 2)
         prior = np.outer(axis, axis)
         self.prior = prior / prior.sum()
         self.reset()
@@ -424,8 +428,8 @@ class VelocityMotion(Motion):
         peak = np.max(log_belief)
         cells = np.exp(log_belief[:n] - peak)
         sigma = step_sigma(self.sigma_cells, dt)
-        row_t = np.stack([axis_drift(rows, sigma, v * dt).T for v in self.speeds])
-        col = np.stack([axis_drift(cols, sigma, v * dt) for v in self.speeds])
+        row_t = np.stack([axis_drift(rows, sigma, float(v) * dt).T for v in self.speeds])
+        col = np.stack([axis_drift(cols, sigma, float(v) * dt) for v in self.speeds])
         joint = (self.velocity * cells[None, None, :]).reshape(k, k, rows, cols)
         moved = np.matmul(np.matmul(row_t[:, None], joint), col[None, :]).reshape(k, k, n)
         kept = row_t.sum(axis=1)[:, None, :, None] * col.sum(axis=2)[None, :, None, :]

@@ -18,7 +18,16 @@ found (``motion.track_view: position``) and looks at the cell of the position pr
 """
 from __future__ import annotations
 
+import math
+import sys
+
 import numpy as np
+
+# The filter's lengths (cells) are scaled down together so the largest is at most this: its
+# squares, and their products with any frame's dt, stay far from overflowing (a length of 1e308
+# was an OverflowError in sigma ** 2). A Kalman filter's estimates are the same when every noise
+# variance is multiplied by one factor (the gains are ratios of them), so nothing else changes.
+MAX_LENGTH_CELLS = 1e100
 
 # A measurement or a filtered position farther than this from the cell belief's peak (cells, on
 # either axis) is another target or the filter gone astray: the cell belief decides.
@@ -48,6 +57,23 @@ def measured_position(values, offsets, grid, peak: int) -> np.ndarray | None:
     return (w[:, None] * rc).sum(axis=0) / w.sum()
 
 
+def walk_filter(measurement_sigma_cells: float, turn_prob: float, sigma_cells: float = 0.0,
+                speed_cells: float = 0.0) -> PositionFilter:
+    """
+    Return the filter of a walking target's settings, its lengths scaled (MAX_LENGTH_CELLS).
+
+    The velocity's random walk is ``q = 2 turn_prob speed_cells^2`` (docs/design.md section
+    12.9); ``q`` and every variance are of the scaled lengths, so any finite lengths work.
+    """
+    lengths = [float(measurement_sigma_cells), float(sigma_cells), float(speed_cells)]
+    largest = max(lengths)
+    if math.isfinite(largest) and largest > MAX_LENGTH_CELLS:
+        lengths = [length / largest * MAX_LENGTH_CELLS for length in lengths]
+    measurement, sigma, speed = lengths
+    measurement = max(measurement, sys.float_info.min)          # > 0 after scaling too
+    return PositionFilter(measurement, 2.0 * float(turn_prob) * speed * speed, sigma, speed)
+
+
 class PositionFilter:
     """
     A constant-velocity Kalman filter on a target's grid position (module docstring).
@@ -65,6 +91,8 @@ class PositionFilter:
     speed_cells : float
         Standard deviation of the velocity when the filter starts (cells/s, >= 0).
 
+    A variance that is not finite is refused (:func:`walk_filter` scales large lengths).
+
     """
 
     def __init__(self, measurement_sigma_cells: float, accel_density: float,
@@ -74,10 +102,16 @@ class PositionFilter:
                              f'{measurement_sigma_cells!r}')
         if not (accel_density >= 0 and sigma_cells >= 0 and speed_cells >= 0):
             raise ValueError('accel_density, sigma_cells and speed_cells must be >= 0')
-        self.r = float(measurement_sigma_cells) ** 2
+        # a product, not ** (which raises OverflowError); a measurement variance that underflows
+        # is the smallest normal number (the update divides by it when nothing else is left)
+        self.r = max(float(measurement_sigma_cells) * float(measurement_sigma_cells),
+                     sys.float_info.min)
         self.q = float(accel_density)
-        self.s2 = float(sigma_cells) ** 2
-        self.v2 = float(speed_cells) ** 2
+        self.s2 = float(sigma_cells) * float(sigma_cells)
+        self.v2 = float(speed_cells) * float(speed_cells)
+        if not all(math.isfinite(v) for v in (self.r, self.q, self.s2, self.v2)):
+            raise ValueError("the filter's variances must be finite (walk_filter scales lengths "
+                             f'over {MAX_LENGTH_CELLS:g} cells)')
         self.reset()
 
     def reset(self) -> None:

@@ -47,7 +47,8 @@ from ipomdp_gaze.model.head_time import tour_detour_deg, view_seconds
 from ipomdp_gaze.model.inhibition import policy_choice, unvisited_choice
 from ipomdp_gaze.model.motion import Motion, VelocityMotion
 from ipomdp_gaze.model.observation import as_observation, check_evidence, CountObservation
-from ipomdp_gaze.model.position_filter import GATE_CELLS, measured_position, PositionFilter
+from ipomdp_gaze.model.position_filter import (GATE_CELLS, measured_position, PositionFilter,
+                                               walk_filter)
 from ipomdp_gaze.model.still_evidence import cell_information, StillEvidence
 from ipomdp_gaze.model.stopping import ABSENT, decide_one, FOUND, initial_log_belief, with_absent
 from ipomdp_gaze.model.view_reach import ViewReach
@@ -227,10 +228,8 @@ def track_filter(settings: SearchSettings) -> PositionFilter | None:
     """
     if settings.motion_track_view != 'position':
         return None
-    speed = settings.motion_speed_cells
-    return PositionFilter(settings.motion_position_sigma_cells,
-                          2.0 * settings.motion_turn_prob * speed ** 2,
-                          settings.motion_sigma_cells, speed)
+    return walk_filter(settings.motion_position_sigma_cells, settings.motion_turn_prob,
+                       settings.motion_sigma_cells, settings.motion_speed_cells)
 
 
 def fixation_index(grid: Grid, cell) -> int:
