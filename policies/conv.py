@@ -51,6 +51,11 @@ FFT_ERROR_FACTOR = 16.0
 # Default truncation: kernel entries below this fraction of the largest are left out of the FFT
 # (below float64 resolution next to the largest term; decisions never depend on it).
 DEFAULT_TRUNCATE = 1e-16
+# A kernel whose absolute values sum past this is refused: a score is a belief-weighted sum of
+# its entries and the FFT path adds up its spectrum over up to P x Q terms (1.7e7 for a 1024 x
+# 1024 grid), so every score and every sum on the way stays finite (huge kernels made NaN
+# scores, and the controller fixated cell 0 forever).
+MAX_KERNEL_ABS_SUM = 1e300
 # Near-maximal candidates re-scored exactly at most; more means a flat belief (a massive tie).
 RESCORE_MAX = 16
 # Cells re-scored per vectorised chunk (memory bound for the gathered windows).
@@ -90,7 +95,23 @@ def check_kernel(values, grid: Grid, what: str = 'kernel') -> np.ndarray:
     bad = np.flatnonzero(~np.isfinite(a))
     if bad.size:
         raise ValueError(f'{what} must be finite, entry {int(bad[0])} is {a.flat[bad[0]]}')
+    check_score_scale(a, what)
     return a
+
+
+def check_score_scale(weights: np.ndarray, what: str, axis: int | None = None) -> None:
+    """
+    Refuse weights whose absolute values sum past :data:`MAX_KERNEL_ABS_SUM` (ValueError).
+
+    ``axis`` sums per row (a logistic policy's theta: one score per row); None sums them all.
+    """
+    with np.errstate(over='ignore'):
+        total = float(np.max(np.abs(weights).sum(axis=axis)))
+    if not total <= MAX_KERNEL_ABS_SUM:
+        per = ' in a row' if axis is not None else ''
+        raise ValueError(f'{what}: the sum of its absolute values{per} must be at most '
+                         f'{MAX_KERNEL_ABS_SUM:g} (a score is a sum of belief times weights and '
+                         f'must not overflow), got {total:g}')
 
 
 def squared_distance_table(grid: Grid) -> np.ndarray:

@@ -13,7 +13,7 @@ from ipomdp_gaze.model.belief import argmax_ties_low
 from ipomdp_gaze.model.grid import Grid
 import numpy as np
 
-from .conv import check_action
+from .conv import check_action, check_score_scale
 
 
 def softmax(scores: np.ndarray) -> np.ndarray:
@@ -43,6 +43,7 @@ class LogisticPolicy:
                              f'grid, got {theta.shape}')
         if not np.all(np.isfinite(theta)):
             raise ValueError('theta contains NaN or inf')
+        check_score_scale(theta, 'theta', axis=1)
         self.grid = grid
         self.theta = theta
         self.action = check_action(action)

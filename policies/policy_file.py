@@ -44,7 +44,7 @@ from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.observation import CountObservation, GaussianObservation
 import numpy as np
 
-from .conv import ACTIONS, ConvPolicy, radial_bins
+from .conv import ACTIONS, check_score_scale, ConvPolicy, radial_bins
 from .logistic import LogisticPolicy
 
 FORMAT = 'ipomdp_gaze/policy-v1'
@@ -212,6 +212,14 @@ def _array(doc: dict, key: str, shape: tuple[int, int], what: str) -> np.ndarray
     return array
 
 
+def _scale(weights: np.ndarray, key: str, axis: int | None = None) -> None:
+    """Refuse weights whose scores can overflow (:func:`conv.check_score_scale`)."""
+    try:
+        check_score_scale(weights, key, axis)
+    except ValueError as exc:
+        raise PolicyFileError(str(exc)) from None
+
+
 def _grid(block) -> Grid:
     if not isinstance(block, dict):
         raise PolicyFileError('grid must be a mapping {rows, cols, spacing_deg}')
@@ -369,11 +377,13 @@ def spec_from_dict(doc, path: Path | None = None) -> PolicySpec:
     kernel = theta = None
     if family == 'conv':
         kernel = _array(doc, 'kernel', grid.kernel_shape, f'a {grid.rows}x{grid.cols} grid')
+        _scale(kernel, 'kernel')
         if 'radial' in doc:
             _check_radial(doc['radial'], grid, kernel)
     else:
         n = grid.n_cells
         theta = _array(doc, 'theta', (n, n), f'a {grid.rows}x{grid.cols} grid')
+        _scale(theta, 'theta', axis=1)
     training, evaluation = _record(doc, 'training'), _record(doc, 'evaluation')
     for key, block in (('training', training), ('evaluation', evaluation)):
         if block.get('prior') is not None:

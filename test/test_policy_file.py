@@ -8,7 +8,8 @@ from ipomdp_gaze.files.observation_file import fingerprint, load_observation
 from ipomdp_gaze.model.fpoc import make_fpoc
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.policies import policy_file as pf
-from ipomdp_gaze.policies.conv import ConvPolicy, kernel_from_radial, radial_bins
+from ipomdp_gaze.policies.conv import (check_kernel, ConvPolicy, kernel_from_radial,
+                                       radial_bins)
 from ipomdp_gaze.policies.logistic import LogisticPolicy
 from ipomdp_gaze.policies.policy_file import (load_policy, load_policy_spec, PolicyFileError,
                                               PolicySpec, save_policy, shipped_kernels)
@@ -233,6 +234,9 @@ ERRORS = [
     ('kernel-nan', _kernel_entry(float('nan')), r'non-finite values in kernel: 1 entries, '
      r'the first at \[1\]\[2\]'),
     ('kernel-inf', _kernel_entry(float('inf')), r'non-finite values in kernel'),
+    ('kernel-huge', _kernel_entry(1e308), r'kernel: the sum of its absolute values must be at '
+     r'most 1e\+300 \(a score is a sum of belief times weights and must not overflow\), got '
+     r'1e\+308'),
     ('theta-for-conv', _set('theta', [[0.0]]), 'family conv takes kernel, not theta'),
     ('radial-disagrees', _kernel_entry(123.0),
      r'radial disagrees with kernel: squared_distance \d+ has weight .* kernel\[1\]\[2\] is 123'),
@@ -286,6 +290,11 @@ def test_logistic_errors(tmp_path):
         load_policy_spec(path)
     path = write_doc(tmp_path, _break(doc, _set('kernel', [[0.0]])))
     with pytest.raises(PolicyFileError, match='family logistic takes theta, not kernel'):
+        load_policy_spec(path)
+    bad[4][0], bad[4][1] = 1e308, -1e308
+    path = write_doc(tmp_path, _break(doc, _set('theta', bad)))
+    with pytest.raises(PolicyFileError, match=r'theta: the sum of its absolute values in a row '
+                                              r'must be at most 1e\+300'):
         load_policy_spec(path)
 
 
@@ -368,6 +377,31 @@ def test_evaluate_cli_bad_file_is_one_line(tmp_path, capsys, content, message):
     err = capsys.readouterr().err
     assert err.count('\n') == 1 and 'Traceback' not in err
     assert err.startswith('ipomdp-gaze evaluate: error: ') and message in err
+
+
+def test_evaluate_cli_kernel_whose_scores_overflow_is_one_line(tmp_path, capsys):
+    """QA: huge finite entries were accepted and made NaN scores (the search fixated cell 0)."""
+    huge = [[1e308 * (-1) ** (r + c) for c in range(7)] for r in range(5)]
+    path = write_doc(tmp_path, dict(good_doc(), kernel=huge, radial=None))
+    assert main(['evaluate', '--grid', '3x4', '--policy-file', str(path),
+                 '--episodes', '10']) == 2
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1 and 'Traceback' not in err
+    assert 'kernel: the sum of its absolute values must be at most 1e+300' in err
+
+
+def test_a_kernel_whose_scores_overflow_is_refused_where_kernels_are_checked():
+    """The parameter's check (``policy.kernel``): the QA kernel, 1e308 of either sign."""
+    grid = Grid(11, 11)
+    with pytest.raises(ValueError, match=r'policy.kernel: the sum of its absolute values must be '
+                                         r'at most 1e\+300 .*, got inf'):
+        check_kernel([-1e308, 1e308] * 220 + [1.0], grid, 'policy.kernel')
+    with pytest.raises(ValueError, match='theta: the sum of its absolute values in a row'):
+        LogisticPolicy(GRID, np.diag([1e301] * GRID.n_cells))
+    kernel = check_kernel([1e297] * 441, grid)                   # the sum is 4.4e299: scores
+    for method in ('direct', 'fft'):                            # stay finite on either path
+        belief = np.random.default_rng(0).dirichlet(np.ones(121))
+        assert np.isfinite(ConvPolicy(grid, kernel, method=method).scores(belief)).all()
 
 
 def test_evaluate_cli_grid_mismatch_is_one_line(tmp_path, capsys):

@@ -24,7 +24,7 @@ from ipomdp_gaze.model.inhibition import unvisited_choice
 from ipomdp_gaze.model.observation import check_evidence
 from ipomdp_gaze.model.observation import gaussian_log_likelihood_ratio as llr
 from ipomdp_gaze.policies.baselines import make_baseline, STRATEGIES
-from ipomdp_gaze.policies.conv import ConvPolicy
+from ipomdp_gaze.policies.conv import ConvPolicy, MAX_KERNEL_ABS_SUM
 from ipomdp_gaze.policies.registry import build_policy
 from ipomdp_gaze.search.gaze import GazeController
 import numpy as np
@@ -243,6 +243,12 @@ def test_conv_policy_with_any_finite_kernel_chooses_a_valid_cell(grid, action, s
         st.floats(-1.0, 1.0), min_size=shape[0] * shape[1],
         max_size=shape[0] * shape[1]))).reshape(shape)
     assume(np.all(np.isfinite(kernel)))
+    with np.errstate(over='ignore'):
+        total = np.abs(kernel).sum()
+    if not total <= MAX_KERNEL_ABS_SUM:                     # its scores could overflow: refused
+        with pytest.raises(ValueError, match='the sum of its absolute values'):
+            ConvPolicy(grid, kernel, action=action)
+        return
     policy = ConvPolicy(grid, kernel, action=action)
     belief = data.draw(beliefs(grid.n_cells))
     rng = np.random.default_rng(data.draw(st.integers(0, 2 ** 32)))
