@@ -74,9 +74,30 @@ def test_a_command_beyond_the_grid_is_clipped_to_its_edge_and_warned():
     inside = joints.joint_state(head_map, head_map.grid.index(4, 6), Time())
     assert head._commanded_cell(inside, head_map) == head_map.grid.index(4, 6)
     assert logger.warnings == []
-    far = JointState(name=['pan_joint', 'tilt_joint'], position=[-100.0, 0.0])
+    far = JointState(name=['pan_joint', 'tilt_joint'], position=[-3.0, 0.0])
     assert head._commanded_cell(far, head_map) == head_map.grid.index(2, 6)    # pan's edge
     assert len(logger.warnings) == 1 and 'beyond the 5x7 grid' in logger.warnings[0]
     nan = JointState(name=['pan_joint', 'tilt_joint'], position=[float('nan'), 0.0])
     assert head._commanded_cell(nan, head_map) is None
     assert 'ignored a pan_tilt command' in logger.warnings[1]
+
+
+@pytest.mark.parametrize('pan_rad', [1e300, -7.0])
+def test_a_command_beyond_a_turn_is_ignored_in_one_readable_line(pan_rad):
+    """
+    QA: a pan of 1e300 rad was clipped and logged with its 300 digits (``:.4f``).
+
+    The detector refuses joint angles beyond one turn as absurd; the camera ignores such a
+    command as malformed, with a short warning, and the head stays where it was.
+    """
+    from ipomdp_gaze.model.grid import Grid
+    from ipomdp_gaze.model.head import PanTiltMap
+    from sensor_msgs.msg import JointState
+    head_map = PanTiltMap(Grid(5, 7, spacing_deg=5.0))
+    head, logger = _head(), _Logger()
+    head.get_logger = lambda: logger
+    absurd = JointState(name=['pan_joint', 'tilt_joint'], position=[pan_rad, 0.0])
+    assert head._commanded_cell(absurd, head_map) is None
+    assert len(logger.warnings) == 1 and len(logger.warnings[0]) < 120
+    assert logger.warnings[0].startswith('ignored a pan_tilt command: pan/tilt ')
+    assert 'beyond +/-6.2832 rad (one turn)' in logger.warnings[0]

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from ipomdp_gaze.model.head_time import SACCADE_TIME_S
 from ipomdp_gaze.msg_adapters import joints
+from ipomdp_gaze.vision.detection import MAX_JOINT_RAD
 
 from .params import Param, T
 
@@ -57,10 +58,15 @@ class SaccadeMixin:
         Return the cell nearest a ``pan_tilt`` command, or None (warned, throttled).
 
         A command more than a cell beyond the grid is warned about (throttled) and clipped to
-        the edge, as a head stops at its joint limits.
+        the edge, as a head stops at its joint limits; one beyond a turn (:data:`MAX_JOINT_RAD`,
+        the detector's bound on joint angles) is malformed: ignored (warned, throttled), the
+        head stays where it is.
         """
         try:
             pan_rad, tilt_rad = joints.angles_from_joint_state(msg, head)
+            if not (abs(pan_rad) <= MAX_JOINT_RAD and abs(tilt_rad) <= MAX_JOINT_RAD):
+                raise ValueError(f'pan/tilt {pan_rad:.4g}, {tilt_rad:.4g} rad: beyond '
+                                 f'+/-{MAX_JOINT_RAD:.4f} rad (one turn)')
             row, col = head.position(pan_rad, tilt_rad)
         except ValueError as exc:
             self.get_logger().warning(f'ignored a pan_tilt command: {exc}',
