@@ -218,6 +218,12 @@ def test_default_policy_is_the_shipped_kernel_of_the_model(task, tmp_path, monke
 @pytest.mark.parametrize('make, message', [
     (lambda d: d / 'missing.png', 'no such file'),
     (lambda d: _write(d / 'text.png', b'not an image'), 'not an image OpenCV can decode'),
+    # QA: cv2.imread shows a truncated JPEG's top part above grey; imdecode refuses it whole,
+    # and the message said it was not an image at all
+    (lambda d: _write(d / 'cut.jpg', _jpeg_bytes()[:3000]), 'truncated or corrupt JPEG: it ends '
+     'before its end-of-image marker (a copy or download cut short?)'),
+    (lambda d: _write(d / 'scrambled.jpg', _jpeg_bytes()[:600] + bytes(2000) + b'\xff\xd9'),
+     'truncated or corrupt JPEG: OpenCV cannot decode it'),
     # 16-bit images are converted (test_find_truth.py); a float image is still refused.
     (lambda d: _png(d / 'deep.tiff', np.zeros((420, 420), dtype=np.float32)),
      '32-bit float32 image; find needs 8 or 16 bits per channel'),
@@ -255,6 +261,12 @@ def test_a_malformed_observation_file_is_one_error_line(task, tmp_path, find_her
 def _write(path, data: bytes):
     path.write_bytes(data)
     return path
+
+
+def _jpeg_bytes() -> bytes:
+    """Return a 320x240 JPEG of seeded noise (about 20 kB)."""
+    image = np.random.default_rng(0).integers(0, 256, (240, 320, 3), dtype=np.uint8)
+    return cv2.imencode('.jpg', image)[1].tobytes()
 
 
 def _png(path, image):

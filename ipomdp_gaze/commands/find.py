@@ -120,7 +120,7 @@ from ipomdp_gaze.search import answer
 from ipomdp_gaze.search.many import check_many_settings
 from ipomdp_gaze.vision.detectors import load_factory
 from ipomdp_gaze.vision.fullframe import MAX_ENLARGED_PX
-from ipomdp_gaze.vision.image_files import decode_quietly
+from ipomdp_gaze.vision.image_files import decode_quietly, undecodable
 from ipomdp_gaze.vision.scales import (finest_scale, ladder_scales, max_enlargement,
                                        min_face_px, SCALE_TABLES)
 from ipomdp_gaze.vision.search import (calibrated_size, check_image_size, clip_box,
@@ -420,9 +420,9 @@ def read_image(path: str, notes: list | None = None, max_side: int = 0,
         image = decode_quietly(data, flags) if data.size else None
     except ValueError as exc:   # over OpenCV's pixel limit, or out of memory
         raise ValueError(f'{path}: {exc}') from None
-    del data
     if image is None:
-        raise ValueError(f'{path}: not an image OpenCV can decode')
+        raise ValueError(f'{path}: {undecodable(data)}')
+    del data
     if pages > 1 and notes is not None:
         notes.append(_pages_note(path, kind, pages))
     if image.ndim == 3 and image.shape[2] in (2, 4):

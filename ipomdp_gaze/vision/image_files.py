@@ -27,6 +27,28 @@ def decode_error(exc: cv2.error) -> str:
     return f'OpenCV cannot decode it: {exc.err or text.strip().splitlines()[-1]}'
 
 
+JPEG_START = b'\xff\xd8\xff'
+JPEG_END = b'\xff\xd9'
+
+
+def undecodable(data: np.ndarray) -> str:
+    """
+    Say in one line why bytes that :func:`decode_quietly` returned None for are no image.
+
+    A JPEG is named as one: ``cv2.imdecode`` refuses a truncated JPEG whole, though
+    ``cv2.imread`` and viewers show its top part above grey (a search of it would give wrong
+    answers), so "not an image" misled. A file cut short ends before the end-of-image marker
+    (trailing zero padding aside).
+    """
+    head = bytes(data[:len(JPEG_START)])
+    if head != JPEG_START:
+        return 'not an image OpenCV can decode'
+    if not bytes(data[-4096:]).rstrip(b'\x00').endswith(JPEG_END):
+        return ('truncated or corrupt JPEG: it ends before its end-of-image marker (a copy or '
+                'download cut short?); OpenCV decodes only its top part, so it is not searched')
+    return 'truncated or corrupt JPEG: OpenCV cannot decode it'
+
+
 @contextmanager
 def _quiet_fd(fd: int = 2):
     """Send what C code writes to file descriptor ``fd`` (stderr) to /dev/null meanwhile."""

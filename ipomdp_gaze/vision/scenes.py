@@ -571,14 +571,14 @@ def _read_image(path: Path, where: str) -> np.ndarray:
     """
     if not path.is_file():
         raise FileNotFoundError(f'{where}: image {path} does not exist')
-    from .image_files import decode_quietly, READ_FLAGS
+    from .image_files import decode_quietly, READ_FLAGS, undecodable
     data = np.fromfile(path, dtype=np.uint8)
     try:
         image = decode_quietly(data, READ_FLAGS) if data.size else None
     except ValueError as exc:   # over OpenCV's pixel limit, or out of memory
         raise ValueError(f'{where}: {path}: {exc}') from None
     if image is None:
-        raise ValueError(f'{where}: cannot decode {path} as an image')
+        raise ValueError(f'{where}: cannot decode {path} as an image: {undecodable(data)}')
     if image.dtype != np.uint8:
         raise ValueError(f'{where}: {path} is {image.dtype}; only 8-bit images are supported')
     if image.ndim == 3 and image.shape[2] == 1:
