@@ -189,3 +189,22 @@ def test_a_huge_motion_length_is_applied_not_an_overflow(change):
     _frames(core, rng, 4, t_s, True)
     assert 0 <= core.fixation < core.grid.n_cells
     assert not np.isnan(core.session.log_belief).any()
+
+
+def test_a_table_fpoc_of_another_length_names_the_nodes_default():
+    """
+    QA: ``fpoc.model table`` with three ``fpoc.dprime`` named the Python class's default.
+
+    The refusal said ``a value not given is its default: ecc_deg [0.0, 1.0]``; the node's
+    default ``fpoc.ecc_deg`` is ``[0.0, 10.0]``, the one it used.
+    """
+    values = dict(DEFAULTS, **{'fpoc.model': 'table', 'fpoc.dprime': [1.0, 2.0, 3.0]})
+    assert DEFAULTS['fpoc.ecc_deg'] == [0.0, 10.0]
+    with pytest.raises(ValueError) as info:
+        build_config(values, build_policy)
+    assert str(info.value) == (
+        'the table FPOC needs fpoc.ecc_deg and fpoc.dprime non-empty and of equal length, got '
+        '2 fpoc.ecc_deg [0.0, 10.0] and 3 fpoc.dprime [1.0, 2.0, 3.0] (fpoc.ecc_deg not given '
+        'is its default, [0.0, 10.0])')
+    table = build_config(dict(values, **{'fpoc.dprime': [4.0, 1.0]}), build_policy)
+    assert table.controller().session is not None

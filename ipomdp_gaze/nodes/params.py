@@ -21,6 +21,7 @@ import math
 from typing import Callable
 
 from ipomdp_gaze.model.fpoc import CameraFPOC, MODELS
+from ipomdp_gaze.search.controller_config import TABLE_ECC_DEG
 from ipomdp_gaze.search.settings import SCHEMA
 from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
                                 SetParametersResult)
@@ -151,7 +152,7 @@ def fpoc_params() -> list[Param]:
               float_range=(1e-6, 12.0)),
         Param('fpoc.scale_deg', 1.5, T.DOUBLE, 'exponential: fall-off scale in degrees',
               float_range=(1e-6, 180.0)),
-        Param('fpoc.ecc_deg', [0.0, 10.0], T.DOUBLE_ARRAY,
+        Param('fpoc.ecc_deg', list(TABLE_ECC_DEG), T.DOUBLE_ARRAY,
               'table: eccentricities in degrees (increasing)'),
     ]
 

@@ -44,6 +44,11 @@ def grid_from(values: Mapping) -> Grid:
     return Grid(values['grid.rows'], values['grid.cols'], values['grid.spacing_deg'])
 
 
+# The nodes' default fpoc.ecc_deg (nodes/params.py declares it): the table FPOC's refusal names
+# it, not the Python class's own default.
+TABLE_ECC_DEG = (0.0, 10.0)
+
+
 def fpoc_from(values: Mapping):
     """Build the FPOC described by ``fpoc.model`` and its ``fpoc.<name>`` parameters."""
     model = values['fpoc.model']
@@ -54,6 +59,13 @@ def fpoc_from(values: Mapping):
         kwargs[name] = list(value) if isinstance(value, (list, tuple, array.array)) else value
     if model == 'table' and not isinstance(kwargs['dprime'], list):
         raise ValueError('the table FPOC needs fpoc.dprime as a list matching fpoc.ecc_deg')
+    if model == 'table' and not (kwargs['dprime'] and isinstance(kwargs['ecc_deg'], list)
+                                 and len(kwargs['ecc_deg']) == len(kwargs['dprime'])):
+        ecc, dprime = kwargs['ecc_deg'], kwargs['dprime']
+        raise ValueError(f'the table FPOC needs fpoc.ecc_deg and fpoc.dprime non-empty and of '
+                         f'equal length, got {len(ecc)} fpoc.ecc_deg {ecc} and {len(dprime)} '
+                         f'fpoc.dprime {dprime} (fpoc.ecc_deg not given is its default, '
+                         f'{list(TABLE_ECC_DEG)})')
     return make_fpoc(model, **kwargs)
 
 
