@@ -415,3 +415,21 @@ def test_search_all_runs_with_its_default_budget():
     searches = search_all(data.astronaut(), fovea_for_model(model), model,
                           build_policy('elm', model.grid, model), settings)
     assert searches[0].decision == 'found' and searches[0].cell == (4, 9)
+
+
+def test_a_small_image_scanned_whole_is_explained_by_the_route_it_replaces():
+    """
+    QA: the default scan (a ladder of full-frame calls) said 'the fovea's smallest window'.
+
+    A 40x30 image is scanned whole on every route; only a route that uses the fovea explains
+    it by the fovea's windows.
+    """
+    task = tasks('yunet').task((40, 30))
+    route, reason = search_route(task, (40, 30), FIND_SETTINGS, False)
+    assert route == 'full_frame' and 'fovea' not in reason
+    assert reason == ('the image (40x30 px) is far below the size the model was calibrated at '
+                      '(420x420): a face there fills much of the frame')
+    route, reason = search_route(task, (40, 30), FIND_SETTINGS, False, 'fovea')
+    assert route == 'full_frame' and reason.startswith("the fovea's smallest window (6x4 px)")
+    route, reason = search_route(task, (160, 120), FIND_SETTINGS, False)
+    assert route == 'full_frame' and reason.endswith("than the scan's scales were calibrated for")

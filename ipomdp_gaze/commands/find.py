@@ -880,16 +880,18 @@ def search_route(task, image_px: tuple[int, int], settings, find_all: bool,
     detector without a scale table: :func:`search_image`); ``reason`` is '' but for
     ``full_frame``.
     """
-    reason = full_frame_reason(task.fovea, image_px, calibrated_size(task.model))
-    if reason:
-        return 'full_frame', reason
     if settings.targets == 'many':
-        return 'many', ''
-    if find_all:
-        return 'all', ''
-    if scan == 'fovea' or scale_table(task.model) is None:
-        return 'fovea', ''
-    return ('ladder' if scan == 'coarse' else 'first'), ''
+        route = 'many'
+    elif find_all:
+        route = 'all'
+    elif scan == 'fovea' or scale_table(task.model) is None:
+        route = 'fovea'
+    else:
+        route = 'ladder' if scan == 'coarse' else 'first'
+    # the ladder uses no fovea: its reason is said of the image and the scan's scales
+    reason = full_frame_reason(task.fovea, image_px, calibrated_size(task.model),
+                               uses_fovea=route != 'ladder')
+    return ('full_frame', reason) if reason else (route, '')
 
 
 def search_one(image, task, settings, rng, find_all: bool,

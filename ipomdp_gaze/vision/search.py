@@ -530,9 +530,13 @@ def search_all(image: np.ndarray, fovea: Fovea, model, policy,
             return searches
 
 
-def full_frame_reason(fovea: Fovea, image_px: tuple[int, int], calibrated_px=None) -> str:
+def full_frame_reason(fovea: Fovea, image_px: tuple[int, int], calibrated_px=None,
+                      uses_fovea: bool = True) -> str:
     """
     Why one full-resolution detector scan should replace the fovea on this image, or ''.
+
+    ``uses_fovea`` False: the search it replaces is ``find``'s scale ladder (``--scan coarse``),
+    which uses no fovea: the same tests, said of the image and the scan's scales.
 
     - the fovea's one-time scan and cheapest first fixation cost more detector pixels than the
       whole image (a small image: the detector's minimum window makes windows expensive);
@@ -551,20 +555,29 @@ def full_frame_reason(fovea: Fovea, image_px: tuple[int, int], calibrated_px=Non
                if w.whole_image) if fovea.config.scan_once else 0
     fixation = sum(w.resized_px[0] * w.resized_px[1] for w in probe
                    if not (fovea.config.scan_once and w.whole_image))
+    size = f'the image ({width}x{height} px)'
     if scan + fixation > width * height:
+        if not uses_fovea:
+            return (f'{size} is so small that one full-resolution scan ({width * height} '
+                    f'detector pixels) costs less than a search')
         return (f'the fovea would cost more detector pixels ({scan + fixation}) than one '
                 f'full-resolution scan ({width * height})')
     min_w, min_h = detector_window_px(fovea.detector)
     small = min(probe, key=lambda w: w.resized_px[0] * w.resized_px[1])
     if small.resized_px[0] < min_w or small.resized_px[1] < min_h:
+        if not uses_fovea:
+            at = '' if calibrated_px is None else f' ({calibrated_px[0]}x{calibrated_px[1]})'
+            return (f'{size} is far below the size the model was calibrated at{at}: a face '
+                    f'there fills much of the frame')
         return (f"the fovea's smallest window ({small.resized_px[0]}x{small.resized_px[1]} px) "
                 f"is smaller than the detector's ({min_w}x{min_h}): the image is far below "
                 f'the size the model was calibrated at')
     if calibrated_px is not None and 2 * width <= calibrated_px[0] \
             and 2 * height <= calibrated_px[1]:
-        return (f'the image ({width}x{height} px) is at most half the size the model was '
-                f'calibrated at ({calibrated_px[0]}x{calibrated_px[1]}) on both sides: a face '
-                f'there fills far more of the frame than the fovea was calibrated for')
+        what = 'the fovea was' if uses_fovea else "the scan's scales were"
+        return (f'{size} is at most half the size the model was calibrated at '
+                f'({calibrated_px[0]}x{calibrated_px[1]}) on both sides: a face there fills far '
+                f'more of the frame than {what} calibrated for')
     return ''
 
 
