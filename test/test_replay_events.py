@@ -525,3 +525,16 @@ def test_a_new_search_on_the_recorded_image_starts_at_the_recorded_prior():
     lines = []
     result = new_search(bag, out=lines.append)
     assert result.cell == (3, 4) and result.decision == 'found', lines
+
+
+def test_a_bad_option_is_its_one_line_before_anything_is_said(cli_here, monkeypatch, tmp_path):
+    """QA: ``replay --policy bogus`` printed ``settings: recorded, with policy=bogus`` first."""
+    bag = _tracked_bag()
+    monkeypatch.setattr('ipomdp_gaze.files.bag.read_bag', lambda path: bag)
+    for flags in (('--policy', 'bogus'), ('--policy', 'bogus', '--new-search')):
+        run = cli_here('replay', tmp_path, *flags)
+        assert run.returncode == 2, run
+        assert run.stdout == '', run.stdout
+        assert run.stderr == ("ipomdp-gaze replay: error: --policy: unknown policy 'bogus'; "
+                              'valid policies: learned, map, random, center, elm, spiral, sweep, '
+                              'coverage, greedy, tempered, switching, nmpt\n'), run.stderr

@@ -165,16 +165,17 @@ def describe_written(path: Path, verb: str = 'wrote') -> str:
 
 
 def run_replay(args) -> int:
-    from ipomdp_gaze.drivers.replay import describe_settings, describe_size, replay
+    from ipomdp_gaze.drivers.replay import check_options, describe_settings, describe_size, replay
     from ipomdp_gaze.files.bag import read_bag
     if not args.path.is_dir():
         raise ValueError(f'{args.path} is not a bag directory')
     bag = read_bag(args.path)
-    print(f'{args.path}: {counted(len(bag.messages), "message")}, {describe_size(bag)}; package '
-          f"{bag.custom_data.get('ipomdp_gaze/version', 'unknown')}")
     overrides = {'observation': args.observation, 'policy': args.policy,
                  'policy_file': args.policy_file, 'confidence': args.confidence,
                  'max_fixations': args.max_fixations}
+    check_options(bag, overrides)           # a bad option: its one line, nothing said before it
+    print(f'{args.path}: {counted(len(bag.messages), "message")}, {describe_size(bag)}; package '
+          f"{bag.custom_data.get('ipomdp_gaze/version', 'unknown')}")
     if args.new_search:
         from ipomdp_gaze.drivers.replay import new_search
         print(describe_settings(bag, overrides, args.new_search))

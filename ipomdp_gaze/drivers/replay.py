@@ -261,6 +261,25 @@ def checked_config(parameters: dict, overrides: dict | None = None) -> Controlle
     return config
 
 
+def check_options(bag, overrides: dict | None = None) -> None:
+    """
+    Refuse an option that the recorded parameters cannot take (ValueError naming the option).
+
+    Against the controller's parameters as recorded at its start, before anything is said of
+    the replay (``--policy bogus`` printed the settings line ``with policy=bogus`` first). A
+    recording refused on its own, or an option refused only with a change set while
+    recording, passes: the replay says its settings and then why it is refused.
+    """
+    recorded = bag.parameters(CONTROLLER)
+    if not recorded or not any(v is not None for v in (overrides or {}).values()):
+        return
+    try:
+        _config(settings_from(recorded), 'the recording')
+    except ValueError:
+        return
+    checked_config(recorded, overrides)
+
+
 def build_controller(values: dict) -> tuple[GazeController, PanTiltMap]:
     """Build the core and the head mapping from the ``gaze_controller`` parameters ``values``."""
     config = _config(values, 'the recording')
