@@ -67,6 +67,42 @@ def test_misspelt_parameters_are_warned_about(context, tmp_path):
         node.destroy_node()
 
 
+def test_another_nodes_parameter_in_a_shared_section_is_not_warned_about(context, tmp_path):
+    """
+    QA: one params file with a ``/**:`` section for a launch's nodes warned in every node.
+
+    ``parameter 'rate_hz' is not a parameter of this node; ignored``, for the cameras'
+    parameters in the controller. rclpy merges every source into one set of overrides, but
+    the params files say where each came from: another node's parameter in a wildcard section
+    is one info line; in the node's own section or ``-p``, or a typo anywhere, a warning.
+    """
+    from ipomdp_gaze.nodes.spin import warn_unused_parameters
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+    shared = tmp_path / 'shared.yaml'
+    shared.write_text('/**:\n  ros__parameters:\n    rate_hz: 5.0\n    confidance: 0.9\n'
+                      '    scene: {file: a.png}\n'
+                      '/gaze_controller:\n  ros__parameters:\n    saccade_time_s: 0.1\n')
+    given = ['rate_hz', 'confidance', 'scene.file', 'saccade_time_s', 'publish_image']
+    node = Node('gaze_controller', context=context,
+                parameter_overrides=[Parameter(name, value=1.0) for name in given])
+    infos = []
+    try:
+        node.declare_parameter('confidence', 0.99)
+        node.get_logger().info = infos.append
+        argv = ['x', '--ros-args', '--params-file', str(shared), '-p', 'publish_image:=true']
+        warned = warn_unused_parameters(node, argv)
+        assert warned == [
+            "parameter 'confidance' is not a parameter of this node; ignored (did you mean "
+            "'confidence'?)",
+            "parameter 'publish_image' is not a parameter of this node; ignored",
+            "parameter 'saccade_time_s' is not a parameter of this node; ignored"]
+        assert infos == ['2 parameters of other ipomdp_gaze nodes in a wildcard (/**) section, '
+                         "not this node's: rate_hz, scene.file; ignored here"]
+    finally:
+        node.destroy_node()
+
+
 @pytest.mark.parametrize('section, node, applies', [
     ('/gaze_controller', '/gaze_controller', True),
     ('/**', '/robot/gaze_controller', True),

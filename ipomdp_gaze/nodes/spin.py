@@ -133,6 +133,11 @@ def params_file_sections(path) -> list[str]:
     Nested namespaces (``ns: {node: {ros__parameters: ...}}``) are joined with ``/``. An
     unreadable file gives an empty list (rcl has already read it, or refused it).
     """
+    return [section for section, _ in _file_sections(path)]
+
+
+def _file_sections(path) -> list[tuple[str, dict]]:
+    """Return ``(section, ros__parameters)`` of each section of a params file ([] unreadable)."""
     try:
         data = yaml.safe_load(Path(path).read_text())
     except (OSError, yaml.YAMLError, UnicodeDecodeError):
@@ -145,11 +150,52 @@ def params_file_sections(path) -> list[str]:
         for key, value in node.items():
             name = f'{prefix}/{str(key).strip("/")}'
             if isinstance(value, dict) and 'ros__parameters' in value:
-                out.append(name)
+                out.append((name, value['ros__parameters']))
             else:
                 walk(value, name)
     walk(data, '')
     return out
+
+
+def _flat_names(params, prefix: str = '') -> set[str]:
+    """Return the parameter names of a ``ros__parameters`` mapping (nested keys joined by .)."""
+    if not isinstance(params, dict):
+        return set()
+    names = set()
+    for key, value in params.items():
+        name = f'{prefix}{key}'
+        names |= _flat_names(value, name + '.') if isinstance(value, dict) else {name}
+    return names
+
+
+def _given_by_section(argv, own: str) -> tuple[set[str], set[str]]:
+    """
+    Return the names ``own`` is given by wildcard sections (``/**``) and by any other way.
+
+    rclpy merges every source into one set of overrides; the params files on the command line
+    say which came from a section that names no node (shared by every node of a launch), and
+    ``-p`` and a section naming the node are its own.
+    """
+    wildcard, named = set(), set()
+    for path in _params_files(argv):
+        for section, params in _file_sections(path):
+            if _matches(section, own):
+                (wildcard if '*' in section else named).update(_flat_names(params))
+    argv = [str(a) for a in argv or []]
+    named.update(argv[i + 1].split(':=', 1)[0] for i, a in enumerate(argv[:-1])
+                 if a in ('-p', '--param'))
+    return wildcard - named, named
+
+
+def package_parameters() -> set[str]:
+    """Return the parameters every node of this package declares (their declaration lists)."""
+    from .camera import camera_params
+    from .controller import controller_params
+    from .detector import detector_params
+    from .recorder import recorder_params
+    from .scene_camera import scene_camera_params
+    return {p.name for make in (camera_params, controller_params, detector_params,
+                                recorder_params, scene_camera_params) for p in make()}
 
 
 def _params_files(argv) -> list[str]:
@@ -164,21 +210,33 @@ def warn_unused_parameters(node, argv) -> list[str]:
 
     rclpy ignores an override for a parameter a node never declares, and a params file whose
     sections name other nodes: a misspelt ``confidance`` or ``gaze_controler:`` would run on
-    defaults without a word. Returns the warnings.
+    defaults without a word. Returns the warnings. A parameter of another node of this package
+    given only in a wildcard section (``/**:``, a params file shared by a launch's nodes) is
+    not warned about: one info line names them all (a typo there, or in the node's own section
+    or ``-p``, is still warned about).
     """
     declared = set(node._parameters)           # rclpy has no public view of either
     given = set(getattr(node, '_parameter_overrides', {}))
-    warnings = []
+    own = node.get_fully_qualified_name()
+    warnings, shared = [], []
+    wildcard = _given_by_section(argv, own)[0] if given - declared else set()
+    others = package_parameters() if wildcard else set()
     for name in sorted(given - declared):
+        if name in wildcard and name in others:
+            shared.append(name)                 # another node's, in a section shared by all
+            continue
         near = difflib.get_close_matches(name, sorted(declared), n=1)
         warnings.append(f"parameter '{name}' is not a parameter of this node; ignored"
                         + (f" (did you mean '{near[0]}'?)" if near else ''))
-    own = node.get_fully_qualified_name()
     for path in _params_files(argv):
         sections = params_file_sections(path)
         if sections and not any(_matches(section, own) for section in sections):
             warnings.append(f'params file {path} has no section for node {own} '
                             f"(its sections: {', '.join(sections)}); none of it applies")
+    if shared:
+        node.get_logger().info(f"{len(shared)} parameter{'s' * (len(shared) > 1)} of other "
+                               f'ipomdp_gaze nodes in a wildcard (/**) section, not this '
+                               f"node's: {', '.join(shared)}; ignored here")
     for text in warnings:
         node.get_logger().warning(text)
     return warnings
