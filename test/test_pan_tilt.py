@@ -12,7 +12,8 @@ from ipomdp_gaze.model.head_camera import observed_cells, pixel_cells
 from ipomdp_gaze.vision.calibrate import count_model, tally_pan_tilt_scenes, tally_views
 from ipomdp_gaze.vision.detector import HaarDetector
 from ipomdp_gaze.vision.pan_tilt import (box_centres_uv, PAN_TILT_GRID, PanTiltSceneSet,
-                                         SceneGeometry, shipped_camera, user_scene, ViewObserver)
+                                         read_scene_file, SceneGeometry, shipped_camera,
+                                         user_scene, ViewObserver)
 from ipomdp_gaze.vision.scenes import TEST_FACES, TRAIN_FACES
 import numpy as np
 import pytest
@@ -226,3 +227,17 @@ def test_calibrate_refuses_options_of_the_other_task(tmp_path, cli_here, args, m
     err = run.stderr
     lines = err.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], err
+
+
+def test_a_truncated_jpeg_scene_file_is_refused_with_the_reason(tmp_path):
+    """cv2.imread showed a JPEG cut short as its top part above grey, a scene of wrong pixels."""
+    import cv2
+    image = np.random.default_rng(0).integers(0, 256, (240, 320, 3), dtype=np.uint8)
+    ok, data = cv2.imencode('.jpg', image)
+    assert ok
+    whole, cut = tmp_path / 'whole.jpg', tmp_path / 'cut.jpg'
+    whole.write_bytes(data.tobytes())
+    cut.write_bytes(data.tobytes()[:len(data) // 2])
+    assert read_scene_file(whole).shape == (240, 320, 3)
+    with pytest.raises(ValueError, match=r"cut\.jpg': truncated or corrupt JPEG: it ends before"):
+        read_scene_file(cut)

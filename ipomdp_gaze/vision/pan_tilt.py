@@ -38,6 +38,7 @@ from ipomdp_gaze.model.head_camera import bin_points, PinholeCamera, point_offse
 from ipomdp_gaze.vision.detector import (box_centres_px, detect, detector_color,
                                          detector_window_px, group_support,
                                          to_detector_image)
+from ipomdp_gaze.vision.image_files import decode_quietly, undecodable
 from ipomdp_gaze.vision.scenes import _paste, load_background, load_faces, Scene, SceneFace, SPLITS
 import numpy as np
 
@@ -546,12 +547,17 @@ def read_scene_file(path) -> np.ndarray:
         If the file is missing, cannot be decoded or is not 8 bits per channel.
 
     """
-    # Not a file: said here, because OpenCV's imread also prints a warning of its own on stderr
-    # for a path it cannot open, a second line after a start-up error's one.
-    image = cv2.imread(str(path), cv2.IMREAD_ANYDEPTH | cv2.IMREAD_ANYCOLOR) \
-        if os.path.isfile(path) else None
-    if image is None:
+    # Read as find reads (image_files): OpenCV's own messages silenced, and a truncated JPEG,
+    # which cv2.imread shows as its top part above grey, refused with the reason.
+    if not os.path.isfile(path):
         raise ValueError(f'scene.file {str(path)!r} is missing or not an image OpenCV can read')
+    data = np.fromfile(str(path), dtype=np.uint8)
+    try:
+        image = decode_quietly(data)
+    except ValueError as exc:
+        raise ValueError(f'scene.file {str(path)!r}: {exc}') from None
+    if image is None:
+        raise ValueError(f'scene.file {str(path)!r}: {undecodable(data)}')
     if image.dtype != np.uint8:
         raise ValueError(f'scene.file {str(path)!r} is {image.dtype}; 8 bits per channel only')
     if image.ndim == 2:
