@@ -65,7 +65,7 @@ MASKS = [
 
 # Commands that cannot run here, by a pattern of the command: (pattern, reason).
 SKIPS = [
-    (re.compile(r'^(?:ros2|colcon|source)\b|\$\(ros2 |^cd ~/ws'),
+    (re.compile(r'^(?:[A-Z_]+=\S*\s+)*(?:ros2|colcon|source)\b|\$\(ros2 |^cd ~/ws'),
      'needs a ROS 2 install (the ros2 CLI, colcon), not on this machine; the nodes themselves run '
      'over real DDS in the demos here and in the ROS tests'),
     (re.compile(r'^python3 -m pip install\b'),

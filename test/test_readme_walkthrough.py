@@ -104,6 +104,9 @@ def test_the_masked_counts_match_a_count_of_one_in_the_singular():
 def test_a_command_without_ros_or_your_files_is_run_with_this_checkout():
     assert 'ROS 2 install' in walkthrough.skip_reason('ros2 topic echo /found')
     assert 'ROS 2 install' in walkthrough.skip_reason('CFG=$(ros2 pkg prefix ipomdp_gaze)/x')
+    assert 'ROS 2 install' in walkthrough.skip_reason(
+        'FASTRTPS_DEFAULT_PROFILES_FILE=$CFG/profile.xml ros2 run <driver package> <driver>')
+    assert not walkthrough.skip_reason('OPENBLAS_NUM_THREADS=1 ipomdp-gaze evaluate')
     assert 'your own' in walkthrough.skip_reason("K=$(python3 -c \"open('my-policy.yaml')\")")
     assert 'docs/reproduction.md' in walkthrough.skip_reason('ipomdp-gaze reproduce --jobs 2')
     assert walkthrough.skip_reason('.venv/bin/ipomdp-gaze find astronaut.png') == ''
