@@ -339,6 +339,8 @@ def test_fresh_views_are_the_pixels_and_cells_a_fixation_would_read_afresh(confi
         for k in range(81):
             after = _replayed(config, reuse, history[:done], img).observe(k)
             assert costs[k] == after.detector_pixels
+            # the pixels a budget is checked with before the fixation (run_search)
+            assert _replayed(config, reuse, history[:done], img).fixation_cost(k) == costs[k]
             np.testing.assert_array_equal(cover[k], ~np.isnan(fresh_counts(after, Grid(9, 9))))
         if reuse and done == 1:       # (1, 1) places (0, 0)'s windows: every one cached
             assert costs[10] == 0 and not cover[10].any() and costs[40] > 0

@@ -434,12 +434,19 @@ class Fovea:
         """
         Detector pixels :meth:`observe` would spend on ``fixation`` now (windows not yet cached).
 
-        With ``scan_once`` the whole-image windows are left out, as :meth:`observe` leaves them.
+        With ``scan_once`` the whole-image windows are left out, as :meth:`observe` leaves them;
+        a window that repeats an earlier one of the fixation, which :meth:`observe` serves from
+        the cache once it has read it, is counted once.
         """
-        windows = self.window_rects(fixation)
-        return int(sum(w.resized_px[0] * w.resized_px[1] for w in windows
-                       if not (self.config.scan_once and w.whole_image)
-                       and (w.cells, w.resized_px) not in self._cache))
+        read, pixels = set(), 0
+        for w in self.window_rects(fixation):
+            key = (w.cells, w.resized_px)
+            if (self.config.scan_once and w.whole_image) or key in self._cache or key in read:
+                continue
+            pixels += w.resized_px[0] * w.resized_px[1]
+            if w.whole_image or self.reuse_windows:
+                read.add(key)
+        return pixels
 
     def fresh_views(self) -> tuple[np.ndarray, np.ndarray]:
         """
