@@ -241,3 +241,12 @@ def test_a_truncated_jpeg_scene_file_is_refused_with_the_reason(tmp_path):
     assert read_scene_file(whole).shape == (240, 320, 3)
     with pytest.raises(ValueError, match=r"cut\.jpg': truncated or corrupt JPEG: it ends before"):
         read_scene_file(cut)
+
+
+def test_an_empty_scene_file_is_refused_in_our_words(tmp_path):
+    """The reason for no bytes is ours, not OpenCV's assertion ('!buf.empty()')."""
+    empty = tmp_path / 'empty.jpg'
+    empty.write_bytes(b'')
+    with pytest.raises(ValueError) as refused:
+        read_scene_file(empty)
+    assert str(refused.value) == f"scene.file '{empty}': not an image OpenCV can decode"

@@ -553,7 +553,7 @@ def read_scene_file(path) -> np.ndarray:
         raise ValueError(f'scene.file {str(path)!r} is missing or not an image OpenCV can read')
     data = np.fromfile(str(path), dtype=np.uint8)
     try:
-        image = decode_quietly(data)
+        image = decode_quietly(data) if data.size else None   # imdecode asserts on no bytes
     except ValueError as exc:
         raise ValueError(f'scene.file {str(path)!r}: {exc}') from None
     if image is None:
