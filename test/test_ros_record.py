@@ -518,21 +518,27 @@ def test_a_message_is_written_while_the_flush_waits_for_the_disk(context, tmp_pa
     """
     Review: the flush held the bag's lock through fsync, so on slow storage every write waited.
 
-    fsync is made to wait for the test: a message written meanwhile from another thread must
-    go in before it is released (the timeouts are a safety net only, nothing is timed).
+    And then its timer's callback still did, under the node's guard in a one-thread executor:
+    the callbacks as the node registered them are called here. fsync is made to wait for the
+    test: the flush callback must return and a message go in before it is released (the
+    timeouts are a safety net only, nothing is timed).
     """
     import os
     import threading
     from ipomdp_gaze.files.bag import read_bag
-    from ipomdp_gaze.nodes.recorder import RecorderNode
+    from ipomdp_gaze.nodes.recorder import FLUSH_PERIOD_S, RecorderNode
+    from rclpy.clock import ClockType
     from rclpy.parameter import Parameter
     from rclpy.serialization import serialize_message
     from sensor_msgs.msg import Image
     recorder = RecorderNode(context=context, parameter_overrides=[
         Parameter('path', value=str(tmp_path / 'bag')), Parameter('topics', value=['image'])])
-    write = recorder._writer_for('image')
+    [write] = [sub.callback for sub in recorder.subscriptions if sub.topic_name == '/image']
+    [flush] = [timer.callback for timer in recorder.timers           # the steady clock's
+               if timer.timer_period_ns == round(FLUSH_PERIOD_S * 1e9)
+               and timer.clock.clock_type == ClockType.STEADY_TIME]
     first, second = bytes([201]) * 8, bytes([202]) * 8
-    entered, release, wrote = threading.Event(), threading.Event(), threading.Event()
+    entered, release, flushed = threading.Event(), threading.Event(), threading.Event()
     in_file, real_fsync = [], os.fsync
 
     def waiting_fsync(fd):
@@ -544,30 +550,60 @@ def test_a_message_is_written_while_the_flush_waits_for_the_disk(context, tmp_pa
     def image(pixels):
         return serialize_message(Image(height=1, width=8, encoding='mono8', step=8, data=pixels))
 
-    def write_second():
-        write(image(second))
-        wrote.set()
+    def flush_callback():
+        flush()
+        flushed.set()
     try:
         write(image(first))
         monkeypatch.setattr(os, 'fsync', waiting_fsync)
-        flusher = threading.Thread(target=recorder._flush)
+        flusher = threading.Thread(target=flush_callback, daemon=True)
         flusher.start()
         assert entered.wait(30)
         assert in_file == [True]            # handed to the system before fsync began
-        writer = threading.Thread(target=write_second)
-        writer.start()
-        assert wrote.wait(20), 'the write waited for fsync'
-        assert flusher.is_alive() and not release.is_set()      # fsync still under way
+        assert flushed.wait(20), 'the flush callback waited for fsync'
+        write(image(second))
+        assert not release.is_set() and recorder.counts['image'] == 2   # fsync still under way
         release.set()
-        flusher.join(30)
-        writer.join(30)
-        assert not flusher.is_alive() and recorder.counts['image'] == 2
     finally:
         release.set()
-        monkeypatch.undo()
         recorder.destroy_node()
+        monkeypatch.undo()
     assert [bytes(m.msg.data) for m in read_bag(tmp_path / 'bag').topic('image')] == \
         [first, second]
+
+
+def test_the_syncer_keeps_one_sync_waiting_and_drops_newer_ones():
+    """A slow disk does not pile up duplicated file handles: one waits, newer ones are closed."""
+    import threading
+    from ipomdp_gaze.nodes.recorder import _Syncer
+    started, release = threading.Event(), threading.Event()
+    done = []
+
+    class Pending:
+
+        def __init__(self, name, block=False):
+            self.name, self.block, self.closed = name, block, False
+
+        def sync(self):
+            if self.block:
+                started.set()
+                assert release.wait(60)
+            done.append(self.name)
+
+        def close(self):
+            self.closed = True
+
+    syncer = _Syncer(logger=None)
+    first, second, third = Pending('first', block=True), Pending('second'), Pending('third')
+    try:
+        assert syncer.submit(first)
+        assert started.wait(30)
+        assert syncer.submit(second)            # waits while the first syncs
+        assert not syncer.submit(third) and third.closed and syncer.dropped == 1
+    finally:
+        release.set()
+        syncer.stop()
+    assert done == ['first', 'second'] and not second.closed
 
 
 def test_a_recorder_in_a_namespace_asks_its_node_there_and_the_replay_reads_it(context,

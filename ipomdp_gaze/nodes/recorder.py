@@ -30,7 +30,8 @@ qos_overrides./pan_tilt.subscription.durability:=volatile`` records a volatile t
 The chunk begun is written and synced every :data:`FLUSH_PERIOD_S` (of the system's clock, also
 under ``use_sim_time``), so a recording cut off loses about a second at most: ``ipomdp-gaze
 reindex`` recovers the rest. Only the hand-off of the bytes to the system holds the bag's lock;
-the ``fsync`` runs after it, so on slow storage the subscriptions' writes do not wait for it.
+the ``fsync`` runs on a thread of its own, so on slow storage the executor and the
+subscriptions' writes do not wait for it.
 
 The bag's ``custom_data`` (in ``metadata.yaml``) holds ``ipomdp_gaze/version`` (the package),
 ``ipomdp_gaze/parameters/<node>`` (every parameter of each node in ``nodes``, as YAML, fetched
@@ -203,6 +204,57 @@ def file_hashes(parameters: dict) -> dict:
     return out
 
 
+class _Syncer:
+    """
+    ``fsync`` the bag's handed-off chunks on a thread of its own, off the executor.
+
+    The flush timer's callback runs, as every write does, under the node's callback guard and
+    in a single-threaded executor: an ``fsync`` there held every write back for as long as the
+    disk took. At most one sync waits besides the one under way; a newer one meanwhile is
+    dropped (its duplicates closed), as the next flush hands the file off again.
+    """
+
+    def __init__(self, logger):
+        self._logger = logger
+        self._ready = threading.Condition()
+        self._waiting, self._stop = None, False
+        self.dropped = 0
+        self._thread = threading.Thread(target=self._run, name='recorder-fsync', daemon=True)
+        self._thread.start()
+
+    def submit(self, pending) -> bool:
+        """Queue ``pending`` (a :class:`~ipomdp_gaze.files.bag.PendingSync`); False: dropped."""
+        with self._ready:
+            if self._stop or self._waiting is not None:
+                self.dropped += 1
+                pending.close()
+                return False
+            self._waiting = pending
+            self._ready.notify()
+            return True
+
+    def _run(self) -> None:
+        while True:
+            with self._ready:
+                while self._waiting is None and not self._stop:
+                    self._ready.wait()
+                pending, self._waiting = self._waiting, None
+            if pending is None:
+                return
+            try:
+                pending.sync()
+            except OSError as exc:          # the disk failed: said, the recording goes on
+                self._logger.error(f'could not sync the bag to the disk: {exc}',
+                                   throttle_duration_sec=5.0)
+
+    def stop(self, timeout_s: float = 30.0) -> None:
+        """Sync what waits, then end the thread (at most ``timeout_s`` for a stuck disk)."""
+        with self._ready:
+            self._stop = True
+            self._ready.notify()
+        self._thread.join(timeout_s)
+
+
 class RecorderNode(QuietPublishers, Node):
     """Subscribe to the search's topics (serialized) and write them to a rosbag2 MCAP bag."""
 
@@ -226,6 +278,7 @@ class RecorderNode(QuietPublishers, Node):
         self.writer = open_writer(values['path'], values['compression'],
                                   max_file_bytes=int(values['max_bag_size_mb'] * 1e6),
                                   max_file_duration_ns=int(values['max_bag_duration_s'] * 1e9))
+        self._syncer = _Syncer(self.get_logger())
         self.writer.set_custom_data('ipomdp_gaze/version', package_version())
         # The namespace the relative topics and nodes were resolved in: a replay's too.
         self.writer.set_custom_data('ipomdp_gaze/namespace', self.get_namespace())
@@ -308,13 +361,14 @@ class RecorderNode(QuietPublishers, Node):
         Write the bag's chunk begun to the disk (:data:`FLUSH_PERIOD_S`).
 
         Under the lock only the hand-off of the bytes to the operating system; ``fsync`` (slow
-        storage: long) runs after it, so a message written meanwhile does not wait for it.
+        storage: long) runs on the syncer's thread (:class:`_Syncer`), so neither the executor
+        nor a message written meanwhile waits for it.
         """
         with self._bag_lock:
             if self.writer is None:
                 return
             pending = self.writer.hand_off()
-        pending.sync()
+        self._syncer.submit(pending)
 
     # -- the other nodes' parameters ---------------------------------------------------------
     def _ask_parameters(self) -> None:
@@ -429,6 +483,9 @@ class RecorderNode(QuietPublishers, Node):
                     writer.close()
                 except OSError as exc:      # the disk is full: the node still goes down
                     self.get_logger().error(f'could not close the bag: {exc}')
+        syncer = getattr(self, '_syncer', None)
+        if syncer is not None:
+            syncer.stop()
         return super().destroy_node()
 
 
