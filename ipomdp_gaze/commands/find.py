@@ -920,7 +920,7 @@ def search_one(image, task, settings, rng, find_all: bool,
     budget = width * height
     scales = scale_table(task.model)
     if route == 'many':
-        prepare_many(task.fovea, task.model, (width, height), scales)      # one-time set-up
+        prepare_many(task.fovea, task.model, scales)      # one-time set-up
         budget = max(budget, given_px or 0)
         return [search_many(image, task.fovea, task.model, settings, pixel_budget=budget,
                             scales=scales, min_face=min_face,
@@ -933,7 +933,7 @@ def search_one(image, task, settings, rng, find_all: bool,
                               start=ladder_start(task.model, scales),
                               finest=finest_scale(scales, min_face, (width, height)))]
     if route == 'first':
-        prepare_many(task.fovea, task.model, (width, height), scales)      # one-time set-up
+        prepare_many(task.fovea, task.model, scales)      # one-time set-up
         return [search_first(image, task.fovea, task.model, settings, pixel_budget=budget,
                              scales=scales, min_face=min_face)]
     return [search_image(image, task.fovea, task.model, task.policy, settings, rng=rng,

@@ -660,15 +660,7 @@ class OccupancySession:
         info, weight = self._still_terms(np.asarray(log_odds, dtype=float), settled)
         if cover is None:
             return np.einsum('kj,kj->k', info, weight)
-        cover = np.asarray(cover, dtype=bool)
-        part = np.flatnonzero(~cover.all(axis=1))              # views not read whole
-        if part.size == cover.shape[0]:
-            return np.einsum('kj,kj->k', info, np.where(cover, weight, 0.0))
-        gains = np.einsum('kj,kj->k', info, weight)
-        if part.size:
-            gains[part] = np.einsum('kj,kj->k', info[part], np.where(cover[part], weight[part],
-                                                                     0.0))
-        return gains
+        return np.einsum('kj,kj->k', info, np.where(np.asarray(cover, dtype=bool), weight, 0.0))
 
     def _still_terms(self, log_odds: np.ndarray, settled) -> tuple[np.ndarray, np.ndarray]:
         """

@@ -1068,38 +1068,15 @@ def _cell_rect(grid: Grid, box: tuple, margin: int, image_px: tuple) -> tuple:
             int(np.ceil(rows.stop * height / grid.rows)))
 
 
-_COSTS = {}
-
-
-def fixation_costs(fovea: Fovea, image_px: tuple[int, int]) -> np.ndarray:
-    """
-    Detector pixels of a fixation at each cell of an image of ``image_px``, (N,), cached.
-
-    The windows of the fixation without the whole-image ones when the fovea scans once (as
-    :meth:`Fovea.fixation_cost` on a fresh image).
-    """
-    key = (fovea.grid.shape, fovea.config, image_px)
-    if key not in _COSTS:
-        if len(_COSTS) >= 64:
-            _COSTS.pop(next(iter(_COSTS)))
-        shape = (image_px[1], image_px[0])
-        _COSTS[key] = np.array([
-            sum(w.resized_px[0] * w.resized_px[1] for w in fovea.window_rects(k, shape)
-                if not (fovea.config.scan_once and w.whole_image))
-            for k in range(fovea.grid.n_cells)], dtype=float)
-    return _COSTS[key]
-
-
-def prepare_many(fovea: Fovea, model, image_px: tuple[int, int],
-                 scales: ScaleTable | None = None) -> None:
+def prepare_many(fovea: Fovea, model, scales: ScaleTable | None = None) -> None:
     """
     Build what :func:`search_many` builds once, outside its seconds (as ``find`` sets up).
 
-    The belief's information table of the model, the fixation costs of the image size and,
-    with ``scales``, the coarse pass's detector; all cached, so a second call costs nothing.
+    The belief's information table of the model and, with ``scales``, the coarse pass's
+    detector; both cached, so a second call costs nothing. (A fixation's cost is the fovea's
+    on the image searched: :meth:`~ipomdp_gaze.vision.fovea.Fovea.fresh_views`.)
     """
     OccupancySession(fovea.grid, model, replace(FIND_SETTINGS, targets='many'))
-    fixation_costs(fovea, image_px)
     if scales is not None:
         coarse_detector(fovea.detector, scales.weak_score)
 
@@ -1158,11 +1135,10 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     check_model(model, fovea)
     settings = replace(FIND_SETTINGS if settings is None else settings, targets='many')
     image_px = check_image(image, fovea)
-    session = OccupancySession(fovea.grid, model, settings,
-                               costs=fixation_costs(fovea, image_px), link=settle,
+    session = OccupancySession(fovea.grid, model, settings, link=settle,
                                empty_by_evidence=empty_by_evidence)
     # a window read already on this image is no new evidence (fresh_counts): the choice
-    # counts only what each fixation would read afresh, and its pixels
+    # counts only what each fixation would read afresh, and its pixels (the costs)
     session.set_fresh(fovea.fresh_views)
     if scales is None:
         sensor = _Recorder(fovea)
