@@ -17,6 +17,7 @@ from pathlib import Path
 import re
 import sys
 
+from ipomdp_gaze.model.wording import counted
 import rclpy
 from rclpy.clock import Clock, ClockType
 import yaml
@@ -168,9 +169,9 @@ def _flat_names(params, prefix: str = '') -> set[str]:
     return names
 
 
-def _given_by_section(argv, own: str) -> tuple[set[str], set[str]]:
+def _wildcard_only(argv, own: str) -> set[str]:
     """
-    Return the names ``own`` is given by wildcard sections (``/**``) and by any other way.
+    Return the names ``own`` is given only by wildcard sections (``/**``), by no other way.
 
     rclpy merges every source into one set of overrides; the params files on the command line
     say which came from a section that names no node (shared by every node of a launch), and
@@ -184,7 +185,7 @@ def _given_by_section(argv, own: str) -> tuple[set[str], set[str]]:
     argv = [str(a) for a in argv or []]
     named.update(argv[i + 1].split(':=', 1)[0] for i, a in enumerate(argv[:-1])
                  if a in ('-p', '--param'))
-    return wildcard - named, named
+    return wildcard - named
 
 
 def package_parameters() -> set[str]:
@@ -219,7 +220,7 @@ def warn_unused_parameters(node, argv) -> list[str]:
     given = set(getattr(node, '_parameter_overrides', {}))
     own = node.get_fully_qualified_name()
     warnings, shared = [], []
-    wildcard = _given_by_section(argv, own)[0] if given - declared else set()
+    wildcard = _wildcard_only(argv, own) if given - declared else set()
     others = package_parameters() if wildcard else set()
     for name in sorted(given - declared):
         if name in wildcard and name in others:
@@ -234,9 +235,9 @@ def warn_unused_parameters(node, argv) -> list[str]:
             warnings.append(f'params file {path} has no section for node {own} '
                             f"(its sections: {', '.join(sections)}); none of it applies")
     if shared:
-        node.get_logger().info(f"{len(shared)} parameter{'s' * (len(shared) > 1)} of other "
-                               f'ipomdp_gaze nodes in a wildcard (/**) section, not this '
-                               f"node's: {', '.join(shared)}; ignored here")
+        node.get_logger().info(f"{counted(len(shared), 'parameter')} of other ipomdp_gaze "
+                               f"nodes in a wildcard (/**) section, not this node's: "
+                               f"{', '.join(shared)}; ignored here")
     for text in warnings:
         node.get_logger().warning(text)
     return warnings
