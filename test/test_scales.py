@@ -156,12 +156,63 @@ def test_a_weak_full_resolution_box_is_strong_only_if_the_enlarged_look_keeps_it
     model, fovea = yunet_420
     image = np.ascontiguousarray(np.rot90(load_photo('coffee'), 2))
     budget = image.shape[0] * image.shape[1]
-    table = scale_table(model)
+    table = replace(scale_table(model), haar_check_score=0.0)     # the look alone
     unlooked = search_many(image, fovea, model, MANY, pixel_budget=budget, scales=table,
                            look_upscale=0)
     looked = search_many(image, fovea, model, MANY, pixel_budget=budget, scales=table)
     assert len(unlooked.faces) == 1 and looked.faces == ()
     assert looked.decision == 'absent' and looked.detector_pixels > unlooked.detector_pixels
+
+
+def test_a_face_below_the_check_score_that_no_cascade_sees_is_not_reported(yunet_420):
+    """The same texture without the look: YuNet's 0.55 box, vetoed by Haar's check."""
+    model, fovea = yunet_420
+    image = np.ascontiguousarray(np.rot90(load_photo('coffee'), 2))
+    budget = image.shape[0] * image.shape[1]
+    table = scale_table(model)
+    assert table.haar_check_score == 0.9 and table.haar_check_neighbors == 1
+    unchecked = search_many(image, fovea, model, MANY, pixel_budget=budget, look_upscale=0,
+                            scales=replace(table, haar_check_score=0.0))
+    checked = search_many(image, fovea, model, MANY, pixel_budget=budget, look_upscale=0,
+                          scales=table)
+    [face] = unchecked.faces
+    x, y, w, h = face.box
+    side = max(w, h) / 2.0
+    crop_w = int(min(image.shape[1], x + w + side)) - int(max(0, x - side))
+    crop_h = int(min(image.shape[0], y + h + side)) - int(max(0, y - side))
+    factor = min(1.0, search.HAAR_CHECK_SIDE_PX / max(w, h))
+    crop_px = round(crop_w * factor) * round(crop_h * factor)
+    assert checked.faces == () and checked.decision == 'absent'
+    assert checked.detector_pixels == unchecked.detector_pixels + crop_px
+
+
+def test_the_haar_check_keeps_what_a_cascade_sees_or_cannot_judge():
+    from skimage import data
+    astronaut, coffee = data.astronaut(), data.coffee()             # 512x512, 600x400
+    face = {'box': (170.0, 60.0, 110.0, 110.0)}                     # the astronaut's face
+    boxes = np.array([face['box']])
+
+    def check(image, faces, scores, box_list=boxes):
+        size = (image.shape[1], image.shape[0])
+        return search.haar_checked(image, faces, box_list, np.array(scores), size, 0.9, 1)
+
+    # half the side on each side, reduced so that the box is at most HAAR_CHECK_SIDE_PX
+    crop_px = round(220 * min(1.0, search.HAAR_CHECK_SIDE_PX / 110)) ** 2
+    assert check(astronaut, [face], [0.5]) == ([face], crop_px)
+    assert check(astronaut, [face], [0.95]) == ([face], 0)          # strong: not read
+    assert check(astronaut, [face], [0.5], np.zeros((0, 4))) == ([face], crop_px)   # no box
+    assert check(coffee, [face], [0.5]) == ([], crop_px)            # texture: vetoed
+    assert check(coffee, [face], [0.95]) == ([face], 0)
+    cut = {'box': (0.0, 60.0, 110.0, 110.0)}                        # cut by the left edge
+    assert check(coffee, [cut], [0.5], np.array([cut['box']])) == ([cut], 0)
+    tiny = {'box': (300.0, 200.0, 8.0, 8.0)}                        # a crop below the window
+    assert check(coffee, [tiny], [0.5], np.array([tiny['box']])) == ([tiny], 0)
+    # a close-up is read reduced so that its box is HAAR_CHECK_SIDE_PX
+    big = cv2.resize(astronaut, None, fx=3.0, fy=3.0)
+    big_face = {'box': (510.0, 180.0, 330.0, 330.0)}
+    kept, pixels = check(big, [big_face], [0.5], np.array([big_face['box']]))
+    assert kept == [big_face]
+    assert pixels == pytest.approx((660 * search.HAAR_CHECK_SIDE_PX / 330) ** 2, rel=0.02)
 
 
 def test_the_coarse_pass_keeps_weaker_boxes_than_the_fine_windows(yunet_420):
