@@ -129,16 +129,11 @@ SECOND_SCORE = 0.05
 SECOND_BOXES = 2
 SECOND_SIDE = 0.25
 SECOND_NEIGHBORS = 8
-# The cascades of find --all's Haar check (haar_checked; its score and neighbours are the scale
-# table's): the frontal and the profile cascade, the profile one also mirrored, so that a
-# turned face YuNet scores low is not vetoed by the frontal cascade alone (the training faces
-# are frontal, and there the frontal cascade alone kept the same 790 of 792 faces).
-HAAR_CHECK_CASCADES = ('haarcascade_frontalface_alt2.xml', 'haarcascade_profileface.xml')
-# The check reads the crop reduced so that the face's box is at most this many pixels (never
-# enlarged), so that a close-up costs no more than a crowd's face. Chosen on the training material
-# of SCALE_TABLES' check: 96 kept the faces 128 kept (64 lost one lfw face of 96 at 1280x886) for
-# 14% fewer detector pixels on the lfw groups at 1280x886.
-HAAR_CHECK_SIDE_PX = 96.0
+# find --all's Haar check (haar_checked; its score and neighbours are the scale table's) reads the
+# crop round a face reduced so that the face's box is at most this many pixels (never enlarged):
+# a cascade sees a face of that size well, and each check costs a few milliseconds (docs/design.md
+# section 11.4, "Haar checks a face below 0.9", where it was chosen on training material).
+HAAR_CHECK_SIDE_PX = 48.0
 # A crowd (find --all, docs/design.md section 11.4): faces down to CROWD_RATIO times the smallest
 # the coarse pass found (or, when it found nothing, than the faces assumed to matter) may be
 # there. Seen well, they are seen that much smaller by a call 1 / CROWD_RATIO times finer; seen
@@ -1314,13 +1309,6 @@ def _second_opinion(image: np.ndarray, found, image_px: tuple[int, int], score: 
     return None, pixels
 
 
-@functools.lru_cache(maxsize=1)
-def haar_check_detector():
-    """Return the frontal (alt2) and profile cascades (the profile also mirrored), once."""
-    from ipomdp_gaze.vision.detectors import make_detector
-    return make_detector('haar', cascade=list(HAAR_CHECK_CASCADES), mirror=[False, True])
-
-
 def haar_checked(image: np.ndarray, faces: list, boxes, scores, image_px: tuple[int, int],
                  score: float, neighbors: int) -> tuple[list, int]:
     """
@@ -1328,17 +1316,18 @@ def haar_checked(image: np.ndarray, faces: list, boxes, scores, image_px: tuple[
 
     A face whose best box (the highest score of the boxes centred in its box; none for a
     face without a box) scores at least ``score`` is kept as it is. Any other is kept only
-    if :func:`haar_check_detector` finds a grouped box of ``neighbors`` neighbours centred
-    in the face's box (cut to the image), in the crop round it (half its side on each side),
-    reduced so that the box is at most :data:`HAAR_CHECK_SIDE_PX`: on the training material
-    YuNet's false faces on turned or enlarged textures are boxes of 0.37-0.83 that no cascade
-    sees (docs/design.md section 11.4). A face the cascades cannot judge keeps its place: one
-    cut by the image's edge (a cascade needs the whole face) or too small for their window.
+    if OpenCV's frontal face cascade (:func:`second_opinion_detector`) finds a grouped box of
+    ``neighbors`` neighbours centred in the face's box (cut to the image), in the crop round
+    it (half its side on each side) reduced so that the box is at most
+    :data:`HAAR_CHECK_SIDE_PX`: on the training material YuNet's false faces on turned or
+    enlarged textures are boxes of 0.37-0.83 that the cascade does not see (docs/design.md
+    section 11.4). A face the cascade cannot judge keeps its place: one cut by the image's
+    edge (a cascade needs the whole face) or too small for its window.
     """
     boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
     scores = np.asarray(scores, dtype=float).reshape(-1)
     centres = boxes[:, :2] + boxes[:, 2:] / 2.0
-    haar = haar_check_detector()
+    haar = second_opinion_detector()
     window = min(detector_window_px(haar))
     kept, pixels = [], 0
     for face in faces:
