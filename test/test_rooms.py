@@ -275,3 +275,21 @@ def test_room_boxes_put_one_face_seen_from_two_views_at_one_place():
     width = side / camera.fx * 180 / math.pi / grid.spacing_deg * ROOM_CELL_PX
     np.testing.assert_allclose(out[:, 2], [width, width])
     assert room_boxes(task, [grid.index(0, 0)]).shape == (0, 4)
+
+
+@pytest.mark.parametrize('args, said', [
+    (['--faces', '2', '--compare', 'many:search.targets=one'],
+     "searcher 'many:search.targets=one': a room searcher looks for everyone"),
+    (['--compare', 'elm:search.targets=many'],
+     "searcher 'elm:search.targets=many': search.targets many is for rooms")])
+def test_evaluate_refuses_what_a_room_or_one_face_would_ignore(args, said, capsys):
+    """A label's search.targets other than the task's was run as if not given."""
+    assert main(['evaluate', '--scenes', 'pan-tilt', *args, '--episodes', '1', '--jobs', '1',
+                 '--quiet']) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f'ipomdp-gaze evaluate: error: {said}')
+
+
+def test_task_spec_takes_a_label_of_the_tasks_own_targets():
+    label = 'many:search.targets=many'
+    assert task_spec('pan-tilt', faces=2, compare=(label,)).compare == (label,)

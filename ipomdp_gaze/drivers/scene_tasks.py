@@ -112,7 +112,8 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
     :data:`ROOM_BUDGET` unless ``max_fixations`` is given.
     ``group_min_neighbors`` (pan-tilt, one face): the grouping the views report for
     ``search.group_stop`` (``Frame.groups``), by default the model's (:func:`model_groups`);
-    rooms report :data:`ROOM_GROUP_MIN_NEIGHBORS`.
+    rooms report :data:`ROOM_GROUP_MIN_NEIGHBORS`. A ``compare`` label's ``search.targets``
+    must be the task's (``one``; ``many`` for rooms).
     """
     if task not in TASKS:
         raise ValueError(f"unknown scene task {task!r}; choose from {', '.join(TASKS)}")
@@ -124,10 +125,17 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
     if faces != (1, 1) and (task != 'pan-tilt' or empty):
         raise ValueError('rooms of several faces are for the pan-tilt task (0 faces: faces=0, '
                          'not empty)')
+    targets = 'one' if faces == (1, 1) else 'many'
     for label in compare:
         name = label.split(':')[0]
-        if ':' in label:
-            compare_settings(SearchSettings(), label)
+        if ':' in label and compare_settings(replace(SearchSettings(), targets=targets),
+                                             label).targets != targets:
+            # the searchers of a task all hold its targets: a label's own would be ignored
+            raise ValueError(f'searcher {label!r}: '
+                             + ('search.targets many is for rooms of several faces (faces K or '
+                                'LO-HI, --faces)' if targets == 'one' else
+                                'a room searcher looks for everyone (search.targets many); '
+                                'one face: faces 1, without --faces'))
         if faces != (1, 1):
             if name not in ROOM_SEARCHERS or (':' in label and name in ROOM_SWEEPS):
                 raise ValueError(f'unknown room searcher {label!r}; choose from '
