@@ -293,3 +293,15 @@ def test_evaluate_refuses_what_a_room_or_one_face_would_ignore(args, said, capsy
 def test_task_spec_takes_a_label_of_the_tasks_own_targets():
     label = 'many:search.targets=many'
     assert task_spec('pan-tilt', faces=2, compare=(label,)).compare == (label,)
+
+
+@pytest.mark.parametrize('args', [['--faces', '2'], []])
+def test_evaluate_refuses_a_grouping_the_task_does_not_take(args, capsys):
+    """Rooms report their own grouping and faces-420 none: --group-min-neighbors was dropped."""
+    scenes = 'pan-tilt' if args else 'faces-420'
+    assert main(['evaluate', '--scenes', scenes, *args, '--group-min-neighbors', '3',
+                 '--episodes', '1', '--jobs', '1', '--quiet']) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ['ipomdp-gaze evaluate: error: group_min_neighbors (--group-min-neighbors) is '
+                   'for the pan-tilt task with one face; rooms report the grouping 5 of '
+                   'config/faces_camera_room_detector.yaml, the fixed-camera tasks none']

@@ -110,10 +110,10 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
     compared with :data:`ROOM_SEARCHERS` only (drivers/rooms.py); the settings are then the
     configuration's with :data:`ROOM_MODEL` and :data:`ROOM_CHOICES`, and the budget
     :data:`ROOM_BUDGET` unless ``max_fixations`` is given.
-    ``group_min_neighbors`` (pan-tilt, one face): the grouping the views report for
-    ``search.group_stop`` (``Frame.groups``), by default the model's (:func:`model_groups`);
-    rooms report :data:`ROOM_GROUP_MIN_NEIGHBORS`. A ``compare`` label's ``search.targets``
-    must be the task's (``one``; ``many`` for rooms).
+    ``group_min_neighbors`` (pan-tilt, one face; refused otherwise): the grouping the views
+    report for ``search.group_stop`` (``Frame.groups``), by default the model's
+    (:func:`model_groups`); rooms report :data:`ROOM_GROUP_MIN_NEIGHBORS`. A ``compare``
+    label's ``search.targets`` must be the task's (``one``; ``many`` for rooms).
     """
     if task not in TASKS:
         raise ValueError(f"unknown scene task {task!r}; choose from {', '.join(TASKS)}")
@@ -166,6 +166,12 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
     if max_fixations is None:
         max_fixations = base.max_fixations or DEFAULT_BUDGET
     settings = settings or replace(base, max_fixations=max_fixations)
+    if group_min_neighbors is not None and (task != 'pan-tilt' or faces != (1, 1)):
+        # not silently dropped: fixed-camera tasks report no groups, rooms their own grouping
+        raise ValueError('group_min_neighbors (--group-min-neighbors) is for the pan-tilt task '
+                         f'with one face; rooms report the grouping {ROOM_GROUP_MIN_NEIGHBORS} '
+                         'of config/faces_camera_room_detector.yaml, the fixed-camera tasks '
+                         'none')
     if task != 'pan-tilt':
         groups = 0
     elif faces != (1, 1):
