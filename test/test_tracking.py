@@ -152,6 +152,14 @@ def test_a_paired_difference_of_fractions_is_cut_to_minus_one_one():
     assert normal_interval(np.array([3.0, -1.0]))[1] < -1.0        # seconds: no bound
 
 
+def test_a_walk_longer_than_the_scene_cameras_is_refused():
+    """The scene camera's bound, an hour: evaluate ran a walk of 1e9 s for ever."""
+    assert tracking.walk_spec(5.0, 'train', duration_s=3600.0).duration_s == 3600.0
+    for duration_s in (3600.5, 1e9):
+        with pytest.raises(ValueError, match='the walk duration must be > 0 s and at most 3600 s'):
+            tracking.walk_spec(5.0, 'train', duration_s=duration_s)
+
+
 def test_walk_options_without_motion_walk_are_refused(cli_here):
     for flag in ('--speed-deg-s', '--walk-duration-s'):
         result = cli_here('evaluate', '--scenes', 'pan-tilt', flag, '5', '--episodes', '1')
