@@ -249,6 +249,20 @@ def test_the_scene_camera_builds_a_room_and_refuses_one_on_a_fixed_view():
         _scene_config(values)
 
 
+@pytest.mark.parametrize('change, said', [
+    ({'scene.file': 'photo.png'}, 'scene.faces is for the held-out scenes, not scene.file'),
+    ({'scene.empty': True}, 'scene.empty shows the one-face scene without its face: leave '
+                            "scene.faces '1'")])
+def test_the_scene_camera_refuses_a_room_it_would_not_show(change, said):
+    """A user's photo ignored scene.faces; scene.empty's refusal named the API's faces=0."""
+    from ipomdp_gaze.nodes.scene_camera import _scene_config, scene_camera_params
+    values = {p.name: p.default for p in scene_camera_params()}
+    values.update({'scene.faces': '2', **change})
+    with pytest.raises(ValueError) as caught:
+        _scene_config(values)
+    assert str(caught.value).startswith(said)
+
+
 def test_room_boxes_put_one_face_seen_from_two_views_at_one_place():
     import math
     from types import SimpleNamespace

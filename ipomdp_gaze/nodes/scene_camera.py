@@ -159,8 +159,16 @@ def _scene_config(values: dict) -> SceneConfig:
     centre = None
     if values['scene.face_x_px'] >= 0 or values['scene.face_y_px'] >= 0:
         centre = (values['scene.face_x_px'], values['scene.face_y_px'])
-    if view != 'pan_tilt' and parse_faces(values.get('scene.faces', '1')) != (1, 1):
+    room = parse_faces(values.get('scene.faces', '1')) != (1, 1)
+    if view != 'pan_tilt' and room:
         raise ValueError('scene.faces is for the pan_tilt view')
+    # in the node's own words (the scene set's say faces=0 and empty=True), and never ignored
+    if room and values['scene.file']:
+        raise ValueError("scene.faces is for the held-out scenes, not scene.file (a user's "
+                         'photo: scene.face_x_px, scene.face_y_px give its face)')
+    if room and values['scene.empty']:
+        raise ValueError('scene.empty shows the one-face scene without its face: leave '
+                         "scene.faces '1' (a room of nobody: scene.faces '0' alone)")
     walking = values.get('scene.motion', 'still') == 'walk'
     split = values.get('scene.split', 'test')
     if walking:
