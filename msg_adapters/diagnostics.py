@@ -59,8 +59,15 @@ def values_of(msg: DiagnosticStatus) -> dict:
     return {kv.key: kv.value for kv in msg.values}
 
 
-def _ending(forced_by: str, confidence: float | None) -> tuple[str, dict]:
-    """Return the message's clause and the values that say how a decision was reached."""
+def _ending(forced_by: str, confidence: float | None,
+            probability: float | None = None) -> tuple[str, dict]:
+    """
+    Return the message's clause and the values that say how a decision was reached.
+
+    A forced answer whose own ``probability`` is at the confidence anyway (a room's pass ends
+    forced while the face the belief names is sure) is not said to be below it, as the log's
+    :func:`~ipomdp_gaze.search.answer.confidence_clause`.
+    """
     values = {'ended': f'forced:{forced_by}' if forced_by else 'confidence'}
     if confidence is not None:
         values['confidence'] = float(confidence)
@@ -68,6 +75,10 @@ def _ending(forced_by: str, confidence: float | None) -> tuple[str, dict]:
     if forced_by == 'group':            # search.group_stop: a stop rule, not a limit
         values['ended'] = 'group'
         clause = ' at a grouped detection of the detector'
+    elif forced_by and confidence is not None and probability is not None \
+            and probability >= confidence:
+        clause = f', forced by {limit} (at the confidence {confidence:g}, before the search ' \
+            'was done)'
     elif forced_by:
         below = f' below the confidence {confidence:g}' if confidence is not None else ''
         clause = f', forced by {limit}{below}'
@@ -90,7 +101,7 @@ def found_status(name: str, row: int, col: int, cell: int, pan_rad: float, tilt_
     (``search.found_radius``), whose belief is ``probability``. ``person`` (only when > 0) is
     the number of the person found by a moving many-target search (:func:`person_of`).
     """
-    clause, ending = _ending(forced_by, confidence)
+    clause, ending = _ending(forced_by, confidence, probability)
     if radius:
         ending['radius'] = int(radius)
     ending.update(_person(person))
@@ -106,7 +117,7 @@ def found_status(name: str, row: int, col: int, cell: int, pan_rad: float, tilt_
 def absent_status(name: str, probability: float, fixations: int, forced_by: str = '',
                   confidence: float | None = None) -> DiagnosticStatus:
     """Build the ``absent`` event: ``P(absent)`` reached the confidence (or was forced)."""
-    clause, ending = _ending(forced_by, confidence)
+    clause, ending = _ending(forced_by, confidence, probability)
     message = (f'no target in the grid: probability {probability:.4f} that nobody is there '
                f'after {counted(fixations, "fixation")}{clause}')
     return status(name, 'ok', message, {'probability': float(probability),

@@ -104,3 +104,15 @@ def test_room_done_event_round_trip():
     assert 'room done: 0 people found (0 new) by search 2' in msg.message
     msg = diagnostics.room_done_status('x', 1, 1, 12, 2, False, 'pass', 0.99)
     assert msg.message.startswith('room done: 1 person found (1 new) by search 2'), msg.message
+
+
+def test_a_forced_answer_at_the_confidence_is_not_said_to_be_below_it():
+    """A room's pass forced found of a sure cell: the event said 1.0000 'below' 0.95."""
+    msg = diagnostics.found_status('x', 9, 7, 106, -0.17, 0.35, 1.0, 16, 'pass', 0.95)
+    assert msg.message.endswith('after 16 fixations, forced by the end of its pass (at the '
+                                'confidence 0.95, before the search was done)')
+    assert diagnostics.values_of(msg)['ended'] == 'forced:pass'
+    msg = diagnostics.absent_status('x', 0.995, 20, 'budget', 0.99)
+    assert 'below' not in msg.message and '(at the confidence 0.99' in msg.message
+    msg = diagnostics.found_status('x', 5, 9, 64, -0.35, 0.0, 0.7539, 12, 'pass', 0.99)
+    assert msg.message.endswith('forced by the end of its pass below the confidence 0.99')
