@@ -208,3 +208,17 @@ def test_a_table_fpoc_of_another_length_names_the_nodes_default():
         'is its default, [0.0, 10.0])')
     table = build_config(dict(values, **{'fpoc.dprime': [4.0, 1.0]}), build_policy)
     assert table.controller().session is not None
+
+
+def test_the_label_of_a_many_target_search_names_the_policy_it_follows():
+    """The log and /diagnostics named a policy the occupancy search does not run."""
+    values = dict(DEFAULTS, **{'search.targets': 'many', 'policy.name': 'map'})
+    assert build_config(values, build_policy).policy_label == \
+        'occupancy infomax (policy.name map is not used with many targets)'
+    room = _values('rooms')
+    assert room['policy.name'] == 'sweep'
+    assert build_config(room, build_policy).policy_label == 'sweep'
+    walking = dict(room, **{'motion.sigma_cells': 0.5})          # a moving search makes no pass
+    assert build_config(walking, build_policy).policy_label.startswith('occupancy infomax')
+    one = dict(values, **{'search.targets': 'one'})
+    assert build_config(one, build_policy).policy_label == 'map'

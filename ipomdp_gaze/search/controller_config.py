@@ -185,10 +185,21 @@ class ControllerConfig:
 
     @property
     def policy_label(self) -> str:
-        """Describe the policy for the log and ``/diagnostics``."""
+        """
+        Describe the policy for the log and ``/diagnostics``.
+
+        With ``search.targets: many`` only ``sweep`` on still targets is a policy the search
+        follows (one pass); any other is kept but unused, the occupancy belief choosing by its
+        own infomax (docs/design.md section 11.6): the label says so rather than name a policy
+        not run.
+        """
         v = self.values
-        return policy_label(v['policy.name'], v.get('policy.kernel'), v.get('policy.file', ''),
-                            v.get('policy.action', 'argmax'))
+        label = policy_label(v['policy.name'], v.get('policy.kernel'), v.get('policy.file', ''),
+                             v.get('policy.action', 'argmax'))
+        if v.get('search.targets') == 'many' and (v['policy.name'] != 'sweep'
+                                                  or self.settings.moving):
+            return f'occupancy infomax (policy.name {label} is not used with many targets)'
+        return label
 
     def controller(self) -> GazeController:
         """Return a new :class:`ipomdp_gaze.search.gaze.GazeController` with this configuration."""
