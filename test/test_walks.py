@@ -106,3 +106,19 @@ def test_the_walk_plot_is_written(tmp_path):
     out = tmp_path / 'walk.png'
     plot_walk(times, face, head, out, 'a walk', events=[(1.0, 'found'), (2.0, 'lost')])
     assert out.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n' and out.stat().st_size > 5000
+
+
+def test_a_long_walk_plot_title_stays_inside_the_figure(tmp_path, monkeypatch):
+    """The walk demo's title, its scene camera's parameters, ran past both edges."""
+    from ipomdp_gaze.vision import walks
+    drawn = []
+    monkeypatch.setattr(walks, 'write_figure', lambda fig, path, dpi: drawn.append(fig))
+    monkeypatch.setattr('matplotlib.pyplot.close', lambda fig: None)
+    title = ('the walking face and the gaze over ROS: seed:=1 motion:=walk speed_deg_s:=5.0 '
+             'walk_duration_s:=5.0 split:=test')
+    times = np.arange(0, 2, 0.5)
+    walks.plot_walk(times, np.ones((4, 2)), np.ones((4, 2)), tmp_path / 'w.png', title)
+    fig = drawn[0]
+    renderer = fig.canvas.get_renderer()
+    box = fig._suptitle.get_window_extent(renderer)
+    assert 0 <= box.x0 and box.x1 <= fig.bbox.width and box.y1 <= fig.bbox.height

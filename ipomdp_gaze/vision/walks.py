@@ -27,12 +27,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 import math
+import textwrap
 
 import cv2
 from ipomdp_gaze.files.writable import write_figure
 from ipomdp_gaze.vision.pan_tilt import PanTiltSceneSet, SceneGeometry
 from ipomdp_gaze.vision.scenes import DEFAULT_FEATHER, feather_mask, load_faces
 import numpy as np
+
+# Characters of a line of plot_walk's title at its 10 pt on the 8-inch figure (about 115 fit).
+TITLE_CHARS = 90
 
 # What a walk is made of: the chance a leg is a pause, how long pauses and the excursion out of
 # reach last (s, uniform), when the excursion starts (fraction of the walk, uniform), and how far
@@ -382,7 +386,9 @@ def plot_walk(times_s, face_rc, head_rc, path, title: str = '', events=()) -> No
             ax.invert_yaxis()
     axes[0].legend(loc='upper right', fontsize=8)
     axes[1].set_xlabel('time (s)')
-    fig.suptitle(title or 'the face and the gaze over time', fontsize=10)
+    # wrapped: the demo's title (the scene camera's parameters) ran past both edges
+    fig.suptitle(textwrap.fill(title or 'the face and the gaze over time', TITLE_CHARS),
+                 fontsize=10)
     fig.tight_layout()
     write_figure(fig, path, dpi=100)
     plt.close(fig)
