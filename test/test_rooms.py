@@ -319,3 +319,15 @@ def test_evaluate_refuses_a_grouping_the_task_does_not_take(args, capsys):
     assert err == ['ipomdp-gaze evaluate: error: group_min_neighbors (--group-min-neighbors) is '
                    'for the pan-tilt task with one face; rooms report the grouping 5 of '
                    'config/faces_camera_room_detector.yaml, the fixed-camera tasks none']
+
+
+@pytest.mark.parametrize('kwargs, said', [
+    ({'faces': 2, 'compare': ('many',)}, "searcher 'many' is the task's own search"),
+    ({'faces': 2, 'compare': ('pass-many', 'pass-many')}, "searcher 'pass-many' is given twice"),
+    ({'compare': ('coverage',)}, "searcher 'coverage' is the task's own search")])
+def test_a_searcher_given_twice_is_refused(kwargs, said):
+    """Results are kept per label: a second 'many' made 1 room read as 2, its head time doubled."""
+    with pytest.raises(ValueError) as caught:
+        task_spec('pan-tilt', **kwargs)
+    assert str(caught.value) == f'{said}: its scenes would be counted twice'
+    assert task_spec('pan-tilt', policy='map', compare=('coverage',)).compare == ('coverage',)

@@ -160,6 +160,12 @@ def test_a_walk_longer_than_the_scene_cameras_is_refused():
             tracking.walk_spec(5.0, 'train', duration_s=duration_s)
 
 
+def test_a_walk_searcher_given_twice_is_refused():
+    """Results are kept per label: one walk was counted as found in 2 of 2."""
+    with pytest.raises(ValueError, match="'track-last-detection' is given twice"):
+        tracking.walk_spec(5.0, 'train', compare=('track-last-detection',) * 2)
+
+
 def test_walk_options_without_motion_walk_are_refused(cli_here):
     for flag in ('--speed-deg-s', '--walk-duration-s'):
         result = cli_here('evaluate', '--scenes', 'pan-tilt', flag, '5', '--episodes', '1')

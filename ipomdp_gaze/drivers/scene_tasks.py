@@ -159,6 +159,13 @@ def task_spec(task: str, policy: str | None = None, policy_file: str | None = No
         name = 'learned' if file else 'elm'
     if policy is not None or policy_file:
         name, file = ('learned', policy_file) if policy_file else (policy, '')
+    # the results are kept per searcher's label: one given twice counted each scene twice
+    own = 'many' if faces != (1, 1) else file or name
+    labels = [own, *compare]
+    for label in compare:
+        if labels.count(label) > 1:
+            twice = "is the task's own search" if label == own else 'is given twice'
+            raise ValueError(f'searcher {label!r} {twice}: its scenes would be counted twice')
     if faces != (1, 1):
         base = replace(base, **ROOM_MODEL, **ROOM_CHOICES)
         if max_fixations is None:

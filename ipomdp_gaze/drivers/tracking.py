@@ -350,6 +350,9 @@ def walk_spec(speed_deg_s: float, split: str = 'test', seed: int = 0,
                          f'hour, as the scene camera), got {duration_s!r}')
     for name in compare:
         _baseline_kwargs(name)
+        if list(compare).count(name) > 1:        # kept per label: its walks counted twice
+            raise ValueError(f'searcher {name!r} is given twice: its walks would be counted '
+                             'twice')
     base, policy, values = walk_settings(config)
     model = values.get('observation.file', '') if model is None else str(model)
     return WalkSpec(split, int(seed), float(speed_deg_s), float(duration_s),
