@@ -52,3 +52,13 @@ def test_stop_processes_terminates_the_polite_and_kills_the_stubborn():
     assert polite.returncode == -15                      # SIGTERM
     assert stubborn.returncode == -9                     # SIGKILL after the wait
     stubborn.stdout.close()
+
+
+def test_the_demos_say_a_node_never_started_so():
+    """A node left unstarted (an earlier one did not come up) read 'exit status None'."""
+    from ipomdp_gaze.harness.processes import exit_states
+    codes = {'scene_camera': None, 'detector': -15, 'controller': 0, 'camera': 1}
+    alive = {'scene_camera': False, 'detector': True, 'controller': True, 'camera': False}
+    assert exit_states(codes, alive) == ('scene_camera not started, detector exit status -15, '
+                                         'controller exit status 0, camera exit status 1 (had '
+                                         'already exited)')

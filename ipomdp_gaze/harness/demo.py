@@ -24,7 +24,7 @@ import time
 from diagnostic_msgs.msg import DiagnosticArray
 from ipomdp_gaze.files.share_files import config_file
 from ipomdp_gaze.files.yaml_files import yaml_parameters
-from ipomdp_gaze.harness.processes import domain_id_for, isolated_nodes
+from ipomdp_gaze.harness.processes import domain_id_for, exit_states, isolated_nodes
 from ipomdp_gaze.harness.watch import quiet_condition, SearchRecord, Watch
 from ipomdp_gaze.model.belief import entropy
 from ipomdp_gaze.model.head import PanTiltMap
@@ -410,9 +410,7 @@ def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = 
             for p in procs:
                 out(f'--- {p.node} output ---\n{p.output().rstrip()}')
         clean = all(codes[k] == 0 for k, running in alive.items() if running)
-        states = ', '.join(f'{k} exit status {v}' + ('' if alive[k] or v is None else
-                                                     ' (had already exited)')
-                           for k, v in codes.items())
+        states = exit_states(codes, alive)
         which = 'both nodes' if len(procs) == 2 else f'all {len(procs)} nodes'
         if record and codes.get('recorder') == 0:
             out(f'recorded the search to {record}')

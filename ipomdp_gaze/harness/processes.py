@@ -119,6 +119,19 @@ def stop_processes(procs, timeout_s: float = 10.0) -> None:
             proc.wait()
 
 
+def exit_states(codes: dict, alive: dict) -> str:
+    """
+    Say how each node of a run ended, for the demos' last line.
+
+    ``codes`` maps a node to its exit code (None: never started, as when an earlier node did
+    not come up in time), ``alive`` whether it was running when stopped; ``detector exit
+    status 0``, ``camera exit status 1 (had already exited)``, ``scene_camera not started``.
+    """
+    return ', '.join(f'{k} not started' if v is None else f'{k} exit status {v}'
+                     + ('' if alive.get(k, True) else ' (had already exited)')
+                     for k, v in codes.items())
+
+
 class NodeExited(RuntimeError):
     """A node process that should be running has exited."""
 

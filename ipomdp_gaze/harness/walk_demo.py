@@ -23,7 +23,7 @@ from ipomdp_gaze.drivers.tracking import face_in_view
 from ipomdp_gaze.files.share_files import config_file
 from ipomdp_gaze.files.yaml_files import yaml_parameters
 from ipomdp_gaze.harness.demo import faces_setup
-from ipomdp_gaze.harness.processes import domain_id_for, isolated_nodes, NodeExited
+from ipomdp_gaze.harness.processes import domain_id_for, exit_states, isolated_nodes, NodeExited
 from ipomdp_gaze.harness.watch import LATCHED, Watch
 from ipomdp_gaze.model.head_camera import PinholeCamera
 from ipomdp_gaze.model.wording import counted
@@ -191,7 +191,7 @@ def run_walk_demo(setup, camera, duration_s: float = DURATION_S, timeout_s: floa
             for p in procs:
                 out(f'--- {p.node} output ---\n{p.output().rstrip()}')
         clean = all(codes[k] == 0 for k, running in alive.items() if running)
-        states_ = ', '.join(f'{k} exit status {v}' for k, v in codes.items())
+        states_ = exit_states(codes, alive)
         out(f'stopped all {len(procs)} nodes ({states_})' +
             ('' if clean else ': NOT a clean shutdown'))
         if plot is not None and frames:
