@@ -221,6 +221,15 @@ def test_the_room_demo_ends_with_one_verdict_line():
     assert sum(line.startswith('fixation ') for line in lines) >= 1
 
 
+def test_the_room_demo_of_nobody_says_so():
+    """It said 'the scene camera put the faces in cells (none)'."""
+    from ipomdp_gaze.drivers.rooms import room_demo
+    lines = []
+    room_demo(0, 0, lines.append)
+    assert lines[-2:] == ['the scene camera put no face in the room',
+                          'found 0 of 0 faces: that is right']
+
+
 @pytest.mark.parametrize('args', [['--faces', '2'], ['--scene', 'faces', '--faces', '2',
                                                      '--fovea'],
                                   ['--scene', 'faces', '--faces', '0-3', '--empty'],

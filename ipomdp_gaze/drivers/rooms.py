@@ -293,8 +293,8 @@ def room_demo(faces, seed: int, out, max_fixations: int | None = None) -> int:
         out(f"face {i}: cell {tuple(int(v) for v in grid.cell(face['cell']))} p="
             f"{face['probability']:.3f}")
     truths = [tuple(int(v) for v in f.cell) for f in scene.faces]
-    out('the scene camera put the faces in cells '
-        + (', '.join(str(t) for t in truths) if truths else '(none)'))
+    out('the scene camera put the faces in cells ' + ', '.join(str(t) for t in truths)
+        if truths else 'the scene camera put no face in the room')
     answers = [tuple(int(v) for v in grid.cell(f['cell'])) for f in found]
     n = match_faces(answers, truths)
     right = n == len(truths) and n == len(answers)
