@@ -180,10 +180,23 @@ def test_a_face_below_the_check_score_that_no_cascade_sees_is_not_reported(yunet
     side = max(w, h) / 2.0
     crop_w = int(min(image.shape[1], x + w + side)) - int(max(0, x - side))
     crop_h = int(min(image.shape[0], y + h + side)) - int(max(0, y - side))
-    factor = min(1.0, search.HAAR_CHECK_SIDE_PX / max(w, h))
-    crop_px = round(crop_w * factor) * round(crop_h * factor)
+    crop_px = check_px(crop_w, crop_h, max(w, h))
     assert checked.faces == () and checked.decision == 'absent'
-    assert checked.detector_pixels == unchecked.detector_pixels + crop_px
+    # a veto reads the crop once per cascade (each sees nothing)
+    vetoed_px = len(search.HAAR_CHECK_CASCADES) * crop_px
+    assert checked.detector_pixels == unchecked.detector_pixels + vetoed_px
+
+
+def check_px(crop_w: int, crop_h: int, side: float) -> int:
+    """
+    Return the pixels one cascade of the Haar check reads of a crop round a box of ``side``.
+
+    The crop resized so that the box is HAAR_CHECK_SIDE_PX, then the pyramid level where the
+    cascade's 20 px window is the smallest face looked for (haar_checked).
+    """
+    factor = search.HAAR_CHECK_SIDE_PX / side
+    first = search.HAAR_CHECK_RANGE[0] * search.HAAR_CHECK_SIDE_PX / 20
+    return round(round(crop_w * factor) * round(crop_h * factor) / first ** 2)
 
 
 def test_the_haar_check_keeps_what_a_cascade_sees_or_cannot_judge():
@@ -196,23 +209,29 @@ def test_the_haar_check_keeps_what_a_cascade_sees_or_cannot_judge():
         size = (image.shape[1], image.shape[0])
         return search.haar_checked(image, faces, box_list, np.array(scores), size, 0.9, 1)
 
-    # half the side on each side, reduced so that the box is at most HAAR_CHECK_SIDE_PX
-    crop_px = round(220 * min(1.0, search.HAAR_CHECK_SIDE_PX / 110)) ** 2
+    # half the side on each side, resized as HAAR_CHECK_SIDE_PX says; the frontal cascade sees
+    # the face (one read), no cascade the texture (a read each)
+    crop_px = check_px(220, 220, 110)
     assert check(astronaut, [face], [0.5]) == ([face], crop_px)
     assert check(astronaut, [face], [0.95]) == ([face], 0)          # strong: not read
     assert check(astronaut, [face], [0.5], np.zeros((0, 4))) == ([face], crop_px)   # no box
-    assert check(coffee, [face], [0.5]) == ([], crop_px)            # texture: vetoed
+    assert check(coffee, [face], [0.5]) == ([], 2 * crop_px)        # texture: vetoed
     assert check(coffee, [face], [0.95]) == ([face], 0)
     cut = {'box': (0.0, 60.0, 110.0, 110.0)}                        # cut by the left edge
     assert check(coffee, [cut], [0.5], np.array([cut['box']])) == ([cut], 0)
-    tiny = {'box': (300.0, 200.0, 8.0, 8.0)}                        # a crop below the window
+    tiny = {'box': (300.0, 200.0, 8.0, 8.0)}                        # beyond 4x to enlarge
     assert check(coffee, [tiny], [0.5], np.array([tiny['box']])) == ([tiny], 0)
-    # a close-up is read reduced so that its box is HAAR_CHECK_SIDE_PX
+    small = {'box': (300.0, 200.0, 30.0, 30.0)}                     # enlarged 3.2x
+    assert check(coffee, [small], [0.5], np.array([small['box']])) == \
+        ([], 2 * check_px(60, 60, 30))
+    # a close-up is read reduced so that its box is HAAR_CHECK_SIDE_PX (each check reads a crop
+    # of about twice that side, whatever the face's size)
+    assert search.HAAR_CHECK_CASCADES[0][0] == 'haarcascade_frontalface_alt2.xml'
     big = cv2.resize(astronaut, None, fx=3.0, fy=3.0)
     big_face = {'box': (510.0, 180.0, 330.0, 330.0)}
     kept, pixels = check(big, [big_face], [0.5], np.array([big_face['box']]))
     assert kept == [big_face]
-    assert pixels == pytest.approx((660 * search.HAAR_CHECK_SIDE_PX / 330) ** 2, rel=0.02)
+    assert pixels == check_px(660, 660, 330)
 
 
 def test_the_coarse_pass_keeps_weaker_boxes_than_the_fine_windows(yunet_420):

@@ -57,7 +57,7 @@ from ipomdp_gaze.vision.detector import box_centres_px, detector_window_px, grou
 from ipomdp_gaze.vision.detectors import detector_from_settings  # noqa: F401 (its old home)
 from ipomdp_gaze.vision.fovea import cell_edges_px, Fovea
 from ipomdp_gaze.vision.fovea_model import check_model, fovea_for_model  # noqa: F401
-from ipomdp_gaze.vision.fullframe import cells_of_points, scaled_size, scan
+from ipomdp_gaze.vision.fullframe import cells_of_points, MAX_SCALE, scaled_size, scan
 from ipomdp_gaze.vision.scales import (box_cells, box_sides, choose_scale, coarse_detector,
                                        coarse_evidence, confirm_scale, ladder_scales,
                                        larger_face_scale, min_face_px, SCALE_RTOL, ScaleTable,
@@ -129,11 +129,17 @@ SECOND_SCORE = 0.05
 SECOND_BOXES = 2
 SECOND_SIDE = 0.25
 SECOND_NEIGHBORS = 8
-# find --all's Haar check (haar_checked; its score and neighbours are the scale table's) reads the
-# crop round a face reduced so that the face's box is at most this many pixels (never enlarged):
-# a cascade sees a face of that size well, and each check costs a few milliseconds (docs/design.md
-# section 11.4, "Haar checks a face below 0.9", where it was chosen on training material).
-HAAR_CHECK_SIDE_PX = 48.0
+# find --all's Haar check (haar_checked; its score and neighbours are the scale table's): OpenCV's
+# frontal (alt2) cascade, then, only if it sees no face, the profile cascade on the crop and on
+# its mirror image, so that a turned face YuNet scores low is not vetoed by the frontal cascade
+# alone. The crop round the face is resized so that the face's box is HAAR_CHECK_SIDE_PX (at
+# most MAX_SCALE times enlarged), and the cascades look only for faces of HAAR_CHECK_RANGE times
+# that side: a few milliseconds a face instead of 20-50 for the cascades' whole pyramid, the same
+# training faces (docs/design.md section 11.4, "Haar checks a face below 0.9").
+HAAR_CHECK_CASCADES = (('haarcascade_frontalface_alt2.xml', False),
+                       ('haarcascade_profileface.xml', True))
+HAAR_CHECK_SIDE_PX = 96.0
+HAAR_CHECK_RANGE = (0.67, 1.5)
 # A crowd (find --all, docs/design.md section 11.4): faces down to CROWD_RATIO times the smallest
 # the coarse pass found (or, when it found nothing, than the faces assumed to matter) may be
 # there. Seen well, they are seen that much smaller by a call 1 / CROWD_RATIO times finer; seen
@@ -1309,6 +1315,16 @@ def _second_opinion(image: np.ndarray, found, image_px: tuple[int, int], score: 
     return None, pixels
 
 
+@functools.lru_cache(maxsize=1)
+def haar_check_detectors() -> tuple:
+    """Return the check's cascades (:data:`HAAR_CHECK_CASCADES`), each a detector, built once."""
+    from ipomdp_gaze.vision.detectors import make_detector
+    sizes = {'min_size_px': round(HAAR_CHECK_RANGE[0] * HAAR_CHECK_SIDE_PX),
+             'max_size_px': round(HAAR_CHECK_RANGE[1] * HAAR_CHECK_SIDE_PX)}
+    return tuple(make_detector('haar', cascade=name, mirror=mirror, **sizes)
+                 for name, mirror in HAAR_CHECK_CASCADES)
+
+
 def haar_checked(image: np.ndarray, faces: list, boxes, scores, image_px: tuple[int, int],
                  score: float, neighbors: int) -> tuple[list, int]:
     """
@@ -1316,19 +1332,22 @@ def haar_checked(image: np.ndarray, faces: list, boxes, scores, image_px: tuple[
 
     A face whose best box (the highest score of the boxes centred in its box; none for a
     face without a box) scores at least ``score`` is kept as it is. Any other is kept only
-    if OpenCV's frontal face cascade (:func:`second_opinion_detector`) finds a grouped box of
-    ``neighbors`` neighbours centred in the face's box (cut to the image), in the crop round
-    it (half its side on each side) reduced so that the box is at most
-    :data:`HAAR_CHECK_SIDE_PX`: on the training material YuNet's false faces on turned or
-    enlarged textures are boxes of 0.37-0.83 that the cascade does not see (docs/design.md
-    section 11.4). A face the cascade cannot judge keeps its place: one cut by the image's
-    edge (a cascade needs the whole face) or too small for its window.
+    if one of the check's cascades (:func:`haar_check_detectors`, in order, the next only when
+    the one before saw nothing) finds a grouped box of ``neighbors`` neighbours centred in
+    the face's box (cut to the image), in the crop round it (half its side on each side)
+    resized so that the box is :data:`HAAR_CHECK_SIDE_PX`, among faces of
+    :data:`HAAR_CHECK_RANGE` times that side: on the training material YuNet's false faces on
+    turned or enlarged textures are boxes of 0.37-0.83 that no cascade sees (docs/design.md
+    section 11.4). A face the cascades cannot judge keeps its place: one cut by the image's
+    edge (a cascade needs the whole face), or too small to be enlarged that far
+    (``MAX_SCALE``) or for their window.
     """
     boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
     scores = np.asarray(scores, dtype=float).reshape(-1)
     centres = boxes[:, :2] + boxes[:, 2:] / 2.0
-    haar = second_opinion_detector()
-    window = min(detector_window_px(haar))
+    cascades = haar_check_detectors()
+    window = max(min(detector_window_px(haar)) for haar in cascades)
+    first_level = max(1.0, HAAR_CHECK_RANGE[0] * HAAR_CHECK_SIDE_PX / window)
     kept, pixels = [], 0
     for face in faces:
         x, y, w, h = clip_box(face['box'], image_px)
@@ -1338,17 +1357,21 @@ def haar_checked(image: np.ndarray, faces: list, boxes, scores, image_px: tuple[
             kept.append(face)
             continue
         x0, y0, x1, y1 = _crop_round((x, y, w, h), image_px, reach=0.5)
-        factor = min(1.0, HAAR_CHECK_SIDE_PX / max(w, h, 1.0))
+        factor = HAAR_CHECK_SIDE_PX / max(w, h, 1.0)
         cut = x <= 0 or y <= 0 or x + w >= image_px[0] or y + h >= image_px[1]
-        if cut or min(x1 - x0, y1 - y0) * factor < window:
+        if cut or min(x1 - x0, y1 - y0) * factor < window or factor > MAX_SCALE:
             kept.append(face)
             continue
-        look = scan(image[y0:y1, x0:x1], haar, (1, 1), factor, min_neighbors=neighbors)
-        pixels += look.detector_pixels
-        # the grouped boxes are in the crop's own pixels (scan maps them back)
-        if any(x <= x0 + gx + gw / 2.0 <= x + w and y <= y0 + gy + gh / 2.0 <= y + h
-               for gx, gy, gw, gh in look.grouped_px):
-            kept.append(face)
+        for haar in cascades:
+            look = scan(image[y0:y1, x0:x1], haar, (1, 1), factor, min_neighbors=neighbors)
+            # the cascade's pyramid starts where its window is the smallest face looked for:
+            # the pixels it reads are those of that level (the crop reduced by first_level)
+            pixels += round(look.detector_pixels / first_level ** 2)
+            # the grouped boxes are in the crop's own pixels (scan maps them back)
+            if any(x <= x0 + gx + gw / 2.0 <= x + w and y <= y0 + gy + gh / 2.0 <= y + h
+                   for gx, gy, gw, gh in look.grouped_px):
+                kept.append(face)
+                break
     return kept, pixels
 
 
