@@ -181,6 +181,23 @@ def test_reindex_refuses_a_folder_without_mcap_files_with_one_line(tmp_path, cli
         'ipomdp-gaze reindex: error: ' + message.format(p=path)]
 
 
+@pytest.mark.parametrize('content', [b'', b'hello, not a bag', b'\x89MCA'])
+def test_reindex_refuses_a_file_that_is_not_mcap_and_changes_nothing(
+        tmp_path, cli_here, content):
+    """QA: a file named .mcap that is not MCAP was replaced by an empty recovered bag."""
+    bag = tmp_path / 'bag'
+    _killed(bag, 40)
+    other = bag / 'bag_1.mcap'
+    other.write_bytes(content)
+    before = {p.name: p.read_bytes() for p in bag.iterdir()}
+    run = cli_here('reindex', bag)
+    assert run.returncode == 2
+    assert run.stderr.strip().splitlines() == [
+        f'ipomdp-gaze reindex: error: {other} is not an MCAP file (it does not begin with the '
+        'MCAP magic); nothing was changed']
+    assert {p.name: p.read_bytes() for p in bag.iterdir()} == before
+
+
 def test_a_write_failing_while_recovering_is_raised_and_leaves_the_bag_as_it_was(
         tmp_path, monkeypatch):
     """Review: a full disk while rewriting was taken for the cut: a shorter file replaced it."""

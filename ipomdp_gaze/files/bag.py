@@ -716,8 +716,8 @@ def reindex(path, force: bool = False) -> Reindexed:
     Raises
     ------
     ValueError
-        If ``path`` is not a folder, holds no MCAP file or already has ``metadata.yaml``
-        (unless ``force``).
+        If ``path`` is not a folder, holds no MCAP file, a file named as one that is not
+        MCAP, or already has ``metadata.yaml`` (unless ``force``).
 
     """
     _need_rosbags()
@@ -734,6 +734,13 @@ def reindex(path, force: bool = False) -> Reindexed:
                          'of a split bag)')
     if not folder_writable(path):
         raise ValueError(f'{path}: the folder is not writable')
+    for file, _ in files:
+        # a file that does not begin as MCAP is not a recording cut off: it would be replaced
+        # by an empty recovered one
+        with open(file, 'rb') as f:
+            if f.read(len(MCAP_MAGIC)) != MCAP_MAGIC:
+                raise ValueError(f'{file} is not an MCAP file (it does not begin with the MCAP '
+                                 'magic); nothing was changed')
     infos, custom, recovered = [], {}, {}
     for file, name in files:
         info = _closed_metadata(file)
