@@ -157,6 +157,8 @@ def resolve_source(source) -> Path:
     path = Path(source)
     if path.is_file():
         return path
+    if path.is_dir():
+        raise PolicyFileError(f'policy file {str(source)!r} is a folder, not a file')
     name = path.name[:-5] if path.name.endswith('.yaml') else path.name
     if str(source) in (name, name + '.yaml'):
         shipped = KERNEL_DIR / f'{name}.yaml'

@@ -189,6 +189,8 @@ def test_unreadable_and_missing_files(tmp_path):
         load_observation(bad)
     with pytest.raises(ObservationFileError, match='not found and not a shipped model'):
         load_observation(tmp_path / 'missing.yaml')
+    with pytest.raises(ObservationFileError, match=r"'.*' is a folder, not a file"):
+        load_observation(tmp_path)                      # QA: it said 'not found'
 
 
 # ---- the one-time scan -------------------------------------------------------------------------

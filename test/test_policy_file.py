@@ -316,6 +316,8 @@ def test_missing_file_lists_shipped_names(tmp_path):
         load_policy_spec('no-such-kernel')
     with pytest.raises(PolicyFileError, match='not found'):
         load_policy_spec(tmp_path / 'absent.yaml')
+    with pytest.raises(PolicyFileError, match=r"'.*' is a folder, not a file"):
+        load_policy_spec(tmp_path)                      # QA: it said 'not found'
 
 
 def test_shipped_names_resolve_with_and_without_suffix(tmp_path, monkeypatch):

@@ -79,6 +79,8 @@ def resolve_source(source) -> Path:
     path = Path(source)
     if path.is_file():
         return path
+    if path.is_dir():
+        raise ObservationFileError(f'observation file {str(source)!r} is a folder, not a file')
     name = path.name[:-5] if path.name.endswith('.yaml') else path.name
     if str(source) in (name, name + '.yaml') and (MODEL_DIR / f'{name}.yaml').is_file():
         return MODEL_DIR / f'{name}.yaml'
