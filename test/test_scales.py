@@ -18,7 +18,7 @@ from ipomdp_gaze.vision.scales import (choose_scale, coarse_detector, coarse_evi
                                        confirm_scale, finest_scale, ladder_scales,
                                        SCALE_TABLES, ScaleRow, ScaleTable)
 from ipomdp_gaze.vision.scenes import load_background, load_faces
-from ipomdp_gaze.vision.search import FIND_SETTINGS, search_many
+from ipomdp_gaze.vision.search import FIND_SETTINGS, search_first, search_many
 import numpy as np
 import pytest
 
@@ -232,6 +232,39 @@ def test_the_haar_check_keeps_what_a_cascade_sees_or_cannot_judge():
     kept, pixels = check(big, [big_face], [0.5], np.array([big_face['box']]))
     assert kept == [big_face]
     assert pixels == check_px(660, 660, 330)
+
+
+def test_an_image_whose_only_face_was_vetoed_is_absent_at_the_other_cells_p_nobody():
+    """Its cells keep their belief (the map), but p_nobody is not that face's near-0 one."""
+    model = load_observation('faces-840-yunet')
+    fovea = fovea_for_model(model)
+    image = cv2.resize(np.ascontiguousarray(np.rot90(load_photo('coffee'))), None, fx=1.5,
+                       fy=1.5)                              # 600x900: a 0.6 box on the spoon
+    budget = image.shape[0] * image.shape[1]
+    table = scale_table(model)
+    unchecked = search_many(image, fovea, model, pixel_budget=budget,
+                            scales=replace(table, haar_check_score=0.0))
+    [face] = unchecked.faces
+    assert unchecked.absent_probability < 0.01 and unchecked.stop == 'found'
+    for run in (search_many, search_first):                 # find --all, find --scan many
+        checked = run(image, fovea, model, pixel_budget=budget, scales=table)
+        belief = np.asarray(checked.belief)
+        occupied = belief >= FIND_SETTINGS.confidence
+        assert checked.faces == () and checked.decision == 'absent'
+        assert checked.stop == 'absent'
+        assert np.array_equal(belief, unchecked.belief) and occupied.sum() == 1
+        assert occupied[face.cell[0] * fovea.grid.cols + face.cell[1]]
+        assert checked.absent_probability == pytest.approx(np.prod(1.0 - belief[~occupied]))
+
+
+def test_finds_one_time_set_up_builds_the_haar_checks_cascades(yunet_420):
+    """Built in prepare_many, outside the first image's seconds, as the coarse detector is."""
+    model, fovea = yunet_420
+    search.haar_check_detectors.cache_clear()
+    search.prepare_many(fovea, model, replace(scale_table(model), haar_check_score=0.0))
+    assert search.haar_check_detectors.cache_info().currsize == 0    # no check: not built
+    search.prepare_many(fovea, model, scale_table(model))
+    assert search.haar_check_detectors.cache_info().currsize == 1
 
 
 def test_the_coarse_pass_keeps_weaker_boxes_than_the_fine_windows(yunet_420):

@@ -63,9 +63,9 @@ class ScaleTable:
 
     ``max_side_px``: the largest face side (detector input px) the detector still finds
     strongly (YuNet's largest anchors; a sliding-window cascade such as Haar has none: inf).
-    ``haar_check_score``: a face of ``find --all`` whose best box scores below it is reported only
-    if OpenCV's Haar cascades confirm it with ``haar_check_neighbors`` (0: no confirmation;
-    :func:`ipomdp_gaze.vision.search.haar_checked`).
+    ``haar_check_score``: a face of ``find --all`` whose best box scores below it is reported
+    only if OpenCV's Haar cascades see it, with ``haar_check_neighbors`` neighbours
+    (:func:`ipomdp_gaze.vision.search.haar_checked`); a score of 0 checks no face.
     """
 
     detector: str

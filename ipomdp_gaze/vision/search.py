@@ -48,7 +48,7 @@ import time
 
 import cv2
 from ipomdp_gaze.model.grid import Grid
-from ipomdp_gaze.model.occupancy import cell_prior, prior_log_odds
+from ipomdp_gaze.model.occupancy import cell_prior, log_nobody, prior_log_odds
 from ipomdp_gaze.search import answer
 from ipomdp_gaze.search.many import OccupancySession
 from ipomdp_gaze.search.sensors import run_search
@@ -1084,12 +1084,15 @@ def prepare_many(fovea: Fovea, model, scales: ScaleTable | None = None) -> None:
     Build what :func:`search_many` builds once, outside its seconds (as ``find`` sets up).
 
     The belief's information table of the model and, with ``scales``, the coarse pass's
-    detector; both cached, so a second call costs nothing. (A fixation's cost is the fovea's
-    on the image searched: :meth:`~ipomdp_gaze.vision.fovea.Fovea.fresh_views`.)
+    detector and the Haar check's cascades (a table with a ``haar_check_score``); all cached,
+    so a second call costs nothing. (A fixation's cost is the fovea's on the image searched:
+    :meth:`~ipomdp_gaze.vision.fovea.Fovea.fresh_views`.)
     """
     OccupancySession(fovea.grid, model, replace(FIND_SETTINGS, targets='many'))
     if scales is not None:
         coarse_detector(fovea.detector, scales.weak_score)
+        if scales.haar_check_score > 0:
+            haar_check_detectors()
 
 
 def search_many(image: np.ndarray, fovea: Fovea, model,
@@ -1135,6 +1138,10 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     that only a finer crop found, when the whole image's calls found none, sends the whole
     image to the crop's scale (:class:`_Coarse`). With the detector's strong score, a face one
     call saw strongly is a face beside faces that several calls saw (``count_faces(strong=)``).
+    With the table's ``haar_check_score`` (YuNet's), a face whose best box is below it is
+    reported only if Haar's cascades see it (:func:`haar_checked`; its pixels are counted, past
+    the budget); a vetoed face's cells keep their belief but are left out of
+    ``absent_probability``.
 
     Raises
     ------
@@ -1169,10 +1176,12 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     found = session.faces(boxes, scores, image_px, link,
                           strong=scales.strong_score if scales is not None
                           and scales.strong_score > 0 else None)
-    checked_px = 0
+    checked_px, vetoed = 0, []
     if scales is not None and scales.haar_check_score > 0:
-        found, checked_px = haar_checked(image, found, boxes, scores, image_px,
-                                         scales.haar_check_score, scales.haar_check_neighbors)
+        kept, checked_px = haar_checked(image, found, boxes, scores, image_px,
+                                        scales.haar_check_score, scales.haar_check_neighbors)
+        vetoed = [f for f in found if not any(f is k for k in kept)]
+        found = kept
     faces = tuple(Face(box=clip_box(f['box'], image_px),
                        cell=tuple(int(v) for v in grid.cell(f['cell'])),
                        probability=f['probability']) for f in found)
@@ -1182,6 +1191,16 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
     result = _image_search(outcome, grid, image_px, calibrated_size(model), t0, decision, faces)
     if checked_px:
         result = replace(result, detector_pixels=result.detector_pixels + checked_px)
+    if vetoed:
+        # the check decided the vetoed faces' cells: they keep their belief (the map), but
+        # P(nobody here) is the other cells' (else an image whose only face was vetoed would be
+        # absent with p_nobody near 0), and such an image stopped at absent, not found
+        out = np.zeros(grid.n_cells, dtype=bool)
+        out[np.concatenate([f['cells'] for f in vetoed])] = True
+        result = replace(result,
+                         absent_probability=float(np.exp(log_nobody(session.log_odds[~out]))))
+        if not faces and result.stop == 'found':
+            result = replace(result, stop='absent')
     if not faces:
         return result
     # the image's answer is its most probable face, at its box's centre (as search_first)
@@ -1208,8 +1227,7 @@ def search_first(image: np.ndarray, fovea: Fovea, model,
     many = search_many(image, fovea, model, settings, pixel_budget=pixel_budget,
                        scales=scales, min_face=min_face)
     if not many.faces:
-        nobody = float(np.prod(1.0 - np.asarray(many.belief, dtype=float)))
-        return replace(many, absent_probability=nobody, seconds=time.perf_counter() - t0)
+        return replace(many, seconds=time.perf_counter() - t0)
     return replace(many, decision='found', seconds=time.perf_counter() - t0)
 
 
