@@ -201,9 +201,10 @@ def report(r: dict) -> dict:
         'images_skipped_between_used': int(np.sum(np.round(steps_s / period_s) - 1)),
         'stamp_gaps_over_0.5s': [round(float(g), 2) for g in np.sort(steps_s[steps_s > 0.5])],
         'fixations': int(waits.size), 'left_out': left_out,
-        'wait_median_ms': round(1e3 * float(np.median(waits)), 1),
-        'wait_p99_ms': round(1e3 * float(np.percentile(waits, 99)), 1),
-        'wait_max_ms': round(1e3 * float(waits.max()), 1),
+        # a run with no fixation answered (a controller that never started) has no waits
+        'wait_median_ms': round(1e3 * float(np.median(waits)), 1) if waits.size else None,
+        'wait_p99_ms': round(1e3 * float(np.percentile(waits, 99)), 1) if waits.size else None,
+        'wait_max_ms': round(1e3 * float(waits.max()), 1) if waits.size else None,
         'waits_over_0.5s': [round(float(w), 2) for w in slow],
         'searches': r['searches'],
         'cpu_percent': {k: round(100 * v) for k, v in r['cpu'].items() if v is not None},
