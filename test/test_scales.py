@@ -191,12 +191,28 @@ def check_px(crop_w: int, crop_h: int, side: float) -> int:
     """
     Return the pixels one cascade of the Haar check reads of a crop round a box of ``side``.
 
-    The crop resized so that the box is HAAR_CHECK_SIDE_PX, then the pyramid level where the
-    cascade's 20 px window is the smallest face looked for (haar_checked).
+    The crop resized so that the box is HAAR_CHECK_SIDE_PX, then the first pyramid level
+    OpenCV runs: 1.1 ** 13, where the 20 px window (69 px) first reaches the 64 px smallest
+    face looked for (test_the_haar_checks_pixels_are_those_of_opencvs_first_level).
     """
     factor = search.HAAR_CHECK_SIDE_PX / side
-    first = search.HAAR_CHECK_RANGE[0] * search.HAAR_CHECK_SIDE_PX / 20
-    return round(round(crop_w * factor) * round(crop_h * factor) / first ** 2)
+    first = 1.1 ** 13
+    return round(round(crop_w * factor) / first) * round(round(crop_h * factor) / first)
+
+
+def test_the_haar_checks_pixels_are_those_of_opencvs_first_level():
+    """The smallest raw box OpenCV gives with the check's min size is its first pyramid level's."""
+    from skimage import data
+    gray = cv2.cvtColor(cv2.resize(data.astronaut(), None, fx=0.5, fy=0.5), cv2.COLOR_RGB2GRAY)
+    for haar in search.haar_check_detectors():
+        level, window = search.first_level(haar)
+        assert haar.min_size_px == (64, 64) and window == (69, 69)
+        assert level == pytest.approx(1.1 ** 13)
+    frontal = search.haar_check_detectors()[0]
+    raw = np.asarray(frontal._classifiers[0].detectMultiScale(
+        gray, scaleFactor=frontal.scale_factor, minNeighbors=0, minSize=frontal.min_size_px,
+        maxSize=frontal.max_size_px)).reshape(-1, 4)
+    assert len(raw) and raw[:, 2].min() == 69            # not 64: no level looks at 64 px
 
 
 def test_the_haar_check_keeps_what_a_cascade_sees_or_cannot_judge():
@@ -221,6 +237,10 @@ def test_the_haar_check_keeps_what_a_cascade_sees_or_cannot_judge():
     assert check(coffee, [cut], [0.5], np.array([cut['box']])) == ([cut], 0)
     tiny = {'box': (300.0, 200.0, 8.0, 8.0)}                        # beyond 4x to enlarge
     assert check(coffee, [tiny], [0.5], np.array([tiny['box']])) == ([tiny], 0)
+    # a crop that, resized, is narrower than the first level's 69 px window: no level reads it
+    narrow = {'box': (5.0, 100.0, 30.0, 60.0)}
+    assert search.haar_checked(coffee[:, :40], [narrow], np.array([narrow['box']]),
+                               np.array([0.5]), (40, 400), 0.9, 1) == ([narrow], 0)
     small = {'box': (300.0, 200.0, 30.0, 30.0)}                     # enlarged 3.2x
     assert check(coffee, [small], [0.5], np.array([small['box']])) == \
         ([], 2 * check_px(60, 60, 30))

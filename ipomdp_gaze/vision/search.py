@@ -1343,6 +1343,22 @@ def haar_check_detectors() -> tuple:
                  for name, mirror in HAAR_CHECK_CASCADES)
 
 
+def first_level(haar) -> tuple[float, tuple[int, int]]:
+    """
+    Return the factor and window (px) of a one-cascade detector's first pyramid level.
+
+    As OpenCV's ``detectMultiScale`` picks it: the first power of the scale factor whose
+    rounded window reaches ``min_size_px`` (20 px and 64 px at 1.1: 1.1 ** 13, a 69 px window),
+    not the minimum size itself; the level reads the image reduced by that factor.
+    """
+    width, height = detector_window_px(haar)
+    least = haar.min_size_px or (0, 0)
+    factor = 1.0
+    while round(width * factor) < least[0] or round(height * factor) < least[1]:
+        factor *= haar.scale_factor
+    return factor, (round(width * factor), round(height * factor))
+
+
 def haar_checked(image: np.ndarray, faces: list, boxes, scores, image_px: tuple[int, int],
                  score: float, neighbors: int) -> tuple[list, int]:
     """
@@ -1357,15 +1373,16 @@ def haar_checked(image: np.ndarray, faces: list, boxes, scores, image_px: tuple[
     :data:`HAAR_CHECK_RANGE` times that side: on the training material YuNet's false faces on
     turned or enlarged textures are boxes of 0.37-0.83 that no cascade sees (docs/design.md
     section 11.4). A face the cascades cannot judge keeps its place: one cut by the image's
-    edge (a cascade needs the whole face), or too small to be enlarged that far
-    (``MAX_SCALE``) or for their window.
+    edge (a cascade needs the whole face), too small to be enlarged that far (``MAX_SCALE``),
+    or whose resized crop is smaller than a cascade's window at its pyramid's first level
+    (:func:`first_level`: no level would read it). The pixels counted are each cascade's
+    first level.
     """
     boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
     scores = np.asarray(scores, dtype=float).reshape(-1)
     centres = boxes[:, :2] + boxes[:, 2:] / 2.0
     cascades = haar_check_detectors()
-    window = max(min(detector_window_px(haar)) for haar in cascades)
-    first_level = max(1.0, HAAR_CHECK_RANGE[0] * HAAR_CHECK_SIDE_PX / window)
+    levels = [first_level(haar) for haar in cascades]
     kept, pixels = [], 0
     for face in faces:
         x, y, w, h = clip_box(face['box'], image_px)
@@ -1377,14 +1394,15 @@ def haar_checked(image: np.ndarray, faces: list, boxes, scores, image_px: tuple[
         x0, y0, x1, y1 = _crop_round((x, y, w, h), image_px, reach=0.5)
         factor = HAAR_CHECK_SIDE_PX / max(w, h, 1.0)
         cut = x <= 0 or y <= 0 or x + w >= image_px[0] or y + h >= image_px[1]
-        if cut or min(x1 - x0, y1 - y0) * factor < window or factor > MAX_SCALE:
+        size = scaled_size(x1 - x0, y1 - y0, factor)
+        if cut or factor > MAX_SCALE or any(size[0] < win[0] or size[1] < win[1]
+                                            for _, win in levels):
             kept.append(face)
             continue
-        for haar in cascades:
+        for haar, (level, _) in zip(cascades, levels):
             look = scan(image[y0:y1, x0:x1], haar, (1, 1), factor, min_neighbors=neighbors)
-            # the cascade's pyramid starts where its window is the smallest face looked for:
-            # the pixels it reads are those of that level (the crop reduced by first_level)
-            pixels += round(look.detector_pixels / first_level ** 2)
+            # the pixels a cascade reads are those of its pyramid's first level (first_level)
+            pixels += round(size[0] / level) * round(size[1] / level)
             # the grouped boxes are in the crop's own pixels (scan maps them back)
             if any(x <= x0 + gx + gw / 2.0 <= x + w and y <= y0 + gy + gh / 2.0 <= y + h
                    for gx, gy, gw, gh in look.grouped_px):
