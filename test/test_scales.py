@@ -182,8 +182,9 @@ def test_a_face_below_the_check_score_that_no_cascade_sees_is_not_reported(yunet
     crop_h = int(min(image.shape[0], y + h + side)) - int(max(0, y - side))
     crop_px = check_px(crop_w, crop_h, max(w, h))
     assert checked.faces == () and checked.decision == 'absent'
-    # a veto reads the crop once per cascade (each sees nothing)
-    vetoed_px = len(search.HAAR_CHECK_CASCADES) * crop_px
+    # a veto reads the crop once per cascade run (each sees nothing): the frontal cascade on
+    # it, the profile one on it and on its mirror image
+    vetoed_px = 3 * crop_px
     assert checked.detector_pixels == unchecked.detector_pixels + vetoed_px
 
 
@@ -226,12 +227,13 @@ def test_the_haar_check_keeps_what_a_cascade_sees_or_cannot_judge():
         return search.haar_checked(image, faces, box_list, np.array(scores), size, 0.9, 1)
 
     # half the side on each side, resized as HAAR_CHECK_SIDE_PX says; the frontal cascade sees
-    # the face (one read), no cascade the texture (a read each)
+    # the face (one read), no cascade the texture (the frontal one, the profile one on the crop
+    # and on its mirror image: three reads)
     crop_px = check_px(220, 220, 110)
     assert check(astronaut, [face], [0.5]) == ([face], crop_px)
     assert check(astronaut, [face], [0.95]) == ([face], 0)          # strong: not read
     assert check(astronaut, [face], [0.5], np.zeros((0, 4))) == ([face], crop_px)   # no box
-    assert check(coffee, [face], [0.5]) == ([], 2 * crop_px)        # texture: vetoed
+    assert check(coffee, [face], [0.5]) == ([], 3 * crop_px)        # texture: vetoed
     assert check(coffee, [face], [0.95]) == ([face], 0)
     cut = {'box': (0.0, 60.0, 110.0, 110.0)}                        # cut by the left edge
     assert check(coffee, [cut], [0.5], np.array([cut['box']])) == ([cut], 0)
@@ -243,7 +245,7 @@ def test_the_haar_check_keeps_what_a_cascade_sees_or_cannot_judge():
                                np.array([0.5]), (40, 400), 0.9, 1) == ([narrow], 0)
     small = {'box': (300.0, 200.0, 30.0, 30.0)}                     # enlarged 3.2x
     assert check(coffee, [small], [0.5], np.array([small['box']])) == \
-        ([], 2 * check_px(60, 60, 30))
+        ([], 3 * check_px(60, 60, 30))
     # a close-up is read reduced so that its box is HAAR_CHECK_SIDE_PX (each check reads a crop
     # of about twice that side, whatever the face's size)
     assert search.HAAR_CHECK_CASCADES[0][0] == 'haarcascade_frontalface_alt2.xml'

@@ -1376,7 +1376,7 @@ def haar_checked(image: np.ndarray, faces: list, boxes, scores, image_px: tuple[
     edge (a cascade needs the whole face), too small to be enlarged that far (``MAX_SCALE``),
     or whose resized crop is smaller than a cascade's window at its pyramid's first level
     (:func:`first_level`: no level would read it). The pixels counted are each cascade's
-    first level.
+    first level, for each image it ran on (the crop, and its mirror image for the profile).
     """
     boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
     scores = np.asarray(scores, dtype=float).reshape(-1)
@@ -1401,8 +1401,10 @@ def haar_checked(image: np.ndarray, faces: list, boxes, scores, image_px: tuple[
             continue
         for haar, (level, _) in zip(cascades, levels):
             look = scan(image[y0:y1, x0:x1], haar, (1, 1), factor, min_neighbors=neighbors)
-            # the pixels a cascade reads are those of its pyramid's first level (first_level)
-            pixels += round(size[0] / level) * round(size[1] / level)
+            # the pixels a cascade reads are those of its pyramid's first level (first_level),
+            # twice for one also run on the mirror image
+            pixels += (round(size[0] / level) * round(size[1] / level)
+                       * (1 + sum(haar.mirror)))
             # the grouped boxes are in the crop's own pixels (scan maps them back)
             if any(x <= x0 + gx + gw / 2.0 <= x + w and y <= y0 + gy + gh / 2.0 <= y + h
                    for gx, gy, gw, gh in look.grouped_px):
