@@ -158,6 +158,6 @@ def bad_policy_files(folder, grid_rows: int = 11, grid_cols: int = 11, marker=No
         else:
             path.write_text(content)
         out[name] = (str(path), words)
-    out['directory'] = (str(folder), 'not found')
+    out['directory'] = (str(folder), 'is a folder, not a file')
     out['missing'] = (str(folder / 'no-such-policy.yaml'), 'not found')
     return out

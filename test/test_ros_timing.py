@@ -144,6 +144,8 @@ def test_no_frame_taken_mid_saccade_is_used_and_the_search_completes(rig, camera
             continue        # the cells in view had ~0 probability: any frame fits
         key = explaining[0]
         assert _seconds(key) >= _seconds(_stamp(target)) + SETTLE_S - 1e-6
+        if key not in poses:
+            continue        # this test's own joint_states subscription missed it (CI, loaded)
         assert poses[key] == cell, f'update {i} used a frame taken at {poses[key]}, not {cell}'
         attributed += 1
     assert attributed >= max(2, (upto + 1) // 2)
