@@ -223,8 +223,12 @@ def test_the_haar_check_keeps_what_a_cascade_sees_or_cannot_judge():
     boxes = np.array([face['box']])
 
     def check(image, faces, scores, box_list=boxes):
+        """Return the faces kept and the pixels read."""
         size = (image.shape[1], image.shape[0])
-        return search.haar_checked(image, faces, box_list, np.array(scores), size, 0.9, 1)
+        keep, pixels = search.haar_checked(image, faces, box_list, np.array(scores), size,
+                                           0.9, 1)
+        assert keep.dtype == bool and keep.shape == (len(faces),)
+        return [f for f, k in zip(faces, keep) if k], pixels
 
     # half the side on each side, resized as HAAR_CHECK_SIDE_PX says; the frontal cascade sees
     # the face (one read), no cascade the texture (the frontal one, the profile one on the crop
@@ -241,8 +245,8 @@ def test_the_haar_check_keeps_what_a_cascade_sees_or_cannot_judge():
     assert check(coffee, [tiny], [0.5], np.array([tiny['box']])) == ([tiny], 0)
     # a crop that, resized, is narrower than the first level's 69 px window: no level reads it
     narrow = {'box': (5.0, 100.0, 30.0, 60.0)}
-    assert search.haar_checked(coffee[:, :40], [narrow], np.array([narrow['box']]),
-                               np.array([0.5]), (40, 400), 0.9, 1) == ([narrow], 0)
+    assert check(np.ascontiguousarray(coffee[:, :40]), [narrow], [0.5],
+                 np.array([narrow['box']])) == ([narrow], 0)
     small = {'box': (300.0, 200.0, 30.0, 30.0)}                     # enlarged 3.2x
     assert check(coffee, [small], [0.5], np.array([small['box']])) == \
         ([], 3 * check_px(60, 60, 30))

@@ -1178,10 +1178,10 @@ def search_many(image: np.ndarray, fovea: Fovea, model,
                           and scales.strong_score > 0 else None)
     checked_px, vetoed = 0, []
     if scales is not None and scales.haar_check_score > 0:
-        kept, checked_px = haar_checked(image, found, boxes, scores, image_px,
+        keep, checked_px = haar_checked(image, found, boxes, scores, image_px,
                                         scales.haar_check_score, scales.haar_check_neighbors)
-        vetoed = [f for f in found if not any(f is k for k in kept)]
-        found = kept
+        vetoed = [f for f, k in zip(found, keep) if not k]
+        found = [f for f, k in zip(found, keep) if k]
     faces = tuple(Face(box=clip_box(f['box'], image_px),
                        cell=tuple(int(v) for v in grid.cell(f['cell'])),
                        probability=f['probability']) for f in found)
@@ -1295,6 +1295,14 @@ def _faint_box(found, threshold: float, max_side_px: float, floor: float = -math
     return boxes[small][int(np.argmax(scores[small]))] if small.any() else None
 
 
+def _centred_in(boxes, box, offset=(0.0, 0.0)) -> np.ndarray:
+    """Return which of ``boxes`` (moved by ``offset``, a crop's corner) are centred in ``box``."""
+    x, y, w, h = box
+    centres = box_centres_px(boxes) + offset
+    return ((centres[:, 0] >= x) & (centres[:, 0] <= x + w)
+            & (centres[:, 1] >= y) & (centres[:, 1] <= y + h))
+
+
 @functools.lru_cache(maxsize=1)
 def second_opinion_detector():
     """Return OpenCV's Haar face cascade (the package's ``haar`` kind), built once."""
@@ -1320,16 +1328,14 @@ def _second_opinion(image: np.ndarray, found, image_px: tuple[int, int], score: 
     window = min(detector_window_px(haar))
     pixels = 0
     for k in keep[np.argsort(-scores[keep], kind='stable')][:n_boxes]:
-        x, y, w, h = boxes[k]
         x0, y0, x1, y1 = _crop_round(boxes[k], image_px, reach=0.5)
         if min(x1 - x0, y1 - y0) < window:
             continue
         look = scan(image[y0:y1, x0:x1], haar, (1, 1), 1.0, min_neighbors=neighbors)
         pixels += look.detector_pixels
-        for gx, gy, gw, gh in look.grouped_px:
-            cx, cy = x0 + gx + gw / 2.0, y0 + gy + gh / 2.0
-            if x <= cx <= x + w and y <= cy <= y + h:
-                return np.array([x0 + gx, y0 + gy, gw, gh], dtype=float), pixels
+        centred = np.flatnonzero(_centred_in(look.grouped_px, boxes[k], (x0, y0)))
+        if centred.size:
+            return np.asarray(look.grouped_px[centred[0]], dtype=float) + (x0, y0, 0, 0), pixels
     return None, pixels
 
 
@@ -1360,9 +1366,9 @@ def first_level(haar) -> tuple[float, tuple[int, int]]:
 
 
 def haar_checked(image: np.ndarray, faces: list, boxes, scores, image_px: tuple[int, int],
-                 score: float, neighbors: int) -> tuple[list, int]:
+                 score: float, neighbors: int) -> tuple[np.ndarray, int]:
     """
-    Return the faces a second detector does not veto, and the pixels it read.
+    Return which of ``faces`` a second detector does not veto (bools), and the pixels it read.
 
     A face whose best box (the highest score of the boxes centred in its box; none for a
     face without a box) scores at least ``score`` is kept as it is. Any other is kept only
@@ -1378,18 +1384,15 @@ def haar_checked(image: np.ndarray, faces: list, boxes, scores, image_px: tuple[
     (:func:`first_level`: no level would read it). The pixels counted are each cascade's
     first level, for each image it ran on (the crop, and its mirror image for the profile).
     """
-    boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
     scores = np.asarray(scores, dtype=float).reshape(-1)
-    centres = boxes[:, :2] + boxes[:, 2:] / 2.0
     cascades = haar_check_detectors()
     levels = [first_level(haar) for haar in cascades]
-    kept, pixels = [], 0
-    for face in faces:
+    keep, pixels = np.zeros(len(faces), dtype=bool), 0
+    for i, face in enumerate(faces):
         x, y, w, h = clip_box(face['box'], image_px)
-        inside = ((centres[:, 0] >= x) & (centres[:, 0] <= x + w)
-                  & (centres[:, 1] >= y) & (centres[:, 1] <= y + h))
+        inside = _centred_in(boxes, (x, y, w, h))
         if inside.any() and scores[inside].max() >= score:
-            kept.append(face)
+            keep[i] = True
             continue
         x0, y0, x1, y1 = _crop_round((x, y, w, h), image_px, reach=0.5)
         factor = HAAR_CHECK_SIDE_PX / max(w, h, 1.0)
@@ -1397,7 +1400,7 @@ def haar_checked(image: np.ndarray, faces: list, boxes, scores, image_px: tuple[
         size = scaled_size(x1 - x0, y1 - y0, factor)
         if cut or factor > MAX_SCALE or any(size[0] < win[0] or size[1] < win[1]
                                             for _, win in levels):
-            kept.append(face)
+            keep[i] = True
             continue
         for haar, (level, _) in zip(cascades, levels):
             look = scan(image[y0:y1, x0:x1], haar, (1, 1), factor, min_neighbors=neighbors)
@@ -1406,11 +1409,10 @@ def haar_checked(image: np.ndarray, faces: list, boxes, scores, image_px: tuple[
             pixels += (round(size[0] / level) * round(size[1] / level)
                        * (1 + sum(haar.mirror)))
             # the grouped boxes are in the crop's own pixels (scan maps them back)
-            if any(x <= x0 + gx + gw / 2.0 <= x + w and y <= y0 + gy + gh / 2.0 <= y + h
-                   for gx, gy, gw, gh in look.grouped_px):
-                kept.append(face)
+            if _centred_in(look.grouped_px, (x, y, w, h), (x0, y0)).any():
+                keep[i] = True
                 break
-    return kept, pixels
+    return keep, pixels
 
 
 def look_factor(box, upscale: float, scale: float = 1.0) -> float:
