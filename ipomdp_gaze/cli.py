@@ -37,6 +37,22 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f'{self.prog}: error: {message}\n')
 
 
+class _CommandParser(_Parser):
+    """
+    A subcommand's parser: an argument it does not know is refused under its own name.
+
+    argparse hands a subcommand's unknown arguments back to the top-level parser, whose error
+    named ``ipomdp-gaze`` alone (``ipomdp-gaze: error: unrecognized arguments: --foo`` for
+    ``ipomdp-gaze controller --foo``); the command run is ``ipomdp-gaze controller``.
+    """
+
+    def parse_known_args(self, args=None, namespace=None):
+        namespace, extras = super().parse_known_args(args, namespace)
+        if extras:
+            self.error(f"unrecognized arguments: {' '.join(extras)}")
+        return namespace, extras
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Build the top-level parser with every subcommand registered."""
     parser = _Parser(
@@ -45,7 +61,8 @@ def build_parser() -> argparse.ArgumentParser:
                     'evaluate, train and run policies that choose where to look next.')
     parser.add_argument('--version', action='version',
                         version=f'%(prog)s {package_version()}')
-    sub = parser.add_subparsers(dest='command', metavar='COMMAND', parser_class=_Parser)
+    sub = parser.add_subparsers(dest='command', metavar='COMMAND',
+                                parser_class=_CommandParser)
     sub.required = True
     for name in COMMANDS:
         importlib.import_module(f'ipomdp_gaze.commands.{name}').add_parser(sub)

@@ -40,6 +40,18 @@ def test_node_subcommands_run_their_node(command, node, capsys):
     assert f'Run the {node} node, exactly as `ros2 run ipomdp_gaze {command}` does' in out
 
 
+@pytest.mark.parametrize('command', [['controller'], ['camera'], ['detector'], ['scene_camera'],
+                                     ['recorder'], ['record', 'bag'], ['find', 'photo.png'],
+                                     ['evaluate']], ids=lambda c: c[0])
+def test_an_unknown_flag_is_refused_in_the_name_of_the_command_run(command, capsys):
+    """QA: ``ipomdp-gaze controller --foo`` said ``ipomdp-gaze: error: ...``, not its command."""
+    with pytest.raises(SystemExit) as exit_info:
+        main([*command, '--foo'])
+    assert exit_info.value.code == 2
+    assert capsys.readouterr().err.strip().splitlines() == [
+        f'ipomdp-gaze {command[0]}: error: unrecognized arguments: --foo']
+
+
 @pytest.mark.parametrize('args, message', [
     (['evaluate', '--policy', 'saliency'], "invalid choice: 'saliency'"),
     (['evaluate', '--grid', '7by7'], 'grid must look like ROWSxCOLS'),

@@ -40,7 +40,7 @@ def test_unparsable_ros_args_exit_2_with_one_line(ros_env, tmp_path, command, ro
     assert run.returncode == 2, run.stderr
     assert 'Traceback' not in run.stderr
     last = run.stderr.strip().splitlines()[-1]
-    assert ': error: ' in last and message in last
+    assert last.startswith(f'ipomdp-gaze {command}: error: ') and message in last  # as run
     assert '/src/' not in last                          # rcl's C source locations are cut
     assert not (tmp_path / 'bag').exists()
 
@@ -163,8 +163,10 @@ def test_a_node_executable_answers_help_and_refuses_a_stray_argument(ros_env, mo
     assert '[INFO]' not in helped.stdout + helped.stderr               # no node started
     stray = run('--seed', '3')
     assert stray.returncode == 2
-    assert stray.stderr.strip().splitlines()[-1].endswith(
-        'unexpected arguments --seed 3 (ROS arguments go after --ros-args; --help for usage)')
+    # Named by the program run (its node was named: gaze_controller for controller).
+    assert stray.stderr.strip().splitlines()[-1] == (
+        f'{module}: error: unexpected arguments --seed 3 (ROS arguments go after --ros-args; '
+        '--help for usage)')
 
 
 @pytest.mark.parametrize('path', sorted((REPO / 'config').glob('*.yaml')), ids=lambda p: p.name)

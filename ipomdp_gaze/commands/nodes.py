@@ -31,4 +31,4 @@ def run(args) -> int:
     """Run the node until shutdown; its exit status."""
     main = importlib.import_module(f'ipomdp_gaze.nodes.{args.executable}').main
     ros = [] if args.ros_args is None else ['--ros-args', *args.ros_args]
-    return main([f'ipomdp-gaze-{args.executable}', *ros])
+    return main([f'ipomdp-gaze {args.executable}', *ros])     # argv[0]: the command as run

@@ -121,7 +121,7 @@ def run_record(args) -> int:
         ros += ['-p', f'compression:={args.compression}']
     from ipomdp_gaze.nodes.recorder import split_overrides
     ros += split_overrides(args.max_bag_size_mb, args.max_bag_duration_s)
-    status = main(['ipomdp-gaze-record', '--ros-args', *ros, *(args.ros_args or [])])
+    status = main(['ipomdp-gaze record', '--ros-args', *ros, *(args.ros_args or [])])
     if args.path.exists():          # else the recorder refused to start: its error says why
         print(describe_written(args.path), flush=True)
     return status

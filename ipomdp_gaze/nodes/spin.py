@@ -53,7 +53,8 @@ def run_node(make_node, node_name: str, args=None) -> int:
     Run a node with the Jazzy idiom: init, spin until SIGINT/SIGTERM, destroy, try_shutdown.
 
     ROS arguments rcl cannot parse (a missing or malformed ``--params-file``, a ``-p`` without
-    ``:=``, an unknown ``--ros-args`` flag) print one line and return 2. An invalid start-up
+    ``:=``, an unknown ``--ros-args`` flag) and an argument that is not for ROS print one line
+    and return 2, named by the program run (:func:`program_name`). An invalid start-up
     parameter (``ValueError`` or ``ParameterException`` from the node's constructor) prints one
     line naming it and returns 1; a clean shutdown returns 0. Parameters given for the node that
     it does not have (a typo) and a params file with no section for it are warned about
@@ -67,26 +68,28 @@ def run_node(make_node, node_name: str, args=None) -> int:
     from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
     from rclpy.utilities import remove_ros_args
     argv = list(sys.argv if args is None else args)
+    program = program_name(argv, node_name)
     try:
         own = remove_ros_args(args=argv)[1:]    # what is not for ROS: the node takes nothing
     except Exception:                           # noqa: B902 (rcl's own parse error, below)
         own = []
     if own:
-        executable = Path(argv[0]).stem if argv else node_name
         if set(own) & {'-h', '--help'}:
-            print(f'usage: ros2 run ipomdp_gaze {executable} [--ros-args --params-file FILE '
+            run = program if program.startswith('ipomdp-gaze ') else \
+                f'ros2 run ipomdp_gaze {program}'
+            print(f'usage: {run} [--ros-args --params-file FILE '
                   f'-p NAME:=VALUE -r FROM:=TO ...]\n\nRun the {node_name} node until Ctrl-C '
                   'or SIGTERM. Its topics, services and parameters: README.md (the "For robot '
                   'users" sections); its shipped parameter files: share/ipomdp_gaze/config/.')
             return 0
-        print(f'{node_name}: error: unexpected argument{"s" * (len(own) > 1)} '
+        print(f'{program}: error: unexpected argument{"s" * (len(own) > 1)} '
               f'{" ".join(own)} (ROS arguments go after --ros-args; --help for usage)',
               file=sys.stderr)
         return 2
     try:
         rclpy.init(args=args)
     except (_rclpy.RCLError, _rclpy.UnknownROSArgsError) as exc:
-        print(f'{node_name}: error: {ros_args_error(exc)}', file=sys.stderr)
+        print(f'{program}: error: {ros_args_error(exc)}', file=sys.stderr)
         return 2
     node = None
     status = 0
@@ -110,6 +113,20 @@ def run_node(make_node, node_name: str, args=None) -> int:
             node.destroy_node()
         rclpy.try_shutdown()
     return status
+
+
+def program_name(argv, node_name: str) -> str:
+    """
+    Return the name of the program run, for its command-line errors, from ``argv[0]``.
+
+    ``controller`` for ``ros2 run ipomdp_gaze controller`` (``lib/ipomdp_gaze/controller``)
+    and ``python -m ipomdp_gaze.nodes.controller`` (``.../controller.py``); the CLI passes
+    its command as it was typed (``ipomdp-gaze controller``). Without ``argv[0]``, the node.
+    """
+    first = str(argv[0]) if argv else ''
+    if not first:
+        return node_name
+    return first if first.startswith('ipomdp-gaze ') else Path(first).stem
 
 
 def ros_args_error(exc) -> str:
