@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 
 from conftest import config_path, REPO, wait_for
+import numpy as np
 import pytest
 
 pytestmark = pytest.mark.ros
@@ -186,3 +187,42 @@ def test_an_override_outside_the_range_ends_the_node_with_the_settings_reason(
                          text=True, timeout=60)
     assert run.returncode == 1, run.stderr
     assert run.stderr.strip().splitlines()[-1] == f'gaze_controller: error: {message}'
+
+
+def test_the_simulated_camera_refuses_a_dprime_its_float32_frames_cannot_hold(context):
+    """
+    QA: the camera took ``fpoc.dprime`` 1e300 and published +inf at the target in every frame.
+
+    A frame every controller refuses, and numpy warned of the cast's overflow at each frame. The
+    value is refused when it is given (start-up or ``ros2 param set``), with the bound; the
+    bound's own frames are finite and cast without a warning.
+    """
+    import warnings
+    from ipomdp_gaze.nodes.camera import SimulatedCameraNode
+    from rclpy.parameter import Parameter
+    reason = ('fpoc.dprime must be at most 1e+38 in the simulated camera (its evidence frames are '
+              "float32, where a larger d' is +inf), got {}")
+    with pytest.raises(ValueError) as info:
+        SimulatedCameraNode(context=context,
+                            parameter_overrides=[Parameter('fpoc.dprime', value=1e300)])
+    assert str(info.value) == reason.format('1e+300')
+    camera = SimulatedCameraNode(context=context, parameter_overrides=[
+        Parameter('target_row', value=5), Parameter('target_col', value=5)])
+    try:
+        assert 'at most 1e+38' in camera.describe_parameter('fpoc.dprime').additional_constraints
+        result = camera.set_parameters([Parameter('fpoc.dprime', value=1e300)])[0]
+        assert not result.successful and result.reason == reason.format('1e+300')
+        result = camera.set_parameters_atomically([Parameter('fpoc.model', value='table'),
+                                                   Parameter('fpoc.dprime', value=[1e39, 0.0])])
+        assert not result.successful and result.reason == reason.format('1e+39')
+        assert camera.get_parameter('fpoc.dprime').value == 4.0
+        assert camera.set_parameters([Parameter('fpoc.dprime', value=1e38)])[0].successful
+        frames = []
+        camera._evidence_pub.publish = frames.append
+        with warnings.catch_warnings():
+            warnings.simplefilter('error')
+            camera._publish_frame()                 # the target at the centre, in view
+        values = np.asarray(frames[0].data)             # NaN: the cells out of view
+        assert not np.isinf(values).any() and np.nanmax(values) > 9e37
+    finally:
+        camera.destroy_node()

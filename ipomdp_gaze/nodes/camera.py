@@ -54,12 +54,26 @@ from .saccade import saccade_params, SaccadeMixin
 from .spin import run_node
 
 NODE_NAME = NODE_NAMES['camera']
+# The camera's frames are float32 (``evidence``, the 32FC1 ``evidence_image``), which hold at most
+# about 3.4e38: a larger d' is +inf in the target's cell, a frame every controller refuses (and
+# numpy warned of the overflow at each frame). A d' of 1e38 is far past certainty (d' 40 already
+# tells target from noise with an error of about 1e-89).
+MAX_FRAME_DPRIME = 1e38
+
+
+def check_frame_dprime(observation: GaussianObservation) -> None:
+    """Refuse (ValueError) an FPOC whose d' the camera's float32 frames cannot hold."""
+    d_max = float(observation.table.max())
+    if d_max > MAX_FRAME_DPRIME:
+        raise ValueError(f'fpoc.dprime must be at most {MAX_FRAME_DPRIME:g} in the simulated '
+                         "camera (its evidence frames are float32, where a larger d' is +inf), "
+                         f'got {d_max:g}')
 
 
 def camera_params() -> list[Param]:
     """Every parameter of the simulated camera, in declaration order."""
-    return grid_params() + fpoc_params() + joint_params(limits=False) + cell_params(
-        'target', 'the target', 'a random {} at each reset') + [
+    return grid_params() + fpoc_params(MAX_FRAME_DPRIME) + joint_params(limits=False) + \
+        cell_params('target', 'the target', 'a random {} at each reset') + [
         Param('seed', 0, T.INTEGER, 'seed of the targets and the observation noise',
               int_range=(0, INT_MAX)),
     ] + saccade_params(max_rate_hz=1000.0) + [
@@ -132,8 +146,9 @@ class SimulatedCameraNode(SaccadeMixin, GuardedNode, QuietPublishers, Node):
         motion = Motion(grid, check_sigma_cells(values['target_motion_sigma_cells'],
                                                 'target_motion_sigma_cells'),
                         check_probability(values['target_jump_prob'], 'target_jump_prob'))
-        return CameraConfig(dict(values), grid, GaussianObservation(grid, fpoc), head, target,
-                            motion)
+        observation = GaussianObservation(grid, fpoc)
+        check_frame_dprime(observation)
+        return CameraConfig(dict(values), grid, observation, head, target, motion)
 
     def _apply_config(self, old: CameraConfig, cfg: CameraConfig) -> None:
         """Follow a new configuration: a new seed restarts the noise, new times the timers."""

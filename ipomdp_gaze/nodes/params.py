@@ -128,16 +128,19 @@ def grid_params() -> list[Param]:
     ]
 
 
-def fpoc_params() -> list[Param]:
+def fpoc_params(max_dprime: float | None = None) -> list[Param]:
     """
     ``fpoc.model`` and the union of every model's parameters (docs/design.md section 2).
 
     The defaults describe a camera whose field of view covers 5x5 cells of a 5-degree grid.
+    ``max_dprime``: the largest d' the node takes (the simulated camera's float32 frames), named
+    in the descriptor of ``fpoc.dprime`` (the node's build checks it).
     """
+    bound = '' if max_dprime is None else f'at most {max_dprime:g} each (float32 frames)'
     return [
         Param('fpoc.model', 'camera', T.STRING, 'FPOC model', choices=tuple(MODELS)),
         Param('fpoc.dprime', 4.0, T.DOUBLE, "d' inside the field of view (camera: a number), "
-              "or d' at each fpoc.ecc_deg (table: a list)", dynamic=True),
+              "or d' at each fpoc.ecc_deg (table: a list)", dynamic=True, constraints=bound),
         Param('fpoc.shape', 'rectangle', T.STRING, 'camera field of view shape',
               choices=CameraFPOC.SHAPES),
         Param('fpoc.half_width_deg', 10.0, T.DOUBLE, 'camera: half-width of the field of view',
