@@ -142,3 +142,34 @@ def test_a_policy_file_used_with_another_prior_is_said_at_start_and_on_each_chan
         assert _log_until(capfd, 'parameters set: policy.file=').count(said['uniform']) == 1
     finally:
         node.destroy_node()
+
+
+def test_a_moving_room_without_an_entry_model_is_said_once_while_it_lasts(context, capfd):
+    """
+    QA: the "no entry model" warning of a moving room came again with every parameter set.
+
+    It is said at start-up, not again while its cause lasts (any other change), and again
+    after the cause went away and came back; another cause is said on its own.
+    """
+    from rclpy.parameter import Parameter
+    no_entry = 'search.targets many with motion and no entry model'
+    no_dwell = 'motion.track_view policy: the people found are not kept in view'
+    capfd.readouterr()
+    node = _node(context, parameter_overrides=[
+        Parameter('search.targets', value='many'), Parameter('motion.sigma_cells', value=0.5),
+        Parameter('motion.track_view', value='peak')])
+    try:
+        assert _log_until(capfd, 'first fixation').count(no_entry) == 1
+        for confidence in (0.9, 0.95):
+            assert _set(node, confidence=confidence).successful
+            assert no_entry not in _log_until(capfd, 'parameters set: confidence=')
+        assert _set(node, motion__track_view='policy').successful
+        log = _log_until(capfd, 'parameters set: motion.track_view=')
+        assert log.count(no_dwell) == 1 and no_entry not in log
+        assert _set(node, motion__jump_prob=0.01).successful        # an entry model
+        log = _log_until(capfd, 'parameters set: motion.jump_prob=')
+        assert no_entry not in log and no_dwell not in log
+        assert _set(node, motion__jump_prob=0.0).successful         # none again
+        assert _log_until(capfd, 'parameters set: motion.jump_prob=').count(no_entry) == 1
+    finally:
+        node.destroy_node()

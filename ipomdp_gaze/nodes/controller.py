@@ -60,7 +60,7 @@ from ipomdp_gaze.policies.policy_file import check_training_prior
 from ipomdp_gaze.policies.registry import build_policy, POLICY_NAMES, PolicyUnavailable
 from ipomdp_gaze.search import answer
 from ipomdp_gaze.search.controller_config import (build_config, ControllerConfig as Config,
-                                                  follow_config, grid_from)
+                                                  follow_config, grid_from, new_warnings)
 from ipomdp_gaze.search.gaze import FrameSequence, SETTLING, STAMP_TOLERANCE_S
 from ipomdp_gaze.search.health import HealthMonitor
 from ipomdp_gaze.search.room import MAX_PERIOD_S, people_text, Person, PERSON_LINK, RoomWatch
@@ -108,7 +108,7 @@ def _same_prior(a, b) -> bool:
 
 def _say_training_prior(cfg: Config) -> None:
     """
-    Add to ``cfg.warning`` that its policy file is used with another prior than its training's.
+    Add to ``cfg.warnings`` that its policy file is used with another prior than its training's.
 
     As ``evaluate`` says it (a policy file records ``training.prior``; without one it was
     trained on the uniform prior); a kernel or a baseline has no training prior to compare.
@@ -116,9 +116,9 @@ def _say_training_prior(cfg: Config) -> None:
     spec = getattr(cfg.policy, 'spec', None)
     if spec is None:
         return
-    said = [cfg.warning] if cfg.warning else []
+    said = list(cfg.warnings)
     check_training_prior(spec, cfg.prior, said.append)
-    cfg.warning = '; '.join(said)
+    cfg.warnings = tuple(said)
 
 
 def controller_params() -> list[Param]:
@@ -300,9 +300,7 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
     def _build(self, values: dict, changed=None, previous: Config | None = None) -> Config:
         """Derive a :class:`Config` from parameter values (ValueError names the problem)."""
         cfg = build_config(values, build_policy, changed, previous)
-        if previous is None or cfg.policy is not previous.policy or \
-                not _same_prior(cfg.prior, previous.prior):
-            _say_training_prior(cfg)        # once, when the policy or the prior changes
+        _say_training_prior(cfg)            # said once while it lasts (new_warnings)
         for name in ('forward_command_topic', 'trajectory_topic'):
             if values[name]:
                 # expanded as the publisher will be ({node}, ~), so that an unknown
@@ -329,8 +327,8 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
             self.set_parameters([Parameter('policy.name', T.STRING, fallback)])
             values['policy.name'] = fallback
             cfg = self._build(values)
-        if cfg.warning:
-            self.get_logger().warning(cfg.warning)
+        if cfg.warnings:
+            self.get_logger().warning('; '.join(cfg.warnings))
         if values['observation.model'] == 'counts':
             self.get_logger().info('observation.model is counts: the fpoc.* parameters are '
                                    'ignored, frames are detection counts for '
@@ -387,8 +385,9 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
 
     def _apply_config(self, old: Config, cfg: Config) -> str:
         """Make the controller follow a new configuration; return the policy for the log."""
-        if cfg.warning:
-            self.get_logger().warning(cfg.warning)
+        said = new_warnings(cfg, old)       # each once while its cause lasts
+        if said:
+            self.get_logger().warning('; '.join(said))
         v, ov = cfg.values, old.values
         core = self.core
         was_following = core.follows_people

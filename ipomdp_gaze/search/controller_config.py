@@ -162,7 +162,13 @@ def observation_from(values: Mapping, grid: Grid, fpoc):
 
 @dataclass
 class ControllerConfig:
-    """Everything a controller derives from its parameters (``values`` keeps them all)."""
+    """
+    Everything a controller derives from its parameters (``values`` keeps them all).
+
+    ``warnings`` says what the configuration will not do (:func:`moving_room_warnings`, then
+    ``policy_warnings``, those of building the policy, kept with it while it is reused): the
+    same for as long as their cause lasts, so that a node says each once (:func:`new_warnings`).
+    """
 
     values: dict
     grid: Grid
@@ -171,8 +177,9 @@ class ControllerConfig:
     policy: object
     head: PanTiltMap
     settings: SearchSettings
-    warning: str = ''
+    warnings: tuple = ()
     prior: np.ndarray | None = None
+    policy_warnings: tuple = ()
 
     @property
     def observation_label(self) -> str:
@@ -244,19 +251,32 @@ def build_config(values: Mapping, build_policy: Callable, changed=None,
             check_room_times(values['room.dwell_s'], values['room.recheck_period_s'])
         check_frame_id(str(values.get('room.frame_id', 'unset')))
         check_settle_time(values['settle_time_s'])
-        warnings = moving_room_warnings(settings)
         policy_changed = changed is None or any(k in changed for k in POLICY_KEYS) or any(
             k.startswith('fpoc.') for k in changed) or observation_changed
         if previous is not None and not policy_changed:
-            policy = previous.policy
+            policy, policy_warnings = previous.policy, list(previous.policy_warnings)
         else:
+            policy_warnings = []
             policy = build_policy(values['policy.name'], grid, observation,
                                   values.get('policy.kernel'), values.get('policy.file', ''),
-                                  values.get('policy.action', 'argmax'), warn=warnings.append)
+                                  values.get('policy.action', 'argmax'),
+                                  warn=policy_warnings.append)
     except KeyError as exc:
         raise ValueError(f'no controller parameter {exc}') from None
     return ControllerConfig(dict(values), grid, fpoc, observation, policy, head, settings,
-                            '; '.join(warnings), prior)
+                            tuple(moving_room_warnings(settings) + policy_warnings), prior,
+                            tuple(policy_warnings))
+
+
+def new_warnings(new: ControllerConfig, old: ControllerConfig | None) -> list[str]:
+    """
+    Return the warnings of ``new`` that ``old`` (the configuration in force; None) did not have.
+
+    A warning is said when its cause appears (at start-up, or by a change), not again on every
+    change while the cause lasts, and again if it goes away and comes back.
+    """
+    said = set(old.warnings) if old is not None else set()
+    return [text for text in new.warnings if text not in said]
 
 
 def moving_room_warnings(settings: SearchSettings) -> list[str]:
