@@ -222,3 +222,39 @@ def test_the_label_of_a_many_target_search_names_the_policy_it_follows():
     assert build_config(walking, build_policy).policy_label.startswith('occupancy infomax')
     one = dict(values, **{'search.targets': 'one'})
     assert build_config(one, build_policy).policy_label == 'map'
+
+
+@pytest.mark.parametrize('name', ['greedy', 'tempered', 'switching'])
+def test_a_policy_many_targets_do_not_use_is_not_refused_for_its_model(name):
+    """
+    QA: ``policy.name greedy`` was refused with ``search.targets many`` on the rooms' counts.
+
+    Its reason (greedy needs the Gaussian model of an FPOC) is that of a policy the occupancy
+    search does not use (docs/design.md section 11.6): it is kept unused, at start-up and by a
+    change, and the search goes on; a switch to one target, which would use it, is refused.
+    """
+    room = _values('rooms')
+    moving = dict(room, **{'policy.name': name, 'motion.sigma_cells': 0.5,
+                           'motion.jump_prob': 0.01})
+    cfg = build_config(moving, build_policy)
+    assert cfg.policy is None and 'needs the Gaussian model of an FPOC' in cfg.policy_error
+    assert cfg.policy_label == f'occupancy infomax (policy.name {name} is not used with many ' \
+        'targets)'
+    core = cfg.controller()
+    core.reset(0.0)
+    t_s = _frames(core, np.random.default_rng(3), 3, 0.0, True)
+    still = build_config(room, build_policy)                 # the rooms' sweep, then greedy
+    changed = build_config(dict(room, **{'policy.name': name}), build_policy, {'policy.name'},
+                           still)
+    assert changed.policy is None
+    for change in ({'confidence': 0.9}, {'search.targets': 'one'}):
+        values = dict(moving, **change)
+        if 'search.targets' in change:
+            with pytest.raises(ValueError, match='needs the Gaussian model of an FPOC, not a '
+                                                 'count model'):
+                build_config(values, build_policy, set(change), cfg)
+            continue
+        new = build_config(values, build_policy, set(change), cfg)
+        follow_config(core, new, cfg.values)
+        _frames(core, np.random.default_rng(4), 3, t_s, True)
+        assert 0 <= core.fixation < core.grid.n_cells

@@ -962,6 +962,8 @@ def new_search(bag, overrides: dict | None = None, out=print):
                          f'fovea mode): {_why_no_scene(bag, detector)}')
     parameters = values_at(bag.parameters(CONTROLLER), parameter_changes(bag), None)
     config = checked_config(parameters, overrides)
+    if config.policy is None:       # kept unused by many targets; this search is one target's
+        raise ValueError(f"policy.name {config.values['policy.name']}: {config.policy_error}")
     core, values = config.controller(), config.values
     given = {k: v for k, v in (('cascade', detector.get('detector.cascade')),
                                ('scale_factor', detector.get('detector.scale_factor', 0) or None),

@@ -165,6 +165,9 @@ class ControllerConfig:
     """
     Everything a controller derives from its parameters (``values`` keeps them all).
 
+    ``policy`` is None when the many-target search does not use it and it cannot be built for
+    this task (``policy_error`` says why; :func:`build_config`).
+
     ``warnings`` says what the configuration will not do (:func:`moving_room_warnings`, then
     ``policy_warnings``, those of building the policy, kept with it while it is reused): the
     same for as long as their cause lasts, so that a node says each once (:func:`new_warnings`).
@@ -180,6 +183,7 @@ class ControllerConfig:
     warnings: tuple = ()
     prior: np.ndarray | None = None
     policy_warnings: tuple = ()
+    policy_error: str = ''
 
     @property
     def observation_label(self) -> str:
@@ -203,8 +207,7 @@ class ControllerConfig:
         v = self.values
         label = policy_label(v['policy.name'], v.get('policy.kernel'), v.get('policy.file', ''),
                              v.get('policy.action', 'argmax'))
-        if v.get('search.targets') == 'many' and (v['policy.name'] != 'sweep'
-                                                  or self.settings.moving):
+        if policy_unused(v['policy.name'], self.settings):
             return f'occupancy infomax (policy.name {label} is not used with many targets)'
         return label
 
@@ -253,19 +256,38 @@ def build_config(values: Mapping, build_policy: Callable, changed=None,
         check_settle_time(values['settle_time_s'])
         policy_changed = changed is None or any(k in changed for k in POLICY_KEYS) or any(
             k.startswith('fpoc.') for k in changed) or observation_changed
-        if previous is not None and not policy_changed:
+        policy_error = ''
+        if previous is not None and not policy_changed and previous.policy is not None:
             policy, policy_warnings = previous.policy, list(previous.policy_warnings)
         else:
             policy_warnings = []
-            policy = build_policy(values['policy.name'], grid, observation,
-                                  values.get('policy.kernel'), values.get('policy.file', ''),
-                                  values.get('policy.action', 'argmax'),
-                                  warn=policy_warnings.append)
+            try:
+                policy = build_policy(values['policy.name'], grid, observation,
+                                      values.get('policy.kernel'), values.get('policy.file', ''),
+                                      values.get('policy.action', 'argmax'),
+                                      warn=policy_warnings.append)
+            except ValueError as exc:
+                # A setting with no effect is not refused: the many-target search does not
+                # use the policy (greedy on a count model); one target would, and then the
+                # policy is built again (previous.policy None) and refused with this reason.
+                if not policy_unused(values['policy.name'], settings):
+                    raise
+                policy, policy_warnings, policy_error = None, [], str(exc)
     except KeyError as exc:
         raise ValueError(f'no controller parameter {exc}') from None
     return ControllerConfig(dict(values), grid, fpoc, observation, policy, head, settings,
                             tuple(moving_room_warnings(settings) + policy_warnings), prior,
-                            tuple(policy_warnings))
+                            tuple(policy_warnings), policy_error)
+
+
+def policy_unused(name: str, settings: SearchSettings) -> bool:
+    """
+    Whether the search ignores the policy ``name``: many targets, but for a still room's sweep.
+
+    The occupancy belief chooses by its own infomax (docs/design.md section 11.6); only a
+    ``sweep`` of still targets makes each search one pass of its poses (section 11.7).
+    """
+    return settings.targets == 'many' and (name != 'sweep' or settings.moving)
 
 
 def new_warnings(new: ControllerConfig, old: ControllerConfig | None) -> list[str]:
