@@ -39,44 +39,56 @@ def rig(launch, probe):
         '--params-file', config_path('controller.yaml'), '-p', 'absent.prior:=0.5',
         '-p', f'confidence:={CONFIDENCE}', '-p', 'diagnostics_period_s:=0.2'])
     camera = launch('camera', ['--params-file', config_path('camera.yaml')])
-    assert wait_for(lambda: rec['targets'] and rec['truth'], 30), \
+    assert wait_for(lambda: rec['targets'] and rec['truth'], 60), \
         controller.output() + camera.output()
     return rec
 
 
 def _search(probe, rec, camera_params, event):
-    """Run one search from a reset; return (beliefs since the reset, the event message)."""
+    """
+    Run one search from a reset; return its beliefs, its event and the other events during it.
+
+    The beliefs are those since the reset's (uniform) one; the other events are those of the
+    other kind (``found`` for ``absent``) from the reset on.
+    """
+    from ipomdp_gaze.msg_adapters.diagnostics import values_of
+    other = 'found' if event == 'absent' else 'absent'
     assert probe.enable(False, CONTROLLER).success
     results = probe.set_parameters(CAMERA, camera_params)
     assert all(r.successful for r in results), [r.reason for r in results]
     n_truth = len(rec['truth'])
     assert probe.reset(CAMERA).success
     assert wait_for(lambda: len(rec['truth']) > n_truth)
-    n_belief, n_event = len(rec['belief']), len(rec[event])
+    n_belief = len(rec['belief'])
     assert probe.reset(CONTROLLER).success
     assert wait_for(lambda: any(np.ptp(np.asarray(m.data)) == 0
                                 for _, m in rec['belief'][n_belief:]))
     first = n_belief + next(i for i, (_, m) in enumerate(rec['belief'][n_belief:])
                             if np.ptp(np.asarray(m.data)) == 0) + 1
+    # Events are counted from the reset's belief on, while the controller is still disabled: an
+    # event of the search before (the start-up one, deciding while enable(False) was on its way
+    # under load) may arrive after enable(False) has returned.
+    n_event, n_other = len(rec[event]), len(rec[other])
     assert probe.enable(True, CONTROLLER).success
     assert wait_for(lambda: len(rec[event]) > n_event, SEARCH_TIMEOUT_S), f'no {event} event'
-    return [np.asarray(m.data, np.float64) for _, m in rec['belief'][first:]], \
-        rec[event][n_event][1]
+    msg = rec[event][n_event][1]
+    # The deciding frame's belief is published before its event, but on another topic: under
+    # load the event can be taken first. Wait for a belief per fixation (the callers check it).
+    fixations = int(values_of(msg)['fixations'])
+    wait_for(lambda: len(rec['belief']) - first >= fixations, 30)
+    return [np.asarray(m.data, np.float64) for _, m in rec['belief'][first:]], msg, \
+        len(rec[other]) - n_other
 
 
 @pytest.fixture(scope='module')
 def absent_search(rig, probe):
-    n_found = len(rig['found'])
-    beliefs, msg = _search(probe, rig, {'empty_scene': True, 'seed': 5}, 'absent')
-    return beliefs, msg, len(rig['found']) - n_found
+    return _search(probe, rig, {'empty_scene': True, 'seed': 5}, 'absent')
 
 
 @pytest.fixture(scope='module')
 def found_search(rig, probe, absent_search):
-    n_absent = len(rig['absent'])
-    beliefs, msg = _search(probe, rig, {'empty_scene': False, 'target_row': 2,
-                                        'target_col': 8, 'seed': 6}, 'found')
-    return beliefs, msg, len(rig['absent']) - n_absent
+    return _search(probe, rig, {'empty_scene': False, 'target_row': 2, 'target_col': 8,
+                                'seed': 6}, 'found')
 
 
 def test_an_empty_scene_is_declared_absent(rig, absent_search):
@@ -135,8 +147,8 @@ def test_with_motion_the_controller_keeps_tracking_after_found(rig, probe, found
         results = probe.set_parameters(CONTROLLER, {'motion.sigma_cells': 1.0,
                                                     'absent.prior': 0.0})
         assert all(r.successful for r in results), [r.reason for r in results]
-        _, msg = _search(probe, rig, {**moving, 'empty_scene': False, 'target_row': -1,
-                                      'target_col': -1, 'seed': 9}, 'found')
+        _, msg, _ = _search(probe, rig, {**moving, 'empty_scene': False, 'target_row': -1,
+                                         'target_col': -1, 'seed': 9}, 'found')
         n_target = len(rig['targets'])
         fixations = diagnostics.parse_found(msg)['fixations']
         assert wait_for(lambda: len(rig['targets']) >= n_target + 3, 30), 'tracking stopped'
