@@ -1,6 +1,7 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """Scale as an action: the coarse pass of ``find --all`` (``ipomdp_gaze.vision.scales``)."""
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 import math
 from pathlib import Path
@@ -288,9 +289,22 @@ def test_finds_one_time_set_up_builds_the_haar_checks_cascades(yunet_420):
     model, fovea = yunet_420
     search.haar_check_detectors.cache_clear()
     search.prepare_many(fovea, model, replace(scale_table(model), haar_check_score=0.0))
-    assert search.haar_check_detectors.cache_info().currsize == 0    # no check: not built
+    assert not search.haar_check_detectors.built()                  # no check: not built
     search.prepare_many(fovea, model, scale_table(model))
-    assert search.haar_check_detectors.cache_info().currsize == 1
+    assert search.haar_check_detectors.built()
+
+
+def test_each_thread_gets_its_own_opencv_cascades():
+    """A cascade classifier must not be called from two threads at once (OpenCV's buffers)."""
+    mine = search.haar_check_detectors()
+    assert search.haar_check_detectors() is mine
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        theirs = list(pool.map(lambda _: (search.haar_check_detectors(),
+                                          search.second_opinion_detector()), range(2)))
+    for cascades, second in theirs:
+        assert all(a is not b for a, b in zip(cascades, mine))
+        assert second is not search.second_opinion_detector()
+        assert [c.cascade_names for c in cascades] == [c.cascade_names for c in mine]
 
 
 def test_the_coarse_pass_keeps_weaker_boxes_than_the_fine_windows(yunet_420):

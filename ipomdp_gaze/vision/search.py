@@ -44,6 +44,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 import functools
 import math
+import threading
 import time
 
 import cv2
@@ -1303,9 +1304,34 @@ def _centred_in(boxes, box, offset=(0.0, 0.0)) -> np.ndarray:
             & (centres[:, 1] >= y) & (centres[:, 1] <= y + h))
 
 
-@functools.lru_cache(maxsize=1)
+def per_thread(build):
+    """
+    Cache ``build()``'s answer once per thread (``cache_clear()``, ``built()`` as lru_cache's).
+
+    OpenCV's cascade classifiers keep buffers between calls of ``detectMultiScale``, so one
+    object must not be called from two threads at once (a node's executor, a user's threads):
+    each thread gets its own, built the first time that thread asks.
+    """
+    local = threading.local()
+
+    @functools.wraps(build)
+    def get():
+        if not hasattr(local, 'value'):
+            local.value = build()
+        return local.value
+
+    def cache_clear() -> None:
+        """Forget this thread's copy."""
+        local.__dict__.pop('value', None)
+
+    get.cache_clear = cache_clear
+    get.built = lambda: hasattr(local, 'value')
+    return get
+
+
+@per_thread
 def second_opinion_detector():
-    """Return OpenCV's Haar face cascade (the package's ``haar`` kind), built once."""
+    """Return OpenCV's Haar face cascade (the package's ``haar`` kind), built once per thread."""
     from ipomdp_gaze.vision.detectors import make_detector
     return make_detector('haar')
 
@@ -1339,9 +1365,9 @@ def _second_opinion(image: np.ndarray, found, image_px: tuple[int, int], score: 
     return None, pixels
 
 
-@functools.lru_cache(maxsize=1)
+@per_thread
 def haar_check_detectors() -> tuple:
-    """Return the check's cascades (:data:`HAAR_CHECK_CASCADES`), each a detector, built once."""
+    """Return the check's cascades (:data:`HAAR_CHECK_CASCADES`), built once per thread."""
     from ipomdp_gaze.vision.detectors import make_detector
     sizes = {'min_size_px': round(HAAR_CHECK_RANGE[0] * HAAR_CHECK_SIDE_PX),
              'max_size_px': round(HAAR_CHECK_RANGE[1] * HAAR_CHECK_SIDE_PX)}
