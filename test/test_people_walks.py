@@ -5,7 +5,8 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
-from ipomdp_gaze.drivers.people_walks import people_result, people_settings, PeopleFrame
+from ipomdp_gaze.drivers.people_walks import (id_switches, people_result, people_settings,
+                                              PeopleFrame)
 import pytest
 
 
@@ -33,6 +34,26 @@ def test_scores_of_two_people_worked_by_hand():
     assert r.found == 1.0
     assert r.false_per_frame == pytest.approx(1 / 4)          # (5, 5) names nobody
     assert r.frames == 4 and r.people == 2
+
+
+def test_identity_switches_worked_by_hand():
+    def frame(t, cells, answers, numbers):
+        return PeopleFrame(t, (5, 5), cells, (True, True), answers, (), numbers)
+
+    frames = [
+        frame(0.5, ((2, 2), (8, 8)), ((2, 2), (8, 8)), (1, 2)),
+        frame(1.0, ((2, 3), (8, 7)), ((2, 3),), (1,)),               # person 1 not named
+        frame(1.5, ((2, 4), (8, 6)), ((8, 6), (2, 4)), (1, 2)),      # the numbers swapped
+        frame(2.0, ((2, 5), None), ((2, 6), (2, 5)), (2, 3)),        # the nearer names it
+        frame(2.5, ((2, 6), (8, 5)), ((8, 5),), (1,)),
+    ]
+    # person 0: 1, 1, 2, 3 (the nearer answer, on its cell) -> 2 switches; person 1:
+    # 2, (not named), 1, (out of reach), 1 -> 1 switch
+    assert id_switches(frames, 2) == 3
+    assert people_result('people', 0, SimpleNamespace(people=2, duration_s=3.0),
+                         frames).id_switches == 3
+    unknown = [PeopleFrame(f.t_s, f.head, f.cells, f.in_view, f.answers) for f in frames]
+    assert id_switches(unknown, 2) == 0                       # no numbers: none counted
 
 
 def test_the_shipped_people_configuration_is_the_tracker_with_many_targets():

@@ -20,7 +20,10 @@ scene: ``in_view`` (the person inside the view), ``max_gap_s`` (the longest time
 reach without being in view, from a view to the next one that has it, or to the walk's end);
 ``tracked`` (the person named by an answer, within one cell: the searcher knows where it is);
 ``found`` (the share of the people that some answer named, within one cell, at some frame);
-``false_per_frame`` (answers within one cell of nobody in reach, per frame).
+``false_per_frame`` (answers within one cell of nobody in reach, per frame); ``id_switches``
+(per scene, summed over its people: how often the number of the answer naming a person, the
+nearest within one cell, changed from one frame that names it to the next that names it, as
+multi-object tracking's identity switches count; a one-target searcher's answer is number 1).
 """
 from __future__ import annotations
 
@@ -66,8 +69,10 @@ class PeopleTracker:
         self.last_t = t_s
         result = self.session.update(Frame(obs.counts, offsets=obs.offsets), dt_s=dt)
         grid = self.task.grid
-        answers = [tuple(int(v) for v in grid.cell(t.cell)) for t in self.session.tracks.found]
-        return result.fixation, answers, [e['event'] for e in self.session.people_events]
+        found = self.session.tracks.found
+        answers = [tuple(int(v) for v in grid.cell(t.cell)) for t in found]
+        return (result.fixation, answers, [e['event'] for e in self.session.people_events],
+                [t.person for t in found])
 
 
 class OneTracker:
@@ -81,12 +86,17 @@ class OneTracker:
 
     def step(self, t_s: float, obs, boxes) -> tuple:
         nxt, answer, event = self.tracker.step(t_s, obs, boxes)
-        return nxt, [] if answer is None else [answer], [event] if event else []
+        answers = [] if answer is None else [answer]
+        return nxt, answers, [event] if event else [], [1] * len(answers)
 
 
 @dataclass(frozen=True)
 class PeopleFrame:
-    """One view: when, the head, each person's cell (None out of reach) and in-view, answers."""
+    """
+    One view: when, the head, each person's cell (None out of reach), in view, answers.
+
+    ``numbers`` are the answers' person numbers (empty: unknown, counted as no switch).
+    """
 
     t_s: float
     head: tuple
@@ -94,6 +104,7 @@ class PeopleFrame:
     in_view: tuple
     answers: tuple
     events: tuple = ()
+    numbers: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -109,22 +120,23 @@ class PeopleResult:
     found: float
     false_per_frame: float
     frames: int
+    id_switches: float = math.nan
 
     def to_dict(self) -> dict:
         return {k: getattr(self, k) for k in ('searcher', 'index', 'people', 'in_view',
                                               'tracked', 'max_gap_s', 'found',
-                                              'false_per_frame', 'frames')}
+                                              'false_per_frame', 'frames', 'id_switches')}
 
 
 def run_people(task: WalkTask, scene, tracker) -> list:
     """Run one searcher over a scene of several walking people on the walks' clock."""
     def record(t, head, stepped):
-        _, answers, events = stepped
+        _, answers, events, numbers = stepped
         truths = scene.truths_at(t)
         return PeopleFrame(
             t, tuple(int(v) for v in task.grid.cell(head)), tuple(tr.cell for tr in truths),
             tuple(tr.cell is not None and task.in_view(tr, head) for tr in truths),
-            tuple(answers), tuple(events))
+            tuple(answers), tuple(events), tuple(int(n) for n in numbers))
     return run_on_clock(task, scene, tracker, record)
 
 
@@ -160,7 +172,27 @@ def people_result(searcher: str, index: int, scene, frames: list) -> PeopleResul
                         float(np.mean(in_view)) if in_view else math.nan,
                         float(np.mean(tracked)) if tracked else math.nan,
                         float(np.mean(gaps)), float(np.mean(found)),
-                        false / len(frames) if frames else math.nan, len(frames))
+                        false / len(frames) if frames else math.nan, len(frames),
+                        float(id_switches(frames, people)))
+
+
+def naming_number(frame: PeopleFrame, person: int) -> int | None:
+    """Return the number of the answer naming ``person`` (the nearest within one cell), or None."""
+    cell = frame.cells[person]
+    if cell is None or not frame.numbers:
+        return None
+    near = [(cells_apart(a, cell), n) for a, n in zip(frame.answers, frame.numbers)
+            if cells_apart(a, cell) <= 1]
+    return min(near)[1] if near else None
+
+
+def id_switches(frames: list, people: int) -> int:
+    """Return how often a person's naming number changed between frames naming it (docstring)."""
+    switches = 0
+    for p in range(people):
+        named = [n for n in (naming_number(f, p) for f in frames) if n is not None]
+        switches += sum(a != b for a, b in zip(named, named[1:]))
+    return switches
 
 
 @dataclass(frozen=True)
@@ -223,7 +255,7 @@ def evaluate_people_walks(spec: PeopleSpec, episodes: int, executor=None,
 def summarise_people(results: list, reference: list | None = None) -> dict:
     """Return means over scenes, and paired 95% intervals of differences to ``reference``."""
     s = {'scenes': len(results)}
-    for key in ('in_view', 'tracked', 'max_gap_s', 'found', 'false_per_frame'):
+    for key in ('in_view', 'tracked', 'max_gap_s', 'found', 'false_per_frame', 'id_switches'):
         values = np.array([getattr(r, key) for r in results], dtype=float)
         s[key] = float(np.nanmean(values)) if values.size else math.nan
         if reference is not None and reference is not results and len(results) > 1:
