@@ -148,6 +148,33 @@ def test_a_face_split_between_two_cells_is_not_lost_and_its_spill_over_is_no_new
     assert len(tracks.tracks) == 1
 
 
+def test_two_people_close_together_keep_their_own_numbers():
+    # Person 2 steps into person 1's gate, its face the likelier: person 1 does not take it (the
+    # old rule, the likeliest cell of the gate, in the order of the numbers: person 1 jumped to
+    # person 2's face and person 2 was lost); each keeps the peak nearest to where it was.
+    grid = Grid(8, 8)
+    tracks = Tracks(grid)
+    a, b = grid.index(2, 1), grid.index(5, 4)
+    first = _field(grid, [a, b])
+    assert len(tracks.step(first, first >= 0.99, 0.5, 0.0)) == 2
+    a1, b1 = grid.index(2, 2), grid.index(4, 3)
+    probability = _field(grid, [a1, b1], p=0.995)
+    probability[b1] = 0.9999
+    assert tracks.step(probability, probability >= 0.99, 0.5, 0.5) == []
+    assert [(t.person, t.cell) for t in tracks.found] == [(1, a1), (2, b1)]
+
+
+def test_the_peaks_are_held_cells_one_per_neighbourhood_likeliest_first():
+    grid = Grid(6, 6)
+    tracks = Tracks(grid)
+    probability = _field(grid, [grid.index(1, 1), grid.index(1, 2), grid.index(4, 4)], p=0.6)
+    probability[grid.index(4, 4)] = 0.8
+    # (1, 1) and (1, 2) hold 1 - 0.4^2 = 0.84 together; (4, 4) holds 0.8 alone
+    assert tracks.peaks(probability, 0.82).tolist() == [grid.index(1, 1)]
+    assert tracks.peaks(probability, 0.5).tolist() == [grid.index(4, 4), grid.index(1, 1)]
+    assert tracks.peaks(probability, 0.9).tolist() == []
+
+
 def test_turns_share_the_head_between_people_with_a_glance_after_each_round():
     turns = Turns(dwell_s=1.0)
     seen = [turns.advance([1, 2], 0.4) for _ in range(9)]

@@ -6,7 +6,13 @@ The people a moving many-target search follows: one track each, and the head's t
 With ``search.targets: many`` and motion on (docs/design.md section 12.10) the occupancy belief
 (:mod:`ipomdp_gaze.model.occupancy`) is predicted between frames and updated cell by cell; it says
 where people are, not who is who. :class:`Tracks` keeps who: after each frame every person found
-is looked for within :data:`GATE_CELLS` of where it was (of where its position filter puts it):
+is looked for within :data:`GATE_CELLS` of where it was (of where its position filter puts it),
+all of them at once: the frame's peaks (cells holding someone, at least the keep probability
+over a cell and its neighbours, the likeliest of its :data:`SPILL_CELLS` neighbourhood) go
+to the people by global nearest-neighbour assignment (the fewest squared cells between each
+person's predicted position and its peak, among assignments that keep the most people; Bar-Shalom
+and Li's GNN), so that where two people meet each keeps the peak its motion leads to, not
+whichever is likelier:
 
 - it stays found at the likeliest cell there while that cell and its neighbours (within
   :data:`SPILL_CELLS`) hold someone with at least the keep probability
@@ -40,6 +46,8 @@ from ipomdp_gaze.model.occupancy import clusters
 from ipomdp_gaze.model.position_filter import GATE_CELLS as FILTER_GATE_CELLS
 from ipomdp_gaze.model.position_filter import measured_position, PositionFilter
 import numpy as np
+from scipy.ndimage import maximum_filter
+from scipy.optimize import linear_sum_assignment
 
 # A person found is looked for again within this many cells (Chebyshev) of where it was: a face
 # walking 20 deg/s crosses 2 cells of 10 degrees in the second between two looks at it.
@@ -152,10 +160,15 @@ class Tracks:
         taken = np.zeros(grid.n_cells, dtype=bool)
         seen = np.ones(grid.n_cells, dtype=bool) if values is None else \
             ~np.isnan(np.asarray(values, dtype=float))
-        for track in self.found:
-            centre = self._centre(track, dt_s)
+        found = self.found
+        centres = [self._centre(track, dt_s) for track in found]
+        assigned = self._assign(found, centres, probability, keep)
+        order = sorted(range(len(found)), key=lambda i: (i not in assigned, i))
+        for i in order:
+            track, centre = found[i], centres[i]
             window = near(grid, centre, GATE_CELLS) & ~taken
-            best = int(np.argmax(np.where(window, probability, -1.0)))
+            best = assigned[i] if i in assigned else \
+                int(np.argmax(np.where(window, probability, -1.0)))
             held = self.held(probability, best, taken)
             confirmed = window.any() and held >= keep
             if confirmed or (window.any() and not seen[best]
@@ -189,6 +202,50 @@ class Tracks:
             taken |= near(grid, best, SPILL_CELLS)
             events.append(self._event(kind, track, seconds))
         return events
+
+    def peaks(self, probability: np.ndarray, keep: float) -> np.ndarray:
+        """
+        Return the cells where someone is held (:meth:`held`), likeliest first.
+
+        Cells are taken in order of probability, each one that holds at least ``keep``, is the
+        likeliest of its :data:`SPILL_CELLS` neighbourhood (a tie is broken by that order) and is
+        not within it of a peak taken before (its spill-over).
+        """
+        probability = np.asarray(probability, dtype=np.float64)
+        with np.errstate(divide='ignore'):
+            empty = np.log1p(-np.minimum(probability, 1.0))
+        empty = empty.reshape(self.grid.rows, self.grid.cols)
+        padded = np.pad(empty, SPILL_CELLS)
+        size = 2 * SPILL_CELLS + 1
+        total = sum(padded[r:r + self.grid.rows, c:c + self.grid.cols]
+                    for r in range(size) for c in range(size))
+        top = maximum_filter(probability.reshape(self.grid.rows, self.grid.cols), size=size,
+                             mode='nearest').reshape(-1)
+        holds = (-np.expm1(total.reshape(-1)) >= keep) & (probability >= top)
+        out, blocked = [], np.zeros(self.grid.n_cells, dtype=bool)
+        for cell in np.argsort(-probability, kind='stable'):
+            if holds[cell] and not blocked[cell]:
+                out.append(int(cell))
+                blocked |= near(self.grid, cell, SPILL_CELLS)
+        return np.array(out, dtype=np.int64)
+
+    def _assign(self, found: list, centres: list, probability, keep: float) -> dict:
+        """Return ``{index in found: cell}``: each person's peak, by global nearest neighbour."""
+        peaks = self.peaks(probability, keep) if found else np.empty(0, dtype=np.int64)
+        if not len(peaks):
+            return {}
+        grid = self.grid
+        peak_rc = np.array([grid.cell(int(c)) for c in peaks], dtype=np.float64)
+        centre_rc = np.array([grid.cell(int(c)) for c in centres], dtype=np.float64)
+        at = np.array([t.position.x if t.position is not None and t.position.started
+                       else grid.cell(t.cell) for t in found], dtype=np.float64)
+        gated = np.max(np.abs(centre_rc[:, None, :] - peak_rc[None, :, :]), axis=2) <= GATE_CELLS
+        cost = np.sum((at[:, None, :] - peak_rc[None, :, :]) ** 2, axis=2)
+        # a pair outside the gate costs more than every gated assignment together: the most
+        # people are kept first, then the fewest squared cells
+        outside = 1.0 + cost[gated].sum()
+        rows, cols = linear_sum_assignment(np.where(gated, cost, outside))
+        return {int(r): int(peaks[c]) for r, c in zip(rows, cols) if gated[r, c]}
 
     def held(self, probability: np.ndarray, cell: int, taken: np.ndarray | None = None) -> float:
         """Return whether someone is within SPILL_CELLS of ``cell``: ``1 - prod (1 - P_j)``."""
