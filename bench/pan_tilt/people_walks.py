@@ -13,7 +13,9 @@ the one-target tracker of ``config/faces_camera_tracking.yaml`` (what the produc
 in the grid's reach, averaged over the people of a scene, then over scenes: ``tracked`` (an
 answer names the person, within one cell: the searcher knows where it is), ``in view``, the
 longest time in reach without being in view (``max gap``), the share of the people found at
-all, and answers naming nobody per frame.
+all, answers naming nobody per frame, and identity switches per scene (summed over its people:
+the number of the answer naming a person changing between frames that name it; a one-target
+searcher always answers number 1).
 
 Regenerate with ``make people-walks`` (``python bench/pan_tilt/people_walks.py [--scenes 30]
 [--speeds 5,15] [--faces 2]``; about 8 minutes per speed at 30 scenes on two idle cores);
