@@ -3,10 +3,12 @@
 """The scores of several walking people (ipomdp_gaze.drivers.people_walks), worked by hand."""
 from __future__ import annotations
 
+import math
 from types import SimpleNamespace
+import warnings
 
 from ipomdp_gaze.drivers.people_walks import (id_switches, people_result, people_settings,
-                                              PeopleFrame)
+                                              PeopleFrame, PeopleResult, summarise_people)
 import pytest
 
 
@@ -62,3 +64,16 @@ def test_the_shipped_people_configuration_is_the_tracker_with_many_targets():
     assert settings.false_alarm_scales == (1.0,) and settings.hotspot_prior > 0
     assert settings.motion_track_view == 'position' and settings.motion_dwell_s == 2.0
     assert values['observation.file'] == 'faces-pan-tilt-profile' and policy == 'coverage'
+
+
+def test_a_record_without_identity_switches_summarises_without_them():
+    # the committed page's record predates id_switches: its page shows '-', not '+nan [...]'
+    def result(index, tracked):
+        return PeopleResult('people', index, 2, 0.5, tracked, 3.0, 1.0, 0.1, 40)
+
+    results, reference = [result(0, 0.6), result(1, 0.7)], [result(0, 0.5), result(1, 0.4)]
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        s = summarise_people(results, reference)
+    assert math.isnan(s['id_switches']) and 'id_switches_minus_reference' not in s
+    assert s['tracked_minus_reference'][0] == pytest.approx(0.2)

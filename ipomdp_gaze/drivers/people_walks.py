@@ -257,9 +257,12 @@ def summarise_people(results: list, reference: list | None = None) -> dict:
     s = {'scenes': len(results)}
     for key in ('in_view', 'tracked', 'max_gap_s', 'found', 'false_per_frame', 'id_switches'):
         values = np.array([getattr(r, key) for r in results], dtype=float)
-        s[key] = float(np.nanmean(values)) if values.size else math.nan
+        # a score a record lacks (id_switches before 0.3.8) is NaN in every scene: no mean
+        s[key] = float(np.nanmean(values)) if np.any(~np.isnan(values)) else math.nan
         if reference is not None and reference is not results and len(results) > 1:
             d = values - np.array([getattr(r, key) for r in reference], dtype=float)
+            d = d[~np.isnan(d)]
             bound = 1.0 if key in ('in_view', 'tracked') else math.inf     # fractions
-            s[f'{key}_minus_reference'] = normal_interval(d[~np.isnan(d)], bound)
+            if d.size:
+                s[f'{key}_minus_reference'] = normal_interval(d, bound)
     return s
