@@ -98,13 +98,17 @@ def test_record_says_what_it_wrote(tmp_path):
     bag = tmp_path / 'bag'
     bag.mkdir()
     (bag / 'bag_0.mcap').write_bytes(b'x' * 1_500_000)
+    topic = '  - {{topic_metadata: {{name: /{}, type: {}, serialization_format: cdr}}, ' \
+        'message_count: {}}}\n'
     (bag / 'metadata.yaml').write_text(
         'rosbag2_bagfile_information:\n  version: 9\n  message_count: 12\n'
+        '  storage_identifier: mcap\n  relative_file_paths: [bag_0.mcap]\n'
+        '  starting_time: {nanoseconds_since_epoch: 1000}\n'
         '  duration: {nanoseconds: 2500000000}\n  topics_with_message_count:\n'
-        '  - {topic_metadata: {name: /belief}, message_count: 9}\n'
-        '  - {topic_metadata: {name: /found}, message_count: 1}\n'
-        '  - {topic_metadata: {name: /pan_tilt}, message_count: 2}\n'
-        '  - {topic_metadata: {name: /absent}, message_count: 0}\n')
+        + topic.format('belief', 'std_msgs/msg/Float64MultiArray', 9)
+        + topic.format('found', 'geometry_msgs/msg/PointStamped', 1)
+        + topic.format('pan_tilt', 'sensor_msgs/msg/JointState', 2)
+        + topic.format('absent', 'std_msgs/msg/Float64', 0))
     assert describe_written(bag) == (f'wrote {bag}: 12 messages over 2.5 s, 1.50 MB (belief 9, '
                                      f'found 1, pan_tilt 2)')
     assert describe_written(tmp_path / 'none').startswith(

@@ -29,6 +29,7 @@ from pathlib import Path
 import re
 import shutil
 
+from ipomdp_gaze.files.bag_metadata import check_document, check_embedded
 from ipomdp_gaze.files.writable import folder_writable, write_text
 import yaml
 
@@ -447,16 +448,33 @@ class Bag:
 
 
 def read_metadata(path) -> dict:
-    """Return ``rosbag2_bagfile_information`` of a bag's ``metadata.yaml``."""
+    """
+    Return ``rosbag2_bagfile_information`` of a bag's ``metadata.yaml``, checked.
+
+    Raises
+    ------
+    ValueError
+        One line: no ``metadata.yaml``, or a key of it missing or of the wrong type, or a file
+        it lists not in the bag (:func:`~ipomdp_gaze.files.bag_metadata.check_document`).
+
+    """
     meta = Path(path) / 'metadata.yaml'
     if not meta.is_file():
         raise ValueError(f'{path} is not a rosbag2 bag: no metadata.yaml' + (
             f' (a recording cut off? `ipomdp-gaze reindex {path}` rebuilds it from the MCAP '
             'files)' if _has_mcap_files(Path(path)) else ''))
     try:
-        return yaml.safe_load(meta.read_text())['rosbag2_bagfile_information']
-    except (yaml.YAMLError, KeyError, TypeError):
-        raise ValueError(f'{meta} is not rosbag2 metadata') from None
+        doc = yaml.safe_load(meta.read_bytes().decode())
+    except OSError as exc:
+        raise ValueError(f'{meta} cannot be read: {exc.strerror}') from None
+    except (UnicodeDecodeError, yaml.YAMLError):
+        raise ValueError(f'{meta} is not rosbag2 metadata: not YAML text') from None
+    try:
+        return check_document(doc, meta, Path(path))
+    except ValueError as exc:
+        raise ValueError(f'{exc}' + (
+            f' (a damaged metadata.yaml? `ipomdp-gaze reindex --force {path}` rebuilds it from '
+            'the MCAP files)' if _has_mcap_files(Path(path)) else '')) from None
 
 
 def _has_mcap_files(path: Path) -> bool:
@@ -569,7 +587,9 @@ def _closed_metadata(file: Path):
         try:
             for record in make_reader(f).iter_metadata():
                 if record.name == ROSBAG2_RECORD:
-                    return yaml.safe_load(record.metadata['serialized_metadata'])
+                    info = yaml.safe_load(record.metadata['serialized_metadata'])
+                    # damaged: the file is rewritten as an unfinished one
+                    return info if check_embedded(info, file) else None
         except Exception:           # noqa: B902 (a damaged summary: rewritten as unfinished)
             return None
     return None
@@ -624,8 +644,9 @@ class _Recovery:
         from mcap.records import Channel, Message, Metadata, Schema
         if isinstance(record, Schema):
             self.schemas[record.id] = record
-        elif isinstance(record, Channel):
-            # every topic, in the order recorded, those without a message too
+        elif isinstance(record, Channel) and record.id not in self.connections:
+            # every topic, in the order recorded, those without a message too (once: a
+            # closed file's summary repeats its channels)
             msgtype = self.schemas[record.schema_id].name
             if msgtype not in self.store.types:
                 raise ValueError(f'{self.file}: {record.topic} holds {msgtype}, a message type '
