@@ -1,6 +1,8 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """The foveal detector's core without ROS: which image serves a fixation, and its counts."""
+from pathlib import Path
+
 from ipomdp_gaze.files.observation_file import load_observation
 from ipomdp_gaze.model.head import PanTiltMap
 from ipomdp_gaze.model.head_camera import observed_cells
@@ -234,6 +236,41 @@ def test_settings_that_repeat_the_observation_file_are_accepted():
                        detector={'kind': 'ensemble', 'members': members}).observer is not None
     with pytest.raises(ValueError, match='detector.members .* contradicts'):
         build_setup('camera', 'faces-pan-tilt-ensemble', detector={'members': members[:1]})
+
+
+def test_a_cascade_dir_without_the_cascades_is_refused_naming_the_folder_and_the_file(tmp_path):
+    """A folder missing, or without a cascade, fell back to OpenCV's cascades unnoticed."""
+    import cv2
+    frontal, profile = 'haarcascade_frontalface_alt2.xml', 'haarcascade_profileface.xml'
+    missing = tmp_path / 'cascades'
+    for mode, source, folder, message in (
+            ('fovea', 'faces-420', missing, f'detector.cascade_dir {missing} does not exist (it '
+                                            f'was to hold {frontal})'),
+            ('fovea', 'faces-420', tmp_path, f'detector.cascade_dir {tmp_path} has no {frontal} '
+                                             "(a cascade of observation.file 'faces-420', looked "
+                                             'for there only)'),
+            ('camera', 'faces-pan-tilt-ensemble', missing,
+             f'detector.cascade_dir {missing} does not exist (it was to hold {frontal}, '
+             f'{profile})'),
+            ('fovea', 'faces-420-yunet', missing, f'detector.cascade_dir {missing} does not '
+                                                  'exist')):
+        with pytest.raises(ValueError) as raised:
+            build_setup(mode, source, cascade_dir=str(folder))
+        assert str(raised.value) == message
+    # the frontal cascade there, the profile one not: the camera model's profile is not taken
+    # from OpenCV's
+    (tmp_path / frontal).write_bytes((Path(cv2.data.haarcascades) / frontal).read_bytes())
+    with pytest.raises(ValueError) as raised:
+        build_setup('camera', cascade_dir=str(tmp_path))
+    assert str(raised.value) == (f'detector.cascade_dir {tmp_path} has no {profile} (a cascade '
+                                 "of observation.file 'faces-pan-tilt-profile', looked for there "
+                                 'only)')
+    with pytest.raises(ValueError, match='is a file; .* needs the cascades'):
+        build_setup('camera', cascade_dir=str(tmp_path / frontal))
+    setup = build_setup('fovea', cascade_dir=str(tmp_path))
+    assert setup.detector.paths == [tmp_path / frontal]
+    assert build_setup('fovea', cascade_dir=str(tmp_path / frontal)).detector.paths == [
+        tmp_path / frontal]
 
 
 def test_an_image_from_the_future_or_the_past_is_rejected_and_counted(fovea_setup):

@@ -297,6 +297,25 @@ def test_settings_that_contradict_the_observation_file_are_refused(probe, nodes,
     assert probe.set_parameters('fov/' + NODE, {'detector.scale_factor': 1.1})[0].successful
 
 
+def test_a_cascade_dir_without_the_cascade_is_refused(probe, nodes, fovea, tmp_path):
+    """It fell back to OpenCV's installed cascades unnoticed, at start and when set."""
+    missing = tmp_path / 'cascades'
+    bad = nodes.start('detector', ['-r', '__ns:=/nocascade', '-p',
+                                   f'detector.cascade_dir:={missing}'])
+    assert wait_for(lambda: not bad.running, 60)
+    assert bad.proc.returncode == 1
+    assert f'detector.cascade_dir {missing} does not exist (it was to hold ' \
+        'haarcascade_frontalface_alt2.xml)' in bad.output()
+    assert 'Traceback' not in bad.output()
+    nodes.killed.append(bad)                                     # exited on purpose
+    result = probe.set_parameters('fov/' + NODE, {'detector.cascade_dir': str(tmp_path)})[0]
+    assert not result.successful
+    assert f'detector.cascade_dir {tmp_path} has no haarcascade_frontalface_alt2.xml' in \
+        result.reason
+    assert probe.get_parameters('fov/' + NODE, ['detector.cascade_dir']) == {
+        'detector.cascade_dir': ''}
+
+
 def test_an_absurd_joint_angle_is_refused_and_counted_and_the_node_lives(camera):
     """The fault of issue 26: pan = 1e308 under the stamp of a valid image, a fixation waiting."""
     from ipomdp_gaze.model.head import PanTiltMap

@@ -95,16 +95,26 @@ def test_to_gray_rejects_images_smaller_than_the_detector_window(haar):
 
 # ---- find_cascade ------------------------------------------------------------------------------
 
-def test_find_cascade_searches_the_explicit_path_first(tmp_path):
+def test_find_cascade_takes_the_explicit_path_only(tmp_path):
     own = tmp_path / REFERENCE_CASCADE
     own.write_text('<opencv_storage/>')
     assert find_cascade(REFERENCE_CASCADE, tmp_path) == own          # a folder
     assert find_cascade(REFERENCE_CASCADE, own) == own               # a file
     assert find_cascade(str(own)) == own                             # a name with a folder
-    # An explicit place without the file falls through to OpenCV's copy.
-    found = find_cascade(REFERENCE_CASCADE, tmp_path / 'elsewhere')
-    assert found == find_cascade(REFERENCE_CASCADE)
-    assert found.parent == (detector_module.Path(cv2.data.haarcascades))
+    assert find_cascade(REFERENCE_CASCADE).parent == detector_module.Path(cv2.data.haarcascades)
+
+
+def test_find_cascade_refuses_an_explicit_place_without_the_file(tmp_path):
+    """It fell through to OpenCV's copy: a cascade_dir mistyped went unnoticed."""
+    with pytest.raises(ValueError) as raised:
+        find_cascade(REFERENCE_CASCADE, tmp_path / 'elsewhere')
+    assert str(raised.value) == (f'cascade folder {tmp_path / "elsewhere"} does not exist (it '
+                                 f'was to hold {REFERENCE_CASCADE})')
+    with pytest.raises(ValueError) as raised:
+        find_cascade(REFERENCE_CASCADE, tmp_path)
+    assert str(raised.value) == f'cascade folder {tmp_path} has no {REFERENCE_CASCADE}'
+    with pytest.raises(ValueError, match=f'has no {REFERENCE_CASCADE}'):
+        HaarDetector(cascade_dir=tmp_path)
 
 
 def test_find_cascade_without_cv2_data_uses_the_system_folder(tmp_path, monkeypatch):
@@ -120,7 +130,7 @@ def test_find_cascade_lists_every_place_searched_in_order(tmp_path, monkeypatch)
     system = tmp_path / 'system'
     monkeypatch.setattr(detector_module, 'SYSTEM_CASCADE_DIRS', (system,))
     with pytest.raises(FileNotFoundError) as info:
-        find_cascade('no_such_cascade.xml', tmp_path)
+        find_cascade(str(tmp_path / 'no_such_cascade.xml'))
     message = str(info.value)
     places = [str(tmp_path / 'no_such_cascade.xml'),
               str(detector_module.Path(cv2.data.haarcascades) / 'no_such_cascade.xml'),

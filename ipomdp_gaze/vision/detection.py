@@ -52,6 +52,7 @@ import bisect
 from collections import deque
 from dataclasses import dataclass, field
 import math
+from pathlib import Path
 import time
 
 from ipomdp_gaze.files.observation_file import load_observation
@@ -201,7 +202,8 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
         Detector settings asked for (``kind`` and the detector's own settings, e.g. those of
         :data:`DETECTOR_KEYS` for ``haar``); each must repeat the file's.
     cascade_dir : str, optional
-        Folder (or file) searched first for the cascade the file names.
+        Folder holding the cascades the file names (or a cascade file), instead of OpenCV's;
+        refused if it does not exist or lacks one of them (:func:`check_cascade_dir`).
 
     Raises
     ------
@@ -240,6 +242,8 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
             raise ValueError(f'detector.{key}: the detector {recorded.get("kind")!r} of '
                              f'observation.file {name!r} has no setting {key!r} (it has '
                              f'{", ".join(sorted(recorded))})')
+    if cascade_dir:
+        check_cascade_dir(cascade_dir, recorded, name)
     differs = sorted(key for key, asked in (detector or {}).items() if asked != recorded[key])
     if differs and not _builds_the_same(recorded, detector, cascade_dir):
         key = differs[0]
@@ -263,6 +267,45 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
         # A record of the file with the wrong types (a fuzzed or hand-edited file).
         raise ValueError(f'observation.file {name!r}: its detector or fovea record is unusable '
                          f'({type(exc).__name__}: {_one_line(exc)})') from None
+
+
+def check_cascade_dir(cascade_dir, recorded: dict, name: str) -> None:
+    """
+    Refuse a ``detector.cascade_dir`` that does not exist or lacks a cascade of ``recorded``.
+
+    Without the check, a cascade missing there was taken from OpenCV's installed ones unnoticed.
+    ``name`` is the observation file recording the detector ``recorded``.
+    """
+    path = Path(cascade_dir)
+    names = _cascade_names(recorded)
+    looked = f' (it was to hold {", ".join(names)})' if names else ''
+    if not path.exists():
+        raise ValueError(f'detector.cascade_dir {path} does not exist{looked}')
+    if not path.is_dir():
+        if len(names) > 1:
+            raise ValueError(f'detector.cascade_dir {path} is a file; observation.file {name!r} '
+                             f'needs the cascades {", ".join(names)}: give their folder')
+        return
+    missing = [n for n in names if not (path / n).is_file()]
+    if missing:
+        raise ValueError(f'detector.cascade_dir {path} has no {missing[0]} (a cascade of '
+                         f'observation.file {name!r}, looked for there only)')
+
+
+def _cascade_names(recorded) -> list:
+    """Return the file names of the Haar cascades a detector record names (members too)."""
+    if not isinstance(recorded, dict):
+        return []
+    if recorded.get('kind') == 'ensemble':
+        members = recorded.get('members')
+        return [n for m in (members if isinstance(members, list) else [])
+                for n in _cascade_names(m)]
+    if recorded.get('kind') != 'haar':
+        return []
+    from ipomdp_gaze.vision.detector import REFERENCE_CASCADE
+    cascade = recorded.get('cascade', REFERENCE_CASCADE)
+    cascades = cascade if isinstance(cascade, list) else [cascade]
+    return [Path(str(c)).name for c in cascades]
 
 
 def _builds_the_same(recorded: dict, asked: dict, cascade_dir) -> bool:

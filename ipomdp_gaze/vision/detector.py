@@ -245,18 +245,21 @@ def find_cascade(name: str = REFERENCE_CASCADE, path=None) -> Path:
         File name of the cascade, e.g. ``'haarcascade_frontalface_alt2.xml'``. A name with a
         folder in it (``'models/my.xml'``) is itself the first place searched.
     path : str or os.PathLike, optional
-        Searched first: a folder holding ``name``, or a cascade file. The other places are
-        searched for the file name of ``name``.
+        A folder holding the file name of ``name``, or a cascade file: the one place searched
+        (another cascade found elsewhere would be used unnoticed). Without it, the places below
+        are searched for the file name of ``name``.
 
     Returns
     -------
     pathlib.Path
-        The first existing file of: ``path``; ``cv2.data.haarcascades`` (pip's
-        opencv-python wheels; Debian's python3-opencv has no ``cv2.data``); then
-        :data:`SYSTEM_CASCADE_DIRS` (Debian's opencv-data package).
+        ``path``'s file; or the first existing file of: ``name`` if it has a folder in it,
+        ``cv2.data.haarcascades`` (pip's opencv-python wheels; Debian's python3-opencv has no
+        ``cv2.data``), then :data:`SYSTEM_CASCADE_DIRS` (Debian's opencv-data package).
 
     Raises
     ------
+    ValueError
+        If ``path`` is given and does not exist, or is a folder without the file.
     FileNotFoundError
         If no place has the file; the message lists every place searched, in order.
 
@@ -264,8 +267,7 @@ def find_cascade(name: str = REFERENCE_CASCADE, path=None) -> Path:
     places = []
     file_name = Path(name).name
     if path is not None:
-        path = Path(path)
-        places.append(path / file_name if path.is_dir() else path)
+        return _cascade_in(Path(path), file_name)
     if len(Path(name).parts) > 1:
         places.append(Path(name))
     data = getattr(cv2, 'data', None)
@@ -279,6 +281,17 @@ def find_cascade(name: str = REFERENCE_CASCADE, path=None) -> Path:
     raise FileNotFoundError(
         f'cascade {name!r} not found; searched, in order:\n  {searched}\n'
         'install opencv-python-headless<5 (pip) or opencv-data (apt), or pass its path')
+
+
+def _cascade_in(path: Path, file_name: str) -> Path:
+    """Return the cascade ``file_name`` in the folder ``path`` (or ``path``, a file)."""
+    if not path.exists():
+        raise ValueError(f'cascade folder {path} does not exist (it was to hold {file_name})')
+    if not path.is_dir():
+        return path
+    if not (path / file_name).is_file():
+        raise ValueError(f'cascade folder {path} has no {file_name}')
+    return path / file_name
 
 
 def _size_pair(name: str, value) -> tuple[int, int] | None:
@@ -315,7 +328,8 @@ class HaarDetector:
         Smallest and largest box ``(width, height)`` searched for, in the pixels of the image the
         detector is given (for the fovea: the resized window), or ``None`` for no limit.
     cascade_dir : str or os.PathLike, optional
-        Folder (or file) searched before the default places.
+        Folder holding the cascades (or a cascade file), instead of the default places; one
+        that does not exist, or lacks a cascade, is refused.
     mirror : bool or list of bool
         Per cascade (one flag for all): also detect in the mirrored image.
 
@@ -375,8 +389,8 @@ class HaarDetector:
         """
         Rebuild the detector :meth:`settings` describes (an observation model's record).
 
-        Each cascade is looked up by file name (:func:`find_cascade`, ``cascade_dir`` first), and
-        a copy whose SHA-256 differs from the recorded one is refused.
+        Each cascade is looked up by file name (:func:`find_cascade`, in ``cascade_dir`` if
+        given), and a copy whose SHA-256 differs from the recorded one is refused.
 
         Raises
         ------

@@ -300,7 +300,7 @@ def detector_from_settings(settings: dict, cascade_dir=None, on_note=None):
     Rebuild the detector an observation model records (``meta['detector']``).
 
     ``cascade_dir`` is passed to factories whose ``from_settings`` takes it (the Haar cascade:
-    a folder searched first for the cascade file). ``on_note(text)``, if given, hears each
+    the folder holding the cascade files). ``on_note(text)``, if given, hears each
     information-only setting that differs (:func:`compare_settings`), e.g. another OpenCV
     version, whose DNN scores may differ in their last digits.
 

@@ -66,7 +66,7 @@ class EnsembleDetector:
     members : list of dict
         ``{'kind': ..., 'weight': w, option: value, ...}`` per detector (``weight`` default 1).
     cascade_dir : str or os.PathLike, optional
-        Passed to the members that take it (Haar: a folder searched first for a cascade).
+        Passed to the members that take it (Haar: the folder holding its cascades).
 
     """
 
