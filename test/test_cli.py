@@ -153,8 +153,8 @@ def test_evaluate_draws_targets_from_a_prior_file(tmp_path, capsys):
 @pytest.mark.parametrize('text, message', [
     ('1 1\n1 1\n', 'a 3x3 grid needs 3 lines of 3 weights, got 2 lines of 2'),
     ('1 1 1\n1 x 1\n1 1 1\n', "not a number in '1 x 1'"),
-    ('1 1 1\n1 -1 1\n1 1 1\n', 'weights must be finite, >= 0 and not all 0'),
-    ('0 0 0\n0 0 0\n0 0 0\n', 'weights must be finite, >= 0 and not all 0'),
+    ('1 1 1\n1 -1 1\n1 1 1\n', 'weights must be >= 0: cell (1, 1) is -1'),
+    ('0 0 0\n0 0 0\n0 0 0\n', 'weights must not all be 0 (the target would be in no cell)'),
     ('1e308 1e308 1e308\n1e308 1e308 1e308\n1e308 1e308 x\n', "not a number in '1e308 1e308 x'"),
 ])
 def test_a_bad_prior_file_is_one_line(tmp_path, capsys, text, message):

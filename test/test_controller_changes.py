@@ -147,7 +147,7 @@ def test_a_prior_follows_into_the_next_search_and_out_of_many_targets():
                      {'belief.prior'}, prior)
     for bad, message in (([1.0] * 120, 'belief.prior must hold one weight per cell, 121 values '
                                        'for a 11x11 grid'),
-                         ([0.0] * 121, 'belief.prior weights must be finite, >= 0 and not all 0')):
+                         ([0.0] * 121, r'belief.prior weights must not all be 0 \(the target')):
         with pytest.raises(ValueError, match=message):
             build_config(dict(values, **{'belief.prior': bad}), build_policy)
 

@@ -218,7 +218,8 @@ def test_bad_kernel_is_rejected_and_the_old_one_stays(probe, cam, bad, words):
     ({'search.false_alarm_scales': [1.0, 2.0]}, 'needs a count model'),
     ({'search.absent_needs_coverage': True}, 'needs a pan/tilt count model'),
     ({'belief.prior': [1.0] * 120}, 'belief.prior must hold one weight per cell, 121 values'),
-    ({'belief.prior': [-1.0] + [1.0] * 120}, 'belief.prior weights must be finite, >= 0'),
+    ({'belief.prior': [-1.0] + [1.0] * 120},
+     'belief.prior weights must be >= 0: cell (0, 0) is -1'),
 ])
 def test_invalid_parameters_are_rejected_with_a_reason(probe, cam, values, words):
     before = probe.get_parameters(NODE, list(values))

@@ -73,7 +73,8 @@ def test_whole_numbers_for_belief_prior_are_taken_as_doubles(context, tmp_path, 
         # Whole numbers go through the same checks as any weights.
         result = _set(node, belief__prior=[-1] + WEIGHTS[1:])
         assert not result.successful
-        assert 'belief.prior weights must be finite, >= 0' in result.reason, result.reason
+        assert 'belief.prior weights must be >= 0: cell (0, 0) is -1' in result.reason, \
+            result.reason
         result = _set(node, belief__prior=WEIGHTS[1:])
         assert not result.successful and 'belief.prior must hold one weight per cell, 121 ' \
             'values' in result.reason, result.reason

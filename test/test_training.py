@@ -428,7 +428,7 @@ def test_a_prior_is_recorded_resumed_and_checked(tmp_path):
     ([[0.5, 0.5]], r'training.prior: a 2x2 grid needs 2 rows of 2 numbers, got shape \(1, 2\)'),
     ([[0.5, 'x'], [0, 0]], 'training.prior must be rows of numbers'),
     ([[0.5, 0.5], [0.5, 0.5]], 'training.prior: prior must sum to 1, got 2'),
-    ([[-0.5, 0.5], [0.5, 0.5]], 'training.prior: prior must be finite and >= 0 in every cell'),
+    ([[-0.5, 0.5], [0.5, 0.5]], 'training.prior: prior must be >= 0 in every cell, got -0.5'),
 ])
 def test_a_bad_recorded_prior_is_one_line(tmp_path, capsys, value, message):
     import yaml

@@ -339,6 +339,6 @@ def read_prior(path: Path, grid) -> np.ndarray:
         raise ValueError(f'--prior {path}: a {grid.rows}x{grid.cols} grid needs {grid.rows} '
                          f'lines of {grid.cols} weights, got {shape}')
     try:
-        return prior_from_weights(rows)
+        return prior_from_weights(rows, grid.shape)
     except ValueError as exc:
         raise ValueError(f'--prior {path}: {exc}') from None

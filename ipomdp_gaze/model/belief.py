@@ -161,8 +161,9 @@ def check_prior(prior, n_cells: int, shape: tuple[int, int] | None = None) -> np
     if values.shape != (n_cells,):
         raise ValueError(f'prior must hold one probability per cell, {n_cells} values (rows x '
                          f'cols, row-major), got shape {np.shape(prior)}')
-    if not np.all(np.isfinite(values)) or np.any(values < 0):
-        raise ValueError('prior must be finite and >= 0 in every cell')
+    for bad, rule in ((~np.isfinite(values), 'finite'), (values < 0, '>= 0')):
+        if np.any(bad):         # a NaN first: it is neither negative nor positive
+            raise ValueError(f'prior must be {rule} in every cell, got {values[bad][0]:g}')
     total = float(values.sum())
     if abs(total - 1.0) > 1e-6:
         raise ValueError(f'prior must sum to 1, got {total:.6g}')
@@ -182,15 +183,24 @@ def draw_cells(rng: np.random.Generator, n_cells: int, prior: np.ndarray | None 
     return rng.choice(n_cells, size=size, p=prior)
 
 
-def prior_from_weights(weights) -> np.ndarray:
+def prior_from_weights(weights, shape: tuple[int, int] | None = None) -> np.ndarray:
     """
     Scale weights >= 0 (one per cell) to a prior summing to 1: a prior file's, ``belief.prior``.
 
-    ValueError ('weights must be finite, >= 0 and not all 0') otherwise; the caller names them.
+    A ValueError says the first thing wrong, in this order (a NaN is neither negative nor
+    positive: it is named as what it is), the cell named ``(row, col)`` of ``shape`` if given:
+    a weight not finite, a weight below 0, then every weight 0. The caller names the setting.
     """
     weights = np.asarray(weights, dtype=float).reshape(-1)
-    if not np.all(np.isfinite(weights)) or np.any(weights < 0) or not weights.max() > 0:
-        raise ValueError('weights must be finite, >= 0 and not all 0')
+
+    def cell(i: int) -> str:
+        return f'cell {divmod(i, shape[1])}' if shape else f'weight {i + 1}'
+    for bad, rule in ((~np.isfinite(weights), 'finite'), (weights < 0, '>= 0')):
+        if np.any(bad):
+            i = int(np.argmax(bad))
+            raise ValueError(f'weights must be {rule}: {cell(i)} is {weights[i]:g}')
+    if not weights.max() > 0:
+        raise ValueError('weights must not all be 0 (the target would be in no cell)')
     weights = weights / weights.max()           # the sum of weights near 1e308 stays finite
     return weights / weights.sum()
 

@@ -109,25 +109,36 @@ def prior_from(values: Mapping, grid: Grid):
     Raises
     ------
     ValueError
-        Unless it holds one weight >= 0 per cell (rows x cols, row-major) with a positive sum;
-        or with ``search.targets`` many, whose belief is not over one target's cell.
+        The most fundamental reason first: any prior with ``search.targets`` many (whose
+        belief is not over one target's cell); values that are not numbers; a count other
+        than one per cell (rows x cols, row-major); then the first weight not finite, below
+        0, or all of them 0 (:func:`~ipomdp_gaze.model.belief.prior_from_weights`).
 
     """
     weights = values.get('belief.prior')
     if weights is None or len(weights) == 0:
         return None
-    weights = np.asarray(list(weights), dtype=float)
-    if weights.size != grid.n_cells:
-        raise ValueError(f'belief.prior must hold one weight per cell, {grid.n_cells} values '
-                         f'for a {grid.rows}x{grid.cols} grid (row-major; none: uniform), got '
-                         f'{weights.size}')
-    try:
-        prior = prior_from_weights(weights)
-    except ValueError as exc:
-        raise ValueError(f'belief.prior {exc}') from None
     if values.get('search.targets', 'one') == 'many':
         raise ValueError(NO_PRIOR_WITH_MANY)
-    return prior
+    try:
+        weights = np.asarray(list(weights), dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f'belief.prior must be numbers, one weight per cell, got '
+                         f'{_shown(weights)}') from None
+    if weights.ndim != 1 or weights.size != grid.n_cells:
+        raise ValueError(f'belief.prior must hold one weight per cell, {grid.n_cells} values '
+                         f'for a {grid.rows}x{grid.cols} grid (row-major; none: uniform), got '
+                         f'{len(weights)}')
+    try:
+        return prior_from_weights(weights, grid.shape)
+    except ValueError as exc:
+        raise ValueError(f'belief.prior {exc}') from None
+
+
+def _shown(value) -> str:
+    """Return ``repr(value)`` cut to 40 characters, for a one-line message."""
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + '...'
 
 
 def observation_from(values: Mapping, grid: Grid, fpoc):
