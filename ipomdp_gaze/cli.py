@@ -163,6 +163,15 @@ class _ReaderGone:
         return getattr(self._stream, name)
 
 
+TOO_LARGE = ('ipomdp-gaze {}: error: out of memory: the task is too large for this machine (a '
+             'smaller --grid or fewer --episodes)')
+# numpy's refusals of an array too large to describe (a count such as --episodes 1e21 sizes
+# it), before any memory is asked for: the same task too large as a MemoryError.
+NUMPY_TOO_LARGE = ('Maximum allowed dimension exceeded',
+                   'array is too big; `arr.size * arr.dtype.itemsize` is larger than the '
+                   'maximum possible size.')
+
+
 def _run(args) -> int:
     """Run the parsed command; its errors as one line (exit 2)."""
     handles = args.command in WORK_COMMANDS and \
@@ -178,11 +187,13 @@ def _run(args) -> int:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     except (CliError, ValueError, OSError) as exc:
-        print(f'ipomdp-gaze {args.command}: error: {exc}', file=sys.stderr)
+        if isinstance(exc, ValueError) and str(exc) in NUMPY_TOO_LARGE:
+            print(TOO_LARGE.format(args.command), file=sys.stderr)
+        else:
+            print(f'ipomdp-gaze {args.command}: error: {exc}', file=sys.stderr)
         return 2
     except MemoryError:
-        print(f'ipomdp-gaze {args.command}: error: out of memory: the task is too large for '
-              f'this machine (a smaller --grid or fewer --episodes)', file=sys.stderr)
+        print(TOO_LARGE.format(args.command), file=sys.stderr)
         return 2
     except Terminated:
         return 143

@@ -300,8 +300,8 @@ def test_logistic_errors(tmp_path):
 
 @pytest.mark.parametrize('text,message', [
     ('grid: [unclosed', r'not YAML at line 1'),
-    ('- 1\n- 2\n', 'a policy file must be a YAML mapping, got list'),
-    ('', 'a policy file must be a YAML mapping, got NoneType'),
+    ('- 1\n- 2\n', 'a policy file must be a YAML mapping, got a list'),
+    ('', r'a policy file must be a YAML mapping, got nothing \(an empty document\)'),
     ('!!python/object/apply:os.system ["echo hi"]\n', 'not YAML'),
 ])
 def test_not_a_policy_document(tmp_path, text, message):

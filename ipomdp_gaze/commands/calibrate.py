@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import math
 from pathlib import Path
 import sys
 import time
@@ -38,8 +39,8 @@ from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.wording import counted
 import numpy as np
 
-from .common import check_output_file, grid_arg, nonneg_int, output_file, positive_float, \
-    positive_int, size_arg
+from .common import check_output_file, grid_arg, nonneg_int, number_arg, output_file, \
+    positive_float, positive_int, size_arg
 from .running import add_run_args, executor_from_args, progress_from_args
 
 # The two tasks of the face issue: image side and face sizes in pixels.
@@ -47,12 +48,20 @@ TASKS = {'paper': (420, (60, 140)), 'small': (840, (24, 140))}
 
 
 def _numbers(kind):
+    """Parse comma-separated numbers (``1/7`` too) for argparse; ``int``: whole ones only."""
+    what = 'whole numbers' if kind is int else 'numbers'
+
     def parse(text: str):
         try:
-            return tuple(kind(eval_fraction(part)) for part in text.split(','))
-        except (ValueError, ZeroDivisionError):
-            raise argparse.ArgumentTypeError(f'expected comma-separated numbers, got '
-                                             f'{text!r}') from None
+            values = [eval_fraction(part) for part in text.split(',')]
+        except (ValueError, ZeroDivisionError, OverflowError):
+            values = None
+        # a whole number: 2.5 is not cut to 2, infinity not an OverflowError
+        whole = values is not None and all(math.isfinite(v) and v == int(v) for v in values)
+        if values is None or (kind is int and not whole):
+            raise argparse.ArgumentTypeError(f'expected comma-separated {what}, got '
+                                             f'{text!r}')
+        return tuple(kind(v) for v in values)
     return parse
 
 
@@ -89,7 +98,7 @@ def add_parser(sub):
     p.add_argument('--task', choices=tuple(TASKS), default=None,
                    help='scene size and face sizes of --scenes: paper (420 px, faces 60-140) '
                         'or small (840 px, faces 24-140); default paper')
-    p.add_argument('--absent-rate', type=float, default=None,
+    p.add_argument('--absent-rate', type=number_arg, default=None,
                    help='fraction of --scenes without a face (default 0)')
     p.add_argument('--seed', type=nonneg_int, default=0, help='scene seed (default 0)')
     p.add_argument('--grid', type=grid_arg, default=None,
@@ -140,14 +149,14 @@ def add_parser(sub):
                    help='--cells grouped: fixed increasing edges on the support (K is then '
                         'their number + R + 2); default: K - 1 - R bins at quantiles of the '
                         'supports on the edge scenes')
-    p.add_argument('--threshold', type=float, default=None,
+    p.add_argument('--threshold', type=number_arg, default=None,
                    help='--cells threshold: the lowest score counted')
     p.add_argument('--edge-images', type=positive_int, default=20, metavar='M',
                    help='--cells score_bins: choose the bin edges on the first M training '
                         'images or scenes (default 20)')
     p.add_argument('--prior', type=positive_float, default=1.0,
                    help='Dirichlet prior per count (default 1)')
-    p.add_argument('--pool-radius', type=float, default=None,
+    p.add_argument('--pool-radius', type=number_arg, default=None,
                    help='pool target tallies of offsets within this distance in cells '
                         '(default 0.5; --pan-tilt 0: none, a view is not round)')
     p.add_argument('--min-tallies', type=nonneg_int, default=None,

@@ -112,6 +112,24 @@ def nonneg_int(text: str) -> int:
     return _int_at_least(text, 0, 'an integer from 0 to 2^63 - 1', INT64_MAX)
 
 
+def _path(text: str, what: str) -> Path:
+    """Parse a path for argparse: an empty one would be the current folder (``Path('')``)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f'an empty {what} ({text!r}: an unset shell '
+                                         'variable?)')
+    return Path(text)
+
+
+def bag_path(text: str) -> Path:
+    """Parse a bag's directory for argparse (not empty)."""
+    return _path(text, 'bag path')
+
+
+def file_arg(text: str) -> Path:
+    """Parse an input file's path for argparse (not empty)."""
+    return _path(text, 'file path')
+
+
 def positive_float(text: str) -> float:
     """Parse a finite number > 0 for argparse."""
     try:
@@ -131,6 +149,26 @@ def _number(text: str, what: str) -> float:
     if not math.isfinite(value):
         raise argparse.ArgumentTypeError(f'expected {what}, got {text!r}')
     return value
+
+
+def number_arg(text: str) -> float:
+    """
+    Parse a number for argparse (its range is the setting's check, which names the flag).
+
+    argparse's own refusal of ``type=float`` names the Python type (``invalid float value``).
+    """
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'expected a number, got {text!r}') from None
+
+
+def integer_arg(text: str) -> int:
+    """Parse a whole number for argparse (``2.5`` too is refused, not cut to 2)."""
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'expected an integer, got {text!r}') from None
 
 
 def nonneg_float(text: str) -> float:
@@ -306,7 +344,7 @@ def plot_format(path: Path, flag: str = '--plot') -> Path:
 
 def add_prior_arg(parser: argparse.ArgumentParser, use: str) -> None:
     """Add ``--prior FILE``, where the target is a priori (:func:`read_prior`); ``use``: how."""
-    parser.add_argument('--prior', type=Path, default=None, metavar='FILE',
+    parser.add_argument('--prior', type=file_arg, default=None, metavar='FILE',
                         help='where the target is a priori: a text file of ROWS lines of COLS '
                              'non-negative weights (spaces or commas; # comments), scaled to '
                              f'sum 1; {use} (default uniform)')
@@ -323,8 +361,12 @@ def read_prior(path: Path, grid) -> np.ndarray:
     """
     try:
         text = Path(path).read_text(encoding='utf-8-sig')
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ValueError(f'--prior {path}: cannot read it ({exc.__class__.__name__})') from None
+    except UnicodeDecodeError:
+        raise ValueError(f'--prior {path}: cannot read it (not UTF-8 text)') from None
+    except OSError as exc:
+        raise ValueError(f'--prior {path}: cannot read it '
+                         f'({"a folder, not a file" if Path(path).is_dir() else exc.strerror})'
+                         ) from None
     rows = []
     for line in text.splitlines():
         line = line.split('#', 1)[0].replace(',', ' ').split()

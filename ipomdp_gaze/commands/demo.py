@@ -24,7 +24,8 @@ from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.vision.pan_tilt import parse_faces
 from ipomdp_gaze.vision.walks import DURATION_S as DEMO_DURATION_S
 
-from .common import check_output_file, nonneg_int, output_file, positive_float, positive_int
+from .common import check_output_file, nonneg_int, number_arg, output_file, positive_float, \
+    positive_int
 from .record import add_split_args
 
 # --motion walk: the walking speed unless --speed-deg-s says (the offline evaluation's default).
@@ -63,10 +64,10 @@ def add_parser(sub):
                         'the camera clock; the last line scores the frames with the face in '
                         'reach: kept in view P%% of frames, centre cell C%%, lost L, '
                         'reacquired R')
-    p.add_argument('--speed-deg-s', type=float, default=None, metavar='V',
+    p.add_argument('--speed-deg-s', type=number_arg, default=None, metavar='V',
                    help=f'--motion walk: walking speed in degrees per second, 0-20 (default '
                         f'{DEMO_SPEED_DEG_S:g})')
-    p.add_argument('--duration-s', type=float, default=None, metavar='D',
+    p.add_argument('--duration-s', type=number_arg, default=None, metavar='D',
                    help=f'--motion walk: length of the walk and of the demo in seconds of the '
                         f'camera clock, 1-3600 (default {DEMO_DURATION_S:g}, the offline '
                         f"walks' length)")

@@ -43,7 +43,8 @@ from ipomdp_gaze.vision.walks import SPEED_DEG_S as WALK_SPEED_DEG_S
 import numpy as np
 
 from .common import (add_prior_arg, add_task_args, bootstrap_count, check_output_file,
-                     nonneg_int, output_file, positive_int, read_prior, task_from_args)
+                     nonneg_int, number_arg, output_file, positive_int, read_prior,
+                     task_from_args)
 from .running import add_run_args, executor_from_args, progress_from_args
 from .search_args import add_scene_args, add_search_args, settings_from_args
 
@@ -89,10 +90,10 @@ def add_parser(sub):
                    help='--scenes pan-tilt: still faces (default) or faces that walk (the '
                         'tracker of config/faces_camera_tracking.yaml against '
                         'track-last-detection on the same walks, docs/design.md section 12)')
-    p.add_argument('--speed-deg-s', type=float, default=None, metavar='V',
+    p.add_argument('--speed-deg-s', type=number_arg, default=None, metavar='V',
                    help='--motion walk: walking speed in degrees per second, 0-20 (default '
                         f'{WALK_SPEED_DEG_S:g})')
-    p.add_argument('--walk-duration-s', type=float, default=None, metavar='S',
+    p.add_argument('--walk-duration-s', type=number_arg, default=None, metavar='S',
                    help=f'--motion walk: seconds per walk, at most 3600 (default '
                         f'{WALK_DURATION_S:g})')
     p.add_argument('--scene-model', default='', metavar='FILE',

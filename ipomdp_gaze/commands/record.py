@@ -19,6 +19,7 @@ from pathlib import Path
 
 from ipomdp_gaze.model.wording import counted
 
+from .common import bag_path
 from .search_args import add_search_args
 
 
@@ -30,7 +31,7 @@ def add_parser(sub):
                     'model files, to a rosbag2 bag (metadata.yaml and MCAP, as ros2 bag record '
                     '-s mcap writes) at PATH, until Ctrl-C or SIGTERM. Same as `ros2 run '
                     'ipomdp_gaze recorder --ros-args -p path:=PATH`.')
-    p.add_argument('path', type=Path, metavar='PATH', help='the bag directory to create')
+    p.add_argument('path', type=bag_path, metavar='PATH', help='the bag directory to create')
     p.add_argument('--topics', default=None, metavar='T1,T2',
                    help='relative topics to record (default: every search topic)')
     p.add_argument('--compression', choices=('none', 'zstd'), default='none',
@@ -50,7 +51,7 @@ def add_parser(sub):
                     '1 MiB: the messages of the last one, not yet written, are lost); the '
                     "recorder's custom data (package version, parameters, file hashes, "
                     'namespace) is taken from the files. Then replay and read_bag read it.')
-    p.add_argument('path', type=Path, metavar='PATH', help='the bag directory')
+    p.add_argument('path', type=bag_path, metavar='PATH', help='the bag directory')
     p.add_argument('--force', action='store_true',
                    help='rebuild metadata.yaml also when the bag has one')
     p.set_defaults(run=run_reindex)
@@ -64,7 +65,7 @@ def add_parser(sub):
                     'and last decision differ from the recording. The frames were '
                     'taken where the recorded search looked, so the replay stops at the first '
                     'fixation that differs.')
-    p.add_argument('path', type=Path, metavar='PATH', help='the bag directory')
+    p.add_argument('path', type=bag_path, metavar='PATH', help='the bag directory')
     p.add_argument('--observation', default=None, metavar='FILE',
                    help='another count model (path or shipped name)')
     p.add_argument('--policy', default=None, help='another policy.name')

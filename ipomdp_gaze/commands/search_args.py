@@ -18,7 +18,7 @@ from dataclasses import replace
 from ipomdp_gaze.search.session import SearchSettings
 from ipomdp_gaze.search.settings import by_key, SCHEMA
 
-from .common import cell_arg, cell_index, probability_arg
+from .common import cell_arg, cell_index, integer_arg, number_arg, probability_arg
 
 # A flag left at this default keeps the command's (or its task's) own setting.
 TASK_DEFAULT = None
@@ -49,7 +49,7 @@ def add_search_args(parser: argparse.ArgumentParser, defaults: SearchSettings | 
             kwargs['action'] = argparse.BooleanOptionalAction
         else:
             kwargs['metavar'] = s.metavar or key.upper()
-            kwargs['type'] = {'float': float, 'int': int, 'floats': float,
+            kwargs['type'] = {'float': number_arg, 'int': integer_arg, 'floats': number_arg,
                               'cell': cell_arg, 'str': str}[s.kind]
             if s.kind == 'floats':
                 kwargs['nargs'] = '+'

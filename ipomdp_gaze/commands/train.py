@@ -17,8 +17,8 @@ from ipomdp_gaze.model.belief import prior_is_uniform
 from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.search.session import SearchSettings
 
-from .common import (add_prior_arg, add_task_args, check_output_file, nonneg_int, output_file,
-                     positive_float, positive_int, read_prior, task_from_args)
+from .common import (add_prior_arg, add_task_args, check_output_file, nonneg_int, number_arg,
+                     output_file, positive_float, positive_int, read_prior, task_from_args)
 from .running import add_run_args, executor_from_args, progress_from_args
 from .search_args import add_scene_args, settings_from_args
 
@@ -55,7 +55,7 @@ def add_parser(sub):
                    help='anneal the step size as lr / (1 + epoch / TAU) (default: constant)')
     p.add_argument('--reward-scale', type=positive_float, default=None,
                    help=f'factor applied to every reward (default {REWARD_SCALE})')
-    p.add_argument('--beta', type=float, default=None, help='eligibility trace decay (0.75)')
+    p.add_argument('--beta', type=number_arg, default=None, help='eligibility trace decay (0.75)')
     p.add_argument('--baseline', dest='baseline', action='store_true', default=None,
                    help='subtract a per-time-step reward baseline (the default)')
     p.add_argument('--no-baseline', dest='baseline', action='store_false',

@@ -112,6 +112,19 @@ def read_yaml(path: Path, error: type[ValueError], shipped: bool = False):
         raise error(f'{path}: YAML nested too deeply to read') from None
 
 
+def yaml_kind(doc) -> str:
+    """Name what a YAML document is in the words of YAML, not Python's (``NoneType``)."""
+    if doc is None:
+        return 'nothing (an empty document)'
+    if isinstance(doc, bool):
+        return 'true or false'
+    if isinstance(doc, (int, float)):
+        return f'the number {doc!r}'
+    if isinstance(doc, str):
+        return 'one line of text' if '\n' not in doc else 'text'
+    return {list: 'a list'}.get(type(doc), f'a {type(doc).__name__}')
+
+
 def check_header(doc, what: str, fmt: str, required, keys, error: type[ValueError]) -> None:
     """
     Check a document is a mapping with every required key, no unknown key and the format string.
@@ -123,7 +136,7 @@ def check_header(doc, what: str, fmt: str, required, keys, error: type[ValueErro
 
     """
     if not isinstance(doc, dict):
-        raise error(f'{what} must be a YAML mapping, got {type(doc).__name__}')
+        raise error(f'{what} must be a YAML mapping, got {yaml_kind(doc)}')
     for key in required:
         if key not in doc:
             raise error(f'missing key {key}')
