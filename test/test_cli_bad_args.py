@@ -37,7 +37,7 @@ def _one_line(run, command: str) -> str:
      "argument --max-fixations: expected an integer, got '1.5'"),
     (['replay', 'bag', '--confidence', 'x'], "argument --confidence: expected a number, got 'x'"),
     (['calibrate', '--scenes', '1', '--out', 'x.yaml', '--absent-rate', 'x'],
-     "argument --absent-rate: expected a number, got 'x'"),
+     "argument --absent-rate: expected a probability in [0, 1), got 'x'"),
     (['calibrate', '--scenes', '1', '--out', 'x.yaml', '--threshold', 'x'],
      "argument --threshold: expected a number, got 'x'"),
     (['calibrate', '--scenes', '1', '--out', 'x.yaml', '--pool-radius', 'x'],
@@ -51,6 +51,20 @@ def _one_line(run, command: str) -> str:
      "argument --face-px: expected comma-separated whole numbers, got '30,1e400'"),
     (['calibrate', '--scenes', '1', '--out', 'x.yaml', '--scales', '1/0'],
      "argument --scales: expected comma-separated numbers, got '1/0'"),
+    # tracebacks: numbers too large for OpenCV, numpy or a semaphore
+    (['calibrate', '--pan-tilt', '--scenes', '1', '--out', 'x.yaml', '--spacing-deg', '1e21'],
+     "argument --spacing-deg: expected degrees in (0, 90], got '1e21'"),
+    (['calibrate', '--scenes', '1', '--out', 'x.yaml', '--fixation-stride', str(10 ** 21)],
+     f"argument --fixation-stride: expected a positive integer up to 2^63 - 1, got '{10 ** 21}'"),
+    (['calibrate', '--scenes', '1', '--out', 'x.yaml', '--jobs', str(10 ** 21)],
+     f"argument --jobs: expected a number of worker processes from 1 to 4096, got '{10 ** 21}'"),
+    (['calibrate', '--scenes', '1', '--out', 'x.yaml', '--windows', str(2 ** 31)],
+     f"argument --windows: expected comma-separated whole numbers, got '{2 ** 31}'"),
+    # the Python names absent_rate and hfov_deg, said after the work began
+    (['calibrate', '--scenes', '1', '--out', 'x.yaml', '--absent-rate', '1.5'],
+     "argument --absent-rate: expected a probability in [0, 1), got '1.5'"),
+    (['calibrate', '--pan-tilt', '--scenes', '1', '--out', 'x.yaml', '--hfov-deg', '180'],
+     "argument --hfov-deg: expected degrees in (0, 180), got '180'"),
     # an empty path is not the current folder
     (['replay', ''], "argument PATH: an empty bag path ('': an unset shell variable?)"),
     (['reindex', ' '], "argument PATH: an empty bag path (' ': an unset shell variable?)"),
@@ -59,6 +73,29 @@ def _one_line(run, command: str) -> str:
 ])
 def test_a_bad_value_is_one_line_naming_the_flag(tmp_path, cli_here, argv, message):
     assert _one_line(cli_here(*argv, cwd=tmp_path), argv[0]) == message
+
+
+def test_calibrate_names_its_flags_where_the_scenes_said_python_names(tmp_path, cli_here):
+    """``face_px must be 1 <= min <= max <= the scene side, got (30, 70)`` of the default."""
+    run = cli_here('calibrate', '--pan-tilt', '--scenes', '1', '--out', 'x.yaml', '--hfov-deg',
+                   '179', cwd=tmp_path)
+    assert _one_line(run, 'calibrate') == (
+        '--face-px 30,70: faces must be MIN <= MAX pixels from 1 to 6, the side of the scene '
+        'that the grid, --camera and --hfov-deg make')
+    run = cli_here('calibrate', '--pan-tilt', '--scenes', '1', '--out', 'x.yaml', '--face-px',
+                   '-1', cwd=tmp_path)
+    assert _one_line(run, 'calibrate') == '--face-px must be MIN,MAX, got -1'
+    (tmp_path / 'labels.csv').write_text('path,x,y\n')
+    run = cli_here('calibrate', '--images', 'labels.csv', '--labels', 'labels.csv', '--out',
+                   'x.yaml', cwd=tmp_path)
+    assert _one_line(run, 'calibrate') == 'image folder labels.csv is a file, not a folder'
+    (tmp_path / 'images').mkdir()
+    (tmp_path / 'other.csv').write_text('name,u\n')
+    run = cli_here('calibrate', '--images', 'images', '--labels', 'other.csv', '--out', 'x.yaml',
+                   cwd=tmp_path)
+    assert _one_line(run, 'calibrate') == ('other.csv: header must name the columns path,x,y; '
+                                           'missing path, x, y')
+    assert not (tmp_path / 'x.yaml').exists()
 
 
 def test_reindex_of_an_empty_path_leaves_the_current_folder_alone(tmp_path, cli_here):
@@ -99,11 +136,13 @@ def test_a_yaml_file_that_is_not_a_mapping_says_what_it_is_in_yaml_words(tmp_pat
         f'{path}: an observation file must be a YAML mapping, got {kind}'
 
 
-@pytest.mark.parametrize('flag', ['--episodes', '--max-fixations', '--horizon', '--bootstrap'])
-def test_a_count_too_large_for_numpy_is_the_task_too_large(cli_here, flag):
-    """The numpy text was said: ``Maximum allowed dimension exceeded``."""
+@pytest.mark.parametrize('flag, value', [('--episodes', 2 ** 63 - 1), ('--horizon', 2 ** 63 - 1),
+                                         ('--max-fixations', 10 ** 21),
+                                         ('--bootstrap', 10 ** 21)])
+def test_a_count_too_large_for_numpy_is_the_task_too_large(cli_here, flag, value):
+    """The numpy text was said: ``Maximum allowed dimension exceeded``, ``array is too big``."""
     run = cli_here('evaluate', '--grid', '3x3', '--episodes', '3', '--jobs', '1', '--quiet',
-                   flag, str(10 ** 21))
+                   flag, str(value))
     assert _one_line(run, 'evaluate') == (
         'out of memory: the task is too large for this machine (a smaller --grid or fewer '
         '--episodes)')

@@ -39,12 +39,16 @@ from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.wording import counted
 import numpy as np
 
-from .common import check_output_file, grid_arg, nonneg_int, number_arg, output_file, \
-    positive_float, positive_int, size_arg
+from .common import check_output_file, grid_arg, jobs_arg, nonneg_int, number_arg, output_file, \
+    positive_float, positive_int, probability_arg, size_arg
 from .running import add_run_args, executor_from_args, progress_from_args
 
 # The two tasks of the face issue: image side and face sizes in pixels.
 TASKS = {'paper': (420, (60, 140)), 'small': (840, (24, 140))}
+
+
+# The largest whole number of a list flag (--windows, --face-px): OpenCV takes C ints.
+MAX_WHOLE = 2 ** 31 - 1
 
 
 def _numbers(kind):
@@ -56,12 +60,28 @@ def _numbers(kind):
             values = [eval_fraction(part) for part in text.split(',')]
         except (ValueError, ZeroDivisionError, OverflowError):
             values = None
-        # a whole number: 2.5 is not cut to 2, infinity not an OverflowError
-        whole = values is not None and all(math.isfinite(v) and v == int(v) for v in values)
+        # a whole number: 2.5 is not cut to 2, infinity not an OverflowError (nor 1e21 later)
+        whole = values is not None and all(math.isfinite(v) and v == int(v) and abs(v) <= MAX_WHOLE
+                                           for v in values)
         if values is None or (kind is int and not whole):
             raise argparse.ArgumentTypeError(f'expected comma-separated {what}, got '
                                              f'{text!r}')
         return tuple(kind(v) for v in values)
+    return parse
+
+
+def _degrees(high: float, bound: str):
+    """Parse an angle > 0 and up to ``high`` (``bound``: whether ``high`` itself is one)."""
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not (0 < value < high or (bound == 'inclusive' and value == high)):   # NaN too
+            raise argparse.ArgumentTypeError(
+                f"expected degrees in (0, {high:g}{']' if bound == 'inclusive' else ')'}, "
+                f'got {text!r}')
+        return value
     return parse
 
 
@@ -98,17 +118,17 @@ def add_parser(sub):
     p.add_argument('--task', choices=tuple(TASKS), default=None,
                    help='scene size and face sizes of --scenes: paper (420 px, faces 60-140) '
                         'or small (840 px, faces 24-140); default paper')
-    p.add_argument('--absent-rate', type=number_arg, default=None,
+    p.add_argument('--absent-rate', type=probability_arg, default=None,
                    help='fraction of --scenes without a face (default 0)')
     p.add_argument('--seed', type=nonneg_int, default=0, help='scene seed (default 0)')
     p.add_argument('--grid', type=grid_arg, default=None,
                    help='grid tiling each image (default 21x21), or the pan/tilt grid '
                         '(default 11x11)')
-    p.add_argument('--spacing-deg', type=positive_float, default=None,
+    p.add_argument('--spacing-deg', type=_degrees(90.0, 'inclusive'), default=None,
                    help='--pan-tilt: degrees between neighbouring cells (default 5)')
     p.add_argument('--camera', type=size_arg, default=None, metavar='WIDTHxHEIGHT',
                    help='--pan-tilt: camera image size in pixels (default 320x240)')
-    p.add_argument('--hfov-deg', type=positive_float, default=None,
+    p.add_argument('--hfov-deg', type=_degrees(180.0, 'exclusive'), default=None,
                    help='--pan-tilt: horizontal field of view, edge to edge (default 25)')
     p.add_argument('--face-px', type=_numbers(int), default=None, metavar='MIN,MAX',
                    help='--pan-tilt: face sides in scene pixels (default 30,70)')
@@ -165,7 +185,7 @@ def add_parser(sub):
     p.add_argument('--fixation-stride', type=positive_int, default=1, metavar='S',
                    help='fixate the cells whose row and column are multiples of S (and the '
                         'last row and column) instead of every cell (default 1: every cell)')
-    p.add_argument('--processes', dest='jobs', type=positive_int, help=argparse.SUPPRESS)
+    p.add_argument('--processes', dest='jobs', type=jobs_arg, help=argparse.SUPPRESS)
     p.add_argument('--out', type=output_file, required=True, metavar='FILE.yaml')
     p.add_argument('--plot', type=output_file, default=None, metavar='PNG',
                    help='figure of the learned FPOC (default: beside --out)')
@@ -409,7 +429,13 @@ def run_pan_tilt(args) -> int:
     geometry = SceneGeometry(grid, camera)
     face_px = tuple(args.face_px) if args.face_px else FACE_PX
     if len(face_px) != 2:
-        raise ValueError(f'--face-px must be MIN,MAX, got {args.face_px}')
+        raise ValueError(f"--face-px must be MIN,MAX, got {','.join(map(str, face_px))}")
+    side = min(geometry.size_px)
+    if not 1 <= face_px[0] <= face_px[1] <= side:
+        # (the scenes' own check named face_px, a default the user had not given, in Python)
+        raise ValueError(f'--face-px {face_px[0]},{face_px[1]}: faces must be MIN <= MAX pixels '
+                         f'from 1 to {side}, the side of the scene that the grid, --camera and '
+                         '--hfov-deg make')
     null_scenes = min(40 if args.null_scenes is None else args.null_scenes, args.scenes)
     scenes = PanTiltSceneSet('train', geometry, face_px, 'rgb', args.seed)
     detector_kwargs, detector = _detector(args)

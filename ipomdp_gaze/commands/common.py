@@ -92,8 +92,21 @@ def _int_at_least(text: str, low: int, what: str, high: int | None = None) -> in
 
 
 def positive_int(text: str) -> int:
-    """Parse an integer >= 1 for argparse."""
-    return _int_at_least(text, 1, 'a positive integer')
+    """Parse an integer from 1 to 2^63 - 1 for argparse (beyond, numpy takes it as an object)."""
+    value = _int_at_least(text, 1, 'a positive integer')
+    if value > INT64_MAX:
+        raise argparse.ArgumentTypeError(f'expected a positive integer up to 2^63 - 1, got '
+                                         f'{text!r}')
+    return value
+
+
+# The most worker processes --jobs starts on this machine (a semaphore counts them in a C int).
+MAX_JOBS = 4096
+
+
+def jobs_arg(text: str) -> int:
+    """Parse ``--jobs``: 1 to :data:`MAX_JOBS` worker processes."""
+    return _int_at_least(text, 1, f'a number of worker processes from 1 to {MAX_JOBS}', MAX_JOBS)
 
 
 # A 95% percentile interval from fewer bootstrap resamples has no 2.5% tail to speak of (one

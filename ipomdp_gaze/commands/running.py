@@ -8,12 +8,12 @@ import os
 from ipomdp_gaze.simulation.executor import make_executor, SCHEDULER_ENV
 from ipomdp_gaze.simulation.progress import Progress
 
-from .common import positive_int
+from .common import jobs_arg
 
 
 def add_run_args(p, jobs_help: str = '') -> None:
     """Add ``--jobs``, ``--scheduler`` and ``--quiet`` to a command's parser."""
-    p.add_argument('--jobs', type=positive_int, default=os.cpu_count() or 1,
+    p.add_argument('--jobs', type=jobs_arg, default=os.cpu_count() or 1,
                    help='worker processes on this machine (default: one per core; 1 runs '
                         'everything in this process; the numbers do not depend on it)'
                         + jobs_help)

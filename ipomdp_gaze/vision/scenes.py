@@ -525,7 +525,8 @@ def read_labelled_folder(folder, csv_path) -> list[LabelledImage]:
     """
     folder = Path(folder)
     if not folder.is_dir():
-        raise FileNotFoundError(f'image folder {folder} does not exist')
+        raise FileNotFoundError(f'image folder {folder} ' + (
+            'is a file, not a folder' if folder.exists() else 'does not exist'))
     csv_path = labels_path(folder, csv_path)
     try:
         return _read_labels(folder, csv_path)
@@ -541,7 +542,7 @@ def _read_labels(folder: Path, csv_path: Path) -> list[LabelledImage]:
         missing = {'path', 'x', 'y'} - set(reader.fieldnames or ())
         if missing:
             raise ValueError(f'{csv_path}: header must name the columns path,x,y; '
-                             f'missing {sorted(missing)}')
+                             f"missing {', '.join(sorted(missing))}")
         for row in reader:
             where = f'{csv_path}, line {reader.line_num}'
             name = (row['path'] or '').strip()
