@@ -60,7 +60,11 @@ def _one_line(run, command: str) -> str:
      f"argument --jobs: expected a number of worker processes from 1 to 4096, got '{10 ** 21}'"),
     (['calibrate', '--scenes', '1', '--out', 'x.yaml', '--windows', str(2 ** 31)],
      f"argument --windows: expected comma-separated whole numbers, got '{2 ** 31}'"),
-    # the Python names absent_rate and hfov_deg, said after the work began
+    (['calibrate', '--scenes', '1', '--out', 'x.yaml', '--scale-factor', '1e21'],
+     "argument --scale-factor: expected a number > 1 and at most 10, got '1e21'"),
+    # the Python names absent_rate, hfov_deg and scale_factor, said after the work began
+    (['calibrate', '--scenes', '1', '--out', 'x.yaml', '--scale-factor', '0.5'],
+     "argument --scale-factor: expected a number > 1 and at most 10, got '0.5'"),
     (['calibrate', '--scenes', '1', '--out', 'x.yaml', '--absent-rate', '1.5'],
      "argument --absent-rate: expected a probability in [0, 1), got '1.5'"),
     (['calibrate', '--pan-tilt', '--scenes', '1', '--out', 'x.yaml', '--hfov-deg', '180'],

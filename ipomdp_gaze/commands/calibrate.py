@@ -85,6 +85,22 @@ def _degrees(high: float, bound: str):
     return parse
 
 
+# The largest Haar pyramid step, the detector node's (a step of 1e21 is std::bad_alloc).
+MAX_SCALE_FACTOR = 10.0
+
+
+def _scale_factor(text: str) -> float:
+    """Parse ``--scale-factor``: detectMultiScale's pyramid step, > 1 and at most 10."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 1.0 < value <= MAX_SCALE_FACTOR:             # NaN too
+        raise argparse.ArgumentTypeError(f'expected a number > 1 and at most '
+                                         f'{MAX_SCALE_FACTOR:g}, got {text!r}')
+    return value
+
+
 def eval_fraction(text: str) -> float:
     """Read ``'0.25'`` or ``'1/7'`` as a number."""
     num, sep, den = text.strip().partition('/')
@@ -147,7 +163,7 @@ def add_parser(sub):
                         '(the shipped models), instead of in every fixation (NMPT)')
     p.add_argument('--max-count', type=positive_int, default=10,
                    help='K: counts are clipped to 0..K-1 (default 10)')
-    p.add_argument('--scale-factor', type=positive_float, default=1.1,
+    p.add_argument('--scale-factor', type=_scale_factor, default=1.1,
                    help='haar: detectMultiScale scale factor (default 1.1)')
     p.add_argument('--detector', default='haar', metavar='KIND',
                    help='detector: haar (default), yunet, an ipomdp_gaze.detectors entry point '
