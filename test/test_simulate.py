@@ -187,8 +187,8 @@ def test_with_a_blind_fpoc_the_belief_stays_at_the_prior():
 @pytest.mark.parametrize('prior, message', [
     (np.full(8, 1 / 8), 'one probability per cell, 9 values'),
     (np.full(9, 0.1), 'sum to 1, got 0.9'),
-    (np.r_[-0.1, np.full(8, 1.1 / 8)], 'finite and >= 0'),
-    (np.r_[np.nan, np.full(8, 1 / 8)], 'finite and >= 0'),
+    (np.r_[-0.1, np.full(8, 1.1 / 8)], '>= 0 in every cell, got -0.1'),
+    (np.r_[np.nan, np.full(8, 1 / 8)], 'finite in every cell, got nan'),
     (np.full((9, 1), 1 / 9), r'\(rows, cols\) = \(3, 3\) or \(9,\), got shape \(9, 1\)'),
     ('centre', "prior must be numbers, one per cell, got str 'centre'"),       # QA: no numpy
     ({'centre': 1.0}, 'prior must be numbers, one per cell, got dict'),      # message, no
