@@ -252,8 +252,8 @@ def test_a_cascade_dir_without_the_cascades_is_refused_naming_the_folder_and_the
             ('camera', 'faces-pan-tilt-ensemble', missing,
              f'detector.cascade_dir {missing} does not exist (it was to hold {frontal}, '
              f'{profile})'),
-            ('fovea', 'faces-420-yunet', missing, f'detector.cascade_dir {missing} does not '
-                                                  'exist')):
+            ('camera', 'faces-pan-tilt-40', missing, f'detector.cascade_dir {missing} does '
+                                                     f'not exist (it was to hold {frontal})')):
         with pytest.raises(ValueError) as raised:
             build_setup(mode, source, cascade_dir=str(folder))
         assert str(raised.value) == message
@@ -271,6 +271,38 @@ def test_a_cascade_dir_without_the_cascades_is_refused_naming_the_folder_and_the
     assert setup.detector.paths == [tmp_path / frontal]
     assert build_setup('fovea', cascade_dir=str(tmp_path / frontal)).detector.paths == [
         tmp_path / frontal]
+
+
+def test_a_cascade_dir_for_a_detector_without_cascades_is_refused(tmp_path, monkeypatch):
+    """A YuNet model uses no Haar cascade: a cascade_dir, existing or not, was ignored."""
+    from ipomdp_gaze.vision.detection import check_cascade_dir
+    for mode, source in (('fovea', 'faces-420-yunet'), ('camera', 'faces-pan-tilt-yunet')):
+        for folder in (tmp_path, tmp_path / 'cascades'):
+            with pytest.raises(ValueError) as raised:
+                build_setup(mode, source, cascade_dir=str(folder))
+            assert str(raised.value) == (f'detector.cascade_dir {folder} is not used: the '
+                                         f'detector of observation.file {source!r}, yunet, '
+                                         "uses no Haar cascade (leave it '')")
+    with pytest.raises(ValueError, match="'x', ensemble, uses no Haar cascade"):
+        check_cascade_dir(tmp_path, {'kind': 'ensemble', 'members': [{'kind': 'yunet'}]}, 'x')
+    # a plug-in is given the folder when its from_settings takes it, so it is not refused
+    (tmp_path / 'cascaded.py').write_text(
+        'class Takes:\n'
+        '    @classmethod\n'
+        '    def from_settings(cls, settings, cascade_dir=None):\n'
+        '        return cls()\n\n\n'
+        'class Ignores:\n'
+        '    @classmethod\n'
+        '    def from_settings(cls, settings):\n'
+        '        return cls()\n')
+    monkeypatch.syspath_prepend(str(tmp_path))
+    check_cascade_dir(tmp_path, {'kind': 'cascaded:Takes'}, 'x')
+    with pytest.raises(ValueError, match="'x', cascaded:Ignores, uses no Haar cascade"):
+        check_cascade_dir(tmp_path, {'kind': 'cascaded:Ignores'}, 'x')
+    # an ensemble with a Haar member takes it (the folder holding its cascade)
+    (tmp_path / 'mine.xml').write_text('')
+    check_cascade_dir(tmp_path, {'kind': 'ensemble', 'members': [
+        {'kind': 'yunet'}, {'kind': 'haar', 'cascade': 'mine.xml'}]}, 'x')
 
 
 def test_an_image_from_the_future_or_the_past_is_rejected_and_counted(fovea_setup):

@@ -316,6 +316,28 @@ def test_a_cascade_dir_without_the_cascade_is_refused(probe, nodes, fovea, tmp_p
         'detector.cascade_dir': ''}
 
 
+def test_a_cascade_dir_with_yunet_is_refused(probe, nodes, fovea, tmp_path):
+    """A YuNet model uses no Haar cascade: the folder was accepted and ignored (start, set)."""
+    bad = nodes.start('detector', ['-r', '__ns:=/yunetcascade', '-p',
+                                   'observation.file:=faces-420-yunet', '-p',
+                                   f'detector.cascade_dir:={tmp_path}'])
+    assert wait_for(lambda: not bad.running, 60)
+    assert bad.proc.returncode == 1
+    assert f'detector.cascade_dir {tmp_path} is not used: the detector of observation.file ' \
+        "'faces-420-yunet', yunet, uses no Haar cascade (leave it '')" in bad.output()
+    assert 'Traceback' not in bad.output()
+    nodes.killed.append(bad)                                     # exited on purpose
+    # (detector.scale_factor back at 0.0, unset: a test before may have set the file's 1.1,
+    # which YuNet's file would refuse first)
+    result = probe.set_parameters_atomically('fov/' + NODE, {
+        'observation.file': 'faces-420-yunet', 'detector.cascade_dir': str(tmp_path),
+        'detector.scale_factor': 0.0})
+    assert not result.successful
+    assert f'detector.cascade_dir {tmp_path} is not used' in result.reason
+    assert probe.get_parameters('fov/' + NODE, ['observation.file', 'detector.cascade_dir']) \
+        == {'observation.file': '', 'detector.cascade_dir': ''}
+
+
 def test_an_absurd_joint_angle_is_refused_and_counted_and_the_node_lives(camera):
     """The fault of issue 26: pan = 1e308 under the stamp of a valid image, a fixation waiting."""
     from ipomdp_gaze.model.head import PanTiltMap

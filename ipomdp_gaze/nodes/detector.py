@@ -114,8 +114,9 @@ def detector_params() -> list[Param]:
               "detectMultiScale minNeighbors (-1: the observation file's)",
               int_range=(-1, 1000)),
         Param('detector.cascade_dir', '', T.STRING,
-              'folder holding the cascades ("": cv2.data, then /usr/share/opencv4); one that '
-              'does not exist or lacks a cascade is refused'),
+              'folder holding the Haar cascades ("": cv2.data, then /usr/share/opencv4); one '
+              'that does not exist or lacks a cascade is refused, any with a detector that uses '
+              'no cascade (YuNet)'),
     ] + joint_params(limits=False) + [
         Param('joint_state_tolerance_s', 0.0, T.DOUBLE,
               'camera mode: pair an image with a joint state stamped at most this far from it '

@@ -51,6 +51,7 @@ from __future__ import annotations
 import bisect
 from collections import deque
 from dataclasses import dataclass, field
+import inspect
 import math
 from pathlib import Path
 import time
@@ -273,10 +274,16 @@ def check_cascade_dir(cascade_dir, recorded: dict, name: str) -> None:
     """
     Refuse a ``detector.cascade_dir`` that does not exist or lacks a cascade of ``recorded``.
 
-    Without the check, a cascade missing there was taken from OpenCV's installed ones unnoticed.
+    Without the check, a cascade missing there was taken from OpenCV's installed ones unnoticed;
+    and a detector that is given no cascade folder (YuNet) ignored it: that is refused too.
     ``name`` is the observation file recording the detector ``recorded``.
     """
     path = Path(cascade_dir)
+    if not _takes_cascade_dir(recorded):
+        kind = recorded.get('kind') if isinstance(recorded, dict) else None
+        raise ValueError(f'detector.cascade_dir {path} is not used: the detector of '
+                         f'observation.file {name!r}, {kind}, uses no Haar cascade (leave it '
+                         "'')")
     names = _cascade_names(recorded)
     looked = f' (it was to hold {", ".join(names)})' if names else ''
     if not path.exists():
@@ -290,6 +297,33 @@ def check_cascade_dir(cascade_dir, recorded: dict, name: str) -> None:
     if missing:
         raise ValueError(f'detector.cascade_dir {path} has no {missing[0]} (a cascade of '
                          f'observation.file {name!r}, looked for there only)')
+
+
+def _takes_cascade_dir(recorded) -> bool:
+    """
+    Whether the detector a record rebuilds is given ``cascade_dir`` (a member of it, or itself).
+
+    Haar is; YuNet is not; a plug-in is when its ``from_settings`` takes it (as
+    :func:`~ipomdp_gaze.vision.detectors.detector_from_settings` passes it). A record whose kind
+    cannot be loaded is left to the build, which names its fault.
+    """
+    from ipomdp_gaze.vision.detectors import load_factory
+    if not isinstance(recorded, dict):
+        return True
+    kind = recorded.get('kind')
+    if kind == 'ensemble':
+        members = recorded.get('members')
+        return not isinstance(members, list) or any(_takes_cascade_dir(m) for m in members)
+    if kind == 'haar':
+        return True
+    try:
+        from_settings = getattr(load_factory(kind), 'from_settings', None)
+        if not callable(from_settings):
+            return False
+        params = inspect.signature(from_settings).parameters
+    except (ValueError, TypeError):
+        return True
+    return 'cascade_dir' in params or any(p.kind == p.VAR_KEYWORD for p in params.values())
 
 
 def _cascade_names(recorded) -> list:
