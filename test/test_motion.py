@@ -149,6 +149,10 @@ def test_per_second_motion_scales_with_elapsed_time():
     log_b = np.log(np.append(np.full(25, 0.6 / 25) * np.linspace(0.1, 1.9, 25), 0.4))
     far.predict_log(log_b)
     np.testing.assert_allclose(np.exp(log_b), np.append(np.full(25, 0.6 / 25), 0.4), rtol=1e-9)
+    # A subnormal gap (5e-324 s): a step of 1e-162 cells, nothing moves (a ZeroDivisionError)
+    before = log_b.copy()
+    motion.over(5e-324).predict_log(log_b)
+    np.testing.assert_allclose(log_b, before, rtol=1e-12)
 
 
 def test_axis_matrix_rows_sum_to_one_and_zero_sigma_is_identity():
@@ -156,9 +160,14 @@ def test_axis_matrix_rows_sum_to_one_and_zero_sigma_is_identity():
     np.testing.assert_array_equal(axis_transition(4, 0.0), np.eye(4))
 
 
-@pytest.mark.parametrize('sigma', [0.022, 0.025, 0.5 * (1 / 500) ** 0.5])
+@pytest.mark.parametrize('sigma', [0.022, 0.025, 0.5 * (1 / 500) ** 0.5, 1e-160, 5e-324])
 def test_a_step_below_resolution_is_exactly_the_identity_and_predicts_nothing(sigma):
-    """``g(1)`` underflows: the general formula gives the identity, and so does the shortcut."""
+    """
+    ``g(1)`` underflows: the general formula gives the identity, and so does the shortcut.
+
+    A sigma whose square is 0 (below 1e-154: a step over a subnormal time, ``0.3 *
+    sqrt(5e-324)`` cells) was a ZeroDivisionError, in a moving search's update too.
+    """
     np.testing.assert_array_equal(axis_transition(9, sigma), np.eye(9))
     np.testing.assert_array_equal(axis_transition(9, sigma), _dense_axis(9, sigma))
     grid = Grid(9, 9, 1.0)
@@ -188,8 +197,9 @@ def _dense_axis(size, sigma):
         return np.eye(size)
     x = np.arange(size)
     offset = x[None, :] - x[:, None]
-    weights = np.where(np.abs(offset) <= math.ceil(3 * sigma),
-                       np.exp(-0.5 * (offset / sigma) ** 2), 0.0)
+    with np.errstate(over='ignore'):            # a tiny sigma: exp(-inf) = 0 off the diagonal
+        weights = np.where(np.abs(offset) <= math.ceil(3 * sigma),
+                           np.exp(-0.5 * (offset / sigma) ** 2), 0.0)
     return weights / weights.sum(axis=1, keepdims=True)
 
 

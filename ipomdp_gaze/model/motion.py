@@ -73,8 +73,9 @@ def axis_transition(size: int, sigma_cells: float) -> np.ndarray:
     the same entries, row sums and quotients as evaluating it for every pair of positions.
     """
     sigma = min(check_sigma_cells(sigma_cells), size * FLAT_STEP_AXES)
-    if sigma == 0 or math.exp(-0.5 / sigma ** 2) == 0.0:
-        return np.eye(size)                     # g(1) underflows: exactly the identity
+    # g(1) underflows: exactly the identity (a sigma below 1e-154, whose square is 0, too)
+    if sigma ** 2 == 0 or math.exp(-0.5 / sigma ** 2) == 0.0:
+        return np.eye(size)
     reach = min(math.ceil(TRUNCATE_SIGMAS * sigma), size - 1)
     offset = np.arange(-reach, reach + 1)
     table = np.zeros(2 * size - 1)              # entry size - 1 + k: g(k)
