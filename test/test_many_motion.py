@@ -11,7 +11,10 @@ from __future__ import annotations
 from dataclasses import replace
 import itertools
 import math
+import os
 
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.motion import Motion, VelocityMotion
 from ipomdp_gaze.model.observation import CountObservation
@@ -22,6 +25,9 @@ from ipomdp_gaze.search.session import Frame, SearchSettings
 from ipomdp_gaze.search.tracks import GLANCE, Tracks, Turns
 import numpy as np
 import pytest
+
+# More examples with PROPERTY_EXAMPLES (make soak uses 1000); CI derandomizes (conftest.py).
+PROPERTY = settings(deadline=None, max_examples=int(os.environ.get('PROPERTY_EXAMPLES', '40')))
 
 
 def _logit(p):
@@ -338,6 +344,126 @@ def test_a_person_not_looked_at_stays_found_and_is_lost_only_where_the_head_look
     looked = np.full(grid.n_cells, 0.0)                # the frame saw every cell: nobody
     events = tracks.step(spread, spread > 1, 0.5, 2.0, values=looked)
     assert [(e['event'], e['person']) for e in events] == [('lost', 1)]
+
+
+def _track_state(tracks) -> list:
+    """Return what the people's tracks hold, their position filters' state too (plain values)."""
+    def filt(f):
+        return None if f is None else (f.started, None if f.x is None else f.x.tolist(),
+                                       f.v.tolist(), f.p.tolist())
+    return [(t.person, t.cell, t.probability, t.found, t.since_s, t.confirmed_s,
+             filt(t.position)) for t in tracks.tracks] + [tracks.next_person]
+
+
+@PROPERTY
+@given(st.integers(0, 35), st.sampled_from([math.nan, math.inf, -math.inf, -1e-9, -0.5,
+                                            1.0 + 1e-9, 2.0, 1e300]),
+       st.floats(0.0, 1.0), st.booleans())
+def test_a_probability_not_in_0_1_is_refused_naming_its_cell_and_no_track_changes(
+        cell, bad, keep, grid_shaped):
+    """
+    A NaN passed every comparison as false: a person lost and reacquired in one frame at nan.
+
+    The probability is checked before anything moves: the tracks, their numbers and their
+    position filters (predicted at the start of a step) are as they were.
+    """
+    from ipomdp_gaze.model.position_filter import walk_filter
+    grid = Grid(6, 6)
+    tracks = Tracks(grid, lambda: walk_filter(0.3, 0.1, 0.3, 0.5))
+    values = np.ones(grid.n_cells)                     # a detection at each cell's centre
+    offsets = np.zeros((grid.n_cells, 2))
+    for t_s, cells in ((0.0, [7, 28]), (0.5, [8, 28])):
+        field = _field(grid, cells)
+        tracks.step(field, field >= 0.99, 0.5, t_s, 0.5, values, offsets)
+    assert [t.position.started for t in tracks.found] == [True, True]
+    before = _track_state(tracks)
+    probability = _field(grid, [9, 27])
+    probability[cell] = bad
+    if grid_shaped:
+        probability = probability.reshape(grid.shape)
+    where = f'cell {tuple(int(v) for v in grid.cell(cell))} is {bad:g}'
+    rule = 'finite' if not math.isfinite(bad) else 'in [0, 1]'
+    for call in (lambda: tracks.step(probability, _field(grid, []) > 1, keep, 1.0, 0.5, values,
+                                     offsets),
+                 lambda: tracks.peaks(probability, keep),
+                 lambda: tracks.held(probability, cell)):
+        with pytest.raises(ValueError) as raised:
+            call()
+        assert str(raised.value) == f'probability must be {rule} in every cell: {where}'
+        assert _track_state(tracks) == before
+    # the same frame without the bad cell goes on as before: nobody lost
+    probability = _field(grid, [9, 27])
+    assert tracks.step(probability, probability >= 0.99, 0.5, 1.0, 0.5) == []
+
+
+def test_the_tracks_refuse_what_they_cannot_follow_before_any_track_changes():
+    grid = Grid(5, 5)
+    tracks = Tracks(grid)
+    field = _field(grid, [12])
+    tracks.step(field, field >= 0.99, 0.5, 0.0)
+    before = _track_state(tracks)
+    occupied = field >= 0.99
+    for args, kwargs, message in (
+            ((field[:-1], occupied[:-1], 0.5, 1.0), {},
+             r'probability must have shape \(25,\) or \(5, 5\), got \(24,\)'),
+            ((['a'] * 25, occupied, 0.5, 1.0), {}, 'probability must be numbers'),
+            ((field, field, 0.5, 1.0), {}, 'occupied must be 25 bools'),
+            ((field, occupied, math.nan, 1.0), {}, r'keep must be a probability in \[0, 1\]'),
+            ((field, occupied, 1.5, 1.0), {}, r'keep must be a probability in \[0, 1\]'),
+            ((field, occupied, 0.5, math.nan), {}, 't_s must be finite'),
+            ((field, occupied, 0.5, 1.0, -0.5), {}, 'dt_s finite and >= 0'),
+            ((field, occupied, 0.5, 1.0), {'values': np.full(25, np.inf)}, r'\+/-inf'),
+            ((field, occupied, 0.5, 1.0), {'offsets': np.zeros((25, 3))},
+             r'offsets must have shape \(25, 2\)')):
+        with pytest.raises(ValueError, match=message):
+            tracks.step(*args, **kwargs)
+        assert _track_state(tracks) == before
+    ahead = np.zeros(grid.n_cells)
+    ahead[3] = np.nan
+    with pytest.raises(ValueError, match=r'ahead must not be NaN: cell \(0, 3\) is nan'):
+        tracks.view(tracks.found[0], 0.0, ahead)
+    assert tracks.view(tracks.found[0], 0.0, np.log(field)) == 12    # log odds: the same order
+
+
+@st.composite
+def _frames_of_any_number(draw):
+    """Frames of a 5x5 grid: counts and NaN (not looked), some with one number anywhere."""
+    frames = []
+    for _ in range(draw(st.integers(1, 12))):
+        values = draw(st.lists(st.sampled_from([0.0, 1.0, 2.0, 3.0, math.nan, math.nan]),
+                               min_size=25, max_size=25))
+        if draw(st.booleans()):
+            values[draw(st.integers(0, 24))] = draw(st.floats())
+        frames.append(values)
+    return frames
+
+
+@PROPERTY
+@given(_frames_of_any_number(), st.floats(0.0, 2.0))
+def test_a_moving_search_rejects_a_bad_frame_and_keeps_its_people(frames, dt_s):
+    """
+    Only the session gives the tracks their probabilities: from a belief no frame makes NaN.
+
+    A frame a node passes on (any numbers) is applied, and the people's probabilities are
+    finite in [0, 1], or rejected with its reason and the belief and the people as they were:
+    nothing raises, so a node drops the frame with a warning and keeps its state.
+    """
+    grid = Grid(5, 5)
+    session = OccupancySession(grid, _sensor(grid), replace(MOVING, motion_track_view='position'),
+                               link=1)
+    session.reset(seed=0)
+    session.start()
+    for values in frames:
+        log_odds, people = session.log_odds.copy(), _track_state(session.tracks)
+        result = session.update(Frame(np.array(values)), dt_s=dt_s)
+        if not result.applied:
+            assert result.reason
+            np.testing.assert_array_equal(session.log_odds, log_odds)
+            assert _track_state(session.tracks) == people
+            continue
+        assert all(np.isfinite(e['probability']) and 0.0 <= e['probability'] <= 1.0
+                   for e in session.people_events)
+        assert all(0.0 <= t.probability <= 1.0 for t in session.tracks.tracks)
 
 
 def _tracked_session(settings, frames=15, cell=12, seed=0):

@@ -35,6 +35,12 @@ cell. :class:`Turns` shares the head between them: each person is looked at for
 ``motion.dwell_s`` seconds in the order found, and after each round one view (a glance) goes to
 the search for people not yet found.
 
+The occupancy probabilities each method takes are checked where they enter (:meth:`Tracks.step`,
+:meth:`~Tracks.peaks`, :meth:`~Tracks.held`, :meth:`~Tracks.view`): a ValueError names what is
+wrong (the shape, or the first cell that is NaN, infinite or outside [0, 1]) before any track
+changes. NaN would have passed every comparison as false: a person lost and reacquired in one
+frame at probability nan, or its gate's likeliest cell taken anywhere.
+
 Pure: no ROS, no clock (times arrive as seconds).
 """
 from __future__ import annotations
@@ -42,6 +48,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 
+from ipomdp_gaze.model.observation import check_evidence
 from ipomdp_gaze.model.occupancy import clusters
 from ipomdp_gaze.model.position_filter import GATE_CELLS as FILTER_GATE_CELLS
 from ipomdp_gaze.model.position_filter import measured_position, PositionFilter
@@ -78,6 +85,48 @@ class Track:
         row, col = grid.cell(self.cell)
         return {'person': self.person, 'cell': int(self.cell), 'row': int(row),
                 'col': int(col), 'probability': float(self.probability), 'found': self.found}
+
+
+def check_probability(probability, grid) -> np.ndarray:
+    """
+    Return occupancy probabilities ``P(x_j = 1)`` as float64 (N,), or raise ValueError.
+
+    One per cell, (N,) or (rows, cols), each finite and in [0, 1]; the error names the first
+    cell that is not, as ``cell (row, col)``.
+    """
+    try:
+        values = np.asarray(probability, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f'probability must be numbers, one per cell, got '
+                         f'{type(probability).__name__}') from None
+    if values.shape not in ((grid.n_cells,), (grid.rows, grid.cols)):
+        raise ValueError(f'probability must have shape ({grid.n_cells},) or ({grid.rows}, '
+                         f'{grid.cols}), got {values.shape}')
+    values = values.reshape(-1)
+    for bad, rule in ((~np.isfinite(values), 'finite'),
+                      ((values < 0) | (values > 1), 'in [0, 1]')):
+        if np.any(bad):         # a NaN first: it is neither below 0 nor above 1
+            i = int(np.argmax(bad))
+            raise ValueError(f'probability must be {rule} in every cell: cell {_rc(grid, i)} is '
+                             f'{values[i]:g}')
+    return values
+
+
+def _rc(grid, cell: int) -> tuple[int, int]:
+    """Return a cell's ``(row, col)`` as plain ints (for messages)."""
+    row, col = grid.cell(int(cell))
+    return int(row), int(col)
+
+
+def _check_keep(keep) -> float:
+    """Return the keep probability as a float in [0, 1], or raise ValueError."""
+    try:
+        value = float(keep)
+    except (TypeError, ValueError):
+        value = math.nan
+    if not 0.0 <= value <= 1.0:
+        raise ValueError(f'keep must be a probability in [0, 1], got {keep!r}')
+    return value
 
 
 def near(grid, cell: int, radius: int) -> np.ndarray:
@@ -155,8 +204,32 @@ class Tracks:
             ``{'event': 'found' | 'lost' | 'reacquired', 'person', 'cell', 'probability',
             'seconds'}`` (``seconds``: tracked before ``lost``, lost before ``reacquired``).
 
+        Raises
+        ------
+        ValueError
+            For inputs the tracks cannot follow (:func:`check_probability`, the shapes, a
+            keep outside [0, 1], times not finite, a frame with +/-inf), before any track
+            changes.
+
         """
         grid, events = self.grid, []
+        probability = check_probability(probability, grid)
+        occupied = np.asarray(occupied)
+        if occupied.dtype != bool or occupied.size != grid.n_cells:
+            raise ValueError(f'occupied must be {grid.n_cells} bools, one per cell, got '
+                             f'{occupied.dtype} of shape {occupied.shape}')
+        occupied = occupied.reshape(-1)
+        keep = _check_keep(keep)
+        if not (math.isfinite(t_s) and math.isfinite(dt_s) and dt_s >= 0):
+            raise ValueError(f't_s must be finite and dt_s finite and >= 0, got {t_s!r}, '
+                             f'{dt_s!r}')
+        if values is not None:
+            values = check_evidence(values, grid.n_cells)
+        if offsets is not None:
+            offsets = np.asarray(offsets, dtype=np.float64)
+            if offsets.shape != (grid.n_cells, 2):
+                raise ValueError(f'offsets must have shape ({grid.n_cells}, 2), got '
+                                 f'{offsets.shape}')
         taken = np.zeros(grid.n_cells, dtype=bool)
         seen = np.ones(grid.n_cells, dtype=bool) if values is None else \
             ~np.isnan(np.asarray(values, dtype=float))
@@ -169,7 +242,7 @@ class Tracks:
             window = near(grid, centre, GATE_CELLS) & ~taken
             best = assigned[i] if i in assigned else \
                 int(np.argmax(np.where(window, probability, -1.0)))
-            held = self.held(probability, best, taken)
+            held = self._held(probability, best, taken)
             confirmed = window.any() and held >= keep
             if confirmed or (window.any() and not seen[best]
                              and t_s - track.confirmed_s <= unseen_s):
@@ -182,7 +255,7 @@ class Tracks:
                     track.position.reset()          # unseen: the occupancy says where
                 continue
             track.found = False
-            track.probability = self.held(probability, track.cell, taken)
+            track.probability = self._held(probability, track.cell, taken)
             events.append(self._event('lost', track, t_s - track.since_s))
             track.since_s = float(t_s)
             if track.position is not None:
@@ -194,7 +267,7 @@ class Tracks:
             best = int(members[np.argmax(probability[members])])
             track, kind = self._who(best)
             seconds = t_s - track.since_s if kind == 'reacquired' else 0.0
-            track.cell, track.probability = best, self.held(probability, best, taken)
+            track.cell, track.probability = best, self._held(probability, best, taken)
             track.found, track.since_s, track.confirmed_s = True, float(t_s), float(t_s)
             if track.position is not None:
                 track.position.reset()
@@ -209,9 +282,10 @@ class Tracks:
 
         Cells are taken in order of probability, each one that holds at least ``keep``, is the
         likeliest of its :data:`SPILL_CELLS` neighbourhood (a tie is broken by that order) and is
-        not within it of a peak taken before (its spill-over).
+        not within it of a peak taken before (its spill-over). ValueError: as :meth:`step`.
         """
-        probability = np.asarray(probability, dtype=np.float64)
+        probability = check_probability(probability, self.grid)
+        keep = _check_keep(keep)
         with np.errstate(divide='ignore'):
             empty = np.log1p(-np.minimum(probability, 1.0))
         empty = empty.reshape(self.grid.rows, self.grid.cols)
@@ -248,7 +322,15 @@ class Tracks:
         return {int(r): int(peaks[c]) for r, c in zip(rows, cols) if gated[r, c]}
 
     def held(self, probability: np.ndarray, cell: int, taken: np.ndarray | None = None) -> float:
-        """Return whether someone is within SPILL_CELLS of ``cell``: ``1 - prod (1 - P_j)``."""
+        """
+        Return whether someone is within SPILL_CELLS of ``cell``: ``1 - prod (1 - P_j)``.
+
+        ValueError: as :meth:`step`.
+        """
+        return self._held(check_probability(probability, self.grid), cell, taken)
+
+    def _held(self, probability: np.ndarray, cell: int, taken: np.ndarray | None = None) -> float:
+        """Return :meth:`held` of probabilities checked already."""
         cells = near(self.grid, cell, SPILL_CELLS)
         if taken is not None:
             cells &= ~taken
@@ -299,9 +381,19 @@ class Tracks:
 
         The cell of its filter's position ``lead_s`` ahead when it has one; else the likeliest
         cell of ``ahead`` (the occupancy predicted ``lead_s`` ahead) within :data:`GATE_CELLS`
-        of it; else its cell.
+        of it; else its cell. ``ahead`` may be the log odds instead (the same order); one
+        with a NaN is refused (ValueError): it would be the likeliest cell.
         """
         grid = self.grid
+        if ahead is not None:
+            ahead = np.asarray(ahead, dtype=np.float64)
+            if ahead.size != grid.n_cells:
+                raise ValueError(f'ahead must be {grid.n_cells} numbers, one per cell, got '
+                                 f'shape {ahead.shape}')
+            ahead = ahead.reshape(-1)
+            if np.isnan(ahead).any():
+                i = int(np.argmax(np.isnan(ahead)))
+                raise ValueError(f'ahead must not be NaN: cell {_rc(grid, i)} is nan')
         if track.position is not None and track.position.started:
             rc = np.clip(np.round(track.position.ahead(lead_s)), 0,
                          [grid.rows - 1, grid.cols - 1]).astype(np.int64)
