@@ -580,3 +580,16 @@ def test_the_face_of_a_letterboxed_hd_frame_gets_the_most_detections(fovea_setup
     counts = np.nan_to_num(out.frame.counts).reshape(21, 21)
     peak = np.unravel_index(np.argmax(counts), counts.shape)
     assert max(abs(peak[0] - face[0]), abs(peak[1] - face[1])) <= 1, (peak, face, counts.max())
+
+
+def test_replay_ignores_a_recorded_cascade_dir_its_detector_never_used(tmp_path):
+    """A bag from before 0.3.8 may hold one with YuNet (accepted and ignored then): replay's."""
+    folder = tmp_path / 'cascades'
+    setup = build_setup('fovea', 'faces-420-yunet', cascade_dir=str(folder),
+                        unused_cascade_dir='ignore')
+    assert type(setup.detector) is type(build_setup('fovea', 'faces-420-yunet').detector)
+    # a detector that uses cascades still has its folder checked
+    with pytest.raises(ValueError, match=f'detector.cascade_dir {folder} does not exist'):
+        build_setup('fovea', 'faces-420', cascade_dir=str(folder), unused_cascade_dir='ignore')
+    with pytest.raises(ValueError, match="unused_cascade_dir must be 'refuse' or 'ignore'"):
+        build_setup('fovea', 'faces-420-yunet', unused_cascade_dir='skip')

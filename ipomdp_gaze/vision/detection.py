@@ -187,7 +187,7 @@ class DetectorSetup:
 
 
 def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | None = None,
-                cascade_dir=None) -> DetectorSetup:
+                cascade_dir=None, unused_cascade_dir: str = 'refuse') -> DetectorSetup:
     """
     Load the observation model of ``mode`` and build its detector and fovea (or view observer).
 
@@ -205,6 +205,10 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
     cascade_dir : str, optional
         Folder holding the cascades the file names (or a cascade file), instead of OpenCV's;
         refused if it does not exist or lacks one of them (:func:`check_cascade_dir`).
+    unused_cascade_dir : {'refuse', 'ignore'}
+        What a ``cascade_dir`` given to a detector that takes none (YuNet) gets: refused (a
+        node's parameter), or ignored (``replay``: a bag recorded before 0.3.8, whose node
+        accepted and ignored it, searches as it did).
 
     Raises
     ------
@@ -243,6 +247,11 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
             raise ValueError(f'detector.{key}: the detector {recorded.get("kind")!r} of '
                              f'observation.file {name!r} has no setting {key!r} (it has '
                              f'{", ".join(sorted(recorded))})')
+    if unused_cascade_dir not in ('refuse', 'ignore'):
+        raise ValueError(f"unused_cascade_dir must be 'refuse' or 'ignore', got "
+                         f'{unused_cascade_dir!r}')
+    if cascade_dir and unused_cascade_dir == 'ignore' and not _takes_cascade_dir(recorded):
+        cascade_dir = None
     if cascade_dir:
         check_cascade_dir(cascade_dir, recorded, name)
     differs = sorted(key for key, asked in (detector or {}).items() if asked != recorded[key])
