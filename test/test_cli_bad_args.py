@@ -150,3 +150,117 @@ def test_a_count_too_large_for_numpy_is_the_task_too_large(cli_here, flag, value
     assert _one_line(run, 'evaluate') == (
         'out of memory: the task is too large for this machine (a smaller --grid or fewer '
         '--episodes)')
+
+
+class WorkBegan(Exception):
+    """The command began the work of a count (a stand-in for the work was called)."""
+
+
+def _began(monkeypatch, *targets):
+    """Make each ``module.name`` raise :class:`WorkBegan` when called."""
+    def fail(*args, **kwargs):
+        raise WorkBegan
+    for target in targets:
+        monkeypatch.setattr(target, fail)
+
+
+SCENES = 'ipomdp_gaze.vision.scenes.SceneSet'
+PAN_TILT_TALLY = 'ipomdp_gaze.vision.calibrate.tally_pan_tilt_scenes'
+TRAINER = 'ipomdp_gaze.policies.training.Trainer'
+SCENE_WORK = ('ipomdp_gaze.commands.evaluate.evaluate_scenes',
+              'ipomdp_gaze.commands.evaluate.evaluate_walks')
+BIG = str(2 ** 63 - 1)
+
+
+@pytest.mark.parametrize('argv, message, work', [
+    # run for ever (a scene, an epoch after another), or queued a piece of work per scene
+    (['calibrate', '--scenes', BIG, '--out', 'x.yaml'],
+     f"argument --scenes: expected a number of scenes from 1 to 100000, got '{BIG}'", (SCENES,)),
+    (['calibrate', '--scenes', '100001', '--out', 'x.yaml'],
+     "argument --scenes: expected a number of scenes from 1 to 100000, got '100001'", (SCENES,)),
+    (['train', '--grid', '3x3', '--epochs', BIG, '--out', 'x.yaml'],
+     f"argument --epochs: expected a number of epochs from 0 to 1000000, got '{BIG}'",
+     (TRAINER,)),
+    (['evaluate', '--scenes', 'pan-tilt', '--jobs', '1', '--episodes', BIG],
+     f'--episodes {BIG}: at most 100000 scenes with --scenes', SCENE_WORK),
+    (['evaluate', '--scenes', 'pan-tilt', '--motion', 'walk', '--jobs', '1', '--episodes',
+      '100001'], '--episodes 100001: at most 100000 walks with --scenes', SCENE_WORK),
+    (['evaluate', '--scenes', 'pan-tilt', '--jobs', '1', '--episodes', '1', '--empty-scenes',
+      BIG], f"argument --empty-scenes: expected a number of scenes from 0 to 100000, got '{BIG}'",
+     SCENE_WORK),
+    # a whole calibration, then a table the observation file cannot hold (K up to 256)
+    (['calibrate', '--scenes', '1', '--out', 'x.yaml', '--max-count', '257'],
+     'argument --max-count: expected K from 2 to 256 (the counts an observation file holds), '
+     "got '257'", (SCENES,)),
+    (['calibrate', '--pan-tilt', '--grid', '3x3', '--scenes', '1', '--out', 'x.yaml',
+      '--cells', 'grouped', '--raw-levels', '254'],
+     "argument --raw-levels: expected an integer from 0 to 253 (K is at most 256), got '254'",
+     (PAN_TILT_TALLY,)),
+    (['calibrate', '--pan-tilt', '--grid', '3x3', '--scenes', '1', '--out', 'x.yaml',
+      '--cells', 'grouped', '--group-edges', '3,6', '--raw-levels', '253'],
+     '--group-edges and --raw-levels make K = 257 counts; an observation file holds at most 256',
+     (PAN_TILT_TALLY,)),
+    # OpenCV's "integer won't fit into a C int"
+    (['calibrate', '--pan-tilt', '--grid', '3x3', '--scenes', '1', '--out', 'x.yaml',
+      '--cells', 'grouped', '--min-neighbors', str(2 ** 31)],
+     f"argument --min-neighbors: expected a positive integer up to 2^31 - 1 (OpenCV's int), "
+     f"got '{2 ** 31}'", (PAN_TILT_TALLY,)),
+    (['evaluate', '--scenes', 'pan-tilt', '--jobs', '1', '--episodes', '1',
+      '--group-min-neighbors', str(2 ** 31)],
+     f"argument --group-min-neighbors: expected an integer from 0 to 2^31 - 1 (OpenCV's int), "
+     f"got '{2 ** 31}'", SCENE_WORK),
+])
+def test_a_count_too_large_to_finish_is_refused_by_its_flag(tmp_path, cli_here, monkeypatch,
+                                                            argv, message, work):
+    """Counts up to 2^63 - 1 were taken: calibrate --scenes and train --epochs ran for ever."""
+    _began(monkeypatch, *work)
+    assert _one_line(cli_here(*argv, cwd=tmp_path), argv[0]) == message
+    assert not (tmp_path / 'x.yaml').exists()
+
+
+@pytest.mark.parametrize('argv', [
+    ['calibrate', '--scenes', '100000', '--out', 'x.yaml', '--max-count', '256'],
+    ['train', '--grid', '3x3', '--epochs', '1000000', '--out', 'x.yaml'],
+])
+def test_the_largest_count_is_taken(tmp_path, cli_here, monkeypatch, argv):
+    """The bounds are inclusive: the work begins (and is stopped here)."""
+    _began(monkeypatch, SCENES, TRAINER)
+    with pytest.raises(WorkBegan):
+        cli_here(*argv, cwd=tmp_path)
+
+
+@pytest.mark.parametrize('argv, message', [
+    (['calibrate', '--pan-tilt', '--scenes', '1', '--out', 'x.yaml', '--spacing-deg', 'inf'],
+     "argument --spacing-deg: expected degrees in (0, 90], got 'inf'"),
+    (['calibrate', '--pan-tilt', '--scenes', '1', '--out', 'x.yaml', '--hfov-deg', '0'],
+     "argument --hfov-deg: expected degrees in (0, 180), got '0'"),
+    (['calibrate', '--scenes', '1', '--out', 'x.yaml', '--scale-factor', 'nan'],
+     "argument --scale-factor: expected a number > 1 and at most 10, got 'nan'"),
+    (['record', 'bag', '--max-bag-duration-s=-inf'],
+     "argument --max-bag-duration-s: expected 0 (no split) to 3.2e+07 s, got '-inf'"),
+])
+def test_bounded_numbers_of_calibrate_and_record_say_their_range(tmp_path, cli_here, argv,
+                                                                 message):
+    assert _one_line(cli_here(*argv, cwd=tmp_path), argv[0]) == message
+
+
+def test_one_range_type_reads_every_bounded_number():
+    """The angles and pyramid step of calibrate, the split limits of record: number_in."""
+    import argparse
+    from ipomdp_gaze.commands import calibrate, record
+    from ipomdp_gaze.commands.common import number_in
+    parse = number_in(0.0, 90.0, 'degrees in (0, 90]', low_open=True)
+    assert parse('90') == 90.0 and parse(' 1e-3 ') == 0.001
+    for text in ('0', '90.5', 'nan', 'inf', '-inf', 'x', ''):
+        with pytest.raises(argparse.ArgumentTypeError) as raised:
+            parse(text)
+        assert str(raised.value) == f'expected degrees in (0, 90], got {text!r}'
+    closed = number_in(0.0, 1.0, 'a fraction')
+    assert closed('0') == 0.0 and closed('1') == 1.0
+    assert calibrate.SPACING_DEG('90') == 90.0 and calibrate.HFOV_DEG('179.5') == 179.5
+    assert calibrate.SCALE_FACTOR('10') == 10.0
+    assert record.split_limit(5.0, 's')('5') == 5.0
+    for parse, text in ((calibrate.HFOV_DEG, '180'), (calibrate.SCALE_FACTOR, '1'),
+                        (record.split_limit(5.0, 's'), '5.5')):
+        with pytest.raises(argparse.ArgumentTypeError):
+            parse(text)

@@ -34,13 +34,15 @@ from pathlib import Path
 import sys
 import time
 
+from ipomdp_gaze.files.observation_file import MAX_K
 from ipomdp_gaze.files.writable import write_figure
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.wording import counted
 import numpy as np
 
-from .common import check_output_file, grid_arg, jobs_arg, nonneg_int, number_arg, output_file, \
-    positive_float, positive_int, probability_arg, size_arg
+from .common import C_INT_MAX, check_output_file, count_in, grid_arg, jobs_arg, nonneg_int, \
+    number_arg, number_in, output_file, positive_float, positive_int, probability_arg, \
+    scene_count, size_arg
 from .running import add_run_args, executor_from_args, progress_from_args
 
 # The two tasks of the face issue: image side and face sizes in pixels.
@@ -48,7 +50,13 @@ TASKS = {'paper': (420, (60, 140)), 'small': (840, (24, 140))}
 
 
 # The largest whole number of a list flag (--windows, --face-px): OpenCV takes C ints.
-MAX_WHOLE = 2 ** 31 - 1
+MAX_WHOLE = C_INT_MAX
+# --max-count: K, the counts 0..K-1 of a cell, as many as an observation file tabulates.
+MAX_COUNT = count_in(2, MAX_K, f'K from 2 to {MAX_K} (the counts an observation file holds)')
+# --min-neighbors: detectMultiScale's minNeighbors, an OpenCV int.
+MIN_NEIGHBORS = count_in(1, C_INT_MAX, "a positive integer up to 2^31 - 1 (OpenCV's int)")
+# --raw-levels: at least one group bin and the empty cell's 0 above them within K.
+RAW_LEVELS = count_in(0, MAX_K - 3, f'an integer from 0 to {MAX_K - 3} (K is at most {MAX_K})')
 
 
 def _numbers(kind):
@@ -70,35 +78,14 @@ def _numbers(kind):
     return parse
 
 
-def _degrees(high: float, bound: str):
-    """Parse an angle > 0 and up to ``high`` (``bound``: whether ``high`` itself is one)."""
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            value = math.nan
-        if not (0 < value < high or (bound == 'inclusive' and value == high)):   # NaN too
-            raise argparse.ArgumentTypeError(
-                f"expected degrees in (0, {high:g}{']' if bound == 'inclusive' else ')'}, "
-                f'got {text!r}')
-        return value
-    return parse
-
-
 # The largest Haar pyramid step, the detector node's (a step of 1e21 is std::bad_alloc).
 MAX_SCALE_FACTOR = 10.0
-
-
-def _scale_factor(text: str) -> float:
-    """Parse ``--scale-factor``: detectMultiScale's pyramid step, > 1 and at most 10."""
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not 1.0 < value <= MAX_SCALE_FACTOR:             # NaN too
-        raise argparse.ArgumentTypeError(f'expected a number > 1 and at most '
-                                         f'{MAX_SCALE_FACTOR:g}, got {text!r}')
-    return value
+# --scale-factor: detectMultiScale's pyramid step, > 1 and at most MAX_SCALE_FACTOR.
+SCALE_FACTOR = number_in(1.0, MAX_SCALE_FACTOR, f'a number > 1 and at most {MAX_SCALE_FACTOR:g}',
+                         low_open=True)
+# --pan-tilt's angles: the cell spacing (up to a right angle) and the lens's field of view.
+SPACING_DEG = number_in(0.0, 90.0, 'degrees in (0, 90]', low_open=True)
+HFOV_DEG = number_in(0.0, 180.0, 'degrees in (0, 180)', low_open=True, high_open=True)
 
 
 def eval_fraction(text: str) -> float:
@@ -121,7 +108,7 @@ def add_parser(sub):
                    help='calibrate the pan/tilt task: a head camera looking around training '
                         'scenes (--scenes N; the shipped faces-pan-tilt model)')
     source = p.add_mutually_exclusive_group(required=True)
-    source.add_argument('--scenes', type=positive_int, metavar='N',
+    source.add_argument('--scenes', type=scene_count, metavar='N',
                         help='N generated training scenes (training faces and backgrounds only)')
     source.add_argument('--images', type=Path, metavar='FOLDER',
                         help='a folder of images, labelled by --labels')
@@ -140,11 +127,11 @@ def add_parser(sub):
     p.add_argument('--grid', type=grid_arg, default=None,
                    help='grid tiling each image (default 21x21), or the pan/tilt grid '
                         '(default 11x11)')
-    p.add_argument('--spacing-deg', type=_degrees(90.0, 'inclusive'), default=None,
+    p.add_argument('--spacing-deg', type=SPACING_DEG, default=None,
                    help='--pan-tilt: degrees between neighbouring cells (default 5)')
     p.add_argument('--camera', type=size_arg, default=None, metavar='WIDTHxHEIGHT',
                    help='--pan-tilt: camera image size in pixels (default 320x240)')
-    p.add_argument('--hfov-deg', type=_degrees(180.0, 'exclusive'), default=None,
+    p.add_argument('--hfov-deg', type=HFOV_DEG, default=None,
                    help='--pan-tilt: horizontal field of view, edge to edge (default 25)')
     p.add_argument('--face-px', type=_numbers(int), default=None, metavar='MIN,MAX',
                    help='--pan-tilt: face sides in scene pixels (default 30,70)')
@@ -161,9 +148,9 @@ def add_parser(sub):
     p.add_argument('--scan-once', action='store_true',
                    help='observe the whole-image window once per image, with its own table '
                         '(the shipped models), instead of in every fixation (NMPT)')
-    p.add_argument('--max-count', type=positive_int, default=10,
+    p.add_argument('--max-count', type=MAX_COUNT, default=10,
                    help='K: counts are clipped to 0..K-1 (default 10)')
-    p.add_argument('--scale-factor', type=_scale_factor, default=1.1,
+    p.add_argument('--scale-factor', type=SCALE_FACTOR, default=1.1,
                    help='haar: detectMultiScale scale factor (default 1.1)')
     p.add_argument('--detector', default='haar', metavar='KIND',
                    help='detector: haar (default), yunet, an ipomdp_gaze.detectors entry point '
@@ -176,9 +163,9 @@ def add_parser(sub):
                         '(default), its best score in K - 1 bins chosen on training data, '
                         'the count of detections scoring at least --threshold, or (--pan-tilt) '
                         'the support of its largest group of raw boxes grouped as OpenCV does')
-    p.add_argument('--min-neighbors', type=positive_int, default=None, metavar='N',
+    p.add_argument('--min-neighbors', type=MIN_NEIGHBORS, default=None, metavar='N',
                    help='--cells grouped: groups of at most N raw boxes are dropped (default 1)')
-    p.add_argument('--raw-levels', type=nonneg_int, default=None, metavar='R',
+    p.add_argument('--raw-levels', type=RAW_LEVELS, default=None, metavar='R',
                    help='--cells grouped: a cell without a group reads its raw count clipped '
                         'to R (default 0: it reads 0)')
     p.add_argument('--group-edges', type=_edges_arg, default=None, metavar='E1,E2,...',
@@ -409,6 +396,10 @@ def _cell_rule(args, pilot):
         neighbors = 1 if args.min_neighbors is None else args.min_neighbors
         levels = args.raw_levels or 0
         if args.group_edges is not None:
+            if len(args.group_edges) + levels + 2 > MAX_K:
+                raise ValueError(f'--group-edges and --raw-levels make K = '
+                                 f'{len(args.group_edges) + levels + 2} counts; an observation '
+                                 f'file holds at most {MAX_K}')
             return CellObservation('grouped', len(args.group_edges) + levels + 2,
                                    args.group_edges, min_neighbors=neighbors, raw_levels=levels)
         if levels > args.max_count - 3:

@@ -109,6 +109,28 @@ def jobs_arg(text: str) -> int:
     return _int_at_least(text, 1, f'a number of worker processes from 1 to {MAX_JOBS}', MAX_JOBS)
 
 
+def count_in(low: int, high: int, what: str):
+    """Return an argparse type: a whole number from ``low`` to ``high``; ``what`` words it."""
+    def parse(text: str) -> int:
+        return _int_at_least(text, low, what, high)
+    return parse
+
+
+# The most scenes a command searches or tallies (calibrate --scenes, evaluate --scenes'
+# --episodes and --empty-scenes): at a second or so of detector time each, more than a day on
+# one core, 500 times the 200 the shipped models were calibrated on. A count beyond ran for
+# ever, a piece of work queued per scene, instead of being refused.
+MAX_SCENES = 100_000
+# The most epochs train runs (the shipped kernels took at most 7700): a day or so of a 7x7
+# grid's training; 2^63 - 1 ran for ever.
+MAX_EPOCHS = 1_000_000
+# The largest C int, OpenCV's: detectMultiScale's minNeighbors (a larger one was OpenCV's
+# "integer won't fit into a C int").
+C_INT_MAX = 2 ** 31 - 1
+
+scene_count = count_in(1, MAX_SCENES, f'a number of scenes from 1 to {MAX_SCENES}')
+
+
 # A 95% percentile interval from fewer bootstrap resamples has no 2.5% tail to speak of (one
 # resample gives the estimate twice).
 MIN_BOOTSTRAP = 10
@@ -143,25 +165,33 @@ def file_arg(text: str) -> Path:
     return _path(text, 'file path')
 
 
-def positive_float(text: str) -> float:
-    """Parse a finite number > 0 for argparse."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'expected a positive number, got {text!r}') from None
-    if not math.isfinite(value) or value <= 0:
-        raise argparse.ArgumentTypeError(f'expected a positive number, got {text!r}')
-    return value
+def number_in(low: float, high: float, what: str, low_open: bool = False,
+              high_open: bool = False):
+    """
+    Return an argparse type: a finite number from ``low`` to ``high``, each end in or not.
+
+    ``what`` words the range for the one refusal, ``expected {what}, got 'text'``, of text
+    that is no number, of NaN and infinity, and of a number outside the range.
+    """
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        above = value > low if low_open else value >= low
+        below = value < high if high_open else value <= high
+        if not (math.isfinite(value) and above and below):        # NaN too
+            raise argparse.ArgumentTypeError(f'expected {what}, got {text!r}')
+        return value
+    return parse
 
 
-def _number(text: str, what: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'expected {what}, got {text!r}') from None
-    if not math.isfinite(value):
-        raise argparse.ArgumentTypeError(f'expected {what}, got {text!r}')
-    return value
+# A finite number > 0 (a spacing, a scale, a step size).
+positive_float = number_in(0.0, math.inf, 'a positive number', low_open=True)
+# A finite number >= 0 (a motion sigma).
+nonneg_float = number_in(0.0, math.inf, 'a number >= 0')
+# A probability in [0, 1) (a jump probability, a prior, a rate).
+probability_arg = number_in(0.0, 1.0, 'a probability in [0, 1)', high_open=True)
 
 
 def number_arg(text: str) -> float:
@@ -182,22 +212,6 @@ def integer_arg(text: str) -> int:
         return int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f'expected an integer, got {text!r}') from None
-
-
-def nonneg_float(text: str) -> float:
-    """Parse a finite number >= 0 (a motion sigma) for argparse."""
-    value = _number(text, 'a number >= 0')
-    if value < 0:
-        raise argparse.ArgumentTypeError(f'expected a number >= 0, got {text!r}')
-    return value
-
-
-def probability_arg(text: str) -> float:
-    """Parse a probability in [0, 1) (a jump probability, a prior, a rate) for argparse."""
-    value = _number(text, 'a probability in [0, 1)')
-    if not 0 <= value < 1:
-        raise argparse.ArgumentTypeError(f'expected a probability in [0, 1), got {text!r}')
-    return value
 
 
 def fpoc_param(text: str) -> tuple[str, object]:

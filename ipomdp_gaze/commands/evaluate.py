@@ -42,15 +42,18 @@ from ipomdp_gaze.vision.walks import DURATION_S as WALK_DURATION_S
 from ipomdp_gaze.vision.walks import SPEED_DEG_S as WALK_SPEED_DEG_S
 import numpy as np
 
-from .common import (add_prior_arg, add_task_args, bootstrap_count, check_output_file,
-                     nonneg_int, number_arg, output_file, positive_int, read_prior,
-                     task_from_args)
+from .common import (add_prior_arg, add_task_args, bootstrap_count, C_INT_MAX,
+                     check_output_file, count_in, MAX_SCENES, nonneg_int, number_arg, output_file,
+                     positive_int, read_prior, task_from_args)
 from .running import add_run_args, executor_from_args, progress_from_args
 from .search_args import add_scene_args, add_search_args, settings_from_args
 
 NO_PREDICTION = ' (no prediction)'
 # --episodes when not given: simulated episodes, scenes of --scenes, walks of --motion walk.
 EPISODES, SCENE_EPISODES, WALK_EPISODES = 20000, 200, 100
+EMPTY_SCENES = count_in(0, MAX_SCENES, f'a number of scenes from 0 to {MAX_SCENES}')
+# detectMultiScale's minNeighbors, an OpenCV int
+GROUP_MIN_NEIGHBORS = count_in(0, C_INT_MAX, "an integer from 0 to 2^31 - 1 (OpenCV's int)")
 
 
 def add_parser(sub):
@@ -77,7 +80,7 @@ def add_parser(sub):
     p.add_argument('--split', choices=('train', 'test'), default=None,
                    help='--scenes: training scenes (for every choice) or held-out test scenes '
                         '(default)')
-    p.add_argument('--empty-scenes', type=nonneg_int, default=None, metavar='M',
+    p.add_argument('--empty-scenes', type=EMPTY_SCENES, default=None, metavar='M',
                    help='--scenes pan-tilt: also M scenes without a face (the same photo crops), '
                         'reported apart per background')
     p.add_argument('--faces', default='1', metavar='K|LO-HI',
@@ -100,7 +103,7 @@ def add_parser(sub):
                    help='--scenes pan-tilt: another pan/tilt observation file (its camera is the '
                         "scene camera's; with --motion walk, the tracker's instead of its "
                         "configuration's observation.file)")
-    p.add_argument('--group-min-neighbors', type=nonneg_int, default=None, metavar='N',
+    p.add_argument('--group-min-neighbors', type=GROUP_MIN_NEIGHBORS, default=None, metavar='N',
                    help="--scenes pan-tilt, one face: the grouping (detectMultiScale's "
                         'min_neighbors) the views report for search.group_stop, as the '
                         "detector node's publish_groups (default: the model's, config/"
@@ -327,6 +330,18 @@ def check_settings(args) -> SearchSettings:
     return settings_from_args(args, SearchSettings())
 
 
+def _scene_episodes(args, default: int, what: str) -> int:
+    """
+    Return ``--episodes`` of ``--scenes`` (``default`` if not given): at most :data:`MAX_SCENES`.
+
+    A piece of work is queued per scene (or walk): 2^63 - 1 of them filled the memory.
+    """
+    episodes = args.episodes or default
+    if episodes > MAX_SCENES:
+        raise ValueError(f'--episodes {episodes}: at most {MAX_SCENES} {what} with --scenes')
+    return episodes
+
+
 def run_scenes(args) -> int:
     """``evaluate --scenes TASK``: held-out scenes through the search session (scene_eval)."""
     if len(args.policy) + len(args.policy_file) > 1:
@@ -347,7 +362,7 @@ def run_scenes(args) -> int:
     if spec.policy_file and not spec.rooms:
         # Every scene starts uniform: a file trained on a prior is said, as without --scenes.
         check_training_prior(load_policy_spec(spec.policy_file), None)
-    episodes = args.episodes or SCENE_EPISODES
+    episodes = _scene_episodes(args, SCENE_EPISODES, 'scenes')
     if args.empty_scenes and args.scenes != 'pan-tilt':
         raise ValueError('--empty-scenes is for --scenes pan-tilt')
     if args.empty_scenes and spec.rooms:
@@ -412,7 +427,7 @@ def run_walks(args) -> int:
                                              ('absent_prior', args.absent_prior))
                if value is not None}
     spec = replace(spec, settings=replace(spec.settings, **changes))
-    episodes = args.episodes or WALK_EPISODES
+    episodes = _scene_episodes(args, WALK_EPISODES, 'walks')
     with executor_from_args(args, episodes) as executor, \
             progress_from_args(args, episodes, 'walks', 'walk') as bar:
         results = evaluate_walks(spec, episodes, executor, progress=bar)

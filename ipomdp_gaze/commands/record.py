@@ -14,12 +14,11 @@ prints where the decisions differ.
 from __future__ import annotations
 
 import argparse
-import math
 from pathlib import Path
 
 from ipomdp_gaze.model.wording import counted
 
-from .common import bag_path
+from .common import bag_path, number_in
 from .search_args import add_search_args
 
 
@@ -93,17 +92,8 @@ def add_split_args(p, when: str = '') -> None:
 
 
 def split_limit(maximum: float, unit: str):
-    """Parse a split limit for argparse: 0 (no split) to ``maximum``."""
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            value = math.nan
-        if not 0.0 <= value <= maximum:             # NaN too
-            raise argparse.ArgumentTypeError(f'expected 0 (no split) to {maximum:g} {unit}, '
-                                             f'got {text!r}')
-        return value
-    return parse
+    """Return the argparse type of a split limit: 0 (no split) to ``maximum`` ``unit``."""
+    return number_in(0.0, maximum, f'0 (no split) to {maximum:g} {unit}')
 
 
 def run_record(args) -> int:

@@ -17,12 +17,14 @@ from ipomdp_gaze.model.belief import prior_is_uniform
 from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.search.session import SearchSettings
 
-from .common import (add_prior_arg, add_task_args, check_output_file, nonneg_int, number_arg,
-                     output_file, positive_float, positive_int, read_prior, task_from_args)
+from .common import (add_prior_arg, add_task_args, check_output_file, count_in, MAX_EPOCHS,
+                     nonneg_int, number_arg, output_file, positive_float, positive_int,
+                     read_prior, task_from_args)
 from .running import add_run_args, executor_from_args, progress_from_args
 from .search_args import add_scene_args, settings_from_args
 
 FAMILY_DEFAULT, REWARD_DEFAULT = 'conv', 'infomax'
+EPOCHS = count_in(0, MAX_EPOCHS, f'a number of epochs from 0 to {MAX_EPOCHS}')
 # The defaults of the learning rate and reward scale: chosen on the 7x7 human task (README).
 LEARNING_RATE = 5.0
 REWARD_SCALE = 1.0
@@ -39,7 +41,7 @@ def add_parser(sub):
                    help=f'reward (default {REWARD_DEFAULT})')
     p.add_argument('--family', choices=('conv', 'logistic'), default=None,
                    help=f'policy family (default {FAMILY_DEFAULT})')
-    p.add_argument('--epochs', type=nonneg_int, required=True,
+    p.add_argument('--epochs', type=EPOCHS, required=True,
                    help='total epochs; with --resume, training continues up to this count')
     p.add_argument('--seed', type=nonneg_int, default=None, help='training seed (default 0)')
     p.add_argument('--out', type=output_file, default=None, metavar='PATH.yaml',
