@@ -196,3 +196,46 @@ def test_reindex_rewrites_a_closed_file_whose_own_rosbag2_record_is_damaged(tmp_
     done = reindex(bag)
     assert done.recovered == {'bag.mcap': 3}
     assert [m.msg.data for m in read_bag(bag).messages] == ['hi'] * 3
+
+
+def _sqlite_bag(path: Path) -> Path:
+    """Write the bag of :func:`_bag` with rosbags' sqlite3 storage (a ``.db3`` file)."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import get_typestore, Stores
+    writer = Writer(path, version=9, storage_plugin=StoragePlugin.SQLITE3)
+    writer.open()
+    connection = writer.add_connection('/note', 'std_msgs/msg/String',
+                                       typestore=get_typestore(Stores.LATEST))
+    for i in range(3):
+        writer.write(connection, 1_000_000 * (i + 1),
+                     bytes([0, 1, 0, 0]) + (3).to_bytes(4, 'little') + b'hi\0')
+    writer.close()
+    return path
+
+
+@pytest.mark.parametrize('make, file, said, really', [
+    (_bag, 'bag.mcap', 'sqlite3', 'an MCAP file'),
+    (_sqlite_bag, 'bag.db3', 'mcap', 'an SQLite database (sqlite3 storage)'),
+])
+def test_a_bag_file_of_the_other_storage_is_one_line_saying_both(tmp_path, cli_here, make, file,
+                                                                 said, really):
+    """The reader's text was said: ``Cannot open database ...: file is not a database``."""
+    from ipomdp_gaze.commands.record import describe_written
+    from ipomdp_gaze.files.bag import read_bag, read_metadata
+    bag = make(tmp_path / 'bag')
+    _edit(bag, _set('storage_identifier', said))
+    actual = 'mcap' if said == 'sqlite3' else 'sqlite3'
+    expected = (f"{bag / file} is {really}, but {bag / 'metadata.yaml'} says "
+                f'storage_identifier: {said} (set it to {actual})')
+    for read in (read_metadata, read_bag):
+        with pytest.raises(ValueError) as raised:
+            read(bag)
+        assert str(raised.value) == expected
+    run = cli_here('replay', bag)
+    assert run.returncode == 2 and run.stdout == ''
+    assert run.stderr.strip().splitlines() == [f'ipomdp-gaze replay: error: {expected}']
+    assert describe_written(bag) == (f'ipomdp-gaze record: nothing readable was written '
+                                     f'({expected})')
+    # the advice is right: the bag reads once the key says what the file is
+    _edit(bag, _set('storage_identifier', actual))
+    assert [m.msg.data for m in read_bag(bag).messages] == ['hi'] * 3

@@ -29,7 +29,8 @@ from pathlib import Path
 import re
 import shutil
 
-from ipomdp_gaze.files.bag_metadata import check_document, check_embedded
+from ipomdp_gaze.files.bag_metadata import check_document, check_embedded, MCAP_MAGIC, \
+    StorageMismatch
 from ipomdp_gaze.files.writable import folder_writable, write_text
 import yaml
 
@@ -45,7 +46,6 @@ MAX_BAG_DURATION_S = 3.2e7
 # The MCAP metadata record of custom data written while recording (a map of key -> value).
 CUSTOM_DATA_RECORD = 'ipomdp_gaze/custom_data'
 ROSBAG2_RECORD = 'rosbag2'          # the metadata record rosbags writes at close
-MCAP_MAGIC = b'\x89MCAP0\r\n'
 
 
 def _need_rosbags() -> None:
@@ -455,7 +455,8 @@ def read_metadata(path) -> dict:
     ------
     ValueError
         One line: no ``metadata.yaml``, or a key of it missing or of the wrong type, or a file
-        it lists not in the bag (:func:`~ipomdp_gaze.files.bag_metadata.check_document`).
+        it lists not in the bag or of the other storage
+        (:func:`~ipomdp_gaze.files.bag_metadata.check_document`).
 
     """
     meta = Path(path) / 'metadata.yaml'
@@ -471,6 +472,8 @@ def read_metadata(path) -> dict:
         raise ValueError(f'{meta} is not rosbag2 metadata: not YAML text') from None
     try:
         return check_document(doc, meta, Path(path))
+    except StorageMismatch:
+        raise                           # the one key to set: no rebuild to suggest
     except ValueError as exc:
         raise ValueError(f'{exc}' + (
             f' (a damaged metadata.yaml? `ipomdp-gaze reindex --force {path}` rebuilds it from '

@@ -6,7 +6,9 @@ The check of a rosbag2 bag's metadata (``metadata.yaml``) before anything reads 
 Every key the ``rosbags`` reader, ``replay``, ``record``'s summary and ``reindex`` read, with
 its type: a damaged or hand-edited ``metadata.yaml`` is refused with one line naming the file
 and the key (``rosbag2_bagfile_information.duration.nanoseconds``), not with the reader's own
-exception text (``KeyError('duration')``) or a traceback. No rclpy here.
+exception text (``KeyError('duration')``) or a traceback; so is a file of the other storage
+than ``storage_identifier`` says (MCAP under ``sqlite3``), which the reader took for a damaged
+file of its own (``file is not a database``, ``File magic is invalid``). No rclpy here.
 """
 from __future__ import annotations
 
@@ -16,6 +18,29 @@ INFO = 'rosbag2_bagfile_information'
 MAX_VERSION = 9                     # the newest rosbag2 metadata version rosbags reads
 STORAGES = ('mcap', 'sqlite3')      # the storage plugins of the rosbags reader
 COMPRESSION_MODES = ('', 'none', 'file', 'message')
+# The first bytes of a file of each storage, and the storage in words.
+MCAP_MAGIC = b'\x89MCAP0\r\n'
+MAGICS = {'mcap': MCAP_MAGIC, 'sqlite3': b'SQLite format 3\x00'}
+STORAGE_WORDS = {'mcap': 'an MCAP file', 'sqlite3': 'an SQLite database (sqlite3 storage)'}
+
+
+class StorageMismatch(ValueError):
+    """A bag file of another storage than its metadata.yaml's ``storage_identifier``."""
+
+    def __init__(self, message: str, storage: str):
+        super().__init__(message)
+        self.storage = storage
+
+
+def file_storage(file: Path) -> str | None:
+    """
+    Return the storage a bag file is by its first bytes: ``mcap``, ``sqlite3`` or None.
+
+    None for neither (a file compressed whole, a damaged one): the reader says what it finds.
+    """
+    with open(file, 'rb') as f:
+        head = f.read(max(len(magic) for magic in MAGICS.values()))
+    return next((name for name, magic in MAGICS.items() if head.startswith(magic)), None)
 
 
 class _Keys:
@@ -75,6 +100,8 @@ def check_document(doc, meta: Path, folder: Path) -> dict:
     ------
     ValueError
         One line naming ``meta`` and the key missing or wrong, or the file listed but absent.
+    StorageMismatch
+        For a listed file of the other storage than ``storage_identifier`` (a ValueError).
 
     """
     keys = _Keys(str(meta))
@@ -93,8 +120,13 @@ def check_document(doc, meta: Path, folder: Path) -> dict:
         if not isinstance(name, str) or not name:
             keys.fail(f'{INFO}.relative_file_paths[{i}]', f'must be a file name, got '
                       f'{_shown(name)}')
-        if not (folder / PurePath(name).name).is_file():
+        file = folder / PurePath(name).name
+        if not file.is_file():
             raise ValueError(f'{meta} lists the file {name}, which is not in {folder}')
+        storage, actual = info['storage_identifier'], file_storage(file)
+        if actual is not None and actual != storage:
+            raise StorageMismatch(f'{file} is {STORAGE_WORDS[actual]}, but {meta} says '
+                                  f'storage_identifier: {storage} (set it to {actual})', actual)
     return info
 
 
