@@ -553,7 +553,8 @@ class _Task:
         try:
             self.fovea = fovea_for_model(model)
         except ValueError as exc:
-            raise ValueError(f'{name}: {exc}') from None
+            # the file given names it (the shipped models by their names)
+            raise ValueError(f'{args.observation if not shipped else name}: {exc}') from None
         self.model = model
         self.policy, policy = build_find_policy(args, model, warn)
         self.policy.select(np.exp(uniform_log_belief(model.grid.n_cells, 1)), 1,

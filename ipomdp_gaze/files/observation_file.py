@@ -32,7 +32,8 @@ import math
 from pathlib import Path
 import re
 
-from ipomdp_gaze.files.yaml_files import check_header, in_folder, plain, read_yaml, write_yaml
+from ipomdp_gaze.files.yaml_files import check_header, check_record, in_folder, plain, read_yaml, \
+    write_yaml
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.observation import CountObservation
 import numpy as np
@@ -45,6 +46,13 @@ MODELS = ('counts',)
 REQUIRED = ('format', 'model', 'grid', 'target', 'null')
 KEYS = REQUIRED + ('image', 'fovea', 'detector', 'cells', 'calibration', 'scan')
 RECORDS = ('image', 'fovea', 'detector', 'cells', 'calibration')
+# The YAML types of the records' keys checked as the file is read (check_record): the detector's
+# and the fovea's own keys are checked where they are known (ipomdp_gaze.vision), calibration is
+# free-form.
+RECORD_TYPES = {'image': {'width': 'integer', 'height': 'integer', 'view': 'text',
+                          'camera': 'mapping'},
+                'detector': {'kind': 'text'}, 'fovea': {}, 'cells': {}}
+CAMERA_TYPES = {'width': 'integer', 'height': 'integer', 'K': 'numbers'}
 MODEL_DIR = Path(str(resources.files('ipomdp_gaze').joinpath('models')))
 # Counts per cell a file may tabulate (K); far above any detector's clipped count.
 MAX_K = 256
@@ -160,6 +168,17 @@ def _scan(block) -> tuple:
     return block['target'], block['null']
 
 
+def _check_record(block: dict, key: str) -> None:
+    """Check the types of a record's keys (its camera's too): ObservationFileError if wrong."""
+    try:
+        if key in RECORD_TYPES:
+            check_record(block, RECORD_TYPES[key], key)
+        if key == 'image' and block.get('camera') is not None:
+            check_record(block['camera'], CAMERA_TYPES, 'image.camera')
+    except ValueError as exc:
+        raise ObservationFileError(str(exc)) from None
+
+
 def model_from_dict(doc, source: str = '') -> CountObservation:
     """
     Validate a parsed observation document and build its model.
@@ -180,6 +199,7 @@ def model_from_dict(doc, source: str = '') -> CountObservation:
         if block is not None and not isinstance(block, dict):
             raise ObservationFileError(f'{key} must be a mapping')
         if block is not None:
+            _check_record(block, key)
             meta[key] = dict(block)
     target, null = _table(doc, 'target', grid), _table(doc, 'null', grid)
     scan_target, scan_null = _scan(doc.get('scan'))

@@ -125,6 +125,77 @@ def yaml_kind(doc) -> str:
     return {list: 'a list'}.get(type(doc), f'a {type(doc).__name__}')
 
 
+def _number(value) -> bool:
+    return isinstance(value, (int, float, np.integer, np.floating)) and \
+        not isinstance(value, bool)
+
+
+def _integer(value) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, bool)
+
+
+def _list_of(test, value, length=None) -> bool:
+    """Tell a list (a tuple, from code rather than YAML) of items passing ``test``."""
+    return isinstance(value, (list, tuple)) and all(test(v) for v in value) and (
+        length is None or len(value) == length)
+
+
+# The types a record's keys may be declared to have (check_record): a test and its words.
+RECORD_KINDS = {
+    'text': (lambda v: isinstance(v, str), 'text'),
+    'texts': (lambda v: isinstance(v, str) or (_list_of(lambda x: isinstance(x, str), v)
+                                               and bool(v)), 'text or a list of text'),
+    'number': (_number, 'a number'),
+    'integer': (_integer, 'an integer'),
+    'flag': (lambda v: isinstance(v, bool), 'true or false'),
+    'flags': (lambda v: isinstance(v, bool) or _list_of(lambda x: isinstance(x, bool), v),
+              'true, false or a list of them'),
+    'size': (lambda v: _integer(v) or _list_of(_integer, v, 2),
+             'an integer or a [width, height] pair of integers'),
+    'pair': (lambda v: _list_of(_integer, v, 2), 'a [width, height] pair of integers'),
+    'integers': (lambda v: _list_of(_integer, v), 'a list of integers'),
+    'numbers': (lambda v: _list_of(_number, v), 'a list of numbers'),
+    'mapping': (lambda v: isinstance(v, dict), 'a mapping'),
+    'mappings': (lambda v: _list_of(lambda x: isinstance(x, dict), v) and bool(v),
+                 'a non-empty list of mappings'),
+}
+
+
+def _shown(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + '...'
+
+
+def check_record(record, types: dict, at: str) -> dict:
+    """
+    Check the YAML types of a record of a file (``detector``, ``fovea``): one line if wrong.
+
+    ``types`` maps a key to a kind of :data:`RECORD_KINDS` (a trailing ``?``: null too); other
+    keys are left to the record's reader, but every key must be text. A hand-edited record
+    reached its reader's ``float()`` or ``sorted()``, whose ``TypeError`` named neither the
+    file nor the key. Returns ``record``.
+
+    Raises
+    ------
+    ValueError
+        ``{at}.{key} must be {what}, got {value}`` (or ``{at} must be a mapping``).
+
+    """
+    if not isinstance(record, dict):
+        raise ValueError(f'{at} must be a mapping, got {yaml_kind(record)}')
+    for key, value in record.items():
+        if not isinstance(key, str):
+            raise ValueError(f'{at} must map names (text) to values, got the key {_shown(key)}')
+        kind = types.get(key)
+        if kind is None or (kind.endswith('?') and value is None):
+            continue
+        test, words = RECORD_KINDS[kind.rstrip('?')]
+        if not test(value):
+            null = ' (or null)' if kind.endswith('?') else ''
+            raise ValueError(f'{at}.{key} must be {words}{null}, got {_shown(value)}')
+    return record
+
+
 def check_header(doc, what: str, fmt: str, required, keys, error: type[ValueError]) -> None:
     """
     Check a document is a mapping with every required key, no unknown key and the format string.

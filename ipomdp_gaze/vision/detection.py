@@ -219,7 +219,7 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
     """
     from ipomdp_gaze.model.cell_observation import cell_observation_of
     from ipomdp_gaze.vision.detectors import detector_from_settings
-    from ipomdp_gaze.vision.fovea_model import fovea_for_model
+    from ipomdp_gaze.vision.fovea_model import check_records, fovea_for_model
     from ipomdp_gaze.vision.pan_tilt import ViewObserver
     if mode not in MODES:
         raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
@@ -242,6 +242,10 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
     recorded = dict(model.meta.get('detector') or {})
     if not recorded:
         raise ValueError(f'observation.file {name!r} does not record its detector')
+    try:
+        check_records(model)
+    except ValueError as exc:
+        raise ValueError(f'observation.file {name!r}: {exc}') from None
     for key, asked in (detector or {}).items():
         if key not in recorded:
             raise ValueError(f'detector.{key}: the detector {recorded.get("kind")!r} of '

@@ -338,6 +338,10 @@ class HaarDetector:
     kind = 'haar'
     color = 'gray'
     info_keys = INFO_KEYS
+    # The YAML types of its record's keys (ipomdp_gaze.files.yaml_files.check_record).
+    record_types = {'cascade': 'texts', 'cascade_sha256': 'texts', 'scale_factor': 'number',
+                    'min_neighbors': 'integer', 'min_size_px': 'size?', 'max_size_px': 'size?',
+                    'mirror': 'flags', 'window_px': 'pair', 'opencv': 'text'}
 
     def __init__(self, cascade=REFERENCE_CASCADE, scale_factor: float = 1.1,
                  min_neighbors: int = 0, min_size_px=None, max_size_px=None, cascade_dir=None,

@@ -40,6 +40,7 @@ import inspect
 import math
 import re
 
+from ipomdp_gaze.files.yaml_files import check_record
 from ipomdp_gaze.vision.detector import (COLORS, detector_settings, INFO_KEYS, KIND_ATTRIBUTE,
                                          OPTIONS_ATTRIBUTE)
 
@@ -315,6 +316,7 @@ def detector_from_settings(settings: dict, cascade_dir=None, on_note=None):
     """
     if not isinstance(settings, dict) or not settings.get('kind'):
         raise ValueError(f'detector settings must be a mapping with a kind, got {settings!r}')
+    check_detector_record(settings)
     kind = settings['kind']
     factory = load_factory(kind)
     info = info_keys_of(factory)
@@ -339,6 +341,34 @@ def detector_from_settings(settings: dict, cascade_dir=None, on_note=None):
         if on_note is not None:
             on_note(note)
     return detector
+
+
+def check_detector_record(settings, at: str = 'detector') -> dict:
+    """
+    Check the YAML types of a detector's record (an observation file's ``detector``).
+
+    Every key is text, ``kind`` a detector kind, and each key its factory declares in
+    ``record_types`` (the shipped detectors do) of its type; an ensemble's members each a
+    detector's record with an integer ``weight``. A hand-edited record was a ``TypeError``
+    from the detector's ``float()`` or ``list()``, naming neither the key nor the file.
+
+    Raises
+    ------
+    ValueError
+        ``{at}.{key} must be {what}, got {value}``.
+
+    """
+    check_record(settings, {'kind': 'text'}, at)
+    if not settings.get('kind'):
+        raise ValueError(f'{at}.kind is missing (the detector kind, e.g. haar)')
+    factory = load_factory(settings['kind'])
+    check_record(settings, getattr(factory, 'record_types', {}), at)
+    if settings['kind'] == 'ensemble':
+        for i, member in enumerate(settings.get('members') or []):
+            where = f'{at}.members[{i}]'
+            check_record(member, {'weight': 'integer'}, where)
+            check_detector_record({k: v for k, v in member.items() if k != 'weight'}, where)
+    return settings
 
 
 def parse_options(pairs) -> dict:

@@ -72,6 +72,9 @@ class EnsembleDetector:
 
     kind = 'ensemble'
     info_keys = INFO_KEYS
+    # The YAML types of its record's keys (ipomdp_gaze.files.yaml_files.check_record); each
+    # member is a detector's record with its weight (check_detector_record).
+    record_types = {'members': 'mappings', 'window_px': 'pair', 'opencv': 'text'}
 
     def __init__(self, members, cascade_dir=None):
         from ipomdp_gaze.vision.detectors import make_detector

@@ -57,6 +57,7 @@ import time
 from typing import NamedTuple
 
 import cv2
+from ipomdp_gaze.files.yaml_files import check_record
 from ipomdp_gaze.model.cell_observation import CellObservation
 from ipomdp_gaze.model.checks import positive_int as _positive_int
 from ipomdp_gaze.model.grid import Grid
@@ -73,6 +74,9 @@ INTERPOLATIONS = {
     'linear': cv2.INTER_LINEAR,
     'cubic': cv2.INTER_CUBIC,
 }
+# The YAML types of the settings of a fovea record (ipomdp_gaze.files.yaml_files.check_record).
+RECORD_TYPES = {'windows_cells': 'integers', 'scales': 'numbers?', 'max_count': 'integer',
+                'interpolation': 'text', 'scan_once': 'flag'}
 
 
 @dataclass(frozen=True)
@@ -150,8 +154,8 @@ class FoveaConfig:
         """Inverse of :meth:`to_dict`; missing keys take the defaults, unknown keys are errors."""
         if not isinstance(data, dict):
             raise ValueError(f'a fovea configuration must be a mapping, got {type(data).__name__}')
-        unknown = set(data) - {'windows_cells', 'scales', 'max_count', 'interpolation',
-                               'scan_once'}
+        check_record(data, RECORD_TYPES, 'fovea')
+        unknown = set(data) - set(RECORD_TYPES)
         if unknown:
             raise ValueError(f'unknown fovea settings: {sorted(unknown)}')
         values = dict(data)

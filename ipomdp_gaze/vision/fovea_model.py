@@ -11,8 +11,27 @@ from __future__ import annotations
 
 from ipomdp_gaze.model.cell_observation import cell_observation_of
 from ipomdp_gaze.vision.detector import detector_settings
-from ipomdp_gaze.vision.detectors import compare_settings, detector_from_settings, info_keys_of
+from ipomdp_gaze.vision.detectors import (check_detector_record, compare_settings,
+                                          detector_from_settings, info_keys_of)
 from ipomdp_gaze.vision.fovea import Fovea, FoveaConfig
+
+
+def check_records(model) -> None:
+    """
+    Check the types of the detector and fovea records a model's file gives, before they are used.
+
+    Raises
+    ------
+    ValueError
+        Naming the record's key and what it must be (``detector.scale_factor must be a
+        number, got [1]``); the caller names the file.
+
+    """
+    meta = getattr(model, 'meta', {})
+    if meta.get('detector') is not None:
+        check_detector_record(meta['detector'])
+    if meta.get('fovea') is not None:
+        FoveaConfig.from_dict(meta['fovea'])
 
 
 def check_model(model, fovea: Fovea) -> None:

@@ -97,6 +97,10 @@ class YuNetDetector:
     kind = 'yunet'
     color = 'rgb'
     info_keys = ('opencv', 'window_px')
+    # The YAML types of its record's keys (ipomdp_gaze.files.yaml_files.check_record).
+    record_types = {'model': 'text?', 'model_sha256': 'text', 'score_threshold': 'number',
+                    'nms_threshold': 'number', 'top_k': 'integer', 'upscale': 'number',
+                    'window_px': 'pair', 'opencv': 'text'}
 
     def __init__(self, model=None, score_threshold: float = 0.5, nms_threshold: float = 0.3,
                  top_k: int = 5000, upscale: float = 1.0):
