@@ -161,3 +161,30 @@ def test_the_shipped_models_pass_the_record_checks():
     from ipomdp_gaze.vision.fovea_model import check_records
     for name in shipped_observations():
         check_records(load_observation(name))
+
+
+def _ensemble_in_ensemble(recursive: bool):
+    """Make the detector an ensemble whose member is an ensemble (itself: a YAML alias)."""
+    def change(doc):
+        inner = {'kind': 'ensemble', 'members': [dict(doc['detector'], weight=1)]}
+        doc['detector'] = {'kind': 'ensemble', 'members': [inner], 'window_px': [20, 20],
+                           'opencv': doc['detector']['opencv']}
+        if recursive:
+            doc['detector']['members'][0] = doc['detector']
+    return change
+
+
+@pytest.mark.parametrize('recursive', [False, True])
+def test_an_ensemble_holding_an_ensemble_is_one_line_even_as_its_own_member(
+        tmp_path, recursive):
+    """An alias making the ensemble its own member was a RecursionError in the record check."""
+    from ipomdp_gaze.vision.detection import build_setup
+    from ipomdp_gaze.vision.detectors import detector_from_settings
+    path = _write(tmp_path, 'faces-420', _ensemble_in_ensemble(recursive))
+    assert ('*id' in path.read_text()) == recursive
+    message = 'detector.members[0]: an ensemble cannot hold an ensemble'
+    with pytest.raises(ValueError) as raised:
+        build_setup('fovea', str(path))
+    assert str(raised.value) == f'observation.file {str(path)!r}: {message}'
+    with pytest.raises(ValueError, match=r'detector\.members\[0\]: an ensemble cannot hold'):
+        detector_from_settings(yaml.safe_load(path.read_text())['detector'])

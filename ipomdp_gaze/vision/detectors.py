@@ -349,8 +349,10 @@ def check_detector_record(settings, at: str = 'detector') -> dict:
 
     Every key is text, ``kind`` a detector kind, and each key its factory declares in
     ``record_types`` (the shipped detectors do) of its type; an ensemble's members each a
-    detector's record with an integer ``weight``. A hand-edited record was a ``TypeError``
-    from the detector's ``float()`` or ``list()``, naming neither the key nor the file.
+    detector's record with an integer ``weight``, none an ensemble (a YAML alias can make an
+    ensemble its own member: checking it was a RecursionError). A hand-edited record was a
+    ``TypeError`` from the detector's ``float()`` or ``list()``, naming neither the key nor
+    the file.
 
     Raises
     ------
@@ -366,7 +368,9 @@ def check_detector_record(settings, at: str = 'detector') -> dict:
     if settings['kind'] == 'ensemble':
         for i, member in enumerate(settings.get('members') or []):
             where = f'{at}.members[{i}]'
-            check_record(member, {'weight': 'integer'}, where)
+            check_record(member, {'weight': 'integer', 'kind': 'text'}, where)
+            if member.get('kind') == settings['kind']:
+                raise ValueError(f'{where}: an ensemble cannot hold an ensemble')
             check_detector_record({k: v for k, v in member.items() if k != 'weight'}, where)
     return settings
 
