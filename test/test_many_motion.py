@@ -530,3 +530,27 @@ def test_a_moving_room_without_an_entry_model_or_a_dwell_view_is_warned_about():
     assert moving_room_warnings(entering) == []
     assert moving_room_warnings(replace(moving, motion_sigma_cells=0.0)) == []      # still
     assert moving_room_warnings(replace(moving, targets='one')) == []
+
+
+def test_a_time_step_that_takes_the_clock_past_the_largest_float_is_refused_before_any_change():
+    """
+    The clock at inf reached the tracks, which refuse an infinite time: after the belief moved.
+
+    Every later frame was refused the same way (the clock stays at inf); now the step is refused
+    before anything changes and the search goes on.
+    """
+    grid = Grid(5, 5)
+    session = OccupancySession(grid, _sensor(grid), replace(MOVING, motion_track_view='position'),
+                               link=1)
+    session.reset(seed=0)
+    session.start()
+    values = np.full(grid.n_cells, np.nan)
+    values[12] = 3.0
+    assert session.update(Frame(values), dt_s=1e308).applied
+    log_odds, people = session.log_odds.copy(), _track_state(session.tracks)
+    with pytest.raises(ValueError, match=r"dt_s 1e\+308 takes the search's clock past the "
+                                         r'largest float \(it is at 1e\+308 s\)'):
+        session.update(Frame(values), dt_s=1e308)
+    np.testing.assert_array_equal(session.log_odds, log_odds)
+    assert _track_state(session.tracks) == people
+    assert session.update(Frame(values), dt_s=1.0).applied

@@ -566,7 +566,12 @@ class OccupancySession:
         return float(self._s()['outside'])
 
     def update(self, frame: Frame, dt_s: float = 0.0) -> StepResult:
-        """Apply a frame taken at the current fixation; decide; choose the next fixation."""
+        """
+        Apply a frame taken at the current fixation; decide; choose the next fixation.
+
+        ValueError, before anything changes: ``dt_s`` not a finite number >= 0, or one that
+        takes a moving search's clock past the largest float.
+        """
         s = self._s()
         if s['fixation'] is None:
             raise OrderError('start the search (the first fixation) before updating it')
@@ -574,6 +579,10 @@ class OccupancySession:
             raise OrderError(f'the search has ended ({s["decision"]}); reset starts a new one')
         k = s['fixation']
         dt_s = check_seconds_elapsed(dt_s)
+        if self._motion.active and not math.isfinite(s['clock_s'] + dt_s):
+            # the people's tracks time their turns on it (Tracks.step refuses an infinite time)
+            raise ValueError(f"dt_s {dt_s!r} takes the search's clock past the largest float "
+                             f"(it is at {s['clock_s']!r} s)")
         try:
             obs = self.check_frame(frame.values)
             offsets = check_offsets(frame.offsets, self.grid.n_cells)
