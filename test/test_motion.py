@@ -165,7 +165,7 @@ def test_a_step_below_resolution_is_exactly_the_identity_and_predicts_nothing(si
     """
     ``g(1)`` underflows: the general formula gives the identity, and so does the shortcut.
 
-    A sigma whose square is 0 (below 1e-154: a step over a subnormal time, ``0.3 *
+    A sigma whose square is 0 (below 1.5e-162: a step over a subnormal time, ``0.3 *
     sqrt(5e-324)`` cells) was a ZeroDivisionError, in a moving search's update too.
     """
     np.testing.assert_array_equal(axis_transition(9, sigma), np.eye(9))

@@ -73,7 +73,7 @@ def axis_transition(size: int, sigma_cells: float) -> np.ndarray:
     the same entries, row sums and quotients as evaluating it for every pair of positions.
     """
     sigma = min(check_sigma_cells(sigma_cells), size * FLAT_STEP_AXES)
-    # g(1) underflows: exactly the identity (a sigma below 1e-154, whose square is 0, too)
+    # g(1) underflows: exactly the identity (a sigma below 1.5e-162, whose square is 0, too)
     if sigma ** 2 == 0 or math.exp(-0.5 / sigma ** 2) == 0.0:
         return np.eye(size)
     reach = min(math.ceil(TRUNCATE_SIGMAS * sigma), size - 1)

@@ -36,9 +36,10 @@ cell. :class:`Turns` shares the head between them: each person is looked at for
 the search for people not yet found.
 
 The occupancy probabilities each method takes are checked where they enter (:meth:`Tracks.step`,
-:meth:`~Tracks.peaks`, :meth:`~Tracks.held`, :meth:`~Tracks.view`): a ValueError names what is
-wrong (the shape, or the first cell that is NaN, infinite or outside [0, 1]) before any track
-changes. NaN would have passed every comparison as false: a person lost and reacquired in one
+:meth:`~Tracks.peaks`, :meth:`~Tracks.held`): a ValueError names what is wrong (the shape, or
+the first cell that is NaN, infinite or outside [0, 1]) before any track changes;
+:meth:`~Tracks.view` refuses an ``ahead`` (occupancy or log odds) of another shape or with a
+NaN. NaN would have passed every comparison as false: a person lost and reacquired in one
 frame at probability nan, or its gate's likeliest cell taken anywhere.
 
 Pure: no ROS, no clock (times arrive as seconds).
