@@ -188,3 +188,21 @@ def test_an_ensemble_holding_an_ensemble_is_one_line_even_as_its_own_member(
     assert str(raised.value) == f'observation.file {str(path)!r}: {message}'
     with pytest.raises(ValueError, match=r'detector\.members\[0\]: an ensemble cannot hold'):
         detector_from_settings(yaml.safe_load(path.read_text())['detector'])
+
+
+def test_a_plug_ins_own_record_types_attribute_is_not_taken_for_a_declaration(tmp_path,
+                                                                              monkeypatch):
+    """Only a map of names to the record kinds declares types; a plug-in's other one is ignored."""
+    from ipomdp_gaze.vision.detectors import check_detector_record
+    (tmp_path / 'typed.py').write_text(
+        'class Other:\n'
+        "    record_types = {'x': float}\n\n\n"
+        'class Listed:\n'
+        "    record_types = ['x']\n\n\n"
+        'class Declared:\n'
+        "    record_types = {'x': 'number'}\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    for kind in ('typed:Other', 'typed:Listed'):
+        assert check_detector_record({'kind': kind, 'x': 'text'}) == {'kind': kind, 'x': 'text'}
+    with pytest.raises(ValueError, match=r'^detector\.x must be a number, got'):
+        check_detector_record({'kind': 'typed:Declared', 'x': 'text'})

@@ -40,7 +40,7 @@ import inspect
 import math
 import re
 
-from ipomdp_gaze.files.yaml_files import check_record
+from ipomdp_gaze.files.yaml_files import check_record, RECORD_KINDS
 from ipomdp_gaze.vision.detector import (COLORS, detector_settings, INFO_KEYS, KIND_ATTRIBUTE,
                                          OPTIONS_ATTRIBUTE)
 
@@ -343,6 +343,22 @@ def detector_from_settings(settings: dict, cascade_dir=None, on_note=None):
     return detector
 
 
+def declared_types(factory) -> dict:
+    """
+    Return the ``record_types`` a detector's factory declares, or ``{}``.
+
+    Only a mapping of names to kinds of :data:`~ipomdp_gaze.files.yaml_files.RECORD_KINDS` (a
+    trailing ``?``: null too) is a declaration: a plug-in's own attribute of that name that is
+    something else says nothing of its record (it was a KeyError in the check).
+    """
+    types = getattr(factory, 'record_types', None)
+    if isinstance(types, dict) and all(
+            isinstance(k, str) and isinstance(v, str) and v.rstrip('?') in RECORD_KINDS
+            for k, v in types.items()):
+        return types
+    return {}
+
+
 def check_detector_record(settings, at: str = 'detector') -> dict:
     """
     Check the YAML types of a detector's record (an observation file's ``detector``).
@@ -364,7 +380,7 @@ def check_detector_record(settings, at: str = 'detector') -> dict:
     if not settings.get('kind'):
         raise ValueError(f'{at}.kind is missing (the detector kind, e.g. haar)')
     factory = load_factory(settings['kind'])
-    check_record(settings, getattr(factory, 'record_types', {}), at)
+    check_record(settings, declared_types(factory), at)
     if settings['kind'] == 'ensemble':
         for i, member in enumerate(settings.get('members') or []):
             where = f'{at}.members[{i}]'
