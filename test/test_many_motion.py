@@ -554,3 +554,18 @@ def test_a_time_step_that_takes_the_clock_past_the_largest_float_is_refused_befo
     np.testing.assert_array_equal(session.log_odds, log_odds)
     assert _track_state(session.tracks) == people
     assert session.update(Frame(values), dt_s=1.0).applied
+
+
+def test_a_walking_room_is_warned_about_and_a_speed_prior_without_a_walk_is_not():
+    """
+    QA: the warnings took motion.speed_cells for motion, not motion.max_speed_cells.
+
+    A walk alone (max_speed_cells, the other motion at 0) is followed as moving people, and
+    was not warned about; a speed prior without max_speed_cells moves nothing (a still room),
+    and was warned about as moving people.
+    """
+    from ipomdp_gaze.search.controller_config import moving_room_warnings
+    walking = SearchSettings(targets='many', motion_max_speed_cells=4.0)
+    assert walking.moving and len(moving_room_warnings(walking)) == 2
+    still = SearchSettings(targets='many', motion_speed_cells=1.5)
+    assert not still.moving and moving_room_warnings(still) == []

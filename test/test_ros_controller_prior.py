@@ -174,3 +174,26 @@ def test_a_moving_room_without_an_entry_model_is_said_once_while_it_lasts(contex
         assert _log_until(capfd, 'parameters set: motion.jump_prob=').count(no_entry) == 1
     finally:
         node.destroy_node()
+
+
+@pytest.mark.parametrize('motion, warned', [('max_speed_cells', True), ('speed_cells', False)])
+def test_a_walking_room_is_warned_about_and_a_still_one_is_not(context, capfd, motion, warned):
+    """
+    QA: the moving room's warnings took motion.speed_cells for motion, not max_speed_cells.
+
+    People who walk (motion.max_speed_cells alone: a velocity, followed in turn) were not
+    warned about; a still room with motion.speed_cells (unused without max_speed_cells) was
+    warned about as people with motion.
+    """
+    from rclpy.parameter import Parameter
+    no_entry = 'search.targets many with motion and no entry model'
+    capfd.readouterr()
+    node = _node(context, parameter_overrides=[
+        Parameter('search.targets', value='many'), Parameter(f'motion.{motion}', value=4.0),
+        Parameter('motion.track_view', value='peak')])
+    try:
+        log = _log_until(capfd, 'first fixation')
+        assert (no_entry in log) == warned, log
+        assert ('many moving targets' in log) == warned, log
+    finally:
+        node.destroy_node()

@@ -321,9 +321,7 @@ def moving_room_warnings(settings: SearchSettings) -> list[str]:
     one a person who comes in later is never found; and only ``motion.track_view`` peak or
     position keeps a person found in view for ``motion.dwell_s``.
     """
-    moving = (settings.motion_sigma_cells > 0 or settings.motion_jump_prob > 0
-              or settings.motion_leave_prob > 0 or settings.motion_speed_cells > 0)
-    if settings.targets != 'many' or not moving:
+    if settings.targets != 'many' or not settings.moving:     # as the session's motion is
         return []
     out = []
     if settings.motion_leave_prob == 0 and settings.motion_jump_prob == 0:
