@@ -134,10 +134,16 @@ def gave_up_status(name: str, fixations: int) -> DiagnosticStatus:
 def lost_status(name: str, row: int, col: int, cell: int, probability: float,
                 absent_probability: float, fixations: int,
                 seconds_tracked: float, person: int = 0) -> DiagnosticStatus:
-    """Build the ``lost`` event (level WARN): the tracked target (or ``person``) is not found."""
+    """
+    Build the ``lost`` event (level WARN): the tracked target (or ``person``) is not found.
+
+    ``probability`` is the most likely cell's now; a person's is that someone is at its last
+    cell (or a cell next to it) now: with others followed, the most likely cell is theirs.
+    """
     shown, nobody = max(0.0, probability), max(0.0, absent_probability)   # never '-0.0000'
+    now = 'someone at its cells now' if person else 'most likely cell now'
     message = (f'{_who(person)} lost: last found at row {row}, col {col}, tracked '
-               f'{seconds_tracked:.2f} s; most likely cell now {shown:.4f}, nobody here '
+               f'{seconds_tracked:.2f} s; {now} {shown:.4f}, nobody here '
                f'{nobody:.4f} after {counted(fixations, "fixation")}')
     return status(name, 'warn', message, {
         'row': row, 'col': col, 'cell': cell, 'probability': float(probability),

@@ -116,3 +116,20 @@ def test_a_forced_answer_at_the_confidence_is_not_said_to_be_below_it():
     assert 'below' not in msg.message and '(at the confidence 0.99' in msg.message
     msg = diagnostics.found_status('x', 5, 9, 64, -0.35, 0.0, 0.7539, 12, 'pass', 0.99)
     assert msg.message.endswith('forced by the end of its pass below the confidence 0.99')
+
+
+def test_a_persons_lost_event_says_its_own_probability_not_the_most_likely_cells():
+    """
+    QA: a person's lost said "most likely cell now 0.0317" while another was followed at 1.0.
+
+    A person's probability is that someone is at its cells (its last one or one next to it);
+    the event of one target still names the most likely cell's.
+    """
+    msg = diagnostics.lost_status('/gaze_controller: lost', 1, 2, 13, 0.0317, 0.0, 92, 0.81,
+                                  person=2)
+    assert msg.message == ('person 2 lost: last found at row 1, col 2, tracked 0.81 s; someone '
+                           'at its cells now 0.0317, nobody here 0.0000 after 92 fixations')
+    assert diagnostics.person_of(msg) == 2
+    assert diagnostics.parse_lost(msg)['probability'] == pytest.approx(0.0317)
+    one = diagnostics.lost_status('/gaze_controller: lost', 1, 2, 13, 0.0317, 0.0, 92, 0.81)
+    assert 'tracked 0.81 s; most likely cell now 0.0317, nobody here' in one.message
