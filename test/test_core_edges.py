@@ -93,8 +93,9 @@ def test_a_budget_of_zero_is_no_budget_in_first_decisions():
 
 
 def test_many_targets_on_one_cell_need_an_absent_prior():
+    """QA: the refusal named search.absent.prior, a parameter no node has (absent.prior)."""
     grid = Grid(1, 1)
-    with pytest.raises(ValueError, match='on 1 cell needs a larger search.absent.prior'):
+    with pytest.raises(ValueError, match=r'on 1 cell needs a larger absent\.prior \(got 0\)'):
         OccupancySession(grid, _gaussian(grid), SearchSettings(targets='many'))
     four = Grid(2, 2)
     with pytest.raises(ValueError, match=r'on 4 cells needs .* \(got 1e-70\)'):

@@ -197,3 +197,18 @@ def test_a_walking_room_is_warned_about_and_a_still_one_is_not(context, capfd, m
         assert ('many moving targets' in log) == warned, log
     finally:
         node.destroy_node()
+
+
+def test_an_absent_prior_too_small_for_many_targets_is_refused_by_its_name(context):
+    """QA: the refusal named search.absent.prior, a parameter the controller does not have."""
+    node = _node(context, cli_args=['--ros-args', '-p', 'grid.rows:=2', '-p', 'grid.cols:=2',
+                                    '-p', 'search.targets:=many', '-p', 'absent.prior:=0.5',
+                                    '-p', 'policy.name:=elm'])
+    try:
+        result = _set(node, absent__prior=1e-70)
+        assert not result.successful
+        assert result.reason.startswith('search.targets many on 4 cells needs a larger '
+                                        'absent.prior (got 1e-70)'), result.reason
+        assert node.get_parameter('absent.prior').value == 0.5
+    finally:
+        node.destroy_node()

@@ -64,7 +64,7 @@ def cell_prior(n_cells: int, absent_prior: float = 0.0) -> float:
     """
     Return the per-cell prior ``q``: ``P(nobody) = (1 - q)^N = absent_prior``, or ``1 / N`` for 0.
 
-    So ``search.absent.prior`` means "nobody here" in both beliefs.
+    So ``absent.prior`` means "nobody here" in both beliefs.
     """
     if absent_prior <= 0:
         return 1.0 / n_cells

@@ -98,7 +98,7 @@ def check_many_settings(settings: SearchSettings, grid=None) -> None:
     """
     if grid is not None and cell_prior(grid.n_cells, settings.absent_prior) >= 1.0:
         raise ValueError(f'search.targets many on {grid.n_cells} cell'
-                         f"{'s' * (grid.n_cells > 1)} needs a larger search.absent.prior (got "
+                         f"{'s' * (grid.n_cells > 1)} needs a larger absent.prior (got "
                          f'{settings.absent_prior:g}): with it the prior of each cell rounds to '
                          f'1, occupied for certain')
     if settings.confidence <= 0.5:
