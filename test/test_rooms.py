@@ -272,6 +272,18 @@ def test_the_scene_camera_refuses_a_room_it_would_not_show(change, said):
     assert str(caught.value).startswith(said)
 
 
+@pytest.mark.parametrize('faces', ['9', 'two', '2-1', '-1', '2.0'])
+def test_the_scene_camera_refuses_a_bad_face_count_by_its_parameter(faces):
+    """QA: the refusal said 'faces must be ...', not the parameter scene.faces."""
+    from ipomdp_gaze.nodes.scene_camera import _scene_config, scene_camera_params
+    values = {p.name: p.default for p in scene_camera_params()}
+    values['scene.faces'] = faces
+    with pytest.raises(ValueError) as caught:
+        _scene_config(values)
+    assert str(caught.value) == (f'scene.faces must be a count K or a range LO-HI with 0 <= LO '
+                                 f'<= HI <= {MAX_FACES}, got {faces!r}')
+
+
 def test_room_boxes_put_one_face_seen_from_two_views_at_one_place():
     import math
     from types import SimpleNamespace

@@ -159,7 +159,10 @@ def _scene_config(values: dict) -> SceneConfig:
     centre = None
     if values['scene.face_x_px'] >= 0 or values['scene.face_y_px'] >= 0:
         centre = (values['scene.face_x_px'], values['scene.face_y_px'])
-    room = parse_faces(values.get('scene.faces', '1')) != (1, 1)
+    try:
+        room = parse_faces(values.get('scene.faces', '1')) != (1, 1)
+    except ValueError as exc:                   # 'faces must be ...': name the parameter
+        raise ValueError(f'scene.{exc}') from None
     if view != 'pan_tilt' and room:
         raise ValueError('scene.faces is for the pan_tilt view')
     # in the node's own words (the scene set's say faces=0 and empty=True), and never ignored
