@@ -538,3 +538,24 @@ def test_a_bad_option_is_its_one_line_before_anything_is_said(cli_here, monkeypa
         assert run.stderr == ("ipomdp-gaze replay: error: --policy: unknown policy 'bogus'; "
                               'valid policies: learned, map, random, center, elm, spiral, sweep, '
                               'coverage, greedy, tempered, switching, nmpt\n'), run.stderr
+
+
+def test_a_last_search_without_a_frame_is_said_so_not_a_bag_without_frames():
+    """
+    QA: a recording stopped as a search began said the bag had no frame to replay.
+
+    A still room's re-check (or a ~/reset) just before the recorder stopped: the bag holds the
+    frames of the searches before it, and the last search, which a replay follows, has none.
+    """
+    face = 5 * 11 + 8
+    values = _parameters('faces_camera_controller.yaml')
+    first = _record(values, lambda i: {face}, 20, belief=True)
+    began = _record(values, lambda i: {face}, 0, start=1100.0, belief=True)
+    assert first.topic('evidence') and not began.topic('evidence')
+    bag = _with(first, list(began.messages))
+    with pytest.raises(ValueError) as caught:
+        replay(bag, out=lambda line: None)
+    assert str(caught.value) == (
+        'bag: its last search, from the reset at 100.0 s of the recording, has no '
+        'evidence_image or evidence frame to replay (the recording ended as it began); a '
+        'replay follows the last search of a bag')

@@ -491,6 +491,11 @@ def _frames(bag, grid: Grid, clock: StampClock | None = None) -> list:
     return frames
 
 
+def _has_frames(bag) -> bool:
+    """Whether ``bag`` holds a frame of evidence (``evidence_image`` or ``evidence``)."""
+    return bool(bag.topic('evidence_image') or bag.topic('evidence'))
+
+
 def _targets(bag, head: PanTiltMap, heads: tuple = (), frames_ns: tuple = ()) -> tuple:
     """
     Return ``(sent_s, cell)`` of each target the controller sent (re-sends dropped), re-sends.
@@ -707,7 +712,15 @@ def replay(bag, overrides: dict | None = None, out=print) -> ReplayResult:
     # stream, which the replayed core must begin fresh, as the node's did
     cut = search_start(bag, config.head, config.controller().reset(0.0))
     if cut is not None:
-        bag = dataclasses.replace(bag, messages=[m for m in bag.messages if m.time_ns >= cut])
+        searched = dataclasses.replace(bag, messages=[m for m in bag.messages
+                                                      if m.time_ns >= cut])
+        if not _has_frames(searched) and _has_frames(bag):
+            # a recording stopped as a search began (a room's re-check, a ~/reset)
+            raise ValueError(f'{bag.path}: its last search, from the reset at '
+                             f'{(cut - origin) * 1e-9:.1f} s of the recording, has no '
+                             f'evidence_image or evidence frame to replay (the recording ended '
+                             f'as it began); a replay follows the last search of a bag')
+        bag = searched
     else:                   # one search: it began with the recording
         cut = origin
     parameters = values_at(recorded_values, changes, cut)
