@@ -212,3 +212,43 @@ def test_an_absent_prior_too_small_for_many_targets_is_refused_by_its_name(conte
         assert node.get_parameter('absent.prior').value == 0.5
     finally:
         node.destroy_node()
+
+
+@pytest.mark.parametrize('decide_at_budget', [False, True])
+def test_a_still_room_that_gave_up_at_its_budget_is_not_said_done(
+        context, capfd, decide_at_budget):
+    """
+    QA: a still room's search that ran out of its budget undecided logged 'room done'.
+
+    No room_done is published after gave_up (the people are those at the confidence), so the
+    log says the search ended undecided; a decision the budget forced is a room done, as before.
+    """
+    from ipomdp_gaze.msg_adapters import grid_arrays
+    from rclpy.parameter import Parameter
+    capfd.readouterr()
+    node = _node(context, parameter_overrides=[
+        Parameter('search.targets', value='many'), Parameter('search.max_fixations', value=3),
+        Parameter('search.decide_at_budget', value=decide_at_budget),
+        Parameter('settle_time_s', value=0.0)])
+    try:
+        grid = node._config.grid
+        published = []
+        node._event_pubs['room_done'].publish = published.append
+        values = np.zeros(grid.n_cells)
+        values[[grid.index(4, 4), grid.index(6, 6)]] = 8.0       # two faces near the centre
+        _log_until(capfd, 'first fixation')
+        for _ in range(3):
+            node._on_evidence(grid_arrays.to_multiarray(values, grid), None)
+        people = '2 people{} (2 new): (4, 4) p=1.000, (6, 6) p=1.000'
+        if decide_at_budget:
+            assert node.core.decision == 'found' and len(published) == 1
+            said = f'room done (search {node.core.search_id}, found, forced by budget): '
+            assert said + people.format('') in _log_until(capfd, 'people')
+        else:
+            assert node.core.decision == 'gave_up' and published == []
+            said = f'search {node.core.search_id} ended undecided (gave_up, forced by budget): '
+            log = _log_until(capfd, 'people')
+            assert said + people.format(' at the confidence 0.95') in log and 'room done' \
+                not in log, log
+    finally:
+        node.destroy_node()

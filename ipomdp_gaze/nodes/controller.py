@@ -777,8 +777,9 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
         Publish the people and room_done of a finished many-target search; keep them in view.
 
         ``room_done`` is published when every cell was decided (``found`` or ``absent``, also
-        when the fixation budget forced it with ``search.decide_at_budget``); after ``gave_up``
-        the people are those whose cells reached the confidence.
+        when the fixation budget forced it with ``search.decide_at_budget``), and the log says
+        the room is done; after ``gave_up`` the people are those whose cells reached the
+        confidence, and the log says the search ended undecided.
         """
         core, grid = self.core, self._config.grid
         session = core.session
@@ -787,16 +788,19 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
         self._publish_people(done.people)
         kind = 're-check' if done.recheck else 'search'
         where = ', '.join(f'{grid.cell(p.cell)} p={p.probability:.3f}' for p in done.people)
+        forced = f', forced by {session.gave_up_reason}' if session.gave_up_reason else ''
+        people_found = people_text(len(done.people))
         if core.decision in ('found', 'absent'):
             self._event_pubs['room_done'].publish(diagnostics.room_done_status(
                 f'{self.get_fully_qualified_name()}: room_done', len(done.people),
                 len(done.new), core.fixations, core.search_id, done.recheck,
                 session.gave_up_reason, core.settings.confidence))
-        self.get_logger().info(
-            f'room done ({kind} {core.search_id}, {core.decision}'
-            f"{f', forced by {session.gave_up_reason}' if session.gave_up_reason else ''}): "
-            f'{people_text(len(done.people))} ({len(done.new)} new)'
-            f'{": " + where if where else ""}')
+            heading = f'room done ({kind} {core.search_id}, {core.decision}{forced})'
+        else:
+            heading = f'{kind} {core.search_id} ended undecided ({core.decision}{forced})'
+            people_found += f' at the confidence {core.settings.confidence}'
+        self.get_logger().info(f'{heading}: {people_found} ({len(done.new)} new)'
+                               f'{": " + where if where else ""}')
         self._make_room_timers(self._config.values)
         self._look_at_next()
 
