@@ -252,3 +252,21 @@ def test_a_still_room_that_gave_up_at_its_budget_is_not_said_done(
                 not in log, log
     finally:
         node.destroy_node()
+
+
+@pytest.mark.parametrize('motion, said', [
+    ({'max_speed_cells': 4.0, 'turn_prob': 0.3},
+     'random walk 0.0 cells/s, jump 0.0/s, walking up to 4.0 cells/s, turn 0.3/s'),
+    ({'sigma_cells': 0.5, 'jump_prob': 0.01}, 'random walk 0.5 cells/s, jump 0.01/s'),
+    ({'leave_prob': 0.1}, 'random walk 0.0 cells/s, jump 0.0/s, leave 0.1/s')])
+def test_the_start_up_line_names_the_motion_the_search_models(context, capfd, motion, said):
+    """QA: a target that only walks was 'a moving target (0.0 cells/s, jump 0.0/s)'."""
+    from rclpy.parameter import Parameter
+    capfd.readouterr()
+    node = _node(context, parameter_overrides=[Parameter('absent.prior', value=0.5)] + [
+        Parameter(f'motion.{name}', value=value) for name, value in motion.items()])
+    try:
+        assert f'; a moving target ({said}), absent prior 0.5,' in \
+            _log_until(capfd, 'first fixation')
+    finally:
+        node.destroy_node()

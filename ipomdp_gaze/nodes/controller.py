@@ -267,8 +267,7 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
         """Describe the target model and the stop rules for the log."""
         v = self._config.values
         motion = ('a still target' if not self.core.motion.active else
-                  f"a moving target ({v['motion.sigma_cells']} cells/s, jump "
-                  f"{v['motion.jump_prob']}/s)")
+                  f'a moving target ({_motion_text(self.core.motion.to_dict())})')
         budget = v['search.max_fixations'] or 'no'
         ior = ', inhibition of return' if v['search.inhibit_return'] else ''
         if v['search.repeat_weight'] < 1.0:
@@ -902,6 +901,23 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
         response.message = state if changed else f'already {state}'
         self.get_logger().info(f'gaze control {response.message}')
         return response
+
+
+def _motion_text(motion: dict) -> str:
+    """
+    Describe a moving target's motion (``Motion.to_dict``) for the start-up line.
+
+    The random walk and the jumps always; the walk (``motion.max_speed_cells``) and the
+    leaving (``motion.leave_prob``) when the model has them: a target that only walks or
+    leaves moves too, though its random walk and jumps are 0.
+    """
+    parts = [f"random walk {motion['sigma_cells']} cells/s, jump {motion['jump_prob']}/s"]
+    if motion.get('max_speed_cells'):
+        parts.append(f"walking up to {motion['max_speed_cells']} cells/s, turn "
+                     f"{motion['turn_prob']}/s")
+    if motion['leave_prob']:
+        parts.append(f"leave {motion['leave_prob']}/s")
+    return ', '.join(parts)
 
 
 def _values_only(msg: Float32MultiArray, grid) -> tuple:
