@@ -100,8 +100,12 @@ def test_parse_faces_reads_k_and_lo_hi(value, pair):
     assert parse_faces(value) == pair
 
 
+# Text int() takes that is not ASCII digits: a sign, an underscore, Arabic-Indic 2 and 0-4.
+NOT_ASCII_COUNTS = ['+2', '1-+3', '0_2', '1 - 3', '\u0662', '1-\u0663', '\u0660-\u0664']
+
+
 @pytest.mark.parametrize('value', ['', 'x', '3-1', '-1', '1-', '0-9', MAX_FACES + 1, 1.5,
-                                   True, None, (1, 2, 3), '1-2-3'])
+                                   True, None, (1, 2, 3), '1-2-3', *NOT_ASCII_COUNTS])
 def test_parse_faces_refuses_bad_values_with_one_message(value):
     with pytest.raises(ValueError, match=r'^faces must be a count K or a range LO-HI'):
         parse_faces(value)
@@ -147,7 +151,7 @@ def test_room_specs_take_room_searchers_only():
         task_spec('faces-420', faces=2)
 
 
-@pytest.mark.parametrize('value', ['5-2', 'x', '9'])
+@pytest.mark.parametrize('value', ['5-2', 'x', '9', '+2', '\u0662'])
 def test_evaluate_refuses_a_bad_faces_value_with_one_line(value, capsys):
     assert main(['evaluate', '--scenes', 'pan-tilt', '--faces', value, '--episodes', '1']) == 2
     err = capsys.readouterr().err.strip().splitlines()
@@ -235,6 +239,8 @@ def test_the_room_demo_of_nobody_says_so():
                                   ['--scene', 'faces', '--faces', '0-3', '--empty'],
                                   ['--scene', 'faces', '--faces', '2', '--plot', 'x.png'],
                                   ['--scene', 'faces', '--faces', '2-1'],
+                                  ['--scene', 'faces', '--faces', '+2'],
+                                  ['--scene', 'faces', '--faces', '\u0662'],
                                   ['--scene', 'faces', '--faces', '2', '--timeout', '5'],
                                   ['--scene', 'faces', '--faces', '2', '--domain-id', '220'],
                                   ['--scene', 'faces', '--faces', '0-2', '--verbose']])
@@ -272,9 +278,13 @@ def test_the_scene_camera_refuses_a_room_it_would_not_show(change, said):
     assert str(caught.value).startswith(said)
 
 
-@pytest.mark.parametrize('faces', ['9', 'two', '2-1', '-1', '2.0'])
+@pytest.mark.parametrize('faces', ['9', 'two', '2-1', '-1', '2.0', *NOT_ASCII_COUNTS])
 def test_the_scene_camera_refuses_a_bad_face_count_by_its_parameter(faces):
-    """QA: the refusal said 'faces must be ...', not the parameter scene.faces."""
+    """
+    QA: the refusal said 'faces must be ...', not the parameter scene.faces.
+
+    QA: '+2' and Arabic-Indic digits were taken as counts (int() reads them).
+    """
     from ipomdp_gaze.nodes.scene_camera import _scene_config, scene_camera_params
     values = {p.name: p.default for p in scene_camera_params()}
     values['scene.faces'] = faces

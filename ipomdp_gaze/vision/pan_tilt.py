@@ -29,6 +29,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 import os
+import re
 import time
 
 import cv2
@@ -360,9 +361,16 @@ class SceneGeometry:
                          borderMode=cv2.BORDER_REPLICATE)
 
 
+# A room's face count as text: K or LO-HI in ASCII digits.
+FACES_TEXT = re.compile(r'([0-9]+)(?:-([0-9]+))?')
+
+
 def parse_faces(value) -> tuple[int, int]:
     """
     Return a room's face count as ``(lo, hi)``: an int K, a pair, or the text ``K`` / ``LO-HI``.
+
+    The text is ASCII digits only: ``int`` alone would also take ``'+2'``, ``'0_2'`` and the
+    digits of other scripts (Arabic-Indic ones).
 
     Raises
     ------
@@ -373,8 +381,11 @@ def parse_faces(value) -> tuple[int, int]:
     text = value.strip() if isinstance(value, str) else value
     try:
         if isinstance(text, str):
-            lo, sep, hi = text.partition('-')
-            pair = (int(lo), int(hi) if sep else int(lo))
+            match = FACES_TEXT.fullmatch(text)
+            if match is None:
+                raise ValueError
+            lo, hi = match.groups()
+            pair = (int(lo), int(hi if hi is not None else lo))
         elif isinstance(text, (tuple, list)):
             pair = tuple(text)
             if len(pair) != 2:
