@@ -270,3 +270,38 @@ def test_the_start_up_line_names_the_motion_the_search_models(context, capfd, mo
             _log_until(capfd, 'first fixation')
     finally:
         node.destroy_node()
+
+
+def test_stop_on_decision_off_is_said_to_be_ignored_by_a_room(context, capfd):
+    """
+    QA: search.stop_on_decision false did nothing with search.targets many, unsaid.
+
+    The still room's search still ends when every cell is decided (room done); the warning is
+    said once while it lasts, and not with one target, which follows it.
+    """
+    from ipomdp_gaze.msg_adapters import grid_arrays
+    from rclpy.parameter import Parameter
+    ignored = 'search.stop_on_decision false is ignored with search.targets many'
+    capfd.readouterr()
+    node = _node(context, parameter_overrides=[
+        Parameter('search.targets', value='many'), Parameter('settle_time_s', value=0.0),
+        Parameter('search.stop_on_decision', value=False)])
+    try:
+        assert _log_until(capfd, 'first fixation').count(ignored) == 1
+        grid = node._config.grid
+        values = np.full(grid.n_cells, -8.0)
+        values[grid.index(5, 5)] = 8.0
+        for _ in range(grid.n_cells):
+            if node.core.stopped:
+                break
+            node._on_evidence(grid_arrays.to_multiarray(values, grid), None)
+        assert node.core.stopped and node.core.decision == 'found'
+        assert 'room done (search' in _log_until(capfd, '1 person')
+        assert _set(node, confidence=0.9).successful
+        assert ignored not in _log_until(capfd, 'parameters set: confidence=')
+        assert _set(node, search__targets='one').successful
+        assert ignored not in _log_until(capfd, 'parameters set: search.targets=')
+        assert _set(node, search__targets='many').successful
+        assert _log_until(capfd, 'parameters set: search.targets=').count(ignored) == 1
+    finally:
+        node.destroy_node()

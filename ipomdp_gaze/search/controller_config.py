@@ -179,7 +179,7 @@ class ControllerConfig:
     ``policy`` is None when the many-target search does not use it and it cannot be built for
     this task (``policy_error`` says why; :func:`build_config`).
 
-    ``warnings`` says what the configuration will not do (:func:`moving_room_warnings`, then
+    ``warnings`` says what the configuration will not do (:func:`room_warnings`, then
     ``policy_warnings``, those of building the policy, kept with it while it is reused): the
     same for as long as their cause lasts, so that a node says each once (:func:`new_warnings`).
     """
@@ -287,7 +287,7 @@ def build_config(values: Mapping, build_policy: Callable, changed=None,
     except KeyError as exc:
         raise ValueError(f'no controller parameter {exc}') from None
     return ControllerConfig(dict(values), grid, fpoc, observation, policy, head, settings,
-                            tuple(moving_room_warnings(settings) + policy_warnings), prior,
+                            tuple(room_warnings(settings) + policy_warnings), prior,
                             tuple(policy_warnings), policy_error)
 
 
@@ -310,6 +310,23 @@ def new_warnings(new: ControllerConfig, old: ControllerConfig | None) -> list[st
     """
     said = set(old.warnings) if old is not None else set()
     return [text for text in new.warnings if text not in said]
+
+
+def room_warnings(settings: SearchSettings) -> list[str]:
+    """
+    Say what a many-target search will not do with ``settings`` (warnings).
+
+    ``search.stop_on_decision`` off is ignored: a still room's search ends when every cell is
+    decided, and a moving room's never ends on a decision, whatever it says
+    (:class:`ipomdp_gaze.search.many.OccupancySession` does not read it); then the moving
+    room's (:func:`moving_room_warnings`).
+    """
+    out = []
+    if settings.targets == 'many' and not settings.stop_on_decision:
+        out.append('search.stop_on_decision false is ignored with search.targets many: a still '
+                   "room's search ends when every cell is decided, a moving room's never ends "
+                   'on a decision')
+    return out + moving_room_warnings(settings)
 
 
 def moving_room_warnings(settings: SearchSettings) -> list[str]:

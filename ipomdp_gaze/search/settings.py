@@ -251,8 +251,9 @@ SCHEMA: tuple[Setting, ...] = (
             'confidence, and that cell is the answer (0: the cell alone)',
             interval=Interval(0, MAX_FOUND_RADIUS), metavar='CELLS'),
     Setting('stop_on_decision', 'search.stop_on_decision', 'bool', True, check_flag,
-            'found and absent end a search (off: they are only reported, as for a moving target, '
-            'and the search goes on to its budget: to measure what every view would give)'),
+            'one target: found and absent end a search (off: they are only reported, as for a '
+            'moving target, and the search goes on to its budget: to measure what every view '
+            'would give; ignored with search.targets many)'),
     Setting('decide_at_budget', 'search.decide_at_budget', 'bool', False, check_flag,
             'still target: when the budget runs out undecided, say absent or found (whichever '
             'is more probable) instead of gave_up'),
