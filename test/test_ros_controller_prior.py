@@ -5,7 +5,9 @@ The controller's ``belief.prior`` on an in-process node: as written, and against
 
 Whole numbers (``-p belief.prior:=[1,2,1,...]``, YAML ``[1, 2, 1]``, a set of integers) reach
 rclpy as an integer array; the controller takes them as doubles. A policy file trained on
-another prior than the one in force is said once, as ``evaluate`` says it.
+another prior than the one in force is said once, as ``evaluate`` says it. The same in-process
+node for what the controller logs: its configuration warnings (said once while they last), its
+start-up line's motion, and how a room's search ended (done, or undecided at its budget).
 """
 from __future__ import annotations
 
