@@ -583,7 +583,7 @@ def test_the_face_of_a_letterboxed_hd_frame_gets_the_most_detections(fovea_setup
 
 
 def test_replay_ignores_a_recorded_cascade_dir_its_detector_never_used(tmp_path):
-    """A bag from before 0.3.8 may hold one with YuNet (accepted and ignored then): replay's."""
+    """A bag from before 0.3.9 may hold one with YuNet (accepted and ignored then): replay's."""
     folder = tmp_path / 'cascades'
     setup = build_setup('fovea', 'faces-420-yunet', cascade_dir=str(folder),
                         unused_cascade_dir='ignore')

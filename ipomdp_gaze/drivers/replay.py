@@ -986,7 +986,7 @@ def new_search(bag, overrides: dict | None = None, out=print):
                         (detector.get('grid.rows', 0), detector.get('grid.cols', 0),
                          detector.get('grid.spacing_deg', 0.0)), given,
                         detector.get('detector.cascade_dir') or None,
-                        unused_cascade_dir='ignore')     # as the recorded node did before 0.3.8
+                        unused_cascade_dir='ignore')     # as the recorded node did before 0.3.9
     settings = core.settings
     if not settings.max_fixations:        # the demo's budget: a still image needs an end
         settings = dataclasses.replace(settings, max_fixations=4 * core.grid.n_cells)

@@ -207,7 +207,7 @@ def build_setup(mode: str, source: str = '', grid=(0, 0, 0.0), detector: dict | 
         refused if it does not exist or lacks one of them (:func:`check_cascade_dir`).
     unused_cascade_dir : {'refuse', 'ignore'}
         What a ``cascade_dir`` given to a detector that takes none (YuNet) gets: refused (a
-        node's parameter), or ignored (``replay``: a bag recorded before 0.3.8, whose node
+        node's parameter), or ignored (``replay``: a bag recorded before 0.3.9, whose node
         accepted and ignored it, searches as it did).
 
     Raises
