@@ -327,6 +327,11 @@ def _record(doc: dict, key: str) -> dict:
             if not (number and math.isfinite(value) and value >= 0
                     and (name != 'epochs' or value == int(value))):
                 raise PolicyFileError(f'training.{name} must be {kind} >= 0, got {value!r}')
+        for name in SCENE_KEYS:                 # what evaluate and the node compare (check_scene)
+            value = block.get(name)
+            if value is not None and (isinstance(value, bool)
+                                      or not isinstance(value, (int, float))):
+                raise PolicyFileError(f'training.{name} must be a number, got {value!r}')
     if key == 'evaluation':
         f90 = block.get('fixations_to_90')
         if f90 is not None and (isinstance(f90, bool) or not isinstance(f90, (int, float))):

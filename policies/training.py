@@ -40,6 +40,7 @@ from typing import Callable
 from ipomdp_gaze.files.observation_file import fingerprint
 from ipomdp_gaze.files.writable import write_file
 from ipomdp_gaze.model.belief import check_prior, draw_cells
+from ipomdp_gaze.model.checks import check_flag, positive_int
 from ipomdp_gaze.model.fpoc import FPOC
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.motion import check_probability, check_sigma_cells, Motion
@@ -52,7 +53,7 @@ import numpy as np
 
 from .conv import ConvPolicy, kernel_from_radial, radial_bins
 from .logistic import LogisticPolicy, sample_rows, softmax
-from .policy_file import FAMILIES, observation_block, PolicySpec, REWARDS
+from .policy_file import FAMILIES, observation_block, PolicyFileError, PolicySpec, REWARDS
 
 CSV_FIELDS = ('epoch', 'episodes', 'mean_return', 'fixations_to_90', 'wall_seconds')
 
@@ -98,21 +99,25 @@ class TrainConfig:
             raise ValueError(f"unknown family {self.family!r}; valid: {', '.join(FAMILIES)}")
         for name in ('learning_rate', 'reward_scale'):
             value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            if not (_is_number(value) and math.isfinite(value) and value > 0):
                 raise ValueError(f'{name} must be a positive finite number, got {value!r}')
         if self.anneal_epochs is not None and not (
-                isinstance(self.anneal_epochs, (int, float)) and self.anneal_epochs > 0):
+                _is_number(self.anneal_epochs) and self.anneal_epochs > 0):
             raise ValueError(f'anneal_epochs must be a positive number or None, '
                              f'got {self.anneal_epochs!r}')
-        if not 0 <= self.beta < 1:
+        if not (_is_number(self.beta) and 0 <= self.beta < 1):
             raise ValueError(f'beta must be in [0, 1), got {self.beta!r}')
+        # Counts and seeds whole (2.5 episodes was numpy's TypeError in the first epoch, a
+        # horizon of 2.5 ran 2 fixations); the baseline a flag ('no' turned it on).
         for name in ('episodes_per_epoch', 'eval_every', 'eval_episodes'):
-            if int(getattr(self, name)) < 1:
-                raise ValueError(f'{name} must be >= 1, got {getattr(self, name)!r}')
+            positive_int(name, getattr(self, name))
+        if self.horizon is not None:
+            positive_int('horizon', self.horizon)
+        for name in ('seed', 'eval_seed'):
+            positive_int(name, getattr(self, name), allow_zero=True)
+        check_flag(self.baseline, 'baseline')
         if self.episodes_per_epoch < 2 and self.baseline:
             raise ValueError('a reward baseline needs at least 2 episodes per epoch')
-        if self.horizon is not None and int(self.horizon) < 1:
-            raise ValueError(f'horizon must be >= 1, got {self.horizon!r}')
         check_sigma_cells(self.motion_sigma_cells, 'motion_sigma_cells')
         check_probability(self.jump_prob, 'jump_prob')
         check_absent_prior(self.absent_prior)
@@ -127,6 +132,12 @@ class TrainConfig:
         if self.prior is not None:
             scene['prior'] = [list(row) for row in self.prior]
         return scene
+
+
+def _is_number(value) -> bool:
+    """Whether ``value`` is a real number (numpy's too), not a bool or a string."""
+    return isinstance(value, (int, float, np.integer, np.floating)) \
+        and not isinstance(value, (bool, np.bool_))
 
 
 def prior_rows(prior) -> tuple[tuple[float, ...], ...]:
@@ -516,13 +527,24 @@ class Trainer:
 
 
 def config_from_spec(spec: PolicySpec, **overrides) -> TrainConfig:
-    """Read the training configuration of a policy file, with ``overrides`` applied."""
+    """
+    Read the training configuration of a policy file, with ``overrides`` applied.
+
+    A recorded setting that :class:`TrainConfig` refuses (a hand-edited ``beta: x``) is a
+    :class:`PolicyFileError` naming the file and ``training.<setting>``.
+    """
     known = set(TrainConfig.__dataclass_fields__)
     recorded = {k: v for k, v in spec.training.items() if k in known}
     recorded.update(reward=spec.reward, family=spec.family)
     if recorded.get('horizon') == spec.grid.n_cells:
         recorded['horizon'] = None
-    config = TrainConfig(**recorded)
+    try:
+        config = TrainConfig(**recorded)
+    except ValueError as exc:
+        where = f'{spec.path}: ' if spec.path is not None else ''
+        text = str(exc)
+        named = text.split(' ', 1)[0] in known
+        raise PolicyFileError(f"{where}training{'.' if named else ': '}{text}") from None
     return replace(config, **{k: v for k, v in overrides.items() if v is not None})
 
 

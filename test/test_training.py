@@ -1,6 +1,8 @@
 # Copyright 2026 ipomdp_gaze developers
 # SPDX-License-Identifier: Apache-2.0
 """GPOMDP training: exact gradients, the eligibility trace, improvement, resume and the CLI."""
+from dataclasses import replace
+
 from ipomdp_gaze.cli import main
 from ipomdp_gaze.model.belief import entropy
 from ipomdp_gaze.model.fpoc import make_fpoc
@@ -180,6 +182,56 @@ def test_config_validation_names_the_problem():
         TrainConfig(beta=1.0)
     with pytest.raises(ValueError, match='conv parameters must have 6 values'):
         Trainer(Grid(3, 3), FPOC, TrainConfig(), params=np.zeros(5))
+
+
+@pytest.mark.parametrize('kwargs, message', [
+    ({'beta': 'x'}, r"beta must be in \[0, 1\), got 'x'"),
+    ({'episodes_per_epoch': 2.5}, 'episodes_per_epoch must be a positive integer, got 2.5'),
+    ({'eval_episodes': None}, 'eval_episodes must be a positive integer, got None'),
+    ({'horizon': 2.5}, 'horizon must be a positive integer, got 2.5'),
+    ({'seed': -3}, 'seed must be a non-negative integer, got -3'),
+    ({'eval_seed': 'x'}, "eval_seed must be a non-negative integer, got 'x'"),
+    ({'baseline': 'no'}, "baseline must be true or false, got 'no'"),
+    ({'learning_rate': '5'}, "learning_rate must be a positive finite number, got '5'"),
+])
+def test_config_refuses_values_of_the_wrong_type_when_made(kwargs, message):
+    """QA: 2.5 episodes failed in numpy in the first epoch, baseline='no' turned it on."""
+    with pytest.raises(ValueError, match=message):
+        TrainConfig(**kwargs)
+
+
+def test_config_takes_numpy_numbers():
+    """QA: learning_rate=np.int64(2) (from np.arange) was 'not a positive finite number'."""
+    config = TrainConfig(learning_rate=np.int64(2), reward_scale=np.float32(0.5),
+                         anneal_epochs=np.int64(10), beta=np.float32(0.5),
+                         episodes_per_epoch=np.int64(4), seed=np.uint8(3))
+    trainer = Trainer(Grid(2, 2), FPOC, replace(config, eval_episodes=20))
+    trainer.run(1)
+    assert trainer.epoch == 1 and np.all(np.isfinite(trainer.params))
+
+
+@pytest.mark.parametrize('key, value, message', [
+    ('beta', 'x', "training.beta must be in [0, 1), got 'x'"),
+    ('episodes_per_epoch', 2.5,
+     'training.episodes_per_epoch must be a positive integer, got 2.5'),
+    ('eval_episodes', None, 'training.eval_episodes must be a positive integer, got None'),
+    ('seed', -3, 'training.seed must be a non-negative integer, got -3'),
+    ('baseline', 'no', "training.baseline must be true or false, got 'no'"),
+    ('episodes_per_epoch', 1, 'training: a reward baseline needs at least 2 episodes per epoch'),
+])
+def test_resume_from_a_bad_training_setting_is_one_line(tmp_path, capsys, key, value, message):
+    """QA: beta: x and 2.5 episodes were tracebacks, seed: -3 numpy's line without the file."""
+    import yaml
+    out = tmp_path / 'p.yaml'
+    common = ['--eval-every', '2', '--eval-episodes', '50', '--final-episodes', '0', '--quiet']
+    assert main(['train', '--grid', '3x3', '--epochs', '2', '--out', str(out)] + common) == 0
+    capsys.readouterr()
+    doc = yaml.safe_load(out.read_text())
+    doc['training'][key] = value
+    out.write_text(yaml.safe_dump(doc))
+    assert main(['train', '--resume', str(out), '--epochs', '4'] + common) == 2
+    [line] = capsys.readouterr().err.strip().splitlines()
+    assert line == f'ipomdp-gaze train: error: {out}: {message}'
 
 
 def test_train_cli_writes_policy_and_curve_and_resumes(tmp_path, capsys):
