@@ -297,3 +297,37 @@ def test_a_prior_is_where_targets_are_drawn_and_the_belief_starts():
         env.reset(options={'target': 0})
     with pytest.raises(ValueError, match='prior must sum to 1'):
         VisualSearchEnv(rows=4, cols=4, prior=np.ones((4, 4)))
+
+
+def test_an_fpoc_whose_frames_overflow_is_refused_as_simulate_refuses_it():
+    """QA: d' 1e200 made every frame a refused one: the belief never moved, steps went on."""
+    from ipomdp_gaze.model.fpoc import make_fpoc
+    from ipomdp_gaze.model.grid import Grid
+    from ipomdp_gaze.model.observation import GaussianObservation
+    with pytest.raises(ValueError, match=r"d' up to 1e\+150 can be simulated, the FPOC gives "
+                                         r'1e\+200'):
+        VisualSearchEnv(rows=3, cols=3, fpoc='camera', fpoc_params={'dprime': 1e200})
+    with pytest.raises(ValueError, match='can be simulated'):
+        VisualSearchEnv(observation=GaussianObservation(Grid(3, 3),
+                                                        make_fpoc('camera', dprime=1e155)))
+
+
+def test_a_frame_the_search_refuses_is_an_error_not_a_step():
+    """A model of one's own whose frame the search refuses: the step says so (it was silent)."""
+    from ipomdp_gaze.model.fpoc import make_fpoc
+    from ipomdp_gaze.model.grid import Grid
+    from ipomdp_gaze.model.observation import GaussianObservation
+
+    class Broken(GaussianObservation):
+
+        def sample(self, targets, fixations, rng, present=None):
+            frame = super().sample(targets, fixations, rng, present)
+            frame[0] = np.inf
+            return frame
+
+    env = VisualSearchEnv(observation=Broken(Grid(3, 3), make_fpoc('camera')))
+    env.reset(seed=0)
+    with pytest.raises(RuntimeError, match='drew a frame the search refused: evidence contains '
+                                           r'\+/-inf'):
+        env.step(4)
+    np.testing.assert_allclose(env.belief, np.full(9, 1 / 9))

@@ -17,7 +17,9 @@ baselines (``None`` in an empty scene: there is no target to name).
 
 By default the observation model is the Gaussian model of ``fpoc`` on a ``rows x cols`` grid
 (7x7); ``observation=`` takes any observation model instead, for example a count model or the
-path or shipped name of an ``ipomdp_gaze/observation-v1`` file, and its grid.
+path or shipped name of an ``ipomdp_gaze/observation-v1`` file, and its grid. A model whose
+drawn frames the search would refuse (a d' above 1e150) is refused when the environment is
+made, as the simulator refuses it; a refused frame in a step is a RuntimeError.
 
 Beyond the paper (docs/design.md section 7), with the defaults off: ``motion_sigma_cells`` and
 ``jump_prob`` make the target take a step of :class:`ipomdp_gaze.model.motion.Motion` after every
@@ -96,6 +98,9 @@ class VisualSearchEnv(gymnasium.Env):
             fpoc = 'human' if fpoc is None else fpoc
             self.fpoc = fpoc if isinstance(fpoc, FPOC) else make_fpoc(fpoc, **(fpoc_params or {}))
             self.model = GaussianObservation(self.grid, self.fpoc)
+        check_sampling = getattr(self.model, 'check_sampling', None)
+        if check_sampling is not None:      # frames the search would refuse, every one: as
+            check_sampling()                # simulate, evaluate and train refuse the model
         if not isinstance(scan, (bool, np.bool_)):
             raise ValueError(f'scan must be True or False, got {scan!r}')
         self.scan = bool(scan) and getattr(self.model, 'has_scan', False)
@@ -219,6 +224,9 @@ class VisualSearchEnv(gymnasium.Env):
         obs = self.model.sample(self._target, k, self.np_random, present=self._present)
         self.session.fixate(k)
         result = self.session.update(Frame(obs))
+        if not result.applied:              # the belief did not move: no step to report
+            raise RuntimeError(f'the observation model drew a frame the search refused: '
+                               f'{result.reason}')
         self._evidence, self._fixation = obs, k
         self._steps += 1
         if self.reward_name == 'infomax':
