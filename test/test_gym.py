@@ -4,7 +4,7 @@
 import gymnasium
 from gymnasium.utils.env_checker import check_env
 from ipomdp_gaze.model.belief import bayes_update, uniform_log_belief
-from ipomdp_gaze.model.fpoc import dprime_matrix
+from ipomdp_gaze.model.fpoc import dprime_matrix, make_fpoc
 from ipomdp_gaze.model.observation import gaussian_log_likelihood_ratio as llr
 import ipomdp_gaze.simulation.gym  # noqa: F401  (registers the environment)
 from ipomdp_gaze.simulation.gym import ENV_ID, VisualSearchEnv
@@ -331,3 +331,18 @@ def test_a_frame_the_search_refuses_is_an_error_not_a_step():
                                            r'\+/-inf'):
         env.step(4)
     np.testing.assert_allclose(env.belief, np.full(9, 1 / 9))
+
+
+@pytest.mark.parametrize('kwargs, words', [
+    ({'observation': 5}, 'observation must be an observation model with its grid, an '
+                         'observation file or a shipped model name, got int'),
+    ({'observation': make_fpoc('camera')}, r'got CameraFPOC \(an FPOC goes in fpoc=\)'),
+    ({'fpoc_params': [1, 2]}, 'fpoc_params must be a dict of parameter names and values, got '
+                              'list'),
+    ({'fpoc': make_fpoc('camera'), 'fpoc_params': {'dprime': 9.0}},
+     'fpoc_params cannot go with an FPOC object'),
+])
+def test_an_observation_or_fpoc_params_of_the_wrong_kind_is_named(kwargs, words):
+    """QA: observation=5 was AttributeError 'int' ... 'grid'; an FPOC's fpoc_params were lost."""
+    with pytest.raises(ValueError, match=words):
+        VisualSearchEnv(**kwargs)

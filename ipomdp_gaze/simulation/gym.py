@@ -87,6 +87,12 @@ class VisualSearchEnv(gymnasium.Env):
             if isinstance(observation, (str, Path)):
                 from ipomdp_gaze.files.observation_file import load_observation
                 observation = load_observation(observation)
+            if not (hasattr(observation, 'sample') and isinstance(getattr(observation, 'grid',
+                                                                          None), Grid)):
+                hint = ' (an FPOC goes in fpoc=)' if isinstance(observation, FPOC) else ''
+                raise ValueError(f'observation must be an observation model with its grid, an '
+                                 f'observation file or a shipped model name, got '
+                                 f'{type(observation).__name__}{hint}')
             self.model = as_observation(observation.grid, observation)
             self.grid, self.fpoc = self.model.grid, getattr(self.model, 'fpoc', None)
             if (rows, cols) != (None, None) and (rows, cols) != self.grid.shape:
@@ -96,6 +102,12 @@ class VisualSearchEnv(gymnasium.Env):
             self.grid = Grid(7 if rows is None else rows, 7 if cols is None else cols,
                              DEFAULT_SPACING_DEG if spacing_deg is None else spacing_deg)
             fpoc = 'human' if fpoc is None else fpoc
+            if fpoc_params is not None and not isinstance(fpoc_params, dict):
+                raise ValueError(f'fpoc_params must be a dict of parameter names and values, '
+                                 f'got {type(fpoc_params).__name__}')
+            if isinstance(fpoc, FPOC) and fpoc_params:
+                raise ValueError('fpoc_params cannot go with an FPOC object, which holds its '
+                                 'parameters: give fpoc by name, or make_fpoc(model, **params)')
             self.fpoc = fpoc if isinstance(fpoc, FPOC) else make_fpoc(fpoc, **(fpoc_params or {}))
             self.model = GaussianObservation(self.grid, self.fpoc)
         check_sampling = getattr(self.model, 'check_sampling', None)
