@@ -138,6 +138,42 @@ def test_given_targets_are_the_searched_cells():
     assert res.correct.all()
 
 
+class Fixed:
+    """A policy of one's own that returns the same choices every time."""
+
+    name = 'fixed'
+
+    def __init__(self, choice):
+        self.choice = choice
+
+    def select(self, belief, t, rng):
+        return self.choice
+
+
+@pytest.mark.parametrize('choice, message', [
+    (np.array([0, -1, 4]), 'policy fixed chose -1 for episode 1 at fixation 1: a fixation is '
+                           r'a cell index in 0..8'),
+    (np.array([0, 4, 9]), 'chose 9 for episode 2'),
+    (np.array([2.7, 0, 0]), 'chose 2.7 for episode 0'),
+    (np.array([0, 4]), r'must choose one cell per episode, shape \(3,\), got shape \(2,\)'),
+    (np.array(['a'] * 3), 'must choose cell indices, got dtype <U1'),
+])
+def test_a_policys_choice_outside_the_grid_is_refused(choice, message):
+    # QA: a policy of one's own returning -1 had its frames drawn at cell 8 (numpy's wrap-round)
+    # while -1 was recorded as the fixation, and 2.7 fixated cell 2, without a word.
+    grid = Grid(3, 3, 1.0)
+    with pytest.raises(ValueError, match=message):
+        simulate(grid, HUMAN, Fixed(choice), 3, 2, seed=0)
+
+
+def test_a_policys_whole_choices_and_one_for_all_are_taken():
+    grid = Grid(3, 3, 1.0)
+    res = simulate(grid, HUMAN, Fixed(np.array([8.0, 0.0, 4.0])), 3, 2, seed=0)
+    np.testing.assert_array_equal(res.fixations, [[8, 8], [0, 0], [4, 4]])
+    assert res.fixations.dtype == np.int64
+    np.testing.assert_array_equal(simulate(grid, HUMAN, Fixed(4), 3, 1, seed=0).fixations, 4)
+
+
 def test_present_of_the_wrong_length_is_refused():
     grid = Grid(3, 3, 1.0)
     with pytest.raises(ValueError, match='one flag per episode'):

@@ -202,6 +202,34 @@ def check_targets(targets, n_cells: int, episodes: int) -> np.ndarray:
     return values
 
 
+def check_fixations(fixations, n_cells: int, episodes: int, t: int, policy) -> np.ndarray:
+    """
+    Return a policy's choices for fixation ``t`` (0-based) as int64 ``(episodes,)``.
+
+    One cell index per episode (one for all is broadcast). A ValueError names the policy, the
+    fixation and the first episode whose choice is no cell of the grid: a negative index drew
+    its frame at a cell counted from the end while -1 was recorded, and 2.7 fixated cell 2.
+    """
+    values = np.asarray(fixations)
+    name = getattr(policy, 'name', type(policy).__name__)
+    if values.shape not in ((episodes,), ()):
+        raise ValueError(f'policy {name} must choose one cell per episode, shape ({episodes},), '
+                         f'got shape {values.shape} at fixation {t + 1}')
+    values = np.broadcast_to(values, (episodes,))
+    if values.dtype.kind in 'iu':
+        bad = (values < 0) | (values >= n_cells)
+    elif values.dtype.kind == 'f':
+        bad = ~((values >= 0) & (values < n_cells) & (values == np.floor(values)))
+    else:
+        raise ValueError(f'policy {name} must choose cell indices, got dtype {values.dtype} at '
+                         f'fixation {t + 1}')
+    if bad.any():
+        e = int(np.flatnonzero(bad)[0])
+        raise ValueError(f'policy {name} chose {values[e].item()!r} for episode {e} at fixation '
+                         f'{t + 1}: a fixation is a cell index in 0..{n_cells - 1}')
+    return values.astype(np.int64)
+
+
 def check_present(present, episodes: int) -> np.ndarray:
     """Return ``present`` as a bool array of shape ``(episodes,)`` (ValueError otherwise)."""
     values = np.asarray(present)
@@ -323,7 +351,7 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
         beliefs.update(model.scan_log_likelihood_ratio(frames, validate=False))
 
     def choose(t):
-        return np.asarray(policy.select(belief, t, rng), dtype=np.int64)
+        return check_fixations(policy.select(belief, t, rng), n, episodes, t, policy)
 
     def record(t, k, gain, where):
         fixations[:, t] = k
