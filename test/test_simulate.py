@@ -174,6 +174,20 @@ def test_a_policys_whole_choices_and_one_for_all_are_taken():
     np.testing.assert_array_equal(simulate(grid, HUMAN, Fixed(4), 3, 1, seed=0).fixations, 4)
 
 
+def test_given_targets_in_cells_the_prior_rules_out_are_refused():
+    # QA: they were taken, and every such search was scored wrong (its belief held 0 there);
+    # the Gymnasium environment and search --target refuse such a target.
+    grid = Grid(3, 3, 1.0)
+    prior = np.full(9, 1 / 8)
+    prior[5] = 0.0
+    policy = make_baseline('elm', grid, HUMAN)
+    with pytest.raises(ValueError, match='targets must be cells the prior allows: episode 1 '
+                                         'has its target in cell 5, which the prior rules out'):
+        simulate(grid, HUMAN, policy, 3, 2, seed=0, targets=[0, 5, 5], prior=prior)
+    res = simulate(grid, HUMAN, policy, 3, 2, seed=0, targets=[0, 4, 8], prior=prior)
+    np.testing.assert_array_equal(res.targets, [0, 4, 8])
+
+
 def test_present_of_the_wrong_length_is_refused():
     grid = Grid(3, 3, 1.0)
     with pytest.raises(ValueError, match='one flag per episode'):

@@ -268,6 +268,7 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
         Batch size, fixations per episode and the seed of all random streams.
     targets : array (episodes,), optional
         Target cells at the first fixation; drawn from the seed's target stream when omitted.
+        With a ``prior``, none may be in a cell it rules out (probability 0).
     progress : callable, optional
         Called with the fixation number after each step.
     motion : Motion, optional
@@ -307,6 +308,11 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
         prior = check_prior(prior, n, grid.shape)
     if targets is not None:
         targets = check_targets(targets, n, episodes)
+        if prior is not None and np.any(prior[targets] == 0):
+            e = int(np.flatnonzero(prior[targets] == 0)[0])
+            raise ValueError(f'targets must be cells the prior allows: episode {e} has its '
+                             f'target in cell {int(targets[e])}, which the prior rules out '
+                             '(probability 0: every search starts sure it is not there)')
     else:
         targets = draw_targets(n, episodes, seed, prior)
     absent_prior = check_absent_prior(absent_prior)
