@@ -188,6 +188,26 @@ def test_given_targets_in_cells_the_prior_rules_out_are_refused():
     np.testing.assert_array_equal(res.targets, [0, 4, 8])
 
 
+@pytest.mark.parametrize('kwargs, message', [
+    ({'horizon': 2.5}, 'horizon must be a positive integer, got 2.5'),
+    ({'horizon': '3'}, "horizon must be a positive integer, got '3'"),
+    ({'horizon': 0}, 'horizon must be a positive integer, got 0'),
+    ({'episodes': 2.5}, 'episodes must be a positive integer, got 2.5'),
+    ({'seed': None}, 'seed must be a non-negative integer, got None'),
+    ({'seed': -1}, 'seed must be a non-negative integer, got -1'),
+])
+def test_counts_and_the_seed_must_be_whole(kwargs, message):
+    # QA: a horizon of 2.5 ran 2 fixations and '3' ran 3; episodes=2.5 and seed=None were
+    # numpy's TypeErrors, seed=-1 its 'expected non-negative integer'.
+    grid = Grid(3, 3, 1.0)
+    args = {'episodes': 3, 'horizon': 2, 'seed': 0, **kwargs}
+    with pytest.raises(ValueError, match=message):
+        simulate(grid, HUMAN, make_baseline('elm', grid, HUMAN), **args)
+    res = simulate(grid, HUMAN, make_baseline('elm', grid, HUMAN), np.int64(3), np.int64(2),
+                   seed=np.uint32(4))
+    assert res.correct.shape == (3, 2)
+
+
 def test_present_of_the_wrong_length_is_refused():
     grid = Grid(3, 3, 1.0)
     with pytest.raises(ValueError, match='one flag per episode'):

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from ipomdp_gaze.model.belief import check_prior, draw_cells, map_cell
+from ipomdp_gaze.model.checks import positive_int
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.motion import check_probability, Motion
 from ipomdp_gaze.model.observation import as_observation
@@ -300,9 +301,11 @@ def simulate(grid: Grid, model, policy: Policy, episodes: int, horizon: int | No
 
     """
     n = grid.n_cells
-    horizon = n if horizon is None else int(horizon)
-    if horizon < 1 or episodes < 1:
-        raise ValueError('episodes and horizon must be >= 1')
+    # Whole numbers, named: a horizon of 2.5 ran 2 fixations, '3' ran 3, episodes=2.5 and
+    # seed=None were numpy's TypeErrors
+    episodes = positive_int('episodes', episodes)
+    horizon = n if horizon is None else positive_int('horizon', horizon)
+    seed = positive_int('seed', seed, allow_zero=True)
     model = as_observation(grid, model)
     if prior is not None:
         prior = check_prior(prior, n, grid.shape)
