@@ -45,6 +45,21 @@ def test_bad_grid_values():
         Grid(0, 3)
 
 
+@pytest.mark.parametrize('args, message', [
+    ((None, 3), 'rows must be a positive integer, got None'),
+    (('x', 3), "rows must be a positive integer, got 'x'"),
+    ((float('inf'), 3), 'rows must be a positive integer, got inf'),
+    ((3, float('nan')), 'cols must be a positive integer, got nan'),
+    (([3], 3), r'rows must be a positive integer, got \[3\]'),
+    ((3, 3, None), 'spacing_deg must be a positive finite number, got None'),
+    ((3, 3, 'x'), "spacing_deg must be a positive finite number, got 'x'"),
+])
+def test_grid_values_that_are_no_numbers_are_named(args, message):
+    """QA: None, 'x' and inf were int()'s TypeError, ValueError and OverflowError."""
+    with pytest.raises(ValueError, match=message):
+        Grid(*args)
+
+
 def test_fixation_window_gives_each_cells_offset_from_the_fixation():
     grid = Grid(3, 5, 2.0)
     dx, dy = grid.offset_table_deg()

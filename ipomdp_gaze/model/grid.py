@@ -10,6 +10,7 @@ image. Offsets of cell ``j`` seen from fixation ``k`` are ``dy = spacing_deg * (
 from __future__ import annotations
 
 from dataclasses import dataclass
+import math
 import re
 
 import numpy as np
@@ -47,10 +48,17 @@ class Grid:
     def __post_init__(self):
         for name in ('rows', 'cols'):
             value = getattr(self, name)
-            if isinstance(value, bool) or int(value) != value or value < 1:
+            try:                        # None, 'x', inf, nan, [3]: refused by name, as 2.5 is
+                whole = not isinstance(value, bool) and int(value) == value and value >= 1
+            except (TypeError, ValueError, OverflowError):
+                whole = False
+            if not whole:
                 raise ValueError(f'{name} must be a positive integer, got {value!r}')
             object.__setattr__(self, name, int(value))
-        spacing = float(self.spacing_deg)
+        try:
+            spacing = float(self.spacing_deg)
+        except (TypeError, ValueError):
+            spacing = math.nan
         if not np.isfinite(spacing) or spacing <= 0:
             raise ValueError(
                 f'spacing_deg must be a positive finite number, got {self.spacing_deg!r}')
