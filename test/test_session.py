@@ -358,6 +358,21 @@ def test_a_rejected_frame_changes_nothing_and_says_why():
         assert session.fixations == 0
 
 
+@pytest.mark.parametrize('scene, message', [
+    (2.7, 'a cell index must be a whole number, got 2.7'),
+    ('3', "a cell index must be a whole number, got '3'"),
+    ([1, 2], r'a cell index must be one whole number, got \[1, 2\]'),
+    (12, 'cell index 12 is outside a 3x4 grid'),
+])
+def test_a_model_sensors_target_is_one_cell_of_the_grid(scene, message):
+    """QA: start(2.7) hid the target in cell 2 and start('3') in cell 3, without a word."""
+    sensor = ModelSensor(GRID, count_model(1), np.random.default_rng(0))
+    with pytest.raises(ValueError, match=message):
+        sensor.start(scene)
+    sensor.start(np.int64(7))
+    assert sensor.target == 7 and type(sensor.target) is int
+
+
 def test_the_event_log_records_each_step():
     model = count_model(8)
     session = SearchSession(GRID, model, build_policy('elm', GRID, model),

@@ -19,7 +19,7 @@ from typing import Protocol
 
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.observation import as_observation
-from ipomdp_gaze.search.session import Frame, SearchSession
+from ipomdp_gaze.search.session import fixation_index, Frame, SearchSession
 import numpy as np
 
 
@@ -61,10 +61,8 @@ class ModelSensor:
         self.target: int | None = None
 
     def start(self, scene) -> None:
-        """``scene``: the target's cell index, or None (no target)."""
-        if scene is not None:
-            self.grid.cell(int(scene))
-        self.target = None if scene is None else int(scene)
+        """``scene``: the target's cell index (a whole number in the grid), or None (no target)."""
+        self.target = None if scene is None else fixation_index(self.grid, scene)
 
     def scan(self) -> Frame | None:
         if not self.scans:
