@@ -7,7 +7,8 @@ Whole numbers (``-p belief.prior:=[1,2,1,...]``, YAML ``[1, 2, 1]``, a set of in
 rclpy as an integer array; the controller takes them as doubles. A policy file trained on
 another prior than the one in force is said once, as ``evaluate`` says it. The same in-process
 node for what the controller logs: its configuration warnings (said once while they last), its
-start-up line's motion, and how a room's search ended (done, or undecided at its budget).
+start-up line's motion and the still-scene rules it says are off for a moving target, and how
+a room's search ended (done, or undecided at its budget).
 """
 from __future__ import annotations
 
@@ -305,5 +306,38 @@ def test_stop_on_decision_off_is_said_to_be_ignored_by_a_room(context, capfd):
         assert ignored not in _log_until(capfd, 'parameters set: search.targets=')
         assert _set(node, search__targets='many').successful
         assert _log_until(capfd, 'parameters set: search.targets=').count(ignored) == 1
+    finally:
+        node.destroy_node()
+
+
+@pytest.mark.parametrize('given, said', [
+    (['--params-file', 'faces_camera_tracking.yaml'],
+     ', no fixation budget, inhibition of return off for a moving target; first fixation'),
+    (['-p', 'motion.sigma_cells:=0.5', '-p', 'search.inhibit_return:=true', '-p',
+      'search.repeat_weight:=0.3'],
+     ', inhibition of return and the repeat weight off for a moving target; first fixation'),
+    (['-p', 'search.targets:=many', '-p', 'motion.sigma_cells:=0.5', '-p',
+      'motion.jump_prob:=0.01', '-p', 'search.inhibit_return:=true'],
+     ', inhibition of return off for moving targets; first fixation'),
+    (['-p', 'search.inhibit_return:=true', '-p', 'search.repeat_weight:=0.3'],
+     ', inhibition of return, repeated views weighted 0.3; first fixation'),
+    (['-p', 'motion.sigma_cells:=0.5'], ', no fixation budget; first fixation')],
+    ids=['tracking-config', 'moving', 'moving-room', 'still', 'moving-without'])
+def test_the_start_up_line_says_the_still_scene_rules_are_off_for_a_moving_target(
+        context, capfd, given, said):
+    """
+    QA: a moving target's start-up line said 'inhibition of return', which the search turns off.
+
+    One target and many switch inhibition of return and the repeat weight off while the target
+    moves (docs/design.md section 12.4); a still target's line names them as before.
+    """
+    from conftest import config_path
+    args = [config_path(a) if a.endswith('.yaml') else a for a in given]
+    capfd.readouterr()
+    node = _node(context, cli_args=['--ros-args'] + args)
+    try:
+        line = next(line for line in _log_until(capfd, 'first fixation').splitlines()
+                    if 'first fixation' in line)
+        assert said in line, line
     finally:
         node.destroy_node()

@@ -264,15 +264,27 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
             f'fixation {cfg.grid.cell(self.core.fixation)}')
 
     def _model_text(self) -> str:
-        """Describe the target model and the stop rules for the log."""
+        """
+        Describe the target model and the stop rules for the log.
+
+        Inhibition of return and the repeat weight are still-scene rules: the search (one
+        target or many) switches them off while the target moves (docs/design.md section 12.4),
+        and the line says so rather than name them as in force.
+        """
         v = self._config.values
-        motion = ('a still target' if not self.core.motion.active else
+        moving = self.core.motion.active
+        motion = ('a still target' if not moving else
                   f'a moving target ({_motion_text(self.core.motion.to_dict())})')
         budget = v['search.max_fixations'] or 'no'
         ior = ', inhibition of return' if v['search.inhibit_return'] else ''
         if v['search.repeat_weight'] < 1.0:
             ior += f", repeated views weighted {v['search.repeat_weight']}"
-        if self._many and self.core.motion.active:
+        if moving:
+            still_rules = (['inhibition of return'] if v['search.inhibit_return'] else []) + \
+                (['the repeat weight'] if v['search.repeat_weight'] < 1.0 else [])
+            who = 'moving targets' if self._many else 'a moving target'
+            ior = f", {' and '.join(still_rules)} off for {who}" if still_rules else ''
+        if self._many and moving:
             motion = ('many moving targets (an occupancy per cell), each person found followed '
                       f"{v['motion.dwell_s']} s in turn, then a view for new people")
         elif self._many:
