@@ -124,10 +124,15 @@ def absent_status(name: str, probability: float, fixations: int, forced_by: str 
                                         'fixations': fixations, **ending})
 
 
-def gave_up_status(name: str, fixations: int) -> DiagnosticStatus:
-    """Build the ``gave_up`` event: the fixation budget ran out undecided (level WARN)."""
+def gave_up_status(name: str, fixations: int, limit: str = 'the budget') -> DiagnosticStatus:
+    """
+    Build the ``gave_up`` event: the search ended undecided at ``limit`` (level WARN).
+
+    ``limit`` names what ended it: the fixation budget, or the parameter of another rule
+    (``search.stop_on_repeat``).
+    """
     return status(name, 'warn',
-                  f'gave up undecided after {counted(fixations, "fixation")} (the budget)',
+                  f'gave up undecided after {counted(fixations, "fixation")} ({limit})',
                   {'fixations': fixations})
 
 

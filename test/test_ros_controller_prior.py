@@ -8,7 +8,8 @@ rclpy as an integer array; the controller takes them as doubles. A policy file t
 another prior than the one in force is said once, as ``evaluate`` says it. The same in-process
 node for what the controller logs: its configuration warnings (said once while they last), its
 start-up line's motion and the still-scene rules it says are off for a moving target, and how
-a room's search ended (done, or undecided at its budget).
+a room's search ended (done, or undecided at its budget), and the parameter behind a search
+that gave up.
 """
 from __future__ import annotations
 
@@ -339,5 +340,51 @@ def test_the_start_up_line_says_the_still_scene_rules_are_off_for_a_moving_targe
         line = next(line for line in _log_until(capfd, 'first fixation').splitlines()
                     if 'first fixation' in line)
         assert said in line, line
+    finally:
+        node.destroy_node()
+
+
+@pytest.mark.parametrize('targets, settings, response, fixations, cause', [
+    ('one', {'search.max_fixations': 2}, 2.0, 2, 'search.max_fixations'),
+    ('one', {'search.inhibit_return': True, 'search.stop_on_repeat': True}, 2.0, 4,
+     'search.stop_on_repeat'),
+    ('one', {'search.stop_on_repeat': True}, 2.0, 1, 'search.stop_on_repeat'),
+    ('many', {'search.max_fixations': 2}, 2.0, 2, 'search.max_fixations'),
+    ('many', {'search.inhibit_return': True}, 2.0, 4, 'search.inhibit_return'),
+    ('many', {'search.stop_on_repeat': True}, 2.0, 1, 'search.stop_on_repeat'),
+    ('many', {'fpoc.dprime': 1e-6}, 0.0, 1, 'no view left would tell anything new')],
+    ids=['budget', 'repeat-inhibited', 'repeat', 'room-budget', 'room-inhibited',
+         'room-repeat', 'room-nothing-new'])
+def test_gave_up_names_the_parameter_behind_its_limit(
+        context, capfd, targets, settings, response, fixations, cause):
+    """
+    QA: 'gave up' always ended '(search.max_fixations)', also when search.stop_on_repeat ended it.
+
+    The log and the gave_up event name the rule that ended the search (the event says 'the
+    budget' for search.max_fixations, as before); a room whose views can tell nothing new
+    gives up by no parameter's rule, and says so.
+    """
+    from ipomdp_gaze.msg_adapters import grid_arrays
+    from rclpy.parameter import Parameter
+    capfd.readouterr()
+    node = _node(context, parameter_overrides=[
+        Parameter('grid.rows', value=2), Parameter('grid.cols', value=2),
+        Parameter('search.targets', value=targets), Parameter('settle_time_s', value=0.0),
+        Parameter('absent.prior', value=0.5), Parameter('confidence', value=0.999)] + [
+        Parameter(name, value=value) for name, value in settings.items()])
+    try:
+        published = []
+        node._event_pubs['gave_up'].publish = published.append
+        grid = node._config.grid
+        _log_until(capfd, 'first fixation')
+        for _ in range(fixations):
+            node._on_evidence(grid_arrays.to_multiarray(np.full(grid.n_cells, response), grid),
+                              None)
+        assert node.core.stopped and node.core.decision == 'gave_up'
+        log = _log_until(capfd, 'gave up')
+        said = f'gave up: no decision after {fixations} fixation'
+        assert f"{said}{'s' if fixations > 1 else ''} ({cause})" in log, log
+        limit = 'the budget' if cause == 'search.max_fixations' else cause
+        assert [m.message.endswith(f'({limit})') for m in published] == [True], published
     finally:
         node.destroy_node()

@@ -64,6 +64,7 @@ from ipomdp_gaze.search.controller_config import (build_config, ControllerConfig
 from ipomdp_gaze.search.gaze import FrameSequence, SETTLING, STAMP_TOLERANCE_S
 from ipomdp_gaze.search.health import HealthMonitor
 from ipomdp_gaze.search.room import MAX_PERIOD_S, people_text, Person, PERSON_LINK, RoomWatch
+from ipomdp_gaze.search.session import PARAMETER_NAMES
 import numpy as np
 from rclpy.clock import ClockChange, JumpThreshold
 from rclpy.duration import Duration
@@ -671,11 +672,14 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
         for event in result.people:
             self._publish_person_event(event)
         if result.gave_up is not None:
+            session = self.core.session
+            cause = _gave_up_cause(session)
             self._event_pubs['gave_up'].publish(diagnostics.gave_up_status(
-                f'{name}: gave_up', result.gave_up.fixations))
+                f'{name}: gave_up', result.gave_up.fixations,
+                'the budget' if session.gave_up_reason == 'budget' else cause))
             self.get_logger().warning(f'gave up: no decision after '
                                       f'{counted(result.gave_up.fixations, "fixation")} '
-                                      f'(search.max_fixations){ending}')
+                                      f'({cause}){ending}')
 
     def _publish_person_event(self, event) -> None:
         """Publish a person's found, lost or reacquired (moving many-target search)."""
@@ -930,6 +934,22 @@ def _motion_text(motion: dict) -> str:
     if motion['leave_prob']:
         parts.append(f"leave {motion['leave_prob']}/s")
     return ', '.join(parts)
+
+
+def _gave_up_cause(session) -> str:
+    """
+    Name what ended a search that gave up: the parameter of the rule behind its limit.
+
+    ``search.max_fixations`` (the budget), ``search.stop_on_repeat`` or, many targets,
+    ``search.inhibit_return`` (reason ``repeat``, :attr:`limit_setting`); a many-target search
+    with no view left that would tell anything new gives up by no parameter's rule.
+    """
+    setting, reason = session.limit_setting, session.gave_up_reason
+    if setting:
+        return PARAMETER_NAMES[setting]
+    if reason == 'repeat':
+        return 'no view left would tell anything new'
+    return answer.LIMITS.get(reason, reason)
 
 
 def _values_only(msg: Float32MultiArray, grid) -> tuple:

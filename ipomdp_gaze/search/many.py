@@ -372,6 +372,18 @@ class OccupancySession:
     decision = property(lambda self: self._s()['decision'])
     gave_up_reason = property(lambda self: self._s()['reason'])
     ended = property(lambda self: self._s()['ended'])
+
+    @property
+    def limit_setting(self) -> str:
+        """
+        Return the setting whose rule ended the search at its limit, else ''.
+
+        ``max_fixations`` (reason ``budget``); for ``repeat``, ``inhibit_return`` (every cell
+        was fixated) or ``stop_on_repeat`` (the best view was one already taken), and '' when
+        no view left would tell anything new; '' for a driver's limit (:meth:`stop`).
+        """
+        s = self._s()
+        return {'budget': 'max_fixations', 'repeat': s['repeat_rule']}.get(s['reason'], '')
     log = property(lambda self: tuple(self._log))
 
     @property
@@ -462,7 +474,7 @@ class OccupancySession:
         self._state = {'base': prior, 'prior': prior, 'fixation': None, 'fixations': 0,
                        'path': deque(maxlen=PATH_SIZE), 'scanned': False, 'decision': '',
                        'reason': '', 'ended': False, 'outside': outside, 'clock_s': 0.0,
-                       'room_done': False, 'decided_once': False,
+                       'room_done': False, 'decided_once': False, 'repeat_rule': '',
                        'visited': np.zeros(n, dtype=bool), 'groups': [],
                        'pass': self._pass}
         self._event('reset', settings=self.settings.to_parameters(), cell_prior=q)
@@ -732,6 +744,7 @@ class OccupancySession:
 
     def _choose(self) -> int | None:
         s = self._s()
+        s['repeat_rule'] = ''           # the rule behind a None (limit_setting)
         if self.passing:
             left = s['pass'][~s['visited'][s['pass']]]
             return int(left[0]) if left.size else None
@@ -750,9 +763,12 @@ class OccupancySession:
         if self.settings.inhibit_return:
             score = np.where(s['visited'], -np.inf, score)
         if not np.isfinite(score).any() or score.max() <= MIN_GAIN / costs.min():
+            if self.settings.inhibit_return and s['visited'].all():
+                s['repeat_rule'] = 'inhibit_return'
             return None
         choice = int(argmax_ties_low(score))
         if self.settings.stop_on_repeat and s['visited'][choice]:
+            s['repeat_rule'] = 'stop_on_repeat'
             return None                 # give up (repeat) rather than look at a cell again
         return choice
 

@@ -652,6 +652,17 @@ class SearchSession:
         return self._state().reason
 
     @property
+    def limit_setting(self) -> str:
+        """
+        Return the setting whose rule ended the search at its limit, else ''.
+
+        ``max_fixations`` (reason ``budget``), ``stop_on_repeat`` (``repeat``: only that rule
+        gives up on a repeat); '' for a driver's limit (:meth:`stop`) or none.
+        """
+        return {'budget': 'max_fixations', 'repeat': 'stop_on_repeat'}.get(
+            self._state().reason, '')
+
+    @property
     def ended(self) -> bool:
         """Return whether the search has ended: no more frames until :meth:`reset`."""
         return self._state().ended
