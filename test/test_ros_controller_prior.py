@@ -8,8 +8,8 @@ rclpy as an integer array; the controller takes them as doubles. A policy file t
 another prior than the one in force is said once, as ``evaluate`` says it. The same in-process
 node for what the controller logs: its configuration warnings (said once while they last), its
 start-up line's motion and the still-scene rules it says are off for a moving target, and how
-a room's search ended (done, or undecided at its budget), and the parameter behind a search
-that gave up.
+a room's search ended (done, or undecided at its budget), the parameter behind a search that
+gave up, and the first search's id (1).
 """
 from __future__ import annotations
 
@@ -386,5 +386,38 @@ def test_gave_up_names_the_parameter_behind_its_limit(
         assert f"{said}{'s' if fixations > 1 else ''} ({cause})" in log, log
         limit = 'the budget' if cause == 'search.max_fixations' else cause
         assert [m.message.endswith(f'({limit})') for m in published] == [True], published
+    finally:
+        node.destroy_node()
+
+
+def test_a_fresh_node_s_first_search_is_search_1(context, capfd):
+    """
+    QA: a freshly started still room's first search was logged 'room done (search 2, ...)'.
+
+    The core began search 1 when it was built, and the node's start restarted it as a new
+    search; search ids grow by one with every new search (docs/design.md section 10.3), so the
+    first is 1 on ``fixation``, ``room_done`` and in the log, and a ``~/reset`` starts 2.
+    """
+    from conftest import config_path
+    from ipomdp_gaze.msg_adapters import diagnostics, grid_arrays
+    from std_srvs.srv import Trigger
+    capfd.readouterr()
+    node = _node(context, cli_args=[
+        '--ros-args', '--params-file', config_path('faces_camera_controller.yaml'),
+        '--params-file', config_path('faces_camera_room_controller.yaml'),
+        '-p', 'settle_time_s:=0.0'])
+    try:
+        grid = node._config.grid
+        published = []
+        node._event_pubs['room_done'].publish = published.append
+        _log_until(capfd, 'first fixation')
+        for search_id in (1, 2):
+            assert node._fixation_msg.data[2] == search_id and node.core.search_id == search_id
+            while not node.core.stopped:                # nobody: the sweep's pass, all empty
+                node._on_evidence(grid_arrays.to_multiarray(np.zeros(grid.n_cells), grid),
+                                  None)
+            assert f'room done (search {search_id}, absent' in _log_until(capfd, 'room done')
+            assert diagnostics.parse_room_done(published[-1])['search_id'] == search_id
+            node._on_reset(Trigger.Request(), Trigger.Response())
     finally:
         node.destroy_node()

@@ -250,7 +250,8 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
         self._resends = 0
         self._health = HealthMonitor(self._now_s())
         self._pan_tilt_msg = None
-        self.core.reset(self._now_s())
+        # the search the core began when built (search 1), restarted on this node's clock
+        self.core.reset(self._now_s(), new_search=False)
         self._clock_before_s = None         # the clock's reading before a jump (pre_callback)
         self._clock_jumps = self.get_clock().create_jump_callback(
             JumpThreshold(min_forward=Duration(seconds=CLOCK_JUMP_FORWARD_S),
