@@ -373,6 +373,35 @@ def test_a_model_sensors_target_is_one_cell_of_the_grid(scene, message):
     assert sensor.target == 7 and type(sensor.target) is int
 
 
+@pytest.mark.parametrize('cell', [True, False, np.True_, np.bool_(False)])
+def test_a_bool_is_no_cell(cell):
+    """QA: fixate(True) fixated cell 1: Python counts a bool as an integer, a cell it is not."""
+    from ipomdp_gaze.search.many import OccupancySession
+    message = f'a cell index must be a whole number, got {cell!r}'
+    model = count_model(1)
+    session = SearchSession(GRID, model, build_policy('elm', GRID, model), SearchSettings())
+    session.reset()
+    session.start()
+    many = OccupancySession(GRID, model, SearchSettings(targets='many'))
+    many.reset()
+    many.start()
+    sensor = ModelSensor(GRID, model, np.random.default_rng(0))
+    for call in (session.fixate, many.fixate, sensor.start, sensor.observe, GRID.cell):
+        with pytest.raises(ValueError, match=f'^{message}$'):
+            call(cell)
+    with pytest.raises(ValueError, match=f'^a row must be a whole number, got {cell!r}$'):
+        GRID.index(cell, 0)
+    with pytest.raises(ValueError, match='^fixation must be an integer cell index'):
+        model.offsets(cell)
+    with pytest.raises(ValueError, match=r'^start_cell must be \(row, col\) integers'):
+        SearchSettings(start_cell=(cell, 0))
+    with pytest.raises(ValueError, match='must be a whole number'):
+        sensor.observe(2.7)                     # was int(): cell 2
+    session.fixate(np.int64(1))
+    assert session.fixation == 1 and type(session.fixation) is int
+    assert SearchSettings(start_cell=(np.int64(1), 0)).start_cell == (1, 0)
+
+
 def test_the_event_log_records_each_step():
     model = count_model(8)
     session = SearchSession(GRID, model, build_policy('elm', GRID, model),

@@ -132,11 +132,14 @@ def check_radius(value, name: str) -> int:
 
 
 def check_start_cell(value, name: str = 'start_cell'):
-    """Return a start cell: ``(row, col)`` integers >= 0, ``'policy'`` or None."""
+    """Return a start cell: ``(row, col)`` integers >= 0 (no bools), ``'policy'`` or None."""
     if value is None or (isinstance(value, str) and value == 'policy'):
         return value
     try:
-        row, col = (operator.index(v) for v in value)
+        items = tuple(value)
+        if any(_is_bool(v) for v in items):
+            raise TypeError(value)
+        row, col = (operator.index(v) for v in items)
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be (row, col) integers, 'policy' or none (the "
                          f'default), got {value!r}') from None

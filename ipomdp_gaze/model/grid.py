@@ -156,12 +156,16 @@ class Grid:
 
 
 def _whole(value, what: str) -> int:
-    """Return a scalar cell coordinate as an int; a fraction (1.5) is refused, not truncated."""
+    """
+    Return a scalar cell coordinate as an int; a fraction (1.5) is refused, not truncated.
+
+    A bool (numpy's too) is refused: ``True`` is no cell, though Python counts it as 1.
+    """
     if type(value) is int:                      # the controller's every frame: no more work
         return value
     try:
         whole = int(value)
-        exact = whole == value
+        exact = whole == value and not isinstance(value, (bool, np.bool_))
     except (TypeError, ValueError, OverflowError):
         exact = False
     if not exact:

@@ -137,8 +137,10 @@ def gaussian_log_likelihood_ratio(observation: np.ndarray, dprime: np.ndarray,
 
 
 def _fixation_index(grid: Grid, fixation) -> int:
-    """Check a single fixation: an integer cell index inside ``grid``."""
+    """Check a single fixation: an integer cell index inside ``grid`` (a bool is none)."""
     try:
+        if isinstance(fixation, bool):
+            raise TypeError(fixation)
         k = operator.index(fixation)
     except TypeError:
         raise ValueError(f'fixation must be an integer cell index, got {fixation!r}') from None

@@ -72,7 +72,7 @@ class ModelSensor:
         return Frame(values, kind='scan')
 
     def observe(self, cell: int) -> Frame:
-        values = self.model.sample(self.target or 0, int(cell), self.rng,
+        values = self.model.sample(self.target or 0, fixation_index(self.grid, cell), self.rng,
                                    present=self.target is not None)
         return Frame(values)
 

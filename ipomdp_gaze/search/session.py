@@ -236,8 +236,9 @@ def fixation_index(grid: Grid, cell) -> int:
     """
     Return the cell a driver fixates (``fixate``) as a row-major index (ValueError otherwise).
 
-    One whole number in the grid: a fraction is refused, not truncated, and so is a sequence
-    or an array, which :meth:`Grid.cell` would take as many cells.
+    One whole number in the grid: a fraction is refused, not truncated, and so is a bool
+    (``True`` is no cell 1), a sequence or an array, which :meth:`Grid.cell` would take as many
+    cells.
     """
     if np.ndim(cell):
         raise ValueError(f'a cell index must be one whole number, got {cell!r}')
