@@ -298,7 +298,7 @@ def test_start_rules_centre_policy_and_cell():
 @pytest.mark.parametrize('changes, message', [
     ({'confidence': 1.0}, r'^confidence must be between 0 and 1 \(exclusive\), got 1.0$'),
     ({'confidence': 0}, r'^confidence must be between 0 and 1 \(exclusive\), got 0$'),
-    ({'confidence': 'high'}, r"^confidence must be between 0 and 1 \(exclusive\), got 'high'$"),
+    ({'confidence': 'high'}, r"^confidence must be a number, got 'high'$"),   # as in YAML
     ({'max_fixations': -1}, r'^search.max_fixations must be an integer >= 0 \(0: no budget\)'),
     ({'max_fixations': 2.5}, r'^search.max_fixations must be an integer >= 0'),
     ({'inhibit_return': 'yes'}, r'^search.inhibit_return must be true or false'),

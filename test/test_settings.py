@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 from dataclasses import fields, replace
 import pickle
+import re
 
 from conftest import REPO
 from ipomdp_gaze.commands.search_args import add_search_args, settings_from_args
@@ -109,6 +110,41 @@ def test_yaml_values_of_the_wrong_kind_are_refused(kind, value, message):
     name = next(s.parameter for s in SCHEMA if s.kind == kind)
     with pytest.raises(ValueError, match=message.replace('.', r'\.')):
         check_parameters({name: value})
+
+
+FLOATS = [s for s in SCHEMA if s.kind == 'float']
+
+
+@pytest.mark.parametrize('setting', FLOATS, ids=[s.key for s in FLOATS])
+def test_a_number_given_from_python_as_a_string_or_a_bool_is_refused_as_in_yaml(setting):
+    """
+    QA: SearchSettings(confidence='0.9') was taken, float() in the checks read the string.
+
+    A float setting from Python refuses a string and a bool (numpy's too) with the message
+    of the YAML check, which refuses YAML's '0.9' and true so; numbers, numpy's too, pass.
+    """
+    text = str(setting.default)
+    for value in (text, True, np.bool_(False)):
+        message = f'{setting.parameter} must be a number, got {value!r}'
+        with pytest.raises(ValueError, match=f'^{re.escape(message)}$'):
+            SearchSettings(**{setting.key: value})
+    with pytest.raises(ValueError, match=re.escape(f'{setting.parameter} must be a number, '
+                                                   'got True')):
+        check_parameters({setting.parameter: True})
+    for number in (setting.default, np.float64(setting.default)):
+        value = getattr(SearchSettings(**{setting.key: number}), setting.key)
+        assert value == setting.default and type(value) is float
+
+
+@pytest.mark.parametrize('value', ['2', '12', [True], ['2.0'], (1.0, '2')])
+def test_a_list_of_numbers_given_from_python_as_strings_or_bools_is_refused(value):
+    """QA: false_alarm_scales='2' was the factor 2 ('12': 1 and 2), [True] the factor 1."""
+    message = f'search.false_alarm_scales must be a list of numbers, got {value!r}'
+    with pytest.raises(ValueError, match=f'^{re.escape(message)}$'):
+        SearchSettings(false_alarm_scales=value)
+    assert SearchSettings(false_alarm_scales=np.array([2.0, 1.0])).false_alarm_scales == \
+        (1.0, 2.0)
+    assert SearchSettings(false_alarm_scales=[np.int64(4), 2]).false_alarm_scales == (2.0, 4.0)
 
 
 def test_a_typo_in_a_settings_namespace_is_refused_other_parameters_pass():

@@ -21,8 +21,10 @@ other edit. The module is pure: no rclpy, no argparse.
 """
 from __future__ import annotations
 
+from collections.abc import Collection
 from dataclasses import dataclass, field, make_dataclass, replace
 import math
+import numbers
 from typing import Callable, Mapping
 
 from ipomdp_gaze.model.checks import (check_budget, check_confidence, check_flag,
@@ -34,6 +36,7 @@ from ipomdp_gaze.model.false_alarms import (check_false_alarm_scales, check_hots
                                             MAX_HOTSPOT_PRIOR)
 from ipomdp_gaze.model.still_evidence import check_repeat_weight
 from ipomdp_gaze.search.room import MAX_PERIOD_S
+import numpy as np
 
 # A prediction further ahead than a minute says nothing about where a walking person is (the
 # head would chase the grid's corner); a dwell is bounded as room.dwell_s is (MAX_PERIOD_S).
@@ -313,7 +316,10 @@ class SettingsBase:
 
     def __post_init__(self):
         for s in self.SCHEMA:
-            object.__setattr__(self, s.key, s.check(getattr(self, s.key), s.parameter))
+            value = getattr(self, s.key)
+            if not _python_kind(s.kind, value):
+                raise ValueError(f'{s.parameter} must be {_KIND_WORDS[s.kind]}, got {value!r}')
+            object.__setattr__(self, s.key, s.check(value, s.parameter))
 
     @property
     def moving(self) -> bool:
@@ -389,6 +395,28 @@ def settings_class(schema=SCHEMA, name: str = 'SearchSettings', module: str = __
 
 _KIND_WORDS = {'float': 'a number', 'int': 'an integer', 'bool': 'true or false',
                'floats': 'a list of numbers', 'cell': '[row, col]', 'str': 'a string'}
+
+
+def _is_number(value) -> bool:
+    """Whether ``value`` is a real number (numpy's too) and no bool, as YAML's check takes."""
+    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+
+
+def _python_kind(kind: str, value) -> bool:
+    """
+    Whether a value given from Python has its setting's kind, as :func:`_check_kind` for YAML.
+
+    A number is no string and no bool (``confidence='0.9'`` and ``True`` are refused, as YAML's
+    ``'0.9'`` and ``true`` are; ``float()`` in the checks took them); a list of numbers is a
+    collection of numbers, not a string (``'2'`` was the factor 2). The other kinds' checks
+    refuse the wrong kind themselves.
+    """
+    if kind == 'float':
+        return _is_number(value)
+    if kind == 'floats':
+        return not isinstance(value, (str, bytes)) and (
+            not isinstance(value, Collection) or all(_is_number(v) for v in value))
+    return True
 
 
 def _check_kind(setting: Setting, value, where: str) -> None:
