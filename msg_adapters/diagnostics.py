@@ -60,18 +60,19 @@ def values_of(msg: DiagnosticStatus) -> dict:
 
 
 def _ending(forced_by: str, confidence: float | None,
-            probability: float | None = None) -> tuple[str, dict]:
+            probability: float | None = None, limit_cause: str = '') -> tuple[str, dict]:
     """
     Return the message's clause and the values that say how a decision was reached.
 
     A forced answer whose own ``probability`` is at the confidence anyway (a room's pass ends
     forced while the face the belief names is sure) is not said to be below it, as the log's
-    :func:`~ipomdp_gaze.search.answer.confidence_clause`.
+    :func:`~ipomdp_gaze.search.answer.confidence_clause`. ``limit_cause``: a repeat stop's
+    (:func:`~ipomdp_gaze.search.answer.limit_text`).
     """
     values = {'ended': f'forced:{forced_by}' if forced_by else 'confidence'}
     if confidence is not None:
         values['confidence'] = float(confidence)
-    limit = answer.LIMITS.get(forced_by, forced_by)
+    limit = answer.limit_text(forced_by, limit_cause)
     if forced_by == 'group':            # search.group_stop: a stop rule, not a limit
         values['ended'] = 'group'
         clause = ' at a grouped detection of the detector'
@@ -171,15 +172,17 @@ def reacquired_status(name: str, row: int, col: int, cell: int, pan_rad: float,
 
 def room_done_status(name: str, people: int, new_people: int, fixations: int, search_id: int,
                      recheck: bool, forced_by: str = '',
-                     confidence: float | None = None) -> DiagnosticStatus:
+                     confidence: float | None = None,
+                     limit_cause: str = '') -> DiagnosticStatus:
     """
     Build the ``room_done`` event of many-target mode: every cell decided, everyone found.
 
     ``people`` found, ``new_people`` among them (not within a cell of anyone known before;
     all of them after ``~/reset``), ``recheck`` whether the search was a periodic re-check;
-    ``ended`` and ``confidence`` as for ``found``.
+    ``ended`` and ``confidence`` as for ``found``; ``limit_cause`` what ended it at a repeat
+    stop (the session's, :data:`~ipomdp_gaze.search.answer.REPEATS`).
     """
-    clause, ending = _ending(forced_by, confidence)
+    clause, ending = _ending(forced_by, confidence, limit_cause=limit_cause)
     kind = 're-check' if recheck else 'search'
     message = (f'room done: {people_text(people)} found ({new_people} new) by {kind} {search_id} '
                f'after {counted(fixations, "fixation")}{clause}')

@@ -106,6 +106,18 @@ def test_room_done_event_round_trip():
     assert msg.message.startswith('room done: 1 person found (1 new) by search 2'), msg.message
 
 
+@pytest.mark.parametrize('cause, words', [
+    ('every_cell', 'the repeat stop (every cell fixated once)'),
+    ('next_repeats', 'the repeat stop (the next fixation would repeat a cell)'),
+    ('nothing_new', 'the repeat stop (no view left would tell anything new)')])
+def test_a_room_done_at_its_repeat_stop_says_what_ended_it(cause, words):
+    """QA: a room forced at its repeat stop was 'forced by every cell fixated once' always."""
+    msg = diagnostics.room_done_status('x', 0, 0, 9, 3, False, 'repeat', 0.99, cause)
+    assert msg.message == ('room done: 0 people found (0 new) by search 3 after 9 fixations, '
+                           f'forced by {words} below the confidence 0.99')
+    assert diagnostics.parse_room_done(msg)['ended'] == 'forced:repeat'
+
+
 def test_a_forced_answer_at_the_confidence_is_not_said_to_be_below_it():
     """A room's pass forced found of a sure cell: the event said 1.0000 'below' 0.95."""
     msg = diagnostics.found_status('x', 9, 7, 106, -0.17, 0.35, 1.0, 16, 'pass', 0.95)

@@ -527,6 +527,28 @@ def test_a_new_search_on_the_recorded_image_starts_at_the_recorded_prior():
     assert result.cell == (3, 4) and result.decision == 'found', lines
 
 
+@pytest.mark.parametrize('inhibit_return, cause', [
+    (False, 'the next fixation would repeat a cell'), (True, 'every cell fixated once')])
+def test_a_new_search_says_what_ended_it_at_its_repeat_stop(inhibit_return, cause):
+    """QA: replay --new-search said 'every cell fixated once' of any repeat stop."""
+    from ipomdp_gaze.drivers.replay import new_search
+    controller = _parameters('faces_fovea_controller.yaml')
+    controller.update({'policy.name': 'elm', 'search.stop_on_repeat': True,
+                       'search.inhibit_return': inhibit_return, 'search.scan': False})
+    detector = yaml_parameters(REPO / 'config' / 'faces_fovea_detector.yaml', 'foveal_detector')
+    side = 420
+    image = SimpleNamespace(encoding='mono8', height=side, width=side, step=side,
+                            data=np.full(side * side, 128, dtype=np.uint8))
+    custom = {'ipomdp_gaze/parameters/gaze_controller': yaml.safe_dump(controller),
+              'ipomdp_gaze/parameters/foveal_detector': yaml.safe_dump(detector)}
+    bag = Bag(Path('bag'), [BagMessage('/image', int(1e9), image, side * side)], custom, 0, 1.0)
+    lines = []
+    result = new_search(bag, out=lines.append)
+    assert (result.decision, result.stop) == ('gave_up', 'repeat'), lines
+    assert lines[-1].startswith('new search on the recorded image: gave up at the repeat stop '
+                                f'({cause}); most likely '), lines
+
+
 def test_a_bad_option_is_its_one_line_before_anything_is_said(cli_here, monkeypatch, tmp_path):
     """QA: ``replay --policy bogus`` printed ``settings: recorded, with policy=bogus`` first."""
     bag = _tracked_bag()

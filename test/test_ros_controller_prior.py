@@ -246,11 +246,12 @@ def test_a_still_room_that_gave_up_at_its_budget_is_not_said_done(
         people = '2 people{} (2 new): (4, 4) p=1.000, (6, 6) p=1.000'
         if decide_at_budget:
             assert node.core.decision == 'found' and len(published) == 1
-            said = f'room done (search {node.core.search_id}, found, forced by budget): '
+            said = f'room done (search {node.core.search_id}, found), forced by the fixation ' \
+                'budget: '
             assert said + people.format('') in _log_until(capfd, 'people')
         else:
             assert node.core.decision == 'gave_up' and published == []
-            said = f'search {node.core.search_id} ended undecided (gave_up, forced by budget): '
+            said = f'search {node.core.search_id} ended undecided at the fixation budget: '
             log = _log_until(capfd, 'people')
             assert said + people.format(' at the confidence 0.95') in log and 'room done' \
                 not in log, log
@@ -344,25 +345,30 @@ def test_the_start_up_line_says_the_still_scene_rules_are_off_for_a_moving_targe
         node.destroy_node()
 
 
-@pytest.mark.parametrize('targets, settings, response, fixations, cause', [
-    ('one', {'search.max_fixations': 2}, 2.0, 2, 'search.max_fixations'),
+@pytest.mark.parametrize('targets, settings, response, fixations, cause, limit', [
+    ('one', {'search.max_fixations': 2}, 2.0, 2, 'search.max_fixations', ''),
     ('one', {'search.inhibit_return': True, 'search.stop_on_repeat': True}, 2.0, 4,
-     'search.stop_on_repeat'),
-    ('one', {'search.stop_on_repeat': True}, 2.0, 1, 'search.stop_on_repeat'),
-    ('many', {'search.max_fixations': 2}, 2.0, 2, 'search.max_fixations'),
-    ('many', {'search.inhibit_return': True}, 2.0, 4, 'search.inhibit_return'),
-    ('many', {'search.stop_on_repeat': True}, 2.0, 1, 'search.stop_on_repeat'),
-    ('many', {'fpoc.dprime': 1e-6}, 0.0, 1, 'no view left would tell anything new')],
+     'search.stop_on_repeat', ''),
+    ('one', {'search.stop_on_repeat': True}, 2.0, 1, 'search.stop_on_repeat', ''),
+    ('many', {'search.max_fixations': 2}, 2.0, 2, 'search.max_fixations',
+     'the fixation budget'),
+    ('many', {'search.inhibit_return': True}, 2.0, 4, 'search.inhibit_return',
+     'the repeat stop (every cell fixated once)'),
+    ('many', {'search.stop_on_repeat': True}, 2.0, 1, 'search.stop_on_repeat',
+     'the repeat stop (the next fixation would repeat a cell)'),
+    ('many', {'fpoc.dprime': 1e-6}, 0.0, 1, 'no view left would tell anything new',
+     'the repeat stop (no view left would tell anything new)')],
     ids=['budget', 'repeat-inhibited', 'repeat', 'room-budget', 'room-inhibited',
          'room-repeat', 'room-nothing-new'])
 def test_gave_up_names_the_parameter_behind_its_limit(
-        context, capfd, targets, settings, response, fixations, cause):
+        context, capfd, targets, settings, response, fixations, cause, limit):
     """
     QA: 'gave up' always ended '(search.max_fixations)', also when search.stop_on_repeat ended it.
 
     The log and the gave_up event name the rule that ended the search (the event says 'the
     budget' for search.max_fixations, as before); a room whose views can tell nothing new
-    gives up by no parameter's rule, and says so.
+    gives up by no parameter's rule, and says so. QA: a room's log line then said
+    '(gave_up, forced by repeat)'; it says the limit in find's and search's words.
     """
     from ipomdp_gaze.msg_adapters import grid_arrays
     from rclpy.parameter import Parameter
@@ -384,8 +390,12 @@ def test_gave_up_names_the_parameter_behind_its_limit(
         log = _log_until(capfd, 'gave up')
         said = f'gave up: no decision after {fixations} fixation'
         assert f"{said}{'s' if fixations > 1 else ''} ({cause})" in log, log
-        limit = 'the budget' if cause == 'search.max_fixations' else cause
-        assert [m.message.endswith(f'({limit})') for m in published] == [True], published
+        event = 'the budget' if cause == 'search.max_fixations' else cause
+        assert [m.message.endswith(f'({event})') for m in published] == [True], published
+        if limit:
+            if 'ended undecided' not in log:
+                log += _log_until(capfd, 'ended undecided')
+            assert f'search {node.core.search_id} ended undecided at {limit}: ' in log, log
     finally:
         node.destroy_node()
 

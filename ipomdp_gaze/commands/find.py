@@ -706,8 +706,8 @@ def plot_title(path: str, result, confidence: float, occupancy: bool = False,
     if nobody:
         return f'{name}: {nobody_text(result, confidence)}, {tail}'
     where = f', cell (row, col) {result.cell}' if result.decision == 'found' else ''
-    return (f'{name}: {answer.heading(result.decision, _reason(result))}{where}, '
-            f'{answer.probability_text(result.decision, p)}'
+    heading = answer.heading(result.decision, _reason(result), _cause(result))
+    return (f'{name}: {heading}{where}, {answer.probability_text(result.decision, p)}'
             f'{answer.confidence_clause(result.decision, _reason(result), p, confidence)}, '
             f'{tail}')
 
@@ -726,8 +726,8 @@ def forced_faces_text(result, confidence: float) -> str:
     which = (f'every face at the confidence {confidence:g}' if sure == len(probabilities) else
              f'no face at the confidence {confidence:g}' if not sure else
              f'{sure} of the faces at the confidence {confidence:g}, the others forced')
-    return (f'search forced by {answer.LIMITS[result.stop]}: cells still undecided on their '
-            f'likelier side; {which}')
+    return (f'search forced by {answer.limit_text(result.stop, _cause(result))}: cells '
+            f'still undecided on their likelier side; {which}')
 
 
 def nobody_text(result, confidence: float) -> str:
@@ -740,12 +740,17 @@ def nobody_text(result, confidence: float) -> str:
     reason = _reason(result)
     rule = ('every cell likelier empty than occupied' if answer.forced('absent', reason) else
             f'every cell decided empty at the confidence {confidence:g}')
-    return (f'{answer.heading("absent", reason)}: {rule}, P(nobody here) '
+    return (f'{answer.heading("absent", reason, _cause(result))}: {rule}, P(nobody here) '
             f'{result.answer_probability:.3f}')
 
 
 def _reason(result) -> str:
     return result.method if result.method in ('full_frame', 'scales') else result.stop
+
+
+def _cause(result) -> str:
+    """Return what ended a search at its repeat stop (``ImageSearch.limit_cause``), else ''."""
+    return getattr(result, 'limit_cause', '')
 
 
 def entry(path: str, result, grid, confidence: float | None = None) -> dict:

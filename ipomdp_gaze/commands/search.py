@@ -123,7 +123,7 @@ def run_search(grid, model, policy, target, settings: SearchSettings, seed, out=
             f'budget ({NO_BUDGET_FRAMES_PER_CELL} per cell); {likeliest}, which is {verdict}')
     elif result.decision == 'gave_up':
         out(f'gave up: no cell reached the confidence {settings.confidence:.12g} at '
-            f'{answer.LIMITS.get(result.reason, result.reason)}; {likeliest}, after '
+            f'{answer.limit_text(result.reason, session.limit_cause)}; {likeliest}, after '
             f'{counted(result.fixations, "fixation")}, which is {verdict}')
     else:
         out(f'{answer.heading(result.decision, result.reason)}: the target is most likely at '
@@ -191,7 +191,7 @@ def run(args) -> int:
             ending = (f'gave up at the cap of an offline search ({NO_BUDGET_FRAMES_PER_CELL} per '
                       'cell)')
         elif result.decision == 'gave_up':
-            ending += f' at {answer.LIMITS.get(result.reason, result.reason)}'
+            ending += f' at {answer.limit_text(result.reason)}'
         # Two lines: one would run past the figure's edges and under the colour bar.
         p = (f'P(absent)={result.absent_probability:.3f}' if result.decision == 'absent'
              else f'p={result.map_probability:.3f}')

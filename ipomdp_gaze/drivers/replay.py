@@ -998,7 +998,7 @@ def new_search(bag, overrides: dict | None = None, out=print):
                         result.stop if answer.forced(result.decision, result.stop) else '')
     if result.decision == 'gave_up':
         out(f'new search on the recorded image: gave up at '
-            f'{answer.LIMITS.get(result.stop, result.stop)}; most likely {result.cell} '
+            f'{answer.limit_text(result.stop, result.limit_cause)}; most likely {result.cell} '
             f'p={result.probability:.3f} after {counted(result.fixations, "fixation")}')
     else:
         out(f'new search on the recorded image: {decision.describe(setup.fovea.grid)}')

@@ -794,8 +794,10 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
 
         ``room_done`` is published when every cell was decided (``found`` or ``absent``, also
         when the fixation budget forced it with ``search.decide_at_budget``), and the log says
-        the room is done; after ``gave_up`` the people are those whose cells reached the
-        confidence, and the log says the search ended undecided.
+        the room is done (``room done (search 2, found), forced by the fixation budget``); after
+        ``gave_up`` the people are those whose cells reached the confidence, and the log says
+        the search ended undecided at its limit, in the words of :mod:`..search.answer`
+        (``search 2 ended undecided at the repeat stop (every cell fixated once)``).
         """
         core, grid = self.core, self._config.grid
         session = core.session
@@ -804,16 +806,18 @@ class GazeControllerNode(GuardedNode, RangeReasons, QuietPublishers, Node):
         self._publish_people(done.people)
         kind = 're-check' if done.recheck else 'search'
         where = ', '.join(f'{grid.cell(p.cell)} p={p.probability:.3f}' for p in done.people)
-        forced = f', forced by {session.gave_up_reason}' if session.gave_up_reason else ''
+        limit = answer.limit_text(session.gave_up_reason, session.limit_cause)
         people_found = people_text(len(done.people))
         if core.decision in ('found', 'absent'):
             self._event_pubs['room_done'].publish(diagnostics.room_done_status(
                 f'{self.get_fully_qualified_name()}: room_done', len(done.people),
                 len(done.new), core.fixations, core.search_id, done.recheck,
-                session.gave_up_reason, core.settings.confidence))
-            heading = f'room done ({kind} {core.search_id}, {core.decision}{forced})'
+                session.gave_up_reason, core.settings.confidence, session.limit_cause))
+            heading = f'room done ({kind} {core.search_id}, {core.decision})' + \
+                (f', forced by {limit}' if limit else '')
         else:
-            heading = f'{kind} {core.search_id} ended undecided ({core.decision}{forced})'
+            heading = f'{kind} {core.search_id} ended undecided' + \
+                (f' at {limit}' if limit else '')
             people_found += f' at the confidence {core.settings.confidence}'
         self.get_logger().info(f'{heading}: {people_found} ({len(done.new)} new)'
                                f'{": " + where if where else ""}')
@@ -949,7 +953,7 @@ def _gave_up_cause(session) -> str:
     if setting:
         return PARAMETER_NAMES[setting]
     if reason == 'repeat':
-        return 'no view left would tell anything new'
+        return answer.REPEATS['nothing_new']
     return answer.LIMITS.get(reason, reason)
 
 

@@ -6,7 +6,9 @@ How a search ended, in one wording for every driver (find, demo, search, replay,
 A search ends with a **decision** (``found``, ``absent`` or ``gave_up``) and a **reason**: the
 evidence reached ``confidence`` (reason ``found`` / ``absent`` / ''), or a limit ended it:
 ``budget`` (the fixation budget), ``pixels`` (``find``'s cost cap: one full-resolution scan of
-detector pixels), ``repeat`` (every cell fixated once), ``timeout``. At a limit a search gives up,
+detector pixels), ``repeat`` (the repeat stop: every cell fixated once, the next fixation would
+repeat a cell, or, many targets, no view left would tell anything new; :data:`REPEATS`),
+``timeout``. At a limit a search gives up,
 or, with ``decide_at_budget``, is **forced** to the likelier of ``found`` and ``absent``, whose
 probability is then below ``confidence``. With ``search.group_stop`` a grouped detection ends a
 search ``found`` at its cell (reason ``group``), whatever its probability.
@@ -25,8 +27,28 @@ import math
 
 # The limits that can end a search, and their words.
 LIMITS = {'budget': 'the fixation budget', 'pixels': 'the pixel budget (one full scan)',
-          'repeat': 'every cell fixated once', 'timeout': 'the time limit',
+          'repeat': 'the repeat stop', 'timeout': 'the time limit',
           'pass': 'the end of its pass'}
+# The causes of a ``repeat`` stop (a session's ``limit_cause``), and their words: with
+# inhibition of return every cell was fixated (search.stop_on_repeat; many targets: also
+# without it), without it the policy's next fixation was a cell fixated already
+# (search.stop_on_repeat), or, many targets, no view left would tell anything new.
+REPEATS = {'every_cell': 'every cell fixated once',
+           'next_repeats': 'the next fixation would repeat a cell',
+           'nothing_new': 'no view left would tell anything new'}
+
+
+def limit_text(reason: str, cause: str = '') -> str:
+    """
+    Return the words of the limit ``reason``; for ``repeat`` with its ``cause`` when known.
+
+    ``the repeat stop (every cell fixated once)``, as ``the pixel budget (one full scan)``;
+    a reason that is no limit of :data:`LIMITS` (a driver's own) is its own word.
+    """
+    words = LIMITS.get(reason, reason)
+    if reason == 'repeat' and cause in REPEATS:
+        return f'{words} ({REPEATS[cause]})'
+    return words
 
 
 def ended(decision: str, reason: str = '') -> str:
@@ -73,8 +95,12 @@ def answer_probability(decision: str, cell_probability: float,
     return float(absent_probability if decision == 'absent' else cell_probability)
 
 
-def heading(decision: str, reason: str = '') -> str:
-    """Return the decision word with how it ended: ``found``, ``absent, forced by ...``."""
+def heading(decision: str, reason: str = '', cause: str = '') -> str:
+    """
+    Return the decision word with how it ended: ``found``, ``absent, forced by ...``.
+
+    ``cause``: a ``repeat`` stop's (:func:`limit_text`).
+    """
     if decision == 'gave_up':
         return 'gave up'
     if reason == 'full_frame':
@@ -84,7 +110,7 @@ def heading(decision: str, reason: str = '') -> str:
     if reason == 'group':
         return f'{decision} at a grouped detection'
     if forced(decision, reason):
-        return f'{decision}, forced by {LIMITS[reason]}'
+        return f'{decision}, forced by {limit_text(reason, cause)}'
     return decision
 
 

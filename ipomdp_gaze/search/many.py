@@ -384,6 +384,21 @@ class OccupancySession:
         """
         s = self._s()
         return {'budget': 'max_fixations', 'repeat': s['repeat_rule']}.get(s['reason'], '')
+
+    @property
+    def limit_cause(self) -> str:
+        """
+        Return what ended the search at a ``repeat`` stop, else '' (:data:`answer.REPEATS`).
+
+        ``every_cell`` (``search.inhibit_return``: every cell was fixated), ``next_repeats``
+        (``search.stop_on_repeat``: the best view was one already taken) or ``nothing_new``
+        (no view left would tell anything new).
+        """
+        s = self._s()
+        if s['reason'] != 'repeat':
+            return ''
+        return {'inhibit_return': 'every_cell', 'stop_on_repeat': 'next_repeats'}.get(
+            s['repeat_rule'], 'nothing_new')
     log = property(lambda self: tuple(self._log))
 
     @property

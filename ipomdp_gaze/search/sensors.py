@@ -85,7 +85,8 @@ class SearchOutcome:
     ``decision`` is ``found``, ``absent`` or ``gave_up`` (``reason`` ``budget`` or ``repeat``),
     or '' when the driver's frame limit stopped it first; ``cell`` the most likely cell then,
     ``path`` the fixated cells, ``detector_pixels`` and ``seconds`` the sensor's cost plus, for
-    ``seconds``, the session's (wall time from start to answer).
+    ``seconds``, the session's (wall time from start to answer). ``limit_cause`` is a repeat
+    stop's cause (the session's, :data:`ipomdp_gaze.search.answer.REPEATS`), else ''.
     """
 
     decision: str
@@ -99,6 +100,7 @@ class SearchOutcome:
     seconds: float
     belief: np.ndarray
     log: tuple
+    limit_cause: str = ''
 
 
 def run_search(session: SearchSession, sensor: Sensor, scene, *, seed=None,
@@ -179,7 +181,8 @@ def run_search(session: SearchSession, sensor: Sensor, scene, *, seed=None,
     return SearchOutcome(session.decision, session.gave_up_reason, best,
                          session.map_probability, session.absent_probability,
                          session.fixations, session.path, int(pixels),
-                         time.perf_counter() - t0, session.belief, session.log)
+                         time.perf_counter() - t0, session.belief, session.log,
+                         session.limit_cause)
 
 
 def _check(result):

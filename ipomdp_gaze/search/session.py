@@ -351,6 +351,8 @@ class _Search:
     scanned: bool = False
     decision: str = ''
     reason: str = ''
+    # A repeat stop's cause (:attr:`SearchSession.limit_cause`), as the settings were then.
+    repeat_cause: str = ''
     ended: bool = False
     decided_once: bool = False
     group_cell: int | None = None
@@ -664,6 +666,17 @@ class SearchSession:
             self._state().reason, '')
 
     @property
+    def limit_cause(self) -> str:
+        """
+        Return what ended the search at a ``repeat`` stop, else '' (:data:`answer.REPEATS`).
+
+        ``every_cell`` (inhibition of return, still target: every cell was fixated) or
+        ``next_repeats`` (the policy's next fixation was a cell fixated already).
+        """
+        search = self._state()
+        return search.repeat_cause if search.reason == 'repeat' else ''
+
+    @property
     def ended(self) -> bool:
         """Return whether the search has ended: no more frames until :meth:`reset`."""
         return self._state().ended
@@ -916,6 +929,8 @@ class SearchSession:
             following = self._choose()
             if following is None:
                 search.decision, search.reason, search.ended = 'gave_up', 'repeat', True
+                search.repeat_cause = 'every_cell' if self.settings.inhibit_return \
+                    and not self.motion.active else 'next_repeats'
                 fired = 'gave_up'
             else:
                 search.fixation = following

@@ -302,6 +302,9 @@ class ImageSearch:
         A full-frame scan's grouped detections, box centres ``(x, y)`` in image pixels.
     faces : tuple of Face
         A many-target search's faces (:func:`search_many`), most probable first; () otherwise.
+    limit_cause : str
+        What ended the search at a ``repeat`` stop (``every_cell``, ``next_repeats``,
+        ``nothing_new``: :data:`ipomdp_gaze.search.answer.REPEATS`), else ''.
 
     """
 
@@ -336,6 +339,7 @@ class ImageSearch:
         return answer.answer_probability(self.decision, self.probability,
                                          self.absent_probability)
     faces: tuple = ()
+    limit_cause: str = ''
 
     @property
     def size_matches(self) -> bool:
@@ -496,7 +500,7 @@ def _image_search(outcome, grid, image_px, calibrated, t0: float, decision: str,
                        seconds=time.perf_counter() - t0, belief=outcome.belief,
                        image_px=image_px, calibrated_px=calibrated, decision=decision,
                        absent_probability=outcome.absent_probability, log=outcome.log,
-                       faces=faces)
+                       faces=faces, limit_cause=outcome.limit_cause)
 
 
 def face_cells(grid: Grid, cell: int, radius: int = 1) -> np.ndarray:

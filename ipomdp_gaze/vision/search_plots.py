@@ -75,7 +75,8 @@ def annotate_image_search(image: np.ndarray, result, fovea,
         p = result.answer_probability
         said = (f'P(nobody here) {p:.3f}, the product over the cells' if occupancy and
                 not np.isnan(p) else answer.probability_text('absent', p))
-        label = f'{answer.heading("absent", reason)}: {said}'
+        label = f'{answer.heading("absent", reason, getattr(result, "limit_cause", ""))}: ' \
+            f'{said}'
     else:
         found = (grid.index(*result.cell), result.probability)
         if result.decision == 'gave_up':
