@@ -181,9 +181,16 @@ def test_the_scaled_null_table_keeps_uninformative_offsets_and_caps_detections()
 
 
 @pytest.mark.parametrize('value', [[], [0.0], [1.0, 1.0], [float('nan')], [-2.0],
-                                   list(range(1, 10)), 'abc', None])
+                                   list(range(1, 10)), None])
 def test_bad_scales_are_refused_with_the_parameter_name(value):
     with pytest.raises(ValueError, match='search.false_alarm_scales must be 1 to 8 distinct'):
+        SearchSettings(false_alarm_scales=value)
+
+
+@pytest.mark.parametrize('value', ['abc', '12', [True]])
+def test_scales_that_are_no_list_of_numbers_are_refused_with_the_parameter_name(value):
+    """Text was read as its characters ('12': the factors 1 and 2), a bool as the factor 1."""
+    with pytest.raises(ValueError, match='search.false_alarm_scales must be a list of numbers'):
         SearchSettings(false_alarm_scales=value)
 
 
