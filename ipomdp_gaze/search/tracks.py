@@ -285,8 +285,10 @@ class Tracks:
         likeliest of its :data:`SPILL_CELLS` neighbourhood (a tie is broken by that order) and is
         not within it of a peak taken before (its spill-over). ValueError: as :meth:`step`.
         """
-        probability = check_probability(probability, self.grid)
-        keep = _check_keep(keep)
+        return self._peaks(check_probability(probability, self.grid), _check_keep(keep))
+
+    def _peaks(self, probability: np.ndarray, keep: float) -> np.ndarray:
+        """Return :meth:`peaks` of probabilities and a keep checked already."""
         with np.errstate(divide='ignore'):
             empty = np.log1p(-np.minimum(probability, 1.0))
         empty = empty.reshape(self.grid.rows, self.grid.cols)
@@ -296,17 +298,17 @@ class Tracks:
                     for r in range(size) for c in range(size))
         top = maximum_filter(probability.reshape(self.grid.rows, self.grid.cols), size=size,
                              mode='nearest').reshape(-1)
-        holds = (-np.expm1(total.reshape(-1)) >= keep) & (probability >= top)
+        holds = np.flatnonzero((-np.expm1(total.reshape(-1)) >= keep) & (probability >= top))
         out, blocked = [], np.zeros(self.grid.n_cells, dtype=bool)
-        for cell in np.argsort(-probability, kind='stable'):
-            if holds[cell] and not blocked[cell]:
+        for cell in holds[np.argsort(-probability[holds], kind='stable')]:
+            if not blocked[cell]:
                 out.append(int(cell))
                 blocked |= near(self.grid, cell, SPILL_CELLS)
         return np.array(out, dtype=np.int64)
 
     def _assign(self, found: list, centres: list, probability, keep: float) -> dict:
         """Return ``{index in found: cell}``: each person's peak, by global nearest neighbour."""
-        peaks = self.peaks(probability, keep) if found else np.empty(0, dtype=np.int64)
+        peaks = self._peaks(probability, keep) if found else np.empty(0, dtype=np.int64)
         if not len(peaks):
             return {}
         grid = self.grid
