@@ -51,7 +51,6 @@ from __future__ import annotations
 import bisect
 from collections import deque
 from dataclasses import dataclass, field
-import inspect
 import math
 from pathlib import Path
 import time
@@ -320,7 +319,7 @@ def _takes_cascade_dir(recorded) -> bool:
     :func:`~ipomdp_gaze.vision.detectors.detector_from_settings` passes it). A record whose kind
     cannot be loaded is left to the build, which names its fault.
     """
-    from ipomdp_gaze.vision.detectors import load_factory
+    from ipomdp_gaze.vision.detectors import load_factory, takes_cascade_dir
     if not isinstance(recorded, dict):
         return True
     kind = recorded.get('kind')
@@ -330,13 +329,9 @@ def _takes_cascade_dir(recorded) -> bool:
     if kind == 'haar':
         return True
     try:
-        from_settings = getattr(load_factory(kind), 'from_settings', None)
-        if not callable(from_settings):
-            return False
-        params = inspect.signature(from_settings).parameters
+        return takes_cascade_dir(load_factory(kind))
     except (ValueError, TypeError):
         return True
-    return 'cascade_dir' in params or any(p.kind == p.VAR_KEYWORD for p in params.values())
 
 
 def _cascade_names(recorded) -> list:

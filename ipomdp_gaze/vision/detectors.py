@@ -296,6 +296,15 @@ def compare_settings(recorded: dict, current: dict, info_keys=INFO_KEYS) -> list
             if key in info_keys and key in recorded and recorded.get(key) != current.get(key)]
 
 
+def takes_cascade_dir(factory) -> bool:
+    """Whether a factory's ``from_settings`` takes ``cascade_dir`` (by name or ``**kwargs``)."""
+    from_settings = getattr(factory, 'from_settings', None)
+    if not callable(from_settings):
+        return False
+    params = inspect.signature(from_settings).parameters
+    return 'cascade_dir' in params or any(p.kind == p.VAR_KEYWORD for p in params.values())
+
+
 def detector_from_settings(settings: dict, cascade_dir=None, on_note=None):
     """
     Rebuild the detector an observation model records (``meta['detector']``).
@@ -322,8 +331,7 @@ def detector_from_settings(settings: dict, cascade_dir=None, on_note=None):
     info = info_keys_of(factory)
     from_settings = getattr(factory, 'from_settings', None)
     if callable(from_settings):
-        params = inspect.signature(from_settings).parameters
-        takes = 'cascade_dir' in params or any(p.kind == p.VAR_KEYWORD for p in params.values())
+        takes = takes_cascade_dir(factory)
         context = {'cascade_dir': cascade_dir} if cascade_dir is not None and takes else {}
         with _named_errors(kind):
             detector = from_settings(dict(settings), **context)
