@@ -422,11 +422,10 @@ def _python_kind(kind: str, value) -> bool:
 def _check_kind(setting: Setting, value, where: str) -> None:
     """Refuse a YAML value of the wrong kind (a string for a number, 1 for true)."""
     kind = setting.kind
-    ok = {'float': isinstance(value, (int, float)) and not isinstance(value, bool),
+    ok = {'float': _is_number(value),
           'int': isinstance(value, int) and not isinstance(value, bool),
           'bool': isinstance(value, bool),
-          'floats': isinstance(value, list) and all(
-              isinstance(v, (int, float)) and not isinstance(v, bool) for v in value),
+          'floats': isinstance(value, list) and all(_is_number(v) for v in value),
           'cell': value is None or isinstance(value, (list, str)),
           'str': isinstance(value, str)}[kind]
     if not ok:
