@@ -282,6 +282,17 @@ def test_a_bad_option_is_named_as_the_option_not_the_recording(option, value, me
     assert settings_from(values, {option: None}) == values
 
 
+def _grey_image_bag(controller: dict) -> Bag:
+    """Return a bag of one grey 420x420 image with the fovea detector's and ``controller``'s settings."""
+    detector = yaml_parameters(REPO / 'config' / 'faces_fovea_detector.yaml', 'foveal_detector')
+    side = 420
+    image = SimpleNamespace(encoding='mono8', height=side, width=side, step=side,
+                            data=np.full(side * side, 128, dtype=np.uint8))
+    custom = {'ipomdp_gaze/parameters/gaze_controller': yaml.safe_dump(controller),
+              'ipomdp_gaze/parameters/foveal_detector': yaml.safe_dump(detector)}
+    return Bag(Path('bag'), [BagMessage('/image', int(1e9), image, side * side)], custom, 0, 1.0)
+
+
 def _with(bag: Bag, messages=(), **custom) -> Bag:
     """Return ``bag`` with more ``messages`` and ``custom_data`` entries."""
     return Bag(bag.path, sorted(list(bag.messages) + list(messages), key=lambda m: m.time_ns),
@@ -515,13 +526,7 @@ def test_a_new_search_on_the_recorded_image_starts_at_the_recorded_prior():
     weights = np.zeros(21 * 21)
     weights[3 * 21 + 4] = 1.0                   # the face is known to be at (3, 4)
     controller['belief.prior'] = weights.tolist()
-    detector = yaml_parameters(REPO / 'config' / 'faces_fovea_detector.yaml', 'foveal_detector')
-    side = 420
-    image = SimpleNamespace(encoding='mono8', height=side, width=side, step=side,
-                            data=np.full(side * side, 128, dtype=np.uint8))
-    custom = {'ipomdp_gaze/parameters/gaze_controller': yaml.safe_dump(controller),
-              'ipomdp_gaze/parameters/foveal_detector': yaml.safe_dump(detector)}
-    bag = Bag(Path('bag'), [BagMessage('/image', int(1e9), image, side * side)], custom, 0, 1.0)
+    bag = _grey_image_bag(controller)
     lines = []
     result = new_search(bag, out=lines.append)
     assert result.cell == (3, 4) and result.decision == 'found', lines
@@ -535,13 +540,7 @@ def test_a_new_search_says_what_ended_it_at_its_repeat_stop(inhibit_return, caus
     controller = _parameters('faces_fovea_controller.yaml')
     controller.update({'policy.name': 'elm', 'search.stop_on_repeat': True,
                        'search.inhibit_return': inhibit_return, 'search.scan': False})
-    detector = yaml_parameters(REPO / 'config' / 'faces_fovea_detector.yaml', 'foveal_detector')
-    side = 420
-    image = SimpleNamespace(encoding='mono8', height=side, width=side, step=side,
-                            data=np.full(side * side, 128, dtype=np.uint8))
-    custom = {'ipomdp_gaze/parameters/gaze_controller': yaml.safe_dump(controller),
-              'ipomdp_gaze/parameters/foveal_detector': yaml.safe_dump(detector)}
-    bag = Bag(Path('bag'), [BagMessage('/image', int(1e9), image, side * side)], custom, 0, 1.0)
+    bag = _grey_image_bag(controller)
     lines = []
     result = new_search(bag, out=lines.append)
     assert (result.decision, result.stop) == ('gave_up', 'repeat'), lines
