@@ -283,7 +283,7 @@ def test_a_bad_option_is_named_as_the_option_not_the_recording(option, value, me
 
 
 def _grey_image_bag(controller: dict) -> Bag:
-    """Return a bag of one grey 420x420 image with the fovea detector's and ``controller``'s settings."""
+    """Return a bag of one grey 420x420 image with the detector's and the controller's settings."""
     detector = yaml_parameters(REPO / 'config' / 'faces_fovea_detector.yaml', 'foveal_detector')
     side = 420
     image = SimpleNamespace(encoding='mono8', height=side, width=side, step=side,
