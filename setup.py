@@ -25,7 +25,7 @@ ROS_INSTALL = bool({'install', 'develop'} & set(sys.argv[1:]))
 
 setup(
     name=PACKAGE,
-    version='0.3.9',
+    version='0.3.10',
     # One import namespace: policies/ and msg_adapters/ are reached through the committed
     # symlinks ipomdp_gaze/policies and ipomdp_gaze/msg_adapters (docs/design.md section 8).
     packages=find_packages(include=[PACKAGE, f'{PACKAGE}.*']),

@@ -251,28 +251,31 @@ def config_path(name: str) -> str:
     return str(config_file(name))
 
 
-def offline_room(seed: int, faces: int):
+def offline_room(seed: int, faces: int, label: str = 'pass-many-cells'):
     """
     Run the offline pass on room 0 of ``seed`` with ``faces`` faces, as the scene camera shows it.
 
-    Return the task, the session's outcome and its people (``drivers.rooms.room_session``).
+    Return the task, the session's outcome and its people (``drivers.rooms.room_session``;
+    ``label`` a room searcher, ``pass-many-cells:parameter=value,...`` for other settings).
     """
     from ipomdp_gaze.drivers.rooms import room_session
     from ipomdp_gaze.drivers.scene_tasks import SceneTask, task_spec
     spec = task_spec('pan-tilt', seed=seed, faces=faces)
     task = SceneTask.get(spec)
     task.sensor.start(task.scene(0).image)
-    _, outcome, _, people = room_session(spec, task, 0, 'pass-many-cells')
+    _, outcome, _, people = room_session(spec, task, 0, label)
     return task, outcome, people
 
 
-def start_room(probe, nodes, seed: int, faces: int, node: str = 'gaze_controller') -> dict:
+def start_room(probe, nodes, seed: int, faces: int, node: str = 'gaze_controller',
+               extra: tuple = ()) -> dict:
     """
     Start the rooms' three nodes (shipped pan/tilt configs, the rooms' overlays) on one room.
 
-    The controller first (dwell 0.3 s, no re-check), then the detector and the scene camera on
-    room 0 of ``seed`` with ``faces`` faces. Return the probe's records (``targets``,
-    ``cells``, ``done``, ``pan_tilt``) and the ``controller`` and ``detector`` processes.
+    The controller first (dwell 0.3 s, no re-check, ``extra`` more arguments), then the detector
+    and the scene camera on room 0 of ``seed`` with ``faces`` faces. Return the probe's records
+    (``targets``, ``cells``, ``done``, ``pan_tilt``) and the ``controller`` and ``detector``
+    processes.
     """
     from diagnostic_msgs.msg import DiagnosticStatus
     from geometry_msgs.msg import PoseArray
@@ -286,7 +289,7 @@ def start_room(probe, nodes, seed: int, faces: int, node: str = 'gaze_controller
     rec['controller'] = nodes.start('controller', [
         '--params-file', config_path('faces_camera_controller.yaml'),
         '--params-file', config_path('faces_camera_room_controller.yaml'),
-        '-p', 'room.dwell_s:=0.3', '-p', 'room.recheck_period_s:=0.0'])
+        '-p', 'room.dwell_s:=0.3', '-p', 'room.recheck_period_s:=0.0', *extra])
     assert wait_for(lambda: rec['pan_tilt'], 60), rec['controller'].output()
     rec['detector'] = nodes.start('detector', [
         '--params-file', config_path('faces_camera_detector.yaml'),

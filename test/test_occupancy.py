@@ -791,6 +791,49 @@ def test_a_pass_cut_by_its_budget_decides_with_its_groups_and_keeps_its_policy()
     assert not session.passing and session.faces() == []
 
 
+def test_a_pass_that_decides_takes_the_posterior_for_empty_once_every_pose_is_seen():
+    """``search.decide_after_pass``: empty by the evidence alone during the pass, then by P."""
+    grid = Grid(5, 5)
+    pt = np.tile([0.5, 0.5], (5, 5, 1))              # counts that say nothing: only the prior
+    model = CountObservation(grid, pt, pt.copy())     # (log odds -5.5 < -4.6) decides a cell
+    poses = [6, 8, 18, 16]
+    for decide in (False, True):
+        session = OccupancySession(grid, model, SearchSettings(
+            targets='many', absent_prior=0.9, confidence=0.99, max_fixations=20,
+            decide_after_pass=decide), link=1)
+        session.set_policy(_Sweep(poses))
+        session.reset()
+        session.start()
+        results = [session.update(Frame(np.zeros(grid.n_cells))) for _ in poses]
+        assert [r.ended for r in results] == [False] * 3 + [True]      # the pass first
+        assert session.path == tuple(poses) and session.decision == 'absent'
+        assert session.room_done == decide
+        assert results[-1].reason == ('' if decide else 'pass')
+
+
+def test_a_pass_that_decides_goes_on_by_infomax_until_the_room_is_done():
+    from ipomdp_gaze.search.sensors import ModelSensor, run_search
+    grid = Grid(3, 3)
+    pt = np.tile([0.1, 0.3, 0.6], (3, 3, 1))         # a face's cell fires more, at every offset
+    model = CountObservation(grid, pt, pt[..., ::-1].copy())
+    poses = [0, 2, 8, 6]
+    ended = {}
+    for decide in (False, True):
+        session = OccupancySession(grid, model, SearchSettings(
+            targets='many', absent_prior=0.5, max_fixations=40, decide_after_pass=decide),
+            link=1)
+        session.set_policy(_Sweep(poses))
+        outcome = run_search(session, ModelSensor(grid, model, np.random.default_rng(0)), 4)
+        ended[decide] = (outcome, session.room_done, [f['cell'] for f in session.faces()])
+    passed, done, cells = ended[False]
+    assert list(passed.path) == poses and passed.reason == 'pass' and not done
+    assert passed.decision == 'absent' and cells == []             # the pass alone missed it
+    decided, done, cells = ended[True]
+    assert list(decided.path[:4]) == poses and len(decided.path) > 4     # views after the pass
+    assert decided.reason == '' and done and decided.decision == 'found'
+    assert [grid.cell(c) for c in cells] == [(1, 1)]                # the face, counted once
+
+
 def test_a_stray_large_box_does_not_become_the_box_of_the_faces_it_covers():
     """Haar's raw boxes (no scores): the box most others overlap is kept, not the largest."""
     from ipomdp_gaze.model.occupancy import merge_boxes

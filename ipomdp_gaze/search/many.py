@@ -54,6 +54,10 @@ ends after the last (reason ``pass``; earlier if every cell was decided) with ev
 likelier side, and its faces also name every grouped detection the frames carried
 (``Frame.groups``) that is not a face already named: more than one cell from it, or, for two
 groups whose frames gave offsets, more than :data:`GROUP_SAME_FACE_CELLS` from where it lies.
+With ``search.decide_after_pass`` the room is not done at the last pose: every cell has been
+seen well, so a cell is decided empty by its posterior from then on, and the search goes on by
+the infomax choice (per second of head time) until every cell is decided (reason '') or the
+budget; its faces still name the groups, of the pass's views and of the later ones.
 
 The answer for drivers: :meth:`OccupancySession.faces` (one face per cluster of occupied cells,
 :func:`ipomdp_gaze.model.occupancy.count_faces`). The session imports no ROS, prints and writes
@@ -762,7 +766,8 @@ class OccupancySession:
         s['repeat_rule'] = ''           # the rule behind a None (limit_setting)
         if self.passing:
             left = s['pass'][~s['visited'][s['pass']]]
-            return int(left[0]) if left.size else None
+            if left.size or not self.settings.decide_after_pass:
+                return int(left[0]) if left.size else None
         if self._fresh is None:
             costs = self.costs_from(s['fixation'])
             score = self.gains() / costs
@@ -874,11 +879,22 @@ class OccupancySession:
         return fired
 
     def _decided(self, log_odds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Cells decided occupied and empty (N,) (``empty_by_evidence``: the evidence alone)."""
+        """
+        Cells decided occupied and empty (N,) (``empty_by_evidence``: the evidence alone).
+
+        After a pass's last pose with ``search.decide_after_pass``, empty by the posterior:
+        every cell was seen well by one of the pass's views.
+        """
         occupied, empty = decided(log_odds, self.settings.confidence)
-        if self.empty_by_evidence:
+        if self.empty_by_evidence and not self._pass_seen():
             empty = empty & decided(log_odds - self._s()['prior'], self.settings.confidence)[1]
         return occupied, empty
+
+    def _pass_seen(self) -> bool:
+        """Whether a pass that goes on to decide (``decide_after_pass``) has taken every pose."""
+        s = self._s()
+        return bool(self.passing and self.settings.decide_after_pass
+                    and s['visited'][s['pass']].all())
 
     def _decide(self) -> str:
         s, settings = self._state, self.settings
@@ -888,7 +904,7 @@ class OccupancySession:
             found = bool(self.faces()) if self.passing else occupied.any()   # and its groups
             s['decision'] = 'found' if found else 'absent'
             return s['decision']
-        if self.passing and s['visited'][s['pass']].all():
+        if self.passing and not settings.decide_after_pass and s['visited'][s['pass']].all():
             return self._end_pass()
         if settings.max_fixations and s['fixations'] >= settings.max_fixations:
             return self._limit('budget')

@@ -276,6 +276,12 @@ SCHEMA: tuple[Setting, ...] = (
             "sweep's tiles see them); while P(absent) is at the confidence and a cell is left, "
             'the next view is one that covers it (the budget still decides; refused for a model '
             'without a camera, no effect on a moving target; docs/design.md section 6.16)'),
+    Setting('decide_after_pass', 'search.decide_after_pass', 'bool', False, check_flag,
+            "search.targets many, one pass of the sweep's poses (policy sweep): after the last "
+            'pose the room is not done yet: the search goes on (the infomax choice per second of '
+            'head time) until every cell is decided at the confidence, a cell empty by its '
+            'posterior now that every cell was seen well, or the budget (off: the pass ends '
+            'the search; docs/design.md section 11.7)'),
     Setting('false_alarm_scales', 'search.false_alarm_scales', 'floats', (1.0,),
             check_false_alarm_scales,
             'still target, count model: the scene may fire the detector this many times as '
