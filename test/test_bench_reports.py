@@ -41,15 +41,19 @@ def test_rooms_report_runs_both_lenses_and_rewrites_from_its_record(tmp_path):
     assert run.returncode == 0, run.stderr[-2000:]
     text = out.read_text()
     assert '## 25 deg lens' in text and '## 40 deg lens' in text
-    assert text.count("Issue 37's rooms items") == 4 and 'not run (`--bound N`)' in text
+    assert text.count("Issue 37's rooms items") == 6 and 'not run (`--bound N`)' in text
+    assert text.count('rooms decided by the belief') == 2
+    decided = 'pass-many-cells:search.decide_after_pass=true,search.repeat_weight=1.0'
     data = json.loads(record.read_text())
     for lens in data['runs'].values():
         rooms = lens['rooms']
-        assert set(rooms) == {'many', 'pass-many', 'pass-many-cells', 'sweep-all-grouped5',
-                              'sweep-all-grouped3'}
+        assert set(rooms) == {'many', 'pass-many', 'pass-many-cells', decided,
+                              'sweep-all-grouped5', 'sweep-all-grouped3'}
         for ours, sweep in zip(rooms['pass-many'], rooms['sweep-all-grouped5']):
             assert ours['index'] == sweep['index'] and ours['path'] == sweep['path']
             assert ours['faces_found'] >= sweep['faces_found']
+        for on, node in zip(rooms[decided], rooms['pass-many-cells']):   # the pass, then more
+            assert on['path'][:len(node['path'])] == node['path']
     again = subprocess.run(script + ['--from-json'], capture_output=True, text=True, timeout=120)
     assert again.returncode == 0, again.stderr[-2000:]
     assert out.read_text() == text
