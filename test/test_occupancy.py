@@ -811,6 +811,29 @@ def test_a_pass_that_decides_takes_the_posterior_for_empty_once_every_pose_is_se
         assert results[-1].reason == ('' if decide else 'pass')
 
 
+def test_a_decided_room_names_no_group_where_its_belief_decided_nobody():
+    """A group in a cell the decided belief holds empty is texture; the pass alone names it."""
+    grid = Grid(5, 5)
+    pt = np.tile([0.5, 0.5], (5, 5, 1))
+    model = CountObservation(grid, pt, pt.copy())
+    groups = np.zeros(grid.n_cells)
+    groups[12] = 1
+    named = {}
+    for decide in (False, True):
+        session = OccupancySession(grid, model, SearchSettings(
+            targets='many', absent_prior=0.9, confidence=0.99, max_fixations=20,
+            decide_after_pass=decide), link=1)
+        session.set_policy(_Sweep([6, 8, 18, 16]))
+        session.reset()
+        session.start()
+        for k in range(4):
+            session.update(Frame(np.zeros(grid.n_cells), groups=groups if k == 1 else None))
+        assert session.ended and session.belief[12] < 0.01
+        named[decide] = ([f['cell'] for f in session.faces()], session.decision)
+    assert named[False] == ([12], 'found')            # the pass names every group
+    assert named[True] == ([], 'absent')               # decided: its belief vetoes it
+
+
 def test_a_pass_that_decides_goes_on_by_infomax_until_the_room_is_done():
     from ipomdp_gaze.search.sensors import ModelSensor, run_search
     grid = Grid(3, 3)

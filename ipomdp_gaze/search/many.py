@@ -441,13 +441,18 @@ class OccupancySession:
         within one cell. Chosen on training rooms (docs/design.md section 11.7). A grouped face
         is ``{'cell', 'cells', 'probability'`` (the belief's, which may doubt it), ``'box':
         None, 'grouped': True, 'at': (row, col)`` in fractional cells or None``}``, in the
-        order the views saw them (row-major within a view).
+        order the views saw them (row-major within a view). With ``search.decide_after_pass``
+        a room the belief decided (:attr:`room_done`) names no group whose cell it decided
+        empty (``P <= 1 - confidence``): on 260 training rooms only texture was (docs/design.md
+        section 11.7).
         """
         rows, cols = self.grid.rows_cols()
-        belief = self.belief
+        belief, s = self.belief, self._s()
+        vetoes = s['room_done'] and self.settings.decide_after_pass
+        empty = 1.0 - self.settings.confidence if vetoes else -1.0
         grouped = [{'cell': cell, 'cells': np.array([cell]), 'probability': float(belief[cell]),
                     'box': None, 'grouped': True, 'at': None if math.isnan(r) else (r, c)}
-                   for cell, r, c in self._s()['groups']]
+                   for cell, r, c in s['groups'] if belief[cell] > empty]
         out = []
 
         def apart(face, others):
