@@ -32,20 +32,28 @@ FACES = '0-4'
 TIMEOUT_S = 240.0
 
 
-def offline(seed: int) -> tuple[list, list]:
-    """Return the room's face cells and the offline session's people, as ``(row, col)``."""
+def offline(seed: int, label: str = 'pass-many-cells') -> tuple[list, list]:
+    """
+    Return the room's face cells and the offline session's people, as ``(row, col)``.
+
+    ``label``: the room searcher (``pass-many-cells:parameter=value,...`` for other settings).
+    """
     spec = task_spec('pan-tilt', seed=seed, faces=FACES)
     task = SceneTask.get(spec)
     scene = task.scene(0)
     task.sensor.start(scene.image)
     grid = task.model.grid
-    _, _, _, faces = room_session(spec, task, 0, 'pass-many-cells')
+    _, _, _, faces = room_session(spec, task, 0, label)
     return ([tuple(int(v) for v in f.cell) for f in scene.faces],
             [tuple(int(v) for v in grid.cell(f['cell'])) for f in faces])
 
 
-def run_room(seed: int) -> dict:
-    """Run the three nodes on the room of ``seed`` until ``room_done``; what they said."""
+def run_room(seed: int, extra: tuple = ()) -> dict:
+    """
+    Run the three nodes on the room of ``seed`` until ``room_done``; what they said.
+
+    ``extra``: more arguments of the controller (``-p name:=value``).
+    """
     from diagnostic_msgs.msg import DiagnosticStatus
     from std_msgs.msg import Float32MultiArray
     grid = Grid(11, 11, 5.0)
@@ -56,7 +64,8 @@ def run_room(seed: int) -> dict:
             done = watch.record(DiagnosticStatus, 'room_done', 10)
             nodes.start('controller', [
                 '--params-file', str(config_file('faces_camera_controller.yaml')),
-                '--params-file', str(config_file('faces_camera_room_controller.yaml'))])
+                '--params-file', str(config_file('faces_camera_room_controller.yaml')),
+                *extra])
             if not watch.wait_until(lambda: watch.matched('room_done') > 0, 60):
                 raise RuntimeError('the controller did not come up')
             nodes.start('detector', [
@@ -79,11 +88,15 @@ def run_room(seed: int) -> dict:
 
 def bench(ctx) -> str:
     """One room per seed, node against offline; a markdown table and the totals."""
-    seeds = range(3) if ctx.quick else range(50)
+    return rooms_table(ctx, range(3) if ctx.quick else range(50))
+
+
+def rooms_table(ctx, seeds, label: str = 'pass-many-cells', extra: tuple = ()) -> str:
+    """Return the table of the node (controller ``extra``) against the offline ``label``."""
     rows, agree, faces, found, false, seconds, clean = [], 0, 0, 0, 0, [], True
     for seed in seeds:
-        truth, expected = offline(seed)
-        run = run_room(seed)
+        truth, expected = offline(seed, label)
+        run = run_room(seed, extra)
         same = sorted(run['people']) == sorted(expected)
         hits = match_faces(run['people'], truth)
         agree += same
