@@ -172,6 +172,20 @@ NUMPY_TOO_LARGE = ('Maximum allowed dimension exceeded',
                    'maximum possible size.')
 
 
+# The Python packages of ROS 2 a command may import (rclpy and the message packages): without
+# them a ROS command says how to install them in one line instead of an import traceback.
+ROS_MISSING = ('ipomdp-gaze {}: error: this command needs ROS 2 Jazzy (No module named {!r}): '
+               "pip install 'ipomdp_gaze[ros]' (rclpy with Fast DDS and the common messages) "
+               'into this environment, or source a ROS 2 Jazzy install')
+
+
+def ros_module(name: str | None) -> bool:
+    """Whether ``name`` (a missing module's) is one of ROS 2's Python packages."""
+    root = (name or '').split('.')[0]
+    return root.startswith(('rcl', 'rosidl', 'rosbag2', 'rpyutils')) or root.endswith(
+        ('_msgs', '_srvs', '_interfaces'))
+
+
 def _run(args) -> int:
     """Run the parsed command; its errors as one line (exit 2)."""
     handles = args.command in WORK_COMMANDS and \
@@ -194,6 +208,11 @@ def _run(args) -> int:
         return 2
     except MemoryError:
         print(TOO_LARGE.format(args.command), file=sys.stderr)
+        return 2
+    except ModuleNotFoundError as exc:
+        if not ros_module(exc.name):
+            raise
+        print(ROS_MISSING.format(args.command, exc.name), file=sys.stderr)
         return 2
     except Terminated:
         return 143

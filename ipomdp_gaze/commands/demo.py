@@ -134,8 +134,6 @@ def _note(line: str) -> None:
 
 
 def run(args) -> int:
-    from ipomdp_gaze.harness.demo import demo_setup, faces_setup, run_demo
-
     def out(line):
         print(line, flush=True)
 
@@ -173,6 +171,7 @@ def run(args) -> int:
         from ipomdp_gaze.drivers.rooms import room_demo
         return room_demo(faces, args.seed, lambda line: print(line, flush=True),
                          args.max_fixations)
+    from ipomdp_gaze.harness.demo import demo_setup, faces_setup, run_demo  # needs ROS 2
     if args.scene == 'faces':
         for flag, value in (('--fpoc', args.fpoc), ('--target', args.target)):
             if value is not None:
