@@ -148,12 +148,12 @@ def check_prior(prior, n_cells: int, shape: tuple[int, int] | None = None) -> np
     target is never there and the belief keeps them at 0.
     """
     try:                                    # a string, a mapping or ragged rows: one line
-        values = np.asarray(prior, dtype=float) if not isinstance(prior, np.ndarray) else prior
+        values = np.asarray(prior)
     except (TypeError, ValueError):
+        values = None
+    if values is None or values.dtype.kind not in 'iuf':    # no text ('0.5'), no true/false
         raise ValueError(f'prior must be numbers, one per cell, got {type(prior).__name__} '
-                         f'{_short(prior)}') from None
-    if values.dtype.kind not in 'iuf':
-        raise ValueError(f'prior must be numbers, got dtype {values.dtype}')
+                         f'{_short(prior)}')
     if values.ndim == 2 and shape is not None and values.shape != tuple(shape):
         raise ValueError(f'prior must be (rows, cols) = {tuple(shape)} or ({n_cells},), got shape '
                          f'{values.shape}')

@@ -5,21 +5,34 @@ The scalar checks every layer uses: one place for each rule and its message.
 
 Each check takes the value and the name users know it by (a parameter, a flag, a field), returns
 the value in its plain Python type and raises ``ValueError`` with one line that starts with the
-name and ends with ``got <value>``. Booleans are never numbers here (``True`` is not a count).
+name and ends with ``got <value>``. Booleans are never numbers here (``True`` is not a count),
+nor is text (``'0.5'``): :func:`is_number` is the one rule, for the settings' YAML and Python
+values and for the researcher API (the belief, motion, FPOC, occupancy and camera objects).
 The search settings (:mod:`ipomdp_gaze.search.settings`) name the check of each setting.
 """
 from __future__ import annotations
 
 import math
+import numbers
 import operator
 
 import numpy as np
 
-_NUMBERS = (int, float, np.integer, np.floating)
-
 
 def _is_bool(value) -> bool:
     return isinstance(value, (bool, np.bool_))
+
+
+def is_number(value) -> bool:
+    """Whether ``value`` is a real number (numpy's too): no bool, no text such as ``'0.5'``."""
+    return isinstance(value, numbers.Real) and not _is_bool(value)
+
+
+def check_number(value, name: str) -> float:
+    """Return a number as a float; anything else (``'0.5'``, ``True``, None) names ``name``."""
+    if not is_number(value):
+        raise ValueError(f'{name} must be a number, got {value!r}')
+    return float(value)
 
 
 def check_flag(value, name: str) -> bool:
@@ -40,14 +53,11 @@ def positive_int(name: str, value, allow_zero: bool = False) -> int:
 
 def finite(name: str, value, positive: bool = False) -> float:
     """Return a finite number (> 0 with ``positive``) as a float."""
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f'{name} must be a number, got {value!r}') from None
-    if not math.isfinite(number) or (positive and number <= 0):
+    checked = check_number(value, name)
+    if not math.isfinite(checked) or (positive and checked <= 0):
         bound = 'finite and > 0' if positive else 'finite'
         raise ValueError(f'{name} must be {bound}, got {value!r}')
-    return number
+    return checked
 
 
 def check_confidence(confidence, name: str = 'confidence') -> float:
@@ -57,11 +67,7 @@ def check_confidence(confidence, name: str = 'confidence') -> float:
     1 is refused: a posterior reaches it only by rounding, so a search at 1 would never stop by
     evidence; 0 would decide before any frame.
     """
-    try:
-        ok = not _is_bool(confidence) and 0.0 < float(confidence) < 1.0
-    except (TypeError, ValueError):
-        ok = False
-    if not ok:
+    if not 0.0 < check_number(confidence, name) < 1.0:
         raise ValueError(f'{name} must be between 0 and 1 (exclusive), got {confidence!r}')
     return float(confidence)
 
@@ -83,10 +89,7 @@ def check_probability(value, name: str) -> float:
 
     1 is refused: it would make the hypothesis certain before any evidence.
     """
-    try:
-        p = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f'{name} must be a probability in [0, 1), got {value!r}') from None
+    p = check_number(value, name)
     if not 0.0 <= p < 1.0:
         raise ValueError(f'{name} must be a probability in [0, 1), got {value!r}')
     return p
@@ -94,10 +97,7 @@ def check_probability(value, name: str) -> float:
 
 def check_sigma_cells(value, name: str = 'sigma_cells') -> float:
     """Return a motion standard deviation in cells: a finite number >= 0."""
-    try:
-        sigma = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f'{name} must be a number >= 0, got {value!r}') from None
+    sigma = check_number(value, name)
     if not math.isfinite(sigma) or sigma < 0:
         raise ValueError(f'{name} must be finite and >= 0, got {value!r}')
     return sigma
@@ -105,15 +105,14 @@ def check_sigma_cells(value, name: str = 'sigma_cells') -> float:
 
 def check_in_range(value, name: str, low: float, high: float, note: str = '') -> float:
     """Return a number in the closed interval ``[low, high]`` as a float (``note`` explains)."""
-    if _is_bool(value) or not isinstance(value, _NUMBERS) or not low <= float(value) <= high:
+    if not is_number(value) or not low <= float(value) <= high:
         raise ValueError(f'{name} must be in [{low:g}, {high:g}]{note}, got {value!r}')
     return float(value)
 
 
 def check_factor_above_one(value, name: str, what: str) -> float:
     """Return a finite factor > 1 as a float (``what``: of what it is a factor)."""
-    if _is_bool(value) or not isinstance(value, _NUMBERS) \
-            or not (math.isfinite(float(value)) and float(value) > 1.0):
+    if not (is_number(value) and math.isfinite(float(value)) and float(value) > 1.0):
         raise ValueError(f'{name} must be a finite factor > 1 of {what}, got {value!r}')
     return float(value)
 

@@ -39,7 +39,7 @@ from __future__ import annotations
 import math
 
 from ipomdp_gaze.model.belief import normalize_log
-from ipomdp_gaze.model.checks import check_factor_above_one, check_in_range
+from ipomdp_gaze.model.checks import check_factor_above_one, check_in_range, is_number
 from ipomdp_gaze.model.observation import CountObservation
 from ipomdp_gaze.model.still_evidence import StillEvidence
 import numpy as np
@@ -55,9 +55,9 @@ MAX_DETECTION_PROBABILITY = 0.95
 
 def check_false_alarm_scales(value, name: str = 'false_alarm_scales') -> tuple:
     """Return the scales as a sorted tuple of floats, or raise ValueError naming ``name``."""
-    try:
-        scales = tuple(float(v) for v in value)
-    except (TypeError, ValueError):
+    try:                                    # numbers: no text ('2' was the factor 2), no bools
+        scales = tuple(float(v) for v in value) if all(is_number(v) for v in value) else ()
+    except TypeError:
         scales = ()
     if not 1 <= len(scales) <= MAX_SCALES or len(set(scales)) != len(scales) \
             or not all(math.isfinite(s) and s > 0 for s in scales):

@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 from typing import Callable
 
+from ipomdp_gaze.model.checks import check_number
 from ipomdp_gaze.model.grid import Grid
 import numpy as np
 from scipy.special import log_ndtr, ndtr, ndtri
@@ -24,14 +25,24 @@ EDGE_TOL_DEG = 1e-9
 
 
 def _positive(name: str, value, allow_zero: bool = False) -> float:
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f'{name} must be a number, got {value!r}') from None
+    value = check_number(value, name)
     if not math.isfinite(value) or value < 0 or (value == 0 and not allow_zero):
         bound = '>= 0' if allow_zero else '> 0'
         raise ValueError(f'{name} must be finite and {bound}, got {value!r}')
     return value
+
+
+def _numbers(name: str, values) -> np.ndarray:
+    """Return a list of numbers as a flat float array: no text ('1'), no true/false."""
+    try:
+        array = np.asarray(values)
+    except (TypeError, ValueError):         # ragged rows
+        array = np.array([''])
+    if array.dtype.kind not in 'iuf':
+        text = repr(values)
+        raise ValueError(f'{name} must be a list of numbers, got '
+                         f"{text if len(text) <= 40 else text[:37] + '...'}")
+    return array.astype(float).ravel()
 
 
 class FPOC:
@@ -176,11 +187,7 @@ class TableFPOC(FPOC):
     defaults = {'ecc_deg': [0.0, 1.0], 'dprime': [2.0, 0.0]}
 
     def __init__(self, ecc_deg=(0.0, 1.0), dprime=(2.0, 0.0)):
-        try:
-            ecc = np.asarray(ecc_deg, dtype=float).ravel()
-            dp = np.asarray(dprime, dtype=float).ravel()
-        except (TypeError, ValueError):
-            raise ValueError('ecc_deg and dprime must be lists of numbers') from None
+        ecc, dp = _numbers('ecc_deg', ecc_deg), _numbers('dprime', dprime)
         if ecc.size < 1 or ecc.size != dp.size:
             raise ValueError(f'ecc_deg and dprime must be non-empty and of equal length, got '
                              f'{ecc.size} ecc_deg {ecc.tolist()} and {dp.size} dprime '

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import math
 import re
 
+from ipomdp_gaze.model.checks import is_number
 import numpy as np
 
 _GRID_RE = re.compile(r'^\s*(\d+)\s*[xX]\s*(\d+)\s*$')
@@ -55,10 +56,7 @@ class Grid:
             if not whole:
                 raise ValueError(f'{name} must be a positive integer, got {value!r}')
             object.__setattr__(self, name, int(value))
-        try:
-            spacing = float(self.spacing_deg)
-        except (TypeError, ValueError):
-            spacing = math.nan
+        spacing = float(self.spacing_deg) if is_number(self.spacing_deg) else math.nan
         if not np.isfinite(spacing) or spacing <= 0:
             raise ValueError(
                 f'spacing_deg must be a positive finite number, got {self.spacing_deg!r}')

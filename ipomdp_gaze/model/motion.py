@@ -39,7 +39,8 @@ import math
 import sys
 
 from ipomdp_gaze.model.belief import normalize_log
-from ipomdp_gaze.model.checks import check_probability, check_sigma_cells  # noqa: F401
+from ipomdp_gaze.model.checks import (check_number, check_probability,  # noqa: F401
+                                      check_sigma_cells)
 from ipomdp_gaze.model.grid import Grid
 import numpy as np
 
@@ -363,7 +364,7 @@ class VelocityMotion(Motion):
                  leave_prob: float = 0.0, max_speed_cells: float = 0.0, turn_prob: float = 0.0,
                  speed_cells: float = 0.0, classes: int = 9):
         super().__init__(grid, sigma_cells, jump_prob, leave_prob)
-        speed = float(max_speed_cells)
+        speed = check_number(max_speed_cells, 'max_speed_cells')
         if not math.isfinite(speed) or speed <= 0:
             raise ValueError(f'max_speed_cells must be > 0, got {max_speed_cells!r}')
         self.max_speed_cells = speed

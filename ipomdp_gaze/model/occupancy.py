@@ -38,6 +38,7 @@ from __future__ import annotations
 import math
 import threading
 
+from ipomdp_gaze.model.checks import check_number
 import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
@@ -51,11 +52,7 @@ GAUSSIAN_BINS = 801
 
 def check_occupancy_prior(value, name: str = 'occupancy prior') -> float:
     """Return a per-cell prior ``q`` in (0, 1) (ValueError with the reason otherwise)."""
-    try:
-        ok = not isinstance(value, bool) and 0.0 < float(value) < 1.0
-    except (TypeError, ValueError):
-        ok = False
-    if not ok:
+    if not 0.0 < check_number(value, name) < 1.0:
         raise ValueError(f'{name} must be between 0 and 1 (exclusive), got {value!r}')
     return float(value)
 

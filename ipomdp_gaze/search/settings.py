@@ -24,19 +24,18 @@ from __future__ import annotations
 from collections.abc import Collection
 from dataclasses import dataclass, field, make_dataclass, replace
 import math
-import numbers
 from typing import Callable, Mapping
 
 from ipomdp_gaze.model.checks import (check_budget, check_confidence, check_flag,
                                       check_positive_cells, check_probability, check_radius,
                                       check_seconds, check_sigma_cells, check_start_cell,
-                                      check_targets, check_track_view, MAX_FOUND_RADIUS)
+                                      check_targets, check_track_view, is_number,
+                                      MAX_FOUND_RADIUS)
 from ipomdp_gaze.model.false_alarms import (check_false_alarm_scales, check_hotspot_prior,
                                             check_hotspot_scale, DEFAULT_HOTSPOT_SCALE,
                                             MAX_HOTSPOT_PRIOR)
 from ipomdp_gaze.model.still_evidence import check_repeat_weight
 from ipomdp_gaze.search.room import MAX_PERIOD_S
-import numpy as np
 
 # A prediction further ahead than a minute says nothing about where a walking person is (the
 # head would chase the grid's corner); a dwell is bounded as room.dwell_s is (MAX_PERIOD_S).
@@ -403,35 +402,30 @@ _KIND_WORDS = {'float': 'a number', 'int': 'an integer', 'bool': 'true or false'
                'floats': 'a list of numbers', 'cell': '[row, col]', 'str': 'a string'}
 
 
-def _is_number(value) -> bool:
-    """Whether ``value`` is a real number (numpy's too) and no bool, as YAML's check takes."""
-    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
-
-
 def _python_kind(kind: str, value) -> bool:
     """
     Whether a value given from Python has its setting's kind, as :func:`_check_kind` for YAML.
 
     A number is no string and no bool (``confidence='0.9'`` and ``True`` are refused, as YAML's
-    ``'0.9'`` and ``true`` are; ``float()`` in the checks took them); a list of numbers is a
-    collection of numbers, not a string (``'2'`` was the factor 2). The other kinds' checks
+    ``'0.9'`` and ``true`` are: :func:`ipomdp_gaze.model.checks.is_number`); a list of numbers
+    is a collection of numbers, not a string (``'2'`` was the factor 2). The other kinds' checks
     refuse the wrong kind themselves.
     """
     if kind == 'float':
-        return _is_number(value)
+        return is_number(value)
     if kind == 'floats':
         return not isinstance(value, (str, bytes)) and (
-            not isinstance(value, Collection) or all(_is_number(v) for v in value))
+            not isinstance(value, Collection) or all(is_number(v) for v in value))
     return True
 
 
 def _check_kind(setting: Setting, value, where: str) -> None:
     """Refuse a YAML value of the wrong kind (a string for a number, 1 for true)."""
     kind = setting.kind
-    ok = {'float': _is_number(value),
+    ok = {'float': is_number(value),
           'int': isinstance(value, int) and not isinstance(value, bool),
           'bool': isinstance(value, bool),
-          'floats': isinstance(value, list) and all(_is_number(v) for v in value),
+          'floats': isinstance(value, list) and all(is_number(v) for v in value),
           'cell': value is None or isinstance(value, (list, str)),
           'str': isinstance(value, str)}[kind]
     if not ok:
