@@ -140,7 +140,7 @@ def test_a_yaml_file_that_is_not_a_mapping_says_what_it_is_in_yaml_words(tmp_pat
         f'{path}: an observation file must be a YAML mapping, got {kind}'
 
 
-@pytest.mark.parametrize('flag, value', [('--episodes', 2 ** 63 - 1), ('--horizon', 2 ** 63 - 1),
+@pytest.mark.parametrize('flag, value', [('--horizon', 2 ** 63 - 1),
                                          ('--max-fixations', 10 ** 21),
                                          ('--bootstrap', 10 ** 21)])
 def test_a_count_too_large_for_numpy_is_the_task_too_large(cli_here, flag, value):
@@ -169,6 +169,7 @@ PAN_TILT_TALLY = 'ipomdp_gaze.vision.calibrate.tally_pan_tilt_scenes'
 TRAINER = 'ipomdp_gaze.policies.training.Trainer'
 SCENE_WORK = ('ipomdp_gaze.commands.evaluate.evaluate_scenes',
               'ipomdp_gaze.commands.evaluate.evaluate_walks')
+SIMULATION = ('ipomdp_gaze.commands.evaluate.evaluate',)
 BIG = str(2 ** 63 - 1)
 
 
@@ -183,6 +184,20 @@ BIG = str(2 ** 63 - 1)
      (TRAINER,)),
     (['evaluate', '--scenes', 'pan-tilt', '--jobs', '1', '--episodes', BIG],
      f'--episodes {BIG}: at most 100000 scenes with --scenes', SCENE_WORK),
+    # ran out of memory (a 7x7 grid holds some 15 kB an episode) or for ever
+    (['evaluate', '--grid', '3x3', '--jobs', '1', '--episodes', BIG],
+     f'--episodes {BIG}: at most 200000 simulated episodes', SIMULATION),
+    (['evaluate', '--observation', 'faces-420', '--jobs', '1', '--episodes', '200001'],
+     '--episodes 200001: at most 200000 simulated episodes', SIMULATION),
+    (['train', '--grid', '3x3', '--epochs', '1', '--out', 'x.yaml', '--episodes-per-epoch',
+      BIG], 'argument --episodes-per-epoch: expected a number of episodes from 1 to 20000, '
+     f"got '{BIG}'", (TRAINER,)),
+    (['train', '--grid', '3x3', '--epochs', '1', '--out', 'x.yaml', '--eval-episodes',
+      '200001'], 'argument --eval-episodes: expected a number of episodes from 1 to 200000, '
+     "got '200001'", (TRAINER,)),
+    (['train', '--grid', '3x3', '--epochs', '1', '--out', 'x.yaml', '--final-episodes', BIG],
+     f"argument --final-episodes: expected a number of episodes from 0 to 200000, got '{BIG}'",
+     (TRAINER,)),
     (['evaluate', '--scenes', 'pan-tilt', '--motion', 'walk', '--jobs', '1', '--episodes',
       '100001'], '--episodes 100001: at most 100000 walks with --scenes', SCENE_WORK),
     (['evaluate', '--scenes', 'pan-tilt', '--jobs', '1', '--episodes', '1', '--empty-scenes',
@@ -221,10 +236,13 @@ def test_a_count_too_large_to_finish_is_refused_by_its_flag(tmp_path, cli_here, 
 @pytest.mark.parametrize('argv', [
     ['calibrate', '--scenes', '100000', '--out', 'x.yaml', '--max-count', '256'],
     ['train', '--grid', '3x3', '--epochs', '1000000', '--out', 'x.yaml'],
+    ['train', '--grid', '3x3', '--epochs', '1', '--out', 'x.yaml', '--episodes-per-epoch',
+     '20000', '--eval-episodes', '200000', '--final-episodes', '200000'],
+    ['evaluate', '--grid', '3x3', '--jobs', '1', '--episodes', '200000'],
 ])
 def test_the_largest_count_is_taken(tmp_path, cli_here, monkeypatch, argv):
     """The bounds are inclusive: the work begins (and is stopped here)."""
-    _began(monkeypatch, SCENES, TRAINER)
+    _began(monkeypatch, SCENES, TRAINER, *SIMULATION)
     with pytest.raises(WorkBegan):
         cli_here(*argv, cwd=tmp_path)
 

@@ -124,6 +124,13 @@ MAX_SCENES = 100_000
 # The most epochs train runs (the shipped kernels took at most 7700): a day or so of a 7x7
 # grid's training; 2^63 - 1 ran for ever.
 MAX_EPOCHS = 1_000_000
+# The most simulated episodes a command runs at once (evaluate --episodes, train --eval-episodes
+# and --final-episodes): 10 times the paper's 20000, docs/reproduction.md's largest run; about
+# 3 GB and 40 s a policy on the 7x7 grid. 2^63 - 1 ran out of memory or for ever.
+MAX_EPISODES = 200_000
+# The most episodes train pools per update (--episodes-per-epoch): 133 times the paper's 150,
+# 1.3 GB and 7 s an epoch on the 7x7 grid (every epoch holds its episodes' eligibility traces).
+MAX_EPOCH_EPISODES = 20_000
 # The largest C int, OpenCV's: detectMultiScale's minNeighbors (a larger one was OpenCV's
 # "integer won't fit into a C int").
 C_INT_MAX = 2 ** 31 - 1

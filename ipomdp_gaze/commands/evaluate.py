@@ -43,8 +43,8 @@ from ipomdp_gaze.vision.walks import SPEED_DEG_S as WALK_SPEED_DEG_S
 import numpy as np
 
 from .common import (add_prior_arg, add_task_args, bootstrap_count, C_INT_MAX,
-                     check_output_file, count_in, MAX_SCENES, nonneg_int, number_arg, output_file,
-                     positive_int, read_prior, task_from_args)
+                     check_output_file, count_in, MAX_EPISODES, MAX_SCENES, nonneg_int,
+                     number_arg, output_file, positive_int, read_prior, task_from_args)
 from .running import add_run_args, executor_from_args, progress_from_args
 from .search_args import add_scene_args, add_search_args, settings_from_args
 
@@ -533,6 +533,8 @@ def run(args) -> int:
     if args.scenes:
         return run_scenes(args)
     args.episodes = args.episodes or EPISODES
+    if args.episodes > MAX_EPISODES:
+        raise ValueError(f'--episodes {args.episodes}: at most {MAX_EPISODES} simulated episodes')
     args.max_fixations = args.max_fixations or None           # 0: no budget, the horizon
     grid, fpoc = task_from_args(args)
     prior = None if args.prior is None else read_prior(args.prior, grid)

@@ -17,14 +17,18 @@ from ipomdp_gaze.model.belief import prior_is_uniform
 from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.search.session import SearchSettings
 
-from .common import (add_prior_arg, add_task_args, check_output_file, count_in, MAX_EPOCHS,
-                     nonneg_int, number_arg, output_file, positive_float, positive_int,
-                     read_prior, task_from_args)
+from .common import (add_prior_arg, add_task_args, check_output_file, count_in,
+                     MAX_EPISODES, MAX_EPOCH_EPISODES, MAX_EPOCHS, nonneg_int, number_arg,
+                     output_file, positive_float, positive_int, read_prior, task_from_args)
 from .running import add_run_args, executor_from_args, progress_from_args
 from .search_args import add_scene_args, settings_from_args
 
 FAMILY_DEFAULT, REWARD_DEFAULT = 'conv', 'infomax'
 EPOCHS = count_in(0, MAX_EPOCHS, f'a number of epochs from 0 to {MAX_EPOCHS}')
+EPOCH_EPISODES = count_in(1, MAX_EPOCH_EPISODES,
+                          f'a number of episodes from 1 to {MAX_EPOCH_EPISODES}')
+EVAL_EPISODES = count_in(1, MAX_EPISODES, f'a number of episodes from 1 to {MAX_EPISODES}')
+FINAL_EPISODES = count_in(0, MAX_EPISODES, f'a number of episodes from 0 to {MAX_EPISODES}')
 # The defaults of the learning rate and reward scale: chosen on the 7x7 human task (README).
 LEARNING_RATE = 5.0
 REWARD_SCALE = 1.0
@@ -64,14 +68,14 @@ def add_parser(sub):
                    help='plain GPOMDP without a baseline')
     p.add_argument('--horizon', type=positive_int, default=None,
                    help='fixations per training episode (default N, the number of cells)')
-    p.add_argument('--episodes-per-epoch', type=positive_int, default=None,
+    p.add_argument('--episodes-per-epoch', type=EPOCH_EPISODES, default=None,
                    help='episodes pooled per update (default 150, the paper)')
     p.add_argument('--eval-every', type=positive_int, default=None, metavar='K',
                    help='evaluate the argmax policy every K epochs (default 50)')
-    p.add_argument('--eval-episodes', type=positive_int, default=None,
+    p.add_argument('--eval-episodes', type=EVAL_EPISODES, default=None,
                    help='episodes of the fixed evaluation set used during training '
                         '(default 2000)')
-    p.add_argument('--final-episodes', type=nonneg_int, default=20000,
+    p.add_argument('--final-episodes', type=FINAL_EPISODES, default=20000,
                    help='episodes of the final evaluation written to the file (default 20000; '
                         '0 skips it)')
     p.add_argument('--final-seed', type=nonneg_int, default=0,
