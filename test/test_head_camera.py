@@ -38,6 +38,15 @@ def test_a_k_that_is_not_a_pinhole_camera_is_refused(k, match):
         PinholeCamera.from_k(320, 240, k)
 
 
+@pytest.mark.parametrize('k', [[[500.0, 0, 160], [0, 500.0, 120], [0, 0, 1]],
+                               ['500', 0, 160, 0, 500.0, 120, 0, 0, 1], 5.0])
+def test_a_k_as_rows_text_or_one_number_is_9_numbers_row_major(k):
+    """Rows were ``a camera record must be {width, height, K}`` (a TypeError); text was taken."""
+    with pytest.raises(ValueError, match=r'^K must be 9 finite numbers \(the 3x3 camera matrix, '
+                       r'row-major\), got '):
+        PinholeCamera.from_dict({'width': 320, 'height': 240, 'K': k})
+
+
 def test_the_principal_point_shows_the_head_cell_and_one_spacing_off_the_next_cell():
     head = (4, 7)
     row, col = pixel_cells(CAMERA.cx, CAMERA.cy, CAMERA, head, 5.0)

@@ -19,6 +19,7 @@ import pytest
 import yaml
 
 SHIPPED = {}
+K_NINE = '9 numbers (a 3x3 matrix, row-major)'
 
 
 def _shipped(name: str) -> dict:
@@ -98,7 +99,19 @@ LOADED = [
      "image.view must be text, got ['pan_tilt']"),
     ('faces-pan-tilt', _set('image', 'camera', [320, 240]),
      'image.camera must be a mapping, got [320, 240]'),
-    ('faces-pan-tilt', _camera('K', 'x'), "image.camera.K must be a list of numbers, got 'x'"),
+    ('faces-pan-tilt', _camera('K', 'x'), f"image.camera.K must be {K_NINE}, got 'x'"),
+    # K of 8 numbers, or as rows, reached the camera with no file named (and the rows as
+    # ``a camera record must be {width, height, K}``)
+    ('faces-pan-tilt', _camera('K', [1, 0, 1, 0, 1, 1, 0, 0]),
+     f'image.camera.K must be {K_NINE}, got [1, 0, 1, 0, 1, 1, 0, 0]'),
+    ('faces-pan-tilt', _camera('K', [[1, 0, 1], [0, 1, 1], [0, 0, 1]]),
+     f'image.camera.K must be {K_NINE}, got [[1, 0, 1], [0, 1, 1], [0, 0, 1]]'),
+    ('faces-pan-tilt', _camera('K', [1, 2, 1, 0, 1, 1, 0, 0, 1]),
+     'image.camera: K must be [fx, 0, cx, 0, fy, cy, 0, 0, 1], got [1.0, 2.0, 1.0, 0.0, 1.0, '
+     '1.0, 0.0, 0.0, 1.0]'),
+    ('faces-pan-tilt', _camera('K', [1, 0, 1, 0, 1, 1, 0, 0, float('nan')]),
+     'image.camera: K must be 9 finite numbers (the 3x3 camera matrix, row-major), got '
+     '[1, 0, 1, 0, 1, 1, 0, 0, nan]'),
     ('faces-pan-tilt', _camera('width', 320.5),
      'image.camera.width must be an integer, got 320.5'),
 ]
@@ -154,6 +167,23 @@ def test_evaluate_scene_model_names_the_file_and_the_key(tmp_path, cli_here):
     assert run.stderr.strip().splitlines() == [
         f'ipomdp-gaze evaluate: error: observation.file {str(path)!r}: detector.min_neighbors '
         'must be an integer, got [0]']
+
+
+@pytest.mark.parametrize('k', [[1, 0, 1, 0, 1, 1, 0, 0], [[1, 0, 1], [0, 1, 1], [0, 0, 1]]])
+def test_a_camera_k_not_of_9_numbers_names_the_file_and_the_key_in_find_and_evaluate(
+        tmp_path, cli_here, k):
+    """``evaluate --scene-model`` said ``K must be 9 finite numbers, got [...]``: no file."""
+    import cv2
+    import numpy as np
+    cv2.imwrite(str(tmp_path / 'grey.png'), np.full((240, 320, 3), 128, np.uint8))
+    path = _write(tmp_path, 'faces-pan-tilt', _camera('K', k))
+    line = f'{path}: image.camera.K must be {K_NINE}, got {k!r}'
+    for argv in (('find', tmp_path / 'grey.png', '--observation', path),
+                 ('evaluate', '--scenes', 'pan-tilt', '--scene-model', path, '--episodes', '1',
+                  '--jobs', '1', '--quiet')):
+        run = cli_here(*argv)
+        assert run.returncode == 2
+        assert run.stderr.strip().splitlines() == [f'ipomdp-gaze {argv[0]}: error: {line}']
 
 
 def test_the_shipped_models_pass_the_record_checks():

@@ -35,6 +35,7 @@ import re
 from ipomdp_gaze.files.yaml_files import check_header, check_record, in_folder, plain, read_yaml, \
     write_yaml
 from ipomdp_gaze.model.grid import Grid
+from ipomdp_gaze.model.head_camera import PinholeCamera
 from ipomdp_gaze.model.observation import CountObservation
 import numpy as np
 
@@ -52,7 +53,7 @@ RECORDS = ('image', 'fovea', 'detector', 'cells', 'calibration')
 RECORD_TYPES = {'image': {'width': 'integer', 'height': 'integer', 'view': 'text',
                           'camera': 'mapping'},
                 'detector': {'kind': 'text'}, 'fovea': {}, 'cells': {}}
-CAMERA_TYPES = {'width': 'integer', 'height': 'integer', 'K': 'numbers'}
+CAMERA_TYPES = {'width': 'integer', 'height': 'integer', 'K': 'matrix3x3'}
 MODEL_DIR = Path(str(resources.files('ipomdp_gaze').joinpath('models')))
 # Counts per cell a file may tabulate (K); far above any detector's clipped count.
 MAX_K = 256
@@ -175,6 +176,10 @@ def _check_record(block: dict, key: str) -> None:
             check_record(block, RECORD_TYPES[key], key)
         if key == 'image' and block.get('camera') is not None:
             check_record(block['camera'], CAMERA_TYPES, 'image.camera')
+            try:                # the camera as a whole: its keys, K's zeros (here, not in use)
+                PinholeCamera.from_dict(block['camera'])
+            except ValueError as exc:
+                raise ValueError(f'image.camera: {exc}') from None
     except ValueError as exc:
         raise ObservationFileError(str(exc)) from None
 

@@ -155,6 +155,7 @@ RECORD_KINDS = {
     'pair': (lambda v: _list_of(_integer, v, 2), 'a [width, height] pair of integers'),
     'integers': (lambda v: _list_of(_integer, v), 'a list of integers'),
     'numbers': (lambda v: _list_of(_number, v), 'a list of numbers'),
+    'matrix3x3': (lambda v: _list_of(_number, v, 9), '9 numbers (a 3x3 matrix, row-major)'),
     'mapping': (lambda v: isinstance(v, dict), 'a mapping'),
     'mappings': (lambda v: _list_of(lambda x: isinstance(x, dict), v) and bool(v),
                  'a non-empty list of mappings'),

@@ -27,8 +27,12 @@ from dataclasses import dataclass
 import math
 
 from ipomdp_gaze.model.checks import finite as _finite
+from ipomdp_gaze.model.checks import is_number
 from ipomdp_gaze.model.grid import Grid
 import numpy as np
+
+# What a camera's K is (camera_info.k, an observation file's image.camera.K).
+K_WORDS = '9 finite numbers (the 3x3 camera matrix, row-major)'
 
 
 @dataclass(frozen=True)
@@ -75,13 +79,18 @@ class PinholeCamera:
         Raises
         ------
         ValueError
-            If K does not have 9 finite numbers with ``fx, fy > 0``, a zero skew and a last row
-            ``0 0 1``, or the size is not positive.
+            If K is not :data:`K_WORDS` with ``fx, fy > 0``, a zero skew and a last row ``0 0 1``,
+            or the size is not positive.
 
         """
-        values = [float(x) for x in k]
+        try:                                # a nested [[...], ...] or text is no K either
+            values = [float(x) if is_number(x) else math.nan for x in k]
+        except TypeError:
+            values = []
         if len(values) != 9 or not all(math.isfinite(x) for x in values):
-            raise ValueError(f'K must be 9 finite numbers, got {values}')
+            text = repr(k.tolist() if isinstance(k, np.ndarray) else k)
+            raise ValueError(f'K must be {K_WORDS}, got '
+                             f"{text if len(text) <= 60 else text[:57] + '...'}")
         if values[1] != 0 or values[3] != 0 or values[6:] != [0.0, 0.0, 1.0]:
             raise ValueError(f'K must be [fx, 0, cx, 0, fy, cy, 0, 0, 1], got {values}')
         return cls(width, height, values[0], values[4], values[2], values[5])
