@@ -13,6 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ipomdp_gaze.files.writable import write_text
+from ipomdp_gaze.model.checks import is_number
 import numpy as np
 import yaml
 
@@ -125,11 +126,6 @@ def yaml_kind(doc) -> str:
     return {list: 'a list'}.get(type(doc), f'a {type(doc).__name__}')
 
 
-def _number(value) -> bool:
-    return isinstance(value, (int, float, np.integer, np.floating)) and \
-        not isinstance(value, bool)
-
-
 def _integer(value) -> bool:
     return isinstance(value, (int, np.integer)) and not isinstance(value, bool)
 
@@ -145,7 +141,7 @@ RECORD_KINDS = {
     'text': (lambda v: isinstance(v, str), 'text'),
     'texts': (lambda v: isinstance(v, str) or (_list_of(lambda x: isinstance(x, str), v)
                                                and bool(v)), 'text or a list of text'),
-    'number': (_number, 'a number'),
+    'number': (is_number, 'a number'),
     'integer': (_integer, 'an integer'),
     'flag': (lambda v: isinstance(v, bool), 'true or false'),
     'flags': (lambda v: isinstance(v, bool) or _list_of(lambda x: isinstance(x, bool), v),
@@ -154,8 +150,8 @@ RECORD_KINDS = {
              'an integer or a [width, height] pair of integers'),
     'pair': (lambda v: _list_of(_integer, v, 2), 'a [width, height] pair of integers'),
     'integers': (lambda v: _list_of(_integer, v), 'a list of integers'),
-    'numbers': (lambda v: _list_of(_number, v), 'a list of numbers'),
-    'matrix3x3': (lambda v: _list_of(_number, v, 9), '9 numbers (a 3x3 matrix, row-major)'),
+    'numbers': (lambda v: _list_of(is_number, v), 'a list of numbers'),
+    'matrix3x3': (lambda v: _list_of(is_number, v, 9), '9 numbers (a 3x3 matrix, row-major)'),
     'mapping': (lambda v: isinstance(v, dict), 'a mapping'),
     'mappings': (lambda v: _list_of(lambda x: isinstance(x, dict), v) and bool(v),
                  'a non-empty list of mappings'),
