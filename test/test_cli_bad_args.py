@@ -282,3 +282,29 @@ def test_one_range_type_reads_every_bounded_number():
                         (record.split_limit(5.0, 's'), '5.5')):
         with pytest.raises(argparse.ArgumentTypeError):
             parse(text)
+
+
+@pytest.mark.parametrize('detector, option, message', [
+    ('haar', 'scale_factor=abc', "detector.scale_factor must be a number, got 'abc'"),
+    ('haar', "scale_factor='1.5'", "detector.scale_factor must be a number, got '1.5'"),
+    ('haar', 'min_neighbors=1.5', 'detector.min_neighbors must be an integer, got 1.5'),
+    ('haar', 'min_neighbors=true', 'detector.min_neighbors must be an integer, got True'),
+    ('haar', 'min_size_px=big', 'detector.min_size_px must be an integer or a [width, height] '
+     "pair of integers (or null), got 'big'"),
+    ('yunet', 'top_k=[5]', 'detector.top_k must be an integer, got [5]'),
+])
+def test_a_detector_option_of_the_wrong_type_is_refused_as_the_file_would_be(
+        tmp_path, cli_here, monkeypatch, detector, option, message):
+    """
+    The record check of the observation file was skipped for ``--detector-option``.
+
+    ``scale_factor=abc`` said ``could not convert string to float: 'abc'``, ``top_k=[5]`` a
+    TypeError's words, each in the detector's own words if at all; ``scale_factor='1.5'`` (text,
+    which the file check refuses) was taken as the number and the calibration began.
+    """
+    _began(monkeypatch, SCENES, PAN_TILT_TALLY)
+    for extra in ((), ('--pan-tilt', '--grid', '3x3')):
+        run = cli_here('calibrate', '--scenes', '1', '--out', 'x.yaml', '--detector', detector,
+                       '--detector-option', option, *extra, cwd=tmp_path)
+        assert _one_line(run, 'calibrate') == f'--detector-option: {message}'
+    assert not (tmp_path / 'x.yaml').exists()

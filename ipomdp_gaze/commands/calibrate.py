@@ -364,9 +364,14 @@ def _check_options(args) -> None:
 def _detector(args):
     """Return the detector's plain settings for the workers, and the detector built from them."""
     from ipomdp_gaze.vision.detector import detector_settings
-    from ipomdp_gaze.vision.detectors import (detector_from_settings, detector_from_spec,
-                                              parse_options)
+    from ipomdp_gaze.vision.detectors import (check_detector_record, detector_from_settings,
+                                              detector_from_spec, load_factory, parse_options)
     spec = {'kind': args.detector, **parse_options(args.detector_option)}
+    load_factory(args.detector)                     # an unknown --detector: its own line
+    try:            # the types of the record the model will hold, in the file check's words
+        check_detector_record(spec)
+    except ValueError as exc:
+        raise ValueError(f'--detector-option: {exc}') from None
     if args.detector == 'haar':
         spec.setdefault('scale_factor', args.scale_factor)
     elif args.scale_factor != 1.1:
