@@ -250,3 +250,27 @@ def test_a_split_bag_renamed_after_the_kill_still_finds_its_open_file(tmp_path):
     done = reindex(renamed)
     assert done.recovered
     assert [m.time_ns for m in read_bag(renamed).messages] == written
+
+
+@pytest.mark.parametrize('name, db3', [('bag_0.mcap', 'bag_0.db3'), ('bag.mcap', 'bag_0.db3')])
+def test_reindex_of_an_sqlite_bag_named_mcap_says_what_it_is_and_what_to_do(
+        tmp_path, cli_here, name, db3):
+    """It said only ``is not an MCAP file``: an SQLite rosbag2 file is no damaged MCAP one."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import get_typestore, Stores
+    bag = tmp_path / 'bag'
+    typestore = get_typestore(Stores.ROS2_JAZZY)
+    with Writer(bag, version=9, storage_plugin=StoragePlugin.SQLITE3) as writer:
+        connection = writer.add_connection('/note', 'std_msgs/msg/String', typestore=typestore)
+        writer.write(connection, 1, typestore.serialize_cdr(
+            typestore.types['std_msgs/msg/String'](data='x'), 'std_msgs/msg/String'))
+    (bag / 'metadata.yaml').unlink()
+    (bag / 'bag.db3').rename(bag / name)
+    before = {p.name: p.read_bytes() for p in bag.iterdir()}
+    run = cli_here('reindex', bag)
+    assert run.returncode == 2
+    assert run.stderr.strip().splitlines() == [
+        f'ipomdp-gaze reindex: error: {bag / name} is an SQLite database (sqlite3 storage), not '
+        f'an MCAP file: rename it {db3} and rebuild the metadata.yaml with `ros2 bag reindex '
+        f'{bag} -s sqlite3` (ipomdp-gaze reindex reads MCAP files); nothing was changed']
+    assert {p.name: p.read_bytes() for p in bag.iterdir()} == before

@@ -29,8 +29,8 @@ from pathlib import Path
 import re
 import shutil
 
-from ipomdp_gaze.files.bag_metadata import check_document, check_embedded, MCAP_MAGIC, \
-    StorageMismatch
+from ipomdp_gaze.files.bag_metadata import check_document, check_embedded, file_storage, \
+    MCAP_MAGIC, STORAGE_WORDS, StorageMismatch
 from ipomdp_gaze.files.writable import folder_writable, write_text
 import yaml
 
@@ -761,10 +761,16 @@ def reindex(path, force: bool = False) -> Reindexed:
     for file, _ in files:
         # a file that does not begin as MCAP is not a recording cut off: it would be replaced
         # by an empty recovered one
-        with open(file, 'rb') as f:
-            if f.read(len(MCAP_MAGIC)) != MCAP_MAGIC:
-                raise ValueError(f'{file} is not an MCAP file (it does not begin with the MCAP '
-                                 'magic); nothing was changed')
+        storage = file_storage(file)
+        if storage == 'sqlite3':        # rosbag2's other storage, named .mcap: rosbag2 reads it
+            db3 = file.stem if re.fullmatch(r'.+_\d+', file.stem) else f'{file.stem}_0'
+            raise ValueError(f'{file} is {STORAGE_WORDS[storage]}, not an MCAP file: rename it '
+                             f'{db3}.db3 and rebuild the metadata.yaml with `ros2 bag reindex '
+                             f'{path} -s sqlite3` (ipomdp-gaze reindex reads MCAP files); '
+                             'nothing was changed')
+        if storage != 'mcap':
+            raise ValueError(f'{file} is not an MCAP file (it does not begin with the MCAP '
+                             'magic); nothing was changed')
     infos, custom, recovered = [], {}, {}
     for file, name in files:
         info = _closed_metadata(file)
