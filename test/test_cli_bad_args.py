@@ -308,3 +308,32 @@ def test_a_detector_option_of_the_wrong_type_is_refused_as_the_file_would_be(
                        '--detector-option', option, *extra, cwd=tmp_path)
         assert _one_line(run, 'calibrate') == f'--detector-option: {message}'
     assert not (tmp_path / 'x.yaml').exists()
+
+
+DEMO_NODES = ('ipomdp_gaze.harness.demo.run_demo', 'ipomdp_gaze.harness.walk_demo.run_walk_demo')
+
+
+@pytest.mark.parametrize('argv', [
+    ['demo', '--seed', str(2 ** 31)],
+    ['demo', '--scene', 'faces', '--seed', str(2 ** 32)],
+    ['demo', '--scene', 'faces', '--fovea', '--seed', str(2 ** 31)],
+    ['demo', '--scene', 'faces', '--motion', 'walk', '--seed', str(2 ** 63 - 1)],
+])
+def test_a_demo_seed_beyond_the_nodes_parameter_is_refused_before_they_start(
+        tmp_path, cli_here, monkeypatch, argv):
+    """The nodes' seed is 0..2^31 - 1: a larger one started them, then a node refused it."""
+    _began(monkeypatch, *DEMO_NODES)
+    assert _one_line(cli_here(*argv, cwd=tmp_path), 'demo') == (
+        f'--seed {argv[-1]}: the nodes take a seed from 0 to 2^31 - 1 (2147483647)')
+
+
+@pytest.mark.parametrize('argv', [
+    ['demo', '--seed', str(2 ** 31 - 1)],
+    ['demo', '--scene', 'faces', '--faces', '2', '--seed', str(2 ** 63 - 1)],
+])
+def test_the_largest_node_seed_and_any_offline_room_seed_are_taken(tmp_path, cli_here,
+                                                                   monkeypatch, argv):
+    """The bound is inclusive, and --faces K runs offline, without the nodes' parameter."""
+    _began(monkeypatch, *DEMO_NODES, 'ipomdp_gaze.drivers.rooms.room_demo')
+    with pytest.raises(WorkBegan):
+        cli_here(*argv, cwd=tmp_path)

@@ -24,8 +24,8 @@ from ipomdp_gaze.model.wording import counted
 from ipomdp_gaze.vision.pan_tilt import parse_faces
 from ipomdp_gaze.vision.walks import DURATION_S as DEMO_DURATION_S
 
-from .common import check_output_file, nonneg_int, number_arg, output_file, positive_float, \
-    positive_int
+from .common import C_INT_MAX, check_output_file, nonneg_int, number_arg, output_file, \
+    positive_float, positive_int
 from .record import add_split_args
 
 # --motion walk: the walking speed unless --speed-deg-s says (the offline evaluation's default).
@@ -76,8 +76,8 @@ def add_parser(sub):
     p.add_argument('--policy', default=None,
                    help="the controller's policy.name (default: the YAML file's; elm for human)")
     p.add_argument('--seed', type=nonneg_int, default=0,
-                   help='seed of both nodes (the camera draws target and noise from it); with '
-                        '--scene faces, which held-out test scene')
+                   help='seed of both nodes, 0 to 2^31 - 1 (the camera draws target and noise '
+                        'from it); with --scene faces, which held-out test scene')
     p.add_argument('--target', default=None, metavar='ROW,COL',
                    help='where the camera hides the target (default: drawn from --seed, so '
                         'the same cell for the same seed: (9, 7) for seed 0)')
@@ -152,6 +152,10 @@ def run(args) -> int:
         if path is not None:
             check_output_file(flag, path)   # before the nodes run, not after
     faces = parse_faces(args.faces)
+    if args.seed > C_INT_MAX and (faces == (1, 1) or args.motion == 'walk'):
+        # a node refused it after the others started (a walk was then scored on no frame)
+        raise ValueError(f'--seed {args.seed}: the nodes take a seed from 0 to 2^31 - 1 '
+                         f'({C_INT_MAX})')
     if args.motion == 'walk':
         return _walk(args, faces, out)
     for flag, value in (('--speed-deg-s', args.speed_deg_s), ('--duration-s', args.duration_s)):
