@@ -421,3 +421,17 @@ def test_a_frame_scanned_whole_because_max_side_shrank_it_says_so(tmp_path, run_
             'size)\n' in result.stderr)
     whole = run_find(path, '--max-side', '0')
     assert 'scanned the whole frame once' in whole.stderr and 'resized it' not in whole.stderr
+
+
+def test_an_empty_folder_among_the_inputs_is_named(images, tmp_path, run_find):
+    """It was passed over in silence: the other image's line alone, as if it had been named."""
+    empty = tmp_path / 'empty'
+    empty.mkdir()
+    result = run_find(images['astronaut'], empty)
+    assert result.returncode == 0, result.stderr
+    assert re.findall(r'^(\S+): decision=', result.stdout, re.M) == [str(images['astronaut'])]
+    assert f'ipomdp-gaze find: {empty}: an empty folder, nothing in it searched' \
+        in result.stderr.splitlines()
+    alone = run_find(empty)
+    assert alone.returncode == 2 and alone.stderr.strip().splitlines() == [
+        f'ipomdp-gaze find: error: no image files in {empty}']

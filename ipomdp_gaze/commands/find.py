@@ -591,7 +591,8 @@ def expand_inputs(paths: list[str], skipped: list | None = None) -> list[str]:
     Each path as given; a folder becomes its image files (by suffix), sorted by name.
 
     ``skipped``, when given, gets ``(folder, names)`` for each folder with other files or
-    folders (not searched: a folder is not walked down). A folder that cannot be listed stays
+    folders (not searched: a folder is not walked down), and ``(folder, [])`` for an empty
+    one. A folder that cannot be listed stays
     as given, and :func:`read_image` reports it, as it does an entry that cannot be stat-ed:
     one line each, the other images still searched.
 
@@ -617,7 +618,7 @@ def expand_inputs(paths: list[str], skipped: list | None = None) -> list[str]:
                    if kinds[f] == 'file' and f.suffix.lower() in IMAGE_SUFFIXES)
         others = [f.name + '/' * (kinds[f] == 'folder') for f in entries
                   if not (kinds[f] == 'file' and f.suffix.lower() in IMAGE_SUFFIXES)]
-        if others and skipped is not None:
+        if (others or not entries) and skipped is not None:
             skipped.append((path, others))
     return out
 
@@ -1126,6 +1127,10 @@ def run(args) -> int:
     skipped = []
     images = expand_inputs(args.images, skipped)
     for folder, names in skipped:
+        if not names:           # alone: the error below says it
+            if images:
+                _note(f'{folder}: an empty folder, nothing in it searched')
+            continue
         files = sum(not name.endswith('/') for name in names)
         folders = len(names) - files
         what = ' and '.join(
