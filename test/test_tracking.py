@@ -132,7 +132,7 @@ def test_evaluate_motion_walk_writes_the_summary_per_searcher(tmp_path):
     (['--compare', 'sweep'], "unknown walk searcher 'sweep'"),
     (['--compare', 'track-last-detection:neighbors=0'], 'expected neighbors=N'),
     (['--compare', 'track-last-detection:neighbors=\u00b2'], 'expected neighbors=N'),
-    (['--walk-duration-s', '0'], 'the walk duration must be > 0 s'),
+    (['--walk-duration-s', '0'], 'the walk duration must be from 1 to 3600 s'),
     (['--faces', '2'], '--motion walk is for --scenes pan-tilt with one face'),
 ])
 def test_bad_walk_arguments_are_one_line(args, message, cli_here):
@@ -156,7 +156,16 @@ def test_a_walk_longer_than_the_scene_cameras_is_refused():
     """The scene camera's bound, an hour: evaluate ran a walk of 1e9 s for ever."""
     assert tracking.walk_spec(5.0, 'train', duration_s=3600.0).duration_s == 3600.0
     for duration_s in (3600.5, 1e9):
-        with pytest.raises(ValueError, match='the walk duration must be > 0 s and at most 3600 s'):
+        with pytest.raises(ValueError, match='the walk duration must be from 1 to 3600 s'):
+            tracking.walk_spec(5.0, 'train', duration_s=duration_s)
+
+
+def test_a_walk_shorter_than_the_scene_cameras_is_refused():
+    """Its bound, 1 s: evaluate scored a walk of 0.4 s on no frame ('in view nan')."""
+    assert tracking.walk_spec(5.0, 'train', duration_s=1.0).duration_s == 1.0
+    for duration_s in (0.99, 0.4, 1e-9):
+        with pytest.raises(ValueError, match=r'the walk duration must be from 1 to 3600 s \(as '
+                           r"the scene camera's scene.walk_duration_s\), got "):
             tracking.walk_spec(5.0, 'train', duration_s=duration_s)
 
 

@@ -97,7 +97,7 @@ def add_parser(sub):
                    help='--motion walk: walking speed in degrees per second, 0-20 (default '
                         f'{WALK_SPEED_DEG_S:g})')
     p.add_argument('--walk-duration-s', type=number_arg, default=None, metavar='S',
-                   help=f'--motion walk: seconds per walk, at most 3600 (default '
+                   help=f'--motion walk: seconds per walk, 1-3600 (default '
                         f'{WALK_DURATION_S:g})')
     p.add_argument('--scene-model', default='', metavar='FILE',
                    help='--scenes pan-tilt: another pan/tilt observation file (its camera is the '

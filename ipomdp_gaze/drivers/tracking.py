@@ -48,7 +48,9 @@ from ipomdp_gaze.vision.pan_tilt import SceneGeometry
 from ipomdp_gaze.vision.walks import check_speed, DURATION_S, WalkSceneSet
 import numpy as np
 
-# The longest walk evaluated, in seconds: the scene camera's bound on scene.walk_duration_s.
+# The shortest and longest walk evaluated, in seconds: the scene camera's bounds on
+# scene.walk_duration_s (a walk of 0.4 s had no frame to score: 'in view nan').
+MIN_DURATION_S = 1.0
 MAX_DURATION_S = 3600.0
 
 # The detector's time per 320x240 view on the clock (s): a constant, so that where the face is
@@ -344,10 +346,11 @@ def walk_spec(speed_deg_s: float, split: str = 'test', seed: int = 0,
     check_speed(speed_deg_s)
     if split not in ('train', 'test'):
         raise ValueError(f"split must be 'train' or 'test', got {split!r}")
-    if not (math.isfinite(duration_s) and 0 < duration_s <= MAX_DURATION_S):
-        # as the scene camera's scene.walk_duration_s: a walk of 1e9 s ran for ever
-        raise ValueError(f'the walk duration must be > 0 s and at most {MAX_DURATION_S:g} s (an '
-                         f'hour, as the scene camera), got {duration_s!r}')
+    if not (math.isfinite(duration_s) and MIN_DURATION_S <= duration_s <= MAX_DURATION_S):
+        # a walk of 1e9 s ran for ever
+        raise ValueError(f'the walk duration must be from {MIN_DURATION_S:g} to '
+                         f"{MAX_DURATION_S:g} s (as the scene camera's scene.walk_duration_s), "
+                         f'got {duration_s!r}')
     for name in compare:
         _baseline_kwargs(name)
         if list(compare).count(name) > 1:        # kept per label: its walks counted twice
