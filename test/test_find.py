@@ -226,7 +226,11 @@ def test_default_policy_is_the_shipped_kernel_of_the_model(task, tmp_path, monke
      'truncated or corrupt JPEG: OpenCV cannot decode it'),
     # 16-bit images are converted (test_find_truth.py); a float image is still refused.
     (lambda d: _png(d / 'deep.tiff', np.zeros((420, 420), dtype=np.float32)),
-     '32-bit float32 image; find needs 8 or 16 bits per channel'),
+     '32-bit float32 image; find needs unsigned 8 or 16 bits per channel'),
+    # signed: "16-bit int16 image; find needs 8 or 16 bits" said it was what find needs
+    (lambda d: _png(d / 'signed.tiff', np.zeros((420, 420), dtype=np.int16)),
+     '16-bit int16 image; find needs unsigned 8 or 16 bits per channel (uint8 or uint16: '
+     'convert it, e.g. to 8-bit PNG)'),
     (lambda d: _png(d / 'dot.png', np.zeros((1, 1), dtype=np.uint8)), 'too small'),
     # a link to itself: was a RuntimeError traceback (Path.resolve) before any image
     (lambda d: _link(d / 'loop.png', 'loop.png'), 'a symbolic link loop'),

@@ -444,8 +444,8 @@ def read_image(path: str, notes: list | None = None, max_side: int = 0,
                          f'by {(2 ** bits - 1) / 255:.4g})')
     if image.dtype != np.uint8:
         bits = 8 * image.dtype.itemsize
-        raise ValueError(f'{path}: {bits}-bit {image.dtype} image; find needs 8 or 16 bits '
-                         f'per channel (convert it, e.g. to 8-bit PNG)')
+        raise ValueError(f'{path}: {bits}-bit {image.dtype} image; find needs unsigned 8 or '
+                         f'16 bits per channel (uint8 or uint16: convert it, e.g. to 8-bit PNG)')
     if image.ndim == 3 and image.shape[2] == 1:
         image = image[:, :, 0]
     if size is not None:
