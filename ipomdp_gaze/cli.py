@@ -164,7 +164,17 @@ class _ReaderGone:
 
 
 TOO_LARGE = ('ipomdp-gaze {}: error: out of memory: the task is too large for this machine (a '
-             'smaller --grid or fewer --episodes)')
+             'smaller --grid or fewer {})')
+# The counts each command sizes its work by (train has no --episodes).
+TOO_LARGE_COUNTS = {'train': '--episodes-per-epoch, --eval-episodes or --final-episodes, or a '
+                             'shorter --horizon'}
+
+
+def too_large(command: str) -> str:
+    """The one line of a task too large for the machine, naming ``command``'s own counts."""
+    return TOO_LARGE.format(command, TOO_LARGE_COUNTS.get(command, '--episodes'))
+
+
 # numpy's refusals of an array too large to describe (a count such as --episodes 1e21 sizes
 # it), before any memory is asked for: the same task too large as a MemoryError.
 NUMPY_TOO_LARGE = ('Maximum allowed dimension exceeded',
@@ -202,12 +212,12 @@ def _run(args) -> int:
         return 0
     except (CliError, ValueError, OSError) as exc:
         if isinstance(exc, ValueError) and str(exc) in NUMPY_TOO_LARGE:
-            print(TOO_LARGE.format(args.command), file=sys.stderr)
+            print(too_large(args.command), file=sys.stderr)
         else:
             print(f'ipomdp-gaze {args.command}: error: {exc}', file=sys.stderr)
         return 2
     except MemoryError:
-        print(TOO_LARGE.format(args.command), file=sys.stderr)
+        print(too_large(args.command), file=sys.stderr)
         return 2
     except ModuleNotFoundError as exc:
         if not ros_module(exc.name):
