@@ -171,7 +171,7 @@ TOO_LARGE_COUNTS = {'train': '--episodes-per-epoch, --eval-episodes or --final-e
 
 
 def too_large(command: str) -> str:
-    """The one line of a task too large for the machine, naming ``command``'s own counts."""
+    """Return the line of a task too large for the machine, naming ``command``'s own counts."""
     return TOO_LARGE.format(command, TOO_LARGE_COUNTS.get(command, '--episodes'))
 
 

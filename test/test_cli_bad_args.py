@@ -153,7 +153,7 @@ def test_a_count_too_large_for_numpy_is_the_task_too_large(cli_here, flag, value
 
 
 def test_a_training_task_too_large_names_trains_own_counts(cli_here, tmp_path):
-    """train has no --episodes: its line named that flag (``fewer --episodes``)."""
+    """The train command has no --episodes: its line named that flag (``fewer --episodes``)."""
     run = cli_here('train', '--grid', '3x3', '--horizon', str(2 ** 62), '--epochs', '1',
                    '--out', 'p.yaml', '--quiet', cwd=tmp_path)
     assert _one_line(run, 'train') == (
