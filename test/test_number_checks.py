@@ -8,6 +8,7 @@ from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head_camera import PinholeCamera
 from ipomdp_gaze.model.motion import Motion, VelocityMotion
 from ipomdp_gaze.model.occupancy import prior_log_odds
+from ipomdp_gaze.model.position_filter import PositionFilter, walk_filter
 from ipomdp_gaze.model.stopping import first_decisions, initial_log_belief
 from ipomdp_gaze.search.session import SearchSettings
 import numpy as np
@@ -32,6 +33,11 @@ CALLS = [
     (lambda v: prior_log_odds(9, v), 'q'),
     (lambda v: PinholeCamera(4, 4, v, 1.0, 1.5, 1.5), 'camera fx'),
     (lambda v: PinholeCamera.from_fov(4, 4, v), 'hfov_deg'),
+    (lambda v: PositionFilter(v, 0.1), 'measurement_sigma_cells'),
+    (lambda v: PositionFilter(0.5, v), 'accel_density'),
+    (lambda v: PositionFilter(0.5, 0.1, sigma_cells=v), 'sigma_cells'),
+    (lambda v: walk_filter(0.5, v), 'turn_prob'),
+    (lambda v: walk_filter(0.5, 0.3, speed_cells=v), 'speed_cells'),
 ]
 
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 import sys
 
+from ipomdp_gaze.model.checks import check_number
 import numpy as np
 
 # The filter's lengths (cells) are scaled down together so the largest is at most this: its
@@ -65,7 +66,9 @@ def walk_filter(measurement_sigma_cells: float, turn_prob: float, sigma_cells: f
     The velocity's random walk is ``q = 2 turn_prob speed_cells^2`` (docs/design.md section
     12.9); ``q`` and every variance are of the scaled lengths, so any finite lengths work.
     """
-    lengths = [float(measurement_sigma_cells), float(sigma_cells), float(speed_cells)]
+    lengths = [check_number(measurement_sigma_cells, 'measurement_sigma_cells'),
+               check_number(sigma_cells, 'sigma_cells'), check_number(speed_cells, 'speed_cells')]
+    turn_prob = check_number(turn_prob, 'turn_prob')
     largest = max(lengths)
     if math.isfinite(largest) and largest > MAX_LENGTH_CELLS:
         lengths = [length / largest * MAX_LENGTH_CELLS for length in lengths]
@@ -97,6 +100,11 @@ class PositionFilter:
 
     def __init__(self, measurement_sigma_cells: float, accel_density: float,
                  sigma_cells: float = 0.0, speed_cells: float = 0.0):
+        measurement_sigma_cells, accel_density, sigma_cells, speed_cells = (
+            check_number(value, name) for value, name in (
+                (measurement_sigma_cells, 'measurement_sigma_cells'),
+                (accel_density, 'accel_density'), (sigma_cells, 'sigma_cells'),
+                (speed_cells, 'speed_cells')))
         if not measurement_sigma_cells > 0:
             raise ValueError(f'measurement_sigma_cells must be > 0, got '
                              f'{measurement_sigma_cells!r}')
