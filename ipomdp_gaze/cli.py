@@ -185,8 +185,8 @@ NUMPY_TOO_LARGE = ('Maximum allowed dimension exceeded',
 # The Python packages of ROS 2 a command may import (rclpy and the message packages): without
 # them a ROS command says how to install them in one line instead of an import traceback.
 ROS_MISSING = ('ipomdp-gaze {}: error: this command needs ROS 2 Jazzy (No module named {!r}): '
-               "pip install 'ipomdp_gaze[ros]' (rclpy with Fast DDS and the common messages) "
-               'into this environment, or source a ROS 2 Jazzy install')
+               'pip install "ros-jazzy-rclpy[fastrtps]" ros-jazzy-common-interfaces (the ros '
+               'extra of setup.py) into this environment, or source a ROS 2 Jazzy install')
 
 
 def ros_module(name: str | None) -> bool:

@@ -43,7 +43,7 @@ def test_a_ros_demo_without_ros_says_what_to_install_in_one_line():
     assert len(lines) == 1 and 'Traceback' not in run.stderr, run.stderr
     assert lines[0].startswith('ipomdp-gaze demo: error: this command needs ROS 2 Jazzy (No '
                                "module named '")
-    assert "pip install 'ipomdp_gaze[ros]'" in lines[0]
+    assert 'pip install "ros-jazzy-rclpy[fastrtps]" ros-jazzy-common-interfaces' in lines[0]
 
 
 def test_the_offline_room_demo_runs_without_ros():
