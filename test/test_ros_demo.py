@@ -60,3 +60,16 @@ def test_demo_finds_the_target_and_stops_both_nodes(ros_env, options, grid_line)
     assert f'hid the target at ({hidden}): that is right' in out
     assert 'stopped both nodes (camera exit status 0, controller exit status 0)' in out
     assert node_processes(domain) == []
+
+
+def test_a_demo_timeout_too_short_for_the_nodes_names_it(ros_env):
+    """No node comes up in a millisecond: the line said only 'did not come up in time'."""
+    domain = int(ros_env['ROS_DOMAIN_ID'])
+    run = subprocess.run(
+        [sys.executable, '-m', 'ipomdp_gaze.cli', 'demo', '--domain-id', str(domain),
+         '--timeout', '0.001'], cwd=REPO, env=ros_env, capture_output=True, text=True,
+        timeout=180)
+    assert run.returncode != 0
+    assert "ipomdp-gaze demo: error: gaze_controller did not come up within the demo's " \
+        '--timeout of 0.001 s' in run.stderr, run.stderr
+    assert node_processes(domain) == []                   # and the one it started is stopped

@@ -379,7 +379,8 @@ def run_demo(setup: DemoSetup, timeout_s: float = 60.0, domain_id: int | None = 
                 proc.start()
                 ready = _started(watch, record_, proc.node)
                 if proc is not procs[-1] and ready is not None and not wait(ready):
-                    raise RuntimeError(f'{proc.name} did not come up in time')
+                    raise RuntimeError(f"{proc.name} did not come up within the demo's "
+                                       f'--timeout of {timeout_s:g} s')
             if recorder is not None or pictures is not None:
                 started = _restart_heard(setup, watch, recorder, wait,
                                          [record_.beliefs, record_.targets, record_.found,

@@ -169,9 +169,11 @@ def run_walk_demo(setup, camera, duration_s: float = DURATION_S, timeout_s: floa
                 proc.start()
                 wait = ready.get(proc.node)
                 if wait is not None and not watch.wait_until(wait, timeout_s, POLL_S):
-                    raise RuntimeError(f'{proc.name} did not come up in time')
+                    raise RuntimeError(f"{proc.name} did not come up within the demo's "
+                                       f'--timeout of {timeout_s:g} s')
             if not watch.wait_until(lambda: bool(truths), timeout_s, POLL_S):
-                raise RuntimeError('the scene camera sent no frame in time')
+                raise RuntimeError(f"the scene camera sent no frame within the demo's "
+                                   f'--timeout of {timeout_s:g} s')
             out(f'the walk has started: following it for {duration_s:g} s of the camera clock')
             walked = watch.wait_until(walk_over, duration_s + timeout_s, POLL_S)
             if not walked:
