@@ -210,6 +210,21 @@ def test_config_takes_numpy_numbers():
     assert trainer.epoch == 1 and np.all(np.isfinite(trainer.params))
 
 
+def _resumed_with(tmp_path, capsys, key, value, final_episodes: int) -> tuple:
+    """Train 2 epochs, set ``training.<key>`` in the file, resume; return (file, stderr)."""
+    import yaml
+    out = tmp_path / 'p.yaml'
+    common = ['--eval-every', '2', '--eval-episodes', '50', '--final-episodes',
+              str(final_episodes), '--quiet']
+    assert main(['train', '--grid', '3x3', '--epochs', '2', '--out', str(out)] + common) == 0
+    capsys.readouterr()
+    doc = yaml.safe_load(out.read_text())
+    doc['training'][key] = value
+    out.write_text(yaml.safe_dump(doc))
+    assert main(['train', '--resume', str(out), '--epochs', '4'] + common) == 2
+    return out, capsys.readouterr().err
+
+
 @pytest.mark.parametrize('key, value, message', [
     ('beta', 'x', "training.beta must be in [0, 1), got 'x'"),
     ('episodes_per_epoch', 2.5,
@@ -221,16 +236,8 @@ def test_config_takes_numpy_numbers():
 ])
 def test_resume_from_a_bad_training_setting_is_one_line(tmp_path, capsys, key, value, message):
     """QA: beta: x and 2.5 episodes were tracebacks, seed: -3 numpy's line without the file."""
-    import yaml
-    out = tmp_path / 'p.yaml'
-    common = ['--eval-every', '2', '--eval-episodes', '50', '--final-episodes', '0', '--quiet']
-    assert main(['train', '--grid', '3x3', '--epochs', '2', '--out', str(out)] + common) == 0
-    capsys.readouterr()
-    doc = yaml.safe_load(out.read_text())
-    doc['training'][key] = value
-    out.write_text(yaml.safe_dump(doc))
-    assert main(['train', '--resume', str(out), '--epochs', '4'] + common) == 2
-    [line] = capsys.readouterr().err.strip().splitlines()
+    out, err = _resumed_with(tmp_path, capsys, key, value, 0)
+    [line] = err.strip().splitlines()
     assert line == f'ipomdp-gaze train: error: {out}: {message}'
 
 
@@ -394,16 +401,7 @@ def test_a_resumed_training_refuses_settings_other_than_its_own(tmp_path, capsys
 @pytest.mark.parametrize('key', ['epochs', 'wall_seconds'])
 def test_resume_from_a_file_whose_count_is_null_is_one_line(tmp_path, capsys, key):
     # QA: training.epochs: null loaded, then train --resume raised int(None)'s TypeError.
-    import yaml
-    out = tmp_path / 'p.yaml'
-    common = ['--eval-every', '2', '--eval-episodes', '50', '--final-episodes', '100', '--quiet']
-    assert main(['train', '--grid', '3x3', '--epochs', '2', '--out', str(out)] + common) == 0
-    capsys.readouterr()
-    doc = yaml.safe_load(out.read_text())
-    doc['training'][key] = None
-    out.write_text(yaml.safe_dump(doc))
-    assert main(['train', '--resume', str(out), '--epochs', '4'] + common) == 2
-    err = capsys.readouterr().err
+    _, err = _resumed_with(tmp_path, capsys, key, None, 100)
     kind = 'a whole number' if key == 'epochs' else 'a number'
     assert err.strip().splitlines()[-1].endswith(f'training.{key} must be {kind} >= 0, got None')
 
