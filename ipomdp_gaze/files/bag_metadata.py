@@ -14,6 +14,8 @@ from __future__ import annotations
 
 from pathlib import Path, PurePath
 
+from ipomdp_gaze.model.checks import short_repr
+
 INFO = 'rosbag2_bagfile_information'
 MAX_VERSION = 9                     # the newest rosbag2 metadata version rosbags reads
 STORAGES = ('mcap', 'sqlite3')      # the storage plugins of the rosbags reader
@@ -54,7 +56,7 @@ class _Keys:
 
     def mapping(self, value, key: str) -> dict:
         if not isinstance(value, dict):
-            self.fail(key, f'must be a mapping, got {_shown(value)}')
+            self.fail(key, f'must be a mapping, got {short_repr(value)}')
         return value
 
     def get(self, mapping: dict, key: str, at: str, kind: str, required: bool = True):
@@ -73,7 +75,7 @@ class _Keys:
         if not checks[kind](value):
             wanted = {'integer': 'an integer, 0 or more', 'text': 'text',
                       'mapping': 'a mapping', 'list': 'a list'}[kind]
-            self.fail(name, f'must be {wanted}, got {_shown(value)}')
+            self.fail(name, f'must be {wanted}, got {short_repr(value)}')
         return value
 
     def nanoseconds(self, mapping: dict, key: str, at: str, field: str) -> int:
@@ -83,11 +85,6 @@ class _Keys:
 
 def _is_count(value) -> bool:
     return isinstance(value, int) and not isinstance(value, bool) and value >= 0
-
-
-def _shown(value) -> str:
-    text = repr(value)
-    return text if len(text) <= 40 else text[:37] + '...'
 
 
 def check_document(doc, meta: Path, folder: Path) -> dict:
@@ -107,10 +104,10 @@ def check_document(doc, meta: Path, folder: Path) -> dict:
     keys = _Keys(str(meta))
     if not isinstance(doc, dict):
         raise ValueError(f'{meta} is not rosbag2 metadata: a mapping with the key {INFO} '
-                         f'expected, got {_shown(doc)}')
+                         f'expected, got {short_repr(doc)}')
     if INFO not in doc:
         raise ValueError(f'{meta} is not rosbag2 metadata: the key {INFO} is missing (its '
-                         f"keys: {_shown(', '.join(map(str, doc)) or 'none')})")
+                         f"keys: {short_repr(', '.join(map(str, doc)) or 'none')})")
     info = keys.mapping(doc[INFO], INFO)
     check_info(info, keys, require_files=False)
     paths = keys.get(info, 'relative_file_paths', INFO, 'list')
@@ -119,7 +116,7 @@ def check_document(doc, meta: Path, folder: Path) -> dict:
     for i, name in enumerate(paths):
         if not isinstance(name, str) or not name:
             keys.fail(f'{INFO}.relative_file_paths[{i}]', f'must be a file name, got '
-                      f'{_shown(name)}')
+                      f'{short_repr(name)}')
         file = folder / PurePath(name).name
         if not file.is_file():
             raise ValueError(f'{meta} lists the file {name}, which is not in {folder}')
@@ -144,15 +141,15 @@ def check_info(info: dict, keys: _Keys, require_files: bool, at: str = INFO) -> 
     storage = keys.get(info, 'storage_identifier', at, 'text')
     if storage not in STORAGES:
         keys.fail(f'{at}.storage_identifier', f"must be one of {', '.join(STORAGES)}, got "
-                  f'{_shown(storage)}')
+                  f'{short_repr(storage)}')
     mode = keys.get(info, 'compression_mode', at, 'text', required=False) or ''
     if mode.lower() not in COMPRESSION_MODES:
         keys.fail(f'{at}.compression_mode', f"must be one of {', '.join(COMPRESSION_MODES[1:])} "
-                  f'or empty, got {_shown(mode)}')
+                  f'or empty, got {short_repr(mode)}')
     compression = keys.get(info, 'compression_format', at, 'text', required=False) or ''
     if mode.lower() not in ('', 'none') and compression != 'zstd':
         keys.fail(f'{at}.compression_format', f'must be zstd (the one compression this reader '
-                  f'reads) with compression_mode {mode}, got {_shown(compression)}')
+                  f'reads) with compression_mode {mode}, got {short_repr(compression)}')
     keys.get(info, 'message_count', at, 'integer')
     keys.nanoseconds(info, 'duration', at, 'nanoseconds')
     keys.nanoseconds(info, 'starting_time', at, 'nanoseconds_since_epoch')
@@ -166,7 +163,7 @@ def check_info(info: dict, keys: _Keys, require_files: bool, at: str = INFO) -> 
             keys.get(topic, key, f'{where}.topic_metadata', 'text')
         if topic['serialization_format'] != 'cdr':
             keys.fail(f'{where}.topic_metadata.serialization_format', 'must be cdr (the one '
-                      f"this reader reads), got {_shown(topic['serialization_format'])}")
+                      f"this reader reads), got {short_repr(topic['serialization_format'])}")
     files = keys.get(info, 'files', at, 'list', required=require_files) or []
     for i, entry in enumerate(files):
         where = f'{at}.files[{i}]'
@@ -179,8 +176,8 @@ def check_info(info: dict, keys: _Keys, require_files: bool, at: str = INFO) -> 
     custom = keys.get(info, 'custom_data', at, 'mapping', required=False) or {}
     for key, value in custom.items():
         if not isinstance(key, str) or not isinstance(value, str):
-            keys.fail(f'{at}.custom_data', f'must map text to text, got {_shown(key)}: '
-                      f'{_shown(value)}')
+            keys.fail(f'{at}.custom_data', f'must map text to text, got {short_repr(key)}: '
+                      f'{short_repr(value)}')
 
 
 def check_embedded(info, file: Path) -> bool:

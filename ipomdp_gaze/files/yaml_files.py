@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ipomdp_gaze.files.writable import write_text
-from ipomdp_gaze.model.checks import is_number
+from ipomdp_gaze.model.checks import is_number, short_repr
 import numpy as np
 import yaml
 
@@ -158,11 +158,6 @@ RECORD_KINDS = {
 }
 
 
-def _shown(value) -> str:
-    text = repr(value)
-    return text if len(text) <= 40 else text[:37] + '...'
-
-
 def check_record(record, types: dict, at: str) -> dict:
     """
     Check the YAML types of a record of a file (``detector``, ``fovea``): one line if wrong.
@@ -182,14 +177,15 @@ def check_record(record, types: dict, at: str) -> dict:
         raise ValueError(f'{at} must be a mapping, got {yaml_kind(record)}')
     for key, value in record.items():
         if not isinstance(key, str):
-            raise ValueError(f'{at} must map names (text) to values, got the key {_shown(key)}')
+            raise ValueError(f'{at} must map names (text) to values, got the key '
+                             f'{short_repr(key)}')
         kind = types.get(key)
         if kind is None or (kind.endswith('?') and value is None):
             continue
         test, words = RECORD_KINDS[kind.rstrip('?')]
         if not test(value):
             null = ' (or null)' if kind.endswith('?') else ''
-            raise ValueError(f'{at}.{key} must be {words}{null}, got {_shown(value)}')
+            raise ValueError(f'{at}.{key} must be {words}{null}, got {short_repr(value)}')
     return record
 
 

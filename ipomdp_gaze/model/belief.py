@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 
+from ipomdp_gaze.model.checks import short_repr
 import numpy as np
 
 TIE_RTOL = 1e-9
@@ -133,12 +134,6 @@ def map_cell(belief: np.ndarray) -> np.ndarray:
     return argmax_ties_low(belief)
 
 
-def _short(value, limit: int = 40) -> str:
-    """Return ``repr(value)`` cut to ``limit`` characters, for a one-line message."""
-    text = repr(value)
-    return text if len(text) <= limit else text[:limit - 3] + '...'
-
-
 def check_prior(prior, n_cells: int, shape: tuple[int, int] | None = None) -> np.ndarray:
     """
     Return a prior over the target's cell as a float array (N,) summing to 1.
@@ -153,7 +148,7 @@ def check_prior(prior, n_cells: int, shape: tuple[int, int] | None = None) -> np
         values = None
     if values is None or values.dtype.kind not in 'iuf':    # no text ('0.5'), no true/false
         raise ValueError(f'prior must be numbers, one per cell, got {type(prior).__name__} '
-                         f'{_short(prior)}')
+                         f'{short_repr(prior)}')
     if values.ndim == 2 and shape is not None and values.shape != tuple(shape):
         raise ValueError(f'prior must be (rows, cols) = {tuple(shape)} or ({n_cells},), got shape '
                          f'{values.shape}')

@@ -23,6 +23,12 @@ def _is_bool(value) -> bool:
     return isinstance(value, (bool, np.bool_))
 
 
+def short_repr(value, limit: int = 40) -> str:
+    """Return ``repr(value)`` cut to ``limit`` characters, for a one-line message."""
+    text = repr(value)
+    return text if len(text) <= limit else text[:limit - 3] + '...'
+
+
 def is_number(value) -> bool:
     """Whether ``value`` is a real number (numpy's too): no bool, no text such as ``'0.5'``."""
     return isinstance(value, numbers.Real) and not _is_bool(value)

@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 from typing import Callable
 
-from ipomdp_gaze.model.checks import check_number
+from ipomdp_gaze.model.checks import check_number, short_repr
 from ipomdp_gaze.model.grid import Grid
 import numpy as np
 from scipy.special import log_ndtr, ndtr, ndtri
@@ -39,9 +39,7 @@ def _numbers(name: str, values) -> np.ndarray:
     except (TypeError, ValueError):         # ragged rows
         array = np.array([''])
     if array.dtype.kind not in 'iuf':
-        text = repr(values)
-        raise ValueError(f'{name} must be a list of numbers, got '
-                         f"{text if len(text) <= 40 else text[:37] + '...'}")
+        raise ValueError(f'{name} must be a list of numbers, got {short_repr(values)}')
     return array.astype(float).ravel()
 
 

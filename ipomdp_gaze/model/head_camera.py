@@ -26,8 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 
-from ipomdp_gaze.model.checks import finite as _finite
-from ipomdp_gaze.model.checks import is_number
+from ipomdp_gaze.model.checks import finite as _finite, is_number, short_repr
 from ipomdp_gaze.model.grid import Grid
 import numpy as np
 
@@ -88,9 +87,8 @@ class PinholeCamera:
         except TypeError:
             values = []
         if len(values) != 9 or not all(math.isfinite(x) for x in values):
-            text = repr(k.tolist() if isinstance(k, np.ndarray) else k)
             raise ValueError(f'K must be {K_WORDS}, got '
-                             f"{text if len(text) <= 60 else text[:57] + '...'}")
+                             f'{short_repr(k.tolist() if isinstance(k, np.ndarray) else k, 60)}')
         if values[1] != 0 or values[3] != 0 or values[6:] != [0.0, 0.0, 1.0]:
             raise ValueError(f'K must be [fx, 0, cx, 0, fy, cy, 0, 0, 1], got {values}')
         return cls(width, height, values[0], values[4], values[2], values[5])

@@ -23,6 +23,7 @@ from typing import Callable, Mapping
 
 from ipomdp_gaze.files.observation_file import load_observation
 from ipomdp_gaze.model.belief import prior_from_weights
+from ipomdp_gaze.model.checks import short_repr
 from ipomdp_gaze.model.fpoc import make_fpoc, parameter_names
 from ipomdp_gaze.model.grid import Grid
 from ipomdp_gaze.model.head import PanTiltMap
@@ -124,7 +125,7 @@ def prior_from(values: Mapping, grid: Grid):
         weights = np.asarray(list(weights), dtype=float)
     except (TypeError, ValueError):
         raise ValueError(f'belief.prior must be numbers, one weight per cell, got '
-                         f'{_shown(weights)}') from None
+                         f'{short_repr(weights)}') from None
     if weights.ndim != 1 or weights.size != grid.n_cells:
         raise ValueError(f'belief.prior must hold one weight per cell, {grid.n_cells} values '
                          f'for a {grid.rows}x{grid.cols} grid (row-major; none: uniform), got '
@@ -133,12 +134,6 @@ def prior_from(values: Mapping, grid: Grid):
         return prior_from_weights(weights, grid.shape)
     except ValueError as exc:
         raise ValueError(f'belief.prior {exc}') from None
-
-
-def _shown(value) -> str:
-    """Return ``repr(value)`` cut to 40 characters, for a one-line message."""
-    text = repr(value)
-    return text if len(text) <= 40 else text[:37] + '...'
 
 
 def observation_from(values: Mapping, grid: Grid, fpoc):
